@@ -1,0 +1,36 @@
+# Two entry points (see README): `make run` opens the TUI on the default
+# scenario, `make test` runs the whole suite. Both set up what they need once.
+PYTHON ?= python3
+VENV := .venv
+STAMP := $(VENV)/.installed
+export PYTHONDONTWRITEBYTECODE := 1
+
+.PHONY: run test bench setup system-deps
+
+run: setup
+	$(VENV)/bin/ladartui
+
+test: setup
+	$(VENV)/bin/python -m pytest -q
+
+bench: setup
+	$(VENV)/bin/ladartui bench
+
+setup: system-deps $(STAMP)
+
+# The wgpu backend runs on Mesa's lavapipe where there is no GPU.
+system-deps:
+	@if ! dpkg -s mesa-vulkan-drivers >/dev/null 2>&1; then \
+	  if [ "$$(id -u)" = 0 ]; then \
+	    echo "installing mesa-vulkan-drivers (lavapipe) ..."; \
+	    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq mesa-vulkan-drivers >/dev/null; \
+	  else \
+	    echo "note: mesa-vulkan-drivers is missing; run 'sudo apt-get install mesa-vulkan-drivers' for the wgpu backend"; \
+	  fi; \
+	fi
+
+$(STAMP): pyproject.toml
+	test -x $(VENV)/bin/python || $(PYTHON) -m venv $(VENV)
+	$(VENV)/bin/python -m pip install -q --disable-pip-version-check "pip==25.3" "setuptools==80.9.0"
+	$(VENV)/bin/python -m pip install -q --disable-pip-version-check -e ".[test]"
+	touch $(STAMP)

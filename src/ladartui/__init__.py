@@ -1,0 +1,45 @@
+"""ladartui: plan airborne foliage-penetrating LADAR collections.
+
+The public API is importable from here; submodules load on first use so that
+``import ladartui`` stays fast and never pulls in the terminal UI.
+"""
+
+import importlib
+
+__version__ = "0.1.0"
+
+_EXPORTS = {
+    "LadarError": "ladartui.errors",
+    "Cancelled": "ladartui.errors",
+    "load_voxels": "ladartui.scene.voxels",
+    "save_voxels": "ladartui.scene.voxels",
+    "generate_scene": "ladartui.scene.generate",
+    "Scene": "ladartui.scene.model",
+    "Occupancy": "ladartui.scene.occupancy",
+    "ScanPose": "ladartui.flight",
+    "FlightPlan": "ladartui.flight",
+    "straight": "ladartui.flight",
+    "turn": "ladartui.flight",
+    "orbit": "ladartui.flight",
+    "flypast": "ladartui.flight",
+    "standoff_sweep": "ladartui.flight",
+    "aim_at": "ladartui.flight",
+    "path_length": "ladartui.flight",
+    "Sensor": "ladartui.sensor",
+    "Scenario": "ladartui.scenario",
+    "load_scenario": "ladartui.scenario",
+    "trace": "ladartui.trace",
+    "simulate": "ladartui.simulate",
+    "compute_measures": "ladartui.measures",
+}
+
+__all__ = sorted(_EXPORTS) + ["__version__"]
+
+
+def __getattr__(name):
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'ladartui' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value

@@ -1,0 +1,3 @@
+from ladartui.cli import main
+
+raise SystemExit(main())

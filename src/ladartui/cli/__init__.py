@@ -1,0 +1,73 @@
+"""The headless command line: ``ladartui COMMAND ...``; with no command, the TUI.
+
+Each command is a module in this package with ``add_parser(subparsers)`` that
+registers itself (``parser.set_defaults(handler=run)``). User mistakes become
+one line on stderr and exit status 2; no traceback reaches the user.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from ladartui import __version__
+from ladartui.errors import Cancelled, LadarError
+
+# Command name -> module under ladartui.cli. Modules load only when needed.
+COMMANDS = {
+    "run": "run",
+    "trace": "trace",
+    "generate": "generate",
+    "info": "info",
+    "validate": "validate",
+    "bench": "bench",
+    "study": "study",
+    "sweep": "sweep",
+    "tui": "tui",
+}
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):
+        # One line naming the flag, no usage dump: the user asked for -h if they want it.
+        self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} -h')\n")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(
+        prog="ladartui",
+        description="Plan airborne foliage-penetrating LADAR collections. "
+        "With no command, opens the terminal UI on the default scenario.",
+    )
+    parser.add_argument("--version", action="version", version=f"ladartui {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    for name, module in COMMANDS.items():
+        try:
+            mod = importlib.import_module(f"ladartui.cli.{module}")
+        except ModuleNotFoundError as error:
+            if error.name == f"ladartui.cli.{module}":
+                continue  # command not built yet
+            raise
+        mod.add_parser(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    argv = list(sys.argv[1:] if argv is None else argv)
+    # `ladartui` and `ladartui SCENARIO.toml` open the TUI.
+    if not argv or (argv[0] not in COMMANDS and not argv[0].startswith("-")):
+        argv = ["tui", *argv]
+    parser = build_parser()
+    try:
+        args = parser.parse_args(argv)
+        if getattr(args, "handler", None) is None:
+            parser.print_help()
+            return 2
+        return int(args.handler(args) or 0)
+    except LadarError as error:
+        print(f"ladartui: error: {error}", file=sys.stderr)
+        return 2
+    except (Cancelled, KeyboardInterrupt):
+        print("ladartui: cancelled; earlier outputs are unchanged", file=sys.stderr)
+        return 130

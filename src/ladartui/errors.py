@@ -1,0 +1,34 @@
+"""User-facing errors: one line naming the file, line or field and what was expected."""
+
+
+class LadarError(Exception):
+    """A mistake in user input (file, scenario field, flag). Shown as one line, no traceback."""
+
+
+class InputFileError(LadarError):
+    """A bad or missing input file; the message starts with ``path:line:`` where known."""
+
+    def __init__(self, path, message, line=None):
+        self.path = str(path)
+        self.line = line
+        where = f"{self.path}:{line}" if line is not None else self.path
+        super().__init__(f"{where}: {message}")
+
+
+class FieldError(LadarError):
+    """A scenario, form or flag field outside its allowed values."""
+
+    def __init__(self, field, value, expected, source=None):
+        self.field = field
+        self.value = value
+        self.expected = expected
+        prefix = f"{source}: " if source else ""
+        super().__init__(f"{prefix}{field} = {value!r}: expected {expected}")
+
+
+class Cancelled(Exception):
+    """A run stopped by its cancel event; nothing was written."""
+
+
+class BackendUnavailable(LadarError):
+    """A tracing backend that cannot run here, with the reason and what to install."""

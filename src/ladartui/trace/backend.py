@@ -1,0 +1,101 @@
+"""The tracing backend protocol and registry.
+
+A backend traces rays in *cell space* (voxel (i, j, k) spans [i, i+1) on each
+axis, see docs/architecture.md) against an ``Occupancy``. ``ladartui.trace``
+converts metres to cells and back, so backends never see the voxel size.
+Backends are probed lazily: an unavailable one explains why only when asked.
+"""
+
+from __future__ import annotations
+
+import threading
+from dataclasses import dataclass, field
+from typing import Callable, Protocol
+
+import numpy as np
+
+from ladartui.errors import BackendUnavailable, FieldError
+
+MISS, VOXEL, GROUND = 0, 1, 2
+METHODS = ("exact", "march")
+
+
+@dataclass
+class CellHits:
+    """Per-ray answers in cell space: kind (u8), index (N, 3) i32, t in cell units."""
+
+    kind: np.ndarray
+    index: np.ndarray
+    t: np.ndarray
+    info: dict = field(default_factory=dict)
+
+
+class Backend(Protocol):
+    name: str
+    summary: str
+
+    def probe(self) -> str | None:
+        """None when usable here, else one line: why not and what to install."""
+
+    def describe(self) -> dict:
+        """What runs the work (threads, adapter name/type/backend), for reports."""
+
+    def trace_cells(self, occupancy, origins, directions, *, method="exact", step=0.5,
+                    precision="f64", cancel: threading.Event | None = None) -> CellHits:
+        """Trace (N, 3) float64 cell-space origins and unit directions."""
+
+
+_FACTORIES: dict[str, Callable[[], Backend]] = {}
+_INSTANCES: dict[str, Backend] = {}
+_lock = threading.Lock()
+
+
+def register_backend(name: str, factory: Callable[[], Backend]) -> None:
+    _FACTORIES[name] = factory
+
+
+def backend_names() -> list[str]:
+    _load_builtin()
+    return list(_FACTORIES)
+
+
+def get_backend(name: str) -> Backend:
+    """The usable backend ``name``; raises BackendUnavailable with the reason."""
+    _load_builtin()
+    if name not in _FACTORIES:
+        raise FieldError("backend", name, "one of " + ", ".join(["auto", *_FACTORIES]))
+    with _lock:
+        if name not in _INSTANCES:
+            _INSTANCES[name] = _FACTORIES[name]()
+    backend = _INSTANCES[name]
+    reason = backend.probe()
+    if reason:
+        raise BackendUnavailable(f"backend {name!r} is unavailable: {reason}")
+    return backend
+
+
+def backend_status() -> dict[str, str | None]:
+    """Each registered backend's probe answer (None = available)."""
+    status = {}
+    for name in backend_names():
+        try:
+            get_backend(name)
+            status[name] = None
+        except BackendUnavailable as error:
+            status[name] = str(error)
+    return status
+
+
+def _load_builtin() -> None:
+    # Importing a backend module registers it; the modules themselves import
+    # their heavy dependencies lazily so this stays cheap.
+    if _FACTORIES:
+        return
+    import importlib
+
+    for module in ("ladartui.trace.numba_backend", "ladartui.trace.wgpu_backend"):
+        try:
+            importlib.import_module(module)
+        except ModuleNotFoundError as error:
+            if error.name != module:
+                raise
