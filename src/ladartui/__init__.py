@@ -1,7 +1,10 @@
 """ladartui: plan airborne foliage-penetrating LADAR collections.
 
 The public API is importable from here; submodules load on first use so that
-``import ladartui`` stays fast and never pulls in the terminal UI.
+``import ladartui`` stays fast and never pulls in the terminal UI. Function
+names never equal module names (``trace`` lives in ``ladartui.tracing``,
+``simulate`` in ``ladartui.simulation``) so a submodule import cannot shadow
+an exported function.
 """
 
 import importlib
@@ -28,9 +31,11 @@ _EXPORTS = {
     "Sensor": "ladartui.sensor",
     "Scenario": "ladartui.scenario",
     "load_scenario": "ladartui.scenario",
-    "trace": "ladartui.trace",
-    "simulate": "ladartui.simulate",
+    "trace": "ladartui.tracing",
+    "simulate": "ladartui.simulation",
     "compute_measures": "ladartui.measures",
+    "TraceResult": "ladartui.tracing",
+    "SimulationResult": "ladartui.simulation",
 }
 
 __all__ = sorted(_EXPORTS) + ["__version__"]

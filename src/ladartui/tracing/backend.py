@@ -93,7 +93,7 @@ def _load_builtin() -> None:
         return
     import importlib
 
-    for module in ("ladartui.trace.numba_backend", "ladartui.trace.wgpu_backend"):
+    for module in ("ladartui.tracing.numba_backend", "ladartui.tracing.wgpu_backend"):
         try:
             importlib.import_module(module)
         except ModuleNotFoundError as error:
