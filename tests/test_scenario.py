@@ -1,0 +1,412 @@
+"""Scenario files: TOML round trips, field limits, unknown keys, model files (report 4.1)."""
+
+import math
+import textwrap
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ladartui.errors import FieldError, InputFileError
+from ladartui.flight import FlightPlan, FlyPast, Manual, Orbit, ScanPose, Standoff, Straight, Turn
+from ladartui.scenario import Scenario, load_scenario, scenario_from_toml
+from ladartui.sensor import Sensor
+
+PROJECT = Path(__file__).resolve().parents[1]
+
+BASE = textwrap.dedent("""\
+    [files]
+    scene = "models/forest.txt"
+    voxel_size = 0.5
+
+    [sensor]
+    grid = 32
+    ray_grid = 2
+    fov_deg = 12.0
+    depth_resolution_m = 1.5
+    pixel_pitch_um = 100.0
+
+    [flight]
+    speed_mps = 25.0
+
+    [flight.start]
+    x = 0.0
+    y = -100.0
+    z = 80.0
+    heading = 0.0
+    azimuth = 0.0
+    depression = 45.0
+
+    [[flight.segments]]
+    kind = "straight"
+    distance = 50.0
+    scans = 2
+
+    [[flight.segments]]
+    kind = "orbit"
+    centre = [10.0, 10.0, 1.0]
+    radius = 60.0
+    altitude = 60.0
+    scans = 8
+
+    [simulation]
+    backend = "auto"
+    method = "march"
+    step = 0.25
+    precision = "f32"
+    fast_mode = true
+    """)
+
+
+def write_models(folder, stem="forest", target=((1, 1, 0), (2, 1, 0), (1, 2, 1))):
+    folder.mkdir(parents=True, exist_ok=True)
+    scene = folder / f"{stem}.txt"
+    scene.write_text("".join(f"{x},{y},{z}\n" for x, y, z in [(5, 5, 3), *target]))
+    (folder / f"{stem}_Target.txt").write_text("".join(f"{x},{y},{z}\n" for x, y, z in target))
+    return scene
+
+
+def write_scenario(tmp_path, text=BASE, name="case.toml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def edited(key_line, new_line, text=BASE):
+    assert key_line in text, key_line
+    return text.replace(key_line, new_line, 1)
+
+
+def line_of(text, fragment):
+    return next(i for i, line in enumerate(text.splitlines(), start=1) if fragment in line)
+
+
+def full_scenario(path, scene_file):
+    start = ScanPose(-50.0, -50.0, 70.0, heading=45.0, azimuth=10.0, depression=40.0)
+    plan = FlightPlan(start, [
+        Straight(40.0, 2),
+        Turn(30.0, 120.0, "left", 3, depression=60.0),
+        Manual([ScanPose(1.5, 2.25, 90.0, 10.0, -20.0, 75.0), ScanPose(3.0, 4.0, 95.0)]),
+        Orbit((10.0, 12.0, 1.0), 55.5, 65.0, 7, direction="left", start_bearing=33.3, arc=270.0),
+        FlyPast((10.0, 12.0), 40.0, 50.0, 100.0, 5, heading=123.4, side="left"),
+        Standoff((10.0, 12.0, 0.5), [90.0, 60.0, 30.0], 55.0, bearing=300.0, heading=10.0,
+                 aim_at=(11.0, 13.0, 0.0)),
+        Straight(10.0, 1, aim_at=(10.0, 12.0, 0.0)),
+    ])
+    return Scenario(path, scene_file, 0.3, Sensor(48, 3, 7.5, 0.75, 37e-6), plan, speed=22.5,
+                    backend="numba", method="march", step=0.3, fast_mode=True, precision="f32")
+
+
+# -- round trips ---------------------------------------------------------------------
+
+
+def test_round_trip_every_segment_kind(tmp_path):
+    scene = write_models(tmp_path / "models")
+    scenario = full_scenario(tmp_path / "s.toml", scene)
+    scenario.save()
+    loaded = load_scenario(tmp_path / "s.toml")
+    assert loaded == scenario
+    assert loaded.poses() == scenario.poses()
+    first_text = (tmp_path / "s.toml").read_text()
+    loaded.save()
+    assert (tmp_path / "s.toml").read_text() == first_text
+    assert load_scenario(tmp_path / "s.toml") == scenario
+    assert 'scene = "models/forest.txt"' in first_text  # relative to the scenario's folder
+    assert "pixel_pitch_um = 37.0" in first_text
+    assert "centre = [10.0, 12.0, 1.0]" in first_text  # points on one line
+
+
+def test_round_trip_of_the_base_text(tmp_path):
+    write_models(tmp_path / "models")
+    scenario = load_scenario(write_scenario(tmp_path))
+    assert scenario.sensor == Sensor(32, 2, 12.0, 1.5, 100e-6)
+    assert (scenario.speed, scenario.method, scenario.step) == (25.0, "march", 0.25)
+    assert (scenario.precision, scenario.fast_mode, scenario.voxel_size) == ("f32", True, 0.5)
+    assert len(scenario.poses()) == 10
+    saved = scenario.save(tmp_path / "copy.toml")
+    assert saved.path == tmp_path / "copy.toml"
+    assert load_scenario(tmp_path / "copy.toml") == saved == scenario.with_changes(
+        path=tmp_path / "copy.toml")
+
+
+def test_paths_resolve_against_the_scenario_folder(tmp_path):
+    scene = write_models(tmp_path / "models")
+    scenario = load_scenario(write_scenario(tmp_path))
+    assert scenario.scene_file == scene
+    assert scenario.target_file == tmp_path / "models" / "forest_Target.txt"
+    assert scenario.scene_output == tmp_path / "case_Scene.txt"
+    assert scenario.target_output == tmp_path / "case_Target.txt"
+    assert scenario.measures_file == tmp_path / "case.cmf"
+    # Saved elsewhere, the scene stays the same file, written relative to the new folder.
+    moved = scenario.save(tmp_path / "runs" / "later.toml")
+    assert 'scene = "../models/forest.txt"' in moved.path.read_text()
+    assert load_scenario(moved.path).scene_file == scene
+    assert moved.measures_file == tmp_path / "runs" / "later.cmf"
+
+
+def test_absolute_scene_path_kept_when_nothing_in_common(tmp_path):
+    scenario = load_scenario(write_scenario(tmp_path, edited(
+        'scene = "models/forest.txt"', 'scene = "/opt/elsewhere/x.txt"')), check_files=False)
+    assert scenario.scene_file == Path("/opt/elsewhere/x.txt")
+    assert scenario.target_file == Path("/opt/elsewhere/x_Target.txt")
+    assert scenario.to_dict()["files"]["scene"] == "/opt/elsewhere/x.txt"
+
+
+# -- missing model files (report 4.1) ------------------------------------------------
+
+
+def test_missing_scene_model_is_named(tmp_path):
+    path = write_scenario(tmp_path)
+    with pytest.raises(InputFileError) as caught:
+        load_scenario(path)
+    scene = tmp_path / "models" / "forest.txt"
+    assert str(caught.value) == f"{path}:2: scene model file {scene} not found (files.scene)"
+    assert load_scenario(path, check_files=False).scene_file == scene
+
+
+def test_missing_target_model_is_named(tmp_path):
+    write_models(tmp_path / "models")
+    (tmp_path / "models" / "forest_Target.txt").unlink()
+    path = write_scenario(tmp_path)
+    with pytest.raises(InputFileError) as caught:
+        load_scenario(path)
+    target = tmp_path / "models" / "forest_Target.txt"
+    assert str(caught.value) == (f"{path}:2: target model file {target} not found (the target "
+                                 "model of forest.txt must sit beside it, named forest_Target.txt)")
+
+
+def test_missing_scenario_file(tmp_path):
+    with pytest.raises(InputFileError) as caught:
+        load_scenario(tmp_path / "nope.toml")
+    assert str(caught.value) == f"{tmp_path / 'nope.toml'}: scenario file not found"
+
+
+# -- field limits ----------------------------------------------------------------------
+
+LIMITS = [
+    ("voxel_size = 0.5", "voxel_size = 0", "files.voxel_size = 0",
+     "a number greater than 0 and at most 100"),
+    ("voxel_size = 0.5", "voxel_size = 250.0", "files.voxel_size = 250.0",
+     "a number greater than 0 and at most 100"),
+    ('scene = "models/forest.txt"', "scene = 3", "files.scene = 3",
+     "the scene model file name (X.txt)"),
+    ("grid = 32", "grid = 2000", "sensor.grid = 2000", "an integer from 1 to 1024"),
+    ("grid = 32", "grid = 32.5", "sensor.grid = 32.5", "an integer from 1 to 1024"),
+    ("ray_grid = 2", "ray_grid = 0", "sensor.ray_grid = 0", "an integer from 1 to 16"),
+    ("fov_deg = 12.0", "fov_deg = 90.0", "sensor.fov_deg = 90.0",
+     "a number greater than 0 and less than 90"),
+    ("fov_deg = 12.0", 'fov_deg = "wide"', "sensor.fov_deg = 'wide'",
+     "a number greater than 0 and less than 90"),
+    ("depth_resolution_m = 1.5", "depth_resolution_m = -1", "sensor.depth_resolution_m = -1",
+     "a number from 0 to 1000"),
+    ("pixel_pitch_um = 100.0", "pixel_pitch_um = 0", "sensor.pixel_pitch_um = 0",
+     "a number greater than 0 and at most 10000"),
+    ("pixel_pitch_um = 100.0", "pixel_pitch_um = 20000.0", "sensor.pixel_pitch_um = 20000.0",
+     "a number greater than 0 and at most 10000"),
+    ("pixel_pitch_um = 100.0", "pixel_pitch_um = true", "sensor.pixel_pitch_um = True",
+     "a number greater than 0 and at most 10000"),
+    ("speed_mps = 25.0", "speed_mps = 0.0", "flight.speed_mps = 0.0",
+     "a number greater than 0 and at most 1000"),
+    ("depression = 45.0", "depression = 0.0", "flight.start.depression = 0.0",
+     "a number from 1 to 90"),
+    ("z = 80.0", "z = -5.0", "flight.start.z = -5.0",
+     "a number greater than 0 and at most 100000"),
+    ("distance = 50.0", "distance = 0.0", "flight.segments[0].distance = 0.0",
+     "a number greater than 0 and at most 1000000"),
+    ("scans = 8", "scans = 0", "flight.segments[1].scans = 0", "an integer from 1 to 10000"),
+    ("radius = 60.0", "radius = -60.0", "flight.segments[1].radius = -60.0",
+     "a number greater than 0 and at most 1000000"),
+    ("centre = [10.0, 10.0, 1.0]", "centre = [10.0]", "flight.segments[1].centre = [10.0]",
+     "a point [x, y] or [x, y, z] in metres, each within +-1000000"),
+    ('kind = "orbit"', 'kind = "circle"', "flight.segments[1].kind = 'circle'",
+     "one of 'manual', 'straight', 'turn', 'orbit', 'flypast', 'standoff'"),
+    ('method = "march"', 'method = "fast"', "simulation.method = 'fast'",
+     "one of 'exact', 'march'"),
+    ("step = 0.25", "step = 0", "simulation.step = 0", "a number greater than 0 and at most 10"),
+    ('precision = "f32"', 'precision = "f16"', "simulation.precision = 'f16'",
+     "one of 'f64', 'f32'"),
+    ("fast_mode = true", "fast_mode = 1", "simulation.fast_mode = 1", "true or false"),
+]
+
+
+@pytest.mark.parametrize("old,new,head,expected", LIMITS, ids=[row[2] for row in LIMITS])
+def test_every_field_limit_names_file_line_field_value_and_range(tmp_path, old, new, head,
+                                                                 expected):
+    text = edited(old, new)
+    path = write_scenario(tmp_path, text)
+    with pytest.raises(FieldError) as caught:
+        load_scenario(path, check_files=False)
+    line = line_of(text, new)
+    assert str(caught.value) == f"{path}:{line}: {head}: expected {expected}"
+
+
+def test_backend_must_be_known(tmp_path):
+    path = write_scenario(tmp_path, edited('backend = "auto"', 'backend = "cuda"'))
+    with pytest.raises(FieldError) as caught:
+        load_scenario(path, check_files=False)
+    message = str(caught.value)
+    assert message.startswith(f"{path}:{line_of(BASE, 'backend')}: simulation.backend = 'cuda': "
+                              "expected one of 'auto', ")
+
+
+def test_aim_above_the_horizon_names_the_segment(tmp_path):
+    text = edited("scans = 2\n", "scans = 2\naim_at = [0.0, 5000.0, 0.0]\n")
+    path = write_scenario(tmp_path, text)
+    with pytest.raises(FieldError) as caught:
+        load_scenario(path, check_files=False)
+    assert caught.value.field == "flight.segments[0].aim_at"
+    assert str(caught.value).startswith(f"{path}:{line_of(text, 'aim_at')}: ")
+
+
+def test_relative_segment_first_needs_a_start(tmp_path):
+    start = BASE[BASE.index("[flight.start]"):BASE.index("[[flight.segments]]")]
+    path = write_scenario(tmp_path, BASE.replace(start, ""))
+    with pytest.raises(FieldError) as caught:
+        load_scenario(path, check_files=False)
+    assert caught.value.field == "flight.start"
+
+
+# -- unknown and missing keys, syntax ------------------------------------------------
+
+
+@pytest.mark.parametrize("old,new,message", [
+    ("grid = 32", "gird = 32", "unknown key 'sensor.gird' (allowed: grid, ray_grid, fov_deg, "
+     "depth_resolution_m, pixel_pitch_um)"),
+    ("radius = 60.0", "raduis = 60.0", "unknown key 'flight.segments[1].raduis' (orbit segment) "
+     "(allowed: kind, centre, radius, altitude, scans, direction, start_bearing, arc, aim_at)"),
+    ("[simulation]", "[simulatoin]", "unknown section [simulatoin] "
+     "(allowed: files, sensor, flight, simulation)"),
+    ("heading = 0.0", "headin = 0.0", "unknown key 'flight.start.headin' "
+     "(allowed: x, y, z, heading, azimuth, depression)"),
+])
+def test_unknown_keys_are_named_with_their_line(tmp_path, old, new, message):
+    text = edited(old, new)
+    path = write_scenario(tmp_path, text)
+    with pytest.raises(InputFileError) as caught:
+        load_scenario(path, check_files=False)
+    assert str(caught.value) == f"{path}:{line_of(text, new)}: {message}"
+
+
+def test_missing_keys(tmp_path):
+    path = write_scenario(tmp_path, edited('scene = "models/forest.txt"\n', ""))
+    with pytest.raises(InputFileError) as caught:
+        load_scenario(path, check_files=False)
+    assert str(caught.value) == f"{path}:1: missing key 'files.scene'"
+    text = edited("radius = 60.0\n", "")
+    path = write_scenario(tmp_path, text)
+    with pytest.raises(InputFileError) as caught:
+        load_scenario(path, check_files=False)
+    header = line_of(text, 'kind = "orbit"') - 1
+    assert str(caught.value) == (f"{path}:{header}: missing key "
+                                 "'flight.segments[1].radius' (orbit segment)")
+
+
+def test_toml_syntax_error_gives_the_line(tmp_path):
+    text = edited("grid = 32", "grid = = 32")
+    path = write_scenario(tmp_path, text)
+    with pytest.raises(InputFileError) as caught:
+        load_scenario(path, check_files=False)
+    assert caught.value.line == line_of(text, "grid = = 32")
+    assert str(caught.value).startswith(f"{path}:{caught.value.line}: not valid TOML: ")
+
+
+# -- API -----------------------------------------------------------------------------
+
+
+def test_with_changes_checks_fields(tmp_path):
+    write_models(tmp_path / "models")
+    scenario = load_scenario(write_scenario(tmp_path))
+    faster = scenario.with_changes(speed=50.0)
+    assert faster.flight_time() == pytest.approx(scenario.flight_time() / 2)
+    with pytest.raises(FieldError) as caught:
+        scenario.with_changes(speed=-1)
+    assert str(caught.value) == ("flight.speed_mps = -1: expected a number greater than 0 "
+                                 "and at most 1000")
+    with pytest.raises(FieldError) as caught:
+        scenario.with_changes(flight=FlightPlan(None, []))
+    assert caught.value.field == "flight.segments"
+
+
+def test_load_scene_reads_both_models(tmp_path):
+    pytest.importorskip("ladartui.scene.model")
+    write_models(tmp_path / "models")
+    scene = load_scenario(write_scenario(tmp_path)).load_scene()
+    assert len(scene.voxels) == 4 and len(scene.target) == 3
+    assert scene.voxel_size == 0.5
+
+
+def test_new_scenario_orbits_the_target_centre(tmp_path):
+    pytest.importorskip("ladartui.scene.voxels")
+    target = ((10, 20, 0), (12, 20, 0), (10, 24, 2), (12, 24, 2))
+    scene = write_models(tmp_path, "woods", target)
+    scenario = Scenario.new(tmp_path / "new.toml", "woods.txt", 0.5)
+    centre = np.mean(target, axis=0) * 0.5  # (5.5, 11, 0.5)
+    for pose in scenario.poses():
+        assert math.dist((pose.x, pose.y), centre[:2]) == pytest.approx(
+            scenario.flight.segments[0].radius)
+    assert scenario.scene_file == scene
+    saved = scenario.save()
+    assert load_scenario(saved.path) == scenario
+
+
+def test_summary_describes_the_collection(tmp_path):
+    write_models(tmp_path / "models")
+    scenario = load_scenario(write_scenario(tmp_path))
+    text = scenario.summary()
+    assert "10 scans: straight (2), orbit (8)" in text
+    assert f"{scenario.path_length():.1f} m" in text
+    assert "32x32 detectors, 2x2 rays each" in text
+    assert f"{32 * 32 * 4 * 10:,} in all" in text
+    assert "case_Scene.txt, case_Target.txt, case.cmf" in text
+
+
+@pytest.mark.parametrize("name", ["orbit", "flypast", "standoff", "manoeuvres"])
+def test_example_scenarios_are_valid(name):
+    example = PROJECT / "scenarios" / f"{name}.toml"
+    scenario = load_scenario(example, check_files=False)
+    assert scenario.scene_file == PROJECT / "scenarios" / "generated" / "small.txt"
+    assert len(scenario.poses()) >= 4
+    assert "ladartui generate small scenarios/generated/small" in example.read_text()
+
+
+def test_validate_command(tmp_path, capsys):
+    from ladartui.cli import main
+
+    write_models(tmp_path / "models")
+    good = write_scenario(tmp_path)
+    assert main(["validate", str(good)]) == 0
+    assert "10 scans" in capsys.readouterr().out
+    bad = write_scenario(tmp_path, edited("grid = 32", "grid = 0"), name="bad.toml")
+    assert main(["validate", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert err == (f"ladartui: error: {bad}:{line_of(BASE, 'grid = 32')}: sensor.grid = 0: "
+                   "expected an integer from 1 to 1024\n")
+
+
+def test_text_parses_like_a_file(tmp_path):
+    scenario = scenario_from_toml(BASE, tmp_path / "x.toml")
+    assert scenario.path == tmp_path / "x.toml"
+    assert scenario.flight.segments[1] == Orbit((10.0, 10.0, 1.0), 60.0, 60.0, 8)
+
+
+def test_round_trip_of_arbitrary_values(tmp_path):
+    hypothesis = pytest.importorskip("hypothesis")
+    st = hypothesis.strategies
+    metres = st.floats(-5000, 5000, allow_nan=False)
+    positive = st.floats(0.01, 5000, allow_nan=False)
+
+    @hypothesis.settings(max_examples=25, deadline=None)
+    @hypothesis.given(centre=st.tuples(metres, metres, st.floats(0, 30)), radius=positive,
+                      altitude=st.floats(500, 5000), scans=st.integers(1, 12),
+                      bearing=st.floats(0, 359.9), fov=st.floats(0.01, 89.9),
+                      pitch_um=st.floats(0.5, 5000), depth=st.floats(0, 100),
+                      voxel=st.floats(0.01, 100))
+    def check(centre, radius, altitude, scans, bearing, fov, pitch_um, depth, voxel):
+        plan = FlightPlan(None, [Orbit(centre, radius, altitude, scans, start_bearing=bearing)])
+        scenario = Scenario(tmp_path / "s.toml", "x.txt", voxel,
+                            Sensor(16, 2, fov, depth, pitch_um / 1e6), plan)
+        again = scenario_from_toml(scenario.to_toml(), scenario.path)
+        assert again == scenario
+        assert again.to_toml() == scenario.to_toml()
+
+    check()

@@ -1,0 +1,188 @@
+"""Sensor rays (report section 7.2, equations 1 and 2, figure 14)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from ladartui.errors import FieldError
+from ladartui.flight import ScanPose
+from ladartui.sensor import Sensor
+
+
+def report_rx(depression):
+    """Equation (1), typed from the report: rotation about x by 90 - D."""
+    a = math.radians(90.0 - depression)
+    return np.array([[1, 0, 0], [0, math.cos(a), -math.sin(a)], [0, math.sin(a), math.cos(a)]])
+
+
+def report_rz(heading, azimuth):
+    """Equation (2), typed from the report: rotation about z by -(H + A)."""
+    a = math.radians(-(heading + azimuth))
+    return np.array([[math.cos(a), -math.sin(a), 0], [math.sin(a), math.cos(a), 0], [0, 0, 1]])
+
+
+def down_looking_rays(n, m, fov, pitch):
+    """Rays at the origin, one by one: detector row-major, then sub-rows, sub-columns."""
+    side = n * m
+    step = fov / side
+    origins, directions, detectors = [], [], []
+    for r in range(n):
+        for c in range(n):
+            for i in range(m):
+                for j in range(m):
+                    kx, ky = c * m + j, r * m + i
+                    ax = -fov / 2 + (kx + 0.5) * step  # column 0 on the left (-x)
+                    ay = fov / 2 - (ky + 0.5) * step   # row 0 at the top (+y)
+                    d = np.array([math.tan(math.radians(ax)), math.tan(math.radians(ay)), -1.0])
+                    directions.append(d / np.linalg.norm(d))
+                    origins.append([(kx + 0.5 - side / 2) * pitch / m,
+                                    (side / 2 - ky - 0.5) * pitch / m, 0.0])
+                    detectors.append(r * n + c)
+    return np.array(origins), np.array(directions), np.array(detectors)
+
+
+def test_figure_14_case_matches_the_report_rotations():
+    sensor = Sensor(grid=3, ray_grid=2, fov=45.0, pixel_pitch=100e-6)
+    pose = ScanPose(100.0, -50.0, 300.0, heading=20.0, azimuth=40.0, depression=60.0)
+    origins, directions, detector = sensor.rays(pose)
+    assert origins.shape == directions.shape == (36, 3)
+    assert origins.dtype == directions.dtype == np.float64 and detector.dtype == np.int32
+
+    local_o, local_d, local_det = down_looking_rays(3, 2, 45.0, 100e-6)
+    rotation = report_rz(20.0, 40.0) @ report_rx(60.0)
+    expected_d = np.array([rotation @ d for d in local_d])
+    expected_o = np.array([rotation @ o + (100.0, -50.0, 300.0) for o in local_o])
+    np.testing.assert_allclose(directions, expected_d, atol=1e-12)
+    np.testing.assert_allclose(origins, expected_o, atol=1e-9)
+    np.testing.assert_array_equal(detector, local_det)
+    assert list(detector) == [d for d in range(9) for _ in range(4)]  # contiguous, row-major
+
+
+def test_nadir_points_straight_down():
+    sensor = Sensor(grid=4, ray_grid=2, fov=20.0)
+    pose = ScanPose(0, 0, 100, heading=37.0, azimuth=0.0, depression=90.0)
+    origin, direction = sensor.central_ray(pose)
+    np.testing.assert_allclose(direction, [0, 0, -1], atol=1e-15)
+    _, directions, _ = sensor.rays(pose)
+    np.testing.assert_allclose(directions.mean(axis=0)[:2], [0, 0], atol=1e-12)
+    assert (directions[:, 2] < 0).all()
+
+
+@pytest.mark.parametrize("heading,azimuth,expected", [
+    (0.0, 0.0, (0.0, 0.5, -math.sqrt(3) / 2)),     # north and down
+    (90.0, 0.0, (0.5, 0.0, -math.sqrt(3) / 2)),    # east
+    (30.0, 60.0, (0.5, 0.0, -math.sqrt(3) / 2)),   # H + A = 90: east
+    (0.0, -90.0, (-0.5, 0.0, -math.sqrt(3) / 2)),  # west
+    (180.0, 0.0, (0.0, -0.5, -math.sqrt(3) / 2)),  # south
+])
+def test_central_ray_directions(heading, azimuth, expected):
+    sensor = Sensor(grid=8, ray_grid=1, fov=10.0)
+    pose = ScanPose(1.0, 2.0, 50.0, heading=heading, azimuth=azimuth, depression=60.0)
+    origin, direction = sensor.central_ray(pose)
+    np.testing.assert_allclose(origin, (1.0, 2.0, 50.0))
+    np.testing.assert_allclose(direction, expected, atol=1e-12)
+    # An odd-free grid has no ray on the axis; the mean of all rays still is.
+    _, directions, _ = sensor.rays(pose)
+    mean = directions.mean(axis=0)
+    np.testing.assert_allclose(mean / np.linalg.norm(mean), expected, atol=1e-9)
+
+
+def ground_points(origins, directions):
+    t = -origins[:, 2] / directions[:, 2]
+    return origins + t[:, None] * directions
+
+
+def test_row_zero_is_the_far_edge_and_column_zero_the_left():
+    n, m = 6, 3
+    sensor = Sensor(grid=n, ray_grid=m, fov=30.0)
+    pose = ScanPose(0.0, 0.0, 100.0, heading=0.0, depression=60.0)  # looking north
+    origins, directions, detector = sensor.rays(pose)
+    ground = ground_points(origins, directions)
+    centre = np.array([ground[detector == d].mean(axis=0) for d in range(n * n)])
+    grid_y = centre[:, 1].reshape(n, n)
+    grid_x = centre[:, 0].reshape(n, n)
+    assert (np.diff(grid_y, axis=0) < 0).all()  # later rows are nearer (further south)
+    assert (np.diff(grid_x, axis=1) > 0).all()  # later columns are further east (right)
+
+
+def test_rays_are_equally_spaced_in_angle_and_do_not_cross():
+    n, m, fov = 5, 4, 20.0
+    sensor = Sensor(grid=n, ray_grid=m, fov=fov, pixel_pitch=1e-3)
+    origins, directions, _ = sensor.rays(ScanPose(0.0, 0.0, 10.0, depression=90.0))
+    side = n * m
+    # Put rays back on the (row, column) grid of the whole view.
+    order = np.arange(side * side).reshape(n, n, m, m).transpose(0, 2, 1, 3).ravel()
+    d = directions[order].reshape(side, side, 3)
+    o = origins[order].reshape(side, side, 3)
+    angle_x = np.degrees(np.arctan2(d[..., 0], -d[..., 2]))
+    angle_y = np.degrees(np.arctan2(d[..., 1], -d[..., 2]))
+    step = fov / side
+    np.testing.assert_allclose(np.diff(angle_x, axis=1), step, atol=1e-9)
+    np.testing.assert_allclose(np.diff(angle_y, axis=0), -step, atol=1e-9)
+    assert angle_x[0, 0] == pytest.approx(-fov / 2 + step / 2)
+    np.testing.assert_allclose(np.linalg.norm(directions, axis=1), 1.0)
+    # Origins on the focal plane, pitch / m apart, spanning n pitches.
+    np.testing.assert_allclose(np.diff(o[..., 0], axis=1), 1e-3 / m)
+    np.testing.assert_allclose(np.diff(o[..., 1], axis=0), -1e-3 / m)
+    assert o[..., 0].max() - o[..., 0].min() == pytest.approx((side - 1) * 1e-3 / m)
+    # Not crossing: order on the ground is the order on the focal plane.
+    ground = ground_points(origins[order], directions[order]).reshape(side, side, 3)
+    assert (np.diff(ground[..., 0], axis=1) > 0).all()
+    assert (np.diff(ground[..., 1], axis=0) < 0).all()
+
+
+def test_row_chunks_are_slices_of_the_whole_scan():
+    sensor = Sensor(grid=7, ray_grid=3, fov=12.0)
+    pose = ScanPose(3.0, 4.0, 60.0, heading=200.0, azimuth=-30.0, depression=35.0)
+    whole = sensor.rays(pose)
+    per_row = 7 * 9
+    for rows in (slice(0, 2), slice(2, 7), range(6, 7)):
+        part = sensor.rays(pose, rows=rows)
+        start, stop = rows.start * per_row, rows.stop * per_row
+        for got, full in zip(part, whole):
+            np.testing.assert_array_equal(got, full[start:stop])
+
+
+def test_footprint_at_nadir_and_tilted():
+    sensor = Sensor(grid=16, ray_grid=1, fov=20.0)
+    corners = sensor.footprint(ScanPose(10.0, 20.0, 100.0, depression=90.0))
+    half = 100.0 * math.tan(math.radians(10.0))
+    np.testing.assert_allclose(corners, [[10 - half, 20 + half, 0], [10 + half, 20 + half, 0],
+                                         [10 + half, 20 - half, 0], [10 - half, 20 - half, 0]])
+    tilted = sensor.footprint(ScanPose(0.0, 0.0, 100.0, depression=45.0), ground_z=5.0)
+    assert (tilted[:, 2] == 5.0).all()
+    assert tilted[0, 1] > tilted[3, 1] > 0  # far edge beyond the near edge, both ahead
+    # Far edge: centre line at 45 - 10 = 35 degrees below horizontal (projected angles).
+    assert np.mean(tilted[:2, 1]) > 95.0 / math.tan(math.radians(35.0)) - 1e-9
+    above = sensor.footprint(ScanPose(0.0, 0.0, 100.0, depression=5.0))
+    assert np.isnan(above[:2]).all() and np.isfinite(above[2:]).all()
+
+
+@pytest.mark.parametrize("field,value,message", [
+    ("grid", 0, "grid = 0: expected an integer from 1 to 1024"),
+    ("grid", 1025, "grid = 1025: expected an integer from 1 to 1024"),
+    ("grid", 64.0, "grid = 64.0: expected an integer from 1 to 1024"),
+    ("grid", True, "grid = True: expected an integer from 1 to 1024"),
+    ("ray_grid", 17, "ray_grid = 17: expected an integer from 1 to 16"),
+    ("ray_grid", 0, "ray_grid = 0: expected an integer from 1 to 16"),
+    ("fov", 0, "fov = 0: expected a number greater than 0 and less than 90"),
+    ("fov", 90, "fov = 90: expected a number greater than 0 and less than 90"),
+    ("depth_resolution", -0.1, "depth_resolution = -0.1: expected a number from 0 to 1000"),
+    ("depth_resolution", 1001, "depth_resolution = 1001: expected a number from 0 to 1000"),
+    ("pixel_pitch", 0.0,
+     "pixel_pitch = 0.0: expected a number greater than 0 and at most 0.01"),
+    ("pixel_pitch", float("inf"),
+     "pixel_pitch = inf: expected a number greater than 0 and at most 0.01"),
+])
+def test_sensor_field_limits(field, value, message):
+    with pytest.raises(FieldError) as caught:
+        Sensor(**{field: value})
+    assert str(caught.value) == message
+
+
+def test_limits_are_accepted():
+    sensor = Sensor(grid=1, ray_grid=16, fov=89.9, depth_resolution=0.0, pixel_pitch=1e-9)
+    origins, directions, detector = sensor.rays(ScanPose(0, 0, 10, depression=1.0))
+    assert origins.shape == (256, 3) and (detector == 0).all()
+    assert Sensor(grid=1024, ray_grid=1).rays_per_scan == 1024**2
