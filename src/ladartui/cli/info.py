@@ -1,0 +1,149 @@
+"""``ladartui info FILE`` and ``ladartui info --backends``: describe inputs and the machine."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+from ladartui.errors import LadarError
+
+
+def add_parser(subparsers):
+    parser = subparsers.add_parser(
+        "info",
+        help="describe a voxel list, a scenario, or the tracing backends",
+        description="For a voxel list (X.txt): voxel count, extent, its target model "
+        "X_Target.txt if present, and the memory and build time of the sparse occupancy "
+        "structure. For a scenario (.toml): its summary. With --backends: each tracing "
+        "backend, whether it can run here (or why not) and what runs the work.",
+    )
+    parser.add_argument("file", metavar="FILE", nargs="?",
+                        help="voxel list (.txt) or scenario (.toml)")
+    parser.add_argument("--backends", action="store_true", help="list the tracing backends")
+    parser.add_argument("--voxel-size", type=float,
+                        help="voxel size in metres, to show the extent and target centre in metres")
+    parser.set_defaults(handler=run)
+    return parser
+
+
+def run(args) -> int:
+    if not args.backends and not args.file:
+        raise LadarError("info needs a FILE (voxel list or scenario .toml) or --backends")
+    if args.backends:
+        print_backends()
+    if args.file:
+        path = Path(args.file)
+        if path.suffix.lower() == ".toml":
+            print_scenario(path)
+        else:
+            print_voxel_list(path, args.voxel_size)
+    return 0
+
+
+def print_scenario(path: Path) -> None:
+    try:
+        from ladartui.scenario import load_scenario
+    except ModuleNotFoundError as error:
+        if error.name != "ladartui.scenario":
+            raise
+        raise LadarError(f"{path}: scenario files cannot be read here (ladartui.scenario "
+                         "is not available)") from None
+    print(load_scenario(path).summary())
+
+
+def print_voxel_list(path: Path, voxel_size=None) -> None:
+    from ladartui.scene.model import target_path_for
+    from ladartui.scene.voxels import load_voxels_counted
+
+    if voxel_size is not None and not voxel_size > 0:
+        from ladartui.errors import FieldError
+
+        raise FieldError("--voxel-size", voxel_size, "a positive number of metres")
+    started = time.perf_counter()
+    voxels, duplicates = load_voxels_counted(path)
+    loaded = time.perf_counter() - started
+    rows = [("voxels", f"{len(voxels):,}" + (f" ({duplicates:,} duplicate lines dropped)"
+                                             if duplicates else ""))]
+    rows.append(("read in", f"{loaded:.2f} s"))
+    shape = (0, 0, 0)
+    if len(voxels):
+        lo, hi = voxels.min(axis=0), voxels.max(axis=0)
+        shape = tuple(int(h) + 1 for h in hi)
+        ranges = ", ".join(f"{axis} {int(low)}..{int(high)}"
+                           for axis, low, high in zip("xyz", lo, hi))
+        rows.append(("extent", f"{ranges}  (shape {shape[0]} x {shape[1]} x {shape[2]})"))
+        if voxel_size:
+            rows.append(("extent (m)", " x ".join(f"{n * voxel_size:.1f}" for n in shape)
+                         + f" at {voxel_size:g} m"))
+    target_path = target_path_for(path)
+    if target_path.is_file() and target_path != path:
+        target, _ = load_voxels_counted(target_path)
+        text = f"{target_path.name}: {len(target):,} voxels"
+        if len(target):
+            inside = _count_inside(target, voxels)
+            text += f", {inside:,} of them in the scene"
+            centre = target.mean(axis=0)
+            text += f"; centre ({centre[0]:.1f}, {centre[1]:.1f}, {centre[2]:.1f}) voxels"
+            if voxel_size:
+                m = centre * voxel_size
+                text += f" = ({m[0]:.2f}, {m[1]:.2f}, {m[2]:.2f}) m"
+            shape = tuple(max(s, int(t) + 1) for s, t in zip(shape, target.max(axis=0)))
+        rows.append(("target", text))
+    else:
+        rows.append(("target", f"none ({target_path.name} not found)"))
+    rows.append(("occupancy", _occupancy_text(voxels, shape)))
+    print(f"{path}: voxel list")
+    width = max(len(name) for name, _ in rows)
+    for name, text in rows:
+        print(f"  {name:<{width}}  {text}")
+
+
+def _count_inside(target, voxels) -> int:
+    import numpy as np
+
+    from ladartui.scene.voxels import voxel_keys
+
+    both = np.concatenate([voxels, target])
+    shape = both.max(axis=0).astype(np.int64) + 1
+    scene_keys = voxel_keys(voxels, shape)
+    target_keys = voxel_keys(target, shape)
+    if scene_keys is None:  # indices too large to pack: compare rows
+        scene_rows = set(map(tuple, voxels.tolist()))
+        return sum(1 for row in map(tuple, target.tolist()) if row in scene_rows)
+    return int(np.isin(target_keys, scene_keys).sum())
+
+
+def _occupancy_text(voxels, shape) -> str:
+    try:
+        from ladartui.scene.occupancy import Occupancy
+    except ModuleNotFoundError as error:
+        if error.name != "ladartui.scene.occupancy":
+            raise
+        return "not available (ladartui.scene.occupancy is missing)"
+    started = time.perf_counter()
+    occupancy = Occupancy.build(voxels, shape)
+    built = time.perf_counter() - started
+    return (f"{occupancy.nbytes / 2**20:.1f} MiB ({occupancy.n_bricks:,} bricks, "
+            f"{occupancy.n_tiles:,} tiles, {occupancy.n_regions:,} regions), "
+            f"built in {built:.2f} s")
+
+
+def print_backends() -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    from ladartui.tracing.backend import backend_status, get_backend
+
+    table = Table(title="Tracing backends")
+    table.add_column("backend")
+    table.add_column("status")
+    table.add_column("details")
+    for name, reason in backend_status().items():
+        if reason is None:
+            backend = get_backend(name)
+            details = ", ".join(f"{k}: {v}" for k, v in backend.describe().items())
+            summary = getattr(backend, "summary", "")
+            table.add_row(name, "available", f"{summary}\n{details}" if summary else details)
+        else:
+            table.add_row(name, "unavailable", reason)
+    Console().print(table)

@@ -1,0 +1,179 @@
+"""The Scene: scene voxels, target voxels, voxel size and extent.
+
+A scene model ``X.txt`` comes with its target model ``X_Target.txt`` (report
+table 2). Voxel (i, j, k) is the unit cube centred on (i, j, k) in grid
+units, so its centre in metres is ``(i, j, k) * voxel_size``.
+"""
+
+from __future__ import annotations
+
+import threading
+from pathlib import Path
+
+import numba
+import numpy as np
+
+from ladartui.errors import FieldError, InputFileError, LadarError
+from ladartui.scene.voxels import load_voxels
+
+
+def target_path_for(scene_path) -> Path:
+    """The target model beside a scene model: ``dir/X.txt`` -> ``dir/X_Target.txt``."""
+    scene_path = Path(scene_path)
+    suffix = scene_path.suffix or ".txt"
+    return scene_path.with_name(f"{scene_path.stem}_Target{suffix}")
+
+
+class Scene:
+    """Scene and target voxel lists over one grid.
+
+    ``voxels`` and ``target`` are (N, 3) int32 arrays of unique voxel indices
+    (target voxels also appear in ``voxels`` for a scene model). ``shape`` is
+    ``(nx, ny, nz)``, by default the largest index + 1 over both lists.
+    """
+
+    def __init__(self, voxels, target, voxel_size, shape=None, name=None, path=None):
+        self.voxels = _as_voxel_array(voxels, "voxels")
+        self.target = _as_voxel_array(target, "target")
+        self.voxel_size = _checked_voxel_size(voxel_size)
+        needed = _extent(self.voxels, self.target)
+        if shape is None:
+            shape = needed
+        shape = tuple(int(s) for s in shape)
+        if len(shape) != 3 or any(s < n for s, n in zip(shape, needed)):
+            raise FieldError("shape", shape, f"(nx, ny, nz) at least {needed}")
+        self.shape = shape
+        self.path = Path(path) if path is not None else None
+        self.name = name if name is not None else (self.path.stem if self.path else "scene")
+        self._occupancy = None
+        self._target_occupancy = None
+        self._init_locks()
+
+    def _init_locks(self):
+        self._lock = threading.Lock()
+        self._target_lock = threading.Lock()
+
+    def __getstate__(self):
+        # Locks cannot be pickled (process pools, Dask workers); each copy gets its own.
+        state = self.__dict__.copy()
+        del state["_lock"], state["_target_lock"]
+        return state
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        self._init_locks()
+
+    @classmethod
+    def load(cls, scene_path, voxel_size, shape=None) -> "Scene":
+        """Read ``X.txt`` and its target ``X_Target.txt``."""
+        _checked_voxel_size(voxel_size)  # before reading what may be large files
+        scene_path = Path(scene_path)
+        target_path = target_path_for(scene_path)
+        voxels = load_voxels(scene_path)
+        if not target_path.is_file():
+            raise InputFileError(
+                target_path,
+                f"target model not found; expected it beside the scene model {scene_path.name} "
+                f"(named {target_path.name})",
+            )
+        target = load_voxels(target_path)  # may be empty: a scene without a target
+        return cls(voxels, target, voxel_size, shape=shape, name=scene_path.stem, path=scene_path)
+
+    @property
+    def target_path(self) -> Path | None:
+        return target_path_for(self.path) if self.path is not None else None
+
+    @property
+    def occupancy(self):
+        """The sparse occupancy of the scene voxels (built once, on first use)."""
+        with self._lock:
+            if self._occupancy is None:
+                self._occupancy = _build_occupancy(self.voxels, self.shape)
+            return self._occupancy
+
+    @property
+    def target_occupancy(self):
+        """The sparse occupancy of the target voxels alone, over the scene's shape."""
+        with self._target_lock:
+            if self._target_occupancy is None:
+                self._target_occupancy = _build_occupancy(self.target, self.shape)
+            return self._target_occupancy
+
+    @property
+    def extent_m(self) -> tuple[float, float, float]:
+        """Width, depth and height of the grid in metres."""
+        return tuple(n * self.voxel_size for n in self.shape)
+
+    def target_centre_m(self) -> np.ndarray:
+        """Centroid of the target voxel centres, metres (x, y, z)."""
+        if len(self.target) == 0:
+            where = f" ({self.target_path} is empty)" if self.path is not None else ""
+            raise LadarError(f"scene {self.name!r} has no target voxels{where}")
+        return self.target.astype(np.float64).mean(axis=0) * self.voxel_size
+
+    def top_height_map(self, target=False) -> np.ndarray:
+        """(nx, ny) int32: highest occupied z in each column, -1 where empty."""
+        return top_height_map(self.target if target else self.voxels, self.shape[0], self.shape[1])
+
+    def __repr__(self):
+        return (f"Scene({self.name!r}, voxels={len(self.voxels)}, target={len(self.target)}, "
+                f"voxel_size={self.voxel_size}, shape={self.shape})")
+
+
+def top_height_map(voxels, nx, ny) -> np.ndarray:
+    """(nx, ny) int32 of the highest occupied z per column, -1 for an empty column.
+
+    One pass over the voxel list: memory is the map itself, never nx*ny*nz.
+    """
+    voxels = np.ascontiguousarray(voxels, dtype=np.int32)
+    heights = np.full((int(nx), int(ny)), -1, dtype=np.int32)
+    if len(voxels):
+        _column_maxima(voxels, heights)
+    return heights
+
+
+@numba.njit(nogil=True, cache=True)
+def _column_maxima(voxels, heights):
+    for i in range(voxels.shape[0]):
+        x, y, z = voxels[i, 0], voxels[i, 1], voxels[i, 2]
+        if z > heights[x, y]:
+            heights[x, y] = z
+
+
+def _build_occupancy(voxels, shape):
+    from ladartui.scene.occupancy import Occupancy  # built by its own module
+
+    return Occupancy.build(voxels, shape)
+
+
+def _checked_voxel_size(voxel_size) -> float:
+    try:
+        size = float(voxel_size)
+    except (TypeError, ValueError):
+        size = float("nan")
+    if not size > 0 or not np.isfinite(size):
+        raise FieldError("voxel_size", voxel_size, "a positive number of metres")
+    return size
+
+
+def _as_voxel_array(voxels, name) -> np.ndarray:
+    array = np.asarray(voxels)
+    if array.size == 0:
+        return np.zeros((0, 3), dtype=np.int32)
+    if array.ndim != 2 or array.shape[1] != 3:
+        raise ValueError(f"{name} must be an (N, 3) array, got shape {array.shape}")
+    if not np.issubdtype(array.dtype, np.integer):
+        raise ValueError(f"{name} must hold integers, got {array.dtype}")
+    if array.min() < 0:
+        raise ValueError(f"{name} holds negative indices; voxel indices start at 0")
+    if array.max() > np.iinfo(np.int32).max:
+        raise ValueError(f"{name} holds indices beyond the int32 range")
+    return np.ascontiguousarray(array, dtype=np.int32)
+
+
+def _extent(*lists) -> tuple[int, int, int]:
+    filled = [v for v in lists if len(v)]
+    if not filled:
+        return (0, 0, 0)
+    top = np.max([v.max(axis=0) for v in filled], axis=0)
+    return tuple(int(t) + 1 for t in top)

@@ -1,0 +1,105 @@
+"""``ladartui generate`` and ``ladartui info`` through the command-line entry point."""
+
+import re
+
+import numpy as np
+import pytest
+
+from ladartui.cli import main
+from ladartui.scene.generate import generate_scene
+from ladartui.scene.voxels import load_voxels
+
+
+def test_generate_writes_the_pair_and_reports_it(tmp_path, capsys):
+    stem = tmp_path / "scenes" / "forest"
+    assert main(["generate", "small", str(stem), "--seed", "3", "--density", "0.5"]) == 0
+    out = capsys.readouterr().out
+    expected = generate_scene("small", seed=3, density=0.5)
+    scene = load_voxels(tmp_path / "scenes" / "forest.txt")
+    target = load_voxels(tmp_path / "scenes" / "forest_Target.txt")
+    np.testing.assert_array_equal(scene, expected.voxels)
+    np.testing.assert_array_equal(target, expected.target)
+    assert f"({len(scene):,} voxels)" in out and f"({len(target):,} voxels)" in out
+    assert "voxel size 0.25 m" in out
+    assert "extent 240 x 240 x" in out
+    x, y, z = expected.target_centre
+    assert f"target centre ({x:.2f}, {y:.2f}, {z:.2f}) m" in out
+
+
+def test_generate_accepts_a_txt_stem_and_options(tmp_path, capsys):
+    out_path = tmp_path / "plain.txt"
+    assert main(["generate", "small", str(out_path), "--no-target", "--terrain",
+                 "--camouflage", "--trees", "10"]) == 0
+    assert (tmp_path / "plain.txt").is_file()
+    assert load_voxels(tmp_path / "plain_Target.txt").shape == (0, 3)
+    out = capsys.readouterr().out
+    assert "no target" in out and "terrain" in out
+
+
+def test_generate_las_copy(tmp_path, capsys):
+    laspy = pytest.importorskip("laspy")
+    assert main(["generate", "small", str(tmp_path / "f"), "--las", "--trees", "5"]) == 0
+    cloud = laspy.read(tmp_path / "f.laz")
+    assert len(cloud.x) == len(load_voxels(tmp_path / "f.txt"))
+
+
+def test_generate_rejects_bad_input_on_one_line(tmp_path, capsys):
+    assert main(["generate", "huge", str(tmp_path / "x")]) == 2
+    err = capsys.readouterr().err
+    assert err == "ladartui: error: preset = 'huge': expected one of small, reference\n"
+    assert main(["generate", "small", str(tmp_path / "x"), "--density", "2"]) == 2
+    assert "density = 2.0: expected a number from 0 to 0.99" in capsys.readouterr().err
+    assert not list(tmp_path.iterdir())
+
+
+def test_info_describes_a_voxel_list_and_its_target(tmp_path, capsys):
+    (tmp_path / "s.txt").write_text("0,0,0\n5,2,9\n5,2,9\n3,7,1\n")
+    (tmp_path / "s_Target.txt").write_text("3,7,1\n4,4,4\n")
+    assert main(["info", str(tmp_path / "s.txt"), "--voxel-size", "0.5"]) == 0
+    out = capsys.readouterr().out
+    assert re.search(r"voxels\s+3 \(1 duplicate lines dropped\)", out)
+    assert "x 0..5, y 0..7, z 0..9  (shape 6 x 8 x 10)" in out
+    assert "3.0 x 4.0 x 5.0 at 0.5 m" in out
+    assert "s_Target.txt: 2 voxels, 1 of them in the scene" in out
+    assert "centre (3.5, 5.5, 2.5) voxels = (1.75, 2.75, 1.25) m" in out
+    pytest.importorskip("ladartui.scene.occupancy")
+    assert re.search(r"occupancy\s+\d+\.\d MiB \(2 bricks, 1 tiles, 1 regions\), built in", out)
+
+
+def test_info_without_target_file(tmp_path, capsys):
+    (tmp_path / "lonely.txt").write_text("1,1,1\n")
+    assert main(["info", str(tmp_path / "lonely.txt")]) == 0
+    assert "none (lonely_Target.txt not found)" in capsys.readouterr().out
+
+
+def test_info_bad_file_is_one_line(tmp_path, capsys):
+    (tmp_path / "bad.txt").write_text("1,2,3\n1,2\n")
+    assert main(["info", str(tmp_path / "bad.txt")]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"ladartui: error: {tmp_path / 'bad.txt'}:2: 2 comma-separated values")
+    assert err.count("\n") == 1
+    assert main(["info"]) == 2
+    assert "needs a FILE" in capsys.readouterr().err
+
+
+def test_info_scenario_summary(tmp_path, capsys):
+    scenario = pytest.importorskip("ladartui.scenario")
+    generated = generate_scene("small", seed=0, trees=4)
+    generated.write(tmp_path / "forest")
+    path = tmp_path / "plan.toml"
+    scenario.Scenario.new(path, tmp_path / "forest.txt", generated.voxel_size).save()
+    assert main(["info", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert out.strip() == scenario.load_scenario(path).summary().strip()
+
+
+def test_info_backends_lists_each_backend(capsys):
+    backend = pytest.importorskip("ladartui.tracing.backend")
+    status = backend.backend_status()
+    assert main(["info", "--backends"]) == 0
+    out = capsys.readouterr().out
+    for name, reason in status.items():
+        assert re.search(rf"{name}\s+│ (available|unavailable)", out)
+        if reason is None:
+            first_key = next(iter(backend.get_backend(name).describe()))
+            assert first_key in out

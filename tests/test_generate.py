@@ -1,0 +1,208 @@
+"""The synthetic forest generator: determinism, target placement, foliage, options."""
+
+import math
+
+import numpy as np
+import pytest
+
+from ladartui.errors import FieldError
+from ladartui.scene.generate import generate_scene, output_paths, scene_params
+from ladartui.scene.model import Scene
+
+
+def as_set(voxels):
+    return set(map(tuple, np.asarray(voxels).tolist()))
+
+
+@pytest.fixture(scope="module")
+def small():
+    return generate_scene("small", seed=0)
+
+
+def test_same_seed_same_scene_other_seed_other_scene(small):
+    again = generate_scene("small", seed=0)
+    np.testing.assert_array_equal(again.voxels, small.voxels)
+    np.testing.assert_array_equal(again.target, small.target)
+    other = generate_scene("small", seed=1)
+    assert as_set(other.voxels) != as_set(small.voxels)
+
+
+def test_lists_are_unique_int32_and_inside_the_shape(small):
+    for voxels in (small.voxels, small.target):
+        assert voxels.dtype == np.int32 and voxels.ndim == 2 and voxels.shape[1] == 3
+        assert len(np.unique(voxels, axis=0)) == len(voxels)
+        assert voxels.min() >= 0 and np.all(voxels.max(axis=0) < np.array(small.shape))
+    assert small.shape[:2] == (240, 240)  # 60 m at 0.25 m
+    assert small.voxel_size == 0.25
+
+
+def test_target_is_in_the_scene_at_the_same_place(small):
+    assert len(small.target) > 0
+    assert as_set(small.target) <= as_set(small.voxels)
+    centre = small.target.mean(axis=0) * small.voxel_size
+    np.testing.assert_allclose(small.target_centre, centre)
+    # At the scene centre, on the ground (the ground plane is the bottom of layer 0).
+    assert abs(centre[0] - 30.0) < 0.5 and abs(centre[1] - 30.0) < 0.5
+    assert small.target[:, 2].min() == 0
+
+
+def test_vehicle_has_the_requested_size_and_is_solid(small):
+    vs = small.voxel_size
+    xy = small.target[:, :2].astype(float) * vs
+    xy -= xy.mean(axis=0)
+    _, vectors = np.linalg.eigh(np.cov(xy.T))
+    along = xy @ vectors[:, 1]
+    across = xy @ vectors[:, 0]
+    assert abs(np.ptp(along) + vs - 5.0) <= 2 * vs
+    assert abs(np.ptp(across) + vs - 2.5) <= 2 * vs
+    assert abs((small.target[:, 2].max() + 1) * vs - 2.2) <= vs
+    volume = len(small.target) * vs**3
+    assert 0.4 * 5 * 2.5 * 2.2 < volume < 5 * 2.5 * 2.2
+
+
+def test_target_is_under_canopy(small):
+    scene = as_set(small.voxels)
+    target = as_set(small.target)
+    columns = {(x, y) for x, y, _ in target}
+    top_of_target = small.target[:, 2].max()
+    covered = sum(1 for x, y in columns
+                  if any((x, y, z) in scene for z in range(top_of_target + 1, small.shape[2])))
+    assert covered / len(columns) > 0.5
+
+
+def test_crowns_are_clumped_shells_with_gaps(small):
+    vs = small.voxel_size
+    v = small.voxels
+    canopy = v[v[:, 2] * vs > 6.0]  # well above the vehicle and the lowest crown bases
+    assert len(canopy) > 1000
+    # Mostly air: a dense-crowned forest volume would be solid.
+    lo, hi = canopy.min(axis=0), canopy.max(axis=0) + 1
+    assert len(canopy) / np.prod(hi - lo) < 0.1
+    # Gaps seen from above inside the canopy's own footprint.
+    heights = np.full(small.shape[:2], -1)
+    np.maximum.at(heights, (v[:, 0], v[:, 1]), v[:, 2])
+    window = heights[100:140, 100:140]  # 10 m x 10 m round the vehicle
+    assert 0.02 < np.mean(window < 0) < 0.9
+    # Clumped: occupied voxels share 8x8x8 bricks (a tracer's memory depends on it).
+    bricks = np.unique(v >> 3, axis=0)
+    assert len(v) / len(bricks) > 8
+
+
+def test_density_controls_foliage():
+    sparse = generate_scene("small", seed=4, density=0.3)
+    dense = generate_scene("small", seed=4, density=0.9)
+    assert dense.parts["foliage"] > 2 * sparse.parts["foliage"]
+    def empty_columns(g):
+        heights = np.full(g.shape[:2], -1)
+        np.maximum.at(heights, (g.voxels[:, 0], g.voxels[:, 1]), g.voxels[:, 2])
+        return np.mean(heights < 0)
+    assert empty_columns(dense) < empty_columns(sparse)
+
+
+def test_no_target():
+    scene = generate_scene("small", seed=2, vehicles=0)
+    assert len(scene.target) == 0 and scene.target_centre is None
+    assert "vehicles" in scene.parts and scene.parts["vehicles"] == 0
+
+
+def test_several_vehicles_are_all_target():
+    scene = generate_scene("small", seed=2, vehicles=3)
+    single = generate_scene("small", seed=2, vehicles=1)
+    assert len(scene.target) > 2.5 * len(single.target)
+    assert as_set(scene.target) <= as_set(scene.voxels)
+
+
+def test_terrain_is_a_watertight_skin_under_everything():
+    scene = generate_scene("small", seed=5, terrain=True, terrain_relief=2.0)
+    v = scene.voxels
+    nx, ny = scene.shape[:2]
+    lowest = np.full((nx, ny), np.iinfo(np.int32).max)
+    np.minimum.at(lowest, (v[:, 0], v[:, 1]), v[:, 2])
+    assert (lowest < np.iinfo(np.int32).max).all()  # every column has ground
+    assert lowest.max() - lowest.min() >= round(2.0 / scene.voxel_size) - 1
+    # The vehicle stands on the ground: under each of its lowest voxels, the layer below is terrain.
+    t = scene.target
+    base = t[:, 2].min()
+    assert base > 0
+    occupied = as_set(v)
+    under = [(x, y, base - 1) for x, y, z in t.tolist() if z == base]
+    assert sum(p in occupied for p in under) >= 0.5 * len(under)
+
+
+def test_camouflage_net_is_scene_only_and_above_the_target():
+    plain = generate_scene("small", seed=6)
+    netted = generate_scene("small", seed=6, camouflage=True)
+    np.testing.assert_array_equal(plain.target, netted.target)
+    extra = as_set(netted.voxels) - as_set(plain.voxels)
+    assert netted.parts["net"] > 0 and len(extra) > 0
+    assert not extra & as_set(netted.target)
+    columns = {(x, y) for x, y, _ in netted.target.tolist()}
+    top = netted.target[:, 2].max()
+    over = {(x, y) for x, y, z in extra if (x, y) in columns and z > top}
+    # Patchy: covers a good share of the vehicle, not all of it.
+    assert 0.2 < len(over) / len(columns) < 0.95
+
+
+def test_write_creates_the_table_2_pair(tmp_path, small):
+    scene_path, target_path = small.write(tmp_path / "sub" / "forest.txt")
+    assert scene_path == tmp_path / "sub" / "forest.txt"
+    assert target_path == tmp_path / "sub" / "forest_Target.txt"
+    loaded = Scene.load(scene_path, small.voxel_size)
+    np.testing.assert_array_equal(loaded.voxels, small.voxels)
+    np.testing.assert_array_equal(loaded.target, small.target)
+    np.testing.assert_allclose(loaded.target_centre_m(), small.target_centre)
+    assert output_paths(tmp_path / "x") == (tmp_path / "x.txt", tmp_path / "x_Target.txt")
+
+
+def test_to_scene_keeps_the_grid(small):
+    scene = small.to_scene()
+    assert scene.shape == small.shape and scene.voxel_size == small.voxel_size
+    np.testing.assert_allclose(scene.target_centre_m(), small.target_centre)
+
+
+@pytest.mark.parametrize(
+    "overrides, message",
+    [
+        ({"density": 1.5}, "density = 1.5: expected a number from 0 to 0.99"),
+        ({"trees": -1}, "trees = -1: expected a whole number, 0 or more"),
+        ({"voxel_size": 0}, "voxel_size = 0: expected a positive number"),
+        ({"crown_radius": (4.0, 2.0)}, "crown_radius = (4.0, 2.0): expected (low, high) positive"),
+        ({"leaves": 3}, "leaves = 3: expected a scene parameter: "),
+        ({"width": 5.0}, "width = 5.0: expected room for the vehicle"),
+    ],
+)
+def test_bad_overrides_name_the_field(overrides, message):
+    with pytest.raises(FieldError) as caught:
+        scene_params("small", **overrides)
+    assert str(caught.value).startswith(message)
+
+
+def test_unknown_preset_and_bad_seed():
+    with pytest.raises(FieldError, match="preset = 'huge': expected one of small, reference"):
+        generate_scene("huge")
+    with pytest.raises(FieldError, match="seed = -3"):
+        generate_scene("small", seed=-3)
+
+
+def packed(voxels, shift=0):
+    """One int64 per voxel (or per 2**shift cell), for fast set operations."""
+    v = np.asarray(voxels).astype(np.int64) >> shift
+    return (v[:, 0] << 42) | (v[:, 1] << 21) | v[:, 2]
+
+
+def count_cells(voxels, shift):
+    keys = np.sort(packed(voxels, shift))
+    return int(np.count_nonzero(np.diff(keys)) + 1)
+
+
+@pytest.mark.slow
+def test_reference_preset_matches_the_reports_figure_11_scale():
+    scene = generate_scene("reference", seed=0)
+    assert scene.shape == (1500, 1500, 900)
+    assert math.isclose(scene.voxel_size, 0.1)
+    assert 3.4e6 < len(scene.voxels) < 4.2e6
+    assert np.isin(packed(scene.target), packed(scene.voxels)).all()
+    # Sparse structure estimate: 64 B per 8^3 brick, 2 KiB per 64^3 tile and 512^3 region.
+    nbytes = count_cells(scene.voxels, 3) * 64 + (count_cells(scene.voxels, 6)
+                                                  + count_cells(scene.voxels, 9)) * 2048
+    assert nbytes < 32 * 2**20

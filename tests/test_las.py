@@ -1,0 +1,85 @@
+"""LAS/LAZ import (voxelising) and export (voxel centres)."""
+
+import numpy as np
+import pytest
+
+laspy = pytest.importorskip("laspy")
+
+from ladartui.errors import FieldError, InputFileError  # noqa: E402
+from ladartui.scene.las import export_las, import_las  # noqa: E402
+
+
+def sorted_rows(a):
+    a = np.asarray(a)
+    return a[np.lexsort(a.T[::-1])]
+
+
+VOXELS = np.array([[3, 4, 0], [3, 4, 1], [10, 2, 7], [25, 30, 12], [3, 5, 0]], dtype=np.int32)
+
+
+@pytest.mark.parametrize("suffix", [".las", ".laz"])
+def test_export_writes_voxel_centres_in_metres(tmp_path, suffix):
+    path = tmp_path / f"cloud{suffix}"
+    export_las(path, VOXELS, 0.25, origin=(100.0, 200.0, 5.0))
+    cloud = laspy.read(path)
+    xyz = np.stack([cloud.x, cloud.y, cloud.z], axis=1)
+    expected = np.array([100.0, 200.0, 5.0]) + VOXELS * 0.25
+    np.testing.assert_allclose(sorted_rows(xyz), sorted_rows(expected), atol=1e-6)
+    # LAZ marks compression in the high bit of the header's point-format byte (offset 104).
+    assert bool(path.read_bytes()[104] & 0x80) == (suffix == ".laz")
+
+
+@pytest.mark.parametrize("suffix", [".las", ".laz"])
+def test_round_trip_with_the_same_origin(tmp_path, suffix):
+    path = tmp_path / f"cloud{suffix}"
+    export_las(path, VOXELS, 0.1, origin=(10.0, 20.0, 0.0))
+    voxels, origin = import_las(path, 0.1, origin=(10.0, 20.0, 0.0))
+    np.testing.assert_array_equal(sorted_rows(voxels), sorted_rows(VOXELS))
+    np.testing.assert_array_equal(origin, [10.0, 20.0, 0.0])
+
+
+def test_default_origin_puts_the_lowest_point_in_voxel_zero(tmp_path):
+    path = tmp_path / "cloud.laz"
+    export_las(path, VOXELS, 0.5)
+    voxels, origin = import_las(path, 0.5)
+    lowest = VOXELS.min(axis=0)
+    np.testing.assert_allclose(origin, lowest * 0.5)
+    np.testing.assert_array_equal(sorted_rows(voxels), sorted_rows(VOXELS - lowest))
+    assert voxels.min(axis=0).tolist() == [0, 0, 0]
+
+
+def test_import_voxelises_and_merges_points(tmp_path):
+    header = laspy.LasHeader(version="1.2", point_format=0)
+    header.scales = [0.001] * 3
+    header.offsets = [0, 0, 0]
+    cloud = laspy.LasData(header)
+    # Voxel size 1 m, origin 0: voxel i spans [i - 0.5, i + 0.5).
+    cloud.x = np.array([0.0, 0.2, 0.49, 0.5, 2.4, 2.6])
+    cloud.y = np.array([0.0, 0.0, 0.0, 0.0, 1.0, 1.0])
+    cloud.z = np.array([0.0, 0.3, 0.0, 0.0, 0.0, 0.0])
+    path = tmp_path / "points.las"
+    cloud.write(path)
+    voxels, _ = import_las(path, 1.0, origin=(0, 0, 0))
+    np.testing.assert_array_equal(sorted_rows(voxels), [[0, 0, 0], [1, 0, 0], [2, 1, 0], [3, 1, 0]])
+
+
+def test_points_below_an_explicit_origin_are_an_error(tmp_path):
+    path = tmp_path / "cloud.las"
+    export_las(path, VOXELS, 1.0)
+    expected = r"origin = \(5\.0, 0\.0, 0\.0\): expected at most half a voxel"
+    with pytest.raises(FieldError, match=expected):
+        import_las(path, 1.0, origin=(5.0, 0.0, 0.0))
+
+
+def test_missing_and_foreign_files(tmp_path):
+    with pytest.raises(InputFileError, match=r"nope\.las: no such file; expected a LAS or LAZ"):
+        import_las(tmp_path / "nope.las", 0.1)
+    junk = tmp_path / "junk.las"
+    junk.write_text("1,2,3\n")
+    with pytest.raises(InputFileError, match=r"junk\.las: not a readable LAS/LAZ point cloud"):
+        import_las(junk, 0.1)
+
+
+def test_bad_voxel_size(tmp_path):
+    with pytest.raises(FieldError, match="voxel_size = 0: expected a positive number of metres"):
+        export_las(tmp_path / "a.las", VOXELS, 0)

@@ -1,0 +1,145 @@
+"""Scene: loading X.txt with X_Target.txt, shape, centre, height map, occupancy."""
+
+import threading
+
+import numpy as np
+import pytest
+
+from ladartui.errors import FieldError, InputFileError, LadarError
+from ladartui.scene.model import Scene, target_path_for, top_height_map
+
+SCENE = np.array([[0, 0, 0], [4, 1, 2], [4, 1, 7], [2, 3, 5], [9, 0, 1]], dtype=np.int32)
+TARGET = np.array([[4, 1, 2], [2, 3, 5]], dtype=np.int32)
+
+
+def write_pair(folder, name="forest"):
+    (folder / f"{name}.txt").write_text("".join(f"{x},{y},{z}\n" for x, y, z in SCENE))
+    (folder / f"{name}_Target.txt").write_text("".join(f"{x},{y},{z}\n" for x, y, z in TARGET))
+    return folder / f"{name}.txt"
+
+
+def test_load_reads_scene_and_target(tmp_path):
+    scene = Scene.load(write_pair(tmp_path), 0.5)
+    np.testing.assert_array_equal(scene.voxels, SCENE)
+    np.testing.assert_array_equal(scene.target, TARGET)
+    assert scene.voxels.dtype == np.int32 and scene.target.dtype == np.int32
+    assert scene.voxel_size == 0.5
+    assert scene.shape == (10, 4, 8)
+    assert scene.name == "forest"
+    assert scene.path == tmp_path / "forest.txt"
+    assert scene.target_path == tmp_path / "forest_Target.txt"
+
+
+def test_target_path_follows_table_2_naming(tmp_path):
+    assert target_path_for(tmp_path / "ExampleScene.txt") == tmp_path / "ExampleScene_Target.txt"
+    assert target_path_for("a/b.c.txt") == target_path_for("a/b.c.txt").parent / "b.c_Target.txt"
+
+
+def test_missing_target_names_the_expected_file(tmp_path):
+    path = write_pair(tmp_path)
+    (tmp_path / "forest_Target.txt").unlink()
+    with pytest.raises(InputFileError) as caught:
+        Scene.load(path, 0.5)
+    assert str(caught.value) == (
+        f"{tmp_path / 'forest_Target.txt'}: target model not found; expected it beside the "
+        "scene model forest.txt (named forest_Target.txt)"
+    )
+
+
+def test_missing_scene_is_named(tmp_path):
+    with pytest.raises(InputFileError, match=r"nothing\.txt: no such file"):
+        Scene.load(tmp_path / "nothing.txt", 0.5)
+
+
+def test_empty_target_loads_but_has_no_centre(tmp_path):
+    path = write_pair(tmp_path)
+    (tmp_path / "forest_Target.txt").write_text("")
+    scene = Scene.load(path, 0.5)
+    assert scene.target.shape == (0, 3) and scene.shape == (10, 4, 8)
+    with pytest.raises(LadarError) as caught:
+        scene.target_centre_m()
+    assert str(caught.value) == (
+        f"scene 'forest' has no target voxels ({tmp_path / 'forest_Target.txt'} is empty)")
+
+
+def test_shape_covers_both_lists_and_can_be_larger():
+    target = np.array([[20, 1, 1]])
+    assert Scene(SCENE, target, 1.0).shape == (21, 4, 8)
+    assert Scene(SCENE, TARGET, 1.0, shape=(10, 4, 900)).shape == (10, 4, 900)
+    expected = r"shape = \(9, 4, 8\): expected \(nx, ny, nz\) at least \(10, 4, 8\)"
+    with pytest.raises(FieldError, match=expected):
+        Scene(SCENE, TARGET, 1.0, shape=(9, 4, 8))
+
+
+@pytest.mark.parametrize("size", [0, -1.0, "big", float("nan")])
+def test_voxel_size_must_be_positive(size):
+    with pytest.raises(FieldError, match="voxel_size"):
+        Scene(SCENE, TARGET, size)
+
+
+def test_target_centre_is_the_centroid_in_metres():
+    scene = Scene(SCENE, TARGET, 0.25)
+    np.testing.assert_allclose(scene.target_centre_m(), [(4 + 2) / 2 * 0.25, (1 + 3) / 2 * 0.25,
+                                                         (2 + 5) / 2 * 0.25])
+    with pytest.raises(LadarError, match="^scene 'scene' has no target voxels$"):
+        Scene(SCENE, np.zeros((0, 3), int), 0.25).target_centre_m()
+
+
+def test_top_height_map_against_a_dense_grid():
+    rng = np.random.default_rng(3)
+    voxels = rng.integers(0, [30, 20, 15], size=(2000, 3))
+    expected = np.full((30, 20), -1)
+    dense = np.zeros((30, 20, 15), bool)
+    dense[tuple(voxels.T)] = True
+    for x in range(30):
+        for y in range(20):
+            filled = np.nonzero(dense[x, y])[0]
+            if len(filled):
+                expected[x, y] = filled.max()
+    np.testing.assert_array_equal(top_height_map(voxels, 30, 20), expected)
+    scene = Scene(SCENE, TARGET, 1.0)
+    heights = scene.top_height_map()
+    assert heights.shape == (10, 4)
+    assert heights[4, 1] == 7 and heights[0, 0] == 0 and heights[1, 1] == -1
+    assert scene.top_height_map(target=True)[4, 1] == 2
+
+
+def test_occupancy_is_built_once_and_matches_the_lists():
+    pytest.importorskip("ladartui.scene.occupancy")
+    scene = Scene(SCENE, TARGET, 1.0, shape=(10, 4, 900))
+    results = []
+    threads = [threading.Thread(target=lambda: results.append(scene.occupancy)) for _ in range(4)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert all(occ is results[0] for occ in results)
+    occupancy = scene.occupancy
+    assert occupancy.count == len(SCENE)
+    assert tuple(occupancy.shape) == (10, 4, 900)
+    assert occupancy.contains(SCENE).all()
+    assert not occupancy.contains(np.array([[1, 1, 1], [4, 1, 3]])).any()
+    target = scene.target_occupancy
+    assert target is scene.target_occupancy
+    assert target.count == len(TARGET) and tuple(target.shape) == (10, 4, 900)
+    assert target.contains(TARGET).all() and not target.contains(np.array([[0, 0, 0]])).any()
+
+
+def test_bad_arrays_are_rejected():
+    with pytest.raises(ValueError, match="negative"):
+        Scene(np.array([[0, -1, 0]]), TARGET, 1.0)
+    with pytest.raises(ValueError, match=r"\(N, 3\)"):
+        Scene(np.array([[0, 1]]), TARGET, 1.0)
+    with pytest.raises(ValueError, match="integers"):
+        Scene(np.array([[0.5, 1, 1]]), TARGET, 1.0)
+
+
+def test_scene_survives_pickling():
+    import pickle
+
+    scene = Scene(SCENE, TARGET, 0.5, shape=(10, 4, 20), name="p")
+    copy = pickle.loads(pickle.dumps(scene))
+    np.testing.assert_array_equal(copy.voxels, SCENE)
+    np.testing.assert_array_equal(copy.target, TARGET)
+    assert (copy.shape, copy.voxel_size, copy.name) == ((10, 4, 20), 0.5, "p")
+    np.testing.assert_array_equal(copy.top_height_map(), scene.top_height_map())

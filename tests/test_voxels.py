@@ -1,0 +1,185 @@
+"""Voxel-list files: round trips, tolerated layouts, every kind of bad line."""
+
+import os
+
+import numpy as np
+import pytest
+
+from ladartui.errors import InputFileError
+from ladartui.scene.voxels import load_voxels, load_voxels_counted, save_voxels, unique_voxels
+
+
+def write(tmp_path, data: bytes, name="scene.txt"):
+    path = tmp_path / name
+    path.write_bytes(data)
+    return path
+
+
+def test_round_trip_matches_text_written_independently(tmp_path):
+    rng = np.random.default_rng(1)
+    voxels = rng.integers(0, 5000, size=(2000, 3)).astype(np.int32)
+    voxels, _ = unique_voxels(voxels)
+    path = tmp_path / "out.txt"
+    save_voxels(path, voxels)
+    expected = "".join(f"{x},{y},{z}\n" for x, y, z in voxels.tolist())
+    assert path.read_text() == expected
+    loaded = load_voxels(path)
+    assert loaded.dtype == np.int32 and loaded.shape == (len(voxels), 3)
+    np.testing.assert_array_equal(loaded, voxels)
+
+
+def test_extreme_values_round_trip(tmp_path):
+    voxels = np.array([[0, 0, 0], [2**31 - 1, 9, 10], [10, 99, 100]], dtype=np.int64)
+    path = tmp_path / "v.txt"
+    save_voxels(path, voxels)
+    assert path.read_text() == "0,0,0\n2147483647,9,10\n10,99,100\n"
+    np.testing.assert_array_equal(load_voxels(path), voxels)
+
+
+def test_empty_list_round_trip(tmp_path):
+    path = tmp_path / "empty.txt"
+    save_voxels(path, np.zeros((0, 3), dtype=np.int32))
+    assert path.read_bytes() == b""
+    assert load_voxels(path).shape == (0, 3)
+
+
+@pytest.mark.parametrize(
+    "data",
+    [
+        b"1,2,3\n4,5,6\n",
+        b"1,2,3\n4,5,6",
+        b"1,2,3\r\n4,5,6\r\n",
+        b" 1 , 2 ,3\n4,\t5 , 6 \n",
+        b"\xef\xbb\xbf1,2,3\n4,5,6\n",
+        b"1,2,3\n4,5,6\n\n\n",
+        b"1,2,3\r\n4,5,6\r\n  \r\n",
+        b"01,002,3\n4,5,6\n",
+    ],
+)
+def test_tolerated_layouts(tmp_path, data):
+    np.testing.assert_array_equal(load_voxels(write(tmp_path, data)), [[1, 2, 3], [4, 5, 6]])
+
+
+@pytest.mark.parametrize(
+    "data, line, message",
+    [
+        (b"1,2,3\n4,5\n", 2, "2 comma-separated values in '4,5'; expected three non-negative "
+         "integers x,y,z separated by commas"),
+        (b"1,2,3,4\n", 1, "4 comma-separated values in '1,2,3,4'; expected three non-negative "
+         "integers x,y,z separated by commas"),
+        (b"1,2,3\n4 5 6\n", 2, "1 comma-separated values in '4 5 6'; expected three non-negative "
+         "integers x,y,z separated by commas"),
+        (b"1,2,3\n1,2.5,3\n", 2, "y = '2.5' is not a whole number; expected three non-negative "
+         "integers x,y,z separated by commas"),
+        (b"1,2,3\n7,8,-1\n", 2, "z = -1 is negative; voxel indices start at 0"),
+        (b"1,2,3\n\n4,5,6\n", 2, "blank line before more voxels; blank lines are allowed only at "
+         "the end of the file"),
+        (b"1,2,3\n  \r\n4,5,6\n", 2, "blank line before more voxels; blank lines are allowed only "
+         "at the end of the file"),
+        (b"x,y,z\n1,2,3\n", 1, "x = 'x' is not a whole number; expected three non-negative "
+         "integers x,y,z separated by commas"),
+        (b"1,2,3\n1,,3\n", 2, "y is empty in '1,,3'; expected three non-negative integers x,y,z "
+         "separated by commas"),
+        (b"1,2,3\n1,2,3x\n", 2, "z = '3x' is not a whole number; expected three non-negative "
+         "integers x,y,z separated by commas"),
+        (b"1,2,3\n1,2,+3\n", 2, "z = '+3' is not a whole number; expected three non-negative "
+         "integers x,y,z separated by commas"),
+        (b"1,2,3\n1,2 2,3\n", 2, "y = '2 2' is not a whole number; expected three non-negative "
+         "integers x,y,z separated by commas"),
+        (b"1,2,3\n2147483648,0,0\n", 2, "x = 2147483648 is too large; expected at most "
+         "2147483647"),
+        (b"1,2,3\n\x00\x01\x02\n", 2, "1 comma-separated values in '\\x00\\x01\\x02'; expected "
+         "three non-negative integers x,y,z separated by commas"),
+        (b"1,2,3\n\xff\xfe,1,1\n", 2, "x = '\ufffd\ufffd' is not a whole number; expected three "
+         "non-negative integers x,y,z separated by commas"),
+    ],
+)
+def test_malformed_lines_name_file_line_and_expectation(tmp_path, data, line, message):
+    path = write(tmp_path, data)
+    with pytest.raises(InputFileError) as caught:
+        load_voxels(path)
+    assert str(caught.value) == f"{path}:{line}: {message}"
+    assert caught.value.line == line
+
+
+def test_error_line_number_counts_from_the_start_deep_in_a_large_file(tmp_path):
+    lines = [f"{i},{i % 7},{i % 11}\n" for i in range(100_000)]
+    lines[87_654] = "5,6\n"
+    path = write(tmp_path, "".join(lines).encode())
+    with pytest.raises(InputFileError, match=rf"^{path}:87655: 2 comma-separated values in '5,6'"):
+        load_voxels(path)
+
+
+def test_missing_file_is_named(tmp_path):
+    path = tmp_path / "nowhere.txt"
+    with pytest.raises(InputFileError) as caught:
+        load_voxels(path)
+    assert str(caught.value) == (
+        f"{path}: no such file; expected three non-negative integers x,y,z separated by commas "
+        "per line"
+    )
+
+
+def test_folder_instead_of_file(tmp_path):
+    with pytest.raises(InputFileError, match="is a folder"):
+        load_voxels(tmp_path)
+
+
+def test_duplicates_are_removed_keeping_first_occurrence_order(tmp_path):
+    path = write(tmp_path, b"5,5,5\n1,2,3\n5,5,5\n0,0,0\n1,2,3\n1,2,4\n")
+    voxels, dropped = load_voxels_counted(path)
+    np.testing.assert_array_equal(voxels, [[5, 5, 5], [1, 2, 3], [0, 0, 0], [1, 2, 4]])
+    assert dropped == 2
+
+
+def test_unique_voxels_agrees_with_numpy_unique_on_random_data():
+    rng = np.random.default_rng(7)
+    voxels = rng.integers(0, 40, size=(50_000, 3)).astype(np.int32)
+    kept, dropped = unique_voxels(voxels)
+    expected_rows, first = np.unique(voxels, axis=0, return_index=True)
+    np.testing.assert_array_equal(kept, voxels[np.sort(first)])
+    assert dropped == len(voxels) - len(expected_rows)
+
+
+def test_unique_voxels_with_keys_too_large_to_pack():
+    big = 2**31 - 1
+    voxels = np.array([[big, big, big], [0, 1, 2], [big, big, big]], dtype=np.int32)
+    kept, dropped = unique_voxels(voxels)
+    np.testing.assert_array_equal(kept, [[big, big, big], [0, 1, 2]])
+    assert dropped == 1
+
+
+def test_save_is_atomic_when_the_data_is_bad(tmp_path):
+    path = tmp_path / "keep.txt"
+    path.write_text("1,2,3\n")
+    with pytest.raises(ValueError):
+        save_voxels(path, np.array([[1, -2, 3]]))
+    with pytest.raises(ValueError):
+        save_voxels(path, np.array([[1.5, 2, 3]]))
+    with pytest.raises(ValueError):
+        save_voxels(path, np.array([1, 2, 3]))
+    assert path.read_text() == "1,2,3\n"
+    assert os.listdir(tmp_path) == ["keep.txt"]
+
+
+def test_python_and_compiled_formatting_agree(monkeypatch):
+    from ladartui.scene import voxels as module
+
+    rng = np.random.default_rng(5)
+    voxels = rng.integers(0, 2**31 - 1, size=(3000, 3))
+    voxels[:10] = rng.integers(0, 12, size=(10, 3))  # short numbers too
+    expected = "".join(f"{x},{y},{z}\n" for x, y, z in voxels.tolist()).encode()
+    assert bytes(module.format_voxel_lines(voxels)) == expected
+    monkeypatch.setattr(module, "_COMPILED_FORMAT_ROWS", 0)
+    assert bytes(module.format_voxel_lines(voxels)) == expected
+
+
+def test_sorted_lists_skip_the_duplicate_search_but_still_find_repeats():
+    sorted_rows = np.array([[0, 0, 1], [0, 0, 2], [0, 1, 0], [3, 0, 0]], dtype=np.int32)
+    kept, dropped = unique_voxels(sorted_rows)
+    np.testing.assert_array_equal(kept, sorted_rows)
+    assert dropped == 0
+    repeated = np.array([[0, 0, 1], [0, 0, 1], [0, 1, 0]], dtype=np.int32)  # sorted, not strictly
+    kept, dropped = unique_voxels(repeated)
+    np.testing.assert_array_equal(kept, [[0, 0, 1], [0, 1, 0]])
+    assert dropped == 1
