@@ -1,0 +1,584 @@
+"""Measures of effectiveness of a collection (report sections 2.2 and 4.4, figure 10).
+
+A run produces two fused voxel lists: the *obscured* view (the full scene, foliage
+in the way) and the *unobscured* view (the target model alone, the ideal that a
+flight path could reach without foliage). Both are scored against the target
+model. Every share is a fraction in 0..1; a measure that has no meaning for the
+inputs (empty target, nothing seen) is ``None`` and shown as "undefined".
+
+The maximum target coverage is the share of target-model voxels with at least
+one face open to empty space, the ground-facing (-z) face aside. It is decided
+with the target model alone (foliage next to the vehicle does not close a
+face): it bounds what any flight path could see, whatever the scene.
+
+Directional statistics use, for each covered target voxel, the unit vector from
+the target's centroid (the mean of all target-model voxel centres) to that
+voxel's centre, in the scene frame (x east, y north, z up). The distribution of
+these vectors says *where around the vehicle* the coverage lies: coverage of
+the roof only gives a mean direction near straight up, coverage of one side
+tilts it towards that side, and an even coverage all round gives a short mean
+resultant length. A covered voxel at the centroid itself has no direction and
+is left out of the statistics (it still counts for coverage).
+
+The ``.cmf`` file ("comparison measures file") is plain text: a header line
+``# ladartui comparison measures, format cmf 1``, then ``[section]`` lines and
+``key = value`` lines. Values are integers, floats (written so they read back
+exactly), comma-separated vectors, or ``undefined``. The coverage after each
+scan is one line per scan, ``scan_k = obscured, unobscured``. Lines starting
+with ``#`` are comments. ``read_cmf`` reads it back into ``Measures``.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field, fields
+
+import numpy as np
+
+from ladartui.atomic import write_text_atomic
+from ladartui.errors import FieldError, InputFileError
+
+CMF_FORMAT = "cmf"
+CMF_VERSION = 1
+CMF_HEADER = f"# ladartui comparison measures, format {CMF_FORMAT} {CMF_VERSION}"
+
+# Faces through which a target voxel can be seen: the ground-facing (-z) face is
+# left out, since a sensor above the ground never looks up at it.
+VISIBLE_FACE_OFFSETS = np.array(
+    [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1]], dtype=np.int64
+)
+
+# Coverage share of the final obscured coverage that counts as "enough looks".
+ENOUGH_SHARE = 0.9
+
+_NOISE = 1e-12
+# Voxel keys pack (i+1, j+1, k+1) into 22 + 22 + 19 bits of one int64.
+_KEY_BITS_XY = 22
+_KEY_BITS_Z = 19
+_KEY_LIMITS = np.array([1 << _KEY_BITS_XY, 1 << _KEY_BITS_XY, 1 << _KEY_BITS_Z], dtype=np.int64)
+
+
+def voxel_keys(voxels) -> np.ndarray:
+    """One int64 key per voxel ``(i, j, k)``, ordered like the voxels lexicographically.
+
+    Indices may range over -1 .. 2**22 - 2 for i and j and -1 .. 2**19 - 2 for
+    k (the -1 lets neighbour lookups step off the grid's low side).
+    """
+    v = np.asarray(voxels, dtype=np.int64).reshape(-1, 3) + 1
+    if v.size and (v.min() < 0 or (v.max(axis=0) >= _KEY_LIMITS).any()):
+        raise FieldError("voxel index", tuple(int(c) for c in v.max(axis=0) - 1),
+                         f"0..{_KEY_LIMITS[0] - 2} for x and y, 0..{_KEY_LIMITS[2] - 2} for z")
+    return (v[:, 0] << (_KEY_BITS_XY + _KEY_BITS_Z)) | (v[:, 1] << _KEY_BITS_Z) | v[:, 2]
+
+
+def keys_to_voxels(keys) -> np.ndarray:
+    """The inverse of ``voxel_keys``: (K, 3) int32 voxel indices."""
+    keys = np.asarray(keys, dtype=np.int64)
+    out = np.empty((keys.size, 3), dtype=np.int32)
+    out[:, 0] = (keys >> (_KEY_BITS_XY + _KEY_BITS_Z)) - 1
+    out[:, 1] = ((keys >> _KEY_BITS_Z) & (_KEY_LIMITS[1] - 1)) - 1
+    out[:, 2] = (keys & (_KEY_LIMITS[2] - 1)) - 1
+    return out
+
+
+def sorted_unique(keys) -> np.ndarray:
+    """The distinct values of an int64 array, sorted.
+
+    Sorting and comparing neighbours is several times faster than np.unique
+    on these arrays.
+    """
+    keys = np.sort(np.asarray(keys, dtype=np.int64).ravel())
+    if keys.size < 2:
+        return keys
+    distinct = np.empty(keys.size, dtype=bool)
+    distinct[0] = True
+    np.not_equal(keys[1:], keys[:-1], out=distinct[1:])
+    return keys[distinct]
+
+
+def _unique_keys(voxels) -> np.ndarray:
+    return sorted_unique(voxel_keys(voxels))
+
+
+def _member(keys: np.ndarray, sorted_keys: np.ndarray) -> np.ndarray:
+    """Boolean mask: which ``keys`` occur in ``sorted_keys`` (sorted, unique)."""
+    if sorted_keys.size == 0:
+        return np.zeros(keys.shape, dtype=bool)
+    pos = np.searchsorted(sorted_keys, keys)
+    pos[pos == sorted_keys.size] = 0
+    return sorted_keys[pos] == keys
+
+
+def visible_mask(target_model) -> np.ndarray:
+    """Which target-model voxels have a face open to empty space (the -z face aside).
+
+    Decided with the target model alone: foliage and other scene voxels do not
+    close a face, since the maximum coverage is a property of the target.
+    """
+    target = np.asarray(target_model, dtype=np.int64).reshape(-1, 3)
+    keys = sorted_unique(voxel_keys(target))
+    visible = np.zeros(len(target), dtype=bool)
+    for offset in VISIBLE_FACE_OFFSETS:
+        visible |= ~_member(voxel_keys(target + offset), keys)
+    return visible
+
+
+@dataclass(frozen=True)
+class DirectionStats:
+    """Directional statistics of a set of covered target voxels.
+
+    ``count`` voxels contributed a unit vector (centroid to voxel centre);
+    ``mean_vector`` is the sample mean of those vectors, ``resultant_length`` its
+    length (0..1), ``mean_direction`` the mean vector made unit length.
+    """
+
+    count: int = 0
+    mean_vector: tuple[float, float, float] | None = None
+    resultant_length: float | None = None
+    mean_direction: tuple[float, float, float] | None = None
+
+    def to_dict(self) -> dict:
+        return {
+            "count": self.count,
+            "mean_vector": _list_or_none(self.mean_vector),
+            "resultant_length": self.resultant_length,
+            "mean_direction": _list_or_none(self.mean_direction),
+        }
+
+
+def direction_stats(voxels, centroid) -> DirectionStats:
+    """Statistics of the unit vectors from ``centroid`` to each voxel centre (grid units)."""
+    v = np.asarray(voxels, dtype=np.float64).reshape(-1, 3) - np.asarray(centroid, dtype=np.float64)
+    norms = np.sqrt((v * v).sum(axis=1))
+    # A voxel at the centroid has no direction (tolerance far below a voxel).
+    keep = norms > 1e-9
+    if not keep.any():
+        return DirectionStats()
+    units = v[keep] / norms[keep, None]
+    mean = units.mean(axis=0)
+    # Rounding noise of a symmetric coverage (1e-17) would read as a direction.
+    mean[np.abs(mean) < _NOISE] = 0.0
+    length = float(math.sqrt(float(mean @ mean)))
+    direction = _clean(mean / length) if length > 0.0 else None
+    return DirectionStats(
+        count=int(keep.sum()),
+        mean_vector=_clean(mean),
+        resultant_length=length,
+        mean_direction=direction,
+    )
+
+
+def _clean(vector) -> tuple[float, float, float]:
+    return tuple(0.0 if abs(c) < _NOISE else float(c) for c in vector)
+
+
+def angle_between(a, b) -> float | None:
+    """Angle in radians between two unit vectors; None if either is undefined."""
+    if a is None or b is None:
+        return None
+    cosine = float(np.clip(np.dot(a, b), -1.0, 1.0))
+    return float(math.acos(cosine))
+
+
+@dataclass(frozen=True)
+class Measures:
+    """Measures of effectiveness of one simulated collection.
+
+    Counts are voxels; coverages and shares are fractions 0..1 (``None`` when
+    undefined). ``*_after_scan`` lists give cumulative coverage after scan
+    1..k. ``scans_for_enough`` is the first scan count whose cumulative obscured
+    coverage reaches ``ENOUGH_SHARE`` of the final obscured coverage.
+    """
+
+    target_voxels: int = 0
+    visible_voxels: int = 0
+    unobscured_voxels: int = 0
+    obscured_voxels: int = 0
+    maximum_coverage: float | None = None
+    unobscured_coverage: float | None = None
+    obscured_coverage: float | None = None
+    model_directions: DirectionStats = field(default_factory=DirectionStats)
+    unobscured_directions: DirectionStats = field(default_factory=DirectionStats)
+    obscured_directions: DirectionStats = field(default_factory=DirectionStats)
+    direction_shift_rad: float | None = None
+    missed_share: float | None = None
+    coverage_ratio: float | None = None
+    obscured_only_voxels: int = 0
+    obscured_after_scan: tuple[float, ...] | None = None
+    unobscured_after_scan: tuple[float, ...] | None = None
+    scans_for_enough: int | None = None
+    scans: int | None = None
+    path_length_m: float | None = None
+    flight_time_s: float | None = None
+    voxel_size: float | None = None
+
+    def to_dict(self) -> dict:
+        """A JSON-safe dict (no NaN: undefined measures are None)."""
+        out = {}
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, DirectionStats):
+                value = value.to_dict()
+            elif isinstance(value, tuple):
+                value = list(value)
+            out[f.name] = value
+        return out
+
+    def to_cmf(self) -> str:
+        """The measures as ``.cmf`` text (see the module docstring)."""
+        lines = [CMF_HEADER, *_CMF_NOTES]
+        for section, entries in _CMF_LAYOUT:
+            lines.append("")
+            lines.append(f"[{section}]")
+            for key, getter, _kind in entries:
+                lines.append(f"{key} = {_format_value(getter(self))}")
+            if section == _PER_SCAN_SECTION:
+                lines.extend(_per_scan_lines(self))
+        return "\n".join(lines) + "\n"
+
+    def write_cmf(self, path) -> None:
+        """Write ``to_cmf()`` to ``path`` atomically."""
+        write_text_atomic(path, self.to_cmf())
+
+
+def compute_measures(target_model, scene_output, target_output, scene_per_scan=None,
+                     target_per_scan=None, path_length_m=None, flight_time_s=None,
+                     voxel_size=None) -> Measures:
+    """Score the obscured (``scene_output``) and unobscured (``target_output``) views.
+
+    All voxel arguments are (K, 3) integer index arrays; outputs may hold
+    non-target voxels (foliage, ground), which are ignored. ``*_per_scan`` are
+    lists of each scan's returns, in flight order, for coverage after each scan.
+    """
+    target = np.asarray(target_model, dtype=np.int64).reshape(-1, 3)
+    target_keys, first = np.unique(voxel_keys(target), return_index=True)
+    target = target[first]
+    total = int(target.shape[0])
+
+    def covered_mask(voxels):
+        if voxels is None:
+            return np.zeros(total, dtype=bool)
+        return _member(target_keys, _unique_keys(voxels))
+
+    unobscured = covered_mask(target_output)
+    obscured = covered_mask(scene_output)
+    visible = visible_mask(target) if total else np.zeros(0, dtype=bool)
+
+    def share(count, whole):
+        return count / whole if whole else None
+
+    centroid = target.mean(axis=0) if total else np.zeros(3)
+    model_dirs = direction_stats(target[visible], centroid)
+    unobscured_dirs = direction_stats(target[unobscured], centroid)
+    obscured_dirs = direction_stats(target[obscured], centroid)
+
+    n_unobscured = int(unobscured.sum())
+    n_obscured = int(obscured.sum())
+    missed = int((unobscured & ~obscured).sum())
+
+    obscured_after = _cumulative_coverage(target_keys, scene_per_scan)
+    unobscured_after = _cumulative_coverage(target_keys, target_per_scan)
+    per_scan = scene_per_scan if scene_per_scan is not None else target_per_scan
+    scans = None if per_scan is None else len(per_scan)
+
+    return Measures(
+        target_voxels=total,
+        visible_voxels=int(visible.sum()),
+        unobscured_voxels=n_unobscured,
+        obscured_voxels=n_obscured,
+        maximum_coverage=share(int(visible.sum()), total),
+        unobscured_coverage=share(n_unobscured, total),
+        obscured_coverage=share(n_obscured, total),
+        model_directions=model_dirs,
+        unobscured_directions=unobscured_dirs,
+        obscured_directions=obscured_dirs,
+        direction_shift_rad=angle_between(unobscured_dirs.mean_direction, obscured_dirs.mean_direction),
+        missed_share=share(missed, n_unobscured),
+        coverage_ratio=share(n_obscured, n_unobscured),
+        obscured_only_voxels=int((obscured & ~unobscured).sum()),
+        obscured_after_scan=obscured_after,
+        unobscured_after_scan=unobscured_after,
+        scans_for_enough=_scans_for_enough(obscured_after),
+        scans=scans,
+        path_length_m=None if path_length_m is None else float(path_length_m),
+        flight_time_s=None if flight_time_s is None else float(flight_time_s),
+        voxel_size=None if voxel_size is None else float(voxel_size),
+    )
+
+
+def _cumulative_coverage(target_keys, per_scan) -> tuple[float, ...] | None:
+    if per_scan is None or target_keys.size == 0:
+        return None
+    seen = np.zeros(target_keys.size, dtype=bool)
+    out = []
+    for returns in per_scan:
+        keys = voxel_keys(returns)
+        if keys.size:
+            pos = np.searchsorted(target_keys, keys)
+            inside = pos < target_keys.size
+            pos, keys = pos[inside], keys[inside]
+            seen[pos[target_keys[pos] == keys]] = True
+        out.append(int(seen.sum()) / target_keys.size)
+    return tuple(out)
+
+
+def _scans_for_enough(after) -> int | None:
+    if not after or after[-1] <= 0:
+        return None
+    goal = ENOUGH_SHARE * after[-1]
+    for k, value in enumerate(after, start=1):
+        if value >= goal - 1e-12:
+            return k
+    return len(after)
+
+
+# The .cmf layout: sections follow the report's figure 10 (target model,
+# unobscured output, obscured output, comparison), then the per-scan and flight
+# figures. Each entry is (key, Measures attribute path, value kind).
+def _direction_entries(prefix):
+    return [
+        ("directions_counted", f"{prefix}.count", "int"),
+        ("sample_mean_vector", f"{prefix}.mean_vector", "vector"),
+        ("mean_resultant_length", f"{prefix}.resultant_length", "float"),
+        ("mean_direction", f"{prefix}.mean_direction", "vector"),
+    ]
+
+
+_CMF_SECTIONS = [
+    ("3d target model", [
+        ("target_voxels", "target_voxels", "int"),
+        ("visible_voxels", "visible_voxels", "int"),
+        ("maximum_target_coverage", "maximum_coverage", "float"),
+        *_direction_entries("model_directions"),
+    ]),
+    ("unobscured 3d target output", [
+        ("covered_voxels", "unobscured_voxels", "int"),
+        ("target_coverage", "unobscured_coverage", "float"),
+        *_direction_entries("unobscured_directions"),
+    ]),
+    ("obscured 3d target output", [
+        ("covered_voxels", "obscured_voxels", "int"),
+        ("target_coverage", "obscured_coverage", "float"),
+        *_direction_entries("obscured_directions"),
+    ]),
+    ("comparison", [
+        ("shift_in_mean_direction_rad", "direction_shift_rad", "float"),
+        ("missed_share", "missed_share", "float"),
+        ("coverage_ratio", "coverage_ratio", "float"),
+        ("obscured_only_voxels", "obscured_only_voxels", "int"),
+    ]),
+    ("coverage after each scan", [
+        ("scans", "scans", "int"),
+        ("scans_for_90_percent_of_final", "scans_for_enough", "int"),
+    ]),
+    ("flight", [
+        ("path_length_m", "path_length_m", "float"),
+        ("flight_time_s", "flight_time_s", "float"),
+        ("voxel_size_m", "voxel_size", "float"),
+    ]),
+]
+
+_CMF_NOTES = [
+    "# shares are fractions 0..1, angles radians, lengths metres, times seconds;",
+    "# 'undefined' marks a measure with no meaning for this run (e.g. nothing seen).",
+    "# directions: unit vectors from the target centroid to each covered voxel centre,",
+    "# frame x east, y north, z up. missed_share: share of the unobscured coverage",
+    "# missing from the obscured view; coverage_ratio: obscured / unobscured coverage.",
+]
+
+
+def _get_path(measures, path):
+    value = measures
+    for part in path.split("."):
+        value = getattr(value, part)
+    return value
+
+
+_PER_SCAN_SECTION = "coverage after each scan"
+_PER_SCAN_KEY = re.compile(r"scan_([1-9][0-9]*)$")
+
+
+def _per_scan_lines(measures) -> list[str]:
+    """``scan_k = obscured, unobscured`` lines: cumulative coverage after scan k."""
+    obscured, unobscured = measures.obscured_after_scan, measures.unobscured_after_scan
+    count = max(len(obscured or ()), len(unobscured or ()))
+    if not count:
+        return []
+    lines = ["# scan_k = obscured, unobscured target coverage after scans 1..k"]
+    for k in range(count):
+        pair = [None if values is None else values[k] for values in (obscured, unobscured)]
+        lines.append(f"scan_{k + 1} = {_format_value(pair)}")
+    return lines
+
+
+def _per_scan_lists(path, rows) -> dict:
+    """The two coverage-after-scan tuples from ``{k: (line, obscured, unobscured)}``."""
+    out = {}
+    if not rows:
+        return out
+    for k in range(1, len(rows) + 1):
+        if k not in rows:
+            raise InputFileError(path, f"scan_{k} missing: expected scan_1 .. scan_{len(rows)}")
+    for column, name in enumerate(("obscured_after_scan", "unobscured_after_scan")):
+        values = [rows[k][column + 1] for k in range(1, len(rows) + 1)]
+        if all(v is None for v in values):
+            out[name] = None
+        elif any(v is None for v in values):
+            line = next(rows[k][0] for k in rows if rows[k][column + 1] is None)
+            raise InputFileError(path, "undefined among defined coverages", line=line)
+        else:
+            out[name] = tuple(values)
+    return out
+
+
+_CMF_LAYOUT = [
+    (section, [(key, (lambda m, p=path: _get_path(m, p)), kind) for key, path, kind in entries])
+    for section, entries in _CMF_SECTIONS
+]
+
+
+def _format_value(value) -> str:
+    if value is None:
+        return "undefined"
+    if isinstance(value, (tuple, list)):
+        return ", ".join(_format_value(v) for v in value)
+    if isinstance(value, float):
+        return repr(value)
+    return str(value)
+
+
+def _parse_value(text: str, kind: str):
+    if text == "undefined":
+        return None
+    if kind == "int":
+        return int(text)
+    if kind == "float":
+        value = float(text)
+        if not math.isfinite(value):
+            raise ValueError("not a finite number")
+        return value
+    items = text.split(",")
+    if len(items) != 3:
+        raise ValueError("expected three comma-separated numbers")
+    return tuple(_parse_value(item.strip(), "float") for item in items)
+
+
+def read_cmf(path) -> Measures:
+    """Read a ``.cmf`` file written by ``Measures.write_cmf``."""
+    try:
+        text = open(path, encoding="utf-8").read()
+    except OSError as error:
+        raise InputFileError(path, f"cannot read: {error.strerror or error}") from None
+    lines = text.splitlines()
+    if not lines or lines[0].strip() != CMF_HEADER:
+        raise InputFileError(path, f"not a measures file: expected first line {CMF_HEADER!r}", line=1)
+    kinds = {(section, key): (attr, kind) for section, entries in _CMF_SECTIONS for key, attr, kind in entries}
+    values: dict[str, object] = {}
+    per_scan: dict[int, tuple] = {}
+    section = None
+    for number, raw in enumerate(lines[1:], start=2):
+        line = raw.strip()
+        if not line or line.startswith("#"):
+            continue
+        if line.startswith("[") and line.endswith("]"):
+            section = line[1:-1].strip()
+            if not any(section == name for name, _ in _CMF_SECTIONS):
+                raise InputFileError(path, f"unknown section [{section}]", line=number)
+            continue
+        key, sep, value = line.partition("=")
+        key = key.strip()
+        scan_key = _PER_SCAN_KEY.match(key)
+        if sep and section == _PER_SCAN_SECTION and scan_key:
+            pair = [t.strip() for t in value.split(",")]
+            try:
+                if len(pair) != 2:
+                    raise ValueError("expected two values: obscured, unobscured")
+                per_scan[int(scan_key.group(1))] = (number, *(_parse_value(t, "float") for t in pair))
+            except ValueError as error:
+                raise InputFileError(path, f"{key}: {error}", line=number) from None
+            continue
+        if not sep or (section, key) not in kinds:
+            raise InputFileError(path, f"expected 'key = value' with a known key in [{section}], got {line!r}",
+                                 line=number)
+        attr, kind = kinds[(section, key)]
+        try:
+            values[attr] = _parse_value(value.strip(), kind)
+        except ValueError as error:
+            raise InputFileError(path, f"{key}: {error}", line=number) from None
+    plain, nested = {}, {}
+    for attr, value in values.items():
+        head, _, tail = attr.partition(".")
+        if tail:
+            nested.setdefault(head, {})[tail] = value
+        else:
+            plain[attr] = value
+    for head, parts in nested.items():
+        plain[head] = DirectionStats(**parts)
+    plain.update(_per_scan_lists(path, per_scan))
+    return Measures(**plain)
+
+
+def _list_or_none(vector):
+    return None if vector is None else list(vector)
+
+
+# --------------------------------------------------------------------------- display
+
+UNDEFINED = "undefined"
+
+
+def format_share(value) -> str:
+    """A fraction as a percentage with one decimal, or "undefined"."""
+    return UNDEFINED if value is None else f"{100.0 * value:.1f} %"
+
+
+def format_number(value, digits=3, unit="") -> str:
+    """A number with ``digits`` decimals (and a unit), or "undefined"."""
+    if value is None:
+        return UNDEFINED
+    return f"{value:.{digits}f}{' ' + unit if unit else ''}"
+
+
+def format_vector(vector, digits=3) -> str:
+    """A 3-vector as "x, y, z", or "undefined"."""
+    if vector is None:
+        return UNDEFINED
+    return ", ".join(f"{c:.{digits}f}" for c in vector)
+
+
+def view_rows(measures: Measures) -> list[tuple[str, str, str, str]]:
+    """Rows (label, target model, unobscured, obscured) as in the report's figure 10."""
+    m = measures
+    views = (m.model_directions, m.unobscured_directions, m.obscured_directions)
+    return [
+        ("Target coverage", format_share(m.maximum_coverage), format_share(m.unobscured_coverage),
+         format_share(m.obscured_coverage)),
+        ("Voxels", f"{m.visible_voxels} of {m.target_voxels}", str(m.unobscured_voxels),
+         str(m.obscured_voxels)),
+        ("Sample mean vector", *(format_vector(v.mean_vector) for v in views)),
+        ("Mean resultant length", *(format_number(v.resultant_length) for v in views)),
+        ("Mean direction", *(format_vector(v.mean_direction) for v in views)),
+    ]
+
+
+def comparison_rows(measures: Measures) -> list[tuple[str, str]]:
+    """Rows (label, value) comparing the views, coverage per scan and the flight."""
+    m = measures
+
+    def after(values):
+        return UNDEFINED if values is None else " ".join(f"{100.0 * v:.0f}" for v in values) + " (%)"
+
+    return [
+        ("Shift in mean direction", format_number(m.direction_shift_rad, unit="rad")),
+        ("Unobscured coverage missed when obscured", format_share(m.missed_share)),
+        ("Obscured / unobscured coverage", format_share(m.coverage_ratio)),
+        ("Seen obscured but not unobscured",
+         f"{m.obscured_only_voxels} voxel{'' if m.obscured_only_voxels == 1 else 's'}"),
+        ("Obscured coverage after each scan", after(m.obscured_after_scan)),
+        ("Unobscured coverage after each scan", after(m.unobscured_after_scan)),
+        (f"Scans to reach {ENOUGH_SHARE:.0%} of final coverage",
+         UNDEFINED if m.scans_for_enough is None else f"{m.scans_for_enough} of {m.scans}"),
+        ("Path length", format_number(m.path_length_m, 1, "m")),
+        ("Flight time", format_number(m.flight_time_s, 1, "s")),
+    ]

@@ -1,0 +1,389 @@
+"""The run: scans along the flight path, the depth-resolution rule, fusion, measures.
+
+``simulate`` traces every scan twice, as the report's section 4.4 describes: once
+against the full scene model (the *obscured* view) and once against the target
+model alone over the same extent (the *unobscured* view, the ideal). Each scan's
+hits pass the detector's depth-resolution rule, and the returns of all scans are
+fused into one voxel list per run. Outputs are written only after both runs
+have finished, each atomically, so a failed or cancelled run leaves earlier
+outputs as they were.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import threading
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numba
+import numpy as np
+
+from ladartui.atomic import atomic_path
+from ladartui.errors import Cancelled
+from ladartui.measures import Measures, compute_measures, keys_to_voxels, sorted_unique, voxel_keys
+from ladartui.tracing.backend import MISS
+
+RUNS = ("scene", "target")
+
+# Aim for trace calls of about this long, so a cancel is answered quickly.
+_CHUNK_SECONDS = 0.1
+_FIRST_CHUNK_RAYS = 32768
+_MIN_CHUNK_RAYS = 1024
+# Larger calls gain nothing, and ray set-up slows down on very large arrays.
+_MAX_CHUNK_RAYS = 65536
+# Detectors with more rays than this are sorted up front, not by insertion.
+_INSERTION_LIMIT = 64
+
+
+# --------------------------------------------------------------------------- depth rule
+
+@numba.njit(nogil=True, cache=True)
+def _depth_rule_kernel(order, grouped, detector, kind, ranges, depth_resolution, kept):
+    """Write the indices of the kept returns into ``kept``; return how many.
+
+    Rays are visited in ``order`` (or 0..n-1 when ``grouped``), which lists
+    each detector's rays together (already sorted by range when groups are
+    large). Within a detector the returns are sorted by range (stably, so equal
+    ranges keep ray order); the first is kept and every later one closer than
+    ``depth_resolution`` to the last kept return is dropped.
+    """
+    n = detector.size
+    group_rays = np.empty(n, dtype=np.int64)
+    group_ranges = np.empty(n, dtype=np.float64)
+    count_kept = 0
+    start = 0
+    while start < n:
+        group = detector[start if grouped else order[start]]
+        stop = start
+        while stop < n and detector[stop if grouped else order[stop]] == group:
+            stop += 1
+        count = 0
+        for position in range(start, stop):
+            ray = position if grouped else order[position]
+            value = ranges[ray]
+            if kind[ray] == MISS or not np.isfinite(value):
+                continue
+            # Insertion sort, stable; linear when the order is sorted already.
+            j = count - 1
+            while j >= 0 and group_ranges[j] > value:
+                group_ranges[j + 1] = group_ranges[j]
+                group_rays[j + 1] = group_rays[j]
+                j -= 1
+            group_ranges[j + 1] = value
+            group_rays[j + 1] = ray
+            count += 1
+        last = 0.0
+        for i in range(count):
+            if i == 0 or group_ranges[i] - last >= depth_resolution:
+                kept[count_kept] = group_rays[i]
+                count_kept += 1
+                last = group_ranges[i]
+        start = stop
+    return count_kept
+
+
+def kept_returns(detector, kind, ranges, depth_resolution) -> np.ndarray:
+    """Indices of the rays whose hits survive the detector's depth resolution.
+
+    Rays are grouped by ``detector`` id and sorted by ``ranges`` (metres); the
+    nearest return of each detector is kept, and each later one is kept only if
+    it lies at least ``depth_resolution`` metres beyond the last kept return.
+    Misses (``kind == MISS``) never return; ground returns are returns.
+    """
+    detector = np.ascontiguousarray(detector)
+    kind = np.ascontiguousarray(kind, dtype=np.uint8)
+    ranges = np.ascontiguousarray(ranges, dtype=np.float64)
+    n = detector.shape[0]
+    if not (kind.shape[0] == ranges.shape[0] == n):
+        raise ValueError("detector, kind and ranges must have the same length")
+    if n == 0:
+        return np.zeros(0, dtype=np.int64)
+    # Sensor rays come grouped by detector in increasing order, a few per
+    # detector: sort each group in place. Otherwise sort everything first.
+    grouped = bool(np.all(detector[1:] >= detector[:-1])) and _largest_group(detector) <= _INSERTION_LIMIT
+    order = np.zeros(0, dtype=np.int64) if grouped else np.lexsort((ranges, detector))
+    kept = np.empty(n, dtype=np.int64)
+    count = _depth_rule_kernel(order.astype(np.int64), grouped, detector, kind, ranges,
+                               float(depth_resolution), kept)
+    return kept[:count]
+
+
+def _largest_group(sorted_ids) -> int:
+    starts = np.flatnonzero(sorted_ids[1:] != sorted_ids[:-1]) + 1
+    bounds = np.concatenate(([0], starts, [sorted_ids.size]))
+    return int(np.diff(bounds).max())
+
+
+def apply_depth_resolution(detector, kind, ranges, depth_resolution) -> np.ndarray:
+    """Boolean mask over the rays: True where the hit survives the depth resolution."""
+    mask = np.zeros(np.shape(detector)[0], dtype=bool)
+    mask[kept_returns(detector, kind, ranges, depth_resolution)] = True
+    return mask
+
+
+def scan_returns(trace_result, detector, depth_resolution) -> np.ndarray:
+    """The voxels one scan returns: hits after the depth rule, unique, (K, 3) int32."""
+    kept = kept_returns(detector, trace_result.kind, trace_result.range, depth_resolution)
+    return unique_voxels(trace_result.index[kept])
+
+
+def unique_voxels(voxels) -> np.ndarray:
+    """The distinct voxels of a (K, 3) list, sorted by (i, j, k), as int32."""
+    voxels = np.asarray(voxels).reshape(-1, 3)
+    if voxels.shape[0] == 0:
+        return np.zeros((0, 3), dtype=np.int32)
+    return keys_to_voxels(sorted_unique(voxel_keys(voxels)))
+
+
+def fuse_scans(per_scan) -> np.ndarray:
+    """The fused output of several scans: the union of their returned voxels."""
+    per_scan = [np.asarray(v).reshape(-1, 3) for v in per_scan]
+    if not per_scan:
+        return np.zeros((0, 3), dtype=np.int32)
+    return unique_voxels(np.concatenate(per_scan))
+
+
+# --------------------------------------------------------------------------- the run
+
+@dataclass(frozen=True)
+class RunProgress:
+    """Where a run stands; passed to the ``progress`` callback.
+
+    The two runs advance together, scan by scan, over the same rays: ``run``
+    is the one just traced, "scene" (obscured) or "target" (unobscured), and
+    ``scan`` counts 1..``scans``. ``rays_done`` and ``rays_total`` count rays
+    traced over both runs, and ``fraction`` is their ratio. ``returns`` is None
+    while a scan is being traced; when a scan is complete, one report per run
+    (scene first) holds that run's returned voxels for the scan, (K, 3) int32.
+    """
+
+    run: str
+    scan: int
+    scans: int
+    rays_done: int
+    rays_total: int
+    fraction: float
+    returns: np.ndarray | None = None
+
+    @property
+    def scan_complete(self) -> bool:
+        return self.returns is not None
+
+
+@dataclass
+class SimulationResult:
+    """Fused outputs, per-scan returns, measures and how the run went.
+
+    ``timings`` holds seconds spent per stage (``setup``: backend choice and
+    scene loading, ``rays``, ``trace``, ``depth_rule``, ``fusion``,
+    ``measures``, ``write``, and ``total``);
+    ``outputs`` the files written (empty when nothing was written).
+    """
+
+    scene_output: np.ndarray
+    target_output: np.ndarray
+    scene_per_scan: list
+    target_per_scan: list
+    measures: Measures
+    backend: str
+    method: str
+    rays_per_scan: int
+    timings: dict = field(default_factory=dict)
+    outputs: dict = field(default_factory=dict)
+
+    @property
+    def scans(self) -> int:
+        return len(self.scene_per_scan)
+
+
+def simulate(scenario, backend=None, method=None, step=None, precision=None,
+             progress: Callable[[RunProgress], None] | None = None,
+             cancel: threading.Event | None = None, write=True, las=False,
+             scene=None) -> SimulationResult:
+    """Simulate the scenario's collection and score it.
+
+    ``backend``, ``method``, ``step`` and ``precision`` override the scenario's
+    tracing settings. Each scan is traced in chunks of whole detector rows,
+    against the scene and then the target alone on the same rays.
+    ``progress`` is called from this thread after every traced chunk and once
+    per run when a scan is complete; ``cancel`` is checked between chunks and
+    stops the run with ``Cancelled`` before anything is written. With
+    ``write`` the fused outputs (``S_Scene.txt``, ``S_Target.txt``, and with
+    ``las`` also ``.las`` copies) and the measures (``S.cmf``) are written
+    atomically once both runs are done. ``scene`` may pass the scenario's
+    already loaded ``Scene`` (its occupancy is built once and kept).
+    """
+    started = time.perf_counter()
+    timings = dict.fromkeys(("setup", "rays", "trace", "depth_rule", "fusion", "measures", "write"),
+                            0.0)
+    settings = _trace_settings(scenario, backend, method, step, precision)
+    if scene is None:
+        scene = scenario.load_scene()
+    poses = list(scenario.poses())
+    runner = _ScanRunner(scene, scenario.sensor, settings, len(poses), timings, progress, cancel)
+    timings["setup"] = time.perf_counter() - started
+
+    per_scan = {run: [] for run in RUNS}
+    for scan, pose in enumerate(poses, start=1):
+        for run, returns in runner.scan(scan, pose).items():
+            per_scan[run].append(returns)
+
+    _check(cancel)
+    tick = time.perf_counter()
+    scene_output = fuse_scans(per_scan["scene"])
+    target_output = fuse_scans(per_scan["target"])
+    timings["fusion"] += time.perf_counter() - tick
+
+    tick = time.perf_counter()
+    measures = compute_measures(
+        scene.target, scene_output, target_output,
+        scene_per_scan=per_scan["scene"], target_per_scan=per_scan["target"],
+        path_length_m=scenario.path_length(), flight_time_s=scenario.flight_time(),
+        voxel_size=scene.voxel_size,
+    )
+    timings["measures"] = time.perf_counter() - tick
+
+    outputs = {}
+    if write:
+        _check(cancel)
+        tick = time.perf_counter()
+        outputs = _write_outputs(scenario, scene_output, target_output, measures,
+                                 scene.voxel_size, las)
+        timings["write"] = time.perf_counter() - tick
+    timings["total"] = time.perf_counter() - started
+    return SimulationResult(
+        scene_output=scene_output, target_output=target_output,
+        scene_per_scan=per_scan["scene"], target_per_scan=per_scan["target"],
+        measures=measures, backend=runner.backend_used or settings["backend"],
+        method=settings["method"], rays_per_scan=scenario.sensor.rays_per_scan,
+        timings=timings, outputs=outputs,
+    )
+
+
+class _ScanRunner:
+    """Traces scans for both runs, sizing chunks and reporting progress."""
+
+    def __init__(self, scene, sensor, settings, scans, timings, progress, cancel):
+        from ladartui.tracing import trace
+
+        self._trace = trace
+        self.voxel_size = scene.voxel_size
+        # Built once per scene (the Scene caches them) and used for every scan.
+        self.occupancies = {"scene": scene.occupancy, "target": scene.target_occupancy}
+        self.sensor = sensor
+        self.settings = settings
+        self.scans = scans
+        self.timings = timings
+        self.progress = progress
+        self.cancel = cancel
+        self.rays_per_row = sensor.grid * sensor.ray_grid ** 2
+        self.rays_total = 2 * sensor.rays_per_scan * scans
+        self.done = 0
+        self.chunk = _FIRST_CHUNK_RAYS
+        self.backend_used = None
+
+    def scan(self, scan, pose) -> dict[str, np.ndarray]:
+        """Trace one scan for both runs; each run's returned voxels, (K, 3) int32."""
+        sensor, timings = self.sensor, self.timings
+        kept = {run: [] for run in RUNS}
+        row = 0
+        while row < sensor.grid:
+            _check(self.cancel)
+            # Whole detector rows, so that the depth rule can run on each chunk.
+            stop = min(sensor.grid, row + max(1, self.chunk // self.rays_per_row))
+            tick = time.perf_counter()
+            origins, directions, detector = sensor.rays(pose, rows=slice(row, stop))
+            timings["rays"] += time.perf_counter() - tick
+            slowest = 0.0
+            for run in RUNS:
+                _check(self.cancel)
+                tick = time.perf_counter()
+                hits = self._trace(self.occupancies[run], origins, directions,
+                                   voxel_size=self.voxel_size, cancel=self.cancel, **self.settings)
+                elapsed = time.perf_counter() - tick
+                timings["trace"] += elapsed
+                slowest = max(slowest, elapsed)
+                self.backend_used = hits.backend
+                tick = time.perf_counter()
+                rays = kept_returns(detector, hits.kind, hits.range, sensor.depth_resolution)
+                kept[run].append(hits.index[rays])
+                timings["depth_rule"] += time.perf_counter() - tick
+                self.done += origins.shape[0]
+                if not (stop == sensor.grid and run == RUNS[-1]):
+                    self._report(run, scan)
+            self.chunk = _next_chunk(self.chunk, origins.shape[0], slowest)
+            row = stop
+        returns = {}
+        for run in RUNS:
+            tick = time.perf_counter()
+            returns[run] = fuse_scans(kept[run])
+            timings["fusion"] += time.perf_counter() - tick
+            self._report(run, scan, returns[run])
+        return returns
+
+    def _report(self, run, scan, returns=None):
+        if self.progress is not None:
+            self.progress(RunProgress(run, scan, self.scans, self.done, self.rays_total,
+                                      self.done / self.rays_total, returns))
+
+
+def _check(cancel):
+    if cancel is not None and cancel.is_set():
+        raise Cancelled("run cancelled; nothing was written")
+
+
+def _trace_settings(scenario, backend, method, step, precision) -> dict:
+    """The scenario's tracing settings with the caller's overrides; "auto" resolved once."""
+    from ladartui.tracing import choose_backend
+
+    backend = scenario.backend if backend is None else backend
+    return {
+        "backend": choose_backend() if backend == "auto" else backend,
+        "method": scenario.method if method is None else method,
+        "step": scenario.step if step is None else step,
+        "precision": scenario.precision if precision is None else precision,
+    }
+
+
+def _next_chunk(chunk, traced, elapsed) -> int:
+    """Size the next trace call to take about ``_CHUNK_SECONDS``."""
+    if 2 * traced < chunk or elapsed <= 0.0:
+        return chunk  # a short tail chunk says little about speed
+    goal = int(traced * _CHUNK_SECONDS / elapsed)
+    # Change gradually: one slow call (a shader compile, a busy machine) must not
+    # shrink every later call to a crawl.
+    return max(_MIN_CHUNK_RAYS, min(goal, 4 * chunk, _MAX_CHUNK_RAYS), chunk // 4)
+
+
+def _write_outputs(scenario, scene_output, target_output, measures, voxel_size, las) -> dict:
+    """Write every output to a temporary file first, then rename them all.
+
+    If any write fails, every temporary file is removed and no earlier output
+    is replaced.
+    """
+    from ladartui.scene.voxels import save_voxels
+
+    targets = {
+        "scene": Path(scenario.scene_output),
+        "target": Path(scenario.target_output),
+        "measures": Path(scenario.measures_file),
+    }
+    writers = {
+        "scene": lambda tmp: save_voxels(tmp, scene_output),
+        "target": lambda tmp: save_voxels(tmp, target_output),
+        "measures": lambda tmp: tmp.write_text(measures.to_cmf(), encoding="utf-8"),
+    }
+    if las:
+        from ladartui.scene.las import export_las
+
+        for run, voxels in (("scene", scene_output), ("target", target_output)):
+            targets[f"{run}_las"] = targets[run].with_suffix(".las")
+            writers[f"{run}_las"] = lambda tmp, v=voxels: export_las(tmp, v, voxel_size)
+    with contextlib.ExitStack() as stack:
+        for name, target in targets.items():
+            tmp = stack.enter_context(atomic_path(target))
+            writers[name](tmp)
+    return {name: str(path) for name, path in targets.items()}

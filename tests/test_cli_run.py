@@ -1,0 +1,82 @@
+"""``ladartui run``: JSON and table output, --no-write, Ctrl-C, bad input."""
+
+import _thread
+import json
+
+import numpy as np
+import pytest
+
+import ladartui.simulation as simulation
+from ladartui.cli import main
+from ladartui.flight import FlightPlan, Manual, ScanPose, aim_at
+from ladartui.measures import read_cmf
+from ladartui.scenario import Scenario
+from ladartui.scene.voxels import save_voxels
+from ladartui.sensor import Sensor
+
+
+@pytest.fixture
+def scenario(tmp_path):
+    target = np.array([(x, y, z) for x in range(8, 12) for y in range(8, 11) for z in range(2)],
+                      dtype=np.int32)
+    canopy = np.array([(x, y, 6) for x in range(6, 14) for y in range(6, 13) if (x + 2 * y) % 3],
+                      dtype=np.int32)
+    save_voxels(tmp_path / "woods.txt", np.vstack([target, canopy]))
+    save_voxels(tmp_path / "woods_Target.txt", target)
+    poses = tuple(aim_at(ScanPose(x, y, 40.0), (9.5, 9.0, 0.5)) for x, y in [(9.5, -10.0), (29.5, 9.0)])
+    return Scenario(tmp_path / "S.toml", "woods.txt", 1.0, Sensor(grid=16, ray_grid=2, fov=20.0),
+                    FlightPlan(segments=[Manual(poses)]), backend="numba").save()
+
+
+def test_json_output_and_files(scenario, capsys):
+    assert main(["run", str(scenario.path), "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["backend"] == "numba" and out["scans"] == 2
+    assert out["rays_per_scan"] == 32 * 32
+    assert set(out["outputs"]) == {"scene", "target", "measures"}
+    measures = read_cmf(scenario.measures_file)
+    assert out["measures"] == json.loads(json.dumps(measures.to_dict()))
+    assert scenario.scene_output.is_file() and scenario.target_output.is_file()
+
+
+def test_table_output_and_no_write(scenario, capsys):
+    assert main(["run", str(scenario.path), "--no-write", "--method", "march", "--step", "0.25"]) == 0
+    out = capsys.readouterr().out
+    assert "Target coverage" in out and "Shift in mean direction" in out
+    assert "numba (march)" in out and "nothing written" in out
+    assert not scenario.scene_output.exists() and not scenario.measures_file.exists()
+
+
+def test_ctrl_c_cancels_and_keeps_earlier_outputs(scenario, capsys, monkeypatch):
+    assert main(["run", str(scenario.path), "--json"]) == 0
+    capsys.readouterr()
+    files = [scenario.scene_output, scenario.target_output, scenario.measures_file]
+    earlier = [p.read_bytes() for p in files]
+    real_simulate = simulation.simulate
+
+    def interrupted(*args, progress=None, cancel=None, **kwargs):
+        def report(p):
+            progress(p)
+            if p.run == "target" and p.returns is not None:
+                _thread.interrupt_main()  # as Ctrl-C would, on the main thread
+                assert cancel.wait(10), "Ctrl-C did not set the cancel event"
+
+        return real_simulate(*args, progress=report, cancel=cancel, **kwargs)
+
+    monkeypatch.setattr(simulation, "simulate", interrupted)
+    # A different method would change the outputs if they were written.
+    assert main(["run", str(scenario.path), "--method", "march", "--step", "1.0"]) == 130
+    assert "cancelled" in capsys.readouterr().err
+    assert [p.read_bytes() for p in files] == earlier
+
+
+def test_bad_input_is_one_line(tmp_path, capsys):
+    assert main(["run", str(tmp_path / "missing.toml")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "missing.toml" in err and "not found" in err
+
+
+def test_bad_backend_is_one_line(scenario, capsys):
+    assert main(["run", str(scenario.path), "--backend", "abacus", "--no-write"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "abacus" in err

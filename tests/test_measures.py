@@ -1,0 +1,197 @@
+"""Measures of effectiveness on hand-made targets with known answers, and the .cmf file."""
+
+import json
+import math
+import warnings
+
+import numpy as np
+import pytest
+
+from ladartui.errors import InputFileError
+from ladartui.measures import CMF_HEADER, Measures, compute_measures, read_cmf, visible_mask
+
+
+def box(nx, ny, nz, origin=(0, 0, 0)):
+    ox, oy, oz = origin
+    return np.array([(ox + i, oy + j, oz + k) for i in range(nx) for j in range(ny) for k in range(nz)],
+                    dtype=np.int32)
+
+
+def top_layer(voxels):
+    return voxels[voxels[:, 2] == voxels[:, 2].max()]
+
+
+def test_solid_box_seen_from_straight_above():
+    target = box(5, 4, 3, origin=(10, 20, 0))
+    top = top_layer(target)
+    foliage_and_ground = np.array([[0, 0, 0], [10, 20, 7], [30, 30, 0]])
+    measures = compute_measures(target, np.vstack([top, foliage_and_ground]), top)
+    # The top layer is 5 x 4 of 60 voxels; foliage and ground returns do not count.
+    assert measures.obscured_coverage == pytest.approx(20 / 60)
+    assert measures.unobscured_coverage == pytest.approx(20 / 60)
+    assert measures.obscured_voxels == measures.unobscured_voxels == 20
+    # Symmetric roof coverage: the mean direction is straight up.
+    assert measures.obscured_directions.mean_direction == pytest.approx((0.0, 0.0, 1.0), abs=1e-12)
+    assert measures.direction_shift_rad == pytest.approx(0.0, abs=1e-6)
+    assert measures.missed_share == 0.0
+    assert measures.coverage_ratio == 1.0
+
+
+def test_resultant_length_of_the_roof_computed_by_hand():
+    # A 3 x 1 x 2 box: centroid (1, 0, 0.5). Roof voxels (0,0,1), (1,0,1), (2,0,1)
+    # point along (-1, 0, 0.5), (0, 0, 0.5), (1, 0, 0.5) from it.
+    target = box(3, 1, 2)
+    measures = compute_measures(target, top_layer(target), top_layer(target))
+    side = 0.5 / math.sqrt(1.25)  # z part of the unit vector (+-1, 0, 0.5)
+    expected_z = (side + 1.0 + side) / 3
+    assert measures.obscured_directions.mean_vector == pytest.approx((0.0, 0.0, expected_z))
+    assert measures.obscured_directions.resultant_length == pytest.approx(expected_z)
+    assert measures.obscured_directions.count == 3
+
+
+def test_maximum_coverage_of_a_solid_box_is_its_surface_share():
+    nx, ny, nz = 6, 5, 4
+    target = box(nx, ny, nz, origin=(3, 3, 0))
+    # Hidden voxels are those with all five neighbours (-z excluded) inside:
+    # an interior in x and y, and below the top layer.
+    hidden = (nx - 2) * (ny - 2) * (nz - 1)
+    measures = compute_measures(target, None, None)
+    assert measures.visible_voxels == nx * ny * nz - hidden
+    assert measures.maximum_coverage == pytest.approx(1 - hidden / (nx * ny * nz))
+
+
+def test_maximum_coverage_ignores_the_ground_facing_face_and_other_objects():
+    # A 3 x 3 x 1 slab floating at z = 5: every voxel shows its top face, so all
+    # are visible, although the centre voxel's only open face besides -z is +z.
+    slab = box(3, 3, 1, origin=(0, 0, 5))
+    assert visible_mask(slab).all()
+    # A 3 x 3 x 3 cube hides the centre voxels of its bottom and middle layers;
+    # the open -z face of the bottom one does not count.
+    cube = box(3, 3, 3)
+    hidden = [tuple(v) for v, seen in zip(cube.tolist(), visible_mask(cube)) if not seen]
+    assert sorted(hidden) == [(1, 1, 0), (1, 1, 1)]
+
+
+def test_single_voxel_target():
+    target = np.array([[4, 4, 2]])
+    measures = compute_measures(target, target, target)
+    assert measures.maximum_coverage == 1.0
+    assert measures.obscured_coverage == measures.unobscured_coverage == 1.0
+    # The only voxel is the centroid: it has no direction.
+    assert measures.obscured_directions.count == 0
+    assert measures.obscured_directions.mean_direction is None
+    assert measures.direction_shift_rad is None
+
+
+def test_nothing_seen_and_empty_target_are_undefined_without_warnings():
+    target = box(2, 2, 2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        nothing = compute_measures(target, np.zeros((0, 3)), np.zeros((0, 3)))
+        empty = compute_measures(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)),
+                                 scene_per_scan=[np.zeros((0, 3))], target_per_scan=[np.zeros((0, 3))])
+    assert nothing.obscured_coverage == 0.0
+    assert nothing.obscured_directions.mean_direction is None
+    assert nothing.missed_share is None and nothing.coverage_ratio is None
+    assert nothing.direction_shift_rad is None
+    assert empty.maximum_coverage is None and empty.obscured_coverage is None
+    assert empty.obscured_after_scan is None
+    for measures in (nothing, empty):
+        text = json.dumps(measures.to_dict(), allow_nan=False)
+        assert "NaN" not in text
+        assert "undefined" in measures.to_cmf()
+
+
+def test_difference_from_the_ideal_and_direction_shift():
+    target = box(4, 4, 2)
+    roof = top_layer(target)
+    east_side = target[(target[:, 0] == 3)]
+    unobscured = np.vstack([roof, east_side])
+    obscured = roof[roof[:, 0] >= 2]  # the eastern half of the roof only
+    measures = compute_measures(target, obscured, unobscured)
+    n_unobscured = len({tuple(v) for v in unobscured.tolist()})
+    assert measures.unobscured_voxels == n_unobscured
+    assert measures.obscured_voxels == 8
+    assert measures.missed_share == pytest.approx((n_unobscured - 8) / n_unobscured)
+    assert measures.coverage_ratio == pytest.approx(8 / n_unobscured)
+    # The shift is the angle between the two mean directions.
+    u = np.array(measures.unobscured_directions.mean_direction)
+    o = np.array(measures.obscured_directions.mean_direction)
+    assert measures.direction_shift_rad == pytest.approx(math.acos(float(u @ o)))
+    assert measures.direction_shift_rad > 0.05
+    # Both lean east (+x), since the coverage lies east of the centroid.
+    assert u[0] > 0 and o[0] > 0
+
+
+def test_coverage_after_each_scan_is_cumulative():
+    target = box(2, 2, 1)  # four voxels
+    scans = [np.array([[0, 0, 0], [9, 9, 0]]), np.array([[0, 0, 0], [1, 0, 0]]),
+             np.zeros((0, 3)), np.array([[0, 1, 0], [1, 1, 0]])]
+    ideal = [target, target, target, target]
+    measures = compute_measures(target, np.vstack(scans), target, scene_per_scan=scans,
+                                target_per_scan=ideal, path_length_m=1200.0, flight_time_s=30.0)
+    assert measures.obscured_after_scan == (0.25, 0.5, 0.5, 1.0)
+    assert measures.unobscured_after_scan == (1.0, 1.0, 1.0, 1.0)
+    assert measures.scans == 4
+    # 90 % of the final coverage is first reached after the fourth scan.
+    assert measures.scans_for_enough == 4
+    assert measures.path_length_m == 1200.0 and measures.flight_time_s == 30.0
+
+
+def test_cmf_round_trip(tmp_path):
+    target = box(4, 3, 3)
+    scans = [top_layer(target)[:5], target[target[:, 1] == 0]]
+    measures = compute_measures(target, np.vstack(scans), target[target[:, 2] >= 1], scene_per_scan=scans,
+                                target_per_scan=[target[target[:, 2] >= 1], np.zeros((0, 3))],
+                                path_length_m=314.159, flight_time_s=12.5, voxel_size=0.25)
+    path = tmp_path / "S.cmf"
+    measures.write_cmf(path)
+    text = path.read_text()
+    assert text.splitlines()[0] == CMF_HEADER
+    assert "[3d target model]" in text and "[obscured 3d target output]" in text
+    assert "maximum_target_coverage = " in text
+    after = measures.obscured_after_scan[1], measures.unobscured_after_scan[1]
+    assert f"scan_2 = {after[0]!r}, {after[1]!r}" in text.splitlines()
+    assert read_cmf(path) == measures
+    empty = compute_measures(np.zeros((0, 3)), None, None)
+    empty.write_cmf(path)
+    assert read_cmf(path) == empty
+
+
+def test_bad_cmf_names_the_line(tmp_path):
+    path = tmp_path / "bad.cmf"
+    good = compute_measures(box(2, 2, 2), box(2, 2, 2), box(2, 2, 2), scene_per_scan=[box(2, 2, 2)] * 2,
+                            target_per_scan=[box(2, 2, 2)] * 2).to_cmf().splitlines()
+    bad = [line if not line.startswith("target_voxels") else "target_voxels = many" for line in good]
+    path.write_text("\n".join(bad) + "\n")
+    with pytest.raises(InputFileError) as error:
+        read_cmf(path)
+    line = bad.index("target_voxels = many") + 1
+    assert f"bad.cmf:{line}:" in str(error.value) and "target_voxels" in str(error.value)
+    skipped = [line for line in good if not line.startswith("scan_1 ")]
+    path.write_text("\n".join(skipped) + "\n")
+    with pytest.raises(InputFileError, match="scan_1 missing"):
+        read_cmf(path)
+    path.write_text("something else\n")
+    with pytest.raises(InputFileError, match="bad.cmf:1:"):
+        read_cmf(path)
+
+
+def test_measures_dict_is_json_safe():
+    measures = compute_measures(box(3, 3, 2), top_layer(box(3, 3, 2)), box(3, 3, 2))
+    data = json.loads(json.dumps(measures.to_dict(), allow_nan=False))
+    assert data["obscured_directions"]["mean_direction"] == pytest.approx([0.0, 0.0, 1.0])
+    assert isinstance(Measures(), Measures)
+
+
+def test_voxel_keys_round_trip_at_the_limits():
+    from ladartui.errors import FieldError
+    from ladartui.measures import keys_to_voxels, voxel_keys
+
+    voxels = np.array([[0, 0, 0], [2**22 - 2, 5, 2**19 - 2], [7, 2**22 - 2, 3], [1, 2, 3]])
+    keys = voxel_keys(voxels)
+    np.testing.assert_array_equal(keys_to_voxels(keys), voxels)
+    # Keys sort like the voxels, x first.
+    assert np.argsort(keys).tolist() == [0, 3, 2, 1]
+    with pytest.raises(FieldError, match="voxel index"):
+        voxel_keys(np.array([[0, 0, 2**19 - 1]]))

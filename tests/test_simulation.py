@@ -1,0 +1,193 @@
+"""The run end to end on tiny hand-made scenes: fusion, measures, outputs, progress, cancel."""
+
+import threading
+
+import numpy as np
+import pytest
+
+from ladartui.errors import Cancelled
+from ladartui.flight import FlightPlan, Manual, ScanPose, aim_at
+from ladartui.measures import read_cmf
+from ladartui.scenario import Scenario
+from ladartui.scene.voxels import load_voxels, save_voxels
+from ladartui.sensor import Sensor
+import ladartui.simulation as simulation
+from ladartui.simulation import fuse_scans, simulate
+
+TARGET_CENTRE = (22.5, 21.5, 1.0)
+
+
+def box(x0, x1, y0, y1, z0, z1):
+    return np.array([(x, y, z) for x in range(x0, x1) for y in range(y0, y1) for z in range(z0, z1)],
+                    dtype=np.int32)
+
+
+def as_set(voxels):
+    return {tuple(v) for v in np.asarray(voxels).tolist()}
+
+
+def make_scenario(folder, scene, target, poses, sensor, name="S"):
+    save_voxels(folder / "forest.txt", scene)
+    save_voxels(folder / "forest_Target.txt", target)
+    return Scenario(folder / f"{name}.toml", "forest.txt", 1.0, sensor,
+                    FlightPlan(segments=[Manual(tuple(poses))]), speed=25.0, backend="numba")
+
+
+@pytest.fixture
+def forest(tmp_path):
+    """A 6 x 4 x 3 vehicle under a patchy canopy layer at z = 8, seen from four scans."""
+    target = box(20, 26, 20, 24, 0, 3)
+    canopy = np.array([(x, y, 8) for x in range(16, 30) for y in range(16, 28) if (7 * x + 3 * y) % 4],
+                      dtype=np.int32)
+    poses = [aim_at(ScanPose(x, y, 60.0), TARGET_CENTRE)
+             for x, y in [(22.5, 0.0), (45.0, 21.5), (22.5, 21.5), (0.0, 21.5)]]
+    sensor = Sensor(grid=32, ray_grid=2, fov=20.0, depth_resolution=1.0)
+    return make_scenario(tmp_path, np.vstack([target, canopy]), target, poses, sensor)
+
+
+def test_forest_run_end_to_end(forest):
+    reports = []
+    result = simulate(forest, progress=reports.append)
+    m = result.measures
+    assert result.backend == "numba"
+    assert result.scans == 4 and len(result.target_per_scan) == 4
+    # Foliage can only take coverage away here.
+    assert 0 < m.obscured_coverage <= m.unobscured_coverage <= m.maximum_coverage <= 1
+    assert m.scans == 4 and m.obscured_after_scan[-1] == pytest.approx(m.obscured_coverage)
+    # The fused output is the union of the scans' returns.
+    assert as_set(result.scene_output) == set().union(*map(as_set, result.scene_per_scan))
+    assert as_set(result.target_output) == set().union(*map(as_set, result.target_per_scan))
+    # The target-only run sees nothing but target voxels and ground.
+    target = as_set(load_voxels(forest.target_file))
+    assert all(v in target or v[2] == 0 for v in as_set(result.target_output))
+    # Outputs on disk are the fused lists and the measures.
+    assert as_set(load_voxels(forest.scene_output)) == as_set(result.scene_output)
+    assert as_set(load_voxels(forest.target_output)) == as_set(result.target_output)
+    assert read_cmf(forest.measures_file) == m
+    assert m.path_length_m == pytest.approx(forest.path_length())
+    assert m.flight_time_s == pytest.approx(forest.path_length() / 25.0)
+    # Progress: both runs, fractions rising to 1, one report with returns per scan.
+    fractions = [p.fraction for p in reports]
+    assert fractions == sorted(fractions) and fractions[-1] == 1.0
+    assert [(p.run, p.scan) for p in reports if p.returns is not None] == \
+        [(run, scan) for scan in (1, 2, 3, 4) for run in ("scene", "target")]
+    assert reports[-1].rays_done == reports[-1].rays_total == 2 * 4 * 64 * 64
+
+
+def test_fusion_over_scans_equals_union_of_single_scan_runs(forest, tmp_path):
+    poses = forest.poses()
+    whole = simulate(forest, write=False)
+    singles = [simulate(forest.with_changes(flight=FlightPlan(segments=[Manual((pose,))])), write=False)
+               for pose in poses]
+    assert as_set(whole.scene_output) == set().union(*(as_set(r.scene_output) for r in singles))
+    for fused, single in zip(whole.scene_per_scan, singles):
+        assert as_set(fused) == as_set(single.scene_output)
+    assert as_set(fuse_scans(whole.scene_per_scan)) == as_set(whole.scene_output)
+
+
+def test_solid_box_from_straight_above(tmp_path):
+    # Nadir over the centre of a 4 x 4 x 3 box, no foliage: diverging rays from
+    # above can only enter the roof, so coverage is the top layer's share and
+    # the mean direction points straight up.
+    target = box(10, 14, 10, 14, 0, 3)
+    pose = ScanPose(12.0, 12.0, 50.0, depression=90.0)
+    sensor = Sensor(grid=32, ray_grid=2, fov=10.0, depth_resolution=0.5)
+    scenario = make_scenario(tmp_path, target, target, [pose], sensor)
+    m = simulate(scenario, write=False).measures
+    assert m.unobscured_coverage == pytest.approx(16 / 48)
+    assert m.obscured_coverage == pytest.approx(16 / 48)
+    assert m.unobscured_directions.mean_direction == pytest.approx((0.0, 0.0, 1.0), abs=1e-9)
+    assert m.direction_shift_rad == pytest.approx(0.0, abs=1e-6)
+
+
+def write_earlier_outputs(scenario):
+    earlier = {}
+    for path, text in ((scenario.scene_output, "1,2,3\n"), (scenario.target_output, "4,5,6\n"),
+                       (scenario.measures_file, "earlier measures\n")):
+        path.write_bytes(text.encode())
+        earlier[path] = text.encode()
+    return earlier
+
+
+def assert_untouched(scenario, earlier):
+    for path, data in earlier.items():
+        assert path.read_bytes() == data
+    leftovers = [p.name for p in scenario.path.parent.iterdir() if p.name.startswith(".")]
+    assert leftovers == []
+
+
+def test_cancel_mid_run_writes_nothing(forest, monkeypatch):
+    # Small chunks, so a scan is traced in several parts and cancel lands inside one.
+    monkeypatch.setattr(simulation, "_FIRST_CHUNK_RAYS", 512)
+    monkeypatch.setattr(simulation, "_next_chunk", lambda chunk, traced, elapsed: chunk)
+    earlier = write_earlier_outputs(forest)
+    cancel = threading.Event()
+    seen = []
+
+    def progress(p):
+        seen.append(p)
+        if p.run == "target" and p.scan == 2 and p.returns is None:
+            cancel.set()
+
+    with pytest.raises(Cancelled):
+        simulate(forest, progress=progress, cancel=cancel)
+    # It stopped at the next chunk, not at the end of the scan.
+    assert seen[-1].run == "target" and seen[-1].scan == 2 and seen[-1].returns is None
+    assert_untouched(forest, earlier)
+
+
+def test_failed_run_leaves_earlier_outputs(forest):
+    earlier = write_earlier_outputs(forest)
+
+    def progress(p):
+        if p.run == "target" and p.scan == 4 and p.returns is not None:
+            raise RuntimeError("viewer crashed")
+
+    with pytest.raises(RuntimeError):
+        simulate(forest, progress=progress)
+    assert_untouched(forest, earlier)
+
+
+def test_no_write_writes_nothing(forest):
+    result = simulate(forest, write=False)
+    assert result.outputs == {}
+    assert not forest.scene_output.exists() and not forest.measures_file.exists()
+
+
+def test_las_outputs_hold_the_fused_voxels(forest):
+    from ladartui.scene.las import import_las
+
+    result = simulate(forest, las=True)
+    for run, fused in (("scene", result.scene_output), ("target", result.target_output)):
+        path = forest.path.with_name(f"S_{run.capitalize()}.las")
+        assert result.outputs[f"{run}_las"] == str(path)
+        voxels, _ = import_las(path, 1.0, origin=(0.0, 0.0, 0.0))
+        assert as_set(voxels) == as_set(fused)
+
+
+def test_every_available_backend_gives_the_same_run(forest):
+    from ladartui.tracing import backend_status
+
+    available = [name for name, reason in backend_status().items() if reason is None]
+    if len(available) < 2:
+        pytest.skip(f"only {available} available here")
+    results = {name: simulate(forest, backend=name, write=False) for name in available}
+    expected = results.pop("numba")
+    for name, result in results.items():
+        assert result.backend == name
+        assert as_set(result.scene_output) == as_set(expected.scene_output), name
+        assert as_set(result.target_output) == as_set(expected.target_output), name
+        assert result.measures == expected.measures
+
+
+def test_chunk_size_does_not_change_the_result(forest, monkeypatch):
+    whole = simulate(forest, write=False)
+    # Three detector rows (32 detectors x 4 rays each) per trace call: 11 calls a scan.
+    monkeypatch.setattr(simulation, "_FIRST_CHUNK_RAYS", 3 * 128)
+    monkeypatch.setattr(simulation, "_next_chunk", lambda chunk, traced, elapsed: chunk)
+    reports = []
+    rows = simulate(forest, write=False, progress=reports.append)
+    assert sum(p.returns is None for p in reports) == 4 * (2 * 11 - 1)
+    for a, b in zip(whole.scene_per_scan + whole.target_per_scan, rows.scene_per_scan + rows.target_per_scan):
+        np.testing.assert_array_equal(a, b)
+    assert rows.measures == whole.measures
