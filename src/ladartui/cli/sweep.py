@@ -1,0 +1,277 @@
+"""``ladartui sweep SPEC``: simulate many flight-path variants on Dask and rank them.
+
+The sweep runs on a worker thread so Ctrl-C on the main thread can set the
+cancel event; rows finished so far stay in the result table and the same
+command resumes. Progress goes to stderr, the ranking to stdout.
+"""
+
+from __future__ import annotations
+
+import json
+import signal
+import threading
+
+from ladartui.errors import Cancelled, FieldError
+
+DEFAULT_TOP = 10
+
+
+def add_parser(subparsers):
+    from ladartui.sweep.ranking import OBJECTIVES
+
+    parser = subparsers.add_parser(
+        "sweep",
+        help="simulate variants of a scenario's flight path and rank them",
+        description="Run every variant of a sweep spec (TOML: a base scenario and the "
+        "parameters to vary) on a Dask cluster, append one row per variant to "
+        "OUT/results.csv, rank the variants and save the best flight path as a scenario. "
+        "An interrupted sweep resumes where it stopped. See docs/sweeps.md.",
+    )
+    parser.add_argument("spec", metavar="SPEC", help="sweep spec file (.toml)")
+    parser.add_argument("--scheduler", metavar="ADDRESS",
+                        help="address of a running Dask scheduler (tcp://HOST:PORT); default: "
+                        "a local cluster on this machine")
+    parser.add_argument("--connect-timeout", metavar="SECONDS", type=float, default=30.0,
+                        help="how long to wait for the scheduler and a first worker (default 30)")
+    parser.add_argument("--workers", metavar="N", type=int,
+                        help="worker processes of the local cluster (default: one per core)")
+    parser.add_argument("--serial", action="store_true",
+                        help="run the variants one by one in this process, without Dask")
+    parser.add_argument("--out", metavar="DIR",
+                        help="folder for results.csv, ranking.csv and the best scenario "
+                        "(default: SPEC's folder/SPEC-results)")
+    parser.add_argument("--objective", metavar="NAME",
+                        help="ranking objective: " + ", ".join(OBJECTIVES)
+                        + " (default: the spec's)")
+    parser.add_argument("--budget", metavar="SECONDS", type=float,
+                        help="flight-time budget for coverage-within-budget (default: the spec's)")
+    parser.add_argument("--cost", metavar="NAME",
+                        help="cost axis of the Pareto front: flight-time or distance")
+    parser.add_argument("--top", metavar="N", type=int, default=DEFAULT_TOP,
+                        help=f"ranked variants to show (default {DEFAULT_TOP})")
+    parser.add_argument("--show", action="store_true",
+                        help="rank the results already in OUT without running anything")
+    parser.add_argument("--json", action="store_true", help="print the ranking as JSON on stdout")
+    parser.set_defaults(handler=run)
+    return parser
+
+
+def run(args) -> int:
+    from rich.console import Console
+
+    from ladartui.sweep import default_out_dir, load_sweep_results, load_sweep_spec
+    from ladartui.sweep.ranking import normal_cost, normal_objective
+
+    if args.workers is not None and args.workers < 1:
+        raise FieldError("--workers", args.workers, "an integer >= 1")
+    if args.serial and args.workers is not None:
+        raise FieldError("--workers", args.workers, "no --workers with --serial (one process "
+                         "runs every variant)")
+    if not args.connect_timeout > 0:
+        raise FieldError("--connect-timeout", args.connect_timeout, "a number of seconds > 0")
+    if args.top < 0:
+        raise FieldError("--top", args.top, "an integer >= 0")
+    if args.scheduler and (args.workers is not None or args.serial):
+        raise FieldError("--scheduler", args.scheduler, "no --workers or --serial with it "
+                         "(the cluster's workers run the sweep)")
+    spec = load_sweep_spec(args.spec)
+    objective = normal_objective(args.objective or spec.objective)
+    normal_cost(args.cost or spec.cost)
+    if args.budget is not None and not args.budget > 0:
+        raise FieldError("--budget", args.budget, "a flight-time budget in seconds, > 0")
+    if objective == "coverage-within-budget" and args.budget is None and spec.budget is None:
+        raise FieldError("--budget", None, "a flight-time budget in seconds (or sweep.budget "
+                         "in the spec) for objective 'coverage-within-budget'")
+    errors = Console(stderr=True)
+    if args.show:
+        out = args.out or default_out_dir(spec)
+        result = load_sweep_results(out, objective=args.objective or spec.objective,
+                                    budget=args.budget if args.budget is not None else spec.budget,
+                                    cost=args.cost or spec.cost)
+        result.parameter_names = spec.parameter_names
+    else:
+        result = _sweep_with_progress(spec, args, errors)
+        if result is None:
+            return 130
+    if args.json:
+        print(json.dumps(result_dict(result, args.top), indent=2, allow_nan=False))
+    else:
+        console = Console()
+        if not console.is_terminal:  # a file or pipe: do not squeeze the table into 80 columns
+            console = Console(width=160)
+        show_result(console, result, args.top)
+    return 0
+
+
+def _sweep_with_progress(spec, args, console):
+    from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn,
+                               TimeElapsedColumn, TimeRemainingColumn)
+
+    from ladartui.sweep import connect, run_sweep
+
+    client = connect(args.scheduler, args.connect_timeout) if args.scheduler else None
+    cancel = threading.Event()
+    outcome = {}
+    columns = (
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("{task.fields[note]}"),
+        TimeElapsedColumn(),
+        TimeRemainingColumn(),
+    )
+    where = f"scheduler {args.scheduler}" if args.scheduler else (
+        "this process" if args.serial else "local cluster")
+    try:
+        with Progress(*columns, console=console, transient=False) as bar:
+            task = bar.add_task(f"sweep on {where}", total=len(spec.variants), note="starting")
+
+            def report(p):
+                outcome["progress"] = p
+                ran = p.done - p.resumed
+                rate = f", {60 * ran / p.elapsed:.1f}/min" if ran and p.elapsed > 0 else ""
+                note = f"{p.resumed} resumed, {p.failed} failed{rate}"
+                bar.update(task, completed=p.done, total=p.total, note=note)
+
+            def work():
+                try:
+                    outcome["result"] = run_sweep(
+                        spec, client=client, progress=report, cancel=cancel, out=args.out,
+                        workers=args.workers, objective=args.objective, budget=args.budget,
+                        cost=args.cost, serial=args.serial)
+                except BaseException as error:  # handed to the main thread
+                    outcome["error"] = error
+
+            worker = threading.Thread(target=work, name="ladartui-sweep", daemon=True)
+            worker.start()
+            previous = _stop_on_sigterm()
+            try:
+                while worker.is_alive():
+                    worker.join(0.1)
+            except KeyboardInterrupt:
+                cancel.set()
+                worker.join()
+                if "result" not in outcome:
+                    outcome["error"] = Cancelled()
+            finally:
+                _restore_sigterm(previous)
+    finally:
+        if client is not None:
+            client.close()
+    if isinstance(outcome.get("error"), Cancelled):
+        last = outcome.get("progress")
+        kept = f"{last.done} of {last.total} variants are" if last else "finished variants are"
+        console.print(f"ladartui: sweep interrupted; {kept} kept in the results table; run the "
+                      "same command again to resume", highlight=False)
+        return None
+    if "error" in outcome:
+        raise outcome["error"]
+    return outcome["result"]
+
+
+def _stop_on_sigterm():
+    """Treat SIGTERM (a batch system's stop) like Ctrl-C: finished rows are kept."""
+    if threading.current_thread() is not threading.main_thread():
+        return None
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    return signal.signal(signal.SIGTERM, interrupt)
+
+
+def _restore_sigterm(previous):
+    if previous is not None:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _cell(value, digits=4) -> str:
+    if value is None:
+        return "-"
+    if isinstance(value, float):
+        return f"{value:.{digits}g}"
+    return str(value)
+
+
+
+
+def result_dict(result, top) -> dict:
+    """The sweep as a JSON-safe dict: files, counts, the best variants and the Pareto front."""
+
+    def entry(ranked):
+        row = ranked.row
+        return {"rank": ranked.rank, "variant": row.get("variant"), "objective": ranked.value,
+                "coverage": ranked.coverage, "cost": ranked.cost, "pareto": ranked.pareto,
+                "parameters": {n: row.get(n) for n in result.parameter_names}}
+
+    return {
+        "objective": result.objective, "cost": result.cost, "budget": result.budget,
+        "variants": len(result.rows), "ran": result.ran, "resumed": result.resumed,
+        "failed": len(result.failures), "workers": result.workers,
+        "elapsed_s": round(result.elapsed, 3),
+        "results": str(result.results_path),
+        "ranking": str(result.ranking_path) if result.ranking_path else None,
+        "best_scenario": str(result.best_scenario_path) if result.best_scenario_path else None,
+        "top": [entry(r) for r in result.ranking[:top] if r.rank is not None],
+        "pareto": [entry(r) for r in result.pareto],
+        "errors": [{"variant": r.get("variant"), "error": r.get("error")}
+                   for r in result.failures],
+    }
+
+
+def show_result(console, result, top) -> None:
+    """The top of the ranking, the Pareto front, failures and the files written."""
+    from rich import box
+    from rich.table import Table
+
+    from ladartui.sweep.ranking import OBJECTIVES
+
+    cost_unit = "s" if result.cost == "flight-time" else "m"
+    short = {"obscured-coverage": "coverage", "coverage-per-km": "cov/km",
+             "coverage-within-budget": "coverage"}
+    table = Table(title=f"Best flight paths by {result.objective}: "
+                  f"{OBJECTIVES[result.objective]}", title_justify="left",
+                  box=box.SIMPLE_HEAD, pad_edge=False)
+    table.add_column("#", justify="right")
+    table.add_column("variant", no_wrap=True)
+    for name in result.parameter_names:
+        table.add_column(name, justify="right")
+    separate = result.objective == "coverage-per-km"
+    if separate:
+        table.add_column(short[result.objective], justify="right")
+    table.add_column("coverage", justify="right")
+    table.add_column(f"{'time' if cost_unit == 's' else 'dist.'} {cost_unit}", justify="right")
+    table.add_column("front")
+    for ranked in [r for r in result.ranking if r.rank is not None][:top]:
+        row = ranked.row
+        table.add_row(str(ranked.rank), str(row.get("variant", ""))[:8],
+                      *(_cell(row.get(n)) for n in result.parameter_names),
+                      *([_cell(ranked.value)] if separate else []), _cell(ranked.coverage, 3),
+                      _cell(ranked.cost, 4), "*" if ranked.pareto else "")
+    console.print(table)
+    front = result.pareto
+    if front:
+        points = ", ".join(f"{str(r.row.get('variant'))[:8]} ({_cell(r.coverage, 3)} at "
+                           f"{_cell(r.cost, 4)} {cost_unit})" for r in front)
+        console.print(f"Pareto front of obscured coverage against {result.cost}, cheapest "
+                      f"first: {points}", highlight=False)
+    unranked = sum(1 for r in result.ranking if r.rank is None and r.row.get("status") == "ok")
+    if unranked:
+        console.print(f"{unranked} finished variant(s) not ranked (objective undefined or over "
+                      "the budget)", highlight=False)
+    failures = result.failures
+    if failures:
+        console.print(f"[bold]{len(failures)} variant(s) failed[/]; first: "
+                      f"{failures[0].get('variant')}: {failures[0].get('error')}", highlight=False)
+    if result.ran or result.resumed:
+        ran = result.ran
+        rate = f" ({60 * ran / result.elapsed:.1f} variants/min)" if ran and result.elapsed else ""
+        console.print(f"{ran} variant(s) run in {result.elapsed:.1f} s{rate} on "
+                      f"{result.workers} worker(s); {result.resumed} resumed from earlier runs",
+                      highlight=False)
+    console.print(f"results  {result.results_path}", highlight=False)
+    if result.ranking_path:
+        console.print(f"ranking  {result.ranking_path}", highlight=False)
+    if result.best_scenario_path:
+        console.print(f"best     {result.best_scenario_path}  (open it with: ladartui "
+                      f"{result.best_scenario_path})", highlight=False)

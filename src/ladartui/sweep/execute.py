@@ -1,0 +1,421 @@
+"""Running a sweep: resume, Dask (a local cluster or a scheduler address), the result files.
+
+Every variant runs the same function, ``run_variant``, whether in this process
+(``serial=True``) or on a Dask worker, so both give the same rows. The base
+scene is loaded once here and scattered to every worker once (broadcast); each
+task gets a reference to the worker's copy, never the arrays themselves, and
+the occupancy built by the first variant on a worker is reused by the rest.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import hashlib
+import importlib.metadata
+import logging
+import os
+import time
+import uuid
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+from ladartui.atomic import atomic_path
+from ladartui.errors import Cancelled, FieldError, InputFileError, LadarError
+from ladartui.sweep.ranking import COSTS, Ranked, normal_cost, normal_objective, rank_rows
+from ladartui.sweep.spec import DEFAULT_BASE, SweepSpec, load_sweep_spec
+from ladartui.sweep.table import read_table, table_text, write_table
+from ladartui.sweep.variant import ScenePayload, apply_parameters, run_variant
+
+RESULTS_NAME = "results.csv"
+RANKING_NAME = "ranking.csv"
+# Rows with these statuses are final; "failed" rows (a crash, a lost worker) run again.
+FINAL_STATUSES = ("ok", "error")
+_POLL_SECONDS = 0.05
+
+
+@dataclass
+class SweepProgress:
+    """Where a sweep stands: variants done (resumed ones included) of total, failures, last row."""
+
+    total: int
+    done: int
+    resumed: int
+    failed: int
+    elapsed: float
+    row: dict | None = None
+
+    @property
+    def fraction(self) -> float:
+        return self.done / self.total if self.total else 1.0
+
+
+@dataclass
+class SweepResult:
+    """The rows of a sweep (spec order), their ranking and the files written."""
+
+    rows: list[dict]
+    ranking: list[Ranked]
+    objective: str
+    cost: str
+    budget: float | None
+    parameter_names: list[str]
+    results_path: Path
+    ranking_path: Path | None = None
+    best_scenario_path: Path | None = None
+    ran: int = 0
+    resumed: int = 0
+    workers: int = 0
+    elapsed: float = 0.0
+    scheduler: str = ""
+    notes: list[str] = field(default_factory=list)
+
+    @property
+    def best(self) -> Ranked | None:
+        """The top-ranked row, or None when no variant could be ranked."""
+        return self.ranking[0] if self.ranking and self.ranking[0].rank == 1 else None
+
+    @property
+    def failures(self) -> list[dict]:
+        return [row for row in self.rows if row.get("status") != "ok"]
+
+    @property
+    def pareto(self) -> list[Ranked]:
+        """Rows on the Pareto front of coverage against cost, cheapest first."""
+        return sorted((r for r in self.ranking if r.pareto), key=lambda r: (r.cost, -r.coverage))
+
+
+def default_out_dir(spec: SweepSpec) -> Path:
+    return spec.path.parent / f"{spec.path.stem}-results"
+
+
+def base_digest(scenario_path, scenario) -> str:
+    """Short hash of the base scenario file and its scene file's size.
+
+    Stored in every row: a resumed sweep reuses only rows made from the same
+    base, so editing the base scenario re-runs every variant.
+    """
+    digest = hashlib.sha256(Path(scenario_path).read_bytes())
+    scene_file = getattr(scenario, "scene_file", None)
+    if scene_file is not None:
+        try:
+            digest.update(f"{Path(scene_file).name}:{Path(scene_file).stat().st_size}".encode())
+        except OSError:
+            pass
+    return digest.hexdigest()[:12]
+
+
+def base_scenario_path(spec: SweepSpec) -> Path:
+    """The base scenario file (the built-in default is created on first use)."""
+    if spec.scenario_path == DEFAULT_BASE:
+        from ladartui.defaults import default_scenario_path
+
+        return default_scenario_path()
+    if not spec.scenario_path.is_file():
+        raise InputFileError(spec.path, f"sweep.scenario: expected an existing scenario file; "
+                             f"{str(spec.scenario_path)!r} does not exist")
+    return spec.scenario_path
+
+
+class _LazyScene:
+    """Loads the base scene on first use, once."""
+
+    def __init__(self, base):
+        self.base, self.scene = base, None
+
+    def __call__(self):
+        if self.scene is None:
+            self.scene = self.base.load_scene()
+        return self.scene
+
+
+def run_sweep(spec, client=None, progress: Callable[[SweepProgress], None] | None = None,
+              cancel=None, *, out=None, workers: int | None = None, objective: str | None = None,
+              budget: float | None = None, cost: str | None = None, serial: bool = False,
+              simulate_options: dict | None = None) -> SweepResult:
+    """Run every variant of ``spec`` not already in the result table, then rank them all.
+
+    ``spec`` is a SweepSpec or a spec file path. ``client`` is a
+    ``distributed.Client``; without one a ``LocalCluster`` of ``workers``
+    processes (default: one per core) runs the sweep and is closed at the
+    end; ``serial=True`` runs the variants one by one in this process.
+    ``progress(SweepProgress)`` is called after each variant; ``cancel``
+    (a ``threading.Event``) stops the sweep with ``Cancelled``, keeping the rows
+    written so far for a later resume. Writes ``out/results.csv`` (row by row),
+    ``out/ranking.csv`` and the best scenario ``out/<name>-best.toml``.
+    """
+    started = time.perf_counter()
+    if not isinstance(spec, SweepSpec):
+        spec = load_sweep_spec(spec)
+    objective = normal_objective(objective or spec.objective)
+    cost = normal_cost(cost or spec.cost)
+    budget = spec.budget if budget is None else float(budget)
+    if objective == "coverage-within-budget" and budget is None:
+        raise FieldError("budget", None, "a flight-time budget in seconds (sweep.budget or "
+                         "--budget) for objective 'coverage-within-budget'")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
+                                or workers < 1):
+        raise FieldError("workers", workers, "an integer >= 1")
+    out = Path(out) if out is not None else default_out_dir(spec)
+    from ladartui.scenario import load_scenario
+
+    base_path = base_scenario_path(spec)
+    base = load_scenario(base_path)
+    with _exclusive(out):
+        return _run_locked(spec, base_path, base, client, progress, cancel, out, workers,
+                           objective, budget, cost, serial, simulate_options, started)
+
+
+@contextlib.contextmanager
+def _exclusive(out: Path):
+    """Hold ``out/.lock`` so two sweeps never write the same result table at once (POSIX)."""
+    out.mkdir(parents=True, exist_ok=True)
+    try:
+        import fcntl
+    except ImportError:  # not POSIX: nothing to lock with
+        yield
+        return
+    with open(out / ".lock", "a+b") as handle:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            raise InputFileError(out, "another sweep is writing its results here; wait for "
+                                 "it or choose another --out") from None
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
+
+
+def _run_locked(spec, base_path, base, client, progress, cancel, out, workers, objective,
+                budget, cost, serial, simulate_options, started) -> SweepResult:
+    digest = base_digest(base_path, base)
+    scene = _LazyScene(base)
+    variants = spec.variants
+    results_path = out / RESULTS_NAME
+    table_rows, _ = read_table(results_path)
+    position = {(row["variant"], row.get("base")): i for i, row in enumerate(table_rows)}
+
+    def stored(variant_id):
+        i = position.get((variant_id, digest))
+        return None if i is None else table_rows[i]
+
+    todo = [v for v in variants
+            if (row := stored(v.id)) is None or row.get("status") not in FINAL_STATUSES]
+    resumed = len(variants) - len(todo)
+    state = SweepProgress(total=len(variants), done=resumed, resumed=resumed, failed=0,
+                          elapsed=0.0)
+
+    def record(row):
+        key = (row["variant"], row["base"])
+        if key in position:
+            table_rows[position[key]] = row
+        else:
+            position[key] = len(table_rows)
+            table_rows.append(row)
+        write_table(results_path, table_rows, spec.parameter_names)
+        state.done += 1
+        state.failed += row.get("status") != "ok"
+        state.elapsed = time.perf_counter() - started
+        state.row = row
+        if progress is not None:
+            progress(dataclasses.replace(state))  # a snapshot: the caller may keep it
+
+    if progress is not None:
+        progress(dataclasses.replace(state))
+    result_workers, scheduler = 0, "serial"
+    if todo:
+        options = dict(simulate_options or {})
+        if serial:
+            result_workers = 1
+            _run_serial(todo, base, digest, scene(), options, record, cancel)
+        else:
+            owned = client is None
+            if owned:
+                client = local_client(workers)
+            try:
+                result_workers = len(client.scheduler_info(n_workers=-1).get("workers", {}))
+                scheduler = client.scheduler.address
+                _run_on_dask(client, todo, base, digest, scene(), options, record, cancel)
+            finally:
+                if owned:
+                    _close(client)
+
+    # The rows as the file holds them (every column present), so this result
+    # and load_sweep_results of the same folder agree.
+    table_rows, _ = read_table(results_path)
+    position = {(row["variant"], row.get("base")): i for i, row in enumerate(table_rows)}
+    rows = [row for v in variants if (row := stored(v.id)) is not None]
+    ranking = rank_rows(rows, objective, budget, cost)
+    result = SweepResult(
+        rows=rows, ranking=ranking, objective=objective, cost=cost, budget=budget,
+        parameter_names=spec.parameter_names, results_path=results_path, ran=len(todo),
+        resumed=resumed, workers=result_workers, scheduler=scheduler,
+    )
+    result.ranking_path = write_ranking(out / RANKING_NAME, ranking, spec.parameter_names)
+    if result.best is not None:
+        result.best_scenario_path = write_best_scenario(
+            out / f"{spec.name}-best.toml", base, result.best.row, spec.parameter_names, scene)
+    result.elapsed = time.perf_counter() - started
+    return result
+
+
+def _run_serial(todo, base, digest, scene, options, record, cancel):
+    for variant in todo:
+        if cancel is not None and cancel.is_set():
+            raise Cancelled("sweep cancelled")
+        run_options = dict(options)
+        if cancel is not None:
+            run_options["cancel"] = cancel
+        record(run_variant(base, variant.params, variant.id, digest, scene, run_options))
+
+
+def _lost_row(variant, digest, future) -> dict:
+    try:
+        error = future.exception(timeout=5)
+        message = f"{type(error).__name__}: {error}"
+    except Exception as reason:  # noqa: BLE001 - the future itself may be gone
+        message = f"task {future.status}: {reason}"
+    return {"variant": variant.id, "status": "failed", "base": digest, **variant.params,
+            "error": message}
+
+
+def _run_on_dask(client, todo, base, digest, scene, options, record, cancel):
+    from distributed import as_completed
+
+    # Plain arrays once to every worker; each rebuilds the Scene once per token.
+    payload = ScenePayload.of(scene, uuid.uuid4().hex)
+    scene_future = client.scatter(payload, broadcast=True, hash=False)
+    tag = uuid.uuid4().hex[:8]
+    pending = {}
+    try:
+        for variant in todo:
+            future = client.submit(run_variant, base, variant.params, variant.id, digest,
+                                   scene_future, options, pure=False,
+                                   key=f"ladartui-variant-{variant.id}-{tag}")
+            pending[future] = variant
+        completed = as_completed(list(pending))
+        while pending:
+            if cancel is not None and cancel.is_set():
+                raise Cancelled("sweep cancelled")
+            batch = completed.next_batch(block=False)
+            if not batch:
+                time.sleep(_POLL_SECONDS)
+                continue
+            for future in batch:
+                variant = pending.pop(future)
+                if future.status == "finished":
+                    row = future.result()
+                else:
+                    row = _lost_row(variant, digest, future)
+                record(row)
+    finally:
+        if pending:
+            client.cancel(list(pending))
+        scene_future.release()
+
+
+def local_client(workers: int | None = None):
+    """A client of a new LocalCluster: ``workers`` processes (default one per core), 1 thread each.
+
+    The tracing kernels are parallel themselves, so each worker's numba pool
+    gets an even share of the cores instead of every worker using them all.
+    """
+    from distributed import Client, LocalCluster
+
+    cores = os.cpu_count() or 1
+    count = workers or cores
+    cluster = LocalCluster(
+        n_workers=count, threads_per_worker=1, processes=True, dashboard_address=None,
+        silence_logs=logging.ERROR, env={"NUMBA_NUM_THREADS": str(max(1, cores // count))},
+    )
+    return Client(cluster)
+
+
+def connect(address: str, timeout: float = 30.0):
+    """A client of the Dask scheduler at ``address`` that has ladartui on every worker."""
+    from distributed import Client
+
+    try:
+        client = Client(address, timeout=f"{timeout}s")
+    except (OSError, TimeoutError, ValueError) as error:
+        raise FieldError("--scheduler", address, f"the address of a running Dask scheduler "
+                         f"(tcp://HOST:PORT); connecting failed: {error}") from None
+    try:
+        client.wait_for_workers(1, timeout=timeout)
+    except (TimeoutError, OSError):
+        _close(client)
+        raise FieldError("--scheduler", address, f"a scheduler with workers; none joined "
+                         f"within {timeout:g} s") from None
+    check_workers(client)
+    return client
+
+
+def check_workers(client) -> None:
+    """Raise LadarError when a worker lacks ladartui or runs another version of it."""
+    mine = importlib.metadata.version("ladartui")
+    answers = client.run(importlib.metadata.version, "ladartui", on_error="return")
+    for worker, answer in answers.items():
+        if isinstance(answer, BaseException):
+            raise LadarError(f"worker {worker} cannot import ladartui ({answer}); install this "
+                             f"version ({mine}) in the workers' environment")
+        if answer != mine:
+            raise LadarError(f"worker {worker} runs ladartui {answer}, this client {mine}; "
+                             "install the same version everywhere")
+
+
+def _close(client):
+    cluster = getattr(client, "cluster", None)
+    client.close()
+    if cluster is not None:
+        cluster.close()
+
+
+def write_ranking(path, ranking: list[Ranked], parameter_names) -> Path:
+    """The ranking as CSV (rank, objective value, Pareto flag, then the row), written atomically."""
+    columns = ["rank", "variant", "objective", "pareto", "coverage", "cost", "status",
+               *parameter_names, "path_length_m", "flight_time_s", "error"]
+    rows = []
+    for entry in ranking:
+        row = entry.row
+        rows.append({**{name: row.get(name) for name in columns}, "rank": entry.rank,
+                     "objective": entry.value, "pareto": entry.pareto,
+                     "coverage": entry.coverage, "cost": entry.cost})
+    text = table_text(rows, columns=columns)
+    with atomic_path(path) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    return Path(path)
+
+
+def write_best_scenario(path, base, row: dict, parameter_names, scene_loader) -> Path:
+    """Save the scenario of ``row`` (the base with its parameters) as a ready-to-open file."""
+    params = {name: row[name] for name in parameter_names if row.get(name) is not None}
+    scenario = apply_parameters(base, params, scene_loader)
+    return scenario.save(path).path  # atomic; relative scene path and outputs follow the file
+
+
+def load_sweep_results(path, objective: str = "obscured-coverage", budget: float | None = None,
+                       cost: str = "flight-time") -> SweepResult:
+    """Read a sweep's result table (a results.csv or the folder holding it) and rank its rows.
+
+    Every row in the file is included; when a variant appears more than once
+    (several base scenarios) each row is kept.
+    """
+    path = Path(path)
+    if path.is_dir():
+        path = path / RESULTS_NAME
+    if not path.exists():
+        raise InputFileError(path, "no sweep results here")
+    rows, header = read_table(path)
+    objective, cost = normal_objective(objective), normal_cost(cost)
+    if objective == "coverage-within-budget" and budget is None:
+        raise FieldError("budget", None, "a flight-time budget in seconds")
+    known = {"variant", "status", "base", "error", "worker", "backend", "method",
+             "run_time_s", "scan_count", *COSTS.values()}
+    from ladartui.sweep.spec import PARAMETERS
+
+    parameter_names = [c for c in header if c in PARAMETERS and c not in known]
+    return SweepResult(rows=rows, ranking=rank_rows(rows, objective, budget, cost),
+                       objective=objective, cost=cost, budget=budget,
+                       parameter_names=parameter_names, results_path=path)

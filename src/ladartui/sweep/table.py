@@ -1,0 +1,142 @@
+"""The sweep result table: one CSV row per variant, rewritten atomically per row.
+
+Why rewrite-and-rename rather than append: every completed variant replaces
+the whole file through a temporary file, fsync and rename. A reader (another
+terminal, the TUI, a spreadsheet) therefore always sees a complete table, a
+crash can never leave a torn line, and the column set may grow (an error row
+written first has no measure columns; the next success adds them). The cost
+is rewriting the rows so far, milliseconds for thousands of rows, against
+seconds of simulation per row. The reader still skips a malformed row (a
+hand edit, a file from elsewhere) rather than failing the whole table.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import os
+from pathlib import Path
+
+from ladartui.atomic import atomic_path
+from ladartui.errors import InputFileError
+
+# Columns that lead every table, in this order; parameters and measures follow.
+LEAD_COLUMNS = ("variant", "status", "base")
+RUN_COLUMNS = ("path_length_m", "flight_time_s", "scan_count", "run_time_s", "backend", "method",
+               "worker")
+TAIL_COLUMNS = ("error",)
+# Never parsed as numbers: a hex id such as "1e50..." would otherwise read as a float.
+TEXT_COLUMNS = frozenset({"variant", "status", "base", "backend", "method", "worker", "error",
+                          "preset"})
+
+
+def format_cell(value) -> str:
+    """One CSV cell: '' for None, repr for floats (exact round trip), JSON for lists."""
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        if math.isnan(value):
+            return "nan"
+        return repr(value)
+    if isinstance(value, (list, tuple, dict)):
+        return json.dumps(value, separators=(",", ":"))
+    if hasattr(value, "tolist"):  # numpy scalars and arrays
+        return format_cell(value.tolist())
+    return str(value)
+
+
+def parse_cell(text: str):
+    """The value a cell was written from (numbers, booleans, lists, None, text)."""
+    if text == "":
+        return None
+    if text in ("true", "false"):
+        return text == "true"
+    if text[0] in "[{":
+        try:
+            return json.loads(text)
+        except ValueError:
+            return text
+    try:
+        return int(text)
+    except ValueError:
+        pass
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
+def order_columns(rows, parameter_names=()) -> list[str]:
+    """Lead columns, parameters, run columns, then other columns as first seen, error last."""
+    fixed = [*LEAD_COLUMNS, *parameter_names, *RUN_COLUMNS]
+    seen = []
+    for row in rows:
+        for key in row:
+            if key not in fixed and key not in TAIL_COLUMNS and key not in seen:
+                seen.append(key)
+    present = set().union(*(row.keys() for row in rows)) if rows else set()
+    lead = [c for c in fixed if c in present or c in LEAD_COLUMNS or c in parameter_names]
+    return [*lead, *seen, *TAIL_COLUMNS]
+
+
+def table_text(rows, parameter_names=(), columns=None) -> str:
+    """The CSV text of ``rows`` (dicts), header first; ``columns`` fixes the columns."""
+    columns = list(columns) if columns is not None else order_columns(rows, parameter_names)
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(columns)
+    for row in rows:
+        writer.writerow([format_cell(row.get(column)) for column in columns])
+    return buffer.getvalue()
+
+
+def write_table(path, rows, parameter_names=()) -> None:
+    """Replace ``path`` with the table of ``rows``: temporary file, fsync, rename."""
+    data = table_text(rows, parameter_names).encode("utf-8")
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as handle:
+            handle.write(data)
+            handle.flush()
+            os.fsync(handle.fileno())
+
+
+def read_table(path) -> tuple[list[dict], list[str]]:
+    """Rows (dicts of parsed values) and the header of a result table.
+
+    A missing file gives no rows. Rows with the wrong number of cells or no
+    variant id are dropped (a torn or hand-edited line), never fatal.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        return [], []
+    except (OSError, UnicodeDecodeError) as error:
+        raise InputFileError(path, f"cannot read the sweep results: {error}") from None
+    reader = csv.reader(io.StringIO(text))
+    try:
+        header = next(reader)
+    except (StopIteration, csv.Error):
+        return [], []
+    if "variant" not in header:
+        raise InputFileError(path, "not a sweep result table: expected a 'variant' column", line=1)
+    rows = []
+    while True:
+        try:
+            cells = next(reader)
+        except StopIteration:
+            break
+        except csv.Error:
+            continue
+        if len(cells) != len(header):
+            continue
+        row = {column: (cell or None) if column in TEXT_COLUMNS else parse_cell(cell)
+               for column, cell in zip(header, cells)}
+        if not row.get("variant"):
+            continue
+        rows.append(row)
+    return rows, header

@@ -1,0 +1,467 @@
+"""Sweeps without a cluster: specs, variant ids, the result table, ranking, serial runs, resume."""
+
+import itertools
+import math
+import os
+import random
+import subprocess
+import sys
+import threading
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from ladartui.errors import Cancelled, InputFileError, LadarError
+from ladartui.sweep import (
+    apply_parameters,
+    load_sweep_results,
+    load_sweep_spec,
+    pareto_front,
+    rank_rows,
+    read_table,
+    run_sweep,
+    variant_id,
+    write_table,
+)
+from ladartui.sweep.table import TEXT_COLUMNS
+
+CENTRE = (15.5, 15.5, 0.5)
+# Columns that depend on where and when a variant ran, not on what it computed.
+VOLATILE = {"run_time_s", "worker"}
+
+
+def write_tiny_scenario(folder, name="base.toml"):
+    """A 32 x 32 canopy with gaps over a 4 x 2 x 2 vehicle, 8 x 8 detectors, a 4-scan orbit."""
+    from ladartui.flight import FlightPlan, Orbit
+    from ladartui.scenario import Scenario
+    from ladartui.scene.voxels import save_voxels
+    from ladartui.sensor import Sensor
+
+    target = np.array([(i, j, k) for i in range(14, 18) for j in range(15, 17) for k in range(2)],
+                      np.int32)
+    canopy = np.array([(i, j, 6) for i in range(32) for j in range(32)
+                       if (i * 7 + j * 13) % 3 == 0], np.int32)
+    save_voxels(folder / "tiny.txt", np.concatenate([target, canopy]))
+    save_voxels(folder / "tiny_Target.txt", target)
+    flight = FlightPlan(segments=(Orbit(centre=CENTRE, radius=20.0, altitude=20.0, scans=4),))
+    scenario = Scenario(folder / name, "tiny.txt", 1.0, Sensor(grid=8, ray_grid=2, fov=20.0),
+                        flight, backend="numba")
+    return scenario.save()
+
+
+def write_spec(folder, body, name="spec.toml", scenario="base.toml"):
+    path = folder / name
+    path.write_text(f'[sweep]\nscenario = "{scenario}"\n{body}', encoding="utf-8")
+    return path
+
+
+TINY_GRID = """
+[grid]
+radius = [10.0, 20.0]
+scans = [2, 4]
+sensor_grid = [8, 0]
+"""
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("tiny")
+    write_tiny_scenario(folder)
+    return folder
+
+
+# -- specs ---------------------------------------------------------------------------
+
+
+def test_grid_is_the_product_of_its_axes(tmp_path):
+    spec = load_sweep_spec(write_spec(tmp_path, """
+[grid]
+radius = [100, 150.5]
+altitude = { start = 100, stop = 300, step = 100 }
+fov = 10
+"""))
+    points = [v.params for v in spec.variants]
+    expected = [{"radius": r, "altitude": a, "fov": 10.0}
+                for r, a in itertools.product([100.0, 150.5], [100.0, 200.0, 300.0])]
+    assert points == expected
+    assert spec.scenario_path == tmp_path / "base.toml"
+
+
+def test_random_draws_follow_the_seed_and_the_bounds(tmp_path):
+    body = """
+[grid]
+preset = ["orbit"]
+[random]
+samples = 20
+seed = {seed}
+heading_offset = {{ min = 10, max = 20 }}
+scans = {{ min = 3, max = 5 }}
+fov = [5.0, 7.5]
+"""
+    first = load_sweep_spec(write_spec(tmp_path, body.format(seed=7), "a.toml")).variants
+    again = load_sweep_spec(write_spec(tmp_path, body.format(seed=7), "b.toml")).variants
+    other = load_sweep_spec(write_spec(tmp_path, body.format(seed=8), "c.toml")).variants
+    assert [v.params for v in first] == [v.params for v in again]
+    assert [v.params for v in first] != [v.params for v in other]
+    for variant in first:
+        p = variant.params
+        assert 10 <= p["heading_offset"] <= 20
+        assert p["scans"] in (3, 4, 5) and isinstance(p["scans"], int)
+        assert p["fov"] in (5.0, 7.5)
+    assert {v.params["scans"] for v in first} == {3, 4, 5}  # 20 draws reach every integer
+
+
+def test_parameters_that_do_not_apply_to_a_preset_make_no_extra_variants(tmp_path):
+    spec = load_sweep_spec(write_spec(tmp_path, """
+[grid]
+preset = ["orbit", "flypast"]
+radius = [50, 60, 70]
+standoff = [10, 20]
+"""))
+    # 3 orbits (radius only) + 2 fly-pasts (standoff only), not 2 x 3 x 2.
+    assert sorted((p["preset"], p.get("radius"), p.get("standoff"))
+                  for p in (v.params for v in spec.variants)) == sorted(
+        [("orbit", r, None) for r in (50.0, 60.0, 70.0)]
+        + [("flypast", None, s) for s in (10.0, 20.0)])
+
+
+@pytest.mark.parametrize("body, key, line", [
+    ("[grid]\nradius = []\n", "grid.radius", 4),
+    ("[grid]\nscans = [2, 2.5]\n", "grid.scans", 4),
+    ("[grid]\nradious = [1]\n", "grid.radious", 4),
+    ("[grid]\npreset = ['circle']\n", "grid.preset", 4),
+    ("objective = 'fastest'\n[grid]\nradius = [1]\n", "sweep.objective", 3),
+    ("objective = 'coverage-within-budget'\n[grid]\nradius = [1]\n", "sweep.budget", None),
+    ("[random]\nseed = 1\nfov = { min = 5, max = 1 }\n", "random.samples", None),
+    ("[random]\nsamples = 2\nfov = { min = 5, max = 1 }\n", "random.fov", 5),
+    ("[grid]\nfov = [1]\n[random]\nsamples = 2\nfov = [1, 2]\n", "random.fov", 7),
+    ("", "grid", None),
+])
+def test_spec_errors_name_the_file_key_and_what_was_expected(tmp_path, body, key, line):
+    path = write_spec(tmp_path, body)
+    with pytest.raises(InputFileError) as caught:
+        load_sweep_spec(path)
+    message = str(caught.value)
+    assert message.startswith(str(path))
+    assert f" {key}" in message or f"{key}:" in message
+    assert "expected" in message and "\n" not in message
+    if line is not None:
+        assert caught.value.line == line
+
+
+def test_a_spec_that_is_not_toml_names_its_line(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text('[sweep]\nscenario = "a.toml"\n[grid]\nradius = [1,\n', encoding="utf-8")
+    with pytest.raises(InputFileError, match="not valid TOML"):
+        load_sweep_spec(path)
+
+
+# -- variant ids ---------------------------------------------------------------------
+
+
+def test_variant_ids_ignore_order_and_number_spelling_but_not_values():
+    a = variant_id({"radius": 100, "scans": 4, "preset": "orbit"})
+    assert a == variant_id({"preset": "orbit", "scans": 4, "radius": 100.0})
+    assert a != variant_id({"preset": "orbit", "scans": 4, "radius": 100.5})
+    assert a != variant_id({"preset": "flypast", "scans": 4, "radius": 100.0})
+    assert len(a) == 16 and int(a, 16) >= 0
+
+
+def test_variant_ids_are_stable_across_processes():
+    params = {"radius": 0.1 + 0.2, "scans": 7, "preset": "standoff"}
+    code = ("from ladartui.sweep import variant_id; "
+            f"print(variant_id({params!r}))")
+    # Another process with another string-hash seed computes the same id.
+    seed = "2" if os.environ.get("PYTHONHASHSEED") == "1" else "1"
+    env = dict(os.environ, PYTHONHASHSEED=seed)
+    other = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                           text=True, check=True).stdout.strip()
+    assert other == variant_id(params)
+
+
+# -- the result table ----------------------------------------------------------------
+
+
+def test_table_round_trips_values_and_grows_columns(tmp_path):
+    rows = [
+        {"variant": "1e50000000000000", "status": "error", "base": "b", "radius": 10.0,
+         "error": 'bad "quote", comma'},
+        {"variant": "00000000000000ff", "status": "ok", "base": "b", "radius": 0.1 + 0.2,
+         "scans": 3, "obscured_coverage": 1 / 3, "after": [0.25, 0.5], "flag": True,
+         "nothing": None},
+    ]
+    path = tmp_path / "results.csv"
+    write_table(path, rows, ["radius", "scans"])
+    back, header = read_table(path)
+    assert header[:5] == ["variant", "status", "base", "radius", "scans"]
+    assert header[-1] == "error"
+    assert back[0]["variant"] == "1e50000000000000"  # a hex id is never read as a number
+    assert back[0]["error"] == 'bad "quote", comma' and back[0]["scans"] is None
+    assert back[1]["radius"] == 0.1 + 0.2 and back[1]["obscured_coverage"] == 1 / 3
+    assert back[1]["after"] == [0.25, 0.5] and back[1]["flag"] is True
+    assert back[1]["nothing"] is None and back[1]["scans"] == 3
+    assert "variant" in TEXT_COLUMNS
+
+
+def test_reader_drops_a_torn_last_line(tmp_path):
+    path = tmp_path / "results.csv"
+    write_table(path, [{"variant": "a" * 16, "status": "ok", "base": "b", "radius": 1.0}])
+    with open(path, "a", encoding="utf-8") as handle:
+        handle.write("bbbbbbbbbbbbbbbb,ok")  # a line cut short by a crash elsewhere
+    rows, _ = read_table(path)
+    assert [r["variant"] for r in rows] == ["a" * 16]
+
+
+# -- ranking -------------------------------------------------------------------------
+
+
+def _dominated(p, q):
+    return q[0] <= p[0] and q[1] >= p[1] and q != p
+
+
+def test_pareto_front_matches_a_brute_force_check():
+    rng = random.Random(3)
+    for _ in range(200):
+        points = [(float(rng.randint(0, 5)), float(rng.randint(0, 5)))
+                  for _ in range(rng.randint(0, 12))]
+        points.append(None)
+        expected = [p is not None and not any(q is not None and _dominated(p, q) for q in points)
+                    for p in points]
+        assert pareto_front(points) == expected
+
+
+def _row(variant, coverage, length, time, status="ok"):
+    return {"variant": variant, "status": status, "obscured_coverage": coverage,
+            "path_length_m": length, "flight_time_s": time}
+
+
+def test_objectives_rank_by_coverage_per_km_and_within_budget():
+    rows = [_row("a", 0.5, 2000.0, 100.0), _row("b", 0.4, 500.0, 25.0),
+            _row("c", 0.9, 9000.0, 450.0), _row("d", None, None, None, status="error"),
+            _row("e", 0.3, 0.0, 0.0)]
+    per_km = rank_rows(rows, "coverage-per-km")
+    assert [(r.row["variant"], r.rank) for r in per_km] == [
+        ("b", 1), ("a", 2), ("c", 3), ("e", None), ("d", None)]
+    assert per_km[0].value == pytest.approx(0.4 / 0.5)
+    budget = rank_rows(rows, "coverage-within-budget", budget=120.0)
+    assert [r.row["variant"] for r in budget if r.rank] == ["a", "b", "e"]
+    best = rank_rows(rows, "obscured-coverage")
+    assert best[0].row["variant"] == "c"
+    # Pareto front (time against coverage): e (0 s), b, a and c each buy more coverage.
+    assert {r.row["variant"] for r in best if r.pareto} == {"e", "b", "a", "c"}
+    with pytest.raises(LadarError, match="objective"):
+        rank_rows(rows, "speed")
+
+
+# -- applying parameters -------------------------------------------------------------
+
+
+def _bearing(pose, centre):
+    return math.degrees(math.atan2(pose.x - centre[0], pose.y - centre[1])) % 360.0
+
+
+def test_parameters_reshape_the_base_flight_and_sensor(tiny):
+    from ladartui.scenario import load_scenario
+
+    base = load_scenario(tiny / "base.toml")
+    scenario = apply_parameters(base, {"radius": 12.0, "altitude": 30.0, "scans": 6,
+                                       "heading_offset": 90.0, "fov": 15.0, "sensor_grid": 4})
+    poses = scenario.poses()
+    assert len(poses) == 6
+    for pose in poses:
+        assert math.hypot(pose.x - CENTRE[0], pose.y - CENTRE[1]) == pytest.approx(12.0)
+        assert pose.z == pytest.approx(30.0)
+    assert _bearing(poses[0], CENTRE) == pytest.approx(180.0 + 90.0)
+    assert (scenario.sensor.fov, scenario.sensor.grid) == (15.0, 4)
+    assert scenario.sensor.ray_grid == base.sensor.ray_grid
+
+
+def test_preset_builds_a_flypast_or_standoff_around_the_base_target(tiny):
+    from ladartui.scenario import load_scenario
+
+    base = load_scenario(tiny / "base.toml")
+    flypast = apply_parameters(base, {"preset": "flypast", "standoff": 8.0, "scans": 5})
+    poses = flypast.poses()
+    closest = min(math.hypot(p.x - CENTRE[0], p.y - CENTRE[1]) for p in poses)
+    assert closest == pytest.approx(8.0)
+    # The base orbit starts due south of the target: the fly-past passes there.
+    assert _bearing(poses[2], CENTRE) == pytest.approx(180.0)
+    assert math.hypot(poses[2].x - CENTRE[0], poses[2].y - CENTRE[1]) == pytest.approx(8.0)
+    assert all(p.z == pytest.approx(20.0) for p in poses)  # the base orbit's altitude
+    standoff = apply_parameters(base, {"preset": "standoff", "standoff": 30.0, "scans": 3})
+    distances = [math.hypot(p.x - CENTRE[0], p.y - CENTRE[1]) for p in standoff.poses()]
+    assert distances == pytest.approx([30.0, 20.0, 10.0])
+    turned = apply_parameters(base, {"preset": "standoff", "standoff": 30.0, "scans": 3,
+                                     "heading_offset": -90.0})
+    assert all(_bearing(p, CENTRE) == pytest.approx(90.0) for p in turned.poses())
+
+
+def test_a_base_standoff_keeps_its_spacing_scaled_to_the_new_standoff(tiny):
+    from ladartui.flight import FlightPlan, Standoff
+    from ladartui.scenario import load_scenario
+
+    base = load_scenario(tiny / "base.toml").with_changes(flight=FlightPlan(segments=(
+        Standoff(target=CENTRE, standoffs=(40.0, 20.0, 10.0), altitude=25.0, bearing=90.0),)))
+    scenario = apply_parameters(base, {"standoff": 80.0})
+    distances = [math.hypot(p.x - CENTRE[0], p.y - CENTRE[1]) for p in scenario.poses()]
+    assert distances == pytest.approx([80.0, 40.0, 20.0])
+    assert all(_bearing(p, CENTRE) == pytest.approx(90.0) for p in scenario.poses())
+    more = apply_parameters(base, {"scans": 4})  # a new count: even spacing from the farthest
+    distances = [math.hypot(p.x - CENTRE[0], p.y - CENTRE[1]) for p in more.poses()]
+    assert distances == pytest.approx([40.0, 30.0, 20.0, 10.0])
+
+
+def test_impossible_parameters_raise_naming_the_sweep_parameter(tiny):
+    from ladartui.scenario import load_scenario
+
+    base = load_scenario(tiny / "base.toml")
+    with pytest.raises(LadarError, match="sensor_grid = 0"):
+        apply_parameters(base, {"sensor_grid": 0})
+    with pytest.raises(LadarError, match="standoff"):
+        apply_parameters(base, {"standoff": 5.0})  # the base flies an orbit, not a fly-past
+
+
+# -- serial runs ---------------------------------------------------------------------
+
+
+def _hand_built(base, radius, scans, grid):
+    """The variant's scenario built directly from the flight and sensor classes."""
+    from ladartui.flight import FlightPlan, Orbit
+
+    flight = FlightPlan(segments=(Orbit(centre=CENTRE, radius=radius, altitude=20.0,
+                                        scans=scans),))
+    return base.with_changes(flight=flight, sensor=replace(base.sensor, grid=grid))
+
+
+def comparable(row):
+    return {k: v for k, v in row.items() if k not in VOLATILE}
+
+
+def test_serial_sweep_rows_match_direct_simulations(tiny, tmp_path):
+    from ladartui.scenario import load_scenario
+    from ladartui.simulation import simulate
+
+    spec = write_spec(tiny, TINY_GRID, name="serial.toml")
+    result = run_sweep(spec, serial=True, out=tmp_path / "out")
+    assert len(result.rows) == 8
+    base = load_scenario(tiny / "base.toml")
+    errors = [r for r in result.rows if r["status"] != "ok"]
+    assert len(errors) == 4
+    assert all(r["sensor_grid"] == 0 and "sensor_grid = 0" in r["error"]
+               and "expected" in r["error"] for r in errors)
+    for row in (r for r in result.rows if r["status"] == "ok"):
+        expected = simulate(_hand_built(base, row["radius"], row["scans"], row["sensor_grid"]),
+                            write=False)
+        measures = expected.measures
+        assert row["obscured_coverage"] == measures.obscured_coverage
+        assert row["unobscured_coverage"] == measures.unobscured_coverage
+        assert row["obscured_after_scan"] == list(measures.obscured_after_scan)
+        assert row["scan_count"] == row["scans"]
+        assert row["path_length_m"] == pytest.approx(2 * math.pi * row["radius"] * (
+            1 if row["scans"] == 1 else (row["scans"] - 1) / row["scans"]))
+        assert row["flight_time_s"] == pytest.approx(row["path_length_m"] / base.speed)
+    # The file holds the same rows, and the ranking and best scenario were written.
+    stored, _ = read_table(tmp_path / "out" / "results.csv")
+    assert sorted(map(repr, map(comparable, stored))) == sorted(
+        map(repr, map(comparable, result.rows)))
+    best = result.best.row
+    assert best["obscured_coverage"] == max(r["obscured_coverage"] for r in result.rows
+                                            if r["status"] == "ok")
+    saved = load_scenario(result.best_scenario_path)
+    assert saved.flight.segments[0].radius == best["radius"]
+    assert len(saved.poses()) == best["scans"]
+    assert saved.scene_file == base.scene_file
+    loaded = load_sweep_results(tmp_path / "out")
+    assert [r.row["variant"] for r in loaded.ranking] == [r.row["variant"] for r in result.ranking]
+
+
+def test_interrupted_sweep_resumes_with_only_the_missing_variants(tiny, tmp_path):
+    spec = write_spec(tiny, TINY_GRID, name="resume.toml")
+    out = tmp_path / "out"
+    cancel = threading.Event()
+    seen = []
+
+    def stop_after_three(progress):
+        seen.append(progress.done)
+        if progress.done >= 3:
+            cancel.set()
+
+    with pytest.raises(Cancelled):
+        run_sweep(spec, serial=True, out=out, progress=stop_after_three, cancel=cancel)
+    first, _ = read_table(out / "results.csv")
+    assert len(first) == 3
+    reports = []
+    result = run_sweep(spec, serial=True, out=out, progress=reports.append)
+    assert (result.resumed, result.ran, len(result.rows)) == (3, 5, 8)
+    assert reports[0].resumed == 3 and reports[-1].done == 8
+    kept = {r["variant"]: r for r in result.rows}
+    for row in first:  # untouched: same worker and run time as before
+        assert {k: v for k, v in kept[row["variant"]].items() if v is not None} == {
+            k: v for k, v in row.items() if v is not None}
+    # Nothing left to do: a third run runs nothing.
+    again = run_sweep(spec, serial=True, out=out)
+    assert (again.resumed, again.ran) == (8, 0)
+
+
+def test_editing_the_base_scenario_runs_every_variant_again(tmp_path):
+    write_tiny_scenario(tmp_path)
+    spec = write_spec(tmp_path, "[grid]\nscans = [2, 3]\n")
+    out = tmp_path / "out"
+    assert run_sweep(spec, serial=True, out=out).ran == 2
+    from ladartui.scenario import load_scenario
+
+    base = load_scenario(tmp_path / "base.toml")
+    base.with_changes(speed=60.0).save()
+    result = run_sweep(spec, serial=True, out=out)
+    assert (result.ran, result.resumed) == (2, 0)
+    assert all(r["flight_time_s"] == pytest.approx(r["path_length_m"] / 60.0) for r in result.rows)
+
+
+def test_the_sweep_core_and_command_import_without_textual_or_dask():
+    code = ("import sys, ladartui.sweep, ladartui.cli.sweep; "
+            "print(sorted(m for m in ('textual', 'distributed') if m in sys.modules))")
+    loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                            check=True).stdout.strip()
+    assert loaded == "[]"  # Dask loads only when a sweep runs on it
+
+
+def test_cli_reports_a_spec_error_in_one_line(tmp_path, capsys):
+    from ladartui.cli import main
+
+    spec = write_spec(tmp_path, "[grid]\nscans = ['many']\n")
+    assert main(["sweep", str(spec), "--serial"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "grid.scans" in err and str(spec) in err
+
+
+def test_cli_serial_sweep_prints_the_ranking_as_json(tiny, tmp_path, capsys):
+    import json
+
+    from ladartui.cli import main
+
+    spec = write_spec(tiny, "[grid]\nradius = [10.0, 20.0]\n", name="cli.toml")
+    assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path), "--json",
+                 "--objective", "coverage-per-km"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["objective"] == "coverage-per-km" and report["variants"] == 2
+    values = [entry["objective"] for entry in report["top"]]
+    assert values == sorted(values, reverse=True)
+    rows, _ = read_table(tmp_path / "results.csv")
+    by_id = {r["variant"]: r for r in rows}
+    for entry in report["top"]:
+        row = by_id[entry["variant"]]
+        assert entry["objective"] == pytest.approx(
+            row["obscured_coverage"] / (row["path_length_m"] / 1000.0))
+    assert os.path.isfile(report["best_scenario"])
+
+
+def test_two_sweeps_never_write_one_folder_at_once(tiny, tmp_path):
+    fcntl = pytest.importorskip("fcntl")  # POSIX only
+    spec = write_spec(tiny, "[grid]\nscans = [2]\n", name="locked.toml")
+    with open(tmp_path / ".lock", "a+b") as held:
+        fcntl.flock(held, fcntl.LOCK_EX)  # as a running sweep holds it
+        with pytest.raises(InputFileError, match="another sweep"):
+            run_sweep(spec, serial=True, out=tmp_path)
+    assert not (tmp_path / "results.csv").exists()
+    assert run_sweep(spec, serial=True, out=tmp_path).ran == 1

@@ -1,0 +1,182 @@
+"""Sweeps on Dask: a 2-worker LocalCluster, and a scheduler and worker started as processes."""
+
+import json
+import os
+import re
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ladartui.errors import Cancelled
+from ladartui.sweep import local_client, read_table, run_sweep
+
+VOLATILE = {"run_time_s", "worker"}
+SWEEP = """
+[grid]
+radius = [10.0, 20.0]
+scans = [2, 3]
+fov = [20.0, -1.0]
+"""
+
+
+def write_tiny_scenario(folder):
+    """A 32 x 32 canopy with gaps over a 4 x 2 x 2 vehicle, 8 x 8 detectors, a 4-scan orbit."""
+    from ladartui.flight import FlightPlan, Orbit
+    from ladartui.scenario import Scenario
+    from ladartui.scene.voxels import save_voxels
+    from ladartui.sensor import Sensor
+
+    target = np.array([(i, j, k) for i in range(14, 18) for j in range(15, 17) for k in range(2)],
+                      np.int32)
+    canopy = np.array([(i, j, 6) for i in range(32) for j in range(32)
+                       if (i * 7 + j * 13) % 3 == 0], np.int32)
+    save_voxels(folder / "tiny.txt", np.concatenate([target, canopy]))
+    save_voxels(folder / "tiny_Target.txt", target)
+    flight = FlightPlan(segments=(Orbit(centre=(15.5, 15.5, 0.5), radius=20.0, altitude=20.0,
+                                        scans=4),))
+    Scenario(folder / "base.toml", "tiny.txt", 1.0, Sensor(grid=8, ray_grid=2, fov=20.0), flight,
+             backend="numba").save()
+    spec = folder / "spec.toml"
+    spec.write_text('[sweep]\nscenario = "base.toml"\n' + SWEEP, encoding="utf-8")
+    return spec
+
+
+def comparable(rows):
+    return {r["variant"]: {k: v for k, v in r.items() if k not in VOLATILE} for r in rows}
+
+
+@pytest.fixture(scope="module")
+def spec(tmp_path_factory):
+    return write_tiny_scenario(tmp_path_factory.mktemp("dask"))
+
+
+@pytest.fixture(scope="module")
+def serial_rows(spec, tmp_path_factory):
+    result = run_sweep(spec, serial=True, out=tmp_path_factory.mktemp("serial"))
+    assert sum(r["status"] == "ok" for r in result.rows) == 4
+    return result.rows
+
+
+@pytest.fixture(scope="module")
+def client():
+    client = local_client(2)
+    yield client
+    cluster = client.cluster
+    client.close()
+    cluster.close()
+
+
+def test_two_workers_give_the_same_rows_as_serial_runs(spec, serial_rows, client, tmp_path):
+    result = run_sweep(spec, client=client, out=tmp_path)
+    assert result.workers == 2
+    assert comparable(result.rows) == comparable(serial_rows)
+    bad = [r for r in result.rows if r["status"] != "ok"]
+    assert len(bad) == 4 and all("fov = -1.0" in r["error"] for r in bad)
+    # Both workers took part, and each rebuilt the scene from the broadcast once.
+    assert len({r["worker"] for r in result.rows}) == 2
+
+    def scenes_built():
+        from ladartui.sweep.variant import _WORKER_SCENES
+
+        return len(_WORKER_SCENES)
+
+    assert set(client.run(scenes_built).values()) == {1}
+
+
+def test_cluster_sweep_resumes_after_an_interruption(spec, serial_rows, client, tmp_path):
+    cancel = threading.Event()
+
+    def stop_after_two(progress):
+        if progress.done >= 2:
+            cancel.set()
+
+    with pytest.raises(Cancelled):
+        run_sweep(spec, client=client, out=tmp_path, progress=stop_after_two, cancel=cancel)
+    before, _ = read_table(tmp_path / "results.csv")
+    assert 2 <= len(before) < 8
+    result = run_sweep(spec, client=client, out=tmp_path)
+    assert (result.resumed, result.ran) == (len(before), 8 - len(before))
+    by_id = {r["variant"]: r for r in result.rows}
+    for row in before:  # kept as they were (same worker, same run time), not run again
+        # (Columns added by later rows read back as None in earlier ones.)
+        assert {k: v for k, v in by_id[row["variant"]].items() if v is not None} == {
+            k: v for k, v in row.items() if v is not None}
+    assert comparable(result.rows) == comparable(serial_rows)
+
+
+def _start(args, log, env):
+    handle = open(log, "wb")
+    return subprocess.Popen(args, stdout=handle, stderr=subprocess.STDOUT, env=env,
+                            start_new_session=True), handle
+
+
+def _wait_for(pattern, log, process, seconds=60.0):
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        match = re.search(pattern, Path(log).read_text(errors="replace"))
+        if match:
+            return match
+        if process.poll() is not None:
+            break
+        time.sleep(0.1)
+    raise AssertionError(f"no {pattern!r} in {log}:\n{Path(log).read_text(errors='replace')}")
+
+
+def _stop(process):
+    if process.poll() is None:
+        process.terminate()
+        try:
+            process.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait()
+
+
+@pytest.mark.slow
+def test_cli_runs_on_a_scheduler_and_worker_started_as_processes(spec, serial_rows, tmp_path):
+    bin_dir = Path(sys.executable).parent
+    env = dict(os.environ, NUMBA_NUM_THREADS="1")
+    started = []
+    try:
+        scheduler, log = _start([str(bin_dir / "dask"), "scheduler", "--host", "127.0.0.1",
+                                 "--port", "0", "--no-dashboard"], tmp_path / "scheduler.log", env)
+        started.append((scheduler, log))
+        address = _wait_for(r"Scheduler at:\s+(tcp://127\.0\.0\.1:\d+)", tmp_path / "scheduler.log",
+                            scheduler).group(1)
+        worker, log = _start([str(bin_dir / "dask"), "worker", address, "--nthreads", "1",
+                              "--no-dashboard"], tmp_path / "worker.log", env)
+        started.append((worker, log))
+        out = tmp_path / "out"
+        run = subprocess.run([str(bin_dir / "ladartui"), "sweep", str(spec), "--scheduler",
+                              address, "--out", str(out), "--json"],
+                             capture_output=True, text=True, env=env, timeout=240)
+        assert run.returncode == 0, run.stderr
+        report = json.loads(run.stdout)
+        assert (report["variants"], report["ran"], report["failed"]) == (8, 8, 4)
+        rows, _ = read_table(out / "results.csv")
+        assert comparable(rows) == comparable(serial_rows)
+        assert report["top"][0]["variant"] == max(
+            (r for r in serial_rows if r["status"] == "ok"),
+            key=lambda r: (r["obscured_coverage"], -r["flight_time_s"]))["variant"]
+    finally:
+        for process, handle in reversed(started):
+            _stop(process)
+            handle.close()
+    assert all(process.poll() is not None for process, _ in started)
+
+
+def test_an_unreachable_scheduler_is_named_in_one_line():
+    from ladartui.errors import LadarError
+    from ladartui.sweep import connect
+
+    started = time.monotonic()
+    with pytest.raises(LadarError) as caught:
+        connect("tcp://127.0.0.1:9", timeout=1.0)
+    message = str(caught.value)
+    assert "--scheduler" in message and "tcp://127.0.0.1:9" in message and "\n" not in message
+    assert time.monotonic() - started < 15
