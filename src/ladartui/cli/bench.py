@@ -1,0 +1,176 @@
+"""``ladartui bench``: tracing speed of every available backend and method.
+
+On the ``reference`` scene (generated into the cache folder when absent) with
+a 128 x 128 sensor and 4 x 4 rays per detector, it measures rays per second
+at 45 degrees depression and at nadir (median of several runs after a
+warm-up), the occupancy set-up time and its memory. Backends come from the
+registry, so a new backend appears here by registering itself.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import statistics
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ladartui.atomic import atomic_path
+from ladartui.errors import BackendUnavailable
+
+DEPRESSIONS = (45.0, 90.0)
+SLANT_RANGE_M = 85.0  # aircraft distance from the aimed target (the default orbit's minimum)
+
+
+def add_parser(subparsers):
+    parser = subparsers.add_parser(
+        "bench", help="measure tracing speed of every available backend and method",
+        description="Trace the reference scene with a 128x128 sensor (4x4 rays per detector) "
+        "at 45 degrees and at nadir; report rays/s, set-up time and occupancy memory.")
+    parser.add_argument("--quick", action="store_true",
+                        help="fewer runs and a 64x64 sensor (a smoke test, not a measurement)")
+    parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    parser.add_argument("--runs", type=int, default=None, help="timed runs per case (median)")
+    parser.set_defaults(handler=run)
+
+
+def run(args):
+    report = run_bench(quick=args.quick, runs=args.runs)
+    if args.json:
+        print(json.dumps(report, indent=2))
+    else:
+        _print_table(report)
+    return 0
+
+
+def cache_dir() -> Path:
+    """Where the generated benchmark scene is kept between runs."""
+    from ladartui.defaults import data_home
+
+    return data_home() / "bench"
+
+
+def load_bench_scene():
+    """(scene, label): the ``reference`` scene, generated into the cache folder when absent."""
+    from ladartui.scene.model import Scene
+
+    path = cache_dir() / "reference-0.npz"
+    if not path.exists():
+        from ladartui.scene.generate import generate_scene
+
+        generated = generate_scene("reference", 0)
+        with atomic_path(path) as tmp:
+            with open(tmp, "wb") as handle:
+                np.savez(handle, voxels=generated.voxels, target=generated.target,
+                         shape=np.array(generated.shape), voxel_size=generated.voxel_size)
+    with np.load(path) as data:
+        scene = Scene(data["voxels"], data["target"], float(data["voxel_size"]),
+                      shape=tuple(int(v) for v in data["shape"]), name="reference")
+    return scene, "reference"
+
+
+def bench_rays(scene, depression, grid=128, ray_grid=4):
+    """Origins and directions (metres) of one look at the target (else the scene centre)."""
+    from ladartui.flight import ScanPose, aim_at
+    from ladartui.sensor import Sensor
+
+    nx, ny, _ = scene.shape
+    if len(scene.target):
+        centre = scene.target.astype(np.float64).mean(axis=0) * scene.voxel_size
+    else:
+        centre = np.array([nx / 2, ny / 2, 0.0]) * scene.voxel_size
+    e = math.radians(depression)
+    aircraft = centre + SLANT_RANGE_M * np.array([0.0, -math.cos(e), math.sin(e)])
+    if depression >= 90.0:
+        aircraft[:2] = centre[:2]
+    pose = aim_at(ScanPose(float(aircraft[0]), float(aircraft[1]), float(aircraft[2]),
+                           0.0, 0.0, 90.0), centre.tolist())
+    origins, directions, _ = Sensor(grid=grid, ray_grid=ray_grid).rays(pose)
+    return origins, directions
+
+
+def run_bench(quick=False, runs=None) -> dict:
+    """Measure every available backend and method; returns the report as a dict."""
+    from ladartui.scene.occupancy import Occupancy
+    from ladartui.tracing import trace
+    from ladartui.tracing.backend import backend_status, get_backend
+
+    runs = runs or (2 if quick else 7)
+    grid = 64 if quick else 128
+    scene, label = load_bench_scene()
+    started, cpu_started = time.perf_counter(), time.process_time()
+    occupancy = Occupancy.build(scene.voxels, scene.shape)
+    setup = time.perf_counter() - started
+    setup_cpu = time.process_time() - cpu_started
+    report = {"scene": label, "shape": list(scene.shape), "voxels": int(occupancy.count),
+              "voxel_size": scene.voxel_size, "setup_seconds": setup, "setup_cpu_seconds": setup_cpu,
+              "occupancy_bytes": occupancy.nbytes, "occupancy": occupancy.summary(),
+              "sensor": f"{grid}x{grid} detectors, 4x4 rays each", "runs": runs,
+              "slant_range_m": SLANT_RANGE_M, "backends": {}, "results": []}
+    rays = {d: bench_rays(scene, d, grid=grid) for d in DEPRESSIONS}
+    for name, reason in backend_status().items():
+        report["backends"][name] = reason or "available"
+        if reason:
+            continue
+        try:
+            backend = get_backend(name)
+        except BackendUnavailable:
+            continue
+        for method in ("exact", "march"):
+            for depression, (origins, directions) in rays.items():
+                kwargs = dict(backend=name, method=method, step=0.5,
+                              voxel_size=scene.voxel_size)
+                warm = time.perf_counter()
+                result = trace(occupancy, origins, directions, **kwargs)
+                warm = time.perf_counter() - warm
+                times, cpu = [], []
+                for _ in range(runs):
+                    c = time.process_time()
+                    t = time.perf_counter()
+                    trace(occupancy, origins, directions, **kwargs)
+                    times.append(time.perf_counter() - t)
+                    cpu.append(time.process_time() - c)
+                median = statistics.median(times)
+                cpu_median = statistics.median(cpu)
+                report["results"].append({
+                    "backend": name, "method": method, "depression": depression,
+                    "rays": len(origins), "rays_per_second": len(origins) / median,
+                    "median_seconds": median, "first_call_seconds": warm,
+                    # On a shared machine wall time includes waiting for the
+                    # cores; rays per CPU-second (all threads) does not.
+                    "cpu_seconds": cpu_median,
+                    "rays_per_cpu_second": len(origins) / cpu_median if cpu_median > 0 else None,
+                    "voxel_hits": float(np.mean(result.kind == 1)),
+                    "ground_hits": float(np.mean(result.kind == 2)),
+                    "device": backend.describe().get("adapter") or "cpu"})
+    return report
+
+
+def _print_table(report):
+    from rich import box
+    from rich.console import Console
+    from rich.table import Table
+
+    console = Console()
+    console.print(f"scene {report['scene']} {report['shape']}, {report['voxels']:,} voxels; "
+                  f"occupancy {report['occupancy_bytes'] / 2**20:.1f} MiB built in "
+                  f"{report['setup_seconds']:.2f} s ({report['setup_cpu_seconds']:.2f} CPU-s); "
+                  f"{report['sensor']}; median of "
+                  f"{report['runs']} runs")
+    table = Table(box=box.SIMPLE_HEAD, pad_edge=False)
+    for name in ("backend", "method", "depr.", "rays/s", "rays/CPU-s", "voxel", "ground"):
+        table.add_column(name, no_wrap=True, min_width=max(len(name), 7))
+    table.add_column("device", no_wrap=True, overflow="ellipsis", max_width=12)
+    for row in report["results"]:
+        per_cpu = row["rays_per_cpu_second"]
+        table.add_row(row["backend"], row["method"], f"{row['depression']:g}",
+                      f"{row['rays_per_second'] / 1e6:.2f} M",
+                      f"{per_cpu / 1e6:.2f} M" if per_cpu else "-",
+                      f"{row['voxel_hits']:.1%}",
+                      f"{row['ground_hits']:.1%}", str(row["device"]))
+    console.print(table)
+    for name, status in report["backends"].items():
+        if status != "available":
+            console.print(f"[dim]{name}: {status}[/dim]")

@@ -1,0 +1,75 @@
+"""``ladartui trace``: trace a file of rays against a scene model, write the hits.
+
+RAYS.npy is an (N, 6) float array: origin x, y, z (metres) and unit direction.
+HITS.npy is (N, 5) float64: kind (0 miss, 1 voxel, 2 ground), i, j, k, range
+in metres (inf for a miss). The output is written atomically.
+"""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+
+from ladartui.atomic import atomic_path
+from ladartui.errors import FieldError, InputFileError
+
+
+def add_parser(subparsers):
+    parser = subparsers.add_parser(
+        "trace", help="trace rays (.npy) against a scene model and write the hits (.npy)",
+        description="Trace an (N, 6) array of rays (origin and unit direction, metres) against "
+        "a voxel scene model; write an (N, 5) array: kind (0 miss, 1 voxel, 2 ground), i, j, k, "
+        "range in metres.")
+    parser.add_argument("--scene", required=True, metavar="X.txt", help="scene model voxel list")
+    parser.add_argument("--rays", required=True, metavar="RAYS.npy", help="(N, 6) float array")
+    parser.add_argument("--out", required=True, metavar="HITS.npy", help="output (N, 5) float64")
+    parser.add_argument("--backend", default="auto", help="backend name or 'auto' (default)")
+    parser.add_argument("--method", default="exact", help="exact (default) or march")
+    parser.add_argument("--step", type=float, default=None, help="march step in voxels (0.5)")
+    parser.add_argument("--voxel-size", type=float, default=1.0, help="metres per voxel (1.0)")
+    parser.set_defaults(handler=run)
+
+
+def load_rays(path) -> np.ndarray:
+    """The (N, 6) float64 rays of a .npy file; InputFileError naming what is wrong."""
+    try:
+        rays = np.load(path, allow_pickle=False)
+    except FileNotFoundError:
+        raise InputFileError(path, "no such file") from None
+    except (ValueError, OSError) as error:
+        raise InputFileError(path, f"not a NumPy .npy array ({error})") from None
+    if rays.ndim != 2 or rays.shape[1] != 6:
+        raise InputFileError(path, f"array of shape {rays.shape}: expected (N, 6): "
+                             "origin x, y, z and direction dx, dy, dz per row")
+    if rays.dtype.kind not in "fiu":
+        raise InputFileError(path, f"dtype {rays.dtype}: expected numbers")
+    rays = rays.astype(np.float64)
+    if not np.all(np.isfinite(rays)):
+        row = int(np.flatnonzero(~np.all(np.isfinite(rays), axis=1))[0])
+        raise InputFileError(path, f"row {row} is not finite: expected finite numbers")
+    zero = np.flatnonzero(~np.any(rays[:, 3:] != 0, axis=1))
+    if len(zero):
+        raise InputFileError(path, f"row {int(zero[0])} has a zero direction: expected a unit vector")
+    return rays
+
+
+def run(args):
+    from ladartui.scene.occupancy import Occupancy
+    from ladartui.scene.voxels import load_voxels
+    from ladartui.tracing import trace
+
+    if not args.voxel_size > 0:
+        raise FieldError("--voxel-size", args.voxel_size, "a positive number of metres")
+    rays = load_rays(args.rays)
+    voxels = load_voxels(args.scene)
+    occupancy = Occupancy.build(voxels)
+    result = trace(occupancy, rays[:, :3], rays[:, 3:], backend=args.backend, method=args.method,
+                   step=args.step, voxel_size=args.voxel_size)
+    with atomic_path(args.out) as tmp:
+        with open(tmp, "wb") as handle:
+            np.save(handle, result.as_array())
+    counts = np.bincount(result.kind, minlength=3)
+    print(f"{len(rays)} rays ({result.backend}, {result.method}): {counts[1]} voxel, "
+          f"{counts[2]} ground, {counts[0]} miss -> {args.out}", file=sys.stderr)
+    return 0

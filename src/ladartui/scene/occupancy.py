@@ -1,0 +1,224 @@
+"""Occupancy: the sparse bitmask hierarchy that every tracer reads.
+
+The layout is a contract shared with the WGSL shader (see docs/architecture.md,
+"Occupancy layout"): all arrays are uint32, nodes have fan-out 8 per axis.
+
+    root    dense grid of 512-voxel cells over the occupied box: region number (index + 1), 0 = empty
+    regions 512 slots per region (64-voxel cells): tile number, 0 = empty
+    tiles   512 slots per tile (8-voxel cells): brick number, 0 = empty
+    bricks  16 words per brick: one bit per voxel
+    columns per 8 x 8 column of bricks: 1 + highest non-empty brick z (relative to the root grid)
+
+Inside any node the local position (lx, ly, lz), each 0..7, is linear
+``l = lx + 8 * ly + 64 * lz``; a brick's bit ``l`` is bit ``l & 31`` of word ``l >> 5``.
+Memory grows with the content only: one node per non-empty cell at its level.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ladartui.errors import FieldError
+
+BRICK_WORDS = 16
+NODE_SLOTS = 512
+# log2 of the cell size (voxels) at each level: brick voxel, tile slot, region slot, root cell.
+VOXEL_SHIFT, BRICK_SHIFT, TILE_SHIFT, REGION_SHIFT = 0, 3, 6, 9
+
+
+@dataclass(frozen=True, eq=False)
+class Occupancy:
+    """Which voxels are occupied, as a sparse hierarchy sized to the content.
+
+    Cell-space coordinates: voxel (i, j, k) spans [i, i+1) x [j, j+1) x [k, k+1).
+    ``bbox_lo``/``bbox_hi`` bound the occupied voxels (hi exclusive; equal when empty).
+    """
+
+    shape: tuple
+    bbox_lo: np.ndarray
+    bbox_hi: np.ndarray
+    root_origin: np.ndarray
+    root_dims: np.ndarray
+    root: np.ndarray
+    regions: np.ndarray
+    tiles: np.ndarray
+    bricks: np.ndarray
+    count: int
+    columns: np.ndarray = None
+
+    @classmethod
+    def build(cls, voxels, shape=None) -> "Occupancy":
+        """Build from an (N, 3) integer voxel list (duplicates allowed) and the scene shape.
+
+        ``shape`` is (nx, ny, nz); by default ``voxels.max(axis=0) + 1``. Voxels
+        outside ``[0, shape)`` raise FieldError.
+        """
+        vox = np.asarray(voxels)
+        if vox.size == 0:
+            vox = vox.reshape(0, 3)
+        if vox.ndim != 2 or vox.shape[1] != 3:
+            raise FieldError("voxels", f"array of shape {vox.shape}", "an (N, 3) integer array")
+        if vox.dtype.kind not in "iu":
+            raise FieldError("voxels", f"dtype {vox.dtype}", "integer voxel indices")
+        vox = vox.astype(np.int64, copy=False)
+        if shape is None:
+            shape = tuple(int(v) + 1 for v in vox.max(axis=0)) if len(vox) else (0, 0, 0)
+        shape = tuple(int(s) for s in shape)
+        if len(shape) != 3 or min(shape) < 0:
+            raise FieldError("shape", shape, "three non-negative integers (nx, ny, nz)")
+        if len(vox):
+            lo = vox.min(axis=0)
+            hi = vox.max(axis=0) + 1
+            if lo.min() < 0 or np.any(hi > np.array(shape)):
+                raise FieldError("voxels", f"indices spanning {lo.tolist()}..{(hi - 1).tolist()}",
+                                 f"indices inside the scene shape {list(shape)}")
+        else:
+            return cls._empty(shape)
+        return cls._from_nonempty(vox, lo, hi, shape)
+
+    @classmethod
+    def _empty(cls, shape):
+        zero = np.zeros(3, np.int64)
+        empty = np.zeros(0, np.uint32)
+        return cls(shape, zero.copy(), zero.copy(), zero.copy(), zero.copy(),
+                   empty, empty.copy(), empty.copy(), empty.copy(), 0, empty.copy())
+
+    @classmethod
+    def _from_nonempty(cls, vox, lo, hi, shape):
+        root_origin = (lo >> REGION_SHIFT) << REGION_SHIFT
+        root_dims = ((hi - 1) >> REGION_SHIFT) - (lo >> REGION_SHIFT) + 1
+        rel = vox - root_origin
+        # One sort key ordering voxels root cell first, then region slot, tile slot,
+        # voxel bit: bricks of a tile and tiles of a region end up adjacent in memory.
+        r = rel >> REGION_SHIFT
+        root_lin = r[:, 0] + root_dims[0] * (r[:, 1] + root_dims[1] * r[:, 2])
+        key = root_lin << 27
+        key |= _local(rel, TILE_SHIFT) << 18
+        key |= _local(rel, BRICK_SHIFT) << 9
+        key |= _local(rel, VOXEL_SHIFT)
+        key.sort()
+        key = key[_starts(key)]  # drop duplicate voxels
+        count = len(key)
+
+        brick_key = key >> 9
+        brick_start = _starts(brick_key)
+        brick_of_voxel = np.cumsum(brick_start) - 1
+        n_bricks = int(brick_of_voxel[-1]) + 1
+        bit = key & 511
+        word = brick_of_voxel * BRICK_WORDS + (bit >> 5)
+        word_start = np.flatnonzero(_starts(word))
+        bricks = np.zeros(n_bricks * BRICK_WORDS, np.uint32)
+        values = np.left_shift(np.uint32(1), (bit & 31).astype(np.uint32))
+        bricks[word[word_start]] = np.bitwise_or.reduceat(values, word_start)
+
+        bkeys = brick_key[brick_start]  # one per brick, in brick order
+        tiles, tkeys = _parents(bkeys, n_bricks)
+        regions, rkeys = _parents(tkeys, len(tkeys))
+        root = np.zeros(int(np.prod(root_dims)), np.uint32)
+        root[rkeys] = np.arange(1, len(rkeys) + 1, dtype=np.uint32)
+        columns = _column_tops(bkeys, root_dims)
+        return cls(shape, lo.astype(np.int64), hi.astype(np.int64), root_origin.astype(np.int64),
+                   root_dims.astype(np.int64), root, regions, tiles, bricks, count, columns)
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes held by the hierarchy arrays."""
+        return int(self.root.nbytes + self.regions.nbytes + self.tiles.nbytes + self.bricks.nbytes
+                   + self.columns.nbytes)
+
+    @property
+    def zmax(self) -> int:
+        """Highest occupied layer, -1 when empty."""
+        return int(self.bbox_hi[2]) - 1 if self.count else -1
+
+    @property
+    def n_bricks(self) -> int:
+        return len(self.bricks) // BRICK_WORDS
+
+    @property
+    def n_tiles(self) -> int:
+        return len(self.tiles) // NODE_SLOTS
+
+    @property
+    def n_regions(self) -> int:
+        return len(self.regions) // NODE_SLOTS
+
+    def contains(self, ijk) -> np.ndarray:
+        """Boolean array: is each (.., 3) voxel index occupied? Outside the scene is False."""
+        ijk = np.asarray(ijk, dtype=np.int64)
+        flat = ijk.reshape(-1, 3)
+        out = np.zeros(len(flat), bool)
+        if self.count == 0 or len(flat) == 0:
+            return out.reshape(ijk.shape[:-1])
+        inside = np.all((flat >= self.bbox_lo) & (flat < self.bbox_hi), axis=1)
+        rel = flat[inside] - self.root_origin
+        r = rel >> REGION_SHIFT
+        node = self.root[r[:, 0] + self.root_dims[0] * (r[:, 1] + self.root_dims[1] * r[:, 2])]
+        node = node.astype(np.int64)
+        for array, shift in ((self.regions, TILE_SHIFT), (self.tiles, BRICK_SHIFT)):
+            ok = node > 0
+            child = np.zeros_like(node)
+            child[ok] = array[(node[ok] - 1) * NODE_SLOTS + _local(rel[ok], shift)]
+            node = child
+        ok = node > 0
+        bit = _local(rel[ok], VOXEL_SHIFT)
+        words = self.bricks[(node[ok] - 1) * BRICK_WORDS + (bit >> 5)].astype(np.int64)
+        hit = np.zeros(len(rel), bool)
+        hit[ok] = (words >> (bit & 31)) & 1 == 1
+        out[inside] = hit
+        return out.reshape(ijk.shape[:-1])
+
+    def summary(self) -> dict:
+        """Node counts and bytes, for reports."""
+        return {"count": self.count, "shape": list(self.shape), "bbox_lo": self.bbox_lo.tolist(),
+                "bbox_hi": self.bbox_hi.tolist(), "root_cells": len(self.root),
+                "regions": self.n_regions, "tiles": self.n_tiles, "bricks": self.n_bricks,
+                "nbytes": self.nbytes}
+
+
+def _local(rel, shift):
+    """Linear slot ``lx + 8 ly + 64 lz`` of each cell inside its parent node at level ``shift``."""
+    c = (rel >> shift) & 7
+    return c[:, 0] | (c[:, 1] << 3) | (c[:, 2] << 6)
+
+
+def _starts(sorted_keys):
+    """True where a run of equal sorted keys begins."""
+    start = np.empty(len(sorted_keys), bool)
+    if len(sorted_keys):
+        start[0] = True
+        np.not_equal(sorted_keys[1:], sorted_keys[:-1], out=start[1:])
+    return start
+
+
+def _column_tops(brick_keys, root_dims):
+    """Per 8 x 8 brick column over the root grid: 1 + its highest non-empty brick's z, 0 if none.
+
+    Indexed ``qx + 64 * root_dims.x * qy`` with ``q = (c - root_origin) >> 3``.
+    """
+    root_lin = brick_keys >> 18
+    rx = root_lin % root_dims[0]
+    ry = (root_lin // root_dims[0]) % root_dims[1]
+    rz = root_lin // (root_dims[0] * root_dims[1])
+    tile_slot = (brick_keys >> 9) & 511
+    brick_slot = brick_keys & 511
+    qx = rx * 64 + (tile_slot & 7) * 8 + (brick_slot & 7)
+    qy = ry * 64 + ((tile_slot >> 3) & 7) * 8 + ((brick_slot >> 3) & 7)
+    qz = rz * 64 + (tile_slot >> 6) * 8 + (brick_slot >> 6)
+    tops = np.zeros(int(root_dims[0] * 64 * root_dims[1] * 64), np.uint32)
+    np.maximum.at(tops, qx + root_dims[0] * 64 * qy, (qz + 1).astype(np.uint32))
+    return tops
+
+
+def _parents(child_keys, n_children):
+    """Nodes one level up: their 512-slot arrays and their own keys (child key >> 9)."""
+    parent_key = child_keys >> 9
+    start = _starts(parent_key)
+    parent_of_child = np.cumsum(start) - 1
+    n_parents = int(parent_of_child[-1]) + 1
+    slots = np.zeros(n_parents * NODE_SLOTS, np.uint32)
+    slots[parent_of_child * NODE_SLOTS + (child_keys & 511)] = np.arange(
+        1, n_children + 1, dtype=np.uint32)
+    return slots, parent_key[start]

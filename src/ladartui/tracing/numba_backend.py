@@ -1,0 +1,436 @@
+"""The numba backend: exact hierarchical traversal and the report's fixed-step march.
+
+Both kernels follow docs/architecture.md ("Exact traversal", "March") step by
+step, so the WGSL shader can mirror them. Rays run in chunks under ``prange``
+in the order given (detector order is coherent: neighbouring rays touch the
+same nodes, so the working set stays in cache).
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import time
+
+import numba
+import numpy as np
+from numba import njit, prange
+
+from ladartui.errors import Cancelled
+from ladartui.tracing.backend import GROUND, MISS, VOXEL, CellHits, register_backend
+
+CHUNK = 64  # rays per prange work item: coherent neighbours stay on one thread
+BLOCK = 1 << 16  # rays per kernel call: cancel is checked between calls
+INF = np.inf
+
+
+@njit(nogil=True, cache=True)
+def _boundary_t(b, o, inv):
+    # The one formula for boundary parameters (shared with the reference tracer).
+    return (b - o) * inv
+
+
+@njit(nogil=True, cache=True)
+def _cell_at(o, d, inv, t):
+    """Cell index on one axis just after parameter ``t``, exact against ``_boundary_t``."""
+    c = math.floor(o + t * d)
+    if d > 0.0:
+        if _boundary_t(c + 1.0, o, inv) <= t:
+            c += 1.0
+        elif _boundary_t(c, o, inv) > t:
+            c -= 1.0
+    elif d < 0.0:
+        if _boundary_t(c, o, inv) <= t:
+            c -= 1.0
+        elif _boundary_t(c + 1.0, o, inv) > t:
+            c += 1.0
+    return np.int64(c)
+
+
+@njit(nogil=True, cache=True)
+def _clamp(v, lo, hi):
+    return lo if v < lo else (hi if v > hi else v)
+
+
+@njit(nogil=True, cache=True)
+def _slab(o, d, inv, lo, hi):
+    """Entry and exit parameters of [lo, hi) on one axis; (inf, -inf) when never inside."""
+    if d > 0.0:
+        return _boundary_t(lo, o, inv), _boundary_t(hi, o, inv)
+    if d < 0.0:
+        return _boundary_t(hi, o, inv), _boundary_t(lo, o, inv)
+    if lo < o < hi:
+        return -INF, INF
+    return INF, -INF
+
+
+@njit(nogil=True, cache=True)
+def _exit_boundary(c, s, positive):
+    if positive:
+        return ((c >> s) + 1) << s
+    return (c >> s) << s
+
+
+@njit(nogil=True, cache=True)
+def _block_t(c, s, positive, o, inv, moving):
+    """Parameter of the exit boundary of the block ``c >> s`` on one axis."""
+    if not moving:
+        return INF
+    return _boundary_t(np.float64(_exit_boundary(c, s, positive)), o, inv)
+
+
+@njit(nogil=True, cache=True)
+def _slot(x, y, z, s):
+    return ((x >> s) & 7) | (((y >> s) & 7) << 3) | (((z >> s) & 7) << 6)
+
+
+@njit(nogil=True, cache=True)
+def _node_skip(c, s, positive, moving, o, inv):
+    """Exit boundary and its parameter of the node ``c >> s`` on one axis."""
+    b = _exit_boundary(c, s, positive)
+    return b, (_boundary_t(np.float64(b), o, inv) if moving else INF)
+
+
+@njit(nogil=True, cache=True)
+def _enter(c, b, stepped, positive, s, o, d, inv, t):
+    """Cell on one axis after crossing into a new node at ``t``: the boundary cell
+    for an axis that stepped, else ``cell_at(t)`` kept inside the node of ``c``."""
+    if stepped:
+        return b if positive else b - 1
+    lo = (c >> s) << s
+    return _clamp(_cell_at(o, d, inv, t), lo, lo + (1 << s) - 1)
+
+
+@njit(nogil=True, cache=True)
+def _brick_entry(b, stepped, positive, o, d, inv, t):
+    """Cell on one axis on entering brick ``b`` at ``t`` after a brick step."""
+    return _enter(b << 3, (b << 3) if positive else ((b + 1) << 3), stepped, positive, 3, o, d,
+                  inv, t)
+
+
+@njit(nogil=True, cache=True)
+def _ground(ox, oy, oz, dx, dy, dz, nx, ny):
+    """(kind, i, j, t) of the ground rule for a ray that hit no voxel."""
+    if dz < 0.0 and oz > 0.0:
+        tg = (0.0 - oz) * (1.0 / dz)
+        gx = ox + tg * dx
+        gy = oy + tg * dy
+        if 0.0 <= gx < nx and 0.0 <= gy < ny:
+            return GROUND, np.int64(math.floor(gx)), np.int64(math.floor(gy)), tg
+    return MISS, np.int64(-1), np.int64(-1), INF
+
+
+@njit(parallel=True, nogil=True, cache=True)
+def _exact_kernel(orig, dirs, root, regions, tiles, bricks, columns, lo, hi, rorg, rdims, nx, ny,
+                  kind, index, tout):
+    """The exact traversal of docs/architecture.md for every ray, chunks under prange.
+
+    The per-ray code is written out here rather than called: passing the
+    arrays to a per-ray function costs reference counting on every ray.
+    Empty root cells and regions are skipped as nodes; inside a tile a DDA
+    over 8-voxel bricks skips empty bricks (and, for descending rays, whole
+    empty brick columns); inside a brick a voxel DDA skips empty 4- and
+    2-voxel blocks and tests bits. Every cell boundary parameter comes from
+    the one formula ``(b - o) * inv``, so the cells visited are those of a
+    plain voxel DDA.
+    """
+    n = orig.shape[0]
+    chunks = (n + CHUNK - 1) // CHUNK
+    for ch in prange(chunks):
+        for r in range(ch * CHUNK, min(n, (ch + 1) * CHUNK)):
+            ox, oy, oz = orig[r, 0], orig[r, 1], orig[r, 2]
+            dx, dy, dz = dirs[r, 0], dirs[r, 1], dirs[r, 2]
+            found = False
+            done = False
+            cx, cy, cz, t = np.int64(-1), np.int64(-1), np.int64(-1), INF
+            for _once in range(1):  # a block to break out of: no hit, or a hit
+                if root.shape[0] == 0:
+                    done = True
+                    break
+                # Step 1: a ray inside a plane of cell faces enters no interior.
+                if (dx == 0.0 and ox == math.floor(ox)) or (dy == 0.0 and oy == math.floor(oy)) \
+                        or (dz == 0.0 and oz == math.floor(oz)):
+                    done = True
+                    break
+                ix = 1.0 / dx if dx != 0.0 else INF
+                iy = 1.0 / dy if dy != 0.0 else INF
+                iz = 1.0 / dz if dz != 0.0 else INF
+                mx, my, mz = dx != 0.0, dy != 0.0, dz != 0.0
+                # Step 2: clip to the occupied box.
+                ex, xx = _slab(ox, dx, ix, lo[0], hi[0])
+                ey, xy = _slab(oy, dy, iy, lo[1], hi[1])
+                ez, xz = _slab(oz, dz, iz, lo[2], hi[2])
+                t0 = max(0.0, max(ex, max(ey, ez)))
+                t1 = min(xx, min(xy, xz))
+                if not t0 < t1:
+                    done = True
+                    break
+                # Step 3: the start cell.
+                cx = _clamp(_cell_at(ox, dx, ix, t0), lo[0], hi[0] - 1)
+                cy = _clamp(_cell_at(oy, dy, iy, t0), lo[1], hi[1] - 1)
+                cz = _clamp(_cell_at(oz, dz, iz, t0), lo[2], hi[2] - 1)
+                px, py, pz = dx > 0.0, dy > 0.0, dz > 0.0
+                sx = 1 if px else -1
+                sy = 1 if py else -1
+                sz = 1 if pz else -1
+                # Offset from a cell to its exit boundary, for the voxel DDA. A still axis
+                # (inv = +inf, origin off the boundaries) gets +1 so its parameter is +inf.
+                fx = 0.0 if dx < 0.0 else 1.0
+                fy = 0.0 if dy < 0.0 else 1.0
+                fz = 0.0 if dz < 0.0 else 1.0
+                t = t0
+                rx0, ry0, rz0 = rorg[0], rorg[1], rorg[2]
+                rdx, rdy = rdims[0], rdims[1]
+                # Brick columns (see Occupancy.columns), relative to the root grid.
+                qx0, qy0, qz0 = rx0 >> 3, ry0 >> 3, rz0 >> 3
+                qnx = rdx * 64
+                descending = dz < 0.0
+                cap = 4 * (hi[0] - lo[0] + hi[1] - lo[1] + hi[2] - lo[2]) + 64
+                steps = 0
+                while steps < cap:
+                    steps += 1
+                    if cx < lo[0] or cy < lo[1] or cz < lo[2] or cx >= hi[0] or cy >= hi[1] or cz >= hi[2]:
+                        done = True
+                        break
+                    s = 9
+                    g = root[((cx - rx0) >> 9) + rdx * (((cy - ry0) >> 9) + rdy * ((cz - rz0) >> 9))]
+                    if g != 0:
+                        s = 6
+                        tl = regions[(np.int64(g) - 1) * 512 + _slot(cx, cy, cz, 6)]
+                        if tl != 0:
+                            # Inside a tile: DDA over its 8 x 8 x 8 brick slots.
+                            tile = (np.int64(tl) - 1) * 512
+                            gx, gy, gz = cx >> 6, cy >> 6, cz >> 6
+                            bx, by, bz = cx >> 3, cy >> 3, cz >> 3
+                            fresh = True  # (cx, cy, cz) is the cell at t
+                            stx, sty, stz = False, False, False  # axes stepped by the last brick step
+                            while steps < cap:
+                                br = tiles[tile + ((bx & 7) | ((by & 7) << 3) | ((bz & 7) << 6))]
+                                if br != 0:
+                                    if not fresh:
+                                        cx = _brick_entry(bx, stx, px, ox, dx, ix, t)
+                                        cy = _brick_entry(by, sty, py, oy, dy, iy, t)
+                                        cz = _brick_entry(bz, stz, pz, oz, dz, iz, t)
+                                    # Voxel DDA inside the brick, skipping empty 4- and 2-voxel
+                                    # blocks; t of each axis's next voxel boundary is recomputed
+                                    # from that boundary whenever the axis steps.
+                                    base = (np.int64(br) - 1) * 16
+                                    tx = (cx + fx - ox) * ix
+                                    ty = (cy + fy - oy) * iy
+                                    tz = (cz + fz - oz) * iz
+                                    while True:
+                                        lx, ly, lz = cx & 7, cy & 7, cz & 7
+                                        w = base + (ly >> 2)
+                                        z4 = w + ((lz & 4) << 1)
+                                        quad = bricks[z4] | bricks[z4 + 2] | bricks[z4 + 4] | bricks[z4 + 6]
+                                        if quad & (0x0F0F0F0F << (lx & 4)) == 0:
+                                            tn = min(_block_t(cx, 2, px, ox, ix, mx),
+                                                     min(_block_t(cy, 2, py, oy, iy, my),
+                                                         _block_t(cz, 2, pz, oz, iz, mz)))
+                                        else:
+                                            z2 = w + ((lz & 6) << 1)
+                                            pair = bricks[z2] | bricks[z2 + 2]
+                                            if pair & (0x303 << ((lx & 6) | ((ly & 2) << 3))) == 0:
+                                                tn = min(_block_t(cx, 1, px, ox, ix, mx),
+                                                         min(_block_t(cy, 1, py, oy, iy, my),
+                                                             _block_t(cz, 1, pz, oz, iz, mz)))
+                                            else:
+                                                bit = lx | ((ly & 3) << 3)
+                                                if (bricks[w + (lz << 1)] >> bit) & 1:
+                                                    found = True
+                                                    done = True
+                                                    break
+                                                tn = min(tx, min(ty, tz))
+                                        if tn >= t1:
+                                            done = True
+                                            break
+                                        steps += 1
+                                        # Every axis passes the voxel boundaries up to tn; tied
+                                        # axes step together (touching an edge is no visit).
+                                        while tx <= tn:
+                                            cx += sx
+                                            tx = (cx + fx - ox) * ix
+                                        while ty <= tn:
+                                            cy += sy
+                                            ty = (cy + fy - oy) * iy
+                                        while tz <= tn:
+                                            cz += sz
+                                            tz = (cz + fz - oz) * iz
+                                        t = tn
+                                        if (cx >> 3) != bx or (cy >> 3) != by or (cz >> 3) != bz or steps >= cap:
+                                            break
+                                    if done:
+                                        break
+                                    bx, by, bz = cx >> 3, cy >> 3, cz >> 3
+                                    fresh = True
+                                else:
+                                    # Skip the empty brick, or for a descending ray above the
+                                    # highest brick of its brick column, that whole column part.
+                                    tbx = (np.float64((bx + 1) << 3 if px else bx << 3) - ox) * ix if mx else INF
+                                    tby = (np.float64((by + 1) << 3 if py else by << 3) - oy) * iy if my else INF
+                                    top = columns[(bx - qx0) + qnx * (by - qy0)] + qz0 if descending else bz + 1
+                                    above = bz >= top
+                                    if above:
+                                        tbz = (np.float64(top << 3) - oz) * iz
+                                    else:
+                                        tbz = (np.float64((bz + 1) << 3 if pz else bz << 3) - oz) * iz if mz else INF
+                                    tn = min(tbx, min(tby, tbz))
+                                    if tn >= t1:
+                                        done = True
+                                        break
+                                    steps += 1
+                                    stx, sty, stz = tbx == tn, tby == tn, tbz == tn
+                                    if stx:
+                                        bx += sx
+                                    if sty:
+                                        by += sy
+                                    if stz:
+                                        bz = top - 1 if above else bz + sz
+                                    elif above:
+                                        bz = _clamp(_cell_at(oz, dz, iz, tn) >> 3, top, bz)
+                                    t = tn
+                                    fresh = False
+                                if (bx >> 3) != gx or (by >> 3) != gy or (bz >> 3) != gz:
+                                    break
+                            if done:
+                                break
+                            if not fresh:
+                                # Left the tile through an empty brick: the cell at t for the node lookup.
+                                cx = _brick_entry(bx, stx, px, ox, dx, ix, t)
+                                cy = _brick_entry(by, sty, py, oy, dy, iy, t)
+                                cz = _brick_entry(bz, stz, pz, oz, dz, iz, t)
+                            continue
+                    # Skip the empty root cell or region c >> s.
+                    bxn, tx = _node_skip(cx, s, px, mx, ox, ix)
+                    byn, ty = _node_skip(cy, s, py, my, oy, iy)
+                    bzn, tz = _node_skip(cz, s, pz, mz, oz, iz)
+                    tn = min(tx, min(ty, tz))
+                    if tn >= t1:
+                        done = True
+                        break
+                    cx = _enter(cx, bxn, tx == tn, px, s, ox, dx, ix, tn)
+                    cy = _enter(cy, byn, ty == tn, py, s, oy, dy, iy, tn)
+                    cz = _enter(cz, bzn, tz == tn, pz, s, oz, dz, iz, tn)
+                    t = tn
+            if found:
+                kind[r] = VOXEL
+                index[r, 0], index[r, 1], index[r, 2] = cx, cy, cz
+                tout[r] = t
+            else:
+                gk, gi, gj, tg = _ground(ox, oy, oz, dx, dy, dz, nx, ny)
+                kind[r] = gk
+                index[r, 0], index[r, 1] = gi, gj
+                index[r, 2] = 0 if gk == GROUND else -1
+                tout[r] = tg
+
+
+@njit(parallel=True, nogil=True, cache=True)
+def _march_kernel(orig, dirs, step, zmax, root, regions, tiles, bricks, lo, hi, rorg, rdims,
+                  nx, ny, kind, index, tout):
+    """The report's fixed-step march (docs/architecture.md "March") for every ray."""
+    n = orig.shape[0]
+    chunks = (n + CHUNK - 1) // CHUNK
+    top = zmax + 1.0
+    # From the first sample on, every sample is inside the extent's box or ends the ray.
+    limit = np.int64((math.sqrt(nx * nx + ny * ny + top * top) + 2.0) / step) + 2
+    for ch in prange(chunks):
+        for r in range(ch * CHUNK, min(n, (ch + 1) * CHUNK)):
+            ox, oy, oz = orig[r, 0], orig[r, 1], orig[r, 2]
+            dx, dy, dz = dirs[r, 0], dirs[r, 1], dirs[r, 2]
+            result = MISS
+            i, j, k, tr = np.int64(-1), np.int64(-1), np.int64(-1), INF
+            t_s = 0.0
+            if oz > top:
+                t_s = (top - oz) * (1.0 / dz) if dz < 0.0 else INF
+            for sample in range(limit if t_s < INF else 0):
+                t = t_s + sample * step
+                cx, cy, cz = ox + t * dx, oy + t * dy, oz + t * dz
+                inside = 0.0 <= cx < nx and 0.0 <= cy < ny
+                if cz < 0.0:
+                    if inside:
+                        result = GROUND
+                        i, j, k, tr = np.int64(math.floor(cx)), np.int64(math.floor(cy)), 0, t
+                    break
+                if not inside or (cz >= top and dz >= 0.0):
+                    break
+                x, y, z = np.int64(math.floor(cx)), np.int64(math.floor(cy)), np.int64(math.floor(cz))
+                if x < lo[0] or y < lo[1] or z < lo[2] or x >= hi[0] or y >= hi[1] or z >= hi[2]:
+                    continue
+                g = root[((x - rorg[0]) >> 9)
+                         + rdims[0] * (((y - rorg[1]) >> 9) + rdims[1] * ((z - rorg[2]) >> 9))]
+                if g == 0:
+                    continue
+                tl = regions[(np.int64(g) - 1) * 512 + _slot(x, y, z, 6)]
+                if tl == 0:
+                    continue
+                br = tiles[(np.int64(tl) - 1) * 512 + _slot(x, y, z, 3)]
+                if br == 0:
+                    continue
+                bit = _slot(x, y, z, 0)
+                if (bricks[(np.int64(br) - 1) * 16 + (bit >> 5)] >> (bit & 31)) & 1:
+                    result = VOXEL
+                    i, j, k, tr = x, y, z, t
+                    break
+            kind[r] = result
+            index[r, 0], index[r, 1], index[r, 2] = i, j, k
+            tout[r] = tr
+
+
+class NumbaBackend:
+    """CPU threads through numba: exact hierarchical traversal and the report's march."""
+
+    name = "numba"
+    summary = "CPU threads (numba), float64"
+
+    def probe(self):
+        return None
+
+    def describe(self):
+        return {"device": "cpu", "threads": numba.get_num_threads(),
+                "threading_layer": _threading_layer(), "precision": "f64"}
+
+    def warm_up(self, occupancy):
+        """Compile (or load from cache) both kernels on a tiny batch."""
+        o = np.array([[0.5, 0.5, 10.0]])
+        d = np.array([[0.0, 0.0, -1.0]])
+        for method in ("exact", "march"):
+            self.trace_cells(occupancy, o, d, method=method)
+
+    def trace_cells(self, occupancy, origins, directions, *, method="exact", step=0.5,
+                    precision="f64", cancel: threading.Event | None = None) -> CellHits:
+        n = len(origins)
+        orig = np.ascontiguousarray(origins, dtype=np.float64)
+        dirs = np.ascontiguousarray(directions, dtype=np.float64)
+        kind = np.zeros(n, np.uint8)
+        index = np.full((n, 3), -1, np.int32)
+        t = np.full(n, np.inf)
+        occ = occupancy
+        nx, ny = float(occ.shape[0]), float(occ.shape[1])
+        lo, hi = occ.bbox_lo.astype(np.int64), occ.bbox_hi.astype(np.int64)
+        rorg, rdims = occ.root_origin.astype(np.int64), occ.root_dims.astype(np.int64)
+        started = time.perf_counter()
+        for a in range(0, n, BLOCK):
+            if cancel is not None and cancel.is_set():
+                raise Cancelled("trace cancelled")
+            b = min(n, a + BLOCK)
+            if method == "exact":
+                _exact_kernel(orig[a:b], dirs[a:b], occ.root, occ.regions, occ.tiles, occ.bricks,
+                              occ.columns, lo, hi, rorg, rdims, nx, ny, kind[a:b], index[a:b],
+                              t[a:b])
+            else:
+                _march_kernel(orig[a:b], dirs[a:b], float(step), float(occ.zmax), occ.root,
+                              occ.regions, occ.tiles, occ.bricks, lo, hi, rorg, rdims, nx, ny,
+                              kind[a:b], index[a:b], t[a:b])
+        info = {"seconds": time.perf_counter() - started, "precision": "f64",
+                "threads": numba.get_num_threads()}
+        return CellHits(kind, index, t, info)
+
+
+def _threading_layer():
+    try:
+        return numba.threading_layer()
+    except ValueError:  # no parallel kernel has run yet
+        return "not yet chosen"
+
+
+register_backend("numba", NumbaBackend)

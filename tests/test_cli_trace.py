@@ -1,0 +1,92 @@
+"""``ladartui trace`` and ``ladartui bench --quick`` from the command line."""
+
+import json
+
+import numpy as np
+import pytest
+
+from ladartui.cli import main
+
+
+@pytest.fixture
+def scene_file(tmp_path):
+    path = tmp_path / "X.txt"
+    path.write_text("5,5,0\n5,5,1\n6,5,1\n9,9,3\n")
+    return path
+
+
+def test_trace_writes_hits(tmp_path, scene_file, capsys):
+    rays = np.array([
+        [5.0, 5.0, 20.0, 0.0, 0.0, -1.0],   # onto voxel (5, 5, 1), top face at z = 1.5
+        [2.0, 2.0, 20.0, 0.0, 0.0, -1.0],   # ground at (2, 2)
+        [2.0, 2.0, 20.0, 0.0, 0.0, 1.0],    # upward: miss
+    ])
+    np.save(tmp_path / "rays.npy", rays)
+    out = tmp_path / "hits.npy"
+    code = main(["trace", "--scene", str(scene_file), "--rays", str(tmp_path / "rays.npy"),
+                 "--out", str(out), "--backend", "numba"])
+    assert code == 0
+    hits = np.load(out)
+    assert hits.shape == (3, 5) and hits.dtype == np.float64
+    assert hits[0, :4].tolist() == [1, 5, 5, 1] and hits[0, 4] == pytest.approx(18.5)
+    assert hits[1, :4].tolist() == [2, 2, 2, 0] and hits[1, 4] == pytest.approx(20.5)
+    assert hits[2, 0] == 0 and np.isinf(hits[2, 4])
+    assert "3 rays" in capsys.readouterr().err
+
+
+def test_trace_march_with_voxel_size(tmp_path, scene_file):
+    rays = np.array([[1.25, 1.25, 10.0, 0.0, 0.0, -1.0]])  # 0.25 m voxels: cell (5, 5)
+    np.save(tmp_path / "rays.npy", rays)
+    out = tmp_path / "hits.npy"
+    assert main(["trace", "--scene", str(scene_file), "--rays", str(tmp_path / "rays.npy"),
+                 "--out", str(out), "--method", "march", "--step", "0.25",
+                 "--voxel-size", "0.25"]) == 0
+    assert np.load(out)[0, :4].tolist() == [1, 5, 5, 1]
+
+
+@pytest.mark.parametrize("array, expected", [
+    (np.zeros((4, 5)), "(4, 5)"),
+    (np.zeros(6), "(6,)"),
+    (np.array([[0, 0, 1, 0, 0, 0.0]]), "zero direction"),
+])
+def test_bad_rays_file_is_one_clear_line(tmp_path, scene_file, capsys, array, expected):
+    np.save(tmp_path / "rays.npy", array)
+    out = tmp_path / "hits.npy"
+    out.write_bytes(b"earlier")
+    code = main(["trace", "--scene", str(scene_file), "--rays", str(tmp_path / "rays.npy"),
+                 "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert "rays.npy" in err and expected in err and "Traceback" not in err
+    assert len(err.strip().splitlines()) == 1
+    assert out.read_bytes() == b"earlier"  # nothing overwritten
+
+
+def test_missing_and_non_npy_rays(tmp_path, scene_file, capsys):
+    (tmp_path / "rays.npy").write_text("not numpy")
+    for rays in (tmp_path / "none.npy", tmp_path / "rays.npy"):
+        code = main(["trace", "--scene", str(scene_file), "--rays", str(rays),
+                     "--out", str(tmp_path / "h.npy")])
+        assert code == 2
+        assert rays.name in capsys.readouterr().err
+    assert not (tmp_path / "h.npy").exists()
+
+
+def test_bench_quick_json(monkeypatch, tmp_path, capsys):
+    bench = pytest.importorskip("ladartui.cli.bench")
+    small = np.array([[i, j, k] for i in range(0, 40, 3) for j in range(0, 40, 2) for k in range(6)])
+
+    def tiny_scene():
+        from ladartui.scene.model import Scene
+        return Scene(small, small[:1], 0.25, shape=(40, 40, 30), name="tiny"), "tiny"
+
+    monkeypatch.setattr(bench, "load_bench_scene", tiny_scene)
+    monkeypatch.setattr(bench, "SLANT_RANGE_M", 5.0)
+    assert main(["bench", "--quick", "--json", "--runs", "1"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["voxels"] == len(small)
+    assert report["occupancy_bytes"] > 0
+    rows = {(r["backend"], r["method"], r["depression"]) for r in report["results"]}
+    assert {("numba", "exact", 45.0), ("numba", "exact", 90.0), ("numba", "march", 45.0),
+            ("numba", "march", 90.0)} <= rows
+    assert all(r["rays_per_second"] > 0 for r in report["results"])

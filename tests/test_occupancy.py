@@ -1,0 +1,94 @@
+"""Occupancy: the sparse hierarchy answers membership exactly and grows with content only."""
+
+import numpy as np
+import pytest
+
+from ladartui.errors import FieldError
+from ladartui.scene.occupancy import Occupancy
+
+
+def _random_scene(rng, shape, n):
+    return np.unique(rng.integers(0, shape, size=(n, 3)), axis=0)
+
+
+def test_listed_voxels_are_occupied_and_others_are_not():
+    rng = np.random.default_rng(3)
+    shape = (700, 600, 90)  # spans several 512-voxel root cells
+    vox = _random_scene(rng, shape, 20_000)
+    occ = Occupancy.build(vox, shape)
+    assert occ.count == len(vox)
+    assert occ.contains(vox).all()
+    probes = rng.integers(0, shape, size=(50_000, 3))
+    listed = set(map(tuple, vox.tolist()))
+    expected = np.array([tuple(p) in listed for p in probes.tolist()])
+    assert np.array_equal(occ.contains(probes), expected)
+
+
+def test_duplicates_counted_once_and_bounds():
+    vox = np.array([[5, 6, 7], [5, 6, 7], [1, 2, 3], [9, 0, 4]])
+    occ = Occupancy.build(vox, (10, 10, 10))
+    assert occ.count == 3
+    assert occ.bbox_lo.tolist() == [1, 0, 3]
+    assert occ.bbox_hi.tolist() == [10, 7, 8]
+    assert occ.zmax == 7
+    # Neighbours of listed voxels, outside the scene and negative indices are empty.
+    assert not occ.contains([[5, 6, 8], [4, 6, 7], [-1, 0, 0], [100, 0, 0]]).any()
+
+
+def test_empty_scene():
+    occ = Occupancy.build(np.zeros((0, 3), int), (8, 8, 8))
+    assert occ.count == 0 and occ.zmax == -1 and occ.nbytes == 0
+    assert not occ.contains([[0, 0, 0]]).any()
+
+
+def test_default_shape_from_voxels():
+    occ = Occupancy.build(np.array([[3, 4, 5]]))
+    assert occ.shape == (4, 5, 6)
+
+
+def test_node_counts_match_distinct_cells():
+    rng = np.random.default_rng(5)
+    vox = _random_scene(rng, (300, 300, 100), 5_000)
+    occ = Occupancy.build(vox, (300, 300, 100))
+    assert occ.n_bricks == len(np.unique(vox >> 3, axis=0))
+    assert occ.n_tiles == len(np.unique(vox >> 6, axis=0))
+    assert occ.n_regions == len(np.unique(vox >> 9, axis=0))
+    assert len(occ.bricks) == 16 * occ.n_bricks
+    for array in (occ.root, occ.regions, occ.tiles, occ.bricks):
+        assert array.dtype == np.uint32
+
+
+def test_same_content_in_a_larger_extent_costs_no_more_memory():
+    rng = np.random.default_rng(7)
+    vox = _random_scene(rng, (400, 400, 120), 40_000) + [300, 200, 0]
+    small = Occupancy.build(vox, (800, 700, 200))
+    large = Occupancy.build(vox, (8000, 7000, 2000))
+    assert large.nbytes <= 1.2 * small.nbytes
+    # Moved far into the large extent, the content still costs about the same.
+    far = Occupancy.build(vox + [5000, 6000, 0], (8000, 7000, 2000))
+    assert far.nbytes <= 1.2 * small.nbytes
+    assert far.contains(vox + [5000, 6000, 0]).all()
+
+
+@pytest.mark.parametrize("bad, shape", [
+    (np.zeros((4, 2), int), (5, 5, 5)),
+    (np.zeros((4, 3), float), (5, 5, 5)),
+    (np.array([[0, 0, 5]]), (5, 5, 5)),
+    (np.array([[-1, 0, 0]]), (5, 5, 5)),
+])
+def test_bad_voxel_lists_are_field_errors(bad, shape):
+    with pytest.raises(FieldError):
+        Occupancy.build(bad, shape)
+
+
+def test_column_tops_give_the_highest_brick_of_each_brick_column():
+    rng = np.random.default_rng(17)
+    shape = (600, 300, 700)
+    vox = _random_scene(rng, shape, 3_000)
+    occ = Occupancy.build(vox, shape)
+    q = (vox - occ.root_origin) >> 3
+    width = 64 * int(occ.root_dims[0])
+    expected = np.zeros(len(occ.columns), np.int64)
+    for (qx, qy, qz) in q.tolist():
+        expected[qx + width * qy] = max(expected[qx + width * qy], qz + 1)
+    assert np.array_equal(occ.columns, expected)

@@ -1,0 +1,156 @@
+"""trace(): metres in and out, argument checks, backend choice and registry behaviour."""
+
+import threading
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import ladartui
+from ladartui.errors import BackendUnavailable, Cancelled, FieldError
+from ladartui.scene.occupancy import Occupancy
+from ladartui.tracing import GROUND, MISS, VOXEL, TraceResult, trace
+from ladartui.tracing.backend import backend_names, backend_status, get_backend
+
+
+def make_block():
+    g = np.arange(10, 20)
+    vox = np.stack(np.meshgrid(g, g, np.arange(0, 5), indexing="ij"), -1).reshape(-1, 3)
+    return Occupancy.build(vox, (40, 40, 10))
+
+
+BLOCK = make_block()
+
+
+@pytest.fixture
+def block():
+    return BLOCK
+
+
+def test_ranges_and_indices_in_metres(block):
+    size = 0.25
+    # Straight down onto voxel (12, 13, 4): its top face is z = 4.5 voxels = 1.125 m.
+    o = np.array([[12 * size, 13 * size, 10.0], [30 * size, 30 * size, 10.0]])
+    d = np.array([[0.0, 0.0, -1.0], [0.0, 0.0, -1.0]])
+    r = trace(block, o, d, voxel_size=size)
+    assert isinstance(r, TraceResult) and r.backend == "numba" and r.method == "exact"
+    assert r.kind.tolist() == [VOXEL, GROUND]
+    assert r.index.tolist() == [[12, 13, 4], [30, 30, 0]]
+    assert r.range[0] == pytest.approx(10.0 - 4.5 * size)
+    assert r.range[1] == pytest.approx(10.0 + 0.5 * size)  # ground plane at z = -0.5 voxel
+    assert r.as_array().shape == (2, 5)
+
+
+def test_directions_are_normalised(block):
+    o = np.array([[3.0, 3.0, 9.0]])
+    a = trace(block, o, np.array([[1.0, 2.0, -3.0]]))
+    b = trace(block, o, np.array([[1.0, 2.0, -3.0]]) * 7.5)
+    assert a.kind[0] == b.kind[0] and np.array_equal(a.index, b.index)
+    assert a.range[0] == pytest.approx(b.range[0])
+
+
+def test_top_level_export_is_the_function():
+    import ladartui.tracing  # noqa: F401  (a submodule import must not shadow the function)
+
+    assert ladartui.trace is trace
+    assert ladartui.Occupancy is Occupancy
+
+
+@pytest.mark.parametrize("kwargs, field", [
+    ({"method": "bogus"}, "method"),
+    ({"method": "march", "step": 0}, "step"),
+    ({"method": "march", "step": -1.0}, "step"),
+    ({"voxel_size": 0}, "voxel_size"),
+    ({"precision": "f16"}, "precision"),
+])
+def test_bad_arguments_are_field_errors(block, kwargs, field):
+    with pytest.raises(FieldError) as error:
+        trace(block, np.zeros((2, 3)), np.ones((2, 3)), **kwargs)
+    assert error.value.field == field
+
+
+def test_bad_ray_arrays_are_field_errors(block):
+    with pytest.raises(FieldError, match="directions"):
+        trace(block, np.zeros((2, 3)), np.ones((3, 3)))
+    with pytest.raises(FieldError, match="origins"):
+        trace(block, np.zeros((2, 2)), np.ones((2, 2)))
+    with pytest.raises(FieldError, match=r"directions\[1\]"):
+        trace(block, np.zeros((2, 3)), np.array([[0, 0, -1.0], [0, 0, 0]]))
+    with pytest.raises(FieldError):
+        trace(block, np.full((1, 3), np.nan), np.ones((1, 3)))
+
+
+def test_unknown_backend_is_a_field_error(block):
+    with pytest.raises(FieldError, match="backend"):
+        trace(block, np.zeros((1, 3)), np.ones((1, 3)), backend="nope")
+
+
+def test_registry_lists_numba_and_explains_unavailable_backends():
+    assert "numba" in backend_names()
+    status = backend_status()
+    assert status["numba"] is None
+    for name, reason in status.items():
+        if reason is not None:
+            with pytest.raises(BackendUnavailable):
+                get_backend(name)
+            assert name in reason
+
+
+def test_cancel_before_start_raises(block):
+    stop = threading.Event()
+    stop.set()
+    with pytest.raises(Cancelled):
+        trace(block, np.zeros((5, 3)), np.ones((5, 3)), cancel=stop)
+
+
+def test_empty_ray_list(block):
+    r = trace(block, np.zeros((0, 3)), np.zeros((0, 3)))
+    assert len(r) == 0 and r.index.shape == (0, 3)
+
+
+def test_every_available_backend_agrees_with_numba():
+    rng = np.random.default_rng(0)
+    vox = rng.integers(0, (30, 30, 12), size=(800, 3))
+    occ = Occupancy.build(vox, (30, 30, 12))
+    o = rng.uniform([0, 0, 14], [30, 30, 30], size=(500, 3))
+    d = rng.normal(size=(500, 3))
+    d[:, 2] = -np.abs(d[:, 2])
+    base = trace(occ, o, d, backend="numba")
+    for name, reason in backend_status().items():
+        if reason is None and name != "numba":
+            other = trace(occ, o, d, backend=name, precision="f64")
+            assert np.array_equal(other.kind, base.kind), name
+            assert np.array_equal(other.index, base.index), name
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    origins=st.lists(st.tuples(*[st.floats(-1e4, 1e4, allow_nan=False) for _ in range(3)]),
+                     min_size=1, max_size=8),
+    direction=st.tuples(*[st.floats(-1, 1, allow_nan=False) for _ in range(3)]).filter(
+        lambda v: max(abs(c) for c in v) > 1e-6),
+    method=st.sampled_from(["exact", "march"]),
+    size=st.floats(0.05, 5.0),
+)
+def test_no_crash_no_nan_valid_kinds(origins, direction, method, size):
+    o = np.array(origins)
+    d = np.tile(direction, (len(o), 1))
+    block = BLOCK
+    r = trace(block, o, d, method=method, voxel_size=size, step=1.0)
+    assert set(r.kind.tolist()) <= {MISS, VOXEL, GROUND}
+    assert not np.isnan(r.range).any()
+    hit = r.kind != MISS
+    assert np.all(r.range[hit] >= 0) and np.all(np.isinf(r.range[~hit]))
+    assert np.all(r.index[~hit] == -1)
+    assert np.all(r.index[hit] >= 0) and np.all(r.index[hit] < block.shape)
+
+
+def test_a_scene_supplies_its_voxel_size():
+    from ladartui.scene.model import Scene
+
+    vox = np.array([[4, 4, 0], [4, 4, 1]])
+    scene = Scene(vox, vox[:1], 0.5, shape=(10, 10, 10))
+    r = trace(scene, np.array([[2.0, 2.0, 5.0]]), np.array([[0.0, 0.0, -1.0]]))
+    assert r.kind[0] == VOXEL and r.index[0].tolist() == [4, 4, 1]
+    assert r.range[0] == pytest.approx(5.0 - 1.5 * 0.5)  # top face of voxel 1 at z = 0.75 m
