@@ -154,3 +154,17 @@ def test_a_scene_supplies_its_voxel_size():
     r = trace(scene, np.array([[2.0, 2.0, 5.0]]), np.array([[0.0, 0.0, -1.0]]))
     assert r.kind[0] == VOXEL and r.index[0].tolist() == [4, 4, 1]
     assert r.range[0] == pytest.approx(5.0 - 1.5 * 0.5)  # top face of voxel 1 at z = 0.75 m
+
+
+def test_registry_lists_every_builtin_backend_even_after_a_direct_import():
+    # Importing one backend module first must not hide the others.
+    import subprocess
+    import sys
+
+    code = (
+        "import ladartui.tracing.wgpu_backend\n"
+        "from ladartui.tracing.backend import backend_names\n"
+        "print(sorted(backend_names()))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "['numba', 'wgpu']"

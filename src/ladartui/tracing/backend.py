@@ -47,7 +47,9 @@ class Backend(Protocol):
 
 _FACTORIES: dict[str, Callable[[], Backend]] = {}
 _INSTANCES: dict[str, Backend] = {}
+_BUILTIN_MODULES = ("ladartui.tracing.numba_backend", "ladartui.tracing.wgpu_backend")
 _lock = threading.Lock()
+_builtin_loaded = False
 
 
 def register_backend(name: str, factory: Callable[[], Backend]) -> None:
@@ -88,14 +90,18 @@ def backend_status() -> dict[str, str | None]:
 
 def _load_builtin() -> None:
     # Importing a backend module registers it; the modules themselves import
-    # their heavy dependencies lazily so this stays cheap.
-    if _FACTORIES:
+    # their heavy dependencies lazily so this stays cheap. A flag, not the
+    # registry's size, says whether this ran: one backend module may have been
+    # imported directly before.
+    global _builtin_loaded
+    if _builtin_loaded:
         return
     import importlib
 
-    for module in ("ladartui.tracing.numba_backend", "ladartui.tracing.wgpu_backend"):
+    for module in _BUILTIN_MODULES:
         try:
             importlib.import_module(module)
         except ModuleNotFoundError as error:
             if error.name != module:
                 raise
+    _builtin_loaded = True

@@ -1,0 +1,461 @@
+// The voxel tracer as a compute shader: one invocation per ray.
+//
+// This is tracing/numba_backend.py written again in WGSL: the same functions
+// under the same names (without the leading underscore), the same steps in the
+// same order, as fixed in docs/architecture.md ("Exact traversal", "March").
+// Read the two side by side; change them together. In f64 both give the same
+// answer, bit for bit, for every ray (tests/test_wgpu_precision.py).
+//
+// Cell space: voxel (i, j, k) spans [i, i+1) on each axis, ground at c_z = 0.
+// tracing/wgpu_backend.py prepends a header declaring `alias real = f64;`
+// (or f32) and the occupancy bindings, read through `fn occ(word) -> u32`:
+// one logical u32 array [root | regions | tiles | bricks | columns] that may
+// be split over several storage bindings. INF stands for +inf: WGSL has no
+// infinity literal, and no ray parameter comes near 1e30.
+
+struct Params {
+    shape: vec4<i32>,        // nx, ny, nz
+    bbox_lo: vec4<i32>,      // occupied box, cell space, hi exclusive
+    bbox_hi: vec4<i32>,
+    root_origin: vec4<i32>,  // cell of root cell (0, 0, 0), a multiple of 512
+    root_dims: vec4<i32>,
+    bases: vec4<u32>,        // first word of root, regions, tiles, bricks in occ()
+    run: vec4<i32>,          // ray count, method (0 exact, 1 march), zmax, root cells
+    extra: vec4<u32>,        // first word of columns in occ(), unused x3
+    reals: vec2<real>,       // march step (voxels), unused
+}
+
+@group(0) @binding(0) var<uniform> params: Params;
+@group(0) @binding(1) var<storage, read> rays: array<real>;             // ox oy oz dx dy dz per ray
+@group(0) @binding(2) var<storage, read_write> hits: array<vec4<i32>>;  // kind, i, j, k
+@group(0) @binding(3) var<storage, read_write> ranges: array<real>;     // t of the hit
+
+const MISS: i32 = 0;
+const VOXEL: i32 = 1;
+const GROUND: i32 = 2;
+const INF: real = 1e30;
+
+struct Hit {
+    kind: i32,
+    i: i32,
+    j: i32,
+    k: i32,
+    t: real,
+}
+
+struct Span {
+    enter: real,
+    leave: real,
+}
+
+fn miss() -> Hit {
+    return Hit(MISS, -1, -1, -1, INF);
+}
+
+// The one formula for boundary parameters (numba: _boundary_t).
+fn boundary_t(b: real, o: real, inv: real) -> real {
+    return (b - o) * inv;
+}
+
+// Cell index on one axis just after parameter t, exact against boundary_t (numba: _cell_at).
+fn cell_at(o: real, d: real, inv: real, t: real) -> i32 {
+    var c = floor(o + t * d);
+    if (d > 0.0) {
+        if (boundary_t(c + 1.0, o, inv) <= t) {
+            c += 1.0;
+        } else if (boundary_t(c, o, inv) > t) {
+            c -= 1.0;
+        }
+    } else if (d < 0.0) {
+        if (boundary_t(c, o, inv) <= t) {
+            c -= 1.0;
+        } else if (boundary_t(c + 1.0, o, inv) > t) {
+            c += 1.0;
+        }
+    }
+    return i32(c);
+}
+
+// Entry and exit parameters of [lo, hi) on one axis; (inf, -inf) when never inside (numba: _slab).
+fn slab(o: real, d: real, inv: real, lo: real, hi: real) -> Span {
+    if (d > 0.0) {
+        return Span(boundary_t(lo, o, inv), boundary_t(hi, o, inv));
+    }
+    if (d < 0.0) {
+        return Span(boundary_t(hi, o, inv), boundary_t(lo, o, inv));
+    }
+    if (lo < o && o < hi) {
+        return Span(-INF, INF);
+    }
+    return Span(INF, -INF);
+}
+
+// numba: _exit_boundary
+fn exit_boundary(c: i32, s: u32, positive: bool) -> i32 {
+    if (positive) {
+        return ((c >> s) + 1) << s;
+    }
+    return (c >> s) << s;
+}
+
+// numba: _slot
+fn slot(x: i32, y: i32, z: i32, s: u32) -> u32 {
+    return u32(((x >> s) & 7) | (((y >> s) & 7) << 3u) | (((z >> s) & 7) << 6u));
+}
+
+struct Skip {
+    b: i32,
+    t: real,
+}
+
+// Exit boundary and its parameter of the node c >> s on one axis (numba: _node_skip).
+fn node_skip(c: i32, s: u32, positive: bool, moving: bool, o: real, d: real, inv: real) -> Skip {
+    let b = exit_boundary(c, s, positive);
+    return Skip(b, select(INF, boundary_t(real(b), o, inv), moving));
+}
+
+// Cell on one axis after crossing into a new node at t: the boundary cell for an
+// axis that stepped, else cell_at(t) kept inside the node of c (numba: _enter).
+fn enter(c: i32, b: i32, stepped: bool, positive: bool, s: u32, o: real, d: real, inv: real, t: real) -> i32 {
+    if (stepped) {
+        return select(b - 1, b, positive);
+    }
+    let lo = (c >> s) << s;
+    return clamp_i(cell_at(o, d, inv, t), lo, lo + (1 << s) - 1);
+}
+
+// Cell on one axis on entering brick b at t after a brick step (numba: _brick_entry).
+fn brick_entry(b: i32, stepped: bool, positive: bool, o: real, d: real, inv: real, t: real) -> i32 {
+    return enter(b << 3u, select((b + 1) << 3u, b << 3u, positive), stepped, positive, 3u, o, d, inv, t);
+}
+
+fn root_cell(x: i32, y: i32, z: i32) -> u32 {
+    let r = params.root_origin;
+    return u32(((x - r.x) >> 9u) + params.root_dims.x * (((y - r.y) >> 9u) + params.root_dims.y * ((z - r.z) >> 9u)));
+}
+
+fn clamp_i(v: i32, lo: i32, hi: i32) -> i32 {
+    return select(select(v, hi, v > hi), lo, v < lo);
+}
+
+// The first occupied voxel along one cell-space ray; kind MISS when none
+// (numba: the per-ray body of _exact_kernel, steps 1 to 5).
+// Empty root cells and regions are skipped as nodes; inside a tile a DDA over
+// 8-voxel bricks skips empty bricks (and, going down, the part of a brick column
+// above its highest brick); inside a brick a voxel DDA tests bits.
+fn first_voxel(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hit {
+    let none = miss();
+    if (params.run.w == 0) {  // empty scene: no root cells
+        return none;
+    }
+    // Step 1: a ray inside a plane of cell faces enters no interior.
+    if ((dx == 0.0 && ox == floor(ox)) || (dy == 0.0 && oy == floor(oy))
+            || (dz == 0.0 && oz == floor(oz))) {
+        return none;
+    }
+    let ix = select(INF, 1.0 / dx, dx != 0.0);
+    let iy = select(INF, 1.0 / dy, dy != 0.0);
+    let iz = select(INF, 1.0 / dz, dz != 0.0);
+    let mx = dx != 0.0;
+    let my = dy != 0.0;
+    let mz = dz != 0.0;
+    let lo = params.bbox_lo;
+    let hi = params.bbox_hi;
+    // Step 2: clip to the occupied box.
+    let span_x = slab(ox, dx, ix, real(lo.x), real(hi.x));
+    let span_y = slab(oy, dy, iy, real(lo.y), real(hi.y));
+    let span_z = slab(oz, dz, iz, real(lo.z), real(hi.z));
+    let t0 = max(0.0, max(span_x.enter, max(span_y.enter, span_z.enter)));
+    let t1 = min(span_x.leave, min(span_y.leave, span_z.leave));
+    if (!(t0 < t1)) {
+        return none;
+    }
+    // Step 3: the start cell.
+    var cx = clamp_i(cell_at(ox, dx, ix, t0), lo.x, hi.x - 1);
+    var cy = clamp_i(cell_at(oy, dy, iy, t0), lo.y, hi.y - 1);
+    var cz = clamp_i(cell_at(oz, dz, iz, t0), lo.z, hi.z - 1);
+    let px = dx > 0.0;
+    let py = dy > 0.0;
+    let pz = dz > 0.0;
+    let sx = select(-1, 1, px);
+    let sy = select(-1, 1, py);
+    let sz = select(-1, 1, pz);
+    // Offset from a cell to its exit boundary, for the voxel DDA. A still axis
+    // (inv = INF, origin off the boundaries) gets +1 so its parameter is huge.
+    let fx = select(real(1.0), real(0.0), dx < 0.0);
+    let fy = select(real(1.0), real(0.0), dy < 0.0);
+    let fz = select(real(1.0), real(0.0), dz < 0.0);
+    var t = t0;
+    let rx0 = params.root_origin.x;
+    let ry0 = params.root_origin.y;
+    let rz0 = params.root_origin.z;
+    let rdx = params.root_dims.x;
+    // Brick columns (see Occupancy.columns), relative to the root grid.
+    let qx0 = rx0 >> 3u;
+    let qy0 = ry0 >> 3u;
+    let qz0 = rz0 >> 3u;
+    let qnx = rdx * 64;
+    let descending = dz < 0.0;
+    let cap = 4 * (hi.x - lo.x + hi.y - lo.y + hi.z - lo.z) + 64;
+    var steps = 0;
+    while (steps < cap) {
+        steps += 1;
+        if (cx < lo.x || cy < lo.y || cz < lo.z || cx >= hi.x || cy >= hi.y || cz >= hi.z) {
+            return none;  // only reachable through rounding at the box's edge
+        }
+        var s = 9u;
+        let g = occ(params.bases.x + root_cell(cx, cy, cz));
+        if (g != 0u) {
+            s = 6u;
+            let tl = occ(params.bases.y + (g - 1u) * 512u + slot(cx, cy, cz, 6u));
+            if (tl != 0u) {
+                // Inside a tile: DDA over its 8 x 8 x 8 brick slots.
+                let tile = params.bases.z + (tl - 1u) * 512u;
+                let gx = cx >> 6u;
+                let gy = cy >> 6u;
+                let gz = cz >> 6u;
+                var bx = cx >> 3u;
+                var by = cy >> 3u;
+                var bz = cz >> 3u;
+                var fresh = true;  // (cx, cy, cz) is the cell at t
+                var stx = false;   // axes stepped by the last brick step
+                var sty = false;
+                var stz = false;
+                while (steps < cap) {
+                    let br = occ(tile + u32((bx & 7) | ((by & 7) << 3u) | ((bz & 7) << 6u)));
+                    if (br != 0u) {
+                        if (!fresh) {
+                            cx = brick_entry(bx, stx, px, ox, dx, ix, t);
+                            cy = brick_entry(by, sty, py, oy, dy, iy, t);
+                            cz = brick_entry(bz, stz, pz, oz, dz, iz, t);
+                        }
+                        // Voxel DDA inside the brick; t of an axis's next boundary is
+                        // recomputed from that boundary whenever the axis steps.
+                        // numba also skips empty 4- and 2-voxel blocks here. Skips never
+                        // change the answer (docs/architecture.md, step 4), and on
+                        // lavapipe the extra branches cost more than the steps they
+                        // save (the voxel-by-voxel loop traced about 20 % more rays
+                        // per CPU second), so the shader steps voxel by voxel; the
+                        // f64 tests check the answers stay identical, t included.
+                        let base = params.bases.w + (br - 1u) * 16u;
+                        var tx = (real(cx) + fx - ox) * ix;
+                        var ty = (real(cy) + fy - oy) * iy;
+                        var tz = (real(cz) + fz - oz) * iz;
+                        loop {
+                            let bit = u32((cx & 7) | ((cy & 7) << 3u) | ((cz & 7) << 6u));
+                            if (((occ(base + (bit >> 5u)) >> (bit & 31u)) & 1u) != 0u) {
+                                return Hit(VOXEL, cx, cy, cz, t);
+                            }
+                            let tn = min(tx, min(ty, tz));
+                            if (tn >= t1) {
+                                return none;
+                            }
+                            steps += 1;
+                            // Tied axes step together: touching an edge or corner is no visit.
+                            if (tx == tn) {
+                                cx += sx;
+                                tx = (real(cx) + fx - ox) * ix;
+                            }
+                            if (ty == tn) {
+                                cy += sy;
+                                ty = (real(cy) + fy - oy) * iy;
+                            }
+                            if (tz == tn) {
+                                cz += sz;
+                                tz = (real(cz) + fz - oz) * iz;
+                            }
+                            t = tn;
+                            if ((cx >> 3u) != bx || (cy >> 3u) != by || (cz >> 3u) != bz || steps >= cap) {
+                                break;
+                            }
+                        }
+                        bx = cx >> 3u;
+                        by = cy >> 3u;
+                        bz = cz >> 3u;
+                        fresh = true;
+                    } else {
+                        // Skip the empty brick, or for a descending ray above the
+                        // highest brick of its brick column, that whole column part.
+                        let tbx = select(INF, (real(select(bx << 3u, (bx + 1) << 3u, px)) - ox) * ix, mx);
+                        let tby = select(INF, (real(select(by << 3u, (by + 1) << 3u, py)) - oy) * iy, my);
+                        var top = bz + 1;
+                        if (descending) {
+                            top = i32(occ(params.extra.x + u32((bx - qx0) + qnx * (by - qy0)))) + qz0;
+                        }
+                        let above = bz >= top;
+                        var tbz: real;
+                        if (above) {
+                            tbz = (real(top << 3u) - oz) * iz;
+                        } else {
+                            tbz = select(INF, (real(select(bz << 3u, (bz + 1) << 3u, pz)) - oz) * iz, mz);
+                        }
+                        let tn = min(tbx, min(tby, tbz));
+                        if (tn >= t1) {
+                            return none;
+                        }
+                        steps += 1;
+                        stx = tbx == tn;
+                        sty = tby == tn;
+                        stz = tbz == tn;
+                        if (stx) {
+                            bx += sx;
+                        }
+                        if (sty) {
+                            by += sy;
+                        }
+                        if (stz) {
+                            bz = select(bz + sz, top - 1, above);
+                        } else if (above) {
+                            bz = clamp_i(cell_at(oz, dz, iz, tn) >> 3u, top, bz);
+                        }
+                        t = tn;
+                        fresh = false;
+                    }
+                    if ((bx >> 3u) != gx || (by >> 3u) != gy || (bz >> 3u) != gz) {
+                        break;
+                    }
+                }
+                if (!fresh) {
+                    // Left the tile through an empty brick: the cell at t for the node lookup.
+                    cx = brick_entry(bx, stx, px, ox, dx, ix, t);
+                    cy = brick_entry(by, sty, py, oy, dy, iy, t);
+                    cz = brick_entry(bz, stz, pz, oz, dz, iz, t);
+                }
+                continue;
+            }
+        }
+        // Skip the empty root cell or region c >> s.
+        let kx = node_skip(cx, s, px, mx, ox, dx, ix);
+        let ky = node_skip(cy, s, py, my, oy, dy, iy);
+        let kz = node_skip(cz, s, pz, mz, oz, dz, iz);
+        let tn = min(kx.t, min(ky.t, kz.t));
+        if (tn >= t1) {
+            return none;
+        }
+        cx = enter(cx, kx.b, kx.t == tn, px, s, ox, dx, ix, tn);
+        cy = enter(cy, ky.b, ky.t == tn, py, s, oy, dy, iy, tn);
+        cz = enter(cz, kz.b, kz.t == tn, pz, s, oz, dz, iz, tn);
+        t = tn;
+    }
+    return none;
+}
+
+// The ground rule for a ray that hit no voxel (numba: _ground).
+fn ground(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hit {
+    let nx = real(params.shape.x);
+    let ny = real(params.shape.y);
+    if (dz < 0.0 && oz > 0.0) {
+        let tg = (0.0 - oz) * (1.0 / dz);
+        let gx = ox + tg * dx;
+        let gy = oy + tg * dy;
+        if (0.0 <= gx && gx < nx && 0.0 <= gy && gy < ny) {
+            return Hit(GROUND, i32(floor(gx)), i32(floor(gy)), 0, tg);
+        }
+    }
+    return miss();
+}
+
+// Is voxel (x, y, z) occupied? (numba: the lookup in _march_kernel). The brick
+// found is remembered between samples, which mostly fall in the same 8-voxel
+// brick: this only saves loads, the answer is the plain lookup's.
+struct BrickCache {
+    key: vec3<i32>,  // brick coordinates (cell >> 3) of the remembered lookup
+    base: u32,       // its first word in occ() + 1, 0 when the brick is empty
+}
+
+fn occupied(x: i32, y: i32, z: i32, cache: ptr<function, BrickCache>) -> bool {
+    let lo = params.bbox_lo;
+    let hi = params.bbox_hi;
+    if (x < lo.x || y < lo.y || z < lo.z || x >= hi.x || y >= hi.y || z >= hi.z) {
+        return false;
+    }
+    let key = vec3<i32>(x >> 3u, y >> 3u, z >> 3u);
+    if (any(key != (*cache).key)) {
+        var base = 0u;
+        let g = occ(params.bases.x + root_cell(x, y, z));
+        if (g != 0u) {
+            let tl = occ(params.bases.y + (g - 1u) * 512u + slot(x, y, z, 6u));
+            if (tl != 0u) {
+                let br = occ(params.bases.z + (tl - 1u) * 512u + slot(x, y, z, 3u));
+                if (br != 0u) {
+                    base = params.bases.w + (br - 1u) * 16u + 1u;
+                }
+            }
+        }
+        *cache = BrickCache(key, base);
+    }
+    if ((*cache).base == 0u) {
+        return false;
+    }
+    let bit = slot(x, y, z, 0u);
+    return ((occ((*cache).base - 1u + (bit >> 5u)) >> (bit & 31u)) & 1u) == 1u;
+}
+
+// The report's fixed-step march for one ray (numba: the per-ray body of _march_kernel).
+fn march_one(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hit {
+    var cache = BrickCache(vec3<i32>(-1), 0u);  // brick coordinates are never negative
+    let step = params.reals.x;
+    let zmax = real(params.run.z);
+    let nx = real(params.shape.x);
+    let ny = real(params.shape.y);
+    let top = zmax + 1.0;
+    var t_s = real(0.0);
+    if (oz > top) {
+        if (dz >= 0.0) {
+            return miss();
+        }
+        t_s = (top - oz) * (1.0 / dz);
+    }
+    // From the start sample on, every sample is inside the extent's box or ends the ray.
+    let limit = i32((sqrt(nx * nx + ny * ny + top * top) + 2.0) / step) + 2;
+    for (var k = 0; k < limit; k++) {
+        let t = t_s + real(k) * step;
+        let cx = ox + t * dx;
+        let cy = oy + t * dy;
+        let cz = oz + t * dz;
+        let gx = floor(cx);
+        let gy = floor(cy);
+        if (cz < 0.0) {
+            if (0.0 <= cx && cx < nx && 0.0 <= cy && cy < ny) {
+                return Hit(GROUND, i32(gx), i32(gy), 0, t);
+            }
+            return miss();
+        }
+        if (!(0.0 <= cx && cx < nx && 0.0 <= cy && cy < ny) || (cz >= top && dz >= 0.0)) {
+            return miss();
+        }
+        if (occupied(i32(gx), i32(gy), i32(floor(cz)), &cache)) {
+            return Hit(VOXEL, i32(gx), i32(gy), i32(floor(cz)), t);
+        }
+    }
+    return miss();
+}
+
+// numba: _exact_kernel and _march_kernel, one invocation per ray.
+@compute @workgroup_size(64)
+fn trace_rays(@builtin(workgroup_id) group: vec3<u32>,
+              @builtin(num_workgroups) groups: vec3<u32>,
+              @builtin(local_invocation_index) lane: u32) {
+    let r = (group.y * groups.x + group.x) * 64u + lane;
+    if (r >= u32(params.run.x)) {
+        return;
+    }
+    let b = r * 6u;
+    let ox = rays[b];
+    let oy = rays[b + 1u];
+    let oz = rays[b + 2u];
+    let dx = rays[b + 3u];
+    let dy = rays[b + 4u];
+    let dz = rays[b + 5u];
+    var hit: Hit;
+    if (params.run.y == 0) {
+        hit = first_voxel(ox, oy, oz, dx, dy, dz);
+        if (hit.kind == MISS) {
+            hit = ground(ox, oy, oz, dx, dy, dz);
+        }
+    } else {
+        hit = march_one(ox, oy, oz, dx, dy, dz);
+    }
+    hits[r] = vec4<i32>(hit.kind, hit.i, hit.j, hit.k);
+    ranges[r] = hit.t;
+}

@@ -1,0 +1,526 @@
+"""The wgpu backend: the occupancy tracer as a WGSL compute shader.
+
+Runs on any adapter wgpu can open: a real GPU (discrete, then integrated) when
+there is one, else a CPU adapter such as Mesa's lavapipe. The shader
+(``shaders/trace.wgsl``) is the numba kernel of ``tracing/numba_backend.py``
+written again in WGSL, step for step, so that in float64 both give the same
+answer for every ray.
+
+Resources:
+
+* The occupancy arrays (root, regions, tiles, bricks, columns; all u32) are laid end
+  to end in one logical word array, split into power-of-two sized chunks,
+  each its own storage binding no larger than the adapter allows. They are
+  uploaded once per ``Occupancy`` object and reused for every call.
+* Rays go in batches that fit one binding; each batch is one dispatch over a
+  2-D grid of workgroups kept within the per-dimension limit.
+
+Precision: ``f64`` needs the adapter's ``shader-f64`` feature (lavapipe has
+it). Without it the backend runs ``f32`` and says so in ``CellHits.info``.
+In ``f32`` each ray starts where it enters the scene's box (moved there on the
+host in float64, the offset added back to ``t``), so an aircraft kilometres
+away loses no precision.
+
+``wgpu`` is imported only inside ``probe`` and later calls: importing this
+module is cheap and never fails.
+"""
+
+from __future__ import annotations
+
+import importlib.resources
+import threading
+import weakref
+
+import numpy as np
+
+from ladartui.errors import BackendUnavailable, Cancelled, FieldError
+from ladartui.tracing.backend import METHODS, MISS, CellHits, register_backend
+
+NAME = "wgpu"
+
+INSTALL_HINT = (
+    "no Vulkan, Metal or D3D12 adapter found: install Debian's "
+    "mesa-vulkan-drivers (lavapipe) or a GPU driver"
+)
+
+WORKGROUP_SIZE = 64  # must equal @workgroup_size in trace.wgsl
+RAY_BATCH = 1 << 20  # rays per dispatch: bounds host and device memory
+METHOD_CODES = {"exact": 0, "march": 1}
+ADAPTER_TYPE_RANK = {"DiscreteGPU": 0, "IntegratedGPU": 1, "VirtualGPU": 2, "CPU": 3}
+# OpenGL adapters lack shader-f64 and large storage buffers; prefer the rest.
+GRAPHICS_BACKEND_RANK = {"Vulkan": 0, "Metal": 0, "D3D12": 0, "OpenGL": 1}
+# Bindings besides the occupancy chunks: params, rays, hit cells, hit ranges.
+FIXED_BINDINGS = 4
+# Ask for no more than this many occupancy bindings (16 GiB at 128 MiB each).
+MAX_OCCUPANCY_BINDINGS = 128
+
+
+def choose_adapter(adapters):
+    """The adapter to use: discrete GPU, integrated GPU, virtual, then CPU.
+
+    Among adapters of one type, Vulkan/Metal/D3D12 come before OpenGL.
+    ``adapters`` are wgpu adapters (anything with ``.info`` mapping
+    ``adapter_type`` and ``backend_type``); None when the list is empty.
+    """
+    def rank(indexed):
+        position, adapter = indexed
+        info = adapter.info
+        return (
+            ADAPTER_TYPE_RANK.get(info.get("adapter_type", ""), 4),
+            GRAPHICS_BACKEND_RANK.get(info.get("backend_type", ""), 2),
+            position,
+        )
+
+    if not adapters:
+        return None
+    return min(enumerate(adapters), key=rank)[1]
+
+
+def chunk_words_for(max_binding_bytes: int) -> int:
+    """Words per occupancy chunk: the largest power of two fitting one binding."""
+    words = max(int(max_binding_bytes) // 4, 1)
+    return 1 << (words.bit_length() - 1)
+
+
+def dispatch_grid(workgroups: int, max_per_dimension: int) -> tuple[int, int]:
+    """(x, y) workgroup counts covering ``workgroups`` within the per-dimension limit."""
+    if workgroups <= 0:
+        return (0, 0)
+    x = min(workgroups, max_per_dimension)
+    y = -(-workgroups // x)
+    if y > max_per_dimension:
+        raise ValueError(f"{workgroups} workgroups exceed a {max_per_dimension}^2 grid")
+    return (x, y)
+
+
+def f32_start_offsets(origins, directions, shape, top, method):
+    """Per-ray float64 ``t`` to move each origin by before it is made float32.
+
+    Exact: where the ray enters the box ``[0, nx] x [0, ny] x [0, top]`` (the
+    scene's extent up to the top of its highest occupied layer), or 0 when it
+    starts inside or never enters. March: the march's own start, where a
+    descending ray crosses ``c_z = top`` (same formula as the kernels), else 0.
+    The shader then sees coordinates no larger than the scene, and the host
+    adds ``t`` back in float64.
+    """
+    o = np.asarray(origins, dtype=np.float64)
+    d = np.asarray(directions, dtype=np.float64)
+    if method == "march":
+        start = np.zeros(len(o))
+        above = (o[:, 2] > top) & (d[:, 2] < 0.0)
+        start[above] = (top - o[above, 2]) * (1.0 / d[above, 2])
+        return start
+    hi = np.array([float(shape[0]), float(shape[1]), max(float(top), 1.0)])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = 1.0 / d
+        t_lo = -o * inv
+        t_hi = (hi - o) * inv
+        # With d == 0 (inv = inf) the pair is (-inf, +inf) inside the slab,
+        # one-signed outside it, NaN on its faces (fmin/fmax skip NaN: no shift).
+        near = np.fmin(t_lo, t_hi)
+        far = np.fmax(t_lo, t_hi)
+        enter = np.fmax(np.fmax(near[:, 0], near[:, 1]), near[:, 2])
+        leave = np.fmin(np.fmin(far[:, 0], far[:, 1]), far[:, 2])
+        # Stay at least half a cell above the ground, so the ground rule still
+        # sees an origin above it.
+        oz, dz = o[:, 2], d[:, 2]
+        ground_cap = (oz - np.minimum(oz, 0.5)) * -inv[:, 2]
+    ground_cap[~((dz < 0.0) & (oz > 0.0))] = np.inf
+    np.fmin(enter, ground_cap, out=enter)
+    return np.where((enter > 0.0) & (enter <= leave), enter, 0.0)
+
+
+def floor_preserving_f32(values):
+    """float32 of float64 ``values``, each in the same unit cell as its float64 value.
+
+    Plain rounding can carry 72.99999999 up to 73.0, which changes the cell a
+    ray starts in (the march's first sample sits on the top face exactly in
+    real numbers, so its cell is decided by the last bit). Such values step
+    down to the float32 just below the integer.
+    """
+    v32 = np.asarray(values, dtype=np.float64).astype(np.float32)
+    crossed = np.floor(v32) > np.floor(values)
+    v32[crossed] = np.nextafter(v32[crossed], np.float32(-np.inf))
+    return v32
+
+
+class _Upload:
+    """An occupancy on the device: its chunk buffers and where each array starts."""
+
+    def __init__(self, buffers, bases, total_words, chunk_shift):
+        self.buffers = buffers
+        self.bases = bases
+        self.total_words = total_words
+        self.chunk_shift = chunk_shift
+        self.bind_groups = {}
+
+
+class WgpuBackend:
+    """Tracer running the WGSL kernel through wgpu (see module docstring)."""
+
+    name = NAME
+    summary = "WGSL compute shader through wgpu (GPU, else lavapipe on the CPU)"
+
+    def __init__(self, *, max_binding_bytes: int | None = None, ray_batch: int = RAY_BATCH,
+                 max_workgroups_per_dimension: int | None = None):
+        """Optional caps below the adapter's limits (tests use them to force
+        occupancy splitting, several batches and 2-D dispatch grids)."""
+        self._caps = {"max-storage-buffer-binding-size": max_binding_bytes,
+                      "max-compute-workgroups-per-dimension": max_workgroups_per_dimension}
+        self._ray_batch = int(ray_batch)
+        self._lock = threading.RLock()
+        self._probed = False
+        self._reason = None
+        self._adapter = None
+        self._device = None
+        self._limits = {}
+        self._has_f64 = False
+        self._uploads = weakref.WeakKeyDictionary()
+        self._pinned_uploads = {}  # for occupancies that cannot be weakly referenced
+        self._pipelines = {}
+        self._ray_buffers = {}
+        self._source = None
+
+    # -- probing and device -------------------------------------------------
+
+    def probe(self) -> str | None:
+        """None when an adapter is usable here, else what to install."""
+        with self._lock:
+            if not self._probed:
+                self._reason = self._find_adapter()
+                self._probed = True
+            return self._reason
+
+    def _find_adapter(self) -> str | None:
+        try:
+            import wgpu
+        except ImportError:
+            return "the wgpu package is not installed: pip install wgpu==0.32.0"
+        except Exception as error:  # a broken install: say so, never crash the caller
+            return f"the wgpu package failed to import ({error}): reinstall wgpu==0.32.0"
+        try:
+            adapters = wgpu.gpu.enumerate_adapters_sync()
+        except Exception as error:  # the native library failed to load or to start
+            return f"wgpu could not list adapters ({error}); {INSTALL_HINT}"
+        adapter = choose_adapter(adapters)
+        if adapter is None:
+            return INSTALL_HINT
+        self._adapter = adapter
+        self._has_f64 = "shader-f64" in adapter.features
+        return None
+
+    def _require(self):
+        reason = self.probe()
+        if reason:
+            raise BackendUnavailable(f"backend {NAME!r} is unavailable: {reason}")
+
+    def _open_device(self):
+        """The device, created once with the limits this backend needs."""
+        if self._device is not None:
+            return self._device
+        self._require()
+        adapter = self._adapter
+        limits = adapter.limits
+        storage = min(limits["max-storage-buffers-per-shader-stage"],
+                      FIXED_BINDINGS + MAX_OCCUPANCY_BINDINGS)
+        wanted = {
+            # The adapter's own maxima: asking for more fails at device creation.
+            "max-storage-buffer-binding-size": limits["max-storage-buffer-binding-size"],
+            "max-buffer-size": limits["max-buffer-size"],
+            "max-storage-buffers-per-shader-stage": storage,
+            "max-compute-workgroups-per-dimension": limits["max-compute-workgroups-per-dimension"],
+        }
+        features = ["shader-f64"] if self._has_f64 else []
+        try:
+            self._device = adapter.request_device_sync(
+                label="ladartui-trace", required_features=features, required_limits=wanted)
+        except Exception as error:
+            raise BackendUnavailable(
+                f"backend {NAME!r} could not open a device on {adapter.info.get('device')!r}: {error}"
+            ) from error
+        self._limits = dict(wanted)
+        for key, cap in self._caps.items():
+            if cap is not None:
+                self._limits[key] = min(self._limits[key], int(cap))
+        return self._device
+
+    def describe(self) -> dict:
+        """Adapter name, type, graphics backend, f64 support and the limits used."""
+        with self._lock:
+            self._require()
+            info = self._adapter.info
+            limits = self._limits or {
+                key: self._adapter.limits[key]
+                for key in ("max-storage-buffer-binding-size", "max-buffer-size",
+                            "max-storage-buffers-per-shader-stage",
+                            "max-compute-workgroups-per-dimension")
+            }
+            return {
+                "backend": NAME,
+                "adapter": info.get("device", ""),
+                "adapter_type": info.get("adapter_type", ""),
+                "graphics_backend": info.get("backend_type", ""),
+                "driver": info.get("description", ""),
+                "f64": self._has_f64,
+                "precisions": ["f64", "f32"] if self._has_f64 else ["f32"],
+                "limits": dict(limits),
+                "workgroup_size": WORKGROUP_SIZE,
+                "ray_batch": self._ray_batch,
+            }
+
+    # -- occupancy upload ---------------------------------------------------
+
+    def _upload(self, occupancy) -> _Upload:
+        """The device copy of ``occupancy``, made on first use (cached by identity)."""
+        try:
+            upload = self._uploads.get(occupancy)
+        except TypeError:
+            upload = self._pinned_uploads.get(id(occupancy), (None, None))
+            upload = upload[1] if upload[0] is occupancy else None
+        if upload is not None:
+            return upload
+        upload = self._make_upload(occupancy)
+        try:
+            self._uploads[occupancy] = upload
+        except TypeError:
+            self._pinned_uploads.clear()  # keep only the latest one alive
+            self._pinned_uploads[id(occupancy)] = (occupancy, upload)
+        return upload
+
+    def _make_upload(self, occupancy) -> _Upload:
+        import wgpu
+
+        device = self._open_device()
+        arrays = [np.ascontiguousarray(part, dtype=np.uint32).ravel()
+                  for part in occupancy_arrays(occupancy)]
+        bases, total = [], 0
+        for array in arrays:
+            bases.append(total)
+            total += array.size
+        if total >= 1 << 32:
+            raise BackendUnavailable(
+                f"backend {NAME!r} cannot address this scene: its occupancy has {total} words (limit 2^32)")
+        max_binding = min(self._limits["max-storage-buffer-binding-size"], self._limits["max-buffer-size"])
+        chunk_words = chunk_words_for(max_binding)
+        chunks = max(-(-total // chunk_words), 1)
+        allowed = self._limits["max-storage-buffers-per-shader-stage"] - FIXED_BINDINGS
+        if chunks > allowed:
+            raise BackendUnavailable(
+                f"backend {NAME!r} cannot hold this scene on {self._adapter.info.get('device')!r}: "
+                f"its occupancy needs {total * 4 / 2**20:.0f} MiB in {chunks} bindings of "
+                f"{chunk_words * 4 / 2**20:.0f} MiB, the adapter allows {allowed}; use backend 'numba'")
+        buffers = []
+        for chunk in range(chunks):
+            start = chunk * chunk_words
+            words = min(chunk_words, total - start)
+            try:
+                buffer = device.create_buffer(
+                    size=max(words, 4) * 4,
+                    usage=wgpu.BufferUsage.STORAGE | wgpu.BufferUsage.COPY_DST)
+            except Exception as error:
+                raise BackendUnavailable(
+                    f"backend {NAME!r} could not allocate {words * 4 / 2**20:.0f} MiB for the occupancy: {error}"
+                ) from error
+            # Copy the slices of each array that fall in this chunk.
+            for base, array in zip(bases, arrays):
+                lo, hi = max(base, start), min(base + array.size, start + words)
+                if lo < hi:
+                    device.queue.write_buffer(buffer, (lo - start) * 4, array[lo - base:hi - base])
+            buffers.append(buffer)
+        shift = chunk_words.bit_length() - 1
+        return _Upload(buffers, bases, total, shift)
+
+    # -- pipelines ----------------------------------------------------------
+
+    def _shader_source(self, real: str, chunks: int, chunk_shift: int) -> str:
+        """trace.wgsl with its header: the float type and the occupancy bindings."""
+        if self._source is None:
+            self._source = (importlib.resources.files("ladartui") / "shaders" / "trace.wgsl").read_text()
+        lines = [f"alias real = {real};"]
+        for chunk in range(chunks):
+            lines.append(f"@group(0) @binding({FIXED_BINDINGS + chunk}) "
+                         f"var<storage, read> occupancy{chunk}: array<u32>;")
+        lines.append("// One logical word array over all chunks (see wgpu_backend.py).")
+        lines.append("fn occ(word: u32) -> u32 {")
+        if chunks == 1:
+            lines.append("    return occupancy0[word];")
+        else:
+            mask = (1 << chunk_shift) - 1
+            lines.append(f"    let offset = word & {mask}u;")
+            lines.append(f"    switch (word >> {chunk_shift}u) {{")
+            for chunk in range(chunks - 1):
+                lines.append(f"        case {chunk}u: {{ return occupancy{chunk}[offset]; }}")
+            lines.append(f"        default: {{ return occupancy{chunks - 1}[offset]; }}")
+            lines.append("    }")
+        lines.append("}")
+        return "\n".join(lines) + "\n\n" + self._source
+
+    def _pipeline(self, precision: str, chunks: int, chunk_shift: int):
+        key = (precision, chunks, chunk_shift)
+        pipeline = self._pipelines.get(key)
+        if pipeline is None:
+            device = self._open_device()
+            code = self._shader_source(precision, chunks, chunk_shift)
+            module = device.create_shader_module(label=f"trace-{precision}", code=code)
+            pipeline = device.create_compute_pipeline(
+                label=f"trace-{precision}-{chunks}", layout="auto",
+                compute={"module": module, "entry_point": "trace_rays"})
+            self._pipelines[key] = pipeline
+        return pipeline
+
+    def _ray_buffers_for(self, precision: str):
+        """Ray input and hit output buffers for one batch, reused across calls."""
+        import wgpu
+
+        buffers = self._ray_buffers.get(precision)
+        if buffers is None:
+            device = self._open_device()
+            real_bytes = 8 if precision == "f64" else 4
+            groups = self._limits["max-compute-workgroups-per-dimension"]
+            rays = max(1, min(self._ray_batch,
+                              self._limits["max-storage-buffer-binding-size"] // (6 * real_bytes),
+                              groups * groups * WORKGROUP_SIZE))
+            usage_in = wgpu.BufferUsage.STORAGE | wgpu.BufferUsage.COPY_DST
+            usage_out = wgpu.BufferUsage.STORAGE | wgpu.BufferUsage.COPY_SRC
+            buffers = {
+                "capacity": rays,
+                "params": device.create_buffer(size=PARAMS_BYTES,
+                                               usage=wgpu.BufferUsage.UNIFORM | wgpu.BufferUsage.COPY_DST),
+                "rays": device.create_buffer(size=rays * 6 * real_bytes, usage=usage_in),
+                "cells": device.create_buffer(size=rays * 16, usage=usage_out),
+                "ranges": device.create_buffer(size=rays * real_bytes, usage=usage_out),
+            }
+            self._ray_buffers[precision] = buffers
+        return buffers
+
+    # -- tracing ------------------------------------------------------------
+
+    def trace_cells(self, occupancy, origins, directions, *, method="exact", step=0.5,
+                    precision="f64", cancel: threading.Event | None = None) -> CellHits:
+        """Trace (N, 3) float64 cell-space rays on the adapter; see ``Backend``."""
+        if method not in METHODS:
+            raise FieldError("method", method, " or ".join(METHODS))
+        if precision not in ("f64", "f32"):
+            raise FieldError("precision", precision, "f64 or f32")
+        origins = np.ascontiguousarray(origins, dtype=np.float64).reshape(-1, 3)
+        directions = np.ascontiguousarray(directions, dtype=np.float64).reshape(-1, 3)
+        if origins.shape != directions.shape:
+            raise ValueError("origins and directions differ in length")
+        step = float(step) if step is not None else 0.5
+        if method == "march" and not step > 0:
+            raise FieldError("step", step, "a positive number of voxels")
+        with self._lock:
+            self._open_device()
+            used = precision if (precision == "f32" or self._has_f64) else "f32"
+            info = {"adapter": self._adapter.info.get("device", ""), "precision": used}
+            if used != precision:
+                info["precision_note"] = "the adapter has no shader-f64: traced in f32"
+            return self._trace(occupancy, origins, directions, method, step, used, cancel, info)
+
+    def _trace(self, occupancy, origins, directions, method, step, precision, cancel, info):
+        n = len(origins)
+        kind = np.zeros(n, dtype=np.uint8)
+        index = np.full((n, 3), -1, dtype=np.int32)
+        t = np.full(n, np.inf)
+        if n == 0:
+            return CellHits(kind, index, t, info)
+        upload = self._upload(occupancy)
+        chunks = len(upload.buffers)
+        pipeline = self._pipeline(precision, chunks, upload.chunk_shift)
+        buffers = self._ray_buffers_for(precision)
+        bind_group = self._bind_group(upload, pipeline, buffers, precision)
+        real = np.float64 if precision == "f64" else np.float32
+        top = float(max(int(occupancy.zmax) + 1, 0))
+        if precision == "f32":
+            offsets = f32_start_offsets(origins, directions, occupancy.shape, top, method)
+        else:
+            offsets = None
+        device = self._device
+        capacity = buffers["capacity"]
+        max_groups = self._limits["max-compute-workgroups-per-dimension"]
+        for start in range(0, n, capacity):
+            if cancel is not None and cancel.is_set():
+                raise Cancelled("trace cancelled")
+            stop = min(start + capacity, n)
+            count = stop - start
+            rays = np.empty((count, 6), dtype=real)
+            if offsets is None:
+                rays[:, :3] = origins[start:stop]
+            else:
+                rays[:, :3] = floor_preserving_f32(
+                    origins[start:stop] + offsets[start:stop, None] * directions[start:stop])
+            rays[:, 3:] = directions[start:stop]
+            device.queue.write_buffer(buffers["params"], 0,
+                                      pack_params(occupancy, upload, method, step, count, precision))
+            device.queue.write_buffer(buffers["rays"], 0, rays)
+            groups = dispatch_grid(-(-count // WORKGROUP_SIZE), max_groups)
+            encoder = device.create_command_encoder()
+            compute = encoder.begin_compute_pass()
+            compute.set_pipeline(pipeline)
+            compute.set_bind_group(0, bind_group)
+            compute.dispatch_workgroups(groups[0], groups[1], 1)
+            compute.end()
+            device.queue.submit([encoder.finish()])
+            cells = np.frombuffer(device.queue.read_buffer(buffers["cells"], 0, count * 16),
+                                  dtype=np.int32).reshape(count, 4)
+            ranges = np.frombuffer(device.queue.read_buffer(buffers["ranges"], 0, count * rays.itemsize),
+                                   dtype=real)
+            kind[start:stop] = cells[:, 0]
+            index[start:stop] = cells[:, 1:]
+            hit = cells[:, 0] != MISS
+            batch_t = ranges.astype(np.float64)
+            if offsets is not None:
+                batch_t = batch_t + offsets[start:stop]
+            t[start:stop] = np.where(hit, batch_t, np.inf)
+        index[kind == MISS] = -1
+        return CellHits(kind, index, t, info)
+
+    def _bind_group(self, upload, pipeline, buffers, precision):
+        key = (precision, id(pipeline), id(buffers["rays"]))
+        group = upload.bind_groups.get(key)
+        if group is None:
+            entries = [
+                {"binding": 0, "resource": {"buffer": buffers["params"]}},
+                {"binding": 1, "resource": {"buffer": buffers["rays"]}},
+                {"binding": 2, "resource": {"buffer": buffers["cells"]}},
+                {"binding": 3, "resource": {"buffer": buffers["ranges"]}},
+            ]
+            for chunk, buffer in enumerate(upload.buffers):
+                entries.append({"binding": FIXED_BINDINGS + chunk, "resource": {"buffer": buffer}})
+            group = self._device.create_bind_group(layout=pipeline.get_bind_group_layout(0), entries=entries)
+            upload.bind_groups[key] = group
+        return group
+
+
+def occupancy_arrays(occupancy):
+    """The u32 arrays laid end to end on the device: root, regions, tiles, bricks, columns."""
+    columns = getattr(occupancy, "columns", None)
+    if columns is None:
+        # No brick-column tops: every column reaches the top of the root grid, so
+        # the column skip never fires (same cells visited, only slower).
+        dims = np.asarray(occupancy.root_dims, dtype=np.int64)
+        columns = np.full(int(dims[0] * 64 * dims[1] * 64), int(dims[2]) * 64, dtype=np.uint32)
+    return [occupancy.root, occupancy.regions, occupancy.tiles, occupancy.bricks, columns]
+
+
+# Params (uniform, see struct Params in trace.wgsl): 8 vec4 of 32-bit integers
+# then a vec2<real> of float parameters (16 bytes in f64, 8 in f32).
+PARAMS_BYTES = 8 * 16 + 16
+
+
+def pack_params(occupancy, upload, method, step, count, precision) -> bytes:
+    """The uniform block for one dispatch, laid out as ``struct Params``."""
+    ints = np.zeros((8, 4), dtype=np.int32)
+    ints[0, :3] = occupancy.shape
+    ints[1, :3] = occupancy.bbox_lo
+    ints[2, :3] = occupancy.bbox_hi
+    ints[3, :3] = occupancy.root_origin
+    ints[4, :3] = occupancy.root_dims
+    ints[5, :] = np.array(upload.bases[:4], dtype=np.int64).astype(np.uint32).view(np.int32)
+    ints[6, :] = (count, METHOD_CODES[method], int(occupancy.zmax), len(occupancy.root))
+    ints[7, 0] = np.array(upload.bases[4], dtype=np.int64).astype(np.uint32).view(np.int32)
+    reals = np.array([step, 0], dtype=np.float64 if precision == "f64" else np.float32)
+    return ints.tobytes() + reals.tobytes()
+
+
+register_backend(NAME, WgpuBackend)
