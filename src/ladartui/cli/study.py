@@ -1,0 +1,161 @@
+"""``ladartui study``: speed against accuracy of every backend, method and setting."""
+
+from __future__ import annotations
+
+import argparse
+import threading
+
+from ladartui.errors import Cancelled, FieldError
+
+DEFAULT_OUT = "study-results"
+CHART_WIDTH, CHART_HEIGHT = 120, 34
+
+
+def add_parser(subparsers) -> None:
+    parser = subparsers.add_parser(
+        "study",
+        help="time and score every tracing backend x method x setting; chart and verdict",
+        description="Trace a scenario's scans with every backend, method, march step, "
+        "precision and ray grid; time them (median after warm-up), compare each ray's first "
+        "hit with exact float64 numba, score obscured target coverage against exact m=8, and "
+        "chart speed against accuracy with the Pareto front. Without a scenario, uses the "
+        "generated 'reference' scene (cached under LADARTUI_HOME). Ctrl-C cancels.",
+    )
+    parser.add_argument("scenario", nargs="?", help="scenario .toml (default: generated scene)")
+    parser.add_argument("--quick", action="store_true",
+                        help="small scene, few settings and scans: a fast check")
+    parser.add_argument("--out", default=DEFAULT_OUT,
+                        help=f"folder for study.csv, study.json, speed-accuracy.svg/.txt "
+                        f"(default: {DEFAULT_OUT})")
+    parser.add_argument("--runs", type=int, default=None,
+                        help="timed runs per setting, median quoted (default 5; 3 with --quick)")
+    parser.add_argument("--warmup", type=int, default=1, help="untimed calls first (default 1)")
+    parser.add_argument("--chart-from", metavar="JSON", default=None,
+                        help="redraw the chart, table and verdict from a study.json; no tracing")
+    parser.add_argument("--scans", type=int, default=None,
+                        help="scans traced, evenly spread over the flight (default 3; 2 with --quick)")
+    parser.set_defaults(handler=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from rich.console import Console
+
+    from ladartui.study import full_settings, quick_settings
+    from ladartui.study.inputs import generated_inputs, scenario_inputs
+
+    if args.chart_from:
+        return _report(_load_result(args.chart_from), args.out)
+    runs = _positive("--runs", args.runs if args.runs is not None else (3 if args.quick else 5))
+    scans = _positive("--scans", args.scans if args.scans is not None else (2 if args.quick else 3))
+    warmup = args.warmup
+    if warmup < 0:
+        raise FieldError("--warmup", warmup, "0 or more")
+    console = Console(stderr=True)
+    if args.scenario:
+        inputs = scenario_inputs(args.scenario, scans)
+    else:
+        preset = "small" if args.quick else "reference"
+        with console.status(f"loading the {preset!r} scene ..."):
+            inputs = generated_inputs(preset, scans, progress=console.print)
+    settings = quick_settings() if args.quick else full_settings()
+    result = _run_with_progress(console, inputs, settings, runs, warmup)
+    return _report(result, args.out)
+
+
+def _load_result(path):
+    import json
+    from pathlib import Path
+
+    from ladartui.errors import InputFileError
+    from ladartui.study.results import StudyResult
+
+    try:
+        data = json.loads(Path(path).read_text(encoding="utf-8"))
+        return StudyResult.from_dict(data)
+    except OSError as error:
+        raise InputFileError(path, f"cannot read it ({error.strerror})") from None
+    except (ValueError, KeyError, TypeError) as error:
+        raise InputFileError(path, f"not a study.json written by 'ladartui study' ({error})") from None
+
+
+def _positive(flag, value):
+    if value < 1:
+        raise FieldError(flag, value, "1 or more")
+    return value
+
+
+def _run_with_progress(console, inputs, settings, runs, warmup):
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from ladartui.study.run import backend_reasons, run_study
+
+    for name, reason in backend_reasons(s.backend for s in settings).items():
+        if reason:
+            console.print(f"[yellow]skipping backend {name}:[/] {reason}")
+    scene = inputs.scene
+    console.print(f"study on {inputs.name}: {len(scene.voxels):,} voxels, shape {scene.shape}, "
+                  f"{len(inputs.poses)} scans, sensor {inputs.sensor.grid}x{inputs.sensor.grid}, "
+                  f"{len(settings)} settings, median of {runs} runs")
+    cancel = threading.Event()
+    outcome = {}
+    progress_bar = Progress(TextColumn("{task.description}"), BarColumn(),
+                            TextColumn("{task.completed}/{task.total} traces"),
+                            TimeElapsedColumn(), console=console, transient=True)
+    task = progress_bar.add_task("starting", total=None)
+
+    plain = not console.is_terminal  # a log file gets one line per setting instead of a bar
+    last = {}
+
+    def report(p):
+        progress_bar.update(task, completed=p.done, total=p.total,
+                            description=f"{p.label} scan {p.scan}/{p.scans}")
+        if plain and last.get("label") != p.label and p.scan == 1:
+            last["label"] = p.label
+            console.print(f"[{p.done}/{p.total} traces] {p.label}", highlight=False)
+
+    def work():
+        try:
+            outcome["result"] = run_study(inputs, settings, runs=runs, warmup=warmup,
+                                          progress=report, cancel=cancel)
+        except BaseException as error:  # handed to the main thread
+            outcome["error"] = error
+
+    worker = threading.Thread(target=work, name="ladartui-study", daemon=True)
+    with progress_bar:
+        worker.start()
+        try:
+            while worker.is_alive():
+                worker.join(0.1)
+        except KeyboardInterrupt:
+            cancel.set()
+            worker.join()
+            raise Cancelled("study cancelled") from None
+    if "error" in outcome:
+        raise outcome["error"]
+    return outcome["result"]
+
+
+def _report(result, out_dir) -> int:
+    from rich.console import Console
+    from rich.table import Table
+    from rich.text import Text
+
+    from ladartui.study.chart import TABLE_COLUMNS, chart_text, table_rows
+    from ladartui.study.run import write_outputs
+
+    console = Console()
+    if not console.is_terminal:
+        console = Console(width=CHART_WIDTH + 20)  # a log file: no need to wrap at 80
+    width = max(60, min(console.width, CHART_WIDTH))
+    console.print(Text.from_ansi(chart_text(result, width, CHART_HEIGHT, color=console.is_terminal)))
+    table = Table(title="Settings (coverage error against " + (result.reference_label or "-") + ")")
+    for column in TABLE_COLUMNS:
+        table.add_column(column, justify="right" if column in ("s/scan", "rays/s", "differ",
+                                                              "cov. error") else "left")
+    for row in table_rows(result):
+        table.add_row(*row)
+    console.print(table)
+    console.print(result.verdict(), highlight=False)
+    paths = write_outputs(result, out_dir, width=CHART_WIDTH, height=CHART_HEIGHT)
+    console.print("wrote " + ", ".join(str(p) for p in paths.values()), highlight=False)
+    return 0

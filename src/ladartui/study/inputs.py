@@ -1,0 +1,115 @@
+"""What a study traces: a scene, a sensor and scan poses, from a scenario or a default.
+
+Without a scenario the study uses a generated scene (``reference`` by default,
+``small`` for a quick check), cached under the data folder (``LADARTUI_HOME``,
+else ``~/.local/share/ladartui``, in ``scenes/``) so it is generated once, and
+the default scenario's orbit around the target at 45 degrees depression.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+from ladartui.atomic import write_text_atomic
+from ladartui.defaults import data_home
+
+DEFAULT_SCANS = 8
+
+
+@dataclass
+class StudyInputs:
+    """A scene, a sensor and the scan poses to trace; ``name`` says where they came from."""
+
+    scene: object
+    sensor: object
+    poses: list
+    name: str
+    notes: list = field(default_factory=list)
+
+    def describe(self) -> dict:
+        scene = self.scene
+        return {
+            "name": self.name, "scene": scene.name, "voxels": int(len(scene.voxels)),
+            "target_voxels": int(len(scene.target)), "shape": list(scene.shape),
+            "voxel_size_m": scene.voxel_size, "scans": len(self.poses),
+            "sensor": {"grid": self.sensor.grid, "fov_deg": self.sensor.fov,
+                       "depth_resolution_m": self.sensor.depth_resolution},
+            "poses": [p.to_dict() for p in self.poses],
+        }
+
+
+def pick_scans(poses, limit: int | None):
+    """At most ``limit`` poses, evenly spread over the flight (first one included)."""
+    poses = list(poses)
+    if limit is None or len(poses) <= limit:
+        return poses
+    picks = np.linspace(0, len(poses) - 1, limit).round().astype(int)
+    return [poses[i] for i in sorted(set(picks.tolist()))]
+
+
+def scenario_inputs(path, scans: int | None = DEFAULT_SCANS) -> StudyInputs:
+    """The scene, sensor and poses of the scenario file at ``path``."""
+    from ladartui.scenario import load_scenario
+
+    scenario = load_scenario(path)
+    scene = scenario.load_scene()
+    all_poses = list(scenario.poses())
+    poses = pick_scans(all_poses, scans)
+    inputs = StudyInputs(scene, scenario.sensor, poses, str(path))
+    if len(poses) < len(all_poses):
+        inputs.notes.append(f"{len(poses)} of the scenario's {len(all_poses)} scans traced "
+                            f"(evenly spread; --scans changes this).")
+    return inputs
+
+
+def generated_inputs(preset: str = "reference", scans: int = DEFAULT_SCANS,
+                     progress=None) -> StudyInputs:
+    """A cached generated scene, the full-size sensor and the default orbit aimed at the target.
+
+    The sensor is the default ``Sensor()`` (128 x 128 detectors, 10 degree view);
+    the flight is the default scenario's orbit at 45 degrees depression, of which
+    ``scans`` evenly spread scans are traced.
+    """
+    from ladartui.defaults import default_flight
+    from ladartui.sensor import Sensor
+
+    scene = cached_scene(preset, progress=progress)
+    sensor = Sensor()
+    all_poses = default_flight(scene.target, scene.voxel_size, sensor).poses()
+    poses = pick_scans(all_poses, scans)
+    inputs = StudyInputs(scene, sensor, poses, f"generated scene {preset!r}")
+    inputs.notes.append(f"{len(poses)} of the default orbit's {len(all_poses)} scans traced.")
+    return inputs
+
+
+def cached_scene(preset: str, folder=None, progress=None):
+    """The generated scene ``preset``, read from the cache or generated and saved there."""
+    from ladartui.scene.generate import generate_scene
+    from ladartui.scene.model import Scene
+
+    folder = Path(folder) if folder is not None else data_home() / "scenes"
+    scene_path = folder / f"{preset}.txt"
+    target_path = folder / f"{preset}_Target.txt"
+    meta_path = folder / f"{preset}.json"
+    if scene_path.is_file() and target_path.is_file() and meta_path.is_file():
+        try:
+            meta = json.loads(meta_path.read_text())
+            return Scene.load(scene_path, meta["voxel_size"], shape=tuple(meta["shape"]))
+        except (ValueError, KeyError, OSError):
+            pass  # a damaged cache is regenerated below
+    if progress is not None:
+        progress(f"generating the {preset!r} scene (once; cached in {folder})")
+    scene = generate_scene(preset)
+    scene.write(folder / preset)
+    # The metadata goes last: its presence says the voxel files are complete.
+    write_text_atomic(meta_path, json.dumps({"voxel_size": scene.voxel_size,
+                                             "shape": list(scene.shape)}) + "\n")
+    return scene.to_scene(name=preset, path=scene_path)
+
+
+def with_ray_grid(sensor, ray_grid: int):
+    return replace(sensor, ray_grid=int(ray_grid))

@@ -1,0 +1,250 @@
+"""Run a study: trace every scan with every setting, time it and score it.
+
+For each ray grid m (smallest first) and each scan, the rays are made once;
+exact float64 numba traces them first (the per-ray reference), then every
+other setting. The first scan of each setting is preceded by ``warmup``
+untimed calls on a slice of its rays (compilation, uploads); a setting's
+timings are one per scan plus repeats of the first scan up to ``runs`` (fewer
+once a setting has spent ``REPEAT_BUDGET_S``), and the figure quoted is their
+median. Only the trace call is timed, not ray generation or scoring.
+Coverage is the obscured target coverage of the fused returns (after the
+depth-resolution rule) of all traced scans, scored by ``compute_measures``;
+its error is taken against exact float64 numba at the largest ray grid.
+"""
+
+from __future__ import annotations
+
+import datetime
+import os
+import platform
+import threading
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from ladartui.errors import BackendUnavailable, Cancelled, LadarError
+from ladartui.study.inputs import StudyInputs, with_ray_grid
+from ladartui.study.misses import MissSummary, summarise, voxel_geometry
+from ladartui.study.results import FAILED, SKIPPED, StudyResult, StudyRow
+from ladartui.study.settings import Setting, reference_setting
+from ladartui.study.timing import timed
+from ladartui.tracing.backend import VOXEL
+
+# Rays per trace call: the cancel event is checked between calls.
+CHUNK_RAYS = 1 << 18
+# Warm-up calls trace this many rays: enough to compile and upload everything.
+WARMUP_RAYS = 4096
+# Repeats of the first scan (to reach ``runs`` timings) stop once a setting has
+# spent this long: a slow setting is timed once per scan instead.
+REPEAT_BUDGET_S = 3.0
+
+
+@dataclass(frozen=True)
+class StudyProgress:
+    """Progress in trace calls: ``done`` of ``total``; ``label`` is the setting now traced."""
+
+    done: int
+    total: int
+    label: str
+    scan: int
+    scans: int
+
+    @property
+    def fraction(self) -> float:
+        return self.done / self.total if self.total else 1.0
+
+
+def backend_reasons(names) -> dict[str, str | None]:
+    """For each backend name, None when usable here, else why not."""
+    from ladartui.tracing.backend import get_backend
+
+    reasons = {}
+    for name in sorted(set(names)):
+        try:
+            get_backend(name)
+            reasons[name] = None
+        except BackendUnavailable as error:
+            reasons[name] = str(error)
+        except LadarError as error:
+            reasons[name] = str(error)
+    return reasons
+
+
+def run_study(inputs: StudyInputs, settings: list[Setting], runs: int = 5, warmup: int = 1,
+              progress: Callable[[StudyProgress], None] | None = None,
+              cancel: threading.Event | None = None) -> StudyResult:
+    """Measure every setting on ``inputs``; see the module docstring for what is measured."""
+    if runs < 1:
+        raise LadarError("runs must be at least 1")
+    if not inputs.poses:
+        raise LadarError(f"{inputs.name}: the flight has no scans to trace")
+    grids = sorted({s.ray_grid for s in settings})
+    # The per-ray reference is traced at every ray grid, listed or not.
+    ordered = []
+    for m in grids:
+        ordered.append(reference_setting(m))
+        ordered += [s for s in settings if s.ray_grid == m and not s.is_reference]
+    listed = set(settings)
+    rows = {s: StudyRow(s) for s in ordered}
+    reasons = backend_reasons(s.backend for s in ordered)
+    if reasons.get("numba"):
+        raise BackendUnavailable(f"the reference tracer is unavailable: {reasons['numba']}")
+    for s, row in rows.items():
+        if reasons.get(s.backend):
+            row.status, row.reason = SKIPPED, reasons[s.backend]
+
+    scene = inputs.scene
+    poses = inputs.poses
+    extra = max(0, runs - len(poses))
+    active = [s for s in ordered if rows[s].status != SKIPPED]
+    total = sum(len(poses) + warmup + extra for _ in active)
+    done = 0
+    returns: dict[Setting, list[np.ndarray]] = {s: [] for s in ordered}
+    notes: dict[Setting, str] = {}
+
+    for m in grids:
+        sensor = with_ray_grid(inputs.sensor, m)
+        grid_settings = [s for s in active if s.ray_grid == m]
+        for scan, pose in enumerate(poses):
+            _check(cancel)
+            origins, directions, detector = sensor.rays(pose)
+            cells = origins / scene.voxel_size + 0.5
+            exact = None
+            exact_classes = None
+            for s in grid_settings:
+                row = rows[s]
+                if row.status != "ok":
+                    continue
+                calls = 1 + (warmup + extra if scan == 0 else 0)
+                call = 0
+                try:
+                    if scan == 0:
+                        # Warm-up: compile and upload on a slice of the scan's rays.
+                        for call in range(warmup):
+                            _check(cancel)
+                            _trace(scene, origins[:WARMUP_RAYS], directions[:WARMUP_RAYS], s,
+                                   cancel)
+                            done += 1
+                    repeats = 1 + (extra if scan == 0 else 0)
+                    for call in range(repeats):
+                        _check(cancel)
+                        if progress is not None:
+                            progress(StudyProgress(done, total, s.label, scan + 1, len(poses)))
+                        hits, seconds = timed(lambda: _trace(scene, origins, directions, s, cancel))
+                        done += 1
+                        row.timing.add(seconds)
+                        if sum(row.timing.seconds) > REPEAT_BUDGET_S:
+                            # Slow settings: every scan is a timed run already.
+                            done += repeats - call - 1
+                            break
+                except Cancelled:
+                    raise
+                except (LadarError, RuntimeError, ValueError, MemoryError) as error:
+                    if s.is_reference:
+                        raise
+                    row.status, row.reason = FAILED, f"{type(error).__name__}: {error}"
+                    done += max(calls - call - 1, 0)
+                    continue
+                note = hits.info.get("precision_note")
+                if note:
+                    notes[s] = note
+                row.rays_per_scan = len(hits.kind)
+                row.scans += 1
+                answer = (hits.kind, hits.index, hits.range)
+                if s.is_reference:
+                    exact = answer
+                    voxel = hits.kind == VOXEL
+                    exact_classes = voxel_geometry(cells[voxel], directions[voxel],
+                                                   hits.index[voxel], scene.occupancy)
+                row.misses.add(summarise(cells, directions, exact, answer, scene.occupancy,
+                                         exact_classes))
+                returns[s].append(_scan_returns(hits, detector, sensor.depth_resolution))
+    if progress is not None:
+        progress(StudyProgress(total, total, "scoring", len(poses), len(poses)))
+
+    coverage = {s: _coverage(scene, returns[s]) for s in ordered if rows[s].status == "ok"}
+    for s, value in coverage.items():
+        rows[s].coverage = value
+        if s in notes:
+            rows[s].reason = notes[s]
+    top = reference_setting(grids[-1])
+    result = StudyResult([rows[s] for s in ordered if s in listed or s.is_reference],
+                         context=_context(inputs, runs, warmup, reasons),
+                         reference_label=top.label, reference_coverage=coverage.get(top))
+    result.notes += inputs.notes
+    if grids[-1] < 8:
+        result.notes.append(f"The converged reference is exact float64 numba at m={grids[-1]}, "
+                            f"the largest ray grid measured (8 in the full study).")
+    if result.reference_coverage is None:
+        result.notes.append("Coverage is undefined (the reference saw no target voxel), "
+                            "so coverage errors are not shown.")
+    result.finish()
+    return result
+
+
+def _trace(scene, origins, directions, setting: Setting, cancel):
+    """One scan traced with ``setting``, in chunks so a cancel is answered quickly."""
+    from ladartui.tracing import trace
+
+    parts = []
+    for start in range(0, len(origins), CHUNK_RAYS):
+        _check(cancel)
+        stop = start + CHUNK_RAYS
+        parts.append(trace(scene.occupancy, origins[start:stop], directions[start:stop],
+                           backend=setting.backend, method=setting.method, step=setting.step,
+                           precision=setting.precision, voxel_size=scene.voxel_size,
+                           cancel=cancel))
+    if len(parts) == 1:
+        return parts[0]
+    first = parts[0]
+    first.kind = np.concatenate([p.kind for p in parts])
+    first.index = np.concatenate([p.index for p in parts])
+    first.range = np.concatenate([p.range for p in parts])
+    return first
+
+
+def _scan_returns(hits, detector, depth_resolution) -> np.ndarray:
+    from ladartui.simulation import scan_returns
+
+    return scan_returns(hits, detector, depth_resolution)
+
+
+def _coverage(scene, per_scan) -> float | None:
+    from ladartui.measures import compute_measures
+    from ladartui.simulation import fuse_scans
+
+    fused = fuse_scans(per_scan)
+    return compute_measures(scene.target, fused, None).obscured_coverage
+
+
+def _check(cancel):
+    if cancel is not None and cancel.is_set():
+        raise Cancelled("study cancelled")
+
+
+def _context(inputs: StudyInputs, runs, warmup, reasons) -> dict:
+    return {
+        "inputs": inputs.describe(), "runs": runs, "warmup": warmup,
+        "created_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "machine": {"cpus": os.cpu_count(), "platform": platform.platform(),
+                    "python": platform.python_version()},
+        "backends": reasons,
+    }
+
+
+def write_outputs(result: StudyResult, out_dir, chart_stem="speed-accuracy", stem="study",
+                  width=100, height=30) -> dict[str, Path]:
+    """Write the CSV, JSON, SVG chart and plain-text chart atomically into ``out_dir``."""
+    from ladartui.atomic import write_text_atomic
+    from ladartui.study.chart import chart_svg, chart_text
+
+    paths = result.write(out_dir, stem)
+    out_dir = Path(out_dir)
+    paths["svg"] = out_dir / f"{chart_stem}.svg"
+    paths["txt"] = out_dir / f"{chart_stem}.txt"
+    write_text_atomic(paths["svg"], chart_svg(result, width, height))
+    write_text_atomic(paths["txt"], chart_text(result, width, height, color=False) + "\n\n"
+                      + result.verdict() + "\n")
+    return paths
