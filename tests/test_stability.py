@@ -460,13 +460,7 @@ def test_very_long_rays_across_a_large_sparse_scene(tracer, record_property):
     check_all(case, [tracer], record_property, "long")
 
 
-LONG_MARCH_BUG = ("wgpu march returns a miss once a ray needs more than 65,536 samples "
-                  "(e.g. 12,000 cells at step 0.25); numba marches on")
-
-
-@pytest.mark.parametrize("tracer", [
-    pytest.param(t, id="-".join(t), marks=pytest.mark.xfail(reason=LONG_MARCH_BUG, strict=False))
-    if t[0] == "wgpu" else pytest.param(t, id="-".join(t)) for t in MARCH])
+@pytest.mark.parametrize("tracer", [pytest.param(t, id="-".join(t)) for t in MARCH])
 def test_march_over_more_than_65536_samples_still_reaches_the_ground(tracer):
     # One voxel in the far corner, above the ray: the march must reach the ground at
     # the ray's ground point (11998.0, 11998.0) -> cell (11998, 11998), 67,882 samples on.

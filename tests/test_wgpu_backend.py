@@ -1,6 +1,7 @@
 """The wgpu backend's plumbing: registration, adapter choice, device limits,
 occupancy upload (cached, split over bindings), batching and dispatch grids,
-cancellation, and the clear errors when there is no adapter.
+march passes for rays longer than lavapipe's loop guard, cancellation, and the
+clear errors when there is no adapter or a loop was ended early.
 
 Answers are checked against the numba backend (an independent implementation
 of the same contract); precision is tests/test_wgpu_precision.py's subject.
@@ -275,3 +276,117 @@ def test_adapter_without_f64_traces_in_f32_and_says_so(gpu, numba_backend):
     assert hits.info["precision"] == "f32" and "shader-f64" in hits.info["precision_note"]
     reference = numba_backend.trace_cells(occupancy, o, d)
     assert np.mean(hits.kind == reference.kind) > 0.999
+
+
+# --- long rays: more loop iterations than lavapipe allows in one invocation ----
+
+LOOP_GUARD = 65_535  # lavapipe's loop iterations per shader invocation, all loops together
+
+
+def on_lavapipe(backend):
+    return "llvmpipe" in backend.describe()["adapter"]
+
+
+@pytest.fixture(scope="module")
+def long_march_case():
+    """A 12,000-cell scene and rays whose answers lie 66,000 to 68,000 samples
+    (step 0.25) down the ray: a 100 x 100 block one layer high near the far
+    corner, and the ground around it."""
+    n = 12_000
+    block = np.array([(x, y, 0) for x in range(11_800, 11_900) for y in range(11_800, 11_900)])
+    voxels = np.vstack([block, [(n - 1, n - 1, 29)]])  # the corner voxel raises the top to 30
+    occupancy = Occupancy.build(voxels, shape=(n, n, 30))
+    rng = np.random.default_rng(21)
+    count = 64
+    origins = np.column_stack([rng.uniform(0, 2, count), rng.uniform(0, 2, count),
+                               rng.uniform(20, 29, count)])
+    targets = np.column_stack([rng.uniform(11_700, 11_990, count), rng.uniform(11_700, 11_990, count),
+                               np.zeros(count)])
+    directions = targets - origins
+    directions /= np.linalg.norm(directions, axis=1)[:, None]
+    return occupancy, origins, directions
+
+
+def test_long_march_rays_agree_with_numba(gpu, numba_backend, long_march_case):
+    occupancy, o, d = long_march_case
+    step = 0.25
+    reference = numba_backend.trace_cells(occupancy, o, d, method="march", step=step)
+    assert np.all(reference.t / step > LOOP_GUARD + 500)  # every answer beyond one invocation's loops
+    assert (reference.kind == 1).sum() >= 8 and (reference.kind == 2).sum() >= 8
+    assert_same(gpu.trace_cells(occupancy, o, d, method="march", step=step, precision="f64"), reference)
+    hits = gpu.trace_cells(occupancy, o, d, method="march", step=step, precision="f32")
+    # float32 samples sit up to ~1e-3 cells off: a sample that close to a face may
+    # fall in the next cell; t is k * 0.25 exactly in both precisions.
+    same = (hits.kind == reference.kind) & np.all(hits.index == reference.index, axis=1)
+    assert np.all(hits.kind != 0) and same.mean() >= 0.95
+    assert np.array_equal(hits.t[same], reference.t[same])
+
+
+def test_long_exact_rays_agree_with_numba(gpu, numba_backend, long_march_case):
+    occupancy, o, d = long_march_case
+    reference = numba_backend.trace_cells(occupancy, o, d, method="exact")
+    assert_same(gpu.trace_cells(occupancy, o, d, method="exact", precision="f64"), reference)
+    hits = gpu.trace_cells(occupancy, o, d, method="exact", precision="f32")
+    assert np.array_equal(hits.kind, reference.kind)
+    assert np.array_equal(hits.index, reference.index)
+    assert np.allclose(hits.t, reference.t, rtol=1e-6)
+
+
+def brick_corridor(n):
+    """An n-cell corridor along x whose every brick is occupied (voxel (x, 7, 7) each
+    8 cells) and a voxel at its far end: a ray along y = z = 0.5 visits all n cells."""
+    voxels = np.array([(x, 7, 7) for x in range(0, n, 8)] + [(n - 1, 0, 0)])
+    occupancy = Occupancy.build(voxels, shape=(n, 8, 8))
+    return occupancy, np.array([[0.5, 0.5, 0.5]]), np.array([[1.0, 0.0, 0.0]])
+
+
+def test_exact_ray_through_40000_cells_of_occupied_bricks(gpu, numba_backend):
+    occupancy, o, d = brick_corridor(40_000)
+    reference = numba_backend.trace_cells(occupancy, o, d)
+    assert reference.index.tolist() == [[39_999, 0, 0]]
+    assert_same(gpu.trace_cells(occupancy, o, d, precision="f64"), reference)
+
+
+def test_a_loop_ended_by_the_adapter_is_reported_not_taken_for_a_miss(gpu, numba_backend,
+                                                                      long_march_case, monkeypatch):
+    """On lavapipe, 70,000 voxel steps (exact) or 131,072 samples in one pass (march)
+    exceed the loop guard: the backend says so. Elsewhere the answers are numba's."""
+    occupancy, o, d = brick_corridor(70_000)
+    march_occupancy, mo, md = long_march_case
+    monkeypatch.setattr(wgpu_backend, "MARCH_SAMPLES_PER_PASS", 1 << 17)
+    calls = [(occupancy, o, d, {}), (march_occupancy, mo[:4], md[:4], {"method": "march", "step": 0.25})]
+    for scene, origins, directions, options in calls:
+        if on_lavapipe(gpu):
+            with pytest.raises(BackendUnavailable, match="could not finish .* rays.*ended their loops early.*use backend 'numba'"):
+                gpu.trace_cells(scene, origins, directions, precision="f64", **options)
+        else:
+            assert_same(gpu.trace_cells(scene, origins, directions, precision="f64", **options),
+                        numba_backend.trace_cells(scene, origins, directions, **options))
+
+
+def test_march_in_many_short_passes_equals_one_pass(gpu, numba_backend, monkeypatch):
+    """Passes of 5 samples: rays resume where the last pass stopped, none skipped or repeated."""
+    shape = (40, 30, 20)
+    occupancy = random_scene(11, shape, 2000)
+    o, d = random_rays(12, shape, 1000)
+    monkeypatch.setattr(wgpu_backend, "MARCH_SAMPLES_PER_PASS", 5)
+    reference = numba_backend.trace_cells(occupancy, o, d, method="march", step=0.5)
+    assert (reference.kind == 1).sum() > 100
+    assert_same(gpu.trace_cells(occupancy, o, d, method="march", step=0.5, precision="f64"), reference)
+
+
+def test_the_driver_prints_nothing_on_stderr_without_a_runtime_dir():
+    # Mesa complains about a missing XDG_RUNTIME_DIR on stderr, which would
+    # scribble over the terminal UI; the backend gives it a private folder.
+    import os
+    import subprocess
+    import sys
+
+    env = {k: v for k, v in os.environ.items() if k != "XDG_RUNTIME_DIR"}
+    code = (
+        "from ladartui.tracing.backend import get_backend\n"
+        "from ladartui.errors import BackendUnavailable\n"
+        "try:\n    get_backend('wgpu')\nexcept BackendUnavailable:\n    pass\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    assert "XDG_RUNTIME_DIR" not in out.stderr

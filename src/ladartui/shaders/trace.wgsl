@@ -12,6 +12,14 @@
 // one logical u32 array [root | regions | tiles | bricks | columns] that may
 // be split over several storage bindings. INF stands for +inf: WGSL has no
 // infinity literal, and no ray parameter comes near 1e30.
+//
+// Loop budget: lavapipe (llvmpipe) ends every loop of an invocation once all its
+// loops together have run 65,535 iterations, a guard against endless shaders,
+// and the code after the loop then runs as if the loop had ended normally. So
+// the march samples at most `extra.z` (well under that) per dispatch and says
+// UNFINISHED; the host dispatches the rest from sample `extra.y` on. A loop that
+// ends early all the same (here or in the exact traversal) says CUT, and the
+// host reports it instead of taking it for a miss.
 
 struct Params {
     shape: vec4<i32>,        // nx, ny, nz
@@ -21,7 +29,7 @@ struct Params {
     root_dims: vec4<i32>,
     bases: vec4<u32>,        // first word of root, regions, tiles, bricks in occ()
     run: vec4<i32>,          // ray count, method (0 exact, 1 march), zmax, root cells
-    extra: vec4<u32>,        // first word of columns in occ(), unused x3
+    extra: vec4<u32>,        // first word of columns in occ(), march: first sample, samples per pass, unused
     reals: vec2<real>,       // march step (voxels), unused
 }
 
@@ -33,6 +41,8 @@ struct Params {
 const MISS: i32 = 0;
 const VOXEL: i32 = 1;
 const GROUND: i32 = 2;
+const UNFINISHED: i32 = 3;  // march: no answer within this pass's samples
+const CUT: i32 = 4;         // a loop was ended by the adapter, not by the ray
 const INF: real = 1e30;
 
 struct Hit {
@@ -50,6 +60,10 @@ struct Span {
 
 fn miss() -> Hit {
     return Hit(MISS, -1, -1, -1, INF);
+}
+
+fn cut() -> Hit {
+    return Hit(CUT, -1, -1, -1, INF);
 }
 
 // The one formula for boundary parameters (numba: _boundary_t).
@@ -337,6 +351,9 @@ fn first_voxel(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hi
         cz = enter(cz, kz.b, kz.t == tn, pz, s, oz, dz, iz, tn);
         t = tn;
     }
+    if (steps < cap) {
+        return cut();  // the loop condition still held: the adapter ended the loop
+    }
     return none;
 }
 
@@ -408,7 +425,11 @@ fn march_one(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hit 
     }
     // From the start sample on, every sample is inside the extent's box or ends the ray.
     let limit = i32((sqrt(nx * nx + ny * ny + top * top) + 2.0) / step) + 2;
-    for (var k = 0; k < limit; k++) {
+    // This pass's samples: [first, last).
+    let first = i32(params.extra.y);
+    let last = min(limit, first + i32(params.extra.z));
+    var k = first;
+    for (; k < last; k++) {
         let t = t_s + real(k) * step;
         let cx = ox + t * dx;
         let cy = oy + t * dy;
@@ -427,6 +448,12 @@ fn march_one(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hit 
         if (occupied(i32(gx), i32(gy), i32(floor(cz)), &cache)) {
             return Hit(VOXEL, i32(gx), i32(gy), i32(floor(cz)), t);
         }
+    }
+    if (k < last) {
+        return cut();
+    }
+    if (last < limit) {
+        return Hit(UNFINISHED, -1, -1, -1, INF);
     }
     return miss();
 }
@@ -450,7 +477,7 @@ fn trace_rays(@builtin(workgroup_id) group: vec3<u32>,
     var hit: Hit;
     if (params.run.y == 0) {
         hit = first_voxel(ox, oy, oz, dx, dy, dz);
-        if (hit.kind == MISS) {
+        if (hit.kind == MISS) {  // not CUT: that ray's voxels were not all seen
             hit = ground(ox, oy, oz, dx, dy, dz);
         }
     } else {

@@ -14,6 +14,12 @@ Resources:
   uploaded once per ``Occupancy`` object and reused for every call.
 * Rays go in batches that fit one binding; each batch is one dispatch over a
   2-D grid of workgroups kept within the per-dimension limit.
+* The march goes in passes of at most ``MARCH_SAMPLES_PER_PASS`` samples a ray:
+  lavapipe ends all loops of a shader invocation after 65,535 iterations in
+  total, so a longer march would stop early. Rays without an answer after a
+  pass are dispatched again from the next sample on. A loop ended early all the
+  same (e.g. an exact ray needing more steps than that) raises
+  ``BackendUnavailable`` rather than passing for a miss.
 
 Precision: ``f64`` needs the adapter's ``shader-f64`` feature (lavapipe has
 it). Without it the backend runs ``f32`` and says so in ``CellHits.info``.
@@ -28,13 +34,16 @@ module is cheap and never fails.
 from __future__ import annotations
 
 import importlib.resources
+import os
+import stat
+import tempfile
 import threading
 import weakref
 
 import numpy as np
 
 from ladartui.errors import BackendUnavailable, Cancelled, FieldError
-from ladartui.tracing.backend import METHODS, MISS, CellHits, register_backend
+from ladartui.tracing.backend import GROUND, METHODS, MISS, VOXEL, CellHits, register_backend
 
 NAME = "wgpu"
 
@@ -53,6 +62,13 @@ GRAPHICS_BACKEND_RANK = {"Vulkan": 0, "Metal": 0, "D3D12": 0, "OpenGL": 1}
 FIXED_BINDINGS = 4
 # Ask for no more than this many occupancy bindings (16 GiB at 128 MiB each).
 MAX_OCCUPANCY_BINDINGS = 128
+# Shader-only hit kinds (trace.wgsl): a march pass ended without an answer, and
+# a loop ended by the adapter's iteration guard rather than by the ray.
+UNFINISHED = 3
+CUT = 4
+# Samples a ray per march pass: well under lavapipe's 65,535 loop iterations
+# per invocation, all loops together.
+MARCH_SAMPLES_PER_PASS = 1 << 15
 
 
 def choose_adapter(adapters):
@@ -155,6 +171,27 @@ class _Upload:
         self.bind_groups = {}
 
 
+def _give_driver_a_runtime_dir() -> None:
+    """Set a private XDG_RUNTIME_DIR when there is no usable one.
+
+    On headless machines Mesa's window-system probing prints "XDG_RUNTIME_DIR is
+    invalid" straight to the process's stderr, which scribbles over the terminal
+    UI. We never open a window, so any private folder satisfies it.
+    """
+    current = os.environ.get("XDG_RUNTIME_DIR")
+    if current and os.path.isdir(current) and os.access(current, os.W_OK | os.X_OK):
+        return
+    folder = os.path.join(tempfile.gettempdir(), f"ladartui-runtime-{os.getuid()}")
+    try:
+        os.makedirs(folder, mode=0o700, exist_ok=True)
+        info = os.lstat(folder)
+        if info.st_uid != os.getuid() or not stat.S_ISDIR(info.st_mode):
+            folder = tempfile.mkdtemp(prefix="ladartui-runtime-")
+    except OSError:
+        folder = tempfile.mkdtemp(prefix="ladartui-runtime-")
+    os.environ["XDG_RUNTIME_DIR"] = folder
+
+
 class WgpuBackend:
     """Tracer running the WGSL kernel through wgpu (see module docstring)."""
 
@@ -192,6 +229,7 @@ class WgpuBackend:
             return self._reason
 
     def _find_adapter(self) -> str | None:
+        _give_driver_a_runtime_dir()
         try:
             import wgpu
         except ImportError:
@@ -435,45 +473,60 @@ class WgpuBackend:
             offsets = f32_start_offsets(origins, directions, occupancy.shape, top, method)
         else:
             offsets = None
-        device = self._device
         capacity = buffers["capacity"]
-        max_groups = self._limits["max-compute-workgroups-per-dimension"]
-        for start in range(0, n, capacity):
-            if cancel is not None and cancel.is_set():
-                raise Cancelled("trace cancelled")
-            stop = min(start + capacity, n)
-            count = stop - start
-            rays = np.empty((count, 6), dtype=real)
-            if offsets is None:
-                rays[:, :3] = origins[start:stop]
-            else:
-                rays[:, :3] = floor_preserving_f32(
-                    origins[start:stop] + offsets[start:stop, None] * directions[start:stop])
-            rays[:, 3:] = directions[start:stop]
-            device.queue.write_buffer(buffers["params"], 0,
-                                      pack_params(occupancy, upload, method, step, count, precision))
-            device.queue.write_buffer(buffers["rays"], 0, rays)
-            groups = dispatch_grid(-(-count // WORKGROUP_SIZE), max_groups)
-            encoder = device.create_command_encoder()
-            compute = encoder.begin_compute_pass()
-            compute.set_pipeline(pipeline)
-            compute.set_bind_group(0, bind_group)
-            compute.dispatch_workgroups(groups[0], groups[1], 1)
-            compute.end()
-            device.queue.submit([encoder.finish()])
-            cells = np.frombuffer(device.queue.read_buffer(buffers["cells"], 0, count * 16),
-                                  dtype=np.int32).reshape(count, 4)
-            ranges = np.frombuffer(device.queue.read_buffer(buffers["ranges"], 0, count * rays.itemsize),
-                                   dtype=real)
-            kind[start:stop] = cells[:, 0]
-            index[start:stop] = cells[:, 1:]
-            hit = cells[:, 0] != MISS
-            batch_t = ranges.astype(np.float64)
-            if offsets is not None:
-                batch_t = batch_t + offsets[start:stop]
-            t[start:stop] = np.where(hit, batch_t, np.inf)
+        pending = np.arange(n)
+        first_sample = 0
+        while True:
+            for start in range(0, len(pending), capacity):
+                if cancel is not None and cancel.is_set():
+                    raise Cancelled("trace cancelled")
+                rows = pending[start:start + capacity]
+                rays = np.empty((len(rows), 6), dtype=real)
+                if offsets is None:
+                    rays[:, :3] = origins[rows]
+                else:
+                    rays[:, :3] = floor_preserving_f32(origins[rows] + offsets[rows, None] * directions[rows])
+                rays[:, 3:] = directions[rows]
+                params = pack_params(occupancy, upload, method, step, len(rows), precision,
+                                     first_sample, MARCH_SAMPLES_PER_PASS)
+                cells, ranges = self._dispatch(pipeline, bind_group, buffers, params, rays)
+                kind[rows] = cells[:, 0]
+                index[rows] = cells[:, 1:]
+                batch_t = ranges.astype(np.float64)
+                if offsets is not None:
+                    batch_t = batch_t + offsets[rows]
+                t[rows] = np.where((cells[:, 0] == VOXEL) | (cells[:, 0] == GROUND), batch_t, np.inf)
+            if np.any(kind[pending] == CUT):
+                raise BackendUnavailable(
+                    f"backend {NAME!r} could not finish {int(np.sum(kind == CUT))} rays on "
+                    f"{info['adapter']!r}: the adapter ended their loops early (lavapipe stops "
+                    f"after 65,535 iterations); use backend 'numba'")
+            pending = pending[kind[pending] == UNFINISHED]
+            if len(pending) == 0:
+                break
+            first_sample += MARCH_SAMPLES_PER_PASS
         index[kind == MISS] = -1
         return CellHits(kind, index, t, info)
+
+    def _dispatch(self, pipeline, bind_group, buffers, params, rays):
+        """One dispatch over ``rays`` (count, 6): their hit cells (count, 4) and ranges."""
+        device = self._device
+        count = len(rays)
+        device.queue.write_buffer(buffers["params"], 0, params)
+        device.queue.write_buffer(buffers["rays"], 0, rays)
+        groups = dispatch_grid(-(-count // WORKGROUP_SIZE), self._limits["max-compute-workgroups-per-dimension"])
+        encoder = device.create_command_encoder()
+        compute = encoder.begin_compute_pass()
+        compute.set_pipeline(pipeline)
+        compute.set_bind_group(0, bind_group)
+        compute.dispatch_workgroups(groups[0], groups[1], 1)
+        compute.end()
+        device.queue.submit([encoder.finish()])
+        cells = np.frombuffer(device.queue.read_buffer(buffers["cells"], 0, count * 16),
+                              dtype=np.int32).reshape(count, 4)
+        ranges = np.frombuffer(device.queue.read_buffer(buffers["ranges"], 0, count * rays.itemsize),
+                               dtype=rays.dtype)
+        return cells, ranges
 
     def _bind_group(self, upload, pipeline, buffers, precision):
         key = (precision, id(pipeline), id(buffers["rays"]))
@@ -508,8 +561,13 @@ def occupancy_arrays(occupancy):
 PARAMS_BYTES = 8 * 16 + 16
 
 
-def pack_params(occupancy, upload, method, step, count, precision) -> bytes:
-    """The uniform block for one dispatch, laid out as ``struct Params``."""
+def pack_params(occupancy, upload, method, step, count, precision, first_sample=0,
+                samples_per_pass=MARCH_SAMPLES_PER_PASS) -> bytes:
+    """The uniform block for one dispatch, laid out as ``struct Params``.
+
+    ``first_sample`` and ``samples_per_pass`` bound the march's samples in this
+    dispatch (see MARCH_SAMPLES_PER_PASS).
+    """
     ints = np.zeros((8, 4), dtype=np.int32)
     ints[0, :3] = occupancy.shape
     ints[1, :3] = occupancy.bbox_lo
@@ -519,6 +577,7 @@ def pack_params(occupancy, upload, method, step, count, precision) -> bytes:
     ints[5, :] = np.array(upload.bases[:4], dtype=np.int64).astype(np.uint32).view(np.int32)
     ints[6, :] = (count, METHOD_CODES[method], int(occupancy.zmax), len(occupancy.root))
     ints[7, 0] = np.array(upload.bases[4], dtype=np.int64).astype(np.uint32).view(np.int32)
+    ints[7, 1:3] = (first_sample, samples_per_pass)
     reals = np.array([step, 0], dtype=np.float64 if precision == "f64" else np.float32)
     return ints.tobytes() + reals.tobytes()
 
