@@ -1,13 +1,18 @@
 """Occupancy: the sparse bitmask hierarchy that every tracer reads.
 
 The layout is a contract shared with the WGSL shader (see docs/architecture.md,
-"Occupancy layout"): all arrays are uint32, nodes have fan-out 8 per axis.
+"Occupancy layout"): the shared arrays are uint32, nodes have fan-out 8 per axis;
+blocks and cubes are optional accelerations a tracer may ignore.
 
     root    dense grid of 512-voxel cells over the occupied box: region number (index + 1), 0 = empty
     regions 512 slots per region (64-voxel cells): tile number, 0 = empty
     tiles   512 slots per tile (8-voxel cells): brick number, 0 = empty
     bricks  16 words per brick: one bit per voxel
     columns per 8 x 8 column of bricks: 1 + highest non-empty brick z (relative to the root grid)
+    blocks  (uint64, optional acceleration) per brick: bit b of its 64 2x2x2 blocks is set
+            when block b holds a voxel, b = bx + 4 * by + 16 * bz with (bx, by, bz) = l >> 1
+    cubes   (uint8, optional acceleration) per downward ray octant and brick cell of the occupied
+            box: the side (bricks) of the largest empty cube with that corner reaching into the octant
 
 Inside any node the local position (lx, ly, lz), each 0..7, is linear
 ``l = lx + 8 * ly + 64 * lz``; a brick's bit ``l`` is bit ``l & 31`` of word ``l >> 5``.
@@ -19,6 +24,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from ladartui.errors import FieldError
 
@@ -26,6 +32,7 @@ BRICK_WORDS = 16
 NODE_SLOTS = 512
 # log2 of the cell size (voxels) at each level: brick voxel, tile slot, region slot, root cell.
 VOXEL_SHIFT, BRICK_SHIFT, TILE_SHIFT, REGION_SHIFT = 0, 3, 6, 9
+CUBE_CAP = 255  # largest stored empty-cube side (uint8)
 
 
 @dataclass(frozen=True, eq=False)
@@ -47,6 +54,10 @@ class Occupancy:
     bricks: np.ndarray
     count: int
     columns: np.ndarray = None
+    blocks: np.ndarray = None
+    cubes: np.ndarray = None
+    cube_origin: np.ndarray = None
+    cube_dims: np.ndarray = None
 
     @classmethod
     def build(cls, voxels, shape=None) -> "Occupancy":
@@ -83,21 +94,17 @@ class Occupancy:
         zero = np.zeros(3, np.int64)
         empty = np.zeros(0, np.uint32)
         return cls(shape, zero.copy(), zero.copy(), zero.copy(), zero.copy(),
-                   empty, empty.copy(), empty.copy(), empty.copy(), 0, empty.copy())
+                   empty, empty.copy(), empty.copy(), empty.copy(), 0, empty.copy(),
+                   np.zeros(0, np.uint64), np.zeros(0, np.uint8), zero.copy(), zero.copy())
 
     @classmethod
     def _from_nonempty(cls, vox, lo, hi, shape):
         root_origin = (lo >> REGION_SHIFT) << REGION_SHIFT
         root_dims = ((hi - 1) >> REGION_SHIFT) - (lo >> REGION_SHIFT) + 1
-        rel = vox - root_origin
         # One sort key ordering voxels root cell first, then region slot, tile slot,
         # voxel bit: bricks of a tile and tiles of a region end up adjacent in memory.
-        r = rel >> REGION_SHIFT
-        root_lin = r[:, 0] + root_dims[0] * (r[:, 1] + root_dims[1] * r[:, 2])
-        key = root_lin << 27
-        key |= _local(rel, TILE_SHIFT) << 18
-        key |= _local(rel, BRICK_SHIFT) << 9
-        key |= _local(rel, VOXEL_SHIFT)
+        key = np.empty(len(vox), np.int64)
+        _voxel_keys(vox, root_origin.astype(np.int64), root_dims.astype(np.int64), key)
         key.sort()
         key = key[_starts(key)]  # drop duplicate voxels
         count = len(key)
@@ -119,14 +126,21 @@ class Occupancy:
         root = np.zeros(int(np.prod(root_dims)), np.uint32)
         root[rkeys] = np.arange(1, len(rkeys) + 1, dtype=np.uint32)
         columns = _column_tops(bkeys, root_dims)
+        brick_cells = _brick_cells(bkeys, root_dims) + (root_origin >> BRICK_SHIFT)
+        cube_origin = lo >> BRICK_SHIFT
+        cube_dims = ((hi - 1) >> BRICK_SHIFT) - cube_origin + 1
+        cubes = _empty_cubes(brick_cells - cube_origin, cube_dims)
         return cls(shape, lo.astype(np.int64), hi.astype(np.int64), root_origin.astype(np.int64),
-                   root_dims.astype(np.int64), root, regions, tiles, bricks, count, columns)
+                   root_dims.astype(np.int64), root, regions, tiles, bricks, count, columns,
+                   block_masks(bricks), cubes, cube_origin.astype(np.int64),
+                   cube_dims.astype(np.int64))
 
     @property
     def nbytes(self) -> int:
         """Bytes held by the hierarchy arrays."""
+        extra = sum(a.nbytes for a in (self.blocks, self.cubes) if a is not None)
         return int(self.root.nbytes + self.regions.nbytes + self.tiles.nbytes + self.bricks.nbytes
-                   + self.columns.nbytes)
+                   + self.columns.nbytes + extra)
 
     @property
     def zmax(self) -> int:
@@ -178,6 +192,19 @@ class Occupancy:
                 "nbytes": self.nbytes}
 
 
+@njit(nogil=True, cache=True)
+def _voxel_keys(vox, root_origin, root_dims, key):
+    # root cell << 27 | region slot << 18 | tile slot << 9 | brick bit, in one pass.
+    for i in range(vox.shape[0]):
+        x = vox[i, 0] - root_origin[0]
+        y = vox[i, 1] - root_origin[1]
+        z = vox[i, 2] - root_origin[2]
+        k = (x >> 9) + root_dims[0] * ((y >> 9) + root_dims[1] * (z >> 9))
+        for shift in (6, 3, 0):
+            k = (k << 9) | ((x >> shift) & 7) | (((y >> shift) & 7) << 3) | (((z >> shift) & 7) << 6)
+        key[i] = k
+
+
 def _local(rel, shift):
     """Linear slot ``lx + 8 ly + 64 lz`` of each cell inside its parent node at level ``shift``."""
     c = (rel >> shift) & 7
@@ -193,11 +220,8 @@ def _starts(sorted_keys):
     return start
 
 
-def _column_tops(brick_keys, root_dims):
-    """Per 8 x 8 brick column over the root grid: 1 + its highest non-empty brick's z, 0 if none.
-
-    Indexed ``qx + 64 * root_dims.x * qy`` with ``q = (c - root_origin) >> 3``.
-    """
+def _brick_cells(brick_keys, root_dims):
+    """(N, 3) brick coordinates ``(c - root_origin) >> 3`` of each brick key."""
     root_lin = brick_keys >> 18
     rx = root_lin % root_dims[0]
     ry = (root_lin // root_dims[0]) % root_dims[1]
@@ -207,6 +231,82 @@ def _column_tops(brick_keys, root_dims):
     qx = rx * 64 + (tile_slot & 7) * 8 + (brick_slot & 7)
     qy = ry * 64 + ((tile_slot >> 3) & 7) * 8 + ((brick_slot >> 3) & 7)
     qz = rz * 64 + (tile_slot >> 6) * 8 + (brick_slot >> 6)
+    return np.column_stack([qx, qy, qz])
+
+
+def block_masks(bricks):
+    """Per brick a uint64 with bit ``bx + 4 by + 16 bz`` set when its 2x2x2 block holds a voxel."""
+    words = bricks.reshape(-1, BRICK_WORDS)
+    masks = np.zeros(len(words), np.uint64)
+    for bz in range(4):
+        for half in range(2):  # word 2 lz + half holds rows ly = 4 half .. 4 half + 3
+            pair = words[:, 4 * bz + half] | words[:, 4 * bz + 2 + half]  # lz = 2 bz, 2 bz + 1
+            pair = pair | (pair >> 8)  # row pairs (ly & 3 = 0, 1) and (2, 3) on rows 0 and 2
+            pair = pair | (pair >> 1)  # column pairs on even bits
+            for row in range(2):
+                by = 2 * half + row
+                for bx in range(4):
+                    bit = (pair >> np.uint32(16 * row + 2 * bx)) & np.uint32(1)
+                    masks |= bit.astype(np.uint64) << np.uint64(bx + 4 * by + 16 * bz)
+    return masks
+
+
+def _empty_cubes(cells, dims):
+    """Per downward octant and brick cell of a ``dims`` box, the side of the largest cube of
+    empty bricks having that cell as the corner facing away from the octant, capped at CUBE_CAP.
+
+    uint8, octant ``o = (d_x <= 0) + 2 (d_y <= 0)`` for rays with ``d_z <= 0`` (sensor rays
+    look down; climbing rays get no jumps, which halves the memory), indexed
+    ``4 * (x + dims.x * (y + dims.y * z)) + o`` (the octants of a cell share a cache line);
+    0 at non-empty bricks. A ray of octant ``o`` in a brick of value ``k`` crosses only
+    empty bricks until it leaves the ``k``-brick cube starting at that brick and reaching
+    along its direction.
+    """
+    dx, dy, dz = (int(v) for v in dims)
+    full = np.zeros((dz, dy, dx), np.uint8)
+    full[cells[:, 2], cells[:, 1], cells[:, 0]] = 1
+    out = np.zeros((dz, dy, dx, 4), np.uint8)
+    _fill_empty_cubes(full, CUBE_CAP, out)
+    return out.reshape(-1)
+
+
+@njit(nogil=True, cache=True)
+def _fill_empty_cubes(full, cap, out):
+    # side(q) = 1 + min(side of the 7 neighbours q + s * delta), the 3-D largest-square rule;
+    # outside the box every brick is empty (side cap).
+    nz, ny, nx = full.shape
+    for o in range(4):
+        sx = -1 if o & 1 else 1
+        sy = -1 if o & 2 else 1
+        sz = -1
+        for kz in range(nz):
+            z = nz - 1 - kz if sz > 0 else kz
+            for ky in range(ny):
+                y = ny - 1 - ky if sy > 0 else ky
+                for kx in range(nx):
+                    x = nx - 1 - kx if sx > 0 else kx
+                    if full[z, y, x]:
+                        out[z, y, x, o] = 0
+                        continue
+                    m = cap
+                    for delta in range(1, 8):
+                        x2 = x + sx * (delta & 1)
+                        y2 = y + sy * ((delta >> 1) & 1)
+                        z2 = z + sz * (delta >> 2)
+                        if 0 <= x2 < nx and 0 <= y2 < ny and 0 <= z2 < nz:
+                            v = out[z2, y2, x2, o]
+                            if v < m:
+                                m = v
+                    out[z, y, x, o] = min(cap, m + 1)
+
+
+def _column_tops(brick_keys, root_dims):
+    """Per 8 x 8 brick column over the root grid: 1 + its highest non-empty brick's z, 0 if none.
+
+    Indexed ``qx + 64 * root_dims.x * qy`` with ``q = (c - root_origin) >> 3``.
+    """
+    q = _brick_cells(brick_keys, root_dims)
+    qx, qy, qz = q[:, 0], q[:, 1], q[:, 2]
     tops = np.zeros(int(root_dims[0] * 64 * root_dims[1] * 64), np.uint32)
     np.maximum.at(tops, qx + root_dims[0] * 64 * qy, (qz + 1).astype(np.uint32))
     return tops

@@ -17,6 +17,7 @@ import numpy as np
 from numba import njit, prange
 
 from ladartui.errors import Cancelled
+from ladartui.scene.occupancy import block_masks
 from ladartui.tracing.backend import GROUND, MISS, VOXEL, CellHits, register_backend
 
 CHUNK = 64  # rays per prange work item: coherent neighbours stay on one thread
@@ -121,16 +122,18 @@ def _ground(ox, oy, oz, dx, dy, dz, nx, ny):
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def _exact_kernel(orig, dirs, root, regions, tiles, bricks, columns, lo, hi, rorg, rdims, nx, ny,
-                  kind, index, tout):
+def _exact_kernel(orig, dirs, root, regions, tiles, bricks, blocks, columns, cubes, corg, cdims,
+                  lo, hi, rorg, rdims, nx, ny, kind, index, tout):
     """The exact traversal of docs/architecture.md for every ray, chunks under prange.
 
     The per-ray code is written out here rather than called: passing the
     arrays to a per-ray function costs reference counting on every ray.
-    Empty root cells and regions are skipped as nodes; inside a tile a DDA
-    over 8-voxel bricks skips empty bricks (and, for descending rays, whole
-    empty brick columns); inside a brick a voxel DDA skips empty 4- and
-    2-voxel blocks and tests bits. Every cell boundary parameter comes from
+    Empty root cells and regions are skipped as nodes; a DDA over 8-voxel
+    bricks skips empty bricks (and, for descending rays, whole empty brick
+    columns), jumps across the empty cube of bricks ahead of the ray
+    (``Occupancy.cubes``) and walks on past tile faces while bricks are known
+    empty; inside a brick a voxel DDA skips empty 4- and 2-voxel blocks (one
+    mask word per brick) and tests bits. Every cell boundary parameter comes from
     the one formula ``(b - o) * inv``, so the cells visited are those of a
     plain voxel DDA.
     """
@@ -184,6 +187,12 @@ def _exact_kernel(orig, dirs, root, regions, tiles, bricks, columns, lo, hi, ror
                 # Brick columns (see Occupancy.columns), relative to the root grid.
                 qx0, qy0, qz0 = rx0 >> 3, ry0 >> 3, rz0 >> 3
                 qnx = rdx * 64
+                # Empty-cube sides (see Occupancy.cubes) for this ray's octant.
+                dox, doy, doz = corg[0], corg[1], corg[2]
+                ddx, ddy, ddz = cdims[0], cdims[1], cdims[2]
+                octant = (0 if px else 1) | (0 if py else 2)
+                if pz:  # cubes are kept for rays that do not climb only
+                    ddx = 0
                 descending = dz < 0.0
                 cap = 4 * (hi[0] - lo[0] + hi[1] - lo[1] + hi[2] - lo[2]) + 64
                 steps = 0
@@ -205,7 +214,18 @@ def _exact_kernel(orig, dirs, root, regions, tiles, bricks, columns, lo, hi, ror
                             fresh = True  # (cx, cy, cz) is the cell at t
                             stx, sty, stz = False, False, False  # axes stepped by the last brick step
                             while steps < cap:
-                                br = tiles[tile + ((bx & 7) | ((by & 7) << 3) | ((bz & 7) << 6))]
+                                # The empty cubes tell empty bricks without the tile; only a
+                                # brick it cannot vouch for needs the tile, so only then does
+                                # leaving the tile end this walk.
+                                ux, uy, uz = bx - dox, by - doy, bz - doz
+                                far = -1
+                                if 0 <= ux < ddx and 0 <= uy < ddy and 0 <= uz < ddz:
+                                    far = np.int64(cubes[((ux + ddx * (uy + ddy * uz)) << 2) | octant])
+                                br = 0
+                                if far <= 0:
+                                    if (bx >> 3) != gx or (by >> 3) != gy or (bz >> 3) != gz:
+                                        break
+                                    br = tiles[tile + ((bx & 7) | ((by & 7) << 3) | ((bz & 7) << 6))]
                                 if br != 0:
                                     if not fresh:
                                         cx = _brick_entry(bx, stx, px, ox, dx, ix, t)
@@ -215,28 +235,26 @@ def _exact_kernel(orig, dirs, root, regions, tiles, bricks, columns, lo, hi, ror
                                     # blocks; t of each axis's next voxel boundary is recomputed
                                     # from that boundary whenever the axis steps.
                                     base = (np.int64(br) - 1) * 16
+                                    mask = blocks[np.int64(br) - 1]  # its 64 2x2x2 blocks, one load
                                     tx = (cx + fx - ox) * ix
                                     ty = (cy + fy - oy) * iy
                                     tz = (cz + fz - oz) * iz
                                     while True:
                                         lx, ly, lz = cx & 7, cy & 7, cz & 7
-                                        w = base + (ly >> 2)
-                                        z4 = w + ((lz & 4) << 1)
-                                        quad = bricks[z4] | bricks[z4 + 2] | bricks[z4 + 4] | bricks[z4 + 6]
-                                        if quad & (0x0F0F0F0F << (lx & 4)) == 0:
+                                        at4 = ((lx >> 2) << 1) | ((ly >> 2) << 3) | ((lz >> 2) << 5)
+                                        if (mask >> np.uint64(at4)) & np.uint64(0x330033) == 0:
                                             tn = min(_block_t(cx, 2, px, ox, ix, mx),
                                                      min(_block_t(cy, 2, py, oy, iy, my),
                                                          _block_t(cz, 2, pz, oz, iz, mz)))
                                         else:
-                                            z2 = w + ((lz & 6) << 1)
-                                            pair = bricks[z2] | bricks[z2 + 2]
-                                            if pair & (0x303 << ((lx & 6) | ((ly & 2) << 3))) == 0:
+                                            at2 = (lx >> 1) | ((ly >> 1) << 2) | ((lz >> 1) << 4)
+                                            if (mask >> np.uint64(at2)) & np.uint64(1) == 0:
                                                 tn = min(_block_t(cx, 1, px, ox, ix, mx),
                                                          min(_block_t(cy, 1, py, oy, iy, my),
                                                              _block_t(cz, 1, pz, oz, iz, mz)))
                                             else:
                                                 bit = lx | ((ly & 3) << 3)
-                                                if (bricks[w + (lz << 1)] >> bit) & 1:
+                                                if (bricks[base + (ly >> 2) + (lz << 1)] >> bit) & 1:
                                                     found = True
                                                     done = True
                                                     break
@@ -264,34 +282,47 @@ def _exact_kernel(orig, dirs, root, regions, tiles, bricks, columns, lo, hi, ror
                                     bx, by, bz = cx >> 3, cy >> 3, cz >> 3
                                     fresh = True
                                 else:
-                                    # Skip the empty brick, or for a descending ray above the
-                                    # highest brick of its brick column, that whole column part.
-                                    tbx = (np.float64((bx + 1) << 3 if px else bx << 3) - ox) * ix if mx else INF
-                                    tby = (np.float64((by + 1) << 3 if py else by << 3) - oy) * iy if my else INF
+                                    # Skip empty bricks: the cube of ``far`` empty bricks ahead
+                                    # (Occupancy.cubes; one brick without it), or for a
+                                    # descending ray above the highest brick of its brick column
+                                    # that whole column part, whichever reaches further.
+                                    k = far if far >= 2 else 1
+                                    near = k - 1
+                                    tbx = (np.float64((bx + k) << 3 if px else (bx - near) << 3) - ox) * ix if mx else INF
+                                    tby = (np.float64((by + k) << 3 if py else (by - near) << 3) - oy) * iy if my else INF
+                                    tbz = (np.float64((bz + k) << 3 if pz else (bz - near) << 3) - oz) * iz if mz else INF
+                                    tn = min(tbx, min(tby, tbz))
                                     top = columns[(bx - qx0) + qnx * (by - qy0)] + qz0 if descending else bz + 1
                                     above = bz >= top
                                     if above:
-                                        tbz = (np.float64(top << 3) - oz) * iz
-                                    else:
-                                        tbz = (np.float64((bz + 1) << 3 if pz else bz << 3) - oz) * iz if mz else INF
-                                    tn = min(tbx, min(tby, tbz))
+                                        tcx = (np.float64((bx + 1) << 3 if px else bx << 3) - ox) * ix if mx else INF
+                                        tcy = (np.float64((by + 1) << 3 if py else by << 3) - oy) * iy if my else INF
+                                        tcz = (np.float64(top << 3) - oz) * iz
+                                        tc = min(tcx, min(tcy, tcz))
+                                        above = tc > tn or k == 1
+                                        if above:
+                                            k, near = 1, 0
+                                            tbx, tby, tbz, tn = tcx, tcy, tcz, tc
                                     if tn >= t1:
                                         done = True
                                         break
                                     steps += 1
                                     stx, sty, stz = tbx == tn, tby == tn, tbz == tn
                                     if stx:
-                                        bx += sx
+                                        bx += sx * k
+                                    elif near > 0:
+                                        bx = _clamp(_cell_at(ox, dx, ix, tn) >> 3, bx - (0 if px else near), bx + (near if px else 0))
                                     if sty:
-                                        by += sy
+                                        by += sy * k
+                                    elif near > 0:
+                                        by = _clamp(_cell_at(oy, dy, iy, tn) >> 3, by - (0 if py else near), by + (near if py else 0))
                                     if stz:
-                                        bz = top - 1 if above else bz + sz
-                                    elif above:
-                                        bz = _clamp(_cell_at(oz, dz, iz, tn) >> 3, top, bz)
+                                        bz = top - 1 if above else bz + sz * k
+                                    elif above or near > 0:
+                                        zlo, zhi = (top, bz) if above else (bz - (0 if pz else near), bz + (near if pz else 0))
+                                        bz = _clamp(_cell_at(oz, dz, iz, tn) >> 3, zlo, zhi)
                                     t = tn
                                     fresh = False
-                                if (bx >> 3) != gx or (by >> 3) != gy or (bz >> 3) != gz:
-                                    break
                             if done:
                                 break
                             if not fresh:
@@ -408,6 +439,8 @@ class NumbaBackend:
         nx, ny = float(occ.shape[0]), float(occ.shape[1])
         lo, hi = occ.bbox_lo.astype(np.int64), occ.bbox_hi.astype(np.int64)
         rorg, rdims = occ.root_origin.astype(np.int64), occ.root_dims.astype(np.int64)
+        cubes, corg, cdims = _cube_arrays(occ)
+        blocks = occ.blocks if getattr(occ, "blocks", None) is not None else block_masks(occ.bricks)
         started = time.perf_counter()
         for a in range(0, n, BLOCK):
             if cancel is not None and cancel.is_set():
@@ -415,8 +448,8 @@ class NumbaBackend:
             b = min(n, a + BLOCK)
             if method == "exact":
                 _exact_kernel(orig[a:b], dirs[a:b], occ.root, occ.regions, occ.tiles, occ.bricks,
-                              occ.columns, lo, hi, rorg, rdims, nx, ny, kind[a:b], index[a:b],
-                              t[a:b])
+                              blocks, occ.columns, cubes, corg, cdims, lo, hi, rorg, rdims, nx, ny,
+                              kind[a:b], index[a:b], t[a:b])
             else:
                 _march_kernel(orig[a:b], dirs[a:b], float(step), float(occ.zmax), occ.root,
                               occ.regions, occ.tiles, occ.bricks, lo, hi, rorg, rdims, nx, ny,
@@ -424,6 +457,14 @@ class NumbaBackend:
         info = {"seconds": time.perf_counter() - started, "precision": "f64",
                 "threads": numba.get_num_threads()}
         return CellHits(kind, index, t, info)
+
+
+def _cube_arrays(occ):
+    """The optional empty-cube sides; an empty box (no jumps) when the occupancy has none."""
+    cubes = getattr(occ, "cubes", None)
+    if cubes is None or occ.cube_dims is None or len(cubes) == 0:
+        return np.zeros(1, np.uint8), np.zeros(3, np.int64), np.zeros(3, np.int64)
+    return cubes, occ.cube_origin.astype(np.int64), occ.cube_dims.astype(np.int64)
 
 
 def _threading_layer():
