@@ -1,0 +1,327 @@
+"""The UI's one door into the core: scenario edits, checks and file handling.
+
+Every check is the core's own (``Scenario``, ``Sensor``, ``ScanPose`` and the
+flight segments raise ``FieldError``); this module only maps form fields to
+those constructors, so limits are never repeated in the interface.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from pathlib import Path
+
+from ladartui.errors import FieldError, InputFileError, LadarError
+from ladartui.flight import (SEGMENT_KINDS, FlightPlan, Manual, ScanPose, aim_at,
+                             number_field)
+from ladartui.scenario import Scenario, load_scenario, target_file_for
+from ladartui.sensor import Sensor
+
+
+@dataclass(frozen=True)
+class Param:
+    """A numeric parameter shown in a panel: where it lives and how it is typed."""
+
+    key: str  # "sensor.grid", "scenario.speed", "start.x"
+    label: str
+    integer: bool = False
+    scale: float = 1.0  # field units -> stored units
+
+    @property
+    def group(self) -> str:
+        return self.key.split(".", 1)[0]
+
+    @property
+    def name(self) -> str:
+        return self.key.split(".", 1)[1]
+
+
+SENSOR_PARAMS = [
+    Param("sensor.grid", "Sensor grid n", integer=True),
+    Param("sensor.ray_grid", "Ray grid m", integer=True),
+    Param("sensor.fov", "Field of view deg"),
+    Param("sensor.depth_resolution", "Depth res. m"),
+    Param("sensor.pixel_pitch", "Pixel pitch um", scale=1e-6),
+]
+START_PARAMS = [
+    Param("start.x", "Start x m"),
+    Param("start.y", "Start y m"),
+    Param("start.z", "Altitude m"),
+    Param("start.heading", "Heading deg"),
+    Param("start.azimuth", "Sensor az deg"),
+    Param("start.depression", "Depression deg"),
+    Param("scenario.speed", "Speed m/s"),
+]
+RUN_PARAMS = [
+    Param("scenario.voxel_size", "Voxel size m"),
+    Param("scenario.step", "March step vox"),
+]
+ALL_PARAMS = {p.key: p for p in SENSOR_PARAMS + START_PARAMS + RUN_PARAMS}
+
+_POSE_FIELDS = ("x", "y", "z", "heading", "azimuth", "depression")
+
+
+def _dataclass_default(cls, name):
+    for f in dataclasses.fields(cls):
+        if f.name == name and f.default is not dataclasses.MISSING:
+            return f.default
+    return None
+
+
+def start_pose(scenario: Scenario) -> ScanPose:
+    """The plan's start pose, or the first scan when the plan has none."""
+    if scenario.flight.start is not None:
+        return scenario.flight.start
+    poses = scenario.poses()
+    return poses[0] if poses else ScanPose(0.0, 0.0, 100.0)
+
+
+def param_value(scenario: Scenario, key: str):
+    group, name = key.split(".", 1)
+    if group == "sensor":
+        return getattr(scenario.sensor, name)
+    if group == "start":
+        return getattr(start_pose(scenario), name)
+    return getattr(scenario, name)
+
+
+def param_default(key: str, fallback=None):
+    """The parameter's default: the constructor's own default, else ``fallback``."""
+    group, name = key.split(".", 1)
+    cls = {"sensor": Sensor, "start": ScanPose, "scenario": Scenario}[group]
+    value = _dataclass_default(cls, name)
+    return fallback if value is None else value
+
+
+def with_param(scenario: Scenario, key: str, value) -> Scenario:
+    """A new scenario with one parameter changed; FieldError (naming it) if not allowed."""
+    group, name = key.split(".", 1)
+    if group == "sensor":
+        try:
+            sensor = dataclasses.replace(scenario.sensor, **{name: value})
+        except FieldError as error:
+            raise FieldError(f"sensor.{error.field}", error.value, error.expected) from None
+        return scenario.with_changes(sensor=sensor)
+    if group == "start":
+        try:
+            start = dataclasses.replace(start_pose(scenario), **{name: value})
+        except FieldError as error:
+            raise FieldError(f"start.{error.field}", error.value, error.expected) from None
+        return scenario.with_changes(flight=FlightPlan(start, scenario.flight.segments))
+    return scenario.with_changes(**{name: value})
+
+
+def check_param(scenario: Scenario, key: str, value) -> None:
+    with_param(scenario, key, value)
+
+
+# -- flight segments -----------------------------------------------------------------
+
+SEGMENT_LABELS = {"manual": "Manual poses", "straight": "Straight", "turn": "Turn",
+                  "orbit": "Orbit", "flypast": "Fly-past", "standoff": "Standoff"}
+FIELD_LABELS = {
+    "distance": "Distance m", "scans": "Scans", "azimuth": "Sensor az deg",
+    "depression": "Depression deg", "aim_at": "Aim at x,y,z m", "radius": "Radius m",
+    "arc": "Arc deg", "direction": "Direction", "centre": "Centre x,y,z m",
+    "altitude": "Altitude m", "start_bearing": "Start bearing deg", "target": "Target x,y,z m",
+    "standoff": "Standoff m", "length": "Length m", "heading": "Heading deg",
+    "side": "Target side", "standoffs": "Standoffs m", "bearing": "Bearing deg",
+}
+CHOICES = {"direction": ("right", "left"), "side": ("right", "left")}
+POINT_FIELDS = {"centre", "target", "aim_at"}
+
+
+def default_segment(kind: str, target_xyz, current: ScanPose | None):
+    """A sensible new segment of ``kind`` around the target (metres)."""
+    tx, ty, tz = (float(v) for v in target_xyz)
+    altitude = current.z if current is not None else 100.0
+    centre = (round(tx, 2), round(ty, 2), round(tz, 2))
+    if kind == "straight":
+        return SEGMENT_KINDS[kind](distance=100.0, scans=5)
+    if kind == "turn":
+        return SEGMENT_KINDS[kind](radius=100.0, arc=90.0, direction="right", scans=4)
+    if kind == "orbit":
+        return SEGMENT_KINDS[kind](centre=centre, radius=100.0, altitude=altitude, scans=12)
+    if kind == "flypast":
+        return SEGMENT_KINDS[kind](target=centre, standoff=100.0, altitude=altitude,
+                                   length=200.0, scans=5)
+    if kind == "standoff":
+        return SEGMENT_KINDS[kind](target=centre, standoffs=(50.0, 100.0, 150.0),
+                                   altitude=altitude)
+    raise FieldError("kind", kind, "a segment kind")
+
+
+def segment_spec(segment, defaults=None):
+    """Form rows (name, label, kind, value, default) for a segment's fields."""
+    defaults = defaults or segment
+    rows = []
+    for f in dataclasses.fields(segment):
+        name = f.name
+        value = getattr(segment, name)
+        default = getattr(defaults, name)
+        if name in CHOICES:
+            kind = CHOICES[name]
+        elif name in POINT_FIELDS:
+            kind = "point"
+        elif name == "standoffs":
+            kind = "points"
+        elif name == "scans":
+            kind = "int"
+        elif f.default is None:
+            kind = "optional"
+        else:
+            kind = "float"
+        rows.append((name, FIELD_LABELS.get(name, name), kind, value, default))
+    return rows
+
+
+def segment_builder(kind: str):
+    cls = SEGMENT_KINDS[kind]
+
+    def build(values):
+        return cls(**values)
+    return build
+
+
+def segment_summary(segment) -> str:
+    """A short description for the segments table."""
+    k = segment.kind
+    if k == "manual":
+        return f"{len(segment.poses)} poses"
+    if k == "straight":
+        return f"{segment.distance:g} m"
+    if k == "turn":
+        return f"{segment.direction} {segment.arc:g} deg r {segment.radius:g} m"
+    if k == "orbit":
+        return f"r {segment.radius:g} m at {segment.altitude:g} m"
+    if k == "flypast":
+        return f"{segment.length:g} m at {segment.standoff:g} m"
+    if k == "standoff":
+        return ", ".join(f"{s:g}" for s in segment.standoffs) + " m"
+    return ""
+
+
+def with_segments(scenario: Scenario, segments) -> Scenario:
+    """The scenario with a new segment list (checked by the scenario)."""
+    start = scenario.flight.start
+    if start is None and any(s.relative for s in segments):
+        start = start_pose(scenario)
+    return scenario.with_changes(flight=FlightPlan(start, tuple(segments)))
+
+
+def aim_all(scenario: Scenario, target_xyz) -> Scenario:
+    """Every segment aimed at the target point: presets and manoeuvres get ``aim_at``,
+    manual poses are turned to look at it."""
+    target = tuple(float(v) for v in target_xyz)
+    segments = []
+    for segment in scenario.flight.segments:
+        if isinstance(segment, Manual):
+            segments.append(Manual(tuple(aim_at(p, target) for p in segment.poses)))
+        else:
+            segments.append(dataclasses.replace(segment, aim_at=target))
+    return with_segments(scenario, segments)
+
+
+def make_pose(values: dict) -> ScanPose:
+    return ScanPose(**{k: values[k] for k in _POSE_FIELDS})
+
+
+# -- files -----------------------------------------------------------------------------
+
+def derived_names(scenario_path: Path | None, scene_path: Path | None) -> list[tuple[str, str]]:
+    """The names a new scenario derives (report table 2), for the setup dialog."""
+    target = target_file_for(scene_path).name if scene_path else "(from the scene model)"
+    if scenario_path is None:
+        outputs = ("(from the scenario file)",) * 3
+    else:
+        probe = _probe_scenario(scenario_path, scene_path)
+        outputs = (probe.scene_output.name, probe.target_output.name, probe.measures_file.name)
+    return [("3D target model", target), ("Scene simulation output", outputs[0]),
+            ("Target simulation output", outputs[1]), ("Comparison measures", outputs[2])]
+
+
+def _probe_scenario(scenario_path, scene_path, voxel_size=1.0) -> Scenario:
+    # a throw-away scenario: the names and checks come from Scenario itself
+    return Scenario(scenario_path, scene_path or Path("scene.txt"), voxel_size, Sensor(),
+                    FlightPlan(None, (Manual((ScanPose(0.0, 0.0, 1.0),)),)))
+
+
+def check_voxel_size(value) -> None:
+    """FieldError unless ``value`` is an allowed voxel size (the scenario's own check)."""
+    _probe_scenario(Path("probe.toml"), None, value)
+
+
+def new_scenario(scenario_path: Path, scene_path: Path, voxel_size: float = 1.0) -> Scenario:
+    """Create and save a new scenario for a scene model (its target model must exist)."""
+    scenario_path = Path(scenario_path)
+    if scenario_path.suffix != ".toml":
+        scenario_path = scenario_path.with_name(scenario_path.name + ".toml")
+    if scenario_path.exists():
+        raise FieldError("scenario file", str(scenario_path),
+                         "a new file name (this one exists: load it instead)")
+    for path, what in ((scene_path, "scene model"), (target_file_for(scene_path), "target model")):
+        if not Path(path).is_file():
+            raise InputFileError(path, f"{what} file not found")
+    scenario = Scenario.new(scenario_path, scene_path, voxel_size)
+    return scenario.save()
+
+
+def load_checked(path: Path) -> Scenario:
+    """Load a scenario after checking every file it names.
+
+    Model files must exist. Outputs are all present (a finished run) or all
+    absent (not run yet); a partial set names the missing file.
+    """
+    scenario = load_scenario(path)
+    outputs = [scenario.scene_output, scenario.target_output, scenario.measures_file]
+    present = [p.is_file() for p in outputs]
+    if any(present) and not all(present):
+        missing = outputs[present.index(False)]
+        raise InputFileError(missing, "output file not found, though the scenario's other "
+                             "outputs exist; run the scenario again to rebuild them")
+    return scenario
+
+
+def read_measures_files(paths) -> list:
+    from ladartui.measures import read_cmf
+
+    out = []
+    for path in paths:
+        if not Path(path).is_file():
+            raise InputFileError(path, "measures file not found")
+        out.append(read_cmf(path))
+    return out
+
+
+def view_angles(values: dict) -> tuple[float, float]:
+    azimuth = number_field("azimuth", values["azimuth"])
+    elevation = number_field("elevation", values["elevation"], -90.0, 90.0)
+    return azimuth, elevation
+
+
+def threshold_value(values: dict) -> float | None:
+    value = values["threshold"]
+    if value is None:
+        return None
+    return number_field("threshold", value, 0.0, None)
+
+
+def backend_choices() -> list[tuple[str, str, bool]]:
+    """(name, one-line description, available) for "auto" and each registered backend."""
+    from ladartui.tracing.backend import backend_status, get_backend
+
+    rows = []
+    status = backend_status()
+    for name, reason in status.items():
+        if reason is None:
+            backend = get_backend(name)
+            rows.append((name, f"{getattr(backend, 'summary', name)}", True))
+        else:
+            rows.append((name, reason, False))
+    best = next((n for n, _, ok in rows if ok), None)
+    auto = f"the best available here ({best})" if best else "no backend is available"
+    return [("auto", auto, best is not None), *rows]
+
+
+def is_user_error(error: BaseException) -> bool:
+    return isinstance(error, LadarError)

@@ -1,0 +1,88 @@
+"""Checked form fields: numbers typed by the analyst, validated by the core's own checks.
+
+A field knows how to turn its text into a value and how to ask the core
+whether the value is allowed (``check`` raises ``FieldError``). While typing,
+a bad value only marks the field; when the analyst commits it (Enter or
+leaving the field) a bad value resets the field to its default and the app
+says why. Limits are never repeated here: they live in the core.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Callable
+
+from textual.widgets import Input
+
+from ladartui.errors import FieldError, LadarError
+
+
+def parse_number(name: str, text: str, integer: bool = False, scale: float = 1.0):
+    """The number typed in ``text`` (times ``scale``), or FieldError naming ``name``."""
+    stripped = text.strip()
+    try:
+        value = float(stripped)
+    except ValueError:
+        raise FieldError(name, stripped, "an integer" if integer else "a number") from None
+    if not math.isfinite(value):
+        raise FieldError(name, stripped, "a finite number")
+    if integer:
+        if value != int(value):
+            raise FieldError(name, stripped, "a whole number")
+        return int(value)
+    return value * scale
+
+
+def format_number(value, integer: bool = False, scale: float = 1.0) -> str:
+    """Text for a field: integers plain, floats to six significant digits."""
+    if value is None:
+        return ""
+    if integer:
+        return str(int(value))
+    return f"{float(value) / scale:.6g}"
+
+
+class NumberField(Input):
+    """A one-line numeric input tied to a named parameter.
+
+    ``check(value)`` must raise ``FieldError`` (or another ``LadarError``) for a
+    value the core rejects; ``default`` is what the field resets to.
+    """
+
+    def __init__(self, name: str, value, *, default, check: Callable[[Any], None],
+                 integer: bool = False, scale: float = 1.0, optional: bool = False,
+                 **kwargs):
+        kwargs.setdefault("compact", True)
+        super().__init__(value=format_number(value, integer, scale), **kwargs)
+        self.field_name = name
+        self.default = default
+        self.check = check
+        self.integer = integer
+        self.scale = scale
+        self.optional = optional
+        self.committed = self.value
+
+    def parsed(self):
+        """The typed value (None for an empty optional field); FieldError if not allowed."""
+        if self.optional and not self.value.strip():
+            value = None
+        else:
+            value = parse_number(self.field_name, self.value, self.integer, self.scale)
+        self.check(value)
+        return value
+
+    def problem(self) -> str | None:
+        """Why the current text is not allowed, or None."""
+        try:
+            self.parsed()
+        except LadarError as error:
+            return str(error)
+        return None
+
+    def set_number(self, value) -> None:
+        self.value = format_number(value, self.integer, self.scale)
+        self.committed = self.value
+        self.remove_class("-bad")
+
+    def reset_to_default(self) -> None:
+        self.set_number(self.default)

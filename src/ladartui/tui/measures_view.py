@@ -1,0 +1,126 @@
+"""Measures as table rows: the report's figure 10 layout and the side-by-side comparison."""
+
+from __future__ import annotations
+
+from rich.text import Text
+
+UNDEFINED = "undefined"
+
+# (label, Measures.to_dict path, kind, better): better is "high", "low" or None
+ROWS = [
+    ("Maximum target coverage", "maximum_coverage", "pct", "high"),
+    ("Unobscured target coverage", "unobscured_coverage", "pct", "high"),
+    ("Obscured target coverage", "obscured_coverage", "pct", "high"),
+    ("Target voxels", "target_voxels", "int", None),
+    ("Visible target voxels", "visible_voxels", "int", None),
+    ("Unobscured voxels", "unobscured_voxels", "int", "high"),
+    ("Obscured voxels", "obscured_voxels", "int", "high"),
+    ("Model mean vector", "model_directions.mean_vector", "vec", None),
+    ("Model resultant length", "model_directions.resultant_length", "num", None),
+    ("Model mean direction", "model_directions.mean_direction", "vec", None),
+    ("Unobscured mean vector", "unobscured_directions.mean_vector", "vec", None),
+    ("Unobscured resultant length", "unobscured_directions.resultant_length", "num", None),
+    ("Unobscured mean direction", "unobscured_directions.mean_direction", "vec", None),
+    ("Obscured mean vector", "obscured_directions.mean_vector", "vec", None),
+    ("Obscured resultant length", "obscured_directions.resultant_length", "num", None),
+    ("Obscured mean direction", "obscured_directions.mean_direction", "vec", None),
+    ("Shift in mean direction (rad)", "direction_shift_rad", "num", "low"),
+    ("Missed share", "missed_share", "pct", "low"),
+    ("Coverage ratio", "coverage_ratio", "num", "high"),
+    ("Scans", "scans", "int", None),
+    ("Scans for 90% of final", "scans_for_enough", "int", "low"),
+    ("Path length (m)", "path_length_m", "num1", "low"),
+    ("Flight time (s)", "flight_time_s", "num1", "low"),
+]
+
+
+# the sidebar's short list (F9 shows every measure)
+COMPACT = [
+    ("Max coverage", "maximum_coverage", "pct"),
+    ("Unobscured cov.", "unobscured_coverage", "pct"),
+    ("Obscured cov.", "obscured_coverage", "pct"),
+    ("Dir. shift rad", "direction_shift_rad", "num"),
+    ("Missed share", "missed_share", "pct"),
+    ("Coverage ratio", "coverage_ratio", "num"),
+    ("Scans", "scans", "int"),
+    ("Scans for 90%", "scans_for_enough", "int"),
+    ("Path m", "path_length_m", "num1"),
+    ("Time s", "flight_time_s", "num1"),
+]
+
+
+def lookup(data: dict, path: str):
+    value = data
+    for part in path.split("."):
+        if not isinstance(value, dict) or part not in value:
+            return None
+        value = value[part]
+    return value
+
+
+def format_value(value, kind: str) -> str:
+    """Text for one measure; None is shown as "undefined"."""
+    if value is None:
+        return UNDEFINED
+    if kind == "pct":
+        return f"{100 * float(value):.1f}%"
+    if kind == "int":
+        return f"{int(value):,}"
+    if kind == "vec":
+        return ", ".join(f"{float(v):.3f}" for v in value)
+    if kind == "num1":
+        return f"{float(value):.1f}"
+    return f"{float(value):.3f}"
+
+
+def measure_rows(measures) -> list[tuple[str, str]]:
+    """(label, text) for each measure of one run (``Measures`` or its dict)."""
+    data = measures if isinstance(measures, dict) else measures.to_dict()
+    return [(label, format_value(lookup(data, path), kind)) for label, path, kind, _ in ROWS]
+
+
+def compact_rows(measures) -> list[tuple[str, str]]:
+    """The sidebar's short list of measures."""
+    data = measures if isinstance(measures, dict) else measures.to_dict()
+    return [(label, format_value(lookup(data, path), kind)) for label, path, kind in COMPACT]
+
+
+def comparison_rows(all_measures: list) -> list[list]:
+    """One row per measure: label then one cell per scenario, differences highlighted.
+
+    Where the scenarios disagree the row label is bold yellow; for a measure
+    with a direction of goodness the best value is green and the worst red.
+    """
+    dicts = [m if isinstance(m, dict) else m.to_dict() for m in all_measures]
+    rows = []
+    for label, path, kind, better in ROWS:
+        values = [lookup(d, path) for d in dicts]
+        texts = [format_value(v, kind) for v in values]
+        differ = len(set(texts)) > 1
+        cells = [Text(t) for t in texts]
+        if differ:
+            numeric = [(float(v), i) for i, v in enumerate(values)
+                       if v is not None and not isinstance(v, (list, tuple))]
+            for cell in cells:
+                cell.stylize("yellow")
+            if better and len(numeric) >= 2:
+                best = max(numeric) if better == "high" else min(numeric)
+                worst = min(numeric) if better == "high" else max(numeric)
+                if best[0] != worst[0]:
+                    for v, i in numeric:
+                        if v == best[0]:
+                            cells[i] = Text(texts[i], style="bold green")
+                        elif v == worst[0]:
+                            cells[i] = Text(texts[i], style="bold red")
+        rows.append([Text(label, style="bold yellow" if differ else ""), *cells])
+    return rows
+
+
+def differing_labels(all_measures: list) -> list[str]:
+    """Labels of the measures whose shown values differ between scenarios."""
+    dicts = [m if isinstance(m, dict) else m.to_dict() for m in all_measures]
+    out = []
+    for label, path, kind, _ in ROWS:
+        if len({format_value(lookup(d, path), kind) for d in dicts}) > 1:
+            out.append(label)
+    return out

@@ -1,0 +1,604 @@
+"""Modal screens: file setup, segment and pose editors, view angle, threshold,
+measures, comparison and help."""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+from textual import on
+from textual.app import ComposeResult
+from textual.binding import Binding
+from textual.containers import Grid, Horizontal, Vertical, VerticalScroll
+from textual.screen import ModalScreen
+from textual.suggester import Suggester
+from textual.widgets import (Button, DataTable, Input, Label, RadioButton, RadioSet, Select,
+                             Static)
+
+from ladartui.errors import FieldError, LadarError
+from ladartui.tui import bridge
+from ladartui.tui.fields import NumberField, format_number, parse_number
+from ladartui.tui.measures_view import comparison_rows, measure_rows
+
+
+class PathSuggester(Suggester):
+    """Completes file paths from what exists on disk."""
+
+    def __init__(self, suffixes: tuple[str, ...] = ()):
+        super().__init__(use_cache=False, case_sensitive=True)
+        self.suffixes = suffixes
+
+    async def get_suggestion(self, value: str) -> str | None:
+        if not value:
+            return None
+        path = Path(value).expanduser()
+        folder = path if value.endswith("/") else path.parent
+        stem = "" if value.endswith("/") else path.name
+        try:
+            names = sorted(p.name + ("/" if p.is_dir() else "") for p in folder.iterdir()
+                           if p.name.startswith(stem) and not p.name.startswith("."))
+        except OSError:
+            return None
+        for name in names:
+            if name.endswith("/") or not self.suffixes or name.endswith(self.suffixes):
+                prefix = value if value.endswith("/") else value[: len(value) - len(stem)]
+                return prefix + name
+        return None
+
+
+class Dialog(ModalScreen):
+    """A modal with a title, closed by Escape."""
+
+    BINDINGS = [Binding("escape", "dismiss_dialog", "Close")]
+    DEFAULT_CSS = """
+    Dialog { align: center middle; }
+    Dialog > .dialog { width: 76; max-width: 100%; height: auto; max-height: 100%;
+                       border: thick $accent; background: $surface; padding: 0 1; }
+    Dialog .row { height: 1; margin: 0 0; }
+    Dialog .row Label { width: 18; }
+    Dialog .row Input, Dialog .row Select { width: 1fr; }
+    Dialog .buttons { height: 1; margin-top: 1; align-horizontal: right; }
+    Dialog .buttons Button { margin-left: 2; }
+    Dialog .message { color: $error; height: auto; }
+    Dialog .info { color: $text-muted; height: auto; }
+    """
+
+    def action_dismiss_dialog(self) -> None:
+        self.dismiss(None)
+
+
+def _row(label: str, widget) -> Horizontal:
+    return Horizontal(Label(label), widget, classes="row")
+
+
+class SetupScreen(Dialog):
+    """File setup (report figure 9): a new scenario or an existing one.
+
+    New: choose the scenario file and the scene model; the target model and the
+    output names are derived and shown. Load: every file is checked; a missing
+    one is named and nothing is loaded. Dismisses with the loaded Scenario.
+    """
+
+    def __init__(self, mode: str = "new", folder: Path | None = None):
+        super().__init__()
+        self.mode = mode
+        self.folder = folder or Path.cwd()
+
+    def compose(self) -> ComposeResult:
+        with Vertical(classes="dialog", id="setup") as box:
+            box.border_title = "Setup scenario"
+            with RadioSet(id="mode"):
+                yield RadioButton("New scenario", value=self.mode == "new", id="mode-new")
+                yield RadioButton("Load scenario", value=self.mode == "load", id="mode-load")
+            yield _row("Scenario file", Input(placeholder="name.toml", id="scenario-file",
+                                              compact=True,
+                                              suggester=PathSuggester((".toml",))))
+            yield _row("3D scene model", Input(placeholder="scene.txt", id="scene-file",
+                                               compact=True,
+                                               suggester=PathSuggester((".txt",))))
+            yield _row("Voxel size m", NumberField("voxel size", 1.0, default=1.0,
+                                                   check=bridge.check_voxel_size,
+                                                   id="voxel-size"))
+            yield Static("", id="derived", classes="info")
+            yield Static("", id="setup-message", classes="message")
+            with Horizontal(classes="buttons"):
+                yield Button("OK", id="setup-ok", variant="primary", compact=True)
+                yield Button("Cancel", id="setup-cancel", compact=True)
+
+    def on_mount(self) -> None:
+        self._apply_mode()
+        self.query_one("#scenario-file", Input).focus()
+
+    @on(RadioSet.Changed, "#mode")
+    def _mode_changed(self, event: RadioSet.Changed) -> None:
+        self.mode = "new" if event.pressed.id == "mode-new" else "load"
+        self._apply_mode()
+
+    def _apply_mode(self) -> None:
+        self.query_one("#scene-file", Input).disabled = self.mode != "new"
+        self.query_one("#voxel-size", Input).disabled = self.mode != "new"
+        self._show_derived()
+
+    @on(Input.Changed)
+    def _typed(self, event: Input.Changed) -> None:
+        self.query_one("#setup-message", Static).update("")
+        if isinstance(event.input, NumberField):
+            event.input.set_class(event.input.problem() is not None, "-bad")
+        self._show_derived()
+
+    def on_input_blurred(self, event: Input.Blurred) -> None:
+        if isinstance(event.input, NumberField):
+            self._commit_voxel_size()
+
+    def _commit_voxel_size(self) -> float:
+        widget = self.query_one("#voxel-size", NumberField)
+        problem = widget.problem()
+        if problem:
+            widget.reset_to_default()
+            self.query_one("#setup-message", Static).update(
+                f"{problem}; reset to {widget.value}")
+        return widget.parsed()
+
+    def _paths(self):
+        scenario = self.query_one("#scenario-file", Input).value.strip()
+        scene = self.query_one("#scene-file", Input).value.strip()
+        scenario_path = self.folder / Path(scenario).expanduser() if scenario else None
+        scene_path = self.folder / Path(scene).expanduser() if scene else None
+        return scenario_path, scene_path
+
+    def _show_derived(self) -> None:
+        scenario_path, scene_path = self._paths()
+        if self.mode == "new":
+            names = bridge.derived_names(scenario_path, scene_path)
+            text = "\n".join(f"{label:<26}{value}" for label, value in names)
+        else:
+            text = "Every file of the scenario is checked before anything is loaded."
+        self.query_one("#derived", Static).update(text)
+
+    @on(Input.Submitted)
+    @on(Button.Pressed, "#setup-ok")
+    def _ok(self, event=None) -> None:
+        scenario_path, scene_path = self._paths()
+        message = self.query_one("#setup-message", Static)
+        try:
+            if scenario_path is None:
+                raise FieldError("scenario file", "", "a file name")
+            if self.mode == "new":
+                if scene_path is None:
+                    raise FieldError("scene model", "", "a scene model file (.txt)")
+                voxel_size = self._commit_voxel_size()
+                scenario = bridge.new_scenario(scenario_path, scene_path, voxel_size)
+            else:
+                scenario = bridge.load_checked(scenario_path)
+        except LadarError as error:
+            message.update(str(error))
+            return
+        self.dismiss(scenario)
+
+    @on(Button.Pressed, "#setup-cancel")
+    def _cancel(self) -> None:
+        self.dismiss(None)
+
+
+class FormScreen(Dialog):
+    """A form of checked number fields and choices; dismisses with the built object.
+
+    ``spec`` is a list of (name, label, kind, value, default) where kind is
+    "int", "float", "optional", "point", "points", or a tuple of choices;
+    ``build(values)`` makes the object (raising FieldError naming a field).
+    """
+
+    def __init__(self, title: str, spec, build, note: str = ""):
+        super().__init__()
+        self.title_text = title
+        self.spec = spec
+        self.build = build
+        self.note = note
+        self.cancelled = True
+
+    def compose(self) -> ComposeResult:
+        with Vertical(classes="dialog") as box:
+            box.border_title = self.title_text
+            with VerticalScroll(classes="form"):
+                for name, label, kind, value, default in self.spec:
+                    if isinstance(kind, tuple):
+                        widget = Select([(c, c) for c in kind], value=value, allow_blank=False,
+                                        id=f"f-{name}", compact=True)
+                    elif kind in ("int", "float", "optional"):
+                        widget = NumberField(name, value, default=default,
+                                             check=self._checker(name),
+                                             integer=kind == "int", optional=kind == "optional",
+                                             id=f"f-{name}")
+                    else:
+                        widget = Input(_point_text(value), id=f"f-{name}", compact=True,
+                                       placeholder="x, y, z" if kind == "point" else "a, b, c")
+                        widget.default_text = _point_text(default)
+                    yield _row(label, widget)
+            if self.note:
+                yield Static(self.note, classes="info")
+            yield Static("", id="form-message", classes="message")
+            with Horizontal(classes="buttons"):
+                yield Button("OK", id="form-ok", variant="primary", compact=True)
+                yield Button("Cancel", id="form-cancel", compact=True)
+
+    DEFAULT_CSS = "FormScreen .form { height: auto; max-height: 16; }"
+
+    def on_mount(self) -> None:
+        fields = self.query(".form Input, .form Select")
+        if fields:
+            fields.first().focus()
+
+    def _checker(self, name):
+        def check(value):
+            values = self.values(raw=True)
+            values[name] = value
+            try:
+                self.build(values)
+            except FieldError as error:
+                if _field_matches(error.field, name):
+                    raise
+        return check
+
+    def values(self, raw=False) -> dict:
+        out = {}
+        for name, _label, kind, _value, default in self.spec:
+            widget = self.query_one(f"#f-{name}")
+            if isinstance(kind, tuple):
+                out[name] = widget.value
+            elif kind in ("int", "float", "optional"):
+                try:
+                    if kind == "optional" and not widget.value.strip():
+                        out[name] = None
+                    else:
+                        out[name] = parse_number(name, widget.value, kind == "int")
+                except FieldError:
+                    if not raw:
+                        raise
+                    out[name] = default
+            else:
+                out[name] = _parse_points(name, widget.value, kind)
+        return out
+
+    def on_input_blurred(self, event: Input.Blurred) -> None:
+        self._commit(event.input)
+
+    def _commit(self, widget) -> bool:
+        message = self.query_one("#form-message", Static)
+        if isinstance(widget, NumberField):
+            problem = widget.problem()
+            if problem:
+                widget.reset_to_default()
+                message.update(f"{problem}; reset to {widget.value or 'empty'}")
+                return False
+        return True
+
+    @on(Input.Changed)
+    def _typing(self, event: Input.Changed) -> None:
+        if isinstance(event.input, NumberField):
+            event.input.set_class(event.input.problem() is not None, "-bad")
+
+    @on(Input.Submitted)
+    @on(Button.Pressed, "#form-ok")
+    def _ok(self, event=None) -> None:
+        if isinstance(event, Input.Submitted) and not self._commit(event.input):
+            return
+        message = self.query_one("#form-message", Static)
+        try:
+            result = self.build(self.values())
+        except LadarError as error:
+            message.update(str(error))
+            # reset the field the core named, so the form is usable again
+            for name, *_ in self.spec:
+                if isinstance(error, FieldError) and _field_matches(error.field, name):
+                    widget = self.query_one(f"#f-{name}")
+                    if isinstance(widget, NumberField):
+                        widget.reset_to_default()
+                        message.update(f"{error}; reset to its default")
+                    elif isinstance(widget, Input):
+                        widget.value = widget.default_text
+                        message.update(f"{error}; reset to its default")
+            return
+        self.cancelled = False
+        self.dismiss(result)
+
+    @on(Button.Pressed, "#form-cancel")
+    def _cancel(self) -> None:
+        self.dismiss(None)
+
+
+def _field_matches(field: str, name: str) -> bool:
+    return field == name or field.endswith("." + name)
+
+
+def _point_text(value) -> str:
+    if value is None:
+        return ""
+    return ", ".join(format_number(v) for v in value)
+
+
+def _parse_points(name, text, kind):
+    text = text.strip()
+    if not text:
+        return None
+    parts = [p for p in text.replace(";", ",").split(",") if p.strip()]
+    numbers = tuple(parse_number(name, p) for p in parts)
+    if kind == "point" and len(numbers) not in (2, 3):
+        raise FieldError(name, text, "x, y, z in metres")
+    if kind == "point" and len(numbers) == 2:
+        numbers = numbers + (0.0,)
+    return numbers
+
+
+class PosesScreen(Dialog):
+    """Manual scan poses in an editable table: pick a row, edit its fields, apply."""
+
+    BINDINGS = [Binding("escape", "dismiss_dialog", "Close"),
+                Binding("ctrl+n", "add_pose", "Add pose"),
+                Binding("delete", "delete_pose", "Delete pose")]
+    COLUMNS = ("x", "y", "z", "heading", "azimuth", "depression")
+
+    def __init__(self, poses, defaults):
+        super().__init__()
+        self.poses = list(poses)
+        self.defaults = defaults
+        self.shown_row = -1
+
+    def compose(self) -> ComposeResult:
+        with Vertical(classes="dialog") as box:
+            box.border_title = "Manual scan poses"
+            yield DataTable(id="poses-table", cursor_type="row", zebra_stripes=True)
+            with Grid(id="pose-fields"):
+                for name in self.COLUMNS:
+                    yield Label(name)
+                for name in self.COLUMNS:
+                    yield NumberField(name, None, default=getattr(self.defaults, name),
+                                      check=self._checker(name), id=f"p-{name}")
+            yield Static("", id="poses-message", classes="message")
+            with Horizontal(classes="buttons"):
+                yield Button("Apply row", id="pose-apply", compact=True)
+                yield Button("Add", id="pose-add", compact=True)
+                yield Button("Delete", id="pose-delete", compact=True)
+                yield Button("OK", id="poses-ok", variant="primary", compact=True)
+                yield Button("Cancel", id="poses-cancel", compact=True)
+
+    DEFAULT_CSS = """
+    PosesScreen #poses-table { height: 10; }
+    PosesScreen #pose-fields { grid-size: 6 2; height: 2; grid-gutter: 0 1; }
+    """
+
+    def on_mount(self) -> None:
+        table = self.query_one(DataTable)
+        table.add_columns("#", *self.COLUMNS)
+        self._fill()
+        table.focus()
+
+    def _fill(self, select: int | None = None) -> None:
+        table = self.query_one(DataTable)
+        table.clear()
+        for i, pose in enumerate(self.poses):
+            table.add_row(str(i + 1), *(f"{getattr(pose, c):.6g}" for c in self.COLUMNS))
+        if self.poses:
+            row = min(select if select is not None else 0, len(self.poses) - 1)
+            table.move_cursor(row=row)
+            self._show(row)
+
+    def _show(self, row: int) -> None:
+        if not 0 <= row < len(self.poses):
+            return
+        self.shown_row = row
+        for name in self.COLUMNS:
+            self.query_one(f"#p-{name}", NumberField).set_number(getattr(self.poses[row], name))
+
+    def _checker(self, name):
+        def check(value):
+            values = {c: self._raw(c) for c in self.COLUMNS}
+            values[name] = value
+            try:
+                bridge.make_pose(values)
+            except FieldError as error:
+                if _field_matches(error.field, name):
+                    raise
+        return check
+
+    def _raw(self, name):
+        widget = self.query_one(f"#p-{name}", NumberField)
+        try:
+            return parse_number(name, widget.value)
+        except FieldError:
+            return widget.default
+
+    @on(DataTable.RowHighlighted)
+    def _highlighted(self, event: DataTable.RowHighlighted) -> None:
+        # a refill re-highlights the row already shown: keep what is being typed
+        if event.cursor_row != self.shown_row:
+            self._show(event.cursor_row)
+
+    def on_input_blurred(self, event: Input.Blurred) -> None:
+        if isinstance(event.input, NumberField):
+            problem = event.input.problem()
+            if problem:
+                event.input.reset_to_default()
+                self.query_one("#poses-message", Static).update(
+                    f"{problem}; reset to {event.input.value}")
+
+    @on(Input.Changed)
+    def _typing(self, event: Input.Changed) -> None:
+        if isinstance(event.input, NumberField):
+            event.input.set_class(event.input.problem() is not None, "-bad")
+
+    @on(Input.Submitted)
+    @on(Button.Pressed, "#pose-apply")
+    def _apply(self, event=None) -> None:
+        table = self.query_one(DataTable)
+        row = table.cursor_row
+        message = self.query_one("#poses-message", Static)
+        problems = []
+        for name in self.COLUMNS:
+            widget = self.query_one(f"#p-{name}", NumberField)
+            problem = widget.problem()
+            if problem:
+                widget.reset_to_default()
+                problems.append(f"{problem}; reset to {widget.value}")
+        try:
+            pose = bridge.make_pose({c: self._raw(c) for c in self.COLUMNS})
+        except LadarError as error:
+            message.update(str(error))
+            return
+        if 0 <= row < len(self.poses):
+            self.poses[row] = pose
+        else:
+            self.poses.append(pose)
+            row = len(self.poses) - 1
+        message.update("\n".join(problems))
+        self._fill(row)
+
+    @on(Button.Pressed, "#pose-add")
+    def action_add_pose(self) -> None:
+        template = self.poses[-1] if self.poses else self.defaults
+        self.poses.append(template)
+        self._fill(len(self.poses) - 1)
+
+    @on(Button.Pressed, "#pose-delete")
+    def action_delete_pose(self) -> None:
+        row = self.query_one(DataTable).cursor_row
+        if 0 <= row < len(self.poses):
+            del self.poses[row]
+            self._fill(row)
+
+    @on(Button.Pressed, "#poses-ok")
+    def _ok(self) -> None:
+        self.dismiss(list(self.poses))
+
+    @on(Button.Pressed, "#poses-cancel")
+    def _cancel(self) -> None:
+        self.dismiss(None)
+
+
+class MeasuresScreen(Dialog):
+    """The measures of the last run (report figure 10)."""
+
+    def __init__(self, measures, title="Comparison measures"):
+        super().__init__()
+        self.measures = measures
+        self.title_text = title
+
+    DEFAULT_CSS = "MeasuresScreen DataTable { height: auto; max-height: 18; }"
+
+    def compose(self) -> ComposeResult:
+        with Vertical(classes="dialog") as box:
+            box.border_title = self.title_text
+            yield DataTable(cursor_type="row", zebra_stripes=True)
+            with Horizontal(classes="buttons"):
+                yield Button("Close", id="measures-close", variant="primary", compact=True)
+
+    def on_mount(self) -> None:
+        table = self.query_one(DataTable)
+        table.add_columns("Measure", "Value")
+        for label, value in measure_rows(self.measures):
+            table.add_row(label, value)
+        table.focus()
+
+    @on(Button.Pressed, "#measures-close")
+    def _close(self) -> None:
+        self.dismiss(None)
+
+
+class CompareScreen(Dialog):
+    """Two or more scenarios' measures (.cmf files) side by side, differences highlighted."""
+
+    def __init__(self, paths: list[Path]):
+        super().__init__()
+        self.paths = list(paths)
+
+    DEFAULT_CSS = """
+    CompareScreen > .dialog { width: 100%; height: 100%; }
+    CompareScreen DataTable { height: 1fr; }
+    """
+
+    def compose(self) -> ComposeResult:
+        with Vertical(classes="dialog") as box:
+            box.border_title = "Compare scenarios"
+            yield _row(".cmf files", Input(" ".join(str(p) for p in self.paths),
+                                           id="cmf-files", compact=True,
+                                           suggester=PathSuggester((".cmf",))))
+            yield Static("Space-separated paths; Enter compares. Green best, red worst, "
+                         "yellow differs.", classes="info")
+            yield Static("", id="compare-message", classes="message")
+            yield DataTable(id="compare-table", zebra_stripes=True)
+            with Horizontal(classes="buttons"):
+                yield Button("Compare", id="compare-go", compact=True, variant="primary")
+                yield Button("Close", id="compare-close", compact=True)
+
+    def on_mount(self) -> None:
+        self.compare()
+
+    @on(Input.Submitted, "#cmf-files")
+    @on(Button.Pressed, "#compare-go")
+    def compare(self) -> None:
+        text = self.query_one("#cmf-files", Input).value.split()
+        message = self.query_one("#compare-message", Static)
+        table = self.query_one("#compare-table", DataTable)
+        table.clear(columns=True)
+        if len(text) < 2:
+            message.update("Give two or more .cmf files to compare.")
+            return
+        try:
+            loaded = bridge.read_measures_files([Path(t).expanduser() for t in text])
+        except LadarError as error:
+            message.update(str(error))
+            return
+        message.update("")
+        table.add_column("Measure")
+        for path in text:
+            table.add_column(Path(path).stem)
+        for row in comparison_rows(loaded):
+            table.add_row(*row)
+
+    @on(Button.Pressed, "#compare-close")
+    def _close(self) -> None:
+        self.dismiss(None)
+
+
+class AngleScreen(FormScreen):
+    """Exact azimuth and elevation for the 3D views (report section 3.5)."""
+
+    def __init__(self, azimuth: float, elevation: float):
+        spec = [("azimuth", "Azimuth (deg)", "float", azimuth, 210.0),
+                ("elevation", "Elevation (deg)", "float", elevation, 30.0)]
+        super().__init__("View angle", spec, bridge.view_angles,
+                         note="Azimuth: compass bearing the view is from; elevation "
+                              "-90..90 above the horizon.")
+
+
+class ThresholdScreen(FormScreen):
+    """Height threshold for the output view (report section 3.5.2)."""
+
+    def __init__(self, threshold: float | None):
+        spec = [("threshold", "Max height (m)", "optional", threshold, None)]
+        super().__init__("Output height threshold", spec, bridge.threshold_value,
+                         note="The output is drawn up to this height; empty shows all.")
+
+
+class HelpScreen(Dialog):
+    """Every key of the app, its views and its dialogs."""
+
+    DEFAULT_CSS = """
+    HelpScreen > .dialog { height: 100%; }
+    HelpScreen DataTable { height: 1fr; }
+    """
+
+    def __init__(self, rows: list[tuple[str, str, str]]):
+        super().__init__()
+        self.rows = rows
+
+    def compose(self) -> ComposeResult:
+        with Vertical(classes="dialog") as box:
+            box.border_title = "Keys (Escape closes; Ctrl+P finds any action)"
+            yield DataTable(cursor_type="row", zebra_stripes=True)
+
+    def on_mount(self) -> None:
+        table = self.query_one(DataTable)
+        table.add_columns("Where", "Key", "Action")
+        for row in self.rows:
+            table.add_row(*row)
+        table.focus()

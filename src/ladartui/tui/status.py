@@ -1,0 +1,54 @@
+"""The status colour bar (report table 1): yellow not ready, green ready, red busy."""
+
+from __future__ import annotations
+
+from textual.app import ComposeResult
+from textual.containers import Horizontal
+from textual.widgets import Button, Static
+
+NOT_READY, READY, BUSY = "not-ready", "ready", "busy"
+LABELS = {NOT_READY: "NOT READY", READY: "READY", BUSY: "BUSY"}
+
+
+class StatusBar(Horizontal):
+    """One line: the state word on its colour, the message, and the Cancel button."""
+
+    DEFAULT_CSS = """
+    StatusBar { height: 1; background: $panel; }
+    StatusBar #status-word { width: 11; text-style: bold; content-align: center middle; }
+    StatusBar #status-text { width: 1fr; padding: 0 1; }
+    StatusBar.-not-ready #status-word { background: #d7af00; color: #000000; }
+    StatusBar.-not-ready #status-text { background: #3a3000; color: #ffffd7; }
+    StatusBar.-ready #status-word { background: #00af00; color: #000000; }
+    StatusBar.-ready #status-text { background: #003a00; color: #d7ffd7; }
+    StatusBar.-busy #status-word { background: #d70000; color: #ffffff; }
+    StatusBar.-busy #status-text { background: #3a0000; color: #ffd7d7; }
+    StatusBar #cancel { min-width: 10; }
+    """
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.state = NOT_READY
+        self.message = ""
+        self.progress: float | None = None
+
+    def compose(self) -> ComposeResult:
+        yield Static(LABELS[NOT_READY], id="status-word")
+        yield Static("", id="status-text")
+        yield Button("Cancel", id="cancel", compact=True, variant="error", disabled=True)
+
+    def on_mount(self) -> None:
+        self.set_class(True, f"-{self.state}")
+
+    def show(self, state: str, message: str, progress: float | None = None,
+             cancellable: bool = False) -> None:
+        """Show ``state`` with ``message``; ``progress`` 0..1 adds a percentage."""
+        for name in LABELS:
+            self.set_class(name == state, f"-{name}")
+        self.state, self.message, self.progress = state, message, progress
+        word = LABELS[state]
+        if progress is not None:
+            word = f"{word} {100 * progress:3.0f}%"
+        self.query_one("#status-word", Static).update(word)
+        self.query_one("#status-text", Static).update(message)
+        self.query_one("#cancel", Button).disabled = not cancellable

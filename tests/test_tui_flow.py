@@ -1,0 +1,523 @@
+"""The terminal UI driven by a Pilot: setup, parameters, run, measures, views.
+
+Every test runs on a tiny generated scene (seeded) in tmp_path.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import dataclasses
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import pytest_asyncio
+
+from ladartui.flight import FlightPlan, Orbit
+from ladartui.measures import Measures, read_cmf
+from ladartui.scenario import Scenario, load_scenario
+from ladartui.scene.generate import generate_scene
+from ladartui.scene.voxels import load_voxels
+from ladartui.sensor import Sensor
+from ladartui.tui.app import CONTROLS, LadarApp
+from ladartui.tui.canvas import ProjectionWidget, TopViewWidget
+from ladartui.tui.fields import NumberField
+from ladartui.tui.measures_view import compact_rows
+from ladartui.tui.screens import CompareScreen, FormScreen, HelpScreen, SetupScreen
+from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
+from ladartui.tui.warmup import tiny_run
+
+
+class LadarApp(LadarApp):
+    """The app without the child-process warm-up (the fixture compiled the kernels)."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("compile_in_child", False)
+        super().__init__(*args, **kwargs)
+
+SIZE = (100, 32)
+
+
+@pytest.fixture(scope="module")
+def scene_files(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("scene")
+    generated = generate_scene("small", seed=11, width=16.0, depth=16.0, trees=5)
+    scene_path, target_path = generated.write(folder / "forest")
+    files = scene_path, tuple(float(v) for v in generated.target_centre), generated.voxel_size
+    # compile the kernels once here; the apps below then skip their child-process warm-up
+    tiny_run(make_scenario(folder, files, name="warm"))
+    return files
+
+
+def make_scenario(folder: Path, scene_files, name="demo", scans=6, grid=8, ray_grid=1):
+    scene_path, centre, voxel_size = scene_files
+    scenario = Scenario(folder / f"{name}.toml", scene_path, voxel_size,
+                        Sensor(grid=grid, ray_grid=ray_grid, fov=8.0),
+                        FlightPlan(None, (Orbit(centre=centre, radius=30.0, altitude=30.0,
+                                                scans=scans),)))
+    return scenario.save()
+
+
+async def wait_until(pilot, condition, timeout=300.0):
+    # generous: a cold numba cache compiles the tracing kernels during the first run
+    start = time.monotonic()
+    while not condition():
+        if time.monotonic() - start > timeout:
+            app = pilot.app
+            raise AssertionError(f"timed out waiting for the app; busy={app.busy!r}, "
+                                 f"messages={app.messages[-3:]}")
+        await pilot.pause(0.05)
+
+
+@pytest_asyncio.fixture(loop_scope="module", scope="module")
+async def shared(tmp_path_factory, scene_files):
+    """One app for the tests that do not run a simulation (each starts from ``fresh``)."""
+    scenario = make_scenario(tmp_path_factory.mktemp("shared"), scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        yield pilot, scenario
+
+
+async def fresh(shared):
+    """The shared app back at its starting state: scenario, views, no dialogs."""
+    pilot, scenario = shared
+    app = pilot.app
+    while len(app.screen_stack) > 1:
+        app.pop_screen()
+    app.set_scenario(scenario, modified=False)
+    app.threshold = None
+    app.output_voxels = None
+    app.show_output()
+    app.action_layout(1)
+    app.query_one("#sidebar").display = True
+    app.query_one("#scene3d").set_camera(app.query_one("#scene3d").camera.__class__())
+    app.messages.clear()
+    app.clear_notifications()  # a toast left by an earlier test could catch a click
+    await pilot.pause()
+    return pilot, app
+
+
+def loaded(app):
+    return app.scene is not None and app.busy is None
+
+
+async def open_app(pilot):
+    await wait_until(pilot, lambda: loaded(pilot.app))
+
+
+def field(app, key) -> NumberField:
+    return app.query_one("#f-" + key.replace(".", "-").replace("_", "-"), NumberField)
+
+
+async def type_into(pilot, widget, text, commit="enter"):
+    widget.focus()
+    await pilot.pause()
+    widget.value = ""
+    await pilot.press(*list(text))
+    if commit:
+        await pilot.press(commit)
+    await pilot.pause()
+
+
+def status(app) -> StatusBar:
+    return app.query_one(StatusBar)
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_opens_a_scenario_ready_and_fills_every_field(shared, tmp_path, scene_files):
+    pilot, app = await fresh(shared)
+    assert status(app).state == READY
+    assert field(app, "sensor.grid").value == "8"
+    assert field(app, "sensor.fov").value == "8"
+    assert field(app, "scenario.voxel_size").value == "0.25"
+    assert field(app, "sensor.pixel_pitch").value == "100"  # micrometres
+    assert app.query_one("#scans").row_count == 6
+    assert app.query_one(TopViewWidget).top is not None
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_invalid_values_reset_to_the_default_with_a_message(shared, tmp_path, scene_files):
+    pilot, app = await fresh(shared)
+    app.action_show_tab("sensor")
+    grid = field(app, "sensor.grid")
+    await type_into(pilot, grid, "0")
+    # Sensor(grid=128) is the documented default
+    assert grid.value == "128" and app.scenario.sensor.grid == 128
+    assert "grid" in app.messages[-1] and "expected" in app.messages[-1]
+    fov = field(app, "sensor.fov")
+    await type_into(pilot, fov, "abc", commit="tab")  # leaving the field commits too
+    assert fov.value == "10" and app.scenario.sensor.fov == 10.0
+    assert "fov" in app.messages[-1]
+    # a good value is kept
+    await type_into(pilot, field(app, "sensor.ray_grid"), "3")
+    assert app.scenario.sensor.ray_grid == 3
+    assert status(app).state == READY
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_a_bad_value_being_typed_turns_the_status_yellow_and_names_it(shared, tmp_path,
+                                                                           scene_files):
+    pilot, app = await fresh(shared)
+    app.action_show_tab("flight")
+    depression = field(app, "start.depression")
+    await type_into(pilot, depression, "95", commit=None)
+    assert status(app).state == NOT_READY
+    assert "start.depression" in status(app).message
+    assert app.check_action("run", ()) is None
+    await pilot.press("enter")
+    await pilot.pause()
+    assert status(app).state == READY
+
+
+async def test_setup_parameters_run_and_measures(tmp_path, scene_files, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    first = make_scenario(tmp_path, scene_files, name="first")
+    app = LadarApp(first.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await open_app(pilot)
+        # file setup: a new scenario for the scene model
+        await pilot.press("f2")
+        await pilot.pause()
+        setup = app.screen
+        assert isinstance(setup, SetupScreen)
+        setup.query_one("#scenario-file").value = "trial.toml"
+        setup.query_one("#scene-file").value = str(scene_files[0])
+        setup.query_one("#voxel-size").value = "0.25"
+        await pilot.pause()
+        derived = str(setup.query_one("#derived").render())
+        for name in ("forest_Target.txt", "trial_Scene.txt", "trial_Target.txt", "trial.cmf"):
+            assert name in derived
+        await pilot.click("#setup-ok")
+        await wait_until(pilot, lambda: loaded(app) and app.scenario.name == "trial")
+        assert (tmp_path / "trial.toml").is_file()
+        assert load_scenario(tmp_path / "trial.toml").voxel_size == 0.25
+        # parameters: a small sensor so the run is quick
+        app.action_show_tab("sensor")
+        await type_into(pilot, field(app, "sensor.grid"), "6")
+        await type_into(pilot, field(app, "sensor.ray_grid"), "1")
+        assert app.scenario.sensor.grid == 6
+        await wait_until(pilot, lambda: status(app).state == READY)
+        # run
+        await pilot.press("f5")
+        await wait_until(pilot, lambda: app.busy is None and app.result is not None)
+        assert "Comparison measures" in app.screen.query_one(".dialog").border_title
+        await pilot.press("escape")
+        scenario = app.scenario
+        for path in (scenario.scene_output, scenario.target_output, scenario.measures_file):
+            assert path.is_file()
+        written = read_cmf(scenario.measures_file)
+        table = app.query_one("#measures")
+        shown = [tuple(str(c) for c in table.get_row_at(i)) for i in range(table.row_count)]
+        assert shown == compact_rows(written)
+        # fusion: the obscured view sees a subset of what the unobscured view sees
+        assert written.obscured_voxels <= written.unobscured_voxels <= written.visible_voxels
+        assert written.scans == len(scenario.poses())
+        fused = load_voxels(scenario.scene_output)
+        assert len(fused) == len(app.result.scene_output)
+        assert status(app).state == READY
+
+
+async def test_a_run_disables_controls_and_cancel_keeps_earlier_outputs(tmp_path, scene_files):
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await open_app(pilot)
+        await pilot.press("f5")
+        await wait_until(pilot, lambda: app.busy is None and app.result is not None)
+        await pilot.press("escape")  # close the measures dialog
+        outputs = [scenario.scene_output, scenario.target_output, scenario.measures_file]
+        before = [p.read_bytes() for p in outputs]
+        saved = scenario.path.read_bytes()
+        # a long run: many scans with a bigger sensor
+        slow = dataclasses.replace(
+            app.scenario.flight.segments[0], scans=4000)
+        app.update_scenario(app.scenario.with_changes(
+            sensor=Sensor(grid=32, ray_grid=2, fov=8.0), flight=FlightPlan(None, (slow,))))
+        await pilot.press("f5")
+        await wait_until(pilot, lambda: app.busy is not None and app.run_in_progress())
+        await wait_until(pilot, lambda: (app.progress or 0) > 0)
+        assert status(app).state == BUSY and "%" in str(
+            status(app).query_one("#status-word").render())
+        enabled = [w.id for w in app.query(CONTROLS) if not w.disabled]
+        assert enabled == ["btn-cancel-run"]
+        assert not app.query_one("#status #cancel").disabled
+        assert app.check_action("save", ()) is None and app.check_action("run", ()) is None
+        await pilot.press("ctrl+s")  # does nothing while busy
+        assert scenario.path.read_bytes() == saved
+        await pilot.press("escape")
+        await wait_until(pilot, lambda: app.busy is None, timeout=30)
+        assert "cancelled" in app.messages[-1].lower()
+        assert [p.read_bytes() for p in outputs] == before
+        assert all(not w.disabled for w in app.query("#sidebar Input") if
+                   w.id != "f-scenario-step")
+        assert status(app).state == READY
+
+
+async def test_progressive_output_during_a_run_unless_fast_mode(tmp_path, scene_files):
+    scenario = make_scenario(tmp_path, scene_files, scans=3000, grid=32, ray_grid=2)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await open_app(pilot)
+        output = app.query_one("#output3d", ProjectionWidget)
+        assert output.points is None  # never run
+        await pilot.press("f5")
+        await wait_until(pilot, lambda: output.points is not None and len(output.points))
+        assert app.busy is not None  # drawn while the run goes on
+        await pilot.press("escape")
+        await wait_until(pilot, lambda: app.busy is None)
+        assert output.points is None  # cancelled: back to the (absent) earlier output
+
+        app.update_scenario(app.scenario.with_changes(fast_mode=True))
+        await pilot.press("f5")
+        await wait_until(pilot, lambda: (app.progress or 0) > 0)
+        await pilot.pause(1.0)  # two progressive redraw intervals
+        assert app.busy is not None and output.points is None
+        await pilot.press("escape")
+        await wait_until(pilot, lambda: app.busy is None)
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_layout_keys_switch_between_the_five_layouts(shared, tmp_path, scene_files):
+    expected = {1: {"scene3d", "topview"}, 2: {"scene3d", "output3d"}, 3: {"scene3d"},
+                4: {"output3d"}, 5: {"scene3d", "output3d", "topview"}}
+    pilot, app = await fresh(shared)
+    app.query_one("#scene3d").focus()
+    for number, shown in expected.items():
+        await pilot.press(str(number))
+        await pilot.pause()
+        visible = {w.id for w in app.query("#views > *") if w.display}
+        assert visible == shown
+        assert all(app.query_one(f"#{w}").size.width > 0 for w in shown)
+    await pilot.press("f6")  # cycles back to the first
+    await pilot.pause()
+    assert app.layout_number == 1
+    await pilot.press("f4")  # hide the panel: the views get the whole width
+    await pilot.pause()
+    assert not app.query_one("#sidebar").display
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_height_threshold_limits_the_output_view(shared, tmp_path, scene_files):
+    pilot, app = await fresh(shared)
+    column = np.array([[3, 4, z] for z in range(21)])
+    app.output_voxels = column
+    app.show_output()
+    output = app.query_one("#output3d", ProjectionWidget)
+    assert len(output.points) == 21
+    await pilot.press("f8")
+    await pilot.pause()
+    assert isinstance(app.screen, FormScreen)
+    await pilot.press("2", "enter")
+    await pilot.pause()
+    # voxel size 0.25 m: centres at z * 0.25 <= 2.0 m are layers 0..8
+    assert sorted(output.points[:, 2].tolist()) == list(range(9))
+    assert "2 m" in output.border_title
+    await pilot.press("f8")
+    await pilot.pause()
+    app.screen.query_one("#f-threshold").value = ""
+    await pilot.press("enter")
+    await pilot.pause()
+    assert len(output.points) == 21 and app.threshold is None
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_loading_a_scenario_with_a_missing_file_names_it_and_loads_nothing(shared, 
+        tmp_path, scene_files):
+    good = make_scenario(tmp_path, scene_files, name="good")
+    broken = tmp_path / "broken.toml"
+    broken.write_text(good.path.read_text().replace(str(Path(scene_files[0]).name),
+                                                    "nowhere.txt")
+                      .replace(str(scene_files[0]), str(tmp_path / "nowhere.txt")))
+    partial = make_scenario(tmp_path, scene_files, name="partial")
+    partial.scene_output.write_text("1,2,3\n")
+    partial.measures_file.write_text("")
+    pilot, app = await fresh(shared)
+    for path, missing in ((broken, "nowhere.txt"), (partial.path, "partial_Target.txt")):
+        await pilot.press("f3")
+        await pilot.pause()
+        assert isinstance(app.screen, SetupScreen) and app.screen.mode == "load"
+        app.screen.query_one("#scenario-file").value = str(path)
+        app.screen.query_one("#setup-ok").press()
+        await pilot.pause()
+        await pilot.pause()
+        message = str(app.screen.query_one("#setup-message").render())
+        assert missing in message
+        await pilot.press("escape")
+        await pilot.pause()
+        assert app.scenario.path == shared[1].path
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_3d_view_rotates_zooms_and_takes_an_exact_angle(shared, tmp_path, scene_files):
+    pilot, app = await fresh(shared)
+    scene3d = app.query_one("#scene3d", ProjectionWidget)
+    output3d = app.query_one("#output3d", ProjectionWidget)
+    scene3d.focus()
+    az = scene3d.camera.azimuth
+    await pilot.press("right", "up", "plus", "d")
+    assert scene3d.camera.azimuth == pytest.approx((az + 15) % 360)
+    assert scene3d.camera.zoom == pytest.approx(1.25)
+    assert scene3d.camera.pan_x > 0
+    assert output3d.camera == scene3d.camera  # the views turn together
+    await pilot.press("f7")
+    await pilot.pause()
+    app.screen.query_one("#f-azimuth").value = "45"
+    app.screen.query_one("#f-elevation").value = "60"
+    app.screen.query_one("#form-ok").press()
+    await pilot.pause()
+    await pilot.pause()
+    assert (scene3d.camera.azimuth, scene3d.camera.elevation) == (45.0, 60.0)
+    await pilot.press("f7")
+    await pilot.pause()
+    app.screen.query_one("#f-elevation").value = "120"
+    app.screen.query_one("#form-ok").press()
+    await pilot.pause()
+    await pilot.pause()
+    assert "elevation" in str(app.screen.query_one("#form-message").render())
+    await pilot.press("escape")
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_top_view_overlay_follows_parameters_without_redrawing_the_scene(shared, 
+        tmp_path, scene_files):
+    pilot, app = await fresh(shared)
+    top = app.query_one(TopViewWidget)
+    await pilot.pause()
+    renders = top.top.renders
+    before = [f.copy() for f in top.footprints]
+    app.action_show_tab("sensor")
+    await type_into(pilot, field(app, "sensor.fov"), "20")
+    await pilot.pause()
+    after = top.footprints
+    # a wider field of view gives larger footprints
+    def area(p):
+        x, y = p[:, 0], p[:, 1]
+        return abs(np.dot(x, np.roll(y, 1)) - np.dot(y, np.roll(x, 1))) / 2
+    assert area(after[0]) > 4 * area(before[0])
+    assert top.top.renders == renders
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_flight_segments_are_added_edited_and_checked(shared, tmp_path, scene_files):
+    pilot, app = await fresh(shared)
+    app.action_show_tab("flight")
+    await pilot.pause()
+    app.action_add_segment("straight")
+    await pilot.pause()
+    form = app.screen
+    assert isinstance(form, FormScreen)
+    distance = form.query_one("#f-distance")
+    await type_into(pilot, distance, "-5", commit="tab")
+    assert distance.value == "100"  # reset to the form's default
+    assert "distance" in str(form.query_one("#form-message").render())
+    form.query_one("#f-scans").value = "3"
+    app.screen.query_one("#form-ok").press()
+    await pilot.pause()
+    await pilot.pause()
+    kinds = [s.kind for s in app.scenario.flight.segments]
+    assert kinds == ["orbit", "straight"]
+    assert len(app.scenario.poses()) == 6 + 3
+    assert app.query_one("#scans").row_count == 9
+    # aim every scan at the target centre: the central ray passes through it
+    app.action_aim_all()
+    await pilot.pause()
+    centre = np.array(scene_files[1])
+    for pose in app.scenario.poses():
+        origin, direction = app.scenario.sensor.central_ray(pose)
+        to_target = centre - np.asarray(origin)
+        cross = np.cross(np.asarray(direction), to_target / np.linalg.norm(to_target))
+        assert np.linalg.norm(cross) < 1e-6
+    # save writes the edited plan
+    await pilot.press("ctrl+s")
+    await pilot.pause()
+    assert [s.kind for s in load_scenario(app.scenario.path).flight.segments] == kinds
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_manual_poses_are_edited_in_a_table(shared, tmp_path, scene_files):
+    pilot, app = await fresh(shared)
+    app.action_manual_poses()
+    await pilot.pause()
+    screen = app.screen
+    screen.query_one("#p-x").value = "12.5"
+    screen.query_one("#p-z").value = "0"  # not allowed: must be above the ground
+    screen.query_one("#pose-apply").press()
+    await pilot.pause()
+    await pilot.pause()
+    assert "z" in str(screen.query_one("#poses-message").render())
+    await pilot.pause()
+    assert screen.query_one("#p-z").value == "30"  # reset to the start pose's altitude
+    screen.query_one("#p-z").value = "40"
+    screen.query_one("#pose-apply").press()
+    await pilot.pause()
+    screen.query_one("#pose-add").press()
+    await pilot.pause()
+    screen.query_one("#poses-ok").press()
+    await pilot.pause()
+    manual = app.scenario.flight.segments[-1]
+    assert manual.kind == "manual" and len(manual.poses) == 2
+    assert manual.poses[0].x == 12.5 and manual.poses[0].z == 40.0
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_compare_shows_scenarios_side_by_side_with_differences_marked(shared, tmp_path,
+                                                                          scene_files):
+    a, b = tmp_path / "a.cmf", tmp_path / "b.cmf"
+    Measures(target_voxels=100, obscured_coverage=0.2, unobscured_coverage=0.5,
+             scans=10).write_cmf(a)
+    Measures(target_voxels=100, obscured_coverage=0.3, unobscured_coverage=0.5,
+             scans=12).write_cmf(b)
+    pilot, app = await fresh(shared)
+    app.push_screen(CompareScreen([a, b]))
+    await pilot.pause()
+    table = app.screen.query_one("#compare-table")
+    assert table.row_count > 10 and len(table.columns) == 3
+    rows = {str(table.get_row_at(i)[0]): table.get_row_at(i) for i in range(table.row_count)}
+    obscured = rows["Obscured target coverage"]
+    assert [str(c) for c in obscured[1:]] == ["20.0%", "30.0%"]
+    assert "red" in str(obscured[1].style) and "green" in str(obscured[2].style)
+    same = rows["Unobscured target coverage"]
+    assert str(same[0].style) == "" and str(same[1].style) == ""
+    await pilot.press("escape")
+    # a missing file is named
+    app.push_screen(CompareScreen([a, tmp_path / "gone.cmf"]))
+    await pilot.pause()
+    assert "gone.cmf" in str(app.screen.query_one("#compare-message").render())
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_help_lists_the_keys_and_the_palette_offers_every_action(shared, tmp_path, scene_files):
+    from ladartui.tui.app import palette_entries
+
+    pilot, app = await fresh(shared)
+    await pilot.press("f1")
+    await pilot.pause()
+    assert isinstance(app.screen, HelpScreen)
+    table = app.screen.query_one("DataTable")
+    keys = {str(table.get_row_at(i)[1]) for i in range(table.row_count)}
+    assert {"F1", "F2", "F3", "F5", "F6", "F8", "Ctrl+S", "Esc"} <= keys
+    await pilot.press("escape")
+    actions = {a.split("(")[0] for _, _, a in palette_entries()}
+    bound = {b.action.split("(")[0] for b in LadarApp.BINDINGS}
+    assert bound <= actions
+    for action in actions:
+        assert callable(getattr(app, f"action_{action}", None)), action
+
+
+def test_pictures_use_24_bit_colour_or_the_256_colour_palette():
+    from ladartui import views
+    from ladartui.tui.canvas import UPPER, picture_strips
+
+    picture = views.Picture.blank(2, 2)
+    picture.rgb[0, 0] = (255, 0, 0)
+    picture.rgb[1, 0] = (0, 0, 255)
+    picture.mask[:, 0] = True
+    (strip,) = picture_strips(picture)
+    first = list(strip)[0]
+    assert first.text.startswith(UPPER)
+    assert first.style.color.triplet == (255, 0, 0) and first.style.bgcolor.triplet == (0, 0, 255)
+    (strip,) = picture_strips(picture, use_256=True)
+    first = list(strip)[0]
+    assert (first.style.color.number, first.style.bgcolor.number) == (196, 21)  # xterm red, blue

@@ -1,0 +1,166 @@
+"""The text-mode view maths (ladartui.views): no terminal needed."""
+
+import numpy as np
+import pytest
+
+from ladartui import views
+from ladartui.views import Camera, TopView
+
+
+def test_grey_ramp_has_the_reports_56_shades_rising_and_never_black():
+    ramp = views.grey_ramp()
+    assert ramp.shape == (56, 3)
+    assert np.all(ramp[:, 0] == ramp[:, 1]) and np.all(ramp[:, 1] == ramp[:, 2])
+    assert np.all(np.diff(ramp[:, 0].astype(int)) > 0)
+    assert ramp.min() > 0
+
+
+def test_shade_indices_are_linear_over_the_range_and_clipped():
+    idx = views.shade_indices([0.0, 4.99, 5.0, 9.99, 10.0, -3.0, 99.0], 0.0, 10.0, 10)
+    assert idx.tolist() == [0, 4, 5, 9, 9, 0, 9]
+
+
+def test_ansi256_picks_the_xterm_cube_and_grey_entries():
+    # xterm-256: 16 + 36 r + 6 g + b over levels (0, 95, 135, 175, 215, 255); greys 232 + k at 8 + 10 k
+    rgb = np.array([[255, 0, 0], [0, 0, 0], [0, 255, 0], [95, 135, 175], [128, 128, 128],
+                    [238, 238, 238]])
+    assert views.to_ansi256(rgb).tolist() == [196, 16, 46, 16 + 36 + 12 + 3, 244, 255]
+
+
+def _heights(nx=12, ny=8):
+    h = np.full((nx, ny), -1, np.int32)
+    h[2, 5] = 20  # one tall column, north-west quarter
+    h[9, 1] = 3   # a low one, south-east
+    return h
+
+
+def test_top_view_at_native_size_puts_north_up_and_shades_by_height():
+    top = TopView(_heights(), voxel_size=0.5)
+    pic = top.scene_layer(8, 12)
+    ramp = views.height_ramp()
+    # voxel (x, y) is pixel (row = ny - 1 - y, col = x)
+    assert tuple(pic.rgb[8 - 1 - 5, 2]) == tuple(ramp[-1])
+    low = views.shade_indices([3], 0, 20, len(ramp))[0]
+    assert tuple(pic.rgb[8 - 1 - 1, 9]) == tuple(ramp[low])
+    assert tuple(pic.rgb[0, 0]) == views.GROUND_RGB
+    assert pic.mask.all()
+
+
+def test_top_view_downsampling_keeps_the_highest_voxel_of_each_block():
+    top = TopView(_heights(), voxel_size=1.0)
+    pic = top.scene_layer(4, 6)  # 2 x 2 voxels per pixel
+    ramp = views.height_ramp()
+    # voxel (2, 5) lies in block x 2..3, y 4..5 -> col 1, row (8 - 6) / 2 = 1
+    assert tuple(pic.rgb[1, 1]) == tuple(ramp[-1])
+    assert tuple(pic.rgb[0, 1]) == views.GROUND_RGB
+
+
+def test_top_view_letterboxes_a_wide_scene_and_leaves_the_margin_undrawn():
+    top = TopView(np.zeros((10, 5), np.int32))
+    pic = top.scene_layer(10, 10)  # 10 x 5 scene into 10 x 10 pixels: rows 2.5..7.5 drawn
+    assert pic.mask[3:7].all()
+    assert not pic.mask[:2].any() and not pic.mask[8:].any()
+
+
+def test_overlays_mark_scans_path_and_footprint_without_redrawing_the_scene():
+    top = TopView(np.zeros((20, 20), np.int32), voxel_size=2.0)
+    first = top.render(20, 20, path=np.array([[0.0, 0.0], [38.0, 0.0]]),
+                       scans=np.array([[10.0, 20.0], [30.0, 20.0]]),
+                       footprints=[np.array([[4.0, 4.0], [16.0, 4.0], [16.0, 16.0], [4.0, 16.0]])])
+    # metres / 2 = voxel; scan (30, 20) m -> voxel (15, 10) -> row 19 - 10, col 15
+    assert tuple(first.rgb[9, 15]) == views.SCAN_RGB
+    assert tuple(first.rgb[9, 5]) == views.START_RGB
+    assert tuple(first.rgb[19, 10]) == views.PATH_RGB  # path along y = 0
+    assert tuple(first.rgb[19 - 2, 5]) == views.FOOTPRINT_RGB  # corner (4, 4) m -> voxel (2, 2)
+    second = top.render(20, 20, scans=np.array([[0.0, 0.0]]))
+    assert tuple(second.rgb[9, 15]) != views.SCAN_RGB
+    assert top.renders == 1  # the scene layer was drawn once and reused
+
+
+def test_frame_grows_to_hold_a_flight_path_outside_the_scene():
+    top = TopView(np.zeros((16, 16), np.int32), voxel_size=1.0)
+    frame = top.frame_for(np.array([[-40.0, 8.0], [56.0, 8.0]]))
+    assert frame[0] <= -39.5 and frame[2] >= 56.5
+    assert frame[1] <= 0 and frame[3] >= 16
+    pic = top.render(32, 64, scans=np.array([[-40.0, 8.0], [56.0, 8.0]]), frame=frame)
+    assert (pic.rgb == np.array(views.SCAN_RGB, np.uint8)).all(axis=2).any()
+    assert (pic.rgb == np.array(views.START_RGB, np.uint8)).all(axis=2).any()
+
+
+def test_view_axes_are_orthonormal_and_match_the_compass():
+    right, up, toward = views.view_axes(180.0, 90.0)  # from straight above, south at the bottom
+    assert np.allclose(toward, [0, 0, 1], atol=1e-12)
+    assert np.allclose(right, [1, 0, 0], atol=1e-12)
+    assert np.allclose(up, [0, 1, 0], atol=1e-12)
+    for az, el in [(0, 0), (37.5, 30), (210, -20)]:
+        m = np.stack(views.view_axes(az, el))
+        assert np.allclose(m @ m.T, np.eye(3), atol=1e-12)
+
+
+def test_projection_from_above_shows_the_highest_voxel_of_a_column():
+    pts = np.array([[5, 5, 0], [5, 5, 9]])
+    bounds = (np.zeros(3), np.array([10.0, 10.0, 9.0]))
+    shade, depth = views.render_points(pts, Camera(180.0, 90.0), 20, 20, bounds=bounds, levels=10)
+    drawn = np.argwhere(shade >= 0)
+    assert len(drawn) == 1
+    assert shade[tuple(drawn[0])] == 9  # top of the height range
+
+
+def test_projection_side_view_keeps_the_nearer_point():
+    # viewer due south (azimuth 180), level: y grows away from the viewer
+    pts = np.array([[5, 8, 3], [5, 2, 3]])
+    bounds = (np.zeros(3), np.array([10.0, 10.0, 6.0]))
+    shade, depth = views.render_points(pts, Camera(180.0, 0.0), 20, 20, bounds=bounds)
+    drawn = np.argwhere(shade >= 0)
+    assert len(drawn) == 1
+    # depth is distance toward the viewer from the bounds' centre (y = 5): nearer point y = 2
+    assert depth[tuple(drawn[0])] == pytest.approx(5 - 2)
+
+
+def test_zoom_and_pan_move_points_on_screen():
+    pts = np.array([[0, 0, 0], [10, 0, 0]])
+    bounds = (np.zeros(3), np.array([10.0, 0.0, 0.0]))
+    r1, c1, _ = views.project(pts, Camera(180.0, 90.0), 40, 40, bounds)
+    r2, c2, _ = views.project(pts, Camera(180.0, 90.0, zoom=2.0), 40, 40, bounds)
+    assert (c2[1] - c2[0]) == pytest.approx(2 * (c1[1] - c1[0]), abs=1)
+    r3, c3, _ = views.project(pts, Camera(180.0, 90.0).panned(0.25, 0.0), 40, 40, bounds)
+    assert c3[0] > c1[0]
+
+
+def test_camera_rotation_wraps_azimuth_and_clamps_elevation():
+    cam = Camera(350.0, 80.0).rotated(20.0, 30.0)
+    assert cam.azimuth == pytest.approx(10.0)
+    assert cam.elevation == 90.0
+
+
+def test_threshold_keeps_voxels_up_to_the_height_in_metres():
+    vox = np.array([[0, 0, 0], [0, 0, 4], [0, 0, 5], [0, 0, 6]])
+    kept = views.threshold_points(vox, 0.5, 2.5)
+    assert kept[:, 2].tolist() == [0, 4, 5]
+    assert len(views.threshold_points(vox, 0.5, None)) == 4
+
+
+def test_subsample_is_bounded_deterministic_and_a_subset():
+    vox = np.arange(3000).reshape(1000, 3)
+    a = views.subsample(vox, 100, seed=1)
+    b = views.subsample(vox, 100, seed=1)
+    assert len(a) == 100 and np.array_equal(a, b)
+    assert set(map(tuple, a)) <= set(map(tuple, vox))
+    assert views.subsample(vox, 5000) is vox
+
+
+def test_surface_points_follow_the_height_map():
+    h = np.full((4, 4), -1, np.int32)
+    h[1, 2] = 7
+    pts = views.surface_points(h)
+    assert pts.tolist() == [[1, 2, 7]]
+
+
+def test_half_block_cells_pair_rows_and_pad_an_odd_last_row():
+    pic = views.Picture.blank(3, 2)
+    pic.rgb[2, 1] = (1, 2, 3)
+    pic.mask[2, 1] = True
+    top, top_mask, bottom, bottom_mask = views.half_block_cells(pic)
+    assert top.shape == (2, 2, 3) and bottom_mask.shape == (2, 2)
+    assert top_mask[1, 1] and tuple(top[1, 1]) == (1, 2, 3)
+    assert not bottom_mask[1].any()
