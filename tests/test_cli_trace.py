@@ -90,3 +90,11 @@ def test_bench_quick_json(monkeypatch, tmp_path, capsys):
     assert {("numba", "exact", 45.0), ("numba", "exact", 90.0), ("numba", "march", 45.0),
             ("numba", "march", 90.0)} <= rows
     assert all(r["rays_per_second"] > 0 for r in report["results"])
+
+
+def test_bench_rejects_a_run_count_below_one(capsys):
+    from ladartui.cli import main
+
+    assert main(["bench", "--runs", "0"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err == ["ladartui: error: --runs = 0: expected a whole number of at least 1"]
