@@ -184,6 +184,24 @@ def aim_at(pose: ScanPose, target_xyz) -> ScanPose:
                    depression=min(depression, 90.0))
 
 
+def _length(name, value):
+    """A distance in metres, more than 0 and at most MAX_COORDINATE."""
+    return number_field(name, value, 0.0, MAX_COORDINATE, low_open=True)
+
+
+def _altitude(value):
+    return number_field("altitude", value, 0.0, MAX_ALTITUDE, low_open=True)
+
+
+def _scans(value):
+    return integer_field("scans", value, 1, MAX_SCANS)
+
+
+def _arc(value):
+    """Degrees flown around a circle, more than 0 and at most a full turn."""
+    return number_field("arc", value, 0.0, 360.0, low_open=True)
+
+
 def _aimed(poses, target):
     return poses if target is None else [aim_at(p, target) for p in poses]
 
@@ -207,8 +225,8 @@ def straight(start: ScanPose, distance: float, scans: int) -> list[ScanPose]:
     (1..scans) sits ``distance * k / scans`` along the path, so the last scan is
     at the end of the manoeuvre. Sensor azimuth and depression are kept.
     """
-    distance = number_field("distance", distance, 0.0, MAX_COORDINATE, low_open=True)
-    scans = integer_field("scans", scans, 1, MAX_SCANS)
+    distance = _length("distance", distance)
+    scans = _scans(scans)
     fx, fy = _forward(start.heading)
     return [replace(start, x=start.x + fx * distance * k / scans,
                     y=start.y + fy * distance * k / scans) for k in range(1, scans + 1)]
@@ -236,10 +254,10 @@ def turn(start: ScanPose, radius: float, arc: float, direction: str, scans: int)
     evenly spaced along the arc (scan k after ``arc * k / scans`` degrees), each
     heading along the tangent. Sensor azimuth and depression are kept.
     """
-    radius = number_field("radius", radius, 0.0, MAX_COORDINATE, low_open=True)
-    arc = number_field("arc", arc, 0.0, 360.0, low_open=True)
+    radius = _length("radius", radius)
+    arc = _arc(arc)
     direction = choice_field("direction", direction, DIRECTIONS)
-    scans = integer_field("scans", scans, 1, MAX_SCANS)
+    scans = _scans(scans)
     clockwise = direction == "right"
     centre = _turn_centre(start, radius, clockwise)
     sign = 1.0 if clockwise else -1.0
@@ -273,12 +291,12 @@ def orbit(centre, radius, altitude, scans, *, direction="right", start_bearing=1
     ``aim_at`` (default: the centre).
     """
     centre = point_field("centre", centre)
-    radius = number_field("radius", radius, 0.0, MAX_COORDINATE, low_open=True)
-    altitude = number_field("altitude", altitude, 0.0, MAX_ALTITUDE, low_open=True)
-    scans = integer_field("scans", scans, 1, MAX_SCANS)
+    radius = _length("radius", radius)
+    altitude = _altitude(altitude)
+    scans = _scans(scans)
     direction = choice_field("direction", direction, DIRECTIONS)
     start_bearing = number_field("start_bearing", start_bearing)
-    arc = number_field("arc", arc, 0.0, 360.0, low_open=True)
+    arc = _arc(arc)
     clockwise = direction == "right"
     step = _arc_steps(arc, scans) * (1.0 if clockwise else -1.0)
     template = _template(altitude)
@@ -298,9 +316,9 @@ def flypast(target, standoff, altitude, length, scans, heading, *, side="right",
     """
     target = point_field("target", target)
     standoff = number_field("standoff", standoff, 0.0, MAX_COORDINATE)
-    altitude = number_field("altitude", altitude, 0.0, MAX_ALTITUDE, low_open=True)
+    altitude = _altitude(altitude)
     length = number_field("length", length, 0.0, MAX_COORDINATE)
-    scans = integer_field("scans", scans, 1, MAX_SCANS)
+    scans = _scans(scans)
     heading = number_field("heading", heading)
     side = choice_field("side", side, DIRECTIONS)
     fx, fy = _forward(heading)
@@ -323,7 +341,7 @@ def standoff_sweep(target, standoffs, altitude, *, bearing=180.0, heading=None,
     """
     target = point_field("target", target)
     distances = standoffs_field("standoffs", standoffs)
-    altitude = number_field("altitude", altitude, 0.0, MAX_ALTITUDE, low_open=True)
+    altitude = _altitude(altitude)
     bearing = number_field("bearing", bearing)
     heading = bearing + 180.0 if heading is None else number_field("heading", heading)
     bx, by = _forward(bearing)
@@ -360,6 +378,19 @@ def _optional_number(name, value, low=None, high=None):
 
 def _set(obj, name, value):
     object.__setattr__(obj, name, value)
+
+
+def _check_pointing(segment):
+    """Check a relative manoeuvre's optional new sensor pointing and aim point."""
+    _set(segment, "azimuth", _optional_number("azimuth", segment.azimuth))
+    _set(segment, "depression", _optional_number("depression", segment.depression, 1.0, 90.0))
+    _set(segment, "aim_at", _optional_point("aim_at", segment.aim_at))
+
+
+def _pointed(segment, current, fly):
+    """Scans of ``fly(start)``, the start re-pointed and the scans aimed as the segment asks."""
+    start = _with_sensor(current, segment.azimuth, segment.depression)
+    return _aimed(fly(start), segment.aim_at)
 
 
 def _chords(poses):
@@ -400,16 +431,12 @@ class Straight:
     relative: ClassVar[bool] = True
 
     def __post_init__(self):
-        _set(self, "distance", number_field("distance", self.distance, 0.0, MAX_COORDINATE,
-                                            low_open=True))
-        _set(self, "scans", integer_field("scans", self.scans, 1, MAX_SCANS))
-        _set(self, "azimuth", _optional_number("azimuth", self.azimuth))
-        _set(self, "depression", _optional_number("depression", self.depression, 1.0, 90.0))
-        _set(self, "aim_at", _optional_point("aim_at", self.aim_at))
+        _set(self, "distance", _length("distance", self.distance))
+        _set(self, "scans", _scans(self.scans))
+        _check_pointing(self)
 
     def build(self, current):
-        start = _with_sensor(current, self.azimuth, self.depression)
-        return _aimed(straight(start, self.distance, self.scans), self.aim_at)
+        return _pointed(self, current, lambda start: straight(start, self.distance, self.scans))
 
     def lead_in(self) -> float:
         """Metres from the start of the manoeuvre to its first scan."""
@@ -434,19 +461,15 @@ class Turn:
     relative: ClassVar[bool] = True
 
     def __post_init__(self):
-        _set(self, "radius", number_field("radius", self.radius, 0.0, MAX_COORDINATE,
-                                          low_open=True))
-        _set(self, "arc", number_field("arc", self.arc, 0.0, 360.0, low_open=True))
+        _set(self, "radius", _length("radius", self.radius))
+        _set(self, "arc", _arc(self.arc))
         _set(self, "direction", choice_field("direction", self.direction, DIRECTIONS))
-        _set(self, "scans", integer_field("scans", self.scans, 1, MAX_SCANS))
-        _set(self, "azimuth", _optional_number("azimuth", self.azimuth))
-        _set(self, "depression", _optional_number("depression", self.depression, 1.0, 90.0))
-        _set(self, "aim_at", _optional_point("aim_at", self.aim_at))
+        _set(self, "scans", _scans(self.scans))
+        _check_pointing(self)
 
     def build(self, current):
-        start = _with_sensor(current, self.azimuth, self.depression)
-        poses = turn(start, self.radius, self.arc, self.direction, self.scans)
-        return _aimed(poses, self.aim_at)
+        return _pointed(self, current, lambda start: turn(start, self.radius, self.arc,
+                                                          self.direction, self.scans))
 
     def lead_in(self) -> float:
         """Metres along the arc from the start of the turn to its first scan."""
@@ -473,14 +496,12 @@ class Orbit:
 
     def __post_init__(self):
         _set(self, "centre", point_field("centre", self.centre))
-        _set(self, "radius", number_field("radius", self.radius, 0.0, MAX_COORDINATE,
-                                          low_open=True))
-        _set(self, "altitude", number_field("altitude", self.altitude, 0.0, MAX_ALTITUDE,
-                                            low_open=True))
-        _set(self, "scans", integer_field("scans", self.scans, 1, MAX_SCANS))
+        _set(self, "radius", _length("radius", self.radius))
+        _set(self, "altitude", _altitude(self.altitude))
+        _set(self, "scans", _scans(self.scans))
         _set(self, "direction", choice_field("direction", self.direction, DIRECTIONS))
         _set(self, "start_bearing", _heading(number_field("start_bearing", self.start_bearing)))
-        _set(self, "arc", number_field("arc", self.arc, 0.0, 360.0, low_open=True))
+        _set(self, "arc", _arc(self.arc))
         _set(self, "aim_at", _optional_point("aim_at", self.aim_at))
 
     def build(self, current):
@@ -511,10 +532,9 @@ class FlyPast:
     def __post_init__(self):
         _set(self, "target", point_field("target", self.target))
         _set(self, "standoff", number_field("standoff", self.standoff, 0.0, MAX_COORDINATE))
-        _set(self, "altitude", number_field("altitude", self.altitude, 0.0, MAX_ALTITUDE,
-                                            low_open=True))
+        _set(self, "altitude", _altitude(self.altitude))
         _set(self, "length", number_field("length", self.length, 0.0, MAX_COORDINATE))
-        _set(self, "scans", integer_field("scans", self.scans, 1, MAX_SCANS))
+        _set(self, "scans", _scans(self.scans))
         _set(self, "heading", _heading(number_field("heading", self.heading)))
         _set(self, "side", choice_field("side", self.side, DIRECTIONS))
         _set(self, "aim_at", _optional_point("aim_at", self.aim_at))
@@ -543,8 +563,7 @@ class Standoff:
     def __post_init__(self):
         _set(self, "target", point_field("target", self.target))
         _set(self, "standoffs", standoffs_field("standoffs", self.standoffs))
-        _set(self, "altitude", number_field("altitude", self.altitude, 0.0, MAX_ALTITUDE,
-                                            low_open=True))
+        _set(self, "altitude", _altitude(self.altitude))
         _set(self, "bearing", _heading(number_field("bearing", self.bearing)))
         if self.heading is not None:
             _set(self, "heading", _heading(number_field("heading", self.heading)))

@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import threading
 
+from ladartui.cli.progress import run_cancellable
 from ladartui.errors import Cancelled
 
 
@@ -59,7 +60,6 @@ def _simulate_with_progress(scenario, args, console):
     from ladartui.simulation import simulate
 
     cancel = threading.Event()
-    outcome = {}
     columns = (
         TextColumn("{task.description}"),
         BarColumn(),
@@ -76,26 +76,10 @@ def _simulate_with_progress(scenario, args, console):
                        description=f"scan {p.scan}/{p.scans} (scene and target runs)",
                        rays=f"{p.rays_done:,}/{p.rays_total:,} rays")
 
-        def work():
-            try:
-                outcome["result"] = simulate(
-                    scenario, progress=report, cancel=cancel, write=args.write, las=args.las)
-            except BaseException as error:  # handed to the main thread
-                outcome["error"] = error
-
-        worker = threading.Thread(target=work, name="ladartui-run", daemon=True)
-        worker.start()
-        try:
-            while worker.is_alive():
-                worker.join(0.1)
-        except KeyboardInterrupt:
-            cancel.set()
-            worker.join()
-            if "result" not in outcome:  # else it finished before it saw the cancel
-                raise Cancelled("run cancelled; nothing was written") from None
-    if "error" in outcome:
-        raise outcome["error"]
-    return outcome["result"]
+        return run_cancellable(
+            lambda: simulate(scenario, progress=report, cancel=cancel, write=args.write,
+                             las=args.las),
+            cancel, "ladartui-run", Cancelled("run cancelled; nothing was written"))
 
 
 def result_dict(scenario, result) -> dict:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import threading
 
+from ladartui.cli.progress import run_cancellable
 from ladartui.errors import Cancelled, FieldError
 
 DEFAULT_OUT = "study-results"
@@ -97,7 +98,6 @@ def _run_with_progress(console, inputs, settings, runs, warmup):
                   f"{len(inputs.poses)} scans, sensor {inputs.sensor.grid}x{inputs.sensor.grid}, "
                   f"{len(settings)} settings, median of {runs} runs")
     cancel = threading.Event()
-    outcome = {}
     progress_bar = Progress(TextColumn("{task.description}"), BarColumn(),
                             TextColumn("{task.completed}/{task.total} traces"),
                             TimeElapsedColumn(), console=console, transient=True)
@@ -113,26 +113,11 @@ def _run_with_progress(console, inputs, settings, runs, warmup):
             last["label"] = p.label
             console.print(f"[{p.done}/{p.total} traces] {p.label}", highlight=False)
 
-    def work():
-        try:
-            outcome["result"] = run_study(inputs, settings, runs=runs, warmup=warmup,
-                                          progress=report, cancel=cancel)
-        except BaseException as error:  # handed to the main thread
-            outcome["error"] = error
-
-    worker = threading.Thread(target=work, name="ladartui-study", daemon=True)
     with progress_bar:
-        worker.start()
-        try:
-            while worker.is_alive():
-                worker.join(0.1)
-        except KeyboardInterrupt:
-            cancel.set()
-            worker.join()
-            raise Cancelled("study cancelled") from None
-    if "error" in outcome:
-        raise outcome["error"]
-    return outcome["result"]
+        return run_cancellable(
+            lambda: run_study(inputs, settings, runs=runs, warmup=warmup, progress=report,
+                              cancel=cancel),
+            cancel, "ladartui-study", Cancelled("study cancelled"))
 
 
 def _report(result, out_dir) -> int:

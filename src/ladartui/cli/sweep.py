@@ -11,6 +11,7 @@ import json
 import signal
 import threading
 
+from ladartui.cli.progress import run_cancellable
 from ladartui.errors import Cancelled, FieldError
 
 DEFAULT_TOP = 10
@@ -134,39 +135,26 @@ def _sweep_with_progress(spec, args, console):
                 bar.update(task, completed=p.done, total=p.total, note=note)
 
             def work():
-                try:
-                    outcome["result"] = run_sweep(
-                        spec, client=client, progress=report, cancel=cancel, out=args.out,
-                        workers=args.workers, objective=args.objective, budget=args.budget,
-                        cost=args.cost, serial=args.serial)
-                except BaseException as error:  # handed to the main thread
-                    outcome["error"] = error
+                return run_sweep(
+                    spec, client=client, progress=report, cancel=cancel, out=args.out,
+                    workers=args.workers, objective=args.objective, budget=args.budget,
+                    cost=args.cost, serial=args.serial)
 
-            worker = threading.Thread(target=work, name="ladartui-sweep", daemon=True)
-            worker.start()
             previous = _stop_on_sigterm()
             try:
-                while worker.is_alive():
-                    worker.join(0.1)
-            except KeyboardInterrupt:
-                cancel.set()
-                worker.join()
-                if "result" not in outcome:
-                    outcome["error"] = Cancelled()
+                return run_cancellable(work, cancel, "ladartui-sweep", Cancelled())
+            except Cancelled:
+                pass  # reported below, once the client is closed
             finally:
                 _restore_sigterm(previous)
     finally:
         if client is not None:
             client.close()
-    if isinstance(outcome.get("error"), Cancelled):
-        last = outcome.get("progress")
-        kept = f"{last.done} of {last.total} variants are" if last else "finished variants are"
-        console.print(f"ladartui: sweep interrupted; {kept} kept in the results table; run the "
-                      "same command again to resume", highlight=False)
-        return None
-    if "error" in outcome:
-        raise outcome["error"]
-    return outcome["result"]
+    last = outcome.get("progress")
+    kept = f"{last.done} of {last.total} variants are" if last else "finished variants are"
+    console.print(f"ladartui: sweep interrupted; {kept} kept in the results table; run the "
+                  "same command again to resume", highlight=False)
+    return None
 
 
 def _stop_on_sigterm():
@@ -191,8 +179,6 @@ def _cell(value, digits=4) -> str:
     if isinstance(value, float):
         return f"{value:.{digits}g}"
     return str(value)
-
-
 
 
 def result_dict(result, top) -> dict:

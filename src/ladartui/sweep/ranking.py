@@ -6,6 +6,7 @@ import math
 from dataclasses import dataclass
 
 from ladartui.errors import FieldError
+from ladartui.pareto import pareto_front as front_of_minima
 
 # Column of the measure every objective is built on: the share of target
 # voxels seen through the foliage over the whole flight.
@@ -81,20 +82,14 @@ def pareto_front(points) -> list[bool]:
     """For (cost, coverage) pairs, whether each is on the front (less cost, more coverage).
 
     A point is dominated when another has cost <= and coverage >= with one of
-    them strict; equal points do not dominate each other. None pairs are off.
+    them strict; equal points do not dominate each other. None pairs, and pairs
+    holding a None or NaN, are off the front (the rule of ladartui.pareto).
     """
-    order = sorted((i for i, p in enumerate(points) if p is not None),
-                   key=lambda i: (points[i][0], -points[i][1]))
-    front = [False] * len(points)
-    best_cheaper = -math.inf  # best coverage among strictly cheaper points
-    group_cost, group_best = None, -math.inf  # the current equal-cost group and its best
-    for i in order:
-        cost, coverage = points[i]
-        if cost != group_cost:
-            best_cheaper = max(best_cheaper, group_best)
-            group_cost, group_best = cost, coverage
-        front[i] = not (best_cheaper >= coverage or group_best > coverage)
-    return front
+    return front_of_minima([None if p is None else (p[0], _negated(p[1])) for p in points])
+
+
+def _negated(value):
+    return None if value is None else -value
 
 
 def rank_rows(rows, objective="obscured-coverage", budget=None, cost="flight-time") -> list[Ranked]:

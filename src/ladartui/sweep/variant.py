@@ -79,43 +79,27 @@ def target_point(scene) -> tuple[float, float, float]:
     return tuple(float(v) for v in scene.target_centre_m())
 
 
-def _segment_target(segment):
-    if segment is None:
-        return None
-    return getattr(segment, "centre", None) or getattr(segment, "target", None)
+def _flypast_turn(side):
+    """Degrees from a fly-past's heading to the bearing of the target: the side it passes."""
+    return 90.0 if side == "right" else -90.0
 
 
-def _segment_bearing(segment):
-    """Compass bearing, from the target, of the base path's first or closest scan.
+def _base_geometry(segment):
+    """What a variant's preset takes from the base's: target, bearing, distance, scans.
 
-    Orbit: its start bearing; standoff: its bearing; fly-past: the side of the
-    target it passes (target on the right: 90 degrees left of the heading).
+    The bearing is that of the base path's first or closest scan, from the
+    target. Orbit: its start bearing; standoff: its bearing; fly-past: the side
+    of the target it passes (target on the right: 90 degrees left of the
+    heading). Without a base preset segment only the bearing has a default.
     """
     if segment is None:
-        return DEFAULT_BEARING
+        return None, DEFAULT_BEARING, None, None
     if segment.kind == "orbit":
-        return segment.start_bearing
-    if segment.kind == "standoff":
-        return segment.bearing
-    return segment.heading + (-90.0 if segment.side == "right" else 90.0)
-
-
-def _segment_distance(segment):
-    if segment is None:
-        return None
-    if segment.kind == "orbit":
-        return segment.radius
+        return segment.centre, segment.start_bearing, segment.radius, segment.scans
     if segment.kind == "flypast":
-        return segment.standoff
-    return max(segment.standoffs)
-
-
-def _scans_of(segment):
-    if segment is None:
-        return None
-    if segment.kind == "standoff":
-        return len(segment.standoffs)
-    return segment.scans
+        return (segment.target, segment.heading - _flypast_turn(segment.side),
+                segment.standoff, segment.scans)
+    return segment.target, segment.bearing, max(segment.standoffs), len(segment.standoffs)
 
 
 def _need(name, value, preset):
@@ -138,16 +122,16 @@ def build_preset(params: dict, base_segment, default_target):
 
     preset = params.get("preset") or base_segment.kind
     same = base_segment is not None and base_segment.kind == preset
-    target = _segment_target(base_segment) or default_target()
-    bearing = _segment_bearing(base_segment) + params.get("heading_offset", 0.0)
+    base_target, base_bearing, base_distance, base_scans = _base_geometry(base_segment)
+    target = base_target or default_target()
+    bearing = base_bearing + params.get("heading_offset", 0.0)
     altitude = params.get("altitude", getattr(base_segment, "altitude", None))
-    scans = params.get("scans", _scans_of(base_segment))
+    scans = params.get("scans", base_scans)
     distance_name = "radius" if preset == "orbit" else "standoff"
     distance = params.get(distance_name)
     if distance is None:
         # A changed preset keeps the base's distance from the target.
-        distance = params.get("standoff" if preset == "orbit" else "radius",
-                              _segment_distance(base_segment))
+        distance = params.get("standoff" if preset == "orbit" else "radius", base_distance)
     altitude = _need("altitude", altitude, preset)
     scans = _need("scans", scans, preset)
     distance = _need(distance_name, distance, preset)
@@ -165,7 +149,7 @@ def build_preset(params: dict, base_segment, default_target):
         side = fields.get("side", "right")
         length = fields.get("length", 2.0 * float(distance))
         fields.update(target=target, standoff=distance, altitude=altitude, scans=scans,
-                      heading=bearing + (90.0 if side == "right" else -90.0), length=length)
+                      heading=bearing + _flypast_turn(side), length=length)
         return FlyPast(**fields)
     fields = dataclasses.asdict(base_segment) if same else {}
     farthest = max(base_segment.standoffs) if same else 0.0

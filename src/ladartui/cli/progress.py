@@ -1,0 +1,48 @@
+"""Long commands: the work runs on a worker thread while the main thread draws progress.
+
+Python delivers Ctrl-C (and the signals turned into it) only to the main
+thread, so the main thread waits in short joins and, when interrupted, sets
+the work's cancel event and waits for the worker to stop between chunks.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import Callable, TypeVar
+
+from ladartui.errors import Cancelled
+
+T = TypeVar("T")
+
+POLL_SECONDS = 0.1  # how soon a Ctrl-C is noticed while waiting
+
+
+def run_cancellable(work: Callable[[], T], cancel: threading.Event, name: str,
+                    cancelled: Cancelled) -> T:
+    """``work()`` on a worker thread named ``name``; its result, or its error raised here.
+
+    On Ctrl-C the ``cancel`` event is set and the worker is awaited; if it had
+    not finished by then, ``cancelled`` is raised (a result that arrived first
+    is returned).
+    """
+    outcome = {}
+
+    def target():
+        try:
+            outcome["result"] = work()
+        except BaseException as error:  # handed to the main thread
+            outcome["error"] = error
+
+    worker = threading.Thread(target=target, name=name, daemon=True)
+    worker.start()
+    try:
+        while worker.is_alive():
+            worker.join(POLL_SECONDS)
+    except KeyboardInterrupt:
+        cancel.set()
+        worker.join()
+        if "result" not in outcome:  # else it finished before it saw the cancel
+            raise cancelled from None
+    if "error" in outcome:
+        raise outcome["error"]
+    return outcome["result"]
