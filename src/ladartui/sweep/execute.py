@@ -304,6 +304,10 @@ def _run_on_dask(client, todo, base, digest, scene, options, record, cancel):
                 time.sleep(_POLL_SECONDS)
                 continue
             for future in batch:
+                # A batch may hold many finished variants: honour a cancel set
+                # while recording them (they run again on resume).
+                if cancel is not None and cancel.is_set():
+                    raise Cancelled("sweep cancelled")
                 variant = pending.pop(future)
                 if future.status == "finished":
                     row = future.result()
