@@ -1,0 +1,716 @@
+"""Flight-path sweeps as a screen: launch or open a sweep, watch it, browse the ranking.
+
+The sweep runs in a thread worker through ``ladartui.sweep.run_sweep``; each
+finished variant reaches the screen through ``call_from_thread`` and the
+ranking and chart are redrawn at most a few times a second. Cancel sets the
+event the sweep checks between variants (and between trace chunks): the rows
+finished so far stay in ``results.csv`` and running the spec again resumes.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import threading
+from pathlib import Path
+
+from rich.text import Text
+from textual import on, work
+from textual.app import ComposeResult
+from textual.binding import Binding
+from textual.containers import Horizontal
+from textual.css.query import NoMatches
+from textual.message import Message
+from textual.screen import Screen
+from textual.validation import ValidationResult, Validator
+from textual.widgets import Button, Checkbox, DataTable, Footer, Input, Label, ProgressBar, Static
+from textual.worker import get_current_worker
+from textual_plotext import PlotextPlot
+
+from ladartui.errors import Cancelled, FieldError, InputFileError, LadarError
+from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
+
+OBJECTIVE_ORDER = ("obscured-coverage", "coverage-per-km", "coverage-within-budget")
+OBJECTIVE_HEADERS = {"obscured-coverage": "coverage", "coverage-per-km": "cov/km",
+                     "coverage-within-budget": "in budget"}
+COST_ORDER = ("flight-time", "distance")
+COST_HEADERS = {"flight-time": "time s", "distance": "dist m"}
+COST_LABELS = {"flight-time": "flight time (s)", "distance": "distance flown (m)"}
+VIEWS = ("both", "table", "chart")
+REDRAW_SECONDS = 0.4  # the ranking and chart are redrawn at most this often while running
+FRONT_MARKER = "◆"
+ERROR_WIDTH = 60  # error text in the table; the detail line shows it whole
+
+
+class ExistingPath(Validator):
+    """An Input validator: the path must exist (a spec, a results.csv or a results folder)."""
+
+    def validate(self, value: str) -> ValidationResult:
+        if not value.strip() or Path(value.strip()).expanduser().exists():
+            return self.success()
+        return self.failure(f"{value.strip()}: no such file or folder")
+
+
+def format_eta(seconds: float | None) -> str:
+    """``1h02m``, ``3m05s`` or ``12s``; ``--`` when unknown."""
+    if seconds is None or not math.isfinite(seconds):
+        return "--"
+    seconds = max(0, int(round(seconds)))
+    hours, rest = divmod(seconds, 3600)
+    minutes, secs = divmod(rest, 60)
+    if hours:
+        return f"{hours}h{minutes:02d}m"
+    if minutes:
+        return f"{minutes}m{secs:02d}s"
+    return f"{secs}s"
+
+
+def eta_seconds(progress) -> float | None:
+    """Time left at the pace of the variants run so far (resumed ones cost nothing)."""
+    ran = progress.done - progress.resumed
+    left = progress.total - progress.done
+    if left <= 0:
+        return 0.0
+    if ran <= 0 or progress.elapsed <= 0:
+        return None
+    return progress.elapsed / ran * left
+
+
+def _number(value, digits=4) -> str:
+    if value is None:
+        return "-"
+    if isinstance(value, float):
+        return f"{value:.{digits}g}"
+    return str(value)
+
+
+def short_path(path) -> str:
+    """``path`` relative to the working folder when inside it (status lines are 80 wide)."""
+    path = Path(path)
+    try:
+        return str(path.resolve().relative_to(Path.cwd().resolve()))
+    except ValueError:
+        return str(path)
+
+
+def start_resource_tracker() -> None:
+    """Start multiprocessing's resource tracker with the process's real stderr.
+
+    The tracker is handed ``sys.stderr.fileno()``; while the interface runs,
+    ``sys.stderr`` is a capture object whose descriptor is -1, so a local
+    cluster started then fails ("bad value(s) in fds_to_keep"). Started once
+    here, it is reused by every later cluster.
+    """
+    from multiprocessing import resource_tracker
+
+    captured = sys.stderr
+    sys.stderr = sys.__stderr__
+    try:
+        resource_tracker.ensure_running()
+    finally:
+        sys.stderr = captured
+
+
+def _sibling_spec(results: Path) -> Path | None:
+    """The spec whose default results folder is ``results`` (``S-results`` beside ``S.toml``)."""
+    folder = results if results.is_dir() else results.parent
+    if not folder.name.endswith("-results"):
+        return None
+    spec = folder.parent / (folder.name[: -len("-results")] + ".toml")
+    return spec if spec.is_file() else None
+
+
+class SweepScreen(Screen):
+    """Launch a flight-path sweep (or open an earlier one), watch it and rank its variants."""
+
+    class OpenScenario(Message):
+        """The analyst asked to open the best flight path's scenario file."""
+
+        def __init__(self, path) -> None:
+            super().__init__()
+            self.path = Path(path)
+
+    BINDINGS = [
+        Binding("f5", "run", "Run", priority=True),
+        Binding("f3", "open_results", "Open", priority=True),
+        Binding("ctrl+x", "cancel", "Cancel", priority=True),
+        Binding("f6", "objective", "Rank by", priority=True),
+        Binding("f7", "cost", "Cost", priority=True),
+        Binding("f8", "best", "Best", priority=True),
+        Binding("f9", "view", "View", priority=True),
+        Binding("escape", "close", "Back", priority=True),
+    ]
+    DEFAULT_CSS = """
+    SweepScreen { layout: vertical; }
+    SweepScreen .sweep-row { height: 1; }
+    SweepScreen .sweep-row Label { padding: 0 1; }
+    SweepScreen #sweep-path { width: 1fr; }
+    SweepScreen #sweep-scheduler { width: 1fr; }
+    SweepScreen #sweep-budget { width: 9; }
+    SweepScreen #sweep-serial { width: auto; margin-left: 1; }
+    SweepScreen #sweep-progress { width: auto; padding: 0 1; }
+    SweepScreen #sweep-progress Bar { width: 20; }
+    SweepScreen #sweep-counts { width: 1fr; }
+    SweepScreen #sweep-body { height: 1fr; }
+    SweepScreen #sweep-table { width: 3fr; height: 1fr; }
+    SweepScreen #sweep-chart { width: 2fr; height: 1fr; }
+    SweepScreen #sweep-body.-table #sweep-chart { display: none; }
+    SweepScreen #sweep-body.-chart #sweep-table { display: none; }
+    SweepScreen #sweep-detail { height: 1; padding: 0 1; background: $panel; }
+    """
+
+    def __init__(self, spec_path=None, *, scheduler: str | None = None, serial: bool = False,
+                 connect_timeout: float = 30.0, **kwargs):
+        """``spec_path``: a sweep spec, results.csv or results folder to open at once;
+        ``scheduler``: a Dask scheduler address to fill in; ``serial``: run without Dask."""
+        super().__init__(**kwargs)
+        self.connect_timeout = connect_timeout
+        self.initial_path = str(spec_path) if spec_path else ""
+        self.initial_scheduler = scheduler or ""
+        self.serial = serial
+        self.spec = None  # the SweepSpec launched or opened, when known
+        self.out: Path | None = None  # the results folder shown
+        self.rows: list[dict] = []
+        self.parameter_names: list[str] = []
+        self.ranking = []
+        self.objective = "obscured-coverage"
+        self.cost = "flight-time"
+        self.budget: float | None = None  # the spec's or the results' budget
+        self.view = "both"
+        self.progress = None  # the last SweepProgress
+        self.last_message = ""
+        self.running = False
+        self._cancel = threading.Event()
+        self._dirty = False
+        self._row_index: dict[str, int] = {}  # variant id -> position in rows, while running
+        self._shown_ids: list = []  # variant ids in table order
+
+    # -- layout ---------------------------------------------------------------
+
+    def compose(self) -> ComposeResult:
+        with Horizontal(classes="sweep-row"):
+            yield Label("Spec")
+            yield Input(self.initial_path, id="sweep-path", compact=True,
+                        placeholder="sweep spec .toml, or results.csv / results folder",
+                        validators=[ExistingPath()], validate_on=["changed", "submitted"],
+                        valid_empty=True)
+        with Horizontal(classes="sweep-row"):
+            yield Label("Scheduler")
+            yield Input(self.initial_scheduler, id="sweep-scheduler", compact=True,
+                        placeholder="tcp://HOST:8786 (empty: this machine)")
+            yield Label("Budget s")
+            yield Input(id="sweep-budget", compact=True, type="number", placeholder="spec",
+                        valid_empty=True)
+            yield Checkbox("serial", self.serial, id="sweep-serial", compact=True,
+                           tooltip="run the variants in this process, without Dask")
+        with Horizontal(classes="sweep-row"):
+            yield ProgressBar(id="sweep-progress", show_eta=False)
+            yield Static("", id="sweep-counts")
+        with Horizontal(id="sweep-body"):
+            yield DataTable(id="sweep-table", cursor_type="row", zebra_stripes=True)
+            yield PlotextPlot(id="sweep-chart")
+        yield Static("", id="sweep-detail")
+        yield StatusBar(id="sweep-status")
+        yield Footer(compact=True)
+
+    def on_mount(self) -> None:
+        self.set_interval(REDRAW_SECONDS, self._redraw_if_dirty)
+        self._draw_table()
+        self._draw_chart()
+        self._status(NOT_READY, "type a sweep spec (F5 runs it) or a results folder (F3 opens it)")
+        self.query_one("#sweep-path", Input).focus()
+        if self.initial_path:
+            self._open(self.initial_path)
+
+    # -- paths and checks -------------------------------------------------------
+
+    def _path_text(self) -> str:
+        return self.query_one("#sweep-path", Input).value.strip()
+
+    def _typed_budget(self) -> float | None:
+        """The Budget field (seconds), or None when empty; FieldError when not a positive number."""
+        text = self.query_one("#sweep-budget", Input).value.strip()
+        if not text:
+            return None
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not (math.isfinite(value) and value > 0):
+            raise FieldError("budget", text, "a flight-time budget in seconds, > 0")
+        return value
+
+    def _budget(self) -> float | None:
+        typed = self._typed_budget()
+        return typed if typed is not None else self.budget
+
+    def _check_spec(self, text: str):
+        """Load and check the spec at ``text`` and its base scenario; LadarError if unusable."""
+        from ladartui.scenario import load_scenario
+        from ladartui.sweep import load_sweep_spec
+        from ladartui.sweep.execute import base_scenario_path
+        from ladartui.sweep.spec import DEFAULT_BASE
+
+        if not text:
+            raise FieldError("spec", text, "the path of a sweep spec (.toml)")
+        path = Path(text).expanduser()
+        if path.is_dir() or path.suffix.lower() == ".csv":
+            sibling = _sibling_spec(path)
+            if sibling is None:
+                raise InputFileError(path, "expected a sweep spec (.toml) to run; F3 opens "
+                                     "results")
+            path = sibling
+        spec = load_sweep_spec(path)
+        if spec.scenario_path != DEFAULT_BASE:
+            load_scenario(base_scenario_path(spec))
+        return spec
+
+    # -- actions ------------------------------------------------------------------
+
+    def action_run(self) -> None:
+        """Check the spec and start the sweep in a thread worker (nothing starts on a mistake)."""
+        if self.running:
+            self._status(BUSY, "a sweep is already running: Ctrl+X cancels it", cancellable=True)
+            return
+        try:
+            spec = self._check_spec(self._path_text())
+            typed = self._typed_budget()
+            budget = typed if typed is not None else spec.budget
+            # The objective and cost chosen here carry over when the same spec runs again.
+            same = self.spec is not None and self.spec.path.resolve() == spec.path.resolve()
+            objective = self.objective if same else spec.objective
+            cost = self.cost if same else spec.cost
+            if objective == "coverage-within-budget" and budget is None:
+                raise FieldError("budget", None, "a flight-time budget in seconds for "
+                                 "objective 'coverage-within-budget'")
+        except LadarError as error:
+            self._status(NOT_READY, str(error))
+            return
+        from ladartui.sweep import default_out_dir
+        from ladartui.sweep.table import read_table
+
+        scheduler = self.query_one("#sweep-scheduler", Input).value.strip()
+        serial = self.query_one("#sweep-serial", Checkbox).value and not scheduler
+        self.spec, self.out = spec, default_out_dir(spec)
+        self.objective, self.cost, self.budget = objective, cost, spec.budget
+        self.parameter_names = spec.parameter_names
+        # Rows already in the table for this spec's variants show at once (they resume).
+        ids = {variant.id for variant in spec.variants}
+        stored, _ = read_table(self.out / "results.csv")
+        self.rows = [row for row in stored if row.get("variant") in ids]
+        self._row_index = {row["variant"]: i for i, row in enumerate(self.rows)}
+        self._rank()
+        if not serial and not scheduler:
+            start_resource_tracker()
+        self.running = True
+        self._cancel = threading.Event()
+        self.progress = None
+        self.query_one("#sweep-progress", ProgressBar).update(total=len(ids), progress=0)
+        where = (f"scheduler {scheduler}" if scheduler
+                 else "this process" if serial else "a local cluster")
+        self.query_one("#sweep-counts", Static).update(f"0/{len(ids)} starting on {where}")
+        self._status(BUSY, f"starting {len(ids)} variants on {where}; results in "
+                     f"{short_path(self.out)}", 0.0, cancellable=True)
+        self._sweep(spec, scheduler, serial, objective, cost, budget, self._cancel)
+
+    def action_open_results(self) -> None:
+        """Open the results of an earlier (or running elsewhere) sweep."""
+        if self.running:
+            self._status(BUSY, "a sweep is running: Ctrl+X cancels it first", cancellable=True)
+            return
+        self._open(self._path_text())
+
+    def action_cancel(self) -> None:
+        if self.running:
+            self._cancel.set()
+            self._status(BUSY, "cancelling after the current variant ...", self._fraction())
+        else:
+            self._status(self._idle_state(), "nothing is running")
+
+    def action_objective(self) -> None:
+        """Rank by the next objective (coverage within budget needs a budget)."""
+        self._switch("objective", OBJECTIVE_ORDER)
+
+    def action_cost(self) -> None:
+        """Switch the Pareto front's cost axis between flight time and distance."""
+        self._switch("cost", COST_ORDER)
+
+    def _switch(self, name: str, order) -> None:
+        start = order.index(getattr(self, name))
+        skipped = ""
+        for step in range(1, len(order) + 1):
+            setattr(self, name, order[(start + step) % len(order)])
+            try:
+                self._rank()
+                break
+            except LadarError as error:  # no usable budget: go on to the next choice
+                skipped = f"{error}; type it in Budget s"
+        self._redraw()
+        if skipped:
+            self._status(self._idle_state(), f"{skipped}; ranking by {self.objective}")
+            return
+        text = f"ranking by {self.objective}"
+        if self.objective == "coverage-within-budget":
+            text += f" (budget {self._budget():g} s)"
+        self._status(self._idle_state(), f"{text}, Pareto front against {self.cost}",
+                     self._fraction() if self.running else None, cancellable=self.running)
+
+    def action_view(self) -> None:
+        self.view = VIEWS[(VIEWS.index(self.view) + 1) % len(VIEWS)]
+        body = self.query_one("#sweep-body")
+        for view in VIEWS:
+            body.set_class(view == self.view and view != "both", f"-{view}")
+
+    def action_best(self) -> None:
+        """Show the best flight path's scenario file and ask the app to open it."""
+        best = self.ranking[0] if self.ranking and self.ranking[0].rank == 1 else None
+        if best is None:
+            self._status(self._idle_state(), f"no variant can be ranked by {self.objective}")
+            return
+        if self.spec is not None:
+            name = f"{self.spec.name}-best"
+            if self.objective != self.spec.objective:
+                name += f"-{self.objective}"
+            self._write_best(self.spec, best.row, list(self.parameter_names),
+                             self.out / f"{name}.toml", self.objective)
+            return
+        found = sorted(self.out.glob("*-best.toml")) if self.out is not None else []
+        if len(found) != 1:
+            self._status(self._idle_state(), "no best-path scenario in the results folder; "
+                         "open the sweep spec to save one")
+            return
+        self._announce_best(found[0], "as saved by the sweep (its spec's objective)")
+
+    def action_close(self) -> None:
+        self._cancel.set()
+        self.dismiss(None)
+
+    @on(Button.Pressed, "#cancel")
+    def _cancel_pressed(self) -> None:
+        self.action_cancel()
+
+    @on(Input.Submitted, "#sweep-path")
+    def _path_submitted(self) -> None:
+        if not self.running:
+            self._open(self._path_text())
+
+    @on(Input.Submitted, "#sweep-budget")
+    def _budget_submitted(self) -> None:
+        try:
+            self._rank()
+        except LadarError as error:
+            self._status(self._idle_state(), str(error))
+            return
+        self._redraw()
+        self._status(self._idle_state(), f"budget {self._budget():g} s"
+                     if self._budget() is not None else "budget from the spec")
+
+    @on(DataTable.RowHighlighted, "#sweep-table")
+    def _row_highlighted(self, event: DataTable.RowHighlighted) -> None:
+        self._show_detail(event.cursor_row)
+
+    # -- opening results ------------------------------------------------------------
+
+    def _open(self, text: str) -> None:
+        from ladartui.sweep import default_out_dir, load_sweep_results, load_sweep_spec
+
+        try:
+            if not text:
+                raise FieldError("spec", text, "a sweep spec, a results.csv or a results folder")
+            path = Path(text).expanduser()
+            spec = None
+            if path.suffix.lower() == ".toml":
+                spec = load_sweep_spec(path)
+                results = default_out_dir(spec)
+                if not (results / "results.csv").exists():
+                    self.spec, self.out, self.rows, self.ranking = spec, results, [], []
+                    self.objective, self.cost, self.budget = spec.objective, spec.cost, spec.budget
+                    self.parameter_names = spec.parameter_names
+                    self._redraw()
+                    self._show_stored(len(spec.variants))
+                    self._status(NOT_READY, f"{path}: {len(spec.variants)} variants, no results "
+                                 "yet: F5 runs the sweep")
+                    return
+            else:
+                results = path
+                sibling = _sibling_spec(path)
+                spec = load_sweep_spec(sibling) if sibling is not None else None
+            objective = spec.objective if spec else "obscured-coverage"
+            budget = spec.budget if spec else None
+            cost = spec.cost if spec else "flight-time"
+            result = load_sweep_results(results, objective=objective, budget=budget, cost=cost)
+        except LadarError as error:
+            self._status(NOT_READY, str(error))
+            return
+        self.spec = spec
+        self.out = result.results_path.parent
+        self.rows, self.ranking = result.rows, result.ranking
+        self.objective, self.cost, self.budget = result.objective, result.cost, result.budget
+        self.parameter_names = spec.parameter_names if spec else result.parameter_names
+        self.progress = None
+        self._redraw()
+        self._show_stored(len(spec.variants) if spec else len(self.rows))
+        self.query_one("#sweep-table", DataTable).focus()
+        self._status(READY, f"{short_path(result.results_path)}: {self._summary()}; "
+                     f"ranked by {self.objective}")
+
+    def _summary(self) -> str:
+        ok = sum(row.get("status") == "ok" for row in self.rows)
+        return f"{len(self.rows)} variants, {ok} ok, {len(self.rows) - ok} failed"
+
+    def _show_stored(self, total: int) -> None:
+        """Progress row of opened results: variants in the table out of the spec's."""
+        self.query_one("#sweep-progress", ProgressBar).update(total=max(total, 1),
+                                                              progress=len(self.rows))
+        text = self._summary()
+        if total != len(self.rows):
+            text = f"{len(self.rows)}/{total} stored: " + text.split(" ", 2)[2]
+        self.query_one("#sweep-counts", Static).update(text)
+
+    # -- the sweep worker ---------------------------------------------------------------
+
+    @work(thread=True, exclusive=True, group="sweep")
+    def _sweep(self, spec, scheduler: str, serial: bool, objective: str, cost: str, budget,
+               cancel: threading.Event) -> None:
+        from ladartui.sweep import connect, run_sweep
+
+        worker = get_current_worker()
+        client = None
+
+        def progress(p):
+            if worker.is_cancelled:
+                cancel.set()
+            self._post(self._show_progress, p)
+
+        try:
+            if scheduler:
+                self._post(self._status, BUSY, f"connecting to {scheduler} ...", 0.0, True)
+                client = connect(scheduler, self.connect_timeout)
+            result = run_sweep(spec, client=client, progress=progress, cancel=cancel,
+                               objective=objective, cost=cost, budget=budget, serial=serial)
+        except Cancelled:
+            self._post(self._finish, None, "cancelled")
+        except LadarError as error:
+            self._post(self._finish, None, str(error))
+        except Exception as error:  # noqa: BLE001 - a crash is shown, never kills the app
+            self._post(self._finish, None, f"{type(error).__name__}: {error}")
+        else:
+            self._post(self._finish, result, "")
+        finally:
+            if client is not None:
+                client.close()
+
+    def _post(self, callback, *args) -> None:
+        def guarded():
+            if not self.is_attached:  # closed meanwhile
+                return
+            try:
+                callback(*args)
+            except NoMatches:
+                pass  # the screen was being taken down as the message arrived
+
+        try:
+            self.app.call_from_thread(guarded)
+        except RuntimeError:
+            pass  # the app has closed
+
+    # -- updates on the UI thread ------------------------------------------------
+
+    def _show_progress(self, p) -> None:
+        self.progress = p
+        if p.row is not None:
+            index = self._row_index.get(p.row.get("variant"))
+            if index is None:  # a new variant; a resumed one replaces its stored row
+                self._row_index[p.row.get("variant")] = len(self.rows)
+                self.rows.append(p.row)
+            else:
+                self.rows[index] = p.row
+            self._dirty = True
+        self.query_one("#sweep-progress", ProgressBar).update(total=max(p.total, 1),
+                                                              progress=p.done)
+        self.query_one("#sweep-counts", Static).update(self._counts_text(p))
+        if not self._cancel.is_set():
+            self._status(BUSY, f"sweeping into {short_path(self.out)}", p.fraction,
+                         cancellable=True)
+
+    def _counts_text(self, p) -> str:
+        return (f"{p.done}/{p.total}, {p.failed} failed, {p.resumed} resumed, "
+                f"ETA {format_eta(eta_seconds(p))}")
+
+    def _finish(self, result, error: str) -> None:
+        self.running = False
+        p = self.progress
+        if result is not None:
+            self.rows, self.ranking = result.rows, result.ranking
+            self.objective, self.cost, self.budget = result.objective, result.cost, result.budget
+            self.out = result.results_path.parent
+            self._redraw()
+            note = "" if not result.failures else f", {len(result.failures)} failed"
+            self.query_one("#sweep-progress", ProgressBar).update(
+                total=max(len(result.rows), 1), progress=len(result.rows))
+            self.query_one("#sweep-counts", Static).update(self._summary())
+            self._status(READY, f"sweep done: {result.ran} run, {result.resumed} resumed{note} "
+                         f"in {format_eta(result.elapsed)}; results in {short_path(self.out)}",
+                         1.0)
+            return
+        self._rank_quietly()
+        self._redraw()
+        kept = f"{p.done} of {p.total} variants kept" if p else "finished variants kept"
+        if error == "cancelled":
+            self._status(NOT_READY, f"sweep cancelled: {kept} in {short_path(self.out)}; "
+                         "F5 resumes")
+        else:
+            self._status(NOT_READY, f"sweep stopped: {error}")
+
+    def _redraw_if_dirty(self) -> None:
+        if self._dirty:
+            self._rank_quietly()
+            self._redraw()
+
+    def _rank(self) -> None:
+        from ladartui.sweep import rank_rows
+
+        budget = self._budget() if self.objective == "coverage-within-budget" else None
+        self.ranking = rank_rows(self.rows, self.objective, budget, self.cost)
+
+    def _rank_quietly(self) -> None:
+        try:
+            self._rank()
+        except LadarError:
+            from ladartui.sweep import rank_rows
+
+            self.ranking = rank_rows(self.rows, "obscured-coverage", None, self.cost)
+            self.objective = "obscured-coverage"
+
+    def _redraw(self) -> None:
+        self._dirty = False
+        self._draw_table()
+        self._draw_chart()
+
+    def _draw_table(self) -> None:
+        table = self.query_one("#sweep-table", DataTable)
+        # Keep the cursor on the same variant when the order changes.
+        current = (self._shown_ids[table.cursor_row]
+                   if 0 <= table.cursor_row < len(self._shown_ids) else None)
+        self._shown_ids = [entry.row.get("variant") for entry in self.ranking]
+        cursor = self._shown_ids.index(current) if current in self._shown_ids else 0
+        table.clear(columns=True)
+        table.add_column("#", key="rank")
+        table.add_column("P", key="pareto")
+        table.add_column(OBJECTIVE_HEADERS[self.objective], key="objective")
+        if self.objective != "obscured-coverage":
+            table.add_column("cov %", key="coverage")
+        table.add_column(COST_HEADERS[self.cost], key="cost")
+        table.add_column("status", key="status")
+        for name in self.parameter_names:
+            table.add_column(name, key=f"param:{name}")
+        table.add_column("variant", key="variant")
+        table.add_column("error", key="error")
+        for index, entry in enumerate(self.ranking):
+            table.add_row(*self._cells(entry), key=str(index))
+        if self.ranking:
+            table.move_cursor(row=cursor)
+            self._show_detail(table.cursor_row)
+        else:
+            self.query_one("#sweep-detail", Static).update("")
+
+    def _cells(self, entry) -> list:
+        row = entry.row
+        status = row.get("status") or "?"
+        if self.objective == "obscured-coverage":
+            value = "-" if entry.value is None else f"{100 * entry.value:.2f}%"
+        else:
+            value = _number(entry.value)
+        cells = [
+            "-" if entry.rank is None else str(entry.rank),
+            Text(FRONT_MARKER, style="bold #ffaf00") if entry.pareto else "",
+            value,
+        ]
+        if self.objective != "obscured-coverage":
+            cells.append("-" if entry.coverage is None else f"{100 * entry.coverage:.2f}")
+        cells.append(_number(entry.cost))
+        cells.append(Text(status, style="green" if status == "ok" else "bold red"))
+        cells.extend(_number(row.get(name)) for name in self.parameter_names)
+        cells.append(str(row.get("variant") or ""))
+        error = str(row.get("error") or "")
+        cells.append(Text(error[:ERROR_WIDTH] + ("…" if len(error) > ERROR_WIDTH else ""),
+                          style="red"))
+        return cells
+
+    def _show_detail(self, index: int) -> None:
+        detail = self.query_one("#sweep-detail", Static)
+        if not (0 <= index < len(self.ranking)):
+            detail.update("")
+            return
+        entry = self.ranking[index]
+        row = entry.row
+        params = ", ".join(f"{name}={_number(row.get(name))}" for name in self.parameter_names
+                           if row.get(name) is not None)
+        text = Text(f"{row.get('variant')}: {params or 'base scenario'}")
+        if row.get("status") != "ok":
+            text.append(f"  {row.get('status')}: {row.get('error') or ''}", style="bold red")
+        elif entry.pareto:
+            text.append("  on the Pareto front", style="#ffaf00")
+        detail.update(text)
+
+    def _draw_chart(self) -> None:
+        plot = self.query_one("#sweep-chart", PlotextPlot)
+        plt = plot.plt
+        plt.clear_data()
+        plt.title(f"{FRONT_MARKER} Pareto front  ★ best")
+        plt.xlabel(COST_LABELS[self.cost])
+        plt.ylabel("coverage %")
+        points = [(e.cost, 100 * e.coverage, e) for e in self.ranking
+                  if e.cost is not None and e.coverage is not None]
+        if points:
+            others = [p for p in points if not p[2].pareto]
+            if others:
+                plt.scatter([p[0] for p in others], [p[1] for p in others], marker="●",
+                            color="cyan")
+            front = sorted((p for p in points if p[2].pareto), key=lambda p: p[0])
+            plt.plot([p[0] for p in front], [p[1] for p in front], marker=FRONT_MARKER,
+                     color="orange")
+            best = [p for p in points if p[2].rank == 1]
+            if best:
+                plt.scatter([best[0][0]], [best[0][1]], marker="★", color="green")
+        plot.refresh()
+
+    def _fraction(self) -> float | None:
+        return self.progress.fraction if self.progress is not None else None
+
+    def _idle_state(self) -> str:
+        if self.running:
+            return BUSY
+        return READY if self.ranking else NOT_READY
+
+    def _status(self, state: str, message: str, progress: float | None = None,
+                cancellable: bool = False) -> None:
+        message = " ".join(message.split())  # always one line
+        self.last_message = message
+        self.query_one("#sweep-status", StatusBar).show(state, message, progress,
+                                                        cancellable or self.running)
+
+    # -- best path ----------------------------------------------------------------
+
+    @work(thread=True, exclusive=True, group="sweep-best")
+    def _write_best(self, spec, row: dict, parameter_names, path: Path, objective: str) -> None:
+        from ladartui.scenario import load_scenario
+        from ladartui.sweep.execute import base_scenario_path, write_best_scenario
+
+        try:
+            base = load_scenario(base_scenario_path(spec))
+            written = write_best_scenario(path, base, row, parameter_names, base.load_scene)
+        except LadarError as error:
+            self._post(self._status, NOT_READY, f"cannot save the best path: {error}")
+            return
+        except Exception as error:  # noqa: BLE001 - shown, never kills the app
+            self._post(self._status, NOT_READY,
+                       f"cannot save the best path: {type(error).__name__}: {error}")
+            return
+        self._post(self._announce_best, written, f"best by {objective}")
+
+    def _announce_best(self, path: Path, how: str) -> None:
+        self.query_one("#sweep-detail", Static).update(f"best path: {path}")
+        self._status(self._idle_state(), f"best path ({how}): {path}",
+                     self._fraction() if self.running else None)
+        self.post_message(self.OpenScenario(path))

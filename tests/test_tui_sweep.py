@@ -1,0 +1,324 @@
+"""The sweep screen driven by a Pilot: open results, reject bad specs, run and cancel a sweep.
+
+Every sweep here runs serially in this process on a hand-made 24 x 24 scene
+with an 8 x 8 detector sensor, so each variant takes milliseconds.
+"""
+
+from __future__ import annotations
+
+import math
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pytest
+from textual.app import App
+from textual.widgets import DataTable
+
+from ladartui.scenario import load_scenario
+from ladartui.sweep import read_table, run_sweep
+from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
+from ladartui.tui.sweep_screen import SweepScreen, eta_seconds, format_eta
+
+SIZE = (80, 24)
+CENTRE = (11.5, 11.5, 0.5)
+
+
+class _Host(App):
+    """A bare app that shows one SweepScreen and records the scenarios it asks to open."""
+
+    def __init__(self, screen: SweepScreen):
+        super().__init__()
+        self.sweep_screen = screen
+        self.opened = []
+
+    def on_mount(self) -> None:
+        self.push_screen(self.sweep_screen)
+
+    def on_sweep_screen_open_scenario(self, message: SweepScreen.OpenScenario) -> None:
+        self.opened.append(message.path)
+
+
+def write_base(folder):
+    """A 24 x 24 canopy with gaps over a 4 x 2 x 2 vehicle; a 2-scan orbit, 8 x 8 detectors."""
+    from ladartui.flight import FlightPlan, Orbit
+    from ladartui.scenario import Scenario
+    from ladartui.scene.voxels import save_voxels
+    from ladartui.sensor import Sensor
+
+    target = np.array([(i, j, k) for i in range(10, 14) for j in range(11, 13) for k in range(2)],
+                      np.int32)
+    canopy = np.array([(i, j, 5) for i in range(24) for j in range(24) if (i * 5 + j * 3) % 4 == 0],
+                      np.int32)
+    save_voxels(folder / "tiny.txt", np.concatenate([target, canopy]))
+    save_voxels(folder / "tiny_Target.txt", target)
+    flight = FlightPlan(segments=(Orbit(centre=CENTRE, radius=15.0, altitude=15.0, scans=2),))
+    Scenario(folder / "base.toml", "tiny.txt", 1.0, Sensor(grid=8, ray_grid=1, fov=25.0),
+             flight, backend="numba").save()
+
+
+def write_spec(folder, body, name="spec.toml"):
+    path = folder / name
+    path.write_text(f'[sweep]\nscenario = "base.toml"\nname = "tiny"\n{body}', encoding="utf-8")
+    return path
+
+
+SMALL_GRID = """
+[grid]
+radius = [8.0, 15.0, 30.0]
+scans = [1, 3]
+sensor_grid = [8, 0]
+"""
+
+
+@pytest.fixture(scope="module")
+def finished(tmp_path_factory):
+    """A sweep run to the end by the core (serially): its spec and results folder."""
+    folder = tmp_path_factory.mktemp("sweep")
+    write_base(folder)
+    spec = write_spec(folder, SMALL_GRID)
+    result = run_sweep(spec, serial=True)
+    return spec, result.results_path.parent
+
+
+# Generous: a numba kernel recompiled after an edit elsewhere can take minutes on a busy machine.
+async def wait_for(pilot, condition, timeout=300.0):
+    start = time.monotonic()
+    while not condition():
+        if time.monotonic() - start > timeout:
+            screen = pilot.app.sweep_screen
+            raise AssertionError(f"timed out; status: {screen.last_message!r}")
+        await pilot.pause(0.05)
+
+
+def table_column(table: DataTable, key: str) -> list[str]:
+    return [str(cell) for cell in table.get_column(key)]
+
+
+def status_of(screen) -> StatusBar:
+    return screen.query_one("#sweep-status", StatusBar)
+
+
+async def test_opening_results_shows_the_ranking_failures_and_pareto_front(finished):
+    spec, results = finished
+    rows, _ = read_table(results / "results.csv")
+    ok = [r for r in rows if r["status"] == "ok"]
+    failed = [r for r in rows if r["status"] != "ok"]
+    assert len(rows) == 12 and len(failed) == 6  # sensor_grid = 0 is impossible
+    screen = SweepScreen(results)
+    app = _Host(screen)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        table = screen.query_one("#sweep-table", DataTable)
+        assert status_of(screen).state == READY
+        assert table.row_count == 12
+        # At 80 x 24 every key is in the footer, and the table and chart share the body.
+        from textual.widgets._footer import FooterKey
+
+        shown_keys = {key.action: key.region for key in screen.query(FooterKey)}
+        for binding in SweepScreen.BINDINGS:
+            region = shown_keys[binding.action]
+            assert region.width > 0 and region.right <= SIZE[0], binding.action
+        assert table.region.height >= 12 and screen.query_one("#sweep-chart").region.width >= 28
+        # Ranked by the spec's objective (obscured coverage): best first, ties to the cheaper.
+        expected = sorted(ok, key=lambda r: (-r["obscured_coverage"], r["flight_time_s"]))
+        shown = table_column(table, "variant")
+        assert shown[:len(ok)] == [r["variant"] for r in expected]
+        assert table_column(table, "rank")[:len(ok)] == [str(i + 1) for i in range(len(ok))]
+        # Failed variants come last, unranked, with their error.
+        assert set(shown[len(ok):]) == {r["variant"] for r in failed}
+        assert table_column(table, "rank")[len(ok):] == ["-"] * len(failed)
+        assert all("sensor_grid" in e for e in table_column(table, "error")[len(ok):])
+        # Pareto marks: no other ok variant is at least as cheap and as good, one strictly.
+        points = {r["variant"]: (r["flight_time_s"], r["obscured_coverage"]) for r in ok}
+
+        def dominated(v):
+            c, g = points[v]
+            return any(c2 <= c and g2 >= g and (c2 < c or g2 > g)
+                       for w, (c2, g2) in points.items() if w != v)
+
+        marks = dict(zip(shown, table_column(table, "pareto")))
+        assert {v for v in points if marks[v]} == {v for v in points if not dominated(v)}
+        assert not any(marks[r["variant"]] for r in failed)
+
+        # Another objective re-ranks: coverage per kilometre flown.
+        table.move_cursor(row=2)
+        await pilot.pause()
+        highlighted = shown[2]
+        await pilot.press("f6")
+        assert screen.objective == "coverage-per-km"
+        # The cursor stays on the variant it was on.
+        assert table_column(table, "variant")[table.cursor_row] == highlighted
+        # A one-scan orbit flies no distance: no coverage per km, so it is not ranked.
+        flown = [r for r in ok if r["path_length_m"] > 0]
+        assert 0 < len(flown) < len(ok)
+        per_km = sorted(flown, key=lambda r: (-r["obscured_coverage"] / (r["path_length_m"] / 1000),
+                                              r["flight_time_s"]))
+        assert table_column(table, "variant")[:len(flown)] == [r["variant"] for r in per_km]
+        assert table_column(table, "rank")[len(flown):] == ["-"] * (12 - len(flown))
+
+        # The best path is saved as a scenario with its parameters and handed to the app.
+        await pilot.press("f8")
+        await wait_for(pilot, lambda: app.opened)
+        best = load_scenario(app.opened[0])
+        assert app.opened[0].parent == results
+        orbit = best.flight.segments[0]
+        assert orbit.radius == per_km[0]["radius"] and orbit.scans == per_km[0]["scans"]
+        assert str(app.opened[0]) in screen.last_message
+
+        # The detail line shows a failed variant's whole error.
+        table.move_cursor(row=table.row_count - 1)
+        await pilot.pause()
+        detail = str(screen.query_one("#sweep-detail").render())
+        assert "error: sensor_grid = 0" in detail
+
+        # No budget in the spec or the field: the budget objective is skipped, with the reason.
+        await pilot.press("f6")
+        assert screen.objective == "obscured-coverage"
+        assert "budget" in screen.last_message
+
+
+async def test_budget_objective_ranks_only_paths_within_the_typed_budget(finished):
+    spec, results = finished
+    rows, _ = read_table(results / "results.csv")
+    ok = [r for r in rows if r["status"] == "ok"]
+    times = sorted({r["flight_time_s"] for r in ok})
+    budget = (times[0] + times[1]) / 2  # between the two shortest flight times
+    screen = SweepScreen(spec)
+    app = _Host(screen)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        screen.query_one("#sweep-budget").value = f"{budget}"
+        await pilot.press("f6", "f6")
+        assert screen.objective == "coverage-within-budget"
+        table = screen.query_one("#sweep-table", DataTable)
+        ranks = table_column(table, "rank")
+        within = [r for r in ok if r["flight_time_s"] <= budget]
+        assert 0 < len(within) < len(ok)
+        assert sum(rank != "-" for rank in ranks) == len(within)
+        assert table_column(table, "variant")[0] == max(
+            within, key=lambda r: r["obscured_coverage"])["variant"]
+
+
+async def test_a_missing_spec_gives_one_line_and_starts_nothing(tmp_path):
+    missing = tmp_path / "nowhere.toml"
+    screen = SweepScreen(missing, serial=True)
+    app = _Host(screen)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("f5")
+        await pilot.pause()
+        assert status_of(screen).state == NOT_READY
+        assert str(missing) in screen.last_message and "no such sweep spec" in screen.last_message
+        assert not screen.running and not list(screen.workers)
+        assert not (tmp_path / "nowhere-results").exists()
+
+
+async def test_a_spec_mistake_names_its_line_and_starts_nothing(tmp_path):
+    write_base(tmp_path)
+    spec = write_spec(tmp_path, "[grid]\nradius = [10.0]\nscans = [2, 2.5]\n")
+    screen = SweepScreen(spec, serial=True)
+    app = _Host(screen)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("f5")
+        await pilot.pause()
+        message = screen.last_message
+        assert status_of(screen).state == NOT_READY
+        assert message.startswith(f"{spec}:6: grid.scans") and "2.5" in message
+        assert "\n" not in message
+        assert not screen.running and not list(screen.workers)
+        assert not (tmp_path / "spec-results").exists()
+
+
+async def test_a_running_sweep_cancels_keeps_its_rows_and_stays_responsive(tmp_path, finished):
+    # ``finished`` ran a sweep in this process already, so the kernels are compiled.
+    write_base(tmp_path)
+    # 720 variants: far more than run while the test waits, so only Cancel can end it early.
+    spec = write_spec(tmp_path, "[grid]\nheading_offset = { start = 0, stop = 359.5, step = 0.5 }"
+                                "\nscans = [1]\n")
+    results = tmp_path / "spec-results" / "results.csv"
+    screen = SweepScreen(spec, serial=True)
+    app = _Host(screen)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("f5")
+        assert screen.running and status_of(screen).state == BUSY
+        await wait_for(pilot, lambda: screen.progress is not None and screen.progress.done >= 2)
+        # Keys still act while the worker runs.
+        await pilot.press("f9")
+        assert screen.running and screen.query_one("#sweep-body").has_class("-table")
+        await pilot.press("ctrl+x")
+        await wait_for(pilot, lambda: not screen.running)
+        assert "cancelled" in screen.last_message and status_of(screen).state == NOT_READY
+        done = screen.progress.done
+        assert 2 <= done < 720
+        kept, _ = read_table(results)
+        assert len(kept) == done and all(r["status"] == "ok" for r in kept)
+        assert screen.query_one("#sweep-table", DataTable).row_count == done
+        counts = str(screen.query_one("#sweep-counts").render())
+        assert counts.startswith(f"{done}/720, 0 failed, 0 resumed") and "ETA" in counts
+        await pilot.press("f6")
+        assert screen.objective == "coverage-per-km"
+        # Run again and leave at once: Escape closes the screen and cancels the run.
+        await pilot.press("f5", "escape")
+        await pilot.pause()
+        assert app.screen is not screen
+        await wait_for(pilot, lambda: not any(w.is_running for w in app.workers))
+        rows, _ = read_table(results)
+        assert done <= len(rows) < 720
+        # The kept variants were resumed, not run again: their rows are as they were.
+        again = {r["variant"]: r for r in rows}
+        assert len(again) == len(rows)
+        assert all(again[r["variant"]] == r for r in kept)
+
+
+async def test_an_unreachable_scheduler_gives_one_line_and_writes_nothing(tmp_path):
+    write_base(tmp_path)
+    spec = write_spec(tmp_path, "[grid]\nradius = [10.0, 20.0]\n")
+    screen = SweepScreen(spec, scheduler="tcp://127.0.0.1:9", connect_timeout=0.5)
+    app = _Host(screen)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("f5")
+        assert screen.running
+        await wait_for(pilot, lambda: not screen.running, timeout=60)
+        message = screen.last_message
+        assert status_of(screen).state == NOT_READY
+        assert "--scheduler" in message and "tcp://127.0.0.1:9" in message and "\n" not in message
+        assert not (tmp_path / "spec-results" / "results.csv").exists()
+
+
+TRACKER_SCRIPT = """
+import asyncio, multiprocessing, sys
+from textual.app import App
+from ladartui.tui.sweep_screen import start_resource_tracker
+
+async def main():
+    async with App().run_test():
+        assert sys.stderr.fileno() == -1, "the app no longer captures stderr"
+        start_resource_tracker()
+        multiprocessing.get_context("spawn").Lock()  # registers with the tracker
+        print("lock made")
+
+asyncio.run(main())
+"""
+
+
+def test_a_local_cluster_can_start_while_the_interface_captures_stderr():
+    # Without the tracker started first, making the lock fails: bad value(s) in fds_to_keep.
+    done = subprocess.run([sys.executable, "-c", TRACKER_SCRIPT], capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "lock made" in done.stdout
+
+
+def test_eta_counts_only_the_variants_run_here():
+    from ladartui.sweep import SweepProgress
+
+    progress = SweepProgress(total=10, done=6, resumed=2, failed=0, elapsed=8.0)
+    assert eta_seconds(progress) == pytest.approx(8.0 / 4 * 4)
+    assert eta_seconds(SweepProgress(10, 2, 2, 0, 1.0)) is None
+    assert format_eta(125) == "2m05s" and format_eta(3725) == "1h02m" and format_eta(None) == "--"
+    assert format_eta(math.inf) == "--"
