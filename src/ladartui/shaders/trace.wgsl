@@ -9,8 +9,9 @@
 // Cell space: voxel (i, j, k) spans [i, i+1) on each axis, ground at c_z = 0.
 // tracing/wgpu_backend.py prepends a header declaring `alias real = f64;`
 // (or f32) and the occupancy bindings, read through `fn occ(word) -> u32`:
-// one logical u32 array [root | regions | tiles | bricks | columns] that may
-// be split over several storage bindings. INF stands for +inf: WGSL has no
+// one logical u32 array [root | regions | tiles | bricks | columns | cubes] that
+// may be split over several storage bindings; cubes holds the four octants'
+// u8 sides of one brick cell in one word (byte `octant`). INF stands for +inf: WGSL has no
 // infinity literal, and no ray parameter comes near 1e30.
 //
 // Loop budget: lavapipe (llvmpipe) ends every loop of an invocation once all its
@@ -30,6 +31,8 @@ struct Params {
     bases: vec4<u32>,        // first word of root, regions, tiles, bricks in occ()
     run: vec4<i32>,          // ray count, method (0 exact, 1 march), zmax, root cells
     extra: vec4<u32>,        // first word of columns in occ(), march: first sample, samples per pass, unused
+    cube_origin: vec4<i32>,  // brick cell of the empty-cube box's corner; w: first word of cubes in occ()
+    cube_dims: vec4<i32>,    // its size in bricks; all zero without cubes (no jumps)
     reals: vec2<real>,       // march step (voxels), unused
 }
 
@@ -156,7 +159,9 @@ fn clamp_i(v: i32, lo: i32, hi: i32) -> i32 {
 // (numba: the per-ray body of _exact_kernel, steps 1 to 5).
 // Empty root cells and regions are skipped as nodes; inside a tile a DDA over
 // 8-voxel bricks skips empty bricks (and, going down, the part of a brick column
-// above its highest brick); inside a brick a voxel DDA tests bits.
+// above its highest brick), jumps across the empty cube of bricks ahead of the
+// ray (Occupancy.cubes) and walks on past tile faces while bricks are known
+// empty; inside a brick a voxel DDA tests bits.
 fn first_voxel(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hit {
     let none = miss();
     if (params.run.w == 0) {  // empty scene: no root cells
@@ -209,6 +214,18 @@ fn first_voxel(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hi
     let qy0 = ry0 >> 3u;
     let qz0 = rz0 >> 3u;
     let qnx = rdx * 64;
+    // Empty-cube sides (see Occupancy.cubes) for this ray's octant.
+    let dox = params.cube_origin.x;
+    let doy = params.cube_origin.y;
+    let doz = params.cube_origin.z;
+    let cube_base = bitcast<u32>(params.cube_origin.w);
+    var ddx = params.cube_dims.x;
+    let ddy = params.cube_dims.y;
+    let ddz = params.cube_dims.z;
+    let octant = select(1u, 0u, px) | select(2u, 0u, py);
+    if (pz) {  // cubes are kept for rays that do not climb only
+        ddx = 0;
+    }
     let descending = dz < 0.0;
     let cap = 4 * (hi.x - lo.x + hi.y - lo.y + hi.z - lo.z) + 64;
     var steps = 0;
@@ -236,7 +253,24 @@ fn first_voxel(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hi
                 var sty = false;
                 var stz = false;
                 while (steps < cap) {
-                    let br = occ(tile + u32((bx & 7) | ((by & 7) << 3u) | ((bz & 7) << 6u)));
+                    // The empty cubes tell empty bricks without the tile; only a
+                    // brick it cannot vouch for needs the tile, so only then does
+                    // leaving the tile end this walk.
+                    let ux = bx - dox;
+                    let uy = by - doy;
+                    let uz = bz - doz;
+                    var far = -1;
+                    if (0 <= ux && ux < ddx && 0 <= uy && uy < ddy && 0 <= uz && uz < ddz) {
+                        let word = occ(cube_base + u32(ux + ddx * (uy + ddy * uz)));
+                        far = i32((word >> (octant << 3u)) & 255u);
+                    }
+                    var br = 0u;
+                    if (far <= 0) {
+                        if ((bx >> 3u) != gx || (by >> 3u) != gy || (bz >> 3u) != gz) {
+                            break;
+                        }
+                        br = occ(tile + u32((bx & 7) | ((by & 7) << 3u) | ((bz & 7) << 6u)));
+                    }
                     if (br != 0u) {
                         if (!fresh) {
                             cx = brick_entry(bx, stx, px, ox, dx, ix, t);
@@ -288,22 +322,36 @@ fn first_voxel(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hi
                         bz = cz >> 3u;
                         fresh = true;
                     } else {
-                        // Skip the empty brick, or for a descending ray above the
-                        // highest brick of its brick column, that whole column part.
-                        let tbx = select(INF, (real(select(bx << 3u, (bx + 1) << 3u, px)) - ox) * ix, mx);
-                        let tby = select(INF, (real(select(by << 3u, (by + 1) << 3u, py)) - oy) * iy, my);
+                        // Skip empty bricks: the cube of `far` empty bricks ahead
+                        // (Occupancy.cubes; one brick without it), or for a
+                        // descending ray above the highest brick of its brick column
+                        // that whole column part, whichever reaches further.
+                        var k = select(1, far, far >= 2);
+                        var near = k - 1;
+                        var tbx = select(INF, (real(select((bx - near) << 3u, (bx + k) << 3u, px)) - ox) * ix, mx);
+                        var tby = select(INF, (real(select((by - near) << 3u, (by + k) << 3u, py)) - oy) * iy, my);
+                        var tbz = select(INF, (real(select((bz - near) << 3u, (bz + k) << 3u, pz)) - oz) * iz, mz);
+                        var tn = min(tbx, min(tby, tbz));
                         var top = bz + 1;
                         if (descending) {
                             top = i32(occ(params.extra.x + u32((bx - qx0) + qnx * (by - qy0)))) + qz0;
                         }
-                        let above = bz >= top;
-                        var tbz: real;
+                        var above = bz >= top;
                         if (above) {
-                            tbz = (real(top << 3u) - oz) * iz;
-                        } else {
-                            tbz = select(INF, (real(select(bz << 3u, (bz + 1) << 3u, pz)) - oz) * iz, mz);
+                            let tcx = select(INF, (real(select(bx << 3u, (bx + 1) << 3u, px)) - ox) * ix, mx);
+                            let tcy = select(INF, (real(select(by << 3u, (by + 1) << 3u, py)) - oy) * iy, my);
+                            let tcz = (real(top << 3u) - oz) * iz;
+                            let tc = min(tcx, min(tcy, tcz));
+                            above = tc > tn || k == 1;
+                            if (above) {
+                                k = 1;
+                                near = 0;
+                                tbx = tcx;
+                                tby = tcy;
+                                tbz = tcz;
+                                tn = tc;
+                            }
                         }
-                        let tn = min(tbx, min(tby, tbz));
                         if (tn >= t1) {
                             return none;
                         }
@@ -312,21 +360,24 @@ fn first_voxel(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hi
                         sty = tby == tn;
                         stz = tbz == tn;
                         if (stx) {
-                            bx += sx;
+                            bx += sx * k;
+                        } else if (near > 0) {
+                            bx = clamp_i(cell_at(ox, dx, ix, tn) >> 3u, bx - select(near, 0, px), bx + select(0, near, px));
                         }
                         if (sty) {
-                            by += sy;
+                            by += sy * k;
+                        } else if (near > 0) {
+                            by = clamp_i(cell_at(oy, dy, iy, tn) >> 3u, by - select(near, 0, py), by + select(0, near, py));
                         }
                         if (stz) {
-                            bz = select(bz + sz, top - 1, above);
+                            bz = select(bz + sz * k, top - 1, above);
                         } else if (above) {
                             bz = clamp_i(cell_at(oz, dz, iz, tn) >> 3u, top, bz);
+                        } else if (near > 0) {
+                            bz = clamp_i(cell_at(oz, dz, iz, tn) >> 3u, bz - select(near, 0, pz), bz + select(0, near, pz));
                         }
                         t = tn;
                         fresh = false;
-                    }
-                    if ((bx >> 3u) != gx || (by >> 3u) != gy || (bz >> 3u) != gz) {
-                        break;
                     }
                 }
                 if (!fresh) {

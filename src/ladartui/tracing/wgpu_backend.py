@@ -8,7 +8,8 @@ answer for every ray.
 
 Resources:
 
-* The occupancy arrays (root, regions, tiles, bricks, columns; all u32) are laid end
+* The occupancy arrays (root, regions, tiles, bricks, columns, and the optional
+  empty-cube sides packed four octants to a word; all u32) are laid end
   to end in one logical word array, split into power-of-two sized chunks,
   each its own storage binding no larger than the adapter allows. They are
   uploaded once per ``Occupancy`` object and reused for every call.
@@ -546,19 +547,37 @@ class WgpuBackend:
 
 
 def occupancy_arrays(occupancy):
-    """The u32 arrays laid end to end on the device: root, regions, tiles, bricks, columns."""
+    """The u32 arrays laid end to end on the device: root, regions, tiles, bricks, columns, cubes."""
     columns = getattr(occupancy, "columns", None)
     if columns is None:
         # No brick-column tops: every column reaches the top of the root grid, so
         # the column skip never fires (same cells visited, only slower).
         dims = np.asarray(occupancy.root_dims, dtype=np.int64)
         columns = np.full(int(dims[0] * 64 * dims[1] * 64), int(dims[2]) * 64, dtype=np.uint32)
-    return [occupancy.root, occupancy.regions, occupancy.tiles, occupancy.bricks, columns]
+    return [occupancy.root, occupancy.regions, occupancy.tiles, occupancy.bricks, columns,
+            cube_words(occupancy)]
 
 
-# Params (uniform, see struct Params in trace.wgsl): 8 vec4 of 32-bit integers
+def cube_words(occupancy):
+    """``Occupancy.cubes`` as u32 words, one per brick cell: byte ``octant`` of word
+    ``cell`` is ``cubes[4 cell + octant]``. Empty when the occupancy has no cubes."""
+    cubes = getattr(occupancy, "cubes", None)
+    if cubes is None or getattr(occupancy, "cube_dims", None) is None or len(cubes) == 0:
+        return np.zeros(0, dtype=np.uint32)
+    return np.ascontiguousarray(cubes, dtype=np.uint8).view("<u4")
+
+
+def cube_box(occupancy):
+    """(cube_origin, cube_dims) as int64 (3,); zero dims (no jumps) without cubes."""
+    if len(cube_words(occupancy)) == 0:
+        return np.zeros(3, np.int64), np.zeros(3, np.int64)
+    return (np.asarray(occupancy.cube_origin, dtype=np.int64),
+            np.asarray(occupancy.cube_dims, dtype=np.int64))
+
+
+# Params (uniform, see struct Params in trace.wgsl): 10 vec4 of 32-bit integers
 # then a vec2<real> of float parameters (16 bytes in f64, 8 in f32).
-PARAMS_BYTES = 8 * 16 + 16
+PARAMS_BYTES = 10 * 16 + 16
 
 
 def pack_params(occupancy, upload, method, step, count, precision, first_sample=0,
@@ -568,7 +587,7 @@ def pack_params(occupancy, upload, method, step, count, precision, first_sample=
     ``first_sample`` and ``samples_per_pass`` bound the march's samples in this
     dispatch (see MARCH_SAMPLES_PER_PASS).
     """
-    ints = np.zeros((8, 4), dtype=np.int32)
+    ints = np.zeros((10, 4), dtype=np.int32)
     ints[0, :3] = occupancy.shape
     ints[1, :3] = occupancy.bbox_lo
     ints[2, :3] = occupancy.bbox_hi
@@ -578,6 +597,10 @@ def pack_params(occupancy, upload, method, step, count, precision, first_sample=
     ints[6, :] = (count, METHOD_CODES[method], int(occupancy.zmax), len(occupancy.root))
     ints[7, 0] = np.array(upload.bases[4], dtype=np.int64).astype(np.uint32).view(np.int32)
     ints[7, 1:3] = (first_sample, samples_per_pass)
+    cube_origin, cube_dims = cube_box(occupancy)
+    ints[8, :3] = cube_origin
+    ints[8, 3] = np.array(upload.bases[5], dtype=np.int64).astype(np.uint32).view(np.int32)
+    ints[9, :3] = cube_dims
     reals = np.array([step, 0], dtype=np.float64 if precision == "f64" else np.float32)
     return ints.tobytes() + reals.tobytes()
 
