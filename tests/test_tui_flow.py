@@ -521,3 +521,76 @@ def test_pictures_use_24_bit_colour_or_the_256_colour_palette():
     (strip,) = picture_strips(picture, use_256=True)
     first = list(strip)[0]
     assert (first.style.color.number, first.style.bgcolor.number) == (196, 21)  # xterm red, blue
+
+
+def shown_keys(app) -> set[str]:
+    """Keys the footer shows (enabled or greyed out) on the current screen."""
+    return {b.binding.key for b in app.active_bindings.values() if b.binding.show}
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_study_key_opens_the_study_of_the_open_scenario_and_esc_returns(shared, tmp_path,
+                                                                            scene_files):
+    from ladartui.tui.app import help_rows, palette_entries
+    from ladartui.tui.study_screen import StudyScreen
+
+    pilot, app = await fresh(shared)
+    assert {"f11", "f12"} <= shown_keys(app)
+    assert {("Anywhere", "F11", "Study"), ("Anywhere", "F12", "Sweep")} <= set(help_rows(app))
+    assert {"study", "sweep"} <= {action for _, _, action in palette_entries()}
+    await pilot.press("f11")
+    await pilot.pause()
+    screen = app.screen
+    assert isinstance(screen, StudyScreen)
+    assert screen.scenario_path == app.scenario.path
+    # the study screen's keys only: the app's F5 must not start a run underneath
+    assert app.check_action("run", ()) is False and "f5" not in shown_keys(app)
+    await pilot.press("f5")
+    await pilot.pause()
+    assert not app.running and app.screen is screen
+    await pilot.press("escape")
+    await pilot.pause()
+    assert not isinstance(app.screen, StudyScreen) and app.tool_screen is None
+    assert app.check_action("study", ()) is True
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_sweep_key_opens_the_sweep_screen_and_its_best_path_loads_in_the_app(
+        shared, tmp_path, scene_files):
+    from ladartui.tui.sweep_screen import SweepScreen
+
+    pilot, app = await fresh(shared)
+    await pilot.press("f12")
+    await pilot.pause()
+    assert isinstance(app.screen, SweepScreen)
+    await pilot.press("escape")
+    await pilot.pause()
+    assert not isinstance(app.screen, SweepScreen) and app.tool_screen is None
+    # the sweep asks to open its best path: the app loads that scenario and shows it
+    best = make_scenario(tmp_path, scene_files, name="tiny-best", scans=3)
+    await pilot.press("f12")
+    await pilot.pause()
+    screen = app.screen
+    screen.post_message(SweepScreen.OpenScenario(best.path))
+    await wait_until(pilot, lambda: loaded(app) and app.scenario.path == best.path, timeout=60)
+    assert app.screen is not screen and app.tool_screen is None
+    assert len(app.scenario.poses()) == 3 and status(app).state == READY
+    app.set_scenario(shared[1], modified=False)
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_study_and_sweep_are_not_offered_while_busy(shared, tmp_path, scene_files):
+    pilot, app = await fresh(shared)
+    app.set_busy("Working...")
+    await pilot.pause()
+    try:
+        assert app.query_one("#btn-study").disabled and app.query_one("#btn-sweep").disabled
+        assert app.check_action("study", ()) is None and app.check_action("sweep", ()) is None
+        await pilot.press("f11")
+        await pilot.press("f12")
+        await pilot.pause()
+        assert app.tool_screen is None and len(app.screen_stack) == 1
+    finally:
+        app.set_busy(None)
+    await pilot.pause()
+    assert not app.query_one("#btn-study").disabled

@@ -183,3 +183,31 @@ def test_sorted_lists_skip_the_duplicate_search_but_still_find_repeats():
     kept, dropped = unique_voxels(repeated)
     np.testing.assert_array_equal(kept, [[0, 0, 1], [0, 1, 0]])
     assert dropped == 1
+
+
+def test_plain_lines_and_the_compiled_checker_read_the_same_voxels(tmp_path, monkeypatch):
+    from ladartui.scene import voxels as module
+
+    rng = np.random.default_rng(3)
+    voxels = rng.integers(0, 3000, size=(5000, 3))
+    voxels[:5] = [[0, 0, 0], [2**31 - 1, 7, 0], [9, 10, 99], [5, 5, 5], [0, 0, 0]]
+    text = "".join(f"{x},{y},{z}\n" for x, y, z in voxels.tolist())
+    for ending in (text, text[:-1]):  # with and without the final newline
+        path = write(tmp_path, ending.encode())
+        expected, first = np.unique(voxels, axis=0, return_index=True)
+        plain = load_voxels(path)
+        np.testing.assert_array_equal(plain, voxels[np.sort(first)])
+        monkeypatch.setattr(module, "_PLAIN_BYTES", 0)  # force the compiled pass
+        np.testing.assert_array_equal(load_voxels(path), plain)
+        monkeypatch.undo()
+
+
+def test_reading_a_plain_file_does_not_import_numba(tmp_path):
+    import subprocess
+    import sys
+
+    path = write(tmp_path, b"1,2,3\n4,5,6\n")
+    code = ("import sys; from ladartui.scene.voxels import load_voxels; "
+            f"assert load_voxels({str(path)!r}).shape == (2, 3); print('numba' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"

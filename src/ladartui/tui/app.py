@@ -9,6 +9,7 @@ post messages back, so the interface never blocks.
 
 from __future__ import annotations
 
+import functools
 import threading
 import time
 from pathlib import Path
@@ -89,9 +90,19 @@ class RunFinished(Message):
         self.result, self.cancelled, self.error = result, cancelled, error
 
 
+def top_height_map(scene) -> np.ndarray:
+    """``scene.top_height_map()`` in plain numpy: the first numba kernel a process
+    loads costs about half a second, which the app must not spend while opening."""
+    voxels = scene.voxels
+    heights = np.full(scene.shape[:2], -1, dtype=np.int32)
+    if len(voxels):
+        np.maximum.at(heights, (voxels[:, 0], voxels[:, 1]), voxels[:, 2])
+    return heights
+
+
 def prepare_views(scene) -> dict:
     """View data that depends only on the scene: top view, 3D sample, bounds (worker thread)."""
-    heights = scene.top_height_map()
+    heights = top_height_map(scene)
     top = views.TopView(heights, scene.voxel_size,
                         target_columns=np.unique(scene.target[:, :2], axis=0))
     sample = views.subsample(scene.voxels, SCENE_POINTS, seed=0)
@@ -128,6 +139,8 @@ class LadarApp(App):
         Binding("f8", "threshold", "Threshold"),
         Binding("f9", "measures", "Measures", show=False),
         Binding("f10", "compare", "Compare"),
+        Binding("f11", "study", "Study"),
+        Binding("f12", "sweep", "Sweep"),
     ]
 
     def __init__(self, scenario_path: Path | str | None = None, *, start_scenario=None,
@@ -151,12 +164,15 @@ class LadarApp(App):
         self.cancel_event = threading.Event()
         self.stop_event = threading.Event()  # set when the app quits: ends background work
         self.kernels_ready = threading.Event()  # the child process has compiled the kernels
+        self.scene_shown = threading.Event()  # the views show the loaded scene
         self.backend_rows: list[tuple[str, str, bool]] | None = None
         self.backend_values = ["auto"]
         self._fields_loading = False
         self.messages: list[str] = []
         self.leaving = False  # set on exit: late worker messages are ignored
         self.running = False
+        self.tool_screen = None  # the study or sweep screen while it is open
+        self.study_result = None  # what the last study screen returned
 
     # -- layout ------------------------------------------------------------------
 
@@ -237,6 +253,11 @@ class LadarApp(App):
                 yield Button("Save ^S", id="btn-save-run", compact=True)
                 yield Button("Cancel", id="btn-cancel-run", variant="error", compact=True,
                              disabled=True)
+            with Grid(classes="button-grid run-buttons"):
+                yield Button("Study F11", id="btn-study", compact=True,
+                             tooltip="Speed against accuracy of every backend and method")
+                yield Button("Sweep F12", id="btn-sweep", compact=True,
+                             tooltip="Launch, open or watch a flight-path sweep")
             yield Static("", id="run-info", classes="info")
             yield Static("probing backends...", id="backend-info", classes="info")
 
@@ -290,7 +311,10 @@ class LadarApp(App):
         except Exception as error:  # keep the app alive; say what broke
             self.post_message(WorkFailed("load", f"{type(error).__name__}: {error}"))
             return
+        self.scene_shown.clear()
         self.post_message(SceneReady(scenario, scene, prepared, output, measures, warning))
+        # probing imports the GPU library: let the interface fill its panels first
+        self.scene_shown.wait(2.0)
         self._probe_backends()
         self._warm_up(scenario, scene)
 
@@ -340,6 +364,7 @@ class LadarApp(App):
         self._draw_overlays()
         if message.warning:
             self.tell(message.warning, severity="warning", timeout=8)
+        self.scene_shown.set()
 
     def on_work_failed(self, message: WorkFailed) -> None:
         if self.closing():
@@ -523,6 +548,9 @@ class LadarApp(App):
         bar.show(READY, f"{self.scenario.path.name}: {poses} scans x {rays:,} rays. F5 runs.")
 
     def check_action(self, action: str, parameters) -> bool | None:
+        if self.tool_screen is not None and self.screen is self.tool_screen:
+            # that screen has its own keys; textual's own actions (focus, quit) stay
+            return False if action in own_actions() else True
         if action == "cancel_run":
             return True if self.run_in_progress() else None
         if self.busy is not None and action not in DISPLAY_ACTIONS:
@@ -1010,6 +1038,61 @@ class LadarApp(App):
     def action_help(self) -> None:
         self.push_screen(HelpScreen(help_rows(self)))
 
+    # -- study and sweep screens -------------------------------------------------------
+
+    @on(Button.Pressed, "#btn-study")
+    def action_study(self) -> None:
+        """The speed-against-accuracy study of the open scenario (its saved file)."""
+        if self.busy or self.tool_screen is not None:
+            return
+        from ladartui.tui.study_screen import StudyScreen  # plotting loads only when used
+
+        path = None
+        if self.scenario is not None and self.scenario.path.is_file():
+            path = self.scenario.path
+            if self.modified:
+                self.tell("The study reads the saved scenario file; save (Ctrl+S) to include "
+                          "your changes.", severity="warning", timeout=8)
+
+        def closed(result) -> None:
+            self.tool_screen = None
+            if result is not None:
+                self.study_result = result
+            self.refresh_bindings()
+
+        self.tool_screen = StudyScreen(scenario_path=path)
+        self.push_screen(self.tool_screen, closed)
+
+    @on(Button.Pressed, "#btn-sweep")
+    def action_sweep(self) -> None:
+        """Launch, open or watch flight-path sweeps."""
+        if self.busy or self.tool_screen is not None:
+            return
+        from ladartui.tui.sweep_screen import SweepScreen  # Dask loads only when used
+
+        def closed(_result) -> None:
+            self.tool_screen = None
+            self.refresh_bindings()
+
+        self.tool_screen = SweepScreen()
+        self.push_screen(self.tool_screen, closed)
+
+    def on_sweep_screen_open_scenario(self, message) -> None:
+        """The sweep's best flight path: open its scenario as F3 would (leaving the sweep
+        screen unless a sweep is still running there)."""
+        if self.closing():
+            return
+        if self.run_in_progress():
+            self.tell("A run is in progress; the best path was not opened.", severity="warning")
+            return
+        screen = self.tool_screen
+        if screen is not None and self.screen is screen and not getattr(screen, "running", False):
+            screen.dismiss(None)
+        else:
+            self.tell(f"Opening {message.path.name}; Esc leaves the sweep screen to see it.")
+        self.result = None
+        self.load(message.path)
+
     def tell(self, message: str, *, title: str = "", severity: str = "information",
              timeout: float = 5) -> None:
         """Show a message to the analyst (and keep it in ``messages`` for the record)."""
@@ -1022,6 +1105,7 @@ class LadarApp(App):
             self.leaving = True
             self.cancel_event.set()
             self.stop_event.set()
+            self.scene_shown.set()
         return self.leaving
 
     def on_unmount(self) -> None:
@@ -1038,6 +1122,8 @@ class LadarApp(App):
 
     def get_system_commands(self, screen):
         yield from super().get_system_commands(screen)
+        if self.tool_screen is not None and screen is self.tool_screen:
+            return  # the study and sweep screens have their own keys
         for title, help_text, action in palette_entries():
             yield SystemCommand(title, help_text, _runner(self, action))
 
@@ -1063,6 +1149,10 @@ def palette_entries() -> list[tuple[str, str, str]]:
         ("Output height threshold", "Draw the output up to a height (F8)", "threshold"),
         ("Show measures", "The measures of the last run (F9)", "measures"),
         ("Compare scenarios", "Two or more .cmf files side by side (F10)", "compare"),
+        ("Speed-against-accuracy study", "Every backend, method and ray grid on this "
+         "scenario (F11)", "study"),
+        ("Flight-path sweep", "Launch, open or watch a sweep; open its best path (F12)",
+         "sweep"),
         ("Aim every scan at the target", "Point the sensor at the target centre", "aim_all"),
         ("Edit selected segment", "Open the selected flight segment", "edit_segment"),
         ("Delete selected segment", "Remove the selected flight segment", "delete_segment"),
@@ -1077,6 +1167,13 @@ def palette_entries() -> list[tuple[str, str, str]]:
     for tab in ("file", "sensor", "flight", "run", "results"):
         entries.append((f"Show {tab} panel", f"Open the {tab} tab", f"show_tab('{tab}')"))
     return entries
+
+
+@functools.cache
+def own_actions() -> frozenset[str]:
+    """Names of the actions this app defines (its keys and its palette entries)."""
+    keys = [binding.action for binding in LadarApp.BINDINGS]
+    return frozenset(action.split("(")[0] for action in keys + [a for _, _, a in palette_entries()])
 
 
 def help_rows(app) -> list[tuple[str, str, str]]:
