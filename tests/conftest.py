@@ -1,8 +1,29 @@
-"""Suite-wide set-up: tests never write into the user's home folder."""
+"""Suite-wide set-up: tests never write into the user's home folder; shared backends."""
 
 import os
 import tempfile
 
+import pytest
+
 # The default scenario and benchmark scenes live under LADARTUI_HOME; point it
 # at a throw-away folder before any test imports ladartui.
 os.environ.setdefault("LADARTUI_HOME", tempfile.mkdtemp(prefix="ladartui-test-home-"))
+
+
+@pytest.fixture(scope="module")
+def wgpu_backend():
+    """A fresh wgpu backend; the test is skipped where no adapter exists."""
+    from ladartui.tracing.wgpu_backend import WgpuBackend
+
+    backend = WgpuBackend()
+    reason = backend.probe()
+    if reason:
+        pytest.skip(f"no wgpu adapter on this machine: {reason}")
+    return backend
+
+
+@pytest.fixture(scope="module")
+def numba_backend():
+    from ladartui.tracing.numba_backend import NumbaBackend
+
+    return NumbaBackend()

@@ -28,17 +28,9 @@ Occupancy = pytest.importorskip("ladartui.scene.occupancy").Occupancy
 
 
 @pytest.fixture(scope="module")
-def gpu():
-    backend = WgpuBackend()
-    reason = backend.probe()
-    if reason:
-        pytest.skip(f"no wgpu adapter on this machine: {reason}")
-    return backend
-
-
-@pytest.fixture(scope="module")
-def numba_backend():
-    return pytest.importorskip("ladartui.tracing.numba_backend").NumbaBackend()
+def gpu(wgpu_backend):
+    # wgpu_backend and numba_backend come from tests/conftest.py.
+    return wgpu_backend
 
 
 def random_scene(seed, shape, n):

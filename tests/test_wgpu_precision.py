@@ -25,21 +25,7 @@ NEAR_TIE = 1e-3  # cells: float32 coordinates of a ~1000-cell scene are good to 
 F32_AGREEMENT = 0.9999
 
 
-@pytest.fixture(scope="module")
-def wgpu_backend():
-    from ladartui.tracing.wgpu_backend import WgpuBackend
-
-    backend = WgpuBackend()
-    reason = backend.probe()
-    if reason:
-        pytest.skip(f"no wgpu adapter on this machine: {reason}")
-    return backend
-
-
-@pytest.fixture(scope="module")
-def numba_backend():
-    module = pytest.importorskip("ladartui.tracing.numba_backend")
-    return module.NumbaBackend()
+# The wgpu_backend and numba_backend fixtures come from tests/conftest.py.
 
 
 def unit(*v):

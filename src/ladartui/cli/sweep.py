@@ -13,6 +13,7 @@ import threading
 
 from ladartui.cli.progress import run_cancellable
 from ladartui.errors import Cancelled, FieldError
+from ladartui.sweep.table import display_cell
 
 DEFAULT_TOP = 10
 
@@ -173,14 +174,6 @@ def _restore_sigterm(previous):
         signal.signal(signal.SIGTERM, previous)
 
 
-def _cell(value, digits=4) -> str:
-    if value is None:
-        return "-"
-    if isinstance(value, float):
-        return f"{value:.{digits}g}"
-    return str(value)
-
-
 def result_dict(result, top) -> dict:
     """The sweep as a JSON-safe dict: files, counts, the best variants and the Pareto front."""
 
@@ -231,14 +224,14 @@ def show_result(console, result, top) -> None:
     for ranked in [r for r in result.ranking if r.rank is not None][:top]:
         row = ranked.row
         table.add_row(str(ranked.rank), str(row.get("variant", ""))[:8],
-                      *(_cell(row.get(n)) for n in result.parameter_names),
-                      *([_cell(ranked.value)] if separate else []), _cell(ranked.coverage, 3),
-                      _cell(ranked.cost, 4), "*" if ranked.pareto else "")
+                      *(display_cell(row.get(n)) for n in result.parameter_names),
+                      *([display_cell(ranked.value)] if separate else []), display_cell(ranked.coverage, 3),
+                      display_cell(ranked.cost, 4), "*" if ranked.pareto else "")
     console.print(table)
     front = result.pareto
     if front:
-        points = ", ".join(f"{str(r.row.get('variant'))[:8]} ({_cell(r.coverage, 3)} at "
-                           f"{_cell(r.cost, 4)} {cost_unit})" for r in front)
+        points = ", ".join(f"{str(r.row.get('variant'))[:8]} ({display_cell(r.coverage, 3)} at "
+                           f"{display_cell(r.cost, 4)} {cost_unit})" for r in front)
         console.print(f"Pareto front of obscured coverage against {result.cost}, cheapest "
                       f"first: {points}", highlight=False)
     unranked = sum(1 for r in result.ranking if r.rank is None and r.row.get("status") == "ok")

@@ -49,6 +49,15 @@ def format_cell(value) -> str:
     return str(value)
 
 
+def display_cell(value, digits=4) -> str:
+    """A cell for people: '-' for None, floats to ``digits`` significant figures."""
+    if value is None:
+        return "-"
+    if isinstance(value, float):
+        return f"{value:.{digits}g}"
+    return str(value)
+
+
 def parse_cell(text: str):
     """The value a cell was written from (numbers, booleans, lists, None, text)."""
     if text == "":

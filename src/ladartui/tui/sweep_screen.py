@@ -28,6 +28,7 @@ from textual.worker import get_current_worker
 from textual_plotext import PlotextPlot
 
 from ladartui.errors import Cancelled, FieldError, InputFileError, LadarError
+from ladartui.sweep.table import display_cell
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
 
 OBJECTIVE_ORDER = ("obscured-coverage", "coverage-per-km", "coverage-within-budget")
@@ -74,14 +75,6 @@ def eta_seconds(progress) -> float | None:
     if ran <= 0 or progress.elapsed <= 0:
         return None
     return progress.elapsed / ran * left
-
-
-def _number(value, digits=4) -> str:
-    if value is None:
-        return "-"
-    if isinstance(value, float):
-        return f"{value:.{digits}g}"
-    return str(value)
 
 
 def short_path(path) -> str:
@@ -620,7 +613,7 @@ class SweepScreen(Screen):
         if self.objective == "obscured-coverage":
             value = "-" if entry.value is None else f"{100 * entry.value:.2f}%"
         else:
-            value = _number(entry.value)
+            value = display_cell(entry.value)
         cells = [
             "-" if entry.rank is None else str(entry.rank),
             Text(FRONT_MARKER, style="bold #ffaf00") if entry.pareto else "",
@@ -628,9 +621,9 @@ class SweepScreen(Screen):
         ]
         if self.objective != "obscured-coverage":
             cells.append("-" if entry.coverage is None else f"{100 * entry.coverage:.2f}")
-        cells.append(_number(entry.cost))
+        cells.append(display_cell(entry.cost))
         cells.append(Text(status, style="green" if status == "ok" else "bold red"))
-        cells.extend(_number(row.get(name)) for name in self.parameter_names)
+        cells.extend(display_cell(row.get(name)) for name in self.parameter_names)
         cells.append(str(row.get("variant") or ""))
         error = str(row.get("error") or "")
         cells.append(Text(error[:ERROR_WIDTH] + ("…" if len(error) > ERROR_WIDTH else ""),
@@ -644,7 +637,7 @@ class SweepScreen(Screen):
             return
         entry = self.ranking[index]
         row = entry.row
-        params = ", ".join(f"{name}={_number(row.get(name))}" for name in self.parameter_names
+        params = ", ".join(f"{name}={display_cell(row.get(name))}" for name in self.parameter_names
                            if row.get(name) is not None)
         text = Text(f"{row.get('variant')}: {params or 'base scenario'}")
         if row.get("status") != "ok":
