@@ -79,4 +79,10 @@ def test_bad_input_is_one_line(tmp_path, capsys):
 def test_bad_backend_is_one_line(scenario, capsys):
     assert main(["run", str(scenario.path), "--backend", "abacus", "--no-write"]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "abacus" in err
+    assert err == "ladartui: error: --backend = 'abacus': expected one of 'auto', 'numba', 'wgpu'"
+
+
+def test_bad_step_names_the_flag(scenario, capsys):
+    assert main(["run", str(scenario.path), "--step", "0", "--no-write"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and err.startswith("ladartui: error: --step = 0.0: expected")

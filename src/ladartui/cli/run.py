@@ -39,12 +39,19 @@ def add_parser(subparsers):
 def run(args) -> int:
     from rich.console import Console
 
+    from ladartui.errors import FieldError
     from ladartui.scenario import load_scenario
 
     scenario = load_scenario(args.scenario)
     # Check the overrides like scenario fields, before any progress is drawn.
-    overrides = {name: getattr(args, name) for name in ("backend", "method", "step", "precision")}
-    scenario = scenario.with_changes(**{k: v for k, v in overrides.items() if v is not None})
+    for name in ("backend", "method", "step", "precision"):
+        value = getattr(args, name)
+        if value is None:
+            continue
+        try:
+            scenario = scenario.with_changes(**{name: value})
+        except FieldError as error:  # name the flag the user typed, not the TOML field
+            raise FieldError(f"--{name}", value, error.expected) from None
     errors = Console(stderr=True)
     result = _simulate_with_progress(scenario, args, errors)
     if args.json:
