@@ -77,10 +77,6 @@ def trace(scene_or_occupancy, origins, directions, backend="auto", method="exact
     if origins.shape != directions.shape:
         raise FieldError("directions", f"array of shape {directions.shape}",
                          f"the same shape as origins {origins.shape}")
-    norm = np.linalg.norm(directions, axis=1)
-    if len(norm) and not np.all(norm > 0):
-        bad = int(np.flatnonzero(~(norm > 0))[0])
-        raise FieldError(f"directions[{bad}]", directions[bad].tolist(), "a non-zero vector")
     if method not in METHODS:
         raise FieldError("method", method, "one of " + ", ".join(METHODS))
     if step is None:
@@ -91,10 +87,18 @@ def trace(scene_or_occupancy, origins, directions, backend="auto", method="exact
         raise FieldError("precision", precision, "f32 or f64")
     name = choose_backend() if backend in (None, "auto") else backend
     engine = get_backend(name)
-    unit = directions / norm[:, None]
-    unit[np.abs(unit) < TINY] = 0.0  # keeps 1 / d finite; moves a ray by nothing measurable
+    # Unit directions with components below TINY set to 0 (keeps 1 / d finite;
+    # moves a ray by nothing measurable), origins in cell space.
+    from ladartui.tracing.prepare import rays_to_cells  # numba: loaded on first trace
+
+    origin_cells, unit = rays_to_cells(origins, directions, voxel_size, TINY)
+    if origin_cells is None:
+        what, bad = unit
+        if what == "zero":
+            raise FieldError(f"directions[{bad}]", directions[bad].tolist(), "a non-zero vector")
+        raise FieldError(what, "non-finite values", "finite numbers")
     started = time.perf_counter()
-    cells = engine.trace_cells(occupancy, to_cells(origins, voxel_size), unit,
+    cells = engine.trace_cells(occupancy, origin_cells, unit,
                                method=method, step=float(step), precision=precision, cancel=cancel)
     info = dict(cells.info)
     info["seconds_total"] = time.perf_counter() - started
@@ -130,6 +134,4 @@ def _rays(name, values):
         array = array[None, :]
     if array.ndim != 2 or array.shape[1] != 3:
         raise FieldError(name, f"array of shape {array.shape}", "an (N, 3) array")
-    if not np.all(np.isfinite(array)):
-        raise FieldError(name, "non-finite values", "finite numbers")
     return array

@@ -1,0 +1,31 @@
+"""The one-pass ray preparation gives the numpy expressions' exact bits."""
+
+import numpy as np
+
+from ladartui.tracing import TINY
+from ladartui.tracing.prepare import rays_to_cells
+
+
+def test_cells_and_unit_directions_match_numpy_bit_for_bit():
+    rng = np.random.default_rng(7)
+    origins = rng.uniform(-1e4, 1e4, (5000, 3))
+    directions = rng.normal(size=(5000, 3)) * rng.uniform(1e-3, 1e3, (5000, 1))
+    directions[:10, 0] = 1e-250  # below TINY once normalised: becomes exactly 0
+    cells, unit = rays_to_cells(origins, directions, 0.1, TINY)
+    expected_unit = directions / np.linalg.norm(directions, axis=1)[:, None]
+    expected_unit[np.abs(expected_unit) < TINY] = 0.0
+    assert np.array_equal(cells, origins / 0.1 + 0.5)
+    assert np.array_equal(unit, expected_unit)
+    assert np.all(unit[:10, 0] == 0.0)
+
+
+def test_first_bad_ray_is_named():
+    origins = np.zeros((4, 3))
+    directions = np.tile([0.0, 0.0, -1.0], (4, 1))
+    directions[2] = 0.0
+    assert rays_to_cells(origins, directions, 1.0, TINY)[1] == ("zero", 2)
+    origins[1, 2] = np.nan
+    assert rays_to_cells(origins, directions, 1.0, TINY)[1] == ("origins", 1)
+    origins[1, 2] = 0.0
+    directions[0, 1] = np.inf
+    assert rays_to_cells(origins, directions, 1.0, TINY)[1] == ("directions", 0)
