@@ -16,7 +16,7 @@ from ladartui.study import (MissSummary, Setting, StudyResult, StudyRow, Timing,
                             chart_text, dominates, full_settings, measure, pareto_front,
                             quick_settings, voxel_geometry)
 from ladartui.study.misses import differing, summarise
-from ladartui.study.pareto import dominator
+from ladartui.pareto import dominator
 from ladartui.tracing.backend import GROUND, MISS, VOXEL
 
 

@@ -168,3 +168,15 @@ def test_registry_lists_every_builtin_backend_even_after_a_direct_import():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "['numba', 'wgpu']"
+
+
+def test_every_public_name_resolves_and_unknown_names_fail():
+    # The lazy exports of the package and of ladartui.scene point at real objects.
+    import ladartui
+    import ladartui.scene
+
+    for package in (ladartui, ladartui.scene):
+        for name in package.__all__:
+            assert getattr(package, name) is not None, (package.__name__, name)
+    with pytest.raises(AttributeError, match="has no attribute 'no_such_name'"):
+        ladartui.scene.no_such_name

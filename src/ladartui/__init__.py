@@ -7,7 +7,7 @@ names never equal module names (``trace`` lives in ``ladartui.tracing``,
 an exported function.
 """
 
-import importlib
+from ladartui.lazy import lazy_getattr
 
 __version__ = "0.1.0"
 
@@ -41,10 +41,4 @@ _EXPORTS = {
 __all__ = sorted(_EXPORTS) + ["__version__"]
 
 
-def __getattr__(name):
-    module = _EXPORTS.get(name)
-    if module is None:
-        raise AttributeError(f"module 'ladartui' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
+__getattr__ = lazy_getattr('ladartui', _EXPORTS, globals())

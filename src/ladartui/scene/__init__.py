@@ -1,7 +1,7 @@
 """Voxel scenes: voxel-list files, LAS/LAZ point clouds, the Scene model and
 the synthetic forest generator. Submodules load on first use."""
 
-import importlib
+from ladartui.lazy import lazy_getattr
 
 _EXPORTS = {
     "load_voxels": "ladartui.scene.voxels",
@@ -17,10 +17,4 @@ _EXPORTS = {
 __all__ = sorted(_EXPORTS)
 
 
-def __getattr__(name):
-    module = _EXPORTS.get(name)
-    if module is None:
-        raise AttributeError(f"module 'ladartui.scene' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
+__getattr__ = lazy_getattr('ladartui.scene', _EXPORTS, globals())

@@ -11,7 +11,7 @@ from pathlib import Path
 
 from ladartui.atomic import write_text_atomic
 from ladartui.study.misses import CLASSES, MissSummary
-from ladartui.study.pareto import dominator, pareto_front
+from ladartui.pareto import dominator, pareto_front
 from ladartui.study.settings import Setting
 from ladartui.study.timing import Timing
 

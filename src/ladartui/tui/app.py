@@ -90,19 +90,9 @@ class RunFinished(Message):
         self.result, self.cancelled, self.error = result, cancelled, error
 
 
-def top_height_map(scene) -> np.ndarray:
-    """``scene.top_height_map()`` in plain numpy: the first numba kernel a process
-    loads costs about half a second, which the app must not spend while opening."""
-    voxels = scene.voxels
-    heights = np.full(scene.shape[:2], -1, dtype=np.int32)
-    if len(voxels):
-        np.maximum.at(heights, (voxels[:, 0], voxels[:, 1]), voxels[:, 2])
-    return heights
-
-
 def prepare_views(scene) -> dict:
     """View data that depends only on the scene: top view, 3D sample, bounds (worker thread)."""
-    heights = top_height_map(scene)
+    heights = scene.top_height_map()
     top = views.TopView(heights, scene.voxel_size,
                         target_columns=np.unique(scene.target[:, :2], axis=0))
     sample = views.subsample(scene.voxels, SCENE_POINTS, seed=0)
@@ -679,18 +669,21 @@ class LadarApp(App):
         title = bridge.SEGMENT_LABELS[segment.kind] + (" (new)" if index is None else "")
 
         def done(result):
-            if result is None:
-                return
-            segments = list(self.scenario.flight.segments)
-            if index is None:
-                segments.append(result)
-            else:
-                segments[index] = result
-            self._apply_segments(segments)
+            if result is not None:
+                self._put_segment(index, result)
 
         self.push_screen(FormScreen(title, spec, bridge.segment_builder(segment.kind),
                                     note="Empty optional fields keep the current pointing."),
                          done)
+
+    def _put_segment(self, index: int | None, segment) -> bool:
+        """Replace segment ``index``, or append when ``index`` is None."""
+        segments = list(self.scenario.flight.segments)
+        if index is None:
+            segments.append(segment)
+        else:
+            segments[index] = segment
+        return self._apply_segments(segments)
 
     def _apply_segments(self, segments) -> bool:
         try:
@@ -727,13 +720,7 @@ class LadarApp(App):
                     self.tell("A manual segment needs at least one pose; not changed.",
                                 severity="warning")
                 return
-            segment = Manual(tuple(result))
-            new = list(self.scenario.flight.segments)
-            if index is None:
-                new.append(segment)
-            else:
-                new[index] = segment
-            self._apply_segments(new)
+            self._put_segment(index, Manual(tuple(result)))
 
         self.push_screen(PosesScreen(poses, bridge.start_pose(self.scenario)), done)
 
