@@ -2,7 +2,7 @@
 
 The layout is a contract shared with the WGSL shader (see docs/architecture.md,
 "Occupancy layout"): the shared arrays are uint32, nodes have fan-out 8 per axis;
-blocks and cubes are optional accelerations a tracer may ignore.
+blocks, cubes and halo are optional accelerations a tracer may ignore.
 
     root    dense grid of 512-voxel cells over the occupied box: region number (index + 1), 0 = empty
     regions 512 slots per region (64-voxel cells): tile number, 0 = empty
@@ -13,6 +13,9 @@ blocks and cubes are optional accelerations a tracer may ignore.
             when block b holds a voxel, b = bx + 4 * by + 16 * bz with (bx, by, bz) = l >> 1
     cubes   (uint8, optional acceleration) per downward ray octant and brick cell of the occupied
             box: the side (bricks) of the largest empty cube with that corner reaching into the octant
+    halo    (uint32, optional acceleration) one bit per brick cell of the occupied box grown by
+            one brick on every side: set when that brick or any of its 26 neighbours holds a
+            voxel (bit l & 31 of word l >> 5, l = x + dims.x * (y + dims.y * z))
 
 Inside any node the local position (lx, ly, lz), each 0..7, is linear
 ``l = lx + 8 * ly + 64 * lz``; a brick's bit ``l`` is bit ``l & 31`` of word ``l >> 5``.
@@ -58,6 +61,9 @@ class Occupancy:
     cubes: np.ndarray = None
     cube_origin: np.ndarray = None
     cube_dims: np.ndarray = None
+    halo: np.ndarray = None
+    halo_origin: np.ndarray = None
+    halo_dims: np.ndarray = None
 
     @classmethod
     def build(cls, voxels, shape=None) -> "Occupancy":
@@ -95,7 +101,8 @@ class Occupancy:
         empty = np.zeros(0, np.uint32)
         return cls(shape, zero.copy(), zero.copy(), zero.copy(), zero.copy(),
                    empty, empty.copy(), empty.copy(), empty.copy(), 0, empty.copy(),
-                   np.zeros(0, np.uint64), np.zeros(0, np.uint8), zero.copy(), zero.copy())
+                   np.zeros(0, np.uint64), np.zeros(0, np.uint8), zero.copy(), zero.copy(),
+                   empty.copy(), zero.copy(), zero.copy())
 
     @classmethod
     def _from_nonempty(cls, vox, lo, hi, shape):
@@ -130,15 +137,18 @@ class Occupancy:
         cube_origin = lo >> BRICK_SHIFT
         cube_dims = ((hi - 1) >> BRICK_SHIFT) - cube_origin + 1
         cubes = _empty_cubes(brick_cells - cube_origin, cube_dims)
+        halo_origin, halo_dims = cube_origin - 1, cube_dims + 2
+        halo = _halo_bits(brick_cells - halo_origin, halo_dims)
         return cls(shape, lo.astype(np.int64), hi.astype(np.int64), root_origin.astype(np.int64),
                    root_dims.astype(np.int64), root, regions, tiles, bricks, count, columns,
                    block_masks(bricks), cubes, cube_origin.astype(np.int64),
-                   cube_dims.astype(np.int64))
+                   cube_dims.astype(np.int64), halo, halo_origin.astype(np.int64),
+                   halo_dims.astype(np.int64))
 
     @property
     def nbytes(self) -> int:
         """Bytes held by the hierarchy arrays."""
-        extra = sum(a.nbytes for a in (self.blocks, self.cubes) if a is not None)
+        extra = sum(a.nbytes for a in (self.blocks, self.cubes, self.halo) if a is not None)
         return int(self.root.nbytes + self.regions.nbytes + self.tiles.nbytes + self.bricks.nbytes
                    + self.columns.nbytes + extra)
 
@@ -268,6 +278,30 @@ def _empty_cubes(cells, dims):
     out = np.zeros((dz, dy, dx, 4), np.uint8)
     _fill_empty_cubes(full, CUBE_CAP, out)
     return out.reshape(-1)
+
+
+def _halo_bits(cells, dims):
+    """Bits over a ``dims`` box of brick cells: set where the brick or a neighbour is non-empty.
+
+    A bundle of rays from one origin that stays within 7 voxels of its centre
+    ray meets no voxel before that ray enters a set cell (see
+    tracing.bundle), so the bundle's rays may all start there.
+    """
+    dx, dy, dz = (int(v) for v in dims)
+    near = np.zeros((dz, dy, dx), bool)
+    near[cells[:, 2], cells[:, 1], cells[:, 0]] = True
+    for axis in range(3):  # grow by one cell along each axis in turn: the 3 x 3 x 3 neighbourhood
+        grown = near.copy()
+        lower = [slice(None)] * 3
+        upper = [slice(None)] * 3
+        lower[axis], upper[axis] = slice(None, -1), slice(1, None)
+        grown[tuple(lower)] |= near[tuple(upper)]
+        grown[tuple(upper)] |= near[tuple(lower)]
+        near = grown
+    packed = np.packbits(near.reshape(-1), bitorder="little")
+    words = np.zeros(-(-len(packed) // 4) * 4, np.uint8)
+    words[:len(packed)] = packed
+    return words.view("<u4").astype(np.uint32)
 
 
 @njit(nogil=True, cache=True)

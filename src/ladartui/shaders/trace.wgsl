@@ -40,6 +40,7 @@ struct Params {
 @group(0) @binding(1) var<storage, read> rays: array<real>;             // ox oy oz dx dy dz per ray
 @group(0) @binding(2) var<storage, read_write> hits: array<vec4<i32>>;  // kind, i, j, k
 @group(0) @binding(3) var<storage, read_write> ranges: array<real>;     // t of the hit
+@group(0) @binding(4) var<storage, read> starts: array<real>;           // bundle start per 64 rays
 
 const MISS: i32 = 0;
 const VOXEL: i32 = 1;
@@ -162,7 +163,7 @@ fn clamp_i(v: i32, lo: i32, hi: i32) -> i32 {
 // above its highest brick), jumps across the empty cube of bricks ahead of the
 // ray (Occupancy.cubes) and walks on past tile faces while bricks are known
 // empty; inside a brick a voxel DDA tests bits.
-fn first_voxel(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hit {
+fn first_voxel(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real, start: real) -> Hit {
     let none = miss();
     if (params.run.w == 0) {  // empty scene: no root cells
         return none;
@@ -180,11 +181,12 @@ fn first_voxel(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hi
     let mz = dz != 0.0;
     let lo = params.bbox_lo;
     let hi = params.bbox_hi;
-    // Step 2: clip to the occupied box.
+    // Step 2: clip to the occupied box, from the bundle start on (step 0, computed
+    // on the host by tracing/bundle.py for each 64 rays: `starts`).
     let span_x = slab(ox, dx, ix, real(lo.x), real(hi.x));
     let span_y = slab(oy, dy, iy, real(lo.y), real(hi.y));
     let span_z = slab(oz, dz, iz, real(lo.z), real(hi.z));
-    let t0 = max(0.0, max(span_x.enter, max(span_y.enter, span_z.enter)));
+    let t0 = max(start, max(span_x.enter, max(span_y.enter, span_z.enter)));
     let t1 = min(span_x.leave, min(span_y.leave, span_z.leave));
     if (!(t0 < t1)) {
         return none;
@@ -285,7 +287,7 @@ fn first_voxel(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hi
                         // save (the voxel-by-voxel loop traced about 20 % more rays
                         // per CPU second), so the shader steps voxel by voxel; the
                         // f64 tests check the answers stay identical, t included.
-                        let base = params.bases.w + (br - 1u) * 16u;
+                        var base = params.bases.w + (br - 1u) * 16u;
                         var tx = (real(cx) + fx - ox) * ix;
                         var ty = (real(cy) + fy - oy) * iy;
                         var tz = (real(cz) + fz - oz) * iz;
@@ -313,7 +315,22 @@ fn first_voxel(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hi
                                 tz = (real(cz) + fz - oz) * iz;
                             }
                             t = tn;
-                            if ((cx >> 3u) != bx || (cy >> 3u) != by || (cz >> 3u) != bz || steps >= cap) {
+                            if ((cx >> 3u) != bx || (cy >> 3u) != by || (cz >> 3u) != bz) {
+                                // Into the next brick: stay in this loop while it is a
+                                // non-empty brick of the same tile.
+                                bx = cx >> 3u;
+                                by = cy >> 3u;
+                                bz = cz >> 3u;
+                                if ((bx >> 3u) != gx || (by >> 3u) != gy || (bz >> 3u) != gz) {
+                                    break;
+                                }
+                                br = occ(tile + u32((bx & 7) | ((by & 7) << 3u) | ((bz & 7) << 6u)));
+                                if (br == 0u) {
+                                    break;
+                                }
+                                base = params.bases.w + (br - 1u) * 16u;
+                            }
+                            if (steps >= cap) {
                                 break;
                             }
                         }
@@ -527,7 +544,7 @@ fn trace_rays(@builtin(workgroup_id) group: vec3<u32>,
     let dz = rays[b + 5u];
     var hit: Hit;
     if (params.run.y == 0) {
-        hit = first_voxel(ox, oy, oz, dx, dy, dz);
+        hit = first_voxel(ox, oy, oz, dx, dy, dz, starts[r / 64u]);
         if (hit.kind == MISS) {  // not CUT: that ray's voxels were not all seen
             hit = ground(ox, oy, oz, dx, dy, dz);
         }

@@ -18,6 +18,7 @@ from numba import njit, prange
 
 from ladartui.errors import Cancelled
 from ladartui.scene.occupancy import block_masks
+from ladartui.tracing.bundle import bundle_start, halo_arrays
 from ladartui.tracing.backend import GROUND, MISS, VOXEL, CellHits, register_backend
 
 CHUNK = 64  # rays per prange work item: coherent neighbours stay on one thread
@@ -25,13 +26,13 @@ BLOCK = 1 << 16  # rays per kernel call: cancel is checked between calls
 INF = np.inf
 
 
-@njit(nogil=True, cache=True)
+@njit(nogil=True, cache=True, inline="always")
 def _boundary_t(b, o, inv):
     # The one formula for boundary parameters (shared with the reference tracer).
     return (b - o) * inv
 
 
-@njit(nogil=True, cache=True)
+@njit(nogil=True, cache=True, inline="always")
 def _cell_at(o, d, inv, t):
     """Cell index on one axis just after parameter ``t``, exact against ``_boundary_t``."""
     c = math.floor(o + t * d)
@@ -48,12 +49,12 @@ def _cell_at(o, d, inv, t):
     return np.int64(c)
 
 
-@njit(nogil=True, cache=True)
+@njit(nogil=True, cache=True, inline="always")
 def _clamp(v, lo, hi):
     return lo if v < lo else (hi if v > hi else v)
 
 
-@njit(nogil=True, cache=True)
+@njit(nogil=True, cache=True, inline="always")
 def _slab(o, d, inv, lo, hi):
     """Entry and exit parameters of [lo, hi) on one axis; (inf, -inf) when never inside."""
     if d > 0.0:
@@ -65,34 +66,26 @@ def _slab(o, d, inv, lo, hi):
     return INF, -INF
 
 
-@njit(nogil=True, cache=True)
+@njit(nogil=True, cache=True, inline="always")
 def _exit_boundary(c, s, positive):
     if positive:
         return ((c >> s) + 1) << s
     return (c >> s) << s
 
 
-@njit(nogil=True, cache=True)
-def _block_t(c, s, positive, o, inv, moving):
-    """Parameter of the exit boundary of the block ``c >> s`` on one axis."""
-    if not moving:
-        return INF
-    return _boundary_t(np.float64(_exit_boundary(c, s, positive)), o, inv)
-
-
-@njit(nogil=True, cache=True)
+@njit(nogil=True, cache=True, inline="always")
 def _slot(x, y, z, s):
     return ((x >> s) & 7) | (((y >> s) & 7) << 3) | (((z >> s) & 7) << 6)
 
 
-@njit(nogil=True, cache=True)
+@njit(nogil=True, cache=True, inline="always")
 def _node_skip(c, s, positive, moving, o, inv):
     """Exit boundary and its parameter of the node ``c >> s`` on one axis."""
     b = _exit_boundary(c, s, positive)
     return b, (_boundary_t(np.float64(b), o, inv) if moving else INF)
 
 
-@njit(nogil=True, cache=True)
+@njit(nogil=True, cache=True, inline="always")
 def _enter(c, b, stepped, positive, s, o, d, inv, t):
     """Cell on one axis after crossing into a new node at ``t``: the boundary cell
     for an axis that stepped, else ``cell_at(t)`` kept inside the node of ``c``."""
@@ -102,14 +95,14 @@ def _enter(c, b, stepped, positive, s, o, d, inv, t):
     return _clamp(_cell_at(o, d, inv, t), lo, lo + (1 << s) - 1)
 
 
-@njit(nogil=True, cache=True)
+@njit(nogil=True, cache=True, inline="always")
 def _brick_entry(b, stepped, positive, o, d, inv, t):
     """Cell on one axis on entering brick ``b`` at ``t`` after a brick step."""
     return _enter(b << 3, (b << 3) if positive else ((b + 1) << 3), stepped, positive, 3, o, d,
                   inv, t)
 
 
-@njit(nogil=True, cache=True)
+@njit(nogil=True, cache=True, inline="always")
 def _ground(ox, oy, oz, dx, dy, dz, nx, ny):
     """(kind, i, j, t) of the ground rule for a ray that hit no voxel."""
     if dz < 0.0 and oz > 0.0:
@@ -123,23 +116,28 @@ def _ground(ox, oy, oz, dx, dy, dz, nx, ny):
 
 @njit(parallel=True, nogil=True, cache=True)
 def _exact_kernel(orig, dirs, root, regions, tiles, bricks, blocks, columns, cubes, corg, cdims,
-                  lo, hi, rorg, rdims, nx, ny, kind, index, tout):
+                  halo, horg, hdims, lo, hi, rorg, rdims, nx, ny, kind, index, tout):
     """The exact traversal of docs/architecture.md for every ray, chunks under prange.
 
     The per-ray code is written out here rather than called: passing the
     arrays to a per-ray function costs reference counting on every ray.
+    Each chunk of rays first gets its bundle start (tracing.bundle), so rays
+    from one aircraft begin near the first brick any of them can meet.
     Empty root cells and regions are skipped as nodes; a DDA over 8-voxel
     bricks skips empty bricks (and, for descending rays, whole empty brick
     columns), jumps across the empty cube of bricks ahead of the ray
     (``Occupancy.cubes``) and walks on past tile faces while bricks are known
     empty; inside a brick a voxel DDA skips empty 4- and 2-voxel blocks (one
-    mask word per brick) and tests bits. Every cell boundary parameter comes from
+    mask word per brick), tests bits and goes on into neighbouring non-empty
+    bricks of the tile. Every cell boundary parameter comes from
     the one formula ``(b - o) * inv``, so the cells visited are those of a
     plain voxel DDA.
     """
     n = orig.shape[0]
     chunks = (n + CHUNK - 1) // CHUNK
     for ch in prange(chunks):
+        # Step 0: where the chunk's rays may all start (tracing.bundle; 0 when they diverge).
+        start = bundle_start(orig, dirs, ch * CHUNK, min(n, (ch + 1) * CHUNK), halo, horg, hdims)
         for r in range(ch * CHUNK, min(n, (ch + 1) * CHUNK)):
             ox, oy, oz = orig[r, 0], orig[r, 1], orig[r, 2]
             dx, dy, dz = dirs[r, 0], dirs[r, 1], dirs[r, 2]
@@ -159,11 +157,11 @@ def _exact_kernel(orig, dirs, root, regions, tiles, bricks, blocks, columns, cub
                 iy = 1.0 / dy if dy != 0.0 else INF
                 iz = 1.0 / dz if dz != 0.0 else INF
                 mx, my, mz = dx != 0.0, dy != 0.0, dz != 0.0
-                # Step 2: clip to the occupied box.
+                # Step 2: clip to the occupied box, from the bundle start on.
                 ex, xx = _slab(ox, dx, ix, lo[0], hi[0])
                 ey, xy = _slab(oy, dy, iy, lo[1], hi[1])
                 ez, xz = _slab(oz, dz, iz, lo[2], hi[2])
-                t0 = max(0.0, max(ex, max(ey, ez)))
+                t0 = max(start, max(ex, max(ey, ez)))
                 t1 = min(xx, min(xy, xz))
                 if not t0 < t1:
                     done = True
@@ -181,6 +179,7 @@ def _exact_kernel(orig, dirs, root, regions, tiles, bricks, blocks, columns, cub
                 fx = 0.0 if dx < 0.0 else 1.0
                 fy = 0.0 if dy < 0.0 else 1.0
                 fz = 0.0 if dz < 0.0 else 1.0
+                ax, ay, az = np.int64(fx), np.int64(fy), np.int64(fz)
                 t = t0
                 rx0, ry0, rz0 = rorg[0], rorg[1], rorg[2]
                 rdx, rdy = rdims[0], rdims[1]
@@ -241,24 +240,20 @@ def _exact_kernel(orig, dirs, root, regions, tiles, bricks, blocks, columns, cub
                                     tz = (cz + fz - oz) * iz
                                     while True:
                                         lx, ly, lz = cx & 7, cy & 7, cz & 7
+                                        bit = lx | ((ly & 3) << 3)
+                                        if (bricks[base + (ly >> 2) + (lz << 1)] >> bit) & 1:
+                                            found = True
+                                            done = True
+                                            break
+                                        # Leave the largest empty aligned block holding the cell:
+                                        # 4 or 2 voxels a side, else the voxel (sh = 2, 1, 0).
                                         at4 = ((lx >> 2) << 1) | ((ly >> 2) << 3) | ((lz >> 2) << 5)
-                                        if (mask >> np.uint64(at4)) & np.uint64(0x330033) == 0:
-                                            tn = min(_block_t(cx, 2, px, ox, ix, mx),
-                                                     min(_block_t(cy, 2, py, oy, iy, my),
-                                                         _block_t(cz, 2, pz, oz, iz, mz)))
-                                        else:
-                                            at2 = (lx >> 1) | ((ly >> 1) << 2) | ((lz >> 1) << 4)
-                                            if (mask >> np.uint64(at2)) & np.uint64(1) == 0:
-                                                tn = min(_block_t(cx, 1, px, ox, ix, mx),
-                                                         min(_block_t(cy, 1, py, oy, iy, my),
-                                                             _block_t(cz, 1, pz, oz, iz, mz)))
-                                            else:
-                                                bit = lx | ((ly & 3) << 3)
-                                                if (bricks[base + (ly >> 2) + (lz << 1)] >> bit) & 1:
-                                                    found = True
-                                                    done = True
-                                                    break
-                                                tn = min(tx, min(ty, tz))
+                                        at2 = (lx >> 1) | ((ly >> 1) << 2) | ((lz >> 1) << 4)
+                                        sh = 2 if (mask >> np.uint64(at4)) & np.uint64(0x330033) == 0 else (
+                                            1 if (mask >> np.uint64(at2)) & np.uint64(1) == 0 else 0)
+                                        tn = min((np.float64(((cx >> sh) + ax) << sh) - ox) * ix,
+                                                 min((np.float64(((cy >> sh) + ay) << sh) - oy) * iy,
+                                                     (np.float64(((cz >> sh) + az) << sh) - oz) * iz))
                                         if tn >= t1:
                                             done = True
                                             break
@@ -275,7 +270,18 @@ def _exact_kernel(orig, dirs, root, regions, tiles, bricks, blocks, columns, cub
                                             cz += sz
                                             tz = (cz + fz - oz) * iz
                                         t = tn
-                                        if (cx >> 3) != bx or (cy >> 3) != by or (cz >> 3) != bz or steps >= cap:
+                                        if (cx >> 3) != bx or (cy >> 3) != by or (cz >> 3) != bz:
+                                            # Into the next brick: stay in this loop while it is a
+                                            # non-empty brick of the same tile.
+                                            bx, by, bz = cx >> 3, cy >> 3, cz >> 3
+                                            if (bx >> 3) != gx or (by >> 3) != gy or (bz >> 3) != gz:
+                                                break
+                                            br = tiles[tile + ((bx & 7) | ((by & 7) << 3) | ((bz & 7) << 6))]
+                                            if br == 0:
+                                                break
+                                            base = (np.int64(br) - 1) * 16
+                                            mask = blocks[np.int64(br) - 1]
+                                        if steps >= cap:
                                             break
                                     if done:
                                         break
@@ -428,7 +434,9 @@ class NumbaBackend:
             self.trace_cells(occupancy, o, d, method=method)
 
     def trace_cells(self, occupancy, origins, directions, *, method="exact", step=0.5,
-                    precision="f64", cancel: threading.Event | None = None) -> CellHits:
+                    precision="f64", cancel: threading.Event | None = None,
+                    bundles: bool = True) -> CellHits:
+        """See ``Backend``; ``bundles=False`` starts every ray at its box entry (for tests)."""
         n = len(origins)
         orig = np.ascontiguousarray(origins, dtype=np.float64)
         dirs = np.ascontiguousarray(directions, dtype=np.float64)
@@ -440,6 +448,7 @@ class NumbaBackend:
         lo, hi = occ.bbox_lo.astype(np.int64), occ.bbox_hi.astype(np.int64)
         rorg, rdims = occ.root_origin.astype(np.int64), occ.root_dims.astype(np.int64)
         cubes, corg, cdims = _cube_arrays(occ)
+        halo = halo_arrays(occ) if bundles else halo_arrays(None)
         blocks = occ.blocks if getattr(occ, "blocks", None) is not None else block_masks(occ.bricks)
         started = time.perf_counter()
         for a in range(0, n, BLOCK):
@@ -448,8 +457,8 @@ class NumbaBackend:
             b = min(n, a + BLOCK)
             if method == "exact":
                 _exact_kernel(orig[a:b], dirs[a:b], occ.root, occ.regions, occ.tiles, occ.bricks,
-                              blocks, occ.columns, cubes, corg, cdims, lo, hi, rorg, rdims, nx, ny,
-                              kind[a:b], index[a:b], t[a:b])
+                              blocks, occ.columns, cubes, corg, cdims, *halo, lo, hi, rorg, rdims,
+                              nx, ny, kind[a:b], index[a:b], t[a:b])
             else:
                 _march_kernel(orig[a:b], dirs[a:b], float(step), float(occ.zmax), occ.root,
                               occ.regions, occ.tiles, occ.bricks, lo, hi, rorg, rdims, nx, ny,

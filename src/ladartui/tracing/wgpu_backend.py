@@ -45,6 +45,7 @@ import numpy as np
 
 from ladartui.errors import BackendUnavailable, Cancelled, FieldError
 from ladartui.tracing.backend import GROUND, METHODS, MISS, VOXEL, CellHits, register_backend
+from ladartui.tracing.bundle import bundle_starts, halo_arrays
 
 NAME = "wgpu"
 
@@ -60,7 +61,7 @@ ADAPTER_TYPE_RANK = {"DiscreteGPU": 0, "IntegratedGPU": 1, "VirtualGPU": 2, "CPU
 # OpenGL adapters lack shader-f64 and large storage buffers; prefer the rest.
 GRAPHICS_BACKEND_RANK = {"Vulkan": 0, "Metal": 0, "D3D12": 0, "OpenGL": 1}
 # Bindings besides the occupancy chunks: params, rays, hit cells, hit ranges.
-FIXED_BINDINGS = 4
+FIXED_BINDINGS = 5
 # Ask for no more than this many occupancy bindings (16 GiB at 128 MiB each).
 MAX_OCCUPANCY_BINDINGS = 128
 # Shader-only hit kinds (trace.wgsl): a march pass ended without an answer, and
@@ -110,7 +111,7 @@ def dispatch_grid(workgroups: int, max_per_dimension: int) -> tuple[int, int]:
     return (x, y)
 
 
-def f32_start_offsets(origins, directions, shape, top, method):
+def f32_start_offsets(origins, directions, shape, top, method, at_least=None):
     """Per-ray float64 ``t`` to move each origin by before it is made float32.
 
     Exact: where the ray enters the box ``[0, nx] x [0, ny] x [0, top]`` (the
@@ -118,7 +119,8 @@ def f32_start_offsets(origins, directions, shape, top, method):
     starts inside or never enters. March: the march's own start, where a
     descending ray crosses ``c_z = top`` (same formula as the kernels), else 0.
     The shader then sees coordinates no larger than the scene, and the host
-    adds ``t`` back in float64.
+    adds ``t`` back in float64. ``at_least`` (exact only): per-ray bundle starts
+    (tracing.bundle) to move at least as far as.
     """
     o = np.asarray(origins, dtype=np.float64)
     d = np.asarray(directions, dtype=np.float64)
@@ -138,6 +140,8 @@ def f32_start_offsets(origins, directions, shape, top, method):
         far = np.fmax(t_lo, t_hi)
         enter = np.fmax(np.fmax(near[:, 0], near[:, 1]), near[:, 2])
         leave = np.fmin(np.fmin(far[:, 0], far[:, 1]), far[:, 2])
+        if at_least is not None:
+            np.fmax(enter, at_least, out=enter)
         # Stay at least half a cell above the ground, so the ground rule still
         # sees an origin above it.
         oz, dz = o[:, 2], d[:, 2]
@@ -428,6 +432,8 @@ class WgpuBackend:
                 "rays": device.create_buffer(size=rays * 6 * real_bytes, usage=usage_in),
                 "cells": device.create_buffer(size=rays * 16, usage=usage_out),
                 "ranges": device.create_buffer(size=rays * real_bytes, usage=usage_out),
+                "starts": device.create_buffer(size=max(1, -(-rays // WORKGROUP_SIZE)) * real_bytes,
+                                               usage=usage_in),
             }
             self._ray_buffers[precision] = buffers
         return buffers
@@ -470,51 +476,73 @@ class WgpuBackend:
         bind_group = self._bind_group(upload, pipeline, buffers, precision)
         real = np.float64 if precision == "f64" else np.float32
         top = float(max(int(occupancy.zmax) + 1, 0))
+        halo = halo_arrays(occupancy)
         if precision == "f32":
-            offsets = f32_start_offsets(origins, directions, occupancy.shape, top, method)
+            # f32 moves each origin to its start on the host (the shader sees no starts).
+            starts = None
+            if method == "exact":
+                starts = np.repeat(bundle_start_array(origins, directions, halo), WORKGROUP_SIZE)[:n]
+            offsets = f32_start_offsets(origins, directions, occupancy.shape, top, method, starts)
         else:
             offsets = None
         capacity = buffers["capacity"]
-        pending = np.arange(n)
+        pending = None  # None: every ray (the first pass), taken in slices, not copies
         first_sample = 0
         while True:
-            for start in range(0, len(pending), capacity):
+            total = n if pending is None else len(pending)
+            for start in range(0, total, capacity):
                 if cancel is not None and cancel.is_set():
                     raise Cancelled("trace cancelled")
-                rows = pending[start:start + capacity]
-                rays = np.empty((len(rows), 6), dtype=real)
-                if offsets is None:
-                    rays[:, :3] = origins[rows]
+                if pending is None:
+                    rows = slice(start, min(total, start + capacity))
+                    count = rows.stop - rows.start
                 else:
-                    rays[:, :3] = floor_preserving_f32(origins[rows] + offsets[rows, None] * directions[rows])
-                rays[:, 3:] = directions[rows]
-                params = pack_params(occupancy, upload, method, step, len(rows), precision,
+                    rows = pending[start:start + capacity]
+                    count = len(rows)
+                batch_origins, batch_directions = origins[rows], directions[rows]
+                rays = np.empty((count, 6), dtype=real)
+                if offsets is None:
+                    rays[:, :3] = batch_origins
+                else:
+                    rays[:, :3] = floor_preserving_f32(batch_origins + offsets[rows, None] * batch_directions)
+                rays[:, 3:] = batch_directions
+                if offsets is None and method == "exact":
+                    starts = bundle_start_array(batch_origins, batch_directions, halo).astype(real)
+                else:
+                    starts = np.zeros(-(-count // WORKGROUP_SIZE), dtype=real)
+                params = pack_params(occupancy, upload, method, step, count, precision,
                                      first_sample, MARCH_SAMPLES_PER_PASS)
-                cells, ranges = self._dispatch(pipeline, bind_group, buffers, params, rays)
-                kind[rows] = cells[:, 0]
+                cells, ranges = self._dispatch(pipeline, bind_group, buffers, params, rays, starts)
+                batch_kind = cells[:, 0]
+                kind[rows] = batch_kind
                 index[rows] = cells[:, 1:]
                 batch_t = ranges.astype(np.float64)
                 if offsets is not None:
-                    batch_t = batch_t + offsets[rows]
-                t[rows] = np.where((cells[:, 0] == VOXEL) | (cells[:, 0] == GROUND), batch_t, np.inf)
-            if np.any(kind[pending] == CUT):
+                    batch_t += offsets[rows]
+                batch_t[(batch_kind != VOXEL) & (batch_kind != GROUND)] = np.inf
+                t[rows] = batch_t
+            done = kind if pending is None else kind[pending]
+            if np.any(done == CUT):
                 raise BackendUnavailable(
                     f"backend {NAME!r} could not finish {int(np.sum(kind == CUT))} rays on "
                     f"{info['adapter']!r}: the adapter ended their loops early (lavapipe stops "
                     f"after 65,535 iterations); use backend 'numba'")
-            pending = pending[kind[pending] == UNFINISHED]
+            pending = (np.flatnonzero(done == UNFINISHED) if pending is None
+                       else pending[done == UNFINISHED])
             if len(pending) == 0:
                 break
             first_sample += MARCH_SAMPLES_PER_PASS
         index[kind == MISS] = -1
         return CellHits(kind, index, t, info)
 
-    def _dispatch(self, pipeline, bind_group, buffers, params, rays):
-        """One dispatch over ``rays`` (count, 6): their hit cells (count, 4) and ranges."""
+    def _dispatch(self, pipeline, bind_group, buffers, params, rays, starts):
+        """One dispatch over ``rays`` (count, 6) with their bundle ``starts`` (one per
+        workgroup): their hit cells (count, 4) and ranges."""
         device = self._device
         count = len(rays)
         device.queue.write_buffer(buffers["params"], 0, params)
         device.queue.write_buffer(buffers["rays"], 0, rays)
+        device.queue.write_buffer(buffers["starts"], 0, starts)
         groups = dispatch_grid(-(-count // WORKGROUP_SIZE), self._limits["max-compute-workgroups-per-dimension"])
         encoder = device.create_command_encoder()
         compute = encoder.begin_compute_pass()
@@ -538,12 +566,21 @@ class WgpuBackend:
                 {"binding": 1, "resource": {"buffer": buffers["rays"]}},
                 {"binding": 2, "resource": {"buffer": buffers["cells"]}},
                 {"binding": 3, "resource": {"buffer": buffers["ranges"]}},
+                {"binding": 4, "resource": {"buffer": buffers["starts"]}},
             ]
             for chunk, buffer in enumerate(upload.buffers):
                 entries.append({"binding": FIXED_BINDINGS + chunk, "resource": {"buffer": buffer}})
             group = self._device.create_bind_group(layout=pipeline.get_bind_group_layout(0), entries=entries)
             upload.bind_groups[key] = group
         return group
+
+
+def bundle_start_array(origins, directions, halo):
+    """float64 bundle start (tracing.bundle) of each ``WORKGROUP_SIZE`` consecutive rays."""
+    out = np.zeros(max(1, -(-len(origins) // WORKGROUP_SIZE)))
+    bundle_starts(np.ascontiguousarray(origins, dtype=np.float64),
+                  np.ascontiguousarray(directions, dtype=np.float64), WORKGROUP_SIZE, *halo, out)
+    return out
 
 
 def occupancy_arrays(occupancy):

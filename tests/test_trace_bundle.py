@@ -1,0 +1,178 @@
+"""Bundle starts (tracing/bundle.py): a lower bound for every ray of a chunk, and no change
+to any answer, on sensor scans where they do skip empty space."""
+
+import math
+
+import numpy as np
+import pytest
+
+from ladartui.flight import ScanPose, aim_at
+from ladartui.scene.occupancy import Occupancy
+from ladartui.sensor import Sensor
+from ladartui.tracing.backend import MISS, VOXEL
+from ladartui.tracing.bundle import BUNDLE_REACH, bundle_start, bundle_starts, halo_arrays
+from ladartui.tracing.reference import reference_trace_cells
+
+CHUNK = 64
+
+
+@pytest.fixture(scope="module")
+def forest():
+    """(voxels, occupancy) of the generated "small" forest (0.25 m voxels)."""
+    from ladartui.scene.generate import generate_scene
+
+    generated = generate_scene("small")
+    return generated.voxels, Occupancy.build(generated.voxels, generated.shape)
+
+
+def scan_rays(occ, rng, scans, slant_cells, depressions=(1.0, 89.9), sensor=None):
+    """Cell-space rays of sensor scans aimed at random points of the scene."""
+    sensor = sensor or Sensor(grid=16, ray_grid=4, fov=5.0)
+    nx, ny, _ = occ.shape
+    origins, directions = [], []
+    for _ in range(scans):
+        aim = np.array([rng.uniform(0.2, 0.8) * nx, rng.uniform(0.2, 0.8) * ny,
+                        rng.uniform(0, occ.zmax + 1)])
+        e = math.radians(rng.uniform(*depressions))
+        a = rng.uniform(0, 2 * math.pi)
+        at = aim + slant_cells * np.array([math.cos(a) * math.cos(e), math.sin(a) * math.cos(e),
+                                           math.sin(e)])
+        pose = aim_at(ScanPose(*at.tolist()), aim.tolist())
+        o, d, _ = sensor.rays(pose)
+        origins.append(o)
+        directions.append(d)
+    return np.concatenate(origins), np.concatenate(directions)
+
+
+def starts_of(occ, origins, directions):
+    out = np.zeros(-(-len(origins) // CHUNK))
+    bundle_starts(origins, directions, CHUNK, *halo_arrays(occ), out)
+    return np.repeat(out, CHUNK)[:len(origins)]
+
+
+def same(a, b):
+    return (np.array_equal(a.kind, b.kind) and np.array_equal(a.index, b.index)
+            and np.array_equal(a.t, b.t))
+
+
+def test_halo_marks_exactly_the_bricks_next_to_voxels():
+    rng = np.random.default_rng(3)
+    shape = (90, 70, 50)
+    vox = rng.integers(0, shape, size=(40, 3))
+    occ = Occupancy.build(vox, shape)
+    halo, origin, dims = halo_arrays(occ)
+    bricks = {tuple(b) for b in (vox >> 3)}
+    for x in range(dims[0]):
+        for y in range(dims[1]):
+            for z in range(dims[2]):
+                cell = (origin[0] + x, origin[1] + y, origin[2] + z)
+                expected = any((cell[0] + i, cell[1] + j, cell[2] + k) in bricks
+                               for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1))
+                lin = x + dims[0] * (y + dims[1] * z)
+                assert bool((halo[lin >> 5] >> (lin & 31)) & 1) == expected, cell
+
+
+def test_start_stops_before_the_only_voxel():
+    # One voxel at z = 100 seen from straight above: the chunk starts one voxel above the
+    # halo (two bricks over the voxel's brick at most), never inside or past the voxel.
+    occ = Occupancy.build(np.array([[40, 40, 100]]), (80, 80, 200))
+    halo = halo_arrays(occ)
+    o = np.tile([40.5, 40.5, 1000.0], (CHUNK, 1))
+    d = np.tile([0.0, 0.0, -1.0], (CHUNK, 1))
+    start = bundle_start(o, d, 0, CHUNK, *halo)
+    halo_top = 8 * ((100 >> 3) + 2)
+    assert start == pytest.approx(1000.0 - halo_top - 1.0)
+    assert 1000.0 - start > 101.0  # before the voxel's top face
+
+
+def test_fanned_chunk_starts_no_further_than_its_reach(numba_backend):
+    # Half the chunk looks straight down, half leans out to a voxel 30 cells to the side
+    # that the centre ray passes two bricks away from: the reach, not the halo, must stop it.
+    occ = Occupancy.build(np.array([[70, 40, 100]]), (120, 80, 200))
+    o = np.tile([40.5, 40.5, 1000.0], (CHUNK, 1))
+    d = np.tile([0.0, 0.0, -1.0], (CHUNK, 1))
+    d[CHUNK // 2:, 0] = 30.0 / 899.5
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    start = bundle_start(o, d, 0, CHUNK, *halo_arrays(occ))
+    spread = np.linalg.norm(d - d.mean(axis=0), axis=1).max()
+    assert start == pytest.approx(BUNDLE_REACH / spread - 1.0 / np.linalg.norm(d.mean(axis=0)))
+    hits = numba_backend.trace_cells(occ, o, d)
+    assert (hits.kind[CHUNK // 2:] == VOXEL).all()
+    assert same(hits, numba_backend.trace_cells(occ, o, d, bundles=False))
+
+
+def test_start_is_zero_for_scattered_rays_and_an_empty_halo(forest):
+    _, occ = forest
+    rng = np.random.default_rng(5)
+    o = rng.uniform(0, 200, size=(CHUNK, 3))
+    d = rng.normal(size=(CHUNK, 3))
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    assert bundle_start(o, d, 0, CHUNK, *halo_arrays(occ)) == 0.0
+    # Origins further apart than the reach: no bundle even with one direction.
+    o = np.zeros((CHUNK, 3)) + [120.0, 120.0, 900.0]
+    o[1, 0] += BUNDLE_REACH + 0.5
+    d = np.tile([0.0, 0.0, -1.0], (CHUNK, 1))
+    assert bundle_start(o, d, 0, CHUNK, *halo_arrays(occ)) == 0.0
+    assert bundle_start(o[:1], d[:1], 0, 1, *halo_arrays(occ)) > 0.0
+    assert bundle_start(o[:1], d[:1], 0, 1, *halo_arrays(None)) == 0.0
+
+
+@pytest.mark.parametrize("slant_m, depressions, fov", [
+    (85.0, (30.0, 89.9), 5.0), (150.0, (1.0, 10.0), 5.0), (10_000.0, (20.0, 60.0), 0.05)])
+def test_starts_bound_every_first_hit_and_change_nothing(forest, numba_backend, slant_m,
+                                                         depressions, fov):
+    vox, occ = forest
+    rng = np.random.default_rng(int(slant_m))
+    sensor = Sensor(grid=16, ray_grid=4, fov=fov)
+    o, d = scan_rays(occ, rng, 6, slant_m / 0.25, depressions, sensor)
+    starts = starts_of(occ, o, d)
+    plain = numba_backend.trace_cells(occ, o, d, bundles=False)
+    bundled = numba_backend.trace_cells(occ, o, d)
+    assert same(plain, bundled)
+    hit = plain.kind == VOXEL
+    assert hit.mean() > 0.3
+    assert np.all(plain.t[hit] >= starts[hit] + 0.5)  # at least the one-voxel margin, less rounding
+    # They skip real distance: most chunks start well past the aircraft.
+    assert np.median(starts) > 0.5 * slant_m / 0.25
+    pick = rng.choice(len(o), 1500, replace=False)
+    ref = reference_trace_cells(vox, occ.shape, o[pick], d[pick])
+    assert np.array_equal(ref.kind, bundled.kind[pick])
+    assert np.array_equal(ref.index, bundled.index[pick])
+
+
+def test_bundles_on_grid_planes_and_axis_directions(numba_backend):
+    # Nadir chunks from origins on brick faces and edges (zero direction components in the
+    # centre ray), over voxels on those same faces.
+    rng = np.random.default_rng(8)
+    shape = (64, 64, 48)
+    vox = rng.integers(0, shape, size=(20_000, 3))
+    occ = Occupancy.build(vox, shape)
+    origins, directions = [], []
+    for x, y in [(16.0, 16.0), (24.0, 31.5), (8.0, 40.0), (32.5, 32.5)]:
+        o = np.tile([x, y, 300.0], (CHUNK, 1))
+        d = np.tile([0.0, 0.0, -1.0], (CHUNK, 1))
+        d[: CHUNK // 2, 0] = np.linspace(-2e-3, 2e-3, CHUNK // 2)  # half of them lean a little
+        origins.append(o)
+        directions.append(d / np.linalg.norm(d, axis=1)[:, None])
+    o, d = np.concatenate(origins), np.concatenate(directions)
+    plain = numba_backend.trace_cells(occ, o, d, bundles=False)
+    bundled = numba_backend.trace_cells(occ, o, d)
+    assert same(plain, bundled)
+    assert (bundled.kind == VOXEL).sum() > CHUNK  # leaning rays and rays off the planes hit
+    ref = reference_trace_cells(vox, shape, o, d)
+    assert np.array_equal(ref.kind, bundled.kind)
+    assert np.array_equal(ref.index, bundled.index)
+    assert starts_of(occ, o, d).min() > 200.0
+
+
+def test_wgpu_scans_match_numba(forest, numba_backend, wgpu_backend):
+    _, occ = forest
+    rng = np.random.default_rng(17)
+    o, d = scan_rays(occ, rng, 8, 85.0 / 0.25, (1.0, 89.9))
+    expected = numba_backend.trace_cells(occ, o, d)
+    assert (expected.kind != MISS).mean() > 0.5
+    got = wgpu_backend.trace_cells(occ, o, d, precision="f64")
+    assert same(expected, got)
+    f32 = wgpu_backend.trace_cells(occ, o, d, precision="f32")
+    agree = (f32.kind == expected.kind) & np.all(f32.index == expected.index, axis=1)
+    assert agree.mean() >= 0.999
