@@ -10,7 +10,8 @@ from ladartui.flight import ScanPose, aim_at
 from ladartui.scene.occupancy import Occupancy
 from ladartui.sensor import Sensor
 from ladartui.tracing.backend import MISS, VOXEL
-from ladartui.tracing.bundle import BUNDLE_REACH, bundle_start, bundle_starts, halo_arrays
+from ladartui.tracing.bundle import (BUNDLE_REACH, FINE_REACH, bundle_start, bundle_starts,
+                                     halo_arrays)
 from ladartui.tracing.reference import reference_trace_cells
 
 CHUNK = 64
@@ -55,50 +56,61 @@ def same(a, b):
             and np.array_equal(a.t, b.t))
 
 
-def test_halo_marks_exactly_the_bricks_next_to_voxels():
+@pytest.mark.parametrize("level, size", [(0, 8), (1, 4)])
+def test_halos_mark_exactly_the_cells_next_to_voxels(level, size):
     rng = np.random.default_rng(3)
     shape = (90, 70, 50)
     vox = rng.integers(0, shape, size=(40, 3))
     occ = Occupancy.build(vox, shape)
-    halo, origin, dims = halo_arrays(occ)
-    bricks = {tuple(b) for b in (vox >> 3)}
+    bits, origin, dims = halo_arrays(occ)[3 * level:3 * level + 3]
+    shift = size.bit_length() - 1
+    assert origin.tolist() == ((vox.min(axis=0) >> shift) - 1).tolist()
+    cells = {tuple(b) for b in (vox >> shift)}
     for x in range(dims[0]):
         for y in range(dims[1]):
             for z in range(dims[2]):
                 cell = (origin[0] + x, origin[1] + y, origin[2] + z)
-                expected = any((cell[0] + i, cell[1] + j, cell[2] + k) in bricks
+                expected = any((cell[0] + i, cell[1] + j, cell[2] + k) in cells
                                for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1))
                 lin = x + dims[0] * (y + dims[1] * z)
-                assert bool((halo[lin >> 5] >> (lin & 31)) & 1) == expected, cell
+                assert bool((bits[lin >> 5] >> (lin & 31)) & 1) == expected, cell
 
 
 def test_start_stops_before_the_only_voxel():
     # One voxel at z = 100 seen from straight above: the chunk starts one voxel above the
-    # halo (two bricks over the voxel's brick at most), never inside or past the voxel.
+    # 4-voxel halo (two 4-voxel cells over the voxel's cell), never inside or past the voxel.
     occ = Occupancy.build(np.array([[40, 40, 100]]), (80, 80, 200))
     halo = halo_arrays(occ)
     o = np.tile([40.5, 40.5, 1000.0], (CHUNK, 1))
     d = np.tile([0.0, 0.0, -1.0], (CHUNK, 1))
     start = bundle_start(o, d, 0, CHUNK, *halo)
-    halo_top = 8 * ((100 >> 3) + 2)
+    halo_top = 4 * ((100 >> 2) + 2)
     assert start == pytest.approx(1000.0 - halo_top - 1.0)
+    brick_only = bundle_start(o, d, 0, CHUNK, *halo[:3], *halo_arrays(None)[3:])
+    assert brick_only == pytest.approx(1000.0 - 8 * ((100 >> 3) + 2) - 1.0)
     assert 1000.0 - start > 101.0  # before the voxel's top face
 
 
-def test_fanned_chunk_starts_no_further_than_its_reach(numba_backend):
-    # Half the chunk looks straight down, half leans out to a voxel 30 cells to the side
-    # that the centre ray passes two bricks away from: the reach, not the halo, must stop it.
-    occ = Occupancy.build(np.array([[70, 40, 100]]), (120, 80, 200))
+@pytest.mark.parametrize("voxel_x, reach", [(70, BUNDLE_REACH), (50, FINE_REACH)])
+def test_fanned_chunk_starts_no_further_than_its_reach(numba_backend, voxel_x, reach):
+    # Half the chunk looks straight down, half leans out to a voxel to the side that the
+    # centre ray passes outside the brick halo (x = 70) or inside it but outside the 4-voxel
+    # halo (x = 50): the reach of that halo, not its cells, must stop the start.
+    occ = Occupancy.build(np.array([[voxel_x, 40, 100]]), (120, 80, 200))
     o = np.tile([40.5, 40.5, 1000.0], (CHUNK, 1))
     d = np.tile([0.0, 0.0, -1.0], (CHUNK, 1))
-    d[CHUNK // 2:, 0] = 30.0 / 899.5
+    d[CHUNK // 2:, 0] = (voxel_x + 0.5 - 40.5) / 899.5
     d /= np.linalg.norm(d, axis=1)[:, None]
     start = bundle_start(o, d, 0, CHUNK, *halo_arrays(occ))
     spread = np.linalg.norm(d - d.mean(axis=0), axis=1).max()
-    assert start == pytest.approx(BUNDLE_REACH / spread - 1.0 / np.linalg.norm(d.mean(axis=0)))
     hits = numba_backend.trace_cells(occ, o, d)
     assert (hits.kind[CHUNK // 2:] == VOXEL).all()
+    assert start < hits.t[CHUNK // 2:].min()
     assert same(hits, numba_backend.trace_cells(occ, o, d, bundles=False))
+    if reach == BUNDLE_REACH:
+        assert start == pytest.approx(reach / spread - 1.0 / np.linalg.norm(d.mean(axis=0)))
+    else:  # the brick halo's stop, 8 voxels over the voxel's brick
+        assert 1000.0 - start * abs(d.mean(axis=0)[2]) == pytest.approx(113.0, abs=0.5)
 
 
 def test_start_is_zero_for_scattered_rays_and_an_empty_halo(forest):
@@ -115,6 +127,10 @@ def test_start_is_zero_for_scattered_rays_and_an_empty_halo(forest):
     assert bundle_start(o, d, 0, CHUNK, *halo_arrays(occ)) == 0.0
     assert bundle_start(o[:1], d[:1], 0, 1, *halo_arrays(occ)) > 0.0
     assert bundle_start(o[:1], d[:1], 0, 1, *halo_arrays(None)) == 0.0
+    # A chunk 2 voxels wide (within the brick reach, not the 4-voxel one) stops at the brick halo.
+    o[1, 0] = o[0, 0] + 3.5
+    wide = bundle_start(o, d, 0, CHUNK, *halo_arrays(occ))
+    assert wide == bundle_start(o, d, 0, CHUNK, *halo_arrays(occ)[:3], *halo_arrays(None)[3:])
 
 
 @pytest.mark.parametrize("slant_m, depressions, fov", [

@@ -16,6 +16,7 @@ blocks, cubes and halo are optional accelerations a tracer may ignore.
     halo    (uint32, optional acceleration) one bit per brick cell of the occupied box grown by
             one brick on every side: set when that brick or any of its 26 neighbours holds a
             voxel (bit l & 31 of word l >> 5, l = x + dims.x * (y + dims.y * z))
+    halo4   (uint32, optional acceleration) the same over 4-voxel cells
 
 Inside any node the local position (lx, ly, lz), each 0..7, is linear
 ``l = lx + 8 * ly + 64 * lz``; a brick's bit ``l`` is bit ``l & 31`` of word ``l >> 5``.
@@ -64,6 +65,9 @@ class Occupancy:
     halo: np.ndarray = None
     halo_origin: np.ndarray = None
     halo_dims: np.ndarray = None
+    halo4: np.ndarray = None
+    halo4_origin: np.ndarray = None
+    halo4_dims: np.ndarray = None
 
     @classmethod
     def build(cls, voxels, shape=None) -> "Occupancy":
@@ -102,7 +106,7 @@ class Occupancy:
         return cls(shape, zero.copy(), zero.copy(), zero.copy(), zero.copy(),
                    empty, empty.copy(), empty.copy(), empty.copy(), 0, empty.copy(),
                    np.zeros(0, np.uint64), np.zeros(0, np.uint8), zero.copy(), zero.copy(),
-                   empty.copy(), zero.copy(), zero.copy())
+                   empty.copy(), zero.copy(), zero.copy(), empty.copy(), zero.copy(), zero.copy())
 
     @classmethod
     def _from_nonempty(cls, vox, lo, hi, shape):
@@ -139,16 +143,21 @@ class Occupancy:
         cubes = _empty_cubes(brick_cells - cube_origin, cube_dims)
         halo_origin, halo_dims = cube_origin - 1, cube_dims + 2
         halo = _halo_bits(brick_cells - halo_origin, halo_dims)
+        halo4_origin = (lo >> 2) - 1
+        halo4_dims = ((hi - 1) >> 2) - (lo >> 2) + 3
+        halo4 = _halo_bits((vox >> 2) - halo4_origin, halo4_dims)
         return cls(shape, lo.astype(np.int64), hi.astype(np.int64), root_origin.astype(np.int64),
                    root_dims.astype(np.int64), root, regions, tiles, bricks, count, columns,
                    block_masks(bricks), cubes, cube_origin.astype(np.int64),
                    cube_dims.astype(np.int64), halo, halo_origin.astype(np.int64),
-                   halo_dims.astype(np.int64))
+                   halo_dims.astype(np.int64), halo4, halo4_origin.astype(np.int64),
+                   halo4_dims.astype(np.int64))
 
     @property
     def nbytes(self) -> int:
         """Bytes held by the hierarchy arrays."""
-        extra = sum(a.nbytes for a in (self.blocks, self.cubes, self.halo) if a is not None)
+        extra = sum(a.nbytes for a in (self.blocks, self.cubes, self.halo, self.halo4)
+                    if a is not None)
         return int(self.root.nbytes + self.regions.nbytes + self.tiles.nbytes + self.bricks.nbytes
                    + self.columns.nbytes + extra)
 
@@ -281,7 +290,7 @@ def _empty_cubes(cells, dims):
 
 
 def _halo_bits(cells, dims):
-    """Bits over a ``dims`` box of brick cells: set where the brick or a neighbour is non-empty.
+    """Bits over a ``dims`` box of cells: set where the cell or a neighbour holds a voxel.
 
     A bundle of rays from one origin that stays within 7 voxels of its centre
     ray meets no voxel before that ray enters a set cell (see

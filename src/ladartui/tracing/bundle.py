@@ -12,8 +12,10 @@ halo cell, that brick and its 26 neighbours are empty. A ray of the chunk is
 at ``P(t) = o + t d`` with ``|P(t) - Q(t)| <= |o - o_c| + t |d - d_c|``; while
 that bound is at most ``BUNDLE_REACH`` (7 voxels, less than a brick), ``P(t)``
 lies in one of those empty bricks. So no ray of the chunk meets a voxel before
-the centre ray enters a set cell (or before the bound passes 7 voxels). The
-start returned is one voxel of centre-ray length before that, so every ray
+the centre ray enters a set cell (or before the bound passes 7 voxels). From
+there the centre ray goes on in the same way over ``Occupancy.halo4`` (4-voxel
+cells, reach 3 voxels) while the bundle is that tight. The start returned is
+one voxel of centre-ray length before the last stop, so every ray
 starts in an empty cell and the cells it visits afterwards, and their
 parameters, are those of a traversal from its box entry.
 """
@@ -26,11 +28,13 @@ import numpy as np
 from numba import njit, prange
 
 BUNDLE_REACH = 7.0  # voxels: under one brick (8), one voxel of slack for rounding
+FINE_REACH = 3.0  # the same over ``Occupancy.halo4`` (4-voxel cells)
 INF = np.inf
 
 
 @njit(nogil=True, cache=True)
-def bundle_start(orig, dirs, first, end, halo, halo_origin, halo_dims):
+def bundle_start(orig, dirs, first, end, halo, halo_origin, halo_dims, fine, fine_origin,
+                 fine_dims):
     """Parameter ``t`` before which no ray ``first..end-1`` meets an occupied voxel (>= 0)."""
     if halo.shape[0] == 0 or end <= first:
         return 0.0
@@ -53,17 +57,31 @@ def bundle_start(orig, dirs, first, end, halo, halo_origin, halo_dims):
     if reach <= 0.0 or length == 0.0:
         return 0.0
     limit = reach / spread if spread > 0.0 else INF
-    # The centre ray over the halo box (brick cells), one brick at a time.
+    stop = _walk(ox, oy, oz, dx, dy, dz, 0.0, limit, halo, halo_origin, halo_dims, 8.0)
+    fine_reach = FINE_REACH - offset
+    if stop < limit and fine.shape[0] != 0 and fine_reach > 0.0:
+        # Near the first brick the centre ray can meet, go on over the 4-voxel halo.
+        fine_limit = fine_reach / spread if spread > 0.0 else INF
+        stop = max(stop, _walk(ox, oy, oz, dx, dy, dz, stop, fine_limit, fine, fine_origin,
+                               fine_dims, 4.0))
+    return max(0.0, stop - 1.0 / length)
+
+
+@njit(nogil=True, cache=True)
+def _walk(ox, oy, oz, dx, dy, dz, start, limit, bits, origin, dims, size):
+    """Where the ray, from ``start`` on, enters a set cell of the ``bits`` grid of
+    ``size``-voxel cells (box ``origin .. origin + dims`` in cells); ``limit`` when it
+    leaves the box, or reaches ``limit``, first."""
     ix = 1.0 / dx if dx != 0.0 else INF
     iy = 1.0 / dy if dy != 0.0 else INF
     iz = 1.0 / dz if dz != 0.0 else INF
-    t0, t1 = 0.0, limit
+    t0, t1 = start, limit
     for axis in range(3):
         o = ox if axis == 0 else (oy if axis == 1 else oz)
         d = dx if axis == 0 else (dy if axis == 1 else dz)
         inv = ix if axis == 0 else (iy if axis == 1 else iz)
-        lo = 8.0 * halo_origin[axis]
-        hi = 8.0 * (halo_origin[axis] + halo_dims[axis])
+        lo = size * origin[axis]
+        hi = size * (origin[axis] + dims[axis])
         if d == 0.0:
             if not lo < o < hi:
                 t1 = -INF
@@ -71,55 +89,59 @@ def bundle_start(orig, dirs, first, end, halo, halo_origin, halo_dims):
             a, b = (lo - o) * inv, (hi - o) * inv
             t0 = max(t0, min(a, b))
             t1 = min(t1, max(a, b))
-    stop = limit
-    if t0 < t1:
-        bx = _cell(ox + t0 * dx, halo_origin[0], halo_dims[0])
-        by = _cell(oy + t0 * dy, halo_origin[1], halo_dims[1])
-        bz = _cell(oz + t0 * dz, halo_origin[2], halo_dims[2])
-        sx = 1 if dx > 0.0 else -1
-        sy = 1 if dy > 0.0 else -1
-        sz = 1 if dz > 0.0 else -1
-        t = t0
-        while True:
-            lin = (bx - halo_origin[0]) + halo_dims[0] * ((by - halo_origin[1])
-                                                          + halo_dims[1] * (bz - halo_origin[2]))
-            if (halo[lin >> 5] >> (lin & 31)) & 1:
-                stop = t
-                break
-            tx = (8.0 * (bx + 1 if dx > 0.0 else bx) - ox) * ix if dx != 0.0 else INF
-            ty = (8.0 * (by + 1 if dy > 0.0 else by) - oy) * iy if dy != 0.0 else INF
-            tz = (8.0 * (bz + 1 if dz > 0.0 else bz) - oz) * iz if dz != 0.0 else INF
-            t = min(tx, min(ty, tz))
-            if t >= t1:
-                break  # left the halo box (or the reach) without meeting a set cell
-            if tx == t:
-                bx += sx
-            if ty == t:
-                by += sy
-            if tz == t:
-                bz += sz
-    return max(0.0, stop - 1.0 / length)
+    if not t0 < t1:
+        return limit
+    scale = 1.0 / size
+    bx = _cell(ox + t0 * dx, scale, origin[0], dims[0])
+    by = _cell(oy + t0 * dy, scale, origin[1], dims[1])
+    bz = _cell(oz + t0 * dz, scale, origin[2], dims[2])
+    sx = 1 if dx > 0.0 else -1
+    sy = 1 if dy > 0.0 else -1
+    sz = 1 if dz > 0.0 else -1
+    t = t0
+    while True:
+        lin = (bx - origin[0]) + dims[0] * ((by - origin[1]) + dims[1] * (bz - origin[2]))
+        if (bits[lin >> 5] >> (lin & 31)) & 1:
+            return t
+        tx = (size * (bx + 1 if dx > 0.0 else bx) - ox) * ix if dx != 0.0 else INF
+        ty = (size * (by + 1 if dy > 0.0 else by) - oy) * iy if dy != 0.0 else INF
+        tz = (size * (bz + 1 if dz > 0.0 else bz) - oz) * iz if dz != 0.0 else INF
+        t = min(tx, min(ty, tz))
+        if t >= t1:
+            return limit  # left the box (or the reach) without meeting a set cell
+        if tx == t:
+            bx += sx
+        if ty == t:
+            by += sy
+        if tz == t:
+            bz += sz
 
 
 @njit(nogil=True, cache=True)
-def _cell(c, origin, dims):
-    b = np.int64(math.floor(c * 0.125))
+def _cell(c, scale, origin, dims):
+    b = np.int64(math.floor(c * scale))
     return min(max(b, origin), origin + dims - 1)
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def bundle_starts(orig, dirs, chunk, halo, halo_origin, halo_dims, out):
+def bundle_starts(orig, dirs, chunk, halo, halo_origin, halo_dims, fine, fine_origin, fine_dims,
+                  out):
     """``bundle_start`` of every ``chunk`` consecutive rays, into ``out``."""
     n = orig.shape[0]
     for c in prange((n + chunk - 1) // chunk):
         out[c] = bundle_start(orig, dirs, c * chunk, min(n, (c + 1) * chunk), halo, halo_origin,
-                              halo_dims)
+                              halo_dims, fine, fine_origin, fine_dims)
 
 
 def halo_arrays(occupancy):
-    """(halo, origin, dims): the occupancy's halo, or an empty one (no bundle starts)."""
-    halo = getattr(occupancy, "halo", None)
-    if halo is None or getattr(occupancy, "halo_dims", None) is None or len(halo) == 0:
+    """(halo, origin, dims, halo4, origin4, dims4): the occupancy's halos, empty ones
+    (no bundle starts, or no fine step) where it has none."""
+    return _bits(occupancy, "halo") + _bits(occupancy, "halo4")
+
+
+def _bits(occupancy, name):
+    bits = getattr(occupancy, name, None)
+    if bits is None or getattr(occupancy, name + "_dims", None) is None or len(bits) == 0:
         return np.zeros(0, np.uint32), np.zeros(3, np.int64), np.zeros(3, np.int64)
-    return (halo, np.asarray(occupancy.halo_origin, np.int64),
-            np.asarray(occupancy.halo_dims, np.int64))
+    return (bits, np.asarray(getattr(occupancy, name + "_origin"), np.int64),
+            np.asarray(getattr(occupancy, name + "_dims"), np.int64))

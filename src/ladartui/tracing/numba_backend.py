@@ -116,7 +116,8 @@ def _ground(ox, oy, oz, dx, dy, dz, nx, ny):
 
 @njit(parallel=True, nogil=True, cache=True)
 def _exact_kernel(orig, dirs, root, regions, tiles, bricks, blocks, columns, cubes, corg, cdims,
-                  halo, horg, hdims, lo, hi, rorg, rdims, nx, ny, kind, index, tout):
+                  halo, horg, hdims, halo4, h4org, h4dims, lo, hi, rorg, rdims, nx, ny, kind,
+                  index, tout):
     """The exact traversal of docs/architecture.md for every ray, chunks under prange.
 
     The per-ray code is written out here rather than called: passing the
@@ -137,7 +138,8 @@ def _exact_kernel(orig, dirs, root, regions, tiles, bricks, blocks, columns, cub
     chunks = (n + CHUNK - 1) // CHUNK
     for ch in prange(chunks):
         # Step 0: where the chunk's rays may all start (tracing.bundle; 0 when they diverge).
-        start = bundle_start(orig, dirs, ch * CHUNK, min(n, (ch + 1) * CHUNK), halo, horg, hdims)
+        start = bundle_start(orig, dirs, ch * CHUNK, min(n, (ch + 1) * CHUNK), halo, horg, hdims,
+                             halo4, h4org, h4dims)
         for r in range(ch * CHUNK, min(n, (ch + 1) * CHUNK)):
             ox, oy, oz = orig[r, 0], orig[r, 1], orig[r, 2]
             dx, dy, dz = dirs[r, 0], dirs[r, 1], dirs[r, 2]
