@@ -18,6 +18,10 @@ cells, reach 3 voxels) while the bundle is that tight. The start returned is
 one voxel of centre-ray length before the last stop, so every ray
 starts in an empty cell and the cells it visits afterwards, and their
 parameters, are those of a traversal from its box entry.
+
+The numba exact kernel compiles ``bundle_start`` into itself, and numba's
+on-disk cache only notices edits to the kernel's own file: after editing this
+one, clear ``tracing/__pycache__/*.nb*`` (a fresh install has no stale cache).
 """
 
 from __future__ import annotations
@@ -47,12 +51,13 @@ def bundle_start(orig, dirs, first, end, halo, halo_origin, halo_dims, fine, fin
     scale = 1.0 / (end - first)
     dx, dy, dz = dx * scale, dy * scale, dz * scale
     length = math.sqrt(dx * dx + dy * dy + dz * dz)
-    offset, spread = 0.0, 0.0
+    offset2, spread2 = 0.0, 0.0  # squared: one square root each, not one per ray
     for r in range(first, end):
         ax, ay, az = orig[r, 0] - ox, orig[r, 1] - oy, orig[r, 2] - oz
-        offset = max(offset, math.sqrt(ax * ax + ay * ay + az * az))
+        offset2 = max(offset2, ax * ax + ay * ay + az * az)
         ax, ay, az = dirs[r, 0] - dx, dirs[r, 1] - dy, dirs[r, 2] - dz
-        spread = max(spread, math.sqrt(ax * ax + ay * ay + az * az))
+        spread2 = max(spread2, ax * ax + ay * ay + az * az)
+    offset, spread = math.sqrt(offset2), math.sqrt(spread2)
     reach = BUNDLE_REACH - offset
     if reach <= 0.0 or length == 0.0:
         return 0.0
