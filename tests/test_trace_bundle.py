@@ -127,6 +127,8 @@ def test_start_is_zero_for_scattered_rays_and_an_empty_halo(forest):
     assert bundle_start(o, d, 0, CHUNK, *halo_arrays(occ)) == 0.0
     assert bundle_start(o[:1], d[:1], 0, 1, *halo_arrays(occ)) > 0.0
     assert bundle_start(o[:1], d[:1], 0, 1, *halo_arrays(None)) == 0.0
+    # So far out that a voxel is below rounding: no start.
+    assert bundle_start(o[:1] + [0.0, 0.0, 1e13], d[:1], 0, 1, *halo_arrays(occ)) == 0.0
     # A chunk 2 voxels wide (within the brick reach, not the 4-voxel one) stops at the brick halo.
     o[1, 0] = o[0, 0] + 3.5
     wide = bundle_start(o, d, 0, CHUNK, *halo_arrays(occ))

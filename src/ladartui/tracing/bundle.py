@@ -33,6 +33,7 @@ from numba import njit, prange
 
 BUNDLE_REACH = 7.0  # voxels: under one brick (8), one voxel of slack for rounding
 FINE_REACH = 3.0  # the same over ``Occupancy.halo4`` (4-voxel cells)
+FAR = 1e12  # cells: beyond this the one-voxel margins drown in rounding, so no bundle start
 INF = np.inf
 
 
@@ -43,6 +44,8 @@ def bundle_start(orig, dirs, first, end, halo, halo_origin, halo_dims, fine, fin
     if halo.shape[0] == 0 or end <= first:
         return 0.0
     ox, oy, oz = orig[first, 0], orig[first, 1], orig[first, 2]
+    if abs(ox) + abs(oy) + abs(oz) > FAR:
+        return 0.0
     dx, dy, dz = 0.0, 0.0, 0.0
     for r in range(first, end):
         dx += dirs[r, 0]
