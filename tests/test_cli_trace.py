@@ -90,6 +90,11 @@ def test_bench_quick_json(monkeypatch, tmp_path, capsys):
     assert {("numba", "exact", 45.0), ("numba", "exact", 90.0), ("numba", "march", 45.0),
             ("numba", "march", 90.0)} <= rows
     assert all(r["rays_per_second"] > 0 for r in report["results"])
+    # Each row's share of numba's rays/s on the same method and angle.
+    numba = {(r["method"], r["depression"]): r["rays_per_second"]
+             for r in report["results"] if r["backend"] == "numba"}
+    for r in report["results"]:
+        assert r["vs_numba"] == pytest.approx(r["rays_per_second"] / numba[r["method"], r["depression"]])
 
 
 def test_bench_rejects_a_run_count_below_one(capsys):

@@ -166,34 +166,41 @@ def run_bench(quick=False, runs=None) -> dict:
               "sensor": f"{grid}x{grid} detectors, 4x4 rays each", "runs": runs,
               "slant_range_m": SLANT_RANGE_M, "backends": {}, "results": []}
     rays = {d: bench_rays(scene, d, grid=grid) for d in DEPRESSIONS}
+    backends = {}
     for name, reason in backend_status().items():
         report["backends"][name] = reason or "available"
-        if reason:
-            continue
-        try:
-            backend = get_backend(name)
-        except BackendUnavailable:
-            continue
-        for method in ("exact", "march"):
-            for depression, (origins, directions) in rays.items():
-                kwargs = dict(backend=name, method=method, step=0.5,
-                              voxel_size=scene.voxel_size)
+        if not reason:
+            try:
+                backends[name] = get_backend(name)
+            except BackendUnavailable:
+                continue
+    for method in ("exact", "march"):
+        for depression, (origins, directions) in rays.items():
+            kwargs = dict(method=method, step=0.5, voxel_size=scene.voxel_size)
+            first, results = {}, {}
+            for name in backends:
                 warm = time.perf_counter()
-                result = trace(occupancy, origins, directions, **kwargs)
-                warm = time.perf_counter() - warm
-                times, cpu = [], []
-                for _ in range(runs):
+                results[name] = trace(occupancy, origins, directions, backend=name, **kwargs)
+                first[name] = time.perf_counter() - warm
+            # Backends take turns run by run, so a slow spell of this shared machine
+            # falls on all of them and their ratio stays fair.
+            times = {name: [] for name in backends}
+            cpu = {name: [] for name in backends}
+            for _ in range(runs):
+                for name in backends:
                     c = time.process_time()
                     t = time.perf_counter()
-                    trace(occupancy, origins, directions, **kwargs)
-                    times.append(time.perf_counter() - t)
-                    cpu.append(time.process_time() - c)
-                median = statistics.median(times)
-                cpu_median = statistics.median(cpu)
+                    trace(occupancy, origins, directions, backend=name, **kwargs)
+                    times[name].append(time.perf_counter() - t)
+                    cpu[name].append(time.process_time() - c)
+            for name, backend in backends.items():
+                median = statistics.median(times[name])
+                cpu_median = statistics.median(cpu[name])
+                result = results[name]
                 report["results"].append({
                     "backend": name, "method": method, "depression": depression,
                     "rays": len(origins), "rays_per_second": len(origins) / median,
-                    "median_seconds": median, "first_call_seconds": warm,
+                    "median_seconds": median, "first_call_seconds": first[name],
                     # On a shared machine wall time includes waiting for the
                     # cores; rays per CPU-second (all threads) does not.
                     "cpu_seconds": cpu_median,
@@ -201,7 +208,17 @@ def run_bench(quick=False, runs=None) -> dict:
                     "voxel_hits": float(np.mean(result.kind == 1)),
                     "ground_hits": float(np.mean(result.kind == 2)),
                     "device": backend.describe().get("adapter") or "cpu"})
+    _add_ratios(report["results"])
     return report
+
+
+def _add_ratios(results):
+    """Each row's rays/s as a share of numba's on the same method and angle (``vs_numba``)."""
+    numba = {(r["method"], r["depression"]): r["rays_per_second"]
+             for r in results if r["backend"] == "numba"}
+    for row in results:
+        base = numba.get((row["method"], row["depression"]))
+        row["vs_numba"] = row["rays_per_second"] / base if base else None
 
 
 def _print_table(report):
@@ -215,14 +232,16 @@ def _print_table(report):
                   f"{report['setup_seconds']:.2f} s ({report['setup_cpu_seconds']:.2f} CPU-s); "
                   f"{report['sensor']}; median of "
                   f"{report['runs']} runs")
-    table = Table(box=box.SIMPLE_HEAD, pad_edge=False)
-    for name in ("backend", "method", "depr.", "rays/s", "rays/CPU-s", "voxel", "ground"):
-        table.add_column(name, no_wrap=True, min_width=max(len(name), 7))
+    table = Table(box=box.SIMPLE_HEAD, pad_edge=False, collapse_padding=True)
+    for name in ("backend", "method", "depr.", "rays/s", "x numba", "rays/CPU-s", "voxel",
+                 "ground"):
+        table.add_column(name, no_wrap=True, min_width=len(name))
     table.add_column("device", no_wrap=True, overflow="ellipsis", max_width=12)
     for row in report["results"]:
         per_cpu = row["rays_per_cpu_second"]
         table.add_row(row["backend"], row["method"], f"{row['depression']:g}",
                       f"{row['rays_per_second'] / 1e6:.2f} M",
+                      f"{row['vs_numba']:.2f}" if row.get("vs_numba") is not None else "-",
                       f"{per_cpu / 1e6:.2f} M" if per_cpu else "-",
                       f"{row['voxel_hits']:.1%}",
                       f"{row['ground_hits']:.1%}", str(row["device"]))
