@@ -194,3 +194,32 @@ def test_wgpu_scans_match_numba(forest, numba_backend, wgpu_backend):
     f32 = wgpu_backend.trace_cells(occ, o, d, precision="f32")
     agree = (f32.kind == expected.kind) & np.all(f32.index == expected.index, axis=1)
     assert agree.mean() >= 0.999
+
+
+def test_f32_offsets_fall_back_to_the_box_entry_when_the_start_is_past_the_scene():
+    from ladartui.tracing.wgpu_backend import f32_start_offsets
+
+    o = np.array([[-1000.0, 50.5, 10.5]])
+    d = np.array([[1.0, 0.0, 0.0]])
+    plain = f32_start_offsets(o, d, (100, 100, 20), 20.0, "exact")
+    assert plain[0] == pytest.approx(1000.0)
+    for start in (np.inf, 2000.0):  # never, or beyond the far side
+        assert f32_start_offsets(o, d, (100, 100, 20), 20.0, "exact", np.array([start])) == \
+            pytest.approx(plain)
+    assert f32_start_offsets(o, d, (100, 100, 20), 20.0, "exact", np.array([1040.0]))[0] == \
+        pytest.approx(1040.0)
+
+
+def test_wgpu_chunks_that_never_meet_the_scene(numba_backend, wgpu_backend):
+    # Parallel rays beside the scene: their start is "never" (the last chunk, one ray with
+    # no spread at all, gets inf on the host; the shader has no infinity).
+    occ = Occupancy.build(np.array([[10, 10, 5], [30, 30, 8]]), (64, 64, 32))
+    o = np.tile([-50.5, 200.5, 40.0], (CHUNK + 1, 1))
+    d = np.tile([0.6, 0.0, -0.8], (CHUNK + 1, 1))
+    assert bundle_start(o, d, 0, CHUNK, *halo_arrays(occ)) > 1e12
+    assert bundle_start(o, d, CHUNK, CHUNK + 1, *halo_arrays(occ)) == np.inf
+    expected = numba_backend.trace_cells(occ, o, d)
+    for precision in ("f64", "f32"):
+        got = wgpu_backend.trace_cells(occ, o, d, precision=precision)
+        assert np.array_equal(got.kind, expected.kind)
+        assert np.array_equal(got.index, expected.index)

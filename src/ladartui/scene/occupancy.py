@@ -292,9 +292,10 @@ def _empty_cubes(cells, dims):
 def _halo_bits(cells, dims):
     """Bits over a ``dims`` box of cells: set where the cell or a neighbour holds a voxel.
 
-    A bundle of rays from one origin that stays within 7 voxels of its centre
-    ray meets no voxel before that ray enters a set cell (see
-    tracing.bundle), so the bundle's rays may all start there.
+    A bundle of rays that stays within one cell less a voxel of its centre ray
+    (7 voxels over bricks, 3 over 4-voxel cells) meets no voxel before that ray
+    enters a set cell (see tracing.bundle), so the bundle's rays may all start
+    there.
     """
     dx, dy, dz = (int(v) for v in dims)
     near = np.zeros((dz, dy, dx), bool)

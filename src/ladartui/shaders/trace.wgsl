@@ -162,7 +162,8 @@ fn clamp_i(v: i32, lo: i32, hi: i32) -> i32 {
 // 8-voxel bricks skips empty bricks (and, going down, the part of a brick column
 // above its highest brick), jumps across the empty cube of bricks ahead of the
 // ray (Occupancy.cubes) and walks on past tile faces while bricks are known
-// empty; inside a brick a voxel DDA tests bits.
+// empty; inside a brick a voxel DDA tests bits and goes on into neighbouring
+// non-empty bricks of the tile. `start` is the ray's bundle start (step 0).
 fn first_voxel(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real, start: real) -> Hit {
     let none = miss();
     if (params.run.w == 0) {  // empty scene: no root cells

@@ -60,10 +60,11 @@ METHOD_CODES = {"exact": 0, "march": 1}
 ADAPTER_TYPE_RANK = {"DiscreteGPU": 0, "IntegratedGPU": 1, "VirtualGPU": 2, "CPU": 3}
 # OpenGL adapters lack shader-f64 and large storage buffers; prefer the rest.
 GRAPHICS_BACKEND_RANK = {"Vulkan": 0, "Metal": 0, "D3D12": 0, "OpenGL": 1}
-# Bindings besides the occupancy chunks: params, rays, hit cells, hit ranges.
+# Bindings besides the occupancy chunks: params, rays, hit cells, hit ranges, bundle starts.
 FIXED_BINDINGS = 5
 # Ask for no more than this many occupancy bindings (16 GiB at 128 MiB each).
 MAX_OCCUPANCY_BINDINGS = 128
+SHADER_INF = 1e30  # trace.wgsl's INF
 # Shader-only hit kinds (trace.wgsl): a march pass ended without an answer, and
 # a loop ended by the adapter's iteration guard rather than by the ray.
 UNFINISHED = 3
@@ -141,7 +142,9 @@ def f32_start_offsets(origins, directions, shape, top, method, at_least=None):
         enter = np.fmax(np.fmax(near[:, 0], near[:, 1]), near[:, 2])
         leave = np.fmin(np.fmin(far[:, 0], far[:, 1]), far[:, 2])
         if at_least is not None:
-            np.fmax(enter, at_least, out=enter)
+            # A start past the box's far side means no voxel: keep the box entry then.
+            moved = np.fmax(enter, at_least)
+            enter = np.where(moved <= leave, moved, enter)
         # Stay at least half a cell above the ground, so the ground rule still
         # sees an origin above it.
         oz, dz = o[:, 2], d[:, 2]
@@ -507,7 +510,9 @@ class WgpuBackend:
                     rays[:, :3] = floor_preserving_f32(batch_origins + offsets[rows, None] * batch_directions)
                 rays[:, 3:] = batch_directions
                 if offsets is None and method == "exact":
-                    starts = bundle_start_array(batch_origins, batch_directions, halo).astype(real)
+                    # The shader has no infinity (its INF is 1e30): cap "never" there.
+                    starts = np.minimum(bundle_start_array(batch_origins, batch_directions, halo),
+                                        SHADER_INF).astype(real)
                 else:
                     starts = np.zeros(-(-count // WORKGROUP_SIZE), dtype=real)
                 params = pack_params(occupancy, upload, method, step, count, precision,
