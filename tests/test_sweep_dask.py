@@ -9,11 +9,11 @@ import threading
 import time
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 from ladartui.errors import Cancelled
 from ladartui.sweep import local_client, read_table, run_sweep
+from tiny_sweep import write_tiny_scenario
 
 VOLATILE = {"run_time_s", "worker"}
 SWEEP = """
@@ -24,23 +24,9 @@ fov = [20.0, -1.0]
 """
 
 
-def write_tiny_scenario(folder):
-    """A 32 x 32 canopy with gaps over a 4 x 2 x 2 vehicle, 8 x 8 detectors, a 4-scan orbit."""
-    from ladartui.flight import FlightPlan, Orbit
-    from ladartui.scenario import Scenario
-    from ladartui.scene.voxels import save_voxels
-    from ladartui.sensor import Sensor
-
-    target = np.array([(i, j, k) for i in range(14, 18) for j in range(15, 17) for k in range(2)],
-                      np.int32)
-    canopy = np.array([(i, j, 6) for i in range(32) for j in range(32)
-                       if (i * 7 + j * 13) % 3 == 0], np.int32)
-    save_voxels(folder / "tiny.txt", np.concatenate([target, canopy]))
-    save_voxels(folder / "tiny_Target.txt", target)
-    flight = FlightPlan(segments=(Orbit(centre=(15.5, 15.5, 0.5), radius=20.0, altitude=20.0,
-                                        scans=4),))
-    Scenario(folder / "base.toml", "tiny.txt", 1.0, Sensor(grid=8, ray_grid=2, fov=20.0), flight,
-             backend="numba").save()
+def write_tiny_spec(folder):
+    """The shared tiny base scenario and a spec of 8 variants over it."""
+    write_tiny_scenario(folder)
     spec = folder / "spec.toml"
     spec.write_text('[sweep]\nscenario = "base.toml"\n' + SWEEP, encoding="utf-8")
     return spec
@@ -52,7 +38,7 @@ def comparable(rows):
 
 @pytest.fixture(scope="module")
 def spec(tmp_path_factory):
-    return write_tiny_scenario(tmp_path_factory.mktemp("dask"))
+    return write_tiny_spec(tmp_path_factory.mktemp("dask"))
 
 
 @pytest.fixture(scope="module")

@@ -1,7 +1,8 @@
 // The voxel tracer as a compute shader: one invocation per ray.
 //
-// This is tracing/numba_backend.py written again in WGSL: the same functions
-// under the same names (without the leading underscore), the same steps in the
+// This is tracing/numba_backend.py (with tracing/axis.py) written again in WGSL:
+// the same functions under the same names (without the leading underscore),
+// the same steps in the
 // same order, as fixed in docs/architecture.md ("Exact traversal", "March").
 // Read the two side by side; change them together. In f64 both give the same
 // answer, bit for bit, for every ray (tests/test_wgpu_precision.py).
@@ -70,12 +71,12 @@ fn cut() -> Hit {
     return Hit(CUT, -1, -1, -1, INF);
 }
 
-// The one formula for boundary parameters (numba: _boundary_t).
+// The one formula for boundary parameters (tracing/axis.py: boundary_t).
 fn boundary_t(b: real, o: real, inv: real) -> real {
     return (b - o) * inv;
 }
 
-// Cell index on one axis just after parameter t, exact against boundary_t (numba: _cell_at).
+// Cell index on one axis just after parameter t, exact against boundary_t (tracing/axis.py: cell_at).
 fn cell_at(o: real, d: real, inv: real, t: real) -> i32 {
     var c = floor(o + t * d);
     if (d > 0.0) {
@@ -94,7 +95,7 @@ fn cell_at(o: real, d: real, inv: real, t: real) -> i32 {
     return i32(c);
 }
 
-// Entry and exit parameters of [lo, hi) on one axis; (inf, -inf) when never inside (numba: _slab).
+// Entry and exit parameters of [lo, hi) on one axis; (inf, -inf) when never inside (tracing/axis.py: slab).
 fn slab(o: real, d: real, inv: real, lo: real, hi: real) -> Span {
     if (d > 0.0) {
         return Span(boundary_t(lo, o, inv), boundary_t(hi, o, inv));

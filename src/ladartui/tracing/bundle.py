@@ -19,9 +19,10 @@ one voxel of centre-ray length before the last stop, so every ray
 starts in an empty cell and the cells it visits afterwards, and their
 parameters, are those of a traversal from its box entry.
 
-The numba exact kernel compiles ``bundle_start`` into itself, and numba's
-on-disk cache only notices edits to the kernel's own file: after editing this
-one, clear ``tracing/__pycache__/*.nb*`` (a fresh install has no stale cache).
+The numba exact kernel compiles ``bundle_start`` (and tracing.axis) into
+itself, and numba's on-disk cache only notices edits to the kernel's own file:
+after editing this one or axis.py, clear ``tracing/__pycache__/*.nb*`` (a
+fresh install has no stale cache).
 """
 
 from __future__ import annotations
@@ -30,6 +31,8 @@ import math
 
 import numpy as np
 from numba import njit, prange
+
+from ladartui.tracing.axis import slab
 
 BUNDLE_REACH = 7.0  # voxels: under one brick (8), one voxel of slack for rounding
 FINE_REACH = 3.0  # the same over ``Occupancy.halo4`` (4-voxel cells)
@@ -83,20 +86,11 @@ def _walk(ox, oy, oz, dx, dy, dz, start, limit, bits, origin, dims, size):
     ix = 1.0 / dx if dx != 0.0 else INF
     iy = 1.0 / dy if dy != 0.0 else INF
     iz = 1.0 / dz if dz != 0.0 else INF
-    t0, t1 = start, limit
-    for axis in range(3):
-        o = ox if axis == 0 else (oy if axis == 1 else oz)
-        d = dx if axis == 0 else (dy if axis == 1 else dz)
-        inv = ix if axis == 0 else (iy if axis == 1 else iz)
-        lo = size * origin[axis]
-        hi = size * (origin[axis] + dims[axis])
-        if d == 0.0:
-            if not lo < o < hi:
-                t1 = -INF
-        else:
-            a, b = (lo - o) * inv, (hi - o) * inv
-            t0 = max(t0, min(a, b))
-            t1 = min(t1, max(a, b))
+    ex, xx = slab(ox, dx, ix, size * origin[0], size * (origin[0] + dims[0]))
+    ey, xy = slab(oy, dy, iy, size * origin[1], size * (origin[1] + dims[1]))
+    ez, xz = slab(oz, dz, iz, size * origin[2], size * (origin[2] + dims[2]))
+    t0 = max(start, max(ex, max(ey, ez)))
+    t1 = min(limit, min(xx, min(xy, xz)))
     if not t0 < t1:
         return limit
     scale = 1.0 / size

@@ -19,51 +19,12 @@ from numba import njit, prange
 from ladartui.errors import Cancelled
 from ladartui.scene.occupancy import block_masks
 from ladartui.tracing.bundle import bundle_start, halo_arrays
+from ladartui.tracing.axis import boundary_t, cell_at, clamp, slab
 from ladartui.tracing.backend import GROUND, MISS, VOXEL, CellHits, register_backend
 
 CHUNK = 64  # rays per prange work item: coherent neighbours stay on one thread
 BLOCK = 1 << 16  # rays per kernel call: cancel is checked between calls
 INF = np.inf
-
-
-@njit(nogil=True, cache=True, inline="always")
-def _boundary_t(b, o, inv):
-    # The one formula for boundary parameters (shared with the reference tracer).
-    return (b - o) * inv
-
-
-@njit(nogil=True, cache=True, inline="always")
-def _cell_at(o, d, inv, t):
-    """Cell index on one axis just after parameter ``t``, exact against ``_boundary_t``."""
-    c = math.floor(o + t * d)
-    if d > 0.0:
-        if _boundary_t(c + 1.0, o, inv) <= t:
-            c += 1.0
-        elif _boundary_t(c, o, inv) > t:
-            c -= 1.0
-    elif d < 0.0:
-        if _boundary_t(c, o, inv) <= t:
-            c -= 1.0
-        elif _boundary_t(c + 1.0, o, inv) > t:
-            c += 1.0
-    return np.int64(c)
-
-
-@njit(nogil=True, cache=True, inline="always")
-def _clamp(v, lo, hi):
-    return lo if v < lo else (hi if v > hi else v)
-
-
-@njit(nogil=True, cache=True, inline="always")
-def _slab(o, d, inv, lo, hi):
-    """Entry and exit parameters of [lo, hi) on one axis; (inf, -inf) when never inside."""
-    if d > 0.0:
-        return _boundary_t(lo, o, inv), _boundary_t(hi, o, inv)
-    if d < 0.0:
-        return _boundary_t(hi, o, inv), _boundary_t(lo, o, inv)
-    if lo < o < hi:
-        return -INF, INF
-    return INF, -INF
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -82,7 +43,7 @@ def _slot(x, y, z, s):
 def _node_skip(c, s, positive, moving, o, inv):
     """Exit boundary and its parameter of the node ``c >> s`` on one axis."""
     b = _exit_boundary(c, s, positive)
-    return b, (_boundary_t(np.float64(b), o, inv) if moving else INF)
+    return b, (boundary_t(np.float64(b), o, inv) if moving else INF)
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -92,7 +53,7 @@ def _enter(c, b, stepped, positive, s, o, d, inv, t):
     if stepped:
         return b if positive else b - 1
     lo = (c >> s) << s
-    return _clamp(_cell_at(o, d, inv, t), lo, lo + (1 << s) - 1)
+    return clamp(cell_at(o, d, inv, t), lo, lo + (1 << s) - 1)
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -160,18 +121,18 @@ def _exact_kernel(orig, dirs, root, regions, tiles, bricks, blocks, columns, cub
                 iz = 1.0 / dz if dz != 0.0 else INF
                 mx, my, mz = dx != 0.0, dy != 0.0, dz != 0.0
                 # Step 2: clip to the occupied box, from the bundle start on.
-                ex, xx = _slab(ox, dx, ix, lo[0], hi[0])
-                ey, xy = _slab(oy, dy, iy, lo[1], hi[1])
-                ez, xz = _slab(oz, dz, iz, lo[2], hi[2])
+                ex, xx = slab(ox, dx, ix, lo[0], hi[0])
+                ey, xy = slab(oy, dy, iy, lo[1], hi[1])
+                ez, xz = slab(oz, dz, iz, lo[2], hi[2])
                 t0 = max(start, max(ex, max(ey, ez)))
                 t1 = min(xx, min(xy, xz))
                 if not t0 < t1:
                     done = True
                     break
                 # Step 3: the start cell.
-                cx = _clamp(_cell_at(ox, dx, ix, t0), lo[0], hi[0] - 1)
-                cy = _clamp(_cell_at(oy, dy, iy, t0), lo[1], hi[1] - 1)
-                cz = _clamp(_cell_at(oz, dz, iz, t0), lo[2], hi[2] - 1)
+                cx = clamp(cell_at(ox, dx, ix, t0), lo[0], hi[0] - 1)
+                cy = clamp(cell_at(oy, dy, iy, t0), lo[1], hi[1] - 1)
+                cz = clamp(cell_at(oz, dz, iz, t0), lo[2], hi[2] - 1)
                 px, py, pz = dx > 0.0, dy > 0.0, dz > 0.0
                 sx = 1 if px else -1
                 sy = 1 if py else -1
@@ -319,16 +280,16 @@ def _exact_kernel(orig, dirs, root, regions, tiles, bricks, blocks, columns, cub
                                     if stx:
                                         bx += sx * k
                                     elif near > 0:
-                                        bx = _clamp(_cell_at(ox, dx, ix, tn) >> 3, bx - (0 if px else near), bx + (near if px else 0))
+                                        bx = clamp(cell_at(ox, dx, ix, tn) >> 3, bx - (0 if px else near), bx + (near if px else 0))
                                     if sty:
                                         by += sy * k
                                     elif near > 0:
-                                        by = _clamp(_cell_at(oy, dy, iy, tn) >> 3, by - (0 if py else near), by + (near if py else 0))
+                                        by = clamp(cell_at(oy, dy, iy, tn) >> 3, by - (0 if py else near), by + (near if py else 0))
                                     if stz:
                                         bz = top - 1 if above else bz + sz * k
                                     elif above or near > 0:
                                         zlo, zhi = (top, bz) if above else (bz - (0 if pz else near), bz + (near if pz else 0))
-                                        bz = _clamp(_cell_at(oz, dz, iz, tn) >> 3, zlo, zhi)
+                                        bz = clamp(cell_at(oz, dz, iz, tn) >> 3, zlo, zhi)
                                     t = tn
                                     fresh = False
                             if done:

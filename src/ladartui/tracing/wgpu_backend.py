@@ -482,10 +482,12 @@ class WgpuBackend:
         halo = halo_arrays(occupancy)
         if precision == "f32":
             # f32 moves each origin to its start on the host (the shader sees no starts).
-            starts = None
+            ray_starts = None
             if method == "exact":
-                starts = np.repeat(bundle_start_array(origins, directions, halo), WORKGROUP_SIZE)[:n]
-            offsets = f32_start_offsets(origins, directions, occupancy.shape, top, method, starts)
+                ray_starts = np.repeat(bundle_start_array(origins, directions, halo),
+                                       WORKGROUP_SIZE)[:n]
+            offsets = f32_start_offsets(origins, directions, occupancy.shape, top, method,
+                                        ray_starts)
         else:
             offsets = None
         capacity = buffers["capacity"]

@@ -1,0 +1,53 @@
+"""One-axis cell arithmetic shared by the tracers (numba kernels, bundle starts).
+
+Every boundary parameter comes from one formula, ``boundary_t``, so cells
+and ties agree wherever they are computed. The WGSL shader has the same
+functions under the same names (shaders/trace.wgsl).
+"""
+
+import math
+
+import numpy as np
+from numba import njit
+
+INF = np.inf
+
+
+@njit(nogil=True, cache=True, inline="always")
+def boundary_t(b, o, inv):
+    # The one formula for boundary parameters (the reference tracer writes the same).
+    return (b - o) * inv
+
+
+@njit(nogil=True, cache=True, inline="always")
+def cell_at(o, d, inv, t):
+    """Cell index on one axis just after parameter ``t``, exact against ``boundary_t``."""
+    c = math.floor(o + t * d)
+    if d > 0.0:
+        if boundary_t(c + 1.0, o, inv) <= t:
+            c += 1.0
+        elif boundary_t(c, o, inv) > t:
+            c -= 1.0
+    elif d < 0.0:
+        if boundary_t(c, o, inv) <= t:
+            c -= 1.0
+        elif boundary_t(c + 1.0, o, inv) > t:
+            c += 1.0
+    return np.int64(c)
+
+
+@njit(nogil=True, cache=True, inline="always")
+def clamp(v, lo, hi):
+    return lo if v < lo else (hi if v > hi else v)
+
+
+@njit(nogil=True, cache=True, inline="always")
+def slab(o, d, inv, lo, hi):
+    """Entry and exit parameters of [lo, hi) on one axis; (inf, -inf) when never inside."""
+    if d > 0.0:
+        return boundary_t(lo, o, inv), boundary_t(hi, o, inv)
+    if d < 0.0:
+        return boundary_t(hi, o, inv), boundary_t(lo, o, inv)
+    if lo < o < hi:
+        return -INF, INF
+    return INF, -INF
