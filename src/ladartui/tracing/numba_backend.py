@@ -19,11 +19,17 @@ from numba import njit, prange
 from ladartui.errors import Cancelled
 from ladartui.scene.occupancy import block_masks
 from ladartui.tracing.bundle import bundle_start, halo_arrays
+from ladartui.tracing.object_order import cone_frame, nearest_voxels
 from ladartui.tracing.axis import boundary_t, cell_at, clamp, slab
 from ladartui.tracing.backend import GROUND, MISS, VOXEL, CellHits, register_backend
 
 CHUNK = 64  # rays per prange work item: coherent neighbours stay on one thread
 BLOCK = 1 << 16  # rays per kernel call: cancel is checked between calls
+SCAN_BLOCK = 1 << 18  # rays per object-order call (one 512 x 512 scan)
+# Object order is used when at most this many occupied voxels per ray are in view
+# (more, and walking the rays is cheaper; see tracing.object_order).
+VOXELS_PER_RAY = 0.6
+MIN_SCAN_RAYS = 4096  # fewer rays: ray order, whose set-up is nil
 INF = np.inf
 
 
@@ -325,6 +331,25 @@ def _exact_kernel(orig, dirs, root, regions, tiles, bricks, blocks, columns, cub
 
 
 @njit(parallel=True, nogil=True, cache=True)
+def _object_order_answers(order, best_t, best_v, vox, orig, dirs, nx, ny, kind, index, tout):
+    """Object-order hits (tracing.object_order) back in ray order, with the ground rule."""
+    for s in prange(order.shape[0]):
+        r = order[s]
+        q = best_v[s]
+        if q >= 0:
+            kind[r] = VOXEL
+            index[r, 0], index[r, 1], index[r, 2] = vox[q, 0], vox[q, 1], vox[q, 2]
+            tout[r] = best_t[s]
+        else:
+            gk, gi, gj, tg = _ground(orig[r, 0], orig[r, 1], orig[r, 2], dirs[r, 0], dirs[r, 1],
+                                     dirs[r, 2], nx, ny)
+            kind[r] = gk
+            index[r, 0], index[r, 1] = gi, gj
+            index[r, 2] = 0 if gk == GROUND else -1
+            tout[r] = tg
+
+
+@njit(parallel=True, nogil=True, cache=True)
 def _march_kernel(orig, dirs, step, zmax, root, regions, tiles, bricks, lo, hi, rorg, rdims,
                   nx, ny, kind, index, tout):
     """The report's fixed-step march (docs/architecture.md "March") for every ray."""
@@ -395,11 +420,14 @@ class NumbaBackend:
         d = np.array([[0.0, 0.0, -1.0]])
         for method in ("exact", "march"):
             self.trace_cells(occupancy, o, d, method=method)
+        self.trace_cells(occupancy, o, d, object_order=True)
 
     def trace_cells(self, occupancy, origins, directions, *, method="exact", step=0.5,
                     precision="f64", cancel: threading.Event | None = None,
-                    bundles: bool = True) -> CellHits:
-        """See ``Backend``; ``bundles=False`` starts every ray at its box entry (for tests)."""
+                    bundles: bool = True, object_order: bool | None = None) -> CellHits:
+        """See ``Backend``. For tests: ``bundles=False`` starts every ray at its box entry;
+        ``object_order`` True traces scans in object order whatever they cost, False never
+        (None: when the rays are a scan with few voxels in view, tracing.object_order)."""
         n = len(origins)
         orig = np.ascontiguousarray(origins, dtype=np.float64)
         dirs = np.ascontiguousarray(directions, dtype=np.float64)
@@ -414,21 +442,44 @@ class NumbaBackend:
         halo = halo_arrays(occ) if bundles else halo_arrays(None)
         blocks = occ.blocks if getattr(occ, "blocks", None) is not None else block_masks(occ.bricks)
         started = time.perf_counter()
-        for a in range(0, n, BLOCK):
-            if cancel is not None and cancel.is_set():
-                raise Cancelled("trace cancelled")
-            b = min(n, a + BLOCK)
-            if method == "exact":
-                _exact_kernel(orig[a:b], dirs[a:b], occ.root, occ.regions, occ.tiles, occ.bricks,
-                              blocks, occ.columns, cubes, corg, cdims, *halo, lo, hi, rorg, rdims,
-                              nx, ny, kind[a:b], index[a:b], t[a:b])
-            else:
-                _march_kernel(orig[a:b], dirs[a:b], float(step), float(occ.zmax), occ.root,
-                              occ.regions, occ.tiles, occ.bricks, lo, hi, rorg, rdims, nx, ny,
-                              kind[a:b], index[a:b], t[a:b])
+        orders = set()
+        scans = method == "exact" and object_order is not False and occ.count > 0
+        for a in range(0, n, SCAN_BLOCK if scans else BLOCK):
+            b = min(n, a + (SCAN_BLOCK if scans else BLOCK))
+            if scans and (object_order or b - a >= MIN_SCAN_RAYS):
+                if cancel is not None and cancel.is_set():
+                    raise Cancelled("trace cancelled")
+                limit = np.inf if object_order else VOXELS_PER_RAY * (b - a)
+                if self._object_order(occ, orig[a:b], dirs[a:b], limit, nx, ny, kind[a:b],
+                                      index[a:b], t[a:b]):
+                    orders.add("object")
+                    continue
+            orders.add("ray")
+            for c in range(a, b, BLOCK):
+                if cancel is not None and cancel.is_set():
+                    raise Cancelled("trace cancelled")
+                d = min(b, c + BLOCK)
+                if method == "exact":
+                    _exact_kernel(orig[c:d], dirs[c:d], occ.root, occ.regions, occ.tiles,
+                                  occ.bricks, blocks, occ.columns, cubes, corg, cdims, *halo, lo, hi,
+                                  rorg, rdims, nx, ny, kind[c:d], index[c:d], t[c:d])
+                else:
+                    _march_kernel(orig[c:d], dirs[c:d], float(step), float(occ.zmax), occ.root,
+                                  occ.regions, occ.tiles, occ.bricks, lo, hi, rorg, rdims, nx, ny,
+                                  kind[c:d], index[c:d], t[c:d])
         info = {"seconds": time.perf_counter() - started, "precision": "f64",
-                "threads": numba.get_num_threads()}
+                "threads": numba.get_num_threads(), "order": "+".join(sorted(orders)) or "ray"}
         return CellHits(kind, index, t, info)
+
+    @staticmethod
+    def _object_order(occ, orig, dirs, max_voxels, nx, ny, kind, index, t):
+        """Trace one scan in object order into kind/index/t; False when it is no scan for it."""
+        frame = cone_frame(orig, dirs)
+        found = None if frame is None else nearest_voxels(occ, orig, dirs, frame, max_voxels)
+        if found is None:
+            return False
+        _object_order_answers(*found, orig, dirs, nx, ny, kind, index, t)
+        return True
 
 
 def _cube_arrays(occ):

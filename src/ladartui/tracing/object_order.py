@@ -1,0 +1,467 @@
+"""Exact tracing of one scan in object order: voxel by voxel instead of ray by ray.
+
+A scan's rays leave one aircraft (origins within a focal plane's width of
+each other) inside a narrow cone. Instead of walking every ray through the
+grid, this visits the occupied voxels that the cone can reach, nearest
+first, and tests each against the rays whose directions can pass through it.
+The answers are those of the ray-order kernel bit for bit: each test is the
+slab test with the kernels' boundary formula ``(b - o) * inv``, and the
+per-axis parameters of one ray split its line into the same cells as the
+DDA's (docs/architecture.md, "Object order").
+
+Why a candidate list is never short. Rays are binned by their gnomonic
+coordinates ``(d.u / d.a, d.v / d.a)`` about the cone's axis ``a``. A ray
+from ``o_r = o_c + delta`` meets voxel V only if the parallel ray from the
+centre ``o_c`` meets ``V - delta``, which lies inside V grown by the origins'
+half-spread on each axis; that grown cube, seen from ``o_c``, projects inside
+the rectangle of its eight projected corners (all in front of ``o_c``). So
+every ray that can meet V is in the bins of that rectangle, widened by
+``EPS`` against rounding. Nodes with corners on both sides of ``o_c``'s
+plane cannot be projected; a brick like that sends the scan back to ray
+order. Nodes wholly behind the plane cannot be met.
+
+Why nearest first may stop early. Every point of a grown cube has depth
+``(x - o_c).a >= near`` (its smallest corner depth), and a ray meeting V
+there has ``t >= (x - o_r).a`` (unit directions, ``d.a <= 1``), so its entry
+is at least ``near``. Voxels come brick by brick in order of the bricks'
+``near``: once every ray of a tile of bins has a hit no further than the
+next brick's ``near``, nothing later can change that tile.
+
+All functions release the GIL; ``emit_voxels`` and ``test_tiles`` run under
+``prange``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+INF = np.inf
+EPS = 1e-9  # widening of projected rectangles (tangent units), far above rounding
+NEAR_MARGIN = 1e-9  # relative lowering of depth bounds, far above rounding
+TILE = 16  # bins per tile side: rays tested together, stopped together
+MAX_SPREAD = 1.0  # largest origin half-spread (cells) handled in object order
+MIN_COS = 0.5  # every ray within 60 degrees of the cone's axis
+
+
+PARTS = 64  # fixed split of the passes over rays (so sums do not depend on the threads)
+
+
+@njit(parallel=True, nogil=True, cache=True)
+def ray_bounds(orig, dirs):
+    """(lo, hi, direction sum) of a batch: origin box and the sum of directions."""
+    n = orig.shape[0]
+    part_lo = np.empty((PARTS, 3))
+    part_hi = np.empty((PARTS, 3))
+    part_sum = np.zeros((PARTS, 3))
+    for k in prange(PARTS):
+        for a in range(3):
+            part_lo[k, a], part_hi[k, a] = INF, -INF
+        for r in range(k * n // PARTS, (k + 1) * n // PARTS):
+            for a in range(3):
+                part_lo[k, a] = min(part_lo[k, a], orig[r, a])
+                part_hi[k, a] = max(part_hi[k, a], orig[r, a])
+                part_sum[k, a] += dirs[r, a]
+    lo, hi, total = part_lo[0].copy(), part_hi[0].copy(), part_sum[0].copy()
+    for k in range(1, PARTS):
+        for a in range(3):
+            lo[a], hi[a] = min(lo[a], part_lo[k, a]), max(hi[a], part_hi[k, a])
+            total[a] += part_sum[k, a]
+    return lo, hi, total
+
+
+def cone_frame(orig, dirs):
+    """(centre, half_spread, axis, u, v) of a batch of rays, or None when it is no scan.
+
+    A scan here: origins within ``MAX_SPREAD`` cells of their centre on every
+    axis (``bin_rays`` then checks every direction is within 60 degrees of
+    the mean direction).
+    """
+    if len(orig) == 0:
+        return None
+    lo, hi, total = ray_bounds(orig, dirs)
+    half = 0.5 * (hi - lo)
+    norm = float(np.linalg.norm(total))
+    if not (np.all(half <= MAX_SPREAD) and norm > 0.0):
+        return None
+    axis = total / norm
+    # u along the first row of rays when there is one (bins then follow the sensor's grid).
+    side = dirs[min(1, len(dirs) - 1)] - dirs[0]
+    side = side - axis * (side @ axis)
+    if np.linalg.norm(side) < 1e-12:
+        side = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        side = side - axis * (side @ axis)
+    u = side / np.linalg.norm(side)
+    v = np.cross(axis, u)
+    # Grown cubes use the spread, widened a hair so that rounding of lo/hi never narrows it.
+    return 0.5 * (lo + hi), half * (1.0 + 1e-9) + 1e-12, axis, u, v
+
+
+@njit(parallel=True, nogil=True, cache=True)
+def _gnomonic(dirs, axis, u, v, p, q):
+    """p, q = d.u / d.a, d.v / d.a per ray; returns (p min, p max, q min, q max, all within
+    60 degrees of the axis)."""
+    n = dirs.shape[0]
+    part = np.empty((PARTS, 4))
+    off_axis = np.zeros(PARTS, np.bool_)
+    for k in prange(PARTS):
+        pmin, pmax, qmin, qmax = INF, -INF, INF, -INF
+        for r in range(k * n // PARTS, (k + 1) * n // PARTS):
+            d0, d1, d2 = dirs[r, 0], dirs[r, 1], dirs[r, 2]
+            w = d0 * axis[0] + d1 * axis[1] + d2 * axis[2]
+            if not w >= MIN_COS:
+                off_axis[k] = True
+                w = 1.0
+            pp = (d0 * u[0] + d1 * u[1] + d2 * u[2]) / w
+            qq = (d0 * v[0] + d1 * v[1] + d2 * v[2]) / w
+            p[r], q[r] = pp, qq
+            pmin, pmax, qmin, qmax = min(pmin, pp), max(pmax, pp), min(qmin, qq), max(qmax, qq)
+        part[k, 0], part[k, 1], part[k, 2], part[k, 3] = pmin, pmax, qmin, qmax
+    return (part[:, 0].min(), part[:, 1].max(), part[:, 2].min(), part[:, 3].max(),
+            not off_axis.any())
+
+
+@njit(nogil=True, cache=True)
+def _sort_into_bins(p, q, grid, nb):
+    """(starts, order): counting sort of the rays by bin ``j * nb + i``."""
+    n = p.shape[0]
+    bin_of = np.empty(n, np.int64)
+    starts = np.zeros(nb * nb + 1, np.int64)
+    for r in range(n):
+        i = min(nb - 1, max(0, np.int64((p[r] - grid[0]) / grid[1])))
+        j = min(nb - 1, max(0, np.int64((q[r] - grid[2]) / grid[3])))
+        bin_of[r] = j * nb + i
+        starts[j * nb + i + 1] += 1
+    for b in range(nb * nb):
+        starts[b + 1] += starts[b]
+    fill = starts[:-1].copy()
+    order = np.empty(n, np.int64)
+    for r in range(n):
+        order[fill[bin_of[r]]] = r
+        fill[bin_of[r]] += 1
+    return starts, order
+
+
+@njit(parallel=True, nogil=True, cache=True)
+def _gather(order, orig, dirs, lo, hi, so, sd, exits):
+    """Rays in sorted order, and where each leaves the box [lo, hi)."""
+    for k in prange(order.shape[0]):
+        r = order[k]
+        leave = INF
+        for a in range(3):
+            so[k, a] = orig[r, a]
+            sd[k, a] = dirs[r, a]
+            if dirs[r, a] != 0.0:
+                inv = 1.0 / dirs[r, a]
+                leave = min(leave, max((lo[a] - orig[r, a]) * inv, (hi[a] - orig[r, a]) * inv))
+        exits[k] = leave
+
+
+def bin_rays(orig, dirs, axis, u, v, nb, lo, hi):
+    """Rays sorted into nb x nb bins of their gnomonic coordinates.
+
+    Returns (starts, order, sorted origins, sorted directions, sorted exits,
+    (p0, p_step, q0, q_step)), or None when a ray is more than 60 degrees off
+    the axis. The rays of bin ``b = j * nb + i`` are sorted positions
+    ``starts[b] .. starts[b + 1]``; ``order`` maps a sorted position back to
+    the ray; its exit is where it leaves the occupied box [lo, hi) (every
+    voxel hit comes before it).
+    """
+    n = len(dirs)
+    p, q = np.empty(n), np.empty(n)
+    pmin, pmax, qmin, qmax, on_axis = _gnomonic(dirs, axis, u, v, p, q)
+    if not on_axis:
+        return None
+    grid = np.array([pmin, (pmax - pmin) / nb if pmax > pmin else 1.0,
+                     qmin, (qmax - qmin) / nb if qmax > qmin else 1.0])
+    starts, order = _sort_into_bins(p, q, grid, nb)
+    so, sd, exits = np.empty((n, 3)), np.empty((n, 3)), np.empty(n)
+    _gather(order, orig, dirs, lo, hi, so, sd, exits)
+    return starts, order, so, sd, exits, grid
+
+
+@njit(nogil=True, cache=True, inline="always")
+def box_bins(x0, y0, z0, size, centre, grow, axis, u, v, grid, nb):
+    """Bins covered by the cube [x0, x0 + size)^3 grown by ``grow``, seen from ``centre``.
+
+    Returns (i0, i1, j0, j1, state, near): state 1 projected (i0 > i1 when it
+    covers no bin), 0 out of every ray's way (wholly behind the centre's plane,
+    or across it but too far from the centre), -1 across the plane near the centre.
+    """
+    pl, ph, ql, qh, near = INF, -INF, INF, -INF, INF
+    behind = 0
+    for k in range(8):
+        rx = (x0 + size + grow[0] if k & 1 else x0 - grow[0]) - centre[0]
+        ry = (y0 + size + grow[1] if k & 2 else y0 - grow[1]) - centre[1]
+        rz = (z0 + size + grow[2] if k & 4 else z0 - grow[2]) - centre[2]
+        w = rx * axis[0] + ry * axis[1] + rz * axis[2]
+        if not w > 0.0:
+            behind += 1
+            continue
+        pp = (rx * u[0] + ry * u[1] + rz * u[2]) / w
+        qq = (rx * v[0] + ry * v[1] + rz * v[2]) / w
+        pl, ph, ql, qh, near = min(pl, pp), max(ph, pp), min(ql, qq), max(qh, qq), min(near, w)
+    if behind == 8:
+        return 0, -1, 0, -1, 0, 0.0
+    if behind > 0:
+        # A ray meets a box straddling the plane only within ``reach`` of the centre:
+        # there its depth, at least t cos(60 deg) - |grow|, is below the box's diameter.
+        spread = math.sqrt(grow[0] ** 2 + grow[1] ** 2 + grow[2] ** 2)
+        reach = spread + (math.sqrt(3.0) * size + 3.0 * spread) / MIN_COS
+        gap = 0.0
+        for a, low in enumerate((x0, y0, z0)):
+            c = centre[a]
+            gap += max(0.0, low - grow[a] - c, c - (low + size + grow[a])) ** 2
+        return 0, -1, 0, -1, (0 if gap > reach * reach else -1), 0.0
+    near -= NEAR_MARGIN * (1.0 + near)  # a bound, so rounding may only lower it
+    i0 = np.int64(math.floor((pl - EPS - grid[0]) / grid[1]))
+    i1 = np.int64(math.floor((ph + EPS - grid[0]) / grid[1]))
+    j0 = np.int64(math.floor((ql - EPS - grid[2]) / grid[3]))
+    j1 = np.int64(math.floor((qh + EPS - grid[2]) / grid[3]))
+    if i1 < 0 or j1 < 0 or i0 >= nb or j0 >= nb:
+        return 0, -1, 0, -1, 1, near
+    return max(i0, 0), min(i1, nb - 1), max(j0, 0), min(j1, nb - 1), 1, near
+
+
+@njit(nogil=True, cache=True)
+def bricks_in_view(centre, grow, axis, u, v, grid, nb, root, regions, tiles, rorg, rdims):
+    """Non-empty bricks whose grown cube covers a bin, nearest first.
+
+    Returns ((m, 4) corner x, y, z and brick number, (m,) near, ok); ok is
+    False when a brick straddles the centre's plane (trace in ray order).
+    """
+    found = np.empty((4096, 4), np.int64)
+    nears = np.empty(4096)
+    m = 0
+    for rz in range(rdims[2]):
+        for ry in range(rdims[1]):
+            for rx in range(rdims[0]):
+                g = root[rx + rdims[0] * (ry + rdims[1] * rz)]
+                if g == 0:
+                    continue
+                x0, y0, z0 = rorg[0] + (rx << 9), rorg[1] + (ry << 9), rorg[2] + (rz << 9)
+                i0, i1, _, _, state, _ = box_bins(x0, y0, z0, 512, centre, grow, axis, u, v, grid, nb)
+                if state == 0 or (state == 1 and i0 > i1):
+                    continue
+                for s1 in range(512):
+                    tl = regions[(np.int64(g) - 1) * 512 + s1]
+                    if tl == 0:
+                        continue
+                    tx, ty, tz = x0 + ((s1 & 7) << 6), y0 + (((s1 >> 3) & 7) << 6), z0 + ((s1 >> 6) << 6)
+                    i0, i1, _, _, state, _ = box_bins(tx, ty, tz, 64, centre, grow, axis, u, v, grid, nb)
+                    if state == 0 or (state == 1 and i0 > i1):
+                        continue
+                    for s2 in range(512):
+                        br = tiles[(np.int64(tl) - 1) * 512 + s2]
+                        if br == 0:
+                            continue
+                        bx, by, bz = tx + ((s2 & 7) << 3), ty + (((s2 >> 3) & 7) << 3), tz + ((s2 >> 6) << 3)
+                        i0, i1, _, _, state, near = box_bins(bx, by, bz, 8, centre, grow, axis, u, v,
+                                                             grid, nb)
+                        if state == -1:
+                            return found[:0], nears[:0], False
+                        if state == 0 or i0 > i1:
+                            continue
+                        if m == found.shape[0]:
+                            bigger = np.empty((2 * m, 4), np.int64)
+                            bigger[:m] = found
+                            found = bigger
+                            nears = np.concatenate((nears, np.empty(m)))
+                        found[m, 0], found[m, 1], found[m, 2], found[m, 3] = bx, by, bz, br
+                        nears[m] = near
+                        m += 1
+    by_near = np.argsort(nears[:m])
+    return found[by_near], nears[by_near], True
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _popcount(x):
+    x = x - ((x >> np.uint32(1)) & np.uint32(0x55555555))
+    x = (x & np.uint32(0x33333333)) + ((x >> np.uint32(2)) & np.uint32(0x33333333))
+    x = (x + (x >> np.uint32(4))) & np.uint32(0x0F0F0F0F)
+    return np.int64(((x * np.uint32(0x01010101)) >> np.uint32(24)) & np.uint32(0xFF))
+
+
+@njit(nogil=True, cache=True)
+def voxels_in(bricks_found, bricks):
+    """Occupied voxels in the found bricks."""
+    total = 0
+    for e in range(bricks_found.shape[0]):
+        base = (bricks_found[e, 3] - 1) * 16
+        for w in range(16):
+            total += _popcount(bricks[base + w])
+    return total
+
+
+@njit(parallel=True, nogil=True, cache=True)
+def emit_voxels(bricks_found, brick_near, bricks, centre, grow, axis, u, v, grid, nb):
+    """Every voxel of the found bricks, in their order: (m, 7) i, j, k, i0, i1, j0, j1
+    (i0 > i1: covers no bin) and (m, 2) its near and its brick's near."""
+    count = bricks_found.shape[0]
+    first = np.zeros(count + 1, np.int64)
+    for e in prange(count):
+        base = (bricks_found[e, 3] - 1) * 16
+        c = 0
+        for w in range(16):
+            c += _popcount(bricks[base + w])
+        first[e + 1] = c
+    for e in range(count):
+        first[e + 1] += first[e]
+    vox = np.empty((first[count], 7), np.int64)
+    nears = np.empty((first[count], 2))
+    for e in prange(count):
+        bx, by, bz = bricks_found[e, 0], bricks_found[e, 1], bricks_found[e, 2]
+        base = (bricks_found[e, 3] - 1) * 16
+        k = first[e]
+        for w in range(16):
+            word = bricks[base + w]
+            bit = 0
+            while word != 0:
+                if (word & np.uint32(0xFF)) == 0:
+                    word >>= np.uint32(8)
+                    bit += 8
+                    continue
+                if word & np.uint32(1):
+                    l = w * 32 + bit
+                    x, y, z = bx + (l & 7), by + ((l >> 3) & 7), bz + (l >> 6)
+                    i0, i1, j0, j1, _, near = box_bins(x, y, z, 1, centre, grow, axis, u, v, grid, nb)
+                    vox[k, 0], vox[k, 1], vox[k, 2] = x, y, z
+                    vox[k, 3], vox[k, 4], vox[k, 5], vox[k, 6] = i0, i1, j0, j1
+                    nears[k, 0], nears[k, 1] = near, brick_near[e]
+                    k += 1
+                word >>= np.uint32(1)
+                bit += 1
+    return vox, nears
+
+
+@njit(nogil=True, cache=True)
+def voxels_per_tile(vox, tiles_per_side):
+    """For each tile of TILE x TILE bins, the voxels covering it, in list order (CSR)."""
+    nt = tiles_per_side
+    starts = np.zeros(nt * nt + 1, np.int64)
+    for e in range(vox.shape[0]):
+        if vox[e, 3] > vox[e, 4]:
+            continue
+        for tj in range(vox[e, 5] // TILE, vox[e, 6] // TILE + 1):
+            for ti in range(vox[e, 3] // TILE, vox[e, 4] // TILE + 1):
+                starts[tj * nt + ti + 1] += 1
+    for b in range(nt * nt):
+        starts[b + 1] += starts[b]
+    fill = starts[:-1].copy()
+    listed = np.empty(starts[-1], np.int64)
+    for e in range(vox.shape[0]):
+        if vox[e, 3] > vox[e, 4]:
+            continue
+        for tj in range(vox[e, 5] // TILE, vox[e, 6] // TILE + 1):
+            for ti in range(vox[e, 3] // TILE, vox[e, 4] // TILE + 1):
+                listed[fill[tj * nt + ti]] = e
+                fill[tj * nt + ti] += 1
+    return starts, listed
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _tile_far(bin_starts, nb, bi0, bi1, bj0, bj1, best_t):
+    far = 0.0
+    for bj in range(bj0, bj1 + 1):
+        for s in range(bin_starts[bj * nb + bi0], bin_starts[bj * nb + bi1 + 1]):
+            far = max(far, best_t[s])
+    return far
+
+
+@njit(parallel=True, nogil=True, cache=True)
+def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, so, sd, best_t,
+               best_v):
+    """Nearest hit of each sorted ray among the voxels of its tile.
+
+    ``best_t`` starts at each ray's exit from the occupied box, a bound no hit
+    reaches (a voxel's interval ends inside the box), ``best_v`` at -1. A tile
+    stops when no later brick can come nearer than every ray's bound.
+    """
+    nt = tiles_per_side
+    for tile in prange(nt * nt):
+        bi0 = (tile % nt) * TILE
+        bi1 = min(nb, bi0 + TILE) - 1
+        bj0 = (tile // nt) * TILE
+        bj1 = min(nb, bj0 + TILE) - 1
+        far = _tile_far(bin_starts, nb, bi0, bi1, bj0, bj1, best_t)  # no bound of the tile is beyond
+        stale = False  # far may be lowered (bounds moved nearer since it was taken)
+        for e in range(tile_starts[tile], tile_starts[tile + 1]):
+            q = listed[e]
+            if nears[q, 1] >= far:
+                if stale:
+                    far = _tile_far(bin_starts, nb, bi0, bi1, bj0, bj1, best_t)
+                    stale = False
+                if nears[q, 1] >= far:
+                    break
+            near = nears[q, 0]
+            if near >= far:
+                continue
+            x, y, z = np.float64(vox[q, 0]), np.float64(vox[q, 1]), np.float64(vox[q, 2])
+            i0, i1 = max(vox[q, 3], bi0), min(vox[q, 4], bi1)
+            for bj in range(max(vox[q, 5], bj0), min(vox[q, 6], bj1) + 1):
+                for s in range(bin_starts[bj * nb + i0], bin_starts[bj * nb + i1 + 1]):
+                    best = best_t[s]
+                    if best <= near:
+                        continue
+                    # The slab test of the reference tracer: the voxel's open interior.
+                    enter, leave = -INF, INF
+                    ox, oy, oz = so[s, 0], so[s, 1], so[s, 2]
+                    dx, dy, dz = sd[s, 0], sd[s, 1], sd[s, 2]
+                    if dx != 0.0:
+                        ix = 1.0 / dx
+                        a, b = (x - ox) * ix, (x + 1.0 - ox) * ix
+                        enter, leave = max(enter, min(a, b)), min(leave, max(a, b))
+                    elif not x < ox < x + 1.0:
+                        continue
+                    if dy != 0.0:
+                        iy = 1.0 / dy
+                        a, b = (y - oy) * iy, (y + 1.0 - oy) * iy
+                        enter, leave = max(enter, min(a, b)), min(leave, max(a, b))
+                    elif not y < oy < y + 1.0:
+                        continue
+                    if dz != 0.0:
+                        iz = 1.0 / dz
+                        a, b = (z - oz) * iz, (z + 1.0 - oz) * iz
+                        enter, leave = max(enter, min(a, b)), min(leave, max(a, b))
+                    elif not z < oz < z + 1.0:
+                        continue
+                    start = max(enter, 0.0)
+                    if start < leave and start < best:
+                        best_t[s] = start
+                        best_v[s] = q
+                        stale = True
+
+
+def nearest_voxels(occ, orig, dirs, frame, max_voxels):
+    """Object-order first hits of a scan, or None.
+
+    Returns (order, best_t, best_v, vox): sorted position ``s`` is ray
+    ``order[s]``; its hit is voxel ``vox[best_v[s], :3]`` at ``best_t[s]``
+    (``best_v`` -1: no voxel, the ground rule decides; ``best_t`` is then a bound).
+
+    None when the scan cannot be projected (a brick straddles the aircraft's
+    plane) or when more than ``max_voxels`` occupied voxels are in view (ray
+    order is then the cheaper way).
+    """
+    centre, grow, axis, u, v = frame
+    n = len(orig)
+    nb = max(1, int(math.ceil(math.sqrt(n))))
+    binned = bin_rays(orig, dirs, axis, u, v, nb, occ.bbox_lo.astype(np.float64),
+                      occ.bbox_hi.astype(np.float64))
+    if binned is None:
+        return None
+    bin_starts, order, so, sd, best_t, grid = binned
+    found, brick_near, ok = bricks_in_view(centre, grow, axis, u, v, grid, nb, occ.root,
+                                           occ.regions, occ.tiles, occ.root_origin.astype(np.int64),
+                                           occ.root_dims.astype(np.int64))
+    if not ok or voxels_in(found, occ.bricks) > max_voxels:
+        return None
+    vox, nears = emit_voxels(found, brick_near, occ.bricks, centre, grow, axis, u, v, grid, nb)
+    tiles_per_side = -(-nb // TILE)
+    tile_starts, listed = voxels_per_tile(vox, tiles_per_side)
+    best_v = np.full(n, -1, np.int64)
+    test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, so, sd, best_t,
+               best_v)
+    return order, best_t, best_v, vox

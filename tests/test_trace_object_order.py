@@ -1,0 +1,211 @@
+"""Object-order tracing of scans (tracing/object_order.py): the same answers as ray order,
+bit for bit, wherever it is used, and ray order wherever it cannot be."""
+
+import math
+
+import numpy as np
+import pytest
+
+from ladartui.flight import ScanPose, aim_at
+from ladartui.scene.occupancy import Occupancy
+from ladartui.sensor import Sensor
+from ladartui.tracing import trace
+from ladartui.tracing.backend import GROUND, MISS, VOXEL
+from ladartui.tracing.numba_backend import NumbaBackend
+from ladartui.tracing.object_order import cone_frame
+from ladartui.tracing.reference import reference_trace_cells
+
+
+@pytest.fixture(scope="module")
+def forest():
+    """(voxels, occupancy) of the generated "small" forest (240 x 240 x 73 cells)."""
+    from ladartui.scene.generate import generate_scene
+
+    generated = generate_scene("small")
+    return generated.voxels, Occupancy.build(generated.voxels, generated.shape)
+
+
+@pytest.fixture(scope="module")
+def numba_backend():
+    return NumbaBackend()
+
+
+def one_scan(aim, depression_deg, azimuth_rad, slant_cells, sensor=None):
+    """Cell-space rays of one sensor scan from ``slant_cells`` away, aimed at ``aim``."""
+    sensor = sensor or Sensor(grid=32, ray_grid=4, fov=5.0)
+    e = math.radians(depression_deg)
+    at = np.asarray(aim, float) + slant_cells * np.array(
+        [math.cos(azimuth_rad) * math.cos(e), math.sin(azimuth_rad) * math.cos(e), math.sin(e)])
+    origins, directions, _ = sensor.rays(aim_at(ScanPose(*at.tolist()), list(aim)))
+    return origins, directions
+
+
+def both_orders(backend, occ, origins, directions):
+    ray = backend.trace_cells(occ, origins, directions, object_order=False)
+    obj = backend.trace_cells(occ, origins, directions, object_order=True)
+    return ray, obj
+
+
+def assert_same(a, b):
+    assert np.array_equal(a.kind, b.kind), np.flatnonzero(a.kind != b.kind)[:5]
+    assert np.array_equal(a.index, b.index), np.flatnonzero((a.index != b.index).any(axis=1))[:5]
+    assert np.array_equal(a.t, b.t), np.flatnonzero(a.t != b.t)[:5]
+
+
+@pytest.mark.parametrize("depression", [1.5, 10.0, 45.0, 89.9, 90.0])
+@pytest.mark.parametrize("slant", [150.0, 600.0])
+def test_scans_match_ray_order_bit_for_bit(forest, numba_backend, depression, slant):
+    _, occ = forest
+    rng = np.random.default_rng(int(depression * 10 + slant))
+    for _ in range(3):
+        aim = [rng.uniform(60, 180), rng.uniform(60, 180), rng.uniform(0, 40)]
+        origins, directions = one_scan(aim, depression, rng.uniform(0, 2 * math.pi), slant)
+        ray, obj = both_orders(numba_backend, occ, origins, directions)
+        # Low looks put the aircraft among the tree tops, where ray order takes over;
+        # well above them it is always object order.
+        above = origins[0, 2] > occ.zmax + 40
+        assert obj.info["order"] == "object" or not above
+        assert ray.info["order"] == "ray"
+        assert_same(ray, obj)
+        assert (obj.kind == VOXEL).sum() > len(obj.kind) // 10  # the scans do see the forest
+
+
+def test_scan_matches_the_reference(forest, numba_backend):
+    voxels, occ = forest
+    # A wide view: voxels, the ground through gaps, and misses past the scene's edge.
+    origins, directions = one_scan([120, 120, 20], 45.0, 0.3, 200.0,
+                                   sensor=Sensor(grid=16, ray_grid=4, fov=40.0))
+    obj = numba_backend.trace_cells(occ, origins, directions, object_order=True)
+    assert obj.info["order"] == "object"
+    pick = np.random.default_rng(0).choice(len(origins), 800, replace=False)
+    ref = reference_trace_cells(voxels, occ.shape, origins[pick], directions[pick])
+    assert np.array_equal(obj.kind[pick], ref.kind)
+    assert np.array_equal(obj.index[pick], ref.index)
+    assert np.array_equal(obj.t[pick], ref.t)
+    assert {MISS, VOXEL, GROUND} <= set(np.unique(ref.kind).tolist())
+
+
+def test_origins_spread_over_the_focal_plane_are_covered(forest, numba_backend):
+    # Origins spread almost a cell each way: rays from the edges meet voxels that rays
+    # from the centre, with the same directions, pass by. Without growing each voxel
+    # by the spread, object order would miss those hits.
+    _, occ = forest
+    rng = np.random.default_rng(5)
+    for _ in range(4):
+        aim = [rng.uniform(60, 180), rng.uniform(60, 180), rng.uniform(0, 40)]
+        origins, directions = one_scan(aim, rng.uniform(30, 90), rng.uniform(0, 6.3), 150.0)
+        origins = origins + rng.uniform(-0.9, 0.9, size=origins.shape)
+        ray, obj = both_orders(numba_backend, occ, origins, directions)
+        assert obj.info["order"] == "object"
+        assert_same(ray, obj)
+
+
+def test_random_scenes_and_jittered_origins(numba_backend):
+    rng = np.random.default_rng(11)
+    for trial in range(12):
+        shape = tuple(int(v) for v in rng.integers(20, 70, size=3))
+        count = int(rng.integers(1, 4000))
+        vox = rng.integers(0, shape, size=(count, 3))
+        occ = Occupancy.build(vox, shape)
+        centre = rng.uniform(0, 1, 3) * shape
+        axis = rng.normal(size=3)
+        axis[2] = -abs(axis[2]) - 0.2
+        axis /= np.linalg.norm(axis)
+        start = centre - axis * rng.uniform(60, 400)
+        # A fan of rays within 20 degrees of the axis, origins jittered by up to 0.4 cell.
+        n = 3000
+        spread = rng.normal(size=(n, 3)) * math.tan(math.radians(rng.uniform(1, 20)))
+        directions = axis + spread - np.outer(spread @ axis, axis)
+        directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+        origins = start + rng.uniform(-0.4, 0.4, size=(n, 3))
+        if trial % 3 == 0:
+            origins = np.round(origins)  # on grid planes, edges and corners
+        ray, obj = both_orders(numba_backend, occ, origins, directions)
+        assert_same(ray, obj)
+        if obj.info["order"] == "object":
+            pick = rng.choice(n, 200, replace=False)
+            ref = reference_trace_cells(vox, shape, origins[pick], directions[pick])
+            assert np.array_equal(obj.t[pick], ref.t) and np.array_equal(obj.index[pick], ref.index)
+
+
+def test_axis_aligned_rays_and_rays_in_cell_faces(numba_backend):
+    # Rays with zero components from origins on cell corners, edges and centres over a
+    # slab with holes: rays lying in a plane of cell faces enter no voxel.
+    shape = (16, 16, 12)
+    grid = np.stack(np.meshgrid(np.arange(16), np.arange(16), np.arange(3, 6), indexing="ij"),
+                    -1).reshape(-1, 3)
+    keep = (grid[:, 0] * 7 + grid[:, 1] * 3 + grid[:, 2]) % 5 != 0
+    occ = Occupancy.build(grid[keep], shape)
+    steps = np.arange(-4, 5) * 0.03
+    fan = np.array([[a, b, -1.0] for a in steps for b in steps])
+    fan /= np.linalg.norm(fan, axis=1, keepdims=True)
+    corners = np.array([[x, y, 40.0] for x in (7.5, 7.75, 8.0, 8.25, 8.5)
+                        for y in (7.5, 8.0, 8.5)])
+    origins = np.repeat(corners, len(fan), axis=0)
+    directions = np.tile(fan, (len(corners), 1))
+    ray, obj = both_orders(numba_backend, occ, origins, directions)
+    assert obj.info["order"] == "object"
+    assert_same(ray, obj)
+    ref = reference_trace_cells(grid[keep], shape, origins, directions)
+    assert np.array_equal(obj.kind, ref.kind) and np.array_equal(obj.t, ref.t)
+    in_face = ((origins[:, 0] % 1 == 0) & (directions[:, 0] == 0)) | (
+        (origins[:, 1] % 1 == 0) & (directions[:, 1] == 0))
+    assert in_face.sum() > 20 and (obj.kind[in_face] != VOXEL).all()
+    assert (obj.kind[~in_face] == VOXEL).sum() > 100
+
+
+def test_far_aircraft(forest, numba_backend):
+    # 10 km away (40,000 cells): projected rectangles and depth bounds stay conservative.
+    _, occ = forest
+    origins, directions = one_scan([120, 120, 10], 30.0, 1.0, 40000.0,
+                                   sensor=Sensor(grid=16, ray_grid=4, fov=0.05))
+    ray, obj = both_orders(numba_backend, occ, origins, directions)
+    assert obj.info["order"] == "object"
+    assert_same(ray, obj)
+    assert (obj.kind == VOXEL).any()
+
+
+def test_ray_order_where_object_order_cannot_or_should_not(forest, numba_backend):
+    _, occ = forest
+    rng = np.random.default_rng(2)
+    # Origins scattered over the scene: no scan.
+    origins = rng.uniform([0, 0, 80], [240, 240, 120], size=(5000, 3))
+    directions = np.tile([0.0, 0.6, -0.8], (5000, 1))
+    assert cone_frame(origins, directions) is None
+    assert numba_backend.trace_cells(occ, origins, directions).info["order"] == "ray"
+    # Directions over a wide cone (beyond 60 degrees of their mean).
+    wide = rng.normal(size=(5000, 3))
+    wide[:, 2] = -np.abs(wide[:, 2])
+    wide /= np.linalg.norm(wide, axis=1, keepdims=True)
+    same_origin = np.tile([120.0, 120.0, 150.0], (5000, 1))
+    result = numba_backend.trace_cells(occ, same_origin, wide, object_order=True)
+    assert result.info["order"] == "ray"
+    # The aircraft among the trees: bricks on both sides of its plane.
+    inside = np.tile([120.0, 120.0, 30.0], (5000, 1))
+    fan = np.tile([0.0, 0.0, -1.0], (5000, 1)) + rng.normal(size=(5000, 3)) * 0.05
+    fan /= np.linalg.norm(fan, axis=1, keepdims=True)
+    ray, obj = both_orders(numba_backend, occ, inside, fan)
+    assert obj.info["order"] == "ray"
+    assert_same(ray, obj)
+    # Far away with a wide view, most of the forest in view: ray order is the cheaper
+    # (auto), while forcing object order still gives the same answers.
+    origins, directions = one_scan([120, 120, 10], 60.0, 0.0, 2000.0,
+                                   sensor=Sensor(grid=64, ray_grid=1, fov=8.0))
+    auto = numba_backend.trace_cells(occ, origins, directions)
+    assert auto.info["order"] == "ray"
+    assert_same(auto, numba_backend.trace_cells(occ, origins, directions, object_order=True))
+
+
+def test_trace_reports_the_order_and_metres(forest):
+    voxels, occ = forest
+    from ladartui.scene.model import Scene
+
+    scene = Scene(voxels, voxels[:0], 0.25, shape=occ.shape)
+    sensor = Sensor(grid=32, ray_grid=4, fov=5.0)  # 16,384 rays: few voxels in view per ray
+    pose = aim_at(ScanPose(30.0, -10.0, 45.0), [30.0, 30.0, 5.0])
+    origins, directions, _ = sensor.rays(pose)
+    result = trace(scene, origins, directions, backend="numba")
+    assert result.info["order"] == "object"
+    cells = NumbaBackend().trace_cells(occ, origins / 0.25 + 0.5, directions, object_order=False)
+    assert np.array_equal(result.kind, cells.kind)
+    assert np.allclose(result.range[cells.kind == VOXEL], cells.t[cells.kind == VOXEL] * 0.25)
