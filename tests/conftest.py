@@ -1,13 +1,17 @@
 """Suite-wide set-up: tests never write into the user's home folder; shared backends."""
 
+import atexit
 import os
+import shutil
 import tempfile
 
 import pytest
 
 # The default scenario and benchmark scenes live under LADARTUI_HOME; point it
-# at a throw-away folder before any test imports ladartui.
-os.environ.setdefault("LADARTUI_HOME", tempfile.mkdtemp(prefix="ladartui-test-home-"))
+# at a throw-away folder before any test imports ladartui, removed at exit.
+if "LADARTUI_HOME" not in os.environ:
+    os.environ["LADARTUI_HOME"] = tempfile.mkdtemp(prefix="ladartui-test-home-")
+    atexit.register(shutil.rmtree, os.environ["LADARTUI_HOME"], ignore_errors=True)
 
 
 @pytest.fixture(scope="module")

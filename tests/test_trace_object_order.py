@@ -25,11 +25,6 @@ def forest():
     return generated.voxels, Occupancy.build(generated.voxels, generated.shape)
 
 
-@pytest.fixture(scope="module")
-def numba_backend():
-    return NumbaBackend()
-
-
 def one_scan(aim, depression_deg, azimuth_rad, slant_cells, sensor=None):
     """Cell-space rays of one sensor scan from ``slant_cells`` away, aimed at ``aim``."""
     sensor = sensor or Sensor(grid=32, ray_grid=4, fov=5.0)

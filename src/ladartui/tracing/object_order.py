@@ -76,7 +76,7 @@ def cone_frame(orig, dirs):
     """(centre, half_spread, axis, u, v) of a batch of rays, or None when it is no scan.
 
     A scan here: origins within ``MAX_SPREAD`` cells of their centre on every
-    axis (``bin_rays`` then checks every direction is within 60 degrees of
+    axis (``ray_grid`` then checks every direction is within 60 degrees of
     the mean direction).
     """
     if len(orig) == 0:
@@ -159,27 +159,31 @@ def _gather(order, orig, dirs, lo, hi, so, sd, exits):
         exits[k] = leave
 
 
-def bin_rays(orig, dirs, axis, u, v, nb, lo, hi):
-    """Rays sorted into nb x nb bins of their gnomonic coordinates.
-
-    Returns (starts, order, sorted origins, sorted directions, sorted exits,
-    (p0, p_step, q0, q_step)), or None when a ray is more than 60 degrees off
-    the axis. The rays of bin ``b = j * nb + i`` are sorted positions
-    ``starts[b] .. starts[b + 1]``; ``order`` maps a sorted position back to
-    the ray; its exit is where it leaves the occupied box [lo, hi) (every
-    voxel hit comes before it).
-    """
+def ray_grid(dirs, axis, u, v, nb):
+    """(p, q, grid) of a scan: gnomonic coordinates and the nb x nb bins over them,
+    ``grid = (p0, p_step, q0, q_step)``; None when a ray is more than 60 degrees
+    off the axis."""
     n = len(dirs)
     p, q = np.empty(n), np.empty(n)
     pmin, pmax, qmin, qmax, on_axis = _gnomonic(dirs, axis, u, v, p, q)
     if not on_axis:
         return None
-    grid = np.array([pmin, (pmax - pmin) / nb if pmax > pmin else 1.0,
-                     qmin, (qmax - qmin) / nb if qmax > qmin else 1.0])
+    return p, q, np.array([pmin, (pmax - pmin) / nb if pmax > pmin else 1.0,
+                           qmin, (qmax - qmin) / nb if qmax > qmin else 1.0])
+
+
+def sort_rays(p, q, grid, nb, orig, dirs, lo, hi):
+    """Rays in bin order: (starts, order, origins, directions, exits).
+
+    The rays of bin ``b = j * nb + i`` are sorted positions ``starts[b] ..
+    starts[b + 1]``; ``order`` maps a sorted position back to the ray; its exit
+    is where it leaves the occupied box [lo, hi) (every voxel hit comes before it).
+    """
+    n = len(p)
     starts, order = _sort_into_bins(p, q, grid, nb)
     so, sd, exits = np.empty((n, 3)), np.empty((n, 3)), np.empty(n)
     _gather(order, orig, dirs, lo, hi, so, sd, exits)
-    return starts, order, so, sd, exits, grid
+    return starts, order, so, sd, exits
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -448,16 +452,18 @@ def nearest_voxels(occ, orig, dirs, frame, max_voxels):
     centre, grow, axis, u, v = frame
     n = len(orig)
     nb = max(1, int(math.ceil(math.sqrt(n))))
-    binned = bin_rays(orig, dirs, axis, u, v, nb, occ.bbox_lo.astype(np.float64),
-                      occ.bbox_hi.astype(np.float64))
-    if binned is None:
+    gnomonic = ray_grid(dirs, axis, u, v, nb)
+    if gnomonic is None:
         return None
-    bin_starts, order, so, sd, best_t, grid = binned
+    p, q, grid = gnomonic
     found, brick_near, ok = bricks_in_view(centre, grow, axis, u, v, grid, nb, occ.root,
                                            occ.regions, occ.tiles, occ.root_origin.astype(np.int64),
                                            occ.root_dims.astype(np.int64))
     if not ok or voxels_in(found, occ.bricks) > max_voxels:
         return None
+    bin_starts, order, so, sd, best_t = sort_rays(p, q, grid, nb, orig, dirs,
+                                                  occ.bbox_lo.astype(np.float64),
+                                                  occ.bbox_hi.astype(np.float64))
     vox, nears = emit_voxels(found, brick_near, occ.bricks, centre, grow, axis, u, v, grid, nb)
     tiles_per_side = -(-nb // TILE)
     tile_starts, listed = voxels_per_tile(vox, tiles_per_side)
