@@ -204,3 +204,26 @@ def test_trace_reports_the_order_and_metres(forest):
     cells = NumbaBackend().trace_cells(occ, origins / 0.25 + 0.5, directions, object_order=False)
     assert np.array_equal(result.kind, cells.kind)
     assert np.allclose(result.range[cells.kind == VOXEL], cells.t[cells.kind == VOXEL] * 0.25)
+
+
+def test_a_pencil_of_rays_just_above_the_canopy(numba_backend):
+    # A field of view of 1e-14 degrees: bins far narrower than any voxel, and voxels
+    # beside the aircraft project far out (tiny depth), so rectangles span astronomically
+    # many bins. They must be clamped: as int64 they overflowed and voxels went missing.
+    # (Scans with bricks across the aircraft's plane close by go to ray order.)
+    orders = []
+    for seed in range(6):
+        rng = np.random.default_rng(seed)
+        vox = np.column_stack([rng.integers(0, 64, 3000), rng.integers(0, 64, 3000),
+                               rng.integers(40, 64, 3000)])
+        occ = Occupancy.build(vox, (64, 64, 80))
+        sensor = Sensor(grid=16, ray_grid=4, fov=1e-14)
+        for _ in range(5):
+            x, y = rng.uniform(10, 54, 2)
+            pose = aim_at(ScanPose(x, y, 64.0 + rng.uniform(0.05, 3)),
+                          [x + rng.uniform(-3, 3), y + rng.uniform(-3, 3), 0.0])
+            origins, directions, _ = sensor.rays(pose)
+            ray, obj = both_orders(numba_backend, occ, origins, directions)
+            orders.append(obj.info["order"])
+            assert_same(ray, obj)
+    assert orders.count("object") >= 20

@@ -220,13 +220,20 @@ def box_bins(x0, y0, z0, size, centre, grow, axis, u, v, grid, nb):
             gap += max(0.0, low - grow[a] - c, c - (low + size + grow[a])) ** 2
         return 0, -1, 0, -1, (0 if gap > reach * reach else -1), 0.0
     near -= NEAR_MARGIN * (1.0 + near)  # a bound, so rounding may only lower it
-    i0 = np.int64(math.floor((pl - EPS - grid[0]) / grid[1]))
-    i1 = np.int64(math.floor((ph + EPS - grid[0]) / grid[1]))
-    j0 = np.int64(math.floor((ql - EPS - grid[2]) / grid[3]))
-    j1 = np.int64(math.floor((qh + EPS - grid[2]) / grid[3]))
+    # Bin numbers clamped as floats first: with a tiny bin step they overflow int64.
+    i0 = _bin(pl - EPS, grid[0], grid[1], nb)
+    i1 = _bin(ph + EPS, grid[0], grid[1], nb)
+    j0 = _bin(ql - EPS, grid[2], grid[3], nb)
+    j1 = _bin(qh + EPS, grid[2], grid[3], nb)
     if i1 < 0 or j1 < 0 or i0 >= nb or j0 >= nb:
         return 0, -1, 0, -1, 1, near
     return max(i0, 0), min(i1, nb - 1), max(j0, 0), min(j1, nb - 1), 1, near
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _bin(x, x0, step, nb):
+    """floor((x - x0) / step), limited to -1 .. nb."""
+    return np.int64(math.floor(min(max((x - x0) / step, -1.0), float(nb))))
 
 
 @njit(nogil=True, cache=True)
