@@ -227,3 +227,32 @@ def test_a_pencil_of_rays_just_above_the_canopy(numba_backend):
             orders.append(obj.info["order"])
             assert_same(ray, obj)
     assert orders.count("object") >= 20
+
+
+def test_order_choice_learns_the_faster_order():
+    from ladartui.tracing.object_order import OrderChoice
+
+    choice = OrderChoice()
+    assert choice.pick() == "object"
+    choice.record("object", 0.040, 1000)  # 40 us per ray
+    assert choice.pick() == "ray"
+    choice.record("ray", 0.010, 1000)
+    picks = []
+    for _ in range(2 * OrderChoice.RETRY):
+        picks.append(choice.pick())
+        choice.record(picks[-1], 0.040 if picks[-1] == "object" else 0.010, 1000)
+    assert picks.count("object") == 2 and picks.count("ray") == 2 * OrderChoice.RETRY - 2
+    # The views change: ray order turns slow, and the retried object order takes over.
+    for _ in range(3 * OrderChoice.RETRY):
+        pick = choice.pick()
+        choice.record(pick, 0.040 if pick == "object" else 0.200, 1000)
+    assert choice.pick() == "object"
+
+
+def test_directions_that_are_not_unit_go_in_ray_order(forest, numba_backend):
+    _, occ = forest
+    origins, directions = one_scan([120, 120, 10], 45.0, 1.0, 200.0)
+    result = numba_backend.trace_cells(occ, origins, 3.0 * directions, object_order=True)
+    assert result.info["order"] == "ray"
+    assert_same(result, numba_backend.trace_cells(occ, origins, 3.0 * directions,
+                                                  object_order=False))

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 import threading
 import time
+import weakref
 
 import numba
 import numpy as np
@@ -19,7 +20,7 @@ from numba import njit, prange
 from ladartui.errors import Cancelled
 from ladartui.scene.occupancy import block_masks
 from ladartui.tracing.bundle import bundle_start, halo_arrays
-from ladartui.tracing.object_order import cone_frame, nearest_voxels
+from ladartui.tracing.object_order import OrderChoice, cone_frame, nearest_voxels
 from ladartui.tracing.axis import boundary_t, cell_at, clamp, slab
 from ladartui.tracing.backend import GROUND, MISS, VOXEL, CellHits, register_backend
 
@@ -407,6 +408,9 @@ class NumbaBackend:
     name = "numba"
     summary = "CPU threads (numba), float64"
 
+    def __init__(self):
+        self._orders = weakref.WeakKeyDictionary()  # occupancy -> OrderChoice
+
     def probe(self):
         return None
 
@@ -427,7 +431,8 @@ class NumbaBackend:
                     bundles: bool = True, object_order: bool | None = None) -> CellHits:
         """See ``Backend``. For tests: ``bundles=False`` starts every ray at its box entry;
         ``object_order`` True traces scans in object order whatever they cost, False never
-        (None: when the rays are a scan with few voxels in view, tracing.object_order)."""
+        (None: blocks that are scans with few voxels in view go in the order that has
+        been faster for this occupancy, ``OrderChoice``)."""
         n = len(origins)
         orig = np.ascontiguousarray(origins, dtype=np.float64)
         dirs = np.ascontiguousarray(directions, dtype=np.float64)
@@ -446,14 +451,21 @@ class NumbaBackend:
         scans = method == "exact" and object_order is not False and occ.count > 0
         for a in range(0, n, SCAN_BLOCK if scans else BLOCK):
             b = min(n, a + (SCAN_BLOCK if scans else BLOCK))
-            if scans and (object_order or b - a >= MIN_SCAN_RAYS):
+            choice = None
+            if scans and object_order is None and b - a >= MIN_SCAN_RAYS:
+                choice = self._orders.setdefault(occ, OrderChoice())
+            block_started = time.perf_counter()
+            if object_order or (choice is not None and choice.pick() == "object"):
                 if cancel is not None and cancel.is_set():
                     raise Cancelled("trace cancelled")
                 limit = np.inf if object_order else VOXELS_PER_RAY * (b - a)
                 if self._object_order(occ, orig[a:b], dirs[a:b], limit, nx, ny, kind[a:b],
                                       index[a:b], t[a:b]):
                     orders.add("object")
+                    if choice is not None:
+                        choice.record("object", time.perf_counter() - block_started, b - a)
                     continue
+                choice = None  # no scan for object order: nothing to learn from this block
             orders.add("ray")
             for c in range(a, b, BLOCK):
                 if cancel is not None and cancel.is_set():
@@ -467,6 +479,8 @@ class NumbaBackend:
                     _march_kernel(orig[c:d], dirs[c:d], float(step), float(occ.zmax), occ.root,
                                   occ.regions, occ.tiles, occ.bricks, lo, hi, rorg, rdims, nx, ny,
                                   kind[c:d], index[c:d], t[c:d])
+            if choice is not None:
+                choice.record("ray", time.perf_counter() - block_started, b - a)
         info = {"seconds": time.perf_counter() - started, "precision": "f64",
                 "threads": numba.get_num_threads(), "order": "+".join(sorted(orders)) or "ray"}
         return CellHits(kind, index, t, info)

@@ -16,24 +16,28 @@ centre ``o_c`` meets ``V - delta``, which lies inside V grown by the origins'
 half-spread on each axis; that grown cube, seen from ``o_c``, projects inside
 the rectangle of its eight projected corners (all in front of ``o_c``). So
 every ray that can meet V is in the bins of that rectangle, widened by
-``EPS`` against rounding. Nodes with corners on both sides of ``o_c``'s
-plane cannot be projected; a brick like that sends the scan back to ray
-order. Nodes wholly behind the plane cannot be met.
+``EPS`` against rounding. Nodes wholly behind ``o_c``'s plane (normal
+``a``) cannot be met, nor can nodes across it farther from ``o_c`` than
+``reach`` (``box_bins``); a brick across it within reach cannot be
+projected and sends the scan back to ray order.
 
 Why nearest first may stop early. Every point of a grown cube has depth
 ``(x - o_c).a >= near`` (its smallest corner depth), and a ray meeting V
 there has ``t >= (x - o_r).a`` (unit directions, ``d.a <= 1``), so its entry
-is at least ``near``. Voxels come brick by brick in order of the bricks'
-``near``: once every ray of a tile of bins has a hit no further than the
-next brick's ``near``, nothing later can change that tile.
+is at least ``near``. Each ray starts with a bound, its exit from the
+occupied box; voxels come brick by brick in order of the bricks' ``near``,
+so once every ray of a tile of bins has a bound no further than the next
+brick's ``near``, nothing later can change that tile.
 
-All functions release the GIL; ``emit_voxels`` and ``test_tiles`` run under
+Which order is faster depends on the scene (``OrderChoice``). All numba
+functions here release the GIL; the passes over rays and voxels run under
 ``prange``.
 """
 
 from __future__ import annotations
 
 import math
+import threading
 
 import numpy as np
 from numba import njit, prange
@@ -95,14 +99,17 @@ def cone_frame(orig, dirs):
         side = side - axis * (side @ axis)
     u = side / np.linalg.norm(side)
     v = np.cross(axis, u)
-    # Grown cubes use the spread, widened a hair so that rounding of lo/hi never narrows it.
-    return 0.5 * (lo + hi), half * (1.0 + 1e-9) + 1e-12, axis, u, v
+    # Grown cubes use the spread, widened by a hair and by a few units in the last place
+    # of the coordinates (far from the origin the centre itself is rounded).
+    centre = 0.5 * (lo + hi)
+    slack = 1e-12 + 8.0 * float(np.spacing(np.abs(np.concatenate((lo, hi))).max()))
+    return centre, half * (1.0 + 1e-9) + slack, axis, u, v
 
 
 @njit(parallel=True, nogil=True, cache=True)
 def _gnomonic(dirs, axis, u, v, p, q):
-    """p, q = d.u / d.a, d.v / d.a per ray; returns (p min, p max, q min, q max, all within
-    60 degrees of the axis)."""
+    """p, q = d.u / d.a, d.v / d.a per ray; returns (p min, p max, q min, q max, all unit
+    and within 60 degrees of the axis)."""
     n = dirs.shape[0]
     part = np.empty((PARTS, 4))
     off_axis = np.zeros(PARTS, np.bool_)
@@ -111,7 +118,9 @@ def _gnomonic(dirs, axis, u, v, p, q):
         for r in range(k * n // PARTS, (k + 1) * n // PARTS):
             d0, d1, d2 = dirs[r, 0], dirs[r, 1], dirs[r, 2]
             w = d0 * axis[0] + d1 * axis[1] + d2 * axis[2]
-            if not w >= MIN_COS:
+            # The depth bounds need unit directions (trace() gives them; a caller of
+            # trace_cells might not): anything else goes in ray order.
+            if not (w >= MIN_COS and abs(d0 * d0 + d1 * d1 + d2 * d2 - 1.0) <= 1e-9):
                 off_axis[k] = True
                 w = 1.0
             pp = (d0 * u[0] + d1 * u[1] + d2 * u[2]) / w
@@ -162,7 +171,7 @@ def _gather(order, orig, dirs, lo, hi, so, sd, exits):
 def ray_grid(dirs, axis, u, v, nb):
     """(p, q, grid) of a scan: gnomonic coordinates and the nb x nb bins over them,
     ``grid = (p0, p_step, q0, q_step)``; None when a ray is more than 60 degrees
-    off the axis."""
+    off the axis or not of unit length."""
     n = len(dirs)
     p, q = np.empty(n), np.empty(n)
     pmin, pmax, qmin, qmax, on_axis = _gnomonic(dirs, axis, u, v, p, q)
@@ -478,3 +487,41 @@ def nearest_voxels(occ, orig, dirs, frame, max_voxels):
     test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, so, sd, best_t,
                best_v)
     return order, best_t, best_v, vox
+
+
+class OrderChoice:
+    """Which order traces an occupancy's scans faster, learned from the calls themselves.
+
+    Neither order wins everywhere: object order costs about the same for any
+    scene in view, ray order is cheap where rays stop early (dense cover) and
+    dear where they pass many gaps (foliage). So the first scan of an
+    occupancy goes in object order, the next in ray order, and from then on
+    the faster one by a running mean of time per ray, with the other tried
+    again every RETRY scans in case the views have changed.
+    """
+
+    RETRY = 16
+
+    def __init__(self):
+        self.seconds_per_ray = {}
+        self.calls = 0
+        self._lock = threading.Lock()
+
+    def pick(self) -> str:
+        with self._lock:
+            self.calls += 1
+            known = self.seconds_per_ray
+            if "object" not in known:
+                return "object"
+            if "ray" not in known:
+                return "ray"
+            best = min(known, key=known.get)
+            if self.calls % self.RETRY == 0:
+                return "ray" if best == "object" else "object"
+            return best
+
+    def record(self, order: str, seconds: float, rays: int) -> None:
+        with self._lock:
+            now = seconds / max(1, rays)
+            before = self.seconds_per_ray.get(order)
+            self.seconds_per_ray[order] = now if before is None else 0.5 * (before + now)
