@@ -494,34 +494,33 @@ class OrderChoice:
 
     Neither order wins everywhere: object order costs about the same for any
     scene in view, ray order is cheap where rays stop early (dense cover) and
-    dear where they pass many gaps (foliage). So the first scan of an
-    occupancy goes in object order, the next in ray order, and from then on
-    the faster one by a running mean of time per ray, with the other tried
+    dear where they pass many gaps (foliage). So the orders take turns until
+    each has been timed twice (a first call may include compiling), then the
+    faster by its better recent time per ray goes on, and the other is tried
     again every RETRY scans in case the views have changed.
     """
 
     RETRY = 16
+    SAMPLES = 2
 
     def __init__(self):
-        self.seconds_per_ray = {}
+        self.samples = {"object": [], "ray": []}  # recent seconds per ray
         self.calls = 0
         self._lock = threading.Lock()
 
     def pick(self) -> str:
         with self._lock:
             self.calls += 1
-            known = self.seconds_per_ray
-            if "object" not in known:
-                return "object"
-            if "ray" not in known:
-                return "ray"
-            best = min(known, key=known.get)
+            timed_object, timed_ray = len(self.samples["object"]), len(self.samples["ray"])
+            if min(timed_object, timed_ray) < self.SAMPLES:
+                return "object" if timed_object <= timed_ray else "ray"
+            best = min(self.samples, key=lambda order: min(self.samples[order]))
             if self.calls % self.RETRY == 0:
                 return "ray" if best == "object" else "object"
             return best
 
     def record(self, order: str, seconds: float, rays: int) -> None:
         with self._lock:
-            now = seconds / max(1, rays)
-            before = self.seconds_per_ray.get(order)
-            self.seconds_per_ray[order] = now if before is None else 0.5 * (before + now)
+            recent = self.samples[order]
+            recent.append(seconds / max(1, rays))
+            del recent[:-self.SAMPLES]
