@@ -42,6 +42,8 @@ import threading
 import numpy as np
 from numba import njit, prange
 
+from ladartui.tracing.axis import slab
+
 INF = np.inf
 EPS = 1e-9  # widening of projected rectangles (tangent units), far above rounding
 NEAR_MARGIN = 1e-9  # relative lowering of depth bounds, far above rounding
@@ -162,9 +164,8 @@ def _gather(order, orig, dirs, lo, hi, so, sd, exits):
         for a in range(3):
             so[k, a] = orig[r, a]
             sd[k, a] = dirs[r, a]
-            if dirs[r, a] != 0.0:
-                inv = 1.0 / dirs[r, a]
-                leave = min(leave, max((lo[a] - orig[r, a]) * inv, (hi[a] - orig[r, a]) * inv))
+            inv = 1.0 / dirs[r, a] if dirs[r, a] != 0.0 else INF
+            leave = min(leave, slab(orig[r, a], dirs[r, a], inv, lo[a], hi[a])[1])
         exits[k] = leave
 
 
@@ -426,27 +427,12 @@ def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, 
                     if best <= near:
                         continue
                     # The slab test of the reference tracer: the voxel's open interior.
-                    enter, leave = -INF, INF
                     ox, oy, oz = so[s, 0], so[s, 1], so[s, 2]
                     dx, dy, dz = sd[s, 0], sd[s, 1], sd[s, 2]
-                    if dx != 0.0:
-                        ix = 1.0 / dx
-                        a, b = (x - ox) * ix, (x + 1.0 - ox) * ix
-                        enter, leave = max(enter, min(a, b)), min(leave, max(a, b))
-                    elif not x < ox < x + 1.0:
-                        continue
-                    if dy != 0.0:
-                        iy = 1.0 / dy
-                        a, b = (y - oy) * iy, (y + 1.0 - oy) * iy
-                        enter, leave = max(enter, min(a, b)), min(leave, max(a, b))
-                    elif not y < oy < y + 1.0:
-                        continue
-                    if dz != 0.0:
-                        iz = 1.0 / dz
-                        a, b = (z - oz) * iz, (z + 1.0 - oz) * iz
-                        enter, leave = max(enter, min(a, b)), min(leave, max(a, b))
-                    elif not z < oz < z + 1.0:
-                        continue
+                    ex, lx = slab(ox, dx, 1.0 / dx if dx != 0.0 else INF, x, x + 1.0)
+                    ey, ly = slab(oy, dy, 1.0 / dy if dy != 0.0 else INF, y, y + 1.0)
+                    ez, lz = slab(oz, dz, 1.0 / dz if dz != 0.0 else INF, z, z + 1.0)
+                    enter, leave = max(ex, max(ey, ez)), min(lx, min(ly, lz))
                     start = max(enter, 0.0)
                     if start < leave and start < best:
                         best_t[s] = start
