@@ -263,3 +263,22 @@ def test_directions_that_are_not_unit_go_in_ray_order(forest, numba_backend):
     assert result.info["order"] == "ray"
     assert_same(result, numba_backend.trace_cells(occ, origins, 3.0 * directions,
                                                   object_order=False))
+
+
+def test_tile_lists_keep_the_nearest_first_order():
+    from ladartui.tracing.object_order import TILE, voxels_per_tile
+
+    rng = np.random.default_rng(4)
+    n, tiles = 5000, 6
+    vox = np.zeros((n, 7), np.int64)
+    low = rng.integers(0, TILE * tiles, (n, 2))
+    vox[:, 3], vox[:, 5] = low[:, 0], low[:, 1]
+    vox[:, 4] = np.minimum(low[:, 0] + rng.integers(-1, 2 * TILE, n), TILE * tiles - 1)
+    vox[:, 6] = np.minimum(low[:, 1] + rng.integers(0, 2 * TILE, n), TILE * tiles - 1)
+    starts, listed = voxels_per_tile(vox, tiles)
+    for tile in range(tiles * tiles):
+        ti, tj = tile % tiles, tile // tiles
+        expected = [e for e in range(n) if vox[e, 3] <= vox[e, 4]
+                    and vox[e, 3] // TILE <= ti <= vox[e, 4] // TILE
+                    and vox[e, 5] // TILE <= tj <= vox[e, 6] // TILE]
+        assert listed[starts[tile]:starts[tile + 1]].tolist() == expected

@@ -357,28 +357,39 @@ def emit_voxels(bricks_found, brick_near, bricks, centre, grow, axis, u, v, grid
     return vox, nears
 
 
-@njit(nogil=True, cache=True)
+@njit(parallel=True, nogil=True, cache=True)
 def voxels_per_tile(vox, tiles_per_side):
-    """For each tile of TILE x TILE bins, the voxels covering it, in list order (CSR)."""
+    """For each tile of TILE x TILE bins, the voxels covering it, in list order (CSR).
+
+    A counting sort in PARTS runs of voxels: each run counts and then places its
+    own entries, after those of the runs before it, so list order is kept.
+    """
     nt = tiles_per_side
+    n = vox.shape[0]
+    counts = np.zeros((nt * nt, PARTS), np.int64)
+    for k in prange(PARTS):
+        for e in range(k * n // PARTS, (k + 1) * n // PARTS):
+            if vox[e, 3] > vox[e, 4]:
+                continue
+            for tj in range(vox[e, 5] // TILE, vox[e, 6] // TILE + 1):
+                for ti in range(vox[e, 3] // TILE, vox[e, 4] // TILE + 1):
+                    counts[tj * nt + ti, k] += 1
     starts = np.zeros(nt * nt + 1, np.int64)
-    for e in range(vox.shape[0]):
-        if vox[e, 3] > vox[e, 4]:
-            continue
-        for tj in range(vox[e, 5] // TILE, vox[e, 6] // TILE + 1):
-            for ti in range(vox[e, 3] // TILE, vox[e, 4] // TILE + 1):
-                starts[tj * nt + ti + 1] += 1
-    for b in range(nt * nt):
-        starts[b + 1] += starts[b]
-    fill = starts[:-1].copy()
-    listed = np.empty(starts[-1], np.int64)
-    for e in range(vox.shape[0]):
-        if vox[e, 3] > vox[e, 4]:
-            continue
-        for tj in range(vox[e, 5] // TILE, vox[e, 6] // TILE + 1):
-            for ti in range(vox[e, 3] // TILE, vox[e, 4] // TILE + 1):
-                listed[fill[tj * nt + ti]] = e
-                fill[tj * nt + ti] += 1
+    at = 0
+    for b in range(nt * nt):  # runs' places within each tile, tile after tile
+        starts[b] = at
+        for k in range(PARTS):
+            counts[b, k], at = at, at + counts[b, k]
+    starts[nt * nt] = at
+    listed = np.empty(at, np.int64)
+    for k in prange(PARTS):
+        for e in range(k * n // PARTS, (k + 1) * n // PARTS):
+            if vox[e, 3] > vox[e, 4]:
+                continue
+            for tj in range(vox[e, 5] // TILE, vox[e, 6] // TILE + 1):
+                for ti in range(vox[e, 3] // TILE, vox[e, 4] // TILE + 1):
+                    listed[counts[tj * nt + ti, k]] = e
+                    counts[tj * nt + ti, k] += 1
     return starts, listed
 
 
