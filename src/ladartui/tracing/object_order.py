@@ -50,9 +50,7 @@ NEAR_MARGIN = 1e-9  # relative lowering of depth bounds, far above rounding
 TILE = 16  # bins per tile side: rays tested together, stopped together
 MAX_SPREAD = 1.0  # largest origin half-spread (cells) handled in object order
 MIN_COS = 0.5  # every ray within 60 degrees of the cone's axis
-
-
-PARTS = 64  # fixed split of the passes over rays (so sums do not depend on the threads)
+PARTS = 64  # fixed split of the parallel passes (so sums do not depend on the threads)
 
 
 @njit(parallel=True, nogil=True, cache=True)
