@@ -244,6 +244,14 @@ def _bin(x, x0, step, nb):
     return np.int64(math.floor(min(max((x - x0) / step, -1.0), float(nb))))
 
 
+@njit(nogil=True, cache=True, inline="always")
+def _out_of_view(x0, y0, z0, size, centre, grow, axis, u, v, grid, nb):
+    """Whether no ray can meet the node: it covers no bin, or lies out of every ray's way
+    (a node across the plane near the centre is opened, its bricks decide)."""
+    i0, i1, _, _, state, _ = box_bins(x0, y0, z0, size, centre, grow, axis, u, v, grid, nb)
+    return state == 0 or (state == 1 and i0 > i1)
+
+
 @njit(nogil=True, cache=True)
 def bricks_in_view(centre, grow, axis, u, v, grid, nb, root, regions, tiles, rorg, rdims):
     """Non-empty bricks whose grown cube covers a bin, nearest first.
@@ -261,16 +269,14 @@ def bricks_in_view(centre, grow, axis, u, v, grid, nb, root, regions, tiles, ror
                 if g == 0:
                     continue
                 x0, y0, z0 = rorg[0] + (rx << 9), rorg[1] + (ry << 9), rorg[2] + (rz << 9)
-                i0, i1, _, _, state, _ = box_bins(x0, y0, z0, 512, centre, grow, axis, u, v, grid, nb)
-                if state == 0 or (state == 1 and i0 > i1):
+                if _out_of_view(x0, y0, z0, 512, centre, grow, axis, u, v, grid, nb):
                     continue
                 for s1 in range(512):
                     tl = regions[(np.int64(g) - 1) * 512 + s1]
                     if tl == 0:
                         continue
                     tx, ty, tz = x0 + ((s1 & 7) << 6), y0 + (((s1 >> 3) & 7) << 6), z0 + ((s1 >> 6) << 6)
-                    i0, i1, _, _, state, _ = box_bins(tx, ty, tz, 64, centre, grow, axis, u, v, grid, nb)
-                    if state == 0 or (state == 1 and i0 > i1):
+                    if _out_of_view(tx, ty, tz, 64, centre, grow, axis, u, v, grid, nb):
                         continue
                     for s2 in range(512):
                         br = tiles[(np.int64(tl) - 1) * 512 + s2]
