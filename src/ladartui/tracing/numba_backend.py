@@ -71,15 +71,17 @@ def _brick_entry(b, stepped, positive, o, d, inv, t):
 
 
 @njit(nogil=True, cache=True, inline="always")
-def _ground(ox, oy, oz, dx, dy, dz, nx, ny):
-    """(kind, i, j, t) of the ground rule for a ray that hit no voxel."""
+def _answer(found, i, j, k, t, ox, oy, oz, dx, dy, dz, nx, ny):
+    """(kind, i, j, k, t) of a ray: the voxel it hit, else the ground rule."""
+    if found:
+        return VOXEL, i, j, k, t
     if dz < 0.0 and oz > 0.0:
         tg = (0.0 - oz) * (1.0 / dz)
         gx = ox + tg * dx
         gy = oy + tg * dy
         if 0.0 <= gx < nx and 0.0 <= gy < ny:
-            return GROUND, np.int64(math.floor(gx)), np.int64(math.floor(gy)), tg
-    return MISS, np.int64(-1), np.int64(-1), INF
+            return GROUND, np.int64(math.floor(gx)), np.int64(math.floor(gy)), np.int64(0), tg
+    return MISS, np.int64(-1), np.int64(-1), np.int64(-1), INF
 
 
 @njit(parallel=True, nogil=True, cache=True)
@@ -319,16 +321,8 @@ def _exact_kernel(orig, dirs, root, regions, tiles, bricks, blocks, columns, cub
                     cy = _enter(cy, byn, ty == tn, py, s, oy, dy, iy, tn)
                     cz = _enter(cz, bzn, tz == tn, pz, s, oz, dz, iz, tn)
                     t = tn
-            if found:
-                kind[r] = VOXEL
-                index[r, 0], index[r, 1], index[r, 2] = cx, cy, cz
-                tout[r] = t
-            else:
-                gk, gi, gj, tg = _ground(ox, oy, oz, dx, dy, dz, nx, ny)
-                kind[r] = gk
-                index[r, 0], index[r, 1] = gi, gj
-                index[r, 2] = 0 if gk == GROUND else -1
-                tout[r] = tg
+            kind[r], index[r, 0], index[r, 1], index[r, 2], tout[r] = _answer(
+                found, cx, cy, cz, t, ox, oy, oz, dx, dy, dz, nx, ny)
 
 
 @njit(parallel=True, nogil=True, cache=True)
@@ -337,17 +331,10 @@ def _object_order_answers(order, best_t, best_v, vox, orig, dirs, nx, ny, kind, 
     for s in prange(order.shape[0]):
         r = order[s]
         q = best_v[s]
-        if q >= 0:
-            kind[r] = VOXEL
-            index[r, 0], index[r, 1], index[r, 2] = vox[q, 0], vox[q, 1], vox[q, 2]
-            tout[r] = best_t[s]
-        else:
-            gk, gi, gj, tg = _ground(orig[r, 0], orig[r, 1], orig[r, 2], dirs[r, 0], dirs[r, 1],
-                                     dirs[r, 2], nx, ny)
-            kind[r] = gk
-            index[r, 0], index[r, 1] = gi, gj
-            index[r, 2] = 0 if gk == GROUND else -1
-            tout[r] = tg
+        i, j, k = (vox[q, 0], vox[q, 1], vox[q, 2]) if q >= 0 else (-1, -1, -1)
+        kind[r], index[r, 0], index[r, 1], index[r, 2], tout[r] = _answer(
+            q >= 0, i, j, k, best_t[s], orig[r, 0], orig[r, 1], orig[r, 2], dirs[r, 0], dirs[r, 1],
+            dirs[r, 2], nx, ny)
 
 
 @njit(parallel=True, nogil=True, cache=True)

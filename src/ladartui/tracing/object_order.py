@@ -257,7 +257,7 @@ def bricks_in_view(centre, grow, axis, u, v, grid, nb, root, regions, tiles, ror
     """Non-empty bricks whose grown cube covers a bin, nearest first.
 
     Returns ((m, 4) corner x, y, z and brick number, (m,) near, ok); ok is
-    False when a brick straddles the centre's plane (trace in ray order).
+    False when a brick crosses the centre's plane near the centre (trace in ray order).
     """
     found = np.empty((4096, 4), np.int64)
     nears = np.empty(4096)
@@ -309,21 +309,10 @@ def _popcount(x):
     return np.int64(((x * np.uint32(0x01010101)) >> np.uint32(24)) & np.uint32(0xFF))
 
 
-@njit(nogil=True, cache=True)
-def voxels_in(bricks_found, bricks):
-    """Occupied voxels in the found bricks."""
-    total = 0
-    for e in range(bricks_found.shape[0]):
-        base = (bricks_found[e, 3] - 1) * 16
-        for w in range(16):
-            total += _popcount(bricks[base + w])
-    return total
-
-
 @njit(parallel=True, nogil=True, cache=True)
-def emit_voxels(bricks_found, brick_near, bricks, centre, grow, axis, u, v, grid, nb):
-    """Every voxel of the found bricks, in their order: (m, 7) i, j, k, i0, i1, j0, j1
-    (i0 > i1: covers no bin) and (m, 2) its near and its brick's near."""
+def voxel_starts(bricks_found, bricks):
+    """Where each found brick's voxels begin in the voxel list (brick e holds
+    ``first[e] .. first[e + 1]``); ``first[-1]`` is the number of voxels in view."""
     count = bricks_found.shape[0]
     first = np.zeros(count + 1, np.int64)
     for e in prange(count):
@@ -334,6 +323,15 @@ def emit_voxels(bricks_found, brick_near, bricks, centre, grow, axis, u, v, grid
         first[e + 1] = c
     for e in range(count):
         first[e + 1] += first[e]
+    return first
+
+
+@njit(parallel=True, nogil=True, cache=True)
+def emit_voxels(bricks_found, brick_near, first, bricks, centre, grow, axis, u, v, grid, nb):
+    """Every voxel of the found bricks, in their order (``first`` from ``voxel_starts``):
+    (m, 7) i, j, k, i0, i1, j0, j1 (i0 > i1: covers no bin) and (m, 2) its near and its
+    brick's near."""
+    count = bricks_found.shape[0]
     vox = np.empty((first[count], 7), np.int64)
     nears = np.empty((first[count], 2))
     for e in prange(count):
@@ -476,12 +474,14 @@ def nearest_voxels(occ, orig, dirs, frame, max_voxels):
     found, brick_near, ok = bricks_in_view(centre, grow, axis, u, v, grid, nb, occ.root,
                                            occ.regions, occ.tiles, occ.root_origin.astype(np.int64),
                                            occ.root_dims.astype(np.int64))
-    if not ok or voxels_in(found, occ.bricks) > max_voxels:
+    first = voxel_starts(found, occ.bricks) if ok else None
+    if not ok or first[-1] > max_voxels:
         return None
     bin_starts, order, so, sd, best_t = sort_rays(p, q, grid, nb, orig, dirs,
                                                   occ.bbox_lo.astype(np.float64),
                                                   occ.bbox_hi.astype(np.float64))
-    vox, nears = emit_voxels(found, brick_near, occ.bricks, centre, grow, axis, u, v, grid, nb)
+    vox, nears = emit_voxels(found, brick_near, first, occ.bricks, centre, grow, axis, u, v, grid,
+                             nb)
     tiles_per_side = -(-nb // TILE)
     tile_starts, listed = voxels_per_tile(vox, tiles_per_side)
     best_v = np.full(n, -1, np.int64)
