@@ -14,37 +14,18 @@ from ladartui.tracing.backend import GROUND, MISS, VOXEL
 from ladartui.tracing.numba_backend import NumbaBackend
 from ladartui.tracing.object_order import cone_frame
 from ladartui.tracing.reference import reference_trace_cells
+from scans import assert_same, forest_scene, one_scan
 
 
 @pytest.fixture(scope="module")
 def forest():
-    """(voxels, occupancy) of the generated "small" forest (240 x 240 x 73 cells)."""
-    from ladartui.scene.generate import generate_scene
-
-    generated = generate_scene("small")
-    return generated.voxels, Occupancy.build(generated.voxels, generated.shape)
-
-
-def one_scan(aim, depression_deg, azimuth_rad, slant_cells, sensor=None):
-    """Cell-space rays of one sensor scan from ``slant_cells`` away, aimed at ``aim``."""
-    sensor = sensor or Sensor(grid=32, ray_grid=4, fov=5.0)
-    e = math.radians(depression_deg)
-    at = np.asarray(aim, float) + slant_cells * np.array(
-        [math.cos(azimuth_rad) * math.cos(e), math.sin(azimuth_rad) * math.cos(e), math.sin(e)])
-    origins, directions, _ = sensor.rays(aim_at(ScanPose(*at.tolist()), list(aim)))
-    return origins, directions
+    return forest_scene()
 
 
 def both_orders(backend, occ, origins, directions):
     ray = backend.trace_cells(occ, origins, directions, object_order=False)
     obj = backend.trace_cells(occ, origins, directions, object_order=True)
     return ray, obj
-
-
-def assert_same(a, b):
-    assert np.array_equal(a.kind, b.kind), np.flatnonzero(a.kind != b.kind)[:5]
-    assert np.array_equal(a.index, b.index), np.flatnonzero((a.index != b.index).any(axis=1))[:5]
-    assert np.array_equal(a.t, b.t), np.flatnonzero(a.t != b.t)[:5]
 
 
 @pytest.mark.parametrize("depression", [1.5, 10.0, 45.0, 89.9, 90.0])
@@ -265,20 +246,41 @@ def test_directions_that_are_not_unit_go_in_ray_order(forest, numba_backend):
                                                   object_order=False))
 
 
-def test_tile_lists_keep_the_nearest_first_order():
-    from ladartui.tracing.object_order import TILE, voxels_per_tile
+@pytest.mark.parametrize("tile, tiles", [(16, 6), (2, 300)])
+def test_tile_lists_keep_the_nearest_first_order(tile, tiles):
+    # 16: the numba tiles (64 runs of voxels); 2: the shader's, many tiles (fewer runs).
+    from ladartui.tracing.object_order import voxels_per_tile
 
     rng = np.random.default_rng(4)
-    n, tiles = 5000, 6
+    n = 5000
     vox = np.zeros((n, 7), np.int64)
-    low = rng.integers(0, TILE * tiles, (n, 2))
+    low = rng.integers(0, tile * tiles, (n, 2))
     vox[:, 3], vox[:, 5] = low[:, 0], low[:, 1]
-    vox[:, 4] = np.minimum(low[:, 0] + rng.integers(-1, 2 * TILE, n), TILE * tiles - 1)
-    vox[:, 6] = np.minimum(low[:, 1] + rng.integers(0, 2 * TILE, n), TILE * tiles - 1)
-    starts, listed = voxels_per_tile(vox, tiles)
-    for tile in range(tiles * tiles):
-        ti, tj = tile % tiles, tile // tiles
-        expected = [e for e in range(n) if vox[e, 3] <= vox[e, 4]
-                    and vox[e, 3] // TILE <= ti <= vox[e, 4] // TILE
-                    and vox[e, 5] // TILE <= tj <= vox[e, 6] // TILE]
-        assert listed[starts[tile]:starts[tile + 1]].tolist() == expected
+    vox[:, 4] = np.minimum(low[:, 0] + rng.integers(-1, 2 * tile, n), tile * tiles - 1)
+    vox[:, 6] = np.minimum(low[:, 1] + rng.integers(0, 2 * tile, n), tile * tiles - 1)
+    starts, listed = voxels_per_tile(vox, tiles, tile)
+    expected = [[] for _ in range(tiles * tiles)]
+    for e in range(n):
+        if vox[e, 3] <= vox[e, 4]:
+            for tj in range(vox[e, 5] // tile, vox[e, 6] // tile + 1):
+                for ti in range(vox[e, 3] // tile, vox[e, 4] // tile + 1):
+                    expected[tj * tiles + ti].append(e)
+    assert sum(map(len, expected)) == len(listed) > n
+    for at, voxels in enumerate(expected):
+        assert listed[starts[at]:starts[at + 1]].tolist() == voxels
+
+
+def test_bins_are_numbered_tile_by_tile():
+    # A tile's rays are contiguous after the sort, and so is each of its rows.
+    from ladartui.tracing.object_order import bin_key
+
+    nb, tile = 37, 4
+    tiles = -(-nb // tile)
+    keys = np.array([[bin_key(i, j, tiles, tile) for i in range(nb)] for j in range(nb)])
+    assert len(np.unique(keys)) == nb * nb and keys.max() < (tiles * tile) ** 2
+    for j in range(nb):
+        for i0 in range(0, nb, tile):
+            row = keys[j, i0:min(nb, i0 + tile)]
+            assert np.array_equal(row, row[0] + np.arange(len(row)))
+    tile_of = (np.arange(nb)[None, :] // tile) + tiles * (np.arange(nb)[:, None] // tile)
+    assert np.array_equal(keys // (tile * tile), tile_of)

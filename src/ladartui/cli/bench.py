@@ -189,13 +189,15 @@ def run_bench(quick=False, runs=None) -> dict:
             # other backend's data should not be in the caches of the timed one.
             times = {name: [] for name in backends}
             cpu = {name: [] for name in backends}
+            last_order = {}
             for _ in range(runs):
                 for name in backends:
                     trace(occupancy, origins, directions, backend=name, **kwargs)
                     c = time.process_time()
                     t = time.perf_counter()
-                    trace(occupancy, origins, directions, backend=name, **kwargs)
+                    timed = trace(occupancy, origins, directions, backend=name, **kwargs)
                     times[name].append(time.perf_counter() - t)
+                    last_order[name] = timed.info.get("order", "ray")
                     cpu[name].append(time.process_time() - c)
             for name, backend in backends.items():
                 median = statistics.median(times[name])
@@ -211,6 +213,7 @@ def run_bench(quick=False, runs=None) -> dict:
                     "rays_per_cpu_second": len(origins) / cpu_median if cpu_median > 0 else None,
                     "voxel_hits": float(np.mean(result.kind == 1)),
                     "ground_hits": float(np.mean(result.kind == 2)),
+                    "order": last_order[name],
                     "device": backend.describe().get("adapter") or "cpu"})
     _add_ratios(report["results"])
     return report
@@ -237,13 +240,13 @@ def _print_table(report):
                   f"{report['sensor']}; median of "
                   f"{report['runs']} runs")
     table = Table(box=box.SIMPLE_HEAD, pad_edge=False, collapse_padding=True)
-    for name in ("backend", "method", "depr.", "rays/s", "x numba", "rays/CPU-s", "voxel",
-                 "ground"):
+    for name in ("backend", "method", "depr.", "order", "rays/s", "x numba", "rays/CPU-s",
+                 "voxel", "ground"):
         table.add_column(name, no_wrap=True, min_width=len(name))
     table.add_column("device", no_wrap=True, overflow="ellipsis", max_width=12)
     for row in report["results"]:
         per_cpu = row["rays_per_cpu_second"]
-        table.add_row(row["backend"], row["method"], f"{row['depression']:g}",
+        table.add_row(row["backend"], row["method"], f"{row['depression']:g}", row["order"],
                       f"{row['rays_per_second'] / 1e6:.2f} M",
                       f"{row['vs_numba']:.2f}" if row.get("vs_numba") is not None else "-",
                       f"{per_cpu / 1e6:.2f} M" if per_cpu else "-",

@@ -2,18 +2,18 @@
 //
 // This is tracing/numba_backend.py (with tracing/axis.py) written again in WGSL:
 // the same functions under the same names (without the leading underscore),
-// the same steps in the
-// same order, as fixed in docs/architecture.md ("Exact traversal", "March").
+// the same steps in the same order, as fixed in docs/architecture.md ("Exact
+// traversal", "March").
 // Read the two side by side; change them together. In f64 both give the same
 // answer, bit for bit, for every ray (tests/test_wgpu_precision.py).
 //
 // Cell space: voxel (i, j, k) spans [i, i+1) on each axis, ground at c_z = 0.
 // tracing/wgpu_backend.py prepends a header declaring `alias real = f64;`
-// (or f32) and the occupancy bindings, read through `fn occ(word) -> u32`:
+// (or f32), the occupancy bindings, read through `fn occ(word) -> u32`, and
+// shaders/axis.wgsl (boundary_t, cell_at, slab, INF):
 // one logical u32 array [root | regions | tiles | bricks | columns | cubes] that
 // may be split over several storage bindings; cubes holds the four octants'
-// u8 sides of one brick cell in one word (byte `octant`). INF stands for +inf: WGSL has no
-// infinity literal, and no ray parameter comes near 1e30.
+// u8 sides of one brick cell in one word (byte `octant`).
 //
 // Loop budget: lavapipe (llvmpipe) ends every loop of an invocation once all its
 // loops together have run 65,535 iterations, a guard against endless shaders,
@@ -48,7 +48,6 @@ const VOXEL: i32 = 1;
 const GROUND: i32 = 2;
 const UNFINISHED: i32 = 3;  // march: no answer within this pass's samples
 const CUT: i32 = 4;         // a loop was ended by the adapter, not by the ray
-const INF: real = 1e30;
 
 struct Hit {
     kind: i32,
@@ -58,55 +57,12 @@ struct Hit {
     t: real,
 }
 
-struct Span {
-    enter: real,
-    leave: real,
-}
-
 fn miss() -> Hit {
     return Hit(MISS, -1, -1, -1, INF);
 }
 
 fn cut() -> Hit {
     return Hit(CUT, -1, -1, -1, INF);
-}
-
-// The one formula for boundary parameters (tracing/axis.py: boundary_t).
-fn boundary_t(b: real, o: real, inv: real) -> real {
-    return (b - o) * inv;
-}
-
-// Cell index on one axis just after parameter t, exact against boundary_t (tracing/axis.py: cell_at).
-fn cell_at(o: real, d: real, inv: real, t: real) -> i32 {
-    var c = floor(o + t * d);
-    if (d > 0.0) {
-        if (boundary_t(c + 1.0, o, inv) <= t) {
-            c += 1.0;
-        } else if (boundary_t(c, o, inv) > t) {
-            c -= 1.0;
-        }
-    } else if (d < 0.0) {
-        if (boundary_t(c, o, inv) <= t) {
-            c -= 1.0;
-        } else if (boundary_t(c + 1.0, o, inv) > t) {
-            c += 1.0;
-        }
-    }
-    return i32(c);
-}
-
-// Entry and exit parameters of [lo, hi) on one axis; (inf, -inf) when never inside (tracing/axis.py: slab).
-fn slab(o: real, d: real, inv: real, lo: real, hi: real) -> Span {
-    if (d > 0.0) {
-        return Span(boundary_t(lo, o, inv), boundary_t(hi, o, inv));
-    }
-    if (d < 0.0) {
-        return Span(boundary_t(hi, o, inv), boundary_t(lo, o, inv));
-    }
-    if (lo < o && o < hi) {
-        return Span(-INF, INF);
-    }
-    return Span(INF, -INF);
 }
 
 // numba: _exit_boundary

@@ -326,8 +326,9 @@ def _exact_kernel(orig, dirs, root, regions, tiles, bricks, blocks, columns, cub
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def _object_order_answers(order, best_t, best_v, vox, orig, dirs, nx, ny, kind, index, tout):
-    """Object-order hits (tracing.object_order) back in ray order, with the ground rule."""
+def scan_answers(order, best_t, best_v, vox, orig, dirs, nx, ny, kind, index, tout):
+    """Object-order hits (tracing.object_order; numba or the wgpu backend's shader) back
+    in ray order, with the ground rule."""
     for s in prange(order.shape[0]):
         r = order[s]
         q = best_v[s]
@@ -479,7 +480,7 @@ class NumbaBackend:
         found = None if frame is None else nearest_voxels(occ, orig, dirs, frame, max_voxels)
         if found is None:
             return False
-        _object_order_answers(*found, orig, dirs, nx, ny, kind, index, t)
+        scan_answers(*found, orig, dirs, nx, ny, kind, index, t)
         return True
 
 

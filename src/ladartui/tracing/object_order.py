@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import math
 import threading
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange
@@ -132,36 +133,58 @@ def _gnomonic(dirs, axis, u, v, p, q):
             not off_axis.any())
 
 
-@njit(nogil=True, cache=True)
-def _sort_into_bins(p, q, grid, nb):
-    """(starts, order): counting sort of the rays by bin ``j * nb + i``."""
-    n = p.shape[0]
-    bin_of = np.empty(n, np.int64)
-    starts = np.zeros(nb * nb + 1, np.int64)
-    for r in range(n):
-        i = min(nb - 1, max(0, np.int64((p[r] - grid[0]) / grid[1])))
-        j = min(nb - 1, max(0, np.int64((q[r] - grid[2]) / grid[3])))
-        bin_of[r] = j * nb + i
-        starts[j * nb + i + 1] += 1
-    for b in range(nb * nb):
-        starts[b + 1] += starts[b]
-    fill = starts[:-1].copy()
-    order = np.empty(n, np.int64)
-    for r in range(n):
-        order[fill[bin_of[r]]] = r
-        fill[bin_of[r]] += 1
-    return starts, order
+@njit(nogil=True, cache=True, inline="always")
+def bin_key(i, j, tiles_per_side, tile):
+    """Sort key of bin (i, j): bins are numbered tile by tile, rows within a tile,
+    so a tile's rays are contiguous and so is each of its rows."""
+    return ((j // tile) * tiles_per_side + i // tile) * tile * tile + (j % tile) * tile + i % tile
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def _gather(order, orig, dirs, lo, hi, so, sd, exits):
-    """Rays in sorted order, and where each leaves the box [lo, hi)."""
+def _bin_keys(p, q, grid, nb, tile, key_of, bin_of):
+    nt = -(-nb // tile)
+    for r in prange(p.shape[0]):
+        i = min(nb - 1, max(0, np.int64((p[r] - grid[0]) / grid[1])))
+        j = min(nb - 1, max(0, np.int64((q[r] - grid[2]) / grid[3])))
+        key_of[r] = bin_key(i, j, nt, tile)
+        bin_of[r] = np.uint32(i | (j << 16))
+
+
+@njit(nogil=True, cache=True)
+def _sort_into_bins(p, q, grid, nb, tile):
+    """(starts, order, bins): counting sort of the rays by ``bin_key``; ``bins`` holds
+    each sorted ray's bin as ``i | j << 16``."""
+    n = p.shape[0]
+    nt = -(-nb // tile)
+    key_of = np.empty(n, np.int64)
+    bin_of = np.empty(n, np.uint32)
+    _bin_keys(p, q, grid, nb, tile, key_of, bin_of)
+    starts = np.zeros(nt * nt * tile * tile + 1, np.int64)
+    for r in range(n):
+        starts[key_of[r] + 1] += 1
+    for b in range(starts.shape[0] - 1):
+        starts[b + 1] += starts[b]
+    fill = starts[:-1].copy()
+    order = np.empty(n, np.int64)
+    bins = np.empty(n, np.uint32)
+    for r in range(n):
+        at = fill[key_of[r]]
+        order[at] = r
+        bins[at] = bin_of[r]
+        fill[key_of[r]] += 1
+    return starts, order, bins
+
+
+@njit(parallel=True, nogil=True, cache=True)
+def _gather(order, orig, dirs, lo, hi, rays, exits):
+    """Rays in sorted order (origin then direction per row), and where each leaves
+    the box [lo, hi)."""
     for k in prange(order.shape[0]):
         r = order[k]
         leave = INF
         for a in range(3):
-            so[k, a] = orig[r, a]
-            sd[k, a] = dirs[r, a]
+            rays[k, a] = orig[r, a]
+            rays[k, 3 + a] = dirs[r, a]
             inv = 1.0 / dirs[r, a] if dirs[r, a] != 0.0 else INF
             leave = min(leave, slab(orig[r, a], dirs[r, a], inv, lo[a], hi[a])[1])
         exits[k] = leave
@@ -180,18 +203,19 @@ def ray_grid(dirs, axis, u, v, nb):
                            qmin, (qmax - qmin) / nb if qmax > qmin else 1.0])
 
 
-def sort_rays(p, q, grid, nb, orig, dirs, lo, hi):
-    """Rays in bin order: (starts, order, origins, directions, exits).
+def sort_rays(p, q, grid, nb, tile, orig, dirs, lo, hi):
+    """Rays in bin order: (starts, order, bins, rays, exits).
 
-    The rays of bin ``b = j * nb + i`` are sorted positions ``starts[b] ..
-    starts[b + 1]``; ``order`` maps a sorted position back to the ray; its exit
-    is where it leaves the occupied box [lo, hi) (every voxel hit comes before it).
+    The rays of the bin with key ``b`` (``bin_key``) are sorted positions
+    ``starts[b] .. starts[b + 1]``; ``order`` maps a sorted position back to the
+    ray; ``rays`` holds its origin and direction, ``bins`` its bin; its exit is
+    where it leaves the occupied box [lo, hi) (every voxel hit comes before it).
     """
     n = len(p)
-    starts, order = _sort_into_bins(p, q, grid, nb)
-    so, sd, exits = np.empty((n, 3)), np.empty((n, 3)), np.empty(n)
-    _gather(order, orig, dirs, lo, hi, so, sd, exits)
-    return starts, order, so, sd, exits
+    starts, order, bins = _sort_into_bins(p, q, grid, nb, tile)
+    rays, exits = np.empty((n, 6)), np.empty(n)
+    _gather(order, orig, dirs, lo, hi, rays, exits)
+    return starts, order, bins, rays, exits
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -360,58 +384,60 @@ def emit_voxels(bricks_found, brick_near, first, bricks, centre, grow, axis, u, 
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def voxels_per_tile(vox, tiles_per_side):
-    """For each tile of TILE x TILE bins, the voxels covering it, in list order (CSR).
+def voxels_per_tile(vox, tiles_per_side, tile):
+    """For each tile of ``tile`` x ``tile`` bins, the voxels covering it, in list order (CSR).
 
-    A counting sort in PARTS runs of voxels: each run counts and then places its
-    own entries, after those of the runs before it, so list order is kept.
+    A counting sort in runs of voxels: each run counts and then places its own
+    entries, after those of the runs before it, so list order is kept (and does
+    not depend on the number of runs, fewer when there are many tiles).
     """
     nt = tiles_per_side
     n = vox.shape[0]
-    counts = np.zeros((nt * nt, PARTS), np.int64)
-    for k in prange(PARTS):
-        for e in range(k * n // PARTS, (k + 1) * n // PARTS):
+    runs = max(2, min(PARTS, (1 << 18) // (nt * nt)))
+    counts = np.zeros((nt * nt, runs), np.int64)
+    for k in prange(runs):
+        for e in range(k * n // runs, (k + 1) * n // runs):
             if vox[e, 3] > vox[e, 4]:
                 continue
-            for tj in range(vox[e, 5] // TILE, vox[e, 6] // TILE + 1):
-                for ti in range(vox[e, 3] // TILE, vox[e, 4] // TILE + 1):
+            for tj in range(vox[e, 5] // tile, vox[e, 6] // tile + 1):
+                for ti in range(vox[e, 3] // tile, vox[e, 4] // tile + 1):
                     counts[tj * nt + ti, k] += 1
     starts = np.zeros(nt * nt + 1, np.int64)
     at = 0
     for b in range(nt * nt):  # runs' places within each tile, tile after tile
         starts[b] = at
-        for k in range(PARTS):
+        for k in range(runs):
             counts[b, k], at = at, at + counts[b, k]
     starts[nt * nt] = at
     listed = np.empty(at, np.int64)
-    for k in prange(PARTS):
-        for e in range(k * n // PARTS, (k + 1) * n // PARTS):
+    for k in prange(runs):
+        for e in range(k * n // runs, (k + 1) * n // runs):
             if vox[e, 3] > vox[e, 4]:
                 continue
-            for tj in range(vox[e, 5] // TILE, vox[e, 6] // TILE + 1):
-                for ti in range(vox[e, 3] // TILE, vox[e, 4] // TILE + 1):
+            for tj in range(vox[e, 5] // tile, vox[e, 6] // tile + 1):
+                for ti in range(vox[e, 3] // tile, vox[e, 4] // tile + 1):
                     listed[counts[tj * nt + ti, k]] = e
                     counts[tj * nt + ti, k] += 1
     return starts, listed
 
 
 @njit(nogil=True, cache=True, inline="always")
-def _tile_far(bin_starts, nb, bi0, bi1, bj0, bj1, best_t):
+def _tile_far(bin_starts, tile, best_t):
     far = 0.0
-    for bj in range(bj0, bj1 + 1):
-        for s in range(bin_starts[bj * nb + bi0], bin_starts[bj * nb + bi1 + 1]):
-            far = max(far, best_t[s])
+    for s in range(bin_starts[tile * TILE * TILE], bin_starts[(tile + 1) * TILE * TILE]):
+        far = max(far, best_t[s])
     return far
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, so, sd, best_t,
+def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, rays, best_t,
                best_v):
-    """Nearest hit of each sorted ray among the voxels of its tile.
+    """Nearest hit of each sorted ray among the voxels of its tile (tiles of TILE bins).
 
     ``best_t`` starts at each ray's exit from the occupied box, a bound no hit
     reaches (a voxel's interval ends inside the box), ``best_v`` at -1. A tile
     stops when no later brick can come nearer than every ray's bound.
+    shaders/object_order.wgsl runs the same tests ray by ray.
     """
     nt = tiles_per_side
     for tile in prange(nt * nt):
@@ -419,13 +445,13 @@ def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, 
         bi1 = min(nb, bi0 + TILE) - 1
         bj0 = (tile // nt) * TILE
         bj1 = min(nb, bj0 + TILE) - 1
-        far = _tile_far(bin_starts, nb, bi0, bi1, bj0, bj1, best_t)  # no bound of the tile is beyond
+        far = _tile_far(bin_starts, tile, best_t)  # no bound of the tile is beyond
         stale = False  # far may be lowered (bounds moved nearer since it was taken)
         for e in range(tile_starts[tile], tile_starts[tile + 1]):
             q = listed[e]
             if nears[q, 1] >= far:
                 if stale:
-                    far = _tile_far(bin_starts, nb, bi0, bi1, bj0, bj1, best_t)
+                    far = _tile_far(bin_starts, tile, best_t)
                     stale = False
                 if nears[q, 1] >= far:
                     break
@@ -435,13 +461,14 @@ def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, 
             x, y, z = np.float64(vox[q, 0]), np.float64(vox[q, 1]), np.float64(vox[q, 2])
             i0, i1 = max(vox[q, 3], bi0), min(vox[q, 4], bi1)
             for bj in range(max(vox[q, 5], bj0), min(vox[q, 6], bj1) + 1):
-                for s in range(bin_starts[bj * nb + i0], bin_starts[bj * nb + i1 + 1]):
+                for s in range(bin_starts[bin_key(i0, bj, nt, TILE)],
+                               bin_starts[bin_key(i1, bj, nt, TILE) + 1]):
                     best = best_t[s]
                     if best <= near:
                         continue
                     # The slab test of the reference tracer: the voxel's open interior.
-                    ox, oy, oz = so[s, 0], so[s, 1], so[s, 2]
-                    dx, dy, dz = sd[s, 0], sd[s, 1], sd[s, 2]
+                    ox, oy, oz = rays[s, 0], rays[s, 1], rays[s, 2]
+                    dx, dy, dz = rays[s, 3], rays[s, 4], rays[s, 5]
                     ex, lx = slab(ox, dx, 1.0 / dx if dx != 0.0 else INF, x, x + 1.0)
                     ey, ly = slab(oy, dy, 1.0 / dy if dy != 0.0 else INF, y, y + 1.0)
                     ez, lz = slab(oz, dz, 1.0 / dz if dz != 0.0 else INF, z, z + 1.0)
@@ -453,17 +480,62 @@ def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, 
                         stale = True
 
 
-def nearest_voxels(occ, orig, dirs, frame, max_voxels):
-    """Object-order first hits of a scan, or None.
+@njit(nogil=True, cache=True, inline="always")
+def _f32_below(x):
+    """The float32 nearest ``x`` from below (a depth bound must not rise)."""
+    f = np.float32(x)
+    if np.float64(f) > x:
+        f = np.nextafter(f, np.float32(-np.inf))
+    return f
 
-    Returns (order, best_t, best_v, vox): sorted position ``s`` is ray
-    ``order[s]``; its hit is voxel ``vox[best_v[s], :3]`` at ``best_t[s]``
-    (``best_v`` -1: no voxel, the ground rule decides; ``best_t`` is then a bound).
 
-    None when the scan cannot be projected (a brick straddles the aircraft's
-    plane) or when more than ``max_voxels`` occupied voxels are in view (ray
-    order is then the cheaper way).
+@njit(parallel=True, nogil=True, cache=True)
+def voxel_words(vox, nears):
+    """The voxels in view as shaders/object_order.wgsl reads them, two u32 vec4 each:
+    (i0 | i1 << 16, j0 | j1 << 16, near, brick's near) with the nears as float32
+    rounded down, then (x, y, z, 0)."""
+    m = vox.shape[0]
+    words = np.zeros((m, 8), np.uint32)
+    reals = words.view(np.float32)
+    for e in prange(m):
+        words[e, 0] = np.uint32(vox[e, 3] & 0xFFFF) | np.uint32((vox[e, 4] & 0xFFFF) << 16)
+        words[e, 1] = np.uint32(vox[e, 5] & 0xFFFF) | np.uint32((vox[e, 6] & 0xFFFF) << 16)
+        reals[e, 2] = _f32_below(nears[e, 0])
+        reals[e, 3] = _f32_below(nears[e, 1])
+        for a in range(3):
+            words[e, 4 + a] = np.uint32(vox[e, a] & 0xFFFFFFFF)
+    return words
+
+
+class Scan(NamedTuple):
+    """A scan made ready for the tile tests (``prepare_scan``).
+
+    Sorted position ``s`` is ray ``order[s]``, with origin and direction
+    ``rays[s]``, bin ``bins[s]`` (``i | j << 16``) and bound ``exits[s]``; the
+    rays of bin key ``b`` are ``bin_starts[b] .. bin_starts[b + 1]``. ``vox`` and
+    ``nears`` are the voxels in view (``emit_voxels``), ``tile_starts`` and
+    ``listed`` each tile's voxels (``voxels_per_tile``).
     """
+
+    order: np.ndarray
+    rays: np.ndarray
+    bins: np.ndarray
+    exits: np.ndarray
+    bin_starts: np.ndarray
+    vox: np.ndarray
+    nears: np.ndarray
+    tile_starts: np.ndarray
+    listed: np.ndarray
+    nb: int
+    tile: int
+    tiles_per_side: int
+
+
+def prepare_scan(occ, orig, dirs, frame, max_voxels, tile=TILE):
+    """A scan's rays binned and sorted, and its voxels in view listed per tile of
+    ``tile`` x ``tile`` bins; None when it cannot be projected (a brick straddles
+    the aircraft's plane) or when more than ``max_voxels`` occupied voxels are in
+    view (ray order is then the cheaper way)."""
     centre, grow, axis, u, v = frame
     n = len(orig)
     nb = max(1, int(math.ceil(math.sqrt(n))))
@@ -477,17 +549,32 @@ def nearest_voxels(occ, orig, dirs, frame, max_voxels):
     first = voxel_starts(found, occ.bricks) if ok else None
     if not ok or first[-1] > max_voxels:
         return None
-    bin_starts, order, so, sd, best_t = sort_rays(p, q, grid, nb, orig, dirs,
-                                                  occ.bbox_lo.astype(np.float64),
-                                                  occ.bbox_hi.astype(np.float64))
+    bin_starts, order, bins, rays, exits = sort_rays(p, q, grid, nb, tile, orig, dirs,
+                                                     occ.bbox_lo.astype(np.float64),
+                                                     occ.bbox_hi.astype(np.float64))
     vox, nears = emit_voxels(found, brick_near, first, occ.bricks, centre, grow, axis, u, v, grid,
                              nb)
-    tiles_per_side = -(-nb // TILE)
-    tile_starts, listed = voxels_per_tile(vox, tiles_per_side)
-    best_v = np.full(n, -1, np.int64)
-    test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, so, sd, best_t,
-               best_v)
-    return order, best_t, best_v, vox
+    tiles_per_side = -(-nb // tile)
+    tile_starts, listed = voxels_per_tile(vox, tiles_per_side, tile)
+    return Scan(order, rays, bins, exits, bin_starts, vox, nears, tile_starts, listed, nb, tile,
+                tiles_per_side)
+
+
+def nearest_voxels(occ, orig, dirs, frame, max_voxels):
+    """Object-order first hits of a scan, or None (see ``prepare_scan``).
+
+    Returns (order, best_t, best_v, vox): sorted position ``s`` is ray
+    ``order[s]``; its hit is voxel ``vox[best_v[s], :3]`` at ``best_t[s]``
+    (``best_v`` -1: no voxel, the ground rule decides; ``best_t`` is then a bound).
+    """
+    scan = prepare_scan(occ, orig, dirs, frame, max_voxels)
+    if scan is None:
+        return None
+    best_t = scan.exits
+    best_v = np.full(len(best_t), -1, np.int64)
+    test_tiles(scan.vox, scan.nears, scan.tile_starts, scan.listed, scan.tiles_per_side,
+               scan.bin_starts, scan.nb, scan.rays, best_t, best_v)
+    return scan.order, best_t, best_v, scan.vox
 
 
 class OrderChoice:

@@ -22,6 +22,14 @@ Resources:
   same (e.g. an exact ray needing more steps than that) raises
   ``BackendUnavailable`` rather than passing for a miss.
 
+Object order: exact ``f64`` scans (one aircraft, a narrow cone; see
+``tracing/object_order.py``) go voxel by voxel as in the numba backend. The
+host bins and sorts the rays and lists the voxels in view per tile with the
+numba functions there (``prepare_scan``); ``shaders/object_order.wgsl`` runs
+the tile tests, one invocation per ray; the host applies the ground rule.
+``OrderChoice`` learns per occupancy whether that or the ray-order shader is
+faster, as in numba, and ``CellHits.info["order"]`` says which ran.
+
 Precision: ``f64`` needs the adapter's ``shader-f64`` feature (lavapipe has
 it). Without it the backend runs ``f32`` and says so in ``CellHits.info``.
 In ``f32`` each ray starts where it enters the scene's box (moved there on the
@@ -39,6 +47,7 @@ import os
 import stat
 import tempfile
 import threading
+import time
 import weakref
 
 import numpy as np
@@ -46,6 +55,8 @@ import numpy as np
 from ladartui.errors import BackendUnavailable, Cancelled, FieldError
 from ladartui.tracing.backend import GROUND, METHODS, MISS, VOXEL, CellHits, register_backend
 from ladartui.tracing.bundle import bundle_starts, halo_arrays
+from ladartui.tracing.numba_backend import MIN_SCAN_RAYS, SCAN_BLOCK, VOXELS_PER_RAY, scan_answers
+from ladartui.tracing.object_order import OrderChoice, cone_frame, prepare_scan, voxel_words
 
 NAME = "wgpu"
 
@@ -72,6 +83,11 @@ CUT = 4
 # Samples a ray per march pass: well under lavapipe's 65,535 loop iterations
 # per invocation, all loops together.
 MARCH_SAMPLES_PER_PASS = 1 << 15
+# Object order (shaders/object_order.wgsl): bins per tile side. Small tiles keep each
+# ray's list short; the shader pays for every entry a ray walks past.
+OBJECT_ORDER_TILE = 2
+# Longest tile list an invocation may walk: under lavapipe's 65,535 loop iterations.
+LOOP_BUDGET = 65_000
 
 
 def choose_adapter(adapters):
@@ -224,7 +240,10 @@ class WgpuBackend:
         self._pinned_uploads = {}  # for occupancies that cannot be weakly referenced
         self._pipelines = {}
         self._ray_buffers = {}
-        self._source = None
+        self._sources = {}
+        self._orders = weakref.WeakKeyDictionary()  # occupancy -> OrderChoice
+        self._scan_buffers = {}  # object order's buffers by name, and their bind group
+        self._scan_group = (None, None)
 
     # -- probing and device -------------------------------------------------
 
@@ -378,10 +397,13 @@ class WgpuBackend:
 
     # -- pipelines ----------------------------------------------------------
 
+    def _shader_file(self, name: str) -> str:
+        if name not in self._sources:
+            self._sources[name] = (importlib.resources.files("ladartui") / "shaders" / name).read_text()
+        return self._sources[name]
+
     def _shader_source(self, real: str, chunks: int, chunk_shift: int) -> str:
-        """trace.wgsl with its header: the float type and the occupancy bindings."""
-        if self._source is None:
-            self._source = (importlib.resources.files("ladartui") / "shaders" / "trace.wgsl").read_text()
+        """trace.wgsl with its header: the float type, the occupancy bindings and axis.wgsl."""
         lines = [f"alias real = {real};"]
         for chunk in range(chunks):
             lines.append(f"@group(0) @binding({FIXED_BINDINGS + chunk}) "
@@ -399,7 +421,7 @@ class WgpuBackend:
             lines.append(f"        default: {{ return occupancy{chunks - 1}[offset]; }}")
             lines.append("    }")
         lines.append("}")
-        return "\n".join(lines) + "\n\n" + self._source
+        return "\n".join(lines) + "\n\n" + self._shader_file("axis.wgsl") + "\n" + self._shader_file("trace.wgsl")
 
     def _pipeline(self, precision: str, chunks: int, chunk_shift: int):
         key = (precision, chunks, chunk_shift)
@@ -412,6 +434,18 @@ class WgpuBackend:
                 label=f"trace-{precision}-{chunks}", layout="auto",
                 compute={"module": module, "entry_point": "trace_rays"})
             self._pipelines[key] = pipeline
+        return pipeline
+
+    def _tiles_pipeline(self):
+        """The object-order pipeline (f64 only)."""
+        pipeline = self._pipelines.get("tiles")
+        if pipeline is None:
+            code = ("alias real = f64;\n\n" + self._shader_file("axis.wgsl") + "\n"
+                    + self._shader_file("object_order.wgsl"))
+            module = self._device.create_shader_module(label="tiles", code=code)
+            pipeline = self._device.create_compute_pipeline(
+                label="tiles", layout="auto", compute={"module": module, "entry_point": "test_tiles"})
+            self._pipelines["tiles"] = pipeline
         return pipeline
 
     def _ray_buffers_for(self, precision: str):
@@ -444,8 +478,13 @@ class WgpuBackend:
     # -- tracing ------------------------------------------------------------
 
     def trace_cells(self, occupancy, origins, directions, *, method="exact", step=0.5,
-                    precision="f64", cancel: threading.Event | None = None) -> CellHits:
-        """Trace (N, 3) float64 cell-space rays on the adapter; see ``Backend``."""
+                    precision="f64", cancel: threading.Event | None = None,
+                    object_order: bool | None = None) -> CellHits:
+        """Trace (N, 3) float64 cell-space rays on the adapter; see ``Backend``.
+
+        ``object_order`` as in the numba backend: True traces exact f64 scans in
+        object order whatever they cost, False never, None as ``OrderChoice`` finds
+        faster. f32 and the march always go in ray order."""
         if method not in METHODS:
             raise FieldError("method", method, " or ".join(METHODS))
         if precision not in ("f64", "f32"):
@@ -463,7 +502,119 @@ class WgpuBackend:
             info = {"adapter": self._adapter.info.get("device", ""), "precision": used}
             if used != precision:
                 info["precision_note"] = "the adapter has no shader-f64: traced in f32"
+            if (method == "exact" and used == "f64" and object_order is not False
+                    and occupancy.count > 0):
+                return self._trace_scans(occupancy, origins, directions, object_order, cancel,
+                                         info)
+            info["order"] = "ray"
             return self._trace(occupancy, origins, directions, method, step, used, cancel, info)
+
+    def _trace_scans(self, occupancy, origins, directions, object_order, cancel, info):
+        """Exact f64 in blocks of up to SCAN_BLOCK rays, each in object or ray order
+        (the numba backend's policy: tracing/numba_backend.py, trace_cells)."""
+        n = len(origins)
+        kind = np.zeros(n, dtype=np.uint8)
+        index = np.full((n, 3), -1, dtype=np.int32)
+        t = np.full(n, np.inf)
+        orders = set()
+        for a in range(0, n, SCAN_BLOCK):
+            b = min(n, a + SCAN_BLOCK)
+            if cancel is not None and cancel.is_set():
+                raise Cancelled("trace cancelled")
+            choice = None
+            if object_order is None and b - a >= MIN_SCAN_RAYS:
+                choice = self._orders.setdefault(occupancy, OrderChoice())
+            started = time.perf_counter()
+            if object_order or (choice is not None and choice.pick() == "object"):
+                limit = np.inf if object_order else VOXELS_PER_RAY * (b - a)
+                if self._object_order(occupancy, origins[a:b], directions[a:b], limit, kind[a:b],
+                                      index[a:b], t[a:b]):
+                    orders.add("object")
+                    if choice is not None:
+                        choice.record("object", time.perf_counter() - started, b - a)
+                    continue
+                choice = None  # no scan for object order: nothing to learn from this block
+            orders.add("ray")
+            hits = self._trace(occupancy, origins[a:b], directions[a:b], "exact", 0.5, "f64",
+                               cancel, info)
+            kind[a:b], index[a:b], t[a:b] = hits.kind, hits.index, hits.t
+            if choice is not None:
+                choice.record("ray", time.perf_counter() - started, b - a)
+        info["order"] = "+".join(sorted(orders)) or "ray"
+        return CellHits(kind, index, t, info)
+
+    def _object_order(self, occupancy, origins, directions, max_voxels, kind, index, t):
+        """One scan in object order into kind/index/t; False when it is no scan for it
+        (or its lists or arrays exceed what the adapter allows)."""
+        frame = cone_frame(origins, directions)
+        scan = None if frame is None else prepare_scan(occupancy, origins, directions, frame,
+                                                       max_voxels, OBJECT_ORDER_TILE)
+        if scan is None or np.diff(scan.tile_starts).max(initial=0) >= LOOP_BUDGET:
+            return False
+        found = self._test_tiles(scan)
+        if found is None:
+            return False
+        nx, ny = float(occupancy.shape[0]), float(occupancy.shape[1])
+        scan_answers(scan.order, *found, scan.vox, origins, directions, nx, ny, kind, index, t)
+        return True
+
+    def _test_tiles(self, scan):
+        """(best_t, best_v) of a prepared scan from shaders/object_order.wgsl, or None
+        when one of its arrays exceeds a storage binding."""
+        n = len(scan.order)
+        inputs = {
+            "rays": scan.rays,
+            "bins": scan.bins,
+            "best_t": np.clip(scan.exits, -SHADER_INF, SHADER_INF),  # the shader has no infinity
+            "voxels": voxel_words(scan.vox, scan.nears),
+            "tile_starts": scan.tile_starts.astype(np.uint32),
+            "listed": scan.listed.astype(np.uint32),
+        }
+        sizes = {name: array.nbytes for name, array in inputs.items()}
+        sizes["best_v"] = 4 * n
+        if max(sizes.values()) > self._limits["max-storage-buffer-binding-size"]:
+            return None
+        buffers = {name: self._scan_buffer(name, size) for name, size in sizes.items()}
+        buffers["params"] = self._scan_buffer("params", 16, uniform=True)
+        queue = self._device.queue
+        queue.write_buffer(buffers["params"], 0,
+                           np.array([n, scan.tile, scan.tiles_per_side, 0], dtype=np.uint32))
+        for name, array in inputs.items():
+            if array.nbytes:
+                queue.write_buffer(buffers[name], 0, np.ascontiguousarray(array))
+        pipeline = self._tiles_pipeline()
+        key = tuple(id(buffers[name]) for name in SCAN_BINDINGS)
+        if self._scan_group[0] != key:  # made again only when a buffer has grown
+            self._scan_group = (key, self._device.create_bind_group(
+                layout=pipeline.get_bind_group_layout(0),
+                entries=[{"binding": b, "resource": {"buffer": buffers[name]}}
+                         for b, name in enumerate(SCAN_BINDINGS)]))
+        group = self._scan_group[1]
+        groups = dispatch_grid(-(-n // WORKGROUP_SIZE),
+                               self._limits["max-compute-workgroups-per-dimension"])
+        encoder = self._device.create_command_encoder()
+        compute = encoder.begin_compute_pass()
+        compute.set_pipeline(pipeline)
+        compute.set_bind_group(0, group)
+        compute.dispatch_workgroups(groups[0], groups[1], 1)
+        compute.end()
+        queue.submit([encoder.finish()])
+        best_t = np.frombuffer(queue.read_buffer(buffers["best_t"], 0, 8 * n), dtype=np.float64)
+        best_v = np.frombuffer(queue.read_buffer(buffers["best_v"], 0, 4 * n), dtype=np.int32)
+        return best_t, best_v
+
+    def _scan_buffer(self, name, size, uniform=False):
+        """A buffer of at least ``size`` bytes for object order, kept for later scans."""
+        import wgpu
+
+        buffer = self._scan_buffers.get(name)
+        if buffer is None or buffer.size < size:
+            usage = (wgpu.BufferUsage.UNIFORM if uniform else
+                     wgpu.BufferUsage.STORAGE | wgpu.BufferUsage.COPY_SRC) | wgpu.BufferUsage.COPY_DST
+            size = max(16, 1 << (max(size, 1) - 1).bit_length())  # room to grow
+            buffer = self._device.create_buffer(label=f"scan-{name}", size=size, usage=usage)
+            self._scan_buffers[name] = buffer
+        return buffer
 
     def _trace(self, occupancy, origins, directions, method, step, precision, cancel, info):
         n = len(origins)
@@ -618,6 +769,9 @@ def cube_box(occupancy):
     return (np.asarray(occupancy.cube_origin, dtype=np.int64),
             np.asarray(occupancy.cube_dims, dtype=np.int64))
 
+
+# Bindings of shaders/object_order.wgsl, in order.
+SCAN_BINDINGS = ("params", "rays", "bins", "best_t", "best_v", "voxels", "tile_starts", "listed")
 
 # Params (uniform, see struct Params in trace.wgsl): 10 vec4 of 32-bit integers
 # then a vec2<real> of float parameters (16 bytes in f64, 8 in f32).

@@ -1,0 +1,34 @@
+"""Scans for the object-order tests: a generated forest and one sensor scan of it."""
+
+import math
+
+import numpy as np
+
+from ladartui.flight import ScanPose, aim_at
+from ladartui.scene.occupancy import Occupancy
+from ladartui.sensor import Sensor
+
+
+def forest_scene():
+    """(voxels, occupancy) of the generated "small" forest (240 x 240 x 73 cells)."""
+    from ladartui.scene.generate import generate_scene
+
+    generated = generate_scene("small")
+    return generated.voxels, Occupancy.build(generated.voxels, generated.shape)
+
+
+def one_scan(aim, depression_deg, azimuth_rad, slant_cells, sensor=None):
+    """Cell-space rays of one sensor scan from ``slant_cells`` away, aimed at ``aim``."""
+    sensor = sensor or Sensor(grid=32, ray_grid=4, fov=5.0)
+    e = math.radians(depression_deg)
+    at = np.asarray(aim, float) + slant_cells * np.array(
+        [math.cos(azimuth_rad) * math.cos(e), math.sin(azimuth_rad) * math.cos(e), math.sin(e)])
+    origins, directions, _ = sensor.rays(aim_at(ScanPose(*at.tolist()), list(aim)))
+    return origins, directions
+
+
+def assert_same(a, b):
+    """Two CellHits agree bit for bit: kind, voxel index and range of every ray."""
+    assert np.array_equal(a.kind, b.kind), np.flatnonzero(a.kind != b.kind)[:5]
+    assert np.array_equal(a.index, b.index), np.flatnonzero((a.index != b.index).any(axis=1))[:5]
+    assert np.array_equal(a.t, b.t), np.flatnonzero(a.t != b.t)[:5]
