@@ -246,19 +246,19 @@ def test_directions_that_are_not_unit_go_in_ray_order(forest, numba_backend):
                                                   object_order=False))
 
 
-@pytest.mark.parametrize("tile, tiles", [(16, 6), (2, 300)])
-def test_tile_lists_keep_the_nearest_first_order(tile, tiles):
+@pytest.mark.parametrize("shift, tiles", [(4, 6), (1, 300)])
+def test_tile_lists_keep_the_nearest_first_order(shift, tiles):
     # 16: the numba tiles (64 runs of voxels); 2: the shader's, many tiles (fewer runs).
     from ladartui.tracing.object_order import voxels_per_tile
 
     rng = np.random.default_rng(4)
-    n = 5000
+    n, tile = 5000, 1 << shift
     vox = np.zeros((n, 7), np.int64)
     low = rng.integers(0, tile * tiles, (n, 2))
     vox[:, 3], vox[:, 5] = low[:, 0], low[:, 1]
     vox[:, 4] = np.minimum(low[:, 0] + rng.integers(-1, 2 * tile, n), tile * tiles - 1)
     vox[:, 6] = np.minimum(low[:, 1] + rng.integers(0, 2 * tile, n), tile * tiles - 1)
-    starts, listed = voxels_per_tile(vox, tiles, tile)
+    starts, listed = voxels_per_tile(vox, tiles, shift)
     expected = [[] for _ in range(tiles * tiles)]
     for e in range(n):
         if vox[e, 3] <= vox[e, 4]:
@@ -274,9 +274,10 @@ def test_bins_are_numbered_tile_by_tile():
     # A tile's rays are contiguous after the sort, and so is each of its rows.
     from ladartui.tracing.object_order import bin_key
 
-    nb, tile = 37, 4
+    nb, shift = 37, 2
+    tile = 1 << shift
     tiles = -(-nb // tile)
-    keys = np.array([[bin_key(i, j, tiles, tile) for i in range(nb)] for j in range(nb)])
+    keys = np.array([[bin_key(i, j, tiles, shift) for i in range(nb)] for j in range(nb)])
     assert len(np.unique(keys)) == nb * nb and keys.max() < (tiles * tile) ** 2
     for j in range(nb):
         for i0 in range(0, nb, tile):

@@ -18,7 +18,7 @@
 
 struct TileParams {
     rays: u32,            // sorted rays in this dispatch
-    tile: u32,            // bins per tile side
+    tile_shift: u32,      // tiles of 1 << tile_shift bins a side
     tiles_per_side: u32,
     unused: u32,
 }
@@ -46,7 +46,7 @@ fn test_tiles(@builtin(workgroup_id) group: vec3<u32>,
     let bin = ray_bins[s];
     let bi = bin & 0xffffu;
     let bj = bin >> 16u;
-    let tile = (bj / params.tile) * params.tiles_per_side + bi / params.tile;
+    let tile = (bj >> params.tile_shift) * params.tiles_per_side + (bi >> params.tile_shift);
     let b = s * 6u;
     let ox = rays[b];
     let oy = rays[b + 1u];

@@ -48,7 +48,8 @@ from ladartui.tracing.axis import slab
 INF = np.inf
 EPS = 1e-9  # widening of projected rectangles (tangent units), far above rounding
 NEAR_MARGIN = 1e-9  # relative lowering of depth bounds, far above rounding
-TILE = 16  # bins per tile side: rays tested together, stopped together
+TILE_SHIFT = 4  # tiles of 16 x 16 bins: rays tested together, stopped together
+TILE = 1 << TILE_SHIFT
 MAX_SPREAD = 1.0  # largest origin half-spread (cells) handled in object order
 MIN_COS = 0.5  # every ray within 60 degrees of the cone's axis
 PARTS = 64  # fixed split of the parallel passes (so sums do not depend on the threads)
@@ -134,32 +135,34 @@ def _gnomonic(dirs, axis, u, v, p, q):
 
 
 @njit(nogil=True, cache=True, inline="always")
-def bin_key(i, j, tiles_per_side, tile):
-    """Sort key of bin (i, j): bins are numbered tile by tile, rows within a tile,
-    so a tile's rays are contiguous and so is each of its rows."""
-    return ((j // tile) * tiles_per_side + i // tile) * tile * tile + (j % tile) * tile + i % tile
+def bin_key(i, j, tiles_per_side, shift):
+    """Sort key of bin (i, j) with tiles of ``1 << shift`` bins a side: bins are
+    numbered tile by tile, rows within a tile, so a tile's rays are contiguous and
+    so is each of its rows. (Shifts, not divisions: several times faster here.)"""
+    mask = (1 << shift) - 1
+    return ((((j >> shift) * tiles_per_side + (i >> shift)) << shift | (j & mask)) << shift) | (i & mask)
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def _bin_keys(p, q, grid, nb, tile, key_of, bin_of):
-    nt = -(-nb // tile)
+def _bin_keys(p, q, grid, nb, shift, key_of, bin_of):
+    nt = -(-nb >> shift)
     for r in prange(p.shape[0]):
         i = min(nb - 1, max(0, np.int64((p[r] - grid[0]) / grid[1])))
         j = min(nb - 1, max(0, np.int64((q[r] - grid[2]) / grid[3])))
-        key_of[r] = bin_key(i, j, nt, tile)
+        key_of[r] = bin_key(i, j, nt, shift)
         bin_of[r] = np.uint32(i | (j << 16))
 
 
 @njit(nogil=True, cache=True)
-def _sort_into_bins(p, q, grid, nb, tile):
+def _sort_into_bins(p, q, grid, nb, shift):
     """(starts, order, bins): counting sort of the rays by ``bin_key``; ``bins`` holds
     each sorted ray's bin as ``i | j << 16``."""
     n = p.shape[0]
-    nt = -(-nb // tile)
+    nt = -(-nb >> shift)
     key_of = np.empty(n, np.int64)
     bin_of = np.empty(n, np.uint32)
-    _bin_keys(p, q, grid, nb, tile, key_of, bin_of)
-    starts = np.zeros(nt * nt * tile * tile + 1, np.int64)
+    _bin_keys(p, q, grid, nb, shift, key_of, bin_of)
+    starts = np.zeros((nt * nt << 2 * shift) + 1, np.int64)
     for r in range(n):
         starts[key_of[r] + 1] += 1
     for b in range(starts.shape[0] - 1):
@@ -203,7 +206,7 @@ def ray_grid(dirs, axis, u, v, nb):
                            qmin, (qmax - qmin) / nb if qmax > qmin else 1.0])
 
 
-def sort_rays(p, q, grid, nb, tile, orig, dirs, lo, hi):
+def sort_rays(p, q, grid, nb, shift, orig, dirs, lo, hi):
     """Rays in bin order: (starts, order, bins, rays, exits).
 
     The rays of the bin with key ``b`` (``bin_key``) are sorted positions
@@ -212,7 +215,7 @@ def sort_rays(p, q, grid, nb, tile, orig, dirs, lo, hi):
     where it leaves the occupied box [lo, hi) (every voxel hit comes before it).
     """
     n = len(p)
-    starts, order, bins = _sort_into_bins(p, q, grid, nb, tile)
+    starts, order, bins = _sort_into_bins(p, q, grid, nb, shift)
     rays, exits = np.empty((n, 6)), np.empty(n)
     _gather(order, orig, dirs, lo, hi, rays, exits)
     return starts, order, bins, rays, exits
@@ -384,8 +387,8 @@ def emit_voxels(bricks_found, brick_near, first, bricks, centre, grow, axis, u, 
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def voxels_per_tile(vox, tiles_per_side, tile):
-    """For each tile of ``tile`` x ``tile`` bins, the voxels covering it, in list order (CSR).
+def voxels_per_tile(vox, tiles_per_side, shift):
+    """For each tile of ``1 << shift`` bins a side, the voxels covering it, in list order (CSR).
 
     A counting sort in runs of voxels: each run counts and then places its own
     entries, after those of the runs before it, so list order is kept (and does
@@ -394,30 +397,30 @@ def voxels_per_tile(vox, tiles_per_side, tile):
     nt = tiles_per_side
     n = vox.shape[0]
     runs = max(2, min(PARTS, (1 << 18) // (nt * nt)))
-    counts = np.zeros((nt * nt, runs), np.int64)
+    counts = np.zeros((runs, nt * nt), np.int64)  # each run counts in its own row
     for k in prange(runs):
         for e in range(k * n // runs, (k + 1) * n // runs):
             if vox[e, 3] > vox[e, 4]:
                 continue
-            for tj in range(vox[e, 5] // tile, vox[e, 6] // tile + 1):
-                for ti in range(vox[e, 3] // tile, vox[e, 4] // tile + 1):
-                    counts[tj * nt + ti, k] += 1
+            for tj in range(vox[e, 5] >> shift, (vox[e, 6] >> shift) + 1):
+                for ti in range(vox[e, 3] >> shift, (vox[e, 4] >> shift) + 1):
+                    counts[k, tj * nt + ti] += 1
     starts = np.zeros(nt * nt + 1, np.int64)
     at = 0
     for b in range(nt * nt):  # runs' places within each tile, tile after tile
         starts[b] = at
         for k in range(runs):
-            counts[b, k], at = at, at + counts[b, k]
+            counts[k, b], at = at, at + counts[k, b]
     starts[nt * nt] = at
     listed = np.empty(at, np.int64)
     for k in prange(runs):
         for e in range(k * n // runs, (k + 1) * n // runs):
             if vox[e, 3] > vox[e, 4]:
                 continue
-            for tj in range(vox[e, 5] // tile, vox[e, 6] // tile + 1):
-                for ti in range(vox[e, 3] // tile, vox[e, 4] // tile + 1):
-                    listed[counts[tj * nt + ti, k]] = e
-                    counts[tj * nt + ti, k] += 1
+            for tj in range(vox[e, 5] >> shift, (vox[e, 6] >> shift) + 1):
+                for ti in range(vox[e, 3] >> shift, (vox[e, 4] >> shift) + 1):
+                    listed[counts[k, tj * nt + ti]] = e
+                    counts[k, tj * nt + ti] += 1
     return starts, listed
 
 
@@ -461,8 +464,8 @@ def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, 
             x, y, z = np.float64(vox[q, 0]), np.float64(vox[q, 1]), np.float64(vox[q, 2])
             i0, i1 = max(vox[q, 3], bi0), min(vox[q, 4], bi1)
             for bj in range(max(vox[q, 5], bj0), min(vox[q, 6], bj1) + 1):
-                for s in range(bin_starts[bin_key(i0, bj, nt, TILE)],
-                               bin_starts[bin_key(i1, bj, nt, TILE) + 1]):
+                for s in range(bin_starts[bin_key(i0, bj, nt, TILE_SHIFT)],
+                               bin_starts[bin_key(i1, bj, nt, TILE_SHIFT) + 1]):
                     best = best_t[s]
                     if best <= near:
                         continue
@@ -527,13 +530,13 @@ class Scan(NamedTuple):
     tile_starts: np.ndarray
     listed: np.ndarray
     nb: int
-    tile: int
+    tile_shift: int
     tiles_per_side: int
 
 
-def prepare_scan(occ, orig, dirs, frame, max_voxels, tile=TILE):
+def prepare_scan(occ, orig, dirs, frame, max_voxels, tile_shift=TILE_SHIFT):
     """A scan's rays binned and sorted, and its voxels in view listed per tile of
-    ``tile`` x ``tile`` bins; None when it cannot be projected (a brick straddles
+    ``1 << tile_shift`` bins a side; None when it cannot be projected (a brick straddles
     the aircraft's plane) or when more than ``max_voxels`` occupied voxels are in
     view (ray order is then the cheaper way)."""
     centre, grow, axis, u, v = frame
@@ -549,15 +552,15 @@ def prepare_scan(occ, orig, dirs, frame, max_voxels, tile=TILE):
     first = voxel_starts(found, occ.bricks) if ok else None
     if not ok or first[-1] > max_voxels:
         return None
-    bin_starts, order, bins, rays, exits = sort_rays(p, q, grid, nb, tile, orig, dirs,
+    bin_starts, order, bins, rays, exits = sort_rays(p, q, grid, nb, tile_shift, orig, dirs,
                                                      occ.bbox_lo.astype(np.float64),
                                                      occ.bbox_hi.astype(np.float64))
     vox, nears = emit_voxels(found, brick_near, first, occ.bricks, centre, grow, axis, u, v, grid,
                              nb)
-    tiles_per_side = -(-nb // tile)
-    tile_starts, listed = voxels_per_tile(vox, tiles_per_side, tile)
-    return Scan(order, rays, bins, exits, bin_starts, vox, nears, tile_starts, listed, nb, tile,
-                tiles_per_side)
+    tiles_per_side = -(-nb >> tile_shift)
+    tile_starts, listed = voxels_per_tile(vox, tiles_per_side, tile_shift)
+    return Scan(order, rays, bins, exits, bin_starts, vox, nears, tile_starts, listed, nb,
+                tile_shift, tiles_per_side)
 
 
 def nearest_voxels(occ, orig, dirs, frame, max_voxels):

@@ -83,9 +83,9 @@ CUT = 4
 # Samples a ray per march pass: well under lavapipe's 65,535 loop iterations
 # per invocation, all loops together.
 MARCH_SAMPLES_PER_PASS = 1 << 15
-# Object order (shaders/object_order.wgsl): bins per tile side. Small tiles keep each
+# Object order (shaders/object_order.wgsl): tiles of 2 x 2 bins. Small tiles keep each
 # ray's list short; the shader pays for every entry a ray walks past.
-OBJECT_ORDER_TILE = 2
+OBJECT_ORDER_TILE_SHIFT = 1
 # Longest tile list an invocation may walk: under lavapipe's 65,535 loop iterations.
 LOOP_BUDGET = 65_000
 
@@ -548,7 +548,7 @@ class WgpuBackend:
         (or its lists or arrays exceed what the adapter allows)."""
         frame = cone_frame(origins, directions)
         scan = None if frame is None else prepare_scan(occupancy, origins, directions, frame,
-                                                       max_voxels, OBJECT_ORDER_TILE)
+                                                       max_voxels, OBJECT_ORDER_TILE_SHIFT)
         if scan is None or np.diff(scan.tile_starts).max(initial=0) >= LOOP_BUDGET:
             return False
         found = self._test_tiles(scan)
@@ -578,7 +578,7 @@ class WgpuBackend:
         buffers["params"] = self._scan_buffer("params", 16, uniform=True)
         queue = self._device.queue
         queue.write_buffer(buffers["params"], 0,
-                           np.array([n, scan.tile, scan.tiles_per_side, 0], dtype=np.uint32))
+                           np.array([n, scan.tile_shift, scan.tiles_per_side, 0], dtype=np.uint32))
         for name, array in inputs.items():
             if array.nbytes:
                 queue.write_buffer(buffers[name], 0, np.ascontiguousarray(array))
