@@ -9,7 +9,7 @@ import pytest
 from ladartui.scene.occupancy import Occupancy
 from ladartui.sensor import Sensor
 from ladartui.tracing.backend import GROUND, MISS, VOXEL
-from ladartui.tracing.object_order import voxel_words
+from ladartui.tracing.object_order import shader_voxels
 from ladartui.tracing.reference import reference_trace_cells
 from scans import assert_same, forest_scene, one_scan
 
@@ -132,6 +132,12 @@ def test_ray_order_where_object_order_cannot_run(forest, f64_backend, numba_back
     assert long_lists.info["order"] == "ray"
     assert_same(expected, long_lists)
     monkeypatch.undo()
+    # A scene too large for float32 voxel coordinates.
+    monkeypatch.setattr(module, "F32_EXACT", max(occ.shape))
+    large = f64_backend.trace_cells(occ, origins, directions, object_order=True)
+    assert large.info["order"] == "ray"
+    assert_same(expected, large)
+    monkeypatch.undo()
     # Origins scattered over the scene: no scan.
     rng = np.random.default_rng(3)
     scattered = rng.uniform([0, 0, 80], [240, 240, 120], size=(5000, 3))
@@ -158,17 +164,15 @@ def test_order_is_learned_per_occupancy(forest, f64_backend, numba_backend):
     assert seen == {"object", "ray"}
 
 
-def test_voxel_words_round_the_nears_down():
+def test_shader_voxels_round_the_brick_nears_down():
     rng = np.random.default_rng(8)
     m = 2000
     vox = np.zeros((m, 7), np.int64)
-    vox[:, :3] = rng.integers(-5000, 5000, (m, 3))
-    vox[:, 3:7] = rng.integers(0, 65536, (m, 4))
+    vox[:, :3] = rng.integers(-(1 << 24) + 1, 1 << 24, (m, 3))
     nears = rng.uniform(-1e-6, 1e5, (m, 2)) * rng.choice([1.0, 1e-6], (m, 2))
-    words = voxel_words(vox, nears)
-    lows = words[:, 2:4].view(np.float32).astype(np.float64)
-    assert (lows <= nears).all()
-    assert (np.nextafter(lows.astype(np.float32), np.float32(np.inf)) >= nears).all()
-    assert np.array_equal(words[:, 0] & 0xFFFF, vox[:, 3]) and np.array_equal(words[:, 0] >> 16, vox[:, 4])
-    assert np.array_equal(words[:, 1] & 0xFFFF, vox[:, 5]) and np.array_equal(words[:, 1] >> 16, vox[:, 6])
-    assert np.array_equal(words[:, 4:7].view(np.int32), vox[:, :3])
+    records = shader_voxels(vox, nears)
+    low = records[:, 0].astype(np.float64)
+    assert (low <= nears[:, 1]).all()
+    assert (np.nextafter(records[:, 0], np.float32(np.inf)).astype(np.float64) >= nears[:, 1]).all()
+    assert (low < nears[:, 1]).any()  # some did need rounding down
+    assert np.array_equal(records[:, 1:].astype(np.int64), vox[:, :3])

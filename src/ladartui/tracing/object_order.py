@@ -493,21 +493,16 @@ def _f32_below(x):
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def voxel_words(vox, nears):
-    """The voxels in view as shaders/object_order.wgsl reads them, two u32 vec4 each:
-    (i0 | i1 << 16, j0 | j1 << 16, near, brick's near) with the nears as float32
-    rounded down, then (x, y, z, 0)."""
+def shader_voxels(vox, nears):
+    """The voxels in view as shaders/object_order.wgsl reads them: float32 (brick's
+    near rounded down, x, y, z) per voxel. Exact for coordinates below 2**24."""
     m = vox.shape[0]
-    words = np.zeros((m, 8), np.uint32)
-    reals = words.view(np.float32)
+    out = np.empty((m, 4), np.float32)
     for e in prange(m):
-        words[e, 0] = np.uint32(vox[e, 3] & 0xFFFF) | np.uint32((vox[e, 4] & 0xFFFF) << 16)
-        words[e, 1] = np.uint32(vox[e, 5] & 0xFFFF) | np.uint32((vox[e, 6] & 0xFFFF) << 16)
-        reals[e, 2] = _f32_below(nears[e, 0])
-        reals[e, 3] = _f32_below(nears[e, 1])
+        out[e, 0] = _f32_below(nears[e, 1])
         for a in range(3):
-            words[e, 4 + a] = np.uint32(vox[e, a] & 0xFFFFFFFF)
-    return words
+            out[e, 1 + a] = np.float32(vox[e, a])
+    return out
 
 
 class Scan(NamedTuple):

@@ -56,7 +56,7 @@ from ladartui.errors import BackendUnavailable, Cancelled, FieldError
 from ladartui.tracing.backend import GROUND, METHODS, MISS, VOXEL, CellHits, register_backend
 from ladartui.tracing.bundle import bundle_starts, halo_arrays
 from ladartui.tracing.numba_backend import MIN_SCAN_RAYS, SCAN_BLOCK, VOXELS_PER_RAY, scan_answers
-from ladartui.tracing.object_order import OrderChoice, cone_frame, prepare_scan, voxel_words
+from ladartui.tracing.object_order import OrderChoice, cone_frame, prepare_scan, shader_voxels
 
 NAME = "wgpu"
 
@@ -86,6 +86,7 @@ MARCH_SAMPLES_PER_PASS = 1 << 15
 # Object order (shaders/object_order.wgsl): tiles of 2 x 2 bins. Small tiles keep each
 # ray's list short; the shader pays for every entry a ray walks past.
 OBJECT_ORDER_TILE_SHIFT = 1
+F32_EXACT = 1 << 24  # integers below this are exact in float32
 # Longest tile list an invocation may walk: under lavapipe's 65,535 loop iterations.
 LOOP_BUDGET = 65_000
 
@@ -547,6 +548,8 @@ class WgpuBackend:
         """One scan in object order into kind/index/t; False when it is no scan for it
         (or its lists or arrays exceed what the adapter allows)."""
         frame = cone_frame(origins, directions)
+        if max(occupancy.shape) >= F32_EXACT:
+            frame = None  # voxel coordinates go to the shader as float32
         scan = None if frame is None else prepare_scan(occupancy, origins, directions, frame,
                                                        max_voxels, OBJECT_ORDER_TILE_SHIFT)
         if scan is None or np.diff(scan.tile_starts).max(initial=0) >= LOOP_BUDGET:
@@ -566,7 +569,7 @@ class WgpuBackend:
             "rays": scan.rays,
             "bins": scan.bins,
             "best_t": np.clip(scan.exits, -SHADER_INF, SHADER_INF),  # the shader has no infinity
-            "voxels": voxel_words(scan.vox, scan.nears),
+            "voxels": shader_voxels(scan.vox, scan.nears),
             "tile_starts": scan.tile_starts.astype(np.uint32),
             "listed": scan.listed.astype(np.uint32),
         }
