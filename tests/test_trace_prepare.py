@@ -29,3 +29,17 @@ def test_first_bad_ray_is_named():
     origins[1, 2] = 0.0
     directions[0, 1] = np.inf
     assert rays_to_cells(origins, directions, 1.0, TINY)[1] == ("directions", 0)
+
+
+def test_a_bad_ray_anywhere_in_a_large_batch_is_found():
+    # The parallel pass runs in 64 parts: a bad ray in any one of them is noticed.
+    rng = np.random.default_rng(3)
+    origins = rng.uniform(-100, 100, (100_000, 3))
+    directions = rng.normal(size=(100_000, 3))
+    for bad in (0, 77_777, 99_999):
+        broken = directions.copy()
+        broken[bad] = 0.0
+        assert rays_to_cells(origins, broken, 0.5, TINY)[1] == ("zero", bad)
+        broken = origins.copy()
+        broken[bad, 1] = -np.inf
+        assert rays_to_cells(broken, directions, 0.5, TINY)[1] == ("origins", bad)
