@@ -243,16 +243,17 @@ def _print_table(report):
     for name in ("backend", "method", "depr.", "order", "rays/s", "x numba", "rays/CPU-s",
                  "voxel", "ground"):
         table.add_column(name, no_wrap=True, min_width=len(name))
-    table.add_column("device", no_wrap=True, overflow="ellipsis", max_width=12)
+    devices = {}
     for row in report["results"]:
         per_cpu = row["rays_per_cpu_second"]
+        devices[row["backend"]] = row["device"]
         table.add_row(row["backend"], row["method"], f"{row['depression']:g}", row["order"],
                       f"{row['rays_per_second'] / 1e6:.2f} M",
                       f"{row['vs_numba']:.2f}" if row.get("vs_numba") is not None else "-",
                       f"{per_cpu / 1e6:.2f} M" if per_cpu else "-",
-                      f"{row['voxel_hits']:.1%}",
-                      f"{row['ground_hits']:.1%}", str(row["device"]))
+                      f"{row['voxel_hits']:.1%}", f"{row['ground_hits']:.1%}")
     console.print(table)
+    console.print("devices: " + "; ".join(f"{name} {device}" for name, device in devices.items()))
     for name, status in report["backends"].items():
         if status != "available":
             console.print(f"[dim]{name}: {status}[/dim]")
