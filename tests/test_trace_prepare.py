@@ -43,3 +43,23 @@ def test_a_bad_ray_anywhere_in_a_large_batch_is_found():
         broken = origins.copy()
         broken[bad, 1] = -np.inf
         assert rays_to_cells(broken, directions, 0.5, TINY)[1] == ("origins", bad)
+
+
+def test_huge_and_tiny_directions_keep_their_direction():
+    # Their squares over- or underflow: scaled by the largest component first, they
+    # give the unit vector of the same direction (here bit for bit).
+    plain = np.array([[1.0, 1.0, -1.0], [3.0, 0.0, -4.0]])
+    for factor in (1e160, 1e300, 1e-170, 1e-300):
+        _, unit = rays_to_cells(np.zeros((2, 3)), plain * factor, 1.0, TINY)
+        assert np.array_equal(unit, plain / np.linalg.norm(plain, axis=1)[:, None]), factor
+    _, unit = rays_to_cells(np.zeros((1, 3)), np.array([[0.0, 0.0, -5e-324]]), 1.0, TINY)
+    assert unit.tolist() == [[0.0, 0.0, -1.0]]  # the smallest float is still a direction
+
+
+def test_a_huge_direction_is_traced_where_it_points():
+    from ladartui.scene.occupancy import Occupancy
+    from ladartui.tracing import trace
+
+    occ = Occupancy.build(np.array([[5, 5, 2]]), (16, 16, 8))
+    down = trace(occ, [[5.0, 5.0, 7.0]], [[0.0, 0.0, -1e200]], backend="numba")  # cell centre
+    assert down.kind[0] == 1 and down.index[0].tolist() == [5, 5, 2]

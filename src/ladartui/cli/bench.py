@@ -189,7 +189,7 @@ def run_bench(quick=False, runs=None) -> dict:
             # other backend's data should not be in the caches of the timed one.
             times = {name: [] for name in backends}
             cpu = {name: [] for name in backends}
-            last_order = {}
+            orders = {name: set() for name in backends}  # over the timed runs
             for _ in range(runs):
                 for name in backends:
                     trace(occupancy, origins, directions, backend=name, **kwargs)
@@ -197,7 +197,7 @@ def run_bench(quick=False, runs=None) -> dict:
                     t = time.perf_counter()
                     timed = trace(occupancy, origins, directions, backend=name, **kwargs)
                     times[name].append(time.perf_counter() - t)
-                    last_order[name] = timed.info.get("order", "ray")
+                    orders[name].add(timed.info.get("order", "ray"))
                     cpu[name].append(time.process_time() - c)
             for name, backend in backends.items():
                 median = statistics.median(times[name])
@@ -213,7 +213,7 @@ def run_bench(quick=False, runs=None) -> dict:
                     "rays_per_cpu_second": len(origins) / cpu_median if cpu_median > 0 else None,
                     "voxel_hits": float(np.mean(result.kind == 1)),
                     "ground_hits": float(np.mean(result.kind == 2)),
-                    "order": last_order[name],
+                    "order": "/".join(sorted(orders[name])),
                     "device": backend.describe().get("adapter") or "cpu"})
     _add_ratios(report["results"])
     return report
@@ -247,13 +247,15 @@ def _print_table(report):
     for row in report["results"]:
         per_cpu = row["rays_per_cpu_second"]
         devices[row["backend"]] = row["device"]
-        table.add_row(row["backend"], row["method"], f"{row['depression']:g}", row["order"],
+        table.add_row(row["backend"], row["method"], f"{row['depression']:g}",
+                      row["order"].replace("object", "obj"),
                       f"{row['rays_per_second'] / 1e6:.2f} M",
                       f"{row['vs_numba']:.2f}" if row.get("vs_numba") is not None else "-",
                       f"{per_cpu / 1e6:.2f} M" if per_cpu else "-",
                       f"{row['voxel_hits']:.1%}", f"{row['ground_hits']:.1%}")
     console.print(table)
-    console.print("devices: " + "; ".join(f"{name} {device}" for name, device in devices.items()))
+    console.print("order: obj object, ray ray order (several: the timed runs differed); devices: "
+                  + "; ".join(f"{name} {device}" for name, device in devices.items()))
     for name, status in report["backends"].items():
         if status != "available":
             console.print(f"[dim]{name}: {status}[/dim]")

@@ -12,11 +12,29 @@ import numpy as np
 from numba import prange
 
 PARTS = 64  # fixed runs of rays for the parallel pass
+# Outside (NORM_LOW, inf) the squares under- or overflow: such directions are
+# scaled by their largest component first (1e160 along x is still along x).
+NORM_LOW = 1e-150
+
+
+@numba.njit(nogil=True, cache=True, inline="always")
+def _scale_and_norm(dx, dy, dz):
+    """(scale, norm): the unit direction is (d / scale) / norm. scale is 1 (and the
+    bits those of d / sqrt(d.d)) unless d.d under- or overflows; norm 0: no direction."""
+    norm = np.sqrt(dx * dx + dy * dy + dz * dz)
+    if NORM_LOW < norm < np.inf:
+        return 1.0, norm
+    m = max(abs(dx), abs(dy), abs(dz))
+    if not 0.0 < m < np.inf:
+        return 1.0, norm
+    dx, dy, dz = dx / m, dy / m, dz / m
+    return m, np.sqrt(dx * dx + dy * dy + dz * dz)
 
 
 @numba.njit(nogil=True, cache=True)
 def _rays_to_cells(origins, directions, voxel_size, tiny, cells, unit):
-    """cells = o / voxel_size + 0.5; unit = d / sqrt(dx*dx + dy*dy + dz*dz), |u| < tiny -> 0.
+    """cells = o / voxel_size + 0.5; unit = d / sqrt(dx*dx + dy*dy + dz*dz), |u| < tiny -> 0
+    (d scaled first where its squares would under- or overflow).
 
     Returns the first ray with a non-finite value (-1 - i for an origin, i for
     a direction) or with a zero-length direction (n + 1 + i); n when all are good.
@@ -28,13 +46,12 @@ def _rays_to_cells(origins, directions, voxel_size, tiny, cells, unit):
                 return -1 - i
             if not np.isfinite(directions[i, a]):
                 return i
-        dx, dy, dz = directions[i, 0], directions[i, 1], directions[i, 2]
-        norm = np.sqrt(dx * dx + dy * dy + dz * dz)
+        scale, norm = _scale_and_norm(directions[i, 0], directions[i, 1], directions[i, 2])
         if not norm > 0:
             return n + 1 + i
         for a in range(3):
             cells[i, a] = origins[i, a] / voxel_size + 0.5
-            u = directions[i, a] / norm
+            u = directions[i, a] / scale / norm
             unit[i, a] = 0.0 if abs(u) < tiny else u
     return n
 
@@ -47,15 +64,14 @@ def _rays_to_cells_parallel(origins, directions, voxel_size, tiny, cells, unit):
     bad = np.zeros(PARTS, np.bool_)
     for k in prange(PARTS):
         for i in range(k * n // PARTS, (k + 1) * n // PARTS):
-            dx, dy, dz = directions[i, 0], directions[i, 1], directions[i, 2]
-            norm = np.sqrt(dx * dx + dy * dy + dz * dz)
+            scale, norm = _scale_and_norm(directions[i, 0], directions[i, 1], directions[i, 2])
             if not norm > 0:
                 bad[k] = True
             for a in range(3):
                 if not (np.isfinite(origins[i, a]) and np.isfinite(directions[i, a])):
                     bad[k] = True
                 cells[i, a] = origins[i, a] / voxel_size + 0.5
-                u = directions[i, a] / norm
+                u = directions[i, a] / scale / norm
                 unit[i, a] = 0.0 if abs(u) < tiny else u
     return not bad.any()
 

@@ -575,7 +575,7 @@ class WgpuBackend:
         }
         sizes = {name: array.nbytes for name, array in inputs.items()}
         sizes["best_v"] = 4 * n
-        if max(sizes.values()) > self._limits["max-storage-buffer-binding-size"]:
+        if max(sizes.values()) > self._scan_buffer_limit():
             return None
         buffers = {name: self._scan_buffer(name, size) for name, size in sizes.items()}
         buffers["params"] = self._scan_buffer("params", 16, uniform=True)
@@ -606,6 +606,9 @@ class WgpuBackend:
         best_v = np.frombuffer(queue.read_buffer(buffers["best_v"], 0, 4 * n), dtype=np.int32)
         return best_t, best_v
 
+    def _scan_buffer_limit(self):
+        return min(self._limits["max-storage-buffer-binding-size"], self._limits["max-buffer-size"])
+
     def _scan_buffer(self, name, size, uniform=False):
         """A buffer of at least ``size`` bytes for object order, kept for later scans."""
         import wgpu
@@ -614,7 +617,9 @@ class WgpuBackend:
         if buffer is None or buffer.size < size:
             usage = (wgpu.BufferUsage.UNIFORM if uniform else
                      wgpu.BufferUsage.STORAGE | wgpu.BufferUsage.COPY_SRC) | wgpu.BufferUsage.COPY_DST
-            size = max(16, 1 << (max(size, 1) - 1).bit_length())  # room to grow
+            # Room to grow, within the limits (which need not be powers of two).
+            size = max(16, min(1 << (max(size, 1) - 1).bit_length(),
+                               self._scan_buffer_limit() // 4 * 4))
             buffer = self._device.create_buffer(label=f"scan-{name}", size=size, usage=usage)
             self._scan_buffers[name] = buffer
         return buffer
