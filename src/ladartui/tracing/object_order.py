@@ -231,16 +231,25 @@ def box_bins(x0, y0, z0, size, centre, grow, axis, u, v, grid, nb):
     """
     pl, ph, ql, qh, near = INF, -INF, INF, -INF, INF
     behind = 0
+    # Corner k is the low corner plus the edges picked by k's bits: its depth and
+    # projections are the low corner's plus those of the edges (rounding far below EPS).
+    lx, ly, lz = x0 - grow[0] - centre[0], y0 - grow[1] - centre[1], z0 - grow[2] - centre[2]
+    ex, ey, ez = size + 2.0 * grow[0], size + 2.0 * grow[1], size + 2.0 * grow[2]
+    w0 = lx * axis[0] + ly * axis[1] + lz * axis[2]
+    p0 = lx * u[0] + ly * u[1] + lz * u[2]
+    q0 = lx * v[0] + ly * v[1] + lz * v[2]
     for k in range(8):
-        rx = (x0 + size + grow[0] if k & 1 else x0 - grow[0]) - centre[0]
-        ry = (y0 + size + grow[1] if k & 2 else y0 - grow[1]) - centre[1]
-        rz = (z0 + size + grow[2] if k & 4 else z0 - grow[2]) - centre[2]
-        w = rx * axis[0] + ry * axis[1] + rz * axis[2]
+        w, pn, qn = w0, p0, q0
+        if k & 1:
+            w, pn, qn = w + ex * axis[0], pn + ex * u[0], qn + ex * v[0]
+        if k & 2:
+            w, pn, qn = w + ey * axis[1], pn + ey * u[1], qn + ey * v[1]
+        if k & 4:
+            w, pn, qn = w + ez * axis[2], pn + ez * u[2], qn + ez * v[2]
         if not w > 0.0:
             behind += 1
             continue
-        pp = (rx * u[0] + ry * u[1] + rz * u[2]) / w
-        qq = (rx * v[0] + ry * v[1] + rz * v[2]) / w
+        pp, qq = pn / w, qn / w
         pl, ph, ql, qh, near = min(pl, pp), max(ph, pp), min(ql, qq), max(qh, qq), min(near, w)
     if behind == 8:
         return 0, -1, 0, -1, 0, 0.0
