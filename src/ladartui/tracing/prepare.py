@@ -18,17 +18,18 @@ NORM_LOW = 1e-150
 
 
 @numba.njit(nogil=True, cache=True, inline="always")
-def _scale_and_norm(dx, dy, dz):
-    """(scale, norm): the unit direction is (d / scale) / norm. scale is 1 (and the
-    bits those of d / sqrt(d.d)) unless d.d under- or overflows; norm 0: no direction."""
+def _scaled(dx, dy, dz):
+    """(dx, dy, dz, norm) with unit direction d / norm: d itself (so the bits of
+    d / sqrt(d.d)) unless d.d under- or overflows, then d over its largest
+    component; norm 0: no direction."""
     norm = np.sqrt(dx * dx + dy * dy + dz * dz)
     if NORM_LOW < norm < np.inf:
-        return 1.0, norm
+        return dx, dy, dz, norm
     m = max(abs(dx), abs(dy), abs(dz))
     if not 0.0 < m < np.inf:
-        return 1.0, norm
+        return dx, dy, dz, norm
     dx, dy, dz = dx / m, dy / m, dz / m
-    return m, np.sqrt(dx * dx + dy * dy + dz * dz)
+    return dx, dy, dz, np.sqrt(dx * dx + dy * dy + dz * dz)
 
 
 @numba.njit(nogil=True, cache=True)
@@ -46,12 +47,12 @@ def _rays_to_cells(origins, directions, voxel_size, tiny, cells, unit):
                 return -1 - i
             if not np.isfinite(directions[i, a]):
                 return i
-        scale, norm = _scale_and_norm(directions[i, 0], directions[i, 1], directions[i, 2])
-        if not norm > 0:
+        d = _scaled(directions[i, 0], directions[i, 1], directions[i, 2])
+        if not d[3] > 0:
             return n + 1 + i
         for a in range(3):
             cells[i, a] = origins[i, a] / voxel_size + 0.5
-            u = directions[i, a] / scale / norm
+            u = d[a] / d[3]
             unit[i, a] = 0.0 if abs(u) < tiny else u
     return n
 
@@ -64,14 +65,14 @@ def _rays_to_cells_parallel(origins, directions, voxel_size, tiny, cells, unit):
     bad = np.zeros(PARTS, np.bool_)
     for k in prange(PARTS):
         for i in range(k * n // PARTS, (k + 1) * n // PARTS):
-            scale, norm = _scale_and_norm(directions[i, 0], directions[i, 1], directions[i, 2])
-            if not norm > 0:
+            d = _scaled(directions[i, 0], directions[i, 1], directions[i, 2])
+            if not d[3] > 0:
                 bad[k] = True
             for a in range(3):
                 if not (np.isfinite(origins[i, a]) and np.isfinite(directions[i, a])):
                     bad[k] = True
                 cells[i, a] = origins[i, a] / voxel_size + 0.5
-                u = directions[i, a] / scale / norm
+                u = d[a] / d[3]
                 unit[i, a] = 0.0 if abs(u) < tiny else u
     return not bad.any()
 
