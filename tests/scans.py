@@ -32,3 +32,20 @@ def assert_same(a, b):
     assert np.array_equal(a.kind, b.kind), np.flatnonzero(a.kind != b.kind)[:5]
     assert np.array_equal(a.index, b.index), np.flatnonzero((a.index != b.index).any(axis=1))[:5]
     assert np.array_equal(a.t, b.t), np.flatnonzero(a.t != b.t)[:5]
+
+
+def random_scan(rng, jitter, n=3000):
+    """A random scene and a fan of ``n`` rays within 20 degrees of a downward axis from
+    60-400 cells away, origins jittered by up to ``jitter`` cell: (voxels, shape,
+    occupancy, origins, directions)."""
+    shape = tuple(int(v) for v in rng.integers(20, 70, size=3))
+    voxels = rng.integers(0, shape, size=(int(rng.integers(1, 4000)), 3))
+    axis = rng.normal(size=3)
+    axis[2] = -abs(axis[2]) - 0.2
+    axis /= np.linalg.norm(axis)
+    start = rng.uniform(0, 1, 3) * shape - axis * rng.uniform(60, 400)
+    spread = rng.normal(size=(n, 3)) * math.tan(math.radians(rng.uniform(1, 20)))
+    directions = axis + spread - np.outer(spread @ axis, axis)
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    origins = start + rng.uniform(-jitter, jitter, size=(n, 3))
+    return voxels, shape, Occupancy.build(voxels, shape), origins, directions

@@ -14,7 +14,7 @@ from ladartui.tracing.backend import GROUND, MISS, VOXEL
 from ladartui.tracing.numba_backend import NumbaBackend
 from ladartui.tracing.object_order import cone_frame
 from ladartui.tracing.reference import reference_trace_cells
-from scans import assert_same, forest_scene, one_scan
+from scans import assert_same, forest_scene, one_scan, random_scan
 
 
 @pytest.fixture(scope="module")
@@ -79,27 +79,13 @@ def test_origins_spread_over_the_focal_plane_are_covered(forest, numba_backend):
 def test_random_scenes_and_jittered_origins(numba_backend):
     rng = np.random.default_rng(11)
     for trial in range(12):
-        shape = tuple(int(v) for v in rng.integers(20, 70, size=3))
-        count = int(rng.integers(1, 4000))
-        vox = rng.integers(0, shape, size=(count, 3))
-        occ = Occupancy.build(vox, shape)
-        centre = rng.uniform(0, 1, 3) * shape
-        axis = rng.normal(size=3)
-        axis[2] = -abs(axis[2]) - 0.2
-        axis /= np.linalg.norm(axis)
-        start = centre - axis * rng.uniform(60, 400)
-        # A fan of rays within 20 degrees of the axis, origins jittered by up to 0.4 cell.
-        n = 3000
-        spread = rng.normal(size=(n, 3)) * math.tan(math.radians(rng.uniform(1, 20)))
-        directions = axis + spread - np.outer(spread @ axis, axis)
-        directions /= np.linalg.norm(directions, axis=1, keepdims=True)
-        origins = start + rng.uniform(-0.4, 0.4, size=(n, 3))
+        vox, shape, occ, origins, directions = random_scan(rng, 0.4)
         if trial % 3 == 0:
             origins = np.round(origins)  # on grid planes, edges and corners
         ray, obj = both_orders(numba_backend, occ, origins, directions)
         assert_same(ray, obj)
         if obj.info["order"] == "object":
-            pick = rng.choice(n, 200, replace=False)
+            pick = rng.choice(len(origins), 200, replace=False)
             ref = reference_trace_cells(vox, shape, origins[pick], directions[pick])
             assert np.array_equal(obj.t[pick], ref.t) and np.array_equal(obj.index[pick], ref.index)
 

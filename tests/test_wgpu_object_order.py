@@ -11,7 +11,7 @@ from ladartui.sensor import Sensor
 from ladartui.tracing.backend import GROUND, MISS, VOXEL
 from ladartui.tracing.object_order import shader_voxels
 from ladartui.tracing.reference import reference_trace_cells
-from scans import assert_same, forest_scene, one_scan
+from scans import assert_same, forest_scene, one_scan, random_scan
 
 # The wgpu_backend and numba_backend fixtures come from tests/conftest.py.
 
@@ -60,18 +60,7 @@ def test_a_wide_view_matches_the_reference(forest, f64_backend):
 def test_random_scenes_spread_origins_and_grid_planes(f64_backend, numba_backend):
     rng = np.random.default_rng(23)
     for trial in range(8):
-        shape = tuple(int(v) for v in rng.integers(20, 70, size=3))
-        vox = rng.integers(0, shape, size=(int(rng.integers(1, 4000)), 3))
-        occ = Occupancy.build(vox, shape)
-        axis = rng.normal(size=3)
-        axis[2] = -abs(axis[2]) - 0.2
-        axis /= np.linalg.norm(axis)
-        start = rng.uniform(0, 1, 3) * shape - axis * rng.uniform(60, 400)
-        n = 3000
-        spread = rng.normal(size=(n, 3)) * math.tan(math.radians(rng.uniform(1, 20)))
-        directions = axis + spread - np.outer(spread @ axis, axis)
-        directions /= np.linalg.norm(directions, axis=1, keepdims=True)
-        origins = start + rng.uniform(-0.9, 0.9, size=(n, 3))
+        _, _, occ, origins, directions = random_scan(rng, 0.9)
         if trial % 2 == 0:
             origins = np.round(origins)  # on grid planes, edges and corners
         gpu = gpu_object_order(f64_backend, occ, origins, directions)

@@ -20,17 +20,12 @@ from numba import njit, prange
 from ladartui.errors import Cancelled
 from ladartui.scene.occupancy import block_masks
 from ladartui.tracing.bundle import bundle_start, halo_arrays
-from ladartui.tracing.object_order import OrderChoice, cone_frame, nearest_voxels
+from ladartui.tracing.object_order import OrderChoice, cone_frame, nearest_voxels, trace_in_blocks
 from ladartui.tracing.axis import boundary_t, cell_at, clamp, slab
 from ladartui.tracing.backend import GROUND, MISS, VOXEL, CellHits, register_backend
 
 CHUNK = 64  # rays per prange work item: coherent neighbours stay on one thread
 BLOCK = 1 << 16  # rays per kernel call: cancel is checked between calls
-SCAN_BLOCK = 1 << 18  # rays per object-order call (one 512 x 512 scan)
-# Object order is used when at most this many occupied voxels per ray are in view
-# (more, and walking the rays is cheaper; see tracing.object_order).
-VOXELS_PER_RAY = 0.6
-MIN_SCAN_RAYS = 4096  # fewer rays: ray order, whose set-up is nil
 INF = np.inf
 
 
@@ -435,26 +430,8 @@ class NumbaBackend:
         halo = halo_arrays(occ) if bundles else halo_arrays(None)
         blocks = occ.blocks if getattr(occ, "blocks", None) is not None else block_masks(occ.bricks)
         started = time.perf_counter()
-        orders = set()
-        scans = method == "exact" and object_order is not False and occ.count > 0
-        for a in range(0, n, SCAN_BLOCK if scans else BLOCK):
-            b = min(n, a + (SCAN_BLOCK if scans else BLOCK))
-            choice = None
-            if scans and object_order is None and b - a >= MIN_SCAN_RAYS:
-                choice = self._orders.setdefault(occ, OrderChoice())
-            block_started = time.perf_counter()
-            if object_order or (choice is not None and choice.pick() == "object"):
-                if cancel is not None and cancel.is_set():
-                    raise Cancelled("trace cancelled")
-                limit = np.inf if object_order else VOXELS_PER_RAY * (b - a)
-                if self._object_order(occ, orig[a:b], dirs[a:b], limit, nx, ny, kind[a:b],
-                                      index[a:b], t[a:b]):
-                    orders.add("object")
-                    if choice is not None:
-                        choice.record("object", time.perf_counter() - block_started, b - a)
-                    continue
-                choice = None  # no scan for object order: nothing to learn from this block
-            orders.add("ray")
+
+        def ray_order(a, b):
             for c in range(a, b, BLOCK):
                 if cancel is not None and cancel.is_set():
                     raise Cancelled("trace cancelled")
@@ -467,8 +444,17 @@ class NumbaBackend:
                     _march_kernel(orig[c:d], dirs[c:d], float(step), float(occ.zmax), occ.root,
                                   occ.regions, occ.tiles, occ.bricks, lo, hi, rorg, rdims, nx, ny,
                                   kind[c:d], index[c:d], t[c:d])
-            if choice is not None:
-                choice.record("ray", time.perf_counter() - block_started, b - a)
+
+        def object_order_block(a, b, max_voxels):
+            return self._object_order(occ, orig[a:b], dirs[a:b], max_voxels, nx, ny, kind[a:b],
+                                      index[a:b], t[a:b])
+
+        if method == "exact" and object_order is not False and occ.count > 0:
+            orders = trace_in_blocks(n, object_order, self._orders.setdefault(occ, OrderChoice()),
+                                     object_order_block, ray_order, cancel)
+        else:
+            ray_order(0, n)
+            orders = {"ray"}
         info = {"seconds": time.perf_counter() - started, "precision": "f64",
                 "threads": numba.get_num_threads(), "order": "+".join(sorted(orders)) or "ray"}
         return CellHits(kind, index, t, info)

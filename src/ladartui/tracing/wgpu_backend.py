@@ -47,7 +47,6 @@ import os
 import stat
 import tempfile
 import threading
-import time
 import weakref
 
 import numpy as np
@@ -55,8 +54,9 @@ import numpy as np
 from ladartui.errors import BackendUnavailable, Cancelled, FieldError
 from ladartui.tracing.backend import GROUND, METHODS, MISS, VOXEL, CellHits, register_backend
 from ladartui.tracing.bundle import bundle_starts, halo_arrays
-from ladartui.tracing.numba_backend import MIN_SCAN_RAYS, SCAN_BLOCK, VOXELS_PER_RAY, scan_answers
-from ladartui.tracing.object_order import OrderChoice, cone_frame, prepare_scan, shader_voxels
+from ladartui.tracing.numba_backend import scan_answers
+from ladartui.tracing.object_order import (OrderChoice, cone_frame, prepare_scan, shader_voxels,
+                                           trace_in_blocks)
 
 NAME = "wgpu"
 
@@ -511,36 +511,23 @@ class WgpuBackend:
             return self._trace(occupancy, origins, directions, method, step, used, cancel, info)
 
     def _trace_scans(self, occupancy, origins, directions, object_order, cancel, info):
-        """Exact f64 in blocks of up to SCAN_BLOCK rays, each in object or ray order
-        (the numba backend's policy: tracing/numba_backend.py, trace_cells)."""
+        """Exact f64 in blocks, each in object or ray order (``trace_in_blocks``)."""
         n = len(origins)
         kind = np.zeros(n, dtype=np.uint8)
         index = np.full((n, 3), -1, dtype=np.int32)
         t = np.full(n, np.inf)
-        orders = set()
-        for a in range(0, n, SCAN_BLOCK):
-            b = min(n, a + SCAN_BLOCK)
-            if cancel is not None and cancel.is_set():
-                raise Cancelled("trace cancelled")
-            choice = None
-            if object_order is None and b - a >= MIN_SCAN_RAYS:
-                choice = self._orders.setdefault(occupancy, OrderChoice())
-            started = time.perf_counter()
-            if object_order or (choice is not None and choice.pick() == "object"):
-                limit = np.inf if object_order else VOXELS_PER_RAY * (b - a)
-                if self._object_order(occupancy, origins[a:b], directions[a:b], limit, kind[a:b],
-                                      index[a:b], t[a:b]):
-                    orders.add("object")
-                    if choice is not None:
-                        choice.record("object", time.perf_counter() - started, b - a)
-                    continue
-                choice = None  # no scan for object order: nothing to learn from this block
-            orders.add("ray")
+
+        def ray_order(a, b):
             hits = self._trace(occupancy, origins[a:b], directions[a:b], "exact", 0.5, "f64",
                                cancel, info)
             kind[a:b], index[a:b], t[a:b] = hits.kind, hits.index, hits.t
-            if choice is not None:
-                choice.record("ray", time.perf_counter() - started, b - a)
+
+        def object_order_block(a, b, max_voxels):
+            return self._object_order(occupancy, origins[a:b], directions[a:b], max_voxels,
+                                      kind[a:b], index[a:b], t[a:b])
+
+        orders = trace_in_blocks(n, object_order, self._orders.setdefault(occupancy, OrderChoice()),
+                                 object_order_block, ray_order, cancel)
         info["order"] = "+".join(sorted(orders)) or "ray"
         return CellHits(kind, index, t, info)
 
