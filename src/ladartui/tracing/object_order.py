@@ -403,6 +403,20 @@ def emit_voxels(bricks_found, brick_near, first, bricks, centre, grow, axis, u, 
     return vox, nears
 
 
+@njit(nogil=True, cache=True, inline="always")
+def _visit_tiles(vox, first, last, shift, nt, slots, listed, place):
+    """For voxels first..last, every tile each covers: count it in ``slots[tile]``, or
+    (``place``) put the voxel at ``listed[slots[tile]]`` and step that slot on."""
+    for e in range(first, last):
+        if vox[e, 3] > vox[e, 4]:
+            continue
+        for tj in range(vox[e, 5] >> shift, (vox[e, 6] >> shift) + 1):
+            for ti in range(vox[e, 3] >> shift, (vox[e, 4] >> shift) + 1):
+                if place:
+                    listed[slots[tj * nt + ti]] = e
+                slots[tj * nt + ti] += 1
+
+
 @njit(parallel=True, nogil=True, cache=True)
 def voxels_per_tile(vox, tiles_per_side, shift):
     """For each tile of ``1 << shift`` bins a side, the voxels covering it, in list order (CSR).
@@ -415,13 +429,9 @@ def voxels_per_tile(vox, tiles_per_side, shift):
     n = vox.shape[0]
     runs = max(2, min(PARTS, (1 << 18) // (nt * nt)))
     counts = np.zeros((runs, nt * nt), np.int64)  # each run counts in its own row
+    nothing = np.empty(0, np.int64)
     for k in prange(runs):
-        for e in range(k * n // runs, (k + 1) * n // runs):
-            if vox[e, 3] > vox[e, 4]:
-                continue
-            for tj in range(vox[e, 5] >> shift, (vox[e, 6] >> shift) + 1):
-                for ti in range(vox[e, 3] >> shift, (vox[e, 4] >> shift) + 1):
-                    counts[k, tj * nt + ti] += 1
+        _visit_tiles(vox, k * n // runs, (k + 1) * n // runs, shift, nt, counts[k], nothing, False)
     starts = np.zeros(nt * nt + 1, np.int64)
     at = 0
     for b in range(nt * nt):  # runs' places within each tile, tile after tile
@@ -431,13 +441,7 @@ def voxels_per_tile(vox, tiles_per_side, shift):
     starts[nt * nt] = at
     listed = np.empty(at, np.int64)
     for k in prange(runs):
-        for e in range(k * n // runs, (k + 1) * n // runs):
-            if vox[e, 3] > vox[e, 4]:
-                continue
-            for tj in range(vox[e, 5] >> shift, (vox[e, 6] >> shift) + 1):
-                for ti in range(vox[e, 3] >> shift, (vox[e, 4] >> shift) + 1):
-                    listed[counts[k, tj * nt + ti]] = e
-                    counts[k, tj * nt + ti] += 1
+        _visit_tiles(vox, k * n // runs, (k + 1) * n // runs, shift, nt, counts[k], listed, True)
     return starts, listed
 
 

@@ -33,13 +33,9 @@ def _scaled(dx, dy, dz):
 
 
 @numba.njit(nogil=True, cache=True)
-def _rays_to_cells(origins, directions, voxel_size, tiny, cells, unit):
-    """cells = o / voxel_size + 0.5; unit = d / sqrt(dx*dx + dy*dy + dz*dz), |u| < tiny -> 0
-    (d scaled first where its squares would under- or overflow).
-
-    Returns the first ray with a non-finite value (-1 - i for an origin, i for
-    a direction) or with a zero-length direction (n + 1 + i); n when all are good.
-    """
+def _first_bad_ray(origins, directions):
+    """The first ray with a non-finite value (-1 - i for an origin, i for a
+    direction) or with a zero-length direction (n + 1 + i); n when all are good."""
     n = origins.shape[0]
     for i in range(n):
         for a in range(3):
@@ -47,20 +43,16 @@ def _rays_to_cells(origins, directions, voxel_size, tiny, cells, unit):
                 return -1 - i
             if not np.isfinite(directions[i, a]):
                 return i
-        d = _scaled(directions[i, 0], directions[i, 1], directions[i, 2])
-        if not d[3] > 0:
+        if not _scaled(directions[i, 0], directions[i, 1], directions[i, 2])[3] > 0:
             return n + 1 + i
-        for a in range(3):
-            cells[i, a] = origins[i, a] / voxel_size + 0.5
-            u = d[a] / d[3]
-            unit[i, a] = 0.0 if abs(u) < tiny else u
     return n
 
 
 @numba.njit(parallel=True, nogil=True, cache=True)
-def _rays_to_cells_parallel(origins, directions, voxel_size, tiny, cells, unit):
-    """What ``_rays_to_cells`` writes, for every ray; True when no ray is bad (a
-    non-finite value or a zero-length direction)."""
+def _rays_to_cells(origins, directions, voxel_size, tiny, cells, unit):
+    """cells = o / voxel_size + 0.5; unit = d / sqrt(dx*dx + dy*dy + dz*dz), |u| < tiny -> 0
+    (d scaled first where its squares would under- or overflow). True when no ray is
+    bad (a non-finite value or a zero-length direction)."""
     n = origins.shape[0]
     bad = np.zeros(PARTS, np.bool_)
     for k in prange(PARTS):
@@ -87,9 +79,9 @@ def rays_to_cells(origins, directions, voxel_size, tiny):
     cells = np.empty((n, 3))
     unit = np.empty((n, 3))
     origins, directions = np.ascontiguousarray(origins), np.ascontiguousarray(directions)
-    if _rays_to_cells_parallel(origins, directions, float(voxel_size), float(tiny), cells, unit):
+    if _rays_to_cells(origins, directions, float(voxel_size), float(tiny), cells, unit):
         return cells, unit
-    first = _rays_to_cells(origins, directions, float(voxel_size), float(tiny), cells, unit)
+    first = _first_bad_ray(origins, directions)
     if first == n:
         return cells, unit
     if first < 0:

@@ -534,9 +534,9 @@ class WgpuBackend:
     def _object_order(self, occupancy, origins, directions, max_voxels, kind, index, t):
         """One scan in object order into kind/index/t; False when it is no scan for it
         (or its lists or arrays exceed what the adapter allows)."""
-        frame = cone_frame(origins, directions)
         if max(occupancy.shape) >= F32_EXACT:
-            frame = None  # voxel coordinates go to the shader as float32
+            return False  # voxel coordinates go to the shader as float32
+        frame = cone_frame(origins, directions)
         scan = None if frame is None else prepare_scan(occupancy, origins, directions, frame,
                                                        max_voxels, OBJECT_ORDER_TILE_SHIFT)
         if scan is None or np.diff(scan.tile_starts).max(initial=0) >= LOOP_BUDGET:
