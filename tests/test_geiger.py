@@ -1,0 +1,112 @@
+"""Statistics of the Geiger-mode model against closed forms (fixed seeds, 3 sigma)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from ladartui.detection import (binomial_at_least, declare_points, fire_counts,
+                                noise_per_bin, optimal_energy_scale, uniform)
+
+PULSES = 4000
+
+
+def _within_3_sigma(observed_share, p, trials):
+    sigma = math.sqrt(p * (1 - p) / trials)
+    assert abs(observed_share - p) <= 3 * sigma, (observed_share, p, sigma)
+
+
+def test_single_surface_fires_with_one_minus_exp():
+    n = 0.7
+    mean = np.array([[0.0, n, 0.0]])
+    counts = fire_counts(mean, PULSES, dead_bins=3, seed=11)
+    _within_3_sigma(counts[0, 1] / PULSES, 1 - math.exp(-n), PULSES)
+    assert counts[0, 0] == counts[0, 2] == 0
+
+
+def test_near_surface_blocks_far_one():
+    n1, n2 = 0.8, 1.5
+    mean = np.array([[n1, 0.0, n2]])
+    counts = fire_counts(mean, PULSES, dead_bins=3, seed=5)
+    _within_3_sigma(counts[0, 2] / PULSES, math.exp(-n1) * (1 - math.exp(-n2)), PULSES)
+    # With a dead time of one bin the detector re-arms: no blocking.
+    rearmed = fire_counts(mean, PULSES, dead_bins=1, seed=5)
+    _within_3_sigma(rearmed[0, 2] / PULSES, 1 - math.exp(-n2), PULSES)
+
+
+def test_noise_only_gate_matches_poisson_expectation():
+    bins = 200
+    per_bin = noise_per_bin(1e5, 0.5)
+    assert per_bin == pytest.approx(1e5 * 2 * 0.5 / 299_792_458.0)
+    mean = np.full((50, bins), per_bin)
+    counts = fire_counts(mean, 200, dead_bins=1, seed=3)
+    # Re-arming after each bin: each bin fires independently, 1 - exp(-N) each.
+    p = 1 - math.exp(-per_bin)
+    trials = 50 * bins * 200
+    _within_3_sigma(counts.sum() / trials, p, trials)
+
+
+def test_coincidence_matches_binomial_sum():
+    n, pulses, k = 0.3, 10, 4
+    p = 1 - math.exp(-n)
+    detectors = 5000
+    counts = fire_counts(np.full((detectors, 1), n), pulses, dead_bins=1, seed=9)
+    declared = declare_points(counts, k)[:, 0]
+    expected = binomial_at_least(pulses, k, p)
+    assert expected == pytest.approx(1 - sum(math.comb(pulses, j) * p ** j * (1 - p) ** (pulses - j)
+                                             for j in range(k)))
+    _within_3_sigma(declared.mean(), expected, detectors)
+
+
+def test_same_seed_same_result_and_detector_subsets_agree():
+    rng = np.random.default_rng(0)
+    mean = rng.uniform(0, 1, size=(64, 20))
+    a = fire_counts(mean, 50, dead_bins=4, seed=42, scan=3)
+    b = fire_counts(mean, 50, dead_bins=4, seed=42, scan=3)
+    assert np.array_equal(a, b)
+    # Chunking: half the detectors, keyed by their ids, give the same rows.
+    ids = np.arange(32, 64)
+    part = fire_counts(mean[32:], 50, dead_bins=4, seed=42, scan=3, detectors=ids)
+    assert np.array_equal(part, a[32:])
+    assert not np.array_equal(fire_counts(mean, 50, dead_bins=4, seed=43, scan=3), a)
+    assert uniform(1, 2, 3, 4, 5) == uniform(1, 2, 3, 4, 5)
+    assert 0 <= uniform(1, 2, 3, 4, 5) < 1
+
+
+def test_same_seed_identical_with_one_and_two_threads():
+    import numba
+    mean = np.random.default_rng(1).uniform(0, 1, size=(128, 16))
+    before = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = fire_counts(mean, 30, dead_bins=2, seed=7)
+        numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
+        two = fire_counts(mean, 30, dead_bins=2, seed=7)
+    finally:
+        numba.set_num_threads(before)
+    assert np.array_equal(one, two)
+
+
+@pytest.mark.parametrize("ratio", [0.1, 0.5, 1.0, 3.0])
+def test_energy_sweep_finds_published_optimum(ratio):
+    n_f = 1.0
+    n_t = ratio * n_f
+    scales = np.linspace(0.05, 4.0, 80)
+    pulses = 3000
+    mean = np.stack([np.array([a * n_f, a * n_t]) for a in scales])
+    counts = fire_counts(mean, pulses, dead_bins=2, seed=21)
+    target_share = counts[:, 1] / pulses
+    a_star = optimal_energy_scale(n_t, n_f)
+    assert a_star == pytest.approx(math.log(1 + n_t / n_f) / n_t)
+    # The analytic curve is flat near its peak: the sampled best scale's
+    # expected share must be within 3 sigma of the optimum's.
+    best = scales[int(np.argmax(target_share))]
+    peak = math.exp(-a_star * n_f) * (1 - math.exp(-a_star * n_t))
+    at_best = math.exp(-best * n_f) * (1 - math.exp(-best * n_t))
+    assert peak - at_best <= 3 * math.sqrt(peak * (1 - peak) / pulses) + 1e-12
+    # Overall detection probability (anything fires) at the optimum: 65-84 %
+    # in whole percent (64.95 % at N_t/N_f = 0.1, 84.25 % at 3).
+    overall = 1 - math.exp(-a_star * (n_f + n_t))
+    assert 65 <= round(overall * 100) <= 84
+    i = int(np.argmin(abs(scales - a_star)))
+    _within_3_sigma(counts[i].sum() / pulses, 1 - math.exp(-scales[i] * (n_f + n_t)), pulses)
