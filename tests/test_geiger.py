@@ -110,3 +110,39 @@ def test_energy_sweep_finds_published_optimum(ratio):
     assert 65 <= round(overall * 100) <= 84
     i = int(np.argmin(abs(scales - a_star)))
     _within_3_sigma(counts[i].sum() / pulses, 1 - math.exp(-scales[i] * (n_f + n_t)), pulses)
+
+
+def test_look_sums_ray_signal_into_bins_and_counts_false_alarms():
+    from ladartui.detection.look import geiger_look
+    # Detector 0: two rays on foliage at 100 m, two on the target at 103 m.
+    # Detector 1: nothing but noise beyond its one ground ray.
+    detector = np.array([0, 0, 0, 0, 1, 1, 1, 1])
+    kind = np.array([1, 1, 1, 1, 2, 0, 0, 0])
+    ranges = np.array([100.0, 100.2, 103.0, 103.4, 105.0, np.inf, np.inf, np.inf])
+    refl = np.array([0.5, 0.5, 0.3, 0.3, 0.2, 0, 0, 0])
+    look = geiger_look(detector, kind, ranges, refl, np.ones(8), rays_per_detector=4,
+                       n_ref=2.0, range_ref=100.0, reflectance_ref=0.5, noise=0.0,
+                       bin_width=1.0, pulses=200, threshold=1, dead_bins=6, seed=1, scan=0)
+    assert look.gate_start == 100.0 and look.mean_counts.shape == (2, 6)
+    assert look.mean_counts[0, 0] == pytest.approx(2 * 0.5 * 1.0 * (100 / 100.2) ** 2 / 2 + 0.5)
+    assert look.mean_counts[0, 3] == pytest.approx(2 * 0.25 * 0.6 * ((100 / 103) ** 2 + (100 / 103.4) ** 2))
+    assert look.false_alarms == 0  # no noise, so only surfaces fire
+    assert look.ray_declared[:5].all() and not look.ray_declared[5:].any()
+    noisy = geiger_look(detector, kind, ranges, refl, np.ones(8), rays_per_detector=4,
+                        n_ref=2.0, range_ref=100.0, reflectance_ref=0.5, noise=0.05,
+                        bin_width=1.0, pulses=200, threshold=1, dead_bins=1, seed=1, scan=0)
+    assert noisy.false_alarms > 0
+    strict = geiger_look(detector, kind, ranges, refl, np.ones(8), rays_per_detector=4,
+                         n_ref=2.0, range_ref=100.0, reflectance_ref=0.5, noise=0.05,
+                         bin_width=1.0, pulses=200, threshold=60, dead_bins=1, seed=1, scan=0)
+    assert strict.false_alarms == 0
+
+
+def test_incidence_cosine_of_nadir_and_slanted_rays():
+    from ladartui.detection.look import incidence_cosines
+    d = np.array([[0, 0, -1.0], [np.sin(0.5), 0, -np.cos(0.5)]])
+    o = np.array([[2.0, 2.0, 10.0], [2.0, 2.0, 10.0]])
+    # Ray 0 (cell z 10.5) meets voxel (2, 2, 3)'s top face (cell z = 4) after 6.5 cells.
+    cos = incidence_cosines(o, d, np.array([1, 2]), np.array([[2, 2, 3], [0, 0, 0]]),
+                            np.array([6.5, 10.5 / np.cos(0.5)]), 1.0)
+    assert cos[0] == pytest.approx(1.0) and cos[1] == pytest.approx(np.cos(0.5))
