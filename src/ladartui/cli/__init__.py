@@ -24,6 +24,7 @@ COMMANDS = {
     "bench": "bench",
     "study": "study",
     "sweep": "sweep",
+    "pulses": "pulses",
     "tui": "tui",
 }
 
