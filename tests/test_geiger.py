@@ -146,3 +146,14 @@ def test_incidence_cosine_of_nadir_and_slanted_rays():
     cos = incidence_cosines(o, d, np.array([1, 2]), np.array([[2, 2, 3], [0, 0, 0]]),
                             np.array([6.5, 10.5 / np.cos(0.5)]), 1.0)
     assert cos[0] == pytest.approx(1.0) and cos[1] == pytest.approx(np.cos(0.5))
+
+
+def test_settings_and_cli_reject_bad_values(capsys):
+    from ladartui.cli import main
+    from ladartui.detection.pulses import GeigerSettings
+    from ladartui.errors import FieldError
+    with pytest.raises(FieldError, match=r"detection.reflectance_target = 1.5: expected a number in 0..1"):
+        GeigerSettings(reflectance_target=1.5)
+    assert GeigerSettings().threshold(1) == 1 and GeigerSettings().threshold(100) == 10
+    assert main(["pulses", "--pulses", "1,x"]) == 2
+    assert "--pulses = '1,x': expected comma-separated whole numbers" in capsys.readouterr().err

@@ -25,9 +25,9 @@ def run(args) -> int:
     try:
         pulses = [int(v) for v in args.pulses.split(",")]
     except ValueError:
-        raise FieldError(f"--pulses: expected comma-separated whole numbers, got {args.pulses!r}") from None
+        raise FieldError("--pulses", args.pulses, "comma-separated whole numbers") from None
     if any(p < 1 or p > 100_000 for p in pulses):
-        raise FieldError(f"--pulses: each must be in 1..100000, got {args.pulses!r}")
+        raise FieldError("--pulses", args.pulses, "pulse counts in 1..100000")
     scenario = load_scenario(args.scenario or default_scenario_path())
     settings = GeigerSettings(n_ref=args.n_ref, seed=args.seed)
     ideal, rows = pulse_study(scenario, pulses, settings, backend=args.backend)

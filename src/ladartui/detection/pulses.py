@@ -40,15 +40,15 @@ class GeigerSettings:
     def __post_init__(self):
         for name in ("n_ref", "range_ref", "reflectance_ref", "dead_time_m"):
             if not getattr(self, name) > 0:
-                raise FieldError(f"detection.{name}: must be > 0, got {getattr(self, name)!r}")
+                raise FieldError(f"detection.{name}", getattr(self, name), "a number > 0")
         for name in ("reflectance_foliage", "reflectance_ground", "reflectance_target"):
             if not 0 <= getattr(self, name) <= 1:
-                raise FieldError(f"detection.{name}: must be in 0..1, got {getattr(self, name)!r}")
+                raise FieldError(f"detection.{name}", getattr(self, name), "a number in 0..1")
         for name in ("dark_rate_hz", "solar_rate_hz"):
             if not getattr(self, name) >= 0:
-                raise FieldError(f"detection.{name}: must be >= 0, got {getattr(self, name)!r}")
+                raise FieldError(f"detection.{name}", getattr(self, name), "a number >= 0")
         if not 0 < self.threshold_share <= 1:
-            raise FieldError(f"detection.threshold_share: must be in (0, 1], got {self.threshold_share!r}")
+            raise FieldError("detection.threshold_share", self.threshold_share, "a number in (0, 1]")
 
     def threshold(self, pulses: int) -> int:
         return max(1, math.ceil(self.threshold_share * pulses - 1e-12))
