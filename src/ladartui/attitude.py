@@ -1,0 +1,57 @@
+"""Platform attitude (optional; the stabilised sensor stays the default).
+
+Frames: the level body frame L is forward, right, down (FRD) at the pose's
+heading ``h`` (clockwise from north, x east, y north, z up), so its axes in
+the scene frame are ``f = (sin h, cos h, 0)``, ``r = (cos h, -sin h, 0)``,
+``d = (0, 0, -1)`` and ``B = [f r d]`` (columns). The report's equations 1
+and 2 give the stabilised ray directions (azimuth and depression relative to
+the horizon). A body-fixed sensor turns them with the aircraft:
+
+    d_world = B Rz(yaw) Ry(pitch) Rx(roll) B^T d_stabilised
+
+(aerospace order: yaw, then pitch, then roll; roll positive right wing down,
+pitch positive nose up, yaw positive to the right, all in degrees). A
+coordinated turn of radius ``r`` at speed ``v`` banks by
+``roll = atan(v^2 / (g r))``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+STANDARD_GRAVITY = 9.80665
+
+
+def coordinated_turn_roll(speed: float, radius: float, g: float = STANDARD_GRAVITY) -> float:
+    """Bank angle (degrees) of a coordinated level turn."""
+    if speed < 0 or radius <= 0:
+        raise ValueError("speed must be >= 0 and radius > 0")
+    return math.degrees(math.atan(speed * speed / (g * radius)))
+
+
+def _level_frame(heading_deg: float) -> np.ndarray:
+    h = math.radians(heading_deg)
+    return np.array([[math.sin(h), math.cos(h), 0.0],
+                     [math.cos(h), -math.sin(h), 0.0],
+                     [0.0, 0.0, -1.0]]).T
+
+
+def attitude_matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    """Rz(yaw) Ry(pitch) Rx(roll), body FRD to level FRD, degrees."""
+    cr, sr = math.cos(math.radians(roll)), math.sin(math.radians(roll))
+    cp, sp = math.cos(math.radians(pitch)), math.sin(math.radians(pitch))
+    cy, sy = math.cos(math.radians(yaw)), math.sin(math.radians(yaw))
+    rx = np.array([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
+    ry = np.array([[cp, 0, sp], [0, 1, 0], [-sp, 0, cp]])
+    rz = np.array([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
+    return rz @ ry @ rx
+
+
+def body_fixed_directions(directions, heading: float, roll: float = 0.0, pitch: float = 0.0,
+                          yaw: float = 0.0) -> np.ndarray:
+    """Stabilised ray directions (N, 3) turned with the aircraft's attitude."""
+    b = _level_frame(heading)
+    rotation = b @ attitude_matrix(roll, pitch, yaw) @ b.T
+    return np.asarray(directions, dtype=np.float64) @ rotation.T
