@@ -1,0 +1,111 @@
+"""Recorded trajectories: a CSV flight log as scan poses (optional).
+
+Format: a header line naming the columns, then one record per line, times
+increasing. Required: ``time`` (s), ``x``, ``y``, ``z`` (metres, scene
+frame), ``heading`` (degrees clockwise from north); optional ``roll``,
+``pitch`` (degrees). Blank lines and lines starting with ``#`` are skipped.
+Scans are taken at ``rate`` Hz from the first record's time (or at given
+``times``); between records positions are interpolated linearly and angles
+along the shortest arc. Errors name ``file:line``.
+"""
+
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from ladartui.errors import LadarError
+from ladartui.flight import ScanPose
+
+REQUIRED = ("time", "x", "y", "z", "heading")
+OPTIONAL = ("roll", "pitch")
+
+
+class TrajectoryError(LadarError):
+    """A flight log that cannot be read."""
+
+
+@dataclass(frozen=True)
+class FlightLog:
+    time: np.ndarray
+    xyz: np.ndarray          # (N, 3)
+    heading: np.ndarray
+    roll: np.ndarray
+    pitch: np.ndarray
+
+
+def load_flight_log(path) -> FlightLog:
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as error:
+        raise TrajectoryError(f"{path}: cannot read flight log ({error})") from None
+    rows = [(n, line) for n, line in enumerate(text.splitlines(), start=1)
+            if line.strip() and not line.lstrip().startswith("#")]
+    if not rows:
+        raise TrajectoryError(f"{path}: empty flight log: expected a header and records")
+    header_line, header = rows[0]
+    names = [name.strip().lower() for name in next(csv.reader([header]))]
+    missing = [c for c in REQUIRED if c not in names]
+    if missing:
+        raise TrajectoryError(f"{path}:{header_line}: header lacks {', '.join(missing)}: "
+                              f"expected columns {', '.join(REQUIRED)} (optional roll, pitch)")
+    columns = {name: names.index(name) for name in (*REQUIRED, *OPTIONAL) if name in names}
+    values = {name: [] for name in (*REQUIRED, *OPTIONAL)}
+    for number, line in rows[1:]:
+        fields = next(csv.reader([line]))
+        if len(fields) != len(names):
+            raise TrajectoryError(f"{path}:{number}: {len(fields)} fields, expected {len(names)}")
+        for name in (*REQUIRED, *OPTIONAL):
+            if name not in columns:
+                values[name].append(0.0)
+                continue
+            raw = fields[columns[name]].strip()
+            try:
+                value = float(raw)
+            except ValueError:
+                raise TrajectoryError(f"{path}:{number}: {name} = {raw!r}: expected a number") from None
+            if not np.isfinite(value):
+                raise TrajectoryError(f"{path}:{number}: {name} = {raw!r}: expected a finite number")
+            values[name].append(value)
+        if len(values["time"]) > 1 and values["time"][-1] <= values["time"][-2]:
+            raise TrajectoryError(f"{path}:{number}: time = {values['time'][-1]!r}: "
+                                  f"expected times increasing (previous {values['time'][-2]!r})")
+        if values["z"][-1] <= 0:
+            raise TrajectoryError(f"{path}:{number}: z = {values['z'][-1]!r}: expected > 0")
+    if len(values["time"]) < 2:
+        raise TrajectoryError(f"{path}: {len(values['time'])} records: expected at least 2")
+    arr = {k: np.array(v, dtype=np.float64) for k, v in values.items()}
+    return FlightLog(arr["time"], np.stack([arr["x"], arr["y"], arr["z"]], axis=1),
+                     arr["heading"], arr["roll"], arr["pitch"])
+
+
+def _angle(times, angles, t):
+    """Interpolate angles (degrees) along the shortest arc between records."""
+    unwrapped = np.degrees(np.unwrap(np.radians(angles)))
+    return np.interp(t, times, unwrapped)
+
+
+def log_poses(log: FlightLog, template: ScanPose, rate: float | None = None,
+              times=None) -> list[ScanPose]:
+    """Scan poses along the log; ``template`` gives the sensor azimuth and depression."""
+    if times is None:
+        if rate is None or not rate > 0:
+            raise TrajectoryError(f"scan rate = {rate!r}: expected a number > 0 (Hz)")
+        count = int(np.floor((log.time[-1] - log.time[0]) * rate + 1e-9)) + 1
+        times = log.time[0] + np.arange(count) / rate
+    times = np.asarray(times, dtype=np.float64)
+    if np.any(times < log.time[0]) or np.any(times > log.time[-1]):
+        raise TrajectoryError(f"scan times must lie within the log's {log.time[0]}..{log.time[-1]} s")
+    xyz = np.stack([np.interp(times, log.time, log.xyz[:, a]) for a in range(3)], axis=1)
+    heading = _angle(log.time, log.heading, times)
+    return [replace(template, x=float(p[0]), y=float(p[1]), z=float(p[2]), heading=float(h) % 360.0)
+            for p, h in zip(xyz, heading)]
+
+
+def log_attitude(log: FlightLog, times) -> tuple[np.ndarray, np.ndarray]:
+    """Roll and pitch (degrees) at the given times, shortest-arc interpolation."""
+    return _angle(log.time, log.roll, times), _angle(log.time, log.pitch, times)
