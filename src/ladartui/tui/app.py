@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from rich.markup import escape
 from textual import on, work
 from textual.app import App, ComposeResult, SystemCommand
 from textual.binding import Binding
@@ -362,7 +363,7 @@ class LadarApp(App):
         self.set_busy(None)
         self.tell(message.error, title=f"Could not {message.what}", severity="error",
                     timeout=10)
-        self.query_one("#run-info", Static).update(message.error)
+        self.query_one("#run-info", Static).update(escape(message.error))
 
     def on_backends_probed(self, message: BackendsProbed) -> None:
         if self.closing():
@@ -438,7 +439,8 @@ class LadarApp(App):
                 ("Target model", sc.target_file.name), ("", target), ("Scene output", sc.scene_output.name),
                 ("Target output", sc.target_output.name),
                 ("Measures", sc.measures_file.name)]
-        text = "\n".join(f"[b]{k:<14}[/b]{v}" if k else f"{'':<14}{v}" for k, v in rows if v)
+        text = "\n".join(f"[b]{k:<14}[/b]{escape(v)}" if k else f"{'':<14}{escape(v)}"
+                         for k, v in rows if v)
         self.query_one("#file-info", Static).update(text)
 
     def _fill_flight_tables(self) -> None:
@@ -508,14 +510,15 @@ class LadarApp(App):
         """True from pressing Run until the run's worker has reported back."""
         return self.running
 
-    def problems(self) -> list[str]:
-        """What is missing before a run (empty: ready)."""
+    def problems(self, fields: bool = True) -> list[str]:
+        """What is missing before a run (empty: ready); ``fields=False`` leaves out
+        typed values, which Run commits (or refuses, focusing the field) itself."""
         if self.scenario is None:
             return ["no scenario: F2 new or F3 open"]
         out = []
         if self.scene is None:
             out.append("scene model not loaded")
-        bad = [f.field_name for f in self.query(NumberField) if f.has_class("-bad")]
+        bad = [f.field_name for f in self.query(NumberField) if fields and f.has_class("-bad")]
         if bad:
             out.append("invalid value in " + ", ".join(bad))
         if self.backend_rows is not None:
@@ -545,7 +548,7 @@ class LadarApp(App):
             return True if self.run_in_progress() else None
         if self.busy is not None and action not in DISPLAY_ACTIONS:
             return None
-        if action == "run" and self.problems():
+        if action == "run" and self.problems(fields=False):
             return None
         return True
 
@@ -585,13 +588,10 @@ class LadarApp(App):
             value = field.parsed()
             scenario = bridge.with_param(self.scenario, key, value)
         except LadarError as error:
-            field.reset_to_default()
-            try:
-                scenario = bridge.with_param(self.scenario, key, field.default)
-            except LadarError:
-                scenario = self.scenario
-                field.set_number(bridge.param_value(scenario, key))
-            self.tell(f"{error}. Reset to the default, {field.value}.",
+            # back to the scenario's value, never to the program's default
+            scenario = self.scenario
+            field.set_number(bridge.param_value(scenario, key))
+            self.tell(f"{error}. Kept the scenario's value, {field.value}.",
                         title="Invalid value", severity="warning", timeout=6)
         else:
             field.committed = field.value
@@ -600,6 +600,28 @@ class LadarApp(App):
                 and scenario.voxel_size != self.scene.voxel_size:
             self._rescale_scene(scenario.voxel_size)
         self.update_scenario(scenario)
+
+    def commit_pending(self) -> bool:
+        """Commit every field whose text differs from its committed value.
+
+        Run, Save and every action that reads the scenario call this first, so
+        nothing runs or is saved that differs from the screen. An invalid
+        pending value stops the action: the field is focused and the app says
+        why; False is returned.
+        """
+        if self.scenario is None:
+            return True
+        for field in self.query(NumberField).results(NumberField):
+            if field.value == field.committed:
+                continue
+            problem = field.problem()
+            if problem is not None:
+                field.focus()
+                self.tell(f"{problem}. Correct the value and try again.",
+                          title="Not done: invalid value", severity="error", timeout=8)
+                return False
+            self.commit_field(field)
+        return True
 
     def _rescale_scene(self, voxel_size: float) -> None:
         from ladartui.scene.model import Scene
@@ -794,6 +816,8 @@ class LadarApp(App):
     def action_save(self) -> None:
         if self.scenario is None or self.busy:
             return
+        if not self.commit_pending():
+            return
         try:
             self.scenario = self.scenario.save()
         except (LadarError, OSError) as error:
@@ -808,6 +832,8 @@ class LadarApp(App):
     @on(Button.Pressed, "#btn-run")
     def action_run(self) -> None:
         if self.busy or self.scenario is None:
+            return
+        if not self.commit_pending():
             return
         problems = self.problems()
         if problems:
@@ -897,7 +923,7 @@ class LadarApp(App):
             return
         if message.error:
             self.tell(message.error, title="Run failed", severity="error", timeout=10)
-            info.update(message.error)
+            info.update(escape(message.error))
             return
         result = message.result
         self.result = result
@@ -1084,7 +1110,8 @@ class LadarApp(App):
              timeout: float = 5) -> None:
         """Show a message to the analyst (and keep it in ``messages`` for the record)."""
         self.messages.append(f"{title}: {message}" if title else message)
-        self.notify(message, title=title, severity=severity, timeout=timeout)
+        # text from files and fields must not be read as markup
+        self.notify(escape(message), title=escape(title), severity=severity, timeout=timeout)
 
     def closing(self) -> bool:
         """True once the app is shutting down: stop any run, ignore late worker news."""
