@@ -120,3 +120,45 @@ async def test_a_file_name_that_looks_like_markup_is_shown_literally(tmp_path, s
         await pilot.click("#file-info", offset=(20, 2))
         await pilot.pause()
         assert app.is_running
+
+
+async def test_quit_new_and_open_with_unsaved_edits_ask_first(tmp_path, scene_files):
+    from ladartui.tui.screens import SetupScreen
+    from ladartui.tui.unsaved import UnsavedScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        app.action_show_tab("sensor")
+        await type_into(pilot, field(app, "sensor.grid"), "12")
+        for key in ("ctrl+q", "f2", "f3"):
+            await pilot.press(key)
+            await pilot.pause()
+            assert isinstance(app.screen, UnsavedScreen), key
+            await pilot.click("#unsaved-cancel")
+            await pilot.pause()
+            assert app.is_running and not isinstance(app.screen, UnsavedScreen)
+        await pilot.press("f3")
+        await pilot.pause()
+        await pilot.click("#unsaved-discard")
+        await pilot.pause()
+        assert isinstance(app.screen, SetupScreen)
+        await pilot.press("escape")
+        await pilot.pause()
+        await pilot.press("ctrl+q")
+        await pilot.pause()
+        await pilot.click("#unsaved-save")
+        await pilot.pause()
+        assert not app.is_running
+    assert load_scenario(scenario.path).sensor.grid == 12
+
+
+async def test_quit_without_edits_does_not_ask(tmp_path, scene_files):
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        await pilot.press("ctrl+q")
+        await pilot.pause()
+        assert not app.is_running

@@ -33,6 +33,7 @@ from ladartui.tui.measures_view import compact_rows
 from ladartui.tui.screens import (AngleScreen, CompareScreen, FormScreen, HelpScreen,
                                   MeasuresScreen, PosesScreen, SetupScreen, ThresholdScreen)
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
+from ladartui.tui.unsaved import UnsavedScreen
 
 SCENE_POINTS = 80_000  # voxels drawn in the 3D scene view, whatever the scene size
 OUTPUT_POINTS = 80_000
@@ -801,9 +802,37 @@ class LadarApp(App):
     def action_open_scenario(self) -> None:
         self._setup("load")
 
+    def unsaved(self) -> bool:
+        """Edits that a save would keep: committed ones, or text typed in a field."""
+        return self.scenario is not None and (
+            self.modified or any(f.value != f.committed for f in self.query(NumberField)))
+
+    def confirm_discard(self, doing: str, then) -> None:
+        """Call ``then`` once unsaved edits are saved or the analyst chose to discard them."""
+        if not self.unsaved():
+            then()
+            return
+
+        def chosen(choice):
+            if choice == "save":
+                self.action_save()
+                if not self.unsaved():
+                    then()
+            elif choice == "discard":
+                then()
+
+        self.push_screen(UnsavedScreen(self.scenario.path.name, doing), chosen)
+
+    async def action_quit(self) -> None:
+        self.confirm_discard("quit", self.exit)
+
     def _setup(self, mode: str) -> None:
         if self.busy:
             return
+        self.confirm_discard("open another scenario" if mode == "load" else
+                             "start a new one", lambda: self._open_setup(mode))
+
+    def _open_setup(self, mode: str) -> None:
 
         def done(scenario):
             if scenario is not None:
@@ -1103,8 +1132,13 @@ class LadarApp(App):
             screen.dismiss(None)
         else:
             self.tell(f"Opening {message.path.name}; Esc leaves the sweep screen to see it.")
-        self.result = None
-        self.load(message.path)
+        path = message.path
+
+        def load():
+            self.result = None
+            self.load(path)
+
+        self.confirm_discard(f"open {path.name}", load)
 
     def tell(self, message: str, *, title: str = "", severity: str = "information",
              timeout: float = 5) -> None:
