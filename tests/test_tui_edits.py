@@ -13,6 +13,7 @@ import shutil
 import pytest
 
 from ladartui.scenario import load_scenario, target_file_for
+from ladartui.tui.status import StatusBar
 from test_tui_flow import (LadarApp, field, loaded, make_scenario, scene_files,  # noqa: F401
                            type_into, wait_until)
 
@@ -56,6 +57,9 @@ async def test_a_value_typed_without_enter_is_what_ctrl_s_saves(tmp_path, scene_
         await pilot.pause()
         assert load_scenario(scenario.path).sensor.grid == 12
         assert field(app, "sensor.grid").value == "12"
+        assert "(modified)" not in app.query_one(StatusBar).message
+        await type_into(pilot, field(app, "sensor.grid"), "16")
+        assert "(modified)" in app.query_one(StatusBar).message
 
 
 async def test_an_invalid_value_typed_stops_run_and_save_and_focuses_the_field(tmp_path,

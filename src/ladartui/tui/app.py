@@ -539,7 +539,9 @@ class LadarApp(App):
             return
         poses = len(self.scenario.poses())
         rays = self.scenario.sensor.rays_per_scan
-        bar.show(READY, f"{self.scenario.path.name}: {poses} scans x {rays:,} rays. F5 runs.")
+        mark = " (modified)" if self.modified else ""
+        bar.show(READY, f"{self.scenario.path.name}{mark}: {poses} scans x {rays:,} rays. "
+                        "F5 runs.")
 
     def check_action(self, action: str, parameters) -> bool | None:
         if self.tool_screen is not None and self.screen is self.tool_screen:
@@ -854,6 +856,7 @@ class LadarApp(App):
             return
         self.modified = False
         self._show_file_info()
+        self.refresh_status()
         self.tell(f"Saved {self.scenario.path}")
 
     # -- run -------------------------------------------------------------------------
