@@ -93,6 +93,7 @@ async def test_an_invalid_value_goes_back_to_the_scenarios_value(tmp_path, scene
         grid = field(app, "sensor.grid")
         await type_into(pilot, grid, "0")
         assert grid.value == "8" and app.scenario.sensor.grid == 8  # not the default 128
+        assert not app.modified
         assert "8" in app.messages[-1]
         ray_grid = field(app, "sensor.ray_grid")
         await type_into(pilot, ray_grid, "x", commit="tab")

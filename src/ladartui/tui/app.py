@@ -596,6 +596,8 @@ class LadarApp(App):
             field.set_number(bridge.param_value(scenario, key))
             self.tell(f"{error}. Kept the scenario's value, {field.value}.",
                         title="Invalid value", severity="warning", timeout=6)
+            self.refresh_status()  # nothing changed: not a modification
+            return
         else:
             field.committed = field.value
         field.remove_class("-bad")
