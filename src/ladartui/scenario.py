@@ -80,7 +80,8 @@ from pathlib import Path
 import tomli_w
 
 from ladartui.atomic import write_text_atomic
-from ladartui.errors import FieldError, InputFileError
+from ladartui.scenario_style import restyle
+from ladartui.errors import FieldError, InputFileError, LadarError
 from ladartui.flight import (
     MAX_SCANS,
     SEGMENT_KINDS,
@@ -314,8 +315,20 @@ class Scenario:
         outputs sit beside the new file).
         """
         scenario = self if path is None else self.with_changes(path=Path(path))
-        write_text_atomic(scenario.path, scenario.to_toml())
+        text = None
+        if self.path.is_file():  # keep the analyst's comments, key order and layout
+            text = restyle(self.path.read_text(encoding="utf-8"), scenario.to_dict(),
+                           _saved_data(self.path))
+        write_text_atomic(scenario.path, text if text is not None else scenario.to_toml())
         return scenario
+
+
+def _saved_data(path: Path) -> dict | None:
+    """What the file at ``path`` means (defaults filled in), or None if unreadable."""
+    try:
+        return load_scenario(path, check_files=False).to_dict()
+    except (LadarError, OSError):
+        return None
 
 
 def target_file_for(scene_file) -> Path:

@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from rich.markup import escape
 from textual import on, work
 from textual.app import App, ComposeResult, SystemCommand
 from textual.binding import Binding
@@ -32,6 +33,7 @@ from ladartui.tui.measures_view import compact_rows
 from ladartui.tui.screens import (AngleScreen, CompareScreen, FormScreen, HelpScreen,
                                   MeasuresScreen, PosesScreen, SetupScreen, ThresholdScreen)
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
+from ladartui.tui.unsaved import UnsavedScreen
 
 SCENE_POINTS = 80_000  # voxels drawn in the 3D scene view, whatever the scene size
 OUTPUT_POINTS = 80_000
@@ -362,7 +364,7 @@ class LadarApp(App):
         self.set_busy(None)
         self.tell(message.error, title=f"Could not {message.what}", severity="error",
                     timeout=10)
-        self.query_one("#run-info", Static).update(message.error)
+        self.query_one("#run-info", Static).update(escape(message.error))
 
     def on_backends_probed(self, message: BackendsProbed) -> None:
         if self.closing():
@@ -438,7 +440,8 @@ class LadarApp(App):
                 ("Target model", sc.target_file.name), ("", target), ("Scene output", sc.scene_output.name),
                 ("Target output", sc.target_output.name),
                 ("Measures", sc.measures_file.name)]
-        text = "\n".join(f"[b]{k:<14}[/b]{v}" if k else f"{'':<14}{v}" for k, v in rows if v)
+        text = "\n".join(f"[b]{k:<14}[/b]{escape(v)}" if k else f"{'':<14}{escape(v)}"
+                         for k, v in rows if v)
         self.query_one("#file-info", Static).update(text)
 
     def _fill_flight_tables(self) -> None:
@@ -508,14 +511,15 @@ class LadarApp(App):
         """True from pressing Run until the run's worker has reported back."""
         return self.running
 
-    def problems(self) -> list[str]:
-        """What is missing before a run (empty: ready)."""
+    def problems(self, fields: bool = True) -> list[str]:
+        """What is missing before a run (empty: ready); ``fields=False`` leaves out
+        typed values, which Run commits (or refuses, focusing the field) itself."""
         if self.scenario is None:
             return ["no scenario: F2 new or F3 open"]
         out = []
         if self.scene is None:
             out.append("scene model not loaded")
-        bad = [f.field_name for f in self.query(NumberField) if f.has_class("-bad")]
+        bad = [f.field_name for f in self.query(NumberField) if fields and f.has_class("-bad")]
         if bad:
             out.append("invalid value in " + ", ".join(bad))
         if self.backend_rows is not None:
@@ -535,7 +539,9 @@ class LadarApp(App):
             return
         poses = len(self.scenario.poses())
         rays = self.scenario.sensor.rays_per_scan
-        bar.show(READY, f"{self.scenario.path.name}: {poses} scans x {rays:,} rays. F5 runs.")
+        mark = " (modified)" if self.modified else ""
+        bar.show(READY, f"{self.scenario.path.name}{mark}: {poses} scans x {rays:,} rays. "
+                        "F5 runs.")
 
     def check_action(self, action: str, parameters) -> bool | None:
         if self.tool_screen is not None and self.screen is self.tool_screen:
@@ -545,7 +551,7 @@ class LadarApp(App):
             return True if self.run_in_progress() else None
         if self.busy is not None and action not in DISPLAY_ACTIONS:
             return None
-        if action == "run" and self.problems():
+        if action == "run" and self.problems(fields=False):
             return None
         return True
 
@@ -585,14 +591,13 @@ class LadarApp(App):
             value = field.parsed()
             scenario = bridge.with_param(self.scenario, key, value)
         except LadarError as error:
-            field.reset_to_default()
-            try:
-                scenario = bridge.with_param(self.scenario, key, field.default)
-            except LadarError:
-                scenario = self.scenario
-                field.set_number(bridge.param_value(scenario, key))
-            self.tell(f"{error}. Reset to the default, {field.value}.",
+            # back to the scenario's value, never to the program's default
+            scenario = self.scenario
+            field.set_number(bridge.param_value(scenario, key))
+            self.tell(f"{error}. Kept the scenario's value, {field.value}.",
                         title="Invalid value", severity="warning", timeout=6)
+            self.refresh_status()  # nothing changed: not a modification
+            return
         else:
             field.committed = field.value
         field.remove_class("-bad")
@@ -600,6 +605,28 @@ class LadarApp(App):
                 and scenario.voxel_size != self.scene.voxel_size:
             self._rescale_scene(scenario.voxel_size)
         self.update_scenario(scenario)
+
+    def commit_pending(self) -> bool:
+        """Commit every field whose text differs from its committed value.
+
+        Run, Save and every action that reads the scenario call this first, so
+        nothing runs or is saved that differs from the screen. An invalid
+        pending value stops the action: the field is focused and the app says
+        why; False is returned.
+        """
+        if self.scenario is None:
+            return True
+        for field in self.query(NumberField).results(NumberField):
+            if field.value == field.committed:
+                continue
+            problem = field.problem()
+            if problem is not None:
+                field.focus()
+                self.tell(f"{problem}. Correct the value and try again.",
+                          title="Not done: invalid value", severity="error", timeout=8)
+                return False
+            self.commit_field(field)
+        return True
 
     def _rescale_scene(self, voxel_size: float) -> None:
         from ladartui.scene.model import Scene
@@ -779,9 +806,37 @@ class LadarApp(App):
     def action_open_scenario(self) -> None:
         self._setup("load")
 
+    def unsaved(self) -> bool:
+        """Edits that a save would keep: committed ones, or text typed in a field."""
+        return self.scenario is not None and (
+            self.modified or any(f.value != f.committed for f in self.query(NumberField)))
+
+    def confirm_discard(self, doing: str, then) -> None:
+        """Call ``then`` once unsaved edits are saved or the analyst chose to discard them."""
+        if not self.unsaved():
+            then()
+            return
+
+        def chosen(choice):
+            if choice == "save":
+                self.action_save()
+                if not self.unsaved():
+                    then()
+            elif choice == "discard":
+                then()
+
+        self.push_screen(UnsavedScreen(self.scenario.path.name, doing), chosen)
+
+    async def action_quit(self) -> None:
+        self.confirm_discard("quit", self.exit)
+
     def _setup(self, mode: str) -> None:
         if self.busy:
             return
+        self.confirm_discard("open another scenario" if mode == "load" else
+                             "start a new one", lambda: self._open_setup(mode))
+
+    def _open_setup(self, mode: str) -> None:
 
         def done(scenario):
             if scenario is not None:
@@ -794,6 +849,8 @@ class LadarApp(App):
     def action_save(self) -> None:
         if self.scenario is None or self.busy:
             return
+        if not self.commit_pending():
+            return
         try:
             self.scenario = self.scenario.save()
         except (LadarError, OSError) as error:
@@ -801,6 +858,7 @@ class LadarApp(App):
             return
         self.modified = False
         self._show_file_info()
+        self.refresh_status()
         self.tell(f"Saved {self.scenario.path}")
 
     # -- run -------------------------------------------------------------------------
@@ -808,6 +866,8 @@ class LadarApp(App):
     @on(Button.Pressed, "#btn-run")
     def action_run(self) -> None:
         if self.busy or self.scenario is None:
+            return
+        if not self.commit_pending():
             return
         problems = self.problems()
         if problems:
@@ -897,7 +957,7 @@ class LadarApp(App):
             return
         if message.error:
             self.tell(message.error, title="Run failed", severity="error", timeout=10)
-            info.update(message.error)
+            info.update(escape(message.error))
             return
         result = message.result
         self.result = result
@@ -1077,14 +1137,20 @@ class LadarApp(App):
             screen.dismiss(None)
         else:
             self.tell(f"Opening {message.path.name}; Esc leaves the sweep screen to see it.")
-        self.result = None
-        self.load(message.path)
+        path = message.path
+
+        def load():
+            self.result = None
+            self.load(path)
+
+        self.confirm_discard(f"open {path.name}", load)
 
     def tell(self, message: str, *, title: str = "", severity: str = "information",
              timeout: float = 5) -> None:
         """Show a message to the analyst (and keep it in ``messages`` for the record)."""
         self.messages.append(f"{title}: {message}" if title else message)
-        self.notify(message, title=title, severity=severity, timeout=timeout)
+        # text from files and fields must not be read as markup
+        self.notify(escape(message), title=escape(title), severity=severity, timeout=timeout)
 
     def closing(self) -> bool:
         """True once the app is shutting down: stop any run, ignore late worker news."""

@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 from pathlib import Path
 
+from rich.markup import escape
 from textual import on
 from textual.app import ComposeResult
 from textual.binding import Binding
@@ -136,7 +137,7 @@ class SetupScreen(Dialog):
         if problem:
             widget.reset_to_default()
             self.query_one("#setup-message", Static).update(
-                f"{problem}; reset to {widget.value}")
+                escape(f"{problem}; reset to {widget.value}"))
         return widget.parsed()
 
     def _paths(self):
@@ -150,7 +151,7 @@ class SetupScreen(Dialog):
         scenario_path, scene_path = self._paths()
         if self.mode == "new":
             names = bridge.derived_names(scenario_path, scene_path)
-            text = "\n".join(f"{label:<26}{value}" for label, value in names)
+            text = escape("\n".join(f"{label:<26}{value}" for label, value in names))
         else:
             text = "Every file of the scenario is checked before anything is loaded."
         self.query_one("#derived", Static).update(text)
@@ -171,7 +172,7 @@ class SetupScreen(Dialog):
             else:
                 scenario = bridge.load_checked(scenario_path)
         except LadarError as error:
-            message.update(str(error))
+            message.update(escape(str(error)))
             return
         self.dismiss(scenario)
 
@@ -268,7 +269,7 @@ class FormScreen(Dialog):
             problem = widget.problem()
             if problem:
                 widget.reset_to_default()
-                message.update(f"{problem}; reset to {widget.value or 'empty'}")
+                message.update(escape(f"{problem}; reset to {widget.value or 'empty'}"))
                 return False
         return True
 
@@ -286,17 +287,17 @@ class FormScreen(Dialog):
         try:
             result = self.build(self.values())
         except LadarError as error:
-            message.update(str(error))
+            message.update(escape(str(error)))
             # reset the field the core named, so the form is usable again
             for name, *_ in self.spec:
                 if isinstance(error, FieldError) and _field_matches(error.field, name):
                     widget = self.query_one(f"#f-{name}")
                     if isinstance(widget, NumberField):
                         widget.reset_to_default()
-                        message.update(f"{error}; reset to its default")
+                        message.update(escape(f"{error}; reset to its default"))
                     elif isinstance(widget, Input):
                         widget.value = widget.default_text
-                        message.update(f"{error}; reset to its default")
+                        message.update(escape(f"{error}; reset to its default"))
             return
         self.cancelled = False
         self.dismiss(result)
@@ -419,7 +420,7 @@ class PosesScreen(Dialog):
             if problem:
                 event.input.reset_to_default()
                 self.query_one("#poses-message", Static).update(
-                    f"{problem}; reset to {event.input.value}")
+                    escape(f"{problem}; reset to {event.input.value}"))
 
     @on(Input.Changed)
     def _typing(self, event: Input.Changed) -> None:
@@ -438,18 +439,18 @@ class PosesScreen(Dialog):
             problem = widget.problem()
             if problem:
                 widget.reset_to_default()
-                problems.append(f"{problem}; reset to {widget.value}")
+                problems.append(escape(f"{problem}; reset to {widget.value}"))
         try:
             pose = bridge.make_pose({c: self._raw(c) for c in self.COLUMNS})
         except LadarError as error:
-            message.update(str(error))
+            message.update(escape(str(error)))
             return
         if 0 <= row < len(self.poses):
             self.poses[row] = pose
         else:
             self.poses.append(pose)
             row = len(self.poses) - 1
-        message.update("\n".join(problems))
+        message.update(escape("\n".join(problems)))
         self._fill(row)
 
     @on(Button.Pressed, "#pose-add")
@@ -545,7 +546,7 @@ class CompareScreen(Dialog):
         try:
             loaded = bridge.read_measures_files([Path(t).expanduser() for t in text])
         except LadarError as error:
-            message.update(str(error))
+            message.update(escape(str(error)))
             return
         message.update("")
         table.add_column("Measure")

@@ -1,0 +1,61 @@
+"""Style-preserving save: a scenario's new values written into the analyst's own file.
+
+A hand-written scenario carries comments, key order and alignment that a
+fresh dump would throw away. ``restyle`` parses the existing text with
+tomlkit and changes only the values that differ from the new data, so a
+load-edit-save round trip changes nothing else. Keys the new data no longer
+has are removed; new keys are appended to their table.
+"""
+
+from __future__ import annotations
+
+import tomlkit
+from tomlkit.exceptions import TOMLKitError
+
+
+def restyle(old_text: str, data: dict, old_data: dict | None = None) -> str | None:
+    """``old_text`` with ``data``'s values in place, or None if it is not a TOML table.
+
+    ``old_data`` is what ``old_text`` meant (defaults filled in); a value equal
+    to it is left as the file has it, written or left out.
+    """
+    try:
+        document = tomlkit.parse(old_text)
+    except TOMLKitError:
+        return None
+    _merge_table(document, data, old_data)
+    return tomlkit.dumps(document)
+
+
+def _plain(item):
+    return item.unwrap() if hasattr(item, "unwrap") else item
+
+
+def _merge_table(table, data: dict, old_data: dict | None) -> None:
+    for key in [k for k in table if k not in data]:
+        del table[key]
+    for key, value in data.items():
+        before = old_data.get(key) if isinstance(old_data, dict) else None
+        if before is not None and _same(before, value):
+            continue  # unchanged: as the file has it, even if left out there
+        if key not in table:
+            table[key] = value
+        elif isinstance(value, dict) and isinstance(_plain(table[key]), dict):
+            _merge_table(table[key], value, before)
+        elif _is_table_list(value) and _is_table_list(_plain(table[key])) \
+                and len(value) == len(table[key]):
+            befores = before if _is_table_list(before) and len(before) == len(value) \
+                else [None] * len(value)
+            for old, new, old_new in zip(table[key], value, befores):  # segments keep comments
+                _merge_table(old, new, old_new)
+        elif not _same(_plain(table[key]), value):
+            table[key] = value
+
+
+def _is_table_list(value) -> bool:
+    return isinstance(value, list) and bool(value) and all(isinstance(v, dict) for v in value)
+
+
+def _same(old, new) -> bool:
+    """Equal values, 8 and 8.0 alike (a loaded int comes back a float), True never 1."""
+    return old == new and isinstance(old, bool) == isinstance(new, bool)

@@ -1,0 +1,80 @@
+"""Saving keeps the analyst's file: comments, key order and layout survive, only changed
+values change (tomlkit, see ladartui.scenario_style)."""
+
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import shutil
+from pathlib import Path
+
+import pytest
+
+from ladartui.scenario import load_scenario
+from ladartui.scenario_style import restyle
+from ladartui.scene.generate import generate_scene
+
+SHIPPED = Path(__file__).resolve().parent.parent / "scenarios"
+NAMES = ["flypast.toml", "manoeuvres.toml", "orbit.toml", "standoff.toml"]
+
+
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory):
+    """The shipped scenarios beside a small generated scene where they expect it."""
+    folder = tmp_path_factory.mktemp("shipped")
+    (folder / "generated").mkdir()
+    generate_scene("small", seed=1, width=16.0, depth=16.0, trees=3).write(
+        folder / "generated" / "small")
+    return folder
+
+
+def changed_lines(before: str, after: str) -> list[str]:
+    return [line for line in difflib.unified_diff(before.splitlines(), after.splitlines(),
+                                                  lineterm="", n=0)
+            if line[:1] in "+-" and line[:3] not in ("+++", "---")]
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_a_shipped_scenario_saved_unchanged_is_byte_for_byte_the_same(folder, name):
+    path = folder / name
+    shutil.copy(SHIPPED / name, path)
+    before = path.read_bytes()
+    load_scenario(path).save()
+    assert path.read_bytes() == before
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_an_edit_changes_only_its_own_line(folder, name):
+    path = folder / name
+    shutil.copy(SHIPPED / name, path)
+    before = path.read_text()
+    scenario = load_scenario(path)
+    scenario.with_changes(sensor=dataclasses.replace(scenario.sensor, grid=48)).save()
+    assert changed_lines(before, path.read_text()) == ["-grid = 64", "+grid = 48"]
+    assert load_scenario(path).sensor.grid == 48
+
+
+def test_a_segment_edit_keeps_the_comments_beside_its_keys(folder):
+    path = folder / "flypast.toml"
+    shutil.copy(SHIPPED / "flypast.toml", path)
+    before = path.read_text()
+    scenario = load_scenario(path)
+    segment = dataclasses.replace(scenario.flight.segments[0], altitude=75.0)
+    flight = dataclasses.replace(scenario.flight, segments=(segment,))
+    scenario.with_changes(flight=flight).save()
+    assert changed_lines(before, path.read_text()) == ["-altitude = 60.0", "+altitude = 75.0"]
+    assert "# horizontal distance at the closest point" in path.read_text()
+
+
+def test_save_as_keeps_the_comments_and_points_at_the_same_scene(folder, tmp_path):
+    path = folder / "orbit.toml"
+    shutil.copy(SHIPPED / "orbit.toml", path)
+    copy = load_scenario(path).save(tmp_path / "copy.toml")
+    text = copy.path.read_text()
+    assert text.startswith(SHIPPED.joinpath("orbit.toml").read_text().splitlines()[0])
+    assert load_scenario(copy.path).scene_file == (folder / "generated" / "small.txt")
+
+
+def test_text_that_is_not_toml_is_not_restyled():
+    assert restyle("grid = = 3", {"grid": 3}) is None
+    assert restyle("# kept\ngrid = 3\n", {"grid": 4}) == "# kept\ngrid = 4\n"

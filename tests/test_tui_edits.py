@@ -1,0 +1,169 @@
+"""The scenario on screen is the scenario that runs and is saved; file text is never markup.
+
+Pilot tests on a tiny generated scene: a value typed but not confirmed with
+Enter is committed by Run and Save (or stops them when invalid), an invalid
+value goes back to the scenario's value, and names or lines read from files
+are shown literally.
+"""
+
+from __future__ import annotations
+
+import shutil
+
+import pytest
+
+from ladartui.scenario import load_scenario, target_file_for
+from ladartui.tui.status import StatusBar
+from test_tui_flow import (LadarApp, field, loaded, make_scenario, scene_files,  # noqa: F401
+                           type_into, wait_until)
+
+SIZE = (100, 32)
+
+
+def copy_scene(source, scene) -> None:
+    """Copy a scene model and its target model (``X.txt`` and ``X_Target.txt``)."""
+    shutil.copy(source, scene)
+    shutil.copy(target_file_for(source), target_file_for(scene))
+
+
+def capture_runs(app) -> list:
+    """Replace the run worker by a recorder of the scenario it would run."""
+    runs = []
+    app._run_worker = lambda scenario, scene, fast, cancel: runs.append(scenario)
+    return runs
+
+
+async def test_a_value_typed_without_enter_is_used_by_run(tmp_path, scene_files):
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        runs = capture_runs(app)
+        app.action_show_tab("sensor")
+        await type_into(pilot, field(app, "sensor.grid"), "12", commit=None)
+        await pilot.press("f5")
+        await pilot.pause()
+        assert [run.sensor.grid for run in runs] == [12]
+
+
+async def test_a_value_typed_without_enter_is_what_ctrl_s_saves(tmp_path, scene_files):
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        app.action_show_tab("sensor")
+        await type_into(pilot, field(app, "sensor.grid"), "12", commit=None)
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        assert load_scenario(scenario.path).sensor.grid == 12
+        assert field(app, "sensor.grid").value == "12"
+        assert "(modified)" not in app.query_one(StatusBar).message
+        await type_into(pilot, field(app, "sensor.grid"), "16")
+        assert "(modified)" in app.query_one(StatusBar).message
+
+
+async def test_an_invalid_value_typed_stops_run_and_save_and_focuses_the_field(tmp_path,
+                                                                              scene_files):
+    scenario = make_scenario(tmp_path, scene_files)
+    before = scenario.path.read_bytes()
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        runs = capture_runs(app)
+        app.action_show_tab("sensor")
+        grid = field(app, "sensor.grid")
+        await type_into(pilot, grid, "0", commit=None)
+        for key in ("f5", "ctrl+s"):
+            app.messages.clear()
+            await pilot.press(key)
+            await pilot.pause()
+            assert app.focused is grid
+            assert "grid" in app.messages[-1] and "0" in app.messages[-1]
+        assert runs == []
+        assert scenario.path.read_bytes() == before
+        assert grid.value == "0"  # the typed text stays for the analyst to correct
+
+
+async def test_an_invalid_value_goes_back_to_the_scenarios_value(tmp_path, scene_files):
+    scenario = make_scenario(tmp_path, scene_files, grid=8, ray_grid=2)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        app.action_show_tab("sensor")
+        grid = field(app, "sensor.grid")
+        await type_into(pilot, grid, "0")
+        assert grid.value == "8" and app.scenario.sensor.grid == 8  # not the default 128
+        assert not app.modified
+        assert "8" in app.messages[-1]
+        ray_grid = field(app, "sensor.ray_grid")
+        await type_into(pilot, ray_grid, "x", commit="tab")
+        assert ray_grid.value == "2" and app.scenario.sensor.ray_grid == 2
+
+
+async def test_a_voxel_line_that_looks_like_markup_is_shown_not_parsed(tmp_path, scene_files):
+    scene = tmp_path / "odd.txt"
+    copy_scene(scene_files[0], scene)
+    with scene.open("a") as out:
+        out.write("[/oops],1,2\n")
+    scenario = make_scenario(tmp_path, (scene, *scene_files[1:]))
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: any("[/oops]" in m for m in app.messages))
+        await pilot.pause()
+        assert "[/oops]" in str(app.query_one("#run-info").render())
+
+
+async def test_a_file_name_that_looks_like_markup_is_shown_literally(tmp_path, scene_files):
+    scene = tmp_path / "[@click=app.quit]x.txt"
+    copy_scene(scene_files[0], scene)
+    scenario = make_scenario(tmp_path, (scene, *scene_files[1:]))
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        info = app.query_one("#file-info")
+        assert "[@click=app.quit]x.txt" in str(info.render())
+        await pilot.click("#file-info", offset=(20, 2))
+        await pilot.pause()
+        assert app.is_running
+
+
+async def test_quit_new_and_open_with_unsaved_edits_ask_first(tmp_path, scene_files):
+    from ladartui.tui.screens import SetupScreen
+    from ladartui.tui.unsaved import UnsavedScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        app.action_show_tab("sensor")
+        await type_into(pilot, field(app, "sensor.grid"), "12")
+        for key in ("ctrl+q", "f2", "f3"):
+            await pilot.press(key)
+            await pilot.pause()
+            assert isinstance(app.screen, UnsavedScreen), key
+            await pilot.click("#unsaved-cancel")
+            await pilot.pause()
+            assert app.is_running and not isinstance(app.screen, UnsavedScreen)
+        await pilot.press("f3")
+        await pilot.pause()
+        await pilot.click("#unsaved-discard")
+        await pilot.pause()
+        assert isinstance(app.screen, SetupScreen)
+        await pilot.press("escape")
+        await pilot.pause()
+        await pilot.press("ctrl+q")
+        await pilot.pause()
+        await pilot.click("#unsaved-save")
+        await pilot.pause()
+        assert not app.is_running
+    assert load_scenario(scenario.path).sensor.grid == 12
+
+
+async def test_quit_without_edits_does_not_ask(tmp_path, scene_files):
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        await pilot.press("ctrl+q")
+        await pilot.pause()
+        assert not app.is_running
