@@ -25,6 +25,7 @@ COMMANDS = {
     "bench": "bench",
     "study": "study",
     "sweep": "sweep",
+    "certs": "certs",
     "tui": "tui",
 }
 
