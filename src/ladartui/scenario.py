@@ -80,8 +80,9 @@ from pathlib import Path
 import tomli_w
 
 from ladartui.atomic import write_text_atomic
-from ladartui.scenario_style import restyle
 from ladartui.errors import FieldError, InputFileError, LadarError
+from ladartui.fileprobe import file_problem
+from ladartui.scenario_style import restyle
 from ladartui.flight import (
     MAX_SCANS,
     SEGMENT_KINDS,
@@ -215,10 +216,10 @@ class Scenario:
     def check_files(self) -> None:
         """InputFileError naming the first referenced model file that does not exist."""
         missing = None
-        if not self.scene_file.is_file():
-            missing = f"scene model file {self.scene_file} not found (files.scene)"
-        elif not self.target_file.is_file():
-            missing = (f"target model file {self.target_file} not found (the target model of "
+        if problem := file_problem(self.scene_file):
+            missing = f"scene model file {self.scene_file} {problem} (files.scene)"
+        elif problem := file_problem(self.target_file):
+            missing = (f"target model file {self.target_file} {problem} (the target model of "
                        f"{self.scene_file.name} must sit beside it, named "
                        f"{self.target_file.name})")
         if missing:

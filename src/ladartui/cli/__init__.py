@@ -13,6 +13,7 @@ import sys
 
 from ladartui import __version__
 from ladartui.errors import Cancelled, LadarError
+from ladartui.textsafe import one_line
 
 # Command name -> module under ladartui.cli. Modules load only when needed.
 COMMANDS = {
@@ -25,6 +26,7 @@ COMMANDS = {
     "study": "study",
     "sweep": "sweep",
     "pulses": "pulses",
+    "certs": "certs",
     "tui": "tui",
 }
 
@@ -67,7 +69,7 @@ def main(argv: list[str] | None = None) -> int:
             return 2
         return int(args.handler(args) or 0)
     except LadarError as error:
-        print(f"ladartui: error: {error}", file=sys.stderr)
+        print(f"ladartui: error: {one_line(error)}", file=sys.stderr)
         return 2
     except (Cancelled, KeyboardInterrupt):
         print("ladartui: cancelled; earlier outputs are unchanged", file=sys.stderr)

@@ -33,6 +33,13 @@ def add_parser(subparsers):
     parser.add_argument("--scheduler", metavar="ADDRESS",
                         help="address of a running Dask scheduler (tcp://HOST:PORT); default: "
                         "a local cluster on this machine")
+    parser.add_argument("--tls-ca-file", metavar="PEM",
+                        help="certificate authority of a TLS scheduler (ladartui certs DIR)")
+    parser.add_argument("--tls-cert", metavar="PEM", help="this client's TLS certificate")
+    parser.add_argument("--tls-key", metavar="PEM", help="this client's TLS private key")
+    parser.add_argument("--insecure", action="store_true",
+                        help="allow a plain tcp:// scheduler that is not on loopback (any "
+                        "peer that reaches it can run code on the cluster and here)")
     parser.add_argument("--connect-timeout", metavar="SECONDS", type=float, default=30.0,
                         help="how long to wait for the scheduler and a first worker (default 30)")
     parser.add_argument("--workers", metavar="N", type=int,
@@ -76,6 +83,16 @@ def run(args) -> int:
     if args.scheduler and (args.workers is not None or args.serial):
         raise FieldError("--scheduler", args.scheduler, "no --workers or --serial with it "
                          "(the cluster's workers run the sweep)")
+    security = None
+    if args.scheduler:
+        from ladartui.sweep.security import cluster_security
+
+        security = cluster_security(args.scheduler, args.tls_ca_file, args.tls_cert,
+                                    args.tls_key, args.insecure)
+    elif args.tls_ca_file or args.tls_cert or args.tls_key or args.insecure:
+        raise FieldError("--scheduler", None, "an address with the TLS or --insecure flags "
+                         "(the local cluster listens on 127.0.0.1 only)")
+    args.security = security
     spec = load_sweep_spec(args.spec)
     objective = normal_objective(args.objective or spec.objective)
     normal_cost(args.cost or spec.cost)
@@ -111,7 +128,7 @@ def _sweep_with_progress(spec, args, console):
 
     from ladartui.sweep import connect, run_sweep
 
-    client = connect(args.scheduler, args.connect_timeout) if args.scheduler else None
+    client = connect(args.scheduler, args.connect_timeout, args.security) if args.scheduler else None
     cancel = threading.Event()
     outcome = {}
     columns = (

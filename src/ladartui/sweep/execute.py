@@ -337,13 +337,16 @@ def local_client(workers: int | None = None):
     return Client(cluster)
 
 
-def connect(address: str, timeout: float = 30.0):
-    """A client of the Dask scheduler at ``address`` that has ladartui on every worker."""
+def connect(address: str, timeout: float = 30.0, security=None):
+    """A client of the Dask scheduler at ``address`` that has ladartui on every worker.
+
+    ``security``: a ``distributed.Security`` for a TLS scheduler (see ``sweep.security``).
+    """
     from distributed import Client
 
     try:
-        client = Client(address, timeout=f"{timeout}s")
-    except (OSError, TimeoutError, ValueError) as error:
+        client = Client(address, timeout=f"{timeout}s", security=security)
+    except (OSError, TimeoutError, ValueError, TypeError) as error:  # TypeError: tls:// sans TLS
         raise FieldError("--scheduler", address, f"the address of a running Dask scheduler "
                          f"(tcp://HOST:PORT); connecting failed: {error}") from None
     try:

@@ -1,0 +1,26 @@
+"""Why an input path cannot be read as a file, in words, without raising."""
+
+import errno
+import os
+from pathlib import Path
+
+
+def file_problem(path: Path) -> str | None:
+    """None when ``path`` is a regular file; else what is wrong ("not found", "is a folder", ...)."""
+    try:
+        if Path(path).is_file():
+            return None
+        if Path(path).is_dir():
+            return "is a folder, expected a file"
+        return "not found"
+    except OSError as error:
+        if error.errno == errno.ENAMETOOLONG:
+            return f"name too long for this system (at most {_name_max(path)} characters a name)"
+        return f"cannot be read ({os.strerror(error.errno) if error.errno else error})"
+
+
+def _name_max(path: Path) -> int:
+    try:
+        return os.pathconf(Path(path).anchor or ".", "PC_NAME_MAX")
+    except (OSError, ValueError):
+        return 255

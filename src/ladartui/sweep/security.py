@@ -1,0 +1,116 @@
+"""Who may talk to the sweep's Dask cluster: mutual TLS, or a plain address on loopback only.
+
+A peer that reaches a Dask scheduler without TLS can run any code on the
+scheduler and every worker, and a rogue worker can hand this client an object
+that runs code when unpickled. So a plain ``tcp://`` address is accepted only
+on loopback (or with ``--insecure``); other clusters use TLS with certificates
+signed by one certificate authority (``ladartui certs DIR`` makes them).
+"""
+
+from __future__ import annotations
+
+import datetime
+import ipaddress
+import os
+from pathlib import Path
+from urllib.parse import urlsplit
+
+from ladartui.errors import FieldError
+from ladartui.fileprobe import file_problem
+
+CA_FILE = "ca.pem"
+CERT_FILE = "cluster.pem"
+KEY_FILE = "cluster-key.pem"
+
+
+def is_loopback(address: str) -> bool:
+    """Whether the host of ``address`` (``tcp://HOST:PORT`` or ``HOST:PORT``) is this machine only."""
+    host = urlsplit(address if "://" in address else f"tcp://{address}").hostname or ""
+    if host == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
+
+
+def cluster_security(address: str, ca_file=None, cert_file=None, key_file=None,
+                     insecure: bool = False):
+    """The ``distributed.Security`` for ``address``, or None for a permitted plain address.
+
+    Raises FieldError naming the flag: a TLS file missing or unreadable, TLS files with
+    a plain address, or a plain address off loopback without ``insecure``.
+    """
+    files = {"--tls-ca-file": ca_file, "--tls-cert": cert_file, "--tls-key": key_file}
+    scheme = address.split("://", 1)[0] if "://" in address else "tcp"
+    if any(files.values()):
+        for flag, path in files.items():
+            if not path:
+                raise FieldError(flag, None, "a PEM file (TLS needs --tls-ca-file, --tls-cert "
+                                 "and --tls-key together; ladartui certs DIR makes them)")
+            if problem := file_problem(Path(path)):
+                raise FieldError(flag, str(path), f"a readable PEM file; it {problem}")
+        if scheme != "tls":
+            raise FieldError("--scheduler", address, "a tls://HOST:PORT address with the TLS "
+                             "files (the scheduler must be started with the same certificates)")
+        from distributed.security import Security
+
+        return Security(tls_ca_file=str(ca_file), tls_client_cert=str(cert_file),
+                        tls_client_key=str(key_file), require_encryption=True)
+    if scheme == "tls":
+        raise FieldError("--scheduler", address, "--tls-ca-file, --tls-cert and --tls-key "
+                         "with a tls:// address")
+    if not insecure and not is_loopback(address):
+        raise FieldError("--scheduler", address, "a tls:// address with --tls-ca-file, "
+                         "--tls-cert and --tls-key, or a loopback address: any peer that "
+                         "reaches a plain tcp:// scheduler can run code on it, its workers "
+                         "and this machine (see docs/sweeps.md; --insecure to use it anyway)")
+    return None
+
+
+def make_certificates(folder, days: int = 365) -> dict[str, Path]:
+    """Write a new certificate authority and one cluster certificate and key into ``folder``.
+
+    Scheduler, workers and client all present the cluster certificate; each accepts only
+    peers whose certificate the authority signed. The keys are readable by the owner only.
+    """
+    from cryptography import x509
+    from cryptography.hazmat.primitives import hashes, serialization
+    from cryptography.hazmat.primitives.asymmetric import ec
+    from cryptography.x509.oid import ExtendedKeyUsageOID, NameOID
+
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    now = datetime.datetime.now(datetime.timezone.utc)
+    start, end = now - datetime.timedelta(minutes=5), now + datetime.timedelta(days=days)
+
+    def name(text):
+        return x509.Name([x509.NameAttribute(NameOID.COMMON_NAME, text)])
+
+    ca_key = ec.generate_private_key(ec.SECP256R1())
+    ca_cert = (x509.CertificateBuilder().subject_name(name("ladartui cluster CA"))
+               .issuer_name(name("ladartui cluster CA")).public_key(ca_key.public_key())
+               .serial_number(x509.random_serial_number()).not_valid_before(start)
+               .not_valid_after(end)
+               .add_extension(x509.BasicConstraints(ca=True, path_length=0), critical=True)
+               .sign(ca_key, hashes.SHA256()))
+    key = ec.generate_private_key(ec.SECP256R1())
+    cert = (x509.CertificateBuilder().subject_name(name("ladartui cluster"))
+            .issuer_name(ca_cert.subject).public_key(key.public_key())
+            .serial_number(x509.random_serial_number()).not_valid_before(start)
+            .not_valid_after(end)
+            .add_extension(x509.BasicConstraints(ca=False, path_length=None), critical=True)
+            .add_extension(x509.ExtendedKeyUsage([ExtendedKeyUsageOID.SERVER_AUTH,
+                                                  ExtendedKeyUsageOID.CLIENT_AUTH]),
+                           critical=False)
+            .sign(ca_key, hashes.SHA256()))
+    pem = serialization.Encoding.PEM
+    paths = {"ca": folder / CA_FILE, "cert": folder / CERT_FILE, "key": folder / KEY_FILE}
+    paths["ca"].write_bytes(ca_cert.public_bytes(pem))
+    paths["cert"].write_bytes(cert.public_bytes(pem))
+    descriptor = os.open(paths["key"], os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+    with os.fdopen(descriptor, "wb") as out:
+        out.write(key.private_bytes(pem, serialization.PrivateFormat.PKCS8,
+                                    serialization.NoEncryption()))
+    os.chmod(paths["key"], 0o600)
+    return paths

@@ -1,0 +1,24 @@
+"""Safe one-line text for messages: control characters escaped, length capped.
+
+Text from files, file names and scenario fields can hold terminal escapes, line
+breaks or megabytes; a message shows it as one readable line. Core module (no UI
+imports) so the CLI and the TUI both use it.
+"""
+
+MAX_MESSAGE_CHARS = 400
+
+
+def _visible(char: str) -> str:
+    code = ord(char)
+    if code < 0x20 or 0x7F <= code < 0xA0 or code in (0x2028, 0x2029):
+        return f"\\x{code:02x}" if code < 0x100 else f"\\u{code:04x}"
+    return char
+
+
+def one_line(text: object, limit: int = MAX_MESSAGE_CHARS) -> str:
+    """``text`` as one line: control characters written as ``\\xNN``, at most ``limit`` characters."""
+    safe = "".join(_visible(char) for char in str(text))
+    if len(safe) <= limit:
+        return safe
+    dropped = len(safe) - limit
+    return f"{safe[:limit]}... ({dropped} more characters)"

@@ -1,0 +1,55 @@
+from pathlib import Path
+
+import ladartui
+
+from ladartui.cli import main
+from ladartui.textsafe import one_line
+
+DEFAULT = (Path(ladartui.__file__).parent / "scenarios" / "default.toml").read_text(encoding="utf-8")
+
+
+def _scenario_with_scene(tmp_path, scene_toml_string):
+    path = tmp_path / "s.toml"
+    path.write_text(DEFAULT.replace('scene = "small.txt"', f"scene = {scene_toml_string}"),
+                    encoding="utf-8")
+    return path
+
+
+def test_one_line_escapes_terminal_controls_and_line_breaks():
+    text = "scene \x1b]0;PWNED\x07 a\r\nb\x9b"
+    safe = one_line(text)
+    assert "\x1b" not in safe and "\x07" not in safe and "\r" not in safe
+    assert "\n" not in safe and "\x9b" not in safe
+    assert safe == "scene \\x1b]0;PWNED\\x07 a\\x0d\\x0ab\\x9b"
+
+
+def test_one_line_caps_length_and_says_how_much_was_cut():
+    safe = one_line("x" * 10_000, limit=100)
+    assert safe.startswith("x" * 100)
+    assert safe.endswith("(9900 more characters)")
+    assert len(safe) < 140
+
+
+def test_cli_error_with_escape_in_scenario_value_reaches_terminal_escaped(tmp_path, capsys):
+    scenario = _scenario_with_scene(tmp_path, '"\\u001b]0;PWNED\\u0007x.txt"')
+    code = main(["validate", str(scenario)])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert "\x1b" not in err and "\x07" not in err
+    assert "\\x1b]0;PWNED" in err
+    assert err.count("\n") == 1
+
+
+def test_cli_error_message_is_capped(tmp_path, capsys):
+    scenario = _scenario_with_scene(tmp_path, '"' + "y" * 100_000 + '.txt"')
+    assert main(["validate", str(scenario)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and len(err) < 1000
+
+
+def test_scene_that_is_a_folder_is_not_reported_as_missing(tmp_path, capsys):
+    (tmp_path / "forest.txt").mkdir()
+    scenario = _scenario_with_scene(tmp_path, '"forest.txt"')
+    assert main(["validate", str(scenario)]) == 2
+    err = capsys.readouterr().err
+    assert "is a folder, expected a file (files.scene)" in err and "not found" not in err
