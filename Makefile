@@ -5,13 +5,21 @@ VENV := .venv
 STAMP := $(VENV)/.installed
 export PYTHONDONTWRITEBYTECODE := 1
 
-.PHONY: run test bench setup system-deps
+.PHONY: run test lint bench setup system-deps
 
 run: setup
 	$(VENV)/bin/ladartui
 
 test: setup
 	$(VENV)/bin/python -m pytest -q
+
+# Style and types (configured in pyproject.toml). Not yet part of `make test`:
+# the tree needs one `ruff format` / `ruff check --fix` pass and the mypy
+# findings fixed first (see README, "Checks").
+lint: setup
+	$(VENV)/bin/ruff check src tests
+	$(VENV)/bin/ruff format --check src tests
+	$(VENV)/bin/mypy
 
 bench: setup
 	$(VENV)/bin/ladartui bench
