@@ -44,6 +44,46 @@ def test_trace_march_with_voxel_size(tmp_path, scene_file):
     assert np.load(out)[0, :4].tolist() == [1, 5, 5, 1]
 
 
+def _three_rays(tmp_path):
+    rays = np.array([
+        [5.0, 5.0, 20.0, 0.0, 0.0, -1.0],
+        [2.0, 2.0, 20.0, 0.0, 0.0, -1.0],
+        [2.0, 2.0, 20.0, 0.0, 0.0, 1.0],
+    ])
+    np.save(tmp_path / "rays.npy", rays)
+    return tmp_path / "rays.npy"
+
+
+def test_trace_precision_f32_on_wgpu(tmp_path, scene_file, capsys, wgpu_backend):
+    rays = _three_rays(tmp_path)
+    hits = {}
+    for precision in ("f64", "f32"):
+        out = tmp_path / f"hits-{precision}.npy"
+        assert main(["trace", "--scene", str(scene_file), "--rays", str(rays), "--out", str(out),
+                     "--backend", "wgpu", "--precision", precision]) == 0
+        hits[precision] = np.load(out)
+        err = capsys.readouterr().err
+    # the message names the arithmetic the backend used
+    assert "wgpu, exact, f32" in err
+    np.testing.assert_array_equal(hits["f32"][:, :4], hits["f64"][:, :4])
+    assert hits["f32"][0, 4] == pytest.approx(18.5)
+
+
+def test_trace_precision_reported_and_checked(tmp_path, scene_file, capsys):
+    rays = _three_rays(tmp_path)
+    out = tmp_path / "hits.npy"
+    assert main(["trace", "--scene", str(scene_file), "--rays", str(rays), "--out", str(out),
+                 "--backend", "numba", "--precision", "f32"]) == 0
+    # numba has only f64 kernels: the line says what was traced, not what was asked
+    assert "numba, exact, f64" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as stop:
+        main(["trace", "--scene", str(scene_file), "--rays", str(rays), "--out", str(out),
+              "--precision", "f16"])
+    assert stop.value.code == 2
+    err = capsys.readouterr().err
+    assert "--precision" in err and "f16" in err and "Traceback" not in err
+
+
 @pytest.mark.parametrize("array, expected", [
     (np.zeros((4, 5)), "(4, 5)"),
     (np.zeros(6), "(6,)"),

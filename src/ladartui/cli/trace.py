@@ -28,6 +28,9 @@ def add_parser(subparsers):
     parser.add_argument("--method", default="exact", help="exact (default) or march")
     parser.add_argument("--step", type=float, default=None, help="march step in voxels (0.5)")
     parser.add_argument("--voxel-size", type=float, default=1.0, help="metres per voxel (1.0)")
+    parser.add_argument("--precision", default="f64", choices=("f64", "f32"),
+                        help="arithmetic of the trace: f64 (default) or f32, as in the API; "
+                        "a backend without f32 kernels traces in f64 and says so")
     parser.set_defaults(handler=run)
 
 
@@ -65,11 +68,12 @@ def run(args):
     voxels = load_voxels(args.scene)
     occupancy = Occupancy.build(voxels)
     result = trace(occupancy, rays[:, :3], rays[:, 3:], backend=args.backend, method=args.method,
-                   step=args.step, voxel_size=args.voxel_size)
+                   step=args.step, precision=args.precision, voxel_size=args.voxel_size)
     with atomic_path(args.out) as tmp:
         with open(tmp, "wb") as handle:
             np.save(handle, result.as_array())
     counts = np.bincount(result.kind, minlength=3)
-    print(f"{len(rays)} rays ({result.backend}, {result.method}): {counts[1]} voxel, "
+    used = result.info.get("precision", args.precision)
+    print(f"{len(rays)} rays ({result.backend}, {result.method}, {used}): {counts[1]} voxel, "
           f"{counts[2]} ground, {counts[0]} miss -> {args.out}", file=sys.stderr)
     return 0
