@@ -33,7 +33,7 @@ from ladartui.tui.measures_view import compact_rows
 from ladartui.tui.screens import (AngleScreen, CompareScreen, FormScreen, HelpScreen,
                                   MeasuresScreen, PosesScreen, SetupScreen, ThresholdScreen)
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
-from ladartui.tui.unsaved import UnsavedScreen
+from ladartui.tui.unsaved import EditGuard
 
 SCENE_POINTS = 80_000  # voxels drawn in the 3D scene view, whatever the scene size
 OUTPUT_POINTS = 80_000
@@ -107,7 +107,7 @@ def prepare_views(scene) -> dict:
             "target_m": tuple(float(v) for v in scene.target_centre_m())}
 
 
-class LadarApp(App):
+class LadarApp(EditGuard, App):
     """Plan a foliage-penetrating LADAR collection: set up, fly, run, compare."""
 
     TITLE = "ladartui"
@@ -606,28 +606,6 @@ class LadarApp(App):
             self._rescale_scene(scenario.voxel_size)
         self.update_scenario(scenario)
 
-    def commit_pending(self) -> bool:
-        """Commit every field whose text differs from its committed value.
-
-        Run, Save and every action that reads the scenario call this first, so
-        nothing runs or is saved that differs from the screen. An invalid
-        pending value stops the action: the field is focused and the app says
-        why; False is returned.
-        """
-        if self.scenario is None:
-            return True
-        for field in self.query(NumberField).results(NumberField):
-            if field.value == field.committed:
-                continue
-            problem = field.problem()
-            if problem is not None:
-                field.focus()
-                self.tell(f"{problem}. Correct the value and try again.",
-                          title="Not done: invalid value", severity="error", timeout=8)
-                return False
-            self.commit_field(field)
-        return True
-
     def _rescale_scene(self, voxel_size: float) -> None:
         from ladartui.scene.model import Scene
 
@@ -805,27 +783,6 @@ class LadarApp(App):
     @on(Button.Pressed, "#btn-open")
     def action_open_scenario(self) -> None:
         self._setup("load")
-
-    def unsaved(self) -> bool:
-        """Edits that a save would keep: committed ones, or text typed in a field."""
-        return self.scenario is not None and (
-            self.modified or any(f.value != f.committed for f in self.query(NumberField)))
-
-    def confirm_discard(self, doing: str, then) -> None:
-        """Call ``then`` once unsaved edits are saved or the analyst chose to discard them."""
-        if not self.unsaved():
-            then()
-            return
-
-        def chosen(choice):
-            if choice == "save":
-                self.action_save()
-                if not self.unsaved():
-                    then()
-            elif choice == "discard":
-                then()
-
-        self.push_screen(UnsavedScreen(self.scenario.path.name, doing), chosen)
 
     async def action_quit(self) -> None:
         self.confirm_discard("quit", self.exit)

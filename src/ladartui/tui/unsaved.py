@@ -1,4 +1,5 @@
-"""The question asked before unsaved edits would be discarded: save, discard or cancel."""
+"""Unsaved edits: fields typed but not committed, and the save / discard / cancel
+question asked before they would be lost."""
 
 from __future__ import annotations
 
@@ -9,6 +10,8 @@ from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.screen import ModalScreen
 from textual.widgets import Button, Static
+
+from ladartui.tui.fields import NumberField
 
 
 class UnsavedScreen(ModalScreen[str | None]):
@@ -43,3 +46,51 @@ class UnsavedScreen(ModalScreen[str | None]):
 
     def action_cancel(self) -> None:
         self.dismiss(None)
+
+
+class EditGuard:
+    """The app's guard over pending and unsaved edits (mixed into ``LadarApp``, which
+    provides ``scenario``, ``modified``, ``commit_field``, ``tell`` and ``action_save``)."""
+
+    def commit_pending(self) -> bool:
+        """Commit every field whose text differs from its committed value.
+
+        Run, Save and every action that reads the scenario call this first, so
+        nothing runs or is saved that differs from the screen. An invalid
+        pending value stops the action: the field is focused and the app says
+        why; False is returned.
+        """
+        if self.scenario is None:
+            return True
+        for field in self.query(NumberField).results(NumberField):
+            if field.value == field.committed:
+                continue
+            problem = field.problem()
+            if problem is not None:
+                field.focus()
+                self.tell(f"{problem}. Correct the value and try again.",
+                          title="Not done: invalid value", severity="error", timeout=8)
+                return False
+            self.commit_field(field)
+        return True
+
+    def unsaved(self) -> bool:
+        """Edits that a save would keep: committed ones, or text typed in a field."""
+        return self.scenario is not None and (
+            self.modified or any(f.value != f.committed for f in self.query(NumberField)))
+
+    def confirm_discard(self, doing: str, then) -> None:
+        """Call ``then`` once unsaved edits are saved or the analyst chose to discard them."""
+        if not self.unsaved():
+            then()
+            return
+
+        def chosen(choice):
+            if choice == "save":
+                self.action_save()
+                if not self.unsaved():
+                    then()
+            elif choice == "discard":
+                then()
+
+        self.push_screen(UnsavedScreen(self.scenario.path.name, doing), chosen)
