@@ -56,8 +56,8 @@ def test_pose_normalises_angles():
 @pytest.mark.parametrize("field,value,message", [
     ("depression", 0.5, "depression = 0.5: expected a number from 1 to 90"),
     ("depression", 91, "depression = 91: expected a number from 1 to 90"),
-    ("z", 0, "z = 0: expected a number greater than 0 and at most 100000"),
-    ("z", -3.0, "z = -3.0: expected a number greater than 0 and at most 100000"),
+    ("z", 0, "z = 0: expected a number greater than 0 and at most 20000"),
+    ("z", -3.0, "z = -3.0: expected a number greater than 0 and at most 20000"),
     ("x", float("nan"), "x = nan: expected a number from -1000000 to 1000000"),
     ("heading", "north", "heading = 'north': expected a finite number"),
     ("azimuth", True, "azimuth = True: expected a finite number"),

@@ -128,7 +128,7 @@ async def test_a_file_name_that_looks_like_markup_is_shown_literally(tmp_path, s
 
 
 async def test_quit_new_and_open_with_unsaved_edits_ask_first(tmp_path, scene_files):
-    from ladartui.tui.screens import SetupScreen
+    from ladartui.tui.file_dialogs import SetupScreen
     from ladartui.tui.unsaved import UnsavedScreen
 
     scenario = make_scenario(tmp_path, scene_files)

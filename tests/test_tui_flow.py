@@ -24,7 +24,8 @@ from ladartui.tui.app import CONTROLS, LadarApp
 from ladartui.tui.canvas import ProjectionWidget, TopViewWidget
 from ladartui.tui.fields import NumberField
 from ladartui.tui.measures_view import compact_rows
-from ladartui.tui.screens import CompareScreen, FormScreen, HelpScreen, SetupScreen
+from ladartui.tui.file_dialogs import SetupScreen
+from ladartui.tui.screens import AngleScreen, CompareScreen, FormScreen, HelpScreen
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
 from ladartui.tui.warmup import tiny_run
 
@@ -150,7 +151,12 @@ async def test_invalid_values_go_back_to_the_scenarios_value_with_a_message(shar
     fov = field(app, "sensor.fov")
     await type_into(pilot, fov, "abc", commit="tab")  # leaving the field commits too
     assert fov.value == "8" and app.scenario.sensor.fov == 8.0
-    assert "fov" in app.messages[-1]
+    # the message speaks the form's words: the label, its unit and the range in that unit
+    assert "Field of view deg: abc is not allowed" in app.messages[-1]
+    pitch = field(app, "sensor.pixel_pitch")
+    await type_into(pilot, pitch, "50000")
+    assert "Pixel pitch um: 50000 is not allowed" in app.messages[-1]
+    assert "at most 10000 um" in app.messages[-1]  # micrometres, as typed, not metres
     # a good value is kept
     await type_into(pilot, field(app, "sensor.ray_grid"), "3")
     assert app.scenario.sensor.ray_grid == 3
@@ -161,11 +167,11 @@ async def test_invalid_values_go_back_to_the_scenarios_value_with_a_message(shar
 async def test_a_bad_value_being_typed_turns_the_status_yellow_and_names_it(shared, tmp_path,
                                                                            scene_files):
     pilot, app = await fresh(shared)
-    app.action_show_tab("flight")
-    depression = field(app, "start.depression")
-    await type_into(pilot, depression, "95", commit=None)
+    app.action_show_tab("sensor")
+    fov = field(app, "sensor.fov")
+    await type_into(pilot, fov, "95", commit=None)
     assert status(app).state == NOT_READY
-    assert "start.depression" in status(app).message
+    assert "Field of view deg" in status(app).message
     # F5 stays offered: it refuses the typed value itself, naming it (tests/test_tui_edits.py)
     await pilot.press("enter")
     await pilot.pause()
@@ -251,8 +257,11 @@ async def test_a_run_disables_controls_and_cancel_keeps_earlier_outputs(tmp_path
         await wait_until(pilot, lambda: app.busy is None, timeout=30)
         assert "cancelled" in app.messages[-1].lower()
         assert [p.read_bytes() for p in outputs] == before
+        # enabled again, except the march step (exact method) and the start pose (an orbit
+        # starts at its own first scan)
         assert all(not w.disabled for w in app.query("#sidebar Input") if
-                   w.id != "f-scenario-step")
+                   w.id != "f-scenario-step" and not w.id.startswith("f-start"))
+        assert all(w.disabled for w in app.query("#sidebar Input") if w.id.startswith("f-start"))
         assert status(app).state == READY
 
 
@@ -324,8 +333,8 @@ async def test_height_threshold_limits_the_output_view(shared, tmp_path, scene_f
 
 
 @pytest.mark.asyncio(loop_scope="module")
-async def test_loading_a_scenario_with_a_missing_file_names_it_and_loads_nothing(shared, 
-        tmp_path, scene_files):
+async def test_a_missing_model_is_refused_but_missing_outputs_open(shared, tmp_path,
+                                                                   scene_files):
     good = make_scenario(tmp_path, scene_files, name="good")
     broken = tmp_path / "broken.toml"
     broken.write_text(good.path.read_text().replace(str(Path(scene_files[0]).name),
@@ -335,19 +344,30 @@ async def test_loading_a_scenario_with_a_missing_file_names_it_and_loads_nothing
     partial.scene_output.write_text("1,2,3\n")
     partial.measures_file.write_text("")
     pilot, app = await fresh(shared)
-    for path, missing in ((broken, "nowhere.txt"), (partial.path, "partial_Target.txt")):
-        await pilot.press("f3")
-        await pilot.pause()
-        assert isinstance(app.screen, SetupScreen) and app.screen.mode == "load"
-        app.screen.query_one("#scenario-file").value = str(path)
-        app.screen.query_one("#setup-ok").press()
-        await pilot.pause()
-        await pilot.pause()
-        message = str(app.screen.query_one("#setup-message").render())
-        assert missing in message
-        await pilot.press("escape")
-        await pilot.pause()
-        assert app.scenario.path == shared[1].path
+    # a missing scene model: named, and nothing is loaded
+    await pilot.press("f3")
+    await pilot.pause()
+    assert isinstance(app.screen, SetupScreen) and app.screen.mode == "load"
+    app.screen.query_one("#scenario-file").value = str(broken)
+    app.screen.query_one("#setup-ok").press()
+    await pilot.pause()
+    await pilot.pause()
+    assert "nowhere.txt" in str(app.screen.query_one("#setup-message").render())
+    await pilot.press("escape")
+    await pilot.pause()
+    assert app.scenario.path == shared[1].path
+    # missing outputs: it opens, says which are missing (yellow) and can still be run
+    await pilot.press("f3")
+    await pilot.pause()
+    app.screen.query_one("#scenario-file").value = str(partial.path)
+    app.screen.query_one("#setup-ok").press()
+    await wait_until(pilot, lambda: app.scenario.path == partial.path and app.busy is None)
+    await pilot.pause()
+    assert status(app).state == NOT_READY
+    assert "partial_Target.txt" in status(app).message
+    assert "partial_Target.txt" in str(app.query_one("#file-info").render())
+    assert app.check_action("run", ()) is True
+    app.set_scenario(shared[1], modified=False)  # leave the shared app as it was
 
 
 @pytest.mark.asyncio(loop_scope="module")
@@ -376,7 +396,11 @@ async def test_3d_view_rotates_zooms_and_takes_an_exact_angle(shared, tmp_path, 
     app.screen.query_one("#form-ok").press()
     await pilot.pause()
     await pilot.pause()
-    assert "elevation" in str(app.screen.query_one("#form-message").render())
+    # refused in the form's words; the dialog stays open with the value to correct
+    assert "Elevation (deg): 120 is not allowed" in str(
+        app.screen.query_one("#form-message").render())
+    assert isinstance(app.screen, AngleScreen)
+    assert app.screen.query_one("#f-elevation").value == "120"
     await pilot.press("escape")
 
 
@@ -411,10 +435,17 @@ async def test_flight_segments_are_added_edited_and_checked(shared, tmp_path, sc
     assert isinstance(form, FormScreen)
     distance = form.query_one("#f-distance")
     await type_into(pilot, distance, "-5", commit="tab")
-    assert distance.value == "100"  # reset to the form's default
-    assert "distance" in str(form.query_one("#form-message").render())
+    # the value stays for correcting, marked, with why in the form's words
+    assert distance.value == "-5" and distance.has_class("-bad")
+    assert "Distance m: -5 is not allowed" in str(form.query_one("#form-message").render())
     form.query_one("#f-scans").value = "3"
-    app.screen.query_one("#form-ok").press()
+    form.query_one("#form-ok").press()  # OK refuses: nothing is replaced unseen
+    await pilot.pause()
+    assert app.screen is form and app.focused is distance
+    assert [s.kind for s in app.scenario.flight.segments] == ["orbit"]
+    assert "Distance m: -5 is not allowed" in str(form.query_one("#form-message").render())
+    distance.value = "100"
+    form.query_one("#form-ok").press()
     await pilot.pause()
     await pilot.pause()
     kinds = [s.kind for s in app.scenario.flight.segments]

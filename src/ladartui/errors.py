@@ -18,10 +18,13 @@ class InputFileError(LadarError):
 class FieldError(LadarError):
     """A scenario, form or flag field outside its allowed values."""
 
-    def __init__(self, field, value, expected, source=None):
+    def __init__(self, field, value, expected, source=None, limits=None):
         self.field = field
         self.value = value
         self.expected = expected
+        # (low, high, low_open, high_open) of a numeric range, so a form can say the
+        # range in its own units; None for other checks
+        self.limits = limits
         prefix = f"{source}: " if source else ""
         super().__init__(f"{prefix}{field} = {value!r}: expected {expected}")
 

@@ -30,7 +30,7 @@ import numpy as np
 from ladartui.errors import FieldError
 
 MAX_COORDINATE = 1e6  # metres; a scene is never larger than a few kilometres
-MAX_ALTITUDE = 1e5
+MAX_ALTITUDE = 20_000.0  # metres; above the ceiling of any high-altitude UAV (about 18 km)
 MAX_SCANS = 10_000
 DIRECTIONS = ("left", "right")
 
@@ -49,8 +49,14 @@ def number_field(name, value, low=None, high=None, *, low_open=False, high_open=
     if ok and high is not None:
         ok = number < high if high_open else number <= high
     if not ok:
-        raise FieldError(name, value, _range_text("a number", low, high, low_open, high_open))
+        raise FieldError(name, value, range_text("a number", low, high, low_open, high_open),
+                         limits=(low, high, low_open, high_open))
     return number
+
+
+def compass_field(name, value):
+    """A compass angle typed by a person: degrees from 0 to 360 (computed headings fold)."""
+    return number_field(name, value, 0.0, 360.0)
 
 
 def integer_field(name, value, low, high):
@@ -60,7 +66,8 @@ def integer_field(name, value, low, high):
     except TypeError:
         number = None
     if number is None or not low <= number <= high:
-        raise FieldError(name, value, f"an integer from {low} to {high}")
+        raise FieldError(name, value, f"an integer from {low} to {high}",
+                         limits=(low, high, False, False))
     return int(number)
 
 
@@ -87,7 +94,7 @@ def point_field(name, value):
     return (xyz[0], xyz[1], xyz[2] if len(xyz) == 3 else 0.0)
 
 
-def _range_text(kind, low, high, low_open, high_open):
+def range_text(kind, low, high, low_open, high_open):
     if low is not None and high is not None:
         if not low_open and not high_open:
             return f"{kind} from {_num(low)} to {_num(high)}"
@@ -597,6 +604,11 @@ class FlightPlan:
         if self.start is not None and not isinstance(self.start, ScanPose):
             raise FieldError("start", self.start, "a ScanPose")
 
+    @property
+    def uses_start(self) -> bool:
+        """Whether ``start`` shapes the path: only when the first segment is relative."""
+        return bool(self.segments) and self.segments[0].relative
+
     def segment_poses(self) -> list[list[ScanPose]]:
         """The scans of each segment, in order."""
         current = self.start
@@ -642,7 +654,7 @@ class FlightPlan:
 
 
 def _prefixed(error: FieldError, prefix: str) -> FieldError:
-    return FieldError(prefix + error.field, error.value, error.expected)
+    return FieldError(prefix + error.field, error.value, error.expected, limits=error.limits)
 
 
 def path_length(poses: Sequence[ScanPose]) -> float:

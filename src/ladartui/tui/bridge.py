@@ -13,7 +13,7 @@ from pathlib import Path
 
 from ladartui.errors import FieldError, InputFileError, LadarError
 from ladartui.flight import (SEGMENT_KINDS, FlightPlan, Manual, ScanPose, aim_at,
-                             number_field)
+                             compass_field, number_field)
 from ladartui.scenario import Scenario, load_scenario, target_file_for
 from ladartui.sensor import Sensor
 
@@ -24,6 +24,7 @@ class Param:
 
     key: str  # "sensor.grid", "scenario.speed", "start.x"
     label: str
+    unit: str = ""  # the unit typed in the field (after ``scale``)
     integer: bool = False
     scale: float = 1.0  # field units -> stored units
 
@@ -39,24 +40,24 @@ class Param:
 SENSOR_PARAMS = [
     Param("sensor.grid", "Sensor grid n", integer=True),
     Param("sensor.ray_grid", "Ray grid m", integer=True),
-    Param("sensor.fov", "Field of view deg"),
-    Param("sensor.depth_resolution", "Depth res. m"),
-    Param("sensor.pixel_pitch", "Pixel pitch um", scale=1e-6),
+    Param("sensor.fov", "Field of view", "deg"),
+    Param("sensor.depth_resolution", "Depth res.", "m"),
+    Param("sensor.pixel_pitch", "Pixel pitch", "um", scale=1e-6),
 ]
 START_PARAMS = [
-    Param("start.x", "Start x m"),
-    Param("start.y", "Start y m"),
-    Param("start.z", "Altitude m"),
-    Param("start.heading", "Heading deg"),
-    Param("start.azimuth", "Sensor az deg"),
-    Param("start.depression", "Depression deg"),
-    Param("scenario.speed", "Speed m/s"),
+    Param("start.x", "Start x", "m"),
+    Param("start.y", "Start y", "m"),
+    Param("start.z", "Altitude", "m"),
+    Param("start.heading", "Heading", "deg"),
+    Param("start.azimuth", "Sensor az", "deg"),
+    Param("start.depression", "Depression", "deg"),
 ]
+FLIGHT_PARAMS = [Param("scenario.speed", "Speed", "m/s")]
 RUN_PARAMS = [
-    Param("scenario.voxel_size", "Voxel size m"),
-    Param("scenario.step", "March step vox"),
+    Param("scenario.voxel_size", "Voxel size", "m"),
+    Param("scenario.step", "March step", "vox"),
 ]
-ALL_PARAMS = {p.key: p for p in SENSOR_PARAMS + START_PARAMS + RUN_PARAMS}
+ALL_PARAMS = {p.key: p for p in SENSOR_PARAMS + START_PARAMS + FLIGHT_PARAMS + RUN_PARAMS}
 
 _POSE_FIELDS = ("x", "y", "z", "heading", "azimuth", "depression")
 
@@ -100,13 +101,17 @@ def with_param(scenario: Scenario, key: str, value) -> Scenario:
         try:
             sensor = dataclasses.replace(scenario.sensor, **{name: value})
         except FieldError as error:
-            raise FieldError(f"sensor.{error.field}", error.value, error.expected) from None
+            raise FieldError(f"sensor.{error.field}", error.value, error.expected,
+                             limits=error.limits) from None
         return scenario.with_changes(sensor=sensor)
     if group == "start":
+        if name == "heading":
+            value = compass_field("heading", value)
         try:
             start = dataclasses.replace(start_pose(scenario), **{name: value})
         except FieldError as error:
-            raise FieldError(f"start.{error.field}", error.value, error.expected) from None
+            raise FieldError(f"start.{error.field}", error.value, error.expected,
+                             limits=error.limits) from None
         return scenario.with_changes(flight=FlightPlan(start, scenario.flight.segments))
     return scenario.with_changes(**{name: value})
 
@@ -267,19 +272,19 @@ def new_scenario(scenario_path: Path, scene_path: Path, voxel_size: float = 1.0)
 
 
 def load_checked(path: Path) -> Scenario:
-    """Load a scenario after checking every file it names.
+    """Load a scenario after checking that the model files it names exist.
 
-    Model files must exist. Outputs are all present (a finished run) or all
-    absent (not run yet); a partial set names the missing file.
+    Missing outputs do not stop it (``missing_outputs`` lists them; a run
+    writes them); a missing scene or target model does, with the file named.
     """
-    scenario = load_scenario(path)
+    return load_scenario(path)
+
+
+def missing_outputs(scenario: Scenario) -> list[Path]:
+    """The outputs of a partial set: empty when all are on disk or none are (not run)."""
     outputs = [scenario.scene_output, scenario.target_output, scenario.measures_file]
-    present = [p.is_file() for p in outputs]
-    if any(present) and not all(present):
-        missing = outputs[present.index(False)]
-        raise InputFileError(missing, "output file not found, though the scenario's other "
-                             "outputs exist; run the scenario again to rebuild them")
-    return scenario
+    missing = [p for p in outputs if not p.is_file()]
+    return [] if len(missing) == len(outputs) else missing
 
 
 def read_measures_files(paths) -> list:

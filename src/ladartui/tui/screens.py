@@ -13,8 +13,7 @@ from textual.binding import Binding
 from textual.containers import Grid, Horizontal, Vertical, VerticalScroll
 from textual.screen import ModalScreen
 from textual.suggester import Suggester
-from textual.widgets import (Button, DataTable, Input, Label, RadioButton, RadioSet, Select,
-                             Static)
+from textual.widgets import Button, DataTable, Input, Label, Select, Static
 
 from ladartui.errors import FieldError, LadarError
 from ladartui.tui import bridge
@@ -70,115 +69,6 @@ class Dialog(ModalScreen):
 
 def _row(label: str, widget) -> Horizontal:
     return Horizontal(Label(label), widget, classes="row")
-
-
-class SetupScreen(Dialog):
-    """File setup (report figure 9): a new scenario or an existing one.
-
-    New: choose the scenario file and the scene model; the target model and the
-    output names are derived and shown. Load: every file is checked; a missing
-    one is named and nothing is loaded. Dismisses with the loaded Scenario.
-    """
-
-    def __init__(self, mode: str = "new", folder: Path | None = None):
-        super().__init__()
-        self.mode = mode
-        self.folder = folder or Path.cwd()
-
-    def compose(self) -> ComposeResult:
-        with Vertical(classes="dialog", id="setup") as box:
-            box.border_title = "Setup scenario"
-            with RadioSet(id="mode"):
-                yield RadioButton("New scenario", value=self.mode == "new", id="mode-new")
-                yield RadioButton("Load scenario", value=self.mode == "load", id="mode-load")
-            yield _row("Scenario file", Input(placeholder="name.toml", id="scenario-file",
-                                              compact=True,
-                                              suggester=PathSuggester((".toml",))))
-            yield _row("3D scene model", Input(placeholder="scene.txt", id="scene-file",
-                                               compact=True,
-                                               suggester=PathSuggester((".txt",))))
-            yield _row("Voxel size m", NumberField("voxel size", 1.0, default=1.0,
-                                                   check=bridge.check_voxel_size,
-                                                   id="voxel-size"))
-            yield Static("", id="derived", classes="info")
-            yield Static("", id="setup-message", classes="message")
-            with Horizontal(classes="buttons"):
-                yield Button("OK", id="setup-ok", variant="primary", compact=True)
-                yield Button("Cancel", id="setup-cancel", compact=True)
-
-    def on_mount(self) -> None:
-        self._apply_mode()
-        self.query_one("#scenario-file", Input).focus()
-
-    @on(RadioSet.Changed, "#mode")
-    def _mode_changed(self, event: RadioSet.Changed) -> None:
-        self.mode = "new" if event.pressed.id == "mode-new" else "load"
-        self._apply_mode()
-
-    def _apply_mode(self) -> None:
-        self.query_one("#scene-file", Input).disabled = self.mode != "new"
-        self.query_one("#voxel-size", Input).disabled = self.mode != "new"
-        self._show_derived()
-
-    @on(Input.Changed)
-    def _typed(self, event: Input.Changed) -> None:
-        self.query_one("#setup-message", Static).update("")
-        if isinstance(event.input, NumberField):
-            event.input.set_class(event.input.problem() is not None, "-bad")
-        self._show_derived()
-
-    def on_input_blurred(self, event: Input.Blurred) -> None:
-        if isinstance(event.input, NumberField):
-            self._commit_voxel_size()
-
-    def _commit_voxel_size(self) -> float:
-        widget = self.query_one("#voxel-size", NumberField)
-        problem = widget.problem()
-        if problem:
-            widget.reset_to_default()
-            self.query_one("#setup-message", Static).update(
-                escape(f"{problem}; reset to {widget.value}"))
-        return widget.parsed()
-
-    def _paths(self):
-        scenario = self.query_one("#scenario-file", Input).value.strip()
-        scene = self.query_one("#scene-file", Input).value.strip()
-        scenario_path = self.folder / Path(scenario).expanduser() if scenario else None
-        scene_path = self.folder / Path(scene).expanduser() if scene else None
-        return scenario_path, scene_path
-
-    def _show_derived(self) -> None:
-        scenario_path, scene_path = self._paths()
-        if self.mode == "new":
-            names = bridge.derived_names(scenario_path, scene_path)
-            text = escape("\n".join(f"{label:<26}{value}" for label, value in names))
-        else:
-            text = "Every file of the scenario is checked before anything is loaded."
-        self.query_one("#derived", Static).update(text)
-
-    @on(Input.Submitted)
-    @on(Button.Pressed, "#setup-ok")
-    def _ok(self, event=None) -> None:
-        scenario_path, scene_path = self._paths()
-        message = self.query_one("#setup-message", Static)
-        try:
-            if scenario_path is None:
-                raise FieldError("scenario file", "", "a file name")
-            if self.mode == "new":
-                if scene_path is None:
-                    raise FieldError("scene model", "", "a scene model file (.txt)")
-                voxel_size = self._commit_voxel_size()
-                scenario = bridge.new_scenario(scenario_path, scene_path, voxel_size)
-            else:
-                scenario = bridge.load_checked(scenario_path)
-        except LadarError as error:
-            message.update(escape(str(error)))
-            return
-        self.dismiss(scenario)
-
-    @on(Button.Pressed, "#setup-cancel")
-    def _cancel(self) -> None:
-        self.dismiss(None)
 
 
 class FormScreen(Dialog):
@@ -261,15 +151,20 @@ class FormScreen(Dialog):
         return out
 
     def on_input_blurred(self, event: Input.Blurred) -> None:
-        self._commit(event.input)
+        self._check(event.input)
 
-    def _commit(self, widget) -> bool:
-        message = self.query_one("#form-message", Static)
+    def _label(self, name: str) -> str:
+        return next((label for n, label, *_ in self.spec if n == name), name)
+
+    def _check(self, widget) -> bool:
+        """Say why a typed value is refused (the text stays, marked, for correcting)."""
         if isinstance(widget, NumberField):
             problem = widget.problem()
             if problem:
-                widget.reset_to_default()
-                message.update(escape(f"{problem}; reset to {widget.value or 'empty'}"))
+                widget.add_class("-bad")
+                self.query_one("#form-message", Static).update(
+                    escape(f"{self._label(widget.field_name)}: {widget.value.strip() or 'empty'}"
+                           f" is not allowed; expected {problem.split('expected ', 1)[-1]}"))
                 return False
         return True
 
@@ -281,23 +176,21 @@ class FormScreen(Dialog):
     @on(Input.Submitted)
     @on(Button.Pressed, "#form-ok")
     def _ok(self, event=None) -> None:
-        if isinstance(event, Input.Submitted) and not self._commit(event.input):
-            return
+        # nothing is replaced behind the analyst's back: an invalid field stops OK
+        for widget in self.query(NumberField):
+            if not self._check(widget):
+                widget.focus()
+                return
         message = self.query_one("#form-message", Static)
         try:
             result = self.build(self.values())
         except LadarError as error:
-            message.update(escape(str(error)))
-            # reset the field the core named, so the form is usable again
-            for name, *_ in self.spec:
+            text = str(error)
+            for name, label, *_ in self.spec:
                 if isinstance(error, FieldError) and _field_matches(error.field, name):
-                    widget = self.query_one(f"#f-{name}")
-                    if isinstance(widget, NumberField):
-                        widget.reset_to_default()
-                        message.update(escape(f"{error}; reset to its default"))
-                    elif isinstance(widget, Input):
-                        widget.value = widget.default_text
-                        message.update(escape(f"{error}; reset to its default"))
+                    self.query_one(f"#f-{name}").focus()
+                    text = f"{label}: {error.value!r} is not allowed; expected {error.expected}"
+            message.update(escape(text))
             return
         self.cancelled = False
         self.dismiss(result)

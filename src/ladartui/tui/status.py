@@ -34,7 +34,7 @@ class StatusBar(Horizontal):
 
     def compose(self) -> ComposeResult:
         yield Static(LABELS[NOT_READY], id="status-word")
-        yield Static("", id="status-text")
+        yield Static("", id="status-text", markup=False)  # names from files: plain text
         yield Button("Cancel", id="cancel", compact=True, variant="error", disabled=True)
 
     def on_mount(self) -> None:

@@ -62,7 +62,7 @@ class EditGuard:
         """
         if self.scenario is None:
             return True
-        for field in self.query(NumberField).results(NumberField):
+        for field in self.query(".param").results(NumberField):
             if field.value == field.committed:
                 continue
             problem = field.problem()
@@ -77,7 +77,8 @@ class EditGuard:
     def unsaved(self) -> bool:
         """Edits that a save would keep: committed ones, or text typed in a field."""
         return self.scenario is not None and (
-            self.modified or any(f.value != f.committed for f in self.query(NumberField)))
+            self.modified or any(f.value != f.committed
+                                 for f in self.query(".param").results(NumberField)))
 
     def confirm_discard(self, doing: str, then) -> None:
         """Call ``then`` once unsaved edits are saved or the analyst chose to discard them."""

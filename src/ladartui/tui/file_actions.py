@@ -1,0 +1,93 @@
+"""New, Open, Save, Save As and the recent list, as the app runs them.
+
+Every action that would replace the scenario asks first when there are
+unsaved edits (``confirm_discard``); a save first commits what is typed in
+the fields (``commit_pending``), so what is written is what is on screen.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ladartui.errors import LadarError
+from ladartui.recent import remember_scenario
+from ladartui.tui.file_dialogs import SaveAsScreen, SetupScreen
+
+
+class FileActions:
+    """Mixed into ``LadarApp``, which provides the scenario model, ``load`` and ``tell``."""
+
+    def _folder(self) -> Path:
+        return self.scenario.path.parent if self.scenario else self.cwd
+
+    def action_new_scenario(self) -> None:
+        self._setup("new")
+
+    def action_open_scenario(self) -> None:
+        self._setup("load")
+
+    def _setup(self, mode: str) -> None:
+        if self.busy:
+            return
+        self.confirm_discard("open another scenario" if mode == "load" else
+                             "start a new one", lambda: self._open_setup(mode))
+
+    def _open_setup(self, mode: str) -> None:
+        def done(scenario):
+            if scenario is not None:
+                self.result = None
+                self.load(None, scenario=scenario)
+
+        self.push_screen(SetupScreen(mode, self._folder()), done)
+
+    def open_path(self, path: Path) -> None:
+        """Open a scenario file (recent list, best sweep path), asking about unsaved edits."""
+        if self.busy:
+            return
+
+        def load():
+            self.result = None
+            self.load(path)
+
+        self.confirm_discard(f"open {path.name}", load)
+
+    def action_open_recent(self, path: str) -> None:
+        self.open_path(Path(path))
+
+    def action_save(self) -> None:
+        if self.scenario is None or self.busy or not self.commit_pending():
+            return
+        self._save_to(None)
+
+    def action_save_as(self) -> None:
+        if self.scenario is None or self.busy or not self.commit_pending():
+            return
+
+        def chosen(path):
+            if path is not None:
+                self._save_to(path)
+
+        self.push_screen(SaveAsScreen(self.scenario.path), chosen)
+
+    def _save_to(self, path: Path | None) -> bool:
+        """Write the scenario (to ``path`` for Save As); True when written."""
+        renamed = path is not None and Path(path) != self.scenario.path
+        try:
+            saved = self.scenario.save(path)
+        except (LadarError, OSError) as error:
+            self.tell(str(error), title="Not saved", severity="error")
+            return False
+        if renamed:
+            self.history.reset(saved)  # undo must not bring back the old file name
+            self.result = None
+            self.output_voxels = None  # the outputs of the old name are not this file's
+            self.show_output()
+            self.show_measures(None)
+        else:
+            self.history.mark_saved(saved)
+        self.scenario = saved
+        remember_scenario(saved.path)
+        self.scenario_changed()
+        self.file_panel.show_recent(saved.path)
+        self.tell(f"Saved {saved.path}")
+        return True

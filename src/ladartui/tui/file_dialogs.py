@@ -1,0 +1,262 @@
+"""Choosing files: the setup dialog (new or open), Save As, and the folder tree in both.
+
+Every path can be typed (with completion from the disk) or picked in the
+tree; picking a file fills the field that takes its kind (a scenario, a
+scene model). The checks are the core's: a missing model or a name that
+exists is refused with the file named.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from rich.markup import escape
+from textual import on
+from textual.app import ComposeResult
+from textual.containers import Horizontal, Vertical
+from textual.widgets import Button, DirectoryTree, Input, RadioButton, RadioSet, Static
+
+from ladartui.errors import FieldError, LadarError
+from ladartui.tui import bridge
+from ladartui.tui.fields import NumberField
+from ladartui.tui.screens import Dialog, PathSuggester, _row
+
+SCENARIO_SUFFIXES = (".toml",)
+SCENE_SUFFIXES = (".txt", ".las", ".laz")
+
+
+class FileTree(DirectoryTree):
+    """Folders, and the files with one of ``suffixes``; hidden entries left out."""
+
+    DEFAULT_CSS = "FileTree { height: 9; border: round $panel-lighten-2; }"
+
+    def __init__(self, path: Path, suffixes: tuple[str, ...], **kwargs):
+        super().__init__(path, **kwargs)
+        self.suffixes = suffixes
+
+    def filter_paths(self, paths):
+        return [p for p in paths if not p.name.startswith(".")
+                and (p.is_dir() or p.suffix.lower() in self.suffixes)]
+
+
+class TreeDialog(Dialog):
+    """A dialog with a folder tree whose root can move up a folder."""
+
+    folder: Path
+
+    def tree_rows(self, suffixes) -> ComposeResult:
+        with Horizontal(classes="buttons tree-buttons"):
+            yield Static("", id="tree-root", classes="info")
+            yield Button("Up a folder", id="tree-up", compact=True)
+        yield FileTree(self.folder, suffixes, id="tree")
+
+    def on_mount(self) -> None:
+        self._show_root()
+
+    def _show_root(self) -> None:
+        self.query_one("#tree-root", Static).update(f"Folder: {escape(str(self.folder))}")
+
+    @on(Button.Pressed, "#tree-up")
+    def _up(self) -> None:
+        self.folder = self.folder.parent
+        self.query_one(FileTree).path = self.folder
+        self._show_root()
+
+    def relative(self, path: Path) -> str:
+        try:
+            return str(path.relative_to(self.base))
+        except ValueError:
+            return str(path)
+
+    base: Path
+
+
+class SetupScreen(TreeDialog):
+    """File setup (report figure 9): a new scenario or an existing one.
+
+    New: choose the scenario file and the scene model; the target model and the
+    output names are derived and shown. Load: every file is checked; a missing
+    model is named and nothing is loaded. Dismisses with the loaded Scenario.
+    """
+
+    DEFAULT_CSS = "SetupScreen .tree-buttons { margin-top: 0; align-horizontal: left; }"
+
+    def __init__(self, mode: str = "new", folder: Path | None = None):
+        super().__init__()
+        self.mode = mode
+        self.base = folder or Path.cwd()
+        self.folder = self.base
+
+    def compose(self) -> ComposeResult:
+        with Vertical(classes="dialog", id="setup") as box:
+            box.border_title = "Setup scenario"
+            with RadioSet(id="mode"):
+                yield RadioButton("New scenario", value=self.mode == "new", id="mode-new")
+                yield RadioButton("Open scenario", value=self.mode == "load", id="mode-load")
+            yield from self.tree_rows(SCENARIO_SUFFIXES + SCENE_SUFFIXES)
+            yield _row("Scenario file", Input(placeholder="name.toml", id="scenario-file",
+                                              compact=True,
+                                              suggester=PathSuggester(SCENARIO_SUFFIXES)))
+            yield _row("3D scene model", Input(placeholder="scene.txt", id="scene-file",
+                                               compact=True,
+                                               suggester=PathSuggester(SCENE_SUFFIXES)))
+            yield _row("Voxel size m", NumberField("voxel size", 1.0, default=1.0,
+                                                   check=bridge.check_voxel_size,
+                                                   id="voxel-size"))
+            yield Static("", id="derived", classes="info")
+            yield Static("", id="setup-message", classes="message", markup=False)
+            with Horizontal(classes="buttons"):
+                yield Button("OK", id="setup-ok", variant="primary", compact=True)
+                yield Button("Cancel", id="setup-cancel", compact=True)
+
+    def on_mount(self) -> None:
+        super().on_mount()
+        self._apply_mode()
+        self.query_one("#scenario-file", Input).focus()
+
+    @on(RadioSet.Changed, "#mode")
+    def _mode_changed(self, event: RadioSet.Changed) -> None:
+        self.mode = "new" if event.pressed.id == "mode-new" else "load"
+        self._apply_mode()
+
+    def _apply_mode(self) -> None:
+        self.query_one("#scene-file", Input).disabled = self.mode != "new"
+        self.query_one("#voxel-size", Input).disabled = self.mode != "new"
+        self._show_derived()
+
+    @on(DirectoryTree.FileSelected, "#tree")
+    def _picked(self, event: DirectoryTree.FileSelected) -> None:
+        event.stop()
+        path = Path(event.path)
+        if path.suffix.lower() in SCENARIO_SUFFIXES:
+            self.query_one("#scenario-file", Input).value = self.relative(path)
+        elif self.mode == "new":
+            self.query_one("#scene-file", Input).value = self.relative(path)
+        else:
+            self.query_one("#setup-message", Static).update(
+                f"{path.name} is a scene model: choose New scenario to make a scenario "
+                "for it, or pick a .toml scenario")
+
+    @on(Input.Changed)
+    def _typed(self, event: Input.Changed) -> None:
+        self.query_one("#setup-message", Static).update("")
+        if isinstance(event.input, NumberField):
+            event.input.set_class(event.input.problem() is not None, "-bad")
+        self._show_derived()
+
+    def _paths(self):
+        scenario = self.query_one("#scenario-file", Input).value.strip()
+        scene = self.query_one("#scene-file", Input).value.strip()
+        scenario_path = self.base / Path(scenario).expanduser() if scenario else None
+        scene_path = self.base / Path(scene).expanduser() if scene else None
+        return scenario_path, scene_path
+
+    def _show_derived(self) -> None:
+        scenario_path, scene_path = self._paths()
+        if self.mode == "new":
+            names = bridge.derived_names(scenario_path, scene_path)
+            text = escape("\n".join(f"{label:<26}{value}" for label, value in names))
+        else:
+            text = ("Every model file of the scenario is checked before anything is loaded; "
+                    "missing outputs are listed, and F5 writes them.")
+        self.query_one("#derived", Static).update(text)
+
+    @on(Input.Submitted)
+    @on(Button.Pressed, "#setup-ok")
+    def _ok(self, event=None) -> None:
+        scenario_path, scene_path = self._paths()
+        message = self.query_one("#setup-message", Static)
+        try:
+            if scenario_path is None:
+                raise FieldError("scenario file", "", "a file name")
+            if self.mode == "new":
+                if scene_path is None:
+                    raise FieldError("scene model", "", "a scene model file (.txt)")
+                field = self.query_one("#voxel-size", NumberField)
+                problem = field.problem()
+                if problem:
+                    field.focus()
+                    raise FieldError("voxel size m", field.value.strip(),
+                                     problem.split("expected ", 1)[-1])
+                scenario = bridge.new_scenario(scenario_path, scene_path, field.parsed())
+            else:
+                scenario = bridge.load_checked(scenario_path)
+        except LadarError as error:
+            message.update(str(error))
+            return
+        self.dismiss(scenario)
+
+    @on(Button.Pressed, "#setup-cancel")
+    def _cancel(self) -> None:
+        self.dismiss(None)
+
+
+class SaveAsScreen(TreeDialog):
+    """Choose a new file name for the scenario; dismisses with the path (not yet written).
+
+    An existing file is refused unless the analyst confirms by pressing OK a
+    second time with the same name.
+    """
+
+    DEFAULT_CSS = "SaveAsScreen .tree-buttons { margin-top: 0; align-horizontal: left; }"
+
+    def __init__(self, current: Path):
+        super().__init__()
+        self.base = current.parent
+        self.folder = self.base
+        self.current = current
+        self.confirmed: Path | None = None
+
+    def compose(self) -> ComposeResult:
+        with Vertical(classes="dialog", id="save-as") as box:
+            box.border_title = "Save scenario as"
+            yield from self.tree_rows(SCENARIO_SUFFIXES)
+            yield _row("Scenario file", Input(self.current.name, id="save-as-file",
+                                              compact=True,
+                                              suggester=PathSuggester(SCENARIO_SUFFIXES)))
+            yield Static("Outputs are named after the scenario and sit beside it.",
+                         classes="info")
+            yield Static("", id="save-as-message", classes="message", markup=False)
+            with Horizontal(classes="buttons"):
+                yield Button("OK", id="save-as-ok", variant="primary", compact=True)
+                yield Button("Cancel", id="save-as-cancel", compact=True)
+
+    def on_mount(self) -> None:
+        super().on_mount()
+        self.query_one("#save-as-file", Input).focus()
+
+    @on(DirectoryTree.FileSelected, "#tree")
+    def _picked(self, event: DirectoryTree.FileSelected) -> None:
+        event.stop()
+        self.query_one("#save-as-file", Input).value = self.relative(Path(event.path))
+
+    @on(Input.Changed, "#save-as-file")
+    def _typed(self) -> None:
+        self.query_one("#save-as-message", Static).update("")
+
+    @on(Input.Submitted, "#save-as-file")
+    @on(Button.Pressed, "#save-as-ok")
+    def _ok(self) -> None:
+        text = self.query_one("#save-as-file", Input).value.strip()
+        message = self.query_one("#save-as-message", Static)
+        if not text:
+            message.update("Scenario file: empty; expected a file name")
+            return
+        path = (self.base / Path(text).expanduser()).resolve()
+        if path.suffix != ".toml":
+            path = path.with_name(path.name + ".toml")
+        if path.is_dir():
+            message.update(f"{path}: is a folder; expected a scenario file name")
+            return
+        if not path.parent.is_dir():
+            message.update(f"{path.parent}: folder not found")
+            return
+        if path.exists() and path != self.current.resolve() and self.confirmed != path:
+            self.confirmed = path
+            message.update(f"{path.name} exists: OK again replaces it")
+            return
+        self.dismiss(path)
+
+    @on(Button.Pressed, "#save-as-cancel")
+    def _cancel(self) -> None:
+        self.dismiss(None)

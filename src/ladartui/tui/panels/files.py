@@ -1,0 +1,90 @@
+"""The File tab: what the scenario reads and writes, New / Open / Save / Save As, and
+the scenarios opened lately."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from rich.text import Text
+from textual import on
+from textual.containers import Grid, VerticalScroll
+from textual.widgets import Button, Label, OptionList, Static
+from textual.widgets.option_list import Option
+
+from ladartui.recent import recent_scenarios
+
+
+class FilePanel(VerticalScroll):
+    DEFAULT_CLASSES = "pane"
+
+    def compose(self):
+        yield Static("", id="file-info")
+        with Grid(classes="button-grid file-buttons"):
+            yield Button("New F2", id="btn-new", compact=True)
+            yield Button("Open F3", id="btn-open", compact=True)
+            yield Button("Save ^S", id="btn-save", compact=True)
+            yield Button("Save as", id="btn-save-as", compact=True)
+            yield Button("Undo ^Z", id="btn-undo", compact=True)
+            yield Button("Redo ^Y", id="btn-redo", compact=True)
+        yield Label("Recent scenarios (Enter opens)", classes="heading", id="recent-heading")
+        yield OptionList(id="recent", compact=True)
+
+    def on_mount(self) -> None:
+        self.show_recent()
+
+    def show(self, scenario, scene, modified: bool, missing: list[Path] = ()) -> None:
+        if scenario is None:
+            self.query_one("#file-info", Static).update("No scenario: F2 new, F3 open.")
+            return
+        voxels = f"{len(scene.voxels):,} voxels" if scene is not None else ""
+        target = f"{len(scene.target):,} voxels" if scene is not None else ""
+        rows = [("Scenario", scenario.path.name + (" (modified)" if modified else "")),
+                ("Folder", shown_folder(scenario.path.parent)),
+                ("Scene model", scenario.scene_file.name), ("", voxels),
+                ("Target model", scenario.target_file.name), ("", target),
+                ("Scene output", scenario.scene_output.name),
+                ("Target output", scenario.target_output.name),
+                ("Measures", scenario.measures_file.name)]
+        text = Text()
+        for key, value in rows:
+            if not value:
+                continue
+            if text:
+                text.append("\n")
+            text.append(f"{key:<14}", style="bold")
+            text.append(value)  # names from files and fields: plain text, never markup
+        if missing:
+            text.append("\nNot on disk yet: " + ", ".join(p.name for p in missing)
+                        + " (F5 writes them)", style="yellow")
+        self.query_one("#file-info", Static).update(text)
+
+    def show_recent(self, current: Path | None = None) -> None:
+        listing = self.query_one("#recent", OptionList)
+        listing.clear_options()
+        paths = [p for p in recent_scenarios() if p != current]
+        for path in paths:
+            listing.add_option(Option(Text(f"{path.name}  {shown_folder(path.parent)}"),
+                                      id=str(path)))
+        listing.display = bool(paths)
+        self.query_one("#recent-heading", Label).display = bool(paths)
+
+    @on(OptionList.OptionSelected, "#recent")
+    def _recent_chosen(self, event: OptionList.OptionSelected) -> None:
+        event.stop()
+        self.app.open_path(Path(event.option.id))
+
+    @on(Button.Pressed, "#btn-new,#btn-open,#btn-save,#btn-save-as,#btn-undo,#btn-redo")
+    async def _pressed(self, event: Button.Pressed) -> None:
+        event.stop()
+        action = {"btn-new": "new_scenario", "btn-open": "open_scenario", "btn-save": "save",
+                  "btn-save-as": "save_as", "btn-undo": "undo", "btn-redo": "redo"}
+        await self.app.run_action(action[event.button.id])
+
+
+def shown_folder(folder: Path) -> str:
+    """The folder relative to the working directory when inside it (shorter, and stable)."""
+    try:
+        relative = folder.relative_to(Path.cwd())
+    except ValueError:
+        return str(folder)
+    return "./" + str(relative) if str(relative) != "." else "."

@@ -1,0 +1,224 @@
+"""The Flight tab: speed, the start pose, the segments of the path and the scans they make.
+
+The start pose shapes the path only when the first segment is relative (a
+straight or a turn); otherwise its fields are disabled, with a note, rather
+than accepting values that change nothing.
+"""
+
+from __future__ import annotations
+
+from textual import on
+from textual.containers import Grid
+from textual.widgets import Button, DataTable, Label, Static
+
+from ladartui.errors import LadarError
+from ladartui.flight import Manual
+from ladartui.tui import bridge
+from ladartui.tui.params import ParamPanel, field_id
+from ladartui.tui.screens import FormScreen, PosesScreen
+
+ADD_BUTTONS = "#add-straight,#add-turn,#add-orbit,#add-flypast,#add-standoff"
+START_UNUSED = "The path starts at its first segment: the start pose is not used."
+
+
+class FlightPanel(ParamPanel):
+    def compose(self):
+        for param in bridge.FLIGHT_PARAMS + bridge.START_PARAMS:
+            yield self.param_row(param)
+        yield Static("", id="start-note", classes="info", markup=False)
+        yield Label("Segments (Enter edits)", classes="heading")
+        yield DataTable(id="segments", cursor_type="row", zebra_stripes=True)
+        with Grid(classes="button-grid"):
+            yield Button("Straight", id="add-straight", compact=True)
+            yield Button("Turn", id="add-turn", compact=True)
+            yield Button("Orbit", id="add-orbit", compact=True)
+            yield Button("Fly-past", id="add-flypast", compact=True)
+            yield Button("Standoff", id="add-standoff", compact=True)
+            yield Button("Poses", id="add-manual", compact=True)
+            yield Button("Edit", id="seg-edit", compact=True)
+            yield Button("Delete", id="seg-delete", compact=True)
+            yield Button("Aim all", id="aim-all", compact=True)
+        yield Label("Scans", classes="heading")
+        yield DataTable(id="scans", cursor_type="row", zebra_stripes=True)
+
+    def on_mount(self) -> None:
+        self.query_one("#segments", DataTable).add_columns("#", "Kind", "Scans", "Detail")
+        self.query_one("#scans", DataTable).add_columns("#", "x", "y", "z", "hdg", "az", "dep")
+
+    # -- showing the scenario --------------------------------------------------------
+
+    def show(self, scenario) -> None:
+        self.fill_fields(scenario)
+        self.enable_start(scenario)
+        self._fill_tables(scenario)
+
+    def enable_start(self, scenario=None) -> None:
+        """Start fields only where the path uses them (and never while busy)."""
+        scenario = scenario or self.app.scenario
+        used = scenario is not None and scenario.flight.uses_start
+        for param in bridge.START_PARAMS:
+            self.query_one("#" + field_id(param.key)).disabled = not used or bool(self.app.busy)
+        note = self.query_one("#start-note", Static)
+        note.update("" if used else START_UNUSED)
+        note.display = not used
+
+    def _fill_tables(self, scenario) -> None:
+        segments = self.query_one("#segments", DataTable)
+        row = segments.cursor_row
+        segments.clear()
+        try:
+            per_segment = scenario.flight.segment_poses()
+        except LadarError:
+            per_segment = [[] for _ in scenario.flight.segments]
+        for i, (segment, poses) in enumerate(zip(scenario.flight.segments, per_segment)):
+            segments.add_row(str(i + 1), bridge.SEGMENT_LABELS.get(segment.kind, segment.kind),
+                             str(len(poses)), bridge.segment_summary(segment))
+        if segments.row_count:
+            segments.move_cursor(row=min(max(row, 0), segments.row_count - 1))
+        scans = self.query_one("#scans", DataTable)
+        scans.clear()
+        for i, p in enumerate(pose for poses in per_segment for pose in poses):
+            scans.add_row(str(i + 1), f"{p.x:.1f}", f"{p.y:.1f}", f"{p.z:.1f}",
+                          f"{p.heading:.0f}", f"{p.azimuth:.0f}", f"{p.depression:.0f}")
+
+    # -- editing segments ------------------------------------------------------------
+
+    def _editable(self) -> bool:
+        return self.app.scenario is not None and not self.app.busy
+
+    def selected(self) -> int:
+        return self.query_one("#segments", DataTable).cursor_row
+
+    @on(Button.Pressed, ADD_BUTTONS)
+    def _add_pressed(self, event: Button.Pressed) -> None:
+        event.stop()
+        self.add_segment(event.button.id.removeprefix("add-"))
+
+    def add_segment(self, kind: str) -> None:
+        if not self._editable():
+            return
+        poses = self.app.scenario.poses()
+        segment = bridge.default_segment(kind, self.app.target_m(), poses[-1] if poses else None)
+        self._edit_segment(segment, None)
+
+    def _edit_segment(self, segment, index: int | None) -> None:
+        defaults = bridge.default_segment(segment.kind, self.app.target_m(), None)
+        spec = bridge.segment_spec(segment, defaults)
+        label = bridge.SEGMENT_LABELS[segment.kind]
+        title = label + (" (new)" if index is None else "")
+
+        def done(result):
+            if result is not None:
+                what = f"add {label.lower()}" if index is None else f"edit segment {index + 1}"
+                self._put_segment(index, result, what)
+
+        self.app.push_screen(FormScreen(title, spec, bridge.segment_builder(segment.kind),
+                                        note="Empty optional fields keep the current "
+                                             "pointing."), done)
+
+    def _put_segment(self, index: int | None, segment, what: str) -> bool:
+        """Replace segment ``index``, or append when ``index`` is None."""
+        segments = list(self.app.scenario.flight.segments)
+        if index is None:
+            segments.append(segment)
+        else:
+            segments[index] = segment
+        return self._apply_segments(segments, what)
+
+    def _apply_segments(self, segments, what: str) -> bool:
+        try:
+            scenario = bridge.with_segments(self.app.scenario, segments)
+        except LadarError as error:
+            self.app.tell(str(error), title="Flight path not changed", severity="error")
+            return False
+        self.app.edit(scenario, what.capitalize())
+        return True
+
+    @on(Button.Pressed, "#add-manual")
+    def _manual_pressed(self, event: Button.Pressed) -> None:
+        event.stop()
+        self.manual_poses()
+
+    def manual_poses(self) -> None:
+        """Edit manual poses: the selected manual segment, or a new one."""
+        if not self._editable():
+            return
+        segments = self.app.scenario.flight.segments
+        index = self.selected()
+        if 0 <= index < len(segments) and segments[index].kind == "manual":
+            self._edit_poses(index)
+        else:
+            poses = self.app.scenario.poses()
+            start = poses[-1] if poses else bridge.start_pose(self.app.scenario)
+            self._edit_poses(None, [start])
+
+    def _edit_poses(self, index: int | None, poses=None) -> None:
+        if poses is None:
+            poses = list(self.app.scenario.flight.segments[index].poses)
+
+        def done(result):
+            if not result:
+                if result is not None:
+                    self.app.tell("A manual segment needs at least one pose; not changed.",
+                                  severity="warning")
+                return
+            what = "add manual poses" if index is None else f"edit poses of segment {index + 1}"
+            self._put_segment(index, Manual(tuple(result)), what)
+
+        self.app.push_screen(PosesScreen(poses, bridge.start_pose(self.app.scenario)), done)
+
+    @on(Button.Pressed, "#seg-edit")
+    def _edit_pressed(self, event: Button.Pressed) -> None:
+        event.stop()
+        self.edit_selected()
+
+    @on(DataTable.RowSelected, "#segments")
+    def _segment_selected(self, event: DataTable.RowSelected) -> None:
+        event.stop()
+        self.edit_selected()
+
+    def edit_selected(self) -> None:
+        if not self._editable():
+            return
+        index = self.selected()
+        segments = self.app.scenario.flight.segments
+        if not 0 <= index < len(segments):
+            return
+        if segments[index].kind == "manual":
+            self._edit_poses(index)
+        else:
+            self._edit_segment(segments[index], index)
+
+    @on(Button.Pressed, "#seg-delete")
+    def _delete_pressed(self, event: Button.Pressed) -> None:
+        event.stop()
+        self.delete_selected()
+
+    def delete_selected(self) -> None:
+        if not self._editable():
+            return
+        index = self.selected()
+        segments = list(self.app.scenario.flight.segments)
+        if not 0 <= index < len(segments):
+            return
+        if len(segments) == 1:
+            self.app.tell("The flight path needs at least one segment.", severity="warning")
+            return
+        del segments[index]
+        self._apply_segments(segments, f"delete segment {index + 1}")
+
+    @on(Button.Pressed, "#aim-all")
+    def _aim_pressed(self, event: Button.Pressed) -> None:
+        event.stop()
+        self.aim_all()
+
+    def aim_all(self) -> None:
+        if not self._editable():
+            return
+        try:
+            scenario = bridge.aim_all(self.app.scenario, self.app.target_m())
+        except LadarError as error:
+            self.app.tell(str(error), title="Cannot aim every scan", severity="error")
+            return
+        self.app.edit(scenario, "Aim every scan at the target")
+        self.app.tell("Every scan now aims at the target centre.")

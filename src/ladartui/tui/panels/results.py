@@ -1,0 +1,43 @@
+"""The Results tab: the last run's measures in a table, and the ways to look further."""
+
+from __future__ import annotations
+
+from rich.text import Text
+from textual import on
+from textual.containers import Grid, VerticalScroll
+from textual.widgets import Button, DataTable, Static
+
+from ladartui.tui.measures_view import compact_rows
+
+NO_RESULTS = "No results yet: F5 runs the scenario."
+
+
+class ResultsPanel(VerticalScroll):
+    DEFAULT_CLASSES = "pane"
+
+    def compose(self):
+        yield Static(NO_RESULTS, id="results-info", classes="info", markup=False)
+        yield DataTable(id="measures", cursor_type="row", zebra_stripes=True)
+        with Grid(classes="button-grid run-buttons"):
+            yield Button("Measures", id="btn-measures", compact=True)
+            yield Button("Compare", id="btn-compare", compact=True)
+            yield Button("Threshold", id="btn-threshold", compact=True)
+
+    def on_mount(self) -> None:
+        self.query_one("#measures", DataTable).add_columns("Measure", "Value")
+
+    def show_measures(self, measures, name: str = "") -> None:
+        table = self.query_one("#measures", DataTable)
+        table.clear()
+        info = self.query_one("#results-info", Static)
+        if measures is None:
+            info.update(NO_RESULTS)
+            return
+        info.update(f"Measures of {name}:")
+        for label, value in compact_rows(measures):
+            table.add_row(Text(label), Text(value))  # text from a file: never markup
+
+    @on(Button.Pressed, "#btn-measures,#btn-compare,#btn-threshold")
+    async def _pressed(self, event: Button.Pressed) -> None:
+        event.stop()
+        await self.app.run_action(event.button.id.removeprefix("btn-"))

@@ -1,0 +1,22 @@
+"""The Sensor tab: detector grid, rays per detector, field of view, depth and pitch."""
+
+from __future__ import annotations
+
+from textual.widgets import Static
+
+from ladartui.tui import bridge
+from ladartui.tui.params import ParamPanel
+
+
+class SensorPanel(ParamPanel):
+    def compose(self):
+        for param in bridge.SENSOR_PARAMS:
+            yield self.param_row(param)
+        yield Static("", id="sensor-info", classes="info", markup=False)
+
+    def show(self, scenario) -> None:
+        self.fill_fields(scenario)
+        s = scenario.sensor
+        self.query_one("#sensor-info", Static).update(
+            f"{s.grid}x{s.grid} detectors, {s.ray_grid}x{s.ray_grid} rays each\n"
+            f"{s.rays_per_scan:,} rays per scan, IFOV {s.ifov * 1000:.3g} mdeg")
