@@ -141,15 +141,26 @@ class LadarApp(EditGuard, FileActions, RunControl, App):
         self.edit(scenario, "Change")
 
     def action_undo(self) -> None:
-        self._step(self.history.undo() if self.history and not self.busy else None, "Undid")
+        if self.busy or self.history is None:
+            return
+        typing = [f for f in self.query(".param").results(NumberField)
+                  if f.value != f.committed]
+        if typing:  # typed but not committed: undo the typing first, as an editor would
+            for f in typing:
+                f.set_number(bridge.param_value(self.scenario, f.field_name))
+            self.refresh_status()
+            self.tell("Undid typing in " + ", ".join(f.param.label for f in typing), timeout=3)
+            return
+        self._step(self.history.undo(), "Undid")
 
     def action_redo(self) -> None:
-        self._step(self.history.redo() if self.history and not self.busy else None, "Redid")
+        if self.busy or self.history is None:
+            return
+        self._step(self.history.redo(), "Redid")
 
     def _step(self, step, done: str) -> None:
         if step is None:
-            self.tell(f"Nothing to {done.lower()[:-1]}o." if done == "Undid"
-                      else "Nothing to redo.", timeout=2)
+            self.tell("Nothing to undo." if done == "Undid" else "Nothing to redo.", timeout=2)
             return
         self.scenario_changed()
         self.tell(f"{done}: {step.label}", timeout=3)

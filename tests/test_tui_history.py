@@ -1,0 +1,196 @@
+"""Undo and redo, Save As, the recent list, the folder tree and the start pose, in the app.
+
+Each test drives a real app on a tiny generated scene with Pilot, as an
+analyst would with the keyboard.
+"""
+
+from __future__ import annotations
+
+from ladartui.flight import FlightPlan, ScanPose, Straight
+from ladartui.recent import recent_scenarios
+from ladartui.scenario import load_scenario
+from ladartui.tui.actions import palette_entries
+from ladartui.tui.file_dialogs import FileTree, SaveAsScreen, SetupScreen
+from ladartui.tui.screens import FormScreen, PosesScreen
+from ladartui.tui.status import StatusBar
+from ladartui.tui.unsaved import UnsavedScreen
+from test_tui_flow import (LadarApp, field, loaded, make_scenario, scene_files,  # noqa: F401
+                           type_into, wait_until)
+
+SIZE = (100, 32)
+
+
+def modified(app) -> bool:
+    return "(modified)" in app.query_one(StatusBar).message
+
+
+async def test_undo_and_redo_a_field_a_segment_and_typing(tmp_path, scene_files):
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        app.action_show_tab("sensor")
+        grid = field(app, "sensor.grid")
+        await type_into(pilot, grid, "12")
+        assert app.scenario.sensor.grid == 12 and modified(app)
+        await pilot.press("ctrl+z")
+        await pilot.pause()
+        assert app.scenario.sensor.grid == 8 and grid.value == "8"
+        assert not modified(app)  # back to what is on disk
+        assert "Sensor grid n 8 -> 12" in app.messages[-1]
+        await pilot.press("ctrl+y")
+        await pilot.pause()
+        assert app.scenario.sensor.grid == 12 and grid.value == "12" and modified(app)
+        # typing not yet committed is undone first, leaving the committed edit in place
+        await type_into(pilot, grid, "20", commit=None)
+        await pilot.press("ctrl+z")
+        await pilot.pause()
+        assert grid.value == "12" and app.scenario.sensor.grid == 12
+        # a segment added, then undone and redone
+        app.action_show_tab("flight")
+        app.action_add_segment("straight")
+        await pilot.pause()
+        assert isinstance(app.screen, FormScreen)
+        app.screen.query_one("#form-ok").press()
+        await pilot.pause()
+        assert [s.kind for s in app.scenario.flight.segments] == ["orbit", "straight"]
+        assert app.query_one("#segments").row_count == 2
+        app.set_focus(None)
+        await pilot.press("ctrl+z")
+        await pilot.pause()
+        assert [s.kind for s in app.scenario.flight.segments] == ["orbit"]
+        assert app.query_one("#segments").row_count == 1
+        await pilot.press("ctrl+y")
+        await pilot.pause()
+        assert [s.kind for s in app.scenario.flight.segments] == ["orbit", "straight"]
+        # undo everything: the scenario on disk again, and Ctrl+S then writes nothing new
+        await pilot.press("ctrl+z", "ctrl+z")
+        await pilot.pause()
+        assert app.scenario == load_scenario(scenario.path) and not modified(app)
+
+
+async def test_undo_a_pose_edit(tmp_path, scene_files):
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        app.action_manual_poses()
+        await pilot.pause()
+        screen = app.screen
+        assert isinstance(screen, PosesScreen)
+        screen.dismiss([ScanPose(1.0, 2.0, 50.0)])
+        await pilot.pause()
+        assert app.scenario.flight.segments[-1].kind == "manual"
+        await pilot.press("ctrl+z")
+        await pilot.pause()
+        assert [s.kind for s in app.scenario.flight.segments] == ["orbit"]
+
+
+async def test_save_as_writes_a_new_file_and_keeps_the_old_one(tmp_path, scene_files):
+    scenario = make_scenario(tmp_path, scene_files)
+    before = scenario.path.read_bytes()
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        app.action_show_tab("sensor")
+        await type_into(pilot, field(app, "sensor.grid"), "16", commit=None)
+        await app.run_action("save_as")  # Ctrl+Shift+S where the terminal sends it
+        await pilot.pause()
+        assert isinstance(app.screen, SaveAsScreen)
+        app.screen.query_one("#save-as-file").value = "copy"
+        await pilot.press("enter")
+        await pilot.pause()
+        copy = tmp_path / "copy.toml"
+        assert load_scenario(copy).sensor.grid == 16  # the typed value, committed first
+        assert scenario.path.read_bytes() == before
+        assert app.scenario.path == copy and not modified(app)
+        assert recent_scenarios()[0] == copy.resolve()
+        # undo cannot bring back the old name; an existing name needs OK twice
+        await pilot.press("ctrl+z")
+        await pilot.pause()
+        assert app.scenario.path == copy
+        await app.run_action("save_as")
+        await pilot.pause()
+        app.screen.query_one("#save-as-file").value = scenario.path.name
+        await pilot.press("enter")
+        await pilot.pause()
+        assert isinstance(app.screen, SaveAsScreen)
+        assert "exists" in str(app.screen.query_one("#save-as-message").render())
+        await pilot.press("escape")
+        await pilot.pause()
+        assert scenario.path.read_bytes() == before
+
+
+async def test_recent_scenarios_are_listed_and_open_after_asking(tmp_path, scene_files,
+                                                                 monkeypatch):
+    monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))
+    first = make_scenario(tmp_path, scene_files, name="first")
+    second = make_scenario(tmp_path, scene_files, name="second")
+    app = LadarApp(first.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        app.open_path(second.path)
+        await wait_until(pilot, lambda: app.scenario.path == second.path and app.busy is None)
+        app.action_show_tab("file")
+        await pilot.pause()
+        listing = app.query_one("#recent")
+        assert listing.option_count == 1 and listing.get_option_at_index(0).id == str(
+            first.path.resolve())
+        assert any(a.startswith("open_recent") and "first.toml" in a
+                   for _, _, a in palette_entries())
+        app.action_show_tab("sensor")
+        await type_into(pilot, field(app, "sensor.grid"), "12")
+        app.action_show_tab("file")
+        listing.focus()
+        listing.highlighted = 0
+        await pilot.press("enter")
+        await pilot.pause()
+        assert isinstance(app.screen, UnsavedScreen)  # the edit is not lost unasked
+        await pilot.click("#unsaved-discard")
+        await wait_until(pilot, lambda: app.scenario.path == first.path and app.busy is None)
+
+
+async def test_the_folder_tree_fills_the_scenario_field(tmp_path, scene_files):
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        await pilot.press("f3")
+        await pilot.pause()
+        screen = app.screen
+        assert isinstance(screen, SetupScreen)
+        tree = screen.query_one(FileTree)
+        await wait_until(pilot, lambda: len(tree.root.children) > 0)
+        names = [node.data.path.name for node in tree.root.children]
+        assert "demo.toml" in names and all(not n.startswith(".") for n in names)
+        assert all(n.endswith((".toml", ".txt", ".las", ".laz")) or (tmp_path / n).is_dir()
+                   for n in names)
+        tree.focus()
+        tree.move_cursor(tree.root.children[names.index("demo.toml")])
+        await pilot.press("enter")
+        await pilot.pause()
+        assert screen.query_one("#scenario-file").value == "demo.toml"
+
+
+async def test_start_pose_fields_follow_the_path_kind_and_refuse_impractical_values(
+        tmp_path, scene_files):
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        app.action_show_tab("flight")
+        await pilot.pause()
+        assert field(app, "start.z").disabled  # an orbit starts at its own first scan
+        straight = app.scenario.with_changes(flight=FlightPlan(
+            ScanPose(0.0, 0.0, 100.0), (Straight(distance=50.0, scans=3),)))
+        app.edit(straight, "a straight path")
+        await pilot.pause()
+        altitude, heading = field(app, "start.z"), field(app, "start.heading")
+        assert not altitude.disabled and not heading.disabled
+        await type_into(pilot, altitude, "100000")
+        assert app.scenario.flight.start.z == 100.0
+        assert "Altitude m: 100000 is not allowed" in app.messages[-1]
+        await type_into(pilot, heading, "400")
+        assert app.scenario.flight.start.heading == 0.0
+        assert "Heading deg: 400 is not allowed; expected a number from 0 to 360 deg" in \
+            app.messages[-1]
