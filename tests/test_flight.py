@@ -56,8 +56,8 @@ def test_pose_normalises_angles():
 @pytest.mark.parametrize("field,value,message", [
     ("depression", 0.5, "depression = 0.5: expected a number from 1 to 90"),
     ("depression", 91, "depression = 91: expected a number from 1 to 90"),
-    ("z", 0, "z = 0: expected a number greater than 0 and at most 20000"),
-    ("z", -3.0, "z = -3.0: expected a number greater than 0 and at most 20000"),
+    ("z", 0, "z = 0: expected a number greater than 0 and at most 100000"),
+    ("z", -3.0, "z = -3.0: expected a number greater than 0 and at most 100000"),
     ("x", float("nan"), "x = nan: expected a number from -1000000 to 1000000"),
     ("heading", "north", "heading = 'north': expected a finite number"),
     ("azimuth", True, "azimuth = True: expected a finite number"),
@@ -286,3 +286,16 @@ def test_flight_time_checks_speed():
     with pytest.raises(FieldError) as caught:
         flight_time(300.0, 0)
     assert str(caught.value) == "speed = 0: expected a number > 0"
+
+
+def test_altitudes_people_ask_for_are_practical_and_headings_they_type_are_compass_angles():
+    from ladartui.flight import MAX_FLIGHT_ALTITUDE, Orbit, compass_field
+
+    with pytest.raises(FieldError, match="at most 20000"):
+        Orbit(centre=(0.0, 0.0, 0.0), radius=50.0, altitude=MAX_FLIGHT_ALTITUDE + 1, scans=4)
+    assert Orbit(centre=(0.0, 0.0, 0.0), radius=50.0, altitude=MAX_FLIGHT_ALTITUDE,
+                 scans=4).altitude == MAX_FLIGHT_ALTITUDE
+    assert compass_field("heading", 360.0) == 360.0
+    for bad in (400.0, -1.0):
+        with pytest.raises(FieldError, match="from 0 to 360"):
+            compass_field("heading", bad)

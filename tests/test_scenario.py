@@ -210,7 +210,7 @@ LIMITS = [
     ("depression = 45.0", "depression = 0.0", "flight.start.depression = 0.0",
      "a number from 1 to 90"),
     ("z = 80.0", "z = -5.0", "flight.start.z = -5.0",
-     "a number greater than 0 and at most 20000"),
+     "a number greater than 0 and at most 100000"),
     ("distance = 50.0", "distance = 0.0", "flight.segments[0].distance = 0.0",
      "a number greater than 0 and at most 1000000"),
     ("scans = 8", "scans = 0", "flight.segments[1].scans = 0", "an integer from 1 to 10000"),

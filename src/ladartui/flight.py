@@ -30,7 +30,8 @@ import numpy as np
 from ladartui.errors import FieldError
 
 MAX_COORDINATE = 1e6  # metres; a scene is never larger than a few kilometres
-MAX_ALTITUDE = 20_000.0  # metres; above the ceiling of any high-altitude UAV (about 18 km)
+MAX_ALTITUDE = 1e5  # metres; any pose (computed ones and cell-space test rays included)
+MAX_FLIGHT_ALTITUDE = 20_000.0  # metres a person may ask to fly: above any UAV's ceiling (~18 km)
 MAX_SCANS = 10_000
 DIRECTIONS = ("left", "right")
 
@@ -197,7 +198,12 @@ def _length(name, value):
 
 
 def _altitude(value):
-    return number_field("altitude", value, 0.0, MAX_ALTITUDE, low_open=True)
+    return altitude_field("altitude", value)
+
+
+def altitude_field(name, value):
+    """An altitude a person asked for: above the ground and at most MAX_FLIGHT_ALTITUDE."""
+    return number_field(name, value, 0.0, MAX_FLIGHT_ALTITUDE, low_open=True)
 
 
 def _scans(value):

@@ -13,7 +13,7 @@ from pathlib import Path
 
 from ladartui.errors import FieldError, InputFileError, LadarError
 from ladartui.flight import (SEGMENT_KINDS, FlightPlan, Manual, ScanPose, aim_at,
-                             compass_field, number_field)
+                             altitude_field, compass_field, number_field)
 from ladartui.scenario import Scenario, load_scenario, target_file_for
 from ladartui.sensor import Sensor
 
@@ -107,6 +107,8 @@ def with_param(scenario: Scenario, key: str, value) -> Scenario:
     if group == "start":
         if name == "heading":
             value = compass_field("heading", value)
+        elif name == "z":
+            value = altitude_field("z", value)
         try:
             start = dataclasses.replace(start_pose(scenario), **{name: value})
         except FieldError as error:

@@ -28,7 +28,7 @@ SCENE_SUFFIXES = (".txt", ".las", ".laz")
 class FileTree(DirectoryTree):
     """Folders, and the files with one of ``suffixes``; hidden entries left out."""
 
-    DEFAULT_CSS = "FileTree { height: 9; border: round $panel-lighten-2; }"
+    DEFAULT_CSS = "FileTree { height: 1fr; min-height: 3; border: round $panel-lighten-2; }"
 
     def __init__(self, path: Path, suffixes: tuple[str, ...], **kwargs):
         super().__init__(path, **kwargs)
@@ -40,13 +40,24 @@ class FileTree(DirectoryTree):
 
 
 class TreeDialog(Dialog):
-    """A dialog with a folder tree whose root can move up a folder."""
+    """A dialog with a folder tree whose root can move up a folder.
+
+    The dialog takes the screen's height (up to a limit) and the tree what the
+    fields leave, so OK and Cancel stay visible on a 24-line terminal.
+    """
+
+    DEFAULT_CSS = """
+    TreeDialog > .dialog { height: 100%; max-height: 34; }
+    TreeDialog .tree-row { height: 1; }
+    TreeDialog #tree-root { width: 1fr; margin: 0; color: $text-muted; }
+    TreeDialog #tree-up { margin-left: 1; }
+    """
 
     folder: Path
 
     def tree_rows(self, suffixes) -> ComposeResult:
-        with Horizontal(classes="buttons tree-buttons"):
-            yield Static("", id="tree-root", classes="info")
+        with Horizontal(classes="tree-row"):
+            yield Static("", id="tree-root", markup=False)
             yield Button("Up a folder", id="tree-up", compact=True)
         yield FileTree(self.folder, suffixes, id="tree")
 
@@ -54,7 +65,7 @@ class TreeDialog(Dialog):
         self._show_root()
 
     def _show_root(self) -> None:
-        self.query_one("#tree-root", Static).update(f"Folder: {escape(str(self.folder))}")
+        self.query_one("#tree-root", Static).update(f"Folder: {self.folder}")
 
     @on(Button.Pressed, "#tree-up")
     def _up(self) -> None:
@@ -78,8 +89,6 @@ class SetupScreen(TreeDialog):
     output names are derived and shown. Load: every file is checked; a missing
     model is named and nothing is loaded. Dismisses with the loaded Scenario.
     """
-
-    DEFAULT_CSS = "SetupScreen .tree-buttons { margin-top: 0; align-horizontal: left; }"
 
     def __init__(self, mode: str = "new", folder: Path | None = None):
         super().__init__()
@@ -197,8 +206,6 @@ class SaveAsScreen(TreeDialog):
     An existing file is refused unless the analyst confirms by pressing OK a
     second time with the same name.
     """
-
-    DEFAULT_CSS = "SaveAsScreen .tree-buttons { margin-top: 0; align-horizontal: left; }"
 
     def __init__(self, current: Path):
         super().__init__()
