@@ -26,6 +26,7 @@ def LadarApp(path):
 @pytest.fixture
 def scenario_path(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)  # folders are shown relative to here: stable text
+    monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))  # no recent list from others
     generated = generate_scene("small", seed=5, width=16.0, depth=16.0, trees=5)
     scene_path, _ = generated.write(tmp_path / "forest")
     centre = tuple(round(float(v), 3) for v in generated.target_centre)
