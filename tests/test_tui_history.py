@@ -194,3 +194,33 @@ async def test_start_pose_fields_follow_the_path_kind_and_refuse_impractical_val
         assert app.scenario.flight.start.heading == 0.0
         assert "Heading deg: 400 is not allowed; expected a number from 0 to 360 deg" in \
             app.messages[-1]
+
+
+async def test_compare_takes_files_picked_in_the_tree(tmp_path, scene_files):
+    from ladartui.tui.screens import CompareScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=(120, 40)) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        for name in ("a", "b"):
+            (tmp_path / f"{name}.cmf").write_text("")
+        await app.run_action("compare")
+        await pilot.pause()
+        screen = app.screen
+        assert isinstance(screen, CompareScreen)
+        tree = screen.query_one(FileTree)
+        await wait_until(pilot, lambda: len(tree.root.children) > 0)
+        names = [node.data.path.name for node in tree.root.children]
+        assert {"a.cmf", "b.cmf"} <= set(names) and "demo.toml" not in names
+        chosen = screen.query_one("#cmf-files")
+        a, b = str(tmp_path / "a.cmf"), str(tmp_path / "b.cmf")
+        assert chosen.value.split() == [a, b]  # the folder's .cmf files to start with
+        tree.focus()
+        picks = []
+        for name in ("a.cmf", "a.cmf", "b.cmf"):  # a pick adds a file, a second one drops it
+            tree.move_cursor(tree.root.children[names.index(name)])
+            await pilot.press("enter")
+            await pilot.pause()
+            picks.append(chosen.value.split())
+        assert picks == [[b], [b, a], [a]]

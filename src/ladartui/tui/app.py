@@ -500,7 +500,7 @@ class LadarApp(EditGuard, FileActions, RunControl, App):
             if own.is_file():
                 paths.append(own)
             paths += sorted(p for p in folder.glob("*.cmf") if p != own)
-        self.push_screen(CompareScreen(paths[:4]))
+        self.push_screen(CompareScreen(paths[:4], self._folder()))
 
     def action_help(self) -> None:
         self.push_screen(HelpScreen(help_rows()))
@@ -513,6 +513,8 @@ class LadarApp(EditGuard, FileActions, RunControl, App):
             return
         from ladartui.tui.study_screen import StudyScreen  # plotting loads only when used
 
+        if not self.commit_pending():
+            return
         path = None
         if self.scenario is not None and self.scenario.path.is_file():
             path = self.scenario.path

@@ -19,24 +19,11 @@ from textual.widgets import Button, DirectoryTree, Input, RadioButton, RadioSet,
 from ladartui.errors import FieldError, LadarError
 from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField
+from ladartui.tui.file_tree import FileTree
 from ladartui.tui.screens import Dialog, PathSuggester, _row
 
 SCENARIO_SUFFIXES = (".toml",)
 SCENE_SUFFIXES = (".txt", ".las", ".laz")
-
-
-class FileTree(DirectoryTree):
-    """Folders, and the files with one of ``suffixes``; hidden entries left out."""
-
-    DEFAULT_CSS = "FileTree { height: 1fr; min-height: 3; border: round $panel-lighten-2; }"
-
-    def __init__(self, path: Path, suffixes: tuple[str, ...], **kwargs):
-        super().__init__(path, **kwargs)
-        self.suffixes = suffixes
-
-    def filter_paths(self, paths):
-        return [p for p in paths if not p.name.startswith(".")
-                and (p.is_dir() or p.suffix.lower() in self.suffixes)]
 
 
 class TreeDialog(Dialog):

@@ -7,6 +7,7 @@ import dataclasses
 from pathlib import Path
 
 from rich.markup import escape
+from rich.text import Text
 from textual import on
 from textual.app import ComposeResult
 from textual.binding import Binding
@@ -18,6 +19,7 @@ from textual.widgets import Button, DataTable, Input, Label, Select, Static
 from ladartui.errors import FieldError, LadarError
 from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField, format_number, parse_number
+from ladartui.tui.file_tree import FileTree
 from ladartui.tui.measures_view import comparison_rows, measure_rows
 
 
@@ -400,13 +402,15 @@ class MeasuresScreen(Dialog):
 class CompareScreen(Dialog):
     """Two or more scenarios' measures (.cmf files) side by side, differences highlighted."""
 
-    def __init__(self, paths: list[Path]):
+    def __init__(self, paths: list[Path], folder: Path | None = None):
         super().__init__()
         self.paths = list(paths)
+        self.folder = folder or (self.paths[0].parent if self.paths else Path.cwd())
 
     DEFAULT_CSS = """
     CompareScreen > .dialog { width: 100%; height: 100%; }
     CompareScreen DataTable { height: 1fr; }
+    CompareScreen FileTree { height: 8; min-height: 3; }
     """
 
     def compose(self) -> ComposeResult:
@@ -415,8 +419,10 @@ class CompareScreen(Dialog):
             yield _row(".cmf files", Input(" ".join(str(p) for p in self.paths),
                                            id="cmf-files", compact=True,
                                            suggester=PathSuggester((".cmf",))))
-            yield Static("Space-separated paths; Enter compares. Green best, red worst, "
-                         "yellow differs.", classes="info")
+            yield FileTree(self.folder, (".cmf",), id="cmf-tree")
+            yield Static("Space-separated paths, or pick files in the tree (again to drop "
+                         "one); Enter compares. Green best, red worst, yellow differs.",
+                         classes="info")
             yield Static("", id="compare-message", classes="message")
             yield DataTable(id="compare-table", zebra_stripes=True)
             with Horizontal(classes="buttons"):
@@ -424,6 +430,16 @@ class CompareScreen(Dialog):
                 yield Button("Close", id="compare-close", compact=True)
 
     def on_mount(self) -> None:
+        self.compare()
+
+    @on(FileTree.FileSelected, "#cmf-tree")
+    def _picked(self, event: FileTree.FileSelected) -> None:
+        event.stop()
+        field = self.query_one("#cmf-files", Input)
+        chosen = field.value.split()
+        picked = str(event.path)
+        field.value = " ".join([c for c in chosen if c != picked] if picked in chosen
+                               else chosen + [picked])
         self.compare()
 
     @on(Input.Submitted, "#cmf-files")
@@ -444,9 +460,9 @@ class CompareScreen(Dialog):
         message.update("")
         table.add_column("Measure")
         for path in text:
-            table.add_column(Path(path).stem)
+            table.add_column(Text(Path(path).stem))  # names from files: never markup
         for row in comparison_rows(loaded):
-            table.add_row(*row)
+            table.add_row(*(Text(c) if isinstance(c, str) else c for c in row))
 
     @on(Button.Pressed, "#compare-close")
     def _close(self) -> None:
