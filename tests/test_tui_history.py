@@ -6,6 +6,8 @@ analyst would with the keyboard.
 
 from __future__ import annotations
 
+import pytest
+
 from ladartui.flight import FlightPlan, ScanPose, Straight
 from ladartui.recent import recent_scenarios
 from ladartui.scenario import load_scenario
@@ -224,3 +226,28 @@ async def test_compare_takes_files_picked_in_the_tree(tmp_path, scene_files):
             await pilot.pause()
             picks.append(chosen.value.split())
         assert picks == [[b], [b, a], [a]]
+
+
+@pytest.mark.parametrize("size", [(80, 24), (120, 40)])
+async def test_no_sidebar_label_or_button_is_clipped(tmp_path, scene_files, size):
+    from rich.cells import cell_len
+    from textual.widgets import Button, Label
+
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=size) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        clipped = []
+        for tab in ("file", "sensor", "flight", "run", "results"):
+            app.action_show_tab(tab)
+            await pilot.pause(0.2)
+            pane = app.query_one(f"#tab-{tab}")
+            for widget in [*pane.query(Button), *pane.query(".row Label")]:
+                if not widget.display or widget.region.width == 0:
+                    continue
+                text = str(widget.label if isinstance(widget, Button) else widget.render())
+                margin = 2 if isinstance(widget, Button) else 0  # a button pads its label
+                if cell_len(text.strip()) + margin > widget.content_region.width:
+                    clipped.append((tab, text, widget.content_region.width))
+        assert not clipped
+        assert any(isinstance(w, Label) for w in app.query(".row Label"))

@@ -323,3 +323,33 @@ def test_eta_counts_only_the_variants_run_here():
     assert eta_seconds(SweepProgress(10, 2, 2, 0, 1.0)) is None
     assert format_eta(125) == "2m05s" and format_eta(3725) == "1h02m" and format_eta(None) == "--"
     assert format_eta(math.inf) == "--"
+
+
+async def test_browse_picks_a_results_folder_in_a_tree_and_opens_it(finished):
+    from ladartui.tui.file_dialogs import PickPathScreen
+    from ladartui.tui.file_tree import FileTree
+
+    _spec, results = finished
+    screen = SweepScreen(serial=True)
+    app = _Host(screen)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        screen.query_one("#sweep-path").value = str(results.parent) + "/"
+        await pilot.press("f2")
+        await pilot.pause()
+        picker = app.screen
+        assert isinstance(picker, PickPathScreen)
+        tree = picker.query_one(FileTree)
+        await wait_for(pilot, lambda: len(tree.root.children) > 0)
+        names = [node.data.path.name for node in tree.root.children]
+        assert results.name in names
+        tree.focus()
+        tree.move_cursor(tree.root.children[names.index(results.name)])
+        await pilot.press("enter")  # a folder: chosen, as results folders are
+        await pilot.pause()
+        assert picker.query_one("#pick-path").value == str(results)
+        picker.query_one("#pick-ok").press()
+        await pilot.pause()
+        await pilot.pause()
+        assert app.screen is screen
+        assert screen.query_one("#sweep-table", DataTable).row_count == 12

@@ -254,3 +254,58 @@ class SaveAsScreen(TreeDialog):
     @on(Button.Pressed, "#save-as-cancel")
     def _cancel(self) -> None:
         self.dismiss(None)
+
+
+class PickPathScreen(TreeDialog):
+    """Pick a file (or, with ``folders``, a folder) in the tree or type it; dismisses with
+    the path, or None."""
+
+    def __init__(self, title: str, suffixes: tuple[str, ...], start: Path | None = None,
+                 folders: bool = False):
+        super().__init__()
+        self.title_text = title
+        self.suffixes = suffixes
+        self.folders = folders
+        self.base = start if start is not None and start.is_dir() else Path.cwd()
+        self.folder = self.base
+
+    def compose(self) -> ComposeResult:
+        with Vertical(classes="dialog", id="pick") as box:
+            box.border_title = self.title_text
+            yield from self.tree_rows(self.suffixes)
+            yield _row("Path", Input(id="pick-path", compact=True,
+                                     suggester=PathSuggester(self.suffixes)))
+            yield Static("", id="pick-message", classes="message", markup=False)
+            with Horizontal(classes="buttons"):
+                yield Button("OK", id="pick-ok", variant="primary", compact=True)
+                yield Button("Cancel", id="pick-cancel", compact=True)
+
+    def on_mount(self) -> None:
+        super().on_mount()
+        self.query_one("#pick-path", Input).focus()
+
+    @on(DirectoryTree.FileSelected, "#tree")
+    def _file_picked(self, event: DirectoryTree.FileSelected) -> None:
+        event.stop()
+        self.query_one("#pick-path", Input).value = str(event.path)
+
+    @on(DirectoryTree.DirectorySelected, "#tree")
+    def _folder_picked(self, event: DirectoryTree.DirectorySelected) -> None:
+        if self.folders:
+            self.query_one("#pick-path", Input).value = str(event.path)
+
+    @on(Input.Submitted, "#pick-path")
+    @on(Button.Pressed, "#pick-ok")
+    def _ok(self) -> None:
+        text = self.query_one("#pick-path", Input).value.strip()
+        path = (self.base / Path(text).expanduser()) if text else None
+        message = self.query_one("#pick-message", Static)
+        if path is None or not path.exists():
+            message.update(f"{text or 'Path'}: not found; pick a file in the tree or type "
+                           "its path")
+            return
+        self.dismiss(path)
+
+    @on(Button.Pressed, "#pick-cancel")
+    def _cancel(self) -> None:
+        self.dismiss(None)

@@ -126,6 +126,7 @@ class SweepScreen(Screen):
     BINDINGS = [
         Binding("f5", "run", "Run", priority=True),
         Binding("f3", "open_results", "Open", priority=True),
+        Binding("f2", "browse", "Browse", priority=True),
         Binding("ctrl+x", "cancel", "Cancel", priority=True),
         Binding("f6", "objective", "Rank by", priority=True),
         Binding("f7", "cost", "Cost", priority=True),
@@ -187,6 +188,7 @@ class SweepScreen(Screen):
                         placeholder="sweep spec .toml, or results.csv / results folder",
                         validators=[ExistingPath()], validate_on=["changed", "submitted"],
                         valid_empty=True)
+            yield Button("Browse F2", id="sweep-browse", compact=True)
         with Horizontal(classes="sweep-row"):
             yield Label("Scheduler")
             yield Input(self.initial_scheduler, id="sweep-scheduler", compact=True,
@@ -381,6 +383,25 @@ class SweepScreen(Screen):
     @on(Button.Pressed, "#cancel")
     def _cancel_pressed(self) -> None:
         self.action_cancel()
+
+    @on(Button.Pressed, "#sweep-browse")
+    def action_browse(self) -> None:
+        """Pick a spec, a results.csv or a results folder in a folder tree."""
+        if self.running:
+            return
+        from ladartui.tui.file_dialogs import PickPathScreen
+
+        typed = Path(self._path_text()).expanduser() if self._path_text() else None
+        start = typed if typed is not None and typed.is_dir() else (
+            typed.parent if typed is not None else None)
+
+        def picked(path) -> None:
+            if path is not None:
+                self.query_one("#sweep-path", Input).value = str(path)
+                self._open(str(path))
+
+        self.app.push_screen(PickPathScreen("Sweep spec or results", (".toml", ".csv"), start,
+                                            folders=True), picked)
 
     @on(Input.Submitted, "#sweep-path")
     def _path_submitted(self) -> None:

@@ -37,7 +37,7 @@ class RunPanel(ParamPanel):
             yield Button("Save ^S", id="btn-save-run", compact=True)
             yield Button("Cancel", id="btn-cancel-run", variant="error", compact=True,
                          disabled=True)
-        with Grid(classes="button-grid run-buttons"):
+        with Grid(classes="button-grid run-buttons two-buttons"):
             yield Button("Study F11", id="btn-study", compact=True,
                          tooltip="Speed against accuracy of every backend and method")
             yield Button("Sweep F12", id="btn-sweep", compact=True,
