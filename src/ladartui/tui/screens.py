@@ -3,7 +3,6 @@ measures, comparison and help."""
 
 from __future__ import annotations
 
-import dataclasses
 from pathlib import Path
 
 from rich.markup import escape
