@@ -144,6 +144,16 @@ async def test_quit_new_and_open_with_unsaved_edits_ask_first(tmp_path, scene_fi
             await pilot.click("#unsaved-cancel")
             await pilot.pause()
             assert app.is_running and not isinstance(app.screen, UnsavedScreen)
+        # the sweep screen's "open best path" asks too, and cancelling keeps the edit
+        from ladartui.tui.sweep_screen import SweepScreen
+
+        other = make_scenario(tmp_path, scene_files, name="best")
+        app.post_message(SweepScreen.OpenScenario(other.path))
+        await pilot.pause()
+        assert isinstance(app.screen, UnsavedScreen)
+        await pilot.click("#unsaved-cancel")
+        await pilot.pause()
+        assert app.scenario.path == scenario.path and app.scenario.sensor.grid == 12
         await pilot.press("f3")
         await pilot.pause()
         await pilot.click("#unsaved-discard")
