@@ -529,7 +529,7 @@ async def test_help_lists_the_keys_and_the_palette_offers_every_action(shared, t
     assert isinstance(app.screen, HelpScreen)
     table = app.screen.query_one("DataTable")
     keys = {str(table.get_row_at(i)[1]) for i in range(table.row_count)}
-    assert {"F1", "F2", "F3", "F5", "F6", "F8", "Ctrl+S", "Esc"} <= keys
+    assert {"F1 / ?", "F2", "F3", "F5", "F6", "F8", "Ctrl+S", "Esc"} <= keys
     await pilot.press("escape")
     actions = {a.split("(")[0] for _, _, a in palette_entries()}
     bound = {b.action.split("(")[0] for b in LadarApp.BINDINGS}

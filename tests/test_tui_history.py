@@ -251,3 +251,40 @@ async def test_no_sidebar_label_or_button_is_clipped(tmp_path, scene_files, size
                     clipped.append((tab, text, widget.content_region.width))
         assert not clipped
         assert any(isinstance(w, Label) for w in app.query(".row Label"))
+
+
+async def test_a_key_remapped_in_keys_toml_changes_the_footer_help_and_palette(
+        tmp_path, scene_files, monkeypatch):
+    from ladartui.tui.app import help_rows
+    from ladartui.tui.app import palette_entries as app_palette
+    from ladartui.tui.screens import HelpScreen
+    from test_tui_edits import capture_runs
+    from test_tui_flow import shown_keys
+
+    home = tmp_path / "home"
+    (home / "config").mkdir(parents=True)
+    (home / "config" / "keys.toml").write_text(
+        '[keys]\nrun = "ctrl+r"\nnonsense = "x"\nthreshold = 3\n')
+    monkeypatch.setenv("LADARTUI_HOME", str(home))
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=(120, 40)) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        keys = shown_keys(app)
+        assert "ctrl+r" in keys and "f5" not in keys  # the footer
+        assert ("Anywhere", "Ctrl+R", "Run") in help_rows(app)  # the help screen
+        assert ("Anywhere", "F5", "Run") not in help_rows(app)
+        await pilot.press("f1")
+        await pilot.pause()
+        assert isinstance(app.screen, HelpScreen)
+        await pilot.press("escape")
+        entries = {title: text for title, text, _ in app_palette(app)}
+        assert entries["Run simulation"].endswith("(Ctrl+R)")  # the palette
+        # the bad lines are named, and the rest of the file still applies
+        problems = [m for m in app.messages if m.startswith("Key not remapped")]
+        assert len(problems) == 2 and "keys.nonsense" in problems[0]
+        assert "keys.threshold = 3" in problems[1]
+        runs = capture_runs(app)
+        await pilot.press("ctrl+r")
+        await pilot.pause()
+        assert len(runs) == 1

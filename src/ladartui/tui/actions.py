@@ -1,108 +1,139 @@
-"""The app's keys, the command palette's entries and the help screen's rows.
+"""One table of the app's commands: its keys, the footer, the palette and the help screen.
 
-Kept in one place so that a key, its palette entry and its line in the help
-screen are written once and cannot disagree with the actions they name.
+Every command is written once (``COMMANDS``): its binding id, the action it
+runs, its default key, its footer label (if it has one) and its palette
+title and help. The bindings, the palette entries and the help rows are all
+drawn from that table with the keys in force, so remapping a key in the
+user's ``keys.toml`` changes the footer, the palette and the help together:
+
+    # ~/.config/ladartui/keys.toml  ($LADARTUI_HOME/config/keys.toml)
+    [keys]
+    run = "f9"            # binding id = key (or "key1,key2")
+    threshold = "t"
 """
 
 from __future__ import annotations
 
-import functools
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
 
 from textual.binding import Binding
 
+from ladartui.recent import config_folder
+from ladartui.textsafe import one_line
 from ladartui.tui import bridge
-from ladartui.tui.canvas import ProjectionWidget
 from ladartui.tui.view_area import LAYOUTS
 
-BINDINGS = [
-    Binding("f1", "help", "Help"),
-    Binding("question_mark", "help", "Help", show=False),
-    Binding("f2", "new_scenario", "New"),
-    Binding("f3", "open_scenario", "Open"),
-    Binding("ctrl+s", "save", "Save"),
-    Binding("ctrl+shift+s", "save_as", "Save as", show=False),
-    Binding("ctrl+z", "undo", "Undo", show=False),
-    Binding("ctrl+y", "redo", "Redo", show=False),
-    Binding("f5", "run", "Run"),
-    Binding("escape", "cancel_run", "Cancel"),
-    Binding("f4", "toggle_panel", "Panel", show=False),
-    Binding("f6", "next_layout", "Layout"),
-    Binding("1", "layout(1)", "Layout 1", show=False),
-    Binding("2", "layout(2)", "Layout 2", show=False),
-    Binding("3", "layout(3)", "Layout 3", show=False),
-    Binding("4", "layout(4)", "Layout 4", show=False),
-    Binding("5", "layout(5)", "Layout 5", show=False),
-    Binding("f7", "view_angle", "Angle", show=False),
-    Binding("f8", "threshold", "Threshold"),
-    Binding("f9", "measures", "Measures", show=False),
-    Binding("f10", "compare", "Compare"),
-    Binding("f11", "study", "Study"),
-    Binding("f12", "sweep", "Sweep"),
+KEYS_FILE = "keys.toml"
+
+
+@dataclass(frozen=True)
+class Command:
+    id: str  # the binding id users remap
+    action: str  # what it runs: "run", "layout(1)"
+    key: str | None  # the default key; None for palette-only commands
+    title: str  # the palette's title
+    help: str  # the palette's help and the help screen's line
+    footer: str | None = None  # the footer's label; None keeps it out of the footer
+
+
+COMMANDS = [
+    Command("help", "help", "f1,question_mark", "Help: keys", "List every key", "Help"),
+    Command("new", "new_scenario", "f2", "New scenario",
+            "Choose a scenario file and a scene model", "New"),
+    Command("open", "open_scenario", "f3", "Open scenario",
+            "Load a scenario; its model files are checked", "Open"),
+    Command("save", "save", "ctrl+s", "Save scenario", "Write the scenario file", "Save"),
+    Command("save-as", "save_as", "ctrl+shift+s", "Save scenario as",
+            "Write the scenario under another name"),
+    Command("undo", "undo", "ctrl+z", "Undo", "Undo the last change to the scenario"),
+    Command("redo", "redo", "ctrl+y", "Redo", "Apply the last undone change again"),
+    Command("run", "run", "f5", "Run simulation", "Run the scenario", "Run"),
+    Command("cancel", "cancel_run", "escape", "Cancel run",
+            "Stop the run; earlier outputs stay", "Cancel"),
+    Command("panel", "toggle_panel", "f4", "Toggle parameter panel",
+            "Hide or show the sidebar"),
+    Command("layout", "next_layout", "f6", "Next layout", "Cycle the five view layouts",
+            "Layout"),
+    Command("angle", "view_angle", "f7", "View angle",
+            "Exact azimuth and elevation of the 3D views"),
+    Command("threshold", "threshold", "f8", "Output height threshold",
+            "Draw the output up to a height", "Threshold"),
+    Command("measures", "measures", "f9", "Show measures", "The measures of the last run"),
+    Command("compare", "compare", "f10", "Compare scenarios",
+            "Two or more .cmf files side by side", "Compare"),
+    Command("study", "study", "f11", "Speed-against-accuracy study",
+            "Every backend, method and ray grid on this scenario", "Study"),
+    Command("sweep", "sweep", "f12", "Flight-path sweep",
+            "Launch, open or watch a sweep; open its best path", "Sweep"),
+    Command("aim-all", "aim_all", None, "Aim every scan at the target",
+            "Point the sensor at the target centre"),
+    Command("edit-segment", "edit_segment", None, "Edit selected segment",
+            "Open the selected flight segment"),
+    Command("delete-segment", "delete_segment", None, "Delete selected segment",
+            "Remove the selected flight segment"),
+    Command("manual-poses", "manual_poses", None, "Manual scan poses", "Edit poses in a table"),
+    *(Command(f"layout-{n}", f"layout({n})", str(n), f"Layout {n}: {name}", "Switch the views")
+      for n, name in LAYOUTS.items()),
+    *(Command(f"add-{kind}", f"add_segment('{kind}')", None,
+              f"Add {bridge.SEGMENT_LABELS[kind].lower()} segment",
+              f"Append a {bridge.SEGMENT_LABELS[kind].lower()} to the flight path")
+      for kind in ("straight", "turn", "orbit", "flypast", "standoff")),
+    *(Command(f"tab-{tab}", f"show_tab('{tab}')", None, f"Show {tab} panel",
+              f"Open the {tab} tab") for tab in ("file", "sensor", "flight", "run", "results")),
 ]
+BY_ID = {command.id: command for command in COMMANDS}
 
 # actions that only change what is displayed: allowed while busy
 DISPLAY_ACTIONS = {"help", "layout", "next_layout", "toggle_panel", "view_angle",
                    "threshold", "quit", "command_palette", "show_tab", "cancel_run"}
 
 
-def palette_entries() -> list[tuple[str, str, str]]:
-    """(title, help, action) for every action, as offered in the command palette."""
-    entries = [
-        ("Help: keys", "List every key (F1)", "help"),
-        ("New scenario", "Choose a scenario file and a scene model (F2)", "new_scenario"),
-        ("Open scenario", "Load a scenario; every file is checked (F3)", "open_scenario"),
-        ("Save scenario", "Write the scenario file (Ctrl+S)", "save"),
-        ("Save scenario as", "Write the scenario under another name (Ctrl+Shift+S)",
-         "save_as"),
-        ("Undo", "Undo the last change to the scenario (Ctrl+Z)", "undo"),
-        ("Redo", "Apply the last undone change again (Ctrl+Y)", "redo"),
-        ("Run simulation", "Run the scenario (F5)", "run"),
-        ("Cancel run", "Stop the run; earlier outputs stay (Esc)", "cancel_run"),
-        ("Next layout", "Cycle the five view layouts (F6)", "next_layout"),
-        ("Toggle parameter panel", "Hide or show the sidebar (F4)", "toggle_panel"),
-        ("View angle", "Exact azimuth and elevation of the 3D views (F7)", "view_angle"),
-        ("Output height threshold", "Draw the output up to a height (F8)", "threshold"),
-        ("Show measures", "The measures of the last run (F9)", "measures"),
-        ("Compare scenarios", "Two or more .cmf files side by side (F10)", "compare"),
-        ("Speed-against-accuracy study", "Every backend, method and ray grid on this "
-         "scenario (F11)", "study"),
-        ("Flight-path sweep", "Launch, open or watch a sweep; open its best path (F12)",
-         "sweep"),
-        ("Aim every scan at the target", "Point the sensor at the target centre", "aim_all"),
-        ("Edit selected segment", "Open the selected flight segment", "edit_segment"),
-        ("Delete selected segment", "Remove the selected flight segment", "delete_segment"),
-        ("Manual scan poses", "Edit poses in a table", "manual_poses"),
-    ]
+def bindings() -> list[Binding]:
+    """The app's key bindings, each with its command's id (so users can remap it)."""
+    return [Binding(c.key, c.action, c.footer or c.title, show=c.footer is not None, id=c.id)
+            for c in COMMANDS if c.key]
+
+
+BINDINGS = bindings()
+
+
+def keys_in_force(keymap: dict[str, str] | None = None) -> dict[str, str]:
+    """Command id -> the keys that run it: the default, or the user's."""
+    keymap = keymap or {}
+    return {c.id: keymap.get(c.id, c.key) for c in COMMANDS if c.key or c.id in keymap}
+
+
+def palette_entries(keymap: dict[str, str] | None = None) -> list[tuple[str, str, str]]:
+    """(title, help, action) for every command and every recent scenario."""
+    keys = keys_in_force(keymap)
+    entries = []
+    for c in COMMANDS:
+        key = keys.get(c.id)
+        entries.append((c.title, f"{c.help} ({key_name(key)})" if key else c.help, c.action))
     from ladartui.recent import recent_scenarios
 
     for path in recent_scenarios():
         entries.append((f"Open recent: {path.name}", str(path), f"open_recent({str(path)!r})"))
-    for n, name in LAYOUTS.items():
-        entries.append((f"Layout {n}: {name}", f"Switch the views (key {n})", f"layout({n})"))
-    for kind in ("straight", "turn", "orbit", "flypast", "standoff"):
-        label = bridge.SEGMENT_LABELS[kind]
-        entries.append((f"Add {label.lower()} segment", f"Append a {label.lower()} to the "
-                        "flight path", f"add_segment('{kind}')"))
-    for tab in ("file", "sensor", "flight", "run", "results"):
-        entries.append((f"Show {tab} panel", f"Open the {tab} tab", f"show_tab('{tab}')"))
     return entries
 
 
-@functools.cache
 def own_actions() -> frozenset[str]:
-    """Names of the actions the main app defines (its keys and its palette entries)."""
-    keys = [binding.action for binding in BINDINGS]
-    fixed = [a for _, _, a in palette_entries() if not a.startswith("open_recent")]
-    return frozenset(action.split("(")[0] for action in keys + fixed + ["open_recent"])
+    """Names of the actions the main app defines (its commands, and opening a recent file)."""
+    return frozenset({c.action.split("(")[0] for c in COMMANDS} | {"open_recent"})
 
 
-def help_rows(dialog_bindings=()) -> list[tuple[str, str, str]]:
-    """(where, key, what) for the help screen; ``dialog_bindings`` are the poses dialog's."""
-    rows = [("Anywhere", key_name(b.key), b.description) for b in BINDINGS]
+def help_rows(keymap: dict[str, str] | None = None, view_bindings=(),
+              dialog_bindings=()) -> list[tuple[str, str, str]]:
+    """(where, key, what) for the help screen, with the keys in force."""
+    keys = keys_in_force(keymap)
+    rows = [("Anywhere", key_name(keys[c.id]), c.footer or c.title)
+            for c in COMMANDS if keys.get(c.id)]
     rows.append(("Anywhere", "Ctrl+P", "Command palette: every action by name"))
     rows.append(("Anywhere", "Ctrl+Q", "Quit (asks first when there are unsaved edits)"))
     rows.append(("Anywhere", "Tab / Shift+Tab", "Move between controls"))
-    for binding in ProjectionWidget.BINDINGS:
+    for binding in view_bindings:
         rows.append(("3D view", key_name(binding.key), binding.description))
     rows.append(("3D view", "mouse drag / wheel", "Rotate / zoom"))
     rows.append(("Fields", "Enter or leave", "Check the value; an invalid one goes back "
@@ -113,6 +144,39 @@ def help_rows(dialog_bindings=()) -> list[tuple[str, str, str]]:
         rows.append(("Poses dialog", key_name(binding.key), binding.description))
     rows.append(("Dialogs", "Escape", "Close without changes"))
     return rows
+
+
+def load_keymap(folder: Path | None = None) -> tuple[dict[str, str], list[str]]:
+    """The user's key remapping from ``keys.toml``, and one line per problem found.
+
+    A missing file is no remapping; a damaged one, an unknown command id or a
+    key that is not text is reported and left out, never fatal.
+    """
+    path = (folder or config_folder()) / KEYS_FILE
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        return {}, []
+    except OSError as error:
+        return {}, [one_line(f"{path}: {error.strerror or error}")]
+    try:
+        document = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        return {}, [one_line(f"{path}: {error}")]
+    table = document.get("keys", {})
+    if not isinstance(table, dict):
+        return {}, [f"{path}: [keys] must be a table of command id = key"]
+    keymap, problems = {}, []
+    for command_id, key in table.items():
+        if command_id not in BY_ID:
+            problems.append(one_line(f"{path}: keys.{command_id}: no such command; expected "
+                                     "one of " + ", ".join(sorted(BY_ID))))
+        elif not isinstance(key, str) or not key.strip():
+            problems.append(one_line(f"{path}: keys.{command_id} = {key!r}: expected a key "
+                                     "name such as \"f9\" or \"ctrl+r\""))
+        else:
+            keymap[command_id] = key.strip()
+    return keymap, problems
 
 
 def key_name(key: str) -> str:
@@ -132,4 +196,4 @@ def key_name(key: str) -> str:
             return k.upper()
         return k
 
-    return " / ".join(one(k) for k in key.split(","))
+    return " / ".join(one(k.strip()) for k in key.split(","))

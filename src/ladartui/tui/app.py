@@ -23,6 +23,7 @@ from textual.widgets import Button, Footer, TabbedContent, TabPane
 from ladartui import views
 from ladartui.edit_history import EditHistory
 from ladartui.tui import actions, bridge
+from ladartui.tui.canvas import ProjectionWidget
 from ladartui.tui.fields import NumberField
 from ladartui.tui.file_actions import FileActions
 from ladartui.tui.panels import FilePanel, FlightPanel, ResultsPanel, RunPanel, SensorPanel
@@ -38,12 +39,18 @@ from ladartui.tui.view_area import LAYOUTS, OUTPUT_POINTS, ViewArea
 # everything the analyst can change; disabled while busy (Cancel is re-enabled)
 CONTROLS = "#sidebar Input, #sidebar Button, #sidebar Select, #sidebar Checkbox, " \
            "#sidebar DataTable, #sidebar OptionList"
-palette_entries, own_actions = actions.palette_entries, actions.own_actions
+own_actions = actions.own_actions
 
 
-def help_rows(_app=None) -> list[tuple[str, str, str]]:
-    """The help screen's rows: the app's keys, the views' and the poses dialog's."""
-    return actions.help_rows(PosesScreen.BINDINGS)
+def palette_entries(app=None) -> list[tuple[str, str, str]]:
+    """The command palette's entries, with the keys in force in ``app``."""
+    return actions.palette_entries(app.keymap if app is not None else None)
+
+
+def help_rows(app=None) -> list[tuple[str, str, str]]:
+    """The help screen's rows: the app's keys (as remapped), the views' and the dialogs'."""
+    return actions.help_rows(app.keymap if app is not None else None,
+                             ProjectionWidget.BINDINGS, PosesScreen.BINDINGS)
 
 
 class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
@@ -78,6 +85,8 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
         self.leaving = False  # set on exit: late worker messages are ignored
         self.running = False
         self.tool_screen = None  # the study or sweep screen while it is open
+        self.keymap, self.keymap_problems = actions.load_keymap()
+        self.set_keymap(self.keymap)
 
     # -- the scenario under edit -----------------------------------------------------
 
@@ -196,6 +205,8 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
         self.run_panel = self.query_one(RunPanel)
         self.results_panel = self.query_one(ResultsPanel)
         self.view_area = self.query_one(ViewArea)
+        for problem in self.keymap_problems:
+            self.tell(problem, title="Key not remapped", severity="warning", timeout=10)
         self.refresh_status()
         if self.start_scenario is not None:
             self.load(None, scenario=self.start_scenario)
@@ -379,7 +390,7 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
         self.push_screen(CompareScreen(paths[:4], self._folder()))
 
     def action_help(self) -> None:
-        self.push_screen(HelpScreen(help_rows()))
+        self.push_screen(HelpScreen(help_rows(self)))
 
     # -- study and sweep screens -------------------------------------------------------
 
@@ -465,7 +476,7 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
         yield from super().get_system_commands(screen)
         if self.tool_screen is not None and screen is self.tool_screen:
             return  # the study and sweep screens have their own keys
-        for title, help_text, action in palette_entries():
+        for title, help_text, action in palette_entries(self):
             yield SystemCommand(title, help_text, _runner(self, action))
 
 
