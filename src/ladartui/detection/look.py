@@ -33,6 +33,7 @@ class GeigerLook:
     declared: np.ndarray      # (D, B) bool
     ray_declared: np.ndarray  # (N,) bool: the ray's hit lies in a declared bin
     false_alarms: int         # declared bins without a return
+    noise_bins: int = 0       # bins without a return (where only noise can fire)
 
 
 def incidence_cosines(origins, directions, kind, index, ranges, voxel_size) -> np.ndarray:
@@ -64,7 +65,7 @@ def geiger_look(detector, kind, ranges, reflectance, cos_incidence, *, rays_per_
     if not hit.any():
         empty = np.zeros((0, 0))
         return GeigerLook(np.zeros(0, np.int64), 0.0, empty, empty.astype(np.int32),
-                          empty.astype(bool), ray_declared, 0)
+                          empty.astype(bool), ray_declared, 0, 0)
     ids, row = np.unique(detector[hit], return_inverse=True)
     r = ranges[hit]
     gate_start = float(np.floor(r.min() / bin_width) * bin_width)
@@ -80,4 +81,5 @@ def geiger_look(detector, kind, ranges, reflectance, cos_incidence, *, rays_per_
     declared = declare_points(counts, threshold)
     ray_declared[np.flatnonzero(hit)] = declared[row, b]
     return GeigerLook(ids, gate_start, mean, counts, declared, ray_declared,
-                      int(np.count_nonzero(declared & ~has_return)))
+                      int(np.count_nonzero(declared & ~has_return)),
+                      int(np.count_nonzero(~has_return)))
