@@ -156,3 +156,16 @@ def test_scenario_from_toml_without_options_has_none():
     scenario = scenario_from_toml(BASE.format(sensor="", segment=ORBIT, extra=""), "/tmp/x.toml")
     assert scenario.detection is None and scenario.sensor.mount == "stabilised"
     assert "detection" not in scenario.to_dict() and "mount" not in scenario.to_dict()["sensor"]
+
+
+def test_scan_footprints_fall_with_attitude(tmp_path):
+    from ladartui.attitude import scan_footprints
+
+    stabilised = _scenario(tmp_path)
+    plain = scan_footprints(stabilised)
+    assert all(np.array_equal(f, stabilised.sensor.footprint(p))
+               for f, p in zip(plain, stabilised.poses()))
+    banked = scan_footprints(_scenario(tmp_path, sensor='mount = "body-fixed"\n'))
+    # A right orbit banks right: each footprint moves away from the centre, outwards.
+    for before, after in zip(plain, banked):
+        assert np.linalg.norm(after.mean(axis=0)[:2]) > np.linalg.norm(before.mean(axis=0)[:2]) + 5

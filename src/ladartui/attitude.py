@@ -87,3 +87,15 @@ def plan_attitudes(plan, speed: float, sensor) -> list:
         return [None] * sum(len(p) for p in segment_poses)
     return [a for segment, poses in zip(plan.segments, segment_poses)
             for a in segment_attitudes(segment, poses, speed)]
+
+
+def scan_footprints(scenario, ground_z: float = 0.0) -> list[np.ndarray]:
+    """Each scan's field-of-view corners on the ground (4, 3), as they fall with attitude.
+
+    For a stabilised sensor these are ``Sensor.footprint(pose)``; a body-fixed
+    one's swing with the bank of turns and orbits and a log's roll and pitch.
+    """
+    sensor = scenario.sensor
+    attitudes = plan_attitudes(scenario.flight, scenario.speed, sensor)
+    return [sensor.footprint(pose, ground_z, attitude)
+            for pose, attitude in zip(scenario.poses(), attitudes)]
