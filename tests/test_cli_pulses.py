@@ -84,3 +84,17 @@ def test_ctrl_c_cancels_with_a_truthful_message(scenario, capsys, monkeypatch):
     captured = capsys.readouterr()
     assert "pulse study cancelled after tracing 2 of 3 scans; no results" in captured.err
     assert "ideal model" not in captured.out
+
+
+def test_work_beyond_the_memory_limit_is_refused_up_front(scenario, capsys, monkeypatch):
+    import ladartui.detection.scan as scan
+
+    monkeypatch.setattr(scan, "memory_limit", lambda: 1 << 16)
+    traced = []
+    monkeypatch.setattr("ladartui.tracing.trace", lambda *a, **k: traced.append(1))
+    assert main(["pulses", str(scenario.path), "--pulses", "1"]) == 2
+    err = capsys.readouterr().err
+    assert "would need about" in err and "3 scans of 1,024 rays" in err and not traced
+    with pytest.raises(Exception, match="one scan's 1,024 rays in two runs"):
+        from ladartui.simulation import simulate
+        simulate(scenario.with_changes(detection=DetectionSettings(model="geiger")), write=False)

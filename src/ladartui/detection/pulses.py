@@ -18,7 +18,7 @@ from typing import Callable
 
 import numpy as np
 
-from ladartui.detection.scan import declare_look, prepare_look
+from ladartui.detection.scan import BYTES_PER_HELD_RAY, check_memory, declare_look, prepare_look
 from ladartui.detection.settings import DetectionSettings
 from ladartui.errors import Cancelled
 from ladartui.measures import voxel_keys
@@ -72,12 +72,16 @@ def pulse_study(scenario, pulses_list, settings: DetectionSettings | None = None
     from ladartui.tracing import trace
 
     settings = settings or scenario.detection or DetectionSettings()
+    poses = scenario.poses()
+    # Every scan's rays are kept (traced once, fired at for each pulse count).
+    check_memory(len(poses) * scenario.sensor.rays_per_scan * BYTES_PER_HELD_RAY,
+                 f"{len(poses)} scans of {scenario.sensor.rays_per_scan:,} rays",
+                 "use fewer scans, a smaller sensor grid or fewer rays per detector")
     if scene is None:
         scene = scenario.load_scene()
     sensor = scenario.sensor
     target_keys = np.unique(voxel_keys(scene.target))
     total = target_keys.size
-    poses = scenario.poses()
     attitudes = plan_attitudes(scenario.flight, scenario.speed, sensor)
     per_scan_units = [max(1.0, p / 10.0) for p in pulses_list]
     units_total = len(poses) * (1.0 + sum(per_scan_units))

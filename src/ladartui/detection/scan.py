@@ -10,16 +10,40 @@ counts as coverage and with certain detection the answer is the ideal one.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 
 import numpy as np
 
 from ladartui.detection.geiger import noise_per_bin
 from ladartui.detection.look import geiger_look, incidence_cosines
+from ladartui.errors import LadarError
 from ladartui.measures import voxel_keys
 
 VOXEL = 1
 GROUND = 2
+# Bytes the model keeps per traced ray until its scan is declared (origins,
+# directions, kind, range, voxel, detector, and the model's per-ray inputs).
+BYTES_PER_HELD_RAY = 110
+# Bytes per (detector, range bin) cell of a look: mean counts, fire probability,
+# fire counts, declared and has-return flags.
+BYTES_PER_BIN = 22
+
+
+def memory_limit() -> int:
+    """Bytes the model may hold at once: half the machine's physical memory."""
+    try:
+        return os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE") // 2
+    except (ValueError, OSError, AttributeError):
+        return 8 << 30
+
+
+def check_memory(nbytes: float, what: str, advice: str) -> None:
+    """LadarError up front when ``nbytes`` would exceed ``memory_limit()``."""
+    limit = memory_limit()
+    if nbytes > limit:
+        raise LadarError(f"the Geiger-mode model would need about {nbytes / 2**30:.1f} GiB for "
+                         f"{what}, more than the {limit / 2**30:.1f} GiB it may use here: {advice}")
 
 
 @dataclass(frozen=True)
@@ -68,6 +92,14 @@ def declare_look(look: LookInputs, settings, sensor, pulses: int, threshold: int
                  scan_key: int) -> LookOutcome:
     """Fire ``pulses`` pulses at one scan (random stream keyed by ``scan_key``)."""
     bin_width = settings.bin_width(sensor.depth_resolution)
+    hit = look.kind != 0
+    if hit.any():
+        span = float(look.range[hit].max() - look.range[hit].min())
+        bins = span / bin_width + 2
+        detectors = np.unique(look.detector[hit]).size
+        check_memory(detectors * bins * BYTES_PER_BIN,
+                     f"{detectors:,} detectors x {bins:,.0f} range bins in one look",
+                     "use a wider detection.bin_width_m or a smaller sensor grid")
     result = geiger_look(
         look.detector, look.kind, look.range, look.reflectance, look.cos_incidence,
         rays_per_detector=sensor.ray_grid ** 2, n_ref=settings.n_ref,
@@ -95,6 +127,9 @@ class GeigerRun:
     def __init__(self, settings, sensor, scene):
         from ladartui.detection.measures import DetectionTally
 
+        check_memory(2 * sensor.rays_per_scan * BYTES_PER_HELD_RAY,
+                     f"one scan's {sensor.rays_per_scan:,} rays in two runs",
+                     "use a smaller sensor grid or fewer rays per detector")
         self.settings = settings
         self.sensor = sensor
         self.voxel_size = scene.voxel_size
