@@ -10,7 +10,6 @@ from ladartui.attitude import body_rotation, coordinated_turn_roll, plan_attitud
 from ladartui.errors import LadarError
 from ladartui.flight import ScanPose, straight
 from ladartui.scenario import load_scenario, scenario_from_toml
-from ladartui.sensor import pose_rotation
 from ladartui.trajectory import load_flight_log, log_poses
 
 EXAMPLE_LOG = Path(__file__).resolve().parents[1] / "scenarios" / "flight-log.csv"

@@ -181,7 +181,8 @@ class LogSegment:
         return log.time[0] + np.arange(count) / self.rate
 
     def build(self, current) -> list[ScanPose]:
-        from ladartui.flight import ScanPose as Pose, aim_at
+        from ladartui.flight import ScanPose as Pose
+        from ladartui.flight import aim_at
 
         template = Pose(0.0, 0.0, 1.0, 0.0, self.azimuth, self.depression)
         poses = log_poses(self._log, template, times=self.scan_times())

@@ -80,7 +80,7 @@ def run(args) -> int:
     state = {"last": None}
     try:
         ideal, rows = _study_with_progress(scenario, pulses, settings, args.backend, errors, state)
-    except Cancelled:
+    except (Cancelled, KeyboardInterrupt):  # the latter: Ctrl-C before the worker started
         print(f"ladartui: pulse study cancelled {_where(state['last'])}; no results, and this "
               "command writes no files", file=sys.stderr)
         return 130
@@ -102,7 +102,7 @@ def _where(progress) -> str:
         return "before the first scan was traced"
     if progress.stage == "trace":
         return f"after tracing {progress.done} of {progress.total} scans"
-    return f"after {progress.done - 1} of {progress.total} pulse counts"
+    return f"after tracing every scan, during pulse count {progress.done} of {progress.total}"
 
 
 def _study_with_progress(scenario, pulses, settings, backend, console, state):

@@ -45,7 +45,8 @@ def incidence_cosines(origins, directions, kind, index, ranges, voxel_size) -> n
     cos[ground] = np.abs(d[ground, 2])
     voxel = hit & ~ground
     if voxel.any():
-        p = np.asarray(origins)[voxel] / voxel_size + 0.5 + d[voxel] * (np.asarray(ranges)[voxel] / voxel_size)[:, None]
+        along = (np.asarray(ranges)[voxel] / voxel_size)[:, None]
+        p = np.asarray(origins)[voxel] / voxel_size + 0.5 + d[voxel] * along
         c = np.asarray(index)[voxel].astype(np.float64)
         # The entry face is the one whose plane the hit point lies closest to.
         gap = np.minimum(np.abs(p - c), np.abs(p - c - 1.0))

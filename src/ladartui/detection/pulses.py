@@ -13,8 +13,8 @@ obscured coverage. See docs/detection.md.
 from __future__ import annotations
 
 import threading
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
-from typing import Callable
 
 import numpy as np
 
