@@ -168,3 +168,21 @@ def test_scan_footprints_fall_with_attitude(tmp_path):
     # A right orbit banks right: each footprint moves away from the centre, outwards.
     for before, after in zip(plain, banked):
         assert np.linalg.norm(after.mean(axis=0)[:2]) > np.linalg.norm(before.mean(axis=0)[:2]) + 5
+
+
+def test_shipped_realism_example_loads_and_saves_unchanged(tmp_path):
+    import shutil
+
+    shipped = EXAMPLE_LOG.parent / "realism.toml"
+    path = tmp_path / "realism.toml"
+    shutil.copy(shipped, path)
+    shutil.copy(EXAMPLE_LOG, tmp_path / "flight-log.csv")
+    scenario = load_scenario(path, check_files=False)
+    assert scenario.geiger and scenario.sensor.mount == "body-fixed"
+    assert [s.kind for s in scenario.flight.segments] == ["orbit", "log"]
+    assert len(scenario.poses()) == 12 + 7
+    roll = plan_attitudes(scenario.flight, scenario.speed, scenario.sensor)[0][0]
+    assert f"banks atan(v^2 / g r) = {roll:.1f} degrees" in shipped.read_text()
+    before = path.read_bytes()
+    scenario.save()
+    assert path.read_bytes() == before
