@@ -84,7 +84,7 @@ def _ideal_by_hand(scenario, folder):
     return [(folder / n).read_bytes() for n in ("scene.txt", "target.txt", "m.cmf")], measures
 
 
-@pytest.mark.parametrize("name", ["default", "manoeuvres", "flypast"])
+@pytest.mark.parametrize("name", ["default", "orbit", "flypast", "standoff", "manoeuvres"])
 def test_options_off_are_byte_identical(name, tmp_path, small_scene):
     absent = _copy(name, tmp_path / "absent", small_scene)
     explicit = _copy(name, tmp_path / "explicit", small_scene,

@@ -93,9 +93,11 @@ def test_body_fixed_mount_banks_orbit_rays(tmp_path):
     _, banked, _ = body.sensor.rays(pose, attitude=attitudes[0])
     expected = plain @ body_rotation(pose.heading, *attitudes[0]).T
     np.testing.assert_allclose(banked, expected, atol=1e-12)
-    # With no bank the body-fixed rays are the stabilised ones exactly.
-    _, level, _ = body.sensor.rays(pose, attitude=(0.0, 0.0))
-    np.testing.assert_array_equal(level, plain)
+    # With no bank the body-fixed rays are the stabilised ones exactly, at any heading.
+    for heading in (0.0, 33.0, 217.5):
+        turned = ScanPose(pose.x, pose.y, pose.z, heading, pose.azimuth, pose.depression)
+        _, level, _ = body.sensor.rays(turned, attitude=(0.0, 0.0))
+        np.testing.assert_array_equal(level, stabilised.sensor.rays(turned)[1])
 
 
 def test_body_fixed_roll_moves_nadir_footprint_by_h_tan_roll(tmp_path):

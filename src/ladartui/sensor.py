@@ -61,7 +61,7 @@ def pose_rotation(pose: ScanPose) -> np.ndarray:
 def _rotation(pose: ScanPose, attitude) -> np.ndarray:
     """``pose_rotation``, turned by the aircraft's (roll, pitch) for a body-fixed sensor."""
     rotation = pose_rotation(pose)
-    if attitude is None:
+    if attitude is None or not any(attitude):  # level flight: the report's rays exactly
         return rotation
     from ladartui.attitude import body_rotation
 
