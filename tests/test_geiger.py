@@ -152,7 +152,8 @@ def test_settings_and_cli_reject_bad_values(capsys):
     from ladartui.cli import main
     from ladartui.detection.settings import DetectionSettings
     from ladartui.errors import FieldError
-    with pytest.raises(FieldError, match=r"detection.reflectance_target = 1.5: expected a number from 0 to 1"):
+    with pytest.raises(FieldError,
+                       match=r"detection.reflectance_target = 1.5: expected a number from 0 to 1"):
         DetectionSettings(reflectance_target=1.5)
     # k keeps the share coincidence / pulses (10 of 100 by default), at least 1.
     settings = DetectionSettings()
