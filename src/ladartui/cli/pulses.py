@@ -116,7 +116,8 @@ def _study_with_progress(scenario, pulses, settings, backend, console, state):
                TextColumn("{task.percentage:>5.1f} %"), TimeElapsedColumn(),
                TimeRemainingColumn())
     with Progress(*columns, console=console, transient=False) as bar:
-        task = bar.add_task("tracing", total=1.0)
+        # Until the first scan is done (a first run also compiles the kernels, about a minute).
+        task = bar.add_task("tracing scan 1 (compiling kernels on a first run)", total=1.0)
 
         def report(p):
             state["last"] = p
