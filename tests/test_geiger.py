@@ -150,10 +150,13 @@ def test_incidence_cosine_of_nadir_and_slanted_rays():
 
 def test_settings_and_cli_reject_bad_values(capsys):
     from ladartui.cli import main
-    from ladartui.detection.pulses import GeigerSettings
+    from ladartui.detection.settings import DetectionSettings
     from ladartui.errors import FieldError
-    with pytest.raises(FieldError, match=r"detection.reflectance_target = 1.5: expected a number in 0..1"):
-        GeigerSettings(reflectance_target=1.5)
-    assert GeigerSettings().threshold(1) == 1 and GeigerSettings().threshold(100) == 10
+    with pytest.raises(FieldError,
+                       match=r"detection.reflectance_target = 1.5: expected a number from 0 to 1"):
+        DetectionSettings(reflectance_target=1.5)
+    # k keeps the share coincidence / pulses (10 of 100 by default), at least 1.
+    settings = DetectionSettings()
+    assert [settings.threshold(m) for m in (1, 10, 25, 100, 1000)] == [1, 1, 3, 10, 100]
     assert main(["pulses", "--pulses", "1,x"]) == 2
     assert "--pulses = '1,x': expected comma-separated whole numbers" in capsys.readouterr().err

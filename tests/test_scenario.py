@@ -219,7 +219,7 @@ LIMITS = [
     ("centre = [10.0, 10.0, 1.0]", "centre = [10.0]", "flight.segments[1].centre = [10.0]",
      "a point [x, y] or [x, y, z] in metres, each within +-1000000"),
     ('kind = "orbit"', 'kind = "circle"', "flight.segments[1].kind = 'circle'",
-     "one of 'manual', 'straight', 'turn', 'orbit', 'flypast', 'standoff'"),
+     "one of 'manual', 'straight', 'turn', 'orbit', 'flypast', 'standoff', 'log'"),
     ('method = "march"', 'method = "fast"', "simulation.method = 'fast'",
      "one of 'exact', 'march'"),
     ("step = 0.25", "step = 0", "simulation.step = 0", "a number greater than 0 and at most 10"),
@@ -271,11 +271,11 @@ def test_relative_segment_first_needs_a_start(tmp_path):
 
 @pytest.mark.parametrize("old,new,message", [
     ("grid = 32", "gird = 32", "unknown key 'sensor.gird' (allowed: grid, ray_grid, fov_deg, "
-     "depth_resolution_m, pixel_pitch_um)"),
+     "depth_resolution_m, pixel_pitch_um, mount)"),
     ("radius = 60.0", "raduis = 60.0", "unknown key 'flight.segments[1].raduis' (orbit segment) "
      "(allowed: kind, centre, radius, altitude, scans, direction, start_bearing, arc, aim_at)"),
     ("[simulation]", "[simulatoin]", "unknown section [simulatoin] "
-     "(allowed: files, sensor, flight, simulation)"),
+     "(allowed: files, sensor, flight, simulation, detection)"),
     ("heading = 0.0", "headin = 0.0", "unknown key 'flight.start.headin' "
      "(allowed: x, y, z, heading, azimuth, depression)"),
 ])

@@ -49,9 +49,53 @@ def attitude_matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
     return rz @ ry @ rx
 
 
+def body_rotation(heading: float, roll: float = 0.0, pitch: float = 0.0,
+                  yaw: float = 0.0) -> np.ndarray:
+    """``B Rz(yaw) Ry(pitch) Rx(roll) B^T``: stabilised to body-fixed, scene frame."""
+    b = _level_frame(heading)
+    return b @ attitude_matrix(roll, pitch, yaw) @ b.T
+
+
 def body_fixed_directions(directions, heading: float, roll: float = 0.0, pitch: float = 0.0,
                           yaw: float = 0.0) -> np.ndarray:
     """Stabilised ray directions (N, 3) turned with the aircraft's attitude."""
-    b = _level_frame(heading)
-    rotation = b @ attitude_matrix(roll, pitch, yaw) @ b.T
+    rotation = body_rotation(heading, roll, pitch, yaw)
     return np.asarray(directions, dtype=np.float64) @ rotation.T
+
+
+def segment_attitudes(segment, poses, speed: float) -> list[tuple[float, float]]:
+    """(roll, pitch) in degrees at each of a segment's scans.
+
+    Turns and orbits bank as coordinated turns at ``speed`` (right turns roll
+    right, positive); a recorded flight log gives its own roll and pitch;
+    every other segment flies wings level.
+    """
+    from ladartui.flight import Orbit, Turn
+
+    if hasattr(segment, "attitudes"):  # a recorded log knows its own
+        return list(segment.attitudes())
+    if isinstance(segment, (Turn, Orbit)):
+        roll = coordinated_turn_roll(speed, segment.radius)
+        return [(roll if segment.direction == "right" else -roll, 0.0)] * len(poses)
+    return [(0.0, 0.0)] * len(poses)
+
+
+def plan_attitudes(plan, speed: float, sensor) -> list:
+    """Per scan of ``plan``: (roll, pitch) for a body-fixed sensor, None for a stabilised one."""
+    segment_poses = plan.segment_poses()
+    if sensor.mount != "body-fixed":
+        return [None] * sum(len(p) for p in segment_poses)
+    return [a for segment, poses in zip(plan.segments, segment_poses)
+            for a in segment_attitudes(segment, poses, speed)]
+
+
+def scan_footprints(scenario, ground_z: float = 0.0) -> list[np.ndarray]:
+    """Each scan's field-of-view corners on the ground (4, 3), as they fall with attitude.
+
+    For a stabilised sensor these are ``Sensor.footprint(pose)``; a body-fixed
+    one's swing with the bank of turns and orbits and a log's roll and pitch.
+    """
+    sensor = scenario.sensor
+    attitudes = plan_attitudes(scenario.flight, scenario.speed, sensor)
+    return [sensor.footprint(pose, ground_z, attitude)
+            for pose, attitude in zip(scenario.poses(), attitudes)]

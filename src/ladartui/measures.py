@@ -212,12 +212,19 @@ class Measures:
     path_length_m: float | None = None
     flight_time_s: float | None = None
     voxel_size: float | None = None
+    # Geiger-mode figures (ladartui.detection.measures.DetectionMeasures); None with
+    # the ideal sensor, and then absent from the dict and the .cmf.
+    detection: object | None = None
 
     def to_dict(self) -> dict:
         """A JSON-safe dict (no NaN: undefined measures are None)."""
         out = {}
         for f in fields(self):
             value = getattr(self, f.name)
+            if f.name == "detection":
+                if value is not None:
+                    out[f.name] = value.to_dict()
+                continue
             if isinstance(value, DirectionStats):
                 value = value.to_dict()
             elif isinstance(value, tuple):
@@ -235,6 +242,8 @@ class Measures:
                 lines.append(f"{key} = {_format_value(getter(self))}")
             if section == _PER_SCAN_SECTION:
                 lines.extend(_per_scan_lines(self))
+        if self.detection is not None:
+            lines.extend(_detection_lines(self.detection))
         return "\n".join(lines) + "\n"
 
     def write_cmf(self, path) -> None:
@@ -432,6 +441,18 @@ def _per_scan_lists(path, rows) -> dict:
     return out
 
 
+def _detection_entries():
+    from ladartui.detection.measures import CMF_ENTRIES, CMF_SECTION
+
+    return CMF_SECTION, CMF_ENTRIES
+
+
+def _detection_lines(detection) -> list[str]:
+    section, entries = _detection_entries()
+    return ["", f"[{section}]", *(f"{key} = {_format_value(getattr(detection, attr))}"
+                                  for key, attr, _kind in entries)]
+
+
 _CMF_LAYOUT = [
     (section, [(key, (lambda m, p=path: _get_path(m, p)), kind) for key, path, kind in entries])
     for section, entries in _CMF_SECTIONS
@@ -474,6 +495,9 @@ def read_cmf(path) -> Measures:
     if not lines or lines[0].strip() != CMF_HEADER:
         raise InputFileError(path, f"not a measures file: expected first line {CMF_HEADER!r}", line=1)
     kinds = {(section, key): (attr, kind) for section, entries in _CMF_SECTIONS for key, attr, kind in entries}
+    detection_section, detection_entries = _detection_entries()
+    kinds.update({(detection_section, key): ("detection." + attr, kind)
+                  for key, attr, kind in detection_entries})
     values: dict[str, object] = {}
     per_scan: dict[int, tuple] = {}
     section = None
@@ -483,7 +507,7 @@ def read_cmf(path) -> Measures:
             continue
         if line.startswith("[") and line.endswith("]"):
             section = line[1:-1].strip()
-            if not any(section == name for name, _ in _CMF_SECTIONS):
+            if not any(section == name for name, _ in _CMF_SECTIONS) and section != detection_section:
                 raise InputFileError(path, f"unknown section [{section}]", line=number)
             continue
         key, sep, value = line.partition("=")
@@ -514,7 +538,12 @@ def read_cmf(path) -> Measures:
         else:
             plain[attr] = value
     for head, parts in nested.items():
-        plain[head] = DirectionStats(**parts)
+        if head == "detection":
+            from ladartui.detection.measures import DetectionMeasures
+
+            plain[head] = DetectionMeasures(**parts)
+        else:
+            plain[head] = DirectionStats(**parts)
     plain.update(_per_scan_lists(path, per_scan))
     return Measures(**plain)
 

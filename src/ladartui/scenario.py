@@ -17,6 +17,7 @@ are caught; keys marked "default" may be left out)::
     fov_deg = 8.0                   # full field of view, degrees, > 0 and < 90
     depth_resolution_m = 1.0        # returns closer than this on one detector merge, 0..1000
     pixel_pitch_um = 100.0          # detector pitch, micrometres, > 0 and <= 10000
+    mount = "stabilised"            # or "body-fixed": rays turn with roll and pitch
 
     [flight]
     speed_mps = 30.0                # for the flight time (default 30)
@@ -54,6 +55,9 @@ Other segment kinds and their keys (``aim_at`` is optional on every kind):
 * ``kind = "standoff"``: ``target``, ``standoffs = [100.0, 150.0, ...]`` (m),
   ``altitude``, ``bearing`` (default 180), ``heading`` (default: towards the
   target).
+* ``kind = "log"``: a recorded flight log ``file`` (CSV, relative to this
+  file's folder; see ``ladartui.trajectory``), scans at ``rate`` (Hz) or at
+  ``times = [..]`` (s); ``azimuth`` (default 0), ``depression`` (default 90).
 
 Straight and turn segments continue from the previous segment's last scan
 (or from ``[flight.start]``); see ``ladartui.flight``. ::
@@ -64,6 +68,12 @@ Straight and turn segments continue from the previous segment's last scan
     step = 0.5                      # march step in voxels, > 0 and <= 10
     precision = "f64"               # "f64" or "f32"
     fast_mode = false               # true: no progressive views during a run
+
+    [detection]                     # optional; absent: the ideal sensor
+    model = "geiger"                # see ladartui.detection.settings for every key
+
+Turns and orbits bank as coordinated turns at ``speed_mps``; only a
+``body-fixed`` sensor sees it (``ladartui.attitude``).
 """
 
 from __future__ import annotations
@@ -80,6 +90,7 @@ from pathlib import Path
 import tomli_w
 
 from ladartui.atomic import write_text_atomic
+from ladartui.detection.settings import DETECTION_KEYS, DetectionSettings, detection_from_table
 from ladartui.errors import FieldError, InputFileError, LadarError
 from ladartui.fileprobe import file_problem
 from ladartui.scenario_style import restyle
@@ -93,6 +104,7 @@ from ladartui.flight import (
     number_field,
 )
 from ladartui.sensor import MAX_PIXEL_PITCH, Sensor
+from ladartui.trajectory import LogSegment
 
 BUILTIN_BACKENDS = ("numba", "wgpu")
 METHODS = ("exact", "march")
@@ -107,6 +119,7 @@ _SENSOR_KEYS = {  # TOML key -> (Sensor field, file units per Sensor unit)
     "fov_deg": ("fov", None),
     "depth_resolution_m": ("depth_resolution", None),
     "pixel_pitch_um": ("pixel_pitch", 1e6),
+    "mount": ("mount", None),
 }
 _POSE_KEYS = ("x", "y", "z", "heading", "azimuth", "depression")
 _SECTIONS = {
@@ -114,7 +127,10 @@ _SECTIONS = {
     "sensor": tuple(_SENSOR_KEYS),
     "flight": ("speed_mps", "start", "segments"),
     "simulation": ("backend", "method", "step", "precision", "fast_mode"),
+    "detection": DETECTION_KEYS,
 }
+# Segment kinds a scenario file may use: the flight plan's, and recorded logs.
+_SEGMENT_KINDS = {**SEGMENT_KINDS, LogSegment.kind: LogSegment}
 
 
 def _backend_choices():
@@ -147,6 +163,7 @@ class Scenario:
     step: float = 0.5
     fast_mode: bool = False
     precision: str = "f64"
+    detection: DetectionSettings | None = None  # None: no [detection] section (ideal)
 
     def __post_init__(self):
         set_ = object.__setattr__
@@ -171,6 +188,16 @@ class Scenario:
         if not isinstance(self.fast_mode, bool):
             raise FieldError("simulation.fast_mode", self.fast_mode, "true or false")
         _check_flight(self.flight)
+        if self.detection is not None:
+            if not isinstance(self.detection, DetectionSettings):
+                raise FieldError("detection", self.detection, "a DetectionSettings")
+            if self.detection.geiger:
+                self.detection.bin_width(self.sensor.depth_resolution)
+
+    @property
+    def geiger(self) -> bool:
+        """True when the [detection] section asks for the Geiger-mode model."""
+        return self.detection is not None and self.detection.geiger
 
     # -- derived file names (report table 2) --
 
@@ -278,6 +305,9 @@ class Scenario:
             f"run        backend {self.backend}, method {self.method}"
             + (f" (step {self.step:g} voxel)" if self.method == "march" else "")
             + f", {self.precision}" + (", fast mode" if self.fast_mode else ""),
+            *([f"attitude   body-fixed sensor: rays turn with the aircraft's roll and pitch "
+               f"(coordinated turns at {self.speed:g} m/s)"] if s.mount == "body-fixed" else []),
+            *([f"detection  {self.detection.describe()}"] if self.detection is not None else []),
             f"outputs    {self.scene_output.name}, {self.target_output.name}, "
             f"{self.measures_file.name} in {self.path.parent}",
         ]
@@ -291,17 +321,24 @@ class Scenario:
         flight = {"speed_mps": self.speed}
         if self.flight.start is not None:
             flight["start"] = self.flight.start.to_dict()
-        flight["segments"] = [_segment_to_dict(seg) for seg in self.flight.segments]
-        return {
+        flight["segments"] = [_segment_to_dict(seg, self.path.parent)
+                              for seg in self.flight.segments]
+        sensor = {"grid": s.grid, "ray_grid": s.ray_grid, "fov_deg": s.fov,
+                  "depth_resolution_m": s.depth_resolution,
+                  "pixel_pitch_um": _to_micrometres(s.pixel_pitch)}
+        if s.mount != "stabilised":  # written only when chosen: older files stay as they were
+            sensor["mount"] = s.mount
+        data = {
             "files": {"scene": _relative(self.scene_file, self.path.parent),
                       "voxel_size": self.voxel_size},
-            "sensor": {"grid": s.grid, "ray_grid": s.ray_grid, "fov_deg": s.fov,
-                       "depth_resolution_m": s.depth_resolution,
-                       "pixel_pitch_um": _to_micrometres(s.pixel_pitch)},
+            "sensor": sensor,
             "flight": flight,
             "simulation": {"backend": self.backend, "method": self.method, "step": self.step,
                            "precision": self.precision, "fast_mode": self.fast_mode},
         }
+        if self.detection is not None:
+            data["detection"] = self.detection.to_dict()
+        return data
 
     def to_toml(self) -> str:
         header = (f"# ladartui scenario. Check it with: ladartui validate {self.path.name}\n"
@@ -434,6 +471,15 @@ class _Reader:
         sensor_table = self.table(doc, "sensor", _SECTIONS["sensor"])
         flight = self.table(doc, "flight", _SECTIONS["flight"], required=("segments",))
         sim = self.table(doc, "simulation", _SECTIONS["simulation"])
+        detection = None
+        if "detection" in doc:
+            table = self.table(doc, "detection", _SECTIONS["detection"])
+            try:
+                detection = detection_from_table(table)
+            except FieldError as error:
+                key = error.field.rpartition(".")[2]
+                raise self.field_error(error.field, table.get(key, error.value),
+                                       error.expected) from None
 
         scene = files["scene"]
         if not isinstance(scene, str) or not scene.strip():
@@ -462,7 +508,8 @@ class _Reader:
             if key in sim:
                 options[key] = sim[key]
         try:
-            return Scenario(self.path, Path(scene), sensor=sensor, flight=plan, **options)
+            return Scenario(self.path, Path(scene), sensor=sensor, flight=plan,
+                            detection=detection, **options)
         except FieldError as error:
             raw = {"files.voxel_size": files.get("voxel_size"),
                    "flight.speed_mps": flight.get("speed_mps")}
@@ -497,12 +544,12 @@ class _Reader:
     def segment(self, item, where):
         if "kind" not in item:
             raise self.file_error(where, f"missing key '{where}.kind' (one of "
-                                  f"{', '.join(SEGMENT_KINDS)})")
+                                  f"{', '.join(_SEGMENT_KINDS)})")
         kind = item["kind"]
-        if kind not in SEGMENT_KINDS:
+        if kind not in _SEGMENT_KINDS:
             raise self.field_error(f"{where}.kind", kind,
-                                   "one of " + ", ".join(repr(k) for k in SEGMENT_KINDS))
-        cls = SEGMENT_KINDS[kind]
+                                   "one of " + ", ".join(repr(k) for k in _SEGMENT_KINDS))
+        cls = _SEGMENT_KINDS[kind]
         fields = dataclasses.fields(cls)
         allowed = ("kind", *(f.name for f in fields))
         required = [f.name for f in fields if f.default is dataclasses.MISSING
@@ -516,6 +563,8 @@ class _Reader:
                                        "{ x = .., y = .., z = .., heading = .., "
                                        "azimuth = .., depression = .. }")
             args["poses"] = [self.pose(p, f"{where}.poses[{i}]") for i, p in enumerate(poses)]
+        if cls is LogSegment and isinstance(args["file"], str) and args["file"].strip():
+            args["file"] = str(_resolve(self.path.parent, args["file"]))
         with self.located(where + ".", item):
             return cls(**args)
 
@@ -585,7 +634,7 @@ def _indexed(dotted: str, arrays: dict[str, int]) -> str:
 # -- writing ------------------------------------------------------------------------
 
 
-def _segment_to_dict(segment) -> dict:
+def _segment_to_dict(segment, folder: Path) -> dict:
     data = {"kind": segment.kind}
     for f in dataclasses.fields(segment):
         value = getattr(segment, f.name)
@@ -593,6 +642,8 @@ def _segment_to_dict(segment) -> dict:
             continue
         if f.name == "poses":
             value = [p.to_dict() for p in value]
+        elif isinstance(segment, LogSegment) and f.name == "file":
+            value = _relative(Path(value), folder)
         elif isinstance(value, tuple):
             value = list(value)
         data[f.name] = value

@@ -35,6 +35,10 @@ MAX_GRID = 1024
 MAX_RAY_GRID = 16
 MAX_DEPTH_RESOLUTION = 1000.0  # metres
 MAX_PIXEL_PITCH = 0.01  # metres; the focal plane spans grid * pitch
+# "stabilised": a gimbal holds azimuth and depression against the horizon (the
+# report's model, the default); "body-fixed": the rays turn with the aircraft's
+# roll and pitch (ladartui.attitude).
+MOUNTS = ("stabilised", "body-fixed")
 
 
 def rotation_x(angle_deg: float) -> np.ndarray:
@@ -52,6 +56,16 @@ def rotation_z(angle_deg: float) -> np.ndarray:
 def pose_rotation(pose: ScanPose) -> np.ndarray:
     """Sensor-to-scene rotation for ``pose``: Rz(-(H + A)) @ Rx(90 - D)."""
     return rotation_z(-(pose.heading + pose.azimuth)) @ rotation_x(90.0 - pose.depression)
+
+
+def _rotation(pose: ScanPose, attitude) -> np.ndarray:
+    """``pose_rotation``, turned by the aircraft's (roll, pitch) for a body-fixed sensor."""
+    rotation = pose_rotation(pose)
+    if attitude is None or not any(attitude):  # level flight: the report's rays exactly
+        return rotation
+    from ladartui.attitude import body_rotation
+
+    return body_rotation(pose.heading, *attitude) @ rotation
 
 
 _KERNEL = None
@@ -115,7 +129,8 @@ class Sensor:
 
     ``fov`` is the full field of view in degrees (on each axis),
     ``depth_resolution`` metres (two returns on one detector closer than this
-    merge), ``pixel_pitch`` metres (report: 100 micrometres).
+    merge), ``pixel_pitch`` metres (report: 100 micrometres), ``mount``
+    "stabilised" (default) or "body-fixed" (see ``MOUNTS``).
     """
 
     grid: int = 128
@@ -123,6 +138,7 @@ class Sensor:
     fov: float = 10.0
     depth_resolution: float = 1.0
     pixel_pitch: float = 100e-6
+    mount: str = "stabilised"
 
     def __post_init__(self):
         set_ = object.__setattr__
@@ -134,6 +150,8 @@ class Sensor:
                                                     0.0, MAX_DEPTH_RESOLUTION))
         set_(self, "pixel_pitch", number_field("pixel_pitch", self.pixel_pitch, 0.0,
                                                MAX_PIXEL_PITCH, low_open=True))
+        if not isinstance(self.mount, str) or self.mount not in MOUNTS:
+            raise FieldError("mount", self.mount, "one of " + ", ".join(repr(m) for m in MOUNTS))
 
     @property
     def detectors(self) -> int:
@@ -159,8 +177,11 @@ class Sensor:
         pos_y = (0.5 - cell) * self.grid * self.pixel_pitch
         return tan_x, tan_y, pos_x, pos_y
 
-    def rays(self, pose: ScanPose, rows: range | slice | None = None):
+    def rays(self, pose: ScanPose, rows: range | slice | None = None, attitude=None):
         """The rays of one scan at ``pose``: (origins, directions, detector).
+
+        ``attitude``: the aircraft's (roll, pitch) in degrees, turning the rays
+        of a body-fixed sensor (None: stabilised, the report's rays exactly).
 
         origins (N, 3) float64 metres in the scene frame; directions (N, 3)
         float64 unit vectors; detector (N,) int32, row-major; N = (n m)^2, or
@@ -179,30 +200,30 @@ class Sensor:
         origins = np.empty((count, 3))
         directions = np.empty((count, 3))
         detector = np.empty(count, dtype=np.int32)
-        _rays_kernel()(self.grid, self.ray_grid, row0, row1, *self._axes, pose_rotation(pose),
+        _rays_kernel()(self.grid, self.ray_grid, row0, row1, *self._axes, _rotation(pose, attitude),
                        np.array(pose.position, dtype=np.float64), origins, directions, detector)
         return origins, directions, detector
 
-    def central_ray(self, pose: ScanPose):
+    def central_ray(self, pose: ScanPose, attitude=None):
         """(origin (3,), unit direction (3,)) of the sensor's boresight at ``pose``."""
-        return np.array(pose.position), pose_rotation(pose) @ np.array([0.0, 0.0, -1.0])
+        return np.array(pose.position), _rotation(pose, attitude) @ np.array([0.0, 0.0, -1.0])
 
-    def corner_directions(self, pose: ScanPose) -> np.ndarray:
+    def corner_directions(self, pose: ScanPose, attitude=None) -> np.ndarray:
         """Unit directions (4, 3) of the field-of-view corners: far-left, far-right,
         near-right, near-left (focal-plane corners (-x,+y), (+x,+y), (+x,-y), (-x,-y))."""
         t = math.tan(math.radians(self.fov / 2))
         local = np.array([[-t, t, -1.0], [t, t, -1.0], [t, -t, -1.0], [-t, -t, -1.0]])
         local /= np.linalg.norm(local, axis=1, keepdims=True)
-        return local @ pose_rotation(pose).T
+        return local @ _rotation(pose, attitude).T
 
-    def footprint(self, pose: ScanPose, ground_z: float = 0.0) -> np.ndarray:
+    def footprint(self, pose: ScanPose, ground_z: float = 0.0, attitude=None) -> np.ndarray:
         """Where the four field-of-view corners meet the plane z = ``ground_z``: (4, 3).
 
         The corners are the edges of the view (angles +-fov/2 on both axes), in
         the order of ``corner_directions``. A corner that never reaches the
         ground (at or above the horizon) is NaN.
         """
-        directions = self.corner_directions(pose)
+        directions = self.corner_directions(pose, attitude)
         origin = np.array(pose.position)
         drop = origin[2] - ground_z
         with np.errstate(divide="ignore", invalid="ignore"):

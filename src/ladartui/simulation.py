@@ -12,6 +12,7 @@ outputs as they were.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import threading
 import time
 from dataclasses import dataclass, field
@@ -223,12 +224,19 @@ def simulate(scenario, backend=None, method=None, step=None, precision=None,
     if scene is None:
         scene = scenario.load_scene()
     poses = list(scenario.poses())
+    from ladartui.attitude import plan_attitudes
+
+    attitudes = plan_attitudes(scenario.flight, scenario.speed, scenario.sensor)
     runner = _ScanRunner(scene, scenario.sensor, settings, len(poses), timings, progress, cancel)
+    if getattr(scenario, "geiger", False):
+        from ladartui.detection.scan import GeigerRun
+
+        runner.geiger = GeigerRun(scenario.detection, scenario.sensor, scene)
     timings["setup"] = time.perf_counter() - started
 
     per_scan = {run: [] for run in RUNS}
-    for scan, pose in enumerate(poses, start=1):
-        for run, returns in runner.scan(scan, pose).items():
+    for scan, (pose, attitude) in enumerate(zip(poses, attitudes), start=1):
+        for run, returns in runner.scan(scan, pose, attitude).items():
             per_scan[run].append(returns)
 
     _check(cancel)
@@ -244,6 +252,8 @@ def simulate(scenario, backend=None, method=None, step=None, precision=None,
         path_length_m=scenario.path_length(), flight_time_s=scenario.flight_time(),
         voxel_size=scene.voxel_size,
     )
+    if runner.geiger is not None:
+        measures = dataclasses.replace(measures, detection=runner.geiger.measures())
     timings["measures"] = time.perf_counter() - tick
 
     outputs = {}
@@ -284,8 +294,9 @@ class _ScanRunner:
         self.done = 0
         self.chunk = _FIRST_CHUNK_RAYS
         self.backend_used = None
+        self.geiger = None  # a detection.scan.GeigerRun when the Geiger model is on
 
-    def scan(self, scan, pose) -> dict[str, np.ndarray]:
+    def scan(self, scan, pose, attitude=None) -> dict[str, np.ndarray]:
         """Trace one scan for both runs; each run's returned voxels, (K, 3) int32."""
         sensor, timings = self.sensor, self.timings
         kept = {run: [] for run in RUNS}
@@ -295,7 +306,8 @@ class _ScanRunner:
             # Whole detector rows, so that the depth rule can run on each chunk.
             stop = min(sensor.grid, row + max(1, self.chunk // self.rays_per_row))
             tick = time.perf_counter()
-            origins, directions, detector = sensor.rays(pose, rows=slice(row, stop))
+            origins, directions, detector = sensor.rays(pose, rows=slice(row, stop),
+                                                        attitude=attitude)
             timings["rays"] += time.perf_counter() - tick
             slowest = 0.0
             for run in RUNS:
@@ -310,6 +322,8 @@ class _ScanRunner:
                 tick = time.perf_counter()
                 rays = kept_returns(detector, hits.kind, hits.range, sensor.depth_resolution)
                 kept[run].append(hits.index[rays])
+                if self.geiger is not None:
+                    self.geiger.add_chunk(run, origins, directions, detector, hits, rays)
                 timings["depth_rule"] += time.perf_counter() - tick
                 self.done += origins.shape[0]
                 if not (stop == sensor.grid and run == RUNS[-1]):
@@ -319,7 +333,10 @@ class _ScanRunner:
         returns = {}
         for run in RUNS:
             tick = time.perf_counter()
-            returns[run] = fuse_scans(kept[run])
+            if self.geiger is not None:  # declared points only (detection.scan)
+                returns[run] = self.geiger.finish_scan(run, scan)
+            else:
+                returns[run] = fuse_scans(kept[run])
             timings["fusion"] += time.perf_counter() - tick
             self._report(run, scan, returns[run])
         return returns

@@ -13,11 +13,13 @@ from __future__ import annotations
 
 import csv
 from dataclasses import dataclass, replace
+from functools import partial
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 
-from ladartui.errors import LadarError
+from ladartui.errors import FieldError, LadarError
 from ladartui.flight import ScanPose
 
 REQUIRED = ("time", "x", "y", "z", "heading")
@@ -109,3 +111,87 @@ def log_poses(log: FlightLog, template: ScanPose, rate: float | None = None,
 def log_attitude(log: FlightLog, times) -> tuple[np.ndarray, np.ndarray]:
     """Roll and pitch (degrees) at the given times, shortest-arc interpolation."""
     return _angle(log.time, log.roll, times), _angle(log.time, log.pitch, times)
+
+
+MAX_SCAN_RATE_HZ = 1000.0
+
+
+@dataclass(frozen=True)
+class LogSegment:
+    """A recorded flight log as a flight-path segment (``kind = "log"``).
+
+    ``file``: the CSV log (absolute; the scenario reader resolves it against
+    the scenario's folder). Scans at ``rate`` Hz from the log's first record,
+    or at the listed ``times`` (seconds, within the log), not both. The sensor
+    points at ``azimuth`` and ``depression`` relative to the aircraft, or at
+    ``aim_at``. Roll and pitch come from the log (used by a body-fixed sensor).
+    """
+
+    file: str
+    rate: float | None = None
+    times: tuple | None = None
+    azimuth: float = 0.0
+    depression: float = 90.0
+    aim_at: tuple | None = None
+    kind: ClassVar[str] = "log"
+    relative: ClassVar[bool] = False
+
+    def __post_init__(self):
+        from ladartui.flight import MAX_SCANS, number_field, point_field
+
+        set_ = partial(object.__setattr__, self)
+        if not isinstance(self.file, (str, Path)) or not str(self.file).strip():
+            raise FieldError("file", self.file, "the flight log's file name (.csv)")
+        set_("file", str(self.file))
+        if (self.rate is None) == (self.times is None):
+            raise FieldError("rate", self.rate, "either a scan rate (Hz) or a list of scan "
+                             "times (s), not both")
+        set_("azimuth", number_field("azimuth", self.azimuth))
+        set_("depression", number_field("depression", self.depression, 1.0, 90.0))
+        if self.aim_at is not None:
+            set_("aim_at", point_field("aim_at", self.aim_at))
+        log = load_flight_log(self.file)
+        set_("_log", log)
+        span = f"times from {log.time[0]:g} to {log.time[-1]:g} s (the log's span)"
+        if self.rate is not None:
+            rate = number_field("rate", self.rate, 0.0, MAX_SCAN_RATE_HZ, low_open=True)
+            set_("rate", rate)
+            if (log.time[-1] - log.time[0]) * rate + 1 > MAX_SCANS:
+                raise FieldError("rate", self.rate, f"at most {MAX_SCANS} scans over the log")
+        else:
+            expected = f"a list of 1 to {MAX_SCANS} {span}"
+            items = None if isinstance(self.times, (str, bytes)) else self.times
+            try:
+                items = list(items)
+            except TypeError:
+                raise FieldError("times", self.times, expected) from None
+            if not 1 <= len(items) <= MAX_SCANS:
+                raise FieldError("times", self.times, expected)
+            try:
+                times = tuple(number_field("times", t, log.time[0], log.time[-1]) for t in items)
+            except FieldError:
+                raise FieldError("times", self.times, expected) from None
+            set_("times", times)
+
+    def scan_times(self) -> np.ndarray:
+        log = self._log
+        if self.times is not None:
+            return np.asarray(self.times, dtype=np.float64)
+        count = int(np.floor((log.time[-1] - log.time[0]) * self.rate + 1e-9)) + 1
+        return log.time[0] + np.arange(count) / self.rate
+
+    def build(self, current) -> list[ScanPose]:
+        from ladartui.flight import ScanPose as Pose
+        from ladartui.flight import aim_at
+
+        template = Pose(0.0, 0.0, 1.0, 0.0, self.azimuth, self.depression)
+        poses = log_poses(self._log, template, times=self.scan_times())
+        return poses if self.aim_at is None else [aim_at(p, self.aim_at) for p in poses]
+
+    def attitudes(self) -> list[tuple[float, float]]:
+        roll, pitch = log_attitude(self._log, self.scan_times())
+        return [(float(r), float(p)) for r, p in zip(roll, pitch)]
+
+    def legs(self, poses):
+        return [float(np.linalg.norm(np.subtract(a.position, b.position)))
+                for a, b in zip(poses, poses[1:])]

@@ -1,39 +1,169 @@
-"""``ladartui pulses``: coverage and false alarms against Geiger-mode pulses per look."""
+"""``ladartui pulses``: coverage and false alarms against Geiger-mode pulses per look.
+
+The study runs on a worker thread (``run_cancellable``) while a rich progress
+bar is drawn on stderr; Ctrl-C stops it between scans. It writes no files:
+the table and the plotext chart go to stdout, or with ``--json`` the rows as
+data (``rows``: one object per pulse count), ready for any charting tool.
+"""
 
 from __future__ import annotations
 
-from ladartui.errors import FieldError
+import dataclasses
+import json
+import sys
+import threading
+
+from ladartui.errors import Cancelled, FieldError
+
+CHART_WIDTH = 78
+CHART_HEIGHT = 20
+LEGEND_HEADROOM = 1.5
 
 
 def add_parser(sub):
     p = sub.add_parser("pulses", help="obscured coverage and false alarms against pulses per look "
-                       "(Geiger-mode detection; see docs/detection.md)")
+                       "(Geiger-mode detection; see docs/detection.md)",
+                       description="Trace each scan once, then fire M pulses per look for each "
+                       "M and declare points where at least k fired (k keeps the scenario's "
+                       "coincidence share). Prints the ideal model's obscured coverage, a row "
+                       "per M and a chart. The scenario's [detection] numbers are used where "
+                       "set. Writes no files.")
     p.add_argument("scenario", nargs="?", help="scenario TOML (default: the default scenario)")
     p.add_argument("--pulses", default="1,10,100", help="comma-separated pulses per look")
-    p.add_argument("--n-ref", type=float, default=5.0,
-                   help="mean photoelectrons of a full-footprint return at the reference range")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--n-ref", type=float, default=None,
+                   help="mean photoelectrons of a full-footprint return at the reference range "
+                   "(default: the scenario's, else 5)")
+    p.add_argument("--seed", type=int, default=None, help="random stream (default: the "
+                   "scenario's, else 0)")
     p.add_argument("--backend", default=None)
+    p.add_argument("--json", action="store_true", help="print the results as JSON, no chart")
+    p.add_argument("--no-chart", dest="chart", action="store_false", help="table only")
     p.set_defaults(handler=run)
 
 
+def _pulse_counts(text):
+    try:
+        pulses = [int(v) for v in text.split(",")]
+    except ValueError:
+        raise FieldError("--pulses", text, "comma-separated whole numbers") from None
+    if any(p < 1 or p > 100_000 for p in pulses):
+        raise FieldError("--pulses", text, "pulse counts in 1..100000")
+    return pulses
+
+
+def _settings(scenario, args):
+    from ladartui.detection.settings import DetectionSettings
+
+    settings = scenario.detection or DetectionSettings()
+    changes = {"model": "geiger"}
+    for flag, name in (("n_ref", "n_ref"), ("seed", "seed")):
+        value = getattr(args, flag)
+        if value is not None:
+            changes[name] = value
+    try:
+        return dataclasses.replace(settings, **changes)
+    except FieldError as error:  # name the flag the user typed
+        flag = "--" + error.field.rpartition(".")[2].replace("_", "-")
+        raise FieldError(flag, error.value, error.expected) from None
+
+
 def run(args) -> int:
+    from rich.console import Console
+
     from ladartui.defaults import default_scenario_path
-    from ladartui.detection.pulses import GeigerSettings, pulse_study
     from ladartui.scenario import load_scenario
 
-    try:
-        pulses = [int(v) for v in args.pulses.split(",")]
-    except ValueError:
-        raise FieldError("--pulses", args.pulses, "comma-separated whole numbers") from None
-    if any(p < 1 or p > 100_000 for p in pulses):
-        raise FieldError("--pulses", args.pulses, "pulse counts in 1..100000")
+    pulses = _pulse_counts(args.pulses)
     scenario = load_scenario(args.scenario or default_scenario_path())
-    settings = GeigerSettings(n_ref=args.n_ref, seed=args.seed)
-    ideal, rows = pulse_study(scenario, pulses, settings, backend=args.backend)
+    settings = _settings(scenario, args)
+    errors = Console(stderr=True)
+    state = {"last": None}
+    try:
+        ideal, rows = _study_with_progress(scenario, pulses, settings, args.backend, errors, state)
+    except (Cancelled, KeyboardInterrupt):  # the latter: Ctrl-C before the worker started
+        print(f"ladartui: pulse study cancelled {_where(state['last'])}; no results, and this "
+              "command writes no files", file=sys.stderr)
+        return 130
+    if args.json:
+        print(json.dumps(result_dict(scenario, settings, ideal, rows), indent=2, allow_nan=False))
+        return 0
     print(f"ideal model: obscured coverage {ideal:.4f}")
     print(f"{'pulses':>7} {'k':>4} {'coverage':>9} {'declared':>9} {'false':>7} {'P_d(target)':>11}")
     for r in rows:
         print(f"{r.pulses:>7} {r.threshold:>4} {r.obscured_coverage:>9.4f} {r.declared_points:>9} "
               f"{r.false_alarms:>7} {r.target_detection:>11.3f}")
+    if args.chart:
+        print(chart_text(ideal, rows, color=sys.stdout.isatty()))
     return 0
+
+
+def _where(progress) -> str:
+    if progress is None:
+        return "before the first scan was traced"
+    if progress.stage == "trace":
+        return f"after tracing {progress.done} of {progress.total} scans"
+    return f"after tracing every scan, during pulse count {progress.done} of {progress.total}"
+
+
+def _study_with_progress(scenario, pulses, settings, backend, console, state):
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+
+    from ladartui.cli.progress import run_cancellable
+    from ladartui.detection.pulses import pulse_study
+
+    cancel = threading.Event()
+    columns = (TextColumn("{task.description}"), BarColumn(),
+               TextColumn("{task.percentage:>5.1f} %"), TimeElapsedColumn(),
+               TimeRemainingColumn())
+    with Progress(*columns, console=console, transient=False) as bar:
+        # Until the first scan is done (a first run also compiles the kernels, about a minute).
+        task = bar.add_task("tracing scan 1 (compiling kernels on a first run)", total=1.0)
+
+        def report(p):
+            state["last"] = p
+            what = (f"tracing scan {p.done}/{p.total}" if p.stage == "trace"
+                    else f"pulse count {p.done}/{p.total} ({pulses[p.done - 1]} pulses)")
+            bar.update(task, completed=p.units_done / p.units_total, description=what)
+
+        return run_cancellable(
+            lambda: pulse_study(scenario, pulses, settings, backend=backend, progress=report,
+                                cancel=cancel),
+            cancel, "ladartui-pulses", Cancelled("pulse study cancelled"))
+
+
+def result_dict(scenario, settings, ideal, rows) -> dict:
+    """The study as JSON-safe data: settings, the ideal coverage and one row per pulse count."""
+    return {"scenario": str(scenario.path), "settings": settings.to_dict(),
+            "ideal_obscured_coverage": ideal, "rows": [r.to_dict() for r in rows]}
+
+
+def chart_text(ideal, rows, width=CHART_WIDTH, height=CHART_HEIGHT, color=True) -> str:
+    """Coverage (%, left axis) and false alarms (right axis) against pulses per look (log)."""
+    import plotext
+
+    from ladartui.study.chart import _PLOTEXT_LOCK
+
+    xs = [r.pulses for r in rows]
+    with _PLOTEXT_LOCK:
+        plotext.clear_figure()
+        plotext.limit_size(False, False)
+        plotext.plotsize(width, height)
+        plotext.theme("pro" if color else "clear")
+        plotext.title("Geiger-mode: coverage and false alarms against pulses per look")
+        plotext.plot(xs, [100.0 * r.obscured_coverage for r in rows], marker="o",
+                     color="green", label="obscured coverage % (Geiger)")
+        plotext.plot(xs, [100.0 * ideal] * len(xs), color="cyan",
+                     label="obscured coverage % (ideal)")
+        plotext.plot(xs, [r.false_alarms for r in rows], marker="x", color="red",
+                     yside="right", label="false alarms (right)")
+        # Head room above the data for the legend, which plotext puts top left.
+        top = max([100.0 * ideal, *(100.0 * r.obscured_coverage for r in rows)])
+        plotext.ylim(0.0, (top or 1.0) * LEGEND_HEADROOM)
+        plotext.ylim(0.0, (max(r.false_alarms for r in rows) or 1.0) * LEGEND_HEADROOM,
+                     yside="right")
+        if len(xs) > 1 and min(xs) > 0:
+            plotext.xscale("log")
+        plotext.xlabel("pulses per look")
+        text = plotext.build()
+        plotext.clear_figure()
+    return text if color else plotext.uncolorize(text)

@@ -124,6 +124,8 @@ def show_result(console, result) -> None:
     for row in comparison_rows(result.measures):
         comparison.add_row(*row)
     console.print(comparison)
+    if result.measures.detection is not None:
+        console.print(detection_table(result.measures.detection))
     total = result.timings.get("total", 0.0)
     console.print(f"backend: {result.backend} ({result.method}); {result.scans} scans x "
                   f"{result.rays_per_scan:,} rays, two runs, in {total:.2f} s")
@@ -132,3 +134,30 @@ def show_result(console, result) -> None:
             console.print(f"wrote {name}: {path}", highlight=False, soft_wrap=True)
     else:
         console.print("nothing written (--no-write)")
+
+
+def detection_table(detection):
+    """The Geiger-mode measures (``[detection] model = "geiger"``) as a table."""
+    from rich.table import Table
+
+    from ladartui.measures import format_share
+
+    def number(value, digits=1):
+        return "undefined" if value is None else f"{value:,.{digits}f}"
+
+    table = Table(title=f"Geiger-mode detection: {detection.pulses} pulses per look, "
+                  f"k = {detection.coincidence}, seed {detection.seed}", show_header=False)
+    table.add_column("")
+    table.add_column("", justify="right")
+    for name, value in (
+        ("declared points (per look)", f"{detection.declared_points:,} "
+                                       f"({number(detection.declared_per_look)})"),
+        ("false alarms (per look)", f"{detection.false_alarms:,} "
+                                    f"({number(detection.false_alarms_per_look)})"),
+        ("false-alarm probability per noise bin", number(detection.false_alarm_probability, 6)),
+        ("P_d of target voxels", format_share(detection.target_detection)),
+        ("ideal sensor: obscured coverage", format_share(detection.ideal_obscured_coverage)),
+        ("ideal sensor: unobscured coverage", format_share(detection.ideal_unobscured_coverage)),
+    ):
+        table.add_row(name, value)
+    return table

@@ -33,6 +33,7 @@ class GeigerLook:
     declared: np.ndarray      # (D, B) bool
     ray_declared: np.ndarray  # (N,) bool: the ray's hit lies in a declared bin
     false_alarms: int         # declared bins without a return
+    noise_bins: int = 0       # bins without a return (where only noise can fire)
 
 
 def incidence_cosines(origins, directions, kind, index, ranges, voxel_size) -> np.ndarray:
@@ -44,7 +45,8 @@ def incidence_cosines(origins, directions, kind, index, ranges, voxel_size) -> n
     cos[ground] = np.abs(d[ground, 2])
     voxel = hit & ~ground
     if voxel.any():
-        p = np.asarray(origins)[voxel] / voxel_size + 0.5 + d[voxel] * (np.asarray(ranges)[voxel] / voxel_size)[:, None]
+        along = (np.asarray(ranges)[voxel] / voxel_size)[:, None]
+        p = np.asarray(origins)[voxel] / voxel_size + 0.5 + d[voxel] * along
         c = np.asarray(index)[voxel].astype(np.float64)
         # The entry face is the one whose plane the hit point lies closest to.
         gap = np.minimum(np.abs(p - c), np.abs(p - c - 1.0))
@@ -64,7 +66,7 @@ def geiger_look(detector, kind, ranges, reflectance, cos_incidence, *, rays_per_
     if not hit.any():
         empty = np.zeros((0, 0))
         return GeigerLook(np.zeros(0, np.int64), 0.0, empty, empty.astype(np.int32),
-                          empty.astype(bool), ray_declared, 0)
+                          empty.astype(bool), ray_declared, 0, 0)
     ids, row = np.unique(detector[hit], return_inverse=True)
     r = ranges[hit]
     gate_start = float(np.floor(r.min() / bin_width) * bin_width)
@@ -80,4 +82,5 @@ def geiger_look(detector, kind, ranges, reflectance, cos_incidence, *, rays_per_
     declared = declare_points(counts, threshold)
     ray_declared[np.flatnonzero(hit)] = declared[row, b]
     return GeigerLook(ids, gate_start, mean, counts, declared, ray_declared,
-                      int(np.count_nonzero(declared & ~has_return)))
+                      int(np.count_nonzero(declared & ~has_return)),
+                      int(np.count_nonzero(~has_return)))

@@ -1,0 +1,100 @@
+"""``ladartui pulses``: JSON rows, the terminal chart, the scenario's settings, Ctrl-C."""
+
+import _thread
+import json
+
+import numpy as np
+import pytest
+
+import ladartui.detection.pulses as pulses_module
+from ladartui.cli import main
+from ladartui.cli.pulses import chart_text
+from ladartui.detection.pulses import PulseRow
+from ladartui.detection.settings import DetectionSettings
+from ladartui.flight import FlightPlan, Manual, ScanPose, aim_at
+from ladartui.scenario import Scenario
+from ladartui.scene.voxels import save_voxels
+from ladartui.sensor import Sensor
+
+
+@pytest.fixture
+def scenario(tmp_path):
+    target = np.array([(x, y, z) for x in range(8, 12) for y in range(8, 11) for z in range(2)],
+                      dtype=np.int32)
+    canopy = np.array([(x, y, 6) for x in range(6, 14) for y in range(6, 13) if (x + 2 * y) % 3],
+                      dtype=np.int32)
+    save_voxels(tmp_path / "woods.txt", np.vstack([target, canopy]))
+    save_voxels(tmp_path / "woods_Target.txt", target)
+    poses = tuple(aim_at(ScanPose(x, y, 40.0), (9.5, 9.0, 0.5))
+                  for x, y in [(9.5, -10.0), (29.5, 9.0), (9.5, 30.0)])
+    return Scenario(tmp_path / "S.toml", "woods.txt", 1.0, Sensor(grid=16, ray_grid=2, fov=20.0),
+                    FlightPlan(segments=[Manual(poses)]), backend="numba",
+                    detection=DetectionSettings(pulses=20, coincidence=4, solar_rate_hz=2e7,
+                                                seed=3)).save()
+
+
+def test_json_rows_use_the_scenario_settings(scenario, capsys):
+    assert main(["pulses", str(scenario.path), "--pulses", "1,5,20", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["settings"]["seed"] == 3 and out["settings"]["model"] == "geiger"
+    rows = out["rows"]
+    assert [r["pulses"] for r in rows] == [1, 5, 20]
+    assert [r["threshold"] for r in rows] == [1, 1, 4]  # the scenario's k share, 4 of 20
+    assert 0 < out["ideal_obscured_coverage"] <= 1
+    assert all(r["obscured_coverage"] <= out["ideal_obscured_coverage"] for r in rows)
+    # k = 1: every noise fire is a false alarm, so five pulses see more than one.
+    assert rows[1]["false_alarms"] > rows[0]["false_alarms"] > 0
+
+
+def test_table_and_chart(scenario, capsys):
+    assert main(["pulses", str(scenario.path), "--pulses", "1,20", "--seed", "5"]) == 0
+    out = capsys.readouterr().out
+    assert "ideal model: obscured coverage" in out
+    assert "pulses per look" in out and "false alarms (right)" in out
+
+
+def test_chart_text_draws_both_series():
+    rows = [PulseRow(1, 1, 0.2, 100, 40, 0.5), PulseRow(100, 10, 0.35, 90, 0, 0.9)]
+    text = chart_text(0.4, rows, width=60, height=15, color=False)
+    assert "obscured coverage % (Geiger)" in text and "obscured coverage % (ideal)" in text
+    assert "40" in text  # the false-alarm axis reaches the largest count
+    assert "\x1b[" not in text
+
+
+def test_bad_flag_names_the_flag(scenario, capsys):
+    assert main(["pulses", str(scenario.path), "--n-ref", "-1"]) == 2
+    assert capsys.readouterr().err.strip() == (
+        "ladartui: error: --n-ref = -1.0: expected a number greater than 0 and at most 1000000")
+
+
+def test_ctrl_c_cancels_with_a_truthful_message(scenario, capsys, monkeypatch):
+    real = pulses_module.pulse_study
+
+    def interrupted(*args, progress=None, cancel=None, **kwargs):
+        def report(p):
+            progress(p)
+            if p.stage == "trace" and p.done == 2:
+                _thread.interrupt_main()  # as Ctrl-C would, on the main thread
+                assert cancel.wait(10), "Ctrl-C did not set the cancel event"
+
+        return real(*args, progress=report, cancel=cancel, **kwargs)
+
+    monkeypatch.setattr(pulses_module, "pulse_study", interrupted)
+    assert main(["pulses", str(scenario.path), "--pulses", "1,20"]) == 130
+    captured = capsys.readouterr()
+    assert "pulse study cancelled after tracing 2 of 3 scans; no results" in captured.err
+    assert "ideal model" not in captured.out
+
+
+def test_work_beyond_the_memory_limit_is_refused_up_front(scenario, capsys, monkeypatch):
+    import ladartui.detection.scan as scan
+
+    monkeypatch.setattr(scan, "memory_limit", lambda: 1 << 16)
+    traced = []
+    monkeypatch.setattr("ladartui.tracing.trace", lambda *a, **k: traced.append(1))
+    assert main(["pulses", str(scenario.path), "--pulses", "1"]) == 2
+    err = capsys.readouterr().err
+    assert "would need about" in err and "3 scans of 1,024 rays" in err and not traced
+    with pytest.raises(Exception, match="one scan's 1,024 rays in two runs"):
+        from ladartui.simulation import simulate
+        simulate(scenario.with_changes(detection=DetectionSettings(model="geiger")), write=False)
