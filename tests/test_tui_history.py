@@ -288,3 +288,30 @@ async def test_a_key_remapped_in_keys_toml_changes_the_footer_help_and_palette(
         await pilot.press("ctrl+r")
         await pilot.pause()
         assert len(runs) == 1
+
+
+async def test_a_flight_log_segment_is_listed_and_says_where_it_is_edited(tmp_path, scene_files):
+    import shutil
+    from pathlib import Path
+
+    from ladartui.trajectory import LogSegment
+
+    log = tmp_path / "flight-log.csv"
+    shutil.copy(Path(__file__).parents[1] / "scenarios" / "flight-log.csv", log)
+    scenario = make_scenario(tmp_path, scene_files)
+    scenario = scenario.with_changes(flight=FlightPlan(None, (
+        *scenario.flight.segments, LogSegment(str(log), rate=2.0)))).save()
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        app.action_show_tab("flight")
+        await pilot.pause()
+        table = app.query_one("#segments")
+        assert table.row_count == 2
+        row = [str(cell) for cell in table.get_row_at(1)]
+        assert row[1] == "Flight log" and row[3] == "flight-log.csv, 2 Hz"
+        table.move_cursor(row=1)
+        app.action_edit_segment()
+        await pilot.pause()
+        assert not isinstance(app.screen, FormScreen)  # no number form for a file's data
+        assert "scenario file" in app.messages[-1]

@@ -26,12 +26,18 @@ from ladartui.tui import actions, bridge
 from ladartui.tui.canvas import ProjectionWidget
 from ladartui.tui.fields import NumberField
 from ladartui.tui.file_actions import FileActions
-from ladartui.tui.panels import FilePanel, FlightPanel, ResultsPanel, RunPanel, SensorPanel
 from ladartui.tui.loading import SceneLoading
+from ladartui.tui.panels import FilePanel, FlightPanel, ResultsPanel, RunPanel, SensorPanel
 from ladartui.tui.params import ParamPanel
 from ladartui.tui.runs import RunControl
-from ladartui.tui.screens import (AngleScreen, CompareScreen, HelpScreen, MeasuresScreen,
-                                  PosesScreen, ThresholdScreen)
+from ladartui.tui.screens import (
+    AngleScreen,
+    CompareScreen,
+    HelpScreen,
+    MeasuresScreen,
+    PosesScreen,
+    ThresholdScreen,
+)
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
 from ladartui.tui.unsaved import EditGuard
 from ladartui.tui.view_area import LAYOUTS, OUTPUT_POINTS, ViewArea

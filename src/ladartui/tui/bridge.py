@@ -125,7 +125,10 @@ def check_param(scenario: Scenario, key: str, value) -> None:
 # -- flight segments -----------------------------------------------------------------
 
 SEGMENT_LABELS = {"manual": "Manual poses", "straight": "Straight", "turn": "Turn",
-                  "orbit": "Orbit", "flypast": "Fly-past", "standoff": "Standoff"}
+                  "orbit": "Orbit", "flypast": "Fly-past", "standoff": "Standoff",
+                  "log": "Flight log"}
+# segments the sidebar shows but cannot edit in a form (their data is a file)
+FILE_SEGMENTS = {"log"}
 FIELD_LABELS = {
     "distance": "Distance m", "scans": "Scans", "azimuth": "Sensor az deg",
     "depression": "Depression deg", "aim_at": "Aim at x,y,z m", "radius": "Radius m",
@@ -205,6 +208,10 @@ def segment_summary(segment) -> str:
         return f"{segment.length:g} m at {segment.standoff:g} m"
     if k == "standoff":
         return ", ".join(f"{s:g}" for s in segment.standoffs) + " m"
+    if k == "log":
+        when = f"{segment.rate:g} Hz" if segment.rate is not None else \
+            f"{len(segment.times)} times"
+        return f"{Path(segment.file).name}, {when}"
     return ""
 
 

@@ -184,8 +184,14 @@ class FlightPanel(ParamPanel):
         segments = self.app.scenario.flight.segments
         if not 0 <= index < len(segments):
             return
-        if segments[index].kind == "manual":
+        kind = segments[index].kind
+        if kind == "manual":
             self._edit_poses(index)
+        elif kind in bridge.FILE_SEGMENTS:
+            self.app.tell(f"A {bridge.SEGMENT_LABELS[kind].lower()} segment comes from its "
+                          f"file ({segments[index].file}): change its file, rate or times in "
+                          "the scenario file. Delete removes it; Aim all points it at the "
+                          "target.", severity="warning", timeout=8)
         else:
             self._edit_segment(segments[index], index)
 
