@@ -29,7 +29,7 @@ def copy_scene(source, scene) -> None:
 def capture_runs(app) -> list:
     """Replace the run worker by a recorder of the scenario it would run."""
     runs = []
-    app._run_worker = lambda scenario, scene, fast, cancel: runs.append(scenario)
+    app._run_worker = lambda scenario, scene, fast: runs.append(scenario)
     return runs
 
 

@@ -12,7 +12,6 @@ interface never blocks.
 
 from __future__ import annotations
 
-import threading
 from pathlib import Path
 
 from textual import on
@@ -41,6 +40,7 @@ from ladartui.tui.screens import (
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
 from ladartui.tui.unsaved import EditGuard
 from ladartui.tui.view_area import LAYOUTS, OUTPUT_POINTS, ViewArea
+from ladartui.tui.work import JobDone, JobProgress
 
 # everything the analyst can change; disabled while busy (Cancel is re-enabled)
 CONTROLS = "#sidebar Input, #sidebar Button, #sidebar Select, #sidebar Checkbox, " \
@@ -83,12 +83,8 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
         self.threshold: float | None = None
         self.busy: str | None = None
         self.progress: float | None = None
-        self.cancel_event = threading.Event()
-        self.stop_event = threading.Event()  # set when the app quits: ends background work
-        self.kernels_ready = threading.Event()  # the child process has compiled the kernels
-        self.scene_shown = threading.Event()  # the views show the loaded scene
+        self.load_worker = self.warm_worker = self.run_worker_handle = None  # the jobs
         self.messages: list[str] = []
-        self.leaving = False  # set on exit: late worker messages are ignored
         self.running = False
         self.tool_screen = None  # the study or sweep screen while it is open
         self.keymap, self.keymap_problems = actions.load_keymap()
@@ -438,8 +434,6 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
     def on_sweep_screen_open_scenario(self, message) -> None:
         """The sweep's best flight path: open its scenario as F3 would (leaving the sweep
         screen unless a sweep is still running there)."""
-        if self.closing():
-            return
         if self.run_in_progress():
             self.tell("A run is in progress; the best path was not opened.", severity="warning")
             return
@@ -457,23 +451,36 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
         # text from files and fields must not be read as markup
         self.notify(message, title=title, severity=severity, timeout=timeout, markup=False)
 
-    def closing(self) -> bool:
-        """True once the app is shutting down: stop any run, ignore late worker news."""
-        if self.leaving or not self.is_running:
-            self.leaving = True
-            self.cancel_event.set()
-            self.stop_event.set()
-            self.scene_shown.set()
-        return self.leaving
+    # -- jobs: every slow piece of work reports here (tui/work.py) -------------------
 
-    def on_unmount(self) -> None:
-        self.closing()
+    JOB_FAILED = {"load": "Could not load", "run": "Run failed", "probe": "Backends not probed",
+                  "warm": "Kernels not compiled"}
+
+    def on_job_progress(self, message: JobProgress) -> None:
+        if message.job == "run":
+            self.run_progressed(message.fraction, message.text, message.detail)
+
+    def on_job_done(self, message: JobDone) -> None:
+        if message.error:  # every failure, expected or not, is told the same way
+            self.tell(message.error, title=self.JOB_FAILED.get(message.job, message.job),
+                      severity="error", timeout=10)
+        if message.job == "load":
+            if message.result is not None:
+                self.loaded(message.result)
+            else:
+                self.set_busy(None)
+                if message.error:
+                    self.run_panel.say(message.error)
+        elif message.job == "probe":
+            self.backends_probed(message.result if message.result is not None else
+                                 [("auto", f"backends could not be probed: {message.error}",
+                                   False)])
+        elif message.job == "run":
+            self.run_finished(message.result, message.cancelled, message.error)
 
     def exit(self, *args, **kwargs) -> None:
-        # a run in a thread cannot be killed: ask it to stop so quitting is quick
-        self.cancel_event.set()
-        self.stop_event.set()
-        self.leaving = True
+        # a thread cannot be killed: cancelling tells every job to stop, so quitting is quick
+        self.workers.cancel_all()
         super().exit(*args, **kwargs)
 
     # -- command palette -------------------------------------------------------------

@@ -11,9 +11,17 @@ import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
-from ladartui.errors import FieldError, InputFileError, LadarError
-from ladartui.flight import (SEGMENT_KINDS, FlightPlan, Manual, ScanPose, aim_at,
-                             altitude_field, compass_field, number_field)
+from ladartui.errors import FieldError, InputFileError
+from ladartui.flight import (
+    SEGMENT_KINDS,
+    FlightPlan,
+    Manual,
+    ScanPose,
+    aim_at,
+    altitude_field,
+    compass_field,
+    number_field,
+)
 from ladartui.scenario import Scenario, load_scenario, target_file_for
 from ladartui.sensor import Sensor
 
@@ -335,7 +343,3 @@ def backend_choices() -> list[tuple[str, str, bool]]:
     best = next((n for n, _, ok in rows if ok), None)
     auto = f"the best available here ({best})" if best else "no backend is available"
     return [("auto", auto, best is not None), *rows]
-
-
-def is_user_error(error: BaseException) -> bool:
-    return isinstance(error, LadarError)

@@ -1,143 +1,104 @@
 """Loading a scenario and its scene, probing the backends and warming the kernels.
 
-All of it runs in a thread worker that posts messages back: the interface
-shows the scenario as soon as its scene is ready, then the backend list,
-while a child process compiles the tracing kernels for the first Run.
+Three jobs (``tui/work.py``): "load" reads the scenario, its scene and any
+earlier results and prepares the views; once they are shown, "probe" lists
+the backends and "warm" has a child process compile the tracing kernels
+for the first Run (compiling here would hold the interpreter lock and
+freeze the interface), then loads them from numba's disk cache.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
-
-from textual import work
-from textual.message import Message
 
 from ladartui.errors import LadarError
 from ladartui.recent import remember_scenario
 from ladartui.tui import bridge
 from ladartui.tui.view_area import prepare_views
+from ladartui.tui.work import start_job
 
 
-class SceneReady(Message):
-    """The load worker finished: the scenario, its scene and the prepared view data."""
+@dataclass
+class Loaded:
+    """What the load job hands the interface."""
 
-    def __init__(self, scenario, scene, prepared, output, measures, warning=None):
-        super().__init__()
-        self.scenario, self.scene, self.prepared = scenario, scene, prepared
-        self.output, self.measures, self.warning = output, measures, warning
-
-
-class WorkFailed(Message):
-    def __init__(self, what: str, error: str):
-        super().__init__()
-        self.what, self.error = what, error
-
-
-class BackendsProbed(Message):
-    def __init__(self, choices):
-        super().__init__()
-        self.choices = choices
+    scenario: object
+    scene: object
+    prepared: dict
+    output: object
+    measures: object
+    warning: str | None
 
 
 class SceneLoading:
-    """The app's loading worker and its messages (mixed into ``LadarApp``)."""
+    """The app's load, probe and warm-up jobs (mixed into ``LadarApp``)."""
 
     def load(self, path: Path | None, scenario=None) -> None:
         """Load a scenario and its scene in a worker (the default scenario when no path)."""
         name = path.name if path else (scenario.path.name if scenario else "default scenario")
         self.set_busy(f"Loading {name}...")
-        self._load_worker(path, scenario)
+        self.load_worker = start_job(self, "load", lambda cancel, progress:
+                                     _load(path, scenario))
 
-    @work(thread=True, exclusive=True, group="load")
-    def _load_worker(self, path: Path | None, scenario) -> None:
-        try:
-            if scenario is None:
-                if path is None:
-                    from ladartui.defaults import default_scenario_path
-
-                    path = default_scenario_path()
-                scenario = bridge.load_checked(path)
-            scene = scenario.load_scene()
-            prepared = prepare_views(scene)
-            warning = None
-            try:
-                output, measures = _existing_results(scenario)
-            except LadarError as error:  # old results must not stop the scenario loading
-                output, measures, warning = None, None, f"earlier results not shown: {error}"
-        except LadarError as error:
-            self.post_message(WorkFailed("load", str(error)))
-            return
-        except Exception as error:  # keep the app alive; say what broke
-            self.post_message(WorkFailed("load", f"{type(error).__name__}: {error}"))
-            return
-        self.scene_shown.clear()
-        self.post_message(SceneReady(scenario, scene, prepared, output, measures, warning))
-        # probing imports the GPU library: let the interface fill its panels first
-        self.scene_shown.wait(2.0)
-        self._probe_backends()
-        self._warm_up(scenario, scene)
-
-    def _warm_up(self, scenario, scene) -> None:
-        """Have the tracing kernels compiled before the first Run (worker thread).
-
-        A child process compiles them into numba's disk cache (compiling here
-        would hold the interpreter lock and freeze the interface); then a
-        one-ray run in this process loads them from the cache.
-        """
-        from ladartui.tui.warmup import tiny_run, warm_in_child
-
-        try:
-            if self.compile_in_child and scenario.path.is_file():
-                warm_in_child(scenario.path, stop=self.stop_event)
-        finally:
-            self.kernels_ready.set()
-        if self.stop_event.is_set():
-            return
-        try:
-            tiny_run(scenario, scene, cancel=self.stop_event)
-        except Exception:  # a warm-up only; the real run reports any problem
-            pass
-
-    def _probe_backends(self) -> None:
-        try:
-            choices = bridge.backend_choices()
-        except Exception as error:
-            choices = [("auto", f"backends could not be probed: {error}", False)]
-        self.post_message(BackendsProbed(choices))
-
-    def on_scene_ready(self, message: SceneReady) -> None:
-        if self.closing():
-            return
-        self.scene = message.scene
-        self.prepared = message.prepared
+    def loaded(self, done: Loaded) -> None:
+        """The load job's result: show it, then probe the backends and warm the kernels."""
+        self.scene = done.scene
+        self.prepared = done.prepared
         self.view_area.set_scene(self.prepared, self.scene.voxel_size)
-        self.missing_outputs = bridge.missing_outputs(message.scenario)
-        self.set_scenario(message.scenario, modified=False)
-        if message.scenario.path.is_file():
-            remember_scenario(message.scenario.path)
-        self.file_panel.show_recent(message.scenario.path)
-        self.output_voxels = message.output
+        self.missing_outputs = bridge.missing_outputs(done.scenario)
+        self.set_scenario(done.scenario, modified=False)
+        if done.scenario.path.is_file():
+            remember_scenario(done.scenario.path)
+        self.file_panel.show_recent(done.scenario.path)
+        self.output_voxels = done.output
         self.show_output()
-        self.show_measures(message.measures)
+        self.show_measures(done.measures)
         self.set_busy(None)
-        if message.warning:
-            self.tell(message.warning, severity="warning", timeout=8)
-        self.scene_shown.set()
+        if done.warning:
+            self.tell(done.warning, severity="warning", timeout=8)
+        # after the panels are drawn: probing imports the GPU library
+        self.call_after_refresh(self._start_background, done.scenario, done.scene)
 
-    def on_work_failed(self, message: WorkFailed) -> None:
-        if self.closing():
-            return
-        self.set_busy(None)
-        self.tell(message.error, title=f"Could not {message.what}", severity="error",
-                  timeout=10)
-        self.run_panel.say(message.error)
+    def _start_background(self, scenario, scene) -> None:
+        start_job(self, "probe", lambda cancel, progress: bridge.backend_choices())
+        compile_in_child = self.compile_in_child
+        self.warm_worker = start_job(self, "warm", lambda cancel, progress:
+                                     _warm_up(scenario, scene, compile_in_child, cancel))
 
-    def on_backends_probed(self, message: BackendsProbed) -> None:
-        if self.closing():
-            return
-        self.run_panel.show_backends(message.choices,
-                                     self.scenario.backend if self.scenario else "auto")
+    def backends_probed(self, choices) -> None:
+        self.run_panel.show_backends(choices, self.scenario.backend if self.scenario else "auto")
         self.refresh_status()
+
+
+def _load(path: Path | None, scenario) -> Loaded:
+    if scenario is None:
+        if path is None:
+            from ladartui.defaults import default_scenario_path
+
+            path = default_scenario_path()
+        scenario = bridge.load_checked(path)
+    scene = scenario.load_scene()
+    prepared = prepare_views(scene)
+    warning = None
+    try:
+        output, measures = _existing_results(scenario)
+    except LadarError as error:  # old results must not stop the scenario loading
+        output, measures, warning = None, None, f"earlier results not shown: {error}"
+    return Loaded(scenario, scene, prepared, output, measures, warning)
+
+
+def _warm_up(scenario, scene, compile_in_child: bool, cancel) -> None:
+    from ladartui.tui.warmup import tiny_run, warm_in_child
+
+    if compile_in_child and scenario.path.is_file():
+        warm_in_child(scenario.path, stop=cancel)
+    if cancel.is_set():
+        return
+    try:
+        tiny_run(scenario, scene, cancel=cancel)
+    except Exception:  # a warm-up only; the real run reports any problem
+        pass
 
 
 def _existing_results(scenario):

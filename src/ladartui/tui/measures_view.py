@@ -114,13 +114,3 @@ def comparison_rows(all_measures: list) -> list[list]:
                             cells[i] = Text(texts[i], style="bold red")
         rows.append([Text(label, style="bold yellow" if differ else ""), *cells])
     return rows
-
-
-def differing_labels(all_measures: list) -> list[str]:
-    """Labels of the measures whose shown values differ between scenarios."""
-    dicts = [m if isinstance(m, dict) else m.to_dict() for m in all_measures]
-    out = []
-    for label, path, kind, _ in ROWS:
-        if len({format_value(lookup(d, path), kind) for d in dicts}) > 1:
-            out.append(label)
-    return out

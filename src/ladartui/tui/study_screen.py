@@ -1,25 +1,23 @@
 """The speed-against-accuracy study as a screen: chart, table and verdict.
 
-The study runs in a thread worker; progress reaches the screen through
-``call_from_thread`` and Cancel (or ``c``) sets the event the study checks
-between trace calls, so nothing blocks the interface.
+The study is a job (``tui/work.py``): its progress and its end reach the
+screen as messages, Cancel (or ``c``) cancels the worker, whose event the
+study checks between trace calls, and any failure (expected or not) is
+shown on the screen while the app stays open.
 """
 
 from __future__ import annotations
 
-import threading
-
-from textual import on, work
+from textual import on
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.screen import Screen
 from textual.widgets import Button, DataTable, Footer, ProgressBar, Static
-from textual.worker import get_current_worker
 from textual_plotext import PlotextPlot
 
-from ladartui.errors import Cancelled, LadarError
 from ladartui.study.chart import TABLE_COLUMNS, draw_chart, table_rows
+from ladartui.tui.work import JobDone, JobProgress, running, start_job
 
 
 class StudyScreen(Screen):
@@ -51,8 +49,7 @@ class StudyScreen(Screen):
         self.scans = scans
         self.runs = runs
         self.result = None
-        self._cancel_event = threading.Event()
-        self._busy = False
+        self.worker = None  # the study job while it runs
 
     def compose(self) -> ComposeResult:
         with Horizontal(id="study-top"):
@@ -61,7 +58,7 @@ class StudyScreen(Screen):
                 yield DataTable(id="study-table", zebra_stripes=True, cursor_type="row")
                 yield Static("", id="study-verdict")
         with Horizontal(id="study-bar"):
-            yield Static(self._idle_text(), id="study-status")
+            yield Static(self._idle_text(), id="study-status", markup=False)
             yield ProgressBar(id="study-progress", show_eta=False)
             yield Button("Quick", id="study-quick", compact=True)
             yield Button("Full", id="study-full", compact=True)
@@ -94,65 +91,37 @@ class StudyScreen(Screen):
         self.action_cancel()
 
     def action_run(self, mode: str) -> None:
-        if self._busy:
+        if running(self.worker):
             return
-        self._busy = True
-        self._cancel_event = threading.Event()
         self._set_busy(True, f"preparing the {mode} study ...")
-        self._study(mode, self._cancel_event)
+        scenario_path, scans, runs = self.scenario_path, self.scans, self.runs
+        self.worker = start_job(self, "study", lambda cancel, progress: _study(
+            mode, scenario_path, scans, runs, cancel, progress))
 
     def action_cancel(self) -> None:
-        if self._busy:
-            self._cancel_event.set()
+        if running(self.worker):
+            self.worker.cancel()
             self._set_status("cancelling after the current trace ...")
 
     def action_close(self) -> None:
-        self._cancel_event.set()
+        if running(self.worker):
+            self.worker.cancel()
         self.dismiss(self.result)
 
-    # -- the worker ------------------------------------------------------------
+    def on_job_progress(self, message: JobProgress) -> None:
+        if message.detail is not None:
+            self._show_progress(message.detail)
+        else:
+            self._set_status(message.text)
 
-    @work(thread=True, exclusive=True, group="study")
-    def _study(self, mode: str, cancel: threading.Event) -> None:
-        from ladartui.study import full_settings, quick_settings
-        from ladartui.study.inputs import generated_inputs, scenario_inputs
-        from ladartui.study.run import run_study
-
-        worker = get_current_worker()
-        quick = mode == "quick"
-        scans = self.scans or (2 if quick else 3)
-        runs = self.runs or (3 if quick else 5)
-        try:
-            if self.scenario_path:
-                inputs = scenario_inputs(self.scenario_path, scans)
-            else:
-                inputs = generated_inputs("small" if quick else "reference", scans,
-                                          progress=lambda text: self._post(self._set_status, text))
-            settings = quick_settings() if quick else full_settings()
-
-            def progress(p):
-                if worker.is_cancelled:
-                    cancel.set()
-                self._post(self._show_progress, p)
-
-            result = run_study(inputs, settings, runs=runs, progress=progress, cancel=cancel)
-        except Cancelled:
-            self._post(self._finish, None, "study cancelled")
-            return
-        except LadarError as error:
-            self._post(self._finish, None, f"error: {error}")
-            return
-        self._post(self._finish, result, f"{mode} study done on {inputs.name}")
-
-    def _post(self, callback, *args) -> None:
-        def on_screen():
-            if self.is_mounted:  # the screen may have been closed meanwhile
-                callback(*args)
-
-        try:
-            self.app.call_from_thread(on_screen)
-        except RuntimeError:
-            pass  # the app has closed
+    def on_job_done(self, message: JobDone) -> None:
+        if message.cancelled:
+            self._finish(None, "study cancelled")
+        elif message.error:
+            self._finish(None, f"error: {message.error}")
+        else:
+            result, text = message.result
+            self._finish(result, text)
 
     # -- updates on the UI thread ---------------------------------------------
 
@@ -162,7 +131,6 @@ class StudyScreen(Screen):
         self._set_status(f"{p.label}, scan {p.scan}/{p.scans}")
 
     def _finish(self, result, message: str) -> None:
-        self._busy = False
         self._set_busy(False, message)
         if result is not None:
             self.show_result(result)
@@ -187,3 +155,23 @@ class StudyScreen(Screen):
 
     def _set_status(self, message: str) -> None:
         self.query_one("#study-status", Static).update(message)
+
+
+def _study(mode: str, scenario_path, scans, runs, cancel, progress):
+    """The study job (worker thread): (result, what was done)."""
+    from ladartui.study import full_settings, quick_settings
+    from ladartui.study.inputs import generated_inputs, scenario_inputs
+    from ladartui.study.run import run_study
+
+    quick = mode == "quick"
+    scans = scans or (2 if quick else 3)
+    runs = runs or (3 if quick else 5)
+    if scenario_path:
+        inputs = scenario_inputs(scenario_path, scans)
+    else:
+        inputs = generated_inputs("small" if quick else "reference", scans,
+                                  progress=lambda text: progress(None, text))
+    settings = quick_settings() if quick else full_settings()
+    result = run_study(inputs, settings, runs=runs, cancel=cancel,
+                       progress=lambda p: progress(p.done / max(p.total, 1), p.label, p))
+    return result, f"{mode} study done on {inputs.name}"

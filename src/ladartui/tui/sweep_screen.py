@@ -1,35 +1,35 @@
 """Flight-path sweeps as a screen: launch or open a sweep, watch it, browse the ranking.
 
-The sweep runs in a thread worker through ``ladartui.sweep.run_sweep``; each
-finished variant reaches the screen through ``call_from_thread`` and the
-ranking and chart are redrawn at most a few times a second. Cancel sets the
-event the sweep checks between variants (and between trace chunks): the rows
-finished so far stay in ``results.csv`` and running the spec again resumes.
+The sweep is a job (``tui/work.py``) running ``ladartui.sweep.run_sweep``;
+each finished variant reaches the screen as a kept progress report, and the
+ranking and chart are redrawn at most a few times a second. Cancel cancels
+the worker, whose event the sweep checks between variants (and between
+trace chunks): the rows finished so far stay in ``results.csv`` and running
+the spec again resumes. Any failure is shown in the status bar; none closes
+the app.
 """
 
 from __future__ import annotations
 
 import math
 import sys
-import threading
 from pathlib import Path
 
 from rich.text import Text
-from textual import on, work
+from textual import on
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal
-from textual.css.query import NoMatches
 from textual.message import Message
 from textual.screen import Screen
 from textual.validation import ValidationResult, Validator
 from textual.widgets import Button, Checkbox, DataTable, Footer, Input, Label, ProgressBar, Static
-from textual.worker import get_current_worker
 from textual_plotext import PlotextPlot
 
-from ladartui.errors import Cancelled, FieldError, InputFileError, LadarError
+from ladartui.errors import FieldError, InputFileError, LadarError
 from ladartui.sweep.table import display_cell
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
+from ladartui.tui.work import JobDone, JobProgress, start_job
 
 OBJECTIVE_ORDER = ("obscured-coverage", "coverage-per-km", "coverage-within-budget")
 OBJECTIVE_HEADERS = {"obscured-coverage": "coverage", "coverage-per-km": "cov/km",
@@ -174,8 +174,8 @@ class SweepScreen(Screen):
         self.progress = None  # the last SweepProgress
         self.last_message = ""
         self.running = False
-        self._cancel = threading.Event()
-        self._dirty = False
+        self.worker = None  # the sweep job while it runs
+        self._dirty = False  # rows arrived since the last redraw (redrawn a few times a second)
         self._row_index: dict[str, int] = {}  # variant id -> position in rows, while running
         self._shown_ids: list = []  # variant ids in table order
 
@@ -298,7 +298,6 @@ class SweepScreen(Screen):
         if not serial and not scheduler:
             start_resource_tracker()
         self.running = True
-        self._cancel = threading.Event()
         self.progress = None
         self.query_one("#sweep-progress", ProgressBar).update(total=len(ids), progress=0)
         where = (f"scheduler {scheduler}" if scheduler
@@ -306,7 +305,9 @@ class SweepScreen(Screen):
         self.query_one("#sweep-counts", Static).update(f"0/{len(ids)} starting on {where}")
         self._status(BUSY, f"starting {len(ids)} variants on {where}; results in "
                      f"{short_path(self.out)}", 0.0, cancellable=True)
-        self._sweep(spec, scheduler, serial, objective, cost, budget, self._cancel)
+        timeout = self.connect_timeout
+        self.worker = start_job(self, "sweep", lambda cancel, progress: _sweep(
+            spec, scheduler, serial, objective, cost, budget, timeout, cancel, progress))
 
     def action_open_results(self) -> None:
         """Open the results of an earlier (or running elsewhere) sweep."""
@@ -317,7 +318,7 @@ class SweepScreen(Screen):
 
     def action_cancel(self) -> None:
         if self.running:
-            self._cancel.set()
+            self.worker.cancel()
             self._status(BUSY, "cancelling after the current variant ...", self._fraction())
         else:
             self._status(self._idle_state(), "nothing is running")
@@ -377,7 +378,8 @@ class SweepScreen(Screen):
         self._announce_best(found[0], "as saved by the sweep (its spec's objective)")
 
     def action_close(self) -> None:
-        self._cancel.set()
+        if self.running:
+            self.worker.cancel()
         self.dismiss(None)
 
     @on(Button.Pressed, "#cancel")
@@ -483,50 +485,22 @@ class SweepScreen(Screen):
 
     # -- the sweep worker ---------------------------------------------------------------
 
-    @work(thread=True, exclusive=True, group="sweep")
-    def _sweep(self, spec, scheduler: str, serial: bool, objective: str, cost: str, budget,
-               cancel: threading.Event) -> None:
-        from ladartui.sweep import connect, run_sweep
-
-        worker = get_current_worker()
-        client = None
-
-        def progress(p):
-            if worker.is_cancelled:
-                cancel.set()
-            self._post(self._show_progress, p)
-
-        try:
-            if scheduler:
-                self._post(self._status, BUSY, f"connecting to {scheduler} ...", 0.0, True)
-                client = connect(scheduler, self.connect_timeout)
-            result = run_sweep(spec, client=client, progress=progress, cancel=cancel,
-                               objective=objective, cost=cost, budget=budget, serial=serial)
-        except Cancelled:
-            self._post(self._finish, None, "cancelled")
-        except LadarError as error:
-            self._post(self._finish, None, str(error))
-        except Exception as error:  # noqa: BLE001 - a crash is shown, never kills the app
-            self._post(self._finish, None, f"{type(error).__name__}: {error}")
+    def on_job_progress(self, message: JobProgress) -> None:
+        if message.detail is not None:
+            self._show_progress(message.detail)
         else:
-            self._post(self._finish, result, "")
-        finally:
-            if client is not None:
-                client.close()
+            self._status(BUSY, message.text, 0.0, True)
 
-    def _post(self, callback, *args) -> None:
-        def guarded():
-            if not self.is_attached:  # closed meanwhile
-                return
-            try:
-                callback(*args)
-            except NoMatches:
-                pass  # the screen was being taken down as the message arrived
-
-        try:
-            self.app.call_from_thread(guarded)
-        except RuntimeError:
-            pass  # the app has closed
+    def on_job_done(self, message: JobDone) -> None:
+        if message.job == "best":
+            if message.error:
+                self._status(NOT_READY, f"cannot save the best path: {message.error}")
+            elif message.result is not None:
+                self._announce_best(*message.result)
+        elif message.cancelled:
+            self._finish(None, "cancelled")
+        else:
+            self._finish(message.result, message.error or "")
 
     # -- updates on the UI thread ------------------------------------------------
 
@@ -543,7 +517,7 @@ class SweepScreen(Screen):
         self.query_one("#sweep-progress", ProgressBar).update(total=max(p.total, 1),
                                                               progress=p.done)
         self.query_one("#sweep-counts", Static).update(self._counts_text(p))
-        if not self._cancel.is_set():
+        if not self.worker.is_cancelled:
             self._status(BUSY, f"sweeping into {short_path(self.out)}", p.fraction,
                          cancellable=True)
 
@@ -706,25 +680,39 @@ class SweepScreen(Screen):
 
     # -- best path ----------------------------------------------------------------
 
-    @work(thread=True, exclusive=True, group="sweep-best")
     def _write_best(self, spec, row: dict, parameter_names, path: Path, objective: str) -> None:
-        from ladartui.scenario import load_scenario
-        from ladartui.sweep.execute import base_scenario_path, write_best_scenario
-
-        try:
-            base = load_scenario(base_scenario_path(spec))
-            written = write_best_scenario(path, base, row, parameter_names, base.load_scene)
-        except LadarError as error:
-            self._post(self._status, NOT_READY, f"cannot save the best path: {error}")
-            return
-        except Exception as error:  # noqa: BLE001 - shown, never kills the app
-            self._post(self._status, NOT_READY,
-                       f"cannot save the best path: {type(error).__name__}: {error}")
-            return
-        self._post(self._announce_best, written, f"best by {objective}")
+        start_job(self, "best", lambda cancel, progress: (
+            _write_best(spec, row, parameter_names, path), f"best by {objective}"))
 
     def _announce_best(self, path: Path, how: str) -> None:
         self.query_one("#sweep-detail", Static).update(f"best path: {path}")
         self._status(self._idle_state(), f"best path ({how}): {path}",
                      self._fraction() if self.running else None)
         self.post_message(self.OpenScenario(path))
+
+
+def _sweep(spec, scheduler: str, serial: bool, objective: str, cost: str, budget,
+           connect_timeout: float, cancel, progress):
+    """The sweep job (worker thread): every finished variant is a kept progress report."""
+    from ladartui.sweep import connect, run_sweep
+
+    client = None
+    try:
+        if scheduler:
+            progress(0.0, f"connecting to {scheduler} ...")
+            client = connect(scheduler, connect_timeout)
+        return run_sweep(spec, client=client, cancel=cancel, objective=objective, cost=cost,
+                         budget=budget, serial=serial,
+                         progress=lambda p: progress(p.fraction, "", p, keep=p.row is not None))
+    finally:
+        if client is not None:
+            client.close()
+
+
+def _write_best(spec, row: dict, parameter_names, path: Path) -> Path:
+    """The best variant as a scenario file beside the results (worker thread)."""
+    from ladartui.scenario import load_scenario
+    from ladartui.sweep.execute import base_scenario_path, write_best_scenario
+
+    base = load_scenario(base_scenario_path(spec))
+    return write_best_scenario(path, base, row, parameter_names, base.load_scene)

@@ -1,0 +1,99 @@
+"""The one worker pattern: jobs report progress and their end as messages, every failure
+is shown and none closes the app, cancelling reaches the task through its worker."""
+
+from __future__ import annotations
+
+import threading
+
+from textual.app import App
+from textual.widgets import Static
+
+from ladartui.errors import Cancelled
+from ladartui.tui.work import JobDone, JobProgress, start_job
+from test_tui_flow import LadarApp, loaded, make_scenario, scene_files, wait_until  # noqa: F401
+
+
+class Host(App):
+    """An app that runs one job and records what it hears."""
+
+    def __init__(self, task):
+        super().__init__()
+        self.job_task, self.heard, self.worker = task, [], None
+
+    def compose(self):
+        yield Static("")
+
+    def on_mount(self) -> None:
+        self.worker = start_job(self, "job", self.job_task)
+
+    def on_job_progress(self, message: JobProgress) -> None:
+        self.heard.append(("progress", message.text))
+
+    def on_job_done(self, message: JobDone) -> None:
+        self.heard.append(("done", message.result, message.cancelled, message.error))
+
+
+def test_a_newer_progress_replaces_an_older_one_of_the_same_job_unless_it_drops_a_detail():
+    old, new = JobProgress("run", 0.1, "a"), JobProgress("run", 0.2, "b")
+    assert new.can_replace(old)
+    assert not JobProgress("study", 0.2, "b").can_replace(old)
+    live = JobProgress("run", 0.1, "a", detail=[1])
+    assert not new.can_replace(live) and JobProgress("run", 0.3, "c", [2]).can_replace(live)
+
+
+async def test_an_unexpected_exception_is_reported_and_the_app_stays_open():
+    def task(cancel, progress):
+        progress(0.5, "half way")
+        raise ZeroDivisionError("division by zero in a kernel")
+
+    app = Host(task)
+    async with app.run_test() as pilot:
+        while not any(h[0] == "done" for h in app.heard):
+            await pilot.pause(0.05)
+        assert app.is_running
+        assert ("done", None, False, "ZeroDivisionError: division by zero in a kernel") \
+            in app.heard
+
+
+async def test_cancelling_the_worker_reaches_the_task_and_reports_cancelled():
+    started = threading.Event()
+
+    def task(cancel, progress):
+        started.set()
+        while not cancel.is_set():
+            cancel.wait(0.01)
+        raise Cancelled()
+
+    app = Host(task)
+    async with app.run_test() as pilot:
+        while not started.is_set():
+            await pilot.pause(0.02)
+        app.worker.cancel()
+        while not any(h[0] == "done" for h in app.heard):
+            await pilot.pause(0.05)
+        assert app.heard[-1] == ("done", None, True, None)
+
+
+async def test_a_study_whose_tracer_fails_unexpectedly_reports_it_and_the_app_stays_open(
+        tmp_path, scene_files, monkeypatch):
+    import ladartui.study.run as study_run
+    from ladartui.tui.study_screen import StudyScreen
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("the tracer fell over")
+
+    monkeypatch.setattr(study_run, "run_study", broken)
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=(120, 40)) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        await pilot.press("f11")
+        await pilot.pause()
+        screen = app.screen
+        assert isinstance(screen, StudyScreen)
+        await pilot.press("q")
+        status = screen.query_one("#study-status", Static)
+        await wait_until(pilot, lambda: "fell over" in str(status.render()))
+        assert "error: RuntimeError: the tracer fell over" in str(status.render())
+        assert app.is_running and app.screen is screen
+        assert not screen.query_one("#study-quick").disabled  # ready to try again
