@@ -15,7 +15,6 @@ import math
 import sys
 from pathlib import Path
 
-from rich.text import Text
 from textual import on
 from textual.app import ComposeResult
 from textual.binding import Binding
@@ -27,20 +26,21 @@ from textual.widgets import Button, Checkbox, DataTable, Footer, Input, Label, P
 from textual_plotext import PlotextPlot
 
 from ladartui.errors import FieldError, InputFileError, LadarError
-from ladartui.sweep.table import display_cell
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
+from ladartui.tui.sweep_view import (
+    detail_text,
+    draw_pareto,
+    eta_seconds,
+    fill_ranking_table,
+    format_eta,
+    short_path,
+)
 from ladartui.tui.work import JobDone, JobProgress, start_job
 
 OBJECTIVE_ORDER = ("obscured-coverage", "coverage-per-km", "coverage-within-budget")
-OBJECTIVE_HEADERS = {"obscured-coverage": "coverage", "coverage-per-km": "cov/km",
-                     "coverage-within-budget": "in budget"}
 COST_ORDER = ("flight-time", "distance")
-COST_HEADERS = {"flight-time": "time s", "distance": "dist m"}
-COST_LABELS = {"flight-time": "flight time (s)", "distance": "distance flown (m)"}
 VIEWS = ("both", "table", "chart")
 REDRAW_SECONDS = 0.4  # the ranking and chart are redrawn at most this often while running
-FRONT_MARKER = "◆"
-ERROR_WIDTH = 60  # error text in the table; the detail line shows it whole
 
 
 class ExistingPath(Validator):
@@ -50,40 +50,6 @@ class ExistingPath(Validator):
         if not value.strip() or Path(value.strip()).expanduser().exists():
             return self.success()
         return self.failure(f"{value.strip()}: no such file or folder")
-
-
-def format_eta(seconds: float | None) -> str:
-    """``1h02m``, ``3m05s`` or ``12s``; ``--`` when unknown."""
-    if seconds is None or not math.isfinite(seconds):
-        return "--"
-    seconds = max(0, int(round(seconds)))
-    hours, rest = divmod(seconds, 3600)
-    minutes, secs = divmod(rest, 60)
-    if hours:
-        return f"{hours}h{minutes:02d}m"
-    if minutes:
-        return f"{minutes}m{secs:02d}s"
-    return f"{secs}s"
-
-
-def eta_seconds(progress) -> float | None:
-    """Time left at the pace of the variants run so far (resumed ones cost nothing)."""
-    ran = progress.done - progress.resumed
-    left = progress.total - progress.done
-    if left <= 0:
-        return 0.0
-    if ran <= 0 or progress.elapsed <= 0:
-        return None
-    return progress.elapsed / ran * left
-
-
-def short_path(path) -> str:
-    """``path`` relative to the working folder when inside it (status lines are 80 wide)."""
-    path = Path(path)
-    try:
-        return str(path.resolve().relative_to(Path.cwd().resolve()))
-    except ValueError:
-        return str(path)
 
 
 def start_resource_tracker() -> None:
@@ -577,90 +543,21 @@ class SweepScreen(Screen):
 
     def _draw_table(self) -> None:
         table = self.query_one("#sweep-table", DataTable)
-        # Keep the cursor on the same variant when the order changes.
-        current = (self._shown_ids[table.cursor_row]
-                   if 0 <= table.cursor_row < len(self._shown_ids) else None)
-        self._shown_ids = [entry.row.get("variant") for entry in self.ranking]
-        cursor = self._shown_ids.index(current) if current in self._shown_ids else 0
-        table.clear(columns=True)
-        table.add_column("#", key="rank")
-        table.add_column("P", key="pareto")
-        table.add_column(OBJECTIVE_HEADERS[self.objective], key="objective")
-        if self.objective != "obscured-coverage":
-            table.add_column("cov %", key="coverage")
-        table.add_column(COST_HEADERS[self.cost], key="cost")
-        table.add_column("status", key="status")
-        for name in self.parameter_names:
-            table.add_column(name, key=f"param:{name}")
-        table.add_column("variant", key="variant")
-        table.add_column("error", key="error")
-        for index, entry in enumerate(self.ranking):
-            table.add_row(*self._cells(entry), key=str(index))
+        self._shown_ids = fill_ranking_table(table, self.ranking, self.objective, self.cost,
+                                             self.parameter_names, self._shown_ids)
         if self.ranking:
-            table.move_cursor(row=cursor)
             self._show_detail(table.cursor_row)
         else:
             self.query_one("#sweep-detail", Static).update("")
 
-    def _cells(self, entry) -> list:
-        row = entry.row
-        status = row.get("status") or "?"
-        if self.objective == "obscured-coverage":
-            value = "-" if entry.value is None else f"{100 * entry.value:.2f}%"
-        else:
-            value = display_cell(entry.value)
-        cells = [
-            "-" if entry.rank is None else str(entry.rank),
-            Text(FRONT_MARKER, style="bold #ffaf00") if entry.pareto else "",
-            value,
-        ]
-        if self.objective != "obscured-coverage":
-            cells.append("-" if entry.coverage is None else f"{100 * entry.coverage:.2f}")
-        cells.append(display_cell(entry.cost))
-        cells.append(Text(status, style="green" if status == "ok" else "bold red"))
-        cells.extend(display_cell(row.get(name)) for name in self.parameter_names)
-        cells.append(str(row.get("variant") or ""))
-        error = str(row.get("error") or "")
-        cells.append(Text(error[:ERROR_WIDTH] + ("…" if len(error) > ERROR_WIDTH else ""),
-                          style="red"))
-        return cells
-
     def _show_detail(self, index: int) -> None:
-        detail = self.query_one("#sweep-detail", Static)
-        if not (0 <= index < len(self.ranking)):
-            detail.update("")
-            return
-        entry = self.ranking[index]
-        row = entry.row
-        params = ", ".join(f"{name}={display_cell(row.get(name))}" for name in self.parameter_names
-                           if row.get(name) is not None)
-        text = Text(f"{row.get('variant')}: {params or 'base scenario'}")
-        if row.get("status") != "ok":
-            text.append(f"  {row.get('status')}: {row.get('error') or ''}", style="bold red")
-        elif entry.pareto:
-            text.append("  on the Pareto front", style="#ffaf00")
-        detail.update(text)
+        entry = self.ranking[index] if 0 <= index < len(self.ranking) else None
+        self.query_one("#sweep-detail", Static).update(
+            detail_text(entry, self.parameter_names) if entry is not None else "")
 
     def _draw_chart(self) -> None:
         plot = self.query_one("#sweep-chart", PlotextPlot)
-        plt = plot.plt
-        plt.clear_data()
-        plt.title(f"{FRONT_MARKER} Pareto front  ★ best")
-        plt.xlabel(COST_LABELS[self.cost])
-        plt.ylabel("coverage %")
-        points = [(e.cost, 100 * e.coverage, e) for e in self.ranking
-                  if e.cost is not None and e.coverage is not None]
-        if points:
-            others = [p for p in points if not p[2].pareto]
-            if others:
-                plt.scatter([p[0] for p in others], [p[1] for p in others], marker="●",
-                            color="cyan")
-            front = sorted((p for p in points if p[2].pareto), key=lambda p: p[0])
-            plt.plot([p[0] for p in front], [p[1] for p in front], marker=FRONT_MARKER,
-                     color="orange")
-            best = [p for p in points if p[2].rank == 1]
-            if best:
-                plt.scatter([best[0][0]], [best[0][1]], marker="★", color="green")
+        draw_pareto(plot.plt, self.ranking, self.cost)
         plot.refresh()
 
     def _fraction(self) -> float | None:

@@ -1,0 +1,139 @@
+"""What the sweep screen draws: the ranking table, the detail line, the Pareto chart,
+and the time left (no widgets are kept here; the screen hands them in)."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+from rich.text import Text
+
+from ladartui.sweep.table import display_cell
+
+OBJECTIVE_HEADERS = {"obscured-coverage": "coverage", "coverage-per-km": "cov/km",
+                     "coverage-within-budget": "in budget"}
+COST_HEADERS = {"flight-time": "time s", "distance": "dist m"}
+COST_LABELS = {"flight-time": "flight time (s)", "distance": "distance flown (m)"}
+FRONT_MARKER = "◆"
+ERROR_WIDTH = 60  # error text in the table; the detail line shows it whole
+
+
+def format_eta(seconds: float | None) -> str:
+    """``1h02m``, ``3m05s`` or ``12s``; ``--`` when unknown."""
+    if seconds is None or not math.isfinite(seconds):
+        return "--"
+    seconds = max(0, int(round(seconds)))
+    hours, rest = divmod(seconds, 3600)
+    minutes, secs = divmod(rest, 60)
+    if hours:
+        return f"{hours}h{minutes:02d}m"
+    if minutes:
+        return f"{minutes}m{secs:02d}s"
+    return f"{secs}s"
+
+
+def eta_seconds(progress) -> float | None:
+    """Time left at the pace of the variants run so far (resumed ones cost nothing)."""
+    ran = progress.done - progress.resumed
+    left = progress.total - progress.done
+    if left <= 0:
+        return 0.0
+    if ran <= 0 or progress.elapsed <= 0:
+        return None
+    return progress.elapsed / ran * left
+
+
+def short_path(path) -> str:
+    """``path`` relative to the working folder when inside it (status lines are 80 wide)."""
+    path = Path(path)
+    try:
+        return str(path.resolve().relative_to(Path.cwd().resolve()))
+    except ValueError:
+        return str(path)
+
+
+def fill_ranking_table(table, ranking, objective: str, cost: str, parameter_names,
+                       shown_ids: list) -> list:
+    """Refill ``table`` with ``ranking``, keeping the cursor on the same variant; the
+    variant ids in table order."""
+    current = shown_ids[table.cursor_row] if 0 <= table.cursor_row < len(shown_ids) else None
+    ids = [entry.row.get("variant") for entry in ranking]
+    cursor = ids.index(current) if current in ids else 0
+    table.clear(columns=True)
+    table.add_column("#", key="rank")
+    table.add_column("P", key="pareto")
+    table.add_column(OBJECTIVE_HEADERS[objective], key="objective")
+    if objective != "obscured-coverage":
+        table.add_column("cov %", key="coverage")
+    table.add_column(COST_HEADERS[cost], key="cost")
+    table.add_column("status", key="status")
+    for name in parameter_names:
+        table.add_column(Text(name), key=f"param:{name}")
+    table.add_column("variant", key="variant")
+    table.add_column("error", key="error")
+    for index, entry in enumerate(ranking):
+        table.add_row(*ranking_cells(entry, objective, parameter_names), key=str(index))
+    if ranking:
+        table.move_cursor(row=cursor)
+    return ids
+
+
+def ranking_cells(entry, objective: str, parameter_names) -> list:
+    """One table row: rank, front marker, objective, (coverage), cost, status, parameters,
+    variant and error; text from the results file is never markup."""
+    row = entry.row
+    status = row.get("status") or "?"
+    if objective == "obscured-coverage":
+        value = "-" if entry.value is None else f"{100 * entry.value:.2f}%"
+    else:
+        value = display_cell(entry.value)
+    cells = [
+        "-" if entry.rank is None else str(entry.rank),
+        Text(FRONT_MARKER, style="bold #ffaf00") if entry.pareto else "",
+        value,
+    ]
+    if objective != "obscured-coverage":
+        cells.append("-" if entry.coverage is None else f"{100 * entry.coverage:.2f}")
+    cells.append(Text(display_cell(entry.cost)))
+    cells.append(Text(status, style="green" if status == "ok" else "bold red"))
+    cells.extend(Text(display_cell(row.get(name))) for name in parameter_names)
+    cells.append(Text(str(row.get("variant") or "")))
+    error = str(row.get("error") or "")
+    cells.append(Text(error[:ERROR_WIDTH] + ("…" if len(error) > ERROR_WIDTH else ""),
+                      style="red"))
+    return cells
+
+
+def detail_text(entry, parameter_names) -> Text:
+    """The detail line of one ranked variant: its parameters, and why it failed."""
+    row = entry.row
+    params = ", ".join(f"{name}={display_cell(row.get(name))}" for name in parameter_names
+                       if row.get(name) is not None)
+    text = Text(f"{row.get('variant')}: {params or 'base scenario'}")
+    if row.get("status") != "ok":
+        text.append(f"  {row.get('status')}: {row.get('error') or ''}", style="bold red")
+    elif entry.pareto:
+        text.append("  on the Pareto front", style="#ffaf00")
+    return text
+
+
+def draw_pareto(plt, ranking, cost: str) -> None:
+    """Coverage against cost on a plotext figure: every variant, the front as a line
+    joining its points, the best marked."""
+    plt.clear_data()
+    plt.title(f"{FRONT_MARKER} Pareto front  ★ best")
+    plt.xlabel(COST_LABELS[cost])
+    plt.ylabel("coverage %")
+    points = [(e.cost, 100 * e.coverage, e) for e in ranking
+              if e.cost is not None and e.coverage is not None]
+    if not points:
+        return
+    others = [p for p in points if not p[2].pareto]
+    if others:
+        plt.scatter([p[0] for p in others], [p[1] for p in others], marker="●", color="cyan")
+    front = sorted((p for p in points if p[2].pareto), key=lambda p: p[0])
+    plt.plot([p[0] for p in front], [p[1] for p in front], marker=FRONT_MARKER,
+             color="orange")
+    best = [p for p in points if p[2].rank == 1]
+    if best:
+        plt.scatter([best[0][0]], [best[0][1]], marker="★", color="green")
