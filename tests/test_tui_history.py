@@ -315,3 +315,17 @@ async def test_a_flight_log_segment_is_listed_and_says_where_it_is_edited(tmp_pa
         await pilot.pause()
         assert not isinstance(app.screen, FormScreen)  # no number form for a file's data
         assert "scenario file" in app.messages[-1]
+
+
+async def test_every_footer_key_fits_an_80_column_terminal(tmp_path, scene_files):
+    from textual.widgets._footer import FooterKey
+
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        await pilot.pause()
+        shown = {key.key: key.region for key in app.screen.query(FooterKey)}
+        assert {"f1", "f5", "f6", "f8", "f10", "f11", "f12"} <= set(shown)
+        assert all(0 < region.right <= 80 for region in shown.values())
+        assert "escape" not in shown  # Cancel joins the footer only while a run goes

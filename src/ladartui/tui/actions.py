@@ -40,11 +40,13 @@ class Command:
 
 COMMANDS = [
     Command("help", "help", "f1,question_mark", "Help: keys", "List every key", "Help"),
+    # New, Open and Save are on the File tab's buttons (with their keys), not in the
+    # footer, so that F10-F12 fit an 80-column footer
     Command("new", "new_scenario", "f2", "New scenario",
-            "Choose a scenario file and a scene model", "New"),
+            "Choose a scenario file and a scene model"),
     Command("open", "open_scenario", "f3", "Open scenario",
-            "Load a scenario; its model files are checked", "Open"),
-    Command("save", "save", "ctrl+s", "Save scenario", "Write the scenario file", "Save"),
+            "Load a scenario; its model files are checked"),
+    Command("save", "save", "ctrl+s", "Save scenario", "Write the scenario file"),
     Command("save-as", "save_as", "ctrl+shift+s", "Save scenario as",
             "Write the scenario under another name"),
     Command("undo", "undo", "ctrl+z", "Undo", "Undo the last change to the scenario"),
@@ -59,7 +61,7 @@ COMMANDS = [
     Command("angle", "view_angle", "f7", "View angle",
             "Exact azimuth and elevation of the 3D views"),
     Command("threshold", "threshold", "f8", "Output height threshold",
-            "Draw the output up to a height", "Threshold"),
+            "Draw the output up to a height", "Thresh"),
     Command("measures", "measures", "f9", "Show measures", "The measures of the last run"),
     Command("compare", "compare", "f10", "Compare scenarios",
             "Two or more .cmf files side by side", "Compare"),

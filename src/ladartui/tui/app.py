@@ -293,8 +293,8 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
         if self.tool_screen is not None and self.screen is self.tool_screen:
             # that screen has its own keys; textual's own actions (focus, quit) stay
             return False if action in own_actions() else True
-        if action == "cancel_run":
-            return True if self.run_in_progress() else None
+        if action == "cancel_run":  # in the footer only while there is a run to cancel
+            return True if self.run_in_progress() else False
         if self.busy is not None and action not in actions.DISPLAY_ACTIONS:
             return None
         if action == "run" and self.problems(fields=False):
