@@ -5,6 +5,8 @@ Every test runs on a tiny generated scene (seeded) in tmp_path.
 
 from __future__ import annotations
 
+import re
+
 import asyncio
 import dataclasses
 import time
@@ -245,6 +247,8 @@ async def test_a_run_disables_controls_and_cancel_keeps_earlier_outputs(tmp_path
         await pilot.press("f5")
         await wait_until(pilot, lambda: app.busy is not None and app.run_in_progress())
         await wait_until(pilot, lambda: (app.progress or 0) > 0)
+        # once two scans have given a pace, the busy bar says how long is left
+        await wait_until(pilot, lambda: re.search(r"about \S+ left", status(app).message))
         assert status(app).state == BUSY and "%" in str(
             status(app).query_one("#status-word").render())
         enabled = [w.id for w in app.query(CONTROLS) if not w.disabled]

@@ -19,7 +19,8 @@ from textual.widgets import DataTable
 from ladartui.scenario import load_scenario
 from ladartui.sweep import read_table, run_sweep
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
-from ladartui.tui.sweep_screen import SweepScreen, eta_seconds, format_eta
+from ladartui.tui.status import format_eta
+from ladartui.tui.sweep_screen import SweepScreen, eta_seconds
 
 SIZE = (80, 24)
 CENTRE = (11.5, 11.5, 0.5)

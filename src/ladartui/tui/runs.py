@@ -16,11 +16,13 @@ from textual.widgets import TabbedContent
 
 from ladartui.errors import Cancelled
 from ladartui.tui.screens import MeasuresScreen
+from ladartui.tui.status import format_eta
 from ladartui.tui.work import running, start_job
 
 LIVE_POINTS = 20_000  # fewer while a run is going, so redraws stay cheap
 LIVE_INTERVAL = 0.5  # seconds between progressive redraws of the output view
 WARM_POLL = 0.1  # seconds between looks at the warm-up while waiting for it
+ETA_AFTER_SCANS = 2  # the time left is shown once this many scans have given a pace
 
 
 class RunControl:
@@ -92,11 +94,12 @@ def _run(scenario, scene, fast: bool, warm, cancel, progress):
     from ladartui.simulation import simulate
 
     last_live = 0.0
+    started = None  # when the first scan began: the pace excludes waiting for the kernels
     fused = np.empty(0, np.int64)  # sorted unique keys of the obscured returns so far
     pending: list[np.ndarray] = []
 
     def scanned(p) -> None:
-        nonlocal last_live, fused
+        nonlocal last_live, fused, started
         if p.returns is not None and p.run == "scene" and not fast and len(p.returns):
             pending.append(voxel_keys(p.returns))
         live = None
@@ -107,7 +110,14 @@ def _run(scenario, scene, fast: bool, warm, cancel, progress):
             last_live = now
             live = keys_to_voxels(fused)
         run = "obscured (scene)" if p.run == "scene" else "unobscured (target)"
-        progress(p.fraction, f"Running {run}: scan {p.scan}/{p.scans}", live)
+        text = f"Running {run}: scan {p.scan}/{p.scans}"
+        if started is None:
+            started = (now, p.fraction)
+        elif p.scan >= ETA_AFTER_SCANS or p.run != "scene":
+            done = p.fraction - started[1]
+            if done > 0:  # at the pace since the first scan
+                text += f", about {format_eta((now - started[0]) * (1 - p.fraction) / done)} left"
+        progress(p.fraction, text, live)
 
     if running(warm):
         progress(0.0, "Compiling the tracing kernels (first run only)...")

@@ -2,12 +2,29 @@
 
 from __future__ import annotations
 
+import math
+
 from textual.app import ComposeResult
 from textual.containers import Horizontal
 from textual.widgets import Button, Static
 
 NOT_READY, READY, BUSY = "not-ready", "ready", "busy"
 LABELS = {NOT_READY: "NOT READY", READY: "READY", BUSY: "BUSY"}
+
+
+def format_eta(seconds: float | None) -> str:
+    """``1h02m``, ``3m05s`` or ``12s``; ``--`` when unknown."""
+    if seconds is None or not math.isfinite(seconds):
+        return "--"
+    seconds = max(0, int(round(seconds)))
+    hours, rest = divmod(seconds, 3600)
+    minutes, secs = divmod(rest, 60)
+    if hours:
+        return f"{hours}h{minutes:02d}m"
+    if minutes:
+        return f"{minutes}m{secs:02d}s"
+    return f"{secs}s"
+
 
 
 class StatusBar(Horizontal):

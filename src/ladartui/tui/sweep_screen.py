@@ -26,13 +26,12 @@ from textual.widgets import Button, Checkbox, DataTable, Footer, Input, Label, P
 from textual_plotext import PlotextPlot
 
 from ladartui.errors import FieldError, InputFileError, LadarError
-from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
+from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar, format_eta
 from ladartui.tui.sweep_view import (
     detail_text,
     draw_pareto,
     eta_seconds,
     fill_ranking_table,
-    format_eta,
     short_path,
 )
 from ladartui.tui.work import JobDone, JobProgress, start_job

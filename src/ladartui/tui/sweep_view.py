@@ -3,7 +3,6 @@ and the time left (no widgets are kept here; the screen hands them in)."""
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 from rich.text import Text
@@ -16,20 +15,6 @@ COST_HEADERS = {"flight-time": "time s", "distance": "dist m"}
 COST_LABELS = {"flight-time": "flight time (s)", "distance": "distance flown (m)"}
 FRONT_MARKER = "◆"
 ERROR_WIDTH = 60  # error text in the table; the detail line shows it whole
-
-
-def format_eta(seconds: float | None) -> str:
-    """``1h02m``, ``3m05s`` or ``12s``; ``--`` when unknown."""
-    if seconds is None or not math.isfinite(seconds):
-        return "--"
-    seconds = max(0, int(round(seconds)))
-    hours, rest = divmod(seconds, 3600)
-    minutes, secs = divmod(rest, 60)
-    if hours:
-        return f"{hours}h{minutes:02d}m"
-    if minutes:
-        return f"{minutes}m{secs:02d}s"
-    return f"{secs}s"
 
 
 def eta_seconds(progress) -> float | None:
