@@ -5,10 +5,9 @@ Every test runs on a tiny generated scene (seeded) in tmp_path.
 
 from __future__ import annotations
 
-import re
-
 import asyncio
 import dataclasses
+import re
 import time
 from pathlib import Path
 
@@ -25,8 +24,8 @@ from ladartui.sensor import Sensor
 from ladartui.tui.app import CONTROLS, LadarApp
 from ladartui.tui.canvas import ProjectionWidget, TopViewWidget
 from ladartui.tui.fields import NumberField
-from ladartui.tui.measures_view import compact_rows
 from ladartui.tui.file_dialogs import SetupScreen
+from ladartui.tui.measures_view import compact_rows
 from ladartui.tui.screens import AngleScreen, CompareScreen, FormScreen, HelpScreen
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
 from ladartui.tui.warmup import tiny_run
