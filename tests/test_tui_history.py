@@ -329,3 +329,27 @@ async def test_every_footer_key_fits_an_80_column_terminal(tmp_path, scene_files
         assert {"f1", "f5", "f6", "f8", "f10", "f11", "f12"} <= set(shown)
         assert all(0 < region.right <= 80 for region in shown.values())
         assert "escape" not in shown  # Cancel joins the footer only while a run goes
+
+
+async def test_the_outputs_export_as_las_point_clouds_after_a_run(tmp_path, scene_files):
+    import laspy
+
+    from ladartui.scene.voxels import load_voxels
+
+    scenario = make_scenario(tmp_path, scene_files, scans=2)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        await app.run_action("export_las")  # nothing to export yet: said, nothing written
+        await wait_until(pilot, lambda: any("Nothing exported" in m for m in app.messages))
+        assert not list(tmp_path.glob("*.las"))
+        await pilot.press("f5")
+        await wait_until(pilot, lambda: app.result is not None and not app.running)
+        await pilot.press("escape")
+        app.action_show_tab("results")
+        await pilot.pause()
+        await pilot.click("#btn-export-las")
+        await wait_until(pilot, lambda: app.messages[-1].startswith("Wrote"))
+        for output in (scenario.scene_output, scenario.target_output):
+            cloud = laspy.read(output.with_suffix(".las"))
+            assert len(cloud.points) == len(load_voxels(output)) > 0

@@ -69,6 +69,8 @@ COMMANDS = [
             "Every backend, method and ray grid on this scenario", "Study"),
     Command("sweep", "sweep", "f12", "Flight-path sweep",
             "Launch, open or watch a sweep; open its best path", "Sweep"),
+    Command("export-las", "export_las", None, "Export outputs as LAS",
+            "Write the scene and target outputs as LAS point clouds beside them"),
     Command("aim-all", "aim_all", None, "Aim every scan at the target",
             "Point the sensor at the target centre"),
     Command("edit-segment", "edit_segment", None, "Edit selected segment",

@@ -40,7 +40,7 @@ from ladartui.tui.screens import (
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
 from ladartui.tui.unsaved import EditGuard
 from ladartui.tui.view_area import LAYOUTS, OUTPUT_POINTS, ViewArea
-from ladartui.tui.work import JobDone, JobProgress
+from ladartui.tui.work import JobDone, JobProgress, start_job
 
 # everything the analyst can change; disabled while busy (Cancel is re-enabled)
 CONTROLS = "#sidebar Input, #sidebar Button, #sidebar Select, #sidebar Checkbox, " \
@@ -391,6 +391,12 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
             paths += sorted(p for p in folder.glob("*.cmf") if p != own)
         self.push_screen(CompareScreen(paths[:4], self._folder()))
 
+    def action_export_las(self) -> None:
+        if self.scenario is None or self.busy:
+            return
+        scenario = self.scenario
+        start_job(self, "export", lambda cancel, progress: bridge.export_outputs_las(scenario))
+
     def action_help(self) -> None:
         self.push_screen(HelpScreen(help_rows(self)))
 
@@ -454,7 +460,7 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
     # -- jobs: every slow piece of work reports here (tui/work.py) -------------------
 
     JOB_FAILED = {"load": "Could not load", "run": "Run failed", "probe": "Backends not probed",
-                  "warm": "Kernels not compiled"}
+                  "warm": "Kernels not compiled", "export": "Nothing exported"}
 
     def on_job_progress(self, message: JobProgress) -> None:
         if message.job == "run":
@@ -477,6 +483,8 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
                                    False)])
         elif message.job == "run":
             self.run_finished(message.result, message.cancelled, message.error)
+        elif message.job == "export" and message.result is not None:
+            self.tell("Wrote " + ", ".join(str(p) for p in message.result))
 
     def exit(self, *args, **kwargs) -> None:
         # a thread cannot be killed: cancelling tells every job to stop, so quitting is quick

@@ -343,3 +343,22 @@ def backend_choices() -> list[tuple[str, str, bool]]:
     best = next((n for n, _, ok in rows if ok), None)
     auto = f"the best available here ({best})" if best else "no backend is available"
     return [("auto", auto, best is not None), *rows]
+
+
+def export_outputs_las(scenario: Scenario, suffix: str = ".las") -> list[Path]:
+    """The scenario's outputs on disk (scene and target) as LAS (or LAZ) point clouds beside
+    them, ``S_Scene.las`` and ``S_Target.las``, as ``run --las`` names them; the paths.
+
+    Both are read first, so a missing output writes nothing.
+    """
+    from ladartui.scene.las import export_las
+    from ladartui.scene.voxels import load_voxels
+
+    outputs = [scenario.scene_output, scenario.target_output]
+    for path in outputs:
+        if not path.is_file():
+            raise InputFileError(path, "output not found: run the scenario first (F5)")
+    clouds = [(path.with_suffix(suffix), load_voxels(path)) for path in outputs]
+    for path, voxels in clouds:
+        export_las(path, voxels, scenario.voxel_size)
+    return [path for path, _ in clouds]

@@ -22,6 +22,9 @@ class ResultsPanel(VerticalScroll):
             yield Button("Measures", id="btn-measures", compact=True)
             yield Button("Compare", id="btn-compare", compact=True)
             yield Button("Threshold", id="btn-threshold", compact=True)
+        with Grid(classes="button-grid run-buttons two-buttons"):
+            yield Button("Export LAS", id="btn-export-las", compact=True,
+                         tooltip="The outputs as LAS point clouds beside them")
 
     def on_mount(self) -> None:
         self.query_one("#measures", DataTable).add_columns("Measure", "Value")
@@ -37,7 +40,7 @@ class ResultsPanel(VerticalScroll):
         for label, value in compact_rows(measures):
             table.add_row(Text(label), Text(value))  # text from a file: never markup
 
-    @on(Button.Pressed, "#btn-measures,#btn-compare,#btn-threshold")
+    @on(Button.Pressed, "#btn-measures,#btn-compare,#btn-threshold,#btn-export-las")
     async def _pressed(self, event: Button.Pressed) -> None:
         event.stop()
-        await self.app.run_action(event.button.id.removeprefix("btn-"))
+        await self.app.run_action(event.button.id.removeprefix("btn-").replace("-", "_"))
