@@ -297,8 +297,10 @@ def test_cli_quick_writes_data_and_chart_files(tmp_path, monkeypatch, capsys):
 
 # --------------------------------------------------------------------------- the screen
 
-async def test_study_screen_runs_in_a_worker_and_shows_chart_table_and_verdict(monkeypatch):
+async def test_study_screen_runs_in_a_worker_and_shows_chart_table_and_verdict(monkeypatch,
+                                                                              tmp_path):
     pytest.importorskip("textual")
+    monkeypatch.setenv("LADARTUI_HOME", str(tmp_path))  # where the screen keeps its study
     from textual.app import App
     from textual.widgets import DataTable, Static
 
@@ -328,6 +330,13 @@ async def test_study_screen_runs_in_a_worker_and_shows_chart_table_and_verdict(m
         assert "Pareto front" in str(screen.query_one("#study-verdict", Static).render())
         await pilot.press("escape")
         assert not isinstance(app.screen, StudyScreen)
+        # opened again, the screen shows the study it kept, without measuring again
+        again = StudyScreen(None, runs=1)
+        app.push_screen(again)
+        await pilot.pause()
+        assert again.result is not None and not list(again.workers)
+        assert again.query_one("#study-table", DataTable).row_count == 2
+        assert "last study" in str(again.query_one("#study-status", Static).render())
 
 
 def test_a_study_json_reads_back_to_the_same_table_and_verdict(tmp_path):

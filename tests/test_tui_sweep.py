@@ -354,3 +354,20 @@ async def test_browse_picks_a_results_folder_in_a_tree_and_opens_it(finished):
         await pilot.pause()
         assert app.screen is screen
         assert screen.query_one("#sweep-table", DataTable).row_count == 12
+
+
+async def test_the_screen_reopens_the_last_sweep_opened(finished, tmp_path, monkeypatch):
+    monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))
+    _spec, results = finished
+    first = SweepScreen(results)
+    app = _Host(first)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        assert first.query_one("#sweep-table", DataTable).row_count == 12
+        app.pop_screen()
+        again = SweepScreen()  # no path: the last sweep opened comes back
+        app.push_screen(again)
+        await pilot.pause()
+        await pilot.pause()
+        assert again.query_one("#sweep-path").value == str(results.resolve())
+        assert again.query_one("#sweep-table", DataTable).row_count == 12

@@ -1,10 +1,11 @@
-"""The scenarios opened lately, newest first, kept in the user's config folder.
+"""Files opened lately, newest first, kept in the user's config folder.
 
-The list lives in ``recent.json`` under ``$LADARTUI_HOME/config`` when
-LADARTUI_HOME is set (tests, portable installs), else in the platform's
-user config folder (``~/.config/ladartui`` on Linux). A missing or damaged
-file is an empty list: remembering files is a convenience, never a reason
-to refuse to start.
+Two lists: the scenarios opened (the terminal UI's File tab and palette) and
+the sweeps opened or run (the sweep screen reopens the last one). They live
+in ``recent.json`` under ``$LADARTUI_HOME/config`` when LADARTUI_HOME is set
+(tests, portable installs), else in the platform's user config folder
+(``~/.config/ladartui`` on Linux). A missing or damaged file is an empty
+list: remembering files is a convenience, never a reason to refuse to start.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from ladartui.atomic import write_text_atomic
 
 RECENT_LIMIT = 10
 RECENT_FILE = "recent.json"
+KINDS = ("scenarios", "sweeps")
 
 
 def config_folder() -> Path:
@@ -27,30 +29,47 @@ def config_folder() -> Path:
     return platformdirs.user_config_path("ladartui")
 
 
-def recent_scenarios(existing_only: bool = True) -> list[Path]:
-    """The remembered scenario files, newest first (those still on disk, by default)."""
+def _read() -> dict[str, list[str]]:
     try:
-        names = json.loads((config_folder() / RECENT_FILE).read_text(encoding="utf-8"))
+        data = json.loads((config_folder() / RECENT_FILE).read_text(encoding="utf-8"))
     except (OSError, ValueError):
-        return []
-    if not isinstance(names, list):
-        return []
-    paths = [Path(name) for name in names if isinstance(name, str)]
-    return [p for p in paths if p.is_file()] if existing_only else paths
+        return {}
+    if isinstance(data, list):  # the first format: scenarios only
+        data = {"scenarios": data}
+    if not isinstance(data, dict):
+        return {}
+    return {kind: [n for n in data.get(kind, []) if isinstance(n, str)]
+            for kind in KINDS if isinstance(data.get(kind, []), list)}
 
 
-def remember_scenario(path) -> list[Path]:
-    """Put ``path`` first in the recent list (at most RECENT_LIMIT); the new list.
+def recent_paths(kind: str, existing_only: bool = True) -> list[Path]:
+    """The remembered files of ``kind``, newest first (those still on disk, by default)."""
+    paths = [Path(name) for name in _read().get(kind, [])]
+    return [p for p in paths if p.exists()] if existing_only else paths
+
+
+def remember_path(kind: str, path) -> list[Path]:
+    """Put ``path`` first in the ``kind`` list (at most RECENT_LIMIT); the new list.
 
     A folder that cannot be written is not an error: the list is returned
     as it would have been.
     """
     path = Path(path).expanduser().resolve()
-    paths = [path] + [p for p in recent_scenarios(existing_only=False) if p != path]
+    data = _read()
+    paths = [path] + [p for p in recent_paths(kind, existing_only=False) if p != path]
     paths = paths[:RECENT_LIMIT]
+    data[kind] = [str(p) for p in paths]
     try:
-        write_text_atomic(config_folder() / RECENT_FILE,
-                          json.dumps([str(p) for p in paths], indent=1) + "\n")
+        write_text_atomic(config_folder() / RECENT_FILE, json.dumps(data, indent=1) + "\n")
     except OSError:
         pass
     return paths
+
+
+def recent_scenarios(existing_only: bool = True) -> list[Path]:
+    return [p for p in recent_paths("scenarios", existing_only) if not existing_only
+            or p.is_file()]
+
+
+def remember_scenario(path) -> list[Path]:
+    return remember_path("scenarios", path)

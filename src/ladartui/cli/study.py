@@ -64,19 +64,9 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _load_result(path):
-    import json
-    from pathlib import Path
+    from ladartui.study.results import read_study
 
-    from ladartui.errors import InputFileError
-    from ladartui.study.results import StudyResult
-
-    try:
-        data = json.loads(Path(path).read_text(encoding="utf-8"))
-        return StudyResult.from_dict(data)
-    except OSError as error:
-        raise InputFileError(path, f"cannot read it ({error.strerror})") from None
-    except (ValueError, KeyError, TypeError) as error:
-        raise InputFileError(path, f"not a study.json written by 'ladartui study' ({error})") from None
+    return read_study(path)
 
 
 def _positive(flag, value):

@@ -10,8 +10,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ladartui.atomic import write_text_atomic
-from ladartui.study.misses import CLASSES, MissSummary
 from ladartui.pareto import dominator, pareto_front
+from ladartui.study.misses import CLASSES, MissSummary
 from ladartui.study.settings import Setting
 from ladartui.study.timing import Timing
 
@@ -263,3 +263,28 @@ def format_share(value) -> str:
     if value and value < 1e-4:
         return f"{value * 100:.4f}%"
     return f"{value * 100:.2f}%"
+
+
+def read_study(path) -> StudyResult:
+    """A ``study.json`` written by a study (the CLI's or the terminal UI's), read back."""
+    from ladartui.errors import InputFileError
+
+    try:
+        data = json.loads(Path(path).read_text(encoding="utf-8"))
+        return StudyResult.from_dict(data)
+    except OSError as error:
+        raise InputFileError(path, f"cannot read it ({error.strerror})") from None
+    except (ValueError, KeyError, TypeError) as error:
+        raise InputFileError(path, f"not a study.json written by 'ladartui study' "
+                             f"({error})") from None
+
+
+def study_folder(scenario_path=None) -> Path:
+    """Where the terminal UI keeps a scenario's last study: ``S-study`` beside ``S.toml``;
+    for the generated scenes, ``study`` in the user data folder."""
+    if scenario_path is None:
+        from ladartui.defaults import data_home
+
+        return data_home() / "study"
+    path = Path(scenario_path)
+    return path.with_name(f"{path.stem}-study")

@@ -71,6 +71,25 @@ class StudyScreen(Screen):
         table.add_columns(*TABLE_COLUMNS)
         plot = self.query_one("#study-chart", PlotextPlot).plt
         plot.title("Speed against accuracy: press q (quick) or f (full)")
+        self._reopen()
+
+    def _reopen(self) -> None:
+        """Show the last study of this scenario, if one was kept."""
+        from ladartui.errors import LadarError
+        from ladartui.study.results import read_study, study_folder
+
+        path = study_folder(self.scenario_path) / "study.json"
+        if not path.is_file():
+            return
+        try:
+            result = read_study(path)
+        except LadarError as error:
+            self._set_status(f"last study not shown: {error}")
+            return
+        self.show_result(result)
+        when = (result.context or {}).get("created_utc", "")
+        self._set_status(f"last study{' of ' + when if when else ''} ({path}): "
+                         "q quick, f full to run again")
 
     def _idle_text(self) -> str:
         where = self.scenario_path or "the generated scenes"
@@ -174,4 +193,9 @@ def _study(mode: str, scenario_path, scans, runs, cancel, progress):
     settings = quick_settings() if quick else full_settings()
     result = run_study(inputs, settings, runs=runs, cancel=cancel,
                        progress=lambda p: progress(p.done / max(p.total, 1), p.label, p))
-    return result, f"{mode} study done on {inputs.name}"
+    from ladartui.study.results import study_folder
+    from ladartui.study.run import write_outputs
+
+    folder = study_folder(scenario_path)
+    write_outputs(result, folder)  # kept, so the screen reopens it next time
+    return result, f"{mode} study done on {inputs.name}; kept in {folder}"

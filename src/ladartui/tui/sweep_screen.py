@@ -26,6 +26,7 @@ from textual.widgets import Button, Checkbox, DataTable, Footer, Input, Label, P
 from textual_plotext import PlotextPlot
 
 from ladartui.errors import FieldError, InputFileError, LadarError
+from ladartui.recent import recent_paths, remember_path
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar, format_eta
 from ladartui.tui.sweep_view import (
     detail_text,
@@ -179,6 +180,11 @@ class SweepScreen(Screen):
         self._draw_chart()
         self._status(NOT_READY, "type a sweep spec (F5 runs it) or a results folder (F3 opens it)")
         self.query_one("#sweep-path", Input).focus()
+        if not self.initial_path:  # reopen the last sweep opened or run
+            last = recent_paths("sweeps")
+            if last:
+                self.initial_path = str(last[0])
+                self.query_one("#sweep-path", Input).value = self.initial_path
         if self.initial_path:
             self._open(self.initial_path)
 
@@ -264,6 +270,7 @@ class SweepScreen(Screen):
             start_resource_tracker()
         self.running = True
         self.progress = None
+        remember_path("sweeps", spec.path)
         self.query_one("#sweep-progress", ProgressBar).update(total=len(ids), progress=0)
         where = (f"scheduler {scheduler}" if scheduler
                  else "this process" if serial else "a local cluster")
@@ -411,6 +418,7 @@ class SweepScreen(Screen):
                     self._show_stored(len(spec.variants))
                     self._status(NOT_READY, f"{path}: {len(spec.variants)} variants, no results "
                                  "yet: F5 runs the sweep")
+                    remember_path("sweeps", path)
                     return
             else:
                 results = path
@@ -434,6 +442,7 @@ class SweepScreen(Screen):
         self.query_one("#sweep-table", DataTable).focus()
         self._status(READY, f"{short_path(result.results_path)}: {self._summary()}; "
                      f"ranked by {self.objective}")
+        remember_path("sweeps", path)  # the screen reopens it next time
 
     def _summary(self) -> str:
         ok = sum(row.get("status") == "ok" for row in self.rows)
