@@ -117,8 +117,11 @@ def draw_pareto(plt, ranking, cost: str) -> None:
     if others:
         plt.scatter([p[0] for p in others], [p[1] for p in others], marker="●", color="cyan")
     front = sorted((p for p in points if p[2].pareto), key=lambda p: p[0])
-    plt.plot([p[0] for p in front], [p[1] for p in front], marker=FRONT_MARKER,
-             color="orange")
+    # a thin line joins the front; its own points sit on it (a line of markers would
+    # read as many points)
+    plt.plot([p[0] for p in front], [p[1] for p in front], marker="braille", color="orange")
+    plt.scatter([p[0] for p in front], [p[1] for p in front], marker=FRONT_MARKER,
+                color="orange")
     best = [p for p in points if p[2].rank == 1]
     if best:
         plt.scatter([best[0][0]], [best[0][1]], marker="★", color="green")
