@@ -169,10 +169,6 @@ class RunProgress:
     fraction: float
     returns: np.ndarray | None = None
 
-    @property
-    def scan_complete(self) -> bool:
-        return self.returns is not None
-
 
 @dataclass
 class SimulationResult:

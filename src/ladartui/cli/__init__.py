@@ -46,13 +46,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"ladartui {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     for name, module in COMMANDS.items():
-        try:
-            mod = importlib.import_module(f"ladartui.cli.{module}")
-        except ModuleNotFoundError as error:
-            if error.name == f"ladartui.cli.{module}":
-                continue  # command not built yet
-            raise
-        mod.add_parser(sub)
+        # a missing command module is an error: a renamed module must not make its
+        # command vanish quietly
+        importlib.import_module(f"ladartui.cli.{module}").add_parser(sub)
     return parser
 
 

@@ -98,11 +98,6 @@ class Scene:
                 self._target_occupancy = _build_occupancy(self.target, self.shape)
             return self._target_occupancy
 
-    @property
-    def extent_m(self) -> tuple[float, float, float]:
-        """Width, depth and height of the grid in metres."""
-        return tuple(n * self.voxel_size for n in self.shape)
-
     def target_centre_m(self) -> np.ndarray:
         """Centroid of the target voxel centres, metres (x, y, z)."""
         if len(self.target) == 0:

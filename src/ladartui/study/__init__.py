@@ -25,7 +25,7 @@ __all__ = [
 
 def __getattr__(name):
     # The runner pulls in the tracing stack; load it only when asked for.
-    if name in ("run_study", "StudyInputs", "StudyProgress", "write_outputs", "study_inputs"):
+    if name in ("run_study", "StudyInputs", "StudyProgress", "write_outputs"):
         from ladartui.study import run
 
         return getattr(run, name)
