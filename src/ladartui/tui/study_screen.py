@@ -38,8 +38,8 @@ class StudyScreen(Screen):
     StudyScreen #study-verdict { height: auto; max-height: 12; overflow-y: auto; padding: 0 1; }
     StudyScreen #study-bar { height: 1; }
     StudyScreen #study-bar Button { margin-left: 1; }
-    StudyScreen #study-status { width: 1fr; padding: 0 1; }
-    StudyScreen ProgressBar { width: 30; }
+    StudyScreen #study-status { height: 1; padding: 0 1; }
+    StudyScreen ProgressBar { width: 1fr; }
     """
 
     def __init__(self, scenario_path=None, scans: int | None = None, runs: int | None = None,
@@ -57,8 +57,8 @@ class StudyScreen(Screen):
             with Vertical(id="study-side"):
                 yield DataTable(id="study-table", zebra_stripes=True, cursor_type="row")
                 yield Static("", id="study-verdict")
+        yield Static(self._idle_text(), id="study-status", markup=False)
         with Horizontal(id="study-bar"):
-            yield Static(self._idle_text(), id="study-status", markup=False)
             yield ProgressBar(id="study-progress", show_eta=False)
             yield Button("Quick", id="study-quick", compact=True)
             yield Button("Full", id="study-full", compact=True)

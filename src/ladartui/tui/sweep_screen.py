@@ -269,6 +269,7 @@ class SweepScreen(Screen):
         if not serial and not scheduler:
             start_resource_tracker()
         self.running = True
+        self.refresh_bindings()
         self.progress = None
         remember_path("sweeps", spec.path)
         self.query_one("#sweep-progress", ProgressBar).update(total=len(ids), progress=0)
@@ -287,6 +288,12 @@ class SweepScreen(Screen):
             self._status(BUSY, "a sweep is running: Ctrl+X cancels it first", cancellable=True)
             return
         self._open(self._path_text())
+
+    def check_action(self, action: str, parameters) -> bool | None:
+        # Cancel joins the footer only while a sweep runs, so every key fits 80 columns
+        if action == "cancel":
+            return True if self.running else False
+        return True
 
     def action_cancel(self) -> None:
         if self.running:
@@ -501,6 +508,7 @@ class SweepScreen(Screen):
 
     def _finish(self, result, error: str) -> None:
         self.running = False
+        self.refresh_bindings()
         p = self.progress
         if result is not None:
             self.rows, self.ranking = result.rows, result.ranking
