@@ -374,3 +374,23 @@ async def test_the_screen_reopens_the_last_sweep_opened(finished, tmp_path, monk
         await pilot.pause()
         assert again.query_one("#sweep-path").value == str(results.resolve())
         assert again.query_one("#sweep-table", DataTable).row_count == 12
+
+
+async def test_a_plain_scheduler_off_this_machine_is_refused_as_the_cli_refuses_it(tmp_path):
+    write_base(tmp_path)
+    spec = write_spec(tmp_path, "[grid]\nradius = [10.0, 20.0]\n")
+    screen = SweepScreen(spec, scheduler="tcp://192.0.2.10:8786", connect_timeout=0.5)
+    app = _Host(screen)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        await pilot.press("f5")
+        await pilot.pause()
+        assert not screen.running and not list(screen.workers)
+        assert "run code on it" in screen.last_message  # says why
+        # a tls:// scheduler needs the certificates folder, named when incomplete
+        screen.query_one("#sweep-scheduler").value = "tls://192.0.2.10:8786"
+        screen.query_one("#sweep-certs").value = str(tmp_path)
+        await pilot.press("f5")
+        await pilot.pause()
+        assert not screen.running
+        assert "certificates" in screen.last_message and "ca.pem" in screen.last_message

@@ -114,3 +114,29 @@ def make_certificates(folder, days: int = 365) -> dict[str, Path]:
                                     serialization.NoEncryption()))
     os.chmod(paths["key"], 0o600)
     return paths
+
+
+def folder_security(address: str, folder=None, insecure: bool = False):
+    """``cluster_security`` for the three files in ``folder`` (as ``ladartui certs`` writes
+    them), with messages naming the folder rather than flags; None for a permitted plain
+    address. For the terminal UI, where one folder is simpler than three files."""
+    scheme = address.split("://", 1)[0] if "://" in address else "tcp"
+    if folder:
+        folder = Path(folder).expanduser()
+        missing = [name for name in (CA_FILE, CERT_FILE, KEY_FILE) if not (folder / name).is_file()]
+        if missing:
+            raise FieldError("certificates", str(folder), "a folder made by 'ladartui certs' "
+                             f"(missing: {', '.join(missing)})")
+        if scheme != "tls":
+            raise FieldError("scheduler", address, "a tls://HOST:PORT address to use the "
+                             "certificates with")
+        return cluster_security(address, folder / CA_FILE, folder / CERT_FILE,
+                                folder / KEY_FILE)
+    if scheme == "tls":
+        raise FieldError("certificates", "", f"the folder of the certificates for {address} "
+                         "(ladartui certs DIR makes them)")
+    if not insecure and not is_loopback(address):
+        raise FieldError("scheduler", address, "a tls:// address with its certificates, or a "
+                         "loopback address: any peer that reaches a plain tcp:// scheduler can "
+                         "run code on it, its workers and this machine (see docs/sweeps.md)")
+    return None

@@ -105,7 +105,7 @@ class SweepScreen(Screen):
     SweepScreen .sweep-row { height: 1; }
     SweepScreen .sweep-row Label { padding: 0 1; }
     SweepScreen #sweep-path { width: 1fr; }
-    SweepScreen #sweep-scheduler { width: 1fr; }
+    SweepScreen #sweep-scheduler, SweepScreen #sweep-certs { width: 1fr; }
     SweepScreen #sweep-budget { width: 9; }
     SweepScreen #sweep-serial { width: auto; margin-left: 1; }
     SweepScreen #sweep-progress { width: auto; padding: 0 1; }
@@ -120,13 +120,14 @@ class SweepScreen(Screen):
     """
 
     def __init__(self, spec_path=None, *, scheduler: str | None = None, serial: bool = False,
-                 connect_timeout: float = 30.0, **kwargs):
+                 connect_timeout: float = 30.0, certs=None, **kwargs):
         """``spec_path``: a sweep spec, results.csv or results folder to open at once;
         ``scheduler``: a Dask scheduler address to fill in; ``serial``: run without Dask."""
         super().__init__(**kwargs)
         self.connect_timeout = connect_timeout
         self.initial_path = str(spec_path) if spec_path else ""
         self.initial_scheduler = scheduler or ""
+        self.initial_certs = str(certs) if certs else ""
         self.serial = serial
         self.spec = None  # the SweepSpec launched or opened, when known
         self.out: Path | None = None  # the results folder shown
@@ -164,6 +165,10 @@ class SweepScreen(Screen):
                         valid_empty=True)
             yield Checkbox("serial", self.serial, id="sweep-serial", compact=True,
                            tooltip="run the variants in this process, without Dask")
+        with Horizontal(classes="sweep-row"):
+            yield Label("Certificates")
+            yield Input(self.initial_certs, id="sweep-certs", compact=True,
+                        placeholder="folder from 'ladartui certs' (for a tls:// scheduler)")
         with Horizontal(classes="sweep-row"):
             yield ProgressBar(id="sweep-progress", show_eta=False)
             yield Static("", id="sweep-counts")
@@ -249,13 +254,19 @@ class SweepScreen(Screen):
             if objective == "coverage-within-budget" and budget is None:
                 raise FieldError("budget", None, "a flight-time budget in seconds for "
                                  "objective 'coverage-within-budget'")
+            scheduler = self.query_one("#sweep-scheduler", Input).value.strip()
+            security = None
+            if scheduler:  # the same rules as the CLI: no plain scheduler off this machine
+                from ladartui.sweep.security import folder_security
+
+                security = folder_security(scheduler,
+                                           self.query_one("#sweep-certs", Input).value.strip())
         except LadarError as error:
             self._status(NOT_READY, str(error))
             return
         from ladartui.sweep import default_out_dir
         from ladartui.sweep.table import read_table
 
-        scheduler = self.query_one("#sweep-scheduler", Input).value.strip()
         serial = self.query_one("#sweep-serial", Checkbox).value and not scheduler
         self.spec, self.out = spec, default_out_dir(spec)
         self.objective, self.cost, self.budget = objective, cost, spec.budget
@@ -280,7 +291,8 @@ class SweepScreen(Screen):
                      f"{short_path(self.out)}", 0.0, cancellable=True)
         timeout = self.connect_timeout
         self.worker = start_job(self, "sweep", lambda cancel, progress: _sweep(
-            spec, scheduler, serial, objective, cost, budget, timeout, cancel, progress))
+            spec, scheduler, security, serial, objective, cost, budget, timeout, cancel,
+            progress))
 
     def action_open_results(self) -> None:
         """Open the results of an earlier (or running elsewhere) sweep."""
@@ -604,7 +616,7 @@ class SweepScreen(Screen):
         self.post_message(self.OpenScenario(path))
 
 
-def _sweep(spec, scheduler: str, serial: bool, objective: str, cost: str, budget,
+def _sweep(spec, scheduler: str, security, serial: bool, objective: str, cost: str, budget,
            connect_timeout: float, cancel, progress):
     """The sweep job (worker thread): every finished variant is a kept progress report."""
     from ladartui.sweep import connect, run_sweep
@@ -613,7 +625,7 @@ def _sweep(spec, scheduler: str, serial: bool, objective: str, cost: str, budget
     try:
         if scheduler:
             progress(0.0, f"connecting to {scheduler} ...")
-            client = connect(scheduler, connect_timeout)
+            client = connect(scheduler, connect_timeout, security)
         return run_sweep(spec, client=client, cancel=cancel, objective=objective, cost=cost,
                          budget=budget, serial=serial,
                          progress=lambda p: progress(p.fraction, "", p, keep=p.row is not None))
