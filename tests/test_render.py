@@ -68,6 +68,15 @@ def test_squares_grow_with_the_zoom_so_voxels_leave_no_gaps():
         assert block.shape[0] == pytest.approx(10 * 54 / 10 * zoom / 3, abs=2)
 
 
+def test_zoomed_in_far_beyond_the_splat_budget_the_squares_still_cover_what_is_in_view():
+    bounds = (np.zeros(3), np.array([299.0, 299.0, 0.0]))
+    floor = box((0, 0, 0), (299, 299, 0))  # 90,000 voxels
+    camera = framing.fit_camera(TOP, (np.array([140.0, 140, 0]), np.array([149.0, 149, 0])),
+                                400, 400, bounds)
+    image = render([Layer(floor, (200, 200, 200))], camera, 400, 400, bounds)
+    assert image.voxel_mask.all()  # 36-pixel squares, no gaps: only voxels in view count
+
+
 def test_a_threshold_rescales_the_colours_to_the_heights_that_remain():
     column = np.array([[0, 0, z] for z in range(21)])
     layers, (lo, hi) = output_layers(column, np.zeros((0, 3)), mode="height")
@@ -110,7 +119,7 @@ def test_output_classes_mark_what_the_foliage_hid():
     target = box((5, 5, 0), (6, 6, 1))  # 8 voxels
     seen = target[:3]
     scene_output = np.vstack([seen, [[0, 0, 5], [1, 1, 7]]])
-    target_output = target[:6]
+    target_output = np.vstack([target[:6], [[0, 0, 0], [9, 9, 0]]])  # and ground returns
     scene, target_seen, hidden = classify(scene_output, target, target_output)
     assert sorted(map(tuple, scene)) == [(0, 0, 5), (1, 1, 7)]
     assert sorted(map(tuple, target_seen)) == sorted(map(tuple, seen))

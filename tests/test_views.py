@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from ladartui import views
+from ladartui.render.raster import Layer, render
 from ladartui.views import Camera, TopView
 
 
@@ -100,21 +101,30 @@ def test_view_axes_are_orthonormal_and_match_the_compass():
 def test_projection_from_above_shows_the_highest_voxel_of_a_column():
     pts = np.array([[5, 5, 0], [5, 5, 9]])
     bounds = (np.zeros(3), np.array([10.0, 10.0, 9.0]))
-    shade, depth = views.render_points(pts, Camera(180.0, 90.0), 20, 20, bounds=bounds, levels=10)
-    drawn = np.argwhere(shade >= 0)
-    assert len(drawn) == 1
-    assert shade[tuple(drawn[0])] == 9  # top of the height range
+    image = render([Layer(pts)], Camera(180.0, 90.0), 20, 20, bounds)
+    drawn = image.rgb[image.voxel_mask]
+    assert 1 <= len(drawn) <= 4  # 1.3 pixels per voxel: a 2 x 2 square
+    assert (drawn == views.height_ramp()[-1]).all()  # only the top voxel shows
 
 
 def test_projection_side_view_keeps_the_nearer_point():
     # viewer due south (azimuth 180), level: y grows away from the viewer
     pts = np.array([[5, 8, 3], [5, 2, 3]])
     bounds = (np.zeros(3), np.array([10.0, 10.0, 6.0]))
-    shade, depth = views.render_points(pts, Camera(180.0, 0.0), 20, 20, bounds=bounds)
-    drawn = np.argwhere(shade >= 0)
-    assert len(drawn) == 1
+    image = render([Layer(pts)], Camera(180.0, 0.0), 20, 20, bounds)
+    assert 1 <= image.voxel_mask.sum() <= 4
     # depth is distance toward the viewer from the bounds' centre (y = 5): nearer point y = 2
-    assert depth[tuple(drawn[0])] == pytest.approx(5 - 2)
+    assert image.depth[image.voxel_mask] == pytest.approx(5 - 2)
+
+
+def test_a_camera_centred_on_a_point_keeps_it_in_the_middle_as_it_turns():
+    bounds = (np.zeros(3), np.array([100.0, 100.0, 20.0]))
+    for az in (0.0, 75.0, 210.0):
+        camera = Camera(az, 30.0, 8.0, centre=(80.0, 20.0, 2.0))
+        row, col, _, _ = views.project_float([[80.0, 20.0, 2.0]], camera, 30, 50, bounds)
+        assert (row[0], col[0]) == pytest.approx((15.0, 25.0))
+    assert Camera(10.0, 20.0, 3.0, centre=(1, 2, 3)).at_angle(400, 100) == Camera(
+        40.0, 90.0, 3.0, centre=(1, 2, 3))
 
 
 def test_zoom_and_pan_move_points_on_screen():

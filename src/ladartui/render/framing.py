@@ -10,10 +10,9 @@ import itertools
 
 import numpy as np
 
-from ladartui.views import Camera, view_axes
+from ladartui.views import MAX_ZOOM, MIN_ZOOM, Camera, view_axes
 
 MARGIN = 0.05   # of the image on each side
-MIN_ZOOM, MAX_ZOOM = 0.1, 1000.0
 
 
 def box_of(voxels) -> tuple[np.ndarray, np.ndarray] | None:
@@ -35,8 +34,8 @@ def fit_camera(camera: Camera, box, rows: int, cols: int, bounds,
     lo, hi = (np.asarray(b, float) for b in box)
     corners = np.array(list(itertools.product(*zip(lo - 0.5, hi + 0.5))))
     blo, bhi = (np.asarray(b, float) for b in bounds)
-    centre = (blo + bhi) / 2.0
     radius = max(float(np.linalg.norm(bhi - blo)) / 2.0, 0.5)
+    centre = (lo + hi) / 2.0  # the view then turns about the box
     right, up, _ = view_axes(camera.azimuth, camera.elevation)
     sx = (corners - centre) @ right
     sy = (corners - centre) @ up
@@ -45,9 +44,8 @@ def fit_camera(camera: Camera, box, rows: int, cols: int, bounds,
     usable = 1.0 - 2.0 * margin
     scale = min(cols * usable / width, rows * usable / height)  # pixels per voxel unit
     zoom = float(np.clip(scale * 2.0 * radius / max(min(cols, rows), 1), MIN_ZOOM, MAX_ZOOM))
-    pan_x = -float(sx.min() + sx.max()) / 2.0 / (2.0 * radius)
-    pan_y = -float(sy.min() + sy.max()) / 2.0 / (2.0 * radius)
-    return Camera(camera.azimuth, camera.elevation, zoom, pan_x, pan_y)
+    return Camera(camera.azimuth, camera.elevation, zoom, 0.0, 0.0,
+                  tuple(float(v) for v in centre))
 
 
 def fit_window(box, margin: float = MARGIN) -> tuple[float, float, float, float]:

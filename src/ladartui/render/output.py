@@ -39,13 +39,19 @@ def below(voxels, voxel_size: float, threshold_m: float | None) -> np.ndarray:
 
 
 def classify(scene_output, target_model, target_output=None):
-    """(scene voxels, target seen, target hidden) of a run's outputs."""
+    """(scene voxels, target seen, target hidden) of a run's outputs.
+
+    ``target_output`` is the run of the target alone: its target voxels not in
+    the scene output are the hidden ones (its ground returns are not target).
+    """
     scene_output = np.asarray(scene_output).reshape(-1, 3)
     is_target = in_set(scene_output, target_model)
     hidden = np.zeros((0, 3), np.int32)
     if target_output is not None and len(target_output):
         target_output = np.asarray(target_output).reshape(-1, 3)
-        hidden = target_output[~in_set(target_output, scene_output)]
+        # the target-only run also returns the ground around the target: not target
+        on_target = target_output[in_set(target_output, target_model)]
+        hidden = on_target[~in_set(on_target, scene_output)]
     return scene_output[~is_target], scene_output[is_target], hidden
 
 

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ladartui.render import colour
-from ladartui.views import Camera, Picture, draw_points, draw_polyline, view_axes
+from ladartui.views import Camera, Picture, draw_points, draw_polyline, project_float
 
 MAX_SPLAT_SAMPLES = 6_000_000  # pixel writes per render; squares shrink beyond it
 OVERLAYS = ("path", "scans", "footprints")
@@ -54,21 +54,8 @@ class Rendering(Picture):
 
 
 def screen_coordinates(points, camera: Camera, rows: int, cols: int, bounds):
-    """(N, 3) points -> float pixel row, col, depth and the pixels per voxel unit.
-
-    A pixel (r, c) covers [r, r + 1) x [c, c + 1); ``views.project`` is the floor
-    of this.
-    """
-    pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    lo, hi = (np.asarray(b, float) for b in bounds)
-    centre = (lo + hi) / 2.0
-    radius = max(float(np.linalg.norm(hi - lo)) / 2.0, 0.5)
-    right, up, toward = view_axes(camera.azimuth, camera.elevation)
-    rel = pts - centre
-    scale = camera.zoom * min(cols, rows) / (2.0 * radius)
-    col = cols / 2.0 + (rel @ right + camera.pan_x * 2.0 * radius) * scale
-    row = rows / 2.0 - (rel @ up + camera.pan_y * 2.0 * radius) * scale
-    return row, col, rel @ toward, scale
+    """(N, 3) points -> float pixel row, col, depth and pixels per voxel unit."""
+    return project_float(points, camera, rows, cols, bounds)
 
 
 def splat_side(scale: float, count: int) -> int:
@@ -118,14 +105,16 @@ def _splat(image: Rendering, parts, camera, bounds) -> None:
     colours = np.concatenate([p[1] for p in parts])
     priority = np.concatenate([np.full(len(p[0]), p[2], np.int32) for p in parts])
     row, col, depth, scale = screen_coordinates(pts, camera, rows, cols, bounds)
-    side = splat_side(scale, len(pts))
+    reach = max(1.0, scale)  # a square reaches half its side beyond the voxel's centre
+    near = (row > -reach) & (row < rows + reach) & (col > -reach) & (col < cols + reach)
+    if not near.any():
+        return
+    row, col, depth, colours, priority = (row[near], col[near], depth[near], colours[near],
+                                          priority[near])
+    side = splat_side(scale, len(row))
     # the square's top-left pixel: centred on the voxel's projected centre
     r0 = np.floor(row - side / 2.0 + 0.5).astype(np.int64)
     c0 = np.floor(col - side / 2.0 + 0.5).astype(np.int64)
-    near = (r0 + side > 0) & (r0 < rows) & (c0 + side > 0) & (c0 < cols)
-    if not near.any():
-        return
-    r0, c0, depth, colours, priority = r0[near], c0[near], depth[near], colours[near], priority[near]
     offsets = np.arange(side)
     rr = (r0[:, None, None] + offsets[None, :, None]).repeat(side, axis=2).reshape(-1)
     cc = (c0[:, None, None] + offsets[None, None, :]).repeat(side, axis=1).reshape(-1)
