@@ -11,6 +11,7 @@ from ladartui.render.raster import Layer, Overlays, render, screen_coordinates
 from ladartui.views import Camera
 
 TOP = Camera(180.0, 90.0)  # looking straight down, north up, east right
+TARGET = colour.TARGET_RGB
 
 
 def box(lo, hi):
@@ -161,13 +162,25 @@ def test_colour_maps_are_monotone_in_lightness_and_distinct_from_the_target():
 
 def test_overlays_are_drawn_over_the_voxels_and_can_be_switched_off():
     bounds = (np.zeros(3), np.array([20.0, 20.0, 10.0]))
-    floor = box((0, 0, 0), (20, 20, 0))
+    floor = box((0, 8, 0), (20, 12, 0))  # a strip under the path, across the footprint
+    post = box((10, 5, 0), (10, 5, 6))  # a voxel column standing on a footprint edge
     path = np.array([[0.0, 10, 8], [20.0, 10, 8]])
     overlays = Overlays(path=path, scans=path, footprints=[np.array([[5.0, 5, 0], [15, 5, 0],
                                                                     [15, 15, 0], [5, 15, 0]])])
     image = render([Layer(floor, (90, 90, 90))], TOP, 40, 40, bounds, overlays=overlays)
     for rgb in (colour.PATH_RGB, colour.SCAN_RGB, colour.START_RGB, colour.FOOTPRINT_RGB):
         assert is_rgb(image, rgb).any(), rgb
+    strip = is_rgb(image, (90, 90, 90))
+    rows = np.nonzero(strip.any(axis=1))[0]
+    assert not is_rgb(image, colour.FOOTPRINT_RGB)[rows].any()  # under the voxels
+    assert is_rgb(image, colour.PATH_RGB)[rows].any()           # over them
+    # footprints lie on the ground: voxels hide them, the flight path stays on top
+    side = Camera(180.0, 10.0)
+    image = render([Layer(post, TARGET)], side, 40, 40, bounds, overlays=overlays)
+    column = is_rgb(image, TARGET)
+    assert column.any() and is_rgb(image, colour.FOOTPRINT_RGB).any()
+    image_without = render([Layer(post, TARGET)], side, 40, 40, bounds)
+    assert np.array_equal(column, is_rgb(image_without, TARGET) & ~is_rgb(image, colour.PATH_RGB))
     overlays.shown = frozenset({"path"})
     image = render([Layer(floor, (90, 90, 90))], TOP, 40, 40, bounds, overlays=overlays)
     assert is_rgb(image, colour.PATH_RGB).any()

@@ -5,7 +5,8 @@ the scene and output views line up). Each voxel is splatted as a square of
 its projected size; where squares overlap, the nearest voxel wins (larger
 depth is nearer the viewer), and at equal depth the layer drawn later wins
 (the target over the scene voxel it shares). Overlays (flight path, scan
-positions, footprints) are drawn over the voxels, each one switchable.
+positions) are drawn over the voxels, footprints under them (they lie on the
+ground), each one switchable.
 Nothing here imports textual.
 """
 
@@ -92,10 +93,13 @@ def render(layers, camera: Camera, rows: int, cols: int, bounds, *, height_range
         else:
             colours = np.broadcast_to(np.array(layer.rgb, np.uint8), (len(pts), 3))
         parts.append((pts, colours, priority))
+    if overlays is not None and "footprints" in overlays.shown:
+        # footprints lie on the ground: under the voxels, never over the target
+        draw_footprints(image, overlays, camera, bounds)
     if parts:
         _splat(image, parts, camera, bounds)
     if overlays is not None:
-        draw_overlays(image, overlays, camera, bounds)
+        draw_flight(image, overlays, camera, bounds)
     return image
 
 
@@ -139,15 +143,18 @@ def _pixels(points, camera, image, bounds) -> np.ndarray:
     return np.stack([row, col], axis=1)
 
 
-def draw_overlays(image: Rendering, overlays: Overlays, camera: Camera, bounds) -> None:
-    """Footprints, then the path, then the scans (the first one marked as the start)."""
+def draw_footprints(image: Rendering, overlays: Overlays, camera: Camera, bounds) -> None:
+    """The sensor footprints, closed polygons."""
+    for polygon in overlays.footprints or ():
+        if polygon is None or len(polygon) < 2:
+            continue
+        pix = _pixels(polygon, camera, image, bounds)
+        draw_polyline(image, np.vstack([pix, pix[:1]]), colour.FOOTPRINT_RGB)
+
+
+def draw_flight(image: Rendering, overlays: Overlays, camera: Camera, bounds) -> None:
+    """The path, then the scans (the first one marked as the start), over everything."""
     shown = overlays.shown
-    if "footprints" in shown:
-        for polygon in overlays.footprints or ():
-            if polygon is None or len(polygon) < 2:
-                continue
-            pix = _pixels(polygon, camera, image, bounds)
-            draw_polyline(image, np.vstack([pix, pix[:1]]), colour.FOOTPRINT_RGB)
     if "path" in shown and overlays.path is not None and len(overlays.path) >= 2:
         draw_polyline(image, _pixels(overlays.path, camera, image, bounds), colour.PATH_RGB)
     if "scans" in shown and overlays.scans is not None and len(overlays.scans):

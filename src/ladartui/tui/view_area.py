@@ -110,11 +110,11 @@ class ViewArea(Container):
         if self.prepared is not None and poses:
             markers = np.array([p.position for p in poses]) / self.voxel_size
             self.markers = markers
-            lo, hi = self.prepared["bounds"]
-            bounds = (np.minimum(lo, markers.min(axis=0)), np.maximum(hi, markers.max(axis=0)))
             ground = [f / self.voxel_size for f in footprints]
+            # the views frame the scene (the path may leave them: p fits it), so that
+            # editing the path never moves the picture
             for widget in self.query(ProjectionWidget):
-                widget.set_markers(markers, bounds, ground)
+                widget.set_markers(markers, self.prepared["bounds"], ground)
 
     # -- the output view -----------------------------------------------------------
 
