@@ -147,9 +147,17 @@ async def test_output_colours_show_what_the_foliage_hid_and_switch_to_height(app
     await pilot.press("c")
     assert "(height)" not in output3d.border_title
     # the threshold keeps the target, drops the canopy and spreads the colours over what is left
-    area.show_output(np.vstack([canopy, seen]), 2.0, target_output=target)
-    assert len(output3d.voxel_layers[0].voxels) == 0
+    ground = np.array([[x, y, 0] for x in range(10) for y in range(10)])
+    area.show_output(np.vstack([canopy, ground, seen]), 2.0, target_output=target)
+    assert len(output3d.voxel_layers[0].voxels) == len(ground)
     assert output3d.height_range == (0.0, max(float(target[:, 2].max()), 1.0))
+    # what the view draws keeps a contrast of 3 against its background, in both colourings
+    for _ in range(2):
+        await pilot.press("c")
+        image = output3d.make_picture(*output3d.picture_size())
+        drawn = np.unique(image.rgb[image.voxel_mask], axis=0)
+        assert len(drawn) >= 2 and (~image.mask).any()
+        assert colour.contrast_ratio(drawn, colour.BACKGROUND).min() >= 3.0
 
 
 @pytest.mark.asyncio(loop_scope="module")
