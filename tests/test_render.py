@@ -185,3 +185,22 @@ def test_overlays_are_drawn_over_the_voxels_and_can_be_switched_off():
     image = render([Layer(floor, (90, 90, 90))], TOP, 40, 40, bounds, overlays=overlays)
     assert is_rgb(image, colour.PATH_RGB).any()
     assert not is_rgb(image, colour.FOOTPRINT_RGB).any() and not is_rgb(image, colour.SCAN_RGB).any()
+
+
+def test_scan_counts_colour_the_target_by_how_many_scans_saw_it():
+    from ladartui.render.output import scan_counts
+
+    target = box((0, 0, 0), (2, 0, 0))  # three voxels
+    per_scan = [target[:1], target[:2], target[:2], np.zeros((0, 3), np.int32)]
+    assert scan_counts(target, per_scan).tolist() == [3, 2, 0]
+    ground = box((0, 2, 0), (2, 2, 0))
+    layers, _ = output_layers(np.vstack([ground, target[:2]]), target, mode="scans",
+                              per_scan=per_scan)
+    assert [len(layer.voxels) for layer in layers] == [3, 2]
+    bounds = (np.zeros(3), np.array([2.0, 2.0, 0.0]))
+    image = render(layers, TOP, 30, 30, bounds)
+    table = colour.height_map()
+    seen = {tuple(c) for c in image.rgb[image.voxel_mask]}
+    # 3 of 4 scans and 2 of 4 scans: colours half and a quarter of the way up the map
+    assert tuple(table[int(2 / 4 * len(table))]) in seen
+    assert tuple(table[int(1 / 4 * len(table))]) in seen

@@ -146,6 +146,18 @@ async def test_output_colours_show_what_the_foliage_hid_and_switch_to_height(app
     assert [layer.rgb for layer in output3d.voxel_layers] == [None, colour.TARGET_RGB]
     await pilot.press("c")
     assert "(height)" not in output3d.border_title
+    # with each scan's returns, a third colouring counts the scans that saw each target voxel
+    area.show_output(np.vstack([canopy, seen]), None, target_output=target,
+                     per_scan=[seen, seen[:3]])
+    await pilot.press("c", "c")
+    assert "scans that saw it" in output3d.border_title
+    values = output3d.voxel_layers[1].values
+    assert sorted(values.tolist()) == sorted([2] * 3 + [1] * (len(seen) - 3))
+    await pilot.press("c")
+    assert "scans" not in output3d.border_title and "(height)" not in output3d.border_title
+    area.show_output(np.vstack([canopy, seen]), None, target_output=target)  # no per-scan data
+    await pilot.press("c", "c")
+    assert "scans" not in output3d.border_title and "(height)" not in output3d.border_title
     # the threshold keeps the target, drops the canopy and spreads the colours over what is left
     ground = np.array([[x, y, 0] for x in range(10) for y in range(10)])
     area.show_output(np.vstack([canopy, ground, seen]), 2.0, target_output=target)

@@ -15,7 +15,7 @@ import numpy as np
 from ladartui.render import colour
 from ladartui.render.raster import Layer
 
-COLOUR_MODES = ("class", "height")
+COLOUR_MODES = ("class", "height", "scans")
 
 
 def _keys(voxels) -> np.ndarray:
@@ -55,13 +55,26 @@ def classify(scene_output, target_model, target_output=None):
     return scene_output[~is_target], scene_output[is_target], hidden
 
 
+def scan_counts(voxels, per_scan) -> np.ndarray:
+    """How many of the scans' return lists (each (K, 3), unique) hold each voxel."""
+    voxels = np.asarray(voxels).reshape(-1, 3)
+    counts = np.zeros(len(voxels), np.int32)
+    keys = _keys(voxels)
+    for returns in per_scan or ():
+        if len(returns):
+            counts += np.isin(keys, _keys(returns))
+    return counts
+
+
 def output_layers(scene_output, target_model, target_output=None, *, mode: str = "class",
-                  voxel_size: float = 1.0, threshold_m: float | None = None):
+                  voxel_size: float = 1.0, threshold_m: float | None = None, per_scan=None):
     """(layers, height_range) for ``raster.render``: the output after the threshold.
 
     ``mode`` "class" draws scene voxels in greys by height and the target
     classes in their colours; "height" shades the obscured output by height
-    (the target still in its colour). The height range runs from the ground
+    (the target still in its colour); "scans" draws scene voxels in greys and
+    colours the target voxels seen by how many scans saw them (1 .. the
+    number of scans in ``per_scan``). The height range runs from the ground
     to the highest voxel that remains, so a threshold spreads the colours over
     what is left.
     """
@@ -72,6 +85,10 @@ def output_layers(scene_output, target_model, target_output=None, *, mode: str =
     if mode == "class":
         layers = [Layer(scene, colour_map="scene-grey"), Layer(hidden, colour.HIDDEN_RGB),
                   Layer(seen, colour.TARGET_RGB)]
+    elif mode == "scans":
+        scans = max(len(per_scan or ()), 1)
+        layers = [Layer(scene, colour_map="scene-grey"),
+                  Layer(seen, values=scan_counts(seen, per_scan), value_range=(1, scans + 1))]
     else:
         layers = [Layer(scene), Layer(seen, colour.TARGET_RGB)]
     shown = [layer.voxels for layer in layers if len(layer.voxels)]

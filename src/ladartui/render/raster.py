@@ -25,12 +25,15 @@ OVERLAYS = ("path", "scans", "footprints")
 
 @dataclass
 class Layer:
-    """Voxels (N, 3 voxel indices) drawn in one colour ``rgb``, or else shaded by height
-    with ``colour_map`` (None: the view's)."""
+    """Voxels (N, 3 voxel indices) drawn in one colour ``rgb``, or else shaded with
+    ``colour_map`` (None: the view's) by height, or by ``values`` (N,) over
+    ``value_range`` when given."""
 
     voxels: np.ndarray
     rgb: tuple[int, int, int] | None = None
     colour_map: str | None = None
+    values: np.ndarray | None = None
+    value_range: tuple[float, float] | None = None
 
 
 @dataclass
@@ -89,7 +92,11 @@ def render(layers, camera: Camera, rows: int, cols: int, bounds, *, height_range
             continue
         if layer.rgb is None:
             table = colour.colour_map(layer.colour_map or colour_map)
-            colours = colour.shade(pts[:, 2], height_range[0], height_range[1], table)
+            if layer.values is not None:
+                lo, hi = layer.value_range or (np.min(layer.values), np.max(layer.values))
+                colours = colour.shade(layer.values, lo, hi, table)
+            else:
+                colours = colour.shade(pts[:, 2], height_range[0], height_range[1], table)
         else:
             colours = np.broadcast_to(np.array(layer.rgb, np.uint8), (len(pts), 3))
         parts.append((pts, colours, priority))

@@ -92,7 +92,7 @@ VIEW_BINDINGS = [
     Binding("t", "view_request('fit_target')", "Zoom to target (every view)", show=False),
     Binding("f", "view_request('fit_scene')", "Fit scene (every view)", show=False),
     Binding("p", "view_request('fit_path')", "Fit flight path (every view)", show=False),
-    Binding("c", "view_request('cycle_output_colour')", "Output: classes / height",
+    Binding("c", "view_request('cycle_output_colour')", "Output: classes / height / scans",
             show=False),
     Binding("g", "view_request('toggle_grey')", "Colour / grey shading", show=False),
     Binding("o", "view_request('cycle_overlays')", "Overlays: all / path / none",

@@ -59,7 +59,8 @@ class ViewArea(Container):
         self.colour_map = "height"      # or "grey": the report's 56 shades
         self.overlays = OVERLAY_CYCLE[0]
         self.markers = None             # scan positions, voxel units
-        self._output_args = (None, None, OUTPUT_POINTS, None)
+        self._output_args = (None, None, OUTPUT_POINTS, None, None)
+        self.per_scan_known = False  # the output shown has per-scan returns ("scans" mode)
         self._target_file_cache: tuple | None = None
 
     def compose(self):
@@ -119,20 +120,30 @@ class ViewArea(Container):
     # -- the output view -----------------------------------------------------------
 
     def show_output(self, voxels, threshold: float | None, limit: int = OUTPUT_POINTS,
-                    target_output=None) -> None:
+                    target_output=None, per_scan=None) -> None:
         """The scene output after the threshold, coloured by ``output_mode``.
 
         ``target_output`` (the target traced without foliage) marks what the
         foliage hid; when not given it is taken from the app's last run, or
         from the scenario's target output file when the output came from disk.
+        ``per_scan`` (each scan's scene returns) counts the scans that saw each
+        target voxel; when not given it is the app's last run's, if that run
+        made this output (files on disk do not keep it).
         """
-        self._output_args = (voxels, threshold, limit, target_output)
+        self._output_args = (voxels, threshold, limit, target_output, per_scan)
+        if per_scan is None:
+            per_scan = self._known_per_scan(voxels)
+        self.per_scan_known = per_scan is not None
+        if self.output_mode == "scans" and per_scan is None:
+            self.output_mode = "class"
         widget = self.query_one("#output3d", ProjectionWidget)
         title = "3D output"
         if threshold is not None:
             title += f" <= {threshold:g} m"
         if self.output_mode == "height":
             title += " (height)"
+        elif self.output_mode == "scans":
+            title += " (target: scans that saw it)"
         widget.base_title = title
         widget._update_title()
         if voxels is None or self.prepared is None:
@@ -145,7 +156,8 @@ class ViewArea(Container):
         scene = views.subsample(scene, limit, seed=0)
         layers, heights = output_layers(
             np.concatenate([scene, seen]), self.prepared["target"], hidden,
-            mode=self.output_mode, voxel_size=self.voxel_size, threshold_m=threshold)
+            mode=self.output_mode, voxel_size=self.voxel_size, threshold_m=threshold,
+            per_scan=per_scan)
         shown = views.threshold_points(np.concatenate([scene, seen]), self.voxel_size,
                                        threshold)
         widget.placeholder = "nothing below the threshold" if len(voxels) else "no returns"
@@ -155,6 +167,12 @@ class ViewArea(Container):
         widget.set_layers(layers, shown,
                           widget.bounds if widget.bounds is not None else self.prepared["bounds"],
                           self.voxel_size, height_range=heights)
+
+    def _known_per_scan(self, voxels):
+        result = getattr(self.app, "result", None)
+        if voxels is not None and result is not None and result.scene_output is voxels:
+            return result.scene_per_scan
+        return None
 
     def _known_target_output(self, voxels):
         # the run's own target output, or the file written beside the scene output
@@ -175,8 +193,7 @@ class ViewArea(Container):
             return None
 
     def _redraw_output(self) -> None:
-        voxels, threshold, limit, target_output = self._output_args
-        self.show_output(voxels, threshold, limit, target_output)
+        self.show_output(*self._output_args)
 
     # -- requests for every view (keys t f p c g o in any view) --------------------
 
@@ -210,9 +227,11 @@ class ViewArea(Container):
         self.query_one(TopViewWidget).fit("path")
 
     def cycle_output_colour(self) -> None:
-        """Output coloured by voxel class, or by height."""
-        modes = COLOUR_MODES
-        self.output_mode = modes[(modes.index(self.output_mode) + 1) % len(modes)]
+        """Output coloured by voxel class, by height, or by scans that saw the target (when
+        the output came from a run in this session)."""
+        modes = [m for m in COLOUR_MODES if m != "scans" or self.per_scan_known]
+        index = modes.index(self.output_mode) if self.output_mode in modes else -1
+        self.output_mode = modes[(index + 1) % len(modes)]
         self._redraw_output()
 
     def toggle_grey(self) -> None:
