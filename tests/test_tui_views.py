@@ -99,6 +99,12 @@ async def test_zoom_to_target_frames_the_target_in_every_view(app_pilot):
     await pilot.press("right")
     row, col, rows, cols = target_pixels(scene3d, box)
     assert (row.mean(), col.mean()) == pytest.approx((rows / 2, cols / 2), abs=1.0)
+    # a scene loaded again is framed whole again, at the same angles
+    azimuth = scene3d.camera.azimuth
+    area.set_scene(area.prepared, area.voxel_size)
+    await pilot.pause()
+    assert scene3d.camera.centre is None and scene3d.camera.zoom == 1.0
+    assert scene3d.camera.azimuth == azimuth and top.framing == "path"
 
 
 @pytest.mark.asyncio(loop_scope="module")

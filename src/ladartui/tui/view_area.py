@@ -13,6 +13,7 @@ from ladartui.render import framing, png
 from ladartui.render.output import COLOUR_MODES, classify, output_layers, scene_layers
 from ladartui.render.raster import OVERLAYS
 from ladartui.tui.canvas import PictureWidget, ProjectionWidget, TopViewWidget
+from ladartui.views import Camera
 
 SCENE_POINTS = 80_000  # voxels drawn in the 3D scene view, whatever the scene size
 OUTPUT_POINTS = 80_000
@@ -80,6 +81,11 @@ class ViewArea(Container):
         top = float(prepared["bounds"][1][2])
         for widget in self.query(ProjectionWidget):
             widget.height_top = top
+            # a new scene: keep the angles, frame the scene again (a centre or a pending
+            # fit of the old one would point elsewhere)
+            widget.camera = Camera(widget.camera.azimuth, widget.camera.elevation)
+            widget.pending_fit = None
+            widget._update_title()
         self.query_one("#scene3d", ProjectionWidget).set_layers(
             scene_layers(prepared["points"], prepared["target"]), prepared["points"],
             prepared["bounds"], voxel_size, height_range=(0.0, top))
