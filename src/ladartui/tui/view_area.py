@@ -15,7 +15,7 @@ from ladartui.render.raster import OVERLAYS
 from ladartui.tui.canvas import PictureWidget, ProjectionWidget, TopViewWidget
 from ladartui.views import Camera
 
-SCENE_POINTS = 80_000  # voxels drawn in the 3D scene view, whatever the scene size
+SCENE_POINTS = 150_000  # voxels drawn in the 3D scene view (all of the small scene)
 OUTPUT_POINTS = 80_000
 MAX_FOOTPRINTS = 400
 # the overlay sets the 'o' key steps through
