@@ -204,3 +204,15 @@ def test_scan_counts_colour_the_target_by_how_many_scans_saw_it():
     # 3 of 4 scans and 2 of 4 scans: colours half and a quarter of the way up the map
     assert tuple(table[int(2 / 4 * len(table))]) in seen
     assert tuple(table[int(1 / 4 * len(table))]) in seen
+
+
+def test_the_top_view_window_zooms_about_a_point_that_stays_put_and_pans_by_fractions():
+    frame = (0.0, 0.0, 100.0, 50.0)
+    assert framing.zoom_window(frame, 2.0) == (25.0, 12.5, 75.0, 37.5)
+    zoomed = framing.zoom_window(frame, 2.0, about=(80.0, 10.0))
+    assert zoomed == (40.0, 5.0, 90.0, 30.0)
+    # the point keeps its place: 80 % across, 20 % up, before and after
+    assert ((80 - zoomed[0]) / (zoomed[2] - zoomed[0]), (10 - zoomed[1]) / (zoomed[3] - zoomed[1])) \
+        == (0.8, 0.2)
+    assert framing.zoom_window(frame, 1000.0)[2] - framing.zoom_window(frame, 1000.0)[0] == 2.0
+    assert framing.pan_window(frame, 0.1, -0.2) == (10.0, -10.0, 110.0, 40.0)

@@ -7,6 +7,7 @@ import time
 import numpy as np
 import pytest
 import pytest_asyncio
+from textual import events
 
 from ladartui.errors import LadarError
 from ladartui.flight import FlightPlan, Orbit
@@ -131,6 +132,15 @@ async def test_top_view_zooms_pans_and_goes_back_to_the_path(app_pilot):
     assert top.frame == frame
     await pilot.press("0")
     assert top.frame == start and top.border_title == "Top view"
+    # the wheel zooms about the point under the pointer (cell 10, 5 of the content area)
+    rows, cols = top.picture_size()
+    under = top.top.to_cells(2 * 5 + 1, 10.5, rows, cols, top.frame)
+    # the pilot's own mouse-event helper (textual is pinned)
+    await pilot._post_mouse_events([events.MouseScrollUp], top, offset=(11, 6))
+    await pilot.pause()
+    x0, y0, x1, y1 = top.frame
+    assert x1 - x0 == pytest.approx((start[2] - start[0]) / 1.25)
+    assert top.top.to_cells(2 * 5 + 1, 10.5, rows, cols, top.frame) == pytest.approx(under)
 
 
 @pytest.mark.asyncio(loop_scope="module")

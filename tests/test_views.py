@@ -78,6 +78,15 @@ def test_overlays_mark_scans_path_and_footprint_without_redrawing_the_scene():
     assert top.renders == 1  # the scene layer was drawn once and reused
 
 
+def test_a_pixel_maps_back_to_the_cell_under_it():
+    top = TopView(np.zeros((20, 10), np.int32), voxel_size=0.5)
+    frame = (-5.0, -2.0, 25.0, 12.0)
+    xy_m = np.array([[3.0, 1.5], [9.75, 4.0]])
+    pixels = top.to_pixels(xy_m, 30, 70, frame)
+    for (row, col), (x, y) in zip(pixels, xy_m):
+        assert top.to_cells(row, col, 30, 70, frame) == pytest.approx((x / 0.5 + 0.5, y / 0.5 + 0.5))
+
+
 def test_frame_grows_to_hold_a_flight_path_outside_the_scene():
     top = TopView(np.zeros((16, 16), np.int32), voxel_size=1.0)
     frame = top.frame_for(np.array([[-40.0, 8.0], [56.0, 8.0]]))

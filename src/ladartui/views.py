@@ -151,6 +151,12 @@ class TopView:
         row = (frame[3] - cells[:, 1]) / scale + off_r
         return np.stack([row, col], axis=1)
 
+    def to_cells(self, row: float, col: float, rows: int, cols: int, frame=None):
+        """The cell-space (x, y) under a pixel position (the inverse of ``to_pixels``)."""
+        frame = frame or self.scene_frame()
+        scale, off_c, off_r = self.fit(rows, cols, frame)
+        return frame[0] + (col - off_c) * scale, frame[3] - (row - off_r) * scale
+
     def scene_layer(self, rows: int, cols: int, frame=None) -> Picture:
         """The height-shaded scene at this pixel size and frame (cached; do not modify)."""
         frame = tuple(frame or self.scene_frame())

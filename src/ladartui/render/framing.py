@@ -57,14 +57,17 @@ def fit_window(box, margin: float = MARGIN) -> tuple[float, float, float, float]
     return (float(x0 - pad), float(y0 - pad), float(x1 + pad), float(y1 + pad))
 
 
-def zoom_window(frame, factor: float, min_size: float = 2.0,
+def zoom_window(frame, factor: float, about=None, min_size: float = 2.0,
                 max_size: float = 1e7) -> tuple[float, float, float, float]:
-    """``frame`` zoomed in by ``factor`` (> 1 shows less) about its centre."""
+    """``frame`` zoomed in by ``factor`` (> 1 shows less) about a point (cell units;
+    default its centre), which stays where it was in the window."""
     x0, y0, x1, y1 = frame
-    cx, cy = (x0 + x1) / 2.0, (y0 + y1) / 2.0
-    half_w = np.clip((x1 - x0) / 2.0 / factor, min_size / 2.0, max_size)
-    half_h = np.clip((y1 - y0) / 2.0 / factor, min_size / 2.0, max_size)
-    return (float(cx - half_w), float(cy - half_h), float(cx + half_w), float(cy + half_h))
+    cx, cy = ((x0 + x1) / 2.0, (y0 + y1) / 2.0) if about is None else about
+    width = float(np.clip((x1 - x0) / factor, min_size, max_size))
+    height = float(np.clip((y1 - y0) / factor, min_size, max_size))
+    sx, sy = width / (x1 - x0), height / (y1 - y0)
+    return (float(cx - (cx - x0) * sx), float(cy - (cy - y0) * sy),
+            float(cx + (x1 - cx) * sx), float(cy + (y1 - cy) * sy))
 
 
 def pan_window(frame, dx: float, dy: float) -> tuple[float, float, float, float]:

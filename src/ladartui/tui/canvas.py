@@ -231,10 +231,10 @@ class TopViewWidget(PictureWidget):
             title += f" {width * self.top.voxel_size:.3g} m across"
         self.border_title = title
 
-    def action_zoom(self, factor: float) -> None:
+    def action_zoom(self, factor: float, about=None) -> None:
         if self.top is None or self.frame is None:
             return
-        self.frame = framing.zoom_window(self.frame, factor)
+        self.frame = framing.zoom_window(self.frame, factor, about)
         self.framing = "manual"
         self._update_title()
         self.invalidate()
@@ -250,13 +250,21 @@ class TopViewWidget(PictureWidget):
     def action_reset_view(self) -> None:
         self.fit("path")
 
-    def on_mouse_scroll_up(self, event: events.MouseScrollUp) -> None:
+    def _wheel(self, event, factor: float) -> None:
+        # the wheel zooms about the point under the pointer
         event.stop()
-        self.action_zoom(1.25)
+        offset = event.get_content_offset(self)
+        about = None
+        if offset is not None and self.top is not None and self.frame is not None:
+            rows, cols = self.picture_size()
+            about = self.top.to_cells(2 * offset.y + 1, offset.x + 0.5, rows, cols, self.frame)
+        self.action_zoom(factor, about)
+
+    def on_mouse_scroll_up(self, event: events.MouseScrollUp) -> None:
+        self._wheel(event, 1.25)
 
     def on_mouse_scroll_down(self, event: events.MouseScrollDown) -> None:
-        event.stop()
-        self.action_zoom(0.8)
+        self._wheel(event, 0.8)
 
     def make_picture(self, rows, cols):
         if self.top is None:
