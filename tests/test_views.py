@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from ladartui import views
+from ladartui.render.raster import Layer, render
 from ladartui.views import Camera, TopView
 
 
@@ -77,6 +78,15 @@ def test_overlays_mark_scans_path_and_footprint_without_redrawing_the_scene():
     assert top.renders == 1  # the scene layer was drawn once and reused
 
 
+def test_a_pixel_maps_back_to_the_cell_under_it():
+    top = TopView(np.zeros((20, 10), np.int32), voxel_size=0.5)
+    frame = (-5.0, -2.0, 25.0, 12.0)
+    xy_m = np.array([[3.0, 1.5], [9.75, 4.0]])
+    pixels = top.to_pixels(xy_m, 30, 70, frame)
+    for (row, col), (x, y) in zip(pixels, xy_m):
+        assert top.to_cells(row, col, 30, 70, frame) == pytest.approx((x / 0.5 + 0.5, y / 0.5 + 0.5))
+
+
 def test_frame_grows_to_hold_a_flight_path_outside_the_scene():
     top = TopView(np.zeros((16, 16), np.int32), voxel_size=1.0)
     frame = top.frame_for(np.array([[-40.0, 8.0], [56.0, 8.0]]))
@@ -100,21 +110,30 @@ def test_view_axes_are_orthonormal_and_match_the_compass():
 def test_projection_from_above_shows_the_highest_voxel_of_a_column():
     pts = np.array([[5, 5, 0], [5, 5, 9]])
     bounds = (np.zeros(3), np.array([10.0, 10.0, 9.0]))
-    shade, depth = views.render_points(pts, Camera(180.0, 90.0), 20, 20, bounds=bounds, levels=10)
-    drawn = np.argwhere(shade >= 0)
-    assert len(drawn) == 1
-    assert shade[tuple(drawn[0])] == 9  # top of the height range
+    image = render([Layer(pts)], Camera(180.0, 90.0), 20, 20, bounds)
+    drawn = image.rgb[image.voxel_mask]
+    assert 1 <= len(drawn) <= 4  # 1.3 pixels per voxel: a 2 x 2 square
+    assert (drawn == views.height_ramp()[-1]).all()  # only the top voxel shows
 
 
 def test_projection_side_view_keeps_the_nearer_point():
     # viewer due south (azimuth 180), level: y grows away from the viewer
     pts = np.array([[5, 8, 3], [5, 2, 3]])
     bounds = (np.zeros(3), np.array([10.0, 10.0, 6.0]))
-    shade, depth = views.render_points(pts, Camera(180.0, 0.0), 20, 20, bounds=bounds)
-    drawn = np.argwhere(shade >= 0)
-    assert len(drawn) == 1
+    image = render([Layer(pts)], Camera(180.0, 0.0), 20, 20, bounds)
+    assert 1 <= image.voxel_mask.sum() <= 4
     # depth is distance toward the viewer from the bounds' centre (y = 5): nearer point y = 2
-    assert depth[tuple(drawn[0])] == pytest.approx(5 - 2)
+    assert image.depth[image.voxel_mask] == pytest.approx(5 - 2)
+
+
+def test_a_camera_centred_on_a_point_keeps_it_in_the_middle_as_it_turns():
+    bounds = (np.zeros(3), np.array([100.0, 100.0, 20.0]))
+    for az in (0.0, 75.0, 210.0):
+        camera = Camera(az, 30.0, 8.0, centre=(80.0, 20.0, 2.0))
+        row, col, _, _ = views.project_float([[80.0, 20.0, 2.0]], camera, 30, 50, bounds)
+        assert (row[0], col[0]) == pytest.approx((15.0, 25.0))
+    assert Camera(10.0, 20.0, 3.0, centre=(1, 2, 3)).at_angle(400, 100) == Camera(
+        40.0, 90.0, 3.0, centre=(1, 2, 3))
 
 
 def test_zoom_and_pan_move_points_on_screen():

@@ -11,47 +11,38 @@ drawn pixels; row 0 is the top of the picture (north in the top view).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-GREY_LEVELS = 56  # the report's grey scale for 3D point plots (section 3.4.1)
-BACKGROUND = (0, 0, 0)
-GROUND_RGB = (58, 46, 34)
-PATH_RGB = (255, 215, 0)
-SCAN_RGB = (255, 60, 60)
-START_RGB = (255, 255, 255)
-FOOTPRINT_RGB = (0, 215, 255)
-TARGET_RGB = (255, 0, 255)
+from ladartui.render.colour import (  # noqa: F401  (the palette, named here too)
+    BACKGROUND,
+    FOOTPRINT_RGB,
+    GREY_LEVELS,
+    GROUND_RGB,
+    PATH_RGB,
+    SCAN_RGB,
+    START_RGB,
+    TARGET_RGB,
+    colour_map,
+    grey_map,
+    height_map,
+    shade_indices,
+)
+
+OVERLAYS = ("path", "scans", "footprints")
 
 
 # -- colour ramps ---------------------------------------------------------
 
 def grey_ramp(levels: int = GREY_LEVELS) -> np.ndarray:
-    """``levels`` grey shades from dark (low) to near white (high), (levels, 3) uint8.
-
-    The report ran from near white to black on a white page; a terminal is
-    usually dark, so the ramp runs the other way and stops short of black.
-    """
-    values = np.linspace(48, 245, levels).round().astype(np.uint8)
-    return np.repeat(values[:, None], 3, axis=1)
+    """The report's grey shades, dark (low) to near white (high): ``colour.grey_map``."""
+    return grey_map(levels)
 
 
 def height_ramp(levels: int = 64) -> np.ndarray:
-    """A terrain-like ramp for the top view: dark green (low) to pale (high)."""
-    anchors = np.array([[20, 70, 30], [40, 120, 40], [130, 170, 60], [220, 220, 170]], float)
-    positions = np.linspace(0.0, 1.0, len(anchors))
-    t = np.linspace(0.0, 1.0, levels)
-    ramp = np.stack([np.interp(t, positions, anchors[:, c]) for c in range(3)], axis=1)
-    return ramp.round().astype(np.uint8)
-
-
-def shade_indices(heights: np.ndarray, lo: float, hi: float, levels: int) -> np.ndarray:
-    """Map heights to integer shade indices 0..levels-1 linearly over [lo, hi]."""
-    heights = np.asarray(heights, dtype=np.float64)
-    span = max(float(hi) - float(lo), 1e-9)
-    index = np.floor((heights - lo) / span * levels)
-    return np.clip(index, 0, levels - 1).astype(np.int32)
+    """The perceptual height colours of every view: ``colour.height_map``."""
+    return height_map(levels)
 
 
 _CUBE = np.array([0, 95, 135, 175, 215, 255])
@@ -86,10 +77,10 @@ class Picture:
     mask: np.ndarray
 
     @classmethod
-    def blank(cls, rows: int, cols: int) -> "Picture":
+    def blank(cls, rows: int, cols: int) -> Picture:
         return cls(np.zeros((rows, cols, 3), np.uint8), np.zeros((rows, cols), bool))
 
-    def copy(self) -> "Picture":
+    def copy(self) -> Picture:
         return Picture(self.rgb.copy(), self.mask.copy())
 
     @property
@@ -113,6 +104,7 @@ class TopView:
     heights: np.ndarray
     voxel_size: float = 1.0
     target_columns: np.ndarray | None = None  # (K, 2) voxel x, y of target voxels
+    colour_map: str = "height"  # or "grey": the report's 56 shades
     _cache: dict = field(default_factory=dict, repr=False)
     renders: int = 0  # how many times the scene layer was drawn (the cache's effect)
 
@@ -159,10 +151,16 @@ class TopView:
         row = (frame[3] - cells[:, 1]) / scale + off_r
         return np.stack([row, col], axis=1)
 
+    def to_cells(self, row: float, col: float, rows: int, cols: int, frame=None):
+        """The cell-space (x, y) under a pixel position (the inverse of ``to_pixels``)."""
+        frame = frame or self.scene_frame()
+        scale, off_c, off_r = self.fit(rows, cols, frame)
+        return frame[0] + (col - off_c) * scale, frame[3] - (row - off_r) * scale
+
     def scene_layer(self, rows: int, cols: int, frame=None) -> Picture:
         """The height-shaded scene at this pixel size and frame (cached; do not modify)."""
         frame = tuple(frame or self.scene_frame())
-        key = (rows, cols, frame)
+        key = (rows, cols, frame, self.colour_map)
         if key not in self._cache:
             self._cache.clear()
             self._cache[key] = self._render(rows, cols, frame)
@@ -193,37 +191,53 @@ class TopView:
         heights = self.heights
         pooled = _block_max(heights, x_lo, x_hi, y_lo, y_hi)
         top = max(int(heights.max()), 1)
-        ramp = height_ramp()
+        ramp = colour_map(self.colour_map)
         shade = ramp[shade_indices(pooled, 0, top, len(ramp))]
         ground = pooled < 0
         rgb = np.where(ground[..., None], np.array(GROUND_RGB, np.uint8), shade)
         picture.rgb[inside] = rgb[inside]
         picture.mask[inside] = True
-        if self.target_columns is not None and len(self.target_columns):
-            tc = np.asarray(self.target_columns, dtype=np.float64)[:, :2] * self.voxel_size
-            pix = np.floor(self.to_pixels(tc, rows, cols, frame)).astype(np.int64)
-            ok = (pix[:, 0] >= 0) & (pix[:, 0] < rows) & (pix[:, 1] >= 0) & (pix[:, 1] < cols)
-            pix = pix[ok]
-            # a magenta tint shows where the hidden target is
-            tint = picture.rgb[pix[:, 0], pix[:, 1]].astype(np.int32)
-            picture.rgb[pix[:, 0], pix[:, 1]] = ((tint + np.array(TARGET_RGB)) // 2).astype(np.uint8)
         return picture
 
+    def draw_target(self, picture: Picture, frame) -> None:
+        """Fill each target column's cell (at least one pixel) in the target colour."""
+        if self.target_columns is None or not len(self.target_columns):
+            return
+        rows, cols = picture.shape
+        cells = np.asarray(self.target_columns, dtype=np.float64)[:, :2]
+        # cell corners (x - 0.5, y + 0.5) and (x + 0.5, y - 0.5) in metres
+        corner_a = self.to_pixels((cells + [-0.5, 0.5]) * self.voxel_size, rows, cols, frame)
+        corner_b = self.to_pixels((cells + [0.5, -0.5]) * self.voxel_size, rows, cols, frame)
+        r0 = np.floor(corner_a[:, 0] + 0.5).astype(np.int64)
+        c0 = np.floor(corner_a[:, 1] + 0.5).astype(np.int64)
+        r1 = np.maximum(np.floor(corner_b[:, 0] + 0.5).astype(np.int64), r0 + 1)
+        c1 = np.maximum(np.floor(corner_b[:, 1] + 0.5).astype(np.int64), c0 + 1)
+        for ra, rb, ca, cb in zip(np.clip(r0, 0, rows), np.clip(r1, 0, rows),
+                                  np.clip(c0, 0, cols), np.clip(c1, 0, cols)):
+            picture.rgb[ra:rb, ca:cb] = TARGET_RGB
+            picture.mask[ra:rb, ca:cb] = True
+
     def render(self, rows: int, cols: int, path=None, scans=None, footprints=None,
-               frame=None) -> Picture:
-        """The scene layer with the flight path, scan positions and footprints drawn over it.
+               frame=None, shown=OVERLAYS) -> Picture:
+        """The scene layer, the footprints, the target, then the flight path and scans.
 
         ``path`` and ``scans`` are (N, 2) x, y metres (the first scan is marked
-        as the start); ``footprints`` a list of (K, 2) ground polygons in metres.
+        as the start); ``footprints`` a list of (K, 2) ground polygons in metres;
+        ``shown`` names the overlays drawn. The target is drawn over the
+        footprints so that they never hide it.
         """
         frame = frame or self.scene_frame()
         picture = self.scene_layer(rows, cols, frame).copy()
+        path = path if "path" in shown else None
+        scans = scans if "scans" in shown else None
+        footprints = footprints if "footprints" in shown else None
         for polygon in footprints or ():
             if polygon is None or len(polygon) < 2:
                 continue
             pix = self.to_pixels(np.asarray(polygon, float)[:, :2], rows, cols, frame)
             closed = np.vstack([pix, pix[:1]])
             draw_polyline(picture, closed, FOOTPRINT_RGB)
+        self.draw_target(picture, frame)
         if path is not None and len(path) >= 2:
             draw_polyline(picture, self.to_pixels(path, rows, cols, frame), PATH_RGB)
         if scans is not None and len(scans):
@@ -285,11 +299,13 @@ def draw_polyline(picture: Picture, pixels, rgb) -> None:
 
 @dataclass(frozen=True)
 class Camera:
-    """An orthographic view: azimuth and elevation in degrees, zoom and pan.
+    """An orthographic view: azimuth and elevation in degrees, zoom, pan and centre.
 
     Azimuth is the compass bearing (clockwise from north) the viewer looks
     *from*; elevation is the angle above the horizon (90 looks straight
-    down). Pan moves the picture by fractions of its width and height.
+    down). The view turns about ``centre`` (voxel units; None: the centre of
+    the view's bounds), so a view framed on the target keeps it in sight while
+    it turns. Pan moves the picture by fractions of its width and height.
     """
 
     azimuth: float = 210.0
@@ -297,19 +313,23 @@ class Camera:
     zoom: float = 1.0
     pan_x: float = 0.0
     pan_y: float = 0.0
+    centre: tuple | None = None
 
-    def rotated(self, d_azimuth=0.0, d_elevation=0.0) -> "Camera":
-        return Camera((self.azimuth + d_azimuth) % 360.0,
-                      float(np.clip(self.elevation + d_elevation, -90.0, 90.0)),
-                      self.zoom, self.pan_x, self.pan_y)
+    def at_angle(self, azimuth: float, elevation: float) -> Camera:
+        return replace(self, azimuth=float(azimuth) % 360.0,
+                       elevation=float(np.clip(elevation, -90.0, 90.0)))
 
-    def zoomed(self, factor: float) -> "Camera":
-        return Camera(self.azimuth, self.elevation,
-                      float(np.clip(self.zoom * factor, 0.1, 100.0)), self.pan_x, self.pan_y)
+    def rotated(self, d_azimuth=0.0, d_elevation=0.0) -> Camera:
+        return self.at_angle(self.azimuth + d_azimuth, self.elevation + d_elevation)
 
-    def panned(self, dx=0.0, dy=0.0) -> "Camera":
-        return Camera(self.azimuth, self.elevation, self.zoom,
-                      self.pan_x + dx / self.zoom, self.pan_y + dy / self.zoom)
+    def zoomed(self, factor: float) -> Camera:
+        return replace(self, zoom=float(np.clip(self.zoom * factor, MIN_ZOOM, MAX_ZOOM)))
+
+    def panned(self, dx=0.0, dy=0.0) -> Camera:
+        return replace(self, pan_x=self.pan_x + dx / self.zoom, pan_y=self.pan_y + dy / self.zoom)
+
+
+MIN_ZOOM, MAX_ZOOM = 0.1, 1000.0
 
 
 def view_axes(azimuth: float, elevation: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -323,70 +343,34 @@ def view_axes(azimuth: float, elevation: float) -> tuple[np.ndarray, np.ndarray,
     return right, up, toward
 
 
-def project(points, camera: Camera, rows: int, cols: int, bounds=None):
-    """Orthographic projection of (N, 3) points to pixel (row, col) and depth.
+def project_float(points, camera: Camera, rows: int, cols: int, bounds=None):
+    """Orthographic projection of (N, 3) points: float pixel row, col, depth, and scale.
 
     ``bounds`` ((3,) lo, (3,) hi) fixes the framing so that several views of
-    one scene (scene and output) line up; by default the points' own box.
-    Returns (row, col) int arrays and depth (larger is nearer the viewer).
+    one scene (scene and output) line up; by default the points' own box. At
+    zoom 1 the bounds' sphere fills the shorter side; ``scale`` is pixels per
+    voxel unit. A pixel (r, c) covers [r, r + 1) x [c, c + 1); depth is larger
+    nearer the viewer.
     """
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     if bounds is None:
         lo, hi = (pts.min(axis=0), pts.max(axis=0)) if len(pts) else (np.zeros(3), np.ones(3))
     else:
         lo, hi = (np.asarray(b, float) for b in bounds)
-    centre = (lo + hi) / 2.0
+    centre = (lo + hi) / 2.0 if camera.centre is None else np.asarray(camera.centre, float)
     radius = max(float(np.linalg.norm(hi - lo)) / 2.0, 0.5)
     right, up, toward = view_axes(camera.azimuth, camera.elevation)
     rel = pts - centre
-    sx = rel @ right
-    sy = rel @ up
-    depth = rel @ toward
     scale = camera.zoom * min(cols, rows) / (2.0 * radius)
-    col = cols / 2.0 + (sx + camera.pan_x * 2.0 * radius) * scale
-    row = rows / 2.0 - (sy + camera.pan_y * 2.0 * radius) * scale
+    col = cols / 2.0 + (rel @ right + camera.pan_x * 2.0 * radius) * scale
+    row = rows / 2.0 - (rel @ up + camera.pan_y * 2.0 * radius) * scale
+    return row, col, rel @ toward, scale
+
+
+def project(points, camera: Camera, rows: int, cols: int, bounds=None):
+    """The pixel (row, col) ints each point falls in, and its depth (``project_float``)."""
+    row, col, depth, _ = project_float(points, camera, rows, cols, bounds)
     return np.floor(row).astype(np.int64), np.floor(col).astype(np.int64), depth
-
-
-def render_points(points, camera: Camera, rows: int, cols: int, *, bounds=None,
-                  levels: int = GREY_LEVELS, height_range=None) -> tuple[np.ndarray, np.ndarray]:
-    """Height-shaded projection of voxel points with a depth buffer.
-
-    Returns ``shade`` (rows, cols) int16 (-1 where nothing is drawn, else a
-    shade 0..levels-1 of the nearest point's height) and ``depth`` (float,
-    -inf where empty). Heights shade over ``height_range`` (default the
-    bounds' z range), so scene and output share one scale.
-    """
-    shade = np.full((rows, cols), -1, np.int16)
-    depth_buffer = np.full((rows, cols), -np.inf)
-    pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
-    if len(pts) == 0 or rows <= 0 or cols <= 0:
-        return shade, depth_buffer
-    row, col, depth = project(pts, camera, rows, cols, bounds)
-    ok = (row >= 0) & (row < rows) & (col >= 0) & (col < cols)
-    if not ok.any():
-        return shade, depth_buffer
-    row, col, depth, z = row[ok], col[ok], depth[ok], pts[ok, 2]
-    if height_range is None:
-        height_range = ((bounds[0][2], bounds[1][2]) if bounds is not None
-                        else (pts[:, 2].min(), pts[:, 2].max()))
-    linear = row * cols + col
-    # depth buffer: the nearest point of each pixel wins; ties go to the higher shade
-    flat_depth = depth_buffer.reshape(-1)
-    np.maximum.at(flat_depth, linear, depth)
-    winners = depth >= flat_depth[linear]
-    shades = shade_indices(z[winners], height_range[0], height_range[1], levels).astype(np.int16)
-    np.maximum.at(shade.reshape(-1), linear[winners], shades)
-    return shade, depth_buffer
-
-
-def shade_picture(shade: np.ndarray, ramp: np.ndarray | None = None) -> Picture:
-    """Turn a shade-index image into a Picture with the given ramp (grey by default)."""
-    ramp = grey_ramp() if ramp is None else ramp
-    mask = shade >= 0
-    rgb = np.zeros(shade.shape + (3,), np.uint8)
-    rgb[mask] = ramp[np.clip(shade[mask], 0, len(ramp) - 1)]
-    return Picture(rgb, mask)
 
 
 def subsample(voxels, limit: int, seed: int = 0) -> np.ndarray:

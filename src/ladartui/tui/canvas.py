@@ -1,9 +1,10 @@
 """Picture widgets: the top view and the 3D views drawn with half-block characters.
 
-The maths lives in ``ladartui.views``; these widgets only turn pictures into
+The pictures come from the core (``ladartui.render`` for the 3D views,
+``ladartui.views.TopView`` for the top view); these widgets only turn them into
 terminal cells (upper half block, foreground = top pixel, background = bottom
 pixel) in 24-bit colour, or in the xterm-256 palette when the terminal has no
-24-bit colour.
+24-bit colour, and turn keys and the mouse into framing requests.
 """
 
 from __future__ import annotations
@@ -19,6 +20,8 @@ from textual.strip import Strip
 from textual.widget import Widget
 
 from ladartui import views
+from ladartui.render import framing
+from ladartui.render.raster import OVERLAYS, Layer, Overlays, render
 from ladartui.views import Camera, Picture
 
 UPPER = "\u2580"
@@ -84,6 +87,19 @@ def picture_strips(picture: Picture, use_256: bool = False) -> list[Strip]:
     return strips
 
 
+# keys every view shares: framing and what is drawn (handled by the view area, for all views)
+VIEW_BINDINGS = [
+    Binding("t", "view_request('fit_target')", "Zoom to target (every view)", show=False),
+    Binding("f", "view_request('fit_scene')", "Fit scene (every view)", show=False),
+    Binding("p", "view_request('fit_path')", "Fit flight path (every view)", show=False),
+    Binding("c", "view_request('cycle_output_colour')", "Output: classes / height / scans",
+            show=False),
+    Binding("g", "view_request('toggle_grey')", "Colour / grey shading", show=False),
+    Binding("o", "view_request('cycle_overlays')", "Overlays: all / path / none",
+            show=False),
+]
+
+
 class PictureWidget(Widget, can_focus=True):
     """Base for views: draws ``make_picture(rows, cols)`` and caches the strips."""
 
@@ -92,20 +108,37 @@ class PictureWidget(Widget, can_focus=True):
     PictureWidget:focus { border: round $accent; }
     """
 
+    class ViewRequest(Message):
+        """A key asked for something that concerns every view (``what`` names a ViewArea
+        method)."""
+
+        def __init__(self, what: str) -> None:
+            super().__init__()
+            self.what = what
+
     def __init__(self, title: str, **kwargs):
         super().__init__(**kwargs)
         self.border_title = title
         self._strips: list[Strip] | None = None
         self._size_key = None
         self.placeholder = "nothing to show yet"
+        self.colour_map = "height"
+        self.shown_overlays = frozenset(OVERLAYS)
 
     def make_picture(self, rows: int, cols: int) -> Picture | None:
         return None
+
+    def picture_size(self) -> tuple[int, int]:
+        """(rows, cols) of the picture at the widget's size: two pixel rows per cell."""
+        return self.size.height * 2, self.size.width
 
     def invalidate(self) -> None:
         """Redraw from the current data (call after changing it)."""
         self._strips = None
         self.refresh()
+
+    def action_view_request(self, what: str) -> None:
+        self.post_message(self.ViewRequest(what))
 
     def _use_256(self) -> bool:
         try:
@@ -133,7 +166,22 @@ class PictureWidget(Widget, can_focus=True):
 
 
 class TopViewWidget(PictureWidget):
-    """The scene from above, with the flight path, scans and footprints over it."""
+    """The scene from above, with the flight path, scans and footprints over it.
+
+    The window follows the flight path until the view is zoomed, panned or
+    framed on the scene or the target; 0 goes back to following the path.
+    """
+
+    BINDINGS = [
+        Binding("plus,equals_sign", "zoom(1.25)", "Zoom in", show=False),
+        Binding("minus", "zoom(0.8)", "Zoom out", show=False),
+        Binding("w", "pan(0, 0.1)", "Pan north", show=False),
+        Binding("s", "pan(0, -0.1)", "Pan south", show=False),
+        Binding("a", "pan(-0.1, 0)", "Pan west", show=False),
+        Binding("d", "pan(0.1, 0)", "Pan east", show=False),
+        Binding("0", "reset_view", "Follow the flight path", show=False),
+        *VIEW_BINDINGS,
+    ]
 
     def __init__(self, **kwargs):
         super().__init__("Top view", **kwargs)
@@ -142,27 +190,92 @@ class TopViewWidget(PictureWidget):
         self.scans = None
         self.footprints = None
         self.frame = None
+        self.framing = "path"  # "path" (follows it), "scene", "target" or "manual"
+        self.target_box = None
         self.placeholder = "no scene loaded"
 
-    def set_scene(self, top: views.TopView | None) -> None:
+    def set_scene(self, top: views.TopView | None, target_box=None) -> None:
         self.top = top
+        self.target_box = target_box
+        self.framing = "path"
+        self._reframe()
         self.invalidate()
 
     def set_overlay(self, path, scans, footprints) -> None:
-        """New flight path overlays; the frame grows to hold the scans if needed."""
+        """New flight path overlays; the window grows to hold the scans if it follows them."""
         self.path, self.scans, self.footprints = path, scans, footprints
-        self.frame = self.top.frame_for(scans) if self.top is not None else None
+        self._reframe()
         self.invalidate()
+
+    def _reframe(self) -> None:
+        if self.top is None:
+            self.frame = None
+        elif self.framing == "path":
+            self.frame = self.top.frame_for(self.scans)
+        elif self.framing == "scene":
+            self.frame = self.top.scene_frame()
+        elif self.framing == "target" and self.target_box is not None:
+            self.frame = framing.fit_window(self.target_box)
+
+    def fit(self, what: str) -> None:
+        """Frame the ``"path"``, the ``"scene"`` or the ``"target"``."""
+        self.framing = what
+        self._reframe()
+        self._update_title()
+        self.invalidate()
+
+    def _update_title(self) -> None:
+        title = "Top view"
+        if self.top is not None and self.frame is not None and self.framing != "path":
+            width = self.frame[2] - self.frame[0]
+            title += f" {width * self.top.voxel_size:.3g} m across"
+        self.border_title = title
+
+    def action_zoom(self, factor: float, about=None) -> None:
+        if self.top is None or self.frame is None:
+            return
+        self.frame = framing.zoom_window(self.frame, factor, about)
+        self.framing = "manual"
+        self._update_title()
+        self.invalidate()
+
+    def action_pan(self, dx: float, dy: float) -> None:
+        if self.top is None or self.frame is None:
+            return
+        self.frame = framing.pan_window(self.frame, dx, dy)
+        self.framing = "manual"
+        self._update_title()
+        self.invalidate()
+
+    def action_reset_view(self) -> None:
+        self.fit("path")
+
+    def _wheel(self, event, factor: float) -> None:
+        # the wheel zooms about the point under the pointer
+        event.stop()
+        offset = event.get_content_offset(self)
+        about = None
+        if offset is not None and self.top is not None and self.frame is not None:
+            rows, cols = self.picture_size()
+            about = self.top.to_cells(2 * offset.y + 1, offset.x + 0.5, rows, cols, self.frame)
+        self.action_zoom(factor, about)
+
+    def on_mouse_scroll_up(self, event: events.MouseScrollUp) -> None:
+        self._wheel(event, 1.25)
+
+    def on_mouse_scroll_down(self, event: events.MouseScrollDown) -> None:
+        self._wheel(event, 0.8)
 
     def make_picture(self, rows, cols):
         if self.top is None:
             return None
+        self.top.colour_map = self.colour_map
         return self.top.render(rows, cols, self.path, self.scans, self.footprints,
-                               frame=self.frame)
+                               frame=self.frame, shown=self.shown_overlays)
 
 
 class ProjectionWidget(PictureWidget):
-    """A 3D view of voxel points: arrows rotate, + and - zoom, w a s d pan, 0 resets."""
+    """A 3D view of voxels: arrows rotate, + and - zoom, w a s d pan, 0 resets."""
 
     BINDINGS = [
         Binding("left", "rotate(-15, 0)", "Rotate left", show=False),
@@ -176,44 +289,75 @@ class ProjectionWidget(PictureWidget):
         Binding("a", "pan(-0.05, 0)", "Pan left", show=False),
         Binding("d", "pan(0.05, 0)", "Pan right", show=False),
         Binding("0", "reset_view", "Reset view", show=False),
+        *VIEW_BINDINGS,
     ]
 
     class CameraChanged(Message):
-        def __init__(self, widget: "ProjectionWidget") -> None:
+        def __init__(self, widget: ProjectionWidget) -> None:
             super().__init__()
             self.widget = widget
 
     def __init__(self, title: str, **kwargs):
         super().__init__(title, **kwargs)
         self.base_title = title
-        self.points = None  # (N, 3) voxel indices, already downsampled
+        self.points = None  # (N, 3) voxel indices of the drawn voxels, already downsampled
+        self.voxel_layers: list[Layer] = []
+        self.height_range = None  # voxel layers shaded from bottom to top colour
         self.bounds = None
-        self.markers = None  # (M, 3) scan positions in voxel units, drawn over the points
+        self.overlays = Overlays()  # in voxel units
         self.voxel_size = 1.0
         self.camera = Camera()
         self.height_top = None  # top of the height shading (voxel layers), shared by views
+        self.pending_fit = None  # a box to frame once the widget has a size
         self._drag = None
         self.placeholder = "nothing to show yet"
         self._update_title()
 
+    @property
+    def markers(self):
+        return self.overlays.scans
+
     def set_points(self, points, bounds=None, voxel_size=1.0) -> None:
-        self.points = None if points is None else np.asarray(points)
-        self.bounds = bounds
+        """Voxels (N, 3) shaded by height."""
+        points = None if points is None else np.asarray(points)
+        self.set_layers(None if points is None else [Layer(points)], points, bounds, voxel_size)
+
+    def set_layers(self, layers, points, bounds=None, voxel_size=1.0,
+                   height_range=None) -> None:
+        """Layers to draw (later ones win ties), the voxels they show, and the shading range."""
+        self.voxel_layers = layers or []
+        self.points = points
+        if bounds is not None:  # kept when cleared, so the views stay lined up
+            self.bounds = bounds
         self.voxel_size = voxel_size
+        self.height_range = height_range
         self.invalidate()
 
-    def set_markers(self, markers, bounds=None) -> None:
-        """Scan positions (voxel units) drawn as a path over the points."""
-        self.markers = None if markers is None else np.asarray(markers, float)
+    def set_markers(self, markers, bounds=None, footprints=None) -> None:
+        """Scan positions (voxel units) drawn as a path over the voxels, and footprints."""
+        markers = None if markers is None else np.asarray(markers, float)
+        self.overlays = Overlays(markers, markers, list(footprints or []), self.shown_overlays)
         if bounds is not None:
             self.bounds = bounds
         self.invalidate()
 
     def set_camera(self, camera: Camera) -> None:
         self.camera = camera
+        self.pending_fit = None
         self._update_title()
         self.invalidate()
         self.post_message(self.CameraChanged(self))
+
+    def fit_box(self, box) -> None:
+        """Frame ``box`` (voxel-index lo, hi) now, or when the widget is first drawn."""
+        rows, cols = self.picture_size()
+        if self.bounds is None or box is None:
+            return
+        if rows and cols:
+            self.set_camera(framing.fit_camera(self.camera, box, rows, cols, self.bounds))
+        else:
+            self.pending_fit = box
+            self.invalidate()
 
     def _update_title(self) -> None:
         c = self.camera
@@ -222,23 +366,22 @@ class ProjectionWidget(PictureWidget):
             self.border_title += f" x{c.zoom:.2g}"
 
     def make_picture(self, rows, cols):
-        if self.points is None or len(self.points) == 0:
+        if not self.voxel_layers or self.bounds is None:
             return None
-        bounds = self.bounds
-        shade, _ = views.render_points(self.points, self.camera, rows, cols, bounds=bounds,
-                                       height_range=self._height_range())
-        picture = views.shade_picture(shade)
-        if self.markers is not None and len(self.markers):
-            row, col, _ = views.project(self.markers, self.camera, rows, cols, bounds)
-            pixels = np.stack([row, col], axis=1).astype(float)
-            if len(pixels) > 1:
-                views.draw_polyline(picture, pixels + 0.5, views.PATH_RGB)
-            views.draw_points(picture, pixels, views.SCAN_RGB)
-            views.draw_points(picture, pixels[:1], views.START_RGB)
-        return picture
+        if self.pending_fit is not None:
+            self.camera = framing.fit_camera(self.camera, self.pending_fit, rows, cols,
+                                             self.bounds)
+            self.pending_fit = None
+            self._update_title()
+        self.overlays.shown = self.shown_overlays
+        return render(self.voxel_layers, self.camera, rows, cols, self.bounds,
+                      height_range=self._height_range(), colour_map=self.colour_map,
+                      overlays=self.overlays)
 
     def _height_range(self):
         # shade by the scene's heights, not by a box stretched up to the aircraft
+        if self.height_range is not None:
+            return self.height_range
         if self.points is None or not len(self.points):
             return None
         return (0.0, float(np.asarray(self.points)[:, 2].max()) if self.height_top is None

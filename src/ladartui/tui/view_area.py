@@ -1,5 +1,6 @@
 """The views beside the sidebar: the 3D scene, the 3D output and the top view, in the
-report's five layouts, with the flight path drawn over them."""
+report's five layouts, with the flight path drawn over them, and the requests that
+concern every view at once (zoom to target, fits, colouring, overlays)."""
 
 from __future__ import annotations
 
@@ -8,11 +9,17 @@ from textual.containers import Container
 
 from ladartui import views
 from ladartui.errors import LadarError
-from ladartui.tui.canvas import ProjectionWidget, TopViewWidget
+from ladartui.render import framing, png
+from ladartui.render.output import COLOUR_MODES, classify, output_layers, scene_layers
+from ladartui.render.raster import OVERLAYS
+from ladartui.tui.canvas import PictureWidget, ProjectionWidget, TopViewWidget
+from ladartui.views import Camera
 
-SCENE_POINTS = 80_000  # voxels drawn in the 3D scene view, whatever the scene size
+SCENE_POINTS = 150_000  # voxels drawn in the 3D scene view (all of the small scene)
 OUTPUT_POINTS = 80_000
 MAX_FOOTPRINTS = 400
+# the overlay sets the 'o' key steps through
+OVERLAY_CYCLE = (frozenset(OVERLAYS), frozenset({"path", "scans"}), frozenset())
 
 LAYOUTS = {
     1: "3D scene + top view",
@@ -35,17 +42,27 @@ def prepare_views(scene) -> dict:
     bounds = (np.zeros(3), np.array([nx - 1, ny - 1, max(top_z, 1)], float))
     top.scene_layer(48, 96)  # warm the cache at a typical size
     return {"top": top, "points": points, "bounds": bounds,
+            "target": np.asarray(scene.target, np.int32),
+            "target_box": framing.box_of(scene.target),
             "target_m": tuple(float(v) for v in scene.target_centre_m())}
 
 
 class ViewArea(Container):
-    """Owns the three views and which of them the layout shows."""
+    """Owns the three views, which of them the layout shows, and how they are drawn."""
 
     def __init__(self, **kwargs):
         super().__init__(classes="layout-1", **kwargs)
         self.layout_number = 1
         self.prepared: dict | None = None
         self.voxel_size = 1.0
+        self.scenario = None
+        self.output_mode = "class"      # or "height": see render.output
+        self.colour_map = "height"      # or "grey": the report's 56 shades
+        self.overlays = OVERLAY_CYCLE[0]
+        self.markers = None             # scan positions, voxel units
+        self._output_args = (None, None, OUTPUT_POINTS, None, None)
+        self.per_scan_known = False  # the output shown has per-scan returns ("scans" mode)
+        self._target_file_cache: tuple | None = None
 
     def compose(self):
         yield ProjectionWidget("3D scene", id="scene3d")
@@ -60,11 +77,18 @@ class ViewArea(Container):
     def set_scene(self, prepared: dict, voxel_size: float) -> None:
         self.prepared = prepared
         self.voxel_size = voxel_size
-        self.query_one(TopViewWidget).set_scene(prepared["top"])
+        self.query_one(TopViewWidget).set_scene(prepared["top"], prepared.get("target_box"))
+        top = float(prepared["bounds"][1][2])
         for widget in self.query(ProjectionWidget):
-            widget.height_top = float(prepared["bounds"][1][2])
-        self.query_one("#scene3d", ProjectionWidget).set_points(
-            prepared["points"], prepared["bounds"], voxel_size)
+            widget.height_top = top
+            # a new scene: keep the angles, frame the scene again (a centre or a pending
+            # fit of the old one would point elsewhere)
+            widget.camera = Camera(widget.camera.azimuth, widget.camera.elevation)
+            widget.pending_fit = None
+            widget._update_title()
+        self.query_one("#scene3d", ProjectionWidget).set_layers(
+            scene_layers(prepared["points"], prepared["target"]), prepared["points"],
+            prepared["bounds"], voxel_size, height_range=(0.0, top))
 
     def rescale(self, voxel_size: float, target_m) -> None:
         """The same voxels at another size (the scenario's voxel size changed)."""
@@ -74,7 +98,8 @@ class ViewArea(Container):
             self.prepared["target_m"] = target_m
 
     def draw_path(self, scenario) -> None:
-        """The scans and their footprints over the top view, and markers in the 3D views."""
+        """The scans and their footprints over the top view, and over the 3D views."""
+        self.scenario = scenario
         top = self.query_one(TopViewWidget)
         if scenario is None:
             top.set_overlay(None, None, None)
@@ -85,33 +110,183 @@ class ViewArea(Container):
         step = max(1, len(poses) // MAX_FOOTPRINTS)
         for pose in poses[::step]:
             try:
-                footprints.append(scenario.sensor.footprint(pose)[:, :2])
+                footprints.append(scenario.sensor.footprint(pose))
             except LadarError:
                 pass
-        top.set_overlay(scans, scans, footprints)
+        top.set_overlay(scans, scans, [f[:, :2] for f in footprints])
         if self.prepared is not None and poses:
             markers = np.array([p.position for p in poses]) / self.voxel_size
-            lo, hi = self.prepared["bounds"]
-            bounds = (np.minimum(lo, markers.min(axis=0)), np.maximum(hi, markers.max(axis=0)))
+            self.markers = markers
+            ground = [f / self.voxel_size for f in footprints]
+            # the views frame the scene (the path may leave them: p fits it), so that
+            # editing the path never moves the picture
             for widget in self.query(ProjectionWidget):
-                widget.set_markers(markers, bounds)
+                widget.set_markers(markers, self.prepared["bounds"], ground)
 
-    def show_output(self, voxels, threshold: float | None, limit: int = OUTPUT_POINTS) -> None:
+    # -- the output view -----------------------------------------------------------
+
+    def show_output(self, voxels, threshold: float | None, limit: int = OUTPUT_POINTS,
+                    target_output=None, per_scan=None) -> None:
+        """The scene output after the threshold, coloured by ``output_mode``.
+
+        ``target_output`` (the target traced without foliage) marks what the
+        foliage hid; when not given it is taken from the app's last run, or
+        from the scenario's target output file when the output came from disk.
+        ``per_scan`` (each scan's scene returns) counts the scans that saw each
+        target voxel; when not given it is the app's last run's, if that run
+        made this output (files on disk do not keep it).
+        """
+        self._output_args = (voxels, threshold, limit, target_output, per_scan)
+        if per_scan is None:
+            per_scan = self._known_per_scan(voxels)
+        self.per_scan_known = per_scan is not None
+        if self.output_mode == "scans" and per_scan is None:
+            self.output_mode = "class"
         widget = self.query_one("#output3d", ProjectionWidget)
         title = "3D output"
         if threshold is not None:
             title += f" <= {threshold:g} m"
+        if self.output_mode == "height":
+            title += " (height)"
+        elif self.output_mode == "scans":
+            title += " (target: scans that saw it)"
         widget.base_title = title
         widget._update_title()
         if voxels is None or self.prepared is None:
             widget.placeholder = "no output yet: F5 runs"
             widget.set_points(None)
             return
-        shown = views.threshold_points(voxels, self.voxel_size, threshold)
+        if target_output is None:
+            target_output = self._known_target_output(voxels)
+        scene, seen, hidden = classify(voxels, self.prepared["target"], target_output)
+        scene = views.subsample(scene, limit, seed=0)
+        layers, heights = output_layers(
+            np.concatenate([scene, seen]), self.prepared["target"], hidden,
+            mode=self.output_mode, voxel_size=self.voxel_size, threshold_m=threshold,
+            per_scan=per_scan)
+        shown = views.threshold_points(np.concatenate([scene, seen]), self.voxel_size,
+                                       threshold)
         widget.placeholder = "nothing below the threshold" if len(voxels) else "no returns"
-        widget.set_points(views.subsample(shown, limit, seed=0),
+        if not any(len(layer.voxels) for layer in layers):
+            widget.set_points(None)
+            return
+        widget.set_layers(layers, shown,
                           widget.bounds if widget.bounds is not None else self.prepared["bounds"],
-                          self.voxel_size)
+                          self.voxel_size, height_range=heights)
+
+    def _known_per_scan(self, voxels):
+        result = getattr(self.app, "result", None)
+        if voxels is not None and result is not None and result.scene_output is voxels:
+            return result.scene_per_scan
+        return None
+
+    def _known_target_output(self, voxels):
+        # the run's own target output, or the file written beside the scene output
+        result = getattr(self.app, "result", None)
+        if result is not None and result.scene_output is voxels:
+            return result.target_output
+        if getattr(self.app, "running", False) or self.scenario is None:
+            return None
+        path = self.scenario.target_output
+        try:
+            key = (str(path), path.stat().st_mtime_ns)
+            if self._target_file_cache is None or self._target_file_cache[0] != key:
+                from ladartui.scene.voxels import load_voxels
+
+                self._target_file_cache = (key, load_voxels(path))
+            return self._target_file_cache[1]
+        except (OSError, LadarError):
+            return None
+
+    def _redraw_output(self) -> None:
+        self.show_output(*self._output_args)
+
+    # -- requests for every view (keys t f p c g o in any view) --------------------
+
+    def fit_target(self) -> None:
+        """Frame the target in every view at once; footprints go (at that scale their
+        edges would band the views), the path and scans stay."""
+        if self.prepared is None or self.prepared.get("target_box") is None:
+            return
+        self.show_overlays(OVERLAY_CYCLE[1])
+        for widget in self.query(ProjectionWidget):
+            widget.fit_box(self.prepared["target_box"])
+        self.query_one(TopViewWidget).fit("target")
+
+    def fit_scene(self) -> None:
+        if self.prepared is None:
+            return
+        self.show_overlays(OVERLAY_CYCLE[0])
+        for widget in self.query(ProjectionWidget):
+            widget.fit_box(self.prepared["bounds"])
+        self.query_one(TopViewWidget).fit("scene")
+
+    def fit_path(self) -> None:
+        if self.prepared is None:
+            return
+        self.show_overlays(OVERLAY_CYCLE[0])
+        lo, hi = self.prepared["bounds"]
+        if self.markers is not None and len(self.markers):
+            lo, hi = np.minimum(lo, self.markers.min(axis=0)), np.maximum(hi, self.markers.max(axis=0))
+        for widget in self.query(ProjectionWidget):
+            widget.fit_box((lo, hi))
+        self.query_one(TopViewWidget).fit("path")
+
+    def cycle_output_colour(self) -> None:
+        """Output coloured by voxel class, by height, or by scans that saw the target (when
+        the output came from a run in this session)."""
+        modes = [m for m in COLOUR_MODES if m != "scans" or self.per_scan_known]
+        index = modes.index(self.output_mode) if self.output_mode in modes else -1
+        self.output_mode = modes[(index + 1) % len(modes)]
+        self._redraw_output()
+
+    def toggle_grey(self) -> None:
+        """Height shading in colour, or in the report's 56 greys (every view)."""
+        self.colour_map = "grey" if self.colour_map == "height" else "height"
+        for widget in self.query(PictureWidget):
+            widget.colour_map = self.colour_map
+            widget.invalidate()
+
+    def cycle_overlays(self) -> None:
+        """All overlays, then path and scans only, then none (every view)."""
+        index = OVERLAY_CYCLE.index(self.overlays) if self.overlays in OVERLAY_CYCLE else -1
+        self.show_overlays(OVERLAY_CYCLE[(index + 1) % len(OVERLAY_CYCLE)])
+
+    def show_overlays(self, names) -> None:
+        """Draw these overlays (of "path", "scans", "footprints") in every view."""
+        self.overlays = frozenset(names)
+        for widget in self.query(PictureWidget):
+            widget.shown_overlays = self.overlays
+            widget.invalidate()
+
+    def on_picture_widget_view_request(self, message: PictureWidget.ViewRequest) -> None:
+        message.stop()
+        if message.what in ("fit_target", "fit_scene", "fit_path", "cycle_output_colour",
+                            "toggle_grey", "cycle_overlays"):
+            getattr(self, message.what)()
+
+    # -- pictures ------------------------------------------------------------------
+
+    def current_view(self, focused=None) -> PictureWidget:
+        """The focused view, else the first one the layout shows."""
+        if isinstance(focused, PictureWidget):
+            return focused
+        shown = [w for w in self.query(PictureWidget) if w.display and w.size.width]
+        return shown[0] if shown else self.query_one("#scene3d", PictureWidget)
+
+    def save_png(self, path, width: int = 1200, height: int = 800, view=None):
+        """Write a view (a widget or its id; default the current one) as a width x height PNG.
+
+        The view is drawn again at that size with the same framing. Returns the
+        path; a bad size or an empty view raises a one-line LadarError.
+        """
+        width, height = png.check_size(width, height)
+        widget = (self.query_one(f"#{view}", PictureWidget) if isinstance(view, str)
+                  else self.current_view(view))
+        picture = widget.make_picture(height, width)
+        if picture is None:
+            raise LadarError(f"{widget.border_title}: nothing to draw yet")
+        return png.write_png(picture.rgb, path)
 
     def focused_projection(self, focused) -> ProjectionWidget:
         if isinstance(focused, ProjectionWidget):
@@ -125,5 +300,6 @@ class ViewArea(Container):
         for widget in self.query(ProjectionWidget):
             if widget is not message.widget and widget.camera != message.widget.camera:
                 widget.camera = message.widget.camera
+                widget.pending_fit = None
                 widget._update_title()
                 widget.invalidate()

@@ -1,0 +1,77 @@
+"""Framing: the camera (3D views) or window (top view) that shows a box with a margin.
+
+Boxes are voxel-index ranges ``lo``..``hi`` (inclusive); the voxels' cubes
+reach half a voxel beyond them.
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+
+from ladartui.views import MAX_ZOOM, MIN_ZOOM, Camera, view_axes
+
+MARGIN = 0.05   # of the image on each side
+
+
+def box_of(voxels) -> tuple[np.ndarray, np.ndarray] | None:
+    """The (lo, hi) voxel-index box of (N, 3) points, or None when there are none."""
+    pts = np.asarray(voxels, dtype=np.float64).reshape(-1, 3)
+    pts = pts[np.all(np.isfinite(pts), axis=1)]
+    if not len(pts):
+        return None
+    return pts.min(axis=0), pts.max(axis=0)
+
+
+def fit_camera(camera: Camera, box, rows: int, cols: int, bounds,
+               margin: float = MARGIN) -> Camera:
+    """``camera``'s angles with the zoom and pan that frame ``box`` in a rows x cols image.
+
+    The box's projected corners fill the image less ``margin`` of it on each
+    side (in the tighter direction), centred.
+    """
+    lo, hi = (np.asarray(b, float) for b in box)
+    corners = np.array(list(itertools.product(*zip(lo - 0.5, hi + 0.5))))
+    blo, bhi = (np.asarray(b, float) for b in bounds)
+    radius = max(float(np.linalg.norm(bhi - blo)) / 2.0, 0.5)
+    centre = (lo + hi) / 2.0  # the view then turns about the box
+    right, up, _ = view_axes(camera.azimuth, camera.elevation)
+    sx = (corners - centre) @ right
+    sy = (corners - centre) @ up
+    width = max(float(np.ptp(sx)), 1e-6)
+    height = max(float(np.ptp(sy)), 1e-6)
+    usable = 1.0 - 2.0 * margin
+    scale = min(cols * usable / width, rows * usable / height)  # pixels per voxel unit
+    zoom = float(np.clip(scale * 2.0 * radius / max(min(cols, rows), 1), MIN_ZOOM, MAX_ZOOM))
+    return Camera(camera.azimuth, camera.elevation, zoom, 0.0, 0.0,
+                  tuple(float(v) for v in centre))
+
+
+def fit_window(box, margin: float = MARGIN) -> tuple[float, float, float, float]:
+    """A top-view frame (x0, y0, x1, y1, cell units) around a voxel box, ``margin`` of its
+    size (at least one voxel) on each side."""
+    lo, hi = (np.asarray(b, float) for b in box)
+    x0, y0, x1, y1 = lo[0], lo[1], hi[0] + 1.0, hi[1] + 1.0
+    pad = max(margin * max(x1 - x0, y1 - y0), 1.0)
+    return (float(x0 - pad), float(y0 - pad), float(x1 + pad), float(y1 + pad))
+
+
+def zoom_window(frame, factor: float, about=None, min_size: float = 2.0,
+                max_size: float = 1e7) -> tuple[float, float, float, float]:
+    """``frame`` zoomed in by ``factor`` (> 1 shows less) about a point (cell units;
+    default its centre), which stays where it was in the window."""
+    x0, y0, x1, y1 = frame
+    cx, cy = ((x0 + x1) / 2.0, (y0 + y1) / 2.0) if about is None else about
+    width = float(np.clip((x1 - x0) / factor, min_size, max_size))
+    height = float(np.clip((y1 - y0) / factor, min_size, max_size))
+    sx, sy = width / (x1 - x0), height / (y1 - y0)
+    return (float(cx - (cx - x0) * sx), float(cy - (cy - y0) * sy),
+            float(cx + (x1 - cx) * sx), float(cy + (y1 - cy) * sy))
+
+
+def pan_window(frame, dx: float, dy: float) -> tuple[float, float, float, float]:
+    """``frame`` moved by fractions of its width (east) and height (north)."""
+    x0, y0, x1, y1 = frame
+    sx, sy = dx * (x1 - x0), dy * (y1 - y0)
+    return (x0 + sx, y0 + sy, x1 + sx, y1 + sy)

@@ -1,0 +1,218 @@
+"""The core renderer (ladartui.render): images with a depth buffer, no terminal needed."""
+
+import itertools
+
+import numpy as np
+import pytest
+
+from ladartui.render import colour, framing
+from ladartui.render.output import classify, output_layers
+from ladartui.render.raster import Layer, Overlays, render, screen_coordinates
+from ladartui.views import Camera
+
+TOP = Camera(180.0, 90.0)  # looking straight down, north up, east right
+TARGET = colour.TARGET_RGB
+
+
+def box(lo, hi):
+    return np.array(list(itertools.product(*(range(a, b + 1) for a, b in zip(lo, hi)))))
+
+
+def is_rgb(image, rgb):
+    return np.all(image.rgb == np.array(rgb, np.uint8), axis=-1)
+
+
+def test_a_box_target_seen_from_above_fills_its_pixels_in_the_target_colour():
+    bounds = (np.zeros(3), np.array([39.0, 39.0, 10.0]))
+    ground = box((0, 0, 0), (39, 39, 0))
+    target = box((10, 20, 1), (17, 25, 3))  # 8 x 6 voxels in plan, 3 high
+    camera = framing.fit_camera(TOP, (np.zeros(3), np.array([39.0, 39, 0])), 80, 80, bounds)
+    image = render([Layer(ground), Layer(target, colour.TARGET_RGB)], camera, 80, 80, bounds)
+    # the projected cube box of the target: pixels whose centres lie inside it
+    row, col, _, scale = screen_coordinates(np.array([[9.5, 25.5, 3], [17.5, 19.5, 3]]),
+                                            camera, 80, 80, bounds)
+    assert scale == pytest.approx(80 * 0.9 / 40)  # the scene fills 90 % of the width
+    r, c = np.mgrid[0:80, 0:80] + 0.5
+    inside = (r > row[0] + 1) & (r < row[1] - 1) & (c > col[0] + 1) & (c < col[1] - 1)
+    near = (r > row[0] - 1) & (r < row[1] + 1) & (c > col[0] - 1) & (c < col[1] + 1)
+    magenta = is_rgb(image, colour.TARGET_RGB)
+    assert inside.sum() > 100
+    assert magenta[inside].all()          # every pixel well inside the box
+    assert not magenta[~near].any()       # and none more than a pixel outside it
+    # north is up: the target (y 20..25 of 0..39) sits in the upper half
+    assert row.mean() < 40 and col.mean() < 40
+
+
+def test_the_depth_buffer_keeps_the_nearer_voxel_in_any_drawing_order():
+    bounds = (np.zeros(3), np.array([4.0, 4.0, 4.0]))
+    low, high = np.array([[2, 2, 0]]), np.array([[2, 2, 4]])
+    for layers in ([Layer(low, (255, 0, 0)), Layer(high, (0, 255, 0))],
+                   [Layer(high, (0, 255, 0)), Layer(low, (255, 0, 0))]):
+        from_above = render(layers, TOP, 20, 20, bounds)
+        assert is_rgb(from_above, (0, 255, 0)).any() and not is_rgb(from_above, (255, 0, 0)).any()
+        from_below = render(layers, Camera(180.0, -90.0), 20, 20, bounds)
+        assert is_rgb(from_below, (255, 0, 0)).any() and not is_rgb(from_below, (0, 255, 0)).any()
+        assert np.isfinite(from_above.depth[from_above.voxel_mask]).all()
+        assert np.isneginf(from_above.depth[~from_above.voxel_mask]).all()
+
+
+def test_squares_grow_with_the_zoom_so_voxels_leave_no_gaps():
+    bounds = (np.zeros(3), np.array([9.0, 9.0, 0.0]))
+    floor = box((0, 0, 0), (9, 9, 0))
+    for zoom in (1.0, 3.0):
+        camera = framing.fit_camera(TOP, (np.zeros(3), np.array([9.0, 9, 0])), 60, 60, bounds)
+        camera = Camera(camera.azimuth, camera.elevation, camera.zoom * zoom / 3, 0, 0)
+        image = render([Layer(floor, (200, 200, 200))], camera, 60, 60, bounds)
+        rows, cols = np.nonzero(image.voxel_mask)
+        block = image.voxel_mask[rows.min():rows.max() + 1, cols.min():cols.max() + 1]
+        assert block.all()  # a solid square, no holes between voxels
+        assert block.shape[0] == pytest.approx(10 * 54 / 10 * zoom / 3, abs=2)
+
+
+def test_zoomed_in_far_beyond_the_splat_budget_the_squares_still_cover_what_is_in_view():
+    bounds = (np.zeros(3), np.array([299.0, 299.0, 0.0]))
+    floor = box((0, 0, 0), (299, 299, 0))  # 90,000 voxels
+    camera = framing.fit_camera(TOP, (np.array([140.0, 140, 0]), np.array([149.0, 149, 0])),
+                                400, 400, bounds)
+    image = render([Layer(floor, (200, 200, 200))], camera, 400, 400, bounds)
+    assert image.voxel_mask.all()  # 36-pixel squares, no gaps: only voxels in view count
+
+
+def test_a_threshold_rescales_the_colours_to_the_heights_that_remain():
+    column = np.array([[0, 0, z] for z in range(21)])
+    layers, (lo, hi) = output_layers(column, np.zeros((0, 3)), mode="height")
+    assert (lo, hi) == (0.0, 20.0)
+    layers, (lo, hi) = output_layers(column, np.zeros((0, 3)), mode="height", voxel_size=0.25,
+                                     threshold_m=2.0)
+    assert (lo, hi) == (0.0, 8.0) and len(layers[0].voxels) == 9
+    bounds = (np.zeros(3), np.array([1.0, 1.0, 20.0]))
+    side = Camera(180.0, 0.0)
+    full = render(output_layers(column, np.zeros((0, 3)), mode="height")[0], side, 60, 60,
+                  bounds, height_range=(0, 20))
+    cut = render(layers, side, 60, 60, bounds, height_range=(lo, hi))
+    table = colour.height_map()
+    # the top remaining voxel takes the top colour after the threshold, not a middling one
+    assert is_rgb(cut, table[-1]).any() and not is_rgb(full, table[-1])[cut.voxel_mask].any()
+    assert len(np.unique(cut.rgb[cut.voxel_mask], axis=0)) == 9
+
+
+def test_fit_target_frames_the_targets_projected_box_with_a_small_margin():
+    bounds = (np.zeros(3), np.array([199.0, 199.0, 30.0]))
+    target = box((120, 40, 0), (126, 43, 2))
+    for camera in (Camera(), Camera(45.0, 60.0), TOP):
+        fitted = framing.fit_camera(camera, framing.box_of(target), 40, 100, bounds)
+        corners = np.array(list(itertools.product(*zip(target.min(0) - 0.5,
+                                                      target.max(0) + 0.5))))
+        row, col, _, _ = screen_coordinates(corners, fitted, 40, 100, bounds)
+        assert row.min() >= 0 and row.max() <= 40 and col.min() >= 0 and col.max() <= 100
+        # fills the tighter direction to within the margin, centred
+        fill = max((row.max() - row.min()) / 40, (col.max() - col.min()) / 100)
+        assert fill == pytest.approx(0.9, abs=1e-6)
+        assert (row.min() + row.max()) / 2 == pytest.approx(20) and \
+            (col.min() + col.max()) / 2 == pytest.approx(50)
+        image = render([Layer(target, colour.TARGET_RGB)], fitted, 40, 100, bounds)
+        box_area = np.ptp(row) * np.ptp(col)
+        assert 0.5 * box_area < is_rgb(image, colour.TARGET_RGB).sum() <= box_area + 2 * (
+            np.ptp(row) + np.ptp(col)) + 4
+
+
+def test_output_classes_mark_what_the_foliage_hid():
+    target = box((5, 5, 0), (6, 6, 1))  # 8 voxels
+    seen = target[:3]
+    scene_output = np.vstack([seen, [[0, 0, 5], [1, 1, 7]]])
+    target_output = np.vstack([target[:6], [[0, 0, 0], [9, 9, 0]]])  # and ground returns
+    scene, target_seen, hidden = classify(scene_output, target, target_output)
+    assert sorted(map(tuple, scene)) == [(0, 0, 5), (1, 1, 7)]
+    assert sorted(map(tuple, target_seen)) == sorted(map(tuple, seen))
+    assert sorted(map(tuple, hidden)) == sorted(map(tuple, target[3:6]))
+
+
+def test_drawn_voxels_keep_a_contrast_of_3_against_the_background_after_a_threshold():
+    rng = np.random.default_rng(1)
+    canopy = np.column_stack([rng.integers(0, 30, 3000), rng.integers(0, 30, 3000),
+                              rng.integers(8, 20, 3000)])
+    ground = box((0, 0, 0), (29, 29, 0))
+    target = box((12, 12, 1), (16, 14, 3))
+    scene_output = np.unique(np.vstack([canopy, ground, target[::2]]), axis=0)
+    bounds = (np.zeros(3), np.array([29.0, 29.0, 19.0]))
+    for mode in ("class", "height"):
+        for cmap in ("height", "grey"):
+            layers, heights = output_layers(scene_output, target, target, mode=mode,
+                                            voxel_size=0.5, threshold_m=2.0)
+            image = render(layers, Camera(), 60, 80, bounds, height_range=heights,
+                           colour_map=cmap)
+            drawn = image.rgb[image.voxel_mask]
+            background = image.rgb[~image.mask]
+            assert len(drawn) > 100 and len(background) > 100
+            assert np.all(background == colour.BACKGROUND)
+            ratio = colour.contrast_ratio(np.unique(drawn, axis=0), colour.BACKGROUND)
+            assert ratio.min() >= 3.0, (mode, cmap, ratio.min())
+
+
+def test_colour_maps_are_monotone_in_lightness_and_distinct_from_the_target():
+    for table in (colour.height_map(), colour.grey_map()):
+        luminance = colour.relative_luminance(table)
+        assert np.all(np.diff(luminance) > 0)
+    assert len(colour.grey_map()) == 56
+    # the target colour is far from every height colour
+    distance = np.abs(colour.height_map().astype(int) - colour.TARGET_RGB).sum(axis=1)
+    assert distance.min() > 150
+    assert colour.contrast_ratio((255, 255, 255), (0, 0, 0)) == pytest.approx(21)
+
+
+def test_overlays_are_drawn_over_the_voxels_and_can_be_switched_off():
+    bounds = (np.zeros(3), np.array([20.0, 20.0, 10.0]))
+    floor = box((0, 8, 0), (20, 12, 0))  # a strip under the path, across the footprint
+    post = box((10, 5, 0), (10, 5, 6))  # a voxel column standing on a footprint edge
+    path = np.array([[0.0, 10, 8], [20.0, 10, 8]])
+    overlays = Overlays(path=path, scans=path, footprints=[np.array([[5.0, 5, 0], [15, 5, 0],
+                                                                    [15, 15, 0], [5, 15, 0]])])
+    image = render([Layer(floor, (90, 90, 90))], TOP, 40, 40, bounds, overlays=overlays)
+    for rgb in (colour.PATH_RGB, colour.SCAN_RGB, colour.START_RGB, colour.FOOTPRINT_RGB):
+        assert is_rgb(image, rgb).any(), rgb
+    strip = is_rgb(image, (90, 90, 90))
+    rows = np.nonzero(strip.any(axis=1))[0]
+    assert not is_rgb(image, colour.FOOTPRINT_RGB)[rows].any()  # under the voxels
+    assert is_rgb(image, colour.PATH_RGB)[rows].any()           # over them
+    # footprints lie on the ground: voxels hide them, the flight path stays on top
+    side = Camera(180.0, 10.0)
+    image = render([Layer(post, TARGET)], side, 40, 40, bounds, overlays=overlays)
+    column = is_rgb(image, TARGET)
+    assert column.any() and is_rgb(image, colour.FOOTPRINT_RGB).any()
+    image_without = render([Layer(post, TARGET)], side, 40, 40, bounds)
+    assert np.array_equal(column, is_rgb(image_without, TARGET) & ~is_rgb(image, colour.PATH_RGB))
+    overlays.shown = frozenset({"path"})
+    image = render([Layer(floor, (90, 90, 90))], TOP, 40, 40, bounds, overlays=overlays)
+    assert is_rgb(image, colour.PATH_RGB).any()
+    assert not is_rgb(image, colour.FOOTPRINT_RGB).any() and not is_rgb(image, colour.SCAN_RGB).any()
+
+
+def test_scan_counts_colour_the_target_by_how_many_scans_saw_it():
+    from ladartui.render.output import scan_counts
+
+    target = box((0, 0, 0), (2, 0, 0))  # three voxels
+    per_scan = [target[:1], target[:2], target[:2], np.zeros((0, 3), np.int32)]
+    assert scan_counts(target, per_scan).tolist() == [3, 2, 0]
+    ground = box((0, 2, 0), (2, 2, 0))
+    layers, _ = output_layers(np.vstack([ground, target[:2]]), target, mode="scans",
+                              per_scan=per_scan)
+    assert [len(layer.voxels) for layer in layers] == [3, 2]
+    bounds = (np.zeros(3), np.array([2.0, 2.0, 0.0]))
+    image = render(layers, TOP, 30, 30, bounds)
+    table = colour.height_map()
+    seen = {tuple(c) for c in image.rgb[image.voxel_mask]}
+    # 3 of 4 scans and 2 of 4 scans: colours half and a quarter of the way up the map
+    assert tuple(table[int(2 / 4 * len(table))]) in seen
+    assert tuple(table[int(1 / 4 * len(table))]) in seen
+
+
+def test_the_top_view_window_zooms_about_a_point_that_stays_put_and_pans_by_fractions():
+    frame = (0.0, 0.0, 100.0, 50.0)
+    assert framing.zoom_window(frame, 2.0) == (25.0, 12.5, 75.0, 37.5)
+    zoomed = framing.zoom_window(frame, 2.0, about=(80.0, 10.0))
+    assert zoomed == (40.0, 5.0, 90.0, 30.0)
+    # the point keeps its place: 80 % across, 20 % up, before and after
+    assert ((80 - zoomed[0]) / (zoomed[2] - zoomed[0]), (10 - zoomed[1]) / (zoomed[3] - zoomed[1])) \
+        == (0.8, 0.2)
+    assert framing.zoom_window(frame, 1000.0)[2] - framing.zoom_window(frame, 1000.0)[0] == 2.0
+    assert framing.pan_window(frame, 0.1, -0.2) == (10.0, -10.0, 110.0, 40.0)

@@ -1,0 +1,204 @@
+"""The views in the app: zoom to target, top-view zoom and pan, output colouring, PNG."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+import pytest_asyncio
+from textual import events
+
+from ladartui.errors import LadarError
+from ladartui.flight import FlightPlan, Orbit
+from ladartui.render import colour
+from ladartui.render.raster import screen_coordinates
+from ladartui.scenario import Scenario
+from ladartui.scene.generate import generate_scene
+from ladartui.sensor import Sensor
+from ladartui.tui.app import LadarApp
+from ladartui.tui.canvas import ProjectionWidget, TopViewWidget
+from ladartui.tui.view_area import ViewArea
+
+SIZE = (120, 40)
+
+
+@pytest.fixture(scope="module")
+def scenario_path(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("views")
+    generated = generate_scene("small", seed=3, width=16.0, depth=16.0, trees=5)
+    scene_path, _ = generated.write(folder / "forest")
+    centre = tuple(round(float(v), 3) for v in generated.target_centre)
+    scenario = Scenario(folder / "views.toml", scene_path, generated.voxel_size,
+                        Sensor(grid=8, ray_grid=1, fov=8.0),
+                        FlightPlan(None, (Orbit(centre=centre, radius=30.0, altitude=30.0,
+                                                scans=6),)))
+    return scenario.save().path
+
+
+@pytest_asyncio.fixture(loop_scope="module", scope="module")
+async def app_pilot(scenario_path):
+    app = LadarApp(scenario_path, compile_in_child=False)
+    async with app.run_test(size=SIZE) as pilot:
+        start = time.monotonic()
+        while app.scene is None or app.busy is not None:
+            assert time.monotonic() - start < 120, "the app did not load the scene"
+            await pilot.pause(0.05)
+        yield pilot
+
+
+async def reset(pilot):
+    app = pilot.app
+    area = app.query_one(ViewArea)
+    app.action_layout(5)
+    area.fit_path()
+    area.query_one("#scene3d", ProjectionWidget).action_reset_view()
+    await pilot.pause()
+    return app, area
+
+
+def target_pixels(widget: ProjectionWidget, box):
+    rows, cols = widget.picture_size()
+    lo, hi = box
+    corners = np.array([[x, y, z] for x in (lo[0] - .5, hi[0] + .5) for y in (lo[1] - .5, hi[1] + .5)
+                        for z in (lo[2] - .5, hi[2] + .5)])
+    row, col, _, _ = screen_coordinates(corners, widget.camera, rows, cols, widget.bounds)
+    return row, col, rows, cols
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_zoom_to_target_frames_the_target_in_every_view(app_pilot):
+    pilot = app_pilot
+    app, area = await reset(pilot)
+    scene3d = app.query_one("#scene3d", ProjectionWidget)
+    output3d = app.query_one("#output3d", ProjectionWidget)
+    top = app.query_one(TopViewWidget)
+    box = area.prepared["target_box"]
+    row, col, rows, cols = target_pixels(scene3d, box)
+    before = max(np.ptp(row) / rows, np.ptp(col) / cols)
+    assert before < 0.3  # a small patch while the views show the whole flight path
+    scene3d.focus()
+    await pilot.press("t")
+    await pilot.pause()
+    for widget in (scene3d, output3d):
+        row, col, rows, cols = target_pixels(widget, box)
+        assert row.min() >= 0 and row.max() <= rows and col.min() >= 0 and col.max() <= cols
+        assert max(np.ptp(row) / rows, np.ptp(col) / cols) == pytest.approx(0.9, abs=0.05)
+    # the top view's window holds the target's columns and little else
+    x0, y0, x1, y1 = top.frame
+    assert x0 < box[0][0] and box[1][0] + 1 < x1 and y0 < box[0][1] and box[1][1] + 1 < y1
+    assert (x1 - x0) < 1.3 * (box[1][0] - box[0][0] + 1) + 2
+    # and the target shows there in its colour
+    rows, cols = top.picture_size()
+    picture = top.make_picture(rows, cols)
+    magenta = np.all(picture.rgb == colour.TARGET_RGB, axis=-1)
+    scale, _, _ = top.top.fit(rows, cols, top.frame)  # cells per pixel
+    columns = len(np.unique(area.prepared["target"][:, :2], axis=0))
+    assert magenta.sum() == pytest.approx(columns / scale ** 2, rel=0.25)
+    assert magenta.sum() > 200
+    # turning the view keeps the target in the middle
+    await pilot.press("right")
+    row, col, rows, cols = target_pixels(scene3d, box)
+    assert (row.mean(), col.mean()) == pytest.approx((rows / 2, cols / 2), abs=1.0)
+    # a scene loaded again is framed whole again, at the same angles
+    azimuth = scene3d.camera.azimuth
+    area.set_scene(area.prepared, area.voxel_size)
+    await pilot.pause()
+    assert scene3d.camera.centre is None and scene3d.camera.zoom == 1.0
+    assert scene3d.camera.azimuth == azimuth and top.framing == "path"
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_top_view_zooms_pans_and_goes_back_to_the_path(app_pilot):
+    pilot = app_pilot
+    app, area = await reset(pilot)
+    top = app.query_one(TopViewWidget)
+    start = top.frame
+    top.focus()
+    await pilot.press("plus")
+    x0, y0, x1, y1 = top.frame
+    assert (x1 - x0) == pytest.approx((start[2] - start[0]) / 1.25)
+    assert (x0 + x1) / 2 == pytest.approx((start[0] + start[2]) / 2)
+    assert "m across" in top.border_title
+    await pilot.press("d")
+    assert top.frame[0] == pytest.approx(x0 + 0.1 * (x1 - x0))
+    await pilot.press("minus", "minus")
+    assert top.frame[2] - top.frame[0] == pytest.approx((start[2] - start[0]) * 1.25 / 1.25 / 0.8,
+                                                        rel=1e-9)
+    # a new flight path leaves a zoomed window alone; 0 follows the path again
+    frame = top.frame
+    app.update_scenario(app.scenario)
+    await pilot.pause()
+    assert top.frame == frame
+    await pilot.press("0")
+    assert top.frame == start and top.border_title == "Top view"
+    # the wheel zooms about the point under the pointer (cell 10, 5 of the content area)
+    rows, cols = top.picture_size()
+    under = top.top.to_cells(2 * 5 + 1, 10.5, rows, cols, top.frame)
+    # the pilot's own mouse-event helper (textual is pinned)
+    await pilot._post_mouse_events([events.MouseScrollUp], top, offset=(11, 6))
+    await pilot.pause()
+    x0, y0, x1, y1 = top.frame
+    assert x1 - x0 == pytest.approx((start[2] - start[0]) / 1.25)
+    assert top.top.to_cells(2 * 5 + 1, 10.5, rows, cols, top.frame) == pytest.approx(under)
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_output_colours_show_what_the_foliage_hid_and_switch_to_height(app_pilot):
+    pilot = app_pilot
+    app, area = await reset(pilot)
+    target = area.prepared["target"]
+    seen, hidden = target[: len(target) // 2], target[len(target) // 2:]
+    canopy = np.array([[x, y, 30] for x in range(5) for y in range(5)])
+    area.show_output(np.vstack([canopy, seen]), None, target_output=target)
+    output3d = app.query_one("#output3d", ProjectionWidget)
+    rgbs = [layer.rgb for layer in output3d.voxel_layers]
+    counts = [len(layer.voxels) for layer in output3d.voxel_layers]
+    assert rgbs == [None, colour.HIDDEN_RGB, colour.TARGET_RGB]
+    assert counts == [len(canopy), len(hidden), len(seen)]
+    output3d.focus()
+    await pilot.press("c")
+    assert "(height)" in output3d.border_title
+    assert [layer.rgb for layer in output3d.voxel_layers] == [None, colour.TARGET_RGB]
+    await pilot.press("c")
+    assert "(height)" not in output3d.border_title
+    # with each scan's returns, a third colouring counts the scans that saw each target voxel
+    area.show_output(np.vstack([canopy, seen]), None, target_output=target,
+                     per_scan=[seen, seen[:3]])
+    await pilot.press("c", "c")
+    assert "scans that saw it" in output3d.border_title
+    values = output3d.voxel_layers[1].values
+    assert sorted(values.tolist()) == sorted([2] * 3 + [1] * (len(seen) - 3))
+    await pilot.press("c")
+    assert "scans" not in output3d.border_title and "(height)" not in output3d.border_title
+    area.show_output(np.vstack([canopy, seen]), None, target_output=target)  # no per-scan data
+    await pilot.press("c", "c")
+    assert "scans" not in output3d.border_title and "(height)" not in output3d.border_title
+    # the threshold keeps the target, drops the canopy and spreads the colours over what is left
+    ground = np.array([[x, y, 0] for x in range(10) for y in range(10)])
+    area.show_output(np.vstack([canopy, ground, seen]), 2.0, target_output=target)
+    assert len(output3d.voxel_layers[0].voxels) == len(ground)
+    assert output3d.height_range == (0.0, max(float(target[:, 2].max()), 1.0))
+    # what the view draws keeps a contrast of 3 against its background, in both colourings
+    for _ in range(2):
+        await pilot.press("c")
+        image = output3d.make_picture(*output3d.picture_size())
+        drawn = np.unique(image.rgb[image.voxel_mask], axis=0)
+        assert len(drawn) >= 2 and (~image.mask).any()
+        assert colour.contrast_ratio(drawn, colour.BACKGROUND).min() >= 3.0
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_a_view_saves_as_a_png_of_the_requested_size(app_pilot, tmp_path):
+    from PIL import Image
+
+    pilot = app_pilot
+    app, area = await reset(pilot)
+    for view in ("scene3d", "topview"):
+        path = area.save_png(tmp_path / f"{view}.png", 321, 123, view)
+        with Image.open(path) as image:
+            assert image.format == "PNG" and image.size == (321, 123)
+            assert len(np.unique(np.asarray(image).reshape(-1, 3), axis=0)) > 5  # not blank
+    with pytest.raises(LadarError, match="picture size = '5 x 123': expected whole numbers"):
+        area.save_png(tmp_path / "bad.png", 5, 123)
+    assert not (tmp_path / "bad.png").exists()
