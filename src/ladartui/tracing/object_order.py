@@ -187,9 +187,10 @@ def _sort_into_bins(p, q, grid, nb, shift):
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def _gather(order, orig, dirs, lo, hi, rays, exits):
-    """Rays in sorted order (origin then direction per row), and where each leaves
-    the box [lo, hi)."""
+def _gather(order, orig, dirs, lo, hi, rays, invs, exits):
+    """Rays in sorted order (origin then direction per row), their inverse directions
+    (the kernels' ``1 / d``, inf for 0: the tile tests then divide nothing), and where
+    each leaves the box [lo, hi)."""
     for k in prange(order.shape[0]):
         r = order[k]
         leave = INF
@@ -197,6 +198,7 @@ def _gather(order, orig, dirs, lo, hi, rays, exits):
             rays[k, a] = orig[r, a]
             rays[k, 3 + a] = dirs[r, a]
             inv = 1.0 / dirs[r, a] if dirs[r, a] != 0.0 else INF
+            invs[k, a] = inv
             leave = min(leave, slab(orig[r, a], dirs[r, a], inv, lo[a], hi[a])[1])
         exits[k] = leave
 
@@ -215,18 +217,19 @@ def ray_grid(dirs, axis, u, v, nb):
 
 
 def sort_rays(p, q, grid, nb, shift, orig, dirs, lo, hi):
-    """Rays in bin order: (starts, order, bins, rays, exits).
+    """Rays in bin order: (starts, order, bins, rays, invs, exits).
 
     The rays of the bin with key ``b`` (``bin_key``) are sorted positions
     ``starts[b] .. starts[b + 1]``; ``order`` maps a sorted position back to the
-    ray; ``rays`` holds its origin and direction, ``bins`` its bin; its exit is
+    ray; ``rays`` holds its origin and direction, ``invs`` its ``1 / d`` per axis,
+    ``bins`` its bin; its exit is
     where it leaves the occupied box [lo, hi) (every voxel hit comes before it).
     """
     n = len(p)
     starts, order, bins = _sort_into_bins(p, q, grid, nb, shift)
-    rays, exits = np.empty((n, 6)), np.empty(n)
-    _gather(order, orig, dirs, lo, hi, rays, exits)
-    return starts, order, bins, rays, exits
+    rays, invs, exits = np.empty((n, 6)), np.empty((n, 3)), np.empty(n)
+    _gather(order, orig, dirs, lo, hi, rays, invs, exits)
+    return starts, order, bins, rays, invs, exits
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -454,7 +457,7 @@ def _tile_far(bin_starts, tile, best_t):
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, rays, best_t,
+def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, rays, invs, best_t,
                best_v):
     """Nearest hit of each sorted ray among the voxels of its tile (tiles of TILE bins).
 
@@ -493,9 +496,9 @@ def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, 
                     # The slab test of the reference tracer: the voxel's open interior.
                     ox, oy, oz = rays[s, 0], rays[s, 1], rays[s, 2]
                     dx, dy, dz = rays[s, 3], rays[s, 4], rays[s, 5]
-                    ex, lx = slab(ox, dx, 1.0 / dx if dx != 0.0 else INF, x, x + 1.0)
-                    ey, ly = slab(oy, dy, 1.0 / dy if dy != 0.0 else INF, y, y + 1.0)
-                    ez, lz = slab(oz, dz, 1.0 / dz if dz != 0.0 else INF, z, z + 1.0)
+                    ex, lx = slab(ox, dx, invs[s, 0], x, x + 1.0)
+                    ey, ly = slab(oy, dy, invs[s, 1], y, y + 1.0)
+                    ez, lz = slab(oz, dz, invs[s, 2], z, z + 1.0)
                     enter, leave = max(ex, max(ey, ez)), min(lx, min(ly, lz))
                     start = max(enter, 0.0)
                     if start < leave and start < best:
@@ -530,7 +533,7 @@ class Scan(NamedTuple):
     """A scan made ready for the tile tests (``prepare_scan``).
 
     Sorted position ``s`` is ray ``order[s]``, with origin and direction
-    ``rays[s]``, bin ``bins[s]`` (``i | j << 16``) and bound ``exits[s]``; the
+    ``rays[s]`` (``invs[s]`` its ``1 / d``), bin ``bins[s]`` (``i | j << 16``) and bound ``exits[s]``; the
     rays of bin key ``b`` are ``bin_starts[b] .. bin_starts[b + 1]``. ``vox`` and
     ``nears`` are the voxels in view (``emit_voxels``), ``tile_starts`` and
     ``listed`` each tile's voxels (``voxels_per_tile``).
@@ -538,6 +541,7 @@ class Scan(NamedTuple):
 
     order: np.ndarray
     rays: np.ndarray
+    invs: np.ndarray
     bins: np.ndarray
     exits: np.ndarray
     bin_starts: np.ndarray
@@ -568,14 +572,14 @@ def prepare_scan(occ, orig, dirs, frame, max_voxels, tile_shift=TILE_SHIFT):
     first = voxel_starts(found, occ.bricks) if ok else None
     if not ok or first[-1] > max_voxels:
         return None
-    bin_starts, order, bins, rays, exits = sort_rays(p, q, grid, nb, tile_shift, orig, dirs,
+    bin_starts, order, bins, rays, invs, exits = sort_rays(p, q, grid, nb, tile_shift, orig, dirs,
                                                      occ.bbox_lo.astype(np.float64),
                                                      occ.bbox_hi.astype(np.float64))
     vox, nears = emit_voxels(found, brick_near, first, occ.bricks, centre, grow, axis, u, v, grid,
                              nb)
     tiles_per_side = -(-nb >> tile_shift)
     tile_starts, listed = voxels_per_tile(vox, tiles_per_side, tile_shift)
-    return Scan(order, rays, bins, exits, bin_starts, vox, nears, tile_starts, listed, nb,
+    return Scan(order, rays, invs, bins, exits, bin_starts, vox, nears, tile_starts, listed, nb,
                 tile_shift, tiles_per_side)
 
 
@@ -592,7 +596,7 @@ def nearest_voxels(occ, orig, dirs, frame, max_voxels):
     best_t = scan.exits
     best_v = np.full(len(best_t), -1, np.int64)
     test_tiles(scan.vox, scan.nears, scan.tile_starts, scan.listed, scan.tiles_per_side,
-               scan.bin_starts, scan.nb, scan.rays, best_t, best_v)
+               scan.bin_starts, scan.nb, scan.rays, scan.invs, best_t, best_v)
     return scan.order, best_t, best_v, scan.vox
 
 
