@@ -464,7 +464,11 @@ def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, 
     ``best_t`` starts at each ray's exit from the occupied box, a bound no hit
     reaches (a voxel's interval ends inside the box), ``best_v`` at -1. A tile
     stops when no later brick can come nearer than every ray's bound.
-    shaders/object_order.wgsl runs the same tests ray by ray.
+    Per row of the tile a mask of live bins: a bin whose every ray has a bound
+    at or before the current brick's ``near`` is cleared when next met, since
+    no later brick (nears only grow down the list) can come nearer; its rays
+    are then never read again (most candidates of a scan are such rays, behind
+    their hit). shaders/object_order.wgsl runs the same tests ray by ray.
     """
     nt = tiles_per_side
     for tile in prange(nt * nt):
@@ -472,39 +476,58 @@ def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, 
         bi1 = min(nb, bi0 + TILE) - 1
         bj0 = (tile // nt) * TILE
         bj1 = min(nb, bj0 + TILE) - 1
+        base = tile * TILE * TILE  # bin_key of the tile's first bin; rows of TILE follow
+        live = np.zeros(TILE, np.int64)  # per row: bit c set while bin (bi0 + c) may still change
+        for r in range(bj1 - bj0 + 1):
+            for c in range(bi1 - bi0 + 1):
+                k = base + r * TILE + c
+                if bin_starts[k + 1] > bin_starts[k]:
+                    live[r] |= np.int64(1) << c
         far = _tile_far(bin_starts, tile, best_t)  # no bound of the tile is beyond
         stale = False  # far may be lowered (bounds moved nearer since it was taken)
         for e in range(tile_starts[tile], tile_starts[tile + 1]):
             q = listed[e]
-            if nears[q, 1] >= far:
+            brick_near = nears[q, 1]
+            if brick_near >= far:
                 if stale:
                     far = _tile_far(bin_starts, tile, best_t)
                     stale = False
-                if nears[q, 1] >= far:
+                if brick_near >= far:
                     break
             near = nears[q, 0]
             if near >= far:
                 continue
             x, y, z = np.float64(vox[q, 0]), np.float64(vox[q, 1]), np.float64(vox[q, 2])
-            i0, i1 = max(vox[q, 3], bi0), min(vox[q, 4], bi1)
-            for bj in range(max(vox[q, 5], bj0), min(vox[q, 6], bj1) + 1):
-                for s in range(bin_starts[bin_key(i0, bj, nt, TILE_SHIFT)],
-                               bin_starts[bin_key(i1, bj, nt, TILE_SHIFT) + 1]):
-                    best = best_t[s]
-                    if best <= near:
+            c0, c1 = max(vox[q, 3], bi0) - bi0, min(vox[q, 4], bi1) - bi0
+            span = ((np.int64(2) << c1) - 1) ^ ((np.int64(1) << c0) - 1)
+            for r in range(max(vox[q, 5], bj0) - bj0, min(vox[q, 6], bj1) - bj0 + 1):
+                row = live[r] & span
+                if row == 0:
+                    continue
+                for c in range(c0, c1 + 1):
+                    if (row >> c) & 1 == 0:
                         continue
-                    # The slab test of the reference tracer: the voxel's open interior.
-                    ox, oy, oz = rays[s, 0], rays[s, 1], rays[s, 2]
-                    dx, dy, dz = rays[s, 3], rays[s, 4], rays[s, 5]
-                    ex, lx = slab(ox, dx, invs[s, 0], x, x + 1.0)
-                    ey, ly = slab(oy, dy, invs[s, 1], y, y + 1.0)
-                    ez, lz = slab(oz, dz, invs[s, 2], z, z + 1.0)
-                    enter, leave = max(ex, max(ey, ez)), min(lx, min(ly, lz))
-                    start = max(enter, 0.0)
-                    if start < leave and start < best:
-                        best_t[s] = start
-                        best_v[s] = q
-                        stale = True
+                    k = base + r * TILE + c
+                    alive = False
+                    for s in range(bin_starts[k], bin_starts[k + 1]):
+                        best = best_t[s]
+                        if best > near:
+                            # The slab test of the reference tracer: the voxel's open interior.
+                            ox, oy, oz = rays[s, 0], rays[s, 1], rays[s, 2]
+                            dx, dy, dz = rays[s, 3], rays[s, 4], rays[s, 5]
+                            ex, lx = slab(ox, dx, invs[s, 0], x, x + 1.0)
+                            ey, ly = slab(oy, dy, invs[s, 1], y, y + 1.0)
+                            ez, lz = slab(oz, dz, invs[s, 2], z, z + 1.0)
+                            enter, leave = max(ex, max(ey, ez)), min(lx, min(ly, lz))
+                            start = max(enter, 0.0)
+                            if start < leave and start < best:
+                                best_t[s] = start
+                                best_v[s] = q
+                                best = start
+                                stale = True
+                        alive = alive or best > brick_near
+                    if not alive:
+                        live[r] &= ~(np.int64(1) << c)
 
 
 @njit(nogil=True, cache=True, inline="always")
