@@ -151,12 +151,19 @@ def bin_key(i, j, tiles_per_side, shift):
     return ((((j >> shift) * tiles_per_side + (i >> shift)) << shift | (j & mask)) << shift) | (i & mask)
 
 
+@njit(nogil=True, cache=True, inline="always")
+def _bin_of(p, q, grid, nb):
+    """(i, j): the bin of gnomonic coordinates (p, q), clamped into the nb x nb grid."""
+    i = min(nb - 1, max(0, np.int64((p - grid[0]) / grid[1])))
+    j = min(nb - 1, max(0, np.int64((q - grid[2]) / grid[3])))
+    return i, j
+
+
 @njit(parallel=True, nogil=True, cache=True)
 def _bin_keys(p, q, grid, nb, shift, key_of, bin_of):
     nt = -(-nb >> shift)
     for r in prange(p.shape[0]):
-        i = min(nb - 1, max(0, np.int64((p[r] - grid[0]) / grid[1])))
-        j = min(nb - 1, max(0, np.int64((q[r] - grid[2]) / grid[3])))
+        i, j = _bin_of(p[r], q[r], grid, nb)
         key_of[r] = bin_key(i, j, nt, shift)
         bin_of[r] = np.uint32(i | (j << 16))
 
@@ -186,21 +193,50 @@ def _sort_into_bins(p, q, grid, nb, shift):
     return starts, order, bins
 
 
+@njit(nogil=True, cache=True, inline="always")
+def _put(k, r, orig, dirs, lo, hi, rays, invs, exits):
+    """Ray r at sorted position k: origin, direction, ``1 / d`` (the kernels' inverse,
+    inf for 0: the tile tests then divide nothing) and where it leaves the box [lo, hi)."""
+    leave = INF
+    for a in range(3):
+        rays[k, a] = orig[r, a]
+        rays[k, 3 + a] = dirs[r, a]
+        inv = 1.0 / dirs[r, a] if dirs[r, a] != 0.0 else INF
+        invs[k, a] = inv
+        leave = min(leave, slab(orig[r, a], dirs[r, a], inv, lo[a], hi[a])[1])
+    exits[k] = leave
+
+
 @njit(parallel=True, nogil=True, cache=True)
 def _gather(order, orig, dirs, lo, hi, rays, invs, exits):
-    """Rays in sorted order (origin then direction per row), their inverse directions
-    (the kernels' ``1 / d``, inf for 0: the tile tests then divide nothing), and where
-    each leaves the box [lo, hi)."""
+    """Rays in sorted order (``_put``)."""
     for k in prange(order.shape[0]):
-        r = order[k]
-        leave = INF
-        for a in range(3):
-            rays[k, a] = orig[r, a]
-            rays[k, 3 + a] = dirs[r, a]
-            inv = 1.0 / dirs[r, a] if dirs[r, a] != 0.0 else INF
-            invs[k, a] = inv
-            leave = min(leave, slab(orig[r, a], dirs[r, a], inv, lo[a], hi[a])[1])
-        exits[k] = leave
+        _put(k, order[k], orig, dirs, lo, hi, rays, invs, exits)
+
+
+@njit(parallel=True, nogil=True, cache=True)
+def _scatter_one_per_bin(p, q, grid, nb, shift, order, bins):
+    """The sort when every bin holds exactly one ray (a whole scan, whose own ray grid
+    the bins then are): each ray's number goes straight to the position of its bin's
+    key, in one parallel pass. Needs nb * nb rays and whole tiles (the keys are then
+    0 .. n-1). False when some bin got none (so another got two): the caller sorts
+    instead."""
+    n = p.shape[0]
+    nt = nb >> shift
+    for k in prange(n):
+        order[k] = -1
+    for r in prange(n):
+        i, j = _bin_of(p[r], q[r], grid, nb)
+        k = bin_key(i, j, nt, shift)
+        order[k] = r
+        bins[k] = np.uint32(i | (j << 16))
+    missing = np.zeros(PARTS, np.bool_)
+    for part in prange(PARTS):
+        for k in range(part * n // PARTS, (part + 1) * n // PARTS):
+            if order[k] < 0:
+                missing[part] = True
+                break
+    return not missing.any()
 
 
 def ray_grid(dirs, axis, u, v, nb):
@@ -224,10 +260,18 @@ def sort_rays(p, q, grid, nb, shift, orig, dirs, lo, hi):
     ray; ``rays`` holds its origin and direction, ``invs`` its ``1 / d`` per axis,
     ``bins`` its bin; its exit is
     where it leaves the occupied box [lo, hi) (every voxel hit comes before it).
+    A whole scan has one ray per bin (nb = ceil(sqrt(n)) bins a side over its own
+    ray grid): then a parallel scatter of the ray numbers replaces the serial
+    counting sort (``_scatter_one_per_bin``; same result when both apply).
     """
     n = len(p)
-    starts, order, bins = _sort_into_bins(p, q, grid, nb, shift)
     rays, invs, exits = np.empty((n, 6)), np.empty((n, 3)), np.empty(n)
+    if n == nb * nb and nb % (1 << shift) == 0:
+        order, bins = np.empty(n, np.int64), np.empty(n, np.uint32)
+        if _scatter_one_per_bin(p, q, grid, nb, shift, order, bins):
+            _gather(order, orig, dirs, lo, hi, rays, invs, exits)
+            return np.arange(n + 1, dtype=np.int64), order, bins, rays, invs, exits
+    starts, order, bins = _sort_into_bins(p, q, grid, nb, shift)
     _gather(order, orig, dirs, lo, hi, rays, invs, exits)
     return starts, order, bins, rays, invs, exits
 
