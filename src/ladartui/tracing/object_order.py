@@ -500,6 +500,18 @@ def _tile_far(bin_starts, tile, best_t):
     return far
 
 
+@njit(nogil=True, cache=True, inline="always")
+def _slab_start(rays, invs, s, x, y, z, best):
+    """Where sorted ray s enters voxel (x, y, z) (the reference tracer's slab test of
+    its open interior, from t = 0 on); ``best`` when it does not, or not before."""
+    ex, lx = slab(rays[s, 0], rays[s, 3], invs[s, 0], x, x + 1.0)
+    ey, ly = slab(rays[s, 1], rays[s, 4], invs[s, 1], y, y + 1.0)
+    ez, lz = slab(rays[s, 2], rays[s, 5], invs[s, 2], z, z + 1.0)
+    enter, leave = max(ex, max(ey, ez)), min(lx, min(ly, lz))
+    start = max(enter, 0.0)
+    return start if start < leave and start < best else best
+
+
 @njit(parallel=True, nogil=True, cache=True)
 def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, rays, invs, best_t,
                best_v):
@@ -522,11 +534,15 @@ def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, 
         bj1 = min(nb, bj0 + TILE) - 1
         base = tile * TILE * TILE  # bin_key of the tile's first bin; rows of TILE follow
         live = np.zeros(TILE, np.int64)  # per row: bit c set while bin (bi0 + c) may still change
+        first = bin_starts[base]
+        single = True  # one ray in every bin of the tile: bin k's ray is first + k - base
         for r in range(bj1 - bj0 + 1):
             for c in range(bi1 - bi0 + 1):
                 k = base + r * TILE + c
                 if bin_starts[k + 1] > bin_starts[k]:
                     live[r] |= np.int64(1) << c
+                single = single and bin_starts[k + 1] - bin_starts[k] == 1 \
+                    and bin_starts[k] == first + r * TILE + c
         far = _tile_far(bin_starts, tile, best_t)  # no bound of the tile is beyond
         stale = False  # far may be lowered (bounds moved nearer since it was taken)
         for e in range(tile_starts[tile], tile_starts[tile + 1]):
@@ -552,19 +568,14 @@ def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, 
                     if (row >> c) & 1 == 0:
                         continue
                     k = base + r * TILE + c
+                    lo_s, hi_s = (first + r * TILE + c, first + r * TILE + c + 1) if single \
+                        else (bin_starts[k], bin_starts[k + 1])
                     alive = False
-                    for s in range(bin_starts[k], bin_starts[k + 1]):
+                    for s in range(lo_s, hi_s):
                         best = best_t[s]
                         if best > near:
-                            # The slab test of the reference tracer: the voxel's open interior.
-                            ox, oy, oz = rays[s, 0], rays[s, 1], rays[s, 2]
-                            dx, dy, dz = rays[s, 3], rays[s, 4], rays[s, 5]
-                            ex, lx = slab(ox, dx, invs[s, 0], x, x + 1.0)
-                            ey, ly = slab(oy, dy, invs[s, 1], y, y + 1.0)
-                            ez, lz = slab(oz, dz, invs[s, 2], z, z + 1.0)
-                            enter, leave = max(ex, max(ey, ez)), min(lx, min(ly, lz))
-                            start = max(enter, 0.0)
-                            if start < leave and start < best:
+                            start = _slab_start(rays, invs, s, x, y, z, best)
+                            if start < best:
                                 best_t[s] = start
                                 best_v[s] = q
                                 best = start
