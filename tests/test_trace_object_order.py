@@ -297,3 +297,29 @@ def test_a_whole_scan_sorts_by_scatter_as_the_counting_sort_does(duplicate):
     for mine, theirs in zip(got, (starts, order, bins, rays, invs, exits)):
         assert np.array_equal(mine, theirs)
     assert np.array_equal(np.diff(starts) == 1, np.ones(nb * nb, bool)) == (not duplicate)
+
+
+def test_order_choice_reads_the_given_clock():
+    # A block that waits (as when other processes hold the cores) costs no CPU time:
+    # on the process's CPU clock the order that computes less wins even though it
+    # took longer by the wall clock; on the wall clock the other one does.
+    import time
+
+    from ladartui.tracing.object_order import MIN_SCAN_RAYS, OrderChoice, trace_in_blocks
+
+    def waits(a, b, max_voxels):  # object order: 30 ms of wall time, no CPU
+        time.sleep(0.03)
+        return True
+
+    def computes(a, b):  # ray order: about 10 ms of CPU
+        end = time.process_time() + 0.01
+        while time.process_time() < end:
+            pass
+
+    picks = {}
+    for name, clock in (("cpu", time.process_time), ("wall", time.perf_counter)):
+        choice = OrderChoice()
+        for _ in range(6):
+            trace_in_blocks(MIN_SCAN_RAYS, None, choice, waits, computes, clock=clock)
+        picks[name] = choice.pick()
+    assert picks == {"cpu": "object", "wall": "ray"}

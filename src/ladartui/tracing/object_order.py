@@ -715,7 +715,8 @@ class OrderChoice:
             del recent[:-self.SAMPLES]
 
 
-def trace_in_blocks(n, object_order, choice, object_block, ray_block, cancel=None):
+def trace_in_blocks(n, object_order, choice, object_block, ray_block, cancel=None,
+                    clock=time.perf_counter):
     """Trace ``n`` exact rays in blocks of up to SCAN_BLOCK, each in object or ray
     order, as both backends do; returns the set of orders used.
 
@@ -724,7 +725,10 @@ def trace_in_blocks(n, object_order, choice, object_block, ray_block, cancel=Non
     ``ray_block(a, b)`` traces them in ray order. ``object_order`` True tries object
     order on every block, whatever it costs; None lets ``choice`` (this
     occupancy's OrderChoice) pick for blocks of at least MIN_SCAN_RAYS and learn
-    from their times.
+    from their times, read from ``clock``: wall time by default (a GPU's work costs
+    the host nothing), the process's CPU time for a CPU backend (time.process_time:
+    on a shared machine, other processes' work then does not make an order look
+    slow, and the choice does not flip with the load).
     """
     orders = set()
     for a in range(0, n, SCAN_BLOCK):
@@ -732,17 +736,17 @@ def trace_in_blocks(n, object_order, choice, object_block, ray_block, cancel=Non
         if cancel is not None and cancel.is_set():
             raise Cancelled("trace cancelled")
         learning = choice if object_order is None and b - a >= MIN_SCAN_RAYS else None
-        started = time.perf_counter()
+        started = clock()
         if object_order or (learning is not None and learning.pick() == "object"):
             limit = np.inf if object_order else VOXELS_PER_RAY * (b - a)
             if object_block(a, b, limit):
                 orders.add("object")
                 if learning is not None:
-                    learning.record("object", time.perf_counter() - started, b - a)
+                    learning.record("object", clock() - started, b - a)
                 continue
             learning = None  # no scan for object order: nothing to learn from this block
         orders.add("ray")
         ray_block(a, b)
         if learning is not None:
-            learning.record("ray", time.perf_counter() - started, b - a)
+            learning.record("ray", clock() - started, b - a)
     return orders
