@@ -1,6 +1,7 @@
 """``ladartui trace`` and ``ladartui bench --quick`` from the command line."""
 
 import json
+import math
 
 import numpy as np
 import pytest
@@ -126,18 +127,45 @@ def test_bench_quick_json(monkeypatch, tmp_path, capsys):
     report = json.loads(capsys.readouterr().out)
     assert report["voxels"] == len(small)
     assert report["occupancy_bytes"] > 0
-    rows = {(r["backend"], r["method"], r["depression"]) for r in report["results"]}
-    assert {("numba", "exact", 45.0), ("numba", "exact", 90.0), ("numba", "march", 45.0),
-            ("numba", "march", 90.0)} <= rows
+    rows = {(r["backend"], r["method"], r["view"], r["depression"]) for r in report["results"]}
+    assert {("numba", "exact", "wide", 45.0), ("numba", "exact", "wide", 90.0),
+            ("numba", "march", "wide", 45.0), ("numba", "march", "wide", 90.0),
+            ("numba", "exact", "narrow", 45.0), ("numba", "exact", "narrow", 90.0)} <= rows
+    assert not any(r["view"] == "narrow" and r["method"] == "march" for r in report["results"])
     assert all(r["rays_per_second"] > 0 for r in report["results"])
     # Which order each traced in: the march always walks the rays.
     assert all(set(r["order"].split("/")) <= {"object", "ray", "object+ray"} for r in report["results"])
     assert all(r["order"] == "ray" for r in report["results"] if r["method"] == "march")
     # Each row's share of numba's rays/s on the same method and angle.
-    numba = {(r["method"], r["depression"]): r["rays_per_second"]
+    numba = {(r["method"], r["view"], r["depression"]): r["rays_per_second"]
              for r in report["results"] if r["backend"] == "numba"}
     for r in report["results"]:
-        assert r["vs_numba"] == pytest.approx(r["rays_per_second"] / numba[r["method"], r["depression"]])
+        assert r["vs_numba"] == pytest.approx(
+            r["rays_per_second"] / numba[r["method"], r["view"], r["depression"]])
+
+
+@pytest.mark.parametrize("depression", [45.0, 90.0])
+def test_bench_narrow_view_is_the_peer_geometry(depression):
+    """The narrow view: 3 degrees across, from 150 m up, its central ray through the target."""
+    from ladartui.cli import bench
+    from ladartui.scene.model import Scene
+
+    target = np.array([[200, 300, 5], [201, 300, 5]])
+    scene = Scene(target, target, 0.1, shape=(1500, 1500, 900))
+    origins, directions = bench.bench_rays(scene, depression, grid=8, ray_grid=2, view="narrow")
+    centre = target.mean(axis=0) * 0.1
+    assert np.allclose(origins[:, 2], 150.0, atol=0.01)
+    mean = directions.mean(axis=0)
+    mean /= np.linalg.norm(mean)
+    to_target = centre - origins.mean(axis=0)
+    assert np.allclose(mean, to_target / np.linalg.norm(to_target), atol=1e-3)
+    assert math.degrees(math.asin(-mean[2])) == pytest.approx(depression, abs=0.1)
+    # 16 rays across a 3 degree view: the first and last of the first row (detector 7, sub-ray 1).
+    spread = math.degrees(math.acos(np.clip(directions[0] @ directions[29], -1, 1)))
+    assert spread == pytest.approx(3.0 * 15 / 16, rel=0.02)
+    if depression < 90.0:
+        bearing = math.degrees(math.atan2(mean[0], mean[1])) % 360
+        assert bearing == pytest.approx(bench.NARROW_BEARING, abs=0.1)
 
 
 def test_bench_rejects_a_run_count_below_one(capsys):

@@ -271,3 +271,55 @@ def test_bins_are_numbered_tile_by_tile():
             assert np.array_equal(row, row[0] + np.arange(len(row)))
     tile_of = (np.arange(nb)[None, :] // tile) + tiles * (np.arange(nb)[:, None] // tile)
     assert np.array_equal(keys // (tile * tile), tile_of)
+
+
+@pytest.mark.parametrize("duplicate", [False, True])
+def test_a_whole_scan_sorts_by_scatter_as_the_counting_sort_does(duplicate):
+    # One ray per bin (a whole scan over its own ray grid): the parallel scatter; a ray
+    # moved into its neighbour's bin leaves a bin empty: the counting sort. Same result.
+    from ladartui.tracing import object_order as oo
+
+    origins, directions = one_scan([100, 100, 10], 60.0, 0.4, 300.0,
+                                   sensor=Sensor(grid=16, ray_grid=4, fov=5.0))
+    if duplicate:
+        directions[5] = directions[6]
+    centre, _, axis, u, v = cone_frame(origins, directions)
+    nb = 64
+    p, q, grid = oo.ray_grid(directions, axis, u, v, nb)
+    lo, hi = np.zeros(3), np.full(3, 200.0)
+    order = np.empty(nb * nb, np.int64)
+    assert oo._scatter_one_per_bin(p, q, grid, nb, 4, order, np.empty(nb * nb, np.uint32)) \
+        == (not duplicate)
+    got = oo.sort_rays(p, q, grid, nb, 4, origins, directions, lo, hi)
+    starts, order, bins = oo._sort_into_bins(p, q, grid, nb, 4)
+    rays, invs, exits = np.empty((nb * nb, 6)), np.empty((nb * nb, 3)), np.empty(nb * nb)
+    oo._gather(order, origins, directions, lo, hi, rays, invs, exits)
+    for mine, theirs in zip(got, (starts, order, bins, rays, invs, exits)):
+        assert np.array_equal(mine, theirs)
+    assert np.array_equal(np.diff(starts) == 1, np.ones(nb * nb, bool)) == (not duplicate)
+
+
+def test_order_choice_reads_the_given_clock():
+    # A block that waits (as when other processes hold the cores) costs no CPU time:
+    # on the process's CPU clock the order that computes less wins even though it
+    # took longer by the wall clock; on the wall clock the other one does.
+    import time
+
+    from ladartui.tracing.object_order import MIN_SCAN_RAYS, OrderChoice, trace_in_blocks
+
+    def waits(a, b, max_voxels):  # object order: 30 ms of wall time, no CPU
+        time.sleep(0.03)
+        return True
+
+    def computes(a, b):  # ray order: about 10 ms of CPU
+        end = time.process_time() + 0.01
+        while time.process_time() < end:
+            pass
+
+    picks = {}
+    for name, clock in (("cpu", time.process_time), ("wall", time.perf_counter)):
+        choice = OrderChoice()
+        for _ in range(6):
+            trace_in_blocks(MIN_SCAN_RAYS, None, choice, waits, computes, clock=clock)
+        picks[name] = choice.pick()
+    assert picks == {"cpu": "object", "wall": "ray"}

@@ -4,7 +4,10 @@ On the ``reference`` scene (generated into the cache folder when absent) with
 a 128 x 128 sensor and 4 x 4 rays per detector, it measures rays per second
 at 45 degrees depression and at nadir (median of several runs after a
 warm-up; backends take turns, each turn an untimed run then a timed one),
-the occupancy set-up time and its memory. Backends come from the
+the occupancy set-up time and its memory. Two views: ``wide`` (the sensor's
+default 10 degree field of view from 85 m, both methods) and ``narrow`` (a 3
+degree view from 150 m up, looking along bearing 60 degrees, exact only: the
+geometry of the side-by-side comparison with Embree). Backends come from the
 registry, so a new backend appears here by registering itself.
 """
 
@@ -23,13 +26,19 @@ from ladartui.errors import BackendUnavailable
 
 DEPRESSIONS = (45.0, 90.0)
 SLANT_RANGE_M = 85.0  # aircraft distance from the aimed target (the default orbit's minimum)
+# The narrow view: a long lens from high up (the peer comparison's geometry).
+NARROW_FOV = 3.0
+NARROW_ALTITUDE_M = 150.0
+NARROW_BEARING = 60.0  # compass bearing from the aircraft to the target
+VIEWS = ("wide", "narrow")
 
 
 def add_parser(subparsers):
     parser = subparsers.add_parser(
         "bench", help="measure tracing speed of every available backend and method",
         description="Trace the reference scene with a 128x128 sensor (4x4 rays per detector) "
-        "at 45 degrees and at nadir; report rays/s, set-up time and occupancy memory.")
+        "at 45 degrees and at nadir, in a wide view (10 degrees from 85 m) and a narrow one "
+        "(3 degrees from 150 m up, exact only); report rays/s, set-up time and occupancy memory.")
     parser.add_argument("--quick", action="store_true",
                         help="fewer runs and a 64x64 sensor (a smoke test, not a measurement)")
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
@@ -128,8 +137,12 @@ def load_bench_scene():
     return scene, "reference"
 
 
-def bench_rays(scene, depression, grid=128, ray_grid=4):
-    """Origins and directions (metres) of one look at the target (else the scene centre)."""
+def bench_rays(scene, depression, grid=128, ray_grid=4, view="wide"):
+    """Origins and directions (metres) of one look at the target (else the scene centre).
+
+    ``wide``: the default field of view from SLANT_RANGE_M away, looking north;
+    ``narrow``: NARROW_FOV from NARROW_ALTITUDE_M up, looking along NARROW_BEARING.
+    """
     from ladartui.flight import ScanPose, aim_at
     from ladartui.sensor import Sensor
 
@@ -139,12 +152,20 @@ def bench_rays(scene, depression, grid=128, ray_grid=4):
     else:
         centre = np.array([nx / 2, ny / 2, 0.0]) * scene.voxel_size
     e = math.radians(depression)
-    aircraft = centre + SLANT_RANGE_M * np.array([0.0, -math.cos(e), math.sin(e)])
+    if view == "narrow":
+        height = NARROW_ALTITUDE_M - centre[2]
+        back = height / math.tan(e) if depression < 90.0 else 0.0
+        b = math.radians(NARROW_BEARING)
+        aircraft = centre + np.array([-back * math.sin(b), -back * math.cos(b), height])
+        sensor = Sensor(grid=grid, ray_grid=ray_grid, fov=NARROW_FOV)
+    else:
+        aircraft = centre + SLANT_RANGE_M * np.array([0.0, -math.cos(e), math.sin(e)])
+        sensor = Sensor(grid=grid, ray_grid=ray_grid)
     if depression >= 90.0:
         aircraft[:2] = centre[:2]
     pose = aim_at(ScanPose(float(aircraft[0]), float(aircraft[1]), float(aircraft[2]),
                            0.0, 0.0, 90.0), centre.tolist())
-    origins, directions, _ = Sensor(grid=grid, ray_grid=ray_grid).rays(pose)
+    origins, directions, _ = sensor.rays(pose)
     return origins, directions
 
 
@@ -165,8 +186,13 @@ def run_bench(quick=False, runs=None) -> dict:
               "voxel_size": scene.voxel_size, "setup_seconds": setup, "setup_cpu_seconds": setup_cpu,
               "occupancy_bytes": occupancy.nbytes, "occupancy": occupancy.summary(),
               "sensor": f"{grid}x{grid} detectors, 4x4 rays each", "runs": runs,
-              "slant_range_m": SLANT_RANGE_M, "backends": {}, "results": []}
-    rays = {d: bench_rays(scene, d, grid=grid) for d in DEPRESSIONS}
+              "slant_range_m": SLANT_RANGE_M,
+              "views": {"wide": f"10 degree view from {SLANT_RANGE_M:g} m, looking north",
+                        "narrow": f"{NARROW_FOV:g} degree view from {NARROW_ALTITUDE_M:g} m up, "
+                                  f"looking along bearing {NARROW_BEARING:g}, exact only"},
+              "backends": {}, "results": []}
+    rays = {(view, d): bench_rays(scene, d, grid=grid, view=view)
+            for view in VIEWS for d in DEPRESSIONS}
     backends = {}
     for name, reason in backend_status().items():
         report["backends"][name] = reason or "available"
@@ -176,7 +202,9 @@ def run_bench(quick=False, runs=None) -> dict:
             except BackendUnavailable:
                 continue
     for method in ("exact", "march"):
-        for depression, (origins, directions) in rays.items():
+        for (view, depression), (origins, directions) in rays.items():
+            if view == "narrow" and method == "march":
+                continue  # thousands of samples a ray from that height: minutes, not a bench
             kwargs = dict(method=method, step=0.5, voxel_size=scene.voxel_size)
             first, results = {}, {}
             for name in backends:
@@ -204,7 +232,7 @@ def run_bench(quick=False, runs=None) -> dict:
                 cpu_median = statistics.median(cpu[name])
                 result = results[name]
                 report["results"].append({
-                    "backend": name, "method": method, "depression": depression,
+                    "backend": name, "method": method, "view": view, "depression": depression,
                     "rays": len(origins), "rays_per_second": len(origins) / median,
                     "median_seconds": median, "first_call_seconds": first[name],
                     # On a shared machine wall time includes waiting for the
@@ -220,11 +248,12 @@ def run_bench(quick=False, runs=None) -> dict:
 
 
 def _add_ratios(results):
-    """Each row's rays/s as a share of numba's on the same method and angle (``vs_numba``)."""
-    numba = {(r["method"], r["depression"]): r["rays_per_second"]
+    """Each row's rays/s as a share of numba's on the same method, view and angle
+    (``vs_numba``)."""
+    numba = {(r["method"], r["view"], r["depression"]): r["rays_per_second"]
              for r in results if r["backend"] == "numba"}
     for row in results:
-        base = numba.get((row["method"], row["depression"]))
+        base = numba.get((row["method"], row["view"], row["depression"]))
         row["vs_numba"] = row["rays_per_second"] / base if base else None
 
 
@@ -240,20 +269,21 @@ def _print_table(report):
                   f"{report['sensor']}; median of "
                   f"{report['runs']} runs")
     table = Table(box=box.SIMPLE_HEAD, pad_edge=False, collapse_padding=True)
-    for name in ("backend", "method", "depr.", "order", "rays/s", "x numba", "rays/CPU-s",
+    for name in ("backend", "method", "view", "depr.", "order", "rays/s", "x numba", "rays/CPU-s",
                  "voxel", "ground"):
         table.add_column(name, no_wrap=True, min_width=len(name))
     devices = {}
     for row in report["results"]:
         per_cpu = row["rays_per_cpu_second"]
         devices[row["backend"]] = row["device"]
-        table.add_row(row["backend"], row["method"], f"{row['depression']:g}",
+        table.add_row(row["backend"], row["method"], row["view"], f"{row['depression']:g}",
                       row["order"].replace("object", "obj"),
                       f"{row['rays_per_second'] / 1e6:.2f} M",
                       f"{row['vs_numba']:.2f}" if row.get("vs_numba") is not None else "-",
                       f"{per_cpu / 1e6:.2f} M" if per_cpu else "-",
                       f"{row['voxel_hits']:.1%}", f"{row['ground_hits']:.1%}")
     console.print(table)
+    console.print(f"views: wide {report['views']['wide']}; narrow {report['views']['narrow']}")
     console.print("order: obj object, ray ray order (several: the timed runs differed); devices: "
                   + "; ".join(f"{name} {device}" for name, device in devices.items()))
     for name, status in report["backends"].items():

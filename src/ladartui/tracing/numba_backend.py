@@ -450,8 +450,9 @@ class NumbaBackend:
                                       index[a:b], t[a:b])
 
         if method == "exact" and object_order is not False and occ.count > 0:
+            # Learned on CPU time: both orders run on this process's threads only.
             orders = trace_in_blocks(n, object_order, self._orders.setdefault(occ, OrderChoice()),
-                                     object_order_block, ray_order, cancel)
+                                     object_order_block, ray_order, cancel, clock=time.process_time)
         else:
             ray_order(0, n)
             orders = {"ray"}

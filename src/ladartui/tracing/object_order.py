@@ -151,12 +151,19 @@ def bin_key(i, j, tiles_per_side, shift):
     return ((((j >> shift) * tiles_per_side + (i >> shift)) << shift | (j & mask)) << shift) | (i & mask)
 
 
+@njit(nogil=True, cache=True, inline="always")
+def _bin_of(p, q, grid, nb):
+    """(i, j): the bin of gnomonic coordinates (p, q), clamped into the nb x nb grid."""
+    i = min(nb - 1, max(0, np.int64((p - grid[0]) / grid[1])))
+    j = min(nb - 1, max(0, np.int64((q - grid[2]) / grid[3])))
+    return i, j
+
+
 @njit(parallel=True, nogil=True, cache=True)
 def _bin_keys(p, q, grid, nb, shift, key_of, bin_of):
     nt = -(-nb >> shift)
     for r in prange(p.shape[0]):
-        i = min(nb - 1, max(0, np.int64((p[r] - grid[0]) / grid[1])))
-        j = min(nb - 1, max(0, np.int64((q[r] - grid[2]) / grid[3])))
+        i, j = _bin_of(p[r], q[r], grid, nb)
         key_of[r] = bin_key(i, j, nt, shift)
         bin_of[r] = np.uint32(i | (j << 16))
 
@@ -186,19 +193,50 @@ def _sort_into_bins(p, q, grid, nb, shift):
     return starts, order, bins
 
 
+@njit(nogil=True, cache=True, inline="always")
+def _put(k, r, orig, dirs, lo, hi, rays, invs, exits):
+    """Ray r at sorted position k: origin, direction, ``1 / d`` (the kernels' inverse,
+    inf for 0: the tile tests then divide nothing) and where it leaves the box [lo, hi)."""
+    leave = INF
+    for a in range(3):
+        rays[k, a] = orig[r, a]
+        rays[k, 3 + a] = dirs[r, a]
+        inv = 1.0 / dirs[r, a] if dirs[r, a] != 0.0 else INF
+        invs[k, a] = inv
+        leave = min(leave, slab(orig[r, a], dirs[r, a], inv, lo[a], hi[a])[1])
+    exits[k] = leave
+
+
 @njit(parallel=True, nogil=True, cache=True)
-def _gather(order, orig, dirs, lo, hi, rays, exits):
-    """Rays in sorted order (origin then direction per row), and where each leaves
-    the box [lo, hi)."""
+def _gather(order, orig, dirs, lo, hi, rays, invs, exits):
+    """Rays in sorted order (``_put``)."""
     for k in prange(order.shape[0]):
-        r = order[k]
-        leave = INF
-        for a in range(3):
-            rays[k, a] = orig[r, a]
-            rays[k, 3 + a] = dirs[r, a]
-            inv = 1.0 / dirs[r, a] if dirs[r, a] != 0.0 else INF
-            leave = min(leave, slab(orig[r, a], dirs[r, a], inv, lo[a], hi[a])[1])
-        exits[k] = leave
+        _put(k, order[k], orig, dirs, lo, hi, rays, invs, exits)
+
+
+@njit(parallel=True, nogil=True, cache=True)
+def _scatter_one_per_bin(p, q, grid, nb, shift, order, bins):
+    """The sort when every bin holds exactly one ray (a whole scan, whose own ray grid
+    the bins then are): each ray's number goes straight to the position of its bin's
+    key, in one parallel pass. Needs nb * nb rays and whole tiles (the keys are then
+    0 .. n-1). False when some bin got none (so another got two): the caller sorts
+    instead."""
+    n = p.shape[0]
+    nt = nb >> shift
+    for k in prange(n):
+        order[k] = -1
+    for r in prange(n):
+        i, j = _bin_of(p[r], q[r], grid, nb)
+        k = bin_key(i, j, nt, shift)
+        order[k] = r
+        bins[k] = np.uint32(i | (j << 16))
+    missing = np.zeros(PARTS, np.bool_)
+    for part in prange(PARTS):
+        for k in range(part * n // PARTS, (part + 1) * n // PARTS):
+            if order[k] < 0:
+                missing[part] = True
+                break
+    return not missing.any()
 
 
 def ray_grid(dirs, axis, u, v, nb):
@@ -215,18 +253,27 @@ def ray_grid(dirs, axis, u, v, nb):
 
 
 def sort_rays(p, q, grid, nb, shift, orig, dirs, lo, hi):
-    """Rays in bin order: (starts, order, bins, rays, exits).
+    """Rays in bin order: (starts, order, bins, rays, invs, exits).
 
     The rays of the bin with key ``b`` (``bin_key``) are sorted positions
     ``starts[b] .. starts[b + 1]``; ``order`` maps a sorted position back to the
-    ray; ``rays`` holds its origin and direction, ``bins`` its bin; its exit is
+    ray; ``rays`` holds its origin and direction, ``invs`` its ``1 / d`` per axis,
+    ``bins`` its bin; its exit is
     where it leaves the occupied box [lo, hi) (every voxel hit comes before it).
+    A whole scan has one ray per bin (nb = ceil(sqrt(n)) bins a side over its own
+    ray grid): then a parallel scatter of the ray numbers replaces the serial
+    counting sort (``_scatter_one_per_bin``; same result when both apply).
     """
     n = len(p)
+    rays, invs, exits = np.empty((n, 6)), np.empty((n, 3)), np.empty(n)
+    if n == nb * nb and nb % (1 << shift) == 0:
+        order, bins = np.empty(n, np.int64), np.empty(n, np.uint32)
+        if _scatter_one_per_bin(p, q, grid, nb, shift, order, bins):
+            _gather(order, orig, dirs, lo, hi, rays, invs, exits)
+            return np.arange(n + 1, dtype=np.int64), order, bins, rays, invs, exits
     starts, order, bins = _sort_into_bins(p, q, grid, nb, shift)
-    rays, exits = np.empty((n, 6)), np.empty(n)
-    _gather(order, orig, dirs, lo, hi, rays, exits)
-    return starts, order, bins, rays, exits
+    _gather(order, orig, dirs, lo, hi, rays, invs, exits)
+    return starts, order, bins, rays, invs, exits
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -453,15 +500,31 @@ def _tile_far(bin_starts, tile, best_t):
     return far
 
 
+@njit(nogil=True, cache=True, inline="always")
+def _slab_start(rays, invs, s, x, y, z, best):
+    """Where sorted ray s enters voxel (x, y, z) (the reference tracer's slab test of
+    its open interior, from t = 0 on); ``best`` when it does not, or not before."""
+    ex, lx = slab(rays[s, 0], rays[s, 3], invs[s, 0], x, x + 1.0)
+    ey, ly = slab(rays[s, 1], rays[s, 4], invs[s, 1], y, y + 1.0)
+    ez, lz = slab(rays[s, 2], rays[s, 5], invs[s, 2], z, z + 1.0)
+    enter, leave = max(ex, max(ey, ez)), min(lx, min(ly, lz))
+    start = max(enter, 0.0)
+    return start if start < leave and start < best else best
+
+
 @njit(parallel=True, nogil=True, cache=True)
-def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, rays, best_t,
+def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, rays, invs, best_t,
                best_v):
     """Nearest hit of each sorted ray among the voxels of its tile (tiles of TILE bins).
 
     ``best_t`` starts at each ray's exit from the occupied box, a bound no hit
     reaches (a voxel's interval ends inside the box), ``best_v`` at -1. A tile
     stops when no later brick can come nearer than every ray's bound.
-    shaders/object_order.wgsl runs the same tests ray by ray.
+    Per row of the tile a mask of live bins: a bin whose every ray has a bound
+    at or before the current brick's ``near`` is cleared when next met, since
+    no later brick (nears only grow down the list) can come nearer; its rays
+    are then never read again (most candidates of a scan are such rays, behind
+    their hit). shaders/object_order.wgsl runs the same tests ray by ray.
     """
     nt = tiles_per_side
     for tile in prange(nt * nt):
@@ -469,39 +532,57 @@ def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, 
         bi1 = min(nb, bi0 + TILE) - 1
         bj0 = (tile // nt) * TILE
         bj1 = min(nb, bj0 + TILE) - 1
+        base = tile * TILE * TILE  # bin_key of the tile's first bin; rows of TILE follow
+        live = np.zeros(TILE, np.int64)  # per row: bit c set while bin (bi0 + c) may still change
+        first = bin_starts[base]
+        single = True  # one ray in every bin of the tile: bin k's ray is first + k - base
+        for r in range(bj1 - bj0 + 1):
+            for c in range(bi1 - bi0 + 1):
+                k = base + r * TILE + c
+                if bin_starts[k + 1] > bin_starts[k]:
+                    live[r] |= np.int64(1) << c
+                single = single and bin_starts[k + 1] - bin_starts[k] == 1 \
+                    and bin_starts[k] == first + r * TILE + c
         far = _tile_far(bin_starts, tile, best_t)  # no bound of the tile is beyond
         stale = False  # far may be lowered (bounds moved nearer since it was taken)
         for e in range(tile_starts[tile], tile_starts[tile + 1]):
             q = listed[e]
-            if nears[q, 1] >= far:
+            brick_near = nears[q, 1]
+            if brick_near >= far:
                 if stale:
                     far = _tile_far(bin_starts, tile, best_t)
                     stale = False
-                if nears[q, 1] >= far:
+                if brick_near >= far:
                     break
             near = nears[q, 0]
             if near >= far:
                 continue
             x, y, z = np.float64(vox[q, 0]), np.float64(vox[q, 1]), np.float64(vox[q, 2])
-            i0, i1 = max(vox[q, 3], bi0), min(vox[q, 4], bi1)
-            for bj in range(max(vox[q, 5], bj0), min(vox[q, 6], bj1) + 1):
-                for s in range(bin_starts[bin_key(i0, bj, nt, TILE_SHIFT)],
-                               bin_starts[bin_key(i1, bj, nt, TILE_SHIFT) + 1]):
-                    best = best_t[s]
-                    if best <= near:
+            c0, c1 = max(vox[q, 3], bi0) - bi0, min(vox[q, 4], bi1) - bi0
+            span = ((np.int64(2) << c1) - 1) ^ ((np.int64(1) << c0) - 1)
+            for r in range(max(vox[q, 5], bj0) - bj0, min(vox[q, 6], bj1) - bj0 + 1):
+                row = live[r] & span
+                if row == 0:
+                    continue
+                for c in range(c0, c1 + 1):
+                    if (row >> c) & 1 == 0:
                         continue
-                    # The slab test of the reference tracer: the voxel's open interior.
-                    ox, oy, oz = rays[s, 0], rays[s, 1], rays[s, 2]
-                    dx, dy, dz = rays[s, 3], rays[s, 4], rays[s, 5]
-                    ex, lx = slab(ox, dx, 1.0 / dx if dx != 0.0 else INF, x, x + 1.0)
-                    ey, ly = slab(oy, dy, 1.0 / dy if dy != 0.0 else INF, y, y + 1.0)
-                    ez, lz = slab(oz, dz, 1.0 / dz if dz != 0.0 else INF, z, z + 1.0)
-                    enter, leave = max(ex, max(ey, ez)), min(lx, min(ly, lz))
-                    start = max(enter, 0.0)
-                    if start < leave and start < best:
-                        best_t[s] = start
-                        best_v[s] = q
-                        stale = True
+                    k = base + r * TILE + c
+                    lo_s, hi_s = (first + r * TILE + c, first + r * TILE + c + 1) if single \
+                        else (bin_starts[k], bin_starts[k + 1])
+                    alive = False
+                    for s in range(lo_s, hi_s):
+                        best = best_t[s]
+                        if best > near:
+                            start = _slab_start(rays, invs, s, x, y, z, best)
+                            if start < best:
+                                best_t[s] = start
+                                best_v[s] = q
+                                best = start
+                                stale = True
+                        alive = alive or best > brick_near
+                    if not alive:
+                        live[r] &= ~(np.int64(1) << c)
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -530,7 +611,7 @@ class Scan(NamedTuple):
     """A scan made ready for the tile tests (``prepare_scan``).
 
     Sorted position ``s`` is ray ``order[s]``, with origin and direction
-    ``rays[s]``, bin ``bins[s]`` (``i | j << 16``) and bound ``exits[s]``; the
+    ``rays[s]`` (``invs[s]`` its ``1 / d``), bin ``bins[s]`` (``i | j << 16``) and bound ``exits[s]``; the
     rays of bin key ``b`` are ``bin_starts[b] .. bin_starts[b + 1]``. ``vox`` and
     ``nears`` are the voxels in view (``emit_voxels``), ``tile_starts`` and
     ``listed`` each tile's voxels (``voxels_per_tile``).
@@ -538,6 +619,7 @@ class Scan(NamedTuple):
 
     order: np.ndarray
     rays: np.ndarray
+    invs: np.ndarray
     bins: np.ndarray
     exits: np.ndarray
     bin_starts: np.ndarray
@@ -568,14 +650,14 @@ def prepare_scan(occ, orig, dirs, frame, max_voxels, tile_shift=TILE_SHIFT):
     first = voxel_starts(found, occ.bricks) if ok else None
     if not ok or first[-1] > max_voxels:
         return None
-    bin_starts, order, bins, rays, exits = sort_rays(p, q, grid, nb, tile_shift, orig, dirs,
+    bin_starts, order, bins, rays, invs, exits = sort_rays(p, q, grid, nb, tile_shift, orig, dirs,
                                                      occ.bbox_lo.astype(np.float64),
                                                      occ.bbox_hi.astype(np.float64))
     vox, nears = emit_voxels(found, brick_near, first, occ.bricks, centre, grow, axis, u, v, grid,
                              nb)
     tiles_per_side = -(-nb >> tile_shift)
     tile_starts, listed = voxels_per_tile(vox, tiles_per_side, tile_shift)
-    return Scan(order, rays, bins, exits, bin_starts, vox, nears, tile_starts, listed, nb,
+    return Scan(order, rays, invs, bins, exits, bin_starts, vox, nears, tile_starts, listed, nb,
                 tile_shift, tiles_per_side)
 
 
@@ -592,7 +674,7 @@ def nearest_voxels(occ, orig, dirs, frame, max_voxels):
     best_t = scan.exits
     best_v = np.full(len(best_t), -1, np.int64)
     test_tiles(scan.vox, scan.nears, scan.tile_starts, scan.listed, scan.tiles_per_side,
-               scan.bin_starts, scan.nb, scan.rays, best_t, best_v)
+               scan.bin_starts, scan.nb, scan.rays, scan.invs, best_t, best_v)
     return scan.order, best_t, best_v, scan.vox
 
 
@@ -633,7 +715,8 @@ class OrderChoice:
             del recent[:-self.SAMPLES]
 
 
-def trace_in_blocks(n, object_order, choice, object_block, ray_block, cancel=None):
+def trace_in_blocks(n, object_order, choice, object_block, ray_block, cancel=None,
+                    clock=time.perf_counter):
     """Trace ``n`` exact rays in blocks of up to SCAN_BLOCK, each in object or ray
     order, as both backends do; returns the set of orders used.
 
@@ -642,7 +725,10 @@ def trace_in_blocks(n, object_order, choice, object_block, ray_block, cancel=Non
     ``ray_block(a, b)`` traces them in ray order. ``object_order`` True tries object
     order on every block, whatever it costs; None lets ``choice`` (this
     occupancy's OrderChoice) pick for blocks of at least MIN_SCAN_RAYS and learn
-    from their times.
+    from their times, read from ``clock``: wall time by default (a GPU's work costs
+    the host nothing), the process's CPU time for a CPU backend (time.process_time:
+    on a shared machine, other processes' work then does not make an order look
+    slow, and the choice does not flip with the load).
     """
     orders = set()
     for a in range(0, n, SCAN_BLOCK):
@@ -650,17 +736,17 @@ def trace_in_blocks(n, object_order, choice, object_block, ray_block, cancel=Non
         if cancel is not None and cancel.is_set():
             raise Cancelled("trace cancelled")
         learning = choice if object_order is None and b - a >= MIN_SCAN_RAYS else None
-        started = time.perf_counter()
+        started = clock()
         if object_order or (learning is not None and learning.pick() == "object"):
             limit = np.inf if object_order else VOXELS_PER_RAY * (b - a)
             if object_block(a, b, limit):
                 orders.add("object")
                 if learning is not None:
-                    learning.record("object", time.perf_counter() - started, b - a)
+                    learning.record("object", clock() - started, b - a)
                 continue
             learning = None  # no scan for object order: nothing to learn from this block
         orders.add("ray")
         ray_block(a, b)
         if learning is not None:
-            learning.record("ray", time.perf_counter() - started, b - a)
+            learning.record("ray", clock() - started, b - a)
     return orders
