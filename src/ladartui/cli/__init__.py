@@ -71,6 +71,9 @@ def main(argv: list[str] | None = None) -> int:
     except LadarError as error:
         print(f"ladartui: error: {one_line(error)}", file=sys.stderr)
         return 2
-    except (Cancelled, KeyboardInterrupt):
-        print("ladartui: cancelled; earlier outputs are unchanged", file=sys.stderr)
+    except Cancelled as error:  # its message says what was (not) written
+        print(f"ladartui: {one_line(error)}", file=sys.stderr)
+        return 130
+    except KeyboardInterrupt:
+        print("ladartui: interrupted", file=sys.stderr)
         return 130

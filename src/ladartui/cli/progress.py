@@ -7,6 +7,8 @@ the work's cancel event and waits for the worker to stop between chunks.
 
 from __future__ import annotations
 
+import contextlib
+import signal
 import threading
 from typing import Callable, TypeVar
 
@@ -46,3 +48,20 @@ def run_cancellable(work: Callable[[], T], cancel: threading.Event, name: str,
     if "error" in outcome:
         raise outcome["error"]
     return outcome["result"]
+
+
+@contextlib.contextmanager
+def sigterm_as_interrupt():
+    """Treat SIGTERM (a batch system's or ``kill``'s stop) like Ctrl-C while inside."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGTERM, interrupt)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
