@@ -28,21 +28,26 @@ def run_cancellable(work: Callable[[], T], cancel: threading.Event, name: str,
     is returned).
     """
     outcome = {}
+    # Waited on instead of join(): a join interrupted by Ctrl-C can report the
+    # thread finished while it still runs, and the process would exit mid-write.
+    finished = threading.Event()
 
     def target():
         try:
             outcome["result"] = work()
         except BaseException as error:  # handed to the main thread
             outcome["error"] = error
+        finally:
+            finished.set()
 
     worker = threading.Thread(target=target, name=name, daemon=True)
     worker.start()
     try:
-        while worker.is_alive():
-            worker.join(POLL_SECONDS)
+        while not finished.wait(POLL_SECONDS):
+            pass
     except KeyboardInterrupt:
         cancel.set()
-        worker.join()
+        finished.wait()
         if "result" not in outcome:  # else it finished before it saw the cancel
             raise cancelled from None
     if "error" in outcome:
