@@ -162,3 +162,43 @@ def test_output_problem_names_unwritable_places(tmp_path):
     with pytest.raises(OutputFileError, match="out.txt: is a folder"):
         (tmp_path / "out.txt").mkdir()
         outputset.check_writable(tmp_path / "ok.txt", tmp_path / "out.txt")
+
+
+def last_error_line(capsys):
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0, err  # refused before any work or progress
+    return err
+
+
+def test_trace_out_a_folder_is_refused_before_tracing(tmp_path, capsys):
+    rays = tmp_path / "rays.npy"
+    np.save(rays, np.array([[0, 0, 5, 0, 0, -1.0]]))
+    save_voxels(tmp_path / "v.txt", np.zeros((1, 3), np.int32))
+    (tmp_path / "hits.npy").mkdir()
+    assert main(["trace", "--scene", str(tmp_path / "v.txt"), "--rays", str(rays), "--out", str(tmp_path / "hits.npy")]) == 2
+    assert "hits.npy: is a folder" in last_error_line(capsys)
+
+
+def test_trace_of_an_empty_npy_is_one_line(tmp_path, capsys):
+    (tmp_path / "rays.npy").write_bytes(b"")
+    save_voxels(tmp_path / "v.txt", np.zeros((1, 3), np.int32))
+    assert main(["trace", "--scene", str(tmp_path / "v.txt"), "--rays", str(tmp_path / "rays.npy"),
+                 "--out", str(tmp_path / "hits.npy")]) == 2
+    assert "rays.npy: empty or cut short" in last_error_line(capsys)
+
+
+def test_generate_into_proc_is_refused(capsys):
+    assert main(["generate", "small", "/proc/x"]) == 2
+    err = last_error_line(capsys)
+    assert "/proc/x.txt: cannot be written" in err
+
+
+def test_sweep_out_an_existing_file_is_refused(tmp_path, capsys):
+    from tiny_sweep import write_tiny_scenario
+
+    write_tiny_scenario(tmp_path)
+    spec = tmp_path / "spec.toml"
+    spec.write_text('[sweep]\nscenario = "base.toml"\n[grid]\nscans = [2, 3]\n', encoding="utf-8")
+    (tmp_path / "results").write_text("a file")
+    assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path / "results")]) == 2
+    assert "results: is a file, expected a folder" in last_error_line(capsys)

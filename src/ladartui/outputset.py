@@ -71,6 +71,16 @@ def check_writable(*paths) -> None:
             raise OutputFileError(path, problem)
 
 
+def check_writable_folder(folder) -> None:
+    """Raise ``OutputFileError`` unless ``folder`` is (or can be made) a writable folder."""
+    folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise OutputFileError(folder, "is a file, expected a folder")
+    problem = output_problem(folder / "probe")
+    if problem:
+        raise OutputFileError(folder, problem.replace("probe", str(folder)))
+
+
 class OutputSet:
     """The files of one run, written together; use as a context manager around the work.
 
