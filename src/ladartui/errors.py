@@ -40,3 +40,7 @@ class OutputFileError(LadarError):
     def __init__(self, path, message):
         self.path = str(path)
         super().__init__(f"{self.path}: {message}")
+
+
+class ResourceLimitError(LadarError):
+    """Work refused up front: its estimated memory or rays exceed the limit."""

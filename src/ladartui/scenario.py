@@ -171,6 +171,13 @@ class Scenario:
         if not isinstance(self.fast_mode, bool):
             raise FieldError("simulation.fast_mode", self.fast_mode, "true or false")
         _check_flight(self.flight)
+        _check_work(self)
+
+    def scan_count(self) -> int:
+        """Scans of the flight plan, counted without building the poses."""
+        return sum(len(seg.poses) if hasattr(seg, "poses") else
+                   len(seg.standoffs) if hasattr(seg, "standoffs") else seg.scans
+                   for seg in self.flight.segments)
 
     # -- derived file names (report table 2) --
 
@@ -637,3 +644,13 @@ def _relative(file: Path, folder: Path) -> str:
 
 
 __all__ = ["Scenario", "load_scenario", "scenario_from_toml", "target_file_for"]
+
+
+def _check_work(scenario):
+    """Refuse a scenario whose rays (two runs of every scan) exceed the work limit."""
+    from ladartui.resources import check_rays
+
+    sensor, scans = scenario.sensor, scenario.scan_count()
+    check_rays(2 * sensor.rays_per_scan * scans,
+               f"{scenario.path.name}: sensor.grid = {sensor.grid}, sensor.ray_grid = "
+               f"{sensor.ray_grid}, {scans:,} scans")

@@ -34,6 +34,9 @@ def add_parser(subparsers):
     parser.add_argument("--no-write", dest="write", action="store_false",
                         help="do not write outputs or measures")
     parser.add_argument("--json", action="store_true", help="print the result as JSON on stdout")
+    parser.add_argument("--max-rays", metavar="N", type=float,
+                        help="refuse a run tracing more rays than this (default 2e9; also "
+                        "LADARTUI_MAX_RAYS)")
     parser.set_defaults(handler=run)
     return parser
 
@@ -44,6 +47,12 @@ def run(args) -> int:
     from ladartui.errors import FieldError
     from ladartui.scenario import load_scenario
 
+    if args.max_rays is not None:
+        from ladartui.resources import set_max_rays
+
+        if not args.max_rays >= 1:
+            raise FieldError("--max-rays", args.max_rays, "a number of rays >= 1")
+        set_max_rays(int(args.max_rays))
     scenario = load_scenario(args.scenario)
     # Check the overrides like scenario fields, before any progress is drawn.
     for name in ("backend", "method", "step", "precision"):

@@ -272,8 +272,10 @@ def describe_bad_line(text: str) -> str:
             return f"{axis} = {token} is negative; voxel indices start at 0"
         if not (token.isascii() and token.isdigit()):
             return f"{axis} = {token!r} is not a whole number; {EXPECTED}"
-        if int(token) > MAX_INDEX:
-            return f"{axis} = {token} is too large; expected at most {MAX_INDEX}"
+        # Length first: int() refuses strings of more than 4,300 digits.
+        if len(token.lstrip("0")) > len(str(MAX_INDEX)) or int(token) > MAX_INDEX:
+            shown = token if len(token) <= 24 else f"{token[:12]}...({len(token)} digits)"
+            return f"{axis} = {shown} is too large; expected at most {MAX_INDEX}"
     return f"cannot read {body.strip()!r}; {EXPECTED}"
 
 

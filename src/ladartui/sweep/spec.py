@@ -170,6 +170,22 @@ def _random_draws(spec: SweepSpec) -> list[dict]:
     return draws
 
 
+# Variants a sweep may expand to; each is a whole run (and a row of the results table).
+MAX_VARIANTS = 100_000
+
+
+def _check_variant_count(path, grid, samples):
+    from ladartui.errors import ResourceLimitError
+
+    count = math.prod(len(values) for values in grid.values()) * max(samples, 1)
+    if count > MAX_VARIANTS:
+        sizes = " x ".join(f"{len(v)} {k}" for k, v in grid.items())
+        draws = f"{samples:,} random draws" if samples else ""
+        raise ResourceLimitError(f"{path}: [grid] and [random] make {count:,} variants "
+                                 f"({' x '.join(filter(None, (sizes, draws)))}), more than the "
+                                 f"limit of {MAX_VARIANTS:,}; use fewer values or samples")
+
+
 def load_sweep_spec(path) -> SweepSpec:
     """Read and check a sweep spec; mistakes raise InputFileError naming the key."""
     path = Path(path)
@@ -245,6 +261,7 @@ def parse_sweep_spec(data: dict, path, text: str = "") -> SweepSpec:
     if not grid and not random:
         checker.fail("grid", "at least one parameter to vary in [grid] or [random]; known: "
                      + ", ".join(PARAMETERS), None)
+    _check_variant_count(path, grid, samples)
     scenario_path = DEFAULT_BASE if scenario == "default" else path.parent / scenario
     return SweepSpec(
         path=path, scenario_path=scenario_path, grid=grid, random=random,
