@@ -360,11 +360,16 @@ def load_scenario(path, check_files=True) -> Scenario:
     return scenario
 
 
+NESTED_TOO_DEEP = "not valid TOML: arrays or tables nested too deep to read"
+
+
 def scenario_from_toml(text: str, path) -> Scenario:
     """Parse scenario TOML ``text`` as if read from ``path`` (errors name that file)."""
     path = _absolute(path)
     try:
         doc = tomllib.loads(text)
+    except RecursionError:
+        raise InputFileError(path, NESTED_TOO_DEEP) from None
     except tomllib.TOMLDecodeError as error:
         message = str(error)
         found = re.search(r"\(at line (\d+), column \d+\)", message)
@@ -506,7 +511,7 @@ class _Reader:
             raise self.file_error(where, f"missing key '{where}.kind' (one of "
                                   f"{', '.join(SEGMENT_KINDS)})")
         kind = item["kind"]
-        if kind not in SEGMENT_KINDS:
+        if not isinstance(kind, str) or kind not in SEGMENT_KINDS:
             raise self.field_error(f"{where}.kind", kind,
                                    "one of " + ", ".join(repr(k) for k in SEGMENT_KINDS))
         cls = SEGMENT_KINDS[kind]

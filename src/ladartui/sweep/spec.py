@@ -172,6 +172,8 @@ def _random_draws(spec: SweepSpec) -> list[dict]:
 
 # Variants a sweep may expand to; each is a whole run (and a row of the results table).
 MAX_VARIANTS = 100_000
+# Random bounds beyond this overflow the draws (floats: max - min; integers: int64).
+RANDOM_BOUND = 1e15
 
 
 def _check_variant_count(path, grid, samples):
@@ -194,6 +196,9 @@ def load_sweep_spec(path) -> SweepSpec:
         data = tomllib.loads(text)
     except FileNotFoundError:
         raise InputFileError(path, "no such sweep spec") from None
+    except RecursionError:
+        raise InputFileError(path, "not valid TOML: arrays or tables nested too deep to read") \
+            from None
     except (OSError, UnicodeDecodeError) as error:
         raise InputFileError(path, f"cannot read: {error}") from None
     except tomllib.TOMLDecodeError as error:
@@ -375,8 +380,9 @@ class _Checker:
         if not {"min", "max"} <= set(value) or not set(value) <= allowed:
             self.fail(key, "{ min = A, max = B } (and integer = true for whole numbers)", value)
         low, high = value["min"], value["max"]
-        if not (_is_number(low) and _is_number(high) and low <= high):
-            self.fail(key, "numbers with min <= max", value)
+        if not (_is_number(low) and _is_number(high) and low <= high
+                and -RANDOM_BOUND <= low and high <= RANDOM_BOUND):
+            self.fail(key, f"numbers with min <= max, within +-{RANDOM_BOUND:g}", value)
         integer = value.get("integer", parameter.kind == "int")
         if not isinstance(integer, bool):
             self.fail(f"{key}.integer", "true or false", integer)
