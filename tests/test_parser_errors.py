@@ -90,7 +90,7 @@ voxel_size = 1.0
 [sensor]
 grid = 16
 ray_grid = 2
-fov = 20.0
+fov_deg = 20.0
 
 [flight]
 speed_mps = 30.0
@@ -196,3 +196,112 @@ def test_fuzz_command_line(scene_folder, capsys, command, words):
     assert code == 2
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "Traceback" not in err, err
+
+
+# ---------------------------------------------------------------- model files
+
+@pytest.mark.parametrize("text, rows", [
+    (b"0,0,0\r\n1,2,3\r\n", [[0, 0, 0], [1, 2, 3]]),  # Windows line ends are fine
+    (b"1 , 2 ,3\n4,5,6\r", [[1, 2, 3], [4, 5, 6]]),
+])
+def test_crlf_line_ends_are_read(tmp_path, text, rows):
+    (tmp_path / "v.txt").write_bytes(text)
+    assert load_voxels(tmp_path / "v.txt").tolist() == rows
+
+
+@pytest.mark.parametrize("text, message", [
+    (b"0,0,0\n1,2\r,3\n", r"v.txt:2: stray carriage return \(\\r\) in '1,2\\r,3'"),
+    (b"0,0,0\n1,\r2,3\n", r"v.txt:2: stray carriage return"),
+    (b"0,0,0\n\r\r\n1,1,1\n", r"v.txt:2: stray carriage return"),
+])
+def test_stray_carriage_return_is_an_error(tmp_path, text, message):
+    (tmp_path / "v.txt").write_bytes(text)
+    with pytest.raises(LadarError, match=message):
+        load_voxels(tmp_path / "v.txt")
+
+
+def write_scenario(folder, scene_text):
+    (folder / "m.txt").write_bytes(scene_text)
+    save_voxels(folder / "m_Target.txt", np.array([[0, 0, 0]], np.int32))
+    path = folder / "m.toml"
+    path.write_text(VALID_SCENARIO.replace("s.txt", "m.txt"))
+    return path
+
+
+def test_validate_reads_the_model_files(tmp_path, capsys):
+    path = write_scenario(tmp_path, b"0,0,0\n1,x,2\n")
+    assert main(["validate", str(path)]) == 2
+    err = one_error_line(capsys)
+    assert "m.txt:2: y = 'x' is not a whole number" in err
+
+
+def test_validate_summary_gives_scene_size_and_memory(tmp_path, capsys):
+    path = write_scenario(tmp_path, b"0,0,0\n1,2,3\n9,4,5\n")
+    assert main(["validate", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "scene      3 voxels, target 1 voxels; extent 10 x 5 x 6 voxels" in out
+    assert "memory     about " in out and "available" in out
+
+
+def test_validate_refuses_a_scene_too_large_for_memory(tmp_path, capsys):
+    path = write_scenario(tmp_path, b"0,0,0\n2147483647,0,0\n")
+    assert main(["validate", str(path)]) == 2
+    assert "m.txt: 2 voxels spanning 2147483648 x 1 x 1 voxels need about" in one_error_line(capsys)
+
+
+def las_with(tmp_path, offset, value):
+    import struct
+
+    from ladartui.scene.las import export_las
+
+    voxels = np.array([(x, y, z) for x in range(6) for y in range(5) for z in range(2)], np.int32)
+    path = tmp_path / "c.las"
+    export_las(path, voxels, 0.25)
+    data = bytearray(path.read_bytes())
+    data[offset:offset + 8] = struct.pack("<d", value)  # x scale at 131, x offset at 155
+    path.write_bytes(bytes(data))
+    return path
+
+
+@pytest.mark.parametrize("offset, value, message", [
+    (131, float("nan"), r"c.las: header scale factors \(nan, "),
+    (131, 0.0, r"c.las: header scale factors \(0, .*expected finite non-zero"),
+    (155, float("inf"), r"c.las: header offsets \(inf, 0, 0\): expected finite"),
+    (155, 1e308, r"c.las: header offsets \(1e\+308, .* too large for the scale factors"),
+])
+def test_las_with_degenerate_scale_or_offset_is_refused(tmp_path, offset, value, message):
+    from ladartui.scene.las import import_las
+
+    with pytest.raises(LadarError, match=message):
+        import_las(las_with(tmp_path, offset, value), 0.25)
+
+
+def test_las_points_that_collapse_are_reported(tmp_path):
+    import laspy
+
+    from ladartui.scene.las import _check_no_collapse
+
+    path = las_with(tmp_path, 155, 0.0)
+    cloud = laspy.read(path)
+    points = np.stack([np.asarray(cloud.x), np.asarray(cloud.y), np.asarray(cloud.z)], axis=1)
+    _check_no_collapse(path, cloud, points)  # distinct points stay distinct
+    # Rounded to whole metres, as a huge offset rounds them, neighbours merge.
+    with pytest.raises(LadarError, match=r"c.las: 60 distinct stored points collapse to 4 once"):
+        _check_no_collapse(path, cloud, np.floor(points))
+
+
+def test_fuzz_seeds_are_valid(scene_folder):
+    path = scene_folder / "seed.toml"
+    path.write_text(VALID_SCENARIO)
+    assert load_scenario(path).scan_count() == 4
+    path.write_text(VALID_SPEC)
+    assert len(load_sweep_spec(path).variants) == 8
+    (scene_folder / "v.txt").write_bytes(VALID_VOXELS)
+    assert len(load_voxels(scene_folder / "v.txt")) == 3
+
+
+def test_flag_errors_escape_what_the_user_typed(capsys):
+    with pytest.raises(SystemExit):
+        main(["validate", "x.toml", "\n\x1b]0;PWNED\x07"])
+    err = one_error_line(capsys)
+    assert "\\x0a\\x1b]0;PWNED\\x07" in err

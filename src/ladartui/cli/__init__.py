@@ -34,7 +34,8 @@ COMMANDS = {
 class _Parser(argparse.ArgumentParser):
     def error(self, message):
         # One line naming the flag, no usage dump: the user asked for -h if they want it.
-        self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} -h')\n")
+        # Arguments are echoed in the message: escape them like any user text.
+        self.exit(2, f"{self.prog}: error: {one_line(message)} (see '{self.prog} -h')\n")
 
 
 def build_parser() -> argparse.ArgumentParser:

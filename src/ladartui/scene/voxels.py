@@ -70,7 +70,17 @@ def _compile_kernels() -> None:
 
 @_kernel
 def _is_blank(c):
-    return c == _SPACE or c == _TAB or c == _CR
+    return c == _SPACE or c == _TAB
+
+
+@_kernel
+def _line_end(buf, pos, n):
+    """True at a line's end: LF, CR LF (files from Windows), or the end of the data.
+
+    A CR anywhere else is a mistake, not a blank."""
+    if pos >= n or buf[pos] == _NEWLINE:
+        return True
+    return buf[pos] == _CR and (pos + 1 >= n or buf[pos + 1] == _NEWLINE)
 
 
 @_kernel
@@ -91,10 +101,12 @@ def _parse_voxel_bytes(buf, start, out):
         line_start = pos
         while pos < n and _is_blank(buf[pos]):
             pos += 1
-        if pos >= n or buf[pos] == _NEWLINE:
+        if _line_end(buf, pos, n):
             if first_blank_line == 0:
                 first_blank_line = line
                 first_blank_offset = line_start
+            if pos < n and buf[pos] == _CR:
+                pos += 1
             pos += 1
             line += 1
             continue
@@ -121,8 +133,10 @@ def _parse_voxel_bytes(buf, start, out):
                     return rows, line, line_start
                 pos += 1
             elif pos < n:
-                if buf[pos] != _NEWLINE:
+                if not _line_end(buf, pos, n):
                     return rows, line, line_start
+                if buf[pos] == _CR:
+                    pos += 1
                 pos += 1
         rows += 1
         line += 1
@@ -258,14 +272,17 @@ def _read_bytes(path: Path) -> np.ndarray:
 
 def describe_bad_line(text: str) -> str:
     """What is wrong with one rejected line, and what was expected."""
-    body = text.rstrip("\r")
-    if not body.strip(" \t\r"):
+    body = text[:-1] if text.endswith("\r") else text  # CR LF line ends are fine
+    if "\r" in body:
+        shown = body.strip(" \t")
+        return f"stray carriage return (\\r) in {shown!r}; {EXPECTED}"
+    if not body.strip(" \t"):
         return "blank line before more voxels; blank lines are allowed only at the end of the file"
     fields = body.split(",")
     if len(fields) != 3:
         return f"{len(fields)} comma-separated values in {body.strip()!r}; {EXPECTED}"
     for axis, field in zip(_AXES, fields):
-        token = field.strip(" \t\r")
+        token = field.strip(" \t")
         if not token:
             return f"{axis} is empty in {body.strip()!r}; {EXPECTED}"
         if token.startswith("-") and token[1:].isascii() and token[1:].isdigit():
