@@ -175,7 +175,8 @@ def test_trace_out_a_folder_is_refused_before_tracing(tmp_path, capsys):
     np.save(rays, np.array([[0, 0, 5, 0, 0, -1.0]]))
     save_voxels(tmp_path / "v.txt", np.zeros((1, 3), np.int32))
     (tmp_path / "hits.npy").mkdir()
-    assert main(["trace", "--scene", str(tmp_path / "v.txt"), "--rays", str(rays), "--out", str(tmp_path / "hits.npy")]) == 2
+    assert main(["trace", "--scene", str(tmp_path / "v.txt"), "--rays", str(rays),
+                 "--out", str(tmp_path / "hits.npy")]) == 2
     assert "hits.npy: is a folder" in last_error_line(capsys)
 
 

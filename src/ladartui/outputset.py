@@ -18,8 +18,8 @@ import json
 import os
 import tempfile
 import threading
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
 
 from ladartui.errors import Cancelled, OutputFileError
 
@@ -186,7 +186,7 @@ class OutputSet:
 
     def _swap(self, temps):
         entries = []
-        for name, path in self.paths.items():
+        for path in self.paths.values():
             backup = path.with_name(f".{path.name}.{os.getpid()}.old")
             entries.append({"path": str(path), "backup": str(backup),
                             "existed": os.path.lexists(path)})
