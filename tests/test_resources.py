@@ -88,3 +88,13 @@ def test_huge_sweep_and_generate_are_refused(tmp_path, capsys):
     assert "1,000,000 variants (100 radius x 100 altitude x 100 scans)" in one_error_line(capsys)
     assert main(["generate", "small", str(tmp_path / "x"), "--trees", "100000000"]) == 2
     assert "trees = 100000000: expected at most 100,000 trees" in one_error_line(capsys)
+
+
+def test_sparse_huge_voxel_file_is_refused_before_reading(tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("LADARTUI_MAX_MEMORY", str(16 * 2**30))
+    path = tmp_path / "sparse.txt"
+    with open(path, "wb") as handle:  # 50 GB on paper, nothing on disk
+        handle.truncate(50 * 10**9)
+    assert main(["info", str(path)]) == 2
+    err = one_error_line(capsys)
+    assert "sparse.txt: a voxel list of 46.6 GiB needs about 140 GiB to read, more than the 16 GiB" in err

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import functools
 import logging
+import os
 import threading
 from pathlib import Path
 
@@ -259,6 +260,7 @@ def _parse_plain_lines(data: np.ndarray) -> np.ndarray | None:
 
 def _read_bytes(path: Path) -> np.ndarray:
     try:
+        _check_read_size(path)
         return np.fromfile(path, dtype=np.uint8)
     except FileNotFoundError:
         raise InputFileError(path, f"no such file; {EXPECTED} per line") from None
@@ -268,6 +270,20 @@ def _read_bytes(path: Path) -> np.ndarray:
         raise InputFileError(path, "cannot be read: permission denied") from None
     except OSError as error:
         raise InputFileError(path, f"cannot be read: {error.strerror or error}") from None
+
+
+def _check_read_size(path: Path) -> None:
+    """Refuse a file whose bytes and parsed rows would not fit in memory (a sparse 50 GB file)."""
+    from ladartui.errors import ResourceLimitError
+    from ladartui.resources import available_memory, gib
+
+    size = os.stat(path).st_size
+    # The bytes, plus up to 12 bytes of int32 row per 6-byte line "0,0,0\n" while parsing.
+    need = 3 * size
+    limit = available_memory()
+    if need > limit:
+        raise ResourceLimitError(f"{path}: a voxel list of {gib(size)} needs about {gib(need)} "
+                                 f"to read, more than the {gib(limit)} of memory available")
 
 
 def describe_bad_line(text: str) -> str:
