@@ -35,3 +35,15 @@ class Cancelled(Exception):
 
 class BackendUnavailable(LadarError):
     """A tracing backend that cannot run here, with the reason and what to install."""
+
+
+class OutputFileError(LadarError):
+    """An output path that cannot be written (a folder, a read-only folder, a locked set)."""
+
+    def __init__(self, path, message):
+        self.path = str(path)
+        super().__init__(f"{self.path}: {message}")
+
+
+class ResourceLimitError(LadarError):
+    """Work refused up front: its estimated memory or rays exceed the limit."""

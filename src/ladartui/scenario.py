@@ -193,11 +193,16 @@ class Scenario:
                 raise FieldError("detection", self.detection, "a DetectionSettings")
             if self.detection.geiger:
                 self.detection.bin_width(self.sensor.depth_resolution)
+        _check_work(self)
 
     @property
     def geiger(self) -> bool:
         """True when the [detection] section asks for the Geiger-mode model."""
         return self.detection is not None and self.detection.geiger
+
+    def scan_count(self) -> int:
+        """Scans of the flight plan, counted without building the poses where it can be."""
+        return sum(_segment_scans(seg) for seg in self.flight.segments)
 
     # -- derived file names (report table 2) --
 
@@ -390,11 +395,16 @@ def load_scenario(path, check_files=True) -> Scenario:
     return scenario
 
 
+NESTED_TOO_DEEP = "not valid TOML: arrays or tables nested too deep to read"
+
+
 def scenario_from_toml(text: str, path) -> Scenario:
     """Parse scenario TOML ``text`` as if read from ``path`` (errors name that file)."""
     path = _absolute(path)
     try:
         doc = tomllib.loads(text)
+    except RecursionError:
+        raise InputFileError(path, NESTED_TOO_DEEP) from None
     except tomllib.TOMLDecodeError as error:
         message = str(error)
         found = re.search(r"\(at line (\d+), column \d+\)", message)
@@ -546,7 +556,7 @@ class _Reader:
             raise self.file_error(where, f"missing key '{where}.kind' (one of "
                                   f"{', '.join(_SEGMENT_KINDS)})")
         kind = item["kind"]
-        if kind not in _SEGMENT_KINDS:
+        if not isinstance(kind, str) or kind not in _SEGMENT_KINDS:
             raise self.field_error(f"{where}.kind", kind,
                                    "one of " + ", ".join(repr(k) for k in _SEGMENT_KINDS))
         cls = _SEGMENT_KINDS[kind]
@@ -688,3 +698,23 @@ def _relative(file: Path, folder: Path) -> str:
 
 
 __all__ = ["Scenario", "load_scenario", "scenario_from_toml", "target_file_for"]
+
+
+def _segment_scans(segment) -> int:
+    if hasattr(segment, "poses"):
+        return len(segment.poses)
+    if hasattr(segment, "standoffs"):
+        return len(segment.standoffs)
+    if hasattr(segment, "scans"):
+        return segment.scans
+    return len(segment.build(None))  # a recorded log: its scans come from the file
+
+
+def _check_work(scenario):
+    """Refuse a scenario whose rays (two runs of every scan) exceed the work limit."""
+    from ladartui.resources import check_rays
+
+    sensor, scans = scenario.sensor, scenario.scan_count()
+    check_rays(2 * sensor.rays_per_scan * scans,
+               f"{scenario.path.name}: sensor.grid = {sensor.grid}, sensor.ray_grid = "
+               f"{sensor.ray_grid}, {scans:,} scans")

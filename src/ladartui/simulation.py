@@ -4,9 +4,10 @@
 against the full scene model (the *obscured* view) and once against the target
 model alone over the same extent (the *unobscured* view, the ideal). Each scan's
 hits pass the detector's depth-resolution rule, and the returns of all scans are
-fused into one voxel list per run. Outputs are written only after both runs
-have finished, each atomically, so a failed or cancelled run leaves earlier
-outputs as they were.
+fused into one voxel list per run. The outputs are checked for writability and
+locked before tracing, and written as one all-or-nothing set after both runs
+have finished (``ladartui.outputset``), so a failed, cancelled or killed run
+leaves the earlier set as it was.
 """
 
 from __future__ import annotations
@@ -22,12 +23,12 @@ from typing import Callable
 import numba
 import numpy as np
 
-from ladartui.atomic import atomic_path
 from ladartui.errors import Cancelled
 from ladartui.measures import Measures, compute_measures, keys_to_voxels, sorted_unique, voxel_keys
 from ladartui.tracing.backend import MISS
 
 RUNS = ("scene", "target")
+NOTHING_WRITTEN = "run cancelled; nothing was written, earlier outputs are unchanged"
 
 # Aim for trace calls of about this long, so a cancel is answered quickly.
 _CHUNK_SECONDS = 0.1
@@ -213,6 +214,13 @@ def simulate(scenario, backend=None, method=None, step=None, precision=None,
     atomically once both runs are done. ``scene`` may pass the scenario's
     already loaded ``Scene`` (its occupancy is built once and kept).
     """
+    with contextlib.ExitStack() as stack:
+        output_set = stack.enter_context(_output_set(scenario, las)) if write else None
+        return _simulate(scenario, backend, method, step, precision, progress, cancel,
+                         output_set, scene)
+
+
+def _simulate(scenario, backend, method, step, precision, progress, cancel, output_set, scene):
     started = time.perf_counter()
     timings = dict.fromkeys(("setup", "rays", "trace", "depth_rule", "fusion", "measures", "write"),
                             0.0)
@@ -253,11 +261,11 @@ def simulate(scenario, backend=None, method=None, step=None, precision=None,
     timings["measures"] = time.perf_counter() - tick
 
     outputs = {}
-    if write:
+    if output_set is not None:
         _check(cancel)
         tick = time.perf_counter()
-        outputs = _write_outputs(scenario, scene_output, target_output, measures,
-                                 scene.voxel_size, las)
+        outputs = _write_outputs(output_set, scene_output, target_output, measures,
+                                 scene.voxel_size, cancel)
         timings["write"] = time.perf_counter() - tick
     timings["total"] = time.perf_counter() - started
     return SimulationResult(
@@ -345,7 +353,7 @@ class _ScanRunner:
 
 def _check(cancel):
     if cancel is not None and cancel.is_set():
-        raise Cancelled("run cancelled; nothing was written")
+        raise Cancelled(NOTHING_WRITTEN)
 
 
 def _trace_settings(scenario, backend, method, step, precision) -> dict:
@@ -371,32 +379,38 @@ def _next_chunk(chunk, traced, elapsed) -> int:
     return max(_MIN_CHUNK_RAYS, min(goal, 4 * chunk, _MAX_CHUNK_RAYS), chunk // 4)
 
 
-def _write_outputs(scenario, scene_output, target_output, measures, voxel_size, las) -> dict:
-    """Write every output to a temporary file first, then rename them all.
-
-    If any write fails, every temporary file is removed and no earlier output
-    is replaced.
-    """
-    from ladartui.scene.voxels import save_voxels
-
-    targets = {
+def output_paths(scenario, las=False) -> dict[str, Path]:
+    """The files a run of ``scenario`` writes, by name."""
+    paths = {
         "scene": Path(scenario.scene_output),
         "target": Path(scenario.target_output),
         "measures": Path(scenario.measures_file),
     }
+    if las:
+        paths["scene_las"] = paths["scene"].with_suffix(".las")
+        paths["target_las"] = paths["target"].with_suffix(".las")
+    return paths
+
+
+def _output_set(scenario, las):
+    from ladartui.outputset import OutputSet
+
+    path = Path(scenario.path)
+    return OutputSet(output_paths(scenario, las), path.with_name(f".{path.stem}.outputs.lock"))
+
+
+def _write_outputs(output_set, scene_output, target_output, measures, voxel_size, cancel) -> dict:
+    """Write every output of the set to a temporary file, then swap them all in together."""
+    from ladartui.scene.voxels import save_voxels
+
     writers = {
         "scene": lambda tmp: save_voxels(tmp, scene_output),
         "target": lambda tmp: save_voxels(tmp, target_output),
         "measures": lambda tmp: tmp.write_text(measures.to_cmf(), encoding="utf-8"),
     }
-    if las:
+    if "scene_las" in output_set.paths:
         from ladartui.scene.las import export_las
 
-        for run, voxels in (("scene", scene_output), ("target", target_output)):
-            targets[f"{run}_las"] = targets[run].with_suffix(".las")
-            writers[f"{run}_las"] = lambda tmp, v=voxels: export_las(tmp, v, voxel_size)
-    with contextlib.ExitStack() as stack:
-        for name, target in targets.items():
-            tmp = stack.enter_context(atomic_path(target))
-            writers[name](tmp)
-    return {name: str(path) for name, path in targets.items()}
+        writers["scene_las"] = lambda tmp: export_las(tmp, scene_output, voxel_size)
+        writers["target_las"] = lambda tmp: export_las(tmp, target_output, voxel_size)
+    return output_set.write(writers, cancel)

@@ -34,7 +34,8 @@ COMMANDS = {
 class _Parser(argparse.ArgumentParser):
     def error(self, message):
         # One line naming the flag, no usage dump: the user asked for -h if they want it.
-        self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} -h')\n")
+        # Arguments are echoed in the message: escape them like any user text.
+        self.exit(2, f"{self.prog}: error: {one_line(message)} (see '{self.prog} -h')\n")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -67,6 +68,9 @@ def main(argv: list[str] | None = None) -> int:
     except LadarError as error:
         print(f"ladartui: error: {one_line(error)}", file=sys.stderr)
         return 2
-    except (Cancelled, KeyboardInterrupt):
-        print("ladartui: cancelled; earlier outputs are unchanged", file=sys.stderr)
+    except Cancelled as error:  # its message says what was (not) written
+        print(f"ladartui: {one_line(error)}", file=sys.stderr)
+        return 130
+    except KeyboardInterrupt:
+        print("ladartui: interrupted", file=sys.stderr)
         return 130

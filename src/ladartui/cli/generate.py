@@ -53,8 +53,11 @@ def overrides_from(args) -> dict:
 
 
 def run(args) -> int:
-    from ladartui.scene.generate import generate_scene
+    from ladartui.outputset import check_writable
+    from ladartui.scene.generate import generate_scene, output_paths
 
+    scene_file = output_paths(args.out)[0]
+    check_writable(*output_paths(args.out), *([scene_file.with_suffix(".laz")] if args.las else []))
     started = time.perf_counter()
     scene = generate_scene(args.preset, seed=args.seed, **overrides_from(args))
     generated = time.perf_counter() - started

@@ -91,7 +91,7 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
         rows.append(("target", text))
     else:
         rows.append(("target", f"none ({target_path.name} not found)"))
-    rows.append(("occupancy", _occupancy_text(voxels, shape)))
+    rows.append(("occupancy", _occupancy_text(voxels, shape, path)))
     print(f"{path}: voxel list")
     width = max(len(name) for name, _ in rows)
     for name, text in rows:
@@ -113,7 +113,7 @@ def _count_inside(target, voxels) -> int:
     return int(np.isin(target_keys, scene_keys).sum())
 
 
-def _occupancy_text(voxels, shape) -> str:
+def _occupancy_text(voxels, shape, path) -> str:
     try:
         from ladartui.scene.occupancy import Occupancy
     except ModuleNotFoundError as error:
@@ -121,7 +121,7 @@ def _occupancy_text(voxels, shape) -> str:
             raise
         return "not available (ladartui.scene.occupancy is missing)"
     started = time.perf_counter()
-    occupancy = Occupancy.build(voxels, shape)
+    occupancy = Occupancy.build(voxels, shape, source=str(path))
     built = time.perf_counter() - started
     return (f"{occupancy.nbytes / 2**20:.1f} MiB ({occupancy.n_bricks:,} bricks, "
             f"{occupancy.n_tiles:,} tiles, {occupancy.n_regions:,} regions), "

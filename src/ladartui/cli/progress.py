@@ -7,6 +7,8 @@ the work's cancel event and waits for the worker to stop between chunks.
 
 from __future__ import annotations
 
+import contextlib
+import signal
 import threading
 from typing import Callable, TypeVar
 
@@ -26,23 +28,45 @@ def run_cancellable(work: Callable[[], T], cancel: threading.Event, name: str,
     is returned).
     """
     outcome = {}
+    # Waited on instead of join(): a join interrupted by Ctrl-C can report the
+    # thread finished while it still runs, and the process would exit mid-write.
+    finished = threading.Event()
 
     def target():
         try:
             outcome["result"] = work()
         except BaseException as error:  # handed to the main thread
             outcome["error"] = error
+        finally:
+            finished.set()
 
     worker = threading.Thread(target=target, name=name, daemon=True)
     worker.start()
     try:
-        while worker.is_alive():
-            worker.join(POLL_SECONDS)
+        while not finished.wait(POLL_SECONDS):
+            pass
     except KeyboardInterrupt:
         cancel.set()
-        worker.join()
+        finished.wait()
         if "result" not in outcome:  # else it finished before it saw the cancel
             raise cancelled from None
     if "error" in outcome:
         raise outcome["error"]
     return outcome["result"]
+
+
+@contextlib.contextmanager
+def sigterm_as_interrupt():
+    """Treat SIGTERM (a batch system's or ``kill``'s stop) like Ctrl-C while inside."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGTERM, interrupt)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)

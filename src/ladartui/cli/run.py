@@ -1,7 +1,9 @@
 """``ladartui run SCENARIO``: simulate a scenario, write its outputs, show the measures.
 
-The run happens on a worker thread so that Ctrl-C on the main thread can set
-the cancel event; the run then stops between chunks and writes nothing.
+The run happens on a worker thread so that Ctrl-C (or SIGTERM) on the main
+thread can set the cancel event; the run then stops between chunks and writes
+nothing, or, when the outputs were already being swapped in, finishes the swap
+and reports the files written.
 Progress goes to stderr, the measures to stdout (a table, or JSON with --json).
 """
 
@@ -10,7 +12,7 @@ from __future__ import annotations
 import json
 import threading
 
-from ladartui.cli.progress import run_cancellable
+from ladartui.cli.progress import run_cancellable, sigterm_as_interrupt
 from ladartui.errors import Cancelled
 
 
@@ -32,6 +34,9 @@ def add_parser(subparsers):
     parser.add_argument("--no-write", dest="write", action="store_false",
                         help="do not write outputs or measures")
     parser.add_argument("--json", action="store_true", help="print the result as JSON on stdout")
+    parser.add_argument("--max-rays", metavar="N", type=float,
+                        help="refuse a run tracing more rays than this (default 2e9; also "
+                        "LADARTUI_MAX_RAYS)")
     parser.set_defaults(handler=run)
     return parser
 
@@ -42,6 +47,12 @@ def run(args) -> int:
     from ladartui.errors import FieldError
     from ladartui.scenario import load_scenario
 
+    if args.max_rays is not None:
+        from ladartui.resources import set_max_rays
+
+        if not args.max_rays >= 1:
+            raise FieldError("--max-rays", args.max_rays, "a number of rays >= 1")
+        set_max_rays(int(args.max_rays))
     scenario = load_scenario(args.scenario)
     # Check the overrides like scenario fields, before any progress is drawn.
     for name in ("backend", "method", "step", "precision"):
@@ -52,6 +63,11 @@ def run(args) -> int:
             scenario = scenario.with_changes(**{name: value})
         except FieldError as error:  # name the flag the user typed, not the TOML field
             raise FieldError(f"--{name}", value, error.expected) from None
+    if args.write:  # before any progress is drawn; the run checks again under its lock
+        from ladartui.outputset import check_writable
+        from ladartui.simulation import output_paths
+
+        check_writable(*output_paths(scenario, args.las).values())
     errors = Console(stderr=True)
     result = _simulate_with_progress(scenario, args, errors)
     if args.json:
@@ -64,7 +80,7 @@ def run(args) -> int:
 def _simulate_with_progress(scenario, args, console):
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
-    from ladartui.simulation import simulate
+    from ladartui.simulation import NOTHING_WRITTEN, simulate
 
     cancel = threading.Event()
     columns = (
@@ -83,10 +99,13 @@ def _simulate_with_progress(scenario, args, console):
                        description=f"scan {p.scan}/{p.scans} (scene and target runs)",
                        rays=f"{p.rays_done:,}/{p.rays_total:,} rays")
 
-        return run_cancellable(
-            lambda: simulate(scenario, progress=report, cancel=cancel, write=args.write,
-                             las=args.las),
-            cancel, "ladartui-run", Cancelled("run cancelled; nothing was written"))
+        # A stop during the write lets the swap finish (or roll back): the files on
+        # disk belong to one run and the result says which.
+        with sigterm_as_interrupt():
+            return run_cancellable(
+                lambda: simulate(scenario, progress=report, cancel=cancel, write=args.write,
+                                 las=args.las),
+                cancel, "ladartui-run", Cancelled(NOTHING_WRITTEN))
 
 
 def result_dict(scenario, result) -> dict:

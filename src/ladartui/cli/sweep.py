@@ -109,6 +109,9 @@ def run(args) -> int:
                                     cost=args.cost or spec.cost)
         result.parameter_names = spec.parameter_names
     else:
+        from ladartui.outputset import check_writable_folder
+
+        check_writable_folder(args.out or default_out_dir(spec))
         result = _sweep_with_progress(spec, args, errors)
         if result is None:
             return 130

@@ -40,6 +40,8 @@ def load_rays(path) -> np.ndarray:
         rays = np.load(path, allow_pickle=False)
     except FileNotFoundError:
         raise InputFileError(path, "no such file") from None
+    except EOFError:
+        raise InputFileError(path, "empty or cut short: expected a NumPy .npy array") from None
     except (ValueError, OSError) as error:
         raise InputFileError(path, f"not a NumPy .npy array ({error})") from None
     if rays.ndim != 2 or rays.shape[1] != 6:
@@ -64,6 +66,9 @@ def run(args):
 
     if not args.voxel_size > 0:
         raise FieldError("--voxel-size", args.voxel_size, "a positive number of metres")
+    from ladartui.outputset import check_writable
+
+    check_writable(args.out)  # before the trace, not after it
     rays = load_rays(args.rays)
     voxels = load_voxels(args.scene)
     occupancy = Occupancy.build(voxels)

@@ -1,4 +1,4 @@
-"""``ladartui validate SCENARIO``: load and check a scenario, then describe it."""
+"""``ladartui validate SCENARIO``: load and check a scenario and its model files, then describe it."""
 
 from __future__ import annotations
 
@@ -6,10 +6,11 @@ from __future__ import annotations
 def add_parser(subparsers):
     parser = subparsers.add_parser(
         "validate",
-        help="check a scenario file and summarise it",
-        description="Load a scenario, check every field against its limits and that its scene "
-        "and target model files exist, then print a summary (sensor, scans, path length, "
-        "flight time, outputs). A mistake is reported on one line with exit status 2.",
+        help="check a scenario file and its model files, and summarise them",
+        description="Load a scenario, check every field against its limits, read and check its "
+        "scene and target model files, estimate the memory the tracing structures need, then "
+        "print a summary (sensor, scans, path length, flight time, scene size, memory, "
+        "outputs). A mistake is reported on one line with exit status 2.",
     )
     parser.add_argument("scenario", metavar="SCENARIO", help="scenario file (.toml)")
     parser.set_defaults(handler=run)
@@ -20,5 +21,32 @@ def run(args) -> int:
     from ladartui.scenario import load_scenario
 
     scenario = load_scenario(args.scenario)
+    scene_lines = scene_summary(scenario)
     print(scenario.summary())
+    for line in scene_lines:
+        print(line)
     return 0
+
+
+def scene_summary(scenario) -> list[str]:
+    """Read both model files (errors name file and line) and size the tracing structures."""
+    import numpy as np
+
+    from ladartui.resources import available_memory, check_occupancy, gib
+
+    scene = scenario.load_scene()
+    nx, ny, nz = scene.shape
+    vs = scene.voxel_size
+    lines = [f"scene      {len(scene.voxels):,} voxels, target {len(scene.target):,} voxels; "
+             f"extent {nx} x {ny} x {nz} voxels = {nx * vs:g} x {ny * vs:g} x {nz * vs:g} m"]
+    need = 0
+    for voxels, source in ((scene.voxels, scenario.scene_file),
+                           (scene.target, scenario.target_file)):
+        if len(voxels):
+            # int64: the far corner + 1 of a voxel at 2**31 - 1 overflows int32.
+            lo, hi = voxels.min(axis=0).astype(np.int64), voxels.max(axis=0).astype(np.int64) + 1
+            need += check_occupancy(lo, hi, len(voxels), str(source))
+    need += scene.voxels.nbytes + scene.target.nbytes + np.dtype(np.int32).itemsize
+    lines.append(f"memory     about {gib(need)} for the scene and its tracing structures "
+                 f"({gib(available_memory())} available)")
+    return lines

@@ -108,6 +108,9 @@ def output_paths(stem) -> tuple[Path, Path]:
     return stem.with_name(stem.name + ".txt"), stem.with_name(stem.name + "_Target.txt")
 
 
+MAX_TREES = 100_000
+
+
 def scene_params(preset="small", **overrides) -> SceneParams:
     """The preset's parameters with ``overrides`` applied and checked."""
     if preset not in PRESETS:
@@ -199,6 +202,10 @@ def _check(p: SceneParams):
     share("density", p.density, 0.99)
     for name in ("trees", "branches", "vehicles"):
         count(name, getattr(p, name))
+    # Each tree costs tens of kilobytes while it is built; refuse before allocating.
+    if p.trees > MAX_TREES:
+        raise FieldError("trees", p.trees, f"at most {MAX_TREES:,} trees ({p.trees:,} would "
+                         f"need about {p.trees * 50e3 / 2**30:.3g} GiB to build)")
     if (not isinstance(p.vehicle_size, (tuple, list)) or len(p.vehicle_size) != 3
             or not all(isinstance(v, (int, float)) and v > 0 for v in p.vehicle_size)):
         raise FieldError("vehicle_size", p.vehicle_size, "(length, width, height) positive metres")

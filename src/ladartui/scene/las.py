@@ -21,6 +21,41 @@ from ladartui.errors import FieldError, InputFileError
 from ladartui.scene.voxels import MAX_INDEX, unique_voxels
 
 
+def _check_header(path, header):
+    """Refuse scale factors and offsets that cannot give distinct, finite coordinates."""
+    scales = np.asarray(header.scales, dtype=np.float64)
+    offsets = np.asarray(header.offsets, dtype=np.float64)
+    if not np.all(np.isfinite(scales)) or np.any(scales == 0):
+        raise InputFileError(path, f"header scale factors {_triple(scales)}: expected finite "
+                             "non-zero numbers (such as 0.001)")
+    if not np.all(np.isfinite(offsets)):
+        raise InputFileError(path, f"header offsets {_triple(offsets)}: expected finite numbers")
+    # Beyond this, adding the offset rounds away the scaled coordinate: points merge.
+    lossy = np.spacing(np.abs(offsets)) * 2 > scales
+    if np.any(lossy):
+        raise InputFileError(path, f"header offsets {_triple(offsets)} are too large for the "
+                             f"scale factors {_triple(scales)}: points would merge; expected "
+                             "offsets near the data")
+
+
+def _check_no_collapse(path, cloud, points):
+    """Distinct stored points must stay distinct once scaled and offset."""
+    if not np.all(np.isfinite(points)):
+        raise InputFileError(path, "coordinates overflow once scaled and offset; expected "
+                             "finite coordinates")
+    raw = np.stack([np.asarray(cloud.X), np.asarray(cloud.Y), np.asarray(cloud.Z)], axis=1)
+    stored = len(np.unique(raw, axis=0))
+    kept = len(np.unique(points, axis=0))
+    if kept < stored:
+        raise InputFileError(path, f"{stored:,} distinct stored points collapse to {kept:,} "
+                             "once scaled and offset; expected scale factors and offsets that "
+                             "keep them apart")
+
+
+def _triple(values) -> str:
+    return "(" + ", ".join(f"{v:g}" for v in values) + ")"
+
+
 def import_las(path, voxel_size, origin=None) -> tuple[np.ndarray, np.ndarray]:
     """Voxelise a LAS/LAZ file: returns ((N, 3) int32 unique voxels, origin (3,) metres)."""
     import laspy
@@ -33,9 +68,11 @@ def import_las(path, voxel_size, origin=None) -> tuple[np.ndarray, np.ndarray]:
         cloud = laspy.read(path)
     except Exception as error:  # laspy raises several kinds for a damaged or foreign file
         raise InputFileError(path, f"not a readable LAS/LAZ point cloud ({error})") from None
+    _check_header(path, cloud.header)
     points = np.stack([np.asarray(cloud.x), np.asarray(cloud.y), np.asarray(cloud.z)], axis=1)
     if not len(points):
         raise InputFileError(path, "holds no points; expected a LAS or LAZ point cloud")
+    _check_no_collapse(path, cloud, points)
     lowest = points.min(axis=0)
     if origin is None:
         origin = lowest

@@ -87,7 +87,8 @@ class Scene:
         """The sparse occupancy of the scene voxels (built once, on first use)."""
         with self._lock:
             if self._occupancy is None:
-                self._occupancy = _build_occupancy(self.voxels, self.shape)
+                self._occupancy = _build_occupancy(self.voxels, self.shape,
+                                                   self.path or self.name)
             return self._occupancy
 
     @property
@@ -95,7 +96,8 @@ class Scene:
         """The sparse occupancy of the target voxels alone, over the scene's shape."""
         with self._target_lock:
             if self._target_occupancy is None:
-                self._target_occupancy = _build_occupancy(self.target, self.shape)
+                self._target_occupancy = _build_occupancy(self.target, self.shape,
+                                                          self.target_path or self.name)
             return self._target_occupancy
 
     def target_centre_m(self) -> np.ndarray:
@@ -128,10 +130,10 @@ def top_height_map(voxels, nx, ny) -> np.ndarray:
     return heights
 
 
-def _build_occupancy(voxels, shape):
+def _build_occupancy(voxels, shape, source):
     from ladartui.scene.occupancy import Occupancy  # built by its own module
 
-    return Occupancy.build(voxels, shape)
+    return Occupancy.build(voxels, shape, source=str(source))
 
 
 def _checked_voxel_size(voxel_size) -> float:

@@ -70,11 +70,12 @@ class Occupancy:
     halo4_dims: np.ndarray = None
 
     @classmethod
-    def build(cls, voxels, shape=None) -> "Occupancy":
+    def build(cls, voxels, shape=None, source="voxels") -> "Occupancy":
         """Build from an (N, 3) integer voxel list (duplicates allowed) and the scene shape.
 
         ``shape`` is (nx, ny, nz); by default ``voxels.max(axis=0) + 1``. Voxels
-        outside ``[0, shape)`` raise FieldError.
+        outside ``[0, shape)`` raise FieldError; a build whose extent-sized arrays
+        would not fit in memory raises ResourceLimitError naming ``source``.
         """
         vox = np.asarray(voxels)
         if vox.size == 0:
@@ -97,6 +98,10 @@ class Occupancy:
                                  f"indices inside the scene shape {list(shape)}")
         else:
             return cls._empty(shape)
+        from ladartui.resources import check_occupancy
+
+        # Some arrays are sized by extent: refuse before allocating what cannot fit.
+        check_occupancy(lo, hi, len(vox), source)
         return cls._from_nonempty(vox, lo, hi, shape)
 
     @classmethod

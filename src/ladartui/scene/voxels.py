@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import functools
 import logging
+import os
 import threading
 from pathlib import Path
 
@@ -70,7 +71,17 @@ def _compile_kernels() -> None:
 
 @_kernel
 def _is_blank(c):
-    return c == _SPACE or c == _TAB or c == _CR
+    return c == _SPACE or c == _TAB
+
+
+@_kernel
+def _line_end(buf, pos, n):
+    """True at a line's end: LF, CR LF (files from Windows), or the end of the data.
+
+    A CR anywhere else is a mistake, not a blank."""
+    if pos >= n or buf[pos] == _NEWLINE:
+        return True
+    return buf[pos] == _CR and (pos + 1 >= n or buf[pos + 1] == _NEWLINE)
 
 
 @_kernel
@@ -91,10 +102,12 @@ def _parse_voxel_bytes(buf, start, out):
         line_start = pos
         while pos < n and _is_blank(buf[pos]):
             pos += 1
-        if pos >= n or buf[pos] == _NEWLINE:
+        if _line_end(buf, pos, n):
             if first_blank_line == 0:
                 first_blank_line = line
                 first_blank_offset = line_start
+            if pos < n and buf[pos] == _CR:
+                pos += 1
             pos += 1
             line += 1
             continue
@@ -121,8 +134,10 @@ def _parse_voxel_bytes(buf, start, out):
                     return rows, line, line_start
                 pos += 1
             elif pos < n:
-                if buf[pos] != _NEWLINE:
+                if not _line_end(buf, pos, n):
                     return rows, line, line_start
+                if buf[pos] == _CR:
+                    pos += 1
                 pos += 1
         rows += 1
         line += 1
@@ -245,6 +260,7 @@ def _parse_plain_lines(data: np.ndarray) -> np.ndarray | None:
 
 def _read_bytes(path: Path) -> np.ndarray:
     try:
+        _check_read_size(path)
         return np.fromfile(path, dtype=np.uint8)
     except FileNotFoundError:
         raise InputFileError(path, f"no such file; {EXPECTED} per line") from None
@@ -256,24 +272,43 @@ def _read_bytes(path: Path) -> np.ndarray:
         raise InputFileError(path, f"cannot be read: {error.strerror or error}") from None
 
 
+def _check_read_size(path: Path) -> None:
+    """Refuse a file whose bytes and parsed rows would not fit in memory (a sparse 50 GB file)."""
+    from ladartui.errors import ResourceLimitError
+    from ladartui.resources import available_memory, gib
+
+    size = os.stat(path).st_size
+    # The bytes, plus up to 12 bytes of int32 row per 6-byte line "0,0,0\n" while parsing.
+    need = 3 * size
+    limit = available_memory()
+    if need > limit:
+        raise ResourceLimitError(f"{path}: a voxel list of {gib(size)} needs about {gib(need)} "
+                                 f"to read, more than the {gib(limit)} of memory available")
+
+
 def describe_bad_line(text: str) -> str:
     """What is wrong with one rejected line, and what was expected."""
-    body = text.rstrip("\r")
-    if not body.strip(" \t\r"):
+    body = text[:-1] if text.endswith("\r") else text  # CR LF line ends are fine
+    if "\r" in body:
+        shown = body.strip(" \t")
+        return f"stray carriage return (\\r) in {shown!r}; {EXPECTED}"
+    if not body.strip(" \t"):
         return "blank line before more voxels; blank lines are allowed only at the end of the file"
     fields = body.split(",")
     if len(fields) != 3:
         return f"{len(fields)} comma-separated values in {body.strip()!r}; {EXPECTED}"
     for axis, field in zip(_AXES, fields):
-        token = field.strip(" \t\r")
+        token = field.strip(" \t")
         if not token:
             return f"{axis} is empty in {body.strip()!r}; {EXPECTED}"
         if token.startswith("-") and token[1:].isascii() and token[1:].isdigit():
             return f"{axis} = {token} is negative; voxel indices start at 0"
         if not (token.isascii() and token.isdigit()):
             return f"{axis} = {token!r} is not a whole number; {EXPECTED}"
-        if int(token) > MAX_INDEX:
-            return f"{axis} = {token} is too large; expected at most {MAX_INDEX}"
+        # Length first: int() refuses strings of more than 4,300 digits.
+        if len(token.lstrip("0")) > len(str(MAX_INDEX)) or int(token) > MAX_INDEX:
+            shown = token if len(token) <= 24 else f"{token[:12]}...({len(token)} digits)"
+            return f"{axis} = {shown} is too large; expected at most {MAX_INDEX}"
     return f"cannot read {body.strip()!r}; {EXPECTED}"
 
 

@@ -170,6 +170,24 @@ def _random_draws(spec: SweepSpec) -> list[dict]:
     return draws
 
 
+# Variants a sweep may expand to; each is a whole run (and a row of the results table).
+MAX_VARIANTS = 100_000
+# Random bounds beyond this overflow the draws (floats: max - min; integers: int64).
+RANDOM_BOUND = 1e15
+
+
+def _check_variant_count(path, grid, samples):
+    from ladartui.errors import ResourceLimitError
+
+    count = math.prod(len(values) for values in grid.values()) * max(samples, 1)
+    if count > MAX_VARIANTS:
+        sizes = " x ".join(f"{len(v)} {k}" for k, v in grid.items())
+        draws = f"{samples:,} random draws" if samples else ""
+        raise ResourceLimitError(f"{path}: [grid] and [random] make {count:,} variants "
+                                 f"({' x '.join(filter(None, (sizes, draws)))}), more than the "
+                                 f"limit of {MAX_VARIANTS:,}; use fewer values or samples")
+
+
 def load_sweep_spec(path) -> SweepSpec:
     """Read and check a sweep spec; mistakes raise InputFileError naming the key."""
     path = Path(path)
@@ -178,6 +196,9 @@ def load_sweep_spec(path) -> SweepSpec:
         data = tomllib.loads(text)
     except FileNotFoundError:
         raise InputFileError(path, "no such sweep spec") from None
+    except RecursionError:
+        raise InputFileError(path, "not valid TOML: arrays or tables nested too deep to read") \
+            from None
     except (OSError, UnicodeDecodeError) as error:
         raise InputFileError(path, f"cannot read: {error}") from None
     except tomllib.TOMLDecodeError as error:
@@ -245,6 +266,7 @@ def parse_sweep_spec(data: dict, path, text: str = "") -> SweepSpec:
     if not grid and not random:
         checker.fail("grid", "at least one parameter to vary in [grid] or [random]; known: "
                      + ", ".join(PARAMETERS), None)
+    _check_variant_count(path, grid, samples)
     scenario_path = DEFAULT_BASE if scenario == "default" else path.parent / scenario
     return SweepSpec(
         path=path, scenario_path=scenario_path, grid=grid, random=random,
@@ -358,8 +380,9 @@ class _Checker:
         if not {"min", "max"} <= set(value) or not set(value) <= allowed:
             self.fail(key, "{ min = A, max = B } (and integer = true for whole numbers)", value)
         low, high = value["min"], value["max"]
-        if not (_is_number(low) and _is_number(high) and low <= high):
-            self.fail(key, "numbers with min <= max", value)
+        if not (_is_number(low) and _is_number(high) and low <= high
+                and -RANDOM_BOUND <= low and high <= RANDOM_BOUND):
+            self.fail(key, f"numbers with min <= max, within +-{RANDOM_BOUND:g}", value)
         integer = value.get("integer", parameter.kind == "int")
         if not isinstance(integer, bool):
             self.fail(f"{key}.integer", "true or false", integer)

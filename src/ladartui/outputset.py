@@ -1,0 +1,282 @@
+"""All-or-nothing output sets: a run's files are replaced together or not at all.
+
+``OutputSet`` checks every path can be written before any work starts, holds a
+lock file per set (a second writer is refused), writes every file to a hidden
+temporary beside its target, fsyncs, and then swaps them in under a journal:
+each old file is renamed to a hidden backup, the new one renamed into place,
+and only when all are in place is the journal removed (the commit point) and
+the backups deleted. A failure rolls the old files back; a run killed during
+the swap leaves the journal, and the next run over the same set rolls it back
+before anything else and removes the hidden temporaries of killed runs.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import errno
+import json
+import os
+import tempfile
+import threading
+from collections.abc import Callable
+from pathlib import Path
+
+from ladartui.errors import Cancelled, OutputFileError
+
+# Called with a step name ("temporaries", "swap", "backups") at each stage of the
+# write; None in use. Tests set it to pause a run there and kill it.
+_step_hook: Callable[[str], None] | None = None
+
+
+def output_problem(path) -> str | None:
+    """None when ``path`` can be written as a file; else what is wrong, in words."""
+    path = Path(path)
+    try:
+        if path.is_dir():
+            return "is a folder, expected a file name"
+        name_max = _name_max(path.parent)
+        if len(os.fsencode(path.name)) > name_max:
+            return f"name too long for this system (at most {name_max} bytes a name)"
+        folder = path.parent
+        while not folder.exists():
+            if folder == folder.parent:
+                break
+            folder = folder.parent
+        if not folder.is_dir():
+            return f"cannot be written: {folder} is a file, not a folder"
+        # Root ignores permission bits and /proc refuses new files: try for real.
+        fd, probe = tempfile.mkstemp(prefix=f".{path.name[:64]}.", suffix=".probe", dir=folder)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as error:
+        reason = os.strerror(error.errno) if error.errno else str(error)
+        return f"cannot be written ({reason.lower()})"
+    return None
+
+
+def _name_max(folder: Path) -> int:
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    try:
+        return os.pathconf(folder, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        return 255
+
+
+def check_writable(*paths) -> None:
+    """Raise ``OutputFileError`` naming the first path that cannot be written."""
+    for path in paths:
+        problem = output_problem(path)
+        if problem:
+            raise OutputFileError(path, problem)
+
+
+def check_writable_folder(folder) -> None:
+    """Raise ``OutputFileError`` unless ``folder`` is (or can be made) a writable folder."""
+    folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise OutputFileError(folder, "is a file, expected a folder")
+    problem = output_problem(folder / "probe")
+    if problem:
+        raise OutputFileError(folder, problem.replace("probe", str(folder)))
+
+
+class OutputSet:
+    """The files of one run, written together; use as a context manager around the work.
+
+    Entering checks every path, takes the lock (refusing a second writer),
+    repairs a killed run's half-done swap and removes stale temporaries.
+    """
+
+    def __init__(self, paths: dict[str, Path], lock: Path):
+        self.paths = {name: Path(path) for name, path in paths.items()}
+        self.lock = Path(lock)
+        self.journal = self.lock.with_name(self.lock.name + ".journal")
+        self._lock_fd = None
+
+    def __enter__(self) -> OutputSet:
+        check_writable(*self.paths.values())
+        self._acquire()
+        try:
+            recover(self.journal)
+            self._remove_stale()
+        except BaseException:
+            self._release()
+            raise
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self._release()
+
+    # -- lock --
+
+    def _acquire(self):
+        import fcntl
+
+        self.lock.parent.mkdir(parents=True, exist_ok=True)
+        while True:
+            fd = os.open(self.lock, os.O_RDWR | os.O_CREAT, 0o644)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError as error:
+                holder = os.read(fd, 32).decode("ascii", "replace").strip() or "?"
+                os.close(fd)
+                if error.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+                    raise OutputFileError(self.lock, f"another run (pid {holder}) is writing "
+                                          "this output set; wait for it to finish") from None
+                raise
+            # The holder before us removes the file as it lets go: lock the one on disk.
+            try:
+                if os.stat(self.lock).st_ino == os.fstat(fd).st_ino:
+                    break
+            except FileNotFoundError:
+                pass
+            os.close(fd)
+        os.ftruncate(fd, 0)
+        os.write(fd, str(os.getpid()).encode("ascii"))
+        self._lock_fd = fd
+
+    def _release(self):
+        if self._lock_fd is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(self.lock)  # still held, so no one else has it open and locked
+            os.close(self._lock_fd)
+            self._lock_fd = None
+
+    def _remove_stale(self):
+        with contextlib.suppress(OSError):
+            self.journal.with_name(self.journal.name + ".tmp").unlink()
+        for path in self.paths.values():
+            for pattern in (f".{path.name}.*.tmp", f"..{path.name}.*.tmp", f".{path.name}.*.old"):
+                for stale in path.parent.glob(pattern):
+                    with contextlib.suppress(OSError):
+                        stale.unlink()
+
+    # -- write --
+
+    def write(self, writers: dict[str, Callable[[Path], None]],
+              cancel: threading.Event | None = None) -> dict[str, str]:
+        """Write every file with ``writers[name](temporary_path)``, then swap them all in.
+
+        Before the swap a set ``cancel`` stops with ``Cancelled`` and nothing
+        replaced; once the swap has begun it runs to the end (or is rolled back
+        on failure), so the files on disk always belong to one run.
+        """
+        temps = {}
+        try:
+            for name, path in self.paths.items():
+                fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+                os.close(fd)
+                temps[name] = Path(tmp)
+                os.chmod(tmp, _default_mode(path))
+                try:
+                    writers[name](temps[name])
+                except OSError as error:
+                    raise _write_error(path, error) from None
+                _fsync_file(temps[name])
+            _step("temporaries")
+            if cancel is not None and cancel.is_set():
+                raise Cancelled("run cancelled; nothing was written, earlier outputs are unchanged")
+            self._swap(temps)
+        finally:
+            for tmp in temps.values():
+                with contextlib.suppress(OSError):
+                    tmp.unlink()
+        return {name: str(path) for name, path in self.paths.items()}
+
+    def _swap(self, temps):
+        entries = []
+        for path in self.paths.values():
+            backup = path.with_name(f".{path.name}.{os.getpid()}.old")
+            entries.append({"path": str(path), "backup": str(backup),
+                            "existed": os.path.lexists(path)})
+        _write_journal(self.journal, entries)
+        try:
+            for entry, tmp in zip(entries, temps.values()):
+                if entry["existed"]:
+                    os.rename(entry["path"], entry["backup"])
+                _step("swap")
+                os.rename(tmp, entry["path"])
+            for folder in {Path(e["path"]).parent for e in entries}:
+                _fsync_dir(folder)
+            os.unlink(self.journal)  # the commit point
+            _fsync_dir(self.journal.parent)
+        except BaseException:
+            _roll_back(entries)
+            with contextlib.suppress(OSError):
+                os.unlink(self.journal)
+            raise
+        _step("backups")
+        for entry in entries:
+            with contextlib.suppress(OSError):
+                os.unlink(entry["backup"])
+
+
+def recover(journal: Path) -> bool:
+    """Undo the swap a killed run left half done (its journal is on disk); True if it did."""
+    try:
+        entries = json.loads(Path(journal).read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        return False
+    except (OSError, ValueError):
+        entries = []  # torn before it was complete: no rename had started
+    _roll_back(entries)
+    with contextlib.suppress(FileNotFoundError):
+        os.unlink(journal)
+    return True
+
+
+def _roll_back(entries):
+    for entry in entries:
+        path, backup = entry["path"], entry["backup"]
+        if entry["existed"]:
+            if os.path.lexists(backup):
+                os.replace(backup, path)
+        elif os.path.lexists(path):
+            os.unlink(path)
+
+
+def _write_journal(journal: Path, entries):
+    tmp = journal.with_name(journal.name + ".tmp")
+    with open(tmp, "w", encoding="utf-8") as handle:
+        json.dump(entries, handle)
+        handle.flush()
+        os.fsync(handle.fileno())
+    os.replace(tmp, journal)
+    _fsync_dir(journal.parent)
+
+
+def _write_error(path, error: OSError) -> OutputFileError:
+    reason = os.strerror(error.errno) if error.errno else str(error)
+    return OutputFileError(path, f"could not be written ({reason.lower()}); "
+                           "nothing was replaced, earlier outputs are unchanged")
+
+
+def _step(name):
+    if _step_hook is not None:
+        _step_hook(name)
+
+
+def _fsync_file(path: Path):
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def _fsync_dir(folder: Path):
+    with contextlib.suppress(OSError):  # some file systems cannot fsync a folder
+        fd = os.open(folder, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
+
+def _default_mode(target: Path) -> int:
+    if target.exists():
+        return target.stat().st_mode & 0o7777
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask

@@ -1,0 +1,109 @@
+"""Up-front estimates of memory and work, and the limits they are checked against.
+
+Work whose estimate exceeds the machine (memory) or the work limit (rays) is
+refused with ``ResourceLimitError`` naming the input, the estimate and the
+limit, before anything is allocated or traced. ``LADARTUI_MAX_MEMORY`` (bytes)
+and ``LADARTUI_MAX_RAYS`` override the limits; ``--max-rays`` on ``run`` too.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from ladartui.errors import ResourceLimitError
+
+# About two days of tracing on one core at ~10 M rays/s (a week of the 2.7e12 rays case
+# is far past it); a real study stays well under.
+DEFAULT_MAX_RAYS = 2 * 10**12 // 1000  # 2e9
+# Content-sized arrays of the occupancy per voxel: sort keys, bricks, masks, halo input.
+_BYTES_PER_VOXEL = 64
+
+
+def available_memory() -> int:
+    """Bytes the run may allocate: ``LADARTUI_MAX_MEMORY``, else the kernel's MemAvailable."""
+    override = os.environ.get("LADARTUI_MAX_MEMORY")
+    if override:
+        try:
+            return int(float(override))
+        except ValueError:
+            pass
+    try:
+        with open("/proc/meminfo", encoding="ascii") as meminfo:
+            for line in meminfo:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    try:
+        return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError):
+        return 8 * 2**30
+
+
+_max_rays_flag: int | None = None
+
+
+def set_max_rays(limit: int | None) -> None:
+    """The work limit for this process (``--max-rays``); None goes back to the default."""
+    global _max_rays_flag
+    _max_rays_flag = limit
+
+
+def max_rays() -> int:
+    if _max_rays_flag is not None:
+        return _max_rays_flag
+    override = os.environ.get("LADARTUI_MAX_RAYS")
+    if override:
+        try:
+            return int(float(override))
+        except ValueError:
+            pass
+    return DEFAULT_MAX_RAYS
+
+
+def occupancy_bytes(lo, hi, count) -> int:
+    """Estimated peak bytes to build the occupancy of ``count`` voxels spanning ``lo..hi``.
+
+    The extent-sized arrays (root grid, column tops, empty-cube distances,
+    halo bits) dominate when voxels are few and far apart.
+    """
+    lo = np.asarray(lo, dtype=object)  # Python ints: extents near 2**31 overflow int64 products
+    hi = np.asarray(hi, dtype=object)
+    last = hi - 1
+    root = [int(b >> 9) - int(a >> 9) + 1 for a, b in zip(lo, last)]
+    cubes = [int(b >> 3) - int(a >> 3) + 1 for a, b in zip(lo, last)]
+    cells4 = [int(b >> 2) - int(a >> 2) + 3 for a, b in zip(lo, last)]
+    size = 4 * root[0] * root[1] * root[2]
+    size += 4 * (root[0] * 64) * (root[1] * 64)  # column tops
+    size += 5 * cubes[0] * cubes[1] * cubes[2]  # empty cubes: the 0/1 grid and 4 octants
+    size += 2 * (cubes[0] + 2) * (cubes[1] + 2) * (cubes[2] + 2)  # brick halo, bool then bits
+    size += 2 * cells4[0] * cells4[1] * cells4[2]  # 4-voxel halo
+    return int(size + _BYTES_PER_VOXEL * int(count))
+
+
+def check_occupancy(lo, hi, count, source="voxels") -> int:
+    """The estimate, or ``ResourceLimitError`` when it exceeds the available memory."""
+    need = occupancy_bytes(lo, hi, count)
+    limit = available_memory()
+    if need > limit:
+        extent = " x ".join(str(int(b) - int(a)) for a, b in zip(lo, hi))
+        raise ResourceLimitError(
+            f"{source}: {int(count):,} voxels spanning {extent} voxels need about "
+            f"{gib(need)} for the tracing structures, more than the {gib(limit)} of memory "
+            "available; crop the scene or use a coarser voxel size")
+    return need
+
+
+def check_rays(rays, source, limit=None) -> None:
+    """``ResourceLimitError`` when ``rays`` exceeds the work limit."""
+    limit = max_rays() if limit is None else limit
+    if rays > limit:
+        raise ResourceLimitError(
+            f"{source}: about {rays:.3g} rays to trace, more than the limit of {limit:.3g} "
+            "(raise it with --max-rays or LADARTUI_MAX_RAYS if this is meant)")
+
+
+def gib(nbytes) -> str:
+    return f"{nbytes / 2**30:.3g} GiB" if nbytes >= 2**27 else f"{nbytes / 2**20:.3g} MiB"

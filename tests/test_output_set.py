@@ -1,0 +1,205 @@
+"""All-or-nothing output sets: checks before tracing, rollback, the lock, stale temporaries."""
+
+import errno
+import os
+
+import numpy as np
+import pytest
+
+import ladartui.outputset as outputset
+from ladartui.cli import main
+from ladartui.errors import OutputFileError
+from ladartui.flight import FlightPlan, Manual, ScanPose, aim_at
+from ladartui.scenario import Scenario
+from ladartui.scene.voxels import save_voxels
+from ladartui.sensor import Sensor
+from ladartui.simulation import _output_set, simulate
+
+
+def make_scenario(folder):
+    target = np.array([(x, y, z) for x in range(8, 12) for y in range(8, 11) for z in range(2)],
+                      dtype=np.int32)
+    canopy = np.array([(x, y, 6) for x in range(6, 14) for y in range(6, 13) if (x + 2 * y) % 3],
+                      dtype=np.int32)
+    folder.mkdir(parents=True, exist_ok=True)
+    save_voxels(folder / "woods.txt", np.vstack([target, canopy]))
+    save_voxels(folder / "woods_Target.txt", target)
+    poses = tuple(aim_at(ScanPose(x, y, 40.0), (9.5, 9.0, 0.5)) for x, y in [(9.5, -10.0), (29.5, 9.0)])
+    return Scenario(folder / "S.toml", "woods.txt", 1.0, Sensor(grid=16, ray_grid=2, fov=20.0),
+                    FlightPlan(segments=[Manual(poses)]), backend="numba").save()
+
+
+def outputs_of(scenario):
+    return [scenario.scene_output, scenario.target_output, scenario.measures_file]
+
+
+def write_old_set(scenario):
+    for index, path in enumerate(outputs_of(scenario)):
+        path.write_text(f"old {index}\n")
+    return snapshot(scenario)
+
+
+def snapshot(scenario):
+    return [p.read_bytes() if p.is_file() else None for p in outputs_of(scenario)]
+
+
+def hidden(folder):
+    return sorted(p.name for p in folder.iterdir() if p.name.startswith("."))
+
+
+@pytest.fixture
+def scenario(tmp_path):
+    return make_scenario(tmp_path)
+
+
+def test_target_output_a_folder_is_refused_before_tracing(scenario, capsys, monkeypatch):
+    old = write_old_set(scenario)
+    scenario.target_output.unlink()
+    scenario.target_output.mkdir()
+    traced = []
+    monkeypatch.setattr("ladartui.simulation._ScanRunner.scan", lambda *a: traced.append(a))
+    assert main(["run", str(scenario.path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "S_Target.txt" in err and "is a folder" in err
+    assert traced == []
+    assert snapshot(scenario)[0::2] == old[0::2]  # S.cmf and S_Scene.txt untouched
+
+
+def test_failed_write_replaces_nothing(scenario, capsys, monkeypatch):
+    old = write_old_set(scenario)
+    import ladartui.scene.voxels as voxels
+
+    real = voxels.save_voxels
+
+    def disk_full(path, data):
+        if ".S_Target.txt." in str(path):
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real(path, data)
+
+    monkeypatch.setattr(voxels, "save_voxels", disk_full)
+    assert main(["run", str(scenario.path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]  # after the progress bar
+    assert err.startswith("ladartui: error:") and "S_Target.txt" in err and "no space left" in err
+    assert "earlier outputs are unchanged" in err
+    assert snapshot(scenario) == old
+    assert hidden(scenario.path.parent) == []
+
+
+def test_failure_during_the_swap_rolls_back(scenario, monkeypatch):
+    old = write_old_set(scenario)
+    real = os.rename
+    moved = []
+
+    def failing(src, dst):
+        if str(src).endswith(".tmp"):
+            moved.append(dst)
+            if len(moved) == 2:  # the first new file is already in place
+                raise OSError(errno.EIO, "Input/output error")
+        return real(src, dst)
+
+    monkeypatch.setattr(outputset.os, "rename", failing)
+    with pytest.raises(OSError):
+        simulate(scenario)
+    assert snapshot(scenario) == old
+    assert hidden(scenario.path.parent) == []
+
+
+def test_second_writer_is_refused(scenario, capsys):
+    old = write_old_set(scenario)
+    with _output_set(scenario, las=False):
+        assert main(["run", str(scenario.path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert "another run" in err and f"pid {os.getpid()}" in err and err.startswith("ladartui: error")
+    assert snapshot(scenario) == old
+    assert main(["run", str(scenario.path)]) == 0  # the lock is let go
+    assert hidden(scenario.path.parent) == []
+
+
+def test_stale_temporaries_are_removed_by_the_next_run(scenario):
+    folder = scenario.path.parent
+    for name in (".S_Scene.txt.k1ll3d.tmp", "..S_Target.txt.x.tmp.y.tmp", ".S.cmf.123.old",
+                 ".S.outputs.lock.journal.tmp"):
+        (folder / name).write_text("stale")
+    (folder / ".other.tmp").write_text("not ours")
+    simulate(scenario)
+    assert hidden(folder) == [".other.tmp"]
+
+
+def test_half_done_swap_is_rolled_back(scenario, tmp_path):
+    old = write_old_set(scenario)
+    paths = outputs_of(scenario)
+    lock = scenario.path.with_name(".S.outputs.lock")
+    journal = lock.with_name(lock.name + ".journal")
+    entries = []
+    for path in paths:
+        entries.append({"path": str(path), "backup": str(path.with_name(f".{path.name}.1.old")),
+                        "existed": True})
+    outputset._write_journal(journal, entries)
+    # As a kill between renames leaves it: the first file new, the second in its backup.
+    os.rename(paths[0], entries[0]["backup"])
+    paths[0].write_text("new 0\n")
+    os.rename(paths[1], entries[1]["backup"])
+    with _output_set(scenario, las=False):
+        assert snapshot(scenario) == old
+    assert hidden(scenario.path.parent) == []
+
+
+@pytest.mark.parametrize("problem, expected", [
+    (lambda p: p.mkdir(), "is a folder"),
+    (lambda p: None, None),
+])
+def test_output_problem(tmp_path, problem, expected):
+    path = tmp_path / "out.txt"
+    problem(path)
+    assert outputset.output_problem(path) == expected or expected in outputset.output_problem(path)
+
+
+def test_output_problem_names_unwritable_places(tmp_path):
+    (tmp_path / "file").write_text("x")
+    assert "is a file, not a folder" in outputset.output_problem(tmp_path / "file" / "out.txt")
+    assert "cannot be written" in outputset.output_problem("/proc/x")
+    assert "name too long" in outputset.output_problem(tmp_path / ("n" * 5000))
+    with pytest.raises(OutputFileError, match="out.txt: is a folder"):
+        (tmp_path / "out.txt").mkdir()
+        outputset.check_writable(tmp_path / "ok.txt", tmp_path / "out.txt")
+
+
+def last_error_line(capsys):
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0, err  # refused before any work or progress
+    return err
+
+
+def test_trace_out_a_folder_is_refused_before_tracing(tmp_path, capsys):
+    rays = tmp_path / "rays.npy"
+    np.save(rays, np.array([[0, 0, 5, 0, 0, -1.0]]))
+    save_voxels(tmp_path / "v.txt", np.zeros((1, 3), np.int32))
+    (tmp_path / "hits.npy").mkdir()
+    assert main(["trace", "--scene", str(tmp_path / "v.txt"), "--rays", str(rays),
+                 "--out", str(tmp_path / "hits.npy")]) == 2
+    assert "hits.npy: is a folder" in last_error_line(capsys)
+
+
+def test_trace_of_an_empty_npy_is_one_line(tmp_path, capsys):
+    (tmp_path / "rays.npy").write_bytes(b"")
+    save_voxels(tmp_path / "v.txt", np.zeros((1, 3), np.int32))
+    assert main(["trace", "--scene", str(tmp_path / "v.txt"), "--rays", str(tmp_path / "rays.npy"),
+                 "--out", str(tmp_path / "hits.npy")]) == 2
+    assert "rays.npy: empty or cut short" in last_error_line(capsys)
+
+
+def test_generate_into_proc_is_refused(capsys):
+    assert main(["generate", "small", "/proc/x"]) == 2
+    err = last_error_line(capsys)
+    assert "/proc/x.txt: cannot be written" in err
+
+
+def test_sweep_out_an_existing_file_is_refused(tmp_path, capsys):
+    from tiny_sweep import write_tiny_scenario
+
+    write_tiny_scenario(tmp_path)
+    spec = tmp_path / "spec.toml"
+    spec.write_text('[sweep]\nscenario = "base.toml"\n[grid]\nscans = [2, 3]\n', encoding="utf-8")
+    (tmp_path / "results").write_text("a file")
+    assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path / "results")]) == 2
+    assert "results: is a file, expected a folder" in last_error_line(capsys)

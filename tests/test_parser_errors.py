@@ -1,0 +1,307 @@
+"""Bad input is one line of the project's own error, never a traceback.
+
+Regression tests for each parser traceback once seen, then bounded
+property-based fuzzers (hypothesis) over the voxel parser, the scenario
+loader, the sweep spec and the command line.
+"""
+
+import os
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from ladartui.cli import main
+from ladartui.errors import LadarError
+from ladartui.scenario import load_scenario, scenario_from_toml
+from ladartui.scene.voxels import load_voxels, save_voxels
+from ladartui.sweep.spec import load_sweep_spec
+
+# More examples for a long search by hand: LADARTUI_FUZZ_EXAMPLES=2000.
+EXAMPLES = int(os.environ.get("LADARTUI_FUZZ_EXAMPLES", "60"))
+FUZZ = settings(max_examples=EXAMPLES, deadline=None, derandomize=True,
+                suppress_health_check=list(HealthCheck))
+
+
+def assert_one_line(error):
+    text = str(error)
+    assert text and "\n" not in text and "Traceback" not in text
+
+
+def one_error_line(capsys):
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and err.startswith("ladartui"), err
+    return err
+
+
+# ---------------------------------------------------------------- regressions
+
+def test_voxel_index_of_4301_digits(tmp_path):
+    path = tmp_path / "big.txt"
+    path.write_text("0,0," + "9" * 4301 + "\n")
+    with pytest.raises(LadarError, match=r"big.txt:1: z = 999999999999\.\.\.\(4301 digits\) is "
+                       "too large") as caught:
+        load_voxels(path)
+    assert len(str(caught.value)) < 200
+
+
+def test_segment_kind_a_list(tmp_path):
+    with pytest.raises(LadarError, match=r"flight.segments\[0\].kind = \[\]: expected one of"):
+        scenario_from_toml('[files]\nscene = "s.txt"\n[[flight.segments]]\nkind = []\n',
+                           tmp_path / "k.toml")
+
+
+def test_arrays_nested_1000_deep(tmp_path):
+    text = '[files]\nscene = "s.txt"\nx = ' + "[" * 1000 + "]" * 1000 + "\n"
+    with pytest.raises(LadarError, match="nested too deep"):
+        scenario_from_toml(text, tmp_path / "deep.toml")
+    spec = tmp_path / "spec.toml"
+    spec.write_text('[sweep]\nscenario = "default"\nx = ' + "[" * 1000 + "]" * 1000 + "\n")
+    with pytest.raises(LadarError, match="spec.toml: not valid TOML: arrays or tables nested"):
+        load_sweep_spec(spec)
+
+
+def test_file_name_of_5000_characters(tmp_path, capsys):
+    assert main(["validate", str(tmp_path / ("a" * 5000 + ".toml"))]) == 2
+    err = one_error_line(capsys)
+    assert len(err) < 1000
+
+
+@pytest.mark.parametrize("rule, key", [
+    ("radius = { min = -1e308, max = 1e308 }", "random.radius"),
+    ("scans = { min = 1, max = 1e300 }", "random.scans"),
+])
+def test_random_bounds_that_overflow(tmp_path, rule, key):
+    spec = tmp_path / "spec.toml"
+    spec.write_text(f'[sweep]\nscenario = "default"\n[random]\nsamples = 3\n{rule}\n')
+    with pytest.raises(LadarError, match=rf"spec.toml:5: {key}: expected numbers with min <= max, "
+                       "within"):
+        load_sweep_spec(spec)
+
+
+# ---------------------------------------------------------------- fuzzers
+
+VALID_VOXELS = b"0,0,0\n1,2,3\n10,0,7\n"
+VALID_SCENARIO = """[files]
+scene = "s.txt"
+voxel_size = 1.0
+
+[sensor]
+grid = 16
+ray_grid = 2
+fov_deg = 20.0
+
+[flight]
+speed_mps = 30.0
+
+[[flight.segments]]
+kind = "orbit"
+centre = [0.5, 0.5, 0.5]
+radius = 20.0
+altitude = 30.0
+scans = 4
+"""
+VALID_SPEC = """[sweep]
+scenario = "default"
+objective = "obscured-coverage"
+
+[grid]
+scans = [2, 3]
+radius = [10.0, 20.0]
+
+[random]
+samples = 2
+seed = 1
+altitude = { min = 20, max = 40 }
+"""
+# Tokens a careless or hostile hand puts in these files.
+TOKENS = ["", "0", "-1", "1e308", "-1e308", "nan", "inf", "9" * 30, "2147483647", "\r", "\t",
+          "\x00", "\x1b]0;x\x07", "[/oops]", "[", "]", "{", "}", "=", ",", '"', "'", "\n",
+          "[]", "{}", "true", "é", "\ufeff", " "]
+
+
+@st.composite
+def mutated(draw, text):
+    """``text`` with a few spans replaced by tokens or arbitrary characters."""
+    for _ in range(draw(st.integers(1, 4))):
+        start = draw(st.integers(0, len(text)))
+        stop = draw(st.integers(start, min(len(text), start + 8)))
+        insert = draw(st.one_of(st.sampled_from(TOKENS), st.text(max_size=6)))
+        text = text[:start] + insert + text[stop:]
+    return text
+
+
+@FUZZ
+@given(mutated(VALID_VOXELS.decode()))
+def test_fuzz_voxel_parser(tmp_path_factory, text):
+    path = tmp_path_factory.mktemp("v") / "v.txt"
+    path.write_bytes(text.encode("utf-8", "surrogatepass"))
+    try:
+        voxels = load_voxels(path)
+    except LadarError as error:
+        assert_one_line(error)
+        assert "v.txt" in str(error)
+    else:
+        assert voxels.ndim == 2 and voxels.shape[1] == 3 and voxels.dtype == np.int32
+
+
+@pytest.fixture(scope="module")
+def scene_folder(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("scene")
+    save_voxels(folder / "s.txt", np.array([[0, 0, 0], [1, 1, 1]], np.int32))
+    save_voxels(folder / "s_Target.txt", np.array([[0, 0, 0]], np.int32))
+    return folder
+
+
+@FUZZ
+@given(text=mutated(VALID_SCENARIO))
+def test_fuzz_scenario_loader(scene_folder, text):
+    path = scene_folder / "fuzz.toml"
+    path.write_bytes(text.encode("utf-8", "surrogatepass"))
+    try:
+        load_scenario(path)
+    except LadarError as error:
+        assert_one_line(error)
+
+
+@FUZZ
+@given(text=mutated(VALID_SPEC))
+def test_fuzz_sweep_spec(scene_folder, text):
+    path = scene_folder / "spec.toml"
+    path.write_bytes(text.encode("utf-8", "surrogatepass"))
+    try:
+        spec = load_sweep_spec(path)
+        assert len(spec.variants) >= 1
+    except LadarError as error:
+        assert_one_line(error)
+
+
+@settings(max_examples=max(1, EXAMPLES * 2 // 3), deadline=None, derandomize=True,
+          suppress_health_check=list(HealthCheck))
+@given(command=st.sampled_from(["validate", "info", "run", "sweep", "trace"]),
+       words=st.lists(st.one_of(st.sampled_from(["--step", "--backend", "--max-rays", "--out",
+                                                 "--precision", "--method", "--rays", "--scene",
+                                                 "-1", "nan", "1e400", "--", "-"]),
+                                st.sampled_from(TOKENS)), max_size=4))
+def test_fuzz_command_line(scene_folder, capsys, command, words):
+    # Only bad invocations: a missing or broken scenario file keeps each one cheap.
+    argv = [command, str(scene_folder / "missing.toml"), *words]
+    if command == "run":
+        argv.append("--no-write")
+    try:
+        code = main(argv)
+    except SystemExit as stop:  # argparse: one line, status 2
+        code = stop.code
+    assert code == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "Traceback" not in err, err
+
+
+# ---------------------------------------------------------------- model files
+
+@pytest.mark.parametrize("text, rows", [
+    (b"0,0,0\r\n1,2,3\r\n", [[0, 0, 0], [1, 2, 3]]),  # Windows line ends are fine
+    (b"1 , 2 ,3\n4,5,6\r", [[1, 2, 3], [4, 5, 6]]),
+])
+def test_crlf_line_ends_are_read(tmp_path, text, rows):
+    (tmp_path / "v.txt").write_bytes(text)
+    assert load_voxels(tmp_path / "v.txt").tolist() == rows
+
+
+@pytest.mark.parametrize("text, message", [
+    (b"0,0,0\n1,2\r,3\n", r"v.txt:2: stray carriage return \(\\r\) in '1,2\\r,3'"),
+    (b"0,0,0\n1,\r2,3\n", r"v.txt:2: stray carriage return"),
+    (b"0,0,0\n\r\r\n1,1,1\n", r"v.txt:2: stray carriage return"),
+])
+def test_stray_carriage_return_is_an_error(tmp_path, text, message):
+    (tmp_path / "v.txt").write_bytes(text)
+    with pytest.raises(LadarError, match=message):
+        load_voxels(tmp_path / "v.txt")
+
+
+def write_scenario(folder, scene_text):
+    (folder / "m.txt").write_bytes(scene_text)
+    save_voxels(folder / "m_Target.txt", np.array([[0, 0, 0]], np.int32))
+    path = folder / "m.toml"
+    path.write_text(VALID_SCENARIO.replace("s.txt", "m.txt"))
+    return path
+
+
+def test_validate_reads_the_model_files(tmp_path, capsys):
+    path = write_scenario(tmp_path, b"0,0,0\n1,x,2\n")
+    assert main(["validate", str(path)]) == 2
+    err = one_error_line(capsys)
+    assert "m.txt:2: y = 'x' is not a whole number" in err
+
+
+def test_validate_summary_gives_scene_size_and_memory(tmp_path, capsys):
+    path = write_scenario(tmp_path, b"0,0,0\n1,2,3\n9,4,5\n")
+    assert main(["validate", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "scene      3 voxels, target 1 voxels; extent 10 x 5 x 6 voxels" in out
+    assert "memory     about " in out and "available" in out
+
+
+def test_validate_refuses_a_scene_too_large_for_memory(tmp_path, capsys):
+    path = write_scenario(tmp_path, b"0,0,0\n2147483647,0,0\n")
+    assert main(["validate", str(path)]) == 2
+    assert "m.txt: 2 voxels spanning 2147483648 x 1 x 1 voxels need about" in one_error_line(capsys)
+
+
+def las_with(tmp_path, offset, value):
+    import struct
+
+    from ladartui.scene.las import export_las
+
+    voxels = np.array([(x, y, z) for x in range(6) for y in range(5) for z in range(2)], np.int32)
+    path = tmp_path / "c.las"
+    export_las(path, voxels, 0.25)
+    data = bytearray(path.read_bytes())
+    data[offset:offset + 8] = struct.pack("<d", value)  # x scale at 131, x offset at 155
+    path.write_bytes(bytes(data))
+    return path
+
+
+@pytest.mark.parametrize("offset, value, message", [
+    (131, float("nan"), r"c.las: header scale factors \(nan, "),
+    (131, 0.0, r"c.las: header scale factors \(0, .*expected finite non-zero"),
+    (155, float("inf"), r"c.las: header offsets \(inf, 0, 0\): expected finite"),
+    (155, 1e308, r"c.las: header offsets \(1e\+308, .* too large for the scale factors"),
+])
+def test_las_with_degenerate_scale_or_offset_is_refused(tmp_path, offset, value, message):
+    from ladartui.scene.las import import_las
+
+    with pytest.raises(LadarError, match=message):
+        import_las(las_with(tmp_path, offset, value), 0.25)
+
+
+def test_las_points_that_collapse_are_reported(tmp_path):
+    import laspy
+
+    from ladartui.scene.las import _check_no_collapse
+
+    path = las_with(tmp_path, 155, 0.0)
+    cloud = laspy.read(path)
+    points = np.stack([np.asarray(cloud.x), np.asarray(cloud.y), np.asarray(cloud.z)], axis=1)
+    _check_no_collapse(path, cloud, points)  # distinct points stay distinct
+    # Rounded to whole metres, as a huge offset rounds them, neighbours merge.
+    with pytest.raises(LadarError, match=r"c.las: 60 distinct stored points collapse to 4 once"):
+        _check_no_collapse(path, cloud, np.floor(points))
+
+
+def test_fuzz_seeds_are_valid(scene_folder):
+    path = scene_folder / "seed.toml"
+    path.write_text(VALID_SCENARIO)
+    assert load_scenario(path).scan_count() == 4
+    path.write_text(VALID_SPEC)
+    assert len(load_sweep_spec(path).variants) == 8
+    (scene_folder / "v.txt").write_bytes(VALID_VOXELS)
+    assert len(load_voxels(scene_folder / "v.txt")) == 3
+
+
+def test_flag_errors_escape_what_the_user_typed(capsys):
+    with pytest.raises(SystemExit):
+        main(["validate", "x.toml", "\n\x1b]0;PWNED\x07"])
+    err = one_error_line(capsys)
+    assert "\\x0a\\x1b]0;PWNED\\x07" in err

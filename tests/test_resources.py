@@ -1,0 +1,100 @@
+"""The resource guard: memory and work estimated up front, refused with one line."""
+
+import numpy as np
+import pytest
+
+from ladartui.cli import main
+from ladartui.errors import ResourceLimitError
+from ladartui.resources import occupancy_bytes, set_max_rays
+from ladartui.scene.occupancy import Occupancy
+from ladartui.scene.voxels import save_voxels
+
+
+def one_error_line(capsys):
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and err.startswith("ladartui: error:"), err
+    return err
+
+
+@pytest.mark.parametrize("far", ["100000,100000,100", "2147483647,0,0"])
+def test_two_voxels_far_apart_are_refused_not_allocated(tmp_path, capsys, far):
+    path = tmp_path / "f.txt"
+    path.write_text(f"0,0,0\n{far}\n")
+    assert main(["info", str(path)]) == 2
+    err = one_error_line(capsys)
+    assert "f.txt: 2 voxels spanning" in err and "GiB" in err and "available" in err
+
+
+def test_memory_limit_is_configurable(tmp_path, monkeypatch):
+    voxels = np.array([(x, y, 0) for x in range(0, 200, 7) for y in range(0, 200, 7)], np.int32)
+    need = occupancy_bytes(voxels.min(0), voxels.max(0) + 1, len(voxels))
+    monkeypatch.setenv("LADARTUI_MAX_MEMORY", str(need - 1))
+    with pytest.raises(ResourceLimitError, match=r"woods.txt: 841 voxels .* more than the"):
+        Occupancy.build(voxels, source="woods.txt")
+    monkeypatch.setenv("LADARTUI_MAX_MEMORY", str(need))
+    assert Occupancy.build(voxels).count == len(voxels)
+
+
+@pytest.mark.parametrize("voxels", [
+    [(x, y, z) for x in range(0, 64, 3) for y in range(0, 40, 5) for z in range(3)],
+    [(0, 0, 0), (700, 300, 20)],
+])
+def test_estimate_covers_what_the_build_holds(voxels):
+    voxels = np.array(voxels, np.int32)
+    occupancy = Occupancy.build(voxels)
+    estimate = occupancy_bytes(voxels.min(0), voxels.max(0) + 1, len(voxels))
+    assert occupancy.nbytes <= estimate <= 40 * occupancy.nbytes + 2**20
+
+
+def write_big_scenario(folder, grid, ray_grid, scans):
+    save_voxels(folder / "s.txt", np.zeros((1, 3), np.int32))
+    save_voxels(folder / "s_Target.txt", np.zeros((1, 3), np.int32))
+    path = folder / "big.toml"
+    path.write_text(f'[files]\nscene = "s.txt"\n[sensor]\ngrid = {grid}\nray_grid = {ray_grid}\n'
+                    '[[flight.segments]]\nkind = "orbit"\ncentre = [0, 0, 0]\nradius = 100\n'
+                    f'altitude = 100\nscans = {scans}\n')
+    return path
+
+
+def test_huge_ray_count_is_refused_at_validation(tmp_path, capsys):
+    path = write_big_scenario(tmp_path, 1024, 16, 10000)
+    assert main(["validate", str(path)]) == 2
+    err = one_error_line(capsys)
+    assert "sensor.grid = 1024, sensor.ray_grid = 16, 10,000 scans" in err
+    assert "5.37e+12 rays" in err and "--max-rays" in err
+
+
+def test_max_rays_flag(tmp_path, capsys):
+    path = write_big_scenario(tmp_path, 16, 2, 4)  # 2 x 1024 x 4 = 8192 rays
+    try:
+        assert main(["run", str(path), "--no-write", "--max-rays", "8000"]) == 2
+        assert "8.19e+03 rays to trace, more than the limit of 8e+03" in one_error_line(capsys)
+        assert main(["run", str(path), "--no-write", "--max-rays", "0"]) == 2
+        assert "--max-rays = 0.0" in one_error_line(capsys)
+    finally:
+        set_max_rays(None)
+
+
+def test_huge_sweep_and_generate_are_refused(tmp_path, capsys):
+    spec = tmp_path / "sp.toml"
+    spec.write_text('[sweep]\nscenario = "default"\n[random]\nsamples = 1000000000000\nseed = 1\n'
+                    'radius = {min = 1, max = 2}\n')
+    assert main(["sweep", str(spec), "--serial"]) == 2
+    assert "1,000,000,000,000 variants" in one_error_line(capsys)
+    spec.write_text('[sweep]\nscenario = "default"\n[grid]\n' + "".join(
+        f"{name} = [{', '.join(str(v) for v in range(1, 101))}]\n"
+        for name in ("radius", "altitude", "scans")))
+    assert main(["sweep", str(spec), "--serial"]) == 2
+    assert "1,000,000 variants (100 radius x 100 altitude x 100 scans)" in one_error_line(capsys)
+    assert main(["generate", "small", str(tmp_path / "x"), "--trees", "100000000"]) == 2
+    assert "trees = 100000000: expected at most 100,000 trees" in one_error_line(capsys)
+
+
+def test_sparse_huge_voxel_file_is_refused_before_reading(tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("LADARTUI_MAX_MEMORY", str(16 * 2**30))
+    path = tmp_path / "sparse.txt"
+    with open(path, "wb") as handle:  # 50 GB on paper, nothing on disk
+        handle.truncate(50 * 10**9)
+    assert main(["info", str(path)]) == 2
+    err = one_error_line(capsys)
+    assert "sparse.txt: a voxel list of 46.6 GiB needs about 140 GiB to read, more than the 16 GiB" in err
