@@ -1,0 +1,70 @@
+"""Chart files drawn with matplotlib: valid SVG and PNG, the series and the Pareto front's order."""
+
+from __future__ import annotations
+
+import json
+import re
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+from PIL import Image
+
+from ladartui.charts import new_figure, save_figure
+from ladartui.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+SVG = "{http://www.w3.org/2000/svg}"
+
+
+def _groups(svg_path: Path, prefix: str) -> list[ET.Element]:
+    tree = ET.parse(svg_path)  # raises on a malformed file
+    assert tree.getroot().tag == f"{SVG}svg"
+    return [g for g in tree.iter(f"{SVG}g") if g.get("id", "").startswith(prefix)]
+
+
+def _line_vertices(group: ET.Element) -> list[tuple[float, float]]:
+    path = next(group.iter(f"{SVG}path"))
+    numbers = [float(n) for n in re.findall(r"-?\d+(?:\.\d+)?", path.get("d", ""))]
+    return list(zip(numbers[0::2], numbers[1::2]))
+
+
+def test_study_chart_from_json_writes_svg_and_png_with_every_series_and_the_front_in_order(tmp_path):
+    source = ROOT / "docs" / "study.json"
+    assert main(["study", "--chart-from", str(source), "--out", str(tmp_path)]) == 0
+    rows = json.loads(source.read_text())["rows"]
+    measured = [r for r in rows if r["status"] == "ok" and r.get("seconds_per_scan") is not None
+                and r.get("coverage_error") is not None]
+    families = {(r["backend"], r["method"], r["precision"] if r["method"] != "march" else "")
+                for r in measured}
+
+    svg = tmp_path / "speed-accuracy.svg"
+    assert len(_groups(svg, "series-")) == len(families) == 5
+    (front,) = _groups(svg, "pareto-front")
+    vertices = _line_vertices(front)
+    front_rows = sorted((r for r in measured if r["front"]), key=lambda r: r["seconds_per_scan"])
+    assert len(vertices) == len(front_rows) >= 2
+    xs = [x for x, _ in vertices]
+    assert xs == sorted(xs)  # the line runs fastest to slowest, the front's order
+    # faster settings on the front are less accurate: the line falls (SVG y grows downwards)
+    errors = [abs(r["coverage_error"]) for r in front_rows]
+    ys = [y for _, y in vertices]
+    assert [a < b for a, b in zip(errors, errors[1:])] == [a > b for a, b in zip(ys, ys[1:])]
+
+    with Image.open(tmp_path / "speed-accuracy.png") as image:
+        assert image.format == "PNG" and image.size == (900, 560)
+
+
+def test_save_figure_writes_the_pixel_size_asked_and_refuses_unknown_formats(tmp_path):
+    figure = new_figure(400, 300)
+    figure.add_subplot().plot([0, 1], [1, 0])
+    with Image.open(save_figure(figure, tmp_path / "a.png")) as image:
+        assert image.size == (400, 300)
+    root = ET.parse(save_figure(figure, tmp_path / "a.svg")).getroot()
+    assert root.get("width") == "288pt" and root.get("height") == "216pt"  # 4 x 3 inches
+    try:
+        save_figure(figure, tmp_path / "a.gif")
+    except ValueError as error:
+        assert "gif" in str(error)
+    else:
+        raise AssertionError("a .gif chart was accepted")
+    assert not (tmp_path / "a.gif").exists()
