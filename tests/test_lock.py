@@ -27,14 +27,17 @@ def _marker_holds(dependency: dict, extra: str) -> bool:
 
 def locked_requirements(lock: dict, extras: tuple[str, ...] = ("test",)) -> dict[str, str]:
     """name -> version of every package the lock installs here for PROJECT[extras]."""
-    packages = {canonicalize_name(p["name"]): p for p in lock["package"]}
+    # A package locked at two versions (a fork by Python version) is named with its version.
+    packages: dict[str, list[dict]] = {}
+    for locked in lock["package"]:
+        packages.setdefault(canonicalize_name(locked["name"]), []).append(locked)
     wanted: dict[str, str] = {}
-    todo: list[tuple[str, tuple[str, ...]]] = [(PROJECT, extras)]
+    todo: list[tuple[str, str | None, tuple[str, ...]]] = [(PROJECT, None, extras)]
     seen: set[tuple[str, str]] = set()
     while todo:
-        name, want_extras = todo.pop()
-        package = packages[canonicalize_name(name)]
+        name, version, want_extras = todo.pop()
         key = canonicalize_name(name)
+        (package,) = [p for p in packages[key] if version in (None, p["version"])]
         wanted[key] = package["version"]
         groups = [("", package.get("dependencies", []))]
         groups += [(e, package.get("optional-dependencies", {}).get(e, [])) for e in want_extras]
@@ -44,7 +47,8 @@ def locked_requirements(lock: dict, extras: tuple[str, ...] = ("test",)) -> dict
             seen.add((key, extra))
             for dependency in dependencies:
                 if _marker_holds(dependency, extra):
-                    todo.append((dependency["name"], tuple(dependency.get("extra", ()))))
+                    todo.append((dependency["name"], dependency.get("version"),
+                                 tuple(dependency.get("extra", ()))))
     return wanted
 
 
@@ -84,8 +88,12 @@ def test_graph_walk_follows_markers_and_extras() -> None:
             {"name": "a", "version": "1.0"},
             {"name": "win-only", "version": "9"},
             {"name": "b", "version": "2.0", "optional-dependencies": {"fast": [{"name": "c"}]}},
-            {"name": "c", "version": "3.0"},
+            {"name": "c", "version": "3.0", "dependencies": [
+                {"name": "d", "version": "1", "marker": "python_full_version < '3.0'"},
+                {"name": "d", "version": "2", "marker": "python_full_version >= '3.0'"}]},
+            {"name": "d", "version": "1"},
+            {"name": "d", "version": "2"},
         ]
     }
-    assert locked_requirements(lock) == {PROJECT: "0.1.0", "a": "1.0", "b": "2.0", "c": "3.0"}
+    assert locked_requirements(lock) == {PROJECT: "0.1.0", "a": "1.0", "b": "2.0", "c": "3.0", "d": "2"}
     assert locked_requirements(lock, extras=()) == {PROJECT: "0.1.0", "a": "1.0"}
