@@ -7,6 +7,8 @@ import re
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
+import numpy as np
+import pytest
 from PIL import Image
 
 from ladartui.charts import new_figure, save_figure
@@ -68,3 +70,52 @@ def test_save_figure_writes_the_pixel_size_asked_and_refuses_unknown_formats(tmp
     else:
         raise AssertionError("a .gif chart was accepted")
     assert not (tmp_path / "a.gif").exists()
+
+
+@pytest.fixture
+def three_scan_scenario(tmp_path):
+    from ladartui.flight import FlightPlan, Manual, ScanPose, aim_at
+    from ladartui.scenario import Scenario
+    from ladartui.scene.voxels import save_voxels
+    from ladartui.sensor import Sensor
+
+    target = np.array([(x, y, z) for x in range(8, 12) for y in range(8, 11) for z in range(2)],
+                      dtype=np.int32)
+    canopy = np.array([(x, y, 6) for x in range(6, 14) for y in range(6, 13) if (x + 2 * y) % 3],
+                      dtype=np.int32)
+    save_voxels(tmp_path / "woods.txt", np.vstack([target, canopy]))
+    save_voxels(tmp_path / "woods_Target.txt", target)
+    spots = [(9.5, -10.0), (29.5, 9.0), (9.5, 29.0)]
+    poses = tuple(aim_at(ScanPose(x, y, 40.0), (9.5, 9.0, 0.5)) for x, y in spots)
+    return Scenario(tmp_path / "S.toml", "woods.txt", 1.0, Sensor(grid=16, ray_grid=2, fov=20.0),
+                    FlightPlan(segments=[Manual(poses)]), backend="numba").save()
+
+
+def test_run_chart_plots_coverage_after_each_scan_with_the_90_percent_point(
+        three_scan_scenario, tmp_path, capsys):
+    svg, png = tmp_path / "cov.svg", tmp_path / "cov.png"
+    assert main(["run", str(three_scan_scenario.path), "--no-write", "--json", "--chart", str(svg)]) == 0
+    measures = json.loads(capsys.readouterr().out)["measures"]
+    assert main(["run", str(three_scan_scenario.path), "--no-write", "--chart", str(png)]) == 0
+    assert f"wrote chart: {png}" in capsys.readouterr().err
+
+    series = _groups(svg, "series-")
+    assert sorted(g.get("id") for g in series) == ["series-obscured", "series-unobscured"]
+    for group in series:  # one vertex per scan
+        assert len(_line_vertices(group)) == 3
+    (enough,) = _groups(svg, "enough-point")
+    k = measures["scans_for_enough"]
+    assert k in (1, 2, 3)
+    (obscured,) = [g for g in series if g.get("id") == "series-obscured"]
+    marker = next(enough.iter(f"{SVG}use"))
+    assert _line_vertices(obscured)[k - 1] == pytest.approx((float(marker.get("x")),
+                                                             float(marker.get("y"))), abs=0.01)
+    with Image.open(png) as image:
+        assert image.size == (800, 480)
+
+
+def test_run_chart_refuses_another_suffix_before_tracing(three_scan_scenario, tmp_path, capsys):
+    assert main(["run", str(three_scan_scenario.path), "--chart", str(tmp_path / "c.pdf")]) == 2
+    err = capsys.readouterr().err
+    assert "--chart" in err and "ending in .svg or .png" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "S_Scene.txt").exists()

@@ -32,6 +32,8 @@ def add_parser(subparsers):
     parser.add_argument("--no-write", dest="write", action="store_false",
                         help="do not write outputs or measures")
     parser.add_argument("--json", action="store_true", help="print the result as JSON on stdout")
+    parser.add_argument("--chart", metavar="FILE",
+                        help="also write the coverage after each scan as a chart (.svg or .png)")
     parser.set_defaults(handler=run)
     return parser
 
@@ -52,8 +54,19 @@ def run(args) -> int:
             scenario = scenario.with_changes(**{name: value})
         except FieldError as error:  # name the flag the user typed, not the TOML field
             raise FieldError(f"--{name}", value, error.expected) from None
+    if args.chart is not None and not args.chart.lower().endswith((".svg", ".png")):
+        raise FieldError("--chart", args.chart, "a file name ending in .svg or .png")
     errors = Console(stderr=True)
     result = _simulate_with_progress(scenario, args, errors)
+    if args.chart is not None:
+        from ladartui.charts import save_figure
+        from ladartui.charts.coverage import coverage_figure
+
+        try:
+            path = save_figure(coverage_figure(result.measures), args.chart)
+        except OSError as error:
+            raise FieldError("--chart", args.chart, f"a writable path ({error.strerror})") from None
+        errors.print(f"wrote chart: {path}", highlight=False, markup=False, soft_wrap=True)
     if args.json:
         print(json.dumps(result_dict(scenario, result), indent=2, allow_nan=False))
     else:
