@@ -119,3 +119,36 @@ def test_run_chart_refuses_another_suffix_before_tracing(three_scan_scenario, tm
     err = capsys.readouterr().err
     assert "--chart" in err and "ending in .svg or .png" in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "S_Scene.txt").exists()
+
+
+def test_sweep_writes_the_pareto_chart_with_the_front_cheapest_first_and_the_best_marked(
+        tmp_path, capsys):
+    from tiny_sweep import write_tiny_scenario
+
+    write_tiny_scenario(tmp_path)
+    spec = tmp_path / "spec.toml"
+    spec.write_text('[sweep]\nscenario = "base.toml"\n[grid]\nradius = [10.0, 20.0, 30.0]\n'
+                    "scans = [2, 4]\n", encoding="utf-8")
+    out = tmp_path / "out"
+    assert main(["sweep", str(spec), "--serial", "--out", str(out), "--json", "--top", "6"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["charts"] == {"svg": str(out / "pareto.svg"), "png": str(out / "pareto.png")}
+
+    svg = out / "pareto.svg"
+    (variants,) = _groups(svg, "series-variants")
+    assert len(list(variants.iter(f"{SVG}use"))) == report["variants"] == 6
+    (front,) = _groups(svg, "pareto-front")
+    vertices = _line_vertices(front)
+    assert len(vertices) == len(report["pareto"]) >= 1
+    costs = [entry["cost"] for entry in report["pareto"]]
+    assert costs == sorted(costs)  # the report's front, cheapest first ...
+    xs = [x for x, _ in vertices]
+    assert xs == sorted(xs)  # ... drawn in that order
+    (best,) = _groups(svg, "best")
+    marker = next(best.iter(f"{SVG}use"))
+    top = report["top"][0]
+    assert top["pareto"]  # the best by coverage is on the front: its marker sits on a vertex
+    index = [entry["variant"] for entry in report["pareto"]].index(top["variant"])
+    assert vertices[index] == pytest.approx((float(marker.get("x")), float(marker.get("y"))), abs=0.01)
+    with Image.open(out / "pareto.png") as image:
+        assert image.size == (800, 480)
