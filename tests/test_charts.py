@@ -34,10 +34,16 @@ def test_study_chart_from_json_writes_svg_and_png_with_every_series_and_the_fron
     source = ROOT / "docs" / "study.json"
     assert main(["study", "--chart-from", str(source), "--out", str(tmp_path)]) == 0
     rows = json.loads(source.read_text())["rows"]
-    measured = [r for r in rows if r["status"] == "ok" and r.get("seconds_per_scan") is not None
-                and r.get("coverage_error") is not None]
-    families = {(r["backend"], r["method"], r["precision"] if r["method"] != "march" else "")
-                for r in measured}
+    measured = [
+        r
+        for r in rows
+        if r["status"] == "ok"
+        and r.get("seconds_per_scan") is not None
+        and r.get("coverage_error") is not None
+    ]
+    families = {
+        (r["backend"], r["method"], r["precision"] if r["method"] != "march" else "") for r in measured
+    }
 
     svg = tmp_path / "speed-accuracy.svg"
     assert len(_groups(svg, "series-")) == len(families) == 5
@@ -79,20 +85,29 @@ def three_scan_scenario(tmp_path):
     from ladartui.scene.voxels import save_voxels
     from ladartui.sensor import Sensor
 
-    target = np.array([(x, y, z) for x in range(8, 12) for y in range(8, 11) for z in range(2)],
-                      dtype=np.int32)
-    canopy = np.array([(x, y, 6) for x in range(6, 14) for y in range(6, 13) if (x + 2 * y) % 3],
-                      dtype=np.int32)
+    target = np.array(
+        [(x, y, z) for x in range(8, 12) for y in range(8, 11) for z in range(2)], dtype=np.int32
+    )
+    canopy = np.array(
+        [(x, y, 6) for x in range(6, 14) for y in range(6, 13) if (x + 2 * y) % 3], dtype=np.int32
+    )
     save_voxels(tmp_path / "woods.txt", np.vstack([target, canopy]))
     save_voxels(tmp_path / "woods_Target.txt", target)
     spots = [(9.5, -10.0), (29.5, 9.0), (9.5, 29.0)]
     poses = tuple(aim_at(ScanPose(x, y, 40.0), (9.5, 9.0, 0.5)) for x, y in spots)
-    return Scenario(tmp_path / "S.toml", "woods.txt", 1.0, Sensor(grid=16, ray_grid=2, fov=20.0),
-                    FlightPlan(segments=[Manual(poses)]), backend="numba").save()
+    return Scenario(
+        tmp_path / "S.toml",
+        "woods.txt",
+        1.0,
+        Sensor(grid=16, ray_grid=2, fov=20.0),
+        FlightPlan(segments=[Manual(poses)]),
+        backend="numba",
+    ).save()
 
 
 def test_run_chart_plots_coverage_after_each_scan_with_the_90_percent_point(
-        three_scan_scenario, tmp_path, capsys):
+    three_scan_scenario, tmp_path, capsys
+):
     svg, png = tmp_path / "cov.svg", tmp_path / "cov.png"
     assert main(["run", str(three_scan_scenario.path), "--no-write", "--json", "--chart", str(svg)]) == 0
     measures = json.loads(capsys.readouterr().out)["measures"]
@@ -108,8 +123,9 @@ def test_run_chart_plots_coverage_after_each_scan_with_the_90_percent_point(
     assert k in (1, 2, 3)
     (obscured,) = [g for g in series if g.get("id") == "series-obscured"]
     marker = next(enough.iter(f"{SVG}use"))
-    assert _line_vertices(obscured)[k - 1] == pytest.approx((float(marker.get("x")),
-                                                             float(marker.get("y"))), abs=0.01)
+    assert _line_vertices(obscured)[k - 1] == pytest.approx(
+        (float(marker.get("x")), float(marker.get("y"))), abs=0.01
+    )
     with Image.open(png) as image:
         assert image.size == (800, 480)
 
@@ -121,14 +137,15 @@ def test_run_chart_refuses_another_suffix_before_tracing(three_scan_scenario, tm
     assert not (tmp_path / "S_Scene.txt").exists()
 
 
-def test_sweep_writes_the_pareto_chart_with_the_front_cheapest_first_and_the_best_marked(
-        tmp_path, capsys):
+def test_sweep_writes_the_pareto_chart_with_the_front_cheapest_first_and_the_best_marked(tmp_path, capsys):
     from tiny_sweep import write_tiny_scenario
 
     write_tiny_scenario(tmp_path)
     spec = tmp_path / "spec.toml"
-    spec.write_text('[sweep]\nscenario = "base.toml"\n[grid]\nradius = [10.0, 20.0, 30.0]\n'
-                    "scans = [2, 4]\n", encoding="utf-8")
+    spec.write_text(
+        '[sweep]\nscenario = "base.toml"\n[grid]\nradius = [10.0, 20.0, 30.0]\nscans = [2, 4]\n',
+        encoding="utf-8",
+    )
     out = tmp_path / "out"
     assert main(["sweep", str(spec), "--serial", "--out", str(out), "--json", "--top", "6"]) == 0
     report = json.loads(capsys.readouterr().out)

@@ -47,8 +47,9 @@ def locked_requirements(lock: dict, extras: tuple[str, ...] = ("test",)) -> dict
             seen.add((key, extra))
             for dependency in dependencies:
                 if _marker_holds(dependency, extra):
-                    todo.append((dependency["name"], dependency.get("version"),
-                                 tuple(dependency.get("extra", ()))))
+                    todo.append(
+                        (dependency["name"], dependency.get("version"), tuple(dependency.get("extra", ())))
+                    )
     return wanted
 
 
@@ -88,9 +89,14 @@ def test_graph_walk_follows_markers_and_extras() -> None:
             {"name": "a", "version": "1.0"},
             {"name": "win-only", "version": "9"},
             {"name": "b", "version": "2.0", "optional-dependencies": {"fast": [{"name": "c"}]}},
-            {"name": "c", "version": "3.0", "dependencies": [
-                {"name": "d", "version": "1", "marker": "python_full_version < '3.0'"},
-                {"name": "d", "version": "2", "marker": "python_full_version >= '3.0'"}]},
+            {
+                "name": "c",
+                "version": "3.0",
+                "dependencies": [
+                    {"name": "d", "version": "1", "marker": "python_full_version < '3.0'"},
+                    {"name": "d", "version": "2", "marker": "python_full_version >= '3.0'"},
+                ],
+            },
             {"name": "d", "version": "1"},
             {"name": "d", "version": "2"},
         ]

@@ -8,6 +8,7 @@ reaches 90 % of the final obscured coverage marked.
 from __future__ import annotations
 
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
 from ladartui.charts import new_figure
 from ladartui.measures import ENOUGH_SHARE, Measures
@@ -30,23 +31,30 @@ def coverage_figure(measures: Measures, width_px: int = 800, height_px: int = 48
         if not after:
             continue
         scans = list(range(1, len(after) + 1))
-        axes.plot(scans, [100.0 * v for v in after], color=color, marker=marker, label=name,
-                  gid=f"series-{name}")
+        axes.plot(
+            scans, [100.0 * v for v in after], color=color, marker=marker, label=name, gid=f"series-{name}"
+        )
         drawn += 1
     enough = measures.scans_for_enough
     obscured = measures.obscured_after_scan
     if enough is not None and obscured:
         value = 100.0 * obscured[enough - 1]
         axes.axvline(enough, color="tab:orange", linestyle="--", linewidth=1)
-        axes.plot([enough], [value], marker="*", markersize=14, color="tab:orange", linestyle="none",
-                  label=f"{ENOUGH_SHARE:.0%} of final obscured coverage: scan {enough}",
-                  gid="enough-point")
+        axes.plot(
+            [enough],
+            [value],
+            marker="*",
+            markersize=14,
+            color="tab:orange",
+            linestyle="none",
+            label=f"{ENOUGH_SHARE:.0%} of final obscured coverage: scan {enough}",
+            gid="enough-point",
+        )
     if not drawn:
-        axes.text(0.5, 0.5, "no per-scan coverage in this run", ha="center",
-                  transform=axes.transAxes)
+        axes.text(0.5, 0.5, "no per-scan coverage in this run", ha="center", transform=axes.transAxes)
         return figure
     axes.set_ylim(bottom=0)
-    axes.xaxis.get_major_locator().set_params(integer=True)
+    axes.xaxis.set_major_locator(MaxNLocator(integer=True))
     axes.grid(True, alpha=0.3)
     axes.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0, fontsize=8)
     figure.tight_layout()

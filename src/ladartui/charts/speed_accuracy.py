@@ -46,20 +46,46 @@ def speed_accuracy_figure(result: StudyResult, width_px: int = 900, height_px: i
         if not rows:
             continue
         color, marker = STYLES.get(name, ("tab:gray", "o"))
-        axes.scatter([x for x, _, _ in rows], [y for _, y, _ in rows], color=color, marker=marker,
-                     s=[18 + 6 * row.setting.ray_grid for _, _, row in rows], label=name, zorder=3,
-                     gid=f"series-{name}")
+        axes.scatter(
+            [x for x, _, _ in rows],
+            [y for _, y, _ in rows],
+            color=color,
+            marker=marker,
+            s=[18 + 6 * row.setting.ray_grid for _, _, row in rows],
+            label=name,
+            zorder=3,
+            gid=f"series-{name}",
+        )
         for x, y, row in rows:
-            axes.annotate(f"m{row.setting.ray_grid}", (x, y), xytext=(4, 3),
-                          textcoords="offset points", fontsize=7, color=color)
+            axes.annotate(
+                f"m{row.setting.ray_grid}",
+                (x, y),
+                xytext=(4, 3),
+                textcoords="offset points",
+                fontsize=7,
+                color=color,
+            )
     front = front_points(result)
     if front:
-        axes.plot([x for x, _, _ in front], [y for _, y, _ in front], color="tab:orange",
-                  linewidth=1.5, zorder=2, label=FRONT_LABEL, gid="pareto-front")
+        axes.plot(
+            [x for x, _, _ in front],
+            [y for _, y, _ in front],
+            color="tab:orange",
+            linewidth=1.5,
+            zorder=2,
+            label=FRONT_LABEL,
+            gid="pareto-front",
+        )
     if all(x > 0 for x, _, _ in points):
         axes.set_xscale("log")
     axes.grid(True, which="both", alpha=0.3)
-    axes.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0, fontsize=8,
-                title="backend / method (size: ray grid m)", title_fontsize=8)
+    axes.legend(
+        loc="upper left",
+        bbox_to_anchor=(1.02, 1.0),
+        borderaxespad=0,
+        fontsize=8,
+        title="backend / method (size: ray grid m)",
+        title_fontsize=8,
+    )
     figure.tight_layout()
     return figure
