@@ -23,7 +23,8 @@ test: setup
 PYTHONS ?= 3.11 3.12 3.13
 test-all: system-deps
 	@set -e; for v in $(PYTHONS); do \
-	  py=$$(command -v python$$v || ls -d $$HOME/.pyenv/versions/$$v.*/bin/python 2>/dev/null | tail -1); \
+	  py=$$(ls -d $$HOME/.pyenv/versions/$$v.*/bin/python 2>/dev/null | tail -1); \
+	  if [ -z "$$py" ] && python$$v -c "" 2>/dev/null; then py=$$(command -v python$$v); fi; \
 	  if [ -z "$$py" ]; then echo "python$$v: not found, skipped"; continue; fi; \
 	  $(MAKE) --no-print-directory VENV=.venv-$$v PYTHON=$$py .venv-$$v/.installed; \
 	  echo "== Python $$v"; .venv-$$v/bin/python -m pytest -q -p no:randomly; \
