@@ -3,9 +3,14 @@
 PYTHON ?= python3
 VENV := .venv
 STAMP := $(VENV)/.installed
+# uv installs exactly the set locked in uv.lock; it is itself installed from the
+# registry into its own small venv, so a machine needs only Python and make.
+UV_VERSION := 0.13.8
+UV_HOME := .uv
+UV := $(UV_HOME)/bin/uv
 export PYTHONDONTWRITEBYTECODE := 1
 
-.PHONY: run test test-all lint bench setup system-deps
+.PHONY: run test test-all lint bench setup system-deps lock
 
 run: setup
 	$(VENV)/bin/ladartui
@@ -18,7 +23,8 @@ test: setup
 PYTHONS ?= 3.11 3.12 3.13
 test-all: system-deps
 	@set -e; for v in $(PYTHONS); do \
-	  py=$$(command -v python$$v || ls -d $$HOME/.pyenv/versions/$$v.*/bin/python 2>/dev/null | tail -1); \
+	  py=$$(ls -d $$HOME/.pyenv/versions/$$v.*/bin/python 2>/dev/null | tail -1); \
+	  if [ -z "$$py" ] && python$$v -c "" 2>/dev/null; then py=$$(command -v python$$v); fi; \
 	  if [ -z "$$py" ]; then echo "python$$v: not found, skipped"; continue; fi; \
 	  $(MAKE) --no-print-directory VENV=.venv-$$v PYTHON=$$py .venv-$$v/.installed; \
 	  echo "== Python $$v"; .venv-$$v/bin/python -m pytest -q -p no:randomly; \
@@ -48,8 +54,20 @@ system-deps:
 	  fi; \
 	fi
 
-$(STAMP): pyproject.toml
+$(UV):
+	$(PYTHON) -m venv $(UV_HOME)
+	$(UV_HOME)/bin/python -m pip install -q --disable-pip-version-check "uv==$(UV_VERSION)"
+
+# --locked: fail (rather than re-resolve) when pyproject.toml and uv.lock disagree.
+# The venv keeps pip (seeded by `python -m venv`) for ad-hoc tools; uv removes
+# any other package the lock does not name.
+$(STAMP): pyproject.toml uv.lock | $(UV)
 	test -x $(VENV)/bin/python || $(PYTHON) -m venv $(VENV)
-	$(VENV)/bin/python -m pip install -q --disable-pip-version-check "pip==25.3" "setuptools==80.9.0"
-	$(VENV)/bin/python -m pip install -q --disable-pip-version-check -e ".[test]"
+	UV_PROJECT_ENVIRONMENT=$(VENV) UV_PYTHON_DOWNLOADS=never \
+	  $(UV) sync --locked --extra test --python $(VENV)/bin/python
 	touch $(STAMP)
+
+# After changing a pin in pyproject.toml: re-resolve and re-install.
+lock: $(UV)
+	$(UV) lock
+	$(MAKE) --no-print-directory $(STAMP)

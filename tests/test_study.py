@@ -288,7 +288,8 @@ def test_cli_quick_writes_data_and_chart_files(tmp_path, monkeypatch, capsys):
     assert status == 0, out.err
     assert "Pareto front" in out.out
     names = sorted(p.name for p in tmp_path.iterdir())
-    assert names == ["speed-accuracy.svg", "speed-accuracy.txt", "study.csv", "study.json"]
+    assert names == ["speed-accuracy.png", "speed-accuracy.svg", "speed-accuracy.txt", "study.csv",
+                     "study.json"]
     data = json.loads((tmp_path / "study.json").read_text())
     assert data["reference"]["label"] == "numba exact f64 m=2"
     assert main(["study", "--scans", "0"]) == 2

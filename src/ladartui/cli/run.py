@@ -37,6 +37,8 @@ def add_parser(subparsers):
     parser.add_argument("--max-rays", metavar="N", type=float,
                         help="refuse a run tracing more rays than this (default 2e9; also "
                         "LADARTUI_MAX_RAYS)")
+    parser.add_argument("--chart", metavar="FILE",
+                        help="also write the coverage after each scan as a chart (.svg or .png)")
     parser.set_defaults(handler=run)
     return parser
 
@@ -68,8 +70,19 @@ def run(args) -> int:
         from ladartui.simulation import output_paths
 
         check_writable(*output_paths(scenario, args.las).values())
+    if args.chart is not None and not args.chart.lower().endswith((".svg", ".png")):
+        raise FieldError("--chart", args.chart, "a file name ending in .svg or .png")
     errors = Console(stderr=True)
     result = _simulate_with_progress(scenario, args, errors)
+    if args.chart is not None:
+        from ladartui.charts import save_figure
+        from ladartui.charts.coverage import coverage_figure
+
+        try:
+            path = save_figure(coverage_figure(result.measures), args.chart)
+        except OSError as error:
+            raise FieldError("--chart", args.chart, f"a writable path ({error.strerror})") from None
+        errors.print(f"wrote chart: {path}", highlight=False, markup=False, soft_wrap=True)
     if args.json:
         print(json.dumps(result_dict(scenario, result), indent=2, allow_nan=False))
     else:

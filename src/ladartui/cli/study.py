@@ -26,7 +26,7 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--quick", action="store_true",
                         help="small scene, few settings and scans: a fast check")
     parser.add_argument("--out", default=DEFAULT_OUT,
-                        help=f"folder for study.csv, study.json, speed-accuracy.svg/.txt "
+                        help=f"folder for study.csv, study.json, speed-accuracy.svg/.png/.txt "
                         f"(default: {DEFAULT_OUT})")
     parser.add_argument("--runs", type=int, default=None,
                         help="timed runs per setting, median quoted (default 5; 3 with --quick)")

@@ -47,7 +47,8 @@ def add_parser(subparsers):
     parser.add_argument("--serial", action="store_true",
                         help="run the variants one by one in this process, without Dask")
     parser.add_argument("--out", metavar="DIR",
-                        help="folder for results.csv, ranking.csv and the best scenario "
+                        help="folder for results.csv, ranking.csv, pareto.svg/.png and the best "
+                        "scenario "
                         "(default: SPEC's folder/SPEC-results)")
     parser.add_argument("--objective", metavar="NAME",
                         help="ranking objective: " + ", ".join(OBJECTIVES)
@@ -115,6 +116,9 @@ def run(args) -> int:
         result = _sweep_with_progress(spec, args, errors)
         if result is None:
             return 130
+    from ladartui.charts.sweep import write_sweep_charts
+
+    result.charts = write_sweep_charts(result, result.results_path.parent)
     if args.json:
         print(json.dumps(result_dict(result, args.top), indent=2, allow_nan=False))
     else:
@@ -211,6 +215,7 @@ def result_dict(result, top) -> dict:
         "results": str(result.results_path),
         "ranking": str(result.ranking_path) if result.ranking_path else None,
         "best_scenario": str(result.best_scenario_path) if result.best_scenario_path else None,
+        "charts": {fmt: str(path) for fmt, path in result.charts.items()},
         "top": [entry(r) for r in result.ranking[:top] if r.rank is not None],
         "pareto": [entry(r) for r in result.pareto],
         "errors": [{"variant": r.get("variant"), "error": r.get("error")}
@@ -271,6 +276,8 @@ def show_result(console, result, top) -> None:
     console.print(f"results  {result.results_path}", highlight=False)
     if result.ranking_path:
         console.print(f"ranking  {result.ranking_path}", highlight=False)
+    for path in result.charts.values():
+        console.print(f"chart    {path}", highlight=False)
     if result.best_scenario_path:
         console.print(f"best     {result.best_scenario_path}  (open it with: ladartui "
                       f"{result.best_scenario_path})", highlight=False)

@@ -236,15 +236,18 @@ def _context(inputs: StudyInputs, runs, warmup, reasons) -> dict:
 
 def write_outputs(result: StudyResult, out_dir, chart_stem="speed-accuracy", stem="study",
                   width=100, height=30) -> dict[str, Path]:
-    """Write the CSV, JSON, SVG chart and plain-text chart atomically into ``out_dir``."""
+    """Write the CSV, JSON, plotted chart (SVG, PNG) and plain-text chart atomically into ``out_dir``."""
     from ladartui.atomic import write_text_atomic
-    from ladartui.study.chart import chart_svg, chart_text
+    from ladartui.charts import save_figure
+    from ladartui.charts.speed_accuracy import speed_accuracy_figure
+    from ladartui.study.chart import chart_text
 
     paths = result.write(out_dir, stem)
     out_dir = Path(out_dir)
-    paths["svg"] = out_dir / f"{chart_stem}.svg"
+    figure = speed_accuracy_figure(result)
+    for fmt in ("svg", "png"):
+        paths[fmt] = save_figure(figure, out_dir / f"{chart_stem}.{fmt}")
     paths["txt"] = out_dir / f"{chart_stem}.txt"
-    write_text_atomic(paths["svg"], chart_svg(result, width, height))
     write_text_atomic(paths["txt"], chart_text(result, width, height, color=False) + "\n\n"
                       + result.verdict() + "\n")
     return paths

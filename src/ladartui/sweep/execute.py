@@ -70,6 +70,7 @@ class SweepResult:
     elapsed: float = 0.0
     scheduler: str = ""
     notes: list[str] = field(default_factory=list)
+    charts: dict[str, Path] = field(default_factory=dict)  # format -> chart file (pareto.svg, .png)
 
     @property
     def best(self) -> Ranked | None:

@@ -1,0 +1,61 @@
+"""Coverage after each scan of a run: how many looks are worth flying.
+
+Cumulative share of the target's visible voxels seen after scans 1..k, obscured
+(through the scene) and unobscured (target alone), with the first scan count that
+reaches 90 % of the final obscured coverage marked.
+"""
+
+from __future__ import annotations
+
+from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
+
+from ladartui.charts import new_figure
+from ladartui.measures import ENOUGH_SHARE, Measures
+
+SERIES = (
+    ("unobscured", "unobscured_after_scan", "tab:blue", "s"),
+    ("obscured", "obscured_after_scan", "tab:green", "o"),
+)
+
+
+def coverage_figure(measures: Measures, width_px: int = 800, height_px: int = 480) -> Figure:
+    figure = new_figure(width_px, height_px)
+    axes = figure.add_subplot()
+    axes.set_title("Target coverage after each scan")
+    axes.set_xlabel("scans flown")
+    axes.set_ylabel("target coverage (%)")
+    drawn = 0
+    for name, attribute, color, marker in SERIES:
+        after = getattr(measures, attribute)
+        if not after:
+            continue
+        scans = list(range(1, len(after) + 1))
+        axes.plot(
+            scans, [100.0 * v for v in after], color=color, marker=marker, label=name, gid=f"series-{name}"
+        )
+        drawn += 1
+    enough = measures.scans_for_enough
+    obscured = measures.obscured_after_scan
+    if enough is not None and obscured:
+        value = 100.0 * obscured[enough - 1]
+        axes.axvline(enough, color="tab:orange", linestyle="--", linewidth=1)
+        axes.plot(
+            [enough],
+            [value],
+            marker="*",
+            markersize=14,
+            color="tab:orange",
+            linestyle="none",
+            label=f"{ENOUGH_SHARE:.0%} of final obscured coverage: scan {enough}",
+            gid="enough-point",
+        )
+    if not drawn:
+        axes.text(0.5, 0.5, "no per-scan coverage in this run", ha="center", transform=axes.transAxes)
+        return figure
+    axes.set_ylim(bottom=0)
+    axes.xaxis.set_major_locator(MaxNLocator(integer=True))
+    axes.grid(True, alpha=0.3)
+    axes.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0, fontsize=8)
+    figure.tight_layout()
+    return figure

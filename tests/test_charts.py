@@ -1,0 +1,171 @@
+"""Chart files drawn with matplotlib: valid SVG and PNG, the series and the Pareto front's order."""
+
+from __future__ import annotations
+
+import json
+import re
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from ladartui.charts import new_figure, save_figure
+from ladartui.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+SVG = "{http://www.w3.org/2000/svg}"
+
+
+def _groups(svg_path: Path, prefix: str) -> list[ET.Element]:
+    tree = ET.parse(svg_path)  # raises on a malformed file
+    assert tree.getroot().tag == f"{SVG}svg"
+    return [g for g in tree.iter(f"{SVG}g") if g.get("id", "").startswith(prefix)]
+
+
+def _line_vertices(group: ET.Element) -> list[tuple[float, float]]:
+    path = next(group.iter(f"{SVG}path"))
+    numbers = [float(n) for n in re.findall(r"-?\d+(?:\.\d+)?", path.get("d", ""))]
+    return list(zip(numbers[0::2], numbers[1::2]))
+
+
+def test_study_chart_from_json_writes_svg_and_png_with_every_series_and_the_front_in_order(tmp_path):
+    source = ROOT / "docs" / "study.json"
+    assert main(["study", "--chart-from", str(source), "--out", str(tmp_path)]) == 0
+    rows = json.loads(source.read_text())["rows"]
+    measured = [
+        r
+        for r in rows
+        if r["status"] == "ok"
+        and r.get("seconds_per_scan") is not None
+        and r.get("coverage_error") is not None
+    ]
+    families = {
+        (r["backend"], r["method"], r["precision"] if r["method"] != "march" else "") for r in measured
+    }
+
+    svg = tmp_path / "speed-accuracy.svg"
+    assert len(_groups(svg, "series-")) == len(families) == 5
+    (front,) = _groups(svg, "pareto-front")
+    vertices = _line_vertices(front)
+    front_rows = sorted((r for r in measured if r["front"]), key=lambda r: r["seconds_per_scan"])
+    assert len(vertices) == len(front_rows) >= 2
+    xs = [x for x, _ in vertices]
+    assert xs == sorted(xs)  # the line runs fastest to slowest, the front's order
+    # faster settings on the front are less accurate: the line falls (SVG y grows downwards)
+    errors = [abs(r["coverage_error"]) for r in front_rows]
+    ys = [y for _, y in vertices]
+    assert [a < b for a, b in zip(errors, errors[1:])] == [a > b for a, b in zip(ys, ys[1:])]
+
+    with Image.open(tmp_path / "speed-accuracy.png") as image:
+        assert image.format == "PNG" and image.size == (900, 560)
+
+
+def test_save_figure_writes_the_pixel_size_asked_and_refuses_unknown_formats(tmp_path):
+    figure = new_figure(400, 300)
+    figure.add_subplot().plot([0, 1], [1, 0])
+    with Image.open(save_figure(figure, tmp_path / "a.png")) as image:
+        assert image.size == (400, 300)
+    root = ET.parse(save_figure(figure, tmp_path / "a.svg")).getroot()
+    assert root.get("width") == "288pt" and root.get("height") == "216pt"  # 4 x 3 inches
+    try:
+        save_figure(figure, tmp_path / "a.gif")
+    except ValueError as error:
+        assert "gif" in str(error)
+    else:
+        raise AssertionError("a .gif chart was accepted")
+    assert not (tmp_path / "a.gif").exists()
+
+
+@pytest.fixture
+def three_scan_scenario(tmp_path):
+    from ladartui.flight import FlightPlan, Manual, ScanPose, aim_at
+    from ladartui.scenario import Scenario
+    from ladartui.scene.voxels import save_voxels
+    from ladartui.sensor import Sensor
+
+    target = np.array(
+        [(x, y, z) for x in range(8, 12) for y in range(8, 11) for z in range(2)], dtype=np.int32
+    )
+    canopy = np.array(
+        [(x, y, 6) for x in range(6, 14) for y in range(6, 13) if (x + 2 * y) % 3], dtype=np.int32
+    )
+    save_voxels(tmp_path / "woods.txt", np.vstack([target, canopy]))
+    save_voxels(tmp_path / "woods_Target.txt", target)
+    spots = [(9.5, -10.0), (29.5, 9.0), (9.5, 29.0)]
+    poses = tuple(aim_at(ScanPose(x, y, 40.0), (9.5, 9.0, 0.5)) for x, y in spots)
+    return Scenario(
+        tmp_path / "S.toml",
+        "woods.txt",
+        1.0,
+        Sensor(grid=16, ray_grid=2, fov=20.0),
+        FlightPlan(segments=[Manual(poses)]),
+        backend="numba",
+    ).save()
+
+
+def test_run_chart_plots_coverage_after_each_scan_with_the_90_percent_point(
+    three_scan_scenario, tmp_path, capsys
+):
+    svg, png = tmp_path / "cov.svg", tmp_path / "cov.png"
+    assert main(["run", str(three_scan_scenario.path), "--no-write", "--json", "--chart", str(svg)]) == 0
+    measures = json.loads(capsys.readouterr().out)["measures"]
+    assert main(["run", str(three_scan_scenario.path), "--no-write", "--chart", str(png)]) == 0
+    assert f"wrote chart: {png}" in capsys.readouterr().err
+
+    series = _groups(svg, "series-")
+    assert sorted(g.get("id") for g in series) == ["series-obscured", "series-unobscured"]
+    for group in series:  # one vertex per scan
+        assert len(_line_vertices(group)) == 3
+    (enough,) = _groups(svg, "enough-point")
+    k = measures["scans_for_enough"]
+    assert k in (1, 2, 3)
+    (obscured,) = [g for g in series if g.get("id") == "series-obscured"]
+    marker = next(enough.iter(f"{SVG}use"))
+    assert _line_vertices(obscured)[k - 1] == pytest.approx(
+        (float(marker.get("x")), float(marker.get("y"))), abs=0.01
+    )
+    with Image.open(png) as image:
+        assert image.size == (800, 480)
+
+
+def test_run_chart_refuses_another_suffix_before_tracing(three_scan_scenario, tmp_path, capsys):
+    assert main(["run", str(three_scan_scenario.path), "--chart", str(tmp_path / "c.pdf")]) == 2
+    err = capsys.readouterr().err
+    assert "--chart" in err and "ending in .svg or .png" in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "S_Scene.txt").exists()
+
+
+def test_sweep_writes_the_pareto_chart_with_the_front_cheapest_first_and_the_best_marked(tmp_path, capsys):
+    from tiny_sweep import write_tiny_scenario
+
+    write_tiny_scenario(tmp_path)
+    spec = tmp_path / "spec.toml"
+    spec.write_text(
+        '[sweep]\nscenario = "base.toml"\n[grid]\nradius = [10.0, 20.0, 30.0]\nscans = [2, 4]\n',
+        encoding="utf-8",
+    )
+    out = tmp_path / "out"
+    assert main(["sweep", str(spec), "--serial", "--out", str(out), "--json", "--top", "6"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["charts"] == {"svg": str(out / "pareto.svg"), "png": str(out / "pareto.png")}
+
+    svg = out / "pareto.svg"
+    (variants,) = _groups(svg, "series-variants")
+    assert len(list(variants.iter(f"{SVG}use"))) == report["variants"] == 6
+    (front,) = _groups(svg, "pareto-front")
+    vertices = _line_vertices(front)
+    assert len(vertices) == len(report["pareto"]) >= 1
+    costs = [entry["cost"] for entry in report["pareto"]]
+    assert costs == sorted(costs)  # the report's front, cheapest first ...
+    xs = [x for x, _ in vertices]
+    assert xs == sorted(xs)  # ... drawn in that order
+    (best,) = _groups(svg, "best")
+    marker = next(best.iter(f"{SVG}use"))
+    top = report["top"][0]
+    assert top["pareto"]  # the best by coverage is on the front: its marker sits on a vertex
+    index = [entry["variant"] for entry in report["pareto"]].index(top["variant"])
+    assert vertices[index] == pytest.approx((float(marker.get("x")), float(marker.get("y"))), abs=0.01)
+    with Image.open(out / "pareto.png") as image:
+        assert image.size == (800, 480)
