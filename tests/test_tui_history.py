@@ -353,3 +353,35 @@ async def test_the_outputs_export_as_las_point_clouds_after_a_run(tmp_path, scen
         for output in (scenario.scene_output, scenario.target_output):
             cloud = laspy.read(output.with_suffix(".las"))
             assert len(cloud.points) == len(load_voxels(output)) > 0
+
+
+async def test_view_commands_reach_every_view_and_a_view_saves_as_png(tmp_path, scene_files):
+    from PIL import Image
+
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=(120, 40)) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        scene3d = app.query_one("#scene3d")
+        before = scene3d.camera
+        app.set_focus(None)
+        await pilot.press("z")  # zoom to target, from anywhere (not only a focused view)
+        await pilot.pause()
+        assert scene3d.camera != before and scene3d.camera.zoom > before.zoom
+        # F7 keeps the target framing (zoom and centre), changing only the angle
+        framed = scene3d.camera
+        await app.run_action("view_angle")
+        await pilot.pause()
+        app.screen.query_one("#f-azimuth").value = "45"
+        app.screen.query_one("#form-ok").press()
+        await pilot.pause()
+        assert scene3d.camera.azimuth == 45.0 and scene3d.camera.zoom == framed.zoom
+        assert scene3d.camera.centre == framed.centre
+        await app.run_action("save_png")
+        await pilot.pause()
+        app.screen.query_one("#f-width").value = "320"
+        app.screen.query_one("#f-height").value = "200"
+        app.screen.query_one("#form-ok").press()
+        await wait_until(pilot, lambda: any(m.startswith("Wrote") for m in app.messages))
+        written = tmp_path / "demo-scene3d.png"
+        assert Image.open(written).size == (320, 200)

@@ -69,6 +69,19 @@ COMMANDS = [
             "Every backend, method and ray grid on this scenario", "Study"),
     Command("sweep", "sweep", "f12", "Flight-path sweep",
             "Launch, open or watch a sweep; open its best path", "Sweep"),
+    Command("zoom-target", "view('fit_target')", "z", "Zoom to target",
+            "Frame the target in every view at once"),
+    Command("fit-scene", "view('fit_scene')", None, "Fit the scene", "Frame the whole scene"),
+    Command("fit-path", "view('fit_path')", None, "Fit the flight path",
+            "Frame the scene and the whole flight path"),
+    Command("output-colour", "view('cycle_output_colour')", None, "Output colouring",
+            "Colour the output by class, by height, or by the scans that saw it"),
+    Command("grey", "view('toggle_grey')", None, "Colour or grey shading",
+            "Height in colour, or in the report's 56 greys"),
+    Command("overlays", "view('cycle_overlays')", None, "Overlays",
+            "All overlays, the path and scans only, or none"),
+    Command("save-png", "save_png", None, "Save view as PNG",
+            "The current view drawn again at a chosen size, beside the scenario"),
     Command("export-las", "export_las", None, "Export outputs as LAS",
             "Write the scene and target outputs as LAS point clouds beside them"),
     Command("aim-all", "aim_all", None, "Aim every scan at the target",
@@ -91,7 +104,7 @@ BY_ID = {command.id: command for command in COMMANDS}
 
 # actions that only change what is displayed: allowed while busy
 DISPLAY_ACTIONS = {"help", "layout", "next_layout", "toggle_panel", "view_angle",
-                   "threshold", "quit", "command_palette", "show_tab", "cancel_run"}
+                   "threshold", "quit", "command_palette", "show_tab", "cancel_run", "view"}
 
 
 def bindings() -> list[Binding]:
@@ -129,7 +142,7 @@ def own_actions() -> frozenset[str]:
 
 
 def help_rows(keymap: dict[str, str] | None = None, view_bindings=(),
-              dialog_bindings=()) -> list[tuple[str, str, str]]:
+              dialog_bindings=(), top_bindings=()) -> list[tuple[str, str, str]]:
     """(where, key, what) for the help screen, with the keys in force."""
     keys = keys_in_force(keymap)
     rows = [("Anywhere", key_name(keys[c.id]), c.footer or c.title)
@@ -140,6 +153,9 @@ def help_rows(keymap: dict[str, str] | None = None, view_bindings=(),
     for binding in view_bindings:
         rows.append(("3D view", key_name(binding.key), binding.description))
     rows.append(("3D view", "mouse drag / wheel", "Rotate / zoom"))
+    for binding in top_bindings:
+        rows.append(("Top view", key_name(binding.key), binding.description))
+    rows.append(("Top view", "mouse wheel", "Zoom about the pointer"))
     rows.append(("Fields", "Enter or leave", "Check the value; an invalid one goes back "
                  "to the scenario's value"))
     rows.append(("Segments table", "Enter", "Edit the segment"))

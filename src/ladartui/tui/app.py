@@ -19,10 +19,9 @@ from textual.app import App, ComposeResult, SystemCommand
 from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, Footer, TabbedContent, TabPane
 
-from ladartui import views
 from ladartui.edit_history import EditHistory
 from ladartui.tui import actions, bridge
-from ladartui.tui.canvas import ProjectionWidget
+from ladartui.tui.canvas import ProjectionWidget, TopViewWidget
 from ladartui.tui.fields import NumberField
 from ladartui.tui.file_actions import FileActions
 from ladartui.tui.loading import SceneLoading
@@ -33,6 +32,7 @@ from ladartui.tui.screens import (
     AngleScreen,
     CompareScreen,
     HelpScreen,
+    ImageSizeScreen,
     MeasuresScreen,
     PosesScreen,
     ThresholdScreen,
@@ -56,7 +56,8 @@ def palette_entries(app=None) -> list[tuple[str, str, str]]:
 def help_rows(app=None) -> list[tuple[str, str, str]]:
     """The help screen's rows: the app's keys (as remapped), the views' and the dialogs'."""
     return actions.help_rows(app.keymap if app is not None else None,
-                             ProjectionWidget.BINDINGS, PosesScreen.BINDINGS)
+                             ProjectionWidget.BINDINGS, PosesScreen.BINDINGS,
+                             TopViewWidget.BINDINGS)
 
 
 class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
@@ -357,10 +358,7 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
 
         def done(result):
             if result is not None:
-                az, el = result
-                camera = widget.camera
-                widget.set_camera(views.Camera(az % 360.0, el, camera.zoom, camera.pan_x,
-                                               camera.pan_y))
+                widget.set_camera(widget.camera.at_angle(*result))  # keeps zoom and centre
 
         self.push_screen(AngleScreen(widget.camera.azimuth, widget.camera.elevation), done)
 
@@ -390,6 +388,24 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
                 paths.append(own)
             paths += sorted(p for p in folder.glob("*.cmf") if p != own)
         self.push_screen(CompareScreen(paths[:4], self._folder()))
+
+    def action_view(self, name: str) -> None:
+        """A view command (zoom to target, fit, colouring, overlays) in every view."""
+        getattr(self.view_area, name)()
+
+    def action_save_png(self) -> None:
+        if self.scenario is None or self.scene is None:
+            return
+        view = self.view_area.current_view(self.focused)
+        name = (view.border_title or view.id or "view").split(" az ")[0]
+        path = self.scenario.path.with_name(f"{self.scenario.path.stem}-{view.id}.png")
+
+        def chosen(size) -> None:
+            if size is not None:
+                area = self.view_area
+                start_job(self, "png", lambda cancel, progress: area.save_png(path, *size, view))
+
+        self.push_screen(ImageSizeScreen(name), chosen)
 
     def action_export_las(self) -> None:
         if self.scenario is None or self.busy:
@@ -460,7 +476,8 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
     # -- jobs: every slow piece of work reports here (tui/work.py) -------------------
 
     JOB_FAILED = {"load": "Could not load", "run": "Run failed", "probe": "Backends not probed",
-                  "warm": "Kernels not compiled", "export": "Nothing exported"}
+                  "warm": "Kernels not compiled", "export": "Nothing exported",
+                  "png": "View not saved"}
 
     def on_job_progress(self, message: JobProgress) -> None:
         if message.job == "run":
@@ -483,6 +500,8 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
                                    False)])
         elif message.job == "run":
             self.run_finished(message.result, message.cancelled, message.error)
+        elif message.job == "png" and message.result is not None:
+            self.tell(f"Wrote {message.result}")
         elif message.job == "export" and message.result is not None:
             self.tell("Wrote " + ", ".join(str(p) for p in message.result))
 

@@ -321,6 +321,13 @@ def view_angles(values: dict) -> tuple[float, float]:
     return azimuth, elevation
 
 
+def image_size(values: dict) -> tuple[int, int]:
+    """A PNG's width and height in pixels, checked as the renderer checks them."""
+    from ladartui.render.png import check_size
+
+    return check_size(values["width"], values["height"])
+
+
 def threshold_value(values: dict) -> float | None:
     value = values["threshold"]
     if value is None:

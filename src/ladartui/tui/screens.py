@@ -488,6 +488,16 @@ class ThresholdScreen(FormScreen):
                          note="The output is drawn up to this height; empty shows all.")
 
 
+class ImageSizeScreen(FormScreen):
+    """The size of a view saved as PNG."""
+
+    def __init__(self, view_name: str, width: int = 1200, height: int = 800):
+        spec = [("width", "Width px", "int", width, width),
+                ("height", "Height px", "int", height, height)]
+        super().__init__(f"Save {view_name} as PNG", spec, bridge.image_size,
+                         note="The view is drawn again at this size, with the same framing.")
+
+
 class HelpScreen(Dialog):
     """Every key of the app, its views and its dialogs."""
 
