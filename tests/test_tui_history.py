@@ -385,3 +385,25 @@ async def test_view_commands_reach_every_view_and_a_view_saves_as_png(tmp_path, 
         await wait_until(pilot, lambda: any(m.startswith("Wrote") for m in app.messages))
         written = tmp_path / "demo-scene3d.png"
         assert Image.open(written).size == (320, 200)
+
+
+async def test_the_top_view_draws_footprints_as_they_fall_with_attitude(tmp_path, scene_files):
+    import dataclasses
+
+    import numpy as np
+
+    from ladartui.attitude import scan_footprints
+    from ladartui.tui.canvas import TopViewWidget
+
+    scenario = make_scenario(tmp_path, scene_files)
+    banked = scenario.with_changes(
+        sensor=dataclasses.replace(scenario.sensor, mount="body-fixed")).save()
+    app = LadarApp(banked.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        drawn = app.query_one(TopViewWidget).footprints
+        expected = [f[:, :2] for f in scan_footprints(banked)]
+        level = [f[:, :2] for f in scan_footprints(scenario)]
+        assert len(drawn) == len(expected)
+        assert all(np.allclose(d, e) for d, e in zip(drawn, expected))
+        assert not all(np.allclose(d, e) for d, e in zip(drawn, level))  # the bank shows

@@ -17,6 +17,7 @@ from pathlib import Path
 from textual import on
 from textual.app import App, ComposeResult, SystemCommand
 from textual.containers import Horizontal, Vertical
+from textual.css.query import NoMatches
 from textual.widgets import Button, Footer, TabbedContent, TabPane
 
 from ladartui.edit_history import EditHistory
@@ -86,6 +87,7 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
         self.progress: float | None = None
         self.load_worker = self.warm_worker = self.run_worker_handle = None  # the jobs
         self.messages: list[str] = []
+        self.leaving = False  # set by exit: news from jobs is no longer shown
         self.running = False
         self.tool_screen = None  # the study or sweep screen while it is open
         self.keymap, self.keymap_problems = actions.load_keymap()
@@ -480,10 +482,20 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
                   "png": "View not saved"}
 
     def on_job_progress(self, message: JobProgress) -> None:
+        if self.leaving:
+            return
         if message.job == "run":
             self.run_progressed(message.fraction, message.text, message.detail)
 
     def on_job_done(self, message: JobDone) -> None:
+        if self.leaving:  # news from a job that ends as the app shuts down
+            return
+        try:
+            self._job_done(message)
+        except NoMatches:  # the app was taken down while the job reported
+            pass
+
+    def _job_done(self, message: JobDone) -> None:
         if message.error:  # every failure, expected or not, is told the same way
             self.tell(message.error, title=self.JOB_FAILED.get(message.job, message.job),
                       severity="error", timeout=10)
@@ -507,6 +519,7 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
 
     def exit(self, *args, **kwargs) -> None:
         # a thread cannot be killed: cancelling tells every job to stop, so quitting is quick
+        self.leaving = True
         self.workers.cancel_all()
         super().exit(*args, **kwargs)
 

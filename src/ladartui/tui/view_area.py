@@ -8,6 +8,7 @@ import numpy as np
 from textual.containers import Container
 
 from ladartui import views
+from ladartui.attitude import plan_attitudes
 from ladartui.errors import LadarError
 from ladartui.render import framing, png
 from ladartui.render.output import COLOUR_MODES, classify, output_layers, scene_layers
@@ -107,10 +108,14 @@ class ViewArea(Container):
         poses = scenario.poses()
         scans = np.array([[p.x, p.y] for p in poses]) if poses else None
         footprints = []
+        try:  # a body-fixed sensor's footprints swing with the aircraft's bank
+            attitudes = plan_attitudes(scenario.flight, scenario.speed, scenario.sensor)
+        except LadarError:
+            attitudes = [None] * len(poses)
         step = max(1, len(poses) // MAX_FOOTPRINTS)
-        for pose in poses[::step]:
+        for pose, attitude in list(zip(poses, attitudes))[::step]:
             try:
-                footprints.append(scenario.sensor.footprint(pose))
+                footprints.append(scenario.sensor.footprint(pose, 0.0, attitude))
             except LadarError:
                 pass
         top.set_overlay(scans, scans, [f[:, :2] for f in footprints])
