@@ -1,6 +1,7 @@
 import numpy as np
 import pytest
 
+from ladartui.errors import FieldError, LadarError
 from ladartui.flight import ScanPose, straight
 from ladartui.trajectory import TrajectoryError, load_flight_log, log_attitude, log_poses
 
@@ -49,3 +50,43 @@ def test_example_log_loads():
     log = load_flight_log(Path(__file__).parents[1] / "scenarios" / "flight-log.csv")
     poses = log_poses(log, ScanPose(0, 0, 60, depression=60.0), rate=2.0)
     assert len(poses) == 7 and np.isclose(poses[-1].x, 110.0)
+
+
+def test_geodetic_to_local_matches_known_lengths_on_the_wgs84_ellipsoid():
+    from ladartui.trajectory import geodetic_to_local
+
+    # a thousandth of a degree of longitude on the equator: 111.319 m east (a / 1000 * pi/180)
+    east = geodetic_to_local([0.0], [0.001], [0.0], (0.0, 0.0, 0.0))[0]
+    assert east[0] == pytest.approx(6378137.0 * np.radians(0.001), rel=1e-9)
+    assert abs(east[1]) < 1e-9 and east[2] == pytest.approx(0.0, abs=1e-3)
+    # straight up from the origin is up, anywhere
+    up = geodetic_to_local([52.1], [-1.3], [180.0], (52.1, -1.3, 80.0))[0]
+    assert up == pytest.approx([0.0, 0.0, 100.0], abs=1e-6)
+    # north along a meridian: a thousandth of a degree at 45 deg is about 111.13 m
+    north = geodetic_to_local([45.001], [7.0], [0.0], (45.0, 7.0, 0.0))[0]
+    assert north[1] == pytest.approx(111.13, abs=0.01) and abs(north[0]) < 1e-9
+
+
+def test_a_log_in_latitude_and_longitude_flies_the_same_poses_as_its_local_copy(tmp_path):
+    from ladartui.trajectory import LogSegment, geodetic_to_local
+
+    origin = (-35.28, 149.13, 560.0)
+    lat = np.array([-35.2805, -35.2800, -35.2795])
+    lon = np.array([149.1290, 149.1300, 149.1310])
+    alt = np.array([660.0, 661.0, 662.0])
+    geo = tmp_path / "geo.csv"
+    geo.write_text("time,latitude,longitude,altitude,heading\n" + "".join(
+        f"{t},{a},{o},{h},45\n" for t, a, o, h in zip((0, 1, 2), lat, lon, alt)))
+    local = geodetic_to_local(lat, lon, alt, origin)
+    xyz = tmp_path / "xyz.csv"
+    xyz.write_text("time,x,y,z,heading\n" + "".join(
+        f"{t},{float(x)!r},{float(y)!r},{float(z)!r},45\n" for t, (x, y, z) in zip((0, 1, 2), local)))
+    from_geo = LogSegment(str(geo), rate=2.0, origin=list(origin)).build(None)
+    from_xyz = LogSegment(str(xyz), rate=2.0).build(None)
+    assert [p.position for p in from_geo] == pytest.approx([p.position for p in from_xyz])
+    assert local[1] == pytest.approx([0.0, 0.0, 101.0], abs=1e-6)  # over the origin
+    assert 90.0 < local[2, 0] < 92.0 and 55.0 < local[2, 1] < 56.0  # 0.001 deg E, 0.0005 deg N
+    with pytest.raises(LadarError, match="origin"):
+        LogSegment(str(geo), rate=2.0)  # a geodetic log without its origin
+    with pytest.raises(FieldError, match="origin latitude"):
+        LogSegment(str(geo), rate=2.0, origin=[95.0, 0.0, 0.0])

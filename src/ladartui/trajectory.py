@@ -3,7 +3,12 @@
 Format: a header line naming the columns, then one record per line, times
 increasing. Required: ``time`` (s), ``x``, ``y``, ``z`` (metres, scene
 frame), ``heading`` (degrees clockwise from north); optional ``roll``,
-``pitch`` (degrees). Blank lines and lines starting with ``#`` are skipped.
+``pitch`` (degrees). Instead of ``x, y, z`` a log may give ``latitude``,
+``longitude`` (degrees, WGS84) and ``altitude`` (metres, same datum as the
+origin): the segment's ``origin = [lat, lon, alt]`` is then the geographic
+point of the scene frame's origin, and positions are converted to the local
+east-north-up frame there exactly (geodetic to ECEF to ENU on the WGS84
+ellipsoid). Blank lines and lines starting with ``#`` are skipped.
 Scans are taken at ``rate`` Hz from the first record's time (or at given
 ``times``); between records positions are interpolated linearly and angles
 along the shortest arc. Errors name ``file:line``.
@@ -23,7 +28,34 @@ from ladartui.errors import FieldError, LadarError
 from ladartui.flight import ScanPose
 
 REQUIRED = ("time", "x", "y", "z", "heading")
+GEODETIC = ("latitude", "longitude", "altitude")
 OPTIONAL = ("roll", "pitch")
+WGS84_A = 6378137.0  # semi-major axis, metres
+WGS84_F = 1 / 298.257223563  # flattening
+WGS84_E2 = WGS84_F * (2 - WGS84_F)  # first eccentricity squared
+
+
+def geodetic_to_ecef(lat_deg, lon_deg, alt_m) -> np.ndarray:
+    """(N, 3) earth-centred, earth-fixed metres of WGS84 latitude, longitude, height."""
+    lat, lon = np.radians(lat_deg), np.radians(lon_deg)
+    prime = WGS84_A / np.sqrt(1 - WGS84_E2 * np.sin(lat) ** 2)
+    return np.stack([(prime + alt_m) * np.cos(lat) * np.cos(lon),
+                     (prime + alt_m) * np.cos(lat) * np.sin(lon),
+                     (prime * (1 - WGS84_E2) + alt_m) * np.sin(lat)], axis=-1)
+
+
+def geodetic_to_local(lat_deg, lon_deg, alt_m, origin) -> np.ndarray:
+    """(N, 3) east, north, up metres of geodetic points, about ``origin`` (lat, lon, alt)."""
+    lat0, lon0, alt0 = (float(v) for v in origin)
+    offset = (geodetic_to_ecef(np.asarray(lat_deg, float), np.asarray(lon_deg, float),
+                               np.asarray(alt_m, float))
+              - geodetic_to_ecef(np.array([lat0]), np.array([lon0]), np.array([alt0]))[0])
+    sl, cl = np.sin(np.radians(lat0)), np.cos(np.radians(lat0))
+    so, co = np.sin(np.radians(lon0)), np.cos(np.radians(lon0))
+    east = -so * offset[:, 0] + co * offset[:, 1]
+    north = -sl * co * offset[:, 0] - sl * so * offset[:, 1] + cl * offset[:, 2]
+    up = cl * co * offset[:, 0] + cl * so * offset[:, 1] + sl * offset[:, 2]
+    return np.stack([east, north, up], axis=1)
 
 
 class TrajectoryError(LadarError):
@@ -39,7 +71,8 @@ class FlightLog:
     pitch: np.ndarray
 
 
-def load_flight_log(path) -> FlightLog:
+def load_flight_log(path, origin=None) -> FlightLog:
+    """The log at ``path``; ``origin`` (lat, lon, alt) places a geodetic log in the scene."""
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
@@ -51,17 +84,24 @@ def load_flight_log(path) -> FlightLog:
         raise TrajectoryError(f"{path}: empty flight log: expected a header and records")
     header_line, header = rows[0]
     names = [name.strip().lower() for name in next(csv.reader([header]))]
-    missing = [c for c in REQUIRED if c not in names]
+    geodetic = all(c in names for c in GEODETIC)
+    required = ("time", *GEODETIC, "heading") if geodetic else REQUIRED
+    missing = [c for c in required if c not in names]
     if missing:
         raise TrajectoryError(f"{path}:{header_line}: header lacks {', '.join(missing)}: "
-                              f"expected columns {', '.join(REQUIRED)} (optional roll, pitch)")
-    columns = {name: names.index(name) for name in (*REQUIRED, *OPTIONAL) if name in names}
-    values = {name: [] for name in (*REQUIRED, *OPTIONAL)}
+                              f"expected columns {', '.join(REQUIRED)}, or time, latitude, "
+                              "longitude, altitude, heading (optional roll, pitch)")
+    if geodetic and origin is None:
+        raise TrajectoryError(f"{path}:{header_line}: a log in latitude and longitude needs "
+                              "the segment's origin = [lat, lon, alt] (the scene frame's "
+                              "origin on the earth)")
+    columns = {name: names.index(name) for name in (*required, *OPTIONAL) if name in names}
+    values = {name: [] for name in (*required, *OPTIONAL)}
     for number, line in rows[1:]:
         fields = next(csv.reader([line]))
         if len(fields) != len(names):
             raise TrajectoryError(f"{path}:{number}: {len(fields)} fields, expected {len(names)}")
-        for name in (*REQUIRED, *OPTIONAL):
+        for name in (*required, *OPTIONAL):
             if name not in columns:
                 values[name].append(0.0)
                 continue
@@ -76,13 +116,25 @@ def load_flight_log(path) -> FlightLog:
         if len(values["time"]) > 1 and values["time"][-1] <= values["time"][-2]:
             raise TrajectoryError(f"{path}:{number}: time = {values['time'][-1]!r}: "
                                   f"expected times increasing (previous {values['time'][-2]!r})")
-        if values["z"][-1] <= 0:
+        if geodetic:
+            lat = values["latitude"][-1]
+            if not -90.0 <= lat <= 90.0:
+                raise TrajectoryError(f"{path}:{number}: latitude = {lat!r}: expected -90..90")
+        elif values["z"][-1] <= 0:
             raise TrajectoryError(f"{path}:{number}: z = {values['z'][-1]!r}: expected > 0")
     if len(values["time"]) < 2:
         raise TrajectoryError(f"{path}: {len(values['time'])} records: expected at least 2")
     arr = {k: np.array(v, dtype=np.float64) for k, v in values.items()}
-    return FlightLog(arr["time"], np.stack([arr["x"], arr["y"], arr["z"]], axis=1),
-                     arr["heading"], arr["roll"], arr["pitch"])
+    if geodetic:
+        xyz = geodetic_to_local(arr["latitude"], arr["longitude"], arr["altitude"], origin)
+        low = int(np.argmin(xyz[:, 2]))
+        if xyz[low, 2] <= 0:
+            raise TrajectoryError(f"{path}:{rows[1 + low][0]}: altitude = "
+                                  f"{arr['altitude'][low]!r} puts the aircraft at "
+                                  f"{xyz[low, 2]:.1f} m above the origin: expected above it")
+    else:
+        xyz = np.stack([arr["x"], arr["y"], arr["z"]], axis=1)
+    return FlightLog(arr["time"], xyz, arr["heading"], arr["roll"], arr["pitch"])
 
 
 def _angle(times, angles, t):
@@ -133,6 +185,7 @@ class LogSegment:
     azimuth: float = 0.0
     depression: float = 90.0
     aim_at: tuple | None = None
+    origin: tuple | None = None  # (lat, lon, alt) of the scene origin, for a geodetic log
     kind: ClassVar[str] = "log"
     relative: ClassVar[bool] = False
 
@@ -150,7 +203,16 @@ class LogSegment:
         set_("depression", number_field("depression", self.depression, 1.0, 90.0))
         if self.aim_at is not None:
             set_("aim_at", point_field("aim_at", self.aim_at))
-        log = load_flight_log(self.file)
+        if self.origin is not None:
+            try:
+                lat, lon, alt = (float(v) for v in self.origin)
+            except (TypeError, ValueError):
+                raise FieldError("origin", self.origin, "[latitude, longitude, altitude] of "
+                                 "the scene frame's origin") from None
+            set_("origin", (number_field("origin latitude", lat, -90.0, 90.0),
+                            number_field("origin longitude", lon, -180.0, 180.0),
+                            number_field("origin altitude", alt, -1e4, 1e5)))
+        log = load_flight_log(self.file, self.origin)
         set_("_log", log)
         span = f"times from {log.time[0]:g} to {log.time[-1]:g} s (the log's span)"
         if self.rate is not None:
