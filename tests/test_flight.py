@@ -299,3 +299,29 @@ def test_altitudes_people_ask_for_are_practical_and_headings_they_type_are_compa
     for bad in (400.0, -1.0):
         with pytest.raises(FieldError, match="from 0 to 360"):
             compass_field("heading", bad)
+
+
+def test_a_centre_too_near_the_horizon_is_blamed_on_the_distance_the_user_wrote():
+    from ladartui.flight import orbit, standoff_sweep
+
+    with pytest.raises(FieldError) as caught:
+        orbit((0.0, 0.0, 0.0), 1e6, 100.0, 4)
+    assert caught.value.field == "radius" and "at most 5729 m at altitude 100 m" in str(
+        caught.value)
+    with pytest.raises(FieldError) as caught:
+        standoff_sweep((0.0, 0.0, 0.0), (50.0, 9000.0), 100.0)
+    assert caught.value.field == "standoffs"
+    with pytest.raises(FieldError) as caught:  # an aim point the user wrote is named as such
+        orbit((0.0, 0.0, 0.0), 1e6, 100.0, 4, aim_at=(0.0, 0.0, 0.0))
+    assert caught.value.field == "aim_at"
+
+
+def test_the_scenario_file_names_the_radius_line(tmp_path):
+    from ladartui.scenario import load_scenario
+
+    path = tmp_path / "far.toml"
+    path.write_text('[files]\nscene = "scene.txt"\nvoxel_size = 1.0\n[[flight.segments]]\n'
+                    'kind = "orbit"\ncentre = [0.0, 0.0, 0.0]\nradius = 1e6\naltitude = 100.0\n'
+                    'scans = 4\n')
+    with pytest.raises(FieldError, match=r"far.toml:7: flight.segments\[0\].radius"):
+        load_scenario(path, check_files=False)

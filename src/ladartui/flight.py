@@ -219,6 +219,21 @@ def _aimed(poses, target):
     return poses if target is None else [aim_at(p, target) for p in poses]
 
 
+def _aimed_at_default(poses, target, altitude, field: str, value, what: str):
+    """Aim at the segment's own ``target`` (no ``aim_at`` written): a point too near the
+    horizon is blamed on the distance the user wrote (``field``), with its limit."""
+    try:
+        return _aimed(poses, target)
+    except FieldError as error:
+        if error.field != "aim_at":
+            raise
+        height = altitude - target[2]
+        limit = height / math.tan(math.radians(1.0)) if height > 0 else 0.0
+        raise FieldError(field, value, f"{what} of at most {limit:.0f} m at altitude "
+                         f"{altitude:g} m, so the {'centre' if field == 'radius' else 'target'} "
+                         "is at least 1 degree below the horizon (or an aim_at point)") from None
+
+
 def _with_sensor(pose, azimuth, depression):
     changes = {}
     if azimuth is not None:
@@ -315,7 +330,9 @@ def orbit(centre, radius, altitude, scans, *, direction="right", start_bearing=1
     template = _template(altitude)
     poses = [_on_circle(template, centre, radius, start_bearing + step * k, clockwise)
              for k in range(scans)]
-    return _aimed(poses, centre if aim_at is None else aim_at)
+    if aim_at is None:
+        return _aimed_at_default(poses, centre, altitude, "radius", radius, "a radius")
+    return _aimed(poses, aim_at)
 
 
 def flypast(target, standoff, altitude, length, scans, heading, *, side="right",
@@ -341,7 +358,10 @@ def flypast(target, standoff, altitude, length, scans, heading, *, side="right",
     template = _template(altitude, heading)
     offsets = [0.0] if scans == 1 else [length * (k / (scans - 1) - 0.5) for k in range(scans)]
     poses = [replace(template, x=cx + fx * s, y=cy + fy * s) for s in offsets]
-    return _aimed(poses, target if aim_at is None else aim_at)
+    if aim_at is None:  # the line's ends are the farthest: blame the standoff and length
+        return _aimed_at_default(poses, target, altitude, "standoff", standoff,
+                                 "a standoff (with half the length)")
+    return _aimed(poses, aim_at)
 
 
 def standoff_sweep(target, standoffs, altitude, *, bearing=180.0, heading=None,
@@ -360,7 +380,10 @@ def standoff_sweep(target, standoffs, altitude, *, bearing=180.0, heading=None,
     bx, by = _forward(bearing)
     template = _template(altitude, heading)
     poses = [replace(template, x=target[0] + bx * s, y=target[1] + by * s) for s in distances]
-    return _aimed(poses, target if aim_at is None else aim_at)
+    if aim_at is None:
+        return _aimed_at_default(poses, target, altitude, "standoffs", list(distances),
+                                 "standoffs")
+    return _aimed(poses, aim_at)
 
 
 def standoffs_field(name, value):
