@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ladartui import defaults
+from ladartui import user_data as defaults
 from ladartui.scenario import load_scenario, scenario_from_toml
 from ladartui.sensor import pose_rotation
 

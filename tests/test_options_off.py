@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from ladartui.defaults import default_scenario_path
+from ladartui.user_data import default_scenario_path
 from ladartui.measures import compute_measures
 from ladartui.scenario import load_scenario
 from ladartui.scene.voxels import save_voxels

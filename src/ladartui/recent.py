@@ -11,22 +11,14 @@ list: remembering files is a convenience, never a reason to refuse to start.
 from __future__ import annotations
 
 import json
-import os
 from pathlib import Path
 
-import platformdirs
-
 from ladartui.atomic import write_text_atomic
+from ladartui.user_data import config_folder
 
 RECENT_LIMIT = 10
 RECENT_FILE = "recent.json"
 KINDS = ("scenarios", "sweeps")
-
-
-def config_folder() -> Path:
-    if os.environ.get("LADARTUI_HOME"):
-        return Path(os.environ["LADARTUI_HOME"]).expanduser() / "config"
-    return platformdirs.user_config_path("ladartui")
 
 
 def _read() -> dict[str, list[str]]:

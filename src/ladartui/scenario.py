@@ -89,11 +89,11 @@ from pathlib import Path
 
 import tomli_w
 
+from ladartui import defaults
 from ladartui.atomic import write_text_atomic
 from ladartui.detection.settings import DETECTION_KEYS, DetectionSettings, detection_from_table
 from ladartui.errors import FieldError, InputFileError, LadarError
 from ladartui.fileprobe import file_problem
-from ladartui.scenario_style import restyle
 from ladartui.flight import (
     MAX_SCANS,
     SEGMENT_KINDS,
@@ -103,6 +103,7 @@ from ladartui.flight import (
     choice_field,
     number_field,
 )
+from ladartui.scenario_style import restyle
 from ladartui.sensor import MAX_PIXEL_PITCH, Sensor
 from ladartui.trajectory import LogSegment
 
@@ -270,8 +271,6 @@ class Scenario:
         The default orbit (see ``ladartui.defaults.default_flight``) reads the
         target model to find the target centre; ``sensor`` defaults likewise.
         """
-        from ladartui import defaults
-
         path = _absolute(path)
         scene_file = _resolve(path.parent, scene_file)
         if sensor is None:

@@ -113,7 +113,7 @@ def run_orbit_bench(runs=3, backend="numba") -> dict:
 
 def cache_dir() -> Path:
     """Where the generated benchmark scene is kept between runs."""
-    from ladartui.defaults import data_home
+    from ladartui.user_data import data_home
 
     return data_home() / "bench"
 

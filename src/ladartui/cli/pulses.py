@@ -70,8 +70,8 @@ def _settings(scenario, args):
 def run(args) -> int:
     from rich.console import Console
 
-    from ladartui.defaults import default_scenario_path
     from ladartui.scenario import load_scenario
+    from ladartui.user_data import default_scenario_path
 
     pulses = _pulse_counts(args.pulses)
     scenario = load_scenario(args.scenario or default_scenario_path())

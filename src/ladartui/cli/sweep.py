@@ -130,8 +130,14 @@ def run(args) -> int:
 
 
 def _sweep_with_progress(spec, args, console):
-    from rich.progress import (BarColumn, MofNCompleteColumn, Progress, TextColumn,
-                               TimeElapsedColumn, TimeRemainingColumn)
+    from rich.progress import (
+        BarColumn,
+        MofNCompleteColumn,
+        Progress,
+        TextColumn,
+        TimeElapsedColumn,
+        TimeRemainingColumn,
+    )
 
     from ladartui.sweep import connect, run_sweep
 

@@ -8,9 +8,9 @@ ray grid 8), and marks the Pareto front. ``draw_chart``/``chart_text``/
 worth using; ``StudyResult.write`` writes CSV and JSON atomically.
 """
 
+from ladartui.pareto import dominates, pareto_front
 from ladartui.study.chart import chart_svg, chart_text, draw_chart, table_rows
 from ladartui.study.misses import CLASSES, MissSummary, summarise, voxel_geometry
-from ladartui.pareto import dominates, pareto_front
 from ladartui.study.results import StudyResult, StudyRow
 from ladartui.study.settings import Setting, full_settings, quick_settings, reference_setting
 from ladartui.study.timing import Timing, measure

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.atomic import write_text_atomic
-from ladartui.defaults import data_home
+from ladartui.user_data import data_home
 
 DEFAULT_SCANS = 8
 

@@ -283,7 +283,7 @@ def study_folder(scenario_path=None) -> Path:
     """Where the terminal UI keeps a scenario's last study: ``S-study`` beside ``S.toml``;
     for the generated scenes, ``study`` in the user data folder."""
     if scenario_path is None:
-        from ladartui.defaults import data_home
+        from ladartui.user_data import data_home
 
         return data_home() / "study"
     path = Path(scenario_path)

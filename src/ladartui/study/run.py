@@ -26,7 +26,7 @@ import numpy as np
 
 from ladartui.errors import BackendUnavailable, Cancelled, LadarError
 from ladartui.study.inputs import StudyInputs, with_ray_grid
-from ladartui.study.misses import MissSummary, summarise, voxel_geometry
+from ladartui.study.misses import summarise, voxel_geometry
 from ladartui.study.results import FAILED, SKIPPED, StudyResult, StudyRow
 from ladartui.study.settings import Setting, reference_setting
 from ladartui.study.timing import timed

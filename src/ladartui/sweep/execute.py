@@ -110,7 +110,7 @@ def base_digest(scenario_path, scenario) -> str:
 def base_scenario_path(spec: SweepSpec) -> Path:
     """The base scenario file (the built-in default is created on first use)."""
     if spec.scenario_path == DEFAULT_BASE:
-        from ladartui.defaults import default_scenario_path
+        from ladartui.user_data import default_scenario_path
 
         return default_scenario_path()
     if not spec.scenario_path.is_file():

@@ -15,8 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ladartui.errors import BackendUnavailable, FieldError
-from ladartui.tracing.backend import (GROUND, METHODS, MISS, VOXEL, backend_names, backend_status,
-                                      get_backend)
+from ladartui.tracing.backend import GROUND, METHODS, MISS, VOXEL, backend_names, backend_status, get_backend
 
 __all__ = ["trace", "TraceResult", "choose_backend", "to_cells", "MISS", "VOXEL", "GROUND",
            "METHODS", "backend_names", "backend_status", "get_backend"]

@@ -19,10 +19,10 @@ from numba import njit, prange
 
 from ladartui.errors import Cancelled
 from ladartui.scene.occupancy import block_masks
-from ladartui.tracing.bundle import bundle_start, halo_arrays
-from ladartui.tracing.object_order import OrderChoice, cone_frame, nearest_voxels, trace_in_blocks
 from ladartui.tracing.axis import boundary_t, cell_at, clamp, slab
 from ladartui.tracing.backend import GROUND, MISS, VOXEL, CellHits, register_backend
+from ladartui.tracing.bundle import bundle_start, halo_arrays
+from ladartui.tracing.object_order import OrderChoice, cone_frame, nearest_voxels, trace_in_blocks
 
 CHUNK = 64  # rays per prange work item: coherent neighbours stay on one thread
 BLOCK = 1 << 16  # rays per kernel call: cancel is checked between calls

@@ -55,8 +55,13 @@ from ladartui.errors import BackendUnavailable, Cancelled, FieldError
 from ladartui.tracing.backend import GROUND, METHODS, MISS, VOXEL, CellHits, register_backend
 from ladartui.tracing.bundle import bundle_starts, halo_arrays
 from ladartui.tracing.numba_backend import scan_answers
-from ladartui.tracing.object_order import (OrderChoice, cone_frame, prepare_scan, shader_voxels,
-                                           trace_in_blocks)
+from ladartui.tracing.object_order import (
+    OrderChoice,
+    cone_frame,
+    prepare_scan,
+    shader_voxels,
+    trace_in_blocks,
+)
 
 NAME = "wgpu"
 

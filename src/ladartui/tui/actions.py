@@ -20,10 +20,10 @@ from pathlib import Path
 
 from textual.binding import Binding
 
-from ladartui.recent import config_folder
 from ladartui.textsafe import one_line
 from ladartui.tui import bridge
 from ladartui.tui.view_area import LAYOUTS
+from ladartui.user_data import config_folder
 
 KEYS_FILE = "keys.toml"
 

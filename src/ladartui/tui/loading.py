@@ -74,7 +74,7 @@ class SceneLoading:
 def _load(path: Path | None, scenario) -> Loaded:
     if scenario is None:
         if path is None:
-            from ladartui.defaults import default_scenario_path
+            from ladartui.user_data import default_scenario_path
 
             path = default_scenario_path()
         scenario = bridge.load_checked(path)
