@@ -22,7 +22,8 @@ def one_scan(aim, depression_deg, azimuth_rad, slant_cells, sensor=None):
     sensor = sensor or Sensor(grid=32, ray_grid=4, fov=5.0)
     e = math.radians(depression_deg)
     at = np.asarray(aim, float) + slant_cells * np.array(
-        [math.cos(azimuth_rad) * math.cos(e), math.sin(azimuth_rad) * math.cos(e), math.sin(e)])
+        [math.cos(azimuth_rad) * math.cos(e), math.sin(azimuth_rad) * math.cos(e), math.sin(e)]
+    )
     origins, directions, _ = sensor.rays(aim_at(ScanPose(*at.tolist()), list(aim)))
     return origins, directions
 

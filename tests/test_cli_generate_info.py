@@ -28,8 +28,12 @@ def test_generate_writes_the_pair_and_reports_it(tmp_path, capsys):
 
 def test_generate_accepts_a_txt_stem_and_options(tmp_path, capsys):
     out_path = tmp_path / "plain.txt"
-    assert main(["generate", "small", str(out_path), "--no-target", "--terrain",
-                 "--camouflage", "--trees", "10"]) == 0
+    assert (
+        main(
+            ["generate", "small", str(out_path), "--no-target", "--terrain", "--camouflage", "--trees", "10"]
+        )
+        == 0
+    )
     assert (tmp_path / "plain.txt").is_file()
     assert load_voxels(tmp_path / "plain_Target.txt").shape == (0, 3)
     out = capsys.readouterr().out

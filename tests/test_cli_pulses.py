@@ -19,18 +19,26 @@ from ladartui.sensor import Sensor
 
 @pytest.fixture
 def scenario(tmp_path):
-    target = np.array([(x, y, z) for x in range(8, 12) for y in range(8, 11) for z in range(2)],
-                      dtype=np.int32)
-    canopy = np.array([(x, y, 6) for x in range(6, 14) for y in range(6, 13) if (x + 2 * y) % 3],
-                      dtype=np.int32)
+    target = np.array(
+        [(x, y, z) for x in range(8, 12) for y in range(8, 11) for z in range(2)], dtype=np.int32
+    )
+    canopy = np.array(
+        [(x, y, 6) for x in range(6, 14) for y in range(6, 13) if (x + 2 * y) % 3], dtype=np.int32
+    )
     save_voxels(tmp_path / "woods.txt", np.vstack([target, canopy]))
     save_voxels(tmp_path / "woods_Target.txt", target)
-    poses = tuple(aim_at(ScanPose(x, y, 40.0), (9.5, 9.0, 0.5))
-                  for x, y in [(9.5, -10.0), (29.5, 9.0), (9.5, 30.0)])
-    return Scenario(tmp_path / "S.toml", "woods.txt", 1.0, Sensor(grid=16, ray_grid=2, fov=20.0),
-                    FlightPlan(segments=[Manual(poses)]), backend="numba",
-                    detection=DetectionSettings(pulses=20, coincidence=4, solar_rate_hz=2e7,
-                                                seed=3)).save()
+    poses = tuple(
+        aim_at(ScanPose(x, y, 40.0), (9.5, 9.0, 0.5)) for x, y in [(9.5, -10.0), (29.5, 9.0), (9.5, 30.0)]
+    )
+    return Scenario(
+        tmp_path / "S.toml",
+        "woods.txt",
+        1.0,
+        Sensor(grid=16, ray_grid=2, fov=20.0),
+        FlightPlan(segments=[Manual(poses)]),
+        backend="numba",
+        detection=DetectionSettings(pulses=20, coincidence=4, solar_rate_hz=2e7, seed=3),
+    ).save()
 
 
 def test_json_rows_use_the_scenario_settings(scenario, capsys):
@@ -64,7 +72,8 @@ def test_chart_text_draws_both_series():
 def test_bad_flag_names_the_flag(scenario, capsys):
     assert main(["pulses", str(scenario.path), "--n-ref", "-1"]) == 2
     assert capsys.readouterr().err.strip() == (
-        "ladartui: error: --n-ref = -1.0: expected a number greater than 0 and at most 1000000")
+        "ladartui: error: --n-ref = -1.0: expected a number greater than 0 and at most 1000000"
+    )
 
 
 def test_ctrl_c_cancels_with_a_truthful_message(scenario, capsys, monkeypatch):
@@ -97,4 +106,5 @@ def test_work_beyond_the_memory_limit_is_refused_up_front(scenario, capsys, monk
     assert "would need about" in err and "3 scans of 1,024 rays" in err and not traced
     with pytest.raises(Exception, match="one scan's 1,024 rays in two runs"):
         from ladartui.simulation import simulate
+
         simulate(scenario.with_changes(detection=DetectionSettings(model="geiger")), write=False)

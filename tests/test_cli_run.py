@@ -17,15 +17,23 @@ from ladartui.sensor import Sensor
 
 @pytest.fixture
 def scenario(tmp_path):
-    target = np.array([(x, y, z) for x in range(8, 12) for y in range(8, 11) for z in range(2)],
-                      dtype=np.int32)
-    canopy = np.array([(x, y, 6) for x in range(6, 14) for y in range(6, 13) if (x + 2 * y) % 3],
-                      dtype=np.int32)
+    target = np.array(
+        [(x, y, z) for x in range(8, 12) for y in range(8, 11) for z in range(2)], dtype=np.int32
+    )
+    canopy = np.array(
+        [(x, y, 6) for x in range(6, 14) for y in range(6, 13) if (x + 2 * y) % 3], dtype=np.int32
+    )
     save_voxels(tmp_path / "woods.txt", np.vstack([target, canopy]))
     save_voxels(tmp_path / "woods_Target.txt", target)
     poses = tuple(aim_at(ScanPose(x, y, 40.0), (9.5, 9.0, 0.5)) for x, y in [(9.5, -10.0), (29.5, 9.0)])
-    return Scenario(tmp_path / "S.toml", "woods.txt", 1.0, Sensor(grid=16, ray_grid=2, fov=20.0),
-                    FlightPlan(segments=[Manual(poses)]), backend="numba").save()
+    return Scenario(
+        tmp_path / "S.toml",
+        "woods.txt",
+        1.0,
+        Sensor(grid=16, ray_grid=2, fov=20.0),
+        FlightPlan(segments=[Manual(poses)]),
+        backend="numba",
+    ).save()
 
 
 def test_json_output_and_files(scenario, capsys):

@@ -17,15 +17,28 @@ def scene_file(tmp_path):
 
 
 def test_trace_writes_hits(tmp_path, scene_file, capsys):
-    rays = np.array([
-        [5.0, 5.0, 20.0, 0.0, 0.0, -1.0],   # onto voxel (5, 5, 1), top face at z = 1.5
-        [2.0, 2.0, 20.0, 0.0, 0.0, -1.0],   # ground at (2, 2)
-        [2.0, 2.0, 20.0, 0.0, 0.0, 1.0],    # upward: miss
-    ])
+    rays = np.array(
+        [
+            [5.0, 5.0, 20.0, 0.0, 0.0, -1.0],  # onto voxel (5, 5, 1), top face at z = 1.5
+            [2.0, 2.0, 20.0, 0.0, 0.0, -1.0],  # ground at (2, 2)
+            [2.0, 2.0, 20.0, 0.0, 0.0, 1.0],  # upward: miss
+        ]
+    )
     np.save(tmp_path / "rays.npy", rays)
     out = tmp_path / "hits.npy"
-    code = main(["trace", "--scene", str(scene_file), "--rays", str(tmp_path / "rays.npy"),
-                 "--out", str(out), "--backend", "numba"])
+    code = main(
+        [
+            "trace",
+            "--scene",
+            str(scene_file),
+            "--rays",
+            str(tmp_path / "rays.npy"),
+            "--out",
+            str(out),
+            "--backend",
+            "numba",
+        ]
+    )
     assert code == 0
     hits = np.load(out)
     assert hits.shape == (3, 5) and hits.dtype == np.float64
@@ -39,18 +52,37 @@ def test_trace_march_with_voxel_size(tmp_path, scene_file):
     rays = np.array([[1.25, 1.25, 10.0, 0.0, 0.0, -1.0]])  # 0.25 m voxels: cell (5, 5)
     np.save(tmp_path / "rays.npy", rays)
     out = tmp_path / "hits.npy"
-    assert main(["trace", "--scene", str(scene_file), "--rays", str(tmp_path / "rays.npy"),
-                 "--out", str(out), "--method", "march", "--step", "0.25",
-                 "--voxel-size", "0.25"]) == 0
+    assert (
+        main(
+            [
+                "trace",
+                "--scene",
+                str(scene_file),
+                "--rays",
+                str(tmp_path / "rays.npy"),
+                "--out",
+                str(out),
+                "--method",
+                "march",
+                "--step",
+                "0.25",
+                "--voxel-size",
+                "0.25",
+            ]
+        )
+        == 0
+    )
     assert np.load(out)[0, :4].tolist() == [1, 5, 5, 1]
 
 
 def _three_rays(tmp_path):
-    rays = np.array([
-        [5.0, 5.0, 20.0, 0.0, 0.0, -1.0],
-        [2.0, 2.0, 20.0, 0.0, 0.0, -1.0],
-        [2.0, 2.0, 20.0, 0.0, 0.0, 1.0],
-    ])
+    rays = np.array(
+        [
+            [5.0, 5.0, 20.0, 0.0, 0.0, -1.0],
+            [2.0, 2.0, 20.0, 0.0, 0.0, -1.0],
+            [2.0, 2.0, 20.0, 0.0, 0.0, 1.0],
+        ]
+    )
     np.save(tmp_path / "rays.npy", rays)
     return tmp_path / "rays.npy"
 
@@ -60,8 +92,24 @@ def test_trace_precision_f32_on_wgpu(tmp_path, scene_file, capsys, wgpu_backend)
     hits = {}
     for precision in ("f64", "f32"):
         out = tmp_path / f"hits-{precision}.npy"
-        assert main(["trace", "--scene", str(scene_file), "--rays", str(rays), "--out", str(out),
-                     "--backend", "wgpu", "--precision", precision]) == 0
+        assert (
+            main(
+                [
+                    "trace",
+                    "--scene",
+                    str(scene_file),
+                    "--rays",
+                    str(rays),
+                    "--out",
+                    str(out),
+                    "--backend",
+                    "wgpu",
+                    "--precision",
+                    precision,
+                ]
+            )
+            == 0
+        )
         hits[precision] = np.load(out)
         err = capsys.readouterr().err
     # the message names the arithmetic the backend used
@@ -73,29 +121,60 @@ def test_trace_precision_f32_on_wgpu(tmp_path, scene_file, capsys, wgpu_backend)
 def test_trace_precision_reported_and_checked(tmp_path, scene_file, capsys):
     rays = _three_rays(tmp_path)
     out = tmp_path / "hits.npy"
-    assert main(["trace", "--scene", str(scene_file), "--rays", str(rays), "--out", str(out),
-                 "--backend", "numba", "--precision", "f32"]) == 0
+    assert (
+        main(
+            [
+                "trace",
+                "--scene",
+                str(scene_file),
+                "--rays",
+                str(rays),
+                "--out",
+                str(out),
+                "--backend",
+                "numba",
+                "--precision",
+                "f32",
+            ]
+        )
+        == 0
+    )
     # numba has only f64 kernels: the line says what was traced, not what was asked
     assert "numba, exact, f64" in capsys.readouterr().err
     with pytest.raises(SystemExit) as stop:
-        main(["trace", "--scene", str(scene_file), "--rays", str(rays), "--out", str(out),
-              "--precision", "f16"])
+        main(
+            [
+                "trace",
+                "--scene",
+                str(scene_file),
+                "--rays",
+                str(rays),
+                "--out",
+                str(out),
+                "--precision",
+                "f16",
+            ]
+        )
     assert stop.value.code == 2
     err = capsys.readouterr().err
     assert "--precision" in err and "f16" in err and "Traceback" not in err
 
 
-@pytest.mark.parametrize("array, expected", [
-    (np.zeros((4, 5)), "(4, 5)"),
-    (np.zeros(6), "(6,)"),
-    (np.array([[0, 0, 1, 0, 0, 0.0]]), "zero direction"),
-])
+@pytest.mark.parametrize(
+    "array, expected",
+    [
+        (np.zeros((4, 5)), "(4, 5)"),
+        (np.zeros(6), "(6,)"),
+        (np.array([[0, 0, 1, 0, 0, 0.0]]), "zero direction"),
+    ],
+)
 def test_bad_rays_file_is_one_clear_line(tmp_path, scene_file, capsys, array, expected):
     np.save(tmp_path / "rays.npy", array)
     out = tmp_path / "hits.npy"
     out.write_bytes(b"earlier")
-    code = main(["trace", "--scene", str(scene_file), "--rays", str(tmp_path / "rays.npy"),
-                 "--out", str(out)])
+    code = main(
+        ["trace", "--scene", str(scene_file), "--rays", str(tmp_path / "rays.npy"), "--out", str(out)]
+    )
     err = capsys.readouterr().err
     assert code == 2
     assert "rays.npy" in err and expected in err and "Traceback" not in err
@@ -106,8 +185,9 @@ def test_bad_rays_file_is_one_clear_line(tmp_path, scene_file, capsys, array, ex
 def test_missing_and_non_npy_rays(tmp_path, scene_file, capsys):
     (tmp_path / "rays.npy").write_text("not numpy")
     for rays in (tmp_path / "none.npy", tmp_path / "rays.npy"):
-        code = main(["trace", "--scene", str(scene_file), "--rays", str(rays),
-                     "--out", str(tmp_path / "h.npy")])
+        code = main(
+            ["trace", "--scene", str(scene_file), "--rays", str(rays), "--out", str(tmp_path / "h.npy")]
+        )
         assert code == 2
         assert rays.name in capsys.readouterr().err
     assert not (tmp_path / "h.npy").exists()
@@ -119,6 +199,7 @@ def test_bench_quick_json(monkeypatch, tmp_path, capsys):
 
     def tiny_scene():
         from ladartui.scene.model import Scene
+
         return Scene(small, small[:1], 0.25, shape=(40, 40, 30), name="tiny"), "tiny"
 
     monkeypatch.setattr(bench, "load_bench_scene", tiny_scene)
@@ -128,20 +209,29 @@ def test_bench_quick_json(monkeypatch, tmp_path, capsys):
     assert report["voxels"] == len(small)
     assert report["occupancy_bytes"] > 0
     rows = {(r["backend"], r["method"], r["view"], r["depression"]) for r in report["results"]}
-    assert {("numba", "exact", "wide", 45.0), ("numba", "exact", "wide", 90.0),
-            ("numba", "march", "wide", 45.0), ("numba", "march", "wide", 90.0),
-            ("numba", "exact", "narrow", 45.0), ("numba", "exact", "narrow", 90.0)} <= rows
+    assert {
+        ("numba", "exact", "wide", 45.0),
+        ("numba", "exact", "wide", 90.0),
+        ("numba", "march", "wide", 45.0),
+        ("numba", "march", "wide", 90.0),
+        ("numba", "exact", "narrow", 45.0),
+        ("numba", "exact", "narrow", 90.0),
+    } <= rows
     assert not any(r["view"] == "narrow" and r["method"] == "march" for r in report["results"])
     assert all(r["rays_per_second"] > 0 for r in report["results"])
     # Which order each traced in: the march always walks the rays.
     assert all(set(r["order"].split("/")) <= {"object", "ray", "object+ray"} for r in report["results"])
     assert all(r["order"] == "ray" for r in report["results"] if r["method"] == "march")
     # Each row's share of numba's rays/s on the same method and angle.
-    numba = {(r["method"], r["view"], r["depression"]): r["rays_per_second"]
-             for r in report["results"] if r["backend"] == "numba"}
+    numba = {
+        (r["method"], r["view"], r["depression"]): r["rays_per_second"]
+        for r in report["results"]
+        if r["backend"] == "numba"
+    }
     for r in report["results"]:
         assert r["vs_numba"] == pytest.approx(
-            r["rays_per_second"] / numba[r["method"], r["view"], r["depression"]])
+            r["rays_per_second"] / numba[r["method"], r["view"], r["depression"]]
+        )
 
 
 @pytest.mark.parametrize("depression", [45.0, 90.0])

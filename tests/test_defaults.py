@@ -85,6 +85,5 @@ def test_default_orbit_circles_the_generated_target_and_keeps_it_in_view(materia
         assert max(angle_x.max(), angle_y.max()) < 0.8 * half_fov
     # Rays are fine enough to sample every voxel: several per voxel at the target.
     slant = math.dist(scenario.poses()[0].position, centre)
-    spacing = slant * math.radians(scenario.sensor.fov) / (scenario.sensor.grid *
-                                                           scenario.sensor.ray_grid)
+    spacing = slant * math.radians(scenario.sensor.fov) / (scenario.sensor.grid * scenario.sensor.ray_grid)
     assert spacing < scenario.voxel_size / 2

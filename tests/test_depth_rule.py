@@ -8,8 +8,12 @@ from ladartui.tracing.backend import GROUND, MISS, VOXEL
 
 
 def kept(detector, kind, ranges, depth):
-    mask = apply_depth_resolution(np.array(detector, dtype=np.int32), np.array(kind, dtype=np.uint8),
-                                  np.array(ranges, dtype=np.float64), depth)
+    mask = apply_depth_resolution(
+        np.array(detector, dtype=np.int32),
+        np.array(kind, dtype=np.uint8),
+        np.array(ranges, dtype=np.float64),
+        depth,
+    )
     return sorted(np.flatnonzero(mask).tolist())
 
 
@@ -84,7 +88,9 @@ def test_matches_a_plain_restatement_on_random_scans(rays_per_detector, shuffle)
 
 
 def test_empty_scan():
-    assert apply_depth_resolution(np.zeros(0, np.int32), np.zeros(0, np.uint8), np.zeros(0), 1.0).shape == (0,)
+    assert apply_depth_resolution(np.zeros(0, np.int32), np.zeros(0, np.uint8), np.zeros(0), 1.0).shape == (
+        0,
+    )
 
 
 class FakeTrace:

@@ -30,8 +30,7 @@ def central_direction(pose):
     """Boresight from the angles alone: bearing H + A, D below the horizontal."""
     bearing = math.radians(pose.heading + pose.azimuth)
     d = math.radians(pose.depression)
-    return np.array([math.cos(d) * math.sin(bearing), math.cos(d) * math.cos(bearing),
-                     -math.sin(d)])
+    return np.array([math.cos(d) * math.sin(bearing), math.cos(d) * math.cos(bearing), -math.sin(d)])
 
 
 def distance_ray_to_point(origin, direction, point):
@@ -53,15 +52,18 @@ def test_pose_normalises_angles():
     assert ScanPose(0, 0, 1, azimuth=180).azimuth == 180.0
 
 
-@pytest.mark.parametrize("field,value,message", [
-    ("depression", 0.5, "depression = 0.5: expected a number from 1 to 90"),
-    ("depression", 91, "depression = 91: expected a number from 1 to 90"),
-    ("z", 0, "z = 0: expected a number greater than 0 and at most 100000"),
-    ("z", -3.0, "z = -3.0: expected a number greater than 0 and at most 100000"),
-    ("x", float("nan"), "x = nan: expected a number from -1000000 to 1000000"),
-    ("heading", "north", "heading = 'north': expected a finite number"),
-    ("azimuth", True, "azimuth = True: expected a finite number"),
-])
+@pytest.mark.parametrize(
+    "field,value,message",
+    [
+        ("depression", 0.5, "depression = 0.5: expected a number from 1 to 90"),
+        ("depression", 91, "depression = 91: expected a number from 1 to 90"),
+        ("z", 0, "z = 0: expected a number greater than 0 and at most 100000"),
+        ("z", -3.0, "z = -3.0: expected a number greater than 0 and at most 100000"),
+        ("x", float("nan"), "x = nan: expected a number from -1000000 to 1000000"),
+        ("heading", "north", "heading = 'north': expected a finite number"),
+        ("azimuth", True, "azimuth = True: expected a finite number"),
+    ],
+)
 def test_pose_field_limits(field, value, message):
     args = {"x": 0.0, "y": 0.0, "z": 10.0, "heading": 0.0, "azimuth": 0.0, "depression": 45.0}
     args[field] = value
@@ -90,10 +92,13 @@ def test_straight_five_scans_start_is_not_a_scan():
 # -- turn (figure 13) ------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("direction,centre,end,end_heading", [
-    ("right", (100.0, 0.0), (100.0, 100.0), 90.0),
-    ("left", (-100.0, 0.0), (-100.0, 100.0), 270.0),
-])
+@pytest.mark.parametrize(
+    "direction,centre,end,end_heading",
+    [
+        ("right", (100.0, 0.0), (100.0, 100.0), 90.0),
+        ("left", (-100.0, 0.0), (-100.0, 100.0), 270.0),
+    ],
+)
 def test_quarter_turn_from_north(direction, centre, end, end_heading):
     start = ScanPose(0.0, 0.0, 50.0, heading=0.0, depression=60.0)
     poses = turn(start, 100.0, 90.0, direction, 4)
@@ -128,8 +133,7 @@ def test_turn_spacing_is_even_along_the_arc():
 
 def test_segments_continue_from_the_last_scan_with_continuous_heading():
     start = ScanPose(0.0, 0.0, 100.0, heading=90.0, depression=45.0)
-    plan = FlightPlan(start, [Straight(300.0, 3), Turn(50.0, 180.0, "left", 3),
-                              Straight(100.0, 2)])
+    plan = FlightPlan(start, [Straight(300.0, 3), Turn(50.0, 180.0, "left", 3), Straight(100.0, 2)])
     first, second, third = plan.segment_poses()
     # The turn starts at the straight's end, turning left from heading 90 (east):
     # its centre is 50 m north of (300, 0); it ends at (300, 100) heading west.
@@ -157,8 +161,7 @@ def test_absolute_then_relative_segment():
     plan = FlightPlan(None, [manual, Straight(20.0, 2, depression=30.0)])
     poses = plan.poses()
     assert plan.path_length() == pytest.approx(20.0)
-    np.testing.assert_allclose([(p.x, p.y) for p in poses], [(0, 0), (0, -10), (0, -20)],
-                               atol=1e-9)
+    np.testing.assert_allclose([(p.x, p.y) for p in poses], [(0, 0), (0, -10), (0, -20)], atol=1e-9)
     assert [p.depression for p in poses] == [70.0, 30.0, 30.0]
     # Between two absolute segments the plan counts the straight jump.
     jump = FlightPlan(None, [manual, Manual([ScanPose(30, 40, 50)])])
@@ -173,24 +176,32 @@ def test_segment_errors_name_the_segment():
     assert caught.value.field == "segments[1].aim_at"
 
 
-@pytest.mark.parametrize("make,message", [
-    (lambda: Straight(-5, 3),
-     "distance = -5: expected a number greater than 0 and at most 1000000"),
-    (lambda: Straight(5, 0), "scans = 0: expected an integer from 1 to 10000"),
-    (lambda: Turn(10, 400, "right", 3),
-     "arc = 400: expected a number greater than 0 and at most 360"),
-    (lambda: Turn(10, 90, "up", 3), "direction = 'up': expected one of 'left', 'right'"),
-    (lambda: Orbit((0, 0), 0, 50, 3),
-     "radius = 0: expected a number greater than 0 and at most 1000000"),
-    (lambda: Orbit((0,), 10, 50, 3),
-     "centre = (0,): expected a point [x, y] or [x, y, z] in metres, each within +-1000000"),
-    (lambda: FlyPast((0, 0), 10, 50, 100, 3, 0, side="below"),
-     "side = 'below': expected one of 'left', 'right'"),
-    (lambda: Standoff((0, 0), [], 50),
-     "standoffs = []: expected a list of 1 to 10000 distances from 0 to 1000000 metres"),
-    (lambda: Standoff((0, 0), [10, -1], 50),
-     "standoffs = [10, -1]: expected a list of 1 to 10000 distances from 0 to 1000000 metres"),
-])
+@pytest.mark.parametrize(
+    "make,message",
+    [
+        (lambda: Straight(-5, 3), "distance = -5: expected a number greater than 0 and at most 1000000"),
+        (lambda: Straight(5, 0), "scans = 0: expected an integer from 1 to 10000"),
+        (lambda: Turn(10, 400, "right", 3), "arc = 400: expected a number greater than 0 and at most 360"),
+        (lambda: Turn(10, 90, "up", 3), "direction = 'up': expected one of 'left', 'right'"),
+        (lambda: Orbit((0, 0), 0, 50, 3), "radius = 0: expected a number greater than 0 and at most 1000000"),
+        (
+            lambda: Orbit((0,), 10, 50, 3),
+            "centre = (0,): expected a point [x, y] or [x, y, z] in metres, each within +-1000000",
+        ),
+        (
+            lambda: FlyPast((0, 0), 10, 50, 100, 3, 0, side="below"),
+            "side = 'below': expected one of 'left', 'right'",
+        ),
+        (
+            lambda: Standoff((0, 0), [], 50),
+            "standoffs = []: expected a list of 1 to 10000 distances from 0 to 1000000 metres",
+        ),
+        (
+            lambda: Standoff((0, 0), [10, -1], 50),
+            "standoffs = [10, -1]: expected a list of 1 to 10000 distances from 0 to 1000000 metres",
+        ),
+    ],
+)
 def test_segment_field_limits(make, message):
     with pytest.raises(FieldError) as caught:
         make()
@@ -227,7 +238,8 @@ def test_partial_orbit_includes_both_ends():
     np.testing.assert_allclose(
         [(p.x, p.y) for p in poses],
         [(0.0, 50.0), (50 * math.sin(math.pi / 4), 50 * math.cos(math.pi / 4)), (50.0, 0.0)],
-        atol=1e-9)
+        atol=1e-9,
+    )
 
 
 def test_flypast_passes_at_the_standoff_with_target_on_the_side():
@@ -251,19 +263,24 @@ def test_flypast_passes_at_the_standoff_with_target_on_the_side():
 def test_standoff_sweep_distances_and_heading():
     target = (0.0, 0.0, 0.0)
     poses = standoff_sweep(target, [300.0, 200.0, 100.0], 70.0, bearing=270.0)
-    np.testing.assert_allclose([(p.x, p.y) for p in poses], [(-300, 0), (-200, 0), (-100, 0)],
-                               atol=1e-9)
+    np.testing.assert_allclose([(p.x, p.y) for p in poses], [(-300, 0), (-200, 0), (-100, 0)], atol=1e-9)
     assert all(p.heading == pytest.approx(90.0) for p in poses)  # towards the target
     assert [p.azimuth for p in poses] == pytest.approx([0.0] * 3, abs=1e-9)
     assert [p.depression for p in poses] == pytest.approx(
-        [math.degrees(math.atan2(70.0, d)) for d in (300, 200, 100)])
+        [math.degrees(math.atan2(70.0, d)) for d in (300, 200, 100)]
+    )
 
 
 @pytest.mark.parametrize("seed", range(5))
 def test_aim_at_points_the_central_ray_at_the_target(seed):
     rng = np.random.default_rng(seed)
-    pose = ScanPose(*rng.uniform(-500, 500, 2), rng.uniform(100, 400),
-                    heading=rng.uniform(0, 360), azimuth=rng.uniform(-180, 180), depression=30)
+    pose = ScanPose(
+        *rng.uniform(-500, 500, 2),
+        rng.uniform(100, 400),
+        heading=rng.uniform(0, 360),
+        azimuth=rng.uniform(-180, 180),
+        depression=30,
+    )
     target = (*rng.uniform(-500, 500, 2), rng.uniform(0, 20))
     aimed = aim_at(pose, target)
     assert aimed.position == pose.position and aimed.heading == pose.heading
@@ -293,8 +310,10 @@ def test_altitudes_people_ask_for_are_practical_and_headings_they_type_are_compa
 
     with pytest.raises(FieldError, match="at most 20000"):
         Orbit(centre=(0.0, 0.0, 0.0), radius=50.0, altitude=MAX_FLIGHT_ALTITUDE + 1, scans=4)
-    assert Orbit(centre=(0.0, 0.0, 0.0), radius=50.0, altitude=MAX_FLIGHT_ALTITUDE,
-                 scans=4).altitude == MAX_FLIGHT_ALTITUDE
+    assert (
+        Orbit(centre=(0.0, 0.0, 0.0), radius=50.0, altitude=MAX_FLIGHT_ALTITUDE, scans=4).altitude
+        == MAX_FLIGHT_ALTITUDE
+    )
     assert compass_field("heading", 360.0) == 360.0
     for bad in (400.0, -1.0):
         with pytest.raises(FieldError, match="from 0 to 360"):
@@ -306,8 +325,7 @@ def test_a_centre_too_near_the_horizon_is_blamed_on_the_distance_the_user_wrote(
 
     with pytest.raises(FieldError) as caught:
         orbit((0.0, 0.0, 0.0), 1e6, 100.0, 4)
-    assert caught.value.field == "radius" and "at most 5729 m at altitude 100 m" in str(
-        caught.value)
+    assert caught.value.field == "radius" and "at most 5729 m at altitude 100 m" in str(caught.value)
     with pytest.raises(FieldError) as caught:
         standoff_sweep((0.0, 0.0, 0.0), (50.0, 9000.0), 100.0)
     assert caught.value.field == "standoffs"
@@ -320,8 +338,10 @@ def test_the_scenario_file_names_the_radius_line(tmp_path):
     from ladartui.scenario import load_scenario
 
     path = tmp_path / "far.toml"
-    path.write_text('[files]\nscene = "scene.txt"\nvoxel_size = 1.0\n[[flight.segments]]\n'
-                    'kind = "orbit"\ncentre = [0.0, 0.0, 0.0]\nradius = 1e6\naltitude = 100.0\n'
-                    'scans = 4\n')
+    path.write_text(
+        '[files]\nscene = "scene.txt"\nvoxel_size = 1.0\n[[flight.segments]]\n'
+        'kind = "orbit"\ncentre = [0.0, 0.0, 0.0]\nradius = 1e6\naltitude = 100.0\n'
+        "scans = 4\n"
+    )
     with pytest.raises(FieldError, match=r"far.toml:7: flight.segments\[0\].radius"):
         load_scenario(path, check_files=False)

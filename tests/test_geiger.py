@@ -5,8 +5,14 @@ import math
 import numpy as np
 import pytest
 
-from ladartui.detection import (binomial_at_least, declare_points, fire_counts,
-                                noise_per_bin, optimal_energy_scale, uniform)
+from ladartui.detection import (
+    binomial_at_least,
+    declare_points,
+    fire_counts,
+    noise_per_bin,
+    optimal_energy_scale,
+    uniform,
+)
 
 PULSES = 4000
 
@@ -53,8 +59,9 @@ def test_coincidence_matches_binomial_sum():
     counts = fire_counts(np.full((detectors, 1), n), pulses, dead_bins=1, seed=9)
     declared = declare_points(counts, k)[:, 0]
     expected = binomial_at_least(pulses, k, p)
-    assert expected == pytest.approx(1 - sum(math.comb(pulses, j) * p ** j * (1 - p) ** (pulses - j)
-                                             for j in range(k)))
+    assert expected == pytest.approx(
+        1 - sum(math.comb(pulses, j) * p**j * (1 - p) ** (pulses - j) for j in range(k))
+    )
     _within_3_sigma(declared.mean(), expected, detectors)
 
 
@@ -75,6 +82,7 @@ def test_same_seed_same_result_and_detector_subsets_agree():
 
 def test_same_seed_identical_with_one_and_two_threads():
     import numba
+
     mean = np.random.default_rng(1).uniform(0, 1, size=(128, 16))
     before = numba.get_num_threads()
     try:
@@ -114,37 +122,85 @@ def test_energy_sweep_finds_published_optimum(ratio):
 
 def test_look_sums_ray_signal_into_bins_and_counts_false_alarms():
     from ladartui.detection.look import geiger_look
+
     # Detector 0: two rays on foliage at 100 m, two on the target at 103 m.
     # Detector 1: nothing but noise beyond its one ground ray.
     detector = np.array([0, 0, 0, 0, 1, 1, 1, 1])
     kind = np.array([1, 1, 1, 1, 2, 0, 0, 0])
     ranges = np.array([100.0, 100.2, 103.0, 103.4, 105.0, np.inf, np.inf, np.inf])
     refl = np.array([0.5, 0.5, 0.3, 0.3, 0.2, 0, 0, 0])
-    look = geiger_look(detector, kind, ranges, refl, np.ones(8), rays_per_detector=4,
-                       n_ref=2.0, range_ref=100.0, reflectance_ref=0.5, noise=0.0,
-                       bin_width=1.0, pulses=200, threshold=1, dead_bins=6, seed=1, scan=0)
+    look = geiger_look(
+        detector,
+        kind,
+        ranges,
+        refl,
+        np.ones(8),
+        rays_per_detector=4,
+        n_ref=2.0,
+        range_ref=100.0,
+        reflectance_ref=0.5,
+        noise=0.0,
+        bin_width=1.0,
+        pulses=200,
+        threshold=1,
+        dead_bins=6,
+        seed=1,
+        scan=0,
+    )
     assert look.gate_start == 100.0 and look.mean_counts.shape == (2, 6)
     assert look.mean_counts[0, 0] == pytest.approx(2 * 0.5 * 1.0 * (100 / 100.2) ** 2 / 2 + 0.5)
     assert look.mean_counts[0, 3] == pytest.approx(2 * 0.25 * 0.6 * ((100 / 103) ** 2 + (100 / 103.4) ** 2))
     assert look.false_alarms == 0  # no noise, so only surfaces fire
     assert look.ray_declared[:5].all() and not look.ray_declared[5:].any()
-    noisy = geiger_look(detector, kind, ranges, refl, np.ones(8), rays_per_detector=4,
-                        n_ref=2.0, range_ref=100.0, reflectance_ref=0.5, noise=0.05,
-                        bin_width=1.0, pulses=200, threshold=1, dead_bins=1, seed=1, scan=0)
+    noisy = geiger_look(
+        detector,
+        kind,
+        ranges,
+        refl,
+        np.ones(8),
+        rays_per_detector=4,
+        n_ref=2.0,
+        range_ref=100.0,
+        reflectance_ref=0.5,
+        noise=0.05,
+        bin_width=1.0,
+        pulses=200,
+        threshold=1,
+        dead_bins=1,
+        seed=1,
+        scan=0,
+    )
     assert noisy.false_alarms > 0
-    strict = geiger_look(detector, kind, ranges, refl, np.ones(8), rays_per_detector=4,
-                         n_ref=2.0, range_ref=100.0, reflectance_ref=0.5, noise=0.05,
-                         bin_width=1.0, pulses=200, threshold=60, dead_bins=1, seed=1, scan=0)
+    strict = geiger_look(
+        detector,
+        kind,
+        ranges,
+        refl,
+        np.ones(8),
+        rays_per_detector=4,
+        n_ref=2.0,
+        range_ref=100.0,
+        reflectance_ref=0.5,
+        noise=0.05,
+        bin_width=1.0,
+        pulses=200,
+        threshold=60,
+        dead_bins=1,
+        seed=1,
+        scan=0,
+    )
     assert strict.false_alarms == 0
 
 
 def test_incidence_cosine_of_nadir_and_slanted_rays():
     from ladartui.detection.look import incidence_cosines
+
     d = np.array([[0, 0, -1.0], [np.sin(0.5), 0, -np.cos(0.5)]])
     o = np.array([[2.0, 2.0, 10.0], [2.0, 2.0, 10.0]])
     # Ray 0 (cell z 10.5) meets voxel (2, 2, 3)'s top face (cell z = 4) after 6.5 cells.
-    cos = incidence_cosines(o, d, np.array([1, 2]), np.array([[2, 2, 3], [0, 0, 0]]),
-                            np.array([6.5, 10.5 / np.cos(0.5)]), 1.0)
+    cos = incidence_cosines(
+        o, d, np.array([1, 2]), np.array([[2, 2, 3], [0, 0, 0]]), np.array([6.5, 10.5 / np.cos(0.5)]), 1.0
+    )
     assert cos[0] == pytest.approx(1.0) and cos[1] == pytest.approx(np.cos(0.5))
 
 
@@ -152,8 +208,10 @@ def test_settings_and_cli_reject_bad_values(capsys):
     from ladartui.cli import main
     from ladartui.detection.settings import DetectionSettings
     from ladartui.errors import FieldError
-    with pytest.raises(FieldError,
-                       match=r"detection.reflectance_target = 1.5: expected a number from 0 to 1"):
+
+    with pytest.raises(
+        FieldError, match=r"detection.reflectance_target = 1.5: expected a number from 0 to 1"
+    ):
         DetectionSettings(reflectance_target=1.5)
     # k keeps the share coincidence / pulses (10 of 100 by default), at least 1.
     settings = DetectionSettings()

@@ -20,16 +20,25 @@ from ladartui.simulation import simulate
 
 @pytest.fixture
 def woods(tmp_path):
-    target = np.array([(x, y, z) for x in range(8, 12) for y in range(8, 11) for z in range(2)],
-                      dtype=np.int32)
-    canopy = np.array([(x, y, 6) for x in range(4, 16) for y in range(4, 15) if (x + 2 * y) % 3],
-                      dtype=np.int32)
+    target = np.array(
+        [(x, y, z) for x in range(8, 12) for y in range(8, 11) for z in range(2)], dtype=np.int32
+    )
+    canopy = np.array(
+        [(x, y, 6) for x in range(4, 16) for y in range(4, 15) if (x + 2 * y) % 3], dtype=np.int32
+    )
     save_voxels(tmp_path / "woods.txt", np.vstack([target, canopy]))
     save_voxels(tmp_path / "woods_Target.txt", target)
-    poses = tuple(aim_at(ScanPose(x, y, 40.0), (9.5, 9.0, 0.5))
-                  for x, y in [(9.5, -10.0), (29.5, 9.0), (-5.0, 20.0)])
-    return Scenario(tmp_path / "S.toml", "woods.txt", 1.0, Sensor(grid=16, ray_grid=2, fov=20.0),
-                    FlightPlan(segments=[Manual(poses)]), backend="numba")
+    poses = tuple(
+        aim_at(ScanPose(x, y, 40.0), (9.5, 9.0, 0.5)) for x, y in [(9.5, -10.0), (29.5, 9.0), (-5.0, 20.0)]
+    )
+    return Scenario(
+        tmp_path / "S.toml",
+        "woods.txt",
+        1.0,
+        Sensor(grid=16, ray_grid=2, fov=20.0),
+        FlightPlan(segments=[Manual(poses)]),
+        backend="numba",
+    )
 
 
 def _geiger(scenario, **settings):
@@ -37,15 +46,18 @@ def _geiger(scenario, **settings):
 
 
 def _outputs(scenario):
-    return [p.read_bytes() for p in (scenario.scene_output, scenario.target_output,
-                                     scenario.measures_file)]
+    return [p.read_bytes() for p in (scenario.scene_output, scenario.target_output, scenario.measures_file)]
 
 
 def test_certain_detection_gives_the_ideal_outputs(woods):
     ideal = simulate(woods, write=False)
     # Huge signal, no noise, a detector that re-arms after each bin: every return declared.
-    certain = simulate(_geiger(woods, n_ref=1e6, dark_rate_hz=0.0, solar_rate_hz=0.0,
-                               dead_time_m=1.0, pulses=3, coincidence=3), write=False)
+    certain = simulate(
+        _geiger(
+            woods, n_ref=1e6, dark_rate_hz=0.0, solar_rate_hz=0.0, dead_time_m=1.0, pulses=3, coincidence=3
+        ),
+        write=False,
+    )
     np.testing.assert_array_equal(certain.scene_output, ideal.scene_output)
     np.testing.assert_array_equal(certain.target_output, ideal.target_output)
     d = certain.measures.detection
@@ -56,8 +68,7 @@ def test_certain_detection_gives_the_ideal_outputs(woods):
 
 def test_weak_signal_and_noise_lose_coverage_and_add_false_alarms(woods):
     ideal = simulate(woods, write=False)
-    run = simulate(_geiger(woods, n_ref=0.5, solar_rate_hz=3e7, pulses=1, coincidence=1),
-                   write=False)
+    run = simulate(_geiger(woods, n_ref=0.5, solar_rate_hz=3e7, pulses=1, coincidence=1), write=False)
     d = run.measures.detection
     assert d.false_alarms > 0 and 0 < d.false_alarm_probability < 1
     assert d.target_detection < 1.0
@@ -74,7 +85,10 @@ def test_run_agrees_with_the_pulse_study_row(woods):
     d = run.measures.detection
     assert row.threshold == 2
     assert (row.obscured_coverage, row.false_alarms, row.declared_points) == (
-        run.measures.obscured_coverage, d.false_alarms, d.declared_points)
+        run.measures.obscured_coverage,
+        d.false_alarms,
+        d.declared_points,
+    )
     assert row.target_detection == d.target_detection and ideal == d.ideal_obscured_coverage
 
 
@@ -109,8 +123,12 @@ def test_same_seed_same_answer_over_threads_and_chunks(woods, monkeypatch):
     monkeypatch.setattr(simulation, "_MAX_CHUNK_RAYS", 256)
     simulate(scenario)
     assert _outputs(scenario) == one
-    other_seed = simulate(scenario.with_changes(detection=DetectionSettings(
-        model="geiger", pulses=20, coincidence=3, solar_rate_hz=1e7, seed=124)), write=False)
+    other_seed = simulate(
+        scenario.with_changes(
+            detection=DetectionSettings(model="geiger", pulses=20, coincidence=3, solar_rate_hz=1e7, seed=124)
+        ),
+        write=False,
+    )
     assert other_seed.measures.detection != read_cmf(scenario.measures_file).detection
 
 

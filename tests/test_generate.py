@@ -65,8 +65,9 @@ def test_target_is_under_canopy(small):
     target = as_set(small.target)
     columns = {(x, y) for x, y, _ in target}
     top_of_target = small.target[:, 2].max()
-    covered = sum(1 for x, y in columns
-                  if any((x, y, z) in scene for z in range(top_of_target + 1, small.shape[2])))
+    covered = sum(
+        1 for x, y in columns if any((x, y, z) in scene for z in range(top_of_target + 1, small.shape[2]))
+    )
     assert covered / len(columns) > 0.5
 
 
@@ -92,10 +93,12 @@ def test_density_controls_foliage():
     sparse = generate_scene("small", seed=4, density=0.3)
     dense = generate_scene("small", seed=4, density=0.9)
     assert dense.parts["foliage"] > 2 * sparse.parts["foliage"]
+
     def empty_columns(g):
         heights = np.full(g.shape[:2], -1)
         np.maximum.at(heights, (g.voxels[:, 0], g.voxels[:, 1]), g.voxels[:, 2])
         return np.mean(heights < 0)
+
     assert empty_columns(dense) < empty_columns(sparse)
 
 
@@ -203,6 +206,8 @@ def test_reference_preset_matches_the_reports_figure_11_scale():
     assert 3.4e6 < len(scene.voxels) < 4.2e6
     assert np.isin(packed(scene.target), packed(scene.voxels)).all()
     # Sparse structure estimate: 64 B per 8^3 brick, 2 KiB per 64^3 tile and 512^3 region.
-    nbytes = count_cells(scene.voxels, 3) * 64 + (count_cells(scene.voxels, 6)
-                                                  + count_cells(scene.voxels, 9)) * 2048
+    nbytes = (
+        count_cells(scene.voxels, 3) * 64
+        + (count_cells(scene.voxels, 6) + count_cells(scene.voxels, 9)) * 2048
+    )
     assert nbytes < 32 * 2**20

@@ -13,8 +13,9 @@ from ladartui.measures import CMF_HEADER, Measures, compute_measures, read_cmf, 
 
 def box(nx, ny, nz, origin=(0, 0, 0)):
     ox, oy, oz = origin
-    return np.array([(ox + i, oy + j, oz + k) for i in range(nx) for j in range(ny) for k in range(nz)],
-                    dtype=np.int32)
+    return np.array(
+        [(ox + i, oy + j, oz + k) for i in range(nx) for j in range(ny) for k in range(nz)], dtype=np.int32
+    )
 
 
 def top_layer(voxels):
@@ -88,8 +89,13 @@ def test_nothing_seen_and_empty_target_are_undefined_without_warnings():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         nothing = compute_measures(target, np.zeros((0, 3)), np.zeros((0, 3)))
-        empty = compute_measures(np.zeros((0, 3)), np.zeros((0, 3)), np.zeros((0, 3)),
-                                 scene_per_scan=[np.zeros((0, 3))], target_per_scan=[np.zeros((0, 3))])
+        empty = compute_measures(
+            np.zeros((0, 3)),
+            np.zeros((0, 3)),
+            np.zeros((0, 3)),
+            scene_per_scan=[np.zeros((0, 3))],
+            target_per_scan=[np.zeros((0, 3))],
+        )
     assert nothing.obscured_coverage == 0.0
     assert nothing.obscured_directions.mean_direction is None
     assert nothing.missed_share is None and nothing.coverage_ratio is None
@@ -125,11 +131,22 @@ def test_difference_from_the_ideal_and_direction_shift():
 
 def test_coverage_after_each_scan_is_cumulative():
     target = box(2, 2, 1)  # four voxels
-    scans = [np.array([[0, 0, 0], [9, 9, 0]]), np.array([[0, 0, 0], [1, 0, 0]]),
-             np.zeros((0, 3)), np.array([[0, 1, 0], [1, 1, 0]])]
+    scans = [
+        np.array([[0, 0, 0], [9, 9, 0]]),
+        np.array([[0, 0, 0], [1, 0, 0]]),
+        np.zeros((0, 3)),
+        np.array([[0, 1, 0], [1, 1, 0]]),
+    ]
     ideal = [target, target, target, target]
-    measures = compute_measures(target, np.vstack(scans), target, scene_per_scan=scans,
-                                target_per_scan=ideal, path_length_m=1200.0, flight_time_s=30.0)
+    measures = compute_measures(
+        target,
+        np.vstack(scans),
+        target,
+        scene_per_scan=scans,
+        target_per_scan=ideal,
+        path_length_m=1200.0,
+        flight_time_s=30.0,
+    )
     assert measures.obscured_after_scan == (0.25, 0.5, 0.5, 1.0)
     assert measures.unobscured_after_scan == (1.0, 1.0, 1.0, 1.0)
     assert measures.scans == 4
@@ -141,9 +158,16 @@ def test_coverage_after_each_scan_is_cumulative():
 def test_cmf_round_trip(tmp_path):
     target = box(4, 3, 3)
     scans = [top_layer(target)[:5], target[target[:, 1] == 0]]
-    measures = compute_measures(target, np.vstack(scans), target[target[:, 2] >= 1], scene_per_scan=scans,
-                                target_per_scan=[target[target[:, 2] >= 1], np.zeros((0, 3))],
-                                path_length_m=314.159, flight_time_s=12.5, voxel_size=0.25)
+    measures = compute_measures(
+        target,
+        np.vstack(scans),
+        target[target[:, 2] >= 1],
+        scene_per_scan=scans,
+        target_per_scan=[target[target[:, 2] >= 1], np.zeros((0, 3))],
+        path_length_m=314.159,
+        flight_time_s=12.5,
+        voxel_size=0.25,
+    )
     path = tmp_path / "S.cmf"
     measures.write_cmf(path)
     text = path.read_text()
@@ -160,8 +184,17 @@ def test_cmf_round_trip(tmp_path):
 
 def test_bad_cmf_names_the_line(tmp_path):
     path = tmp_path / "bad.cmf"
-    good = compute_measures(box(2, 2, 2), box(2, 2, 2), box(2, 2, 2), scene_per_scan=[box(2, 2, 2)] * 2,
-                            target_per_scan=[box(2, 2, 2)] * 2).to_cmf().splitlines()
+    good = (
+        compute_measures(
+            box(2, 2, 2),
+            box(2, 2, 2),
+            box(2, 2, 2),
+            scene_per_scan=[box(2, 2, 2)] * 2,
+            target_per_scan=[box(2, 2, 2)] * 2,
+        )
+        .to_cmf()
+        .splitlines()
+    )
     bad = [line if not line.startswith("target_voxels") else "target_voxels = many" for line in good]
     path.write_text("\n".join(bad) + "\n")
     with pytest.raises(InputFileError) as error:

@@ -70,12 +70,15 @@ def test_same_content_in_a_larger_extent_costs_no_more_memory():
     assert far.contains(vox + [5000, 6000, 0]).all()
 
 
-@pytest.mark.parametrize("bad, shape", [
-    (np.zeros((4, 2), int), (5, 5, 5)),
-    (np.zeros((4, 3), float), (5, 5, 5)),
-    (np.array([[0, 0, 5]]), (5, 5, 5)),
-    (np.array([[-1, 0, 0]]), (5, 5, 5)),
-])
+@pytest.mark.parametrize(
+    "bad, shape",
+    [
+        (np.zeros((4, 2), int), (5, 5, 5)),
+        (np.zeros((4, 3), float), (5, 5, 5)),
+        (np.array([[0, 0, 5]]), (5, 5, 5)),
+        (np.array([[-1, 0, 0]]), (5, 5, 5)),
+    ],
+)
 def test_bad_voxel_lists_are_field_errors(bad, shape):
     with pytest.raises(FieldError):
         Occupancy.build(bad, shape)
@@ -89,6 +92,6 @@ def test_column_tops_give_the_highest_brick_of_each_brick_column():
     q = (vox - occ.root_origin) >> 3
     width = 64 * int(occ.root_dims[0])
     expected = np.zeros(len(occ.columns), np.int64)
-    for (qx, qy, qz) in q.tolist():
+    for qx, qy, qz in q.tolist():
         expected[qx + width * qy] = max(expected[qx + width * qy], qz + 1)
     assert np.array_equal(occ.columns, expected)

@@ -17,13 +17,13 @@ from pathlib import Path
 
 import pytest
 
-from ladartui.user_data import default_scenario_path
 from ladartui.measures import compute_measures
 from ladartui.scenario import load_scenario
 from ladartui.scene.voxels import save_voxels
 from ladartui.sensor import Sensor
 from ladartui.simulation import fuse_scans, scan_returns, simulate
 from ladartui.tracing import trace
+from ladartui.user_data import default_scenario_path
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "scenarios"
 
@@ -49,14 +49,19 @@ def _copy(name, tmp_path, small_scene, extra=""):
     path.write_text(text, encoding="utf-8")
     scenario = load_scenario(path)
     s = scenario.sensor
-    small = Sensor(grid=24, ray_grid=2, fov=s.fov, depth_resolution=s.depth_resolution,
-                   pixel_pitch=s.pixel_pitch, mount=s.mount)
+    small = Sensor(
+        grid=24,
+        ray_grid=2,
+        fov=s.fov,
+        depth_resolution=s.depth_resolution,
+        pixel_pitch=s.pixel_pitch,
+        mount=s.mount,
+    )
     return scenario.with_changes(sensor=small, backend="numba")
 
 
 def _files(scenario):
-    return [p.read_bytes() for p in (scenario.scene_output, scenario.target_output,
-                                     scenario.measures_file)]
+    return [p.read_bytes() for p in (scenario.scene_output, scenario.target_output, scenario.measures_file)]
 
 
 def _ideal_by_hand(scenario, folder):
@@ -66,17 +71,28 @@ def _ideal_by_hand(scenario, folder):
     for pose in scenario.poses():
         origins, directions, detector = scenario.sensor.rays(pose)
         for run, occupancy in (("scene", scene.occupancy), ("target", scene.target_occupancy)):
-            hits = trace(occupancy, origins, directions, voxel_size=scene.voxel_size,
-                         backend="numba", method=scenario.method, step=scenario.step,
-                         precision=scenario.precision)
+            hits = trace(
+                occupancy,
+                origins,
+                directions,
+                voxel_size=scene.voxel_size,
+                backend="numba",
+                method=scenario.method,
+                step=scenario.step,
+                precision=scenario.precision,
+            )
             per_scan[run].append(scan_returns(hits, detector, scenario.sensor.depth_resolution))
     scene_output, target_output = fuse_scans(per_scan["scene"]), fuse_scans(per_scan["target"])
-    measures = compute_measures(scene.target, scene_output, target_output,
-                                scene_per_scan=per_scan["scene"],
-                                target_per_scan=per_scan["target"],
-                                path_length_m=scenario.path_length(),
-                                flight_time_s=scenario.flight_time(),
-                                voxel_size=scene.voxel_size)
+    measures = compute_measures(
+        scene.target,
+        scene_output,
+        target_output,
+        scene_per_scan=per_scan["scene"],
+        target_per_scan=per_scan["target"],
+        path_length_m=scenario.path_length(),
+        flight_time_s=scenario.flight_time(),
+        voxel_size=scene.voxel_size,
+    )
     folder.mkdir()
     save_voxels(folder / "scene.txt", scene_output)
     save_voxels(folder / "target.txt", target_output)
@@ -87,10 +103,8 @@ def _ideal_by_hand(scenario, folder):
 @pytest.mark.parametrize("name", ["default", "orbit", "flypast", "standoff", "manoeuvres"])
 def test_options_off_are_byte_identical(name, tmp_path, small_scene):
     absent = _copy(name, tmp_path / "absent", small_scene)
-    explicit = _copy(name, tmp_path / "explicit", small_scene,
-                     extra='\n[detection]\nmodel = "ideal"\n')
-    explicit = explicit.with_changes(sensor=Sensor(**{**vars(explicit.sensor),
-                                                      "mount": "stabilised"}))
+    explicit = _copy(name, tmp_path / "explicit", small_scene, extra='\n[detection]\nmodel = "ideal"\n')
+    explicit = explicit.with_changes(sensor=Sensor(**{**vars(explicit.sensor), "mount": "stabilised"}))
     assert absent.detection is None and explicit.detection.model == "ideal"
 
     result = simulate(absent)

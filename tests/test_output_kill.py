@@ -37,8 +37,7 @@ PAUSING_RUN = textwrap.dedent("""
 
 
 def digest(scenario):
-    return [hashlib.sha256(p.read_bytes()).hexdigest() if p.is_file() else None
-            for p in outputs_of(scenario)]
+    return [hashlib.sha256(p.read_bytes()).hexdigest() if p.is_file() else None for p in outputs_of(scenario)]
 
 
 @pytest.fixture(scope="module")
@@ -53,16 +52,20 @@ def new_set(tmp_path_factory):
 POINTS = [("temporaries", 1), ("swap", 2), ("backups", 1)]
 
 
-@pytest.mark.parametrize("sig", [signal.SIGKILL, signal.SIGINT, signal.SIGTERM],
-                         ids=["SIGKILL", "SIGINT", "SIGTERM"])
+@pytest.mark.parametrize(
+    "sig", [signal.SIGKILL, signal.SIGINT, signal.SIGTERM], ids=["SIGKILL", "SIGINT", "SIGTERM"]
+)
 @pytest.mark.parametrize("step, occurrence", POINTS, ids=[p[0] for p in POINTS])
 def test_killed_run_leaves_one_set(tmp_path, new_set, sig, step, occurrence):
     scenario = make_scenario(tmp_path / "s")
     write_old_set(scenario)
     old_set = digest(scenario)
-    process = subprocess.Popen([sys.executable, "-c", PAUSING_RUN, step, str(occurrence),
-                                str(scenario.path)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                               text=True)
+    process = subprocess.Popen(
+        [sys.executable, "-c", PAUSING_RUN, step, str(occurrence), str(scenario.path)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     assert process.stdout.readline().strip() == "paused"
     process.send_signal(sig)
     out, err = process.communicate(timeout=60)

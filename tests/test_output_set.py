@@ -17,16 +17,24 @@ from ladartui.simulation import _output_set, simulate
 
 
 def make_scenario(folder):
-    target = np.array([(x, y, z) for x in range(8, 12) for y in range(8, 11) for z in range(2)],
-                      dtype=np.int32)
-    canopy = np.array([(x, y, 6) for x in range(6, 14) for y in range(6, 13) if (x + 2 * y) % 3],
-                      dtype=np.int32)
+    target = np.array(
+        [(x, y, z) for x in range(8, 12) for y in range(8, 11) for z in range(2)], dtype=np.int32
+    )
+    canopy = np.array(
+        [(x, y, 6) for x in range(6, 14) for y in range(6, 13) if (x + 2 * y) % 3], dtype=np.int32
+    )
     folder.mkdir(parents=True, exist_ok=True)
     save_voxels(folder / "woods.txt", np.vstack([target, canopy]))
     save_voxels(folder / "woods_Target.txt", target)
     poses = tuple(aim_at(ScanPose(x, y, 40.0), (9.5, 9.0, 0.5)) for x, y in [(9.5, -10.0), (29.5, 9.0)])
-    return Scenario(folder / "S.toml", "woods.txt", 1.0, Sensor(grid=16, ray_grid=2, fov=20.0),
-                    FlightPlan(segments=[Manual(poses)]), backend="numba").save()
+    return Scenario(
+        folder / "S.toml",
+        "woods.txt",
+        1.0,
+        Sensor(grid=16, ray_grid=2, fov=20.0),
+        FlightPlan(segments=[Manual(poses)]),
+        backend="numba",
+    ).save()
 
 
 def outputs_of(scenario):
@@ -117,8 +125,12 @@ def test_second_writer_is_refused(scenario, capsys):
 
 def test_stale_temporaries_are_removed_by_the_next_run(scenario):
     folder = scenario.path.parent
-    for name in (".S_Scene.txt.k1ll3d.tmp", "..S_Target.txt.x.tmp.y.tmp", ".S.cmf.123.old",
-                 ".S.outputs.lock.journal.tmp"):
+    for name in (
+        ".S_Scene.txt.k1ll3d.tmp",
+        "..S_Target.txt.x.tmp.y.tmp",
+        ".S.cmf.123.old",
+        ".S.outputs.lock.journal.tmp",
+    ):
         (folder / name).write_text("stale")
     (folder / ".other.tmp").write_text("not ours")
     simulate(scenario)
@@ -132,8 +144,9 @@ def test_half_done_swap_is_rolled_back(scenario, tmp_path):
     journal = lock.with_name(lock.name + ".journal")
     entries = []
     for path in paths:
-        entries.append({"path": str(path), "backup": str(path.with_name(f".{path.name}.1.old")),
-                        "existed": True})
+        entries.append(
+            {"path": str(path), "backup": str(path.with_name(f".{path.name}.1.old")), "existed": True}
+        )
     outputset._write_journal(journal, entries)
     # As a kill between renames leaves it: the first file new, the second in its backup.
     os.rename(paths[0], entries[0]["backup"])
@@ -144,10 +157,13 @@ def test_half_done_swap_is_rolled_back(scenario, tmp_path):
     assert hidden(scenario.path.parent) == []
 
 
-@pytest.mark.parametrize("problem, expected", [
-    (lambda p: p.mkdir(), "is a folder"),
-    (lambda p: None, None),
-])
+@pytest.mark.parametrize(
+    "problem, expected",
+    [
+        (lambda p: p.mkdir(), "is a folder"),
+        (lambda p: None, None),
+    ],
+)
 def test_output_problem(tmp_path, problem, expected):
     path = tmp_path / "out.txt"
     problem(path)
@@ -175,16 +191,40 @@ def test_trace_out_a_folder_is_refused_before_tracing(tmp_path, capsys):
     np.save(rays, np.array([[0, 0, 5, 0, 0, -1.0]]))
     save_voxels(tmp_path / "v.txt", np.zeros((1, 3), np.int32))
     (tmp_path / "hits.npy").mkdir()
-    assert main(["trace", "--scene", str(tmp_path / "v.txt"), "--rays", str(rays),
-                 "--out", str(tmp_path / "hits.npy")]) == 2
+    assert (
+        main(
+            [
+                "trace",
+                "--scene",
+                str(tmp_path / "v.txt"),
+                "--rays",
+                str(rays),
+                "--out",
+                str(tmp_path / "hits.npy"),
+            ]
+        )
+        == 2
+    )
     assert "hits.npy: is a folder" in last_error_line(capsys)
 
 
 def test_trace_of_an_empty_npy_is_one_line(tmp_path, capsys):
     (tmp_path / "rays.npy").write_bytes(b"")
     save_voxels(tmp_path / "v.txt", np.zeros((1, 3), np.int32))
-    assert main(["trace", "--scene", str(tmp_path / "v.txt"), "--rays", str(tmp_path / "rays.npy"),
-                 "--out", str(tmp_path / "hits.npy")]) == 2
+    assert (
+        main(
+            [
+                "trace",
+                "--scene",
+                str(tmp_path / "v.txt"),
+                "--rays",
+                str(tmp_path / "rays.npy"),
+                "--out",
+                str(tmp_path / "hits.npy"),
+            ]
+        )
+        == 2
+    )
     assert "rays.npy: empty or cut short" in last_error_line(capsys)
 
 

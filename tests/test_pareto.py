@@ -22,8 +22,7 @@ def test_two_and_three_objective_fronts_match_a_pairwise_check_with_ties_and_gap
     gaps = [None, (float("nan"), 1.0), (1.0, None)]
     for k in (2, 3):
         for _ in range(300):
-            points = [tuple(float(rng.randint(0, 4)) for _ in range(k))
-                      for _ in range(rng.randint(0, 15))]
+            points = [tuple(float(rng.randint(0, 4)) for _ in range(k)) for _ in range(rng.randint(0, 15))]
             points += rng.sample(gaps, rng.randint(0, 3))
             rng.shuffle(points)
             assert pareto_front(points) == _brute_force(points)
@@ -32,8 +31,7 @@ def test_two_and_three_objective_fronts_match_a_pairwise_check_with_ties_and_gap
 def test_identical_points_share_the_front_under_both_orientations():
     assert pareto_front([(2, 2), (2, 2), (3, 3)]) == [True, True, False]
     # Sweeps maximise coverage: (cost 1, coverage 0.5) twice, both beat (1, 0.4).
-    assert sweep_front([(1, 0.5), (1, 0.5), (1, 0.4), (1, float("nan"))]) == [
-        True, True, False, False]
+    assert sweep_front([(1, 0.5), (1, 0.5), (1, 0.4), (1, float("nan"))]) == [True, True, False, False]
 
 
 def test_dominator_is_the_cheapest_front_point_that_dominates():

@@ -20,8 +20,9 @@ from ladartui.sweep.spec import load_sweep_spec
 
 # More examples for a long search by hand: LADARTUI_FUZZ_EXAMPLES=2000.
 EXAMPLES = int(os.environ.get("LADARTUI_FUZZ_EXAMPLES", "60"))
-FUZZ = settings(max_examples=EXAMPLES, deadline=None, derandomize=True,
-                suppress_health_check=list(HealthCheck))
+FUZZ = settings(
+    max_examples=EXAMPLES, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck)
+)
 
 
 def assert_one_line(error):
@@ -37,19 +38,22 @@ def one_error_line(capsys):
 
 # ---------------------------------------------------------------- regressions
 
+
 def test_voxel_index_of_4301_digits(tmp_path):
     path = tmp_path / "big.txt"
     path.write_text("0,0," + "9" * 4301 + "\n")
-    with pytest.raises(LadarError, match=r"big.txt:1: z = 999999999999\.\.\.\(4301 digits\) is "
-                       "too large") as caught:
+    with pytest.raises(
+        LadarError,
+        match=r"big.txt:1: z = 999999999999\.\.\.\(4301 digits\) is "
+        "too large",
+    ) as caught:
         load_voxels(path)
     assert len(str(caught.value)) < 200
 
 
 def test_segment_kind_a_list(tmp_path):
     with pytest.raises(LadarError, match=r"flight.segments\[0\].kind = \[\]: expected one of"):
-        scenario_from_toml('[files]\nscene = "s.txt"\n[[flight.segments]]\nkind = []\n',
-                           tmp_path / "k.toml")
+        scenario_from_toml('[files]\nscene = "s.txt"\n[[flight.segments]]\nkind = []\n', tmp_path / "k.toml")
 
 
 def test_arrays_nested_1000_deep(tmp_path):
@@ -68,15 +72,21 @@ def test_file_name_of_5000_characters(tmp_path, capsys):
     assert len(err) < 1000
 
 
-@pytest.mark.parametrize("rule, key", [
-    ("radius = { min = -1e308, max = 1e308 }", "random.radius"),
-    ("scans = { min = 1, max = 1e300 }", "random.scans"),
-])
+@pytest.mark.parametrize(
+    "rule, key",
+    [
+        ("radius = { min = -1e308, max = 1e308 }", "random.radius"),
+        ("scans = { min = 1, max = 1e300 }", "random.scans"),
+    ],
+)
 def test_random_bounds_that_overflow(tmp_path, rule, key):
     spec = tmp_path / "spec.toml"
     spec.write_text(f'[sweep]\nscenario = "default"\n[random]\nsamples = 3\n{rule}\n')
-    with pytest.raises(LadarError, match=rf"spec.toml:5: {key}: expected numbers with min <= max, "
-                       "within"):
+    with pytest.raises(
+        LadarError,
+        match=rf"spec.toml:5: {key}: expected numbers with min <= max, "
+        "within",
+    ):
         load_sweep_spec(spec)
 
 
@@ -116,9 +126,37 @@ seed = 1
 altitude = { min = 20, max = 40 }
 """
 # Tokens a careless or hostile hand puts in these files.
-TOKENS = ["", "0", "-1", "1e308", "-1e308", "nan", "inf", "9" * 30, "2147483647", "\r", "\t",
-          "\x00", "\x1b]0;x\x07", "[/oops]", "[", "]", "{", "}", "=", ",", '"', "'", "\n",
-          "[]", "{}", "true", "é", "\ufeff", " "]
+TOKENS = [
+    "",
+    "0",
+    "-1",
+    "1e308",
+    "-1e308",
+    "nan",
+    "inf",
+    "9" * 30,
+    "2147483647",
+    "\r",
+    "\t",
+    "\x00",
+    "\x1b]0;x\x07",
+    "[/oops]",
+    "[",
+    "]",
+    "{",
+    "}",
+    "=",
+    ",",
+    '"',
+    "'",
+    "\n",
+    "[]",
+    "{}",
+    "true",
+    "é",
+    "\ufeff",
+    " ",
+]
 
 
 @st.composite
@@ -177,13 +215,38 @@ def test_fuzz_sweep_spec(scene_folder, text):
         assert_one_line(error)
 
 
-@settings(max_examples=max(1, EXAMPLES * 2 // 3), deadline=None, derandomize=True,
-          suppress_health_check=list(HealthCheck))
-@given(command=st.sampled_from(["validate", "info", "run", "sweep", "trace"]),
-       words=st.lists(st.one_of(st.sampled_from(["--step", "--backend", "--max-rays", "--out",
-                                                 "--precision", "--method", "--rays", "--scene",
-                                                 "-1", "nan", "1e400", "--", "-"]),
-                                st.sampled_from(TOKENS)), max_size=4))
+@settings(
+    max_examples=max(1, EXAMPLES * 2 // 3),
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=list(HealthCheck),
+)
+@given(
+    command=st.sampled_from(["validate", "info", "run", "sweep", "trace"]),
+    words=st.lists(
+        st.one_of(
+            st.sampled_from(
+                [
+                    "--step",
+                    "--backend",
+                    "--max-rays",
+                    "--out",
+                    "--precision",
+                    "--method",
+                    "--rays",
+                    "--scene",
+                    "-1",
+                    "nan",
+                    "1e400",
+                    "--",
+                    "-",
+                ]
+            ),
+            st.sampled_from(TOKENS),
+        ),
+        max_size=4,
+    ),
+)
 def test_fuzz_command_line(scene_folder, capsys, command, words):
     # Only bad invocations: a missing or broken scenario file keeps each one cheap.
     argv = [command, str(scene_folder / "missing.toml"), *words]
@@ -200,20 +263,27 @@ def test_fuzz_command_line(scene_folder, capsys, command, words):
 
 # ---------------------------------------------------------------- model files
 
-@pytest.mark.parametrize("text, rows", [
-    (b"0,0,0\r\n1,2,3\r\n", [[0, 0, 0], [1, 2, 3]]),  # Windows line ends are fine
-    (b"1 , 2 ,3\n4,5,6\r", [[1, 2, 3], [4, 5, 6]]),
-])
+
+@pytest.mark.parametrize(
+    "text, rows",
+    [
+        (b"0,0,0\r\n1,2,3\r\n", [[0, 0, 0], [1, 2, 3]]),  # Windows line ends are fine
+        (b"1 , 2 ,3\n4,5,6\r", [[1, 2, 3], [4, 5, 6]]),
+    ],
+)
 def test_crlf_line_ends_are_read(tmp_path, text, rows):
     (tmp_path / "v.txt").write_bytes(text)
     assert load_voxels(tmp_path / "v.txt").tolist() == rows
 
 
-@pytest.mark.parametrize("text, message", [
-    (b"0,0,0\n1,2\r,3\n", r"v.txt:2: stray carriage return \(\\r\) in '1,2\\r,3'"),
-    (b"0,0,0\n1,\r2,3\n", r"v.txt:2: stray carriage return"),
-    (b"0,0,0\n\r\r\n1,1,1\n", r"v.txt:2: stray carriage return"),
-])
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        (b"0,0,0\n1,2\r,3\n", r"v.txt:2: stray carriage return \(\\r\) in '1,2\\r,3'"),
+        (b"0,0,0\n1,\r2,3\n", r"v.txt:2: stray carriage return"),
+        (b"0,0,0\n\r\r\n1,1,1\n", r"v.txt:2: stray carriage return"),
+    ],
+)
 def test_stray_carriage_return_is_an_error(tmp_path, text, message):
     (tmp_path / "v.txt").write_bytes(text)
     with pytest.raises(LadarError, match=message):
@@ -258,17 +328,20 @@ def las_with(tmp_path, offset, value):
     path = tmp_path / "c.las"
     export_las(path, voxels, 0.25)
     data = bytearray(path.read_bytes())
-    data[offset:offset + 8] = struct.pack("<d", value)  # x scale at 131, x offset at 155
+    data[offset : offset + 8] = struct.pack("<d", value)  # x scale at 131, x offset at 155
     path.write_bytes(bytes(data))
     return path
 
 
-@pytest.mark.parametrize("offset, value, message", [
-    (131, float("nan"), r"c.las: header scale factors \(nan, "),
-    (131, 0.0, r"c.las: header scale factors \(0, .*expected finite non-zero"),
-    (155, float("inf"), r"c.las: header offsets \(inf, 0, 0\): expected finite"),
-    (155, 1e308, r"c.las: header offsets \(1e\+308, .* too large for the scale factors"),
-])
+@pytest.mark.parametrize(
+    "offset, value, message",
+    [
+        (131, float("nan"), r"c.las: header scale factors \(nan, "),
+        (131, 0.0, r"c.las: header scale factors \(0, .*expected finite non-zero"),
+        (155, float("inf"), r"c.las: header offsets \(inf, 0, 0\): expected finite"),
+        (155, 1e308, r"c.las: header offsets \(1e\+308, .* too large for the scale factors"),
+    ],
+)
 def test_las_with_degenerate_scale_or_offset_is_refused(tmp_path, offset, value, message):
     from ladartui.scene.las import import_las
 

@@ -5,8 +5,7 @@ from __future__ import annotations
 from ladartui.recent import RECENT_LIMIT, config_folder, recent_scenarios, remember_scenario
 
 
-def test_the_newest_comes_first_without_duplicates_and_the_list_is_bounded(tmp_path,
-                                                                          monkeypatch):
+def test_the_newest_comes_first_without_duplicates_and_the_list_is_bounded(tmp_path, monkeypatch):
     monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))
     files = []
     for n in range(RECENT_LIMIT + 3):

@@ -29,16 +29,17 @@ def test_a_box_target_seen_from_above_fills_its_pixels_in_the_target_colour():
     camera = framing.fit_camera(TOP, (np.zeros(3), np.array([39.0, 39, 0])), 80, 80, bounds)
     image = render([Layer(ground), Layer(target, colour.TARGET_RGB)], camera, 80, 80, bounds)
     # the projected cube box of the target: pixels whose centres lie inside it
-    row, col, _, scale = screen_coordinates(np.array([[9.5, 25.5, 3], [17.5, 19.5, 3]]),
-                                            camera, 80, 80, bounds)
+    row, col, _, scale = screen_coordinates(
+        np.array([[9.5, 25.5, 3], [17.5, 19.5, 3]]), camera, 80, 80, bounds
+    )
     assert scale == pytest.approx(80 * 0.9 / 40)  # the scene fills 90 % of the width
     r, c = np.mgrid[0:80, 0:80] + 0.5
     inside = (r > row[0] + 1) & (r < row[1] - 1) & (c > col[0] + 1) & (c < col[1] - 1)
     near = (r > row[0] - 1) & (r < row[1] + 1) & (c > col[0] - 1) & (c < col[1] + 1)
     magenta = is_rgb(image, colour.TARGET_RGB)
     assert inside.sum() > 100
-    assert magenta[inside].all()          # every pixel well inside the box
-    assert not magenta[~near].any()       # and none more than a pixel outside it
+    assert magenta[inside].all()  # every pixel well inside the box
+    assert not magenta[~near].any()  # and none more than a pixel outside it
     # north is up: the target (y 20..25 of 0..39) sits in the upper half
     assert row.mean() < 40 and col.mean() < 40
 
@@ -46,8 +47,10 @@ def test_a_box_target_seen_from_above_fills_its_pixels_in_the_target_colour():
 def test_the_depth_buffer_keeps_the_nearer_voxel_in_any_drawing_order():
     bounds = (np.zeros(3), np.array([4.0, 4.0, 4.0]))
     low, high = np.array([[2, 2, 0]]), np.array([[2, 2, 4]])
-    for layers in ([Layer(low, (255, 0, 0)), Layer(high, (0, 255, 0))],
-                   [Layer(high, (0, 255, 0)), Layer(low, (255, 0, 0))]):
+    for layers in (
+        [Layer(low, (255, 0, 0)), Layer(high, (0, 255, 0))],
+        [Layer(high, (0, 255, 0)), Layer(low, (255, 0, 0))],
+    ):
         from_above = render(layers, TOP, 20, 20, bounds)
         assert is_rgb(from_above, (0, 255, 0)).any() and not is_rgb(from_above, (255, 0, 0)).any()
         from_below = render(layers, Camera(180.0, -90.0), 20, 20, bounds)
@@ -64,7 +67,7 @@ def test_squares_grow_with_the_zoom_so_voxels_leave_no_gaps():
         camera = Camera(camera.azimuth, camera.elevation, camera.zoom * zoom / 3, 0, 0)
         image = render([Layer(floor, (200, 200, 200))], camera, 60, 60, bounds)
         rows, cols = np.nonzero(image.voxel_mask)
-        block = image.voxel_mask[rows.min():rows.max() + 1, cols.min():cols.max() + 1]
+        block = image.voxel_mask[rows.min() : rows.max() + 1, cols.min() : cols.max() + 1]
         assert block.all()  # a solid square, no holes between voxels
         assert block.shape[0] == pytest.approx(10 * 54 / 10 * zoom / 3, abs=2)
 
@@ -72,8 +75,7 @@ def test_squares_grow_with_the_zoom_so_voxels_leave_no_gaps():
 def test_zoomed_in_far_beyond_the_splat_budget_the_squares_still_cover_what_is_in_view():
     bounds = (np.zeros(3), np.array([299.0, 299.0, 0.0]))
     floor = box((0, 0, 0), (299, 299, 0))  # 90,000 voxels
-    camera = framing.fit_camera(TOP, (np.array([140.0, 140, 0]), np.array([149.0, 149, 0])),
-                                400, 400, bounds)
+    camera = framing.fit_camera(TOP, (np.array([140.0, 140, 0]), np.array([149.0, 149, 0])), 400, 400, bounds)
     image = render([Layer(floor, (200, 200, 200))], camera, 400, 400, bounds)
     assert image.voxel_mask.all()  # 36-pixel squares, no gaps: only voxels in view count
 
@@ -82,13 +84,15 @@ def test_a_threshold_rescales_the_colours_to_the_heights_that_remain():
     column = np.array([[0, 0, z] for z in range(21)])
     layers, (lo, hi) = output_layers(column, np.zeros((0, 3)), mode="height")
     assert (lo, hi) == (0.0, 20.0)
-    layers, (lo, hi) = output_layers(column, np.zeros((0, 3)), mode="height", voxel_size=0.25,
-                                     threshold_m=2.0)
+    layers, (lo, hi) = output_layers(
+        column, np.zeros((0, 3)), mode="height", voxel_size=0.25, threshold_m=2.0
+    )
     assert (lo, hi) == (0.0, 8.0) and len(layers[0].voxels) == 9
     bounds = (np.zeros(3), np.array([1.0, 1.0, 20.0]))
     side = Camera(180.0, 0.0)
-    full = render(output_layers(column, np.zeros((0, 3)), mode="height")[0], side, 60, 60,
-                  bounds, height_range=(0, 20))
+    full = render(
+        output_layers(column, np.zeros((0, 3)), mode="height")[0], side, 60, 60, bounds, height_range=(0, 20)
+    )
     cut = render(layers, side, 60, 60, bounds, height_range=(lo, hi))
     table = colour.height_map()
     # the top remaining voxel takes the top colour after the threshold, not a middling one
@@ -101,19 +105,22 @@ def test_fit_target_frames_the_targets_projected_box_with_a_small_margin():
     target = box((120, 40, 0), (126, 43, 2))
     for camera in (Camera(), Camera(45.0, 60.0), TOP):
         fitted = framing.fit_camera(camera, framing.box_of(target), 40, 100, bounds)
-        corners = np.array(list(itertools.product(*zip(target.min(0) - 0.5,
-                                                      target.max(0) + 0.5))))
+        corners = np.array(list(itertools.product(*zip(target.min(0) - 0.5, target.max(0) + 0.5))))
         row, col, _, _ = screen_coordinates(corners, fitted, 40, 100, bounds)
         assert row.min() >= 0 and row.max() <= 40 and col.min() >= 0 and col.max() <= 100
         # fills the tighter direction to within the margin, centred
         fill = max((row.max() - row.min()) / 40, (col.max() - col.min()) / 100)
         assert fill == pytest.approx(0.9, abs=1e-6)
-        assert (row.min() + row.max()) / 2 == pytest.approx(20) and \
-            (col.min() + col.max()) / 2 == pytest.approx(50)
+        assert (row.min() + row.max()) / 2 == pytest.approx(20) and (
+            col.min() + col.max()
+        ) / 2 == pytest.approx(50)
         image = render([Layer(target, colour.TARGET_RGB)], fitted, 40, 100, bounds)
         box_area = np.ptp(row) * np.ptp(col)
-        assert 0.5 * box_area < is_rgb(image, colour.TARGET_RGB).sum() <= box_area + 2 * (
-            np.ptp(row) + np.ptp(col)) + 4
+        assert (
+            0.5 * box_area
+            < is_rgb(image, colour.TARGET_RGB).sum()
+            <= box_area + 2 * (np.ptp(row) + np.ptp(col)) + 4
+        )
 
 
 def test_output_classes_mark_what_the_foliage_hid():
@@ -129,18 +136,19 @@ def test_output_classes_mark_what_the_foliage_hid():
 
 def test_drawn_voxels_keep_a_contrast_of_3_against_the_background_after_a_threshold():
     rng = np.random.default_rng(1)
-    canopy = np.column_stack([rng.integers(0, 30, 3000), rng.integers(0, 30, 3000),
-                              rng.integers(8, 20, 3000)])
+    canopy = np.column_stack(
+        [rng.integers(0, 30, 3000), rng.integers(0, 30, 3000), rng.integers(8, 20, 3000)]
+    )
     ground = box((0, 0, 0), (29, 29, 0))
     target = box((12, 12, 1), (16, 14, 3))
     scene_output = np.unique(np.vstack([canopy, ground, target[::2]]), axis=0)
     bounds = (np.zeros(3), np.array([29.0, 29.0, 19.0]))
     for mode in ("class", "height"):
         for cmap in ("height", "grey"):
-            layers, heights = output_layers(scene_output, target, target, mode=mode,
-                                            voxel_size=0.5, threshold_m=2.0)
-            image = render(layers, Camera(), 60, 80, bounds, height_range=heights,
-                           colour_map=cmap)
+            layers, heights = output_layers(
+                scene_output, target, target, mode=mode, voxel_size=0.5, threshold_m=2.0
+            )
+            image = render(layers, Camera(), 60, 80, bounds, height_range=heights, colour_map=cmap)
             drawn = image.rgb[image.voxel_mask]
             background = image.rgb[~image.mask]
             assert len(drawn) > 100 and len(background) > 100
@@ -165,15 +173,16 @@ def test_overlays_are_drawn_over_the_voxels_and_can_be_switched_off():
     floor = box((0, 8, 0), (20, 12, 0))  # a strip under the path, across the footprint
     post = box((10, 5, 0), (10, 5, 6))  # a voxel column standing on a footprint edge
     path = np.array([[0.0, 10, 8], [20.0, 10, 8]])
-    overlays = Overlays(path=path, scans=path, footprints=[np.array([[5.0, 5, 0], [15, 5, 0],
-                                                                    [15, 15, 0], [5, 15, 0]])])
+    overlays = Overlays(
+        path=path, scans=path, footprints=[np.array([[5.0, 5, 0], [15, 5, 0], [15, 15, 0], [5, 15, 0]])]
+    )
     image = render([Layer(floor, (90, 90, 90))], TOP, 40, 40, bounds, overlays=overlays)
     for rgb in (colour.PATH_RGB, colour.SCAN_RGB, colour.START_RGB, colour.FOOTPRINT_RGB):
         assert is_rgb(image, rgb).any(), rgb
     strip = is_rgb(image, (90, 90, 90))
     rows = np.nonzero(strip.any(axis=1))[0]
     assert not is_rgb(image, colour.FOOTPRINT_RGB)[rows].any()  # under the voxels
-    assert is_rgb(image, colour.PATH_RGB)[rows].any()           # over them
+    assert is_rgb(image, colour.PATH_RGB)[rows].any()  # over them
     # footprints lie on the ground: voxels hide them, the flight path stays on top
     side = Camera(180.0, 10.0)
     image = render([Layer(post, TARGET)], side, 40, 40, bounds, overlays=overlays)
@@ -194,8 +203,7 @@ def test_scan_counts_colour_the_target_by_how_many_scans_saw_it():
     per_scan = [target[:1], target[:2], target[:2], np.zeros((0, 3), np.int32)]
     assert scan_counts(target, per_scan).tolist() == [3, 2, 0]
     ground = box((0, 2, 0), (2, 2, 0))
-    layers, _ = output_layers(np.vstack([ground, target[:2]]), target, mode="scans",
-                              per_scan=per_scan)
+    layers, _ = output_layers(np.vstack([ground, target[:2]]), target, mode="scans", per_scan=per_scan)
     assert [len(layer.voxels) for layer in layers] == [3, 2]
     bounds = (np.zeros(3), np.array([2.0, 2.0, 0.0]))
     image = render(layers, TOP, 30, 30, bounds)
@@ -212,7 +220,9 @@ def test_the_top_view_window_zooms_about_a_point_that_stays_put_and_pans_by_frac
     zoomed = framing.zoom_window(frame, 2.0, about=(80.0, 10.0))
     assert zoomed == (40.0, 5.0, 90.0, 30.0)
     # the point keeps its place: 80 % across, 20 % up, before and after
-    assert ((80 - zoomed[0]) / (zoomed[2] - zoomed[0]), (10 - zoomed[1]) / (zoomed[3] - zoomed[1])) \
-        == (0.8, 0.2)
+    assert ((80 - zoomed[0]) / (zoomed[2] - zoomed[0]), (10 - zoomed[1]) / (zoomed[3] - zoomed[1])) == (
+        0.8,
+        0.2,
+    )
     assert framing.zoom_window(frame, 1000.0)[2] - framing.zoom_window(frame, 1000.0)[0] == 2.0
     assert framing.pan_window(frame, 0.1, -0.2) == (10.0, -10.0, 110.0, 40.0)

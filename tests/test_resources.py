@@ -35,10 +35,13 @@ def test_memory_limit_is_configurable(tmp_path, monkeypatch):
     assert Occupancy.build(voxels).count == len(voxels)
 
 
-@pytest.mark.parametrize("voxels", [
-    [(x, y, z) for x in range(0, 64, 3) for y in range(0, 40, 5) for z in range(3)],
-    [(0, 0, 0), (700, 300, 20)],
-])
+@pytest.mark.parametrize(
+    "voxels",
+    [
+        [(x, y, z) for x in range(0, 64, 3) for y in range(0, 40, 5) for z in range(3)],
+        [(0, 0, 0), (700, 300, 20)],
+    ],
+)
 def test_estimate_covers_what_the_build_holds(voxels):
     voxels = np.array(voxels, np.int32)
     occupancy = Occupancy.build(voxels)
@@ -50,9 +53,11 @@ def write_big_scenario(folder, grid, ray_grid, scans):
     save_voxels(folder / "s.txt", np.zeros((1, 3), np.int32))
     save_voxels(folder / "s_Target.txt", np.zeros((1, 3), np.int32))
     path = folder / "big.toml"
-    path.write_text(f'[files]\nscene = "s.txt"\n[sensor]\ngrid = {grid}\nray_grid = {ray_grid}\n'
-                    '[[flight.segments]]\nkind = "orbit"\ncentre = [0, 0, 0]\nradius = 100\n'
-                    f'altitude = 100\nscans = {scans}\n')
+    path.write_text(
+        f'[files]\nscene = "s.txt"\n[sensor]\ngrid = {grid}\nray_grid = {ray_grid}\n'
+        '[[flight.segments]]\nkind = "orbit"\ncentre = [0, 0, 0]\nradius = 100\n'
+        f"altitude = 100\nscans = {scans}\n"
+    )
     return path
 
 
@@ -77,13 +82,19 @@ def test_max_rays_flag(tmp_path, capsys):
 
 def test_huge_sweep_and_generate_are_refused(tmp_path, capsys):
     spec = tmp_path / "sp.toml"
-    spec.write_text('[sweep]\nscenario = "default"\n[random]\nsamples = 1000000000000\nseed = 1\n'
-                    'radius = {min = 1, max = 2}\n')
+    spec.write_text(
+        '[sweep]\nscenario = "default"\n[random]\nsamples = 1000000000000\nseed = 1\n'
+        "radius = {min = 1, max = 2}\n"
+    )
     assert main(["sweep", str(spec), "--serial"]) == 2
     assert "1,000,000,000,000 variants" in one_error_line(capsys)
-    spec.write_text('[sweep]\nscenario = "default"\n[grid]\n' + "".join(
-        f"{name} = [{', '.join(str(v) for v in range(1, 101))}]\n"
-        for name in ("radius", "altitude", "scans")))
+    spec.write_text(
+        '[sweep]\nscenario = "default"\n[grid]\n'
+        + "".join(
+            f"{name} = [{', '.join(str(v) for v in range(1, 101))}]\n"
+            for name in ("radius", "altitude", "scans")
+        )
+    )
     assert main(["sweep", str(spec), "--serial"]) == 2
     assert "1,000,000 variants (100 radius x 100 altitude x 100 scans)" in one_error_line(capsys)
     assert main(["generate", "small", str(tmp_path / "x"), "--trees", "100000000"]) == 2

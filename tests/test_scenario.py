@@ -83,18 +83,38 @@ def line_of(text, fragment):
 
 def full_scenario(path, scene_file):
     start = ScanPose(-50.0, -50.0, 70.0, heading=45.0, azimuth=10.0, depression=40.0)
-    plan = FlightPlan(start, [
-        Straight(40.0, 2),
-        Turn(30.0, 120.0, "left", 3, depression=60.0),
-        Manual([ScanPose(1.5, 2.25, 90.0, 10.0, -20.0, 75.0), ScanPose(3.0, 4.0, 95.0)]),
-        Orbit((10.0, 12.0, 1.0), 55.5, 65.0, 7, direction="left", start_bearing=33.3, arc=270.0),
-        FlyPast((10.0, 12.0), 40.0, 50.0, 100.0, 5, heading=123.4, side="left"),
-        Standoff((10.0, 12.0, 0.5), [90.0, 60.0, 30.0], 55.0, bearing=300.0, heading=10.0,
-                 aim_at=(11.0, 13.0, 0.0)),
-        Straight(10.0, 1, aim_at=(10.0, 12.0, 0.0)),
-    ])
-    return Scenario(path, scene_file, 0.3, Sensor(48, 3, 7.5, 0.75, 37e-6), plan, speed=22.5,
-                    backend="numba", method="march", step=0.3, fast_mode=True, precision="f32")
+    plan = FlightPlan(
+        start,
+        [
+            Straight(40.0, 2),
+            Turn(30.0, 120.0, "left", 3, depression=60.0),
+            Manual([ScanPose(1.5, 2.25, 90.0, 10.0, -20.0, 75.0), ScanPose(3.0, 4.0, 95.0)]),
+            Orbit((10.0, 12.0, 1.0), 55.5, 65.0, 7, direction="left", start_bearing=33.3, arc=270.0),
+            FlyPast((10.0, 12.0), 40.0, 50.0, 100.0, 5, heading=123.4, side="left"),
+            Standoff(
+                (10.0, 12.0, 0.5),
+                [90.0, 60.0, 30.0],
+                55.0,
+                bearing=300.0,
+                heading=10.0,
+                aim_at=(11.0, 13.0, 0.0),
+            ),
+            Straight(10.0, 1, aim_at=(10.0, 12.0, 0.0)),
+        ],
+    )
+    return Scenario(
+        path,
+        scene_file,
+        0.3,
+        Sensor(48, 3, 7.5, 0.75, 37e-6),
+        plan,
+        speed=22.5,
+        backend="numba",
+        method="march",
+        step=0.3,
+        fast_mode=True,
+        precision="f32",
+    )
 
 
 # -- round trips ---------------------------------------------------------------------
@@ -125,8 +145,9 @@ def test_round_trip_of_the_base_text(tmp_path):
     assert len(scenario.poses()) == 10
     saved = scenario.save(tmp_path / "copy.toml")
     assert saved.path == tmp_path / "copy.toml"
-    assert load_scenario(tmp_path / "copy.toml") == saved == scenario.with_changes(
-        path=tmp_path / "copy.toml")
+    assert (
+        load_scenario(tmp_path / "copy.toml") == saved == scenario.with_changes(path=tmp_path / "copy.toml")
+    )
 
 
 def test_paths_resolve_against_the_scenario_folder(tmp_path):
@@ -145,8 +166,10 @@ def test_paths_resolve_against_the_scenario_folder(tmp_path):
 
 
 def test_absolute_scene_path_kept_when_nothing_in_common(tmp_path):
-    scenario = load_scenario(write_scenario(tmp_path, edited(
-        'scene = "models/forest.txt"', 'scene = "/opt/elsewhere/x.txt"')), check_files=False)
+    scenario = load_scenario(
+        write_scenario(tmp_path, edited('scene = "models/forest.txt"', 'scene = "/opt/elsewhere/x.txt"')),
+        check_files=False,
+    )
     assert scenario.scene_file == Path("/opt/elsewhere/x.txt")
     assert scenario.target_file == Path("/opt/elsewhere/x_Target.txt")
     assert scenario.to_dict()["files"]["scene"] == "/opt/elsewhere/x.txt"
@@ -171,8 +194,10 @@ def test_missing_target_model_is_named(tmp_path):
     with pytest.raises(InputFileError) as caught:
         load_scenario(path)
     target = tmp_path / "models" / "forest_Target.txt"
-    assert str(caught.value) == (f"{path}:2: target model file {target} not found (the target "
-                                 "model of forest.txt must sit beside it, named forest_Target.txt)")
+    assert str(caught.value) == (
+        f"{path}:2: target model file {target} not found (the target "
+        "model of forest.txt must sit beside it, named forest_Target.txt)"
+    )
 
 
 def test_missing_scenario_file(tmp_path):
@@ -184,54 +209,90 @@ def test_missing_scenario_file(tmp_path):
 # -- field limits ----------------------------------------------------------------------
 
 LIMITS = [
-    ("voxel_size = 0.5", "voxel_size = 0", "files.voxel_size = 0",
-     "a number greater than 0 and at most 100"),
-    ("voxel_size = 0.5", "voxel_size = 250.0", "files.voxel_size = 250.0",
-     "a number greater than 0 and at most 100"),
-    ('scene = "models/forest.txt"', "scene = 3", "files.scene = 3",
-     "the scene model file name (X.txt)"),
+    ("voxel_size = 0.5", "voxel_size = 0", "files.voxel_size = 0", "a number greater than 0 and at most 100"),
+    (
+        "voxel_size = 0.5",
+        "voxel_size = 250.0",
+        "files.voxel_size = 250.0",
+        "a number greater than 0 and at most 100",
+    ),
+    ('scene = "models/forest.txt"', "scene = 3", "files.scene = 3", "the scene model file name (X.txt)"),
     ("grid = 32", "grid = 2000", "sensor.grid = 2000", "an integer from 1 to 1024"),
     ("grid = 32", "grid = 32.5", "sensor.grid = 32.5", "an integer from 1 to 1024"),
     ("ray_grid = 2", "ray_grid = 0", "sensor.ray_grid = 0", "an integer from 1 to 16"),
-    ("fov_deg = 12.0", "fov_deg = 90.0", "sensor.fov_deg = 90.0",
-     "a number greater than 0 and less than 90"),
-    ("fov_deg = 12.0", 'fov_deg = "wide"', "sensor.fov_deg = 'wide'",
-     "a number greater than 0 and less than 90"),
-    ("depth_resolution_m = 1.5", "depth_resolution_m = -1", "sensor.depth_resolution_m = -1",
-     "a number from 0 to 1000"),
-    ("pixel_pitch_um = 100.0", "pixel_pitch_um = 0", "sensor.pixel_pitch_um = 0",
-     "a number greater than 0 and at most 10000"),
-    ("pixel_pitch_um = 100.0", "pixel_pitch_um = 20000.0", "sensor.pixel_pitch_um = 20000.0",
-     "a number greater than 0 and at most 10000"),
-    ("pixel_pitch_um = 100.0", "pixel_pitch_um = true", "sensor.pixel_pitch_um = True",
-     "a number greater than 0 and at most 10000"),
-    ("speed_mps = 25.0", "speed_mps = 0.0", "flight.speed_mps = 0.0",
-     "a number greater than 0 and at most 1000"),
-    ("depression = 45.0", "depression = 0.0", "flight.start.depression = 0.0",
-     "a number from 1 to 90"),
-    ("z = 80.0", "z = -5.0", "flight.start.z = -5.0",
-     "a number greater than 0 and at most 100000"),
-    ("distance = 50.0", "distance = 0.0", "flight.segments[0].distance = 0.0",
-     "a number greater than 0 and at most 1000000"),
+    ("fov_deg = 12.0", "fov_deg = 90.0", "sensor.fov_deg = 90.0", "a number greater than 0 and less than 90"),
+    (
+        "fov_deg = 12.0",
+        'fov_deg = "wide"',
+        "sensor.fov_deg = 'wide'",
+        "a number greater than 0 and less than 90",
+    ),
+    (
+        "depth_resolution_m = 1.5",
+        "depth_resolution_m = -1",
+        "sensor.depth_resolution_m = -1",
+        "a number from 0 to 1000",
+    ),
+    (
+        "pixel_pitch_um = 100.0",
+        "pixel_pitch_um = 0",
+        "sensor.pixel_pitch_um = 0",
+        "a number greater than 0 and at most 10000",
+    ),
+    (
+        "pixel_pitch_um = 100.0",
+        "pixel_pitch_um = 20000.0",
+        "sensor.pixel_pitch_um = 20000.0",
+        "a number greater than 0 and at most 10000",
+    ),
+    (
+        "pixel_pitch_um = 100.0",
+        "pixel_pitch_um = true",
+        "sensor.pixel_pitch_um = True",
+        "a number greater than 0 and at most 10000",
+    ),
+    (
+        "speed_mps = 25.0",
+        "speed_mps = 0.0",
+        "flight.speed_mps = 0.0",
+        "a number greater than 0 and at most 1000",
+    ),
+    ("depression = 45.0", "depression = 0.0", "flight.start.depression = 0.0", "a number from 1 to 90"),
+    ("z = 80.0", "z = -5.0", "flight.start.z = -5.0", "a number greater than 0 and at most 100000"),
+    (
+        "distance = 50.0",
+        "distance = 0.0",
+        "flight.segments[0].distance = 0.0",
+        "a number greater than 0 and at most 1000000",
+    ),
     ("scans = 8", "scans = 0", "flight.segments[1].scans = 0", "an integer from 1 to 10000"),
-    ("radius = 60.0", "radius = -60.0", "flight.segments[1].radius = -60.0",
-     "a number greater than 0 and at most 1000000"),
-    ("centre = [10.0, 10.0, 1.0]", "centre = [10.0]", "flight.segments[1].centre = [10.0]",
-     "a point [x, y] or [x, y, z] in metres, each within +-1000000"),
-    ('kind = "orbit"', 'kind = "circle"', "flight.segments[1].kind = 'circle'",
-     "one of 'manual', 'straight', 'turn', 'orbit', 'flypast', 'standoff', 'log'"),
-    ('method = "march"', 'method = "fast"', "simulation.method = 'fast'",
-     "one of 'exact', 'march'"),
+    (
+        "radius = 60.0",
+        "radius = -60.0",
+        "flight.segments[1].radius = -60.0",
+        "a number greater than 0 and at most 1000000",
+    ),
+    (
+        "centre = [10.0, 10.0, 1.0]",
+        "centre = [10.0]",
+        "flight.segments[1].centre = [10.0]",
+        "a point [x, y] or [x, y, z] in metres, each within +-1000000",
+    ),
+    (
+        'kind = "orbit"',
+        'kind = "circle"',
+        "flight.segments[1].kind = 'circle'",
+        "one of 'manual', 'straight', 'turn', 'orbit', 'flypast', 'standoff', 'log'",
+    ),
+    ('method = "march"', 'method = "fast"', "simulation.method = 'fast'", "one of 'exact', 'march'"),
     ("step = 0.25", "step = 0", "simulation.step = 0", "a number greater than 0 and at most 10"),
-    ('precision = "f32"', 'precision = "f16"', "simulation.precision = 'f16'",
-     "one of 'f64', 'f32'"),
+    ('precision = "f32"', 'precision = "f16"', "simulation.precision = 'f16'", "one of 'f64', 'f32'"),
     ("fast_mode = true", "fast_mode = 1", "simulation.fast_mode = 1", "true or false"),
 ]
 
 
 @pytest.mark.parametrize("old,new,head,expected", LIMITS, ids=[row[2] for row in LIMITS])
-def test_every_field_limit_names_file_line_field_value_and_range(tmp_path, old, new, head,
-                                                                 expected):
+def test_every_field_limit_names_file_line_field_value_and_range(tmp_path, old, new, head, expected):
     text = edited(old, new)
     path = write_scenario(tmp_path, text)
     with pytest.raises(FieldError) as caught:
@@ -245,8 +306,9 @@ def test_backend_must_be_known(tmp_path):
     with pytest.raises(FieldError) as caught:
         load_scenario(path, check_files=False)
     message = str(caught.value)
-    assert message.startswith(f"{path}:{line_of(BASE, 'backend')}: simulation.backend = 'cuda': "
-                              "expected one of 'auto', ")
+    assert message.startswith(
+        f"{path}:{line_of(BASE, 'backend')}: simulation.backend = 'cuda': expected one of 'auto', "
+    )
 
 
 def test_aim_above_the_horizon_names_the_segment(tmp_path):
@@ -259,7 +321,7 @@ def test_aim_above_the_horizon_names_the_segment(tmp_path):
 
 
 def test_relative_segment_first_needs_a_start(tmp_path):
-    start = BASE[BASE.index("[flight.start]"):BASE.index("[[flight.segments]]")]
+    start = BASE[BASE.index("[flight.start]") : BASE.index("[[flight.segments]]")]
     path = write_scenario(tmp_path, BASE.replace(start, ""))
     with pytest.raises(FieldError) as caught:
         load_scenario(path, check_files=False)
@@ -269,16 +331,33 @@ def test_relative_segment_first_needs_a_start(tmp_path):
 # -- unknown and missing keys, syntax ------------------------------------------------
 
 
-@pytest.mark.parametrize("old,new,message", [
-    ("grid = 32", "gird = 32", "unknown key 'sensor.gird' (allowed: grid, ray_grid, fov_deg, "
-     "depth_resolution_m, pixel_pitch_um, mount)"),
-    ("radius = 60.0", "raduis = 60.0", "unknown key 'flight.segments[1].raduis' (orbit segment) "
-     "(allowed: kind, centre, radius, altitude, scans, direction, start_bearing, arc, aim_at)"),
-    ("[simulation]", "[simulatoin]", "unknown section [simulatoin] "
-     "(allowed: files, sensor, flight, simulation, detection)"),
-    ("heading = 0.0", "headin = 0.0", "unknown key 'flight.start.headin' "
-     "(allowed: x, y, z, heading, azimuth, depression)"),
-])
+@pytest.mark.parametrize(
+    "old,new,message",
+    [
+        (
+            "grid = 32",
+            "gird = 32",
+            "unknown key 'sensor.gird' (allowed: grid, ray_grid, fov_deg, "
+            "depth_resolution_m, pixel_pitch_um, mount)",
+        ),
+        (
+            "radius = 60.0",
+            "raduis = 60.0",
+            "unknown key 'flight.segments[1].raduis' (orbit segment) "
+            "(allowed: kind, centre, radius, altitude, scans, direction, start_bearing, arc, aim_at)",
+        ),
+        (
+            "[simulation]",
+            "[simulatoin]",
+            "unknown section [simulatoin] (allowed: files, sensor, flight, simulation, detection)",
+        ),
+        (
+            "heading = 0.0",
+            "headin = 0.0",
+            "unknown key 'flight.start.headin' (allowed: x, y, z, heading, azimuth, depression)",
+        ),
+    ],
+)
 def test_unknown_keys_are_named_with_their_line(tmp_path, old, new, message):
     text = edited(old, new)
     path = write_scenario(tmp_path, text)
@@ -297,8 +376,7 @@ def test_missing_keys(tmp_path):
     with pytest.raises(InputFileError) as caught:
         load_scenario(path, check_files=False)
     header = line_of(text, 'kind = "orbit"') - 1
-    assert str(caught.value) == (f"{path}:{header}: missing key "
-                                 "'flight.segments[1].radius' (orbit segment)")
+    assert str(caught.value) == (f"{path}:{header}: missing key 'flight.segments[1].radius' (orbit segment)")
 
 
 def test_toml_syntax_error_gives_the_line(tmp_path):
@@ -320,8 +398,7 @@ def test_with_changes_checks_fields(tmp_path):
     assert faster.flight_time() == pytest.approx(scenario.flight_time() / 2)
     with pytest.raises(FieldError) as caught:
         scenario.with_changes(speed=-1)
-    assert str(caught.value) == ("flight.speed_mps = -1: expected a number greater than 0 "
-                                 "and at most 1000")
+    assert str(caught.value) == ("flight.speed_mps = -1: expected a number greater than 0 and at most 1000")
     with pytest.raises(FieldError) as caught:
         scenario.with_changes(flight=FlightPlan(None, []))
     assert caught.value.field == "flight.segments"
@@ -342,8 +419,7 @@ def test_new_scenario_orbits_the_target_centre(tmp_path):
     scenario = Scenario.new(tmp_path / "new.toml", "woods.txt", 0.5)
     centre = np.mean(target, axis=0) * 0.5  # (5.5, 11, 0.5)
     for pose in scenario.poses():
-        assert math.dist((pose.x, pose.y), centre[:2]) == pytest.approx(
-            scenario.flight.segments[0].radius)
+        assert math.dist((pose.x, pose.y), centre[:2]) == pytest.approx(scenario.flight.segments[0].radius)
     assert scenario.scene_file == scene
     saved = scenario.save()
     assert load_scenario(saved.path) == scenario
@@ -379,8 +455,10 @@ def test_validate_command(tmp_path, capsys):
     bad = write_scenario(tmp_path, edited("grid = 32", "grid = 0"), name="bad.toml")
     assert main(["validate", str(bad)]) == 2
     err = capsys.readouterr().err
-    assert err == (f"ladartui: error: {bad}:{line_of(BASE, 'grid = 32')}: sensor.grid = 0: "
-                   "expected an integer from 1 to 1024\n")
+    assert err == (
+        f"ladartui: error: {bad}:{line_of(BASE, 'grid = 32')}: sensor.grid = 0: "
+        "expected an integer from 1 to 1024\n"
+    )
 
 
 def test_text_parses_like_a_file(tmp_path):
@@ -396,15 +474,22 @@ def test_round_trip_of_arbitrary_values(tmp_path):
     positive = st.floats(0.01, 5000, allow_nan=False)
 
     @hypothesis.settings(max_examples=25, deadline=None)
-    @hypothesis.given(centre=st.tuples(metres, metres, st.floats(0, 30)), radius=positive,
-                      altitude=st.floats(500, 5000), scans=st.integers(1, 12),
-                      bearing=st.floats(0, 359.9), fov=st.floats(0.01, 89.9),
-                      pitch_um=st.floats(0.5, 5000), depth=st.floats(0, 100),
-                      voxel=st.floats(0.01, 100))
+    @hypothesis.given(
+        centre=st.tuples(metres, metres, st.floats(0, 30)),
+        radius=positive,
+        altitude=st.floats(500, 5000),
+        scans=st.integers(1, 12),
+        bearing=st.floats(0, 359.9),
+        fov=st.floats(0.01, 89.9),
+        pitch_um=st.floats(0.5, 5000),
+        depth=st.floats(0, 100),
+        voxel=st.floats(0.01, 100),
+    )
     def check(centre, radius, altitude, scans, bearing, fov, pitch_um, depth, voxel):
         plan = FlightPlan(None, [Orbit(centre, radius, altitude, scans, start_bearing=bearing)])
-        scenario = Scenario(tmp_path / "s.toml", "x.txt", voxel,
-                            Sensor(16, 2, fov, depth, pitch_um / 1e6), plan)
+        scenario = Scenario(
+            tmp_path / "s.toml", "x.txt", voxel, Sensor(16, 2, fov, depth, pitch_um / 1e6), plan
+        )
         again = scenario_from_toml(scenario.to_toml(), scenario.path)
         assert again == scenario
         assert again.to_toml() == scenario.to_toml()

@@ -47,8 +47,10 @@ def _error(tmp_path, **parts):
 
 
 def test_detection_section_reads_checks_and_saves(tmp_path):
-    scenario = _scenario(tmp_path, extra='[detection]\nmodel = "geiger"\npulses = 50\n'
-                                         'coincidence = 5\nsolar_rate_hz = 2e6\nseed = 7\n')
+    scenario = _scenario(
+        tmp_path,
+        extra='[detection]\nmodel = "geiger"\npulses = 50\ncoincidence = 5\nsolar_rate_hz = 2e6\nseed = 7\n',
+    )
     d = scenario.detection
     assert scenario.geiger and (d.pulses, d.coincidence, d.solar_rate_hz, d.seed) == (50, 5, 2e6, 7)
     assert d.bin_width_m is None and d.bin_width(scenario.sensor.depth_resolution) == 1.0
@@ -59,24 +61,34 @@ def test_detection_section_reads_checks_and_saves(tmp_path):
     assert "[detection]" in text and "bin_width_m" not in text  # unset keys stay unset
 
 
-@pytest.mark.parametrize("extra, expected", [
-    ('[detection]\nmodel = "geiger"\npulses = 10\ncoincidence = 11\n',
-     "S.toml:21: detection.coincidence = 11: expected an integer from 1 to 10"),
-    ('[detection]\nmodel = "photon"\n',
-     "S.toml:19: detection.model = 'photon': expected one of 'ideal', 'geiger'"),
-    ('[detection]\nreflectance_target = 1.5\n',
-     "S.toml:19: detection.reflectance_target = 1.5: expected a number from 0 to 1"),
-    ('[detection]\ndark_rate_hz = -1\n',
-     "S.toml:19: detection.dark_rate_hz = -1: expected a number from 0 to 10000000000"),
-    ('[detection]\nn_pulses = 3\n', "S.toml:19: unknown key 'detection.n_pulses'"),
-])
+@pytest.mark.parametrize(
+    "extra, expected",
+    [
+        (
+            '[detection]\nmodel = "geiger"\npulses = 10\ncoincidence = 11\n',
+            "S.toml:21: detection.coincidence = 11: expected an integer from 1 to 10",
+        ),
+        (
+            '[detection]\nmodel = "photon"\n',
+            "S.toml:19: detection.model = 'photon': expected one of 'ideal', 'geiger'",
+        ),
+        (
+            "[detection]\nreflectance_target = 1.5\n",
+            "S.toml:19: detection.reflectance_target = 1.5: expected a number from 0 to 1",
+        ),
+        (
+            "[detection]\ndark_rate_hz = -1\n",
+            "S.toml:19: detection.dark_rate_hz = -1: expected a number from 0 to 10000000000",
+        ),
+        ("[detection]\nn_pulses = 3\n", "S.toml:19: unknown key 'detection.n_pulses'"),
+    ],
+)
 def test_detection_errors_name_field_value_and_range(tmp_path, extra, expected):
     assert expected in _error(tmp_path, extra=extra)
 
 
 def test_zero_depth_resolution_needs_a_bin_width(tmp_path):
-    message = _error(tmp_path, sensor="depth_resolution_m = 0.0\n",
-                     extra='[detection]\nmodel = "geiger"\n')
+    message = _error(tmp_path, sensor="depth_resolution_m = 0.0\n", extra='[detection]\nmodel = "geiger"\n')
     assert "detection.bin_width_m" in message and "depth_resolution_m is 0" in message
 
 
@@ -84,9 +96,9 @@ def test_body_fixed_mount_banks_orbit_rays(tmp_path):
     stabilised = _scenario(tmp_path)
     assert plan_attitudes(stabilised.flight, stabilised.speed, stabilised.sensor) == [None] * 4
     body = _scenario(tmp_path, sensor='mount = "body-fixed"\n')
-    assert 'mount = "body-fixed"' in body.to_toml() and 'mount' not in stabilised.to_toml()
+    assert 'mount = "body-fixed"' in body.to_toml() and "mount" not in stabilised.to_toml()
     attitudes = plan_attitudes(body.flight, body.speed, body.sensor)
-    roll = math.degrees(math.atan(40.0 ** 2 / (9.80665 * 100.0)))
+    roll = math.degrees(math.atan(40.0**2 / (9.80665 * 100.0)))
     assert attitudes == [(pytest.approx(roll), 0.0)] * 4  # a right (clockwise) orbit rolls right
     pose = body.poses()[0]
     _, plain, _ = stabilised.sensor.rays(pose)
@@ -111,15 +123,18 @@ def test_body_fixed_roll_moves_nadir_footprint_by_h_tan_roll(tmp_path):
     assert hit[0] == pytest.approx(-50.0 * math.tan(math.radians(30.0)))
     assert rolled[0] < level[0] - 25.0
     assert coordinated_turn_roll(40.0, 100.0) == pytest.approx(
-        math.degrees(math.atan(1600 / (9.80665 * 100))))
+        math.degrees(math.atan(1600 / (9.80665 * 100)))
+    )
 
 
 def test_log_segment_reads_the_log_and_saves_it_relative(tmp_path):
     (tmp_path / "logs").mkdir()
     (tmp_path / "logs" / "pass.csv").write_text(EXAMPLE_LOG.read_text(), encoding="utf-8")
-    scenario = _scenario(tmp_path, segment='kind = "log"\nfile = "logs/pass.csv"\nrate = 2.0\n'
-                                           'depression = 60.0\n',
-                         sensor='mount = "body-fixed"\n')
+    scenario = _scenario(
+        tmp_path,
+        segment='kind = "log"\nfile = "logs/pass.csv"\nrate = 2.0\ndepression = 60.0\n',
+        sensor='mount = "body-fixed"\n',
+    )
     log = load_flight_log(EXAMPLE_LOG)
     expected = log_poses(log, ScanPose(0.0, 0.0, 1.0, 0.0, 0.0, 60.0), rate=2.0)
     assert scenario.poses() == expected and len(expected) == 7
@@ -132,10 +147,8 @@ def test_log_segment_reads_the_log_and_saves_it_relative(tmp_path):
 
 
 def test_straight_log_reproduces_straight_manoeuvre(tmp_path):
-    (tmp_path / "line.csv").write_text("time,x,y,z,heading\n0,0,0,60,90\n4,120,0,60,90\n",
-                                       encoding="utf-8")
-    scenario = _scenario(tmp_path, segment='kind = "log"\nfile = "line.csv"\n'
-                                           'times = [1.0, 2.0, 3.0, 4.0]\n')
+    (tmp_path / "line.csv").write_text("time,x,y,z,heading\n0,0,0,60,90\n4,120,0,60,90\n", encoding="utf-8")
+    scenario = _scenario(tmp_path, segment='kind = "log"\nfile = "line.csv"\ntimes = [1.0, 2.0, 3.0, 4.0]\n')
     start = ScanPose(0.0, 0.0, 60.0, heading=90.0)
     for got, want in zip(scenario.poses(), straight(start, 120.0, 4), strict=True):
         assert got.position == pytest.approx(want.position) and got.heading == want.heading
@@ -143,14 +156,16 @@ def test_straight_log_reproduces_straight_manoeuvre(tmp_path):
 
 def test_log_segment_errors(tmp_path):
     assert "flight.segments[0].times" in _error(
-        tmp_path, segment=f'kind = "log"\nfile = "{EXAMPLE_LOG}"\ntimes = [9.0]\n')
-    assert "either a scan rate" in _error(
-        tmp_path, segment=f'kind = "log"\nfile = "{EXAMPLE_LOG}"\n')
+        tmp_path, segment=f'kind = "log"\nfile = "{EXAMPLE_LOG}"\ntimes = [9.0]\n'
+    )
+    assert "either a scan rate" in _error(tmp_path, segment=f'kind = "log"\nfile = "{EXAMPLE_LOG}"\n')
     (tmp_path / "bad.csv").write_text("time,x,y,z,heading\n0,0,0,60,0\n1,zz,0,60,0\n")
     assert _error(tmp_path, segment='kind = "log"\nfile = "bad.csv"\nrate = 1.0\n').endswith(
-        "bad.csv:3: x = 'zz': expected a number")
+        "bad.csv:3: x = 'zz': expected a number"
+    )
     assert "cannot read flight log" in _error(
-        tmp_path, segment='kind = "log"\nfile = "missing.csv"\nrate = 1.0\n')
+        tmp_path, segment='kind = "log"\nfile = "missing.csv"\nrate = 1.0\n'
+    )
 
 
 def test_scenario_from_toml_without_options_has_none():
@@ -164,8 +179,7 @@ def test_scan_footprints_fall_with_attitude(tmp_path):
 
     stabilised = _scenario(tmp_path)
     plain = scan_footprints(stabilised)
-    assert all(np.array_equal(f, stabilised.sensor.footprint(p))
-               for f, p in zip(plain, stabilised.poses()))
+    assert all(np.array_equal(f, stabilised.sensor.footprint(p)) for f, p in zip(plain, stabilised.poses()))
     banked = scan_footprints(_scenario(tmp_path, sensor='mount = "body-fixed"\n'))
     # A right orbit banks right: each footprint moves away from the centre, outwards.
     for before, after in zip(plain, banked):

@@ -23,15 +23,16 @@ def folder(tmp_path_factory):
     """The shipped scenarios beside a small generated scene where they expect it."""
     folder = tmp_path_factory.mktemp("shipped")
     (folder / "generated").mkdir()
-    generate_scene("small", seed=1, width=16.0, depth=16.0, trees=3).write(
-        folder / "generated" / "small")
+    generate_scene("small", seed=1, width=16.0, depth=16.0, trees=3).write(folder / "generated" / "small")
     return folder
 
 
 def changed_lines(before: str, after: str) -> list[str]:
-    return [line for line in difflib.unified_diff(before.splitlines(), after.splitlines(),
-                                                  lineterm="", n=0)
-            if line[:1] in "+-" and line[:3] not in ("+++", "---")]
+    return [
+        line
+        for line in difflib.unified_diff(before.splitlines(), after.splitlines(), lineterm="", n=0)
+        if line[:1] in "+-" and line[:3] not in ("+++", "---")
+    ]
 
 
 @pytest.mark.parametrize("name", NAMES)

@@ -59,7 +59,8 @@ def test_empty_target_loads_but_has_no_centre(tmp_path):
     with pytest.raises(LadarError) as caught:
         scene.target_centre_m()
     assert str(caught.value) == (
-        f"scene 'forest' has no target voxels ({tmp_path / 'forest_Target.txt'} is empty)")
+        f"scene 'forest' has no target voxels ({tmp_path / 'forest_Target.txt'} is empty)"
+    )
 
 
 def test_shape_covers_both_lists_and_can_be_larger():
@@ -79,8 +80,9 @@ def test_voxel_size_must_be_positive(size):
 
 def test_target_centre_is_the_centroid_in_metres():
     scene = Scene(SCENE, TARGET, 0.25)
-    np.testing.assert_allclose(scene.target_centre_m(), [(4 + 2) / 2 * 0.25, (1 + 3) / 2 * 0.25,
-                                                         (2 + 5) / 2 * 0.25])
+    np.testing.assert_allclose(
+        scene.target_centre_m(), [(4 + 2) / 2 * 0.25, (1 + 3) / 2 * 0.25, (2 + 5) / 2 * 0.25]
+    )
     with pytest.raises(LadarError, match="^scene 'scene' has no target voxels$"):
         Scene(SCENE, np.zeros((0, 3), int), 0.25).target_centre_m()
 

@@ -33,11 +33,12 @@ def down_looking_rays(n, m, fov, pitch):
                 for j in range(m):
                     kx, ky = c * m + j, r * m + i
                     ax = -fov / 2 + (kx + 0.5) * step  # column 0 on the left (-x)
-                    ay = fov / 2 - (ky + 0.5) * step   # row 0 at the top (+y)
+                    ay = fov / 2 - (ky + 0.5) * step  # row 0 at the top (+y)
                     d = np.array([math.tan(math.radians(ax)), math.tan(math.radians(ay)), -1.0])
                     directions.append(d / np.linalg.norm(d))
-                    origins.append([(kx + 0.5 - side / 2) * pitch / m,
-                                    (side / 2 - ky - 0.5) * pitch / m, 0.0])
+                    origins.append(
+                        [(kx + 0.5 - side / 2) * pitch / m, (side / 2 - ky - 0.5) * pitch / m, 0.0]
+                    )
                     detectors.append(r * n + c)
     return np.array(origins), np.array(directions), np.array(detectors)
 
@@ -69,13 +70,16 @@ def test_nadir_points_straight_down():
     assert (directions[:, 2] < 0).all()
 
 
-@pytest.mark.parametrize("heading,azimuth,expected", [
-    (0.0, 0.0, (0.0, 0.5, -math.sqrt(3) / 2)),     # north and down
-    (90.0, 0.0, (0.5, 0.0, -math.sqrt(3) / 2)),    # east
-    (30.0, 60.0, (0.5, 0.0, -math.sqrt(3) / 2)),   # H + A = 90: east
-    (0.0, -90.0, (-0.5, 0.0, -math.sqrt(3) / 2)),  # west
-    (180.0, 0.0, (0.0, -0.5, -math.sqrt(3) / 2)),  # south
-])
+@pytest.mark.parametrize(
+    "heading,azimuth,expected",
+    [
+        (0.0, 0.0, (0.0, 0.5, -math.sqrt(3) / 2)),  # north and down
+        (90.0, 0.0, (0.5, 0.0, -math.sqrt(3) / 2)),  # east
+        (30.0, 60.0, (0.5, 0.0, -math.sqrt(3) / 2)),  # H + A = 90: east
+        (0.0, -90.0, (-0.5, 0.0, -math.sqrt(3) / 2)),  # west
+        (180.0, 0.0, (0.0, -0.5, -math.sqrt(3) / 2)),  # south
+    ],
+)
 def test_central_ray_directions(heading, azimuth, expected):
     sensor = Sensor(grid=8, ray_grid=1, fov=10.0)
     pose = ScanPose(1.0, 2.0, 50.0, heading=heading, azimuth=azimuth, depression=60.0)
@@ -148,8 +152,15 @@ def test_footprint_at_nadir_and_tilted():
     sensor = Sensor(grid=16, ray_grid=1, fov=20.0)
     corners = sensor.footprint(ScanPose(10.0, 20.0, 100.0, depression=90.0))
     half = 100.0 * math.tan(math.radians(10.0))
-    np.testing.assert_allclose(corners, [[10 - half, 20 + half, 0], [10 + half, 20 + half, 0],
-                                         [10 + half, 20 - half, 0], [10 - half, 20 - half, 0]])
+    np.testing.assert_allclose(
+        corners,
+        [
+            [10 - half, 20 + half, 0],
+            [10 + half, 20 + half, 0],
+            [10 + half, 20 - half, 0],
+            [10 - half, 20 - half, 0],
+        ],
+    )
     tilted = sensor.footprint(ScanPose(0.0, 0.0, 100.0, depression=45.0), ground_z=5.0)
     assert (tilted[:, 2] == 5.0).all()
     assert tilted[0, 1] > tilted[3, 1] > 0  # far edge beyond the near edge, both ahead
@@ -159,22 +170,23 @@ def test_footprint_at_nadir_and_tilted():
     assert np.isnan(above[:2]).all() and np.isfinite(above[2:]).all()
 
 
-@pytest.mark.parametrize("field,value,message", [
-    ("grid", 0, "grid = 0: expected an integer from 1 to 1024"),
-    ("grid", 1025, "grid = 1025: expected an integer from 1 to 1024"),
-    ("grid", 64.0, "grid = 64.0: expected an integer from 1 to 1024"),
-    ("grid", True, "grid = True: expected an integer from 1 to 1024"),
-    ("ray_grid", 17, "ray_grid = 17: expected an integer from 1 to 16"),
-    ("ray_grid", 0, "ray_grid = 0: expected an integer from 1 to 16"),
-    ("fov", 0, "fov = 0: expected a number greater than 0 and less than 90"),
-    ("fov", 90, "fov = 90: expected a number greater than 0 and less than 90"),
-    ("depth_resolution", -0.1, "depth_resolution = -0.1: expected a number from 0 to 1000"),
-    ("depth_resolution", 1001, "depth_resolution = 1001: expected a number from 0 to 1000"),
-    ("pixel_pitch", 0.0,
-     "pixel_pitch = 0.0: expected a number greater than 0 and at most 0.01"),
-    ("pixel_pitch", float("inf"),
-     "pixel_pitch = inf: expected a number greater than 0 and at most 0.01"),
-])
+@pytest.mark.parametrize(
+    "field,value,message",
+    [
+        ("grid", 0, "grid = 0: expected an integer from 1 to 1024"),
+        ("grid", 1025, "grid = 1025: expected an integer from 1 to 1024"),
+        ("grid", 64.0, "grid = 64.0: expected an integer from 1 to 1024"),
+        ("grid", True, "grid = True: expected an integer from 1 to 1024"),
+        ("ray_grid", 17, "ray_grid = 17: expected an integer from 1 to 16"),
+        ("ray_grid", 0, "ray_grid = 0: expected an integer from 1 to 16"),
+        ("fov", 0, "fov = 0: expected a number greater than 0 and less than 90"),
+        ("fov", 90, "fov = 90: expected a number greater than 0 and less than 90"),
+        ("depth_resolution", -0.1, "depth_resolution = -0.1: expected a number from 0 to 1000"),
+        ("depth_resolution", 1001, "depth_resolution = 1001: expected a number from 0 to 1000"),
+        ("pixel_pitch", 0.0, "pixel_pitch = 0.0: expected a number greater than 0 and at most 0.01"),
+        ("pixel_pitch", float("inf"), "pixel_pitch = inf: expected a number greater than 0 and at most 0.01"),
+    ],
+)
 def test_sensor_field_limits(field, value, message):
     with pytest.raises(FieldError) as caught:
         Sensor(**{field: value})

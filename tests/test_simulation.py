@@ -5,21 +5,22 @@ import threading
 import numpy as np
 import pytest
 
+import ladartui.simulation as simulation
 from ladartui.errors import Cancelled
 from ladartui.flight import FlightPlan, Manual, ScanPose, aim_at
 from ladartui.measures import read_cmf
 from ladartui.scenario import Scenario
 from ladartui.scene.voxels import load_voxels, save_voxels
 from ladartui.sensor import Sensor
-import ladartui.simulation as simulation
 from ladartui.simulation import fuse_scans, simulate
 
 TARGET_CENTRE = (22.5, 21.5, 1.0)
 
 
 def box(x0, x1, y0, y1, z0, z1):
-    return np.array([(x, y, z) for x in range(x0, x1) for y in range(y0, y1) for z in range(z0, z1)],
-                    dtype=np.int32)
+    return np.array(
+        [(x, y, z) for x in range(x0, x1) for y in range(y0, y1) for z in range(z0, z1)], dtype=np.int32
+    )
 
 
 def as_set(voxels):
@@ -29,18 +30,28 @@ def as_set(voxels):
 def make_scenario(folder, scene, target, poses, sensor, name="S"):
     save_voxels(folder / "forest.txt", scene)
     save_voxels(folder / "forest_Target.txt", target)
-    return Scenario(folder / f"{name}.toml", "forest.txt", 1.0, sensor,
-                    FlightPlan(segments=[Manual(tuple(poses))]), speed=25.0, backend="numba")
+    return Scenario(
+        folder / f"{name}.toml",
+        "forest.txt",
+        1.0,
+        sensor,
+        FlightPlan(segments=[Manual(tuple(poses))]),
+        speed=25.0,
+        backend="numba",
+    )
 
 
 @pytest.fixture
 def forest(tmp_path):
     """A 6 x 4 x 3 vehicle under a patchy canopy layer at z = 8, seen from four scans."""
     target = box(20, 26, 20, 24, 0, 3)
-    canopy = np.array([(x, y, 8) for x in range(16, 30) for y in range(16, 28) if (7 * x + 3 * y) % 4],
-                      dtype=np.int32)
-    poses = [aim_at(ScanPose(x, y, 60.0), TARGET_CENTRE)
-             for x, y in [(22.5, 0.0), (45.0, 21.5), (22.5, 21.5), (0.0, 21.5)]]
+    canopy = np.array(
+        [(x, y, 8) for x in range(16, 30) for y in range(16, 28) if (7 * x + 3 * y) % 4], dtype=np.int32
+    )
+    poses = [
+        aim_at(ScanPose(x, y, 60.0), TARGET_CENTRE)
+        for x, y in [(22.5, 0.0), (45.0, 21.5), (22.5, 21.5), (0.0, 21.5)]
+    ]
     sensor = Sensor(grid=32, ray_grid=2, fov=20.0, depth_resolution=1.0)
     return make_scenario(tmp_path, np.vstack([target, canopy]), target, poses, sensor)
 
@@ -69,16 +80,19 @@ def test_forest_run_end_to_end(forest):
     # Progress: both runs, fractions rising to 1, one report with returns per scan.
     fractions = [p.fraction for p in reports]
     assert fractions == sorted(fractions) and fractions[-1] == 1.0
-    assert [(p.run, p.scan) for p in reports if p.returns is not None] == \
-        [(run, scan) for scan in (1, 2, 3, 4) for run in ("scene", "target")]
+    assert [(p.run, p.scan) for p in reports if p.returns is not None] == [
+        (run, scan) for scan in (1, 2, 3, 4) for run in ("scene", "target")
+    ]
     assert reports[-1].rays_done == reports[-1].rays_total == 2 * 4 * 64 * 64
 
 
 def test_fusion_over_scans_equals_union_of_single_scan_runs(forest, tmp_path):
     poses = forest.poses()
     whole = simulate(forest, write=False)
-    singles = [simulate(forest.with_changes(flight=FlightPlan(segments=[Manual((pose,))])), write=False)
-               for pose in poses]
+    singles = [
+        simulate(forest.with_changes(flight=FlightPlan(segments=[Manual((pose,))])), write=False)
+        for pose in poses
+    ]
     assert as_set(whole.scene_output) == set().union(*(as_set(r.scene_output) for r in singles))
     for fused, single in zip(whole.scene_per_scan, singles):
         assert as_set(fused) == as_set(single.scene_output)
@@ -102,8 +116,11 @@ def test_solid_box_from_straight_above(tmp_path):
 
 def write_earlier_outputs(scenario):
     earlier = {}
-    for path, text in ((scenario.scene_output, "1,2,3\n"), (scenario.target_output, "4,5,6\n"),
-                       (scenario.measures_file, "earlier measures\n")):
+    for path, text in (
+        (scenario.scene_output, "1,2,3\n"),
+        (scenario.target_output, "4,5,6\n"),
+        (scenario.measures_file, "earlier measures\n"),
+    ):
         path.write_bytes(text.encode())
         earlier[path] = text.encode()
     return earlier

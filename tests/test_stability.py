@@ -31,8 +31,9 @@ from ladartui.tracing.reference import reference_trace_cells
 CALL_SECONDS = 60.0  # a call that takes longer is taken for an endless loop
 F32_RELATIVE = 2e-6  # float32 rounding allowance, relative to the scene size (about 16 ulp)
 MARCH_STEPS = (1.0, 0.5, 0.25, 0.1)
-EXAMPLES = settings(max_examples=25, deadline=None, derandomize=True,
-                    suppress_health_check=[HealthCheck.too_slow])
+EXAMPLES = settings(
+    max_examples=25, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow]
+)
 
 
 def _tracers():
@@ -59,8 +60,14 @@ def warm(tracer):
     if tracer in _WARM:
         return
     backend, method, precision = tracer
-    trace(Occupancy.build(np.array([[0, 0, 0]]), (2, 2, 2)), [[0.0, 0.0, 3.0]], [[0.0, 0.0, -1.0]],
-          backend=backend, method=method, precision=precision)
+    trace(
+        Occupancy.build(np.array([[0, 0, 0]]), (2, 2, 2)),
+        [[0.0, 0.0, 3.0]],
+        [[0.0, 0.0, -1.0]],
+        backend=backend,
+        method=method,
+        precision=precision,
+    )
     _WARM.add(tracer)
 
 
@@ -69,6 +76,7 @@ def _param(tracers):
 
 
 # --------------------------------------------------------------------------- cases and checks
+
 
 class Case:
     """A scene (voxel list and shape) and rays, all in cell space."""
@@ -97,9 +105,16 @@ class Case:
 
         def call():
             try:
-                box["result"] = trace(self.occupancy, metres, self.sent_directions, backend=backend,
-                                      method=method, step=step, precision=precision,
-                                      voxel_size=self.voxel_size)
+                box["result"] = trace(
+                    self.occupancy,
+                    metres,
+                    self.sent_directions,
+                    backend=backend,
+                    method=method,
+                    step=step,
+                    precision=precision,
+                    voxel_size=self.voxel_size,
+                )
             except BaseException as error:  # handed to the test thread
                 box["error"] = error
 
@@ -148,8 +163,11 @@ def assert_valid(case: Case, answer, method, precision="f64"):
     finite_t = np.where(np.isfinite(t), t, 0.0)
     point = case.origins + finite_t[:, None] * case.directions
     eps = precision_eps(case, precision)
-    tol = (1e-9 * np.maximum(1.0, np.abs(point)) + eps
-           + 1e-12 * np.maximum(1.0, finite_t)[:, None] * np.ones((1, 3)))
+    tol = (
+        1e-9 * np.maximum(1.0, np.abs(point))
+        + eps
+        + 1e-12 * np.maximum(1.0, finite_t)[:, None] * np.ones((1, 3))
+    )
     cell = index[voxel]
     p = point[voxel]
     assert np.all((p >= cell - tol[voxel]) & (p <= cell + 1 + tol[voxel])), "range off its voxel"
@@ -204,15 +222,19 @@ def assert_same(answer, reference, precision, what="", case=None, record=None):
     bad = np.flatnonzero(differ)
     if precision == "f32" and case is not None and bad.size:
         eps = precision_eps(case, precision)
-        explained = [_near(case, i, kind[i], index[i], eps)
-                     and (_fragile(case, i, r_kind[i], r_index[i], eps)
-                          or _fragile(case, i, kind[i], index[i], eps)) for i in bad]
+        explained = [
+            _near(case, i, kind[i], index[i], eps)
+            and (_fragile(case, i, r_kind[i], r_index[i], eps) or _fragile(case, i, kind[i], index[i], eps))
+            for i in bad
+        ]
         if record is not None:
             record(f"{what}float32 ties within {eps:.1e} cells", int(np.sum(explained)))
         bad = bad[~np.array(explained, bool)]
-    assert bad.size == 0, (f"{what}{bad.size} of {len(kind)} rays differ from the reference; "
-                           f"first ray {bad[0]}: {kind[bad[0]]} {index[bad[0]]} vs "
-                           f"{r_kind[bad[0]]} {r_index[bad[0]]}")
+    assert bad.size == 0, (
+        f"{what}{bad.size} of {len(kind)} rays differ from the reference; "
+        f"first ray {bad[0]}: {kind[bad[0]]} {index[bad[0]]} vs "
+        f"{r_kind[bad[0]]} {r_index[bad[0]]}"
+    )
     same = ~differ & (r_kind != MISS)
     if precision == "f64":
         np.testing.assert_allclose(t[same], r_t[same], rtol=1e-9, atol=1e-9)
@@ -234,8 +256,7 @@ def assert_never_earlier(case: Case, answer, reference) -> int:
     scale = np.maximum(1.0, np.abs(np.where(np.isfinite(r_t), r_t, 0.0)))
     earlier = t < r_t - 1e-6 * scale
     point = case.origins[earlier] + t[earlier, None] * case.directions[earlier]
-    on_boundary = np.any(np.abs(point - np.round(point)) <= 1e-9 * np.maximum(1, np.abs(point)),
-                         axis=1)
+    on_boundary = np.any(np.abs(point - np.round(point)) <= 1e-9 * np.maximum(1, np.abs(point)), axis=1)
     assert on_boundary.all(), "march ended earlier than the exact answer off a cell boundary"
     return int(earlier.sum())
 
@@ -255,8 +276,7 @@ def check_all(case: Case, tracers, record=None, label=""):
             answer = case.run(tracer, step)
             assert_valid(case, answer, tracer[1], tracer[2])
             if tracer[1] == "exact":
-                assert_same(answer, reference, tracer[2], f"{'-'.join(tracer)} {label}: ", case,
-                            record)
+                assert_same(answer, reference, tracer[2], f"{'-'.join(tracer)} {label}: ", case, record)
             else:
                 earlier = assert_never_earlier(case, answer, reference)
                 if record is not None:
@@ -272,6 +292,7 @@ def random_scene(rng, nx, ny, nz, density):
 
 
 # --------------------------------------------------------------------------- random cases
+
 
 @st.composite
 def random_cases(draw):
@@ -306,6 +327,7 @@ def test_random_rays_in_random_scenes_give_valid_answers_and_exact_ones_match_th
 
 
 # --------------------------------------------------------------------------- named hard cases
+
 
 @_param(EXACT + MARCH)
 def test_rays_along_grid_planes_and_axes(tracer, record_property):
@@ -385,8 +407,9 @@ def test_grazing_rays_at_one_degree_and_below(tracer, record_property):
     n = 300
     dep = np.radians(rng.uniform(0.01, 1.0, n))
     azimuth = rng.uniform(0, 2 * np.pi, n)
-    directions = np.stack([np.cos(dep) * np.sin(azimuth), np.cos(dep) * np.cos(azimuth),
-                           -np.sin(dep)], axis=1)
+    directions = np.stack(
+        [np.cos(dep) * np.sin(azimuth), np.cos(dep) * np.cos(azimuth), -np.sin(dep)], axis=1
+    )
     centre = np.array([30.0, 30.0, 0.0])
     origins = centre - 40.0 * directions * np.array([1, 1, 0]) + np.array([0, 0, 1])
     origins[:, 2] = rng.uniform(0.2, 6.5, n)
@@ -409,8 +432,7 @@ def test_origins_on_voxel_boundaries_and_inside_occupied_voxels(tracer, record_p
     kind, index, t = case.run(tracer)
     if tracer[1] == "exact":
         assert kind.tolist() == [VOXEL] * 5 + [MISS]
-        assert index.tolist() == [[2, 2, 2], [2, 2, 2], [2, 2, 2], [5, 2, 2], [2, 2, 2],
-                                  [-1, -1, -1]]
+        assert index.tolist() == [[2, 2, 2], [2, 2, 2], [2, 2, 2], [5, 2, 2], [2, 2, 2], [-1, -1, -1]]
         np.testing.assert_allclose(t[:5], [0.0, 0.0, 0.0, 2.0, 0.0], atol=1e-6)
     else:
         # The march's first sample is below the ground plane: a ground return the
@@ -437,8 +459,10 @@ def test_aircraft_ten_km_away(tracer, record_property):
     bearing = rng.uniform(0, 2 * np.pi, n)
     depression = np.radians(rng.uniform(2.0, 40.0, n))
     distance = 100_000.0
-    away = np.stack([np.cos(depression) * np.sin(bearing), np.cos(depression) * np.cos(bearing),
-                     np.sin(depression)], axis=1)
+    away = np.stack(
+        [np.cos(depression) * np.sin(bearing), np.cos(depression) * np.cos(bearing), np.sin(depression)],
+        axis=1,
+    )
     origins = aim + distance * away
     case = Case(voxels, (64, 64, 12), origins, -away, voxel_size=0.1)
     reference = check_all(case, [tracer], record_property, "10 km")
@@ -450,12 +474,13 @@ def test_very_long_rays_across_a_large_sparse_scene(tracer, record_property):
     # 20,000 x 20,000 cells with scattered voxels: memory follows content, rays cross it all.
     rng = np.random.default_rng(4)
     nx = ny = 20_000
-    voxels = np.unique(np.column_stack([rng.integers(0, nx, 3000), rng.integers(0, ny, 3000),
-                                        rng.integers(0, 30, 3000)]), axis=0)
+    voxels = np.unique(
+        np.column_stack([rng.integers(0, nx, 3000), rng.integers(0, ny, 3000), rng.integers(0, 30, 3000)]),
+        axis=0,
+    )
     n = 64
     start = np.column_stack([rng.uniform(0, 50, n), rng.uniform(0, 50, n), rng.uniform(20, 31, n)])
-    end = np.column_stack([rng.uniform(nx - 50, nx, n), rng.uniform(ny - 50, ny, n),
-                           np.zeros(n)])
+    end = np.column_stack([rng.uniform(nx - 50, nx, n), rng.uniform(ny - 50, ny, n), np.zeros(n)])
     case = Case(voxels, (nx, ny, 30), start, end - start)
     check_all(case, [tracer], record_property, "long")
 
@@ -487,6 +512,7 @@ def test_sensors_below_the_canopy_top(tracer, record_property):
 
 # --------------------------------------------------------------------------- march, measured
 
+
 @_param(MARCH)
 def test_march_misses_thin_diagonal_features_and_the_rate_is_recorded(tracer, record_property):
     # One-voxel-thick diagonal branches (6-connected staircases) under rays at 45 degrees.
@@ -496,14 +522,18 @@ def test_march_misses_thin_diagonal_features_and_the_rate_is_recorded(tracer, re
         x, y, z = rng.integers(5, 55), rng.integers(5, 55), rng.integers(4, 14)
         dx, dy = rng.choice([-1, 1], 2)
         for k in range(8):
-            branches += [(x + k * dx, y + k * dy, z + k), (x + k * dx + dx, y + k * dy, z + k),
-                         (x + (k + 1) * dx, y + (k + 1) * dy, z + k)]
+            branches += [
+                (x + k * dx, y + k * dy, z + k),
+                (x + k * dx + dx, y + k * dy, z + k),
+                (x + (k + 1) * dx, y + (k + 1) * dy, z + k),
+            ]
     voxels = np.unique(np.clip(np.array(branches), 0, 63), axis=0)
     n = 3000
     azimuth = rng.uniform(0, 2 * np.pi, n)
     dep = np.radians(45.0)
-    directions = np.stack([np.cos(dep) * np.sin(azimuth), np.cos(dep) * np.cos(azimuth),
-                           -np.full(n, np.sin(dep))], axis=1)
+    directions = np.stack(
+        [np.cos(dep) * np.sin(azimuth), np.cos(dep) * np.cos(azimuth), -np.full(n, np.sin(dep))], axis=1
+    )
     origins = np.column_stack([rng.uniform(0, 64, n), rng.uniform(0, 64, n), np.full(n, 40.0)])
     origins -= 0 * directions
     case = Case(voxels, (64, 64, 24), origins, directions)
@@ -523,6 +553,7 @@ def test_march_misses_thin_diagonal_features_and_the_rate_is_recorded(tracer, re
 
 # --------------------------------------------------------------------------- measures
 
+
 def test_measures_stay_defined_or_say_undefined_on_degenerate_inputs():
     import json
 
@@ -531,8 +562,9 @@ def test_measures_stay_defined_or_say_undefined_on_degenerate_inputs():
     empty = np.zeros((0, 3), np.int32)
     # No target voxel seen, one scan: coverage is a defined 0, directions undefined.
     target = np.array([[4, 4, 0], [5, 4, 0]])
-    m = compute_measures(target, np.array([[0, 0, 3]]), target, scene_per_scan=[empty],
-                         target_per_scan=[target])
+    m = compute_measures(
+        target, np.array([[0, 0, 3]]), target, scene_per_scan=[empty], target_per_scan=[target]
+    )
     assert m.obscured_coverage == 0.0 and m.unobscured_coverage == 1.0
     assert m.obscured_directions.mean_direction is None and m.direction_shift_rad is None
     assert m.obscured_after_scan == (0.0,) and m.scans == 1
@@ -560,7 +592,12 @@ def test_measures_of_a_hidden_one_voxel_target_traced_in_one_scan():
     hits = trace(occupancy, origins, [[0.0, 0.0, -1.0]], backend="numba")
     returns = scan_returns(hits, np.zeros(1, np.int32), 1.0)
     assert returns.tolist() == [[4, 4, 3]]
-    m = compute_measures(np.array([[4, 4, 0]]), returns, np.array([[4, 4, 0]]),
-                         scene_per_scan=[returns], target_per_scan=[np.array([[4, 4, 0]])])
+    m = compute_measures(
+        np.array([[4, 4, 0]]),
+        returns,
+        np.array([[4, 4, 0]]),
+        scene_per_scan=[returns],
+        target_per_scan=[np.array([[4, 4, 0]])],
+    )
     assert m.obscured_coverage == 0.0 and m.obscured_directions.mean_direction is None
     assert m.missed_share == 1.0

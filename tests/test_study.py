@@ -12,15 +12,27 @@ import numpy as np
 import pytest
 
 from ladartui.errors import Cancelled
-from ladartui.study import (MissSummary, Setting, StudyResult, StudyRow, Timing, chart_svg,
-                            chart_text, dominates, full_settings, measure, pareto_front,
-                            quick_settings, voxel_geometry)
-from ladartui.study.misses import differing, summarise
 from ladartui.pareto import dominator
+from ladartui.study import (
+    MissSummary,
+    Setting,
+    StudyResult,
+    StudyRow,
+    Timing,
+    chart_svg,
+    chart_text,
+    dominates,
+    full_settings,
+    measure,
+    pareto_front,
+    quick_settings,
+    voxel_geometry,
+)
+from ladartui.study.misses import differing, summarise
 from ladartui.tracing.backend import GROUND, MISS, VOXEL
 
-
 # --------------------------------------------------------------------------- Pareto front
+
 
 def test_pareto_front_of_a_hand_drawn_set():
     # (seconds, error): (3, 3) loses to (2, 3); (2, 4) loses to (2, 3).
@@ -46,11 +58,13 @@ def test_equal_points_do_not_dominate_each_other_and_missing_values_never_count(
 
 # --------------------------------------------------------------------------- timing
 
+
 def test_measure_times_only_after_warm_up_and_quotes_the_median():
     ticks = iter([0.0, 5.0, 10.0, 12.0, 20.0, 21.0])  # three timed calls: 5, 2, 1 seconds
     calls = []
-    result, timing = measure(lambda: calls.append(1) or len(calls), runs=3, warmup=2,
-                             clock=lambda: next(ticks))
+    result, timing = measure(
+        lambda: calls.append(1) or len(calls), runs=3, warmup=2, clock=lambda: next(ticks)
+    )
     assert len(calls) == 5 and result == 5
     assert timing.seconds == [5.0, 2.0, 1.0]
     assert timing.median == 2.0
@@ -65,6 +79,7 @@ def test_measure_stops_on_cancel():
 
 
 # --------------------------------------------------------------------------- miss classes
+
 
 def test_a_vertical_ray_through_a_voxel_centre_is_in_no_class():
     classes = voxel_geometry([[5.5, 5.5, 20.0]], [[0, 0, -1.0]], [[5, 5, 3]])
@@ -99,12 +114,16 @@ def test_grazing_and_edge_entries():
 
 
 def test_summary_counts_differing_rays_and_which_way_they_err():
-    exact = (np.array([VOXEL, VOXEL, GROUND, MISS], np.uint8),
-             np.array([[1, 1, 1], [2, 2, 2], [3, 3, 0], [-1, -1, -1]], np.int32),
-             np.array([5.0, 6.0, 9.0, np.inf]))
-    other = (np.array([VOXEL, GROUND, GROUND, MISS], np.uint8),
-             np.array([[1, 1, 1], [2, 3, 0], [3, 4, 0], [-1, -1, -1]], np.int32),
-             np.array([5.5, 8.0, 7.0, np.inf]))
+    exact = (
+        np.array([VOXEL, VOXEL, GROUND, MISS], np.uint8),
+        np.array([[1, 1, 1], [2, 2, 2], [3, 3, 0], [-1, -1, -1]], np.int32),
+        np.array([5.0, 6.0, 9.0, np.inf]),
+    )
+    other = (
+        np.array([VOXEL, GROUND, GROUND, MISS], np.uint8),
+        np.array([[1, 1, 1], [2, 3, 0], [3, 4, 0], [-1, -1, -1]], np.int32),
+        np.array([5.5, 8.0, 7.0, np.inf]),
+    )
     assert differing(exact[0], exact[1], other[0], other[1]).tolist() == [False, True, True, False]
     o = np.zeros((4, 3))
     d = np.tile([0.0, 0.0, -1.0], (4, 1))
@@ -121,6 +140,7 @@ def test_summary_counts_differing_rays_and_which_way_they_err():
 
 # --------------------------------------------------------------------------- settings
 
+
 def test_full_study_covers_every_backend_method_and_setting():
     settings = full_settings()
     tracers = {s.tracer for s in settings}
@@ -128,13 +148,18 @@ def test_full_study_covers_every_backend_method_and_setting():
     assert {("wgpu", "exact", p, None) for p in ("f64", "f32")} <= tracers
     for backend in ("numba", "wgpu"):
         assert {s.step for s in settings if s.backend == backend and s.method == "march"} == {
-            1.0, 0.5, 0.25, 0.1}
+            1.0,
+            0.5,
+            0.25,
+            0.1,
+        }
     assert {s.ray_grid for s in settings} == {1, 2, 4, 8}
     assert len(settings) == len(set(settings)) == 11 * 4
     assert len(quick_settings()) < len(settings) / 2
 
 
 # --------------------------------------------------------------------------- results
+
 
 def _row(label_setting, seconds, error, share, status="ok"):
     row = StudyRow(label_setting, status=status, rays_per_scan=1000, scans=2)
@@ -154,10 +179,10 @@ def _result():
     slow_march = Setting("numba", "march", "f64", 0.1, 4)
     gpu = Setting("wgpu", "exact", "f32", None, 4)
     rows = [
-        _row(exact1, [1.0, 1.2, 1.1], -0.10, 0.0),     # fast, coarse
-        _row(exact4, [4.0, 4.4, 4.2], 0.0, 0.0),       # the converged reference
-        _row(march, [2.0, 2.0, 2.0], +0.02, 0.06),     # in between: on the front
-        _row(slow_march, [9.0, 9.0], +0.01, 0.02),     # slower than exact and worse
+        _row(exact1, [1.0, 1.2, 1.1], -0.10, 0.0),  # fast, coarse
+        _row(exact4, [4.0, 4.4, 4.2], 0.0, 0.0),  # the converged reference
+        _row(march, [2.0, 2.0, 2.0], +0.02, 0.06),  # in between: on the front
+        _row(slow_march, [9.0, 9.0], +0.01, 0.02),  # slower than exact and worse
         _row(gpu, [], None, 0.0, status="skipped"),
     ]
     result = StudyResult(rows, reference_label=exact4.label, reference_coverage=0.5)
@@ -168,9 +193,13 @@ def _result():
 def test_finish_scores_coverage_error_and_marks_the_front():
     result = _result()
     fronts = {row.label: row.front for row in result.rows}
-    assert fronts == {"numba exact f64 m=1": True, "numba exact f64 m=4": True,
-                      "numba march 0.5 f64 m=4": True, "numba march 0.1 f64 m=4": False,
-                      "wgpu exact f32 m=4": False}
+    assert fronts == {
+        "numba exact f64 m=1": True,
+        "numba exact f64 m=4": True,
+        "numba march 0.5 f64 m=4": True,
+        "numba march 0.1 f64 m=4": False,
+        "wgpu exact f32 m=4": False,
+    }
     assert result.rows[3].dominated_by == "numba exact f64 m=4"
     assert result.rows[0].coverage_error == pytest.approx(-0.10)
     assert result.rows[0].seconds_per_scan == pytest.approx(1.1)
@@ -206,6 +235,7 @@ def test_chart_marks_the_front_as_text_and_svg():
 
 # --------------------------------------------------------------------------- a real study
 
+
 def _tiny_inputs(depth_resolution=0.0):
     from ladartui.flight import orbit
     from ladartui.scene.model import Scene
@@ -233,8 +263,9 @@ def _reference_answers(inputs, m):
     out = []
     for pose in inputs.poses:
         origins, directions, _ = sensor.rays(pose)
-        out.append(reference_trace_cells(scene.voxels, scene.shape,
-                                         origins / scene.voxel_size + 0.5, directions))
+        out.append(
+            reference_trace_cells(scene.voxels, scene.shape, origins / scene.voxel_size + 0.5, directions)
+        )
     return out
 
 
@@ -243,8 +274,12 @@ def test_run_study_scores_against_an_independent_reference_and_skips_unknown_bac
 
     pytest.importorskip("numba")
     inputs = _tiny_inputs()
-    settings = [Setting("numba", "exact", "f64", None, 1), Setting("numba", "march", "f64", 1.0, 1),
-                Setting("numba", "exact", "f64", None, 2), Setting("nosuch", "exact", "f64", None, 2)]
+    settings = [
+        Setting("numba", "exact", "f64", None, 1),
+        Setting("numba", "march", "f64", 1.0, 1),
+        Setting("numba", "exact", "f64", None, 2),
+        Setting("nosuch", "exact", "f64", None, 2),
+    ]
     seen = []
     result = run_study(inputs, settings, runs=2, warmup=1, progress=seen.append)
     rows = {row.label: row for row in result.rows}
@@ -288,8 +323,13 @@ def test_cli_quick_writes_data_and_chart_files(tmp_path, monkeypatch, capsys):
     assert status == 0, out.err
     assert "Pareto front" in out.out
     names = sorted(p.name for p in tmp_path.iterdir())
-    assert names == ["speed-accuracy.png", "speed-accuracy.svg", "speed-accuracy.txt", "study.csv",
-                     "study.json"]
+    assert names == [
+        "speed-accuracy.png",
+        "speed-accuracy.svg",
+        "speed-accuracy.txt",
+        "study.csv",
+        "study.json",
+    ]
     data = json.loads((tmp_path / "study.json").read_text())
     assert data["reference"]["label"] == "numba exact f64 m=2"
     assert main(["study", "--scans", "0"]) == 2
@@ -298,8 +338,8 @@ def test_cli_quick_writes_data_and_chart_files(tmp_path, monkeypatch, capsys):
 
 # --------------------------------------------------------------------------- the screen
 
-async def test_study_screen_runs_in_a_worker_and_shows_chart_table_and_verdict(monkeypatch,
-                                                                              tmp_path):
+
+async def test_study_screen_runs_in_a_worker_and_shows_chart_table_and_verdict(monkeypatch, tmp_path):
     pytest.importorskip("textual")
     monkeypatch.setenv("LADARTUI_HOME", str(tmp_path))  # where the screen keeps its study
     from textual.app import App
@@ -310,9 +350,13 @@ async def test_study_screen_runs_in_a_worker_and_shows_chart_table_and_verdict(m
     from ladartui.tui.study_screen import StudyScreen
 
     monkeypatch.setattr(study_inputs, "generated_inputs", lambda *a, **k: _tiny_inputs(1.0))
-    monkeypatch.setattr(study_settings, "quick_settings", lambda: [
-        Setting("numba", "exact", "f64", None, 1), Setting("numba", "march", "f64", 1.0, 1)])
+    monkeypatch.setattr(
+        study_settings,
+        "quick_settings",
+        lambda: [Setting("numba", "exact", "f64", None, 1), Setting("numba", "march", "f64", 1.0, 1)],
+    )
     import ladartui.study as study_package
+
     monkeypatch.setattr(study_package, "quick_settings", study_settings.quick_settings)
 
     class Host(App):

@@ -55,15 +55,22 @@ def tiny(tmp_path_factory):
 
 
 def test_grid_is_the_product_of_its_axes(tmp_path):
-    spec = load_sweep_spec(write_spec(tmp_path, """
+    spec = load_sweep_spec(
+        write_spec(
+            tmp_path,
+            """
 [grid]
 radius = [100, 150.5]
 altitude = { start = 100, stop = 300, step = 100 }
 fov = 10
-"""))
+""",
+        )
+    )
     points = [v.params for v in spec.variants]
-    expected = [{"radius": r, "altitude": a, "fov": 10.0}
-                for r, a in itertools.product([100.0, 150.5], [100.0, 200.0, 300.0])]
+    expected = [
+        {"radius": r, "altitude": a, "fov": 10.0}
+        for r, a in itertools.product([100.0, 150.5], [100.0, 200.0, 300.0])
+    ]
     assert points == expected
     assert spec.scenario_path == tmp_path / "base.toml"
 
@@ -93,31 +100,40 @@ fov = [5.0, 7.5]
 
 
 def test_parameters_that_do_not_apply_to_a_preset_make_no_extra_variants(tmp_path):
-    spec = load_sweep_spec(write_spec(tmp_path, """
+    spec = load_sweep_spec(
+        write_spec(
+            tmp_path,
+            """
 [grid]
 preset = ["orbit", "flypast"]
 radius = [50, 60, 70]
 standoff = [10, 20]
-"""))
+""",
+        )
+    )
     # 3 orbits (radius only) + 2 fly-pasts (standoff only), not 2 x 3 x 2.
-    assert sorted((p["preset"], p.get("radius"), p.get("standoff"))
-                  for p in (v.params for v in spec.variants)) == sorted(
-        [("orbit", r, None) for r in (50.0, 60.0, 70.0)]
-        + [("flypast", None, s) for s in (10.0, 20.0)])
+    assert sorted(
+        (p["preset"], p.get("radius"), p.get("standoff")) for p in (v.params for v in spec.variants)
+    ) == sorted(
+        [("orbit", r, None) for r in (50.0, 60.0, 70.0)] + [("flypast", None, s) for s in (10.0, 20.0)]
+    )
 
 
-@pytest.mark.parametrize("body, key, line", [
-    ("[grid]\nradius = []\n", "grid.radius", 4),
-    ("[grid]\nscans = [2, 2.5]\n", "grid.scans", 4),
-    ("[grid]\nradious = [1]\n", "grid.radious", 4),
-    ("[grid]\npreset = ['circle']\n", "grid.preset", 4),
-    ("objective = 'fastest'\n[grid]\nradius = [1]\n", "sweep.objective", 3),
-    ("objective = 'coverage-within-budget'\n[grid]\nradius = [1]\n", "sweep.budget", None),
-    ("[random]\nseed = 1\nfov = { min = 5, max = 1 }\n", "random.samples", None),
-    ("[random]\nsamples = 2\nfov = { min = 5, max = 1 }\n", "random.fov", 5),
-    ("[grid]\nfov = [1]\n[random]\nsamples = 2\nfov = [1, 2]\n", "random.fov", 7),
-    ("", "grid", None),
-])
+@pytest.mark.parametrize(
+    "body, key, line",
+    [
+        ("[grid]\nradius = []\n", "grid.radius", 4),
+        ("[grid]\nscans = [2, 2.5]\n", "grid.scans", 4),
+        ("[grid]\nradious = [1]\n", "grid.radious", 4),
+        ("[grid]\npreset = ['circle']\n", "grid.preset", 4),
+        ("objective = 'fastest'\n[grid]\nradius = [1]\n", "sweep.objective", 3),
+        ("objective = 'coverage-within-budget'\n[grid]\nradius = [1]\n", "sweep.budget", None),
+        ("[random]\nseed = 1\nfov = { min = 5, max = 1 }\n", "random.samples", None),
+        ("[random]\nsamples = 2\nfov = { min = 5, max = 1 }\n", "random.fov", 5),
+        ("[grid]\nfov = [1]\n[random]\nsamples = 2\nfov = [1, 2]\n", "random.fov", 7),
+        ("", "grid", None),
+    ],
+)
 def test_spec_errors_name_the_file_key_and_what_was_expected(tmp_path, body, key, line):
     path = write_spec(tmp_path, body)
     with pytest.raises(InputFileError) as caught:
@@ -150,13 +166,13 @@ def test_variant_ids_ignore_order_and_number_spelling_but_not_values():
 
 def test_variant_ids_are_stable_across_processes():
     params = {"radius": 0.1 + 0.2, "scans": 7, "preset": "standoff"}
-    code = ("from ladartui.sweep import variant_id; "
-            f"print(variant_id({params!r}))")
+    code = f"from ladartui.sweep import variant_id; print(variant_id({params!r}))"
     # Another process with another string-hash seed computes the same id.
     seed = "2" if os.environ.get("PYTHONHASHSEED") == "1" else "1"
     env = dict(os.environ, PYTHONHASHSEED=seed)
-    other = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
-                           text=True, check=True).stdout.strip()
+    other = subprocess.run(
+        [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
+    ).stdout.strip()
     assert other == variant_id(params)
 
 
@@ -165,11 +181,24 @@ def test_variant_ids_are_stable_across_processes():
 
 def test_table_round_trips_values_and_grows_columns(tmp_path):
     rows = [
-        {"variant": "1e50000000000000", "status": "error", "base": "b", "radius": 10.0,
-         "error": 'bad "quote", comma'},
-        {"variant": "00000000000000ff", "status": "ok", "base": "b", "radius": 0.1 + 0.2,
-         "scans": 3, "obscured_coverage": 1 / 3, "after": [0.25, 0.5], "flag": True,
-         "nothing": None},
+        {
+            "variant": "1e50000000000000",
+            "status": "error",
+            "base": "b",
+            "radius": 10.0,
+            "error": 'bad "quote", comma',
+        },
+        {
+            "variant": "00000000000000ff",
+            "status": "ok",
+            "base": "b",
+            "radius": 0.1 + 0.2,
+            "scans": 3,
+            "obscured_coverage": 1 / 3,
+            "after": [0.25, 0.5],
+            "flag": True,
+            "nothing": None,
+        },
     ]
     path = tmp_path / "results.csv"
     write_table(path, rows, ["radius", "scans"])
@@ -203,26 +232,40 @@ def _dominated(p, q):
 def test_pareto_front_matches_a_brute_force_check():
     rng = random.Random(3)
     for _ in range(200):
-        points = [(float(rng.randint(0, 5)), float(rng.randint(0, 5)))
-                  for _ in range(rng.randint(0, 12))]
+        points = [(float(rng.randint(0, 5)), float(rng.randint(0, 5))) for _ in range(rng.randint(0, 12))]
         points.append(None)
-        expected = [p is not None and not any(q is not None and _dominated(p, q) for q in points)
-                    for p in points]
+        expected = [
+            p is not None and not any(q is not None and _dominated(p, q) for q in points) for p in points
+        ]
         assert pareto_front(points) == expected
 
 
 def _row(variant, coverage, length, time, status="ok"):
-    return {"variant": variant, "status": status, "obscured_coverage": coverage,
-            "path_length_m": length, "flight_time_s": time}
+    return {
+        "variant": variant,
+        "status": status,
+        "obscured_coverage": coverage,
+        "path_length_m": length,
+        "flight_time_s": time,
+    }
 
 
 def test_objectives_rank_by_coverage_per_km_and_within_budget():
-    rows = [_row("a", 0.5, 2000.0, 100.0), _row("b", 0.4, 500.0, 25.0),
-            _row("c", 0.9, 9000.0, 450.0), _row("d", None, None, None, status="error"),
-            _row("e", 0.3, 0.0, 0.0)]
+    rows = [
+        _row("a", 0.5, 2000.0, 100.0),
+        _row("b", 0.4, 500.0, 25.0),
+        _row("c", 0.9, 9000.0, 450.0),
+        _row("d", None, None, None, status="error"),
+        _row("e", 0.3, 0.0, 0.0),
+    ]
     per_km = rank_rows(rows, "coverage-per-km")
     assert [(r.row["variant"], r.rank) for r in per_km] == [
-        ("b", 1), ("a", 2), ("c", 3), ("e", None), ("d", None)]
+        ("b", 1),
+        ("a", 2),
+        ("c", 3),
+        ("e", None),
+        ("d", None),
+    ]
     assert per_km[0].value == pytest.approx(0.4 / 0.5)
     budget = rank_rows(rows, "coverage-within-budget", budget=120.0)
     assert [r.row["variant"] for r in budget if r.rank] == ["a", "b", "e"]
@@ -245,8 +288,10 @@ def test_parameters_reshape_the_base_flight_and_sensor(tiny):
     from ladartui.scenario import load_scenario
 
     base = load_scenario(tiny / "base.toml")
-    scenario = apply_parameters(base, {"radius": 12.0, "altitude": 30.0, "scans": 6,
-                                       "heading_offset": 90.0, "fov": 15.0, "sensor_grid": 4})
+    scenario = apply_parameters(
+        base,
+        {"radius": 12.0, "altitude": 30.0, "scans": 6, "heading_offset": 90.0, "fov": 15.0, "sensor_grid": 4},
+    )
     poses = scenario.poses()
     assert len(poses) == 6
     for pose in poses:
@@ -272,8 +317,9 @@ def test_preset_builds_a_flypast_or_standoff_around_the_base_target(tiny):
     standoff = apply_parameters(base, {"preset": "standoff", "standoff": 30.0, "scans": 3})
     distances = [math.hypot(p.x - CENTRE[0], p.y - CENTRE[1]) for p in standoff.poses()]
     assert distances == pytest.approx([30.0, 20.0, 10.0])
-    turned = apply_parameters(base, {"preset": "standoff", "standoff": 30.0, "scans": 3,
-                                     "heading_offset": -90.0})
+    turned = apply_parameters(
+        base, {"preset": "standoff", "standoff": 30.0, "scans": 3, "heading_offset": -90.0}
+    )
     assert all(_bearing(p, CENTRE) == pytest.approx(90.0) for p in turned.poses())
 
 
@@ -281,8 +327,11 @@ def test_a_base_standoff_keeps_its_spacing_scaled_to_the_new_standoff(tiny):
     from ladartui.flight import FlightPlan, Standoff
     from ladartui.scenario import load_scenario
 
-    base = load_scenario(tiny / "base.toml").with_changes(flight=FlightPlan(segments=(
-        Standoff(target=CENTRE, standoffs=(40.0, 20.0, 10.0), altitude=25.0, bearing=90.0),)))
+    base = load_scenario(tiny / "base.toml").with_changes(
+        flight=FlightPlan(
+            segments=(Standoff(target=CENTRE, standoffs=(40.0, 20.0, 10.0), altitude=25.0, bearing=90.0),)
+        )
+    )
     scenario = apply_parameters(base, {"standoff": 80.0})
     distances = [math.hypot(p.x - CENTRE[0], p.y - CENTRE[1]) for p in scenario.poses()]
     assert distances == pytest.approx([80.0, 40.0, 20.0])
@@ -309,8 +358,7 @@ def _hand_built(base, radius, scans, grid):
     """The variant's scenario built directly from the flight and sensor classes."""
     from ladartui.flight import FlightPlan, Orbit
 
-    flight = FlightPlan(segments=(Orbit(centre=CENTRE, radius=radius, altitude=20.0,
-                                        scans=scans),))
+    flight = FlightPlan(segments=(Orbit(centre=CENTRE, radius=radius, altitude=20.0, scans=scans),))
     return base.with_changes(flight=flight, sensor=replace(base.sensor, grid=grid))
 
 
@@ -328,26 +376,27 @@ def test_serial_sweep_rows_match_direct_simulations(tiny, tmp_path):
     base = load_scenario(tiny / "base.toml")
     errors = [r for r in result.rows if r["status"] != "ok"]
     assert len(errors) == 4
-    assert all(r["sensor_grid"] == 0 and "sensor_grid = 0" in r["error"]
-               and "expected" in r["error"] for r in errors)
+    assert all(
+        r["sensor_grid"] == 0 and "sensor_grid = 0" in r["error"] and "expected" in r["error"] for r in errors
+    )
     for row in (r for r in result.rows if r["status"] == "ok"):
-        expected = simulate(_hand_built(base, row["radius"], row["scans"], row["sensor_grid"]),
-                            write=False)
+        expected = simulate(_hand_built(base, row["radius"], row["scans"], row["sensor_grid"]), write=False)
         measures = expected.measures
         assert row["obscured_coverage"] == measures.obscured_coverage
         assert row["unobscured_coverage"] == measures.unobscured_coverage
         assert row["obscured_after_scan"] == list(measures.obscured_after_scan)
         assert row["scan_count"] == row["scans"]
-        assert row["path_length_m"] == pytest.approx(2 * math.pi * row["radius"] * (
-            1 if row["scans"] == 1 else (row["scans"] - 1) / row["scans"]))
+        assert row["path_length_m"] == pytest.approx(
+            2 * math.pi * row["radius"] * (1 if row["scans"] == 1 else (row["scans"] - 1) / row["scans"])
+        )
         assert row["flight_time_s"] == pytest.approx(row["path_length_m"] / base.speed)
     # The file holds the same rows, and the ranking and best scenario were written.
     stored, _ = read_table(tmp_path / "out" / "results.csv")
-    assert sorted(map(repr, map(comparable, stored))) == sorted(
-        map(repr, map(comparable, result.rows)))
+    assert sorted(map(repr, map(comparable, stored))) == sorted(map(repr, map(comparable, result.rows)))
     best = result.best.row
-    assert best["obscured_coverage"] == max(r["obscured_coverage"] for r in result.rows
-                                            if r["status"] == "ok")
+    assert best["obscured_coverage"] == max(
+        r["obscured_coverage"] for r in result.rows if r["status"] == "ok"
+    )
     saved = load_scenario(result.best_scenario_path)
     assert saved.flight.segments[0].radius == best["radius"]
     assert len(saved.poses()) == best["scans"]
@@ -378,7 +427,8 @@ def test_interrupted_sweep_resumes_with_only_the_missing_variants(tiny, tmp_path
     kept = {r["variant"]: r for r in result.rows}
     for row in first:  # untouched: same worker and run time as before
         assert {k: v for k, v in kept[row["variant"]].items() if v is not None} == {
-            k: v for k, v in row.items() if v is not None}
+            k: v for k, v in row.items() if v is not None
+        }
     # Nothing left to do: a third run runs nothing.
     again = run_sweep(spec, serial=True, out=out)
     assert (again.resumed, again.ran) == (8, 0)
@@ -399,10 +449,13 @@ def test_editing_the_base_scenario_runs_every_variant_again(tmp_path):
 
 
 def test_the_sweep_core_and_command_import_without_textual_or_dask():
-    code = ("import sys, ladartui.sweep, ladartui.cli.sweep; "
-            "print(sorted(m for m in ('textual', 'distributed') if m in sys.modules))")
-    loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                            check=True).stdout.strip()
+    code = (
+        "import sys, ladartui.sweep, ladartui.cli.sweep; "
+        "print(sorted(m for m in ('textual', 'distributed') if m in sys.modules))"
+    )
+    loaded = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    ).stdout.strip()
     assert loaded == "[]"  # Dask loads only when a sweep runs on it
 
 
@@ -421,8 +474,21 @@ def test_cli_serial_sweep_prints_the_ranking_as_json(tiny, tmp_path, capsys):
     from ladartui.cli import main
 
     spec = write_spec(tiny, "[grid]\nradius = [10.0, 20.0]\n", name="cli.toml")
-    assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path), "--json",
-                 "--objective", "coverage-per-km"]) == 0
+    assert (
+        main(
+            [
+                "sweep",
+                str(spec),
+                "--serial",
+                "--out",
+                str(tmp_path),
+                "--json",
+                "--objective",
+                "coverage-per-km",
+            ]
+        )
+        == 0
+    )
     report = json.loads(capsys.readouterr().out)
     assert report["objective"] == "coverage-per-km" and report["variants"] == 2
     values = [entry["objective"] for entry in report["top"]]
@@ -431,8 +497,7 @@ def test_cli_serial_sweep_prints_the_ranking_as_json(tiny, tmp_path, capsys):
     by_id = {r["variant"]: r for r in rows}
     for entry in report["top"]:
         row = by_id[entry["variant"]]
-        assert entry["objective"] == pytest.approx(
-            row["obscured_coverage"] / (row["path_length_m"] / 1000.0))
+        assert entry["objective"] == pytest.approx(row["obscured_coverage"] / (row["path_length_m"] / 1000.0))
     assert os.path.isfile(report["best_scenario"])
 
 

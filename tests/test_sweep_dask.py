@@ -91,14 +91,16 @@ def test_cluster_sweep_resumes_after_an_interruption(spec, serial_rows, client, 
     for row in before:  # kept as they were (same worker, same run time), not run again
         # (Columns added by later rows read back as None in earlier ones.)
         assert {k: v for k, v in by_id[row["variant"]].items() if v is not None} == {
-            k: v for k, v in row.items() if v is not None}
+            k: v for k, v in row.items() if v is not None
+        }
     assert comparable(result.rows) == comparable(serial_rows)
 
 
 def _start(args, log, env):
     handle = open(log, "wb")
-    return subprocess.Popen(args, stdout=handle, stderr=subprocess.STDOUT, env=env,
-                            start_new_session=True), handle
+    return subprocess.Popen(
+        args, stdout=handle, stderr=subprocess.STDOUT, env=env, start_new_session=True
+    ), handle
 
 
 def _wait_for(pattern, log, process, seconds=60.0):
@@ -129,26 +131,50 @@ def test_cli_runs_on_a_scheduler_and_worker_started_as_processes(spec, serial_ro
     env = dict(os.environ, NUMBA_NUM_THREADS="1")
     started = []
     try:
-        scheduler, log = _start([str(bin_dir / "dask"), "scheduler", "--host", "127.0.0.1",
-                                 "--port", "0", "--no-dashboard"], tmp_path / "scheduler.log", env)
+        scheduler, log = _start(
+            [str(bin_dir / "dask"), "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard"],
+            tmp_path / "scheduler.log",
+            env,
+        )
         started.append((scheduler, log))
-        address = _wait_for(r"Scheduler at:\s+(tcp://127\.0\.0\.1:\d+)", tmp_path / "scheduler.log",
-                            scheduler).group(1)
-        worker, log = _start([str(bin_dir / "dask"), "worker", address, "--nthreads", "1",
-                              "--no-dashboard"], tmp_path / "worker.log", env)
+        address = _wait_for(
+            r"Scheduler at:\s+(tcp://127\.0\.0\.1:\d+)", tmp_path / "scheduler.log", scheduler
+        ).group(1)
+        worker, log = _start(
+            [str(bin_dir / "dask"), "worker", address, "--nthreads", "1", "--no-dashboard"],
+            tmp_path / "worker.log",
+            env,
+        )
         started.append((worker, log))
         out = tmp_path / "out"
-        run = subprocess.run([str(bin_dir / "ladartui"), "sweep", str(spec), "--scheduler",
-                              address, "--out", str(out), "--json"],
-                             capture_output=True, text=True, env=env, timeout=240)
+        run = subprocess.run(
+            [
+                str(bin_dir / "ladartui"),
+                "sweep",
+                str(spec),
+                "--scheduler",
+                address,
+                "--out",
+                str(out),
+                "--json",
+            ],
+            capture_output=True,
+            text=True,
+            env=env,
+            timeout=240,
+        )
         assert run.returncode == 0, run.stderr
         report = json.loads(run.stdout)
         assert (report["variants"], report["ran"], report["failed"]) == (8, 8, 4)
         rows, _ = read_table(out / "results.csv")
         assert comparable(rows) == comparable(serial_rows)
-        assert report["top"][0]["variant"] == max(
-            (r for r in serial_rows if r["status"] == "ok"),
-            key=lambda r: (r["obscured_coverage"], -r["flight_time_s"]))["variant"]
+        assert (
+            report["top"][0]["variant"]
+            == max(
+                (r for r in serial_rows if r["status"] == "ok"),
+                key=lambda r: (r["obscured_coverage"], -r["flight_time_s"]),
+            )["variant"]
+        )
     finally:
         for process, handle in reversed(started):
             _stop(process)

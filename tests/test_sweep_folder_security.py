@@ -14,12 +14,15 @@ def test_a_folder_made_by_certs_gives_mutual_tls_for_a_tls_scheduler(tmp_path):
     assert security.require_encryption and security.tls_client_cert.endswith("cluster.pem")
 
 
-@pytest.mark.parametrize("address, folder, words", [
-    ("tcp://10.0.0.5:8786", None, "run code on it"),        # plain, off this machine
-    ("tls://10.0.0.5:8786", None, "the folder of the certificates"),
-    ("tcp://10.0.0.5:8786", "certs", "tls://HOST:PORT"),    # certificates need tls://
-    ("tls://10.0.0.5:8786", "empty", "missing: ca.pem, cluster.pem, cluster-key.pem"),
-])
+@pytest.mark.parametrize(
+    "address, folder, words",
+    [
+        ("tcp://10.0.0.5:8786", None, "run code on it"),  # plain, off this machine
+        ("tls://10.0.0.5:8786", None, "the folder of the certificates"),
+        ("tcp://10.0.0.5:8786", "certs", "tls://HOST:PORT"),  # certificates need tls://
+        ("tls://10.0.0.5:8786", "empty", "missing: ca.pem, cluster.pem, cluster-key.pem"),
+    ],
+)
 def test_what_is_refused_says_why(tmp_path, address, folder, words):
     make_certificates(tmp_path / "certs")
     (tmp_path / "empty").mkdir()

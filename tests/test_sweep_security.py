@@ -10,22 +10,28 @@ from ladartui.errors import FieldError
 from ladartui.sweep.security import cluster_security, is_loopback, make_certificates
 
 
-@pytest.mark.parametrize("address", ["tcp://127.0.0.1:8786", "127.0.0.1:8786",
-                                     "tcp://localhost:8786", "tcp://[::1]:8786"])
+@pytest.mark.parametrize(
+    "address", ["tcp://127.0.0.1:8786", "127.0.0.1:8786", "tcp://localhost:8786", "tcp://[::1]:8786"]
+)
 def test_plain_loopback_address_needs_no_tls(address):
     assert is_loopback(address)
     assert cluster_security(address) is None
 
 
-@pytest.mark.parametrize("address", ["tcp://0.0.0.0:8786", "tcp://192.0.2.1:8786",
-                                     "head:8786", "tcp://127.example.com:8786"])
+@pytest.mark.parametrize(
+    "address", ["tcp://0.0.0.0:8786", "tcp://192.0.2.1:8786", "head:8786", "tcp://127.example.com:8786"]
+)
 def test_plain_address_off_loopback_is_refused_unless_insecure(address):
     with pytest.raises(FieldError, match="can run code"):
         cluster_security(address)
     assert cluster_security(address, insecure=True) is None
     # In a subprocess, like a user's shell (the CLI in-process disturbs a later Dask loop).
-    run = subprocess.run([sys.executable, "-m", "ladartui", "sweep", "spec.toml",
-                          "--scheduler", address], capture_output=True, text=True, timeout=60)
+    run = subprocess.run(
+        [sys.executable, "-m", "ladartui", "sweep", "spec.toml", "--scheduler", address],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
     assert run.returncode == 2
     err = run.stderr
     assert err.count("\n") == 1 and "--insecure" in err and "Traceback" not in err
@@ -46,13 +52,23 @@ def _server_security(paths):
     from distributed.security import Security
 
     ca, cert, key = (str(paths[k]) for k in ("ca", "cert", "key"))
-    return Security(tls_ca_file=ca, tls_scheduler_cert=cert, tls_scheduler_key=key,
-                    tls_worker_cert=cert, tls_worker_key=key, tls_client_cert=cert,
-                    tls_client_key=key, require_encryption=True)
+    return Security(
+        tls_ca_file=ca,
+        tls_scheduler_cert=cert,
+        tls_scheduler_key=key,
+        tls_worker_cert=cert,
+        tls_worker_key=key,
+        tls_client_cert=cert,
+        tls_client_key=key,
+        require_encryption=True,
+    )
 
 
-@pytest.mark.skipif(not os.environ.get("LADARTUI_TLS_TEST"), reason="passes alone (1.4 s) but "
-                    "the whole file sometimes hangs after it; set LADARTUI_TLS_TEST=1 to run it")
+@pytest.mark.skipif(
+    not os.environ.get("LADARTUI_TLS_TEST"),
+    reason="passes alone (1.4 s) but "
+    "the whole file sometimes hangs after it; set LADARTUI_TLS_TEST=1 to run it",
+)
 def test_tls_scheduler_on_loopback_refuses_clients_without_its_certificates(tmp_path):
     from distributed import Client, LocalCluster
     from distributed.security import Security
@@ -61,9 +77,15 @@ def test_tls_scheduler_on_loopback_refuses_clients_without_its_certificates(tmp_
 
     ours = make_certificates(tmp_path / "ours")
     rogue = make_certificates(tmp_path / "rogue")
-    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tls",
-                      host="127.0.0.1", dashboard_address=None,
-                      security=_server_security(ours)) as cluster:
+    with LocalCluster(
+        n_workers=1,
+        threads_per_worker=1,
+        processes=False,
+        protocol="tls",
+        host="127.0.0.1",
+        dashboard_address=None,
+        security=_server_security(ours),
+    ) as cluster:
         address = cluster.scheduler_address
         assert address.startswith("tls://127.0.0.1:")
         port = address.rsplit(":", 1)[1]
@@ -72,8 +94,12 @@ def test_tls_scheduler_on_loopback_refuses_clients_without_its_certificates(tmp_
             Client(f"tcp://127.0.0.1:{port}", timeout="2s")
         with pytest.raises((OSError, TimeoutError, TypeError)):
             Client(address, timeout="2s")
-        foreign = Security(tls_ca_file=str(rogue["ca"]), tls_client_cert=str(rogue["cert"]),
-                           tls_client_key=str(rogue["key"]), require_encryption=True)
+        foreign = Security(
+            tls_ca_file=str(rogue["ca"]),
+            tls_client_cert=str(rogue["cert"]),
+            tls_client_key=str(rogue["key"]),
+            require_encryption=True,
+        )
         with pytest.raises((OSError, TimeoutError)):
             Client(address, timeout="2s", security=foreign)
         # Through the sweep's own connect: refused without the files, accepted with them.

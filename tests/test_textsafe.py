@@ -1,7 +1,6 @@
 from pathlib import Path
 
 import ladartui
-
 from ladartui.cli import main
 from ladartui.textsafe import one_line
 
@@ -10,8 +9,7 @@ DEFAULT = (Path(ladartui.__file__).parent / "scenarios" / "default.toml").read_t
 
 def _scenario_with_scene(tmp_path, scene_toml_string):
     path = tmp_path / "s.toml"
-    path.write_text(DEFAULT.replace('scene = "small.txt"', f"scene = {scene_toml_string}"),
-                    encoding="utf-8")
+    path.write_text(DEFAULT.replace('scene = "small.txt"', f"scene = {scene_toml_string}"), encoding="utf-8")
     return path
 
 

@@ -7,7 +7,6 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import ladartui
 from ladartui.errors import BackendUnavailable, Cancelled, FieldError
 from ladartui.scene.occupancy import Occupancy
 from ladartui.tracing import GROUND, MISS, VOXEL, TraceResult, trace
@@ -57,13 +56,16 @@ def test_top_level_export_is_the_function():
     assert ladartui.Occupancy is Occupancy
 
 
-@pytest.mark.parametrize("kwargs, field", [
-    ({"method": "bogus"}, "method"),
-    ({"method": "march", "step": 0}, "step"),
-    ({"method": "march", "step": -1.0}, "step"),
-    ({"voxel_size": 0}, "voxel_size"),
-    ({"precision": "f16"}, "precision"),
-])
+@pytest.mark.parametrize(
+    "kwargs, field",
+    [
+        ({"method": "bogus"}, "method"),
+        ({"method": "march", "step": 0}, "step"),
+        ({"method": "march", "step": -1.0}, "step"),
+        ({"voxel_size": 0}, "voxel_size"),
+        ({"precision": "f16"}, "precision"),
+    ],
+)
 def test_bad_arguments_are_field_errors(block, kwargs, field):
     with pytest.raises(FieldError) as error:
         trace(block, np.zeros((2, 3)), np.ones((2, 3)), **kwargs)
@@ -126,10 +128,12 @@ def test_every_available_backend_agrees_with_numba():
 
 @settings(max_examples=30, deadline=None)
 @given(
-    origins=st.lists(st.tuples(*[st.floats(-1e4, 1e4, allow_nan=False) for _ in range(3)]),
-                     min_size=1, max_size=8),
+    origins=st.lists(
+        st.tuples(*[st.floats(-1e4, 1e4, allow_nan=False) for _ in range(3)]), min_size=1, max_size=8
+    ),
     direction=st.tuples(*[st.floats(-1, 1, allow_nan=False) for _ in range(3)]).filter(
-        lambda v: max(abs(c) for c in v) > 1e-6),
+        lambda v: max(abs(c) for c in v) > 1e-6
+    ),
     method=st.sampled_from(["exact", "march"]),
     size=st.floats(0.05, 5.0),
 )
@@ -172,11 +176,10 @@ def test_registry_lists_every_builtin_backend_even_after_a_direct_import():
 
 def test_every_public_name_resolves_and_unknown_names_fail():
     # The lazy exports of the package and of ladartui.scene point at real objects.
-    import ladartui
     import ladartui.scene
 
     for package in (ladartui, ladartui.scene):
         for name in package.__all__:
             assert getattr(package, name) is not None, (package.__name__, name)
     with pytest.raises(AttributeError, match="has no attribute 'no_such_name'"):
-        ladartui.scene.no_such_name
+        _ = ladartui.scene.no_such_name

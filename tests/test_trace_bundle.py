@@ -10,8 +10,7 @@ from ladartui.flight import ScanPose, aim_at
 from ladartui.scene.occupancy import Occupancy
 from ladartui.sensor import Sensor
 from ladartui.tracing.backend import MISS, VOXEL
-from ladartui.tracing.bundle import (BUNDLE_REACH, FINE_REACH, bundle_start, bundle_starts,
-                                     halo_arrays)
+from ladartui.tracing.bundle import BUNDLE_REACH, FINE_REACH, bundle_start, bundle_starts, halo_arrays
 from ladartui.tracing.reference import reference_trace_cells
 
 CHUNK = 64
@@ -32,12 +31,10 @@ def scan_rays(occ, rng, scans, slant_cells, depressions=(1.0, 89.9), sensor=None
     nx, ny, _ = occ.shape
     origins, directions = [], []
     for _ in range(scans):
-        aim = np.array([rng.uniform(0.2, 0.8) * nx, rng.uniform(0.2, 0.8) * ny,
-                        rng.uniform(0, occ.zmax + 1)])
+        aim = np.array([rng.uniform(0.2, 0.8) * nx, rng.uniform(0.2, 0.8) * ny, rng.uniform(0, occ.zmax + 1)])
         e = math.radians(rng.uniform(*depressions))
         a = rng.uniform(0, 2 * math.pi)
-        at = aim + slant_cells * np.array([math.cos(a) * math.cos(e), math.sin(a) * math.cos(e),
-                                           math.sin(e)])
+        at = aim + slant_cells * np.array([math.cos(a) * math.cos(e), math.sin(a) * math.cos(e), math.sin(e)])
         pose = aim_at(ScanPose(*at.tolist()), aim.tolist())
         o, d, _ = sensor.rays(pose)
         origins.append(o)
@@ -48,12 +45,11 @@ def scan_rays(occ, rng, scans, slant_cells, depressions=(1.0, 89.9), sensor=None
 def starts_of(occ, origins, directions):
     out = np.zeros(-(-len(origins) // CHUNK))
     bundle_starts(origins, directions, CHUNK, *halo_arrays(occ), out)
-    return np.repeat(out, CHUNK)[:len(origins)]
+    return np.repeat(out, CHUNK)[: len(origins)]
 
 
 def same(a, b):
-    return (np.array_equal(a.kind, b.kind) and np.array_equal(a.index, b.index)
-            and np.array_equal(a.t, b.t))
+    return np.array_equal(a.kind, b.kind) and np.array_equal(a.index, b.index) and np.array_equal(a.t, b.t)
 
 
 @pytest.mark.parametrize("level, size", [(0, 8), (1, 4)])
@@ -62,7 +58,7 @@ def test_halos_mark_exactly_the_cells_next_to_voxels(level, size):
     shape = (90, 70, 50)
     vox = rng.integers(0, shape, size=(40, 3))
     occ = Occupancy.build(vox, shape)
-    bits, origin, dims = halo_arrays(occ)[3 * level:3 * level + 3]
+    bits, origin, dims = halo_arrays(occ)[3 * level : 3 * level + 3]
     shift = size.bit_length() - 1
     assert origin.tolist() == ((vox.min(axis=0) >> shift) - 1).tolist()
     cells = {tuple(b) for b in (vox >> shift)}
@@ -70,8 +66,12 @@ def test_halos_mark_exactly_the_cells_next_to_voxels(level, size):
         for y in range(dims[1]):
             for z in range(dims[2]):
                 cell = (origin[0] + x, origin[1] + y, origin[2] + z)
-                expected = any((cell[0] + i, cell[1] + j, cell[2] + k) in cells
-                               for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1))
+                expected = any(
+                    (cell[0] + i, cell[1] + j, cell[2] + k) in cells
+                    for i in (-1, 0, 1)
+                    for j in (-1, 0, 1)
+                    for k in (-1, 0, 1)
+                )
                 lin = x + dims[0] * (y + dims[1] * z)
                 assert bool((bits[lin >> 5] >> (lin & 31)) & 1) == expected, cell
 
@@ -99,13 +99,13 @@ def test_fanned_chunk_starts_no_further_than_its_reach(numba_backend, voxel_x, r
     occ = Occupancy.build(np.array([[voxel_x, 40, 100]]), (120, 80, 200))
     o = np.tile([40.5, 40.5, 1000.0], (CHUNK, 1))
     d = np.tile([0.0, 0.0, -1.0], (CHUNK, 1))
-    d[CHUNK // 2:, 0] = (voxel_x + 0.5 - 40.5) / 899.5
+    d[CHUNK // 2 :, 0] = (voxel_x + 0.5 - 40.5) / 899.5
     d /= np.linalg.norm(d, axis=1)[:, None]
     start = bundle_start(o, d, 0, CHUNK, *halo_arrays(occ))
     spread = np.linalg.norm(d - d.mean(axis=0), axis=1).max()
     hits = numba_backend.trace_cells(occ, o, d)
-    assert (hits.kind[CHUNK // 2:] == VOXEL).all()
-    assert start < hits.t[CHUNK // 2:].min()
+    assert (hits.kind[CHUNK // 2 :] == VOXEL).all()
+    assert start < hits.t[CHUNK // 2 :].min()
     assert same(hits, numba_backend.trace_cells(occ, o, d, bundles=False))
     if reach == BUNDLE_REACH:
         assert start == pytest.approx(reach / spread - 1.0 / np.linalg.norm(d.mean(axis=0)))
@@ -135,10 +135,11 @@ def test_start_is_zero_for_scattered_rays_and_an_empty_halo(forest):
     assert wide == bundle_start(o, d, 0, CHUNK, *halo_arrays(occ)[:3], *halo_arrays(None)[3:])
 
 
-@pytest.mark.parametrize("slant_m, depressions, fov", [
-    (85.0, (30.0, 89.9), 5.0), (150.0, (1.0, 10.0), 5.0), (10_000.0, (20.0, 60.0), 0.05)])
-def test_starts_bound_every_first_hit_and_change_nothing(forest, numba_backend, slant_m,
-                                                         depressions, fov):
+@pytest.mark.parametrize(
+    "slant_m, depressions, fov",
+    [(85.0, (30.0, 89.9), 5.0), (150.0, (1.0, 10.0), 5.0), (10_000.0, (20.0, 60.0), 0.05)],
+)
+def test_starts_bound_every_first_hit_and_change_nothing(forest, numba_backend, slant_m, depressions, fov):
     vox, occ = forest
     rng = np.random.default_rng(int(slant_m))
     sensor = Sensor(grid=16, ray_grid=4, fov=fov)
@@ -204,10 +205,12 @@ def test_f32_offsets_fall_back_to_the_box_entry_when_the_start_is_past_the_scene
     plain = f32_start_offsets(o, d, (100, 100, 20), 20.0, "exact")
     assert plain[0] == pytest.approx(1000.0)
     for start in (np.inf, 2000.0):  # never, or beyond the far side
-        assert f32_start_offsets(o, d, (100, 100, 20), 20.0, "exact", np.array([start])) == \
-            pytest.approx(plain)
-    assert f32_start_offsets(o, d, (100, 100, 20), 20.0, "exact", np.array([1040.0]))[0] == \
-        pytest.approx(1040.0)
+        assert f32_start_offsets(o, d, (100, 100, 20), 20.0, "exact", np.array([start])) == pytest.approx(
+            plain
+        )
+    assert f32_start_offsets(o, d, (100, 100, 20), 20.0, "exact", np.array([1040.0]))[0] == pytest.approx(
+        1040.0
+    )
 
 
 def test_wgpu_chunks_that_never_meet_the_scene(numba_backend, wgpu_backend):

@@ -27,13 +27,18 @@ def assert_matches_reference(vox, shape, origins, directions):
     occ = Occupancy.build(vox, shape)
     got = exact(occ, origins, directions)
     ref = reference_trace_cells(vox, shape, origins, directions)
-    wrong = np.flatnonzero((got.kind != ref.kind) | np.any(got.index != ref.index, axis=1)
-                           | ~((got.t == ref.t) | np.isclose(got.t, ref.t, rtol=0, atol=1e-9)))
+    wrong = np.flatnonzero(
+        (got.kind != ref.kind)
+        | np.any(got.index != ref.index, axis=1)
+        | ~((got.t == ref.t) | np.isclose(got.t, ref.t, rtol=0, atol=1e-9))
+    )
     if len(wrong):
         i = wrong[0]
-        pytest.fail(f"{len(wrong)} of {len(got.kind)} rays differ; first: o={origins[i].tolist()} "
-                    f"d={directions[i].tolist()} got {got.kind[i]} {got.index[i]} {got.t[i]} "
-                    f"reference {ref.kind[i]} {ref.index[i]} {ref.t[i]}")
+        pytest.fail(
+            f"{len(wrong)} of {len(got.kind)} rays differ; first: o={origins[i].tolist()} "
+            f"d={directions[i].tolist()} got {got.kind[i]} {got.index[i]} {got.t[i]} "
+            f"reference {ref.kind[i]} {ref.index[i]} {ref.t[i]}"
+        )
     return got
 
 
@@ -79,8 +84,9 @@ def test_axis_aligned_rays():
 
 def test_rays_running_along_faces_hit_nothing():
     shape = (10, 10, 10)
-    vox = np.array([[i, j, k] for i in range(10) for j in range(10) for k in range(10)
-                    if (i + j + k) % 2 == 0])
+    vox = np.array(
+        [[i, j, k] for i in range(10) for j in range(10) for k in range(10) if (i + j + k) % 2 == 0]
+    )
     occ = Occupancy.build(vox, shape)
     # In the plane x = 4 (a face plane): touches voxels on both sides, enters none.
     o = np.array([[4.0, 0.3, 12.0], [4.0, -2.0, 5.5], [3.0, 5.0, 5.0]])
@@ -110,8 +116,17 @@ def test_diagonal_ray_through_corners_is_not_a_hit():
     shape = (10, 10, 10)
     vox = []
     for k in range(9):
-        for off in [(1, 0, 0), (0, 1, 0), (0, 0, 1), (1, 1, 0), (1, 0, 1), (0, 1, 1),
-                    (-1, 0, 0), (0, -1, 0), (0, 0, -1)]:
+        for off in [
+            (1, 0, 0),
+            (0, 1, 0),
+            (0, 0, 1),
+            (1, 1, 0),
+            (1, 0, 1),
+            (0, 1, 1),
+            (-1, 0, 0),
+            (0, -1, 0),
+            (0, 0, -1),
+        ]:
             c = np.array([k, k, k]) + off
             if c.min() >= 0 and c.max() < 10:
                 vox.append(c)
@@ -125,8 +140,10 @@ def test_diagonal_ray_through_corners_is_not_a_hit():
     assert_matches_reference(with_hit, shape, o, d)
     # Against the reference on many 45-degree rays from integer points.
     rng = np.random.default_rng(4)
-    dirs = np.array([[a, b, c] for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1)
-                     if (a, b, c) != (0, 0, 0)], float)
+    dirs = np.array(
+        [[a, b, c] for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1) if (a, b, c) != (0, 0, 0)],
+        float,
+    )
     dirs = unit(dirs)
     o = rng.integers(-2, 12, size=(2000, 3)).astype(float)
     dd = dirs[rng.integers(0, len(dirs), 2000)]
@@ -219,8 +236,9 @@ def test_random_slab_lets_through_the_expected_share():
     # the ground with probability (1 - p) ** L.
     rng = np.random.default_rng(14)
     p, layers, side = 0.1, 6, 200
-    cells = np.stack(np.meshgrid(np.arange(side), np.arange(side), np.arange(2, 2 + layers),
-                                 indexing="ij"), -1).reshape(-1, 3)
+    cells = np.stack(
+        np.meshgrid(np.arange(side), np.arange(side), np.arange(2, 2 + layers), indexing="ij"), -1
+    ).reshape(-1, 3)
     vox = cells[rng.random(len(cells)) < p]
     occ = Occupancy.build(vox, (side, side, 20))
     xy = rng.uniform(0, side, size=(40_000, 2))
@@ -238,7 +256,8 @@ def test_random_slab_lets_through_the_expected_share():
     seed=st.integers(0, 2**32 - 1),
     origin=st.tuples(*[st.floats(-50, 50, allow_nan=False) for _ in range(3)]),
     direction=st.tuples(*[st.floats(-1, 1, allow_nan=False) for _ in range(3)]).filter(
-        lambda v: max(abs(c) for c in v) > 1e-3),
+        lambda v: max(abs(c) for c in v) > 1e-3
+    ),
 )
 def test_any_ray_gives_a_valid_answer_equal_to_the_reference(seed, origin, direction):
     rng = np.random.default_rng(seed)

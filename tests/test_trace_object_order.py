@@ -49,8 +49,9 @@ def test_scans_match_ray_order_bit_for_bit(forest, numba_backend, depression, sl
 def test_scan_matches_the_reference(forest, numba_backend):
     voxels, occ = forest
     # A wide view: voxels, the ground through gaps, and misses past the scene's edge.
-    origins, directions = one_scan([120, 120, 20], 45.0, 0.3, 200.0,
-                                   sensor=Sensor(grid=16, ray_grid=4, fov=40.0))
+    origins, directions = one_scan(
+        [120, 120, 20], 45.0, 0.3, 200.0, sensor=Sensor(grid=16, ray_grid=4, fov=40.0)
+    )
     obj = numba_backend.trace_cells(occ, origins, directions, object_order=True)
     assert obj.info["order"] == "object"
     pick = np.random.default_rng(0).choice(len(origins), 800, replace=False)
@@ -94,15 +95,15 @@ def test_axis_aligned_rays_and_rays_in_cell_faces(numba_backend):
     # Rays with zero components from origins on cell corners, edges and centres over a
     # slab with holes: rays lying in a plane of cell faces enter no voxel.
     shape = (16, 16, 12)
-    grid = np.stack(np.meshgrid(np.arange(16), np.arange(16), np.arange(3, 6), indexing="ij"),
-                    -1).reshape(-1, 3)
+    grid = np.stack(np.meshgrid(np.arange(16), np.arange(16), np.arange(3, 6), indexing="ij"), -1).reshape(
+        -1, 3
+    )
     keep = (grid[:, 0] * 7 + grid[:, 1] * 3 + grid[:, 2]) % 5 != 0
     occ = Occupancy.build(grid[keep], shape)
     steps = np.arange(-4, 5) * 0.03
     fan = np.array([[a, b, -1.0] for a in steps for b in steps])
     fan /= np.linalg.norm(fan, axis=1, keepdims=True)
-    corners = np.array([[x, y, 40.0] for x in (7.5, 7.75, 8.0, 8.25, 8.5)
-                        for y in (7.5, 8.0, 8.5)])
+    corners = np.array([[x, y, 40.0] for x in (7.5, 7.75, 8.0, 8.25, 8.5) for y in (7.5, 8.0, 8.5)])
     origins = np.repeat(corners, len(fan), axis=0)
     directions = np.tile(fan, (len(corners), 1))
     ray, obj = both_orders(numba_backend, occ, origins, directions)
@@ -111,7 +112,8 @@ def test_axis_aligned_rays_and_rays_in_cell_faces(numba_backend):
     ref = reference_trace_cells(grid[keep], shape, origins, directions)
     assert np.array_equal(obj.kind, ref.kind) and np.array_equal(obj.t, ref.t)
     in_face = ((origins[:, 0] % 1 == 0) & (directions[:, 0] == 0)) | (
-        (origins[:, 1] % 1 == 0) & (directions[:, 1] == 0))
+        (origins[:, 1] % 1 == 0) & (directions[:, 1] == 0)
+    )
     assert in_face.sum() > 20 and (obj.kind[in_face] != VOXEL).all()
     assert (obj.kind[~in_face] == VOXEL).sum() > 100
 
@@ -119,8 +121,9 @@ def test_axis_aligned_rays_and_rays_in_cell_faces(numba_backend):
 def test_far_aircraft(forest, numba_backend):
     # 10 km away (40,000 cells): projected rectangles and depth bounds stay conservative.
     _, occ = forest
-    origins, directions = one_scan([120, 120, 10], 30.0, 1.0, 40000.0,
-                                   sensor=Sensor(grid=16, ray_grid=4, fov=0.05))
+    origins, directions = one_scan(
+        [120, 120, 10], 30.0, 1.0, 40000.0, sensor=Sensor(grid=16, ray_grid=4, fov=0.05)
+    )
     ray, obj = both_orders(numba_backend, occ, origins, directions)
     assert obj.info["order"] == "object"
     assert_same(ray, obj)
@@ -151,8 +154,9 @@ def test_ray_order_where_object_order_cannot_or_should_not(forest, numba_backend
     assert_same(ray, obj)
     # Far away with a wide view, most of the forest in view: ray order is the cheaper
     # (auto), while forcing object order still gives the same answers.
-    origins, directions = one_scan([120, 120, 10], 60.0, 0.0, 2000.0,
-                                   sensor=Sensor(grid=64, ray_grid=1, fov=8.0))
+    origins, directions = one_scan(
+        [120, 120, 10], 60.0, 0.0, 2000.0, sensor=Sensor(grid=64, ray_grid=1, fov=8.0)
+    )
     auto = numba_backend.trace_cells(occ, origins, directions)
     assert auto.info["order"] == "ray"
     assert_same(auto, numba_backend.trace_cells(occ, origins, directions, object_order=True))
@@ -181,14 +185,17 @@ def test_a_pencil_of_rays_just_above_the_canopy(numba_backend):
     orders = []
     for seed in range(6):
         rng = np.random.default_rng(seed)
-        vox = np.column_stack([rng.integers(0, 64, 3000), rng.integers(0, 64, 3000),
-                               rng.integers(40, 64, 3000)])
+        vox = np.column_stack(
+            [rng.integers(0, 64, 3000), rng.integers(0, 64, 3000), rng.integers(40, 64, 3000)]
+        )
         occ = Occupancy.build(vox, (64, 64, 80))
         sensor = Sensor(grid=16, ray_grid=4, fov=1e-14)
         for _ in range(5):
             x, y = rng.uniform(10, 54, 2)
-            pose = aim_at(ScanPose(x, y, 64.0 + rng.uniform(0.05, 3)),
-                          [x + rng.uniform(-3, 3), y + rng.uniform(-3, 3), 0.0])
+            pose = aim_at(
+                ScanPose(x, y, 64.0 + rng.uniform(0.05, 3)),
+                [x + rng.uniform(-3, 3), y + rng.uniform(-3, 3), 0.0],
+            )
             origins, directions, _ = sensor.rays(pose)
             ray, obj = both_orders(numba_backend, occ, origins, directions)
             orders.append(obj.info["order"])
@@ -216,7 +223,7 @@ def test_order_choice_learns_the_faster_order():
     assert picks[4:].count("o") == 2 and picks[4:].count("r") == 2 * OrderChoice.RETRY - 2
     # The views change: ray order turns slow, and the retried object order takes over.
     picks = run(choice, 4 * OrderChoice.RETRY, {"object": 0.040, "ray": 0.200})
-    assert picks[-2 * OrderChoice.RETRY:].count("r") == 2  # its retries only
+    assert picks[-2 * OrderChoice.RETRY :].count("r") == 2  # its retries only
     first = OrderChoice()
     first.record("object", 0.9, 1000)  # compiling
     assert run(first, 3, {"object": 0.040, "ray": 0.060}) == "ror"
@@ -228,8 +235,7 @@ def test_directions_that_are_not_unit_go_in_ray_order(forest, numba_backend):
     origins, directions = one_scan([120, 120, 10], 45.0, 1.0, 200.0)
     result = numba_backend.trace_cells(occ, origins, 3.0 * directions, object_order=True)
     assert result.info["order"] == "ray"
-    assert_same(result, numba_backend.trace_cells(occ, origins, 3.0 * directions,
-                                                  object_order=False))
+    assert_same(result, numba_backend.trace_cells(occ, origins, 3.0 * directions, object_order=False))
 
 
 @pytest.mark.parametrize("shift, tiles", [(4, 6), (1, 300)])
@@ -253,7 +259,7 @@ def test_tile_lists_keep_the_nearest_first_order(shift, tiles):
                     expected[tj * tiles + ti].append(e)
     assert sum(map(len, expected)) == len(listed) > n
     for at, voxels in enumerate(expected):
-        assert listed[starts[at]:starts[at + 1]].tolist() == voxels
+        assert listed[starts[at] : starts[at + 1]].tolist() == voxels
 
 
 def test_bins_are_numbered_tile_by_tile():
@@ -267,7 +273,7 @@ def test_bins_are_numbered_tile_by_tile():
     assert len(np.unique(keys)) == nb * nb and keys.max() < (tiles * tile) ** 2
     for j in range(nb):
         for i0 in range(0, nb, tile):
-            row = keys[j, i0:min(nb, i0 + tile)]
+            row = keys[j, i0 : min(nb, i0 + tile)]
             assert np.array_equal(row, row[0] + np.arange(len(row)))
     tile_of = (np.arange(nb)[None, :] // tile) + tiles * (np.arange(nb)[:, None] // tile)
     assert np.array_equal(keys // (tile * tile), tile_of)
@@ -279,8 +285,9 @@ def test_a_whole_scan_sorts_by_scatter_as_the_counting_sort_does(duplicate):
     # moved into its neighbour's bin leaves a bin empty: the counting sort. Same result.
     from ladartui.tracing import object_order as oo
 
-    origins, directions = one_scan([100, 100, 10], 60.0, 0.4, 300.0,
-                                   sensor=Sensor(grid=16, ray_grid=4, fov=5.0))
+    origins, directions = one_scan(
+        [100, 100, 10], 60.0, 0.4, 300.0, sensor=Sensor(grid=16, ray_grid=4, fov=5.0)
+    )
     if duplicate:
         directions[5] = directions[6]
     centre, _, axis, u, v = cone_frame(origins, directions)
@@ -288,8 +295,7 @@ def test_a_whole_scan_sorts_by_scatter_as_the_counting_sort_does(duplicate):
     p, q, grid = oo.ray_grid(directions, axis, u, v, nb)
     lo, hi = np.zeros(3), np.full(3, 200.0)
     order = np.empty(nb * nb, np.int64)
-    assert oo._scatter_one_per_bin(p, q, grid, nb, 4, order, np.empty(nb * nb, np.uint32)) \
-        == (not duplicate)
+    assert oo._scatter_one_per_bin(p, q, grid, nb, 4, order, np.empty(nb * nb, np.uint32)) == (not duplicate)
     got = oo.sort_rays(p, q, grid, nb, 4, origins, directions, lo, hi)
     starts, order, bins = oo._sort_into_bins(p, q, grid, nb, 4)
     rays, invs, exits = np.empty((nb * nb, 6)), np.empty((nb * nb, 3)), np.empty(nb * nb)

@@ -15,7 +15,9 @@ def test_straight_log_reproduces_straight_poses(tmp_path):
     path.write_text("\n".join(lines) + "\n")
     got = log_poses(load_flight_log(path), start, times=[1, 2, 3, 4])
     for a, b in zip(got, poses):
-        assert (a.x, a.y, a.z, a.heading, a.depression) == pytest.approx((b.x, b.y, b.z, b.heading, b.depression))
+        assert (a.x, a.y, a.z, a.heading, a.depression) == pytest.approx(
+            (b.x, b.y, b.z, b.heading, b.depression)
+        )
     # At 2 Hz a scan falls halfway between records.
     half = log_poses(load_flight_log(path), start, rate=2.0)
     assert len(half) == 9 and half[1].x == pytest.approx((start.x + poses[0].x) / 2)
@@ -30,13 +32,16 @@ def test_headings_and_roll_interpolate_along_the_shortest_arc(tmp_path):
     assert roll[0] == pytest.approx(0.0) and pitch[0] == 0.0
 
 
-@pytest.mark.parametrize("text, where, what", [
-    ("time,x,y,z\n0,0,0,50\n", ":1:", "header lacks heading"),
-    ("time,x,y,z,heading\n0,0,0,50,0\n1,0,abc,50,0\n", ":3:", "y = 'abc': expected a number"),
-    ("time,x,y,z,heading\n0,0,0,50,0\n0,0,1,50,0\n", ":3:", "expected times increasing"),
-    ("time,x,y,z,heading\n0,0,0,50,0\n1,0,1,50\n", ":3:", "4 fields, expected 5"),
-    ("time,x,y,z,heading\n0,0,0,50,0\n1,0,1,-5,0\n", ":3:", "z = -5.0: expected > 0"),
-])
+@pytest.mark.parametrize(
+    "text, where, what",
+    [
+        ("time,x,y,z\n0,0,0,50\n", ":1:", "header lacks heading"),
+        ("time,x,y,z,heading\n0,0,0,50,0\n1,0,abc,50,0\n", ":3:", "y = 'abc': expected a number"),
+        ("time,x,y,z,heading\n0,0,0,50,0\n0,0,1,50,0\n", ":3:", "expected times increasing"),
+        ("time,x,y,z,heading\n0,0,0,50,0\n1,0,1,50\n", ":3:", "4 fields, expected 5"),
+        ("time,x,y,z,heading\n0,0,0,50,0\n1,0,1,-5,0\n", ":3:", "z = -5.0: expected > 0"),
+    ],
+)
 def test_malformed_lines_name_file_and_line(tmp_path, text, where, what):
     path = tmp_path / "bad.csv"
     path.write_text(text)
@@ -47,6 +52,7 @@ def test_malformed_lines_name_file_and_line(tmp_path, text, where, what):
 
 def test_example_log_loads():
     from pathlib import Path
+
     log = load_flight_log(Path(__file__).parents[1] / "scenarios" / "flight-log.csv")
     poses = log_poses(log, ScanPose(0, 0, 60, depression=60.0), rate=2.0)
     assert len(poses) == 7 and np.isclose(poses[-1].x, 110.0)
@@ -75,12 +81,18 @@ def test_a_log_in_latitude_and_longitude_flies_the_same_poses_as_its_local_copy(
     lon = np.array([149.1290, 149.1300, 149.1310])
     alt = np.array([660.0, 661.0, 662.0])
     geo = tmp_path / "geo.csv"
-    geo.write_text("time,latitude,longitude,altitude,heading\n" + "".join(
-        f"{t},{a},{o},{h},45\n" for t, a, o, h in zip((0, 1, 2), lat, lon, alt)))
+    geo.write_text(
+        "time,latitude,longitude,altitude,heading\n"
+        + "".join(f"{t},{a},{o},{h},45\n" for t, a, o, h in zip((0, 1, 2), lat, lon, alt))
+    )
     local = geodetic_to_local(lat, lon, alt, origin)
     xyz = tmp_path / "xyz.csv"
-    xyz.write_text("time,x,y,z,heading\n" + "".join(
-        f"{t},{float(x)!r},{float(y)!r},{float(z)!r},45\n" for t, (x, y, z) in zip((0, 1, 2), local)))
+    xyz.write_text(
+        "time,x,y,z,heading\n"
+        + "".join(
+            f"{t},{float(x)!r},{float(y)!r},{float(z)!r},45\n" for t, (x, y, z) in zip((0, 1, 2), local)
+        )
+    )
     from_geo = LogSegment(str(geo), rate=2.0, origin=list(origin)).build(None)
     from_xyz = LogSegment(str(xyz), rate=2.0).build(None)
     assert [p.position for p in from_geo] == pytest.approx([p.position for p in from_xyz])

@@ -10,12 +10,16 @@ from __future__ import annotations
 
 import shutil
 
-import pytest
-
 from ladartui.scenario import load_scenario, target_file_for
 from ladartui.tui.status import StatusBar
-from test_tui_flow import (LadarApp, field, loaded, make_scenario, scene_files,  # noqa: F401
-                           type_into, wait_until)
+from test_tui_flow import (
+    LadarApp,
+    field,
+    loaded,
+    make_scenario,
+    type_into,
+    wait_until,
+)
 
 SIZE = (100, 32)
 
@@ -62,8 +66,7 @@ async def test_a_value_typed_without_enter_is_what_ctrl_s_saves(tmp_path, scene_
         assert "(modified)" in app.query_one(StatusBar).message
 
 
-async def test_an_invalid_value_typed_stops_run_and_save_and_focuses_the_field(tmp_path,
-                                                                              scene_files):
+async def test_an_invalid_value_typed_stops_run_and_save_and_focuses_the_field(tmp_path, scene_files):
     scenario = make_scenario(tmp_path, scene_files)
     before = scenario.path.read_bytes()
     app = LadarApp(scenario.path)

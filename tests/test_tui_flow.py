@@ -5,7 +5,6 @@ Every test runs on a tiny generated scene (seeded) in tmp_path.
 
 from __future__ import annotations
 
-import asyncio
 import dataclasses
 import re
 import time
@@ -15,10 +14,9 @@ import numpy as np
 import pytest
 import pytest_asyncio
 
-from ladartui.flight import FlightPlan, Orbit
+from ladartui.flight import FlightPlan
 from ladartui.measures import Measures, read_cmf
-from ladartui.scenario import Scenario, load_scenario
-from ladartui.scene.generate import generate_scene
+from ladartui.scenario import load_scenario
 from ladartui.scene.voxels import load_voxels
 from ladartui.sensor import Sensor
 from ladartui.tui.app import CONTROLS, LadarApp
@@ -28,7 +26,7 @@ from ladartui.tui.file_dialogs import SetupScreen
 from ladartui.tui.measures_view import compact_rows
 from ladartui.tui.screens import AngleScreen, CompareScreen, FormScreen, HelpScreen
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
-from ladartui.tui.warmup import tiny_run
+from tui_support import make_scenario
 
 
 class LadarApp(LadarApp):
@@ -38,27 +36,8 @@ class LadarApp(LadarApp):
         kwargs.setdefault("compile_in_child", False)
         super().__init__(*args, **kwargs)
 
+
 SIZE = (100, 32)
-
-
-@pytest.fixture(scope="module")
-def scene_files(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("scene")
-    generated = generate_scene("small", seed=11, width=16.0, depth=16.0, trees=5)
-    scene_path, target_path = generated.write(folder / "forest")
-    files = scene_path, tuple(float(v) for v in generated.target_centre), generated.voxel_size
-    # compile the kernels once here; the apps below then skip their child-process warm-up
-    tiny_run(make_scenario(folder, files, name="warm"))
-    return files
-
-
-def make_scenario(folder: Path, scene_files, name="demo", scans=6, grid=8, ray_grid=1):
-    scene_path, centre, voxel_size = scene_files
-    scenario = Scenario(folder / f"{name}.toml", scene_path, voxel_size,
-                        Sensor(grid=grid, ray_grid=ray_grid, fov=8.0),
-                        FlightPlan(None, (Orbit(centre=centre, radius=30.0, altitude=30.0,
-                                                scans=scans),)))
-    return scenario.save()
 
 
 async def wait_until(pilot, condition, timeout=300.0):
@@ -67,8 +46,9 @@ async def wait_until(pilot, condition, timeout=300.0):
     while not condition():
         if time.monotonic() - start > timeout:
             app = pilot.app
-            raise AssertionError(f"timed out waiting for the app; busy={app.busy!r}, "
-                                 f"messages={app.messages[-3:]}")
+            raise AssertionError(
+                f"timed out waiting for the app; busy={app.busy!r}, messages={app.messages[-3:]}"
+            )
         await pilot.pause(0.05)
 
 
@@ -140,8 +120,7 @@ async def test_opens_a_scenario_ready_and_fills_every_field(shared, tmp_path, sc
 
 
 @pytest.mark.asyncio(loop_scope="module")
-async def test_invalid_values_go_back_to_the_scenarios_value_with_a_message(shared, tmp_path,
-                                                                           scene_files):
+async def test_invalid_values_go_back_to_the_scenarios_value_with_a_message(shared, tmp_path, scene_files):
     pilot, app = await fresh(shared)
     app.action_show_tab("sensor")
     grid = field(app, "sensor.grid")
@@ -165,8 +144,7 @@ async def test_invalid_values_go_back_to_the_scenarios_value_with_a_message(shar
 
 
 @pytest.mark.asyncio(loop_scope="module")
-async def test_a_bad_value_being_typed_turns_the_status_yellow_and_names_it(shared, tmp_path,
-                                                                           scene_files):
+async def test_a_bad_value_being_typed_turns_the_status_yellow_and_names_it(shared, tmp_path, scene_files):
     pilot, app = await fresh(shared)
     app.action_show_tab("sensor")
     fov = field(app, "sensor.fov")
@@ -239,17 +217,18 @@ async def test_a_run_disables_controls_and_cancel_keeps_earlier_outputs(tmp_path
         before = [p.read_bytes() for p in outputs]
         saved = scenario.path.read_bytes()
         # a long run: many scans with a bigger sensor
-        slow = dataclasses.replace(
-            app.scenario.flight.segments[0], scans=4000)
-        app.update_scenario(app.scenario.with_changes(
-            sensor=Sensor(grid=32, ray_grid=2, fov=8.0), flight=FlightPlan(None, (slow,))))
+        slow = dataclasses.replace(app.scenario.flight.segments[0], scans=4000)
+        app.update_scenario(
+            app.scenario.with_changes(
+                sensor=Sensor(grid=32, ray_grid=2, fov=8.0), flight=FlightPlan(None, (slow,))
+            )
+        )
         await pilot.press("f5")
         await wait_until(pilot, lambda: app.busy is not None and app.run_in_progress())
         await wait_until(pilot, lambda: (app.progress or 0) > 0)
         # once two scans have given a pace, the busy bar says how long is left
         await wait_until(pilot, lambda: re.search(r"about \S+ left", status(app).message))
-        assert status(app).state == BUSY and "%" in str(
-            status(app).query_one("#status-word").render())
+        assert status(app).state == BUSY and "%" in str(status(app).query_one("#status-word").render())
         enabled = [w.id for w in app.query(CONTROLS) if not w.disabled]
         assert enabled == ["btn-cancel-run"]
         assert not app.query_one("#status #cancel").disabled
@@ -262,8 +241,11 @@ async def test_a_run_disables_controls_and_cancel_keeps_earlier_outputs(tmp_path
         assert [p.read_bytes() for p in outputs] == before
         # enabled again, except the march step (exact method) and the start pose (an orbit
         # starts at its own first scan)
-        assert all(not w.disabled for w in app.query("#sidebar Input") if
-                   w.id != "f-scenario-step" and not w.id.startswith("f-start"))
+        assert all(
+            not w.disabled
+            for w in app.query("#sidebar Input")
+            if w.id != "f-scenario-step" and not w.id.startswith("f-start")
+        )
         assert all(w.disabled for w in app.query("#sidebar Input") if w.id.startswith("f-start"))
         assert status(app).state == READY
 
@@ -293,8 +275,13 @@ async def test_progressive_output_during_a_run_unless_fast_mode(tmp_path, scene_
 
 @pytest.mark.asyncio(loop_scope="module")
 async def test_layout_keys_switch_between_the_five_layouts(shared, tmp_path, scene_files):
-    expected = {1: {"scene3d", "topview"}, 2: {"scene3d", "output3d"}, 3: {"scene3d"},
-                4: {"output3d"}, 5: {"scene3d", "output3d", "topview"}}
+    expected = {
+        1: {"scene3d", "topview"},
+        2: {"scene3d", "output3d"},
+        3: {"scene3d"},
+        4: {"output3d"},
+        5: {"scene3d", "output3d", "topview"},
+    }
     pilot, app = await fresh(shared)
     app.query_one("#scene3d").focus()
     for number, shown in expected.items():
@@ -336,13 +323,14 @@ async def test_height_threshold_limits_the_output_view(shared, tmp_path, scene_f
 
 
 @pytest.mark.asyncio(loop_scope="module")
-async def test_a_missing_model_is_refused_but_missing_outputs_open(shared, tmp_path,
-                                                                   scene_files):
+async def test_a_missing_model_is_refused_but_missing_outputs_open(shared, tmp_path, scene_files):
     good = make_scenario(tmp_path, scene_files, name="good")
     broken = tmp_path / "broken.toml"
-    broken.write_text(good.path.read_text().replace(str(Path(scene_files[0]).name),
-                                                    "nowhere.txt")
-                      .replace(str(scene_files[0]), str(tmp_path / "nowhere.txt")))
+    broken.write_text(
+        good.path.read_text()
+        .replace(str(Path(scene_files[0]).name), "nowhere.txt")
+        .replace(str(scene_files[0]), str(tmp_path / "nowhere.txt"))
+    )
     partial = make_scenario(tmp_path, scene_files, name="partial")
     partial.scene_output.write_text("1,2,3\n")
     partial.measures_file.write_text("")
@@ -400,16 +388,14 @@ async def test_3d_view_rotates_zooms_and_takes_an_exact_angle(shared, tmp_path, 
     await pilot.pause()
     await pilot.pause()
     # refused in the form's words; the dialog stays open with the value to correct
-    assert "Elevation (deg): 120 is not allowed" in str(
-        app.screen.query_one("#form-message").render())
+    assert "Elevation (deg): 120 is not allowed" in str(app.screen.query_one("#form-message").render())
     assert isinstance(app.screen, AngleScreen)
     assert app.screen.query_one("#f-elevation").value == "120"
     await pilot.press("escape")
 
 
 @pytest.mark.asyncio(loop_scope="module")
-async def test_top_view_overlay_follows_parameters_without_redrawing_the_scene(shared, 
-        tmp_path, scene_files):
+async def test_top_view_overlay_follows_parameters_without_redrawing_the_scene(shared, tmp_path, scene_files):
     pilot, app = await fresh(shared)
     top = app.query_one(TopViewWidget)
     await pilot.pause()
@@ -419,10 +405,12 @@ async def test_top_view_overlay_follows_parameters_without_redrawing_the_scene(s
     await type_into(pilot, field(app, "sensor.fov"), "20")
     await pilot.pause()
     after = top.footprints
+
     # a wider field of view gives larger footprints
     def area(p):
         x, y = p[:, 0], p[:, 1]
         return abs(np.dot(x, np.roll(y, 1)) - np.dot(y, np.roll(x, 1))) / 2
+
     assert area(after[0]) > 4 * area(before[0])
     assert top.top.renders == renders
 
@@ -497,13 +485,10 @@ async def test_manual_poses_are_edited_in_a_table(shared, tmp_path, scene_files)
 
 
 @pytest.mark.asyncio(loop_scope="module")
-async def test_compare_shows_scenarios_side_by_side_with_differences_marked(shared, tmp_path,
-                                                                          scene_files):
+async def test_compare_shows_scenarios_side_by_side_with_differences_marked(shared, tmp_path, scene_files):
     a, b = tmp_path / "a.cmf", tmp_path / "b.cmf"
-    Measures(target_voxels=100, obscured_coverage=0.2, unobscured_coverage=0.5,
-             scans=10).write_cmf(a)
-    Measures(target_voxels=100, obscured_coverage=0.3, unobscured_coverage=0.5,
-             scans=12).write_cmf(b)
+    Measures(target_voxels=100, obscured_coverage=0.2, unobscured_coverage=0.5, scans=10).write_cmf(a)
+    Measures(target_voxels=100, obscured_coverage=0.3, unobscured_coverage=0.5, scans=12).write_cmf(b)
     pilot, app = await fresh(shared)
     app.push_screen(CompareScreen([a, b]))
     await pilot.pause()
@@ -564,8 +549,7 @@ def shown_keys(app) -> set[str]:
 
 
 @pytest.mark.asyncio(loop_scope="module")
-async def test_study_key_opens_the_study_of_the_open_scenario_and_esc_returns(shared, tmp_path,
-                                                                            scene_files):
+async def test_study_key_opens_the_study_of_the_open_scenario_and_esc_returns(shared, tmp_path, scene_files):
     from ladartui.tui.app import help_rows, palette_entries
     from ladartui.tui.study_screen import StudyScreen
 
@@ -591,7 +575,8 @@ async def test_study_key_opens_the_study_of_the_open_scenario_and_esc_returns(sh
 
 @pytest.mark.asyncio(loop_scope="module")
 async def test_sweep_key_opens_the_sweep_screen_and_its_best_path_loads_in_the_app(
-        shared, tmp_path, scene_files):
+    shared, tmp_path, scene_files
+):
     from ladartui.tui.sweep_screen import SweepScreen
 
     pilot, app = await fresh(shared)

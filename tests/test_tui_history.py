@@ -16,8 +16,14 @@ from ladartui.tui.file_dialogs import FileTree, SaveAsScreen, SetupScreen
 from ladartui.tui.screens import FormScreen, PosesScreen
 from ladartui.tui.status import StatusBar
 from ladartui.tui.unsaved import UnsavedScreen
-from test_tui_flow import (LadarApp, field, loaded, make_scenario, scene_files,  # noqa: F401
-                           type_into, wait_until)
+from test_tui_flow import (
+    LadarApp,
+    field,
+    loaded,
+    make_scenario,
+    type_into,
+    wait_until,
+)
 
 SIZE = (100, 32)
 
@@ -123,8 +129,7 @@ async def test_save_as_writes_a_new_file_and_keeps_the_old_one(tmp_path, scene_f
         assert scenario.path.read_bytes() == before
 
 
-async def test_recent_scenarios_are_listed_and_open_after_asking(tmp_path, scene_files,
-                                                                 monkeypatch):
+async def test_recent_scenarios_are_listed_and_open_after_asking(tmp_path, scene_files, monkeypatch):
     monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))
     first = make_scenario(tmp_path, scene_files, name="first")
     second = make_scenario(tmp_path, scene_files, name="second")
@@ -136,10 +141,8 @@ async def test_recent_scenarios_are_listed_and_open_after_asking(tmp_path, scene
         app.action_show_tab("file")
         await pilot.pause()
         listing = app.query_one("#recent")
-        assert listing.option_count == 1 and listing.get_option_at_index(0).id == str(
-            first.path.resolve())
-        assert any(a.startswith("open_recent") and "first.toml" in a
-                   for _, _, a in palette_entries())
+        assert listing.option_count == 1 and listing.get_option_at_index(0).id == str(first.path.resolve())
+        assert any(a.startswith("open_recent") and "first.toml" in a for _, _, a in palette_entries())
         app.action_show_tab("sensor")
         await type_into(pilot, field(app, "sensor.grid"), "12")
         app.action_show_tab("file")
@@ -165,8 +168,7 @@ async def test_the_folder_tree_fills_the_scenario_field(tmp_path, scene_files):
         await wait_until(pilot, lambda: len(tree.root.children) > 0)
         names = [node.data.path.name for node in tree.root.children]
         assert "demo.toml" in names and all(not n.startswith(".") for n in names)
-        assert all(n.endswith((".toml", ".txt", ".las", ".laz")) or (tmp_path / n).is_dir()
-                   for n in names)
+        assert all(n.endswith((".toml", ".txt", ".las", ".laz")) or (tmp_path / n).is_dir() for n in names)
         tree.focus()
         tree.move_cursor(tree.root.children[names.index("demo.toml")])
         await pilot.press("enter")
@@ -174,8 +176,7 @@ async def test_the_folder_tree_fills_the_scenario_field(tmp_path, scene_files):
         assert screen.query_one("#scenario-file").value == "demo.toml"
 
 
-async def test_start_pose_fields_follow_the_path_kind_and_refuse_impractical_values(
-        tmp_path, scene_files):
+async def test_start_pose_fields_follow_the_path_kind_and_refuse_impractical_values(tmp_path, scene_files):
     scenario = make_scenario(tmp_path, scene_files)
     app = LadarApp(scenario.path)
     async with app.run_test(size=SIZE) as pilot:
@@ -183,8 +184,9 @@ async def test_start_pose_fields_follow_the_path_kind_and_refuse_impractical_val
         app.action_show_tab("flight")
         await pilot.pause()
         assert field(app, "start.z").disabled  # an orbit starts at its own first scan
-        straight = app.scenario.with_changes(flight=FlightPlan(
-            ScanPose(0.0, 0.0, 100.0), (Straight(distance=50.0, scans=3),)))
+        straight = app.scenario.with_changes(
+            flight=FlightPlan(ScanPose(0.0, 0.0, 100.0), (Straight(distance=50.0, scans=3),))
+        )
         app.edit(straight, "a straight path")
         await pilot.pause()
         altitude, heading = field(app, "start.z"), field(app, "start.heading")
@@ -194,8 +196,7 @@ async def test_start_pose_fields_follow_the_path_kind_and_refuse_impractical_val
         assert "Altitude m: 100000 is not allowed" in app.messages[-1]
         await type_into(pilot, heading, "400")
         assert app.scenario.flight.start.heading == 0.0
-        assert "Heading deg: 400 is not allowed; expected a number from 0 to 360 deg" in \
-            app.messages[-1]
+        assert "Heading deg: 400 is not allowed; expected a number from 0 to 360 deg" in app.messages[-1]
 
 
 async def test_compare_takes_files_picked_in_the_tree(tmp_path, scene_files):
@@ -254,7 +255,8 @@ async def test_no_sidebar_label_or_button_is_clipped(tmp_path, scene_files, size
 
 
 async def test_a_key_remapped_in_keys_toml_changes_the_footer_help_and_palette(
-        tmp_path, scene_files, monkeypatch):
+    tmp_path, scene_files, monkeypatch
+):
     from ladartui.tui.app import help_rows
     from ladartui.tui.app import palette_entries as app_palette
     from ladartui.tui.screens import HelpScreen
@@ -263,8 +265,7 @@ async def test_a_key_remapped_in_keys_toml_changes_the_footer_help_and_palette(
 
     home = tmp_path / "home"
     (home / "config").mkdir(parents=True)
-    (home / "config" / "keys.toml").write_text(
-        '[keys]\nrun = "ctrl+r"\nnonsense = "x"\nthreshold = 3\n')
+    (home / "config" / "keys.toml").write_text('[keys]\nrun = "ctrl+r"\nnonsense = "x"\nthreshold = 3\n')
     monkeypatch.setenv("LADARTUI_HOME", str(home))
     scenario = make_scenario(tmp_path, scene_files)
     app = LadarApp(scenario.path)
@@ -299,8 +300,9 @@ async def test_a_flight_log_segment_is_listed_and_says_where_it_is_edited(tmp_pa
     log = tmp_path / "flight-log.csv"
     shutil.copy(Path(__file__).parents[1] / "scenarios" / "flight-log.csv", log)
     scenario = make_scenario(tmp_path, scene_files)
-    scenario = scenario.with_changes(flight=FlightPlan(None, (
-        *scenario.flight.segments, LogSegment(str(log), rate=2.0)))).save()
+    scenario = scenario.with_changes(
+        flight=FlightPlan(None, (*scenario.flight.segments, LogSegment(str(log), rate=2.0)))
+    ).save()
     app = LadarApp(scenario.path)
     async with app.run_test(size=SIZE) as pilot:
         await wait_until(pilot, lambda: loaded(app))
@@ -396,8 +398,7 @@ async def test_the_top_view_draws_footprints_as_they_fall_with_attitude(tmp_path
     from ladartui.tui.canvas import TopViewWidget
 
     scenario = make_scenario(tmp_path, scene_files)
-    banked = scenario.with_changes(
-        sensor=dataclasses.replace(scenario.sensor, mount="body-fixed")).save()
+    banked = scenario.with_changes(sensor=dataclasses.replace(scenario.sensor, mount="body-fixed")).save()
     app = LadarApp(banked.path)
     async with app.run_test(size=SIZE) as pilot:
         await wait_until(pilot, lambda: loaded(app))

@@ -30,18 +30,20 @@ def scenario_path(tmp_path, monkeypatch):
     generated = generate_scene("small", seed=5, width=16.0, depth=16.0, trees=5)
     scene_path, _ = generated.write(tmp_path / "forest")
     centre = tuple(round(float(v), 3) for v in generated.target_centre)
-    scenario = Scenario(tmp_path / "snap.toml", scene_path, generated.voxel_size,
-                        Sensor(grid=8, ray_grid=1, fov=8.0),
-                        FlightPlan(None, (Orbit(centre=centre, radius=20.0, altitude=20.0,
-                                                scans=6),)))
+    scenario = Scenario(
+        tmp_path / "snap.toml",
+        scene_path,
+        generated.voxel_size,
+        Sensor(grid=8, ray_grid=1, fov=8.0),
+        FlightPlan(None, (Orbit(centre=centre, radius=20.0, altitude=20.0, scans=6),)),
+    )
     scenario = scenario.save()
     tiny_run(scenario)  # compile the kernels here rather than in a child of each app
     return scenario.path
 
 
 def settled(app) -> bool:
-    return (app.scene is not None and app.busy is None and app.backend_rows is not None
-            and not app.running)
+    return app.scene is not None and app.busy is None and app.backend_rows is not None and not app.running
 
 
 async def wait_for(pilot, condition, timeout=300.0):
@@ -64,6 +66,7 @@ def prepare(*keys, run=False):
         for key in keys:
             await pilot.press(key)
         await pilot.pause(0.2)
+
     return run_before
 
 
@@ -74,13 +77,11 @@ def test_layout_1_scene_and_top_view(snap_compare, scenario_path, size):
 
 @pytest.mark.parametrize("size", [(80, 24), (120, 40)])
 def test_layout_2_scene_and_output_after_a_run(snap_compare, scenario_path, size):
-    assert snap_compare(LadarApp(scenario_path), terminal_size=size,
-                        run_before=prepare("2", run=True))
+    assert snap_compare(LadarApp(scenario_path), terminal_size=size, run_before=prepare("2", run=True))
 
 
 def test_layout_5_scene_output_and_top_view(snap_compare, scenario_path):
-    assert snap_compare(LadarApp(scenario_path), terminal_size=(120, 40),
-                        run_before=prepare("5", run=True))
+    assert snap_compare(LadarApp(scenario_path), terminal_size=(120, 40), run_before=prepare("5", run=True))
 
 
 def test_flight_panel(snap_compare, scenario_path):
@@ -89,4 +90,5 @@ def test_flight_panel(snap_compare, scenario_path):
         pilot.app.action_show_tab("flight")
         pilot.app.query_one("#scene3d").focus()
         await pilot.pause(0.2)
+
     assert snap_compare(LadarApp(scenario_path), terminal_size=(80, 24), run_before=run_before)

@@ -18,8 +18,7 @@ from textual.widgets import DataTable
 
 from ladartui.scenario import load_scenario
 from ladartui.sweep import read_table, run_sweep
-from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
-from ladartui.tui.status import format_eta
+from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar, format_eta
 from ladartui.tui.sweep_screen import SweepScreen, eta_seconds
 
 SIZE = (80, 24)
@@ -48,15 +47,14 @@ def write_base(folder):
     from ladartui.scene.voxels import save_voxels
     from ladartui.sensor import Sensor
 
-    target = np.array([(i, j, k) for i in range(10, 14) for j in range(11, 13) for k in range(2)],
-                      np.int32)
-    canopy = np.array([(i, j, 5) for i in range(24) for j in range(24) if (i * 5 + j * 3) % 4 == 0],
-                      np.int32)
+    target = np.array([(i, j, k) for i in range(10, 14) for j in range(11, 13) for k in range(2)], np.int32)
+    canopy = np.array([(i, j, 5) for i in range(24) for j in range(24) if (i * 5 + j * 3) % 4 == 0], np.int32)
     save_voxels(folder / "tiny.txt", np.concatenate([target, canopy]))
     save_voxels(folder / "tiny_Target.txt", target)
     flight = FlightPlan(segments=(Orbit(centre=CENTRE, radius=15.0, altitude=15.0, scans=2),))
-    Scenario(folder / "base.toml", "tiny.txt", 1.0, Sensor(grid=8, ray_grid=1, fov=25.0),
-             flight, backend="numba").save()
+    Scenario(
+        folder / "base.toml", "tiny.txt", 1.0, Sensor(grid=8, ray_grid=1, fov=25.0), flight, backend="numba"
+    ).save()
 
 
 def write_spec(folder, body, name="spec.toml"):
@@ -128,19 +126,18 @@ async def test_opening_results_shows_the_ranking_failures_and_pareto_front(finis
         # Ranked by the spec's objective (obscured coverage): best first, ties to the cheaper.
         expected = sorted(ok, key=lambda r: (-r["obscured_coverage"], r["flight_time_s"]))
         shown = table_column(table, "variant")
-        assert shown[:len(ok)] == [r["variant"] for r in expected]
-        assert table_column(table, "rank")[:len(ok)] == [str(i + 1) for i in range(len(ok))]
+        assert shown[: len(ok)] == [r["variant"] for r in expected]
+        assert table_column(table, "rank")[: len(ok)] == [str(i + 1) for i in range(len(ok))]
         # Failed variants come last, unranked, with their error.
-        assert set(shown[len(ok):]) == {r["variant"] for r in failed}
-        assert table_column(table, "rank")[len(ok):] == ["-"] * len(failed)
-        assert all("sensor_grid" in e for e in table_column(table, "error")[len(ok):])
+        assert set(shown[len(ok) :]) == {r["variant"] for r in failed}
+        assert table_column(table, "rank")[len(ok) :] == ["-"] * len(failed)
+        assert all("sensor_grid" in e for e in table_column(table, "error")[len(ok) :])
         # Pareto marks: no other ok variant is at least as cheap and as good, one strictly.
         points = {r["variant"]: (r["flight_time_s"], r["obscured_coverage"]) for r in ok}
 
         def dominated(v):
             c, g = points[v]
-            return any(c2 <= c and g2 >= g and (c2 < c or g2 > g)
-                       for w, (c2, g2) in points.items() if w != v)
+            return any(c2 <= c and g2 >= g and (c2 < c or g2 > g) for w, (c2, g2) in points.items() if w != v)
 
         marks = dict(zip(shown, table_column(table, "pareto")))
         assert {v for v in points if marks[v]} == {v for v in points if not dominated(v)}
@@ -157,10 +154,11 @@ async def test_opening_results_shows_the_ranking_failures_and_pareto_front(finis
         # A one-scan orbit flies no distance: no coverage per km, so it is not ranked.
         flown = [r for r in ok if r["path_length_m"] > 0]
         assert 0 < len(flown) < len(ok)
-        per_km = sorted(flown, key=lambda r: (-r["obscured_coverage"] / (r["path_length_m"] / 1000),
-                                              r["flight_time_s"]))
-        assert table_column(table, "variant")[:len(flown)] == [r["variant"] for r in per_km]
-        assert table_column(table, "rank")[len(flown):] == ["-"] * (12 - len(flown))
+        per_km = sorted(
+            flown, key=lambda r: (-r["obscured_coverage"] / (r["path_length_m"] / 1000), r["flight_time_s"])
+        )
+        assert table_column(table, "variant")[: len(flown)] == [r["variant"] for r in per_km]
+        assert table_column(table, "rank")[len(flown) :] == ["-"] * (12 - len(flown))
 
         # The best path is saved as a scenario with its parameters and handed to the app.
         await pilot.press("f8")
@@ -201,8 +199,9 @@ async def test_budget_objective_ranks_only_paths_within_the_typed_budget(finishe
         within = [r for r in ok if r["flight_time_s"] <= budget]
         assert 0 < len(within) < len(ok)
         assert sum(rank != "-" for rank in ranks) == len(within)
-        assert table_column(table, "variant")[0] == max(
-            within, key=lambda r: r["obscured_coverage"])["variant"]
+        assert (
+            table_column(table, "variant")[0] == max(within, key=lambda r: r["obscured_coverage"])["variant"]
+        )
 
 
 async def test_a_missing_spec_gives_one_line_and_starts_nothing(tmp_path):
@@ -240,8 +239,9 @@ async def test_a_running_sweep_cancels_keeps_its_rows_and_stays_responsive(tmp_p
     # ``finished`` ran a sweep in this process already, so the kernels are compiled.
     write_base(tmp_path)
     # 720 variants: far more than run while the test waits, so only Cancel can end it early.
-    spec = write_spec(tmp_path, "[grid]\nheading_offset = { start = 0, stop = 359.5, step = 0.5 }"
-                                "\nscans = [1]\n")
+    spec = write_spec(
+        tmp_path, "[grid]\nheading_offset = { start = 0, stop = 359.5, step = 0.5 }\nscans = [1]\n"
+    )
     results = tmp_path / "spec-results" / "results.csv"
     screen = SweepScreen(spec, serial=True)
     app = _Host(screen)
@@ -313,8 +313,7 @@ asyncio.run(main())
 
 def test_a_local_cluster_can_start_while_the_interface_captures_stderr():
     # Without the tracker started first, making the lock fails: bad value(s) in fds_to_keep.
-    done = subprocess.run([sys.executable, "-c", TRACKER_SCRIPT], capture_output=True,
-                          text=True, timeout=120)
+    done = subprocess.run([sys.executable, "-c", TRACKER_SCRIPT], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr[-2000:]
     assert "lock made" in done.stdout
 

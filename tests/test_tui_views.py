@@ -29,10 +29,13 @@ def scenario_path(tmp_path_factory):
     generated = generate_scene("small", seed=3, width=16.0, depth=16.0, trees=5)
     scene_path, _ = generated.write(folder / "forest")
     centre = tuple(round(float(v), 3) for v in generated.target_centre)
-    scenario = Scenario(folder / "views.toml", scene_path, generated.voxel_size,
-                        Sensor(grid=8, ray_grid=1, fov=8.0),
-                        FlightPlan(None, (Orbit(centre=centre, radius=30.0, altitude=30.0,
-                                                scans=6),)))
+    scenario = Scenario(
+        folder / "views.toml",
+        scene_path,
+        generated.voxel_size,
+        Sensor(grid=8, ray_grid=1, fov=8.0),
+        FlightPlan(None, (Orbit(centre=centre, radius=30.0, altitude=30.0, scans=6),)),
+    )
     return scenario.save().path
 
 
@@ -60,8 +63,14 @@ async def reset(pilot):
 def target_pixels(widget: ProjectionWidget, box):
     rows, cols = widget.picture_size()
     lo, hi = box
-    corners = np.array([[x, y, z] for x in (lo[0] - .5, hi[0] + .5) for y in (lo[1] - .5, hi[1] + .5)
-                        for z in (lo[2] - .5, hi[2] + .5)])
+    corners = np.array(
+        [
+            [x, y, z]
+            for x in (lo[0] - 0.5, hi[0] + 0.5)
+            for y in (lo[1] - 0.5, hi[1] + 0.5)
+            for z in (lo[2] - 0.5, hi[2] + 0.5)
+        ]
+    )
     row, col, _, _ = screen_coordinates(corners, widget.camera, rows, cols, widget.bounds)
     return row, col, rows, cols
 
@@ -94,7 +103,7 @@ async def test_zoom_to_target_frames_the_target_in_every_view(app_pilot):
     magenta = np.all(picture.rgb == colour.TARGET_RGB, axis=-1)
     scale, _, _ = top.top.fit(rows, cols, top.frame)  # cells per pixel
     columns = len(np.unique(area.prepared["target"][:, :2], axis=0))
-    assert magenta.sum() == pytest.approx(columns / scale ** 2, rel=0.25)
+    assert magenta.sum() == pytest.approx(columns / scale**2, rel=0.25)
     assert magenta.sum() > 200
     # turning the view keeps the target in the middle
     await pilot.press("right")
@@ -123,8 +132,7 @@ async def test_top_view_zooms_pans_and_goes_back_to_the_path(app_pilot):
     await pilot.press("d")
     assert top.frame[0] == pytest.approx(x0 + 0.1 * (x1 - x0))
     await pilot.press("minus", "minus")
-    assert top.frame[2] - top.frame[0] == pytest.approx((start[2] - start[0]) * 1.25 / 1.25 / 0.8,
-                                                        rel=1e-9)
+    assert top.frame[2] - top.frame[0] == pytest.approx((start[2] - start[0]) * 1.25 / 1.25 / 0.8, rel=1e-9)
     # a new flight path leaves a zoomed window alone; 0 follows the path again
     frame = top.frame
     app.update_scenario(app.scenario)
@@ -148,7 +156,7 @@ async def test_output_colours_show_what_the_foliage_hid_and_switch_to_height(app
     pilot = app_pilot
     app, area = await reset(pilot)
     target = area.prepared["target"]
-    seen, hidden = target[: len(target) // 2], target[len(target) // 2:]
+    seen, hidden = target[: len(target) // 2], target[len(target) // 2 :]
     canopy = np.array([[x, y, 30] for x in range(5) for y in range(5)])
     area.show_output(np.vstack([canopy, seen]), None, target_output=target)
     output3d = app.query_one("#output3d", ProjectionWidget)
@@ -163,8 +171,7 @@ async def test_output_colours_show_what_the_foliage_hid_and_switch_to_height(app
     await pilot.press("c")
     assert "(height)" not in output3d.border_title
     # with each scan's returns, a third colouring counts the scans that saw each target voxel
-    area.show_output(np.vstack([canopy, seen]), None, target_output=target,
-                     per_scan=[seen, seen[:3]])
+    area.show_output(np.vstack([canopy, seen]), None, target_output=target, per_scan=[seen, seen[:3]])
     await pilot.press("c", "c")
     assert "scans that saw it" in output3d.border_title
     values = output3d.voxel_layers[1].values

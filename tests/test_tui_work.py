@@ -10,7 +10,7 @@ from textual.widgets import Static
 
 from ladartui.errors import Cancelled
 from ladartui.tui.work import JobDone, JobProgress, start_job
-from test_tui_flow import LadarApp, loaded, make_scenario, scene_files, wait_until  # noqa: F401
+from test_tui_flow import LadarApp, loaded, make_scenario, wait_until
 
 
 class Host(App):
@@ -51,8 +51,7 @@ async def test_an_unexpected_exception_is_reported_and_the_app_stays_open():
         while not any(h[0] == "done" for h in app.heard):
             await pilot.pause(0.05)
         assert app.is_running
-        assert ("done", None, False, "ZeroDivisionError: division by zero in a kernel") \
-            in app.heard
+        assert ("done", None, False, "ZeroDivisionError: division by zero in a kernel") in app.heard
 
 
 async def test_cancelling_the_worker_reaches_the_task_and_reports_cancelled():
@@ -75,7 +74,8 @@ async def test_cancelling_the_worker_reaches_the_task_and_reports_cancelled():
 
 
 async def test_a_study_whose_tracer_fails_unexpectedly_reports_it_and_the_app_stays_open(
-        tmp_path, scene_files, monkeypatch):
+    tmp_path, scene_files, monkeypatch
+):
     import ladartui.study.run as study_run
     from ladartui.tui.study_screen import StudyScreen
 

@@ -23,15 +23,14 @@ def test_shade_indices_are_linear_over_the_range_and_clipped():
 
 def test_ansi256_picks_the_xterm_cube_and_grey_entries():
     # xterm-256: 16 + 36 r + 6 g + b over levels (0, 95, 135, 175, 215, 255); greys 232 + k at 8 + 10 k
-    rgb = np.array([[255, 0, 0], [0, 0, 0], [0, 255, 0], [95, 135, 175], [128, 128, 128],
-                    [238, 238, 238]])
+    rgb = np.array([[255, 0, 0], [0, 0, 0], [0, 255, 0], [95, 135, 175], [128, 128, 128], [238, 238, 238]])
     assert views.to_ansi256(rgb).tolist() == [196, 16, 46, 16 + 36 + 12 + 3, 244, 255]
 
 
 def _heights(nx=12, ny=8):
     h = np.full((nx, ny), -1, np.int32)
     h[2, 5] = 20  # one tall column, north-west quarter
-    h[9, 1] = 3   # a low one, south-east
+    h[9, 1] = 3  # a low one, south-east
     return h
 
 
@@ -65,9 +64,13 @@ def test_top_view_letterboxes_a_wide_scene_and_leaves_the_margin_undrawn():
 
 def test_overlays_mark_scans_path_and_footprint_without_redrawing_the_scene():
     top = TopView(np.zeros((20, 20), np.int32), voxel_size=2.0)
-    first = top.render(20, 20, path=np.array([[0.0, 0.0], [38.0, 0.0]]),
-                       scans=np.array([[10.0, 20.0], [30.0, 20.0]]),
-                       footprints=[np.array([[4.0, 4.0], [16.0, 4.0], [16.0, 16.0], [4.0, 16.0]])])
+    first = top.render(
+        20,
+        20,
+        path=np.array([[0.0, 0.0], [38.0, 0.0]]),
+        scans=np.array([[10.0, 20.0], [30.0, 20.0]]),
+        footprints=[np.array([[4.0, 4.0], [16.0, 4.0], [16.0, 16.0], [4.0, 16.0]])],
+    )
     # metres / 2 = voxel; scan (30, 20) m -> voxel (15, 10) -> row 19 - 10, col 15
     assert tuple(first.rgb[9, 15]) == views.SCAN_RGB
     assert tuple(first.rgb[9, 5]) == views.START_RGB
@@ -133,7 +136,8 @@ def test_a_camera_centred_on_a_point_keeps_it_in_the_middle_as_it_turns():
         row, col, _, _ = views.project_float([[80.0, 20.0, 2.0]], camera, 30, 50, bounds)
         assert (row[0], col[0]) == pytest.approx((15.0, 25.0))
     assert Camera(10.0, 20.0, 3.0, centre=(1, 2, 3)).at_angle(400, 100) == Camera(
-        40.0, 90.0, 3.0, centre=(1, 2, 3))
+        40.0, 90.0, 3.0, centre=(1, 2, 3)
+    )
 
 
 def test_zoom_and_pan_move_points_on_screen():

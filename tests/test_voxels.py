@@ -63,35 +63,78 @@ def test_tolerated_layouts(tmp_path, data):
 @pytest.mark.parametrize(
     "data, line, message",
     [
-        (b"1,2,3\n4,5\n", 2, "2 comma-separated values in '4,5'; expected three non-negative "
-         "integers x,y,z separated by commas"),
-        (b"1,2,3,4\n", 1, "4 comma-separated values in '1,2,3,4'; expected three non-negative "
-         "integers x,y,z separated by commas"),
-        (b"1,2,3\n4 5 6\n", 2, "1 comma-separated values in '4 5 6'; expected three non-negative "
-         "integers x,y,z separated by commas"),
-        (b"1,2,3\n1,2.5,3\n", 2, "y = '2.5' is not a whole number; expected three non-negative "
-         "integers x,y,z separated by commas"),
+        (
+            b"1,2,3\n4,5\n",
+            2,
+            "2 comma-separated values in '4,5'; expected three non-negative "
+            "integers x,y,z separated by commas",
+        ),
+        (
+            b"1,2,3,4\n",
+            1,
+            "4 comma-separated values in '1,2,3,4'; expected three non-negative "
+            "integers x,y,z separated by commas",
+        ),
+        (
+            b"1,2,3\n4 5 6\n",
+            2,
+            "1 comma-separated values in '4 5 6'; expected three non-negative "
+            "integers x,y,z separated by commas",
+        ),
+        (
+            b"1,2,3\n1,2.5,3\n",
+            2,
+            "y = '2.5' is not a whole number; expected three non-negative integers x,y,z separated by commas",
+        ),
         (b"1,2,3\n7,8,-1\n", 2, "z = -1 is negative; voxel indices start at 0"),
-        (b"1,2,3\n\n4,5,6\n", 2, "blank line before more voxels; blank lines are allowed only at "
-         "the end of the file"),
-        (b"1,2,3\n  \r\n4,5,6\n", 2, "blank line before more voxels; blank lines are allowed only "
-         "at the end of the file"),
-        (b"x,y,z\n1,2,3\n", 1, "x = 'x' is not a whole number; expected three non-negative "
-         "integers x,y,z separated by commas"),
-        (b"1,2,3\n1,,3\n", 2, "y is empty in '1,,3'; expected three non-negative integers x,y,z "
-         "separated by commas"),
-        (b"1,2,3\n1,2,3x\n", 2, "z = '3x' is not a whole number; expected three non-negative "
-         "integers x,y,z separated by commas"),
-        (b"1,2,3\n1,2,+3\n", 2, "z = '+3' is not a whole number; expected three non-negative "
-         "integers x,y,z separated by commas"),
-        (b"1,2,3\n1,2 2,3\n", 2, "y = '2 2' is not a whole number; expected three non-negative "
-         "integers x,y,z separated by commas"),
-        (b"1,2,3\n2147483648,0,0\n", 2, "x = 2147483648 is too large; expected at most "
-         "2147483647"),
-        (b"1,2,3\n\x00\x01\x02\n", 2, "1 comma-separated values in '\\x00\\x01\\x02'; expected "
-         "three non-negative integers x,y,z separated by commas"),
-        (b"1,2,3\n\xff\xfe,1,1\n", 2, "x = '\ufffd\ufffd' is not a whole number; expected three "
-         "non-negative integers x,y,z separated by commas"),
+        (
+            b"1,2,3\n\n4,5,6\n",
+            2,
+            "blank line before more voxels; blank lines are allowed only at the end of the file",
+        ),
+        (
+            b"1,2,3\n  \r\n4,5,6\n",
+            2,
+            "blank line before more voxels; blank lines are allowed only at the end of the file",
+        ),
+        (
+            b"x,y,z\n1,2,3\n",
+            1,
+            "x = 'x' is not a whole number; expected three non-negative integers x,y,z separated by commas",
+        ),
+        (
+            b"1,2,3\n1,,3\n",
+            2,
+            "y is empty in '1,,3'; expected three non-negative integers x,y,z separated by commas",
+        ),
+        (
+            b"1,2,3\n1,2,3x\n",
+            2,
+            "z = '3x' is not a whole number; expected three non-negative integers x,y,z separated by commas",
+        ),
+        (
+            b"1,2,3\n1,2,+3\n",
+            2,
+            "z = '+3' is not a whole number; expected three non-negative integers x,y,z separated by commas",
+        ),
+        (
+            b"1,2,3\n1,2 2,3\n",
+            2,
+            "y = '2 2' is not a whole number; expected three non-negative integers x,y,z separated by commas",
+        ),
+        (b"1,2,3\n2147483648,0,0\n", 2, "x = 2147483648 is too large; expected at most 2147483647"),
+        (
+            b"1,2,3\n\x00\x01\x02\n",
+            2,
+            "1 comma-separated values in '\\x00\\x01\\x02'; expected "
+            "three non-negative integers x,y,z separated by commas",
+        ),
+        (
+            b"1,2,3\n\xff\xfe,1,1\n",
+            2,
+            "x = '\ufffd\ufffd' is not a whole number; expected three "
+            "non-negative integers x,y,z separated by commas",
+        ),
     ],
 )
 def test_malformed_lines_name_file_line_and_expectation(tmp_path, data, line, message):
@@ -115,8 +158,7 @@ def test_missing_file_is_named(tmp_path):
     with pytest.raises(InputFileError) as caught:
         load_voxels(path)
     assert str(caught.value) == (
-        f"{path}: no such file; expected three non-negative integers x,y,z separated by commas "
-        "per line"
+        f"{path}: no such file; expected three non-negative integers x,y,z separated by commas per line"
     )
 
 
@@ -207,7 +249,9 @@ def test_reading_a_plain_file_does_not_import_numba(tmp_path):
     import sys
 
     path = write(tmp_path, b"1,2,3\n4,5,6\n")
-    code = ("import sys; from ladartui.scene.voxels import load_voxels; "
-            f"assert load_voxels({str(path)!r}).shape == (2, 3); print('numba' in sys.modules)")
+    code = (
+        "import sys; from ladartui.scene.voxels import load_voxels; "
+        f"assert load_voxels({str(path)!r}).shape == (2, 3); print('numba' in sys.modules)"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"

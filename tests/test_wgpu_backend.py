@@ -21,8 +21,14 @@ import pytest
 from ladartui.errors import BackendUnavailable, Cancelled
 from ladartui.tracing import backend as registry
 from ladartui.tracing import wgpu_backend
-from ladartui.tracing.wgpu_backend import (INSTALL_HINT, WgpuBackend, choose_adapter,
-                                           chunk_words_for, dispatch_grid, floor_preserving_f32)
+from ladartui.tracing.wgpu_backend import (
+    INSTALL_HINT,
+    WgpuBackend,
+    choose_adapter,
+    chunk_words_for,
+    dispatch_grid,
+    floor_preserving_f32,
+)
 
 Occupancy = pytest.importorskip("ladartui.scene.occupancy").Occupancy
 
@@ -98,9 +104,11 @@ def test_floor_preserving_f32_keeps_each_value_in_its_cell():
 
 
 def test_module_import_is_cheap_and_registers_the_backend():
-    code = ("import sys, ladartui.tracing.wgpu_backend as m; "
-            "from ladartui.tracing.backend import _FACTORIES; "
-            "print('wgpu' in sys.modules, _FACTORIES.get('wgpu') is m.WgpuBackend)")
+    code = (
+        "import sys, ladartui.tracing.wgpu_backend as m; "
+        "from ladartui.tracing.backend import _FACTORIES; "
+        "print('wgpu' in sys.modules, _FACTORIES.get('wgpu') is m.WgpuBackend)"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.split() == ["False", "True"]
     assert "wgpu" in registry.backend_names()
@@ -290,10 +298,12 @@ def long_march_case():
     occupancy = Occupancy.build(voxels, shape=(n, n, 30))
     rng = np.random.default_rng(21)
     count = 64
-    origins = np.column_stack([rng.uniform(0, 2, count), rng.uniform(0, 2, count),
-                               rng.uniform(20, 29, count)])
-    targets = np.column_stack([rng.uniform(11_700, 11_990, count), rng.uniform(11_700, 11_990, count),
-                               np.zeros(count)])
+    origins = np.column_stack(
+        [rng.uniform(0, 2, count), rng.uniform(0, 2, count), rng.uniform(20, 29, count)]
+    )
+    targets = np.column_stack(
+        [rng.uniform(11_700, 11_990, count), rng.uniform(11_700, 11_990, count), np.zeros(count)]
+    )
     directions = targets - origins
     directions /= np.linalg.norm(directions, axis=1)[:, None]
     return occupancy, origins, directions
@@ -339,8 +349,9 @@ def test_exact_ray_through_40000_cells_of_occupied_bricks(gpu, numba_backend):
     assert_same(gpu.trace_cells(occupancy, o, d, precision="f64"), reference)
 
 
-def test_a_loop_ended_by_the_adapter_is_reported_not_taken_for_a_miss(gpu, numba_backend,
-                                                                      long_march_case, monkeypatch):
+def test_a_loop_ended_by_the_adapter_is_reported_not_taken_for_a_miss(
+    gpu, numba_backend, long_march_case, monkeypatch
+):
     """On lavapipe, 70,000 voxel steps (exact) or 131,072 samples in one pass (march)
     exceed the loop guard: the backend says so. Elsewhere the answers are numba's."""
     occupancy, o, d = brick_corridor(70_000)
@@ -349,11 +360,16 @@ def test_a_loop_ended_by_the_adapter_is_reported_not_taken_for_a_miss(gpu, numba
     calls = [(occupancy, o, d, {}), (march_occupancy, mo[:4], md[:4], {"method": "march", "step": 0.25})]
     for scene, origins, directions, options in calls:
         if on_lavapipe(gpu):
-            with pytest.raises(BackendUnavailable, match="could not finish .* rays.*ended their loops early.*use backend 'numba'"):
+            with pytest.raises(
+                BackendUnavailable,
+                match="could not finish .* rays.*ended their loops early.*use backend 'numba'",
+            ):
                 gpu.trace_cells(scene, origins, directions, precision="f64", **options)
         else:
-            assert_same(gpu.trace_cells(scene, origins, directions, precision="f64", **options),
-                        numba_backend.trace_cells(scene, origins, directions, **options))
+            assert_same(
+                gpu.trace_cells(scene, origins, directions, precision="f64", **options),
+                numba_backend.trace_cells(scene, origins, directions, **options),
+            )
 
 
 def test_march_in_many_short_passes_equals_one_pass(gpu, numba_backend, monkeypatch):

@@ -48,8 +48,9 @@ def test_scans_match_numba_bit_for_bit(forest, f64_backend, numba_backend, depre
 
 def test_a_wide_view_matches_the_reference(forest, f64_backend):
     voxels, occ = forest
-    origins, directions = one_scan([120, 120, 20], 45.0, 0.3, 200.0,
-                                   sensor=Sensor(grid=16, ray_grid=4, fov=40.0))
+    origins, directions = one_scan(
+        [120, 120, 20], 45.0, 0.3, 200.0, sensor=Sensor(grid=16, ray_grid=4, fov=40.0)
+    )
     gpu = gpu_object_order(f64_backend, occ, origins, directions)
     pick = np.random.default_rng(1).choice(len(origins), 800, replace=False)
     ref = reference_trace_cells(voxels, occ.shape, origins[pick], directions[pick])
@@ -69,8 +70,9 @@ def test_random_scenes_spread_origins_and_grid_planes(f64_backend, numba_backend
 
 def test_rays_in_cell_faces_and_zero_components(f64_backend, numba_backend):
     shape = (16, 16, 12)
-    grid = np.stack(np.meshgrid(np.arange(16), np.arange(16), np.arange(3, 6), indexing="ij"),
-                    -1).reshape(-1, 3)
+    grid = np.stack(np.meshgrid(np.arange(16), np.arange(16), np.arange(3, 6), indexing="ij"), -1).reshape(
+        -1, 3
+    )
     occ = Occupancy.build(grid[(grid[:, 0] * 7 + grid[:, 1] * 3 + grid[:, 2]) % 5 != 0], shape)
     steps = np.arange(-4, 5) * 0.03
     fan = np.array([[a, b, -1.0] for a in steps for b in steps])
@@ -85,8 +87,9 @@ def test_rays_in_cell_faces_and_zero_components(f64_backend, numba_backend):
 
 def test_far_aircraft(forest, f64_backend, numba_backend):
     _, occ = forest
-    origins, directions = one_scan([120, 120, 10], 30.0, 1.0, 40000.0,
-                                   sensor=Sensor(grid=16, ray_grid=4, fov=0.05))
+    origins, directions = one_scan(
+        [120, 120, 10], 30.0, 1.0, 40000.0, sensor=Sensor(grid=16, ray_grid=4, fov=0.05)
+    )
     gpu = gpu_object_order(f64_backend, occ, origins, directions)
     assert_same(numba_backend.trace_cells(occ, origins, directions, object_order=False), gpu)
     assert (gpu.kind == VOXEL).any()
@@ -97,8 +100,9 @@ def test_buffers_grow_and_are_reused(forest, f64_backend, numba_backend):
     # for a large one, and a small scan after it reads none of the large one's data.
     _, occ = forest
     for grid in (8, 40, 12):
-        origins, directions = one_scan([100, 140, 20], 60.0, 2.0, 180.0,
-                                       sensor=Sensor(grid=grid, ray_grid=4, fov=6.0))
+        origins, directions = one_scan(
+            [100, 140, 20], 60.0, 2.0, 180.0, sensor=Sensor(grid=grid, ray_grid=4, fov=6.0)
+        )
         gpu = gpu_object_order(f64_backend, occ, origins, directions)
         assert_same(numba_backend.trace_cells(occ, origins, directions, object_order=False), gpu)
 
@@ -110,8 +114,10 @@ def test_ray_order_where_object_order_cannot_run(forest, f64_backend, numba_back
     origins, directions = one_scan([120, 120, 10], 45.0, 1.0, 200.0)
     expected = numba_backend.trace_cells(occ, origins, directions, object_order=False)
     # f32, or object order turned off: the ray-order shader.
-    assert f64_backend.trace_cells(occ, origins, directions, precision="f32",
-                                   object_order=True).info["order"] == "ray"
+    assert (
+        f64_backend.trace_cells(occ, origins, directions, precision="f32", object_order=True).info["order"]
+        == "ray"
+    )
     off = f64_backend.trace_cells(occ, origins, directions, object_order=False)
     assert off.info["order"] == "ray"
     assert_same(expected, off)

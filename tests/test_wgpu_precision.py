@@ -138,15 +138,17 @@ def test_edge_cases_match_numba(wgpu_backend, numba_backend, edge_scene):
 def test_edge_cases_march_matches_numba(wgpu_backend, numba_backend, edge_scene, step):
     _cases, origins, directions = edge_arrays()
     reference = numba_backend.trace_cells(edge_scene, origins, directions, method="march", step=step)
-    hits = wgpu_backend.trace_cells(edge_scene, origins, directions, method="march", step=step,
-                                    precision="f64")
+    hits = wgpu_backend.trace_cells(
+        edge_scene, origins, directions, method="march", step=step, precision="f64"
+    )
     assert np.array_equal(hits.kind, reference.kind)
     assert np.array_equal(hits.index, reference.index)
     assert np.array_equal(hits.t, reference.t)
     # The march lands on boundaries often here; nadir samples are exact in float32 too.
     nadir = directions[:, 2] == -1.0
-    hits32 = wgpu_backend.trace_cells(edge_scene, origins[nadir], directions[nadir], method="march",
-                                      step=step, precision="f32")
+    hits32 = wgpu_backend.trace_cells(
+        edge_scene, origins[nadir], directions[nadir], method="march", step=step, precision="f32"
+    )
     assert np.array_equal(hits32.kind, reference.kind[nadir])
     assert np.array_equal(hits32.index, reference.index[nadir])
 
@@ -154,13 +156,41 @@ def test_edge_cases_march_matches_numba(wgpu_backend, numba_backend, edge_scene,
 def test_empty_scene(wgpu_backend, numba_backend):
     empty = Occupancy.build(np.zeros((0, 3), np.int64), shape=(8, 8, 4))
     # Ground points at cell centres or on the extent's faces (exact in float32 too).
-    origins = np.array([[3.5, 2.5, 5.0], [8.0, 2.5, 5.0], [0.0, 7.5, 5.0], [2.5, 2.5, 6.0],
-                        [2.5, 2.5, 6.0], [2.5, 2.5, 0.5], [2.5, 2.5, 0.5], [-20000.0, 4.5, 20000.5]])
-    directions = np.array([[0, 0, -1], unit(0, 0, -1), unit(0, 0, -1), unit(1, 1, -2),
-                           unit(-2, 1, -2), unit(0, 0, 1), unit(1, 0, 0), unit(1, 0, -1)])
+    origins = np.array(
+        [
+            [3.5, 2.5, 5.0],
+            [8.0, 2.5, 5.0],
+            [0.0, 7.5, 5.0],
+            [2.5, 2.5, 6.0],
+            [2.5, 2.5, 6.0],
+            [2.5, 2.5, 0.5],
+            [2.5, 2.5, 0.5],
+            [-20000.0, 4.5, 20000.5],
+        ]
+    )
+    directions = np.array(
+        [
+            [0, 0, -1],
+            unit(0, 0, -1),
+            unit(0, 0, -1),
+            unit(1, 1, -2),
+            unit(-2, 1, -2),
+            unit(0, 0, 1),
+            unit(1, 0, 0),
+            unit(1, 0, -1),
+        ]
+    )
     expected_kind = [GROUND, MISS, GROUND, GROUND, MISS, MISS, MISS, GROUND]
-    expected_index = [[3, 2, 0], [-1, -1, -1], [0, 7, 0], [5, 5, 0], [-1, -1, -1],
-                      [-1, -1, -1], [-1, -1, -1], [0, 4, 0]]
+    expected_index = [
+        [3, 2, 0],
+        [-1, -1, -1],
+        [0, 7, 0],
+        [5, 5, 0],
+        [-1, -1, -1],
+        [-1, -1, -1],
+        [-1, -1, -1],
+        [0, 4, 0],
+    ]
     expected_t = [5.0, np.inf, 5.0, 3 * math.sqrt(6.0), np.inf, np.inf, np.inf, 20000.5 * S2]
     reference = numba_backend.trace_cells(empty, origins, directions)
     assert reference.kind.tolist() == expected_kind
@@ -210,9 +240,11 @@ def aircraft_rays(rng, occupancy, n, distance):
     elevation = np.radians(rng.uniform(15, 89.9, n))
     centre = np.array([nx / 2, ny / 2, 0.0])
     origins = centre + distance * np.column_stack(
-        [np.cos(heading) * np.cos(elevation), np.sin(heading) * np.cos(elevation), np.sin(elevation)])
-    aims = np.column_stack([rng.uniform(-0.1, 1.1, n) * nx, rng.uniform(-0.1, 1.1, n) * ny,
-                            rng.uniform(0, top, n)])
+        [np.cos(heading) * np.cos(elevation), np.sin(heading) * np.cos(elevation), np.sin(elevation)]
+    )
+    aims = np.column_stack(
+        [rng.uniform(-0.1, 1.1, n) * nx, rng.uniform(-0.1, 1.1, n) * ny, rng.uniform(0, top, n)]
+    )
     directions = aims - origins
     return origins, directions / np.linalg.norm(directions, axis=1)[:, None]
 
@@ -221,8 +253,9 @@ def scattered_rays(rng, occupancy, n):
     """Origins in and around the scene box, directions uniform on the sphere."""
     nx, ny, nz = occupancy.shape
     top = occupancy.zmax + 1
-    origins = np.column_stack([rng.uniform(-0.2, 1.2, n) * nx, rng.uniform(-0.2, 1.2, n) * ny,
-                               rng.uniform(0, 2 * top + 2, n)])
+    origins = np.column_stack(
+        [rng.uniform(-0.2, 1.2, n) * nx, rng.uniform(-0.2, 1.2, n) * ny, rng.uniform(0, 2 * top + 2, n)]
+    )
     directions = rng.normal(size=(n, 3))
     return origins, directions / np.linalg.norm(directions, axis=1)[:, None]
 
@@ -252,8 +285,7 @@ def test_f64_random_rays_identical(wgpu_backend, numba_backend, forest, random_r
     origins, directions = random_rays
     reference = numba_backend.trace_cells(forest, origins, directions, method=method, step=0.5)
     assert np.count_nonzero(reference.kind == VOXEL) > len(origins) // 4  # a real workout
-    hits = wgpu_backend.trace_cells(forest, origins, directions, method=method, step=0.5,
-                                    precision="f64")
+    hits = wgpu_backend.trace_cells(forest, origins, directions, method=method, step=0.5, precision="f64")
     assert_same_hits(hits, reference, t_rtol=1e-12)
 
 
@@ -286,16 +318,14 @@ def is_near_tie(numba_backend, occupancy, o, d, method, got_kind, got_index, got
     shifts = [NEAR_TIE * (math.cos(a) * u + math.sin(a) * v) for a in angles]
     shifts += [NEAR_TIE * s * e for e in np.eye(3) for s in (1, -1)]
     origins = o + np.array(shifts)
-    perturbed = numba_backend.trace_cells(occupancy, origins, np.tile(d, (len(origins), 1)),
-                                          method=method)
+    perturbed = numba_backend.trace_cells(occupancy, origins, np.tile(d, (len(origins), 1)), method=method)
     same = (perturbed.kind == got_kind) & np.all(perturbed.index == got_index, axis=1)
     return bool(same.any())
 
 
 def check_f32(wgpu_backend, numba_backend, occupancy, origins, directions, method):
     reference = numba_backend.trace_cells(occupancy, origins, directions, method=method, step=0.5)
-    hits = wgpu_backend.trace_cells(occupancy, origins, directions, method=method, step=0.5,
-                                    precision="f32")
+    hits = wgpu_backend.trace_cells(occupancy, origins, directions, method=method, step=0.5, precision="f32")
     assert hits.info["precision"] == "f32"
     hit = reference.kind != MISS
     far_t = np.zeros(len(origins), bool)
@@ -304,11 +334,21 @@ def check_f32(wgpu_backend, numba_backend, occupancy, origins, directions, metho
     agreement = 1.0 - len(bad) / len(origins)
     assert agreement >= F32_AGREEMENT, f"{method}: {len(bad)} of {len(origins)} rays differ"
     for r in bad:
-        assert is_near_tie(numba_backend, occupancy, origins[r], directions[r], method,
-                           hits.kind[r], hits.index[r], hits.t[r], reference.t[r]), (
+        assert is_near_tie(
+            numba_backend,
+            occupancy,
+            origins[r],
+            directions[r],
+            method,
+            hits.kind[r],
+            hits.index[r],
+            hits.t[r],
+            reference.t[r],
+        ), (
             f"ray {r} ({origins[r].tolist()}, {directions[r].tolist()}): float32 says "
             f"{hits.kind[r]} {hits.index[r].tolist()} t={hits.t[r]}, float64 says "
-            f"{reference.kind[r]} {reference.index[r].tolist()} t={reference.t[r]}")
+            f"{reference.kind[r]} {reference.index[r].tolist()} t={reference.t[r]}"
+        )
     assert np.all(np.isinf(hits.t[hits.kind == MISS]))
 
 

@@ -12,13 +12,14 @@ def write_tiny_scenario(folder, name="base.toml"):
     from ladartui.scene.voxels import save_voxels
     from ladartui.sensor import Sensor
 
-    target = np.array([(i, j, k) for i in range(14, 18) for j in range(15, 17) for k in range(2)],
-                      np.int32)
-    canopy = np.array([(i, j, 6) for i in range(32) for j in range(32)
-                       if (i * 7 + j * 13) % 3 == 0], np.int32)
+    target = np.array([(i, j, k) for i in range(14, 18) for j in range(15, 17) for k in range(2)], np.int32)
+    canopy = np.array(
+        [(i, j, 6) for i in range(32) for j in range(32) if (i * 7 + j * 13) % 3 == 0], np.int32
+    )
     save_voxels(folder / "tiny.txt", np.concatenate([target, canopy]))
     save_voxels(folder / "tiny_Target.txt", target)
     flight = FlightPlan(segments=(Orbit(centre=CENTRE, radius=20.0, altitude=20.0, scans=4),))
-    scenario = Scenario(folder / name, "tiny.txt", 1.0, Sensor(grid=8, ray_grid=2, fov=20.0),
-                        flight, backend="numba")
+    scenario = Scenario(
+        folder / name, "tiny.txt", 1.0, Sensor(grid=8, ray_grid=2, fov=20.0), flight, backend="numba"
+    )
     return scenario.save()

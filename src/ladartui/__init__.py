@@ -41,4 +41,4 @@ _EXPORTS = {
 __all__ = sorted(_EXPORTS) + ["__version__"]
 
 
-__getattr__ = lazy_getattr('ladartui', _EXPORTS, globals())
+__getattr__ = lazy_getattr("ladartui", _EXPORTS, globals())

@@ -33,9 +33,7 @@ def coordinated_turn_roll(speed: float, radius: float, g: float = STANDARD_GRAVI
 
 def _level_frame(heading_deg: float) -> np.ndarray:
     h = math.radians(heading_deg)
-    return np.array([[math.sin(h), math.cos(h), 0.0],
-                     [math.cos(h), -math.sin(h), 0.0],
-                     [0.0, 0.0, -1.0]]).T
+    return np.array([[math.sin(h), math.cos(h), 0.0], [math.cos(h), -math.sin(h), 0.0], [0.0, 0.0, -1.0]]).T
 
 
 def attitude_matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
@@ -49,15 +47,15 @@ def attitude_matrix(roll: float, pitch: float, yaw: float) -> np.ndarray:
     return rz @ ry @ rx
 
 
-def body_rotation(heading: float, roll: float = 0.0, pitch: float = 0.0,
-                  yaw: float = 0.0) -> np.ndarray:
+def body_rotation(heading: float, roll: float = 0.0, pitch: float = 0.0, yaw: float = 0.0) -> np.ndarray:
     """``B Rz(yaw) Ry(pitch) Rx(roll) B^T``: stabilised to body-fixed, scene frame."""
     b = _level_frame(heading)
     return b @ attitude_matrix(roll, pitch, yaw) @ b.T
 
 
-def body_fixed_directions(directions, heading: float, roll: float = 0.0, pitch: float = 0.0,
-                          yaw: float = 0.0) -> np.ndarray:
+def body_fixed_directions(
+    directions, heading: float, roll: float = 0.0, pitch: float = 0.0, yaw: float = 0.0
+) -> np.ndarray:
     """Stabilised ray directions (N, 3) turned with the aircraft's attitude."""
     rotation = body_rotation(heading, roll, pitch, yaw)
     return np.asarray(directions, dtype=np.float64) @ rotation.T
@@ -85,8 +83,11 @@ def plan_attitudes(plan, speed: float, sensor) -> list:
     segment_poses = plan.segment_poses()
     if sensor.mount != "body-fixed":
         return [None] * sum(len(p) for p in segment_poses)
-    return [a for segment, poses in zip(plan.segments, segment_poses)
-            for a in segment_attitudes(segment, poses, speed)]
+    return [
+        a
+        for segment, poses in zip(plan.segments, segment_poses)
+        for a in segment_attitudes(segment, poses, speed)
+    ]
 
 
 def scan_footprints(scenario, ground_z: float = 0.0) -> list[np.ndarray]:
@@ -97,5 +98,4 @@ def scan_footprints(scenario, ground_z: float = 0.0) -> list[np.ndarray]:
     """
     sensor = scenario.sensor
     attitudes = plan_attitudes(scenario.flight, scenario.speed, sensor)
-    return [sensor.footprint(pose, ground_z, attitude)
-            for pose, attitude in zip(scenario.poses(), attitudes)]
+    return [sensor.footprint(pose, ground_z, attitude) for pose, attitude in zip(scenario.poses(), attitudes)]

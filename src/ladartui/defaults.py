@@ -44,6 +44,5 @@ def default_flight(target_voxels, voxel_size, sensor: Sensor = DEFAULT_SENSOR) -
     slant = max(MIN_SLANT_RANGE, VIEW_MARGIN * size / (2 * math.tan(math.radians(sensor.fov / 2))))
     radius = slant * math.cos(math.radians(DEFAULT_DEPRESSION))
     altitude = centre[2] + slant * math.sin(math.radians(DEFAULT_DEPRESSION))
-    orbit = Orbit(centre=centre, radius=round(radius, 1), altitude=round(altitude, 1),
-                  scans=DEFAULT_SCANS)
+    orbit = Orbit(centre=centre, radius=round(radius, 1), altitude=round(altitude, 1), scans=DEFAULT_SCANS)
     return FlightPlan(None, (orbit,))

@@ -47,7 +47,7 @@ class EditHistory(Generic[State]):
         if state == self.current:
             return
         self._undo.append(Step(self.current, state, label))
-        del self._undo[:-self.depth]
+        del self._undo[: -self.depth]
         self._redo.clear()
         self.current = state
 

@@ -21,9 +21,10 @@ from __future__ import annotations
 import math
 import numbers
 import operator
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from functools import partial
-from typing import ClassVar, Sequence
+from typing import ClassVar
 
 import numpy as np
 
@@ -50,8 +51,12 @@ def number_field(name, value, low=None, high=None, *, low_open=False, high_open=
     if ok and high is not None:
         ok = number < high if high_open else number <= high
     if not ok:
-        raise FieldError(name, value, range_text("a number", low, high, low_open, high_open),
-                         limits=(low, high, low_open, high_open))
+        raise FieldError(
+            name,
+            value,
+            range_text("a number", low, high, low_open, high_open),
+            limits=(low, high, low_open, high_open),
+        )
     return number
 
 
@@ -67,8 +72,7 @@ def integer_field(name, value, low, high):
     except TypeError:
         number = None
     if number is None or not low <= number <= high:
-        raise FieldError(name, value, f"an integer from {low} to {high}",
-                         limits=(low, high, False, False))
+        raise FieldError(name, value, f"an integer from {low} to {high}", limits=(low, high, False, False))
     return int(number)
 
 
@@ -156,8 +160,14 @@ class ScanPose:
         return (self.x, self.y, self.z)
 
     def to_dict(self) -> dict:
-        return {"x": self.x, "y": self.y, "z": self.z, "heading": self.heading,
-                "azimuth": self.azimuth, "depression": self.depression}
+        return {
+            "x": self.x,
+            "y": self.y,
+            "z": self.z,
+            "heading": self.heading,
+            "azimuth": self.azimuth,
+            "depression": self.depression,
+        }
 
 
 def _forward(heading):
@@ -185,11 +195,13 @@ def aim_at(pose: ScanPose, target_xyz) -> ScanPose:
         return replace(pose, depression=90.0)
     depression = math.degrees(math.atan2(-dz, horizontal))
     if depression < 1.0:
-        raise FieldError("aim_at", target_xyz,
-                         f"a point at least 1 degree below the horizon from scan position "
-                         f"({pose.x:g}, {pose.y:g}, {pose.z:g})")
-    return replace(pose, azimuth=_bearing(dx, dy) - pose.heading,
-                   depression=min(depression, 90.0))
+        raise FieldError(
+            "aim_at",
+            target_xyz,
+            f"a point at least 1 degree below the horizon from scan position "
+            f"({pose.x:g}, {pose.y:g}, {pose.z:g})",
+        )
+    return replace(pose, azimuth=_bearing(dx, dy) - pose.heading, depression=min(depression, 90.0))
 
 
 def _length(name, value):
@@ -229,9 +241,13 @@ def _aimed_at_default(poses, target, altitude, field: str, value, what: str):
             raise
         height = altitude - target[2]
         limit = height / math.tan(math.radians(1.0)) if height > 0 else 0.0
-        raise FieldError(field, value, f"{what} of at most {limit:.0f} m at altitude "
-                         f"{altitude:g} m, so the {'centre' if field == 'radius' else 'target'} "
-                         "is at least 1 degree below the horizon (or an aim_at point)") from None
+        raise FieldError(
+            field,
+            value,
+            f"{what} of at most {limit:.0f} m at altitude "
+            f"{altitude:g} m, so the {'centre' if field == 'radius' else 'target'} "
+            "is at least 1 degree below the horizon (or an aim_at point)",
+        ) from None
 
 
 def _with_sensor(pose, azimuth, depression):
@@ -256,8 +272,10 @@ def straight(start: ScanPose, distance: float, scans: int) -> list[ScanPose]:
     distance = _length("distance", distance)
     scans = _scans(scans)
     fx, fy = _forward(start.heading)
-    return [replace(start, x=start.x + fx * distance * k / scans,
-                    y=start.y + fy * distance * k / scans) for k in range(1, scans + 1)]
+    return [
+        replace(start, x=start.x + fx * distance * k / scans, y=start.y + fy * distance * k / scans)
+        for k in range(1, scans + 1)
+    ]
 
 
 def _turn_centre(start, radius, clockwise):
@@ -271,8 +289,7 @@ def _on_circle(template, centre, radius, bearing, clockwise):
     """A pose on a circle at compass ``bearing`` from ``centre``, heading along the tangent."""
     bx, by = _forward(bearing)
     heading = bearing + (90.0 if clockwise else -90.0)
-    return replace(template, x=centre[0] + radius * bx, y=centre[1] + radius * by,
-                   heading=heading)
+    return replace(template, x=centre[0] + radius * bx, y=centre[1] + radius * by, heading=heading)
 
 
 def turn(start: ScanPose, radius: float, arc: float, direction: str, scans: int) -> list[ScanPose]:
@@ -290,8 +307,10 @@ def turn(start: ScanPose, radius: float, arc: float, direction: str, scans: int)
     centre = _turn_centre(start, radius, clockwise)
     sign = 1.0 if clockwise else -1.0
     first_bearing = start.heading - sign * 90.0
-    return [_on_circle(start, centre, radius, first_bearing + sign * arc * k / scans, clockwise)
-            for k in range(1, scans + 1)]
+    return [
+        _on_circle(start, centre, radius, first_bearing + sign * arc * k / scans, clockwise)
+        for k in range(1, scans + 1)
+    ]
 
 
 # -- presets (report figure 1) --------------------------------------------------------
@@ -308,8 +327,9 @@ def _arc_steps(arc, scans):
     return arc / (scans - 1) if scans > 1 else 0.0
 
 
-def orbit(centre, radius, altitude, scans, *, direction="right", start_bearing=180.0,
-          arc=360.0, aim_at=None) -> list[ScanPose]:
+def orbit(
+    centre, radius, altitude, scans, *, direction="right", start_bearing=180.0, arc=360.0, aim_at=None
+) -> list[ScanPose]:
     """Circle ``centre`` (a target point) at ``radius`` metres and ``altitude`` metres.
 
     The first scan is at compass ``start_bearing`` from the centre (180: south
@@ -328,15 +348,15 @@ def orbit(centre, radius, altitude, scans, *, direction="right", start_bearing=1
     clockwise = direction == "right"
     step = _arc_steps(arc, scans) * (1.0 if clockwise else -1.0)
     template = _template(altitude)
-    poses = [_on_circle(template, centre, radius, start_bearing + step * k, clockwise)
-             for k in range(scans)]
+    poses = [_on_circle(template, centre, radius, start_bearing + step * k, clockwise) for k in range(scans)]
     if aim_at is None:
         return _aimed_at_default(poses, centre, altitude, "radius", radius, "a radius")
     return _aimed(poses, aim_at)
 
 
-def flypast(target, standoff, altitude, length, scans, heading, *, side="right",
-            aim_at=None) -> list[ScanPose]:
+def flypast(
+    target, standoff, altitude, length, scans, heading, *, side="right", aim_at=None
+) -> list[ScanPose]:
     """Fly a straight line of ``length`` metres past ``target`` on ``heading``.
 
     The target is on the aircraft's ``side`` ("right" or "left") at horizontal
@@ -359,13 +379,15 @@ def flypast(target, standoff, altitude, length, scans, heading, *, side="right",
     offsets = [0.0] if scans == 1 else [length * (k / (scans - 1) - 0.5) for k in range(scans)]
     poses = [replace(template, x=cx + fx * s, y=cy + fy * s) for s in offsets]
     if aim_at is None:  # the line's ends are the farthest: blame the standoff and length
-        return _aimed_at_default(poses, target, altitude, "standoff", standoff,
-                                 "a standoff (with half the length)")
+        return _aimed_at_default(
+            poses, target, altitude, "standoff", standoff, "a standoff (with half the length)"
+        )
     return _aimed(poses, aim_at)
 
 
-def standoff_sweep(target, standoffs, altitude, *, bearing=180.0, heading=None,
-                   aim_at=None) -> list[ScanPose]:
+def standoff_sweep(
+    target, standoffs, altitude, *, bearing=180.0, heading=None, aim_at=None
+) -> list[ScanPose]:
     """One scan at each horizontal distance in ``standoffs`` (metres) from ``target``.
 
     Scans lie along compass ``bearing`` from the target (180: south of it), in
@@ -381,8 +403,7 @@ def standoff_sweep(target, standoffs, altitude, *, bearing=180.0, heading=None,
     template = _template(altitude, heading)
     poses = [replace(template, x=target[0] + bx * s, y=target[1] + by * s) for s in distances]
     if aim_at is None:
-        return _aimed_at_default(poses, target, altitude, "standoffs", list(distances),
-                                 "standoffs")
+        return _aimed_at_default(poses, target, altitude, "standoffs", list(distances), "standoffs")
     return _aimed(poses, aim_at)
 
 
@@ -504,8 +525,9 @@ class Turn:
         _check_pointing(self)
 
     def build(self, current):
-        return _pointed(self, current, lambda start: turn(start, self.radius, self.arc,
-                                                          self.direction, self.scans))
+        return _pointed(
+            self, current, lambda start: turn(start, self.radius, self.arc, self.direction, self.scans)
+        )
 
     def lead_in(self) -> float:
         """Metres along the arc from the start of the turn to its first scan."""
@@ -541,9 +563,16 @@ class Orbit:
         _set(self, "aim_at", _optional_point("aim_at", self.aim_at))
 
     def build(self, current):
-        return orbit(self.centre, self.radius, self.altitude, self.scans,
-                     direction=self.direction, start_bearing=self.start_bearing,
-                     arc=self.arc, aim_at=self.aim_at)
+        return orbit(
+            self.centre,
+            self.radius,
+            self.altitude,
+            self.scans,
+            direction=self.direction,
+            start_bearing=self.start_bearing,
+            arc=self.arc,
+            aim_at=self.aim_at,
+        )
 
     def legs(self, poses):
         arc_between = math.radians(_arc_steps(self.arc, self.scans)) * self.radius
@@ -576,8 +605,16 @@ class FlyPast:
         _set(self, "aim_at", _optional_point("aim_at", self.aim_at))
 
     def build(self, current):
-        return flypast(self.target, self.standoff, self.altitude, self.length, self.scans,
-                       self.heading, side=self.side, aim_at=self.aim_at)
+        return flypast(
+            self.target,
+            self.standoff,
+            self.altitude,
+            self.length,
+            self.scans,
+            self.heading,
+            side=self.side,
+            aim_at=self.aim_at,
+        )
 
     def legs(self, poses):
         return _chords(poses)
@@ -606,8 +643,14 @@ class Standoff:
         _set(self, "aim_at", _optional_point("aim_at", self.aim_at))
 
     def build(self, current):
-        return standoff_sweep(self.target, self.standoffs, self.altitude, bearing=self.bearing,
-                              heading=self.heading, aim_at=self.aim_at)
+        return standoff_sweep(
+            self.target,
+            self.standoffs,
+            self.altitude,
+            bearing=self.bearing,
+            heading=self.heading,
+            aim_at=self.aim_at,
+        )
 
     def legs(self, poses):
         return _chords(poses)
@@ -644,8 +687,9 @@ class FlightPlan:
         result = []
         for index, segment in enumerate(self.segments):
             if segment.relative and current is None:
-                raise FieldError("start", None, f"a start pose before the {segment.kind} "
-                                 f"segment (segment {index + 1})")
+                raise FieldError(
+                    "start", None, f"a start pose before the {segment.kind} segment (segment {index + 1})"
+                )
             try:
                 poses = segment.build(current)
             except FieldError as error:
@@ -671,8 +715,9 @@ class FlightPlan:
         previous = None
         for segment, poses in zip(self.segments, self.segment_poses()):
             if previous is not None:
-                total += (segment.lead_in() if segment.relative
-                          else math.dist(previous.position, poses[0].position))
+                total += (
+                    segment.lead_in() if segment.relative else math.dist(previous.position, poses[0].position)
+                )
             total += sum(segment.legs(poses))
             previous = poses[-1]
         return total

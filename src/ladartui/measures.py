@@ -45,9 +45,7 @@ CMF_HEADER = f"# ladartui comparison measures, format {CMF_FORMAT} {CMF_VERSION}
 
 # Faces through which a target voxel can be seen: the ground-facing (-z) face is
 # left out, since a sensor above the ground never looks up at it.
-VISIBLE_FACE_OFFSETS = np.array(
-    [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1]], dtype=np.int64
-)
+VISIBLE_FACE_OFFSETS = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1]], dtype=np.int64)
 
 # Coverage share of the final obscured coverage that counts as "enough looks".
 ENOUGH_SHARE = 0.9
@@ -67,8 +65,11 @@ def voxel_keys(voxels) -> np.ndarray:
     """
     v = np.asarray(voxels, dtype=np.int64).reshape(-1, 3) + 1
     if v.size and (v.min() < 0 or (v.max(axis=0) >= _KEY_LIMITS).any()):
-        raise FieldError("voxel index", tuple(int(c) for c in v.max(axis=0) - 1),
-                         f"0..{_KEY_LIMITS[0] - 2} for x and y, 0..{_KEY_LIMITS[2] - 2} for z")
+        raise FieldError(
+            "voxel index",
+            tuple(int(c) for c in v.max(axis=0) - 1),
+            f"0..{_KEY_LIMITS[0] - 2} for x and y, 0..{_KEY_LIMITS[2] - 2} for z",
+        )
     return (v[:, 0] << (_KEY_BITS_XY + _KEY_BITS_Z)) | (v[:, 1] << _KEY_BITS_Z) | v[:, 2]
 
 
@@ -251,9 +252,16 @@ class Measures:
         write_text_atomic(path, self.to_cmf())
 
 
-def compute_measures(target_model, scene_output, target_output, scene_per_scan=None,
-                     target_per_scan=None, path_length_m=None, flight_time_s=None,
-                     voxel_size=None) -> Measures:
+def compute_measures(
+    target_model,
+    scene_output,
+    target_output,
+    scene_per_scan=None,
+    target_per_scan=None,
+    path_length_m=None,
+    flight_time_s=None,
+    voxel_size=None,
+) -> Measures:
     """Score the obscured (``scene_output``) and unobscured (``target_output``) views.
 
     All voxel arguments are (K, 3) integer index arrays; outputs may hold
@@ -355,37 +363,55 @@ def _direction_entries(prefix):
 
 
 _CMF_SECTIONS = [
-    ("3d target model", [
-        ("target_voxels", "target_voxels", "int"),
-        ("visible_voxels", "visible_voxels", "int"),
-        ("maximum_target_coverage", "maximum_coverage", "float"),
-        *_direction_entries("model_directions"),
-    ]),
-    ("unobscured 3d target output", [
-        ("covered_voxels", "unobscured_voxels", "int"),
-        ("target_coverage", "unobscured_coverage", "float"),
-        *_direction_entries("unobscured_directions"),
-    ]),
-    ("obscured 3d target output", [
-        ("covered_voxels", "obscured_voxels", "int"),
-        ("target_coverage", "obscured_coverage", "float"),
-        *_direction_entries("obscured_directions"),
-    ]),
-    ("comparison", [
-        ("shift_in_mean_direction_rad", "direction_shift_rad", "float"),
-        ("missed_share", "missed_share", "float"),
-        ("coverage_ratio", "coverage_ratio", "float"),
-        ("obscured_only_voxels", "obscured_only_voxels", "int"),
-    ]),
-    ("coverage after each scan", [
-        ("scans", "scans", "int"),
-        ("scans_for_90_percent_of_final", "scans_for_enough", "int"),
-    ]),
-    ("flight", [
-        ("path_length_m", "path_length_m", "float"),
-        ("flight_time_s", "flight_time_s", "float"),
-        ("voxel_size_m", "voxel_size", "float"),
-    ]),
+    (
+        "3d target model",
+        [
+            ("target_voxels", "target_voxels", "int"),
+            ("visible_voxels", "visible_voxels", "int"),
+            ("maximum_target_coverage", "maximum_coverage", "float"),
+            *_direction_entries("model_directions"),
+        ],
+    ),
+    (
+        "unobscured 3d target output",
+        [
+            ("covered_voxels", "unobscured_voxels", "int"),
+            ("target_coverage", "unobscured_coverage", "float"),
+            *_direction_entries("unobscured_directions"),
+        ],
+    ),
+    (
+        "obscured 3d target output",
+        [
+            ("covered_voxels", "obscured_voxels", "int"),
+            ("target_coverage", "obscured_coverage", "float"),
+            *_direction_entries("obscured_directions"),
+        ],
+    ),
+    (
+        "comparison",
+        [
+            ("shift_in_mean_direction_rad", "direction_shift_rad", "float"),
+            ("missed_share", "missed_share", "float"),
+            ("coverage_ratio", "coverage_ratio", "float"),
+            ("obscured_only_voxels", "obscured_only_voxels", "int"),
+        ],
+    ),
+    (
+        "coverage after each scan",
+        [
+            ("scans", "scans", "int"),
+            ("scans_for_90_percent_of_final", "scans_for_enough", "int"),
+        ],
+    ),
+    (
+        "flight",
+        [
+            ("path_length_m", "path_length_m", "float"),
+            ("flight_time_s", "flight_time_s", "float"),
+            ("voxel_size_m", "voxel_size", "float"),
+        ],
+    ),
 ]
 
 _CMF_NOTES = [
@@ -449,8 +475,11 @@ def _detection_entries():
 
 def _detection_lines(detection) -> list[str]:
     section, entries = _detection_entries()
-    return ["", f"[{section}]", *(f"{key} = {_format_value(getattr(detection, attr))}"
-                                  for key, attr, _kind in entries)]
+    return [
+        "",
+        f"[{section}]",
+        *(f"{key} = {_format_value(getattr(detection, attr))}" for key, attr, _kind in entries),
+    ]
 
 
 _CMF_LAYOUT = [
@@ -494,10 +523,13 @@ def read_cmf(path) -> Measures:
     lines = text.splitlines()
     if not lines or lines[0].strip() != CMF_HEADER:
         raise InputFileError(path, f"not a measures file: expected first line {CMF_HEADER!r}", line=1)
-    kinds = {(section, key): (attr, kind) for section, entries in _CMF_SECTIONS for key, attr, kind in entries}
+    kinds = {
+        (section, key): (attr, kind) for section, entries in _CMF_SECTIONS for key, attr, kind in entries
+    }
     detection_section, detection_entries = _detection_entries()
-    kinds.update({(detection_section, key): ("detection." + attr, kind)
-                  for key, attr, kind in detection_entries})
+    kinds.update(
+        {(detection_section, key): ("detection." + attr, kind) for key, attr, kind in detection_entries}
+    )
     values: dict[str, object] = {}
     per_scan: dict[int, tuple] = {}
     section = None
@@ -523,8 +555,9 @@ def read_cmf(path) -> Measures:
                 raise InputFileError(path, f"{key}: {error}", line=number) from None
             continue
         if not sep or (section, key) not in kinds:
-            raise InputFileError(path, f"expected 'key = value' with a known key in [{section}], got {line!r}",
-                                 line=number)
+            raise InputFileError(
+                path, f"expected 'key = value' with a known key in [{section}], got {line!r}", line=number
+            )
         attr, kind = kinds[(section, key)]
         try:
             values[attr] = _parse_value(value.strip(), kind)
@@ -581,10 +614,18 @@ def view_rows(measures: Measures) -> list[tuple[str, str, str, str]]:
     m = measures
     views = (m.model_directions, m.unobscured_directions, m.obscured_directions)
     return [
-        ("Target coverage", format_share(m.maximum_coverage), format_share(m.unobscured_coverage),
-         format_share(m.obscured_coverage)),
-        ("Voxels", f"{m.visible_voxels} of {m.target_voxels}", str(m.unobscured_voxels),
-         str(m.obscured_voxels)),
+        (
+            "Target coverage",
+            format_share(m.maximum_coverage),
+            format_share(m.unobscured_coverage),
+            format_share(m.obscured_coverage),
+        ),
+        (
+            "Voxels",
+            f"{m.visible_voxels} of {m.target_voxels}",
+            str(m.unobscured_voxels),
+            str(m.obscured_voxels),
+        ),
         ("Sample mean vector", *(format_vector(v.mean_vector) for v in views)),
         ("Mean resultant length", *(format_number(v.resultant_length) for v in views)),
         ("Mean direction", *(format_vector(v.mean_direction) for v in views)),
@@ -602,12 +643,16 @@ def comparison_rows(measures: Measures) -> list[tuple[str, str]]:
         ("Shift in mean direction", format_number(m.direction_shift_rad, unit="rad")),
         ("Unobscured coverage missed when obscured", format_share(m.missed_share)),
         ("Obscured / unobscured coverage", format_share(m.coverage_ratio)),
-        ("Seen obscured but not unobscured",
-         f"{m.obscured_only_voxels} voxel{'' if m.obscured_only_voxels == 1 else 's'}"),
+        (
+            "Seen obscured but not unobscured",
+            f"{m.obscured_only_voxels} voxel{'' if m.obscured_only_voxels == 1 else 's'}",
+        ),
         ("Obscured coverage after each scan", after(m.obscured_after_scan)),
         ("Unobscured coverage after each scan", after(m.unobscured_after_scan)),
-        (f"Scans to reach {ENOUGH_SHARE:.0%} of final coverage",
-         UNDEFINED if m.scans_for_enough is None else f"{m.scans_for_enough} of {m.scans}"),
+        (
+            f"Scans to reach {ENOUGH_SHARE:.0%} of final coverage",
+            UNDEFINED if m.scans_for_enough is None else f"{m.scans_for_enough} of {m.scans}",
+        ),
         ("Path length", format_number(m.path_length_m, 1, "m")),
         ("Flight time", format_number(m.flight_time_s, 1, "s")),
     ]

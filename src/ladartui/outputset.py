@@ -122,8 +122,10 @@ class OutputSet:
                 holder = os.read(fd, 32).decode("ascii", "replace").strip() or "?"
                 os.close(fd)
                 if error.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
-                    raise OutputFileError(self.lock, f"another run (pid {holder}) is writing "
-                                          "this output set; wait for it to finish") from None
+                    raise OutputFileError(
+                        self.lock,
+                        f"another run (pid {holder}) is writing this output set; wait for it to finish",
+                    ) from None
                 raise
             # The holder before us removes the file as it lets go: lock the one on disk.
             try:
@@ -154,8 +156,9 @@ class OutputSet:
 
     # -- write --
 
-    def write(self, writers: dict[str, Callable[[Path], None]],
-              cancel: threading.Event | None = None) -> dict[str, str]:
+    def write(
+        self, writers: dict[str, Callable[[Path], None]], cancel: threading.Event | None = None
+    ) -> dict[str, str]:
         """Write every file with ``writers[name](temporary_path)``, then swap them all in.
 
         Before the swap a set ``cancel`` stops with ``Cancelled`` and nothing
@@ -188,8 +191,7 @@ class OutputSet:
         entries = []
         for path in self.paths.values():
             backup = path.with_name(f".{path.name}.{os.getpid()}.old")
-            entries.append({"path": str(path), "backup": str(backup),
-                            "existed": os.path.lexists(path)})
+            entries.append({"path": str(path), "backup": str(backup), "existed": os.path.lexists(path)})
         _write_journal(self.journal, entries)
         try:
             for entry, tmp in zip(entries, temps.values()):
@@ -248,8 +250,9 @@ def _write_journal(journal: Path, entries):
 
 def _write_error(path, error: OSError) -> OutputFileError:
     reason = os.strerror(error.errno) if error.errno else str(error)
-    return OutputFileError(path, f"could not be written ({reason.lower()}); "
-                           "nothing was replaced, earlier outputs are unchanged")
+    return OutputFileError(
+        path, f"could not be written ({reason.lower()}); nothing was replaced, earlier outputs are unchanged"
+    )
 
 
 def _step(name):

@@ -13,7 +13,7 @@ variants); more take the O(n^2) pairwise check.
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from collections.abc import Sequence
 
 Point = Sequence[float]
 

@@ -30,8 +30,11 @@ def _read() -> dict[str, list[str]]:
         data = {"scenarios": data}
     if not isinstance(data, dict):
         return {}
-    return {kind: [n for n in data.get(kind, []) if isinstance(n, str)]
-            for kind in KINDS if isinstance(data.get(kind, []), list)}
+    return {
+        kind: [n for n in data.get(kind, []) if isinstance(n, str)]
+        for kind in KINDS
+        if isinstance(data.get(kind, []), list)
+    }
 
 
 def recent_paths(kind: str, existing_only: bool = True) -> list[Path]:
@@ -59,8 +62,7 @@ def remember_path(kind: str, path) -> list[Path]:
 
 
 def recent_scenarios(existing_only: bool = True) -> list[Path]:
-    return [p for p in recent_paths("scenarios", existing_only) if not existing_only
-            or p.is_file()]
+    return [p for p in recent_paths("scenarios", existing_only) if not existing_only or p.is_file()]
 
 
 def remember_scenario(path) -> list[Path]:

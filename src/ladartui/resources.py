@@ -92,7 +92,8 @@ def check_occupancy(lo, hi, count, source="voxels") -> int:
         raise ResourceLimitError(
             f"{source}: {int(count):,} voxels spanning {extent} voxels need about "
             f"{gib(need)} for the tracing structures, more than the {gib(limit)} of memory "
-            "available; crop the scene or use a coarser voxel size")
+            "available; crop the scene or use a coarser voxel size"
+        )
     return need
 
 
@@ -102,7 +103,8 @@ def check_rays(rays, source, limit=None) -> None:
     if rays > limit:
         raise ResourceLimitError(
             f"{source}: about {rays:.3g} rays to trace, more than the limit of {limit:.3g} "
-            "(raise it with --max-rays or LADARTUI_MAX_RAYS if this is meant)")
+            "(raise it with --max-rays or LADARTUI_MAX_RAYS if this is meant)"
+        )
 
 
 def gib(nbytes) -> str:

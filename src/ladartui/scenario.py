@@ -171,21 +171,20 @@ class Scenario:
         path = _absolute(self.path)
         set_(self, "path", path)
         set_(self, "scene_file", _resolve(path.parent, self.scene_file))
-        set_(self, "voxel_size", number_field("files.voxel_size", self.voxel_size, 0.0,
-                                              MAX_VOXEL_SIZE, low_open=True))
+        set_(
+            self,
+            "voxel_size",
+            number_field("files.voxel_size", self.voxel_size, 0.0, MAX_VOXEL_SIZE, low_open=True),
+        )
         if not isinstance(self.sensor, Sensor):
             raise FieldError("sensor", self.sensor, "a Sensor")
         if not isinstance(self.flight, FlightPlan):
             raise FieldError("flight", self.flight, "a FlightPlan")
-        set_(self, "speed", number_field("flight.speed_mps", self.speed, 0.0, MAX_SPEED,
-                                         low_open=True))
-        set_(self, "backend", choice_field("simulation.backend", self.backend,
-                                           _backend_choices()))
+        set_(self, "speed", number_field("flight.speed_mps", self.speed, 0.0, MAX_SPEED, low_open=True))
+        set_(self, "backend", choice_field("simulation.backend", self.backend, _backend_choices()))
         set_(self, "method", choice_field("simulation.method", self.method, METHODS))
-        set_(self, "step", number_field("simulation.step", self.step, 0.0, MAX_STEP,
-                                        low_open=True))
-        set_(self, "precision", choice_field("simulation.precision", self.precision,
-                                             PRECISIONS))
+        set_(self, "step", number_field("simulation.step", self.step, 0.0, MAX_STEP, low_open=True))
+        set_(self, "precision", choice_field("simulation.precision", self.precision, PRECISIONS))
         if not isinstance(self.fast_mode, bool):
             raise FieldError("simulation.fast_mode", self.fast_mode, "true or false")
         _check_flight(self.flight)
@@ -252,9 +251,11 @@ class Scenario:
         if problem := file_problem(self.scene_file):
             missing = f"scene model file {self.scene_file} {problem} (files.scene)"
         elif problem := file_problem(self.target_file):
-            missing = (f"target model file {self.target_file} {problem} (the target model of "
-                       f"{self.scene_file.name} must sit beside it, named "
-                       f"{self.target_file.name})")
+            missing = (
+                f"target model file {self.target_file} {problem} (the target model of "
+                f"{self.scene_file.name} must sit beside it, named "
+                f"{self.target_file.name})"
+            )
         if missing:
             line = _key_lines(self.path).get("files.scene") if self.path.is_file() else None
             raise InputFileError(self.path, missing, line)
@@ -264,8 +265,7 @@ class Scenario:
         return dataclasses.replace(self, **fields)
 
     @classmethod
-    def new(cls, path, scene_file, voxel_size=1.0, *, sensor=None, flight=None,
-            **options) -> Scenario:
+    def new(cls, path, scene_file, voxel_size=1.0, *, sensor=None, flight=None, **options) -> Scenario:
         """A new scenario for ``scene_file``; without ``flight``, an orbit around its target.
 
         The default orbit (see ``ladartui.defaults.default_flight``) reads the
@@ -278,8 +278,11 @@ class Scenario:
         if flight is None:
             target_file = target_file_for(scene_file)
             if not target_file.is_file():
-                raise InputFileError(target_file, "target model not found (a new scenario's "
-                                     "default orbit circles the target of X_Target.txt)")
+                raise InputFileError(
+                    target_file,
+                    "target model not found (a new scenario's "
+                    "default orbit circles the target of X_Target.txt)",
+                )
             from ladartui.scene.voxels import load_voxels
 
             flight = defaults.default_flight(load_voxels(target_file), voxel_size)
@@ -291,8 +294,9 @@ class Scenario:
         s = self.sensor
         altitudes = [p.z for p in poses]
         depressions = [p.depression for p in poses]
-        kinds = ", ".join(f"{seg.kind} ({len(ps)})"
-                          for seg, ps in zip(self.flight.segments, self.flight.segment_poses()))
+        kinds = ", ".join(
+            f"{seg.kind} ({len(ps)})" for seg, ps in zip(self.flight.segments, self.flight.segment_poses())
+        )
         length = self.path_length()
         lines = [
             f"scenario   {self.path}",
@@ -308,9 +312,16 @@ class Scenario:
             f"rays       {s.rays_per_scan:,} per scan, {s.rays_per_scan * len(poses):,} in all",
             f"run        backend {self.backend}, method {self.method}"
             + (f" (step {self.step:g} voxel)" if self.method == "march" else "")
-            + f", {self.precision}" + (", fast mode" if self.fast_mode else ""),
-            *([f"attitude   body-fixed sensor: rays turn with the aircraft's roll and pitch "
-               f"(coordinated turns at {self.speed:g} m/s)"] if s.mount == "body-fixed" else []),
+            + f", {self.precision}"
+            + (", fast mode" if self.fast_mode else ""),
+            *(
+                [
+                    f"attitude   body-fixed sensor: rays turn with the aircraft's roll and pitch "
+                    f"(coordinated turns at {self.speed:g} m/s)"
+                ]
+                if s.mount == "body-fixed"
+                else []
+            ),
             *([f"detection  {self.detection.describe()}"] if self.detection is not None else []),
             f"outputs    {self.scene_output.name}, {self.target_output.name}, "
             f"{self.measures_file.name} in {self.path.parent}",
@@ -325,29 +336,38 @@ class Scenario:
         flight = {"speed_mps": self.speed}
         if self.flight.start is not None:
             flight["start"] = self.flight.start.to_dict()
-        flight["segments"] = [_segment_to_dict(seg, self.path.parent)
-                              for seg in self.flight.segments]
-        sensor = {"grid": s.grid, "ray_grid": s.ray_grid, "fov_deg": s.fov,
-                  "depth_resolution_m": s.depth_resolution,
-                  "pixel_pitch_um": _to_micrometres(s.pixel_pitch)}
+        flight["segments"] = [_segment_to_dict(seg, self.path.parent) for seg in self.flight.segments]
+        sensor = {
+            "grid": s.grid,
+            "ray_grid": s.ray_grid,
+            "fov_deg": s.fov,
+            "depth_resolution_m": s.depth_resolution,
+            "pixel_pitch_um": _to_micrometres(s.pixel_pitch),
+        }
         if s.mount != "stabilised":  # written only when chosen: older files stay as they were
             sensor["mount"] = s.mount
         data = {
-            "files": {"scene": _relative(self.scene_file, self.path.parent),
-                      "voxel_size": self.voxel_size},
+            "files": {"scene": _relative(self.scene_file, self.path.parent), "voxel_size": self.voxel_size},
             "sensor": sensor,
             "flight": flight,
-            "simulation": {"backend": self.backend, "method": self.method, "step": self.step,
-                           "precision": self.precision, "fast_mode": self.fast_mode},
+            "simulation": {
+                "backend": self.backend,
+                "method": self.method,
+                "step": self.step,
+                "precision": self.precision,
+                "fast_mode": self.fast_mode,
+            },
         }
         if self.detection is not None:
             data["detection"] = self.detection.to_dict()
         return data
 
     def to_toml(self) -> str:
-        header = (f"# ladartui scenario. Check it with: ladartui validate {self.path.name}\n"
-                  f"# A run writes {self.scene_output.name}, {self.target_output.name} and "
-                  f"{self.measures_file.name} beside this file.\n\n")
+        header = (
+            f"# ladartui scenario. Check it with: ladartui validate {self.path.name}\n"
+            f"# A run writes {self.scene_output.name}, {self.target_output.name} and "
+            f"{self.measures_file.name} beside this file.\n\n"
+        )
         return header + _compact_arrays(tomli_w.dumps(self.to_dict()))
 
     def save(self, path=None) -> Scenario:
@@ -359,8 +379,7 @@ class Scenario:
         scenario = self if path is None else self.with_changes(path=Path(path))
         text = None
         if self.path.is_file():  # keep the analyst's comments, key order and layout
-            text = restyle(self.path.read_text(encoding="utf-8"), scenario.to_dict(),
-                           _saved_data(self.path))
+            text = restyle(self.path.read_text(encoding="utf-8"), scenario.to_dict(), _saved_data(self.path))
         write_text_atomic(scenario.path, text if text is not None else scenario.to_toml())
         return scenario
 
@@ -448,25 +467,24 @@ class _Reader:
             yield
         except FieldError as error:
             head = re.split(r"[.\[]", error.field, maxsplit=1)[0]
-            rest = error.field[len(head):]
+            rest = error.field[len(head) :]
             key = (rename or {}).get(head, head)
-            value = table.get(key, error.value) if isinstance(table, dict) and not rest \
-                else error.value
+            value = table.get(key, error.value) if isinstance(table, dict) and not rest else error.value
             raise self.field_error(prefix + key + rest, value, error.expected) from None
 
     def table(self, doc, key, allowed, required=()):
         value = doc.get(key.rsplit(".", 1)[-1], {}) if isinstance(doc, dict) else {}
         if not isinstance(value, dict):
-            raise self.file_error(key, f"'{key}' must be a table ([{key}]), not "
-                                  f"{type(value).__name__}")
+            raise self.file_error(key, f"'{key}' must be a table ([{key}]), not {type(value).__name__}")
         self.keys(value, key, allowed, required)
         return value
 
     def keys(self, table, where, allowed, required=(), what=""):
         for name in table:
             if name not in allowed:
-                raise self.file_error(f"{where}.{name}", f"unknown key '{where}.{name}'{what} "
-                                      f"(allowed: {', '.join(allowed)})")
+                raise self.file_error(
+                    f"{where}.{name}", f"unknown key '{where}.{name}'{what} (allowed: {', '.join(allowed)})"
+                )
         for name in required:
             if name not in table:
                 raise self.file_error(where, f"missing key '{where}.{name}'{what}")
@@ -474,8 +492,7 @@ class _Reader:
     def scenario(self, doc) -> Scenario:
         for name in doc:
             if name not in _SECTIONS:
-                raise self.file_error(name, f"unknown section [{name}] "
-                                      f"(allowed: {', '.join(_SECTIONS)})")
+                raise self.file_error(name, f"unknown section [{name}] (allowed: {', '.join(_SECTIONS)})")
         files = self.table(doc, "files", _SECTIONS["files"], required=("scene",))
         sensor_table = self.table(doc, "sensor", _SECTIONS["sensor"])
         flight = self.table(doc, "flight", _SECTIONS["flight"], required=("segments",))
@@ -487,8 +504,7 @@ class _Reader:
                 detection = detection_from_table(table)
             except FieldError as error:
                 key = error.field.rpartition(".")[2]
-                raise self.field_error(error.field, table.get(key, error.value),
-                                       error.expected) from None
+                raise self.field_error(error.field, table.get(key, error.value), error.expected) from None
 
         scene = files["scene"]
         if not isinstance(scene, str) or not scene.strip():
@@ -496,14 +512,18 @@ class _Reader:
 
         if "pixel_pitch_um" in sensor_table:  # checked in the file's unit
             with self.located("sensor.", sensor_table):
-                number_field("pixel_pitch_um", sensor_table["pixel_pitch_um"], 0.0,
-                             MAX_PIXEL_PITCH * 1e6, low_open=True)
+                number_field(
+                    "pixel_pitch_um",
+                    sensor_table["pixel_pitch_um"],
+                    0.0,
+                    MAX_PIXEL_PITCH * 1e6,
+                    low_open=True,
+                )
         sensor_args = {}
         for key, (name, scale) in _SENSOR_KEYS.items():
             if key in sensor_table:
                 value = sensor_table[key]
-                if scale is not None and isinstance(value, (int, float)) \
-                        and not isinstance(value, bool):
+                if scale is not None and isinstance(value, (int, float)) and not isinstance(value, bool):
                     value = value / scale  # dividing by 1e6 is exact for 100 -> 1e-4
                 sensor_args[name] = value
         rename = {name: key for key, (name, _) in _SENSOR_KEYS.items()}
@@ -511,20 +531,18 @@ class _Reader:
             sensor = Sensor(**sensor_args)
 
         plan = self.flight_plan(flight)
-        options = {"voxel_size": files.get("voxel_size", 1.0),
-                   "speed": flight.get("speed_mps", 30.0)}
+        options = {"voxel_size": files.get("voxel_size", 1.0), "speed": flight.get("speed_mps", 30.0)}
         for key in _SECTIONS["simulation"]:
             if key in sim:
                 options[key] = sim[key]
         try:
-            return Scenario(self.path, Path(scene), sensor=sensor, flight=plan,
-                            detection=detection, **options)
+            return Scenario(
+                self.path, Path(scene), sensor=sensor, flight=plan, detection=detection, **options
+            )
         except FieldError as error:
-            raw = {"files.voxel_size": files.get("voxel_size"),
-                   "flight.speed_mps": flight.get("speed_mps")}
+            raw = {"files.voxel_size": files.get("voxel_size"), "flight.speed_mps": flight.get("speed_mps")}
             table, _, key = error.field.rpartition(".")
-            value = raw.get(error.field, sim.get(key, error.value) if table == "simulation"
-                            else error.value)
+            value = raw.get(error.field, sim.get(key, error.value) if table == "simulation" else error.value)
             raise self.field_error(error.field, value, error.expected) from None
 
     def pose(self, table, where) -> ScanPose:
@@ -537,12 +555,11 @@ class _Reader:
     def flight_plan(self, flight) -> FlightPlan:
         start = self.pose(flight["start"], "flight.start") if "start" in flight else None
         items = flight["segments"]
-        if not isinstance(items, list) or not items or not all(isinstance(i, dict)
-                                                                 for i in items):
-            raise self.file_error("flight.segments", "'flight.segments' must be one or more "
-                                  "[[flight.segments]] tables")
-        segments = [self.segment(item, f"flight.segments[{index}]")
-                    for index, item in enumerate(items)]
+        if not isinstance(items, list) or not items or not all(isinstance(i, dict) for i in items):
+            raise self.file_error(
+                "flight.segments", "'flight.segments' must be one or more [[flight.segments]] tables"
+            )
+        segments = [self.segment(item, f"flight.segments[{index}]") for index, item in enumerate(items)]
         plan = FlightPlan(start, segments)
         try:
             _check_flight(plan)
@@ -552,25 +569,32 @@ class _Reader:
 
     def segment(self, item, where):
         if "kind" not in item:
-            raise self.file_error(where, f"missing key '{where}.kind' (one of "
-                                  f"{', '.join(_SEGMENT_KINDS)})")
+            raise self.file_error(where, f"missing key '{where}.kind' (one of {', '.join(_SEGMENT_KINDS)})")
         kind = item["kind"]
         if not isinstance(kind, str) or kind not in _SEGMENT_KINDS:
-            raise self.field_error(f"{where}.kind", kind,
-                                   "one of " + ", ".join(repr(k) for k in _SEGMENT_KINDS))
+            raise self.field_error(
+                f"{where}.kind", kind, "one of " + ", ".join(repr(k) for k in _SEGMENT_KINDS)
+            )
         cls = _SEGMENT_KINDS[kind]
         fields = dataclasses.fields(cls)
         allowed = ("kind", *(f.name for f in fields))
-        required = [f.name for f in fields if f.default is dataclasses.MISSING
-                    and f.default_factory is dataclasses.MISSING]
+        required = [
+            f.name
+            for f in fields
+            if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
+        ]
         self.keys(item, where, allowed, required, what=f" ({kind} segment)")
         args = {k: v for k, v in item.items() if k != "kind"}
         if cls is Manual:
             poses = args["poses"]
             if not isinstance(poses, list) or not poses:
-                raise self.field_error(f"{where}.poses", poses, "a list of one or more poses "
-                                       "{ x = .., y = .., z = .., heading = .., "
-                                       "azimuth = .., depression = .. }")
+                raise self.field_error(
+                    f"{where}.poses",
+                    poses,
+                    "a list of one or more poses "
+                    "{ x = .., y = .., z = .., heading = .., "
+                    "azimuth = .., depression = .. }",
+                )
             args["poses"] = [self.pose(p, f"{where}.poses[{i}]") for i, p in enumerate(poses)]
         if cls is LogSegment and isinstance(args["file"], str) and args["file"].strip():
             args["file"] = str(_resolve(self.path.parent, args["file"]))
@@ -714,6 +738,8 @@ def _check_work(scenario):
     from ladartui.resources import check_rays
 
     sensor, scans = scenario.sensor, scenario.scan_count()
-    check_rays(2 * sensor.rays_per_scan * scans,
-               f"{scenario.path.name}: sensor.grid = {sensor.grid}, sensor.ray_grid = "
-               f"{sensor.ray_grid}, {scans:,} scans")
+    check_rays(
+        2 * sensor.rays_per_scan * scans,
+        f"{scenario.path.name}: sensor.grid = {sensor.grid}, sensor.ray_grid = "
+        f"{sensor.ray_grid}, {scans:,} scans",
+    )

@@ -42,10 +42,8 @@ def _merge_table(table, data: dict, old_data: dict | None) -> None:
             table[key] = value
         elif isinstance(value, dict) and isinstance(_plain(table[key]), dict):
             _merge_table(table[key], value, before)
-        elif _is_table_list(value) and _is_table_list(_plain(table[key])) \
-                and len(value) == len(table[key]):
-            befores = before if _is_table_list(before) and len(before) == len(value) \
-                else [None] * len(value)
+        elif _is_table_list(value) and _is_table_list(_plain(table[key])) and len(value) == len(table[key]):
+            befores = before if _is_table_list(before) and len(before) == len(value) else [None] * len(value)
             for old, new, old_new in zip(table[key], value, befores):  # segments keep comments
                 _merge_table(old, new, old_new)
         elif not _same(_plain(table[key]), value):

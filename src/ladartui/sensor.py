@@ -84,8 +84,9 @@ def _rays_kernel():
         import numba
 
         @numba.njit(nogil=True, cache=True)
-        def build(n, m, row0, row1, tan_x, tan_y, pos_x, pos_y, rotation, position,
-                  origins, directions, detector):
+        def build(
+            n, m, row0, row1, tan_x, tan_y, pos_x, pos_y, rotation, position, origins, directions, detector
+        ):
             # R (tx, ty, -1) / |.| = (tx R[:,0] + (ty R[:,1] - R[:,2])) / |.|: one term per
             # column, one per row. Origins likewise: px R[:,0] + (py R[:,1] + position).
             col_dir = np.empty((n * m, 3))
@@ -144,12 +145,17 @@ class Sensor:
         set_ = object.__setattr__
         set_(self, "grid", integer_field("grid", self.grid, 1, MAX_GRID))
         set_(self, "ray_grid", integer_field("ray_grid", self.ray_grid, 1, MAX_RAY_GRID))
-        set_(self, "fov", number_field("fov", self.fov, 0.0, 90.0, low_open=True,
-                                       high_open=True))
-        set_(self, "depth_resolution", number_field("depth_resolution", self.depth_resolution,
-                                                    0.0, MAX_DEPTH_RESOLUTION))
-        set_(self, "pixel_pitch", number_field("pixel_pitch", self.pixel_pitch, 0.0,
-                                               MAX_PIXEL_PITCH, low_open=True))
+        set_(self, "fov", number_field("fov", self.fov, 0.0, 90.0, low_open=True, high_open=True))
+        set_(
+            self,
+            "depth_resolution",
+            number_field("depth_resolution", self.depth_resolution, 0.0, MAX_DEPTH_RESOLUTION),
+        )
+        set_(
+            self,
+            "pixel_pitch",
+            number_field("pixel_pitch", self.pixel_pitch, 0.0, MAX_PIXEL_PITCH, low_open=True),
+        )
         if not isinstance(self.mount, str) or self.mount not in MOUNTS:
             raise FieldError("mount", self.mount, "one of " + ", ".join(repr(m) for m in MOUNTS))
 
@@ -200,8 +206,18 @@ class Sensor:
         origins = np.empty((count, 3))
         directions = np.empty((count, 3))
         detector = np.empty(count, dtype=np.int32)
-        _rays_kernel()(self.grid, self.ray_grid, row0, row1, *self._axes, _rotation(pose, attitude),
-                       np.array(pose.position, dtype=np.float64), origins, directions, detector)
+        _rays_kernel()(
+            self.grid,
+            self.ray_grid,
+            row0,
+            row1,
+            *self._axes,
+            _rotation(pose, attitude),
+            np.array(pose.position, dtype=np.float64),
+            origins,
+            directions,
+            detector,
+        )
         return origins, directions, detector
 
     def central_ray(self, pose: ScanPose, attitude=None):

@@ -16,9 +16,9 @@ import contextlib
 import dataclasses
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
 
 import numba
 import numpy as np
@@ -41,6 +41,7 @@ _INSERTION_LIMIT = 64
 
 
 # --------------------------------------------------------------------------- depth rule
+
 
 @numba.njit(nogil=True, cache=True)
 def _depth_rule_kernel(order, grouped, detector, kind, ranges, depth_resolution, kept):
@@ -108,8 +109,9 @@ def kept_returns(detector, kind, ranges, depth_resolution) -> np.ndarray:
     grouped = bool(np.all(detector[1:] >= detector[:-1])) and _largest_group(detector) <= _INSERTION_LIMIT
     order = np.zeros(0, dtype=np.int64) if grouped else np.lexsort((ranges, detector))
     kept = np.empty(n, dtype=np.int64)
-    count = _depth_rule_kernel(order.astype(np.int64), grouped, detector, kind, ranges,
-                               float(depth_resolution), kept)
+    count = _depth_rule_kernel(
+        order.astype(np.int64), grouped, detector, kind, ranges, float(depth_resolution), kept
+    )
     return kept[:count]
 
 
@@ -149,6 +151,7 @@ def fuse_scans(per_scan) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------- the run
+
 
 @dataclass(frozen=True)
 class RunProgress:
@@ -197,10 +200,18 @@ class SimulationResult:
         return len(self.scene_per_scan)
 
 
-def simulate(scenario, backend=None, method=None, step=None, precision=None,
-             progress: Callable[[RunProgress], None] | None = None,
-             cancel: threading.Event | None = None, write=True, las=False,
-             scene=None) -> SimulationResult:
+def simulate(
+    scenario,
+    backend=None,
+    method=None,
+    step=None,
+    precision=None,
+    progress: Callable[[RunProgress], None] | None = None,
+    cancel: threading.Event | None = None,
+    write=True,
+    las=False,
+    scene=None,
+) -> SimulationResult:
     """Simulate the scenario's collection and score it.
 
     ``backend``, ``method``, ``step`` and ``precision`` override the scenario's
@@ -216,14 +227,12 @@ def simulate(scenario, backend=None, method=None, step=None, precision=None,
     """
     with contextlib.ExitStack() as stack:
         output_set = stack.enter_context(_output_set(scenario, las)) if write else None
-        return _simulate(scenario, backend, method, step, precision, progress, cancel,
-                         output_set, scene)
+        return _simulate(scenario, backend, method, step, precision, progress, cancel, output_set, scene)
 
 
 def _simulate(scenario, backend, method, step, precision, progress, cancel, output_set, scene):
     started = time.perf_counter()
-    timings = dict.fromkeys(("setup", "rays", "trace", "depth_rule", "fusion", "measures", "write"),
-                            0.0)
+    timings = dict.fromkeys(("setup", "rays", "trace", "depth_rule", "fusion", "measures", "write"), 0.0)
     settings = _trace_settings(scenario, backend, method, step, precision)
     if scene is None:
         scene = scenario.load_scene()
@@ -251,9 +260,13 @@ def _simulate(scenario, backend, method, step, precision, progress, cancel, outp
 
     tick = time.perf_counter()
     measures = compute_measures(
-        scene.target, scene_output, target_output,
-        scene_per_scan=per_scan["scene"], target_per_scan=per_scan["target"],
-        path_length_m=scenario.path_length(), flight_time_s=scenario.flight_time(),
+        scene.target,
+        scene_output,
+        target_output,
+        scene_per_scan=per_scan["scene"],
+        target_per_scan=per_scan["target"],
+        path_length_m=scenario.path_length(),
+        flight_time_s=scenario.flight_time(),
         voxel_size=scene.voxel_size,
     )
     if runner.geiger is not None:
@@ -264,16 +277,20 @@ def _simulate(scenario, backend, method, step, precision, progress, cancel, outp
     if output_set is not None:
         _check(cancel)
         tick = time.perf_counter()
-        outputs = _write_outputs(output_set, scene_output, target_output, measures,
-                                 scene.voxel_size, cancel)
+        outputs = _write_outputs(output_set, scene_output, target_output, measures, scene.voxel_size, cancel)
         timings["write"] = time.perf_counter() - tick
     timings["total"] = time.perf_counter() - started
     return SimulationResult(
-        scene_output=scene_output, target_output=target_output,
-        scene_per_scan=per_scan["scene"], target_per_scan=per_scan["target"],
-        measures=measures, backend=runner.backend_used or settings["backend"],
-        method=settings["method"], rays_per_scan=scenario.sensor.rays_per_scan,
-        timings=timings, outputs=outputs,
+        scene_output=scene_output,
+        target_output=target_output,
+        scene_per_scan=per_scan["scene"],
+        target_per_scan=per_scan["target"],
+        measures=measures,
+        backend=runner.backend_used or settings["backend"],
+        method=settings["method"],
+        rays_per_scan=scenario.sensor.rays_per_scan,
+        timings=timings,
+        outputs=outputs,
     )
 
 
@@ -293,7 +310,7 @@ class _ScanRunner:
         self.timings = timings
         self.progress = progress
         self.cancel = cancel
-        self.rays_per_row = sensor.grid * sensor.ray_grid ** 2
+        self.rays_per_row = sensor.grid * sensor.ray_grid**2
         self.rays_total = 2 * sensor.rays_per_scan * scans
         self.done = 0
         self.chunk = _FIRST_CHUNK_RAYS
@@ -310,15 +327,20 @@ class _ScanRunner:
             # Whole detector rows, so that the depth rule can run on each chunk.
             stop = min(sensor.grid, row + max(1, self.chunk // self.rays_per_row))
             tick = time.perf_counter()
-            origins, directions, detector = sensor.rays(pose, rows=slice(row, stop),
-                                                        attitude=attitude)
+            origins, directions, detector = sensor.rays(pose, rows=slice(row, stop), attitude=attitude)
             timings["rays"] += time.perf_counter() - tick
             slowest = 0.0
             for run in RUNS:
                 _check(self.cancel)
                 tick = time.perf_counter()
-                hits = self._trace(self.occupancies[run], origins, directions,
-                                   voxel_size=self.voxel_size, cancel=self.cancel, **self.settings)
+                hits = self._trace(
+                    self.occupancies[run],
+                    origins,
+                    directions,
+                    voxel_size=self.voxel_size,
+                    cancel=self.cancel,
+                    **self.settings,
+                )
                 elapsed = time.perf_counter() - tick
                 timings["trace"] += elapsed
                 slowest = max(slowest, elapsed)
@@ -347,8 +369,11 @@ class _ScanRunner:
 
     def _report(self, run, scan, returns=None):
         if self.progress is not None:
-            self.progress(RunProgress(run, scan, self.scans, self.done, self.rays_total,
-                                      self.done / self.rays_total, returns))
+            self.progress(
+                RunProgress(
+                    run, scan, self.scans, self.done, self.rays_total, self.done / self.rays_total, returns
+                )
+            )
 
 
 def _check(cancel):

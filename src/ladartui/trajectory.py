@@ -39,17 +39,23 @@ def geodetic_to_ecef(lat_deg, lon_deg, alt_m) -> np.ndarray:
     """(N, 3) earth-centred, earth-fixed metres of WGS84 latitude, longitude, height."""
     lat, lon = np.radians(lat_deg), np.radians(lon_deg)
     prime = WGS84_A / np.sqrt(1 - WGS84_E2 * np.sin(lat) ** 2)
-    return np.stack([(prime + alt_m) * np.cos(lat) * np.cos(lon),
-                     (prime + alt_m) * np.cos(lat) * np.sin(lon),
-                     (prime * (1 - WGS84_E2) + alt_m) * np.sin(lat)], axis=-1)
+    return np.stack(
+        [
+            (prime + alt_m) * np.cos(lat) * np.cos(lon),
+            (prime + alt_m) * np.cos(lat) * np.sin(lon),
+            (prime * (1 - WGS84_E2) + alt_m) * np.sin(lat),
+        ],
+        axis=-1,
+    )
 
 
 def geodetic_to_local(lat_deg, lon_deg, alt_m, origin) -> np.ndarray:
     """(N, 3) east, north, up metres of geodetic points, about ``origin`` (lat, lon, alt)."""
     lat0, lon0, alt0 = (float(v) for v in origin)
-    offset = (geodetic_to_ecef(np.asarray(lat_deg, float), np.asarray(lon_deg, float),
-                               np.asarray(alt_m, float))
-              - geodetic_to_ecef(np.array([lat0]), np.array([lon0]), np.array([alt0]))[0])
+    offset = (
+        geodetic_to_ecef(np.asarray(lat_deg, float), np.asarray(lon_deg, float), np.asarray(alt_m, float))
+        - geodetic_to_ecef(np.array([lat0]), np.array([lon0]), np.array([alt0]))[0]
+    )
     sl, cl = np.sin(np.radians(lat0)), np.cos(np.radians(lat0))
     so, co = np.sin(np.radians(lon0)), np.cos(np.radians(lon0))
     east = -so * offset[:, 0] + co * offset[:, 1]
@@ -65,7 +71,7 @@ class TrajectoryError(LadarError):
 @dataclass(frozen=True)
 class FlightLog:
     time: np.ndarray
-    xyz: np.ndarray          # (N, 3)
+    xyz: np.ndarray  # (N, 3)
     heading: np.ndarray
     roll: np.ndarray
     pitch: np.ndarray
@@ -78,8 +84,11 @@ def load_flight_log(path, origin=None) -> FlightLog:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as error:
         raise TrajectoryError(f"{path}: cannot read flight log ({error})") from None
-    rows = [(n, line) for n, line in enumerate(text.splitlines(), start=1)
-            if line.strip() and not line.lstrip().startswith("#")]
+    rows = [
+        (n, line)
+        for n, line in enumerate(text.splitlines(), start=1)
+        if line.strip() and not line.lstrip().startswith("#")
+    ]
     if not rows:
         raise TrajectoryError(f"{path}: empty flight log: expected a header and records")
     header_line, header = rows[0]
@@ -88,13 +97,17 @@ def load_flight_log(path, origin=None) -> FlightLog:
     required = ("time", *GEODETIC, "heading") if geodetic else REQUIRED
     missing = [c for c in required if c not in names]
     if missing:
-        raise TrajectoryError(f"{path}:{header_line}: header lacks {', '.join(missing)}: "
-                              f"expected columns {', '.join(REQUIRED)}, or time, latitude, "
-                              "longitude, altitude, heading (optional roll, pitch)")
+        raise TrajectoryError(
+            f"{path}:{header_line}: header lacks {', '.join(missing)}: "
+            f"expected columns {', '.join(REQUIRED)}, or time, latitude, "
+            "longitude, altitude, heading (optional roll, pitch)"
+        )
     if geodetic and origin is None:
-        raise TrajectoryError(f"{path}:{header_line}: a log in latitude and longitude needs "
-                              "the segment's origin = [lat, lon, alt] (the scene frame's "
-                              "origin on the earth)")
+        raise TrajectoryError(
+            f"{path}:{header_line}: a log in latitude and longitude needs "
+            "the segment's origin = [lat, lon, alt] (the scene frame's "
+            "origin on the earth)"
+        )
     columns = {name: names.index(name) for name in (*required, *OPTIONAL) if name in names}
     values = {name: [] for name in (*required, *OPTIONAL)}
     for number, line in rows[1:]:
@@ -114,8 +127,10 @@ def load_flight_log(path, origin=None) -> FlightLog:
                 raise TrajectoryError(f"{path}:{number}: {name} = {raw!r}: expected a finite number")
             values[name].append(value)
         if len(values["time"]) > 1 and values["time"][-1] <= values["time"][-2]:
-            raise TrajectoryError(f"{path}:{number}: time = {values['time'][-1]!r}: "
-                                  f"expected times increasing (previous {values['time'][-2]!r})")
+            raise TrajectoryError(
+                f"{path}:{number}: time = {values['time'][-1]!r}: "
+                f"expected times increasing (previous {values['time'][-2]!r})"
+            )
         if geodetic:
             lat = values["latitude"][-1]
             if not -90.0 <= lat <= 90.0:
@@ -129,9 +144,11 @@ def load_flight_log(path, origin=None) -> FlightLog:
         xyz = geodetic_to_local(arr["latitude"], arr["longitude"], arr["altitude"], origin)
         low = int(np.argmin(xyz[:, 2]))
         if xyz[low, 2] <= 0:
-            raise TrajectoryError(f"{path}:{rows[1 + low][0]}: altitude = "
-                                  f"{arr['altitude'][low]!r} puts the aircraft at "
-                                  f"{xyz[low, 2]:.1f} m above the origin: expected above it")
+            raise TrajectoryError(
+                f"{path}:{rows[1 + low][0]}: altitude = "
+                f"{arr['altitude'][low]!r} puts the aircraft at "
+                f"{xyz[low, 2]:.1f} m above the origin: expected above it"
+            )
     else:
         xyz = np.stack([arr["x"], arr["y"], arr["z"]], axis=1)
     return FlightLog(arr["time"], xyz, arr["heading"], arr["roll"], arr["pitch"])
@@ -143,8 +160,7 @@ def _angle(times, angles, t):
     return np.interp(t, times, unwrapped)
 
 
-def log_poses(log: FlightLog, template: ScanPose, rate: float | None = None,
-              times=None) -> list[ScanPose]:
+def log_poses(log: FlightLog, template: ScanPose, rate: float | None = None, times=None) -> list[ScanPose]:
     """Scan poses along the log; ``template`` gives the sensor azimuth and depression."""
     if times is None:
         if rate is None or not rate > 0:
@@ -156,8 +172,10 @@ def log_poses(log: FlightLog, template: ScanPose, rate: float | None = None,
         raise TrajectoryError(f"scan times must lie within the log's {log.time[0]}..{log.time[-1]} s")
     xyz = np.stack([np.interp(times, log.time, log.xyz[:, a]) for a in range(3)], axis=1)
     heading = _angle(log.time, log.heading, times)
-    return [replace(template, x=float(p[0]), y=float(p[1]), z=float(p[2]), heading=float(h) % 360.0)
-            for p, h in zip(xyz, heading)]
+    return [
+        replace(template, x=float(p[0]), y=float(p[1]), z=float(p[2]), heading=float(h) % 360.0)
+        for p, h in zip(xyz, heading)
+    ]
 
 
 def log_attitude(log: FlightLog, times) -> tuple[np.ndarray, np.ndarray]:
@@ -197,8 +215,9 @@ class LogSegment:
             raise FieldError("file", self.file, "the flight log's file name (.csv)")
         set_("file", str(self.file))
         if (self.rate is None) == (self.times is None):
-            raise FieldError("rate", self.rate, "either a scan rate (Hz) or a list of scan "
-                             "times (s), not both")
+            raise FieldError(
+                "rate", self.rate, "either a scan rate (Hz) or a list of scan times (s), not both"
+            )
         set_("azimuth", number_field("azimuth", self.azimuth))
         set_("depression", number_field("depression", self.depression, 1.0, 90.0))
         if self.aim_at is not None:
@@ -207,11 +226,17 @@ class LogSegment:
             try:
                 lat, lon, alt = (float(v) for v in self.origin)
             except (TypeError, ValueError):
-                raise FieldError("origin", self.origin, "[latitude, longitude, altitude] of "
-                                 "the scene frame's origin") from None
-            set_("origin", (number_field("origin latitude", lat, -90.0, 90.0),
-                            number_field("origin longitude", lon, -180.0, 180.0),
-                            number_field("origin altitude", alt, -1e4, 1e5)))
+                raise FieldError(
+                    "origin", self.origin, "[latitude, longitude, altitude] of the scene frame's origin"
+                ) from None
+            set_(
+                "origin",
+                (
+                    number_field("origin latitude", lat, -90.0, 90.0),
+                    number_field("origin longitude", lon, -180.0, 180.0),
+                    number_field("origin altitude", alt, -1e4, 1e5),
+                ),
+            )
         log = load_flight_log(self.file, self.origin)
         set_("_log", log)
         span = f"times from {log.time[0]:g} to {log.time[-1]:g} s (the log's span)"
@@ -255,5 +280,4 @@ class LogSegment:
         return [(float(r), float(p)) for r, p in zip(roll, pitch)]
 
     def legs(self, poses):
-        return [float(np.linalg.norm(np.subtract(a.position, b.position)))
-                for a, b in zip(poses, poses[1:])]
+        return [float(np.linalg.norm(np.subtract(a.position, b.position))) for a, b in zip(poses, poses[1:])]

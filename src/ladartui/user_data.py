@@ -91,8 +91,9 @@ def _materialise(folder: Path) -> None:
     # generator if its scene ever moves the target.
     centre = target_centre(scene.target, scene.voxel_size)
     segments = tuple(_recentred(seg, centre) for seg in packaged.flight.segments)
-    scenario = packaged.with_changes(voxel_size=float(scene.voxel_size),
-                                     flight=replace(packaged.flight, segments=segments))
+    scenario = packaged.with_changes(
+        voxel_size=float(scene.voxel_size), flight=replace(packaged.flight, segments=segments)
+    )
     # Written last: its presence marks the folder complete. Keep the packaged
     # text (with its comments) when nothing had to change.
     if scenario == packaged:

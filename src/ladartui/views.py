@@ -35,6 +35,7 @@ OVERLAYS = ("path", "scans", "footprints")
 
 # -- colour ramps ---------------------------------------------------------
 
+
 def grey_ramp(levels: int = GREY_LEVELS) -> np.ndarray:
     """The report's grey shades, dark (low) to near white (high): ``colour.grey_map``."""
     return grey_map(levels)
@@ -68,6 +69,7 @@ def to_ansi256(rgb: np.ndarray) -> np.ndarray:
 
 
 # -- top view -------------------------------------------------------------
+
 
 @dataclass
 class Picture:
@@ -131,8 +133,12 @@ class TopView:
                 x1, y1 = max(x1, cells[:, 0].max()), max(y1, cells[:, 1].max())
         pad = margin * max(x1 - x0, y1 - y0)
         snap = max(self.extent) / 8.0 or 1.0
-        return (float(np.floor((x0 - pad) / snap) * snap), float(np.floor((y0 - pad) / snap) * snap),
-                float(np.ceil((x1 + pad) / snap) * snap), float(np.ceil((y1 + pad) / snap) * snap))
+        return (
+            float(np.floor((x0 - pad) / snap) * snap),
+            float(np.floor((y0 - pad) / snap) * snap),
+            float(np.ceil((x1 + pad) / snap) * snap),
+            float(np.ceil((y1 + pad) / snap) * snap),
+        )
 
     def fit(self, rows: int, cols: int, frame=None) -> tuple[float, float, float]:
         """Scale (cells per pixel) and pixel offsets that fit the frame, aspect kept."""
@@ -212,13 +218,15 @@ class TopView:
         c0 = np.floor(corner_a[:, 1] + 0.5).astype(np.int64)
         r1 = np.maximum(np.floor(corner_b[:, 0] + 0.5).astype(np.int64), r0 + 1)
         c1 = np.maximum(np.floor(corner_b[:, 1] + 0.5).astype(np.int64), c0 + 1)
-        for ra, rb, ca, cb in zip(np.clip(r0, 0, rows), np.clip(r1, 0, rows),
-                                  np.clip(c0, 0, cols), np.clip(c1, 0, cols)):
+        for ra, rb, ca, cb in zip(
+            np.clip(r0, 0, rows), np.clip(r1, 0, rows), np.clip(c0, 0, cols), np.clip(c1, 0, cols)
+        ):
             picture.rgb[ra:rb, ca:cb] = TARGET_RGB
             picture.mask[ra:rb, ca:cb] = True
 
-    def render(self, rows: int, cols: int, path=None, scans=None, footprints=None,
-               frame=None, shown=OVERLAYS) -> Picture:
+    def render(
+        self, rows: int, cols: int, path=None, scans=None, footprints=None, frame=None, shown=OVERLAYS
+    ) -> Picture:
         """The scene layer, the footprints, the target, then the flight path and scans.
 
         ``path`` and ``scans`` are (N, 2) x, y metres (the first scan is marked
@@ -297,6 +305,7 @@ def draw_polyline(picture: Picture, pixels, rgb) -> None:
 
 # -- 3D projection --------------------------------------------------------
 
+
 @dataclass(frozen=True)
 class Camera:
     """An orthographic view: azimuth and elevation in degrees, zoom, pan and centre.
@@ -316,8 +325,7 @@ class Camera:
     centre: tuple | None = None
 
     def at_angle(self, azimuth: float, elevation: float) -> Camera:
-        return replace(self, azimuth=float(azimuth) % 360.0,
-                       elevation=float(np.clip(elevation, -90.0, 90.0)))
+        return replace(self, azimuth=float(azimuth) % 360.0, elevation=float(np.clip(elevation, -90.0, 90.0)))
 
     def rotated(self, d_azimuth=0.0, d_elevation=0.0) -> Camera:
         return self.at_angle(self.azimuth + d_azimuth, self.elevation + d_elevation)

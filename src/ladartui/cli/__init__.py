@@ -46,7 +46,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"ladartui {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
-    for name, module in COMMANDS.items():
+    for module in COMMANDS.values():
         # a missing command module is an error: a renamed module must not make its
         # command vanish quietly
         importlib.import_module(f"ladartui.cli.{module}").add_parser(sub)

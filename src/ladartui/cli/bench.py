@@ -35,17 +35,23 @@ VIEWS = ("wide", "narrow")
 
 def add_parser(subparsers):
     parser = subparsers.add_parser(
-        "bench", help="measure tracing speed of every available backend and method",
+        "bench",
+        help="measure tracing speed of every available backend and method",
         description="Trace the reference scene with a 128x128 sensor (4x4 rays per detector) "
         "at 45 degrees and at nadir, in a wide view (10 degrees from 85 m) and a narrow one "
-        "(3 degrees from 150 m up, exact only); report rays/s, set-up time and occupancy memory.")
-    parser.add_argument("--quick", action="store_true",
-                        help="fewer runs and a 64x64 sensor (a smoke test, not a measurement)")
+        "(3 degrees from 150 m up, exact only); report rays/s, set-up time and occupancy memory.",
+    )
+    parser.add_argument(
+        "--quick", action="store_true", help="fewer runs and a 64x64 sensor (a smoke test, not a measurement)"
+    )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.add_argument("--runs", type=int, default=None, help="timed runs per case (median)")
-    parser.add_argument("--orbit", action="store_true",
-                        help="instead, time a whole 36-scan orbit (scene and target-only runs, "
-                        "depth rule, fusion, measures) end to end after a warm-up")
+    parser.add_argument(
+        "--orbit",
+        action="store_true",
+        help="instead, time a whole 36-scan orbit (scene and target-only runs, "
+        "depth rule, fusion, measures) end to end after a warm-up",
+    )
     parser.set_defaults(handler=run)
 
 
@@ -59,11 +65,13 @@ def run(args):
         if args.json:
             print(json.dumps(report, indent=2))
         else:
-            print(f"{report['scans']}-scan orbit on {report['scene']}, {report['sensor']}, "
-                  f"{report['backend']}: median {report['median_seconds']:.2f} s end to end "
-                  f"over {report['runs']} runs after a warm-up "
-                  f"(trace {report['median_trace_seconds']:.2f} s; "
-                  f"{report['rays']:,} rays over both runs)")
+            print(
+                f"{report['scans']}-scan orbit on {report['scene']}, {report['sensor']}, "
+                f"{report['backend']}: median {report['median_seconds']:.2f} s end to end "
+                f"over {report['runs']} runs after a warm-up "
+                f"(trace {report['median_trace_seconds']:.2f} s; "
+                f"{report['rays']:,} rays over both runs)"
+            )
         return 0
     report = run_bench(quick=args.quick, runs=args.runs)
     if args.json:
@@ -88,12 +96,22 @@ def run_orbit_bench(runs=3, backend="numba") -> dict:
     scene, label = load_bench_scene()
     centre = scene.target.astype(np.float64).mean(axis=0) * scene.voxel_size
     e = math.radians(ORBIT_DEPRESSION)
-    orbit = Orbit(centre=tuple(centre), radius=ORBIT_SLANT_RANGE_M * math.cos(e),
-                  altitude=ORBIT_SLANT_RANGE_M * math.sin(e), scans=ORBIT_SCANS)
+    orbit = Orbit(
+        centre=tuple(centre),
+        radius=ORBIT_SLANT_RANGE_M * math.cos(e),
+        altitude=ORBIT_SLANT_RANGE_M * math.sin(e),
+        scans=ORBIT_SCANS,
+    )
     sensor = Sensor(grid=128, ray_grid=4, fov=5.0)
     folder = cache_dir()
-    scenario = Scenario(folder / "orbit-bench.toml", folder / "reference.txt", scene.voxel_size,
-                        sensor, FlightPlan(segments=(orbit,)), backend=backend)
+    scenario = Scenario(
+        folder / "orbit-bench.toml",
+        folder / "reference.txt",
+        scene.voxel_size,
+        sensor,
+        FlightPlan(segments=(orbit,)),
+        backend=backend,
+    )
     simulate(scenario, scene=scene, write=False)  # warm-up: kernels, occupancy
     totals, traces = [], []
     for _ in range(runs):
@@ -101,14 +119,21 @@ def run_orbit_bench(runs=3, backend="numba") -> dict:
         result = simulate(scenario, scene=scene, write=False)
         totals.append(time.perf_counter() - started)
         traces.append(result.timings.get("trace", float("nan")))
-    return {"scene": label, "sensor": "128x128 detectors, 4x4 rays each, 5 degree field of view",
-            "scans": ORBIT_SCANS, "slant_range_m": ORBIT_SLANT_RANGE_M,
-            "depression": ORBIT_DEPRESSION, "backend": result.backend, "runs": runs,
-            "rays": 2 * ORBIT_SCANS * sensor.rays_per_scan,
-            "median_seconds": statistics.median(totals), "all_seconds": totals,
-            "median_trace_seconds": statistics.median(traces),
-            "obscured_coverage": result.measures.obscured_coverage,
-            "unobscured_coverage": result.measures.unobscured_coverage}
+    return {
+        "scene": label,
+        "sensor": "128x128 detectors, 4x4 rays each, 5 degree field of view",
+        "scans": ORBIT_SCANS,
+        "slant_range_m": ORBIT_SLANT_RANGE_M,
+        "depression": ORBIT_DEPRESSION,
+        "backend": result.backend,
+        "runs": runs,
+        "rays": 2 * ORBIT_SCANS * sensor.rays_per_scan,
+        "median_seconds": statistics.median(totals),
+        "all_seconds": totals,
+        "median_trace_seconds": statistics.median(traces),
+        "obscured_coverage": result.measures.obscured_coverage,
+        "unobscured_coverage": result.measures.unobscured_coverage,
+    }
 
 
 def cache_dir() -> Path:
@@ -129,11 +154,21 @@ def load_bench_scene():
         generated = generate_scene("reference", 0)
         with atomic_path(path) as tmp:
             with open(tmp, "wb") as handle:
-                np.savez(handle, voxels=generated.voxels, target=generated.target,
-                         shape=np.array(generated.shape), voxel_size=generated.voxel_size)
+                np.savez(
+                    handle,
+                    voxels=generated.voxels,
+                    target=generated.target,
+                    shape=np.array(generated.shape),
+                    voxel_size=generated.voxel_size,
+                )
     with np.load(path) as data:
-        scene = Scene(data["voxels"], data["target"], float(data["voxel_size"]),
-                      shape=tuple(int(v) for v in data["shape"]), name="reference")
+        scene = Scene(
+            data["voxels"],
+            data["target"],
+            float(data["voxel_size"]),
+            shape=tuple(int(v) for v in data["shape"]),
+            name="reference",
+        )
     return scene, "reference"
 
 
@@ -163,8 +198,9 @@ def bench_rays(scene, depression, grid=128, ray_grid=4, view="wide"):
         sensor = Sensor(grid=grid, ray_grid=ray_grid)
     if depression >= 90.0:
         aircraft[:2] = centre[:2]
-    pose = aim_at(ScanPose(float(aircraft[0]), float(aircraft[1]), float(aircraft[2]),
-                           0.0, 0.0, 90.0), centre.tolist())
+    pose = aim_at(
+        ScanPose(float(aircraft[0]), float(aircraft[1]), float(aircraft[2]), 0.0, 0.0, 90.0), centre.tolist()
+    )
     origins, directions, _ = sensor.rays(pose)
     return origins, directions
 
@@ -182,17 +218,27 @@ def run_bench(quick=False, runs=None) -> dict:
     occupancy = Occupancy.build(scene.voxels, scene.shape)
     setup = time.perf_counter() - started
     setup_cpu = time.process_time() - cpu_started
-    report = {"scene": label, "shape": list(scene.shape), "voxels": int(occupancy.count),
-              "voxel_size": scene.voxel_size, "setup_seconds": setup, "setup_cpu_seconds": setup_cpu,
-              "occupancy_bytes": occupancy.nbytes, "occupancy": occupancy.summary(),
-              "sensor": f"{grid}x{grid} detectors, 4x4 rays each", "runs": runs,
-              "slant_range_m": SLANT_RANGE_M,
-              "views": {"wide": f"10 degree view from {SLANT_RANGE_M:g} m, looking north",
-                        "narrow": f"{NARROW_FOV:g} degree view from {NARROW_ALTITUDE_M:g} m up, "
-                                  f"looking along bearing {NARROW_BEARING:g}, exact only"},
-              "backends": {}, "results": []}
-    rays = {(view, d): bench_rays(scene, d, grid=grid, view=view)
-            for view in VIEWS for d in DEPRESSIONS}
+    report = {
+        "scene": label,
+        "shape": list(scene.shape),
+        "voxels": int(occupancy.count),
+        "voxel_size": scene.voxel_size,
+        "setup_seconds": setup,
+        "setup_cpu_seconds": setup_cpu,
+        "occupancy_bytes": occupancy.nbytes,
+        "occupancy": occupancy.summary(),
+        "sensor": f"{grid}x{grid} detectors, 4x4 rays each",
+        "runs": runs,
+        "slant_range_m": SLANT_RANGE_M,
+        "views": {
+            "wide": f"10 degree view from {SLANT_RANGE_M:g} m, looking north",
+            "narrow": f"{NARROW_FOV:g} degree view from {NARROW_ALTITUDE_M:g} m up, "
+            f"looking along bearing {NARROW_BEARING:g}, exact only",
+        },
+        "backends": {},
+        "results": [],
+    }
+    rays = {(view, d): bench_rays(scene, d, grid=grid, view=view) for view in VIEWS for d in DEPRESSIONS}
     backends = {}
     for name, reason in backend_status().items():
         report["backends"][name] = reason or "available"
@@ -231,18 +277,26 @@ def run_bench(quick=False, runs=None) -> dict:
                 median = statistics.median(times[name])
                 cpu_median = statistics.median(cpu[name])
                 result = results[name]
-                report["results"].append({
-                    "backend": name, "method": method, "view": view, "depression": depression,
-                    "rays": len(origins), "rays_per_second": len(origins) / median,
-                    "median_seconds": median, "first_call_seconds": first[name],
-                    # On a shared machine wall time includes waiting for the
-                    # cores; rays per CPU-second (all threads) does not.
-                    "cpu_seconds": cpu_median,
-                    "rays_per_cpu_second": len(origins) / cpu_median if cpu_median > 0 else None,
-                    "voxel_hits": float(np.mean(result.kind == 1)),
-                    "ground_hits": float(np.mean(result.kind == 2)),
-                    "order": "/".join(sorted(orders[name])),
-                    "device": backend.describe().get("adapter") or "cpu"})
+                report["results"].append(
+                    {
+                        "backend": name,
+                        "method": method,
+                        "view": view,
+                        "depression": depression,
+                        "rays": len(origins),
+                        "rays_per_second": len(origins) / median,
+                        "median_seconds": median,
+                        "first_call_seconds": first[name],
+                        # On a shared machine wall time includes waiting for the
+                        # cores; rays per CPU-second (all threads) does not.
+                        "cpu_seconds": cpu_median,
+                        "rays_per_cpu_second": len(origins) / cpu_median if cpu_median > 0 else None,
+                        "voxel_hits": float(np.mean(result.kind == 1)),
+                        "ground_hits": float(np.mean(result.kind == 2)),
+                        "order": "/".join(sorted(orders[name])),
+                        "device": backend.describe().get("adapter") or "cpu",
+                    }
+                )
     _add_ratios(report["results"])
     return report
 
@@ -250,8 +304,11 @@ def run_bench(quick=False, runs=None) -> dict:
 def _add_ratios(results):
     """Each row's rays/s as a share of numba's on the same method, view and angle
     (``vs_numba``)."""
-    numba = {(r["method"], r["view"], r["depression"]): r["rays_per_second"]
-             for r in results if r["backend"] == "numba"}
+    numba = {
+        (r["method"], r["view"], r["depression"]): r["rays_per_second"]
+        for r in results
+        if r["backend"] == "numba"
+    }
     for row in results:
         base = numba.get((row["method"], row["view"], row["depression"]))
         row["vs_numba"] = row["rays_per_second"] / base if base else None
@@ -263,29 +320,49 @@ def _print_table(report):
     from rich.table import Table
 
     console = Console()
-    console.print(f"scene {report['scene']} {report['shape']}, {report['voxels']:,} voxels; "
-                  f"occupancy {report['occupancy_bytes'] / 2**20:.1f} MiB built in "
-                  f"{report['setup_seconds']:.2f} s ({report['setup_cpu_seconds']:.2f} CPU-s); "
-                  f"{report['sensor']}; median of "
-                  f"{report['runs']} runs")
+    console.print(
+        f"scene {report['scene']} {report['shape']}, {report['voxels']:,} voxels; "
+        f"occupancy {report['occupancy_bytes'] / 2**20:.1f} MiB built in "
+        f"{report['setup_seconds']:.2f} s ({report['setup_cpu_seconds']:.2f} CPU-s); "
+        f"{report['sensor']}; median of "
+        f"{report['runs']} runs"
+    )
     table = Table(box=box.SIMPLE_HEAD, pad_edge=False, collapse_padding=True)
-    for name in ("backend", "method", "view", "depr.", "order", "rays/s", "x numba", "rays/CPU-s",
-                 "voxel", "ground"):
+    for name in (
+        "backend",
+        "method",
+        "view",
+        "depr.",
+        "order",
+        "rays/s",
+        "x numba",
+        "rays/CPU-s",
+        "voxel",
+        "ground",
+    ):
         table.add_column(name, no_wrap=True, min_width=len(name))
     devices = {}
     for row in report["results"]:
         per_cpu = row["rays_per_cpu_second"]
         devices[row["backend"]] = row["device"]
-        table.add_row(row["backend"], row["method"], row["view"], f"{row['depression']:g}",
-                      row["order"].replace("object", "obj"),
-                      f"{row['rays_per_second'] / 1e6:.2f} M",
-                      f"{row['vs_numba']:.2f}" if row.get("vs_numba") is not None else "-",
-                      f"{per_cpu / 1e6:.2f} M" if per_cpu else "-",
-                      f"{row['voxel_hits']:.1%}", f"{row['ground_hits']:.1%}")
+        table.add_row(
+            row["backend"],
+            row["method"],
+            row["view"],
+            f"{row['depression']:g}",
+            row["order"].replace("object", "obj"),
+            f"{row['rays_per_second'] / 1e6:.2f} M",
+            f"{row['vs_numba']:.2f}" if row.get("vs_numba") is not None else "-",
+            f"{per_cpu / 1e6:.2f} M" if per_cpu else "-",
+            f"{row['voxel_hits']:.1%}",
+            f"{row['ground_hits']:.1%}",
+        )
     console.print(table)
     console.print(f"views: wide {report['views']['wide']}; narrow {report['views']['narrow']}")
-    console.print("order: obj object, ray ray order (several: the timed runs differed); devices: "
-                  + "; ".join(f"{name} {device}" for name, device in devices.items()))
+    console.print(
+        "order: obj object, ray ray order (several: the timed runs differed); devices: "
+        + "; ".join(f"{name} {device}" for name, device in devices.items())
+    )
     for name, status in report["backends"].items():
         if status != "available":
             console.print(f"[dim]{name}: {status}[/dim]")

@@ -13,8 +13,9 @@ def add_parser(subparsers):
         "only peers holding a certificate from this authority. See docs/sweeps.md.",
     )
     parser.add_argument("folder", metavar="DIR", help="folder for the three PEM files")
-    parser.add_argument("--days", type=int, default=365,
-                        help="validity of the certificates in days (default 365)")
+    parser.add_argument(
+        "--days", type=int, default=365, help="validity of the certificates in days (default 365)"
+    )
     parser.add_argument("--force", action="store_true", help="replace existing files in DIR")
     parser.set_defaults(handler=run)
     return parser
@@ -33,8 +34,12 @@ def run(args) -> int:
         raise FieldError("DIR", str(folder), "a folder (this is an existing file)")
     existing = [name for name in (CA_FILE, CERT_FILE, KEY_FILE) if (folder / name).exists()]
     if existing and not args.force:
-        raise FieldError("DIR", str(folder), f"a folder without {', '.join(existing)} "
-                         "(--force replaces them; every cluster machine then needs the new ones)")
+        raise FieldError(
+            "DIR",
+            str(folder),
+            f"a folder without {', '.join(existing)} "
+            "(--force replaces them; every cluster machine then needs the new ones)",
+        )
     try:
         paths = make_certificates(folder, args.days)
     except OSError as error:

@@ -16,20 +16,23 @@ def add_parser(subparsers):
         "seed and options always give the same scene.",
     )
     parser.add_argument("preset", metavar="PRESET", help="small or reference")
-    parser.add_argument("out", metavar="OUT",
-                        help="output stem: dir/name or dir/name.txt (writes name.txt and "
-                        "name_Target.txt)")
+    parser.add_argument(
+        "out",
+        metavar="OUT",
+        help="output stem: dir/name or dir/name.txt (writes name.txt and name_Target.txt)",
+    )
     parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    parser.add_argument("--density", type=float,
-                        help="share of each crown's surface covered by leaf clumps, 0 to 0.99")
+    parser.add_argument(
+        "--density", type=float, help="share of each crown's surface covered by leaf clumps, 0 to 0.99"
+    )
     parser.add_argument("--trees", type=int, help="number of trees")
     parser.add_argument("--voxel-size", type=float, help="voxel size in metres")
     parser.add_argument("--vehicles", type=int, help="number of vehicles (all in the target)")
     parser.add_argument("--no-target", action="store_true", help="no vehicle, empty target model")
-    parser.add_argument("--terrain", action="store_true",
-                        help="gentle terrain instead of flat ground")
-    parser.add_argument("--camouflage", action="store_true",
-                        help="drape a camouflage net over the vehicle (scene only)")
+    parser.add_argument("--terrain", action="store_true", help="gentle terrain instead of flat ground")
+    parser.add_argument(
+        "--camouflage", action="store_true", help="drape a camouflage net over the vehicle (scene only)"
+    )
     parser.add_argument("--las", action="store_true", help="also write OUT.laz (voxel centres)")
     parser.set_defaults(handler=run)
     return parser
@@ -38,8 +41,12 @@ def add_parser(subparsers):
 def overrides_from(args) -> dict:
     """Scene parameter overrides from the command's flags."""
     overrides = {}
-    for flag, name in (("density", "density"), ("trees", "trees"),
-                       ("voxel_size", "voxel_size"), ("vehicles", "vehicles")):
+    for flag, name in (
+        ("density", "density"),
+        ("trees", "trees"),
+        ("voxel_size", "voxel_size"),
+        ("vehicles", "vehicles"),
+    ):
         value = getattr(args, flag)
         if value is not None:
             overrides[name] = value
@@ -66,8 +73,9 @@ def run(args) -> int:
     written = time.perf_counter() - started
     vs = scene.voxel_size
     nx, ny, nz = scene.shape
-    print(f"wrote {scene_path} ({len(scene.voxels):,} voxels) and {target_path} "
-          f"({len(scene.target):,} voxels)")
+    print(
+        f"wrote {scene_path} ({len(scene.voxels):,} voxels) and {target_path} ({len(scene.target):,} voxels)"
+    )
     if args.las:
         from ladartui.scene.las import export_las
 

@@ -17,11 +17,13 @@ def add_parser(subparsers):
         "structure. For a scenario (.toml): its summary. With --backends: each tracing "
         "backend, whether it can run here (or why not) and what runs the work.",
     )
-    parser.add_argument("file", metavar="FILE", nargs="?",
-                        help="voxel list (.txt) or scenario (.toml)")
+    parser.add_argument("file", metavar="FILE", nargs="?", help="voxel list (.txt) or scenario (.toml)")
     parser.add_argument("--backends", action="store_true", help="list the tracing backends")
-    parser.add_argument("--voxel-size", type=float,
-                        help="voxel size in metres, to show the extent and target centre in metres")
+    parser.add_argument(
+        "--voxel-size",
+        type=float,
+        help="voxel size in metres, to show the extent and target centre in metres",
+    )
     parser.set_defaults(handler=run)
     return parser
 
@@ -46,8 +48,9 @@ def print_scenario(path: Path) -> None:
     except ModuleNotFoundError as error:
         if error.name != "ladartui.scenario":
             raise
-        raise LadarError(f"{path}: scenario files cannot be read here (ladartui.scenario "
-                         "is not available)") from None
+        raise LadarError(
+            f"{path}: scenario files cannot be read here (ladartui.scenario is not available)"
+        ) from None
     print(load_scenario(path).summary())
 
 
@@ -62,19 +65,20 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
     started = time.perf_counter()
     voxels, duplicates = load_voxels_counted(path)
     loaded = time.perf_counter() - started
-    rows = [("voxels", f"{len(voxels):,}" + (f" ({duplicates:,} duplicate lines dropped)"
-                                             if duplicates else ""))]
+    rows = [
+        ("voxels", f"{len(voxels):,}" + (f" ({duplicates:,} duplicate lines dropped)" if duplicates else ""))
+    ]
     rows.append(("read in", f"{loaded:.2f} s"))
     shape = (0, 0, 0)
     if len(voxels):
         lo, hi = voxels.min(axis=0), voxels.max(axis=0)
         shape = tuple(int(h) + 1 for h in hi)
-        ranges = ", ".join(f"{axis} {int(low)}..{int(high)}"
-                           for axis, low, high in zip("xyz", lo, hi))
+        ranges = ", ".join(f"{axis} {int(low)}..{int(high)}" for axis, low, high in zip("xyz", lo, hi))
         rows.append(("extent", f"{ranges}  (shape {shape[0]} x {shape[1]} x {shape[2]})"))
         if voxel_size:
-            rows.append(("extent (m)", " x ".join(f"{n * voxel_size:.1f}" for n in shape)
-                         + f" at {voxel_size:g} m"))
+            rows.append(
+                ("extent (m)", " x ".join(f"{n * voxel_size:.1f}" for n in shape) + f" at {voxel_size:g} m")
+            )
     target_path = target_path_for(path)
     if target_path.is_file() and target_path != path:
         target, _ = load_voxels_counted(target_path)
@@ -123,9 +127,11 @@ def _occupancy_text(voxels, shape, path) -> str:
     started = time.perf_counter()
     occupancy = Occupancy.build(voxels, shape, source=str(path))
     built = time.perf_counter() - started
-    return (f"{occupancy.nbytes / 2**20:.1f} MiB ({occupancy.n_bricks:,} bricks, "
-            f"{occupancy.n_tiles:,} tiles, {occupancy.n_regions:,} regions), "
-            f"built in {built:.2f} s")
+    return (
+        f"{occupancy.nbytes / 2**20:.1f} MiB ({occupancy.n_bricks:,} bricks, "
+        f"{occupancy.n_tiles:,} tiles, {occupancy.n_regions:,} regions), "
+        f"built in {built:.2f} s"
+    )
 
 
 def print_backends() -> None:

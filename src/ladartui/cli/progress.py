@@ -10,7 +10,8 @@ from __future__ import annotations
 import contextlib
 import signal
 import threading
-from typing import Callable, TypeVar
+from collections.abc import Callable
+from typing import TypeVar
 
 from ladartui.errors import Cancelled
 
@@ -19,8 +20,7 @@ T = TypeVar("T")
 POLL_SECONDS = 0.1  # how soon a Ctrl-C is noticed while waiting
 
 
-def run_cancellable(work: Callable[[], T], cancel: threading.Event, name: str,
-                    cancelled: Cancelled) -> T:
+def run_cancellable(work: Callable[[], T], cancel: threading.Event, name: str, cancelled: Cancelled) -> T:
     """``work()`` on a worker thread named ``name``; its result, or its error raised here.
 
     On Ctrl-C the ``cancel`` event is set and the worker is awaited; if it had

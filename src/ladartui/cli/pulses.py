@@ -21,20 +21,26 @@ LEGEND_HEADROOM = 1.5
 
 
 def add_parser(sub):
-    p = sub.add_parser("pulses", help="obscured coverage and false alarms against pulses per look "
-                       "(Geiger-mode detection; see docs/detection.md)",
-                       description="Trace each scan once, then fire M pulses per look for each "
-                       "M and declare points where at least k fired (k keeps the scenario's "
-                       "coincidence share). Prints the ideal model's obscured coverage, a row "
-                       "per M and a chart. The scenario's [detection] numbers are used where "
-                       "set. Writes no files.")
+    p = sub.add_parser(
+        "pulses",
+        help="obscured coverage and false alarms against pulses per look "
+        "(Geiger-mode detection; see docs/detection.md)",
+        description="Trace each scan once, then fire M pulses per look for each "
+        "M and declare points where at least k fired (k keeps the scenario's "
+        "coincidence share). Prints the ideal model's obscured coverage, a row "
+        "per M and a chart. The scenario's [detection] numbers are used where "
+        "set. Writes no files.",
+    )
     p.add_argument("scenario", nargs="?", help="scenario TOML (default: the default scenario)")
     p.add_argument("--pulses", default="1,10,100", help="comma-separated pulses per look")
-    p.add_argument("--n-ref", type=float, default=None,
-                   help="mean photoelectrons of a full-footprint return at the reference range "
-                   "(default: the scenario's, else 5)")
-    p.add_argument("--seed", type=int, default=None, help="random stream (default: the "
-                   "scenario's, else 0)")
+    p.add_argument(
+        "--n-ref",
+        type=float,
+        default=None,
+        help="mean photoelectrons of a full-footprint return at the reference range "
+        "(default: the scenario's, else 5)",
+    )
+    p.add_argument("--seed", type=int, default=None, help="random stream (default: the scenario's, else 0)")
     p.add_argument("--backend", default=None)
     p.add_argument("--json", action="store_true", help="print the results as JSON, no chart")
     p.add_argument("--no-chart", dest="chart", action="store_false", help="table only")
@@ -81,8 +87,11 @@ def run(args) -> int:
     try:
         ideal, rows = _study_with_progress(scenario, pulses, settings, args.backend, errors, state)
     except (Cancelled, KeyboardInterrupt):  # the latter: Ctrl-C before the worker started
-        print(f"ladartui: pulse study cancelled {_where(state['last'])}; no results, and this "
-              "command writes no files", file=sys.stderr)
+        print(
+            f"ladartui: pulse study cancelled {_where(state['last'])}; no results, and this "
+            "command writes no files",
+            file=sys.stderr,
+        )
         return 130
     if args.json:
         print(json.dumps(result_dict(scenario, settings, ideal, rows), indent=2, allow_nan=False))
@@ -90,8 +99,10 @@ def run(args) -> int:
     print(f"ideal model: obscured coverage {ideal:.4f}")
     print(f"{'pulses':>7} {'k':>4} {'coverage':>9} {'declared':>9} {'false':>7} {'P_d(target)':>11}")
     for r in rows:
-        print(f"{r.pulses:>7} {r.threshold:>4} {r.obscured_coverage:>9.4f} {r.declared_points:>9} "
-              f"{r.false_alarms:>7} {r.target_detection:>11.3f}")
+        print(
+            f"{r.pulses:>7} {r.threshold:>4} {r.obscured_coverage:>9.4f} {r.declared_points:>9} "
+            f"{r.false_alarms:>7} {r.target_detection:>11.3f}"
+        )
     if args.chart:
         print(chart_text(ideal, rows, color=sys.stdout.isatty()))
     return 0
@@ -112,29 +123,42 @@ def _study_with_progress(scenario, pulses, settings, backend, console, state):
     from ladartui.detection.pulses import pulse_study
 
     cancel = threading.Event()
-    columns = (TextColumn("{task.description}"), BarColumn(),
-               TextColumn("{task.percentage:>5.1f} %"), TimeElapsedColumn(),
-               TimeRemainingColumn())
+    columns = (
+        TextColumn("{task.description}"),
+        BarColumn(),
+        TextColumn("{task.percentage:>5.1f} %"),
+        TimeElapsedColumn(),
+        TimeRemainingColumn(),
+    )
     with Progress(*columns, console=console, transient=False) as bar:
         # Until the first scan is done (a first run also compiles the kernels, about a minute).
         task = bar.add_task("tracing scan 1 (compiling kernels on a first run)", total=1.0)
 
         def report(p):
             state["last"] = p
-            what = (f"tracing scan {p.done}/{p.total}" if p.stage == "trace"
-                    else f"pulse count {p.done}/{p.total} ({pulses[p.done - 1]} pulses)")
+            what = (
+                f"tracing scan {p.done}/{p.total}"
+                if p.stage == "trace"
+                else f"pulse count {p.done}/{p.total} ({pulses[p.done - 1]} pulses)"
+            )
             bar.update(task, completed=p.units_done / p.units_total, description=what)
 
         return run_cancellable(
-            lambda: pulse_study(scenario, pulses, settings, backend=backend, progress=report,
-                                cancel=cancel),
-            cancel, "ladartui-pulses", Cancelled("pulse study cancelled"))
+            lambda: pulse_study(scenario, pulses, settings, backend=backend, progress=report, cancel=cancel),
+            cancel,
+            "ladartui-pulses",
+            Cancelled("pulse study cancelled"),
+        )
 
 
 def result_dict(scenario, settings, ideal, rows) -> dict:
     """The study as JSON-safe data: settings, the ideal coverage and one row per pulse count."""
-    return {"scenario": str(scenario.path), "settings": settings.to_dict(),
-            "ideal_obscured_coverage": ideal, "rows": [r.to_dict() for r in rows]}
+    return {
+        "scenario": str(scenario.path),
+        "settings": settings.to_dict(),
+        "ideal_obscured_coverage": ideal,
+        "rows": [r.to_dict() for r in rows],
+    }
 
 
 def chart_text(ideal, rows, width=CHART_WIDTH, height=CHART_HEIGHT, color=True) -> str:
@@ -150,17 +174,26 @@ def chart_text(ideal, rows, width=CHART_WIDTH, height=CHART_HEIGHT, color=True) 
         plotext.plotsize(width, height)
         plotext.theme("pro" if color else "clear")
         plotext.title("Geiger-mode: coverage and false alarms against pulses per look")
-        plotext.plot(xs, [100.0 * r.obscured_coverage for r in rows], marker="o",
-                     color="green", label="obscured coverage % (Geiger)")
-        plotext.plot(xs, [100.0 * ideal] * len(xs), color="cyan",
-                     label="obscured coverage % (ideal)")
-        plotext.plot(xs, [r.false_alarms for r in rows], marker="x", color="red",
-                     yside="right", label="false alarms (right)")
+        plotext.plot(
+            xs,
+            [100.0 * r.obscured_coverage for r in rows],
+            marker="o",
+            color="green",
+            label="obscured coverage % (Geiger)",
+        )
+        plotext.plot(xs, [100.0 * ideal] * len(xs), color="cyan", label="obscured coverage % (ideal)")
+        plotext.plot(
+            xs,
+            [r.false_alarms for r in rows],
+            marker="x",
+            color="red",
+            yside="right",
+            label="false alarms (right)",
+        )
         # Head room above the data for the legend, which plotext puts top left.
         top = max([100.0 * ideal, *(100.0 * r.obscured_coverage for r in rows)])
         plotext.ylim(0.0, (top or 1.0) * LEGEND_HEADROOM)
-        plotext.ylim(0.0, (max(r.false_alarms for r in rows) or 1.0) * LEGEND_HEADROOM,
-                     yside="right")
+        plotext.ylim(0.0, (max(r.false_alarms for r in rows) or 1.0) * LEGEND_HEADROOM, yside="right")
         if len(xs) > 1 and min(xs) > 0:
             plotext.xscale("log")
         plotext.xlabel("pulses per look")

@@ -25,20 +25,26 @@ def add_parser(subparsers):
         "S.cmf beside the scenario, and show the measures of effectiveness.",
     )
     parser.add_argument("scenario", metavar="SCENARIO", help="scenario file (.toml)")
-    parser.add_argument("--backend", metavar="B", help="tracing backend: auto, numba or wgpu "
-                        "(default: the scenario's)")
+    parser.add_argument(
+        "--backend", metavar="B", help="tracing backend: auto, numba or wgpu (default: the scenario's)"
+    )
     parser.add_argument("--method", metavar="M", help="tracing method: exact or march")
     parser.add_argument("--step", metavar="S", type=float, help="march step in voxels")
     parser.add_argument("--precision", metavar="P", help="tracing precision: f32 or f64")
     parser.add_argument("--las", action="store_true", help="also write the outputs as LAS point clouds")
-    parser.add_argument("--no-write", dest="write", action="store_false",
-                        help="do not write outputs or measures")
+    parser.add_argument(
+        "--no-write", dest="write", action="store_false", help="do not write outputs or measures"
+    )
     parser.add_argument("--json", action="store_true", help="print the result as JSON on stdout")
-    parser.add_argument("--max-rays", metavar="N", type=float,
-                        help="refuse a run tracing more rays than this (default 2e9; also "
-                        "LADARTUI_MAX_RAYS)")
-    parser.add_argument("--chart", metavar="FILE",
-                        help="also write the coverage after each scan as a chart (.svg or .png)")
+    parser.add_argument(
+        "--max-rays",
+        metavar="N",
+        type=float,
+        help="refuse a run tracing more rays than this (default 2e9; also LADARTUI_MAX_RAYS)",
+    )
+    parser.add_argument(
+        "--chart", metavar="FILE", help="also write the coverage after each scan as a chart (.svg or .png)"
+    )
     parser.set_defaults(handler=run)
     return parser
 
@@ -108,17 +114,22 @@ def _simulate_with_progress(scenario, args, console):
         task = bar.add_task("starting", total=1.0, rays="")
 
         def report(p):
-            bar.update(task, completed=p.fraction,
-                       description=f"scan {p.scan}/{p.scans} (scene and target runs)",
-                       rays=f"{p.rays_done:,}/{p.rays_total:,} rays")
+            bar.update(
+                task,
+                completed=p.fraction,
+                description=f"scan {p.scan}/{p.scans} (scene and target runs)",
+                rays=f"{p.rays_done:,}/{p.rays_total:,} rays",
+            )
 
         # A stop during the write lets the swap finish (or roll back): the files on
         # disk belong to one run and the result says which.
         with sigterm_as_interrupt():
             return run_cancellable(
-                lambda: simulate(scenario, progress=report, cancel=cancel, write=args.write,
-                                 las=args.las),
-                cancel, "ladartui-run", Cancelled(NOTHING_WRITTEN))
+                lambda: simulate(scenario, progress=report, cancel=cancel, write=args.write, las=args.las),
+                cancel,
+                "ladartui-run",
+                Cancelled(NOTHING_WRITTEN),
+            )
 
 
 def result_dict(scenario, result) -> dict:
@@ -159,8 +170,10 @@ def show_result(console, result) -> None:
     if result.measures.detection is not None:
         console.print(detection_table(result.measures.detection))
     total = result.timings.get("total", 0.0)
-    console.print(f"backend: {result.backend} ({result.method}); {result.scans} scans x "
-                  f"{result.rays_per_scan:,} rays, two runs, in {total:.2f} s")
+    console.print(
+        f"backend: {result.backend} ({result.method}); {result.scans} scans x "
+        f"{result.rays_per_scan:,} rays, two runs, in {total:.2f} s"
+    )
     if result.outputs:
         for name, path in result.outputs.items():
             console.print(f"wrote {name}: {path}", highlight=False, soft_wrap=True)
@@ -177,15 +190,22 @@ def detection_table(detection):
     def number(value, digits=1):
         return "undefined" if value is None else f"{value:,.{digits}f}"
 
-    table = Table(title=f"Geiger-mode detection: {detection.pulses} pulses per look, "
-                  f"k = {detection.coincidence}, seed {detection.seed}", show_header=False)
+    table = Table(
+        title=f"Geiger-mode detection: {detection.pulses} pulses per look, "
+        f"k = {detection.coincidence}, seed {detection.seed}",
+        show_header=False,
+    )
     table.add_column("")
     table.add_column("", justify="right")
     for name, value in (
-        ("declared points (per look)", f"{detection.declared_points:,} "
-                                       f"({number(detection.declared_per_look)})"),
-        ("false alarms (per look)", f"{detection.false_alarms:,} "
-                                    f"({number(detection.false_alarms_per_look)})"),
+        (
+            "declared points (per look)",
+            f"{detection.declared_points:,} ({number(detection.declared_per_look)})",
+        ),
+        (
+            "false alarms (per look)",
+            f"{detection.false_alarms:,} ({number(detection.false_alarms_per_look)})",
+        ),
         ("false-alarm probability per noise bin", number(detection.false_alarm_probability, 6)),
         ("P_d of target voxels", format_share(detection.target_detection)),
         ("ideal sensor: obscured coverage", format_share(detection.ideal_obscured_coverage)),

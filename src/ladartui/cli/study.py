@@ -23,18 +23,33 @@ def add_parser(subparsers) -> None:
         "generated 'reference' scene (cached under LADARTUI_HOME). Ctrl-C cancels.",
     )
     parser.add_argument("scenario", nargs="?", help="scenario .toml (default: generated scene)")
-    parser.add_argument("--quick", action="store_true",
-                        help="small scene, few settings and scans: a fast check")
-    parser.add_argument("--out", default=DEFAULT_OUT,
-                        help=f"folder for study.csv, study.json, speed-accuracy.svg/.png/.txt "
-                        f"(default: {DEFAULT_OUT})")
-    parser.add_argument("--runs", type=int, default=None,
-                        help="timed runs per setting, median quoted (default 5; 3 with --quick)")
+    parser.add_argument(
+        "--quick", action="store_true", help="small scene, few settings and scans: a fast check"
+    )
+    parser.add_argument(
+        "--out",
+        default=DEFAULT_OUT,
+        help=f"folder for study.csv, study.json, speed-accuracy.svg/.png/.txt (default: {DEFAULT_OUT})",
+    )
+    parser.add_argument(
+        "--runs",
+        type=int,
+        default=None,
+        help="timed runs per setting, median quoted (default 5; 3 with --quick)",
+    )
     parser.add_argument("--warmup", type=int, default=1, help="untimed calls first (default 1)")
-    parser.add_argument("--chart-from", metavar="JSON", default=None,
-                        help="redraw the chart, table and verdict from a study.json; no tracing")
-    parser.add_argument("--scans", type=int, default=None,
-                        help="scans traced, evenly spread over the flight (default 3; 2 with --quick)")
+    parser.add_argument(
+        "--chart-from",
+        metavar="JSON",
+        default=None,
+        help="redraw the chart, table and verdict from a study.json; no tracing",
+    )
+    parser.add_argument(
+        "--scans",
+        type=int,
+        default=None,
+        help="scans traced, evenly spread over the flight (default 3; 2 with --quick)",
+    )
     parser.set_defaults(handler=run)
 
 
@@ -84,30 +99,40 @@ def _run_with_progress(console, inputs, settings, runs, warmup):
         if reason:
             console.print(f"[yellow]skipping backend {name}:[/] {reason}")
     scene = inputs.scene
-    console.print(f"study on {inputs.name}: {len(scene.voxels):,} voxels, shape {scene.shape}, "
-                  f"{len(inputs.poses)} scans, sensor {inputs.sensor.grid}x{inputs.sensor.grid}, "
-                  f"{len(settings)} settings, median of {runs} runs")
+    console.print(
+        f"study on {inputs.name}: {len(scene.voxels):,} voxels, shape {scene.shape}, "
+        f"{len(inputs.poses)} scans, sensor {inputs.sensor.grid}x{inputs.sensor.grid}, "
+        f"{len(settings)} settings, median of {runs} runs"
+    )
     cancel = threading.Event()
-    progress_bar = Progress(TextColumn("{task.description}"), BarColumn(),
-                            TextColumn("{task.completed}/{task.total} traces"),
-                            TimeElapsedColumn(), console=console, transient=True)
+    progress_bar = Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        TextColumn("{task.completed}/{task.total} traces"),
+        TimeElapsedColumn(),
+        console=console,
+        transient=True,
+    )
     task = progress_bar.add_task("starting", total=None)
 
     plain = not console.is_terminal  # a log file gets one line per setting instead of a bar
     last = {}
 
     def report(p):
-        progress_bar.update(task, completed=p.done, total=p.total,
-                            description=f"{p.label} scan {p.scan}/{p.scans}")
+        progress_bar.update(
+            task, completed=p.done, total=p.total, description=f"{p.label} scan {p.scan}/{p.scans}"
+        )
         if plain and last.get("label") != p.label and p.scan == 1:
             last["label"] = p.label
             console.print(f"[{p.done}/{p.total} traces] {p.label}", highlight=False)
 
     with progress_bar:
         return run_cancellable(
-            lambda: run_study(inputs, settings, runs=runs, warmup=warmup, progress=report,
-                              cancel=cancel),
-            cancel, "ladartui-study", Cancelled("study cancelled"))
+            lambda: run_study(inputs, settings, runs=runs, warmup=warmup, progress=report, cancel=cancel),
+            cancel,
+            "ladartui-study",
+            Cancelled("study cancelled"),
+        )
 
 
 def _report(result, out_dir) -> int:
@@ -125,8 +150,9 @@ def _report(result, out_dir) -> int:
     console.print(Text.from_ansi(chart_text(result, width, CHART_HEIGHT, color=console.is_terminal)))
     table = Table(title="Settings (coverage error against " + (result.reference_label or "-") + ")")
     for column in TABLE_COLUMNS:
-        table.add_column(column, justify="right" if column in ("s/scan", "rays/s", "differ",
-                                                              "cov. error") else "left")
+        table.add_column(
+            column, justify="right" if column in ("s/scan", "rays/s", "differ", "cov. error") else "left"
+        )
     for row in table_rows(result):
         table.add_row(*row)
     console.print(table)

@@ -30,37 +30,70 @@ def add_parser(subparsers):
         "An interrupted sweep resumes where it stopped. See docs/sweeps.md.",
     )
     parser.add_argument("spec", metavar="SPEC", help="sweep spec file (.toml)")
-    parser.add_argument("--scheduler", metavar="ADDRESS",
-                        help="address of a running Dask scheduler (tcp://HOST:PORT); default: "
-                        "a local cluster on this machine")
-    parser.add_argument("--tls-ca-file", metavar="PEM",
-                        help="certificate authority of a TLS scheduler (ladartui certs DIR)")
+    parser.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="address of a running Dask scheduler (tcp://HOST:PORT); default: "
+        "a local cluster on this machine",
+    )
+    parser.add_argument(
+        "--tls-ca-file", metavar="PEM", help="certificate authority of a TLS scheduler (ladartui certs DIR)"
+    )
     parser.add_argument("--tls-cert", metavar="PEM", help="this client's TLS certificate")
     parser.add_argument("--tls-key", metavar="PEM", help="this client's TLS private key")
-    parser.add_argument("--insecure", action="store_true",
-                        help="allow a plain tcp:// scheduler that is not on loopback (any "
-                        "peer that reaches it can run code on the cluster and here)")
-    parser.add_argument("--connect-timeout", metavar="SECONDS", type=float, default=30.0,
-                        help="how long to wait for the scheduler and a first worker (default 30)")
-    parser.add_argument("--workers", metavar="N", type=int,
-                        help="worker processes of the local cluster (default: one per core)")
-    parser.add_argument("--serial", action="store_true",
-                        help="run the variants one by one in this process, without Dask")
-    parser.add_argument("--out", metavar="DIR",
-                        help="folder for results.csv, ranking.csv, pareto.svg/.png and the best "
-                        "scenario "
-                        "(default: SPEC's folder/SPEC-results)")
-    parser.add_argument("--objective", metavar="NAME",
-                        help="ranking objective: " + ", ".join(OBJECTIVES)
-                        + " (default: the spec's)")
-    parser.add_argument("--budget", metavar="SECONDS", type=float,
-                        help="flight-time budget for coverage-within-budget (default: the spec's)")
-    parser.add_argument("--cost", metavar="NAME",
-                        help="cost axis of the Pareto front: flight-time or distance")
-    parser.add_argument("--top", metavar="N", type=int, default=DEFAULT_TOP,
-                        help=f"ranked variants to show (default {DEFAULT_TOP})")
-    parser.add_argument("--show", action="store_true",
-                        help="rank the results already in OUT without running anything")
+    parser.add_argument(
+        "--insecure",
+        action="store_true",
+        help="allow a plain tcp:// scheduler that is not on loopback (any "
+        "peer that reaches it can run code on the cluster and here)",
+    )
+    parser.add_argument(
+        "--connect-timeout",
+        metavar="SECONDS",
+        type=float,
+        default=30.0,
+        help="how long to wait for the scheduler and a first worker (default 30)",
+    )
+    parser.add_argument(
+        "--workers",
+        metavar="N",
+        type=int,
+        help="worker processes of the local cluster (default: one per core)",
+    )
+    parser.add_argument(
+        "--serial", action="store_true", help="run the variants one by one in this process, without Dask"
+    )
+    parser.add_argument(
+        "--out",
+        metavar="DIR",
+        help="folder for results.csv, ranking.csv, pareto.svg/.png and the best "
+        "scenario "
+        "(default: SPEC's folder/SPEC-results)",
+    )
+    parser.add_argument(
+        "--objective",
+        metavar="NAME",
+        help="ranking objective: " + ", ".join(OBJECTIVES) + " (default: the spec's)",
+    )
+    parser.add_argument(
+        "--budget",
+        metavar="SECONDS",
+        type=float,
+        help="flight-time budget for coverage-within-budget (default: the spec's)",
+    )
+    parser.add_argument(
+        "--cost", metavar="NAME", help="cost axis of the Pareto front: flight-time or distance"
+    )
+    parser.add_argument(
+        "--top",
+        metavar="N",
+        type=int,
+        default=DEFAULT_TOP,
+        help=f"ranked variants to show (default {DEFAULT_TOP})",
+    )
+    parser.add_argument(
+        "--show", action="store_true", help="rank the results already in OUT without running anything"
+    )
     parser.add_argument("--json", action="store_true", help="print the ranking as JSON on stdout")
     parser.set_defaults(handler=run)
     return parser
@@ -75,24 +108,32 @@ def run(args) -> int:
     if args.workers is not None and args.workers < 1:
         raise FieldError("--workers", args.workers, "an integer >= 1")
     if args.serial and args.workers is not None:
-        raise FieldError("--workers", args.workers, "no --workers with --serial (one process "
-                         "runs every variant)")
+        raise FieldError(
+            "--workers", args.workers, "no --workers with --serial (one process runs every variant)"
+        )
     if not args.connect_timeout > 0:
         raise FieldError("--connect-timeout", args.connect_timeout, "a number of seconds > 0")
     if args.top < 0:
         raise FieldError("--top", args.top, "an integer >= 0")
     if args.scheduler and (args.workers is not None or args.serial):
-        raise FieldError("--scheduler", args.scheduler, "no --workers or --serial with it "
-                         "(the cluster's workers run the sweep)")
+        raise FieldError(
+            "--scheduler",
+            args.scheduler,
+            "no --workers or --serial with it (the cluster's workers run the sweep)",
+        )
     security = None
     if args.scheduler:
         from ladartui.sweep.security import cluster_security
 
-        security = cluster_security(args.scheduler, args.tls_ca_file, args.tls_cert,
-                                    args.tls_key, args.insecure)
+        security = cluster_security(
+            args.scheduler, args.tls_ca_file, args.tls_cert, args.tls_key, args.insecure
+        )
     elif args.tls_ca_file or args.tls_cert or args.tls_key or args.insecure:
-        raise FieldError("--scheduler", None, "an address with the TLS or --insecure flags "
-                         "(the local cluster listens on 127.0.0.1 only)")
+        raise FieldError(
+            "--scheduler",
+            None,
+            "an address with the TLS or --insecure flags (the local cluster listens on 127.0.0.1 only)",
+        )
     args.security = security
     spec = load_sweep_spec(args.spec)
     objective = normal_objective(args.objective or spec.objective)
@@ -100,14 +141,21 @@ def run(args) -> int:
     if args.budget is not None and not args.budget > 0:
         raise FieldError("--budget", args.budget, "a flight-time budget in seconds, > 0")
     if objective == "coverage-within-budget" and args.budget is None and spec.budget is None:
-        raise FieldError("--budget", None, "a flight-time budget in seconds (or sweep.budget "
-                         "in the spec) for objective 'coverage-within-budget'")
+        raise FieldError(
+            "--budget",
+            None,
+            "a flight-time budget in seconds (or sweep.budget "
+            "in the spec) for objective 'coverage-within-budget'",
+        )
     errors = Console(stderr=True)
     if args.show:
         out = args.out or default_out_dir(spec)
-        result = load_sweep_results(out, objective=args.objective or spec.objective,
-                                    budget=args.budget if args.budget is not None else spec.budget,
-                                    cost=args.cost or spec.cost)
+        result = load_sweep_results(
+            out,
+            objective=args.objective or spec.objective,
+            budget=args.budget if args.budget is not None else spec.budget,
+            cost=args.cost or spec.cost,
+        )
         result.parameter_names = spec.parameter_names
     else:
         from ladartui.outputset import check_writable_folder
@@ -152,8 +200,11 @@ def _sweep_with_progress(spec, args, console):
         TimeElapsedColumn(),
         TimeRemainingColumn(),
     )
-    where = f"scheduler {args.scheduler}" if args.scheduler else (
-        "this process" if args.serial else "local cluster")
+    where = (
+        f"scheduler {args.scheduler}"
+        if args.scheduler
+        else ("this process" if args.serial else "local cluster")
+    )
     try:
         with Progress(*columns, console=console, transient=False) as bar:
             task = bar.add_task(f"sweep on {where}", total=len(spec.variants), note="starting")
@@ -167,9 +218,17 @@ def _sweep_with_progress(spec, args, console):
 
             def work():
                 return run_sweep(
-                    spec, client=client, progress=report, cancel=cancel, out=args.out,
-                    workers=args.workers, objective=args.objective, budget=args.budget,
-                    cost=args.cost, serial=args.serial)
+                    spec,
+                    client=client,
+                    progress=report,
+                    cancel=cancel,
+                    out=args.out,
+                    workers=args.workers,
+                    objective=args.objective,
+                    budget=args.budget,
+                    cost=args.cost,
+                    serial=args.serial,
+                )
 
             previous = _stop_on_sigterm()
             try:
@@ -183,8 +242,11 @@ def _sweep_with_progress(spec, args, console):
             client.close()
     last = outcome.get("progress")
     kept = f"{last.done} of {last.total} variants are" if last else "finished variants are"
-    console.print(f"ladartui: sweep interrupted; {kept} kept in the results table; run the "
-                  "same command again to resume", highlight=False)
+    console.print(
+        f"ladartui: sweep interrupted; {kept} kept in the results table; run the "
+        "same command again to resume",
+        highlight=False,
+    )
     return None
 
 
@@ -209,14 +271,25 @@ def result_dict(result, top) -> dict:
 
     def entry(ranked):
         row = ranked.row
-        return {"rank": ranked.rank, "variant": row.get("variant"), "objective": ranked.value,
-                "coverage": ranked.coverage, "cost": ranked.cost, "pareto": ranked.pareto,
-                "parameters": {n: row.get(n) for n in result.parameter_names}}
+        return {
+            "rank": ranked.rank,
+            "variant": row.get("variant"),
+            "objective": ranked.value,
+            "coverage": ranked.coverage,
+            "cost": ranked.cost,
+            "pareto": ranked.pareto,
+            "parameters": {n: row.get(n) for n in result.parameter_names},
+        }
 
     return {
-        "objective": result.objective, "cost": result.cost, "budget": result.budget,
-        "variants": len(result.rows), "ran": result.ran, "resumed": result.resumed,
-        "failed": len(result.failures), "workers": result.workers,
+        "objective": result.objective,
+        "cost": result.cost,
+        "budget": result.budget,
+        "variants": len(result.rows),
+        "ran": result.ran,
+        "resumed": result.resumed,
+        "failed": len(result.failures),
+        "workers": result.workers,
         "elapsed_s": round(result.elapsed, 3),
         "results": str(result.results_path),
         "ranking": str(result.ranking_path) if result.ranking_path else None,
@@ -224,8 +297,7 @@ def result_dict(result, top) -> dict:
         "charts": {fmt: str(path) for fmt, path in result.charts.items()},
         "top": [entry(r) for r in result.ranking[:top] if r.rank is not None],
         "pareto": [entry(r) for r in result.pareto],
-        "errors": [{"variant": r.get("variant"), "error": r.get("error")}
-                   for r in result.failures],
+        "errors": [{"variant": r.get("variant"), "error": r.get("error")} for r in result.failures],
     }
 
 
@@ -237,11 +309,17 @@ def show_result(console, result, top) -> None:
     from ladartui.sweep.ranking import OBJECTIVES
 
     cost_unit = "s" if result.cost == "flight-time" else "m"
-    short = {"obscured-coverage": "coverage", "coverage-per-km": "cov/km",
-             "coverage-within-budget": "coverage"}
-    table = Table(title=f"Best flight paths by {result.objective}: "
-                  f"{OBJECTIVES[result.objective]}", title_justify="left",
-                  box=box.SIMPLE_HEAD, pad_edge=False)
+    short = {
+        "obscured-coverage": "coverage",
+        "coverage-per-km": "cov/km",
+        "coverage-within-budget": "coverage",
+    }
+    table = Table(
+        title=f"Best flight paths by {result.objective}: {OBJECTIVES[result.objective]}",
+        title_justify="left",
+        box=box.SIMPLE_HEAD,
+        pad_edge=False,
+    )
     table.add_column("#", justify="right")
     table.add_column("variant", no_wrap=True)
     for name in result.parameter_names:
@@ -254,36 +332,55 @@ def show_result(console, result, top) -> None:
     table.add_column("front")
     for ranked in [r for r in result.ranking if r.rank is not None][:top]:
         row = ranked.row
-        table.add_row(str(ranked.rank), str(row.get("variant", ""))[:8],
-                      *(display_cell(row.get(n)) for n in result.parameter_names),
-                      *([display_cell(ranked.value)] if separate else []), display_cell(ranked.coverage, 3),
-                      display_cell(ranked.cost, 4), "*" if ranked.pareto else "")
+        table.add_row(
+            str(ranked.rank),
+            str(row.get("variant", ""))[:8],
+            *(display_cell(row.get(n)) for n in result.parameter_names),
+            *([display_cell(ranked.value)] if separate else []),
+            display_cell(ranked.coverage, 3),
+            display_cell(ranked.cost, 4),
+            "*" if ranked.pareto else "",
+        )
     console.print(table)
     front = result.pareto
     if front:
-        points = ", ".join(f"{str(r.row.get('variant'))[:8]} ({display_cell(r.coverage, 3)} at "
-                           f"{display_cell(r.cost, 4)} {cost_unit})" for r in front)
-        console.print(f"Pareto front of obscured coverage against {result.cost}, cheapest "
-                      f"first: {points}", highlight=False)
+        points = ", ".join(
+            f"{str(r.row.get('variant'))[:8]} ({display_cell(r.coverage, 3)} at "
+            f"{display_cell(r.cost, 4)} {cost_unit})"
+            for r in front
+        )
+        console.print(
+            f"Pareto front of obscured coverage against {result.cost}, cheapest first: {points}",
+            highlight=False,
+        )
     unranked = sum(1 for r in result.ranking if r.rank is None and r.row.get("status") == "ok")
     if unranked:
-        console.print(f"{unranked} finished variant(s) not ranked (objective undefined or over "
-                      "the budget)", highlight=False)
+        console.print(
+            f"{unranked} finished variant(s) not ranked (objective undefined or over the budget)",
+            highlight=False,
+        )
     failures = result.failures
     if failures:
-        console.print(f"[bold]{len(failures)} variant(s) failed[/]; first: "
-                      f"{failures[0].get('variant')}: {failures[0].get('error')}", highlight=False)
+        console.print(
+            f"[bold]{len(failures)} variant(s) failed[/]; first: "
+            f"{failures[0].get('variant')}: {failures[0].get('error')}",
+            highlight=False,
+        )
     if result.ran or result.resumed:
         ran = result.ran
         rate = f" ({60 * ran / result.elapsed:.1f} variants/min)" if ran and result.elapsed else ""
-        console.print(f"{ran} variant(s) run in {result.elapsed:.1f} s{rate} on "
-                      f"{result.workers} worker(s); {result.resumed} resumed from earlier runs",
-                      highlight=False)
+        console.print(
+            f"{ran} variant(s) run in {result.elapsed:.1f} s{rate} on "
+            f"{result.workers} worker(s); {result.resumed} resumed from earlier runs",
+            highlight=False,
+        )
     console.print(f"results  {result.results_path}", highlight=False)
     if result.ranking_path:
         console.print(f"ranking  {result.ranking_path}", highlight=False)
     for path in result.charts.values():
         console.print(f"chart    {path}", highlight=False)
     if result.best_scenario_path:
-        console.print(f"best     {result.best_scenario_path}  (open it with: ladartui "
-                      f"{result.best_scenario_path})", highlight=False)
+        console.print(
+            f"best     {result.best_scenario_path}  (open it with: ladartui {result.best_scenario_path})",
+            highlight=False,
+        )

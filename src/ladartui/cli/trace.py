@@ -17,10 +17,12 @@ from ladartui.errors import FieldError, InputFileError
 
 def add_parser(subparsers):
     parser = subparsers.add_parser(
-        "trace", help="trace rays (.npy) against a scene model and write the hits (.npy)",
+        "trace",
+        help="trace rays (.npy) against a scene model and write the hits (.npy)",
         description="Trace an (N, 6) array of rays (origin and unit direction, metres) against "
         "a voxel scene model; write an (N, 5) array: kind (0 miss, 1 voxel, 2 ground), i, j, k, "
-        "range in metres.")
+        "range in metres.",
+    )
     parser.add_argument("--scene", required=True, metavar="X.txt", help="scene model voxel list")
     parser.add_argument("--rays", required=True, metavar="RAYS.npy", help="(N, 6) float array")
     parser.add_argument("--out", required=True, metavar="HITS.npy", help="output (N, 5) float64")
@@ -28,9 +30,13 @@ def add_parser(subparsers):
     parser.add_argument("--method", default="exact", help="exact (default) or march")
     parser.add_argument("--step", type=float, default=None, help="march step in voxels (0.5)")
     parser.add_argument("--voxel-size", type=float, default=1.0, help="metres per voxel (1.0)")
-    parser.add_argument("--precision", default="f64", choices=("f64", "f32"),
-                        help="arithmetic of the trace: f64 (default) or f32, as in the API; "
-                        "a backend without f32 kernels traces in f64 and says so")
+    parser.add_argument(
+        "--precision",
+        default="f64",
+        choices=("f64", "f32"),
+        help="arithmetic of the trace: f64 (default) or f32, as in the API; "
+        "a backend without f32 kernels traces in f64 and says so",
+    )
     parser.set_defaults(handler=run)
 
 
@@ -45,8 +51,10 @@ def load_rays(path) -> np.ndarray:
     except (ValueError, OSError) as error:
         raise InputFileError(path, f"not a NumPy .npy array ({error})") from None
     if rays.ndim != 2 or rays.shape[1] != 6:
-        raise InputFileError(path, f"array of shape {rays.shape}: expected (N, 6): "
-                             "origin x, y, z and direction dx, dy, dz per row")
+        raise InputFileError(
+            path,
+            f"array of shape {rays.shape}: expected (N, 6): origin x, y, z and direction dx, dy, dz per row",
+        )
     if rays.dtype.kind not in "fiu":
         raise InputFileError(path, f"dtype {rays.dtype}: expected numbers")
     rays = rays.astype(np.float64)
@@ -72,13 +80,24 @@ def run(args):
     rays = load_rays(args.rays)
     voxels = load_voxels(args.scene)
     occupancy = Occupancy.build(voxels)
-    result = trace(occupancy, rays[:, :3], rays[:, 3:], backend=args.backend, method=args.method,
-                   step=args.step, precision=args.precision, voxel_size=args.voxel_size)
+    result = trace(
+        occupancy,
+        rays[:, :3],
+        rays[:, 3:],
+        backend=args.backend,
+        method=args.method,
+        step=args.step,
+        precision=args.precision,
+        voxel_size=args.voxel_size,
+    )
     with atomic_path(args.out) as tmp:
         with open(tmp, "wb") as handle:
             np.save(handle, result.as_array())
     counts = np.bincount(result.kind, minlength=3)
     used = result.info.get("precision", args.precision)
-    print(f"{len(rays)} rays ({result.backend}, {result.method}, {used}): {counts[1]} voxel, "
-          f"{counts[2]} ground, {counts[0]} miss -> {args.out}", file=sys.stderr)
+    print(
+        f"{len(rays)} rays ({result.backend}, {result.method}, {used}): {counts[1]} voxel, "
+        f"{counts[2]} ground, {counts[0]} miss -> {args.out}",
+        file=sys.stderr,
+    )
     return 0

@@ -9,9 +9,11 @@ from ladartui.errors import InputFileError
 
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser(
-        "tui", help="open the terminal UI (the default when no command is given)",
+        "tui",
+        help="open the terminal UI (the default when no command is given)",
         description="Open the terminal UI on SCENARIO.toml, or on the default scenario "
-                    "(created with its scene on first use).")
+        "(created with its scene on first use).",
+    )
     parser.add_argument("scenario", nargs="?", type=Path, help="a scenario file (.toml)")
     parser.set_defaults(handler=run)
 

@@ -37,16 +37,19 @@ def scene_summary(scenario) -> list[str]:
     scene = scenario.load_scene()
     nx, ny, nz = scene.shape
     vs = scene.voxel_size
-    lines = [f"scene      {len(scene.voxels):,} voxels, target {len(scene.target):,} voxels; "
-             f"extent {nx} x {ny} x {nz} voxels = {nx * vs:g} x {ny * vs:g} x {nz * vs:g} m"]
+    lines = [
+        f"scene      {len(scene.voxels):,} voxels, target {len(scene.target):,} voxels; "
+        f"extent {nx} x {ny} x {nz} voxels = {nx * vs:g} x {ny * vs:g} x {nz * vs:g} m"
+    ]
     need = 0
-    for voxels, source in ((scene.voxels, scenario.scene_file),
-                           (scene.target, scenario.target_file)):
+    for voxels, source in ((scene.voxels, scenario.scene_file), (scene.target, scenario.target_file)):
         if len(voxels):
             # int64: the far corner + 1 of a voxel at 2**31 - 1 overflows int32.
             lo, hi = voxels.min(axis=0).astype(np.int64), voxels.max(axis=0).astype(np.int64) + 1
             need += check_occupancy(lo, hi, len(voxels), str(source))
     need += scene.voxels.nbytes + scene.target.nbytes + np.dtype(np.int32).itemsize
-    lines.append(f"memory     about {gib(need)} for the scene and its tracing structures "
-                 f"({gib(available_memory())} available)")
+    lines.append(
+        f"memory     about {gib(need)} for the scene and its tracing structures "
+        f"({gib(available_memory())} available)"
+    )
     return lines

@@ -5,8 +5,14 @@
 a scenario's ``[detection]`` section (``detection.settings``) stays quick.
 """
 
-_GEIGER = ("binomial_at_least", "declare_points", "fire_counts", "noise_per_bin",
-           "optimal_energy_scale", "uniform")
+_GEIGER = (
+    "binomial_at_least",
+    "declare_points",
+    "fire_counts",
+    "noise_per_bin",
+    "optimal_energy_scale",
+    "uniform",
+)
 
 __all__ = list(_GEIGER)
 

@@ -53,8 +53,11 @@ def _uniform(seed, scan, detector, pulse, bin_):
 
 def uniform(seed: int, scan: int, detector: int, pulse: int, bin_: int) -> float:
     """The generator's uniform in [0, 1) for one (seed, scan, detector, pulse, bin)."""
-    return float(_uniform(np.uint64(seed & _MASK), np.uint64(scan), np.uint64(detector),
-                          np.uint64(pulse), np.uint64(bin_)))
+    return float(
+        _uniform(
+            np.uint64(seed & _MASK), np.uint64(scan), np.uint64(detector), np.uint64(pulse), np.uint64(bin_)
+        )
+    )
 
 
 @numba.njit(cache=True, nogil=True, parallel=True)
@@ -75,8 +78,9 @@ def _fire_kernel(fire_prob, detectors, pulses, dead_bins, seed, scan, counts):
                     armed_at = b + dead_bins
 
 
-def fire_counts(mean_counts, pulses: int, dead_bins: int, seed: int, scan: int = 0,
-                detectors=None) -> np.ndarray:
+def fire_counts(
+    mean_counts, pulses: int, dead_bins: int, seed: int, scan: int = 0, detectors=None
+) -> np.ndarray:
     """Times each bin fired over ``pulses`` pulses.
 
     ``mean_counts``: (D, B) mean primary counts per detector and range bin
@@ -91,11 +95,15 @@ def fire_counts(mean_counts, pulses: int, dead_bins: int, seed: int, scan: int =
         raise ValueError("pulses and dead_bins must be at least 1")
     if np.any(~np.isfinite(mean)) or np.any(mean < 0):
         raise ValueError("mean counts must be finite and non-negative")
-    ids = np.arange(mean.shape[0], dtype=np.uint64) if detectors is None \
+    ids = (
+        np.arange(mean.shape[0], dtype=np.uint64)
+        if detectors is None
         else np.ascontiguousarray(detectors, dtype=np.uint64)
+    )
     counts = np.zeros(mean.shape, dtype=np.int32)
-    _fire_kernel(-np.expm1(-mean), ids, int(pulses), int(dead_bins),
-                 np.uint64(seed & _MASK), np.uint64(scan), counts)
+    _fire_kernel(
+        -np.expm1(-mean), ids, int(pulses), int(dead_bins), np.uint64(seed & _MASK), np.uint64(scan), counts
+    )
     return counts
 
 
@@ -113,8 +121,9 @@ def noise_per_bin(rate_hz: float, bin_width_m: float) -> float:
 
 def binomial_at_least(pulses: int, threshold: int, p: float) -> float:
     """P(at least ``threshold`` of ``pulses`` Bernoulli(p) trials succeed)."""
-    return float(sum(math.comb(pulses, j) * p ** j * (1.0 - p) ** (pulses - j)
-                     for j in range(threshold, pulses + 1)))
+    return float(
+        sum(math.comb(pulses, j) * p**j * (1.0 - p) ** (pulses - j) for j in range(threshold, pulses + 1))
+    )
 
 
 def optimal_energy_scale(n_target: float, n_foliage: float) -> float:

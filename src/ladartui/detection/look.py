@@ -26,14 +26,14 @@ MISS = 0
 
 @dataclass(frozen=True)
 class GeigerLook:
-    detectors: np.ndarray     # (D,) detector ids that have at least one return
-    gate_start: float         # metres, start of bin 0
-    mean_counts: np.ndarray   # (D, B) signal + noise
-    counts: np.ndarray        # (D, B) fires over the pulses
-    declared: np.ndarray      # (D, B) bool
+    detectors: np.ndarray  # (D,) detector ids that have at least one return
+    gate_start: float  # metres, start of bin 0
+    mean_counts: np.ndarray  # (D, B) signal + noise
+    counts: np.ndarray  # (D, B) fires over the pulses
+    declared: np.ndarray  # (D, B) bool
     ray_declared: np.ndarray  # (N,) bool: the ray's hit lies in a declared bin
-    false_alarms: int         # declared bins without a return
-    noise_bins: int = 0       # bins without a return (where only noise can fire)
+    false_alarms: int  # declared bins without a return
+    noise_bins: int = 0  # bins without a return (where only noise can fire)
 
 
 def incidence_cosines(origins, directions, kind, index, ranges, voxel_size) -> np.ndarray:
@@ -55,25 +55,45 @@ def incidence_cosines(origins, directions, kind, index, ranges, voxel_size) -> n
     return cos
 
 
-def geiger_look(detector, kind, ranges, reflectance, cos_incidence, *, rays_per_detector: int,
-                n_ref: float, range_ref: float, reflectance_ref: float, noise: float,
-                bin_width: float, pulses: int, threshold: int, dead_bins: int,
-                seed: int, scan: int) -> GeigerLook:
+def geiger_look(
+    detector,
+    kind,
+    ranges,
+    reflectance,
+    cos_incidence,
+    *,
+    rays_per_detector: int,
+    n_ref: float,
+    range_ref: float,
+    reflectance_ref: float,
+    noise: float,
+    bin_width: float,
+    pulses: int,
+    threshold: int,
+    dead_bins: int,
+    seed: int,
+    scan: int,
+) -> GeigerLook:
     detector = np.asarray(detector, dtype=np.int64)
     ranges = np.asarray(ranges, dtype=np.float64)
     hit = np.asarray(kind) != MISS
     ray_declared = np.zeros(detector.size, dtype=bool)
     if not hit.any():
         empty = np.zeros((0, 0))
-        return GeigerLook(np.zeros(0, np.int64), 0.0, empty, empty.astype(np.int32),
-                          empty.astype(bool), ray_declared, 0, 0)
+        return GeigerLook(
+            np.zeros(0, np.int64), 0.0, empty, empty.astype(np.int32), empty.astype(bool), ray_declared, 0, 0
+        )
     ids, row = np.unique(detector[hit], return_inverse=True)
     r = ranges[hit]
     gate_start = float(np.floor(r.min() / bin_width) * bin_width)
     bins = int(np.floor((r.max() - gate_start) / bin_width)) + 1
     b = np.minimum(((r - gate_start) / bin_width).astype(np.int64), bins - 1)
-    signal = (n_ref / rays_per_detector) * (np.asarray(reflectance)[hit] / reflectance_ref) \
-        * (range_ref / np.maximum(r, 1e-9)) ** 2 * np.asarray(cos_incidence)[hit]
+    signal = (
+        (n_ref / rays_per_detector)
+        * (np.asarray(reflectance)[hit] / reflectance_ref)
+        * (range_ref / np.maximum(r, 1e-9)) ** 2
+        * np.asarray(cos_incidence)[hit]
+    )
     mean = np.full((ids.size, bins), float(noise))
     np.add.at(mean, (row, b), signal)
     has_return = np.zeros((ids.size, bins), dtype=bool)
@@ -81,6 +101,13 @@ def geiger_look(detector, kind, ranges, reflectance, cos_incidence, *, rays_per_
     counts = fire_counts(mean, pulses, dead_bins, seed, scan, detectors=ids)
     declared = declare_points(counts, threshold)
     ray_declared[np.flatnonzero(hit)] = declared[row, b]
-    return GeigerLook(ids, gate_start, mean, counts, declared, ray_declared,
-                      int(np.count_nonzero(declared & ~has_return)),
-                      int(np.count_nonzero(~has_return)))
+    return GeigerLook(
+        ids,
+        gate_start,
+        mean,
+        counts,
+        declared,
+        ray_declared,
+        int(np.count_nonzero(declared & ~has_return)),
+        int(np.count_nonzero(~has_return)),
+    )

@@ -79,16 +79,18 @@ class DetectionTally:
     def measures(self, settings, ideal_obscured, ideal_unobscured) -> DetectionMeasures:
         looks = self.looks or None
         return DetectionMeasures(
-            pulses=settings.pulses, coincidence=settings.coincidence, seed=settings.seed,
+            pulses=settings.pulses,
+            coincidence=settings.coincidence,
+            seed=settings.seed,
             declared_points=self.declared,
             declared_per_look=self.declared / looks if looks else None,
             false_alarms=self.false_alarms,
             false_alarms_per_look=self.false_alarms / looks if looks else None,
-            false_alarm_probability=(self.false_alarms / self.noise_bins
-                                     if self.noise_bins else None),
-            target_detection=(self.target_declared / self.target_ideal
-                              if self.target_ideal else None),
-            ideal_obscured_coverage=ideal_obscured, ideal_unobscured_coverage=ideal_unobscured)
+            false_alarm_probability=(self.false_alarms / self.noise_bins if self.noise_bins else None),
+            target_detection=(self.target_declared / self.target_ideal if self.target_ideal else None),
+            ideal_obscured_coverage=ideal_obscured,
+            ideal_unobscured_coverage=ideal_unobscured,
+        )
 
 
 def coverage(target_model, voxels) -> float | None:

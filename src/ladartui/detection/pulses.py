@@ -59,9 +59,15 @@ def _check(cancel):
         raise Cancelled("pulse study cancelled; nothing was written")
 
 
-def pulse_study(scenario, pulses_list, settings: DetectionSettings | None = None, scene=None,
-                backend=None, progress: Callable[[PulseProgress], None] | None = None,
-                cancel: threading.Event | None = None) -> tuple[float, list[PulseRow]]:
+def pulse_study(
+    scenario,
+    pulses_list,
+    settings: DetectionSettings | None = None,
+    scene=None,
+    backend=None,
+    progress: Callable[[PulseProgress], None] | None = None,
+    cancel: threading.Event | None = None,
+) -> tuple[float, list[PulseRow]]:
     """Ideal obscured coverage and one ``PulseRow`` per pulse count.
 
     ``settings`` default to the scenario's ``[detection]`` section (or its
@@ -74,9 +80,11 @@ def pulse_study(scenario, pulses_list, settings: DetectionSettings | None = None
     settings = settings or scenario.detection or DetectionSettings()
     poses = scenario.poses()
     # Every scan's rays are kept (traced once, fired at for each pulse count).
-    check_memory(len(poses) * scenario.sensor.rays_per_scan * BYTES_PER_HELD_RAY,
-                 f"{len(poses)} scans of {scenario.sensor.rays_per_scan:,} rays",
-                 "use fewer scans, a smaller sensor grid or fewer rays per detector")
+    check_memory(
+        len(poses) * scenario.sensor.rays_per_scan * BYTES_PER_HELD_RAY,
+        f"{len(poses)} scans of {scenario.sensor.rays_per_scan:,} rays",
+        "use fewer scans, a smaller sensor grid or fewer rays per detector",
+    )
     if scene is None:
         scene = scenario.load_scene()
     sensor = scenario.sensor
@@ -95,13 +103,22 @@ def pulse_study(scenario, pulses_list, settings: DetectionSettings | None = None
     for scan, pose in enumerate(poses):
         _check(cancel)
         origins, directions, detector = sensor.rays(pose, attitude=attitudes[scan])
-        hits = trace(scene.occupancy, origins, directions, voxel_size=scene.voxel_size,
-                     backend=backend or scenario.backend, method=scenario.method,
-                     step=scenario.step, precision=scenario.precision, cancel=cancel)
+        hits = trace(
+            scene.occupancy,
+            origins,
+            directions,
+            voxel_size=scene.voxel_size,
+            backend=backend or scenario.backend,
+            method=scenario.method,
+            step=scenario.step,
+            precision=scenario.precision,
+            cancel=cancel,
+        )
         kept = kept_returns(detector, hits.kind, hits.range, sensor.depth_resolution)
         ideal.append(voxel_keys(hits.index[kept]))
-        looks.append(prepare_look(origins, directions, detector, hits, kept, target_keys,
-                                  settings, scene.voxel_size))
+        looks.append(
+            prepare_look(origins, directions, detector, hits, kept, target_keys, settings, scene.voxel_size)
+        )
         units += 1.0
         report("trace", scan + 1, len(poses))
     ideal_cov = np.isin(target_keys, np.concatenate(ideal)).sum() / total if total else 0.0
@@ -120,6 +137,14 @@ def pulse_study(scenario, pulses_list, settings: DetectionSettings | None = None
             units += per_scan_units[row]
             report("pulses", row + 1, len(pulses_list))
         covered = np.isin(target_keys, np.concatenate(declared_keys)).sum() if total else 0
-        rows.append(PulseRow(pulses, k, covered / total if total else 0.0, points, false_alarms,
-                             target_declared / target_ideal if target_ideal else 0.0))
+        rows.append(
+            PulseRow(
+                pulses,
+                k,
+                covered / total if total else 0.0,
+                points,
+                false_alarms,
+                target_declared / target_ideal if target_ideal else 0.0,
+            )
+        )
     return float(ideal_cov), rows

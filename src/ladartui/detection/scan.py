@@ -42,22 +42,24 @@ def check_memory(nbytes: float, what: str, advice: str) -> None:
     """LadarError up front when ``nbytes`` would exceed ``memory_limit()``."""
     limit = memory_limit()
     if nbytes > limit:
-        raise LadarError(f"the Geiger-mode model would need about {nbytes / 2**30:.1f} GiB for "
-                         f"{what}, more than the {limit / 2**30:.1f} GiB it may use here: {advice}")
+        raise LadarError(
+            f"the Geiger-mode model would need about {nbytes / 2**30:.1f} GiB for "
+            f"{what}, more than the {limit / 2**30:.1f} GiB it may use here: {advice}"
+        )
 
 
 @dataclass(frozen=True)
 class LookInputs:
     """A scan's rays and hits with the model's per-ray inputs."""
 
-    detector: np.ndarray     # (N,) detector id
-    kind: np.ndarray         # (N,) trace kind (0 miss, 1 voxel, 2 ground)
-    range: np.ndarray        # (N,) metres
-    index: np.ndarray        # (N, 3) voxel hit
+    detector: np.ndarray  # (N,) detector id
+    kind: np.ndarray  # (N,) trace kind (0 miss, 1 voxel, 2 ground)
+    range: np.ndarray  # (N,) metres
+    index: np.ndarray  # (N, 3) voxel hit
     reflectance: np.ndarray  # (N,)
     cos_incidence: np.ndarray
-    is_target: np.ndarray    # (N,) bool: the hit is a target-model voxel
-    kept: np.ndarray         # (N,) bool: the hit survives the depth rule
+    is_target: np.ndarray  # (N,) bool: the hit is a target-model voxel
+    kept: np.ndarray  # (N,) bool: the hit survives the depth rule
 
 
 @dataclass(frozen=True)
@@ -65,31 +67,36 @@ class LookOutcome:
     """What one scan declared."""
 
     declared_voxels: np.ndarray  # (K, 3) voxels of kept returns in declared bins
-    declared_points: int         # declared bins (returns and noise)
-    false_alarms: int            # declared bins without a return
-    noise_bins: int              # bins without a return
-    target_ideal: int            # distinct target voxels the ideal model returns
-    target_declared: int         # of those, declared
+    declared_points: int  # declared bins (returns and noise)
+    false_alarms: int  # declared bins without a return
+    noise_bins: int  # bins without a return
+    target_ideal: int  # distinct target voxels the ideal model returns
+    target_declared: int  # of those, declared
 
 
-def prepare_look(origins, directions, detector, hits, kept_rays, target_keys, settings,
-                 voxel_size) -> LookInputs:
+def prepare_look(
+    origins, directions, detector, hits, kept_rays, target_keys, settings, voxel_size
+) -> LookInputs:
     """The model's inputs for one scan; ``kept_rays`` indexes the rays the depth rule keeps."""
     kind = np.asarray(hits.kind)
     index = np.asarray(hits.index)
     is_target = (kind == VOXEL) & np.isin(voxel_keys(np.maximum(index, 0)), target_keys)
-    reflectance = np.where(kind == GROUND, settings.reflectance_ground,
-                           np.where(is_target, settings.reflectance_target,
-                                    settings.reflectance_foliage))
+    reflectance = np.where(
+        kind == GROUND,
+        settings.reflectance_ground,
+        np.where(is_target, settings.reflectance_target, settings.reflectance_foliage),
+    )
     cos = incidence_cosines(origins, directions, kind, index, hits.range, voxel_size)
     kept = np.zeros(kind.shape[0], dtype=bool)
     kept[kept_rays] = True
-    return LookInputs(np.asarray(detector), kind, np.asarray(hits.range), index, reflectance,
-                      cos, is_target, kept)
+    return LookInputs(
+        np.asarray(detector), kind, np.asarray(hits.range), index, reflectance, cos, is_target, kept
+    )
 
 
-def declare_look(look: LookInputs, settings, sensor, pulses: int, threshold: int,
-                 scan_key: int) -> LookOutcome:
+def declare_look(
+    look: LookInputs, settings, sensor, pulses: int, threshold: int, scan_key: int
+) -> LookOutcome:
     """Fire ``pulses`` pulses at one scan (random stream keyed by ``scan_key``)."""
     bin_width = settings.bin_width(sensor.depth_resolution)
     hit = look.kind != 0
@@ -97,21 +104,40 @@ def declare_look(look: LookInputs, settings, sensor, pulses: int, threshold: int
         span = float(look.range[hit].max() - look.range[hit].min())
         bins = span / bin_width + 2
         detectors = np.unique(look.detector[hit]).size
-        check_memory(detectors * bins * BYTES_PER_BIN,
-                     f"{detectors:,} detectors x {bins:,.0f} range bins in one look",
-                     "use a wider detection.bin_width_m or a smaller sensor grid")
+        check_memory(
+            detectors * bins * BYTES_PER_BIN,
+            f"{detectors:,} detectors x {bins:,.0f} range bins in one look",
+            "use a wider detection.bin_width_m or a smaller sensor grid",
+        )
     result = geiger_look(
-        look.detector, look.kind, look.range, look.reflectance, look.cos_incidence,
-        rays_per_detector=sensor.ray_grid ** 2, n_ref=settings.n_ref,
-        range_ref=settings.range_ref_m, reflectance_ref=settings.reflectance_ref,
-        noise=noise_per_bin(settings.noise_rate_hz, bin_width), bin_width=bin_width,
-        pulses=pulses, threshold=threshold, dead_bins=settings.dead_bins(bin_width),
-        seed=settings.seed, scan=scan_key)
+        look.detector,
+        look.kind,
+        look.range,
+        look.reflectance,
+        look.cos_incidence,
+        rays_per_detector=sensor.ray_grid**2,
+        n_ref=settings.n_ref,
+        range_ref=settings.range_ref_m,
+        reflectance_ref=settings.reflectance_ref,
+        noise=noise_per_bin(settings.noise_rate_hz, bin_width),
+        bin_width=bin_width,
+        pulses=pulses,
+        threshold=threshold,
+        dead_bins=settings.dead_bins(bin_width),
+        seed=settings.seed,
+        scan=scan_key,
+    )
     declared_rays = result.ray_declared & look.kept
     ideal_target = np.unique(voxel_keys(look.index[look.kept & look.is_target]))
     declared_target = np.unique(voxel_keys(look.index[declared_rays & look.is_target]))
-    return LookOutcome(look.index[declared_rays], int(result.declared.sum()), result.false_alarms,
-                       result.noise_bins, int(ideal_target.size), int(declared_target.size))
+    return LookOutcome(
+        look.index[declared_rays],
+        int(result.declared.sum()),
+        result.false_alarms,
+        result.noise_bins,
+        int(ideal_target.size),
+        int(declared_target.size),
+    )
 
 
 class GeigerRun:
@@ -127,9 +153,11 @@ class GeigerRun:
     def __init__(self, settings, sensor, scene):
         from ladartui.detection.measures import DetectionTally
 
-        check_memory(2 * sensor.rays_per_scan * BYTES_PER_HELD_RAY,
-                     f"one scan's {sensor.rays_per_scan:,} rays in two runs",
-                     "use a smaller sensor grid or fewer rays per detector")
+        check_memory(
+            2 * sensor.rays_per_scan * BYTES_PER_HELD_RAY,
+            f"one scan's {sensor.rays_per_scan:,} rays in two runs",
+            "use a smaller sensor grid or fewer rays per detector",
+        )
         self.settings = settings
         self.sensor = sensor
         self.voxel_size = scene.voxel_size
@@ -140,8 +168,17 @@ class GeigerRun:
         self.chunks = {"scene": [], "target": []}
 
     def add_chunk(self, run, origins, directions, detector, hits, kept_rays) -> None:
-        self.chunks[run].append((origins, directions, detector, np.asarray(hits.kind),
-                                 np.asarray(hits.range), np.asarray(hits.index), kept_rays))
+        self.chunks[run].append(
+            (
+                origins,
+                directions,
+                detector,
+                np.asarray(hits.kind),
+                np.asarray(hits.range),
+                np.asarray(hits.index),
+                kept_rays,
+            )
+        )
 
     def finish_scan(self, run: str, scan: int) -> np.ndarray:
         """The declared voxels of ``run``'s scan ``scan`` (1-based), unique (K, 3)."""
@@ -155,11 +192,13 @@ class GeigerRun:
         hits = SimpleNamespace(kind=join(3), range=join(4), index=join(5))
         kept = np.concatenate([c[6] + o for c, o in zip(chunks, offsets)])
         self.ideal[run].append(unique_voxels(hits.index[kept]))
-        look = prepare_look(join(0), join(1), join(2), hits, kept, self.target_keys,
-                            self.settings, self.voxel_size)
+        look = prepare_look(
+            join(0), join(1), join(2), hits, kept, self.target_keys, self.settings, self.voxel_size
+        )
         key = scan - 1 + (self.TARGET_RUN_KEY if run == "target" else 0)
-        outcome = declare_look(look, self.settings, self.sensor, self.settings.pulses,
-                               self.settings.coincidence, scan_key=key)
+        outcome = declare_look(
+            look, self.settings, self.sensor, self.settings.pulses, self.settings.coincidence, scan_key=key
+        )
         if run == "scene":
             self.tally.add(outcome)
         return unique_voxels(outcome.declared_voxels)
@@ -167,6 +206,8 @@ class GeigerRun:
     def measures(self):
         from ladartui.detection.measures import coverage
 
-        ideal = {run: coverage(self.target_model, np.concatenate(v) if v else np.zeros((0, 3)))
-                 for run, v in self.ideal.items()}
+        ideal = {
+            run: coverage(self.target_model, np.concatenate(v) if v else np.zeros((0, 3)))
+            for run, v in self.ideal.items()
+        }
         return self.tally.measures(self.settings, ideal["scene"], ideal["target"])

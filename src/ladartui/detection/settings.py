@@ -61,26 +61,37 @@ class DetectionSettings:
     def __post_init__(self):
         set_ = object.__setattr__
         set_(self, "model", choice_field("detection.model", self.model, MODELS))
-        set_(self, "n_ref", number_field("detection.n_ref", self.n_ref, 0.0, MAX_PHOTOELECTRONS,
-                                         low_open=True))
-        set_(self, "range_ref_m", number_field("detection.range_ref_m", self.range_ref_m, 0.0,
-                                               MAX_RANGE_M, low_open=True))
-        set_(self, "reflectance_ref", number_field("detection.reflectance_ref",
-                                                   self.reflectance_ref, 0.0, 1.0, low_open=True))
+        set_(
+            self, "n_ref", number_field("detection.n_ref", self.n_ref, 0.0, MAX_PHOTOELECTRONS, low_open=True)
+        )
+        set_(
+            self,
+            "range_ref_m",
+            number_field("detection.range_ref_m", self.range_ref_m, 0.0, MAX_RANGE_M, low_open=True),
+        )
+        set_(
+            self,
+            "reflectance_ref",
+            number_field("detection.reflectance_ref", self.reflectance_ref, 0.0, 1.0, low_open=True),
+        )
         for name in ("reflectance_foliage", "reflectance_ground", "reflectance_target"):
             set_(self, name, number_field(f"detection.{name}", getattr(self, name), 0.0, 1.0))
         for name in ("dark_rate_hz", "solar_rate_hz"):
-            set_(self, name, number_field(f"detection.{name}", getattr(self, name), 0.0,
-                                          MAX_RATE_HZ))
+            set_(self, name, number_field(f"detection.{name}", getattr(self, name), 0.0, MAX_RATE_HZ))
         if self.bin_width_m is not None:
-            set_(self, "bin_width_m", number_field("detection.bin_width_m", self.bin_width_m,
-                                                   0.0, 1000.0, low_open=True))
+            set_(
+                self,
+                "bin_width_m",
+                number_field("detection.bin_width_m", self.bin_width_m, 0.0, 1000.0, low_open=True),
+            )
         if self.dead_time_m is not None:
-            set_(self, "dead_time_m", number_field("detection.dead_time_m", self.dead_time_m,
-                                                   0.0, MAX_RANGE_M, low_open=True))
+            set_(
+                self,
+                "dead_time_m",
+                number_field("detection.dead_time_m", self.dead_time_m, 0.0, MAX_RANGE_M, low_open=True),
+            )
         set_(self, "pulses", integer_field("detection.pulses", self.pulses, 1, MAX_PULSES))
-        set_(self, "coincidence", integer_field("detection.coincidence", self.coincidence, 1,
-                                                self.pulses))
+        set_(self, "coincidence", integer_field("detection.coincidence", self.coincidence, 1, self.pulses))
         set_(self, "seed", integer_field("detection.seed", self.seed, 0, MAX_SEED))
 
     @property
@@ -95,8 +106,11 @@ class DetectionSettings:
         """Range bin width in metres: the set one, else the sensor's depth resolution."""
         width = depth_resolution if self.bin_width_m is None else self.bin_width_m
         if not width > 0:
-            raise FieldError("detection.bin_width_m", self.bin_width_m,
-                             "a number > 0 (needed when sensor.depth_resolution_m is 0)")
+            raise FieldError(
+                "detection.bin_width_m",
+                self.bin_width_m,
+                "a number > 0 (needed when sensor.depth_resolution_m is 0)",
+            )
         return width
 
     def dead_bins(self, bin_width: float) -> int:
@@ -117,8 +131,7 @@ class DetectionSettings:
 
     def to_dict(self) -> dict:
         """The TOML section (keys left unset, None, are not written)."""
-        return {f.name: getattr(self, f.name) for f in fields(self)
-                if getattr(self, f.name) is not None}
+        return {f.name: getattr(self, f.name) for f in fields(self) if getattr(self, f.name) is not None}
 
     def describe(self) -> str:
         """One line for scenario summaries."""
@@ -126,9 +139,11 @@ class DetectionSettings:
             return "ideal (every return that survives the depth rule)"
         dead = "one fire per pulse" if self.dead_time_m is None else f"dead time {self.dead_time_m:g} m"
         width = "depth resolution" if self.bin_width_m is None else f"{self.bin_width_m:g} m"
-        return (f"geiger, {self.pulses} pulses, k = {self.coincidence}, N_ref {self.n_ref:g} "
-                f"at {self.range_ref_m:g} m, noise {self.noise_rate_hz:g} Hz, bins {width}, "
-                f"{dead}, seed {self.seed}")
+        return (
+            f"geiger, {self.pulses} pulses, k = {self.coincidence}, N_ref {self.n_ref:g} "
+            f"at {self.range_ref_m:g} m, noise {self.noise_rate_hz:g} Hz, bins {width}, "
+            f"{dead}, seed {self.seed}"
+        )
 
 
 DETECTION_KEYS = tuple(f.name for f in fields(DetectionSettings))

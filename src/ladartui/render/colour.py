@@ -21,23 +21,32 @@ PATH_RGB = (255, 215, 0)
 SCAN_RGB = (255, 60, 60)
 START_RGB = (255, 255, 255)
 FOOTPRINT_RGB = (255, 150, 50)  # outside the height colours, and not the target
-TARGET_RGB = (255, 0, 255)      # the target, in every view
-HIDDEN_RGB = (0, 235, 255)      # target voxels seen only without foliage: what it hid
-SCENE_GREY = (110, 215)         # grey range of scene voxels beside a coloured target
+TARGET_RGB = (255, 0, 255)  # the target, in every view
+HIDDEN_RGB = (0, 235, 255)  # target voxels seen only without foliage: what it hid
+SCENE_GREY = (110, 215)  # grey range of scene voxels beside a coloured target
 
 
 def _oklab_to_srgb(lab: np.ndarray) -> np.ndarray:
     """OKLab (..., 3) to sRGB 0..1 (unclipped), Ottosson's published matrices."""
-    m1 = np.array([[1.0, 0.3963377774, 0.2158037573],
-                   [1.0, -0.1055613458, -0.0638541728],
-                   [1.0, -0.0894841775, -1.2914855480]])
-    m2 = np.array([[4.0767416621, -3.3077115913, 0.2309699292],
-                   [-1.2684380046, 2.6097574011, -0.3413193965],
-                   [-0.0041960863, -0.7034186147, 1.7076147010]])
+    m1 = np.array(
+        [
+            [1.0, 0.3963377774, 0.2158037573],
+            [1.0, -0.1055613458, -0.0638541728],
+            [1.0, -0.0894841775, -1.2914855480],
+        ]
+    )
+    m2 = np.array(
+        [
+            [4.0767416621, -3.3077115913, 0.2309699292],
+            [-1.2684380046, 2.6097574011, -0.3413193965],
+            [-0.0041960863, -0.7034186147, 1.7076147010],
+        ]
+    )
     lms = (lab @ m1.T) ** 3
     linear = lms @ m2.T
-    return np.where(linear <= 0.0031308, 12.92 * linear,
-                    1.055 * np.abs(linear) ** (1 / 2.4) * np.sign(linear) - 0.055)
+    return np.where(
+        linear <= 0.0031308, 12.92 * linear, 1.055 * np.abs(linear) ** (1 / 2.4) * np.sign(linear) - 0.055
+    )
 
 
 @functools.cache
@@ -54,8 +63,7 @@ def height_map(levels: int = RAMP_LEVELS) -> np.ndarray:
     out = np.zeros((levels, 3))
     for n in range(levels):
         for chroma in np.linspace(0.15, 0.0, 31):
-            rgb = _oklab_to_srgb(np.array([lightness[n], chroma * np.cos(hue[n]),
-                                           chroma * np.sin(hue[n])]))
+            rgb = _oklab_to_srgb(np.array([lightness[n], chroma * np.cos(hue[n]), chroma * np.sin(hue[n])]))
             if np.all(rgb >= -1e-6) and np.all(rgb <= 1 + 1e-6):
                 break
         out[n] = rgb

@@ -12,7 +12,7 @@ import numpy as np
 
 from ladartui.views import MAX_ZOOM, MIN_ZOOM, Camera, view_axes
 
-MARGIN = 0.05   # of the image on each side
+MARGIN = 0.05  # of the image on each side
 
 
 def box_of(voxels) -> tuple[np.ndarray, np.ndarray] | None:
@@ -24,8 +24,7 @@ def box_of(voxels) -> tuple[np.ndarray, np.ndarray] | None:
     return pts.min(axis=0), pts.max(axis=0)
 
 
-def fit_camera(camera: Camera, box, rows: int, cols: int, bounds,
-               margin: float = MARGIN) -> Camera:
+def fit_camera(camera: Camera, box, rows: int, cols: int, bounds, margin: float = MARGIN) -> Camera:
     """``camera``'s angles with the zoom and pan that frame ``box`` in a rows x cols image.
 
     The box's projected corners fill the image less ``margin`` of it on each
@@ -44,8 +43,7 @@ def fit_camera(camera: Camera, box, rows: int, cols: int, bounds,
     usable = 1.0 - 2.0 * margin
     scale = min(cols * usable / width, rows * usable / height)  # pixels per voxel unit
     zoom = float(np.clip(scale * 2.0 * radius / max(min(cols, rows), 1), MIN_ZOOM, MAX_ZOOM))
-    return Camera(camera.azimuth, camera.elevation, zoom, 0.0, 0.0,
-                  tuple(float(v) for v in centre))
+    return Camera(camera.azimuth, camera.elevation, zoom, 0.0, 0.0, tuple(float(v) for v in centre))
 
 
 def fit_window(box, margin: float = MARGIN) -> tuple[float, float, float, float]:
@@ -57,8 +55,9 @@ def fit_window(box, margin: float = MARGIN) -> tuple[float, float, float, float]
     return (float(x0 - pad), float(y0 - pad), float(x1 + pad), float(y1 + pad))
 
 
-def zoom_window(frame, factor: float, about=None, min_size: float = 2.0,
-                max_size: float = 1e7) -> tuple[float, float, float, float]:
+def zoom_window(
+    frame, factor: float, about=None, min_size: float = 2.0, max_size: float = 1e7
+) -> tuple[float, float, float, float]:
     """``frame`` zoomed in by ``factor`` (> 1 shows less) about a point (cell units;
     default its centre), which stays where it was in the window."""
     x0, y0, x1, y1 = frame
@@ -66,8 +65,12 @@ def zoom_window(frame, factor: float, about=None, min_size: float = 2.0,
     width = float(np.clip((x1 - x0) / factor, min_size, max_size))
     height = float(np.clip((y1 - y0) / factor, min_size, max_size))
     sx, sy = width / (x1 - x0), height / (y1 - y0)
-    return (float(cx - (cx - x0) * sx), float(cy - (cy - y0) * sy),
-            float(cx + (x1 - cx) * sx), float(cy + (y1 - cy) * sy))
+    return (
+        float(cx - (cx - x0) * sx),
+        float(cy - (cy - y0) * sy),
+        float(cx + (x1 - cx) * sx),
+        float(cy + (y1 - cy) * sy),
+    )
 
 
 def pan_window(frame, dx: float, dy: float) -> tuple[float, float, float, float]:

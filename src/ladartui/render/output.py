@@ -66,8 +66,16 @@ def scan_counts(voxels, per_scan) -> np.ndarray:
     return counts
 
 
-def output_layers(scene_output, target_model, target_output=None, *, mode: str = "class",
-                  voxel_size: float = 1.0, threshold_m: float | None = None, per_scan=None):
+def output_layers(
+    scene_output,
+    target_model,
+    target_output=None,
+    *,
+    mode: str = "class",
+    voxel_size: float = 1.0,
+    threshold_m: float | None = None,
+    per_scan=None,
+):
     """(layers, height_range) for ``raster.render``: the output after the threshold.
 
     ``mode`` "class" draws scene voxels in greys by height and the target
@@ -80,15 +88,21 @@ def output_layers(scene_output, target_model, target_output=None, *, mode: str =
     """
     if mode not in COLOUR_MODES:
         raise ValueError(f"unknown colour mode {mode!r}; expected one of {COLOUR_MODES}")
-    scene, seen, hidden = (below(v, voxel_size, threshold_m)
-                           for v in classify(scene_output, target_model, target_output))
+    scene, seen, hidden = (
+        below(v, voxel_size, threshold_m) for v in classify(scene_output, target_model, target_output)
+    )
     if mode == "class":
-        layers = [Layer(scene, colour_map="scene-grey"), Layer(hidden, colour.HIDDEN_RGB),
-                  Layer(seen, colour.TARGET_RGB)]
+        layers = [
+            Layer(scene, colour_map="scene-grey"),
+            Layer(hidden, colour.HIDDEN_RGB),
+            Layer(seen, colour.TARGET_RGB),
+        ]
     elif mode == "scans":
         scans = max(len(per_scan or ()), 1)
-        layers = [Layer(scene, colour_map="scene-grey"),
-                  Layer(seen, values=scan_counts(seen, per_scan), value_range=(1, scans + 1))]
+        layers = [
+            Layer(scene, colour_map="scene-grey"),
+            Layer(seen, values=scan_counts(seen, per_scan), value_range=(1, scans + 1)),
+        ]
     else:
         layers = [Layer(scene), Layer(seen, colour.TARGET_RGB)]
     shown = [layer.voxels for layer in layers if len(layer.voxels)]

@@ -70,8 +70,17 @@ def splat_side(scale: float, count: int) -> int:
     return side
 
 
-def render(layers, camera: Camera, rows: int, cols: int, bounds, *, height_range=None,
-           colour_map: str = "height", overlays: Overlays | None = None) -> Rendering:
+def render(
+    layers,
+    camera: Camera,
+    rows: int,
+    cols: int,
+    bounds,
+    *,
+    height_range=None,
+    colour_map: str = "height",
+    overlays: Overlays | None = None,
+) -> Rendering:
     """Render voxel layers (later layers win ties) and overlays into an image.
 
     Heights shade over ``height_range`` (voxel layers, default the bounds' z
@@ -120,8 +129,7 @@ def _splat(image: Rendering, parts, camera, bounds) -> None:
     near = (row > -reach) & (row < rows + reach) & (col > -reach) & (col < cols + reach)
     if not near.any():
         return
-    row, col, depth, colours, priority = (row[near], col[near], depth[near], colours[near],
-                                          priority[near])
+    row, col, depth, colours, priority = (row[near], col[near], depth[near], colours[near], priority[near])
     side = splat_side(scale, len(row))
     # the square's top-left pixel: centred on the voxel's projected centre
     r0 = np.floor(row - side / 2.0 + 0.5).astype(np.int64)

@@ -17,4 +17,4 @@ _EXPORTS = {
 __all__ = sorted(_EXPORTS)
 
 
-__getattr__ = lazy_getattr('ladartui.scene', _EXPORTS, globals())
+__getattr__ = lazy_getattr("ladartui.scene", _EXPORTS, globals())

@@ -64,9 +64,17 @@ PRESETS = {
     "small": SceneParams(),
     # The report's figure-11 scale: 1500 x 1500 x 900 voxels, about 3.8 M voxels.
     "reference": SceneParams(
-        voxel_size=0.1, width=150.0, depth=150.0, height=90.0, trees=186,
-        tree_height=(14.0, 26.0), crown_radius=(2.5, 5.0), trunk_radius=(0.15, 0.35),
-        density=0.55, clump_radius=(0.2, 0.4), branches=8,
+        voxel_size=0.1,
+        width=150.0,
+        depth=150.0,
+        height=90.0,
+        trees=186,
+        tree_height=(14.0, 26.0),
+        crown_radius=(2.5, 5.0),
+        trunk_radius=(0.15, 0.35),
+        density=0.55,
+        clump_radius=(0.2, 0.4),
+        branches=8,
     ),
 }
 
@@ -96,8 +104,14 @@ class GeneratedScene:
         """This scene as a :class:`ladartui.scene.model.Scene`."""
         from ladartui.scene.model import Scene
 
-        return Scene(self.voxels, self.target, self.voxel_size, shape=self.shape,
-                     name=name or f"{self.preset}-{self.seed}", path=path)
+        return Scene(
+            self.voxels,
+            self.target,
+            self.voxel_size,
+            shape=self.shape,
+            name=name or f"{self.preset}-{self.seed}",
+            path=path,
+        )
 
 
 def output_paths(stem) -> tuple[Path, Path]:
@@ -162,8 +176,14 @@ def generate_scene(preset="small", seed=0, **overrides) -> GeneratedScene:
     nz = max(top, round(params.height / vs) if params.height else 0)
     centre = target.astype(np.float64).mean(axis=0) * vs if len(target) else None
     return GeneratedScene(
-        voxels=voxels, target=target, voxel_size=vs, shape=(nx, ny, nz), target_centre=centre,
-        params=params, seed=int(seed), preset=preset,
+        voxels=voxels,
+        target=target,
+        voxel_size=vs,
+        shape=(nx, ny, nz),
+        target_centre=centre,
+        params=params,
+        seed=int(seed),
+        preset=preset,
         parts={name: len(v) for name, v in parts.items()},
     )
 
@@ -173,8 +193,12 @@ def generate_scene(preset="small", seed=0, **overrides) -> GeneratedScene:
 
 def _check(p: SceneParams):
     def positive(name, value):
-        if not (isinstance(value, (int, float)) and not isinstance(value, bool) and value > 0
-                and math.isfinite(value)):
+        if not (
+            isinstance(value, (int, float))
+            and not isinstance(value, bool)
+            and value > 0
+            and math.isfinite(value)
+        ):
             raise FieldError(name, value, "a positive number")
 
     def share(name, value, top=1.0):
@@ -186,9 +210,12 @@ def _check(p: SceneParams):
             raise FieldError(name, value, "a whole number, 0 or more")
 
     def span(name, value):
-        if (not isinstance(value, (tuple, list)) or len(value) != 2
-                or not all(isinstance(v, (int, float)) and v > 0 for v in value)
-                or value[0] > value[1]):
+        if (
+            not isinstance(value, (tuple, list))
+            or len(value) != 2
+            or not all(isinstance(v, (int, float)) and v > 0 for v in value)
+            or value[0] > value[1]
+        ):
             raise FieldError(name, value, "(low, high) positive metres with low <= high")
 
     for name in ("voxel_size", "width", "depth", "terrain_relief"):
@@ -204,10 +231,17 @@ def _check(p: SceneParams):
         count(name, getattr(p, name))
     # Each tree costs tens of kilobytes while it is built; refuse before allocating.
     if p.trees > MAX_TREES:
-        raise FieldError("trees", p.trees, f"at most {MAX_TREES:,} trees ({p.trees:,} would "
-                         f"need about {p.trees * 50e3 / 2**30:.3g} GiB to build)")
-    if (not isinstance(p.vehicle_size, (tuple, list)) or len(p.vehicle_size) != 3
-            or not all(isinstance(v, (int, float)) and v > 0 for v in p.vehicle_size)):
+        raise FieldError(
+            "trees",
+            p.trees,
+            f"at most {MAX_TREES:,} trees ({p.trees:,} would "
+            f"need about {p.trees * 50e3 / 2**30:.3g} GiB to build)",
+        )
+    if (
+        not isinstance(p.vehicle_size, (tuple, list))
+        or len(p.vehicle_size) != 3
+        or not all(isinstance(v, (int, float)) and v > 0 for v in p.vehicle_size)
+    ):
         raise FieldError("vehicle_size", p.vehicle_size, "(length, width, height) positive metres")
     cells = (p.width / p.voxel_size) * (p.depth / p.voxel_size)
     if cells > 1e8:
@@ -235,14 +269,15 @@ def _terrain(p: SceneParams, nx, ny, rng) -> np.ndarray:
         surface += np.sin(kx * x[:, None] + ky * y[None, :] + phase)
     span = surface.max() - surface.min()
     surface = (surface - surface.min()) / (span if span > 0 else 1.0) * p.terrain_relief
-    return (np.floor(surface / vs).astype(np.int32) + 1)
+    return np.floor(surface / vs).astype(np.int32) + 1
 
 
 def _terrain_voxels(top: np.ndarray) -> np.ndarray:
     """A watertight skin: each column filled down to its lowest neighbour's top."""
     padded = np.pad(top, 1, mode="edge")
-    lowest = np.minimum.reduce([padded[:-2, 1:-1], padded[2:, 1:-1], padded[1:-1, :-2],
-                                padded[1:-1, 2:], top])
+    lowest = np.minimum.reduce(
+        [padded[:-2, 1:-1], padded[2:, 1:-1], padded[1:-1, :-2], padded[1:-1, 2:], top]
+    )
     bottom = np.minimum(lowest + 1, top)
     counts = (top - bottom + 1).ravel()
     xs, ys = np.meshgrid(np.arange(top.shape[0]), np.arange(top.shape[1]), indexing="ij")
@@ -318,8 +353,13 @@ def _vehicle_voxels(vehicle: _Vehicle, p: SceneParams, nx, ny) -> np.ndarray:
     hull_top = 0.6 * height
     wheel_r = 0.2 * height
     chamfer = 0.1 * length
-    hull = ((np.abs(u) <= half_l) & (np.abs(v) <= half_w) & (w >= clearance) & (w <= hull_top)
-            & (u + (w - clearance) <= half_l + (hull_top - clearance) - chamfer))
+    hull = (
+        (np.abs(u) <= half_l)
+        & (np.abs(v) <= half_w)
+        & (w >= clearance)
+        & (w <= hull_top)
+        & (u + (w - clearance) <= half_l + (hull_top - clearance) - chamfer)
+    )
     wheel_x = np.array([-0.3, 0.3]) * length
     near_side = (np.abs(v) >= half_w - 0.15 * width) & (np.abs(v) <= half_w - 0.02 * width)
     wheels = np.zeros_like(hull)
@@ -327,8 +367,13 @@ def _vehicle_voxels(vehicle: _Vehicle, p: SceneParams, nx, ny) -> np.ndarray:
         wheels |= near_side & ((u - axle) ** 2 + (w - wheel_r) ** 2 <= wheel_r**2)
     cabin_back, cabin_front = 0.02 * length, 0.34 * length
     slope = 0.4  # the windscreen leans back this far per metre of rise
-    cabin = ((u >= cabin_back) & (u <= cabin_front - slope * (w - hull_top))
-             & (np.abs(v) <= half_w - 0.08 * width) & (w > hull_top) & (w <= height))
+    cabin = (
+        (u >= cabin_back)
+        & (u <= cabin_front - slope * (w - hull_top))
+        & (np.abs(v) <= half_w - 0.08 * width)
+        & (w > hull_top)
+        & (w <= height)
+    )
     solid = grid[hull | wheels | cabin]
     return _clip(solid, nx, ny)
 
@@ -339,12 +384,13 @@ def _carve_clearance(voxels, vehicle: _Vehicle, vs, margin=0.3, headroom=0.5):
         return voxels
     length, width, height = vehicle.size
     reach = (math.hypot(length, width) / 2 + margin) / vs + 1
-    near = np.nonzero((np.abs(voxels[:, 0] - vehicle.cx) <= reach)
-                      & (np.abs(voxels[:, 1] - vehicle.cy) <= reach)
-                      & (voxels[:, 2] <= vehicle.base + (height + headroom) / vs + 1))[0]
+    near = np.nonzero(
+        (np.abs(voxels[:, 0] - vehicle.cx) <= reach)
+        & (np.abs(voxels[:, 1] - vehicle.cy) <= reach)
+        & (voxels[:, 2] <= vehicle.base + (height + headroom) / vs + 1)
+    )[0]
     u, v, w = _local_frame(vehicle, voxels[near], vs)
-    inside = ((np.abs(u) <= length / 2 + margin) & (np.abs(v) <= width / 2 + margin)
-              & (w <= height + headroom))
+    inside = (np.abs(u) <= length / 2 + margin) & (np.abs(v) <= width / 2 + margin) & (w <= height + headroom)
     keep = np.ones(len(voxels), dtype=bool)
     keep[near[inside]] = False
     return voxels[keep]
@@ -449,8 +495,16 @@ def _place_trees(p: SceneParams, nx, ny, ground, vehicles, rng) -> _Trees:
         crown_base[-n_cover:] = np.clip(crown_base[-n_cover:], low, None)
         height[-n_cover:] = np.maximum(height[-n_cover:], crown_base[-n_cover:] + 2 * reach * 0.8)
     base = ground[x.astype(np.int64), y.astype(np.int64)]
-    return _Trees(x, y, base.astype(np.float64), height, crown_base, crown_radius,
-                  np.maximum(trunk_radius, 0.5), conifer)
+    return _Trees(
+        x,
+        y,
+        base.astype(np.float64),
+        height,
+        crown_base,
+        crown_radius,
+        np.maximum(trunk_radius, 0.5),
+        conifer,
+    )
 
 
 def _trunk_voxels(trees: _Trees, vs) -> np.ndarray:
@@ -466,8 +520,7 @@ def _trunk_voxels(trees: _Trees, vs) -> np.ndarray:
         cx, cy = int(round(trees.x[i])), int(round(trees.y[i]))
         distance = np.hypot(ox + cx - trees.x[i], oy + cy - trees.y[i])
         taper = radius * (1 - 0.6 * layers / max(top, 1))
-        skin = ((distance[None, :] <= taper[:, None] + 0.5)
-                & (distance[None, :] > taper[:, None] - 1))
+        skin = (distance[None, :] <= taper[:, None] + 0.5) & (distance[None, :] > taper[:, None] - 1)
         layer, cell = np.nonzero(skin)
         z = trees.base[i] + layers[layer]
         pieces.append(np.stack([cx + ox[cell], cy + oy[cell], z], axis=1))
@@ -487,15 +540,19 @@ def _branch_voxels(trees: _Trees, p: SceneParams, rng) -> np.ndarray:
         return np.zeros((0, 3), dtype=np.int32)
     tree = np.repeat(broad, p.branches)
     centre_z, half = _crown_centre(trees)
-    start_z = (trees.base[tree] + trees.crown_base[tree]
-               + rng.uniform(0, 0.6, tree.size) * 2 * half[tree])
+    start_z = trees.base[tree] + trees.crown_base[tree] + rng.uniform(0, 0.6, tree.size) * 2 * half[tree]
     azimuth = rng.uniform(0, 2 * np.pi, tree.size)
     rise = rng.uniform(0.2, 0.9, tree.size)  # end height inside the crown, share of half-height
     reach = 0.85 * trees.crown_radius[tree] * np.sqrt(1 - np.minimum(rise, 0.95) ** 2)
     start = np.stack([trees.x[tree], trees.y[tree], start_z], axis=1)
-    end = np.stack([trees.x[tree] + reach * np.cos(azimuth),
-                    trees.y[tree] + reach * np.sin(azimuth),
-                    centre_z[tree] + rise * half[tree]], axis=1)
+    end = np.stack(
+        [
+            trees.x[tree] + reach * np.cos(azimuth),
+            trees.y[tree] + reach * np.sin(azimuth),
+            centre_z[tree] + rise * half[tree],
+        ],
+        axis=1,
+    )
     return _segments(start, end)
 
 
@@ -534,9 +591,12 @@ def _foliage_voxels(trees: _Trees, p: SceneParams, rng) -> np.ndarray:
 
     def lumps(azimuth, elevation):
         a, ph = amplitude[tree], phase[tree]
-        return (1 + a[:, 0] * np.cos(2 * azimuth + ph[:, 0])
-                + a[:, 1] * np.cos(3 * azimuth + ph[:, 1])
-                + a[:, 2] * np.cos(2 * elevation + ph[:, 2]))
+        return (
+            1
+            + a[:, 0] * np.cos(2 * azimuth + ph[:, 0])
+            + a[:, 1] * np.cos(3 * azimuth + ph[:, 1])
+            + a[:, 2] * np.cos(2 * elevation + ph[:, 2])
+        )
 
     bulge = lumps(np.arctan2(direction[:, 1], direction[:, 0]), np.arcsin(direction[:, 2]))
     ex = direction[:, 0] * radius[tree] * depth * bulge
@@ -593,8 +653,13 @@ def _concat(pieces) -> np.ndarray:
 
 def _clip(voxels, nx, ny) -> np.ndarray:
     voxels = np.asarray(voxels, dtype=np.int32).reshape(-1, 3)
-    inside = ((voxels[:, 0] >= 0) & (voxels[:, 0] < nx) & (voxels[:, 1] >= 0)
-              & (voxels[:, 1] < ny) & (voxels[:, 2] >= 0))
+    inside = (
+        (voxels[:, 0] >= 0)
+        & (voxels[:, 0] < nx)
+        & (voxels[:, 1] >= 0)
+        & (voxels[:, 1] < ny)
+        & (voxels[:, 2] >= 0)
+    )
     return voxels[inside]
 
 

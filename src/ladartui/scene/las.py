@@ -26,30 +26,36 @@ def _check_header(path, header):
     scales = np.asarray(header.scales, dtype=np.float64)
     offsets = np.asarray(header.offsets, dtype=np.float64)
     if not np.all(np.isfinite(scales)) or np.any(scales == 0):
-        raise InputFileError(path, f"header scale factors {_triple(scales)}: expected finite "
-                             "non-zero numbers (such as 0.001)")
+        raise InputFileError(
+            path, f"header scale factors {_triple(scales)}: expected finite non-zero numbers (such as 0.001)"
+        )
     if not np.all(np.isfinite(offsets)):
         raise InputFileError(path, f"header offsets {_triple(offsets)}: expected finite numbers")
     # Beyond this, adding the offset rounds away the scaled coordinate: points merge.
     lossy = np.spacing(np.abs(offsets)) * 2 > scales
     if np.any(lossy):
-        raise InputFileError(path, f"header offsets {_triple(offsets)} are too large for the "
-                             f"scale factors {_triple(scales)}: points would merge; expected "
-                             "offsets near the data")
+        raise InputFileError(
+            path,
+            f"header offsets {_triple(offsets)} are too large for the "
+            f"scale factors {_triple(scales)}: points would merge; expected "
+            "offsets near the data",
+        )
 
 
 def _check_no_collapse(path, cloud, points):
     """Distinct stored points must stay distinct once scaled and offset."""
     if not np.all(np.isfinite(points)):
-        raise InputFileError(path, "coordinates overflow once scaled and offset; expected "
-                             "finite coordinates")
+        raise InputFileError(path, "coordinates overflow once scaled and offset; expected finite coordinates")
     raw = np.stack([np.asarray(cloud.X), np.asarray(cloud.Y), np.asarray(cloud.Z)], axis=1)
     stored = len(np.unique(raw, axis=0))
     kept = len(np.unique(points, axis=0))
     if kept < stored:
-        raise InputFileError(path, f"{stored:,} distinct stored points collapse to {kept:,} "
-                             "once scaled and offset; expected scale factors and offsets that "
-                             "keep them apart")
+        raise InputFileError(
+            path,
+            f"{stored:,} distinct stored points collapse to {kept:,} "
+            "once scaled and offset; expected scale factors and offsets that "
+            "keep them apart",
+        )
 
 
 def _triple(values) -> str:
@@ -81,12 +87,14 @@ def import_las(path, voxel_size, origin=None) -> tuple[np.ndarray, np.ndarray]:
         raise FieldError("origin", tuple(origin.tolist()), "three finite coordinates in metres")
     indices = np.floor((points - origin) / size + 0.5)
     if indices.min() < 0:
-        raise FieldError("origin", tuple(origin.tolist()),
-                         f"at most half a voxel above the lowest point {tuple(lowest.tolist())}",
-                         source=str(path))
+        raise FieldError(
+            "origin",
+            tuple(origin.tolist()),
+            f"at most half a voxel above the lowest point {tuple(lowest.tolist())}",
+            source=str(path),
+        )
     if indices.max() > MAX_INDEX:
-        raise FieldError("voxel_size", voxel_size, "large enough for the cloud's extent",
-                         source=str(path))
+        raise FieldError("voxel_size", voxel_size, "large enough for the cloud's extent", source=str(path))
     voxels, _ = unique_voxels(indices.astype(np.int32))
     return voxels, origin
 

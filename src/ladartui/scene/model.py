@@ -63,7 +63,7 @@ class Scene:
         self._init_locks()
 
     @classmethod
-    def load(cls, scene_path, voxel_size, shape=None) -> "Scene":
+    def load(cls, scene_path, voxel_size, shape=None) -> Scene:
         """Read ``X.txt`` and its target ``X_Target.txt``."""
         _checked_voxel_size(voxel_size)  # before reading what may be large files
         scene_path = Path(scene_path)
@@ -87,8 +87,7 @@ class Scene:
         """The sparse occupancy of the scene voxels (built once, on first use)."""
         with self._lock:
             if self._occupancy is None:
-                self._occupancy = _build_occupancy(self.voxels, self.shape,
-                                                   self.path or self.name)
+                self._occupancy = _build_occupancy(self.voxels, self.shape, self.path or self.name)
             return self._occupancy
 
     @property
@@ -96,8 +95,9 @@ class Scene:
         """The sparse occupancy of the target voxels alone, over the scene's shape."""
         with self._target_lock:
             if self._target_occupancy is None:
-                self._target_occupancy = _build_occupancy(self.target, self.shape,
-                                                          self.target_path or self.name)
+                self._target_occupancy = _build_occupancy(
+                    self.target, self.shape, self.target_path or self.name
+                )
             return self._target_occupancy
 
     def target_centre_m(self) -> np.ndarray:
@@ -112,8 +112,10 @@ class Scene:
         return top_height_map(self.target if target else self.voxels, self.shape[0], self.shape[1])
 
     def __repr__(self):
-        return (f"Scene({self.name!r}, voxels={len(self.voxels)}, target={len(self.target)}, "
-                f"voxel_size={self.voxel_size}, shape={self.shape})")
+        return (
+            f"Scene({self.name!r}, voxels={len(self.voxels)}, target={len(self.target)}, "
+            f"voxel_size={self.voxel_size}, shape={self.shape})"
+        )
 
 
 def top_height_map(voxels, nx, ny) -> np.ndarray:

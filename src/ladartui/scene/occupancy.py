@@ -70,7 +70,7 @@ class Occupancy:
     halo4_dims: np.ndarray = None
 
     @classmethod
-    def build(cls, voxels, shape=None, source="voxels") -> "Occupancy":
+    def build(cls, voxels, shape=None, source="voxels") -> Occupancy:
         """Build from an (N, 3) integer voxel list (duplicates allowed) and the scene shape.
 
         ``shape`` is (nx, ny, nz); by default ``voxels.max(axis=0) + 1``. Voxels
@@ -94,8 +94,11 @@ class Occupancy:
             lo = vox.min(axis=0)
             hi = vox.max(axis=0) + 1
             if lo.min() < 0 or np.any(hi > np.array(shape)):
-                raise FieldError("voxels", f"indices spanning {lo.tolist()}..{(hi - 1).tolist()}",
-                                 f"indices inside the scene shape {list(shape)}")
+                raise FieldError(
+                    "voxels",
+                    f"indices spanning {lo.tolist()}..{(hi - 1).tolist()}",
+                    f"indices inside the scene shape {list(shape)}",
+                )
         else:
             return cls._empty(shape)
         from ladartui.resources import check_occupancy
@@ -108,10 +111,29 @@ class Occupancy:
     def _empty(cls, shape):
         zero = np.zeros(3, np.int64)
         empty = np.zeros(0, np.uint32)
-        return cls(shape, zero.copy(), zero.copy(), zero.copy(), zero.copy(),
-                   empty, empty.copy(), empty.copy(), empty.copy(), 0, empty.copy(),
-                   np.zeros(0, np.uint64), np.zeros(0, np.uint8), zero.copy(), zero.copy(),
-                   empty.copy(), zero.copy(), zero.copy(), empty.copy(), zero.copy(), zero.copy())
+        return cls(
+            shape,
+            zero.copy(),
+            zero.copy(),
+            zero.copy(),
+            zero.copy(),
+            empty,
+            empty.copy(),
+            empty.copy(),
+            empty.copy(),
+            0,
+            empty.copy(),
+            np.zeros(0, np.uint64),
+            np.zeros(0, np.uint8),
+            zero.copy(),
+            zero.copy(),
+            empty.copy(),
+            zero.copy(),
+            zero.copy(),
+            empty.copy(),
+            zero.copy(),
+            zero.copy(),
+        )
 
     @classmethod
     def _from_nonempty(cls, vox, lo, hi, shape):
@@ -151,20 +173,42 @@ class Occupancy:
         halo4_origin = (lo >> 2) - 1
         halo4_dims = ((hi - 1) >> 2) - (lo >> 2) + 3
         halo4 = _halo_bits((vox >> 2) - halo4_origin, halo4_dims)
-        return cls(shape, lo.astype(np.int64), hi.astype(np.int64), root_origin.astype(np.int64),
-                   root_dims.astype(np.int64), root, regions, tiles, bricks, count, columns,
-                   block_masks(bricks), cubes, cube_origin.astype(np.int64),
-                   cube_dims.astype(np.int64), halo, halo_origin.astype(np.int64),
-                   halo_dims.astype(np.int64), halo4, halo4_origin.astype(np.int64),
-                   halo4_dims.astype(np.int64))
+        return cls(
+            shape,
+            lo.astype(np.int64),
+            hi.astype(np.int64),
+            root_origin.astype(np.int64),
+            root_dims.astype(np.int64),
+            root,
+            regions,
+            tiles,
+            bricks,
+            count,
+            columns,
+            block_masks(bricks),
+            cubes,
+            cube_origin.astype(np.int64),
+            cube_dims.astype(np.int64),
+            halo,
+            halo_origin.astype(np.int64),
+            halo_dims.astype(np.int64),
+            halo4,
+            halo4_origin.astype(np.int64),
+            halo4_dims.astype(np.int64),
+        )
 
     @property
     def nbytes(self) -> int:
         """Bytes held by the hierarchy arrays."""
-        extra = sum(a.nbytes for a in (self.blocks, self.cubes, self.halo, self.halo4)
-                    if a is not None)
-        return int(self.root.nbytes + self.regions.nbytes + self.tiles.nbytes + self.bricks.nbytes
-                   + self.columns.nbytes + extra)
+        extra = sum(a.nbytes for a in (self.blocks, self.cubes, self.halo, self.halo4) if a is not None)
+        return int(
+            self.root.nbytes
+            + self.regions.nbytes
+            + self.tiles.nbytes
+            + self.bricks.nbytes
+            + self.columns.nbytes
+            + extra
+        )
 
     @property
     def zmax(self) -> int:
@@ -210,10 +254,17 @@ class Occupancy:
 
     def summary(self) -> dict:
         """Node counts and bytes, for reports."""
-        return {"count": self.count, "shape": list(self.shape), "bbox_lo": self.bbox_lo.tolist(),
-                "bbox_hi": self.bbox_hi.tolist(), "root_cells": len(self.root),
-                "regions": self.n_regions, "tiles": self.n_tiles, "bricks": self.n_bricks,
-                "nbytes": self.nbytes}
+        return {
+            "count": self.count,
+            "shape": list(self.shape),
+            "bbox_lo": self.bbox_lo.tolist(),
+            "bbox_hi": self.bbox_hi.tolist(),
+            "root_cells": len(self.root),
+            "regions": self.n_regions,
+            "tiles": self.n_tiles,
+            "bricks": self.n_bricks,
+            "nbytes": self.nbytes,
+        }
 
 
 @njit(nogil=True, cache=True)
@@ -315,7 +366,7 @@ def _halo_bits(cells, dims):
         near = grown
     packed = np.packbits(near.reshape(-1), bitorder="little")
     words = np.zeros(-(-len(packed) // 4) * 4, np.uint8)
-    words[:len(packed)] = packed
+    words[: len(packed)] = packed
     return words.view("<u4").astype(np.uint32)
 
 
@@ -368,6 +419,5 @@ def _parents(child_keys, n_children):
     parent_of_child = np.cumsum(start) - 1
     n_parents = int(parent_of_child[-1]) + 1
     slots = np.zeros(n_parents * NODE_SLOTS, np.uint32)
-    slots[parent_of_child * NODE_SLOTS + (child_keys & 511)] = np.arange(
-        1, n_children + 1, dtype=np.uint32)
+    slots[parent_of_child * NODE_SLOTS + (child_keys & 511)] = np.arange(1, n_children + 1, dtype=np.uint32)
     return slots, parent_key[start]

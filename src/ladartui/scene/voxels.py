@@ -218,7 +218,7 @@ def _parse_checked(path: Path, buf: np.ndarray, start: int) -> np.ndarray:
 _PLAIN_BYTES = 4_000_000
 # byte -> 0 digit, 1 comma, 2 newline, 3 anything else
 _BYTE_CLASS = np.full(256, 3, dtype=np.uint8)
-_BYTE_CLASS[_ZERO:_NINE + 1] = 0
+_BYTE_CLASS[_ZERO : _NINE + 1] = 0
 _BYTE_CLASS[_COMMA] = 1
 _BYTE_CLASS[_NEWLINE] = 2
 
@@ -238,8 +238,9 @@ def _parse_plain_lines(data: np.ndarray) -> np.ndarray | None:
         return None
     separators = np.flatnonzero(classes)
     kinds = classes[separators]
-    if len(kinds) % 3 or not (np.all(kinds[0::3] == 1) and np.all(kinds[1::3] == 1)
-                              and np.all(kinds[2::3] == 2)):
+    if len(kinds) % 3 or not (
+        np.all(kinds[0::3] == 1) and np.all(kinds[1::3] == 1) and np.all(kinds[2::3] == 2)
+    ):
         return None
     starts = np.empty_like(separators)
     starts[0] = 0
@@ -282,8 +283,10 @@ def _check_read_size(path: Path) -> None:
     need = 3 * size
     limit = available_memory()
     if need > limit:
-        raise ResourceLimitError(f"{path}: a voxel list of {gib(size)} needs about {gib(need)} "
-                                 f"to read, more than the {gib(limit)} of memory available")
+        raise ResourceLimitError(
+            f"{path}: a voxel list of {gib(size)} needs about {gib(need)} "
+            f"to read, more than the {gib(limit)} of memory available"
+        )
 
 
 def describe_bad_line(text: str) -> str:

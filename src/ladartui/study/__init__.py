@@ -16,10 +16,28 @@ from ladartui.study.settings import Setting, full_settings, quick_settings, refe
 from ladartui.study.timing import Timing, measure
 
 __all__ = [
-    "CLASSES", "MissSummary", "Setting", "StudyResult", "StudyRow", "Timing", "chart_svg",
-    "chart_text", "dominates", "draw_chart", "full_settings", "measure", "pareto_front",
-    "quick_settings", "reference_setting", "run_study", "StudyInputs", "StudyProgress",
-    "summarise", "table_rows", "voxel_geometry", "write_outputs",
+    "CLASSES",
+    "MissSummary",
+    "Setting",
+    "StudyResult",
+    "StudyRow",
+    "Timing",
+    "chart_svg",
+    "chart_text",
+    "dominates",
+    "draw_chart",
+    "full_settings",
+    "measure",
+    "pareto_front",
+    "quick_settings",
+    "reference_setting",
+    "run_study",
+    "StudyInputs",
+    "StudyProgress",
+    "summarise",
+    "table_rows",
+    "voxel_geometry",
+    "write_outputs",
 ]
 
 

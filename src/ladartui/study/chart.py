@@ -80,14 +80,18 @@ def draw_chart(plt, result: StudyResult, title: str = TITLE, labels: bool = True
     xs = [p[0] for p in points]
     ys = [p[1] for p in points]
     if front:
-        plt.scatter([p[0] for p in front], [p[1] for p in front], marker=FRONT_MARKER,
-                    color=FRONT_COLOR, label="Pareto front")
+        plt.scatter(
+            [p[0] for p in front],
+            [p[1] for p in front],
+            marker=FRONT_MARKER,
+            color=FRONT_COLOR,
+            label="Pareto front",
+        )
         if labels:
             # Labels start a little right of their marker (log axis: a factor).
             shift = (max(xs) / min(xs)) ** 0.02 if min(xs) > 0 else 1.0
             for x, y, row in front:
-                plt.text(short_label(row.setting), x * shift, y, color=FRONT_COLOR,
-                         alignment="left")
+                plt.text(short_label(row.setting), x * shift, y, color=FRONT_COLOR, alignment="left")
     # Head room above the data for the legend, which plotext puts top left.
     top = max(ys) if max(ys) > 0 else 1.0
     plt.ylim(0.0, top * LEGEND_HEADROOM)
@@ -109,14 +113,24 @@ def chart_text(result: StudyResult, width: int = 100, height: int = 30, color: b
     return text if color else plotext.uncolorize(text)
 
 
-def chart_svg(result: StudyResult, width: int = 100, height: int = 30,
-              title: str = "ladartui study: speed against accuracy") -> str:
+def chart_svg(
+    result: StudyResult,
+    width: int = 100,
+    height: int = 30,
+    title: str = "ladartui study: speed against accuracy",
+) -> str:
     """The chart as an SVG document: the coloured terminal text recorded by rich."""
     from rich.console import Console
     from rich.text import Text
 
-    console = Console(record=True, width=width, file=io.StringIO(), color_system="256",
-                      force_terminal=True, legacy_windows=False)
+    console = Console(
+        record=True,
+        width=width,
+        file=io.StringIO(),
+        color_system="256",
+        force_terminal=True,
+        legacy_windows=False,
+    )
     console.print(Text.from_ansi(chart_text(result, width, height)), soft_wrap=True)
     return console.export_svg(title=title)
 
@@ -134,7 +148,15 @@ def table_rows(result: StudyResult) -> list[tuple[str, ...]]:
             out.append((row.label, "-", "-", "-", "-", "", f"{row.status}: {row.reason}"))
             continue
         note = f"beaten by {row.dominated_by}" if row.dominated_by else ""
-        out.append((row.label, format_seconds(row.seconds_per_scan),
-                    format_rate(row.rays_per_second), format_share(row.hit_differs),
-                    format_points(row.coverage_error), "*" if row.front else "", note))
+        out.append(
+            (
+                row.label,
+                format_seconds(row.seconds_per_scan),
+                format_rate(row.rays_per_second),
+                format_share(row.hit_differs),
+                format_points(row.coverage_error),
+                "*" if row.front else "",
+                note,
+            )
+        )
     return out

@@ -33,11 +33,18 @@ class StudyInputs:
     def describe(self) -> dict:
         scene = self.scene
         return {
-            "name": self.name, "scene": scene.name, "voxels": int(len(scene.voxels)),
-            "target_voxels": int(len(scene.target)), "shape": list(scene.shape),
-            "voxel_size_m": scene.voxel_size, "scans": len(self.poses),
-            "sensor": {"grid": self.sensor.grid, "fov_deg": self.sensor.fov,
-                       "depth_resolution_m": self.sensor.depth_resolution},
+            "name": self.name,
+            "scene": scene.name,
+            "voxels": int(len(scene.voxels)),
+            "target_voxels": int(len(scene.target)),
+            "shape": list(scene.shape),
+            "voxel_size_m": scene.voxel_size,
+            "scans": len(self.poses),
+            "sensor": {
+                "grid": self.sensor.grid,
+                "fov_deg": self.sensor.fov,
+                "depth_resolution_m": self.sensor.depth_resolution,
+            },
             "poses": [p.to_dict() for p in self.poses],
         }
 
@@ -61,13 +68,14 @@ def scenario_inputs(path, scans: int | None = DEFAULT_SCANS) -> StudyInputs:
     poses = pick_scans(all_poses, scans)
     inputs = StudyInputs(scene, scenario.sensor, poses, str(path))
     if len(poses) < len(all_poses):
-        inputs.notes.append(f"{len(poses)} of the scenario's {len(all_poses)} scans traced "
-                            f"(evenly spread; --scans changes this).")
+        inputs.notes.append(
+            f"{len(poses)} of the scenario's {len(all_poses)} scans traced "
+            f"(evenly spread; --scans changes this)."
+        )
     return inputs
 
 
-def generated_inputs(preset: str = "reference", scans: int = DEFAULT_SCANS,
-                     progress=None) -> StudyInputs:
+def generated_inputs(preset: str = "reference", scans: int = DEFAULT_SCANS, progress=None) -> StudyInputs:
     """A cached generated scene, the full-size sensor and the default orbit aimed at the target.
 
     The sensor is the default ``Sensor()`` (128 x 128 detectors, 10 degree view);
@@ -106,8 +114,9 @@ def cached_scene(preset: str, folder=None, progress=None):
     scene = generate_scene(preset)
     scene.write(folder / preset)
     # The metadata goes last: its presence says the voxel files are complete.
-    write_text_atomic(meta_path, json.dumps({"voxel_size": scene.voxel_size,
-                                             "shape": list(scene.shape)}) + "\n")
+    write_text_atomic(
+        meta_path, json.dumps({"voxel_size": scene.voxel_size, "shape": list(scene.shape)}) + "\n"
+    )
     return scene.to_scene(name=preset, path=scene_path)
 
 

@@ -119,7 +119,7 @@ class MissSummary:
         """Share of rays whose first hit differs (0..1), None with no rays."""
         return self.differing / self.rays if self.rays else None
 
-    def add(self, other: "MissSummary") -> None:
+    def add(self, other: MissSummary) -> None:
         self.rays += other.rays
         self.voxel_rays += other.voxel_rays
         self.differing += other.differing
@@ -131,10 +131,17 @@ class MissSummary:
             self.base[name] += other.base[name]
 
     def to_dict(self) -> dict:
-        return {"rays": self.rays, "voxel_rays": self.voxel_rays, "differing": self.differing,
-                "share": self.share, "later": self.later, "earlier": self.earlier,
-                "no_voxel": self.no_voxel,
-                "classes": dict(self.classes), "base": dict(self.base)}
+        return {
+            "rays": self.rays,
+            "voxel_rays": self.voxel_rays,
+            "differing": self.differing,
+            "share": self.share,
+            "later": self.later,
+            "earlier": self.earlier,
+            "no_voxel": self.no_voxel,
+            "classes": dict(self.classes),
+            "base": dict(self.base),
+        }
 
     def describe(self) -> str:
         """One line: how many differ, which way, and which classes they fall in."""
@@ -145,12 +152,13 @@ class MissSummary:
             own = self.classes[name] / self.differing
             base = self.base[name] / self.voxel_rays if self.voxel_rays else 0.0
             parts.append(f"{name} {own:.0%} (all rays {base:.0%})")
-        return (f"{self.differing} differ ({self.later} later, {self.earlier} earlier, "
-                f"{self.no_voxel} ground or miss on both sides); " + ", ".join(parts))
+        return (
+            f"{self.differing} differ ({self.later} later, {self.earlier} earlier, "
+            f"{self.no_voxel} ground or miss on both sides); " + ", ".join(parts)
+        )
 
 
-def summarise(origins, directions, exact, other, occupancy=None,
-              exact_voxel_classes=None) -> MissSummary:
+def summarise(origins, directions, exact, other, occupancy=None, exact_voxel_classes=None) -> MissSummary:
     """Compare one scan's answers with the exact ones and classify the differing rays.
 
     ``exact`` and ``other`` are (kind, index, range) triples over the same rays;
@@ -163,8 +171,9 @@ def summarise(origins, directions, exact, other, occupancy=None,
     e_voxel = e_kind == VOXEL
     out.voxel_rays = int(e_voxel.sum())
     if exact_voxel_classes is None:
-        exact_voxel_classes = voxel_geometry(origins[e_voxel], directions[e_voxel],
-                                             e_index[e_voxel], occupancy)
+        exact_voxel_classes = voxel_geometry(
+            origins[e_voxel], directions[e_voxel], e_index[e_voxel], occupancy
+        )
     for name in CLASSES:
         out.base[name] = int(exact_voxel_classes[name].sum())
     diff = differing(e_kind, e_index, m_kind, m_index)
@@ -176,8 +185,7 @@ def summarise(origins, directions, exact, other, occupancy=None,
     feature = np.where(e_voxel[:, None], e_index, m_index)
     has_feature = diff & ((e_kind == VOXEL) | (m_kind == VOXEL))
     out.no_voxel = int((diff & ~has_feature).sum())
-    classes = voxel_geometry(origins[has_feature], directions[has_feature], feature[has_feature],
-                             occupancy)
+    classes = voxel_geometry(origins[has_feature], directions[has_feature], feature[has_feature], occupancy)
     for name in CLASSES:
         out.classes[name] = int(classes[name].sum())
     return out

@@ -65,13 +65,22 @@ class StudyRow:
 
     def to_dict(self) -> dict:
         return {
-            "label": self.label, **self.setting.to_dict(), "status": self.status,
-            "reason": self.reason, "rays_per_scan": self.rays_per_scan, "scans": self.scans,
-            "runs": self.timing.runs, "seconds": list(self.timing.seconds),
-            "seconds_per_scan": self.seconds_per_scan, "rays_per_second": self.rays_per_second,
-            "hit_differs": self.hit_differs, "misses": self.misses.to_dict(),
-            "coverage": self.coverage, "coverage_error": self.coverage_error,
-            "front": self.front, "dominated_by": self.dominated_by,
+            "label": self.label,
+            **self.setting.to_dict(),
+            "status": self.status,
+            "reason": self.reason,
+            "rays_per_scan": self.rays_per_scan,
+            "scans": self.scans,
+            "runs": self.timing.runs,
+            "seconds": list(self.timing.seconds),
+            "seconds_per_scan": self.seconds_per_scan,
+            "rays_per_second": self.rays_per_second,
+            "hit_differs": self.hit_differs,
+            "misses": self.misses.to_dict(),
+            "coverage": self.coverage,
+            "coverage_error": self.coverage_error,
+            "front": self.front,
+            "dominated_by": self.dominated_by,
         }
 
 
@@ -80,10 +89,28 @@ def _abs(value):
 
 
 CSV_COLUMNS = (
-    "label", "backend", "method", "precision", "step", "ray_grid", "status", "reason",
-    "rays_per_scan", "scans", "runs", "seconds_per_scan", "rays_per_second", "hit_differs",
-    "differing_rays", "later", "earlier", *(f"{name}_share" for name in CLASSES),
-    "coverage", "coverage_error", "front", "dominated_by",
+    "label",
+    "backend",
+    "method",
+    "precision",
+    "step",
+    "ray_grid",
+    "status",
+    "reason",
+    "rays_per_scan",
+    "scans",
+    "runs",
+    "seconds_per_scan",
+    "rays_per_second",
+    "hit_differs",
+    "differing_rays",
+    "later",
+    "earlier",
+    *(f"{name}_share" for name in CLASSES),
+    "coverage",
+    "coverage_error",
+    "front",
+    "dominated_by",
 )
 
 
@@ -123,15 +150,18 @@ class StudyResult:
         lines = []
         front = self.front_rows()
         if front:
-            lines.append("Pareto front (fastest first; none of these is beaten on speed, "
-                         "coverage error and first-hit agreement at once):")
+            lines.append(
+                "Pareto front (fastest first; none of these is beaten on speed, "
+                "coverage error and first-hit agreement at once):"
+            )
             lines += [f"  {describe_row(r)}" for r in front]
         else:
             lines.append("No setting produced a complete measurement.")
         dominated = self.dominated_rows()
         if dominated:
-            lines.append("Never worth using (dominated: another setting is at least as fast "
-                         "and at least as accurate):")
+            lines.append(
+                "Never worth using (dominated: another setting is at least as fast and at least as accurate):"
+            )
             lines += [f"  {r.label}: beaten by {r.dominated_by}" for r in dominated]
             everywhere = _tracers_dominated_everywhere(self.rows)
             if everywhere:
@@ -147,35 +177,51 @@ class StudyResult:
 
     def to_dict(self) -> dict:
         return {
-            "context": self.context, "objectives": list(OBJECTIVES),
+            "context": self.context,
+            "objectives": list(OBJECTIVES),
             "reference": {"label": self.reference_label, "coverage": self.reference_coverage},
-            "notes": list(self.notes), "rows": [row.to_dict() for row in self.rows],
+            "notes": list(self.notes),
+            "rows": [row.to_dict() for row in self.rows],
             "verdict": self.verdict(),
         }
 
     @classmethod
-    def from_dict(cls, data: dict) -> "StudyResult":
+    def from_dict(cls, data: dict) -> StudyResult:
         """Read back what ``to_dict`` wrote (to redraw a chart without measuring again)."""
         rows = []
         for item in data["rows"]:
-            setting = Setting(item["backend"], item["method"], item["precision"], item["step"],
-                              item["ray_grid"])
+            setting = Setting(
+                item["backend"], item["method"], item["precision"], item["step"], item["ray_grid"]
+            )
             misses = item.get("misses") or {}
-            row = StudyRow(setting, status=item["status"], reason=item.get("reason"),
-                           rays_per_scan=item.get("rays_per_scan"), scans=item.get("scans", 0),
-                           timing=Timing(list(item.get("seconds") or [])),
-                           misses=MissSummary(
-                               rays=misses.get("rays", 0), voxel_rays=misses.get("voxel_rays", 0),
-                               differing=misses.get("differing", 0), later=misses.get("later", 0),
-                               earlier=misses.get("earlier", 0),
-                               no_voxel=misses.get("no_voxel", 0),
-                               classes=dict(misses.get("classes") or {n: 0 for n in CLASSES}),
-                               base=dict(misses.get("base") or {n: 0 for n in CLASSES})),
-                           coverage=item.get("coverage"))
+            row = StudyRow(
+                setting,
+                status=item["status"],
+                reason=item.get("reason"),
+                rays_per_scan=item.get("rays_per_scan"),
+                scans=item.get("scans", 0),
+                timing=Timing(list(item.get("seconds") or [])),
+                misses=MissSummary(
+                    rays=misses.get("rays", 0),
+                    voxel_rays=misses.get("voxel_rays", 0),
+                    differing=misses.get("differing", 0),
+                    later=misses.get("later", 0),
+                    earlier=misses.get("earlier", 0),
+                    no_voxel=misses.get("no_voxel", 0),
+                    classes=dict(misses.get("classes") or {n: 0 for n in CLASSES}),
+                    base=dict(misses.get("base") or {n: 0 for n in CLASSES}),
+                ),
+                coverage=item.get("coverage"),
+            )
             rows.append(row)
         reference = data.get("reference") or {}
-        result = cls(rows, context=data.get("context") or {}, reference_label=reference.get("label"),
-                     reference_coverage=reference.get("coverage"), notes=list(data.get("notes") or []))
+        result = cls(
+            rows,
+            context=data.get("context") or {},
+            reference_label=reference.get("label"),
+            reference_coverage=reference.get("coverage"),
+            notes=list(data.get("notes") or []),
+        )
         result.finish()
         return result
 
@@ -200,10 +246,30 @@ def _csv_record(row: StudyRow) -> list:
     s = row.setting
     m = row.misses
     shares = [m.classes[name] / m.differing if m.differing else None for name in CLASSES]
-    return [row.label, s.backend, s.method, s.precision, s.step, s.ray_grid, row.status,
-            row.reason, row.rays_per_scan, row.scans, row.timing.runs, row.seconds_per_scan,
-            row.rays_per_second, row.hit_differs, m.differing, m.later, m.earlier, *shares,
-            row.coverage, row.coverage_error, row.front, row.dominated_by]
+    return [
+        row.label,
+        s.backend,
+        s.method,
+        s.precision,
+        s.step,
+        s.ray_grid,
+        row.status,
+        row.reason,
+        row.rays_per_scan,
+        row.scans,
+        row.timing.runs,
+        row.seconds_per_scan,
+        row.rays_per_second,
+        row.hit_differs,
+        m.differing,
+        m.later,
+        m.earlier,
+        *shares,
+        row.coverage,
+        row.coverage_error,
+        row.front,
+        row.dominated_by,
+    ]
 
 
 def _csv_value(value):
@@ -219,18 +285,23 @@ def _tracers_dominated_everywhere(rows) -> list[str]:
     for row in rows:
         if row.status == OK:
             by_tracer.setdefault(row.setting.tracer_label, []).append(row)
-    return [label for label, group in by_tracer.items()
-            if group and all(r.dominated_by is not None for r in group)]
+    return [
+        label
+        for label, group in by_tracer.items()
+        if group and all(r.dominated_by is not None for r in group)
+    ]
 
 
 def describe_row(row: StudyRow) -> str:
     """One line: label, speed and both accuracy figures."""
     if row.status != OK:
         return f"{row.label}: {row.status} ({row.reason})"
-    return (f"{row.label}: {format_seconds(row.seconds_per_scan)}/scan, "
-            f"{format_rate(row.rays_per_second)} rays/s, "
-            f"coverage error {format_points(row.coverage_error)}, "
-            f"{format_share(row.hit_differs)} of first hits differ")
+    return (
+        f"{row.label}: {format_seconds(row.seconds_per_scan)}/scan, "
+        f"{format_rate(row.rays_per_second)} rays/s, "
+        f"coverage error {format_points(row.coverage_error)}, "
+        f"{format_share(row.hit_differs)} of first hits differ"
+    )
 
 
 def format_seconds(value) -> str:
@@ -275,8 +346,7 @@ def read_study(path) -> StudyResult:
     except OSError as error:
         raise InputFileError(path, f"cannot read it ({error.strerror})") from None
     except (ValueError, KeyError, TypeError) as error:
-        raise InputFileError(path, f"not a study.json written by 'ladartui study' "
-                             f"({error})") from None
+        raise InputFileError(path, f"not a study.json written by 'ladartui study' ({error})") from None
 
 
 def study_folder(scenario_path=None) -> Path:

@@ -18,9 +18,9 @@ import datetime
 import os
 import platform
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
@@ -72,9 +72,14 @@ def backend_reasons(names) -> dict[str, str | None]:
     return reasons
 
 
-def run_study(inputs: StudyInputs, settings: list[Setting], runs: int = 5, warmup: int = 1,
-              progress: Callable[[StudyProgress], None] | None = None,
-              cancel: threading.Event | None = None) -> StudyResult:
+def run_study(
+    inputs: StudyInputs,
+    settings: list[Setting],
+    runs: int = 5,
+    warmup: int = 1,
+    progress: Callable[[StudyProgress], None] | None = None,
+    cancel: threading.Event | None = None,
+) -> StudyResult:
     """Measure every setting on ``inputs``; see the module docstring for what is measured."""
     if runs < 1:
         raise LadarError("runs must be at least 1")
@@ -118,21 +123,22 @@ def run_study(inputs: StudyInputs, settings: list[Setting], runs: int = 5, warmu
                 if row.status != "ok":
                     continue
                 calls = 1 + (warmup + extra if scan == 0 else 0)
-                call = 0
+                done_before = done  # a failure counts this scan's calls as done
                 try:
                     if scan == 0:
                         # Warm-up: compile and upload on a slice of the scan's rays.
-                        for call in range(warmup):
+                        for _ in range(warmup):
                             _check(cancel)
-                            _trace(scene, origins[:WARMUP_RAYS], directions[:WARMUP_RAYS], s,
-                                   cancel)
+                            _trace(scene, origins[:WARMUP_RAYS], directions[:WARMUP_RAYS], s, cancel)
                             done += 1
                     repeats = 1 + (extra if scan == 0 else 0)
                     for call in range(repeats):
                         _check(cancel)
                         if progress is not None:
                             progress(StudyProgress(done, total, s.label, scan + 1, len(poses)))
-                        hits, seconds = timed(lambda: _trace(scene, origins, directions, s, cancel))
+                        hits, seconds = timed(
+                            lambda o=origins, d=directions, s=s: _trace(scene, o, d, s, cancel)
+                        )
                         done += 1
                         row.timing.add(seconds)
                         if sum(row.timing.seconds) > REPEAT_BUDGET_S:
@@ -145,7 +151,7 @@ def run_study(inputs: StudyInputs, settings: list[Setting], runs: int = 5, warmu
                     if s.is_reference:
                         raise
                     row.status, row.reason = FAILED, f"{type(error).__name__}: {error}"
-                    done += max(calls - call - 1, 0)
+                    done = done_before + calls
                     continue
                 note = hits.info.get("precision_note")
                 if note:
@@ -156,10 +162,10 @@ def run_study(inputs: StudyInputs, settings: list[Setting], runs: int = 5, warmu
                 if s.is_reference:
                     exact = answer
                     voxel = hits.kind == VOXEL
-                    exact_classes = voxel_geometry(cells[voxel], directions[voxel],
-                                                   hits.index[voxel], scene.occupancy)
-                row.misses.add(summarise(cells, directions, exact, answer, scene.occupancy,
-                                         exact_classes))
+                    exact_classes = voxel_geometry(
+                        cells[voxel], directions[voxel], hits.index[voxel], scene.occupancy
+                    )
+                row.misses.add(summarise(cells, directions, exact, answer, scene.occupancy, exact_classes))
                 returns[s].append(_scan_returns(hits, detector, sensor.depth_resolution))
     if progress is not None:
         progress(StudyProgress(total, total, "scoring", len(poses), len(poses)))
@@ -170,16 +176,22 @@ def run_study(inputs: StudyInputs, settings: list[Setting], runs: int = 5, warmu
         if s in notes:
             rows[s].reason = notes[s]
     top = reference_setting(grids[-1])
-    result = StudyResult([rows[s] for s in ordered if s in listed or s.is_reference],
-                         context=_context(inputs, runs, warmup, reasons),
-                         reference_label=top.label, reference_coverage=coverage.get(top))
+    result = StudyResult(
+        [rows[s] for s in ordered if s in listed or s.is_reference],
+        context=_context(inputs, runs, warmup, reasons),
+        reference_label=top.label,
+        reference_coverage=coverage.get(top),
+    )
     result.notes += inputs.notes
     if grids[-1] < 8:
-        result.notes.append(f"The converged reference is exact float64 numba at m={grids[-1]}, "
-                            f"the largest ray grid measured (8 in the full study).")
+        result.notes.append(
+            f"The converged reference is exact float64 numba at m={grids[-1]}, "
+            f"the largest ray grid measured (8 in the full study)."
+        )
     if result.reference_coverage is None:
-        result.notes.append("Coverage is undefined (the reference saw no target voxel), "
-                            "so coverage errors are not shown.")
+        result.notes.append(
+            "Coverage is undefined (the reference saw no target voxel), so coverage errors are not shown."
+        )
     result.finish()
     return result
 
@@ -192,10 +204,19 @@ def _trace(scene, origins, directions, setting: Setting, cancel):
     for start in range(0, len(origins), CHUNK_RAYS):
         _check(cancel)
         stop = start + CHUNK_RAYS
-        parts.append(trace(scene.occupancy, origins[start:stop], directions[start:stop],
-                           backend=setting.backend, method=setting.method, step=setting.step,
-                           precision=setting.precision, voxel_size=scene.voxel_size,
-                           cancel=cancel))
+        parts.append(
+            trace(
+                scene.occupancy,
+                origins[start:stop],
+                directions[start:stop],
+                backend=setting.backend,
+                method=setting.method,
+                step=setting.step,
+                precision=setting.precision,
+                voxel_size=scene.voxel_size,
+                cancel=cancel,
+            )
+        )
     if len(parts) == 1:
         return parts[0]
     first = parts[0]
@@ -226,16 +247,22 @@ def _check(cancel):
 
 def _context(inputs: StudyInputs, runs, warmup, reasons) -> dict:
     return {
-        "inputs": inputs.describe(), "runs": runs, "warmup": warmup,
-        "created_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-        "machine": {"cpus": os.cpu_count(), "platform": platform.platform(),
-                    "python": platform.python_version()},
+        "inputs": inputs.describe(),
+        "runs": runs,
+        "warmup": warmup,
+        "created_utc": datetime.datetime.now(datetime.UTC).isoformat(timespec="seconds"),
+        "machine": {
+            "cpus": os.cpu_count(),
+            "platform": platform.platform(),
+            "python": platform.python_version(),
+        },
         "backends": reasons,
     }
 
 
-def write_outputs(result: StudyResult, out_dir, chart_stem="speed-accuracy", stem="study",
-                  width=100, height=30) -> dict[str, Path]:
+def write_outputs(
+    result: StudyResult, out_dir, chart_stem="speed-accuracy", stem="study", width=100, height=30
+) -> dict[str, Path]:
     """Write the CSV, JSON, plotted chart (SVG, PNG) and plain-text chart atomically into ``out_dir``."""
     from ladartui.atomic import write_text_atomic
     from ladartui.charts import save_figure
@@ -248,6 +275,7 @@ def write_outputs(result: StudyResult, out_dir, chart_stem="speed-accuracy", ste
     for fmt in ("svg", "png"):
         paths[fmt] = save_figure(figure, out_dir / f"{chart_stem}.{fmt}")
     paths["txt"] = out_dir / f"{chart_stem}.txt"
-    write_text_atomic(paths["txt"], chart_text(result, width, height, color=False) + "\n\n"
-                      + result.verdict() + "\n")
+    write_text_atomic(
+        paths["txt"], chart_text(result, width, height, color=False) + "\n\n" + result.verdict() + "\n"
+    )
     return paths

@@ -5,8 +5,8 @@ from __future__ import annotations
 import statistics
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable
 
 from ladartui.errors import Cancelled
 
@@ -36,8 +36,13 @@ def timed(call: Callable[[], object], clock=time.perf_counter):
     return result, clock() - start
 
 
-def measure(call: Callable[[], object], runs: int = 5, warmup: int = 1,
-            cancel: threading.Event | None = None, clock=time.perf_counter):
+def measure(
+    call: Callable[[], object],
+    runs: int = 5,
+    warmup: int = 1,
+    cancel: threading.Event | None = None,
+    clock=time.perf_counter,
+):
     """Call ``call`` ``warmup`` times untimed, then ``runs`` times timed.
 
     Returns (the last result, Timing). Warm-up absorbs one-off costs (numba

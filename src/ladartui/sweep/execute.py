@@ -17,9 +17,9 @@ import logging
 import os
 import time
 import uuid
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
 
 from ladartui.atomic import atomic_path
 from ladartui.errors import Cancelled, FieldError, InputFileError, LadarError
@@ -114,8 +114,10 @@ def base_scenario_path(spec: SweepSpec) -> Path:
 
         return default_scenario_path()
     if not spec.scenario_path.is_file():
-        raise InputFileError(spec.path, f"sweep.scenario: expected an existing scenario file; "
-                             f"{str(spec.scenario_path)!r} does not exist")
+        raise InputFileError(
+            spec.path,
+            f"sweep.scenario: expected an existing scenario file; {str(spec.scenario_path)!r} does not exist",
+        )
     return spec.scenario_path
 
 
@@ -131,10 +133,20 @@ class _LazyScene:
         return self.scene
 
 
-def run_sweep(spec, client=None, progress: Callable[[SweepProgress], None] | None = None,
-              cancel=None, *, out=None, workers: int | None = None, objective: str | None = None,
-              budget: float | None = None, cost: str | None = None, serial: bool = False,
-              simulate_options: dict | None = None) -> SweepResult:
+def run_sweep(
+    spec,
+    client=None,
+    progress: Callable[[SweepProgress], None] | None = None,
+    cancel=None,
+    *,
+    out=None,
+    workers: int | None = None,
+    objective: str | None = None,
+    budget: float | None = None,
+    cost: str | None = None,
+    serial: bool = False,
+    simulate_options: dict | None = None,
+) -> SweepResult:
     """Run every variant of ``spec`` not already in the result table, then rank them all.
 
     ``spec`` is a SweepSpec or a spec file path. ``client`` is a
@@ -153,10 +165,13 @@ def run_sweep(spec, client=None, progress: Callable[[SweepProgress], None] | Non
     cost = normal_cost(cost or spec.cost)
     budget = spec.budget if budget is None else float(budget)
     if objective == "coverage-within-budget" and budget is None:
-        raise FieldError("budget", None, "a flight-time budget in seconds (sweep.budget or "
-                         "--budget) for objective 'coverage-within-budget'")
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
-                                or workers < 1):
+        raise FieldError(
+            "budget",
+            None,
+            "a flight-time budget in seconds (sweep.budget or "
+            "--budget) for objective 'coverage-within-budget'",
+        )
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise FieldError("workers", workers, "an integer >= 1")
     out = Path(out) if out is not None else default_out_dir(spec)
     from ladartui.scenario import load_scenario
@@ -164,8 +179,22 @@ def run_sweep(spec, client=None, progress: Callable[[SweepProgress], None] | Non
     base_path = base_scenario_path(spec)
     base = load_scenario(base_path)
     with _exclusive(out):
-        return _run_locked(spec, base_path, base, client, progress, cancel, out, workers,
-                           objective, budget, cost, serial, simulate_options, started)
+        return _run_locked(
+            spec,
+            base_path,
+            base,
+            client,
+            progress,
+            cancel,
+            out,
+            workers,
+            objective,
+            budget,
+            cost,
+            serial,
+            simulate_options,
+            started,
+        )
 
 
 @contextlib.contextmanager
@@ -181,16 +210,31 @@ def _exclusive(out: Path):
         try:
             fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
-            raise InputFileError(out, "another sweep is writing its results here; wait for "
-                                 "it or choose another --out") from None
+            raise InputFileError(
+                out, "another sweep is writing its results here; wait for it or choose another --out"
+            ) from None
         try:
             yield
         finally:
             fcntl.flock(handle, fcntl.LOCK_UN)
 
 
-def _run_locked(spec, base_path, base, client, progress, cancel, out, workers, objective,
-                budget, cost, serial, simulate_options, started) -> SweepResult:
+def _run_locked(
+    spec,
+    base_path,
+    base,
+    client,
+    progress,
+    cancel,
+    out,
+    workers,
+    objective,
+    budget,
+    cost,
+    serial,
+    simulate_options,
+    started,
+) -> SweepResult:
     digest = base_digest(base_path, base)
     scene = _LazyScene(base)
     variants = spec.variants
@@ -202,11 +246,9 @@ def _run_locked(spec, base_path, base, client, progress, cancel, out, workers, o
         i = position.get((variant_id, digest))
         return None if i is None else table_rows[i]
 
-    todo = [v for v in variants
-            if (row := stored(v.id)) is None or row.get("status") not in FINAL_STATUSES]
+    todo = [v for v in variants if (row := stored(v.id)) is None or row.get("status") not in FINAL_STATUSES]
     resumed = len(variants) - len(todo)
-    state = SweepProgress(total=len(variants), done=resumed, resumed=resumed, failed=0,
-                          elapsed=0.0)
+    state = SweepProgress(total=len(variants), done=resumed, resumed=resumed, failed=0, elapsed=0.0)
 
     def record(row):
         key = (row["variant"], row["base"])
@@ -250,14 +292,23 @@ def _run_locked(spec, base_path, base, client, progress, cancel, out, workers, o
     rows = [row for v in variants if (row := stored(v.id)) is not None]
     ranking = rank_rows(rows, objective, budget, cost)
     result = SweepResult(
-        rows=rows, ranking=ranking, objective=objective, cost=cost, budget=budget,
-        parameter_names=spec.parameter_names, results_path=results_path, ran=len(todo),
-        resumed=resumed, workers=result_workers, scheduler=scheduler,
+        rows=rows,
+        ranking=ranking,
+        objective=objective,
+        cost=cost,
+        budget=budget,
+        parameter_names=spec.parameter_names,
+        results_path=results_path,
+        ran=len(todo),
+        resumed=resumed,
+        workers=result_workers,
+        scheduler=scheduler,
     )
     result.ranking_path = write_ranking(out / RANKING_NAME, ranking, spec.parameter_names)
     if result.best is not None:
         result.best_scenario_path = write_best_scenario(
-            out / f"{spec.name}-best.toml", base, result.best.row, spec.parameter_names, scene)
+            out / f"{spec.name}-best.toml", base, result.best.row, spec.parameter_names, scene
+        )
     result.elapsed = time.perf_counter() - started
     return result
 
@@ -278,8 +329,7 @@ def _lost_row(variant, digest, future) -> dict:
         message = f"{type(error).__name__}: {error}"
     except Exception as reason:  # noqa: BLE001 - the future itself may be gone
         message = f"task {future.status}: {reason}"
-    return {"variant": variant.id, "status": "failed", "base": digest, **variant.params,
-            "error": message}
+    return {"variant": variant.id, "status": "failed", "base": digest, **variant.params, "error": message}
 
 
 def _run_on_dask(client, todo, base, digest, scene, options, record, cancel):
@@ -292,9 +342,17 @@ def _run_on_dask(client, todo, base, digest, scene, options, record, cancel):
     pending = {}
     try:
         for variant in todo:
-            future = client.submit(run_variant, base, variant.params, variant.id, digest,
-                                   scene_future, options, pure=False,
-                                   key=f"ladartui-variant-{variant.id}-{tag}")
+            future = client.submit(
+                run_variant,
+                base,
+                variant.params,
+                variant.id,
+                digest,
+                scene_future,
+                options,
+                pure=False,
+                key=f"ladartui-variant-{variant.id}-{tag}",
+            )
             pending[future] = variant
         completed = as_completed(list(pending))
         while pending:
@@ -332,8 +390,12 @@ def local_client(workers: int | None = None):
     cores = os.cpu_count() or 1
     count = workers or cores
     cluster = LocalCluster(
-        n_workers=count, threads_per_worker=1, processes=True, dashboard_address=None,
-        silence_logs=logging.ERROR, env={"NUMBA_NUM_THREADS": str(max(1, cores // count))},
+        n_workers=count,
+        threads_per_worker=1,
+        processes=True,
+        dashboard_address=None,
+        silence_logs=logging.ERROR,
+        env={"NUMBA_NUM_THREADS": str(max(1, cores // count))},
     )
     return Client(cluster)
 
@@ -348,14 +410,18 @@ def connect(address: str, timeout: float = 30.0, security=None):
     try:
         client = Client(address, timeout=f"{timeout}s", security=security)
     except (OSError, TimeoutError, ValueError, TypeError) as error:  # TypeError: tls:// sans TLS
-        raise FieldError("--scheduler", address, f"the address of a running Dask scheduler "
-                         f"(tcp://HOST:PORT); connecting failed: {error}") from None
+        raise FieldError(
+            "--scheduler",
+            address,
+            f"the address of a running Dask scheduler (tcp://HOST:PORT); connecting failed: {error}",
+        ) from None
     try:
         client.wait_for_workers(1, timeout=timeout)
     except (TimeoutError, OSError):
         _close(client)
-        raise FieldError("--scheduler", address, f"a scheduler with workers; none joined "
-                         f"within {timeout:g} s") from None
+        raise FieldError(
+            "--scheduler", address, f"a scheduler with workers; none joined within {timeout:g} s"
+        ) from None
     check_workers(client)
     return client
 
@@ -366,11 +432,15 @@ def check_workers(client) -> None:
     answers = client.run(importlib.metadata.version, "ladartui", on_error="return")
     for worker, answer in answers.items():
         if isinstance(answer, BaseException):
-            raise LadarError(f"worker {worker} cannot import ladartui ({answer}); install this "
-                             f"version ({mine}) in the workers' environment")
+            raise LadarError(
+                f"worker {worker} cannot import ladartui ({answer}); install this "
+                f"version ({mine}) in the workers' environment"
+            )
         if answer != mine:
-            raise LadarError(f"worker {worker} runs ladartui {answer}, this client {mine}; "
-                             "install the same version everywhere")
+            raise LadarError(
+                f"worker {worker} runs ladartui {answer}, this client {mine}; "
+                "install the same version everywhere"
+            )
 
 
 def _close(client):
@@ -382,14 +452,32 @@ def _close(client):
 
 def write_ranking(path, ranking: list[Ranked], parameter_names) -> Path:
     """The ranking as CSV (rank, objective value, Pareto flag, then the row), written atomically."""
-    columns = ["rank", "variant", "objective", "pareto", "coverage", "cost", "status",
-               *parameter_names, "path_length_m", "flight_time_s", "error"]
+    columns = [
+        "rank",
+        "variant",
+        "objective",
+        "pareto",
+        "coverage",
+        "cost",
+        "status",
+        *parameter_names,
+        "path_length_m",
+        "flight_time_s",
+        "error",
+    ]
     rows = []
     for entry in ranking:
         row = entry.row
-        rows.append({**{name: row.get(name) for name in columns}, "rank": entry.rank,
-                     "objective": entry.value, "pareto": entry.pareto,
-                     "coverage": entry.coverage, "cost": entry.cost})
+        rows.append(
+            {
+                **{name: row.get(name) for name in columns},
+                "rank": entry.rank,
+                "objective": entry.value,
+                "pareto": entry.pareto,
+                "coverage": entry.coverage,
+                "cost": entry.cost,
+            }
+        )
     text = table_text(rows, columns=columns)
     with atomic_path(path) as tmp:
         tmp.write_text(text, encoding="utf-8")
@@ -403,8 +491,9 @@ def write_best_scenario(path, base, row: dict, parameter_names, scene_loader) ->
     return scenario.save(path).path  # atomic; relative scene path and outputs follow the file
 
 
-def load_sweep_results(path, objective: str = "obscured-coverage", budget: float | None = None,
-                       cost: str = "flight-time") -> SweepResult:
+def load_sweep_results(
+    path, objective: str = "obscured-coverage", budget: float | None = None, cost: str = "flight-time"
+) -> SweepResult:
     """Read a sweep's result table (a results.csv or the folder holding it) and rank its rows.
 
     Every row in the file is included; when a variant appears more than once
@@ -419,11 +508,27 @@ def load_sweep_results(path, objective: str = "obscured-coverage", budget: float
     objective, cost = normal_objective(objective), normal_cost(cost)
     if objective == "coverage-within-budget" and budget is None:
         raise FieldError("budget", None, "a flight-time budget in seconds")
-    known = {"variant", "status", "base", "error", "worker", "backend", "method",
-             "run_time_s", "scan_count", *COSTS.values()}
+    known = {
+        "variant",
+        "status",
+        "base",
+        "error",
+        "worker",
+        "backend",
+        "method",
+        "run_time_s",
+        "scan_count",
+        *COSTS.values(),
+    }
     from ladartui.sweep.spec import PARAMETERS
 
     parameter_names = [c for c in header if c in PARAMETERS and c not in known]
-    return SweepResult(rows=rows, ranking=rank_rows(rows, objective, budget, cost),
-                       objective=objective, cost=cost, budget=budget,
-                       parameter_names=parameter_names, results_path=path)
+    return SweepResult(
+        rows=rows,
+        ranking=rank_rows(rows, objective, budget, cost),
+        objective=objective,
+        cost=cost,
+        budget=budget,
+        parameter_names=parameter_names,
+        results_path=path,
+    )

@@ -15,9 +15,9 @@ COVERAGE_COLUMN = "obscured_coverage"
 OBJECTIVES = {
     "obscured-coverage": "obscured target coverage (higher is better)",
     "coverage-per-km": "obscured coverage per kilometre flown (higher is better; undefined "
-                       "for a path of zero length)",
+    "for a path of zero length)",
     "coverage-within-budget": "obscured coverage of paths flown within the flight-time budget "
-                              "(longer paths are not ranked)",
+    "(longer paths are not ranked)",
 }
 COSTS = {"flight-time": "flight_time_s", "distance": "path_length_m"}
 
@@ -72,8 +72,9 @@ def objective_value(row: dict, objective: str, budget: float | None = None) -> f
         length = _number(row.get("path_length_m"))
         return coverage / (length / 1000.0) if length else None
     if budget is None:
-        raise FieldError("budget", None, "a flight-time budget in seconds for "
-                         "objective 'coverage-within-budget'")
+        raise FieldError(
+            "budget", None, "a flight-time budget in seconds for objective 'coverage-within-budget'"
+        )
     time = _number(row.get("flight_time_s"))
     return coverage if time is not None and time <= budget else None
 
@@ -103,8 +104,9 @@ def rank_rows(rows, objective="obscured-coverage", budget=None, cost="flight-tim
     for row in rows:
         coverage = coverage_of(row) if row.get("status") == "ok" else None
         cost_value = _number(row.get(cost_column)) if coverage is not None else None
-        entries.append(Ranked(row, objective_value(row, objective, budget), None, False,
-                              cost_value, coverage))
+        entries.append(
+            Ranked(row, objective_value(row, objective, budget), None, False, cost_value, coverage)
+        )
     flags = pareto_front([(e.cost, e.coverage) if e.cost is not None else None for e in entries])
     for entry, flag in zip(entries, flags):
         entry.pareto = flag

@@ -34,8 +34,7 @@ def is_loopback(address: str) -> bool:
         return False
 
 
-def cluster_security(address: str, ca_file=None, cert_file=None, key_file=None,
-                     insecure: bool = False):
+def cluster_security(address: str, ca_file=None, cert_file=None, key_file=None, insecure: bool = False):
     """The ``distributed.Security`` for ``address``, or None for a permitted plain address.
 
     Raises FieldError naming the flag: a TLS file missing or unreadable, TLS files with
@@ -46,25 +45,42 @@ def cluster_security(address: str, ca_file=None, cert_file=None, key_file=None,
     if any(files.values()):
         for flag, path in files.items():
             if not path:
-                raise FieldError(flag, None, "a PEM file (TLS needs --tls-ca-file, --tls-cert "
-                                 "and --tls-key together; ladartui certs DIR makes them)")
+                raise FieldError(
+                    flag,
+                    None,
+                    "a PEM file (TLS needs --tls-ca-file, --tls-cert "
+                    "and --tls-key together; ladartui certs DIR makes them)",
+                )
             if problem := file_problem(Path(path)):
                 raise FieldError(flag, str(path), f"a readable PEM file; it {problem}")
         if scheme != "tls":
-            raise FieldError("--scheduler", address, "a tls://HOST:PORT address with the TLS "
-                             "files (the scheduler must be started with the same certificates)")
+            raise FieldError(
+                "--scheduler",
+                address,
+                "a tls://HOST:PORT address with the TLS "
+                "files (the scheduler must be started with the same certificates)",
+            )
         from distributed.security import Security
 
-        return Security(tls_ca_file=str(ca_file), tls_client_cert=str(cert_file),
-                        tls_client_key=str(key_file), require_encryption=True)
+        return Security(
+            tls_ca_file=str(ca_file),
+            tls_client_cert=str(cert_file),
+            tls_client_key=str(key_file),
+            require_encryption=True,
+        )
     if scheme == "tls":
-        raise FieldError("--scheduler", address, "--tls-ca-file, --tls-cert and --tls-key "
-                         "with a tls:// address")
+        raise FieldError(
+            "--scheduler", address, "--tls-ca-file, --tls-cert and --tls-key with a tls:// address"
+        )
     if not insecure and not is_loopback(address):
-        raise FieldError("--scheduler", address, "a tls:// address with --tls-ca-file, "
-                         "--tls-cert and --tls-key, or a loopback address: any peer that "
-                         "reaches a plain tcp:// scheduler can run code on it, its workers "
-                         "and this machine (see docs/sweeps.md; --insecure to use it anyway)")
+        raise FieldError(
+            "--scheduler",
+            address,
+            "a tls:// address with --tls-ca-file, "
+            "--tls-cert and --tls-key, or a loopback address: any peer that "
+            "reaches a plain tcp:// scheduler can run code on it, its workers "
+            "and this machine (see docs/sweeps.md; --insecure to use it anyway)",
+        )
     return None
 
 
@@ -81,37 +97,47 @@ def make_certificates(folder, days: int = 365) -> dict[str, Path]:
 
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    now = datetime.datetime.now(datetime.timezone.utc)
+    now = datetime.datetime.now(datetime.UTC)
     start, end = now - datetime.timedelta(minutes=5), now + datetime.timedelta(days=days)
 
     def name(text):
         return x509.Name([x509.NameAttribute(NameOID.COMMON_NAME, text)])
 
     ca_key = ec.generate_private_key(ec.SECP256R1())
-    ca_cert = (x509.CertificateBuilder().subject_name(name("ladartui cluster CA"))
-               .issuer_name(name("ladartui cluster CA")).public_key(ca_key.public_key())
-               .serial_number(x509.random_serial_number()).not_valid_before(start)
-               .not_valid_after(end)
-               .add_extension(x509.BasicConstraints(ca=True, path_length=0), critical=True)
-               .sign(ca_key, hashes.SHA256()))
+    ca_cert = (
+        x509.CertificateBuilder()
+        .subject_name(name("ladartui cluster CA"))
+        .issuer_name(name("ladartui cluster CA"))
+        .public_key(ca_key.public_key())
+        .serial_number(x509.random_serial_number())
+        .not_valid_before(start)
+        .not_valid_after(end)
+        .add_extension(x509.BasicConstraints(ca=True, path_length=0), critical=True)
+        .sign(ca_key, hashes.SHA256())
+    )
     key = ec.generate_private_key(ec.SECP256R1())
-    cert = (x509.CertificateBuilder().subject_name(name("ladartui cluster"))
-            .issuer_name(ca_cert.subject).public_key(key.public_key())
-            .serial_number(x509.random_serial_number()).not_valid_before(start)
-            .not_valid_after(end)
-            .add_extension(x509.BasicConstraints(ca=False, path_length=None), critical=True)
-            .add_extension(x509.ExtendedKeyUsage([ExtendedKeyUsageOID.SERVER_AUTH,
-                                                  ExtendedKeyUsageOID.CLIENT_AUTH]),
-                           critical=False)
-            .sign(ca_key, hashes.SHA256()))
+    cert = (
+        x509.CertificateBuilder()
+        .subject_name(name("ladartui cluster"))
+        .issuer_name(ca_cert.subject)
+        .public_key(key.public_key())
+        .serial_number(x509.random_serial_number())
+        .not_valid_before(start)
+        .not_valid_after(end)
+        .add_extension(x509.BasicConstraints(ca=False, path_length=None), critical=True)
+        .add_extension(
+            x509.ExtendedKeyUsage([ExtendedKeyUsageOID.SERVER_AUTH, ExtendedKeyUsageOID.CLIENT_AUTH]),
+            critical=False,
+        )
+        .sign(ca_key, hashes.SHA256())
+    )
     pem = serialization.Encoding.PEM
     paths = {"ca": folder / CA_FILE, "cert": folder / CERT_FILE, "key": folder / KEY_FILE}
     paths["ca"].write_bytes(ca_cert.public_bytes(pem))
     paths["cert"].write_bytes(cert.public_bytes(pem))
     descriptor = os.open(paths["key"], os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
     with os.fdopen(descriptor, "wb") as out:
-        out.write(key.private_bytes(pem, serialization.PrivateFormat.PKCS8,
-                                    serialization.NoEncryption()))
+        out.write(key.private_bytes(pem, serialization.PrivateFormat.PKCS8, serialization.NoEncryption()))
     os.chmod(paths["key"], 0o600)
     return paths
 
@@ -125,18 +151,26 @@ def folder_security(address: str, folder=None, insecure: bool = False):
         folder = Path(folder).expanduser()
         missing = [name for name in (CA_FILE, CERT_FILE, KEY_FILE) if not (folder / name).is_file()]
         if missing:
-            raise FieldError("certificates", str(folder), "a folder made by 'ladartui certs' "
-                             f"(missing: {', '.join(missing)})")
+            raise FieldError(
+                "certificates",
+                str(folder),
+                f"a folder made by 'ladartui certs' (missing: {', '.join(missing)})",
+            )
         if scheme != "tls":
-            raise FieldError("scheduler", address, "a tls://HOST:PORT address to use the "
-                             "certificates with")
-        return cluster_security(address, folder / CA_FILE, folder / CERT_FILE,
-                                folder / KEY_FILE)
+            raise FieldError("scheduler", address, "a tls://HOST:PORT address to use the certificates with")
+        return cluster_security(address, folder / CA_FILE, folder / CERT_FILE, folder / KEY_FILE)
     if scheme == "tls":
-        raise FieldError("certificates", "", f"the folder of the certificates for {address} "
-                         "(ladartui certs DIR makes them)")
+        raise FieldError(
+            "certificates",
+            "",
+            f"the folder of the certificates for {address} (ladartui certs DIR makes them)",
+        )
     if not insecure and not is_loopback(address):
-        raise FieldError("scheduler", address, "a tls:// address with its certificates, or a "
-                         "loopback address: any peer that reaches a plain tcp:// scheduler can "
-                         "run code on it, its workers and this machine (see docs/sweeps.md)")
+        raise FieldError(
+            "scheduler",
+            address,
+            "a tls:// address with its certificates, or a "
+            "loopback address: any peer that reaches a plain tcp:// scheduler can "
+            "run code on it, its workers and this machine (see docs/sweeps.md)",
+        )
     return None

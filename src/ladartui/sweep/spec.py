@@ -88,7 +88,7 @@ class Variant:
     id: str
 
     @classmethod
-    def of(cls, params: dict) -> "Variant":
+    def of(cls, params: dict) -> Variant:
         return cls(dict(params), variant_id(params))
 
 
@@ -132,7 +132,8 @@ def variant_id(params: dict) -> str:
     # repr of a float round-trips exactly, so equal values always give equal text.
     text = json.dumps(
         {k: (repr(v) if isinstance(v, float) else v) for k, v in canonical.items()},
-        sort_keys=True, separators=(",", ":"),
+        sort_keys=True,
+        separators=(",", ":"),
     )
     return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
 
@@ -183,9 +184,11 @@ def _check_variant_count(path, grid, samples):
     if count > MAX_VARIANTS:
         sizes = " x ".join(f"{len(v)} {k}" for k, v in grid.items())
         draws = f"{samples:,} random draws" if samples else ""
-        raise ResourceLimitError(f"{path}: [grid] and [random] make {count:,} variants "
-                                 f"({' x '.join(filter(None, (sizes, draws)))}), more than the "
-                                 f"limit of {MAX_VARIANTS:,}; use fewer values or samples")
+        raise ResourceLimitError(
+            f"{path}: [grid] and [random] make {count:,} variants "
+            f"({' x '.join(filter(None, (sizes, draws)))}), more than the "
+            f"limit of {MAX_VARIANTS:,}; use fewer values or samples"
+        )
 
 
 def load_sweep_spec(path) -> SweepSpec:
@@ -197,8 +200,7 @@ def load_sweep_spec(path) -> SweepSpec:
     except FileNotFoundError:
         raise InputFileError(path, "no such sweep spec") from None
     except RecursionError:
-        raise InputFileError(path, "not valid TOML: arrays or tables nested too deep to read") \
-            from None
+        raise InputFileError(path, "not valid TOML: arrays or tables nested too deep to read") from None
     except (OSError, UnicodeDecodeError) as error:
         raise InputFileError(path, f"cannot read: {error}") from None
     except tomllib.TOMLDecodeError as error:
@@ -214,25 +216,27 @@ def parse_sweep_spec(data: dict, path, text: str = "") -> SweepSpec:
     checker.known_keys(data, "", {"sweep", "grid", "random"})
     head = data.get("sweep")
     if not isinstance(head, dict):
-        checker.fail("sweep", "a [sweep] table with scenario = \"BASE.toml\"")
+        checker.fail("sweep", 'a [sweep] table with scenario = "BASE.toml"')
     checker.known_keys(head, "sweep.", {"scenario", "name", "objective", "cost", "budget"})
     scenario = head.get("scenario")
     if not isinstance(scenario, str) or not scenario:
-        checker.fail("sweep.scenario", "the base scenario file, a path relative to the spec",
-                     scenario)
-    objective = checker.choice(head, "sweep.objective", "objective", OBJECTIVE_NAMES,
-                               "obscured-coverage")
+        checker.fail("sweep.scenario", "the base scenario file, a path relative to the spec", scenario)
+    objective = checker.choice(head, "sweep.objective", "objective", OBJECTIVE_NAMES, "obscured-coverage")
     cost = checker.choice(head, "sweep.cost", "cost", COST_NAMES, "flight-time")
     budget = head.get("budget")
     if budget is not None and not (_is_number(budget) and budget > 0):
         checker.fail("sweep.budget", "a flight-time budget in seconds, > 0", budget)
     if objective == "coverage-within-budget" and budget is None:
-        checker.fail("sweep.budget", "a flight-time budget in seconds for objective "
-                     "'coverage-within-budget'", None)
+        checker.fail(
+            "sweep.budget", "a flight-time budget in seconds for objective 'coverage-within-budget'", None
+        )
     name = head.get("name", path.stem)
     if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]*", name):
-        checker.fail("sweep.name", "a file-name stem of letters, digits, '.', '_' or '-' "
-                     "(it names the best-path scenario file)", name)
+        checker.fail(
+            "sweep.name",
+            "a file-name stem of letters, digits, '.', '_' or '-' (it names the best-path scenario file)",
+            name,
+        )
 
     grid = {}
     table = data.get("grid", {})
@@ -258,20 +262,29 @@ def parse_sweep_spec(data: dict, path, text: str = "") -> SweepSpec:
                 continue
             checker.parameter_name(f"random.{key}", key)
             if key in grid:
-                checker.fail(f"random.{key}", "each parameter in [grid] or [random], not both",
-                             value)
+                checker.fail(f"random.{key}", "each parameter in [grid] or [random], not both", value)
             random[key] = checker.random_rule(f"random.{key}", key, value)
         if not random:
             checker.fail("random", "at least one parameter rule besides samples and seed", None)
     if not grid and not random:
-        checker.fail("grid", "at least one parameter to vary in [grid] or [random]; known: "
-                     + ", ".join(PARAMETERS), None)
+        checker.fail(
+            "grid",
+            "at least one parameter to vary in [grid] or [random]; known: " + ", ".join(PARAMETERS),
+            None,
+        )
     _check_variant_count(path, grid, samples)
     scenario_path = DEFAULT_BASE if scenario == "default" else path.parent / scenario
     return SweepSpec(
-        path=path, scenario_path=scenario_path, grid=grid, random=random,
-        samples=samples, seed=seed, objective=objective, cost=cost,
-        budget=float(budget) if budget is not None else None, name=name,
+        path=path,
+        scenario_path=scenario_path,
+        grid=grid,
+        random=random,
+        samples=samples,
+        seed=seed,
+        objective=objective,
+        cost=cost,
+        budget=float(budget) if budget is not None else None,
+        name=name,
     )
 
 
@@ -289,8 +302,7 @@ class _Checker:
     def fail(self, key, expected, value=...):
         shown = "" if value is ... else f" (got {value!r})"
         table, _, name = key.rpartition(".")
-        raise InputFileError(self.path, f"{key}: expected {expected}{shown}",
-                             line=self.line(table, name))
+        raise InputFileError(self.path, f"{key}: expected {expected}{shown}", line=self.line(table, name))
 
     def line(self, table, key):
         """1-based line of ``key`` in ``[table]`` (or of the table header), None if not found."""
@@ -311,8 +323,11 @@ class _Checker:
     def known_keys(self, table, prefix, allowed):
         for key in table:
             if key not in allowed:
-                raise InputFileError(self.path, f"{prefix}{key}: unknown key; expected one of "
-                                     + ", ".join(sorted(allowed)), line=self.line(prefix, key))
+                raise InputFileError(
+                    self.path,
+                    f"{prefix}{key}: unknown key; expected one of " + ", ".join(sorted(allowed)),
+                    line=self.line(prefix, key),
+                )
 
     def choice(self, table, key, short, allowed, default):
         value = table.get(short, default)
@@ -323,8 +338,11 @@ class _Checker:
 
     def parameter_name(self, key, name):
         if name not in PARAMETERS:
-            raise InputFileError(self.path, f"{key}: unknown parameter; expected one of "
-                                 + ", ".join(PARAMETERS), line=self.line(*key.rsplit(".", 1)))
+            raise InputFileError(
+                self.path,
+                f"{key}: unknown parameter; expected one of " + ", ".join(PARAMETERS),
+                line=self.line(*key.rsplit(".", 1)),
+            )
 
     def scalar(self, key, name, value):
         parameter = PARAMETERS[name]
@@ -380,8 +398,13 @@ class _Checker:
         if not {"min", "max"} <= set(value) or not set(value) <= allowed:
             self.fail(key, "{ min = A, max = B } (and integer = true for whole numbers)", value)
         low, high = value["min"], value["max"]
-        if not (_is_number(low) and _is_number(high) and low <= high
-                and -RANDOM_BOUND <= low and high <= RANDOM_BOUND):
+        if not (
+            _is_number(low)
+            and _is_number(high)
+            and low <= high
+            and -RANDOM_BOUND <= low
+            and high <= RANDOM_BOUND
+        ):
             self.fail(key, f"numbers with min <= max, within +-{RANDOM_BOUND:g}", value)
         integer = value.get("integer", parameter.kind == "int")
         if not isinstance(integer, bool):

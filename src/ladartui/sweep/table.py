@@ -24,12 +24,10 @@ from ladartui.errors import InputFileError
 
 # Columns that lead every table, in this order; parameters and measures follow.
 LEAD_COLUMNS = ("variant", "status", "base")
-RUN_COLUMNS = ("path_length_m", "flight_time_s", "scan_count", "run_time_s", "backend", "method",
-               "worker")
+RUN_COLUMNS = ("path_length_m", "flight_time_s", "scan_count", "run_time_s", "backend", "method", "worker")
 TAIL_COLUMNS = ("error",)
 # Never parsed as numbers: a hex id such as "1e50..." would otherwise read as a float.
-TEXT_COLUMNS = frozenset({"variant", "status", "base", "backend", "method", "worker", "error",
-                          "preset"})
+TEXT_COLUMNS = frozenset({"variant", "status", "base", "backend", "method", "worker", "error", "preset"})
 
 
 def format_cell(value) -> str:
@@ -143,8 +141,10 @@ def read_table(path) -> tuple[list[dict], list[str]]:
             continue
         if len(cells) != len(header):
             continue
-        row = {column: (cell or None) if column in TEXT_COLUMNS else parse_cell(cell)
-               for column, cell in zip(header, cells)}
+        row = {
+            column: (cell or None) if column in TEXT_COLUMNS else parse_cell(cell)
+            for column, cell in zip(header, cells)
+        }
         if not row.get("variant"):
             continue
         rows.append(row)

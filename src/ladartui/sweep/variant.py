@@ -37,8 +37,12 @@ import numpy as np
 from ladartui.errors import Cancelled, FieldError, LadarError
 
 PRESET_KINDS = ("orbit", "flypast", "standoff")
-SENSOR_FIELDS = {"sensor_grid": "grid", "ray_grid": "ray_grid", "fov": "fov",
-                 "depth_resolution": "depth_resolution"}
+SENSOR_FIELDS = {
+    "sensor_grid": "grid",
+    "ray_grid": "ray_grid",
+    "fov": "fov",
+    "depth_resolution": "depth_resolution",
+}
 FLIGHT_PARAMETERS = ("preset", "radius", "standoff", "altitude", "scans", "heading_offset", "arc")
 
 # A path built without a base preset starts (or passes closest) due south of the target.
@@ -97,15 +101,20 @@ def _base_geometry(segment):
     if segment.kind == "orbit":
         return segment.centre, segment.start_bearing, segment.radius, segment.scans
     if segment.kind == "flypast":
-        return (segment.target, segment.heading - _flypast_turn(segment.side),
-                segment.standoff, segment.scans)
+        return (
+            segment.target,
+            segment.heading - _flypast_turn(segment.side),
+            segment.standoff,
+            segment.scans,
+        )
     return segment.target, segment.bearing, max(segment.standoffs), len(segment.standoffs)
 
 
 def _need(name, value, preset):
     if value is None:
-        raise FieldError(name, None, f"a value in the sweep, since the base scenario has "
-                         f"no {preset} to take it from")
+        raise FieldError(
+            name, None, f"a value in the sweep, since the base scenario has no {preset} to take it from"
+        )
     return value
 
 
@@ -138,8 +147,7 @@ def build_preset(params: dict, base_segment, default_target):
 
     if preset == "orbit":
         fields = dataclasses.asdict(base_segment) if same else {}
-        fields.update(centre=target, radius=distance, altitude=altitude, scans=scans,
-                      start_bearing=bearing)
+        fields.update(centre=target, radius=distance, altitude=altitude, scans=scans, start_bearing=bearing)
         if "arc" in params:
             fields["arc"] = params["arc"]
         fields.setdefault("aim_at", None)
@@ -148,8 +156,14 @@ def build_preset(params: dict, base_segment, default_target):
         fields = dataclasses.asdict(base_segment) if same else {}
         side = fields.get("side", "right")
         length = fields.get("length", 2.0 * float(distance))
-        fields.update(target=target, standoff=distance, altitude=altitude, scans=scans,
-                      heading=bearing + _flypast_turn(side), length=length)
+        fields.update(
+            target=target,
+            standoff=distance,
+            altitude=altitude,
+            scans=scans,
+            heading=bearing + _flypast_turn(side),
+            length=length,
+        )
         return FlyPast(**fields)
     fields = dataclasses.asdict(base_segment) if same else {}
     farthest = max(base_segment.standoffs) if same else 0.0
@@ -174,15 +188,21 @@ def variant_flight(base_flight, params: dict, scene_loader):
     index, segment = preset_segment(base_flight)
     if "preset" not in params and segment is None:
         name = next(iter(flight_params))
-        raise FieldError(name, params[name], "a 'preset' in the sweep: the base scenario's "
-                         "flight plan has no orbit, flypast or standoff segment to vary")
+        raise FieldError(
+            name,
+            params[name],
+            "a 'preset' in the sweep: the base scenario's "
+            "flight plan has no orbit, flypast or standoff segment to vary",
+        )
     if "preset" not in params:
         preset = segment.kind
         wrong = [k for k in flight_params if k not in APPLIES[preset]]
         if wrong:
-            raise FieldError(wrong[0], params[wrong[0]],
-                             f"a parameter of the base's {preset} (" +
-                             ", ".join(sorted(APPLIES[preset])) + ")")
+            raise FieldError(
+                wrong[0],
+                params[wrong[0]],
+                f"a parameter of the base's {preset} (" + ", ".join(sorted(APPLIES[preset])) + ")",
+            )
 
     def default_target():
         return target_point(scene_loader())
@@ -223,9 +243,15 @@ def _as_parameter(error: FieldError, params: dict) -> FieldError:
     for name, sensor_field in SENSOR_FIELDS.items():
         if sensor_field == field and name in params:
             return FieldError(name, params[name], error.expected)
-    aliases = {"centre": "preset", "target": "preset", "start_bearing": "heading_offset",
-               "bearing": "heading_offset", "heading": "heading_offset", "standoffs": "standoff",
-               "speed_mps": "speed"}
+    aliases = {
+        "centre": "preset",
+        "target": "preset",
+        "start_bearing": "heading_offset",
+        "bearing": "heading_offset",
+        "heading": "heading_offset",
+        "standoffs": "standoff",
+        "speed_mps": "speed",
+    }
     name = aliases.get(field, field)
     if name in params:
         return FieldError(name, params[name], error.expected)
@@ -258,8 +284,9 @@ def worker_name() -> str:
     return f"{socket.gethostname()}:{os.getpid()}"
 
 
-def run_variant(base, params: dict, variant_id: str, base_digest: str = "", scene=None,
-                simulate_options=None) -> dict:
+def run_variant(
+    base, params: dict, variant_id: str, base_digest: str = "", scene=None, simulate_options=None
+) -> dict:
     """Simulate one variant (scene and target-only runs, nothing written) and return its row.
 
     ``scene`` is the loaded base scene (shared by every variant on a worker);
@@ -312,9 +339,16 @@ class ScenePayload:
     path: str | None
 
     @classmethod
-    def of(cls, scene, token: str) -> "ScenePayload":
-        return cls(token, scene.voxels, scene.target, scene.voxel_size, tuple(scene.shape),
-                   scene.name, None if scene.path is None else str(scene.path))
+    def of(cls, scene, token: str) -> ScenePayload:
+        return cls(
+            token,
+            scene.voxels,
+            scene.target,
+            scene.voxel_size,
+            tuple(scene.shape),
+            scene.name,
+            None if scene.path is None else str(scene.path),
+        )
 
 
 # Scenes rebuilt on this worker, by payload token: the occupancy built by the
@@ -333,8 +367,14 @@ def scene_of(scene):
     with _worker_lock:
         cached = _WORKER_SCENES.get(scene.token)
         if cached is None:
-            cached = Scene(scene.voxels, scene.target, scene.voxel_size, shape=scene.shape,
-                           name=scene.name, path=scene.path)
+            cached = Scene(
+                scene.voxels,
+                scene.target,
+                scene.voxel_size,
+                shape=scene.shape,
+                name=scene.name,
+                path=scene.path,
+            )
             _WORKER_SCENES[scene.token] = cached
             while len(_WORKER_SCENES) > _WORKER_SCENES_KEPT:
                 _WORKER_SCENES.popitem(last=False)

@@ -17,8 +17,19 @@ import numpy as np
 from ladartui.errors import BackendUnavailable, FieldError
 from ladartui.tracing.backend import GROUND, METHODS, MISS, VOXEL, backend_names, backend_status, get_backend
 
-__all__ = ["trace", "TraceResult", "choose_backend", "to_cells", "MISS", "VOXEL", "GROUND",
-           "METHODS", "backend_names", "backend_status", "get_backend"]
+__all__ = [
+    "trace",
+    "TraceResult",
+    "choose_backend",
+    "to_cells",
+    "MISS",
+    "VOXEL",
+    "GROUND",
+    "METHODS",
+    "backend_names",
+    "backend_status",
+    "get_backend",
+]
 
 DEFAULT_STEP = 0.5
 TINY = 1e-200
@@ -40,8 +51,7 @@ class TraceResult:
 
     def as_array(self) -> np.ndarray:
         """(N, 5) float64: kind, i, j, k, range."""
-        return np.column_stack([self.kind.astype(np.float64), self.index.astype(np.float64),
-                                self.range])
+        return np.column_stack([self.kind.astype(np.float64), self.index.astype(np.float64), self.range])
 
 
 @functools.cache
@@ -49,8 +59,12 @@ def choose_backend() -> str:
     """The fastest usable backend: wgpu on a real GPU adapter, else numba (probed once)."""
     try:
         gpu = get_backend("wgpu")
-        if str(gpu.describe().get("adapter_type", "")).lower() in ("discretegpu", "integratedgpu",
-                                                                  "discrete", "integrated"):
+        if str(gpu.describe().get("adapter_type", "")).lower() in (
+            "discretegpu",
+            "integratedgpu",
+            "discrete",
+            "integrated",
+        ):
             return "wgpu"
     except (BackendUnavailable, FieldError):
         pass
@@ -62,8 +76,17 @@ def to_cells(origins_m, voxel_size):
     return np.asarray(origins_m, dtype=np.float64) / voxel_size + 0.5
 
 
-def trace(scene_or_occupancy, origins, directions, backend="auto", method="exact", step=None,
-          precision="f64", voxel_size=None, cancel: threading.Event | None = None) -> TraceResult:
+def trace(
+    scene_or_occupancy,
+    origins,
+    directions,
+    backend="auto",
+    method="exact",
+    step=None,
+    precision="f64",
+    voxel_size=None,
+    cancel: threading.Event | None = None,
+) -> TraceResult:
     """Trace rays (metres, scene frame) against a Scene or an Occupancy.
 
     ``method`` is "exact" (first voxel whose interior the ray enters) or "march"
@@ -74,8 +97,9 @@ def trace(scene_or_occupancy, origins, directions, backend="auto", method="exact
     origins = _rays("origins", origins)
     directions = _rays("directions", directions)
     if origins.shape != directions.shape:
-        raise FieldError("directions", f"array of shape {directions.shape}",
-                         f"the same shape as origins {origins.shape}")
+        raise FieldError(
+            "directions", f"array of shape {directions.shape}", f"the same shape as origins {origins.shape}"
+        )
     if method not in METHODS:
         raise FieldError("method", method, "one of " + ", ".join(METHODS))
     if step is None:
@@ -97,8 +121,9 @@ def trace(scene_or_occupancy, origins, directions, backend="auto", method="exact
             raise FieldError(f"directions[{bad}]", directions[bad].tolist(), "a non-zero vector")
         raise FieldError(what, "non-finite values", "finite numbers")
     started = time.perf_counter()
-    cells = engine.trace_cells(occupancy, origin_cells, unit,
-                               method=method, step=float(step), precision=precision, cancel=cancel)
+    cells = engine.trace_cells(
+        occupancy, origin_cells, unit, method=method, step=float(step), precision=precision, cancel=cancel
+    )
     info = dict(cells.info)
     info["seconds_total"] = time.perf_counter() - started
     return TraceResult(cells.kind, cells.index, cells.t * voxel_size, name, method, info)

@@ -9,8 +9,9 @@ Backends are probed lazily: an unavailable one explains why only when asked.
 from __future__ import annotations
 
 import threading
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Callable, Protocol
+from typing import Protocol
 
 import numpy as np
 
@@ -40,8 +41,17 @@ class Backend(Protocol):
     def describe(self) -> dict:
         """What runs the work (threads, adapter name/type/backend), for reports."""
 
-    def trace_cells(self, occupancy, origins, directions, *, method="exact", step=0.5,
-                    precision="f64", cancel: threading.Event | None = None) -> CellHits:
+    def trace_cells(
+        self,
+        occupancy,
+        origins,
+        directions,
+        *,
+        method="exact",
+        step=0.5,
+        precision="f64",
+        cancel: threading.Event | None = None,
+    ) -> CellHits:
         """Trace (N, 3) float64 cell-space origins and unit directions."""
 
 

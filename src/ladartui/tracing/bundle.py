@@ -41,8 +41,7 @@ INF = np.inf
 
 
 @njit(nogil=True, cache=True)
-def bundle_start(orig, dirs, first, end, halo, halo_origin, halo_dims, fine, fine_origin,
-                 fine_dims):
+def bundle_start(orig, dirs, first, end, halo, halo_origin, halo_dims, fine, fine_origin, fine_dims):
     """Parameter ``t`` before which no ray ``first..end-1`` meets an occupied voxel (>= 0)."""
     if halo.shape[0] == 0 or end <= first:
         return 0.0
@@ -73,8 +72,7 @@ def bundle_start(orig, dirs, first, end, halo, halo_origin, halo_dims, fine, fin
     if stop < limit and fine.shape[0] != 0 and fine_reach > 0.0:
         # Near the first brick the centre ray can meet, go on over the 4-voxel halo.
         fine_limit = fine_reach / spread if spread > 0.0 else INF
-        stop = max(stop, _walk(ox, oy, oz, dx, dy, dz, stop, fine_limit, fine, fine_origin,
-                               fine_dims, 4.0))
+        stop = max(stop, _walk(ox, oy, oz, dx, dy, dz, stop, fine_limit, fine, fine_origin, fine_dims, 4.0))
     return max(0.0, stop - 1.0 / length)
 
 
@@ -126,13 +124,22 @@ def _cell(c, scale, origin, dims):
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def bundle_starts(orig, dirs, chunk, halo, halo_origin, halo_dims, fine, fine_origin, fine_dims,
-                  out):
+def bundle_starts(orig, dirs, chunk, halo, halo_origin, halo_dims, fine, fine_origin, fine_dims, out):
     """``bundle_start`` of every ``chunk`` consecutive rays, into ``out``."""
     n = orig.shape[0]
     for c in prange((n + chunk - 1) // chunk):
-        out[c] = bundle_start(orig, dirs, c * chunk, min(n, (c + 1) * chunk), halo, halo_origin,
-                              halo_dims, fine, fine_origin, fine_dims)
+        out[c] = bundle_start(
+            orig,
+            dirs,
+            c * chunk,
+            min(n, (c + 1) * chunk),
+            halo,
+            halo_origin,
+            halo_dims,
+            fine,
+            fine_origin,
+            fine_dims,
+        )
 
 
 def halo_arrays(occupancy):
@@ -145,5 +152,8 @@ def _bits(occupancy, name):
     bits = getattr(occupancy, name, None)
     if bits is None or getattr(occupancy, name + "_dims", None) is None or len(bits) == 0:
         return np.zeros(0, np.uint32), np.zeros(3, np.int64), np.zeros(3, np.int64)
-    return (bits, np.asarray(getattr(occupancy, name + "_origin"), np.int64),
-            np.asarray(getattr(occupancy, name + "_dims"), np.int64))
+    return (
+        bits,
+        np.asarray(getattr(occupancy, name + "_origin"), np.int64),
+        np.asarray(getattr(occupancy, name + "_dims"), np.int64),
+    )

@@ -61,8 +61,7 @@ def _enter(c, b, stepped, positive, s, o, d, inv, t):
 @njit(nogil=True, cache=True, inline="always")
 def _brick_entry(b, stepped, positive, o, d, inv, t):
     """Cell on one axis on entering brick ``b`` at ``t`` after a brick step."""
-    return _enter(b << 3, (b << 3) if positive else ((b + 1) << 3), stepped, positive, 3, o, d,
-                  inv, t)
+    return _enter(b << 3, (b << 3) if positive else ((b + 1) << 3), stepped, positive, 3, o, d, inv, t)
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -80,9 +79,34 @@ def _answer(found, i, j, k, t, ox, oy, oz, dx, dy, dz, nx, ny):
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def _exact_kernel(orig, dirs, root, regions, tiles, bricks, blocks, columns, cubes, corg, cdims,
-                  halo, horg, hdims, halo4, h4org, h4dims, lo, hi, rorg, rdims, nx, ny, kind,
-                  index, tout):
+def _exact_kernel(
+    orig,
+    dirs,
+    root,
+    regions,
+    tiles,
+    bricks,
+    blocks,
+    columns,
+    cubes,
+    corg,
+    cdims,
+    halo,
+    horg,
+    hdims,
+    halo4,
+    h4org,
+    h4dims,
+    lo,
+    hi,
+    rorg,
+    rdims,
+    nx,
+    ny,
+    kind,
+    index,
+    tout,
+):
     """The exact traversal of docs/architecture.md for every ray, chunks under prange.
 
     The per-ray code is written out here rather than called: passing the
@@ -103,8 +127,9 @@ def _exact_kernel(orig, dirs, root, regions, tiles, bricks, blocks, columns, cub
     chunks = (n + CHUNK - 1) // CHUNK
     for ch in prange(chunks):
         # Step 0: where the chunk's rays may all start (tracing.bundle; 0 when they diverge).
-        start = bundle_start(orig, dirs, ch * CHUNK, min(n, (ch + 1) * CHUNK), halo, horg, hdims,
-                             halo4, h4org, h4dims)
+        start = bundle_start(
+            orig, dirs, ch * CHUNK, min(n, (ch + 1) * CHUNK), halo, horg, hdims, halo4, h4org, h4dims
+        )
         for r in range(ch * CHUNK, min(n, (ch + 1) * CHUNK)):
             ox, oy, oz = orig[r, 0], orig[r, 1], orig[r, 2]
             dx, dy, dz = dirs[r, 0], dirs[r, 1], dirs[r, 2]
@@ -116,8 +141,11 @@ def _exact_kernel(orig, dirs, root, regions, tiles, bricks, blocks, columns, cub
                     done = True
                     break
                 # Step 1: a ray inside a plane of cell faces enters no interior.
-                if (dx == 0.0 and ox == math.floor(ox)) or (dy == 0.0 and oy == math.floor(oy)) \
-                        or (dz == 0.0 and oz == math.floor(oz)):
+                if (
+                    (dx == 0.0 and ox == math.floor(ox))
+                    or (dy == 0.0 and oy == math.floor(oy))
+                    or (dz == 0.0 and oz == math.floor(oz))
+                ):
                     done = True
                     break
                 ix = 1.0 / dx if dx != 0.0 else INF
@@ -216,11 +244,18 @@ def _exact_kernel(orig, dirs, root, regions, tiles, bricks, blocks, columns, cub
                                         # 4 or 2 voxels a side, else the voxel (sh = 2, 1, 0).
                                         at4 = ((lx >> 2) << 1) | ((ly >> 2) << 3) | ((lz >> 2) << 5)
                                         at2 = (lx >> 1) | ((ly >> 1) << 2) | ((lz >> 1) << 4)
-                                        sh = 2 if (mask >> np.uint64(at4)) & np.uint64(0x330033) == 0 else (
-                                            1 if (mask >> np.uint64(at2)) & np.uint64(1) == 0 else 0)
-                                        tn = min((np.float64(((cx >> sh) + ax) << sh) - ox) * ix,
-                                                 min((np.float64(((cy >> sh) + ay) << sh) - oy) * iy,
-                                                     (np.float64(((cz >> sh) + az) << sh) - oz) * iz))
+                                        sh = (
+                                            2
+                                            if (mask >> np.uint64(at4)) & np.uint64(0x330033) == 0
+                                            else (1 if (mask >> np.uint64(at2)) & np.uint64(1) == 0 else 0)
+                                        )
+                                        tn = min(
+                                            (np.float64(((cx >> sh) + ax) << sh) - ox) * ix,
+                                            min(
+                                                (np.float64(((cy >> sh) + ay) << sh) - oy) * iy,
+                                                (np.float64(((cz >> sh) + az) << sh) - oz) * iz,
+                                            ),
+                                        )
                                         if tn >= t1:
                                             done = True
                                             break
@@ -261,15 +296,37 @@ def _exact_kernel(orig, dirs, root, regions, tiles, bricks, blocks, columns, cub
                                     # that whole column part, whichever reaches further.
                                     k = far if far >= 2 else 1
                                     near = k - 1
-                                    tbx = (np.float64((bx + k) << 3 if px else (bx - near) << 3) - ox) * ix if mx else INF
-                                    tby = (np.float64((by + k) << 3 if py else (by - near) << 3) - oy) * iy if my else INF
-                                    tbz = (np.float64((bz + k) << 3 if pz else (bz - near) << 3) - oz) * iz if mz else INF
+                                    tbx = (
+                                        (np.float64((bx + k) << 3 if px else (bx - near) << 3) - ox) * ix
+                                        if mx
+                                        else INF
+                                    )
+                                    tby = (
+                                        (np.float64((by + k) << 3 if py else (by - near) << 3) - oy) * iy
+                                        if my
+                                        else INF
+                                    )
+                                    tbz = (
+                                        (np.float64((bz + k) << 3 if pz else (bz - near) << 3) - oz) * iz
+                                        if mz
+                                        else INF
+                                    )
                                     tn = min(tbx, min(tby, tbz))
-                                    top = columns[(bx - qx0) + qnx * (by - qy0)] + qz0 if descending else bz + 1
+                                    top = (
+                                        columns[(bx - qx0) + qnx * (by - qy0)] + qz0 if descending else bz + 1
+                                    )
                                     above = bz >= top
                                     if above:
-                                        tcx = (np.float64((bx + 1) << 3 if px else bx << 3) - ox) * ix if mx else INF
-                                        tcy = (np.float64((by + 1) << 3 if py else by << 3) - oy) * iy if my else INF
+                                        tcx = (
+                                            (np.float64((bx + 1) << 3 if px else bx << 3) - ox) * ix
+                                            if mx
+                                            else INF
+                                        )
+                                        tcy = (
+                                            (np.float64((by + 1) << 3 if py else by << 3) - oy) * iy
+                                            if my
+                                            else INF
+                                        )
                                         tcz = (np.float64(top << 3) - oz) * iz
                                         tc = min(tcx, min(tcy, tcz))
                                         above = tc > tn or k == 1
@@ -284,15 +341,27 @@ def _exact_kernel(orig, dirs, root, regions, tiles, bricks, blocks, columns, cub
                                     if stx:
                                         bx += sx * k
                                     elif near > 0:
-                                        bx = clamp(cell_at(ox, dx, ix, tn) >> 3, bx - (0 if px else near), bx + (near if px else 0))
+                                        bx = clamp(
+                                            cell_at(ox, dx, ix, tn) >> 3,
+                                            bx - (0 if px else near),
+                                            bx + (near if px else 0),
+                                        )
                                     if sty:
                                         by += sy * k
                                     elif near > 0:
-                                        by = clamp(cell_at(oy, dy, iy, tn) >> 3, by - (0 if py else near), by + (near if py else 0))
+                                        by = clamp(
+                                            cell_at(oy, dy, iy, tn) >> 3,
+                                            by - (0 if py else near),
+                                            by + (near if py else 0),
+                                        )
                                     if stz:
                                         bz = top - 1 if above else bz + sz * k
                                     elif above or near > 0:
-                                        zlo, zhi = (top, bz) if above else (bz - (0 if pz else near), bz + (near if pz else 0))
+                                        zlo, zhi = (
+                                            (top, bz)
+                                            if above
+                                            else (bz - (0 if pz else near), bz + (near if pz else 0))
+                                        )
                                         bz = clamp(cell_at(oz, dz, iz, tn) >> 3, zlo, zhi)
                                     t = tn
                                     fresh = False
@@ -317,7 +386,8 @@ def _exact_kernel(orig, dirs, root, regions, tiles, bricks, blocks, columns, cub
                     cz = _enter(cz, bzn, tz == tn, pz, s, oz, dz, iz, tn)
                     t = tn
             kind[r], index[r, 0], index[r, 1], index[r, 2], tout[r] = _answer(
-                found, cx, cy, cz, t, ox, oy, oz, dx, dy, dz, nx, ny)
+                found, cx, cy, cz, t, ox, oy, oz, dx, dy, dz, nx, ny
+            )
 
 
 @njit(parallel=True, nogil=True, cache=True)
@@ -329,13 +399,26 @@ def scan_answers(order, best_t, best_v, vox, orig, dirs, nx, ny, kind, index, to
         q = best_v[s]
         i, j, k = (vox[q, 0], vox[q, 1], vox[q, 2]) if q >= 0 else (-1, -1, -1)
         kind[r], index[r, 0], index[r, 1], index[r, 2], tout[r] = _answer(
-            q >= 0, i, j, k, best_t[s], orig[r, 0], orig[r, 1], orig[r, 2], dirs[r, 0], dirs[r, 1],
-            dirs[r, 2], nx, ny)
+            q >= 0,
+            i,
+            j,
+            k,
+            best_t[s],
+            orig[r, 0],
+            orig[r, 1],
+            orig[r, 2],
+            dirs[r, 0],
+            dirs[r, 1],
+            dirs[r, 2],
+            nx,
+            ny,
+        )
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def _march_kernel(orig, dirs, step, zmax, root, regions, tiles, bricks, lo, hi, rorg, rdims,
-                  nx, ny, kind, index, tout):
+def _march_kernel(
+    orig, dirs, step, zmax, root, regions, tiles, bricks, lo, hi, rorg, rdims, nx, ny, kind, index, tout
+):
     """The report's fixed-step march (docs/architecture.md "March") for every ray."""
     n = orig.shape[0]
     chunks = (n + CHUNK - 1) // CHUNK
@@ -365,8 +448,9 @@ def _march_kernel(orig, dirs, step, zmax, root, regions, tiles, bricks, lo, hi, 
                 x, y, z = np.int64(math.floor(cx)), np.int64(math.floor(cy)), np.int64(math.floor(cz))
                 if x < lo[0] or y < lo[1] or z < lo[2] or x >= hi[0] or y >= hi[1] or z >= hi[2]:
                     continue
-                g = root[((x - rorg[0]) >> 9)
-                         + rdims[0] * (((y - rorg[1]) >> 9) + rdims[1] * ((z - rorg[2]) >> 9))]
+                g = root[
+                    ((x - rorg[0]) >> 9) + rdims[0] * (((y - rorg[1]) >> 9) + rdims[1] * ((z - rorg[2]) >> 9))
+                ]
                 if g == 0:
                     continue
                 tl = regions[(np.int64(g) - 1) * 512 + _slot(x, y, z, 6)]
@@ -398,8 +482,12 @@ class NumbaBackend:
         return None
 
     def describe(self):
-        return {"device": "cpu", "threads": numba.get_num_threads(),
-                "threading_layer": _threading_layer(), "precision": "f64"}
+        return {
+            "device": "cpu",
+            "threads": numba.get_num_threads(),
+            "threading_layer": _threading_layer(),
+            "precision": "f64",
+        }
 
     def warm_up(self, occupancy):
         """Compile (or load from cache) both kernels on a tiny batch."""
@@ -409,9 +497,19 @@ class NumbaBackend:
             self.trace_cells(occupancy, o, d, method=method)
         self.trace_cells(occupancy, o, d, object_order=True)
 
-    def trace_cells(self, occupancy, origins, directions, *, method="exact", step=0.5,
-                    precision="f64", cancel: threading.Event | None = None,
-                    bundles: bool = True, object_order: bool | None = None) -> CellHits:
+    def trace_cells(
+        self,
+        occupancy,
+        origins,
+        directions,
+        *,
+        method="exact",
+        step=0.5,
+        precision="f64",
+        cancel: threading.Event | None = None,
+        bundles: bool = True,
+        object_order: bool | None = None,
+    ) -> CellHits:
         """See ``Backend``. For tests: ``bundles=False`` starts every ray at its box entry;
         ``object_order`` True traces scans in object order whatever they cost, False never
         (None: blocks that are scans with few voxels in view go in the order that has
@@ -437,27 +535,75 @@ class NumbaBackend:
                     raise Cancelled("trace cancelled")
                 d = min(b, c + BLOCK)
                 if method == "exact":
-                    _exact_kernel(orig[c:d], dirs[c:d], occ.root, occ.regions, occ.tiles,
-                                  occ.bricks, blocks, occ.columns, cubes, corg, cdims, *halo, lo, hi,
-                                  rorg, rdims, nx, ny, kind[c:d], index[c:d], t[c:d])
+                    _exact_kernel(
+                        orig[c:d],
+                        dirs[c:d],
+                        occ.root,
+                        occ.regions,
+                        occ.tiles,
+                        occ.bricks,
+                        blocks,
+                        occ.columns,
+                        cubes,
+                        corg,
+                        cdims,
+                        *halo,
+                        lo,
+                        hi,
+                        rorg,
+                        rdims,
+                        nx,
+                        ny,
+                        kind[c:d],
+                        index[c:d],
+                        t[c:d],
+                    )
                 else:
-                    _march_kernel(orig[c:d], dirs[c:d], float(step), float(occ.zmax), occ.root,
-                                  occ.regions, occ.tiles, occ.bricks, lo, hi, rorg, rdims, nx, ny,
-                                  kind[c:d], index[c:d], t[c:d])
+                    _march_kernel(
+                        orig[c:d],
+                        dirs[c:d],
+                        float(step),
+                        float(occ.zmax),
+                        occ.root,
+                        occ.regions,
+                        occ.tiles,
+                        occ.bricks,
+                        lo,
+                        hi,
+                        rorg,
+                        rdims,
+                        nx,
+                        ny,
+                        kind[c:d],
+                        index[c:d],
+                        t[c:d],
+                    )
 
         def object_order_block(a, b, max_voxels):
-            return self._object_order(occ, orig[a:b], dirs[a:b], max_voxels, nx, ny, kind[a:b],
-                                      index[a:b], t[a:b])
+            return self._object_order(
+                occ, orig[a:b], dirs[a:b], max_voxels, nx, ny, kind[a:b], index[a:b], t[a:b]
+            )
 
         if method == "exact" and object_order is not False and occ.count > 0:
             # Learned on CPU time: both orders run on this process's threads only.
-            orders = trace_in_blocks(n, object_order, self._orders.setdefault(occ, OrderChoice()),
-                                     object_order_block, ray_order, cancel, clock=time.process_time)
+            orders = trace_in_blocks(
+                n,
+                object_order,
+                self._orders.setdefault(occ, OrderChoice()),
+                object_order_block,
+                ray_order,
+                cancel,
+                clock=time.process_time,
+            )
         else:
             ray_order(0, n)
             orders = {"ray"}
-        info = {"seconds": time.perf_counter() - started, "precision": "f64",
-                "threads": numba.get_num_threads(), "order": "+".join(sorted(orders)) or "ray"}
+        info = {
+            "seconds": time.perf_counter() - started,
+            "precision": "f64",
+            "threads": numba.get_num_threads(),
+            "order": "+".join(sorted(orders)) or "ray",
+        }
         return CellHits(kind, index, t, info)
 
     @staticmethod

@@ -138,8 +138,7 @@ def _gnomonic(dirs, axis, u, v, p, q):
             p[r], q[r] = pp, qq
             pmin, pmax, qmin, qmax = min(pmin, pp), max(pmax, pp), min(qmin, qq), max(qmax, qq)
         part[k, 0], part[k, 1], part[k, 2], part[k, 3] = pmin, pmax, qmin, qmax
-    return (part[:, 0].min(), part[:, 1].max(), part[:, 2].min(), part[:, 3].max(),
-            not off_axis.any())
+    return (part[:, 0].min(), part[:, 1].max(), part[:, 2].min(), part[:, 3].max(), not off_axis.any())
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -248,8 +247,18 @@ def ray_grid(dirs, axis, u, v, nb):
     pmin, pmax, qmin, qmax, on_axis = _gnomonic(dirs, axis, u, v, p, q)
     if not on_axis:
         return None
-    return p, q, np.array([pmin, (pmax - pmin) / nb if pmax > pmin else 1.0,
-                           qmin, (qmax - qmin) / nb if qmax > qmin else 1.0])
+    return (
+        p,
+        q,
+        np.array(
+            [
+                pmin,
+                (pmax - pmin) / nb if pmax > pmin else 1.0,
+                qmin,
+                (qmax - qmin) / nb if qmax > qmin else 1.0,
+            ]
+        ),
+    )
 
 
 def sort_rays(p, q, grid, nb, shift, orig, dirs, lo, hi):
@@ -374,8 +383,9 @@ def bricks_in_view(centre, grow, axis, u, v, grid, nb, root, regions, tiles, ror
                         if br == 0:
                             continue
                         bx, by, bz = tx + ((s2 & 7) << 3), ty + (((s2 >> 3) & 7) << 3), tz + ((s2 >> 6) << 3)
-                        i0, i1, _, _, state, near = box_bins(bx, by, bz, 8, centre, grow, axis, u, v,
-                                                             grid, nb)
+                        i0, i1, _, _, state, near = box_bins(
+                            bx, by, bz, 8, centre, grow, axis, u, v, grid, nb
+                        )
                         if state == -1:
                             return found[:0], nears[:0], False
                         if state == 0 or i0 > i1:
@@ -438,8 +448,8 @@ def emit_voxels(bricks_found, brick_near, first, bricks, centre, grow, axis, u, 
                     bit += 8
                     continue
                 if word & np.uint32(1):
-                    l = w * 32 + bit
-                    x, y, z = bx + (l & 7), by + ((l >> 3) & 7), bz + (l >> 6)
+                    cell = w * 32 + bit
+                    x, y, z = bx + (cell & 7), by + ((cell >> 3) & 7), bz + (cell >> 6)
                     i0, i1, j0, j1, _, near = box_bins(x, y, z, 1, centre, grow, axis, u, v, grid, nb)
                     vox[k, 0], vox[k, 1], vox[k, 2] = x, y, z
                     vox[k, 3], vox[k, 4], vox[k, 5], vox[k, 6] = i0, i1, j0, j1
@@ -513,8 +523,7 @@ def _slab_start(rays, invs, s, x, y, z, best):
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, rays, invs, best_t,
-               best_v):
+def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, rays, invs, best_t, best_v):
     """Nearest hit of each sorted ray among the voxels of its tile (tiles of TILE bins).
 
     ``best_t`` starts at each ray's exit from the occupied box, a bound no hit
@@ -541,8 +550,11 @@ def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, 
                 k = base + r * TILE + c
                 if bin_starts[k + 1] > bin_starts[k]:
                     live[r] |= np.int64(1) << c
-                single = single and bin_starts[k + 1] - bin_starts[k] == 1 \
+                single = (
+                    single
+                    and bin_starts[k + 1] - bin_starts[k] == 1
                     and bin_starts[k] == first + r * TILE + c
+                )
         far = _tile_far(bin_starts, tile, best_t)  # no bound of the tile is beyond
         stale = False  # far may be lowered (bounds moved nearer since it was taken)
         for e in range(tile_starts[tile], tile_starts[tile + 1]):
@@ -568,8 +580,11 @@ def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, 
                     if (row >> c) & 1 == 0:
                         continue
                     k = base + r * TILE + c
-                    lo_s, hi_s = (first + r * TILE + c, first + r * TILE + c + 1) if single \
+                    lo_s, hi_s = (
+                        (first + r * TILE + c, first + r * TILE + c + 1)
+                        if single
                         else (bin_starts[k], bin_starts[k + 1])
+                    )
                     alive = False
                     for s in range(lo_s, hi_s):
                         best = best_t[s]
@@ -644,21 +659,44 @@ def prepare_scan(occ, orig, dirs, frame, max_voxels, tile_shift=TILE_SHIFT):
     if gnomonic is None:
         return None
     p, q, grid = gnomonic
-    found, brick_near, ok = bricks_in_view(centre, grow, axis, u, v, grid, nb, occ.root,
-                                           occ.regions, occ.tiles, occ.root_origin.astype(np.int64),
-                                           occ.root_dims.astype(np.int64))
+    found, brick_near, ok = bricks_in_view(
+        centre,
+        grow,
+        axis,
+        u,
+        v,
+        grid,
+        nb,
+        occ.root,
+        occ.regions,
+        occ.tiles,
+        occ.root_origin.astype(np.int64),
+        occ.root_dims.astype(np.int64),
+    )
     first = voxel_starts(found, occ.bricks) if ok else None
     if not ok or first[-1] > max_voxels:
         return None
-    bin_starts, order, bins, rays, invs, exits = sort_rays(p, q, grid, nb, tile_shift, orig, dirs,
-                                                     occ.bbox_lo.astype(np.float64),
-                                                     occ.bbox_hi.astype(np.float64))
-    vox, nears = emit_voxels(found, brick_near, first, occ.bricks, centre, grow, axis, u, v, grid,
-                             nb)
+    bin_starts, order, bins, rays, invs, exits = sort_rays(
+        p, q, grid, nb, tile_shift, orig, dirs, occ.bbox_lo.astype(np.float64), occ.bbox_hi.astype(np.float64)
+    )
+    vox, nears = emit_voxels(found, brick_near, first, occ.bricks, centre, grow, axis, u, v, grid, nb)
     tiles_per_side = -(-nb >> tile_shift)
     tile_starts, listed = voxels_per_tile(vox, tiles_per_side, tile_shift)
-    return Scan(order, rays, invs, bins, exits, bin_starts, vox, nears, tile_starts, listed, nb,
-                tile_shift, tiles_per_side)
+    return Scan(
+        order,
+        rays,
+        invs,
+        bins,
+        exits,
+        bin_starts,
+        vox,
+        nears,
+        tile_starts,
+        listed,
+        nb,
+        tile_shift,
+        tiles_per_side,
+    )
 
 
 def nearest_voxels(occ, orig, dirs, frame, max_voxels):
@@ -673,8 +711,19 @@ def nearest_voxels(occ, orig, dirs, frame, max_voxels):
         return None
     best_t = scan.exits
     best_v = np.full(len(best_t), -1, np.int64)
-    test_tiles(scan.vox, scan.nears, scan.tile_starts, scan.listed, scan.tiles_per_side,
-               scan.bin_starts, scan.nb, scan.rays, scan.invs, best_t, best_v)
+    test_tiles(
+        scan.vox,
+        scan.nears,
+        scan.tile_starts,
+        scan.listed,
+        scan.tiles_per_side,
+        scan.bin_starts,
+        scan.nb,
+        scan.rays,
+        scan.invs,
+        best_t,
+        best_v,
+    )
     return scan.order, best_t, best_v, scan.vox
 
 
@@ -712,11 +761,10 @@ class OrderChoice:
         with self._lock:
             recent = self.samples[order]
             recent.append(seconds / max(1, rays))
-            del recent[:-self.SAMPLES]
+            del recent[: -self.SAMPLES]
 
 
-def trace_in_blocks(n, object_order, choice, object_block, ray_block, cancel=None,
-                    clock=time.perf_counter):
+def trace_in_blocks(n, object_order, choice, object_block, ray_block, cancel=None, clock=time.perf_counter):
     """Trace ``n`` exact rays in blocks of up to SCAN_BLOCK, each in object or ray
     order, as both backends do; returns the set of orders used.
 

@@ -66,8 +66,7 @@ from ladartui.tracing.object_order import (
 NAME = "wgpu"
 
 INSTALL_HINT = (
-    "no Vulkan, Metal or D3D12 adapter found: install Debian's "
-    "mesa-vulkan-drivers (lavapipe) or a GPU driver"
+    "no Vulkan, Metal or D3D12 adapter found: install Debian's mesa-vulkan-drivers (lavapipe) or a GPU driver"
 )
 
 WORKGROUP_SIZE = 64  # must equal @workgroup_size in trace.wgsl
@@ -103,6 +102,7 @@ def choose_adapter(adapters):
     ``adapters`` are wgpu adapters (anything with ``.info`` mapping
     ``adapter_type`` and ``backend_type``); None when the list is empty.
     """
+
     def rank(indexed):
         position, adapter = indexed
         info = adapter.info
@@ -228,12 +228,19 @@ class WgpuBackend:
     name = NAME
     summary = "WGSL compute shader through wgpu (GPU, else lavapipe on the CPU)"
 
-    def __init__(self, *, max_binding_bytes: int | None = None, ray_batch: int = RAY_BATCH,
-                 max_workgroups_per_dimension: int | None = None):
+    def __init__(
+        self,
+        *,
+        max_binding_bytes: int | None = None,
+        ray_batch: int = RAY_BATCH,
+        max_workgroups_per_dimension: int | None = None,
+    ):
         """Optional caps below the adapter's limits (tests use them to force
         occupancy splitting, several batches and 2-D dispatch grids)."""
-        self._caps = {"max-storage-buffer-binding-size": max_binding_bytes,
-                      "max-compute-workgroups-per-dimension": max_workgroups_per_dimension}
+        self._caps = {
+            "max-storage-buffer-binding-size": max_binding_bytes,
+            "max-compute-workgroups-per-dimension": max_workgroups_per_dimension,
+        }
         self._ray_batch = int(ray_batch)
         self._lock = threading.RLock()
         self._probed = False
@@ -292,8 +299,7 @@ class WgpuBackend:
         self._require()
         adapter = self._adapter
         limits = adapter.limits
-        storage = min(limits["max-storage-buffers-per-shader-stage"],
-                      FIXED_BINDINGS + MAX_OCCUPANCY_BINDINGS)
+        storage = min(limits["max-storage-buffers-per-shader-stage"], FIXED_BINDINGS + MAX_OCCUPANCY_BINDINGS)
         wanted = {
             # The adapter's own maxima: asking for more fails at device creation.
             "max-storage-buffer-binding-size": limits["max-storage-buffer-binding-size"],
@@ -304,7 +310,8 @@ class WgpuBackend:
         features = ["shader-f64"] if self._has_f64 else []
         try:
             self._device = adapter.request_device_sync(
-                label="ladartui-trace", required_features=features, required_limits=wanted)
+                label="ladartui-trace", required_features=features, required_limits=wanted
+            )
         except Exception as error:
             raise BackendUnavailable(
                 f"backend {NAME!r} could not open a device on {adapter.info.get('device')!r}: {error}"
@@ -322,9 +329,12 @@ class WgpuBackend:
             info = self._adapter.info
             limits = self._limits or {
                 key: self._adapter.limits[key]
-                for key in ("max-storage-buffer-binding-size", "max-buffer-size",
-                            "max-storage-buffers-per-shader-stage",
-                            "max-compute-workgroups-per-dimension")
+                for key in (
+                    "max-storage-buffer-binding-size",
+                    "max-buffer-size",
+                    "max-storage-buffers-per-shader-stage",
+                    "max-compute-workgroups-per-dimension",
+                )
             }
             return {
                 "backend": NAME,
@@ -362,15 +372,15 @@ class WgpuBackend:
         import wgpu
 
         device = self._open_device()
-        arrays = [np.ascontiguousarray(part, dtype=np.uint32).ravel()
-                  for part in occupancy_arrays(occupancy)]
+        arrays = [np.ascontiguousarray(part, dtype=np.uint32).ravel() for part in occupancy_arrays(occupancy)]
         bases, total = [], 0
         for array in arrays:
             bases.append(total)
             total += array.size
         if total >= 1 << 32:
             raise BackendUnavailable(
-                f"backend {NAME!r} cannot address this scene: its occupancy has {total} words (limit 2^32)")
+                f"backend {NAME!r} cannot address this scene: its occupancy has {total} words (limit 2^32)"
+            )
         max_binding = min(self._limits["max-storage-buffer-binding-size"], self._limits["max-buffer-size"])
         chunk_words = chunk_words_for(max_binding)
         chunks = max(-(-total // chunk_words), 1)
@@ -379,24 +389,26 @@ class WgpuBackend:
             raise BackendUnavailable(
                 f"backend {NAME!r} cannot hold this scene on {self._adapter.info.get('device')!r}: "
                 f"its occupancy needs {total * 4 / 2**20:.0f} MiB in {chunks} bindings of "
-                f"{chunk_words * 4 / 2**20:.0f} MiB, the adapter allows {allowed}; use backend 'numba'")
+                f"{chunk_words * 4 / 2**20:.0f} MiB, the adapter allows {allowed}; use backend 'numba'"
+            )
         buffers = []
         for chunk in range(chunks):
             start = chunk * chunk_words
             words = min(chunk_words, total - start)
             try:
                 buffer = device.create_buffer(
-                    size=max(words, 4) * 4,
-                    usage=wgpu.BufferUsage.STORAGE | wgpu.BufferUsage.COPY_DST)
+                    size=max(words, 4) * 4, usage=wgpu.BufferUsage.STORAGE | wgpu.BufferUsage.COPY_DST
+                )
             except Exception as error:
                 raise BackendUnavailable(
-                    f"backend {NAME!r} could not allocate {words * 4 / 2**20:.0f} MiB for the occupancy: {error}"
+                    f"backend {NAME!r} could not allocate {words * 4 / 2**20:.0f} MiB "
+                    f"for the occupancy: {error}"
                 ) from error
             # Copy the slices of each array that fall in this chunk.
             for base, array in zip(bases, arrays):
                 lo, hi = max(base, start), min(base + array.size, start + words)
                 if lo < hi:
-                    device.queue.write_buffer(buffer, (lo - start) * 4, array[lo - base:hi - base])
+                    device.queue.write_buffer(buffer, (lo - start) * 4, array[lo - base : hi - base])
             buffers.append(buffer)
         shift = chunk_words.bit_length() - 1
         return _Upload(buffers, bases, total, shift)
@@ -412,8 +424,10 @@ class WgpuBackend:
         """trace.wgsl with its header: the float type, the occupancy bindings and axis.wgsl."""
         lines = [f"alias real = {real};"]
         for chunk in range(chunks):
-            lines.append(f"@group(0) @binding({FIXED_BINDINGS + chunk}) "
-                         f"var<storage, read> occupancy{chunk}: array<u32>;")
+            lines.append(
+                f"@group(0) @binding({FIXED_BINDINGS + chunk}) "
+                f"var<storage, read> occupancy{chunk}: array<u32>;"
+            )
         lines.append("// One logical word array over all chunks (see wgpu_backend.py).")
         lines.append("fn occ(word: u32) -> u32 {")
         if chunks == 1:
@@ -427,7 +441,13 @@ class WgpuBackend:
             lines.append(f"        default: {{ return occupancy{chunks - 1}[offset]; }}")
             lines.append("    }")
         lines.append("}")
-        return "\n".join(lines) + "\n\n" + self._shader_file("axis.wgsl") + "\n" + self._shader_file("trace.wgsl")
+        return (
+            "\n".join(lines)
+            + "\n\n"
+            + self._shader_file("axis.wgsl")
+            + "\n"
+            + self._shader_file("trace.wgsl")
+        )
 
     def _pipeline(self, precision: str, chunks: int, chunk_shift: int):
         key = (precision, chunks, chunk_shift)
@@ -437,8 +457,10 @@ class WgpuBackend:
             code = self._shader_source(precision, chunks, chunk_shift)
             module = device.create_shader_module(label=f"trace-{precision}", code=code)
             pipeline = device.create_compute_pipeline(
-                label=f"trace-{precision}-{chunks}", layout="auto",
-                compute={"module": module, "entry_point": "trace_rays"})
+                label=f"trace-{precision}-{chunks}",
+                layout="auto",
+                compute={"module": module, "entry_point": "trace_rays"},
+            )
             self._pipelines[key] = pipeline
         return pipeline
 
@@ -446,11 +468,16 @@ class WgpuBackend:
         """The object-order pipeline (f64 only)."""
         pipeline = self._pipelines.get("tiles")
         if pipeline is None:
-            code = ("alias real = f64;\n\n" + self._shader_file("axis.wgsl") + "\n"
-                    + self._shader_file("object_order.wgsl"))
+            code = (
+                "alias real = f64;\n\n"
+                + self._shader_file("axis.wgsl")
+                + "\n"
+                + self._shader_file("object_order.wgsl")
+            )
             module = self._device.create_shader_module(label="tiles", code=code)
             pipeline = self._device.create_compute_pipeline(
-                label="tiles", layout="auto", compute={"module": module, "entry_point": "test_tiles"})
+                label="tiles", layout="auto", compute={"module": module, "entry_point": "test_tiles"}
+            )
             self._pipelines["tiles"] = pipeline
         return pipeline
 
@@ -463,29 +490,45 @@ class WgpuBackend:
             device = self._open_device()
             real_bytes = 8 if precision == "f64" else 4
             groups = self._limits["max-compute-workgroups-per-dimension"]
-            rays = max(1, min(self._ray_batch,
-                              self._limits["max-storage-buffer-binding-size"] // (6 * real_bytes),
-                              groups * groups * WORKGROUP_SIZE))
+            rays = max(
+                1,
+                min(
+                    self._ray_batch,
+                    self._limits["max-storage-buffer-binding-size"] // (6 * real_bytes),
+                    groups * groups * WORKGROUP_SIZE,
+                ),
+            )
             usage_in = wgpu.BufferUsage.STORAGE | wgpu.BufferUsage.COPY_DST
             usage_out = wgpu.BufferUsage.STORAGE | wgpu.BufferUsage.COPY_SRC
             buffers = {
                 "capacity": rays,
-                "params": device.create_buffer(size=PARAMS_BYTES,
-                                               usage=wgpu.BufferUsage.UNIFORM | wgpu.BufferUsage.COPY_DST),
+                "params": device.create_buffer(
+                    size=PARAMS_BYTES, usage=wgpu.BufferUsage.UNIFORM | wgpu.BufferUsage.COPY_DST
+                ),
                 "rays": device.create_buffer(size=rays * 6 * real_bytes, usage=usage_in),
                 "cells": device.create_buffer(size=rays * 16, usage=usage_out),
                 "ranges": device.create_buffer(size=rays * real_bytes, usage=usage_out),
-                "starts": device.create_buffer(size=max(1, -(-rays // WORKGROUP_SIZE)) * real_bytes,
-                                               usage=usage_in),
+                "starts": device.create_buffer(
+                    size=max(1, -(-rays // WORKGROUP_SIZE)) * real_bytes, usage=usage_in
+                ),
             }
             self._ray_buffers[precision] = buffers
         return buffers
 
     # -- tracing ------------------------------------------------------------
 
-    def trace_cells(self, occupancy, origins, directions, *, method="exact", step=0.5,
-                    precision="f64", cancel: threading.Event | None = None,
-                    object_order: bool | None = None) -> CellHits:
+    def trace_cells(
+        self,
+        occupancy,
+        origins,
+        directions,
+        *,
+        method="exact",
+        step=0.5,
+        precision="f64",
+        cancel: threading.Event | None = None,
+        object_order: bool | None = None,
+    ) -> CellHits:
         """Trace (N, 3) float64 cell-space rays on the adapter; see ``Backend``.
 
         ``object_order`` as in the numba backend: True traces exact f64 scans in
@@ -508,10 +551,8 @@ class WgpuBackend:
             info = {"adapter": self._adapter.info.get("device", ""), "precision": used}
             if used != precision:
                 info["precision_note"] = "the adapter has no shader-f64: traced in f32"
-            if (method == "exact" and used == "f64" and object_order is not False
-                    and occupancy.count > 0):
-                return self._trace_scans(occupancy, origins, directions, object_order, cancel,
-                                         info)
+            if method == "exact" and used == "f64" and object_order is not False and occupancy.count > 0:
+                return self._trace_scans(occupancy, origins, directions, object_order, cancel, info)
             info["order"] = "ray"
             return self._trace(occupancy, origins, directions, method, step, used, cancel, info)
 
@@ -523,16 +564,22 @@ class WgpuBackend:
         t = np.full(n, np.inf)
 
         def ray_order(a, b):
-            hits = self._trace(occupancy, origins[a:b], directions[a:b], "exact", 0.5, "f64",
-                               cancel, info)
+            hits = self._trace(occupancy, origins[a:b], directions[a:b], "exact", 0.5, "f64", cancel, info)
             kind[a:b], index[a:b], t[a:b] = hits.kind, hits.index, hits.t
 
         def object_order_block(a, b, max_voxels):
-            return self._object_order(occupancy, origins[a:b], directions[a:b], max_voxels,
-                                      kind[a:b], index[a:b], t[a:b])
+            return self._object_order(
+                occupancy, origins[a:b], directions[a:b], max_voxels, kind[a:b], index[a:b], t[a:b]
+            )
 
-        orders = trace_in_blocks(n, object_order, self._orders.setdefault(occupancy, OrderChoice()),
-                                 object_order_block, ray_order, cancel)
+        orders = trace_in_blocks(
+            n,
+            object_order,
+            self._orders.setdefault(occupancy, OrderChoice()),
+            object_order_block,
+            ray_order,
+            cancel,
+        )
         info["order"] = "+".join(sorted(orders)) or "ray"
         return CellHits(kind, index, t, info)
 
@@ -542,8 +589,11 @@ class WgpuBackend:
         if max(occupancy.shape) >= F32_EXACT:
             return False  # voxel coordinates go to the shader as float32
         frame = cone_frame(origins, directions)
-        scan = None if frame is None else prepare_scan(occupancy, origins, directions, frame,
-                                                       max_voxels, OBJECT_ORDER_TILE_SHIFT)
+        scan = (
+            None
+            if frame is None
+            else prepare_scan(occupancy, origins, directions, frame, max_voxels, OBJECT_ORDER_TILE_SHIFT)
+        )
         if scan is None or np.diff(scan.tile_starts).max(initial=0) >= LOOP_BUDGET:
             return False
         found = self._test_tiles(scan)
@@ -572,21 +622,27 @@ class WgpuBackend:
         buffers = {name: self._scan_buffer(name, size) for name, size in sizes.items()}
         buffers["params"] = self._scan_buffer("params", 16, uniform=True)
         queue = self._device.queue
-        queue.write_buffer(buffers["params"], 0,
-                           np.array([n, scan.tile_shift, scan.tiles_per_side, 0], dtype=np.uint32))
+        queue.write_buffer(
+            buffers["params"], 0, np.array([n, scan.tile_shift, scan.tiles_per_side, 0], dtype=np.uint32)
+        )
         for name, array in inputs.items():
             if array.nbytes:
                 queue.write_buffer(buffers[name], 0, np.ascontiguousarray(array))
         pipeline = self._tiles_pipeline()
         key = tuple(id(buffers[name]) for name in SCAN_BINDINGS)
         if self._scan_group[0] != key:  # made again only when a buffer has grown
-            self._scan_group = (key, self._device.create_bind_group(
-                layout=pipeline.get_bind_group_layout(0),
-                entries=[{"binding": b, "resource": {"buffer": buffers[name]}}
-                         for b, name in enumerate(SCAN_BINDINGS)]))
+            self._scan_group = (
+                key,
+                self._device.create_bind_group(
+                    layout=pipeline.get_bind_group_layout(0),
+                    entries=[
+                        {"binding": b, "resource": {"buffer": buffers[name]}}
+                        for b, name in enumerate(SCAN_BINDINGS)
+                    ],
+                ),
+            )
         group = self._scan_group[1]
-        groups = dispatch_grid(-(-n // WORKGROUP_SIZE),
-                               self._limits["max-compute-workgroups-per-dimension"])
+        groups = dispatch_grid(-(-n // WORKGROUP_SIZE), self._limits["max-compute-workgroups-per-dimension"])
         encoder = self._device.create_command_encoder()
         compute = encoder.begin_compute_pass()
         compute.set_pipeline(pipeline)
@@ -607,11 +663,11 @@ class WgpuBackend:
 
         buffer = self._scan_buffers.get(name)
         if buffer is None or buffer.size < size:
-            usage = (wgpu.BufferUsage.UNIFORM if uniform else
-                     wgpu.BufferUsage.STORAGE | wgpu.BufferUsage.COPY_SRC) | wgpu.BufferUsage.COPY_DST
+            usage = (
+                wgpu.BufferUsage.UNIFORM if uniform else wgpu.BufferUsage.STORAGE | wgpu.BufferUsage.COPY_SRC
+            ) | wgpu.BufferUsage.COPY_DST
             # Room to grow, within the limits (which need not be powers of two).
-            size = max(16, min(1 << (max(size, 1) - 1).bit_length(),
-                               self._scan_buffer_limit() // 4 * 4))
+            size = max(16, min(1 << (max(size, 1) - 1).bit_length(), self._scan_buffer_limit() // 4 * 4))
             buffer = self._device.create_buffer(label=f"scan-{name}", size=size, usage=usage)
             self._scan_buffers[name] = buffer
         return buffer
@@ -635,10 +691,8 @@ class WgpuBackend:
             # f32 moves each origin to its start on the host (the shader sees no starts).
             ray_starts = None
             if method == "exact":
-                ray_starts = np.repeat(bundle_start_array(origins, directions, halo),
-                                       WORKGROUP_SIZE)[:n]
-            offsets = f32_start_offsets(origins, directions, occupancy.shape, top, method,
-                                        ray_starts)
+                ray_starts = np.repeat(bundle_start_array(origins, directions, halo), WORKGROUP_SIZE)[:n]
+            offsets = f32_start_offsets(origins, directions, occupancy.shape, top, method, ray_starts)
         else:
             offsets = None
         capacity = buffers["capacity"]
@@ -653,7 +707,7 @@ class WgpuBackend:
                     rows = slice(start, min(total, start + capacity))
                     count = rows.stop - rows.start
                 else:
-                    rows = pending[start:start + capacity]
+                    rows = pending[start : start + capacity]
                     count = len(rows)
                 batch_origins, batch_directions = origins[rows], directions[rows]
                 rays = np.empty((count, 6), dtype=real)
@@ -664,12 +718,14 @@ class WgpuBackend:
                 rays[:, 3:] = batch_directions
                 if offsets is None and method == "exact":
                     # The shader has no infinity (its INF is 1e30): cap "never" there.
-                    starts = np.minimum(bundle_start_array(batch_origins, batch_directions, halo),
-                                        SHADER_INF).astype(real)
+                    starts = np.minimum(
+                        bundle_start_array(batch_origins, batch_directions, halo), SHADER_INF
+                    ).astype(real)
                 else:
                     starts = np.zeros(-(-count // WORKGROUP_SIZE), dtype=real)
-                params = pack_params(occupancy, upload, method, step, count, precision,
-                                     first_sample, MARCH_SAMPLES_PER_PASS)
+                params = pack_params(
+                    occupancy, upload, method, step, count, precision, first_sample, MARCH_SAMPLES_PER_PASS
+                )
                 cells, ranges = self._dispatch(pipeline, bind_group, buffers, params, rays, starts)
                 batch_kind = cells[:, 0]
                 kind[rows] = batch_kind
@@ -684,9 +740,9 @@ class WgpuBackend:
                 raise BackendUnavailable(
                     f"backend {NAME!r} could not finish {int(np.sum(kind == CUT))} rays on "
                     f"{info['adapter']!r}: the adapter ended their loops early (lavapipe stops "
-                    f"after 65,535 iterations); use backend 'numba'")
-            pending = (np.flatnonzero(done == UNFINISHED) if pending is None
-                       else pending[done == UNFINISHED])
+                    f"after 65,535 iterations); use backend 'numba'"
+                )
+            pending = np.flatnonzero(done == UNFINISHED) if pending is None else pending[done == UNFINISHED]
             if len(pending) == 0:
                 break
             first_sample += MARCH_SAMPLES_PER_PASS
@@ -701,7 +757,9 @@ class WgpuBackend:
         device.queue.write_buffer(buffers["params"], 0, params)
         device.queue.write_buffer(buffers["rays"], 0, rays)
         device.queue.write_buffer(buffers["starts"], 0, starts)
-        groups = dispatch_grid(-(-count // WORKGROUP_SIZE), self._limits["max-compute-workgroups-per-dimension"])
+        groups = dispatch_grid(
+            -(-count // WORKGROUP_SIZE), self._limits["max-compute-workgroups-per-dimension"]
+        )
         encoder = device.create_command_encoder()
         compute = encoder.begin_compute_pass()
         compute.set_pipeline(pipeline)
@@ -709,10 +767,12 @@ class WgpuBackend:
         compute.dispatch_workgroups(groups[0], groups[1], 1)
         compute.end()
         device.queue.submit([encoder.finish()])
-        cells = np.frombuffer(device.queue.read_buffer(buffers["cells"], 0, count * 16),
-                              dtype=np.int32).reshape(count, 4)
-        ranges = np.frombuffer(device.queue.read_buffer(buffers["ranges"], 0, count * rays.itemsize),
-                               dtype=rays.dtype)
+        cells = np.frombuffer(
+            device.queue.read_buffer(buffers["cells"], 0, count * 16), dtype=np.int32
+        ).reshape(count, 4)
+        ranges = np.frombuffer(
+            device.queue.read_buffer(buffers["ranges"], 0, count * rays.itemsize), dtype=rays.dtype
+        )
         return cells, ranges
 
     def _bind_group(self, upload, pipeline, buffers, precision):
@@ -736,8 +796,13 @@ class WgpuBackend:
 def bundle_start_array(origins, directions, halo):
     """float64 bundle start (tracing.bundle) of each ``WORKGROUP_SIZE`` consecutive rays."""
     out = np.zeros(max(1, -(-len(origins) // WORKGROUP_SIZE)))
-    bundle_starts(np.ascontiguousarray(origins, dtype=np.float64),
-                  np.ascontiguousarray(directions, dtype=np.float64), WORKGROUP_SIZE, *halo, out)
+    bundle_starts(
+        np.ascontiguousarray(origins, dtype=np.float64),
+        np.ascontiguousarray(directions, dtype=np.float64),
+        WORKGROUP_SIZE,
+        *halo,
+        out,
+    )
     return out
 
 
@@ -749,8 +814,14 @@ def occupancy_arrays(occupancy):
         # the column skip never fires (same cells visited, only slower).
         dims = np.asarray(occupancy.root_dims, dtype=np.int64)
         columns = np.full(int(dims[0] * 64 * dims[1] * 64), int(dims[2]) * 64, dtype=np.uint32)
-    return [occupancy.root, occupancy.regions, occupancy.tiles, occupancy.bricks, columns,
-            cube_words(occupancy)]
+    return [
+        occupancy.root,
+        occupancy.regions,
+        occupancy.tiles,
+        occupancy.bricks,
+        columns,
+        cube_words(occupancy),
+    ]
 
 
 def cube_words(occupancy):
@@ -766,8 +837,10 @@ def cube_box(occupancy):
     """(cube_origin, cube_dims) as int64 (3,); zero dims (no jumps) without cubes."""
     if len(cube_words(occupancy)) == 0:
         return np.zeros(3, np.int64), np.zeros(3, np.int64)
-    return (np.asarray(occupancy.cube_origin, dtype=np.int64),
-            np.asarray(occupancy.cube_dims, dtype=np.int64))
+    return (
+        np.asarray(occupancy.cube_origin, dtype=np.int64),
+        np.asarray(occupancy.cube_dims, dtype=np.int64),
+    )
 
 
 # Bindings of shaders/object_order.wgsl, in order.
@@ -778,8 +851,9 @@ SCAN_BINDINGS = ("params", "rays", "bins", "best_t", "best_v", "voxels", "tile_s
 PARAMS_BYTES = 10 * 16 + 16
 
 
-def pack_params(occupancy, upload, method, step, count, precision, first_sample=0,
-                samples_per_pass=MARCH_SAMPLES_PER_PASS) -> bytes:
+def pack_params(
+    occupancy, upload, method, step, count, precision, first_sample=0, samples_per_pass=MARCH_SAMPLES_PER_PASS
+) -> bytes:
     """The uniform block for one dispatch, laid out as ``struct Params``.
 
     ``first_sample`` and ``samples_per_pass`` bound the march's samples in this

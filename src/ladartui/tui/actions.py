@@ -42,75 +42,146 @@ COMMANDS = [
     Command("help", "help", "f1,question_mark", "Help: keys", "List every key", "Help"),
     # New, Open and Save are on the File tab's buttons (with their keys), not in the
     # footer, so that F10-F12 fit an 80-column footer
-    Command("new", "new_scenario", "f2", "New scenario",
-            "Choose a scenario file and a scene model"),
-    Command("open", "open_scenario", "f3", "Open scenario",
-            "Load a scenario; its model files are checked"),
+    Command("new", "new_scenario", "f2", "New scenario", "Choose a scenario file and a scene model"),
+    Command("open", "open_scenario", "f3", "Open scenario", "Load a scenario; its model files are checked"),
     Command("save", "save", "ctrl+s", "Save scenario", "Write the scenario file"),
-    Command("save-as", "save_as", "ctrl+shift+s", "Save scenario as",
-            "Write the scenario under another name"),
+    Command(
+        "save-as", "save_as", "ctrl+shift+s", "Save scenario as", "Write the scenario under another name"
+    ),
     Command("undo", "undo", "ctrl+z", "Undo", "Undo the last change to the scenario"),
     Command("redo", "redo", "ctrl+y", "Redo", "Apply the last undone change again"),
     Command("run", "run", "f5", "Run simulation", "Run the scenario", "Run"),
-    Command("cancel", "cancel_run", "escape", "Cancel run",
-            "Stop the run; earlier outputs stay", "Cancel"),
-    Command("panel", "toggle_panel", "f4", "Toggle parameter panel",
-            "Hide or show the sidebar"),
-    Command("layout", "next_layout", "f6", "Next layout", "Cycle the five view layouts",
-            "Layout"),
-    Command("angle", "view_angle", "f7", "View angle",
-            "Exact azimuth and elevation of the 3D views"),
-    Command("threshold", "threshold", "f8", "Output height threshold",
-            "Draw the output up to a height", "Thresh"),
+    Command("cancel", "cancel_run", "escape", "Cancel run", "Stop the run; earlier outputs stay", "Cancel"),
+    Command("panel", "toggle_panel", "f4", "Toggle parameter panel", "Hide or show the sidebar"),
+    Command("layout", "next_layout", "f6", "Next layout", "Cycle the five view layouts", "Layout"),
+    Command("angle", "view_angle", "f7", "View angle", "Exact azimuth and elevation of the 3D views"),
+    Command(
+        "threshold", "threshold", "f8", "Output height threshold", "Draw the output up to a height", "Thresh"
+    ),
     Command("measures", "measures", "f9", "Show measures", "The measures of the last run"),
-    Command("compare", "compare", "f10", "Compare scenarios",
-            "Two or more .cmf files side by side", "Compare"),
-    Command("study", "study", "f11", "Speed-against-accuracy study",
-            "Every backend, method and ray grid on this scenario", "Study"),
-    Command("sweep", "sweep", "f12", "Flight-path sweep",
-            "Launch, open or watch a sweep; open its best path", "Sweep"),
-    Command("zoom-target", "view('fit_target')", "z", "Zoom to target",
-            "Frame the target in every view at once"),
+    Command(
+        "compare", "compare", "f10", "Compare scenarios", "Two or more .cmf files side by side", "Compare"
+    ),
+    Command(
+        "study",
+        "study",
+        "f11",
+        "Speed-against-accuracy study",
+        "Every backend, method and ray grid on this scenario",
+        "Study",
+    ),
+    Command(
+        "sweep",
+        "sweep",
+        "f12",
+        "Flight-path sweep",
+        "Launch, open or watch a sweep; open its best path",
+        "Sweep",
+    ),
+    Command(
+        "zoom-target", "view('fit_target')", "z", "Zoom to target", "Frame the target in every view at once"
+    ),
     Command("fit-scene", "view('fit_scene')", None, "Fit the scene", "Frame the whole scene"),
-    Command("fit-path", "view('fit_path')", None, "Fit the flight path",
-            "Frame the scene and the whole flight path"),
-    Command("output-colour", "view('cycle_output_colour')", None, "Output colouring",
-            "Colour the output by class, by height, or by the scans that saw it"),
-    Command("grey", "view('toggle_grey')", None, "Colour or grey shading",
-            "Height in colour, or in the report's 56 greys"),
-    Command("overlays", "view('cycle_overlays')", None, "Overlays",
-            "All overlays, the path and scans only, or none"),
-    Command("save-png", "save_png", None, "Save view as PNG",
-            "The current view drawn again at a chosen size, beside the scenario"),
-    Command("export-las", "export_las", None, "Export outputs as LAS",
-            "Write the scene and target outputs as LAS point clouds beside them"),
-    Command("aim-all", "aim_all", None, "Aim every scan at the target",
-            "Point the sensor at the target centre"),
-    Command("edit-segment", "edit_segment", None, "Edit selected segment",
-            "Open the selected flight segment"),
-    Command("delete-segment", "delete_segment", None, "Delete selected segment",
-            "Remove the selected flight segment"),
+    Command(
+        "fit-path",
+        "view('fit_path')",
+        None,
+        "Fit the flight path",
+        "Frame the scene and the whole flight path",
+    ),
+    Command(
+        "output-colour",
+        "view('cycle_output_colour')",
+        None,
+        "Output colouring",
+        "Colour the output by class, by height, or by the scans that saw it",
+    ),
+    Command(
+        "grey",
+        "view('toggle_grey')",
+        None,
+        "Colour or grey shading",
+        "Height in colour, or in the report's 56 greys",
+    ),
+    Command(
+        "overlays",
+        "view('cycle_overlays')",
+        None,
+        "Overlays",
+        "All overlays, the path and scans only, or none",
+    ),
+    Command(
+        "save-png",
+        "save_png",
+        None,
+        "Save view as PNG",
+        "The current view drawn again at a chosen size, beside the scenario",
+    ),
+    Command(
+        "export-las",
+        "export_las",
+        None,
+        "Export outputs as LAS",
+        "Write the scene and target outputs as LAS point clouds beside them",
+    ),
+    Command(
+        "aim-all", "aim_all", None, "Aim every scan at the target", "Point the sensor at the target centre"
+    ),
+    Command(
+        "edit-segment", "edit_segment", None, "Edit selected segment", "Open the selected flight segment"
+    ),
+    Command(
+        "delete-segment",
+        "delete_segment",
+        None,
+        "Delete selected segment",
+        "Remove the selected flight segment",
+    ),
     Command("manual-poses", "manual_poses", None, "Manual scan poses", "Edit poses in a table"),
-    *(Command(f"layout-{n}", f"layout({n})", str(n), f"Layout {n}: {name}", "Switch the views")
-      for n, name in LAYOUTS.items()),
-    *(Command(f"add-{kind}", f"add_segment('{kind}')", None,
-              f"Add {bridge.SEGMENT_LABELS[kind].lower()} segment",
-              f"Append a {bridge.SEGMENT_LABELS[kind].lower()} to the flight path")
-      for kind in ("straight", "turn", "orbit", "flypast", "standoff")),
-    *(Command(f"tab-{tab}", f"show_tab('{tab}')", None, f"Show {tab} panel",
-              f"Open the {tab} tab") for tab in ("file", "sensor", "flight", "run", "results")),
+    *(
+        Command(f"layout-{n}", f"layout({n})", str(n), f"Layout {n}: {name}", "Switch the views")
+        for n, name in LAYOUTS.items()
+    ),
+    *(
+        Command(
+            f"add-{kind}",
+            f"add_segment('{kind}')",
+            None,
+            f"Add {bridge.SEGMENT_LABELS[kind].lower()} segment",
+            f"Append a {bridge.SEGMENT_LABELS[kind].lower()} to the flight path",
+        )
+        for kind in ("straight", "turn", "orbit", "flypast", "standoff")
+    ),
+    *(
+        Command(f"tab-{tab}", f"show_tab('{tab}')", None, f"Show {tab} panel", f"Open the {tab} tab")
+        for tab in ("file", "sensor", "flight", "run", "results")
+    ),
 ]
 BY_ID = {command.id: command for command in COMMANDS}
 
 # actions that only change what is displayed: allowed while busy
-DISPLAY_ACTIONS = {"help", "layout", "next_layout", "toggle_panel", "view_angle",
-                   "threshold", "quit", "command_palette", "show_tab", "cancel_run", "view"}
+DISPLAY_ACTIONS = {
+    "help",
+    "layout",
+    "next_layout",
+    "toggle_panel",
+    "view_angle",
+    "threshold",
+    "quit",
+    "command_palette",
+    "show_tab",
+    "cancel_run",
+    "view",
+}
 
 
 def bindings() -> list[Binding]:
     """The app's key bindings, each with its command's id (so users can remap it)."""
-    return [Binding(c.key, c.action, c.footer or c.title, show=c.footer is not None, id=c.id)
-            for c in COMMANDS if c.key]
+    return [
+        Binding(c.key, c.action, c.footer or c.title, show=c.footer is not None, id=c.id)
+        for c in COMMANDS
+        if c.key
+    ]
 
 
 BINDINGS = bindings()
@@ -141,12 +212,12 @@ def own_actions() -> frozenset[str]:
     return frozenset({c.action.split("(")[0] for c in COMMANDS} | {"open_recent"})
 
 
-def help_rows(keymap: dict[str, str] | None = None, view_bindings=(),
-              dialog_bindings=(), top_bindings=()) -> list[tuple[str, str, str]]:
+def help_rows(
+    keymap: dict[str, str] | None = None, view_bindings=(), dialog_bindings=(), top_bindings=()
+) -> list[tuple[str, str, str]]:
     """(where, key, what) for the help screen, with the keys in force."""
     keys = keys_in_force(keymap)
-    rows = [("Anywhere", key_name(keys[c.id]), c.footer or c.title)
-            for c in COMMANDS if keys.get(c.id)]
+    rows = [("Anywhere", key_name(keys[c.id]), c.footer or c.title) for c in COMMANDS if keys.get(c.id)]
     rows.append(("Anywhere", "Ctrl+P", "Command palette: every action by name"))
     rows.append(("Anywhere", "Ctrl+Q", "Quit (asks first when there are unsaved edits)"))
     rows.append(("Anywhere", "Tab / Shift+Tab", "Move between controls"))
@@ -156,8 +227,9 @@ def help_rows(keymap: dict[str, str] | None = None, view_bindings=(),
     for binding in top_bindings:
         rows.append(("Top view", key_name(binding.key), binding.description))
     rows.append(("Top view", "mouse wheel", "Zoom about the pointer"))
-    rows.append(("Fields", "Enter or leave", "Check the value; an invalid one goes back "
-                 "to the scenario's value"))
+    rows.append(
+        ("Fields", "Enter or leave", "Check the value; an invalid one goes back to the scenario's value")
+    )
     rows.append(("Segments table", "Enter", "Edit the segment"))
     rows.append(("Recent list", "Enter", "Open the scenario"))
     for binding in dialog_bindings:
@@ -189,11 +261,15 @@ def load_keymap(folder: Path | None = None) -> tuple[dict[str, str], list[str]]:
     keymap, problems = {}, []
     for command_id, key in table.items():
         if command_id not in BY_ID:
-            problems.append(one_line(f"{path}: keys.{command_id}: no such command; expected "
-                                     "one of " + ", ".join(sorted(BY_ID))))
+            problems.append(
+                one_line(
+                    f"{path}: keys.{command_id}: no such command; expected one of " + ", ".join(sorted(BY_ID))
+                )
+            )
         elif not isinstance(key, str) or not key.strip():
-            problems.append(one_line(f"{path}: keys.{command_id} = {key!r}: expected a key "
-                                     "name such as \"f9\" or \"ctrl+r\""))
+            problems.append(
+                one_line(f'{path}: keys.{command_id} = {key!r}: expected a key name such as "f9" or "ctrl+r"')
+            )
         else:
             keymap[command_id] = key.strip()
     return keymap, problems
@@ -201,9 +277,18 @@ def load_keymap(folder: Path | None = None) -> tuple[dict[str, str], list[str]]:
 
 def key_name(key: str) -> str:
     """How a key is written for people: F5, Ctrl+S, ?, +."""
-    names = {"question_mark": "?", "equals_sign": "=", "plus": "+", "minus": "-",
-             "escape": "Esc", "left": "Left", "right": "Right", "up": "Up", "down": "Down",
-             "delete": "Delete"}
+    names = {
+        "question_mark": "?",
+        "equals_sign": "=",
+        "plus": "+",
+        "minus": "-",
+        "escape": "Esc",
+        "left": "Left",
+        "right": "Right",
+        "up": "Up",
+        "down": "Down",
+        "delete": "Delete",
+    }
 
     def one(k: str) -> str:
         if k in names:

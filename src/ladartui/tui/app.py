@@ -44,8 +44,10 @@ from ladartui.tui.view_area import LAYOUTS, OUTPUT_POINTS, ViewArea
 from ladartui.tui.work import JobDone, JobProgress, start_job
 
 # everything the analyst can change; disabled while busy (Cancel is re-enabled)
-CONTROLS = "#sidebar Input, #sidebar Button, #sidebar Select, #sidebar Checkbox, " \
-           "#sidebar DataTable, #sidebar OptionList"
+CONTROLS = (
+    "#sidebar Input, #sidebar Button, #sidebar Select, #sidebar Checkbox, "
+    "#sidebar DataTable, #sidebar OptionList"
+)
 own_actions = actions.own_actions
 
 
@@ -56,9 +58,12 @@ def palette_entries(app=None) -> list[tuple[str, str, str]]:
 
 def help_rows(app=None) -> list[tuple[str, str, str]]:
     """The help screen's rows: the app's keys (as remapped), the views' and the dialogs'."""
-    return actions.help_rows(app.keymap if app is not None else None,
-                             ProjectionWidget.BINDINGS, PosesScreen.BINDINGS,
-                             TopViewWidget.BINDINGS)
+    return actions.help_rows(
+        app.keymap if app is not None else None,
+        ProjectionWidget.BINDINGS,
+        PosesScreen.BINDINGS,
+        TopViewWidget.BINDINGS,
+    )
 
 
 class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
@@ -68,8 +73,14 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
     CSS_PATH = Path(__file__).with_name("app.tcss")
     BINDINGS = actions.BINDINGS
 
-    def __init__(self, scenario_path: Path | str | None = None, *, start_scenario=None,
-                 cwd: Path | None = None, compile_in_child: bool = True):
+    def __init__(
+        self,
+        scenario_path: Path | str | None = None,
+        *,
+        start_scenario=None,
+        cwd: Path | None = None,
+        compile_in_child: bool = True,
+    ):
         super().__init__()
         self.compile_in_child = compile_in_child
         self.scenario_path = Path(scenario_path) if scenario_path else None
@@ -132,8 +143,7 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
     def action_undo(self) -> None:
         if self.busy or self.history is None:
             return
-        typing = [f for f in self.query(".param").results(NumberField)
-                  if f.value != f.committed]
+        typing = [f for f in self.query(".param").results(NumberField) if f.value != f.committed]
         if typing:  # typed but not committed: undo the typing first, as an editor would
             for f in typing:
                 f.set_number(bridge.param_value(self.scenario, f.field_name))
@@ -170,8 +180,7 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
         from ladartui.scene.model import Scene
 
         old = self.scene
-        self.scene = Scene(old.voxels, old.target, voxel_size, shape=old.shape, name=old.name,
-                           path=old.path)
+        self.scene = Scene(old.voxels, old.target, voxel_size, shape=old.shape, name=old.name, path=old.path)
         self.view_area.rescale(voxel_size, tuple(float(v) for v in self.scene.target_centre_m()))
 
     def commit_field(self, field: NumberField) -> bool:
@@ -260,8 +269,11 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
         out = []
         if self.scene is None:
             out.append("scene model not loaded")
-        bad = [f"{f.param.label} {f.param.unit}".strip() for f in self.query(NumberField)
-               if fields and f.has_class("-bad") and hasattr(f, "param")]
+        bad = [
+            f"{f.param.label} {f.param.unit}".strip()
+            for f in self.query(NumberField)
+            if fields and f.has_class("-bad") and hasattr(f, "param")
+        ]
         if bad:
             out.append("invalid value in " + ", ".join(bad))
         rows = self.backend_rows
@@ -287,8 +299,10 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
         if self.missing_outputs:
             # runnable, but the set on disk is incomplete: yellow until a run rewrites it
             names = ", ".join(p.name for p in self.missing_outputs)
-            bar.show(NOT_READY, f"{self.scenario.path.name}{mark}: outputs missing ({names}); "
-                                "F5 runs and writes them.")
+            bar.show(
+                NOT_READY,
+                f"{self.scenario.path.name}{mark}: outputs missing ({names}); F5 runs and writes them.",
+            )
             return
         bar.show(READY, text)
 
@@ -432,8 +446,11 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
         if self.scenario is not None and self.scenario.path.is_file():
             path = self.scenario.path
             if self.modified:
-                self.tell("The study reads the saved scenario file; save (Ctrl+S) to include "
-                          "your changes.", severity="warning", timeout=8)
+                self.tell(
+                    "The study reads the saved scenario file; save (Ctrl+S) to include your changes.",
+                    severity="warning",
+                    timeout=8,
+                )
 
         def closed(_result) -> None:
             self.tool_screen = None
@@ -468,8 +485,9 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
             self.tell(f"Opening {message.path.name}; Esc leaves the sweep screen to see it.")
         self.open_path(message.path)
 
-    def tell(self, message: str, *, title: str = "", severity: str = "information",
-             timeout: float = 5) -> None:
+    def tell(
+        self, message: str, *, title: str = "", severity: str = "information", timeout: float = 5
+    ) -> None:
         """Show a message to the analyst (and keep it in ``messages`` for the record)."""
         self.messages.append(f"{title}: {message}" if title else message)
         # text from files and fields must not be read as markup
@@ -477,9 +495,14 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
 
     # -- jobs: every slow piece of work reports here (tui/work.py) -------------------
 
-    JOB_FAILED = {"load": "Could not load", "run": "Run failed", "probe": "Backends not probed",
-                  "warm": "Kernels not compiled", "export": "Nothing exported",
-                  "png": "View not saved"}
+    JOB_FAILED = {
+        "load": "Could not load",
+        "run": "Run failed",
+        "probe": "Backends not probed",
+        "warm": "Kernels not compiled",
+        "export": "Nothing exported",
+        "png": "View not saved",
+    }
 
     def on_job_progress(self, message: JobProgress) -> None:
         if self.leaving:
@@ -497,8 +520,12 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
 
     def _job_done(self, message: JobDone) -> None:
         if message.error:  # every failure, expected or not, is told the same way
-            self.tell(message.error, title=self.JOB_FAILED.get(message.job, message.job),
-                      severity="error", timeout=10)
+            self.tell(
+                message.error,
+                title=self.JOB_FAILED.get(message.job, message.job),
+                severity="error",
+                timeout=10,
+            )
         if message.job == "load":
             if message.result is not None:
                 self.loaded(message.result)
@@ -507,9 +534,11 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
                 if message.error:
                     self.run_panel.say(message.error)
         elif message.job == "probe":
-            self.backends_probed(message.result if message.result is not None else
-                                 [("auto", f"backends could not be probed: {message.error}",
-                                   False)])
+            self.backends_probed(
+                message.result
+                if message.result is not None
+                else [("auto", f"backends could not be probed: {message.error}", False)]
+            )
         elif message.job == "run":
             self.run_finished(message.result, message.cancelled, message.error)
         elif message.job == "png" and message.result is not None:
@@ -536,4 +565,5 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
 def _runner(app, action: str):
     def run():
         app.call_later(app.run_action, action)
+
     return run

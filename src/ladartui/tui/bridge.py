@@ -109,8 +109,9 @@ def with_param(scenario: Scenario, key: str, value) -> Scenario:
         try:
             sensor = dataclasses.replace(scenario.sensor, **{name: value})
         except FieldError as error:
-            raise FieldError(f"sensor.{error.field}", error.value, error.expected,
-                             limits=error.limits) from None
+            raise FieldError(
+                f"sensor.{error.field}", error.value, error.expected, limits=error.limits
+            ) from None
         return scenario.with_changes(sensor=sensor)
     if group == "start":
         if name == "heading":
@@ -120,8 +121,9 @@ def with_param(scenario: Scenario, key: str, value) -> Scenario:
         try:
             start = dataclasses.replace(start_pose(scenario), **{name: value})
         except FieldError as error:
-            raise FieldError(f"start.{error.field}", error.value, error.expected,
-                             limits=error.limits) from None
+            raise FieldError(
+                f"start.{error.field}", error.value, error.expected, limits=error.limits
+            ) from None
         return scenario.with_changes(flight=FlightPlan(start, scenario.flight.segments))
     return scenario.with_changes(**{name: value})
 
@@ -132,18 +134,36 @@ def check_param(scenario: Scenario, key: str, value) -> None:
 
 # -- flight segments -----------------------------------------------------------------
 
-SEGMENT_LABELS = {"manual": "Manual poses", "straight": "Straight", "turn": "Turn",
-                  "orbit": "Orbit", "flypast": "Fly-past", "standoff": "Standoff",
-                  "log": "Flight log"}
+SEGMENT_LABELS = {
+    "manual": "Manual poses",
+    "straight": "Straight",
+    "turn": "Turn",
+    "orbit": "Orbit",
+    "flypast": "Fly-past",
+    "standoff": "Standoff",
+    "log": "Flight log",
+}
 # segments the sidebar shows but cannot edit in a form (their data is a file)
 FILE_SEGMENTS = {"log"}
 FIELD_LABELS = {
-    "distance": "Distance m", "scans": "Scans", "azimuth": "Sensor az deg",
-    "depression": "Depression deg", "aim_at": "Aim at x,y,z m", "radius": "Radius m",
-    "arc": "Arc deg", "direction": "Direction", "centre": "Centre x,y,z m",
-    "altitude": "Altitude m", "start_bearing": "Start bearing deg", "target": "Target x,y,z m",
-    "standoff": "Standoff m", "length": "Length m", "heading": "Heading deg",
-    "side": "Target side", "standoffs": "Standoffs m", "bearing": "Bearing deg",
+    "distance": "Distance m",
+    "scans": "Scans",
+    "azimuth": "Sensor az deg",
+    "depression": "Depression deg",
+    "aim_at": "Aim at x,y,z m",
+    "radius": "Radius m",
+    "arc": "Arc deg",
+    "direction": "Direction",
+    "centre": "Centre x,y,z m",
+    "altitude": "Altitude m",
+    "start_bearing": "Start bearing deg",
+    "target": "Target x,y,z m",
+    "standoff": "Standoff m",
+    "length": "Length m",
+    "heading": "Heading deg",
+    "side": "Target side",
+    "standoffs": "Standoffs m",
+    "bearing": "Bearing deg",
 }
 CHOICES = {"direction": ("right", "left"), "side": ("right", "left")}
 POINT_FIELDS = {"centre", "target", "aim_at"}
@@ -161,11 +181,9 @@ def default_segment(kind: str, target_xyz, current: ScanPose | None):
     if kind == "orbit":
         return SEGMENT_KINDS[kind](centre=centre, radius=100.0, altitude=altitude, scans=12)
     if kind == "flypast":
-        return SEGMENT_KINDS[kind](target=centre, standoff=100.0, altitude=altitude,
-                                   length=200.0, scans=5)
+        return SEGMENT_KINDS[kind](target=centre, standoff=100.0, altitude=altitude, length=200.0, scans=5)
     if kind == "standoff":
-        return SEGMENT_KINDS[kind](target=centre, standoffs=(50.0, 100.0, 150.0),
-                                   altitude=altitude)
+        return SEGMENT_KINDS[kind](target=centre, standoffs=(50.0, 100.0, 150.0), altitude=altitude)
     raise FieldError("kind", kind, "a segment kind")
 
 
@@ -198,6 +216,7 @@ def segment_builder(kind: str):
 
     def build(values):
         return cls(**values)
+
     return build
 
 
@@ -217,8 +236,7 @@ def segment_summary(segment) -> str:
     if k == "standoff":
         return ", ".join(f"{s:g}" for s in segment.standoffs) + " m"
     if k == "log":
-        when = f"{segment.rate:g} Hz" if segment.rate is not None else \
-            f"{len(segment.times)} times"
+        when = f"{segment.rate:g} Hz" if segment.rate is not None else f"{len(segment.times)} times"
         return f"{Path(segment.file).name}, {when}"
     return ""
 
@@ -250,6 +268,7 @@ def make_pose(values: dict) -> ScanPose:
 
 # -- files -----------------------------------------------------------------------------
 
+
 def derived_names(scenario_path: Path | None, scene_path: Path | None) -> list[tuple[str, str]]:
     """The names a new scenario derives (report table 2), for the setup dialog."""
     target = target_file_for(scene_path).name if scene_path else "(from the scene model)"
@@ -258,14 +277,23 @@ def derived_names(scenario_path: Path | None, scene_path: Path | None) -> list[t
     else:
         probe = _probe_scenario(scenario_path, scene_path)
         outputs = (probe.scene_output.name, probe.target_output.name, probe.measures_file.name)
-    return [("3D target model", target), ("Scene simulation output", outputs[0]),
-            ("Target simulation output", outputs[1]), ("Comparison measures", outputs[2])]
+    return [
+        ("3D target model", target),
+        ("Scene simulation output", outputs[0]),
+        ("Target simulation output", outputs[1]),
+        ("Comparison measures", outputs[2]),
+    ]
 
 
 def _probe_scenario(scenario_path, scene_path, voxel_size=1.0) -> Scenario:
     # a throw-away scenario: the names and checks come from Scenario itself
-    return Scenario(scenario_path, scene_path or Path("scene.txt"), voxel_size, Sensor(),
-                    FlightPlan(None, (Manual((ScanPose(0.0, 0.0, 1.0),)),)))
+    return Scenario(
+        scenario_path,
+        scene_path or Path("scene.txt"),
+        voxel_size,
+        Sensor(),
+        FlightPlan(None, (Manual((ScanPose(0.0, 0.0, 1.0),)),)),
+    )
 
 
 def check_voxel_size(value) -> None:
@@ -279,8 +307,9 @@ def new_scenario(scenario_path: Path, scene_path: Path, voxel_size: float = 1.0)
     if scenario_path.suffix != ".toml":
         scenario_path = scenario_path.with_name(scenario_path.name + ".toml")
     if scenario_path.exists():
-        raise FieldError("scenario file", str(scenario_path),
-                         "a new file name (this one exists: load it instead)")
+        raise FieldError(
+            "scenario file", str(scenario_path), "a new file name (this one exists: load it instead)"
+        )
     for path, what in ((scene_path, "scene model"), (target_file_for(scene_path), "target model")):
         if not Path(path).is_file():
             raise InputFileError(path, f"{what} file not found")

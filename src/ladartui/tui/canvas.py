@@ -68,8 +68,9 @@ def picture_strips(picture: Picture, use_256: bool = False) -> list[Strip]:
             style = styles.get(key)
             if style is None and key is not None:
                 if t and b:
-                    style = Style(color=colour(top_codes, top, r, c),
-                                  bgcolor=colour(bottom_codes, bottom, r, c))
+                    style = Style(
+                        color=colour(top_codes, top, r, c), bgcolor=colour(bottom_codes, bottom, r, c)
+                    )
                 elif t:
                     style = Style(color=colour(top_codes, top, r, c))
                 else:
@@ -92,11 +93,9 @@ VIEW_BINDINGS = [
     Binding("t", "view_request('fit_target')", "Zoom to target (every view)", show=False),
     Binding("f", "view_request('fit_scene')", "Fit scene (every view)", show=False),
     Binding("p", "view_request('fit_path')", "Fit flight path (every view)", show=False),
-    Binding("c", "view_request('cycle_output_colour')", "Output: classes / height / scans",
-            show=False),
+    Binding("c", "view_request('cycle_output_colour')", "Output: classes / height / scans", show=False),
     Binding("g", "view_request('toggle_grey')", "Colour / grey shading", show=False),
-    Binding("o", "view_request('cycle_overlays')", "Overlays: all / path / none",
-            show=False),
+    Binding("o", "view_request('cycle_overlays')", "Overlays: all / path / none", show=False),
 ]
 
 
@@ -155,8 +154,7 @@ class PictureWidget(Widget, can_focus=True):
                 text = self.placeholder[:width]
                 blank = [Strip.blank(width)] * height
                 if height:
-                    blank[height // 2] = Strip([Segment(text.center(width), Style(dim=True))],
-                                               width)
+                    blank[height // 2] = Strip([Segment(text.center(width), Style(dim=True))], width)
                 self._strips = blank
             else:
                 self._strips = picture_strips(picture, self._use_256())
@@ -270,8 +268,9 @@ class TopViewWidget(PictureWidget):
         if self.top is None:
             return None
         self.top.colour_map = self.colour_map
-        return self.top.render(rows, cols, self.path, self.scans, self.footprints,
-                               frame=self.frame, shown=self.shown_overlays)
+        return self.top.render(
+            rows, cols, self.path, self.scans, self.footprints, frame=self.frame, shown=self.shown_overlays
+        )
 
 
 class ProjectionWidget(PictureWidget):
@@ -322,8 +321,7 @@ class ProjectionWidget(PictureWidget):
         points = None if points is None else np.asarray(points)
         self.set_layers(None if points is None else [Layer(points)], points, bounds, voxel_size)
 
-    def set_layers(self, layers, points, bounds=None, voxel_size=1.0,
-                   height_range=None) -> None:
+    def set_layers(self, layers, points, bounds=None, voxel_size=1.0, height_range=None) -> None:
         """Layers to draw (later ones win ties), the voxels they show, and the shading range."""
         self.voxel_layers = layers or []
         self.points = points
@@ -369,14 +367,20 @@ class ProjectionWidget(PictureWidget):
         if not self.voxel_layers or self.bounds is None:
             return None
         if self.pending_fit is not None:
-            self.camera = framing.fit_camera(self.camera, self.pending_fit, rows, cols,
-                                             self.bounds)
+            self.camera = framing.fit_camera(self.camera, self.pending_fit, rows, cols, self.bounds)
             self.pending_fit = None
             self._update_title()
         self.overlays.shown = self.shown_overlays
-        return render(self.voxel_layers, self.camera, rows, cols, self.bounds,
-                      height_range=self._height_range(), colour_map=self.colour_map,
-                      overlays=self.overlays)
+        return render(
+            self.voxel_layers,
+            self.camera,
+            rows,
+            cols,
+            self.bounds,
+            height_range=self._height_range(),
+            colour_map=self.colour_map,
+            overlays=self.overlays,
+        )
 
     def _height_range(self):
         # shade by the scene's heights, not by a box stretched up to the aircraft
@@ -384,8 +388,10 @@ class ProjectionWidget(PictureWidget):
             return self.height_range
         if self.points is None or not len(self.points):
             return None
-        return (0.0, float(np.asarray(self.points)[:, 2].max()) if self.height_top is None
-                else self.height_top)
+        return (
+            0.0,
+            float(np.asarray(self.points)[:, 2].max()) if self.height_top is None else self.height_top,
+        )
 
     def action_rotate(self, d_azimuth: float, d_elevation: float) -> None:
         self.set_camera(self.camera.rotated(d_azimuth, d_elevation))

@@ -10,7 +10,8 @@ says why. Limits are never repeated here: they live in the core.
 from __future__ import annotations
 
 import math
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 from textual.widgets import Input
 
@@ -49,9 +50,18 @@ class NumberField(Input):
     value the core rejects; ``default`` is what the field resets to.
     """
 
-    def __init__(self, name: str, value, *, default, check: Callable[[Any], None],
-                 integer: bool = False, scale: float = 1.0, optional: bool = False,
-                 **kwargs):
+    def __init__(
+        self,
+        name: str,
+        value,
+        *,
+        default,
+        check: Callable[[Any], None],
+        integer: bool = False,
+        scale: float = 1.0,
+        optional: bool = False,
+        **kwargs,
+    ):
         kwargs.setdefault("compact", True)
         super().__init__(value=format_number(value, integer, scale), **kwargs)
         self.field_name = name

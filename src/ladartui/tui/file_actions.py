@@ -29,8 +29,9 @@ class FileActions:
     def _setup(self, mode: str) -> None:
         if self.busy:
             return
-        self.confirm_discard("open another scenario" if mode == "load" else
-                             "start a new one", lambda: self._open_setup(mode))
+        self.confirm_discard(
+            "open another scenario" if mode == "load" else "start a new one", lambda: self._open_setup(mode)
+        )
 
     def _open_setup(self, mode: str) -> None:
         def done(scenario):

@@ -90,15 +90,28 @@ class SetupScreen(TreeDialog):
                 yield RadioButton("New scenario", value=self.mode == "new", id="mode-new")
                 yield RadioButton("Open scenario", value=self.mode == "load", id="mode-load")
             yield from self.tree_rows(SCENARIO_SUFFIXES + SCENE_SUFFIXES)
-            yield _row("Scenario file", Input(placeholder="name.toml", id="scenario-file",
-                                              compact=True,
-                                              suggester=PathSuggester(SCENARIO_SUFFIXES)))
-            yield _row("3D scene model", Input(placeholder="scene.txt", id="scene-file",
-                                               compact=True,
-                                               suggester=PathSuggester(SCENE_SUFFIXES)))
-            yield _row("Voxel size m", NumberField("voxel size", 1.0, default=1.0,
-                                                   check=bridge.check_voxel_size,
-                                                   id="voxel-size"))
+            yield _row(
+                "Scenario file",
+                Input(
+                    placeholder="name.toml",
+                    id="scenario-file",
+                    compact=True,
+                    suggester=PathSuggester(SCENARIO_SUFFIXES),
+                ),
+            )
+            yield _row(
+                "3D scene model",
+                Input(
+                    placeholder="scene.txt",
+                    id="scene-file",
+                    compact=True,
+                    suggester=PathSuggester(SCENE_SUFFIXES),
+                ),
+            )
+            yield _row(
+                "Voxel size m",
+                NumberField("voxel size", 1.0, default=1.0, check=bridge.check_voxel_size, id="voxel-size"),
+            )
             yield Static("", id="derived", classes="info")
             yield Static("", id="setup-message", classes="message", markup=False)
             with Horizontal(classes="buttons"):
@@ -131,7 +144,8 @@ class SetupScreen(TreeDialog):
         else:
             self.query_one("#setup-message", Static).update(
                 f"{path.name} is a scene model: choose New scenario to make a scenario "
-                "for it, or pick a .toml scenario")
+                "for it, or pick a .toml scenario"
+            )
 
     @on(Input.Changed)
     def _typed(self, event: Input.Changed) -> None:
@@ -153,8 +167,10 @@ class SetupScreen(TreeDialog):
             names = bridge.derived_names(scenario_path, scene_path)
             text = escape("\n".join(f"{label:<26}{value}" for label, value in names))
         else:
-            text = ("Every model file of the scenario is checked before anything is loaded; "
-                    "missing outputs are listed, and F5 writes them.")
+            text = (
+                "Every model file of the scenario is checked before anything is loaded; "
+                "missing outputs are listed, and F5 writes them."
+            )
         self.query_one("#derived", Static).update(text)
 
     @on(Input.Submitted)
@@ -172,8 +188,7 @@ class SetupScreen(TreeDialog):
                 problem = field.problem()
                 if problem:
                     field.focus()
-                    raise FieldError("voxel size m", field.value.strip(),
-                                     problem.split("expected ", 1)[-1])
+                    raise FieldError("voxel size m", field.value.strip(), problem.split("expected ", 1)[-1])
                 scenario = bridge.new_scenario(scenario_path, scene_path, field.parsed())
             else:
                 scenario = bridge.load_checked(scenario_path)
@@ -205,11 +220,16 @@ class SaveAsScreen(TreeDialog):
         with Vertical(classes="dialog", id="save-as") as box:
             box.border_title = "Save scenario as"
             yield from self.tree_rows(SCENARIO_SUFFIXES)
-            yield _row("Scenario file", Input(self.current.name, id="save-as-file",
-                                              compact=True,
-                                              suggester=PathSuggester(SCENARIO_SUFFIXES)))
-            yield Static("Outputs are named after the scenario and sit beside it.",
-                         classes="info")
+            yield _row(
+                "Scenario file",
+                Input(
+                    self.current.name,
+                    id="save-as-file",
+                    compact=True,
+                    suggester=PathSuggester(SCENARIO_SUFFIXES),
+                ),
+            )
+            yield Static("Outputs are named after the scenario and sit beside it.", classes="info")
             yield Static("", id="save-as-message", classes="message", markup=False)
             with Horizontal(classes="buttons"):
                 yield Button("OK", id="save-as-ok", variant="primary", compact=True)
@@ -260,8 +280,9 @@ class PickPathScreen(TreeDialog):
     """Pick a file (or, with ``folders``, a folder) in the tree or type it; dismisses with
     the path, or None."""
 
-    def __init__(self, title: str, suffixes: tuple[str, ...], start: Path | None = None,
-                 folders: bool = False):
+    def __init__(
+        self, title: str, suffixes: tuple[str, ...], start: Path | None = None, folders: bool = False
+    ):
         super().__init__()
         self.title_text = title
         self.suffixes = suffixes
@@ -273,8 +294,7 @@ class PickPathScreen(TreeDialog):
         with Vertical(classes="dialog", id="pick") as box:
             box.border_title = self.title_text
             yield from self.tree_rows(self.suffixes)
-            yield _row("Path", Input(id="pick-path", compact=True,
-                                     suggester=PathSuggester(self.suffixes)))
+            yield _row("Path", Input(id="pick-path", compact=True, suggester=PathSuggester(self.suffixes)))
             yield Static("", id="pick-message", classes="message", markup=False)
             with Horizontal(classes="buttons"):
                 yield Button("OK", id="pick-ok", variant="primary", compact=True)
@@ -301,8 +321,7 @@ class PickPathScreen(TreeDialog):
         path = (self.base / Path(text).expanduser()) if text else None
         message = self.query_one("#pick-message", Static)
         if path is None or not path.exists():
-            message.update(f"{text or 'Path'}: not found; pick a file in the tree or type "
-                           "its path")
+            message.update(f"{text or 'Path'}: not found; pick a file in the tree or type its path")
             return
         self.dismiss(path)
 

@@ -17,5 +17,8 @@ class FileTree(DirectoryTree):
         self.suffixes = suffixes
 
     def filter_paths(self, paths):
-        return [p for p in paths if not p.name.startswith(".")
-                and (p.is_dir() or p.suffix.lower() in self.suffixes)]
+        return [
+            p
+            for p in paths
+            if not p.name.startswith(".") and (p.is_dir() or p.suffix.lower() in self.suffixes)
+        ]

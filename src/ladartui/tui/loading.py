@@ -38,8 +38,7 @@ class SceneLoading:
         """Load a scenario and its scene in a worker (the default scenario when no path)."""
         name = path.name if path else (scenario.path.name if scenario else "default scenario")
         self.set_busy(f"Loading {name}...")
-        self.load_worker = start_job(self, "load", lambda cancel, progress:
-                                     _load(path, scenario))
+        self.load_worker = start_job(self, "load", lambda cancel, progress: _load(path, scenario))
 
     def loaded(self, done: Loaded) -> None:
         """The load job's result: show it, then probe the backends and warm the kernels."""
@@ -63,8 +62,9 @@ class SceneLoading:
     def _start_background(self, scenario, scene) -> None:
         start_job(self, "probe", lambda cancel, progress: bridge.backend_choices())
         compile_in_child = self.compile_in_child
-        self.warm_worker = start_job(self, "warm", lambda cancel, progress:
-                                     _warm_up(scenario, scene, compile_in_child, cancel))
+        self.warm_worker = start_job(
+            self, "warm", lambda cancel, progress: _warm_up(scenario, scene, compile_in_child, cancel)
+        )
 
     def backends_probed(self, choices) -> None:
         self.run_panel.show_backends(choices, self.scenario.backend if self.scenario else "auto")

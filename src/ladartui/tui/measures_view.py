@@ -99,8 +99,11 @@ def comparison_rows(all_measures: list) -> list[list]:
         differ = len(set(texts)) > 1
         cells = [Text(t) for t in texts]
         if differ:
-            numeric = [(float(v), i) for i, v in enumerate(values)
-                       if v is not None and not isinstance(v, (list, tuple))]
+            numeric = [
+                (float(v), i)
+                for i, v in enumerate(values)
+                if v is not None and not isinstance(v, (list, tuple))
+            ]
             for cell in cells:
                 cell.stylize("yellow")
             if better and len(numeric) >= 2:

@@ -32,9 +32,13 @@ def field_message(param: bridge.Param, typed: str, error: LadarError) -> str:
         if error.limits is not None:
             low, high, low_open, high_open = error.limits
             kind = "a whole number" if param.integer else "a number"
-            expected = range_text(kind, None if low is None else low / param.scale,
-                                  None if high is None else high / param.scale,
-                                  low_open, high_open)
+            expected = range_text(
+                kind,
+                None if low is None else low / param.scale,
+                None if high is None else high / param.scale,
+                low_open,
+                high_open,
+            )
             if param.unit:
                 expected += f" {param.unit}"
         return f"{shown}: {typed.strip() or 'empty'} is not allowed; expected {expected}"
@@ -51,9 +55,16 @@ class ParamPanel(VerticalScroll):
         self.loading_fields = False  # set while filling fields from the scenario
 
     def param_row(self, param: bridge.Param) -> Horizontal:
-        field = NumberField(param.key, None, default=None, integer=param.integer,
-                            scale=param.scale, check=self._checker(param.key),
-                            id=field_id(param.key), classes="param")
+        field = NumberField(
+            param.key,
+            None,
+            default=None,
+            integer=param.integer,
+            scale=param.scale,
+            check=self._checker(param.key),
+            id=field_id(param.key),
+            classes="param",
+        )
         field.param = param
         label = f"{param.label} {param.unit}".strip()
         return Horizontal(Label(label), field, classes="row", id=field_id(param.key) + "-row")
@@ -62,6 +73,7 @@ class ParamPanel(VerticalScroll):
         def check(value):
             if self.app.scenario is not None:
                 bridge.check_param(self.app.scenario, key, value)
+
         return check
 
     def param_fields(self) -> list[NumberField]:
@@ -107,12 +119,15 @@ class ParamPanel(VerticalScroll):
             scenario = bridge.with_param(app.scenario, param.key, value)
         except LadarError as error:
             field.set_number(bridge.param_value(app.scenario, param.key))
-            app.tell(f"{field_message(param, typed, error)}. Kept {field.value}.",
-                     title="Invalid value", severity="warning", timeout=8)
+            app.tell(
+                f"{field_message(param, typed, error)}. Kept {field.value}.",
+                title="Invalid value",
+                severity="warning",
+                timeout=8,
+            )
             app.refresh_status()
             return False
-        before = format_number(bridge.param_value(app.scenario, param.key), param.integer,
-                               param.scale)
+        before = format_number(bridge.param_value(app.scenario, param.key), param.integer, param.scale)
         field.committed = field.value
         field.remove_class("-bad")
         app.edit(scenario, f"{param.label} {before} -> {field.value}")

@@ -44,8 +44,8 @@ class RunControl:
     def _run_worker(self, scenario, scene, fast: bool) -> None:
         warm = self.warm_worker
         self.run_worker_handle = start_job(
-            self, "run", lambda cancel, progress: _run(scenario, scene, fast, warm, cancel,
-                                                       progress))
+            self, "run", lambda cancel, progress: _run(scenario, scene, fast, warm, cancel, progress)
+        )
 
     def run_progressed(self, fraction, text: str, live) -> None:
         if self.busy is None:
@@ -78,14 +78,15 @@ class RunControl:
         self.show_output()
         self.show_measures(result.measures)
         total = result.timings.get("total") if isinstance(result.timings, dict) else None
-        self.run_panel.say(f"Last run: {result.backend}"
-                           + (f", {total:.1f} s" if total else "")
-                           + f"; wrote {self.scenario.measures_file.name}")
+        self.run_panel.say(
+            f"Last run: {result.backend}"
+            + (f", {total:.1f} s" if total else "")
+            + f"; wrote {self.scenario.measures_file.name}"
+        )
         self.file_panel.show(self.scenario, self.scene, self.modified)
         self.refresh_status()
         self.query_one("#tabs", TabbedContent).active = "tab-results"
-        self.push_screen(MeasuresScreen(result.measures,
-                                        f"Comparison measures: {self.scenario.name}"))
+        self.push_screen(MeasuresScreen(result.measures, f"Comparison measures: {self.scenario.name}"))
 
 
 def _run(scenario, scene, fast: bool, warm, cancel, progress):

@@ -36,8 +36,11 @@ class PathSuggester(Suggester):
         folder = path if value.endswith("/") else path.parent
         stem = "" if value.endswith("/") else path.name
         try:
-            names = sorted(p.name + ("/" if p.is_dir() else "") for p in folder.iterdir()
-                           if p.name.startswith(stem) and not p.name.startswith("."))
+            names = sorted(
+                p.name + ("/" if p.is_dir() else "")
+                for p in folder.iterdir()
+                if p.name.startswith(stem) and not p.name.startswith(".")
+            )
         except OSError:
             return None
         for name in names:
@@ -94,16 +97,30 @@ class FormScreen(Dialog):
             with VerticalScroll(classes="form"):
                 for name, label, kind, value, default in self.spec:
                     if isinstance(kind, tuple):
-                        widget = Select([(c, c) for c in kind], value=value, allow_blank=False,
-                                        id=f"f-{name}", compact=True)
+                        widget = Select(
+                            [(c, c) for c in kind],
+                            value=value,
+                            allow_blank=False,
+                            id=f"f-{name}",
+                            compact=True,
+                        )
                     elif kind in ("int", "float", "optional"):
-                        widget = NumberField(name, value, default=default,
-                                             check=self._checker(name),
-                                             integer=kind == "int", optional=kind == "optional",
-                                             id=f"f-{name}")
+                        widget = NumberField(
+                            name,
+                            value,
+                            default=default,
+                            check=self._checker(name),
+                            integer=kind == "int",
+                            optional=kind == "optional",
+                            id=f"f-{name}",
+                        )
                     else:
-                        widget = Input(_point_text(value), id=f"f-{name}", compact=True,
-                                       placeholder="x, y, z" if kind == "point" else "a, b, c")
+                        widget = Input(
+                            _point_text(value),
+                            id=f"f-{name}",
+                            compact=True,
+                            placeholder="x, y, z" if kind == "point" else "a, b, c",
+                        )
                         widget.default_text = _point_text(default)
                     yield _row(label, widget)
             if self.note:
@@ -129,6 +146,7 @@ class FormScreen(Dialog):
             except FieldError as error:
                 if _field_matches(error.field, name):
                     raise
+
         return check
 
     def values(self, raw=False) -> dict:
@@ -164,8 +182,11 @@ class FormScreen(Dialog):
             if problem:
                 widget.add_class("-bad")
                 self.query_one("#form-message", Static).update(
-                    escape(f"{self._label(widget.field_name)}: {widget.value.strip() or 'empty'}"
-                           f" is not allowed; expected {problem.split('expected ', 1)[-1]}"))
+                    escape(
+                        f"{self._label(widget.field_name)}: {widget.value.strip() or 'empty'}"
+                        f" is not allowed; expected {problem.split('expected ', 1)[-1]}"
+                    )
+                )
                 return False
         return True
 
@@ -227,9 +248,11 @@ def _parse_points(name, text, kind):
 class PosesScreen(Dialog):
     """Manual scan poses in an editable table: pick a row, edit its fields, apply."""
 
-    BINDINGS = [Binding("escape", "dismiss_dialog", "Close"),
-                Binding("ctrl+n", "add_pose", "Add pose"),
-                Binding("delete", "delete_pose", "Delete pose")]
+    BINDINGS = [
+        Binding("escape", "dismiss_dialog", "Close"),
+        Binding("ctrl+n", "add_pose", "Add pose"),
+        Binding("delete", "delete_pose", "Delete pose"),
+    ]
     COLUMNS = ("x", "y", "z", "heading", "azimuth", "depression")
 
     def __init__(self, poses, defaults):
@@ -246,8 +269,13 @@ class PosesScreen(Dialog):
                 for name in self.COLUMNS:
                     yield Label(name)
                 for name in self.COLUMNS:
-                    yield NumberField(name, None, default=getattr(self.defaults, name),
-                                      check=self._checker(name), id=f"p-{name}")
+                    yield NumberField(
+                        name,
+                        None,
+                        default=getattr(self.defaults, name),
+                        check=self._checker(name),
+                        id=f"p-{name}",
+                    )
             yield Static("", id="poses-message", classes="message")
             with Horizontal(classes="buttons"):
                 yield Button("Apply row", id="pose-apply", compact=True)
@@ -293,6 +321,7 @@ class PosesScreen(Dialog):
             except FieldError as error:
                 if _field_matches(error.field, name):
                     raise
+
         return check
 
     def _raw(self, name):
@@ -314,7 +343,8 @@ class PosesScreen(Dialog):
             if problem:
                 event.input.reset_to_default()
                 self.query_one("#poses-message", Static).update(
-                    escape(f"{problem}; reset to {event.input.value}"))
+                    escape(f"{problem}; reset to {event.input.value}")
+                )
 
     @on(Input.Changed)
     def _typing(self, event: Input.Changed) -> None:
@@ -415,13 +445,21 @@ class CompareScreen(Dialog):
     def compose(self) -> ComposeResult:
         with Vertical(classes="dialog") as box:
             box.border_title = "Compare scenarios"
-            yield _row(".cmf files", Input(" ".join(str(p) for p in self.paths),
-                                           id="cmf-files", compact=True,
-                                           suggester=PathSuggester((".cmf",))))
+            yield _row(
+                ".cmf files",
+                Input(
+                    " ".join(str(p) for p in self.paths),
+                    id="cmf-files",
+                    compact=True,
+                    suggester=PathSuggester((".cmf",)),
+                ),
+            )
             yield FileTree(self.folder, (".cmf",), id="cmf-tree")
-            yield Static("Space-separated paths, or pick files in the tree (again to drop "
-                         "one); Enter compares. Green best, red worst, yellow differs.",
-                         classes="info")
+            yield Static(
+                "Space-separated paths, or pick files in the tree (again to drop "
+                "one); Enter compares. Green best, red worst, yellow differs.",
+                classes="info",
+            )
             yield Static("", id="compare-message", classes="message")
             yield DataTable(id="compare-table", zebra_stripes=True)
             with Horizontal(classes="buttons"):
@@ -437,8 +475,7 @@ class CompareScreen(Dialog):
         field = self.query_one("#cmf-files", Input)
         chosen = field.value.split()
         picked = str(event.path)
-        field.value = " ".join([c for c in chosen if c != picked] if picked in chosen
-                               else chosen + [picked])
+        field.value = " ".join([c for c in chosen if c != picked] if picked in chosen else chosen + [picked])
         self.compare()
 
     @on(Input.Submitted, "#cmf-files")
@@ -472,11 +509,16 @@ class AngleScreen(FormScreen):
     """Exact azimuth and elevation for the 3D views (report section 3.5)."""
 
     def __init__(self, azimuth: float, elevation: float):
-        spec = [("azimuth", "Azimuth (deg)", "float", azimuth, 210.0),
-                ("elevation", "Elevation (deg)", "float", elevation, 30.0)]
-        super().__init__("View angle", spec, bridge.view_angles,
-                         note="Azimuth: compass bearing the view is from; elevation "
-                              "-90..90 above the horizon.")
+        spec = [
+            ("azimuth", "Azimuth (deg)", "float", azimuth, 210.0),
+            ("elevation", "Elevation (deg)", "float", elevation, 30.0),
+        ]
+        super().__init__(
+            "View angle",
+            spec,
+            bridge.view_angles,
+            note="Azimuth: compass bearing the view is from; elevation -90..90 above the horizon.",
+        )
 
 
 class ThresholdScreen(FormScreen):
@@ -484,18 +526,25 @@ class ThresholdScreen(FormScreen):
 
     def __init__(self, threshold: float | None):
         spec = [("threshold", "Max height (m)", "optional", threshold, None)]
-        super().__init__("Output height threshold", spec, bridge.threshold_value,
-                         note="The output is drawn up to this height; empty shows all.")
+        super().__init__(
+            "Output height threshold",
+            spec,
+            bridge.threshold_value,
+            note="The output is drawn up to this height; empty shows all.",
+        )
 
 
 class ImageSizeScreen(FormScreen):
     """The size of a view saved as PNG."""
 
     def __init__(self, view_name: str, width: int = 1200, height: int = 800):
-        spec = [("width", "Width px", "int", width, width),
-                ("height", "Height px", "int", height, height)]
-        super().__init__(f"Save {view_name} as PNG", spec, bridge.image_size,
-                         note="The view is drawn again at this size, with the same framing.")
+        spec = [("width", "Width px", "int", width, width), ("height", "Height px", "int", height, height)]
+        super().__init__(
+            f"Save {view_name} as PNG",
+            spec,
+            bridge.image_size,
+            note="The view is drawn again at this size, with the same framing.",
+        )
 
 
 class HelpScreen(Dialog):

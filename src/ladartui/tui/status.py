@@ -26,7 +26,6 @@ def format_eta(seconds: float | None) -> str:
     return f"{secs}s"
 
 
-
 class StatusBar(Horizontal):
     """One line: the state word on its colour, the message, and the Cancel button."""
 
@@ -57,8 +56,9 @@ class StatusBar(Horizontal):
     def on_mount(self) -> None:
         self.set_class(True, f"-{self.state}")
 
-    def show(self, state: str, message: str, progress: float | None = None,
-             cancellable: bool = False) -> None:
+    def show(
+        self, state: str, message: str, progress: float | None = None, cancellable: bool = False
+    ) -> None:
         """Show ``state`` with ``message``; ``progress`` 0..1 adds a percentage."""
         for name in LABELS:
             self.set_class(name == state, f"-{name}")

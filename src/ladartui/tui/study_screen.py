@@ -42,8 +42,7 @@ class StudyScreen(Screen):
     StudyScreen ProgressBar { width: 1fr; }
     """
 
-    def __init__(self, scenario_path=None, scans: int | None = None, runs: int | None = None,
-                 **kwargs):
+    def __init__(self, scenario_path=None, scans: int | None = None, runs: int | None = None, **kwargs):
         super().__init__(**kwargs)
         self.scenario_path = scenario_path
         self.scans = scans
@@ -62,8 +61,7 @@ class StudyScreen(Screen):
             yield ProgressBar(id="study-progress", show_eta=False)
             yield Button("Quick", id="study-quick", compact=True)
             yield Button("Full", id="study-full", compact=True)
-            yield Button("Cancel", id="study-cancel", compact=True, variant="error",
-                         disabled=True)
+            yield Button("Cancel", id="study-cancel", compact=True, variant="error", disabled=True)
         yield Footer()
 
     def on_mount(self) -> None:
@@ -88,8 +86,7 @@ class StudyScreen(Screen):
             return
         self.show_result(result)
         when = (result.context or {}).get("created_utc", "")
-        self._set_status(f"last study{' of ' + when if when else ''} ({path}): "
-                         "q quick, f full to run again")
+        self._set_status(f"last study{' of ' + when if when else ''} ({path}): q quick, f full to run again")
 
     def _idle_text(self) -> str:
         where = self.scenario_path or "the generated scenes"
@@ -114,8 +111,9 @@ class StudyScreen(Screen):
             return
         self._set_busy(True, f"preparing the {mode} study ...")
         scenario_path, scans, runs = self.scenario_path, self.scans, self.runs
-        self.worker = start_job(self, "study", lambda cancel, progress: _study(
-            mode, scenario_path, scans, runs, cancel, progress))
+        self.worker = start_job(
+            self, "study", lambda cancel, progress: _study(mode, scenario_path, scans, runs, cancel, progress)
+        )
 
     def action_cancel(self) -> None:
         if running(self.worker):
@@ -145,8 +143,7 @@ class StudyScreen(Screen):
     # -- updates on the UI thread ---------------------------------------------
 
     def _show_progress(self, p) -> None:
-        self.query_one("#study-progress", ProgressBar).update(total=max(p.total, 1),
-                                                              progress=p.done)
+        self.query_one("#study-progress", ProgressBar).update(total=max(p.total, 1), progress=p.done)
         self._set_status(f"{p.label}, scan {p.scan}/{p.scans}")
 
     def _finish(self, result, message: str) -> None:
@@ -188,11 +185,17 @@ def _study(mode: str, scenario_path, scans, runs, cancel, progress):
     if scenario_path:
         inputs = scenario_inputs(scenario_path, scans)
     else:
-        inputs = generated_inputs("small" if quick else "reference", scans,
-                                  progress=lambda text: progress(None, text))
+        inputs = generated_inputs(
+            "small" if quick else "reference", scans, progress=lambda text: progress(None, text)
+        )
     settings = quick_settings() if quick else full_settings()
-    result = run_study(inputs, settings, runs=runs, cancel=cancel,
-                       progress=lambda p: progress(p.done / max(p.total, 1), p.label, p))
+    result = run_study(
+        inputs,
+        settings,
+        runs=runs,
+        cancel=cancel,
+        progress=lambda p: progress(p.done / max(p.total, 1), p.label, p),
+    )
     from ladartui.study.results import study_folder
     from ladartui.study.run import write_outputs
 

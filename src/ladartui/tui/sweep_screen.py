@@ -119,8 +119,16 @@ class SweepScreen(Screen):
     SweepScreen #sweep-detail { height: 1; padding: 0 1; background: $panel; }
     """
 
-    def __init__(self, spec_path=None, *, scheduler: str | None = None, serial: bool = False,
-                 connect_timeout: float = 30.0, certs=None, **kwargs):
+    def __init__(
+        self,
+        spec_path=None,
+        *,
+        scheduler: str | None = None,
+        serial: bool = False,
+        connect_timeout: float = 30.0,
+        certs=None,
+        **kwargs,
+    ):
         """``spec_path``: a sweep spec, results.csv or results folder to open at once;
         ``scheduler``: a Dask scheduler address to fill in; ``serial``: run without Dask."""
         super().__init__(**kwargs)
@@ -151,24 +159,41 @@ class SweepScreen(Screen):
     def compose(self) -> ComposeResult:
         with Horizontal(classes="sweep-row"):
             yield Label("Spec")
-            yield Input(self.initial_path, id="sweep-path", compact=True,
-                        placeholder="sweep spec .toml, or results.csv / results folder",
-                        validators=[ExistingPath()], validate_on=["changed", "submitted"],
-                        valid_empty=True)
+            yield Input(
+                self.initial_path,
+                id="sweep-path",
+                compact=True,
+                placeholder="sweep spec .toml, or results.csv / results folder",
+                validators=[ExistingPath()],
+                validate_on=["changed", "submitted"],
+                valid_empty=True,
+            )
             yield Button("Browse F2", id="sweep-browse", compact=True)
         with Horizontal(classes="sweep-row"):
             yield Label("Scheduler")
-            yield Input(self.initial_scheduler, id="sweep-scheduler", compact=True,
-                        placeholder="tcp://HOST:8786 (empty: this machine)")
+            yield Input(
+                self.initial_scheduler,
+                id="sweep-scheduler",
+                compact=True,
+                placeholder="tcp://HOST:8786 (empty: this machine)",
+            )
             yield Label("Budget s")
-            yield Input(id="sweep-budget", compact=True, type="number", placeholder="spec",
-                        valid_empty=True)
-            yield Checkbox("serial", self.serial, id="sweep-serial", compact=True,
-                           tooltip="run the variants in this process, without Dask")
+            yield Input(id="sweep-budget", compact=True, type="number", placeholder="spec", valid_empty=True)
+            yield Checkbox(
+                "serial",
+                self.serial,
+                id="sweep-serial",
+                compact=True,
+                tooltip="run the variants in this process, without Dask",
+            )
         with Horizontal(classes="sweep-row"):
             yield Label("Certificates")
-            yield Input(self.initial_certs, id="sweep-certs", compact=True,
-                        placeholder="folder from 'ladartui certs' (for a tls:// scheduler)")
+            yield Input(
+                self.initial_certs,
+                id="sweep-certs",
+                compact=True,
+                placeholder="folder from 'ladartui certs' (for a tls:// scheduler)",
+            )
         with Horizontal(classes="sweep-row"):
             yield ProgressBar(id="sweep-progress", show_eta=False)
             yield Static("", id="sweep-counts")
@@ -228,8 +253,7 @@ class SweepScreen(Screen):
         if path.is_dir() or path.suffix.lower() == ".csv":
             sibling = _sibling_spec(path)
             if sibling is None:
-                raise InputFileError(path, "expected a sweep spec (.toml) to run; F3 opens "
-                                     "results")
+                raise InputFileError(path, "expected a sweep spec (.toml) to run; F3 opens results")
             path = sibling
         spec = load_sweep_spec(path)
         if spec.scenario_path != DEFAULT_BASE:
@@ -252,15 +276,15 @@ class SweepScreen(Screen):
             objective = self.objective if same else spec.objective
             cost = self.cost if same else spec.cost
             if objective == "coverage-within-budget" and budget is None:
-                raise FieldError("budget", None, "a flight-time budget in seconds for "
-                                 "objective 'coverage-within-budget'")
+                raise FieldError(
+                    "budget", None, "a flight-time budget in seconds for objective 'coverage-within-budget'"
+                )
             scheduler = self.query_one("#sweep-scheduler", Input).value.strip()
             security = None
             if scheduler:  # the same rules as the CLI: no plain scheduler off this machine
                 from ladartui.sweep.security import folder_security
 
-                security = folder_security(scheduler,
-                                           self.query_one("#sweep-certs", Input).value.strip())
+                security = folder_security(scheduler, self.query_one("#sweep-certs", Input).value.strip())
         except LadarError as error:
             self._status(NOT_READY, str(error))
             return
@@ -284,15 +308,22 @@ class SweepScreen(Screen):
         self.progress = None
         remember_path("sweeps", spec.path)
         self.query_one("#sweep-progress", ProgressBar).update(total=len(ids), progress=0)
-        where = (f"scheduler {scheduler}" if scheduler
-                 else "this process" if serial else "a local cluster")
+        where = f"scheduler {scheduler}" if scheduler else "this process" if serial else "a local cluster"
         self.query_one("#sweep-counts", Static).update(f"0/{len(ids)} starting on {where}")
-        self._status(BUSY, f"starting {len(ids)} variants on {where}; results in "
-                     f"{short_path(self.out)}", 0.0, cancellable=True)
+        self._status(
+            BUSY,
+            f"starting {len(ids)} variants on {where}; results in {short_path(self.out)}",
+            0.0,
+            cancellable=True,
+        )
         timeout = self.connect_timeout
-        self.worker = start_job(self, "sweep", lambda cancel, progress: _sweep(
-            spec, scheduler, security, serial, objective, cost, budget, timeout, cancel,
-            progress))
+        self.worker = start_job(
+            self,
+            "sweep",
+            lambda cancel, progress: _sweep(
+                spec, scheduler, security, serial, objective, cost, budget, timeout, cancel, progress
+            ),
+        )
 
     def action_open_results(self) -> None:
         """Open the results of an earlier (or running elsewhere) sweep."""
@@ -339,8 +370,12 @@ class SweepScreen(Screen):
         text = f"ranking by {self.objective}"
         if self.objective == "coverage-within-budget":
             text += f" (budget {self._budget():g} s)"
-        self._status(self._idle_state(), f"{text}, Pareto front against {self.cost}",
-                     self._fraction() if self.running else None, cancellable=self.running)
+        self._status(
+            self._idle_state(),
+            f"{text}, Pareto front against {self.cost}",
+            self._fraction() if self.running else None,
+            cancellable=self.running,
+        )
 
     def action_view(self) -> None:
         self.view = VIEWS[(VIEWS.index(self.view) + 1) % len(VIEWS)]
@@ -358,13 +393,16 @@ class SweepScreen(Screen):
             name = f"{self.spec.name}-best"
             if self.objective != self.spec.objective:
                 name += f"-{self.objective}"
-            self._write_best(self.spec, best.row, list(self.parameter_names),
-                             self.out / f"{name}.toml", self.objective)
+            self._write_best(
+                self.spec, best.row, list(self.parameter_names), self.out / f"{name}.toml", self.objective
+            )
             return
         found = sorted(self.out.glob("*-best.toml")) if self.out is not None else []
         if len(found) != 1:
-            self._status(self._idle_state(), "no best-path scenario in the results folder; "
-                         "open the sweep spec to save one")
+            self._status(
+                self._idle_state(),
+                "no best-path scenario in the results folder; open the sweep spec to save one",
+            )
             return
         self._announce_best(found[0], "as saved by the sweep (its spec's objective)")
 
@@ -385,16 +423,18 @@ class SweepScreen(Screen):
         from ladartui.tui.file_dialogs import PickPathScreen
 
         typed = Path(self._path_text()).expanduser() if self._path_text() else None
-        start = typed if typed is not None and typed.is_dir() else (
-            typed.parent if typed is not None else None)
+        start = (
+            typed if typed is not None and typed.is_dir() else (typed.parent if typed is not None else None)
+        )
 
         def picked(path) -> None:
             if path is not None:
                 self.query_one("#sweep-path", Input).value = str(path)
                 self._open(str(path))
 
-        self.app.push_screen(PickPathScreen("Sweep spec or results", (".toml", ".csv"), start,
-                                            folders=True), picked)
+        self.app.push_screen(
+            PickPathScreen("Sweep spec or results", (".toml", ".csv"), start, folders=True), picked
+        )
 
     @on(Input.Submitted, "#sweep-path")
     def _path_submitted(self) -> None:
@@ -409,8 +449,10 @@ class SweepScreen(Screen):
             self._status(self._idle_state(), str(error))
             return
         self._redraw()
-        self._status(self._idle_state(), f"budget {self._budget():g} s"
-                     if self._budget() is not None else "budget from the spec")
+        self._status(
+            self._idle_state(),
+            f"budget {self._budget():g} s" if self._budget() is not None else "budget from the spec",
+        )
 
     @on(DataTable.RowHighlighted, "#sweep-table")
     def _row_highlighted(self, event: DataTable.RowHighlighted) -> None:
@@ -435,8 +477,9 @@ class SweepScreen(Screen):
                     self.parameter_names = spec.parameter_names
                     self._redraw()
                     self._show_stored(len(spec.variants))
-                    self._status(NOT_READY, f"{path}: {len(spec.variants)} variants, no results "
-                                 "yet: F5 runs the sweep")
+                    self._status(
+                        NOT_READY, f"{path}: {len(spec.variants)} variants, no results yet: F5 runs the sweep"
+                    )
                     remember_path("sweeps", path)
                     return
             else:
@@ -459,8 +502,9 @@ class SweepScreen(Screen):
         self._redraw()
         self._show_stored(len(spec.variants) if spec else len(self.rows))
         self.query_one("#sweep-table", DataTable).focus()
-        self._status(READY, f"{short_path(result.results_path)}: {self._summary()}; "
-                     f"ranked by {self.objective}")
+        self._status(
+            READY, f"{short_path(result.results_path)}: {self._summary()}; ranked by {self.objective}"
+        )
         remember_path("sweeps", path)  # the screen reopens it next time
 
     def _summary(self) -> str:
@@ -469,8 +513,7 @@ class SweepScreen(Screen):
 
     def _show_stored(self, total: int) -> None:
         """Progress row of opened results: variants in the table out of the spec's."""
-        self.query_one("#sweep-progress", ProgressBar).update(total=max(total, 1),
-                                                              progress=len(self.rows))
+        self.query_one("#sweep-progress", ProgressBar).update(total=max(total, 1), progress=len(self.rows))
         text = self._summary()
         if total != len(self.rows):
             text = f"{len(self.rows)}/{total} stored: " + text.split(" ", 2)[2]
@@ -507,16 +550,13 @@ class SweepScreen(Screen):
             else:
                 self.rows[index] = p.row
             self._dirty = True
-        self.query_one("#sweep-progress", ProgressBar).update(total=max(p.total, 1),
-                                                              progress=p.done)
+        self.query_one("#sweep-progress", ProgressBar).update(total=max(p.total, 1), progress=p.done)
         self.query_one("#sweep-counts", Static).update(self._counts_text(p))
         if not self.worker.is_cancelled:
-            self._status(BUSY, f"sweeping into {short_path(self.out)}", p.fraction,
-                         cancellable=True)
+            self._status(BUSY, f"sweeping into {short_path(self.out)}", p.fraction, cancellable=True)
 
     def _counts_text(self, p) -> str:
-        return (f"{p.done}/{p.total}, {p.failed} failed, {p.resumed} resumed, "
-                f"ETA {format_eta(eta_seconds(p))}")
+        return f"{p.done}/{p.total}, {p.failed} failed, {p.resumed} resumed, ETA {format_eta(eta_seconds(p))}"
 
     def _finish(self, result, error: str) -> None:
         self.running = False
@@ -529,18 +569,21 @@ class SweepScreen(Screen):
             self._redraw()
             note = "" if not result.failures else f", {len(result.failures)} failed"
             self.query_one("#sweep-progress", ProgressBar).update(
-                total=max(len(result.rows), 1), progress=len(result.rows))
+                total=max(len(result.rows), 1), progress=len(result.rows)
+            )
             self.query_one("#sweep-counts", Static).update(self._summary())
-            self._status(READY, f"sweep done: {result.ran} run, {result.resumed} resumed{note} "
-                         f"in {format_eta(result.elapsed)}; results in {short_path(self.out)}",
-                         1.0)
+            self._status(
+                READY,
+                f"sweep done: {result.ran} run, {result.resumed} resumed{note} "
+                f"in {format_eta(result.elapsed)}; results in {short_path(self.out)}",
+                1.0,
+            )
             return
         self._rank_quietly()
         self._redraw()
         kept = f"{p.done} of {p.total} variants kept" if p else "finished variants kept"
         if error == "cancelled":
-            self._status(NOT_READY, f"sweep cancelled: {kept} in {short_path(self.out)}; "
-                         "F5 resumes")
+            self._status(NOT_READY, f"sweep cancelled: {kept} in {short_path(self.out)}; F5 resumes")
         else:
             self._status(NOT_READY, f"sweep stopped: {error}")
 
@@ -571,8 +614,9 @@ class SweepScreen(Screen):
 
     def _draw_table(self) -> None:
         table = self.query_one("#sweep-table", DataTable)
-        self._shown_ids = fill_ranking_table(table, self.ranking, self.objective, self.cost,
-                                             self.parameter_names, self._shown_ids)
+        self._shown_ids = fill_ranking_table(
+            table, self.ranking, self.objective, self.cost, self.parameter_names, self._shown_ids
+        )
         if self.ranking:
             self._show_detail(table.cursor_row)
         else:
@@ -581,7 +625,8 @@ class SweepScreen(Screen):
     def _show_detail(self, index: int) -> None:
         entry = self.ranking[index] if 0 <= index < len(self.ranking) else None
         self.query_one("#sweep-detail", Static).update(
-            detail_text(entry, self.parameter_names) if entry is not None else "")
+            detail_text(entry, self.parameter_names) if entry is not None else ""
+        )
 
     def _draw_chart(self) -> None:
         plot = self.query_one("#sweep-chart", PlotextPlot)
@@ -596,28 +641,42 @@ class SweepScreen(Screen):
             return BUSY
         return READY if self.ranking else NOT_READY
 
-    def _status(self, state: str, message: str, progress: float | None = None,
-                cancellable: bool = False) -> None:
+    def _status(
+        self, state: str, message: str, progress: float | None = None, cancellable: bool = False
+    ) -> None:
         message = " ".join(message.split())  # always one line
         self.last_message = message
-        self.query_one("#sweep-status", StatusBar).show(state, message, progress,
-                                                        cancellable or self.running)
+        self.query_one("#sweep-status", StatusBar).show(state, message, progress, cancellable or self.running)
 
     # -- best path ----------------------------------------------------------------
 
     def _write_best(self, spec, row: dict, parameter_names, path: Path, objective: str) -> None:
-        start_job(self, "best", lambda cancel, progress: (
-            _write_best(spec, row, parameter_names, path), f"best by {objective}"))
+        start_job(
+            self,
+            "best",
+            lambda cancel, progress: (_write_best(spec, row, parameter_names, path), f"best by {objective}"),
+        )
 
     def _announce_best(self, path: Path, how: str) -> None:
         self.query_one("#sweep-detail", Static).update(f"best path: {path}")
-        self._status(self._idle_state(), f"best path ({how}): {path}",
-                     self._fraction() if self.running else None)
+        self._status(
+            self._idle_state(), f"best path ({how}): {path}", self._fraction() if self.running else None
+        )
         self.post_message(self.OpenScenario(path))
 
 
-def _sweep(spec, scheduler: str, security, serial: bool, objective: str, cost: str, budget,
-           connect_timeout: float, cancel, progress):
+def _sweep(
+    spec,
+    scheduler: str,
+    security,
+    serial: bool,
+    objective: str,
+    cost: str,
+    budget,
+    connect_timeout: float,
+    cancel,
+    progress,
+):
     """The sweep job (worker thread): every finished variant is a kept progress report."""
     from ladartui.sweep import connect, run_sweep
 
@@ -626,9 +685,16 @@ def _sweep(spec, scheduler: str, security, serial: bool, objective: str, cost: s
         if scheduler:
             progress(0.0, f"connecting to {scheduler} ...")
             client = connect(scheduler, connect_timeout, security)
-        return run_sweep(spec, client=client, cancel=cancel, objective=objective, cost=cost,
-                         budget=budget, serial=serial,
-                         progress=lambda p: progress(p.fraction, "", p, keep=p.row is not None))
+        return run_sweep(
+            spec,
+            client=client,
+            cancel=cancel,
+            objective=objective,
+            cost=cost,
+            budget=budget,
+            serial=serial,
+            progress=lambda p: progress(p.fraction, "", p, keep=p.row is not None),
+        )
     finally:
         if client is not None:
             client.close()

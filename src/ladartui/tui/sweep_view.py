@@ -9,8 +9,11 @@ from rich.text import Text
 
 from ladartui.sweep.table import display_cell
 
-OBJECTIVE_HEADERS = {"obscured-coverage": "coverage", "coverage-per-km": "cov/km",
-                     "coverage-within-budget": "in budget"}
+OBJECTIVE_HEADERS = {
+    "obscured-coverage": "coverage",
+    "coverage-per-km": "cov/km",
+    "coverage-within-budget": "in budget",
+}
 COST_HEADERS = {"flight-time": "time s", "distance": "dist m"}
 COST_LABELS = {"flight-time": "flight time (s)", "distance": "distance flown (m)"}
 FRONT_MARKER = "◆"
@@ -37,8 +40,7 @@ def short_path(path) -> str:
         return str(path)
 
 
-def fill_ranking_table(table, ranking, objective: str, cost: str, parameter_names,
-                       shown_ids: list) -> list:
+def fill_ranking_table(table, ranking, objective: str, cost: str, parameter_names, shown_ids: list) -> list:
     """Refill ``table`` with ``ranking``, keeping the cursor on the same variant; the
     variant ids in table order."""
     current = shown_ids[table.cursor_row] if 0 <= table.cursor_row < len(shown_ids) else None
@@ -84,16 +86,16 @@ def ranking_cells(entry, objective: str, parameter_names) -> list:
     cells.extend(Text(display_cell(row.get(name))) for name in parameter_names)
     cells.append(Text(str(row.get("variant") or "")))
     error = str(row.get("error") or "")
-    cells.append(Text(error[:ERROR_WIDTH] + ("…" if len(error) > ERROR_WIDTH else ""),
-                      style="red"))
+    cells.append(Text(error[:ERROR_WIDTH] + ("…" if len(error) > ERROR_WIDTH else ""), style="red"))
     return cells
 
 
 def detail_text(entry, parameter_names) -> Text:
     """The detail line of one ranked variant: its parameters, and why it failed."""
     row = entry.row
-    params = ", ".join(f"{name}={display_cell(row.get(name))}" for name in parameter_names
-                       if row.get(name) is not None)
+    params = ", ".join(
+        f"{name}={display_cell(row.get(name))}" for name in parameter_names if row.get(name) is not None
+    )
     text = Text(f"{row.get('variant')}: {params or 'base scenario'}")
     if row.get("status") != "ok":
         text.append(f"  {row.get('status')}: {row.get('error') or ''}", style="bold red")
@@ -109,8 +111,7 @@ def draw_pareto(plt, ranking, cost: str) -> None:
     plt.title(f"{FRONT_MARKER} Pareto front  ★ best")
     plt.xlabel(COST_LABELS[cost])
     plt.ylabel("coverage %")
-    points = [(e.cost, 100 * e.coverage, e) for e in ranking
-              if e.cost is not None and e.coverage is not None]
+    points = [(e.cost, 100 * e.coverage, e) for e in ranking if e.cost is not None and e.coverage is not None]
     if not points:
         return
     others = [p for p in points if not p[2].pareto]
@@ -120,8 +121,7 @@ def draw_pareto(plt, ranking, cost: str) -> None:
     # a thin line joins the front; its own points sit on it (a line of markers would
     # read as many points)
     plt.plot([p[0] for p in front], [p[1] for p in front], marker="braille", color="orange")
-    plt.scatter([p[0] for p in front], [p[1] for p in front], marker=FRONT_MARKER,
-                color="orange")
+    plt.scatter([p[0] for p in front], [p[1] for p in front], marker=FRONT_MARKER, color="orange")
     best = [p for p in points if p[2].rank == 1]
     if best:
         plt.scatter([best[0][0]], [best[0][1]], marker="★", color="green")

@@ -32,8 +32,9 @@ class UnsavedScreen(ModalScreen[str | None]):
 
     def compose(self) -> ComposeResult:
         with Vertical():
-            yield Static(f"{escape(self.scenario_name)} has unsaved edits. "
-                         f"Save them before you {escape(self.doing)}?")
+            yield Static(
+                f"{escape(self.scenario_name)} has unsaved edits. Save them before you {escape(self.doing)}?"
+            )
             with Horizontal():
                 yield Button("Save", id="unsaved-save", variant="primary", compact=True)
                 yield Button("Discard", id="unsaved-discard", variant="error", compact=True)
@@ -68,8 +69,12 @@ class EditGuard:
             problem = field.problem()
             if problem is not None:
                 field.focus()
-                self.tell(f"{problem}. Correct the value and try again.",
-                          title="Not done: invalid value", severity="error", timeout=8)
+                self.tell(
+                    f"{problem}. Correct the value and try again.",
+                    title="Not done: invalid value",
+                    severity="error",
+                    timeout=8,
+                )
                 return False
             self.commit_field(field)
         return True
@@ -77,8 +82,8 @@ class EditGuard:
     def unsaved(self) -> bool:
         """Edits that a save would keep: committed ones, or text typed in a field."""
         return self.scenario is not None and (
-            self.modified or any(f.value != f.committed
-                                 for f in self.query(".param").results(NumberField)))
+            self.modified or any(f.value != f.committed for f in self.query(".param").results(NumberField))
+        )
 
     def confirm_discard(self, doing: str, then) -> None:
         """Call ``then`` once unsaved edits are saved or the analyst chose to discard them."""

@@ -34,18 +34,21 @@ LAYOUTS = {
 def prepare_views(scene) -> dict:
     """View data that depends only on the scene: top view, 3D sample, bounds (worker thread)."""
     heights = scene.top_height_map()
-    top = views.TopView(heights, scene.voxel_size,
-                        target_columns=np.unique(scene.target[:, :2], axis=0))
+    top = views.TopView(heights, scene.voxel_size, target_columns=np.unique(scene.target[:, :2], axis=0))
     sample = views.subsample(scene.voxels, SCENE_POINTS, seed=0)
     points = np.concatenate([sample, views.surface_points(heights, SCENE_POINTS // 3)])
     nx, ny, nz = scene.shape
     top_z = int(heights.max()) if heights.size and heights.max() >= 0 else nz - 1
     bounds = (np.zeros(3), np.array([nx - 1, ny - 1, max(top_z, 1)], float))
     top.scene_layer(48, 96)  # warm the cache at a typical size
-    return {"top": top, "points": points, "bounds": bounds,
-            "target": np.asarray(scene.target, np.int32),
-            "target_box": framing.box_of(scene.target),
-            "target_m": tuple(float(v) for v in scene.target_centre_m())}
+    return {
+        "top": top,
+        "points": points,
+        "bounds": bounds,
+        "target": np.asarray(scene.target, np.int32),
+        "target_box": framing.box_of(scene.target),
+        "target_m": tuple(float(v) for v in scene.target_centre_m()),
+    }
 
 
 class ViewArea(Container):
@@ -57,10 +60,10 @@ class ViewArea(Container):
         self.prepared: dict | None = None
         self.voxel_size = 1.0
         self.scenario = None
-        self.output_mode = "class"      # or "height": see render.output
-        self.colour_map = "height"      # or "grey": the report's 56 shades
+        self.output_mode = "class"  # or "height": see render.output
+        self.colour_map = "height"  # or "grey": the report's 56 shades
         self.overlays = OVERLAY_CYCLE[0]
-        self.markers = None             # scan positions, voxel units
+        self.markers = None  # scan positions, voxel units
         self._output_args = (None, None, OUTPUT_POINTS, None, None)
         self.per_scan_known = False  # the output shown has per-scan returns ("scans" mode)
         self._target_file_cache: tuple | None = None
@@ -88,8 +91,12 @@ class ViewArea(Container):
             widget.pending_fit = None
             widget._update_title()
         self.query_one("#scene3d", ProjectionWidget).set_layers(
-            scene_layers(prepared["points"], prepared["target"]), prepared["points"],
-            prepared["bounds"], voxel_size, height_range=(0.0, top))
+            scene_layers(prepared["points"], prepared["target"]),
+            prepared["points"],
+            prepared["bounds"],
+            voxel_size,
+            height_range=(0.0, top),
+        )
 
     def rescale(self, voxel_size: float, target_m) -> None:
         """The same voxels at another size (the scenario's voxel size changed)."""
@@ -130,8 +137,9 @@ class ViewArea(Container):
 
     # -- the output view -----------------------------------------------------------
 
-    def show_output(self, voxels, threshold: float | None, limit: int = OUTPUT_POINTS,
-                    target_output=None, per_scan=None) -> None:
+    def show_output(
+        self, voxels, threshold: float | None, limit: int = OUTPUT_POINTS, target_output=None, per_scan=None
+    ) -> None:
         """The scene output after the threshold, coloured by ``output_mode``.
 
         ``target_output`` (the target traced without foliage) marks what the
@@ -166,18 +174,26 @@ class ViewArea(Container):
         scene, seen, hidden = classify(voxels, self.prepared["target"], target_output)
         scene = views.subsample(scene, limit, seed=0)
         layers, heights = output_layers(
-            np.concatenate([scene, seen]), self.prepared["target"], hidden,
-            mode=self.output_mode, voxel_size=self.voxel_size, threshold_m=threshold,
-            per_scan=per_scan)
-        shown = views.threshold_points(np.concatenate([scene, seen]), self.voxel_size,
-                                       threshold)
+            np.concatenate([scene, seen]),
+            self.prepared["target"],
+            hidden,
+            mode=self.output_mode,
+            voxel_size=self.voxel_size,
+            threshold_m=threshold,
+            per_scan=per_scan,
+        )
+        shown = views.threshold_points(np.concatenate([scene, seen]), self.voxel_size, threshold)
         widget.placeholder = "nothing below the threshold" if len(voxels) else "no returns"
         if not any(len(layer.voxels) for layer in layers):
             widget.set_points(None)
             return
-        widget.set_layers(layers, shown,
-                          widget.bounds if widget.bounds is not None else self.prepared["bounds"],
-                          self.voxel_size, height_range=heights)
+        widget.set_layers(
+            layers,
+            shown,
+            widget.bounds if widget.bounds is not None else self.prepared["bounds"],
+            self.voxel_size,
+            height_range=heights,
+        )
 
     def _known_per_scan(self, voxels):
         result = getattr(self.app, "result", None)
@@ -266,8 +282,14 @@ class ViewArea(Container):
 
     def on_picture_widget_view_request(self, message: PictureWidget.ViewRequest) -> None:
         message.stop()
-        if message.what in ("fit_target", "fit_scene", "fit_path", "cycle_output_colour",
-                            "toggle_grey", "cycle_overlays"):
+        if message.what in (
+            "fit_target",
+            "fit_scene",
+            "fit_path",
+            "cycle_output_colour",
+            "toggle_grey",
+            "cycle_overlays",
+        ):
             getattr(self, message.what)()
 
     # -- pictures ------------------------------------------------------------------
@@ -286,8 +308,9 @@ class ViewArea(Container):
         path; a bad size or an empty view raises a one-line LadarError.
         """
         width, height = png.check_size(width, height)
-        widget = (self.query_one(f"#{view}", PictureWidget) if isinstance(view, str)
-                  else self.current_view(view))
+        widget = (
+            self.query_one(f"#{view}", PictureWidget) if isinstance(view, str) else self.current_view(view)
+        )
         picture = widget.make_picture(height, width)
         if picture is None:
             raise LadarError(f"{widget.border_title}: nothing to draw yet")

@@ -21,7 +21,8 @@ def tiny_run(scenario, scene=None, cancel=None) -> None:
 
     tiny = scenario.with_changes(
         sensor=Sensor(grid=1, ray_grid=1, fov=scenario.sensor.fov),
-        flight=FlightPlan(None, (Manual((scenario.poses()[0],)),)))
+        flight=FlightPlan(None, (Manual((scenario.poses()[0],)),)),
+    )
     simulate(tiny, write=False, scene=scene, cancel=cancel)
 
 
@@ -33,9 +34,11 @@ def warm_in_child(scenario_path, stop=None, timeout: float = 600.0) -> bool:
     import time
 
     try:
-        child = subprocess.Popen([sys.executable, "-m", "ladartui.tui.warmup",
-                                  str(scenario_path)],
-                                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        child = subprocess.Popen(
+            [sys.executable, "-m", "ladartui.tui.warmup", str(scenario_path)],
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
     except OSError:
         return False
     deadline = time.monotonic() + timeout

@@ -15,8 +15,9 @@ off): nothing a task raises can close the app. Cancelling is
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, Callable, ClassVar
+from typing import Any, ClassVar
 
 from textual.message import Message
 from textual.worker import Worker, get_current_worker
@@ -42,8 +43,12 @@ class JobProgress(Message):
 
     def can_replace(self, message: Message) -> bool:
         # a queued report with a detail (a live view) is only replaced by one with a detail
-        return (isinstance(message, JobProgress) and message.job == self.job
-                and not message.keep and (message.detail is None or self.detail is not None))
+        return (
+            isinstance(message, JobProgress)
+            and message.job == self.job
+            and not message.keep
+            and (message.detail is None or self.detail is not None)
+        )
 
 
 @dataclass
@@ -67,8 +72,7 @@ def start_job(node, job: str, task: Task) -> Worker:
     def body():
         worker = get_current_worker()
 
-        def progress(fraction: float | None, text: str, detail: Any = None,
-                     keep: bool = False) -> None:
+        def progress(fraction: float | None, text: str, detail: Any = None, keep: bool = False) -> None:
             node.post_message(JobProgress(job, fraction, text, detail, keep))
 
         try:
@@ -82,8 +86,7 @@ def start_job(node, job: str, task: Task) -> Worker:
         else:  # a task that finished did its work, even if cancel came too late to stop it
             node.post_message(JobDone(job, result))
 
-    return node.run_worker(body, name=job, group=job, thread=True, exclusive=True,
-                           exit_on_error=False)
+    return node.run_worker(body, name=job, group=job, thread=True, exclusive=True, exit_on_error=False)
 
 
 def running(worker: Worker | None) -> bool:

@@ -38,13 +38,17 @@ class FilePanel(VerticalScroll):
             return
         voxels = f"{len(scene.voxels):,} voxels" if scene is not None else ""
         target = f"{len(scene.target):,} voxels" if scene is not None else ""
-        rows = [("Scenario", scenario.path.name + (" (modified)" if modified else "")),
-                ("Folder", shown_folder(scenario.path.parent)),
-                ("Scene model", scenario.scene_file.name), ("", voxels),
-                ("Target model", scenario.target_file.name), ("", target),
-                ("Scene output", scenario.scene_output.name),
-                ("Target output", scenario.target_output.name),
-                ("Measures", scenario.measures_file.name)]
+        rows = [
+            ("Scenario", scenario.path.name + (" (modified)" if modified else "")),
+            ("Folder", shown_folder(scenario.path.parent)),
+            ("Scene model", scenario.scene_file.name),
+            ("", voxels),
+            ("Target model", scenario.target_file.name),
+            ("", target),
+            ("Scene output", scenario.scene_output.name),
+            ("Target output", scenario.target_output.name),
+            ("Measures", scenario.measures_file.name),
+        ]
         text = Text()
         for key, value in rows:
             if not value:
@@ -54,8 +58,10 @@ class FilePanel(VerticalScroll):
             text.append(f"{key:<14}", style="bold")
             text.append(value)  # names from files and fields: plain text, never markup
         if missing:
-            text.append("\nNot on disk yet: " + ", ".join(p.name for p in missing)
-                        + " (F5 writes them)", style="yellow")
+            text.append(
+                "\nNot on disk yet: " + ", ".join(p.name for p in missing) + " (F5 writes them)",
+                style="yellow",
+            )
         self.query_one("#file-info", Static).update(text)
 
     def show_recent(self, current: Path | None = None) -> None:
@@ -63,8 +69,7 @@ class FilePanel(VerticalScroll):
         listing.clear_options()
         paths = [p for p in recent_scenarios() if p != current]
         for path in paths:
-            listing.add_option(Option(Text(f"{path.name}  {shown_folder(path.parent)}"),
-                                      id=str(path)))
+            listing.add_option(Option(Text(f"{path.name}  {shown_folder(path.parent)}"), id=str(path)))
         listing.display = bool(paths)
         self.query_one("#recent-heading", Label).display = bool(paths)
 
@@ -76,8 +81,14 @@ class FilePanel(VerticalScroll):
     @on(Button.Pressed, "#btn-new,#btn-open,#btn-save,#btn-save-as,#btn-undo,#btn-redo")
     async def _pressed(self, event: Button.Pressed) -> None:
         event.stop()
-        action = {"btn-new": "new_scenario", "btn-open": "open_scenario", "btn-save": "save",
-                  "btn-save-as": "save_as", "btn-undo": "undo", "btn-redo": "redo"}
+        action = {
+            "btn-new": "new_scenario",
+            "btn-open": "open_scenario",
+            "btn-save": "save",
+            "btn-save-as": "save_as",
+            "btn-undo": "undo",
+            "btn-redo": "redo",
+        }
         await self.app.run_action(action[event.button.id])
 
 

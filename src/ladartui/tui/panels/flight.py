@@ -71,15 +71,26 @@ class FlightPanel(ParamPanel):
         except LadarError:
             per_segment = [[] for _ in scenario.flight.segments]
         for i, (segment, poses) in enumerate(zip(scenario.flight.segments, per_segment)):
-            segments.add_row(str(i + 1), bridge.SEGMENT_LABELS.get(segment.kind, segment.kind),
-                             str(len(poses)), bridge.segment_summary(segment))
+            segments.add_row(
+                str(i + 1),
+                bridge.SEGMENT_LABELS.get(segment.kind, segment.kind),
+                str(len(poses)),
+                bridge.segment_summary(segment),
+            )
         if segments.row_count:
             segments.move_cursor(row=min(max(row, 0), segments.row_count - 1))
         scans = self.query_one("#scans", DataTable)
         scans.clear()
         for i, p in enumerate(pose for poses in per_segment for pose in poses):
-            scans.add_row(str(i + 1), f"{p.x:.1f}", f"{p.y:.1f}", f"{p.z:.1f}",
-                          f"{p.heading:.0f}", f"{p.azimuth:.0f}", f"{p.depression:.0f}")
+            scans.add_row(
+                str(i + 1),
+                f"{p.x:.1f}",
+                f"{p.y:.1f}",
+                f"{p.z:.1f}",
+                f"{p.heading:.0f}",
+                f"{p.azimuth:.0f}",
+                f"{p.depression:.0f}",
+            )
 
     # -- editing segments ------------------------------------------------------------
 
@@ -112,9 +123,15 @@ class FlightPanel(ParamPanel):
                 what = f"add {label.lower()}" if index is None else f"edit segment {index + 1}"
                 self._put_segment(index, result, what)
 
-        self.app.push_screen(FormScreen(title, spec, bridge.segment_builder(segment.kind),
-                                        note="Empty optional fields keep the current "
-                                             "pointing."), done)
+        self.app.push_screen(
+            FormScreen(
+                title,
+                spec,
+                bridge.segment_builder(segment.kind),
+                note="Empty optional fields keep the current pointing.",
+            ),
+            done,
+        )
 
     def _put_segment(self, index: int | None, segment, what: str) -> bool:
         """Replace segment ``index``, or append when ``index`` is None."""
@@ -159,8 +176,9 @@ class FlightPanel(ParamPanel):
         def done(result):
             if not result:
                 if result is not None:
-                    self.app.tell("A manual segment needs at least one pose; not changed.",
-                                  severity="warning")
+                    self.app.tell(
+                        "A manual segment needs at least one pose; not changed.", severity="warning"
+                    )
                 return
             what = "add manual poses" if index is None else f"edit poses of segment {index + 1}"
             self._put_segment(index, Manual(tuple(result)), what)
@@ -188,10 +206,14 @@ class FlightPanel(ParamPanel):
         if kind == "manual":
             self._edit_poses(index)
         elif kind in bridge.FILE_SEGMENTS:
-            self.app.tell(f"A {bridge.SEGMENT_LABELS[kind].lower()} segment comes from its "
-                          f"file ({segments[index].file}): change its file, rate or times in "
-                          "the scenario file. Delete removes it; Aim all points it at the "
-                          "target.", severity="warning", timeout=8)
+            self.app.tell(
+                f"A {bridge.SEGMENT_LABELS[kind].lower()} segment comes from its "
+                f"file ({segments[index].file}): change its file, rate or times in "
+                "the scenario file. Delete removes it; Aim all points it at the "
+                "target.",
+                severity="warning",
+                timeout=8,
+            )
         else:
             self._edit_segment(segments[index], index)
 

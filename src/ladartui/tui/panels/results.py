@@ -23,8 +23,12 @@ class ResultsPanel(VerticalScroll):
             yield Button("Compare", id="btn-compare", compact=True)
             yield Button("Threshold", id="btn-threshold", compact=True)
         with Grid(classes="button-grid run-buttons two-buttons"):
-            yield Button("Export LAS", id="btn-export-las", compact=True,
-                         tooltip="The outputs as LAS point clouds beside them")
+            yield Button(
+                "Export LAS",
+                id="btn-export-las",
+                compact=True,
+                tooltip="The outputs as LAS point clouds beside them",
+            )
 
     def on_mount(self) -> None:
         self.query_one("#measures", DataTable).add_columns("Measure", "Value")

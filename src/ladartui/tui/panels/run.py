@@ -22,26 +22,44 @@ class RunPanel(ParamPanel):
         self.backend_values = ["auto"]
 
     def compose(self):
-        yield Horizontal(Label("Backend"), Select([("auto", "auto")], value="auto",
-                                                  allow_blank=False, id="backend", compact=True),
-                         classes="row")
-        yield Horizontal(Label("Method"), Select([("exact", "exact"), ("march", "march")],
-                                                 value="exact", allow_blank=False, id="method",
-                                                 compact=True), classes="row")
+        yield Horizontal(
+            Label("Backend"),
+            Select([("auto", "auto")], value="auto", allow_blank=False, id="backend", compact=True),
+            classes="row",
+        )
+        yield Horizontal(
+            Label("Method"),
+            Select(
+                [("exact", "exact"), ("march", "march")],
+                value="exact",
+                allow_blank=False,
+                id="method",
+                compact=True,
+            ),
+            classes="row",
+        )
         for param in bridge.RUN_PARAMS:
             yield self.param_row(param)
-        yield Checkbox("Fast mode", id="fast-mode", compact=True,
-                       tooltip="Show only the final output, not each scan as it lands")
+        yield Checkbox(
+            "Fast mode",
+            id="fast-mode",
+            compact=True,
+            tooltip="Show only the final output, not each scan as it lands",
+        )
         with Grid(classes="button-grid run-buttons"):
             yield Button("Run F5", id="btn-run", variant="success", compact=True)
             yield Button("Save ^S", id="btn-save-run", compact=True)
-            yield Button("Cancel", id="btn-cancel-run", variant="error", compact=True,
-                         disabled=True)
+            yield Button("Cancel", id="btn-cancel-run", variant="error", compact=True, disabled=True)
         with Grid(classes="button-grid run-buttons two-buttons"):
-            yield Button("Study F11", id="btn-study", compact=True,
-                         tooltip="Speed against accuracy of every backend and method")
-            yield Button("Sweep F12", id="btn-sweep", compact=True,
-                         tooltip="Launch, open or watch a flight-path sweep")
+            yield Button(
+                "Study F11",
+                id="btn-study",
+                compact=True,
+                tooltip="Speed against accuracy of every backend and method",
+            )
+            yield Button(
+                "Sweep F12", id="btn-sweep", compact=True, tooltip="Launch, open or watch a flight-path sweep"
+            )
         yield Static("", id="run-info", classes="info", markup=False)
         yield Static("probing backends...", id="backend-info", classes="info")
 
@@ -133,6 +151,11 @@ class RunPanel(ParamPanel):
     @on(Button.Pressed, "#btn-run,#btn-save-run,#btn-cancel-run,#btn-study,#btn-sweep")
     async def _pressed(self, event: Button.Pressed) -> None:
         event.stop()
-        action = {"btn-run": "run", "btn-save-run": "save", "btn-cancel-run": "cancel_run",
-                  "btn-study": "study", "btn-sweep": "sweep"}
+        action = {
+            "btn-run": "run",
+            "btn-save-run": "save",
+            "btn-cancel-run": "cancel_run",
+            "btn-study": "study",
+            "btn-sweep": "sweep",
+        }
         await self.app.run_action(action[event.button.id])

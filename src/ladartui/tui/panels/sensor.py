@@ -19,4 +19,5 @@ class SensorPanel(ParamPanel):
         s = scenario.sensor
         self.query_one("#sensor-info", Static).update(
             f"{s.grid}x{s.grid} detectors, {s.ray_grid}x{s.ray_grid} rays each\n"
-            f"{s.rays_per_scan:,} rays per scan, IFOV {s.ifov * 1000:.3g} mdeg")
+            f"{s.rays_per_scan:,} rays per scan, IFOV {s.ifov * 1000:.3g} mdeg"
+        )
