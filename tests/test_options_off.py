@@ -12,11 +12,13 @@ compared byte for byte:
   rule, fusion and ``compute_measures`` (the path before the options existed).
 """
 
+import dataclasses
 import shutil
 from pathlib import Path
 
 import pytest
 
+from ladartui.levels import target_levels
 from ladartui.measures import compute_measures
 from ladartui.scenario import load_scenario
 from ladartui.scene.voxels import save_voxels
@@ -93,6 +95,15 @@ def _ideal_by_hand(scenario, folder):
         flight_time_s=scenario.flight_time(),
         voxel_size=scene.voxel_size,
     )
+    # Detect / recognise / identify belong to every run's measures (not an option).
+    levels = target_levels(
+        scene.target,
+        per_scan["scene"],
+        scenario.flight.scan_times(scenario.speed),
+        scenario.flight.scan_distances(),
+        scenario.level_thresholds,
+    )
+    measures = dataclasses.replace(measures, levels=levels)
     folder.mkdir()
     save_voxels(folder / "scene.txt", scene_output)
     save_voxels(folder / "target.txt", target_output)

@@ -711,6 +711,16 @@ class FlightPlan:
         scan) it is the straight distance. The lead-in from ``start`` to the
         very first scan is not counted: this is the length of the collection.
         """
+        distances = self.scan_distances()
+        return distances[-1] if distances else 0.0
+
+    def scan_distances(self) -> list[float]:
+        """Metres flown from the first scan to each scan (0 for the first), in flying order.
+
+        The one source of distance along the path: ``path_length`` is its last
+        value and ``scan_times`` divides it by the speed.
+        """
+        distances: list[float] = []
         total = 0.0
         previous = None
         for segment, poses in zip(self.segments, self.segment_poses()):
@@ -718,9 +728,16 @@ class FlightPlan:
                 total += (
                     segment.lead_in() if segment.relative else math.dist(previous.position, poses[0].position)
                 )
-            total += sum(segment.legs(poses))
+            distances.append(total)
+            for leg in segment.legs(poses):
+                total += leg
+                distances.append(total)
             previous = poses[-1]
-        return total
+        return distances
+
+    def scan_times(self, speed: float) -> list[float]:
+        """Seconds flown from the first scan to each scan at ``speed`` metres per second."""
+        return [flight_time(distance, speed) for distance in self.scan_distances()]
 
     def flight_time(self, speed: float) -> float:
         """Seconds to fly ``path_length()`` at ``speed`` metres per second."""

@@ -216,13 +216,15 @@ class Measures:
     # Geiger-mode figures (ladartui.detection.measures.DetectionMeasures); None with
     # the ideal sensor, and then absent from the dict and the .cmf.
     detection: object | None = None
+    # Detect / recognise / identify (ladartui.levels.LevelResult); None: not computed.
+    levels: object | None = None
 
     def to_dict(self) -> dict:
         """A JSON-safe dict (no NaN: undefined measures are None)."""
         out = {}
         for f in fields(self):
             value = getattr(self, f.name)
-            if f.name == "detection":
+            if f.name in ("detection", "levels"):
                 if value is not None:
                     out[f.name] = value.to_dict()
                 continue
@@ -245,6 +247,8 @@ class Measures:
                 lines.extend(_per_scan_lines(self))
         if self.detection is not None:
             lines.extend(_detection_lines(self.detection))
+        if self.levels is not None:
+            lines.extend(["", *self.levels.cmf_lines()])
         return "\n".join(lines) + "\n"
 
     def write_cmf(self, path) -> None:
@@ -530,8 +534,12 @@ def read_cmf(path) -> Measures:
     kinds.update(
         {(detection_section, key): ("detection." + attr, kind) for key, attr, kind in detection_entries}
     )
+    from ladartui.levels import CMF_SECTION as levels_section
+    from ladartui.levels import levels_from_cmf
+
     values: dict[str, object] = {}
     per_scan: dict[int, tuple] = {}
+    levels: dict[str, tuple[int, str]] | None = None
     section = None
     for number, raw in enumerate(lines[1:], start=2):
         line = raw.strip()
@@ -539,11 +547,16 @@ def read_cmf(path) -> Measures:
             continue
         if line.startswith("[") and line.endswith("]"):
             section = line[1:-1].strip()
-            if not any(section == name for name, _ in _CMF_SECTIONS) and section != detection_section:
+            if section == levels_section:
+                levels = {}
+            elif not any(section == name for name, _ in _CMF_SECTIONS) and section != detection_section:
                 raise InputFileError(path, f"unknown section [{section}]", line=number)
             continue
         key, sep, value = line.partition("=")
         key = key.strip()
+        if sep and section == levels_section and levels is not None:
+            levels[key] = (number, value.strip())
+            continue
         scan_key = _PER_SCAN_KEY.match(key)
         if sep and section == _PER_SCAN_SECTION and scan_key:
             pair = [t.strip() for t in value.split(",")]
@@ -578,6 +591,8 @@ def read_cmf(path) -> Measures:
         else:
             plain[head] = DirectionStats(**parts)
     plain.update(_per_scan_lists(path, per_scan))
+    if levels is not None:
+        plain["levels"] = levels_from_cmf(path, levels)
     return Measures(**plain)
 
 

@@ -72,6 +72,14 @@ Straight and turn segments continue from the previous segment's last scan
     [detection]                     # optional; absent: the ideal sensor
     model = "geiger"                # see ladartui.detection.settings for every key
 
+    [levels]                        # optional; detect / recognise / identify thresholds
+    detect = 0.10                   # share of the target's visible voxels seen (default 0.10)
+    recognise = 0.30                # (default 0.30)
+    identify = 0.50                 # (default 0.50)
+    detect_footprint = 0.10         # share of its footprint cells (x-y columns) seen (default 0.10)
+    recognise_footprint = 0.50      # (default 0.50)
+    identify_footprint = 0.75       # (default 0.75); see ladartui.levels for why
+
 Turns and orbits bank as coordinated turns at ``speed_mps``; only a
 ``body-fixed`` sensor sees it (``ladartui.attitude``).
 """
@@ -103,6 +111,7 @@ from ladartui.flight import (
     choice_field,
     number_field,
 )
+from ladartui.levels import LEVEL_KEYS, LevelThresholds, levels_from_table
 from ladartui.scenario_style import restyle
 from ladartui.sensor import MAX_PIXEL_PITCH, Sensor
 from ladartui.trajectory import LogSegment
@@ -129,6 +138,7 @@ _SECTIONS = {
     "flight": ("speed_mps", "start", "segments"),
     "simulation": ("backend", "method", "step", "precision", "fast_mode"),
     "detection": DETECTION_KEYS,
+    "levels": LEVEL_KEYS,
 }
 # Segment kinds a scenario file may use: the flight plan's, and recorded logs.
 _SEGMENT_KINDS = {**SEGMENT_KINDS, LogSegment.kind: LogSegment}
@@ -165,6 +175,7 @@ class Scenario:
     fast_mode: bool = False
     precision: str = "f64"
     detection: DetectionSettings | None = None  # None: no [detection] section (ideal)
+    levels: LevelThresholds | None = None  # None: no [levels] section (the defaults)
 
     def __post_init__(self):
         set_ = object.__setattr__
@@ -193,12 +204,19 @@ class Scenario:
                 raise FieldError("detection", self.detection, "a DetectionSettings")
             if self.detection.geiger:
                 self.detection.bin_width(self.sensor.depth_resolution)
+        if self.levels is not None and not isinstance(self.levels, LevelThresholds):
+            raise FieldError("levels", self.levels, "a LevelThresholds")
         _check_work(self)
 
     @property
     def geiger(self) -> bool:
         """True when the [detection] section asks for the Geiger-mode model."""
         return self.detection is not None and self.detection.geiger
+
+    @property
+    def level_thresholds(self) -> LevelThresholds:
+        """The [levels] thresholds, or their defaults when the section is absent."""
+        return self.levels if self.levels is not None else LevelThresholds()
 
     def scan_count(self) -> int:
         """Scans of the flight plan, counted without building the poses where it can be."""
@@ -323,6 +341,7 @@ class Scenario:
                 else []
             ),
             *([f"detection  {self.detection.describe()}"] if self.detection is not None else []),
+            "levels     " + _levels_text(self.level_thresholds, self.levels is None),
             f"outputs    {self.scene_output.name}, {self.target_output.name}, "
             f"{self.measures_file.name} in {self.path.parent}",
         ]
@@ -360,6 +379,8 @@ class Scenario:
         }
         if self.detection is not None:
             data["detection"] = self.detection.to_dict()
+        if self.levels is not None:
+            data["levels"] = self.levels.to_dict()
         return data
 
     def to_toml(self) -> str:
@@ -382,6 +403,14 @@ class Scenario:
             text = restyle(self.path.read_text(encoding="utf-8"), scenario.to_dict(), _saved_data(self.path))
         write_text_atomic(scenario.path, text if text is not None else scenario.to_toml())
         return scenario
+
+
+def _levels_text(thresholds: LevelThresholds, default: bool) -> str:
+    shares = ", ".join(
+        f"{level} {thresholds.voxel_share(level):.0%} / {thresholds.footprint_share(level):.0%}"
+        for level in ("detect", "recognise", "identify")
+    )
+    return f"{shares} of visible voxels / footprint" + (" (defaults)" if default else "")
 
 
 def _saved_data(path: Path) -> dict | None:
@@ -506,6 +535,15 @@ class _Reader:
                 key = error.field.rpartition(".")[2]
                 raise self.field_error(error.field, table.get(key, error.value), error.expected) from None
 
+        levels = None
+        if "levels" in doc:
+            table = self.table(doc, "levels", _SECTIONS["levels"])
+            try:
+                levels = levels_from_table(table)
+            except FieldError as error:
+                key = error.field.rpartition(".")[2]
+                raise self.field_error(error.field, table.get(key, error.value), error.expected) from None
+
         scene = files["scene"]
         if not isinstance(scene, str) or not scene.strip():
             raise self.field_error("files.scene", scene, "the scene model file name (X.txt)")
@@ -537,7 +575,13 @@ class _Reader:
                 options[key] = sim[key]
         try:
             return Scenario(
-                self.path, Path(scene), sensor=sensor, flight=plan, detection=detection, **options
+                self.path,
+                Path(scene),
+                sensor=sensor,
+                flight=plan,
+                detection=detection,
+                levels=levels,
+                **options,
             )
         except FieldError as error:
             raw = {"files.voxel_size": files.get("voxel_size"), "flight.speed_mps": flight.get("speed_mps")}

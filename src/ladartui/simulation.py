@@ -271,6 +271,7 @@ def _simulate(scenario, backend, method, step, precision, progress, cancel, outp
     )
     if runner.geiger is not None:
         measures = dataclasses.replace(measures, detection=runner.geiger.measures())
+    measures = dataclasses.replace(measures, levels=run_levels(scenario, scene.target, per_scan["scene"]))
     timings["measures"] = time.perf_counter() - tick
 
     outputs = {}
@@ -291,6 +292,19 @@ def _simulate(scenario, backend, method, step, precision, progress, cancel, outp
         rays_per_scan=scenario.sensor.rays_per_scan,
         timings=timings,
         outputs=outputs,
+    )
+
+
+def run_levels(scenario, target, scene_per_scan):
+    """Detect / recognise / identify for the target in the obscured view of a run."""
+    from ladartui.levels import target_levels
+
+    return target_levels(
+        target,
+        scene_per_scan,
+        scenario.flight.scan_times(scenario.speed),
+        scenario.flight.scan_distances(),
+        scenario.level_thresholds,
     )
 
 

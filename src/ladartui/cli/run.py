@@ -169,6 +169,8 @@ def show_result(console, result) -> None:
     console.print(comparison)
     if result.measures.detection is not None:
         console.print(detection_table(result.measures.detection))
+    if result.measures.levels is not None:
+        console.print(levels_table(result.measures.levels))
     total = result.timings.get("total", 0.0)
     console.print(
         f"backend: {result.backend} ({result.method}); {result.scans} scans x "
@@ -212,4 +214,23 @@ def detection_table(detection):
         ("ideal sensor: unobscured coverage", format_share(detection.ideal_unobscured_coverage)),
     ):
         table.add_row(name, value)
+    return table
+
+
+def levels_table(levels):
+    """Detect / recognise / identify: each level's thresholds and the scan that reached it."""
+    from rich.table import Table
+
+    from ladartui.measures import format_share
+
+    table = Table(
+        title=f"Levels: {format_share(levels.visible_share)} of {levels.visible_voxels or 0} "
+        f"visible voxels, {format_share(levels.footprint_share)} of {levels.footprint_cells or 0} "
+        "footprint cells seen"
+    )
+    table.add_column("level")
+    table.add_column("needs voxels / footprint", justify="right")
+    table.add_column("reached at")
+    for row in levels.rows():
+        table.add_row(*row)
     return table

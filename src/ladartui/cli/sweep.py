@@ -79,7 +79,8 @@ def add_parser(subparsers):
         "--budget",
         metavar="SECONDS",
         type=float,
-        help="flight-time budget for coverage-within-budget (default: the spec's)",
+        help="flight-time budget in seconds for coverage-within-budget and "
+        "identified-within-budget (default: the spec's)",
     )
     parser.add_argument(
         "--cost", metavar="NAME", help="cost axis of the Pareto front: flight-time or distance"
@@ -103,7 +104,7 @@ def run(args) -> int:
     from rich.console import Console
 
     from ladartui.sweep import default_out_dir, load_sweep_results, load_sweep_spec
-    from ladartui.sweep.ranking import normal_cost, normal_objective
+    from ladartui.sweep.ranking import BUDGET_OBJECTIVES, normal_cost, normal_objective
 
     if args.workers is not None and args.workers < 1:
         raise FieldError("--workers", args.workers, "an integer >= 1")
@@ -140,12 +141,11 @@ def run(args) -> int:
     normal_cost(args.cost or spec.cost)
     if args.budget is not None and not args.budget > 0:
         raise FieldError("--budget", args.budget, "a flight-time budget in seconds, > 0")
-    if objective == "coverage-within-budget" and args.budget is None and spec.budget is None:
+    if objective in BUDGET_OBJECTIVES and args.budget is None and spec.budget is None:
         raise FieldError(
             "--budget",
             None,
-            "a flight-time budget in seconds (or sweep.budget "
-            "in the spec) for objective 'coverage-within-budget'",
+            f"a flight-time budget in seconds (or sweep.budget in the spec) for objective '{objective}'",
         )
     errors = Console(stderr=True)
     if args.show:
@@ -269,6 +269,18 @@ def _restore_sigterm(previous):
 def result_dict(result, top) -> dict:
     """The sweep as a JSON-safe dict: files, counts, the best variants and the Pareto front."""
 
+    from ladartui.sweep.ranking import LEVEL_NAMES, level_of, levels_text
+
+    def levels(row):
+        per_level = {level: level_of(row, level) for level in LEVEL_NAMES}
+        return [
+            {
+                level: dict(zip(("reached", "scan", "flight_time_s", "distance_m"), per_level[level][i]))
+                for level in LEVEL_NAMES
+            }
+            for i in range(len(per_level["identify"]))
+        ]
+
     def entry(ranked):
         row = ranked.row
         return {
@@ -279,6 +291,8 @@ def result_dict(result, top) -> dict:
             "cost": ranked.cost,
             "pareto": ranked.pareto,
             "parameters": {n: row.get(n) for n in result.parameter_names},
+            "levels": levels(row),
+            "levels_text": levels_text(row),
         }
 
     return {
@@ -294,6 +308,7 @@ def result_dict(result, top) -> dict:
         "results": str(result.results_path),
         "ranking": str(result.ranking_path) if result.ranking_path else None,
         "best_scenario": str(result.best_scenario_path) if result.best_scenario_path else None,
+        "best_levels": levels_text(result.best.row) if result.best is not None else None,
         "charts": {fmt: str(path) for fmt, path in result.charts.items()},
         "top": [entry(r) for r in result.ranking[:top] if r.rank is not None],
         "pareto": [entry(r) for r in result.pareto],
@@ -313,6 +328,10 @@ def show_result(console, result, top) -> None:
         "obscured-coverage": "coverage",
         "coverage-per-km": "cov/km",
         "coverage-within-budget": "coverage",
+        "time-to-identify": "identify s",
+        "distance-to-identify": "identify m",
+        "worst-target-coverage": "worst cov.",
+        "identified-within-budget": "identified",
     }
     table = Table(
         title=f"Best flight paths by {result.objective}: {OBJECTIVES[result.objective]}",
@@ -324,7 +343,7 @@ def show_result(console, result, top) -> None:
     table.add_column("variant", no_wrap=True)
     for name in result.parameter_names:
         table.add_column(name, justify="right")
-    separate = result.objective == "coverage-per-km"
+    separate = result.objective not in ("obscured-coverage", "coverage-within-budget")
     if separate:
         table.add_column(short[result.objective], justify="right")
     table.add_column("coverage", justify="right")
@@ -384,3 +403,7 @@ def show_result(console, result, top) -> None:
             f"best     {result.best_scenario_path}  (open it with: ladartui {result.best_scenario_path})",
             highlight=False,
         )
+    if result.best is not None:
+        from ladartui.sweep.ranking import levels_text
+
+        console.print(f"best path {levels_text(result.best.row)}", highlight=False, markup=False)

@@ -23,7 +23,14 @@ from pathlib import Path
 
 from ladartui.atomic import atomic_path
 from ladartui.errors import Cancelled, FieldError, InputFileError, LadarError
-from ladartui.sweep.ranking import COSTS, Ranked, normal_cost, normal_objective, rank_rows
+from ladartui.sweep.ranking import (
+    BUDGET_OBJECTIVES,
+    COSTS,
+    Ranked,
+    normal_cost,
+    normal_objective,
+    rank_rows,
+)
 from ladartui.sweep.spec import DEFAULT_BASE, SweepSpec, load_sweep_spec
 from ladartui.sweep.table import read_table, table_text, write_table
 from ladartui.sweep.variant import ScenePayload, apply_parameters, run_variant
@@ -164,12 +171,11 @@ def run_sweep(
     objective = normal_objective(objective or spec.objective)
     cost = normal_cost(cost or spec.cost)
     budget = spec.budget if budget is None else float(budget)
-    if objective == "coverage-within-budget" and budget is None:
+    if objective in BUDGET_OBJECTIVES and budget is None:
         raise FieldError(
             "budget",
             None,
-            "a flight-time budget in seconds (sweep.budget or "
-            "--budget) for objective 'coverage-within-budget'",
+            f"a flight-time budget in seconds (sweep.budget or --budget) for objective '{objective}'",
         )
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise FieldError("workers", workers, "an integer >= 1")
@@ -506,7 +512,7 @@ def load_sweep_results(
         raise InputFileError(path, "no sweep results here")
     rows, header = read_table(path)
     objective, cost = normal_objective(objective), normal_cost(cost)
-    if objective == "coverage-within-budget" and budget is None:
+    if objective in BUDGET_OBJECTIVES and budget is None:
         raise FieldError("budget", None, "a flight-time budget in seconds")
     known = {
         "variant",

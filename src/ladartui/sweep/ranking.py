@@ -1,4 +1,12 @@
-"""Ranking sweep rows by an objective, and the Pareto front of coverage against cost."""
+"""Ranking sweep rows by an objective, and the Pareto front of coverage against cost.
+
+Objectives on coverage score the share of target voxels seen through the
+foliage; objectives on levels (``ladartui.levels``) score when the target(s)
+reach identification: the flight time or distance until every target is
+identified, and how many targets are identified within a flight-time budget.
+A row is read per target through ``target_values``: today the target model is
+one target, so each list holds one value.
+"""
 
 from __future__ import annotations
 
@@ -11,6 +19,9 @@ from ladartui.pareto import pareto_front as front_of_minima
 # Column of the measure every objective is built on: the share of target
 # voxels seen through the foliage over the whole flight.
 COVERAGE_COLUMN = "obscured_coverage"
+# Columns of the levels (Measures.levels flattened by the sweep's row builder).
+LEVEL_COLUMN = "levels.{level}.{field}"
+LEVEL_NAMES = ("detect", "recognise", "identify")
 
 OBJECTIVES = {
     "obscured-coverage": "obscured target coverage (higher is better)",
@@ -18,7 +29,17 @@ OBJECTIVES = {
     "for a path of zero length)",
     "coverage-within-budget": "obscured coverage of paths flown within the flight-time budget "
     "(longer paths are not ranked)",
+    "time-to-identify": "flight time until every target is identified (lower is better; paths "
+    "that do not identify them all are not ranked)",
+    "distance-to-identify": "distance flown until every target is identified (lower is better; "
+    "paths that do not identify them all are not ranked)",
+    "worst-target-coverage": "obscured coverage of the worst-covered target (higher is better)",
+    "identified-within-budget": "targets identified within the flight-time budget (higher is "
+    "better; ties go to the earlier identification; paths identifying none are not ranked)",
 }
+# Objectives whose smaller values are better; the rest rank larger values first.
+LOWER_IS_BETTER = frozenset({"time-to-identify", "distance-to-identify"})
+BUDGET_OBJECTIVES = frozenset({"coverage-within-budget", "identified-within-budget"})
 COSTS = {"flight-time": "flight_time_s", "distance": "path_length_m"}
 
 
@@ -58,11 +79,97 @@ def coverage_of(row: dict) -> float | None:
     return _number(row.get(COVERAGE_COLUMN))
 
 
+def target_values(row: dict, column: str) -> list:
+    """The value of ``column`` for each target of the row, in target order.
+
+    The target model is one target today, so this is ``[row[column]]``;
+    per-target columns add their values here.
+    """
+    return [row.get(column)]
+
+
+def level_of(row: dict, level: str) -> list[tuple[bool, int | None, float | None, float | None]]:
+    """Per target: (reached, scan, flight time s, distance m) of ``level`` in the row."""
+    columns = [
+        LEVEL_COLUMN.format(level=level, field=f) for f in ("reached", "scan", "flight_time_s", "distance_m")
+    ]
+    values = [target_values(row, c) for c in columns]
+    out = []
+    for reached, scan, time, distance in zip(*values):
+        ok = reached is True
+        out.append(
+            (ok, scan if ok else None, _number(time) if ok else None, _number(distance) if ok else None)
+        )
+    return out
+
+
+def time_to_identify(row: dict, field: str = "flight_time_s") -> float | None:
+    """Seconds (or metres, ``field="distance_m"``) until every target is identified; None if one is not."""
+    index = 2 if field == "flight_time_s" else 3
+    values = [t[index] if t[0] else None for t in level_of(row, "identify")]
+    known = [float(v) for v in values if v is not None]
+    return max(known) if known and len(known) == len(values) else None
+
+
+def worst_target_coverage(row: dict) -> float | None:
+    """The lowest obscured coverage over the row's targets (None if one is undefined)."""
+    values = [_number(v) for v in target_values(row, COVERAGE_COLUMN)]
+    known = [v for v in values if v is not None]
+    return min(known) if known and len(known) == len(values) else None
+
+
+def identified_within(row: dict, budget: float) -> tuple[int, float | None]:
+    """Targets identified at a flight time within ``budget`` s, and when the last of them was."""
+    times = [t[2] for t in level_of(row, "identify") if t[0] and t[2] is not None and t[2] <= budget]
+    return len(times), (max(times) if times else None)
+
+
+def levels_text(row: dict) -> str:
+    """Which level the row's path reaches and when, per target, e.g. for the recommended path."""
+    texts = []
+    per_level = {level: level_of(row, level) for level in LEVEL_NAMES}
+    count = len(per_level["identify"])
+    for index in range(count):
+        reached = [(level, per_level[level][index]) for level in LEVEL_NAMES if per_level[level][index][0]]
+        prefix = f"target {index + 1} " if count > 1 else ""
+        if not reached:
+            known = any(
+                v is not None
+                for v in target_values(row, LEVEL_COLUMN.format(level="detect", field="reached"))
+            )
+            texts.append(prefix + ("reaches no level (not detected)" if known else "levels unknown"))
+            continue
+        level, (_, scan, time, distance) = reached[-1]
+        scans = target_values(row, "levels.scans")[index]
+        of = f" of {scans}" if isinstance(scans, int) and not isinstance(scans, bool) else ""
+        text = (
+            f"{prefix}reaches {level} at scan {scan}{of} ({_amount(time, 's')}, {_amount(distance, 'm')} "
+            "from the first scan)"
+        )
+        if level != LEVEL_NAMES[-1]:
+            text += "; identify not reached"
+        texts.append(text)
+    return "; ".join(texts)
+
+
+def _amount(value, unit) -> str:
+    return "?" if value is None else f"{value:.1f} {unit}"
+
+
 def objective_value(row: dict, objective: str, budget: float | None = None) -> float | None:
     """The row's score under ``objective``; None when undefined or out of budget."""
     objective = normal_objective(objective)
     if row.get("status") != "ok":
         return None
+    if objective == "time-to-identify":
+        return time_to_identify(row)
+    if objective == "distance-to-identify":
+        return time_to_identify(row, "distance_m")
+    if objective == "worst-target-coverage":
+        return worst_target_coverage(row)
+    if objective == "identified-within-budget":
+        count = identified_within(row, _need_budget(budget, objective))[0]
+        return float(count) if count else None
     coverage = coverage_of(row)
     if coverage is None:
         return None
@@ -71,12 +178,23 @@ def objective_value(row: dict, objective: str, budget: float | None = None) -> f
     if objective == "coverage-per-km":
         length = _number(row.get("path_length_m"))
         return coverage / (length / 1000.0) if length else None
-    if budget is None:
-        raise FieldError(
-            "budget", None, "a flight-time budget in seconds for objective 'coverage-within-budget'"
-        )
+    budget = _need_budget(budget, objective)
     time = _number(row.get("flight_time_s"))
     return coverage if time is not None and time <= budget else None
+
+
+def _need_budget(budget, objective) -> float:
+    if budget is None:
+        raise FieldError("budget", None, f"a flight-time budget in seconds for objective '{objective}'")
+    return budget
+
+
+def _tie_break(row: dict, objective: str, budget) -> float:
+    """Between equal values: the earlier identification for targets within budget, else nothing."""
+    if objective == "identified-within-budget" and budget is not None:
+        last = identified_within(row, budget)[1]
+        return last if last is not None else math.inf
+    return 0.0
 
 
 def pareto_front(points) -> list[bool]:
@@ -96,7 +214,8 @@ def _negated(value):
 def rank_rows(rows, objective="obscured-coverage", budget=None, cost="flight-time") -> list[Ranked]:
     """Rows best first under ``objective``; unrankable rows (failed, undefined) last.
 
-    Ties go to the cheaper path, then to the variant id, so the order is stable.
+    Ties go to the cheaper path (for identified-within-budget first to the
+    earlier identification), then to the variant id, so the order is stable.
     """
     objective, cost = normal_objective(objective), normal_cost(cost)
     cost_column = COSTS[cost]
@@ -111,11 +230,14 @@ def rank_rows(rows, objective="obscured-coverage", budget=None, cost="flight-tim
     for entry, flag in zip(entries, flags):
         entry.pareto = flag
 
+    sign = 1.0 if objective in LOWER_IS_BETTER else -1.0
+
     def key(entry):
         cost_key = entry.cost if entry.cost is not None else math.inf
         if entry.value is None:
-            return (1, 0.0, cost_key, str(entry.row.get("variant")))
-        return (0, -entry.value, cost_key, str(entry.row.get("variant")))
+            return (1, 0.0, 0.0, cost_key, str(entry.row.get("variant")))
+        tie = _tie_break(entry.row, objective, budget)
+        return (0, sign * entry.value, tie, cost_key, str(entry.row.get("variant")))
 
     entries.sort(key=key)
     rank = 0

@@ -40,6 +40,7 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.errors import InputFileError
+from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.sweep.variant import applicable
 
 PRESETS = ("orbit", "flypast", "standoff")
@@ -76,7 +77,8 @@ PARAMETERS = {
     )
 }
 
-OBJECTIVE_NAMES = ("obscured-coverage", "coverage-per-km", "coverage-within-budget")
+OBJECTIVE_NAMES = tuple(OBJECTIVES)
+BUDGET_OBJECTIVE_NAMES = tuple(sorted(BUDGET_OBJECTIVES))
 COST_NAMES = ("flight-time", "distance")
 
 
@@ -226,10 +228,8 @@ def parse_sweep_spec(data: dict, path, text: str = "") -> SweepSpec:
     budget = head.get("budget")
     if budget is not None and not (_is_number(budget) and budget > 0):
         checker.fail("sweep.budget", "a flight-time budget in seconds, > 0", budget)
-    if objective == "coverage-within-budget" and budget is None:
-        checker.fail(
-            "sweep.budget", "a flight-time budget in seconds for objective 'coverage-within-budget'", None
-        )
+    if objective in BUDGET_OBJECTIVE_NAMES and budget is None:
+        checker.fail("sweep.budget", f"a flight-time budget in seconds for objective '{objective}'", None)
     name = head.get("name", path.stem)
     if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]*", name):
         checker.fail(

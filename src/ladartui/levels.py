@@ -1,0 +1,417 @@
+"""Detect, recognise, identify: how many looks until a target is seen well enough.
+
+The report leaves "the target coverage required for identification" as a
+measure still to be investigated (section 2.2). Here each level is a pair of
+thresholds the analyst sets in the scenario's ``[levels]`` section:
+
+* a share of the target's *visible* voxels (those with a face open to empty
+  space, ``ladartui.measures.visible_mask``) seen through the foliage, and
+* a share of its *footprint cells* seen: the (x, y) voxel columns that hold
+  at least one target voxel. A footprint cell counts as seen once any target
+  voxel in its column has been seen, so the footprint share says how much of
+  the vehicle's extent the looks have found, not how many points they found.
+
+A level is reached at the first scan after which both shares reach its
+thresholds. The two guard against different misleading views: a patch of roof
+voxels at one end of a vehicle may hold a tenth of its visible voxels yet
+cover little of its extent (the footprint share stays low), while a view of
+the whole roof from above covers the whole footprint with few of the voxels
+(the voxel share stays low). A footprint threshold of 0 turns the spatial
+check off for that level.
+
+Scans are counted 1..n as the CLI reports them; the flight time and distance
+at a scan are measured from the first scan along the flight plan
+(``FlightPlan.scan_times`` and ``scan_distances``, the same source as the
+run's path length and flight time). "Not reached" is ``reached = False``
+with no scan, time or distance (None in Python, null in JSON, the words
+``not reached`` in text and in the ``.cmf``), never NaN.
+
+``levels_from_curves`` is the pure rule from share-after-each-scan curves;
+``target_levels`` builds the curves for one target from its voxels and each
+scan's returns, so a scene with several targets calls it once per target.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from ladartui.errors import FieldError, InputFileError
+
+LEVELS = ("detect", "recognise", "identify")
+NOT_REACHED = "not reached"
+CMF_SECTION = "levels"
+# Shares are ratios of counts; a share equal to its threshold in exact
+# arithmetic may land a rounding step below it.
+_TOLERANCE = 1e-12
+
+
+@dataclass(frozen=True)
+class LevelThresholds:
+    """The ``[levels]`` scenario section: per level, a voxel share and a footprint share (0..1).
+
+    Defaults, for a vehicle-sized target: detection needs enough returns to
+    stand out from the canopy (10 % of what can be seen, spread over 10 % of
+    its extent); recognising its class needs its overall size and shape
+    (30 % of its visible voxels over half its footprint); identifying it
+    needs most of its visible surface (50 % over three quarters of its
+    footprint). The report sets no such values: they are starting points,
+    and the analyst sets them for the target class at hand (from looks that
+    analysts have judged), per scenario.
+    """
+
+    detect: float = 0.10
+    recognise: float = 0.30
+    identify: float = 0.50
+    detect_footprint: float = 0.10
+    recognise_footprint: float = 0.50
+    identify_footprint: float = 0.75
+
+    def __post_init__(self):
+        for kind, low_open in (("", True), ("_footprint", False)):
+            previous = None
+            for level in LEVELS:
+                name = level + kind
+                value = getattr(self, name)
+                low = 0.0 if previous is None else getattr(self, previous)
+                what = "visible voxels" if not kind else "footprint cells"
+                if previous is None:
+                    limit = "> 0 and <= 1" if low_open else "from 0 to 1"
+                    expected = f"a share of the target's {what} {limit}"
+                else:
+                    expected = (
+                        f"a share of the target's {what} from levels.{previous} "
+                        f"({low:g}) to 1 (a higher level needs at least as much)"
+                    )
+                ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+                ok = ok and (value > low if low_open and previous is None else value >= low) and value <= 1
+                if not ok:
+                    raise FieldError(f"levels.{name}", value, expected)
+                object.__setattr__(self, name, float(value))
+                previous = name
+
+    def voxel_share(self, level: str) -> float:
+        return float(getattr(self, level))
+
+    def footprint_share(self, level: str) -> float:
+        return float(getattr(self, level + "_footprint"))
+
+    def to_dict(self) -> dict:
+        """The TOML section."""
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+
+LEVEL_KEYS = tuple(f.name for f in fields(LevelThresholds))
+
+
+def levels_from_table(table: dict) -> LevelThresholds:
+    """A ``[levels]`` table (keys already checked against LEVEL_KEYS) as thresholds."""
+    return LevelThresholds(**table)
+
+
+@dataclass(frozen=True)
+class LevelReached:
+    """One level for one target: reached or not, and at which scan, flight time and distance."""
+
+    level: str
+    reached: bool
+    scan: int | None = None  # 1-based
+    flight_time_s: float | None = None
+    distance_m: float | None = None
+
+    def describe(self) -> str:
+        """``scan 3 of 8, 4.2 s, 125.7 m`` or ``not reached``."""
+        if not self.reached:
+            return NOT_REACHED
+        return f"scan {self.scan}, {self.flight_time_s:.1f} s, {self.distance_m:.1f} m"
+
+    def to_dict(self) -> dict:
+        return {
+            "reached": self.reached,
+            "scan": self.scan,
+            "flight_time_s": self.flight_time_s,
+            "distance_m": self.distance_m,
+        }
+
+
+@dataclass(frozen=True)
+class LevelResult:
+    """The levels one target reached over a flight, with the thresholds and final shares.
+
+    ``visible_share`` and ``footprint_share`` are the shares seen after the
+    last scan (None when the target has no visible voxels or no scans).
+    """
+
+    thresholds: LevelThresholds
+    levels: tuple[LevelReached, ...]
+    scans: int = 0
+    visible_voxels: int | None = None
+    footprint_cells: int | None = None
+    visible_share: float | None = None
+    footprint_share: float | None = None
+
+    def level(self, name: str) -> LevelReached:
+        for item in self.levels:
+            if item.level == name:
+                return item
+        raise KeyError(name)
+
+    @property
+    def highest(self) -> LevelReached | None:
+        """The highest level reached (None: not even detected)."""
+        reached = [item for item in self.levels if item.reached]
+        return reached[-1] if reached else None
+
+    def summary(self) -> str:
+        """One line: the highest level reached and when, e.g. for a recommended path."""
+        top = self.highest
+        if top is None:
+            return "not detected (no level reached)"
+        text = f"reaches {top.level} at {top.describe()}"
+        missing = [item.level for item in self.levels if not item.reached]
+        if missing:
+            text += f"; {', '.join(missing)} {NOT_REACHED}"
+        return text
+
+    def to_dict(self) -> dict:
+        """A JSON-safe dict; a level not reached has ``reached: false`` and null scan, time, distance."""
+        return {
+            "visible_voxels": self.visible_voxels,
+            "footprint_cells": self.footprint_cells,
+            "visible_share": self.visible_share,
+            "footprint_share": self.footprint_share,
+            "scans": self.scans,
+            "thresholds": self.thresholds.to_dict(),
+            **{item.level: item.to_dict() for item in self.levels},
+        }
+
+    def rows(self) -> list[tuple[str, str, str]]:
+        """(level, "voxel % / footprint %" thresholds, where reached) rows for tables."""
+        t = self.thresholds
+        return [
+            (
+                item.level.capitalize(),
+                f"{100 * t.voxel_share(item.level):g} % / {100 * t.footprint_share(item.level):g} %",
+                item.describe(),
+            )
+            for item in self.levels
+        ]
+
+    def cmf_lines(self) -> list[str]:
+        """The ``[levels]`` section of a ``.cmf`` file (read back by ``levels_from_cmf``)."""
+        lines = [
+            f"[{CMF_SECTION}]",
+            "# detect / recognise / identify in the obscured view: a level is reached at the first",
+            "# scan after which the shares of the target's visible voxels and of its footprint",
+            "# cells (x-y columns) seen both reach its thresholds (level_threshold = voxel, footprint).",
+            "# level = scan, flight time s, distance m (from the first scan), or: not reached",
+            f"scans = {self.scans}",
+            f"visible_voxels = {_text(self.visible_voxels)}",
+            f"footprint_cells = {_text(self.footprint_cells)}",
+            f"visible_share = {_text(self.visible_share)}",
+            f"footprint_share = {_text(self.footprint_share)}",
+        ]
+        for level in LEVELS:
+            t = self.thresholds
+            lines.append(f"{level}_threshold = {t.voxel_share(level)!r}, {t.footprint_share(level)!r}")
+        for item in self.levels:
+            value = (
+                f"{item.scan}, {item.flight_time_s!r}, {item.distance_m!r}" if item.reached else NOT_REACHED
+            )
+            lines.append(f"{item.level} = {value}")
+        return lines
+
+
+def _text(value) -> str:
+    if value is None:
+        return "undefined"
+    return repr(value) if isinstance(value, float) else str(value)
+
+
+def _first_scan(curve: Sequence[float], threshold: float) -> int | None:
+    for k, value in enumerate(curve, start=1):
+        if value >= threshold - _TOLERANCE:
+            return k
+    return None
+
+
+def levels_from_curves(
+    visible_share: Sequence[float] | None,
+    footprint_share: Sequence[float] | None,
+    scan_times: Sequence[float],
+    scan_distances: Sequence[float],
+    thresholds: LevelThresholds | None = None,
+    *,
+    visible_voxels: int | None = None,
+    footprint_cells: int | None = None,
+) -> LevelResult:
+    """For each level: the first scan whose shares both reach its thresholds, and its time and distance.
+
+    ``visible_share[k]`` and ``footprint_share[k]`` are the shares seen after
+    scans 1..k+1 (cumulative, so never falling); ``scan_times`` and
+    ``scan_distances`` are seconds and metres from the first scan to each
+    scan. None curves (a target with nothing visible) reach no level.
+    """
+    thresholds = thresholds or LevelThresholds()
+    count = len(scan_times)
+    if len(scan_distances) != count:
+        raise ValueError(f"{len(scan_distances)} scan distances for {count} scan times")
+    for name, curve in (("visible", visible_share), ("footprint", footprint_share)):
+        if curve is not None and len(curve) != count:
+            raise ValueError(f"{len(curve)} {name} shares for {count} scans")
+    usable = visible_share is not None and footprint_share is not None and count > 0
+    results = []
+    for level in LEVELS:
+        scan = None
+        if visible_share is not None and footprint_share is not None:
+            by_voxels = _first_scan(visible_share, thresholds.voxel_share(level))
+            by_footprint = _first_scan(footprint_share, thresholds.footprint_share(level))
+            if by_voxels is not None and by_footprint is not None:
+                scan = max(by_voxels, by_footprint)
+        if scan is None:
+            results.append(LevelReached(level, False))
+        else:
+            results.append(
+                LevelReached(level, True, scan, float(scan_times[scan - 1]), float(scan_distances[scan - 1]))
+            )
+    return LevelResult(
+        thresholds=thresholds,
+        levels=tuple(results),
+        scans=count,
+        visible_voxels=visible_voxels,
+        footprint_cells=footprint_cells,
+        visible_share=float(visible_share[-1]) if usable and visible_share else None,
+        footprint_share=float(footprint_share[-1]) if usable and footprint_share else None,
+    )
+
+
+def share_curves(target_voxels, per_scan_returns) -> tuple[list[float], list[float], int, int] | None:
+    """Cumulative (visible-voxel share, footprint share) after each scan, and the two totals.
+
+    ``per_scan_returns``: each scan's returned voxels, (K, 3), in flight order;
+    returns that are not target voxels (foliage, ground) are ignored. None
+    when the target has no visible voxel.
+    """
+    from ladartui.measures import sorted_unique, visible_mask, voxel_keys
+
+    target = np.unique(np.asarray(target_voxels, dtype=np.int64).reshape(-1, 3), axis=0)
+    if target.shape[0] == 0:
+        return None
+    visible = visible_mask(target)
+    visible_keys = sorted_unique(voxel_keys(target[visible]))
+    if visible_keys.size == 0:
+        return None
+    target_keys = voxel_keys(target)  # sorted: np.unique sorts rows, keys keep that order
+    columns = target[:, :2].copy()
+    column_ids = np.unique(columns, axis=0, return_inverse=True)[1].ravel()
+    cells = int(column_ids.max()) + 1
+    seen_voxel = np.zeros(target.shape[0], dtype=bool)
+    visible_at = np.isin(target_keys, visible_keys)
+    voxel_curve, footprint_curve = [], []
+    for returns in per_scan_returns:
+        keys = sorted_unique(voxel_keys(np.asarray(returns).reshape(-1, 3)))
+        if keys.size:
+            seen_voxel |= np.isin(target_keys, keys, assume_unique=True)
+        voxel_curve.append(int((seen_voxel & visible_at).sum()) / visible_keys.size)
+        footprint_curve.append(np.unique(column_ids[seen_voxel]).size / cells)
+    return voxel_curve, footprint_curve, int(visible_keys.size), cells
+
+
+def target_levels(
+    target_voxels,
+    per_scan_returns,
+    scan_times: Sequence[float],
+    scan_distances: Sequence[float],
+    thresholds: LevelThresholds | None = None,
+) -> LevelResult:
+    """The levels one target reaches: its share curves from each scan's returns, then the rule."""
+    curves = share_curves(target_voxels, per_scan_returns)
+    if curves is None:
+        return levels_from_curves(None, None, scan_times, scan_distances, thresholds)
+    voxel_curve, footprint_curve, visible, cells = curves
+    return levels_from_curves(
+        voxel_curve,
+        footprint_curve,
+        scan_times,
+        scan_distances,
+        thresholds,
+        visible_voxels=visible,
+        footprint_cells=cells,
+    )
+
+
+# --------------------------------------------------------------------------- .cmf
+
+
+def levels_from_cmf(path, entries: dict[str, tuple[int, str]]) -> LevelResult:
+    """The ``[levels]`` section of a ``.cmf`` file back as a LevelResult.
+
+    ``entries`` maps each key to (line number, value text). Errors name the
+    file, the line and what was expected.
+    """
+    known = {"scans", "visible_voxels", "footprint_cells", "visible_share", "footprint_share"}
+    known |= {f"{level}_threshold" for level in LEVELS} | set(LEVELS)
+    for key, (line, _) in entries.items():
+        if key not in known:
+            raise InputFileError(path, f"unknown key {key!r} in [{CMF_SECTION}]", line=line)
+    first_line = min((line for line, _ in entries.values()), default=None)
+
+    def get(key):
+        if key not in entries:
+            raise InputFileError(path, f"[{CMF_SECTION}] lacks {key}", line=first_line)
+        return entries[key]
+
+    def number(key, kind):
+        line, text = get(key)
+        if text == "undefined" and key != "scans":
+            return None
+        try:
+            value = kind(text)
+        except ValueError:
+            raise InputFileError(path, f"{key}: expected {kind.__name__}, got {text!r}", line=line) from None
+        if not math.isfinite(value):
+            raise InputFileError(path, f"{key}: expected a finite number, got {text!r}", line=line)
+        return value
+
+    def numbers(key, count, what):
+        line, text = get(key)
+        parts = [p.strip() for p in text.split(",")]
+        try:
+            values = [float(p) for p in parts]
+        except ValueError:
+            values = []
+        if len(values) != count or not all(math.isfinite(v) for v in values):
+            raise InputFileError(path, f"{key}: expected {what}, got {text!r}", line=line)
+        return values
+
+    shares = {}
+    for level in LEVELS:
+        voxel, footprint = numbers(f"{level}_threshold", 2, "voxel share, footprint share")
+        shares[level], shares[level + "_footprint"] = voxel, footprint
+    try:
+        thresholds = LevelThresholds(**shares)
+    except FieldError as error:
+        line = get(error.field.split(".")[-1].replace("_footprint", "") + "_threshold")[0]
+        raise InputFileError(path, str(error), line=line) from None
+    reached = []
+    for level in LEVELS:
+        line, text = get(level)
+        if text == NOT_REACHED:
+            reached.append(LevelReached(level, False))
+            continue
+        scan, time_s, distance = numbers(level, 3, f"scan, flight time, distance or {NOT_REACHED!r}")
+        if scan != int(scan) or scan < 1:
+            raise InputFileError(path, f"{level}: expected a scan number >= 1, got {text!r}", line=line)
+        reached.append(LevelReached(level, True, int(scan), time_s, distance))
+    return LevelResult(
+        thresholds=thresholds,
+        levels=tuple(reached),
+        scans=number("scans", int),
+        visible_voxels=number("visible_voxels", int),
+        footprint_cells=number("footprint_cells", int),
+        visible_share=number("visible_share", float),
+        footprint_share=number("footprint_share", float),
+    )
