@@ -96,6 +96,39 @@ def test_cluster_sweep_resumes_after_an_interruption(spec, serial_rows, client, 
     assert comparable(result.rows) == comparable(serial_rows)
 
 
+def test_ranking_by_time_to_identify_is_the_same_on_dask_and_serially(client, tmp_path):
+    from ladartui.levels import LevelThresholds
+    from ladartui.scenario import load_scenario
+    from ladartui.sweep.ranking import levels_text, time_to_identify
+
+    base = write_tiny_scenario(tmp_path)
+    # Identify at 55 % of the visible voxels: the 30 m orbits (half the target seen) never do.
+    load_scenario(base.path).with_changes(levels=LevelThresholds(0.1, 0.3, 0.55, 0.1, 0.5, 0.75)).save()
+    spec = tmp_path / "identify.toml"
+    spec.write_text(
+        '[sweep]\nscenario = "base.toml"\nobjective = "time-to-identify"\n'
+        "[grid]\nradius = [10.0, 20.0, 30.0]\nheading_offset = [0.0, 90.0]\n",
+        encoding="utf-8",
+    )
+    serial = run_sweep(spec, serial=True, out=tmp_path / "serial")
+    on_dask = run_sweep(spec, client=client, out=tmp_path / "dask")
+
+    def ranking(result):
+        return [(r.row["variant"], r.rank, r.value) for r in result.ranking]
+
+    assert ranking(on_dask) == ranking(serial)
+    ranked = [r for r in serial.ranking if r.rank is not None]
+    values = [r.value for r in ranked]
+    assert values == sorted(values) and len(set(values)) >= 3  # a real order, not all ties
+    assert all(r.value == time_to_identify(r.row) for r in ranked)
+    unranked = [r for r in serial.ranking if r.rank is None]
+    assert unranked and all(r.row["radius"] == 30.0 for r in unranked)
+    assert all(r.row["levels.identify.reached"] is False for r in unranked)
+    best = on_dask.best.row
+    assert levels_text(best) == levels_text(serial.best.row)
+    assert levels_text(best).startswith("reaches identify at scan ")
+
+
 def _start(args, log, env):
     handle = open(log, "wb")
     return subprocess.Popen(

@@ -1,0 +1,99 @@
+"""Sweep objectives on levels: time / distance to identify, worst-target coverage,
+targets identified within a budget, and the recommended path's levels text."""
+
+import pytest
+
+from ladartui.errors import FieldError, InputFileError
+from ladartui.sweep import load_sweep_results, load_sweep_spec, rank_rows, write_table
+from ladartui.sweep.ranking import levels_text, objective_value
+
+
+def row(variant, coverage, identify=None, recognise=None, status="ok", flight_time=10.0, scans=6):
+    """A result row as the sweep writes it: levels flattened as levels.<level>.<field>."""
+    out = {
+        "variant": variant,
+        "status": status,
+        "obscured_coverage": coverage,
+        "flight_time_s": flight_time,
+        "path_length_m": 30.0 * flight_time,
+        "levels.scans": scans,
+    }
+    for level, at in (("detect", recognise or identify), ("recognise", recognise), ("identify", identify)):
+        scan, time = at if at is not None else (None, None)
+        out[f"levels.{level}.reached"] = at is not None
+        out[f"levels.{level}.scan"] = scan
+        out[f"levels.{level}.flight_time_s"] = time
+        out[f"levels.{level}.distance_m"] = None if time is None else 30.0 * time
+    return out
+
+
+ROWS = [
+    row("a", 0.9, identify=(4, 6.0), recognise=(2, 2.0)),
+    row("b", 0.6, identify=(2, 2.0), recognise=(1, 0.0), flight_time=12.0),
+    row("c", 0.95, recognise=(3, 4.0)),  # best coverage, never identified
+    row("d", 0.7, identify=(3, 4.0), recognise=(2, 2.0), flight_time=8.0),
+    row("e", None, status="error"),
+]
+
+
+def order(ranking):
+    return [(r.row["variant"], r.rank) for r in ranking]
+
+
+def test_time_to_identify_ranks_the_earliest_identification_first_and_unidentified_last():
+    ranking = rank_rows(ROWS, "time-to-identify")
+    assert order(ranking) == [("b", 1), ("d", 2), ("a", 3), ("c", None), ("e", None)]
+    assert [r.value for r in ranking[:3]] == [2.0, 4.0, 6.0]
+    distance = rank_rows(ROWS, "distance-to-identify")
+    assert [r.value for r in distance[:3]] == [60.0, 120.0, 180.0]
+
+
+def test_ties_in_time_to_identify_go_to_the_cheaper_path():
+    rows = [
+        row("x", 0.5, identify=(2, 2.0), flight_time=9.0),
+        row("y", 0.5, identify=(2, 2.0), flight_time=7.0),
+    ]
+    assert order(rank_rows(rows, "time_to_identify")) == [("y", 1), ("x", 2)]
+
+
+def test_worst_target_coverage_is_the_target_coverage_with_one_target():
+    ranking = rank_rows(ROWS, "worst-target-coverage")
+    assert order(ranking)[:4] == [("c", 1), ("a", 2), ("d", 3), ("b", 4)]
+    assert [r.value for r in ranking[:4]] == [0.95, 0.9, 0.7, 0.6]
+
+
+def test_identified_within_budget_counts_targets_and_prefers_the_earlier_identification():
+    ranking = rank_rows(ROWS, "identified-within-budget", budget=5.0)
+    # a identifies at 6 s: over the budget, like c (never) and e (failed).
+    assert order(ranking) == [("b", 1), ("d", 2), ("a", None), ("c", None), ("e", None)]
+    assert [r.value for r in ranking[:2]] == [1.0, 1.0]
+    with pytest.raises(FieldError, match="budget = None: expected a flight-time budget"):
+        objective_value(ROWS[0], "identified-within-budget")
+
+
+def test_levels_text_says_which_level_the_path_reaches_and_when():
+    assert levels_text(ROWS[0]) == "reaches identify at scan 4 of 6 (6.0 s, 180.0 m from the first scan)"
+    assert levels_text(ROWS[2]) == (
+        "reaches recognise at scan 3 of 6 (4.0 s, 120.0 m from the first scan); identify not reached"
+    )
+    assert levels_text(row("n", 0.0)) == "reaches no level (not detected)"
+    assert levels_text({"variant": "old", "status": "ok", "obscured_coverage": 0.5}) == "levels unknown"
+
+
+def test_objectives_survive_the_result_table(tmp_path):
+    path = tmp_path / "results.csv"
+    write_table(path, ROWS, [])
+    result = load_sweep_results(path, objective="time-to-identify")
+    assert order(result.ranking) == order(rank_rows(ROWS, "time-to-identify"))
+    assert levels_text(result.ranking[0].row) == levels_text(ROWS[1])
+
+
+def test_spec_objectives_and_their_budget(tmp_path):
+    (tmp_path / "base.toml").write_text("")
+    path = tmp_path / "s.toml"
+    head = '[sweep]\nscenario = "base.toml"\nobjective = "{}"\n[grid]\nradius = [1.0]\n'
+    path.write_text(head.format("time-to-identify"))
+    assert load_sweep_spec(path).objective == "time-to-identify"
+    path.write_text(head.format("identified-within-budget"))
+    with pytest.raises(InputFileError, match="sweep.budget: expected a flight-time budget in seconds for "):
+        load_sweep_spec(path)
