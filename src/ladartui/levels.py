@@ -295,29 +295,31 @@ def share_curves(target_voxels, per_scan_returns) -> tuple[list[float], list[flo
     returns that are not target voxels (foliage, ground) are ignored. None
     when the target has no visible voxel.
     """
-    from ladartui.measures import sorted_unique, visible_mask, voxel_keys
+    from ladartui.measures import visible_mask, voxel_keys
 
     target = np.unique(np.asarray(target_voxels, dtype=np.int64).reshape(-1, 3), axis=0)
     if target.shape[0] == 0:
         return None
     visible = visible_mask(target)
-    visible_keys = sorted_unique(voxel_keys(target[visible]))
-    if visible_keys.size == 0:
+    visible_count = int(visible.sum())
+    if visible_count == 0:
         return None
-    target_keys = voxel_keys(target)  # sorted: np.unique sorts rows, keys keep that order
-    columns = target[:, :2].copy()
-    column_ids = np.unique(columns, axis=0, return_inverse=True)[1].ravel()
-    cells = int(column_ids.max()) + 1
-    seen_voxel = np.zeros(target.shape[0], dtype=bool)
-    visible_at = np.isin(target_keys, visible_keys)
+    target_keys = voxel_keys(target)  # sorted: np.unique sorts the rows, keys keep their order
+    column_of = np.unique(target[:, :2], axis=0, return_inverse=True)[1].ravel()
+    cells = int(column_of.max()) + 1
+    seen = np.zeros(target.shape[0], dtype=bool)
+    column_seen = np.zeros(cells, dtype=bool)
     voxel_curve, footprint_curve = [], []
     for returns in per_scan_returns:
-        keys = sorted_unique(voxel_keys(np.asarray(returns).reshape(-1, 3)))
+        keys = voxel_keys(np.asarray(returns).reshape(-1, 3))
         if keys.size:
-            seen_voxel |= np.isin(target_keys, keys, assume_unique=True)
-        voxel_curve.append(int((seen_voxel & visible_at).sum()) / visible_keys.size)
-        footprint_curve.append(np.unique(column_ids[seen_voxel]).size / cells)
-    return voxel_curve, footprint_curve, int(visible_keys.size), cells
+            pos = np.minimum(np.searchsorted(target_keys, keys), target_keys.size - 1)
+            hit = pos[target_keys[pos] == keys]
+            seen[hit] = True
+            column_seen[column_of[hit]] = True
+        voxel_curve.append(int((seen & visible).sum()) / visible_count)
+        footprint_curve.append(int(column_seen.sum()) / cells)
+    return voxel_curve, footprint_curve, visible_count, cells
 
 
 def target_levels(
