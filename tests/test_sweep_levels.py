@@ -97,3 +97,27 @@ def test_spec_objectives_and_their_budget(tmp_path):
     path.write_text(head.format("identified-within-budget"))
     with pytest.raises(InputFileError, match="sweep.budget: expected a flight-time budget in seconds for "):
         load_sweep_spec(path)
+
+
+def test_cli_sweep_says_which_level_the_recommended_path_reaches(tmp_path, capsys):
+    import json
+
+    from ladartui.cli import main
+    from tiny_sweep import write_tiny_scenario
+
+    write_tiny_scenario(tmp_path)
+    spec = tmp_path / "spec.toml"
+    spec.write_text(
+        '[sweep]\nscenario = "base.toml"\nobjective = "time-to-identify"\n[grid]\nradius = [20.0, 30.0]\n'
+    )
+    assert main(["sweep", str(spec), "--serial"]) == 0
+    text = capsys.readouterr().out
+    assert "identify s" in text
+    line = next(s for s in text.splitlines() if s.startswith("best path "))
+    assert line.startswith("best path reaches identify at scan ") and "from the first scan)" in line
+    assert main(["sweep", str(spec), "--show", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert "best path " + out["best_levels"] == line
+    best = out["top"][0]
+    assert best["levels"][0]["identify"]["reached"] is True
+    assert best["objective"] == best["levels"][0]["identify"]["flight_time_s"]
