@@ -32,12 +32,16 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ladartui.atomic import write_text_atomic
 from ladartui.errors import FieldError, InputFileError
+
+if TYPE_CHECKING:
+    from ladartui.levels import LevelResult
 
 CMF_FORMAT = "cmf"
 CMF_VERSION = 1
@@ -217,7 +221,7 @@ class Measures:
     # the ideal sensor, and then absent from the dict and the .cmf.
     detection: object | None = None
     # Detect / recognise / identify (ladartui.levels.LevelResult); None: not computed.
-    levels: object | None = None
+    levels: LevelResult | None = None
 
     def to_dict(self) -> dict:
         """A JSON-safe dict (no NaN: undefined measures are None)."""
@@ -591,9 +595,10 @@ def read_cmf(path) -> Measures:
         else:
             plain[head] = DirectionStats(**parts)
     plain.update(_per_scan_lists(path, per_scan))
+    measures = Measures(**plain)
     if levels is not None:
-        plain["levels"] = levels_from_cmf(path, levels)
-    return Measures(**plain)
+        measures = replace(measures, levels=levels_from_cmf(path, levels))
+    return measures
 
 
 def _list_or_none(vector):
