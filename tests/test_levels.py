@@ -213,8 +213,13 @@ def test_levels_section_round_trips_and_keeps_the_analysts_comments(tmp_path):
 
 BAD_LEVELS = [
     ("identify = 0.6", "identify = 1.5", "levels.identify = 1.5", "from levels.recognise (0.25) to 1"),
-    ("detect = 0.05", "detect = 0", "levels.detect = 0", "visible voxels > 0 and <= 1"),
-    ("detect = 0.05", 'detect = "high"', "levels.detect = 'high'", "visible voxels > 0 and <= 1"),
+    ("detect = 0.05", "detect = 0", "levels.detect = 0", "visible voxels greater than 0 and at most 1"),
+    (
+        "detect = 0.05",
+        'detect = "high"',
+        "levels.detect = 'high'",
+        "visible voxels greater than 0 and at most 1",
+    ),
     ("recognise = 0.25 ", "recognise = 0.01 ", "levels.recognise = 0.01", "from levels.detect (0.05) to 1"),
     (
         "detect_footprint = 0.0",

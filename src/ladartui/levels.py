@@ -34,12 +34,14 @@ scan's returns, so a scene with several targets calls it once per target.
 from __future__ import annotations
 
 import math
+import numbers
 from collections.abc import Sequence
 from dataclasses import dataclass, fields
 
 import numpy as np
 
 from ladartui.errors import FieldError, InputFileError
+from ladartui.flight import range_text
 
 LEVELS = ("detect", "recognise", "identify")
 NOT_REACHED = "not reached"
@@ -71,27 +73,32 @@ class LevelThresholds:
     identify_footprint: float = 0.75
 
     def __post_init__(self):
-        for kind, low_open in (("", True), ("_footprint", False)):
-            previous = None
+        # Each level needs at least what the level below it needs; a voxel share
+        # of 0 would count a target as detected before anything is seen.
+        for suffix, what, low_open in (
+            ("", "visible voxels", True),
+            ("_footprint", "footprint cells", False),
+        ):
+            below = None
             for level in LEVELS:
-                name = level + kind
+                name = level + suffix
                 value = getattr(self, name)
-                low = 0.0 if previous is None else getattr(self, previous)
-                what = "visible voxels" if not kind else "footprint cells"
-                if previous is None:
-                    limit = "> 0 and <= 1" if low_open else "from 0 to 1"
-                    expected = f"a share of the target's {what} {limit}"
+                if below is None:
+                    expected = range_text(f"a share of the target's {what}", 0.0, 1.0, low_open, False)
+                    low = 0.0
                 else:
+                    low = getattr(self, below)
                     expected = (
-                        f"a share of the target's {what} from levels.{previous} "
-                        f"({low:g}) to 1 (a higher level needs at least as much)"
+                        f"a share of the target's {what} from levels.{below} ({low:g}) to 1 "
+                        "(a higher level needs at least as much)"
                     )
-                ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
-                ok = ok and (value > low if low_open and previous is None else value >= low) and value <= 1
+                ok = isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+                ok = ok and math.isfinite(value) and value <= 1.0
+                ok = ok and (value > low if below is None and low_open else value >= low)
                 if not ok:
                     raise FieldError(f"levels.{name}", value, expected)
                 object.__setattr__(self, name, float(value))
-                previous = name
+                below = name
 
     def voxel_share(self, level: str) -> float:
         return float(getattr(self, level))
@@ -123,7 +130,7 @@ class LevelReached:
     distance_m: float | None = None
 
     def describe(self) -> str:
-        """``scan 3 of 8, 4.2 s, 125.7 m`` or ``not reached``."""
+        """``scan 3, 4.2 s, 125.7 m`` or ``not reached``."""
         if not self.reached:
             return NOT_REACHED
         return f"scan {self.scan}, {self.flight_time_s:.1f} s, {self.distance_m:.1f} m"
