@@ -89,6 +89,25 @@ def test_curves_must_match_the_scans():
         levels_from_curves([0.1, 0.2, 0.3], [0.1, 0.2], [0.0, 1.0], [0.0, 1.0])
 
 
+def test_scan_distances_follow_the_path_and_end_at_its_length():
+    from ladartui.flight import FlightPlan, Manual, ScanPose, Straight, Turn
+
+    start = ScanPose(0.0, 0.0, 100.0, heading=90.0, depression=45.0)
+    plan = FlightPlan(start, [Straight(300.0, 3), Turn(50.0, 180.0, "left", 3), Straight(100.0, 2)])
+    arc = 50.0 * math.radians(60.0)
+    # 2 x 100 m straight, three 60-degree arcs (the first from the turn's start), 2 x 50 m.
+    expected = [0.0, 100.0, 200.0, 200.0 + arc, 200.0 + 2 * arc, 200.0 + 3 * arc]
+    expected += [expected[-1] + 50.0, expected[-1] + 100.0]
+    distances = plan.scan_distances()
+    assert distances == pytest.approx(expected, abs=1e-9) and len(distances) == len(plan.poses())
+    assert distances[-1] == plan.path_length()
+    assert plan.scan_times(25.0) == [d / 25.0 for d in distances]
+    jump = FlightPlan(
+        None, [Manual([ScanPose(0, 0, 50)]), Manual([ScanPose(30, 40, 50), ScanPose(30, 40, 50)])]
+    )
+    assert jump.scan_distances() == [0.0, 50.0, 50.0]
+
+
 # -- the spatial variant on a hand-made target ------------------------------------------
 
 
