@@ -121,3 +121,15 @@ def test_cli_sweep_says_which_level_the_recommended_path_reaches(tmp_path, capsy
     best = out["top"][0]
     assert best["levels"][0]["identify"]["reached"] is True
     assert best["objective"] == best["levels"][0]["identify"]["flight_time_s"]
+    late = [
+        r
+        for r in load_sweep_results(tmp_path / "spec-results").rows
+        if r["levels.identify.flight_time_s"] > 1e-9
+    ]
+    assert late  # some variant identifies after its first scan
+    assert (
+        main(["sweep", str(spec), "--show", "--objective", "identified-within-budget", "--budget", "1e-9"])
+        == 0
+    )
+    text = capsys.readouterr().out
+    assert f"{len(late)} finished variant(s) not ranked (no target identified within the budget)" in text

@@ -374,10 +374,12 @@ def show_result(console, result, top) -> None:
         )
     unranked = sum(1 for r in result.ranking if r.rank is None and r.row.get("status") == "ok")
     if unranked:
-        console.print(
-            f"{unranked} finished variant(s) not ranked (objective undefined or over the budget)",
-            highlight=False,
-        )
+        reason = {
+            "time-to-identify": "a target not identified",
+            "distance-to-identify": "a target not identified",
+            "identified-within-budget": "no target identified within the budget",
+        }.get(result.objective, "objective undefined or over the budget")
+        console.print(f"{unranked} finished variant(s) not ranked ({reason})", highlight=False)
     failures = result.failures
     if failures:
         console.print(
