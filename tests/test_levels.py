@@ -288,3 +288,27 @@ def test_bad_levels_lines_in_a_cmf_name_the_line(tmp_path):
         with pytest.raises(InputFileError) as caught:
             read_cmf(path)
         assert str(caught.value).startswith(f"{path}:{line}: ") and says in str(caught.value)
+
+
+def test_coverage_chart_marks_the_scan_of_each_level_reached(tmp_path):
+    import re
+    import xml.etree.ElementTree as ET
+
+    from ladartui.charts import save_figure
+    from ladartui.charts.coverage import coverage_figure
+
+    levels = levels_from_curves([0.15, 0.35, 0.4, 0.45], [0.2, 0.6, 0.6, 0.6], TIMES[:4], DISTANCES[:4])
+    measures = Measures(obscured_after_scan=(0.1, 0.3, 0.35, 0.4), levels=levels)
+    path = save_figure(coverage_figure(measures), tmp_path / "c.svg")
+    groups = {g.get("id"): g for g in ET.parse(path).iter("{http://www.w3.org/2000/svg}g") if g.get("id")}
+
+    def xs(gid):
+        d = next(groups[gid].iter("{http://www.w3.org/2000/svg}path")).get("d")
+        numbers = [float(n) for n in re.findall(r"-?\d+(?:\.\d+)?", d)]
+        return numbers[0::2]
+
+    scan_x = xs("series-obscured")  # one vertex per scan
+    assert "level-identify" not in groups  # 45 % never reaches 50 %
+    for level, scan in (("detect", 1), ("recognise", 2)):
+        assert reached(levels)[level] == scan
+        assert xs(f"level-{level}") == pytest.approx([scan_x[scan - 1]] * 2, abs=0.01)

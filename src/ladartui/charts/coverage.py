@@ -1,8 +1,10 @@
 """Coverage after each scan of a run: how many looks are worth flying.
 
-Cumulative share of the target's visible voxels seen after scans 1..k, obscured
+Cumulative share of the target-model voxels seen after scans 1..k, obscured
 (through the scene) and unobscured (target alone), with the first scan count that
-reaches 90 % of the final obscured coverage marked.
+reaches 90 % of the final obscured coverage marked, and the scans at which the
+target was detected, recognised and identified (``ladartui.levels``; those use
+shares of its visible voxels and footprint, so they need not sit on a curve).
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from matplotlib.ticker import MaxNLocator
 from ladartui.charts import new_figure
 from ladartui.measures import ENOUGH_SHARE, Measures
 
+LEVEL_COLOURS = {"detect": "tab:gray", "recognise": "tab:purple", "identify": "tab:red"}
 SERIES = (
     ("unobscured", "unobscured_after_scan", "tab:blue", "s"),
     ("obscured", "obscured_after_scan", "tab:green", "o"),
@@ -50,6 +53,7 @@ def coverage_figure(measures: Measures, width_px: int = 800, height_px: int = 48
             label=f"{ENOUGH_SHARE:.0%} of final obscured coverage: scan {enough}",
             gid="enough-point",
         )
+    _mark_levels(axes, measures)
     if not drawn:
         axes.text(0.5, 0.5, "no per-scan coverage in this run", ha="center", transform=axes.transAxes)
         return figure
@@ -59,3 +63,19 @@ def coverage_figure(measures: Measures, width_px: int = 800, height_px: int = 48
     axes.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0, fontsize=8)
     figure.tight_layout()
     return figure
+
+
+def _mark_levels(axes, measures: Measures) -> None:
+    """A dotted vertical line at the scan where each level was reached."""
+    if measures.levels is None:
+        return
+    for item in measures.levels.levels:
+        if item.reached:
+            axes.axvline(
+                item.scan,
+                color=LEVEL_COLOURS.get(item.level, "black"),
+                linestyle=":",
+                linewidth=1.5,
+                label=f"{item.level}: {item.describe()}",
+                gid=f"level-{item.level}",
+            )
