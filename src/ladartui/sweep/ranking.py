@@ -14,6 +14,7 @@ import math
 from dataclasses import dataclass
 
 from ladartui.errors import FieldError
+from ladartui.levels import LEVELS as LEVEL_NAMES
 from ladartui.pareto import pareto_front as front_of_minima
 
 # Column of the measure every objective is built on: the share of target
@@ -21,7 +22,6 @@ from ladartui.pareto import pareto_front as front_of_minima
 COVERAGE_COLUMN = "obscured_coverage"
 # Columns of the levels (Measures.levels flattened by the sweep's row builder).
 LEVEL_COLUMN = "levels.{level}.{field}"
-LEVEL_NAMES = ("detect", "recognise", "identify")
 
 OBJECTIVES = {
     "obscured-coverage": "obscured target coverage (higher is better)",
@@ -103,9 +103,17 @@ def level_of(row: dict, level: str) -> list[tuple[bool, int | None, float | None
     return out
 
 
-def time_to_identify(row: dict, field: str = "flight_time_s") -> float | None:
-    """Seconds (or metres, ``field="distance_m"``) until every target is identified; None if one is not."""
-    index = 2 if field == "flight_time_s" else 3
+def time_to_identify(row: dict) -> float | None:
+    """Seconds of flight until every target is identified; None if one never is."""
+    return _until_all_identified(row, 2)
+
+
+def distance_to_identify(row: dict) -> float | None:
+    """Metres flown until every target is identified; None if one never is."""
+    return _until_all_identified(row, 3)
+
+
+def _until_all_identified(row: dict, index: int) -> float | None:
     values = [t[index] if t[0] else None for t in level_of(row, "identify")]
     known = [float(v) for v in values if v is not None]
     return max(known) if known and len(known) == len(values) else None
@@ -164,7 +172,7 @@ def objective_value(row: dict, objective: str, budget: float | None = None) -> f
     if objective == "time-to-identify":
         return time_to_identify(row)
     if objective == "distance-to-identify":
-        return time_to_identify(row, "distance_m")
+        return distance_to_identify(row)
     if objective == "worst-target-coverage":
         return worst_target_coverage(row)
     if objective == "identified-within-budget":
