@@ -91,6 +91,7 @@ import tomli_w
 
 from ladartui import defaults
 from ladartui.atomic import write_text_atomic
+from ladartui.checks import choice_field, number_field
 from ladartui.detection.settings import DETECTION_KEYS, DetectionSettings, detection_from_table
 from ladartui.errors import FieldError, InputFileError, LadarError
 from ladartui.fileprobe import file_problem
@@ -100,8 +101,6 @@ from ladartui.flight import (
     FlightPlan,
     Manual,
     ScanPose,
-    choice_field,
-    number_field,
 )
 from ladartui.scenario_style import restyle
 from ladartui.sensor import MAX_PIXEL_PITCH, Sensor

@@ -21,8 +21,8 @@ import numpy as np
 from ladartui.detection.scan import BYTES_PER_HELD_RAY, check_memory, declare_look, prepare_look
 from ladartui.detection.settings import DetectionSettings
 from ladartui.errors import Cancelled
-from ladartui.measures import voxel_keys
-from ladartui.simulation import kept_returns
+from ladartui.returns import kept_returns
+from ladartui.scene.keys import voxel_keys
 
 # Kept for callers of the first version: the settings are the [detection] section's.
 GeigerSettings = DetectionSettings

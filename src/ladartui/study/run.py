@@ -227,14 +227,14 @@ def _trace(scene, origins, directions, setting: Setting, cancel):
 
 
 def _scan_returns(hits, detector, depth_resolution) -> np.ndarray:
-    from ladartui.simulation import scan_returns
+    from ladartui.returns import scan_returns
 
     return scan_returns(hits, detector, depth_resolution)
 
 
 def _coverage(scene, per_scan) -> float | None:
     from ladartui.measures import compute_measures
-    from ladartui.simulation import fuse_scans
+    from ladartui.returns import fuse_scans
 
     fused = fuse_scans(per_scan)
     return compute_measures(scene.target, fused, None).obscured_coverage
@@ -266,8 +266,8 @@ def write_outputs(
     """Write the CSV, JSON, plotted chart (SVG, PNG) and plain-text chart atomically into ``out_dir``."""
     from ladartui.atomic import write_text_atomic
     from ladartui.charts import save_figure
-    from ladartui.charts.speed_accuracy import speed_accuracy_figure
     from ladartui.study.chart import chart_text
+    from ladartui.study.figure import speed_accuracy_figure
 
     paths = result.write(out_dir, stem)
     out_dir = Path(out_dir)
