@@ -104,11 +104,10 @@ from ladartui.flight import (
 )
 from ladartui.scenario_style import restyle
 from ladartui.sensor import MAX_PIXEL_PITCH, Sensor
+from ladartui.tracing.backend import METHODS, PRECISIONS
 from ladartui.trajectory import LogSegment
 
 BUILTIN_BACKENDS = ("numba", "wgpu")
-METHODS = ("exact", "march")
-PRECISIONS = ("f64", "f32")
 MAX_VOXEL_SIZE = 100.0
 MAX_SPEED = 1000.0
 MAX_STEP = 10.0

@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ladartui.errors import Cancelled
+from ladartui.errors import check_cancelled
 from ladartui.measures import Measures, compute_measures
 from ladartui.returns import fuse_scans, kept_returns
 
@@ -138,7 +138,7 @@ def _simulate(scenario, backend, method, step, precision, progress, cancel, outp
         for run, returns in runner.scan(scan, pose, attitude).items():
             per_scan[run].append(returns)
 
-    _check(cancel)
+    check_cancelled(cancel, NOTHING_WRITTEN)
     tick = time.perf_counter()
     scene_output = fuse_scans(per_scan["scene"])
     target_output = fuse_scans(per_scan["target"])
@@ -161,7 +161,7 @@ def _simulate(scenario, backend, method, step, precision, progress, cancel, outp
 
     outputs = {}
     if output_set is not None:
-        _check(cancel)
+        check_cancelled(cancel, NOTHING_WRITTEN)
         tick = time.perf_counter()
         outputs = _write_outputs(output_set, scene_output, target_output, measures, scene.voxel_size, cancel)
         timings["write"] = time.perf_counter() - tick
@@ -209,7 +209,7 @@ class _ScanRunner:
         kept = {run: [] for run in RUNS}
         row = 0
         while row < sensor.grid:
-            _check(self.cancel)
+            check_cancelled(self.cancel, NOTHING_WRITTEN)
             # Whole detector rows, so that the depth rule can run on each chunk.
             stop = min(sensor.grid, row + max(1, self.chunk // self.rays_per_row))
             tick = time.perf_counter()
@@ -217,7 +217,7 @@ class _ScanRunner:
             timings["rays"] += time.perf_counter() - tick
             slowest = 0.0
             for run in RUNS:
-                _check(self.cancel)
+                check_cancelled(self.cancel, NOTHING_WRITTEN)
                 tick = time.perf_counter()
                 hits = self._trace(
                     self.occupancies[run],
@@ -260,11 +260,6 @@ class _ScanRunner:
                     run, scan, self.scans, self.done, self.rays_total, self.done / self.rays_total, returns
                 )
             )
-
-
-def _check(cancel):
-    if cancel is not None and cancel.is_set():
-        raise Cancelled(NOTHING_WRITTEN)
 
 
 def _trace_settings(scenario, backend, method, step, precision) -> dict:
