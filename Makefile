@@ -10,12 +10,13 @@ UV_HOME := .uv
 UV := $(UV_HOME)/bin/uv
 export PYTHONDONTWRITEBYTECODE := 1
 
-.PHONY: run test test-all lint bench setup system-deps lock
+.PHONY: run test test-all lint lint-imports bench setup system-deps lock
 
 run: setup
 	$(VENV)/bin/ladartui
 
 test: setup
+	$(VENV)/bin/lint-imports --no-cache --no-logo
 	$(VENV)/bin/python -m pytest -q
 
 # The suite on every supported Python (interpreters found on PATH or under
@@ -37,6 +38,11 @@ lint: setup
 	$(VENV)/bin/ruff check src tests
 	$(VENV)/bin/ruff format --check src tests
 	$(VENV)/bin/mypy
+
+# The import contracts in pyproject.toml (layers, no cycles, core below the shells).
+# --no-cache: the check takes well under a second and leaves nothing in the tree.
+lint-imports: setup
+	$(VENV)/bin/lint-imports --no-cache --no-logo
 
 bench: setup
 	$(VENV)/bin/ladartui bench

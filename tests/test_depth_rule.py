@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from ladartui.simulation import apply_depth_resolution, fuse_scans, scan_returns, unique_voxels
+from ladartui.returns import apply_depth_resolution, fuse_scans, scan_returns, unique_voxels
 from ladartui.tracing.backend import GROUND, MISS, VOXEL
 
 

@@ -306,7 +306,8 @@ def test_flight_time_checks_speed():
 
 
 def test_altitudes_people_ask_for_are_practical_and_headings_they_type_are_compass_angles():
-    from ladartui.flight import MAX_FLIGHT_ALTITUDE, Orbit, compass_field
+    from ladartui.checks import compass_field
+    from ladartui.flight import MAX_FLIGHT_ALTITUDE, Orbit
 
     with pytest.raises(FieldError, match="at most 20000"):
         Orbit(centre=(0.0, 0.0, 0.0), radius=50.0, altitude=MAX_FLIGHT_ALTITUDE + 1, scans=4)

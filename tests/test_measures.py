@@ -219,7 +219,7 @@ def test_measures_dict_is_json_safe():
 
 def test_voxel_keys_round_trip_at_the_limits():
     from ladartui.errors import FieldError
-    from ladartui.measures import keys_to_voxels, voxel_keys
+    from ladartui.scene.keys import keys_to_voxels, voxel_keys
 
     voxels = np.array([[0, 0, 0], [2**22 - 2, 5, 2**19 - 2], [7, 2**22 - 2, 3], [1, 2, 3]])
     keys = voxel_keys(voxels)

@@ -20,10 +20,11 @@ import pytest
 
 from ladartui.levels import target_levels
 from ladartui.measures import compute_measures
+from ladartui.returns import fuse_scans, scan_returns
 from ladartui.scenario import load_scenario
 from ladartui.scene.voxels import save_voxels
 from ladartui.sensor import Sensor
-from ladartui.simulation import fuse_scans, scan_returns, simulate
+from ladartui.simulation import simulate
 from ladartui.tracing import trace
 from ladartui.user_data import default_scenario_path
 

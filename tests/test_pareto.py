@@ -3,8 +3,9 @@
 import math
 import random
 
+import pytest
+
 from ladartui.pareto import dominator, pareto_front
-from ladartui.sweep.ranking import pareto_front as sweep_front
 
 
 def _brute_force(points):
@@ -25,16 +26,30 @@ def test_two_and_three_objective_fronts_match_a_pairwise_check_with_ties_and_gap
             points = [tuple(float(rng.randint(0, 4)) for _ in range(k)) for _ in range(rng.randint(0, 15))]
             points += rng.sample(gaps, rng.randint(0, 3))
             rng.shuffle(points)
-            assert pareto_front(points) == _brute_force(points)
+            assert pareto_front(points, ("min",) * k) == _brute_force(points)
 
 
 def test_identical_points_share_the_front_under_both_orientations():
-    assert pareto_front([(2, 2), (2, 2), (3, 3)]) == [True, True, False]
+    assert pareto_front([(2, 2), (2, 2), (3, 3)], ("min", "min")) == [True, True, False]
     # Sweeps maximise coverage: (cost 1, coverage 0.5) twice, both beat (1, 0.4).
-    assert sweep_front([(1, 0.5), (1, 0.5), (1, 0.4), (1, float("nan"))]) == [True, True, False, False]
+    front = pareto_front([(1, 0.5), (1, 0.5), (1, 0.4), (1, float("nan"))], ("min", "max"))
+    assert front == [True, True, False, False]
+
+
+def test_the_sense_decides_the_front_and_must_be_stated():
+    points = [(1, 1), (2, 2)]
+    assert pareto_front(points, ("min", "min")) == [True, False]
+    assert pareto_front(points, ("max", "max")) == [False, True]
+    assert pareto_front(points, ("min", "max")) == [True, True]
+    with pytest.raises(ValueError, match="'min' or 'max'"):
+        pareto_front(points, ("least", "most"))
+    with pytest.raises(ValueError, match="2 objectives against 3 senses"):
+        pareto_front(points, ("min", "min", "min"))
+    with pytest.raises(TypeError):
+        pareto_front(points)  # type: ignore[call-arg]
 
 
 def test_dominator_is_the_cheapest_front_point_that_dominates():
     points = [(1, 5), (2, 1), (3, 0.5), (4, 6), None]
-    assert dominator(points, 3) == 0
-    assert dominator(points, 4) is None and dominator(points, 1) is None
+    assert dominator(points, 3, ("min", "min")) == 0
+    assert dominator(points, 4, ("min", "min")) is None and dominator(points, 1, ("min", "min")) is None

@@ -5,7 +5,8 @@ import itertools
 import numpy as np
 import pytest
 
-from ladartui.render import colour, framing
+from ladartui import colour
+from ladartui.render import framing
 from ladartui.render.output import classify, output_layers
 from ladartui.render.raster import Layer, Overlays, render, screen_coordinates
 from ladartui.views import Camera

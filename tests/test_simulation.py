@@ -9,10 +9,11 @@ import ladartui.simulation as simulation
 from ladartui.errors import Cancelled
 from ladartui.flight import FlightPlan, Manual, ScanPose, aim_at
 from ladartui.measures import read_cmf
+from ladartui.returns import fuse_scans
 from ladartui.scenario import Scenario
 from ladartui.scene.voxels import load_voxels, save_voxels
 from ladartui.sensor import Sensor
-from ladartui.simulation import fuse_scans, simulate
+from ladartui.simulation import simulate
 
 TARGET_CENTRE = (22.5, 21.5, 1.0)
 

@@ -583,7 +583,7 @@ def test_measures_stay_defined_or_say_undefined_on_degenerate_inputs():
 
 def test_measures_of_a_hidden_one_voxel_target_traced_in_one_scan():
     from ladartui.measures import compute_measures
-    from ladartui.simulation import scan_returns
+    from ladartui.returns import scan_returns
 
     # A roof over a one-voxel target: a nadir ray sees the roof, never the target.
     voxels = np.array([(4, 4, 0)] + [(x, y, 3) for x in range(3, 6) for y in range(3, 6)])

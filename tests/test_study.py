@@ -37,23 +37,28 @@ from ladartui.tracing.backend import GROUND, MISS, VOXEL
 def test_pareto_front_of_a_hand_drawn_set():
     # (seconds, error): (3, 3) loses to (2, 3); (2, 4) loses to (2, 3).
     points = [(1, 5), (2, 3), (3, 3), (2, 4), (4, 1)]
-    assert pareto_front(points) == [True, True, False, False, True]
-    assert dominator(points, 2) == 1
-    assert dominator(points, 3) == 1
-    assert dominator(points, 0) is None
+    assert pareto_front(points, ("min", "min")) == [True, True, False, False, True]
+    assert dominator(points, 2, ("min", "min")) == 1
+    assert dominator(points, 3, ("min", "min")) == 1
+    assert dominator(points, 0, ("min", "min")) is None
 
 
 def test_points_on_a_trade_off_curve_are_all_on_the_front_and_any_worse_point_is_not():
     xs = np.linspace(0.1, 10, 25)
     curve = [(float(x), float(1 / x)) for x in xs]
     worse = [(x * 1.01, y * 1.01) for x, y in curve]
-    front = pareto_front(curve + worse)
+    front = pareto_front(curve + worse, ("min", "min"))
     assert all(front[:25]) and not any(front[25:])
 
 
 def test_equal_points_do_not_dominate_each_other_and_missing_values_never_count():
     assert not dominates((1, 1), (1, 1))
-    assert pareto_front([(1, 1), (1, 1), None, (0, float("nan"))]) == [True, True, False, False]
+    assert pareto_front([(1, 1), (1, 1), None, (0, float("nan"))], ("min", "min")) == [
+        True,
+        True,
+        False,
+        False,
+    ]
 
 
 # --------------------------------------------------------------------------- timing

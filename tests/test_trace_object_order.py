@@ -23,8 +23,8 @@ def forest():
 
 
 def both_orders(backend, occ, origins, directions):
-    ray = backend.trace_cells(occ, origins, directions, object_order=False)
-    obj = backend.trace_cells(occ, origins, directions, object_order=True)
+    ray = backend.trace_cells(occ, origins, directions, order="ray")
+    obj = backend.trace_cells(occ, origins, directions, order="object")
     return ray, obj
 
 
@@ -52,7 +52,7 @@ def test_scan_matches_the_reference(forest, numba_backend):
     origins, directions = one_scan(
         [120, 120, 20], 45.0, 0.3, 200.0, sensor=Sensor(grid=16, ray_grid=4, fov=40.0)
     )
-    obj = numba_backend.trace_cells(occ, origins, directions, object_order=True)
+    obj = numba_backend.trace_cells(occ, origins, directions, order="object")
     assert obj.info["order"] == "object"
     pick = np.random.default_rng(0).choice(len(origins), 800, replace=False)
     ref = reference_trace_cells(voxels, occ.shape, origins[pick], directions[pick])
@@ -143,7 +143,7 @@ def test_ray_order_where_object_order_cannot_or_should_not(forest, numba_backend
     wide[:, 2] = -np.abs(wide[:, 2])
     wide /= np.linalg.norm(wide, axis=1, keepdims=True)
     same_origin = np.tile([120.0, 120.0, 150.0], (5000, 1))
-    result = numba_backend.trace_cells(occ, same_origin, wide, object_order=True)
+    result = numba_backend.trace_cells(occ, same_origin, wide, order="object")
     assert result.info["order"] == "ray"
     # The aircraft among the trees: bricks on both sides of its plane.
     inside = np.tile([120.0, 120.0, 30.0], (5000, 1))
@@ -159,7 +159,7 @@ def test_ray_order_where_object_order_cannot_or_should_not(forest, numba_backend
     )
     auto = numba_backend.trace_cells(occ, origins, directions)
     assert auto.info["order"] == "ray"
-    assert_same(auto, numba_backend.trace_cells(occ, origins, directions, object_order=True))
+    assert_same(auto, numba_backend.trace_cells(occ, origins, directions, order="object"))
 
 
 def test_trace_reports_the_order_and_metres(forest):
@@ -172,7 +172,7 @@ def test_trace_reports_the_order_and_metres(forest):
     origins, directions, _ = sensor.rays(pose)
     result = trace(scene, origins, directions, backend="numba")
     assert result.info["order"] == "object"
-    cells = NumbaBackend().trace_cells(occ, origins / 0.25 + 0.5, directions, object_order=False)
+    cells = NumbaBackend().trace_cells(occ, origins / 0.25 + 0.5, directions, order="ray")
     assert np.array_equal(result.kind, cells.kind)
     assert np.allclose(result.range[cells.kind == VOXEL], cells.t[cells.kind == VOXEL] * 0.25)
 
@@ -233,9 +233,9 @@ def test_order_choice_learns_the_faster_order():
 def test_directions_that_are_not_unit_go_in_ray_order(forest, numba_backend):
     _, occ = forest
     origins, directions = one_scan([120, 120, 10], 45.0, 1.0, 200.0)
-    result = numba_backend.trace_cells(occ, origins, 3.0 * directions, object_order=True)
+    result = numba_backend.trace_cells(occ, origins, 3.0 * directions, order="object")
     assert result.info["order"] == "ray"
-    assert_same(result, numba_backend.trace_cells(occ, origins, 3.0 * directions, object_order=False))
+    assert_same(result, numba_backend.trace_cells(occ, origins, 3.0 * directions, order="ray"))
 
 
 @pytest.mark.parametrize("shift, tiles", [(4, 6), (1, 300)])
@@ -326,6 +326,6 @@ def test_order_choice_reads_the_given_clock():
     for name, clock in (("cpu", time.process_time), ("wall", time.perf_counter)):
         choice = OrderChoice()
         for _ in range(6):
-            trace_in_blocks(MIN_SCAN_RAYS, None, choice, waits, computes, clock=clock)
+            trace_in_blocks(MIN_SCAN_RAYS, "auto", choice, waits, computes, clock=clock)
         picks[name] = choice.pick()
     assert picks == {"cpu": "object", "wall": "ray"}

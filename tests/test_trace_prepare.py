@@ -1,7 +1,9 @@
 """The one-pass ray preparation gives the numpy expressions' exact bits."""
 
 import numpy as np
+import pytest
 
+from ladartui.errors import FieldError
 from ladartui.tracing import TINY
 from ladartui.tracing.prepare import rays_to_cells
 
@@ -19,16 +21,22 @@ def test_cells_and_unit_directions_match_numpy_bit_for_bit():
     assert np.all(unit[:10, 0] == 0.0)
 
 
+def _bad_ray(origins, directions, voxel_size=1.0):
+    with pytest.raises(FieldError) as error:
+        rays_to_cells(origins, directions, voxel_size, TINY)
+    return error.value.field, error.value.expected
+
+
 def test_first_bad_ray_is_named():
     origins = np.zeros((4, 3))
     directions = np.tile([0.0, 0.0, -1.0], (4, 1))
     directions[2] = 0.0
-    assert rays_to_cells(origins, directions, 1.0, TINY)[1] == ("zero", 2)
+    assert _bad_ray(origins, directions) == ("directions[2]", "a non-zero vector")
     origins[1, 2] = np.nan
-    assert rays_to_cells(origins, directions, 1.0, TINY)[1] == ("origins", 1)
+    assert _bad_ray(origins, directions) == ("origins[1]", "finite numbers")
     origins[1, 2] = 0.0
     directions[0, 1] = np.inf
-    assert rays_to_cells(origins, directions, 1.0, TINY)[1] == ("directions", 0)
+    assert _bad_ray(origins, directions) == ("directions[0]", "finite numbers")
 
 
 def test_a_bad_ray_anywhere_in_a_large_batch_is_found():
@@ -39,10 +47,10 @@ def test_a_bad_ray_anywhere_in_a_large_batch_is_found():
     for bad in (0, 77_777, 99_999):
         broken = directions.copy()
         broken[bad] = 0.0
-        assert rays_to_cells(origins, broken, 0.5, TINY)[1] == ("zero", bad)
+        assert _bad_ray(origins, broken, 0.5) == (f"directions[{bad}]", "a non-zero vector")
         broken = origins.copy()
         broken[bad, 1] = -np.inf
-        assert rays_to_cells(broken, directions, 0.5, TINY)[1] == ("origins", bad)
+        assert _bad_ray(broken, directions, 0.5) == (f"origins[{bad}]", "finite numbers")
 
 
 def test_huge_and_tiny_directions_keep_their_direction():

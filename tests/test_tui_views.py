@@ -9,9 +9,9 @@ import pytest
 import pytest_asyncio
 from textual import events
 
+from ladartui import colour
 from ladartui.errors import LadarError
 from ladartui.flight import FlightPlan, Orbit
-from ladartui.render import colour
 from ladartui.render.raster import screen_coordinates
 from ladartui.scenario import Scenario
 from ladartui.scene.generate import generate_scene

@@ -29,7 +29,7 @@ def f64_backend(wgpu_backend):
 
 
 def gpu_object_order(backend, occ, origins, directions):
-    hits = backend.trace_cells(occ, origins, directions, object_order=True)
+    hits = backend.trace_cells(occ, origins, directions, order="object")
     assert hits.info["order"] == "object"
     return hits
 
@@ -42,7 +42,7 @@ def test_scans_match_numba_bit_for_bit(forest, f64_backend, numba_backend, depre
         aim = [rng.uniform(60, 180), rng.uniform(60, 180), rng.uniform(0, 40)]
         origins, directions = one_scan(aim, depression, rng.uniform(0, 2 * math.pi), slant)
         gpu = gpu_object_order(f64_backend, occ, origins, directions)
-        assert_same(numba_backend.trace_cells(occ, origins, directions, object_order=False), gpu)
+        assert_same(numba_backend.trace_cells(occ, origins, directions, order="ray"), gpu)
         assert (gpu.kind == VOXEL).sum() > len(gpu.kind) // 10
 
 
@@ -65,7 +65,7 @@ def test_random_scenes_spread_origins_and_grid_planes(f64_backend, numba_backend
         if trial % 2 == 0:
             origins = np.round(origins)  # on grid planes, edges and corners
         gpu = gpu_object_order(f64_backend, occ, origins, directions)
-        assert_same(numba_backend.trace_cells(occ, origins, directions, object_order=False), gpu)
+        assert_same(numba_backend.trace_cells(occ, origins, directions, order="ray"), gpu)
 
 
 def test_rays_in_cell_faces_and_zero_components(f64_backend, numba_backend):
@@ -81,7 +81,7 @@ def test_rays_in_cell_faces_and_zero_components(f64_backend, numba_backend):
     origins = np.repeat(corners, len(fan), axis=0)
     directions = np.tile(fan, (len(corners), 1))
     gpu = gpu_object_order(f64_backend, occ, origins, directions)
-    assert_same(numba_backend.trace_cells(occ, origins, directions, object_order=False), gpu)
+    assert_same(numba_backend.trace_cells(occ, origins, directions, order="ray"), gpu)
     assert ((directions[:, 0] == 0) & (origins[:, 0] % 1 == 0)).any()
 
 
@@ -91,7 +91,7 @@ def test_far_aircraft(forest, f64_backend, numba_backend):
         [120, 120, 10], 30.0, 1.0, 40000.0, sensor=Sensor(grid=16, ray_grid=4, fov=0.05)
     )
     gpu = gpu_object_order(f64_backend, occ, origins, directions)
-    assert_same(numba_backend.trace_cells(occ, origins, directions, object_order=False), gpu)
+    assert_same(numba_backend.trace_cells(occ, origins, directions, order="ray"), gpu)
     assert (gpu.kind == VOXEL).any()
 
 
@@ -104,7 +104,7 @@ def test_buffers_grow_and_are_reused(forest, f64_backend, numba_backend):
             [100, 140, 20], 60.0, 2.0, 180.0, sensor=Sensor(grid=grid, ray_grid=4, fov=6.0)
         )
         gpu = gpu_object_order(f64_backend, occ, origins, directions)
-        assert_same(numba_backend.trace_cells(occ, origins, directions, object_order=False), gpu)
+        assert_same(numba_backend.trace_cells(occ, origins, directions, order="ray"), gpu)
 
 
 def test_ray_order_where_object_order_cannot_run(forest, f64_backend, numba_backend, monkeypatch):
@@ -112,24 +112,24 @@ def test_ray_order_where_object_order_cannot_run(forest, f64_backend, numba_back
 
     _, occ = forest
     origins, directions = one_scan([120, 120, 10], 45.0, 1.0, 200.0)
-    expected = numba_backend.trace_cells(occ, origins, directions, object_order=False)
+    expected = numba_backend.trace_cells(occ, origins, directions, order="ray")
     # f32, or object order turned off: the ray-order shader.
     assert (
-        f64_backend.trace_cells(occ, origins, directions, precision="f32", object_order=True).info["order"]
+        f64_backend.trace_cells(occ, origins, directions, precision="f32", order="object").info["order"]
         == "ray"
     )
-    off = f64_backend.trace_cells(occ, origins, directions, object_order=False)
+    off = f64_backend.trace_cells(occ, origins, directions, order="ray")
     assert off.info["order"] == "ray"
     assert_same(expected, off)
     # A tile list longer than an invocation may walk on lavapipe.
     monkeypatch.setattr(module, "LOOP_BUDGET", 1)
-    long_lists = f64_backend.trace_cells(occ, origins, directions, object_order=True)
+    long_lists = f64_backend.trace_cells(occ, origins, directions, order="object")
     assert long_lists.info["order"] == "ray"
     assert_same(expected, long_lists)
     monkeypatch.undo()
     # A scene too large for float32 voxel coordinates.
     monkeypatch.setattr(module, "F32_EXACT", max(occ.shape))
-    large = f64_backend.trace_cells(occ, origins, directions, object_order=True)
+    large = f64_backend.trace_cells(occ, origins, directions, order="object")
     assert large.info["order"] == "ray"
     assert_same(expected, large)
     monkeypatch.undo()
@@ -137,7 +137,7 @@ def test_ray_order_where_object_order_cannot_run(forest, f64_backend, numba_back
     rng = np.random.default_rng(3)
     scattered = rng.uniform([0, 0, 80], [240, 240, 120], size=(5000, 3))
     down = np.tile([0.0, 0.6, -0.8], (5000, 1))
-    hits = f64_backend.trace_cells(occ, scattered, down, object_order=True)
+    hits = f64_backend.trace_cells(occ, scattered, down, order="object")
     assert hits.info["order"] == "ray"
     assert_same(numba_backend.trace_cells(occ, scattered, down), hits)
 
@@ -150,7 +150,7 @@ def test_order_is_learned_per_occupancy(forest, f64_backend, numba_backend):
     _, occ = forest
     backend = WgpuBackend()
     origins, directions = one_scan([120, 120, 10], 45.0, 1.0, 200.0)  # few voxels per ray
-    expected = numba_backend.trace_cells(occ, origins, directions, object_order=False)
+    expected = numba_backend.trace_cells(occ, origins, directions, order="ray")
     seen = set()
     for _ in range(4):
         hits = backend.trace_cells(occ, origins, directions)

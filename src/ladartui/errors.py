@@ -33,6 +33,15 @@ class Cancelled(Exception):
     """A run stopped by its cancel event; nothing was written."""
 
 
+def check_cancelled(cancel, message: str) -> None:
+    """Raise ``Cancelled(message)`` once ``cancel`` (a threading.Event, or None) is set.
+
+    The one cancel check of the core: long work calls it between its steps.
+    """
+    if cancel is not None and cancel.is_set():
+        raise Cancelled(message)
+
+
 class BackendUnavailable(LadarError):
     """A tracing backend that cannot run here, with the reason and what to install."""
 

@@ -21,7 +21,7 @@ import threading
 from collections.abc import Callable
 from pathlib import Path
 
-from ladartui.errors import Cancelled, OutputFileError
+from ladartui.errors import OutputFileError, check_cancelled
 
 # Called with a step name ("temporaries", "swap", "backups") at each stage of the
 # write; None in use. Tests set it to pause a run there and kill it.
@@ -178,8 +178,7 @@ class OutputSet:
                     raise _write_error(path, error) from None
                 _fsync_file(temps[name])
             _step("temporaries")
-            if cancel is not None and cancel.is_set():
-                raise Cancelled("run cancelled; nothing was written, earlier outputs are unchanged")
+            check_cancelled(cancel, "run cancelled; nothing was written, earlier outputs are unchanged")
             self._swap(temps)
         finally:
             for tmp in temps.values():

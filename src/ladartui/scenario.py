@@ -99,6 +99,7 @@ import tomli_w
 
 from ladartui import defaults
 from ladartui.atomic import write_text_atomic
+from ladartui.checks import choice_field, number_field
 from ladartui.detection.settings import DETECTION_KEYS, DetectionSettings, detection_from_table
 from ladartui.errors import FieldError, InputFileError, LadarError
 from ladartui.fileprobe import file_problem
@@ -108,17 +109,14 @@ from ladartui.flight import (
     FlightPlan,
     Manual,
     ScanPose,
-    choice_field,
-    number_field,
 )
 from ladartui.levels import LEVEL_KEYS, LevelThresholds, levels_from_table
 from ladartui.scenario_style import restyle
 from ladartui.sensor import MAX_PIXEL_PITCH, Sensor
+from ladartui.tracing.backend import METHODS, PRECISIONS
 from ladartui.trajectory import LogSegment
 
 BUILTIN_BACKENDS = ("numba", "wgpu")
-METHODS = ("exact", "march")
-PRECISIONS = ("f64", "f32")
 MAX_VOXEL_SIZE = 100.0
 MAX_SPEED = 1000.0
 MAX_STEP = 10.0

@@ -28,8 +28,9 @@ from functools import cached_property
 
 import numpy as np
 
+from ladartui.checks import integer_field, number_field
 from ladartui.errors import FieldError
-from ladartui.flight import ScanPose, integer_field, number_field
+from ladartui.flight import ScanPose
 
 MAX_GRID = 1024
 MAX_RAY_GRID = 16

@@ -20,12 +20,11 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numba
 import numpy as np
 
-from ladartui.errors import Cancelled
-from ladartui.measures import Measures, compute_measures, keys_to_voxels, sorted_unique, voxel_keys
-from ladartui.tracing.backend import MISS
+from ladartui.errors import check_cancelled
+from ladartui.measures import Measures, compute_measures
+from ladartui.returns import fuse_scans, kept_returns
 
 RUNS = ("scene", "target")
 NOTHING_WRITTEN = "run cancelled; nothing was written, earlier outputs are unchanged"
@@ -36,119 +35,6 @@ _FIRST_CHUNK_RAYS = 32768
 _MIN_CHUNK_RAYS = 1024
 # Larger calls gain nothing, and ray set-up slows down on very large arrays.
 _MAX_CHUNK_RAYS = 65536
-# Detectors with more rays than this are sorted up front, not by insertion.
-_INSERTION_LIMIT = 64
-
-
-# --------------------------------------------------------------------------- depth rule
-
-
-@numba.njit(nogil=True, cache=True)
-def _depth_rule_kernel(order, grouped, detector, kind, ranges, depth_resolution, kept):
-    """Write the indices of the kept returns into ``kept``; return how many.
-
-    Rays are visited in ``order`` (or 0..n-1 when ``grouped``), which lists
-    each detector's rays together (already sorted by range when groups are
-    large). Within a detector the returns are sorted by range (stably, so equal
-    ranges keep ray order); the first is kept and every later one closer than
-    ``depth_resolution`` to the last kept return is dropped.
-    """
-    n = detector.size
-    group_rays = np.empty(n, dtype=np.int64)
-    group_ranges = np.empty(n, dtype=np.float64)
-    count_kept = 0
-    start = 0
-    while start < n:
-        group = detector[start if grouped else order[start]]
-        stop = start
-        while stop < n and detector[stop if grouped else order[stop]] == group:
-            stop += 1
-        count = 0
-        for position in range(start, stop):
-            ray = position if grouped else order[position]
-            value = ranges[ray]
-            if kind[ray] == MISS or not np.isfinite(value):
-                continue
-            # Insertion sort, stable; linear when the order is sorted already.
-            j = count - 1
-            while j >= 0 and group_ranges[j] > value:
-                group_ranges[j + 1] = group_ranges[j]
-                group_rays[j + 1] = group_rays[j]
-                j -= 1
-            group_ranges[j + 1] = value
-            group_rays[j + 1] = ray
-            count += 1
-        last = 0.0
-        for i in range(count):
-            if i == 0 or group_ranges[i] - last >= depth_resolution:
-                kept[count_kept] = group_rays[i]
-                count_kept += 1
-                last = group_ranges[i]
-        start = stop
-    return count_kept
-
-
-def kept_returns(detector, kind, ranges, depth_resolution) -> np.ndarray:
-    """Indices of the rays whose hits survive the detector's depth resolution.
-
-    Rays are grouped by ``detector`` id and sorted by ``ranges`` (metres); the
-    nearest return of each detector is kept, and each later one is kept only if
-    it lies at least ``depth_resolution`` metres beyond the last kept return.
-    Misses (``kind == MISS``) never return; ground returns are returns.
-    """
-    detector = np.ascontiguousarray(detector)
-    kind = np.ascontiguousarray(kind, dtype=np.uint8)
-    ranges = np.ascontiguousarray(ranges, dtype=np.float64)
-    n = detector.shape[0]
-    if not (kind.shape[0] == ranges.shape[0] == n):
-        raise ValueError("detector, kind and ranges must have the same length")
-    if n == 0:
-        return np.zeros(0, dtype=np.int64)
-    # Sensor rays come grouped by detector in increasing order, a few per
-    # detector: sort each group in place. Otherwise sort everything first.
-    grouped = bool(np.all(detector[1:] >= detector[:-1])) and _largest_group(detector) <= _INSERTION_LIMIT
-    order = np.zeros(0, dtype=np.int64) if grouped else np.lexsort((ranges, detector))
-    kept = np.empty(n, dtype=np.int64)
-    count = _depth_rule_kernel(
-        order.astype(np.int64), grouped, detector, kind, ranges, float(depth_resolution), kept
-    )
-    return kept[:count]
-
-
-def _largest_group(sorted_ids) -> int:
-    starts = np.flatnonzero(sorted_ids[1:] != sorted_ids[:-1]) + 1
-    bounds = np.concatenate(([0], starts, [sorted_ids.size]))
-    return int(np.diff(bounds).max())
-
-
-def apply_depth_resolution(detector, kind, ranges, depth_resolution) -> np.ndarray:
-    """Boolean mask over the rays: True where the hit survives the depth resolution."""
-    mask = np.zeros(np.shape(detector)[0], dtype=bool)
-    mask[kept_returns(detector, kind, ranges, depth_resolution)] = True
-    return mask
-
-
-def scan_returns(trace_result, detector, depth_resolution) -> np.ndarray:
-    """The voxels one scan returns: hits after the depth rule, unique, (K, 3) int32."""
-    kept = kept_returns(detector, trace_result.kind, trace_result.range, depth_resolution)
-    return unique_voxels(trace_result.index[kept])
-
-
-def unique_voxels(voxels) -> np.ndarray:
-    """The distinct voxels of a (K, 3) list, sorted by (i, j, k), as int32."""
-    voxels = np.asarray(voxels).reshape(-1, 3)
-    if voxels.shape[0] == 0:
-        return np.zeros((0, 3), dtype=np.int32)
-    return keys_to_voxels(sorted_unique(voxel_keys(voxels)))
-
-
-def fuse_scans(per_scan) -> np.ndarray:
-    """The fused output of several scans: the union of their returned voxels."""
-    per_scan = [np.asarray(v).reshape(-1, 3) for v in per_scan]
-    if not per_scan:
-        return np.zeros((0, 3), dtype=np.int32)
-    return unique_voxels(np.concatenate(per_scan))
-
 
 # --------------------------------------------------------------------------- the run
 
@@ -252,7 +138,7 @@ def _simulate(scenario, backend, method, step, precision, progress, cancel, outp
         for run, returns in runner.scan(scan, pose, attitude).items():
             per_scan[run].append(returns)
 
-    _check(cancel)
+    check_cancelled(cancel, NOTHING_WRITTEN)
     tick = time.perf_counter()
     scene_output = fuse_scans(per_scan["scene"])
     target_output = fuse_scans(per_scan["target"])
@@ -276,7 +162,7 @@ def _simulate(scenario, backend, method, step, precision, progress, cancel, outp
 
     outputs = {}
     if output_set is not None:
-        _check(cancel)
+        check_cancelled(cancel, NOTHING_WRITTEN)
         tick = time.perf_counter()
         outputs = _write_outputs(output_set, scene_output, target_output, measures, scene.voxel_size, cancel)
         timings["write"] = time.perf_counter() - tick
@@ -337,7 +223,7 @@ class _ScanRunner:
         kept = {run: [] for run in RUNS}
         row = 0
         while row < sensor.grid:
-            _check(self.cancel)
+            check_cancelled(self.cancel, NOTHING_WRITTEN)
             # Whole detector rows, so that the depth rule can run on each chunk.
             stop = min(sensor.grid, row + max(1, self.chunk // self.rays_per_row))
             tick = time.perf_counter()
@@ -345,7 +231,7 @@ class _ScanRunner:
             timings["rays"] += time.perf_counter() - tick
             slowest = 0.0
             for run in RUNS:
-                _check(self.cancel)
+                check_cancelled(self.cancel, NOTHING_WRITTEN)
                 tick = time.perf_counter()
                 hits = self._trace(
                     self.occupancies[run],
@@ -388,11 +274,6 @@ class _ScanRunner:
                     run, scan, self.scans, self.done, self.rays_total, self.done / self.rays_total, returns
                 )
             )
-
-
-def _check(cancel):
-    if cancel is not None and cancel.is_set():
-        raise Cancelled(NOTHING_WRITTEN)
 
 
 def _trace_settings(scenario, backend, method, step, precision) -> dict:

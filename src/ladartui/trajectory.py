@@ -208,7 +208,8 @@ class LogSegment:
     relative: ClassVar[bool] = False
 
     def __post_init__(self):
-        from ladartui.flight import MAX_SCANS, number_field, point_field
+        from ladartui.checks import number_field, point_field
+        from ladartui.flight import MAX_SCANS
 
         set_ = partial(object.__setattr__, self)
         if not isinstance(self.file, (str, Path)) or not str(self.file).strip():

@@ -15,7 +15,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from ladartui.render.colour import (  # noqa: F401  (the palette, named here too)
+from ladartui.colour import (  # noqa: F401  (the palette, named here too)
     BACKGROUND,
     FOOTPRINT_RGB,
     GREY_LEVELS,

@@ -23,6 +23,7 @@ import numpy as np
 
 from ladartui.atomic import atomic_path
 from ladartui.errors import BackendUnavailable
+from ladartui.tracing.backend import METHODS
 
 DEPRESSIONS = (45.0, 90.0)
 SLANT_RANGE_M = 85.0  # aircraft distance from the aimed target (the default orbit's minimum)
@@ -247,7 +248,7 @@ def run_bench(quick=False, runs=None) -> dict:
                 backends[name] = get_backend(name)
             except BackendUnavailable:
                 continue
-    for method in ("exact", "march"):
+    for method in METHODS:
         for (view, depression), (origins, directions) in rays.items():
             if view == "narrow" and method == "march":
                 continue  # thousands of samples a ray from that height: minutes, not a bench

@@ -105,13 +105,13 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
 def _count_inside(target, voxels) -> int:
     import numpy as np
 
-    from ladartui.scene.voxels import voxel_keys
+    from ladartui.errors import FieldError
+    from ladartui.scene.keys import voxel_keys
 
-    both = np.concatenate([voxels, target])
-    shape = both.max(axis=0).astype(np.int64) + 1
-    scene_keys = voxel_keys(voxels, shape)
-    target_keys = voxel_keys(target, shape)
-    if scene_keys is None:  # indices too large to pack: compare rows
+    try:
+        scene_keys = voxel_keys(voxels)
+        target_keys = voxel_keys(target)
+    except FieldError:  # indices too large to pack: compare rows
         scene_rows = set(map(tuple, voxels.tolist()))
         return sum(1 for row in map(tuple, target.tolist()) if row in scene_rows)
     return int(np.isin(target_keys, scene_keys).sum())

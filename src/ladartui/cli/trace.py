@@ -13,6 +13,7 @@ import numpy as np
 
 from ladartui.atomic import atomic_path
 from ladartui.errors import FieldError, InputFileError
+from ladartui.tracing.backend import METHODS, PRECISIONS
 
 
 def add_parser(subparsers):
@@ -27,13 +28,13 @@ def add_parser(subparsers):
     parser.add_argument("--rays", required=True, metavar="RAYS.npy", help="(N, 6) float array")
     parser.add_argument("--out", required=True, metavar="HITS.npy", help="output (N, 5) float64")
     parser.add_argument("--backend", default="auto", help="backend name or 'auto' (default)")
-    parser.add_argument("--method", default="exact", help="exact (default) or march")
+    parser.add_argument("--method", default=METHODS[0], help=" or ".join(METHODS) + " (default: exact)")
     parser.add_argument("--step", type=float, default=None, help="march step in voxels (0.5)")
     parser.add_argument("--voxel-size", type=float, default=1.0, help="metres per voxel (1.0)")
     parser.add_argument(
         "--precision",
-        default="f64",
-        choices=("f64", "f32"),
+        default=PRECISIONS[0],
+        choices=PRECISIONS,
         help="arithmetic of the trace: f64 (default) or f32, as in the API; "
         "a backend without f32 kernels traces in f64 and says so",
     )

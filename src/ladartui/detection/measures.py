@@ -20,7 +20,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from ladartui.measures import voxel_keys
+from ladartui.scene.keys import voxel_keys
 
 # (.cmf key, attribute, kind) in the [geiger detection] section.
 CMF_SECTION = "geiger detection"

@@ -20,9 +20,9 @@ import numpy as np
 
 from ladartui.detection.scan import BYTES_PER_HELD_RAY, check_memory, declare_look, prepare_look
 from ladartui.detection.settings import DetectionSettings
-from ladartui.errors import Cancelled
-from ladartui.measures import voxel_keys
-from ladartui.simulation import kept_returns
+from ladartui.errors import check_cancelled
+from ladartui.returns import kept_returns
+from ladartui.scene.keys import voxel_keys
 
 # Kept for callers of the first version: the settings are the [detection] section's.
 GeigerSettings = DetectionSettings
@@ -52,11 +52,6 @@ class PulseProgress:
     # per 10), for one overall bar.
     units_done: float
     units_total: float
-
-
-def _check(cancel):
-    if cancel is not None and cancel.is_set():
-        raise Cancelled("pulse study cancelled; nothing was written")
 
 
 def pulse_study(
@@ -101,7 +96,7 @@ def pulse_study(
 
     looks, ideal = [], []
     for scan, pose in enumerate(poses):
-        _check(cancel)
+        check_cancelled(cancel, "pulse study cancelled; nothing was written")
         origins, directions, detector = sensor.rays(pose, attitude=attitudes[scan])
         hits = trace(
             scene.occupancy,
@@ -127,7 +122,7 @@ def pulse_study(
         k = settings.threshold(pulses)
         declared_keys, points, false_alarms, target_ideal, target_declared = [], 0, 0, 0, 0
         for scan, look in enumerate(looks):
-            _check(cancel)
+            check_cancelled(cancel, "pulse study cancelled; nothing was written")
             outcome = declare_look(look, settings, sensor, pulses, k, scan_key=scan)
             points += outcome.declared_points
             false_alarms += outcome.false_alarms

@@ -18,7 +18,8 @@ import numpy as np
 from ladartui.detection.geiger import noise_per_bin
 from ladartui.detection.look import geiger_look, incidence_cosines
 from ladartui.errors import LadarError
-from ladartui.measures import voxel_keys
+from ladartui.returns import unique_voxels
+from ladartui.scene.keys import voxel_keys
 
 VOXEL = 1
 GROUND = 2
@@ -183,8 +184,6 @@ class GeigerRun:
     def finish_scan(self, run: str, scan: int) -> np.ndarray:
         """The declared voxels of ``run``'s scan ``scan`` (1-based), unique (K, 3)."""
         from types import SimpleNamespace
-
-        from ladartui.simulation import unique_voxels
 
         chunks, self.chunks[run] = self.chunks[run], []
         offsets = np.cumsum([0] + [c[2].shape[0] for c in chunks[:-1]])

@@ -28,8 +28,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields
 
+from ladartui.checks import choice_field, integer_field, number_field
 from ladartui.errors import FieldError
-from ladartui.flight import choice_field, integer_field, number_field
 
 MODELS = ("ideal", "geiger")
 MAX_PULSES = 100_000

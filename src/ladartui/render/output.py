@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ladartui.render import colour
+from ladartui import colour
 from ladartui.render.raster import Layer
 
 COLOUR_MODES = ("class", "height", "scans")

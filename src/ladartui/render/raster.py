@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ladartui.render import colour
+from ladartui import colour
 from ladartui.views import Camera, Picture, draw_points, draw_polyline, project_float
 
 MAX_SPLAT_SAMPLES = 6_000_000  # pixel writes per render; squares shrink beyond it

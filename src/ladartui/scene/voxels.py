@@ -391,22 +391,11 @@ def _first_occurrences(keys, bits):
     return keep
 
 
-def voxel_keys(voxels: np.ndarray, shape=None) -> np.ndarray | None:
-    """One int64 per voxel, ``(x * ny + y) * nz + z`` over ``shape`` (default max + 1).
-
-    None when the packed key would not fit in 63 bits.
-    """
-    voxels = np.asarray(voxels)
-    if shape is None:
-        shape = _column_max(voxels) + 1 if len(voxels) else (1, 1, 1)
-    nx, ny, nz = (int(s) for s in shape)
-    if nx * ny * nz >= 2**63:
-        return None
-    return _pack_keys(np.ascontiguousarray(voxels), ny, nz)
-
-
 def _numpy_keys(voxels: np.ndarray) -> np.ndarray | None:
-    """``voxel_keys`` in plain numpy (no kernel to load for a file read at start-up)."""
+    """One int64 per row, ``(x * ny + y) * nz + z`` over the rows' own extent; None past 63 bits.
+
+    Spans every index a file may hold (``scene.keys`` covers those of a scene in memory).
+    """
     nx, ny, nz = (int(s) for s in _column_max(voxels) + 1)
     if nx * ny * nz >= 2**63:
         return None
@@ -415,14 +404,6 @@ def _numpy_keys(voxels: np.ndarray) -> np.ndarray | None:
 
 def _column_max(voxels: np.ndarray) -> np.ndarray:
     return np.array([voxels[:, axis].max() for axis in range(3)], dtype=np.int64)
-
-
-@_kernel
-def _pack_keys(voxels, ny, nz):
-    keys = np.empty(voxels.shape[0], dtype=np.int64)
-    for i in range(voxels.shape[0]):
-        keys[i] = (np.int64(voxels[i, 0]) * ny + voxels[i, 1]) * nz + voxels[i, 2]
-    return keys
 
 
 def save_voxels(path, voxels) -> None:

@@ -1,8 +1,6 @@
 // One-axis cell arithmetic shared by the shaders (tracing/axis.py, the same
-// functions under the same names). INF stands for +inf: WGSL has no infinity
-// literal, and no ray parameter comes near 1e30.
-
-const INF: real = 1e30;
+// functions under the same names). INF (from the header, tracing/config.py's
+// SHADER_INF) stands for +inf: WGSL has no infinity literal.
 
 struct Span {
     enter: real,

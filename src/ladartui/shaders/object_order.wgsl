@@ -15,7 +15,8 @@
 // coordinates as float32, exact below 2^24; so in f64 the answers are numba's
 // bit for bit (tests/test_wgpu_object_order.py).
 //
-// tracing/wgpu_backend.py prepends `alias real = f64;` and shaders/axis.wgsl.
+// tracing/wgpu_backend.py prepends the header of tracing/config.py (wgsl_constants:
+// `alias real = f64;`, INF, BUNDLE, ...) and shaders/axis.wgsl.
 // Loop budget (see trace.wgsl): the host sends no tile list of 65,535 voxels or more.
 
 struct TileParams {
@@ -35,11 +36,11 @@ struct TileParams {
 @group(0) @binding(7) var<storage, read> listed: array<u32>;        // voxel numbers, tile by tile
 
 // numba: test_tiles (tracing/object_order.py)
-@compute @workgroup_size(64)
+@compute @workgroup_size(BUNDLE)
 fn test_tiles(@builtin(workgroup_id) group: vec3<u32>,
               @builtin(num_workgroups) groups: vec3<u32>,
               @builtin(local_invocation_index) lane: u32) {
-    let s = (group.y * groups.x + group.x) * 64u + lane;
+    let s = (group.y * groups.x + group.x) * BUNDLE + lane;
     if (s >= params.rays) {
         return;
     }

@@ -9,8 +9,10 @@
 //
 // Cell space: voxel (i, j, k) spans [i, i+1) on each axis, ground at c_z = 0.
 // tracing/wgpu_backend.py prepends a header declaring `alias real = f64;`
-// (or f32), the occupancy bindings, read through `fn occ(word) -> u32`, and
-// shaders/axis.wgsl (boundary_t, cell_at, slab, INF):
+// (or f32) and the constants shared with the host (tracing/config.py,
+// wgsl_constants: hit kinds, INF, BUNDLE, method codes), the occupancy
+// bindings, read through `fn occ(word) -> u32`, and shaders/axis.wgsl
+// (boundary_t, cell_at, slab):
 // one logical u32 array [root | regions | tiles | bricks | columns | cubes] that
 // may be split over several storage bindings; cubes holds the four octants'
 // u8 sides of one brick cell in one word (byte `octant`).
@@ -41,13 +43,10 @@ struct Params {
 @group(0) @binding(1) var<storage, read> rays: array<real>;             // ox oy oz dx dy dz per ray
 @group(0) @binding(2) var<storage, read_write> hits: array<vec4<i32>>;  // kind, i, j, k
 @group(0) @binding(3) var<storage, read_write> ranges: array<real>;     // t of the hit
-@group(0) @binding(4) var<storage, read> starts: array<real>;           // bundle start per 64 rays
+@group(0) @binding(4) var<storage, read> starts: array<real>;           // bundle start per BUNDLE rays
 
-const MISS: i32 = 0;
-const VOXEL: i32 = 1;
-const GROUND: i32 = 2;
-const UNFINISHED: i32 = 3;  // march: no answer within this pass's samples
-const CUT: i32 = 4;         // a loop was ended by the adapter, not by the ray
+// MISS, VOXEL, GROUND; UNFINISHED (march: no answer within this pass's samples);
+// CUT (a loop was ended by the adapter, not by the ray): from the header.
 
 struct Hit {
     kind: i32,
@@ -140,7 +139,7 @@ fn first_voxel(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real, start
     let lo = params.bbox_lo;
     let hi = params.bbox_hi;
     // Step 2: clip to the occupied box, from the bundle start on (step 0, computed
-    // on the host by tracing/bundle.py for each 64 rays: `starts`).
+    // on the host by tracing/bundle.py for each BUNDLE rays: `starts`).
     let span_x = slab(ox, dx, ix, real(lo.x), real(hi.x));
     let span_y = slab(oy, dy, iy, real(lo.y), real(hi.y));
     let span_z = slab(oz, dz, iz, real(lo.z), real(hi.z));
@@ -383,7 +382,7 @@ fn first_voxel(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real, start
     return none;
 }
 
-// The ground rule for a ray that hit no voxel (numba: _ground).
+// The ground rule for a ray that hit no voxel (numba: ray_answer).
 fn ground(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hit {
     let nx = real(params.shape.x);
     let ny = real(params.shape.y);
@@ -485,11 +484,11 @@ fn march_one(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hit 
 }
 
 // numba: _exact_kernel and _march_kernel, one invocation per ray.
-@compute @workgroup_size(64)
+@compute @workgroup_size(BUNDLE)
 fn trace_rays(@builtin(workgroup_id) group: vec3<u32>,
               @builtin(num_workgroups) groups: vec3<u32>,
               @builtin(local_invocation_index) lane: u32) {
-    let r = (group.y * groups.x + group.x) * 64u + lane;
+    let r = (group.y * groups.x + group.x) * BUNDLE + lane;
     if (r >= u32(params.run.x)) {
         return;
     }
@@ -501,8 +500,8 @@ fn trace_rays(@builtin(workgroup_id) group: vec3<u32>,
     let dy = rays[b + 4u];
     let dz = rays[b + 5u];
     var hit: Hit;
-    if (params.run.y == 0) {
-        hit = first_voxel(ox, oy, oz, dx, dy, dz, starts[r / 64u]);
+    if (params.run.y == METHOD_EXACT) {
+        hit = first_voxel(ox, oy, oz, dx, dy, dz, starts[r / BUNDLE]);
         if (hit.kind == MISS) {  // not CUT: that ray's voxels were not all seen
             hit = ground(ox, oy, oz, dx, dy, dz);
         }

@@ -10,13 +10,16 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ladartui.atomic import write_text_atomic
-from ladartui.pareto import dominator, pareto_front
+from ladartui.pareto import Sense, dominator, pareto_front
 from ladartui.study.misses import CLASSES, MissSummary
 from ladartui.study.settings import Setting
 from ladartui.study.timing import Timing
 
 OK, SKIPPED, FAILED = "ok", "skipped", "failed"
 OBJECTIVES = ("seconds per scan", "|obscured coverage error|", "share of first hits that differ")
+
+# The study's objectives (StudyRow.objectives): less of each is better.
+OBJECTIVE_SENSE: tuple[Sense, ...] = ("min", "min", "min")
 
 
 @dataclass
@@ -55,7 +58,7 @@ class StudyRow:
         return self.misses.share
 
     def objectives(self) -> tuple | None:
-        """(seconds per scan, |coverage error|, share differing): all to be minimised."""
+        """(seconds per scan, |coverage error|, share differing): OBJECTIVE_SENSE, all minimised."""
         if self.status != OK:
             return None
         values = (self.seconds_per_scan, _abs(self.coverage_error), self.hit_differs)
@@ -124,19 +127,16 @@ class StudyResult:
     reference_coverage: float | None = None
     notes: list[str] = field(default_factory=list)
 
-    def ok_rows(self) -> list[StudyRow]:
-        return [row for row in self.rows if row.status == OK]
-
     def finish(self) -> None:
         """Coverage errors against the converged reference, then the Pareto front."""
         for row in self.rows:
             if row.coverage is not None and self.reference_coverage is not None:
                 row.coverage_error = row.coverage - self.reference_coverage
         points = [row.objectives() for row in self.rows]
-        front = pareto_front(points)
+        front = pareto_front(points, OBJECTIVE_SENSE)
         for i, row in enumerate(self.rows):
             row.front = front[i]
-            j = dominator(points, i)
+            j = dominator(points, i, OBJECTIVE_SENSE)
             row.dominated_by = self.rows[j].label if j is not None else None
 
     def front_rows(self) -> list[StudyRow]:

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ladartui.errors import BackendUnavailable, Cancelled, LadarError
+from ladartui.errors import BackendUnavailable, Cancelled, LadarError, check_cancelled
 from ladartui.study.inputs import StudyInputs, with_ray_grid
 from ladartui.study.misses import summarise, voxel_geometry
 from ladartui.study.results import FAILED, SKIPPED, StudyResult, StudyRow
@@ -113,7 +113,7 @@ def run_study(
         sensor = with_ray_grid(inputs.sensor, m)
         grid_settings = [s for s in active if s.ray_grid == m]
         for scan, pose in enumerate(poses):
-            _check(cancel)
+            check_cancelled(cancel, "study cancelled")
             origins, directions, detector = sensor.rays(pose)
             cells = origins / scene.voxel_size + 0.5
             exact = None
@@ -128,12 +128,12 @@ def run_study(
                     if scan == 0:
                         # Warm-up: compile and upload on a slice of the scan's rays.
                         for _ in range(warmup):
-                            _check(cancel)
+                            check_cancelled(cancel, "study cancelled")
                             _trace(scene, origins[:WARMUP_RAYS], directions[:WARMUP_RAYS], s, cancel)
                             done += 1
                     repeats = 1 + (extra if scan == 0 else 0)
                     for call in range(repeats):
-                        _check(cancel)
+                        check_cancelled(cancel, "study cancelled")
                         if progress is not None:
                             progress(StudyProgress(done, total, s.label, scan + 1, len(poses)))
                         hits, seconds = timed(
@@ -202,7 +202,7 @@ def _trace(scene, origins, directions, setting: Setting, cancel):
 
     parts = []
     for start in range(0, len(origins), CHUNK_RAYS):
-        _check(cancel)
+        check_cancelled(cancel, "study cancelled")
         stop = start + CHUNK_RAYS
         parts.append(
             trace(
@@ -227,22 +227,17 @@ def _trace(scene, origins, directions, setting: Setting, cancel):
 
 
 def _scan_returns(hits, detector, depth_resolution) -> np.ndarray:
-    from ladartui.simulation import scan_returns
+    from ladartui.returns import scan_returns
 
     return scan_returns(hits, detector, depth_resolution)
 
 
 def _coverage(scene, per_scan) -> float | None:
     from ladartui.measures import compute_measures
-    from ladartui.simulation import fuse_scans
+    from ladartui.returns import fuse_scans
 
     fused = fuse_scans(per_scan)
     return compute_measures(scene.target, fused, None).obscured_coverage
-
-
-def _check(cancel):
-    if cancel is not None and cancel.is_set():
-        raise Cancelled("study cancelled")
 
 
 def _context(inputs: StudyInputs, runs, warmup, reasons) -> dict:
@@ -266,8 +261,8 @@ def write_outputs(
     """Write the CSV, JSON, plotted chart (SVG, PNG) and plain-text chart atomically into ``out_dir``."""
     from ladartui.atomic import write_text_atomic
     from ladartui.charts import save_figure
-    from ladartui.charts.speed_accuracy import speed_accuracy_figure
     from ladartui.study.chart import chart_text
+    from ladartui.study.figure import speed_accuracy_figure
 
     paths = result.write(out_dir, stem)
     out_dir = Path(out_dir)

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass
 
+from ladartui.tracing.backend import PRECISIONS
+
 MARCH_STEPS = (1.0, 0.5, 0.25, 0.1)
 RAY_GRIDS = (1, 2, 4, 8)
 QUICK_RAY_GRIDS = (1, 2)
@@ -56,7 +58,7 @@ def reference_setting(ray_grid: int) -> Setting:
     return Setting("numba", "exact", "f64", None, ray_grid)
 
 
-def tracer_settings(steps=MARCH_STEPS, exact_wgpu=("f64", "f32"), march_backends=("numba", "wgpu")):
+def tracer_settings(steps=MARCH_STEPS, exact_wgpu=PRECISIONS, march_backends=("numba", "wgpu")):
     """Tracer configurations (ray grid 1): exact numba, exact wgpu per precision, march per step.
 
     The numba backend computes in float64 only. The wgpu march runs in float32,

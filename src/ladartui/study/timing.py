@@ -8,7 +8,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from ladartui.errors import Cancelled
+from ladartui.errors import check_cancelled
 
 
 @dataclass
@@ -53,16 +53,11 @@ def measure(
         raise ValueError("runs must be at least 1")
     result = None
     for _ in range(warmup):
-        _check(cancel)
+        check_cancelled(cancel, "study cancelled")
         result = call()
     timing = Timing()
     for _ in range(runs):
-        _check(cancel)
+        check_cancelled(cancel, "study cancelled")
         result, seconds = timed(call, clock)
         timing.add(seconds)
     return result, timing
-
-
-def _check(cancel):
-    if cancel is not None and cancel.is_set():
-        raise Cancelled("study cancelled")

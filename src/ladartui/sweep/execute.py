@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ladartui.atomic import atomic_path
-from ladartui.errors import Cancelled, FieldError, InputFileError, LadarError
+from ladartui.errors import FieldError, InputFileError, LadarError, check_cancelled
 from ladartui.sweep.ranking import (
     BUDGET_OBJECTIVES,
     COSTS,
@@ -321,8 +321,7 @@ def _run_locked(
 
 def _run_serial(todo, base, digest, scene, options, record, cancel):
     for variant in todo:
-        if cancel is not None and cancel.is_set():
-            raise Cancelled("sweep cancelled")
+        check_cancelled(cancel, "sweep cancelled")
         run_options = dict(options)
         if cancel is not None:
             run_options["cancel"] = cancel
@@ -362,8 +361,7 @@ def _run_on_dask(client, todo, base, digest, scene, options, record, cancel):
             pending[future] = variant
         completed = as_completed(list(pending))
         while pending:
-            if cancel is not None and cancel.is_set():
-                raise Cancelled("sweep cancelled")
+            check_cancelled(cancel, "sweep cancelled")
             batch = completed.next_batch(block=False)
             if not batch:
                 time.sleep(_POLL_SECONDS)
@@ -371,8 +369,7 @@ def _run_on_dask(client, todo, base, digest, scene, options, record, cancel):
             for future in batch:
                 # A batch may hold many finished variants: honour a cancel set
                 # while recording them (they run again on resume).
-                if cancel is not None and cancel.is_set():
-                    raise Cancelled("sweep cancelled")
+                check_cancelled(cancel, "sweep cancelled")
                 variant = pending.pop(future)
                 if future.status == "finished":
                     row = future.result()

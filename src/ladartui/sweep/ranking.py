@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 from ladartui.errors import FieldError
 from ladartui.levels import LEVELS as LEVEL_NAMES
-from ladartui.pareto import pareto_front as front_of_minima
+from ladartui.pareto import Sense, pareto_front
 
 # Column of the measure every objective is built on: the share of target
 # voxels seen through the foliage over the whole flight.
@@ -205,18 +205,8 @@ def _tie_break(row: dict, objective: str, budget) -> float:
     return 0.0
 
 
-def pareto_front(points) -> list[bool]:
-    """For (cost, coverage) pairs, whether each is on the front (less cost, more coverage).
-
-    A point is dominated when another has cost <= and coverage >= with one of
-    them strict; equal points do not dominate each other. None pairs, and pairs
-    holding a None or NaN, are off the front (the rule of ladartui.pareto).
-    """
-    return front_of_minima([None if p is None else (p[0], _negated(p[1])) for p in points])
-
-
-def _negated(value):
-    return None if value is None else -value
+# (cost, coverage): less cost and more coverage are better (ladartui.pareto).
+COST_COVERAGE: tuple[Sense, Sense] = ("min", "max")
 
 
 def rank_rows(rows, objective="obscured-coverage", budget=None, cost="flight-time") -> list[Ranked]:
@@ -234,7 +224,9 @@ def rank_rows(rows, objective="obscured-coverage", budget=None, cost="flight-tim
         entries.append(
             Ranked(row, objective_value(row, objective, budget), None, False, cost_value, coverage)
         )
-    flags = pareto_front([(e.cost, e.coverage) if e.cost is not None else None for e in entries])
+    flags = pareto_front(
+        [(e.cost, e.coverage) if e.cost is not None else None for e in entries], COST_COVERAGE
+    )
     for entry, flag in zip(entries, flags):
         entry.pareto = flag
 

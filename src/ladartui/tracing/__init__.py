@@ -15,7 +15,17 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ladartui.errors import BackendUnavailable, FieldError
-from ladartui.tracing.backend import GROUND, METHODS, MISS, VOXEL, backend_names, backend_status, get_backend
+from ladartui.tracing.backend import (
+    GROUND,
+    METHODS,
+    MISS,
+    PRECISIONS,
+    VOXEL,
+    backend_names,
+    backend_status,
+    get_backend,
+)
+from ladartui.tracing.config import DEFAULT_STEP
 
 __all__ = [
     "trace",
@@ -31,7 +41,6 @@ __all__ = [
     "get_backend",
 ]
 
-DEFAULT_STEP = 0.5
 TINY = 1e-200
 
 
@@ -106,8 +115,8 @@ def trace(
         step = DEFAULT_STEP
     if not (isinstance(step, (int, float, np.floating, np.integer)) and np.isfinite(step) and step > 0):
         raise FieldError("step", step, "a positive number of voxels")
-    if precision not in ("f32", "f64"):
-        raise FieldError("precision", precision, "f32 or f64")
+    if precision not in PRECISIONS:
+        raise FieldError("precision", precision, " or ".join(PRECISIONS))
     name = choose_backend() if backend in (None, "auto") else backend
     engine = get_backend(name)
     # Unit directions with components below TINY set to 0 (keeps 1 / d finite;
@@ -115,11 +124,6 @@ def trace(
     from ladartui.tracing.prepare import rays_to_cells  # numba: loaded on first trace
 
     origin_cells, unit = rays_to_cells(origins, directions, voxel_size, TINY)
-    if origin_cells is None:
-        what, bad = unit
-        if what == "zero":
-            raise FieldError(f"directions[{bad}]", directions[bad].tolist(), "a non-zero vector")
-        raise FieldError(what, "non-finite values", "finite numbers")
     started = time.perf_counter()
     cells = engine.trace_cells(
         occupancy, origin_cells, unit, method=method, step=float(step), precision=precision, cancel=cancel

@@ -2,7 +2,7 @@
 
 Every boundary parameter comes from one formula, ``boundary_t``, so cells
 and ties agree wherever they are computed. The WGSL shader has the same
-functions under the same names (shaders/trace.wgsl).
+functions under the same names (shaders/axis.wgsl).
 """
 
 import math
@@ -10,7 +10,7 @@ import math
 import numpy as np
 from numba import njit
 
-INF = np.inf
+from ladartui.tracing.config import INF
 
 
 @njit(nogil=True, cache=True, inline="always")

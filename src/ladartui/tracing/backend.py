@@ -11,14 +11,28 @@ from __future__ import annotations
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Protocol
+from typing import Literal, Protocol
 
 import numpy as np
 
 from ladartui.errors import BackendUnavailable, FieldError
+from ladartui.tracing.config import GROUND, MISS, VOXEL  # noqa: F401  (the kinds of CellHits)
 
-MISS, VOXEL, GROUND = 0, 1, 2
-METHODS = ("exact", "march")
+METHODS = ("exact", "march")  # the exact traversal; the report's fixed-step march
+PRECISIONS = ("f64", "f32")  # float64 everywhere; float32 on adapters without shader-f64
+# Which order exact scans go in: "auto" lets each block go the way that has been
+# faster on this occupancy (object_order.OrderChoice), "object" takes object order
+# wherever it applies whatever it costs, "ray" never. The march and f32 always go
+# in ray order.
+TraceOrder = Literal["auto", "object", "ray"]
+ORDERS: tuple[TraceOrder, ...] = ("auto", "object", "ray")
+
+
+def check_order(order: str) -> TraceOrder:
+    """``order`` if it is one of ORDERS, else FieldError."""
+    if order not in ORDERS:
+        raise FieldError("order", order, "one of " + ", ".join(ORDERS))
+    return order
 
 
 @dataclass
@@ -51,8 +65,9 @@ class Backend(Protocol):
         step=0.5,
         precision="f64",
         cancel: threading.Event | None = None,
+        order: TraceOrder = "auto",
     ) -> CellHits:
-        """Trace (N, 3) float64 cell-space origins and unit directions."""
+        """Trace (N, 3) float64 cell-space origins and unit directions (``order``: ORDERS)."""
 
 
 _FACTORIES: dict[str, Callable[[], Backend]] = {}

@@ -33,11 +33,7 @@ import numpy as np
 from numba import njit, prange
 
 from ladartui.tracing.axis import slab
-
-BUNDLE_REACH = 7.0  # voxels: under one brick (8), one voxel of slack for rounding
-FINE_REACH = 3.0  # the same over ``Occupancy.halo4`` (4-voxel cells)
-FAR = 1e12  # cells: beyond this the one-voxel margins drown in rounding, so no bundle start
-INF = np.inf
+from ladartui.tracing.config import BUNDLE_REACH, FAR, FINE_REACH, INF
 
 
 @njit(nogil=True, cache=True)

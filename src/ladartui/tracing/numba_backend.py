@@ -17,16 +17,14 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-from ladartui.errors import Cancelled
+from ladartui.errors import check_cancelled
 from ladartui.scene.occupancy import block_masks
+from ladartui.tracing.answers import ray_answer, scan_answers
 from ladartui.tracing.axis import boundary_t, cell_at, clamp, slab
-from ladartui.tracing.backend import GROUND, MISS, VOXEL, CellHits, register_backend
+from ladartui.tracing.backend import GROUND, MISS, VOXEL, CellHits, TraceOrder, check_order, register_backend
 from ladartui.tracing.bundle import bundle_start, halo_arrays
+from ladartui.tracing.config import BLOCK, BUNDLE, INF
 from ladartui.tracing.object_order import OrderChoice, cone_frame, nearest_voxels, trace_in_blocks
-
-CHUNK = 64  # rays per prange work item: coherent neighbours stay on one thread
-BLOCK = 1 << 16  # rays per kernel call: cancel is checked between calls
-INF = np.inf
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -62,20 +60,6 @@ def _enter(c, b, stepped, positive, s, o, d, inv, t):
 def _brick_entry(b, stepped, positive, o, d, inv, t):
     """Cell on one axis on entering brick ``b`` at ``t`` after a brick step."""
     return _enter(b << 3, (b << 3) if positive else ((b + 1) << 3), stepped, positive, 3, o, d, inv, t)
-
-
-@njit(nogil=True, cache=True, inline="always")
-def _answer(found, i, j, k, t, ox, oy, oz, dx, dy, dz, nx, ny):
-    """(kind, i, j, k, t) of a ray: the voxel it hit, else the ground rule."""
-    if found:
-        return VOXEL, i, j, k, t
-    if dz < 0.0 and oz > 0.0:
-        tg = (0.0 - oz) * (1.0 / dz)
-        gx = ox + tg * dx
-        gy = oy + tg * dy
-        if 0.0 <= gx < nx and 0.0 <= gy < ny:
-            return GROUND, np.int64(math.floor(gx)), np.int64(math.floor(gy)), np.int64(0), tg
-    return MISS, np.int64(-1), np.int64(-1), np.int64(-1), INF
 
 
 @njit(parallel=True, nogil=True, cache=True)
@@ -124,13 +108,13 @@ def _exact_kernel(
     plain voxel DDA.
     """
     n = orig.shape[0]
-    chunks = (n + CHUNK - 1) // CHUNK
+    chunks = (n + BUNDLE - 1) // BUNDLE
     for ch in prange(chunks):
         # Step 0: where the chunk's rays may all start (tracing.bundle; 0 when they diverge).
         start = bundle_start(
-            orig, dirs, ch * CHUNK, min(n, (ch + 1) * CHUNK), halo, horg, hdims, halo4, h4org, h4dims
+            orig, dirs, ch * BUNDLE, min(n, (ch + 1) * BUNDLE), halo, horg, hdims, halo4, h4org, h4dims
         )
-        for r in range(ch * CHUNK, min(n, (ch + 1) * CHUNK)):
+        for r in range(ch * BUNDLE, min(n, (ch + 1) * BUNDLE)):
             ox, oy, oz = orig[r, 0], orig[r, 1], orig[r, 2]
             dx, dy, dz = dirs[r, 0], dirs[r, 1], dirs[r, 2]
             found = False
@@ -385,34 +369,9 @@ def _exact_kernel(
                     cy = _enter(cy, byn, ty == tn, py, s, oy, dy, iy, tn)
                     cz = _enter(cz, bzn, tz == tn, pz, s, oz, dz, iz, tn)
                     t = tn
-            kind[r], index[r, 0], index[r, 1], index[r, 2], tout[r] = _answer(
+            kind[r], index[r, 0], index[r, 1], index[r, 2], tout[r] = ray_answer(
                 found, cx, cy, cz, t, ox, oy, oz, dx, dy, dz, nx, ny
             )
-
-
-@njit(parallel=True, nogil=True, cache=True)
-def scan_answers(order, best_t, best_v, vox, orig, dirs, nx, ny, kind, index, tout):
-    """Object-order hits (tracing.object_order; numba or the wgpu backend's shader) back
-    in ray order, with the ground rule."""
-    for s in prange(order.shape[0]):
-        r = order[s]
-        q = best_v[s]
-        i, j, k = (vox[q, 0], vox[q, 1], vox[q, 2]) if q >= 0 else (-1, -1, -1)
-        kind[r], index[r, 0], index[r, 1], index[r, 2], tout[r] = _answer(
-            q >= 0,
-            i,
-            j,
-            k,
-            best_t[s],
-            orig[r, 0],
-            orig[r, 1],
-            orig[r, 2],
-            dirs[r, 0],
-            dirs[r, 1],
-            dirs[r, 2],
-            nx,
-            ny,
-        )
 
 
 @njit(parallel=True, nogil=True, cache=True)
@@ -421,12 +380,12 @@ def _march_kernel(
 ):
     """The report's fixed-step march (docs/architecture.md "March") for every ray."""
     n = orig.shape[0]
-    chunks = (n + CHUNK - 1) // CHUNK
+    chunks = (n + BUNDLE - 1) // BUNDLE
     top = zmax + 1.0
     # From the first sample on, every sample is inside the extent's box or ends the ray.
     limit = np.int64((math.sqrt(nx * nx + ny * ny + top * top) + 2.0) / step) + 2
     for ch in prange(chunks):
-        for r in range(ch * CHUNK, min(n, (ch + 1) * CHUNK)):
+        for r in range(ch * BUNDLE, min(n, (ch + 1) * BUNDLE)):
             ox, oy, oz = orig[r, 0], orig[r, 1], orig[r, 2]
             dx, dy, dz = dirs[r, 0], dirs[r, 1], dirs[r, 2]
             result = MISS
@@ -489,14 +448,6 @@ class NumbaBackend:
             "precision": "f64",
         }
 
-    def warm_up(self, occupancy):
-        """Compile (or load from cache) both kernels on a tiny batch."""
-        o = np.array([[0.5, 0.5, 10.0]])
-        d = np.array([[0.0, 0.0, -1.0]])
-        for method in ("exact", "march"):
-            self.trace_cells(occupancy, o, d, method=method)
-        self.trace_cells(occupancy, o, d, object_order=True)
-
     def trace_cells(
         self,
         occupancy,
@@ -508,12 +459,11 @@ class NumbaBackend:
         precision="f64",
         cancel: threading.Event | None = None,
         bundles: bool = True,
-        object_order: bool | None = None,
+        order: TraceOrder = "auto",
     ) -> CellHits:
-        """See ``Backend``. For tests: ``bundles=False`` starts every ray at its box entry;
-        ``object_order`` True traces scans in object order whatever they cost, False never
-        (None: blocks that are scans with few voxels in view go in the order that has
-        been faster for this occupancy, ``OrderChoice``)."""
+        """See ``Backend`` (``order`` there). For tests: ``bundles=False`` starts every
+        ray at its box entry."""
+        check_order(order)
         n = len(origins)
         orig = np.ascontiguousarray(origins, dtype=np.float64)
         dirs = np.ascontiguousarray(directions, dtype=np.float64)
@@ -531,8 +481,7 @@ class NumbaBackend:
 
         def ray_order(a, b):
             for c in range(a, b, BLOCK):
-                if cancel is not None and cancel.is_set():
-                    raise Cancelled("trace cancelled")
+                check_cancelled(cancel, "trace cancelled")
                 d = min(b, c + BLOCK)
                 if method == "exact":
                     _exact_kernel(
@@ -584,11 +533,11 @@ class NumbaBackend:
                 occ, orig[a:b], dirs[a:b], max_voxels, nx, ny, kind[a:b], index[a:b], t[a:b]
             )
 
-        if method == "exact" and object_order is not False and occ.count > 0:
+        if method == "exact" and order != "ray" and occ.count > 0:
             # Learned on CPU time: both orders run on this process's threads only.
             orders = trace_in_blocks(
                 n,
-                object_order,
+                order,
                 self._orders.setdefault(occ, OrderChoice()),
                 object_order_block,
                 ray_order,

@@ -44,23 +44,22 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, prange
 
-from ladartui.errors import Cancelled
+from ladartui.errors import check_cancelled
 from ladartui.tracing.axis import slab
+from ladartui.tracing.config import (
+    EPS,
+    INF,
+    MAX_SPREAD,
+    MIN_COS,
+    MIN_SCAN_RAYS,
+    NEAR_MARGIN,
+    PARTS,
+    SCAN_BLOCK,
+    TILE_SHIFT,
+    VOXELS_PER_RAY,
+)
 
-INF = np.inf
-EPS = 1e-9  # widening of projected rectangles (tangent units), far above rounding
-NEAR_MARGIN = 1e-9  # relative lowering of depth bounds, far above rounding
-TILE_SHIFT = 4  # tiles of 16 x 16 bins: rays tested together, stopped together
 TILE = 1 << TILE_SHIFT
-MAX_SPREAD = 1.0  # largest origin half-spread (cells) handled in object order
-MIN_COS = 0.5  # every ray within 60 degrees of the cone's axis
-PARTS = 64  # fixed split of the parallel passes (so sums do not depend on the threads)
-# When a backend tries object order (trace_in_blocks):
-SCAN_BLOCK = 1 << 18  # rays per object-order call (one 512 x 512 scan)
-MIN_SCAN_RAYS = 4096  # fewer rays: ray order, whose set-up is nil
-# At most this many occupied voxels in view per ray (more, and walking the rays is
-# cheaper: the measured crossover on the reference scene).
-VOXELS_PER_RAY = 0.6
 
 
 @njit(parallel=True, nogil=True, cache=True)
@@ -764,14 +763,14 @@ class OrderChoice:
             del recent[: -self.SAMPLES]
 
 
-def trace_in_blocks(n, object_order, choice, object_block, ray_block, cancel=None, clock=time.perf_counter):
+def trace_in_blocks(n, order, choice, object_block, ray_block, cancel=None, clock=time.perf_counter):
     """Trace ``n`` exact rays in blocks of up to SCAN_BLOCK, each in object or ray
     order, as both backends do; returns the set of orders used.
 
     ``object_block(a, b, max_voxels)`` traces rays a..b in object order and says
     whether it could (a scan with at most ``max_voxels`` voxels in view);
-    ``ray_block(a, b)`` traces them in ray order. ``object_order`` True tries object
-    order on every block, whatever it costs; None lets ``choice`` (this
+    ``ray_block(a, b)`` traces them in ray order. ``order`` "object" tries object
+    order on every block, whatever it costs; "auto" lets ``choice`` (this
     occupancy's OrderChoice) pick for blocks of at least MIN_SCAN_RAYS and learn
     from their times, read from ``clock``: wall time by default (a GPU's work costs
     the host nothing), the process's CPU time for a CPU backend (time.process_time:
@@ -781,12 +780,11 @@ def trace_in_blocks(n, object_order, choice, object_block, ray_block, cancel=Non
     orders = set()
     for a in range(0, n, SCAN_BLOCK):
         b = min(n, a + SCAN_BLOCK)
-        if cancel is not None and cancel.is_set():
-            raise Cancelled("trace cancelled")
-        learning = choice if object_order is None and b - a >= MIN_SCAN_RAYS else None
+        check_cancelled(cancel, "trace cancelled")
+        learning = choice if order == "auto" and b - a >= MIN_SCAN_RAYS else None
         started = clock()
-        if object_order or (learning is not None and learning.pick() == "object"):
-            limit = np.inf if object_order else VOXELS_PER_RAY * (b - a)
+        if order == "object" or (learning is not None and learning.pick() == "object"):
+            limit = np.inf if order == "object" else VOXELS_PER_RAY * (b - a)
             if object_block(a, b, limit):
                 orders.add("object")
                 if learning is not None:

@@ -11,7 +11,9 @@ import numba
 import numpy as np
 from numba import prange
 
-PARTS = 64  # fixed runs of rays for the parallel pass
+from ladartui.errors import FieldError
+from ladartui.tracing.config import PARTS
+
 # Outside (NORM_LOW, inf) the squares under- or overflow: such directions are
 # scaled by their largest component first (1e160 along x is still along x).
 NORM_LOW = 1e-150
@@ -70,10 +72,9 @@ def _rays_to_cells(origins, directions, voxel_size, tiny, cells, unit):
 
 
 def rays_to_cells(origins, directions, voxel_size, tiny):
-    """(cells, unit) for (N, 3) float64 arrays, or (None, (what, ray)) for the first bad ray.
-
-    ``what`` is "origins", "directions" (a non-finite value) or "zero" (a
-    zero-length direction).
+    """(cells, unit) for (N, 3) float64 arrays; FieldError naming the first bad ray:
+    ``origins[i]`` or ``directions[i]`` with a non-finite value, ``directions[i]``
+    of zero length.
     """
     n = len(origins)
     cells = np.empty((n, 3))
@@ -85,7 +86,8 @@ def rays_to_cells(origins, directions, voxel_size, tiny):
     if first == n:
         return cells, unit
     if first < 0:
-        return None, ("origins", -1 - first)
+        raise FieldError(f"origins[{-1 - first}]", origins[-1 - first].tolist(), "finite numbers")
     if first < n:
-        return None, ("directions", first)
-    return None, ("zero", first - n - 1)
+        raise FieldError(f"directions[{first}]", directions[first].tolist(), "finite numbers")
+    zero = first - n - 1
+    raise FieldError(f"directions[{zero}]", directions[zero].tolist(), "a non-zero vector")

@@ -51,10 +51,33 @@ import weakref
 
 import numpy as np
 
-from ladartui.errors import BackendUnavailable, Cancelled, FieldError
-from ladartui.tracing.backend import GROUND, METHODS, MISS, VOXEL, CellHits, register_backend
+from ladartui.errors import BackendUnavailable, FieldError, check_cancelled
+from ladartui.tracing.answers import scan_answers
+from ladartui.tracing.backend import (
+    GROUND,
+    METHODS,
+    MISS,
+    PRECISIONS,
+    VOXEL,
+    CellHits,
+    TraceOrder,
+    check_order,
+    register_backend,
+)
 from ladartui.tracing.bundle import bundle_starts, halo_arrays
-from ladartui.tracing.numba_backend import scan_answers
+from ladartui.tracing.config import (
+    BUNDLE,
+    CUT,
+    LOOP_BUDGET,
+    MARCH_SAMPLES_PER_PASS,
+    MAX_OCCUPANCY_BINDINGS,
+    METHOD_CODES,
+    OBJECT_ORDER_TILE_SHIFT,
+    RAY_BATCH,
+    SHADER_INF,
+    UNFINISHED,
+    wgsl_constants,
+)
 from ladartui.tracing.object_order import (
     OrderChoice,
     cone_frame,
@@ -69,30 +92,12 @@ INSTALL_HINT = (
     "no Vulkan, Metal or D3D12 adapter found: install Debian's mesa-vulkan-drivers (lavapipe) or a GPU driver"
 )
 
-WORKGROUP_SIZE = 64  # must equal @workgroup_size in trace.wgsl
-RAY_BATCH = 1 << 20  # rays per dispatch: bounds host and device memory
-METHOD_CODES = {"exact": 0, "march": 1}
 ADAPTER_TYPE_RANK = {"DiscreteGPU": 0, "IntegratedGPU": 1, "VirtualGPU": 2, "CPU": 3}
 # OpenGL adapters lack shader-f64 and large storage buffers; prefer the rest.
 GRAPHICS_BACKEND_RANK = {"Vulkan": 0, "Metal": 0, "D3D12": 0, "OpenGL": 1}
 # Bindings besides the occupancy chunks: params, rays, hit cells, hit ranges, bundle starts.
 FIXED_BINDINGS = 5
-# Ask for no more than this many occupancy bindings (16 GiB at 128 MiB each).
-MAX_OCCUPANCY_BINDINGS = 128
-SHADER_INF = 1e30  # trace.wgsl's INF
-# Shader-only hit kinds (trace.wgsl): a march pass ended without an answer, and
-# a loop ended by the adapter's iteration guard rather than by the ray.
-UNFINISHED = 3
-CUT = 4
-# Samples a ray per march pass: well under lavapipe's 65,535 loop iterations
-# per invocation, all loops together.
-MARCH_SAMPLES_PER_PASS = 1 << 15
-# Object order (shaders/object_order.wgsl): tiles of 2 x 2 bins. Small tiles keep each
-# ray's list short; the shader pays for every entry a ray walks past.
-OBJECT_ORDER_TILE_SHIFT = 1
 F32_EXACT = 1 << 24  # integers below this are exact in float32
-# Longest tile list an invocation may walk: under lavapipe's 65,535 loop iterations.
-LOOP_BUDGET = 65_000
 
 
 def choose_adapter(adapters):
@@ -343,9 +348,9 @@ class WgpuBackend:
                 "graphics_backend": info.get("backend_type", ""),
                 "driver": info.get("description", ""),
                 "f64": self._has_f64,
-                "precisions": ["f64", "f32"] if self._has_f64 else ["f32"],
+                "precisions": list(PRECISIONS) if self._has_f64 else ["f32"],
                 "limits": dict(limits),
-                "workgroup_size": WORKGROUP_SIZE,
+                "workgroup_size": BUNDLE,
                 "ray_batch": self._ray_batch,
             }
 
@@ -421,8 +426,8 @@ class WgpuBackend:
         return self._sources[name]
 
     def _shader_source(self, real: str, chunks: int, chunk_shift: int) -> str:
-        """trace.wgsl with its header: the float type, the occupancy bindings and axis.wgsl."""
-        lines = [f"alias real = {real};"]
+        """trace.wgsl with its header: the constants, the occupancy bindings and axis.wgsl."""
+        lines = [wgsl_constants(real)]
         for chunk in range(chunks):
             lines.append(
                 f"@group(0) @binding({FIXED_BINDINGS + chunk}) "
@@ -469,7 +474,8 @@ class WgpuBackend:
         pipeline = self._pipelines.get("tiles")
         if pipeline is None:
             code = (
-                "alias real = f64;\n\n"
+                wgsl_constants("f64")
+                + "\n"
                 + self._shader_file("axis.wgsl")
                 + "\n"
                 + self._shader_file("object_order.wgsl")
@@ -495,7 +501,7 @@ class WgpuBackend:
                 min(
                     self._ray_batch,
                     self._limits["max-storage-buffer-binding-size"] // (6 * real_bytes),
-                    groups * groups * WORKGROUP_SIZE,
+                    groups * groups * BUNDLE,
                 ),
             )
             usage_in = wgpu.BufferUsage.STORAGE | wgpu.BufferUsage.COPY_DST
@@ -508,9 +514,7 @@ class WgpuBackend:
                 "rays": device.create_buffer(size=rays * 6 * real_bytes, usage=usage_in),
                 "cells": device.create_buffer(size=rays * 16, usage=usage_out),
                 "ranges": device.create_buffer(size=rays * real_bytes, usage=usage_out),
-                "starts": device.create_buffer(
-                    size=max(1, -(-rays // WORKGROUP_SIZE)) * real_bytes, usage=usage_in
-                ),
+                "starts": device.create_buffer(size=max(1, -(-rays // BUNDLE)) * real_bytes, usage=usage_in),
             }
             self._ray_buffers[precision] = buffers
         return buffers
@@ -527,17 +531,15 @@ class WgpuBackend:
         step=0.5,
         precision="f64",
         cancel: threading.Event | None = None,
-        object_order: bool | None = None,
+        order: TraceOrder = "auto",
     ) -> CellHits:
-        """Trace (N, 3) float64 cell-space rays on the adapter; see ``Backend``.
-
-        ``object_order`` as in the numba backend: True traces exact f64 scans in
-        object order whatever they cost, False never, None as ``OrderChoice`` finds
-        faster. f32 and the march always go in ray order."""
+        """Trace (N, 3) float64 cell-space rays on the adapter; see ``Backend``
+        (``order`` there: only exact f64 scans can go in object order)."""
         if method not in METHODS:
             raise FieldError("method", method, " or ".join(METHODS))
-        if precision not in ("f64", "f32"):
-            raise FieldError("precision", precision, "f64 or f32")
+        if precision not in PRECISIONS:
+            raise FieldError("precision", precision, " or ".join(PRECISIONS))
+        check_order(order)
         origins = np.ascontiguousarray(origins, dtype=np.float64).reshape(-1, 3)
         directions = np.ascontiguousarray(directions, dtype=np.float64).reshape(-1, 3)
         if origins.shape != directions.shape:
@@ -551,12 +553,12 @@ class WgpuBackend:
             info = {"adapter": self._adapter.info.get("device", ""), "precision": used}
             if used != precision:
                 info["precision_note"] = "the adapter has no shader-f64: traced in f32"
-            if method == "exact" and used == "f64" and object_order is not False and occupancy.count > 0:
-                return self._trace_scans(occupancy, origins, directions, object_order, cancel, info)
+            if method == "exact" and used == "f64" and order != "ray" and occupancy.count > 0:
+                return self._trace_scans(occupancy, origins, directions, order, cancel, info)
             info["order"] = "ray"
             return self._trace(occupancy, origins, directions, method, step, used, cancel, info)
 
-    def _trace_scans(self, occupancy, origins, directions, object_order, cancel, info):
+    def _trace_scans(self, occupancy, origins, directions, order, cancel, info):
         """Exact f64 in blocks, each in object or ray order (``trace_in_blocks``)."""
         n = len(origins)
         kind = np.zeros(n, dtype=np.uint8)
@@ -574,7 +576,7 @@ class WgpuBackend:
 
         orders = trace_in_blocks(
             n,
-            object_order,
+            order,
             self._orders.setdefault(occupancy, OrderChoice()),
             object_order_block,
             ray_order,
@@ -642,7 +644,7 @@ class WgpuBackend:
                 ),
             )
         group = self._scan_group[1]
-        groups = dispatch_grid(-(-n // WORKGROUP_SIZE), self._limits["max-compute-workgroups-per-dimension"])
+        groups = dispatch_grid(-(-n // BUNDLE), self._limits["max-compute-workgroups-per-dimension"])
         encoder = self._device.create_command_encoder()
         compute = encoder.begin_compute_pass()
         compute.set_pipeline(pipeline)
@@ -691,7 +693,7 @@ class WgpuBackend:
             # f32 moves each origin to its start on the host (the shader sees no starts).
             ray_starts = None
             if method == "exact":
-                ray_starts = np.repeat(bundle_start_array(origins, directions, halo), WORKGROUP_SIZE)[:n]
+                ray_starts = np.repeat(bundle_start_array(origins, directions, halo), BUNDLE)[:n]
             offsets = f32_start_offsets(origins, directions, occupancy.shape, top, method, ray_starts)
         else:
             offsets = None
@@ -701,8 +703,7 @@ class WgpuBackend:
         while True:
             total = n if pending is None else len(pending)
             for start in range(0, total, capacity):
-                if cancel is not None and cancel.is_set():
-                    raise Cancelled("trace cancelled")
+                check_cancelled(cancel, "trace cancelled")
                 if pending is None:
                     rows = slice(start, min(total, start + capacity))
                     count = rows.stop - rows.start
@@ -722,7 +723,7 @@ class WgpuBackend:
                         bundle_start_array(batch_origins, batch_directions, halo), SHADER_INF
                     ).astype(real)
                 else:
-                    starts = np.zeros(-(-count // WORKGROUP_SIZE), dtype=real)
+                    starts = np.zeros(-(-count // BUNDLE), dtype=real)
                 params = pack_params(
                     occupancy, upload, method, step, count, precision, first_sample, MARCH_SAMPLES_PER_PASS
                 )
@@ -757,9 +758,7 @@ class WgpuBackend:
         device.queue.write_buffer(buffers["params"], 0, params)
         device.queue.write_buffer(buffers["rays"], 0, rays)
         device.queue.write_buffer(buffers["starts"], 0, starts)
-        groups = dispatch_grid(
-            -(-count // WORKGROUP_SIZE), self._limits["max-compute-workgroups-per-dimension"]
-        )
+        groups = dispatch_grid(-(-count // BUNDLE), self._limits["max-compute-workgroups-per-dimension"])
         encoder = device.create_command_encoder()
         compute = encoder.begin_compute_pass()
         compute.set_pipeline(pipeline)
@@ -794,12 +793,12 @@ class WgpuBackend:
 
 
 def bundle_start_array(origins, directions, halo):
-    """float64 bundle start (tracing.bundle) of each ``WORKGROUP_SIZE`` consecutive rays."""
-    out = np.zeros(max(1, -(-len(origins) // WORKGROUP_SIZE)))
+    """float64 bundle start (tracing.bundle) of each ``BUNDLE`` consecutive rays."""
+    out = np.zeros(max(1, -(-len(origins) // BUNDLE)))
     bundle_starts(
         np.ascontiguousarray(origins, dtype=np.float64),
         np.ascontiguousarray(directions, dtype=np.float64),
-        WORKGROUP_SIZE,
+        BUNDLE,
         *halo,
         out,
     )

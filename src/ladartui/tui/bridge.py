@@ -11,6 +11,7 @@ import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
+from ladartui.checks import compass_field, number_field
 from ladartui.errors import FieldError, InputFileError
 from ladartui.flight import (
     SEGMENT_KINDS,
@@ -19,8 +20,6 @@ from ladartui.flight import (
     ScanPose,
     aim_at,
     altitude_field,
-    compass_field,
-    number_field,
 )
 from ladartui.scenario import Scenario, load_scenario, target_file_for
 from ladartui.sensor import Sensor

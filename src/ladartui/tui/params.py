@@ -14,8 +14,8 @@ from textual import on
 from textual.containers import Horizontal, VerticalScroll
 from textual.widgets import Input, Label
 
+from ladartui.checks import range_text
 from ladartui.errors import FieldError, LadarError
-from ladartui.flight import range_text
 from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField, format_number
 

@@ -91,7 +91,7 @@ class RunControl:
 
 def _run(scenario, scene, fast: bool, warm, cancel, progress):
     """The run job (worker thread): wait for the kernels, simulate, fuse as scans land."""
-    from ladartui.measures import keys_to_voxels, voxel_keys
+    from ladartui.scene.keys import keys_to_voxels, voxel_keys
     from ladartui.simulation import simulate
 
     last_live = 0.0

@@ -9,6 +9,7 @@ from textual.containers import Grid, Horizontal
 from textual.widgets import Button, Checkbox, Label, Select, Static
 
 from ladartui.errors import LadarError
+from ladartui.tracing.backend import METHODS
 from ladartui.tui import bridge
 from ladartui.tui.params import ParamPanel, field_id
 
@@ -30,7 +31,7 @@ class RunPanel(ParamPanel):
         yield Horizontal(
             Label("Method"),
             Select(
-                [("exact", "exact"), ("march", "march")],
+                [(method, method) for method in METHODS],
                 value="exact",
                 allow_blank=False,
                 id="method",

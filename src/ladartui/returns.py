@@ -1,0 +1,127 @@
+"""Hits to returns: the depth-resolution rule per detector, and fusing scans.
+
+Each scan's hits pass the detector's depth-resolution rule (report section
+7.4); the returned voxels of all scans are fused into one sorted voxel list.
+Used by the run (``simulation``) and by the detection models, which sit below it.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from ladartui.scene.keys import keys_to_voxels, sorted_unique, voxel_keys
+from ladartui.tracing.backend import MISS
+
+# Detectors with more rays than this are sorted up front, not by insertion.
+_INSERTION_LIMIT = 64
+
+
+# --------------------------------------------------------------------------- depth rule
+
+
+@numba.njit(nogil=True, cache=True)
+def _depth_rule_kernel(order, grouped, detector, kind, ranges, depth_resolution, kept):
+    """Write the indices of the kept returns into ``kept``; return how many.
+
+    Rays are visited in ``order`` (or 0..n-1 when ``grouped``), which lists
+    each detector's rays together (already sorted by range when groups are
+    large). Within a detector the returns are sorted by range (stably, so equal
+    ranges keep ray order); the first is kept and every later one closer than
+    ``depth_resolution`` to the last kept return is dropped.
+    """
+    n = detector.size
+    group_rays = np.empty(n, dtype=np.int64)
+    group_ranges = np.empty(n, dtype=np.float64)
+    count_kept = 0
+    start = 0
+    while start < n:
+        group = detector[start if grouped else order[start]]
+        stop = start
+        while stop < n and detector[stop if grouped else order[stop]] == group:
+            stop += 1
+        count = 0
+        for position in range(start, stop):
+            ray = position if grouped else order[position]
+            value = ranges[ray]
+            if kind[ray] == MISS or not np.isfinite(value):
+                continue
+            # Insertion sort, stable; linear when the order is sorted already.
+            j = count - 1
+            while j >= 0 and group_ranges[j] > value:
+                group_ranges[j + 1] = group_ranges[j]
+                group_rays[j + 1] = group_rays[j]
+                j -= 1
+            group_ranges[j + 1] = value
+            group_rays[j + 1] = ray
+            count += 1
+        last = 0.0
+        for i in range(count):
+            if i == 0 or group_ranges[i] - last >= depth_resolution:
+                kept[count_kept] = group_rays[i]
+                count_kept += 1
+                last = group_ranges[i]
+        start = stop
+    return count_kept
+
+
+def kept_returns(detector, kind, ranges, depth_resolution) -> np.ndarray:
+    """Indices of the rays whose hits survive the detector's depth resolution.
+
+    Rays are grouped by ``detector`` id and sorted by ``ranges`` (metres); the
+    nearest return of each detector is kept, and each later one is kept only if
+    it lies at least ``depth_resolution`` metres beyond the last kept return.
+    Misses (``kind == MISS``) never return; ground returns are returns.
+    """
+    detector = np.ascontiguousarray(detector)
+    kind = np.ascontiguousarray(kind, dtype=np.uint8)
+    ranges = np.ascontiguousarray(ranges, dtype=np.float64)
+    n = detector.shape[0]
+    if not (kind.shape[0] == ranges.shape[0] == n):
+        raise ValueError("detector, kind and ranges must have the same length")
+    if n == 0:
+        return np.zeros(0, dtype=np.int64)
+    # Sensor rays come grouped by detector in increasing order, a few per
+    # detector: sort each group in place. Otherwise sort everything first.
+    grouped = bool(np.all(detector[1:] >= detector[:-1])) and _largest_group(detector) <= _INSERTION_LIMIT
+    order = np.zeros(0, dtype=np.int64) if grouped else np.lexsort((ranges, detector))
+    kept = np.empty(n, dtype=np.int64)
+    count = _depth_rule_kernel(
+        order.astype(np.int64), grouped, detector, kind, ranges, float(depth_resolution), kept
+    )
+    return kept[:count]
+
+
+def _largest_group(sorted_ids) -> int:
+    starts = np.flatnonzero(sorted_ids[1:] != sorted_ids[:-1]) + 1
+    bounds = np.concatenate(([0], starts, [sorted_ids.size]))
+    return int(np.diff(bounds).max())
+
+
+def apply_depth_resolution(detector, kind, ranges, depth_resolution) -> np.ndarray:
+    """Boolean mask over the rays: True where the hit survives the depth resolution."""
+    mask = np.zeros(np.shape(detector)[0], dtype=bool)
+    mask[kept_returns(detector, kind, ranges, depth_resolution)] = True
+    return mask
+
+
+def scan_returns(trace_result, detector, depth_resolution) -> np.ndarray:
+    """The voxels one scan returns: hits after the depth rule, unique, (K, 3) int32."""
+    kept = kept_returns(detector, trace_result.kind, trace_result.range, depth_resolution)
+    return unique_voxels(trace_result.index[kept])
+
+
+def unique_voxels(voxels) -> np.ndarray:
+    """The distinct voxels of a (K, 3) list, sorted by (i, j, k), as int32."""
+    voxels = np.asarray(voxels).reshape(-1, 3)
+    if voxels.shape[0] == 0:
+        return np.zeros((0, 3), dtype=np.int32)
+    return keys_to_voxels(sorted_unique(voxel_keys(voxels)))
+
+
+def fuse_scans(per_scan) -> np.ndarray:
+    """The fused output of several scans: the union of their returned voxels."""
+    per_scan = [np.asarray(v).reshape(-1, 3) for v in per_scan]
+    if not per_scan:
+        return np.zeros((0, 3), dtype=np.int32)
+    return unique_voxels(np.concatenate(per_scan))

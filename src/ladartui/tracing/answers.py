@@ -1,0 +1,52 @@
+"""A ray's answer, shared by both backends: the voxel it hit, else the ground rule.
+
+``ray_answer`` is compiled into the numba exact kernel and written again in
+WGSL (shaders/trace.wgsl, ``ground``); ``scan_answers`` puts object-order hits
+(from numba's tiles or the wgpu backend's shader) back in ray order with it.
+"""
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from ladartui.tracing.config import GROUND, INF, MISS, VOXEL
+
+
+@njit(nogil=True, cache=True, inline="always")
+def ray_answer(found, i, j, k, t, ox, oy, oz, dx, dy, dz, nx, ny):
+    """(kind, i, j, k, t) of a ray: the voxel it hit, else the ground rule."""
+    if found:
+        return VOXEL, i, j, k, t
+    if dz < 0.0 and oz > 0.0:
+        tg = (0.0 - oz) * (1.0 / dz)
+        gx = ox + tg * dx
+        gy = oy + tg * dy
+        if 0.0 <= gx < nx and 0.0 <= gy < ny:
+            return GROUND, np.int64(math.floor(gx)), np.int64(math.floor(gy)), np.int64(0), tg
+    return MISS, np.int64(-1), np.int64(-1), np.int64(-1), INF
+
+
+@njit(parallel=True, nogil=True, cache=True)
+def scan_answers(order, best_t, best_v, vox, orig, dirs, nx, ny, kind, index, tout):
+    """Object-order hits (tracing.object_order; numba or the wgpu backend's shader) back
+    in ray order, with the ground rule."""
+    for s in prange(order.shape[0]):
+        r = order[s]
+        q = best_v[s]
+        i, j, k = (vox[q, 0], vox[q, 1], vox[q, 2]) if q >= 0 else (-1, -1, -1)
+        kind[r], index[r, 0], index[r, 1], index[r, 2], tout[r] = ray_answer(
+            q >= 0,
+            i,
+            j,
+            k,
+            best_t[s],
+            orig[r, 0],
+            orig[r, 1],
+            orig[r, 2],
+            dirs[r, 0],
+            dirs[r, 1],
+            dirs[r, 2],
+            nx,
+            ny,
+        )

@@ -1,0 +1,89 @@
+"""Tracing's constants and tuning knobs, in one place.
+
+Hit kinds and the numbers the numba kernels and the WGSL shaders must agree on
+live here once: ``wgsl_constants`` writes them into the shader source when it is
+assembled, so the shaders never restate them. The tuning knobs of both backends
+sit below them, each with why it has its value.
+
+The numba kernels take these as compile-time constants, and numba's on-disk
+cache only notices edits to a kernel's own file: after changing a value here,
+clear ``tracing/__pycache__/*.nb*`` (a fresh install has no stale cache).
+"""
+
+from __future__ import annotations
+
+# -- answers ----------------------------------------------------------------------
+
+MISS, VOXEL, GROUND = 0, 1, 2  # hit kinds of every backend (CellHits.kind)
+# Shader-only kinds: a march pass ended without an answer, and a loop ended by the
+# adapter's iteration guard rather than by the ray (see shaders/trace.wgsl).
+UNFINISHED, CUT = 3, 4
+INF = float("inf")  # the parameter of no hit (CellHits.t of a miss)
+# The shader's +inf: WGSL has no infinity literal, and no ray parameter comes near it.
+SHADER_INF = 1e30
+# Method codes the shader reads from its parameters (params.run.y).
+METHOD_CODES = {"exact": 0, "march": 1}
+
+# -- work split -------------------------------------------------------------------
+
+# Rays per bundle: one numba prange work item (coherent neighbours stay on one
+# thread), one WGSL workgroup, and one bundle start each (tracing.bundle).
+BUNDLE = 64
+# Parallel passes split into this many fixed runs, so sums do not depend on the threads.
+PARTS = 64
+BLOCK = 1 << 16  # rays per numba kernel call: cancel is checked between calls
+DEFAULT_STEP = 0.5  # voxels between march samples
+
+# -- bundle starts (tracing.bundle) -------------------------------------------------
+
+BUNDLE_REACH = 7.0  # voxels: under one brick (8), one voxel of slack for rounding
+FINE_REACH = 3.0  # the same over ``Occupancy.halo4`` (4-voxel cells)
+FAR = 1e12  # cells: beyond this the one-voxel margins drown in rounding, so no bundle start
+
+# -- object order (tracing.object_order) --------------------------------------------
+
+EPS = 1e-9  # widening of projected rectangles (tangent units), far above rounding
+NEAR_MARGIN = 1e-9  # relative lowering of depth bounds, far above rounding
+TILE_SHIFT = 4  # tiles of 16 x 16 bins: rays tested together, stopped together
+MAX_SPREAD = 1.0  # largest origin half-spread (cells) handled in object order
+MIN_COS = 0.5  # every ray within 60 degrees of the cone's axis
+SCAN_BLOCK = 1 << 18  # rays per object-order call (one 512 x 512 scan)
+MIN_SCAN_RAYS = 4096  # fewer rays: ray order, whose set-up is nil
+# At most this many occupied voxels in view per ray (more, and walking the rays is
+# cheaper: the measured crossover on the reference scene).
+VOXELS_PER_RAY = 0.6
+
+# -- wgpu (tracing.wgpu_backend) ----------------------------------------------------
+
+RAY_BATCH = 1 << 20  # rays per dispatch: bounds host and device memory
+# Ask for no more than this many occupancy bindings (16 GiB at 128 MiB each).
+MAX_OCCUPANCY_BINDINGS = 128
+# Samples a ray per march pass: well under lavapipe's 65,535 loop iterations
+# per invocation, all loops together.
+MARCH_SAMPLES_PER_PASS = 1 << 15
+# Object order in the shader: tiles of 2 x 2 bins. Small tiles keep each ray's
+# list short; the shader pays for every entry a ray walks past.
+OBJECT_ORDER_TILE_SHIFT = 1
+# Longest tile list an invocation may walk: under lavapipe's 65,535 loop iterations.
+LOOP_BUDGET = 65_000
+
+
+def wgsl_constants(real: str) -> str:
+    """The header every shader is assembled after: the float type and the shared constants."""
+    if real not in ("f32", "f64"):
+        raise ValueError(f"real must be f32 or f64, not {real!r}")
+    kinds = {"MISS": MISS, "VOXEL": VOXEL, "GROUND": GROUND, "UNFINISHED": UNFINISHED, "CUT": CUT}
+    lines = [
+        "// Written by tracing/config.py (wgsl_constants): change the values there.",
+        f"alias real = {real};",
+        *(f"const {name}: i32 = {value};" for name, value in kinds.items()),
+        *(f"const METHOD_{name.upper()}: i32 = {code};" for name, code in METHOD_CODES.items()),
+        f"const INF: real = {_wgsl_float(SHADER_INF)};",
+        f"const BUNDLE: u32 = {BUNDLE}u;",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def _wgsl_float(value: float) -> str:
+    # repr gives 1e+30; WGSL reads 1e30 as the same abstract float.
+    return repr(float(value)).replace("e+", "e")
