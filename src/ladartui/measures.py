@@ -39,7 +39,8 @@ import numpy as np
 
 from ladartui.atomic import write_text_atomic
 from ladartui.errors import InputFileError
-from ladartui.scene.keys import sorted_unique, voxel_keys
+from ladartui.scene.keys import member as _member
+from ladartui.scene.keys import sorted_unique, visible_mask, voxel_keys
 
 if TYPE_CHECKING:
     from ladartui.levels import LevelResult
@@ -47,10 +48,6 @@ if TYPE_CHECKING:
 CMF_FORMAT = "cmf"
 CMF_VERSION = 1
 CMF_HEADER = f"# ladartui comparison measures, format {CMF_FORMAT} {CMF_VERSION}"
-
-# Faces through which a target voxel can be seen: the ground-facing (-z) face is
-# left out, since a sensor above the ground never looks up at it.
-VISIBLE_FACE_OFFSETS = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1]], dtype=np.int64)
 
 # Coverage share of the final obscured coverage that counts as "enough looks".
 ENOUGH_SHARE = 0.9
@@ -60,29 +57,6 @@ _NOISE = 1e-12
 
 def _unique_keys(voxels) -> np.ndarray:
     return sorted_unique(voxel_keys(voxels))
-
-
-def _member(keys: np.ndarray, sorted_keys: np.ndarray) -> np.ndarray:
-    """Boolean mask: which ``keys`` occur in ``sorted_keys`` (sorted, unique)."""
-    if sorted_keys.size == 0:
-        return np.zeros(keys.shape, dtype=bool)
-    pos = np.searchsorted(sorted_keys, keys)
-    pos[pos == sorted_keys.size] = 0
-    return sorted_keys[pos] == keys
-
-
-def visible_mask(target_model) -> np.ndarray:
-    """Which target-model voxels have a face open to empty space (the -z face aside).
-
-    Decided with the target model alone: foliage and other scene voxels do not
-    close a face, since the maximum coverage is a property of the target.
-    """
-    target = np.asarray(target_model, dtype=np.int64).reshape(-1, 3)
-    keys = sorted_unique(voxel_keys(target))
-    visible = np.zeros(len(target), dtype=bool)
-    for offset in VISIBLE_FACE_OFFSETS:
-        visible |= ~_member(voxel_keys(target + offset), keys)
-    return visible
 
 
 @dataclass(frozen=True)

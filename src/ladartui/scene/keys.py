@@ -1,6 +1,7 @@
 """Voxel keys: one int64 per voxel, for sorting, set membership and fusing.
 
-The one home of ``voxel_keys`` and its inverse; measures, simulation, the
+The one home of ``voxel_keys`` and its inverse, and of the target-model
+visibility built on them; measures, simulation, the
 detection models and the CLI all use these, so keys from any of them compare.
 """
 
@@ -56,3 +57,31 @@ def sorted_unique(keys) -> np.ndarray:
     distinct[0] = True
     np.not_equal(keys[1:], keys[:-1], out=distinct[1:])
     return keys[distinct]
+
+
+# Faces through which a target voxel can be seen: the ground-facing (-z) face is
+# left out, since a sensor above the ground never looks up at it.
+VISIBLE_FACE_OFFSETS = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1]], dtype=np.int64)
+
+
+def member(keys: np.ndarray, sorted_keys: np.ndarray) -> np.ndarray:
+    """Boolean mask: which ``keys`` occur in ``sorted_keys`` (sorted, unique)."""
+    if sorted_keys.size == 0:
+        return np.zeros(keys.shape, dtype=bool)
+    pos = np.searchsorted(sorted_keys, keys)
+    pos[pos == sorted_keys.size] = 0
+    return sorted_keys[pos] == keys
+
+
+def visible_mask(target_model) -> np.ndarray:
+    """Which target-model voxels have a face open to empty space (the -z face aside).
+
+    Decided with the target model alone: foliage and other scene voxels do not
+    close a face, since the maximum coverage is a property of the target.
+    """
+    target = np.asarray(target_model, dtype=np.int64).reshape(-1, 3)
+    keys = sorted_unique(voxel_keys(target))
+    visible = np.zeros(len(target), dtype=bool)
+    for offset in VISIBLE_FACE_OFFSETS:
+        visible |= ~member(voxel_keys(target + offset), keys)
+    return visible
