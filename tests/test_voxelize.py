@@ -288,3 +288,32 @@ def test_progress_and_cancel():
 
     with pytest.raises(Cancelled, match="nothing was written"):
         voxelize(sphere, 1.0, solid=True, progress=stop_at_first, cancel=cancel)
+
+
+def test_a_mesh_setting_no_voxel_is_refused():
+    flat = square(0.0, up=True)  # on the ground plane, its normal up: the voxel behind is below ground
+    with pytest.raises(InputFileError, match=r"square\.obj: sets no voxels at 1 m"):
+        voxelize(flat, 1.0)
+    assert len(voxelize(flat, 1.0, Placement(1.0, 1.0, 0.3)).voxels) == 9  # lifted into layer 0
+
+
+def test_reader_warnings_become_notes_not_stderr(capsys):
+    import logging
+
+    from ladartui.scene.voxelize import _trimesh_notes
+
+    with _trimesh_notes() as notes:
+        logging.getLogger("trimesh.exchange.ply").warning("unable to load image!")
+    assert notes == ["unable to load image!"]
+    assert capsys.readouterr().err == ""
+    assert not logging.getLogger("trimesh").handlers
+
+
+def test_work_is_split_by_voxel_tests_for_progress_and_cancel(monkeypatch):
+    from ladartui.scene import voxelize as module
+
+    monkeypatch.setattr(module, "_CHUNK_TESTS", 100)
+    monkeypatch.setattr(module, "_CHUNK_TRIANGLES", 4)
+    tests = np.array([10, 10, 500, 10, 10, 10, 10, 10, 10, 10, 10, 10], dtype=float)
+    # the big triangle alone; at most 4 triangles a call otherwise
+    assert module._chunk_bounds(tests) == [0, 2, 3, 7, 11, 12]

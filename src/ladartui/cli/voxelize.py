@@ -9,6 +9,7 @@ import time
 
 from ladartui.cli.progress import run_cancellable, sigterm_as_interrupt
 from ladartui.errors import Cancelled, FieldError
+from ladartui.textsafe import one_line
 
 
 def add_parser(subparsers):
@@ -98,6 +99,8 @@ def run(args) -> int:
     check_writable(*outputs)
     mesh = load_mesh(args.mesh, scale=args.scale, up=args.up)
     errors = Console(stderr=True)
+    for note in mesh.notes:
+        errors.print(f"note: {mesh.path}: {one_line(note)}", highlight=False, markup=False, soft_wrap=True)
     cancel = threading.Event()
     started = time.perf_counter()
     with sigterm_as_interrupt():
@@ -163,7 +166,8 @@ def _report(console, args, mesh, done, outputs, elapsed) -> None:
         detail += f", {result.inside:,} with their centre inside"
     say = lambda text: console.print(text, highlight=False, markup=False, soft_wrap=True)  # noqa: E731
     say(
-        f"{mesh.path}: {len(mesh.faces):,} triangles, {'closed' if mesh.closed else 'not closed'}; "
+        f"{mesh.path}: {len(mesh.faces):,} triangle{'s' if len(mesh.faces) != 1 else ''}, "
+        f"{'closed' if mesh.closed else 'not closed'}; "
         f"{kind} model of {len(result.voxels):,} voxels at {vs:g} m ({detail}) in {elapsed:.2f} s"
     )
     if len(result.voxels):

@@ -28,9 +28,11 @@ encloses: its outer layer in surface mode, all of them in solid mode.
 
 from __future__ import annotations
 
+import contextlib
+import logging
 import math
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -41,8 +43,10 @@ from ladartui.scene.voxels import MAX_INDEX
 
 MESH_SUFFIXES = (".obj", ".stl", ".ply")
 CANCELLED = "voxelisation cancelled; nothing was written"
-# Triangles per kernel call: progress and cancel are checked between calls.
+# Progress and cancel are checked between kernel calls: each call takes at most
+# this many triangles, or this many (triangle, voxel) tests (a few tens of ms).
 _CHUNK_TRIANGLES = 8192
+_CHUNK_TESTS = 2_000_000
 
 
 @dataclass(frozen=True)
@@ -64,6 +68,7 @@ class Mesh:
     faces: np.ndarray  # (F, 3) int64
     closed: bool  # watertight and consistently wound
     problem: str  # why it is not closed, in words ("" when it is)
+    notes: tuple[str, ...] = ()  # what the reader warned about (textures, metadata)
 
 
 @dataclass(frozen=True)
@@ -93,9 +98,10 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
     import trimesh
 
     try:
-        # process=True merges repeated vertices (an STL repeats them per triangle), so
-        # that closedness can be checked on the shared edges.
-        loaded = trimesh.load(str(path), file_type=kind[1:], force="mesh", process=True)
+        with _trimesh_notes() as notes:
+            # process=True merges repeated vertices (an STL repeats them per triangle),
+            # so that closedness can be checked on the shared edges.
+            loaded = trimesh.load(str(path), file_type=kind[1:], force="mesh", process=True)
     except Exception as error:  # trimesh's parsers raise many kinds on malformed text
         raise InputFileError(
             path, f"not a readable {kind[1:].upper()} mesh ({type(error).__name__}: {error})"
@@ -107,19 +113,50 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
     if not np.all(np.isfinite(vertices)):
         bad = int(np.count_nonzero(~np.all(np.isfinite(vertices), axis=1)))
         raise InputFileError(path, f"{bad} vertices have coordinates that are not finite numbers")
-    problem = _closed_problem(loaded)
-    if not problem and float(getattr(loaded, "volume", 0.0)) < 0:
+    problem = _closed_problem(loaded, len(vertices))
+    if not problem and _signed_volume(vertices, faces) < 0:
         faces = faces[:, ::-1].copy()  # wound inside out: turn the normals outward
     vertices = vertices * scale
     if up == "y":
         vertices = np.column_stack([vertices[:, 0], -vertices[:, 2], vertices[:, 1]])
-    return Mesh(path, vertices, faces, not problem, problem)
+    return Mesh(path, vertices, faces, not problem, problem, tuple(notes))
 
 
-def _closed_problem(mesh) -> str:
+@contextlib.contextmanager
+def _trimesh_notes() -> Iterator[list[str]]:
+    """Collect what trimesh logs while reading (a texture it could not load), as one-line notes.
+
+    Left alone, its warnings would reach stderr with tracebacks through
+    logging's last-resort handler.
+    """
+    notes: list[str] = []
+
+    class Collect(logging.Handler):
+        def emit(self, record: logging.LogRecord) -> None:
+            notes.append(record.getMessage())
+
+    logger = logging.getLogger("trimesh")
+    handler = Collect(logging.WARNING)
+    propagate = logger.propagate
+    logger.addHandler(handler)
+    logger.propagate = False
+    try:
+        yield notes
+    finally:
+        logger.removeHandler(handler)
+        logger.propagate = propagate
+
+
+def _signed_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
+    """Volume enclosed by a closed mesh; negative when its normals point inward."""
+    a, b, c = (vertices[faces[:, n]] - vertices[0] for n in range(3))
+    return float(np.einsum("ij,ij->", a, np.cross(b, c))) / 6.0
+
+
+def _closed_problem(mesh, vertex_count: int) -> str:
     """Why the mesh does not bound a solid, in words; "" when it does."""
-    edges = np.sort(np.asarray(mesh.edges), axis=1)
-    _, uses = np.unique(edges, axis=0, return_counts=True)
+    edges = np.sort(np.asarray(mesh.edges, dtype=np.int64), axis=1)
+    _, uses = np.unique(edges[:, 0] * vertex_count + edges[:, 1], return_counts=True)
     open_edges = int(np.count_nonzero(uses == 1))
     shared = int(np.count_nonzero(uses > 2))
     if open_edges or shared:
@@ -242,15 +279,30 @@ def estimate_bytes(triangles: np.ndarray, solid: bool) -> int:
     """Peak bytes of voxelising ``triangles``: the dense grid, the crossings, the voxel list."""
     grid = _working_grid(triangles)
     cells = math.prod(grid.shape)
-    if solid:
-        filled = cells
-    else:  # at most one voxel per (triangle, candidate voxel) pair
-        lo = np.ceil(triangles.min(axis=1) - 0.5)
-        hi = np.floor(triangles.max(axis=1) + 0.5)
-        filled = min(cells, int(np.prod(np.maximum(hi - lo + 1, 0), axis=1).sum()))
+    # surface mode sets at most one voxel per (triangle, candidate voxel) test
+    filled = cells if solid else min(cells, int(_candidate_tests(triangles).sum()))
     crossings = 4 * grid.shape[0] * grid.shape[1] * (grid.shape[2] + 1) if solid else 0
     # np.nonzero's three int64 index arrays and the int32 voxel list
     return cells + crossings + 36 * filled
+
+
+def _candidate_tests(triangles: np.ndarray) -> np.ndarray:
+    """Per triangle, how many voxels its bounding box touches: the surface pass's tests."""
+    lo = np.ceil(triangles.min(axis=1) - 0.5)
+    hi = np.floor(triangles.max(axis=1) + 0.5)
+    return np.prod(np.maximum(hi - lo + 1, 0), axis=1)  # float64: no overflow
+
+
+def _chunk_bounds(tests: np.ndarray) -> list[int]:
+    """Triangle indices splitting the work into calls of bounded size."""
+    cumulative = np.cumsum(tests)
+    bounds = [0]
+    while bounds[-1] < len(tests):
+        start = bounds[-1]
+        before = cumulative[start - 1] if start else 0.0
+        stop = int(np.searchsorted(cumulative, before + _CHUNK_TESTS, side="right"))
+        bounds.append(min(max(stop, start + 1), start + _CHUNK_TRIANGLES, len(tests)))
+    return bounds
 
 
 def voxelize(
@@ -289,11 +341,12 @@ def voxelize(
     total = passes * len(local)
     marks = np.zeros(grid.shape, dtype=np.uint8)
 
+    bounds = _chunk_bounds(_candidate_tests(local))
+
     def chunks(step: Callable[[int, int], None], passed: int) -> None:
-        for start in range(0, len(local), _CHUNK_TRIANGLES):
+        for start, stop in zip(bounds, bounds[1:]):
             if cancel is not None and cancel.is_set():
                 raise Cancelled(CANCELLED)
-            stop = min(start + _CHUNK_TRIANGLES, len(local))
             step(start, stop)
             if progress is not None:
                 progress(passed + stop, total)
@@ -306,6 +359,12 @@ def voxelize(
         chunks(lambda a, b: kernels.add_crossings(local, a, b, crossings), len(local))
         inside = int(kernels.fill_inside(crossings, marks))
         del crossings
+    if surface == 0:
+        raise InputFileError(
+            mesh.path,
+            f"sets no voxels at {voxel_size:g} m: its surface only lies on or touches voxel "
+            "boundaries (a face on a boundary counts for the voxel behind it, away from its normal)",
+        )
     found = np.nonzero(marks)
     voxels = np.column_stack(found).astype(np.int32) + grid.origin.astype(np.int32)
     return Voxelized(np.ascontiguousarray(voxels), surface, inside, solid, float(voxel_size))
