@@ -163,3 +163,11 @@ def test_unwritable_output_is_refused_before_the_work(tmp_path, truck, forest, c
     assert main([*args, "--into", str(forest)]) == 2
     assert "out_Target.txt: is a folder" in one_error_line(capsys)
     assert not (tmp_path / "out.txt").exists()
+
+
+def test_a_bad_scene_file_is_one_line_naming_its_line(tmp_path, truck, forest, capsys):
+    forest.write_text("1,2,3\n4,five,6\n")
+    args = ["voxelize", str(truck), str(tmp_path / "out"), "--voxel-size", "0.1", "--at", "3,3"]
+    assert main([*args, "--into", str(forest)]) == 2
+    assert one_error_line(capsys).startswith(f"ladartui: error: {forest}:2: y = 'five' is not a whole number")
+    assert not (tmp_path / "out.txt").exists()

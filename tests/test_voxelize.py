@@ -278,16 +278,24 @@ def test_too_fine_a_voxel_size_is_refused_up_front(monkeypatch):
 def test_progress_and_cancel():
     sphere = as_mesh(trimesh.creation.icosphere(subdivisions=5, radius=10.0))  # 20,480 triangles
     seen = []
-    voxelize(sphere, 1.0, solid=True, progress=lambda done, total: seen.append((done, total)))
-    assert seen[-1] == (2 * 20480, 2 * 20480) and len(seen) > 2
-    assert [done for done, _ in seen] == sorted(done for done, _ in seen)
+    voxelize(sphere, 1.0, solid=True, progress=lambda *report: seen.append(report))
+    stages = [stage for stage, _, _ in seen]
+    assert stages == sorted(stages, key=["surface", "inside", "filling", "collecting"].index)
+    assert ("surface", 20480, 20480) in seen and ("inside", 20480, 20480) in seen
+    assert seen[-1][0] == "collecting" and seen[-1][1] == seen[-1][2] == 21  # x slabs of the grid
     cancel = threading.Event()
 
-    def stop_at_first(done, total):
-        cancel.set()
+    def stop_at(stage):
+        def report(name, done, total):
+            if name == stage:
+                cancel.set()
 
-    with pytest.raises(Cancelled, match="nothing was written"):
-        voxelize(sphere, 1.0, solid=True, progress=stop_at_first, cancel=cancel)
+        return report
+
+    for stage in ("surface", "inside", "filling"):
+        cancel.clear()
+        with pytest.raises(Cancelled, match="nothing was written"):
+            voxelize(sphere, 1.0, solid=True, progress=stop_at(stage), cancel=cancel)
 
 
 def test_a_mesh_setting_no_voxel_is_refused():

@@ -71,7 +71,7 @@ def run(args) -> int:
 
     from ladartui.outputset import check_writable
     from ladartui.scene.insertion import scene_model_paths
-    from ladartui.scene.voxelize import CANCELLED, Placement, load_mesh
+    from ladartui.scene.voxelize import CANCELLED, Placement
 
     if not (args.voxel_size > 0 and math.isfinite(args.voxel_size)):
         raise FieldError("--voxel-size", args.voxel_size, "a positive number of metres")
@@ -97,52 +97,70 @@ def run(args) -> int:
             target = target.with_name(target.name + ".txt")
         outputs = (target,)
     check_writable(*outputs)
-    mesh = load_mesh(args.mesh, scale=args.scale, up=args.up)
     errors = Console(stderr=True)
-    for note in mesh.notes:
-        errors.print(f"note: {mesh.path}: {one_line(note)}", highlight=False, markup=False, soft_wrap=True)
     cancel = threading.Event()
     started = time.perf_counter()
     with sigterm_as_interrupt():
-        done = run_cancellable(
-            lambda: _work(args, mesh, placement, outputs, errors, cancel),
+        mesh, result, insertion = run_cancellable(
+            lambda: _work(args, placement, outputs, errors, cancel),
             cancel,
             "ladartui-voxelize",
             Cancelled(CANCELLED),
         )
     elapsed = time.perf_counter() - started
-    _report(Console(), args, mesh, done, outputs, elapsed)
+    _report(Console(), args, mesh, (result, insertion), outputs, elapsed)
     return 0
 
 
-def _work(args, mesh, placement, outputs, console, cancel):
-    """Voxelise (with progress) and write; runs on the worker thread."""
+def _work(args, placement, outputs, console, cancel):
+    """Read, voxelise (with progress), insert and write; runs on the worker thread."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
     from ladartui.scene.insertion import insert_vehicle, load_scene_model, write_scene_model
-    from ladartui.scene.voxelize import voxelize
+    from ladartui.scene.voxelize import CANCELLED, load_mesh, voxelize
     from ladartui.scene.voxels import save_voxels
 
-    columns = (TextColumn("voxelising"), BarColumn(), TextColumn("{task.fields[done]}"), TimeElapsedColumn())
+    columns = (
+        TextColumn("{task.description}"),
+        BarColumn(),
+        TextColumn("{task.fields[done]}"),
+        TimeElapsedColumn(),
+    )
     # A bar only on a terminal: a log or a pipe gets the summary alone.
     with Progress(*columns, console=console, transient=True, disable=not console.is_terminal) as bar:
-        task = bar.add_task("voxelising", total=1.0, done="")
+        task = bar.add_task(f"reading {args.mesh}", total=None, done="")
+        mesh = load_mesh(args.mesh, scale=args.scale, up=args.up)
+        for note in mesh.notes:
+            console.print(
+                f"note: {mesh.path}: {one_line(note)}", highlight=False, markup=False, soft_wrap=True
+            )
+        if args.into:  # a bad scene file is found before the work
+            bar.update(task, description=f"reading {args.into}")
+            scene, target, had_target = load_scene_model(args.into)
+        bar.update(task, description="voxelising", total=1.0, completed=0.0)
 
-        def report(done: int, total: int) -> None:
-            bar.update(task, completed=done / total, done=f"{done:,}/{total:,} triangle passes")
+        units = {"surface": "triangles", "inside": "triangles", "filling": "slabs", "collecting": "slabs"}
+
+        def report(stage: str, done: int, total: int) -> None:
+            bar.update(
+                task,
+                description=stage,
+                completed=done / total,
+                done=f"{done:,}/{total:,} {units.get(stage, '')}",
+            )
 
         with _flag_names():
             result = voxelize(mesh, args.voxel_size, placement, args.solid, progress=report, cancel=cancel)
-    if not args.into:
         if cancel.is_set():
-            raise Cancelled("voxelisation cancelled; nothing was written")
-        save_voxels(outputs[0], result.voxels)
-        return result, None
-    scene, target, had_target = load_scene_model(args.into)
-    with _flag_names():
-        insertion = insert_vehicle(scene, target, result.voxels, args.voxel_size, had_target, args.into)
-    write_scene_model(args.out, insertion, cancel)
-    return result, insertion
+            raise Cancelled(CANCELLED)
+        bar.update(task, description="writing", total=None, done="")
+        if not args.into:
+            save_voxels(outputs[0], result.voxels)
+            return mesh, result, None
+        with _flag_names():
+            insertion = insert_vehicle(scene, target, result.voxels, args.voxel_size, had_target, args.into)
+        write_scene_model(args.out, insertion, cancel)
+        return mesh, result, insertion
 
 
 @contextlib.contextmanager

@@ -276,14 +276,18 @@ def _working_grid(triangles: np.ndarray) -> _Grid:
 
 
 def estimate_bytes(triangles: np.ndarray, solid: bool) -> int:
-    """Peak bytes of voxelising ``triangles``: the dense grid, the crossings, the voxel list."""
+    """Peak bytes of voxelising ``triangles`` and writing the result.
+
+    The dense grid, the crossings (solid), the voxel list and its text; the
+    voxel count is bounded by the grid (solid) or the triangle-voxel tests.
+    """
     grid = _working_grid(triangles)
     cells = math.prod(grid.shape)
     # surface mode sets at most one voxel per (triangle, candidate voxel) test
     filled = cells if solid else min(cells, int(_candidate_tests(triangles).sum()))
     crossings = 4 * grid.shape[0] * grid.shape[1] * (grid.shape[2] + 1) if solid else 0
-    # np.nonzero's three int64 index arrays and the int32 voxel list
-    return cells + crossings + 36 * filled
+    # Per voxel: the int32 list, and writing it (an int64 copy and about 20 bytes of text).
+    return cells + crossings + 56 * filled
 
 
 def _candidate_tests(triangles: np.ndarray) -> np.ndarray:
@@ -310,13 +314,15 @@ def voxelize(
     voxel_size: float,
     placement: Placement | None = None,
     solid: bool = False,
-    progress: Callable[[int, int], None] | None = None,
+    progress: Callable[[str, int, int], None] | None = None,
     cancel: threading.Event | None = None,
 ) -> Voxelized:
     """Voxelise ``mesh`` exactly (see the module's rules) at ``voxel_size`` metres.
 
-    ``progress(done, total)`` is called from this thread between chunks of
-    triangles; a set ``cancel`` stops with ``Cancelled``. Work whose memory
+    ``progress(stage, done, total)`` is called from this thread between
+    chunks of each stage ("surface" and "inside" count triangles, "filling"
+    and "collecting" x slabs of the grid); a set ``cancel`` stops with
+    ``Cancelled``. Work whose memory
     would exceed the machine is refused up front with ``ResourceLimitError``.
     """
     from ladartui.resources import available_memory, gib
@@ -337,37 +343,50 @@ def voxelize(
     from ladartui.scene import voxelize_kernels as kernels
 
     local = triangles - grid.origin.astype(np.float64)  # exact: whole numbers
-    passes = 2 if solid else 1
-    total = passes * len(local)
     marks = np.zeros(grid.shape, dtype=np.uint8)
 
-    bounds = _chunk_bounds(_candidate_tests(local))
-
-    def chunks(step: Callable[[int, int], None], passed: int) -> None:
+    def stage(name: str, bounds: list[int], step: Callable[[int, int], object]) -> None:
         for start, stop in zip(bounds, bounds[1:]):
             if cancel is not None and cancel.is_set():
                 raise Cancelled(CANCELLED)
             step(start, stop)
             if progress is not None:
-                progress(passed + stop, total)
+                progress(name, stop, bounds[-1])
 
-    chunks(lambda a, b: kernels.mark_surface(local, a, b, marks), 0)
+    triangle_chunks = _chunk_bounds(_candidate_tests(local))
+    stage("surface", triangle_chunks, lambda a, b: kernels.mark_surface(local, a, b, marks))
     surface = int(np.count_nonzero(marks))
-    inside = 0
-    if solid:
-        crossings = np.zeros((*grid.shape[:2], grid.shape[2] + 1), dtype=np.int32)
-        chunks(lambda a, b: kernels.add_crossings(local, a, b, crossings), len(local))
-        inside = int(kernels.fill_inside(crossings, marks))
-        del crossings
     if surface == 0:
         raise InputFileError(
             mesh.path,
             f"sets no voxels at {voxel_size:g} m: its surface only lies on or touches voxel "
             "boundaries (a face on a boundary counts for the voxel behind it, away from its normal)",
         )
-    found = np.nonzero(marks)
-    voxels = np.column_stack(found).astype(np.int32) + grid.origin.astype(np.int32)
-    return Voxelized(np.ascontiguousarray(voxels), surface, inside, solid, float(voxel_size))
+    slabs = _slab_bounds(grid.shape)
+    inside = 0
+    if solid:
+        crossings = np.zeros((*grid.shape[:2], grid.shape[2] + 1), dtype=np.int32)
+        stage("inside", triangle_chunks, lambda a, b: kernels.add_crossings(local, a, b, crossings))
+        counts: list[int] = []
+        stage("filling", slabs, lambda a, b: counts.append(kernels.fill_inside(crossings, marks, a, b)))
+        inside = int(sum(counts))
+        del crossings
+    voxels = np.empty((int(np.count_nonzero(marks)), 3), dtype=np.int32)
+    rows = [0]
+    origin = grid.origin.astype(np.int32)
+    stage(
+        "collecting",
+        slabs,
+        lambda a, b: rows.append(kernels.collect_voxels(marks, a, b, origin, voxels, rows[-1])),
+    )
+    return Voxelized(voxels, surface, inside, solid, float(voxel_size))
+
+
+def _slab_bounds(shape: tuple[int, int, int]) -> list[int]:
+    """x indices splitting a grid pass into calls of about ``_CHUNK_TESTS`` cells."""
+    per_slab = max(shape[1] * shape[2], 1)
+    step = max(1, _CHUNK_TESTS // per_slab)
+    return [*range(0, shape[0], step), shape[0]]
 
 
 def merge_voxels(*lists: np.ndarray) -> np.ndarray:

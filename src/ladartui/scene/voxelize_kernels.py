@@ -168,15 +168,15 @@ def add_crossings(triangles, start, stop, crossings):
 
 
 @numba.njit(nogil=True, cache=True)
-def fill_inside(crossings, grid):
-    """Set ``grid`` where the winding number (crossings summed above the centre) is not zero.
+def fill_inside(crossings, grid, start, stop):
+    """Set ``grid[start:stop]`` where the winding number (crossings above the centre) is not zero.
 
-    Returns how many centres are inside.
+    Returns how many centres there are inside.
     """
-    gx, gy, gz = grid.shape
+    gz = grid.shape[2]
     inside = 0
-    for i in range(gx):
-        for j in range(gy):
+    for i in range(start, stop):
+        for j in range(grid.shape[1]):
             winding = crossings[i, j, gz]
             for k in range(gz - 1, -1, -1):
                 if winding != 0:
@@ -184,3 +184,20 @@ def fill_inside(crossings, grid):
                     inside += 1
                 winding += crossings[i, j, k]
     return inside
+
+
+@numba.njit(nogil=True, cache=True)
+def collect_voxels(grid, start, stop, origin, out, row):
+    """Write the indices of set voxels of ``grid[start:stop]`` (plus ``origin``) from ``out[row]``.
+
+    Returns the next free row. In (x, y, z) order, like the files this project writes.
+    """
+    for i in range(start, stop):
+        for j in range(grid.shape[1]):
+            for k in range(grid.shape[2]):
+                if grid[i, j, k]:
+                    out[row, 0] = origin[0] + i
+                    out[row, 1] = origin[1] + j
+                    out[row, 2] = origin[2] + k
+                    row += 1
+    return row
