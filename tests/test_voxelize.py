@@ -325,3 +325,10 @@ def test_work_is_split_by_voxel_tests_for_progress_and_cancel(monkeypatch):
     tests = np.array([10, 10, 500, 10, 10, 10, 10, 10, 10, 10, 10, 10], dtype=float)
     # the big triangle alone; at most 4 triangles a call otherwise
     assert module._chunk_bounds(tests) == [0, 2, 3, 7, 11, 12]
+
+
+def test_rounding_at_the_scene_edge_is_not_a_refusal():
+    # (1.05 - 1.1) / 0.1 is -0.5000000000000004: the west face is on the edge, not past it.
+    slab = as_mesh(trimesh.creation.box(extents=(2.2, 0.6, 0.6)))
+    result = voxelize(slab, 0.1, Placement(1.05, 1.05, 0.0), solid=True)
+    assert voxel_set(result.voxels) == block(range(22), range(8, 14), range(6))

@@ -23,7 +23,9 @@ Voxels (the rules in :mod:`ladartui.scene.voxelize_kernels`):
   solid's interior.
 
 So a box whose faces lie on voxel boundaries gives exactly the voxels it
-encloses: its outer layer in surface mode, all of them in solid mode.
+encloses: its outer layer in surface mode, all of them in solid mode. Grid
+coordinates within ``SNAP`` (1e-4) of a voxel of a boundary or a centre are
+put on it first: mesh files round (an STL holds float32).
 """
 
 from __future__ import annotations
@@ -191,7 +193,7 @@ def grid_triangles(mesh: Mesh, voxel_size: float, placement: Placement | None = 
     vertices = mesh.vertices
     low, high = vertices.min(axis=0), vertices.max(axis=0)
     if placement is None:
-        grid = (vertices - low) / vs - 0.5
+        grid = _snap((vertices - low) / vs - 0.5)
     else:
         if not all(math.isfinite(v) for v in (placement.x, placement.y, placement.z, placement.heading)):
             raise FieldError("at", placement, "finite x, y, z metres and heading degrees")
@@ -203,12 +205,14 @@ def grid_triangles(mesh: Mesh, voxel_size: float, placement: Placement | None = 
         # Clockwise from north: the mesh's +y (forward) goes to (sin h, cos h).
         east = local[:, 0] * cos + local[:, 1] * sin
         north = local[:, 1] * cos - local[:, 0] * sin
-        grid = np.column_stack(
-            [
-                (placement.x + east) / vs,
-                (placement.y + north) / vs,
-                (placement.z + local[:, 2]) / vs - 0.5,
-            ]
+        grid = _snap(
+            np.column_stack(
+                [
+                    (placement.x + east) / vs,
+                    (placement.y + north) / vs,
+                    (placement.z + local[:, 2]) / vs - 0.5,
+                ]
+            )
         )
         lowest = grid.min(axis=0)
         for axis, name, way in ((0, "x", "east"), (1, "y", "north")):
@@ -221,7 +225,6 @@ def grid_triangles(mesh: Mesh, voxel_size: float, placement: Placement | None = 
                     f"it reaches {name} = {lowest[axis] * vs:.3f} m, {short:.3f} m past the scene's "
                     f"edge at {name} = {-0.5 * vs:g} m (voxel indices start at 0); move it {way}",
                 )
-    grid = _snap(grid)
     if grid.max() > MAX_INDEX - 1:
         raise FieldError("voxel_size", voxel_size, f"a size keeping voxel indices below {MAX_INDEX}")
     return np.ascontiguousarray(grid[mesh.faces])
