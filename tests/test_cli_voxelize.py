@@ -171,3 +171,34 @@ def test_a_bad_scene_file_is_one_line_naming_its_line(tmp_path, truck, forest, c
     assert main([*args, "--into", str(forest)]) == 2
     assert one_error_line(capsys).startswith(f"ladartui: error: {forest}:2: y = 'five' is not a whole number")
     assert not (tmp_path / "out.txt").exists()
+
+
+def test_cancelled_writes_leave_the_earlier_files(tmp_path, forest, monkeypatch):
+    import threading
+
+    from ladartui.errors import Cancelled
+    from ladartui.scene import insertion as module
+
+    monkeypatch.setattr(module, "_WRITE_ROWS", 100)
+    vehicle = np.array([[i, j, 0] for i in range(20, 40) for j in range(20, 40)], dtype=np.int32)
+    scene, target, had = module.load_scene_model(forest)
+    inserted = module.insert_vehicle(scene, target, vehicle, 0.1, had)
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    cancel = threading.Event()
+    stages = []
+
+    def cancel_on_second_chunk(stage, done, total):
+        stages.append((stage, done, total))
+        if len(stages) == 2:
+            cancel.set()
+
+    with pytest.raises(Cancelled):
+        module.write_scene_model(forest, inserted, cancel, cancel_on_second_chunk)
+    with pytest.raises(Cancelled):
+        module.save_model(tmp_path / "forest_Target.txt", vehicle, cancel)
+    assert stages[:2] == [("writing", 100, len(inserted.scene)), ("writing", 200, len(inserted.scene))]
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before  # no temporaries left either
+    cancel.clear()
+    module.write_scene_model(forest, inserted, cancel)
+    np.testing.assert_array_equal(load_voxels(forest), inserted.scene)
+    np.testing.assert_array_equal(load_voxels(tmp_path / "forest_Target.txt"), inserted.target)

@@ -116,14 +116,13 @@ def _work(args, placement, outputs, console, cancel):
     """Read, voxelise (with progress), insert and write; runs on the worker thread."""
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-    from ladartui.scene.insertion import insert_vehicle, load_scene_model, write_scene_model
+    from ladartui.scene.insertion import insert_vehicle, load_scene_model, save_model, write_scene_model
     from ladartui.scene.voxelize import CANCELLED, load_mesh, voxelize
-    from ladartui.scene.voxels import save_voxels
 
     columns = (
-        TextColumn("{task.description}"),
+        TextColumn("{task.description}", markup=False),  # paths are not markup
         BarColumn(),
-        TextColumn("{task.fields[done]}"),
+        TextColumn("{task.fields[done]}", markup=False),
         TimeElapsedColumn(),
     )
     # A bar only on a terminal: a log or a pipe gets the summary alone.
@@ -132,14 +131,20 @@ def _work(args, placement, outputs, console, cancel):
         mesh = load_mesh(args.mesh, scale=args.scale, up=args.up)
         for note in mesh.notes:
             console.print(
-                f"note: {mesh.path}: {one_line(note)}", highlight=False, markup=False, soft_wrap=True
+                one_line(f"note: {mesh.path}: {note}"), highlight=False, markup=False, soft_wrap=True
             )
         if args.into:  # a bad scene file is found before the work
             bar.update(task, description=f"reading {args.into}")
             scene, target, had_target = load_scene_model(args.into)
         bar.update(task, description="voxelising", total=1.0, completed=0.0)
 
-        units = {"surface": "triangles", "inside": "triangles", "filling": "slabs", "collecting": "slabs"}
+        units = {
+            "surface": "triangles",
+            "inside": "triangles",
+            "filling": "slabs",
+            "collecting": "slabs",
+            "writing": "voxels",
+        }
 
         def report(stage: str, done: int, total: int) -> None:
             bar.update(
@@ -153,13 +158,12 @@ def _work(args, placement, outputs, console, cancel):
             result = voxelize(mesh, args.voxel_size, placement, args.solid, progress=report, cancel=cancel)
         if cancel.is_set():
             raise Cancelled(CANCELLED)
-        bar.update(task, description="writing", total=None, done="")
         if not args.into:
-            save_voxels(outputs[0], result.voxels)
+            save_model(outputs[0], result.voxels, cancel, report)
             return mesh, result, None
         with _flag_names():
             insertion = insert_vehicle(scene, target, result.voxels, args.voxel_size, had_target, args.into)
-        write_scene_model(args.out, insertion, cancel)
+        write_scene_model(args.out, insertion, cancel, report)
         return mesh, result, insertion
 
 

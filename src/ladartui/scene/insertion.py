@@ -1,4 +1,4 @@
-"""Putting a voxelised vehicle into a scene model and its target model.
+"""Putting a voxelised vehicle into a scene model and its target model; writing models.
 
 The report keeps the target in the same x-y location in both files (table
 2): the vehicle's voxels join the scene model ``X.txt`` and its target model
@@ -87,21 +87,63 @@ def insert_vehicle(
     )
 
 
-def write_scene_model(out, insertion: Insertion, cancel: threading.Event | None = None) -> tuple[Path, Path]:
+def write_scene_model(
+    out,
+    insertion: Insertion,
+    cancel: threading.Event | None = None,
+    progress: Callable[[str, int, int], None] | None = None,
+) -> tuple[Path, Path]:
     """Write ``X.txt`` and ``X_Target.txt`` as one set (both or neither); returns their paths."""
     from ladartui.outputset import OutputSet
-    from ladartui.scene.voxels import format_voxel_lines
 
     scene_path, target_path = scene_model_paths(out)
     paths = {"scene": scene_path, "target": target_path}
     lock = scene_path.with_name(f".{scene_path.stem}.model.lock")
 
     def writer(voxels: np.ndarray) -> Callable[[Path], None]:
-        def write(tmp: Path) -> None:
-            tmp.write_bytes(format_voxel_lines(voxels))
-
-        return write
+        return lambda tmp: write_voxel_lines(tmp, voxels, cancel, progress)
 
     with OutputSet(paths, lock) as output_set:
         output_set.write({"scene": writer(insertion.scene), "target": writer(insertion.target)}, cancel)
     return scene_path, target_path
+
+
+def save_model(
+    path,
+    voxels: np.ndarray,
+    cancel: threading.Event | None = None,
+    progress: Callable[[str, int, int], None] | None = None,
+) -> None:
+    """Write one voxel list atomically; cancelled, it leaves ``path`` as it was."""
+    from ladartui.atomic import atomic_path
+
+    with atomic_path(path) as tmp:
+        write_voxel_lines(tmp, voxels, cancel, progress)
+
+
+_WRITE_ROWS = 1_000_000  # rows formatted at a time: cancel is checked between them
+
+
+def write_voxel_lines(
+    path: Path,
+    voxels: np.ndarray,
+    cancel: threading.Event | None = None,
+    progress: Callable[[str, int, int], None] | None = None,
+) -> None:
+    """``x,y,z`` lines of (N, 3) non-negative voxels into ``path`` (a temporary the caller swaps in).
+
+    Formatted a million rows at a time, so a large model needs no text
+    buffer of its own size and a set ``cancel`` stops it (``Cancelled``).
+    """
+    from ladartui.errors import Cancelled
+    from ladartui.scene.voxelize import CANCELLED
+    from ladartui.scene.voxels import format_voxel_lines
+
+    with open(path, "wb") as stream:
+        for start in range(0, len(voxels), _WRITE_ROWS):
+            if cancel is not None and cancel.is_set():
+                raise Cancelled(CANCELLED)
+            stop = min(start + _WRITE_ROWS, len(voxels))
+            stream.write(format_voxel_lines(voxels[start:stop]))
+            if progress is not None:
+                progress("writing", stop, len(voxels))

@@ -49,6 +49,7 @@ CANCELLED = "voxelisation cancelled; nothing was written"
 # this many triangles, or this many (triangle, voxel) tests (a few tens of ms).
 _CHUNK_TRIANGLES = 8192
 _CHUNK_TESTS = 2_000_000
+_WRITE_BUFFER = 64 * 2**20  # formatting a million rows: their int64 copy and text
 
 
 @dataclass(frozen=True)
@@ -289,8 +290,8 @@ def estimate_bytes(triangles: np.ndarray, solid: bool) -> int:
     # surface mode sets at most one voxel per (triangle, candidate voxel) test
     filled = cells if solid else min(cells, int(_candidate_tests(triangles).sum()))
     crossings = 4 * grid.shape[0] * grid.shape[1] * (grid.shape[2] + 1) if solid else 0
-    # Per voxel: the int32 list, and writing it (an int64 copy and about 20 bytes of text).
-    return cells + crossings + 56 * filled
+    # Per voxel: the int32 list; it is written a million rows at a time.
+    return cells + crossings + 12 * filled + _WRITE_BUFFER
 
 
 def _candidate_tests(triangles: np.ndarray) -> np.ndarray:
