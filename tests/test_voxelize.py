@@ -332,3 +332,10 @@ def test_rounding_at_the_scene_edge_is_not_a_refusal():
     slab = as_mesh(trimesh.creation.box(extents=(2.2, 0.6, 0.6)))
     result = voxelize(slab, 0.1, Placement(1.05, 1.05, 0.0), solid=True)
     assert voxel_set(result.voxels) == block(range(22), range(8, 14), range(6))
+
+
+def test_stray_vertices_do_not_move_the_mesh():
+    box = trimesh.creation.box(extents=(3, 4, 5))
+    vertices = np.vstack([box.vertices, [[-40.0, -40.0, -40.0]]])  # in no triangle
+    mesh = Mesh(Path("stray.obj"), vertices, np.asarray(box.faces), True, "")
+    assert voxel_set(voxelize(mesh, 1.0, solid=True).voxels) == block(range(3), range(4), range(5))

@@ -192,7 +192,8 @@ def grid_triangles(mesh: Mesh, voxel_size: float, placement: Placement | None = 
     """
     vs = _checked_size(voxel_size)
     vertices = mesh.vertices
-    low, high = vertices.min(axis=0), vertices.max(axis=0)
+    used = vertices[np.unique(mesh.faces)]  # stray vertices in no triangle do not move the mesh
+    low, high = used.min(axis=0), used.max(axis=0)
     if placement is None:
         grid = _snap((vertices - low) / vs - 0.5)
     else:
