@@ -339,3 +339,17 @@ def test_stray_vertices_do_not_move_the_mesh():
     vertices = np.vstack([box.vertices, [[-40.0, -40.0, -40.0]]])  # in no triangle
     mesh = Mesh(Path("stray.obj"), vertices, np.asarray(box.faces), True, "")
     assert voxel_set(voxelize(mesh, 1.0, solid=True).voxels) == block(range(3), range(4), range(5))
+
+
+def test_voxelize_modules_do_not_import_textual():
+    import subprocess
+    import sys
+
+    probe = (
+        "import sys\n"
+        "import ladartui.scene.voxelize, ladartui.scene.voxelize_kernels, ladartui.scene.insertion\n"
+        "import ladartui.cli.voxelize\n"
+        "print(sorted(m for m in sys.modules if m.split('.')[0] == 'textual'))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
+    assert done.stdout.strip() == "[]"
