@@ -109,10 +109,10 @@ def test_surface_voxels_agree_with_clipping_on_random_triangles():
         np.testing.assert_array_equal(grid, expected)
 
 
-def test_sphere_solid_count_follows_its_volume():
-    radius = 20.0
+@pytest.mark.parametrize("radius", [20.0, 50.0])
+def test_sphere_solid_count_follows_its_volume(radius):
     sphere = trimesh.creation.icosphere(subdivisions=5, radius=radius)
-    result = voxelize(as_mesh(sphere), 1.0, Placement(25.0, 25.0, 0.0), solid=True)
+    result = voxelize(as_mesh(sphere), 1.0, Placement(radius + 5, radius + 5, 0.0), solid=True)
     volume = sphere.volume
     # Centres inside sample the volume: within a fraction of a per cent.
     assert abs(result.inside - volume) / volume < 0.005
@@ -122,6 +122,8 @@ def test_sphere_solid_count_follows_its_volume():
     assert abs(len(result.voxels) - grown) / grown < 0.01
     assert len(result.voxels) - result.surface <= volume <= len(result.voxels)
     assert len(np.unique(result.voxels, axis=0)) == len(result.voxels)
+    # The half-voxel shell is 9 / (4 R) of the volume: within a few per cent from R = 50 voxels.
+    assert abs(len(result.voxels) - volume) / volume < (0.05 if radius >= 50 else 0.13)
 
 
 def test_inside_centres_of_a_random_convex_mesh_match_its_face_planes():
