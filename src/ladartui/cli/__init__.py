@@ -27,6 +27,7 @@ COMMANDS = {
     "sweep": "sweep",
     "pulses": "pulses",
     "certs": "certs",
+    "voxelize": "voxelize",
     "tui": "tui",
 }
 

@@ -1,0 +1,217 @@
+"""``ladartui voxelize MESH OUT``: a target model from a triangle mesh, optionally put into a scene."""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import threading
+import time
+
+from ladartui.cli.progress import run_cancellable, sigterm_as_interrupt
+from ladartui.errors import Cancelled, FieldError
+from ladartui.textsafe import one_line
+
+
+def add_parser(subparsers):
+    parser = subparsers.add_parser(
+        "voxelize",
+        help="make a target model from a mesh (.obj, .stl, .ply), optionally inserted into a scene",
+        description="Voxelise a triangle mesh exactly: a voxel is set when the surface passes "
+        "through its interior (a face lying on a voxel boundary counts for the voxel on its "
+        "inner side), and with --solid also when its centre is inside the closed mesh. The mesh "
+        "is in metres (see --scale), z up (see --up), its +y the vehicle's forward direction. "
+        "Without --into, OUT is the target model (a comma-delimited voxel list). With --into "
+        "SCENE.txt, the vehicle is added to that scene model and its SCENE_Target.txt, written "
+        "together as OUT.txt and OUT_Target.txt (OUT may be SCENE itself).",
+    )
+    parser.add_argument("mesh", metavar="MESH", help="mesh file: .obj, .stl or .ply")
+    parser.add_argument(
+        "out", metavar="OUT", help="target model to write (.txt added when missing); with --into, the scene"
+    )
+    parser.add_argument(
+        "--voxel-size", metavar="V", type=float, required=True, help="voxel size in metres (the scene's)"
+    )
+    parser.add_argument(
+        "--at",
+        metavar="X,Y[,Z]",
+        help="where the middle of the mesh's footprint goes, metres in the scene; Z is the height "
+        "of its lowest point above the ground (default 0, resting on flat ground). Without --at "
+        "the mesh starts at voxel (0, 0, 0)",
+    )
+    parser.add_argument(
+        "--heading", metavar="DEG", type=float, default=0.0, help="degrees clockwise from north (needs --at)"
+    )
+    parser.add_argument("--solid", action="store_true", help="fill the inside (needs a closed mesh)")
+    parser.add_argument(
+        "--into", metavar="SCENE", help="scene model (X.txt) to add the vehicle to, with X_Target.txt"
+    )
+    # --id ID (the vehicle's target id, a fourth column of the target model) goes here.
+    parser.add_argument(
+        "--scale", metavar="S", type=float, default=1.0, help="metres per mesh unit (default 1; 0.001 for mm)"
+    )
+    parser.add_argument("--up", choices=("z", "y"), default="z", help="the mesh's up axis (default z)")
+    parser.set_defaults(handler=run)
+    return parser
+
+
+def _position(text: str) -> tuple[float, ...]:
+    try:
+        values = tuple(float(part) for part in text.split(","))
+    except ValueError:
+        values = ()
+    if len(values) not in (2, 3) or not all(math.isfinite(v) for v in values):
+        raise FieldError("--at", text, "X,Y or X,Y,Z in metres, e.g. 30,25")
+    return values
+
+
+def run(args) -> int:
+    from pathlib import Path
+
+    from rich.console import Console
+
+    from ladartui.outputset import check_writable
+    from ladartui.scene.insertion import scene_model_paths
+    from ladartui.scene.voxelize import CANCELLED, Placement
+
+    if not (args.voxel_size > 0 and math.isfinite(args.voxel_size)):
+        raise FieldError("--voxel-size", args.voxel_size, "a positive number of metres")
+    if not (args.scale > 0 and math.isfinite(args.scale)):
+        raise FieldError("--scale", args.scale, "a positive number of metres per mesh unit")
+    if not math.isfinite(args.heading):
+        raise FieldError("--heading", args.heading, "degrees clockwise from north")
+    if args.at is None and (args.heading or args.into):
+        flag = "--into" if args.into else "--heading"
+        raise FieldError(flag, args.into or args.heading, "--at X,Y too: where the vehicle goes in the scene")
+    placement = None
+    if args.at is not None:
+        x, y, *rest = _position(args.at)
+        placement = Placement(x, y, rest[0] if rest else 0.0, args.heading)
+    outputs: tuple[Path, ...]
+    if args.into:
+        outputs = scene_model_paths(args.out)
+    else:
+        target = Path(args.out)
+        if target.suffix.lower() != ".txt":
+            if target.suffix.lower() in (".obj", ".stl", ".ply"):
+                raise FieldError("OUT", args.out, "a voxel-list name ending in .txt, not a mesh")
+            target = target.with_name(target.name + ".txt")
+        outputs = (target,)
+    check_writable(*outputs)
+    errors = Console(stderr=True)
+    cancel = threading.Event()
+    started = time.perf_counter()
+    with sigterm_as_interrupt():
+        mesh, result, insertion = run_cancellable(
+            lambda: _work(args, placement, outputs, errors, cancel),
+            cancel,
+            "ladartui-voxelize",
+            Cancelled(CANCELLED),
+        )
+    elapsed = time.perf_counter() - started
+    _report(Console(), args, mesh, (result, insertion), outputs, elapsed)
+    return 0
+
+
+def _work(args, placement, outputs, console, cancel):
+    """Read, voxelise (with progress), insert and write; runs on the worker thread."""
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from ladartui.scene.insertion import insert_vehicle, load_scene_model, save_model, write_scene_model
+    from ladartui.scene.voxelize import CANCELLED, load_mesh, voxelize
+
+    columns = (
+        TextColumn("{task.description}", markup=False),  # paths are not markup
+        BarColumn(),
+        TextColumn("{task.fields[done]}", markup=False),
+        TimeElapsedColumn(),
+    )
+    # A bar only on a terminal: a log or a pipe gets the summary alone.
+    with Progress(*columns, console=console, transient=True, disable=not console.is_terminal) as bar:
+        task = bar.add_task(f"reading {args.mesh}", total=None, done="")
+        mesh = load_mesh(args.mesh, scale=args.scale, up=args.up)
+        for note in mesh.notes:
+            console.print(
+                one_line(f"note: {mesh.path}: {note}"), highlight=False, markup=False, soft_wrap=True
+            )
+        if args.into:  # a bad scene file is found before the work
+            bar.update(task, description=f"reading {args.into}")
+            scene, target, had_target = load_scene_model(args.into)
+        bar.update(task, description="voxelising", total=1.0, completed=0.0)
+
+        units = {
+            "surface": "triangles",
+            "inside": "triangles",
+            "filling": "slabs",
+            "collecting": "slabs",
+            "writing": "voxels",
+        }
+
+        def report(stage: str, done: int, total: int) -> None:
+            bar.update(
+                task,
+                description=stage,
+                completed=done / total,
+                done=f"{done:,}/{total:,} {units.get(stage, '')}",
+            )
+
+        with _flag_names():
+            result = voxelize(mesh, args.voxel_size, placement, args.solid, progress=report, cancel=cancel)
+        if cancel.is_set():
+            raise Cancelled(CANCELLED)
+        if not args.into:
+            save_model(outputs[0], result.voxels, cancel, report)
+            return mesh, result, None
+        with _flag_names():
+            insertion = insert_vehicle(scene, target, result.voxels, args.voxel_size, had_target, args.into)
+        write_scene_model(args.out, insertion, cancel, report)
+        return mesh, result, insertion
+
+
+@contextlib.contextmanager
+def _flag_names():
+    """Name the flag the user typed in the core's field errors (``at`` -> ``--at``)."""
+    try:
+        yield
+    except FieldError as error:
+        if error.field in ("at", "voxel_size"):
+            flag = "--" + error.field.replace("_", "-")
+            raise FieldError(flag, error.value, error.expected) from None
+        raise
+
+
+def _report(console, args, mesh, done, outputs, elapsed) -> None:
+    result, insertion = done
+    vs = args.voxel_size
+    kind = "solid" if result.solid else "surface"
+    detail = f"{result.surface:,} on the surface"
+    if result.solid:
+        detail += f", {result.inside:,} with their centre inside"
+    say = lambda text: console.print(text, highlight=False, markup=False, soft_wrap=True)  # noqa: E731
+    say(
+        f"{mesh.path}: {len(mesh.faces):,} triangle{'s' if len(mesh.faces) != 1 else ''}, "
+        f"{'closed' if mesh.closed else 'not closed'}; "
+        f"{kind} model of {len(result.voxels):,} voxels at {vs:g} m ({detail}) in {elapsed:.2f} s"
+    )
+    if len(result.voxels):
+        low, high = result.voxels.min(axis=0), result.voxels.max(axis=0)
+        say(
+            "voxels "
+            + ", ".join(f"{n} {lo}..{hi}" for n, lo, hi in zip("xyz", low, high))
+            + f" ({(high[0] - low[0] + 1) * vs:.2f} x {(high[1] - low[1] + 1) * vs:.2f} x "
+            f"{(high[2] - low[2] + 1) * vs:.2f} m)"
+        )
+    if insertion is None:
+        say(f"wrote {outputs[0]}")
+        return
+    scene_path, target_path = outputs
+    say(
+        f"wrote {scene_path} ({len(insertion.scene):,} voxels, {insertion.added:,} new) and "
+        f"{target_path} ({len(insertion.target):,} voxels"
+        + (", a new target model" if insertion.new_target else "")
+        + ")"
+    )
+    if insertion.occupied:
+        say(
+            f"note: {insertion.occupied:,} of the vehicle's voxels were already in the scene "
+            "(ground, plants or another vehicle)"
+        )

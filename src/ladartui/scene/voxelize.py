@@ -1,0 +1,410 @@
+"""Target models from triangle meshes (.obj, .stl, .ply), exactly voxelised.
+
+A mesh is read with trimesh, in metres (``scale`` converts other units) with z
+up (``up="y"`` for meshes modelled y-up), and its own x and y taken as east
+and north at heading 0: a vehicle modelled nose along +y faces ``heading``.
+
+Placement (:class:`Placement`): the point under the middle of the mesh's
+bounding box, at its lowest z, goes to scene position (x, y) metres at height
+z above the ground (the plane at voxel z = -0.5; 0 rests the mesh on flat
+ground), turned by the heading about the vertical through that point. That
+is the report's relation of scene and target models: the target sits at the
+same x-y location in both (table 2). Without a placement the mesh's
+bounding box starts at the corner of voxel (0, 0, 0), resting on the ground.
+
+Voxels (the rules in :mod:`ladartui.scene.voxelize_kernels`):
+
+- surface: every voxel whose interior the surface passes through; a face
+  lying exactly on a voxel boundary sets the voxel on its inner side (the
+  side its normal points away from), one touching only an edge or corner
+  sets nothing;
+- solid (closed meshes only): the surface voxels plus every voxel whose
+  centre is inside; together, exactly the voxels whose interior meets the
+  solid's interior.
+
+So a box whose faces lie on voxel boundaries gives exactly the voxels it
+encloses: its outer layer in surface mode, all of them in solid mode. Grid
+coordinates within ``SNAP`` (1e-4) of a voxel of a boundary or a centre are
+put on it first: mesh files round (an STL holds float32).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import logging
+import math
+import threading
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ladartui.errors import Cancelled, FieldError, InputFileError, ResourceLimitError
+from ladartui.scene.voxels import MAX_INDEX
+
+MESH_SUFFIXES = (".obj", ".stl", ".ply")
+CANCELLED = "voxelisation cancelled; nothing was written"
+# Progress and cancel are checked between kernel calls: each call takes at most
+# this many triangles, or this many (triangle, voxel) tests (a few tens of ms).
+_CHUNK_TRIANGLES = 8192
+_CHUNK_TESTS = 2_000_000
+_WRITE_BUFFER = 64 * 2**20  # formatting a million rows: their int64 copy and text
+
+
+@dataclass(frozen=True)
+class Placement:
+    """Where the mesh goes in the scene: metres, and degrees clockwise from north."""
+
+    x: float
+    y: float
+    z: float = 0.0  # height of the mesh's lowest point above the ground
+    heading: float = 0.0
+
+
+@dataclass(frozen=True)
+class Mesh:
+    """A triangle mesh in metres, z up, with outward normals when it is closed."""
+
+    path: Path
+    vertices: np.ndarray  # (V, 3) float64
+    faces: np.ndarray  # (F, 3) int64
+    closed: bool  # watertight and consistently wound
+    problem: str  # why it is not closed, in words ("" when it is)
+    notes: tuple[str, ...] = ()  # what the reader warned about (textures, metadata)
+
+
+@dataclass(frozen=True)
+class Voxelized:
+    """A voxelised mesh: sorted unique scene voxel indices."""
+
+    voxels: np.ndarray  # (N, 3) int32
+    surface: int  # how many of them the surface passes through
+    inside: int  # solid mode: how many centres lie inside (0 in surface mode)
+    solid: bool
+    voxel_size: float
+
+
+def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
+    """Read a mesh file; ``InputFileError`` naming the file for anything unreadable or empty."""
+    path = Path(path)
+    if not (scale > 0 and math.isfinite(scale)):
+        raise FieldError("scale", scale, "a positive number of metres per mesh unit")
+    if up not in ("y", "z"):
+        raise FieldError("up", up, "'z' or 'y'")
+    kind = path.suffix.lower()
+    if kind not in MESH_SUFFIXES:
+        raise InputFileError(path, f"unsupported mesh type {path.suffix!r}; expected .obj, .stl or .ply")
+    if not path.is_file():
+        what = "is a folder" if path.is_dir() else "no such file"
+        raise InputFileError(path, f"{what}; expected a mesh file ({kind})")
+    import trimesh
+
+    try:
+        with _trimesh_notes() as notes:
+            # process=True merges repeated vertices (an STL repeats them per triangle),
+            # so that closedness can be checked on the shared edges.
+            loaded = trimesh.load(str(path), file_type=kind[1:], force="mesh", process=True)
+    except Exception as error:  # trimesh's parsers raise many kinds on malformed text
+        raise InputFileError(
+            path, f"not a readable {kind[1:].upper()} mesh ({type(error).__name__}: {error})"
+        ) from None
+    faces = np.asarray(getattr(loaded, "faces", np.zeros((0, 3))), dtype=np.int64).reshape(-1, 3)
+    vertices = np.asarray(getattr(loaded, "vertices", np.zeros((0, 3))), dtype=np.float64).reshape(-1, 3)
+    if len(faces) == 0:
+        raise InputFileError(path, "holds no triangles; expected a triangle mesh")
+    if not np.all(np.isfinite(vertices)):
+        bad = int(np.count_nonzero(~np.all(np.isfinite(vertices), axis=1)))
+        raise InputFileError(path, f"{bad} vertices have coordinates that are not finite numbers")
+    problem = _closed_problem(loaded, len(vertices))
+    if not problem and _signed_volume(vertices, faces) < 0:
+        faces = faces[:, ::-1].copy()  # wound inside out: turn the normals outward
+    vertices = vertices * scale
+    if up == "y":
+        vertices = np.column_stack([vertices[:, 0], -vertices[:, 2], vertices[:, 1]])
+    return Mesh(path, vertices, faces, not problem, problem, tuple(notes))
+
+
+@contextlib.contextmanager
+def _trimesh_notes() -> Iterator[list[str]]:
+    """Collect what trimesh logs while reading (a texture it could not load), as one-line notes.
+
+    Left alone, its warnings would reach stderr with tracebacks through
+    logging's last-resort handler.
+    """
+    notes: list[str] = []
+
+    class Collect(logging.Handler):
+        def emit(self, record: logging.LogRecord) -> None:
+            notes.append(record.getMessage())
+
+    logger = logging.getLogger("trimesh")
+    handler = Collect(logging.WARNING)
+    propagate = logger.propagate
+    logger.addHandler(handler)
+    logger.propagate = False
+    try:
+        yield notes
+    finally:
+        logger.removeHandler(handler)
+        logger.propagate = propagate
+
+
+def _signed_volume(vertices: np.ndarray, faces: np.ndarray) -> float:
+    """Volume enclosed by a closed mesh; negative when its normals point inward."""
+    a, b, c = (vertices[faces[:, n]] - vertices[0] for n in range(3))
+    return float(np.einsum("ij,ij->", a, np.cross(b, c))) / 6.0
+
+
+def _closed_problem(mesh, vertex_count: int) -> str:
+    """Why the mesh does not bound a solid, in words; "" when it does."""
+    edges = np.sort(np.asarray(mesh.edges, dtype=np.int64), axis=1)
+    _, uses = np.unique(edges[:, 0] * vertex_count + edges[:, 1], return_counts=True)
+    open_edges = int(np.count_nonzero(uses == 1))
+    shared = int(np.count_nonzero(uses > 2))
+    if open_edges or shared:
+        parts = []
+        if open_edges:
+            parts.append(f"{open_edges:,} edges border only one triangle (holes)")
+        if shared:
+            parts.append(f"{shared:,} edges are shared by more than two triangles")
+        return "; ".join(parts)
+    if not mesh.is_winding_consistent:
+        return "its triangles are not wound consistently (some face inward)"
+    return ""
+
+
+def require_closed(mesh: Mesh) -> None:
+    """Solid voxelisation needs a closed mesh: ``InputFileError`` saying why this one is not."""
+    if not mesh.closed:
+        raise InputFileError(
+            mesh.path,
+            f"not a closed mesh: {mesh.problem}; solid voxelisation needs a closed surface "
+            "(repair the mesh, or leave out --solid for a surface model)",
+        )
+
+
+def grid_triangles(mesh: Mesh, voxel_size: float, placement: Placement | None = None) -> np.ndarray:
+    """The mesh's triangles as (T, 3, 3) float64 in scene grid units, placed.
+
+    Raises ``FieldError`` on ``placement`` when part of the mesh would fall
+    below the ground or at negative voxel indices.
+    """
+    vs = _checked_size(voxel_size)
+    vertices = mesh.vertices
+    used = vertices[np.unique(mesh.faces)]  # stray vertices in no triangle do not move the mesh
+    low, high = used.min(axis=0), used.max(axis=0)
+    if placement is None:
+        grid = _snap((vertices - low) / vs - 0.5)
+    else:
+        if not all(math.isfinite(v) for v in (placement.x, placement.y, placement.z, placement.heading)):
+            raise FieldError("at", placement, "finite x, y, z metres and heading degrees")
+        if placement.z < 0:
+            raise FieldError("at", placement.z, "a height of 0 m or more above the ground (z)")
+        centre = np.array([(low[0] + high[0]) / 2, (low[1] + high[1]) / 2, low[2]])
+        local = vertices - centre
+        cos, sin = _turn(placement.heading)
+        # Clockwise from north: the mesh's +y (forward) goes to (sin h, cos h).
+        east = local[:, 0] * cos + local[:, 1] * sin
+        north = local[:, 1] * cos - local[:, 0] * sin
+        grid = _snap(
+            np.column_stack(
+                [
+                    (placement.x + east) / vs,
+                    (placement.y + north) / vs,
+                    (placement.z + local[:, 2]) / vs - 0.5,
+                ]
+            )
+        )
+        lowest = grid.min(axis=0)
+        for axis, name, way in ((0, "x", "east"), (1, "y", "north")):
+            if lowest[axis] < -0.5:
+                short = (-0.5 - lowest[axis]) * vs
+                raise FieldError(
+                    "at",
+                    f"{placement.x:g},{placement.y:g},{placement.z:g}",
+                    f"a position keeping the mesh inside the scene: at heading {placement.heading:g} "
+                    f"it reaches {name} = {lowest[axis] * vs:.3f} m, {short:.3f} m past the scene's "
+                    f"edge at {name} = {-0.5 * vs:g} m (voxel indices start at 0); move it {way}",
+                )
+    if grid.max() > MAX_INDEX - 1:
+        raise FieldError("voxel_size", voxel_size, f"a size keeping voxel indices below {MAX_INDEX}")
+    return np.ascontiguousarray(grid[mesh.faces])
+
+
+# Grid coordinates within this much of a voxel of a voxel boundary or centre (a
+# multiple of 0.5) are put on it. Mesh files are not exact: an STL holds float32
+# (0.8 m is 0.800000012 m) and 1.6 m / 0.1 m is 16.000000000000004 in float64; a
+# box 1.6 m tall must not set a layer of voxels 2e-7 of a voxel above its top.
+# 1e-4 of a 0.1 m voxel is 10 micrometres, below anything a mesh means.
+SNAP = 1e-4
+
+
+def _snap(grid: np.ndarray) -> np.ndarray:
+    halves = np.round(grid * 2.0) / 2.0
+    return np.where(np.abs(grid - halves) <= SNAP, halves, grid)
+
+
+def _turn(heading: float) -> tuple[float, float]:
+    """cos and sin of a heading in degrees; exact at quarter turns (no 6e-17 residue)."""
+    quarter = heading / 90.0
+    if quarter == round(quarter):
+        return ((1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0))[int(round(quarter)) % 4]
+    radians = math.radians(heading)
+    return math.cos(radians), math.sin(radians)
+
+
+def _checked_size(voxel_size) -> float:
+    try:
+        size = float(voxel_size)
+    except (TypeError, ValueError):
+        size = float("nan")
+    if not (size > 0 and math.isfinite(size)):
+        raise FieldError("voxel_size", voxel_size, "a positive number of metres")
+    return size
+
+
+@dataclass(frozen=True)
+class _Grid:
+    """The dense working grid over the triangles' bounding box, in scene indices."""
+
+    origin: np.ndarray  # (3,) int64, scene index of the grid's voxel (0, 0, 0)
+    shape: tuple[int, int, int]
+
+
+def _working_grid(triangles: np.ndarray) -> _Grid:
+    flat = triangles.reshape(-1, 3)
+    lo = np.maximum(np.ceil(flat.min(axis=0) - 0.5), 0).astype(np.int64)
+    hi = np.floor(flat.max(axis=0) + 0.5).astype(np.int64)
+    nx, ny, nz = (int(n) for n in np.maximum(hi - lo + 1, 1))
+    return _Grid(lo, (nx, ny, nz))
+
+
+def estimate_bytes(triangles: np.ndarray, solid: bool) -> int:
+    """Peak bytes of voxelising ``triangles`` and writing the result.
+
+    The dense grid, the crossings (solid), the voxel list and its text; the
+    voxel count is bounded by the grid (solid) or the triangle-voxel tests.
+    """
+    grid = _working_grid(triangles)
+    cells = math.prod(grid.shape)
+    # surface mode sets at most one voxel per (triangle, candidate voxel) test
+    filled = cells if solid else min(cells, int(_candidate_tests(triangles).sum()))
+    crossings = 4 * grid.shape[0] * grid.shape[1] * (grid.shape[2] + 1) if solid else 0
+    # Per voxel: the int32 list; it is written a million rows at a time.
+    return cells + crossings + 12 * filled + _WRITE_BUFFER
+
+
+def _candidate_tests(triangles: np.ndarray) -> np.ndarray:
+    """Per triangle, how many voxels its bounding box touches: the surface pass's tests."""
+    lo = np.ceil(triangles.min(axis=1) - 0.5)
+    hi = np.floor(triangles.max(axis=1) + 0.5)
+    return np.prod(np.maximum(hi - lo + 1, 0), axis=1)  # float64: no overflow
+
+
+def _chunk_bounds(tests: np.ndarray) -> list[int]:
+    """Triangle indices splitting the work into calls of bounded size."""
+    cumulative = np.cumsum(tests)
+    bounds = [0]
+    while bounds[-1] < len(tests):
+        start = bounds[-1]
+        before = cumulative[start - 1] if start else 0.0
+        stop = int(np.searchsorted(cumulative, before + _CHUNK_TESTS, side="right"))
+        bounds.append(min(max(stop, start + 1), start + _CHUNK_TRIANGLES, len(tests)))
+    return bounds
+
+
+def voxelize(
+    mesh: Mesh,
+    voxel_size: float,
+    placement: Placement | None = None,
+    solid: bool = False,
+    progress: Callable[[str, int, int], None] | None = None,
+    cancel: threading.Event | None = None,
+) -> Voxelized:
+    """Voxelise ``mesh`` exactly (see the module's rules) at ``voxel_size`` metres.
+
+    ``progress(stage, done, total)`` is called from this thread between
+    chunks of each stage ("surface" and "inside" count triangles, "filling"
+    and "collecting" x slabs of the grid); a set ``cancel`` stops with
+    ``Cancelled``. Work whose memory
+    would exceed the machine is refused up front with ``ResourceLimitError``.
+    """
+    from ladartui.resources import available_memory, gib
+
+    if solid:
+        require_closed(mesh)
+    triangles = grid_triangles(mesh, voxel_size, placement)
+    need = estimate_bytes(triangles, solid)
+    limit = available_memory()
+    grid = _working_grid(triangles)
+    if need > limit:
+        nx, ny, nz = grid.shape
+        raise ResourceLimitError(
+            f"{mesh.path}: voxel size {voxel_size:g} m makes a {nx:,} x {ny:,} x {nz:,} voxel box "
+            f"needing about {gib(need)}, more than the {gib(limit)} of memory available; "
+            "use a larger --voxel-size"
+        )
+    from ladartui.scene import voxelize_kernels as kernels
+
+    local = triangles - grid.origin.astype(np.float64)  # exact: whole numbers
+    marks = np.zeros(grid.shape, dtype=np.uint8)
+
+    def stage(name: str, bounds: list[int], step: Callable[[int, int], object]) -> None:
+        for start, stop in zip(bounds, bounds[1:]):
+            if cancel is not None and cancel.is_set():
+                raise Cancelled(CANCELLED)
+            step(start, stop)
+            if progress is not None:
+                progress(name, stop, bounds[-1])
+
+    triangle_chunks = _chunk_bounds(_candidate_tests(local))
+    stage("surface", triangle_chunks, lambda a, b: kernels.mark_surface(local, a, b, marks))
+    surface = int(np.count_nonzero(marks))
+    if surface == 0:
+        raise InputFileError(
+            mesh.path,
+            f"sets no voxels at {voxel_size:g} m: its surface only lies on or touches voxel "
+            "boundaries (a face on a boundary counts for the voxel behind it, away from its normal)",
+        )
+    slabs = _slab_bounds(grid.shape)
+    inside = 0
+    if solid:
+        crossings = np.zeros((*grid.shape[:2], grid.shape[2] + 1), dtype=np.int32)
+        stage("inside", triangle_chunks, lambda a, b: kernels.add_crossings(local, a, b, crossings))
+        counts: list[int] = []
+        stage("filling", slabs, lambda a, b: counts.append(kernels.fill_inside(crossings, marks, a, b)))
+        inside = int(sum(counts))
+        del crossings
+    voxels = np.empty((int(np.count_nonzero(marks)), 3), dtype=np.int32)
+    rows = [0]
+    origin = grid.origin.astype(np.int32)
+    stage(
+        "collecting",
+        slabs,
+        lambda a, b: rows.append(kernels.collect_voxels(marks, a, b, origin, voxels, rows[-1])),
+    )
+    return Voxelized(voxels, surface, inside, solid, float(voxel_size))
+
+
+def _slab_bounds(shape: tuple[int, int, int]) -> list[int]:
+    """x indices splitting a grid pass into calls of about ``_CHUNK_TESTS`` cells."""
+    per_slab = max(shape[1] * shape[2], 1)
+    step = max(1, _CHUNK_TESTS // per_slab)
+    return [*range(0, shape[0], step), shape[0]]
+
+
+def merge_voxels(*lists: np.ndarray) -> np.ndarray:
+    """The union of voxel lists, sorted by (x, y, z) like the files this project writes."""
+    from ladartui.scene.voxels import voxel_keys
+
+    stacked = np.concatenate([np.asarray(v, dtype=np.int32).reshape(-1, 3) for v in lists])
+    if len(stacked) == 0:
+        return np.zeros((0, 3), dtype=np.int32)
+    shape = stacked.max(axis=0).astype(np.int64) + 1
+    keys = voxel_keys(stacked, shape)
+    if keys is None:  # too large to pack: the slower row-wise unique
+        return np.unique(stacked, axis=0).astype(np.int32)
+    keys = np.unique(keys)
+    ny, nz = int(shape[1]), int(shape[2])
+    return np.column_stack([keys // (ny * nz), keys // nz % ny, keys % nz]).astype(np.int32)

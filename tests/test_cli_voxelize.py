@@ -1,0 +1,204 @@
+"""``ladartui voxelize``: target models from meshes, inserted into scene models, and its errors."""
+
+import numpy as np
+import pytest
+import trimesh
+
+from ladartui.cli import main
+from ladartui.scene.model import Scene
+from ladartui.scene.voxelize import Placement, load_mesh, merge_voxels, voxelize
+from ladartui.scene.voxels import load_voxels, save_voxels
+
+
+@pytest.fixture
+def truck(tmp_path):
+    """A closed 2 x 4 x 1.5 m box, as an STL file."""
+    path = tmp_path / "truck.stl"
+    trimesh.creation.box(extents=(2.0, 4.0, 1.5)).export(path)
+    return path
+
+
+@pytest.fixture
+def forest(tmp_path):
+    """A 6 x 6 m scene at 0.1 m (scattered plant voxels, a corner post) with a one-voxel target."""
+    rng = np.random.default_rng(5)
+    plants = rng.integers(0, 60, size=(400, 3))
+    plants[:, 2] = rng.integers(10, 40, size=400)
+    scene = np.vstack([plants, [[59, 59, 0], [0, 0, 0], [5, 55, 0]]])
+    save_voxels(tmp_path / "forest.txt", scene)
+    save_voxels(tmp_path / "forest_Target.txt", [[5, 55, 0]])
+    return tmp_path / "forest.txt"
+
+
+def one_error_line(capsys) -> str:
+    captured = capsys.readouterr()
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1, captured.err
+    assert "Traceback" not in captured.err
+    return lines[0]
+
+
+def test_writes_a_target_model_that_loads_back(tmp_path, truck, capsys):
+    out = tmp_path / "models" / "truck_Target.txt"
+    assert main(["voxelize", str(truck), str(out), "--voxel-size", "0.1", "--solid"]) == 0
+    voxels = load_voxels(out)
+    assert len(voxels) == 20 * 40 * 15  # faces on voxel boundaries: exactly the box
+    np.testing.assert_array_equal(voxels, voxelize(load_mesh(truck), 0.1, solid=True).voxels)
+    text = capsys.readouterr().out
+    assert "12 triangles, closed; solid model of 12,000 voxels at 0.1 m" in text
+    assert "voxels x 0..19, y 0..39, z 0..14 (2.00 x 4.00 x 1.50 m)" in text
+    assert f"wrote {out}" in text
+
+
+def test_adds_the_suffix_and_writes_surface_models(tmp_path, truck):
+    assert main(["voxelize", str(truck), str(tmp_path / "shell"), "--voxel-size", "0.1"]) == 0
+    assert len(load_voxels(tmp_path / "shell.txt")) == 20 * 40 * 15 - 18 * 38 * 13
+
+
+def test_inserts_a_turned_vehicle_into_a_scene_and_its_target(tmp_path, truck, forest, capsys):
+    before = load_voxels(forest)
+    out = tmp_path / "with_truck"
+    args = ["voxelize", str(truck), str(out), "--voxel-size", "0.1", "--solid"]
+    assert main([*args, "--at", "3,2.9", "--heading", "30", "--into", str(forest)]) == 0
+    vehicle = voxelize(load_mesh(truck), 0.1, Placement(3.0, 2.9, 0.0, 30.0), solid=True).voxels
+    scene = Scene.load(tmp_path / "with_truck.txt", 0.1)  # the scene and target loaders
+    np.testing.assert_array_equal(scene.voxels, merge_voxels(before, vehicle))
+    np.testing.assert_array_equal(scene.target, merge_voxels([[5, 55, 0]], vehicle))
+    # The turned vehicle keeps its voxel count within rounding: the box grown by a
+    # voxel's reach in plan (a b + 1 + (a + b)(cos + sin) cells a layer, 15 layers).
+    grown = (20 * 40 + 1 + 60 * (np.cos(np.pi / 6) + np.sin(np.pi / 6))) * 15
+    assert abs(len(vehicle) - grown) / grown < 0.01
+    # Same x-y location in both models: every target voxel is in the scene.
+    assert {tuple(v) for v in scene.target.tolist()} <= {tuple(v) for v in scene.voxels.tolist()}
+    occupied = len(before) + len(vehicle) - len(scene.voxels)
+    text = capsys.readouterr().out
+    assert f"({len(scene.voxels):,} voxels, {len(vehicle) - occupied:,} new)" in text
+    assert np.array_equal(load_voxels(forest), before)  # the input scene is untouched
+
+
+def test_insertion_in_place_replaces_both_files(tmp_path, truck, forest):
+    args = ["voxelize", str(truck), str(forest), "--voxel-size", "0.1", "--at", "3.05,3.05"]
+    assert main([*args, "--into", str(forest)]) == 0
+    assert len(load_voxels(tmp_path / "forest_Target.txt")) == 1 + 20 * 40 * 15 - 18 * 38 * 13
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["forest.txt", "forest_Target.txt", "truck.stl"]
+
+
+def test_a_scene_without_a_target_model_gets_one(tmp_path, truck, forest, capsys):
+    (tmp_path / "forest_Target.txt").unlink()
+    out = tmp_path / "new"
+    args = ["voxelize", str(truck), str(out), "--voxel-size", "0.1", "--at", "3.05,3.05"]
+    assert main([*args, "--into", str(forest)]) == 0
+    assert len(load_voxels(tmp_path / "new_Target.txt")) == 20 * 40 * 15 - 18 * 38 * 13
+    assert "a new target model" in capsys.readouterr().out
+
+
+def test_a_vehicle_past_the_scene_edge_is_refused_and_nothing_written(tmp_path, truck, forest, capsys):
+    args = ["voxelize", str(truck), str(tmp_path / "out"), "--voxel-size", "0.1", "--into", str(forest)]
+    assert main([*args, "--at", "5.5,3"]) == 2
+    line = one_error_line(capsys)
+    assert line == (
+        f"ladartui: error: {forest}: the vehicle would reach x = 6.550 m, past the scene's edge at "
+        "x = 5.95 m; place it inside the scene"
+    )
+    assert not (tmp_path / "out.txt").exists() and not (tmp_path / "out_Target.txt").exists()
+
+
+def test_open_mesh_in_solid_mode_is_one_line(tmp_path, capsys):
+    shape = trimesh.creation.box(extents=(1, 1, 1))
+    shape.faces = shape.faces[:-2]
+    mesh = tmp_path / "open.obj"
+    shape.export(mesh)
+    assert main(["voxelize", str(mesh), str(tmp_path / "t"), "--voxel-size", "0.1", "--solid"]) == 2
+    line = one_error_line(capsys)
+    assert line.startswith(f"ladartui: error: {mesh}: not a closed mesh: 4 edges border only one triangle")
+    assert "leave out --solid" in line
+    assert not (tmp_path / "t.txt").exists()
+    assert main(["voxelize", str(mesh), str(tmp_path / "t"), "--voxel-size", "0.1"]) == 0  # surface is fine
+
+
+@pytest.mark.parametrize(
+    ("name", "content", "message"),
+    [
+        ("bad.obj", "v 0 0 0\nv 1 0\nf 1 2 3\n", "not a readable OBJ mesh"),
+        ("bad.ply", "ply\nformat nonsense\n", "not a readable PLY mesh"),
+        ("empty.stl", "", "holds no triangles; expected a triangle mesh"),
+    ],
+)
+def test_malformed_mesh_is_one_line(tmp_path, capsys, name, content, message):
+    (tmp_path / name).write_text(content)
+    assert main(["voxelize", str(tmp_path / name), str(tmp_path / "t"), "--voxel-size", "0.1"]) == 2
+    line = one_error_line(capsys)
+    assert line.startswith(f"ladartui: error: {tmp_path / name}: {message}")
+    assert not (tmp_path / "t.txt").exists()
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        (["--at", "1,x"], "--at = '1,x': expected X,Y or X,Y,Z in metres"),
+        (["--heading", "30"], "--heading = 30.0: expected --at X,Y too"),
+        (["--into", "scene.txt"], "--into = 'scene.txt': expected --at X,Y too"),
+        (["--voxel-size", "-1"], "--voxel-size = -1.0: expected a positive number of metres"),
+        (["--at", "0.5,5"], "--at = '0.5,5,0': expected a position keeping the mesh inside the scene"),
+        (["--at", "5,5,-1"], "--at = -1.0: expected a height of 0 m or more above the ground"),
+    ],
+)
+def test_bad_flags_are_one_line(tmp_path, truck, capsys, extra, message):
+    assert main(["voxelize", str(truck), str(tmp_path / "t"), "--voxel-size", "0.1", *extra]) == 2
+    assert message in one_error_line(capsys)
+    assert not (tmp_path / "t.txt").exists()
+
+
+def test_memory_beyond_the_machine_is_refused_with_its_estimate(tmp_path, truck, capsys, monkeypatch):
+    monkeypatch.setenv("LADARTUI_MAX_MEMORY", str(64 * 2**20))
+    assert main(["voxelize", str(truck), str(tmp_path / "t"), "--voxel-size", "0.005", "--solid"]) == 2
+    line = one_error_line(capsys)
+    assert "voxel size 0.005 m makes a 401 x 801 x 301 voxel box needing about" in line
+    assert "more than the 64 MiB of memory available" in line
+
+
+def test_unwritable_output_is_refused_before_the_work(tmp_path, truck, forest, capsys):
+    (tmp_path / "out_Target.txt").mkdir()
+    args = ["voxelize", str(truck), str(tmp_path / "out"), "--voxel-size", "0.1", "--at", "3,3"]
+    assert main([*args, "--into", str(forest)]) == 2
+    assert "out_Target.txt: is a folder" in one_error_line(capsys)
+    assert not (tmp_path / "out.txt").exists()
+
+
+def test_a_bad_scene_file_is_one_line_naming_its_line(tmp_path, truck, forest, capsys):
+    forest.write_text("1,2,3\n4,five,6\n")
+    args = ["voxelize", str(truck), str(tmp_path / "out"), "--voxel-size", "0.1", "--at", "3,3"]
+    assert main([*args, "--into", str(forest)]) == 2
+    assert one_error_line(capsys).startswith(f"ladartui: error: {forest}:2: y = 'five' is not a whole number")
+    assert not (tmp_path / "out.txt").exists()
+
+
+def test_cancelled_writes_leave_the_earlier_files(tmp_path, forest, monkeypatch):
+    import threading
+
+    from ladartui.errors import Cancelled
+    from ladartui.scene import insertion as module
+
+    monkeypatch.setattr(module, "_WRITE_ROWS", 100)
+    vehicle = np.array([[i, j, 0] for i in range(20, 40) for j in range(20, 40)], dtype=np.int32)
+    scene, target, had = module.load_scene_model(forest)
+    inserted = module.insert_vehicle(scene, target, vehicle, 0.1, had)
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    cancel = threading.Event()
+    stages = []
+
+    def cancel_on_second_chunk(stage, done, total):
+        stages.append((stage, done, total))
+        if len(stages) == 2:
+            cancel.set()
+
+    with pytest.raises(Cancelled):
+        module.write_scene_model(forest, inserted, cancel, cancel_on_second_chunk)
+    with pytest.raises(Cancelled):
+        module.save_model(tmp_path / "forest_Target.txt", vehicle, cancel)
+    assert stages[:2] == [("writing", 100, len(inserted.scene)), ("writing", 200, len(inserted.scene))]
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before  # no temporaries left either
+    cancel.clear()
+    module.write_scene_model(forest, inserted, cancel)
+    np.testing.assert_array_equal(load_voxels(forest), inserted.scene)
+    np.testing.assert_array_equal(load_voxels(tmp_path / "forest_Target.txt"), inserted.target)
