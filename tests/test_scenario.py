@@ -349,7 +349,7 @@ def test_relative_segment_first_needs_a_start(tmp_path):
         (
             "[simulation]",
             "[simulatoin]",
-            "unknown section [simulatoin] (allowed: files, sensor, flight, simulation, detection)",
+            "unknown section [simulatoin] (allowed: files, sensor, flight, simulation, detection, targets)",
         ),
         (
             "heading = 0.0",

@@ -271,6 +271,9 @@ def _simulate(scenario, backend, method, step, precision, progress, cancel, outp
     )
     if runner.geiger is not None:
         measures = dataclasses.replace(measures, detection=runner.geiger.measures())
+    measures = dataclasses.replace(
+        measures, targets=_per_target(scenario, scene, per_scan, scene_output, target_output, measures)
+    )
     timings["measures"] = time.perf_counter() - tick
 
     outputs = {}
@@ -291,6 +294,27 @@ def _simulate(scenario, backend, method, step, precision, progress, cancel, outp
         rays_per_scan=scenario.sensor.rays_per_scan,
         timings=timings,
         outputs=outputs,
+    )
+
+
+def _per_target(scenario, scene, per_scan, scene_output, target_output, measures):
+    """Every measure for each target of the scene's target model, named by the scenario."""
+    from ladartui.target_measures import compute_target_measures
+
+    names = getattr(scenario, "target_name", None)
+    # Per-target detect/recognise/identify levels plug in on the result: each
+    # TargetMeasures.levels from its measures.obscured_after_scan and the flight.
+    return compute_target_measures(
+        scene.target,
+        scene.target_ids,
+        scene_output,
+        target_output,
+        scene_per_scan=per_scan["scene"],
+        target_per_scan=per_scan["target"],
+        names=names,
+        path_length_m=measures.path_length_m,
+        flight_time_s=measures.flight_time_s,
+        voxel_size=measures.voxel_size,
     )
 
 

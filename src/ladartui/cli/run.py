@@ -167,6 +167,9 @@ def show_result(console, result) -> None:
     for row in comparison_rows(result.measures):
         comparison.add_row(*row)
     console.print(comparison)
+    if result.measures.targets is not None:
+        for table in target_tables(result.measures.targets):
+            console.print(table)
     if result.measures.detection is not None:
         console.print(detection_table(result.measures.detection))
     total = result.timings.get("total", 0.0)
@@ -179,6 +182,31 @@ def show_result(console, result) -> None:
             console.print(f"wrote {name}: {path}", highlight=False, soft_wrap=True)
     else:
         console.print("nothing written (--no-write)")
+
+
+def target_tables(per_target):
+    """Each target's measures with the worst and mean, and each one's coverage after each scan."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    from ladartui.target_measures import TABLE_HEADER, TABLE_NOTE, after_scan_rows, table_rows
+
+    count = len(per_target.targets)
+    table = Table(
+        title=f"Measures per target ({count} target{'' if count == 1 else 's'})", caption=TABLE_NOTE
+    )
+    for index, name in enumerate(TABLE_HEADER):
+        table.add_column(name, justify="left" if index == 0 else "right")
+    rows = table_rows(per_target)
+    for index, row in enumerate(rows):
+        # Names come from the scenario file: shown as text, never as markup.
+        table.add_row(escape(row[0]), *row[1:], end_section=index == count - 1)
+    curves = Table(title="Obscured coverage after each scan, per target (%)", show_header=False)
+    curves.add_column("")
+    curves.add_column("")
+    for index, (name, curve) in enumerate(after_scan_rows(per_target)):
+        curves.add_row(escape(name), curve, end_section=index == count - 1)
+    return [table, curves]
 
 
 def detection_table(detection):
