@@ -74,7 +74,7 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
         ("voxels", f"{len(voxels):,}" + (f" ({duplicates:,} duplicate lines dropped)" if duplicates else ""))
     ]
     if ids is not None and len(ids):
-        rows.append(("targets", _targets_text(ids).removeprefix(" in ")))
+        rows.append(("targets", _targets_text(ids)))
     rows.append(("read in", f"{loaded:.2f} s"))
     shape = (0, 0, 0)
     if len(voxels):
@@ -91,10 +91,8 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
         target, ids = load_target(target_path)
         text = f"{target_path.name}: {len(target):,} voxels"
         if len(target):
-            text += _targets_text(ids)
-        if len(target):
             inside = _count_inside(target, voxels)
-            text += f", {inside:,} of them in the scene"
+            text += f", {inside:,} of them in the scene; {_targets_text(ids)}"
             centre = target.mean(axis=0)
             text += f"; centre ({centre[0]:.1f}, {centre[1]:.1f}, {centre[2]:.1f}) voxels"
             if voxel_size:
@@ -112,14 +110,14 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
 
 
 def _targets_text(ids) -> str:
-    """ " in 3 targets (ids 1, 2, 3)" or " in 1 target"."""
+    """ "3 targets (ids 1, 2, 3)" or "1 target (id 1)"."""
     import numpy as np
 
     distinct = [int(i) for i in np.unique(ids)]
     if len(distinct) == 1:
-        return f" in 1 target (id {distinct[0]})"
+        return f"1 target (id {distinct[0]})"
     shown = ", ".join(map(str, distinct[:8])) + (", ..." if len(distinct) > 8 else "")
-    return f" in {len(distinct)} targets (ids {shown})"
+    return f"{len(distinct)} targets (ids {shown})"
 
 
 def _count_inside(target, voxels) -> int:

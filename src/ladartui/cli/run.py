@@ -24,7 +24,11 @@ def add_parser(subparsers):
         "target alone (unobscured), fuse the returns, write S_Scene.txt, S_Target.txt and "
         "S.cmf beside the scenario, and show the measures of effectiveness.",
     )
-    parser.add_argument("scenario", metavar="SCENARIO", help="scenario file (.toml)")
+    parser.add_argument(
+        "scenario",
+        metavar="SCENARIO",
+        help="scenario file (.toml), or a bundled one by name: default, convoy (made on first use)",
+    )
     parser.add_argument(
         "--backend", metavar="B", help="tracing backend: auto, numba or wgpu (default: the scenario's)"
     )
@@ -61,7 +65,9 @@ def run(args) -> int:
         if not args.max_rays >= 1:
             raise FieldError("--max-rays", args.max_rays, "a number of rays >= 1")
         set_max_rays(int(args.max_rays))
-    scenario = load_scenario(args.scenario)
+    from ladartui.user_data import bundled_or_path
+
+    scenario = load_scenario(bundled_or_path(args.scenario))
     # Check the overrides like scenario fields, before any progress is drawn.
     for name in ("backend", "method", "step", "precision"):
         value = getattr(args, name)

@@ -12,15 +12,20 @@ def add_parser(subparsers):
         "print a summary (sensor, scans, path length, flight time, scene size, memory, "
         "outputs). A mistake is reported on one line with exit status 2.",
     )
-    parser.add_argument("scenario", metavar="SCENARIO", help="scenario file (.toml)")
+    parser.add_argument(
+        "scenario",
+        metavar="SCENARIO",
+        help="scenario file (.toml), or a bundled one by name (default, convoy)",
+    )
     parser.set_defaults(handler=run)
     return parser
 
 
 def run(args) -> int:
     from ladartui.scenario import load_scenario
+    from ladartui.user_data import bundled_or_path
 
-    scenario = load_scenario(args.scenario)
+    scenario = load_scenario(bundled_or_path(args.scenario))
     scene_lines = scene_summary(scenario)
     print(scenario.summary())
     for line in scene_lines:
