@@ -12,6 +12,7 @@ compared byte for byte:
   rule, fusion and ``compute_measures`` (the path before the options existed).
 """
 
+import dataclasses
 import shutil
 from pathlib import Path
 
@@ -22,6 +23,7 @@ from ladartui.scenario import load_scenario
 from ladartui.scene.voxels import save_voxels
 from ladartui.sensor import Sensor
 from ladartui.simulation import fuse_scans, scan_returns, simulate
+from ladartui.target_measures import compute_target_measures
 from ladartui.tracing import trace
 from ladartui.user_data import default_scenario_path
 
@@ -93,6 +95,19 @@ def _ideal_by_hand(scenario, folder):
         flight_time_s=scenario.flight_time(),
         voxel_size=scene.voxel_size,
     )
+    # Every run scores each target of the target model too (one here).
+    per_target = compute_target_measures(
+        scene.target,
+        scene.target_ids,
+        scene_output,
+        target_output,
+        per_scan["scene"],
+        per_scan["target"],
+        path_length_m=measures.path_length_m,
+        flight_time_s=measures.flight_time_s,
+        voxel_size=measures.voxel_size,
+    )
+    measures = dataclasses.replace(measures, targets=per_target)
     folder.mkdir()
     save_voxels(folder / "scene.txt", scene_output)
     save_voxels(folder / "target.txt", target_output)

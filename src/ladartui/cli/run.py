@@ -173,8 +173,9 @@ def show_result(console, result) -> None:
     for row in comparison_rows(result.measures):
         comparison.add_row(*row)
     console.print(comparison)
-    if result.measures.targets is not None:
-        for table in target_tables(result.measures.targets):
+    targets = result.measures.targets
+    if targets is not None and len(targets.targets) > 1:  # one target: the tables above are its own
+        for table in target_tables(targets):
             console.print(table)
     if result.measures.detection is not None:
         console.print(detection_table(result.measures.detection))
