@@ -332,6 +332,19 @@ def test_convoy_is_made_on_first_use_with_three_named_targets():
     centre = np.array(scenario.flight.segments[0].centre)
     assert np.allclose(centre, scene.target.mean(axis=0) * scene.voxel_size, atol=0.01)
     small = scenario.with_changes(sensor=Sensor(grid=24, ray_grid=1, fov=36.0), backend="numba")
-    m = simulate(small, write=False).measures
+    m = simulate(small).measures
     assert [t.name for t in m.targets.targets] == ["netted truck", "truck B", "truck C"]
     assert all(t.measures.obscured_after_scan is not None for t in m.targets.targets)
+    # Its outputs sit beside it without touching its models: a second run reads the same.
+    assert read_cmf(small.measures_file) == m
+    assert load_scenario(path).load_scene().target_id_list == [1, 2, 3]
+
+
+def test_a_run_never_overwrites_its_own_model_files(tmp_path):
+    # Scenario forest.toml writes forest_Target.txt: the target model of forest.txt.
+    scenario = two_box_scenario(tmp_path).with_changes(path=tmp_path / "boxes.toml")
+    before = (tmp_path / "boxes_Target.txt").read_bytes()
+    with pytest.raises(FieldError, match=r"boxes.toml: files.scene = 'boxes.txt'.*boxes_Target.txt would"):
+        simulate(scenario)
+    assert (tmp_path / "boxes_Target.txt").read_bytes() == before
+    assert not (tmp_path / "boxes.cmf").exists()

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import os
 import threading
 import time
 from collections.abc import Callable
@@ -441,9 +442,30 @@ def output_paths(scenario, las=False) -> dict[str, Path]:
     return paths
 
 
+def check_outputs_spare_inputs(scenario, las=False) -> None:
+    """Refuse a run whose outputs would overwrite its own model files.
+
+    A scenario ``S.toml`` writes ``S_Target.txt``: with the scene model named
+    ``S.txt`` beside it, that is the target model itself.
+    """
+    from ladartui.errors import FieldError
+
+    inputs = {os.path.normpath(Path(f).absolute()) for f in (scenario.scene_file, scenario.target_file)}
+    for name, path in output_paths(scenario, las).items():
+        if os.path.normpath(path.absolute()) in inputs:
+            raise FieldError(
+                "files.scene",
+                Path(scenario.scene_file).name,
+                f"a scene model not named after the scenario: the run's {name} output "
+                f"{path.name} would overwrite a model file",
+                source=str(scenario.path),
+            )
+
+
 def _output_set(scenario, las):
     from ladartui.outputset import OutputSet
 
+    check_outputs_spare_inputs(scenario, las)
     path = Path(scenario.path)
     return OutputSet(output_paths(scenario, las), path.with_name(f".{path.stem}.outputs.lock"))
 

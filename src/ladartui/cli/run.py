@@ -79,8 +79,9 @@ def run(args) -> int:
             raise FieldError(f"--{name}", value, error.expected) from None
     if args.write:  # before any progress is drawn; the run checks again under its lock
         from ladartui.outputset import check_writable
-        from ladartui.simulation import output_paths
+        from ladartui.simulation import check_outputs_spare_inputs, output_paths
 
+        check_outputs_spare_inputs(scenario, args.las)
         check_writable(*output_paths(scenario, args.las).values())
     if args.chart is not None and not args.chart.lower().endswith((".svg", ".png")):
         raise FieldError("--chart", args.chart, "a file name ending in .svg or .png")

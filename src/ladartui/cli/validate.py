@@ -42,10 +42,18 @@ def scene_summary(scenario) -> list[str]:
     scene = scenario.load_scene()
     nx, ny, nz = scene.shape
     vs = scene.voxel_size
+    ids = scene.target_id_list if len(scene.target) else []
+    in_targets = f" in {len(ids)} targets" if len(ids) > 1 else ""
     lines = [
-        f"scene      {len(scene.voxels):,} voxels, target {len(scene.target):,} voxels; "
+        f"scene      {len(scene.voxels):,} voxels, target {len(scene.target):,} voxels{in_targets}; "
         f"extent {nx} x {ny} x {nz} voxels = {nx * vs:g} x {ny * vs:g} x {nz * vs:g} m"
     ]
+    unused = [i for i, _ in scenario.target_names if i not in ids]
+    if unused:  # a name for an id the target model does not hold: likely a typo
+        lines.append(
+            f"note       [targets] names ids {', '.join(map(str, unused))} are not in "
+            f"{scenario.target_file.name} (its ids: {', '.join(map(str, ids)) or 'none'})"
+        )
     need = 0
     for voxels, source in ((scene.voxels, scenario.scene_file), (scene.target, scenario.target_file)):
         if len(voxels):
