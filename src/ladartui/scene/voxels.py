@@ -269,7 +269,11 @@ def _unique_labelled(path: Path, voxels: np.ndarray, ids: np.ndarray) -> tuple[n
     """Drop repeated voxels (first kept); refuse a voxel given two different ids."""
     if len(voxels) < 2:
         return voxels, ids
-    _, first, inverse = np.unique(voxels, axis=0, return_index=True, return_inverse=True)
+    keys = _numpy_keys(voxels)
+    if keys is not None and bool(np.all(keys[1:] > keys[:-1])):  # sorted (ours are): no repeats
+        return voxels, ids
+    rows = voxels if keys is None else keys  # one int64 a voxel sorts faster than rows
+    _, first, inverse = np.unique(rows, axis=0, return_index=True, return_inverse=True)
     inverse = inverse.reshape(-1)
     conflict = np.flatnonzero(ids != ids[first[inverse]])
     if len(conflict):
