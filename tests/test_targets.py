@@ -348,3 +348,21 @@ def test_a_run_never_overwrites_its_own_model_files(tmp_path):
         simulate(scenario)
     assert (tmp_path / "boxes_Target.txt").read_bytes() == before
     assert not (tmp_path / "boxes.cmf").exists()
+
+
+def test_las_outputs_mark_each_voxel_with_its_target(tmp_path):
+    laspy = pytest.importorskip("laspy")
+    scenario = two_box_scenario(tmp_path)
+    result = simulate(scenario, las=True)
+    for name, output in (("S_Target.las", result.target_output), ("S_Scene.las", result.scene_output)):
+        cloud = laspy.read(tmp_path / name)
+        voxels = np.floor(np.stack([cloud.x, cloud.y, cloud.z], axis=1) + 0.5).astype(int)
+        assert {tuple(v) for v in voxels.tolist()} == {tuple(v) for v in np.asarray(output).tolist()}
+        owner = {
+            **dict.fromkeys(map(tuple, OPEN.tolist()), 1),
+            **dict.fromkeys(map(tuple, ROOFED.tolist()), 2),
+        }
+        expected = [owner.get(tuple(v), 0) for v in voxels.tolist()]
+        assert np.asarray(cloud.point_source_id).tolist() == expected
+    # The scene output holds roof voxels (0) and the open box (1), never the roofed box.
+    assert sorted(set(laspy.read(tmp_path / "S_Scene.las").point_source_id.tolist())) == [0, 1]

@@ -281,7 +281,7 @@ def _simulate(scenario, backend, method, step, precision, progress, cancel, outp
     if output_set is not None:
         _check(cancel)
         tick = time.perf_counter()
-        outputs = _write_outputs(output_set, scene_output, target_output, measures, scene.voxel_size, cancel)
+        outputs = _write_outputs(output_set, scene_output, target_output, measures, scene, cancel)
         timings["write"] = time.perf_counter() - tick
     timings["total"] = time.perf_counter() - started
     return SimulationResult(
@@ -470,8 +470,11 @@ def _output_set(scenario, las):
     return OutputSet(output_paths(scenario, las), path.with_name(f".{path.stem}.outputs.lock"))
 
 
-def _write_outputs(output_set, scene_output, target_output, measures, voxel_size, cancel) -> dict:
-    """Write every output of the set to a temporary file, then swap them all in together."""
+def _write_outputs(output_set, scene_output, target_output, measures, scene, cancel) -> dict:
+    """Write every output of the set to a temporary file, then swap them all in together.
+
+    LAS outputs carry each voxel's target id as its point source id (0: not a target voxel).
+    """
     from ladartui.scene.voxels import save_voxels
 
     writers = {
@@ -482,6 +485,11 @@ def _write_outputs(output_set, scene_output, target_output, measures, voxel_size
     if "scene_las" in output_set.paths:
         from ladartui.scene.las import export_las
 
-        writers["scene_las"] = lambda tmp: export_las(tmp, scene_output, voxel_size)
-        writers["target_las"] = lambda tmp: export_las(tmp, target_output, voxel_size)
+        size = scene.voxel_size
+        writers["scene_las"] = lambda tmp: export_las(
+            tmp, scene_output, size, ids=scene.target_ids_of(scene_output)
+        )
+        writers["target_las"] = lambda tmp: export_las(
+            tmp, target_output, size, ids=scene.target_ids_of(target_output)
+        )
     return output_set.write(writers, cancel)

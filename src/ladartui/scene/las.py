@@ -12,7 +12,8 @@ A target model's target ids travel as each point's ``point_source_id`` (an
 unsigned 16-bit field every LAS point format has, hence ids 1..65535):
 ``export_las(..., ids=...)`` writes them and ``import_las_target`` reads them
 back. A cloud whose points all have source id 0 (the usual value) is one
-target, id 1.
+target, id 1. A run's LAS outputs mark target voxels with their id and
+every other voxel (foliage, ground) with 0.
 """
 
 from __future__ import annotations
@@ -149,7 +150,8 @@ def _voxel_indices(path, voxel_size, origin) -> tuple[np.ndarray, np.ndarray, np
 def export_las(path, voxels, voxel_size, origin=(0.0, 0.0, 0.0), ids=None) -> None:
     """Write voxel centres (metres) as a LAS 1.2 file, or LAZ for a ``.laz`` path, atomically.
 
-    ``ids`` (one target id 1..65535 per voxel) are written as point_source_id.
+    ``ids`` (one target id 1..65535 per voxel, or 0 for a voxel of no target)
+    are written as point_source_id.
     """
     import laspy
 
@@ -169,8 +171,8 @@ def export_las(path, voxels, voxel_size, origin=(0.0, 0.0, 0.0), ids=None) -> No
     cloud.x, cloud.y, cloud.z = centres[:, 0], centres[:, 1], centres[:, 2]
     if ids is not None:
         ids = np.asarray(ids)
-        if ids.shape != (len(centres),) or (len(ids) and (ids.min() < 1 or ids.max() > MAX_TARGET_ID)):
-            raise ValueError(f"ids must be {len(centres)} target ids in 1..{MAX_TARGET_ID}")
+        if ids.shape != (len(centres),) or (len(ids) and (ids.min() < 0 or ids.max() > MAX_TARGET_ID)):
+            raise ValueError(f"ids must be {len(centres)} target ids in 0..{MAX_TARGET_ID}")
         cloud.point_source_id = ids.astype(np.uint16)
     compress = path.suffix.lower() == ".laz"
     # Write to a stream: given a path, laspy picks compression from the suffix (.tmp here).

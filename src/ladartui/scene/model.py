@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.errors import FieldError, InputFileError, LadarError
-from ladartui.scene.voxels import MAX_TARGET_ID, load_target, load_voxels
+from ladartui.scene.voxels import MAX_TARGET_ID, load_target, load_voxels, voxel_keys
 
 
 def target_path_for(scene_path) -> Path:
@@ -82,6 +82,22 @@ class Scene:
         return cls(
             voxels, target, voxel_size, shape=shape, name=scene_path.stem, path=scene_path, target_ids=ids
         )
+
+    def target_ids_of(self, voxels) -> np.ndarray:
+        """The target id of each of ``voxels`` ((K, 3) inside the shape), 0 where not a target voxel."""
+        voxels = np.asarray(voxels).reshape(-1, 3)
+        out = np.zeros(len(voxels), dtype=np.int32)
+        keys = voxel_keys(self.target, self.shape) if len(self.target) and len(voxels) else None
+        if keys is None:
+            return out
+        order = np.argsort(keys)
+        sorted_keys = keys[order]
+        wanted = voxel_keys(voxels, self.shape)
+        assert wanted is not None  # the same shape packed the target's keys
+        pos = np.minimum(np.searchsorted(sorted_keys, wanted), len(sorted_keys) - 1)
+        hit = sorted_keys[pos] == wanted
+        out[hit] = self.target_ids[order[pos[hit]]]
+        return out
 
     @property
     def target_id_list(self) -> list[int]:
