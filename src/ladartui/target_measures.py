@@ -152,6 +152,7 @@ class PerTarget:
         for target in self.targets:
             lines += ["", f"[target {target.target_id}]", f"name = {json.dumps(target.name)}"]
             lines += section_lines(target.measures, prefix=f"target {target.target_id} / ")
+            # A target's levels (TargetMeasures.levels) belong here, as [target N / levels].
         return lines
 
 
@@ -281,9 +282,9 @@ def read_target_lines(path, lines: list[tuple[int, str]], overall: Measures) -> 
                 name = json.loads(value)
             except ValueError:
                 name = None
-            if not isinstance(name, str):
+            if not isinstance(name, str) or not name.isprintable():
                 raise InputFileError(
-                    path, f'name: expected a quoted name such as "truck", got {value}', number
+                    path, f'name: expected a quoted name such as "truck", got {value!r}', number
                 )
             names[target_id] = name
         elif section == TARGETS_SECTION and sep and key == "count":
