@@ -366,3 +366,17 @@ def test_las_outputs_mark_each_voxel_with_its_target(tmp_path):
         assert np.asarray(cloud.point_source_id).tolist() == expected
     # The scene output holds roof voxels (0) and the open box (1), never the roofed box.
     assert sorted(set(laspy.read(tmp_path / "S_Scene.las").point_source_id.tolist())) == [0, 1]
+
+
+def test_chart_draws_each_targets_coverage(tmp_path):
+    import xml.etree.ElementTree as ET
+
+    from ladartui.charts import save_figure
+    from ladartui.charts.coverage import coverage_figure
+
+    scenario = two_box_scenario(tmp_path, names=((2, "cost $5 $x^2$"),))
+    measures = simulate(scenario, write=False).measures
+    path = save_figure(coverage_figure(measures), tmp_path / "c.svg")
+    groups = {g.get("id"): g for g in ET.parse(path).iter("{http://www.w3.org/2000/svg}g") if g.get("id")}
+    assert {"series-obscured", "series-unobscured", "target-1", "target-2"} <= set(groups)
+    assert "cost $5 $x^2$" in path.read_text()  # the name as written, not as mathtext

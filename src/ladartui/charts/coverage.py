@@ -2,7 +2,9 @@
 
 Cumulative share of the target's visible voxels seen after scans 1..k, obscured
 (through the scene) and unobscured (target alone), with the first scan count that
-reaches 90 % of the final obscured coverage marked.
+reaches 90 % of the final obscured coverage marked. With several targets each
+target's own obscured coverage is drawn too (thin lines), so the target that
+needs the most looks shows.
 """
 
 from __future__ import annotations
@@ -13,6 +15,8 @@ from matplotlib.ticker import MaxNLocator
 from ladartui.charts import new_figure
 from ladartui.measures import ENOUGH_SHARE, Measures
 
+# Colours of the per-target lines, apart from the overall series and the 90 % mark.
+TARGET_COLOURS = ("tab:purple", "tab:brown", "tab:pink", "tab:gray", "tab:olive", "tab:cyan", "tab:red")
 SERIES = (
     ("unobscured", "unobscured_after_scan", "tab:blue", "s"),
     ("obscured", "obscured_after_scan", "tab:green", "o"),
@@ -35,6 +39,23 @@ def coverage_figure(measures: Measures, width_px: int = 800, height_px: int = 48
             scans, [100.0 * v for v in after], color=color, marker=marker, label=name, gid=f"series-{name}"
         )
         drawn += 1
+    targets = getattr(measures.targets, "targets", ())
+    if drawn and len(targets) > 1:
+        for index, target in enumerate(targets):
+            after = target.measures.obscured_after_scan
+            if not after:
+                continue
+            axes.plot(
+                range(1, len(after) + 1),
+                [100.0 * v for v in after],
+                linewidth=1,
+                linestyle=":",
+                marker=".",
+                color=TARGET_COLOURS[index % len(TARGET_COLOURS)],
+                # Names come from the scenario: a "$" must not start matplotlib's mathtext.
+                label=f"obscured: {target.target_id} {target.name}".replace("$", r"\$"),
+                gid=f"target-{target.target_id}",
+            )
     enough = measures.scans_for_enough
     obscured = measures.obscured_after_scan
     if enough is not None and obscured:
