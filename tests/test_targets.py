@@ -36,6 +36,21 @@ def test_four_column_file_round_trip_is_exact(tmp_path):
     assert np.array_equal(got, voxels) and np.array_equal(got_ids, ids)
 
 
+def test_large_four_column_file_round_trip_through_the_compiled_writer_and_reader(tmp_path):
+    from ladartui.scene import voxels as module
+
+    rng = np.random.default_rng(3)
+    voxels = rng.integers(0, 5000, (module._COMPILED_FORMAT_ROWS + 10_000, 3)).astype(np.int32)
+    voxels = np.unique(voxels, axis=0)[::-1]  # unique, in an order that is not sorted
+    assert len(voxels) >= module._COMPILED_FORMAT_ROWS  # the compiled formatter's side of the limit
+    ids = rng.integers(1, 65536, len(voxels))
+    path = tmp_path / "big_Target.txt"
+    save_voxels(path, voxels, ids=ids)
+    assert path.stat().st_size > module._PLAIN_BYTES  # read by the compiled parser
+    got, got_ids = load_target(path)
+    assert np.array_equal(got, voxels) and np.array_equal(got_ids, ids)
+
+
 def test_four_column_file_through_the_compiled_parser(tmp_path):
     # Spaces and CR LF leave the array fast path: the checked kernel reads 4 columns too.
     path = tmp_path / "m_Target.txt"
