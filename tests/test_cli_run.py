@@ -8,8 +8,8 @@ import pytest
 
 import ladartui.simulation as simulation
 from ladartui.cli import main
+from ladartui.cmf import read_cmf
 from ladartui.flight import FlightPlan, Manual, ScanPose, aim_at
-from ladartui.measures import read_cmf
 from ladartui.scenario import Scenario
 from ladartui.scene.voxels import save_voxels
 from ladartui.sensor import Sensor

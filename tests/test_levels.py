@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from ladartui.cli import main
+from ladartui.cmf import read_cmf
 from ladartui.errors import FieldError, InputFileError
 from ladartui.levels import (
     NOT_REACHED,
@@ -17,7 +18,7 @@ from ladartui.levels import (
     share_curves,
     target_levels,
 )
-from ladartui.measures import Measures, read_cmf, visible_mask
+from ladartui.measures import Measures, visible_mask
 from ladartui.scenario import load_scenario
 from tiny_sweep import write_tiny_scenario
 

@@ -7,8 +7,9 @@ import warnings
 import numpy as np
 import pytest
 
+from ladartui.cmf import read_cmf
 from ladartui.errors import InputFileError
-from ladartui.measures import CMF_HEADER, Measures, compute_measures, read_cmf, visible_mask
+from ladartui.measures import CMF_HEADER, Measures, compute_measures, visible_mask
 
 
 def box(nx, ny, nz, origin=(0, 0, 0)):

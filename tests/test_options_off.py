@@ -25,6 +25,7 @@ from ladartui.scenario import load_scenario
 from ladartui.scene.voxels import save_voxels
 from ladartui.sensor import Sensor
 from ladartui.simulation import simulate
+from ladartui.target_measures import LevelInputs, compute_target_measures
 from ladartui.tracing import trace
 from ladartui.user_data import default_scenario_path
 
@@ -105,6 +106,24 @@ def _ideal_by_hand(scenario, folder):
         scenario.level_thresholds,
     )
     measures = dataclasses.replace(measures, levels=levels)
+    # Every run scores each target of the target model too (one here).
+    per_target = compute_target_measures(
+        scene.target,
+        scene.target_ids,
+        scene_output,
+        target_output,
+        per_scan["scene"],
+        per_scan["target"],
+        levels=LevelInputs(
+            scenario.flight.scan_times(scenario.speed),
+            scenario.flight.scan_distances(),
+            scenario.level_thresholds,
+        ),
+        path_length_m=measures.path_length_m,
+        flight_time_s=measures.flight_time_s,
+        voxel_size=measures.voxel_size,
+    )
+    measures = dataclasses.replace(measures, targets=per_target)
     folder.mkdir()
     save_voxels(folder / "scene.txt", scene_output)
     save_voxels(folder / "target.txt", target_output)

@@ -349,7 +349,8 @@ def test_relative_segment_first_needs_a_start(tmp_path):
         (
             "[simulation]",
             "[simulatoin]",
-            "unknown section [simulatoin] (allowed: files, sensor, flight, simulation, detection, levels)",
+            "unknown section [simulatoin] "
+            "(allowed: files, sensor, flight, simulation, detection, levels, targets)",
         ),
         (
             "heading = 0.0",

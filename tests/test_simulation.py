@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 import ladartui.simulation as simulation
+from ladartui.cmf import read_cmf
 from ladartui.errors import Cancelled
 from ladartui.flight import FlightPlan, Manual, ScanPose, aim_at
-from ladartui.measures import read_cmf
 from ladartui.returns import fuse_scans
 from ladartui.scenario import Scenario
 from ladartui.scene.voxels import load_voxels, save_voxels

@@ -14,8 +14,9 @@ import numpy as np
 import pytest
 import pytest_asyncio
 
+from ladartui.cmf import read_cmf
 from ladartui.flight import FlightPlan
-from ladartui.measures import Measures, read_cmf
+from ladartui.measures import Measures
 from ladartui.scenario import load_scenario
 from ladartui.scene.voxels import load_voxels
 from ladartui.sensor import Sensor

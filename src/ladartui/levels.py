@@ -233,6 +233,19 @@ class LevelResult:
         return lines
 
 
+def level_result_from_dict(data: dict) -> LevelResult:
+    """The inverse of ``LevelResult.to_dict`` (the JSON of a run)."""
+    return LevelResult(
+        thresholds=LevelThresholds(**data["thresholds"]),
+        levels=tuple(LevelReached(level=name, **data[name]) for name in LEVELS),
+        scans=data["scans"],
+        visible_voxels=data["visible_voxels"],
+        footprint_cells=data["footprint_cells"],
+        visible_share=data["visible_share"],
+        footprint_share=data["footprint_share"],
+    )
+
+
 def _text(value) -> str:
     if value is None:
         return "undefined"

@@ -25,7 +25,12 @@ The ``.cmf`` file ("comparison measures file") is plain text: a header line
 ``key = value`` lines. Values are integers, floats (written so they read back
 exactly), comma-separated vectors, or ``undefined``. The coverage after each
 scan is one line per scan, ``scan_k = obscured, unobscured``. Lines starting
-with ``#`` are comments. ``read_cmf`` reads it back into ``Measures``.
+with ``#`` are comments. ``ladartui.cmf.read_cmf`` reads it back into ``Measures``.
+
+Format 2 adds, after these, the measures of each target of a target model
+with several targets and their worst and mean (``ladartui.target_measures``);
+the sections above keep meaning all targets together. Format 1 files (no
+per-target part) still read as before.
 """
 
 from __future__ import annotations
@@ -46,8 +51,10 @@ if TYPE_CHECKING:
     from ladartui.levels import LevelResult
 
 CMF_FORMAT = "cmf"
-CMF_VERSION = 1
+CMF_VERSION = 2
 CMF_HEADER = f"# ladartui comparison measures, format {CMF_FORMAT} {CMF_VERSION}"
+# Headers read: this version's, and format 1 (written before per-target measures).
+CMF_HEADERS = {f"# ladartui comparison measures, format {CMF_FORMAT} {v}": v for v in (1, CMF_VERSION)}
 
 # Coverage share of the final obscured coverage that counts as "enough looks".
 ENOUGH_SHARE = 0.9
@@ -152,13 +159,16 @@ class Measures:
     detection: object | None = None
     # Detect / recognise / identify (ladartui.levels.LevelResult); None: not computed.
     levels: LevelResult | None = None
+    # Each target's measures, worst and mean (ladartui.target_measures.PerTarget);
+    # None when not computed (a format-1 file), and then absent likewise.
+    targets: object | None = None
 
     def to_dict(self) -> dict:
         """A JSON-safe dict (no NaN: undefined measures are None)."""
-        out = {}
+        out: dict[str, object] = {}
         for f in fields(self):
             value = getattr(self, f.name)
-            if f.name in ("detection", "levels"):
+            if f.name in ("detection", "levels", "targets"):
                 if value is not None:
                     out[f.name] = value.to_dict()
                 continue
@@ -169,20 +179,38 @@ class Measures:
             out[f.name] = value
         return out
 
+    @classmethod
+    def from_dict(cls, data: dict) -> Measures:
+        """The inverse of ``to_dict`` (JSON written by ``ladartui run --json``)."""
+        values: dict[str, object] = {}
+        for f in fields(cls):
+            if f.name not in data:
+                continue
+            value = data[f.name]
+            if f.name == "detection":
+                from ladartui.detection.measures import DetectionMeasures
+
+                value = DetectionMeasures(**value)
+            elif f.name in ("targets", "levels"):
+                continue  # their readers sit above this module: ladartui.cmf.measures_from_dict
+            elif f.name.endswith("_directions"):
+                value = DirectionStats(
+                    **{k: tuple(v) if isinstance(v, list) else v for k, v in value.items()}  # type: ignore[arg-type]
+                )
+            elif isinstance(value, list):
+                value = tuple(value)
+            values[f.name] = value
+        return cls(**values)  # type: ignore[arg-type]
+
     def to_cmf(self) -> str:
         """The measures as ``.cmf`` text (see the module docstring)."""
-        lines = [CMF_HEADER, *_CMF_NOTES]
-        for section, entries in _CMF_LAYOUT:
-            lines.append("")
-            lines.append(f"[{section}]")
-            for key, getter, _kind in entries:
-                lines.append(f"{key} = {_format_value(getter(self))}")
-            if section == _PER_SCAN_SECTION:
-                lines.extend(_per_scan_lines(self))
+        lines = [CMF_HEADER, *_CMF_NOTES, *section_lines(self)]
         if self.detection is not None:
             lines.extend(_detection_lines(self.detection))
         if self.levels is not None:
             lines.extend(["", *self.levels.cmf_lines()])
+        if self.targets is not None:
+            lines.extend(self.targets.cmf_lines())  # type: ignore[attr-defined]
         return "\n".join(lines) + "\n"
 
     def write_cmf(self, path) -> None:
@@ -352,6 +380,8 @@ _CMF_SECTIONS = [
     ),
 ]
 
+CMF_FLIGHT_SECTION = "flight"
+
 _CMF_NOTES = [
     "# shares are fractions 0..1, angles radians, lengths metres, times seconds;",
     "# 'undefined' marks a measure with no meaning for this run (e.g. nothing seen).",
@@ -359,6 +389,25 @@ _CMF_NOTES = [
     "# frame x east, y north, z up. missed_share: share of the unobscured coverage",
     "# missing from the obscured view; coverage_ratio: obscured / unobscured coverage.",
 ]
+
+
+def section_lines(measures: Measures, prefix: str = "") -> list[str]:
+    """The figure-10 sections of ``measures`` as ``.cmf`` lines, headers ``[prefix + name]``.
+
+    With a prefix (one target's block) the flight section is left out: it is
+    the run's, written once.
+    """
+    lines = []
+    for section, entries in _CMF_LAYOUT:
+        if prefix and section == CMF_FLIGHT_SECTION:
+            continue
+        lines.append("")
+        lines.append(f"[{prefix}{section}]")
+        for key, getter, _kind in entries:
+            lines.append(f"{key} = {_format_value(getter(measures))}")
+        if section == _PER_SCAN_SECTION:
+            lines.extend(_per_scan_lines(measures))
+    return lines
 
 
 def _get_path(measures, path):
@@ -452,15 +501,8 @@ def _parse_value(text: str, kind: str):
     return tuple(_parse_value(item.strip(), "float") for item in items)
 
 
-def read_cmf(path) -> Measures:
-    """Read a ``.cmf`` file written by ``Measures.write_cmf``."""
-    try:
-        text = open(path, encoding="utf-8").read()
-    except OSError as error:
-        raise InputFileError(path, f"cannot read: {error.strerror or error}") from None
-    lines = text.splitlines()
-    if not lines or lines[0].strip() != CMF_HEADER:
-        raise InputFileError(path, f"not a measures file: expected first line {CMF_HEADER!r}", line=1)
+def measures_from_lines(path, numbered_lines) -> Measures:
+    """``Measures`` from the (line number, text) pairs of the figure-10 and detection sections."""
     kinds = {
         (section, key): (attr, kind) for section, entries in _CMF_SECTIONS for key, attr, kind in entries
     }
@@ -475,7 +517,7 @@ def read_cmf(path) -> Measures:
     per_scan: dict[int, tuple] = {}
     levels: dict[str, tuple[int, str]] | None = None
     section = None
-    for number, raw in enumerate(lines[1:], start=2):
+    for number, raw in numbered_lines:
         line = raw.strip()
         if not line or line.startswith("#"):
             continue

@@ -79,6 +79,8 @@ Straight and turn segments continue from the previous segment's last scan
     detect_footprint = 0.10         # share of its footprint cells (x-y columns) seen (default 0.10)
     recognise_footprint = 0.50      # (default 0.50)
     identify_footprint = 0.75       # (default 0.75); see ladartui.levels for why
+    [targets]                       # optional: names of the target model's targets
+    names = { 1 = "truck", 2 = "van" }  # id -> name; an unnamed id reads "target N"
 
 Turns and orbits bank as coordinated turns at ``speed_mps``; only a
 ``body-fixed`` sensor sees it (``ladartui.attitude``).
@@ -137,7 +139,9 @@ _SECTIONS = {
     "simulation": ("backend", "method", "step", "precision", "fast_mode"),
     "detection": DETECTION_KEYS,
     "levels": LEVEL_KEYS,
+    "targets": ("names",),
 }
+MAX_TARGET_NAME = 60
 # Segment kinds a scenario file may use: the flight plan's, and recorded logs.
 _SEGMENT_KINDS = {**SEGMENT_KINDS, LogSegment.kind: LogSegment}
 
@@ -174,6 +178,7 @@ class Scenario:
     precision: str = "f64"
     detection: DetectionSettings | None = None  # None: no [detection] section (ideal)
     levels: LevelThresholds | None = None  # None: no [levels] section (the defaults)
+    target_names: tuple[tuple[int, str], ...] = ()  # [targets] names: (id, name), ascending ids
 
     def __post_init__(self):
         set_ = object.__setattr__
@@ -197,6 +202,7 @@ class Scenario:
         if not isinstance(self.fast_mode, bool):
             raise FieldError("simulation.fast_mode", self.fast_mode, "true or false")
         _check_flight(self.flight)
+        set_(self, "target_names", _checked_target_names(self.target_names))
         if self.detection is not None:
             if not isinstance(self.detection, DetectionSettings):
                 raise FieldError("detection", self.detection, "a DetectionSettings")
@@ -215,6 +221,10 @@ class Scenario:
     def level_thresholds(self) -> LevelThresholds:
         """The [levels] thresholds, or their defaults when the section is absent."""
         return self.levels if self.levels is not None else LevelThresholds()
+
+    def target_name(self, target_id: int) -> str:
+        """The name ``[targets] names`` gives a target id, else "target N"."""
+        return dict(self.target_names).get(int(target_id), f"target {int(target_id)}")
 
     def scan_count(self) -> int:
         """Scans of the flight plan, counted without building the poses where it can be."""
@@ -299,9 +309,9 @@ class Scenario:
                     "target model not found (a new scenario's "
                     "default orbit circles the target of X_Target.txt)",
                 )
-            from ladartui.scene.voxels import load_voxels
+            from ladartui.scene.voxels import load_target
 
-            flight = defaults.default_flight(load_voxels(target_file), voxel_size)
+            flight = defaults.default_flight(load_target(target_file)[0], voxel_size)
         return cls(path, scene_file, voxel_size, sensor, flight, **options)
 
     def summary(self) -> str:
@@ -340,6 +350,11 @@ class Scenario:
             ),
             *([f"detection  {self.detection.describe()}"] if self.detection is not None else []),
             "levels     " + _levels_text(self.level_thresholds, self.levels is None),
+            *(
+                ["targets    " + ", ".join(f"{i} {name!r}" for i, name in self.target_names)]
+                if self.target_names
+                else []
+            ),
             f"outputs    {self.scene_output.name}, {self.target_output.name}, "
             f"{self.measures_file.name} in {self.path.parent}",
         ]
@@ -379,6 +394,8 @@ class Scenario:
             data["detection"] = self.detection.to_dict()
         if self.levels is not None:
             data["levels"] = self.levels.to_dict()
+        if self.target_names:
+            data["targets"] = {"names": {str(i): name for i, name in self.target_names}}
         return data
 
     def to_toml(self) -> str:
@@ -541,6 +558,13 @@ class _Reader:
             except FieldError as error:
                 key = error.field.rpartition(".")[2]
                 raise self.field_error(error.field, table.get(key, error.value), error.expected) from None
+        target_names: tuple = ()
+        if "targets" in doc:
+            names = self.table(doc, "targets", _SECTIONS["targets"]).get("names", {})
+            try:
+                target_names = _checked_target_names(names)
+            except FieldError as error:
+                raise self.field_error("targets.names", error.value, error.expected) from None
 
         scene = files["scene"]
         if not isinstance(scene, str) or not scene.strip():
@@ -579,6 +603,7 @@ class _Reader:
                 flight=plan,
                 detection=detection,
                 levels=levels,
+                target_names=target_names,
                 **options,
             )
         except FieldError as error:
@@ -642,6 +667,35 @@ class _Reader:
             args["file"] = str(_resolve(self.path.parent, args["file"]))
         with self.located(where + ".", item):
             return cls(**args)
+
+
+def _checked_target_names(names) -> tuple[tuple[int, str], ...]:
+    """``{id: name}`` (ids as TOML keys "1" or ints) as ((id, name), ...) by ascending id."""
+    from ladartui.scene.voxels import MAX_TARGET_ID
+
+    expected = (
+        f'a table of target id (1..{MAX_TARGET_ID}) = "name", e.g. {{ 1 = "truck" }}, '
+        f"names of 1 to {MAX_TARGET_NAME} printable characters"
+    )
+    items = names.items() if isinstance(names, dict) else names
+    try:
+        pairs = [(key, value) for key, value in items]
+    except (TypeError, ValueError):
+        raise FieldError("targets.names", names, expected) from None
+    out = {}
+    for key, value in pairs:
+        text = str(key).strip()
+        if not (text.isascii() and text.isdigit() and 1 <= int(text) <= MAX_TARGET_ID):
+            raise FieldError("targets.names", key, expected)
+        if (
+            not isinstance(value, str)
+            or not value.strip()
+            or len(value) > MAX_TARGET_NAME
+            or not value.isprintable()
+        ):
+            raise FieldError("targets.names", value, expected)
+        out[int(text)] = value
+    return tuple(sorted(out.items()))
 
 
 def _check_flight(plan: FlightPlan) -> None:

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import os
 import threading
 import time
 from collections.abc import Callable
@@ -158,13 +159,16 @@ def _simulate(scenario, backend, method, step, precision, progress, cancel, outp
     if runner.geiger is not None:
         measures = dataclasses.replace(measures, detection=runner.geiger.measures())
     measures = dataclasses.replace(measures, levels=run_levels(scenario, scene.target, per_scan["scene"]))
+    measures = dataclasses.replace(
+        measures, targets=_per_target(scenario, scene, per_scan, scene_output, target_output, measures)
+    )
     timings["measures"] = time.perf_counter() - tick
 
     outputs = {}
     if output_set is not None:
         check_cancelled(cancel, NOTHING_WRITTEN)
         tick = time.perf_counter()
-        outputs = _write_outputs(output_set, scene_output, target_output, measures, scene.voxel_size, cancel)
+        outputs = _write_outputs(output_set, scene_output, target_output, measures, scene, cancel)
         timings["write"] = time.perf_counter() - tick
     timings["total"] = time.perf_counter() - started
     return SimulationResult(
@@ -191,6 +195,30 @@ def run_levels(scenario, target, scene_per_scan):
         scenario.flight.scan_times(scenario.speed),
         scenario.flight.scan_distances(),
         scenario.level_thresholds,
+    )
+
+
+def _per_target(scenario, scene, per_scan, scene_output, target_output, measures):
+    """Every measure for each target of the scene's target model, named by the scenario."""
+    from ladartui.target_measures import LevelInputs, compute_target_measures
+
+    names = getattr(scenario, "target_name", None)
+    flight = scenario.flight
+    levels = LevelInputs(
+        flight.scan_times(scenario.speed), flight.scan_distances(), scenario.level_thresholds
+    )
+    return compute_target_measures(
+        scene.target,
+        scene.target_ids,
+        scene_output,
+        target_output,
+        scene_per_scan=per_scan["scene"],
+        target_per_scan=per_scan["target"],
+        names=names,
+        levels=levels,
+        path_length_m=measures.path_length_m,
+        flight_time_s=measures.flight_time_s,
+        voxel_size=measures.voxel_size,
     )
 
 
@@ -312,15 +340,39 @@ def output_paths(scenario, las=False) -> dict[str, Path]:
     return paths
 
 
+def check_outputs_spare_inputs(scenario, las=False) -> None:
+    """Refuse a run whose outputs would overwrite its own model files.
+
+    A scenario ``S.toml`` writes ``S_Target.txt``: with the scene model named
+    ``S.txt`` beside it, that is the target model itself.
+    """
+    from ladartui.errors import FieldError
+
+    inputs = {os.path.normpath(Path(f).absolute()) for f in (scenario.scene_file, scenario.target_file)}
+    for name, path in output_paths(scenario, las).items():
+        if os.path.normpath(path.absolute()) in inputs:
+            raise FieldError(
+                "files.scene",
+                Path(scenario.scene_file).name,
+                f"a scene model not named after the scenario: the run's {name} output "
+                f"{path.name} would overwrite a model file",
+                source=str(scenario.path),
+            )
+
+
 def _output_set(scenario, las):
     from ladartui.outputset import OutputSet
 
+    check_outputs_spare_inputs(scenario, las)
     path = Path(scenario.path)
     return OutputSet(output_paths(scenario, las), path.with_name(f".{path.stem}.outputs.lock"))
 
 
-def _write_outputs(output_set, scene_output, target_output, measures, voxel_size, cancel) -> dict:
-    """Write every output of the set to a temporary file, then swap them all in together."""
+def _write_outputs(output_set, scene_output, target_output, measures, scene, cancel) -> dict:
+    """Write every output of the set to a temporary file, then swap them all in together.
+
+    LAS outputs carry each voxel's target id as its point source id (0: not a target voxel).
+    """
     from ladartui.scene.voxels import save_voxels
 
     writers = {
@@ -331,6 +383,11 @@ def _write_outputs(output_set, scene_output, target_output, measures, voxel_size
     if "scene_las" in output_set.paths:
         from ladartui.scene.las import export_las
 
-        writers["scene_las"] = lambda tmp: export_las(tmp, scene_output, voxel_size)
-        writers["target_las"] = lambda tmp: export_las(tmp, target_output, voxel_size)
+        size = scene.voxel_size
+        writers["scene_las"] = lambda tmp: export_las(
+            tmp, scene_output, size, ids=scene.target_ids_of(scene_output)
+        )
+        writers["target_las"] = lambda tmp: export_las(
+            tmp, target_output, size, ids=scene.target_ids_of(target_output)
+        )
     return output_set.write(writers, cancel)

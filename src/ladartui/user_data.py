@@ -1,12 +1,14 @@
-"""The user's folders, and the built-in default scenario materialised in one.
+"""The user's folders, and the bundled scenarios materialised in one.
 
-The default scenario ships as package data (``ladartui/scenarios/default.toml``);
-its scene is generated, never shipped. ``default_scenario_path()`` puts both in
+Bundled scenarios ship as package data (``ladartui/scenarios/NAME.toml``:
+``default``, and ``convoy``, three vehicles, one under a camouflage net);
+their scenes are generated, never shipped. ``bundled_scenario_path(NAME)``
+(``default_scenario_path()`` for the default) puts a scenario and its scene in
 the user data folder on first use and returns the scenario's path:
 
-    $LADARTUI_HOME/default/                      if LADARTUI_HOME is set
-    $XDG_DATA_HOME/ladartui/default/             else, if XDG_DATA_HOME is set
-    ~/.local/share/ladartui/default/             otherwise
+    $LADARTUI_HOME/NAME/                         if LADARTUI_HOME is set
+    $XDG_DATA_HOME/ladartui/NAME/                else, if XDG_DATA_HOME is set
+    ~/.local/share/ladartui/NAME/                otherwise
 
 Settings (recent files, keys) live in ``config_folder()``: ``$LADARTUI_HOME/config``
 when that is set, else the platform's user config folder. This module sits
@@ -31,6 +33,11 @@ from ladartui.scenario import scenario_from_toml
 
 DEFAULT_PRESET = "small"
 DEFAULT_SCENARIO_NAME = "default.toml"
+# Bundled scenario name -> (generator preset, overrides) of the scene it names.
+BUNDLED = {
+    "default": (DEFAULT_PRESET, {}),
+    "convoy": (DEFAULT_PRESET, {"vehicles": 3, "camouflage": True}),
+}
 
 
 def config_folder() -> Path:
@@ -53,7 +60,12 @@ def default_folder() -> Path:
 
 def default_scenario_text() -> str:
     """The packaged default scenario (TOML)."""
-    return (resources.files("ladartui") / "scenarios" / DEFAULT_SCENARIO_NAME).read_text("utf-8")
+    return bundled_scenario_text("default")
+
+
+def bundled_scenario_text(name: str) -> str:
+    """The packaged scenario ``name`` (TOML)."""
+    return (resources.files("ladartui") / "scenarios" / f"{name}.toml").read_text("utf-8")
 
 
 def default_scenario_path() -> Path:
@@ -61,32 +73,57 @@ def default_scenario_path() -> Path:
 
     Idempotent: when the scenario and both model files are there it returns at once.
     """
-    folder = default_folder()
-    scenario_path = folder / DEFAULT_SCENARIO_NAME
-    if _complete(folder):
+    return bundled_scenario_path("default")
+
+
+def bundled_scenario_path(name: str) -> Path:
+    """The bundled scenario ``name`` in the user data folder, made with its scene on first use."""
+    if name not in BUNDLED:
+        from ladartui.errors import FieldError
+
+        raise FieldError("scenario", name, "a bundled scenario: " + ", ".join(BUNDLED))
+    folder = data_home() / name
+    scenario_path = folder / f"{name}.toml"
+    if _complete(folder, name):
         return scenario_path
     folder.mkdir(parents=True, exist_ok=True)
     with _lock(folder / ".lock"):
-        if not _complete(folder):  # another process may have finished meanwhile
-            _materialise(folder)
+        if not _complete(folder, name):  # another process may have finished meanwhile
+            _materialise(folder, name)
     return scenario_path
 
 
-def _model_files(folder: Path):
-    return folder / f"{DEFAULT_PRESET}.txt", folder / f"{DEFAULT_PRESET}_Target.txt"
+def bundled_or_path(argument) -> Path:
+    """A scenario argument as a path: an existing file as it is, else a bundled name
+    (``convoy`` or ``convoy.toml``, with no folder) made ready in the user data folder."""
+    path = Path(argument)
+    stem = path.stem if path.suffix == ".toml" else path.name
+    if path.parent == Path(".") and stem in BUNDLED and not path.exists():
+        return bundled_scenario_path(stem)
+    return path
 
 
-def _complete(folder: Path) -> bool:
-    return all(p.is_file() for p in (folder / DEFAULT_SCENARIO_NAME, *_model_files(folder)))
+def _model_files(folder: Path, name: str):
+    from ladartui.scenario import target_file_for
+
+    scene_file = scenario_from_toml(bundled_scenario_text(name), folder / f"{name}.toml").scene_file
+    return scene_file, target_file_for(scene_file)
 
 
-def _materialise(folder: Path) -> None:
+def _complete(folder: Path, name: str = "default") -> bool:
+    if not (folder / f"{name}.toml").is_file():
+        return False
+    return all(p.is_file() for p in _model_files(folder, name))
+
+
+def _materialise(folder: Path, name: str = "default") -> None:
     from ladartui.scene.generate import generate_scene
 
-    scene = generate_scene(DEFAULT_PRESET)
-    scene.write(folder / DEFAULT_PRESET)
-    text = default_scenario_text()
-    packaged = scenario_from_toml(text, folder / DEFAULT_SCENARIO_NAME)
+    preset, overrides = BUNDLED[name]
+    scene = generate_scene(preset, **overrides)
+    scene.write(_model_files(folder, name)[0])
+    text = bundled_scenario_text(name)
+    packaged = scenario_from_toml(text, folder / f"{name}.toml")
     # The packaged orbit names the small scene's target centre; follow the
     # generator if its scene ever moves the target.
     centre = target_centre(scene.target, scene.voxel_size)

@@ -5,6 +5,8 @@ Cumulative share of the target-model voxels seen after scans 1..k, obscured
 reaches 90 % of the final obscured coverage marked, and the scans at which the
 target was detected, recognised and identified (``ladartui.levels``; those use
 shares of its visible voxels and footprint, so they need not sit on a curve).
+With several targets each target's own obscured coverage is drawn too (thin
+lines), so the target that needs the most looks shows.
 """
 
 from __future__ import annotations
@@ -16,6 +18,8 @@ from ladartui.charts import new_figure
 from ladartui.measures import ENOUGH_SHARE, Measures
 
 LEVEL_COLOURS = {"detect": "tab:gray", "recognise": "tab:purple", "identify": "tab:red"}
+# Colours of the per-target lines, apart from the overall series and the 90 % mark.
+TARGET_COLOURS = ("tab:purple", "tab:brown", "tab:pink", "tab:gray", "tab:olive", "tab:cyan", "tab:red")
 SERIES = (
     ("unobscured", "unobscured_after_scan", "tab:blue", "s"),
     ("obscured", "obscured_after_scan", "tab:green", "o"),
@@ -38,6 +42,23 @@ def coverage_figure(measures: Measures, width_px: int = 800, height_px: int = 48
             scans, [100.0 * v for v in after], color=color, marker=marker, label=name, gid=f"series-{name}"
         )
         drawn += 1
+    targets = getattr(measures.targets, "targets", ())
+    if drawn and len(targets) > 1:
+        for index, target in enumerate(targets):
+            after = target.measures.obscured_after_scan
+            if not after:
+                continue
+            axes.plot(
+                range(1, len(after) + 1),
+                [100.0 * v for v in after],
+                linewidth=1,
+                linestyle=":",
+                marker=".",
+                color=TARGET_COLOURS[index % len(TARGET_COLOURS)],
+                # Names come from the scenario: a "$" must not start matplotlib's mathtext.
+                label=f"obscured: {target.target_id} {target.name}".replace("$", r"\$"),
+                gid=f"target-{target.target_id}",
+            )
     enough = measures.scans_for_enough
     obscured = measures.obscured_after_scan
     if enough is not None and obscured:

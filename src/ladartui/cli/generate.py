@@ -27,13 +27,17 @@ def add_parser(subparsers):
     )
     parser.add_argument("--trees", type=int, help="number of trees")
     parser.add_argument("--voxel-size", type=float, help="voxel size in metres")
-    parser.add_argument("--vehicles", type=int, help="number of vehicles (all in the target)")
+    parser.add_argument("--vehicles", type=int, help="number of vehicles, each its own target (id 1, 2, ...)")
     parser.add_argument("--no-target", action="store_true", help="no vehicle, empty target model")
     parser.add_argument("--terrain", action="store_true", help="gentle terrain instead of flat ground")
     parser.add_argument(
         "--camouflage", action="store_true", help="drape a camouflage net over the vehicle (scene only)"
     )
-    parser.add_argument("--las", action="store_true", help="also write OUT.laz (voxel centres)")
+    parser.add_argument(
+        "--las",
+        action="store_true",
+        help="also write OUT.laz and OUT_Target.laz (voxel centres; target ids as point source ids)",
+    )
     parser.set_defaults(handler=run)
     return parser
 
@@ -60,11 +64,14 @@ def overrides_from(args) -> dict:
 
 
 def run(args) -> int:
+    import numpy as np
+
     from ladartui.outputset import check_writable
     from ladartui.scene.generate import generate_scene, output_paths
 
-    scene_file = output_paths(args.out)[0]
-    check_writable(*output_paths(args.out), *([scene_file.with_suffix(".laz")] if args.las else []))
+    scene_file, target_file = output_paths(args.out)
+    las_files = [scene_file.with_suffix(".laz"), target_file.with_suffix(".laz")] if args.las else []
+    check_writable(scene_file, target_file, *las_files)
     started = time.perf_counter()
     scene = generate_scene(args.preset, seed=args.seed, **overrides_from(args))
     generated = time.perf_counter() - started
@@ -79,15 +86,18 @@ def run(args) -> int:
     if args.las:
         from ladartui.scene.las import export_las
 
-        las_path = scene_path.with_suffix(".laz")
-        export_las(las_path, scene.voxels, vs)
-        print(f"wrote {las_path} (voxel centres in metres)")
+        export_las(las_files[0], scene.voxels, vs)
+        export_las(las_files[1], scene.target, vs, ids=scene.ids())
+        print(f"wrote {las_files[0]} and {las_files[1]} (voxel centres in metres)")
     print(f"preset {scene.preset}, seed {scene.seed}, voxel size {vs:g} m")
     print(f"extent {nx} x {ny} x {nz} voxels = {nx * vs:.1f} x {ny * vs:.1f} x {nz * vs:.1f} m")
     print("parts (before merging): " + ", ".join(f"{k} {v:,}" for k, v in scene.parts.items()))
     if scene.target_centre is not None:
         x, y, z = scene.target_centre
-        print(f"target centre ({x:.2f}, {y:.2f}, {z:.2f}) m")
+        targets = len(np.unique(scene.ids()))
+        print(
+            f"target centre ({x:.2f}, {y:.2f}, {z:.2f}) m" + (f", {targets} targets" if targets > 1 else "")
+        )
     else:
         print("no target")
     print(f"generated in {generated:.2f} s, written in {written:.2f} s")

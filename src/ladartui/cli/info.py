@@ -56,18 +56,25 @@ def print_scenario(path: Path) -> None:
 
 def print_voxel_list(path: Path, voxel_size=None) -> None:
     from ladartui.scene.model import target_path_for
-    from ladartui.scene.voxels import load_voxels_counted
+    from ladartui.scene.voxels import load_target, load_voxels_counted
 
     if voxel_size is not None and not voxel_size > 0:
         from ladartui.errors import FieldError
 
         raise FieldError("--voxel-size", voxel_size, "a positive number of metres")
     started = time.perf_counter()
-    voxels, duplicates = load_voxels_counted(path)
+    ids = None
+    if path.stem.endswith("_Target"):  # a target model: x,y,z or x,y,z,id lines
+        voxels, ids = load_target(path)
+        duplicates = 0
+    else:
+        voxels, duplicates = load_voxels_counted(path)
     loaded = time.perf_counter() - started
     rows = [
         ("voxels", f"{len(voxels):,}" + (f" ({duplicates:,} duplicate lines dropped)" if duplicates else ""))
     ]
+    if ids is not None and len(ids):
+        rows.append(("targets", _targets_text(ids)))
     rows.append(("read in", f"{loaded:.2f} s"))
     shape = (0, 0, 0)
     if len(voxels):
@@ -81,11 +88,11 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
             )
     target_path = target_path_for(path)
     if target_path.is_file() and target_path != path:
-        target, _ = load_voxels_counted(target_path)
+        target, ids = load_target(target_path)
         text = f"{target_path.name}: {len(target):,} voxels"
         if len(target):
             inside = _count_inside(target, voxels)
-            text += f", {inside:,} of them in the scene"
+            text += f", {inside:,} of them in the scene; {_targets_text(ids)}"
             centre = target.mean(axis=0)
             text += f"; centre ({centre[0]:.1f}, {centre[1]:.1f}, {centre[2]:.1f}) voxels"
             if voxel_size:
@@ -100,6 +107,17 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
     width = max(len(name) for name, _ in rows)
     for name, text in rows:
         print(f"  {name:<{width}}  {text}")
+
+
+def _targets_text(ids) -> str:
+    """ "3 targets (ids 1, 2, 3)" or "1 target (id 1)"."""
+    import numpy as np
+
+    distinct = [int(i) for i in np.unique(ids)]
+    if len(distinct) == 1:
+        return f"1 target (id {distinct[0]})"
+    shown = ", ".join(map(str, distinct[:8])) + (", ..." if len(distinct) > 8 else "")
+    return f"{len(distinct)} targets (ids {shown})"
 
 
 def _count_inside(target, voxels) -> int:

@@ -24,7 +24,11 @@ def add_parser(subparsers):
         "target alone (unobscured), fuse the returns, write S_Scene.txt, S_Target.txt and "
         "S.cmf beside the scenario, and show the measures of effectiveness.",
     )
-    parser.add_argument("scenario", metavar="SCENARIO", help="scenario file (.toml)")
+    parser.add_argument(
+        "scenario",
+        metavar="SCENARIO",
+        help="scenario file (.toml), or a bundled one by name: default, convoy (made on first use)",
+    )
     parser.add_argument(
         "--backend", metavar="B", help="tracing backend: auto, numba or wgpu (default: the scenario's)"
     )
@@ -61,7 +65,9 @@ def run(args) -> int:
         if not args.max_rays >= 1:
             raise FieldError("--max-rays", args.max_rays, "a number of rays >= 1")
         set_max_rays(int(args.max_rays))
-    scenario = load_scenario(args.scenario)
+    from ladartui.user_data import bundled_or_path
+
+    scenario = load_scenario(bundled_or_path(args.scenario))
     # Check the overrides like scenario fields, before any progress is drawn.
     for name in ("backend", "method", "step", "precision"):
         value = getattr(args, name)
@@ -73,8 +79,9 @@ def run(args) -> int:
             raise FieldError(f"--{name}", value, error.expected) from None
     if args.write:  # before any progress is drawn; the run checks again under its lock
         from ladartui.outputset import check_writable
-        from ladartui.simulation import output_paths
+        from ladartui.simulation import check_outputs_spare_inputs, output_paths
 
+        check_outputs_spare_inputs(scenario, args.las)
         check_writable(*output_paths(scenario, args.las).values())
     if args.chart is not None and not args.chart.lower().endswith((".svg", ".png")):
         raise FieldError("--chart", args.chart, "a file name ending in .svg or .png")
@@ -167,6 +174,10 @@ def show_result(console, result) -> None:
     for row in comparison_rows(result.measures):
         comparison.add_row(*row)
     console.print(comparison)
+    targets = result.measures.targets
+    if targets is not None and len(targets.targets) > 1:  # one target: the tables above are its own
+        for table in target_tables(targets):
+            console.print(table)
     if result.measures.detection is not None:
         console.print(detection_table(result.measures.detection))
     if result.measures.levels is not None:
@@ -181,6 +192,31 @@ def show_result(console, result) -> None:
             console.print(f"wrote {name}: {path}", highlight=False, soft_wrap=True)
     else:
         console.print("nothing written (--no-write)")
+
+
+def target_tables(per_target):
+    """Each target's measures with the worst and mean, and each one's coverage after each scan."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    from ladartui.target_measures import TABLE_HEADER, TABLE_NOTE, after_scan_rows, table_rows
+
+    count = len(per_target.targets)
+    table = Table(
+        title=f"Measures per target ({count} target{'' if count == 1 else 's'})", caption=TABLE_NOTE
+    )
+    for index, name in enumerate(TABLE_HEADER):
+        table.add_column(name, justify="left" if index == 0 else "right")
+    rows = table_rows(per_target)
+    for index, row in enumerate(rows):
+        # Names come from the scenario file: shown as text, never as markup.
+        table.add_row(escape(row[0]), *row[1:], end_section=index == count - 1)
+    curves = Table(title="Obscured coverage after each scan, per target (%)", show_header=False)
+    curves.add_column("")
+    curves.add_column("")
+    for index, (name, curve) in enumerate(after_scan_rows(per_target)):
+        curves.add_row(escape(name), curve, end_section=index == count - 1)
+    return [table, curves]
 
 
 def detection_table(detection):

@@ -12,15 +12,20 @@ def add_parser(subparsers):
         "print a summary (sensor, scans, path length, flight time, scene size, memory, "
         "outputs). A mistake is reported on one line with exit status 2.",
     )
-    parser.add_argument("scenario", metavar="SCENARIO", help="scenario file (.toml)")
+    parser.add_argument(
+        "scenario",
+        metavar="SCENARIO",
+        help="scenario file (.toml), or a bundled one by name (default, convoy)",
+    )
     parser.set_defaults(handler=run)
     return parser
 
 
 def run(args) -> int:
     from ladartui.scenario import load_scenario
+    from ladartui.user_data import bundled_or_path
 
-    scenario = load_scenario(args.scenario)
+    scenario = load_scenario(bundled_or_path(args.scenario))
     scene_lines = scene_summary(scenario)
     print(scenario.summary())
     for line in scene_lines:
@@ -37,10 +42,18 @@ def scene_summary(scenario) -> list[str]:
     scene = scenario.load_scene()
     nx, ny, nz = scene.shape
     vs = scene.voxel_size
+    ids = scene.target_id_list if len(scene.target) else []
+    in_targets = f" in {len(ids)} targets" if len(ids) > 1 else ""
     lines = [
-        f"scene      {len(scene.voxels):,} voxels, target {len(scene.target):,} voxels; "
+        f"scene      {len(scene.voxels):,} voxels, target {len(scene.target):,} voxels{in_targets}; "
         f"extent {nx} x {ny} x {nz} voxels = {nx * vs:g} x {ny * vs:g} x {nz * vs:g} m"
     ]
+    unused = [i for i, _ in scenario.target_names if i not in ids]
+    if unused:  # a name for an id the target model does not hold: likely a typo
+        lines.append(
+            f"note       [targets] names ids {', '.join(map(str, unused))} are not in "
+            f"{scenario.target_file.name} (its ids: {', '.join(map(str, ids)) or 'none'})"
+        )
     need = 0
     for voxels, source in ((scene.voxels, scenario.scene_file), (scene.target, scenario.target_file)):
         if len(voxels):

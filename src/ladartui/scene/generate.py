@@ -18,7 +18,10 @@ target model, the same every time for the same seed and parameters:
   that belongs to the scene, not to the target.
 
 The target list holds the vehicle voxels only, at the same x-y as in the
-scene (report table 2). All sizes are metres; the grid is voxel indices.
+scene (report table 2). Each vehicle is its own target: vehicle k (the first,
+netted one is 1) has target id k. With more than one vehicle the target model
+is written as ``x,y,z,id`` lines; with one it keeps the report's ``x,y,z``.
+All sizes are metres; the grid is voxel indices.
 """
 
 from __future__ import annotations
@@ -92,12 +95,23 @@ class GeneratedScene:
     seed: int
     preset: str
     parts: dict[str, int] = field(default_factory=dict)  # voxels per part, before merging
+    target_ids: np.ndarray | None = None  # target id per target voxel: vehicle k is k; None: all 1
+
+    def ids(self) -> np.ndarray:
+        """The target id of each target voxel (all 1 without labels)."""
+        if self.target_ids is None:
+            return np.ones(len(self.target), dtype=np.int32)
+        return self.target_ids
 
     def write(self, stem) -> tuple[Path, Path]:
-        """Write ``stem.txt`` and ``stem_Target.txt`` (each atomically); returns both paths."""
+        """Write ``stem.txt`` and ``stem_Target.txt`` (each atomically); returns both paths.
+
+        The target model carries an id column when there is more than one vehicle.
+        """
         scene_path, target_path = output_paths(stem)
         save_voxels(scene_path, self.voxels)
-        save_voxels(target_path, self.target)
+        labelled = self.params.vehicles > 1
+        save_voxels(target_path, self.target, ids=self.ids() if labelled else None)
         return scene_path, target_path
 
     def to_scene(self, name=None, path=None):
@@ -111,6 +125,7 @@ class GeneratedScene:
             shape=self.shape,
             name=name or f"{self.preset}-{self.seed}",
             path=path,
+            target_ids=self.ids(),
         )
 
 
@@ -168,7 +183,7 @@ def generate_scene(preset="small", seed=0, **overrides) -> GeneratedScene:
             parts[name] = _carve_clearance(parts[name], vehicle, vs)
     if params.camouflage and vehicles:
         parts["net"] = _clip(_net_voxels(vehicles[0], params, ground, rng), nx, ny)
-    target = _merge(vehicle_voxels)
+    target, target_ids = _merge_labelled(vehicle_voxels)
     parts["vehicles"] = target
     voxels = _merge(list(parts.values()))
 
@@ -185,6 +200,7 @@ def generate_scene(preset="small", seed=0, **overrides) -> GeneratedScene:
         seed=int(seed),
         preset=preset,
         parts={name: len(v) for name, v in parts.items()},
+        target_ids=target_ids,
     )
 
 
@@ -661,6 +677,21 @@ def _clip(voxels, nx, ny) -> np.ndarray:
         & (voxels[:, 2] >= 0)
     )
     return voxels[inside]
+
+
+def _merge_labelled(lists) -> tuple[np.ndarray, np.ndarray]:
+    """Union of voxel lists (sorted like ``_merge``) and the 1-based index of the list
+    each voxel came from; a voxel in several lists keeps the first."""
+    voxels = _concat(lists)
+    labels = np.repeat(np.arange(1, len(lists) + 1, dtype=np.int32), [len(v) for v in lists])
+    if not len(voxels):
+        return voxels, labels
+    top = voxels.max(axis=0).astype(np.int64) + 1
+    keys = (voxels[:, 0].astype(np.int64) * top[1] + voxels[:, 1]) * top[2] + voxels[:, 2]
+    order = np.argsort(keys, kind="stable")
+    keys = keys[order]
+    first = np.concatenate(([True], keys[1:] != keys[:-1]))
+    return voxels[order[first]], labels[order[first]]
 
 
 def _merge(lists) -> np.ndarray:

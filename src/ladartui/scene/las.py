@@ -7,6 +7,13 @@ lowest coordinate of the cloud on each axis: the minimum point lands in voxel
 0 on every axis and no index is negative. Export writes voxel centres,
 ``origin + index * voxel_size`` metres. LAZ (compressed) is chosen by the
 ``.laz`` suffix.
+
+A target model's target ids travel as each point's ``point_source_id`` (an
+unsigned 16-bit field every LAS point format has, hence ids 1..65535):
+``export_las(..., ids=...)`` writes them and ``import_las_target`` reads them
+back. A cloud whose points all have source id 0 (the usual value) is one
+target, id 1. A run's LAS outputs mark target voxels with their id and
+every other voxel (foliage, ground) with 0.
 """
 
 from __future__ import annotations
@@ -18,7 +25,7 @@ import numpy as np
 
 from ladartui.atomic import atomic_path
 from ladartui.errors import FieldError, InputFileError
-from ladartui.scene.voxels import MAX_INDEX, unique_voxels
+from ladartui.scene.voxels import MAX_INDEX, MAX_TARGET_ID, unique_voxels
 
 
 def _check_header(path, header):
@@ -64,6 +71,48 @@ def _triple(values) -> str:
 
 def import_las(path, voxel_size, origin=None) -> tuple[np.ndarray, np.ndarray]:
     """Voxelise a LAS/LAZ file: returns ((N, 3) int32 unique voxels, origin (3,) metres)."""
+    indices, _, origin = _voxel_indices(path, voxel_size, origin)
+    voxels, _ = unique_voxels(indices)
+    return voxels, origin
+
+
+def import_las_target(path, voxel_size, origin=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Voxelise a LAS/LAZ target model with its ids.
+
+    Returns ((N, 3) int32 unique voxels, (N,) int32 target ids, origin). The id
+    is each point's ``point_source_id``; all 0 reads as one target (id 1). A
+    voxel holding points of two targets is refused (a smaller voxel size
+    keeps them apart), as is a source id 0 beside labelled points.
+    """
+    path = Path(path)
+    indices, source_ids, origin = _voxel_indices(path, voxel_size, origin)
+    ids = source_ids.astype(np.int32)
+    if not ids.any():
+        ids[:] = 1
+    elif not ids.all():
+        raise InputFileError(
+            path,
+            f"{int(np.count_nonzero(ids == 0)):,} points have point_source_id 0 beside labelled "
+            f"points; expected every point's target id in 1..{MAX_TARGET_ID}",
+        )
+    _, first, inverse = np.unique(indices, axis=0, return_index=True, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    conflict = np.flatnonzero(ids != ids[first[inverse]])
+    if len(conflict):
+        row = int(conflict[0])
+        x, y, z = (int(c) for c in indices[row])
+        raise InputFileError(
+            path,
+            f"voxel {x},{y},{z} holds points of targets {int(ids[first[inverse[row]]])} and "
+            f"{int(ids[row])} at voxel size {float(voxel_size):g} m; expected each voxel in one "
+            "target (try a smaller voxel size)",
+        )
+    keep = np.sort(first)
+    return indices[keep], ids[keep], origin
+
+
+def _voxel_indices(path, voxel_size, origin) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each point's voxel ((P, 3) int32), its point_source_id (P,), and the origin."""
     import laspy
 
     path = Path(path)
@@ -95,12 +144,15 @@ def import_las(path, voxel_size, origin=None) -> tuple[np.ndarray, np.ndarray]:
         )
     if indices.max() > MAX_INDEX:
         raise FieldError("voxel_size", voxel_size, "large enough for the cloud's extent", source=str(path))
-    voxels, _ = unique_voxels(indices.astype(np.int32))
-    return voxels, origin
+    return indices.astype(np.int32), np.asarray(cloud.point_source_id), origin
 
 
-def export_las(path, voxels, voxel_size, origin=(0.0, 0.0, 0.0)) -> None:
-    """Write voxel centres (metres) as a LAS 1.2 file, or LAZ for a ``.laz`` path, atomically."""
+def export_las(path, voxels, voxel_size, origin=(0.0, 0.0, 0.0), ids=None) -> None:
+    """Write voxel centres (metres) as a LAS 1.2 file, or LAZ for a ``.laz`` path, atomically.
+
+    ``ids`` (one target id 1..65535 per voxel, or 0 for a voxel of no target)
+    are written as point_source_id.
+    """
     import laspy
 
     path = Path(path)
@@ -117,6 +169,11 @@ def export_las(path, voxels, voxel_size, origin=(0.0, 0.0, 0.0)) -> None:
     header.offsets = np.floor(centres.min(axis=0)) if len(centres) else np.zeros(3)
     cloud = laspy.LasData(header)
     cloud.x, cloud.y, cloud.z = centres[:, 0], centres[:, 1], centres[:, 2]
+    if ids is not None:
+        ids = np.asarray(ids)
+        if ids.shape != (len(centres),) or (len(ids) and (ids.min() < 0 or ids.max() > MAX_TARGET_ID)):
+            raise ValueError(f"ids must be {len(centres)} target ids in 0..{MAX_TARGET_ID}")
+        cloud.point_source_id = ids.astype(np.uint16)
     compress = path.suffix.lower() == ".laz"
     # Write to a stream: given a path, laspy picks compression from the suffix (.tmp here).
     with atomic_path(path) as tmp, open(tmp, "wb+") as stream:

@@ -13,7 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.errors import FieldError, InputFileError, LadarError
-from ladartui.scene.voxels import load_voxels
+from ladartui.scene.keys import voxel_keys
+from ladartui.scene.voxels import MAX_TARGET_ID, load_target, load_voxels
 
 
 def target_path_for(scene_path) -> Path:
@@ -29,11 +30,14 @@ class Scene:
     ``voxels`` and ``target`` are (N, 3) int32 arrays of unique voxel indices
     (target voxels also appear in ``voxels`` for a scene model). ``shape`` is
     ``(nx, ny, nz)``, by default the largest index + 1 over both lists.
+    ``target_ids`` (one int32 per target voxel, 1..65535) says which target
+    each target voxel belongs to; by default all belong to target 1.
     """
 
-    def __init__(self, voxels, target, voxel_size, shape=None, name=None, path=None):
+    def __init__(self, voxels, target, voxel_size, shape=None, name=None, path=None, target_ids=None):
         self.voxels = _as_voxel_array(voxels, "voxels")
         self.target = _as_voxel_array(target, "target")
+        self.target_ids = _as_target_ids(target_ids, len(self.target))
         self.voxel_size = _checked_voxel_size(voxel_size)
         needed = _extent(self.voxels, self.target)
         if shape is None:
@@ -75,8 +79,30 @@ class Scene:
                 f"target model not found; expected it beside the scene model {scene_path.name} "
                 f"(named {target_path.name})",
             )
-        target = load_voxels(target_path)  # may be empty: a scene without a target
-        return cls(voxels, target, voxel_size, shape=shape, name=scene_path.stem, path=scene_path)
+        target, ids = load_target(target_path)  # may be empty: a scene without a target
+        return cls(
+            voxels, target, voxel_size, shape=shape, name=scene_path.stem, path=scene_path, target_ids=ids
+        )
+
+    def target_ids_of(self, voxels) -> np.ndarray:
+        """The target id of each of ``voxels`` ((K, 3) inside the shape), 0 where not a target voxel."""
+        voxels = np.asarray(voxels).reshape(-1, 3)
+        out = np.zeros(len(voxels), dtype=np.int32)
+        if not (len(self.target) and len(voxels)):
+            return out
+        keys = voxel_keys(self.target)
+        order = np.argsort(keys)
+        sorted_keys = keys[order]
+        wanted = voxel_keys(voxels)
+        pos = np.minimum(np.searchsorted(sorted_keys, wanted), len(sorted_keys) - 1)
+        hit = sorted_keys[pos] == wanted
+        out[hit] = self.target_ids[order[pos[hit]]]
+        return out
+
+    @property
+    def target_id_list(self) -> list[int]:
+        """The distinct target ids, ascending (``[1]`` for a one-target model)."""
+        return [int(i) for i in np.unique(self.target_ids)]
 
     @property
     def target_path(self) -> Path | None:
@@ -160,6 +186,17 @@ def _as_voxel_array(voxels, name) -> np.ndarray:
         raise ValueError(f"{name} holds negative indices; voxel indices start at 0")
     if array.max() > np.iinfo(np.int32).max:
         raise ValueError(f"{name} holds indices beyond the int32 range")
+    return np.ascontiguousarray(array, dtype=np.int32)
+
+
+def _as_target_ids(ids, count: int) -> np.ndarray:
+    if ids is None:
+        return np.ones(count, dtype=np.int32)
+    array = np.asarray(ids)
+    if array.shape != (count,) or (count and not np.issubdtype(array.dtype, np.integer)):
+        raise ValueError(f"target_ids must be {count} integers, got shape {array.shape}")
+    if count and (array.min() < 1 or array.max() > MAX_TARGET_ID):
+        raise ValueError(f"target_ids must lie in 1..{MAX_TARGET_ID}")
     return np.ascontiguousarray(array, dtype=np.int32)
 
 

@@ -396,15 +396,14 @@ def _slab_bounds(shape: tuple[int, int, int]) -> list[int]:
 
 def merge_voxels(*lists: np.ndarray) -> np.ndarray:
     """The union of voxel lists, sorted by (x, y, z) like the files this project writes."""
-    from ladartui.scene.voxels import voxel_keys
+    from ladartui.errors import FieldError
+    from ladartui.scene.keys import keys_to_voxels, sorted_unique, voxel_keys
 
     stacked = np.concatenate([np.asarray(v, dtype=np.int32).reshape(-1, 3) for v in lists])
     if len(stacked) == 0:
         return np.zeros((0, 3), dtype=np.int32)
-    shape = stacked.max(axis=0).astype(np.int64) + 1
-    keys = voxel_keys(stacked, shape)
-    if keys is None:  # too large to pack: the slower row-wise unique
+    try:
+        keys = voxel_keys(stacked)
+    except FieldError:  # indices too large to pack: the slower row-wise unique
         return np.unique(stacked, axis=0).astype(np.int32)
-    keys = np.unique(keys)
-    ny, nz = int(shape[1]), int(shape[2])
-    return np.column_stack([keys // (ny * nz), keys // nz % ny, keys % nz]).astype(np.int32)
+    return keys_to_voxels(sorted_unique(keys))

@@ -88,11 +88,14 @@ def _line_end(buf, pos, n):
 def _parse_voxel_bytes(buf, start, out):
     """Parse ``buf[start:]`` into ``out`` rows.
 
-    Returns ``(rows, bad_line, bad_offset)``: ``bad_line`` is 0 when every
-    line was good, else the 1-based number of the first bad line, which starts
-    at byte ``bad_offset``. A blank line is bad only if a voxel line follows it.
+    Every line holds ``out.shape[1]`` comma-separated values (3 for ``x,y,z``,
+    4 for a target model's ``x,y,z,id``). Returns ``(rows, bad_line,
+    bad_offset)``: ``bad_line`` is 0 when every line was good, else the
+    1-based number of the first bad line, which starts at byte ``bad_offset``.
+    A blank line is bad only if a voxel line follows it.
     """
     n = buf.shape[0]
+    columns = out.shape[1]
     pos = start
     line = 1
     rows = 0
@@ -113,7 +116,7 @@ def _parse_voxel_bytes(buf, start, out):
             continue
         if first_blank_line != 0:
             return rows, first_blank_line, first_blank_offset
-        for axis in range(3):
+        for axis in range(columns):
             while pos < n and _is_blank(buf[pos]):
                 pos += 1
             digits = 0
@@ -129,7 +132,7 @@ def _parse_voxel_bytes(buf, start, out):
             out[rows, axis] = value
             while pos < n and _is_blank(buf[pos]):
                 pos += 1
-            if axis < 2:
+            if axis < columns - 1:
                 if pos >= n or buf[pos] != _COMMA:
                     return rows, line, line_start
                 pos += 1
@@ -155,22 +158,23 @@ def _count_digits(value):
 
 @_kernel
 def _format_voxel_bytes(voxels):
-    """The file's bytes: ``x,y,z\\n`` per row, in row order."""
+    """The file's bytes: ``x,y,z\\n`` (or ``x,y,z,id\\n``) per row, in row order."""
+    columns = voxels.shape[1]
     total = 0
     for row in range(voxels.shape[0]):
-        for axis in range(3):
+        for axis in range(columns):
             total += _count_digits(voxels[row, axis]) + 1
     out = np.empty(total, dtype=np.uint8)
     pos = 0
     for row in range(voxels.shape[0]):
-        for axis in range(3):
+        for axis in range(columns):
             value = voxels[row, axis]
             digits = _count_digits(value)
             for k in range(digits - 1, -1, -1):
                 out[pos + k] = _ZERO + value % 10
                 value //= 10
             pos += digits
-            out[pos] = _COMMA if axis < 2 else _NEWLINE
+            out[pos] = _COMMA if axis < columns - 1 else _NEWLINE
             pos += 1
     return out
 
@@ -186,32 +190,107 @@ def load_voxels(path) -> np.ndarray:
     return voxels
 
 
-def load_voxels_counted(path) -> tuple[np.ndarray, int]:
+def load_voxels_counted(path, _target=False) -> tuple[np.ndarray, int]:
     """Like :func:`load_voxels`, also returning how many duplicate lines were dropped."""
     path = Path(path)
-    buf = _read_bytes(path)
-    start = len(_BOM) if buf[: len(_BOM)].tobytes() == _BOM else 0
-    parsed = _parse_plain_lines(buf[start:]) if len(buf) <= _PLAIN_BYTES else None
-    if parsed is None:  # some other layout, or a mistake: the exact checker decides
-        parsed = _parse_checked(path, buf, start)
+    parsed = _parse_file(path, _read_bytes(path), 3, _target)
     voxels, duplicates = unique_voxels(parsed)
     if duplicates:
         log.info("%s: dropped %d duplicate voxel lines", path, duplicates)
     return voxels, duplicates
 
 
-def _parse_checked(path: Path, buf: np.ndarray, start: int) -> np.ndarray:
+def _parse_file(path: Path, buf: np.ndarray, columns: int, target: bool) -> np.ndarray:
+    """Rows of ``columns`` values; ``target``: a target model (errors say x,y,z or x,y,z,id)."""
+    start = len(_BOM) if buf[: len(_BOM)].tobytes() == _BOM else 0
+    parsed = _parse_plain_lines(buf[start:], columns) if len(buf) <= _PLAIN_BYTES else None
+    if parsed is None:  # some other layout, or a mistake: the exact checker decides
+        parsed = _parse_checked(path, buf, start, columns, target)
+    return parsed
+
+
+def _first_line_columns(buf: np.ndarray, start: int) -> int:
+    """4 when the first line holds three commas (``x,y,z,id``), else 3."""
+    head = buf[start : start + 256]
+    ends = np.flatnonzero(head == _NEWLINE)
+    line = head[: ends[0]] if len(ends) else head
+    return 4 if int(np.count_nonzero(line == _COMMA)) == 3 else 3
+
+
+def _parse_checked(path: Path, buf: np.ndarray, start: int, columns: int, target: bool) -> np.ndarray:
     """Every tolerated layout; ``InputFileError`` naming the first bad line."""
     capacity = int(np.count_nonzero(buf == _NEWLINE)) + 1
-    out = np.empty((capacity, 3), dtype=np.int32)
+    out = np.empty((capacity, columns), dtype=np.int32)
     rows, bad_line, bad_offset = _parse_voxel_bytes(buf, start, out)
     if bad_line:
         end = bad_offset
         while end < len(buf) and buf[end] != _NEWLINE:
             end += 1
         text = buf[bad_offset:end].tobytes().decode("utf-8", errors="replace")
-        raise InputFileError(path, describe_bad_line(text), line=int(bad_line))
+        message = describe_bad_line(text, columns, target)
+        raise InputFileError(path, message, line=int(bad_line))
     return out[:rows]
+
+
+MAX_TARGET_ID = 65535  # a LAS point source id is an unsigned 16-bit number
+EXPECTED_TARGET = (
+    "expected x,y,z or x,y,z,id: three non-negative integers and an optional target id "
+    f"1..{MAX_TARGET_ID}, the same number of values on every line"
+)
+
+
+def load_target(path) -> tuple[np.ndarray, np.ndarray]:
+    """Read a target model: ``((N, 3) int32 unique voxels, (N,) int32 target ids)``.
+
+    Lines are ``x,y,z`` (one target, id 1: the report's layout) or
+    ``x,y,z,id`` with ``id`` in 1..``MAX_TARGET_ID``; every line has the
+    same number of values. A repeated voxel line is dropped; the same voxel
+    given two different ids is an error naming the later line.
+    """
+    path = Path(path)
+    buf = _read_bytes(path)
+    start = len(_BOM) if buf[: len(_BOM)].tobytes() == _BOM else 0
+    if _first_line_columns(buf, start) == 3:  # the report's layout: the scene parser as it is
+        voxels, _ = load_voxels_counted(path, _target=True)
+        return voxels, np.ones(len(voxels), dtype=np.int32)
+    rows = _parse_file(path, buf, 4, target=True)
+    ids = rows[:, 3]
+    bad = np.flatnonzero((ids < 1) | (ids > MAX_TARGET_ID))
+    if len(bad):  # blank lines come only at the end: row r is line r + 1
+        raise InputFileError(
+            path,
+            f"id = {int(ids[bad[0]])} is not a target id; {EXPECTED_TARGET}",
+            line=int(bad[0]) + 1,
+        )
+    return _unique_labelled(path, np.ascontiguousarray(rows[:, :3]), np.ascontiguousarray(ids))
+
+
+def _unique_labelled(path: Path, voxels: np.ndarray, ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Drop repeated voxels (first kept); refuse a voxel given two different ids."""
+    if len(voxels) < 2:
+        return voxels, ids
+    keys = _numpy_keys(voxels)
+    if keys is not None and bool(np.all(keys[1:] > keys[:-1])):  # sorted (ours are): no repeats
+        return voxels, ids
+    rows = voxels if keys is None else keys  # one int64 a voxel sorts faster than rows
+    _, first, inverse = np.unique(rows, axis=0, return_index=True, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    conflict = np.flatnonzero(ids != ids[first[inverse]])
+    if len(conflict):
+        row = int(conflict[0])
+        earlier = int(first[inverse[row]])
+        x, y, z = (int(c) for c in voxels[row])
+        raise InputFileError(
+            path,
+            f"voxel {x},{y},{z} is target {int(ids[row])} here but target {int(ids[earlier])} "
+            f"on line {earlier + 1}; expected each voxel in one target",
+            line=row + 1,
+        )
+    if len(first) == len(voxels):
+        return voxels, ids
+    keep = np.sort(first)
+    log.info("%s: dropped %d duplicate voxel lines", path, len(voxels) - len(keep))
+    return voxels[keep], ids[keep]
 
 
 # Up to this size the array passes beat loading the compiled kernel (~45 ms a megabyte).
@@ -223,14 +302,16 @@ _BYTE_CLASS[_COMMA] = 1
 _BYTE_CLASS[_NEWLINE] = 2
 
 
-def _parse_plain_lines(data: np.ndarray) -> np.ndarray | None:
+def _parse_plain_lines(data: np.ndarray, columns: int = 3) -> np.ndarray | None:
     """Rows of ``data`` when every line is exactly ``x,y,z`` (digits only), else None.
+
+    ``columns`` values a line (4 for a target model's ``x,y,z,id``).
 
     The common case, in array passes without numba; anything else (spaces,
     CR, blank lines, mistakes, values beyond ``MAX_INDEX``) returns None.
     """
     if len(data) == 0:
-        return np.zeros((0, 3), dtype=np.int32)
+        return np.zeros((0, columns), dtype=np.int32)
     if data[-1] != _NEWLINE:
         data = np.append(data, np.uint8(_NEWLINE))
     classes = _BYTE_CLASS[data]
@@ -238,8 +319,9 @@ def _parse_plain_lines(data: np.ndarray) -> np.ndarray | None:
         return None
     separators = np.flatnonzero(classes)
     kinds = classes[separators]
-    if len(kinds) % 3 or not (
-        np.all(kinds[0::3] == 1) and np.all(kinds[1::3] == 1) and np.all(kinds[2::3] == 2)
+    if len(kinds) % columns or not (
+        all(np.all(kinds[axis::columns] == 1) for axis in range(columns - 1))
+        and np.all(kinds[columns - 1 :: columns] == 2)
     ):
         return None
     starts = np.empty_like(separators)
@@ -256,7 +338,7 @@ def _parse_plain_lines(data: np.ndarray) -> np.ndarray | None:
         values = np.where(inside, values * 10 + digit, values)
     if values.max() > MAX_INDEX:
         return None
-    return values.astype(np.int32).reshape(-1, 3)
+    return values.astype(np.int32).reshape(-1, columns)
 
 
 def _read_bytes(path: Path) -> np.ndarray:
@@ -289,30 +371,44 @@ def _check_read_size(path: Path) -> None:
         )
 
 
-def describe_bad_line(text: str) -> str:
-    """What is wrong with one rejected line, and what was expected."""
+def describe_bad_line(text: str, columns: int = 3, target: bool = False) -> str:
+    """What is wrong with one rejected line, and what was expected.
+
+    ``columns`` values a line were expected (4: a target model's ``x,y,z,id``,
+    as its first line set); ``target``: the file is a target model.
+    """
+    expected = EXPECTED_TARGET if target else EXPECTED
     body = text[:-1] if text.endswith("\r") else text  # CR LF line ends are fine
     if "\r" in body:
         shown = body.strip(" \t")
-        return f"stray carriage return (\\r) in {shown!r}; {EXPECTED}"
+        return f"stray carriage return (\\r) in {shown!r}; {expected}"
     if not body.strip(" \t"):
         return "blank line before more voxels; blank lines are allowed only at the end of the file"
     fields = body.split(",")
-    if len(fields) != 3:
-        return f"{len(fields)} comma-separated values in {body.strip()!r}; {EXPECTED}"
-    for axis, field in zip(_AXES, fields):
+    if len(fields) != columns:
+        if target and len(fields) in (3, 4):
+            return (
+                f"{len(fields)} comma-separated values in {body.strip()!r} but the file's first "
+                f"line has {columns}; {EXPECTED_TARGET}"
+            )
+        return f"{len(fields)} comma-separated values in {body.strip()!r}; {expected}"
+    for axis, field in zip((*_AXES, "id"), fields):
         token = field.strip(" \t")
         if not token:
-            return f"{axis} is empty in {body.strip()!r}; {EXPECTED}"
+            return f"{axis} is empty in {body.strip()!r}; {expected}"
         if token.startswith("-") and token[1:].isascii() and token[1:].isdigit():
+            if axis == "id":
+                return f"id = {token} is not a target id; {EXPECTED_TARGET}"
             return f"{axis} = {token} is negative; voxel indices start at 0"
         if not (token.isascii() and token.isdigit()):
-            return f"{axis} = {token!r} is not a whole number; {EXPECTED}"
+            return f"{axis} = {token!r} is not a whole number; {expected}"
         # Length first: int() refuses strings of more than 4,300 digits.
         if len(token.lstrip("0")) > len(str(MAX_INDEX)) or int(token) > MAX_INDEX:
             shown = token if len(token) <= 24 else f"{token[:12]}...({len(token)} digits)"
+            if axis == "id":
+                return f"id = {shown} is not a target id; {EXPECTED_TARGET}"
             return f"{axis} = {shown} is too large; expected at most {MAX_INDEX}"
-    return f"cannot read {body.strip()!r}; {EXPECTED}"
+    return f"cannot read {body.strip()!r}; {expected}"
 
 
 def unique_voxels(voxels: np.ndarray) -> tuple[np.ndarray, int]:
@@ -406,8 +502,11 @@ def _column_max(voxels: np.ndarray) -> np.ndarray:
     return np.array([voxels[:, axis].max() for axis in range(3)], dtype=np.int64)
 
 
-def save_voxels(path, voxels) -> None:
-    """Write ``voxels`` ((N, 3) non-negative integers) as an ``x,y,z`` list, atomically."""
+def save_voxels(path, voxels, ids=None) -> None:
+    """Write ``voxels`` ((N, 3) non-negative integers) as an ``x,y,z`` list, atomically.
+
+    With ``ids`` ((N,) target ids 1..``MAX_TARGET_ID``) the lines are ``x,y,z,id``.
+    """
     voxels = np.asarray(voxels)
     if voxels.ndim != 2 or voxels.shape[1] != 3:
         raise ValueError(f"voxels must be an (N, 3) array, got shape {voxels.shape}")
@@ -416,6 +515,13 @@ def save_voxels(path, voxels) -> None:
     voxels = np.ascontiguousarray(voxels, dtype=np.int64)
     if len(voxels) and (voxels.min() < 0 or voxels.max() > MAX_INDEX):
         raise ValueError(f"voxel indices must lie in 0..{MAX_INDEX}")
+    if ids is not None:
+        ids = np.asarray(ids)
+        if ids.shape != (len(voxels),) or (len(ids) and not np.issubdtype(ids.dtype, np.integer)):
+            raise ValueError(f"ids must be {len(voxels)} integers, got shape {ids.shape}")
+        if len(ids) and (ids.min() < 1 or ids.max() > MAX_TARGET_ID):
+            raise ValueError(f"target ids must lie in 1..{MAX_TARGET_ID}")
+        voxels = np.column_stack([voxels, ids.astype(np.int64)])
     data = format_voxel_lines(voxels)
     with atomic_path(path) as tmp, open(tmp, "wb") as stream:
         stream.write(data)
@@ -426,8 +532,9 @@ _COMPILED_FORMAT_ROWS = 200_000
 
 
 def format_voxel_lines(voxels: np.ndarray) -> bytes | memoryview:
-    """The ``x,y,z\\n`` text of non-negative integer rows, as bytes."""
+    """The ``x,y,z\\n`` text of non-negative integer rows, as bytes (``x,y,z,id`` for 4 columns)."""
     voxels = np.ascontiguousarray(voxels, dtype=np.int64)
     if len(voxels) < _COMPILED_FORMAT_ROWS:
-        return "".join(map("{},{},{}\n".format, *voxels.T.tolist())).encode("ascii")
+        line = ",".join(["{}"] * voxels.shape[1]) + "\n"
+        return "".join(map(line.format, *voxels.T.tolist())).encode("ascii")
     return memoryview(_format_voxel_bytes(voxels))

@@ -333,7 +333,7 @@ def missing_outputs(scenario: Scenario) -> list[Path]:
 
 
 def read_measures_files(paths) -> list:
-    from ladartui.measures import read_cmf
+    from ladartui.cmf import read_cmf
 
     out = []
     for path in paths:

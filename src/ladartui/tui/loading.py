@@ -105,7 +105,7 @@ def _existing_results(scenario):
     """The scene output and measures of an earlier run, if both are on disk."""
     if not (scenario.scene_output.is_file() and scenario.measures_file.is_file()):
         return None, None
-    from ladartui.measures import read_cmf
+    from ladartui.cmf import read_cmf
     from ladartui.scene.voxels import load_voxels
 
     return load_voxels(scenario.scene_output), read_cmf(scenario.measures_file)
