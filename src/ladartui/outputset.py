@@ -165,7 +165,7 @@ class OutputSet:
         replaced; once the swap has begun it runs to the end (or is rolled back
         on failure), so the files on disk always belong to one run.
         """
-        temps = {}
+        temps: dict[str, Path] = {}
         try:
             for name, path in self.paths.items():
                 fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
@@ -182,9 +182,9 @@ class OutputSet:
                 raise Cancelled("run cancelled; nothing was written, earlier outputs are unchanged")
             self._swap(temps)
         finally:
-            for tmp in temps.values():
+            for temp in temps.values():
                 with contextlib.suppress(OSError):
-                    tmp.unlink()
+                    temp.unlink()
         return {name: str(path) for name, path in self.paths.items()}
 
     def _swap(self, temps):

@@ -320,7 +320,7 @@ class _ScanRunner:
     def scan(self, scan, pose, attitude=None) -> dict[str, np.ndarray]:
         """Trace one scan for both runs; each run's returned voxels, (K, 3) int32."""
         sensor, timings = self.sensor, self.timings
-        kept = {run: [] for run in RUNS}
+        kept: dict[str, list[np.ndarray]] = {run: [] for run in RUNS}
         row = 0
         while row < sensor.grid:
             _check(self.cancel)

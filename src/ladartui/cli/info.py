@@ -69,7 +69,7 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
         ("voxels", f"{len(voxels):,}" + (f" ({duplicates:,} duplicate lines dropped)" if duplicates else ""))
     ]
     rows.append(("read in", f"{loaded:.2f} s"))
-    shape = (0, 0, 0)
+    shape: tuple[int, ...] = (0, 0, 0)
     if len(voxels):
         lo, hi = voxels.min(axis=0), voxels.max(axis=0)
         shape = tuple(int(h) + 1 for h in hi)
@@ -111,7 +111,7 @@ def _count_inside(target, voxels) -> int:
     shape = both.max(axis=0).astype(np.int64) + 1
     scene_keys = voxel_keys(voxels, shape)
     target_keys = voxel_keys(target, shape)
-    if scene_keys is None:  # indices too large to pack: compare rows
+    if scene_keys is None or target_keys is None:  # indices too large to pack: compare rows
         scene_rows = set(map(tuple, voxels.tolist()))
         return sum(1 for row in map(tuple, target.tolist()) if row in scene_rows)
     return int(np.isin(target_keys, scene_keys).sum())
