@@ -33,6 +33,7 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass, field, fields
+from typing import Any
 
 import numpy as np
 
@@ -171,7 +172,8 @@ def direction_stats(voxels, centroid) -> DirectionStats:
 
 
 def _clean(vector) -> tuple[float, float, float]:
-    return tuple(0.0 if abs(c) < _NOISE else float(c) for c in vector)
+    x, y, z = (0.0 if abs(c) < _NOISE else float(c) for c in vector)
+    return (x, y, z)
 
 
 def angle_between(a, b) -> float | None:
@@ -449,7 +451,7 @@ def _per_scan_lines(measures) -> list[str]:
 
 def _per_scan_lists(path, rows) -> dict:
     """The two coverage-after-scan tuples from ``{k: (line, obscured, unobscured)}``."""
-    out = {}
+    out: dict[str, tuple | None] = {}
     if not rows:
         return out
     for k in range(1, len(rows) + 1):
@@ -523,7 +525,7 @@ def read_cmf(path) -> Measures:
     lines = text.splitlines()
     if not lines or lines[0].strip() != CMF_HEADER:
         raise InputFileError(path, f"not a measures file: expected first line {CMF_HEADER!r}", line=1)
-    kinds = {
+    kinds: dict[tuple[str | None, str], tuple[str, str]] = {
         (section, key): (attr, kind) for section, entries in _CMF_SECTIONS for key, attr, kind in entries
     }
     detection_section, detection_entries = _detection_entries()
@@ -563,13 +565,14 @@ def read_cmf(path) -> Measures:
             values[attr] = _parse_value(value.strip(), kind)
         except ValueError as error:
             raise InputFileError(path, f"{key}: {error}", line=number) from None
-    plain, nested = {}, {}
-    for attr, value in values.items():
+    plain: dict[str, Any] = {}
+    nested: dict[str, dict[str, Any]] = {}
+    for attr, parsed in values.items():
         head, _, tail = attr.partition(".")
         if tail:
-            nested.setdefault(head, {})[tail] = value
+            nested.setdefault(head, {})[tail] = parsed
         else:
-            plain[attr] = value
+            plain[attr] = parsed
     for head, parts in nested.items():
         if head == "detection":
             from ladartui.detection.measures import DetectionMeasures
@@ -609,7 +612,7 @@ def format_vector(vector, digits=3) -> str:
     return ", ".join(f"{c:.{digits}f}" for c in vector)
 
 
-def view_rows(measures: Measures) -> list[tuple[str, str, str, str]]:
+def view_rows(measures: Measures) -> list[tuple[str, ...]]:
     """Rows (label, target model, unobscured, obscured) as in the report's figure 10."""
     m = measures
     views = (m.model_directions, m.unobscured_directions, m.obscured_directions)
