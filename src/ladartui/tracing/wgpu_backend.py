@@ -48,6 +48,7 @@ import stat
 import tempfile
 import threading
 import weakref
+from typing import Any
 
 import numpy as np
 
@@ -244,18 +245,18 @@ class WgpuBackend:
         self._ray_batch = int(ray_batch)
         self._lock = threading.RLock()
         self._probed = False
-        self._reason = None
-        self._adapter = None
-        self._device = None
-        self._limits = {}
+        self._reason: str | None = None
+        self._adapter: Any = None  # wgpu objects (wgpu ships no type information)
+        self._device: Any = None
+        self._limits: dict[str, int] = {}
         self._has_f64 = False
-        self._uploads = weakref.WeakKeyDictionary()
-        self._pinned_uploads = {}  # for occupancies that cannot be weakly referenced
-        self._pipelines = {}
-        self._ray_buffers = {}
-        self._sources = {}
-        self._orders = weakref.WeakKeyDictionary()  # occupancy -> OrderChoice
-        self._scan_buffers = {}  # object order's buffers by name, and their bind group
+        self._uploads: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()
+        self._pinned_uploads: dict[int, Any] = {}  # for occupancies that cannot be weakly referenced
+        self._pipelines: dict[Any, Any] = {}
+        self._ray_buffers: dict[Any, Any] = {}
+        self._sources: dict[str, str] = {}
+        self._orders: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()  # -> OrderChoice
+        self._scan_buffers: dict[str, Any] = {}  # object order's buffers by name, and their bind group
         self._scan_group = (None, None)
 
     # -- probing and device -------------------------------------------------
