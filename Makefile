@@ -33,8 +33,8 @@ test-all: system-deps
 	done
 
 # Style and types (configured in pyproject.toml), run by `make test` before the
-# suite: any finding fails it. mypy keeps its cache in .mypy_cache (a few
-# seconds cold, under a second warm; see README, "Checks").
+# suite: any finding fails it. mypy keeps its cache in .mypy_cache (about 13 s
+# cold, under a second warm; see README, "Checks").
 lint: setup
 	$(VENV)/bin/ruff check src tests
 	$(VENV)/bin/ruff format --check src tests

@@ -20,6 +20,7 @@ import tempfile
 import threading
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from ladartui.errors import Cancelled, OutputFileError
 
@@ -92,7 +93,7 @@ class OutputSet:
         self.paths = {name: Path(path) for name, path in paths.items()}
         self.lock = Path(lock)
         self.journal = self.lock.with_name(self.lock.name + ".journal")
-        self._lock_fd = None
+        self._lock_fd: int | None = None
 
     def __enter__(self) -> OutputSet:
         check_writable(*self.paths.values())
@@ -188,7 +189,7 @@ class OutputSet:
         return {name: str(path) for name, path in self.paths.items()}
 
     def _swap(self, temps):
-        entries = []
+        entries: list[dict[str, Any]] = []  # the journal's: path, backup, existed
         for path in self.paths.values():
             backup = path.with_name(f".{path.name}.{os.getpid()}.old")
             entries.append({"path": str(path), "backup": str(backup), "existed": os.path.lexists(path)})

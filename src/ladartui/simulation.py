@@ -247,7 +247,7 @@ def _simulate(scenario, backend, method, step, precision, progress, cancel, outp
         runner.geiger = GeigerRun(scenario.detection, scenario.sensor, scene)
     timings["setup"] = time.perf_counter() - started
 
-    per_scan = {run: [] for run in RUNS}
+    per_scan: dict[str, list[np.ndarray]] = {run: [] for run in RUNS}
     for scan, (pose, attitude) in enumerate(zip(poses, attitudes), start=1):
         for run, returns in runner.scan(scan, pose, attitude).items():
             per_scan[run].append(returns)

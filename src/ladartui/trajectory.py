@@ -247,9 +247,11 @@ class LogSegment:
                 raise FieldError("rate", self.rate, f"at most {MAX_SCANS} scans over the log")
         else:
             expected = f"a list of 1 to {MAX_SCANS} {span}"
-            items = None if isinstance(self.times, (str, bytes)) else self.times
+            given = self.times
+            if given is None or isinstance(given, (str, bytes)):
+                raise FieldError("times", self.times, expected)
             try:
-                items = list(items)
+                items = list(given)
             except TypeError:
                 raise FieldError("times", self.times, expected) from None
             if not 1 <= len(items) <= MAX_SCANS:

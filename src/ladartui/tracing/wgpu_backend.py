@@ -54,7 +54,7 @@ import numpy as np
 
 from ladartui.errors import BackendUnavailable, Cancelled, FieldError
 from ladartui.tracing.backend import GROUND, METHODS, MISS, VOXEL, CellHits, register_backend
-from ladartui.tracing.bundle import bundle_starts, halo_arrays
+from ladartui.tracing.bundle import Halos, bundle_starts, halo_arrays
 from ladartui.tracing.numba_backend import scan_answers
 from ladartui.tracing.object_order import (
     OrderChoice,
@@ -257,7 +257,7 @@ class WgpuBackend:
         self._sources: dict[str, str] = {}
         self._orders: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()  # -> OrderChoice
         self._scan_buffers: dict[str, Any] = {}  # object order's buffers by name, and their bind group
-        self._scan_group = (None, None)
+        self._scan_group: tuple[tuple[int, ...] | None, Any] = (None, None)  # buffer ids, bind group
 
     # -- probing and device -------------------------------------------------
 
@@ -604,7 +604,7 @@ class WgpuBackend:
         scan_answers(scan.order, *found, scan.vox, origins, directions, nx, ny, kind, index, t)
         return True
 
-    def _test_tiles(self, scan):
+    def _test_tiles(self, scan) -> tuple[np.ndarray, np.ndarray] | None:
         """(best_t, best_v) of a prepared scan from shaders/object_order.wgsl, or None
         when one of its arrays exceeds a storage binding."""
         n = len(scan.order)
@@ -704,6 +704,7 @@ class WgpuBackend:
             for start in range(0, total, capacity):
                 if cancel is not None and cancel.is_set():
                     raise Cancelled("trace cancelled")
+                rows: slice | np.ndarray
                 if pending is None:
                     rows = slice(start, min(total, start + capacity))
                     count = rows.stop - rows.start
@@ -794,7 +795,7 @@ class WgpuBackend:
         return group
 
 
-def bundle_start_array(origins, directions, halo):
+def bundle_start_array(origins, directions, halo: Halos):
     """float64 bundle start (tracing.bundle) of each ``WORKGROUP_SIZE`` consecutive rays."""
     out = np.zeros(max(1, -(-len(origins) // WORKGROUP_SIZE)))
     bundle_starts(

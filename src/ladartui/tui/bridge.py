@@ -200,6 +200,7 @@ def segment_spec(segment, defaults=None):
         name = f.name
         value = getattr(segment, name)
         default = getattr(defaults, name)
+        kind: str | tuple[str, ...]  # a tuple: the choices of a select
         if name in CHOICES:
             kind = CHOICES[name]
         elif name in POINT_FIELDS:
