@@ -24,6 +24,7 @@ from ladartui.tui.app import CONTROLS, LadarApp
 from ladartui.tui.canvas import ProjectionWidget, TopViewWidget
 from ladartui.tui.fields import NumberField
 from ladartui.tui.file_dialogs import SetupScreen
+from ladartui.tui.host import AppHost
 from ladartui.tui.measures_view import compact_rows
 from ladartui.tui.screens import AngleScreen, CompareScreen, FormScreen, HelpScreen
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
@@ -118,6 +119,17 @@ async def test_opens_a_scenario_ready_and_fills_every_field(shared, tmp_path, sc
     assert field(app, "sensor.pixel_pitch").value == "100"  # micrometres
     assert app.query_one("#scans").row_count == 6
     assert app.query_one(TopViewWidget).top is not None
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_the_app_has_everything_its_parts_are_declared_to_use(shared):
+    # tui/host.py declares what the mixins and panels use of the app: the type
+    # checker holds the app's methods to it, this holds its attributes
+    pilot, app = await fresh(shared)
+    declared = list(vars(AppHost)["__annotations__"])
+    assert "scene" in declared and "view_area" in declared
+    assert [name for name in declared if not hasattr(app, name)] == []
+    assert AppHost not in type(app).__mro__  # a declaration only: no App between the mixins
 
 
 @pytest.mark.asyncio(loop_scope="module")

@@ -27,8 +27,8 @@ VIEW_MARGIN = 1.5  # footprint width over the target's horizontal size
 
 def target_centre(target_voxels, voxel_size) -> tuple[float, float, float]:
     """Centroid of the target voxel centres in metres."""
-    centre = np.asarray(target_voxels, dtype=np.float64).mean(axis=0) * float(voxel_size)
-    return tuple(float(c) for c in centre)
+    x, y, z = np.asarray(target_voxels, dtype=np.float64).mean(axis=0) * float(voxel_size)
+    return (float(x), float(y), float(z))
 
 
 def default_flight(target_voxels, voxel_size, sensor: Sensor = DEFAULT_SENSOR) -> FlightPlan:

@@ -38,7 +38,7 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass, field, fields, replace
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -112,7 +112,8 @@ def direction_stats(voxels, centroid) -> DirectionStats:
 
 
 def _clean(vector) -> tuple[float, float, float]:
-    return tuple(0.0 if abs(c) < _NOISE else float(c) for c in vector)
+    x, y, z = (0.0 if abs(c) < _NOISE else float(c) for c in vector)
+    return (x, y, z)
 
 
 def angle_between(a, b) -> float | None:
@@ -436,7 +437,7 @@ def _per_scan_lines(measures) -> list[str]:
 
 def _per_scan_lists(path, rows) -> dict:
     """The two coverage-after-scan tuples from ``{k: (line, obscured, unobscured)}``."""
-    out = {}
+    out: dict[str, tuple | None] = {}
     if not rows:
         return out
     for k in range(1, len(rows) + 1):
@@ -503,7 +504,7 @@ def _parse_value(text: str, kind: str):
 
 def measures_from_lines(path, numbered_lines) -> Measures:
     """``Measures`` from the (line number, text) pairs of the figure-10 and detection sections."""
-    kinds = {
+    kinds: dict[tuple[str | None, str], tuple[str, str]] = {
         (section, key): (attr, kind) for section, entries in _CMF_SECTIONS for key, attr, kind in entries
     }
     detection_section, detection_entries = _detection_entries()
@@ -552,13 +553,14 @@ def measures_from_lines(path, numbered_lines) -> Measures:
             values[attr] = _parse_value(value.strip(), kind)
         except ValueError as error:
             raise InputFileError(path, f"{key}: {error}", line=number) from None
-    plain, nested = {}, {}
-    for attr, value in values.items():
+    plain: dict[str, Any] = {}
+    nested: dict[str, dict[str, Any]] = {}
+    for attr, parsed in values.items():
         head, _, tail = attr.partition(".")
         if tail:
-            nested.setdefault(head, {})[tail] = value
+            nested.setdefault(head, {})[tail] = parsed
         else:
-            plain[attr] = value
+            plain[attr] = parsed
     for head, parts in nested.items():
         if head == "detection":
             from ladartui.detection.measures import DetectionMeasures
@@ -601,7 +603,7 @@ def format_vector(vector, digits=3) -> str:
     return ", ".join(f"{c:.{digits}f}" for c in vector)
 
 
-def view_rows(measures: Measures) -> list[tuple[str, str, str, str]]:
+def view_rows(measures: Measures) -> list[tuple[str, ...]]:
     """Rows (label, target model, unobscured, obscured) as in the report's figure 10."""
     m = measures
     views = (m.model_directions, m.unobscured_directions, m.obscured_directions)

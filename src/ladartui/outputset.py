@@ -20,6 +20,7 @@ import tempfile
 import threading
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from ladartui.errors import OutputFileError, check_cancelled
 
@@ -92,7 +93,7 @@ class OutputSet:
         self.paths = {name: Path(path) for name, path in paths.items()}
         self.lock = Path(lock)
         self.journal = self.lock.with_name(self.lock.name + ".journal")
-        self._lock_fd = None
+        self._lock_fd: int | None = None
 
     def __enter__(self) -> OutputSet:
         check_writable(*self.paths.values())
@@ -165,7 +166,7 @@ class OutputSet:
         replaced; once the swap has begun it runs to the end (or is rolled back
         on failure), so the files on disk always belong to one run.
         """
-        temps = {}
+        temps: dict[str, Path] = {}
         try:
             for name, path in self.paths.items():
                 fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
@@ -181,13 +182,13 @@ class OutputSet:
             check_cancelled(cancel, "run cancelled; nothing was written, earlier outputs are unchanged")
             self._swap(temps)
         finally:
-            for tmp in temps.values():
+            for temp in temps.values():
                 with contextlib.suppress(OSError):
-                    tmp.unlink()
+                    temp.unlink()
         return {name: str(path) for name, path in self.paths.items()}
 
     def _swap(self, temps):
-        entries = []
+        entries: list[dict[str, Any]] = []  # the journal's: path, backup, existed
         for path in self.paths.values():
             backup = path.with_name(f".{path.name}.{os.getpid()}.old")
             entries.append({"path": str(path), "backup": str(backup), "existed": os.path.lexists(path)})

@@ -365,11 +365,11 @@ class Scenario:
     def to_dict(self) -> dict:
         """The TOML document as plain data (paths relative to the scenario's folder)."""
         s = self.sensor
-        flight = {"speed_mps": self.speed}
+        flight: dict[str, object] = {"speed_mps": self.speed}
         if self.flight.start is not None:
             flight["start"] = self.flight.start.to_dict()
         flight["segments"] = [_segment_to_dict(seg, self.path.parent) for seg in self.flight.segments]
-        sensor = {
+        sensor: dict[str, object] = {
             "grid": s.grid,
             "ray_grid": s.ray_grid,
             "fov_deg": s.fov,
@@ -627,7 +627,7 @@ class _Reader:
                 "flight.segments", "'flight.segments' must be one or more [[flight.segments]] tables"
             )
         segments = [self.segment(item, f"flight.segments[{index}]") for index, item in enumerate(items)]
-        plan = FlightPlan(start, segments)
+        plan = FlightPlan(start, tuple(segments))
         try:
             _check_flight(plan)
         except FieldError as error:

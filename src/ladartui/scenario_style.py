@@ -9,6 +9,8 @@ has are removed; new keys are appended to their table.
 
 from __future__ import annotations
 
+from typing import TypeGuard
+
 import tomlkit
 from tomlkit.exceptions import TOMLKitError
 
@@ -50,7 +52,7 @@ def _merge_table(table, data: dict, old_data: dict | None) -> None:
             table[key] = value
 
 
-def _is_table_list(value) -> bool:
+def _is_table_list(value: object) -> TypeGuard[list[dict]]:
     return isinstance(value, list) and bool(value) and all(isinstance(v, dict) for v in value)
 
 

@@ -134,7 +134,7 @@ def _simulate(scenario, backend, method, step, precision, progress, cancel, outp
         runner.geiger = GeigerRun(scenario.detection, scenario.sensor, scene)
     timings["setup"] = time.perf_counter() - started
 
-    per_scan = {run: [] for run in RUNS}
+    per_scan: dict[str, list[np.ndarray]] = {run: [] for run in RUNS}
     for scan, (pose, attitude) in enumerate(zip(poses, attitudes), start=1):
         for run, returns in runner.scan(scan, pose, attitude).items():
             per_scan[run].append(returns)
@@ -248,7 +248,7 @@ class _ScanRunner:
     def scan(self, scan, pose, attitude=None) -> dict[str, np.ndarray]:
         """Trace one scan for both runs; each run's returned voxels, (K, 3) int32."""
         sensor, timings = self.sensor, self.timings
-        kept = {run: [] for run in RUNS}
+        kept: dict[str, list[np.ndarray]] = {run: [] for run in RUNS}
         row = 0
         while row < sensor.grid:
             check_cancelled(self.cancel, NOTHING_WRITTEN)

@@ -109,7 +109,7 @@ def load_flight_log(path, origin=None) -> FlightLog:
             "origin on the earth)"
         )
     columns = {name: names.index(name) for name in (*required, *OPTIONAL) if name in names}
-    values = {name: [] for name in (*required, *OPTIONAL)}
+    values: dict[str, list[float]] = {name: [] for name in (*required, *OPTIONAL)}
     for number, line in rows[1:]:
         fields = next(csv.reader([line]))
         if len(fields) != len(names):
@@ -248,9 +248,11 @@ class LogSegment:
                 raise FieldError("rate", self.rate, f"at most {MAX_SCANS} scans over the log")
         else:
             expected = f"a list of 1 to {MAX_SCANS} {span}"
-            items = None if isinstance(self.times, (str, bytes)) else self.times
+            given = self.times
+            if given is None or isinstance(given, (str, bytes)):
+                raise FieldError("times", self.times, expected)
             try:
-                items = list(items)
+                items = list(given)
             except TypeError:
                 raise FieldError("times", self.times, expected) from None
             if not 1 <= len(items) <= MAX_SCANS:
@@ -261,23 +263,30 @@ class LogSegment:
                 raise FieldError("times", self.times, expected) from None
             set_("times", times)
 
+    @property
+    def log(self) -> FlightLog:
+        """The flight log read from ``file`` (read once, when the segment is made)."""
+        return self.__dict__["_log"]
+
     def scan_times(self) -> np.ndarray:
-        log = self._log
+        log = self.log
         if self.times is not None:
             return np.asarray(self.times, dtype=np.float64)
-        count = int(np.floor((log.time[-1] - log.time[0]) * self.rate + 1e-9)) + 1
-        return log.time[0] + np.arange(count) / self.rate
+        rate = self.rate
+        assert rate is not None  # __post_init__ requires a rate when there are no times
+        count = int(np.floor((log.time[-1] - log.time[0]) * rate + 1e-9)) + 1
+        return log.time[0] + np.arange(count) / rate
 
     def build(self, current) -> list[ScanPose]:
         from ladartui.flight import ScanPose as Pose
         from ladartui.flight import aim_at
 
         template = Pose(0.0, 0.0, 1.0, 0.0, self.azimuth, self.depression)
-        poses = log_poses(self._log, template, times=self.scan_times())
+        poses = log_poses(self.log, template, times=self.scan_times())
         return poses if self.aim_at is None else [aim_at(p, self.aim_at) for p in poses]
 
     def attitudes(self) -> list[tuple[float, float]]:
-        roll, pitch = log_attitude(self._log, self.scan_times())
+        roll, pitch = log_attitude(self.log, self.scan_times())
         return [(float(r), float(p)) for r, p in zip(roll, pitch)]
 
     def legs(self, poses):

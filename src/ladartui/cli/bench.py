@@ -262,9 +262,9 @@ def run_bench(quick=False, runs=None) -> dict:
             # falls on all of them and their ratio stays fair. Each turn traces once
             # untimed first: in a real run a backend's scans follow each other, and the
             # other backend's data should not be in the caches of the timed one.
-            times = {name: [] for name in backends}
-            cpu = {name: [] for name in backends}
-            orders = {name: set() for name in backends}  # over the timed runs
+            times: dict[str, list[float]] = {name: [] for name in backends}
+            cpu: dict[str, list[float]] = {name: [] for name in backends}
+            orders: dict[str, set[str]] = {name: set() for name in backends}  # over the timed runs
             for _ in range(runs):
                 for name in backends:
                     trace(occupancy, origins, directions, backend=name, **kwargs)

@@ -76,7 +76,7 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
     if ids is not None and len(ids):
         rows.append(("targets", _targets_text(ids)))
     rows.append(("read in", f"{loaded:.2f} s"))
-    shape = (0, 0, 0)
+    shape: tuple[int, ...] = (0, 0, 0)
     if len(voxels):
         lo, hi = voxels.min(axis=0), voxels.max(axis=0)
         shape = tuple(int(h) + 1 for h in hi)

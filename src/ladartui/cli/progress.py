@@ -11,7 +11,7 @@ import contextlib
 import signal
 import threading
 from collections.abc import Callable
-from typing import TypeVar
+from typing import Any, TypeVar
 
 from ladartui.errors import Cancelled
 
@@ -27,7 +27,7 @@ def run_cancellable(work: Callable[[], T], cancel: threading.Event, name: str, c
     not finished by then, ``cancelled`` is raised (a result that arrived first
     is returned).
     """
-    outcome = {}
+    outcome: dict[str, Any] = {}  # "result" or "error"
     # Waited on instead of join(): a join interrupted by Ctrl-C can report the
     # thread finished while it still runs, and the process would exit mid-write.
     finished = threading.Event()

@@ -116,7 +116,7 @@ def _run_with_progress(console, inputs, settings, runs, warmup):
     task = progress_bar.add_task("starting", total=None)
 
     plain = not console.is_terminal  # a log file gets one line per setting instead of a bar
-    last = {}
+    last: dict[str, str] = {}
 
     def report(p):
         progress_bar.update(

@@ -165,8 +165,8 @@ class GeigerRun:
         self.target_model = scene.target
         self.target_keys = np.unique(voxel_keys(scene.target))
         self.tally = DetectionTally()
-        self.ideal = {"scene": [], "target": []}
-        self.chunks = {"scene": [], "target": []}
+        self.ideal: dict[str, list[np.ndarray]] = {"scene": [], "target": []}
+        self.chunks: dict[str, list[tuple]] = {"scene": [], "target": []}  # a scan's traced rays
 
     def add_chunk(self, run, origins, directions, detector, hits, kept_rays) -> None:
         self.chunks[run].append(

@@ -53,8 +53,8 @@ class Rendering(Picture):
     voxel or an overlay, ``depth`` (rows, cols) float of the voxel shown (-inf where none),
     ``voxel_mask`` of pixels that show a voxel."""
 
-    depth: np.ndarray | None = None
-    voxel_mask: np.ndarray | None = None
+    depth: np.ndarray
+    voxel_mask: np.ndarray
 
 
 def screen_coordinates(points, camera: Camera, rows: int, cols: int, bounds):

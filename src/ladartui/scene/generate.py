@@ -318,7 +318,7 @@ class _Vehicle:
 def _place_vehicles(p: SceneParams, nx, ny, ground, rng) -> list[_Vehicle]:
     vs = p.voxel_size
     length = p.vehicle_size[0]
-    vehicles = []
+    vehicles: list[_Vehicle] = []
     for index in range(p.vehicles):
         heading = rng.uniform(0, 2 * np.pi)
         if index == 0:
@@ -334,7 +334,8 @@ def _place_vehicles(p: SceneParams, nx, ny, ground, rng) -> list[_Vehicle]:
         x0, x1 = max(int(cx) - reach, 0), min(int(cx) + reach + 1, nx)
         y0, y1 = max(int(cy) - reach, 0), min(int(cy) + reach + 1, ny)
         base = int(ground[x0:x1, y0:y1].max())
-        vehicles.append(_Vehicle(cx, cy, base, heading, tuple(p.vehicle_size)))
+        size_l, size_w, size_h = p.vehicle_size  # a list from a file is a 3-tuple here
+        vehicles.append(_Vehicle(cx, cy, base, heading, (size_l, size_w, size_h)))
     return vehicles
 
 

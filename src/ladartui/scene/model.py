@@ -204,5 +204,5 @@ def _extent(*lists) -> tuple[int, int, int]:
     filled = [v for v in lists if len(v)]
     if not filled:
         return (0, 0, 0)
-    top = np.max([v.max(axis=0) for v in filled], axis=0)
-    return tuple(int(t) + 1 for t in top)
+    x, y, z = np.max([v.max(axis=0) for v in filled], axis=0)
+    return (int(x) + 1, int(y) + 1, int(z) + 1)

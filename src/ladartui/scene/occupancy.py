@@ -57,17 +57,17 @@ class Occupancy:
     tiles: np.ndarray
     bricks: np.ndarray
     count: int
-    columns: np.ndarray = None
-    blocks: np.ndarray = None
-    cubes: np.ndarray = None
-    cube_origin: np.ndarray = None
-    cube_dims: np.ndarray = None
-    halo: np.ndarray = None
-    halo_origin: np.ndarray = None
-    halo_dims: np.ndarray = None
-    halo4: np.ndarray = None
-    halo4_origin: np.ndarray = None
-    halo4_dims: np.ndarray = None
+    columns: np.ndarray | None = None
+    blocks: np.ndarray | None = None
+    cubes: np.ndarray | None = None
+    cube_origin: np.ndarray | None = None
+    cube_dims: np.ndarray | None = None
+    halo: np.ndarray | None = None
+    halo_origin: np.ndarray | None = None
+    halo_dims: np.ndarray | None = None
+    halo4: np.ndarray | None = None
+    halo4_origin: np.ndarray | None = None
+    halo4_dims: np.ndarray | None = None
 
     @classmethod
     def build(cls, voxels, shape=None, source="voxels") -> Occupancy:
@@ -200,15 +200,9 @@ class Occupancy:
     @property
     def nbytes(self) -> int:
         """Bytes held by the hierarchy arrays."""
-        extra = sum(a.nbytes for a in (self.blocks, self.cubes, self.halo, self.halo4) if a is not None)
-        return int(
-            self.root.nbytes
-            + self.regions.nbytes
-            + self.tiles.nbytes
-            + self.bricks.nbytes
-            + self.columns.nbytes
-            + extra
-        )
+        optional = (self.columns, self.blocks, self.cubes, self.halo, self.halo4)
+        extra = sum(a.nbytes for a in optional if a is not None)
+        return int(self.root.nbytes + self.regions.nbytes + self.tiles.nbytes + self.bricks.nbytes + extra)
 
     @property
     def zmax(self) -> int:

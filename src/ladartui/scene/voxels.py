@@ -17,6 +17,7 @@ import functools
 import logging
 import os
 import threading
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -34,7 +35,7 @@ _BOM = b"\xef\xbb\xbf"
 _NEWLINE, _CR, _SPACE, _TAB, _COMMA, _ZERO, _NINE = 10, 13, 32, 9, 44, 48, 57
 _MAX_DIGITS = len(str(MAX_INDEX))
 
-_KERNELS: list[str] = []  # names of this module's numba kernels, callees first
+_KERNELS: dict[str, Callable] = {}  # this module's numba kernels (Python functions), callees first
 _kernels_lock = threading.Lock()
 _compiled = False
 
@@ -45,14 +46,13 @@ def _kernel(func):
     numba is imported only then; compiling rebinds every kernel of the module
     at once, so kernels calling kernels see compiled callees.
     """
-    _KERNELS.append(func.__name__)
+    _KERNELS[func.__name__] = func
 
     @functools.wraps(func)
     def first_call(*args):
         _compile_kernels()
         return globals()[func.__name__](*args)
 
-    first_call.py_func = func
     return first_call
 
 
@@ -64,8 +64,8 @@ def _compile_kernels() -> None:
         import numba
 
         module = globals()
-        for name in _KERNELS:
-            module[name] = numba.njit(nogil=True, cache=True)(module[name].py_func)
+        for name, py_func in _KERNELS.items():
+            module[name] = numba.njit(nogil=True, cache=True)(py_func)
         _compiled = True
 
 

@@ -142,7 +142,7 @@ def table_rows(result: StudyResult) -> list[tuple[str, ...]]:
     """Rows of text for a table of all settings (same columns as ``TABLE_COLUMNS``)."""
     from ladartui.study.results import format_rate
 
-    out = []
+    out: list[tuple[str, ...]] = []
     for row in result.rows:
         if row.status != OK:
             out.append((row.label, "-", "-", "-", "-", "", f"{row.status}: {row.reason}"))

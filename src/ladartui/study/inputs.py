@@ -11,11 +11,16 @@ from __future__ import annotations
 import json
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ladartui.atomic import write_text_atomic
 from ladartui.user_data import data_home
+
+if TYPE_CHECKING:
+    from ladartui.scene.model import Scene
+    from ladartui.sensor import Sensor
 
 DEFAULT_SCANS = 8
 
@@ -24,8 +29,8 @@ DEFAULT_SCANS = 8
 class StudyInputs:
     """A scene, a sensor and the scan poses to trace; ``name`` says where they came from."""
 
-    scene: object
-    sensor: object
+    scene: Scene
+    sensor: Sensor
     poses: list
     name: str
     notes: list = field(default_factory=list)

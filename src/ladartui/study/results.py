@@ -140,7 +140,7 @@ class StudyResult:
             row.dominated_by = self.rows[j].label if j is not None else None
 
     def front_rows(self) -> list[StudyRow]:
-        return sorted((r for r in self.rows if r.front), key=lambda r: r.seconds_per_scan)
+        return sorted((r for r in self.rows if r.front), key=_seconds_or_inf)
 
     def dominated_rows(self) -> list[StudyRow]:
         return [r for r in self.rows if r.dominated_by is not None]
@@ -167,7 +167,7 @@ class StudyResult:
             if everywhere:
                 lines.append("Dominated at every ray grid measured: " + ", ".join(everywhere) + ".")
         skipped = [r for r in self.rows if r.status != OK]
-        reasons = {}
+        reasons: dict[str, list[str]] = {}
         for r in skipped:
             reasons.setdefault(r.reason or r.status, []).append(r.label)
         for reason, labels in reasons.items():
@@ -358,3 +358,9 @@ def study_folder(scenario_path=None) -> Path:
         return data_home() / "study"
     path = Path(scenario_path)
     return path.with_name(f"{path.stem}-study")
+
+
+def _seconds_or_inf(row: StudyRow) -> float:
+    # front rows have every objective measured; an unmeasured time would sort last
+    seconds = row.seconds_per_scan
+    return math.inf if seconds is None else seconds

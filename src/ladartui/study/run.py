@@ -20,6 +20,7 @@ import platform
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -60,7 +61,7 @@ def backend_reasons(names) -> dict[str, str | None]:
     """For each backend name, None when usable here, else why not."""
     from ladartui.tracing.backend import get_backend
 
-    reasons = {}
+    reasons: dict[str, str | None] = {}
     for name in sorted(set(names)):
         try:
             get_backend(name)
@@ -136,9 +137,7 @@ def run_study(
                         check_cancelled(cancel, "study cancelled")
                         if progress is not None:
                             progress(StudyProgress(done, total, s.label, scan + 1, len(poses)))
-                        hits, seconds = timed(
-                            lambda o=origins, d=directions, s=s: _trace(scene, o, d, s, cancel)
-                        )
+                        hits, seconds = timed(partial(_trace, scene, origins, directions, s, cancel))
                         done += 1
                         row.timing.add(seconds)
                         if sum(row.timing.seconds) > REPEAT_BUDGET_S:

@@ -14,6 +14,7 @@ import dataclasses
 import hashlib
 import importlib.metadata
 import logging
+import math
 import os
 import time
 import uuid
@@ -91,7 +92,7 @@ class SweepResult:
     @property
     def pareto(self) -> list[Ranked]:
         """Rows on the Pareto front of coverage against cost, cheapest first."""
-        return sorted((r for r in self.ranking if r.pareto), key=lambda r: (r.cost, -r.coverage))
+        return sorted((r for r in self.ranking if r.pareto), key=_cheapest_first)
 
 
 def default_out_dir(spec: SweepSpec) -> Path:
@@ -535,3 +536,10 @@ def load_sweep_results(
         parameter_names=parameter_names,
         results_path=path,
     )
+
+
+def _cheapest_first(entry: Ranked) -> tuple[float, float]:
+    # a Pareto row has both its cost and its coverage (an unmeasured one would sort last)
+    cost = math.inf if entry.cost is None else entry.cost
+    coverage = -math.inf if entry.coverage is None else entry.coverage
+    return cost, -coverage

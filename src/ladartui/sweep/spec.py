@@ -36,6 +36,7 @@ import tomllib
 from dataclasses import dataclass, field
 from itertools import product
 from pathlib import Path
+from typing import NoReturn
 
 import numpy as np
 
@@ -251,9 +252,10 @@ def parse_sweep_spec(data: dict, path, text: str = "") -> SweepSpec:
     if table is not None:
         if not isinstance(table, dict):
             checker.fail("random", "a [random] table with samples, seed and parameter rules", table)
-        samples = table.get("samples")
-        if not (isinstance(samples, int) and not isinstance(samples, bool) and samples >= 1):
-            checker.fail("random.samples", "the number of random draws, an integer >= 1", samples)
+        drawn = table.get("samples")
+        if not (isinstance(drawn, int) and not isinstance(drawn, bool) and drawn >= 1):
+            checker.fail("random.samples", "the number of random draws, an integer >= 1", drawn)
+        samples = drawn
         seed = table.get("seed", 0)
         if not (isinstance(seed, int) and not isinstance(seed, bool) and seed >= 0):
             checker.fail("random.seed", "an integer >= 0", seed)
@@ -299,7 +301,7 @@ class _Checker:
         self.path = path
         self.lines = text.splitlines()
 
-    def fail(self, key, expected, value=...):
+    def fail(self, key: str, expected: str, value: object = ...) -> NoReturn:
         shown = "" if value is ... else f" (got {value!r})"
         table, _, name = key.rpartition(".")
         raise InputFileError(self.path, f"{key}: expected {expected}{shown}", line=self.line(table, name))

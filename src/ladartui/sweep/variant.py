@@ -80,7 +80,8 @@ def preset_segment(flight):
 
 def target_point(scene) -> tuple[float, float, float]:
     """Centre of the scene's target model in metres (the aim point when the base has none)."""
-    return tuple(float(v) for v in scene.target_centre_m())
+    x, y, z = (float(v) for v in scene.target_centre_m())
+    return (x, y, z)
 
 
 def _flypast_turn(side):
@@ -268,7 +269,7 @@ def _flatten(prefix, value, out):
 
 def measure_columns(measures: dict, reserved=()) -> dict:
     """Measures as flat columns (``obscured_directions.mean_direction``); lists stay lists."""
-    flat = {}
+    flat: dict[str, object] = {}
     _flatten("", measures, flat)
     renames = {"scans": "scan_count"}
     out = {}

@@ -103,7 +103,7 @@ def get_backend(name: str) -> Backend:
 
 def backend_status() -> dict[str, str | None]:
     """Each registered backend's probe answer (None = available)."""
-    status = {}
+    status: dict[str, str | None] = {}
     for name in backend_names():
         try:
             get_backend(name)

@@ -138,13 +138,16 @@ def bundle_starts(orig, dirs, chunk, halo, halo_origin, halo_dims, fine, fine_or
         )
 
 
-def halo_arrays(occupancy):
+Halos = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+def halo_arrays(occupancy) -> Halos:
     """(halo, origin, dims, halo4, origin4, dims4): the occupancy's halos, empty ones
     (no bundle starts, or no fine step) where it has none."""
     return _bits(occupancy, "halo") + _bits(occupancy, "halo4")
 
 
-def _bits(occupancy, name):
+def _bits(occupancy, name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     bits = getattr(occupancy, name, None)
     if bits is None or getattr(occupancy, name + "_dims", None) is None or len(bits) == 0:
         return np.zeros(0, np.uint32), np.zeros(3, np.int64), np.zeros(3, np.int64)

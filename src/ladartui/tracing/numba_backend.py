@@ -12,6 +12,7 @@ import math
 import threading
 import time
 import weakref
+from typing import Any
 
 import numba
 import numpy as np
@@ -196,7 +197,7 @@ def _exact_kernel(
                                 # brick it cannot vouch for needs the tile, so only then does
                                 # leaving the tile end this walk.
                                 ux, uy, uz = bx - dox, by - doy, bz - doz
-                                far = -1
+                                far = np.int64(-1)
                                 if 0 <= ux < ddx and 0 <= uy < ddy and 0 <= uz < ddz:
                                     far = np.int64(cubes[((ux + ddx * (uy + ddy * uz)) << 2) | octant])
                                 br = 0
@@ -400,7 +401,7 @@ def _march_kernel(
                 if cz < 0.0:
                     if inside:
                         result = GROUND
-                        i, j, k, tr = np.int64(math.floor(cx)), np.int64(math.floor(cy)), 0, t
+                        i, j, k, tr = np.int64(math.floor(cx)), np.int64(math.floor(cy)), np.int64(0), t
                     break
                 if not inside or (cz >= top and dz >= 0.0):
                     break
@@ -435,7 +436,7 @@ class NumbaBackend:
     summary = "CPU threads (numba), float64"
 
     def __init__(self):
-        self._orders = weakref.WeakKeyDictionary()  # occupancy -> OrderChoice
+        self._orders: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()  # -> OrderChoice
 
     def probe(self):
         return None

@@ -672,8 +672,10 @@ def prepare_scan(occ, orig, dirs, frame, max_voxels, tile_shift=TILE_SHIFT):
         occ.root_origin.astype(np.int64),
         occ.root_dims.astype(np.int64),
     )
-    first = voxel_starts(found, occ.bricks) if ok else None
-    if not ok or first[-1] > max_voxels:
+    if not ok:
+        return None
+    first = voxel_starts(found, occ.bricks)
+    if first[-1] > max_voxels:
         return None
     bin_starts, order, bins, rays, invs, exits = sort_rays(
         p, q, grid, nb, tile_shift, orig, dirs, occ.bbox_lo.astype(np.float64), occ.bbox_hi.astype(np.float64)
@@ -698,7 +700,9 @@ def prepare_scan(occ, orig, dirs, frame, max_voxels, tile_shift=TILE_SHIFT):
     )
 
 
-def nearest_voxels(occ, orig, dirs, frame, max_voxels):
+def nearest_voxels(
+    occ, orig, dirs, frame, max_voxels
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
     """Object-order first hits of a scan, or None (see ``prepare_scan``).
 
     Returns (order, best_t, best_v, vox): sorted position ``s`` is ray
@@ -741,7 +745,7 @@ class OrderChoice:
     SAMPLES = 2
 
     def __init__(self):
-        self.samples = {"object": [], "ray": []}  # recent seconds per ray
+        self.samples: dict[str, list[float]] = {"object": [], "ray": []}  # recent seconds per ray
         self.calls = 0
         self._lock = threading.Lock()
 

@@ -48,6 +48,7 @@ import stat
 import tempfile
 import threading
 import weakref
+from typing import Any
 
 import numpy as np
 
@@ -64,7 +65,7 @@ from ladartui.tracing.backend import (
     check_order,
     register_backend,
 )
-from ladartui.tracing.bundle import bundle_starts, halo_arrays
+from ladartui.tracing.bundle import Halos, bundle_starts, halo_arrays
 from ladartui.tracing.config import (
     BUNDLE,
     CUT,
@@ -249,19 +250,19 @@ class WgpuBackend:
         self._ray_batch = int(ray_batch)
         self._lock = threading.RLock()
         self._probed = False
-        self._reason = None
-        self._adapter = None
-        self._device = None
-        self._limits = {}
+        self._reason: str | None = None
+        self._adapter: Any = None  # wgpu objects (wgpu ships no type information)
+        self._device: Any = None
+        self._limits: dict[str, int] = {}
         self._has_f64 = False
-        self._uploads = weakref.WeakKeyDictionary()
-        self._pinned_uploads = {}  # for occupancies that cannot be weakly referenced
-        self._pipelines = {}
-        self._ray_buffers = {}
-        self._sources = {}
-        self._orders = weakref.WeakKeyDictionary()  # occupancy -> OrderChoice
-        self._scan_buffers = {}  # object order's buffers by name, and their bind group
-        self._scan_group = (None, None)
+        self._uploads: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()
+        self._pinned_uploads: dict[int, Any] = {}  # for occupancies that cannot be weakly referenced
+        self._pipelines: dict[Any, Any] = {}
+        self._ray_buffers: dict[Any, Any] = {}
+        self._sources: dict[str, str] = {}
+        self._orders: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()  # -> OrderChoice
+        self._scan_buffers: dict[str, Any] = {}  # object order's buffers by name, and their bind group
+        self._scan_group: tuple[tuple[int, ...] | None, Any] = (None, None)  # buffer ids, bind group
 
     # -- probing and device -------------------------------------------------
 
@@ -605,7 +606,7 @@ class WgpuBackend:
         scan_answers(scan.order, *found, scan.vox, origins, directions, nx, ny, kind, index, t)
         return True
 
-    def _test_tiles(self, scan):
+    def _test_tiles(self, scan) -> tuple[np.ndarray, np.ndarray] | None:
         """(best_t, best_v) of a prepared scan from shaders/object_order.wgsl, or None
         when one of its arrays exceeds a storage binding."""
         n = len(scan.order)
@@ -704,6 +705,7 @@ class WgpuBackend:
             total = n if pending is None else len(pending)
             for start in range(0, total, capacity):
                 check_cancelled(cancel, "trace cancelled")
+                rows: slice | np.ndarray
                 if pending is None:
                     rows = slice(start, min(total, start + capacity))
                     count = rows.stop - rows.start
@@ -792,7 +794,7 @@ class WgpuBackend:
         return group
 
 
-def bundle_start_array(origins, directions, halo):
+def bundle_start_array(origins, directions, halo: Halos):
     """float64 bundle start (tracing.bundle) of each ``BUNDLE`` consecutive rays."""
     out = np.zeros(max(1, -(-len(origins) // BUNDLE)))
     bundle_starts(

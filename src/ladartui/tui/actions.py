@@ -18,7 +18,7 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from textual.binding import Binding
+from textual.binding import Binding, BindingType
 
 from ladartui.textsafe import one_line
 from ladartui.tui import bridge
@@ -175,7 +175,7 @@ DISPLAY_ACTIONS = {
 }
 
 
-def bindings() -> list[Binding]:
+def bindings() -> list[BindingType]:
     """The app's key bindings, each with its command's id (so users can remap it)."""
     return [
         Binding(c.key, c.action, c.footer or c.title, show=c.footer is not None, id=c.id)
@@ -190,7 +190,12 @@ BINDINGS = bindings()
 def keys_in_force(keymap: dict[str, str] | None = None) -> dict[str, str]:
     """Command id -> the keys that run it: the default, or the user's."""
     keymap = keymap or {}
-    return {c.id: keymap.get(c.id, c.key) for c in COMMANDS if c.key or c.id in keymap}
+    keys = {}
+    for c in COMMANDS:
+        key = keymap.get(c.id, c.key)
+        if (c.key or c.id in keymap) and key is not None:
+            keys[c.id] = key
+    return keys
 
 
 def palette_entries(keymap: dict[str, str] | None = None) -> list[tuple[str, str, str]]:

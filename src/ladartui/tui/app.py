@@ -13,21 +13,24 @@ interface never blocks.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from textual import on
 from textual.app import App, ComposeResult, SystemCommand
 from textual.containers import Horizontal, Vertical
 from textual.css.query import NoMatches
+from textual.notifications import SeverityLevel
+from textual.screen import Screen
 from textual.widgets import Button, Footer, TabbedContent, TabPane
 
 from ladartui.edit_history import EditHistory
+from ladartui.scenario import Scenario
 from ladartui.tui import actions, bridge
 from ladartui.tui.canvas import ProjectionWidget, TopViewWidget
-from ladartui.tui.fields import NumberField
 from ladartui.tui.file_actions import FileActions
 from ladartui.tui.loading import SceneLoading
 from ladartui.tui.panels import FilePanel, FlightPanel, ResultsPanel, RunPanel, SensorPanel
-from ladartui.tui.params import ParamPanel
+from ladartui.tui.params import ParamField, ParamPanel
 from ladartui.tui.runs import RunControl
 from ladartui.tui.screens import (
     AngleScreen,
@@ -49,6 +52,9 @@ CONTROLS = (
     "#sidebar DataTable, #sidebar OptionList"
 )
 own_actions = actions.own_actions
+
+if TYPE_CHECKING:
+    from ladartui.scene.model import Scene
 
 
 def palette_entries(app=None) -> list[tuple[str, str, str]]:
@@ -77,7 +83,7 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
         self,
         scenario_path: Path | str | None = None,
         *,
-        start_scenario=None,
+        start_scenario: Scenario | None = None,
         cwd: Path | None = None,
         compile_in_child: bool = True,
     ):
@@ -86,7 +92,7 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
         self.scenario_path = Path(scenario_path) if scenario_path else None
         self.start_scenario = start_scenario
         self.cwd = Path(cwd) if cwd else Path.cwd()
-        self.history: EditHistory | None = None
+        self.history: EditHistory[Scenario] | None = None
         self.scene = None
         self.prepared = None
         self.measures = None
@@ -100,18 +106,18 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
         self.messages: list[str] = []
         self.leaving = False  # set by exit: news from jobs is no longer shown
         self.running = False
-        self.tool_screen = None  # the study or sweep screen while it is open
+        self.tool_screen: Screen[None] | None = None  # the study or sweep screen while it is open
         self.keymap, self.keymap_problems = actions.load_keymap()
         self.set_keymap(self.keymap)
 
     # -- the scenario under edit -----------------------------------------------------
 
     @property
-    def scenario(self):
+    def scenario(self) -> Scenario | None:
         return self.history.current if self.history is not None else None
 
     @scenario.setter
-    def scenario(self, scenario) -> None:
+    def scenario(self, scenario: Scenario) -> None:
         if self.history is None:
             self.history = EditHistory(scenario)
         else:
@@ -121,7 +127,7 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
     def modified(self) -> bool:
         return self.history is not None and self.history.modified
 
-    def set_scenario(self, scenario, modified=True) -> None:
+    def set_scenario(self, scenario: Scenario, modified: bool = True) -> None:
         """Adopt a whole scenario: loaded (``modified=False``) or edited (an undoable step)."""
         if modified and self.history is not None:
             self.edit(scenario, "Scenario replaced")
@@ -132,21 +138,24 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
             self.history.reset(scenario)
         self.scenario_changed()
 
-    def edit(self, scenario, label: str) -> None:
+    def edit(self, scenario: Scenario, label: str) -> None:
         """The one path for every change to the scenario: recorded for undo, then shown."""
+        if self.history is None:  # the first scenario is adopted, not edited
+            self.set_scenario(scenario, modified=False)
+            return
         self.history.edit(scenario, label)
         self.scenario_changed()
 
-    def update_scenario(self, scenario) -> None:
+    def update_scenario(self, scenario: Scenario) -> None:
         self.edit(scenario, "Change")
 
     def action_undo(self) -> None:
         if self.busy or self.history is None:
             return
-        typing = [f for f in self.query(".param").results(NumberField) if f.value != f.committed]
+        typing = [f for f in self.query(".param").results(ParamField) if f.value != f.committed]
         if typing:  # typed but not committed: undo the typing first, as an editor would
             for f in typing:
-                f.set_number(bridge.param_value(self.scenario, f.field_name))
+                f.set_number(bridge.param_value(self.history.current, f.field_name))
             self.refresh_status()
             self.tell("Undid typing in " + ", ".join(f.param.label for f in typing), timeout=3)
             return
@@ -167,8 +176,10 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
     def scenario_changed(self) -> None:
         """Show the current scenario everywhere: panels, views and status."""
         scenario = self.scenario
+        if scenario is None:
+            return
         if self.scene is not None and scenario.voxel_size != self.scene.voxel_size:
-            self._rescale_scene(scenario.voxel_size)
+            self._rescale_scene(self.scene, scenario.voxel_size)
         for panel in (self.sensor_panel, self.flight_panel, self.run_panel):
             panel.show(scenario)
         self.file_panel.show(scenario, self.scene, self.modified, self.missing_outputs)
@@ -176,18 +187,19 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
         self.sub_title = scenario.path.name + (" (modified)" if self.modified else "")
         self.refresh_status()
 
-    def _rescale_scene(self, voxel_size: float) -> None:
+    def _rescale_scene(self, old: Scene, voxel_size: float) -> None:
         from ladartui.scene.model import Scene
 
-        old = self.scene
-        self.scene = Scene(old.voxels, old.target, voxel_size, shape=old.shape, name=old.name, path=old.path)
-        self.view_area.rescale(voxel_size, tuple(float(v) for v in self.scene.target_centre_m()))
+        self.scene = scene = Scene(
+            old.voxels, old.target, voxel_size, shape=old.shape, name=old.name, path=old.path
+        )
+        self.view_area.rescale(voxel_size, tuple(float(v) for v in scene.target_centre_m()))
 
-    def commit_field(self, field: NumberField) -> bool:
+    def commit_field(self, field: ParamField) -> bool:
         panel = next(a for a in field.ancestors if isinstance(a, ParamPanel))
         return panel.commit_field(field)
 
-    def target_m(self):
+    def target_m(self) -> tuple[float, ...]:
         if self.prepared is not None:
             return self.prepared["target_m"]
         return (0.0, 0.0, 0.0)
@@ -271,8 +283,8 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
             out.append("scene model not loaded")
         bad = [
             f"{f.param.label} {f.param.unit}".strip()
-            for f in self.query(NumberField)
-            if fields and f.has_class("-bad") and hasattr(f, "param")
+            for f in self.query(ParamField)
+            if fields and f.has_class("-bad")
         ]
         if bad:
             out.append("invalid value in " + ", ".join(bad))
@@ -289,19 +301,20 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
             bar.show(BUSY, self.busy, self.progress, cancellable=self.run_in_progress())
             return
         problems = self.problems()
-        if problems:
+        scenario = self.scenario
+        if problems or scenario is None:  # no scenario is one of the problems
             bar.show(NOT_READY, "; ".join(problems))
             return
-        poses = len(self.scenario.poses())
-        rays = self.scenario.sensor.rays_per_scan
+        poses = len(scenario.poses())
+        rays = scenario.sensor.rays_per_scan
         mark = " (modified)" if self.modified else ""
-        text = f"{self.scenario.path.name}{mark}: {poses} scans x {rays:,} rays. F5 runs."
+        text = f"{scenario.path.name}{mark}: {poses} scans x {rays:,} rays. F5 runs."
         if self.missing_outputs:
             # runnable, but the set on disk is incomplete: yellow until a run rewrites it
             names = ", ".join(p.name for p in self.missing_outputs)
             bar.show(
                 NOT_READY,
-                f"{self.scenario.path.name}{mark}: outputs missing ({names}); F5 runs and writes them.",
+                f"{scenario.path.name}{mark}: outputs missing ({names}); F5 runs and writes them.",
             )
             return
         bar.show(READY, text)
@@ -416,10 +429,10 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
         name = (view.border_title or view.id or "view").split(" az ")[0]
         path = self.scenario.path.with_name(f"{self.scenario.path.stem}-{view.id}.png")
 
-        def chosen(size) -> None:
+        def chosen(size: tuple[int, int] | None) -> None:
             if size is not None:
-                area = self.view_area
-                start_job(self, "png", lambda cancel, progress: area.save_png(path, *size, view))
+                area, (width, height) = self.view_area, size
+                start_job(self, "png", lambda cancel, progress: area.save_png(path, width, height, view))
 
         self.push_screen(ImageSizeScreen(name), chosen)
 
@@ -456,8 +469,8 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
             self.tool_screen = None
             self.refresh_bindings()
 
-        self.tool_screen = StudyScreen(scenario_path=path)
-        self.push_screen(self.tool_screen, closed)
+        self.tool_screen = screen = StudyScreen(scenario_path=path)
+        self.push_screen(screen, closed)
 
     def action_sweep(self) -> None:
         """Launch, open or watch flight-path sweeps."""
@@ -469,8 +482,8 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
             self.tool_screen = None
             self.refresh_bindings()
 
-        self.tool_screen = SweepScreen()
-        self.push_screen(self.tool_screen, closed)
+        self.tool_screen = screen = SweepScreen()
+        self.push_screen(screen, closed)
 
     def on_sweep_screen_open_scenario(self, message) -> None:
         """The sweep's best flight path: open its scenario as F3 would (leaving the sweep
@@ -486,7 +499,7 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
         self.open_path(message.path)
 
     def tell(
-        self, message: str, *, title: str = "", severity: str = "information", timeout: float = 5
+        self, message: str, *, title: str = "", severity: SeverityLevel = "information", timeout: float = 5
     ) -> None:
         """Show a message to the analyst (and keep it in ``messages`` for the record)."""
         self.messages.append(f"{title}: {message}" if title else message)

@@ -16,8 +16,13 @@ from ladartui.errors import FieldError, InputFileError
 from ladartui.flight import (
     SEGMENT_KINDS,
     FlightPlan,
+    FlyPast,
     Manual,
+    Orbit,
     ScanPose,
+    Standoff,
+    Straight,
+    Turn,
     aim_at,
     altitude_field,
 )
@@ -174,15 +179,15 @@ def default_segment(kind: str, target_xyz, current: ScanPose | None):
     altitude = current.z if current is not None else 100.0
     centre = (round(tx, 2), round(ty, 2), round(tz, 2))
     if kind == "straight":
-        return SEGMENT_KINDS[kind](distance=100.0, scans=5)
+        return Straight(distance=100.0, scans=5)
     if kind == "turn":
-        return SEGMENT_KINDS[kind](radius=100.0, arc=90.0, direction="right", scans=4)
+        return Turn(radius=100.0, arc=90.0, direction="right", scans=4)
     if kind == "orbit":
-        return SEGMENT_KINDS[kind](centre=centre, radius=100.0, altitude=altitude, scans=12)
+        return Orbit(centre=centre, radius=100.0, altitude=altitude, scans=12)
     if kind == "flypast":
-        return SEGMENT_KINDS[kind](target=centre, standoff=100.0, altitude=altitude, length=200.0, scans=5)
+        return FlyPast(target=centre, standoff=100.0, altitude=altitude, length=200.0, scans=5)
     if kind == "standoff":
-        return SEGMENT_KINDS[kind](target=centre, standoffs=(50.0, 100.0, 150.0), altitude=altitude)
+        return Standoff(target=centre, standoffs=(50.0, 100.0, 150.0), altitude=altitude)
     raise FieldError("kind", kind, "a segment kind")
 
 
@@ -194,6 +199,7 @@ def segment_spec(segment, defaults=None):
         name = f.name
         value = getattr(segment, name)
         default = getattr(defaults, name)
+        kind: str | tuple[str, ...]  # a tuple: the choices of a select
         if name in CHOICES:
             kind = CHOICES[name]
         elif name in POINT_FIELDS:

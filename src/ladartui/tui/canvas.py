@@ -9,6 +9,8 @@ pixel) in 24-bit colour, or in the xterm-256 palette when the terminal has no
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from rich.color import Color
 from rich.segment import Segment
@@ -31,6 +33,8 @@ LOWER = "\u2584"
 def picture_strips(picture: Picture, use_256: bool = False) -> list[Strip]:
     """One Strip per cell row: two pixel rows per cell, runs of one style merged."""
     top, top_mask, bottom, bottom_mask = views.half_block_cells(picture)
+    top_codes: np.ndarray | None
+    bottom_codes: np.ndarray | None
     if use_256:
         top_codes = views.to_ansi256(top)
         bottom_codes = views.to_ansi256(bottom)
@@ -53,6 +57,7 @@ def picture_strips(picture: Picture, use_256: bool = False) -> list[Strip]:
         run_style = None
         for c in range(cols):
             t, b = top_mask[r, c], bottom_mask[r, c]
+            key: tuple | None
             if t and b:
                 key = ("tb", tuple(top[r, c]), tuple(bottom[r, c]))
                 char = UPPER
@@ -119,7 +124,7 @@ class PictureWidget(Widget, can_focus=True):
         super().__init__(**kwargs)
         self.border_title = title
         self._strips: list[Strip] | None = None
-        self._size_key = None
+        self._size_key: tuple[int, int] | None = None
         self.placeholder = "nothing to show yet"
         self.colour_map = "height"
         self.shown_overlays = frozenset(OVERLAYS)
@@ -181,13 +186,13 @@ class TopViewWidget(PictureWidget):
         *VIEW_BINDINGS,
     ]
 
-    def __init__(self, **kwargs):
+    def __init__(self, **kwargs: Any) -> None:
         super().__init__("Top view", **kwargs)
         self.top: views.TopView | None = None
         self.path = None
         self.scans = None
         self.footprints = None
-        self.frame = None
+        self.frame: tuple[float, float, float, float] | None = None
         self.framing = "path"  # "path" (follows it), "scene", "target" or "manual"
         self.target_box = None
         self.placeholder = "no scene loaded"
@@ -306,9 +311,9 @@ class ProjectionWidget(PictureWidget):
         self.overlays = Overlays()  # in voxel units
         self.voxel_size = 1.0
         self.camera = Camera()
-        self.height_top = None  # top of the height shading (voxel layers), shared by views
+        self.height_top: float | None = None  # top of the height shading (voxel layers), shared by views
         self.pending_fit = None  # a box to frame once the widget has a size
-        self._drag = None
+        self._drag: tuple[int, int] | None = None
         self.placeholder = "nothing to show yet"
         self._update_title()
 

@@ -12,9 +12,10 @@ from pathlib import Path
 from ladartui.errors import LadarError
 from ladartui.recent import remember_scenario
 from ladartui.tui.file_dialogs import SaveAsScreen, SetupScreen
+from ladartui.tui.host import Host
 
 
-class FileActions:
+class FileActions(Host):
     """Mixed into ``LadarApp``, which provides the scenario model, ``load`` and ``tell``."""
 
     def _folder(self) -> Path:
@@ -72,20 +73,23 @@ class FileActions:
 
     def _save_to(self, path: Path | None) -> bool:
         """Write the scenario (to ``path`` for Save As); True when written."""
-        renamed = path is not None and Path(path) != self.scenario.path
+        history = self.history
+        if history is None:  # no scenario: nothing to write
+            return False
+        renamed = path is not None and Path(path) != history.current.path
         try:
-            saved = self.scenario.save(path)
+            saved = history.current.save(path)
         except (LadarError, OSError) as error:
             self.tell(str(error), title="Not saved", severity="error")
             return False
         if renamed:
-            self.history.reset(saved)  # undo must not bring back the old file name
+            history.reset(saved)  # undo must not bring back the old file name
             self.result = None
             self.output_voxels = None  # the outputs of the old name are not this file's
             self.show_output()
             self.show_measures(None)
         else:
-            self.history.mark_saved(saved)
+            history.mark_saved(saved)
         self.scenario = saved
         remember_scenario(saved.path)
         self.scenario_changed()

@@ -11,30 +11,39 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from ladartui.errors import LadarError
 from ladartui.recent import remember_scenario
 from ladartui.tui import bridge
+from ladartui.tui.host import Host
 from ladartui.tui.view_area import prepare_views
 from ladartui.tui.work import start_job
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from ladartui.measures import Measures
+    from ladartui.scenario import Scenario
+    from ladartui.scene.model import Scene
 
 
 @dataclass
 class Loaded:
     """What the load job hands the interface."""
 
-    scenario: object
-    scene: object
-    prepared: dict
-    output: object
-    measures: object
+    scenario: Scenario
+    scene: Scene
+    prepared: dict[str, Any]
+    output: np.ndarray | None
+    measures: Measures | None
     warning: str | None
 
 
-class SceneLoading:
+class SceneLoading(Host):
     """The app's load, probe and warm-up jobs (mixed into ``LadarApp``)."""
 
-    def load(self, path: Path | None, scenario=None) -> None:
+    def load(self, path: Path | None, scenario: Scenario | None = None) -> None:
         """Load a scenario and its scene in a worker (the default scenario when no path)."""
         name = path.name if path else (scenario.path.name if scenario else "default scenario")
         self.set_busy(f"Loading {name}...")
@@ -44,7 +53,7 @@ class SceneLoading:
         """The load job's result: show it, then probe the backends and warm the kernels."""
         self.scene = done.scene
         self.prepared = done.prepared
-        self.view_area.set_scene(self.prepared, self.scene.voxel_size)
+        self.view_area.set_scene(done.prepared, done.scene.voxel_size)
         self.missing_outputs = bridge.missing_outputs(done.scenario)
         self.set_scenario(done.scenario, modified=False)
         if done.scenario.path.is_file():

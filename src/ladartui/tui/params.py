@@ -10,6 +10,9 @@ with a message in the field's label and units.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 from textual import on
 from textual.containers import Horizontal, VerticalScroll
 from textual.widgets import Input, Label
@@ -18,6 +21,7 @@ from ladartui.checks import range_text
 from ladartui.errors import FieldError, LadarError
 from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField, format_number
+from ladartui.tui.host import AppHost, host_of
 
 
 def field_id(key: str) -> str:
@@ -45,39 +49,45 @@ def field_message(param: bridge.Param, typed: str, error: LadarError) -> str:
     return f"{shown}: {error}"
 
 
+class ParamField(NumberField):
+    """A panel's field for one scenario parameter (``param``)."""
+
+    def __init__(self, param: bridge.Param, *, check: Callable[[Any], None], **kwargs: Any):
+        super().__init__(
+            param.key, None, default=None, integer=param.integer, scale=param.scale, check=check, **kwargs
+        )
+        self.param = param
+
+
 class ParamPanel(VerticalScroll):
     """A sidebar panel with parameter fields; subclasses compose with ``param_row``."""
 
     DEFAULT_CLASSES = "pane"
 
-    def __init__(self, **kwargs):
+    def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)
         self.loading_fields = False  # set while filling fields from the scenario
 
+    @property
+    def host(self) -> AppHost:
+        """The app this panel edits the scenario of."""
+        return host_of(self)
+
     def param_row(self, param: bridge.Param) -> Horizontal:
-        field = NumberField(
-            param.key,
-            None,
-            default=None,
-            integer=param.integer,
-            scale=param.scale,
-            check=self._checker(param.key),
-            id=field_id(param.key),
-            classes="param",
-        )
-        field.param = param
+        field = ParamField(param, check=self._checker(param.key), id=field_id(param.key), classes="param")
         label = f"{param.label} {param.unit}".strip()
         return Horizontal(Label(label), field, classes="row", id=field_id(param.key) + "-row")
 
     def _checker(self, key):
         def check(value):
-            if self.app.scenario is not None:
-                bridge.check_param(self.app.scenario, key, value)
+            scenario = self.host.scenario
+            if scenario is not None:
+                bridge.check_param(scenario, key, value)
 
         return check
 
-    def param_fields(self) -> list[NumberField]:
-        return list(self.query(".param").results(NumberField))
+    def param_fields(self) -> list[ParamField]:
+        return list(self.query(".param").results(ParamField))
 
     def fill_fields(self, scenario) -> None:
         """Show the scenario's values (typing in progress is replaced)."""
@@ -92,22 +102,22 @@ class ParamPanel(VerticalScroll):
 
     @on(Input.Changed, ".param")
     def _typed(self, event: Input.Changed) -> None:
-        if self.loading_fields:
+        if self.loading_fields or not isinstance(event.input, NumberField):
             return
         event.input.set_class(event.input.problem() is not None, "-bad")
-        self.app.refresh_status()
+        self.host.refresh_status()
 
     @on(Input.Submitted, ".param")
     @on(Input.Blurred, ".param")
     def _committed(self, event) -> None:
         self.commit_field(event.input)
 
-    def commit_field(self, field: NumberField) -> bool:
+    def commit_field(self, field: ParamField) -> bool:
         """Apply the typed value; an invalid one goes back to the scenario's value, with why.
 
         True when the field now holds the scenario's value (changed or not).
         """
-        app = self.app
+        app = self.host
         if app.scenario is None or field.value == field.committed:
             field.remove_class("-bad")
             app.refresh_status()

@@ -10,14 +10,19 @@ interpreter lock.
 from __future__ import annotations
 
 import time
+from typing import TYPE_CHECKING
 
 import numpy as np
 from textual.widgets import TabbedContent
 
 from ladartui.errors import Cancelled
+from ladartui.tui.host import Host
 from ladartui.tui.screens import MeasuresScreen
 from ladartui.tui.status import format_eta
 from ladartui.tui.work import running, start_job
+
+if TYPE_CHECKING:
+    from ladartui.simulation import SimulationResult
 
 LIVE_POINTS = 20_000  # fewer while a run is going, so redraws stay cheap
 LIVE_INTERVAL = 0.5  # seconds between progressive redraws of the output view
@@ -25,7 +30,7 @@ WARM_POLL = 0.1  # seconds between looks at the warm-up while waiting for it
 ETA_AFTER_SCANS = 2  # the time left is shown once this many scans have given a pace
 
 
-class RunControl:
+class RunControl(Host):
     """The app's Run and Cancel (mixed into ``LadarApp``)."""
 
     def action_run(self) -> None:
@@ -56,11 +61,14 @@ class RunControl:
             self.show_output(limit=LIVE_POINTS)
 
     def action_cancel_run(self) -> None:
-        if self.run_in_progress():
-            self.run_worker_handle.cancel()
+        worker = self.run_worker_handle
+        if self.run_in_progress() and worker is not None:
+            worker.cancel()
             self.set_busy("Cancelling: earlier outputs stay as they were...", self.progress)
 
-    def run_finished(self, result=None, cancelled: bool = False, error: str | None = None):
+    def run_finished(
+        self, result: SimulationResult | None = None, cancelled: bool = False, error: str | None = None
+    ) -> None:
         self.running = False
         self.set_busy(None)
         if cancelled:
@@ -69,8 +77,8 @@ class RunControl:
             self.output_voxels = self.result.scene_output if self.result else None
             self.show_output()
             return
-        if error:
-            self.run_panel.say(error)
+        if error or result is None:
+            self.run_panel.say(error or "Run failed: no result.")
             return
         self.result = result
         self.missing_outputs = []
@@ -78,15 +86,14 @@ class RunControl:
         self.show_output()
         self.show_measures(result.measures)
         total = result.timings.get("total") if isinstance(result.timings, dict) else None
-        self.run_panel.say(
-            f"Last run: {result.backend}"
-            + (f", {total:.1f} s" if total else "")
-            + f"; wrote {self.scenario.measures_file.name}"
-        )
-        self.file_panel.show(self.scenario, self.scene, self.modified)
+        scenario = self.scenario
+        wrote = f"; wrote {scenario.measures_file.name}" if scenario is not None else ""
+        self.run_panel.say(f"Last run: {result.backend}" + (f", {total:.1f} s" if total else "") + wrote)
+        self.file_panel.show(scenario, self.scene, self.modified)
         self.refresh_status()
         self.query_one("#tabs", TabbedContent).active = "tab-results"
-        self.push_screen(MeasuresScreen(result.measures, f"Comparison measures: {self.scenario.name}"))
+        name = scenario.name if scenario is not None else ""
+        self.push_screen(MeasuresScreen(result.measures, f"Comparison measures: {name}"))
 
 
 def _run(scenario, scene, fast: bool, warm, cancel, progress):

@@ -13,6 +13,7 @@ from textual.binding import Binding
 from textual.containers import Grid, Horizontal, Vertical, VerticalScroll
 from textual.screen import ModalScreen
 from textual.suggester import Suggester
+from textual.widget import Widget
 from textual.widgets import Button, DataTable, Input, Label, Select, Static
 
 from ladartui.errors import FieldError, LadarError
@@ -96,6 +97,7 @@ class FormScreen(Dialog):
             box.border_title = self.title_text
             with VerticalScroll(classes="form"):
                 for name, label, kind, value, default in self.spec:
+                    widget: Widget
                     if isinstance(kind, tuple):
                         widget = Select(
                             [(c, c) for c in kind],
@@ -121,7 +123,6 @@ class FormScreen(Dialog):
                             compact=True,
                             placeholder="x, y, z" if kind == "point" else "a, b, c",
                         )
-                        widget.default_text = _point_text(default)
                     yield _row(label, widget)
             if self.note:
                 yield Static(self.note, classes="info")
@@ -152,10 +153,11 @@ class FormScreen(Dialog):
     def values(self, raw=False) -> dict:
         out = {}
         for name, _label, kind, _value, default in self.spec:
-            widget = self.query_one(f"#f-{name}")
             if isinstance(kind, tuple):
-                out[name] = widget.value
-            elif kind in ("int", "float", "optional"):
+                out[name] = self.query_one(f"#f-{name}", Select).value
+                continue
+            widget = self.query_one(f"#f-{name}", Input)  # a NumberField is an Input
+            if kind in ("int", "float", "optional"):
                 try:
                     if kind == "optional" and not widget.value.strip():
                         out[name] = None

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 from textual.app import ComposeResult
 from textual.containers import Horizontal
@@ -42,7 +43,7 @@ class StatusBar(Horizontal):
     StatusBar #cancel { min-width: 10; }
     """
 
-    def __init__(self, **kwargs):
+    def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)
         self.state = NOT_READY
         self.message = ""

@@ -14,6 +14,7 @@ from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.screen import Screen
 from textual.widgets import Button, DataTable, Footer, ProgressBar, Static
+from textual.worker import Worker
 from textual_plotext import PlotextPlot
 
 from ladartui.study.chart import TABLE_COLUMNS, draw_chart, table_rows
@@ -48,7 +49,7 @@ class StudyScreen(Screen):
         self.scans = scans
         self.runs = runs
         self.result = None
-        self.worker = None  # the study job while it runs
+        self.worker: Worker | None = None  # the study job while it runs
 
     def compose(self) -> ComposeResult:
         with Horizontal(id="study-top"):

@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from textual import on
 from textual.app import ComposeResult
@@ -36,6 +37,12 @@ from ladartui.tui.sweep_view import (
     short_path,
 )
 from ladartui.tui.work import JobDone, JobProgress, start_job
+
+if TYPE_CHECKING:
+    from textual.worker import Worker
+
+    from ladartui.sweep.ranking import Ranked
+    from ladartui.sweep.spec import SweepSpec
 
 OBJECTIVE_ORDER = ("obscured-coverage", "coverage-per-km", "coverage-within-budget")
 COST_ORDER = ("flight-time", "distance")
@@ -137,11 +144,11 @@ class SweepScreen(Screen):
         self.initial_scheduler = scheduler or ""
         self.initial_certs = str(certs) if certs else ""
         self.serial = serial
-        self.spec = None  # the SweepSpec launched or opened, when known
+        self.spec: SweepSpec | None = None  # launched or opened, when known
         self.out: Path | None = None  # the results folder shown
         self.rows: list[dict] = []
         self.parameter_names: list[str] = []
-        self.ranking = []
+        self.ranking: list[Ranked] = []
         self.objective = "obscured-coverage"
         self.cost = "flight-time"
         self.budget: float | None = None  # the spec's or the results' budget
@@ -149,7 +156,7 @@ class SweepScreen(Screen):
         self.progress = None  # the last SweepProgress
         self.last_message = ""
         self.running = False
-        self.worker = None  # the sweep job while it runs
+        self.worker: Worker | None = None  # the sweep job while it runs
         self._dirty = False  # rows arrived since the last redraw (redrawn a few times a second)
         self._row_index: dict[str, int] = {}  # variant id -> position in rows, while running
         self._shown_ids: list = []  # variant ids in table order
@@ -339,7 +346,7 @@ class SweepScreen(Screen):
         return True
 
     def action_cancel(self) -> None:
-        if self.running:
+        if self.running and self.worker is not None:
             self.worker.cancel()
             self._status(BUSY, "cancelling after the current variant ...", self._fraction())
         else:
@@ -389,7 +396,7 @@ class SweepScreen(Screen):
         if best is None:
             self._status(self._idle_state(), f"no variant can be ranked by {self.objective}")
             return
-        if self.spec is not None:
+        if self.spec is not None and self.out is not None:  # set together
             name = f"{self.spec.name}-best"
             if self.objective != self.spec.objective:
                 name += f"-{self.objective}"
@@ -407,7 +414,7 @@ class SweepScreen(Screen):
         self._announce_best(found[0], "as saved by the sweep (its spec's objective)")
 
     def action_close(self) -> None:
-        if self.running:
+        if self.running and self.worker is not None:
             self.worker.cancel()
         self.dismiss(None)
 
@@ -552,7 +559,7 @@ class SweepScreen(Screen):
             self._dirty = True
         self.query_one("#sweep-progress", ProgressBar).update(total=max(p.total, 1), progress=p.done)
         self.query_one("#sweep-counts", Static).update(self._counts_text(p))
-        if not self.worker.is_cancelled:
+        if self.worker is not None and not self.worker.is_cancelled:
             self._status(BUSY, f"sweeping into {short_path(self.out)}", p.fraction, cancellable=True)
 
     def _counts_text(self, p) -> str:

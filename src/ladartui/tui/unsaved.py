@@ -3,6 +3,8 @@ question asked before they would be lost."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from rich.markup import escape
 from textual import on
 from textual.app import ComposeResult
@@ -11,7 +13,8 @@ from textual.containers import Horizontal, Vertical
 from textual.screen import ModalScreen
 from textual.widgets import Button, Static
 
-from ladartui.tui.fields import NumberField
+from ladartui.tui.host import Host
+from ladartui.tui.params import ParamField
 
 
 class UnsavedScreen(ModalScreen[str | None]):
@@ -42,14 +45,14 @@ class UnsavedScreen(ModalScreen[str | None]):
 
     @on(Button.Pressed)
     def _chosen(self, event: Button.Pressed) -> None:
-        choice = event.button.id.removeprefix("unsaved-")
+        choice = (event.button.id or "").removeprefix("unsaved-")
         self.dismiss(None if choice == "cancel" else choice)
 
     def action_cancel(self) -> None:
         self.dismiss(None)
 
 
-class EditGuard:
+class EditGuard(Host):
     """The app's guard over pending and unsaved edits (mixed into ``LadarApp``, which
     provides ``scenario``, ``modified``, ``commit_field``, ``tell`` and ``action_save``)."""
 
@@ -63,7 +66,7 @@ class EditGuard:
         """
         if self.scenario is None:
             return True
-        for field in self.query(".param").results(NumberField):
+        for field in self.query(".param").results(ParamField):
             if field.value == field.committed:
                 continue
             problem = field.problem()
@@ -82,12 +85,13 @@ class EditGuard:
     def unsaved(self) -> bool:
         """Edits that a save would keep: committed ones, or text typed in a field."""
         return self.scenario is not None and (
-            self.modified or any(f.value != f.committed for f in self.query(".param").results(NumberField))
+            self.modified or any(f.value != f.committed for f in self.query(".param").results(ParamField))
         )
 
-    def confirm_discard(self, doing: str, then) -> None:
+    def confirm_discard(self, doing: str, then: Callable[[], None]) -> None:
         """Call ``then`` once unsaved edits are saved or the analyst chose to discard them."""
-        if not self.unsaved():
+        scenario = self.scenario
+        if scenario is None or not self.unsaved():
             then()
             return
 
@@ -99,4 +103,4 @@ class EditGuard:
             elif choice == "discard":
                 then()
 
-        self.push_screen(UnsavedScreen(self.scenario.path.name, doing), chosen)
+        self.push_screen(UnsavedScreen(scenario.path.name, doing), chosen)

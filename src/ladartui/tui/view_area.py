@@ -4,6 +4,8 @@ concern every view at once (zoom to target, fits, colouring, overlays)."""
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from textual.containers import Container
 
@@ -20,7 +22,7 @@ SCENE_POINTS = 150_000  # voxels drawn in the 3D scene view (all of the small sc
 OUTPUT_POINTS = 80_000
 MAX_FOOTPRINTS = 400
 # the overlay sets the 'o' key steps through
-OVERLAY_CYCLE = (frozenset(OVERLAYS), frozenset({"path", "scans"}), frozenset())
+OVERLAY_CYCLE: tuple[frozenset[str], ...] = (frozenset(OVERLAYS), frozenset({"path", "scans"}), frozenset())
 
 LAYOUTS = {
     1: "3D scene + top view",
@@ -54,7 +56,7 @@ def prepare_views(scene) -> dict:
 class ViewArea(Container):
     """Owns the three views, which of them the layout shows, and how they are drawn."""
 
-    def __init__(self, **kwargs):
+    def __init__(self, **kwargs: Any) -> None:
         super().__init__(classes="layout-1", **kwargs)
         self.layout_number = 1
         self.prepared: dict | None = None
@@ -63,8 +65,8 @@ class ViewArea(Container):
         self.output_mode = "class"  # or "height": see render.output
         self.colour_map = "height"  # or "grey": the report's 56 shades
         self.overlays = OVERLAY_CYCLE[0]
-        self.markers = None  # scan positions, voxel units
-        self._output_args = (None, None, OUTPUT_POINTS, None, None)
+        self.markers: np.ndarray | None = None  # scan positions, voxel units
+        self._output_args: tuple[Any, float | None, int, Any, Any] = (None, None, OUTPUT_POINTS, None, None)
         self.per_scan_known = False  # the output shown has per-scan returns ("scans" mode)
         self._target_file_cache: tuple | None = None
 

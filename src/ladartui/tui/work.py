@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any, ClassVar, TypeGuard
 
 from textual.message import Message
 from textual.worker import Worker, get_current_worker
@@ -89,6 +89,6 @@ def start_job(node, job: str, task: Task) -> Worker:
     return node.run_worker(body, name=job, group=job, thread=True, exclusive=True, exit_on_error=False)
 
 
-def running(worker: Worker | None) -> bool:
+def running(worker: Worker | None) -> TypeGuard[Worker]:
     """Whether ``worker`` exists and has not finished (used from any thread)."""
     return worker is not None and not worker.is_finished

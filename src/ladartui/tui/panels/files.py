@@ -3,6 +3,7 @@ the scenarios opened lately."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 
 from rich.text import Text
@@ -12,6 +13,7 @@ from textual.widgets import Button, Label, OptionList, Static
 from textual.widgets.option_list import Option
 
 from ladartui.recent import recent_scenarios
+from ladartui.tui.host import host_of
 
 
 class FilePanel(VerticalScroll):
@@ -32,7 +34,7 @@ class FilePanel(VerticalScroll):
     def on_mount(self) -> None:
         self.show_recent()
 
-    def show(self, scenario, scene, modified: bool, missing: list[Path] = ()) -> None:
+    def show(self, scenario, scene, modified: bool, missing: Sequence[Path] = ()) -> None:
         if scenario is None:
             self.query_one("#file-info", Static).update("No scenario: F2 new, F3 open.")
             return
@@ -76,7 +78,8 @@ class FilePanel(VerticalScroll):
     @on(OptionList.OptionSelected, "#recent")
     def _recent_chosen(self, event: OptionList.OptionSelected) -> None:
         event.stop()
-        self.app.open_path(Path(event.option.id))
+        if event.option.id is not None:  # each recent entry's id is its path
+            host_of(self).open_path(Path(event.option.id))
 
     @on(Button.Pressed, "#btn-new,#btn-open,#btn-save,#btn-save-as,#btn-undo,#btn-redo")
     async def _pressed(self, event: Button.Pressed) -> None:
@@ -89,7 +92,7 @@ class FilePanel(VerticalScroll):
             "btn-undo": "undo",
             "btn-redo": "redo",
         }
-        await self.app.run_action(action[event.button.id])
+        await self.app.run_action(action[event.button.id or ""])
 
 
 def shown_folder(folder: Path) -> str:

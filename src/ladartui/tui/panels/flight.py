@@ -7,6 +7,8 @@ than accepting values that change nothing.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from textual import on
 from textual.containers import Grid
 from textual.widgets import Button, DataTable, Label, Static
@@ -16,6 +18,9 @@ from ladartui.flight import Manual
 from ladartui.tui import bridge
 from ladartui.tui.params import ParamPanel, field_id
 from ladartui.tui.screens import FormScreen, PosesScreen
+
+if TYPE_CHECKING:
+    from ladartui.scenario import Scenario
 
 ADD_BUTTONS = "#add-straight,#add-turn,#add-orbit,#add-flypast,#add-standoff"
 START_UNUSED = "The path starts at its first segment: the start pose is not used."
@@ -54,10 +59,10 @@ class FlightPanel(ParamPanel):
 
     def enable_start(self, scenario=None) -> None:
         """Start fields only where the path uses them (and never while busy)."""
-        scenario = scenario or self.app.scenario
+        scenario = scenario or self.host.scenario
         used = scenario is not None and scenario.flight.uses_start
         for param in bridge.START_PARAMS:
-            self.query_one("#" + field_id(param.key)).disabled = not used or bool(self.app.busy)
+            self.query_one("#" + field_id(param.key)).disabled = not used or bool(self.host.busy)
         note = self.query_one("#start-note", Static)
         note.update("" if used else START_UNUSED)
         note.display = not used
@@ -94,8 +99,9 @@ class FlightPanel(ParamPanel):
 
     # -- editing segments ------------------------------------------------------------
 
-    def _editable(self) -> bool:
-        return self.app.scenario is not None and not self.app.busy
+    def _editing(self) -> Scenario | None:
+        """The scenario to edit, or None when there is none or the app is busy."""
+        return None if self.host.busy else self.host.scenario
 
     def selected(self) -> int:
         return self.query_one("#segments", DataTable).cursor_row
@@ -103,17 +109,18 @@ class FlightPanel(ParamPanel):
     @on(Button.Pressed, ADD_BUTTONS)
     def _add_pressed(self, event: Button.Pressed) -> None:
         event.stop()
-        self.add_segment(event.button.id.removeprefix("add-"))
+        self.add_segment((event.button.id or "").removeprefix("add-"))
 
     def add_segment(self, kind: str) -> None:
-        if not self._editable():
+        scenario = self._editing()
+        if scenario is None:
             return
-        poses = self.app.scenario.poses()
-        segment = bridge.default_segment(kind, self.app.target_m(), poses[-1] if poses else None)
+        poses = scenario.poses()
+        segment = bridge.default_segment(kind, self.host.target_m(), poses[-1] if poses else None)
         self._edit_segment(segment, None)
 
     def _edit_segment(self, segment, index: int | None) -> None:
-        defaults = bridge.default_segment(segment.kind, self.app.target_m(), None)
+        defaults = bridge.default_segment(segment.kind, self.host.target_m(), None)
         spec = bridge.segment_spec(segment, defaults)
         label = bridge.SEGMENT_LABELS[segment.kind]
         title = label + (" (new)" if index is None else "")
@@ -135,7 +142,10 @@ class FlightPanel(ParamPanel):
 
     def _put_segment(self, index: int | None, segment, what: str) -> bool:
         """Replace segment ``index``, or append when ``index`` is None."""
-        segments = list(self.app.scenario.flight.segments)
+        scenario = self.host.scenario
+        if scenario is None:
+            return False
+        segments = list(scenario.flight.segments)
         if index is None:
             segments.append(segment)
         else:
@@ -143,12 +153,15 @@ class FlightPanel(ParamPanel):
         return self._apply_segments(segments, what)
 
     def _apply_segments(self, segments, what: str) -> bool:
-        try:
-            scenario = bridge.with_segments(self.app.scenario, segments)
-        except LadarError as error:
-            self.app.tell(str(error), title="Flight path not changed", severity="error")
+        scenario = self.host.scenario
+        if scenario is None:
             return False
-        self.app.edit(scenario, what.capitalize())
+        try:
+            scenario = bridge.with_segments(scenario, segments)
+        except LadarError as error:
+            self.host.tell(str(error), title="Flight path not changed", severity="error")
+            return False
+        self.host.edit(scenario, what.capitalize())
         return True
 
     @on(Button.Pressed, "#add-manual")
@@ -158,32 +171,35 @@ class FlightPanel(ParamPanel):
 
     def manual_poses(self) -> None:
         """Edit manual poses: the selected manual segment, or a new one."""
-        if not self._editable():
+        scenario = self._editing()
+        if scenario is None:
             return
-        segments = self.app.scenario.flight.segments
+        segments = scenario.flight.segments
         index = self.selected()
-        if 0 <= index < len(segments) and segments[index].kind == "manual":
-            self._edit_poses(index)
+        if 0 <= index < len(segments) and isinstance(segments[index], Manual):
+            self._edit_poses(scenario, index)
         else:
-            poses = self.app.scenario.poses()
-            start = poses[-1] if poses else bridge.start_pose(self.app.scenario)
-            self._edit_poses(None, [start])
+            poses = scenario.poses()
+            start = poses[-1] if poses else bridge.start_pose(scenario)
+            self._edit_poses(scenario, None, [start])
 
-    def _edit_poses(self, index: int | None, poses=None) -> None:
-        if poses is None:
-            poses = list(self.app.scenario.flight.segments[index].poses)
+    def _edit_poses(self, scenario: Scenario, index: int | None, poses=None) -> None:
+        """Edit the poses of manual segment ``index``, or ``poses`` as a new one (index None)."""
+        if index is not None:
+            segment = scenario.flight.segments[index]
+            poses = list(segment.poses) if isinstance(segment, Manual) else []
 
         def done(result):
             if not result:
                 if result is not None:
-                    self.app.tell(
+                    self.host.tell(
                         "A manual segment needs at least one pose; not changed.", severity="warning"
                     )
                 return
             what = "add manual poses" if index is None else f"edit poses of segment {index + 1}"
             self._put_segment(index, Manual(tuple(result)), what)
 
-        self.app.push_screen(PosesScreen(poses, bridge.start_pose(self.app.scenario)), done)
+        self.app.push_screen(PosesScreen(poses, bridge.start_pose(scenario)), done)
 
     @on(Button.Pressed, "#seg-edit")
     def _edit_pressed(self, event: Button.Pressed) -> None:
@@ -196,17 +212,18 @@ class FlightPanel(ParamPanel):
         self.edit_selected()
 
     def edit_selected(self) -> None:
-        if not self._editable():
+        scenario = self._editing()
+        if scenario is None:
             return
         index = self.selected()
-        segments = self.app.scenario.flight.segments
+        segments = scenario.flight.segments
         if not 0 <= index < len(segments):
             return
         kind = segments[index].kind
         if kind == "manual":
-            self._edit_poses(index)
+            self._edit_poses(scenario, index)
         elif kind in bridge.FILE_SEGMENTS:
-            self.app.tell(
+            self.host.tell(
                 f"A {bridge.SEGMENT_LABELS[kind].lower()} segment comes from its "
                 f"file ({segments[index].file}): change its file, rate or times in "
                 "the scenario file. Delete removes it; Aim all points it at the "
@@ -223,14 +240,15 @@ class FlightPanel(ParamPanel):
         self.delete_selected()
 
     def delete_selected(self) -> None:
-        if not self._editable():
+        scenario = self._editing()
+        if scenario is None:
             return
         index = self.selected()
-        segments = list(self.app.scenario.flight.segments)
+        segments = list(scenario.flight.segments)
         if not 0 <= index < len(segments):
             return
         if len(segments) == 1:
-            self.app.tell("The flight path needs at least one segment.", severity="warning")
+            self.host.tell("The flight path needs at least one segment.", severity="warning")
             return
         del segments[index]
         self._apply_segments(segments, f"delete segment {index + 1}")
@@ -241,12 +259,13 @@ class FlightPanel(ParamPanel):
         self.aim_all()
 
     def aim_all(self) -> None:
-        if not self._editable():
+        scenario = self._editing()
+        if scenario is None:
             return
         try:
-            scenario = bridge.aim_all(self.app.scenario, self.app.target_m())
+            scenario = bridge.aim_all(scenario, self.host.target_m())
         except LadarError as error:
-            self.app.tell(str(error), title="Cannot aim every scan", severity="error")
+            self.host.tell(str(error), title="Cannot aim every scan", severity="error")
             return
-        self.app.edit(scenario, "Aim every scan at the target")
-        self.app.tell("Every scan now aims at the target centre.")
+        self.host.edit(scenario, "Aim every scan at the target")
+        self.host.tell("Every scan now aims at the target centre.")

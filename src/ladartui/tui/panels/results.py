@@ -47,4 +47,4 @@ class ResultsPanel(VerticalScroll):
     @on(Button.Pressed, "#btn-measures,#btn-compare,#btn-threshold,#btn-export-las")
     async def _pressed(self, event: Button.Pressed) -> None:
         event.stop()
-        await self.app.run_action(event.button.id.removeprefix("btn-").replace("-", "_"))
+        await self.app.run_action((event.button.id or "").removeprefix("btn-").replace("-", "_"))

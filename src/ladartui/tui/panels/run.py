@@ -3,6 +3,8 @@ study and sweep buttons with what the last run said."""
 
 from __future__ import annotations
 
+from typing import Any
+
 from rich.text import Text
 from textual import on
 from textual.containers import Grid, Horizontal
@@ -17,7 +19,7 @@ STEP_KEY = "scenario.step"
 
 
 class RunPanel(ParamPanel):
-    def __init__(self, **kwargs):
+    def __init__(self, **kwargs: Any) -> None:
         super().__init__(**kwargs)
         self.backend_rows: list[tuple[str, str, bool]] | None = None
         self.backend_values = ["auto"]
@@ -78,9 +80,9 @@ class RunPanel(ParamPanel):
 
     def enable_step(self, scenario=None) -> None:
         """The march step only matters to the march method."""
-        scenario = scenario or self.app.scenario
+        scenario = scenario or self.host.scenario
         step = self.query_one("#" + field_id(STEP_KEY))
-        step.disabled = scenario is None or scenario.method != "march" or bool(self.app.busy)
+        step.disabled = scenario is None or scenario.method != "march" or bool(self.host.busy)
 
     def say(self, text: str) -> None:
         self.query_one("#run-info", Static).update(text)
@@ -123,7 +125,7 @@ class RunPanel(ParamPanel):
     # -- choices that edit the scenario ----------------------------------------------
 
     def _choose(self, label: str, **change) -> None:
-        app = self.app
+        app = self.host
         if self.loading_fields or app.scenario is None:
             return
         name, value = next(iter(change.items()))
@@ -159,4 +161,4 @@ class RunPanel(ParamPanel):
             "btn-study": "study",
             "btn-sweep": "sweep",
         }
-        await self.app.run_action(action[event.button.id])
+        await self.app.run_action(action[event.button.id or ""])
