@@ -206,3 +206,22 @@ async def test_the_views_are_images_when_an_image_mode_is_forced_and_half_blocks
         scene3d.post_message(PictureWidget.ViewRequest("fit_target"))
         await pilot.pause(0.3)
         assert not np.array_equal(np.asarray(scene3d.image_view.image), rgb)
+
+
+def test_an_iterm2_image_is_the_pictures_png_stretched_over_its_cells():
+    import base64
+
+    from PIL import Image
+
+    from ladartui.tui.terminal_image import iterm_sequence, to_pil
+
+    rgb = np.zeros((40, 30, 3), np.uint8)
+    rgb[5:10, 3:7] = (255, 0, 255)
+    sequence = iterm_sequence(to_pil(rgb), cols=3, rows=2)
+    assert sequence.startswith("\x1b]1337;File=inline=1;") and sequence.endswith("\x07")
+    header, data = sequence[len("\x1b]1337;File=") : -1].split(":", 1)
+    fields = dict(item.split("=") for item in header.split(";"))
+    assert fields["width"] == "3" and fields["height"] == "2" and fields["preserveAspectRatio"] == "0"
+    png = base64.b64decode(data)
+    assert int(fields["size"]) == len(png)
+    assert np.array_equal(np.asarray(Image.open(io.BytesIO(png)).convert("RGB")), rgb)
