@@ -156,9 +156,9 @@ async def _loaded(pilot):
     await pilot.pause(0.2)
 
 
-@pytest.mark.parametrize("mode", ["kitty", "sixel", "iterm", "halfblocks"])
+@pytest.mark.parametrize("mode", ["kitty", "sixel", "iterm", "halfblocks-24bit", "halfblocks-256"])
 async def test_the_views_are_images_when_an_image_mode_is_forced_and_half_blocks_otherwise(
-    tmp_path, scene_files, mode
+    tmp_path, scene_files, mode, monkeypatch
 ):
     from textual_image.widget import SixelImage, TGPImage
 
@@ -166,6 +166,15 @@ async def test_the_views_are_images_when_an_image_mode_is_forced_and_half_blocks
     from ladartui.tui.canvas import PictureWidget
     from tui_support import make_scenario
 
+    colours = None
+    if mode.startswith("halfblocks"):
+        mode, colours = mode.split("-")
+        # the terminal's colour depth as rich (and so Textual) reads it
+        monkeypatch.setenv("TERM", "xterm-256color")
+        if colours == "24bit":
+            monkeypatch.setenv("COLORTERM", "truecolor")
+        else:
+            monkeypatch.delenv("COLORTERM", raising=False)
     scenario = make_scenario(tmp_path, scene_files)
     graphics = Graphics(mode, True, f"set to {mode}")
     app = LadarApp(scenario.path, compile_in_child=False, graphics=graphics)
@@ -189,6 +198,10 @@ async def test_the_views_are_images_when_an_image_mode_is_forced_and_half_blocks
         if mode == "halfblocks":  # the text path draws half-block cells
             rows = [scene3d.render_line(y) for y in range(scene3d.size.height)]
             assert sum("\u2580" in seg.text or "\u2584" in seg.text for row in rows for seg in row) > 20
+            # what reaches the terminal: 24-bit colours only where COLORTERM says so
+            written = "".join(row.render(app.console) for row in rows)
+            assert ("38;2;" in written) == (colours == "24bit")
+            assert ("38;5;" in written) == (colours == "256")
             return
         # the image is the view's picture at the terminal's pixels (10 x 20 a cell when
         # the terminal cannot be asked), not the half-block picture
