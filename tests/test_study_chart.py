@@ -7,7 +7,7 @@ import random
 
 import pytest
 
-from ladartui.study.chart import chart_points, chart_text, label_places, short_label
+from ladartui.study.chart import chart_points, chart_text, family, label_places, short_label
 from ladartui.study.chart_layout import PlotArea, frame_size, place_labels
 from ladartui.study.misses import MissSummary
 from ladartui.study.results import StudyResult, StudyRow
@@ -107,3 +107,19 @@ def test_frame_size_reads_plotexts_frame():
     columns, rows = frame_size(text)
     assert rows == len(_plot_rows(text)) and columns == len(_plot_rows(text)[0])
     assert short_label(crowded_result().rows[0].setting) == "nb ex m1"
+
+
+def test_each_series_has_its_own_colour_in_the_chart_and_its_legend():
+    import re
+
+    result = crowded_result()
+    text = chart_text(result, 100, 30, color=True)
+    plot, legend = text[: text.index("└")], text[text.index("└") :]
+    # the colour each legend entry is drawn in, and the colours the plot's markers use
+    entries = dict(re.findall(r"\x1b\[38;5;(\d+)m[o*] ([a-zA-Z0-9 ]+?)(?:\x1b|\s\()", legend))
+    assert len(entries) == 6 and len(set(entries.values())) == 6
+    marker_colours = set(re.findall(r"\x1b\[38;5;(\d+)m[^\x1b]*[o*]", plot))
+    # every series with points off the front shows its own colour (front points are drawn as *)
+    off_front = {family(row.setting) for row in result.rows if not row.front}
+    assert {colour for colour, name in entries.items() if name in off_front} <= marker_colours
+    assert len(off_front) >= 4

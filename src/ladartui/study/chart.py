@@ -16,17 +16,19 @@ import threading
 
 from ladartui.study.results import OK, StudyResult, format_points, format_seconds, format_share
 
-# Series by tracer family, each with its own colour (plotext colour names).
+# Series by tracer family, each with its own colour: fixed xterm-256 colours, not the
+# 16 named ones, which a terminal's (or Textual's) theme may draw alike (red and
+# magenta both came out pink).
 FAMILIES = (
-    ("numba exact f64", "green"),
-    ("wgpu exact f64", "cyan"),
-    ("wgpu exact f32", "blue"),
-    ("numba march", "red"),
-    ("wgpu march", "magenta"),
+    ("numba exact f64", 40),  # green
+    ("wgpu exact f64", 44),  # cyan
+    ("wgpu exact f32", 33),  # blue
+    ("numba march", 160),  # red
+    ("wgpu march", 165),  # violet
 )
 FRONT_MARKER = "*"
 POINT_MARKER = "o"
-FRONT_COLOR = "orange"
+FRONT_COLOR = 214  # orange
 HEADROOM = 1.08  # above the highest point: its label may sit a row above it
 TITLE = "Speed against accuracy (* = Pareto front)"
 X_LABEL = "seconds per scan (log)"
