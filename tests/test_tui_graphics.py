@@ -162,7 +162,7 @@ async def test_the_views_are_images_when_an_image_mode_is_forced_and_half_blocks
 ):
     from textual_image.widget import SixelImage, TGPImage
 
-    from ladartui.tui.app import LadarApp
+    from ladartui.tui.app import LadarApp, help_rows
     from ladartui.tui.canvas import PictureWidget
     from tui_support import make_scenario
 
@@ -184,6 +184,9 @@ async def test_the_views_are_images_when_an_image_mode_is_forced_and_half_blocks
         await pilot.pause(0.3)
         views = list(app.query(PictureWidget))
         assert len(views) == 3
+        # the help screen says how the views are drawn and why
+        assert ("Views", "settings.toml", "Drawn as " + graphics.describe()) in help_rows(app)
+        assert f"set to {mode}" in graphics.describe()
         for view in views:
             if mode == "halfblocks":
                 assert view.image_view is None and not view.query(TGPImage) and not view.query(SixelImage)

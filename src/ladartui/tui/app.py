@@ -59,13 +59,17 @@ def palette_entries(app=None) -> list[tuple[str, str, str]]:
 
 
 def help_rows(app=None) -> list[tuple[str, str, str]]:
-    """The help screen's rows: the app's keys (as remapped), the views' and the dialogs'."""
-    return actions.help_rows(
+    """The help screen's rows: the app's keys (as remapped), the views' and the dialogs',
+    and how the views are drawn (``graphics`` in settings.toml forces it)."""
+    rows = actions.help_rows(
         app.keymap if app is not None else None,
         ProjectionWidget.BINDINGS,
         PosesScreen.BINDINGS,
         TopViewWidget.BINDINGS,
     )
+    if app is not None:
+        rows.append(("Views", "settings.toml", "Drawn as " + app.graphics.describe()))
+    return rows
 
 
 class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
