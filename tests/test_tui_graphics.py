@@ -241,3 +241,35 @@ def test_an_iterm2_image_is_the_pictures_png_stretched_over_its_cells():
     png = base64.b64decode(data)
     assert int(fields["size"]) == len(png)
     assert np.array_equal(np.asarray(Image.open(io.BytesIO(png)).convert("RGB")), rgb)
+
+
+def test_the_command_line_flag_forces_the_mode_for_one_session(monkeypatch, capsys):
+    import ladartui.tui
+    from ladartui import cli
+
+    calls = []
+    monkeypatch.setattr(ladartui.tui, "run_app", lambda path, graphics=None: calls.append((path, graphics)))
+    assert cli.main(["--graphics", "kitty"]) == 0
+    assert cli.main(["--graphics=halfblocks"]) == 0
+    assert cli.main(["tui", "--graphics", "sixel"]) == 0
+    assert calls == [(None, "kitty"), (None, "halfblocks"), (None, "sixel")]
+    with pytest.raises(SystemExit) as stop:
+        cli.main(["--graphics", "retina"])
+    assert stop.value.code == 2
+    error = capsys.readouterr().err.strip()
+    assert "\n" not in error and "invalid choice: 'retina'" in error and "iterm" in error
+
+
+def test_detect_puts_the_flag_over_the_settings_file(tmp_path, monkeypatch):
+    from ladartui.tui.graphics import detect
+
+    (tmp_path / "settings.toml").write_text('[display]\ngraphics = "kitty"\n')
+    graphics, problems = detect(folder=tmp_path)
+    assert (graphics.mode, graphics.reason, problems) == ("kitty", "set to kitty", [])
+    graphics, _ = detect("halfblocks", folder=tmp_path)
+    assert graphics.mode == "halfblocks" and graphics.seconds >= 0.0
+    (tmp_path / "settings.toml").write_text('[display]\ngraphics = "retina"\n')
+    monkeypatch.setenv("TMUX", "/tmp/tmux-0/default,1,0")  # auto never asks a terminal here
+    graphics, problems = detect(folder=tmp_path)
+    assert graphics.mode == "halfblocks"  # auto
+    assert len(problems) == 1 and "settings.toml:2:" in problems[0]
