@@ -56,8 +56,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
-    # `ladartui` and `ladartui SCENARIO.toml` open the TUI.
-    if not argv or (argv[0] not in COMMANDS and not argv[0].startswith("-")):
+    # `ladartui`, `ladartui SCENARIO.toml` and `ladartui --graphics MODE` open the TUI.
+    tui_flag = bool(argv) and argv[0].split("=")[0] == "--graphics"
+    if not argv or tui_flag or (argv[0] not in COMMANDS and not argv[0].startswith("-")):
         argv = ["tui", *argv]
     parser = build_parser()
     try:

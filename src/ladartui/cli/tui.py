@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ladartui.errors import InputFileError
+from ladartui.tui.graphics import MODES  # no textual: the mode is chosen before the app loads
 
 
 def add_parser(subparsers) -> None:
@@ -15,6 +16,12 @@ def add_parser(subparsers) -> None:
         "(created with its scene on first use).",
     )
     parser.add_argument("scenario", nargs="?", type=Path, help="a scenario file (.toml)")
+    parser.add_argument(
+        "--graphics",
+        choices=MODES,
+        help="how the views are drawn: real pixels (sixel, kitty, iterm), half-block characters "
+        "(halfblocks) or auto (chosen at start-up; the default, or [display] graphics in settings.toml)",
+    )
     parser.set_defaults(handler=run)
 
 
@@ -24,4 +31,4 @@ def run(args) -> int:
         raise InputFileError(path, "scenario file not found")
     from ladartui.tui import run_app
 
-    return run_app(path)
+    return run_app(path, args.graphics)

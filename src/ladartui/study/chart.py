@@ -11,28 +11,31 @@ with a large marker and labelled.
 from __future__ import annotations
 
 import io
+import math
 import threading
 
 from ladartui.study.results import OK, StudyResult, format_points, format_seconds, format_share
 
-# Series by tracer family, each with its own colour (plotext colour names).
+# Series by tracer family, each with its own colour: fixed xterm-256 colours, not the
+# 16 named ones, which a terminal's (or Textual's) theme may draw alike (red and
+# magenta both came out pink).
 FAMILIES = (
-    ("numba exact f64", "green"),
-    ("wgpu exact f64", "cyan"),
-    ("wgpu exact f32", "blue"),
-    ("numba march", "red"),
-    ("wgpu march", "magenta"),
+    ("numba exact f64", 40),  # green
+    ("wgpu exact f64", 44),  # cyan
+    ("wgpu exact f32", 33),  # blue
+    ("numba march", 160),  # red
+    ("wgpu march", 165),  # violet
 )
 FRONT_MARKER = "*"
 POINT_MARKER = "o"
-FRONT_COLOR = "orange"
-LEGEND_HEADROOM = 1.5
+FRONT_COLOR = 214  # orange
+HEADROOM = 1.08  # above the highest point: its label may sit a row above it
 TITLE = "Speed against accuracy (* = Pareto front)"
 X_LABEL = "seconds per scan (log)"
 Y_LABEL = "|coverage error| (pts)"
 
 # The plotext module keeps one global figure: serialise its users.
-_PLOTEXT_LOCK = threading.Lock()
+_PLOTEXT_LOCK = threading.RLock()
 
 
 def family(setting) -> str:
@@ -61,8 +64,23 @@ def chart_points(result: StudyResult):
     return points
 
 
-def draw_chart(plt, result: StudyResult, title: str = TITLE, labels: bool = True) -> None:
-    """Draw the chart on ``plt`` (plotext or a plotext figure); size and theme are the caller's."""
+def chart_limits(points) -> tuple[tuple[float, float], tuple[float, float]]:
+    """(log10 seconds at the left and right edges, error points at the bottom and top)."""
+    xs = [math.log10(max(x, 1e-9)) for x, _, _ in points]
+    lo, hi = (min(xs), max(xs)) if xs else (0.0, 1.0)
+    if hi - lo < 1e-6:
+        lo, hi = lo - 0.5, hi + 0.5
+    top = max((y for _, y, _ in points), default=0.0)
+    return (lo, hi), (0.0, top * HEADROOM if top > 0 else 1.0)
+
+
+def draw_chart(plt, result: StudyResult, title: str = TITLE, labels=None) -> None:
+    """Draw the chart on ``plt`` (plotext or a plotext figure); size and theme are the caller's.
+
+    ``labels``: (text, x, y) of the front's labels as ``label_places`` placed them for
+    the chart's size; None draws none. The legend is not drawn here but beside the
+    chart (``legend_text``), where it covers no point.
+    """
     plt.clear_data()
     points = chart_points(result)
     plt.title(title)
@@ -75,42 +93,98 @@ def draw_chart(plt, result: StudyResult, title: str = TITLE, labels: bool = True
         xs = [x for x, _, row in points if family(row.setting) == name]
         ys = [y for _, y, row in points if family(row.setting) == name]
         if xs:
-            plt.scatter(xs, ys, marker=POINT_MARKER, color=color, label=name)
+            plt.scatter(xs, ys, marker=POINT_MARKER, color=color)
     front = sorted((p for p in points if p[2].front), key=lambda p: p[0])
-    xs = [p[0] for p in points]
-    ys = [p[1] for p in points]
     if front:
-        plt.scatter(
-            [p[0] for p in front],
-            [p[1] for p in front],
-            marker=FRONT_MARKER,
-            color=FRONT_COLOR,
-            label="Pareto front",
-        )
-        if labels:
-            # Labels start a little right of their marker (log axis: a factor).
-            shift = (max(xs) / min(xs)) ** 0.02 if min(xs) > 0 else 1.0
-            for x, y, row in front:
-                plt.text(short_label(row.setting), x * shift, y, color=FRONT_COLOR, alignment="left")
-    # Head room above the data for the legend, which plotext puts top left.
-    top = max(ys) if max(ys) > 0 else 1.0
-    plt.ylim(0.0, top * LEGEND_HEADROOM)
+        plt.scatter([p[0] for p in front], [p[1] for p in front], marker=FRONT_MARKER, color=FRONT_COLOR)
+    for text, x, y in labels or []:
+        plt.text(text, x, y, color=FRONT_COLOR, alignment="left")
+    x_range, y_range = chart_limits(points)
     plt.xscale("log")
+    plt.xlim(*x_range)  # log10 units on a log axis
+    plt.ylim(*y_range)
+
+
+def label_places(result: StudyResult, width: int, height: int) -> list[tuple[str, float, float]]:
+    """Places for the front's labels on a width x height chart where none touches another
+    label or a marker (see ``chart_layout``); labels with no room are left out."""
+    import plotext
+
+    from ladartui.study.chart_layout import PlotArea, frame_size, place_labels
+
+    points = chart_points(result)
+    if not points or width < 20 or height < 8:
+        return []
+    with _PLOTEXT_LOCK:
+        plotext.clear_figure()
+        plotext.limit_size(False, False)
+        plotext.plotsize(width, height)
+        plotext.theme("clear")
+        draw_chart(plotext, result)
+        text = plotext.uncolorize(plotext.build())
+        plotext.clear_figure()
+    size = frame_size(text)
+    if size is None or size[0] < 2 or size[1] < 2:
+        return []
+    area = PlotArea(size[0], size[1], *chart_limits(points))
+    front = sorted((p for p in points if p[2].front), key=lambda p: p[0])
+    return place_labels(
+        area,
+        [(x, y) for x, y, _ in points],
+        [(short_label(row.setting), x, y) for x, y, row in front],
+    )
+
+
+def legend_entries(result: StudyResult) -> list[tuple[str, str, int]]:
+    """(marker, name, plotext colour) of each series drawn, then the front."""
+    names = {family(row.setting) for _, _, row in chart_points(result)}
+    entries = [(POINT_MARKER, name, color) for name, color in FAMILIES if name in names]
+    if any(row.front for _, _, row in chart_points(result)):
+        entries.append(
+            (
+                FRONT_MARKER,
+                "Pareto front (labels: backend, ex = exact or march step, m = ray grid)",
+                FRONT_COLOR,
+            )
+        )
+    return entries
+
+
+def legend_text(result: StudyResult, width: int = 100, color: bool = True) -> str:
+    """The legend as lines of at most ``width`` characters (ANSI colours unless not ``color``)."""
+    import plotext
+
+    lines: list[str] = []
+    line, length = "", 0
+    for marker, name, colour in legend_entries(result):
+        entry = f"{marker} {name}"
+        if length and length + 2 + len(entry) > width:
+            lines.append(line)
+            line, length = "", 0
+        shown = plotext.colorize(entry, colour) if color else entry
+        line, length = (line + "  " + shown, length + 2 + len(entry)) if length else (shown, len(entry))
+    if line:
+        lines.append(line)
+    return "\n".join(lines)
 
 
 def chart_text(result: StudyResult, width: int = 100, height: int = 30, color: bool = True) -> str:
-    """The chart as terminal text (ANSI colours unless ``color`` is False)."""
+    """The chart as terminal text, its legend below it (ANSI colours unless ``color`` is False)."""
     import plotext
 
+    legend = legend_text(result, width, color)
+    chart_height = max(8, height - (legend.count("\n") + 1 if legend else 0))
+    labels = label_places(result, width, chart_height)
     with _PLOTEXT_LOCK:
         plotext.clear_figure()
         plotext.limit_size(False, False)  # the size asked for, not the terminal's
-        plotext.plotsize(width, height)
+        plotext.plotsize(width, chart_height)
         plotext.theme("pro" if color else "clear")
-        draw_chart(plotext, result)
+        draw_chart(plotext, result, labels=labels)
         text = plotext.build()
         plotext.clear_figure()
-    return text if color else plotext.uncolorize(text)
+    text = text if color else plotext.uncolorize(text)
+    return text.rstrip("\n") + ("\n" + legend if legend else "")
 
 
 def chart_svg(

@@ -12,6 +12,7 @@ interface never blocks.
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -28,6 +29,7 @@ from ladartui.scenario import Scenario
 from ladartui.tui import actions, bridge
 from ladartui.tui.canvas import ProjectionWidget, TopViewWidget
 from ladartui.tui.file_actions import FileActions
+from ladartui.tui.graphics import Graphics, has_truecolor
 from ladartui.tui.loading import SceneLoading
 from ladartui.tui.panels import FilePanel, FlightPanel, ResultsPanel, RunPanel, SensorPanel
 from ladartui.tui.params import ParamField, ParamPanel
@@ -63,13 +65,17 @@ def palette_entries(app=None) -> list[tuple[str, str, str]]:
 
 
 def help_rows(app=None) -> list[tuple[str, str, str]]:
-    """The help screen's rows: the app's keys (as remapped), the views' and the dialogs'."""
-    return actions.help_rows(
+    """The help screen's rows: the app's keys (as remapped), the views' and the dialogs',
+    and how the views are drawn (``graphics`` in settings.toml forces it)."""
+    rows = actions.help_rows(
         app.keymap if app is not None else None,
         ProjectionWidget.BINDINGS,
         PosesScreen.BINDINGS,
         TopViewWidget.BINDINGS,
     )
+    if app is not None:
+        rows.append(("Views", "settings.toml", "Drawn as " + app.graphics.describe()))
+    return rows
 
 
 class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
@@ -86,8 +92,13 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
         start_scenario: Scenario | None = None,
         cwd: Path | None = None,
         compile_in_child: bool = True,
+        graphics: Graphics | None = None,
+        graphics_problems: list[str] | None = None,
     ):
         super().__init__()
+        # how the views reach the terminal (chosen before the app starts: tui/graphics.py)
+        self.graphics = graphics or Graphics(truecolor=has_truecolor(os.environ), reason="not chosen")
+        self.graphics_problems = list(graphics_problems or [])
         self.compile_in_child = compile_in_child
         self.scenario_path = Path(scenario_path) if scenario_path else None
         self.start_scenario = start_scenario
@@ -233,6 +244,8 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
         self.view_area = self.query_one(ViewArea)
         for problem in self.keymap_problems:
             self.tell(problem, title="Key not remapped", severity="warning", timeout=10)
+        for problem in self.graphics_problems:
+            self.tell(problem, title="Settings", severity="warning", timeout=10)
         self.refresh_status()
         if self.start_scenario is not None:
             self.load(None, scenario=self.start_scenario)

@@ -27,6 +27,7 @@ from ladartui.render.raster import OVERLAYS, Layer, Overlays, render
 from ladartui.views import Camera, Picture
 
 UPPER = "\u2580"
+MAX_IMAGE_SIDE = 960  # pixels: the terminal scales the picture up to the view
 LOWER = "\u2584"
 
 
@@ -110,6 +111,7 @@ class PictureWidget(Widget, can_focus=True):
     DEFAULT_CSS = """
     PictureWidget { width: 1fr; height: 1fr; border: round $panel-lighten-2; }
     PictureWidget:focus { border: round $accent; }
+    PictureWidget > .view-image { width: 1fr; height: 1fr; }
     """
 
     class ViewRequest(Message):
@@ -128,16 +130,71 @@ class PictureWidget(Widget, can_focus=True):
         self.placeholder = "nothing to show yet"
         self.colour_map = "height"
         self.shown_overlays = frozenset(OVERLAYS)
+        self.image_mode: str | None = None  # kitty, sixel or iterm: drawn by ``image_view``
+        self.image_view: Widget | None = None
+        self._cell_pixels = (1, 2)  # picture pixels per cell (x, y)
+        self._image_pending = False
+
+    def on_mount(self) -> None:
+        graphics = getattr(self.app, "graphics", None)
+        if graphics is not None and graphics.image:
+            from ladartui.tui import terminal_image
+
+            self.image_mode = graphics.mode
+            self._cell_pixels = terminal_image.cell_pixels()
+            self.image_view = terminal_image.image_widget(graphics.mode, classes="view-image")
+            self.image_view.display = False
+            self.mount(self.image_view)
 
     def make_picture(self, rows: int, cols: int) -> Picture | None:
         return None
 
     def picture_size(self) -> tuple[int, int]:
-        """(rows, cols) of the picture at the widget's size: two pixel rows per cell."""
-        return self.size.height * 2, self.size.width
+        """(rows, cols) of the picture at the widget's size: two pixel rows per cell with
+        half-blocks, the terminal's pixels (at most MAX_IMAGE_SIDE a side) with images."""
+        return self.picture_size_for(self.size.width, self.size.height)
+
+    def picture_size_for(self, width: int, height: int) -> tuple[int, int]:
+        px, py = self._cell_pixels
+        rows, cols = height * py, width * px
+        scale = min(1.0, MAX_IMAGE_SIDE / max(rows, cols, 1))
+        return max(1, round(rows * scale)) if rows else 0, max(1, round(cols * scale)) if cols else 0
+
+    def cell_to_pixel(self, x: float, y: float) -> tuple[float, float]:
+        """Picture (row, col) of a point given in cells from the content's top left."""
+        rows, cols = self.picture_size()
+        width, height = self.size
+        return y * rows / max(height, 1), x * cols / max(width, 1)
 
     def invalidate(self) -> None:
         """Redraw from the current data (call after changing it)."""
+        self._strips = None
+        self._schedule_image()
+        self.refresh()
+
+    def on_resize(self, event: events.Resize) -> None:
+        self._schedule_image()
+
+    def _schedule_image(self) -> None:
+        if self.image_view is not None and not self._image_pending:
+            self._image_pending = True
+            self.call_after_refresh(self._update_image)
+
+    def _update_image(self) -> None:
+        """Draw the picture at the terminal's pixels and hand it to the image widget."""
+        self._image_pending = False
+        if self.image_view is None:
+            return
+        from ladartui.tui.terminal_image import to_pil
+
+        width, height = self.size
+        picture = self.make_picture(*self.picture_size()) if width and height else None
+        if picture is None:
+            self.image_view.display = False
+            self.image_view.image = None  # type: ignore[attr-defined]
+        else:
+            self.image_view.image = to_pil(picture.rgb)  # type: ignore[attr-defined]
+            self.image_view.display = True
         self._strips = None
         self.refresh()
 
@@ -154,9 +211,13 @@ class PictureWidget(Widget, can_focus=True):
         width, height = self.size
         if self._strips is None or self._size_key != (width, height):
             self._size_key = (width, height)
-            picture = self.make_picture(height * 2, width) if width and height else None
+            if self.image_view is not None:  # the image widget draws the picture
+                picture = None
+            else:
+                picture = self.make_picture(height * 2, width) if width and height else None
             if picture is None:
-                text = self.placeholder[:width]
+                shown = self.image_view is not None and self.image_view.display
+                text = "" if shown else self.placeholder[:width]
                 blank = [Strip.blank(width)] * height
                 if height:
                     blank[height // 2] = Strip([Segment(text.center(width), Style(dim=True))], width)
@@ -260,7 +321,8 @@ class TopViewWidget(PictureWidget):
         about = None
         if offset is not None and self.top is not None and self.frame is not None:
             rows, cols = self.picture_size()
-            about = self.top.to_cells(2 * offset.y + 1, offset.x + 0.5, rows, cols, self.frame)
+            row, col = self.cell_to_pixel(offset.x + 0.5, offset.y + 0.5)
+            about = self.top.to_cells(row, col, rows, cols, self.frame)
         self.action_zoom(factor, about)
 
     def on_mouse_scroll_up(self, event: events.MouseScrollUp) -> None:

@@ -8,6 +8,7 @@ shown on the screen while the app stays open.
 
 from __future__ import annotations
 
+from rich.text import Text
 from textual import on
 from textual.app import ComposeResult
 from textual.binding import Binding
@@ -17,7 +18,7 @@ from textual.widgets import Button, DataTable, Footer, ProgressBar, Static
 from textual.worker import Worker
 from textual_plotext import PlotextPlot
 
-from ladartui.study.chart import TABLE_COLUMNS, draw_chart, table_rows
+from ladartui.study.chart import TABLE_COLUMNS, draw_chart, label_places, legend_text, table_rows
 from ladartui.tui.work import JobDone, JobProgress, running, start_job
 
 
@@ -33,7 +34,9 @@ class StudyScreen(Screen):
     DEFAULT_CSS = """
     StudyScreen { layout: vertical; }
     StudyScreen #study-top { height: 1fr; }
-    StudyScreen #study-chart { width: 3fr; min-height: 16; }
+    StudyScreen #study-chart-box { width: 3fr; }
+    StudyScreen #study-chart { height: 1fr; min-height: 16; }
+    StudyScreen #study-legend { height: auto; padding: 0 1; }
     StudyScreen #study-side { width: 2fr; }
     StudyScreen #study-table { height: 1fr; }
     StudyScreen #study-verdict { height: auto; max-height: 12; overflow-y: auto; padding: 0 1; }
@@ -53,7 +56,9 @@ class StudyScreen(Screen):
 
     def compose(self) -> ComposeResult:
         with Horizontal(id="study-top"):
-            yield PlotextPlot(id="study-chart")
+            with Vertical(id="study-chart-box"):
+                yield PlotextPlot(id="study-chart")
+                yield Static("", id="study-legend")  # beside the points, never over them
             with Vertical(id="study-side"):
                 yield DataTable(id="study-table", zebra_stripes=True, cursor_type="row")
                 yield Static("", id="study-verdict")
@@ -155,14 +160,27 @@ class StudyScreen(Screen):
     def show_result(self, result) -> None:
         """Draw ``result``'s chart, table and verdict."""
         self.result = result
-        plot = self.query_one("#study-chart", PlotextPlot)
-        draw_chart(plot.plt, result)
-        plot.refresh()
+        self._draw_chart()
+        self.call_after_refresh(self._draw_chart)  # again once the chart has its size
         table = self.query_one("#study-table", DataTable)
         table.clear()
         for row in table_rows(result):
             table.add_row(*row)
         self.query_one("#study-verdict", Static).update(result.verdict())
+
+    def _draw_chart(self) -> None:
+        # labels are placed for the chart's size, so that none covers another or a point
+        if self.result is None:
+            return
+        plot = self.query_one("#study-chart", PlotextPlot)
+        width, height = plot.size
+        draw_chart(plot.plt, self.result, labels=label_places(self.result, width, height))
+        plot.refresh()
+        legend = self.query_one("#study-legend", Static)
+        legend.update(Text.from_ansi(legend_text(self.result, max(20, width - 2))))
+
+    def on_resize(self, event) -> None:
+        self.call_after_refresh(self._draw_chart)
 
     def _set_busy(self, busy: bool, message: str) -> None:
         self.query_one("#study-cancel", Button).disabled = not busy
