@@ -77,6 +77,39 @@ def test_not_a_terminal_or_a_plain_console_gets_half_blocks_without_asking():
     assert probe.calls == 0
 
 
+@pytest.mark.parametrize("term", ["vt220", "vt100", "dumb"])
+def test_a_terminal_without_block_glyphs_gets_plain_characters_without_asking(term):
+    probe = Probe("sixel")
+    graphics = choose("auto", {"TERM": term}, True, probe)
+    assert graphics.mode == "characters" and not graphics.image
+    assert probe.calls == 0
+    assert graphics.describe().startswith("plain characters, 256 colours")
+
+
+def test_plain_characters_draw_each_pixel_as_two_coloured_spaces():
+    from ladartui.tui.canvas import character_strips
+
+    rgb = np.zeros((2, 3, 3), np.uint8)
+    rgb[0, 0] = (255, 0, 0)
+    rgb[1, 2] = (0, 0, 255)
+    mask = np.zeros((2, 3), bool)
+    mask[0, 0] = mask[1, 2] = True
+    strips = character_strips(Picture(rgb, mask))
+    assert [strip.cell_length for strip in strips] == [6, 6]
+    assert all(seg.text.strip() == "" for strip in strips for seg in strip)  # no glyphs at all
+    coloured = [
+        (row, seg.style.bgcolor.triplet.hex)
+        for row, strip in enumerate(strips)
+        for seg in strip
+        if seg.style is not None and seg.style.bgcolor is not None
+    ]
+    assert coloured == [(0, "#ff0000"), (1, "#0000ff")]
+    # where the pixel sits: two cells per pixel, so the blue one starts at cell 4
+    assert strips[1].crop(4, 6).text == "  " and strips[1].crop(0, 4).cell_length == 4
+    text = _ansi(character_strips(Picture(rgb, mask), use_256=True), "256")
+    assert "48;5;" in text and "48;2;" not in text and "\u2580" not in text
+
+
 def test_colour_depth_follows_colorterm():
     assert choose("auto", {"TERM": "xterm-256color", "COLORTERM": "truecolor"}, True, Probe(None)).truecolor
     assert choose("auto", {"TERM": "xterm-256color", "COLORTERM": "24bit"}, True, Probe(None)).truecolor
@@ -222,6 +255,30 @@ async def test_the_views_are_images_when_an_image_mode_is_forced_and_half_blocks
         scene3d.post_message(PictureWidget.ViewRequest("fit_target"))
         await pilot.pause(0.3)
         assert not np.array_equal(np.asarray(scene3d.image_view.image), rgb)
+
+
+async def test_the_views_draw_plain_characters_when_that_mode_is_forced(tmp_path, scene_files):
+    from ladartui.tui.app import LadarApp
+    from ladartui.tui.canvas import PictureWidget
+    from tui_support import make_scenario
+
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path, compile_in_child=False, graphics=Graphics("characters", False, "set"))
+    async with app.run_test(size=(120, 40)) as pilot:
+        await _loaded(pilot)
+        app.action_layout(5)
+        await pilot.pause(0.3)
+        scene3d = app.query_one("#scene3d", PictureWidget)
+        width, height = scene3d.size
+        # one square pixel every two cells, a pixel row a cell row
+        assert scene3d.picture_size() == (height, width // 2)
+        rows = [scene3d.render_line(y) for y in range(height)]
+        assert all(row.cell_length == width for row in rows)
+        assert not any("\u2580" in seg.text or "\u2584" in seg.text for row in rows for seg in row)
+        painted = sum(
+            seg.cell_length for row in rows for seg in row if seg.style and seg.style.bgcolor is not None
+        )
+        assert painted > width * height // 10  # the scene is drawn, as coloured cells
 
 
 def test_an_iterm2_image_is_the_pictures_png_stretched_over_its_cells():

@@ -94,6 +94,28 @@ def picture_strips(picture: Picture, use_256: bool = False) -> list[Strip]:
     return strips
 
 
+def character_strips(picture: Picture, use_256: bool = False) -> list[Strip]:
+    """One Strip per pixel row, each pixel two spaces on its colour (no block glyphs)."""
+    codes = views.to_ansi256(picture.rgb) if use_256 else None
+    styles: dict = {}
+    strips = []
+    rows, cols = picture.shape
+    for r in range(rows):
+        segments = []
+        for c in range(cols):
+            if not picture.mask[r, c]:
+                segments.append(Segment("  "))
+                continue
+            key = int(codes[r, c]) if codes is not None else tuple(int(v) for v in picture.rgb[r, c])
+            style = styles.get(key)
+            if style is None:
+                colour = Color.from_ansi(key) if isinstance(key, int) else Color.from_rgb(*key)
+                style = styles[key] = Style(bgcolor=colour)
+            segments.append(Segment("  ", style))
+        strips.append(Strip(Segment.simplify(segments), cols * 2))
+    return strips
+
+
 # keys every view shares: framing and what is drawn (handled by the view area, for all views)
 VIEW_BINDINGS = [
     Binding("t", "view_request('fit_target')", "Zoom to target (every view)", show=False),
@@ -132,11 +154,15 @@ class PictureWidget(Widget, can_focus=True):
         self.shown_overlays = frozenset(OVERLAYS)
         self.image_mode: str | None = None  # kitty, sixel or iterm: drawn by ``image_view``
         self.image_view: Widget | None = None
-        self._cell_pixels = (1, 2)  # picture pixels per cell (x, y)
+        self._cell_pixels: tuple[float, float] = (1, 2)  # picture pixels per cell (x, y)
+        self.characters = False  # plain characters: ``character_strips``
         self._image_pending = False
 
     def on_mount(self) -> None:
         graphics = getattr(self.app, "graphics", None)
+        if graphics is not None and graphics.mode == "characters":
+            self.characters = True
+            self._cell_pixels = (0.5, 1)  # a square pixel is two cells wide
         if graphics is not None and graphics.image:
             from ladartui.tui import terminal_image
 
@@ -156,7 +182,7 @@ class PictureWidget(Widget, can_focus=True):
 
     def picture_size_for(self, width: int, height: int) -> tuple[int, int]:
         px, py = self._cell_pixels
-        rows, cols = height * py, width * px
+        rows, cols = height * py, int(width * px)
         scale = min(1.0, MAX_IMAGE_SIDE / max(rows, cols, 1))
         return max(1, round(rows * scale)) if rows else 0, max(1, round(cols * scale)) if cols else 0
 
@@ -214,7 +240,8 @@ class PictureWidget(Widget, can_focus=True):
             if self.image_view is not None:  # the image widget draws the picture
                 picture = None
             else:
-                picture = self.make_picture(height * 2, width) if width and height else None
+                size = self.picture_size_for(width, height)
+                picture = self.make_picture(*size) if width and height and all(size) else None
             if picture is None:
                 shown = self.image_view is not None and self.image_view.display
                 text = "" if shown else self.placeholder[:width]
@@ -223,7 +250,8 @@ class PictureWidget(Widget, can_focus=True):
                     blank[height // 2] = Strip([Segment(text.center(width), Style(dim=True))], width)
                 self._strips = blank
             else:
-                self._strips = picture_strips(picture, self._use_256())
+                draw = character_strips if self.characters else picture_strips
+                self._strips = [s.extend_cell_length(width) for s in draw(picture, self._use_256())]
         if y < len(self._strips):
             return self._strips[y]
         return Strip.blank(width)

@@ -1,13 +1,17 @@
-"""How the views reach the terminal: real pixels or half-block characters.
+"""How the views reach the terminal: real pixels, half-block or plain characters.
 
 Modes: ``kitty`` (Kitty graphics protocol), ``sixel``, ``iterm`` (iTerm2 inline
 images), all drawn by ``textual-image``; else ``halfblocks`` (two pixels a
 cell), in 24-bit colour where the terminal says it has it (``COLORTERM``), else
-in the xterm 256-colour palette. ``auto`` (the default) chooses at start-up,
-before the app takes the terminal's input:
+in the xterm 256-colour palette; else ``characters``: plain spaces on a
+coloured background, one square pixel every two cells, for terminals without
+block glyphs. ``auto`` (the default) chooses at start-up, before the app
+takes the terminal's input:
 
 - not a terminal, or inside tmux or screen (they pass no graphics by default):
   half-blocks, without asking the terminal anything;
+- a terminal without block glyphs (``TERM`` dumb, vt100, vt102 or vt220):
+  plain characters;
 - iTerm2 (``TERM_PROGRAM``, or ``LC_TERMINAL``, which ssh forwards): iterm;
 - kitty (``KITTY_WINDOW_ID``, or ``TERM=xterm-kitty``, which ssh forwards): kitty;
 - otherwise the terminal is asked (textual-image's own queries: Sixel in the
@@ -18,7 +22,7 @@ The mode can be forced in the settings file, ``settings.toml`` in the config
 folder::
 
     [display]
-    graphics = "sixel"   # auto, halfblocks, sixel, kitty or iterm
+    graphics = "sixel"   # auto, halfblocks, characters, sixel, kitty or iterm
 
 or for one session by ``ladartui tui --graphics MODE``.
 """
@@ -37,8 +41,9 @@ from ladartui.scenario import _key_lines_from_text
 from ladartui.textsafe import one_line
 from ladartui.user_data import config_folder
 
-MODES = ("auto", "halfblocks", "sixel", "kitty", "iterm")
+MODES = ("auto", "halfblocks", "characters", "sixel", "kitty", "iterm")
 IMAGE_MODES = ("sixel", "kitty", "iterm")
+NO_BLOCK_GLYPHS = ("dumb", "vt100", "vt102", "vt220")
 SETTINGS_FILE = "settings.toml"
 SETTING = "display.graphics"
 
@@ -48,7 +53,7 @@ class Graphics:
     """The chosen way to draw the views, and why."""
 
     mode: str = "halfblocks"  # one of MODES but "auto"
-    truecolor: bool = True  # else the 256-colour palette (half-blocks only)
+    truecolor: bool = True  # else the 256-colour palette (half-blocks and characters)
     reason: str = ""
     seconds: float = 0.0  # time taken to choose (asking the terminal)
 
@@ -58,7 +63,12 @@ class Graphics:
 
     def describe(self) -> str:
         colours = "24-bit colour" if self.truecolor else "256 colours"
-        what = "half-blocks, " + colours if self.mode == "halfblocks" else f"{self.mode} images"
+        if self.mode == "halfblocks":
+            what = "half-blocks, " + colours
+        elif self.mode == "characters":
+            what = "plain characters, " + colours
+        else:
+            what = f"{self.mode} images"
         return f"{what}: {self.reason}"
 
 
@@ -95,7 +105,9 @@ def choose(
             "inside tmux or screen, which pass no graphics by default "
             '(graphics = "sixel" suits tmux 3.4+ built with Sixel)',
         )
-    if env.get("TERM", "").lower() in ("dumb", "linux", "vt100", "vt220"):
+    if env.get("TERM", "").lower() in NO_BLOCK_GLYPHS:
+        return Graphics("characters", truecolor, f"TERM={env['TERM']} has no block glyphs")
+    if env.get("TERM", "").lower() == "linux":
         return Graphics("halfblocks", truecolor, f"TERM={env['TERM']} shows no graphics")
     if env.get("TERM_PROGRAM") == "iTerm.app" or env.get("LC_TERMINAL") == "iTerm2":
         return Graphics("iterm", True, "iTerm2")
