@@ -20,7 +20,8 @@ def add_parser(subparsers) -> None:
         "--graphics",
         choices=MODES,
         help="how the views are drawn: real pixels (sixel, kitty, iterm), half-block characters "
-        "(halfblocks), plain coloured characters (characters) or auto (chosen at start-up; the default, or [display] graphics in settings.toml)",
+        "(halfblocks), plain coloured characters (characters) or auto (chosen at start-up; "
+        "the default, or [display] graphics in settings.toml)",
     )
     parser.set_defaults(handler=run)
 
