@@ -95,3 +95,18 @@ def test_column_tops_give_the_highest_brick_of_each_brick_column():
     for qx, qy, qz in q.tolist():
         expected[qx + width * qy] = max(expected[qx + width * qy], qz + 1)
     assert np.array_equal(occ.columns, expected)
+
+
+@pytest.mark.parametrize("dtype", [np.int32, np.int64, np.uint16, np.int16])
+def test_the_same_voxels_in_any_integer_type_and_order_build_the_same_occupancy(dtype):
+    rng = np.random.default_rng(8)
+    vox = _random_scene(rng, (600, 200, 60), 4_000)
+    shuffled = np.concatenate([vox, vox[:500]])[rng.permutation(len(vox) + 500)]  # repeats too
+    reference = Occupancy.build(vox.astype(np.int64), (600, 200, 60))
+    built = Occupancy.build(shuffled.astype(dtype), (600, 200, 60))
+    assert built.count == len(vox)
+    for field in ("root", "regions", "tiles", "bricks", "columns", "blocks", "cubes", "halo", "halo4"):
+        assert np.array_equal(getattr(built, field), getattr(reference, field)), field
+    # and the bricks are exactly the listed voxels
+    assert built.contains(vox).all()
+    assert int(sum(int(w).bit_count() for w in built.bricks)) == len(vox)

@@ -84,15 +84,16 @@ class Occupancy:
             raise FieldError("voxels", f"array of shape {vox.shape}", "an (N, 3) integer array")
         if vox.dtype.kind not in "iu":
             raise FieldError("voxels", f"dtype {vox.dtype}", "integer voxel indices")
-        vox = vox.astype(np.int64, copy=False)
+        if vox.dtype not in (np.int32, np.int64):  # the kernels are compiled for these two
+            vox = vox.astype(np.int64)
         if shape is None:
             shape = tuple(int(v) + 1 for v in vox.max(axis=0)) if len(vox) else (0, 0, 0)
         shape = tuple(int(s) for s in shape)
         if len(shape) != 3 or min(shape) < 0:
             raise FieldError("shape", shape, "three non-negative integers (nx, ny, nz)")
         if len(vox):
-            lo = vox.min(axis=0)
-            hi = vox.max(axis=0) + 1
+            lo = vox.min(axis=0).astype(np.int64)
+            hi = vox.max(axis=0).astype(np.int64) + 1
             if lo.min() < 0 or np.any(hi > np.array(shape)):
                 raise FieldError(
                     "voxels",
@@ -141,24 +142,18 @@ class Occupancy:
         root_dims = ((hi - 1) >> REGION_SHIFT) - (lo >> REGION_SHIFT) + 1
         # One sort key ordering voxels root cell first, then region slot, tile slot,
         # voxel bit: bricks of a tile and tiles of a region end up adjacent in memory.
+        # Per-voxel work runs in kernels over this one int64 array: the build's peak
+        # memory is the voxel list plus 8 bytes a voxel, not several per-voxel temporaries.
         key = np.empty(len(vox), np.int64)
         _voxel_keys(vox, root_origin.astype(np.int64), root_dims.astype(np.int64), key)
         key.sort()
-        key = key[_starts(key)]  # drop duplicate voxels
-        count = len(key)
-
-        brick_key = key >> 9
-        brick_start = _starts(brick_key)
-        brick_of_voxel = np.cumsum(brick_start) - 1
-        n_bricks = int(brick_of_voxel[-1]) + 1
-        bit = key & 511
-        word = brick_of_voxel * BRICK_WORDS + (bit >> 5)
-        word_start = np.flatnonzero(_starts(word))
+        count = _compact_unique(key)  # drop duplicate voxels
+        n_bricks = _count_bricks(key, count)
         bricks = np.zeros(n_bricks * BRICK_WORDS, np.uint32)
-        values = np.left_shift(np.uint32(1), (bit & 31).astype(np.uint32))
-        bricks[word[word_start]] = np.bitwise_or.reduceat(values, word_start)
+        bkeys = np.empty(n_bricks, np.int64)  # one per brick, in brick order
+        _fill_bricks(key, count, bricks, bkeys)
+        del key
 
-        bkeys = brick_key[brick_start]  # one per brick, in brick order
         tiles, tkeys = _parents(bkeys, n_bricks)
         regions, rkeys = _parents(tkeys, len(tkeys))
         root = np.zeros(int(np.prod(root_dims)), np.uint32)
@@ -172,7 +167,7 @@ class Occupancy:
         halo = _halo_bits(brick_cells - halo_origin, halo_dims)
         halo4_origin = (lo >> 2) - 1
         halo4_dims = ((hi - 1) >> 2) - (lo >> 2) + 3
-        halo4 = _halo_bits((vox >> 2) - halo4_origin, halo4_dims)
+        halo4 = _halo_bits_of_voxels(vox, 2, halo4_origin, halo4_dims)
         return cls(
             shape,
             lo.astype(np.int64),
@@ -274,6 +269,56 @@ def _voxel_keys(vox, root_origin, root_dims, key):
         key[i] = k
 
 
+@njit(nogil=True, cache=True)
+def _compact_unique(sorted_keys):
+    # Distinct values to the front, in place; returns how many.
+    n = sorted_keys.shape[0]
+    if n == 0:
+        return 0
+    count = 1
+    for i in range(1, n):
+        if sorted_keys[i] != sorted_keys[count - 1]:
+            sorted_keys[count] = sorted_keys[i]
+            count += 1
+    return count
+
+
+@njit(nogil=True, cache=True)
+def _count_bricks(keys, count):
+    bricks = 0
+    previous = -1
+    for i in range(count):
+        b = keys[i] >> 9
+        if b != previous:
+            bricks += 1
+            previous = b
+    return bricks
+
+
+@njit(nogil=True, cache=True)
+def _fill_bricks(keys, count, bricks, brick_keys):
+    # Sorted distinct voxel keys: brick key = key >> 9, the voxel's bit = key & 511.
+    n = -1
+    previous = -1
+    for i in range(count):
+        b = keys[i] >> 9
+        if b != previous:
+            n += 1
+            brick_keys[n] = b
+            previous = b
+        bit = keys[i] & 511
+        bricks[n * BRICK_WORDS + (bit >> 5)] |= np.uint32(1) << np.uint32(bit & 31)
+
+
+@njit(nogil=True, cache=True)
+def _mark_cells(vox, shift, origin, near):
+    for i in range(vox.shape[0]):
+        x = (vox[i, 0] >> shift) - origin[0]
+        y = (vox[i, 1] >> shift) - origin[1]
+        z = (vox[i, 2] >> shift) - origin[2]
+        near[z, y, x] = True
+
+
 def _local(rel, shift):
     """Linear slot ``lx + 8 ly + 64 lz`` of each cell inside its parent node at level ``shift``."""
     c = (rel >> shift) & 7
@@ -350,6 +395,19 @@ def _halo_bits(cells, dims):
     dx, dy, dz = (int(v) for v in dims)
     near = np.zeros((dz, dy, dx), bool)
     near[cells[:, 2], cells[:, 1], cells[:, 0]] = True
+    return _grown_bits(near)
+
+
+def _halo_bits_of_voxels(vox, shift, origin, dims):
+    """``_halo_bits`` over cells of ``2**shift`` voxels, marked straight from the voxels."""
+    dx, dy, dz = (int(v) for v in dims)
+    near = np.zeros((dz, dy, dx), bool)
+    _mark_cells(vox, shift, np.asarray(origin, np.int64), near)
+    return _grown_bits(near)
+
+
+def _grown_bits(near):
+    """``near`` grown to each cell's 3 x 3 x 3 neighbourhood, packed into uint32 words."""
     for axis in range(3):  # grow by one cell along each axis in turn: the 3 x 3 x 3 neighbourhood
         grown = near.copy()
         lower = [slice(None)] * 3
