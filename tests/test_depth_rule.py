@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from ladartui.returns import apply_depth_resolution, fuse_scans, scan_returns, unique_voxels
+from ladartui.returns import apply_depth_resolution, fuse_scans, kept_returns, scan_returns, unique_voxels
 from ladartui.tracing.backend import GROUND, MISS, VOXEL
 
 
@@ -59,8 +59,11 @@ def test_equal_ranges_keep_the_earliest_ray():
 def reference_rule(detector, kind, ranges, depth):
     """A plain re-statement of the rule, one detector at a time."""
     keep = np.zeros(len(detector), dtype=bool)
-    for d in set(detector.tolist()):
-        rays = [i for i in range(len(detector)) if detector[i] == d and kind[i] != MISS]
+    rays_of: dict[int, list[int]] = {}
+    for i, d in enumerate(detector.tolist()):
+        if kind[i] != MISS:
+            rays_of.setdefault(d, []).append(i)
+    for rays in rays_of.values():
         rays.sort(key=lambda i: (ranges[i], i))
         last = None
         for i in rays:
@@ -121,3 +124,31 @@ def test_fusion_is_the_union_of_the_scans():
     assert sorted(map(tuple, fused.tolist())) == [(0, 0, 0), (2, 1, 3), (4, 0, 1)]
     assert fuse_scans([]).shape == (0, 3)
     assert unique_voxels(np.array([[3, 2, 1], [3, 2, 1]])).tolist() == [[3, 2, 1]]
+
+
+@pytest.mark.parametrize("rays_per_detector", [1, 16])
+def test_a_whole_scan_split_into_parallel_parts_matches_the_plain_restatement(rays_per_detector):
+    # Big enough (>= 2**14 rays) for the parts path; detectors of unequal sizes too.
+    rng = np.random.default_rng(7 + rays_per_detector)
+    sizes = rng.integers(1, 2 * rays_per_detector + 1, size=40_000 // rays_per_detector)
+    detector = np.repeat(np.arange(sizes.size, dtype=np.int64), sizes)
+    n = detector.size
+    assert n >= 2**14
+    kind = rng.choice([MISS, VOXEL, GROUND], size=n).astype(np.uint8)
+    ranges = np.round(rng.uniform(0, 6, size=n), 1)
+    ranges[kind == MISS] = np.inf
+    expected = reference_rule(detector, kind, ranges, 0.5)
+    np.testing.assert_array_equal(apply_depth_resolution(detector, kind, ranges, 0.5), expected)
+    # in ray order within parts, parts in order: the same indices a single pass gives
+    kept_rays = kept_returns(detector, kind, ranges, 0.5)
+    assert sorted(kept_rays.tolist()) == np.flatnonzero(expected).tolist()
+    assert np.all(np.diff(detector[kept_rays]) >= 0)
+
+
+def test_fusing_sorted_scans_and_unsorted_ones_gives_the_same_union():
+    rng = np.random.default_rng(4)
+    scans = [unique_voxels(rng.integers(0, 50, size=(400, 3))) for _ in range(6)]
+    fused = fuse_scans(scans)  # each sorted: merged
+    raw = fuse_scans([s[::-1] for s in scans])  # each reversed: sorted from scratch
+    assert np.array_equal(fused, raw)
+    assert np.array_equal(fused, np.unique(np.concatenate(scans), axis=0))

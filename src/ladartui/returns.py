@@ -65,6 +65,58 @@ def _depth_rule_kernel(order, grouped, detector, kind, ranges, depth_resolution,
     return count_kept
 
 
+@numba.njit(nogil=True, cache=True)
+def _grouped_rule(start, stop, detector, kind, ranges, depth_resolution, kept, group_rays, group_ranges):
+    """``_depth_rule_kernel`` over rays ``start:stop`` already grouped by detector (whole
+    groups); writes from ``kept[start]`` on and returns how many."""
+    count_kept = 0
+    first = start
+    while first < stop:
+        group = detector[first]
+        last_ray = first
+        while last_ray < stop and detector[last_ray] == group:
+            last_ray += 1
+        count = 0
+        for ray in range(first, last_ray):
+            value = ranges[ray]
+            if kind[ray] == MISS or not np.isfinite(value):
+                continue
+            j = count - 1
+            while j >= 0 and group_ranges[j] > value:
+                group_ranges[j + 1] = group_ranges[j]
+                group_rays[j + 1] = group_rays[j]
+                j -= 1
+            group_ranges[j + 1] = value
+            group_rays[j + 1] = ray
+            count += 1
+        last = 0.0
+        for i in range(count):
+            if i == 0 or group_ranges[i] - last >= depth_resolution:
+                kept[start + count_kept] = group_rays[i]
+                count_kept += 1
+                last = group_ranges[i]
+        first = last_ray
+    return count_kept
+
+
+@numba.njit(nogil=True, cache=True, parallel=True)
+def _grouped_rule_in_parts(bounds, detector, kind, ranges, depth_resolution, kept, counts):
+    # Each part is whole detector groups and writes inside its own rays' span of
+    # ``kept``, so the parts run at once and, joined in order, equal one pass.
+    for part in numba.prange(bounds.size - 1):
+        start, stop = bounds[part], bounds[part + 1]
+        group_rays = np.empty(_INSERTION_LIMIT, dtype=np.int64)
+        group_ranges = np.empty(_INSERTION_LIMIT, dtype=np.float64)
+        counts[part] = _grouped_rule(
+            start, stop, detector, kind, ranges, depth_resolution, kept, group_rays, group_ranges
+        )
+
+
+# Parts a grouped scan's depth rule is split into (whole detectors each), run in parallel.
+_RULE_PARTS = 32
+_PARALLEL_RULE_RAYS = 1 << 14  # fewer rays than this: one pass beats starting threads
+
+
 def kept_returns(detector, kind, ranges, depth_resolution) -> np.ndarray:
     """Indices of the rays whose hits survive the detector's depth resolution.
 
@@ -84,8 +136,15 @@ def kept_returns(detector, kind, ranges, depth_resolution) -> np.ndarray:
     # Sensor rays come grouped by detector in increasing order, a few per
     # detector: sort each group in place. Otherwise sort everything first.
     grouped = bool(np.all(detector[1:] >= detector[:-1])) and _largest_group(detector) <= _INSERTION_LIMIT
-    order = np.zeros(0, dtype=np.int64) if grouped else np.lexsort((ranges, detector))
     kept = np.empty(n, dtype=np.int64)
+    if grouped and n >= _PARALLEL_RULE_RAYS:
+        # part bounds at the start of the group holding every n/_RULE_PARTS-th ray
+        cuts = detector[np.arange(1, _RULE_PARTS) * n // _RULE_PARTS]
+        bounds = np.unique(np.concatenate(([0], np.searchsorted(detector, cuts), [n])))
+        counts = np.zeros(bounds.size - 1, dtype=np.int64)
+        _grouped_rule_in_parts(bounds, detector, kind, ranges, float(depth_resolution), kept, counts)
+        return np.concatenate([kept[bounds[i] : bounds[i] + counts[i]] for i in range(counts.size)])
+    order = np.zeros(0, dtype=np.int64) if grouped else np.lexsort((ranges, detector))
     count = _depth_rule_kernel(
         order.astype(np.int64), grouped, detector, kind, ranges, float(depth_resolution), kept
     )
@@ -124,4 +183,7 @@ def fuse_scans(per_scan) -> np.ndarray:
     per_scan = [np.asarray(v).reshape(-1, 3) for v in per_scan]
     if not per_scan:
         return np.zeros((0, 3), dtype=np.int32)
-    return unique_voxels(np.concatenate(per_scan))
+    keys = [voxel_keys(v) for v in per_scan]
+    # Scans' outputs come sorted (unique_voxels): merging them beats sorting anew.
+    sorted_runs = len(keys) > 1 and all(bool(np.all(k[1:] >= k[:-1])) for k in keys)
+    return keys_to_voxels(sorted_unique(np.concatenate(keys), sorted_runs=sorted_runs))

@@ -200,9 +200,16 @@ def run_levels(scenario, target, scene_per_scan):
 
 def _per_target(scenario, scene, per_scan, scene_output, target_output, measures):
     """Every measure for each target of the scene's target model, named by the scenario."""
-    from ladartui.target_measures import LevelInputs, compute_target_measures
+    from ladartui.target_measures import LevelInputs, PerTarget, TargetMeasures, compute_target_measures
 
     names = getattr(scenario, "target_name", None)
+    ids = np.unique(scene.target_ids)
+    if ids.size == 1:
+        # One target: its measures are the overall ones (the same voxels), not computed twice.
+        target_id = int(ids[0])
+        alone = dataclasses.replace(measures, detection=None, targets=None)
+        name = names(target_id) if names is not None else f"target {target_id}"
+        return PerTarget((TargetMeasures(target_id, name, alone),))
     flight = scenario.flight
     levels = LevelInputs(
         flight.scan_times(scenario.speed), flight.scan_distances(), scenario.level_thresholds
