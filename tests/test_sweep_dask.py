@@ -9,6 +9,7 @@ import threading
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from ladartui.errors import Cancelled
@@ -225,3 +226,37 @@ def test_an_unreachable_scheduler_is_named_in_one_line():
     message = str(caught.value)
     assert "--scheduler" in message and "tcp://127.0.0.1:9" in message and "\n" not in message
     assert time.monotonic() - started < 15
+
+
+def test_several_targets_reach_the_workers_and_rank_alike_on_dask_and_serially(client, tmp_path):
+    from ladartui.scene.voxels import load_voxels, save_voxels
+    from ladartui.sweep.ranking import target_names, time_to_identify
+
+    base = write_tiny_scenario(tmp_path)
+    # The vehicle as two targets: its front half (x < 16) and its back half.
+    target = load_voxels(tmp_path / "tiny_Target.txt")
+    save_voxels(tmp_path / "tiny_Target.txt", target, ids=np.where(target[:, 0] < 16, 1, 2))
+    base.with_changes(target_names=((1, "front"), (2, "back"))).save()
+    spec = tmp_path / "two.toml"
+    spec.write_text(
+        '[sweep]\nscenario = "base.toml"\nobjective = "time-to-identify"\n'
+        "[grid]\nradius = [10.0, 30.0]\nheading_offset = [0.0, 90.0]\n",
+        encoding="utf-8",
+    )
+    serial = run_sweep(spec, serial=True, out=tmp_path / "serial")
+    on_dask = run_sweep(spec, client=client, out=tmp_path / "dask")
+
+    def ranking(result):
+        return [(r.row["variant"], r.rank, r.value) for r in result.ranking]
+
+    assert ranking(on_dask) == ranking(serial)
+    assert any(r.rank is not None for r in serial.ranking)  # some path identifies both halves
+    for result in (serial, on_dask):
+        for r in result.ranking:
+            assert target_names(r.row) == ["front", "back"]  # the ids reached every worker
+            per = r.row["targets.per_target"]
+            assert [t["measures"]["target_voxels"] for t in per] == [8, 8]
+            # identified only when both halves are: the later of the two times
+            times = [t["measures"]["levels"]["identify"]["flight_time_s"] for t in per]
+            expected = max(times) if None not in times else None
+            assert r.value == time_to_identify(r.row) == (expected if r.rank is not None else None)

@@ -133,3 +133,69 @@ def test_cli_sweep_says_which_level_the_recommended_path_reaches(tmp_path, capsy
     )
     text = capsys.readouterr().out
     assert f"{len(late)} finished variant(s) not ranked (no target identified within the budget)" in text
+
+
+def two_target_row(variant, identify_times, coverages, names=("truck", "van")):
+    """A row whose ``targets.per_target`` cell holds each target's measures (as a run writes)."""
+    per_target = []
+    for i, (time, coverage, name) in enumerate(zip(identify_times, coverages, names), start=1):
+        levels = {"scans": 6}
+        for level in ("detect", "recognise", "identify"):
+            reached = time is not None
+            levels[level] = {
+                "reached": reached,
+                "scan": 3 if reached else None,
+                "flight_time_s": time,
+                "distance_m": None if time is None else 30.0 * time,
+            }
+        per_target.append(
+            {"id": i, "name": name, "measures": {"obscured_coverage": coverage, "levels": levels}}
+        )
+    out = row(variant, sum(coverages) / len(coverages), identify=(3, min(t or 99.0 for t in identify_times)))
+    out["targets.per_target"] = per_target
+    return out
+
+
+TWO_TARGETS = [
+    two_target_row("p", (2.0, 9.0), (0.8, 0.5)),  # both identified, the last at 9 s
+    two_target_row("q", (4.0, 5.0), (0.6, 0.55)),  # both by 5 s: first on time to identify all
+    two_target_row("r", (1.0, None), (0.9, 0.2)),  # the van never: unranked on time, worst 0.2
+]
+
+
+def test_objectives_over_several_targets_read_each_target():
+    from ladartui.sweep.ranking import identified_within, time_to_identify, worst_target_coverage
+
+    assert [time_to_identify(r) for r in TWO_TARGETS] == [9.0, 5.0, None]
+    assert [worst_target_coverage(r) for r in TWO_TARGETS] == [0.5, 0.55, 0.2]
+    assert [identified_within(r, 4.5) for r in TWO_TARGETS] == [(1, 2.0), (1, 4.0), (1, 1.0)]
+    assert order(rank_rows(TWO_TARGETS, "time-to-identify")) == [("q", 1), ("p", 2), ("r", None)]
+    assert order(rank_rows(TWO_TARGETS, "worst-target-coverage")) == [("q", 1), ("p", 2), ("r", 3)]
+    # within 4.5 s each identifies one target; the earliest identification wins the tie
+    ranked = order(rank_rows(TWO_TARGETS, "identified-within-budget", budget=4.5))
+    assert ranked == [("r", 1), ("p", 2), ("q", 3)]
+    text = levels_text(TWO_TARGETS[2])
+    assert text.startswith("truck reaches identify at scan 3") and "van reaches no level" in text
+
+
+def test_several_targets_survive_the_result_table(tmp_path):
+    path = tmp_path / "results.csv"
+    write_table(path, TWO_TARGETS, [])
+    result = load_sweep_results(path, objective="time-to-identify")
+    again = sorted((r.row for r in result.ranking), key=lambda r: r["variant"])
+    assert [r["targets.per_target"] for r in again] == [r["targets.per_target"] for r in TWO_TARGETS]
+    assert order(result.ranking) == [("q", 1), ("p", 2), ("r", None)]
+
+
+def test_a_spec_may_name_a_bundled_scenario(tmp_path):
+    from ladartui.scenario import load_scenario
+    from ladartui.sweep.execute import base_scenario_path
+
+    spec_path = tmp_path / "convoy-sweep.toml"
+    spec_path.write_text('[sweep]\nscenario = "convoy"\n[grid]\nradius = [40.0, 60.0]\n', encoding="utf-8")
+    base = base_scenario_path(load_sweep_spec(spec_path))
+    assert base.name == "convoy.toml"
+    assert [name for _, name in load_scenario(base).target_names][:1] == ["netted truck"]
+    # a file of that name beside the spec wins over the bundled one
+    (tmp_path / "convoy").write_text("")
+    assert load_sweep_spec(spec_path).scenario_path == tmp_path / "convoy"

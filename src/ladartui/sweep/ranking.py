@@ -4,8 +4,9 @@ Objectives on coverage score the share of target voxels seen through the
 foliage; objectives on levels (``ladartui.levels``) score when the target(s)
 reach identification: the flight time or distance until every target is
 identified, and how many targets are identified within a flight-time budget.
-A row is read per target through ``target_values``: today the target model is
-one target, so each list holds one value.
+A row is read per target through ``target_values``: from the row's
+``targets.per_target`` cell (each target's measures, as ``Measures.to_dict``
+writes them) where it has one, else the row's own column as one target.
 """
 
 from __future__ import annotations
@@ -79,13 +80,33 @@ def coverage_of(row: dict) -> float | None:
     return _number(row.get(COVERAGE_COLUMN))
 
 
-def target_values(row: dict, column: str) -> list:
-    """The value of ``column`` for each target of the row, in target order.
+PER_TARGET_COLUMN = "targets.per_target"
 
-    The target model is one target today, so this is ``[row[column]]``;
-    per-target columns add their values here.
-    """
-    return [row.get(column)]
+
+def target_values(row: dict, column: str) -> list:
+    """The value of ``column`` (a dotted measures path, e.g. ``levels.identify.scan``)
+    for each target of the row, in target order."""
+    targets = row.get(PER_TARGET_COLUMN)
+    if not isinstance(targets, list) or not targets:
+        return [row.get(column)]
+    values = []
+    for target in targets:
+        value = target.get("measures") if isinstance(target, dict) else None
+        for part in column.split("."):
+            value = value.get(part) if isinstance(value, dict) else None
+        values.append(value)
+    return values
+
+
+def target_names(row: dict) -> list[str]:
+    """The row's target names in target order ("target N" where unnamed)."""
+    targets = row.get(PER_TARGET_COLUMN)
+    if not isinstance(targets, list) or not targets:
+        return ["target 1"]
+    return [
+        str(t.get("name") or f"target {t.get('id', i + 1)}") if isinstance(t, dict) else f"target {i + 1}"
+        for i, t in enumerate(targets)
+    ]
 
 
 def level_of(row: dict, level: str) -> list[tuple[bool, int | None, float | None, float | None]]:
@@ -137,9 +158,10 @@ def levels_text(row: dict) -> str:
     texts = []
     per_level = {level: level_of(row, level) for level in LEVEL_NAMES}
     count = len(per_level["identify"])
+    names = target_names(row)
     for index in range(count):
         reached = [(level, per_level[level][index]) for level in LEVEL_NAMES if per_level[level][index][0]]
-        prefix = f"target {index + 1} " if count > 1 else ""
+        prefix = f"{names[index]} " if count > 1 else ""
         if not reached:
             known = any(
                 v is not None

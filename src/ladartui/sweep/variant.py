@@ -338,6 +338,7 @@ class ScenePayload:
     shape: tuple
     name: str
     path: str | None
+    target_ids: np.ndarray | None = None  # one id a target voxel (several targets)
 
     @classmethod
     def of(cls, scene, token: str) -> ScenePayload:
@@ -349,6 +350,7 @@ class ScenePayload:
             tuple(scene.shape),
             scene.name,
             None if scene.path is None else str(scene.path),
+            scene.target_ids,
         )
 
 
@@ -375,6 +377,7 @@ def scene_of(scene):
                 shape=scene.shape,
                 name=scene.name,
                 path=scene.path,
+                target_ids=scene.target_ids,
             )
             _WORKER_SCENES[scene.token] = cached
             while len(_WORKER_SCENES) > _WORKER_SCENES_KEPT:

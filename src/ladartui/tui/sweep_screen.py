@@ -252,7 +252,7 @@ class SweepScreen(Screen):
         from ladartui.scenario import load_scenario
         from ladartui.sweep import load_sweep_spec
         from ladartui.sweep.execute import base_scenario_path
-        from ladartui.sweep.spec import DEFAULT_BASE
+        from ladartui.sweep.spec import bundled_name
 
         if not text:
             raise FieldError("spec", text, "the path of a sweep spec (.toml)")
@@ -263,7 +263,7 @@ class SweepScreen(Screen):
                 raise InputFileError(path, "expected a sweep spec (.toml) to run; F3 opens results")
             path = sibling
         spec = load_sweep_spec(path)
-        if spec.scenario_path != DEFAULT_BASE:
+        if bundled_name(spec.scenario_path) is None:
             load_scenario(base_scenario_path(spec))
         return spec
 
