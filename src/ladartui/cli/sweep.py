@@ -321,18 +321,10 @@ def show_result(console, result, top) -> None:
     from rich import box
     from rich.table import Table
 
+    from ladartui.sweep.ranking import OBJECTIVE_HEADERS as short
     from ladartui.sweep.ranking import OBJECTIVES
 
     cost_unit = "s" if result.cost == "flight-time" else "m"
-    short = {
-        "obscured-coverage": "coverage",
-        "coverage-per-km": "cov/km",
-        "coverage-within-budget": "coverage",
-        "time-to-identify": "identify s",
-        "distance-to-identify": "identify m",
-        "worst-target-coverage": "worst cov.",
-        "identified-within-budget": "identified",
-    }
     table = Table(
         title=f"Best flight paths by {result.objective}: {OBJECTIVES[result.objective]}",
         title_justify="left",

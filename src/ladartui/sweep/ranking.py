@@ -41,6 +41,16 @@ OBJECTIVES = {
 # Objectives whose smaller values are better; the rest rank larger values first.
 LOWER_IS_BETTER = frozenset({"time-to-identify", "distance-to-identify"})
 BUDGET_OBJECTIVES = frozenset({"coverage-within-budget", "identified-within-budget"})
+# Short column headers of each objective's value, for the CLI's and the TUI's tables.
+OBJECTIVE_HEADERS = {
+    "obscured-coverage": "coverage",
+    "coverage-per-km": "cov/km",
+    "coverage-within-budget": "in budget",
+    "time-to-identify": "identify s",
+    "distance-to-identify": "identify m",
+    "worst-target-coverage": "worst cov.",
+    "identified-within-budget": "identified",
+}
 COSTS = {"flight-time": "flight_time_s", "distance": "path_length_m"}
 
 

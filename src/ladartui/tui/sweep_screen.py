@@ -28,6 +28,7 @@ from textual_plotext import PlotextPlot
 
 from ladartui.errors import FieldError, InputFileError, LadarError
 from ladartui.recent import recent_paths, remember_path
+from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar, format_eta
 from ladartui.tui.sweep_view import (
     detail_text,
@@ -44,7 +45,7 @@ if TYPE_CHECKING:
     from ladartui.sweep.ranking import Ranked
     from ladartui.sweep.spec import SweepSpec
 
-OBJECTIVE_ORDER = ("obscured-coverage", "coverage-per-km", "coverage-within-budget")
+OBJECTIVE_ORDER = tuple(OBJECTIVES)  # F6 steps through them in this order
 COST_ORDER = ("flight-time", "distance")
 VIEWS = ("both", "table", "chart")
 REDRAW_SECONDS = 0.4  # the ranking and chart are redrawn at most this often while running
@@ -282,9 +283,9 @@ class SweepScreen(Screen):
             same = self.spec is not None and self.spec.path.resolve() == spec.path.resolve()
             objective = self.objective if same else spec.objective
             cost = self.cost if same else spec.cost
-            if objective == "coverage-within-budget" and budget is None:
+            if objective in BUDGET_OBJECTIVES and budget is None:
                 raise FieldError(
-                    "budget", None, "a flight-time budget in seconds for objective 'coverage-within-budget'"
+                    "budget", None, f"a flight-time budget in seconds for objective '{objective}'"
                 )
             scheduler = self.query_one("#sweep-scheduler", Input).value.strip()
             security = None
@@ -375,7 +376,7 @@ class SweepScreen(Screen):
             self._status(self._idle_state(), f"{skipped}; ranking by {self.objective}")
             return
         text = f"ranking by {self.objective}"
-        if self.objective == "coverage-within-budget":
+        if self.objective in BUDGET_OBJECTIVES:
             text += f" (budget {self._budget():g} s)"
         self._status(
             self._idle_state(),
@@ -602,7 +603,7 @@ class SweepScreen(Screen):
     def _rank(self) -> None:
         from ladartui.sweep import rank_rows
 
-        budget = self._budget() if self.objective == "coverage-within-budget" else None
+        budget = self._budget() if self.objective in BUDGET_OBJECTIVES else None
         self.ranking = rank_rows(self.rows, self.objective, budget, self.cost)
 
     def _rank_quietly(self) -> None:

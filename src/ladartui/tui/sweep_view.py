@@ -7,13 +7,9 @@ from pathlib import Path
 
 from rich.text import Text
 
+from ladartui.sweep.ranking import OBJECTIVE_HEADERS
 from ladartui.sweep.table import display_cell
 
-OBJECTIVE_HEADERS = {
-    "obscured-coverage": "coverage",
-    "coverage-per-km": "cov/km",
-    "coverage-within-budget": "in budget",
-}
 COST_HEADERS = {"flight-time": "time s", "distance": "dist m"}
 COST_LABELS = {"flight-time": "flight time (s)", "distance": "distance flown (m)"}
 FRONT_MARKER = "◆"
