@@ -25,7 +25,7 @@ from ladartui.tui.canvas import ProjectionWidget, TopViewWidget
 from ladartui.tui.fields import NumberField
 from ladartui.tui.file_dialogs import SetupScreen
 from ladartui.tui.host import AppHost
-from ladartui.tui.measures_view import compact_rows
+from ladartui.tui.measures_view import compact_rows, level_rows
 from ladartui.tui.screens import AngleScreen, CompareScreen, FormScreen, HelpScreen
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
 from tui_support import make_scenario
@@ -209,7 +209,8 @@ async def test_setup_parameters_run_and_measures(tmp_path, scene_files, monkeypa
         written = read_cmf(scenario.measures_file)
         table = app.query_one("#measures")
         shown = [tuple(str(c) for c in table.get_row_at(i)) for i in range(table.row_count)]
-        assert shown == compact_rows(written)
+        assert shown == compact_rows(written) + level_rows(written, short=True)
+        assert [label for label, _ in shown[-3:]] == ["Detect", "Recognise", "Identify"]
         # fusion: the obscured view sees a subset of what the unobscured view sees
         assert written.obscured_voxels <= written.unobscured_voxels <= written.visible_voxels
         assert written.scans == len(scenario.poses())

@@ -22,6 +22,16 @@ SCAN_RGB = (255, 60, 60)
 START_RGB = (255, 255, 255)
 FOOTPRINT_RGB = (255, 150, 50)  # outside the height colours, and not the target
 TARGET_RGB = (255, 0, 255)  # the target, in every view
+# Several targets: one colour each, in id order (the first is TARGET_RGB), apart from
+# the height colours, the ground, the overlays and HIDDEN_RGB, in 24-bit and 256 colours.
+TARGET_PALETTE = (TARGET_RGB, (150, 90, 255), (255, 175, 255), (200, 0, 80), (255, 255, 255))
+
+
+def target_colour(index: int) -> tuple[int, int, int]:
+    """The colour of the ``index``-th target (0-based, in id order), cycling the palette."""
+    return TARGET_PALETTE[index % len(TARGET_PALETTE)]
+
+
 HIDDEN_RGB = (0, 235, 255)  # target voxels seen only without foliage: what it hid
 SCENE_GREY = (110, 215)  # grey range of scene voxels beside a coloured target
 

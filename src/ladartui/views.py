@@ -28,6 +28,7 @@ from ladartui.colour import (  # noqa: F401  (the palette, named here too)
     grey_map,
     height_map,
     shade_indices,
+    target_colour,
 )
 
 OVERLAYS = ("path", "scans", "footprints")
@@ -106,6 +107,7 @@ class TopView:
     heights: np.ndarray
     voxel_size: float = 1.0
     target_columns: np.ndarray | None = None  # (K, 2) voxel x, y of target voxels
+    target_column_rgb: np.ndarray | None = None  # (K, 3) colour of each (default TARGET_RGB)
     colour_map: str = "height"  # or "grey": the report's 56 shades
     _cache: dict = field(default_factory=dict, repr=False)
     renders: int = 0  # how many times the scene layer was drawn (the cache's effect)
@@ -218,10 +220,11 @@ class TopView:
         c0 = np.floor(corner_a[:, 1] + 0.5).astype(np.int64)
         r1 = np.maximum(np.floor(corner_b[:, 0] + 0.5).astype(np.int64), r0 + 1)
         c1 = np.maximum(np.floor(corner_b[:, 1] + 0.5).astype(np.int64), c0 + 1)
-        for ra, rb, ca, cb in zip(
-            np.clip(r0, 0, rows), np.clip(r1, 0, rows), np.clip(c0, 0, cols), np.clip(c1, 0, cols)
+        rgb = self.target_column_rgb
+        for k, (ra, rb, ca, cb) in enumerate(
+            zip(np.clip(r0, 0, rows), np.clip(r1, 0, rows), np.clip(c0, 0, cols), np.clip(c1, 0, cols))
         ):
-            picture.rgb[ra:rb, ca:cb] = TARGET_RGB
+            picture.rgb[ra:rb, ca:cb] = TARGET_RGB if rgb is None else rgb[k]
             picture.mask[ra:rb, ca:cb] = True
 
     def render(
@@ -416,6 +419,22 @@ def threshold_points(voxels, voxel_size: float, max_height_m: float | None) -> n
     if max_height_m is None or len(voxels) == 0:
         return voxels
     return voxels[voxels[:, 2] * voxel_size <= max_height_m]
+
+
+def target_columns(target, target_ids=None) -> tuple[np.ndarray, np.ndarray | None]:
+    """The x-y columns of the target voxels, and each column's colour when ``target_ids``
+    names several targets (the colour of the column's highest voxel: what the top view sees)."""
+    target = np.asarray(target).reshape(-1, 3)
+    ids = None if target_ids is None else np.asarray(target_ids).reshape(-1)
+    if ids is None or len(np.unique(ids)) < 2:
+        return np.unique(target[:, :2], axis=0), None
+    order = np.lexsort((target[:, 2], target[:, 1], target[:, 0]))
+    cols = target[order, :2]
+    last = np.ones(len(cols), bool)
+    last[:-1] = np.any(cols[1:] != cols[:-1], axis=1)  # the highest voxel of each column
+    rank = {int(t): i for i, t in enumerate(np.unique(ids))}
+    rgb = np.array([target_colour(rank[int(t)]) for t in ids[order][last]], dtype=np.uint8)
+    return cols[last], rgb
 
 
 def half_block_cells(picture: Picture):

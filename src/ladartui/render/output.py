@@ -30,6 +30,26 @@ def in_set(voxels, others) -> np.ndarray:
     return np.isin(_keys(voxels), _keys(others))
 
 
+def target_layers(voxels, target_model, target_ids=None) -> list[Layer]:
+    """``voxels`` (target voxels) as layers in the target colour: one colour per target
+    (ids in ascending order, ``colour.target_colour``) when ``target_ids`` names several."""
+    voxels = np.asarray(voxels).reshape(-1, 3)
+    ids = None if target_ids is None else np.asarray(target_ids).reshape(-1)
+    if ids is None or len(np.unique(ids)) < 2 or not len(voxels):
+        return [Layer(voxels, colour.TARGET_RGB)]
+    model = np.asarray(target_model).reshape(-1, 3)
+    order = np.argsort(_keys(model))
+    sorted_keys = _keys(model)[order]
+    wanted = _keys(voxels)
+    pos = np.minimum(np.searchsorted(sorted_keys, wanted), len(sorted_keys) - 1)
+    found = sorted_keys[pos] == wanted
+    of_voxel = np.where(found, ids[order[pos]], 0)
+    return [
+        Layer(voxels[of_voxel == target_id], colour.target_colour(index))
+        for index, target_id in enumerate(np.unique(ids))
+    ]
+
+
 def below(voxels, voxel_size: float, threshold_m: float | None) -> np.ndarray:
     """The rows of ``voxels`` whose centre height is at most ``threshold_m`` (None: all)."""
     voxels = np.asarray(voxels).reshape(-1, 3)
@@ -75,6 +95,7 @@ def output_layers(
     voxel_size: float = 1.0,
     threshold_m: float | None = None,
     per_scan=None,
+    target_ids=None,
 ):
     """(layers, height_range) for ``raster.render``: the output after the threshold.
 
@@ -82,7 +103,8 @@ def output_layers(
     classes in their colours; "height" shades the obscured output by height
     (the target still in its colour); "scans" draws scene voxels in greys and
     colours the target voxels seen by how many scans saw them (1 .. the
-    number of scans in ``per_scan``). The height range runs from the ground
+    number of scans in ``per_scan``). With ``target_ids`` (one per target model
+    voxel) naming several targets, each target has its own colour. The height range runs from the ground
     to the highest voxel that remains, so a threshold spreads the colours over
     what is left.
     """
@@ -95,7 +117,7 @@ def output_layers(
         layers = [
             Layer(scene, colour_map="scene-grey"),
             Layer(hidden, colour.HIDDEN_RGB),
-            Layer(seen, colour.TARGET_RGB),
+            *target_layers(seen, target_model, target_ids),
         ]
     elif mode == "scans":
         scans = max(len(per_scan or ()), 1)
@@ -104,12 +126,12 @@ def output_layers(
             Layer(seen, values=scan_counts(seen, per_scan), value_range=(1, scans + 1)),
         ]
     else:
-        layers = [Layer(scene), Layer(seen, colour.TARGET_RGB)]
+        layers = [Layer(scene), *target_layers(seen, target_model, target_ids)]
     shown = [layer.voxels for layer in layers if len(layer.voxels)]
     top = max((float(v[:, 2].max()) for v in shown), default=1.0)
     return layers, (0.0, max(top, 1.0))
 
 
-def scene_layers(scene_points, target_model):
-    """Layers of the 3D scene view: the scene by height, the target in its colour."""
-    return [Layer(scene_points), Layer(np.asarray(target_model).reshape(-1, 3), colour.TARGET_RGB)]
+def scene_layers(scene_points, target_model, target_ids=None):
+    """Layers of the 3D scene view: the scene by height, each target in its colour."""
+    return [Layer(scene_points), *target_layers(target_model, target_model, target_ids)]

@@ -202,7 +202,13 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
         from ladartui.scene.model import Scene
 
         self.scene = scene = Scene(
-            old.voxels, old.target, voxel_size, shape=old.shape, name=old.name, path=old.path
+            old.voxels,
+            old.target,
+            voxel_size,
+            shape=old.shape,
+            name=old.name,
+            path=old.path,
+            target_ids=old.target_ids,
         )
         self.view_area.rescale(voxel_size, tuple(float(v) for v in scene.target_centre_m()))
 
@@ -452,8 +458,8 @@ class LadarApp(EditGuard, FileActions, SceneLoading, RunControl, App):
     def action_export_las(self) -> None:
         if self.scenario is None or self.busy:
             return
-        scenario = self.scenario
-        start_job(self, "export", lambda cancel, progress: bridge.export_outputs_las(scenario))
+        scenario, scene = self.scenario, self.scene
+        start_job(self, "export", lambda cancel, progress: bridge.export_outputs_las(scenario, scene=scene))
 
     def action_help(self) -> None:
         self.push_screen(HelpScreen(help_rows(self)))

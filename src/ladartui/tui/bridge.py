@@ -386,9 +386,11 @@ def backend_choices() -> list[tuple[str, str, bool]]:
     return [("auto", auto, best is not None), *rows]
 
 
-def export_outputs_las(scenario: Scenario, suffix: str = ".las") -> list[Path]:
+def export_outputs_las(scenario: Scenario, suffix: str = ".las", scene=None) -> list[Path]:
     """The scenario's outputs on disk (scene and target) as LAS (or LAZ) point clouds beside
     them, ``S_Scene.las`` and ``S_Target.las``, as ``run --las`` names them; the paths.
+    With the loaded ``scene``, each point carries its target id (0: not a target), as
+    ``run --las`` writes them.
 
     Both are read first, so a missing output writes nothing.
     """
@@ -401,5 +403,6 @@ def export_outputs_las(scenario: Scenario, suffix: str = ".las") -> list[Path]:
             raise InputFileError(path, "output not found: run the scenario first (F5)")
     clouds = [(path.with_suffix(suffix), load_voxels(path)) for path in outputs]
     for path, voxels in clouds:
-        export_las(path, voxels, scenario.voxel_size)
+        ids = None if scene is None else scene.target_ids_of(voxels)
+        export_las(path, voxels, scenario.voxel_size, ids=ids)
     return [path for path, _ in clouds]

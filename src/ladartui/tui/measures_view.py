@@ -4,6 +4,9 @@ from __future__ import annotations
 
 from rich.text import Text
 
+from ladartui.colour import target_colour
+from ladartui.levels import LEVELS
+
 UNDEFINED = "undefined"
 
 # (label, Measures.to_dict path, kind, better): better is "high", "low" or None
@@ -90,30 +93,93 @@ def comparison_rows(all_measures: list) -> list[list]:
 
     Where the scenarios disagree the row label is bold yellow; for a measure
     with a direction of goodness the best value is green and the worst red.
+    When every run holds the same several targets, rows per target follow.
     """
     dicts = [m if isinstance(m, dict) else m.to_dict() for m in all_measures]
+    rows = [
+        _compare_row(label, [lookup(d, path) for d in dicts], kind, better)
+        for label, path, kind, better in ROWS
+    ]
+    for level in LEVELS:
+        scans = [lookup(d, f"levels.{level}.scan") for d in dicts]
+        rows.append(_compare_row(f"{level.capitalize()} at scan", scans, "int", "low"))
+    targets = [d.get("targets") for d in dicts]
+    if all(isinstance(t, dict) for t in targets):
+        per = [{t["id"]: t for t in tt["per_target"]} for tt in targets if isinstance(tt, dict)]
+        ids = sorted(per[0]) if per else []
+        if len(ids) > 1 and all(sorted(p) == ids for p in per):
+            for target_id in ids:
+                name = per[0][target_id]["name"]
+                for label, path, kind, better in TARGET_ROWS:
+                    values = [lookup(p[target_id]["measures"], path) for p in per]
+                    rows.append(_compare_row(f"{name}: {label}", values, kind, better))
+    return rows
+
+
+def _compare_row(label: str, values: list, kind: str, better) -> list:
+    texts = [format_value(v, kind) for v in values]
+    differ = len(set(texts)) > 1
+    cells = [Text(t) for t in texts]
+    if differ:
+        numeric = [
+            (float(v), i) for i, v in enumerate(values) if v is not None and not isinstance(v, (list, tuple))
+        ]
+        for cell in cells:
+            cell.stylize("yellow")
+        if better and len(numeric) >= 2:
+            best = max(numeric) if better == "high" else min(numeric)
+            worst = min(numeric) if better == "high" else max(numeric)
+            if best[0] != worst[0]:
+                for v, i in numeric:
+                    if v == best[0]:
+                        cells[i] = Text(texts[i], style="bold green")
+                    elif v == worst[0]:
+                        cells[i] = Text(texts[i], style="bold red")
+    return [Text(label, style="bold yellow" if differ else ""), *cells]
+
+
+# per target, in the comparison and the measures dialog
+TARGET_ROWS = [
+    ("obscured coverage", "obscured_coverage", "pct", "high"),
+    ("unobscured coverage", "unobscured_coverage", "pct", "high"),
+    ("maximum coverage", "maximum_coverage", "pct", "high"),
+    ("identify at scan", "levels.identify.scan", "int", "low"),
+]
+
+
+def level_rows(measures, short: bool = False) -> list[tuple[str, str]]:
+    """(level, where it was reached or "not reached") for the whole target model."""
+    levels = measures.levels
+    if levels is None:
+        return []
     rows = []
-    for label, path, kind, better in ROWS:
-        values = [lookup(d, path) for d in dicts]
-        texts = [format_value(v, kind) for v in values]
-        differ = len(set(texts)) > 1
-        cells = [Text(t) for t in texts]
-        if differ:
-            numeric = [
-                (float(v), i)
-                for i, v in enumerate(values)
-                if v is not None and not isinstance(v, (list, tuple))
-            ]
-            for cell in cells:
-                cell.stylize("yellow")
-            if better and len(numeric) >= 2:
-                best = max(numeric) if better == "high" else min(numeric)
-                worst = min(numeric) if better == "high" else max(numeric)
-                if best[0] != worst[0]:
-                    for v, i in numeric:
-                        if v == best[0]:
-                            cells[i] = Text(texts[i], style="bold green")
-                        elif v == worst[0]:
-                            cells[i] = Text(texts[i], style="bold red")
-        rows.append([Text(label, style="bold yellow" if differ else ""), *cells])
+    for item in levels.levels:
+        if short and item.reached:
+            text = f"scan {item.scan}, {item.flight_time_s:.1f} s"
+        else:
+            text = item.describe()
+        rows.append((item.level.capitalize(), text))
+    return rows
+
+
+def highest_level(levels) -> str:
+    """``identify @ 15`` (the highest level reached and its scan), or ``none``."""
+    top = None if levels is None else levels.highest
+    return "none" if top is None else f"{top.level} @ {top.scan}"
+
+
+def target_rows(measures) -> list[tuple[Text, str, str]]:
+    """(name in its view colour, obscured coverage, highest level @ scan) per target, then
+    the worst and the mean coverage; empty for a model of one target."""
+    per = measures.targets
+    if per is None or len(per.targets) < 2:
+        return []
+    rows = []
+    for index, target in enumerate(per.targets):
+        swatch = Text("\u25a0 ", style="rgb({},{},{})".format(*target_colour(index)))
+        name = swatch + Text(target.name)  # a name from a file: text, never markup
+        m = target.measures
+        rows.append((name, format_value(m.obscured_coverage, "pct"), highest_level(m.levels)))
+    for label, summary in (("worst", per.worst), ("mean", per.mean)):
+        rows.append((Text(label, style="italic"), format_value(summary.obscured_coverage, "pct"), ""))
     return rows

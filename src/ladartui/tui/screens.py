@@ -17,10 +17,11 @@ from textual.widget import Widget
 from textual.widgets import Button, DataTable, Input, Label, Select, Static
 
 from ladartui.errors import FieldError, LadarError
+from ladartui.measures import Measures
 from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField, format_number, parse_number
 from ladartui.tui.file_tree import FileTree
-from ladartui.tui.measures_view import comparison_rows, measure_rows
+from ladartui.tui.measures_view import comparison_rows, level_rows, measure_rows, target_rows
 
 
 class PathSuggester(Suggester):
@@ -423,6 +424,11 @@ class MeasuresScreen(Dialog):
         table.add_columns("Measure", "Value")
         for label, value in measure_rows(self.measures):
             table.add_row(label, value)
+        if isinstance(self.measures, Measures):
+            for label, value in level_rows(self.measures):
+                table.add_row(label, value)
+            for target, coverage, level in target_rows(self.measures):
+                table.add_row(target, f"{coverage} obscured" + (f", {level}" if level else ""))
         table.focus()
 
     @on(Button.Pressed, "#measures-close")

@@ -36,7 +36,8 @@ LAYOUTS = {
 def prepare_views(scene) -> dict:
     """View data that depends only on the scene: top view, 3D sample, bounds (worker thread)."""
     heights = scene.top_height_map()
-    top = views.TopView(heights, scene.voxel_size, target_columns=np.unique(scene.target[:, :2], axis=0))
+    columns, column_rgb = views.target_columns(scene.target, scene.target_ids)
+    top = views.TopView(heights, scene.voxel_size, target_columns=columns, target_column_rgb=column_rgb)
     sample = views.subsample(scene.voxels, SCENE_POINTS, seed=0)
     points = np.concatenate([sample, views.surface_points(heights, SCENE_POINTS // 3)])
     nx, ny, nz = scene.shape
@@ -48,6 +49,7 @@ def prepare_views(scene) -> dict:
         "points": points,
         "bounds": bounds,
         "target": np.asarray(scene.target, np.int32),
+        "target_ids": np.asarray(scene.target_ids),
         "target_box": framing.box_of(scene.target),
         "target_m": tuple(float(v) for v in scene.target_centre_m()),
     }
@@ -93,7 +95,7 @@ class ViewArea(Container):
             widget.pending_fit = None
             widget._update_title()
         self.query_one("#scene3d", ProjectionWidget).set_layers(
-            scene_layers(prepared["points"], prepared["target"]),
+            scene_layers(prepared["points"], prepared["target"], prepared.get("target_ids")),
             prepared["points"],
             prepared["bounds"],
             voxel_size,
@@ -183,6 +185,7 @@ class ViewArea(Container):
             voxel_size=self.voxel_size,
             threshold_m=threshold,
             per_scan=per_scan,
+            target_ids=self.prepared.get("target_ids"),
         )
         shown = views.threshold_points(np.concatenate([scene, seen]), self.voxel_size, threshold)
         widget.placeholder = "nothing below the threshold" if len(voxels) else "no returns"

@@ -7,7 +7,8 @@ from textual import on
 from textual.containers import Grid, VerticalScroll
 from textual.widgets import Button, DataTable, Static
 
-from ladartui.tui.measures_view import compact_rows
+from ladartui.measures import Measures
+from ladartui.tui.measures_view import compact_rows, level_rows, target_rows
 
 NO_RESULTS = "No results yet: F5 runs the scenario."
 
@@ -43,6 +44,14 @@ class ResultsPanel(VerticalScroll):
         info.update(f"Measures of {name}:")
         for label, value in compact_rows(measures):
             table.add_row(Text(label), Text(value))  # text from a file: never markup
+        if isinstance(measures, Measures):
+            for label, value in level_rows(measures, short=True):
+                table.add_row(Text(label), Text(value))
+            targets = target_rows(measures)
+            if targets:
+                table.add_row(Text("Targets", style="bold"), Text("obsc., level @ scan", style="dim"))
+            for target, coverage, level in targets:
+                table.add_row(target, Text(f"{coverage}, {level}" if level else coverage))
 
     @on(Button.Pressed, "#btn-measures,#btn-compare,#btn-threshold,#btn-export-las")
     async def _pressed(self, event: Button.Pressed) -> None:
