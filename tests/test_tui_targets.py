@@ -51,8 +51,8 @@ async def test_rows_colours_and_comparison_per_target(tmp_path):
         ]
         values = dict(rows)
         # the open box's roof is seen at scan 1 (recognised there); the roofed one never
-        assert values[f"\u25a0 {NAME}"] == "33.3%, recognise @ 1"
-        assert values["\u25a0 roofed"] == "0.0%, none"
+        assert values[f"\u25a0 {NAME}"] == "33.3% rec@1"
+        assert values["\u25a0 roofed"] == "0.0% none"
         assert values["worst"] == "0.0%" and values["mean"] == "16.7%"
 
         # The output view: each target seen in its colour (the roofed one is not seen).

@@ -15,7 +15,12 @@ def add_parser(subparsers) -> None:
         description="Open the terminal UI on SCENARIO.toml, or on the default scenario "
         "(created with its scene on first use).",
     )
-    parser.add_argument("scenario", nargs="?", type=Path, help="a scenario file (.toml)")
+    parser.add_argument(
+        "scenario",
+        nargs="?",
+        type=Path,
+        help="a scenario file (.toml), or a bundled one by name (default, convoy)",
+    )
     parser.add_argument(
         "--graphics",
         choices=MODES,
@@ -28,6 +33,10 @@ def add_parser(subparsers) -> None:
 
 def run(args) -> int:
     path = args.scenario
+    if path is not None:
+        from ladartui.user_data import bundled_or_path
+
+        path = bundled_or_path(path)  # "convoy": the bundled scenario, made on first use
     if path is not None and not path.is_file():
         raise InputFileError(path, "scenario file not found")
     from ladartui.tui import run_app

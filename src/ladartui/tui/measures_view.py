@@ -162,13 +162,18 @@ def level_rows(measures, short: bool = False) -> list[tuple[str, str]]:
     return rows
 
 
-def highest_level(levels) -> str:
-    """``identify @ 15`` (the highest level reached and its scan), or ``none``."""
+SHORT_LEVELS = {"detect": "det", "recognise": "rec", "identify": "id"}
+
+
+def highest_level(levels, short: bool = False) -> str:
+    """``identify @ 15`` (the highest level reached and its scan; ``id@15`` short), or ``none``."""
     top = None if levels is None else levels.highest
-    return "none" if top is None else f"{top.level} @ {top.scan}"
+    if top is None:
+        return "none"
+    return f"{SHORT_LEVELS[top.level]}@{top.scan}" if short else f"{top.level} @ {top.scan}"
 
 
-def target_rows(measures) -> list[tuple[Text, str, str]]:
+def target_rows(measures, short: bool = False) -> list[tuple[Text, str, str]]:
     """(name in its view colour, obscured coverage, highest level @ scan) per target, then
     the worst and the mean coverage; empty for a model of one target."""
     per = measures.targets
@@ -179,7 +184,7 @@ def target_rows(measures) -> list[tuple[Text, str, str]]:
         swatch = Text("\u25a0 ", style="rgb({},{},{})".format(*target_colour(index)))
         name = swatch + Text(target.name)  # a name from a file: text, never markup
         m = target.measures
-        rows.append((name, format_value(m.obscured_coverage, "pct"), highest_level(m.levels)))
+        rows.append((name, format_value(m.obscured_coverage, "pct"), highest_level(m.levels, short)))
     for label, summary in (("worst", per.worst), ("mean", per.mean)):
         rows.append((Text(label, style="italic"), format_value(summary.obscured_coverage, "pct"), ""))
     return rows

@@ -47,11 +47,11 @@ class ResultsPanel(VerticalScroll):
         if isinstance(measures, Measures):
             for label, value in level_rows(measures, short=True):
                 table.add_row(Text(label), Text(value))
-            targets = target_rows(measures)
+            targets = target_rows(measures, short=True)
             if targets:
-                table.add_row(Text("Targets", style="bold"), Text("obsc., level @ scan", style="dim"))
+                table.add_row(Text("Targets", style="bold"), Text("obsc. level@scan", style="dim"))
             for target, coverage, level in targets:
-                table.add_row(target, Text(f"{coverage}, {level}" if level else coverage))
+                table.add_row(target, Text(f"{coverage} {level}" if level else coverage))
 
     @on(Button.Pressed, "#btn-measures,#btn-compare,#btn-threshold,#btn-export-las")
     async def _pressed(self, event: Button.Pressed) -> None:
