@@ -49,7 +49,7 @@ class ResultsPanel(VerticalScroll):
                 table.add_row(Text(label), Text(value))
             targets = target_rows(measures, short=True)
             if targets:
-                table.add_row(Text("Targets", style="bold"), Text("obsc. level@scan", style="dim"))
+                table.add_row(Text("Targets", style="bold"), Text("obsc. lvl@scan", style="dim"))
             for target, coverage, level in targets:
                 table.add_row(target, Text(f"{coverage} {level}" if level else coverage))
 
