@@ -108,4 +108,4 @@ def test_sparse_huge_voxel_file_is_refused_before_reading(tmp_path, capsys, monk
         handle.truncate(50 * 10**9)
     assert main(["info", str(path)]) == 2
     err = one_error_line(capsys)
-    assert "sparse.txt: a voxel list of 46.6 GiB needs about 140 GiB to read, more than the 16 GiB" in err
+    assert "sparse.txt: a voxel list of 46.6 GiB needs about 93.1 GiB to read, more than the 16 GiB" in err

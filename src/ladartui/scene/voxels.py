@@ -193,7 +193,7 @@ def load_voxels(path) -> np.ndarray:
 def load_voxels_counted(path, _target=False) -> tuple[np.ndarray, int]:
     """Like :func:`load_voxels`, also returning how many duplicate lines were dropped."""
     path = Path(path)
-    parsed = _parse_file(path, _read_bytes(path), 3, _target)
+    parsed = _read_rows(path, 3, _target)
     voxels, duplicates = unique_voxels(parsed)
     if duplicates:
         log.info("%s: dropped %d duplicate voxel lines", path, duplicates)
@@ -248,12 +248,12 @@ def load_target(path) -> tuple[np.ndarray, np.ndarray]:
     given two different ids is an error naming the later line.
     """
     path = Path(path)
-    buf = _read_bytes(path)
-    start = len(_BOM) if buf[: len(_BOM)].tobytes() == _BOM else 0
-    if _first_line_columns(buf, start) == 3:  # the report's layout: the scene parser as it is
+    head = _read_bytes(path, limit=4096)
+    start = len(_BOM) if head[: len(_BOM)].tobytes() == _BOM else 0
+    if _first_line_columns(head, start) == 3:  # the report's layout: the scene parser as it is
         voxels, _ = load_voxels_counted(path, _target=True)
         return voxels, np.ones(len(voxels), dtype=np.int32)
-    rows = _parse_file(path, buf, 4, target=True)
+    rows = _read_rows(path, 4, target=True)
     ids = rows[:, 3]
     bad = np.flatnonzero((ids < 1) | (ids > MAX_TARGET_ID))
     if len(bad):  # blank lines come only at the end: row r is line r + 1
@@ -341,9 +341,78 @@ def _parse_plain_lines(data: np.ndarray, columns: int = 3) -> np.ndarray | None:
     return values.astype(np.int32).reshape(-1, columns)
 
 
-def _read_bytes(path: Path) -> np.ndarray:
+# Files larger than this are read in blocks of _BLOCK_BYTES (cut at line ends) and
+# parsed as they come: the peak is the parsed rows plus one block, not the file's
+# bytes and its rows together.
+_BLOCK_BYTES = 4 << 20
+
+
+def _read_rows(path: Path, columns: int, target: bool) -> np.ndarray:
+    """The rows of a voxel list (``columns`` values a line), read whole when small,
+    else streamed block by block; ``InputFileError`` naming the first bad line."""
+    size = _file_size(path)
+    if size <= _PLAIN_BYTES:
+        return _parse_file(path, _read_bytes(path), columns, target)
+    # At most one row per 6 bytes ("0,0,0\n"); pages never written are never taken.
+    out = np.empty((size // (2 * columns) + 1, columns), dtype=np.int32)
+    rows = 0
+    lines = 0  # lines before the current block
+    blank_line = 0  # a blank line at the end of the blocks read so far (0: none)
+    first = True
+    for block in _blocks(path):
+        start = len(_BOM) if first and block[: len(_BOM)].tobytes() == _BOM else 0
+        first = False
+        got, bad_line, bad_offset = _parse_voxel_bytes(block, start, out[rows:])
+        if blank_line and (got or bad_line):  # voxels after a blank line of an earlier block
+            raise InputFileError(path, describe_bad_line("", columns, target), line=blank_line)
+        if bad_line:
+            end = bad_offset
+            while end < len(block) and block[end] != _NEWLINE:
+                end += 1
+            text = block[bad_offset:end].tobytes().decode("utf-8", errors="replace")
+            raise InputFileError(path, describe_bad_line(text, columns, target), line=lines + int(bad_line))
+        in_block = int(np.count_nonzero(block == _NEWLINE)) + (1 if block[-1] != _NEWLINE else 0)
+        if in_block > got and not blank_line:  # the block ended in blank lines
+            blank_line = lines + got + 1
+        rows += got
+        lines += in_block
+    out.resize((rows, columns), refcheck=False)  # in place: no copy of the rows
+    return out
+
+
+def _blocks(path: Path):
+    """The file's bytes in blocks of about _BLOCK_BYTES, each ending at a line end
+    (the last may not), as uint8 arrays."""
+    try:
+        with open(path, "rb") as handle:
+            carry = b""
+            while True:
+                data = handle.read(_BLOCK_BYTES)
+                if not data:
+                    if carry:
+                        yield np.frombuffer(carry, dtype=np.uint8)
+                    return
+                data = carry + data
+                cut = data.rfind(b"\n") + 1
+                carry = data[cut:]
+                if cut:
+                    yield np.frombuffer(data[:cut], dtype=np.uint8)
+    except OSError as error:
+        raise InputFileError(path, f"cannot be read: {error.strerror or error}") from None
+
+
+def _file_size(path: Path) -> int:
+    _read_bytes(path, limit=0)  # the same checks and messages as a whole read
+    return os.stat(path).st_size
+
+
+def _read_bytes(path: Path, limit: int | None = None) -> np.ndarray:
+    """The file's bytes (the first ``limit`` with a limit), after the memory check."""
     try:
         _check_read_size(path)
+        if limit is not None:
+            with open(path, "rb") as handle:
+                return np.frombuffer(handle.read(limit), dtype=np.uint8)
         return np.fromfile(path, dtype=np.uint8)
     except FileNotFoundError:
         raise InputFileError(path, f"no such file; {EXPECTED} per line") from None
@@ -361,8 +430,9 @@ def _check_read_size(path: Path) -> None:
     from ladartui.resources import available_memory, gib
 
     size = os.stat(path).st_size
-    # The bytes, plus up to 12 bytes of int32 row per 6-byte line "0,0,0\n" while parsing.
-    need = 3 * size
+    # Up to 12 bytes of int32 row per 6-byte line "0,0,0\n", plus the bytes (small files,
+    # read whole) or one block (large ones, streamed).
+    need = 2 * size + min(size, _BLOCK_BYTES)
     limit = available_memory()
     if need > limit:
         raise ResourceLimitError(
@@ -416,6 +486,10 @@ def unique_voxels(voxels: np.ndarray) -> tuple[np.ndarray, int]:
     voxels = np.ascontiguousarray(voxels, dtype=np.int32)
     if len(voxels) < 2:
         return voxels, 0
+    # Sorted files (ours are) cannot repeat a voxel: checked in place for large lists
+    # (no key array); small ones (start-up files) stay in numpy, without loading numba.
+    if voxels.nbytes > _PLAIN_BYTES and _rows_increasing(voxels):
+        return voxels, 0
     keys = _numpy_keys(voxels)
     if keys is None:  # indices too large to pack into one int64
         _, first = np.unique(voxels, axis=0, return_index=True)
@@ -428,6 +502,19 @@ def unique_voxels(voxels: np.ndarray) -> tuple[np.ndarray, int]:
     if kept == len(voxels):
         return voxels, 0
     return _select_rows(voxels, keep, kept), len(voxels) - kept
+
+
+@_kernel
+def _rows_increasing(voxels):
+    # Strictly increasing rows in (x, y, z) order, checked in place (no key array).
+    for i in range(1, voxels.shape[0]):
+        for axis in range(3):
+            a, b = voxels[i - 1, axis], voxels[i, axis]
+            if a < b:
+                break
+            if a > b or axis == 2:
+                return False
+    return True
 
 
 @_kernel
