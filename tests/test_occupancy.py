@@ -110,3 +110,25 @@ def test_the_same_voxels_in_any_integer_type_and_order_build_the_same_occupancy(
     # and the bricks are exactly the listed voxels
     assert built.contains(vox).all()
     assert int(sum(int(w).bit_count() for w in built.bricks)) == len(vox)
+
+
+@pytest.mark.parametrize("kind", ["dense", "scattered", "one column"])
+def test_the_memory_estimate_bounds_what_the_build_takes(kind):
+    import tracemalloc
+
+    from ladartui.resources import occupancy_bytes
+
+    rng = np.random.default_rng(2)
+    if kind == "dense":  # a forest-like slab
+        vox = _random_scene(rng, (400, 400, 60), 300_000)
+    elif kind == "scattered":  # every voxel in its own tile
+        vox = rng.integers(0, 16, size=(2_000, 3)) * 64
+    else:
+        vox = np.column_stack([np.zeros(5000, int), np.zeros(5000, int), np.arange(5000)])
+    Occupancy.build(np.array([[0, 0, 0], [9, 9, 9]]))  # kernels loaded before measuring
+    tracemalloc.start()
+    Occupancy.build(vox)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    estimate = occupancy_bytes(vox.min(axis=0), vox.max(axis=0) + 1, len(vox))
+    assert peak <= estimate, (peak, estimate)

@@ -17,8 +17,12 @@ from ladartui.errors import ResourceLimitError
 # About two days of tracing on one core at ~10 M rays/s (a week of the 2.7e12 rays case
 # is far past it); a real study stays well under.
 DEFAULT_MAX_RAYS = 2 * 10**12 // 1000  # 2e9
-# Content-sized arrays of the occupancy per voxel: sort keys, bricks, masks, halo input.
-_BYTES_PER_VOXEL = 64
+# Content-sized parts of the occupancy build: the sort key of each voxel, then per node
+# (at most one per voxel, at most one per cell of its level over the extent): a brick's
+# 16 words and block mask, a tile's or a region's 512 slots.
+_KEY_BYTES = 8
+_BRICK_BYTES = 16 * 4 + 8
+_NODE_BYTES = 512 * 4
 
 
 def available_memory() -> int:
@@ -78,9 +82,22 @@ def occupancy_bytes(lo, hi, count) -> int:
     size = 4 * root[0] * root[1] * root[2]
     size += 4 * (root[0] * 64) * (root[1] * 64)  # column tops
     size += 5 * cubes[0] * cubes[1] * cubes[2]  # empty cubes: the 0/1 grid and 4 octants
-    size += 2 * (cubes[0] + 2) * (cubes[1] + 2) * (cubes[2] + 2)  # brick halo, bool then bits
-    size += 2 * cells4[0] * cells4[1] * cells4[2]  # 4-voxel halo
-    return int(size + _BYTES_PER_VOXEL * int(count))
+    # halos: a bool grid, its grown copy and a temporary of the growing, then the bits
+    size += 3 * (cubes[0] + 2) * (cubes[1] + 2) * (cubes[2] + 2)  # brick halo
+    size += 3 * cells4[0] * cells4[1] * cells4[2]  # 4-voxel halo
+    count = int(count)
+    nodes = _BRICK_BYTES * min(count, _cells(lo, last, 3)) + _NODE_BYTES * (
+        min(count, _cells(lo, last, 6)) + min(count, _cells(lo, last, 9))
+    )
+    return int(size + _KEY_BYTES * count + nodes)
+
+
+def _cells(lo, last, shift) -> int:
+    """Cells of ``2**shift`` voxels a side over the extent ``lo..last``."""
+    out = 1
+    for a, b in zip(lo, last):
+        out *= int(b >> shift) - int(a >> shift) + 1
+    return out
 
 
 def check_occupancy(lo, hi, count, source="voxels") -> int:
