@@ -129,6 +129,26 @@ def test_ranking_by_time_to_identify_is_the_same_on_dask_and_serially(client, tm
     assert levels_text(best).startswith("reaches identify at scan ")
 
 
+def test_two_target_ranking_by_time_to_identify_all_is_the_same_on_dask_and_serially(client, tmp_path):
+    from ladartui.sweep.ranking import time_to_identify
+    from tiny_sweep import write_two_target_spec
+
+    spec = write_two_target_spec(tmp_path, "time-to-identify")
+    serial = run_sweep(spec, serial=True, out=tmp_path / "serial")
+    on_dask = run_sweep(spec, client=client, out=tmp_path / "dask")
+
+    def ranking(result):
+        return [(r.row["variant"], r.rank, r.value) for r in result.ranking]
+
+    assert ranking(on_dask) == ranking(serial)
+    assert comparable(on_dask.rows) == comparable(serial.rows)
+    assert all(r["targets.ids"] == [1, 2] for r in on_dask.rows)  # the workers saw both targets
+    ranked = [r for r in on_dask.ranking if r.rank is not None]
+    # Looking down (altitude 40) never sees the roofed target: only the low paths rank.
+    assert {r.row["altitude"] for r in ranked} == {2.0}
+    assert all(r.value == time_to_identify(r.row) for r in ranked)
+
+
 def _start(args, log, env):
     handle = open(log, "wb")
     return subprocess.Popen(

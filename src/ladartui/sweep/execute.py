@@ -32,7 +32,7 @@ from ladartui.sweep.ranking import (
     normal_objective,
     rank_rows,
 )
-from ladartui.sweep.spec import DEFAULT_BASE, SweepSpec, load_sweep_spec
+from ladartui.sweep.spec import SweepSpec, load_sweep_spec
 from ladartui.sweep.table import read_table, table_text, write_table
 from ladartui.sweep.variant import ScenePayload, apply_parameters, run_variant
 
@@ -116,11 +116,17 @@ def base_digest(scenario_path, scenario) -> str:
 
 
 def base_scenario_path(spec: SweepSpec) -> Path:
-    """The base scenario file (the built-in default is created on first use)."""
-    if spec.scenario_path == DEFAULT_BASE:
-        from ladartui.user_data import default_scenario_path
+    """The base scenario file; a bundled name ("default", "convoy") with no such file beside
+    the spec is the bundled scenario, made with its scene on first use."""
+    from ladartui.user_data import bundled_or_path
 
-        return default_scenario_path()
+    try:
+        written = spec.scenario_path.relative_to(spec.path.parent)  # as the spec names it
+    except ValueError:
+        written = spec.scenario_path
+    scenario_path = bundled_or_path(written, spec.path.parent)
+    if scenario_path != spec.scenario_path:
+        return scenario_path
     if not spec.scenario_path.is_file():
         raise InputFileError(
             spec.path,

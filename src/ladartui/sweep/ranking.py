@@ -4,8 +4,8 @@ Objectives on coverage score the share of target voxels seen through the
 foliage; objectives on levels (``ladartui.levels``) score when the target(s)
 reach identification: the flight time or distance until every target is
 identified, and how many targets are identified within a flight-time budget.
-A row is read per target through ``target_values``: today the target model is
-one target, so each list holds one value.
+A row is read per target through ``sweep.columns.target_values`` (one value
+per target id; a row without per-target columns reads as one target).
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from ladartui.errors import FieldError
 from ladartui.levels import LEVELS as LEVEL_NAMES
 from ladartui.pareto import Sense, pareto_front
+from ladartui.sweep.columns import target_names, target_values
 
 # Column of the measure every objective is built on: the share of target
 # voxels seen through the foliage over the whole flight.
@@ -79,15 +80,6 @@ def coverage_of(row: dict) -> float | None:
     return _number(row.get(COVERAGE_COLUMN))
 
 
-def target_values(row: dict, column: str) -> list:
-    """The value of ``column`` for each target of the row, in target order.
-
-    The target model is one target today, so this is ``[row[column]]``;
-    per-target columns add their values here.
-    """
-    return [row.get(column)]
-
-
 def level_of(row: dict, level: str) -> list[tuple[bool, int | None, float | None, float | None]]:
     """Per target: (reached, scan, flight time s, distance m) of ``level`` in the row."""
     columns = [
@@ -133,17 +125,21 @@ def identified_within(row: dict, budget: float) -> tuple[int, float | None]:
 
 
 def levels_text(row: dict) -> str:
-    """Which level the row's path reaches and when, per target, e.g. for the recommended path."""
+    """Which level the row's path reaches and when, per target, e.g. for the recommended path.
+
+    With several targets it names them and leads with how many are identified,
+    e.g. ``identifies 2 of 3 targets: truck reaches identify at scan 3 of 8 (...); ...``.
+    """
     texts = []
     per_level = {level: level_of(row, level) for level in LEVEL_NAMES}
     count = len(per_level["identify"])
+    names = target_names(row)
     for index in range(count):
         reached = [(level, per_level[level][index]) for level in LEVEL_NAMES if per_level[level][index][0]]
-        prefix = f"target {index + 1} " if count > 1 else ""
+        prefix = f"{names[index]} " if count > 1 else ""
         if not reached:
-            known = any(
-                v is not None
-                for v in target_values(row, LEVEL_COLUMN.format(level="detect", field="reached"))
+            known = (
+                target_values(row, LEVEL_COLUMN.format(level="detect", field="reached"))[index] is not None
             )
             texts.append(prefix + ("reaches no level (not detected)" if known else "levels unknown"))
             continue
@@ -157,6 +153,14 @@ def levels_text(row: dict) -> str:
         if level != LEVEL_NAMES[-1]:
             text += "; identify not reached"
         texts.append(text)
+    if count > 1:
+        identified = sum(t[0] for t in per_level["identify"])
+        lead = (
+            f"identifies all {count} targets"
+            if identified == count
+            else f"identifies {identified} of {count} targets"
+        )
+        return lead + ": " + "; ".join(texts)
     return "; ".join(texts)
 
 

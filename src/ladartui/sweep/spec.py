@@ -4,7 +4,7 @@ A spec is a TOML file::
 
     [sweep]
     scenario = "orbit.toml"          # base scenario, relative to this file;
-                                     # "default": the built-in default scenario
+                                     # a bundled name ("default", "convoy"): that scenario
     objective = "coverage-per-km"    # see ladartui.sweep.ranking.OBJECTIVES
     cost = "flight-time"             # Pareto cost: "flight-time" or "distance"
     budget = 300.0                   # flight-time budget, seconds
@@ -45,8 +45,6 @@ from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.sweep.variant import applicable
 
 PRESETS = ("orbit", "flypast", "standoff")
-# ``scenario = "default"`` names the built-in default scenario (small generated scene).
-DEFAULT_BASE = Path("<default>")
 
 
 @dataclass(frozen=True)
@@ -275,7 +273,8 @@ def parse_sweep_spec(data: dict, path, text: str = "") -> SweepSpec:
             None,
         )
     _check_variant_count(path, grid, samples)
-    scenario_path = DEFAULT_BASE if scenario == "default" else path.parent / scenario
+    # A bundled name ("default", "convoy") is resolved when the sweep runs (execute.base_scenario_path).
+    scenario_path = path.parent / scenario
     return SweepSpec(
         path=path,
         scenario_path=scenario_path,
