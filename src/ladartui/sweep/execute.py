@@ -32,7 +32,7 @@ from ladartui.sweep.ranking import (
     normal_objective,
     rank_rows,
 )
-from ladartui.sweep.spec import SweepSpec, load_sweep_spec
+from ladartui.sweep.spec import DEFAULT_BASE, SweepSpec, load_sweep_spec
 from ladartui.sweep.table import read_table, table_text, write_table
 from ladartui.sweep.variant import ScenePayload, apply_parameters, run_variant
 
@@ -118,8 +118,10 @@ def base_digest(scenario_path, scenario) -> str:
 def base_scenario_path(spec: SweepSpec) -> Path:
     """The base scenario file; a bundled name ("default", "convoy") with no such file beside
     the spec is the bundled scenario, made with its scene on first use."""
-    from ladartui.user_data import bundled_or_path
+    from ladartui.user_data import bundled_or_path, bundled_scenario_path
 
+    if spec.scenario_path == DEFAULT_BASE:
+        return bundled_scenario_path("default")
     try:
         written = spec.scenario_path.relative_to(spec.path.parent)  # as the spec names it
     except ValueError:

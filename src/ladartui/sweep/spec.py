@@ -45,6 +45,9 @@ from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.sweep.variant import applicable
 
 PRESETS = ("orbit", "flypast", "standoff")
+# ``scenario = "default"`` names the built-in default scenario (small generated scene); other
+# bundled names ("convoy") are resolved when the sweep runs (execute.base_scenario_path).
+DEFAULT_BASE = Path("<default>")
 
 
 @dataclass(frozen=True)
@@ -273,8 +276,7 @@ def parse_sweep_spec(data: dict, path, text: str = "") -> SweepSpec:
             None,
         )
     _check_variant_count(path, grid, samples)
-    # A bundled name ("default", "convoy") is resolved when the sweep runs (execute.base_scenario_path).
-    scenario_path = path.parent / scenario
+    scenario_path = DEFAULT_BASE if scenario == "default" else path.parent / scenario
     return SweepSpec(
         path=path,
         scenario_path=scenario_path,
