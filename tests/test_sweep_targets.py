@@ -108,3 +108,31 @@ def test_a_bundled_scenario_name_is_a_sweep_base(tmp_path):
     # A file of that name beside the spec wins over the bundled one.
     (tmp_path / "convoy").write_text(path.read_text(encoding="utf-8"), encoding="utf-8")
     assert base_scenario_path(load_sweep_spec(spec)) == tmp_path / "convoy"
+
+
+def test_cli_sweep_shows_targets_identified_and_names_them(tmp_path, capsys):
+    import json
+
+    from ladartui.cli import main
+
+    spec = write_two_target_spec(tmp_path, "time-to-identify")
+    assert main(["sweep", str(spec), "--serial"]) == 0
+    text = capsys.readouterr().out
+    assert "identified" in text and text.count(" 2/2 ") == 2  # the two ranked paths
+    assert "2 finished variant(s) not ranked (a target not identified)" in text
+    line = next(s for s in text.splitlines() if s.startswith("best path "))
+    assert line.startswith("best path identifies all 2 targets: open reaches identify at scan 4 of 4")
+    assert main(["sweep", str(spec), "--show", "--json"]) == 0
+    best = json.loads(capsys.readouterr().out)["top"][0]
+    assert [(t["target"], t["name"]) for t in best["levels"]] == [(1, "open"), (2, "roofed")]
+    assert best["objective"] == max(t["identify"]["flight_time_s"] for t in best["levels"])
+
+
+def test_cli_sweep_names_the_target_no_path_identifies(tmp_path, capsys):
+    from ladartui.cli import main
+
+    spec = write_two_target_spec(tmp_path, "time-to-identify")
+    spec.write_text(spec.read_text().replace("altitude = [2.0, 40.0]", "altitude = [40.0]"))
+    assert main(["sweep", str(spec), "--serial"]) == 0
+    text = capsys.readouterr().out
+    assert "no variant identifies roofed" in text and "best path" not in text

@@ -124,6 +124,26 @@ def identified_within(row: dict, budget: float) -> tuple[int, float | None]:
     return len(times), (max(times) if times else None)
 
 
+def identified_count(row: dict) -> int:
+    """How many of the row's targets its path identifies (by its last scan)."""
+    return sum(t[0] for t in level_of(row, "identify"))
+
+
+def never_identified(rows) -> list[str]:
+    """Names of the targets no finished row identifies (rows of one sweep share their targets)."""
+    done = [r for r in rows if r.get("status") == "ok"]
+    if not done:
+        return []
+    names = target_names(done[0])
+    if len(names) < 2:
+        return []
+    seen = [
+        any(level_of(r, "identify")[i][0] for r in done if len(level_of(r, "identify")) == len(names))
+        for i in range(len(names))
+    ]
+    return [name for name, identified in zip(names, seen) if not identified]
+
+
 def levels_text(row: dict) -> str:
     """Which level the row's path reaches and when, per target, e.g. for the recommended path.
 
