@@ -136,3 +136,31 @@ def test_cli_sweep_names_the_target_no_path_identifies(tmp_path, capsys):
     assert main(["sweep", str(spec), "--serial"]) == 0
     text = capsys.readouterr().out
     assert "no variant identifies roofed" in text and "best path" not in text
+
+
+def test_a_row_with_a_per_target_cell_reads_per_target(sweep):
+    """Tables written with one JSON cell of every target's measures still rank per target."""
+    from ladartui.sweep.columns import target_names
+    from ladartui.sweep.ranking import time_to_identify, worst_target_coverage
+
+    row = by_path(sweep)[(2.0, 5.0)]
+    old = {k: v for k, v in row.items() if not k.startswith(("target.", "targets.ids"))}
+    old["targets.per_target"] = [
+        {
+            "id": i,
+            "name": row[f"target.{i}.name"],
+            "measures": {
+                "obscured_coverage": row[f"target.{i}.obscured_coverage"],
+                "levels": {
+                    "identify": {
+                        f: row[f"target.{i}.levels.identify.{f}"]
+                        for f in ("reached", "scan", "flight_time_s", "distance_m")
+                    }
+                },
+            },
+        }
+        for i in (1, 2)
+    ]
+    assert target_names(old) == ["open", "roofed"]
+    assert time_to_identify(old) == time_to_identify(row) == row["flight_time_s"]
+    assert worst_target_coverage(old) == worst_target_coverage(row) == 6 / 18

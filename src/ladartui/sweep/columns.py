@@ -13,8 +13,10 @@ and per target flat columns named by the target's id::
 
 Variants of one sweep share the base scene, so they share the targets; a
 table mixing bases (or an older table) may hold rows with other ids or none:
-their missing cells read back as None, and a row without ``targets.ids``
-reads as one target through the overall columns. Why id-named columns and not
+their missing cells read back as None. A row holding instead a
+``targets.per_target`` cell (each target's ``Measures.to_dict``, as an
+earlier version wrote) is read from that cell; a row with neither reads as
+one target through the overall columns. Why id-named columns and not
 one JSON cell per row: a spreadsheet can sort and chart ``target.2.obscured_coverage``
 directly, and a row stays a few hundred cells even with many targets (the
 per-target direction vectors and after-scan curves are left to the run's
@@ -27,6 +29,7 @@ from ladartui.levels import LEVELS
 
 IDS_COLUMN = "targets.ids"
 PER_TARGET_KEY = "per_target"
+PER_TARGET_COLUMN = "targets.per_target"  # the JSON cell of an earlier table (read, not written)
 # Per-target measures kept as columns (the rest of a target's measures are in its run's .cmf).
 SCALARS = (
     "target_voxels",
@@ -78,18 +81,37 @@ def target_ids(row: dict) -> list[int]:
 def target_names(row: dict) -> list[str]:
     """Each target's name in target order ("target N" where the row has none)."""
     ids = target_ids(row)
-    if not ids:
-        return [""]
-    return [str(row.get(target_column(i, "name")) or f"target {i}") for i in ids]
+    if ids:
+        return [str(row.get(target_column(i, "name")) or f"target {i}") for i in ids]
+    cell = _per_target_cell(row)
+    if cell:
+        return [str(t.get("name") or f"target {t.get('id', n + 1)}") for n, t in enumerate(cell)]
+    return ["target 1"]
 
 
 def target_values(row: dict, column: str) -> list:
     """The value of ``column`` for each target of the row, in target order.
 
-    A row with per-target columns gives one value per target id; a row
-    without (an older table) gives the overall column, as one target.
+    ``column`` is a measure or a dotted levels path (``levels.identify.scan``).
+    A row with per-target columns gives one value per target id; one with a
+    ``targets.per_target`` cell, each target's value from it; a row with
+    neither, the overall column as one target.
     """
     ids = target_ids(row)
-    if not ids:
+    if ids:
+        return [row.get(target_column(i, column)) for i in ids]
+    cell = _per_target_cell(row)
+    if not cell:
         return [row.get(column)]
-    return [row.get(target_column(i, column)) for i in ids]
+    values = []
+    for target in cell:
+        value = target.get("measures")
+        for part in column.split("."):
+            value = value.get(part) if isinstance(value, dict) else None
+        values.append(value)
+    return values
+
+
+def _per_target_cell(row: dict) -> list[dict]:
+    cell = row.get(PER_TARGET_COLUMN)
+    return [t for t in cell if isinstance(t, dict)] if isinstance(cell, list) else []

@@ -32,7 +32,7 @@ from ladartui.sweep.ranking import (
     normal_objective,
     rank_rows,
 )
-from ladartui.sweep.spec import DEFAULT_BASE, SweepSpec, load_sweep_spec
+from ladartui.sweep.spec import SweepSpec, bundled_name, load_sweep_spec
 from ladartui.sweep.table import read_table, table_text, write_table
 from ladartui.sweep.variant import ScenePayload, apply_parameters, run_variant
 
@@ -116,19 +116,12 @@ def base_digest(scenario_path, scenario) -> str:
 
 
 def base_scenario_path(spec: SweepSpec) -> Path:
-    """The base scenario file; a bundled name ("default", "convoy") with no such file beside
-    the spec is the bundled scenario, made with its scene on first use."""
-    from ladartui.user_data import bundled_or_path, bundled_scenario_path
+    """The base scenario file (a bundled one is made on first use)."""
+    bundled = bundled_name(spec.scenario_path)
+    if bundled is not None:
+        from ladartui.user_data import bundled_scenario_path
 
-    if spec.scenario_path == DEFAULT_BASE:
-        return bundled_scenario_path("default")
-    try:
-        written = spec.scenario_path.relative_to(spec.path.parent)  # as the spec names it
-    except ValueError:
-        written = spec.scenario_path
-    scenario_path = bundled_or_path(written, spec.path.parent)
-    if scenario_path != spec.scenario_path:
-        return scenario_path
+        return bundled_scenario_path(bundled)
     if not spec.scenario_path.is_file():
         raise InputFileError(
             spec.path,

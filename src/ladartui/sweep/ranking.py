@@ -16,7 +16,9 @@ from dataclasses import dataclass
 from ladartui.errors import FieldError
 from ladartui.levels import LEVELS as LEVEL_NAMES
 from ladartui.pareto import Sense, pareto_front
-from ladartui.sweep.columns import target_names, target_values
+from ladartui.sweep.columns import PER_TARGET_COLUMN as PER_TARGET_COLUMN  # rows per target
+from ladartui.sweep.columns import target_names as target_names
+from ladartui.sweep.columns import target_values as target_values
 
 # Column of the measure every objective is built on: the share of target
 # voxels seen through the foliage over the whole flight.

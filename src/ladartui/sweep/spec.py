@@ -4,7 +4,7 @@ A spec is a TOML file::
 
     [sweep]
     scenario = "orbit.toml"          # base scenario, relative to this file;
-                                     # a bundled name ("default", "convoy"): that scenario
+                                     # "default", "convoy": a bundled scenario
     objective = "coverage-per-km"    # see ladartui.sweep.ranking.OBJECTIVES
     cost = "flight-time"             # Pareto cost: "flight-time" or "distance"
     budget = 300.0                   # flight-time budget, seconds
@@ -43,11 +43,22 @@ import numpy as np
 from ladartui.errors import InputFileError
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.sweep.variant import applicable
+from ladartui.user_data import bundled_scenario_name
 
 PRESETS = ("orbit", "flypast", "standoff")
-# ``scenario = "default"`` names the built-in default scenario (small generated scene); other
-# bundled names ("convoy") are resolved when the sweep runs (execute.base_scenario_path).
+# ``scenario = "default"`` (or another bundled name, e.g. "convoy") names a bundled
+# scenario, made in the user data folder on first use; held as ``<name>``.
 DEFAULT_BASE = Path("<default>")
+
+
+def bundled_base(name: str) -> Path:
+    return Path(f"<{name}>")
+
+
+def bundled_name(scenario_path: Path) -> str | None:
+    """The bundled scenario a spec's ``scenario_path`` names, or None for a file."""
+    text = str(scenario_path)
+    return text[1:-1] if text.startswith("<") and text.endswith(">") else None
 
 
 @dataclass(frozen=True)
@@ -276,7 +287,10 @@ def parse_sweep_spec(data: dict, path, text: str = "") -> SweepSpec:
             None,
         )
     _check_variant_count(path, grid, samples)
-    scenario_path = DEFAULT_BASE if scenario == "default" else path.parent / scenario
+    scenario_path = path.parent / scenario
+    bundled = bundled_scenario_name(scenario)  # "convoy" or "convoy.toml" with no such file here
+    if bundled is not None and not scenario_path.exists():
+        scenario_path = bundled_base(bundled)
     return SweepSpec(
         path=path,
         scenario_path=scenario_path,
