@@ -118,7 +118,7 @@ def test_cli_sweep_shows_targets_identified_and_names_them(tmp_path, capsys):
     spec = write_two_target_spec(tmp_path, "time-to-identify")
     assert main(["sweep", str(spec), "--serial"]) == 0
     text = capsys.readouterr().out
-    assert "identified" in text and text.count(" 2/2 ") == 2  # the two ranked paths
+    assert "targets id." in text and text.count(" 2/2 ") == 2  # the two ranked paths
     assert "2 finished variant(s) not ranked (a target not identified)" in text
     line = next(s for s in text.splitlines() if s.startswith("best path "))
     assert line.startswith("best path identifies all 2 targets: open reaches identify at scan 4 of 4")

@@ -355,10 +355,10 @@ def show_result(console, result, top) -> None:
     if separate:
         table.add_column(short[result.objective], justify="right")
     shown = [r for r in result.ranking if r.rank is not None][:top]
-    # Several targets: how many each path identifies (all its scans), e.g. "2/3".
+    # Several targets: how many each path identifies by its last scan, e.g. "2/3".
     several = any(len(target_ids(r.row)) > 1 for r in shown)
     if several:
-        table.add_column("identified", justify="right")
+        table.add_column("targets id.", justify="right")
     table.add_column("coverage", justify="right")
     table.add_column(f"{'time' if cost_unit == 's' else 'dist.'} {cost_unit}", justify="right")
     table.add_column("front")
