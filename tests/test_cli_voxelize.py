@@ -181,7 +181,7 @@ def test_cancelled_writes_leave_the_earlier_files(tmp_path, forest, monkeypatch)
 
     monkeypatch.setattr(module, "_WRITE_ROWS", 100)
     vehicle = np.array([[i, j, 0] for i in range(20, 40) for j in range(20, 40)], dtype=np.int32)
-    scene, target, had = module.load_scene_model(forest)
+    scene, target, _, had = module.load_scene_model(forest)
     inserted = module.insert_vehicle(scene, target, vehicle, 0.1, had)
     before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
     cancel = threading.Event()

@@ -175,7 +175,8 @@ def test_objectives_over_several_targets_read_each_target():
     ranked = order(rank_rows(TWO_TARGETS, "identified-within-budget", budget=4.5))
     assert ranked == [("r", 1), ("p", 2), ("q", 3)]
     text = levels_text(TWO_TARGETS[2])
-    assert text.startswith("truck reaches identify at scan 3") and "van reaches no level" in text
+    assert text.startswith("identifies 1 of 2 targets: truck reaches identify at scan 3")
+    assert "van reaches no level" in text
 
 
 def test_several_targets_survive_the_result_table(tmp_path):

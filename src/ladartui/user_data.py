@@ -93,13 +93,20 @@ def bundled_scenario_path(name: str) -> Path:
     return scenario_path
 
 
+def bundled_scenario_name(argument) -> str | None:
+    """The bundled scenario ``argument`` names (``convoy`` or ``convoy.toml``, no folder), else None."""
+    path = Path(argument)
+    stem = path.stem if path.suffix == ".toml" else path.name
+    return stem if path.parent == Path(".") and stem in BUNDLED else None
+
+
 def bundled_or_path(argument) -> Path:
     """A scenario argument as a path: an existing file as it is, else a bundled name
     (``convoy`` or ``convoy.toml``, with no folder) made ready in the user data folder."""
     path = Path(argument)
-    stem = path.stem if path.suffix == ".toml" else path.name
-    if path.parent == Path(".") and stem in BUNDLED and not path.exists():
-        return bundled_scenario_path(stem)
+    name = bundled_scenario_name(argument)
+    if name is not None and not path.exists():
+        return bundled_scenario_path(name)
     return path
 
 

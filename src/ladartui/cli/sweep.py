@@ -269,14 +269,21 @@ def _restore_sigterm(previous):
 def result_dict(result, top) -> dict:
     """The sweep as a JSON-safe dict: files, counts, the best variants and the Pareto front."""
 
+    from ladartui.sweep.columns import target_ids, target_names
     from ladartui.sweep.ranking import LEVEL_NAMES, level_of, levels_text
 
     def levels(row):
         per_level = {level: level_of(row, level) for level in LEVEL_NAMES}
+        ids: list[int | None] = [*target_ids(row)] or [None]
+        names = target_names(row)
         return [
             {
-                level: dict(zip(("reached", "scan", "flight_time_s", "distance_m"), per_level[level][i]))
-                for level in LEVEL_NAMES
+                "target": ids[i],
+                "name": names[i] or None,
+                **{
+                    level: dict(zip(("reached", "scan", "flight_time_s", "distance_m"), per_level[level][i]))
+                    for level in LEVEL_NAMES
+                },
             }
             for i in range(len(per_level["identify"]))
         ]
@@ -321,8 +328,9 @@ def show_result(console, result, top) -> None:
     from rich import box
     from rich.table import Table
 
+    from ladartui.sweep.columns import target_ids
     from ladartui.sweep.ranking import OBJECTIVE_HEADERS as short
-    from ladartui.sweep.ranking import OBJECTIVES
+    from ladartui.sweep.ranking import OBJECTIVES, identified_count, never_identified
 
     cost_unit = "s" if result.cost == "flight-time" else "m"
     table = Table(
@@ -338,16 +346,22 @@ def show_result(console, result, top) -> None:
     separate = result.objective not in ("obscured-coverage", "coverage-within-budget")
     if separate:
         table.add_column(short[result.objective], justify="right")
+    shown = [r for r in result.ranking if r.rank is not None][:top]
+    # Several targets: how many each path identifies by its last scan, e.g. "2/3".
+    several = any(len(target_ids(r.row)) > 1 for r in shown)
+    if several:
+        table.add_column("targets id.", justify="right")
     table.add_column("coverage", justify="right")
     table.add_column(f"{'time' if cost_unit == 's' else 'dist.'} {cost_unit}", justify="right")
     table.add_column("front")
-    for ranked in [r for r in result.ranking if r.rank is not None][:top]:
+    for ranked in shown:
         row = ranked.row
         table.add_row(
             str(ranked.rank),
             str(row.get("variant", ""))[:8],
             *(display_cell(row.get(n)) for n in result.parameter_names),
             *([display_cell(ranked.value)] if separate else []),
+            *([f"{identified_count(row)}/{len(target_ids(row))}"] if several else []),
             display_cell(ranked.coverage, 3),
             display_cell(ranked.cost, 4),
             "*" if ranked.pareto else "",
@@ -372,6 +386,9 @@ def show_result(console, result, top) -> None:
             "identified-within-budget": "no target identified within the budget",
         }.get(result.objective, "objective undefined or over the budget")
         console.print(f"{unranked} finished variant(s) not ranked ({reason})", highlight=False)
+        missed = never_identified(result.rows)
+        if missed and result.objective in ("time-to-identify", "distance-to-identify"):
+            console.print("no variant identifies " + ", ".join(missed), highlight=False, markup=False)
     failures = result.failures
     if failures:
         console.print(

@@ -45,7 +45,14 @@ def add_parser(subparsers):
     parser.add_argument(
         "--into", metavar="SCENE", help="scene model (X.txt) to add the vehicle to, with X_Target.txt"
     )
-    # --id ID (the vehicle's target id, a fourth column of the target model) goes here.
+    parser.add_argument(
+        "--id",
+        metavar="N",
+        type=int,
+        help="the vehicle's target id (1..65535): OUT is written as x,y,z,id lines; with --into the "
+        "scene's targets keep their ids (a three-column target model is target 1) and N must be "
+        "new. Without --id the vehicle joins a one-target model, or takes the next free id",
+    )
     parser.add_argument(
         "--scale", metavar="S", type=float, default=1.0, help="metres per mesh unit (default 1; 0.001 for mm)"
     )
@@ -72,6 +79,7 @@ def run(args) -> int:
     from ladartui.outputset import check_writable
     from ladartui.scene.insertion import scene_model_paths
     from ladartui.scene.voxelize import CANCELLED, Placement
+    from ladartui.scene.voxels import MAX_TARGET_ID
 
     if not (args.voxel_size > 0 and math.isfinite(args.voxel_size)):
         raise FieldError("--voxel-size", args.voxel_size, "a positive number of metres")
@@ -79,6 +87,8 @@ def run(args) -> int:
         raise FieldError("--scale", args.scale, "a positive number of metres per mesh unit")
     if not math.isfinite(args.heading):
         raise FieldError("--heading", args.heading, "degrees clockwise from north")
+    if args.id is not None and not 1 <= args.id <= MAX_TARGET_ID:
+        raise FieldError("--id", args.id, f"a target id from 1 to {MAX_TARGET_ID}")
     if args.at is None and (args.heading or args.into):
         flag = "--into" if args.into else "--heading"
         raise FieldError(flag, args.into or args.heading, "--at X,Y too: where the vehicle goes in the scene")
@@ -114,6 +124,7 @@ def run(args) -> int:
 
 def _work(args, placement, outputs, console, cancel):
     """Read, voxelise (with progress), insert and write; runs on the worker thread."""
+    import numpy as np
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
     from ladartui.scene.insertion import insert_vehicle, load_scene_model, save_model, write_scene_model
@@ -135,7 +146,7 @@ def _work(args, placement, outputs, console, cancel):
             )
         if args.into:  # a bad scene file is found before the work
             bar.update(task, description=f"reading {args.into}")
-            scene, target, had_target = load_scene_model(args.into)
+            scene, target, target_ids, had_target = load_scene_model(args.into)
         bar.update(task, description="voxelising", total=1.0, completed=0.0)
 
         units = {
@@ -159,10 +170,13 @@ def _work(args, placement, outputs, console, cancel):
         if cancel.is_set():
             raise Cancelled(CANCELLED)
         if not args.into:
-            save_model(outputs[0], result.voxels, cancel, report)
+            ids = None if args.id is None else np.full(len(result.voxels), args.id, dtype=np.int32)
+            save_model(outputs[0], result.voxels, cancel, report, ids)
             return mesh, result, None
         with _flag_names():
-            insertion = insert_vehicle(scene, target, result.voxels, args.voxel_size, had_target, args.into)
+            insertion = insert_vehicle(
+                scene, target, result.voxels, args.voxel_size, had_target, args.into, target_ids, args.id
+            )
         write_scene_model(args.out, insertion, cancel, report)
         return mesh, result, insertion
 
@@ -173,7 +187,7 @@ def _flag_names():
     try:
         yield
     except FieldError as error:
-        if error.field in ("at", "voxel_size"):
+        if error.field in ("at", "voxel_size", "id"):
             flag = "--" + error.field.replace("_", "-")
             raise FieldError(flag, error.value, error.expected) from None
         raise
@@ -201,13 +215,18 @@ def _report(console, args, mesh, done, outputs, elapsed) -> None:
             f"{(high[2] - low[2] + 1) * vs:.2f} m)"
         )
     if insertion is None:
-        say(f"wrote {outputs[0]}")
+        say(f"wrote {outputs[0]}" + (f" (target {args.id})" if args.id is not None else ""))
         return
     scene_path, target_path = outputs
     say(
         f"wrote {scene_path} ({len(insertion.scene):,} voxels, {insertion.added:,} new) and "
         f"{target_path} ({len(insertion.target):,} voxels"
         + (", a new target model" if insertion.new_target else "")
+        + (
+            f"; the vehicle is target {insertion.vehicle_id} of {len(set(insertion.target_ids.tolist()))}"
+            if insertion.target_ids is not None
+            else ""
+        )
         + ")"
     )
     if insertion.occupied:

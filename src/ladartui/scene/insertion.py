@@ -29,6 +29,10 @@ class Insertion:
     added: int  # vehicle voxels new to the scene
     occupied: int  # vehicle voxels the scene already held (ground, plants, another vehicle)
     new_target: bool  # the scene had no target model file: one is started
+    # One id per target voxel when the target model names targets (x,y,z,id lines), else None
+    # (the report's x,y,z layout: one target, which the vehicle joins).
+    target_ids: np.ndarray | None = None
+    vehicle_id: int | None = None  # the vehicle's target id, when the model names targets
 
 
 def scene_model_paths(out) -> tuple[Path, Path]:
@@ -39,9 +43,10 @@ def scene_model_paths(out) -> tuple[Path, Path]:
     return scene, target_path_for(scene)
 
 
-def load_scene_model(scene_path) -> tuple[np.ndarray, np.ndarray, bool]:
-    """The scene's voxels and its target's (empty when ``X_Target.txt`` is absent), and whether it was."""
-    from ladartui.scene.voxels import load_voxels
+def load_scene_model(scene_path) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
+    """The scene's voxels, its target's and their target ids (empty when ``X_Target.txt`` is
+    absent; 1 on every line of a three-column target model), and whether it was there."""
+    from ladartui.scene.voxels import load_target, load_voxels
 
     scene_path = Path(scene_path)
     voxels = load_voxels(scene_path)
@@ -49,8 +54,9 @@ def load_scene_model(scene_path) -> tuple[np.ndarray, np.ndarray, bool]:
         raise InputFileError(scene_path, "the scene model is empty; expected the voxels of a scene")
     target_path = target_path_for(scene_path)
     if not target_path.exists():
-        return voxels, np.zeros((0, 3), dtype=np.int32), False
-    return voxels, load_voxels(target_path), True
+        return voxels, np.zeros((0, 3), dtype=np.int32), np.zeros(0, dtype=np.int32), False
+    target, ids = load_target(target_path)
+    return voxels, target, ids, True
 
 
 def insert_vehicle(
@@ -60,13 +66,22 @@ def insert_vehicle(
     voxel_size: float,
     had_target: bool = True,
     source: object = "scene",
+    target_ids: np.ndarray | None = None,
+    vehicle_id: int | None = None,
 ) -> Insertion:
     """Add ``vehicle`` voxels to ``scene`` and ``target``.
 
     Refused (``LadarError`` naming ``source``, the scene file) when the
     vehicle reaches past the scene's x-y extent: the scene's ground ends there.
+
+    Target ids: with ``vehicle_id`` the vehicle becomes that target and the
+    existing targets keep their ids (``target_ids``; a three-column model is
+    target 1); an id already in use, or a vehicle voxel already in another
+    target, is refused (``FieldError`` on ``id``, ``LadarError``). Without it,
+    a model of one target takes the vehicle into that target (the report's
+    three-column layout, written as before) and a model of several gives it
+    the next free id.
     """
-    # A target id for this vehicle (a fourth column of the target model) joins here.
     extent = scene[:, :2].max(axis=0).astype(np.int64) + 1
     reach = vehicle[:, :2].max(axis=0) if len(vehicle) else np.zeros(2, dtype=np.int64)
     for axis, name in ((0, "x"), (1, "y")):
@@ -78,13 +93,64 @@ def insert_vehicle(
             )
     merged = merge_voxels(scene, vehicle)
     added = len(merged) - len(scene)
+    ids = np.ones(len(target), dtype=np.int32) if target_ids is None else np.asarray(target_ids, np.int32)
+    several = bool(len(ids)) and bool(np.any(ids != ids[0]))
+    if vehicle_id is None and not several:
+        return Insertion(
+            scene=merged,
+            target=merge_voxels(target, vehicle),
+            added=added,
+            occupied=len(vehicle) - added,
+            new_target=not had_target,
+        )
+    if vehicle_id is None:
+        vehicle_id = int(ids.max()) + 1
+    labelled_target, labelled_ids = _add_target(target, ids, vehicle, vehicle_id, source)
     return Insertion(
         scene=merged,
-        target=merge_voxels(target, vehicle),
+        target=labelled_target,
         added=added,
         occupied=len(vehicle) - added,
         new_target=not had_target,
+        target_ids=labelled_ids,
+        vehicle_id=vehicle_id,
     )
+
+
+def _add_target(
+    target: np.ndarray, ids: np.ndarray, vehicle: np.ndarray, vehicle_id: int, source: object
+) -> tuple[np.ndarray, np.ndarray]:
+    """Target voxels and ids with the vehicle added as target ``vehicle_id``, sorted by voxel."""
+    from ladartui.errors import FieldError
+    from ladartui.scene.keys import voxel_keys
+    from ladartui.scene.voxels import MAX_TARGET_ID
+
+    if not 1 <= vehicle_id <= MAX_TARGET_ID:
+        raise FieldError("id", vehicle_id, f"a target id from 1 to {MAX_TARGET_ID}")
+    used = sorted({int(i) for i in ids})
+    if vehicle_id in used:
+        raise FieldError(
+            "id",
+            vehicle_id,
+            f"a target id not yet in {target_path_for(Path(str(source))).name} "
+            f"(it has {', '.join(map(str, used))})",
+        )
+    vehicle = merge_voxels(vehicle)  # sorted, unique
+    target_keys, vehicle_keys = voxel_keys(target), voxel_keys(vehicle)
+    clash = np.isin(vehicle_keys, target_keys)
+    if np.any(clash):
+        first = vehicle[int(np.argmax(clash))]
+        owner = int(ids[int(np.flatnonzero(target_keys == voxel_keys(first[None, :])[0])[0])])
+        x, y, z = (int(c) for c in first)
+        raise LadarError(
+            f"{source}: {int(clash.sum()):,} of the vehicle's voxels are already target voxels "
+            f"(voxel {x},{y},{z} is target {owner}); expected the vehicle apart from the other "
+            "targets (move it with --at)"
+        )
+    voxels = np.concatenate([np.asarray(target, np.int32).reshape(-1, 3), vehicle])
+    labels = np.concatenate([ids, np.full(len(vehicle), vehicle_id, dtype=np.int32)])
+    order = np.argsort(np.concatenate([target_keys, vehicle_keys]), kind="stable")
+    return voxels[order], labels[order]
 
 
 def write_scene_model(
@@ -100,11 +166,12 @@ def write_scene_model(
     paths = {"scene": scene_path, "target": target_path}
     lock = scene_path.with_name(f".{scene_path.stem}.model.lock")
 
-    def writer(voxels: np.ndarray) -> Callable[[Path], None]:
-        return lambda tmp: write_voxel_lines(tmp, voxels, cancel, progress)
+    def writer(voxels: np.ndarray, ids: np.ndarray | None = None) -> Callable[[Path], None]:
+        return lambda tmp: write_voxel_lines(tmp, voxels, cancel, progress, ids)
 
+    target = writer(insertion.target, insertion.target_ids)
     with OutputSet(paths, lock) as output_set:
-        output_set.write({"scene": writer(insertion.scene), "target": writer(insertion.target)}, cancel)
+        output_set.write({"scene": writer(insertion.scene), "target": target}, cancel)
     return scene_path, target_path
 
 
@@ -113,12 +180,14 @@ def save_model(
     voxels: np.ndarray,
     cancel: threading.Event | None = None,
     progress: Callable[[str, int, int], None] | None = None,
+    ids: np.ndarray | None = None,
 ) -> None:
-    """Write one voxel list atomically; cancelled, it leaves ``path`` as it was."""
+    """Write one voxel list atomically (``x,y,z,id`` lines with ``ids``); cancelled, it leaves
+    ``path`` as it was."""
     from ladartui.atomic import atomic_path
 
     with atomic_path(path) as tmp:
-        write_voxel_lines(tmp, voxels, cancel, progress)
+        write_voxel_lines(tmp, voxels, cancel, progress, ids)
 
 
 _WRITE_ROWS = 1_000_000  # rows formatted at a time: cancel is checked between them
@@ -129,8 +198,10 @@ def write_voxel_lines(
     voxels: np.ndarray,
     cancel: threading.Event | None = None,
     progress: Callable[[str, int, int], None] | None = None,
+    ids: np.ndarray | None = None,
 ) -> None:
-    """``x,y,z`` lines of (N, 3) non-negative voxels into ``path`` (a temporary the caller swaps in).
+    """``x,y,z`` lines of (N, 3) non-negative voxels into ``path`` (a temporary the caller swaps in);
+    ``x,y,z,id`` lines with ``ids`` (one target id per voxel).
 
     Formatted a million rows at a time, so a large model needs no text
     buffer of its own size and a set ``cancel`` stops it (``Cancelled``).
@@ -139,6 +210,8 @@ def write_voxel_lines(
     from ladartui.scene.voxelize import CANCELLED
     from ladartui.scene.voxels import format_voxel_lines
 
+    if ids is not None:
+        voxels = np.column_stack([np.asarray(voxels, np.int64), np.asarray(ids, np.int64)])
     with open(path, "wb") as stream:
         for start in range(0, len(voxels), _WRITE_ROWS):
             if cancel is not None and cancel.is_set():

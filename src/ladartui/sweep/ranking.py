@@ -4,9 +4,8 @@ Objectives on coverage score the share of target voxels seen through the
 foliage; objectives on levels (``ladartui.levels``) score when the target(s)
 reach identification: the flight time or distance until every target is
 identified, and how many targets are identified within a flight-time budget.
-A row is read per target through ``target_values``: from the row's
-``targets.per_target`` cell (each target's measures, as ``Measures.to_dict``
-writes them) where it has one, else the row's own column as one target.
+A row is read per target through ``sweep.columns.target_values`` (one value
+per target id; a row without per-target columns reads as one target).
 """
 
 from __future__ import annotations
@@ -17,6 +16,9 @@ from dataclasses import dataclass
 from ladartui.errors import FieldError
 from ladartui.levels import LEVELS as LEVEL_NAMES
 from ladartui.pareto import Sense, pareto_front
+from ladartui.sweep.columns import PER_TARGET_COLUMN as PER_TARGET_COLUMN  # rows per target
+from ladartui.sweep.columns import target_names as target_names
+from ladartui.sweep.columns import target_values as target_values
 
 # Column of the measure every objective is built on: the share of target
 # voxels seen through the foliage over the whole flight.
@@ -90,35 +92,6 @@ def coverage_of(row: dict) -> float | None:
     return _number(row.get(COVERAGE_COLUMN))
 
 
-PER_TARGET_COLUMN = "targets.per_target"
-
-
-def target_values(row: dict, column: str) -> list:
-    """The value of ``column`` (a dotted measures path, e.g. ``levels.identify.scan``)
-    for each target of the row, in target order."""
-    targets = row.get(PER_TARGET_COLUMN)
-    if not isinstance(targets, list) or not targets:
-        return [row.get(column)]
-    values = []
-    for target in targets:
-        value = target.get("measures") if isinstance(target, dict) else None
-        for part in column.split("."):
-            value = value.get(part) if isinstance(value, dict) else None
-        values.append(value)
-    return values
-
-
-def target_names(row: dict) -> list[str]:
-    """The row's target names in target order ("target N" where unnamed)."""
-    targets = row.get(PER_TARGET_COLUMN)
-    if not isinstance(targets, list) or not targets:
-        return ["target 1"]
-    return [
-        str(t.get("name") or f"target {t.get('id', i + 1)}") if isinstance(t, dict) else f"target {i + 1}"
-        for i, t in enumerate(targets)
-    ]
-
-
 def level_of(row: dict, level: str) -> list[tuple[bool, int | None, float | None, float | None]]:
     """Per target: (reached, scan, flight time s, distance m) of ``level`` in the row."""
     columns = [
@@ -163,8 +136,32 @@ def identified_within(row: dict, budget: float) -> tuple[int, float | None]:
     return len(times), (max(times) if times else None)
 
 
+def identified_count(row: dict) -> int:
+    """How many of the row's targets its path identifies (by its last scan)."""
+    return sum(t[0] for t in level_of(row, "identify"))
+
+
+def never_identified(rows) -> list[str]:
+    """Names of the targets no finished row identifies (rows of one sweep share their targets)."""
+    done = [r for r in rows if r.get("status") == "ok"]
+    if not done:
+        return []
+    names = target_names(done[0])
+    if len(names) < 2:
+        return []
+    seen = [
+        any(level_of(r, "identify")[i][0] for r in done if len(level_of(r, "identify")) == len(names))
+        for i in range(len(names))
+    ]
+    return [name for name, identified in zip(names, seen) if not identified]
+
+
 def levels_text(row: dict) -> str:
-    """Which level the row's path reaches and when, per target, e.g. for the recommended path."""
+    """Which level the row's path reaches and when, per target, e.g. for the recommended path.
+
+    With several targets it names them and leads with how many are identified,
+    e.g. ``identifies 2 of 3 targets: truck reaches identify at scan 3 of 8 (...); ...``.
+    """
     texts = []
     per_level = {level: level_of(row, level) for level in LEVEL_NAMES}
     count = len(per_level["identify"])
@@ -173,9 +170,8 @@ def levels_text(row: dict) -> str:
         reached = [(level, per_level[level][index]) for level in LEVEL_NAMES if per_level[level][index][0]]
         prefix = f"{names[index]} " if count > 1 else ""
         if not reached:
-            known = any(
-                v is not None
-                for v in target_values(row, LEVEL_COLUMN.format(level="detect", field="reached"))
+            known = (
+                target_values(row, LEVEL_COLUMN.format(level="detect", field="reached"))[index] is not None
             )
             texts.append(prefix + ("reaches no level (not detected)" if known else "levels unknown"))
             continue
@@ -189,6 +185,14 @@ def levels_text(row: dict) -> str:
         if level != LEVEL_NAMES[-1]:
             text += "; identify not reached"
         texts.append(text)
+    if count > 1:
+        identified = sum(t[0] for t in per_level["identify"])
+        lead = (
+            f"identifies all {count} targets"
+            if identified == count
+            else f"identifies {identified} of {count} targets"
+        )
+        return lead + ": " + "; ".join(texts)
     return "; ".join(texts)
 
 

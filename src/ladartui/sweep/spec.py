@@ -43,7 +43,7 @@ import numpy as np
 from ladartui.errors import InputFileError
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.sweep.variant import applicable
-from ladartui.user_data import BUNDLED
+from ladartui.user_data import bundled_scenario_name
 
 PRESETS = ("orbit", "flypast", "standoff")
 # ``scenario = "default"`` (or another bundled name, e.g. "convoy") names a bundled
@@ -288,8 +288,9 @@ def parse_sweep_spec(data: dict, path, text: str = "") -> SweepSpec:
         )
     _check_variant_count(path, grid, samples)
     scenario_path = path.parent / scenario
-    if scenario in BUNDLED and not scenario_path.exists():
-        scenario_path = bundled_base(scenario)
+    bundled = bundled_scenario_name(scenario)  # "convoy" or "convoy.toml" with no such file here
+    if bundled is not None and not scenario_path.exists():
+        scenario_path = bundled_base(bundled)
     return SweepSpec(
         path=path,
         scenario_path=scenario_path,

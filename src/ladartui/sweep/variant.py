@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ladartui.errors import Cancelled, FieldError, LadarError
+from ladartui.sweep.columns import PER_TARGET_KEY, per_target_columns
 
 PRESET_KINDS = ("orbit", "flypast", "standoff")
 SENSOR_FIELDS = {
@@ -304,6 +305,8 @@ def run_variant(
         scenario = apply_parameters(base, params, lambda: scene)
         result = simulate(scenario, **(simulate_options or {}), write=False, scene=scene)
         measures = result.measures.to_dict()
+        # Per-target measures become flat columns per target id (sweep.columns), not one JSON cell.
+        per_target = (measures.get("targets") or {}).pop(PER_TARGET_KEY, None)
         row["path_length_m"] = scenario.flight.path_length()
         row["flight_time_s"] = scenario.flight.flight_time(scenario.speed)
         row["backend"] = result.backend
@@ -314,6 +317,8 @@ def run_variant(
             if key in ("measure.path_length_m", "measure.flight_time_s"):
                 continue  # the same figures as the row's own columns
             row[key] = value
+        if per_target is not None:
+            row.update(per_target_columns(per_target))
         if row.get("scan_count") is None:
             row["scan_count"] = len(scenario.flight.poses())
     except Cancelled:
@@ -338,7 +343,7 @@ class ScenePayload:
     shape: tuple
     name: str
     path: str | None
-    target_ids: np.ndarray | None = None  # one id a target voxel (several targets)
+    target_ids: np.ndarray  # one id per target voxel (several targets)
 
     @classmethod
     def of(cls, scene, token: str) -> ScenePayload:
