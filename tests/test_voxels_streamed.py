@@ -109,3 +109,27 @@ def test_large_lists_are_checked_for_order_in_place_and_repeats_still_dropped():
     swapped[[10, 11]] = swapped[[11, 10]]  # out of order, nothing repeated
     kept, dropped = unique_voxels(swapped)
     assert dropped == 0 and np.array_equal(kept, swapped)
+
+
+def test_any_text_reads_the_same_streamed_as_whole(tmp_path):
+    from hypothesis import HealthCheck, given, settings
+    from hypothesis import strategies as st
+
+    lines = st.lists(
+        st.one_of(
+            st.tuples(*[st.integers(0, 300)] * 3).map(lambda v: ",".join(map(str, v))),
+            st.text(alphabet="0123456789, \t\r-x", max_size=12),
+        ),
+        max_size=60,
+    )
+    path = tmp_path / "fuzz.txt"
+
+    @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+    @given(lines=lines, block=st.integers(1, 40), final_newline=st.booleans())
+    def check(lines, block, final_newline):
+        path.write_bytes(("\n".join(lines) + ("\n" if final_newline else "")).encode())
+        with pytest.MonkeyPatch.context() as patch:
+            whole, streamed = _both(patch, load_voxels, path, block)
+        assert streamed == whole
+
+    check()
