@@ -308,24 +308,28 @@ def test_a_whole_scan_sorts_by_scatter_as_the_counting_sort_does(duplicate):
 def test_order_choice_reads_the_given_clock():
     # A block that waits (as when other processes hold the cores) costs no CPU time:
     # on the process's CPU clock the order that computes less wins even though it
-    # took longer by the wall clock; on the wall clock the other one does.
-    import time
-
+    # took longer by the wall clock; on the wall clock the other one does. The blocks
+    # advance scripted clocks rather than sleep and spin: real clocks made the answer
+    # hang on how busy the machine was (10 ms of CPU took over 30 ms of wall time on
+    # loaded cores, so the wall clock picked object order too).
     from ladartui.tracing.object_order import MIN_SCAN_RAYS, OrderChoice, trace_in_blocks
 
+    elapsed = {"cpu": 0.0, "wall": 0.0}
+
     def waits(a, b, max_voxels):  # object order: 30 ms of wall time, no CPU
-        time.sleep(0.03)
+        elapsed["wall"] += 0.03
         return True
 
-    def computes(a, b):  # ray order: about 10 ms of CPU
-        end = time.process_time() + 0.01
-        while time.process_time() < end:
-            pass
+    def computes(a, b):  # ray order: 10 ms of CPU, as long by the wall clock
+        elapsed["cpu"] += 0.01
+        elapsed["wall"] += 0.01
 
     picks = {}
-    for name, clock in (("cpu", time.process_time), ("wall", time.perf_counter)):
+    for name in ("cpu", "wall"):
         choice = OrderChoice()
         for _ in range(6):
-            trace_in_blocks(MIN_SCAN_RAYS, "auto", choice, waits, computes, clock=clock)
+            trace_in_blocks(
+                MIN_SCAN_RAYS, "auto", choice, waits, computes, clock=lambda name=name: elapsed[name]
+            )
         picks[name] = choice.pick()
     assert picks == {"cpu": "object", "wall": "ray"}
