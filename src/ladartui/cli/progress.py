@@ -41,13 +41,16 @@ def run_cancellable(work: Callable[[], T], cancel: threading.Event, name: str, c
             finished.set()
 
     worker = threading.Thread(target=target, name=name, daemon=True)
-    worker.start()
     try:
+        # Started inside the try: a Ctrl-C can land while start() waits for the
+        # worker (a busy machine may run the worker far before this thread resumes).
+        worker.start()
         while not finished.wait(POLL_SECONDS):
             pass
     except KeyboardInterrupt:
         cancel.set()
-        finished.wait()
+        if worker.ident is not None:  # else it never ran a line: with cancel set, it writes nothing
+            finished.wait()
         if "result" not in outcome:  # else it finished before it saw the cancel
             raise cancelled from None
     if "error" in outcome:
