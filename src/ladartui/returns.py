@@ -33,69 +33,44 @@ def _depth_rule_kernel(order, grouped, detector, kind, ranges, depth_resolution,
     n = detector.size
     group_rays = np.empty(n, dtype=np.int64)
     group_ranges = np.empty(n, dtype=np.float64)
+    return _rule_over(
+        0, n, order, grouped, detector, kind, ranges, depth_resolution, kept, group_rays, group_ranges
+    )
+
+
+@numba.njit(nogil=True, cache=True)
+def _rule_over(start, stop, order, grouped, detector, kind, ranges, depth_resolution, kept, rays, values):
+    """The rule over positions ``start:stop`` (whole detector groups), writing the kept
+    rays from ``kept[start]`` on; returns how many. ``rays``/``values``: scratch for a group."""
     count_kept = 0
-    start = 0
-    while start < n:
-        group = detector[start if grouped else order[start]]
-        stop = start
-        while stop < n and detector[stop if grouped else order[stop]] == group:
-            stop += 1
+    first = start
+    while first < stop:
+        group = detector[first if grouped else order[first]]
+        end = first
+        while end < stop and detector[end if grouped else order[end]] == group:
+            end += 1
         count = 0
-        for position in range(start, stop):
+        for position in range(first, end):
             ray = position if grouped else order[position]
             value = ranges[ray]
             if kind[ray] == MISS or not np.isfinite(value):
                 continue
             # Insertion sort, stable; linear when the order is sorted already.
             j = count - 1
-            while j >= 0 and group_ranges[j] > value:
-                group_ranges[j + 1] = group_ranges[j]
-                group_rays[j + 1] = group_rays[j]
+            while j >= 0 and values[j] > value:
+                values[j + 1] = values[j]
+                rays[j + 1] = rays[j]
                 j -= 1
-            group_ranges[j + 1] = value
-            group_rays[j + 1] = ray
+            values[j + 1] = value
+            rays[j + 1] = ray
             count += 1
         last = 0.0
         for i in range(count):
-            if i == 0 or group_ranges[i] - last >= depth_resolution:
-                kept[count_kept] = group_rays[i]
+            if i == 0 or values[i] - last >= depth_resolution:
+                kept[start + count_kept] = rays[i]
                 count_kept += 1
-                last = group_ranges[i]
-        start = stop
-    return count_kept
-
-
-@numba.njit(nogil=True, cache=True)
-def _grouped_rule(start, stop, detector, kind, ranges, depth_resolution, kept, group_rays, group_ranges):
-    """``_depth_rule_kernel`` over rays ``start:stop`` already grouped by detector (whole
-    groups); writes from ``kept[start]`` on and returns how many."""
-    count_kept = 0
-    first = start
-    while first < stop:
-        group = detector[first]
-        last_ray = first
-        while last_ray < stop and detector[last_ray] == group:
-            last_ray += 1
-        count = 0
-        for ray in range(first, last_ray):
-            value = ranges[ray]
-            if kind[ray] == MISS or not np.isfinite(value):
-                continue
-            j = count - 1
-            while j >= 0 and group_ranges[j] > value:
-                group_ranges[j + 1] = group_ranges[j]
-                group_rays[j + 1] = group_rays[j]
-                j -= 1
-            group_ranges[j + 1] = value
-            group_rays[j + 1] = ray
-            count += 1
-        last = 0.0
-        for i in range(count):
-            if i == 0 or group_ranges[i] - last >= depth_resolution:
-                kept[start + count_kept] = group_rays[i]
-                count_kept += 1
-                last = group_ranges[i]
-        first = last_ray
+                last = values[i]
+        first = end
     return count_kept
 
 
@@ -107,8 +82,18 @@ def _grouped_rule_in_parts(bounds, detector, kind, ranges, depth_resolution, kep
         start, stop = bounds[part], bounds[part + 1]
         group_rays = np.empty(_INSERTION_LIMIT, dtype=np.int64)
         group_ranges = np.empty(_INSERTION_LIMIT, dtype=np.float64)
-        counts[part] = _grouped_rule(
-            start, stop, detector, kind, ranges, depth_resolution, kept, group_rays, group_ranges
+        counts[part] = _rule_over(
+            start,
+            stop,
+            bounds[:0],
+            True,
+            detector,
+            kind,
+            ranges,
+            depth_resolution,
+            kept,
+            group_rays,
+            group_ranges,
         )
 
 
