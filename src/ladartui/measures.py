@@ -43,6 +43,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ladartui.atomic import write_text_atomic
+from ladartui.directions import DirectionStats, angle_between, direction_stats
 from ladartui.errors import InputFileError
 from ladartui.scene.keys import member as _member
 from ladartui.scene.keys import sorted_unique, visible_mask, voxel_keys
@@ -59,69 +60,9 @@ CMF_HEADERS = {f"# ladartui comparison measures, format {CMF_FORMAT} {v}": v for
 # Coverage share of the final obscured coverage that counts as "enough looks".
 ENOUGH_SHARE = 0.9
 
-_NOISE = 1e-12
-
 
 def _unique_keys(voxels) -> np.ndarray:
     return sorted_unique(voxel_keys(voxels))
-
-
-@dataclass(frozen=True)
-class DirectionStats:
-    """Directional statistics of a set of covered target voxels.
-
-    ``count`` voxels contributed a unit vector (centroid to voxel centre);
-    ``mean_vector`` is the sample mean of those vectors, ``resultant_length`` its
-    length (0..1), ``mean_direction`` the mean vector made unit length.
-    """
-
-    count: int = 0
-    mean_vector: tuple[float, float, float] | None = None
-    resultant_length: float | None = None
-    mean_direction: tuple[float, float, float] | None = None
-
-    def to_dict(self) -> dict:
-        return {
-            "count": self.count,
-            "mean_vector": _list_or_none(self.mean_vector),
-            "resultant_length": self.resultant_length,
-            "mean_direction": _list_or_none(self.mean_direction),
-        }
-
-
-def direction_stats(voxels, centroid) -> DirectionStats:
-    """Statistics of the unit vectors from ``centroid`` to each voxel centre (grid units)."""
-    v = np.asarray(voxels, dtype=np.float64).reshape(-1, 3) - np.asarray(centroid, dtype=np.float64)
-    norms = np.sqrt((v * v).sum(axis=1))
-    # A voxel at the centroid has no direction (tolerance far below a voxel).
-    keep = norms > 1e-9
-    if not keep.any():
-        return DirectionStats()
-    units = v[keep] / norms[keep, None]
-    mean = units.mean(axis=0)
-    # Rounding noise of a symmetric coverage (1e-17) would read as a direction.
-    mean[np.abs(mean) < _NOISE] = 0.0
-    length = float(math.sqrt(float(mean @ mean)))
-    direction = _clean(mean / length) if length > 0.0 else None
-    return DirectionStats(
-        count=int(keep.sum()),
-        mean_vector=_clean(mean),
-        resultant_length=length,
-        mean_direction=direction,
-    )
-
-
-def _clean(vector) -> tuple[float, float, float]:
-    x, y, z = (0.0 if abs(c) < _NOISE else float(c) for c in vector)
-    return (x, y, z)
-
-
-def angle_between(a, b) -> float | None:
-    """Angle in radians between two unit vectors; None if either is undefined."""
-    if a is None or b is None:
-        return None
-    cosine = float(np.clip(np.dot(a, b), -1.0, 1.0))
-    return float(math.acos(cosine))
 
 
 @dataclass(frozen=True)
@@ -573,10 +514,6 @@ def measures_from_lines(path, numbered_lines) -> Measures:
     if levels is not None:
         measures = replace(measures, levels=levels_from_cmf(path, levels))
     return measures
-
-
-def _list_or_none(vector):
-    return None if vector is None else list(vector)
 
 
 # --------------------------------------------------------------------------- display
