@@ -350,9 +350,10 @@ _BLOCK_BYTES = 4 << 20
 def _read_rows(path: Path, columns: int, target: bool) -> np.ndarray:
     """The rows of a voxel list (``columns`` values a line), read whole when small,
     else streamed block by block; ``InputFileError`` naming the first bad line."""
-    size = _file_size(path)
-    if size <= _PLAIN_BYTES:
-        return _parse_file(path, _read_bytes(path), columns, target)
+    head = _read_bytes(path, limit=_PLAIN_BYTES + 1)
+    if len(head) <= _PLAIN_BYTES:  # the whole file
+        return _parse_file(path, head, columns, target)
+    size = os.stat(path).st_size
     # At most one row per 6 bytes ("0,0,0\n"); pages never written are never taken.
     out = np.empty((size // (2 * columns) + 1, columns), dtype=np.int32)
     rows = 0
@@ -399,11 +400,6 @@ def _blocks(path: Path):
                     yield np.frombuffer(data[:cut], dtype=np.uint8)
     except OSError as error:
         raise InputFileError(path, f"cannot be read: {error.strerror or error}") from None
-
-
-def _file_size(path: Path) -> int:
-    _read_bytes(path, limit=0)  # the same checks and messages as a whole read
-    return os.stat(path).st_size
 
 
 def _read_bytes(path: Path, limit: int | None = None) -> np.ndarray:
