@@ -204,7 +204,7 @@ def test_a_pencil_of_rays_just_above_the_canopy(numba_backend):
 
 
 def test_order_choice_learns_the_faster_order():
-    from ladartui.tracing.object_order import OrderChoice
+    from ladartui.tracing.order_choice import OrderChoice
 
     def run(choice, calls, seconds):
         picks = ""
@@ -305,6 +305,83 @@ def test_a_whole_scan_sorts_by_scatter_as_the_counting_sort_does(duplicate):
     assert np.array_equal(np.diff(starts) == 1, np.ones(nb * nb, bool)) == (not duplicate)
 
 
+@pytest.mark.parametrize("duplicate", [False, True])
+def test_a_scan_traced_by_bin_order_matches_ray_order(duplicate, numba_backend):
+    # The tile tests read rays through the bin order: without copies when every bin
+    # holds one ray (bin_order's empty starts), through the starts when one holds two.
+    from ladartui.tracing import object_order as oo
+
+    _, occ = forest_scene()
+    origins, directions = one_scan(
+        [100, 100, 10], 60.0, 0.4, 300.0, sensor=Sensor(grid=64, ray_grid=4, fov=6.0)
+    )
+    if duplicate:
+        directions[5] = directions[6]
+    frame = cone_frame(origins, directions)
+    nb = int(math.ceil(math.sqrt(len(origins))))
+    p, q, grid = oo.ray_grid(directions, frame[2], frame[3], frame[4], nb)
+    order, starts = oo.bin_order(p, q, grid, nb, 4)
+    assert (len(starts) == 0) == (not duplicate)
+    assert np.array_equal(np.sort(order), np.arange(len(origins)))
+    ray, obj = both_orders(numba_backend, occ, origins, directions)
+    assert obj.info["order"] == "object"
+    assert_same(ray, obj)
+    assert (obj.kind == VOXEL).sum() > len(obj.kind) // 10
+
+
+@pytest.mark.parametrize("axis", [(0.3, 0.4, -0.866), (-0.3, -0.4, 0.866), (0.6, -0.1, -0.79)])
+def test_voxels_of_a_brick_come_front_first(axis):
+    # Along a ray every cell coordinate moves with its direction's sign, so listing
+    # layers, rows and cells in the axis's direction puts each voxel after every voxel
+    # a ray with the axis's signs can meet before it.
+    from ladartui.tracing import object_order as oo
+
+    rng = np.random.default_rng(7)
+    cells = rng.choice(512, 200, replace=False)
+    voxels = np.stack([8 + cells % 8, 16 + (cells // 8) % 8, 24 + cells // 64], axis=1)
+    occ = Occupancy.build(voxels, (64, 64, 64))
+    a = np.array(axis) / np.linalg.norm(axis)
+    u = np.cross(a, [0.0, 0.0, 1.0])
+    u /= np.linalg.norm(u)
+    v = np.cross(a, u)
+    centre = np.array([12.0, 20.0, 28.0]) - 500.0 * a
+    found, near, ok = oo.bricks_in_view(
+        centre,
+        np.zeros(3),
+        a,
+        u,
+        v,
+        np.array([-1.0, 0.5, -1.0, 0.5]),
+        4,
+        occ.root,
+        occ.regions,
+        occ.tiles,
+        occ.root_origin.astype(np.int64),
+        occ.root_dims.astype(np.int64),
+    )
+    assert ok and len(found) == 1
+    first = oo.voxel_starts(found, occ.bricks)
+    vox, _ = oo.emit_voxels(
+        found, near, first, occ.bricks, centre, np.zeros(3), a, u, v, np.array([-1.0, 0.5, -1.0, 0.5]), 4
+    )
+    assert sorted(map(tuple, vox[:, :3].tolist())) == sorted(map(tuple, voxels.tolist()))
+    ahead = vox[:, :3] * np.where(a < 0, -1, 1)  # coordinates in the order the axis meets them
+    keys = [(z, y, x) for x, y, z in ahead.tolist()]
+    assert keys == sorted(keys)
+
+
+@pytest.mark.parametrize("tiles", [1, 2, 64, 1024, 1089, 4096])
+def test_tile_stride_visits_every_tile_once_and_spreads_each_thread_share(tiles):
+    from ladartui.tracing.tile_tests import tile_stride
+
+    stride = tile_stride(tiles)
+    visit = (np.arange(tiles) * stride) % tiles
+    assert np.array_equal(np.sort(visit), np.arange(tiles))
+    if tiles >= 64:  # each half of the steps (one of two threads) takes tiles from both halves
+        for half in (visit[: tiles // 2], visit[tiles // 2 :]):
+            assert 0.3 < (half < tiles // 2).mean() < 0.7
+
+
 def test_order_choice_reads_the_given_clock():
     # A block that waits (as when other processes hold the cores) costs no CPU time:
     # on the process's CPU clock the order that computes less wins even though it
@@ -312,7 +389,8 @@ def test_order_choice_reads_the_given_clock():
     # advance scripted clocks rather than sleep and spin: real clocks made the answer
     # hang on how busy the machine was (10 ms of CPU took over 30 ms of wall time on
     # loaded cores, so the wall clock picked object order too).
-    from ladartui.tracing.object_order import MIN_SCAN_RAYS, OrderChoice, trace_in_blocks
+    from ladartui.tracing.config import MIN_SCAN_RAYS
+    from ladartui.tracing.order_choice import OrderChoice, trace_in_blocks
 
     elapsed = {"cpu": 0.0, "wall": 0.0}
 

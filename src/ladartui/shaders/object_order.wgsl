@@ -1,6 +1,6 @@
 // Object-order tile tests as a compute shader: one invocation per ray.
 //
-// This is tracing/object_order.py's test_tiles seen from the ray's side. The
+// This is tracing/tile_tests.py's test_tiles seen from the ray's side. The
 // host (prepare_scan there) bins the rays, sorts them tile by tile, finds the
 // occupied voxels in view nearest brick first and lists each tile's voxels in
 // that order. Each invocation takes one sorted ray down its tile's list: it
@@ -35,7 +35,7 @@ struct TileParams {
 @group(0) @binding(6) var<storage, read> tile_starts: array<u32>;   // tile's entries in `listed`
 @group(0) @binding(7) var<storage, read> listed: array<u32>;        // voxel numbers, tile by tile
 
-// numba: test_tiles (tracing/object_order.py)
+// numba: test_tiles (tracing/tile_tests.py)
 @compute @workgroup_size(BUNDLE)
 fn test_tiles(@builtin(workgroup_id) group: vec3<u32>,
               @builtin(num_workgroups) groups: vec3<u32>,

@@ -20,12 +20,14 @@ from numba import njit, prange
 
 from ladartui.errors import check_cancelled
 from ladartui.scene.occupancy import block_masks
-from ladartui.tracing.answers import ray_answer, scan_answers
+from ladartui.tracing.answers import ray_answer
 from ladartui.tracing.axis import boundary_t, cell_at, clamp, slab
 from ladartui.tracing.backend import GROUND, MISS, VOXEL, CellHits, TraceOrder, check_order, register_backend
 from ladartui.tracing.bundle import bundle_start, halo_arrays
 from ladartui.tracing.config import BLOCK, BUNDLE, INF
-from ladartui.tracing.object_order import OrderChoice, cone_frame, nearest_voxels, trace_in_blocks
+from ladartui.tracing.object_order import cone_frame
+from ladartui.tracing.order_choice import OrderChoice, trace_in_blocks
+from ladartui.tracing.tile_tests import trace_scan
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -560,11 +562,7 @@ class NumbaBackend:
     def _object_order(occ, orig, dirs, max_voxels, nx, ny, kind, index, t):
         """Trace one scan in object order into kind/index/t; False when it is no scan for it."""
         frame = cone_frame(orig, dirs)
-        found = None if frame is None else nearest_voxels(occ, orig, dirs, frame, max_voxels)
-        if found is None:
-            return False
-        scan_answers(*found, orig, dirs, nx, ny, kind, index, t)
-        return True
+        return frame is not None and trace_scan(occ, orig, dirs, frame, max_voxels, nx, ny, kind, index, t)
 
 
 def _cube_arrays(occ):

@@ -37,29 +37,21 @@ functions here release the GIL; the passes over rays and voxels run under
 from __future__ import annotations
 
 import math
-import threading
-import time
 from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange
 
-from ladartui.errors import check_cancelled
 from ladartui.tracing.axis import slab
 from ladartui.tracing.config import (
     EPS,
     INF,
     MAX_SPREAD,
     MIN_COS,
-    MIN_SCAN_RAYS,
     NEAR_MARGIN,
     PARTS,
-    SCAN_BLOCK,
     TILE_SHIFT,
-    VOXELS_PER_RAY,
 )
-
-TILE = 1 << TILE_SHIFT
 
 
 @njit(parallel=True, nogil=True, cache=True)
@@ -163,17 +155,18 @@ def _bin_keys(p, q, grid, nb, shift, key_of, bin_of):
     for r in prange(p.shape[0]):
         i, j = _bin_of(p[r], q[r], grid, nb)
         key_of[r] = bin_key(i, j, nt, shift)
-        bin_of[r] = np.uint32(i | (j << 16))
+        if bin_of.shape[0]:
+            bin_of[r] = np.uint32(i | (j << 16))
 
 
 @njit(nogil=True, cache=True)
-def _sort_into_bins(p, q, grid, nb, shift):
+def _sort_into_bins(p, q, grid, nb, shift, with_bins=True):
     """(starts, order, bins): counting sort of the rays by ``bin_key``; ``bins`` holds
-    each sorted ray's bin as ``i | j << 16``."""
+    each sorted ray's bin as ``i | j << 16`` (empty unless ``with_bins``)."""
     n = p.shape[0]
     nt = -(-nb >> shift)
     key_of = np.empty(n, np.int64)
-    bin_of = np.empty(n, np.uint32)
+    bin_of = np.empty(n if with_bins else 0, np.uint32)
     _bin_keys(p, q, grid, nb, shift, key_of, bin_of)
     starts = np.zeros((nt * nt << 2 * shift) + 1, np.int64)
     for r in range(n):
@@ -182,11 +175,12 @@ def _sort_into_bins(p, q, grid, nb, shift):
         starts[b + 1] += starts[b]
     fill = starts[:-1].copy()
     order = np.empty(n, np.int64)
-    bins = np.empty(n, np.uint32)
+    bins = np.empty(bin_of.shape[0], np.uint32)
     for r in range(n):
         at = fill[key_of[r]]
         order[at] = r
-        bins[at] = bin_of[r]
+        if with_bins:
+            bins[at] = bin_of[r]
         fill[key_of[r]] += 1
     return starts, order, bins
 
@@ -218,7 +212,7 @@ def _scatter_one_per_bin(p, q, grid, nb, shift, order, bins):
     the bins then are): each ray's number goes straight to the position of its bin's
     key, in one parallel pass. Needs nb * nb rays and whole tiles (the keys are then
     0 .. n-1). False when some bin got none (so another got two): the caller sorts
-    instead."""
+    instead. ``bins`` may be empty (not wanted)."""
     n = p.shape[0]
     nt = nb >> shift
     for k in prange(n):
@@ -227,7 +221,8 @@ def _scatter_one_per_bin(p, q, grid, nb, shift, order, bins):
         i, j = _bin_of(p[r], q[r], grid, nb)
         k = bin_key(i, j, nt, shift)
         order[k] = r
-        bins[k] = np.uint32(i | (j << 16))
+        if bins.shape[0]:
+            bins[k] = np.uint32(i | (j << 16))
     missing = np.zeros(PARTS, np.bool_)
     for part in prange(PARTS):
         for k in range(part * n // PARTS, (part + 1) * n // PARTS):
@@ -282,6 +277,19 @@ def sort_rays(p, q, grid, nb, shift, orig, dirs, lo, hi):
     starts, order, bins = _sort_into_bins(p, q, grid, nb, shift)
     _gather(order, orig, dirs, lo, hi, rays, invs, exits)
     return starts, order, bins, rays, invs, exits
+
+
+def bin_order(p, q, grid, nb, shift):
+    """(order, starts) of the rays in bin order without copying them (``sort_rays``
+    copies them too): sorted position s is ray ``order[s]``; ``starts`` as there, or
+    empty when every bin holds exactly one ray (bin key b is then position b)."""
+    n = len(p)
+    if n == nb * nb and nb % (1 << shift) == 0:
+        order = np.empty(n, np.int64)
+        if _scatter_one_per_bin(p, q, grid, nb, shift, order, np.empty(0, np.uint32)):
+            return order, np.empty(0, np.int64)
+    starts, order, _ = _sort_into_bins(p, q, grid, nb, shift, False)
+    return order, starts
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -430,32 +438,42 @@ def voxel_starts(bricks_found, bricks):
 def emit_voxels(bricks_found, brick_near, first, bricks, centre, grow, axis, u, v, grid, nb):
     """Every voxel of the found bricks, in their order (``first`` from ``voxel_starts``):
     (m, 7) i, j, k, i0, i1, j0, j1 (i0 > i1: covers no bin) and (m, 2) its near and its
-    brick's near."""
+    brick's near.
+
+    Within a brick, front first: layers, rows and cells in the order the axis
+    crosses them. A ray's cells only move with its direction's signs, so for rays
+    with the axis's signs a voxel listed later is never met before one listed
+    earlier; their first hit then comes first and their later candidates fail the
+    cheap ``near`` check instead of taking slab tests.
+    """
     count = bricks_found.shape[0]
     vox = np.empty((first[count], 7), np.int64)
     nears = np.empty((first[count], 2))
+    flip_x, flip_y, flip_z = 7 if axis[0] < 0.0 else 0, 7 if axis[1] < 0.0 else 0, 7 if axis[2] < 0.0 else 0
     for e in prange(count):
         bx, by, bz = bricks_found[e, 0], bricks_found[e, 1], bricks_found[e, 2]
         base = (bricks_found[e, 3] - 1) * 16
         k = first[e]
-        for w in range(16):
-            word = bricks[base + w]
-            bit = 0
-            while word != 0:
-                if (word & np.uint32(0xFF)) == 0:
-                    word >>= np.uint32(8)
-                    bit += 8
+        for zi in range(8):
+            dz = zi ^ flip_z
+            layer = np.int64(bricks[base + 2 * dz]) | (np.int64(bricks[base + 2 * dz + 1]) << 32)
+            if layer == 0:
+                continue
+            for yi in range(8):
+                dy = yi ^ flip_y
+                row = (layer >> (8 * dy)) & 0xFF
+                if row == 0:
                     continue
-                if word & np.uint32(1):
-                    cell = w * 32 + bit
-                    x, y, z = bx + (cell & 7), by + ((cell >> 3) & 7), bz + (cell >> 6)
+                for xi in range(8):
+                    dx = xi ^ flip_x
+                    if (row >> dx) & 1 == 0:
+                        continue
+                    x, y, z = bx + dx, by + dy, bz + dz
                     i0, i1, j0, j1, _, near = box_bins(x, y, z, 1, centre, grow, axis, u, v, grid, nb)
                     vox[k, 0], vox[k, 1], vox[k, 2] = x, y, z
                     vox[k, 3], vox[k, 4], vox[k, 5], vox[k, 6] = i0, i1, j0, j1
                     nears[k, 0], nears[k, 1] = near, brick_near[e]
                     k += 1
-                word >>= np.uint32(1)
-                bit += 1
     return vox, nears
 
 
@@ -499,104 +517,6 @@ def voxels_per_tile(vox, tiles_per_side, shift):
     for k in prange(runs):
         _visit_tiles(vox, k * n // runs, (k + 1) * n // runs, shift, nt, counts[k], listed, True)
     return starts, listed
-
-
-@njit(nogil=True, cache=True, inline="always")
-def _tile_far(bin_starts, tile, best_t):
-    far = 0.0
-    for s in range(bin_starts[tile * TILE * TILE], bin_starts[(tile + 1) * TILE * TILE]):
-        far = max(far, best_t[s])
-    return far
-
-
-@njit(nogil=True, cache=True, inline="always")
-def _slab_start(rays, invs, s, x, y, z, best):
-    """Where sorted ray s enters voxel (x, y, z) (the reference tracer's slab test of
-    its open interior, from t = 0 on); ``best`` when it does not, or not before."""
-    ex, lx = slab(rays[s, 0], rays[s, 3], invs[s, 0], x, x + 1.0)
-    ey, ly = slab(rays[s, 1], rays[s, 4], invs[s, 1], y, y + 1.0)
-    ez, lz = slab(rays[s, 2], rays[s, 5], invs[s, 2], z, z + 1.0)
-    enter, leave = max(ex, max(ey, ez)), min(lx, min(ly, lz))
-    start = max(enter, 0.0)
-    return start if start < leave and start < best else best
-
-
-@njit(parallel=True, nogil=True, cache=True)
-def test_tiles(vox, nears, tile_starts, listed, tiles_per_side, bin_starts, nb, rays, invs, best_t, best_v):
-    """Nearest hit of each sorted ray among the voxels of its tile (tiles of TILE bins).
-
-    ``best_t`` starts at each ray's exit from the occupied box, a bound no hit
-    reaches (a voxel's interval ends inside the box), ``best_v`` at -1. A tile
-    stops when no later brick can come nearer than every ray's bound.
-    Per row of the tile a mask of live bins: a bin whose every ray has a bound
-    at or before the current brick's ``near`` is cleared when next met, since
-    no later brick (nears only grow down the list) can come nearer; its rays
-    are then never read again (most candidates of a scan are such rays, behind
-    their hit). shaders/object_order.wgsl runs the same tests ray by ray.
-    """
-    nt = tiles_per_side
-    for tile in prange(nt * nt):
-        bi0 = (tile % nt) * TILE
-        bi1 = min(nb, bi0 + TILE) - 1
-        bj0 = (tile // nt) * TILE
-        bj1 = min(nb, bj0 + TILE) - 1
-        base = tile * TILE * TILE  # bin_key of the tile's first bin; rows of TILE follow
-        live = np.zeros(TILE, np.int64)  # per row: bit c set while bin (bi0 + c) may still change
-        first = bin_starts[base]
-        single = True  # one ray in every bin of the tile: bin k's ray is first + k - base
-        for r in range(bj1 - bj0 + 1):
-            for c in range(bi1 - bi0 + 1):
-                k = base + r * TILE + c
-                if bin_starts[k + 1] > bin_starts[k]:
-                    live[r] |= np.int64(1) << c
-                single = (
-                    single
-                    and bin_starts[k + 1] - bin_starts[k] == 1
-                    and bin_starts[k] == first + r * TILE + c
-                )
-        far = _tile_far(bin_starts, tile, best_t)  # no bound of the tile is beyond
-        stale = False  # far may be lowered (bounds moved nearer since it was taken)
-        for e in range(tile_starts[tile], tile_starts[tile + 1]):
-            q = listed[e]
-            brick_near = nears[q, 1]
-            if brick_near >= far:
-                if stale:
-                    far = _tile_far(bin_starts, tile, best_t)
-                    stale = False
-                if brick_near >= far:
-                    break
-            near = nears[q, 0]
-            if near >= far:
-                continue
-            x, y, z = np.float64(vox[q, 0]), np.float64(vox[q, 1]), np.float64(vox[q, 2])
-            c0, c1 = max(vox[q, 3], bi0) - bi0, min(vox[q, 4], bi1) - bi0
-            span = ((np.int64(2) << c1) - 1) ^ ((np.int64(1) << c0) - 1)
-            for r in range(max(vox[q, 5], bj0) - bj0, min(vox[q, 6], bj1) - bj0 + 1):
-                row = live[r] & span
-                if row == 0:
-                    continue
-                for c in range(c0, c1 + 1):
-                    if (row >> c) & 1 == 0:
-                        continue
-                    k = base + r * TILE + c
-                    lo_s, hi_s = (
-                        (first + r * TILE + c, first + r * TILE + c + 1)
-                        if single
-                        else (bin_starts[k], bin_starts[k + 1])
-                    )
-                    alive = False
-                    for s in range(lo_s, hi_s):
-                        best = best_t[s]
-                        if best > near:
-                            start = _slab_start(rays, invs, s, x, y, z, best)
-                            if start < best:
-                                best_t[s] = start
-                                best_v[s] = q
-                                best = start
-                                stale = True
-                        alive = alive or best > brick_near
-                    if not alive:
-                        live[r] &= ~(np.int64(1) << c)
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -646,18 +566,12 @@ class Scan(NamedTuple):
     tiles_per_side: int
 
 
-def prepare_scan(occ, orig, dirs, frame, max_voxels, tile_shift=TILE_SHIFT):
-    """A scan's rays binned and sorted, and its voxels in view listed per tile of
-    ``1 << tile_shift`` bins a side; None when it cannot be projected (a brick straddles
-    the aircraft's plane) or when more than ``max_voxels`` occupied voxels are in
-    view (ray order is then the cheaper way)."""
+def scan_voxels(occ, frame, grid, nb, max_voxels, tile_shift):
+    """(vox, nears, tile_starts, listed): the voxels in view of a scan whose rays are
+    binned by ``grid`` (``emit_voxels``), listed per tile of ``1 << tile_shift`` bins a
+    side (``voxels_per_tile``); None when a brick straddles the aircraft's plane near
+    it, or when more than ``max_voxels`` are in view."""
     centre, grow, axis, u, v = frame
-    n = len(orig)
-    nb = max(1, int(math.ceil(math.sqrt(n))))
-    gnomonic = ray_grid(dirs, axis, u, v, nb)
-    if gnomonic is None:
-        return None
-    p, q, grid = gnomonic
     found, brick_near, ok = bricks_in_view(
         centre,
         grow,
@@ -677,12 +591,30 @@ def prepare_scan(occ, orig, dirs, frame, max_voxels, tile_shift=TILE_SHIFT):
     first = voxel_starts(found, occ.bricks)
     if first[-1] > max_voxels:
         return None
+    vox, nears = emit_voxels(found, brick_near, first, occ.bricks, centre, grow, axis, u, v, grid, nb)
+    tile_starts, listed = voxels_per_tile(vox, -(-nb >> tile_shift), tile_shift)
+    return vox, nears, tile_starts, listed
+
+
+def prepare_scan(occ, orig, dirs, frame, max_voxels, tile_shift=TILE_SHIFT):
+    """A scan's rays binned and copied in bin order (``sort_rays``), and its voxels in
+    view listed per tile of ``1 << tile_shift`` bins a side (``scan_voxels``); None
+    when it cannot be projected or has too many voxels in view (ray order is then the
+    cheaper way), or when a ray is not of unit length within 60 degrees of the axis."""
+    n = len(orig)
+    nb = max(1, int(math.ceil(math.sqrt(n))))
+    gnomonic = ray_grid(dirs, frame[2], frame[3], frame[4], nb)
+    if gnomonic is None:
+        return None
+    p, q, grid = gnomonic
+    voxels = scan_voxels(occ, frame, grid, nb, max_voxels, tile_shift)
+    if voxels is None:
+        return None
     bin_starts, order, bins, rays, invs, exits = sort_rays(
         p, q, grid, nb, tile_shift, orig, dirs, occ.bbox_lo.astype(np.float64), occ.bbox_hi.astype(np.float64)
     )
-    vox, nears = emit_voxels(found, brick_near, first, occ.bricks, centre, grow, axis, u, v, grid, nb)
+    vox, nears, tile_starts, listed = voxels
     tiles_per_side = -(-nb >> tile_shift)
-    tile_starts, listed = voxels_per_tile(vox, tiles_per_side, tile_shift)
     return Scan(
         order,
         rays,
@@ -698,105 +630,3 @@ def prepare_scan(occ, orig, dirs, frame, max_voxels, tile_shift=TILE_SHIFT):
         tile_shift,
         tiles_per_side,
     )
-
-
-def nearest_voxels(
-    occ, orig, dirs, frame, max_voxels
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
-    """Object-order first hits of a scan, or None (see ``prepare_scan``).
-
-    Returns (order, best_t, best_v, vox): sorted position ``s`` is ray
-    ``order[s]``; its hit is voxel ``vox[best_v[s], :3]`` at ``best_t[s]``
-    (``best_v`` -1: no voxel, the ground rule decides; ``best_t`` is then a bound).
-    """
-    scan = prepare_scan(occ, orig, dirs, frame, max_voxels)
-    if scan is None:
-        return None
-    best_t = scan.exits
-    best_v = np.full(len(best_t), -1, np.int64)
-    test_tiles(
-        scan.vox,
-        scan.nears,
-        scan.tile_starts,
-        scan.listed,
-        scan.tiles_per_side,
-        scan.bin_starts,
-        scan.nb,
-        scan.rays,
-        scan.invs,
-        best_t,
-        best_v,
-    )
-    return scan.order, best_t, best_v, scan.vox
-
-
-class OrderChoice:
-    """Which order traces an occupancy's scans faster, learned from the calls themselves.
-
-    Neither order wins everywhere: object order costs about the same for any
-    scene in view, ray order is cheap where rays stop early (dense cover) and
-    dear where they pass many gaps (foliage). So the orders take turns until
-    each has been timed twice (a first call may include compiling), then the
-    faster by its better recent time per ray goes on, and the other is tried
-    again every RETRY scans in case the views have changed.
-    """
-
-    RETRY = 16
-    SAMPLES = 2
-
-    def __init__(self):
-        self.samples: dict[str, list[float]] = {"object": [], "ray": []}  # recent seconds per ray
-        self.calls = 0
-        self._lock = threading.Lock()
-
-    def pick(self) -> str:
-        with self._lock:
-            self.calls += 1
-            timed_object, timed_ray = len(self.samples["object"]), len(self.samples["ray"])
-            if min(timed_object, timed_ray) < self.SAMPLES:
-                return "object" if timed_object <= timed_ray else "ray"
-            best = min(self.samples, key=lambda order: min(self.samples[order]))
-            if self.calls % self.RETRY == 0:
-                return "ray" if best == "object" else "object"
-            return best
-
-    def record(self, order: str, seconds: float, rays: int) -> None:
-        with self._lock:
-            recent = self.samples[order]
-            recent.append(seconds / max(1, rays))
-            del recent[: -self.SAMPLES]
-
-
-def trace_in_blocks(n, order, choice, object_block, ray_block, cancel=None, clock=time.perf_counter):
-    """Trace ``n`` exact rays in blocks of up to SCAN_BLOCK, each in object or ray
-    order, as both backends do; returns the set of orders used.
-
-    ``object_block(a, b, max_voxels)`` traces rays a..b in object order and says
-    whether it could (a scan with at most ``max_voxels`` voxels in view);
-    ``ray_block(a, b)`` traces them in ray order. ``order`` "object" tries object
-    order on every block, whatever it costs; "auto" lets ``choice`` (this
-    occupancy's OrderChoice) pick for blocks of at least MIN_SCAN_RAYS and learn
-    from their times, read from ``clock``: wall time by default (a GPU's work costs
-    the host nothing), the process's CPU time for a CPU backend (time.process_time:
-    on a shared machine, other processes' work then does not make an order look
-    slow, and the choice does not flip with the load).
-    """
-    orders = set()
-    for a in range(0, n, SCAN_BLOCK):
-        b = min(n, a + SCAN_BLOCK)
-        check_cancelled(cancel, "trace cancelled")
-        learning = choice if order == "auto" and b - a >= MIN_SCAN_RAYS else None
-        started = clock()
-        if order == "object" or (learning is not None and learning.pick() == "object"):
-            limit = np.inf if order == "object" else VOXELS_PER_RAY * (b - a)
-            if object_block(a, b, limit):
-                orders.add("object")
-                if learning is not None:
-                    learning.record("object", clock() - started, b - a)
-                continue
-            learning = None  # no scan for object order: nothing to learn from this block
-        orders.add("ray")
-        ray_block(a, b)
-        if learning is not None:
-            learning.record("ray", clock() - started, b - a)
-    return orders

@@ -79,13 +79,8 @@ from ladartui.tracing.config import (
     UNFINISHED,
     wgsl_constants,
 )
-from ladartui.tracing.object_order import (
-    OrderChoice,
-    cone_frame,
-    prepare_scan,
-    shader_voxels,
-    trace_in_blocks,
-)
+from ladartui.tracing.object_order import cone_frame, prepare_scan, shader_voxels
+from ladartui.tracing.order_choice import OrderChoice, trace_in_blocks
 
 NAME = "wgpu"
 

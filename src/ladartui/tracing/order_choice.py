@@ -1,0 +1,88 @@
+"""Which order traces a block of rays: learned per occupancy from the blocks' own times.
+
+Both backends' ``trace_cells`` run their exact rays through ``trace_in_blocks``:
+blocks that are scans may go in object order (tracing.object_order), the rest,
+and scans where walking the rays is cheaper, in ray order.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+
+import numpy as np
+
+from ladartui.errors import check_cancelled
+from ladartui.tracing.config import MIN_SCAN_RAYS, SCAN_BLOCK, VOXELS_PER_RAY
+
+
+class OrderChoice:
+    """Which order traces an occupancy's scans faster, learned from the calls themselves.
+
+    Neither order wins everywhere: object order costs about the same for any
+    scene in view, ray order is cheap where rays stop early (dense cover) and
+    dear where they pass many gaps (foliage). So the orders take turns until
+    each has been timed twice (a first call may include compiling), then the
+    faster by its better recent time per ray goes on, and the other is tried
+    again every RETRY scans in case the views have changed.
+    """
+
+    RETRY = 16
+    SAMPLES = 2
+
+    def __init__(self):
+        self.samples: dict[str, list[float]] = {"object": [], "ray": []}  # recent seconds per ray
+        self.calls = 0
+        self._lock = threading.Lock()
+
+    def pick(self) -> str:
+        with self._lock:
+            self.calls += 1
+            timed_object, timed_ray = len(self.samples["object"]), len(self.samples["ray"])
+            if min(timed_object, timed_ray) < self.SAMPLES:
+                return "object" if timed_object <= timed_ray else "ray"
+            best = min(self.samples, key=lambda order: min(self.samples[order]))
+            if self.calls % self.RETRY == 0:
+                return "ray" if best == "object" else "object"
+            return best
+
+    def record(self, order: str, seconds: float, rays: int) -> None:
+        with self._lock:
+            recent = self.samples[order]
+            recent.append(seconds / max(1, rays))
+            del recent[: -self.SAMPLES]
+
+
+def trace_in_blocks(n, order, choice, object_block, ray_block, cancel=None, clock=time.perf_counter):
+    """Trace ``n`` exact rays in blocks of up to SCAN_BLOCK, each in object or ray
+    order, as both backends do; returns the set of orders used.
+
+    ``object_block(a, b, max_voxels)`` traces rays a..b in object order and says
+    whether it could (a scan with at most ``max_voxels`` voxels in view);
+    ``ray_block(a, b)`` traces them in ray order. ``order`` "object" tries object
+    order on every block, whatever it costs; "auto" lets ``choice`` (this
+    occupancy's OrderChoice) pick for blocks of at least MIN_SCAN_RAYS and learn
+    from their times, read from ``clock``: wall time by default (a GPU's work costs
+    the host nothing), the process's CPU time for a CPU backend (time.process_time:
+    on a shared machine, other processes' work then does not make an order look
+    slow, and the choice does not flip with the load).
+    """
+    orders = set()
+    for a in range(0, n, SCAN_BLOCK):
+        b = min(n, a + SCAN_BLOCK)
+        check_cancelled(cancel, "trace cancelled")
+        learning = choice if order == "auto" and b - a >= MIN_SCAN_RAYS else None
+        started = clock()
+        if order == "object" or (learning is not None and learning.pick() == "object"):
+            limit = np.inf if order == "object" else VOXELS_PER_RAY * (b - a)
+            if object_block(a, b, limit):
+                orders.add("object")
+                if learning is not None:
+                    learning.record("object", clock() - started, b - a)
+                continue
+            learning = None  # no scan for object order: nothing to learn from this block
+        orders.add("ray")
+        ray_block(a, b)
+        if learning is not None:
+            learning.record("ray", clock() - started, b - a)
+    return orders

@@ -1,0 +1,224 @@
+"""The numba backend's object-order tests: each tile of bins against its voxels.
+
+``trace_scan`` runs a whole scan: the rays are binned (``object_order.bin_order``,
+an order and no copies), the voxels in view listed per tile
+(``object_order.scan_voxels``), and ``test_tiles`` then takes each tile on its
+own: it copies the tile's rays next to each other, tests them against the
+tile's voxels nearest first, and writes their answers in ray order. One pass
+over the rays does the copying, the testing and the answers, so a scan's rays
+are read from memory about once (docs/architecture.md, "Object order").
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from ladartui.tracing.answers import ray_answer
+from ladartui.tracing.axis import slab
+from ladartui.tracing.config import INF, TILE_SHIFT
+from ladartui.tracing.object_order import bin_order, ray_grid, scan_voxels
+
+TILE = 1 << TILE_SHIFT
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _slab_start(ray, s, x, y, z, best):
+    """Where tile ray s enters voxel (x, y, z) (the reference tracer's slab test of
+    its open interior, from t = 0 on); ``best`` when it does not, or not before.
+    ``ray[s]`` holds origin, direction and ``1 / d`` (inf for 0)."""
+    ex, lx = slab(ray[s, 0], ray[s, 3], ray[s, 6], x, x + 1.0)
+    ey, ly = slab(ray[s, 1], ray[s, 4], ray[s, 7], y, y + 1.0)
+    ez, lz = slab(ray[s, 2], ray[s, 5], ray[s, 8], z, z + 1.0)
+    enter, leave = max(ex, max(ey, ez)), min(lx, min(ly, lz))
+    start = max(enter, 0.0)
+    return start if start < leave and start < best else best
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _load_ray(r, orig, dirs, lo, hi, ray, s):
+    """Ray r into tile row s: origin, direction, ``1 / d`` (the kernels' inverse, inf
+    for 0: the slab tests then divide nothing); returns where it leaves the box [lo, hi)."""
+    leave = INF
+    for a in range(3):
+        o, d = orig[r, a], dirs[r, a]
+        inv = 1.0 / d if d != 0.0 else INF
+        ray[s, a], ray[s, 3 + a], ray[s, 6 + a] = o, d, inv
+        leave = min(leave, slab(o, d, inv, lo[a], hi[a])[1])
+    return leave
+
+
+def tile_stride(tiles):
+    """A step through the tiles that is prime to their number and near the golden
+    section of it: ``(k * stride) % tiles`` then visits every tile once, and any run of
+    k (one thread's share of a prange) takes tiles from all over the scan, so threads
+    get equal work when one side of a scan (the far side at 45 degrees) costs more."""
+    stride = max(1, round(tiles * 0.6180339887))
+    while math.gcd(stride, tiles) != 1:
+        stride += 1
+    return stride
+
+
+@njit(parallel=True, nogil=True, cache=True)
+def test_tiles(
+    vox,
+    nears,
+    tile_starts,
+    listed,
+    nt,
+    stride,
+    bin_starts,
+    order,
+    nb,
+    orig,
+    dirs,
+    lo,
+    hi,
+    nx,
+    ny,
+    kind,
+    index,
+    tout,
+):
+    """Nearest hit of each ray among the voxels of its tile (tiles of TILE bins), and
+    its answer (``ray_answer``) into kind/index/tout at the ray's own place.
+
+    Sorted position s is ray ``order[s]``; bin key b holds positions
+    ``bin_starts[b] .. bin_starts[b + 1]``, or position b alone when ``bin_starts``
+    is empty (one ray per bin, whole tiles). A tile's rays start with their exit
+    from the occupied box [lo, hi) as bound, a bound no hit reaches (a voxel's
+    interval ends inside the box), and no voxel. A tile stops when no later brick
+    can come nearer than every ray's bound. Per row of the tile a mask of live
+    bins: a bin whose every ray has a bound at or before the current brick's
+    ``near`` is cleared when next met, since no later brick (nears only grow down
+    the list) can come nearer; its rays are then never read again (most candidates
+    of a scan are such rays, behind their hit). shaders/object_order.wgsl runs the
+    same tests ray by ray.
+    """
+    tiles = nt * nt
+    single = bin_starts.shape[0] == 0
+    for step in prange(tiles):
+        tile = (step * stride) % tiles
+        bi0 = (tile % nt) * TILE
+        bi1 = min(nb, bi0 + TILE) - 1
+        bj0 = (tile // nt) * TILE
+        bj1 = min(nb, bj0 + TILE) - 1
+        base = tile * TILE * TILE  # bin_key of the tile's first bin; rows of TILE follow
+        s0 = base if single else bin_starts[base]
+        m = TILE * TILE if single else bin_starts[base + TILE * TILE] - s0
+        if m == 0:
+            continue
+        starts = np.empty(TILE * TILE + 1, np.int64)  # bin b of the tile: tile rays starts[b] ..
+        for b in range(TILE * TILE + 1):
+            starts[b] = b if single else bin_starts[base + b] - s0
+        live = np.zeros(TILE, np.int64)  # per row: bit c set while bin (bi0 + c) may still change
+        for r in range(bj1 - bj0 + 1):
+            for c in range(bi1 - bi0 + 1):
+                if starts[r * TILE + c + 1] > starts[r * TILE + c]:
+                    live[r] |= np.int64(1) << c
+        ray = np.empty((m, 9))
+        best_t = np.empty(m)
+        best_v = np.full(m, -1, np.int64)
+        far = 0.0  # no bound of the tile is beyond
+        for s in range(m):
+            best_t[s] = _load_ray(order[s0 + s], orig, dirs, lo, hi, ray, s)
+            far = max(far, best_t[s])
+        stale = False  # far may be lowered (bounds moved nearer since it was taken)
+        for e in range(tile_starts[tile], tile_starts[tile + 1]):
+            q = listed[e]
+            brick_near = nears[q, 1]
+            if brick_near >= far:
+                if stale:
+                    far = 0.0
+                    for s in range(m):
+                        far = max(far, best_t[s])
+                    stale = False
+                if brick_near >= far:
+                    break
+            near = nears[q, 0]
+            if near >= far:
+                continue
+            x, y, z = np.float64(vox[q, 0]), np.float64(vox[q, 1]), np.float64(vox[q, 2])
+            c0, c1 = max(vox[q, 3], bi0) - bi0, min(vox[q, 4], bi1) - bi0
+            span = ((np.int64(2) << c1) - 1) ^ ((np.int64(1) << c0) - 1)
+            for r in range(max(vox[q, 5], bj0) - bj0, min(vox[q, 6], bj1) - bj0 + 1):
+                row = live[r] & span
+                if row == 0:
+                    continue
+                for c in range(c0, c1 + 1):
+                    if (row >> c) & 1 == 0:
+                        continue
+                    b = r * TILE + c
+                    alive = False
+                    for s in range(starts[b], starts[b + 1]):
+                        best = best_t[s]
+                        if best > near:
+                            start = _slab_start(ray, s, x, y, z, best)
+                            if start < best:
+                                best_t[s] = start
+                                best_v[s] = q
+                                best = start
+                                stale = True
+                        alive = alive or best > brick_near
+                    if not alive:
+                        live[r] &= ~(np.int64(1) << c)
+        for s in range(m):
+            r = order[s0 + s]
+            q = best_v[s]
+            i, j, k = (vox[q, 0], vox[q, 1], vox[q, 2]) if q >= 0 else (-1, -1, -1)
+            kind[r], index[r, 0], index[r, 1], index[r, 2], tout[r] = ray_answer(
+                q >= 0,
+                i,
+                j,
+                k,
+                best_t[s],
+                ray[s, 0],
+                ray[s, 1],
+                ray[s, 2],
+                ray[s, 3],
+                ray[s, 4],
+                ray[s, 5],
+                nx,
+                ny,
+            )
+
+
+def trace_scan(occ, orig, dirs, frame, max_voxels, nx, ny, kind, index, t):
+    """One scan's exact answers in object order into kind/index/t; False (nothing
+    written) when it is no scan for it (``object_order.prepare_scan`` says when)."""
+    n = len(orig)
+    nb = max(1, int(math.ceil(math.sqrt(n))))
+    gnomonic = ray_grid(dirs, frame[2], frame[3], frame[4], nb)
+    if gnomonic is None:
+        return False
+    p, q, grid = gnomonic
+    voxels = scan_voxels(occ, frame, grid, nb, max_voxels, TILE_SHIFT)
+    if voxels is None:
+        return False
+    order, bin_starts = bin_order(p, q, grid, nb, TILE_SHIFT)
+    vox, nears, tile_starts, listed = voxels
+    nt = -(-nb >> TILE_SHIFT)
+    lo, hi = occ.bbox_lo.astype(np.float64), occ.bbox_hi.astype(np.float64)
+    test_tiles(
+        vox,
+        nears,
+        tile_starts,
+        listed,
+        nt,
+        tile_stride(nt * nt),
+        bin_starts,
+        order,
+        nb,
+        orig,
+        dirs,
+        lo,
+        hi,
+        nx,
+        ny,
+        kind,
+        index,
+        t,
+    )
+    return True
