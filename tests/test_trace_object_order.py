@@ -238,8 +238,9 @@ def test_directions_that_are_not_unit_go_in_ray_order(forest, numba_backend):
     assert_same(result, numba_backend.trace_cells(occ, origins, 3.0 * directions, order="ray"))
 
 
+@pytest.mark.parametrize("threads", [1, 2, 64])
 @pytest.mark.parametrize("shift, tiles", [(4, 6), (1, 300)])
-def test_tile_lists_keep_the_nearest_first_order(shift, tiles):
+def test_tile_lists_keep_the_nearest_first_order(shift, tiles, threads):
     # 16: the numba tiles (64 runs of voxels); 2: the shader's, many tiles (fewer runs).
     from ladartui.tracing.object_order import voxels_per_tile
 
@@ -250,7 +251,7 @@ def test_tile_lists_keep_the_nearest_first_order(shift, tiles):
     vox[:, 3], vox[:, 5] = low[:, 0], low[:, 1]
     vox[:, 4] = np.minimum(low[:, 0] + rng.integers(-1, 2 * tile, n), tile * tiles - 1)
     vox[:, 6] = np.minimum(low[:, 1] + rng.integers(0, 2 * tile, n), tile * tiles - 1)
-    starts, listed = voxels_per_tile(vox, tiles, shift)
+    starts, listed = voxels_per_tile(vox, tiles, shift, threads)
     expected = [[] for _ in range(tiles * tiles)]
     for e in range(n):
         if vox[e, 3] <= vox[e, 4]:

@@ -79,7 +79,7 @@ def rays_to_cells(origins, directions, voxel_size, tiny):
     n = len(origins)
     cells = np.empty((n, 3))
     unit = np.empty((n, 3))
-    origins, directions = np.ascontiguousarray(origins), np.ascontiguousarray(directions)
+    # Strided views (columns of one (N, 6) array) are read in place: a copy costs as much as the pass.
     if _rays_to_cells(origins, directions, float(voxel_size), float(tiny), cells, unit):
         return cells, unit
     first = _first_bad_ray(origins, directions)
