@@ -37,6 +37,51 @@ def _slab_start(ray, s, x, y, z, best):
     return start if start < leave and start < best else best
 
 
+# Bit numbers of powers of two below 2**32 by a de Bruijn sequence: x * 0x077CB531 puts
+# a distinct 5-bit pattern in the top bits for each power x.
+_DE_BRUIJN_BITS = (
+    0,
+    1,
+    28,
+    2,
+    29,
+    14,
+    24,
+    3,
+    30,
+    22,
+    20,
+    15,
+    25,
+    17,
+    4,
+    8,
+    31,
+    27,
+    13,
+    23,
+    21,
+    19,
+    16,
+    7,
+    26,
+    12,
+    18,
+    6,
+    11,
+    5,
+    10,
+    9,
+)
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _bit_number(power):
+    """n for power = 2**n, n < 32 (a row's live bins: walking the set bits skips the
+    dead ones without a test each, 5 % of the tile tests at nadir)."""
+    return _DE_BRUIJN_BITS[((power * 0x077CB531) & 0xFFFFFFFF) >> 27]
+
+
 @njit(nogil=True, cache=True, inline="always")
 def _load_ray(r, orig, dirs, lo, hi, ray, s):
     """Ray r into tile row s: origin, direction, ``1 / d`` (the kernels' inverse, inf
@@ -147,10 +192,10 @@ def test_tiles(
                 row = live[r] & span
                 if row == 0:
                     continue
-                for c in range(c0, c1 + 1):
-                    if (row >> c) & 1 == 0:
-                        continue
-                    b = r * TILE + c
+                while row != 0:  # the live bins of the span, lowest first
+                    low = row & -row
+                    row ^= low
+                    b = r * TILE + _bit_number(low)
                     alive = False
                     for s in range(starts[b], starts[b + 1]):
                         best = best_t[s]
@@ -163,7 +208,7 @@ def test_tiles(
                                 stale = True
                         alive = alive or best > brick_near
                     if not alive:
-                        live[r] &= ~(np.int64(1) << c)
+                        live[r] &= ~low
         for s in range(m):
             r = order[s0 + s]
             q = best_v[s]
