@@ -1,8 +1,9 @@
 """A ray's answer, shared by both backends: the voxel it hit, else the ground rule.
 
-``ray_answer`` is compiled into the numba exact kernel and written again in
-WGSL (shaders/trace.wgsl, ``ground``); ``scan_answers`` puts object-order hits
-(from numba's tiles or the wgpu backend's shader) back in ray order with it.
+``ray_answer`` is compiled into the numba kernels (the exact kernel and the
+object-order tile tests) and written again in WGSL (shaders/trace.wgsl,
+``ground``); ``scan_answers`` puts the wgpu backend's object-order hits back in
+ray order with it.
 """
 
 import math
@@ -29,8 +30,8 @@ def ray_answer(found, i, j, k, t, ox, oy, oz, dx, dy, dz, nx, ny):
 
 @njit(parallel=True, nogil=True, cache=True)
 def scan_answers(order, best_t, best_v, vox, orig, dirs, nx, ny, kind, index, tout):
-    """Object-order hits (tracing.object_order; numba or the wgpu backend's shader) back
-    in ray order, with the ground rule."""
+    """Object-order hits of the wgpu backend's shader (tracing.object_order) back in ray
+    order, with the ground rule."""
     for s in prange(order.shape[0]):
         r = order[s]
         q = best_v[s]

@@ -29,9 +29,11 @@ occupied box; voxels come brick by brick in order of the bricks' ``near``,
 so once every ray of a tile of bins has a bound no further than the next
 brick's ``near``, nothing later can change that tile.
 
-Which order is faster depends on the scene (``OrderChoice``). All numba
-functions here release the GIL; the passes over rays and voxels run under
-``prange``.
+This module makes a scan ready for those tests: its frame, its rays' bins, and
+its voxels in view listed per tile. numba's tests are in tracing/tile_tests.py,
+the wgpu backend's in shaders/object_order.wgsl; which order is faster depends
+on the scene (tracing/order_choice.py). All numba functions here release the
+GIL; the passes over rays and voxels run under ``prange``.
 """
 
 from __future__ import annotations
