@@ -412,3 +412,26 @@ def test_order_choice_reads_the_given_clock():
             )
         picks[name] = choice.pick()
     assert picks == {"cpu": "object", "wall": "ray"}
+
+
+@pytest.mark.parametrize("order, method", [("object", "exact"), ("ray", "exact"), ("auto", "march")])
+def test_every_ray_gets_an_answer_written(monkeypatch, order, method):
+    # The backend's output arrays start uninitialised: every path must write every
+    # ray. Junk in the new arrays shows up as a difference from a clean run.
+    import types
+
+    import ladartui.tracing.numba_backend as nb_module
+
+    _, occ = forest_scene()
+    origins, directions = one_scan([100, 100, 10], 50.0, 1.0, 300.0)
+    clean = NumbaBackend().trace_cells(occ, origins, directions, order=order, method=method)
+
+    def junk(shape, dtype=float):
+        out = np.empty(shape, dtype)
+        out.view(np.uint8)[...] = 0x5A
+        return out
+
+    monkeypatch.setattr(nb_module, "np", types.SimpleNamespace(**{**vars(np), "empty": junk}))
+    dirty = NumbaBackend().trace_cells(occ, origins, directions, order=order, method=method)
+    assert_same(clean, dirty)
+    assert clean.info["order"] == ("object" if order == "object" else "ray")

@@ -470,9 +470,10 @@ class NumbaBackend:
         n = len(origins)
         orig = np.ascontiguousarray(origins, dtype=np.float64)
         dirs = np.ascontiguousarray(directions, dtype=np.float64)
-        kind = np.zeros(n, np.uint8)
-        index = np.full((n, 3), -1, np.int32)
-        t = np.full(n, np.inf)
+        # Every path below writes every ray's answer (both kernels and the tile tests).
+        kind = np.empty(n, np.uint8)
+        index = np.empty((n, 3), np.int32)
+        t = np.empty(n)
         occ = occupancy
         nx, ny = float(occ.shape[0]), float(occ.shape[1])
         lo, hi = occ.bbox_lo.astype(np.int64), occ.bbox_hi.astype(np.int64)
