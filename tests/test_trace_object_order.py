@@ -435,3 +435,14 @@ def test_every_ray_gets_an_answer_written(monkeypatch, order, method):
     dirty = NumbaBackend().trace_cells(occ, origins, directions, order=order, method=method)
     assert_same(clean, dirty)
     assert clean.info["order"] == ("object" if order == "object" else "ray")
+
+
+@pytest.mark.parametrize(
+    "nb, shift",
+    [(512, 6), (256, 6), (128, 5), (64, 4), (400, 4), (401, 6), (96, 4), (24, 2), (3, 2)],
+)
+def test_tiles_are_as_big_as_divide_the_bins_into_at_least_four_a_side(nb, shift):
+    # 64 x 64 at most (a row is one int64 mask); dividing nb keeps the parallel scatter.
+    from ladartui.tracing.tile_tests import tile_shift_for
+
+    assert tile_shift_for(nb) == shift

@@ -53,7 +53,6 @@ from ladartui.tracing.config import (
     MIN_COS,
     NEAR_MARGIN,
     PARTS,
-    TILE_SHIFT,
 )
 
 
@@ -602,7 +601,7 @@ def scan_voxels(occ, frame, grid, nb, max_voxels, tile_shift):
     return vox, nears, tile_starts, listed
 
 
-def prepare_scan(occ, orig, dirs, frame, max_voxels, tile_shift=TILE_SHIFT):
+def prepare_scan(occ, orig, dirs, frame, max_voxels, tile_shift):
     """A scan's rays binned and copied in bin order (``sort_rays``), and its voxels in
     view listed per tile of ``1 << tile_shift`` bins a side (``scan_voxels``); None
     when it cannot be projected or has too many voxels in view (ray order is then the

@@ -18,10 +18,8 @@ from numba import njit, prange
 
 from ladartui.tracing.answers import ray_answer
 from ladartui.tracing.axis import slab
-from ladartui.tracing.config import INF, TILE_SHIFT
+from ladartui.tracing.config import INF, MAX_TILE_SHIFT
 from ladartui.tracing.object_order import bin_order, ray_grid, scan_voxels
-
-TILE = 1 << TILE_SHIFT
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -37,49 +35,50 @@ def _slab_start(ray, s, x, y, z, best):
     return start if start < leave and start < best else best
 
 
-# Bit numbers of powers of two below 2**32 by a de Bruijn sequence: x * 0x077CB531 puts
-# a distinct 5-bit pattern in the top bits for each power x.
+# Bit numbers of powers of two by a de Bruijn sequence: x * _DE_BRUIJN (mod 2**64)
+# puts a distinct 6-bit pattern in the top bits for each power x.
+_DE_BRUIJN = 0x03F79D71B4CB0A89
 _DE_BRUIJN_BITS = (
-    0,
-    1,
-    28,
-    2,
-    29,
-    14,
-    24,
-    3,
-    30,
-    22,
-    20,
-    15,
-    25,
-    17,
-    4,
-    8,
-    31,
-    27,
-    13,
-    23,
-    21,
-    19,
-    16,
-    7,
-    26,
-    12,
-    18,
-    6,
-    11,
-    5,
-    10,
-    9,
+    (
+        0,
+        1,
+        48,
+        2,
+        57,
+        49,
+        28,
+        3,
+        61,
+        58,
+        50,
+        42,
+        38,
+        29,
+        17,
+        4,
+        62,
+        55,
+        59,
+        36,
+        53,
+        51,
+        43,
+        22,
+        45,
+        39,
+        33,
+        30,
+    )
+    + (24, 18, 12, 5, 63, 47, 56, 27, 60, 41, 37, 16, 54, 35, 52, 21, 44, 32, 23, 11, 46, 26, 40, 15, 34, 20)
+    + (31, 10, 25, 14, 19, 9, 13, 8, 7, 6)
 )
 
 
 @njit(nogil=True, cache=True, inline="always")
 def _bit_number(power):
-    """n for power = 2**n, n < 32 (a row's live bins: walking the set bits skips the
-    dead ones without a test each, 5 % of the tile tests at nadir)."""
-    return _DE_BRUIJN_BITS[((power * 0x077CB531) & 0xFFFFFFFF) >> 27]
+    """n for power = 2**n, n < 64 (a row's live bins: walking the set bits skips the
+    dead ones without a test each)."""
+    return _DE_BRUIJN_BITS[(np.uint64(power) * np.uint64(_DE_BRUIJN)) >> np.uint64(58)]
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -93,6 +92,17 @@ def _load_ray(r, orig, dirs, lo, hi, ray, s):
         ray[s, a], ray[s, 3 + a], ray[s, 6 + a] = o, d, inv
         leave = min(leave, slab(o, d, inv, lo[a], hi[a])[1])
     return leave
+
+
+def tile_shift_for(nb):
+    """Tiles of ``1 << shift`` bins a side for an nb x nb grid of bins: the largest up
+    to MAX_TILE_SHIFT that divides nb (a whole scan's rays then go to their bins by
+    the parallel scatter) and leaves at least 4 x 4 tiles for the threads; else
+    about a quarter of nb (the counting sort places the rays)."""
+    for shift in range(MAX_TILE_SHIFT, 1, -1):
+        if nb % (1 << shift) == 0 and nb >> shift >= 4:
+            return shift
+    return max(2, min(MAX_TILE_SHIFT, (nb // 4).bit_length() - 1))
 
 
 def tile_stride(tiles):
@@ -113,6 +123,7 @@ def test_tiles(
     tile_starts,
     listed,
     nt,
+    shift,
     stride,
     bin_starts,
     order,
@@ -127,7 +138,7 @@ def test_tiles(
     index,
     tout,
 ):
-    """Nearest hit of each ray among the voxels of its tile (tiles of TILE bins), and
+    """Nearest hit of each ray among the voxels of its tile (tiles of ``1 << shift`` bins a side), and
     its answer (``ray_answer``) into kind/index/tout at the ray's own place.
 
     Sorted position s is ray ``order[s]``; bin key b holds positions
@@ -143,25 +154,26 @@ def test_tiles(
     same tests ray by ray.
     """
     tiles = nt * nt
+    tile_side = 1 << shift
     single = bin_starts.shape[0] == 0
     for step in prange(tiles):
         tile = (step * stride) % tiles
-        bi0 = (tile % nt) * TILE
-        bi1 = min(nb, bi0 + TILE) - 1
-        bj0 = (tile // nt) * TILE
-        bj1 = min(nb, bj0 + TILE) - 1
-        base = tile * TILE * TILE  # bin_key of the tile's first bin; rows of TILE follow
+        bi0 = (tile % nt) * tile_side
+        bi1 = min(nb, bi0 + tile_side) - 1
+        bj0 = (tile // nt) * tile_side
+        bj1 = min(nb, bj0 + tile_side) - 1
+        base = tile * tile_side * tile_side  # bin_key of the tile's first bin; rows of tile_side follow
         s0 = base if single else bin_starts[base]
-        m = TILE * TILE if single else bin_starts[base + TILE * TILE] - s0
+        m = tile_side * tile_side if single else bin_starts[base + tile_side * tile_side] - s0
         if m == 0:
             continue
-        starts = np.empty(TILE * TILE + 1, np.int64)  # bin b of the tile: tile rays starts[b] ..
-        for b in range(TILE * TILE + 1):
+        starts = np.empty(tile_side * tile_side + 1, np.int64)  # bin b of the tile: tile rays starts[b] ..
+        for b in range(tile_side * tile_side + 1):
             starts[b] = b if single else bin_starts[base + b] - s0
-        live = np.zeros(TILE, np.int64)  # per row: bit c set while bin (bi0 + c) may still change
+        live = np.zeros(tile_side, np.int64)  # per row: bit c set while bin (bi0 + c) may still change
         for r in range(bj1 - bj0 + 1):
             for c in range(bi1 - bi0 + 1):
-                if starts[r * TILE + c + 1] > starts[r * TILE + c]:
+                if starts[r * tile_side + c + 1] > starts[r * tile_side + c]:
                     live[r] |= np.int64(1) << c
         ray = np.empty((m, 9))
         best_t = np.empty(m)
@@ -195,7 +207,7 @@ def test_tiles(
                 while row != 0:  # the live bins of the span, lowest first
                     low = row & -row
                     row ^= low
-                    b = r * TILE + _bit_number(low)
+                    b = r * tile_side + _bit_number(low)
                     alive = False
                     for s in range(starts[b], starts[b + 1]):
                         best = best_t[s]
@@ -239,12 +251,13 @@ def trace_scan(occ, orig, dirs, frame, max_voxels, nx, ny, kind, index, t):
     if gnomonic is None:
         return False
     p, q, grid = gnomonic
-    voxels = scan_voxels(occ, frame, grid, nb, max_voxels, TILE_SHIFT)
+    shift = tile_shift_for(nb)
+    voxels = scan_voxels(occ, frame, grid, nb, max_voxels, shift)
     if voxels is None:
         return False
-    order, bin_starts = bin_order(p, q, grid, nb, TILE_SHIFT)
+    order, bin_starts = bin_order(p, q, grid, nb, shift)
     vox, nears, tile_starts, listed = voxels
-    nt = -(-nb >> TILE_SHIFT)
+    nt = -(-nb >> shift)
     lo, hi = occ.bbox_lo.astype(np.float64), occ.bbox_hi.astype(np.float64)
     test_tiles(
         vox,
@@ -252,6 +265,7 @@ def trace_scan(occ, orig, dirs, frame, max_voxels, nx, ny, kind, index, t):
         tile_starts,
         listed,
         nt,
+        shift,
         tile_stride(nt * nt),
         bin_starts,
         order,
