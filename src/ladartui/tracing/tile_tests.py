@@ -145,13 +145,13 @@ def test_tiles(
     ``bin_starts[b] .. bin_starts[b + 1]``, or position b alone when ``bin_starts``
     is empty (one ray per bin, whole tiles). A tile's rays start with their exit
     from the occupied box [lo, hi) as bound, a bound no hit reaches (a voxel's
-    interval ends inside the box), and no voxel. A tile stops when no later brick
-    can come nearer than every ray's bound. Per row of the tile a mask of live
-    bins: a bin whose every ray has a bound at or before the current brick's
-    ``near`` is cleared when next met, since no later brick (nears only grow down
-    the list) can come nearer; its rays are then never read again (most candidates
-    of a scan are such rays, behind their hit). shaders/object_order.wgsl runs the
-    same tests ray by ray.
+    interval ends inside the box), and no voxel. A tile stops when no later voxel
+    can come nearer than every ray's bound (a voxel's ``near`` is below every
+    entry into it). Per row of the tile a mask of live bins: a bin is cleared when
+    met with every one of its rays bound at or before the least ``near`` of the
+    voxels after this one, which then cannot change it; its rays are never read
+    again (most candidates of a scan are such rays, behind their hit).
+    shaders/object_order.wgsl runs the same tests ray by ray.
     """
     tiles = nt * nt
     tile_side = 1 << shift
@@ -182,32 +182,49 @@ def test_tiles(
         for s in range(m):
             best_t[s] = _load_ray(order[s0 + s], orig, dirs, lo, hi, ray, s)
             far = max(far, best_t[s])
+        # rest[k]: the least near of the tile's entries from k on. No later voxel can
+        # bring a ray nearer than that, so a ray whose bound is there is done.
+        e0, e1 = tile_starts[tile], tile_starts[tile + 1]
+        rest = np.empty(e1 - e0 + 1)
+        rest[e1 - e0] = INF
+        for e in range(e1 - 1, e0 - 1, -1):
+            rest[e - e0] = min(nears[listed[e], 0], rest[e - e0 + 1])
         stale = False  # far may be lowered (bounds moved nearer since it was taken)
-        for e in range(tile_starts[tile], tile_starts[tile + 1]):
-            q = listed[e]
-            brick_near = nears[q, 1]
-            if brick_near >= far:
+        for e in range(e0, e1):
+            if rest[e - e0] >= far:
                 if stale:
                     far = 0.0
                     for s in range(m):
                         far = max(far, best_t[s])
                     stale = False
-                if brick_near >= far:
+                if rest[e - e0] >= far:
                     break
+            q = listed[e]
             near = nears[q, 0]
             if near >= far:
                 continue
+            after = rest[e - e0 + 1]
             x, y, z = np.float64(vox[q, 0]), np.float64(vox[q, 1]), np.float64(vox[q, 2])
             c0, c1 = max(vox[q, 3], bi0) - bi0, min(vox[q, 4], bi1) - bi0
             span = ((np.int64(2) << c1) - 1) ^ ((np.int64(1) << c0) - 1)
             for r in range(max(vox[q, 5], bj0) - bj0, min(vox[q, 6], bj1) - bj0 + 1):
                 row = live[r] & span
-                if row == 0:
-                    continue
                 while row != 0:  # the live bins of the span, lowest first
                     low = row & -row
                     row ^= low
                     b = r * tile_side + _bit_number(low)
+                    if single:  # bin b holds tile ray b alone
+                        best = best_t[b]
+                        if best > near:
+                            start = _slab_start(ray, b, x, y, z, best)
+                            if start < best:
+                                best_t[b] = start
+                                best_v[b] = q
+                                best = start
+                                stale = True
+                        if not best > after:
+                            live[r] &= ~low
+                        continue
                     alive = False
                     for s in range(starts[b], starts[b + 1]):
                         best = best_t[s]
@@ -218,7 +235,7 @@ def test_tiles(
                                 best_v[s] = q
                                 best = start
                                 stale = True
-                        alive = alive or best > brick_near
+                        alive = alive or best > after
                     if not alive:
                         live[r] &= ~low
         for s in range(m):
