@@ -5,6 +5,8 @@ import pytest
 
 from ladartui.errors import FieldError
 from ladartui.tracing import TINY
+from ladartui.tracing.config import SCAN_BLOCK
+from ladartui.tracing.object_order import ray_bounds
 from ladartui.tracing.prepare import rays_to_cells
 
 
@@ -13,12 +15,27 @@ def test_cells_and_unit_directions_match_numpy_bit_for_bit():
     origins = rng.uniform(-1e4, 1e4, (5000, 3))
     directions = rng.normal(size=(5000, 3)) * rng.uniform(1e-3, 1e3, (5000, 1))
     directions[:10, 0] = 1e-250  # below TINY once normalised: becomes exactly 0
-    cells, unit = rays_to_cells(origins, directions, 0.1, TINY)
+    cells, unit, _ = rays_to_cells(origins, directions, 0.1, TINY)
     expected_unit = directions / np.linalg.norm(directions, axis=1)[:, None]
     expected_unit[np.abs(expected_unit) < TINY] = 0.0
     assert np.array_equal(cells, origins / 0.1 + 0.5)
     assert np.array_equal(unit, expected_unit)
     assert np.all(unit[:10, 0] == 0.0)
+
+
+@pytest.mark.parametrize("n", [1, 63, 5000, 2 * SCAN_BLOCK + 777])
+def test_block_bounds_are_the_scan_frames_bounds_bit_for_bit(n):
+    # What a scan's frame would compute in a pass of its own, per block of SCAN_BLOCK rays.
+    rng = np.random.default_rng(n)
+    origins = rng.uniform(-50.0, 50.0, (n, 3))
+    directions = rng.normal(size=(n, 3))
+    cells, unit, bounds = rays_to_cells(origins, directions, 0.25, TINY)
+    assert bounds.shape == (-(-n // SCAN_BLOCK), 9)
+    for b, row in enumerate(bounds):
+        block = slice(b * SCAN_BLOCK, (b + 1) * SCAN_BLOCK)
+        lo, hi, total = ray_bounds(cells[block], unit[block])
+        assert np.array_equal(row, np.concatenate([lo, hi, total]))
+    assert np.array_equal(bounds[0, :3], cells[:SCAN_BLOCK].min(axis=0))
 
 
 def _bad_ray(origins, directions, voxel_size=1.0):
@@ -58,9 +75,9 @@ def test_huge_and_tiny_directions_keep_their_direction():
     # give the unit vector of the same direction (here bit for bit).
     plain = np.array([[1.0, 1.0, -1.0], [3.0, 0.0, -4.0]])
     for factor in (1e160, 1e300, 1e-170, 1e-300):
-        _, unit = rays_to_cells(np.zeros((2, 3)), plain * factor, 1.0, TINY)
+        _, unit, _ = rays_to_cells(np.zeros((2, 3)), plain * factor, 1.0, TINY)
         assert np.array_equal(unit, plain / np.linalg.norm(plain, axis=1)[:, None]), factor
-    _, unit = rays_to_cells(np.zeros((1, 3)), np.array([[0.0, 0.0, -5e-324]]), 1.0, TINY)
+    _, unit, _ = rays_to_cells(np.zeros((1, 3)), np.array([[0.0, 0.0, -5e-324]]), 1.0, TINY)
     assert unit.tolist() == [[0.0, 0.0, -1.0]]  # the smallest float is still a direction
 
 

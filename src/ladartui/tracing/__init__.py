@@ -123,10 +123,17 @@ def trace(
     # moves a ray by nothing measurable), origins in cell space.
     from ladartui.tracing.prepare import rays_to_cells  # numba: loaded on first trace
 
-    origin_cells, unit = rays_to_cells(origins, directions, voxel_size, TINY)
+    origin_cells, unit, block_bounds = rays_to_cells(origins, directions, voxel_size, TINY)
     started = time.perf_counter()
     cells = engine.trace_cells(
-        occupancy, origin_cells, unit, method=method, step=float(step), precision=precision, cancel=cancel
+        occupancy,
+        origin_cells,
+        unit,
+        method=method,
+        step=float(step),
+        precision=precision,
+        cancel=cancel,
+        block_bounds=block_bounds,
     )
     info = dict(cells.info)
     info["seconds_total"] = time.perf_counter() - started

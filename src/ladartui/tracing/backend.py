@@ -66,8 +66,13 @@ class Backend(Protocol):
         precision="f64",
         cancel: threading.Event | None = None,
         order: TraceOrder = "auto",
+        block_bounds=None,
     ) -> CellHits:
-        """Trace (N, 3) float64 cell-space origins and unit directions (``order``: ORDERS)."""
+        """Trace (N, 3) float64 cell-space origins and unit directions (``order``: ORDERS).
+
+        ``block_bounds``, when given, is ``prepare.rays_to_cells``'s third answer for these
+        rays: per block of SCAN_BLOCK rays the origins' least and greatest cells and the
+        directions' sum, which a scan's frame is made of (object order)."""
 
 
 _FACTORIES: dict[str, Callable[[], Backend]] = {}

@@ -24,7 +24,7 @@ from ladartui.tracing.answers import ray_answer
 from ladartui.tracing.axis import boundary_t, cell_at, clamp, slab
 from ladartui.tracing.backend import GROUND, MISS, VOXEL, CellHits, TraceOrder, check_order, register_backend
 from ladartui.tracing.bundle import bundle_start, halo_arrays
-from ladartui.tracing.config import BLOCK, BUNDLE, INF
+from ladartui.tracing.config import BLOCK, BUNDLE, INF, SCAN_BLOCK
 from ladartui.tracing.object_order import cone_frame
 from ladartui.tracing.order_choice import OrderChoice, trace_in_blocks
 from ladartui.tracing.tile_tests import trace_scan
@@ -463,6 +463,7 @@ class NumbaBackend:
         cancel: threading.Event | None = None,
         bundles: bool = True,
         order: TraceOrder = "auto",
+        block_bounds=None,
     ) -> CellHits:
         """See ``Backend`` (``order`` there). For tests: ``bundles=False`` starts every
         ray at its box entry."""
@@ -533,8 +534,9 @@ class NumbaBackend:
                     )
 
         def object_order_block(a, b, max_voxels):
+            bounds = None if block_bounds is None else block_bounds[a // SCAN_BLOCK]
             return self._object_order(
-                occ, orig[a:b], dirs[a:b], max_voxels, nx, ny, kind[a:b], index[a:b], t[a:b]
+                occ, orig[a:b], dirs[a:b], bounds, max_voxels, nx, ny, kind[a:b], index[a:b], t[a:b]
             )
 
         if method == "exact" and order != "ray" and occ.count > 0:
@@ -560,9 +562,9 @@ class NumbaBackend:
         return CellHits(kind, index, t, info)
 
     @staticmethod
-    def _object_order(occ, orig, dirs, max_voxels, nx, ny, kind, index, t):
+    def _object_order(occ, orig, dirs, bounds, max_voxels, nx, ny, kind, index, t):
         """Trace one scan in object order into kind/index/t; False when it is no scan for it."""
-        frame = cone_frame(orig, dirs)
+        frame = cone_frame(orig, dirs, bounds)
         return frame is not None and trace_scan(occ, orig, dirs, frame, max_voxels, nx, ny, kind, index, t)
 
 

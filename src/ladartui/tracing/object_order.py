@@ -79,16 +79,17 @@ def ray_bounds(orig, dirs):
     return lo, hi, total
 
 
-def cone_frame(orig, dirs):
+def cone_frame(orig, dirs, bounds=None):
     """(centre, half_spread, axis, u, v) of a batch of rays, or None when it is no scan.
 
     A scan here: origins within ``MAX_SPREAD`` cells of their centre on every
     axis (``ray_grid`` then checks every direction is within 60 degrees of
-    the mean direction).
+    the mean direction). ``bounds``: the batch's ``ray_bounds`` as nine numbers,
+    when known (prepare.rays_to_cells finds them).
     """
     if len(orig) == 0:
         return None
-    lo, hi, total = ray_bounds(orig, dirs)
+    lo, hi, total = ray_bounds(orig, dirs) if bounds is None else (bounds[:3], bounds[3:6], bounds[6:9])
     half = 0.5 * (hi - lo)
     norm = float(np.linalg.norm(total))
     if not (np.all(half <= MAX_SPREAD) and norm > 0.0):

@@ -12,7 +12,7 @@ import numpy as np
 from numba import prange
 
 from ladartui.errors import FieldError
-from ladartui.tracing.config import PARTS
+from ladartui.tracing.config import INF, PARTS, SCAN_BLOCK
 
 # Outside (NORM_LOW, inf) the squares under- or overflow: such directions are
 # scaled by their largest component first (1e160 along x is still along x).
@@ -51,40 +51,66 @@ def _first_bad_ray(origins, directions):
 
 
 @numba.njit(parallel=True, nogil=True, cache=True)
-def _rays_to_cells(origins, directions, voxel_size, tiny, cells, unit):
+def _rays_to_cells(origins, directions, voxel_size, tiny, block, cells, unit, bounds):
     """cells = o / voxel_size + 0.5; unit = d / sqrt(dx*dx + dy*dy + dz*dz), |u| < tiny -> 0
     (d scaled first where its squares would under- or overflow). True when no ray is
-    bad (a non-finite value or a zero-length direction)."""
+    bad (a non-finite value or a zero-length direction).
+
+    ``bounds[b]`` gets the least and greatest cell of the origins and the sum of the
+    unit directions of rays ``b * block ..`` (``object_order.ray_bounds``, summed in
+    the same runs), so a scan's frame costs no pass of its own."""
     n = origins.shape[0]
-    bad = np.zeros(PARTS, np.bool_)
-    for k in prange(PARTS):
-        for i in range(k * n // PARTS, (k + 1) * n // PARTS):
+    items = bounds.shape[0] * PARTS
+    bad = np.zeros(items, np.bool_)
+    part = np.empty((items, 9))
+    for item in prange(items):
+        first = item // PARTS * block
+        m = min(n, first + block) - first
+        k = item % PARTS
+        lo = np.full(3, INF)
+        hi = np.full(3, -INF)
+        total = np.zeros(3)
+        for i in range(first + k * m // PARTS, first + (k + 1) * m // PARTS):
             d = _scaled(directions[i, 0], directions[i, 1], directions[i, 2])
             if not d[3] > 0:
-                bad[k] = True
+                bad[item] = True
             for a in range(3):
                 if not (np.isfinite(origins[i, a]) and np.isfinite(directions[i, a])):
-                    bad[k] = True
-                cells[i, a] = origins[i, a] / voxel_size + 0.5
+                    bad[item] = True
+                c = origins[i, a] / voxel_size + 0.5
                 u = d[a] / d[3]
-                unit[i, a] = 0.0 if abs(u) < tiny else u
+                u = 0.0 if abs(u) < tiny else u
+                cells[i, a], unit[i, a] = c, u
+                lo[a], hi[a] = min(lo[a], c), max(hi[a], c)
+                total[a] += u
+        part[item, :3], part[item, 3:6], part[item, 6:] = lo, hi, total
+    for b in range(bounds.shape[0]):
+        bounds[b] = part[b * PARTS]
+        for k in range(1, PARTS):
+            for a in range(3):
+                bounds[b, a] = min(bounds[b, a], part[b * PARTS + k, a])
+                bounds[b, 3 + a] = max(bounds[b, 3 + a], part[b * PARTS + k, 3 + a])
+                bounds[b, 6 + a] += part[b * PARTS + k, 6 + a]
     return not bad.any()
 
 
 def rays_to_cells(origins, directions, voxel_size, tiny):
-    """(cells, unit) for (N, 3) float64 arrays; FieldError naming the first bad ray:
-    ``origins[i]`` or ``directions[i]`` with a non-finite value, ``directions[i]``
-    of zero length.
+    """(cells, unit, bounds) for (N, 3) float64 arrays; FieldError naming the first bad
+    ray: ``origins[i]`` or ``directions[i]`` with a non-finite value,
+    ``directions[i]`` of zero length. ``bounds`` is (blocks, 9): per SCAN_BLOCK rays,
+    the origins' least and greatest cells and the directions' sum (the backends'
+    ``block_bounds``).
     """
     n = len(origins)
     cells = np.empty((n, 3))
     unit = np.empty((n, 3))
+    bounds = np.empty((-(-n // SCAN_BLOCK), 9))
     # Strided views (columns of one (N, 6) array) are read in place: a copy costs as much as the pass.
-    if _rays_to_cells(origins, directions, float(voxel_size), float(tiny), cells, unit):
-        return cells, unit
+    if _rays_to_cells(origins, directions, float(voxel_size), float(tiny), SCAN_BLOCK, cells, unit, bounds):
+        return cells, unit, bounds
     first = _first_bad_ray(origins, directions)
     if first == n:
-        return cells, unit
+        return cells, unit, bounds
     if first < 0:
         raise FieldError(f"origins[{-1 - first}]", origins[-1 - first].tolist(), "finite numbers")
     if first < n:

@@ -75,6 +75,7 @@ from ladartui.tracing.config import (
     METHOD_CODES,
     OBJECT_ORDER_TILE_SHIFT,
     RAY_BATCH,
+    SCAN_BLOCK,
     SHADER_INF,
     UNFINISHED,
     wgsl_constants,
@@ -528,6 +529,7 @@ class WgpuBackend:
         precision="f64",
         cancel: threading.Event | None = None,
         order: TraceOrder = "auto",
+        block_bounds=None,
     ) -> CellHits:
         """Trace (N, 3) float64 cell-space rays on the adapter; see ``Backend``
         (``order`` there: only exact f64 scans can go in object order)."""
@@ -550,11 +552,11 @@ class WgpuBackend:
             if used != precision:
                 info["precision_note"] = "the adapter has no shader-f64: traced in f32"
             if method == "exact" and used == "f64" and order != "ray" and occupancy.count > 0:
-                return self._trace_scans(occupancy, origins, directions, order, cancel, info)
+                return self._trace_scans(occupancy, origins, directions, order, cancel, info, block_bounds)
             info["order"] = "ray"
             return self._trace(occupancy, origins, directions, method, step, used, cancel, info)
 
-    def _trace_scans(self, occupancy, origins, directions, order, cancel, info):
+    def _trace_scans(self, occupancy, origins, directions, order, cancel, info, block_bounds):
         """Exact f64 in blocks, each in object or ray order (``trace_in_blocks``)."""
         n = len(origins)
         kind = np.zeros(n, dtype=np.uint8)
@@ -566,8 +568,9 @@ class WgpuBackend:
             kind[a:b], index[a:b], t[a:b] = hits.kind, hits.index, hits.t
 
         def object_order_block(a, b, max_voxels):
+            bounds = None if block_bounds is None else block_bounds[a // SCAN_BLOCK]
             return self._object_order(
-                occupancy, origins[a:b], directions[a:b], max_voxels, kind[a:b], index[a:b], t[a:b]
+                occupancy, origins[a:b], directions[a:b], bounds, max_voxels, kind[a:b], index[a:b], t[a:b]
             )
 
         orders = trace_in_blocks(
@@ -581,12 +584,12 @@ class WgpuBackend:
         info["order"] = "+".join(sorted(orders)) or "ray"
         return CellHits(kind, index, t, info)
 
-    def _object_order(self, occupancy, origins, directions, max_voxels, kind, index, t):
+    def _object_order(self, occupancy, origins, directions, bounds, max_voxels, kind, index, t):
         """One scan in object order into kind/index/t; False when it is no scan for it
         (or its lists or arrays exceed what the adapter allows)."""
         if max(occupancy.shape) >= F32_EXACT:
             return False  # voxel coordinates go to the shader as float32
-        frame = cone_frame(origins, directions)
+        frame = cone_frame(origins, directions, bounds)
         scan = (
             None
             if frame is None
