@@ -89,25 +89,53 @@ def cone_frame(orig, dirs, bounds=None):
     """
     if len(orig) == 0:
         return None
-    lo, hi, total = ray_bounds(orig, dirs) if bounds is None else (bounds[:3], bounds[3:6], bounds[6:9])
-    half = 0.5 * (hi - lo)
-    norm = float(np.linalg.norm(total))
-    if not (np.all(half <= MAX_SPREAD) and norm > 0.0):
+    if bounds is None:
+        lo, hi, total = ray_bounds(orig, dirs)
+        bounds = np.concatenate((lo, hi, total))
+    frame = np.empty((5, 3))
+    if not _frame(np.asarray(bounds, np.float64), dirs[0], dirs[min(1, len(dirs) - 1)], frame):
         return None
+    return frame[0], frame[1], frame[2], frame[3], frame[4]
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@njit(nogil=True, cache=True)
+def _frame(bounds, first, second, frame):
+    """cone_frame's rows (centre, half spread, axis, u, v) from the nine numbers of
+    ``ray_bounds`` and the first two directions; False when it is no scan. (Compiled:
+    as numpy calls on 3-vectors it cost 0.2 ms, a fiftieth of a scan.)"""
+    lo, hi, total = bounds[0:3], bounds[3:6], bounds[6:9]
+    half = 0.5 * (hi - lo)
+    norm = math.sqrt(total[0] ** 2 + total[1] ** 2 + total[2] ** 2)
+    if not (half.max() <= MAX_SPREAD and norm > 0.0):
+        return False
     axis = total / norm
     # u along the first row of rays when there is one (bins then follow the sensor's grid).
-    side = dirs[min(1, len(dirs) - 1)] - dirs[0]
-    side = side - axis * (side @ axis)
-    if np.linalg.norm(side) < 1e-12:
+    side = second - first
+    side = side - axis * _dot(side, axis)
+    if math.sqrt(_dot(side, side)) < 1e-12:
         side = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-        side = side - axis * (side @ axis)
-    u = side / np.linalg.norm(side)
-    v = np.cross(axis, u)
+        side = side - axis * _dot(side, axis)
+    u = side / math.sqrt(_dot(side, side))
+    v = np.array(
+        [axis[1] * u[2] - axis[2] * u[1], axis[2] * u[0] - axis[0] * u[2], axis[0] * u[1] - axis[1] * u[0]]
+    )
     # Grown cubes use the spread, widened by a hair and by a few units in the last place
     # of the coordinates (far from the origin the centre itself is rounded).
-    centre = 0.5 * (lo + hi)
-    slack = 1e-12 + 8.0 * float(np.spacing(np.abs(np.concatenate((lo, hi))).max()))
-    return centre, half * (1.0 + 1e-9) + slack, axis, u, v
+    largest = max(np.abs(lo).max(), np.abs(hi).max())
+    slack = 1e-12 + 8.0 * (np.nextafter(largest, INF) - largest)
+    frame[0], frame[1], frame[2], frame[3], frame[4] = (
+        0.5 * (lo + hi),
+        half * (1.0 + 1e-9) + slack,
+        axis,
+        u,
+        v,
+    )
+    return True
 
 
 @njit(parallel=True, nogil=True, cache=True)
