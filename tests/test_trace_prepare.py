@@ -13,6 +13,8 @@ from ladartui.tracing.prepare import rays_to_cells
 def test_cells_and_unit_directions_match_numpy_bit_for_bit():
     rng = np.random.default_rng(7)
     origins = rng.uniform(-1e4, 1e4, (5000, 3))
+    origins[2000:] = np.repeat(origins[2000:2600], 5, axis=0)  # runs of one origin reuse its cell
+    origins[4000:4002] = [[0.0, -0.0, 1.0], [-0.0, 0.0, 1.0]]
     directions = rng.normal(size=(5000, 3)) * rng.uniform(1e-3, 1e3, (5000, 1))
     directions[:10, 0] = 1e-250  # below TINY once normalised: becomes exactly 0
     cells, unit, _ = rays_to_cells(origins, directions, 0.1, TINY)
