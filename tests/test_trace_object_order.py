@@ -455,7 +455,9 @@ def test_a_scan_where_every_ray_hits_stops_tiles_early_and_still_matches(numba_b
     roof = np.stack(np.meshgrid(np.arange(96), np.arange(96), [40], indexing="ij"), -1).reshape(-1, 3)
     cover = rng.integers([0, 0, 0], [96, 96, 40], (60000, 3))
     occ = Occupancy.build(np.concatenate([roof, cover]), (96, 96, 60))
-    origins, directions = one_scan([48, 48, 40], 70.0, 0.3, 400.0, sensor=Sensor(grid=64, ray_grid=4, fov=4.0))
+    origins, directions = one_scan(
+        [48, 48, 40], 70.0, 0.3, 400.0, sensor=Sensor(grid=64, ray_grid=4, fov=4.0)
+    )
     ray, obj = both_orders(numba_backend, occ, origins, directions)
     assert obj.info["order"] == "object"
     assert (obj.kind == VOXEL).all() and (obj.index[:, 2] == 40).mean() > 0.99
