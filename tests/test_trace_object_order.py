@@ -296,7 +296,9 @@ def test_a_whole_scan_sorts_by_scatter_as_the_counting_sort_does(duplicate):
     p, q, grid = oo.ray_grid(directions, axis, u, v, nb)
     lo, hi = np.zeros(3), np.full(3, 200.0)
     order = np.empty(nb * nb, np.int64)
-    assert oo._scatter_one_per_bin(p, q, grid, nb, 4, order, np.empty(nb * nb, np.uint32)) == (not duplicate)
+    assert oo._scatter_one_per_bin(p, q, grid, nb, 4, order, np.empty(nb * nb, np.uint32), np.empty(2)) == (
+        not duplicate
+    )
     got = oo.sort_rays(p, q, grid, nb, 4, origins, directions, lo, hi)
     starts, order, bins = oo._sort_into_bins(p, q, grid, nb, 4)
     rays, invs, exits = np.empty((nb * nb, 6)), np.empty((nb * nb, 3)), np.empty(nb * nb)
@@ -321,8 +323,13 @@ def test_a_scan_traced_by_bin_order_matches_ray_order(duplicate, numba_backend):
     frame = cone_frame(origins, directions)
     nb = int(math.ceil(math.sqrt(len(origins))))
     p, q, grid = oo.ray_grid(directions, frame[2], frame[3], frame[4], nb)
-    order, starts = oo.bin_order(p, q, grid, nb, 4)
+    order, starts, measured = oo.bin_order(p, q, grid, nb, 4)
     assert (len(starts) == 0) == (not duplicate)
+    # Every ray within the measured slack of its bin's middle; a sensor's grid is nearly even.
+    i, j = np.floor((p - grid[0]) / grid[1]), np.floor((q - grid[2]) / grid[3])
+    assert np.abs((p - grid[0]) / grid[1] - i - 0.5).max() <= measured[4]
+    assert np.abs((q - grid[2]) / grid[3] - j - 0.5).max() <= measured[5]
+    assert measured[4:].max() < (0.1 if not duplicate else 0.6)
     assert np.array_equal(np.sort(order), np.arange(len(origins)))
     ray, obj = both_orders(numba_backend, occ, origins, directions)
     assert obj.info["order"] == "object"
@@ -352,7 +359,7 @@ def test_voxels_of_a_brick_come_front_first(axis):
         a,
         u,
         v,
-        np.array([-1.0, 0.5, -1.0, 0.5]),
+        np.array([-1.0, 0.5, -1.0, 0.5, 0.5, 0.5]),
         4,
         occ.root,
         occ.regions,
@@ -363,7 +370,17 @@ def test_voxels_of_a_brick_come_front_first(axis):
     assert ok and len(found) == 1
     first = oo.voxel_starts(found, occ.bricks)
     vox, _ = oo.emit_voxels(
-        found, near, first, occ.bricks, centre, np.zeros(3), a, u, v, np.array([-1.0, 0.5, -1.0, 0.5]), 4
+        found,
+        near,
+        first,
+        occ.bricks,
+        centre,
+        np.zeros(3),
+        a,
+        u,
+        v,
+        np.array([-1.0, 0.5, -1.0, 0.5, 0.5, 0.5]),
+        4,
     )
     assert sorted(map(tuple, vox[:, :3].tolist())) == sorted(map(tuple, voxels.tolist()))
     ahead = vox[:, :3] * np.where(a < 0, -1, 1)  # coordinates in the order the axis meets them

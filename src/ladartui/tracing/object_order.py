@@ -114,8 +114,10 @@ def _frame(bounds, first, second, frame):
     if not (half.max() <= MAX_SPREAD and norm > 0.0):
         return False
     axis = total / norm
-    # u along the first row of rays when there is one (bins then follow the sensor's grid).
-    side = second - first
+    # u along the first row of rays when there is one (bins then follow the sensor's grid):
+    # the step between their points on the plane one unit along the axis, which a
+    # row of a pinhole grid keeps to exactly (their own difference leans off it).
+    side = second / _dot(second, axis) - first / _dot(first, axis)
     side = side - axis * _dot(side, axis)
     if math.sqrt(_dot(side, side)) < 1e-12:
         side = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
@@ -238,22 +240,28 @@ def _gather(order, orig, dirs, lo, hi, rays, invs, exits):
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def _scatter_one_per_bin(p, q, grid, nb, shift, order, bins):
+def _scatter_one_per_bin(p, q, grid, nb, shift, order, bins, slack):
     """The sort when every bin holds exactly one ray (a whole scan, whose own ray grid
     the bins then are): each ray's number goes straight to the position of its bin's
     key, in one parallel pass. Needs nb * nb rays and whole tiles (the keys are then
     0 .. n-1). False when some bin got none (so another got two): the caller sorts
-    instead. ``bins`` may be empty (not wanted)."""
+    instead. ``bins`` may be empty (not wanted). ``slack`` gets the largest distance,
+    in bins, of a ray's p and q from its bin's middle."""
     n = p.shape[0]
     nt = nb >> shift
     for k in prange(n):
         order[k] = -1
-    for r in prange(n):
-        i, j = _bin_of(p[r], q[r], grid, nb)
-        k = bin_key(i, j, nt, shift)
-        order[k] = r
-        if bins.shape[0]:
-            bins[k] = np.uint32(i | (j << 16))
+    far = np.zeros((PARTS, 2))
+    for part in prange(PARTS):
+        for r in range(part * n // PARTS, (part + 1) * n // PARTS):
+            i, j = _bin_of(p[r], q[r], grid, nb)
+            k = bin_key(i, j, nt, shift)
+            order[k] = r
+            far[part, 0] = max(far[part, 0], abs((p[r] - grid[0]) / grid[1] - (i + 0.5)))
+            far[part, 1] = max(far[part, 1], abs((q[r] - grid[2]) / grid[3] - (j + 0.5)))
+            if bins.shape[0]:
+                bins[k] = np.uint32(i | (j << 16))
+    slack[0], slack[1] = far[:, 0].max(), far[:, 1].max()
     missing = np.zeros(PARTS, np.bool_)
     for part in prange(PARTS):
         for k in range(part * n // PARTS, (part + 1) * n // PARTS):
@@ -265,25 +273,23 @@ def _scatter_one_per_bin(p, q, grid, nb, shift, order, bins):
 
 def ray_grid(dirs, axis, u, v, nb):
     """(p, q, grid) of a scan: gnomonic coordinates and the nb x nb bins over them,
-    ``grid = (p0, p_step, q0, q_step)``; None when a ray is more than 60 degrees
-    off the axis or not of unit length."""
+    ``grid = (p0, p_step, q0, q_step, p_slack, q_slack)``; None when a ray is more than
+    60 degrees off the axis or not of unit length.
+
+    The bins are centred on an even spread of nb values from the least to the
+    greatest coordinate, so a scan's own ray grid puts each ray near its bin's
+    middle (robust to the sensor's small unevenness). A ray of bin i lies within
+    ``slack`` bins of i + 1/2 (0.5 here: anywhere in its bin; ``bin_order`` measures
+    less for a whole scan, and voxels then cover fewer bins, ``box_bins``).
+    """
     n = len(dirs)
     p, q = np.empty(n), np.empty(n)
     pmin, pmax, qmin, qmax, on_axis = _gnomonic(dirs, axis, u, v, p, q)
     if not on_axis:
         return None
-    return (
-        p,
-        q,
-        np.array(
-            [
-                pmin,
-                (pmax - pmin) / nb if pmax > pmin else 1.0,
-                qmin,
-                (qmax - qmin) / nb if qmax > qmin else 1.0,
-            ]
-        ),
-    )
+    p_step = (pmax - pmin) / (nb - 1) if pmax > pmin and nb > 1 else 1.0
+    q_step = (qmax - qmin) / (nb - 1) if qmax > qmin and nb > 1 else 1.0
+    return p, q, np.array([pmin - 0.5 * p_step, p_step, qmin - 0.5 * q_step, q_step, 0.5, 0.5])
 
 
 def sort_rays(p, q, grid, nb, shift, orig, dirs, lo, hi):
@@ -302,7 +308,7 @@ def sort_rays(p, q, grid, nb, shift, orig, dirs, lo, hi):
     rays, invs, exits = np.empty((n, 6)), np.empty((n, 3)), np.empty(n)
     if n == nb * nb and nb % (1 << shift) == 0:
         order, bins = np.empty(n, np.int64), np.empty(n, np.uint32)
-        if _scatter_one_per_bin(p, q, grid, nb, shift, order, bins):
+        if _scatter_one_per_bin(p, q, grid, nb, shift, order, bins, np.empty(2)):
             _gather(order, orig, dirs, lo, hi, rays, invs, exits)
             return np.arange(n + 1, dtype=np.int64), order, bins, rays, invs, exits
     starts, order, bins = _sort_into_bins(p, q, grid, nb, shift)
@@ -311,16 +317,22 @@ def sort_rays(p, q, grid, nb, shift, orig, dirs, lo, hi):
 
 
 def bin_order(p, q, grid, nb, shift):
-    """(order, starts) of the rays in bin order without copying them (``sort_rays``
+    """(order, starts, grid) of the rays in bin order without copying them (``sort_rays``
     copies them too): sorted position s is ray ``order[s]``; ``starts`` as there, or
-    empty when every bin holds exactly one ray (bin key b is then position b)."""
+    empty when every bin holds exactly one ray (bin key b is then position b). The
+    grid comes back with the slack measured then: how far, in bins, any ray lies from
+    its bin's middle (a scan's rays sit near the middles, so voxels cover fewer bins)."""
     n = len(p)
     if n == nb * nb and nb % (1 << shift) == 0:
         order = np.empty(n, np.int64)
-        if _scatter_one_per_bin(p, q, grid, nb, shift, order, np.empty(0, np.uint32)):
-            return order, np.empty(0, np.int64)
+        slack = np.empty(2)
+        if _scatter_one_per_bin(p, q, grid, nb, shift, order, np.empty(0, np.uint32), slack):
+            measured = grid.copy()
+            # A hair over the measure: it is rounded as box_bins' own positions are.
+            measured[4:] = np.minimum(0.5, slack + 1e-6)
+            return order, np.empty(0, np.int64), measured
     starts, order, _ = _sort_into_bins(p, q, grid, nb, shift, False)
-    return order, starts
+    return order, starts, grid
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -368,19 +380,26 @@ def box_bins(x0, y0, z0, size, centre, grow, axis, u, v, grid, nb):
         return 0, -1, 0, -1, (0 if gap > reach * reach else -1), 0.0
     near -= NEAR_MARGIN * (1.0 + near)  # a bound, so rounding may only lower it
     # Bin numbers clamped as floats first: with a tiny bin step they overflow int64.
-    i0 = _bin(pl - EPS, grid[0], grid[1], nb)
-    i1 = _bin(ph + EPS, grid[0], grid[1], nb)
-    j0 = _bin(ql - EPS, grid[2], grid[3], nb)
-    j1 = _bin(qh + EPS, grid[2], grid[3], nb)
+    i0 = _first_bin(pl - EPS, grid[0], grid[1], grid[4], nb)
+    i1 = _last_bin(ph + EPS, grid[0], grid[1], grid[4], nb)
+    j0 = _first_bin(ql - EPS, grid[2], grid[3], grid[5], nb)
+    j1 = _last_bin(qh + EPS, grid[2], grid[3], grid[5], nb)
     if i1 < 0 or j1 < 0 or i0 >= nb or j0 >= nb:
         return 0, -1, 0, -1, 1, near
     return max(i0, 0), min(i1, nb - 1), max(j0, 0), min(j1, nb - 1), 1, near
 
 
 @njit(nogil=True, cache=True, inline="always")
-def _bin(x, x0, step, nb):
-    """floor((x - x0) / step), limited to -1 .. nb."""
-    return np.int64(math.floor(min(max((x - x0) / step, -1.0), float(nb))))
+def _first_bin(x, x0, step, slack, nb):
+    """The first bin whose ray can lie at or above x (its middle within ``slack`` of
+    the ray), limited to -1 .. nb."""
+    return np.int64(math.ceil(min(max((x - x0) / step - 0.5 - slack, -1.0), float(nb))))
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _last_bin(x, x0, step, slack, nb):
+    """The last bin whose ray can lie at or below x, limited to -1 .. nb."""
+    return np.int64(math.floor(min(max((x - x0) / step - 0.5 + slack, -1.0), float(nb))))
 
 
 @njit(nogil=True, cache=True, inline="always")

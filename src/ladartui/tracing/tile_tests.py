@@ -272,10 +272,10 @@ def trace_scan(occ, orig, dirs, frame, max_voxels, nx, ny, kind, index, t):
         return False
     p, q, grid = gnomonic
     shift = tile_shift_for(nb)
+    order, bin_starts, grid = bin_order(p, q, grid, nb, shift)
     voxels = scan_voxels(occ, frame, grid, nb, max_voxels, shift)
     if voxels is None:
         return False
-    order, bin_starts = bin_order(p, q, grid, nb, shift)
     vox, nears, tile_starts, listed = voxels
     nt = -(-nb >> shift)
     test_tiles(
