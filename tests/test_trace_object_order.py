@@ -12,8 +12,8 @@ from ladartui.sensor import Sensor
 from ladartui.tracing import trace
 from ladartui.tracing.backend import GROUND, MISS, VOXEL
 from ladartui.tracing.numba_backend import NumbaBackend
-from ladartui.tracing.object_order import cone_frame
 from ladartui.tracing.reference import reference_trace_cells
+from ladartui.tracing.scan_rays import cone_frame
 from scans import assert_same, forest_scene, one_scan, random_scan
 
 
@@ -265,7 +265,7 @@ def test_tile_lists_keep_the_nearest_first_order(shift, tiles, threads):
 
 def test_bins_are_numbered_tile_by_tile():
     # A tile's rays are contiguous after the sort, and so is each of its rows.
-    from ladartui.tracing.object_order import bin_key
+    from ladartui.tracing.scan_rays import bin_key
 
     nb, shift = 37, 2
     tile = 1 << shift
@@ -284,7 +284,7 @@ def test_bins_are_numbered_tile_by_tile():
 def test_a_whole_scan_sorts_by_scatter_as_the_counting_sort_does(duplicate):
     # One ray per bin (a whole scan over its own ray grid): the parallel scatter; a ray
     # moved into its neighbour's bin leaves a bin empty: the counting sort. Same result.
-    from ladartui.tracing import object_order as oo
+    from ladartui.tracing import scan_rays as sr
 
     origins, directions = one_scan(
         [100, 100, 10], 60.0, 0.4, 300.0, sensor=Sensor(grid=16, ray_grid=4, fov=5.0)
@@ -293,16 +293,16 @@ def test_a_whole_scan_sorts_by_scatter_as_the_counting_sort_does(duplicate):
         directions[5] = directions[6]
     centre, _, axis, u, v = cone_frame(origins, directions)
     nb = 64
-    p, q, grid = oo.ray_grid(directions, axis, u, v, nb)
+    p, q, grid = sr.ray_grid(directions, axis, u, v, nb)
     lo, hi = np.zeros(3), np.full(3, 200.0)
     order = np.empty(nb * nb, np.int64)
-    assert oo._scatter_one_per_bin(p, q, grid, nb, 4, order, np.empty(nb * nb, np.uint32), np.empty(2)) == (
+    assert sr._scatter_one_per_bin(p, q, grid, nb, 4, order, np.empty(nb * nb, np.uint32), np.empty(2)) == (
         not duplicate
     )
-    got = oo.sort_rays(p, q, grid, nb, 4, origins, directions, lo, hi)
-    starts, order, bins = oo._sort_into_bins(p, q, grid, nb, 4)
+    got = sr.sort_rays(p, q, grid, nb, 4, origins, directions, lo, hi)
+    starts, order, bins = sr._sort_into_bins(p, q, grid, nb, 4)
     rays, invs, exits = np.empty((nb * nb, 6)), np.empty((nb * nb, 3)), np.empty(nb * nb)
-    oo._gather(order, origins, directions, lo, hi, rays, invs, exits)
+    sr._gather(order, origins, directions, lo, hi, rays, invs, exits)
     for mine, theirs in zip(got, (starts, order, bins, rays, invs, exits)):
         assert np.array_equal(mine, theirs)
     assert np.array_equal(np.diff(starts) == 1, np.ones(nb * nb, bool)) == (not duplicate)
@@ -312,7 +312,7 @@ def test_a_whole_scan_sorts_by_scatter_as_the_counting_sort_does(duplicate):
 def test_a_scan_traced_by_bin_order_matches_ray_order(duplicate, numba_backend):
     # The tile tests read rays through the bin order: without copies when every bin
     # holds one ray (bin_order's empty starts), through the starts when one holds two.
-    from ladartui.tracing import object_order as oo
+    from ladartui.tracing import scan_rays as sr
 
     _, occ = forest_scene()
     origins, directions = one_scan(
@@ -322,8 +322,8 @@ def test_a_scan_traced_by_bin_order_matches_ray_order(duplicate, numba_backend):
         directions[5] = directions[6]
     frame = cone_frame(origins, directions)
     nb = int(math.ceil(math.sqrt(len(origins))))
-    p, q, grid = oo.ray_grid(directions, frame[2], frame[3], frame[4], nb)
-    order, starts, measured = oo.bin_order(p, q, grid, nb, 4)
+    p, q, grid = sr.ray_grid(directions, frame[2], frame[3], frame[4], nb)
+    order, starts, measured = sr.bin_order(p, q, grid, nb, 4)
     assert (len(starts) == 0) == (not duplicate)
     # Every ray within the measured slack of its bin's middle; a sensor's grid is nearly even.
     i, j = np.floor((p - grid[0]) / grid[1]), np.floor((q - grid[2]) / grid[3])

@@ -6,8 +6,8 @@ import pytest
 from ladartui.errors import FieldError
 from ladartui.tracing import TINY
 from ladartui.tracing.config import SCAN_BLOCK
-from ladartui.tracing.object_order import ray_bounds
 from ladartui.tracing.prepare import rays_to_cells
+from ladartui.tracing.scan_rays import ray_bounds
 
 
 def test_cells_and_unit_directions_match_numpy_bit_for_bit():

@@ -25,8 +25,8 @@ from ladartui.tracing.axis import boundary_t, cell_at, clamp, slab
 from ladartui.tracing.backend import GROUND, MISS, VOXEL, CellHits, TraceOrder, check_order, register_backend
 from ladartui.tracing.bundle import bundle_start, halo_arrays
 from ladartui.tracing.config import BLOCK, BUNDLE, INF, SCAN_BLOCK
-from ladartui.tracing.object_order import cone_frame
 from ladartui.tracing.order_choice import OrderChoice, trace_in_blocks
+from ladartui.tracing.scan_rays import cone_frame
 from ladartui.tracing.tile_tests import trace_scan
 
 

@@ -59,7 +59,7 @@ def _rays_to_cells(origins, directions, voxel_size, tiny, block, cells, unit, bo
     bad (a non-finite value or a zero-length direction).
 
     ``bounds[b]`` gets the least and greatest cell of the origins and the sum of the
-    unit directions of rays ``b * block ..`` (``object_order.ray_bounds``, summed in
+    unit directions of rays ``b * block ..`` (``scan_rays.ray_bounds``, summed in
     the same runs), so a scan's frame costs no pass of its own."""
     n = origins.shape[0]
     items = bounds.shape[0] * PARTS

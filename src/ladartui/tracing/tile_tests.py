@@ -1,6 +1,6 @@
 """The numba backend's object-order tests: each tile of bins against its voxels.
 
-``trace_scan`` runs a whole scan: the rays are binned (``object_order.bin_order``,
+``trace_scan`` runs a whole scan: the rays are binned (``scan_rays.bin_order``,
 an order and no copies), the voxels in view listed per tile
 (``object_order.scan_voxels``), and ``test_tiles`` then takes each tile on its
 own: it copies the tile's rays next to each other, tests them against the
@@ -19,7 +19,8 @@ from numba import njit, prange
 from ladartui.tracing.answers import ray_answer
 from ladartui.tracing.axis import slab
 from ladartui.tracing.config import INF, MAX_TILE_SHIFT
-from ladartui.tracing.object_order import bin_order, ray_grid, scan_voxels
+from ladartui.tracing.object_order import scan_voxels
+from ladartui.tracing.scan_rays import bin_order, ray_grid
 
 
 @njit(nogil=True, cache=True, inline="always")

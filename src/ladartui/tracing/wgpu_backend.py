@@ -80,8 +80,9 @@ from ladartui.tracing.config import (
     UNFINISHED,
     wgsl_constants,
 )
-from ladartui.tracing.object_order import cone_frame, prepare_scan, shader_voxels
+from ladartui.tracing.object_order import prepare_scan, shader_voxels
 from ladartui.tracing.order_choice import OrderChoice, trace_in_blocks
+from ladartui.tracing.scan_rays import cone_frame
 
 NAME = "wgpu"
 
