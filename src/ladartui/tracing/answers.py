@@ -28,20 +28,27 @@ def ray_answer(found, i, j, k, t, ox, oy, oz, dx, dy, dz, nx, ny):
     return MISS, np.int64(-1), np.int64(-1), np.int64(-1), INF
 
 
+@njit(nogil=True, cache=True, inline="always")
+def put_answer(r, q, t, vox, ox, oy, oz, dx, dy, dz, nx, ny, kind, index, tout):
+    """Ray r's answer into kind/index/tout: voxel ``vox[q, :3]`` at t, or for q < 0
+    the ground rule (the object-order tests' way to write what they found)."""
+    i, j, k = (vox[q, 0], vox[q, 1], vox[q, 2]) if q >= 0 else (-1, -1, -1)
+    kind[r], index[r, 0], index[r, 1], index[r, 2], tout[r] = ray_answer(
+        q >= 0, i, j, k, t, ox, oy, oz, dx, dy, dz, nx, ny
+    )
+
+
 @njit(parallel=True, nogil=True, cache=True)
 def scan_answers(order, best_t, best_v, vox, orig, dirs, nx, ny, kind, index, tout):
     """Object-order hits of the wgpu backend's shader (tracing.object_order) back in ray
     order, with the ground rule."""
     for s in prange(order.shape[0]):
         r = order[s]
-        q = best_v[s]
-        i, j, k = (vox[q, 0], vox[q, 1], vox[q, 2]) if q >= 0 else (-1, -1, -1)
-        kind[r], index[r, 0], index[r, 1], index[r, 2], tout[r] = ray_answer(
-            q >= 0,
-            i,
-            j,
-            k,
+        put_answer(
+            r,
+            best_v[s],
             best_t[s],
+            vox,
             orig[r, 0],
             orig[r, 1],
             orig[r, 2],
@@ -50,4 +57,7 @@ def scan_answers(order, best_t, best_v, vox, orig, dirs, nx, ny, kind, index, to
             dirs[r, 2],
             nx,
             ny,
+            kind,
+            index,
+            tout,
         )

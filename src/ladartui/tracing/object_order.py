@@ -46,7 +46,7 @@ import numpy as np
 from numba import njit, prange
 
 from ladartui.tracing.config import EPS, INF, MIN_COS, NEAR_MARGIN, PARTS
-from ladartui.tracing.scan_rays import ray_grid, sort_rays
+from ladartui.tracing.scan_rays import scan_grid, sort_rays
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -368,12 +368,10 @@ def prepare_scan(occ, orig, dirs, frame, max_voxels, tile_shift):
     view listed per tile of ``1 << tile_shift`` bins a side (``scan_voxels``); None
     when it cannot be projected or has too many voxels in view (ray order is then the
     cheaper way), or when a ray is not of unit length within 60 degrees of the axis."""
-    n = len(orig)
-    nb = max(1, int(math.ceil(math.sqrt(n))))
-    gnomonic = ray_grid(dirs, frame[2], frame[3], frame[4], nb)
-    if gnomonic is None:
+    binned = scan_grid(dirs, frame)
+    if binned is None:
         return None
-    p, q, grid = gnomonic
+    nb, p, q, grid = binned
     voxels = scan_voxels(occ, frame, grid, nb, max_voxels, tile_shift)
     if voxels is None:
         return None

@@ -258,6 +258,15 @@ def ray_grid(dirs, axis, u, v, nb):
     return p, q, np.array([pmin - 0.5 * p_step, p_step, qmin - 0.5 * q_step, q_step, 0.5, 0.5])
 
 
+def scan_grid(dirs, frame):
+    """(nb, p, q, grid) of a scan with ``frame`` (``cone_frame``): nb = ceil(sqrt(N))
+    bins a side over its rays (``ray_grid``); None when a ray is not of unit length
+    within 60 degrees of the axis."""
+    nb = max(1, int(math.ceil(math.sqrt(len(dirs)))))
+    gnomonic = ray_grid(dirs, frame[2], frame[3], frame[4], nb)
+    return None if gnomonic is None else (nb, *gnomonic)
+
+
 def sort_rays(p, q, grid, nb, shift, orig, dirs, lo, hi):
     """Rays in bin order: (starts, order, bins, rays, invs, exits).
 

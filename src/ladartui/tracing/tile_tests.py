@@ -16,11 +16,11 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from ladartui.tracing.answers import ray_answer
+from ladartui.tracing.answers import put_answer
 from ladartui.tracing.axis import slab
 from ladartui.tracing.config import INF, MAX_TILE_SHIFT
 from ladartui.tracing.object_order import scan_voxels
-from ladartui.tracing.scan_rays import bin_order, ray_grid
+from ladartui.tracing.scan_rays import bin_order, scan_grid
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -243,15 +243,11 @@ def test_tiles(
                     if not alive:
                         live[r] &= ~low
         for s in range(m):
-            r = order[s0 + s]
-            q = best_v[s]
-            i, j, k = (vox[q, 0], vox[q, 1], vox[q, 2]) if q >= 0 else (-1, -1, -1)
-            kind[r], index[r, 0], index[r, 1], index[r, 2], tout[r] = ray_answer(
-                q >= 0,
-                i,
-                j,
-                k,
+            put_answer(
+                order[s0 + s],
+                best_v[s],
                 best_t[s],
+                vox,
                 ray[s, 0],
                 ray[s, 1],
                 ray[s, 2],
@@ -260,18 +256,19 @@ def test_tiles(
                 ray[s, 5],
                 nx,
                 ny,
+                kind,
+                index,
+                tout,
             )
 
 
 def trace_scan(occ, orig, dirs, frame, max_voxels, nx, ny, kind, index, t):
     """One scan's exact answers in object order into kind/index/t; False (nothing
     written) when it is no scan for it (``object_order.prepare_scan`` says when)."""
-    n = len(orig)
-    nb = max(1, int(math.ceil(math.sqrt(n))))
-    gnomonic = ray_grid(dirs, frame[2], frame[3], frame[4], nb)
-    if gnomonic is None:
+    binned = scan_grid(dirs, frame)
+    if binned is None:
         return False
-    p, q, grid = gnomonic
+    nb, p, q, grid = binned
     shift = tile_shift_for(nb)
     order, bin_starts, grid = bin_order(p, q, grid, nb, shift)
     voxels = scan_voxels(occ, frame, grid, nb, max_voxels, shift)
