@@ -6,8 +6,9 @@ import trimesh
 
 from ladartui.cli import main
 from ladartui.scene.model import Scene
+from ladartui.scene.target_model import load_target
 from ladartui.scene.voxelize import Placement, load_mesh, voxelize
-from ladartui.scene.voxels import load_target, load_voxels, save_voxels
+from ladartui.scene.voxels import load_voxels, save_voxels
 
 SIZE = 0.5
 

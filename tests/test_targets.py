@@ -12,7 +12,8 @@ from ladartui.measures import compute_measures
 from ladartui.scenario import Scenario, load_scenario
 from ladartui.scene.generate import generate_scene
 from ladartui.scene.model import Scene
-from ladartui.scene.voxels import load_target, load_voxels, save_voxels
+from ladartui.scene.target_model import load_target
+from ladartui.scene.voxels import load_voxels, save_voxels
 from ladartui.sensor import Sensor
 from ladartui.simulation import simulate
 from ladartui.target_measures import compute_target_measures

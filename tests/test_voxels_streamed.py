@@ -8,7 +8,8 @@ import pytest
 
 import ladartui.scene.voxels as voxels_module
 from ladartui.errors import InputFileError
-from ladartui.scene.voxels import load_target, load_voxels
+from ladartui.scene.target_model import load_target
+from ladartui.scene.voxels import load_voxels
 
 
 def _outcome(load, path):

@@ -309,7 +309,7 @@ class Scenario:
                     "target model not found (a new scenario's "
                     "default orbit circles the target of X_Target.txt)",
                 )
-            from ladartui.scene.voxels import load_target
+            from ladartui.scene.target_model import load_target
 
             flight = defaults.default_flight(load_target(target_file)[0], voxel_size)
         return cls(path, scene_file, voxel_size, sensor, flight, **options)

@@ -56,7 +56,8 @@ def print_scenario(path: Path) -> None:
 
 def print_voxel_list(path: Path, voxel_size=None) -> None:
     from ladartui.scene.model import target_path_for
-    from ladartui.scene.voxels import load_target, load_voxels_counted
+    from ladartui.scene.target_model import load_target
+    from ladartui.scene.voxels import load_voxels_counted
 
     if voxel_size is not None and not voxel_size > 0:
         from ladartui.errors import FieldError

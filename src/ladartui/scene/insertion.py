@@ -46,7 +46,8 @@ def scene_model_paths(out) -> tuple[Path, Path]:
 def load_scene_model(scene_path) -> tuple[np.ndarray, np.ndarray, np.ndarray, bool]:
     """The scene's voxels, its target's and their target ids (empty when ``X_Target.txt`` is
     absent; 1 on every line of a three-column target model), and whether it was there."""
-    from ladartui.scene.voxels import load_target, load_voxels
+    from ladartui.scene.target_model import load_target
+    from ladartui.scene.voxels import load_voxels
 
     scene_path = Path(scene_path)
     voxels = load_voxels(scene_path)

@@ -14,7 +14,8 @@ import numpy as np
 
 from ladartui.errors import FieldError, InputFileError, LadarError
 from ladartui.scene.keys import voxel_keys
-from ladartui.scene.voxels import MAX_TARGET_ID, load_target, load_voxels
+from ladartui.scene.target_model import load_target
+from ladartui.scene.voxels import MAX_TARGET_ID, load_voxels
 
 
 def target_path_for(scene_path) -> Path:
