@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 import trimesh
 
+from cli_support import one_error_line
 from ladartui.cli import main
 from ladartui.scene.model import Scene
 from ladartui.scene.voxelize import Placement, load_mesh, merge_voxels, voxelize
@@ -28,14 +29,6 @@ def forest(tmp_path):
     save_voxels(tmp_path / "forest.txt", scene)
     save_voxels(tmp_path / "forest_Target.txt", [[5, 55, 0]])
     return tmp_path / "forest.txt"
-
-
-def one_error_line(capsys) -> str:
-    captured = capsys.readouterr()
-    lines = captured.err.strip().splitlines()
-    assert len(lines) == 1, captured.err
-    assert "Traceback" not in captured.err
-    return lines[0]
 
 
 def test_writes_a_target_model_that_loads_back(tmp_path, truck, capsys):

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 import trimesh
 
+from cli_support import one_error_line
 from ladartui.cli import main
 from ladartui.scene.model import Scene
 from ladartui.scene.target_model import load_target
@@ -31,13 +32,6 @@ def field(tmp_path, target, ids=None):
 
 def vehicle_at(box, x, y):
     return voxelize(load_mesh(box), SIZE, Placement(x, y, 0.0, 0.0), solid=True).voxels
-
-
-def one_error_line(capsys) -> str:
-    captured = capsys.readouterr()
-    lines = captured.err.strip().splitlines()
-    assert len(lines) == 1 and "Traceback" not in captured.err, captured.err
-    return lines[0]
 
 
 def test_id_writes_a_four_column_target_model_that_loads_back(tmp_path, box, capsys):

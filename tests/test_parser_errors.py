@@ -12,6 +12,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from cli_support import one_error_line
 from ladartui.cli import main
 from ladartui.errors import LadarError
 from ladartui.scenario import load_scenario, scenario_from_toml
@@ -28,12 +29,6 @@ FUZZ = settings(
 def assert_one_line(error):
     text = str(error)
     assert text and "\n" not in text and "Traceback" not in text
-
-
-def one_error_line(capsys):
-    err = capsys.readouterr().err.strip()
-    assert err.count("\n") == 0 and err.startswith("ladartui"), err
-    return err
 
 
 # ---------------------------------------------------------------- regressions

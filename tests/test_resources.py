@@ -3,17 +3,12 @@
 import numpy as np
 import pytest
 
+from cli_support import one_error_line
 from ladartui.cli import main
 from ladartui.errors import ResourceLimitError
 from ladartui.resources import occupancy_bytes, set_max_rays
 from ladartui.scene.occupancy import Occupancy
 from ladartui.scene.voxels import save_voxels
-
-
-def one_error_line(capsys):
-    err = capsys.readouterr().err.strip()
-    assert err.count("\n") == 0 and err.startswith("ladartui: error:"), err
-    return err
 
 
 @pytest.mark.parametrize("far", ["100000,100000,100", "2147483647,0,0"])

@@ -62,7 +62,7 @@ def test_every_numba_reference_in_the_shaders_names_a_function_that_exists(shade
     assert broken_references(text, functions) == []
 
 
-def test_the_shaders_cite_the_kernels_they_mirror(functions):
+def test_the_shaders_cite_the_kernels_they_mirror():
     cited = "\n".join(s.read_text() for s in SHADERS)
     for name in ("_exact_kernel", "_march_kernel", "ray_answer", "test_tiles"):
         assert f"numba: {name}" in cited or f"of {name}" in cited or f" {name} and" in cited

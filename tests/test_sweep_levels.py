@@ -186,17 +186,3 @@ def test_several_targets_survive_the_result_table(tmp_path):
     again = sorted((r.row for r in result.ranking), key=lambda r: r["variant"])
     assert [r["targets.per_target"] for r in again] == [r["targets.per_target"] for r in TWO_TARGETS]
     assert order(result.ranking) == [("q", 1), ("p", 2), ("r", None)]
-
-
-def test_a_spec_may_name_a_bundled_scenario(tmp_path):
-    from ladartui.scenario import load_scenario
-    from ladartui.sweep.execute import base_scenario_path
-
-    spec_path = tmp_path / "convoy-sweep.toml"
-    spec_path.write_text('[sweep]\nscenario = "convoy"\n[grid]\nradius = [40.0, 60.0]\n', encoding="utf-8")
-    base = base_scenario_path(load_sweep_spec(spec_path))
-    assert base.name == "convoy.toml"
-    assert [name for _, name in load_scenario(base).target_names][:1] == ["netted truck"]
-    # a file of that name beside the spec wins over the bundled one
-    (tmp_path / "convoy").write_text("")
-    assert load_sweep_spec(spec_path).scenario_path == tmp_path / "convoy"

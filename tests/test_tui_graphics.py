@@ -219,7 +219,6 @@ async def test_the_views_are_images_when_an_image_mode_is_forced_and_half_blocks
         assert len(views) == 3
         # the help screen says how the views are drawn and why
         assert ("Views", "settings.toml", "Drawn as " + graphics.describe()) in help_rows(app)
-        assert f"set to {mode}" in graphics.describe()
         for view in views:
             if mode == "halfblocks":
                 assert view.image_view is None and not view.query(TGPImage) and not view.query(SixelImage)

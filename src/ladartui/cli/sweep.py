@@ -269,7 +269,7 @@ def _restore_sigterm(previous):
 def result_dict(result, top) -> dict:
     """The sweep as a JSON-safe dict: files, counts, the best variants and the Pareto front."""
 
-    from ladartui.sweep.columns import target_ids, target_names
+    from ladartui.sweep.columns import LEVEL_FIELDS, target_ids, target_names
     from ladartui.sweep.ranking import LEVEL_NAMES, level_of, levels_text
 
     def levels(row):
@@ -280,10 +280,7 @@ def result_dict(result, top) -> dict:
             {
                 "target": ids[i],
                 "name": names[i] or None,
-                **{
-                    level: dict(zip(("reached", "scan", "flight_time_s", "distance_m"), per_level[level][i]))
-                    for level in LEVEL_NAMES
-                },
+                **{level: dict(zip(LEVEL_FIELDS, per_level[level][i])) for level in LEVEL_NAMES},
             }
             for i in range(len(per_level["identify"]))
         ]

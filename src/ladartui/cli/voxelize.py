@@ -8,7 +8,7 @@ import threading
 import time
 
 from ladartui.cli.progress import run_cancellable, sigterm_as_interrupt
-from ladartui.errors import Cancelled, FieldError
+from ladartui.errors import Cancelled, FieldError, check_cancelled
 from ladartui.textsafe import one_line
 
 
@@ -167,8 +167,7 @@ def _work(args, placement, outputs, console, cancel):
 
         with _flag_names():
             result = voxelize(mesh, args.voxel_size, placement, args.solid, progress=report, cancel=cancel)
-        if cancel.is_set():
-            raise Cancelled(CANCELLED)
+        check_cancelled(cancel, CANCELLED)
         if not args.into:
             ids = None if args.id is None else np.full(len(result.voxels), args.id, dtype=np.int32)
             save_model(outputs[0], result.voxels, cancel, report, ids)

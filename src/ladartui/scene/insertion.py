@@ -207,7 +207,7 @@ def write_voxel_lines(
     Formatted a million rows at a time, so a large model needs no text
     buffer of its own size and a set ``cancel`` stops it (``Cancelled``).
     """
-    from ladartui.errors import Cancelled
+    from ladartui.errors import check_cancelled
     from ladartui.scene.voxelize import CANCELLED
     from ladartui.scene.voxels import format_voxel_lines
 
@@ -215,8 +215,7 @@ def write_voxel_lines(
         voxels = np.column_stack([np.asarray(voxels, np.int64), np.asarray(ids, np.int64)])
     with open(path, "wb") as stream:
         for start in range(0, len(voxels), _WRITE_ROWS):
-            if cancel is not None and cancel.is_set():
-                raise Cancelled(CANCELLED)
+            check_cancelled(cancel, CANCELLED)
             stop = min(start + _WRITE_ROWS, len(voxels))
             stream.write(format_voxel_lines(voxels[start:stop]))
             if progress is not None:

@@ -40,7 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ladartui.errors import Cancelled, FieldError, InputFileError, ResourceLimitError
+from ladartui.errors import FieldError, InputFileError, ResourceLimitError, check_cancelled
 from ladartui.scene.voxels import MAX_INDEX
 
 MESH_SUFFIXES = (".obj", ".stl", ".ply")
@@ -352,8 +352,7 @@ def voxelize(
 
     def stage(name: str, bounds: list[int], step: Callable[[int, int], object]) -> None:
         for start, stop in zip(bounds, bounds[1:]):
-            if cancel is not None and cancel.is_set():
-                raise Cancelled(CANCELLED)
+            check_cancelled(cancel, CANCELLED)
             step(start, stop)
             if progress is not None:
                 progress(name, stop, bounds[-1])

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from ladartui.errors import FieldError
 from ladartui.levels import LEVELS as LEVEL_NAMES
 from ladartui.pareto import Sense, pareto_front
-from ladartui.sweep.columns import PER_TARGET_COLUMN as PER_TARGET_COLUMN  # rows per target
+from ladartui.sweep.columns import LEVEL_FIELDS
 from ladartui.sweep.columns import target_names as target_names
 from ladartui.sweep.columns import target_values as target_values
 
@@ -94,9 +94,7 @@ def coverage_of(row: dict) -> float | None:
 
 def level_of(row: dict, level: str) -> list[tuple[bool, int | None, float | None, float | None]]:
     """Per target: (reached, scan, flight time s, distance m) of ``level`` in the row."""
-    columns = [
-        LEVEL_COLUMN.format(level=level, field=f) for f in ("reached", "scan", "flight_time_s", "distance_m")
-    ]
+    columns = [LEVEL_COLUMN.format(level=level, field=f) for f in LEVEL_FIELDS]
     values = [target_values(row, c) for c in columns]
     out = []
     for reached, scan, time, distance in zip(*values):
@@ -149,10 +147,9 @@ def never_identified(rows) -> list[str]:
     names = target_names(done[0])
     if len(names) < 2:
         return []
-    seen = [
-        any(level_of(r, "identify")[i][0] for r in done if len(level_of(r, "identify")) == len(names))
-        for i in range(len(names))
-    ]
+    identify = [level_of(r, "identify") for r in done]
+    identify = [per_target for per_target in identify if len(per_target) == len(names)]
+    seen = [any(per_target[i][0] for per_target in identify) for i in range(len(names))]
     return [name for name, identified in zip(names, seen) if not identified]
 
 

@@ -48,7 +48,6 @@ from ladartui.user_data import bundled_scenario_name
 PRESETS = ("orbit", "flypast", "standoff")
 # ``scenario = "default"`` (or another bundled name, e.g. "convoy") names a bundled
 # scenario, made in the user data folder on first use; held as ``<name>``.
-DEFAULT_BASE = Path("<default>")
 
 
 def bundled_base(name: str) -> Path:
