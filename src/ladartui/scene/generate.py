@@ -34,6 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.errors import FieldError
+from ladartui.scene.trees import branch_voxels, concat_voxels, foliage_voxels, place_trees, trunk_voxels
 from ladartui.scene.voxels import save_voxels
 
 
@@ -173,10 +174,10 @@ def generate_scene(preset="small", seed=0, **overrides) -> GeneratedScene:
 
     vehicles = _place_vehicles(params, nx, ny, ground, rng)
     vehicle_voxels = [_vehicle_voxels(v, params, nx, ny) for v in vehicles]
-    trees = _place_trees(params, nx, ny, ground, vehicles, rng)
-    parts["trunks"] = _trunk_voxels(trees, vs)
-    parts["branches"] = _branch_voxels(trees, params, rng)
-    parts["foliage"] = _foliage_voxels(trees, params, rng)
+    trees = place_trees(params, nx, ny, ground, vehicles, rng)
+    parts["trunks"] = trunk_voxels(trees, vs)
+    parts["branches"] = branch_voxels(trees, params, rng)
+    parts["foliage"] = foliage_voxels(trees, params, rng)
     for name in ("trunks", "branches", "foliage"):
         parts[name] = _clip(parts[name], nx, ny)
         for vehicle in vehicles:
@@ -446,228 +447,6 @@ def _net_voxels(vehicle: _Vehicle, p: SceneParams, ground, rng) -> np.ndarray:
     return np.stack([cols[column, 0], cols[column, 1], z], axis=1).astype(np.int32)
 
 
-# ---- trees --------------------------------------------------------------------
-
-
-@dataclass
-class _Trees:
-    """Per-tree arrays, grid units (x, y centre; base layer; heights in voxels)."""
-
-    x: np.ndarray
-    y: np.ndarray
-    base: np.ndarray
-    height: np.ndarray
-    crown_base: np.ndarray
-    crown_radius: np.ndarray
-    trunk_radius: np.ndarray
-    conifer: np.ndarray
-
-    def __len__(self):
-        return len(self.x)
-
-
-def _place_trees(p: SceneParams, nx, ny, ground, vehicles, rng) -> _Trees:
-    vs = p.voxel_size
-    # Up to three of the trees stand round the first vehicle; the rest anywhere.
-    n_cover = min(3, p.trees) if vehicles else 0
-    # A jittered grid keeps trunks apart without a rejection loop.
-    spacing = math.sqrt(nx * ny / max(p.trees, 1))
-    gx = np.arange(spacing / 2, nx, spacing)
-    gy = np.arange(spacing / 2, ny, spacing)
-    x, y = (a.ravel() for a in np.meshgrid(gx, gy, indexing="ij"))
-    x = x + rng.uniform(-0.35, 0.35, x.size) * spacing
-    y = y + rng.uniform(-0.35, 0.35, y.size) * spacing
-    pick = rng.permutation(x.size)[: p.trees - n_cover]
-    x, y = x[pick], y[pick]
-    cover_x, cover_y = [], []
-    if vehicles:
-        length, width, height = p.vehicle_size
-        keep = np.ones(x.size, dtype=bool)
-        for v in vehicles:
-            keep &= np.hypot(x - v.cx, y - v.cy) * vs > length / 2 + 1.5
-        x, y = x[keep], y[keep]
-        # Trees standing round the first vehicle so that their crowns close over it.
-        first = vehicles[0]
-        start = rng.uniform(0, 2 * np.pi)
-        for k in range(n_cover):
-            angle = start + k * 2 * np.pi / 3 + rng.uniform(-0.3, 0.3)
-            distance = (length / 2 + rng.uniform(1.0, 2.0)) / vs
-            cover_x.append(first.cx + distance * np.cos(angle))
-            cover_y.append(first.cy + distance * np.sin(angle))
-    count = x.size + len(cover_x)
-    x = np.clip(np.concatenate([x, cover_x]), 0, nx - 1)
-    y = np.clip(np.concatenate([y, cover_y]), 0, ny - 1)
-    height = rng.uniform(*p.tree_height, count) / vs
-    crown_radius = rng.uniform(*p.crown_radius, count) / vs
-    conifer = rng.random(count) < p.conifer_share
-    crown_share = np.where(conifer, rng.uniform(0.7, 0.85, count), rng.uniform(0.5, 0.7, count))
-    crown_base = height * (1 - crown_share)
-    trunk_radius = rng.uniform(*p.trunk_radius, count) / vs
-    if n_cover:
-        # Cover trees: broadleaf, wide crowns reaching over the vehicle, high enough to clear it.
-        reach = (p.vehicle_size[0] / 2 + 2.5) / vs
-        crown_radius[-n_cover:] = np.maximum(crown_radius[-n_cover:], reach)
-        conifer[-n_cover:] = False
-        low = (p.vehicle_size[2] + 1.5) / vs
-        crown_base[-n_cover:] = np.clip(crown_base[-n_cover:], low, None)
-        height[-n_cover:] = np.maximum(height[-n_cover:], crown_base[-n_cover:] + 2 * reach * 0.8)
-    base = ground[x.astype(np.int64), y.astype(np.int64)]
-    return _Trees(
-        x,
-        y,
-        base.astype(np.float64),
-        height,
-        crown_base,
-        crown_radius,
-        np.maximum(trunk_radius, 0.5),
-        conifer,
-    )
-
-
-def _trunk_voxels(trees: _Trees, vs) -> np.ndarray:
-    """Hollow tapering tubes (only the skin can be seen), 1.5 voxels thick."""
-    pieces = []
-    for i in range(len(trees)):
-        radius = trees.trunk_radius[i]
-        top = trees.height[i] if trees.conifer[i] else 0.8 * trees.height[i]
-        layers = np.arange(int(top))
-        reach = int(math.ceil(radius)) + 1
-        offsets = np.arange(-reach, reach + 1)
-        ox, oy = (a.ravel() for a in np.meshgrid(offsets, offsets, indexing="ij"))
-        cx, cy = int(round(trees.x[i])), int(round(trees.y[i]))
-        distance = np.hypot(ox + cx - trees.x[i], oy + cy - trees.y[i])
-        taper = radius * (1 - 0.6 * layers / max(top, 1))
-        skin = (distance[None, :] <= taper[:, None] + 0.5) & (distance[None, :] > taper[:, None] - 1)
-        layer, cell = np.nonzero(skin)
-        z = trees.base[i] + layers[layer]
-        pieces.append(np.stack([cx + ox[cell], cy + oy[cell], z], axis=1))
-    return _concat(pieces)
-
-
-def _crown_centre(trees: _Trees):
-    """Centre (grid) and half-height of each crown's envelope."""
-    half = (trees.height - trees.crown_base) / 2
-    return trees.base + trees.crown_base + half, half
-
-
-def _branch_voxels(trees: _Trees, p: SceneParams, rng) -> np.ndarray:
-    """Straight limbs from the trunk out to the crown's skin (broadleaf trees)."""
-    broad = np.nonzero(~trees.conifer)[0]
-    if not len(broad) or not p.branches:
-        return np.zeros((0, 3), dtype=np.int32)
-    tree = np.repeat(broad, p.branches)
-    centre_z, half = _crown_centre(trees)
-    start_z = trees.base[tree] + trees.crown_base[tree] + rng.uniform(0, 0.6, tree.size) * 2 * half[tree]
-    azimuth = rng.uniform(0, 2 * np.pi, tree.size)
-    rise = rng.uniform(0.2, 0.9, tree.size)  # end height inside the crown, share of half-height
-    reach = 0.85 * trees.crown_radius[tree] * np.sqrt(1 - np.minimum(rise, 0.95) ** 2)
-    start = np.stack([trees.x[tree], trees.y[tree], start_z], axis=1)
-    end = np.stack(
-        [
-            trees.x[tree] + reach * np.cos(azimuth),
-            trees.y[tree] + reach * np.sin(azimuth),
-            centre_z[tree] + rise * half[tree],
-        ],
-        axis=1,
-    )
-    return _segments(start, end)
-
-
-def _segments(start, end) -> np.ndarray:
-    """Voxels along straight segments, sampled every half voxel."""
-    steps = np.maximum(np.ceil(np.linalg.norm(end - start, axis=1) * 2).astype(np.int64), 1) + 1
-    seg = np.repeat(np.arange(len(start)), steps)
-    first = np.cumsum(steps) - steps
-    t = (np.arange(seg.size) - first[seg]) / (steps[seg] - 1)
-    points = start[seg] + (end - start)[seg] * t[:, None]
-    return np.floor(points + 0.5).astype(np.int32)
-
-
-def _foliage_voxels(trees: _Trees, p: SceneParams, rng) -> np.ndarray:
-    """Leaf clumps scattered through the outer shell of every crown."""
-    vs = p.voxel_size
-    centre_z, half = _crown_centre(trees)
-    radius = trees.crown_radius
-    conifer = trees.conifer
-    # Envelope surface areas (grid units squared): ellipsoid (Thomsen) or cone side.
-    a, c = radius, half
-    ellipsoid = 4 * np.pi * (((a * a) ** 1.6 + 2 * (a * c) ** 1.6) / 3) ** (1 / 1.6)
-    cone = np.pi * radius * np.hypot(radius, 2 * half)
-    area = np.where(conifer, cone, ellipsoid)
-    clump_area = np.pi * (np.mean(p.clump_radius) / vs) ** 2
-    per_tree = np.ceil(-math.log(1 - p.density) * area / clump_area).astype(np.int64)
-    tree = np.repeat(np.arange(len(trees)), per_tree)
-    n = tree.size
-    depth = 1 - p.shell_depth * rng.random(n)  # share of the envelope radius
-    # Ellipsoid: a uniform direction, scaled to the envelope.
-    direction = rng.normal(size=(n, 3))
-    direction /= np.linalg.norm(direction, axis=1, keepdims=True)
-    # Lumpy envelopes: each crown bulges along a few random low-order waves.
-    amplitude = rng.uniform(0.0, 0.15, (len(trees), 3))
-    phase = rng.uniform(0, 2 * np.pi, (len(trees), 3))
-
-    def lumps(azimuth, elevation):
-        a, ph = amplitude[tree], phase[tree]
-        return (
-            1
-            + a[:, 0] * np.cos(2 * azimuth + ph[:, 0])
-            + a[:, 1] * np.cos(3 * azimuth + ph[:, 1])
-            + a[:, 2] * np.cos(2 * elevation + ph[:, 2])
-        )
-
-    bulge = lumps(np.arctan2(direction[:, 1], direction[:, 0]), np.arcsin(direction[:, 2]))
-    ex = direction[:, 0] * radius[tree] * depth * bulge
-    ey = direction[:, 1] * radius[tree] * depth * bulge
-    ez = centre_z[tree] + direction[:, 2] * half[tree] * depth * bulge
-    # Cone: area-uniform over the side (apex at the top of the tree).
-    s = np.sqrt(rng.random(n))
-    angle = rng.uniform(0, 2 * np.pi, n)
-    ring = radius[tree] * s * depth * lumps(angle, s * np.pi)
-    top = trees.base[tree] + trees.height[tree]
-    is_cone = conifer[tree]
-    cx = trees.x[tree] + np.where(is_cone, ring * np.cos(angle), ex)
-    cy = trees.y[tree] + np.where(is_cone, ring * np.sin(angle), ey)
-    cz = np.where(is_cone, top - s * 2 * half[tree], ez)
-    centres = np.floor(np.stack([cx, cy, cz], axis=1) + 0.5).astype(np.int32)
-    clump = rng.uniform(*p.clump_radius, n) / vs
-    return _stamp_clumps(centres, clump, rng)
-
-
-def _stamp_clumps(centres, radii, rng, variants=6) -> np.ndarray:
-    """Place a ragged flattened blob at every centre; blobs grouped by size class."""
-    classes = np.maximum(np.round(radii * 2) / 2, 0.5)  # half-voxel size classes
-    variant = rng.integers(0, variants, len(centres))
-    pieces = []
-    for size in np.unique(classes):
-        templates = [_clump_template(size, rng) for _ in range(variants)]
-        in_class = classes == size
-        for k, template in enumerate(templates):
-            chosen = centres[in_class & (variant == k)]
-            if len(chosen):
-                pieces.append((chosen[:, None, :] + template[None, :, :]).reshape(-1, 3))
-    return _concat(pieces)
-
-
-def _clump_template(radius, rng, flatness=0.35) -> np.ndarray:
-    """Offsets of one leaf clump: an oblate blob whose rim is thinned at random."""
-    reach = int(math.ceil(radius))
-    o = np.arange(-reach, reach + 1)
-    ox, oy, oz = (a.ravel() for a in np.meshgrid(o, o, o, indexing="ij"))
-    vertical = max(radius * flatness, 0.5)
-    r = np.sqrt((ox**2 + oy**2) / radius**2 + oz**2 / vertical**2)
-    keep = (r <= 1.0) & ((r <= 0.6) | (rng.random(r.size) < 0.6))
-    keep[(ox == 0) & (oy == 0) & (oz == 0)] = True
-    return np.stack([ox[keep], oy[keep], oz[keep]], axis=1).astype(np.int32)
-
-
-# ---- assembly -----------------------------------------------------------------
-
-
-def _concat(pieces) -> np.ndarray:
-    pieces = [np.asarray(p, dtype=np.int32).reshape(-1, 3) for p in pieces if len(p)]
-    return np.concatenate(pieces) if pieces else np.zeros((0, 3), dtype=np.int32)
-
-
 def _clip(voxels, nx, ny) -> np.ndarray:
     voxels = np.asarray(voxels, dtype=np.int32).reshape(-1, 3)
     inside = (
@@ -683,7 +462,7 @@ def _clip(voxels, nx, ny) -> np.ndarray:
 def _merge_labelled(lists) -> tuple[np.ndarray, np.ndarray]:
     """Union of voxel lists (sorted like ``_merge``) and the 1-based index of the list
     each voxel came from; a voxel in several lists keeps the first."""
-    voxels = _concat(lists)
+    voxels = concat_voxels(lists)
     labels = np.repeat(np.arange(1, len(lists) + 1, dtype=np.int32), [len(v) for v in lists])
     if not len(voxels):
         return voxels, labels
@@ -697,7 +476,7 @@ def _merge_labelled(lists) -> tuple[np.ndarray, np.ndarray]:
 
 def _merge(lists) -> np.ndarray:
     """Union of voxel lists, sorted by x, then y, then z."""
-    voxels = _concat(lists)
+    voxels = concat_voxels(lists)
     if not len(voxels):
         return voxels
     top = voxels.max(axis=0).astype(np.int64) + 1
