@@ -115,6 +115,7 @@ from ladartui.flight import (
 from ladartui.levels import LEVEL_KEYS, LevelThresholds, levels_from_table
 from ladartui.scenario_style import restyle
 from ladartui.sensor import MAX_PIXEL_PITCH, Sensor
+from ladartui.toml_lines import key_lines, key_lines_from_text
 from ladartui.tracing.backend import METHODS, PRECISIONS
 from ladartui.trajectory import LogSegment
 
@@ -283,7 +284,7 @@ class Scenario:
                 f"{self.target_file.name})"
             )
         if missing:
-            line = _key_lines(self.path).get("files.scene") if self.path.is_file() else None
+            line = key_lines(self.path).get("files.scene") if self.path.is_file() else None
             raise InputFileError(self.path, missing, line)
 
     def with_changes(self, **fields) -> Scenario:
@@ -484,7 +485,7 @@ class _Reader:
 
     def __init__(self, path: Path, text: str):
         self.path = path
-        self.lines = _key_lines_from_text(text)
+        self.lines = key_lines_from_text(text)
 
     def line(self, key: str):
         # The exact key, else the nearest enclosing table or array item.
@@ -708,56 +709,6 @@ def _check_flight(plan: FlightPlan) -> None:
         raise FieldError("flight." + error.field, error.value, error.expected) from None
     if count > MAX_SCANS:
         raise FieldError("flight.segments", f"{count} scans", f"at most {MAX_SCANS} scans")
-
-
-# -- line numbers for error messages --------------------------------------------------
-
-_HEADER = re.compile(r"^\s*(\[\[?)\s*([A-Za-z0-9_.\-]+)\s*\]\]?")
-_KEY = re.compile(r"^\s*([A-Za-z0-9_\-]+)\s*=")
-
-
-def _key_lines(path: Path) -> dict[str, int]:
-    try:
-        return _key_lines_from_text(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError):
-        return {}
-
-
-def _key_lines_from_text(text: str) -> dict[str, int]:
-    """Map dotted keys ("flight.segments[1].radius") to their 1-based line numbers.
-
-    A light scan of bare keys and table headers, enough to point at the line of
-    a bad value; anything it does not recognise is simply not mapped.
-    """
-    lines: dict[str, int] = {}
-    arrays: dict[str, int] = {}  # array-of-tables name -> current index
-    current = ""
-    for number, line in enumerate(text.splitlines(), start=1):
-        header = _HEADER.match(line)
-        if header:
-            name = _indexed(header.group(2), arrays)
-            if header.group(1) == "[[":
-                arrays[header.group(2)] = arrays.get(header.group(2), -1) + 1
-                name = f"{name}[{arrays[header.group(2)]}]"
-            current = name
-            lines.setdefault(current, number)
-            continue
-        key = _KEY.match(line)
-        if key:
-            lines.setdefault(f"{current}.{key.group(1)}" if current else key.group(1), number)
-    return lines
-
-
-def _indexed(dotted: str, arrays: dict[str, int]) -> str:
-    # "flight.segments.poses" -> "flight.segments[2].poses" inside segment 2.
-    parts = dotted.split(".")
-    out = []
-    for i, part in enumerate(parts):
-        out.append(part)
-        prefix = ".".join(parts[: i + 1])
-        if i < len(parts) - 1 and prefix in arrays:
-            out[-1] = f"{part}[{arrays[prefix]}]"
-    return ".".join(out)
 
 
 # -- writing ------------------------------------------------------------------------

@@ -37,8 +37,8 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from ladartui.scenario import _key_lines_from_text
 from ladartui.textsafe import one_line
+from ladartui.toml_lines import key_lines_from_text
 from ladartui.user_data import config_folder
 
 MODES = ("auto", "halfblocks", "characters", "sixel", "kitty", "iterm")
@@ -145,7 +145,7 @@ def read_setting(folder: Path | None = None) -> tuple[str, list[str]]:
     except tomllib.TOMLDecodeError as error:
         return "auto", [one_line(f"{path}: {error}")]
     display = document.get("display", {})
-    line = _key_lines_from_text(text).get(SETTING)
+    line = key_lines_from_text(text).get(SETTING)
     where = f"{path}:{line}" if line else str(path)
     if not isinstance(display, dict):
         return "auto", [f"{where}: display must be a table, [display]"]
