@@ -19,7 +19,8 @@ from textual.widgets import DataTable
 from ladartui.scenario import load_scenario
 from ladartui.sweep import read_table, run_sweep
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar, format_eta
-from ladartui.tui.sweep_screen import SweepScreen, eta_seconds
+from ladartui.tui.sweep_screen import SweepScreen
+from ladartui.tui.sweep_view import eta_seconds
 
 SIZE = (80, 24)
 CENTRE = (11.5, 11.5, 0.5)
@@ -305,7 +306,7 @@ async def test_an_unreachable_scheduler_gives_one_line_and_writes_nothing(tmp_pa
 TRACKER_SCRIPT = """
 import asyncio, multiprocessing, sys
 from textual.app import App
-from ladartui.tui.sweep_screen import start_resource_tracker
+from ladartui.tui.sweep_jobs import start_resource_tracker
 
 async def main():
     async with App().run_test():

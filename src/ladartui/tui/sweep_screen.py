@@ -12,7 +12,6 @@ the app.
 from __future__ import annotations
 
 import math
-import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -30,6 +29,7 @@ from ladartui.errors import FieldError, InputFileError, LadarError
 from ladartui.recent import recent_paths, remember_path
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar, format_eta
+from ladartui.tui.sweep_jobs import sibling_spec, start_resource_tracker, sweep_job, write_best
 from ladartui.tui.sweep_view import (
     detail_text,
     draw_pareto,
@@ -58,33 +58,6 @@ class ExistingPath(Validator):
         if not value.strip() or Path(value.strip()).expanduser().exists():
             return self.success()
         return self.failure(f"{value.strip()}: no such file or folder")
-
-
-def start_resource_tracker() -> None:
-    """Start multiprocessing's resource tracker with the process's real stderr.
-
-    The tracker is handed ``sys.stderr.fileno()``; while the interface runs,
-    ``sys.stderr`` is a capture object whose descriptor is -1, so a local
-    cluster started then fails ("bad value(s) in fds_to_keep"). Started once
-    here, it is reused by every later cluster.
-    """
-    from multiprocessing import resource_tracker
-
-    captured = sys.stderr
-    sys.stderr = sys.__stderr__
-    try:
-        resource_tracker.ensure_running()
-    finally:
-        sys.stderr = captured
-
-
-def _sibling_spec(results: Path) -> Path | None:
-    """The spec whose default results folder is ``results`` (``S-results`` beside ``S.toml``)."""
-    folder = results if results.is_dir() else results.parent
-    if not folder.name.endswith("-results"):
-        return None
-    spec = folder.parent / (folder.name[: -len("-results")] + ".toml")
-    return spec if spec.is_file() else None
 
 
 class SweepScreen(Screen):
@@ -259,7 +232,7 @@ class SweepScreen(Screen):
             raise FieldError("spec", text, "the path of a sweep spec (.toml)")
         path = Path(text).expanduser()
         if path.is_dir() or path.suffix.lower() == ".csv":
-            sibling = _sibling_spec(path)
+            sibling = sibling_spec(path)
             if sibling is None:
                 raise InputFileError(path, "expected a sweep spec (.toml) to run; F3 opens results")
             path = sibling
@@ -328,7 +301,7 @@ class SweepScreen(Screen):
         self.worker = start_job(
             self,
             "sweep",
-            lambda cancel, progress: _sweep(
+            lambda cancel, progress: sweep_job(
                 spec, scheduler, security, serial, objective, cost, budget, timeout, cancel, progress
             ),
         )
@@ -492,7 +465,7 @@ class SweepScreen(Screen):
                     return
             else:
                 results = path
-                sibling = _sibling_spec(path)
+                sibling = sibling_spec(path)
                 spec = load_sweep_spec(sibling) if sibling is not None else None
             objective = spec.objective if spec else "obscured-coverage"
             budget = spec.budget if spec else None
@@ -662,7 +635,7 @@ class SweepScreen(Screen):
         start_job(
             self,
             "best",
-            lambda cancel, progress: (_write_best(spec, row, parameter_names, path), f"best by {objective}"),
+            lambda cancel, progress: (write_best(spec, row, parameter_names, path), f"best by {objective}"),
         )
 
     def _announce_best(self, path: Path, how: str) -> None:
@@ -671,47 +644,3 @@ class SweepScreen(Screen):
             self._idle_state(), f"best path ({how}): {path}", self._fraction() if self.running else None
         )
         self.post_message(self.OpenScenario(path))
-
-
-def _sweep(
-    spec,
-    scheduler: str,
-    security,
-    serial: bool,
-    objective: str,
-    cost: str,
-    budget,
-    connect_timeout: float,
-    cancel,
-    progress,
-):
-    """The sweep job (worker thread): every finished variant is a kept progress report."""
-    from ladartui.sweep import connect, run_sweep
-
-    client = None
-    try:
-        if scheduler:
-            progress(0.0, f"connecting to {scheduler} ...")
-            client = connect(scheduler, connect_timeout, security)
-        return run_sweep(
-            spec,
-            client=client,
-            cancel=cancel,
-            objective=objective,
-            cost=cost,
-            budget=budget,
-            serial=serial,
-            progress=lambda p: progress(p.fraction, "", p, keep=p.row is not None),
-        )
-    finally:
-        if client is not None:
-            client.close()
-
-
-def _write_best(spec, row: dict, parameter_names, path: Path) -> Path:
-    """The best variant as a scenario file beside the results (worker thread)."""
-    from ladartui.scenario import load_scenario
-    from ladartui.sweep.execute import base_scenario_path, write_best_scenario
-
-    base = load_scenario(base_scenario_path(spec))
-    return write_best_scenario(path, base, row, parameter_names, base.load_scene)

@@ -1,0 +1,79 @@
+"""The sweep screen's work outside the interface thread: the sweep job, writing the
+best variant as a scenario, and the paths and process set-up they need. Nothing
+here draws; tui/sweep_screen.py starts these and shows what they report."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+
+def start_resource_tracker() -> None:
+    """Start multiprocessing's resource tracker with the process's real stderr.
+
+    The tracker is handed ``sys.stderr.fileno()``; while the interface runs,
+    ``sys.stderr`` is a capture object whose descriptor is -1, so a local
+    cluster started then fails ("bad value(s) in fds_to_keep"). Started once
+    here, it is reused by every later cluster.
+    """
+    from multiprocessing import resource_tracker
+
+    captured = sys.stderr
+    sys.stderr = sys.__stderr__
+    try:
+        resource_tracker.ensure_running()
+    finally:
+        sys.stderr = captured
+
+
+def sibling_spec(results: Path) -> Path | None:
+    """The spec whose default results folder is ``results`` (``S-results`` beside ``S.toml``)."""
+    folder = results if results.is_dir() else results.parent
+    if not folder.name.endswith("-results"):
+        return None
+    spec = folder.parent / (folder.name[: -len("-results")] + ".toml")
+    return spec if spec.is_file() else None
+
+
+def sweep_job(
+    spec,
+    scheduler: str,
+    security,
+    serial: bool,
+    objective: str,
+    cost: str,
+    budget,
+    connect_timeout: float,
+    cancel,
+    progress,
+):
+    """The sweep job (worker thread): every finished variant is a kept progress report."""
+    from ladartui.sweep import connect, run_sweep
+
+    client = None
+    try:
+        if scheduler:
+            progress(0.0, f"connecting to {scheduler} ...")
+            client = connect(scheduler, connect_timeout, security)
+        return run_sweep(
+            spec,
+            client=client,
+            cancel=cancel,
+            objective=objective,
+            cost=cost,
+            budget=budget,
+            serial=serial,
+            progress=lambda p: progress(p.fraction, "", p, keep=p.row is not None),
+        )
+    finally:
+        if client is not None:
+            client.close()
+
+
+def write_best(spec, row: dict, parameter_names, path: Path) -> Path:
+    """The best variant as a scenario file beside the results (worker thread)."""
+    from ladartui.scenario import load_scenario
+    from ladartui.sweep.execute import base_scenario_path, write_best_scenario
+
+    base = load_scenario(base_scenario_path(spec))
+    return write_best_scenario(path, base, row, parameter_names, base.load_scene)
