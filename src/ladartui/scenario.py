@@ -112,7 +112,7 @@ from ladartui.flight import (
     Manual,
     ScanPose,
 )
-from ladartui.levels import LEVEL_KEYS, LevelThresholds, levels_from_table
+from ladartui.levels import LEVEL_KEYS, LEVELS, LevelThresholds, levels_from_table
 from ladartui.scenario_style import restyle
 from ladartui.sensor import MAX_PIXEL_PITCH, Sensor
 from ladartui.toml_lines import key_lines, key_lines_from_text
@@ -424,7 +424,7 @@ class Scenario:
 def _levels_text(thresholds: LevelThresholds, default: bool) -> str:
     shares = ", ".join(
         f"{level} {thresholds.voxel_share(level):.0%} / {thresholds.footprint_share(level):.0%}"
-        for level in ("detect", "recognise", "identify")
+        for level in LEVELS
     )
     return f"{shares} of visible voxels / footprint" + (" (defaults)" if default else "")
 

@@ -202,7 +202,7 @@ def _per_target(scenario, scene, per_scan, scene_output, target_output, measures
     """Every measure for each target of the scene's target model, named by the scenario."""
     from ladartui.target_measures import LevelInputs, PerTarget, TargetMeasures, compute_target_measures
 
-    names = getattr(scenario, "target_name", None)
+    names = scenario.target_name
     ids = np.unique(scene.target_ids)
     if ids.size == 1:
         # One target: its measures are the overall ones (the same voxels), not computed twice.

@@ -27,6 +27,7 @@ section but the flight, with the same keys.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import json
 import math
 import re
@@ -44,7 +45,7 @@ from ladartui.measures import (
     measures_from_lines,
     section_lines,
 )
-from ladartui.scene.keys import keys_to_voxels, sorted_unique, voxel_keys
+from ladartui.scene.keys import keys_to_voxels, member, sorted_unique, voxel_keys
 
 HIGH, LOW = "high", "low"  # which way is better
 # (Measures field, .cmf key, better, kind); the *_after_scan fields are per-scan tuples.
@@ -104,11 +105,11 @@ class PerTarget:
 
     targets: tuple[TargetMeasures, ...]
 
-    @property
+    @functools.cached_property  # summed once: tables, .cmf lines and JSON all read them
     def worst(self) -> TargetSummary:
         return _summary(self.targets, worst=True)
 
-    @property
+    @functools.cached_property
     def mean(self) -> TargetSummary:
         return _summary(self.targets, worst=False)
 
@@ -181,10 +182,7 @@ def compute_target_measures(
         if voxels is None:
             return None
         keys = voxel_keys(voxels)
-        if all_keys.size == 0 or keys.size == 0:
-            return np.zeros((0, 3), dtype=np.int32)
-        pos = np.minimum(np.searchsorted(all_keys, keys), all_keys.size - 1)
-        return keys_to_voxels(keys[all_keys[pos] == keys])
+        return keys_to_voxels(keys[member(keys, all_keys)])
 
     def per_scan(returns):
         return None if returns is None else [on_target(r) for r in returns]
