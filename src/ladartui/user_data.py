@@ -117,13 +117,13 @@ def _model_files(folder: Path, name: str):
     return scene_file, target_file_for(scene_file)
 
 
-def _complete(folder: Path, name: str = "default") -> bool:
+def _complete(folder: Path, name: str) -> bool:
     if not (folder / f"{name}.toml").is_file():
         return False
     return all(p.is_file() for p in _model_files(folder, name))
 
 
-def _materialise(folder: Path, name: str = "default") -> None:
+def _materialise(folder: Path, name: str) -> None:
     from ladartui.scene.generate import generate_scene
 
     preset, overrides = BUNDLED[name]
