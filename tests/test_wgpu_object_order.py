@@ -9,8 +9,8 @@ import pytest
 from ladartui.scene.occupancy import Occupancy
 from ladartui.sensor import Sensor
 from ladartui.tracing.backend import GROUND, MISS, VOXEL
-from ladartui.tracing.object_order import shader_voxels
 from ladartui.tracing.reference import reference_trace_cells
+from ladartui.tracing.shader_scan import cell_packing, ray_tiles_of, tile_entries, voxel_words
 from scans import assert_same, forest_scene, one_scan, random_scan
 
 # The wgpu_backend and numba_backend fixtures come from tests/conftest.py.
@@ -108,6 +108,7 @@ def test_buffers_grow_and_are_reused(forest, f64_backend, numba_backend):
 
 
 def test_ray_order_where_object_order_cannot_run(forest, f64_backend, numba_backend, monkeypatch):
+    from ladartui.tracing import shader_scan
     from ladartui.tracing import wgpu_backend as module
 
     _, occ = forest
@@ -127,8 +128,8 @@ def test_ray_order_where_object_order_cannot_run(forest, f64_backend, numba_back
     assert long_lists.info["order"] == "ray"
     assert_same(expected, long_lists)
     monkeypatch.undo()
-    # A scene too large for float32 voxel coordinates.
-    monkeypatch.setattr(module, "F32_EXACT", max(occ.shape))
+    # Voxels in view whose cells do not pack into the shader's word.
+    monkeypatch.setattr(shader_scan, "PACKED_BITS", 8)
     large = f64_backend.trace_cells(occ, origins, directions, order="object")
     assert large.info["order"] == "ray"
     assert_same(expected, large)
@@ -159,15 +160,48 @@ def test_order_is_learned_per_occupancy(forest, f64_backend, numba_backend):
     assert seen == {"object", "ray"}
 
 
-def test_shader_voxels_round_the_brick_nears_down():
+def test_cells_pack_into_one_word_and_back():
     rng = np.random.default_rng(8)
-    m = 2000
+    for spans in ([2048, 2048, 1024], [1, 300, 7], [1 << 20, 1, 1 << 12], [5000, 5000, 1]):
+        vox = np.zeros((500, 7), np.int64)
+        vox[:, :3] = rng.integers(0, spans, (500, 3)) + rng.integers(-(1 << 23), 1 << 23, 3)
+        vox[:2, :3] = vox[:, :3].min(axis=0), vox[:, :3].max(axis=0)
+        offset, shifts, masks = cell_packing(vox)
+        tile_starts = np.array([0, len(vox)])
+        listed = rng.permutation(len(vox))
+        words = voxel_words(vox, np.zeros((len(vox), 2)), offset, shifts)
+        packed = tile_entries(tile_starts, listed, words)[:, 1]
+        cells = np.stack([(packed >> np.uint32(shifts[a])) & np.uint32(masks[a]) for a in range(3)], axis=1)
+        assert np.array_equal(cells.astype(np.int64) + offset, vox[listed, :3])
+    vox[:2, :3] = [0, 0, 0], [1 << 11, 1 << 11, 1 << 10]  # 12 + 12 + 11 bits
+    assert cell_packing(vox) is None
+
+
+def test_tile_entries_carry_the_least_near_still_to_come_rounded_down():
+    rng = np.random.default_rng(9)
+    m = 3000
     vox = np.zeros((m, 7), np.int64)
-    vox[:, :3] = rng.integers(-(1 << 24) + 1, 1 << 24, (m, 3))
     nears = rng.uniform(-1e-6, 1e5, (m, 2)) * rng.choice([1.0, 1e-6], (m, 2))
-    records = shader_voxels(vox, nears)
-    low = records[:, 0].astype(np.float64)
-    assert (low <= nears[:, 1]).all()
-    assert (np.nextafter(records[:, 0], np.float32(np.inf)).astype(np.float64) >= nears[:, 1]).all()
-    assert (low < nears[:, 1]).any()  # some did need rounding down
-    assert np.array_equal(records[:, 1:].astype(np.int64), vox[:, :3])
+    tile_starts = np.array([0, 0, 700, 701, 2900, 4000])
+    listed = rng.integers(0, m, tile_starts[-1])
+    words = voxel_words(vox, nears, np.zeros(3, np.int64), np.zeros(3, np.int64))
+    rests = tile_entries(tile_starts, listed, words)[:, 0]
+    rests = rests.view(np.float32).astype(np.float64)
+    exact = np.concatenate(
+        [
+            np.minimum.accumulate(nears[listed[a:b], 0][::-1])[::-1]
+            for a, b in zip(tile_starts[:-1], tile_starts[1:])
+        ]
+    )
+    assert (rests <= exact).all()
+    assert (np.nextafter(rests.astype(np.float32), np.float32(np.inf)).astype(np.float64) > exact).all()
+    assert (rests < exact).any()  # some did need rounding down
+
+
+def test_ray_tiles_follow_the_bins_starts():
+    rng = np.random.default_rng(4)
+    shift = 1
+    counts = rng.integers(0, 3, 4 * 25)  # 25 tiles of 2 x 2 bins
+    bin_starts = np.concatenate([[0], np.cumsum(counts)])
+    per_tile = counts.reshape(25, 4).sum(axis=1)
+    assert np.array_equal(ray_tiles_of(bin_starts, shift), np.repeat(np.arange(25), per_tile))

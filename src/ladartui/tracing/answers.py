@@ -9,7 +9,7 @@ ray order with it.
 import math
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from ladartui.tracing.config import GROUND, INF, MISS, VOXEL
 
@@ -36,28 +36,3 @@ def put_answer(r, q, t, vox, ox, oy, oz, dx, dy, dz, nx, ny, kind, index, tout):
     kind[r], index[r, 0], index[r, 1], index[r, 2], tout[r] = ray_answer(
         q >= 0, i, j, k, t, ox, oy, oz, dx, dy, dz, nx, ny
     )
-
-
-@njit(parallel=True, nogil=True, cache=True)
-def scan_answers(order, best_t, best_v, vox, orig, dirs, nx, ny, kind, index, tout):
-    """Object-order hits of the wgpu backend's shader (tracing.object_order) back in ray
-    order, with the ground rule."""
-    for s in prange(order.shape[0]):
-        r = order[s]
-        put_answer(
-            r,
-            best_v[s],
-            best_t[s],
-            vox,
-            orig[r, 0],
-            orig[r, 1],
-            orig[r, 2],
-            dirs[r, 0],
-            dirs[r, 1],
-            dirs[r, 2],
-            nx,
-            ny,
-            kind,
-            index,
-            tout,
-        )

@@ -51,3 +51,14 @@ def slab(o, d, inv, lo, hi):
     if lo < o < hi:
         return -INF, INF
     return INF, -INF
+
+
+@njit(nogil=True, cache=True, inline="always")
+def cube_start(ox, oy, oz, dx, dy, dz, ix, iy, iz, x, y, z):
+    """(start, leave): where the ray enters the cell at (x, y, z), from t = 0 on, and
+    leaves it (the reference tracer's slab test of the cell's open interior; ``i*``
+    are ``1 / d``, inf for 0). It meets the cell if start < leave."""
+    ex, lx = slab(ox, dx, ix, x, x + 1.0)
+    ey, ly = slab(oy, dy, iy, y, y + 1.0)
+    ez, lz = slab(oz, dz, iz, z, z + 1.0)
+    return max(max(ex, max(ey, ez)), 0.0), min(lx, min(ly, lz))

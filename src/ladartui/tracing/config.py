@@ -67,7 +67,7 @@ MAX_OCCUPANCY_BINDINGS = 128
 MARCH_SAMPLES_PER_PASS = 1 << 15
 # Object order in the shader: tiles of 2 x 2 bins. Small tiles keep each ray's
 # list short; the shader pays for every entry a ray walks past.
-OBJECT_ORDER_TILE_SHIFT = 1
+OBJECT_ORDER_TILE_SHIFT = 2
 # Longest tile list an invocation may walk: under lavapipe's 65,535 loop iterations.
 LOOP_BUDGET = 65_000
 

@@ -39,14 +39,12 @@ GIL; the passes over rays and voxels run under ``prange``.
 from __future__ import annotations
 
 import math
-from typing import NamedTuple
 
 import numba
 import numpy as np
 from numba import njit, prange
 
 from ladartui.tracing.config import EPS, INF, MIN_COS, NEAR_MARGIN, PARTS
-from ladartui.tracing.scan_rays import scan_grid, sort_rays
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -286,53 +284,6 @@ def voxels_per_tile(vox, tiles_per_side, shift, threads):
     return starts, listed
 
 
-@njit(nogil=True, cache=True, inline="always")
-def _f32_below(x):
-    """The float32 nearest ``x`` from below (a depth bound must not rise)."""
-    f = np.float32(x)
-    if np.float64(f) > x:
-        f = np.nextafter(f, np.float32(-np.inf))
-    return f
-
-
-@njit(parallel=True, nogil=True, cache=True)
-def shader_voxels(vox, nears):
-    """The voxels in view as shaders/object_order.wgsl reads them: float32 (brick's
-    near rounded down, x, y, z) per voxel. Exact for coordinates below 2**24."""
-    m = vox.shape[0]
-    out = np.empty((m, 4), np.float32)
-    for e in prange(m):
-        out[e, 0] = _f32_below(nears[e, 1])
-        for a in range(3):
-            out[e, 1 + a] = np.float32(vox[e, a])
-    return out
-
-
-class Scan(NamedTuple):
-    """A scan made ready for the tile tests (``prepare_scan``).
-
-    Sorted position ``s`` is ray ``order[s]``, with origin and direction
-    ``rays[s]`` (``invs[s]`` its ``1 / d``), bin ``bins[s]`` (``i | j << 16``) and bound ``exits[s]``; the
-    rays of bin key ``b`` are ``bin_starts[b] .. bin_starts[b + 1]``. ``vox`` and
-    ``nears`` are the voxels in view (``emit_voxels``), ``tile_starts`` and
-    ``listed`` each tile's voxels (``voxels_per_tile``).
-    """
-
-    order: np.ndarray
-    rays: np.ndarray
-    invs: np.ndarray
-    bins: np.ndarray
-    exits: np.ndarray
-    bin_starts: np.ndarray
-    vox: np.ndarray
-    nears: np.ndarray
-    tile_starts: np.ndarray
-    listed: np.ndarray
-    nb: int
-    tile_shift: int
-    tiles_per_side: int
-
-
 def scan_voxels(occ, frame, grid, nb, max_voxels, tile_shift):
     """(vox, nears, tile_starts, listed): the voxels in view of a scan whose rays are
     binned by ``grid`` (``emit_voxels``), listed per tile of ``1 << tile_shift`` bins a
@@ -361,37 +312,3 @@ def scan_voxels(occ, frame, grid, nb, max_voxels, tile_shift):
     vox, nears = emit_voxels(found, brick_near, first, occ.bricks, centre, grow, axis, u, v, grid, nb)
     tile_starts, listed = voxels_per_tile(vox, -(-nb >> tile_shift), tile_shift, numba.get_num_threads())
     return vox, nears, tile_starts, listed
-
-
-def prepare_scan(occ, orig, dirs, frame, max_voxels, tile_shift):
-    """A scan's rays binned and copied in bin order (``sort_rays``), and its voxels in
-    view listed per tile of ``1 << tile_shift`` bins a side (``scan_voxels``); None
-    when it cannot be projected or has too many voxels in view (ray order is then the
-    cheaper way), or when a ray is not of unit length within 60 degrees of the axis."""
-    binned = scan_grid(dirs, frame)
-    if binned is None:
-        return None
-    nb, p, q, grid = binned
-    voxels = scan_voxels(occ, frame, grid, nb, max_voxels, tile_shift)
-    if voxels is None:
-        return None
-    bin_starts, order, bins, rays, invs, exits = sort_rays(
-        p, q, grid, nb, tile_shift, orig, dirs, occ.bbox_lo.astype(np.float64), occ.bbox_hi.astype(np.float64)
-    )
-    vox, nears, tile_starts, listed = voxels
-    tiles_per_side = -(-nb >> tile_shift)
-    return Scan(
-        order,
-        rays,
-        invs,
-        bins,
-        exits,
-        bin_starts,
-        vox,
-        nears,
-        tile_starts,
-        listed,
-        nb,
-        tile_shift,
-        tiles_per_side,
-    )

@@ -5,8 +5,7 @@ narrow cone) gets a frame: the origins' centre and half-spread and the cone's
 axis ``a`` with two directions ``u``, ``v`` across it (``cone_frame``). Its rays
 are binned by their gnomonic coordinates ``(d.u / d.a, d.v / d.a)`` in an
 nb x nb grid (``ray_grid``) and put in bin order, tile by tile
-(``bin_order``, or ``sort_rays`` which also copies them, for the wgpu
-backend). tracing/object_order.py finds the voxels in view of those bins.
+(``bin_order``). tracing/object_order.py finds the voxels in view of those bins.
 All numba functions here release the GIL; the passes over rays run under
 ``prange``.
 """
@@ -18,7 +17,6 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from ladartui.tracing.axis import slab
 from ladartui.tracing.config import INF, MAX_SPREAD, MIN_COS, PARTS
 
 
@@ -149,24 +147,20 @@ def _bin_of(p, q, grid, nb):
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def _bin_keys(p, q, grid, nb, shift, key_of, bin_of):
+def _bin_keys(p, q, grid, nb, shift, key_of):
     nt = -(-nb >> shift)
     for r in prange(p.shape[0]):
         i, j = _bin_of(p[r], q[r], grid, nb)
         key_of[r] = bin_key(i, j, nt, shift)
-        if bin_of.shape[0]:
-            bin_of[r] = np.uint32(i | (j << 16))
 
 
 @njit(nogil=True, cache=True)
-def _sort_into_bins(p, q, grid, nb, shift, with_bins=True):
-    """(starts, order, bins): counting sort of the rays by ``bin_key``; ``bins`` holds
-    each sorted ray's bin as ``i | j << 16`` (empty unless ``with_bins``)."""
+def _sort_into_bins(p, q, grid, nb, shift):
+    """(starts, order): counting sort of the rays by ``bin_key``."""
     n = p.shape[0]
     nt = -(-nb >> shift)
     key_of = np.empty(n, np.int64)
-    bin_of = np.empty(n if with_bins else 0, np.uint32)
-    _bin_keys(p, q, grid, nb, shift, key_of, bin_of)
+    _bin_keys(p, q, grid, nb, shift, key_of)
     starts = np.zeros((nt * nt << 2 * shift) + 1, np.int64)
     for r in range(n):
         starts[key_of[r] + 1] += 1
@@ -174,44 +168,19 @@ def _sort_into_bins(p, q, grid, nb, shift, with_bins=True):
         starts[b + 1] += starts[b]
     fill = starts[:-1].copy()
     order = np.empty(n, np.int64)
-    bins = np.empty(bin_of.shape[0], np.uint32)
     for r in range(n):
-        at = fill[key_of[r]]
-        order[at] = r
-        if with_bins:
-            bins[at] = bin_of[r]
+        order[fill[key_of[r]]] = r
         fill[key_of[r]] += 1
-    return starts, order, bins
-
-
-@njit(nogil=True, cache=True, inline="always")
-def _put(k, r, orig, dirs, lo, hi, rays, invs, exits):
-    """Ray r at sorted position k: origin, direction, ``1 / d`` (the kernels' inverse,
-    inf for 0: the tile tests then divide nothing) and where it leaves the box [lo, hi)."""
-    leave = INF
-    for a in range(3):
-        rays[k, a] = orig[r, a]
-        rays[k, 3 + a] = dirs[r, a]
-        inv = 1.0 / dirs[r, a] if dirs[r, a] != 0.0 else INF
-        invs[k, a] = inv
-        leave = min(leave, slab(orig[r, a], dirs[r, a], inv, lo[a], hi[a])[1])
-    exits[k] = leave
+    return starts, order
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def _gather(order, orig, dirs, lo, hi, rays, invs, exits):
-    """Rays in sorted order (``_put``)."""
-    for k in prange(order.shape[0]):
-        _put(k, order[k], orig, dirs, lo, hi, rays, invs, exits)
-
-
-@njit(parallel=True, nogil=True, cache=True)
-def _scatter_one_per_bin(p, q, grid, nb, shift, order, bins, slack):
+def _scatter_one_per_bin(p, q, grid, nb, shift, order, slack):
     """The sort when every bin holds exactly one ray (a whole scan, whose own ray grid
     the bins then are): each ray's number goes straight to the position of its bin's
     key, in one parallel pass. Needs nb * nb rays and whole tiles (the keys are then
     0 .. n-1). False when some bin got none (so another got two): the caller sorts
-    instead. ``bins`` may be empty (not wanted). ``slack`` gets the largest distance,
+    instead. ``slack`` gets the largest distance,
     in bins, of a ray's p and q from its bin's middle."""
     n = p.shape[0]
     nt = nb >> shift
@@ -225,8 +194,6 @@ def _scatter_one_per_bin(p, q, grid, nb, shift, order, bins, slack):
             order[k] = r
             far[part, 0] = max(far[part, 0], abs((p[r] - grid[0]) / grid[1] - (i + 0.5)))
             far[part, 1] = max(far[part, 1], abs((q[r] - grid[2]) / grid[3] - (j + 0.5)))
-            if bins.shape[0]:
-                bins[k] = np.uint32(i | (j << 16))
     slack[0], slack[1] = far[:, 0].max(), far[:, 1].max()
     missing = np.zeros(PARTS, np.bool_)
     for part in prange(PARTS):
@@ -267,44 +234,21 @@ def scan_grid(dirs, frame):
     return None if gnomonic is None else (nb, *gnomonic)
 
 
-def sort_rays(p, q, grid, nb, shift, orig, dirs, lo, hi):
-    """Rays in bin order: (starts, order, bins, rays, invs, exits).
-
-    The rays of the bin with key ``b`` (``bin_key``) are sorted positions
-    ``starts[b] .. starts[b + 1]``; ``order`` maps a sorted position back to the
-    ray; ``rays`` holds its origin and direction, ``invs`` its ``1 / d`` per axis,
-    ``bins`` its bin; its exit is
-    where it leaves the occupied box [lo, hi) (every voxel hit comes before it).
-    A whole scan has one ray per bin (nb = ceil(sqrt(n)) bins a side over its own
-    ray grid): then a parallel scatter of the ray numbers replaces the serial
-    counting sort (``_scatter_one_per_bin``; same result when both apply).
-    """
-    n = len(p)
-    rays, invs, exits = np.empty((n, 6)), np.empty((n, 3)), np.empty(n)
-    if n == nb * nb and nb % (1 << shift) == 0:
-        order, bins = np.empty(n, np.int64), np.empty(n, np.uint32)
-        if _scatter_one_per_bin(p, q, grid, nb, shift, order, bins, np.empty(2)):
-            _gather(order, orig, dirs, lo, hi, rays, invs, exits)
-            return np.arange(n + 1, dtype=np.int64), order, bins, rays, invs, exits
-    starts, order, bins = _sort_into_bins(p, q, grid, nb, shift)
-    _gather(order, orig, dirs, lo, hi, rays, invs, exits)
-    return starts, order, bins, rays, invs, exits
-
-
 def bin_order(p, q, grid, nb, shift):
-    """(order, starts, grid) of the rays in bin order without copying them (``sort_rays``
-    copies them too): sorted position s is ray ``order[s]``; ``starts`` as there, or
-    empty when every bin holds exactly one ray (bin key b is then position b). The
+    """(order, starts, grid) of the rays in bin order, without copying them: sorted
+    position s is ray ``order[s]``; the rays of the bin with key ``b`` (``bin_key``)
+    are sorted positions ``starts[b] .. starts[b + 1]``, or ``starts`` is empty when
+    every bin holds exactly one ray (bin key b is then position b). The
     grid comes back with the slack measured then: how far, in bins, any ray lies from
     its bin's middle (a scan's rays sit near the middles, so voxels cover fewer bins)."""
     n = len(p)
     if n == nb * nb and nb % (1 << shift) == 0:
         order = np.empty(n, np.int64)
         slack = np.empty(2)
-        if _scatter_one_per_bin(p, q, grid, nb, shift, order, np.empty(0, np.uint32), slack):
+        if _scatter_one_per_bin(p, q, grid, nb, shift, order, slack):
             measured = grid.copy()
             # A hair over the measure: it is rounded as box_bins' own positions are.
             measured[4:] = np.minimum(0.5, slack + 1e-6)
             return order, np.empty(0, np.int64), measured
-    starts, order, _ = _sort_into_bins(p, q, grid, nb, shift, False)
+    starts, order = _sort_into_bins(p, q, grid, nb, shift)
     return order, starts, grid

@@ -17,7 +17,7 @@ import numpy as np
 from numba import njit, prange
 
 from ladartui.tracing.answers import put_answer
-from ladartui.tracing.axis import slab
+from ladartui.tracing.axis import cube_start
 from ladartui.tracing.config import INF, MAX_TILE_SHIFT
 from ladartui.tracing.object_order import scan_voxels
 from ladartui.tracing.scan_rays import bin_order, scan_grid
@@ -28,11 +28,20 @@ def _slab_start(ray, s, x, y, z, best):
     """Where tile ray s enters voxel (x, y, z) (the reference tracer's slab test of
     its open interior, from t = 0 on); ``best`` when it does not, or not before.
     ``ray[s]`` holds origin, direction and ``1 / d`` (inf for 0)."""
-    ex, lx = slab(ray[s, 0], ray[s, 3], ray[s, 6], x, x + 1.0)
-    ey, ly = slab(ray[s, 1], ray[s, 4], ray[s, 7], y, y + 1.0)
-    ez, lz = slab(ray[s, 2], ray[s, 5], ray[s, 8], z, z + 1.0)
-    enter, leave = max(ex, max(ey, ez)), min(lx, min(ly, lz))
-    start = max(enter, 0.0)
+    start, leave = cube_start(
+        ray[s, 0],
+        ray[s, 1],
+        ray[s, 2],
+        ray[s, 3],
+        ray[s, 4],
+        ray[s, 5],
+        ray[s, 6],
+        ray[s, 7],
+        ray[s, 8],
+        x,
+        y,
+        z,
+    )
     return start if start < leave and start < best else best
 
 

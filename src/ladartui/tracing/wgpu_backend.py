@@ -24,9 +24,10 @@ Resources:
 
 Object order: exact ``f64`` scans (one aircraft, a narrow cone; see
 ``tracing/object_order.py``) go voxel by voxel as in the numba backend. The
-host bins and sorts the rays and lists the voxels in view per tile with the
-numba functions there (``prepare_scan``); ``shaders/object_order.wgsl`` runs
-the tile tests, one invocation per ray; the host applies the ground rule.
+host puts the rays in bin order and lists the voxels in view per tile with the
+numba functions of ``tracing/shader_scan.py`` (``prepare_shader_scan``);
+``shaders/object_order.wgsl`` runs the tile tests, one invocation per ray; the
+host makes each hit an answer, or applies the ground rule (``entry_answers``).
 ``OrderChoice`` learns per occupancy whether that or the ray-order shader is
 faster, as in numba, and ``CellHits.info["order"]`` says which ran.
 
@@ -53,7 +54,6 @@ from typing import Any
 import numpy as np
 
 from ladartui.errors import BackendUnavailable, FieldError, check_cancelled
-from ladartui.tracing.answers import scan_answers
 from ladartui.tracing.backend import (
     GROUND,
     METHODS,
@@ -80,9 +80,9 @@ from ladartui.tracing.config import (
     UNFINISHED,
     wgsl_constants,
 )
-from ladartui.tracing.object_order import prepare_scan, shader_voxels
 from ladartui.tracing.order_choice import OrderChoice, trace_in_blocks
 from ladartui.tracing.scan_rays import cone_frame
+from ladartui.tracing.shader_scan import entry_answers, prepare_shader_scan
 
 NAME = "wgpu"
 
@@ -95,7 +95,6 @@ ADAPTER_TYPE_RANK = {"DiscreteGPU": 0, "IntegratedGPU": 1, "VirtualGPU": 2, "CPU
 GRAPHICS_BACKEND_RANK = {"Vulkan": 0, "Metal": 0, "D3D12": 0, "OpenGL": 1}
 # Bindings besides the occupancy chunks: params, rays, hit cells, hit ranges, bundle starts.
 FIXED_BINDINGS = 5
-F32_EXACT = 1 << 24  # integers below this are exact in float32
 
 
 def choose_adapter(adapters):
@@ -588,45 +587,43 @@ class WgpuBackend:
     def _object_order(self, occupancy, origins, directions, bounds, max_voxels, kind, index, t):
         """One scan in object order into kind/index/t; False when it is no scan for it
         (or its lists or arrays exceed what the adapter allows)."""
-        if max(occupancy.shape) >= F32_EXACT:
-            return False  # voxel coordinates go to the shader as float32
         frame = cone_frame(origins, directions, bounds)
         scan = (
             None
             if frame is None
-            else prepare_scan(occupancy, origins, directions, frame, max_voxels, OBJECT_ORDER_TILE_SHIFT)
+            else prepare_shader_scan(
+                occupancy, origins, directions, frame, max_voxels, OBJECT_ORDER_TILE_SHIFT
+            )
         )
         if scan is None or np.diff(scan.tile_starts).max(initial=0) >= LOOP_BUDGET:
             return False
-        found = self._test_tiles(scan)
+        found = self._test_tiles(occupancy, origins, directions, scan)
         if found is None:
             return False
         nx, ny = float(occupancy.shape[0]), float(occupancy.shape[1])
-        scan_answers(scan.order, *found, scan.vox, origins, directions, nx, ny, kind, index, t)
+        entry_answers(found, scan.listed, scan.vox, origins, directions, nx, ny, kind, index, t)
         return True
 
-    def _test_tiles(self, scan) -> tuple[np.ndarray, np.ndarray] | None:
-        """(best_t, best_v) of a prepared scan from shaders/object_order.wgsl, or None
-        when one of its arrays exceeds a storage binding."""
-        n = len(scan.order)
+    def _test_tiles(self, occupancy, origins, directions, scan) -> np.ndarray | None:
+        """Each ray's hit as an entry of the scan's tile lists (-1 none), from
+        shaders/object_order.wgsl; None when an array exceeds a storage binding."""
+        n = len(origins)
         inputs = {
-            "rays": scan.rays,
-            "bins": scan.bins,
-            "best_t": np.clip(scan.exits, -SHADER_INF, SHADER_INF),  # the shader has no infinity
-            "voxels": shader_voxels(scan.vox, scan.nears),
-            "tile_starts": scan.tile_starts.astype(np.uint32),
-            "listed": scan.listed.astype(np.uint32),
+            "origins": origins,
+            "directions": directions,
+            "order": scan.order,
+            "ray_tiles": scan.ray_tiles,
+            "tile_starts": scan.tile_starts,
+            "entries": scan.entries,
         }
         sizes = {name: array.nbytes for name, array in inputs.items()}
-        sizes["best_v"] = 4 * n
+        sizes["found"] = 4 * n
         if max(sizes.values()) > self._scan_buffer_limit():
             return None
         buffers = {name: self._scan_buffer(name, size) for name, size in sizes.items()}
-        buffers["params"] = self._scan_buffer("params", 16, uniform=True)
+        buffers["params"] = self._scan_buffer("params", TILE_PARAMS_BYTES, uniform=True)
         queue = self._device.queue
-        queue.write_buffer(
-            buffers["params"], 0, np.array([n, scan.tile_shift, scan.tiles_per_side, 0], dtype=np.uint32)
-        )
+        queue.write_buffer(buffers["params"], 0, pack_tile_params(n, scan, occupancy))
         for name, array in inputs.items():
             if array.nbytes:
                 queue.write_buffer(buffers[name], 0, np.ascontiguousarray(array))
@@ -652,9 +649,7 @@ class WgpuBackend:
         compute.dispatch_workgroups(groups[0], groups[1], 1)
         compute.end()
         queue.submit([encoder.finish()])
-        best_t = np.frombuffer(queue.read_buffer(buffers["best_t"], 0, 8 * n), dtype=np.float64)
-        best_v = np.frombuffer(queue.read_buffer(buffers["best_v"], 0, 4 * n), dtype=np.int32)
-        return best_t, best_v
+        return np.frombuffer(queue.read_buffer(buffers["found"], 0, 4 * n), dtype=np.int32)
 
     def _scan_buffer_limit(self):
         return min(self._limits["max-storage-buffer-binding-size"], self._limits["max-buffer-size"])
@@ -844,7 +839,20 @@ def cube_box(occupancy):
 
 
 # Bindings of shaders/object_order.wgsl, in order.
-SCAN_BINDINGS = ("params", "rays", "bins", "best_t", "best_v", "voxels", "tile_starts", "listed")
+SCAN_BINDINGS = ("params", "origins", "directions", "order", "ray_tiles", "tile_starts", "entries", "found")
+# Its uniform block, struct TileParams: six vec4 of 32-bit integers.
+TILE_PARAMS_BYTES = 6 * 16
+
+
+def pack_tile_params(rays, scan, occupancy) -> bytes:
+    """The uniform block of one object-order dispatch, laid out as ``struct TileParams``."""
+    offset, shifts, masks = scan.packing
+    ints = np.zeros((6, 4), dtype=np.int64)
+    ints[0, :3] = (rays, scan.tile_shift, 0 if len(scan.ray_tiles) else 1)
+    ints[1, :3], ints[2, :3], ints[3, :3] = shifts, masks, offset
+    ints[4, :3], ints[5, :3] = occupancy.bbox_lo, occupancy.bbox_hi
+    return ints.astype(np.uint32).tobytes()  # the i32 fields as their two's complement
+
 
 # Params (uniform, see struct Params in trace.wgsl): 10 vec4 of 32-bit integers
 # then a vec2<real> of float parameters (16 bytes in f64, 8 in f32).

@@ -1,0 +1,192 @@
+"""The host's half of the wgpu backend's object order: a scan made ready for
+shaders/object_order.wgsl, and the shader's hits made answers.
+
+The steps are numba's (tracing/tile_tests.py's ``trace_scan``): the rays in bin
+order (``scan_rays.bin_order``, no copies: the shader reads each ray through
+the order), the voxels in view listed per tile (``object_order.scan_voxels``).
+What differs is the shape of the lists. The shader runs one invocation per ray
+and lavapipe loads storage lane by lane, so each word an invocation reads
+costs: a tile's entry is two u32 (``tile_entries``), the least voxel ``near``
+from it to the end of its list (the tile stop numba takes per tile, here per
+ray) and the voxel's cell packed into one word relative to the voxels' least
+corner (``cell_packing``). The shader writes back the entry of each ray's hit;
+``entry_answers`` turns it into the voxel and recomputes ``t`` with the slab
+test both tracers share (``axis.cube_start``).
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+from numba import njit, prange
+
+from ladartui.tracing.answers import put_answer
+from ladartui.tracing.axis import cube_start
+from ladartui.tracing.config import INF
+from ladartui.tracing.object_order import scan_voxels
+from ladartui.tracing.scan_rays import bin_order, scan_grid
+
+PACKED_BITS = 32  # a packed cell is one u32
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _f32_below(x):
+    """The float32 nearest ``x`` from below (a depth bound must not rise)."""
+    f = np.float32(x)
+    if np.float64(f) > x:
+        f = np.nextafter(f, np.float32(-np.inf))
+    return f
+
+
+class ShaderScan(NamedTuple):
+    """A scan made ready for the shader (``prepare_shader_scan``).
+
+    Sorted position ``s`` is ray ``order[s]``, in tile ``ray_tiles[s]`` (empty when
+    every bin holds one ray: the tile is then ``s >> 2 * tile_shift``). Tile ``k``'s
+    entries are ``tile_starts[k] .. tile_starts[k + 1]`` of ``entries`` (rest as
+    float32 bits, packed cell); entry ``e`` is voxel ``listed[e]`` of ``vox``.
+    ``packing`` is (offset, shifts, masks) of the cells (``cell_packing``).
+    """
+
+    order: np.ndarray
+    ray_tiles: np.ndarray
+    tile_starts: np.ndarray
+    entries: np.ndarray
+    listed: np.ndarray
+    vox: np.ndarray
+    packing: tuple
+    tile_shift: int
+
+
+def cell_packing(vox):
+    """(offset, shifts, masks) that pack cell ``vox[e, :3]`` into one u32 as
+    ``sum((cell[a] - offset[a]) << shifts[a])``, each axis with the bits its span
+    of the voxels needs; None when they need more than 32 bits together. An axis
+    with one value takes no bits (shift and mask 0)."""
+    offset, top = _cell_box(vox)
+    bits = [int(span).bit_length() for span in top - offset]
+    if sum(bits) > PACKED_BITS:
+        return None
+    shifts = np.array([0, bits[0], bits[0] + bits[1]], np.int64) * (np.array(bits) > 0)
+    masks = np.array([(1 << b) - 1 for b in bits], np.int64)
+    return offset, shifts, masks
+
+
+@njit(nogil=True, cache=True)
+def _cell_box(vox):
+    """(least, greatest) cell of the voxels per axis; zeros when there are none."""
+    lo, hi = np.zeros(3, np.int64), np.zeros(3, np.int64)
+    if vox.shape[0]:
+        lo[:], hi[:] = vox[0, :3], vox[0, :3]
+    for q in range(1, vox.shape[0]):
+        for a in range(3):
+            lo[a], hi[a] = min(lo[a], vox[q, a]), max(hi[a], vox[q, a])
+    return lo, hi
+
+
+@njit(parallel=True, nogil=True, cache=True)
+def voxel_words(vox, nears, offset, shifts):
+    """(m, 2) u32 per voxel: its ``near`` as float32 rounded down (still a lower
+    bound), and its packed cell."""
+    words = np.empty((vox.shape[0], 2), np.uint32)
+    as_float = words.view(np.float32)
+    for q in prange(vox.shape[0]):
+        as_float[q, 0] = _f32_below(nears[q, 0])
+        packed = 0
+        for a in range(3):
+            packed |= (vox[q, a] - offset[a]) << shifts[a]
+        words[q, 1] = np.uint32(packed)
+    return words
+
+
+@njit(parallel=True, nogil=True, cache=True)
+def tile_entries(tile_starts, listed, words):
+    """Each tile's entries as the shader reads them: (E, 2) u32, the least voxel
+    ``near`` from this entry to the end of its tile's list (of ``voxel_words``'
+    float32 nears: rounding down commutes with the minimum) and the packed cell."""
+    entries = np.empty((listed.shape[0], 2), np.uint32)
+    as_float = entries.view(np.float32)
+    near = words.view(np.float32)
+    for tile in prange(tile_starts.shape[0] - 1):
+        first, end = tile_starts[tile], tile_starts[tile + 1]
+        rest = INF
+        for k in range(end - first):  # last entry first (a reversed range ran slower)
+            e = end - 1 - k
+            q = listed[e]
+            rest = min(rest, np.float64(near[q, 0]))
+            as_float[e, 0] = np.float32(rest)
+            entries[e, 1] = words[q, 1]
+    return entries
+
+
+@njit(parallel=True, nogil=True, cache=True)
+def ray_tiles_of(bin_starts, shift):
+    """Tile of every sorted position, from the bins' starts (bin key ``b`` holds
+    positions ``bin_starts[b] .. bin_starts[b + 1]``; a tile's bins are contiguous)."""
+    per_tile = 1 << (2 * shift)
+    tiles = (bin_starts.shape[0] - 1) // per_tile
+    out = np.empty(bin_starts[-1], np.uint32)
+    for tile in prange(tiles):
+        for s in range(bin_starts[tile * per_tile], bin_starts[(tile + 1) * per_tile]):
+            out[s] = tile
+    return out
+
+
+def prepare_shader_scan(occ, orig, dirs, frame, max_voxels, tile_shift):
+    """A scan's rays in bin order and its voxels in view as tile entries for the
+    shader (tiles of ``1 << tile_shift`` bins a side); None when it cannot be
+    projected, has more than ``max_voxels`` voxels in view, or its voxels' cells do
+    not pack into 32 bits (ray order then)."""
+    binned = scan_grid(dirs, frame)
+    if binned is None:
+        return None
+    nb, p, q, grid = binned
+    order, bin_starts, grid = bin_order(p, q, grid, nb, tile_shift)
+    voxels = scan_voxels(occ, frame, grid, nb, max_voxels, tile_shift)
+    if voxels is None:
+        return None
+    vox, nears, tile_starts, listed = voxels
+    packing = cell_packing(vox)
+    if packing is None:
+        return None
+    offset, shifts, _ = packing
+    ray_tiles = ray_tiles_of(bin_starts, tile_shift) if len(bin_starts) else np.empty(0, np.uint32)
+    return ShaderScan(
+        order.astype(np.uint32),
+        ray_tiles,
+        tile_starts.astype(np.uint32),
+        tile_entries(tile_starts, listed, voxel_words(vox, nears, offset, shifts)),
+        listed,
+        vox,
+        packing,
+        tile_shift,
+    )
+
+
+@njit(parallel=True, nogil=True, cache=True)
+def entry_answers(found, listed, vox, orig, dirs, nx, ny, kind, index, tout):
+    """Every ray's answer from the shader's ``found`` (per ray, the entry of its hit,
+    -1 none): the voxel ``vox[listed[e]]`` at the start of its slab test, else the
+    ground rule."""
+    for r in prange(found.shape[0]):
+        ox, oy, oz = orig[r, 0], orig[r, 1], orig[r, 2]
+        dx, dy, dz = dirs[r, 0], dirs[r, 1], dirs[r, 2]
+        q, t = -1, INF
+        if found[r] >= 0:
+            q = listed[found[r]]
+            t = cube_start(
+                ox,
+                oy,
+                oz,
+                dx,
+                dy,
+                dz,
+                1.0 / dx if dx != 0.0 else INF,
+                1.0 / dy if dy != 0.0 else INF,
+                1.0 / dz if dz != 0.0 else INF,
+                np.float64(vox[q, 0]),
+                np.float64(vox[q, 1]),
+                np.float64(vox[q, 2]),
+            )[0]
+        put_answer(r, q, t, vox, ox, oy, oz, dx, dy, dz, nx, ny, kind, index, tout)
