@@ -251,6 +251,9 @@ class WgpuBackend:
         self._device: Any = None
         self._limits: dict[str, int] = {}
         self._has_f64 = False
+        # On a CPU adapter (lavapipe) storage buffers can be mapped: the scan's arrays
+        # then go straight into them instead of through a staging copy each way.
+        self._maps_storage = False
         self._uploads: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()
         self._pinned_uploads: dict[int, Any] = {}  # for occupancies that cannot be weakly referenced
         self._pipelines: dict[Any, Any] = {}
@@ -259,6 +262,7 @@ class WgpuBackend:
         self._orders: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()  # -> OrderChoice
         self._scan_buffers: dict[str, Any] = {}  # object order's buffers by name, and their bind group
         self._scan_group: tuple[tuple[int, ...] | None, Any] = (None, None)  # buffer ids, bind group
+        self._mapping: dict[str, Any] = {}  # object-order buffers being mapped for the next scan
 
     # -- probing and device -------------------------------------------------
 
@@ -287,6 +291,9 @@ class WgpuBackend:
             return INSTALL_HINT
         self._adapter = adapter
         self._has_f64 = "shader-f64" in adapter.features
+        self._maps_storage = (
+            adapter.info.get("adapter_type") == "CPU" and "mappable-primary-buffers" in adapter.features
+        )
         return None
 
     def _require(self):
@@ -310,6 +317,8 @@ class WgpuBackend:
             "max-compute-workgroups-per-dimension": limits["max-compute-workgroups-per-dimension"],
         }
         features = ["shader-f64"] if self._has_f64 else []
+        if self._maps_storage:
+            features.append("mappable-primary-buffers")
         try:
             self._device = adapter.request_device_sync(
                 label="ladartui-trace", required_features=features, required_limits=wanted
@@ -607,6 +616,8 @@ class WgpuBackend:
     def _test_tiles(self, occupancy, origins, directions, scan) -> np.ndarray | None:
         """Each ray's hit as an entry of the scan's tile lists (-1 none), from
         shaders/object_order.wgsl; None when an array exceeds a storage binding."""
+        import wgpu
+
         n = len(origins)
         inputs = {
             "origins": origins,
@@ -625,8 +636,7 @@ class WgpuBackend:
         queue = self._device.queue
         queue.write_buffer(buffers["params"], 0, pack_tile_params(n, scan, occupancy))
         for name, array in inputs.items():
-            if array.nbytes:
-                queue.write_buffer(buffers[name], 0, np.ascontiguousarray(array))
+            self._fill(name, buffers[name], np.ascontiguousarray(array))
         pipeline = self._tiles_pipeline()
         key = tuple(id(buffers[name]) for name in SCAN_BINDINGS)
         if self._scan_group[0] != key:  # made again only when a buffer has grown
@@ -649,7 +659,48 @@ class WgpuBackend:
         compute.dispatch_workgroups(groups[0], groups[1], 1)
         compute.end()
         queue.submit([encoder.finish()])
-        return np.frombuffer(queue.read_buffer(buffers["found"], 0, 4 * n), dtype=np.int32)
+        found = np.frombuffer(self._read(buffers["found"], 4 * n), dtype=np.int32)
+        if self._maps_storage:
+            # Map the inputs for the next scan now, so that the wait for it passes
+            # while the host works (asked for right after the host's numba passes,
+            # a map waited for their threads to stop spinning).
+            for name in inputs:
+                self._mapping[name] = buffers[name].map_async(wgpu.MapMode.WRITE)
+        return found
+
+    def _fill(self, name, buffer, array):
+        """``array`` into the start of object-order buffer ``name``, which is left
+        unmapped for the dispatch."""
+        import wgpu
+
+        mapping = self._mapping.pop(name, None)
+        if not self._maps_storage:
+            if array.nbytes:
+                self._device.queue.write_buffer(buffer, 0, array)
+            return
+        if mapping is not None:
+            mapping.sync_wait()
+        elif array.nbytes:
+            buffer.map_sync(wgpu.MapMode.WRITE)
+        else:
+            return
+        try:
+            if array.nbytes:
+                buffer.write_mapped(array, 0)
+        finally:
+            buffer.unmap()
+
+    def _read(self, buffer, size):
+        """A copy of the first ``size`` bytes of an object-order buffer, once the queue is done."""
+        import wgpu
+
+        if not self._maps_storage:
+            return self._device.queue.read_buffer(buffer, 0, size)
+        buffer.map_sync(wgpu.MapMode.READ, 0, size)
+        try:
+            return buffer.read_mapped(0, size)
+        finally:
+            buffer.unmap()
 
     def _scan_buffer_limit(self):
         return min(self._limits["max-storage-buffer-binding-size"], self._limits["max-buffer-size"])
@@ -660,9 +711,17 @@ class WgpuBackend:
 
         buffer = self._scan_buffers.get(name)
         if buffer is None or buffer.size < size:
-            usage = (
-                wgpu.BufferUsage.UNIFORM if uniform else wgpu.BufferUsage.STORAGE | wgpu.BufferUsage.COPY_SRC
-            ) | wgpu.BufferUsage.COPY_DST
+            mapping = self._mapping.pop(name, None)
+            if mapping is not None:  # the old buffer goes: end its mapping first
+                mapping.sync_wait()
+                buffer.unmap()
+            usage = wgpu.BufferUsage.STORAGE
+            if uniform:
+                usage = wgpu.BufferUsage.UNIFORM | wgpu.BufferUsage.COPY_DST
+            elif self._maps_storage:
+                usage |= wgpu.BufferUsage.MAP_READ if name == "found" else wgpu.BufferUsage.MAP_WRITE
+            else:
+                usage |= wgpu.BufferUsage.COPY_SRC if name == "found" else wgpu.BufferUsage.COPY_DST
             # Room to grow, within the limits (which need not be powers of two).
             size = max(16, min(1 << (max(size, 1) - 1).bit_length(), self._scan_buffer_limit() // 4 * 4))
             buffer = self._device.create_buffer(label=f"scan-{name}", size=size, usage=usage)
