@@ -2,8 +2,8 @@
 
 ``ray_answer`` is compiled into the numba kernels (the exact kernel and the
 object-order tile tests) and written again in WGSL (shaders/trace.wgsl,
-``ground``); ``scan_answers`` puts the wgpu backend's object-order hits back in
-ray order with it.
+``ground``); ``put_answer`` writes an object-order hit with it (numba's tile
+tests, and tracing/shader_scan.py for the wgpu backend's shader).
 """
 
 import math

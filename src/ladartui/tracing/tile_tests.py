@@ -273,7 +273,8 @@ def test_tiles(
 
 def trace_scan(occ, orig, dirs, frame, max_voxels, nx, ny, kind, index, t):
     """One scan's exact answers in object order into kind/index/t; False (nothing
-    written) when it is no scan for it (``object_order.prepare_scan`` says when)."""
+    written) when it is no scan for it: its rays cannot be binned (``scan_grid``), or
+    ``scan_voxels`` finds a brick it cannot project or more than ``max_voxels`` in view."""
     binned = scan_grid(dirs, frame)
     if binned is None:
         return False

@@ -83,6 +83,7 @@ from ladartui.tracing.config import (
 from ladartui.tracing.order_choice import OrderChoice, trace_in_blocks
 from ladartui.tracing.scan_rays import cone_frame
 from ladartui.tracing.shader_scan import entry_answers, prepare_shader_scan
+from ladartui.tracing.wgpu_scans import ScanDispatcher, dispatch_grid
 
 NAME = "wgpu"
 
@@ -123,17 +124,6 @@ def chunk_words_for(max_binding_bytes: int) -> int:
     """Words per occupancy chunk: the largest power of two fitting one binding."""
     words = max(int(max_binding_bytes) // 4, 1)
     return 1 << (words.bit_length() - 1)
-
-
-def dispatch_grid(workgroups: int, max_per_dimension: int) -> tuple[int, int]:
-    """(x, y) workgroup counts covering ``workgroups`` within the per-dimension limit."""
-    if workgroups <= 0:
-        return (0, 0)
-    x = min(workgroups, max_per_dimension)
-    y = -(-workgroups // x)
-    if y > max_per_dimension:
-        raise ValueError(f"{workgroups} workgroups exceed a {max_per_dimension}^2 grid")
-    return (x, y)
 
 
 def f32_start_offsets(origins, directions, shape, top, method, at_least=None):
@@ -251,8 +241,7 @@ class WgpuBackend:
         self._device: Any = None
         self._limits: dict[str, int] = {}
         self._has_f64 = False
-        # On a CPU adapter (lavapipe) storage buffers can be mapped: the scan's arrays
-        # then go straight into them instead of through a staging copy each way.
+        # On a CPU adapter (lavapipe) storage buffers can be mapped (tracing/wgpu_scans.py).
         self._maps_storage = False
         self._uploads: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()
         self._pinned_uploads: dict[int, Any] = {}  # for occupancies that cannot be weakly referenced
@@ -260,9 +249,7 @@ class WgpuBackend:
         self._ray_buffers: dict[Any, Any] = {}
         self._sources: dict[str, str] = {}
         self._orders: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()  # -> OrderChoice
-        self._scan_buffers: dict[str, Any] = {}  # object order's buffers by name, and their bind group
-        self._scan_group: tuple[tuple[int, ...] | None, Any] = (None, None)  # buffer ids, bind group
-        self._mapping: dict[str, Any] = {}  # object-order buffers being mapped for the next scan
+        self._scans: ScanDispatcher | None = None  # object order on the device, once it is open
 
     # -- probing and device -------------------------------------------------
 
@@ -331,6 +318,7 @@ class WgpuBackend:
         for key, cap in self._caps.items():
             if cap is not None:
                 self._limits[key] = min(self._limits[key], int(cap))
+        self._scans = ScanDispatcher(self._device, self._limits, self._shader_file, self._maps_storage)
         return self._device
 
     def describe(self) -> dict:
@@ -475,24 +463,6 @@ class WgpuBackend:
             self._pipelines[key] = pipeline
         return pipeline
 
-    def _tiles_pipeline(self):
-        """The object-order pipeline (f64 only)."""
-        pipeline = self._pipelines.get("tiles")
-        if pipeline is None:
-            code = (
-                wgsl_constants("f64")
-                + "\n"
-                + self._shader_file("axis.wgsl")
-                + "\n"
-                + self._shader_file("object_order.wgsl")
-            )
-            module = self._device.create_shader_module(label="tiles", code=code)
-            pipeline = self._device.create_compute_pipeline(
-                label="tiles", layout="auto", compute={"module": module, "entry_point": "test_tiles"}
-            )
-            self._pipelines["tiles"] = pipeline
-        return pipeline
-
     def _ray_buffers_for(self, precision: str):
         """Ray input and hit output buffers for one batch, reused across calls."""
         import wgpu
@@ -606,127 +576,13 @@ class WgpuBackend:
         )
         if scan is None or np.diff(scan.tile_starts).max(initial=0) >= LOOP_BUDGET:
             return False
-        found = self._test_tiles(occupancy, origins, directions, scan)
+        assert self._scans is not None  # the device is open
+        found = self._scans.test_tiles(occupancy, origins, directions, scan)
         if found is None:
             return False
         nx, ny = float(occupancy.shape[0]), float(occupancy.shape[1])
         entry_answers(found, scan.listed, scan.vox, origins, directions, nx, ny, kind, index, t)
         return True
-
-    def _test_tiles(self, occupancy, origins, directions, scan) -> np.ndarray | None:
-        """Each ray's hit as an entry of the scan's tile lists (-1 none), from
-        shaders/object_order.wgsl; None when an array exceeds a storage binding."""
-        import wgpu
-
-        n = len(origins)
-        inputs = {
-            "origins": origins,
-            "directions": directions,
-            "order": scan.order,
-            "ray_tiles": scan.ray_tiles,
-            "tile_starts": scan.tile_starts,
-            "entries": scan.entries,
-        }
-        sizes = {name: array.nbytes for name, array in inputs.items()}
-        sizes["found"] = 4 * n
-        if max(sizes.values()) > self._scan_buffer_limit():
-            return None
-        buffers = {name: self._scan_buffer(name, size) for name, size in sizes.items()}
-        buffers["params"] = self._scan_buffer("params", TILE_PARAMS_BYTES, uniform=True)
-        queue = self._device.queue
-        queue.write_buffer(buffers["params"], 0, pack_tile_params(n, scan, occupancy))
-        for name, array in inputs.items():
-            self._fill(name, buffers[name], np.ascontiguousarray(array))
-        pipeline = self._tiles_pipeline()
-        key = tuple(id(buffers[name]) for name in SCAN_BINDINGS)
-        if self._scan_group[0] != key:  # made again only when a buffer has grown
-            self._scan_group = (
-                key,
-                self._device.create_bind_group(
-                    layout=pipeline.get_bind_group_layout(0),
-                    entries=[
-                        {"binding": b, "resource": {"buffer": buffers[name]}}
-                        for b, name in enumerate(SCAN_BINDINGS)
-                    ],
-                ),
-            )
-        group = self._scan_group[1]
-        groups = dispatch_grid(-(-n // BUNDLE), self._limits["max-compute-workgroups-per-dimension"])
-        encoder = self._device.create_command_encoder()
-        compute = encoder.begin_compute_pass()
-        compute.set_pipeline(pipeline)
-        compute.set_bind_group(0, group)
-        compute.dispatch_workgroups(groups[0], groups[1], 1)
-        compute.end()
-        queue.submit([encoder.finish()])
-        found = np.frombuffer(self._read(buffers["found"], 4 * n), dtype=np.int32)
-        if self._maps_storage:
-            # Map the inputs for the next scan now, so that the wait for it passes
-            # while the host works (asked for right after the host's numba passes,
-            # a map waited for their threads to stop spinning).
-            for name in inputs:
-                self._mapping[name] = buffers[name].map_async(wgpu.MapMode.WRITE)
-        return found
-
-    def _fill(self, name, buffer, array):
-        """``array`` into the start of object-order buffer ``name``, which is left
-        unmapped for the dispatch."""
-        import wgpu
-
-        mapping = self._mapping.pop(name, None)
-        if not self._maps_storage:
-            if array.nbytes:
-                self._device.queue.write_buffer(buffer, 0, array)
-            return
-        if mapping is not None:
-            mapping.sync_wait()
-        elif array.nbytes:
-            buffer.map_sync(wgpu.MapMode.WRITE)
-        else:
-            return
-        try:
-            if array.nbytes:
-                buffer.write_mapped(array, 0)
-        finally:
-            buffer.unmap()
-
-    def _read(self, buffer, size):
-        """A copy of the first ``size`` bytes of an object-order buffer, once the queue is done."""
-        import wgpu
-
-        if not self._maps_storage:
-            return self._device.queue.read_buffer(buffer, 0, size)
-        buffer.map_sync(wgpu.MapMode.READ, 0, size)
-        try:
-            return buffer.read_mapped(0, size)
-        finally:
-            buffer.unmap()
-
-    def _scan_buffer_limit(self):
-        return min(self._limits["max-storage-buffer-binding-size"], self._limits["max-buffer-size"])
-
-    def _scan_buffer(self, name, size, uniform=False):
-        """A buffer of at least ``size`` bytes for object order, kept for later scans."""
-        import wgpu
-
-        buffer = self._scan_buffers.get(name)
-        if buffer is None or buffer.size < size:
-            mapping = self._mapping.pop(name, None)
-            if mapping is not None:  # the old buffer goes: end its mapping first
-                mapping.sync_wait()
-                buffer.unmap()
-            usage = wgpu.BufferUsage.STORAGE
-            if uniform:
-                usage = wgpu.BufferUsage.UNIFORM | wgpu.BufferUsage.COPY_DST
-            elif self._maps_storage:
-                usage |= wgpu.BufferUsage.MAP_READ if name == "found" else wgpu.BufferUsage.MAP_WRITE
-            else:
-                usage |= wgpu.BufferUsage.COPY_SRC if name == "found" else wgpu.BufferUsage.COPY_DST
-            # Room to grow, within the limits (which need not be powers of two).
-            size = max(16, min(1 << (max(size, 1) - 1).bit_length(), self._scan_buffer_limit() // 4 * 4))
-            buffer = self._device.create_buffer(label=f"scan-{name}", size=size, usage=usage)
-            self._scan_buffers[name] = buffer
-        return buffer
 
     def _trace(self, occupancy, origins, directions, method, step, precision, cancel, info):
         n = len(origins)
@@ -895,22 +751,6 @@ def cube_box(occupancy):
         np.asarray(occupancy.cube_origin, dtype=np.int64),
         np.asarray(occupancy.cube_dims, dtype=np.int64),
     )
-
-
-# Bindings of shaders/object_order.wgsl, in order.
-SCAN_BINDINGS = ("params", "origins", "directions", "order", "ray_tiles", "tile_starts", "entries", "found")
-# Its uniform block, struct TileParams: six vec4 of 32-bit integers.
-TILE_PARAMS_BYTES = 6 * 16
-
-
-def pack_tile_params(rays, scan, occupancy) -> bytes:
-    """The uniform block of one object-order dispatch, laid out as ``struct TileParams``."""
-    offset, shifts, masks = scan.packing
-    ints = np.zeros((6, 4), dtype=np.int64)
-    ints[0, :3] = (rays, scan.tile_shift, 0 if len(scan.ray_tiles) else 1)
-    ints[1, :3], ints[2, :3], ints[3, :3] = shifts, masks, offset
-    ints[4, :3], ints[5, :3] = occupancy.bbox_lo, occupancy.bbox_hi
-    return ints.astype(np.uint32).tobytes()  # the i32 fields as their two's complement
 
 
 # Params (uniform, see struct Params in trace.wgsl): 10 vec4 of 32-bit integers
