@@ -107,6 +107,24 @@ def test_buffers_grow_and_are_reused(forest, f64_backend, numba_backend):
         assert_same(numba_backend.trace_cells(occ, origins, directions, order="ray"), gpu)
 
 
+def test_arrays_through_the_queue_give_the_same_answers(forest, f64_backend, numba_backend):
+    # On lavapipe the scan's buffers are mapped by the host; a GPU's way, copies
+    # through the queue, runs here too and answers the same, scan after scan.
+    from ladartui.tracing.wgpu_backend import WgpuBackend
+
+    _, occ = forest
+    queued = WgpuBackend(map_storage=False)
+    queued.trace_cells(occ, *one_scan([100, 140, 20], 60.0, 2.0, 180.0), order="object")
+    assert not queued.describe()["maps_storage"]
+    if f64_backend.describe()["adapter_type"] == "CPU":
+        assert f64_backend.describe()["maps_storage"]  # lavapipe: the mapped way
+    for depression in (45.0, 80.0):
+        origins, directions = one_scan([120, 110, 15], depression, 0.7, 200.0)
+        expected = numba_backend.trace_cells(occ, origins, directions, order="ray")
+        for backend in (queued, f64_backend):
+            assert_same(expected, gpu_object_order(backend, occ, origins, directions))
+
+
 def test_ray_order_where_object_order_cannot_run(forest, f64_backend, numba_backend, monkeypatch):
     from ladartui.tracing import shader_scan
     from ladartui.tracing import wgpu_backend as module

@@ -226,14 +226,18 @@ class WgpuBackend:
         max_binding_bytes: int | None = None,
         ray_batch: int = RAY_BATCH,
         max_workgroups_per_dimension: int | None = None,
+        map_storage: bool = True,
     ):
         """Optional caps below the adapter's limits (tests use them to force
-        occupancy splitting, several batches and 2-D dispatch grids)."""
+        occupancy splitting, several batches and 2-D dispatch grids);
+        ``map_storage=False`` copies object order's arrays through the queue even
+        on a CPU adapter, as on a GPU (tests run that way on lavapipe)."""
         self._caps = {
             "max-storage-buffer-binding-size": max_binding_bytes,
             "max-compute-workgroups-per-dimension": max_workgroups_per_dimension,
         }
         self._ray_batch = int(ray_batch)
+        self._map_storage = map_storage
         self._lock = threading.RLock()
         self._probed = False
         self._reason: str | None = None
@@ -279,7 +283,9 @@ class WgpuBackend:
         self._adapter = adapter
         self._has_f64 = "shader-f64" in adapter.features
         self._maps_storage = (
-            adapter.info.get("adapter_type") == "CPU" and "mappable-primary-buffers" in adapter.features
+            self._map_storage
+            and adapter.info.get("adapter_type") == "CPU"
+            and "mappable-primary-buffers" in adapter.features
         )
         return None
 
@@ -346,6 +352,7 @@ class WgpuBackend:
                 "limits": dict(limits),
                 "workgroup_size": BUNDLE,
                 "ray_batch": self._ray_batch,
+                "maps_storage": self._maps_storage,  # object order's buffers mapped by the host
             }
 
     # -- occupancy upload ---------------------------------------------------
