@@ -18,7 +18,7 @@
 // its list and recomputes t with the same slab test. In f64 the answers are
 // numba's bit for bit (tests/test_wgpu_object_order.py).
 //
-// tracing/wgpu_backend.py prepends the header of tracing/config.py (wgsl_constants:
+// tracing/wgpu_scans.py prepends the header of tracing/config.py (wgsl_constants:
 // `alias real = f64;`, INF, BUNDLE, ...) and shaders/axis.wgsl.
 // Loop budget (see trace.wgsl): the host sends no tile list of 65,535 entries or more.
 
