@@ -476,3 +476,45 @@ def test_a_scan_where_every_ray_hits_stops_tiles_early_and_still_matches(numba_b
     assert obj.info["order"] == "object"
     assert (obj.kind == VOXEL).all() and (obj.index[:, 2] == 40).mean() > 0.99
     assert_same(ray, obj)
+
+
+@pytest.mark.parametrize("depression", [35.0, 90.0])
+def test_bricks_in_view_are_every_brick_a_ray_can_meet_nearest_first(depression):
+    # The walk over root cells and regions runs in parallel; its list must be every
+    # non-empty brick whose own test passes (whatever the threads), nearest first.
+    import numba
+
+    from ladartui.tracing import object_order as oo
+    from ladartui.tracing.scan_rays import scan_grid
+
+    rng = np.random.default_rng(11)
+    shape = (1100, 700, 90)
+    voxels = np.unique(rng.integers(0, shape, (20000, 3)), axis=0)
+    occ = Occupancy.build(voxels, shape)
+    assert len(occ.root_dims) == 3 and int(np.prod(occ.root_dims)) >= 4  # several root cells
+    origins, directions = one_scan(
+        [550, 350, 40], depression, 0.4, 900.0, sensor=Sensor(grid=16, ray_grid=2, fov=40.0)
+    )
+    frame = cone_frame(origins, directions)
+    nb, _, _, grid = scan_grid(directions, frame)
+    args = (*frame, grid, nb, occ.root, occ.regions, occ.tiles)
+    args += (occ.root_origin.astype(np.int64), occ.root_dims.astype(np.int64))
+    found, near, ok = oo.bricks_in_view(*args)
+    assert ok and 50 < len(found)
+    assert np.all(np.diff(near) >= 0)
+    expected = {}
+    for corner in np.unique(voxels // 8, axis=0) * 8:
+        i0, i1, _, _, state, brick_near = oo.box_bins(*corner.tolist(), 8, *frame, grid, nb)
+        assert state != -1
+        if state == 1 and i0 <= i1:
+            expected[tuple(corner.tolist())] = brick_near
+    assert len(expected) < len(np.unique(voxels // 8, axis=0))  # some are out of view
+    assert {tuple(c) for c in found[:, :3].tolist()} == set(expected)
+    assert all(expected[tuple(c)] == n for c, n in zip(found[:, :3].tolist(), near))
+    threads = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        alone = oo.bricks_in_view(*args)
+    finally:
+        numba.set_num_threads(threads)
+    assert np.array_equal(alone[0], found) and np.array_equal(alone[1], near)

@@ -23,7 +23,7 @@ from numba import njit, prange
 
 from ladartui.tracing.answers import put_answer
 from ladartui.tracing.axis import cube_start
-from ladartui.tracing.config import INF
+from ladartui.tracing.config import INF, PARTS
 from ladartui.tracing.object_order import scan_voxels
 from ladartui.tracing.scan_rays import bin_order, scan_grid
 
@@ -73,15 +73,24 @@ def cell_packing(vox):
     return offset, shifts, masks
 
 
-@njit(nogil=True, cache=True)
+@njit(parallel=True, nogil=True, cache=True)
 def _cell_box(vox):
     """(least, greatest) cell of the voxels per axis; zeros when there are none."""
+    m = vox.shape[0]
     lo, hi = np.zeros(3, np.int64), np.zeros(3, np.int64)
-    if vox.shape[0]:
-        lo[:], hi[:] = vox[0, :3], vox[0, :3]
-    for q in range(1, vox.shape[0]):
+    if m == 0:
+        return lo, hi
+    spans = min(PARTS, m)  # every span holds a voxel
+    span_lo, span_hi = np.empty((spans, 3), np.int64), np.empty((spans, 3), np.int64)
+    for span in prange(spans):
+        first, end = span * m // spans, (span + 1) * m // spans
         for a in range(3):
-            lo[a], hi[a] = min(lo[a], vox[q, a]), max(hi[a], vox[q, a])
+            least = greatest = vox[first, a]
+            for q in range(first + 1, end):
+                least, greatest = min(least, vox[q, a]), max(greatest, vox[q, a])
+            span_lo[span, a], span_hi[span, a] = least, greatest
+    for a in range(3):
+        lo[a], hi[a] = span_lo[:, a].min(), span_hi[:, a].max()
     return lo, hi
 
 
