@@ -116,6 +116,10 @@ async def test_opening_results_shows_the_ranking_failures_and_pareto_front(finis
         # At 80 x 24 every key is in the footer, and the table and chart share the body.
         from textual.widgets._footer import FooterKey
 
+        # The footer composes its keys after the screen's bindings settle: on a busy
+        # machine that can take more than one pause (CI once saw none yet).
+        await wait_for(pilot, lambda: any(key.action == "run" for key in screen.query(FooterKey)))
+        await pilot.pause()
         shown_keys = {key.action: key.region for key in screen.query(FooterKey)}
         for binding in SweepScreen.BINDINGS:
             if binding.action == "cancel":  # shown only while a sweep runs
