@@ -82,7 +82,19 @@ def test_a_reference_to_a_missing_or_moved_function_is_reported(functions):
     ]
 
 
-SHARED = ("MISS", "VOXEL", "GROUND", "UNFINISHED", "CUT", "INF", "BUNDLE", "METHOD_EXACT", "METHOD_MARCH")
+SHARED = (
+    "MISS",
+    "VOXEL",
+    "GROUND",
+    "UNFINISHED",
+    "CUT",
+    "NO_VOXEL",
+    "CUT_WORD",
+    "INF",
+    "BUNDLE",
+    "METHOD_EXACT",
+    "METHOD_MARCH",
+)
 
 
 @pytest.mark.parametrize("shader", SHADERS, ids=[s.name for s in SHADERS])
@@ -101,13 +113,8 @@ def test_the_shader_header_carries_the_python_values(real):
     consts = dict(re.findall(r"const (\w+): \w+ = ([^;]+);", header))
     assert f"alias real = {real};" in header
     assert set(consts) == set(SHARED)
-    assert {name: int(consts[name]) for name in ("MISS", "VOXEL", "GROUND", "UNFINISHED", "CUT")} == {
-        "MISS": config.MISS,
-        "VOXEL": config.VOXEL,
-        "GROUND": config.GROUND,
-        "UNFINISHED": config.UNFINISHED,
-        "CUT": config.CUT,
-    }
+    codes = ("MISS", "VOXEL", "GROUND", "UNFINISHED", "CUT", "NO_VOXEL", "CUT_WORD")
+    assert {name: int(consts[name]) for name in codes} == {name: getattr(config, name) for name in codes}
     assert float(consts["INF"]) == config.SHADER_INF
     assert consts["BUNDLE"] == f"{config.BUNDLE}u"
     assert int(consts["METHOD_EXACT"]) == config.METHOD_CODES["exact"]

@@ -44,6 +44,10 @@ struct Params {
 @group(0) @binding(2) var<storage, read_write> hits: array<vec4<i32>>;  // kind, i, j, k
 @group(0) @binding(3) var<storage, read_write> ranges: array<real>;     // t of the hit
 @group(0) @binding(4) var<storage, read> starts: array<real>;           // bundle start per BUNDLE rays
+// first_hits (exact rays, tracing/wgpu_hits.py): the host's arrays as they are, one word back a ray.
+@group(0) @binding(5) var<storage, read> origins: array<real>;          // ox oy oz per ray
+@group(0) @binding(6) var<storage, read> directions: array<real>;       // dx dy dz per ray
+@group(0) @binding(7) var<storage, read_write> found: array<i32>;       // hit voxel's box offset, NO_VOXEL, CUT_WORD
 
 // MISS, VOXEL, GROUND; UNFINISHED (march: no answer within this pass's samples);
 // CUT (a loop was ended by the adapter, not by the ray): from the header.
@@ -502,4 +506,32 @@ fn trace_rays(@builtin(workgroup_id) group: vec3<u32>,
     }
     hits[r] = vec4<i32>(hit.kind, hit.i, hit.j, hit.k);
     ranges[r] = hit.t;
+}
+
+// Exact rays without their answers: each ray's first voxel as its offset in the
+// occupied box, (i - lo.x) + sx * ((j - lo.y) + sy * (k - lo.z)) with s the box's
+// sides (the host makes sure that fits an i32); NO_VOXEL when it hits none (the
+// host applies the ground rule), CUT_WORD when the adapter ended its loop. The
+// host recomputes t (axis.cube_start, as for object order): a quarter of
+// trace_rays' bytes back, and no repacking of the rays on the way in.
+@compute @workgroup_size(BUNDLE)
+fn first_hits(@builtin(workgroup_id) group: vec3<u32>,
+              @builtin(num_workgroups) groups: vec3<u32>,
+              @builtin(local_invocation_index) lane: u32) {
+    let r = (group.y * groups.x + group.x) * BUNDLE + lane;
+    if (r >= u32(params.run.x)) {
+        return;
+    }
+    let b = r * 3u;
+    let hit = first_voxel(origins[b], origins[b + 1u], origins[b + 2u],
+                          directions[b], directions[b + 1u], directions[b + 2u], starts[r / BUNDLE]);
+    var word = NO_VOXEL;
+    if (hit.kind == VOXEL) {
+        let lo = params.bbox_lo;
+        let side = params.bbox_hi - lo;
+        word = (hit.i - lo.x) + side.x * ((hit.j - lo.y) + side.y * (hit.k - lo.z));
+    } else if (hit.kind == CUT) {
+        word = CUT_WORD;
+    }
+    found[r] = word;
 }

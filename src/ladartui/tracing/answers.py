@@ -3,15 +3,17 @@
 ``ray_answer`` is compiled into the numba kernels (the exact kernel and the
 object-order tile tests) and written again in WGSL (shaders/trace.wgsl,
 ``ground``); ``put_answer`` writes an object-order hit with it (numba's tile
-tests, and tracing/shader_scan.py for the wgpu backend's shader).
+tests, and tracing/shader_scan.py for the wgpu backend's shader), and
+``box_offset_answers`` the hits of the wgpu backend's exact ray order.
 """
 
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
-from ladartui.tracing.config import GROUND, INF, MISS, VOXEL
+from ladartui.tracing.axis import cube_start
+from ladartui.tracing.config import CUT_WORD, GROUND, INF, MISS, VOXEL
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -36,3 +38,41 @@ def put_answer(r, q, t, vox, ox, oy, oz, dx, dy, dz, nx, ny, kind, index, tout):
     kind[r], index[r, 0], index[r, 1], index[r, 2], tout[r] = ray_answer(
         q >= 0, i, j, k, t, ox, oy, oz, dx, dy, dz, nx, ny
     )
+
+
+@njit(parallel=True, nogil=True, cache=True)
+def box_offset_answers(found, lo, sx, sy, orig, dirs, nx, ny, kind, index, tout):
+    """Every ray's answer from shaders/trace.wgsl's ``first_hits`` words: the voxel at
+    box offset ``found[r]`` (``(i - lo[0]) + sx * ((j - lo[1]) + sy * (k - lo[2]))``),
+    entered where the slab test both tracers share says (``axis.cube_start``); for
+    NO_VOXEL the ground rule. Returns how many rays say CUT_WORD (left as misses)."""
+    cut = 0
+    for r in prange(found.shape[0]):
+        ox, oy, oz = orig[r, 0], orig[r, 1], orig[r, 2]
+        dx, dy, dz = dirs[r, 0], dirs[r, 1], dirs[r, 2]
+        word = np.int64(found[r])
+        i, j, k, t = np.int64(-1), np.int64(-1), np.int64(-1), INF
+        if word == CUT_WORD:
+            cut += 1
+        elif word >= 0:
+            i = lo[0] + word % sx
+            j = lo[1] + (word // sx) % sy
+            k = lo[2] + word // (sx * sy)
+            t = cube_start(
+                ox,
+                oy,
+                oz,
+                dx,
+                dy,
+                dz,
+                1.0 / dx if dx != 0.0 else INF,
+                1.0 / dy if dy != 0.0 else INF,
+                1.0 / dz if dz != 0.0 else INF,
+                np.float64(i),
+                np.float64(j),
+                np.float64(k),
+            )[0]
+        kind[r], index[r, 0], index[r, 1], index[r, 2], tout[r] = ray_answer(
+            word >= 0, i, j, k, t, ox, oy, oz, dx, dy, dz, nx, ny
+        )
+    return cut

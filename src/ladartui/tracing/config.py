@@ -73,17 +73,27 @@ MARCH_SAMPLES_PER_PASS = 1 << 15
 OBJECT_ORDER_TILE_SHIFT = 2
 # Longest tile list an invocation may walk: under lavapipe's 65,535 loop iterations.
 LOOP_BUDGET = 65_000
+# trace.wgsl's first_hits: a ray's word when it hits no voxel, or its loop was cut.
+NO_VOXEL, CUT_WORD = -1, -2
 
 
 def wgsl_constants(real: str) -> str:
     """The header every shader is assembled after: the float type and the shared constants."""
     if real not in ("f32", "f64"):
         raise ValueError(f"real must be f32 or f64, not {real!r}")
-    kinds = {"MISS": MISS, "VOXEL": VOXEL, "GROUND": GROUND, "UNFINISHED": UNFINISHED, "CUT": CUT}
+    codes = {
+        "MISS": MISS,
+        "VOXEL": VOXEL,
+        "GROUND": GROUND,
+        "UNFINISHED": UNFINISHED,
+        "CUT": CUT,
+        "NO_VOXEL": NO_VOXEL,
+        "CUT_WORD": CUT_WORD,
+    }
     lines = [
         "// Written by tracing/config.py (wgsl_constants): change the values there.",
         f"alias real = {real};",
-        *(f"const {name}: i32 = {value};" for name, value in kinds.items()),
+        *(f"const {name}: i32 = {value};" for name, value in codes.items()),
         *(f"const METHOD_{name.upper()}: i32 = {code};" for name, code in METHOD_CODES.items()),
         f"const INF: real = {_wgsl_float(SHADER_INF)};",
         f"const BUNDLE: u32 = {BUNDLE}u;",

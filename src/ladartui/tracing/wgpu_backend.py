@@ -83,6 +83,7 @@ from ladartui.tracing.config import (
 from ladartui.tracing.order_choice import OrderChoice, trace_in_blocks
 from ladartui.tracing.scan_rays import cone_frame
 from ladartui.tracing.shader_scan import entry_answers, prepare_shader_scan
+from ladartui.tracing.wgpu_hits import HIT_BINDINGS, FirstHits, box_sides
 from ladartui.tracing.wgpu_scans import ScanDispatcher, dispatch_grid
 
 NAME = "wgpu"
@@ -94,8 +95,9 @@ INSTALL_HINT = (
 ADAPTER_TYPE_RANK = {"DiscreteGPU": 0, "IntegratedGPU": 1, "VirtualGPU": 2, "CPU": 3}
 # OpenGL adapters lack shader-f64 and large storage buffers; prefer the rest.
 GRAPHICS_BACKEND_RANK = {"Vulkan": 0, "Metal": 0, "D3D12": 0, "OpenGL": 1}
-# Bindings besides the occupancy chunks: params, rays, hit cells, hit ranges, bundle starts.
-FIXED_BINDINGS = 5
+# Bindings besides the occupancy chunks: params, rays, hit cells, hit ranges, bundle
+# starts (trace_rays); origins, directions, found (first_hits, tracing/wgpu_hits.py).
+FIXED_BINDINGS = 8
 
 
 def choose_adapter(adapters):
@@ -254,6 +256,7 @@ class WgpuBackend:
         self._sources: dict[str, str] = {}
         self._orders: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()  # -> OrderChoice
         self._scans: ScanDispatcher | None = None  # object order on the device, once it is open
+        self._hits: FirstHits | None = None  # exact ray order on the device, once it is open
 
     # -- probing and device -------------------------------------------------
 
@@ -325,6 +328,8 @@ class WgpuBackend:
             if cap is not None:
                 self._limits[key] = min(self._limits[key], int(cap))
         self._scans = ScanDispatcher(self._device, self._limits, self._shader_file, self._maps_storage)
+        cpu = adapter.info.get("adapter_type") == "CPU"
+        self._hits = FirstHits(self._device, self._limits, self._ray_batch, bundle_starts=cpu)
         return self._device
 
     def describe(self) -> dict:
@@ -455,17 +460,21 @@ class WgpuBackend:
             + self._shader_file("trace.wgsl")
         )
 
-    def _pipeline(self, precision: str, chunks: int, chunk_shift: int):
-        key = (precision, chunks, chunk_shift)
+    def _pipeline(self, precision: str, chunks: int, chunk_shift: int, entry: str = "trace_rays"):
+        """trace.wgsl's ``entry`` (trace_rays or first_hits) for this occupancy layout."""
+        key = (precision, chunks, chunk_shift, entry)
         pipeline = self._pipelines.get(key)
         if pipeline is None:
             device = self._open_device()
-            code = self._shader_source(precision, chunks, chunk_shift)
-            module = device.create_shader_module(label=f"trace-{precision}", code=code)
+            module = self._pipelines.get(key[:3])
+            if module is None:
+                code = self._shader_source(precision, chunks, chunk_shift)
+                module = device.create_shader_module(label=f"trace-{precision}", code=code)
+                self._pipelines[key[:3]] = module
             pipeline = device.create_compute_pipeline(
-                label=f"trace-{precision}-{chunks}",
+                label=f"{entry}-{precision}-{chunks}",
                 layout="auto",
-                compute={"module": module, "entry_point": "trace_rays"},
+                compute={"module": module, "entry_point": entry},
             )
             self._pipelines[key] = pipeline
         return pipeline
@@ -599,6 +608,9 @@ class WgpuBackend:
         if n == 0:
             return CellHits(kind, index, t, info)
         upload = self._upload(occupancy)
+        if method == "exact" and precision == "f64" and box_sides(occupancy) is not None:
+            self._first_hits(occupancy, upload, origins, directions, cancel, info, kind, index, t)
+            return CellHits(kind, index, t, info)
         chunks = len(upload.buffers)
         pipeline = self._pipeline(precision, chunks, upload.chunk_shift)
         buffers = self._ray_buffers_for(precision)
@@ -656,17 +668,37 @@ class WgpuBackend:
                 t[rows] = batch_t
             done = kind if pending is None else kind[pending]
             if np.any(done == CUT):
-                raise BackendUnavailable(
-                    f"backend {NAME!r} could not finish {int(np.sum(kind == CUT))} rays on "
-                    f"{info['adapter']!r}: the adapter ended their loops early (lavapipe stops "
-                    f"after 65,535 iterations); use backend 'numba'"
-                )
+                raise _cut_short(int(np.sum(kind == CUT)), info)
             pending = np.flatnonzero(done == UNFINISHED) if pending is None else pending[done == UNFINISHED]
             if len(pending) == 0:
                 break
             first_sample += MARCH_SAMPLES_PER_PASS
         index[kind == MISS] = -1
         return CellHits(kind, index, t, info)
+
+    def _first_hits(self, occupancy, upload, origins, directions, cancel, info, kind, index, t):
+        """Exact f64 rays through trace.wgsl's first_hits (tracing/wgpu_hits.py)."""
+        assert self._hits is not None  # the device is open
+        pipeline = self._pipeline("f64", len(upload.buffers), upload.chunk_shift, "first_hits")
+        buffers = self._hits.buffers(PARAMS_BYTES)
+        key = ("first_hits", id(pipeline), id(buffers["origins"]))
+        bound = {b: buffers[name] for name, b in HIT_BINDINGS.items()}
+        group = self._occupancy_group(upload, pipeline, key, bound)
+        cut = self._hits.trace(
+            occupancy,
+            pipeline,
+            group,
+            lambda count: pack_params(occupancy, upload, "exact", 0.5, count, "f64"),
+            origins,
+            directions,
+            halo_arrays(occupancy),
+            cancel,
+            kind,
+            index,
+            t,
+        )
+        if cut:
+            raise _cut_short(cut, info)
 
     def _dispatch(self, pipeline, bind_group, buffers, params, rays, starts):
         """One dispatch over ``rays`` (count, 6) with their bundle ``starts`` (one per
@@ -693,21 +725,28 @@ class WgpuBackend:
         return cells, ranges
 
     def _bind_group(self, upload, pipeline, buffers, precision):
-        key = (precision, id(pipeline), id(buffers["rays"]))
+        names = ("params", "rays", "cells", "ranges", "starts")  # trace_rays' bindings 0-4
+        bound = {b: buffers[name] for b, name in enumerate(names)}
+        return self._occupancy_group(upload, pipeline, (precision, id(pipeline), id(buffers["rays"])), bound)
+
+    def _occupancy_group(self, upload, pipeline, key, bound):
+        """The bind group of ``bound`` (binding -> buffer) and the occupancy's chunks,
+        made once per ``key`` and kept with the upload."""
         group = upload.bind_groups.get(key)
         if group is None:
-            entries = [
-                {"binding": 0, "resource": {"buffer": buffers["params"]}},
-                {"binding": 1, "resource": {"buffer": buffers["rays"]}},
-                {"binding": 2, "resource": {"buffer": buffers["cells"]}},
-                {"binding": 3, "resource": {"buffer": buffers["ranges"]}},
-                {"binding": 4, "resource": {"buffer": buffers["starts"]}},
-            ]
+            entries = [{"binding": b, "resource": {"buffer": buffer}} for b, buffer in bound.items()]
             for chunk, buffer in enumerate(upload.buffers):
                 entries.append({"binding": FIXED_BINDINGS + chunk, "resource": {"buffer": buffer}})
             group = self._device.create_bind_group(layout=pipeline.get_bind_group_layout(0), entries=entries)
             upload.bind_groups[key] = group
         return group
+
+
+def _cut_short(rays: int, info) -> BackendUnavailable:
+    return BackendUnavailable(
+        f"backend {NAME!r} could not finish {rays} rays on {info['adapter']!r}: the adapter "
+        f"ended their loops early (lavapipe stops after 65,535 iterations); use backend 'numba'"
+    )
 
 
 def bundle_start_array(origins, directions, halo: Halos):

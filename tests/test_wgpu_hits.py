@@ -1,0 +1,127 @@
+"""The wgpu backend's exact ray order (tracing/wgpu_hits.py, trace.wgsl's
+first_hits): one word a ray back, in batches, bundle starts only where they
+pay, and trace_rays where a box's offsets do not fit an i32.
+Every answer is checked against the numba backend, bit for bit."""
+
+from __future__ import annotations
+
+import threading
+
+import numpy as np
+import pytest
+
+from ladartui.errors import Cancelled
+from ladartui.tracing import wgpu_backend, wgpu_hits
+from ladartui.tracing.wgpu_backend import WgpuBackend
+from ladartui.tracing.wgpu_hits import box_sides
+from test_wgpu_backend import assert_same, random_rays, random_scene
+
+SHAPE = (50, 40, 30)
+
+
+@pytest.fixture(scope="module")
+def case():
+    occupancy = random_scene(21, SHAPE, 5000)
+    origins, directions = random_rays(22, SHAPE, 3000)
+    return occupancy, origins, directions
+
+
+def test_box_sides_fit_an_i32_or_are_refused():
+    def box(lo, hi):
+        return type("Box", (), {"bbox_lo": lo, "bbox_hi": hi})()
+
+    assert box_sides(box((2, 3, 4), (12, 8, 5))) == (10, 5, 1)
+    assert box_sides(box((0, 0, 0), (1 << 11, 1 << 10, 1 << 10))) == (
+        1 << 11,
+        1 << 10,
+        1 << 10,
+    )  # 2^31 offsets
+    assert box_sides(box((0, 0, 0), (1 << 11, 1 << 10, (1 << 10) + 1))) is None
+    assert box_sides(box((5, 5, 5), (5, 9, 9))) is None  # empty box
+
+
+def test_batches_in_flight_give_numba_answers(wgpu_backend, numba_backend, case):
+    """Batches of 640 rays (five, the last one short) and the one-batch call
+    agree with numba, ray for ray."""
+    occupancy, origins, directions = case
+    reference = numba_backend.trace_cells(occupancy, origins, directions, order="ray")
+    assert (reference.kind == 1).sum() > 500 and (reference.kind == 2).sum() > 10
+    batched = WgpuBackend(ray_batch=640)
+    hits = batched.trace_cells(occupancy, origins, directions, order="ray")
+    assert batched._hits.batch == 640 and hits.info["order"] == "ray"
+    assert_same(hits, reference)
+    assert_same(wgpu_backend.trace_cells(occupancy, origins, directions, order="ray"), reference)
+
+
+def scan_from(height):
+    """A 64 x 64 fan of rays looking down from one point above the scene's middle."""
+    angles = np.linspace(-0.3, 0.3, 64)
+    ax, ay = np.meshgrid(angles, angles)
+    directions = np.column_stack([np.tan(ax).ravel(), np.tan(ay).ravel(), -np.ones(ax.size)])
+    directions /= np.linalg.norm(directions, axis=1)[:, None]
+    origins = np.tile([SHAPE[0] / 2 + 0.25, SHAPE[1] / 2 + 0.25, height], (len(directions), 1))
+    return origins, directions
+
+
+def test_without_bundle_starts_the_answers_are_the_same(wgpu_backend, numba_backend, case):
+    """Starts on, then off for other rays (the starts of the first must not be
+    used for them), then on again: numba's answers each time."""
+    occupancy = case[0]
+    origins, directions = scan_from(SHAPE[2] * 4.0)  # long bundle starts
+    other_origins, other_directions = scan_from(SHAPE[2] + 0.5)  # hits before those starts
+    wgpu_backend.trace_cells(occupancy, origins[:10], directions[:10])  # opens the device
+    hits = wgpu_backend._hits
+    assert hits.bundle_starts == (wgpu_backend.describe()["adapter_type"] == "CPU")
+    was = hits.bundle_starts
+    try:
+        for starts, o, d in (
+            (True, origins, directions),
+            (False, other_origins, other_directions),
+            (True, other_origins, other_directions),
+        ):
+            hits.bundle_starts = starts
+            assert_same(
+                wgpu_backend.trace_cells(occupancy, o, d, order="ray"),
+                numba_backend.trace_cells(occupancy, o, d, order="ray"),
+            )
+    finally:
+        hits.bundle_starts = was
+
+
+def test_a_box_too_large_for_i32_offsets_goes_through_trace_rays(
+    wgpu_backend, numba_backend, case, monkeypatch
+):
+    occupancy, origins, directions = case
+    used = []
+    first_hits = WgpuBackend._first_hits
+    monkeypatch.setattr(WgpuBackend, "_first_hits", lambda self, *a: used.append(1) or first_hits(self, *a))
+    reference = numba_backend.trace_cells(occupancy, origins, directions, order="ray")
+    assert_same(wgpu_backend.trace_cells(occupancy, origins, directions, order="ray"), reference)
+    assert used
+    used.clear()
+    monkeypatch.setattr(wgpu_hits, "OFFSET_LIMIT", 100)
+    assert_same(wgpu_backend.trace_cells(occupancy, origins, directions, order="ray"), reference)
+    assert not used
+
+
+def test_cancelled_with_batches_in_flight_leaves_the_backend_usable(numba_backend, case, monkeypatch):
+    """Cancelled after the first batch's answers: Cancelled, the read-back buffer
+    not left mapped, and the next call answers in full."""
+    occupancy, origins, directions = case
+    backend = WgpuBackend(ray_batch=640)
+    cancel = threading.Event()
+    answers = wgpu_hits.box_offset_answers
+
+    def answer_then_cancel(*args):
+        cancel.set()
+        return answers(*args)
+
+    monkeypatch.setattr(wgpu_hits, "box_offset_answers", answer_then_cancel)
+    with pytest.raises(Cancelled):
+        backend.trace_cells(occupancy, origins, directions, order="ray", cancel=cancel)
+    assert backend._hits.buffers(wgpu_backend.PARAMS_BYTES)["back"].map_state == "unmapped"
+    monkeypatch.setattr(wgpu_hits, "box_offset_answers", answers)
+    assert_same(
+        backend.trace_cells(occupancy, origins, directions, order="ray"),
+        numba_backend.trace_cells(occupancy, origins, directions, order="ray"),
+    )
