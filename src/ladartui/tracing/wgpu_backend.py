@@ -14,7 +14,10 @@ Resources:
   each its own storage binding no larger than the adapter allows. They are
   uploaded once per ``Occupancy`` object and reused for every call.
 * Rays go in batches that fit one binding; each batch is one dispatch over a
-  2-D grid of workgroups kept within the per-dimension limit.
+  2-D grid of workgroups kept within the per-dimension limit. Exact ``f64``
+  rays go through trace.wgsl's ``first_hits`` (``tracing/wgpu_hits.py``: the
+  rays as the host holds them, one word a ray back); f32 and the march
+  through ``trace_rays`` (rays packed six reals a ray, kind, cell and ``t`` back).
 * The march goes in passes of at most ``MARCH_SAMPLES_PER_PASS`` samples a ray:
   lavapipe ends all loops of a shader invocation after 65,535 iterations in
   total, so a longer march would stop early. Rays without an answer after a
