@@ -26,9 +26,9 @@ from ladartui.tracing.wgpu_backend import (
     WgpuBackend,
     choose_adapter,
     chunk_words_for,
-    dispatch_grid,
     floor_preserving_f32,
 )
+from ladartui.tracing.wgpu_scans import dispatch_grid
 
 Occupancy = pytest.importorskip("ladartui.scene.occupancy").Occupancy
 

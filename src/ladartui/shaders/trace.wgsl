@@ -512,7 +512,7 @@ fn trace_rays(@builtin(workgroup_id) group: vec3<u32>,
 // occupied box, (i - lo.x) + sx * ((j - lo.y) + sy * (k - lo.z)) with s the box's
 // sides (the host makes sure that fits an i32); NO_VOXEL when it hits none (the
 // host applies the ground rule), CUT_WORD when the adapter ended its loop. The
-// host recomputes t (axis.cube_start, as for object order): a quarter of
+// host recomputes t (answers.voxel_entry, as for object order): a quarter of
 // trace_rays' bytes back, and no repacking of the rays on the way in.
 @compute @workgroup_size(BUNDLE)
 fn first_hits(@builtin(workgroup_id) group: vec3<u32>,

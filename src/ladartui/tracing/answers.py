@@ -40,12 +40,24 @@ def put_answer(r, q, t, vox, ox, oy, oz, dx, dy, dz, nx, ny, kind, index, tout):
     )
 
 
+@njit(nogil=True, cache=True, inline="always")
+def voxel_entry(ox, oy, oz, dx, dy, dz, i, j, k):
+    """Where the ray enters voxel (i, j, k): the slab test both tracers share
+    (``axis.cube_start``), for a voxel the ray is known to hit."""
+    inv_x = 1.0 / dx if dx != 0.0 else INF
+    inv_y = 1.0 / dy if dy != 0.0 else INF
+    inv_z = 1.0 / dz if dz != 0.0 else INF
+    return cube_start(
+        ox, oy, oz, dx, dy, dz, inv_x, inv_y, inv_z, np.float64(i), np.float64(j), np.float64(k)
+    )[0]
+
+
 @njit(parallel=True, nogil=True, cache=True)
 def box_offset_answers(found, lo, sx, sy, orig, dirs, nx, ny, kind, index, tout):
     """Every ray's answer from shaders/trace.wgsl's ``first_hits`` words: the voxel at
     box offset ``found[r]`` (``(i - lo[0]) + sx * ((j - lo[1]) + sy * (k - lo[2]))``),
-    entered where the slab test both tracers share says (``axis.cube_start``); for
-    NO_VOXEL the ground rule. Returns how many rays say CUT_WORD (left as misses)."""
+    entered where ``voxel_entry`` says; for NO_VOXEL the ground rule. Returns how
+    many rays say CUT_WORD (left as misses)."""
     cut = 0
     for r in prange(found.shape[0]):
         ox, oy, oz = orig[r, 0], orig[r, 1], orig[r, 2]
@@ -58,20 +70,7 @@ def box_offset_answers(found, lo, sx, sy, orig, dirs, nx, ny, kind, index, tout)
             i = lo[0] + word % sx
             j = lo[1] + (word // sx) % sy
             k = lo[2] + word // (sx * sy)
-            t = cube_start(
-                ox,
-                oy,
-                oz,
-                dx,
-                dy,
-                dz,
-                1.0 / dx if dx != 0.0 else INF,
-                1.0 / dy if dy != 0.0 else INF,
-                1.0 / dz if dz != 0.0 else INF,
-                np.float64(i),
-                np.float64(j),
-                np.float64(k),
-            )[0]
+            t = voxel_entry(ox, oy, oz, dx, dy, dz, i, j, k)
         kind[r], index[r, 0], index[r, 1], index[r, 2], tout[r] = ray_answer(
             word >= 0, i, j, k, t, ox, oy, oz, dx, dy, dz, nx, ny
         )

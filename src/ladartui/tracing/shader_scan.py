@@ -11,7 +11,7 @@ from it to the end of its list (the tile stop numba takes per tile, here per
 ray) and the voxel's cell packed into one word relative to the voxels' least
 corner (``cell_packing``). The shader writes back the entry of each ray's hit;
 ``entry_answers`` turns it into the voxel and recomputes ``t`` with the slab
-test both tracers share (``axis.cube_start``).
+test both tracers share (``answers.voxel_entry``).
 """
 
 from __future__ import annotations
@@ -21,8 +21,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, prange
 
-from ladartui.tracing.answers import put_answer
-from ladartui.tracing.axis import cube_start
+from ladartui.tracing.answers import put_answer, voxel_entry
 from ladartui.tracing.config import INF, PARTS
 from ladartui.tracing.object_order import scan_voxels
 from ladartui.tracing.scan_rays import bin_order, scan_grid
@@ -184,18 +183,5 @@ def entry_answers(found, listed, vox, orig, dirs, nx, ny, kind, index, tout):
         q, t = -1, INF
         if found[r] >= 0:
             q = listed[found[r]]
-            t = cube_start(
-                ox,
-                oy,
-                oz,
-                dx,
-                dy,
-                dz,
-                1.0 / dx if dx != 0.0 else INF,
-                1.0 / dy if dy != 0.0 else INF,
-                1.0 / dz if dz != 0.0 else INF,
-                np.float64(vox[q, 0]),
-                np.float64(vox[q, 1]),
-                np.float64(vox[q, 2]),
-            )[0]
+            t = voxel_entry(ox, oy, oz, dx, dy, dz, vox[q, 0], vox[q, 1], vox[q, 2])
         put_answer(r, q, t, vox, ox, oy, oz, dx, dy, dz, nx, ny, kind, index, tout)

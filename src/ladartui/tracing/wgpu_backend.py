@@ -87,7 +87,7 @@ from ladartui.tracing.order_choice import OrderChoice, trace_in_blocks
 from ladartui.tracing.scan_rays import cone_frame
 from ladartui.tracing.shader_scan import entry_answers, prepare_shader_scan
 from ladartui.tracing.wgpu_hits import HIT_BINDINGS, FirstHits, box_sides
-from ladartui.tracing.wgpu_scans import ScanDispatcher, dispatch_grid
+from ladartui.tracing.wgpu_scans import ScanDispatcher, dispatch_encoder
 
 NAME = "wgpu"
 
@@ -711,14 +711,7 @@ class WgpuBackend:
         device.queue.write_buffer(buffers["params"], 0, params)
         device.queue.write_buffer(buffers["rays"], 0, rays)
         device.queue.write_buffer(buffers["starts"], 0, starts)
-        groups = dispatch_grid(-(-count // BUNDLE), self._limits["max-compute-workgroups-per-dimension"])
-        encoder = device.create_command_encoder()
-        compute = encoder.begin_compute_pass()
-        compute.set_pipeline(pipeline)
-        compute.set_bind_group(0, bind_group)
-        compute.dispatch_workgroups(groups[0], groups[1], 1)
-        compute.end()
-        device.queue.submit([encoder.finish()])
+        device.queue.submit([dispatch_encoder(device, self._limits, pipeline, bind_group, count).finish()])
         cells = np.frombuffer(
             device.queue.read_buffer(buffers["cells"], 0, count * 16), dtype=np.int32
         ).reshape(count, 4)

@@ -26,7 +26,7 @@ from ladartui.errors import check_cancelled
 from ladartui.tracing.answers import box_offset_answers
 from ladartui.tracing.bundle import Halos, bundle_starts
 from ladartui.tracing.config import BUNDLE, SHADER_INF
-from ladartui.tracing.wgpu_scans import dispatch_grid
+from ladartui.tracing.wgpu_scans import dispatch_encoder
 
 # Bindings of first_hits besides the occupancy chunks (trace.wgsl).
 HIT_BINDINGS = {"params": 0, "starts": 4, "origins": 5, "directions": 6, "found": 7}
@@ -106,13 +106,7 @@ class FirstHits:
             elif self._stale_starts:  # another call's starts, not these rays'
                 queue.write_buffer(buffers["starts"], 0, np.zeros(-(-self.batch // BUNDLE)))
                 self._stale_starts = False
-            groups = dispatch_grid(-(-count // BUNDLE), self._limits["max-compute-workgroups-per-dimension"])
-            encoder = self._device.create_command_encoder()
-            compute = encoder.begin_compute_pass()
-            compute.set_pipeline(pipeline)
-            compute.set_bind_group(0, group)
-            compute.dispatch_workgroups(groups[0], groups[1], 1)
-            compute.end()
+            encoder = dispatch_encoder(self._device, self._limits, pipeline, group, count)
             encoder.copy_buffer_to_buffer(buffers["found"], 0, buffers["back"], 0, 4 * count)
             queue.submit([encoder.finish()])
             back = buffers["back"]

@@ -32,6 +32,19 @@ def dispatch_grid(workgroups: int, max_per_dimension: int) -> tuple[int, int]:
     return (x, y)
 
 
+def dispatch_encoder(device, limits: dict[str, int], pipeline, group, rays: int):
+    """A command encoder holding one dispatch of ``pipeline`` with bind group 0
+    ``group`` over ``rays`` rays (BUNDLE a workgroup), to be finished by the caller."""
+    groups = dispatch_grid(-(-rays // BUNDLE), limits["max-compute-workgroups-per-dimension"])
+    encoder = device.create_command_encoder()
+    compute = encoder.begin_compute_pass()
+    compute.set_pipeline(pipeline)
+    compute.set_bind_group(0, group)
+    compute.dispatch_workgroups(groups[0], groups[1], 1)
+    compute.end()
+    return encoder
+
+
 # Bindings of shaders/object_order.wgsl, in order.
 SCAN_BINDINGS = ("params", "origins", "directions", "order", "ray_tiles", "tile_starts", "entries", "found")
 # Its uniform block, struct TileParams: six vec4 of 32-bit integers.
@@ -119,14 +132,7 @@ class ScanDispatcher:
                 ),
             )
         group = self._group[1]
-        groups = dispatch_grid(-(-n // BUNDLE), self._limits["max-compute-workgroups-per-dimension"])
-        encoder = self._device.create_command_encoder()
-        compute = encoder.begin_compute_pass()
-        compute.set_pipeline(pipeline)
-        compute.set_bind_group(0, group)
-        compute.dispatch_workgroups(groups[0], groups[1], 1)
-        compute.end()
-        queue.submit([encoder.finish()])
+        queue.submit([dispatch_encoder(self._device, self._limits, pipeline, group, n).finish()])
         found = np.frombuffer(self._read(buffers["found"], 4 * n), dtype=np.int32)
         if self.maps_storage:
             # Map the inputs for the next scan now, so that the wait for it passes
