@@ -14,7 +14,7 @@ from ladartui.errors import Cancelled
 from ladartui.tracing import wgpu_backend, wgpu_hits
 from ladartui.tracing.wgpu_backend import WgpuBackend
 from ladartui.tracing.wgpu_hits import box_sides
-from test_wgpu_backend import assert_same, random_rays, random_scene
+from test_wgpu_backend import Occupancy, assert_same, random_rays, random_scene
 
 SHAPE = (50, 40, 30)
 
@@ -125,3 +125,17 @@ def test_cancelled_with_batches_in_flight_leaves_the_backend_usable(numba_backen
         backend.trace_cells(occupancy, origins, directions, order="ray"),
         numba_backend.trace_cells(occupancy, origins, directions, order="ray"),
     )
+
+
+def test_hits_in_a_box_away_from_the_origin_decode_to_their_cells(wgpu_backend, numba_backend):
+    """Voxels only in x 30..41, y 20..25, z 5..9 of a 64 x 64 x 16 grid: every hit's
+    box offset decodes back to the voxel numba finds (the box's corner is not 0)."""
+    rng = np.random.default_rng(31)
+    voxels = np.column_stack([rng.integers(30, 42, 400), rng.integers(20, 26, 400), rng.integers(5, 10, 400)])
+    occupancy = Occupancy.build(voxels, shape=(64, 64, 16))
+    assert tuple(occupancy.bbox_lo) == (30, 20, 5) and box_sides(occupancy) == (12, 6, 5)
+    origins, directions = random_rays(32, (64, 64, 16), 4000)
+    origins[:, :2] = origins[:, :2] * 0.3 + np.array([28.0, 18.0])  # over the box
+    reference = numba_backend.trace_cells(occupancy, origins, directions, order="ray")
+    assert (reference.kind == 1).sum() > 150
+    assert_same(wgpu_backend.trace_cells(occupancy, origins, directions, order="ray"), reference)
