@@ -20,14 +20,11 @@ import pytest
 
 from ladartui.errors import BackendUnavailable, Cancelled
 from ladartui.tracing import backend as registry
-from ladartui.tracing import wgpu_backend
-from ladartui.tracing.wgpu_backend import (
-    INSTALL_HINT,
-    WgpuBackend,
-    choose_adapter,
-    chunk_words_for,
-    floor_preserving_f32,
-)
+from ladartui.tracing import wgpu_backend, wgpu_occupancy
+from ladartui.tracing.f32_rays import floor_preserving_f32
+from ladartui.tracing.wgpu_adapter import INSTALL_HINT, choose_adapter
+from ladartui.tracing.wgpu_backend import WgpuBackend
+from ladartui.tracing.wgpu_occupancy import chunk_words_for
 from ladartui.tracing.wgpu_scans import dispatch_grid
 
 Occupancy = pytest.importorskip("ladartui.scene.occupancy").Occupancy
@@ -190,7 +187,7 @@ def test_occupancy_split_over_bindings(gpu, numba_backend):
     """A binding cap of 4 KiB (1024 words) splits the occupancy over several bindings."""
     shape = (120, 100, 40)
     occupancy = random_scene(3, shape, 6000)
-    words = sum(len(part) for part in wgpu_backend.occupancy_arrays(occupancy))
+    words = sum(len(part) for part in wgpu_occupancy.occupancy_arrays(occupancy))
     small = WgpuBackend(max_binding_bytes=4096)
     upload = small._upload(occupancy)
     assert len(upload.buffers) == -(-words // 1024) >= 3

@@ -11,9 +11,10 @@ import numpy as np
 import pytest
 
 from ladartui.errors import Cancelled
-from ladartui.tracing import wgpu_backend, wgpu_hits
+from ladartui.tracing import wgpu_hits
 from ladartui.tracing.wgpu_backend import WgpuBackend
 from ladartui.tracing.wgpu_hits import box_sides
+from ladartui.tracing.wgpu_occupancy import PARAMS_BYTES
 from test_wgpu_backend import Occupancy, assert_same, random_rays, random_scene
 
 SHAPE = (50, 40, 30)
@@ -119,7 +120,7 @@ def test_cancelled_with_batches_in_flight_leaves_the_backend_usable(numba_backen
     monkeypatch.setattr(wgpu_hits, "box_offset_answers", answer_then_cancel)
     with pytest.raises(Cancelled):
         backend.trace_cells(occupancy, origins, directions, order="ray", cancel=cancel)
-    assert backend._hits.buffers(wgpu_backend.PARAMS_BYTES)["back"].map_state == "unmapped"
+    assert backend._hits.buffers(PARAMS_BYTES)["back"].map_state == "unmapped"
     monkeypatch.setattr(wgpu_hits, "box_offset_answers", answers)
     assert_same(
         backend.trace_cells(occupancy, origins, directions, order="ray"),

@@ -8,8 +8,8 @@
 // answer, bit for bit, for every ray (tests/test_wgpu_precision.py).
 //
 // Cell space: voxel (i, j, k) spans [i, i+1) on each axis, ground at c_z = 0.
-// tracing/wgpu_backend.py prepends a header declaring `alias real = f64;`
-// (or f32) and the constants shared with the host (tracing/config.py,
+// tracing/wgpu_backend.py prepends a header (tracing/wgpu_occupancy.py)
+// declaring `alias real = f64;` (or f32) and the constants shared with the host (tracing/config.py,
 // wgsl_constants: hit kinds, INF, BUNDLE, method codes), the occupancy
 // bindings, read through `fn occ(word) -> u32`, and shaders/axis.wgsl
 // (boundary_t, cell_at, slab):

@@ -33,7 +33,7 @@ import numpy as np
 from numba import njit, prange
 
 from ladartui.tracing.axis import slab
-from ladartui.tracing.config import BUNDLE_REACH, FAR, FINE_REACH, INF
+from ladartui.tracing.config import BUNDLE, BUNDLE_REACH, FAR, FINE_REACH, INF
 
 
 @njit(nogil=True, cache=True)
@@ -156,3 +156,16 @@ def _bits(occupancy, name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         np.asarray(getattr(occupancy, name + "_origin"), np.int64),
         np.asarray(getattr(occupancy, name + "_dims"), np.int64),
     )
+
+
+def bundle_start_array(origins, directions, halo: Halos):
+    """float64 bundle start (tracing.bundle) of each ``BUNDLE`` consecutive rays."""
+    out = np.zeros(max(1, -(-len(origins) // BUNDLE)))
+    bundle_starts(
+        np.ascontiguousarray(origins, dtype=np.float64),
+        np.ascontiguousarray(directions, dtype=np.float64),
+        BUNDLE,
+        *halo,
+        out,
+    )
+    return out

@@ -8,11 +8,8 @@ answer for every ray.
 
 Resources:
 
-* The occupancy arrays (root, regions, tiles, bricks, columns, and the optional
-  empty-cube sides packed four octants to a word; all u32) are laid end
-  to end in one logical word array, split into power-of-two sized chunks,
-  each its own storage binding no larger than the adapter allows. They are
-  uploaded once per ``Occupancy`` object and reused for every call.
+* The occupancy goes to the device once per ``Occupancy`` object, in chunks of
+  one storage binding each (``tracing/wgpu_occupancy.py``), and serves every call.
 * Rays go in batches that fit one binding; each batch is one dispatch over a
   2-D grid of workgroups kept within the per-dimension limit. Exact ``f64``
   rays go through trace.wgsl's ``first_hits`` (``tracing/wgpu_hits.py``: the
@@ -36,9 +33,8 @@ faster, as in numba, and ``CellHits.info["order"]`` says which ran.
 
 Precision: ``f64`` needs the adapter's ``shader-f64`` feature (lavapipe has
 it). Without it the backend runs ``f32`` and says so in ``CellHits.info``.
-In ``f32`` each ray starts where it enters the scene's box (moved there on the
-host in float64, the offset added back to ``t``), so an aircraft kilometres
-away loses no precision.
+In ``f32`` each ray starts where it enters the scene's box
+(``tracing/f32_rays.py``), so an aircraft kilometres away loses no precision.
 
 ``wgpu`` is imported only inside ``probe`` and later calls: importing this
 module is cheap and never fails.
@@ -47,9 +43,6 @@ module is cheap and never fails.
 from __future__ import annotations
 
 import importlib.resources
-import os
-import stat
-import tempfile
 import threading
 import weakref
 from typing import Any
@@ -68,155 +61,36 @@ from ladartui.tracing.backend import (
     check_order,
     register_backend,
 )
-from ladartui.tracing.bundle import Halos, bundle_starts, halo_arrays
+from ladartui.tracing.bundle import bundle_start_array, halo_arrays
 from ladartui.tracing.config import (
     BUNDLE,
     CUT,
     LOOP_BUDGET,
     MARCH_SAMPLES_PER_PASS,
     MAX_OCCUPANCY_BINDINGS,
-    METHOD_CODES,
     OBJECT_ORDER_TILE_SHIFT,
     RAY_BATCH,
     SCAN_BLOCK,
     SHADER_INF,
     UNFINISHED,
-    wgsl_constants,
 )
+from ladartui.tracing.f32_rays import f32_start_offsets, floor_preserving_f32
 from ladartui.tracing.order_choice import OrderChoice, trace_in_blocks
 from ladartui.tracing.scan_rays import cone_frame
 from ladartui.tracing.shader_scan import entry_answers, prepare_shader_scan
+from ladartui.tracing.wgpu_adapter import INSTALL_HINT, choose_adapter, give_driver_a_runtime_dir
 from ladartui.tracing.wgpu_hits import HIT_BINDINGS, FirstHits, box_sides
+from ladartui.tracing.wgpu_occupancy import (
+    FIXED_BINDINGS,
+    PARAMS_BYTES,
+    Upload,
+    occupancy_header,
+    pack_params,
+    upload_occupancy,
+)
 from ladartui.tracing.wgpu_scans import ScanDispatcher, dispatch_encoder
 
 NAME = "wgpu"
-
-INSTALL_HINT = (
-    "no Vulkan, Metal or D3D12 adapter found: install Debian's mesa-vulkan-drivers (lavapipe) or a GPU driver"
-)
-
-ADAPTER_TYPE_RANK = {"DiscreteGPU": 0, "IntegratedGPU": 1, "VirtualGPU": 2, "CPU": 3}
-# OpenGL adapters lack shader-f64 and large storage buffers; prefer the rest.
-GRAPHICS_BACKEND_RANK = {"Vulkan": 0, "Metal": 0, "D3D12": 0, "OpenGL": 1}
-# Bindings besides the occupancy chunks: params, rays, hit cells, hit ranges, bundle
-# starts (trace_rays); origins, directions, found (first_hits, tracing/wgpu_hits.py).
-FIXED_BINDINGS = 8
-
-
-def choose_adapter(adapters):
-    """The adapter to use: discrete GPU, integrated GPU, virtual, then CPU.
-
-    Among adapters of one type, Vulkan/Metal/D3D12 come before OpenGL.
-    ``adapters`` are wgpu adapters (anything with ``.info`` mapping
-    ``adapter_type`` and ``backend_type``); None when the list is empty.
-    """
-
-    def rank(indexed):
-        position, adapter = indexed
-        info = adapter.info
-        return (
-            ADAPTER_TYPE_RANK.get(info.get("adapter_type", ""), 4),
-            GRAPHICS_BACKEND_RANK.get(info.get("backend_type", ""), 2),
-            position,
-        )
-
-    if not adapters:
-        return None
-    return min(enumerate(adapters), key=rank)[1]
-
-
-def chunk_words_for(max_binding_bytes: int) -> int:
-    """Words per occupancy chunk: the largest power of two fitting one binding."""
-    words = max(int(max_binding_bytes) // 4, 1)
-    return 1 << (words.bit_length() - 1)
-
-
-def f32_start_offsets(origins, directions, shape, top, method, at_least=None):
-    """Per-ray float64 ``t`` to move each origin by before it is made float32.
-
-    Exact: where the ray enters the box ``[0, nx] x [0, ny] x [0, top]`` (the
-    scene's extent up to the top of its highest occupied layer), or 0 when it
-    starts inside or never enters. March: the march's own start, where a
-    descending ray crosses ``c_z = top`` (same formula as the kernels), else 0.
-    The shader then sees coordinates no larger than the scene, and the host
-    adds ``t`` back in float64. ``at_least`` (exact only): per-ray bundle starts
-    (tracing.bundle) to move at least as far as.
-    """
-    o = np.asarray(origins, dtype=np.float64)
-    d = np.asarray(directions, dtype=np.float64)
-    if method == "march":
-        start = np.zeros(len(o))
-        above = (o[:, 2] > top) & (d[:, 2] < 0.0)
-        start[above] = (top - o[above, 2]) * (1.0 / d[above, 2])
-        return start
-    hi = np.array([float(shape[0]), float(shape[1]), max(float(top), 1.0)])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        inv = 1.0 / d
-        t_lo = -o * inv
-        t_hi = (hi - o) * inv
-        # With d == 0 (inv = inf) the pair is (-inf, +inf) inside the slab,
-        # one-signed outside it, NaN on its faces (fmin/fmax skip NaN: no shift).
-        near = np.fmin(t_lo, t_hi)
-        far = np.fmax(t_lo, t_hi)
-        enter = np.fmax(np.fmax(near[:, 0], near[:, 1]), near[:, 2])
-        leave = np.fmin(np.fmin(far[:, 0], far[:, 1]), far[:, 2])
-        if at_least is not None:
-            # A start past the box's far side means no voxel: keep the box entry then.
-            moved = np.fmax(enter, at_least)
-            enter = np.where(moved <= leave, moved, enter)
-        # Stay at least half a cell above the ground, so the ground rule still
-        # sees an origin above it.
-        oz, dz = o[:, 2], d[:, 2]
-        ground_cap = (oz - np.minimum(oz, 0.5)) * -inv[:, 2]
-    ground_cap[~((dz < 0.0) & (oz > 0.0))] = np.inf
-    np.fmin(enter, ground_cap, out=enter)
-    return np.where((enter > 0.0) & (enter <= leave), enter, 0.0)
-
-
-def floor_preserving_f32(values):
-    """float32 of float64 ``values``, each in the same unit cell as its float64 value.
-
-    Plain rounding can carry 72.99999999 up to 73.0, which changes the cell a
-    ray starts in (the march's first sample sits on the top face exactly in
-    real numbers, so its cell is decided by the last bit). Such values step
-    down to the float32 just below the integer.
-    """
-    v32 = np.asarray(values, dtype=np.float64).astype(np.float32)
-    crossed = np.floor(v32) > np.floor(values)
-    v32[crossed] = np.nextafter(v32[crossed], np.float32(-np.inf))
-    return v32
-
-
-class _Upload:
-    """An occupancy on the device: its chunk buffers and where each array starts."""
-
-    def __init__(self, buffers, bases, total_words, chunk_shift):
-        self.buffers = buffers
-        self.bases = bases
-        self.total_words = total_words
-        self.chunk_shift = chunk_shift
-        self.bind_groups = {}
-
-
-def _give_driver_a_runtime_dir() -> None:
-    """Set a private XDG_RUNTIME_DIR when there is no usable one.
-
-    On headless machines Mesa's window-system probing prints "XDG_RUNTIME_DIR is
-    invalid" straight to the process's stderr, which scribbles over the terminal
-    UI. We never open a window, so any private folder satisfies it.
-    """
-    current = os.environ.get("XDG_RUNTIME_DIR")
-    if current and os.path.isdir(current) and os.access(current, os.W_OK | os.X_OK):
-        return
-    folder = os.path.join(tempfile.gettempdir(), f"ladartui-runtime-{os.getuid()}")
-    try:
-        os.makedirs(folder, mode=0o700, exist_ok=True)
-        info = os.lstat(folder)
-        if info.st_uid != os.getuid() or not stat.S_ISDIR(info.st_mode):
-            folder = tempfile.mkdtemp(prefix="ladartui-runtime-")
-    except OSError:
-        folder = tempfile.mkdtemp(prefix="ladartui-runtime-")
-    os.environ["XDG_RUNTIME_DIR"] = folder
 
 
 class WgpuBackend:
@@ -254,7 +128,8 @@ class WgpuBackend:
         self._maps_storage = False
         self._uploads: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()
         self._pinned_uploads: dict[int, Any] = {}  # for occupancies that cannot be weakly referenced
-        self._pipelines: dict[Any, Any] = {}
+        self._modules: dict[Any, Any] = {}  # trace.wgsl compiled, by precision and chunks
+        self._pipelines: dict[Any, Any] = {}  # its entry points, by the same and entry
         self._ray_buffers: dict[Any, Any] = {}
         self._sources: dict[str, str] = {}
         self._orders: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()  # -> OrderChoice
@@ -272,7 +147,7 @@ class WgpuBackend:
             return self._reason
 
     def _find_adapter(self) -> str | None:
-        _give_driver_a_runtime_dir()
+        give_driver_a_runtime_dir()
         try:
             import wgpu
         except ImportError:
@@ -365,7 +240,7 @@ class WgpuBackend:
 
     # -- occupancy upload ---------------------------------------------------
 
-    def _upload(self, occupancy) -> _Upload:
+    def _upload(self, occupancy) -> Upload:
         """The device copy of ``occupancy``, made on first use (cached by identity)."""
         try:
             upload = self._uploads.get(occupancy)
@@ -382,50 +257,9 @@ class WgpuBackend:
             self._pinned_uploads[id(occupancy)] = (occupancy, upload)
         return upload
 
-    def _make_upload(self, occupancy) -> _Upload:
-        import wgpu
-
+    def _make_upload(self, occupancy) -> Upload:
         device = self._open_device()
-        arrays = [np.ascontiguousarray(part, dtype=np.uint32).ravel() for part in occupancy_arrays(occupancy)]
-        bases, total = [], 0
-        for array in arrays:
-            bases.append(total)
-            total += array.size
-        if total >= 1 << 32:
-            raise BackendUnavailable(
-                f"backend {NAME!r} cannot address this scene: its occupancy has {total} words (limit 2^32)"
-            )
-        max_binding = min(self._limits["max-storage-buffer-binding-size"], self._limits["max-buffer-size"])
-        chunk_words = chunk_words_for(max_binding)
-        chunks = max(-(-total // chunk_words), 1)
-        allowed = self._limits["max-storage-buffers-per-shader-stage"] - FIXED_BINDINGS
-        if chunks > allowed:
-            raise BackendUnavailable(
-                f"backend {NAME!r} cannot hold this scene on {self._adapter.info.get('device')!r}: "
-                f"its occupancy needs {total * 4 / 2**20:.0f} MiB in {chunks} bindings of "
-                f"{chunk_words * 4 / 2**20:.0f} MiB, the adapter allows {allowed}; use backend 'numba'"
-            )
-        buffers = []
-        for chunk in range(chunks):
-            start = chunk * chunk_words
-            words = min(chunk_words, total - start)
-            try:
-                buffer = device.create_buffer(
-                    size=max(words, 4) * 4, usage=wgpu.BufferUsage.STORAGE | wgpu.BufferUsage.COPY_DST
-                )
-            except Exception as error:
-                raise BackendUnavailable(
-                    f"backend {NAME!r} could not allocate {words * 4 / 2**20:.0f} MiB "
-                    f"for the occupancy: {error}"
-                ) from error
-            # Copy the slices of each array that fall in this chunk.
-            for base, array in zip(bases, arrays):
-                lo, hi = max(base, start), min(base + array.size, start + words)
-                if lo < hi:
-                    device.queue.write_buffer(buffer, (lo - start) * 4, array[lo - base : hi - base])
-            buffers.append(buffer)
-        shift = chunk_words.bit_length() - 1
-        return _Upload(buffers, bases, total, shift)
+        return upload_occupancy(device, occupancy, self._limits, self._adapter.info.get("device"), NAME)
 
     # -- pipelines ----------------------------------------------------------
 
@@ -435,33 +269,9 @@ class WgpuBackend:
         return self._sources[name]
 
     def _shader_source(self, real: str, chunks: int, chunk_shift: int) -> str:
-        """trace.wgsl with its header: the constants, the occupancy bindings and axis.wgsl."""
-        lines = [wgsl_constants(real)]
-        for chunk in range(chunks):
-            lines.append(
-                f"@group(0) @binding({FIXED_BINDINGS + chunk}) "
-                f"var<storage, read> occupancy{chunk}: array<u32>;"
-            )
-        lines.append("// One logical word array over all chunks (see wgpu_backend.py).")
-        lines.append("fn occ(word: u32) -> u32 {")
-        if chunks == 1:
-            lines.append("    return occupancy0[word];")
-        else:
-            mask = (1 << chunk_shift) - 1
-            lines.append(f"    let offset = word & {mask}u;")
-            lines.append(f"    switch (word >> {chunk_shift}u) {{")
-            for chunk in range(chunks - 1):
-                lines.append(f"        case {chunk}u: {{ return occupancy{chunk}[offset]; }}")
-            lines.append(f"        default: {{ return occupancy{chunks - 1}[offset]; }}")
-            lines.append("    }")
-        lines.append("}")
-        return (
-            "\n".join(lines)
-            + "\n\n"
-            + self._shader_file("axis.wgsl")
-            + "\n"
-            + self._shader_file("trace.wgsl")
-        )
+        """trace.wgsl after its header (wgpu_occupancy.occupancy_header) and axis.wgsl."""
+        header = occupancy_header(real, chunks, chunk_shift)
+        return "\n\n".join((header, self._shader_file("axis.wgsl"), self._shader_file("trace.wgsl")))
 
     def _pipeline(self, precision: str, chunks: int, chunk_shift: int, entry: str = "trace_rays"):
         """trace.wgsl's ``entry`` (trace_rays or first_hits) for this occupancy layout."""
@@ -469,11 +279,11 @@ class WgpuBackend:
         pipeline = self._pipelines.get(key)
         if pipeline is None:
             device = self._open_device()
-            module = self._pipelines.get(key[:3])
+            module = self._modules.get(key[:3])
             if module is None:
                 code = self._shader_source(precision, chunks, chunk_shift)
                 module = device.create_shader_module(label=f"trace-{precision}", code=code)
-                self._pipelines[key[:3]] = module
+                self._modules[key[:3]] = module
             pipeline = device.create_compute_pipeline(
                 label=f"{entry}-{precision}-{chunks}",
                 layout="auto",
@@ -611,8 +421,9 @@ class WgpuBackend:
         if n == 0:
             return CellHits(kind, index, t, info)
         upload = self._upload(occupancy)
-        if method == "exact" and precision == "f64" and box_sides(occupancy) is not None:
-            self._first_hits(occupancy, upload, origins, directions, cancel, info, kind, index, t)
+        sides = box_sides(occupancy) if method == "exact" and precision == "f64" else None
+        if sides is not None:
+            self._first_hits(occupancy, sides, upload, origins, directions, cancel, info, kind, index, t)
             return CellHits(kind, index, t, info)
         chunks = len(upload.buffers)
         pipeline = self._pipeline(precision, chunks, upload.chunk_shift)
@@ -679,16 +490,17 @@ class WgpuBackend:
         index[kind == MISS] = -1
         return CellHits(kind, index, t, info)
 
-    def _first_hits(self, occupancy, upload, origins, directions, cancel, info, kind, index, t):
+    def _first_hits(self, occupancy, sides, upload, origins, directions, cancel, info, kind, index, t):
         """Exact f64 rays through trace.wgsl's first_hits (tracing/wgpu_hits.py)."""
         assert self._hits is not None  # the device is open
         pipeline = self._pipeline("f64", len(upload.buffers), upload.chunk_shift, "first_hits")
         buffers = self._hits.buffers(PARAMS_BYTES)
         key = ("first_hits", id(pipeline), id(buffers["origins"]))
         bound = {b: buffers[name] for name, b in HIT_BINDINGS.items()}
-        group = self._occupancy_group(upload, pipeline, key, bound)
+        group = upload.bind_group(self._device, pipeline, key, bound)
         cut = self._hits.trace(
             occupancy,
+            sides,
             pipeline,
             group,
             lambda count: pack_params(occupancy, upload, "exact", 0.5, count, "f64"),
@@ -723,19 +535,9 @@ class WgpuBackend:
     def _bind_group(self, upload, pipeline, buffers, precision):
         names = ("params", "rays", "cells", "ranges", "starts")  # trace_rays' bindings 0-4
         bound = {b: buffers[name] for b, name in enumerate(names)}
-        return self._occupancy_group(upload, pipeline, (precision, id(pipeline), id(buffers["rays"])), bound)
-
-    def _occupancy_group(self, upload, pipeline, key, bound):
-        """The bind group of ``bound`` (binding -> buffer) and the occupancy's chunks,
-        made once per ``key`` and kept with the upload."""
-        group = upload.bind_groups.get(key)
-        if group is None:
-            entries = [{"binding": b, "resource": {"buffer": buffer}} for b, buffer in bound.items()]
-            for chunk, buffer in enumerate(upload.buffers):
-                entries.append({"binding": FIXED_BINDINGS + chunk, "resource": {"buffer": buffer}})
-            group = self._device.create_bind_group(layout=pipeline.get_bind_group_layout(0), entries=entries)
-            upload.bind_groups[key] = group
-        return group
+        return upload.bind_group(
+            self._device, pipeline, (precision, id(pipeline), id(buffers["rays"])), bound
+        )
 
 
 def _cut_short(rays: int, info) -> BackendUnavailable:
@@ -743,87 +545,6 @@ def _cut_short(rays: int, info) -> BackendUnavailable:
         f"backend {NAME!r} could not finish {rays} rays on {info['adapter']!r}: the adapter "
         f"ended their loops early (lavapipe stops after 65,535 iterations); use backend 'numba'"
     )
-
-
-def bundle_start_array(origins, directions, halo: Halos):
-    """float64 bundle start (tracing.bundle) of each ``BUNDLE`` consecutive rays."""
-    out = np.zeros(max(1, -(-len(origins) // BUNDLE)))
-    bundle_starts(
-        np.ascontiguousarray(origins, dtype=np.float64),
-        np.ascontiguousarray(directions, dtype=np.float64),
-        BUNDLE,
-        *halo,
-        out,
-    )
-    return out
-
-
-def occupancy_arrays(occupancy):
-    """The u32 arrays laid end to end on the device: root, regions, tiles, bricks, columns, cubes."""
-    columns = getattr(occupancy, "columns", None)
-    if columns is None:
-        # No brick-column tops: every column reaches the top of the root grid, so
-        # the column skip never fires (same cells visited, only slower).
-        dims = np.asarray(occupancy.root_dims, dtype=np.int64)
-        columns = np.full(int(dims[0] * 64 * dims[1] * 64), int(dims[2]) * 64, dtype=np.uint32)
-    return [
-        occupancy.root,
-        occupancy.regions,
-        occupancy.tiles,
-        occupancy.bricks,
-        columns,
-        cube_words(occupancy),
-    ]
-
-
-def cube_words(occupancy):
-    """``Occupancy.cubes`` as u32 words, one per brick cell: byte ``octant`` of word
-    ``cell`` is ``cubes[4 cell + octant]``. Empty when the occupancy has no cubes."""
-    cubes = getattr(occupancy, "cubes", None)
-    if cubes is None or getattr(occupancy, "cube_dims", None) is None or len(cubes) == 0:
-        return np.zeros(0, dtype=np.uint32)
-    return np.ascontiguousarray(cubes, dtype=np.uint8).view("<u4")
-
-
-def cube_box(occupancy):
-    """(cube_origin, cube_dims) as int64 (3,); zero dims (no jumps) without cubes."""
-    if len(cube_words(occupancy)) == 0:
-        return np.zeros(3, np.int64), np.zeros(3, np.int64)
-    return (
-        np.asarray(occupancy.cube_origin, dtype=np.int64),
-        np.asarray(occupancy.cube_dims, dtype=np.int64),
-    )
-
-
-# Params (uniform, see struct Params in trace.wgsl): 10 vec4 of 32-bit integers
-# then a vec2<real> of float parameters (16 bytes in f64, 8 in f32).
-PARAMS_BYTES = 10 * 16 + 16
-
-
-def pack_params(
-    occupancy, upload, method, step, count, precision, first_sample=0, samples_per_pass=MARCH_SAMPLES_PER_PASS
-) -> bytes:
-    """The uniform block for one dispatch, laid out as ``struct Params``.
-
-    ``first_sample`` and ``samples_per_pass`` bound the march's samples in this
-    dispatch (see MARCH_SAMPLES_PER_PASS).
-    """
-    ints = np.zeros((10, 4), dtype=np.int32)
-    ints[0, :3] = occupancy.shape
-    ints[1, :3] = occupancy.bbox_lo
-    ints[2, :3] = occupancy.bbox_hi
-    ints[3, :3] = occupancy.root_origin
-    ints[4, :3] = occupancy.root_dims
-    ints[5, :] = np.array(upload.bases[:4], dtype=np.int64).astype(np.uint32).view(np.int32)
-    ints[6, :] = (count, METHOD_CODES[method], int(occupancy.zmax), len(occupancy.root))
-    ints[7, 0] = np.array(upload.bases[4], dtype=np.int64).astype(np.uint32).view(np.int32)
-    ints[7, 1:3] = (first_sample, samples_per_pass)
-    cube_origin, cube_dims = cube_box(occupancy)
-    ints[8, :3] = cube_origin
-    ints[8, 3] = np.array(upload.bases[5], dtype=np.int64).astype(np.uint32).view(np.int32)
-    ints[9, :3] = cube_dims
-    reals = np.array([step, 0], dtype=np.float64 if precision == "f64" else np.float32)
-    return ints.tobytes() + reals.tobytes()
 
 
 register_backend(NAME, WgpuBackend)

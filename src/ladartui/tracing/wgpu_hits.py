@@ -24,7 +24,7 @@ import numpy as np
 
 from ladartui.errors import check_cancelled
 from ladartui.tracing.answers import box_offset_answers
-from ladartui.tracing.bundle import Halos, bundle_starts
+from ladartui.tracing.bundle import Halos, bundle_start_array
 from ladartui.tracing.config import BUNDLE, SHADER_INF
 from ladartui.tracing.wgpu_scans import dispatch_encoder
 
@@ -64,6 +64,7 @@ class FirstHits:
     def trace(
         self,
         occupancy,
+        sides: tuple[int, int, int],
         pipeline,
         group,
         params_for: Callable[[int], bytes],
@@ -77,13 +78,12 @@ class FirstHits:
     ) -> int:
         """Answers of contiguous (N, 3) float64 rays into kind/index/t; returns how many
         rays the adapter cut short (their answers are then not to be used).
+        ``sides``: the occupied box's (``box_sides``, not None);
         ``group`` binds ``buffers()`` and the occupancy at HIT_BINDINGS;
         ``params_for(count)`` gives the uniform block of a batch. The words come
         back through a mapped buffer, read in place by the answers."""
         import wgpu
 
-        sides = box_sides(occupancy)
-        assert sides is not None  # the caller checks
         buffers = self._buffers
         queue = self._device.queue
         lo = np.asarray(occupancy.bbox_lo, np.int64)
@@ -98,10 +98,10 @@ class FirstHits:
             queue.write_buffer(buffers["origins"], 0, o)
             queue.write_buffer(buffers["directions"], 0, d)
             if self.bundle_starts:
-                starts = np.zeros(-(-count // BUNDLE))
-                bundle_starts(o, d, BUNDLE, *halo, starts)
                 # SHADER_INF is the shader's "never".
-                queue.write_buffer(buffers["starts"], 0, np.minimum(starts, SHADER_INF))
+                queue.write_buffer(
+                    buffers["starts"], 0, np.minimum(bundle_start_array(o, d, halo), SHADER_INF)
+                )
                 self._stale_starts = True
             elif self._stale_starts:  # another call's starts, not these rays'
                 queue.write_buffer(buffers["starts"], 0, np.zeros(-(-self.batch // BUNDLE)))
