@@ -11,9 +11,11 @@ import numpy as np
 import pytest
 
 from ladartui.errors import Cancelled
-from ladartui.tracing import wgpu_hits
+from ladartui.tracing import TINY, wgpu_hits
+from ladartui.tracing.config import SCAN_BLOCK
+from ladartui.tracing.prepare import rays_to_cells
 from ladartui.tracing.wgpu_backend import WgpuBackend
-from ladartui.tracing.wgpu_hits import box_sides
+from ladartui.tracing.wgpu_hits import box_sides, one_origin
 from ladartui.tracing.wgpu_occupancy import PARAMS_BYTES
 from test_wgpu_backend import Occupancy, assert_same, random_rays, random_scene
 
@@ -120,7 +122,7 @@ def test_cancelled_with_batches_in_flight_leaves_the_backend_usable(numba_backen
     monkeypatch.setattr(wgpu_hits, "box_offset_answers", answer_then_cancel)
     with pytest.raises(Cancelled):
         backend.trace_cells(occupancy, origins, directions, order="ray", cancel=cancel)
-    assert backend._hits.buffers(PARAMS_BYTES)["back"].map_state == "unmapped"
+    assert [b.map_state for b in backend._hits.buffers(PARAMS_BYTES)["back"]] == ["unmapped"] * 2
     monkeypatch.setattr(wgpu_hits, "box_offset_answers", answers)
     assert_same(
         backend.trace_cells(occupancy, origins, directions, order="ray"),
@@ -140,3 +142,74 @@ def test_hits_in_a_box_away_from_the_origin_decode_to_their_cells(wgpu_backend, 
     reference = numba_backend.trace_cells(occupancy, origins, directions, order="ray")
     assert (reference.kind == 1).sum() > 150
     assert_same(wgpu_backend.trace_cells(occupancy, origins, directions, order="ray"), reference)
+
+
+def test_one_origin_is_read_from_the_block_bounds():
+    """rays_to_cells' bounds say when every ray of a range starts at one point."""
+    origins, directions = scan_from(SHAPE[2] * 2.0)
+    _, _, bounds = rays_to_cells(origins, directions, 1.0, TINY)
+    assert one_origin(bounds, 0, len(origins))
+    assert not one_origin(None, 0, len(origins)) and not one_origin(bounds, 5, 5)
+    moved = origins.copy()
+    moved[1000, 2] = np.nextafter(moved[1000, 2], np.inf)  # one ray, one ulp higher
+    assert not one_origin(rays_to_cells(moved, directions, 1.0, TINY)[2], 0, len(origins))
+    # Blocks of SCAN_BLOCK rays: only those a range touches count, and they must agree.
+    row = bounds[0]
+    other = row.copy()
+    other[[2, 5]] += 1.0  # another scan, one cell higher
+    two = np.array([row, other])
+    assert not one_origin(two, 0, 2 * SCAN_BLOCK)
+    assert one_origin(two, 0, SCAN_BLOCK) and one_origin(two, SCAN_BLOCK + 7, 2 * SCAN_BLOCK)
+    assert one_origin(np.array([row, row]), 3, SCAN_BLOCK + 3)
+
+
+def test_rays_from_one_origin_give_numba_answers_with_one_origin_written(
+    wgpu_backend, numba_backend, case, monkeypatch
+):
+    """A scan traced in ray order writes its one origin for all its rays, and the
+    shader reads that one for every ray, not what an earlier call left in the
+    buffer (other rays' origins are traced first): numba's answers, bit for bit."""
+    occupancy, origins, directions = case
+    scan_origins, scan_directions = scan_from(SHAPE[2] + 3.5)
+    cells, unit, bounds = rays_to_cells(scan_origins, scan_directions, 1.0, TINY)
+    shared = []
+    trace = wgpu_hits.FirstHits.trace
+    monkeypatch.setattr(
+        wgpu_hits.FirstHits, "trace", lambda self, *a, **k: shared.append(a[-1]) or trace(self, *a, **k)
+    )
+    assert_same(
+        wgpu_backend.trace_cells(occupancy, origins, directions, order="ray"),
+        numba_backend.trace_cells(occupancy, origins, directions, order="ray"),
+    )
+    reference = numba_backend.trace_cells(occupancy, cells, unit, order="ray")
+    assert (reference.kind == 1).sum() > 500
+    for order in ("ray", "auto"):  # auto: the scan's blocks in ray order too, if chosen
+        assert_same(
+            wgpu_backend.trace_cells(occupancy, cells, unit, order=order, block_bounds=bounds), reference
+        )
+    assert shared[:2] == [False, True]
+
+
+def test_a_failure_on_the_answer_thread_reaches_the_caller(numba_backend, case, monkeypatch):
+    """Batch 0 is answered on the worker thread while batch 2 is written: its error
+    comes back to the caller, no read-back buffer stays mapped, and the next call
+    answers in full."""
+    occupancy, origins, directions = case
+    backend = WgpuBackend(ray_batch=640)
+    answers = wgpu_hits.box_offset_answers
+    threads = []
+
+    def fail(*args):
+        threads.append(threading.current_thread().name)
+        raise RuntimeError("answers failed")
+
+    monkeypatch.setattr(wgpu_hits, "box_offset_answers", fail)
+    with pytest.raises(RuntimeError, match="answers failed"):
+        backend.trace_cells(occupancy, origins, directions, order="ray")
+    assert len(threads) == 1 and threads[0].startswith("ladartui-answers")
+    assert [b.map_state for b in backend._hits.buffers(PARAMS_BYTES)["back"]] == ["unmapped"] * 2
+    monkeypatch.setattr(wgpu_hits, "box_offset_answers", answers)
+    assert_same(
+        backend.trace_cells(occupancy, origins, directions, order="ray"),
+        numba_backend.trace_cells(occupancy, origins, directions, order="ray"),
+    )

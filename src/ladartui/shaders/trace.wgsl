@@ -33,7 +33,7 @@ struct Params {
     root_dims: vec4<i32>,
     bases: vec4<u32>,        // first word of root, regions, tiles, bricks in occ()
     run: vec4<i32>,          // ray count, method (0 exact, 1 march), zmax, root cells
-    extra: vec4<u32>,        // first word of columns in occ(), march: first sample, samples per pass, unused
+    extra: vec4<u32>,        // first word of columns in occ(), march: first sample, samples per pass; first_hits: 1 when all rays share origins[0..3]
     cube_origin: vec4<i32>,  // brick cell of the empty-cube box's corner; w: first word of cubes in occ()
     cube_dims: vec4<i32>,    // its size in bricks; all zero without cubes (no jumps)
     reals: vec2<real>,       // march step (voxels), unused
@@ -523,7 +523,8 @@ fn first_hits(@builtin(workgroup_id) group: vec3<u32>,
         return;
     }
     let b = r * 3u;
-    let hit = first_voxel(origins[b], origins[b + 1u], origins[b + 2u],
+    let o = select(b, 0u, params.extra.w == 1u);  // a scan's one origin: 24 bytes written, not 24 a ray
+    let hit = first_voxel(origins[o], origins[o + 1u], origins[o + 2u],
                           directions[b], directions[b + 1u], directions[b + 2u], starts[r / BUNDLE]);
     var word = NO_VOXEL;
     if (hit.kind == VOXEL) {

@@ -79,7 +79,7 @@ from ladartui.tracing.order_choice import OrderChoice, trace_in_blocks
 from ladartui.tracing.scan_rays import cone_frame
 from ladartui.tracing.shader_scan import entry_answers, prepare_shader_scan
 from ladartui.tracing.wgpu_adapter import INSTALL_HINT, choose_adapter, give_driver_a_runtime_dir
-from ladartui.tracing.wgpu_hits import HIT_BINDINGS, FirstHits, box_sides
+from ladartui.tracing.wgpu_hits import HIT_BINDINGS, FirstHits, box_sides, one_origin
 from ladartui.tracing.wgpu_occupancy import (
     FIXED_BINDINGS,
     PARAMS_BYTES,
@@ -362,18 +362,20 @@ class WgpuBackend:
             if method == "exact" and used == "f64" and order != "ray" and occupancy.count > 0:
                 return self._trace_scans(occupancy, origins, directions, order, cancel, info, block_bounds)
             info["order"] = "ray"
-            return self._trace(occupancy, origins, directions, method, step, used, cancel, info)
+            shared = one_origin(block_bounds, 0, len(origins))
+            return self._trace(occupancy, origins, directions, method, step, used, cancel, info, shared)
 
     def _trace_scans(self, occupancy, origins, directions, order, cancel, info, block_bounds):
         """Exact f64 in blocks, each in object or ray order (``trace_in_blocks``)."""
         n = len(origins)
-        kind = np.zeros(n, dtype=np.uint8)
-        index = np.full((n, 3), -1, dtype=np.int32)
-        t = np.full(n, np.inf)
+        kind, index, t = empty_answers(n)  # every block writes all its rays
 
         def ray_order(a, b):
-            hits = self._trace(occupancy, origins[a:b], directions[a:b], "exact", 0.5, "f64", cancel, info)
-            kind[a:b], index[a:b], t[a:b] = hits.kind, hits.index, hits.t
+            shared = one_origin(block_bounds, a, b)
+            into = (kind[a:b], index[a:b], t[a:b])
+            self._trace(
+                occupancy, origins[a:b], directions[a:b], "exact", 0.5, "f64", cancel, info, shared, into
+            )
 
         def object_order_block(a, b, max_voxels):
             bounds = None if block_bounds is None else block_bounds[a // SCAN_BLOCK]
@@ -413,17 +415,32 @@ class WgpuBackend:
         entry_answers(found, scan.listed, scan.vox, origins, directions, nx, ny, kind, index, t)
         return True
 
-    def _trace(self, occupancy, origins, directions, method, step, precision, cancel, info):
+    def _trace(
+        self,
+        occupancy,
+        origins,
+        directions,
+        method,
+        step,
+        precision,
+        cancel,
+        info,
+        shared_origin=False,
+        into=None,
+    ):
+        """``shared_origin``: every ray starts at origins[0] (``one_origin``); ``into``:
+        the (kind, index, t) arrays to answer in, else new ones. Every pass below
+        writes every ray's answer, so they start empty (no filling pass)."""
         n = len(origins)
-        kind = np.zeros(n, dtype=np.uint8)
-        index = np.full((n, 3), -1, dtype=np.int32)
-        t = np.full(n, np.inf)
+        kind, index, t = empty_answers(n) if into is None else into
         if n == 0:
             return CellHits(kind, index, t, info)
         upload = self._upload(occupancy)
         sides = box_sides(occupancy) if method == "exact" and precision == "f64" else None
         if sides is not None:
-            self._first_hits(occupancy, sides, upload, origins, directions, cancel, info, kind, index, t)
+            self._first_hits(
+                occupancy, sides, upload, origins, directions, cancel, info, kind, index, t, shared_origin
+            )
             return CellHits(kind, index, t, info)
         chunks = len(upload.buffers)
         pipeline = self._pipeline(precision, chunks, upload.chunk_shift)
@@ -490,7 +507,9 @@ class WgpuBackend:
         index[kind == MISS] = -1
         return CellHits(kind, index, t, info)
 
-    def _first_hits(self, occupancy, sides, upload, origins, directions, cancel, info, kind, index, t):
+    def _first_hits(
+        self, occupancy, sides, upload, origins, directions, cancel, info, kind, index, t, shared_origin
+    ):
         """Exact f64 rays through trace.wgsl's first_hits (tracing/wgpu_hits.py)."""
         assert self._hits is not None  # the device is open
         pipeline = self._pipeline("f64", len(upload.buffers), upload.chunk_shift, "first_hits")
@@ -503,7 +522,9 @@ class WgpuBackend:
             sides,
             pipeline,
             group,
-            lambda count: pack_params(occupancy, upload, "exact", 0.5, count, "f64"),
+            lambda count, shared: pack_params(
+                occupancy, upload, "exact", 0.5, count, "f64", shared_origin=shared
+            ),
             origins,
             directions,
             halo_arrays(occupancy),
@@ -511,6 +532,7 @@ class WgpuBackend:
             kind,
             index,
             t,
+            shared_origin,
         )
         if cut:
             raise _cut_short(cut, info)
@@ -538,6 +560,11 @@ class WgpuBackend:
         return upload.bind_group(
             self._device, pipeline, (precision, id(pipeline), id(buffers["rays"])), bound
         )
+
+
+def empty_answers(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(kind, index, t) for ``n`` rays, not filled: for passes that answer every ray."""
+    return np.empty(n, dtype=np.uint8), np.empty((n, 3), dtype=np.int32), np.empty(n)
 
 
 def _cut_short(rays: int, info) -> BackendUnavailable:

@@ -5,11 +5,12 @@ The shader reads the host's (N, 3) float64 origins and directions as they are
 offset in the occupied box; ``answers.box_offset_answers`` then makes the
 answers on the host, ``t`` recomputed by the slab test object order uses too,
 and the ground rule where no voxel was hit. Per ray that moves 48 bytes in and
-4 out, against trace_rays' 48 and 24, and the host makes no numpy pass over
+4 out, against trace_rays' 48 and 24 (24 in when the rays share one origin,
+as a scan's do), and the host makes no numpy pass over
 the rays besides the bundle starts (on a CPU adapter only) and the answers.
-Batches are as large as the buffers allow: on an H200, four dispatches of
-65,536 rays took twice as long as one of 262,144 (each wait for the device
-waits for all it was given, so batches in flight would not overlap either).
+Batches are as large as the buffers allow (on an H200, four dispatches of
+65,536 rays one after the other took twice as long as one of 262,144), and
+overlap: the host writes one batch and answers another while the device traces.
 trace_rays stays for the march, f32, and boxes whose offsets do not fit an i32.
 
 ``wgpu`` is imported only inside the methods, as in tracing/wgpu_backend.py.
@@ -18,6 +19,8 @@ trace_rays stays for the march, f32, and boxes whose offsets do not fit an i32.
 from __future__ import annotations
 
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
+from contextlib import contextmanager
 from typing import Any
 
 import numpy as np
@@ -25,7 +28,7 @@ import numpy as np
 from ladartui.errors import check_cancelled
 from ladartui.tracing.answers import box_offset_answers
 from ladartui.tracing.bundle import Halos, bundle_start_array
-from ladartui.tracing.config import BUNDLE, SHADER_INF
+from ladartui.tracing.config import BUNDLE, SCAN_BLOCK, SHADER_INF
 from ladartui.tracing.wgpu_scans import dispatch_encoder
 
 # Bindings of first_hits besides the occupancy chunks (trace.wgsl).
@@ -39,6 +42,35 @@ def box_sides(occupancy) -> tuple[int, int, int] | None:
     if min(sides) <= 0 or sides[0] * sides[1] * sides[2] > OFFSET_LIMIT:
         return None
     return sides[0], sides[1], sides[2]
+
+
+def one_origin(block_bounds, first: int, end: int) -> bool:
+    """True when rays ``first..end`` all start at one point, by ``block_bounds``
+    (``prepare.rays_to_cells``' third answer: the least and greatest origin of
+    each SCAN_BLOCK rays). Equal least and greatest means equal values, and a
+    cell there is never -0.0, so equal bits."""
+    if block_bounds is None or end <= first:
+        return False
+    rows = np.asarray(block_bounds)[first // SCAN_BLOCK : -(-end // SCAN_BLOCK)]
+    return bool(len(rows)) and bool((rows[:, :6] == np.tile(rows[:1, :3], 2)).all())
+
+
+@contextmanager
+def mapped_words(back, count: int):
+    """The first ``count`` i32 words of read-back buffer ``back``, mapped once the
+    device has written them (a wait for all submitted work), read in place and
+    unmapped after the block."""
+    import wgpu
+
+    back.map_sync(wgpu.MapMode.READ, 0, 4 * count)
+    try:
+        view = back.read_mapped(0, 4 * count, copy=False)
+        try:
+            yield np.frombuffer(view, np.int32)
+        finally:
+            del view  # the view must go before the unmap
+    finally:
+        back.unmap()
 
 
 class FirstHits:
@@ -60,6 +92,7 @@ class FirstHits:
         self.bundle_starts = bundle_starts
         self._stale_starts = False  # the starts buffer holds starts (else zeros)
         self._buffers: dict[str, Any] = {}
+        self._answer_thread: ThreadPoolExecutor | None = None
 
     def trace(
         self,
@@ -67,7 +100,7 @@ class FirstHits:
         sides: tuple[int, int, int],
         pipeline,
         group,
-        params_for: Callable[[int], bytes],
+        params_for: Callable[[int, bool], bytes],
         origins,
         directions,
         halo: Halos,
@@ -75,27 +108,34 @@ class FirstHits:
         kind,
         index,
         t,
+        shared_origin: bool = False,
     ) -> int:
         """Answers of contiguous (N, 3) float64 rays into kind/index/t; returns how many
         rays the adapter cut short (their answers are then not to be used).
         ``sides``: the occupied box's (``box_sides``, not None);
         ``group`` binds ``buffers()`` and the occupancy at HIT_BINDINGS;
-        ``params_for(count)`` gives the uniform block of a batch. The words come
-        back through a mapped buffer, read in place by the answers."""
-        import wgpu
+        ``params_for(count, shared_origin)`` gives the uniform block of a batch;
+        ``shared_origin``: every ray starts at ``origins[0]`` (``one_origin``), so
+        only that origin is written.
 
+        Batches overlap: the device traces batch k + 1 while batch k is answered
+        (on a thread of its own) and batch k + 2 written; words come back through
+        two mapped buffers in turn, read in place. A wait waits for all submitted
+        work, so k + 1 is submitted only once k's words are there.
+        """
         buffers = self._buffers
         queue = self._device.queue
         lo = np.asarray(occupancy.bbox_lo, np.int64)
         nx, ny = float(occupancy.shape[0]), float(occupancy.shape[1])
-        cut = 0
-        for first in range(0, len(origins), self.batch):
-            check_cancelled(cancel, "trace cancelled")
-            end = min(len(origins), first + self.batch)
-            o, d = origins[first:end], directions[first:end]
-            count = end - first
-            queue.write_buffer(buffers["params"], 0, params_for(count))
-            queue.write_buffer(buffers["origins"], 0, o)
+        firsts = range(0, len(origins), self.batch)
+
+        def rows(k: int) -> slice:
+            return slice(firsts[k], min(len(origins), firsts[k] + self.batch))
+
+        def write(k: int) -> None:
+            o, d = origins[rows(k)], directions[rows(k)]
+            queue.write_buffer(buffers["params"], 0, params_for(len(o), shared_origin))
+            queue.write_buffer(buffers["origins"], 0, o[:1] if shared_origin else o)
             queue.write_buffer(buffers["directions"], 0, d)
             if self.bundle_starts:
                 # SHADER_INF is the shader's "never".
@@ -106,34 +146,50 @@ class FirstHits:
             elif self._stale_starts:  # another call's starts, not these rays'
                 queue.write_buffer(buffers["starts"], 0, np.zeros(-(-self.batch // BUNDLE)))
                 self._stale_starts = False
+
+        def submit(k: int) -> None:
+            count = len(origins[rows(k)])
             encoder = dispatch_encoder(self._device, self._limits, pipeline, group, count)
-            encoder.copy_buffer_to_buffer(buffers["found"], 0, buffers["back"], 0, 4 * count)
+            encoder.copy_buffer_to_buffer(buffers["found"], 0, buffers["back"][k % 2], 0, 4 * count)
             queue.submit([encoder.finish()])
-            back = buffers["back"]
-            back.map_sync(wgpu.MapMode.READ, 0, 4 * count)
-            words = back.read_mapped(0, 4 * count, copy=False)
-            try:
-                cut += box_offset_answers(
-                    np.frombuffer(words, np.int32),
-                    lo,
-                    sides[0],
-                    sides[1],
-                    o,
-                    d,
-                    nx,
-                    ny,
-                    kind[first:end],
-                    index[first:end],
-                    t[first:end],
-                )
-            finally:
-                del words  # the view must go before the unmap
-                back.unmap()
+
+        def answer(k: int, words) -> int:
+            here = rows(k)
+            o, d = origins[here], directions[here]
+            return box_offset_answers(
+                words, lo, sides[0], sides[1], o, d, nx, ny, kind[here], index[here], t[here]
+            )
+
+        check_cancelled(cancel, "trace cancelled")
+        write(0)
+        submit(0)
+        if len(firsts) > 1:
+            write(1)  # while the device traces batch 0
+        cut = 0
+        for k in range(len(firsts)):
+            with mapped_words(buffers["back"][k % 2], rows(k).stop - rows(k).start) as words:
+                if k + 1 < len(firsts):
+                    submit(k + 1)  # traced while batch k's answers are made
+                if k + 2 >= len(firsts):
+                    cut += answer(k, words)
+                    continue
+                answering = self._answerer().submit(answer, k, words)
+                try:
+                    check_cancelled(cancel, "trace cancelled")
+                    write(k + 2)  # while batch k is answered and k + 1 traced
+                finally:
+                    cut += answering.result()  # before the words are unmapped
         return cut
 
+    def _answerer(self) -> ThreadPoolExecutor:
+        """The thread that makes one batch's answers while this one writes the next."""
+        if self._answer_thread is None:
+            self._answer_thread = ThreadPoolExecutor(1, thread_name_prefix="ladartui-answers")
+        return self._answer_thread
+
     def buffers(self, params_bytes: int) -> dict[str, Any]:
-        """The batch's buffers by HIT_BINDINGS name (and the read-back buffer,
-        "back"), made on first use and kept."""
+        """The batch's buffers by HIT_BINDINGS name (and "back", the two read-back
+        buffers that batches take in turn), made on first use and kept."""
         import wgpu
 
         if not self._buffers:
@@ -157,6 +213,6 @@ class FirstHits:
                     size=rays * 4,
                     usage=wgpu.BufferUsage.STORAGE | wgpu.BufferUsage.COPY_SRC,
                 ),
-                "back": create(label="hits-back", size=rays * 4, usage=back),
+                "back": [create(label=f"hits-back-{k}", size=rays * 4, usage=back) for k in (0, 1)],
             }
         return self._buffers

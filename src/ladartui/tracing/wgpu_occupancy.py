@@ -168,12 +168,21 @@ def cube_box(occupancy):
 
 
 def pack_params(
-    occupancy, upload, method, step, count, precision, first_sample=0, samples_per_pass=MARCH_SAMPLES_PER_PASS
+    occupancy,
+    upload,
+    method,
+    step,
+    count,
+    precision,
+    first_sample=0,
+    samples_per_pass=MARCH_SAMPLES_PER_PASS,
+    shared_origin=False,
 ) -> bytes:
     """The uniform block for one dispatch, laid out as ``struct Params``.
 
     ``first_sample`` and ``samples_per_pass`` bound the march's samples in this
-    dispatch (see MARCH_SAMPLES_PER_PASS).
+    dispatch (see MARCH_SAMPLES_PER_PASS); ``shared_origin``: first_hits reads
+    one origin for every ray.
     """
     ints = np.zeros((10, 4), dtype=np.int32)
     ints[0, :3] = occupancy.shape
@@ -184,7 +193,7 @@ def pack_params(
     ints[5, :] = np.array(upload.bases[:4], dtype=np.int64).astype(np.uint32).view(np.int32)
     ints[6, :] = (count, METHOD_CODES[method], int(occupancy.zmax), len(occupancy.root))
     ints[7, 0] = np.array(upload.bases[4], dtype=np.int64).astype(np.uint32).view(np.int32)
-    ints[7, 1:3] = (first_sample, samples_per_pass)
+    ints[7, 1:4] = (first_sample, samples_per_pass, int(shared_origin))
     cube_origin, cube_dims = cube_box(occupancy)
     ints[8, :3] = cube_origin
     ints[8, 3] = np.array(upload.bases[5], dtype=np.int64).astype(np.uint32).view(np.int32)
