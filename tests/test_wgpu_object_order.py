@@ -223,3 +223,39 @@ def test_ray_tiles_follow_the_bins_starts():
     bin_starts = np.concatenate([[0], np.cumsum(counts)])
     per_tile = counts.reshape(25, 4).sum(axis=1)
     assert np.array_equal(ray_tiles_of(bin_starts, shift), np.repeat(np.arange(25), per_tile))
+
+
+@pytest.mark.parametrize(
+    "order, method, precision",
+    [
+        ("object", "exact", "f64"),
+        ("ray", "exact", "f64"),
+        ("auto", "exact", "f64"),
+        ("auto", "march", "f64"),
+        ("ray", "exact", "f32"),
+    ],
+)
+def test_every_ray_gets_an_answer_written(forest, monkeypatch, order, method, precision):
+    """The wgpu backend's answer arrays start unfilled: every path must write every
+    ray. Junk in the new arrays shows up as a difference from a clean run."""
+    import types
+
+    import ladartui.tracing.wgpu_backend as wgpu_module
+    from ladartui.tracing.wgpu_backend import WgpuBackend
+
+    _, occ = forest
+    origins, directions = one_scan([100, 100, 10], 50.0, 1.0, 300.0)
+    backend = WgpuBackend()
+    if precision == "f64" and "f64" not in backend.describe()["precisions"]:
+        pytest.skip("the adapter has no shader-f64")
+    calls = {"order": order, "method": method, "precision": precision}
+    clean = [backend.trace_cells(occ, origins, directions, **calls) for _ in range(4)]
+
+    def junk(shape, dtype=float):
+        out = np.empty(shape, dtype)
+        out.view(np.uint8)[...] = 0x5A
+        return out
+
+    monkeypatch.setattr(wgpu_module, "np", types.SimpleNamespace(**{**vars(np), "empty": junk}))
+    for expected in clean:  # auto: both orders, as they take turns
+        assert_same(expected, backend.trace_cells(occ, origins, directions, **calls))
