@@ -428,6 +428,49 @@ def test_order_choice_reads_the_given_clock():
     assert picks == {"cpu": "object", "wall": "ray"}
 
 
+def test_blocks_picked_for_ray_order_go_together():
+    """Once ray order has won, the blocks picked for it one after another go to
+    ray_block as one run (up to RAY_RUN_BLOCKS), broken where the choice retries
+    object order; a short last block joins the run before it. Every ray is traced
+    once, and each run is learned from as one sample."""
+    from ladartui.tracing.config import MIN_SCAN_RAYS, SCAN_BLOCK
+    from ladartui.tracing.order_choice import RAY_RUN_BLOCKS, OrderChoice, trace_in_blocks
+
+    def traced(n, retry):
+        choice = OrderChoice()
+        choice.RETRY = retry
+        choice.samples = {"object": [1e-6, 1e-6], "ray": [1e-7, 1e-7]}
+        calls = []
+        now = [0.0]  # seconds: object order costs ten times what ray order does
+
+        def object_block(a, b, limit):
+            calls.append(("object", a // SCAN_BLOCK, b / SCAN_BLOCK))
+            now[0] += (b - a) * 1e-6
+            return True
+
+        def ray_block(a, b):
+            calls.append(("ray", a // SCAN_BLOCK, b / SCAN_BLOCK))
+            now[0] += (b - a) * 1e-7
+
+        trace_in_blocks(n, "auto", choice, object_block, ray_block, clock=lambda: now[0])
+        covered = sorted((a, b) for _, a, b in calls)
+        assert covered[0][0] == 0 and covered[-1][1] == n / SCAN_BLOCK
+        assert all(x[1] == y[0] for x, y in zip(covered, covered[1:]))  # no gap, no overlap
+        return calls, choice
+
+    calls, choice = traced(20 * SCAN_BLOCK, OrderChoice.RETRY)  # the 16th pick retries object order
+    assert calls == [("ray", 0, 15), ("object", 15, 16), ("ray", 16, 20)]
+    assert choice.calls == 20 and len(choice.samples["ray"]) == 2
+    tail = MIN_SCAN_RAYS // 2
+    calls, _ = traced(2 * RAY_RUN_BLOCKS * SCAN_BLOCK + 8 * SCAN_BLOCK + tail, 1000)
+    last = 2 * RAY_RUN_BLOCKS + 8 + tail / SCAN_BLOCK
+    assert calls == [
+        ("ray", 0, RAY_RUN_BLOCKS),
+        ("ray", RAY_RUN_BLOCKS, 2 * RAY_RUN_BLOCKS),
+        ("ray", 2 * RAY_RUN_BLOCKS, last),
+    ]
+
+
 @pytest.mark.parametrize("order, method", [("object", "exact"), ("ray", "exact"), ("auto", "march")])
 def test_every_ray_gets_an_answer_written(monkeypatch, order, method):
     # The backend's output arrays start uninitialised: every path must write every

@@ -15,6 +15,8 @@ import numpy as np
 from ladartui.errors import check_cancelled
 from ladartui.tracing.config import MIN_SCAN_RAYS, SCAN_BLOCK, VOXELS_PER_RAY
 
+RAY_RUN_BLOCKS = 16  # blocks one ray_block call may take: bounds the wait for a cancel
+
 
 class OrderChoice:
     """Which order traces an occupancy's scans faster, learned from the calls themselves.
@@ -65,24 +67,41 @@ def trace_in_blocks(n, order, choice, object_block, ray_block, cancel=None, cloc
     from their times, read from ``clock``: wall time by default (a GPU's work costs
     the host nothing), the process's CPU time for a CPU backend (time.process_time:
     on a shared machine, other processes' work then does not make an order look
-    slow, and the choice does not flip with the load).
+    slow, and the choice does not flip with the load). In "auto", blocks picked
+    for ray order one after another go to ``ray_block`` together, up to
+    RAY_RUN_BLOCKS of them (the wgpu backend overlaps the batches of one call),
+    and are timed as one.
     """
     orders = set()
-    for a in range(0, n, SCAN_BLOCK):
+    picked = None  # the choice's pick for the block at ``a``, when made ahead
+    a = 0
+    while a < n:
         b = min(n, a + SCAN_BLOCK)
         check_cancelled(cancel, "trace cancelled")
         learning = choice if order == "auto" and b - a >= MIN_SCAN_RAYS else None
+        pick, picked = (picked or learning.pick()) if learning is not None else None, None
         started = clock()
-        if order == "object" or (learning is not None and learning.pick() == "object"):
+        if order == "object" or pick == "object":
             limit = np.inf if order == "object" else VOXELS_PER_RAY * (b - a)
             if object_block(a, b, limit):
                 orders.add("object")
                 if learning is not None:
                     learning.record("object", clock() - started, b - a)
+                a = b
                 continue
             learning = None  # no scan for object order: nothing to learn from this block
+        if learning is not None:  # picked for ray order: so may the blocks after it be
+            while b < n and b - a < RAY_RUN_BLOCKS * SCAN_BLOCK:
+                after = min(n, b + SCAN_BLOCK)
+                if after - b >= MIN_SCAN_RAYS:
+                    picked = choice.pick()
+                    if picked != "ray":
+                        break
+                    picked = None
+                b = after
         orders.add("ray")
         ray_block(a, b)
         if learning is not None:
             learning.record("ray", clock() - started, b - a)
+        a = b
     return orders
