@@ -214,16 +214,25 @@ def test_order_choice_learns_the_faster_order():
             choice.record(pick, seconds[pick], 1000)
         return picks
 
+    def calls_of(picks, letter, first_call):
+        return [first_call + k for k, p in enumerate(picks) if p == letter]
+
+    assert (OrderChoice.RETRY, OrderChoice.MAX_RETRY) == (16, 64)
     choice = OrderChoice()
     # Turns until each order is timed twice; a slow first call (compiling) is forgiven.
     choice.record("object", 0.5, 1000)
     choice.samples["object"].clear()
-    picks = run(choice, 4 + 2 * OrderChoice.RETRY, {"object": 0.040, "ray": 0.010})
+    picks = run(choice, 250, {"object": 0.040, "ray": 0.010})
     assert picks[:4] == "oror"
-    assert picks[4:].count("o") == 2 and picks[4:].count("r") == 2 * OrderChoice.RETRY - 2
-    # The views change: ray order turns slow, and the retried object order takes over.
-    picks = run(choice, 4 * OrderChoice.RETRY, {"object": 0.040, "ray": 0.200})
-    assert picks[-2 * OrderChoice.RETRY :].count("r") == 2  # its retries only
+    # Ray order leads from call 2 on. Object order is tried again 16 calls later, and
+    # after each retry it loses, twice as long after: 32, then 64 at most.
+    assert calls_of(picks[4:], "o", 5) == [18, 18 + 32, 18 + 32 + 64, 18 + 32 + 2 * 64, 18 + 32 + 3 * 64]
+    assert choice.retry_every == 64
+    # The views change: ray order turns slow. Its own next two times show it, object
+    # order leads again, and ray order is retried 16 calls later, then 32, 64 later.
+    picks = run(choice, 150, {"object": 0.040, "ray": 0.200})
+    assert picks[:3] == "rro"
+    assert calls_of(picks[2:], "r", 253) == [252 + 16, 252 + 16 + 32, 252 + 16 + 32 + 64]
     first = OrderChoice()
     first.record("object", 0.9, 1000)  # compiling
     assert run(first, 3, {"object": 0.040, "ray": 0.060}) == "ror"
@@ -428,7 +437,7 @@ def test_order_choice_reads_the_given_clock():
     assert picks == {"cpu": "object", "wall": "ray"}
 
 
-def test_blocks_picked_for_ray_order_go_together():
+def test_blocks_picked_for_ray_order_go_together(monkeypatch):
     """Once ray order has won, the blocks picked for it one after another go to
     ray_block as one run (up to RAY_RUN_BLOCKS), broken where the choice retries
     object order; a short last block joins the run before it. Every ray is traced
@@ -437,8 +446,8 @@ def test_blocks_picked_for_ray_order_go_together():
     from ladartui.tracing.order_choice import RAY_RUN_BLOCKS, OrderChoice, trace_in_blocks
 
     def traced(n, retry):
+        monkeypatch.setattr(OrderChoice, "RETRY", retry)
         choice = OrderChoice()
-        choice.RETRY = retry
         choice.samples = {"object": [1e-6, 1e-6], "ray": [1e-7, 1e-7]}
         calls = []
         now = [0.0]  # seconds: object order costs ten times what ray order does

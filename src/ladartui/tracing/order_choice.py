@@ -26,16 +26,27 @@ class OrderChoice:
     dear where they pass many gaps (foliage). So the orders take turns until
     each has been timed twice (a first call may include compiling), then the
     faster by its better recent time per ray goes on, and the other is tried
-    again every RETRY scans in case the views have changed.
+    again in case the views have changed: RETRY scans after the lead last
+    changed, then twice as long after each retry that loses, up to MAX_RETRY
+    scans (on the reference orbit, losing retries every 16 scans were a tenth
+    of the numba backend's work).
     """
 
     RETRY = 16
+    MAX_RETRY = 64
     SAMPLES = 2
 
     def __init__(self):
         self.samples: dict[str, list[float]] = {"object": [], "ray": []}  # recent seconds per ray
         self.calls = 0
+        self.retry_every = self.RETRY
+        self._next_retry = self.RETRY  # the call that retries the other order
+        self._retrying: str | None = None  # the order a retry picked, until it is timed
+        self._leader: str | None = None  # the faster order by the samples so far
         self._lock = threading.Lock()
+
+    def _best(self) -> str:
+        return min(self.samples, key=lambda order: min(self.samples[order]))
 
     def pick(self) -> str:
         with self._lock:
@@ -43,9 +54,11 @@ class OrderChoice:
             timed_object, timed_ray = len(self.samples["object"]), len(self.samples["ray"])
             if min(timed_object, timed_ray) < self.SAMPLES:
                 return "object" if timed_object <= timed_ray else "ray"
-            best = min(self.samples, key=lambda order: min(self.samples[order]))
-            if self.calls % self.RETRY == 0:
-                return "ray" if best == "object" else "object"
+            best = self._best()
+            if self.calls >= self._next_retry:
+                self._next_retry = self.calls + self.retry_every
+                self._retrying = "ray" if best == "object" else "object"
+                return self._retrying
             return best
 
     def record(self, order: str, seconds: float, rays: int) -> None:
@@ -53,6 +66,16 @@ class OrderChoice:
             recent = self.samples[order]
             recent.append(seconds / max(1, rays))
             del recent[: -self.SAMPLES]
+            leader = self._best() if all(self.samples.values()) else None
+            if leader != self._leader:  # the views changed (or a first lead): look again soon
+                self.retry_every = self.RETRY
+                self._next_retry = self.calls + self.RETRY
+            elif order == self._retrying:  # a retry lost: wait twice as long for the next
+                self.retry_every = min(self.MAX_RETRY, 2 * self.retry_every)
+                self._next_retry = self.calls + self.retry_every
+            if order == self._retrying:
+                self._retrying = None
+            self._leader = leader
 
 
 def trace_in_blocks(n, order, choice, object_block, ray_block, cancel=None, clock=time.perf_counter):
