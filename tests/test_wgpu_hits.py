@@ -53,6 +53,8 @@ def test_batches_in_flight_give_numba_answers(wgpu_backend, numba_backend, case)
     hits = batched.trace_cells(occupancy, origins, directions, order="ray")
     assert batched._hits.batch == 640 and hits.info["order"] == "ray"
     assert_same(hits, reference)
+    batched._hits.bundle_starts = not batched._hits.bundle_starts  # answers on the thread, or not
+    assert_same(batched.trace_cells(occupancy, origins, directions, order="ray"), reference)
     assert_same(wgpu_backend.trace_cells(occupancy, origins, directions, order="ray"), reference)
 
 
@@ -190,23 +192,28 @@ def test_rays_from_one_origin_give_numba_answers_with_one_origin_written(
     assert shared[:2] == [False, True]
 
 
-def test_a_failure_on_the_answer_thread_reaches_the_caller(numba_backend, case, monkeypatch):
-    """Batch 0 is answered on the worker thread while batch 2 is written: its error
-    comes back to the caller, no read-back buffer stays mapped, and the next call
-    answers in full."""
+@pytest.mark.parametrize("bundle_starts", [False, True])
+def test_a_failure_in_the_answers_reaches_the_caller(numba_backend, case, monkeypatch, bundle_starts):
+    """Without bundle starts, batch 0 is answered on the worker thread while batch
+    2 is written; with them (numba runs in the writing too) on the calling thread.
+    Either way its error comes back to the caller, no read-back buffer stays
+    mapped, and the next call answers in full."""
     occupancy, origins, directions = case
     backend = WgpuBackend(ray_batch=640)
+    backend.trace_cells(occupancy, origins[:10], directions[:10])  # opens the device
+    backend._hits.bundle_starts = bundle_starts
     answers = wgpu_hits.box_offset_answers
     threads = []
 
     def fail(*args):
-        threads.append(threading.current_thread().name)
+        threads.append(threading.current_thread())
         raise RuntimeError("answers failed")
 
     monkeypatch.setattr(wgpu_hits, "box_offset_answers", fail)
     with pytest.raises(RuntimeError, match="answers failed"):
         backend.trace_cells(occupancy, origins, directions, order="ray")
-    assert len(threads) == 1 and threads[0].startswith("ladartui-answers")
+    assert len(threads) == 1
+    assert (threads[0] is threading.current_thread()) == bundle_starts
     assert [b.map_state for b in backend._hits.buffers(PARAMS_BYTES)["back"]] == ["unmapped"] * 2
     monkeypatch.setattr(wgpu_hits, "box_offset_answers", answers)
     assert_same(

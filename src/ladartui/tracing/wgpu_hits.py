@@ -119,9 +119,10 @@ class FirstHits:
         only that origin is written.
 
         Batches overlap: the device traces batch k + 1 while batch k is answered
-        (on a thread of its own) and batch k + 2 written; words come back through
-        two mapped buffers in turn, read in place. A wait waits for all submitted
-        work, so k + 1 is submitted only once k's words are there.
+        (on a thread of its own where there are no bundle starts to compute) and
+        batch k + 2 written; words come back through two mapped buffers in turn,
+        read in place. A wait waits for all submitted work, so k + 1 is submitted
+        only once k's words are there.
         """
         buffers = self._buffers
         queue = self._device.queue
@@ -167,18 +168,25 @@ class FirstHits:
             write(1)  # while the device traces batch 0
         cut = 0
         for k in range(len(firsts)):
+            later = k + 2 < len(firsts)
             with mapped_words(buffers["back"][k % 2], rows(k).stop - rows(k).start) as words:
                 if k + 1 < len(firsts):
                     submit(k + 1)  # traced while batch k's answers are made
-                if k + 2 >= len(firsts):
-                    cut += answer(k, words)
+                if later and not self.bundle_starts:
+                    # Batch k answered on the thread while this one writes batch k + 2.
+                    # Only where writing runs no numba (bundle starts do): two parallel
+                    # regions at once would abort under numba's workqueue layer.
+                    answering = self._answerer().submit(answer, k, words)
+                    try:
+                        check_cancelled(cancel, "trace cancelled")
+                        write(k + 2)
+                    finally:
+                        cut += answering.result()  # before the words are unmapped
                     continue
-                answering = self._answerer().submit(answer, k, words)
-                try:
-                    check_cancelled(cancel, "trace cancelled")
-                    write(k + 2)  # while batch k is answered and k + 1 traced
-                finally:
-                    cut += answering.result()  # before the words are unmapped
+                cut += answer(k, words)
+            if later:
+                check_cancelled(cancel, "trace cancelled")
+                write(k + 2)
         return cut
 
     def _answerer(self) -> ThreadPoolExecutor:
