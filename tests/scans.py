@@ -50,3 +50,17 @@ def random_scan(rng, jitter, n=3000):
     directions /= np.linalg.norm(directions, axis=1, keepdims=True)
     origins = start + rng.uniform(-jitter, jitter, size=(n, 3))
     return voxels, shape, Occupancy.build(voxels, shape), origins, directions
+
+
+def numpy_with_junk_empty():
+    """numpy, except that ``empty`` fills its arrays with the byte 0x5A: set as a
+    backend module's ``np``, any answer a path leaves unwritten differs from a
+    clean run's."""
+    import types
+
+    def junk(shape, dtype=float):
+        out = np.empty(shape, dtype)
+        out.view(np.uint8)[...] = 0x5A
+        return out
+
+    return types.SimpleNamespace(**{**vars(np), "empty": junk})

@@ -14,7 +14,7 @@ from ladartui.tracing.backend import GROUND, MISS, VOXEL
 from ladartui.tracing.numba_backend import NumbaBackend
 from ladartui.tracing.reference import reference_trace_cells
 from ladartui.tracing.scan_rays import cone_frame
-from scans import assert_same, forest_scene, one_scan, random_scan
+from scans import assert_same, forest_scene, numpy_with_junk_empty, one_scan, random_scan
 
 
 @pytest.fixture(scope="module")
@@ -484,20 +484,13 @@ def test_blocks_picked_for_ray_order_go_together(monkeypatch):
 def test_every_ray_gets_an_answer_written(monkeypatch, order, method):
     # The backend's output arrays start uninitialised: every path must write every
     # ray. Junk in the new arrays shows up as a difference from a clean run.
-    import types
-
     import ladartui.tracing.numba_backend as nb_module
 
     _, occ = forest_scene()
     origins, directions = one_scan([100, 100, 10], 50.0, 1.0, 300.0)
     clean = NumbaBackend().trace_cells(occ, origins, directions, order=order, method=method)
 
-    def junk(shape, dtype=float):
-        out = np.empty(shape, dtype)
-        out.view(np.uint8)[...] = 0x5A
-        return out
-
-    monkeypatch.setattr(nb_module, "np", types.SimpleNamespace(**{**vars(np), "empty": junk}))
+    monkeypatch.setattr(nb_module, "np", numpy_with_junk_empty())
     dirty = NumbaBackend().trace_cells(occ, origins, directions, order=order, method=method)
     assert_same(clean, dirty)
     assert clean.info["order"] == ("object" if order == "object" else "ray")

@@ -11,7 +11,7 @@ from ladartui.sensor import Sensor
 from ladartui.tracing.backend import GROUND, MISS, VOXEL
 from ladartui.tracing.reference import reference_trace_cells
 from ladartui.tracing.shader_scan import cell_packing, ray_tiles_of, tile_entries, voxel_words
-from scans import assert_same, forest_scene, one_scan, random_scan
+from scans import assert_same, forest_scene, numpy_with_junk_empty, one_scan, random_scan
 
 # The wgpu_backend and numba_backend fixtures come from tests/conftest.py.
 
@@ -238,8 +238,6 @@ def test_ray_tiles_follow_the_bins_starts():
 def test_every_ray_gets_an_answer_written(forest, monkeypatch, order, method, precision):
     """The wgpu backend's answer arrays start unfilled: every path must write every
     ray. Junk in the new arrays shows up as a difference from a clean run."""
-    import types
-
     import ladartui.tracing.wgpu_backend as wgpu_module
     from ladartui.tracing.wgpu_backend import WgpuBackend
 
@@ -251,11 +249,6 @@ def test_every_ray_gets_an_answer_written(forest, monkeypatch, order, method, pr
     calls = {"order": order, "method": method, "precision": precision}
     clean = [backend.trace_cells(occ, origins, directions, **calls) for _ in range(4)]
 
-    def junk(shape, dtype=float):
-        out = np.empty(shape, dtype)
-        out.view(np.uint8)[...] = 0x5A
-        return out
-
-    monkeypatch.setattr(wgpu_module, "np", types.SimpleNamespace(**{**vars(np), "empty": junk}))
+    monkeypatch.setattr(wgpu_module, "np", numpy_with_junk_empty())
     for expected in clean:  # auto: both orders, as they take turns
         assert_same(expected, backend.trace_cells(occ, origins, directions, **calls))
