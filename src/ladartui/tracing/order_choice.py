@@ -102,7 +102,8 @@ def trace_in_blocks(n, order, choice, object_block, ray_block, cancel=None, cloc
         b = min(n, a + SCAN_BLOCK)
         check_cancelled(cancel, "trace cancelled")
         learning = choice if order == "auto" and b - a >= MIN_SCAN_RAYS else None
-        pick, picked = (picked or learning.pick()) if learning is not None else None, None
+        pick = None if learning is None else picked or learning.pick()
+        picked = None
         started = clock()
         if order == "object" or pick == "object":
             limit = np.inf if order == "object" else VOXELS_PER_RAY * (b - a)

@@ -88,7 +88,7 @@ from ladartui.tracing.wgpu_occupancy import (
     pack_params,
     upload_occupancy,
 )
-from ladartui.tracing.wgpu_scans import ScanDispatcher, dispatch_encoder
+from ladartui.tracing.wgpu_scans import ScanDispatcher, dispatch_encoder, rays_per_dispatch
 
 NAME = "wgpu"
 
@@ -300,15 +300,7 @@ class WgpuBackend:
         if buffers is None:
             device = self._open_device()
             real_bytes = 8 if precision == "f64" else 4
-            groups = self._limits["max-compute-workgroups-per-dimension"]
-            rays = max(
-                1,
-                min(
-                    self._ray_batch,
-                    self._limits["max-storage-buffer-binding-size"] // (6 * real_bytes),
-                    groups * groups * BUNDLE,
-                ),
-            )
+            rays = rays_per_dispatch(self._limits, self._ray_batch, 6 * real_bytes)
             usage_in = wgpu.BufferUsage.STORAGE | wgpu.BufferUsage.COPY_DST
             usage_out = wgpu.BufferUsage.STORAGE | wgpu.BufferUsage.COPY_SRC
             buffers = {
@@ -522,8 +514,8 @@ class WgpuBackend:
             sides,
             pipeline,
             group,
-            lambda count, shared: pack_params(
-                occupancy, upload, "exact", 0.5, count, "f64", shared_origin=shared
+            lambda count: pack_params(
+                occupancy, upload, "exact", 0.5, count, "f64", shared_origin=shared_origin
             ),
             origins,
             directions,

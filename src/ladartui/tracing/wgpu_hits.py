@@ -29,7 +29,7 @@ from ladartui.errors import check_cancelled
 from ladartui.tracing.answers import box_offset_answers
 from ladartui.tracing.bundle import Halos, bundle_start_array
 from ladartui.tracing.config import BUNDLE, SCAN_BLOCK, SHADER_INF
-from ladartui.tracing.wgpu_scans import dispatch_encoder
+from ladartui.tracing.wgpu_scans import dispatch_encoder, rays_per_dispatch
 
 # Bindings of first_hits besides the occupancy chunks (trace.wgsl).
 HIT_BINDINGS = {"params": 0, "starts": 4, "origins": 5, "directions": 6, "found": 7}
@@ -85,10 +85,7 @@ class FirstHits:
         starts at its entry into the occupied box."""
         self._device = device
         self._limits = limits
-        groups = limits["max-compute-workgroups-per-dimension"]
-        self.batch = max(
-            1, min(ray_batch, limits["max-storage-buffer-binding-size"] // 24, groups * groups * BUNDLE)
-        )
+        self.batch = rays_per_dispatch(limits, ray_batch, 24)  # the directions' binding
         self.bundle_starts = bundle_starts
         self._stale_starts = False  # the starts buffer holds starts (else zeros)
         self._buffers: dict[str, Any] = {}
@@ -100,7 +97,7 @@ class FirstHits:
         sides: tuple[int, int, int],
         pipeline,
         group,
-        params_for: Callable[[int, bool], bytes],
+        params_for: Callable[[int], bytes],
         origins,
         directions,
         halo: Halos,
@@ -114,9 +111,9 @@ class FirstHits:
         rays the adapter cut short (their answers are then not to be used).
         ``sides``: the occupied box's (``box_sides``, not None);
         ``group`` binds ``buffers()`` and the occupancy at HIT_BINDINGS;
-        ``params_for(count, shared_origin)`` gives the uniform block of a batch;
-        ``shared_origin``: every ray starts at ``origins[0]`` (``one_origin``), so
-        only that origin is written.
+        ``params_for(count)`` gives the uniform block of a batch (saying whether
+        the rays share one origin); ``shared_origin``: every ray starts at
+        ``origins[0]`` (``one_origin``), so only that origin is written.
 
         Batches overlap: the device traces batch k + 1 while batch k is answered
         (on a thread of its own where there are no bundle starts to compute) and
@@ -133,9 +130,12 @@ class FirstHits:
         def rows(k: int) -> slice:
             return slice(firsts[k], min(len(origins), firsts[k] + self.batch))
 
+        def count(k: int) -> int:
+            return rows(k).stop - rows(k).start
+
         def write(k: int) -> None:
             o, d = origins[rows(k)], directions[rows(k)]
-            queue.write_buffer(buffers["params"], 0, params_for(len(o), shared_origin))
+            queue.write_buffer(buffers["params"], 0, params_for(len(o)))
             queue.write_buffer(buffers["origins"], 0, o[:1] if shared_origin else o)
             queue.write_buffer(buffers["directions"], 0, d)
             if self.bundle_starts:
@@ -149,9 +149,8 @@ class FirstHits:
                 self._stale_starts = False
 
         def submit(k: int) -> None:
-            count = len(origins[rows(k)])
-            encoder = dispatch_encoder(self._device, self._limits, pipeline, group, count)
-            encoder.copy_buffer_to_buffer(buffers["found"], 0, buffers["back"][k % 2], 0, 4 * count)
+            encoder = dispatch_encoder(self._device, self._limits, pipeline, group, count(k))
+            encoder.copy_buffer_to_buffer(buffers["found"], 0, buffers["back"][k % 2], 0, 4 * count(k))
             queue.submit([encoder.finish()])
 
         def answer(k: int, words) -> int:
@@ -169,7 +168,7 @@ class FirstHits:
         cut = 0
         for k in range(len(firsts)):
             later = k + 2 < len(firsts)
-            with mapped_words(buffers["back"][k % 2], rows(k).stop - rows(k).start) as words:
+            with mapped_words(buffers["back"][k % 2], count(k)) as words:
                 if k + 1 < len(firsts):
                     submit(k + 1)  # traced while batch k's answers are made
                 if later and not self.bundle_starts:

@@ -32,6 +32,14 @@ def dispatch_grid(workgroups: int, max_per_dimension: int) -> tuple[int, int]:
     return (x, y)
 
 
+def rays_per_dispatch(limits: dict[str, int], ray_batch: int, binding_bytes_per_ray: int) -> int:
+    """Rays in one dispatch: at most ``ray_batch``, as many as the largest binding
+    holds at ``binding_bytes_per_ray``, and as many as ``dispatch_grid`` can cover."""
+    groups = limits["max-compute-workgroups-per-dimension"]
+    by_binding = limits["max-storage-buffer-binding-size"] // binding_bytes_per_ray
+    return max(1, min(ray_batch, by_binding, groups * groups * BUNDLE))
+
+
 def dispatch_encoder(device, limits: dict[str, int], pipeline, group, rays: int):
     """A command encoder holding one dispatch of ``pipeline`` with bind group 0
     ``group`` over ``rays`` rays (BUNDLE a workgroup), to be finished by the caller."""
