@@ -11,9 +11,12 @@ from ladartui.scene.occupancy import Occupancy
 from ladartui.sensor import Sensor
 from ladartui.tracing import trace
 from ladartui.tracing.backend import GROUND, MISS, VOXEL
+from ladartui.tracing.config import SCAN_BLOCK
 from ladartui.tracing.numba_backend import NumbaBackend
+from ladartui.tracing.prepare import one_origin
 from ladartui.tracing.reference import reference_trace_cells
-from ladartui.tracing.scan_rays import cone_frame
+from ladartui.tracing.scan_rays import cone_frame, ray_bounds
+from ladartui.tracing.tile_tests import trace_scan
 from scans import assert_same, forest_scene, numpy_with_junk_empty, one_scan, random_scan
 
 
@@ -22,9 +25,21 @@ def forest():
     return forest_scene()
 
 
+def block_bounds(origins, directions):
+    """What rays_to_cells finds per SCAN_BLOCK rays, for rays already in cell space."""
+    rows = []
+    for a in range(0, len(origins), SCAN_BLOCK):
+        rows.append(np.concatenate(ray_bounds(origins[a : a + SCAN_BLOCK], directions[a : a + SCAN_BLOCK])))
+    return np.array(rows)
+
+
 def both_orders(backend, occ, origins, directions):
+    """Ray order, and object order (which must agree with and without the block bounds
+    that tell it when every ray starts at one point)."""
     ray = backend.trace_cells(occ, origins, directions, order="ray")
     obj = backend.trace_cells(occ, origins, directions, order="object")
+    bounds = block_bounds(origins, directions)
+    assert_same(obj, backend.trace_cells(occ, origins, directions, order="object", block_bounds=bounds))
     return ray, obj
 
 
@@ -563,3 +578,49 @@ def test_bricks_in_view_are_every_brick_a_ray_can_meet_nearest_first(depression)
     finally:
         numba.set_num_threads(threads)
     assert np.array_equal(alone[0], found) and np.array_equal(alone[1], near)
+
+
+def test_trace_tells_the_tile_tests_when_rays_share_one_origin(forest, monkeypatch):
+    from ladartui.tracing import numba_backend as nb
+
+    voxels, occ = forest
+    origins, directions = one_scan([120, 120, 20], 45.0, 0.7, 300.0)
+    told = []
+
+    def spy(*args, shared_origin=False):
+        told.append(shared_origin)
+        return trace_scan(*args, shared_origin=shared_origin)
+
+    monkeypatch.setattr(nb, "trace_scan", spy)
+    pinhole = np.repeat(origins[:1], len(origins), axis=0)
+    for rays_from, shared in ((pinhole, True), (origins, False)):
+        told.clear()
+        fresh = Occupancy.build(voxels, occ.shape)  # its first scan goes in object order
+        result = trace(fresh, rays_from, directions, backend="numba")
+        assert result.info["order"] == "object" and told == [shared]
+
+
+def test_rays_from_one_origin_read_that_origin_alone(forest, numba_backend):
+    """With a shared origin the tile tests read orig[0] for every ray: answers as from
+    the real origins though every other row holds NaN; so do rays from two origins,
+    whose bounds do not say shared."""
+    _, occ = forest
+    origins, directions = one_scan([120, 120, 20], 45.0, 0.7, 300.0)
+    origins[:] = origins[0]  # a pinhole camera (the sensor's spread over its focal plane)
+    bounds = block_bounds(origins, directions)
+    assert one_origin(bounds, 0, len(origins))
+    ray = numba_backend.trace_cells(occ, origins, directions, order="ray")
+    junk = np.full_like(origins, np.nan)
+    junk[0] = origins[0]
+    nx, ny = float(occ.shape[0]), float(occ.shape[1])
+    n = len(origins)
+    answers = (np.empty(n, np.uint8), np.empty((n, 3), np.int32), np.empty(n))
+    frame = cone_frame(origins, directions, bounds[0])
+    assert trace_scan(occ, junk, directions, frame, np.inf, nx, ny, *answers, shared_origin=True)
+    assert_same(ray, type(ray)(*answers, {}))
+    moved = origins.copy()
+    moved[1::2] += [0.5, 0.0, 0.0]  # half the rays from a point half a cell east
+    assert not one_origin(block_bounds(moved, directions), 0, len(moved))
+    ray, obj = both_orders(numba_backend, occ, moved, directions)
+    assert obj.info["order"] == "object"
+    assert_same(ray, obj)

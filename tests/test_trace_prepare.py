@@ -6,7 +6,7 @@ import pytest
 from ladartui.errors import FieldError
 from ladartui.tracing import TINY
 from ladartui.tracing.config import SCAN_BLOCK
-from ladartui.tracing.prepare import rays_to_cells
+from ladartui.tracing.prepare import one_origin, rays_to_cells
 from ladartui.tracing.scan_rays import ray_bounds
 
 
@@ -90,3 +90,23 @@ def test_a_huge_direction_is_traced_where_it_points():
     occ = Occupancy.build(np.array([[5, 5, 2]]), (16, 16, 8))
     down = trace(occ, [[5.0, 5.0, 7.0]], [[0.0, 0.0, -1e200]], backend="numba")  # cell centre
     assert down.kind[0] == 1 and down.index[0].tolist() == [5, 5, 2]
+
+
+def test_one_origin_is_read_from_the_block_bounds():
+    """rays_to_cells' bounds say when every ray of a range starts at one point."""
+    directions = np.random.default_rng(3).normal(size=(4096, 3))
+    origins = np.tile([32.25, 32.25, 40.0], (len(directions), 1))
+    _, _, bounds = rays_to_cells(origins, directions, 1.0, TINY)
+    assert one_origin(bounds, 0, len(origins))
+    assert not one_origin(None, 0, len(origins)) and not one_origin(bounds, 5, 5)
+    moved = origins.copy()
+    moved[1000, 2] = np.nextafter(moved[1000, 2], np.inf)  # one ray, one ulp higher
+    assert not one_origin(rays_to_cells(moved, directions, 1.0, TINY)[2], 0, len(origins))
+    # Blocks of SCAN_BLOCK rays: only those a range touches count, and they must agree.
+    row = bounds[0]
+    other = row.copy()
+    other[[2, 5]] += 1.0  # another scan, one cell higher
+    two = np.array([row, other])
+    assert not one_origin(two, 0, 2 * SCAN_BLOCK)
+    assert one_origin(two, 0, SCAN_BLOCK) and one_origin(two, SCAN_BLOCK + 7, 2 * SCAN_BLOCK)
+    assert one_origin(np.array([row, row]), 3, SCAN_BLOCK + 3)

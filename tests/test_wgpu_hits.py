@@ -12,10 +12,9 @@ import pytest
 
 from ladartui.errors import Cancelled
 from ladartui.tracing import TINY, wgpu_hits
-from ladartui.tracing.config import SCAN_BLOCK
 from ladartui.tracing.prepare import rays_to_cells
 from ladartui.tracing.wgpu_backend import WgpuBackend
-from ladartui.tracing.wgpu_hits import box_sides, one_origin
+from ladartui.tracing.wgpu_hits import box_sides
 from ladartui.tracing.wgpu_occupancy import PARAMS_BYTES
 from test_wgpu_backend import Occupancy, assert_same, random_rays, random_scene
 
@@ -144,25 +143,6 @@ def test_hits_in_a_box_away_from_the_origin_decode_to_their_cells(wgpu_backend, 
     reference = numba_backend.trace_cells(occupancy, origins, directions, order="ray")
     assert (reference.kind == 1).sum() > 150
     assert_same(wgpu_backend.trace_cells(occupancy, origins, directions, order="ray"), reference)
-
-
-def test_one_origin_is_read_from_the_block_bounds():
-    """rays_to_cells' bounds say when every ray of a range starts at one point."""
-    origins, directions = scan_from(SHAPE[2] * 2.0)
-    _, _, bounds = rays_to_cells(origins, directions, 1.0, TINY)
-    assert one_origin(bounds, 0, len(origins))
-    assert not one_origin(None, 0, len(origins)) and not one_origin(bounds, 5, 5)
-    moved = origins.copy()
-    moved[1000, 2] = np.nextafter(moved[1000, 2], np.inf)  # one ray, one ulp higher
-    assert not one_origin(rays_to_cells(moved, directions, 1.0, TINY)[2], 0, len(origins))
-    # Blocks of SCAN_BLOCK rays: only those a range touches count, and they must agree.
-    row = bounds[0]
-    other = row.copy()
-    other[[2, 5]] += 1.0  # another scan, one cell higher
-    two = np.array([row, other])
-    assert not one_origin(two, 0, 2 * SCAN_BLOCK)
-    assert one_origin(two, 0, SCAN_BLOCK) and one_origin(two, SCAN_BLOCK + 7, 2 * SCAN_BLOCK)
-    assert one_origin(np.array([row, row]), 3, SCAN_BLOCK + 3)
 
 
 def test_rays_from_one_origin_give_numba_answers_with_one_origin_written(

@@ -26,6 +26,7 @@ from ladartui.tracing.backend import GROUND, MISS, VOXEL, CellHits, TraceOrder, 
 from ladartui.tracing.bundle import bundle_start, halo_arrays
 from ladartui.tracing.config import BLOCK, BUNDLE, INF, SCAN_BLOCK
 from ladartui.tracing.order_choice import OrderChoice, trace_in_blocks
+from ladartui.tracing.prepare import one_origin
 from ladartui.tracing.scan_rays import cone_frame
 from ladartui.tracing.tile_tests import trace_scan
 
@@ -535,8 +536,9 @@ class NumbaBackend:
 
         def object_order_block(a, b, max_voxels):
             bounds = None if block_bounds is None else block_bounds[a // SCAN_BLOCK]
+            shared = one_origin(block_bounds, a, b)
             return self._object_order(
-                occ, orig[a:b], dirs[a:b], bounds, max_voxels, nx, ny, kind[a:b], index[a:b], t[a:b]
+                occ, orig[a:b], dirs[a:b], bounds, shared, max_voxels, nx, ny, kind[a:b], index[a:b], t[a:b]
             )
 
         if method == "exact" and order != "ray" and occ.count > 0:
@@ -562,10 +564,13 @@ class NumbaBackend:
         return CellHits(kind, index, t, info)
 
     @staticmethod
-    def _object_order(occ, orig, dirs, bounds, max_voxels, nx, ny, kind, index, t):
-        """Trace one scan in object order into kind/index/t; False when it is no scan for it."""
+    def _object_order(occ, orig, dirs, bounds, shared_origin, max_voxels, nx, ny, kind, index, t):
+        """Trace one scan in object order into kind/index/t; False when it is no scan for it.
+        ``shared_origin``: every ray starts at ``orig[0]``."""
         frame = cone_frame(orig, dirs, bounds)
-        return frame is not None and trace_scan(occ, orig, dirs, frame, max_voxels, nx, ny, kind, index, t)
+        return frame is not None and trace_scan(
+            occ, orig, dirs, frame, max_voxels, nx, ny, kind, index, t, shared_origin=shared_origin
+        )
 
 
 def _cube_arrays(occ):

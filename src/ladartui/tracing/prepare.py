@@ -125,3 +125,14 @@ def rays_to_cells(origins, directions, voxel_size, tiny):
         raise FieldError(f"directions[{first}]", directions[first].tolist(), "finite numbers")
     zero = first - n - 1
     raise FieldError(f"directions[{zero}]", directions[zero].tolist(), "a non-zero vector")
+
+
+def one_origin(block_bounds, first: int, end: int) -> bool:
+    """True when rays ``first..end`` all start at one point, by ``block_bounds``
+    (``prepare.rays_to_cells``' third answer: the least and greatest origin of
+    each SCAN_BLOCK rays). Equal least and greatest means equal values, and a
+    cell there is never -0.0, so equal bits."""
+    if block_bounds is None or end <= first:
+        return False
+    rows = np.asarray(block_bounds)[first // SCAN_BLOCK : -(-end // SCAN_BLOCK)]
+    return bool(len(rows)) and bool((rows[:, :6] == np.tile(rows[:1, :3], 2)).all())

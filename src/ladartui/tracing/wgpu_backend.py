@@ -76,10 +76,11 @@ from ladartui.tracing.config import (
 )
 from ladartui.tracing.f32_rays import f32_start_offsets, floor_preserving_f32
 from ladartui.tracing.order_choice import OrderChoice, trace_in_blocks
+from ladartui.tracing.prepare import one_origin
 from ladartui.tracing.scan_rays import cone_frame
 from ladartui.tracing.shader_scan import entry_answers, prepare_shader_scan
 from ladartui.tracing.wgpu_adapter import INSTALL_HINT, choose_adapter, give_driver_a_runtime_dir
-from ladartui.tracing.wgpu_hits import HIT_BINDINGS, FirstHits, box_sides, one_origin
+from ladartui.tracing.wgpu_hits import HIT_BINDINGS, FirstHits, box_sides
 from ladartui.tracing.wgpu_occupancy import (
     FIXED_BINDINGS,
     PARAMS_BYTES,

@@ -28,7 +28,7 @@ import numpy as np
 from ladartui.errors import check_cancelled
 from ladartui.tracing.answers import box_offset_answers
 from ladartui.tracing.bundle import Halos, bundle_start_array
-from ladartui.tracing.config import BUNDLE, SCAN_BLOCK, SHADER_INF
+from ladartui.tracing.config import BUNDLE, SHADER_INF
 from ladartui.tracing.wgpu_scans import dispatch_encoder, rays_per_dispatch
 
 # Bindings of first_hits besides the occupancy chunks (trace.wgsl).
@@ -42,17 +42,6 @@ def box_sides(occupancy) -> tuple[int, int, int] | None:
     if min(sides) <= 0 or sides[0] * sides[1] * sides[2] > OFFSET_LIMIT:
         return None
     return sides[0], sides[1], sides[2]
-
-
-def one_origin(block_bounds, first: int, end: int) -> bool:
-    """True when rays ``first..end`` all start at one point, by ``block_bounds``
-    (``prepare.rays_to_cells``' third answer: the least and greatest origin of
-    each SCAN_BLOCK rays). Equal least and greatest means equal values, and a
-    cell there is never -0.0, so equal bits."""
-    if block_bounds is None or end <= first:
-        return False
-    rows = np.asarray(block_bounds)[first // SCAN_BLOCK : -(-end // SCAN_BLOCK)]
-    return bool(len(rows)) and bool((rows[:, :6] == np.tile(rows[:1, :3], 2)).all())
 
 
 @contextmanager
