@@ -208,6 +208,7 @@ def test_bench_quick_json(monkeypatch, tmp_path, capsys):
     report = json.loads(capsys.readouterr().out)
     assert report["voxels"] == len(small)
     assert report["occupancy_bytes"] > 0
+    assert report["warm_up"]["numba"]["calls"] == 1  # --quick: the compiling call alone
     rows = {(r["backend"], r["method"], r["view"], r["depression"]) for r in report["results"]}
     assert {
         ("numba", "exact", "wide", 45.0),
@@ -264,3 +265,43 @@ def test_bench_rejects_a_run_count_below_one(capsys):
     assert main(["bench", "--runs", "0"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert err == ["ladartui: error: --runs = 0: expected a whole number of at least 1"]
+
+
+class FakeClock:
+    """A clock that each traced call moves on by the next of ``durations`` seconds."""
+
+    def __init__(self, durations):
+        self.now, self.durations = 0.0, iter(durations)
+
+    def __call__(self):
+        return self.now
+
+    def trace_once(self):
+        self.now += next(self.durations)
+
+
+@pytest.mark.parametrize(
+    "durations, calls",
+    [
+        # Compiling (40 s, not counted), then a GPU raising its clocks: calls of 1/8 s,
+        # then 1/16, then steady at 1/32 (windows of 1/4 s: 2, 4, 8 and 8 calls).
+        ([40.0] + [1 / 8] * 2 + [1 / 16] * 4 + [1 / 32] * 100, 1 + 2 + 4 + 8 + 8),
+        ([40.0] + [1 / 32] * 100, 1 + 8 + 8),  # steady from the start: two windows
+    ],
+)
+def test_warm_up_runs_until_the_speed_settles(durations, calls):
+    from ladartui.cli.bench import warm_up
+
+    clock = FakeClock(durations)
+    done = warm_up(clock.trace_once, most=5.0, window=0.25, clock=clock)
+    assert done["calls"] == calls and done["seconds"] == clock.now - 40.0
+
+
+def test_warm_up_stops_at_its_limit_and_calls_at_least_once():
+    from ladartui.cli.bench import warm_up
+
+    # Never settles: windows of 1/64 s calls and of 1/16 s calls by turns.
+    clock = FakeClock([40.0] + ([1 / 64] * 16 + [1 / 16] * 4) * 10)
+    assert warm_up(clock.trace_once, most=1.0, window=0.25, clock=clock) == {"calls": 41, "seconds": 1.0}
+    clock = FakeClock([3.0])
+    assert warm_up(clock.trace_once, most=0.0, clock=clock) == {"calls": 1, "seconds": 0.0}
