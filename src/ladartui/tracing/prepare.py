@@ -129,7 +129,7 @@ def rays_to_cells(origins, directions, voxel_size, tiny):
 
 def one_origin(block_bounds, first: int, end: int) -> bool:
     """True when rays ``first..end`` all start at one point, by ``block_bounds``
-    (``prepare.rays_to_cells``' third answer: the least and greatest origin of
+    (``rays_to_cells``' third answer: the least and greatest origin of
     each SCAN_BLOCK rays). Equal least and greatest means equal values, and a
     cell there is never -0.0, so equal bits."""
     if block_bounds is None or end <= first:
