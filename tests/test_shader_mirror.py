@@ -94,6 +94,7 @@ SHARED = (
     "BUNDLE",
     "METHOD_EXACT",
     "METHOD_MARCH",
+    "MARCH_SKIP_MARGIN",
 )
 
 
@@ -116,6 +117,7 @@ def test_the_shader_header_carries_the_python_values(real):
     codes = ("MISS", "VOXEL", "GROUND", "UNFINISHED", "CUT", "NO_VOXEL", "CUT_WORD")
     assert {name: int(consts[name]) for name in codes} == {name: getattr(config, name) for name in codes}
     assert float(consts["INF"]) == config.SHADER_INF
+    assert float(consts["MARCH_SKIP_MARGIN"]) == config.MARCH_SKIP_MARGIN
     assert consts["BUNDLE"] == f"{config.BUNDLE}u"
     assert int(consts["METHOD_EXACT"]) == config.METHOD_CODES["exact"]
     assert int(consts["METHOD_MARCH"]) == config.METHOD_CODES["march"]

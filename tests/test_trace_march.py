@@ -106,3 +106,88 @@ def test_march_on_an_empty_scene_reaches_the_ground():
     got = run(occ, [[3.5, 4.5, 8.0]], [[0.0, 0.0, -1.0]], "march", 0.5)
     assert got.kind[0] == GROUND and got.index[0].tolist() == [3, 4, 0]
     assert got.t[0] == pytest.approx(0.5 + 8.0)  # first sample below c_z = 0 (starts at c_z = 0)
+
+
+def march_every_sample(occupied, shape, zmax, o, d, step):
+    """The march of docs/architecture.md for one ray with every sample taken (no jumps
+    over empty nodes), in numpy, with the kernel's formulas: (kind, cell, t)."""
+    nx, ny = float(shape[0]), float(shape[1])
+    top = zmax + 1.0
+    t_s = 0.0
+    if o[2] > top:
+        if d[2] >= 0.0:
+            return MISS, (-1, -1, -1), math.inf
+        t_s = (top - o[2]) * (1.0 / d[2])
+    limit = int((math.sqrt(nx * nx + ny * ny + top * top) + 2.0) / step) + 2
+    t = t_s + np.arange(limit) * step
+    c = o[None, :] + t[:, None] * d[None, :]
+    inside = (0.0 <= c[:, 0]) & (c[:, 0] < nx) & (0.0 <= c[:, 1]) & (c[:, 1] < ny)
+    cell = np.floor(c).astype(np.int64)
+    in_grid = np.all((cell >= 0) & (cell < occupied.shape), axis=1)
+    hit = np.zeros(limit, bool)
+    hit[in_grid] = occupied[tuple(cell[in_grid].T)]
+    ends = (c[:, 2] < 0.0) | ~inside | ((c[:, 2] >= top) & (d[2] >= 0.0)) | hit
+    if not ends.any():
+        return MISS, (-1, -1, -1), math.inf
+    s = int(np.argmax(ends))
+    if c[s, 2] < 0.0:
+        if inside[s]:
+            return GROUND, (int(cell[s, 0]), int(cell[s, 1]), 0), t[s]
+        return MISS, (-1, -1, -1), math.inf
+    if hit[s]:
+        return VOXEL, tuple(int(v) for v in cell[s]), t[s]
+    return MISS, (-1, -1, -1), math.inf
+
+
+def sparse_scene_and_rays(seed, n=400):
+    """Clumps in a 700 x 150 x 80 box (two root cells along x, many empty regions
+    and bricks) and rays that end (ground, sides, top) or hit just past an empty
+    node, along cell faces' planes, from cell corners, inside the box or above it."""
+    rng = np.random.default_rng(seed)
+    shape = (700, 150, 80)
+    clumps = rng.integers([0, 0, 0], [700, 150, 70], size=(12, 3))
+    voxels = np.unique(np.concatenate([c + rng.integers(0, 6, size=(30, 3)) for c in clumps]), axis=0)
+    voxels = voxels[np.all(voxels < shape, axis=1)]
+    occ = Occupancy.build(voxels, shape)
+    occupied = np.zeros(shape, bool)
+    occupied[tuple(voxels.T)] = True
+    origins = rng.uniform([0, 0, 0], [700, 150, 160], size=(n, 3))
+    directions = rng.normal(size=(n, 3))
+    directions[: n // 4, 2] = -np.abs(directions[: n // 4, 2])  # down: ground or a hit
+    directions[n // 4 : n // 3, rng.integers(0, 3)] = 0.0  # along cell faces' planes
+    origins[n // 3 : n // 2] = np.floor(origins[n // 3 : n // 2])  # from cell corners
+    directions[n // 2 : n // 2 + 40] = (
+        voxels[rng.integers(0, len(voxels), 40)] + 0.5 - origins[n // 2 : n // 2 + 40]
+    )
+    directions /= np.linalg.norm(directions, axis=1)[:, None]
+    return voxels, shape, occ, occupied, origins, directions
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_jumps_over_empty_nodes_keep_every_answer(seed):
+    """numba's march jumps over the samples of empty root cells, regions and bricks;
+    the answers stay those of taking every sample."""
+    voxels, shape, occ, occupied, origins, directions = sparse_scene_and_rays(seed)
+    n = len(origins)
+    for step in (0.5, 0.37):
+        got = run(occ, origins, directions, "march", step)
+        for r in range(n):
+            kind, cell, t = march_every_sample(
+                occupied, shape, float(voxels[:, 2].max()), origins[r], directions[r], step
+            )
+            assert (got.kind[r], tuple(got.index[r].tolist()), got.t[r]) == (kind, cell, t), (r, step)
+        assert {MISS, VOXEL, GROUND} <= set(got.kind.tolist())
+
+
+@pytest.mark.parametrize("precision", ["f64", "f32"])
+def test_the_shaders_jumps_are_numbas(wgpu_backend, numba_backend, precision):
+    """The shader's march takes the same jumps: numba's answers (f32: the same kinds
+    and cells wherever f32 samples fall where f64 ones do, nearly everywhere)."""
+    _, _, occ, _, origins, directions = sparse_scene_and_rays(7)
+    reference = numba_backend.trace_cells(occ, origins, directions, method="march", step=0.5)
+    got = wgpu_backend.trace_cells(occ, origins, directions, method="march", step=0.5, precision=precision)
+    if precision == "f64":
+        assert np.array_equal(got.kind, reference.kind) and np.array_equal(got.index, reference.index)
+        assert np.array_equal(got.t, reference.t)
+    else:
+        assert np.mean(got.kind == reference.kind) > 0.98

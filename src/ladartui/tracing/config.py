@@ -73,6 +73,9 @@ MARCH_SAMPLES_PER_PASS = 1 << 15
 OBJECT_ORDER_TILE_SHIFT = 2
 # Longest tile list an invocation may walk: under lavapipe's 65,535 loop iterations.
 LOOP_BUDGET = 65_000
+# The march jumps over samples certain to lie in an empty node: certain by this margin
+# (voxels), far above the rounding of a sample's position, float32 included.
+MARCH_SKIP_MARGIN = 0.01
 # trace.wgsl's first_hits: a ray's word when it hits no voxel, or its loop was cut.
 NO_VOXEL, CUT_WORD = -1, -2
 
@@ -96,6 +99,7 @@ def wgsl_constants(real: str) -> str:
         *(f"const {name}: i32 = {value};" for name, value in codes.items()),
         *(f"const METHOD_{name.upper()}: i32 = {code};" for name, code in METHOD_CODES.items()),
         f"const INF: real = {_wgsl_float(SHADER_INF)};",
+        f"const MARCH_SKIP_MARGIN: real = {_wgsl_float(MARCH_SKIP_MARGIN)};",
         f"const BUNDLE: u32 = {BUNDLE}u;",
     ]
     return "\n".join(lines) + "\n"

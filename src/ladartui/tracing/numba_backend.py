@@ -25,6 +25,7 @@ from ladartui.tracing.axis import boundary_t, cell_at, clamp, slab
 from ladartui.tracing.backend import GROUND, MISS, VOXEL, CellHits, TraceOrder, check_order, register_backend
 from ladartui.tracing.bundle import bundle_start, halo_arrays
 from ladartui.tracing.config import BLOCK, BUNDLE, INF, SCAN_BLOCK
+from ladartui.tracing.march_skip import last_sample_in_node
 from ladartui.tracing.order_choice import OrderChoice, trace_in_blocks
 from ladartui.tracing.prepare import one_origin
 from ladartui.tracing.scan_rays import cone_frame
@@ -397,7 +398,10 @@ def _march_kernel(
             t_s = 0.0
             if oz > top:
                 t_s = (top - oz) * (1.0 / dz) if dz < 0.0 else INF
-            for sample in range(limit if t_s < INF else 0):
+            samples = limit if t_s < INF else 0
+            sample = np.int64(-1)
+            while sample + 1 < samples:
+                sample += 1
                 t = t_s + sample * step
                 cx, cy, cz = ox + t * dx, oy + t * dy, oz + t * dz
                 inside = 0.0 <= cx < nx and 0.0 <= cy < ny
@@ -414,19 +418,26 @@ def _march_kernel(
                 g = root[
                     ((x - rorg[0]) >> 9) + rdims[0] * (((y - rorg[1]) >> 9) + rdims[1] * ((z - rorg[2]) >> 9))
                 ]
-                if g == 0:
-                    continue
-                tl = regions[(np.int64(g) - 1) * 512 + _slot(x, y, z, 6)]
-                if tl == 0:
-                    continue
-                br = tiles[(np.int64(tl) - 1) * 512 + _slot(x, y, z, 3)]
-                if br == 0:
-                    continue
-                bit = _slot(x, y, z, 0)
-                if (bricks[(np.int64(br) - 1) * 16 + (bit >> 5)] >> (bit & 31)) & 1:
-                    result = VOXEL
-                    i, j, k, tr = x, y, z, t
-                    break
+                empty = 9 if g == 0 else 0
+                if g != 0:
+                    tl = regions[(np.int64(g) - 1) * 512 + _slot(x, y, z, 6)]
+                    empty = 6 if tl == 0 else 0
+                    if tl != 0:
+                        br = tiles[(np.int64(tl) - 1) * 512 + _slot(x, y, z, 3)]
+                        empty = 3 if br == 0 else 0
+                        if br != 0:
+                            bit = _slot(x, y, z, 0)
+                            if (bricks[(np.int64(br) - 1) * 16 + (bit >> 5)] >> (bit & 31)) & 1:
+                                result = VOXEL
+                                i, j, k, tr = x, y, z, t
+                                break
+                if empty:  # an empty node: on past its samples (none of them ends the ray)
+                    sample = max(
+                        sample,
+                        last_sample_in_node(
+                            x, y, z, empty, ox, oy, oz, dx, dy, dz, t_s, step, nx, ny, top, samples
+                        ),
+                    )
             kind[r] = result
             index[r, 0], index[r, 1], index[r, 2] = i, j, k
             tout[r] = tr
