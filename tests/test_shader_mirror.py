@@ -64,7 +64,7 @@ def test_every_numba_reference_in_the_shaders_names_a_function_that_exists(shade
 
 def test_the_shaders_cite_the_kernels_they_mirror():
     cited = "\n".join(s.read_text() for s in SHADERS)
-    for name in ("_exact_kernel", "_march_kernel", "ray_answer", "test_tiles"):
+    for name in ("_exact_kernel", "march_kernel", "ray_answer", "test_tiles"):
         assert f"numba: {name}" in cited or f"of {name}" in cited or f" {name} and" in cited
 
 
@@ -73,7 +73,7 @@ def test_a_reference_to_a_missing_or_moved_function_is_reported(functions):
         "// numba: _no_such_kernel\n"
         "// The ground rule (numba: _ground).\n"
         "// numba: test_tiles (tracing/numba_backend.py)\n"  # exists, but not in that file
-        "// numba: the per-ray body of _march_kernel\n"  # fine
+        "// numba: the per-ray body of march_kernel\n"  # fine
     )
     assert broken_references(text, functions) == [
         "1: _no_such_kernel is not defined in ladartui/tracing",

@@ -1,6 +1,6 @@
 // The voxel tracer as a compute shader: one invocation per ray.
 //
-// This is tracing/numba_backend.py (with tracing/axis.py) written again in WGSL:
+// This is tracing/numba_backend.py and tracing/march.py (with tracing/axis.py) written again in WGSL:
 // the same functions under the same names (without the leading underscore),
 // the same steps in the same order, as fixed in docs/architecture.md ("Exact
 // traversal", "March").
@@ -76,7 +76,7 @@ fn exit_boundary(c: i32, s: u32, positive: bool) -> i32 {
     return (c >> s) << s;
 }
 
-// numba: _slot
+// numba: node_slot (tracing/axis.py)
 fn slot(x: i32, y: i32, z: i32, s: u32) -> u32 {
     return u32(((x >> s) & 7) | (((y >> s) & 7) << 3u) | (((z >> s) & 7) << 6u));
 }
@@ -401,12 +401,12 @@ fn ground(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hit {
     return miss();
 }
 
-// The report's fixed-step march for one ray (numba: the per-ray body of _march_kernel).
+// The report's fixed-step march for one ray (numba: the per-ray body of march_kernel).
 // Each sample's lookup is numba's; the brick found is remembered while the
 // samples stay in it, which saves loads, not answers. Written as one loop with
 // plain variables (a lookup function with its cache behind a pointer ran 8 %
 // slower on lavapipe).
-// The march's jump over an empty node (tracing/march_skip.py, the same steps): the
+// The march's jump over an empty node (numba: last_sample_on_axis, the same steps): the
 // last sample certain to stay in [lo_face, hi_face) on one axis, as a real, at most cap.
 fn last_sample_on_axis(o: real, d: real, lo_face: real, hi_face: real, t_s: real, step: real, cap: real) -> real {
     if (d > 0.0) {
@@ -516,7 +516,7 @@ fn march_one(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hit 
     return miss();
 }
 
-// numba: _exact_kernel and _march_kernel, one invocation per ray.
+// numba: _exact_kernel and march_kernel, one invocation per ray.
 @compute @workgroup_size(BUNDLE)
 fn trace_rays(@builtin(workgroup_id) group: vec3<u32>,
               @builtin(num_workgroups) groups: vec3<u32>,

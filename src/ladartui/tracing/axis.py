@@ -1,8 +1,9 @@
-"""One-axis cell arithmetic shared by the tracers (numba kernels, bundle starts).
+"""Cell arithmetic shared by the tracers (numba kernels, bundle starts): per axis,
+and the slot of a cell in its node of the occupancy.
 
 Every boundary parameter comes from one formula, ``boundary_t``, so cells
 and ties agree wherever they are computed. The WGSL shader has the same
-functions under the same names (shaders/axis.wgsl).
+functions under the same names (shaders/axis.wgsl; ``node_slot`` is trace.wgsl's ``slot``).
 """
 
 import math
@@ -62,3 +63,11 @@ def cube_start(ox, oy, oz, dx, dy, dz, ix, iy, iz, x, y, z):
     ey, ly = slab(oy, dy, iy, y, y + 1.0)
     ez, lz = slab(oz, dz, iz, z, z + 1.0)
     return max(max(ex, max(ey, ez)), 0.0), min(lx, min(ly, lz))
+
+
+@njit(nogil=True, cache=True, inline="always")
+def node_slot(x, y, z, shift):
+    """Which of its node's 8 x 8 x 8 children holds cell (x, y, z), the children
+    being ``1 << shift`` cells a side: the slot in the occupancy's regions (6),
+    tiles (3) and brick bits (0)."""
+    return ((x >> shift) & 7) | (((y >> shift) & 7) << 3) | (((z >> shift) & 7) << 6)

@@ -1,4 +1,5 @@
-"""The numba backend: exact hierarchical traversal and the report's fixed-step march.
+"""The numba backend: exact hierarchical traversal, and the report's fixed-step
+march (its kernel in tracing/march.py).
 
 Both kernels follow docs/architecture.md ("Exact traversal", "March") step by
 step, so the WGSL shader can mirror them. Rays run in chunks under ``prange``
@@ -21,11 +22,11 @@ from numba import njit, prange
 from ladartui.errors import check_cancelled
 from ladartui.scene.occupancy import block_masks
 from ladartui.tracing.answers import ray_answer
-from ladartui.tracing.axis import boundary_t, cell_at, clamp, slab
-from ladartui.tracing.backend import GROUND, MISS, VOXEL, CellHits, TraceOrder, check_order, register_backend
+from ladartui.tracing.axis import boundary_t, cell_at, clamp, node_slot, slab
+from ladartui.tracing.backend import CellHits, TraceOrder, check_order, register_backend
 from ladartui.tracing.bundle import bundle_start, halo_arrays
 from ladartui.tracing.config import BLOCK, BUNDLE, INF, SCAN_BLOCK
-from ladartui.tracing.march_skip import last_sample_in_node
+from ladartui.tracing.march import march_kernel
 from ladartui.tracing.order_choice import OrderChoice, trace_in_blocks
 from ladartui.tracing.prepare import one_origin
 from ladartui.tracing.scan_rays import cone_frame
@@ -37,11 +38,6 @@ def _exit_boundary(c, s, positive):
     if positive:
         return ((c >> s) + 1) << s
     return (c >> s) << s
-
-
-@njit(nogil=True, cache=True, inline="always")
-def _slot(x, y, z, s):
-    return ((x >> s) & 7) | (((y >> s) & 7) << 3) | (((z >> s) & 7) << 6)
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -188,7 +184,7 @@ def _exact_kernel(
                     g = root[((cx - rx0) >> 9) + rdx * (((cy - ry0) >> 9) + rdy * ((cz - rz0) >> 9))]
                     if g != 0:
                         s = 6
-                        tl = regions[(np.int64(g) - 1) * 512 + _slot(cx, cy, cz, 6)]
+                        tl = regions[(np.int64(g) - 1) * 512 + node_slot(cx, cy, cz, 6)]
                         if tl != 0:
                             # Inside a tile: DDA over its 8 x 8 x 8 brick slots.
                             tile = (np.int64(tl) - 1) * 512
@@ -379,70 +375,6 @@ def _exact_kernel(
             )
 
 
-@njit(parallel=True, nogil=True, cache=True)
-def _march_kernel(
-    orig, dirs, step, zmax, root, regions, tiles, bricks, lo, hi, rorg, rdims, nx, ny, kind, index, tout
-):
-    """The report's fixed-step march (docs/architecture.md "March") for every ray."""
-    n = orig.shape[0]
-    chunks = (n + BUNDLE - 1) // BUNDLE
-    top = zmax + 1.0
-    # From the first sample on, every sample is inside the extent's box or ends the ray.
-    limit = np.int64((math.sqrt(nx * nx + ny * ny + top * top) + 2.0) / step) + 2
-    for ch in prange(chunks):
-        for r in range(ch * BUNDLE, min(n, (ch + 1) * BUNDLE)):
-            ox, oy, oz = orig[r, 0], orig[r, 1], orig[r, 2]
-            dx, dy, dz = dirs[r, 0], dirs[r, 1], dirs[r, 2]
-            result = MISS
-            i, j, k, tr = np.int64(-1), np.int64(-1), np.int64(-1), INF
-            t_s = 0.0
-            if oz > top:
-                t_s = (top - oz) * (1.0 / dz) if dz < 0.0 else INF
-            samples = limit if t_s < INF else 0
-            sample = np.int64(-1)
-            while sample + 1 < samples:
-                sample += 1
-                t = t_s + sample * step
-                cx, cy, cz = ox + t * dx, oy + t * dy, oz + t * dz
-                inside = 0.0 <= cx < nx and 0.0 <= cy < ny
-                if cz < 0.0:
-                    if inside:
-                        result = GROUND
-                        i, j, k, tr = np.int64(math.floor(cx)), np.int64(math.floor(cy)), np.int64(0), t
-                    break
-                if not inside or (cz >= top and dz >= 0.0):
-                    break
-                x, y, z = np.int64(math.floor(cx)), np.int64(math.floor(cy)), np.int64(math.floor(cz))
-                if x < lo[0] or y < lo[1] or z < lo[2] or x >= hi[0] or y >= hi[1] or z >= hi[2]:
-                    continue
-                g = root[
-                    ((x - rorg[0]) >> 9) + rdims[0] * (((y - rorg[1]) >> 9) + rdims[1] * ((z - rorg[2]) >> 9))
-                ]
-                empty = 9 if g == 0 else 0
-                if g != 0:
-                    tl = regions[(np.int64(g) - 1) * 512 + _slot(x, y, z, 6)]
-                    empty = 6 if tl == 0 else 0
-                    if tl != 0:
-                        br = tiles[(np.int64(tl) - 1) * 512 + _slot(x, y, z, 3)]
-                        empty = 3 if br == 0 else 0
-                        if br != 0:
-                            bit = _slot(x, y, z, 0)
-                            if (bricks[(np.int64(br) - 1) * 16 + (bit >> 5)] >> (bit & 31)) & 1:
-                                result = VOXEL
-                                i, j, k, tr = x, y, z, t
-                                break
-                if empty:  # an empty node: on past its samples (none of them ends the ray)
-                    sample = max(
-                        sample,
-                        last_sample_in_node(
-                            x, y, z, empty, ox, oy, oz, dx, dy, dz, t_s, step, nx, ny, top, samples
-                        ),
-                    )
-            kind[r] = result
-            index[r, 0], index[r, 1], index[r, 2] = i, j, k
-            tout[r] = tr
-
-
 class NumbaBackend:
     """CPU threads through numba: exact hierarchical traversal and the report's march."""
 
@@ -525,7 +457,7 @@ class NumbaBackend:
                         t[c:d],
                     )
                 else:
-                    _march_kernel(
+                    march_kernel(
                         orig[c:d],
                         dirs[c:d],
                         float(step),
