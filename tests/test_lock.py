@@ -13,6 +13,7 @@ from importlib import metadata
 from pathlib import Path
 
 from packaging.markers import Marker
+from packaging.requirements import Requirement
 from packaging.utils import canonicalize_name
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -62,9 +63,12 @@ def test_lock_names_every_direct_pin_at_its_pinned_version() -> None:
     pyproject = tomllib.loads((ROOT / "pyproject.toml").read_text())
     wanted = locked_requirements(lock)
     pins = pyproject["project"]["dependencies"] + pyproject["project"]["optional-dependencies"]["test"]
-    for pin in pins:
-        name, version = pin.split("==")
-        assert wanted[canonicalize_name(name)] == version, f"uv.lock disagrees with pyproject on {pin}"
+    for pin in map(Requirement, pins):
+        (spec,) = pin.specifier  # one exact pin each, a platform marker at most
+        assert spec.operator == "==", f"{pin} is not pinned"
+        if pin.marker is None or pin.marker.evaluate():
+            locked = wanted[canonicalize_name(pin.name)]
+            assert locked == spec.version, f"uv.lock disagrees with pyproject on {pin}"
 
 
 def test_installed_versions_equal_the_lock() -> None:

@@ -7,18 +7,11 @@ names never equal module names (``trace`` lives in ``ladartui.tracing``,
 an exported function.
 """
 
-import os
-
+from ladartui import threads
 from ladartui.lazy import lazy_getattr
 
-# numba's OpenMP threads spin for milliseconds after each parallel pass by default
-# (libgomp: 300,000 spins), each holding a core: on a 2-core machine that starved
-# lavapipe's threads (the wgpu backend ran up to 30 % slower), Dask's workers and
-# the terminal UI. 30,000 spins still bridge the short gaps between a trace's
-# passes (numba's own trace times did not change). Set before numba loads the
-# library; a user's own setting stands.
-if "OMP_WAIT_POLICY" not in os.environ:
-    os.environ.setdefault("GOMP_SPINCOUNT", "30000")
+# Before numba loads: its TBB layer where installed, else a short OpenMP spin.
+threads.configure()
 
 __version__ = "0.1.0"
 

@@ -311,11 +311,18 @@ def run_bench(quick=False, runs=None) -> dict:
                         "voxel_hits": float(np.mean(result.kind == 1)),
                         "ground_hits": float(np.mean(result.kind == 2)),
                         "order": "/".join(sorted(orders[name])),
-                        "device": backend.describe().get("adapter") or "cpu",
+                        "device": _device(backend.describe()),
                     }
                 )
     _add_ratios(report["results"])
     return report
+
+
+def _device(described: dict) -> str:
+    """The adapter, or the CPU with its threads and numba's threading layer (TBB or OpenMP)."""
+    if described.get("adapter"):
+        return str(described["adapter"])
+    return f"cpu, {described.get('threads', '?')} threads ({described.get('threading_layer', '?')})"
 
 
 def warm_up(trace_once, most=WARM_MOST_S, window=WARM_WINDOW_S, clock=time.perf_counter) -> dict:

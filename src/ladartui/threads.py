@@ -1,0 +1,58 @@
+"""numba's threading layer, chosen when ``ladartui`` is imported (before numba starts
+its threads on the first parallel kernel).
+
+TBB where its runtime is installed (the ``tbb`` wheel, x86-64 Linux): its threads
+steal work and sleep when idle. Under OpenMP (libgomp, numba's next choice) every
+parallel pass ends at a barrier that waits for each thread's fixed share, and
+waiting threads spin: with one other busy process on a 2-core machine a trace took
+3-6x its time, under TBB 1.4-2.6x (docs/architecture.md, "Threads"). TBB is also
+the layer numba calls safe under both threads and fork (Dask's workers).
+
+numba finds the runtime by its name, ``libtbb.so.12``, which the wheel puts in the
+environment's ``lib`` folder, off the loader's path; loading it there first lets
+numba's own lookup find it. A user's ``NUMBA_THREADING_LAYER`` still decides.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import sys
+from pathlib import Path
+
+TBB_RUNTIME = "libtbb.so.12"
+
+
+def tbb_runtime() -> Path | None:
+    """The TBB runtime in this Python environment's ``lib`` folder, if there is one."""
+    for prefix in dict.fromkeys((sys.prefix, sys.base_prefix)):
+        path = Path(prefix) / "lib" / TBB_RUNTIME
+        if path.is_file():
+            return path
+    return None
+
+
+def load_tbb() -> bool:
+    """Load the environment's TBB runtime so numba can pick its TBB layer; False when
+    there is none or it does not load (numba then uses OpenMP)."""
+    path = tbb_runtime()
+    if path is None:
+        return False
+    try:
+        ctypes.CDLL(str(path), mode=ctypes.RTLD_GLOBAL)
+    except OSError:
+        return False
+    return True
+
+
+def configure() -> None:
+    """Prefer TBB; shorten OpenMP's spin for where numba falls back to it.
+
+    libgomp's default spin (300,000) kept numba's threads on the cores for
+    milliseconds after each parallel pass, which starved lavapipe (the wgpu backend
+    up to 30 % slower), Dask's workers and the terminal UI; 30,000 still bridges
+    the gaps between a trace's passes. A user's own spin count or wait policy stands.
+    """
+    load_tbb()
+    if "OMP_WAIT_POLICY" not in os.environ:
+        os.environ.setdefault("GOMP_SPINCOUNT", "30000")
