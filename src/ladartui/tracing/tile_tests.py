@@ -12,9 +12,12 @@ are read from memory about once (docs/architecture.md, "Object order").
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
-from numba import njit, prange
+from llvmlite import ir
+from numba import njit, prange, types
+from numba.extending import intrinsic
 
 from ladartui.tracing.answers import put_answer
 from ladartui.tracing.axis import cube_start
@@ -45,50 +48,21 @@ def _slab_start(ray, s, x, y, z, best):
     return start if start < leave and start < best else best
 
 
-# Bit numbers of powers of two by a de Bruijn sequence: x * _DE_BRUIJN (mod 2**64)
-# puts a distinct 6-bit pattern in the top bits for each power x.
-_DE_BRUIJN = 0x03F79D71B4CB0A89
-_DE_BRUIJN_BITS = (
-    (
-        0,
-        1,
-        48,
-        2,
-        57,
-        49,
-        28,
-        3,
-        61,
-        58,
-        50,
-        42,
-        38,
-        29,
-        17,
-        4,
-        62,
-        55,
-        59,
-        36,
-        53,
-        51,
-        43,
-        22,
-        45,
-        39,
-        33,
-        30,
-    )
-    + (24, 18, 12, 5, 63, 47, 56, 27, 60, 41, 37, 16, 54, 35, 52, 21, 44, 32, 23, 11, 46, 26, 40, 15, 34, 20)
-    + (31, 10, 25, 14, 19, 9, 13, 8, 7, 6)
-)
+def _cttz(typingctx, value):
+    """The number of zero bits below the lowest set bit of a nonzero integer: LLVM's
+    cttz, one instruction (a row's live bins: walking the set bits skips the dead
+    ones without a test each; a de Bruijn table lookup here made the tile tests
+    10 % slower)."""
+    if not isinstance(value, types.Integer):
+        return None
+
+    def codegen(context, builder, signature, args):
+        return builder.cttz(args[0], ir.Constant(ir.IntType(1), 0))
+
+    return value(value), codegen
 
 
-@njit(nogil=True, cache=True, inline="always")
-def _bit_number(power):
-    """n for power = 2**n, n < 64 (a row's live bins: walking the set bits skips the
-    dead ones without a test each)."""
-    return _DE_BRUIJN_BITS[(np.uint64(power) * np.uint64(_DE_BRUIJN)) >> np.uint64(58)]
+_trailing_zeros: Any = intrinsic(_cttz)
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -227,7 +201,7 @@ def test_tiles(
                 while row != 0:  # the live bins of the span, lowest first
                     low = row & -row
                     row ^= low
-                    b = r * tile_side + _bit_number(low)
+                    b = r * tile_side + _trailing_zeros(low)
                     if single:  # bin b holds tile ray b alone
                         best = best_t[b]
                         if best > near:
