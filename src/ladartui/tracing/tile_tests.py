@@ -149,14 +149,20 @@ def test_tiles(
         m = tile_side * tile_side if single else bin_starts[base + tile_side * tile_side] - s0
         if m == 0:
             continue
-        starts = np.empty(tile_side * tile_side + 1, np.int64)  # bin b of the tile: tile rays starts[b] ..
-        for b in range(tile_side * tile_side + 1):
-            starts[b] = b if single else bin_starts[base + b] - s0
         live = np.zeros(tile_side, np.int64)  # per row: bit c set while bin (bi0 + c) may still change
-        for r in range(bj1 - bj0 + 1):
-            for c in range(bi1 - bi0 + 1):
-                if starts[r * tile_side + c + 1] > starts[r * tile_side + c]:
-                    live[r] |= np.int64(1) << c
+        if single:  # every bin holds one ray: whole rows live
+            starts = np.empty(0, np.int64)
+            for r in range(bj1 - bj0 + 1):
+                live[r] = (np.int64(2) << (bi1 - bi0)) - 1
+        else:
+            # bin b of the tile: tile rays starts[b] ..
+            starts = np.empty(tile_side * tile_side + 1, np.int64)
+            for b in range(tile_side * tile_side + 1):
+                starts[b] = bin_starts[base + b] - s0
+            for r in range(bj1 - bj0 + 1):
+                for c in range(bi1 - bi0 + 1):
+                    if starts[r * tile_side + c + 1] > starts[r * tile_side + c]:
+                        live[r] |= np.int64(1) << c
         ray = np.empty((m, 9))
         best_t = np.empty(m)
         best_v = np.full(m, -1, np.int64)
