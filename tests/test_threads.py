@@ -17,7 +17,7 @@ LAYER_AFTER_TRACE = (
     "from ladartui import Occupancy, trace\n"
     "occ = Occupancy.build(np.array([[1, 1, 1]]), (4, 4, 4))\n"
     "r = trace(occ, np.full((8, 3), 0.15), np.tile([0.0, 0.0, 1.0], (8, 1)), backend='numba')\n"
-    "assert (r.kind == 1).sum() == 0 and (r.kind == 0).all()\n"
+    "assert (r.kind == 0).all()  # upward rays: misses\n"
     "print(numba.threading_layer())\n"
 )
 TBB_WHEEL_PLATFORM = sys.platform == "linux" and platform.machine() == "x86_64"

@@ -4,9 +4,9 @@ its threads on the first parallel kernel).
 TBB where its runtime is installed (the ``tbb`` wheel, x86-64 Linux): its threads
 steal work and sleep when idle. Under OpenMP (libgomp, numba's next choice) every
 parallel pass ends at a barrier that waits for each thread's fixed share, and
-waiting threads spin: with one other busy process on a 2-core machine a trace took
-3-6x its time, under TBB 1.4-2.6x (docs/architecture.md, "Threads"). TBB is also
-the layer numba calls safe under both threads and fork (Dask's workers).
+waiting threads spin, so a trace beside another busy process slowed far more
+(figures: docs/architecture.md, "Threads"). TBB is also the layer numba calls
+safe under both threads and fork (Dask's workers).
 
 numba finds the runtime by its name, ``libtbb.so.12``, which the wheel puts in the
 environment's ``lib`` folder, off the loader's path; loading it there first lets

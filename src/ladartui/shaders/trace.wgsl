@@ -401,11 +401,6 @@ fn ground(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hit {
     return miss();
 }
 
-// The report's fixed-step march for one ray (numba: the per-ray body of march_kernel).
-// Each sample's lookup is numba's; the brick found is remembered while the
-// samples stay in it, which saves loads, not answers. Written as one loop with
-// plain variables (a lookup function with its cache behind a pointer ran 8 %
-// slower on lavapipe).
 // The march's jump over an empty node (numba: last_sample_on_axis, the same steps): the
 // last sample certain to stay in [lo_face, hi_face) on one axis, as a real, at most cap.
 fn last_sample_on_axis(o: real, d: real, lo_face: real, hi_face: real, t_s: real, step: real, cap: real) -> real {
@@ -434,6 +429,11 @@ fn last_sample_in_node(c: vec3<i32>, shift: u32, o: vec3<real>, d: vec3<real>, t
     return -1;
 }
 
+// The report's fixed-step march for one ray (numba: the per-ray body of march_kernel).
+// Each sample's lookup is numba's; the brick found is remembered while the
+// samples stay in it, which saves loads, not answers. Written as one loop with
+// plain variables (a lookup function with its cache behind a pointer ran 8 %
+// slower on lavapipe).
 fn march_one(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hit {
     var key = vec3<i32>(-1);  // brick coordinates (cell >> 3) of the remembered lookup; never negative
     var base = 0u;            // its first word in occ() + 1, 0 when the brick is empty
