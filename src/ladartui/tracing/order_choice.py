@@ -11,6 +11,7 @@ import threading
 import time
 
 import numpy as np
+from numba.core import event as numba_event
 
 from ladartui.errors import check_cancelled
 from ladartui.tracing.config import MIN_SCAN_RAYS, SCAN_BLOCK, VOXELS_PER_RAY
@@ -24,19 +25,25 @@ class OrderChoice:
     Neither order wins everywhere: object order costs about the same for any
     scene in view, ray order is cheap where rays stop early (dense cover) and
     dear where they pass many gaps (foliage). So the orders take turns until
-    each has been timed twice (a first call may include compiling), then the
-    faster by its better recent time per ray goes on, and the other is tried
-    again in case the views have changed: RETRY scans after the lead last
-    changed, then twice as long after each retry that loses, up to MAX_RETRY
-    scans (on the reference orbit, losing retries every 16 scans were a tenth
-    of the numba backend's work).
+    each has been timed twice (a process's first calls also start threads and
+    touch new memory; compiling is not counted, ``trace_in_blocks``), except
+    that an order timed at over SETTLED_GAP times the best of an order timed
+    twice is not timed again then (a scan in ray order at 45 degrees on the
+    reference scene costs four object-order scans; the wgpu backend, whose
+    first calls also build pipelines, passes ``settled_gap=inf``). Then the faster by its
+    better recent time per ray goes on, and the other is tried again in case
+    the views have changed: RETRY scans after the lead last changed, then
+    twice as long after each retry that loses, up to MAX_RETRY scans (on the
+    reference orbit, losing retries every 16 scans were a tenth of the numba
+    backend's work).
     """
 
     RETRY = 16
     MAX_RETRY = 64
     SAMPLES = 2
 
-    def __init__(self):
+    def __init__(self, settled_gap: float = 2.0):
+        self.settled_gap = settled_gap
         self.samples: dict[str, list[float]] = {"object": [], "ray": []}  # recent seconds per ray
         self.calls = 0
         self.retry_every = self.RETRY
@@ -48,12 +55,22 @@ class OrderChoice:
     def _best(self) -> str:
         return min(self.samples, key=lambda order: min(self.samples[order]))
 
+    def _needs_sample(self, order: str) -> bool:
+        mine = self.samples[order]
+        other = self.samples["ray" if order == "object" else "object"]
+        if len(mine) >= self.SAMPLES:
+            return False
+        settled_far_ahead = (
+            len(other) >= self.SAMPLES and bool(mine) and min(mine) > self.settled_gap * min(other)
+        )
+        return not settled_far_ahead
+
     def pick(self) -> str:
         with self._lock:
             self.calls += 1
-            timed_object, timed_ray = len(self.samples["object"]), len(self.samples["ray"])
-            if min(timed_object, timed_ray) < self.SAMPLES:
-                return "object" if timed_object <= timed_ray else "ray"
+            learning = [order for order in ("object", "ray") if self._needs_sample(order)]
+            if learning:  # the less timed first, object order on a tie
+                return min(learning, key=lambda order: len(self.samples[order]))
             best = self._best()
             if self.calls >= self._next_retry:
                 self._next_retry = self.calls + self.retry_every
@@ -78,6 +95,31 @@ class OrderChoice:
             self._leader = leader
 
 
+class CompileTime(numba_event.Listener):
+    """How far ``clock`` advances while this thread compiles or loads numba kernels
+    (holds numba's compiler lock, or waits for it): a process's first call of a
+    kernel, not the cost of the order that made it."""
+
+    def __init__(self, clock):
+        self.clock = clock
+        self.seconds = 0.0
+        self._thread = threading.get_ident()
+        self._depth = 0  # the lock is re-entrant: time the outermost hold
+        self._began = 0.0
+
+    def on_start(self, event):
+        if threading.get_ident() == self._thread:
+            if self._depth == 0:
+                self._began = self.clock()
+            self._depth += 1
+
+    def on_end(self, event):
+        if threading.get_ident() == self._thread and self._depth > 0:
+            self._depth -= 1
+            if self._depth == 0:
+                self.seconds += self.clock() - self._began
+
+
 def trace_in_blocks(n, order, choice, object_block, ray_block, cancel=None, clock=time.perf_counter):
     """Trace ``n`` exact rays in blocks of up to SCAN_BLOCK, each in object or ray
     order, as both backends do; returns the set of orders used.
@@ -93,8 +135,18 @@ def trace_in_blocks(n, order, choice, object_block, ray_block, cancel=None, cloc
     slow, and the choice does not flip with the load). In "auto", blocks picked
     for ray order one after another go to ``ray_block`` together, up to
     RAY_RUN_BLOCKS of them (the wgpu backend overlaps the batches of one call),
-    and are timed as one.
+    and are timed as one. Time spent compiling numba kernels (``CompileTime``) is
+    not counted.
     """
+    compiling = CompileTime(clock)
+    with numba_event.install_listener("numba:compiler_lock", compiling):
+        return _trace_blocks(n, order, choice, object_block, ray_block, cancel, clock, compiling)
+
+
+def _trace_blocks(n, order, choice, object_block, ray_block, cancel, clock, compiling):
+    def spent(started, compiled):  # a block's time, less its compiling
+        return clock() - started - (compiling.seconds - compiled)
+
     orders = set()
     picked = None  # the choice's pick for the block at ``a``, when made ahead
     a = 0
@@ -104,13 +156,13 @@ def trace_in_blocks(n, order, choice, object_block, ray_block, cancel=None, cloc
         learning = choice if order == "auto" and b - a >= MIN_SCAN_RAYS else None
         pick = None if learning is None else picked or learning.pick()
         picked = None
-        started = clock()
+        started, compiled = clock(), compiling.seconds
         if order == "object" or pick == "object":
             limit = np.inf if order == "object" else VOXELS_PER_RAY * (b - a)
             if object_block(a, b, limit):
                 orders.add("object")
                 if learning is not None:
-                    learning.record("object", clock() - started, b - a)
+                    learning.record("object", spent(started, compiled), b - a)
                 a = b
                 continue
             learning = None  # no scan for object order: nothing to learn from this block
@@ -126,6 +178,6 @@ def trace_in_blocks(n, order, choice, object_block, ray_block, cancel=None, cloc
         orders.add("ray")
         ray_block(a, b)
         if learning is not None:
-            learning.record("ray", clock() - started, b - a)
+            learning.record("ray", spent(started, compiled), b - a)
         a = b
     return orders

@@ -43,6 +43,7 @@ module is cheap and never fails.
 from __future__ import annotations
 
 import importlib.resources
+import math
 import threading
 import weakref
 from typing import Any
@@ -379,7 +380,7 @@ class WgpuBackend:
         orders = trace_in_blocks(
             n,
             order,
-            self._orders.setdefault(occupancy, OrderChoice()),
+            self._orders.setdefault(occupancy, OrderChoice(settled_gap=math.inf)),
             object_order_block,
             ray_order,
             cancel,
