@@ -272,9 +272,9 @@ def test_trailing_zeros_numbers_the_lowest_set_bit():
     # The tile tests walk a row's live bins by their lowest set bit.
     from numba import njit
 
-    from ladartui.tracing.tile_tests import _trailing_zeros
+    from ladartui.tracing.llvm_ops import trailing_zeros
 
-    count = njit(lambda x: _trailing_zeros(x))
+    count = njit(lambda x: trailing_zeros(x))
     rng = np.random.default_rng(5)
     values = [np.int64(1) << n for n in range(63)] + [np.int64(-(2**63))]
     values += [np.int64(x) for x in rng.integers(1, 2**62, 200)] + [np.int64(-1), np.int64(-6)]

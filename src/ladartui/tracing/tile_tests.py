@@ -12,16 +12,14 @@ are read from memory about once (docs/architecture.md, "Object order").
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
-from llvmlite import ir
-from numba import njit, prange, types
-from numba.extending import intrinsic
+from numba import njit, prange
 
 from ladartui.tracing.answers import put_answer
 from ladartui.tracing.axis import cube_start
 from ladartui.tracing.config import INF, MAX_TILE_SHIFT
+from ladartui.tracing.llvm_ops import prefetch_row, prefetch_row_for_write, trailing_zeros
 from ladartui.tracing.object_order import scan_voxels
 from ladartui.tracing.scan_rays import bin_order, scan_grid
 
@@ -48,21 +46,11 @@ def _slab_start(ray, s, x, y, z, best):
     return start if start < leave and start < best else best
 
 
-def _cttz(typingctx, value):
-    """The number of zero bits below the lowest set bit of a nonzero integer: LLVM's
-    cttz, one instruction (a row's live bins: walking the set bits skips the dead
-    ones without a test each; a de Bruijn table lookup here made the tile tests
-    10 % slower)."""
-    if not isinstance(value, types.Integer):
-        return None
-
-    def codegen(context, builder, signature, args):
-        return builder.cttz(args[0], ir.Constant(ir.IntType(1), 0))
-
-    return value(value), codegen
-
-
-_trailing_zeros: Any = intrinsic(_cttz)
+# Prefetch distances, in tile rays and in list entries. Prefetching the rays' loads and
+# answers made the tile tests 1.11-1.19x faster, and the entries' voxels 2 % more
+# (peer rays, 2 threads, 32 against 64 rays ahead within noise).
+AHEAD = 32
+ENTRIES_AHEAD = 8
 
 
 @njit(nogil=True, cache=True, inline="always")
@@ -167,6 +155,10 @@ def test_tiles(
         best_t = np.empty(m)
         best_v = np.full(m, -1, np.int64)
         for s in range(m):
+            if s + AHEAD < m:  # the permutation hides the next rays from the hardware's prefetchers
+                prefetch_row(dirs, order[s0 + s + AHEAD])
+                if not shared_origin:
+                    prefetch_row(orig, order[s0 + s + AHEAD])
             r = order[s0 + s]
             _load_ray(r, 0 if shared_origin else r, orig, dirs, ray, s)
             best_t[s] = INF
@@ -194,6 +186,9 @@ def test_tiles(
                     stale = False
                 if rest[e - e0] >= far:
                     break
+            if e + ENTRIES_AHEAD < e1:
+                prefetch_row(vox, listed[e + ENTRIES_AHEAD])
+                prefetch_row(nears, listed[e + ENTRIES_AHEAD])
             q = listed[e]
             near = nears[q, 0]
             if near >= far:
@@ -207,7 +202,7 @@ def test_tiles(
                 while row != 0:  # the live bins of the span, lowest first
                     low = row & -row
                     row ^= low
-                    b = r * tile_side + _trailing_zeros(low)
+                    b = r * tile_side + trailing_zeros(low)
                     if single:  # bin b holds tile ray b alone
                         best = best_t[b]
                         if best > near:
@@ -236,6 +231,9 @@ def test_tiles(
                     if not alive:
                         live[r] &= ~low
         for s in range(m):
+            if s + AHEAD < m:
+                prefetch_row_for_write(index, order[s0 + s + AHEAD])
+                prefetch_row_for_write(tout, order[s0 + s + AHEAD])
             put_answer(
                 order[s0 + s],
                 best_v[s],
