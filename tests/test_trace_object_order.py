@@ -268,21 +268,6 @@ def test_bins_are_numbered_tile_by_tile():
     assert np.array_equal(keys // (tile * tile), tile_of)
 
 
-def test_trailing_zeros_numbers_the_lowest_set_bit():
-    # The tile tests walk a row's live bins by their lowest set bit.
-    from numba import njit
-
-    from ladartui.tracing.llvm_ops import trailing_zeros
-
-    count = njit(lambda x: trailing_zeros(x))
-    rng = np.random.default_rng(5)
-    values = [np.int64(1) << n for n in range(63)] + [np.int64(-(2**63))]
-    values += [np.int64(x) for x in rng.integers(1, 2**62, 200)] + [np.int64(-1), np.int64(-6)]
-    for x in values:
-        lowest = int(x) & -int(x)
-        assert count(x) == lowest.bit_length() - 1, x
-
-
 @pytest.mark.parametrize("duplicate", [False, True])
 def test_a_whole_scan_sorts_by_scatter_as_the_counting_sort_does(duplicate):
     # One ray per bin (a whole scan over its own ray grid): the parallel scatter; a ray
