@@ -183,3 +183,32 @@ def test_every_public_name_resolves_and_unknown_names_fail():
             assert getattr(package, name) is not None, (package.__name__, name)
     with pytest.raises(AttributeError, match="has no attribute 'no_such_name'"):
         _ = ladartui.scene.no_such_name
+
+
+def test_ranges_are_scaled_without_touching_a_backends_own_arrays(block, monkeypatch):
+    # trace() turns the backend's cell ranges into metres in place when the array is
+    # the backend's own new one; an array that is a view (of memory the backend
+    # keeps) is copied instead, so the backend's memory keeps its cell ranges.
+    from ladartui.tracing import backend as registry
+    from ladartui.tracing.backend import CellHits
+
+    kept = np.arange(6.0)
+
+    class KeepsItsRanges:
+        def probe(self):
+            return None
+
+        def trace_cells(self, occupancy, origins, directions, **kwargs):
+            n = len(origins)
+            ranges = kept[:n] if kwargs.get("step") == 0.25 else np.arange(float(n))
+            return CellHits(np.ones(n, np.uint8), np.zeros((n, 3), np.int32), ranges, {})
+
+    monkeypatch.setitem(registry._FACTORIES, "keeps", KeepsItsRanges)
+    monkeypatch.setattr(registry, "_INSTANCES", dict(registry._INSTANCES))
+    origins = np.zeros((3, 3))
+    directions = np.tile([0.0, 0.0, -1.0], (3, 1))
+    fresh = trace(block, origins, directions, backend="keeps", voxel_size=0.5)
+    assert np.array_equal(fresh.range, [0.0, 0.5, 1.0])
+    viewed = trace(block, origins, directions, backend="keeps", voxel_size=0.5, step=0.25)
+    assert np.array_equal(viewed.range, [0.0, 0.5, 1.0])
+    assert np.array_equal(kept, np.arange(6.0))

@@ -374,10 +374,10 @@ def test_voxels_of_a_brick_come_front_first(axis):
 
 
 @pytest.mark.parametrize("tiles", [1, 2, 64, 1024, 1089, 4096])
-def test_tile_stride_visits_every_tile_once_and_spreads_each_thread_share(tiles):
-    from ladartui.tracing.tile_tests import tile_stride
+def test_spread_stride_visits_every_tile_once_and_spreads_each_thread_share(tiles):
+    from ladartui.tracing.object_order import spread_stride
 
-    stride = tile_stride(tiles)
+    stride = spread_stride(tiles)
     visit = (np.arange(tiles) * stride) % tiles
     assert np.array_equal(np.sort(visit), np.arange(tiles))
     if tiles >= 64:  # each half of the steps (one of two threads) takes tiles from both halves

@@ -137,7 +137,12 @@ def trace(
     )
     info = dict(cells.info)
     info["seconds_total"] = time.perf_counter() - started
-    return TraceResult(cells.kind, cells.index, cells.t * voxel_size, name, method, info)
+    metres = cells.t
+    if metres.base is None and metres.flags.writeable:  # the backend's own new array: scaled in place
+        metres *= voxel_size
+    else:
+        metres = metres * voxel_size
+    return TraceResult(cells.kind, cells.index, metres, name, method, info)
 
 
 def _occupancy_and_size(target, voxel_size):

@@ -122,6 +122,19 @@ def _out_of_view(x0, y0, z0, size, centre, grow, axis, u, v, grid, nb):
     return state == 0 or (state == 1 and i0 > i1)
 
 
+@njit(nogil=True, cache=True)
+def spread_stride(count):
+    """A step through ``count`` items that is prime to their number and near the golden
+    section of it: ``(k * stride) % count`` then visits every item once, and any run of
+    k (one thread's share of a prange) takes items from all over, so threads get equal
+    work when the costly items lie together (the far side of a scan at 45 degrees,
+    the regions in view)."""
+    stride = max(1, round(count * 0.6180339887))
+    while math.gcd(stride, count) != 1:
+        stride += 1
+    return stride
+
+
 @njit(parallel=True, nogil=True, cache=True)
 def bricks_in_view(centre, grow, axis, u, v, grid, nb, root, regions, tiles, rorg, rdims):
     """Non-empty bricks whose grown cube covers a bin, nearest first.
@@ -148,7 +161,9 @@ def bricks_in_view(centre, grow, axis, u, v, grid, nb, root, regions, tiles, ror
     marks = np.zeros((items, 8), np.int64)  # bit s2 & 63 of word s2 >> 6: brick s2 in view
     counts = np.zeros(items + 1, np.int64)
     crossing = np.zeros(items, np.bool_)
-    for item in prange(items):
+    stride = spread_stride(items)  # the regions in view lie together
+    for step in prange(items):
+        item = (step * stride) % items
         x0, y0, z0, tl = _region(item, live, root, regions, rorg, rdims)
         if tl == 0 or _out_of_view(x0, y0, z0, 64, centre, grow, axis, u, v, grid, nb):
             continue
@@ -172,7 +187,8 @@ def bricks_in_view(centre, grow, axis, u, v, grid, nb, root, regions, tiles, ror
         counts[item + 1] += counts[item]
     found = np.empty((counts[items], 4), np.int64)
     nears = np.empty(counts[items])
-    for item in prange(items):
+    for step in prange(items):
+        item = (step * stride) % items
         k = counts[item]
         if counts[item + 1] == k:
             continue

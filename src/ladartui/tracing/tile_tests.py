@@ -11,8 +11,6 @@ are read from memory about once (docs/architecture.md, "Object order").
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 from numba import njit, prange
 
@@ -20,7 +18,7 @@ from ladartui.tracing.answers import put_answer
 from ladartui.tracing.axis import cube_start
 from ladartui.tracing.config import INF, MAX_TILE_SHIFT
 from ladartui.tracing.llvm_ops import prefetch_row, prefetch_row_for_write, trailing_zeros
-from ladartui.tracing.object_order import scan_voxels
+from ladartui.tracing.object_order import scan_voxels, spread_stride
 from ladartui.tracing.scan_rays import bin_order, scan_grid
 
 
@@ -71,17 +69,6 @@ def tile_shift_for(nb):
         if nb % (1 << shift) == 0 and nb >> shift >= 4:
             return shift
     return max(2, min(MAX_TILE_SHIFT, (nb // 4).bit_length() - 1))
-
-
-def tile_stride(tiles):
-    """A step through the tiles that is prime to their number and near the golden
-    section of it: ``(k * stride) % tiles`` then visits every tile once, and any run of
-    k (one thread's share of a prange) takes tiles from all over the scan, so threads
-    get equal work when one side of a scan (the far side at 45 degrees) costs more."""
-    stride = max(1, round(tiles * 0.6180339887))
-    while math.gcd(stride, tiles) != 1:
-        stride += 1
-    return stride
 
 
 @njit(parallel=True, nogil=True, cache=True)
@@ -276,7 +263,7 @@ def trace_scan(occ, orig, dirs, frame, max_voxels, nx, ny, kind, index, t, share
         listed,
         nt,
         shift,
-        tile_stride(nt * nt),
+        spread_stride(nt * nt),
         bin_starts,
         order,
         nb,
