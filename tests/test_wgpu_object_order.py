@@ -252,3 +252,47 @@ def test_every_ray_gets_an_answer_written(forest, monkeypatch, order, method, pr
     monkeypatch.setattr(wgpu_module, "np", numpy_with_junk_empty())
     for expected in clean:  # auto: both orders, as they take turns
         assert_same(expected, backend.trace_cells(occ, origins, directions, **calls))
+
+
+def test_rays_from_one_origin_send_and_read_that_origin_alone(
+    forest, f64_backend, numba_backend, monkeypatch
+):
+    """trace() tells the shader when every ray of a block starts at one point (the
+    block bounds say so): one origin row goes to the device and every ray reads it.
+    The shader's hits are the same as from every ray's own row, even when the other
+    rows hold NaN; rays from two origins are not told."""
+    from ladartui.tracing import trace, wgpu_scans
+    from ladartui.tracing.config import OBJECT_ORDER_TILE_SHIFT
+    from ladartui.tracing.scan_rays import cone_frame, ray_bounds
+    from ladartui.tracing.shader_scan import prepare_shader_scan
+
+    voxels, occ = forest
+    origins, directions = one_scan([120, 120, 20], 45.0, 0.7, 300.0)
+    origins[:] = origins[0]  # a pinhole camera
+    frame = cone_frame(origins, directions, np.concatenate(ray_bounds(origins, directions)))
+    scan = prepare_shader_scan(occ, origins, directions, frame, np.inf, OBJECT_ORDER_TILE_SHIFT)
+    f64_backend.trace_cells(occ, origins, directions, order="object")  # opens the device
+    dispatcher = f64_backend._scans
+    own_rows = dispatcher.test_tiles(occ, origins, directions, scan).copy()
+    junk = np.full_like(origins, np.nan)
+    junk[0] = origins[0]
+    assert np.array_equal(dispatcher.test_tiles(occ, junk, directions, scan, shared_origin=True), own_rows)
+    assert (own_rows >= 0).mean() > 0.5  # most rays hit: the comparison has teeth
+
+    sent = []
+    real_test_tiles = wgpu_scans.ScanDispatcher.test_tiles
+
+    def spy(self, occupancy, origins, directions, scan, shared_origin=False):
+        sent.append(shared_origin)
+        return real_test_tiles(self, occupancy, origins, directions, scan, shared_origin)
+
+    monkeypatch.setattr(wgpu_scans.ScanDispatcher, "test_tiles", spy)
+    moved = origins.copy()
+    moved[1::2] += [0.5, 0.0, 0.0]  # half the rays from a point half a cell east
+    for rays_from, shared in ((origins, True), (moved, False)):
+        sent.clear()
+        fresh = Occupancy.build(voxels, occ.shape)  # its first scan goes in object order
+        result = trace(fresh, rays_from - 0.5, directions, backend="wgpu", voxel_size=1.0)
+        expected = numba_backend.trace_cells(occ, rays_from, directions, order="ray")
+        assert result.info["order"] == "object" and sent == [shared]
+        assert np.array_equal(result.kind, expected.kind) and np.array_equal(result.index, expected.index)

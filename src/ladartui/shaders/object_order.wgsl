@@ -26,7 +26,7 @@ struct TileParams {
     rays: u32,               // rays in this dispatch
     tile_shift: u32,         // tiles of 1 << tile_shift bins a side
     one_per_bin: u32,        // 1: sorted position s is in tile s >> (2 * tile_shift)
-    unused: u32,
+    one_origin: u32,         // 1: every ray starts at origins[0..3] (one row sent)
     shifts: vec4<u32>,       // packed cell: axis a is (cell >> shifts[a]) & masks[a]
     masks: vec4<u32>,
     offset: vec4<i32>,       // cell of packed (0, 0, 0)
@@ -104,7 +104,8 @@ fn test_tiles(@builtin(workgroup_id) group: vec3<u32>,
     }
     let r = order[s];
     let b = r * 3u;
-    let o = vec3<real>(origins[b], origins[b + 1u], origins[b + 2u]);
+    let ob = select(b, 0u, params.one_origin != 0u);
+    let o = vec3<real>(origins[ob], origins[ob + 1u], origins[ob + 2u]);
     let d = vec3<real>(directions[b], directions[b + 1u], directions[b + 2u]);
     let inv = select(vec3<real>(INF), vec3<real>(1.0) / d, d != vec3<real>(0.0));
     let lo = vec3<real>(params.box_lo.xyz);

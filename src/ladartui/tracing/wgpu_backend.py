@@ -373,9 +373,9 @@ class WgpuBackend:
 
         def object_order_block(a, b, max_voxels):
             bounds = None if block_bounds is None else block_bounds[a // SCAN_BLOCK]
-            return self._object_order(
-                occupancy, origins[a:b], directions[a:b], bounds, max_voxels, kind[a:b], index[a:b], t[a:b]
-            )
+            shared = one_origin(block_bounds, a, b)
+            block = (origins[a:b], directions[a:b], bounds, shared, max_voxels)
+            return self._object_order(occupancy, *block, kind[a:b], index[a:b], t[a:b])
 
         orders = trace_in_blocks(
             n,
@@ -388,9 +388,12 @@ class WgpuBackend:
         info["order"] = "+".join(sorted(orders)) or "ray"
         return CellHits(kind, index, t, info)
 
-    def _object_order(self, occupancy, origins, directions, bounds, max_voxels, kind, index, t):
+    def _object_order(
+        self, occupancy, origins, directions, bounds, shared_origin, max_voxels, kind, index, t
+    ):
         """One scan in object order into kind/index/t; False when it is no scan for it
-        (or its lists or arrays exceed what the adapter allows)."""
+        (or its lists or arrays exceed what the adapter allows). ``shared_origin``:
+        every ray starts at ``origins[0]`` (``prepare.one_origin``)."""
         frame = cone_frame(origins, directions, bounds)
         scan = (
             None
@@ -402,7 +405,7 @@ class WgpuBackend:
         if scan is None or np.diff(scan.tile_starts).max(initial=0) >= LOOP_BUDGET:
             return False
         assert self._scans is not None  # the device is open
-        found = self._scans.test_tiles(occupancy, origins, directions, scan)
+        found = self._scans.test_tiles(occupancy, origins, directions, scan, shared_origin)
         if found is None:
             return False
         nx, ny = float(occupancy.shape[0]), float(occupancy.shape[1])

@@ -59,11 +59,12 @@ SCAN_BINDINGS = ("params", "origins", "directions", "order", "ray_tiles", "tile_
 TILE_PARAMS_BYTES = 6 * 16
 
 
-def pack_tile_params(rays, scan, occupancy) -> bytes:
-    """The uniform block of one object-order dispatch, laid out as ``struct TileParams``."""
+def pack_tile_params(rays, scan, occupancy, shared_origin=False) -> bytes:
+    """The uniform block of one object-order dispatch, laid out as ``struct TileParams``
+    (``shared_origin``: every ray starts at the one origin sent)."""
     offset, shifts, masks = scan.packing
     ints = np.zeros((6, 4), dtype=np.int64)
-    ints[0, :3] = (rays, scan.tile_shift, 0 if len(scan.ray_tiles) else 1)
+    ints[0] = (rays, scan.tile_shift, 0 if len(scan.ray_tiles) else 1, 1 if shared_origin else 0)
     ints[1, :3], ints[2, :3], ints[3, :3] = shifts, masks, offset
     ints[4, :3], ints[5, :3] = occupancy.bbox_lo, occupancy.bbox_hi
     return ints.astype(np.uint32).tobytes()  # the i32 fields as their two's complement
@@ -102,14 +103,15 @@ class ScanDispatcher:
             self._compiled = pipeline
         return self._compiled
 
-    def test_tiles(self, occupancy, origins, directions, scan) -> np.ndarray | None:
+    def test_tiles(self, occupancy, origins, directions, scan, shared_origin=False) -> np.ndarray | None:
         """Each ray's hit as an entry of the scan's tile lists (-1 none), from
-        shaders/object_order.wgsl; None when an array exceeds a storage binding."""
+        shaders/object_order.wgsl; None when an array exceeds a storage binding.
+        ``shared_origin``: every ray starts at ``origins[0]``, the one row sent."""
         import wgpu
 
         n = len(origins)
         inputs = {
-            "origins": origins,
+            "origins": origins[:1] if shared_origin else origins,
             "directions": directions,
             "order": scan.order,
             "ray_tiles": scan.ray_tiles,
@@ -123,7 +125,7 @@ class ScanDispatcher:
         buffers = {name: self._buffer(name, size) for name, size in sizes.items()}
         buffers["params"] = self._buffer("params", TILE_PARAMS_BYTES, uniform=True)
         queue = self._device.queue
-        queue.write_buffer(buffers["params"], 0, pack_tile_params(n, scan, occupancy))
+        queue.write_buffer(buffers["params"], 0, pack_tile_params(n, scan, occupancy, shared_origin))
         for name, array in inputs.items():
             self._fill(name, buffers[name], np.ascontiguousarray(array))
         pipeline = self._pipeline()
