@@ -7,6 +7,8 @@ import threading
 import time
 
 import numba
+import numpy as np
+import pytest
 from numba.core import event as numba_event
 
 from ladartui.tracing.config import MIN_SCAN_RAYS, SCAN_BLOCK
@@ -194,3 +196,77 @@ def test_a_real_compile_is_not_charged():
     trace_in_blocks(MIN_SCAN_RAYS, "auto", Choice(), compiles, None)
     whole = time.perf_counter() - started
     assert len(elapsed) == 1 and whole > 0.02 and elapsed[0] < 0.25 * whole
+
+
+def test_sample_spans_spread_a_share_of_the_rays_over_the_block():
+    from ladartui.tracing.order_choice import sample_spans
+
+    spans = sample_spans(1000, 1000 + 262_144, 1 / 16)
+    assert len(spans) == 4 and sum(end - first for first, end in spans) == 262_144 // 16
+    centres = [(first + end) / 2 - 1000 for first, end in spans]
+    assert np.allclose(centres, [32_768, 98_304, 163_840, 229_376], atol=1)
+    for n in (1, 3, 10, 100):  # small blocks: runs inside the block, none empty
+        spans = sample_spans(5, 5 + n, 1 / 16)
+        assert all(5 <= first < end <= 5 + n for first, end in spans)
+        assert spans == sorted(spans) and all(x[1] <= y[0] for x, y in zip(spans, spans[1:]))
+
+
+def test_ray_order_is_timed_on_a_sample_while_it_does_not_lead():
+    """With ``ray_sample``, a pick of ray order while object order leads (or nothing
+    does yet) traces about that share of the block in ray order, spread over it, for
+    its time per ray; object order answers the whole block and is timed too. Once ray
+    order leads it takes whole blocks. A block object order cannot take goes to ray
+    order whole, and teaches nothing."""
+    from ladartui.tracing.order_choice import sample_spans
+
+    n = 4 * MIN_SCAN_RAYS
+    now = [0.0]
+    calls = []
+    per_ray = {"ray": 4e-6}
+    scan_seconds = {"object": 0.010}
+    is_scan = [True]
+
+    def object_block(a, b, limit):
+        calls.append(("object", a, b))
+        if is_scan[0]:
+            now[0] += scan_seconds["object"]
+        return is_scan[0]
+
+    def ray_block(a, b):
+        calls.append(("ray", a, b))
+        now[0] += (b - a) * per_ray["ray"]
+
+    def trace_once(choice):
+        calls.clear()
+        return trace_in_blocks(n, "auto", choice, object_block, ray_block, clock=lambda: now[0])
+
+    choice = OrderChoice(ray_sample=1 / 16)
+    assert trace_once(choice) == {"object"} and calls == [("object", 0, n)]
+    # Ray order's turn: a sixteenth in four runs, then object order for the answers.
+    assert trace_once(choice) == {"object"}
+    assert calls == [("ray", a, b) for a, b in sample_spans(0, n, 1 / 16)] + [("object", 0, n)]
+    assert choice.samples["ray"] == [pytest.approx(4e-6)] and len(choice.samples["object"]) == 2
+    # Ray order costs 6.5x object order's per ray here: object order goes on, and
+    # ray order's retry 16 calls after the lead was set is a sample again.
+    picks = []
+    for _ in range(16):
+        trace_once(choice)
+        picks.append("".join(kind[0] for kind, _, _ in calls))
+    assert picks[:-1] == ["o"] * 15 and picks[-1] == "rrrro"
+    # The scene changes: ray order turns cheap. Its next sample shows it, and from
+    # then on it traces whole blocks.
+    per_ray["ray"] = 1e-8
+    picks = []
+    while not picks or "r" not in picks[-1]:  # the lost retry doubled the wait: 32 calls
+        trace_once(choice)
+        picks.append("".join(kind[0] for kind, _, _ in calls))
+    assert len(picks) == 32 and picks[-1] == "rrrro" and choice.pick() == "ray"
+    assert trace_once(choice) == {"ray"} and calls == [("ray", 0, n)]
+    # Not a scan: ray order traces the block whole on a sampled pick, and nothing is learned.
+    fresh = OrderChoice(ray_sample=1 / 16)
+    fresh.record("object", 0.010, n)
+    is_scan[0] = False
+    recorded = {order: list(times) for order, times in fresh.samples.items()}
+    assert trace_once(fresh) == {"ray"}
+    assert [kind for kind, _, _ in calls] == ["ray"] * 4 + ["object", "ray"] and calls[-1] == ("ray", 0, n)
+    assert fresh.samples == recorded

@@ -514,3 +514,29 @@ def test_rays_from_one_origin_read_that_origin_alone(forest, numba_backend):
     ray, obj = both_orders(numba_backend, occ, moved, directions)
     assert obj.info["order"] == "object"
     assert_same(ray, obj)
+
+
+def test_numba_times_ray_order_on_a_sample_of_a_scan(forest, monkeypatch):
+    # An occupancy's second scan is ray order's first turn: about a sixteenth of the
+    # rays go through the ray-order kernel for its time, object order answers all.
+    from ladartui.tracing import numba_backend as nb
+    from ladartui.tracing.order_choice import RAY_SAMPLE
+
+    voxels, occ = forest
+    origins, directions = one_scan([120, 120, 20], 45.0, 0.7, 300.0)
+    kernel_rays = []
+    real_kernel = nb._exact_kernel
+
+    def counting(orig, *args):
+        kernel_rays.append(len(orig))
+        return real_kernel(orig, *args)
+
+    monkeypatch.setattr(nb, "_exact_kernel", counting)
+    fresh = Occupancy.build(voxels, occ.shape)
+    backend = NumbaBackend()
+    first = backend.trace_cells(fresh, origins, directions)
+    assert first.info["order"] == "object" and kernel_rays == []
+    second = backend.trace_cells(fresh, origins, directions)
+    assert second.info["order"] == "object"
+    assert sum(kernel_rays) == pytest.approx(RAY_SAMPLE * len(origins), abs=4)
+    assert_same(first, second)

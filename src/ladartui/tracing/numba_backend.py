@@ -27,7 +27,7 @@ from ladartui.tracing.backend import CellHits, TraceOrder, check_order, register
 from ladartui.tracing.bundle import bundle_start, halo_arrays
 from ladartui.tracing.config import BLOCK, BUNDLE, INF, SCAN_BLOCK
 from ladartui.tracing.march import march_kernel
-from ladartui.tracing.order_choice import OrderChoice, trace_in_blocks
+from ladartui.tracing.order_choice import RAY_SAMPLE, OrderChoice, trace_in_blocks
 from ladartui.tracing.prepare import one_origin
 from ladartui.tracing.scan_rays import cone_frame
 from ladartui.tracing.tile_tests import trace_scan
@@ -489,7 +489,7 @@ class NumbaBackend:
             orders = trace_in_blocks(
                 n,
                 order,
-                self._orders.setdefault(occ, OrderChoice()),
+                self._orders.setdefault(occ, OrderChoice(ray_sample=RAY_SAMPLE)),
                 object_order_block,
                 ray_order,
                 cancel,

@@ -17,6 +17,9 @@ from ladartui.errors import check_cancelled
 from ladartui.tracing.config import MIN_SCAN_RAYS, SCAN_BLOCK, VOXELS_PER_RAY
 
 RAY_RUN_BLOCKS = 16  # blocks one ray_block call may take: bounds the wait for a cancel
+# Share of a block's rays that times ray order while it does not lead (numba): a
+# retry then costs a sixteenth of a ray-order scan beside the object-order one.
+RAY_SAMPLE = 1 / 16
 
 
 class OrderChoice:
@@ -27,23 +30,30 @@ class OrderChoice:
     dear where they pass many gaps (foliage). So the orders take turns until
     each has been timed twice (a process's first calls also start threads and
     touch new memory; compiling is not counted, ``trace_in_blocks``), except
-    that an order timed at over SETTLED_GAP times the best of an order timed
-    twice is not timed again then (a scan in ray order at 45 degrees on the
-    reference scene costs four object-order scans; the wgpu backend, whose
-    first calls also build pipelines, passes ``settled_gap=inf``). Then the faster by its
-    better recent time per ray goes on, and the other is tried again in case
-    the views have changed: RETRY scans after the lead last changed, then
-    twice as long after each retry that loses, up to MAX_RETRY scans (on the
-    reference orbit, losing retries every 16 scans were a tenth of the numba
-    backend's work).
+    that an order timed at over ``settled_gap`` times the best of an order
+    timed twice is not timed again then (a scan in ray order at 45 degrees on
+    the reference scene costs four object-order scans; the wgpu backend, whose
+    first calls also build pipelines, passes ``settled_gap=inf``). Then the
+    faster by its better recent time per ray goes on, and the other is tried
+    again in case the views have changed: RETRY scans after the lead last
+    changed, then twice as long after each retry that loses, up to MAX_RETRY
+    scans (on the reference orbit, losing retries every 16 scans were a tenth
+    of the numba backend's work).
+
+    Ray order's cost is per ray, so while it does not lead it can be timed on
+    ``ray_sample`` of a block's rays (spread over the block), object order
+    answering the whole block; object order's cost is per scan, so it is timed
+    on whole blocks. None: ray order too takes whole blocks (the wgpu backend,
+    where each call costs a dispatch).
     """
 
     RETRY = 16
     MAX_RETRY = 64
     SAMPLES = 2
 
-    def __init__(self, settled_gap: float = 2.0):
+    def __init__(self, settled_gap: float = 2.0, ray_sample: float | None = None):
         self.settled_gap = settled_gap
+        self.ray_sample = ray_sample
         self.samples: dict[str, list[float]] = {"object": [], "ray": []}  # recent seconds per ray
         self.calls = 0
         self.retry_every = self.RETRY
@@ -77,6 +87,11 @@ class OrderChoice:
                 self._retrying = "ray" if best == "object" else "object"
                 return self._retrying
             return best
+
+    def times_ray_order_on_a_sample(self) -> bool:
+        """Whether a pick of ray order is timed on a sample of the block (``ray_sample``)."""
+        with self._lock:
+            return self.ray_sample is not None and self._leader != "ray"
 
     def record(self, order: str, seconds: float, rays: int) -> None:
         with self._lock:
@@ -143,6 +158,18 @@ def trace_in_blocks(n, order, choice, object_block, ray_block, cancel=None, cloc
         return _trace_blocks(n, order, choice, object_block, ray_block, cancel, clock, compiling)
 
 
+def sample_spans(first: int, end: int, share: float, spans: int = 4) -> list[tuple[int, int]]:
+    """About ``share`` of rays ``first..end`` as ``spans`` runs, centred on equal parts
+    of the range (for a scan, strips across its image: near and far rays alike)."""
+    n = end - first
+    length = max(1, round(n * share / spans))
+    runs = []
+    for k in range(spans):
+        start = first + min(max(0, (2 * k + 1) * n // (2 * spans) - length // 2), n - length)
+        runs.append((start, start + min(length, n)))
+    return sorted(set(runs))
+
+
 def _trace_blocks(n, order, choice, object_block, ray_block, cancel, clock, compiling):
     def spent(started, compiled):  # a block's time, less its compiling
         return clock() - started - (compiling.seconds - compiled)
@@ -157,6 +184,19 @@ def _trace_blocks(n, order, choice, object_block, ray_block, cancel, clock, comp
         pick = None if learning is None else picked or learning.pick()
         picked = None
         started, compiled = clock(), compiling.seconds
+        if pick == "ray" and learning is not None and learning.times_ray_order_on_a_sample():
+            spans = sample_spans(a, b, learning.ray_sample)
+            for first, end in spans:
+                ray_block(first, end)
+            ray_seconds = spent(started, compiled)
+            started, compiled = clock(), compiling.seconds
+            if object_block(a, b, VOXELS_PER_RAY * (b - a)):  # the block's answers
+                orders.add("object")
+                learning.record("ray", ray_seconds, sum(end - first for first, end in spans))
+                learning.record("object", spent(started, compiled), b - a)
+                a = b
+                continue
+            learning = None  # no scan for object order: ray order answers, untimed
         if order == "object" or pick == "object":
             limit = np.inf if order == "object" else VOXELS_PER_RAY * (b - a)
             if object_block(a, b, limit):
