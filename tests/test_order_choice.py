@@ -15,15 +15,18 @@ from ladartui.tracing.config import MIN_SCAN_RAYS, SCAN_BLOCK
 from ladartui.tracing.order_choice import RAY_RUN_BLOCKS, OrderChoice, trace_in_blocks
 
 
-def test_order_choice_learns_the_faster_order():
-    def run(choice, calls, seconds):
-        picks = ""
-        for _ in range(calls):
-            pick = choice.pick()
-            picks += pick[0]
-            choice.record(pick, seconds[pick], 1000)
-        return picks
+def run(choice, calls, seconds):
+    """``calls`` picks of ``choice``, each recorded as taking ``seconds[pick]`` for 1,000
+    rays; the picks' first letters."""
+    picks = ""
+    for _ in range(calls):
+        pick = choice.pick()
+        picks += pick[0]
+        choice.record(pick, seconds[pick], 1000)
+    return picks
 
+
+def test_order_choice_learns_the_faster_order():
     def calls_of(picks, letter, first_call):
         return [first_call + k for k, p in enumerate(picks) if p == letter]
 
@@ -119,14 +122,6 @@ def test_blocks_picked_for_ray_order_go_together(monkeypatch):
 
 
 def test_an_order_far_slower_than_a_settled_one_is_timed_once():
-    def run(choice, calls, seconds):
-        picks = ""
-        for _ in range(calls):
-            pick = choice.pick()
-            picks += pick[0]
-            choice.record(pick, seconds[pick], 1000)
-        return picks
-
     slow_ray = {"object": 0.010, "ray": 0.040}
     # Object order is timed twice (settled); ray order's one time is four times its
     # best, so ray order waits for its retry, 16 calls after the lead was first known.
