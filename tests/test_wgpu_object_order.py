@@ -161,21 +161,25 @@ def test_ray_order_where_object_order_cannot_run(forest, f64_backend, numba_back
     assert_same(numba_backend.trace_cells(occ, scattered, down), hits)
 
 
-def test_order_is_learned_per_occupancy(forest, f64_backend, numba_backend):
-    # Left to choose, the backend takes turns between the orders (OrderChoice) and
-    # every call gives the same answers.
+def test_order_is_learned_per_occupancy(forest, f64_backend, numba_backend, monkeypatch):
+    # Left to choose, the backend takes turns between the orders (OrderChoice): each is
+    # timed twice, and every call gives the same answers. On a CPU adapter ray order's
+    # turns while it does not lead are samples (object order answers), on a GPU whole.
+    from ladartui.tracing.order_choice import RAY_SAMPLE
     from ladartui.tracing.wgpu_backend import WgpuBackend
 
     _, occ = forest
     backend = WgpuBackend()
     origins, directions = one_scan([120, 120, 10], 45.0, 1.0, 200.0)  # few voxels per ray
     expected = numba_backend.trace_cells(occ, origins, directions, order="ray")
-    seen = set()
     for _ in range(4):
-        hits = backend.trace_cells(occ, origins, directions)
-        seen.add(hits.info["order"])
-        assert_same(expected, hits)
-    assert seen == {"object", "ray"}
+        assert_same(expected, backend.trace_cells(occ, origins, directions))
+    choice = backend._orders[occ]
+    assert [len(times) for times in choice.samples.values()] == [2, 2]
+    cpu = backend.describe()["adapter_type"] == "CPU"
+    assert choice.ray_sample == (RAY_SAMPLE if cpu else None)
+    monkeypatch.setitem(backend._adapter.info, "adapter_type", "DiscreteGPU" if cpu else "CPU")
+    assert backend._order_choice().ray_sample == (None if cpu else RAY_SAMPLE)
 
 
 def test_cells_pack_into_one_word_and_back():

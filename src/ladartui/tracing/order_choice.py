@@ -17,8 +17,9 @@ from ladartui.errors import check_cancelled
 from ladartui.tracing.config import MIN_SCAN_RAYS, SCAN_BLOCK, VOXELS_PER_RAY
 
 RAY_RUN_BLOCKS = 16  # blocks one ray_block call may take: bounds the wait for a cancel
-# Share of a block's rays that times ray order while it does not lead (numba): a
-# retry then costs a sixteenth of a ray-order scan beside the object-order one.
+# Share of a block's rays that times ray order while it does not lead (numba, and
+# wgpu on a CPU adapter): a retry then costs a sixteenth of a ray-order scan beside
+# the object-order one.
 RAY_SAMPLE = 1 / 16
 
 
@@ -43,8 +44,8 @@ class OrderChoice:
     Ray order's cost is per ray, so while it does not lead it can be timed on
     ``ray_sample`` of a block's rays (spread over the block), object order
     answering the whole block; object order's cost is per scan, so it is timed
-    on whole blocks. None: ray order too takes whole blocks (the wgpu backend,
-    where each call costs a dispatch).
+    on whole blocks. None: ray order too takes whole blocks (the wgpu backend on
+    a GPU, where each call costs a dispatch).
     """
 
     RETRY = 16
