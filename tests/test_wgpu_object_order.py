@@ -178,7 +178,7 @@ def test_order_is_learned_per_occupancy(forest, f64_backend, numba_backend, monk
     assert [len(times) for times in choice.samples.values()] == [2, 2]
     cpu = backend.describe()["adapter_type"] == "CPU"
     assert choice.ray_sample == (RAY_SAMPLE if cpu else None)
-    monkeypatch.setitem(backend._adapter.info, "adapter_type", "DiscreteGPU" if cpu else "CPU")
+    monkeypatch.setattr(backend, "_cpu_adapter", not cpu)
     assert backend._order_choice().ray_sample == (None if cpu else RAY_SAMPLE)
 
 

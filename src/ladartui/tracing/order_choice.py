@@ -185,24 +185,21 @@ def _trace_blocks(n, order, choice, object_block, ray_block, cancel, clock, comp
         pick = None if learning is None else picked or learning.pick()
         picked = None
         started, compiled = clock(), compiling.seconds
+        sampled = None  # (seconds, rays) of ray order timed on a sample of this block
         if pick == "ray" and learning is not None and learning.times_ray_order_on_a_sample():
             spans = sample_spans(a, b, learning.ray_sample)
             for first, end in spans:
                 ray_block(first, end)
-            ray_seconds = spent(started, compiled)
+            sampled = (spent(started, compiled), sum(end - first for first, end in spans))
+            pick = "object"  # which answers the block
             started, compiled = clock(), compiling.seconds
-            if object_block(a, b, VOXELS_PER_RAY * (b - a)):  # the block's answers
-                orders.add("object")
-                learning.record("ray", ray_seconds, sum(end - first for first, end in spans))
-                learning.record("object", spent(started, compiled), b - a)
-                a = b
-                continue
-            learning = None  # no scan for object order: ray order answers, untimed
         if order == "object" or pick == "object":
             limit = np.inf if order == "object" else VOXELS_PER_RAY * (b - a)
             if object_block(a, b, limit):
                 orders.add("object")
                 if learning is not None:
+                    if sampled is not None:
+                        learning.record("ray", *sampled)
                     learning.record("object", spent(started, compiled), b - a)
                 a = b
                 continue

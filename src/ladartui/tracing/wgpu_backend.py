@@ -126,7 +126,8 @@ class WgpuBackend:
         self._device: Any = None
         self._limits: dict[str, int] = {}
         self._has_f64 = False
-        # On a CPU adapter (lavapipe) storage buffers can be mapped (tracing/wgpu_scans.py).
+        self._cpu_adapter = False  # lavapipe and the like: a dispatch costs little, memory is the host's
+        # On a CPU adapter storage buffers can be mapped (tracing/wgpu_scans.py).
         self._maps_storage = False
         self._uploads: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()
         self._pinned_uploads: dict[int, Any] = {}  # for occupancies that cannot be weakly referenced
@@ -165,10 +166,9 @@ class WgpuBackend:
             return INSTALL_HINT
         self._adapter = adapter
         self._has_f64 = "shader-f64" in adapter.features
+        self._cpu_adapter = adapter.info.get("adapter_type") == "CPU"
         self._maps_storage = (
-            self._map_storage
-            and adapter.info.get("adapter_type") == "CPU"
-            and "mappable-primary-buffers" in adapter.features
+            self._map_storage and self._cpu_adapter and "mappable-primary-buffers" in adapter.features
         )
         return None
 
@@ -208,8 +208,7 @@ class WgpuBackend:
             if cap is not None:
                 self._limits[key] = min(self._limits[key], int(cap))
         self._scans = ScanDispatcher(self._device, self._limits, self._shader_file, self._maps_storage)
-        cpu = adapter.info.get("adapter_type") == "CPU"
-        self._hits = FirstHits(self._device, self._limits, self._ray_batch, bundle_starts=cpu)
+        self._hits = FirstHits(self._device, self._limits, self._ray_batch, bundle_starts=self._cpu_adapter)
         return self._device
 
     def describe(self) -> dict:
@@ -394,8 +393,7 @@ class WgpuBackend:
         while it does not lead (there a dispatch costs little beside the work: on
         lavapipe a sixteenth in four runs read 1.27x the per-ray time of whole
         blocks, against ray order's 4.5-5x object order's), on a GPU on whole blocks."""
-        cpu = self._adapter is not None and self._adapter.info.get("adapter_type") == "CPU"
-        return OrderChoice(settled_gap=math.inf, ray_sample=RAY_SAMPLE if cpu else None)
+        return OrderChoice(settled_gap=math.inf, ray_sample=RAY_SAMPLE if self._cpu_adapter else None)
 
     def _object_order(
         self, occupancy, origins, directions, bounds, shared_origin, max_voxels, kind, index, t
