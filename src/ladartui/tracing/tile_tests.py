@@ -48,7 +48,9 @@ def tile_shift_for(nb):
     return max(2, min(MAX_TILE_SHIFT, (nb // 4).bit_length() - 1))
 
 
-@njit(parallel=True, nogil=True, cache=True)
+# error_model="numpy": a division by zero gives inf, as the guarded divisions here never
+# meet; without the check, the pass of inverses runs as vector code.
+@njit(parallel=True, nogil=True, cache=True, error_model="numpy")
 def test_tiles(
     vox,
     nears,
