@@ -92,6 +92,7 @@ SHARED = (
     "CUT_WORD",
     "INF",
     "BUNDLE",
+    "NO_CELL",
     "METHOD_EXACT",
     "METHOD_MARCH",
     "MARCH_SKIP_MARGIN",
@@ -118,6 +119,7 @@ def test_the_shader_header_carries_the_python_values(real):
     assert {name: int(consts[name]) for name in codes} == {name: getattr(config, name) for name in codes}
     assert float(consts["INF"]) == config.SHADER_INF
     assert float(consts["MARCH_SKIP_MARGIN"]) == config.MARCH_SKIP_MARGIN
+    assert consts["NO_CELL"] == f"{config.NO_CELL}u" and config.NO_CELL == 2**32 - 1
     assert consts["BUNDLE"] == f"{config.BUNDLE}u"
     assert int(consts["METHOD_EXACT"]) == config.METHOD_CODES["exact"]
     assert int(consts["METHOD_MARCH"]) == config.METHOD_CODES["march"]

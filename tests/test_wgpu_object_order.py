@@ -9,6 +9,7 @@ import pytest
 from ladartui.scene.occupancy import Occupancy
 from ladartui.sensor import Sensor
 from ladartui.tracing.backend import GROUND, MISS, VOXEL
+from ladartui.tracing.config import NO_CELL
 from ladartui.tracing.reference import reference_trace_cells
 from ladartui.tracing.shader_scan import cell_packing, ray_tiles_of, tile_entries, voxel_words
 from scans import assert_same, forest_scene, numpy_with_junk_empty, one_scan, random_scan
@@ -184,7 +185,7 @@ def test_order_is_learned_per_occupancy(forest, f64_backend, numba_backend, monk
 
 def test_cells_pack_into_one_word_and_back():
     rng = np.random.default_rng(8)
-    for spans in ([2048, 2048, 1024], [1, 300, 7], [1 << 20, 1, 1 << 12], [5000, 5000, 1]):
+    for spans in ([2048, 2048, 1000], [1, 300, 7], [1 << 20, 1, 1 << 12], [5000, 5000, 1]):
         vox = np.zeros((500, 7), np.int64)
         vox[:, :3] = rng.integers(0, spans, (500, 3)) + rng.integers(-(1 << 23), 1 << 23, 3)
         vox[:2, :3] = vox[:, :3].min(axis=0), vox[:, :3].max(axis=0)
@@ -197,6 +198,12 @@ def test_cells_pack_into_one_word_and_back():
         assert np.array_equal(cells.astype(np.int64) + offset, vox[listed, :3])
     vox[:2, :3] = [0, 0, 0], [1 << 11, 1 << 11, 1 << 10]  # 12 + 12 + 11 bits
     assert cell_packing(vox) is None
+    # 11 + 11 + 10 bits, and the greatest corner packs to all ones: the shader's no hit.
+    vox[:, :3] = 5
+    vox[1, :3] = [5 + 2047, 5 + 2047, 5 + 1023]
+    assert cell_packing(vox) is None
+    vox[1, 2] -= 1
+    assert cell_packing(vox) is not None
 
 
 def test_tile_entries_carry_the_least_near_still_to_come_rounded_down():
@@ -263,12 +270,12 @@ def test_rays_from_one_origin_send_and_read_that_origin_alone(
 ):
     """trace() tells the shader when every ray of a block starts at one point (the
     block bounds say so): one origin row goes to the device and every ray reads it.
-    The shader's hits are the same as from every ray's own row, even when the other
-    rows hold NaN; rays from two origins are not told."""
+    The shader's hits, and the host's answers from them, are the same as from every
+    ray's own row, even when the other rows hold NaN; rays from two origins are not told."""
     from ladartui.tracing import trace, wgpu_scans
     from ladartui.tracing.config import OBJECT_ORDER_TILE_SHIFT
     from ladartui.tracing.scan_rays import cone_frame, ray_bounds
-    from ladartui.tracing.shader_scan import prepare_shader_scan
+    from ladartui.tracing.shader_scan import entry_answers, prepare_shader_scan
 
     voxels, occ = forest
     origins, directions = one_scan([120, 120, 20], 45.0, 0.7, 300.0)
@@ -281,7 +288,15 @@ def test_rays_from_one_origin_send_and_read_that_origin_alone(
     junk = np.full_like(origins, np.nan)
     junk[0] = origins[0]
     assert np.array_equal(dispatcher.test_tiles(occ, junk, directions, scan, shared_origin=True), own_rows)
-    assert (own_rows >= 0).mean() > 0.5  # most rays hit: the comparison has teeth
+    assert (own_rows != NO_CELL).mean() > 0.5  # most rays hit: the comparison has teeth
+    # The host's answers read that origin alone too.
+    answers = []
+    for rows, shared in ((origins, False), (junk, True)):
+        out = (np.zeros(len(rows), np.uint8), np.zeros((len(rows), 3), np.int32), np.zeros(len(rows)))
+        entry_answers(own_rows, *scan.packing, rows, shared, directions, *map(float, occ.shape[:2]), *out)
+        answers.append(out)
+    assert all(np.array_equal(a, b) for a, b in zip(*answers))
+    assert np.isfinite(answers[1][2][answers[1][0] == VOXEL]).all()
 
     sent = []
     real_test_tiles = wgpu_scans.ScanDispatcher.test_tiles

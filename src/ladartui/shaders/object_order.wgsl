@@ -14,8 +14,8 @@
 // lavapipe loads a storage value lane by lane, so the layout counts words:
 // an entry is two (rest as float32 rounded down, still a lower bound; the
 // voxel's cell packed into one u32 relative to the scan's offset), and the
-// shader writes the hit's entry number alone: the host takes the voxel from
-// its list and recomputes t with the same slab test. In f64 the answers are
+// shader writes the hit's packed cell alone (NO_CELL: none): the host unpacks
+// it and recomputes t with the same slab test. In f64 the answers are
 // numba's bit for bit (tests/test_wgpu_object_order.py).
 //
 // tracing/wgpu_scans.py prepends the header of tracing/config.py (wgsl_constants:
@@ -41,20 +41,20 @@ struct TileParams {
 @group(0) @binding(4) var<storage, read> ray_tiles: array<u32>;    // tile of sorted position (unless one_per_bin)
 @group(0) @binding(5) var<storage, read> tile_starts: array<u32>;  // tile's entries
 @group(0) @binding(6) var<storage, read> entries: array<vec2<u32>>; // rest (f32 bits), packed cell
-@group(0) @binding(7) var<storage, read_write> found: array<i32>;  // per ray: entry of its hit, -1 none
+@group(0) @binding(7) var<storage, read_write> found: array<u32>;  // per ray: packed cell of its hit, NO_CELL none
 
-// The entry of the first voxel the ray meets before `bound` among entries
-// first .. last, -1 none. `enter_face` and `leave_face` are per axis the cell
+// The packed cell of the first voxel the ray meets before `bound` among entries
+// first .. last, NO_CELL none. `enter_face` and `leave_face` are per axis the cell
 // offsets (0 or 1) of the faces the ray enters and leaves a cell by, so each
 // slab parameter is the reference tracer's boundary_t, bit for bit, with no
 // min or max (lavapipe's are slow). A still axis (d = 0) has no faces: the ray
 // is inside the open slab for every t or never, which `still` checks; the
 // caller passes it as a constant, so the usual loop goes without.
 fn first_hit(first: u32, last: u32, bound: real, o: vec3<real>, d: vec3<real>, inv: vec3<real>,
-             enter_face: vec3<real>, leave_face: vec3<real>, still: bool) -> i32 {
+             enter_face: vec3<real>, leave_face: vec3<real>, still: bool) -> u32 {
     let offset = vec3<real>(params.offset.xyz);
     var best = bound;
-    var hit = -1;
+    var hit = NO_CELL;
     for (var e = first; e < last; e++) {
         let entry = entries[e];
         if (real(bitcast<f32>(entry.x)) >= best) {
@@ -81,7 +81,7 @@ fn first_hit(first: u32, last: u32, bound: real, o: vec3<real>, d: vec3<real>, i
         let start = select(enter, 0.0, enter < 0.0);
         if (start < leave && start < best) {
             best = start;
-            hit = i32(e);
+            hit = entry.y;
         }
     }
     return hit;

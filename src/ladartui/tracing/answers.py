@@ -3,7 +3,8 @@
 ``ray_answer`` is compiled into the numba kernels (the exact kernel and the
 object-order tile tests) and written again in WGSL (shaders/trace.wgsl,
 ``ground``); ``put_answer`` writes an object-order hit with it (numba's tile
-tests, and tracing/shader_scan.py for the wgpu backend's shader), and
+tests; tracing/shader_scan.py's ``entry_answers`` calls it for the wgpu backend's
+shader), and
 ``box_offset_answers`` the hits of the wgpu backend's exact ray order.
 """
 

@@ -78,6 +78,9 @@ LOOP_BUDGET = 65_000
 MARCH_SKIP_MARGIN = 0.01
 # trace.wgsl's first_hits: a ray's word when it hits no voxel, or its loop was cut.
 NO_VOXEL, CUT_WORD = -1, -2
+# The object-order shader's word for a ray without a hit: the packed cell no voxel
+# has (shader_scan.cell_packing refuses the one box whose corner packs to it).
+NO_CELL = 0xFFFFFFFF
 
 
 def wgsl_constants(real: str) -> str:
@@ -101,6 +104,7 @@ def wgsl_constants(real: str) -> str:
         f"const INF: real = {_wgsl_float(SHADER_INF)};",
         f"const MARCH_SKIP_MARGIN: real = {_wgsl_float(MARCH_SKIP_MARGIN)};",
         f"const BUNDLE: u32 = {BUNDLE}u;",
+        f"const NO_CELL: u32 = {NO_CELL}u;",
     ]
     return "\n".join(lines) + "\n"
 

@@ -9,9 +9,9 @@ and lavapipe loads storage lane by lane, so each word an invocation reads
 costs: a tile's entry is two u32 (``tile_entries``), the least voxel ``near``
 from it to the end of its list (the tile stop numba takes per tile, here per
 ray) and the voxel's cell packed into one word relative to the voxels' least
-corner (``cell_packing``). The shader writes back the entry of each ray's hit;
-``entry_answers`` turns it into the voxel and recomputes ``t`` with the slab
-test both tracers share (``answers.voxel_entry``).
+corner (``cell_packing``). The shader writes back the packed cell of each ray's
+hit; ``entry_answers`` unpacks it and recomputes ``t`` with the slab test both
+tracers share (``answers.voxel_entry``), reading nothing but the rays.
 """
 
 from __future__ import annotations
@@ -21,8 +21,8 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit, prange
 
-from ladartui.tracing.answers import put_answer, voxel_entry
-from ladartui.tracing.config import INF, PARTS
+from ladartui.tracing.answers import ray_answer, voxel_entry
+from ladartui.tracing.config import INF, NO_CELL, PARTS
 from ladartui.tracing.object_order import scan_voxels
 from ladartui.tracing.scan_rays import bin_order, scan_grid
 
@@ -44,16 +44,14 @@ class ShaderScan(NamedTuple):
     Sorted position ``s`` is ray ``order[s]``, in tile ``ray_tiles[s]`` (empty when
     every bin holds one ray: the tile is then ``s >> 2 * tile_shift``). Tile ``k``'s
     entries are ``tile_starts[k] .. tile_starts[k + 1]`` of ``entries`` (rest as
-    float32 bits, packed cell); entry ``e`` is voxel ``listed[e]`` of ``vox``.
-    ``packing`` is (offset, shifts, masks) of the cells (``cell_packing``).
+    float32 bits, packed cell). ``packing`` is (offset, shifts, masks) of the cells
+    (``cell_packing``).
     """
 
     order: np.ndarray
     ray_tiles: np.ndarray
     tile_starts: np.ndarray
     entries: np.ndarray
-    listed: np.ndarray
-    vox: np.ndarray
     packing: tuple
     tile_shift: int
 
@@ -61,14 +59,18 @@ class ShaderScan(NamedTuple):
 def cell_packing(vox):
     """(offset, shifts, masks) that pack cell ``vox[e, :3]`` into one u32 as
     ``sum((cell[a] - offset[a]) << shifts[a])``, each axis with the bits its span
-    of the voxels needs; None when they need more than 32 bits together. An axis
-    with one value takes no bits (shift and mask 0)."""
+    of the voxels needs; None when they need more than 32 bits together, or when
+    the greatest corner packs to NO_CELL (the shader's word for no hit: every
+    span a full 32 bits of ones). An axis with one value takes no bits (shift
+    and mask 0)."""
     offset, top = _cell_box(vox)
     bits = [int(span).bit_length() for span in top - offset]
     if sum(bits) > PACKED_BITS:
         return None
     shifts = np.array([0, bits[0], bits[0] + bits[1]], np.int64) * (np.array(bits) > 0)
     masks = np.array([(1 << b) - 1 for b in bits], np.int64)
+    if sum(int(top[a] - offset[a]) << int(shifts[a]) for a in range(3)) == NO_CELL:
+        return None
     return offset, shifts, masks
 
 
@@ -165,23 +167,28 @@ def prepare_shader_scan(occ, orig, dirs, frame, max_voxels, tile_shift):
         ray_tiles,
         tile_starts.astype(np.uint32),
         tile_entries(tile_starts, listed, voxel_words(vox, nears, offset, shifts)),
-        listed,
-        vox,
         packing,
         tile_shift,
     )
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def entry_answers(found, listed, vox, orig, dirs, nx, ny, kind, index, tout):
-    """Every ray's answer from the shader's ``found`` (per ray, the entry of its hit,
-    -1 none): the voxel ``vox[listed[e]]`` at the start of its slab test, else the
-    ground rule."""
+def entry_answers(found, offset, shifts, masks, orig, shared_origin, dirs, nx, ny, kind, index, tout):
+    """Every ray's answer from the shader's ``found`` (per ray, the packed cell of its
+    hit, NO_CELL none; ``cell_packing``'s offset, shifts and masks unpack it): that
+    voxel at the start of its slab test, else the ground rule. ``shared_origin``:
+    every ray starts at ``orig[0]``, which is then read for all."""
     for r in prange(found.shape[0]):
-        ox, oy, oz = orig[r, 0], orig[r, 1], orig[r, 2]
+        o = np.int64(0) if shared_origin else np.int64(r)  # (prange's r is unsigned)
+        ox, oy, oz = orig[o, 0], orig[o, 1], orig[o, 2]
         dx, dy, dz = dirs[r, 0], dirs[r, 1], dirs[r, 2]
-        q, t = -1, INF
-        if found[r] >= 0:
-            q = listed[found[r]]
-            t = voxel_entry(ox, oy, oz, dx, dy, dz, vox[q, 0], vox[q, 1], vox[q, 2])
-        put_answer(r, q, t, vox, ox, oy, oz, dx, dy, dz, nx, ny, kind, index, tout)
+        word = np.int64(found[r])
+        i, j, k, t = np.int64(-1), np.int64(-1), np.int64(-1), INF
+        if word != NO_CELL:
+            i = offset[0] + ((word >> shifts[0]) & masks[0])
+            j = offset[1] + ((word >> shifts[1]) & masks[1])
+            k = offset[2] + ((word >> shifts[2]) & masks[2])
+            t = voxel_entry(ox, oy, oz, dx, dy, dz, i, j, k)
+        kind[r], index[r, 0], index[r, 1], index[r, 2], tout[r] = ray_answer(
+            word != NO_CELL, i, j, k, t, ox, oy, oz, dx, dy, dz, nx, ny
+        )

@@ -416,7 +416,10 @@ class WgpuBackend:
         if found is None:
             return False
         nx, ny = float(occupancy.shape[0]), float(occupancy.shape[1])
-        entry_answers(found, scan.listed, scan.vox, origins, directions, nx, ny, kind, index, t)
+        offset, shifts, masks = scan.packing
+        entry_answers(
+            found, offset, shifts, masks, origins, shared_origin, directions, nx, ny, kind, index, t
+        )
         return True
 
     def _trace(

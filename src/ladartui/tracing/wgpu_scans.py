@@ -104,7 +104,7 @@ class ScanDispatcher:
         return self._compiled
 
     def test_tiles(self, occupancy, origins, directions, scan, shared_origin=False) -> np.ndarray | None:
-        """Each ray's hit as an entry of the scan's tile lists (-1 none), from
+        """Each ray's hit as its packed cell (``scan.packing``; NO_CELL none), from
         shaders/object_order.wgsl; None when an array exceeds a storage binding.
         ``shared_origin``: every ray starts at ``origins[0]``, the one row sent."""
         import wgpu
@@ -143,7 +143,7 @@ class ScanDispatcher:
             )
         group = self._group[1]
         queue.submit([dispatch_encoder(self._device, self._limits, pipeline, group, n).finish()])
-        found = np.frombuffer(self._read(buffers["found"], 4 * n), dtype=np.int32)
+        found = np.frombuffer(self._read(buffers["found"], 4 * n), dtype=np.uint32)
         if self.maps_storage:
             # Map the inputs for the next scan now, so that the wait for it passes
             # while the host works (asked for right after the host's numba passes,
