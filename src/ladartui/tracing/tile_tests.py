@@ -5,9 +5,9 @@ an order and no copies), the voxels in view listed per tile
 (``object_order.scan_voxels``), and ``test_tiles`` then takes each tile on its
 own: it copies the tile's rays next to each other, tests them against the
 tile's voxels nearest first (eight rays at a time, tracing/slab_lanes.py), and
-writes their answers in ray order. One pass
-over the rays does the copying, the testing and the answers, so a scan's rays
-are read from memory about once (docs/architecture.md, "Object order").
+writes their answers in ray order. One pass over the rays does the copying,
+the testing and the answers, so a scan's rays are read from memory about once
+(docs/architecture.md, "Object order").
 """
 
 from __future__ import annotations
