@@ -282,13 +282,13 @@ def test_a_whole_scan_sorts_by_scatter_as_the_counting_sort_does(duplicate):
     centre, _, axis, u, v = cone_frame(origins, directions)
     nb = 64
     p, q, grid = sr.ray_grid(directions, axis, u, v, nb)
-    scattered = np.empty(nb * nb, np.int64)
+    scattered = np.empty(nb * nb, np.uint32)
     assert sr._scatter_one_per_bin(p, q, grid, nb, 4, scattered, np.empty(2)) == (not duplicate)
     starts, order = sr._sort_into_bins(p, q, grid, nb, 4)
     if not duplicate:
         assert np.array_equal(scattered, order)
     got_order, got_starts, _ = sr.bin_order(p, q, grid, nb, 4)
-    assert np.array_equal(got_order, order)
+    assert np.array_equal(got_order, order) and got_order.dtype == order.dtype == np.uint32
     assert len(got_starts) == (len(starts) if duplicate else 0)
     assert np.array_equal(np.diff(starts) == 1, np.ones(nb * nb, bool)) == (not duplicate)
 

@@ -19,6 +19,10 @@ from numba import njit, prange
 
 from ladartui.tracing.config import INF, MAX_SPREAD, MIN_COS, PARTS
 
+# Ray numbers in bin order are u32 (a block holds far fewer rays): half the bytes
+# the tile tests read, and the shader's own type. NO_RAY marks a bin left empty.
+NO_RAY = np.uint32(0xFFFFFFFF)
+
 
 @njit(parallel=True, nogil=True, cache=True)
 def ray_bounds(orig, dirs):
@@ -167,7 +171,7 @@ def _sort_into_bins(p, q, grid, nb, shift):
     for b in range(starts.shape[0] - 1):
         starts[b + 1] += starts[b]
     fill = starts[:-1].copy()
-    order = np.empty(n, np.int64)
+    order = np.empty(n, np.uint32)
     for r in range(n):
         order[fill[key_of[r]]] = r
         fill[key_of[r]] += 1
@@ -185,7 +189,7 @@ def _scatter_one_per_bin(p, q, grid, nb, shift, order, slack):
     n = p.shape[0]
     nt = nb >> shift
     for k in prange(n):
-        order[k] = -1
+        order[k] = NO_RAY
     far = np.zeros((PARTS, 2))
     for part in prange(PARTS):
         for r in range(part * n // PARTS, (part + 1) * n // PARTS):
@@ -198,7 +202,7 @@ def _scatter_one_per_bin(p, q, grid, nb, shift, order, slack):
     missing = np.zeros(PARTS, np.bool_)
     for part in prange(PARTS):
         for k in range(part * n // PARTS, (part + 1) * n // PARTS):
-            if order[k] < 0:
+            if order[k] == NO_RAY:
                 missing[part] = True
                 break
     return not missing.any()
@@ -236,14 +240,14 @@ def scan_grid(dirs, frame):
 
 def bin_order(p, q, grid, nb, shift):
     """(order, starts, grid) of the rays in bin order, without copying them: sorted
-    position s is ray ``order[s]``; the rays of the bin with key ``b`` (``bin_key``)
+    position s is ray ``order[s]`` (u32); the rays of the bin with key ``b`` (``bin_key``)
     are sorted positions ``starts[b] .. starts[b + 1]``, or ``starts`` is empty when
     every bin holds exactly one ray (bin key b is then position b). The
     grid comes back with the slack measured then: how far, in bins, any ray lies from
     its bin's middle (a scan's rays sit near the middles, so voxels cover fewer bins)."""
     n = len(p)
     if n == nb * nb and nb % (1 << shift) == 0:
-        order = np.empty(n, np.int64)
+        order = np.empty(n, np.uint32)
         slack = np.empty(2)
         if _scatter_one_per_bin(p, q, grid, nb, shift, order, slack):
             measured = grid.copy()

@@ -163,7 +163,7 @@ def prepare_shader_scan(occ, orig, dirs, frame, max_voxels, tile_shift):
     offset, shifts, _ = packing
     ray_tiles = ray_tiles_of(bin_starts, tile_shift) if len(bin_starts) else np.empty(0, np.uint32)
     return ShaderScan(
-        order.astype(np.uint32),
+        order,
         ray_tiles,
         tile_starts.astype(np.uint32),
         tile_entries(tile_starts, listed, voxel_words(vox, nears, offset, shifts)),
