@@ -2,9 +2,8 @@
 
 ``ray_answer`` is compiled into the numba kernels (the exact kernel and the
 object-order tile tests) and written again in WGSL (shaders/trace.wgsl,
-``ground``); ``put_answer`` writes an object-order hit with it (numba's tile
-tests; tracing/shader_scan.py's ``entry_answers`` calls it for the wgpu backend's
-shader), and
+``ground``); ``put_answer`` writes numba's object-order hits with it (the tile
+tests), tracing/shader_scan.py's ``entry_answers`` the wgpu shader's, and
 ``box_offset_answers`` the hits of the wgpu backend's exact ray order.
 """
 

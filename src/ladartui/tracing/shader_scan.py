@@ -60,9 +60,8 @@ def cell_packing(vox):
     """(offset, shifts, masks) that pack cell ``vox[e, :3]`` into one u32 as
     ``sum((cell[a] - offset[a]) << shifts[a])``, each axis with the bits its span
     of the voxels needs; None when they need more than 32 bits together, or when
-    the greatest corner packs to NO_CELL (the shader's word for no hit: every
-    span a full 32 bits of ones). An axis with one value takes no bits (shift
-    and mask 0)."""
+    the greatest cell packs to NO_CELL, the shader's word for no hit (32 bits,
+    every span all ones). An axis with one value takes no bits (shift and mask 0)."""
     offset, top = _cell_box(vox)
     bits = [int(span).bit_length() for span in top - offset]
     if sum(bits) > PACKED_BITS:
