@@ -6,17 +6,20 @@
 // order. Each invocation takes one ray (sorted position s, ray order[s]) down
 // its tile's list: it stops at the first entry whose `rest` (the least voxel
 // near from there to the end of the list, numba's tile stop) is at or beyond
-// the ray's bound, and slab-tests every voxel before it; a hit strictly nearer
-// than the bound becomes the bound (of equal entries the first listed stays,
-// as in numba). The bound starts where the ray leaves the occupied box (every
-// hit starts before that).
+// the nearest hit so far, and slab-tests every voxel before it; a hit strictly
+// nearer becomes the bound (of equal entries the first listed stays, as in
+// numba). numba's bound where the ray leaves the occupied box is left out:
+// no hit starts beyond it, and on lavapipe its three slabs cost more than the
+// entries it spared (the tile tests ran 1.04-1.09x faster without it).
 //
-// lavapipe loads a storage value lane by lane, so the layout counts words:
-// an entry is two (rest as float32 rounded down, still a lower bound; the
-// voxel's cell packed into one u32 relative to the scan's offset), and the
-// shader writes the hit's packed cell alone (NO_CELL: none): the host unpacks
-// it and recomputes t with the same slab test. In f64 the answers are
-// numba's bit for bit (tests/test_wgpu_object_order.py).
+// lavapipe runs eight invocations as one vector and pays for every operation
+// in the entry loop, so the loop holds as few as it can: an entry is two words
+// (rest as float32 rounded down, still a lower bound; the voxel's cell packed
+// into one u32 relative to the scan's offset), the offset rides in each ray's
+// face offsets, and a still axis costs one mask test. The shader
+// writes the hit's packed cell alone (NO_CELL: none): the host unpacks it and
+// recomputes t with the same slab test. In f64 the answers are numba's bit for
+// bit (tests/test_wgpu_object_order.py).
 //
 // tracing/wgpu_scans.py prepends the header of tracing/config.py (wgsl_constants:
 // `alias real = f64;`, INF, BUNDLE, ...) and shaders/axis.wgsl.
@@ -27,11 +30,9 @@ struct TileParams {
     tile_shift: u32,         // tiles of 1 << tile_shift bins a side
     one_per_bin: u32,        // 1: sorted position s is in tile s >> (2 * tile_shift)
     one_origin: u32,         // 1: every ray starts at origins[0..3] (one row sent)
-    shifts: vec4<u32>,       // packed cell: axis a is (cell >> shifts[a]) & masks[a]
+    shifts: vec4<u32>,       // packed cell: axis a is (cell >> shifts[a]) & masks[a] (at most 31 bits)
     masks: vec4<u32>,
     offset: vec4<i32>,       // cell of packed (0, 0, 0)
-    box_lo: vec4<i32>,       // the occupied box, hi exclusive
-    box_hi: vec4<i32>,
 }
 
 @group(0) @binding(0) var<uniform> params: TileParams;
@@ -43,27 +44,27 @@ struct TileParams {
 @group(0) @binding(6) var<storage, read> entries: array<vec2<u32>>; // rest (f32 bits), packed cell
 @group(0) @binding(7) var<storage, read_write> found: array<u32>;  // per ray: packed cell of its hit, NO_CELL none
 
-// The packed cell of the first voxel the ray meets before `bound` among entries
-// first .. last, NO_CELL none. `enter_face` and `leave_face` are per axis the cell
-// offsets (0 or 1) of the faces the ray enters and leaves a cell by, so each
-// slab parameter is the reference tracer's boundary_t, bit for bit, with no
-// min or max (lavapipe's are slow). A still axis (d = 0) has no faces: the ray
-// is inside the open slab for every t or never, which `still` checks (one loop
-// for both kinds of ray: two inlined copies of it, one per value, made the
-// tile tests on lavapipe 1.03-1.11x slower).
-fn first_hit(first: u32, last: u32, bound: real, o: vec3<real>, d: vec3<real>, inv: vec3<real>,
-             enter_face: vec3<real>, leave_face: vec3<real>, still: bool) -> u32 {
-    let offset = vec3<real>(params.offset.xyz);
-    var best = bound;
+// The packed cell of the first voxel the ray meets among entries first .. last,
+// NO_CELL none. `enter_face` and `leave_face` are per axis the cells' offset
+// plus the face (0 or 1) the ray enters and leaves a cell by, so each slab
+// parameter is the reference tracer's boundary_t of the face's coordinate, bit
+// for bit (sums of small integers are exact), with no min or max (lavapipe's
+// are slow). A still axis (d = 0) has no faces: the ray is inside the open slab
+// of one cell there or of none, which `still_axis` made a test of the packed
+// cell, (cell & still_mask) == still_cell (always true when no axis is still).
+fn first_hit(first: u32, last: u32, o: vec3<real>, inv: vec3<real>, enter_face: vec3<real>,
+             leave_face: vec3<real>, still_mask: u32, still_cell: u32) -> u32 {
+    var best = INF;
     var hit = NO_CELL;
     for (var e = first; e < last; e++) {
         let entry = entries[e];
         if (real(bitcast<f32>(entry.x)) >= best) {
-            break;  // no voxel from here on starts before the bound
+            break;  // no voxel from here on starts before the nearest hit
         }
-        let x = offset.x + real((entry.y >> params.shifts.x) & params.masks.x);
-        let y = offset.y + real((entry.y >> params.shifts.y) & params.masks.y);
-        let z = offset.z + real((entry.y >> params.shifts.z) & params.masks.z);
+        // Axes of at most 31 bits: i32's conversion is lavapipe's cheap one.
+        let x = real(i32((entry.y >> params.shifts.x) & params.masks.x));
+        let y = real(i32((entry.y >> params.shifts.y) & params.masks.y));
+        let z = real(i32((entry.y >> params.shifts.z) & params.masks.z));
         let ex = boundary_t(x + enter_face.x, o.x, inv.x);
         let ey = boundary_t(y + enter_face.y, o.y, inv.y);
         let ez = boundary_t(z + enter_face.z, o.z, inv.z);
@@ -74,11 +75,9 @@ fn first_hit(first: u32, last: u32, bound: real, o: vec3<real>, d: vec3<real>, i
         enter = select(enter, ez, ez > enter);
         var leave = select(lx, ly, ly < lx);
         leave = select(leave, lz, lz < leave);
-        if (still) {
-            let inside = (d.x != 0.0 || (x < o.x && o.x < x + 1.0)) && (d.y != 0.0 || (y < o.y && o.y < y + 1.0))
-                && (d.z != 0.0 || (z < o.z && o.z < z + 1.0));
-            enter = select(INF, enter, inside);
-        }
+        // (Outside a still axis's slab its parameters are +-inf or NaN; inside,
+        // -inf and +inf, which the slab passes over.)
+        enter = select(INF, enter, (entry.y & still_mask) == still_cell);
         let start = select(enter, 0.0, enter < 0.0);
         if (start < leave && start < best) {
             best = start;
@@ -86,6 +85,19 @@ fn first_hit(first: u32, last: u32, bound: real, o: vec3<real>, d: vec3<real>, i
         }
     }
     return hit;
+}
+
+// One axis's share of the still test, as (mask, cell, never) over packed cells:
+// (0, 0, 0) when the ray moves along the axis. When it does not, the ray is in
+// the open slab of cell c (c < o < c + 1) only for c = floor(o), and never when
+// o lies on a face or that cell is outside the packing's span.
+fn still_axis(o: real, d: real, offset: i32, shift: u32, mask: u32) -> vec3<u32> {
+    if (d != 0.0) {
+        return vec3<u32>(0u);
+    }
+    let c = floor(o) - real(offset);
+    let never = floor(o) == o || c < 0.0 || c > real(mask);
+    return vec3<u32>(mask << shift, u32(clamp(c, 0.0, real(mask))) << shift, select(0u, 1u, never));
 }
 
 // numba: test_tiles (tracing/tile_tests.py)
@@ -109,14 +121,18 @@ fn test_tiles(@builtin(workgroup_id) group: vec3<u32>,
     let o = vec3<real>(origins[ob], origins[ob + 1u], origins[ob + 2u]);
     let d = vec3<real>(directions[b], directions[b + 1u], directions[b + 2u]);
     let inv = select(vec3<real>(INF), vec3<real>(1.0) / d, d != vec3<real>(0.0));
-    let lo = vec3<real>(params.box_lo.xyz);
-    let hi = vec3<real>(params.box_hi.xyz);
-    // Where it leaves the occupied box: every hit starts before that.
-    let bound = min(slab(o.x, d.x, inv.x, lo.x, hi.x).leave,
-                    min(slab(o.y, d.y, inv.y, lo.y, hi.y).leave, slab(o.z, d.z, inv.z, lo.z, hi.z).leave));
-    let enter_face = select(vec3<real>(0.0), vec3<real>(1.0), d < vec3<real>(0.0));
-    let leave_face = vec3<real>(1.0) - enter_face;
+    let face = select(vec3<real>(0.0), vec3<real>(1.0), d < vec3<real>(0.0));
+    let offset = vec3<real>(params.offset.xyz);
+    // (Loaded before the still test: after it, the tile tests ran 1.04-1.08x slower on lavapipe.)
     let first = tile_starts[tile];
     let last = tile_starts[tile + 1u];
-    found[r] = first_hit(first, last, bound, o, d, inv, enter_face, leave_face, any(d == vec3<real>(0.0)));
+    let sx = still_axis(o.x, d.x, params.offset.x, params.shifts.x, params.masks.x);
+    let sy = still_axis(o.y, d.y, params.offset.y, params.shifts.y, params.masks.y);
+    let sz = still_axis(o.z, d.z, params.offset.z, params.shifts.z, params.masks.z);
+    // No cell matches all ones (cell_packing keeps NO_CELL free).
+    let never = (sx.z | sy.z | sz.z) != 0u;
+    let still_mask = select(sx.x | sy.x | sz.x, NO_CELL, never);
+    let still_cell = select(sx.y | sy.y | sz.y, NO_CELL, never);
+    found[r] = first_hit(first, last, o, inv, face + offset, (vec3<real>(1.0) - face) + offset, still_mask,
+                         still_cell);
 }

@@ -59,12 +59,13 @@ class ShaderScan(NamedTuple):
 def cell_packing(vox):
     """(offset, shifts, masks) that pack cell ``vox[e, :3]`` into one u32 as
     ``sum((cell[a] - offset[a]) << shifts[a])``, each axis with the bits its span
-    of the voxels needs; None when they need more than 32 bits together, or when
-    the greatest cell packs to NO_CELL, the shader's word for no hit (32 bits,
-    every span all ones). An axis with one value takes no bits (shift and mask 0)."""
+    of the voxels needs; None when they need more than 32 bits together or one
+    axis needs 32 (the shader unpacks an axis as i32), or when the greatest cell
+    packs to NO_CELL, the shader's word for no hit (32 bits, every span all
+    ones). An axis with one value takes no bits (shift and mask 0)."""
     offset, top = _cell_box(vox)
     bits = [int(span).bit_length() for span in top - offset]
-    if sum(bits) > PACKED_BITS:
+    if sum(bits) > PACKED_BITS or max(bits) >= PACKED_BITS:
         return None
     shifts = np.array([0, bits[0], bits[0] + bits[1]], np.int64) * (np.array(bits) > 0)
     masks = np.array([(1 << b) - 1 for b in bits], np.int64)

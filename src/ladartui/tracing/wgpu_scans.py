@@ -55,18 +55,17 @@ def dispatch_encoder(device, limits: dict[str, int], pipeline, group, rays: int)
 
 # Bindings of shaders/object_order.wgsl, in order.
 SCAN_BINDINGS = ("params", "origins", "directions", "order", "ray_tiles", "tile_starts", "entries", "found")
-# Its uniform block, struct TileParams: six vec4 of 32-bit integers.
-TILE_PARAMS_BYTES = 6 * 16
+# Its uniform block, struct TileParams: four vec4 of 32-bit integers.
+TILE_PARAMS_BYTES = 4 * 16
 
 
-def pack_tile_params(rays, scan, occupancy, shared_origin=False) -> bytes:
+def pack_tile_params(rays, scan, shared_origin=False) -> bytes:
     """The uniform block of one object-order dispatch, laid out as ``struct TileParams``
     (``shared_origin``: every ray starts at the one origin sent)."""
     offset, shifts, masks = scan.packing
-    ints = np.zeros((6, 4), dtype=np.int64)
+    ints = np.zeros((4, 4), dtype=np.int64)
     ints[0] = (rays, scan.tile_shift, 0 if len(scan.ray_tiles) else 1, 1 if shared_origin else 0)
     ints[1, :3], ints[2, :3], ints[3, :3] = shifts, masks, offset
-    ints[4, :3], ints[5, :3] = occupancy.bbox_lo, occupancy.bbox_hi
     return ints.astype(np.uint32).tobytes()  # the i32 fields as their two's complement
 
 
@@ -103,7 +102,7 @@ class ScanDispatcher:
             self._compiled = pipeline
         return self._compiled
 
-    def test_tiles(self, occupancy, origins, directions, scan, shared_origin=False) -> np.ndarray | None:
+    def test_tiles(self, origins, directions, scan, shared_origin=False) -> np.ndarray | None:
         """Each ray's hit as its packed cell (``scan.packing``; NO_CELL none), from
         shaders/object_order.wgsl; None when an array exceeds a storage binding.
         ``shared_origin``: every ray starts at ``origins[0]``, the one row sent."""
@@ -125,7 +124,7 @@ class ScanDispatcher:
         buffers = {name: self._buffer(name, size) for name, size in sizes.items()}
         buffers["params"] = self._buffer("params", TILE_PARAMS_BYTES, uniform=True)
         queue = self._device.queue
-        queue.write_buffer(buffers["params"], 0, pack_tile_params(n, scan, occupancy, shared_origin))
+        queue.write_buffer(buffers["params"], 0, pack_tile_params(n, scan, shared_origin))
         for name, array in inputs.items():
             self._fill(name, buffers[name], np.ascontiguousarray(array))
         pipeline = self._pipeline()
