@@ -239,7 +239,7 @@ def test_tile_lists_keep_the_nearest_first_order(shift, tiles, threads):
     vox[:, 3], vox[:, 5] = low[:, 0], low[:, 1]
     vox[:, 4] = np.minimum(low[:, 0] + rng.integers(-1, 2 * tile, n), tile * tiles - 1)
     vox[:, 6] = np.minimum(low[:, 1] + rng.integers(0, 2 * tile, n), tile * tiles - 1)
-    starts, listed = voxels_per_tile(vox, tiles, shift, threads)
+    starts, listed = voxels_per_tile(vox, tiles, shift, threads, np.arange(n))
     expected = [[] for _ in range(tiles * tiles)]
     for e in range(n):
         if vox[e, 3] <= vox[e, 4]:
@@ -249,6 +249,11 @@ def test_tile_lists_keep_the_nearest_first_order(shift, tiles, threads):
     assert sum(map(len, expected)) == len(listed) > n
     for at, voxels in enumerate(expected):
         assert listed[starts[at] : starts[at + 1]].tolist() == voxels
+    # With a payload (the shader's words), each place holds its voxel's payload instead.
+    payload = rng.integers(0, 1 << 63, n, dtype=np.uint64) * 2 + 1
+    paid_starts, paid = voxels_per_tile(vox, tiles, shift, threads, payload)
+    assert paid.dtype == np.uint64 and np.array_equal(paid_starts, starts)
+    assert np.array_equal(paid, payload[listed])
 
 
 def test_bins_are_numbered_tile_by_tile():

@@ -11,7 +11,7 @@ from ladartui.sensor import Sensor
 from ladartui.tracing.backend import GROUND, MISS, VOXEL
 from ladartui.tracing.config import NO_CELL
 from ladartui.tracing.reference import reference_trace_cells
-from ladartui.tracing.shader_scan import cell_packing, ray_tiles_of, tile_entries, voxel_words
+from ladartui.tracing.shader_scan import cell_packing, ray_tiles_of, tile_rests, voxel_words
 from scans import assert_same, forest_scene, numpy_with_junk_empty, one_scan, random_scan
 
 # The wgpu_backend and numba_backend fixtures come from tests/conftest.py.
@@ -224,7 +224,9 @@ def test_cells_pack_into_one_word_and_back():
         tile_starts = np.array([0, len(vox)])
         listed = rng.permutation(len(vox))
         words = voxel_words(vox, np.zeros((len(vox), 2)), offset, shifts)
-        packed = tile_entries(tile_starts, listed, words)[:, 1]
+        entries = words[listed]
+        tile_rests(tile_starts, entries)
+        packed = entries[:, 1]
         cells = np.stack([(packed >> np.uint32(shifts[a])) & np.uint32(masks[a]) for a in range(3)], axis=1)
         assert np.array_equal(cells.astype(np.int64) + offset, vox[listed, :3])
     vox[:2, :3] = [0, 0, 0], [1 << 11, 1 << 11, 1 << 10]  # 12 + 12 + 11 bits
@@ -243,7 +245,7 @@ def test_cells_pack_into_one_word_and_back():
     assert cell_packing(vox) is not None
 
 
-def test_tile_entries_carry_the_least_near_still_to_come_rounded_down():
+def test_tile_rests_carry_the_least_near_still_to_come_rounded_down():
     rng = np.random.default_rng(9)
     m = 3000
     vox = np.zeros((m, 7), np.int64)
@@ -251,8 +253,9 @@ def test_tile_entries_carry_the_least_near_still_to_come_rounded_down():
     tile_starts = np.array([0, 0, 700, 701, 2900, 4000])
     listed = rng.integers(0, m, tile_starts[-1])
     words = voxel_words(vox, nears, np.zeros(3, np.int64), np.zeros(3, np.int64))
-    rests = tile_entries(tile_starts, listed, words)[:, 0]
-    rests = rests.view(np.float32).astype(np.float64)
+    entries = words[listed]
+    tile_rests(tile_starts, entries)
+    rests = entries[:, 0].view(np.float32).astype(np.float64)
     exact = np.concatenate(
         [
             np.minimum.accumulate(nears[listed[a:b], 0][::-1])[::-1]

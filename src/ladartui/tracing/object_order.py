@@ -314,16 +314,17 @@ def _emit_brick(e, bricks_found, brick_near, first, bricks, centre, grow, axis, 
 
 
 @njit(nogil=True, cache=True, inline="always")
-def _visit_tiles(vox, first, last, shift, nt, slots, listed, place):
+def _visit_tiles(vox, first, last, shift, nt, slots, listed, payload, place):
     """For voxels first..last, every tile each covers: count it in ``slots[tile]``, or
-    (``place``) put the voxel at ``listed[slots[tile]]`` and step that slot on."""
+    (``place``) put the voxel's ``payload[e]`` at ``listed[slots[tile]]`` and step
+    that slot on."""
     for e in range(first, last):
         if vox[e, 3] > vox[e, 4]:
             continue
         for tj in range(vox[e, 5] >> shift, (vox[e, 6] >> shift) + 1):
             for ti in range(vox[e, 3] >> shift, (vox[e, 4] >> shift) + 1):
                 if place:
-                    listed[slots[tj * nt + ti]] = e
+                    listed[slots[tj * nt + ti]] = payload[e]
                 slots[tj * nt + ti] += 1
 
 
@@ -356,8 +357,10 @@ def _run_places(counts):
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def voxels_per_tile(vox, tiles_per_side, shift, threads):
-    """For each tile of ``1 << shift`` bins a side, the voxels covering it, in list order (CSR).
+def voxels_per_tile(vox, tiles_per_side, shift, threads, payload):
+    """For each tile of ``1 << shift`` bins a side, the voxels covering it, in list order
+    (CSR), as ``payload[e]`` for voxel e: numba lists the voxels' numbers, the wgpu
+    backend the words its shader reads (which saves a pass gathering them).
 
     A counting sort in runs of voxels: each run counts and then places its own
     entries, after those of the runs before it, so list order is kept (and does
@@ -369,21 +372,34 @@ def voxels_per_tile(vox, tiles_per_side, shift, threads):
     n = vox.shape[0]
     runs = max(2, min(PARTS, 2 * threads, (1 << 18) // (nt * nt)))
     counts = np.zeros((runs, nt * nt), np.int64)  # each run counts in its own row
-    nothing = np.empty(0, np.int64)
+    listed = np.empty(0, payload.dtype)
     for k in prange(runs):
-        _visit_tiles(vox, k * n // runs, (k + 1) * n // runs, shift, nt, counts[k], nothing, False)
+        _visit_tiles(vox, k * n // runs, (k + 1) * n // runs, shift, nt, counts[k], listed, payload, False)
     starts = _run_places(counts)
-    listed = np.empty(starts[-1], np.int64)
+    listed = np.empty(starts[-1], payload.dtype)
     for k in prange(runs):
-        _visit_tiles(vox, k * n // runs, (k + 1) * n // runs, shift, nt, counts[k], listed, True)
+        _visit_tiles(vox, k * n // runs, (k + 1) * n // runs, shift, nt, counts[k], listed, payload, True)
     return starts, listed
 
 
 def scan_voxels(occ, frame, grid, nb, max_voxels, tile_shift):
     """(vox, nears, tile_starts, listed): the voxels in view of a scan whose rays are
-    binned by ``grid`` (``emit_voxels``), listed per tile of ``1 << tile_shift`` bins a
-    side (``voxels_per_tile``); None when a brick straddles the aircraft's plane near
-    it, or when more than ``max_voxels`` are in view."""
+    binned by ``grid`` (``voxels_in_view``), listed per tile of ``1 << tile_shift`` bins
+    a side (``voxels_per_tile``); None when ``voxels_in_view`` finds none to give."""
+    found = voxels_in_view(occ, frame, grid, nb, max_voxels)
+    if found is None:
+        return None
+    vox, nears = found
+    numbers = np.arange(len(vox), dtype=np.int64)
+    tiles = -(-nb >> tile_shift)
+    tile_starts, listed = voxels_per_tile(vox, tiles, tile_shift, numba.get_num_threads(), numbers)
+    return vox, nears, tile_starts, listed
+
+
+def voxels_in_view(occ, frame, grid, nb, max_voxels):
+    """(vox, nears) of ``emit_voxels`` for the voxels in view of a scan whose rays are
+    binned by ``grid``; None when a brick straddles the aircraft's plane near it, or
+    when more than ``max_voxels`` are in view."""
     centre, grow, axis, u, v = frame
     found, brick_near, ok = bricks_in_view(
         centre,
@@ -404,6 +420,4 @@ def scan_voxels(occ, frame, grid, nb, max_voxels, tile_shift):
     first = voxel_starts(found, occ.bricks)
     if first[-1] > max_voxels:
         return None
-    vox, nears = emit_voxels(found, brick_near, first, occ.bricks, centre, grow, axis, u, v, grid, nb)
-    tile_starts, listed = voxels_per_tile(vox, -(-nb >> tile_shift), tile_shift, numba.get_num_threads())
-    return vox, nears, tile_starts, listed
+    return emit_voxels(found, brick_near, first, occ.bricks, centre, grow, axis, u, v, grid, nb)

@@ -3,13 +3,14 @@ shaders/object_order.wgsl, and the shader's hits made answers.
 
 The steps are numba's (tracing/tile_tests.py's ``trace_scan``): the rays in bin
 order (``scan_rays.bin_order``, no copies: the shader reads each ray through
-the order), the voxels in view listed per tile (``object_order.scan_voxels``).
-What differs is the shape of the lists. The shader runs one invocation per ray
-and lavapipe loads storage lane by lane, so each word an invocation reads
-costs: a tile's entry is two u32 (``tile_entries``), the least voxel ``near``
-from it to the end of its list (the tile stop numba takes per tile, here per
-ray) and the voxel's cell packed into one word relative to the voxels' least
-corner (``cell_packing``). The shader writes back the packed cell of each ray's
+the order), the voxels in view (``object_order.voxels_in_view``) listed per
+tile (``object_order.voxels_per_tile``). What differs is the shape of the
+lists. The shader runs one invocation per ray and lavapipe loads storage lane
+by lane, so each word an invocation reads costs: a tile's entry is two u32
+(``voxel_words``, listed as they are, then ``tile_rests``), the least voxel
+``near`` from it to the end of its list (the tile stop numba takes per tile,
+here per ray) and the voxel's cell packed into one word relative to the
+voxels' least corner (``cell_packing``). The shader writes back the packed cell of each ray's
 hit; ``entry_answers`` unpacks it and recomputes ``t`` with the slab test both
 tracers share (``answers.voxel_entry``), reading nothing but the rays.
 """
@@ -18,12 +19,13 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
+import numba
 import numpy as np
 from numba import njit, prange
 
 from ladartui.tracing.answers import ray_answer, voxel_entry
 from ladartui.tracing.config import INF, NO_CELL, PARTS
-from ladartui.tracing.object_order import scan_voxels
+from ladartui.tracing.object_order import voxels_in_view, voxels_per_tile
 from ladartui.tracing.scan_rays import bin_order, scan_grid
 
 PACKED_BITS = 32  # a packed cell is one u32
@@ -111,23 +113,19 @@ def voxel_words(vox, nears, offset, shifts):
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def tile_entries(tile_starts, listed, words):
-    """Each tile's entries as the shader reads them: (E, 2) u32, the least voxel
-    ``near`` from this entry to the end of its tile's list (of ``voxel_words``'
-    float32 nears: rounding down commutes with the minimum) and the packed cell."""
-    entries = np.empty((listed.shape[0], 2), np.uint32)
-    as_float = entries.view(np.float32)
-    near = words.view(np.float32)
+def tile_rests(tile_starts, entries):
+    """In place: each tile's entries (rows ``tile_starts[k] .. tile_starts[k + 1]`` of
+    (E, 2) u32, ``voxel_words``' words as listed) get in their first word the least
+    float32 near from that entry to the end of the list (rounding down commutes with
+    the minimum)."""
+    near = entries.view(np.float32)
     for tile in prange(tile_starts.shape[0] - 1):
         first, end = tile_starts[tile], tile_starts[tile + 1]
-        rest = INF
+        rest = np.float32(np.inf)
         for k in range(end - first):  # last entry first (a reversed range ran slower)
             e = end - 1 - k
-            q = listed[e]
-            rest = min(rest, np.float64(near[q, 0]))
-            as_float[e, 0] = np.float32(rest)
-            entries[e, 1] = words[q, 1]
-    return entries
+            rest = min(rest, near[e, 0])
+            near[e, 0] = rest
 
 
 @njit(parallel=True, nogil=True, cache=True)
@@ -153,23 +151,22 @@ def prepare_shader_scan(occ, orig, dirs, frame, max_voxels, tile_shift):
         return None
     nb, p, q, grid = binned
     order, bin_starts, grid = bin_order(p, q, grid, nb, tile_shift)
-    voxels = scan_voxels(occ, frame, grid, nb, max_voxels, tile_shift)
+    voxels = voxels_in_view(occ, frame, grid, nb, max_voxels)
     if voxels is None:
         return None
-    vox, nears, tile_starts, listed = voxels
+    vox, nears = voxels
     packing = cell_packing(vox)
     if packing is None:
         return None
     offset, shifts, _ = packing
+    # The lists hold the shader's words themselves (two u32 as one u64 each).
+    words = voxel_words(vox, nears, offset, shifts).view(np.uint64).reshape(-1)
+    tiles = -(-nb >> tile_shift)
+    tile_starts, listed = voxels_per_tile(vox, tiles, tile_shift, numba.get_num_threads(), words)
+    entries = listed.view(np.uint32).reshape(-1, 2)
+    tile_rests(tile_starts, entries)
     ray_tiles = ray_tiles_of(bin_starts, tile_shift) if len(bin_starts) else np.empty(0, np.uint32)
-    return ShaderScan(
-        order,
-        ray_tiles,
-        tile_starts.astype(np.uint32),
-        tile_entries(tile_starts, listed, voxel_words(vox, nears, offset, shifts)),
-        packing,
-        tile_shift,
-    )
+    return ShaderScan(order, ray_tiles, tile_starts.astype(np.uint32), entries, packing, tile_shift)
 
 
 @njit(parallel=True, nogil=True, cache=True)
