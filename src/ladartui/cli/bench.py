@@ -303,6 +303,7 @@ def run_bench(quick=False, runs=None) -> dict:
                         "rays": len(origins),
                         "rays_per_second": len(origins) / median,
                         "median_seconds": median,
+                        "run_seconds": times[name],  # run by run, in turn with the others
                         "first_call_seconds": first[name],
                         # On a shared machine wall time includes waiting for the
                         # cores; rays per CPU-second (all threads) does not.
@@ -347,16 +348,19 @@ def warm_up(trace_once, most=WARM_MOST_S, window=WARM_WINDOW_S, clock=time.perf_
 
 
 def _add_ratios(results):
-    """Each row's rays/s as a share of numba's on the same method, view and angle
-    (``vs_numba``)."""
+    """Each row's speed as a share of numba's on the same method, view and angle
+    (``vs_numba``): the median over runs of numba's time over the row's in the same
+    turn, so a slow spell of the machine, which falls on both runs of a turn, moves
+    it less than it moves either median."""
     numba = {
-        (r["method"], r["view"], r["depression"]): r["rays_per_second"]
+        (r["method"], r["view"], r["depression"]): r["run_seconds"]
         for r in results
         if r["backend"] == "numba"
     }
     for row in results:
         base = numba.get((row["method"], row["view"], row["depression"]))
-        row["vs_numba"] = row["rays_per_second"] / base if base else None
+        pairs = [b / t for b, t in zip(base or (), row["run_seconds"]) if t > 0]
+        row["vs_numba"] = statistics.median(pairs) if pairs else None
 
 
 def _print_table(report):
