@@ -545,3 +545,23 @@ def test_numba_times_ray_order_on_a_sample_of_a_scan(forest, monkeypatch):
     assert second.info["order"] == "object"
     assert sum(kernel_rays) == pytest.approx(RAY_SAMPLE * len(origins), abs=4)
     assert_same(first, second)
+
+
+@pytest.mark.parametrize("order", ["object", "ray"])
+def test_one_origin_broadcast_to_every_ray_answers_as_rows_do(forest, numba_backend, order):
+    """rays_to_cells gives a pinhole scan's origins as one row broadcast: both orders read
+    it (object order its one row, ray order rows made per block) with the same answers
+    as from rows of their own."""
+    from ladartui.tracing import TINY
+    from ladartui.tracing.prepare import rays_to_cells
+
+    _, occ = forest
+    origins, directions = one_scan([120, 120, 20], 45.0, 0.7, 300.0)
+    origins[:] = origins[0]
+    cells, unit, bounds = rays_to_cells(origins, directions, 1.0, TINY)
+    assert cells.strides[0] == 0
+    shared = numba_backend.trace_cells(occ, cells, unit, order=order, block_bounds=bounds)
+    rows = numba_backend.trace_cells(occ, np.array(cells), unit, order=order, block_bounds=bounds)
+    assert shared.info["order"] == rows.info["order"] == order
+    assert_same(rows, shared)
+    assert (shared.kind == VOXEL).mean() > 0.5

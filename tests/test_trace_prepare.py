@@ -110,3 +110,20 @@ def test_one_origin_is_read_from_the_block_bounds():
     assert not one_origin(two, 0, 2 * SCAN_BLOCK)
     assert one_origin(two, 0, SCAN_BLOCK) and one_origin(two, SCAN_BLOCK + 7, 2 * SCAN_BLOCK)
     assert one_origin(np.array([row, row]), 3, SCAN_BLOCK + 3)
+
+
+@pytest.mark.parametrize("n", [4096, SCAN_BLOCK + 5])
+def test_one_origin_for_every_ray_is_one_row_broadcast(n):
+    """A pinhole scan's origins are one cell broadcast to every ray (no rows written);
+    two scans' blocks, each from its own point, get every row, as do runs of origins."""
+    rng = np.random.default_rng(n)
+    directions = rng.normal(size=(n, 3))
+    origins = np.tile([12.3, -4.5, 150.0], (n, 1))
+    cells, unit, bounds = rays_to_cells(origins, directions, 0.1, TINY)
+    assert cells.shape == (n, 3) and cells.strides[0] == 0 and not cells.flags.writeable
+    assert np.array_equal(cells, origins / 0.1 + 0.5)
+    assert np.array_equal(unit, rays_to_cells(origins + np.arange(n)[:, None], directions, 0.1, TINY)[1])
+    moved = origins.copy()
+    moved[n // 2 :] += [0.0, 0.0, 1e-3]  # a second point halfway (two scans, or two blocks)
+    cells, _, _ = rays_to_cells(moved, directions, 0.1, TINY)
+    assert cells.strides[0] == 24 and np.array_equal(cells, moved / 0.1 + 0.5)

@@ -355,3 +355,21 @@ def test_rays_from_one_origin_send_and_read_that_origin_alone(
         expected = numba_backend.trace_cells(occ, rays_from, directions, order="ray")
         assert result.info["order"] == "object" and sent == [shared]
         assert np.array_equal(result.kind, expected.kind) and np.array_equal(result.index, expected.index)
+
+
+@pytest.mark.parametrize("order", ["object", "ray"])
+def test_one_origin_broadcast_to_every_ray_answers_as_rows_do(forest, f64_backend, numba_backend, order):
+    """rays_to_cells' one origin row broadcast to every ray: the shader's object order
+    sends and reads that row, its ray order gets rows; the answers are numba's."""
+    from ladartui.tracing import TINY
+    from ladartui.tracing.prepare import rays_to_cells
+
+    _, occ = forest
+    origins, directions = one_scan([120, 120, 20], 45.0, 0.7, 300.0)
+    origins[:] = origins[0]
+    cells, unit, bounds = rays_to_cells(origins, directions, 1.0, TINY)
+    assert cells.strides[0] == 0
+    gpu = f64_backend.trace_cells(occ, cells, unit, order=order, block_bounds=bounds)
+    assert gpu.info["order"] == order
+    assert_same(numba_backend.trace_cells(occ, np.array(cells), unit, order="ray"), gpu)
+    assert (gpu.kind == VOXEL).mean() > 0.5

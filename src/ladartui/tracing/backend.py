@@ -69,6 +69,8 @@ class Backend(Protocol):
         block_bounds=None,
     ) -> CellHits:
         """Trace (N, 3) float64 cell-space origins and unit directions (``order``: ORDERS).
+        The origins may be one row broadcast to every ray (``prepare.rays_to_cells``
+        gives them so when all are one point; ``prepare.float_rows``).
 
         ``block_bounds``, when given, is ``prepare.rays_to_cells``'s third answer for these
         rays: per block of SCAN_BLOCK rays the origins' least and greatest cells and the

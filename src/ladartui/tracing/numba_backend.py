@@ -28,7 +28,7 @@ from ladartui.tracing.bundle import bundle_start, halo_arrays
 from ladartui.tracing.config import BLOCK, BUNDLE, INF, SCAN_BLOCK
 from ladartui.tracing.march import march_kernel
 from ladartui.tracing.order_choice import RAY_SAMPLE, OrderChoice, trace_in_blocks
-from ladartui.tracing.prepare import one_origin
+from ladartui.tracing.prepare import float_rows, one_origin
 from ladartui.tracing.scan_rays import cone_frame
 from ladartui.tracing.tile_tests import trace_scan
 
@@ -413,7 +413,7 @@ class NumbaBackend:
         ray at its box entry."""
         check_order(order)
         n = len(origins)
-        orig = np.ascontiguousarray(origins, dtype=np.float64)
+        orig = float_rows(origins)  # one row broadcast stays so: ray order makes rows per block
         dirs = np.ascontiguousarray(directions, dtype=np.float64)
         # Every path below writes every ray's answer (both kernels and the tile tests).
         kind = np.empty(n, np.uint8)
@@ -434,7 +434,7 @@ class NumbaBackend:
                 d = min(b, c + BLOCK)
                 if method == "exact":
                     _exact_kernel(
-                        orig[c:d],
+                        np.ascontiguousarray(orig[c:d]),
                         dirs[c:d],
                         occ.root,
                         occ.regions,
@@ -458,7 +458,7 @@ class NumbaBackend:
                     )
                 else:
                     march_kernel(
-                        orig[c:d],
+                        np.ascontiguousarray(orig[c:d]),
                         dirs[c:d],
                         float(step),
                         float(occ.zmax),
@@ -480,8 +480,11 @@ class NumbaBackend:
         def object_order_block(a, b, max_voxels):
             bounds = None if block_bounds is None else block_bounds[a // SCAN_BLOCK]
             shared = one_origin(block_bounds, a, b)
+            rows = (
+                orig[a : a + 1] if shared else np.ascontiguousarray(orig[a:b])
+            )  # shared: row 0 alone is read
             return self._object_order(
-                occ, orig[a:b], dirs[a:b], bounds, shared, max_voxels, nx, ny, kind[a:b], index[a:b], t[a:b]
+                occ, rows, dirs[a:b], bounds, shared, max_voxels, nx, ny, kind[a:b], index[a:b], t[a:b]
             )
 
         if method == "exact" and order != "ray" and occ.count > 0:
@@ -509,7 +512,7 @@ class NumbaBackend:
     @staticmethod
     def _object_order(occ, orig, dirs, bounds, shared_origin, max_voxels, nx, ny, kind, index, t):
         """Trace one scan in object order into kind/index/t; False when it is no scan for it.
-        ``shared_origin``: every ray starts at ``orig[0]``."""
+        ``shared_origin``: every ray starts at ``orig[0]`` (then the only row given)."""
         frame = cone_frame(orig, dirs, bounds)
         return frame is not None and trace_scan(
             occ, orig, dirs, frame, max_voxels, nx, ny, kind, index, t, shared_origin=shared_origin

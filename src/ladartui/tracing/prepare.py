@@ -5,8 +5,8 @@ operations in the same order, so the same bits), without their temporaries:
 on a 262,144-ray scan the numpy passes cost a fifth of a nadir trace. The pass
 is bound by its divisions, so it runs on every core (2.8 ms serial, 1.4 ms on
 two), and a ray from the same origin as the one before reuses its cell (a
-scan's rays often share one); a serial pass then finds the first bad ray, if
-any, for the message.
+scan's rays often share one); when all do, the cells are one row broadcast. A
+serial pass then finds the first bad ray, if any, for the message.
 """
 
 import numba
@@ -52,11 +52,25 @@ def _first_bad_ray(origins, directions):
     return n
 
 
+@numba.njit(nogil=True, cache=True, inline="always")
+def _item_rays(item, n, block):
+    """The rays of work item ``item``: PARTS items share each ``block`` rays."""
+    first = item // PARTS * block
+    m = min(n, first + block) - first
+    k = item % PARTS
+    return first + k * m // PARTS, first + (k + 1) * m // PARTS
+
+
 @numba.njit(parallel=True, nogil=True, cache=True)
-def _rays_to_cells(origins, directions, voxel_size, tiny, block, cells, unit, bounds):
+def _rays_to_cells(origins, directions, voxel_size, tiny, block, cells, unit, bounds, repeats):
     """cells = o / voxel_size + 0.5; unit = d / sqrt(dx*dx + dy*dy + dz*dz), |u| < tiny -> 0
     (d scaled first where its squares would under- or overflow). True when no ray is
     bad (a non-finite value or a zero-length direction).
+
+    A ray from the same origin as the ray before it gets no cell written (a scan's
+    rays often share one): ``repeats[item]`` says that some ray of the work item
+    (``_item_rays``) was one, and ``_fill_repeats`` completes the cells when they
+    are not all one point.
 
     ``bounds[b]`` gets the least and greatest cell of the origins and the sum of the
     unit directions of rays ``b * block ..`` (``scan_rays.ray_bounds``, summed in
@@ -66,32 +80,34 @@ def _rays_to_cells(origins, directions, voxel_size, tiny, block, cells, unit, bo
     bad = np.zeros(items, np.bool_)
     part = np.empty((items, 9))
     for item in prange(items):
-        first = item // PARTS * block
-        m = min(n, first + block) - first
-        k = item % PARTS
         lo = np.full(3, INF)
         hi = np.full(3, -INF)
         total = np.zeros(3)
-        last = np.full(3, np.nan)  # the previous origin and its cell: a scan's rays share one
+        last = np.full(3, np.nan)  # the previous origin and its cell
         last_cell = np.empty(3)
-        for i in range(first + k * m // PARTS, first + (k + 1) * m // PARTS):
+        repeated = False
+        first, end = _item_rays(item, n, block)
+        for i in range(first, end):
             d = _scaled(directions[i, 0], directions[i, 1], directions[i, 2])
             if not d[3] > 0:
                 bad[item] = True
             same = origins[i, 0] == last[0] and origins[i, 1] == last[1] and origins[i, 2] == last[2]
+            repeated |= same
             for a in range(3):
                 if not (np.isfinite(origins[i, a]) and np.isfinite(directions[i, a])):
                     bad[item] = True
                 if not same:  # (equal inputs, equal bits: the division is the pass's cost)
                     last[a] = origins[i, a]
                     last_cell[a] = origins[i, a] / voxel_size + 0.5
+                    cells[i, a] = last_cell[a]
                 c = last_cell[a]
                 u = d[a] / d[3]
                 u = 0.0 if abs(u) < tiny else u
-                cells[i, a], unit[i, a] = c, u
+                unit[i, a] = u
                 lo[a], hi[a] = min(lo[a], c), max(hi[a], c)
                 total[a] += u
         part[item, :3], part[item, 3:6], part[item, 6:] = lo, hi, total
+        repeats[item] = repeated  # (once: the items' flags share a cache line)
     for b in range(bounds.shape[0]):
         bounds[b] = part[b * PARTS]
         for k in range(1, PARTS):
@@ -102,22 +118,49 @@ def _rays_to_cells(origins, directions, voxel_size, tiny, block, cells, unit, bo
     return not bad.any()
 
 
+@numba.njit(parallel=True, nogil=True, cache=True)
+def _fill_repeats(origins, block, cells, repeats):
+    """The cells ``_rays_to_cells`` left unwritten: a ray from the same origin as the
+    ray before it has that ray's cell (each item's first ray has its own)."""
+    n = origins.shape[0]
+    for item in prange(repeats.shape[0]):
+        if not repeats[item]:
+            continue
+        first, end = _item_rays(item, n, block)
+        for i in range(first + 1, end):
+            if origins[i, 0] == origins[i - 1, 0] and origins[i, 1] == origins[i - 1, 1]:
+                if origins[i, 2] == origins[i - 1, 2]:
+                    cells[i, 0], cells[i, 1], cells[i, 2] = cells[i - 1, 0], cells[i - 1, 1], cells[i - 1, 2]
+
+
 def rays_to_cells(origins, directions, voxel_size, tiny):
     """(cells, unit, bounds) for (N, 3) float64 arrays; FieldError naming the first bad
     ray: ``origins[i]`` or ``directions[i]`` with a non-finite value,
     ``directions[i]`` of zero length. ``bounds`` is (blocks, 9): per SCAN_BLOCK rays,
     the origins' least and greatest cells and the directions' sum (the backends'
     ``block_bounds``).
+
+    When every ray starts at one point, ``cells`` is that one cell broadcast to
+    (N, 3) (read-only, no rows of its own: a pinhole scan's 262,144 origins are not
+    written out); the backends read one row then, or make rows where they need them
+    (``float_rows``).
     """
     n = len(origins)
     cells = np.empty((n, 3))
     unit = np.empty((n, 3))
     bounds = np.empty((-(-n // SCAN_BLOCK), 9))
+    repeats = np.zeros(len(bounds) * PARTS, np.bool_)
     # Strided views (columns of one (N, 6) array) are read in place: a copy costs as much as the pass.
-    if _rays_to_cells(origins, directions, float(voxel_size), float(tiny), SCAN_BLOCK, cells, unit, bounds):
-        return cells, unit, bounds
-    first = _first_bad_ray(origins, directions)
+    ok = _rays_to_cells(
+        origins, directions, float(voxel_size), float(tiny), SCAN_BLOCK, cells, unit, bounds, repeats
+    )
+    first = n if ok else _first_bad_ray(origins, directions)
     if first == n:
+        if not repeats.any():
+            return cells, unit, bounds
+        if one_origin(bounds, 0, n):
+            return np.broadcast_to(cells[0].copy(), (n, 3)), unit, bounds
+        _fill_repeats(origins, SCAN_BLOCK, cells, repeats)
         return cells, unit, bounds
     if first < 0:
         raise FieldError(f"origins[{-1 - first}]", origins[-1 - first].tolist(), "finite numbers")
@@ -125,6 +168,15 @@ def rays_to_cells(origins, directions, voxel_size, tiny):
         raise FieldError(f"directions[{first}]", directions[first].tolist(), "finite numbers")
     zero = first - n - 1
     raise FieldError(f"directions[{zero}]", directions[zero].tolist(), "a non-zero vector")
+
+
+def float_rows(origins):
+    """``origins`` for the backends: ``rays_to_cells``' one cell broadcast to every ray
+    as it is (a path that reads a row per ray makes rows of its slice with
+    ``np.ascontiguousarray``), any other array as C-contiguous float64."""
+    if origins.ndim == 2 and origins.dtype == np.float64 and origins.strides[0] == 0:
+        return origins
+    return np.ascontiguousarray(origins, dtype=np.float64)
 
 
 def one_origin(block_bounds, first: int, end: int) -> bool:
