@@ -108,17 +108,27 @@ def test_tiles(
             continue
         # bin b of the tile: tile rays starts[b] .. starts[b + 1]; cols[s]: tile ray s's column
         starts = np.empty(tile_side * tile_side + 1, np.int64)
-        for b in range(tile_side * tile_side + 1):
-            starts[b] = b if single else bin_starts[base + b] - s0
         live = np.zeros(tile_side, np.int64)  # per row: bit c set while bin (bi0 + c) may still change
         cols = np.zeros(m + LANES, np.int64)
-        for r in range(bj1 - bj0 + 1):
-            for c in range(bi1 - bi0 + 1):
-                b = r * tile_side + c
-                if starts[b + 1] > starts[b]:
-                    live[r] |= np.int64(1) << c
-                for s in range(starts[b], starts[b + 1]):
-                    cols[s] = c
+        if single:  # every bin of the (whole) tile holds one ray: loops without branches
+            for b in range(tile_side * tile_side + 1):
+                starts[b] = b
+            for s in range(m):
+                cols[s] = s & (tile_side - 1)
+            width = bi1 - bi0 + 1
+            full = np.int64(-1) if width >= 64 else (np.int64(1) << width) - 1
+            for r in range(bj1 - bj0 + 1):
+                live[r] = full
+        else:
+            for b in range(tile_side * tile_side + 1):
+                starts[b] = bin_starts[base + b] - s0
+            for r in range(bj1 - bj0 + 1):
+                for c in range(bi1 - bi0 + 1):
+                    b = r * tile_side + c
+                    if starts[b + 1] > starts[b]:
+                        live[r] |= np.int64(1) << c
+                    for s in range(starts[b], starts[b + 1]):
+                        cols[s] = c
         # By rows: origin, direction, 1 / d; padded by LANES (slab_lanes reads 8 rays a call).
         ray = np.empty((9, m + LANES))
         ray[:, m:] = 0.0
