@@ -28,6 +28,19 @@ def one_scan(aim, depression_deg, azimuth_rad, slant_cells, sensor=None):
     return origins, directions
 
 
+def pinhole_scan_cells():
+    """(cells, unit, bounds) of ``rays_to_cells`` for one scan whose rays all start at
+    one point: the cells are that one row broadcast (checked here)."""
+    from ladartui.tracing import TINY
+    from ladartui.tracing.prepare import rays_to_cells
+
+    origins, directions = one_scan([120, 120, 20], 45.0, 0.7, 300.0)
+    origins[:] = origins[0]
+    cells, unit, bounds = rays_to_cells(origins, directions, 1.0, TINY)
+    assert cells.strides[0] == 0
+    return cells, unit, bounds
+
+
 def assert_same(a, b):
     """Two CellHits agree bit for bit: kind, voxel index and range of every ray."""
     assert np.array_equal(a.kind, b.kind), np.flatnonzero(a.kind != b.kind)[:5]

@@ -17,7 +17,7 @@ from ladartui.tracing.prepare import one_origin
 from ladartui.tracing.reference import reference_trace_cells
 from ladartui.tracing.scan_rays import cone_frame, ray_bounds
 from ladartui.tracing.tile_tests import trace_scan
-from scans import assert_same, forest_scene, numpy_with_junk_empty, one_scan, random_scan
+from scans import assert_same, forest_scene, numpy_with_junk_empty, one_scan, pinhole_scan_cells, random_scan
 
 
 @pytest.fixture(scope="module")
@@ -552,14 +552,8 @@ def test_one_origin_broadcast_to_every_ray_answers_as_rows_do(forest, numba_back
     """rays_to_cells gives a pinhole scan's origins as one row broadcast: both orders read
     it (object order its one row, ray order rows made per block) with the same answers
     as from rows of their own."""
-    from ladartui.tracing import TINY
-    from ladartui.tracing.prepare import rays_to_cells
-
     _, occ = forest
-    origins, directions = one_scan([120, 120, 20], 45.0, 0.7, 300.0)
-    origins[:] = origins[0]
-    cells, unit, bounds = rays_to_cells(origins, directions, 1.0, TINY)
-    assert cells.strides[0] == 0
+    cells, unit, bounds = pinhole_scan_cells()
     shared = numba_backend.trace_cells(occ, cells, unit, order=order, block_bounds=bounds)
     rows = numba_backend.trace_cells(occ, np.array(cells), unit, order=order, block_bounds=bounds)
     assert shared.info["order"] == rows.info["order"] == order

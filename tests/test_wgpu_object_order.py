@@ -12,7 +12,7 @@ from ladartui.tracing.backend import GROUND, MISS, VOXEL
 from ladartui.tracing.config import NO_CELL
 from ladartui.tracing.reference import reference_trace_cells
 from ladartui.tracing.shader_scan import cell_packing, ray_tiles_of, tile_rests, voxel_words
-from scans import assert_same, forest_scene, numpy_with_junk_empty, one_scan, random_scan
+from scans import assert_same, forest_scene, numpy_with_junk_empty, one_scan, pinhole_scan_cells, random_scan
 
 # The wgpu_backend and numba_backend fixtures come from tests/conftest.py.
 
@@ -361,14 +361,8 @@ def test_rays_from_one_origin_send_and_read_that_origin_alone(
 def test_one_origin_broadcast_to_every_ray_answers_as_rows_do(forest, f64_backend, numba_backend, order):
     """rays_to_cells' one origin row broadcast to every ray: the shader's object order
     sends and reads that row, its ray order gets rows; the answers are numba's."""
-    from ladartui.tracing import TINY
-    from ladartui.tracing.prepare import rays_to_cells
-
     _, occ = forest
-    origins, directions = one_scan([120, 120, 20], 45.0, 0.7, 300.0)
-    origins[:] = origins[0]
-    cells, unit, bounds = rays_to_cells(origins, directions, 1.0, TINY)
-    assert cells.strides[0] == 0
+    cells, unit, bounds = pinhole_scan_cells()
     gpu = f64_backend.trace_cells(occ, cells, unit, order=order, block_bounds=bounds)
     assert gpu.info["order"] == order
     assert_same(numba_backend.trace_cells(occ, np.array(cells), unit, order="ray"), gpu)
