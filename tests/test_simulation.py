@@ -209,3 +209,17 @@ def test_chunk_size_does_not_change_the_result(forest, monkeypatch):
     for a, b in zip(whole.scene_per_scan + whole.target_per_scan, rows.scene_per_scan + rows.target_per_scan):
         np.testing.assert_array_equal(a, b)
     assert rows.measures == whole.measures
+
+
+def test_fast_chunks_grow_to_a_whole_object_order_scan():
+    """Trace calls grow fourfold while fast, up to one object-order block (a 128 x 128
+    sensor's whole scan with 4 x 4 rays, which object order takes in one call), and
+    shrink at most fourfold after a slow one."""
+    from ladartui.tracing.config import SCAN_BLOCK
+
+    chunk, sizes = simulation._FIRST_CHUNK_RAYS, []
+    for _ in range(4):
+        chunk = simulation._next_chunk(chunk, chunk, 0.01)  # 10 ms a call: far under the goal
+        sizes.append(chunk)
+    assert sizes == [4 * simulation._FIRST_CHUNK_RAYS, SCAN_BLOCK, SCAN_BLOCK, SCAN_BLOCK]
+    assert simulation._next_chunk(SCAN_BLOCK, SCAN_BLOCK, 10.0) == SCAN_BLOCK // 4
