@@ -10,7 +10,7 @@
 // nearer becomes the bound (of equal entries the first listed stays, as in
 // numba). numba's bound where the ray leaves the occupied box is left out:
 // no hit starts beyond it, and on lavapipe its three slabs cost more than the
-// entries it spared (the tile tests ran 1.04-1.09x faster without it).
+// entries it spared (the tile tests ran 1.01-1.11x faster without it).
 //
 // lavapipe runs eight invocations as one vector and pays for every operation
 // in the entry loop, so the loop holds as few as it can: an entry is two words
