@@ -87,17 +87,21 @@ fn first_hit(first: u32, last: u32, o: vec3<real>, inv: vec3<real>, enter_face: 
     return hit;
 }
 
-// One axis's share of the still test, as (mask, cell, never) over packed cells:
-// (0, 0, 0) when the ray moves along the axis. When it does not, the ray is in
-// the open slab of cell c (c < o < c + 1) only for c = floor(o), and never when
-// o lies on a face or that cell is outside the packing's span.
-fn still_axis(o: real, d: real, offset: i32, shift: u32, mask: u32) -> vec3<u32> {
+// One axis's share of the still test, as (mask, cell) over packed cells, joined
+// with the other axes' by OR: (0, 0) when the ray moves along the axis. When it
+// does not, the ray is in the open slab of cell c (c < o < c + 1) only for
+// c = floor(o), and never when o lies on a face or that cell is outside the
+// packing's span: then all ones for both, which no cell matches (cell_packing
+// keeps NO_CELL free) whatever the other axes add.
+fn still_axis(o: real, d: real, offset: i32, shift: u32, mask: u32) -> vec2<u32> {
     if (d != 0.0) {
-        return vec3<u32>(0u);
+        return vec2<u32>(0u);
     }
     let c = floor(o) - real(offset);
-    let never = floor(o) == o || c < 0.0 || c > real(mask);
-    return vec3<u32>(mask << shift, u32(clamp(c, 0.0, real(mask))) << shift, select(0u, 1u, never));
+    if (floor(o) == o || c < 0.0 || c > real(mask)) {
+        return vec2<u32>(NO_CELL);
+    }
+    return vec2<u32>(mask << shift, u32(c) << shift);
 }
 
 // numba: test_tiles (tracing/tile_tests.py)
@@ -126,13 +130,8 @@ fn test_tiles(@builtin(workgroup_id) group: vec3<u32>,
     // (Loaded before the still test: after it, the tile tests ran 1.04-1.08x slower on lavapipe.)
     let first = tile_starts[tile];
     let last = tile_starts[tile + 1u];
-    let sx = still_axis(o.x, d.x, params.offset.x, params.shifts.x, params.masks.x);
-    let sy = still_axis(o.y, d.y, params.offset.y, params.shifts.y, params.masks.y);
-    let sz = still_axis(o.z, d.z, params.offset.z, params.shifts.z, params.masks.z);
-    // No cell matches all ones (cell_packing keeps NO_CELL free).
-    let never = (sx.z | sy.z | sz.z) != 0u;
-    let still_mask = select(sx.x | sy.x | sz.x, NO_CELL, never);
-    let still_cell = select(sx.y | sy.y | sz.y, NO_CELL, never);
-    found[r] = first_hit(first, last, o, inv, face + offset, (vec3<real>(1.0) - face) + offset, still_mask,
-                         still_cell);
+    let still = still_axis(o.x, d.x, params.offset.x, params.shifts.x, params.masks.x)
+        | still_axis(o.y, d.y, params.offset.y, params.shifts.y, params.masks.y)
+        | still_axis(o.z, d.z, params.offset.z, params.shifts.z, params.masks.z);
+    found[r] = first_hit(first, last, o, inv, face + offset, (vec3<real>(1.0) - face) + offset, still.x, still.y);
 }

@@ -28,7 +28,7 @@ from ladartui.tracing.bundle import bundle_start, halo_arrays
 from ladartui.tracing.config import BLOCK, BUNDLE, INF, SCAN_BLOCK
 from ladartui.tracing.march import march_kernel
 from ladartui.tracing.order_choice import RAY_SAMPLE, OrderChoice, trace_in_blocks
-from ladartui.tracing.prepare import float_rows, one_origin
+from ladartui.tracing.prepare import float_rows, one_origin, origin_rows
 from ladartui.tracing.scan_rays import cone_frame
 from ladartui.tracing.tile_tests import trace_scan
 
@@ -434,7 +434,7 @@ class NumbaBackend:
                 d = min(b, c + BLOCK)
                 if method == "exact":
                     _exact_kernel(
-                        np.ascontiguousarray(orig[c:d]),
+                        origin_rows(orig[c:d]),
                         dirs[c:d],
                         occ.root,
                         occ.regions,
@@ -458,7 +458,7 @@ class NumbaBackend:
                     )
                 else:
                     march_kernel(
-                        np.ascontiguousarray(orig[c:d]),
+                        origin_rows(orig[c:d]),
                         dirs[c:d],
                         float(step),
                         float(occ.zmax),
@@ -480,9 +480,7 @@ class NumbaBackend:
         def object_order_block(a, b, max_voxels):
             bounds = None if block_bounds is None else block_bounds[a // SCAN_BLOCK]
             shared = one_origin(block_bounds, a, b)
-            rows = (
-                orig[a : a + 1] if shared else np.ascontiguousarray(orig[a:b])
-            )  # shared: row 0 alone is read
+            rows = origin_rows(orig[a:b], shared)
             return self._object_order(
                 occ, rows, dirs[a:b], bounds, shared, max_voxels, nx, ny, kind[a:b], index[a:b], t[a:b]
             )

@@ -172,11 +172,17 @@ def rays_to_cells(origins, directions, voxel_size, tiny):
 
 def float_rows(origins):
     """``origins`` for the backends: ``rays_to_cells``' one cell broadcast to every ray
-    as it is (a path that reads a row per ray makes rows of its slice with
-    ``np.ascontiguousarray``), any other array as C-contiguous float64."""
+    as it is (``origin_rows`` gives a kernel the rows it reads), any other array as
+    C-contiguous float64."""
     if origins.ndim == 2 and origins.dtype == np.float64 and origins.strides[0] == 0:
         return origins
     return np.ascontiguousarray(origins, dtype=np.float64)
+
+
+def origin_rows(origins, shared=False):
+    """The origin rows a kernel reads: the first alone when every ray starts there
+    (``shared``), else a C-contiguous row per ray (made here from a broadcast one)."""
+    return origins[:1] if shared else np.ascontiguousarray(origins)
 
 
 def one_origin(block_bounds, first: int, end: int) -> bool:

@@ -77,7 +77,7 @@ from ladartui.tracing.config import (
 )
 from ladartui.tracing.f32_rays import f32_start_offsets, floor_preserving_f32
 from ladartui.tracing.order_choice import RAY_SAMPLE, OrderChoice, trace_in_blocks
-from ladartui.tracing.prepare import float_rows, one_origin
+from ladartui.tracing.prepare import float_rows, one_origin, origin_rows
 from ladartui.tracing.scan_rays import cone_frame
 from ladartui.tracing.shader_scan import entry_answers, prepare_shader_scan
 from ladartui.tracing.wgpu_adapter import INSTALL_HINT, choose_adapter, give_driver_a_runtime_dir
@@ -417,7 +417,7 @@ class WgpuBackend:
             return False
         nx, ny = float(occupancy.shape[0]), float(occupancy.shape[1])
         offset, shifts, masks = scan.packing
-        rows = origins[:1] if shared_origin else np.ascontiguousarray(origins)  # shared: row 0 alone is read
+        rows = origin_rows(origins, shared_origin)
         entry_answers(found, offset, shifts, masks, rows, shared_origin, directions, nx, ny, kind, index, t)
         return True
 
@@ -441,7 +441,7 @@ class WgpuBackend:
         kind, index, t = empty_answers(n) if into is None else into
         if n == 0:
             return CellHits(kind, index, t, info)
-        origins = np.ascontiguousarray(origins)  # rows of their own (float_rows may broadcast one)
+        origins = origin_rows(origins)
         upload = self._upload(occupancy)
         sides = box_sides(occupancy) if method == "exact" and precision == "f64" else None
         if sides is not None:

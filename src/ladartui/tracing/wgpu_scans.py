@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from ladartui.tracing.config import BUNDLE, wgsl_constants
+from ladartui.tracing.prepare import origin_rows
 
 
 def dispatch_grid(workgroups: int, max_per_dimension: int) -> tuple[int, int]:
@@ -110,7 +111,7 @@ class ScanDispatcher:
 
         n = len(origins)
         inputs = {
-            "origins": origins[:1] if shared_origin else origins,
+            "origins": origin_rows(origins, shared_origin),
             "directions": directions,
             "order": scan.order,
             "ray_tiles": scan.ray_tiles,
