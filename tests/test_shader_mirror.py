@@ -64,7 +64,7 @@ def test_every_numba_reference_in_the_shaders_names_a_function_that_exists(shade
 
 def test_the_shaders_cite_the_kernels_they_mirror():
     cited = "\n".join(s.read_text() for s in SHADERS)
-    for name in ("_exact_kernel", "march_kernel", "ray_answer", "test_tiles"):
+    for name in ("_exact_kernel", "march_kernel", "ground_answers", "test_tiles"):
         assert f"numba: {name}" in cited or f"of {name}" in cited or f" {name} and" in cited
 
 

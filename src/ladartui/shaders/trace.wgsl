@@ -386,21 +386,6 @@ fn first_voxel(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real, start
     return none;
 }
 
-// The ground rule for a ray that hit no voxel (numba: ray_answer).
-fn ground(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hit {
-    let nx = real(params.shape.x);
-    let ny = real(params.shape.y);
-    if (dz < 0.0 && oz > 0.0) {
-        let tg = (0.0 - oz) * (1.0 / dz);
-        let gx = ox + tg * dx;
-        let gy = oy + tg * dy;
-        if (0.0 <= gx && gx < nx && 0.0 <= gy && gy < ny) {
-            return Hit(GROUND, i32(floor(gx)), i32(floor(gy)), 0, tg);
-        }
-    }
-    return miss();
-}
-
 // The march's jump over an empty node (numba: last_sample_on_axis, the same steps): the
 // last sample certain to stay in [lo_face, hi_face) on one axis, as a real, at most cap.
 fn last_sample_on_axis(o: real, d: real, lo_face: real, hi_face: real, t_s: real, step: real, cap: real) -> real {
@@ -534,10 +519,9 @@ fn trace_rays(@builtin(workgroup_id) group: vec3<u32>,
     let dz = rays[b + 5u];
     var hit: Hit;
     if (params.run.y == METHOD_EXACT) {
+        // No voxel is MISS here: the host applies the ground rule in float64
+        // (numba: ground_answers), where no fused multiply-add can move it.
         hit = first_voxel(ox, oy, oz, dx, dy, dz, starts[r / BUNDLE]);
-        if (hit.kind == MISS) {  // not CUT: that ray's voxels were not all seen
-            hit = ground(ox, oy, oz, dx, dy, dz);
-        }
     } else {
         hit = march_one(ox, oy, oz, dx, dy, dz);
     }

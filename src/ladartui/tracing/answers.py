@@ -1,10 +1,13 @@
 """A ray's answer, shared by both backends: the voxel it hit, else the ground rule.
 
 ``ray_answer`` is compiled into the numba kernels (the exact kernel and the
-object-order tile tests) and written again in WGSL (shaders/trace.wgsl,
-``ground``); ``put_answer`` writes numba's object-order hits with it (the tile
-tests), tracing/shader_scan.py's ``entry_answers`` the wgpu shader's, and
-``box_offset_answers`` the hits of the wgpu backend's exact ray order.
+object-order tile tests); ``put_answer`` writes numba's object-order hits with
+it (the tile tests), tracing/shader_scan.py's ``entry_answers`` the wgpu
+shader's, ``box_offset_answers`` the hits of the wgpu backend's exact ray
+order, and ``ground_answers`` the ground rule for the rays in which its
+``trace_rays`` (f32, or a box too large for offsets) found no voxel. No shader
+applies the ground rule: a GPU may fuse its multiply and add (an f32 ray onto
+a corner of the extent then missed), and on the host it is numba's, bit for bit.
 """
 
 import math
@@ -75,3 +78,26 @@ def box_offset_answers(found, lo, sx, sy, orig, dirs, nx, ny, kind, index, tout)
             word >= 0, i, j, k, t, ox, oy, oz, dx, dy, dz, nx, ny
         )
     return cut
+
+
+@njit(parallel=True, nogil=True, cache=True)
+def ground_answers(rows, orig, dirs, nx, ny, kind, index, tout):
+    """The ground rule (``ray_answer`` with no voxel) for rays ``rows``, in float64
+    on the rays as given: the wgpu backend's answer where ``trace_rays`` found none."""
+    for n in prange(rows.shape[0]):
+        r = rows[n]
+        kind[r], index[r, 0], index[r, 1], index[r, 2], tout[r] = ray_answer(
+            False,
+            np.int64(-1),
+            np.int64(-1),
+            np.int64(-1),
+            INF,
+            orig[r, 0],
+            orig[r, 1],
+            orig[r, 2],
+            dirs[r, 0],
+            dirs[r, 1],
+            dirs[r, 2],
+            nx,
+            ny,
+        )

@@ -44,12 +44,7 @@ def f32_start_offsets(origins, directions, shape, top, method, at_least=None):
             # A start past the box's far side means no voxel: keep the box entry then.
             moved = np.fmax(enter, at_least)
             enter = np.where(moved <= leave, moved, enter)
-        # Stay at least half a cell above the ground, so the ground rule still
-        # sees an origin above it.
-        oz, dz = o[:, 2], d[:, 2]
-        ground_cap = (oz - np.minimum(oz, 0.5)) * -inv[:, 2]
-    ground_cap[~((dz < 0.0) & (oz > 0.0))] = np.inf
-    np.fmin(enter, ground_cap, out=enter)
+    # The ground rule needs no care here: the host applies it to the rays as given.
     return np.where((enter > 0.0) & (enter <= leave), enter, 0.0)
 
 

@@ -51,6 +51,7 @@ from typing import Any
 import numpy as np
 
 from ladartui.errors import BackendUnavailable, FieldError, check_cancelled
+from ladartui.tracing.answers import ground_answers
 from ladartui.tracing.backend import (
     GROUND,
     METHODS,
@@ -511,6 +512,10 @@ class WgpuBackend:
             if len(pending) == 0:
                 break
             first_sample += MARCH_SAMPLES_PER_PASS
+        if method == "exact":
+            # The shader leaves the ground rule to the host (answers.ground_answers).
+            nx, ny = float(occupancy.shape[0]), float(occupancy.shape[1])
+            ground_answers(np.flatnonzero(kind == MISS), origins, directions, nx, ny, kind, index, t)
         index[kind == MISS] = -1
         return CellHits(kind, index, t, info)
 
