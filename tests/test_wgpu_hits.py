@@ -150,15 +150,21 @@ def test_rays_from_one_origin_give_numba_answers_with_one_origin_written(
 ):
     """A scan traced in ray order writes its one origin for all its rays, and the
     shader reads that one for every ray, not what an earlier call left in the
-    buffer (other rays' origins are traced first): numba's answers, bit for bit."""
+    buffer (other rays' origins are traced first): numba's answers, bit for bit.
+    The host never makes a row per ray of that origin: the batches and the
+    answers read its one row (on either thread), and so does the f32 shader's
+    ground rule."""
     occupancy, origins, directions = case
     scan_origins, scan_directions = scan_from(SHAPE[2] + 3.5)
     cells, unit, bounds = rays_to_cells(scan_origins, scan_directions, 1.0, TINY)
     shared = []
     trace = wgpu_hits.FirstHits.trace
-    monkeypatch.setattr(
-        wgpu_hits.FirstHits, "trace", lambda self, *a, **k: shared.append(a[-1]) or trace(self, *a, **k)
-    )
+
+    def record_then_trace(self, *args, **kwargs):
+        shared.append((args[-1], len(args[5])))  # shared_origin, origin rows given
+        return trace(self, *args, **kwargs)
+
+    monkeypatch.setattr(wgpu_hits.FirstHits, "trace", record_then_trace)
     assert_same(
         wgpu_backend.trace_cells(occupancy, origins, directions, order="ray"),
         numba_backend.trace_cells(occupancy, origins, directions, order="ray"),
@@ -169,7 +175,18 @@ def test_rays_from_one_origin_give_numba_answers_with_one_origin_written(
         assert_same(
             wgpu_backend.trace_cells(occupancy, cells, unit, order=order, block_bounds=bounds), reference
         )
-    assert shared[:2] == [False, True]
+    assert shared[:2] == [(False, len(origins)), (True, 1)]
+    batched = WgpuBackend(ray_batch=640)
+    for bundle_starts in (False, True):
+        batched.trace_cells(occupancy, origins[:10], directions[:10])  # opens the device
+        batched._hits.bundle_starts = bundle_starts
+        assert_same(batched.trace_cells(occupancy, cells, unit, order="ray", block_bounds=bounds), reference)
+    assert shared[-1] == (True, 1)
+    f32 = wgpu_backend.trace_cells(occupancy, cells, unit, precision="f32", block_bounds=bounds)
+    ground = (f32.kind == 2) & (reference.kind == 2)
+    assert ground.sum() > 100
+    assert np.array_equal(f32.index[ground], reference.index[ground])
+    assert np.array_equal(f32.t[ground], reference.t[ground])
 
 
 @pytest.mark.parametrize("bundle_starts", [False, True])

@@ -56,14 +56,16 @@ def voxel_entry(ox, oy, oz, dx, dy, dz, i, j, k):
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def box_offset_answers(found, lo, sx, sy, orig, dirs, nx, ny, kind, index, tout):
+def box_offset_answers(found, lo, sx, sy, orig, shared_origin, dirs, nx, ny, kind, index, tout):
     """Every ray's answer from shaders/trace.wgsl's ``first_hits`` words: the voxel at
     box offset ``found[r]`` (``(i - lo[0]) + sx * ((j - lo[1]) + sy * (k - lo[2]))``),
     entered where ``voxel_entry`` says; for NO_VOXEL the ground rule. Returns how
-    many rays say CUT_WORD (left as misses)."""
+    many rays say CUT_WORD (left as misses). ``shared_origin``: every ray starts at
+    ``orig[0]``, which is then read for all."""
     cut = 0
     for r in prange(found.shape[0]):
-        ox, oy, oz = orig[r, 0], orig[r, 1], orig[r, 2]
+        o = np.int64(0) if shared_origin else np.int64(r)  # (prange's r is unsigned)
+        ox, oy, oz = orig[o, 0], orig[o, 1], orig[o, 2]
         dx, dy, dz = dirs[r, 0], dirs[r, 1], dirs[r, 2]
         word = np.int64(found[r])
         i, j, k, t = np.int64(-1), np.int64(-1), np.int64(-1), INF
@@ -81,20 +83,22 @@ def box_offset_answers(found, lo, sx, sy, orig, dirs, nx, ny, kind, index, tout)
 
 
 @njit(parallel=True, nogil=True, cache=True)
-def ground_answers(rows, orig, dirs, nx, ny, kind, index, tout):
+def ground_answers(rows, orig, shared_origin, dirs, nx, ny, kind, index, tout):
     """The ground rule (``ray_answer`` with no voxel) for rays ``rows``, in float64
-    on the rays as given: the wgpu backend's answer where ``trace_rays`` found none."""
+    on the rays as given: the wgpu backend's answer where ``trace_rays`` found none.
+    ``shared_origin``: every ray starts at ``orig[0]``."""
     for n in prange(rows.shape[0]):
         r = rows[n]
+        o = np.int64(0) if shared_origin else r
         kind[r], index[r, 0], index[r, 1], index[r, 2], tout[r] = ray_answer(
             False,
             np.int64(-1),
             np.int64(-1),
             np.int64(-1),
             INF,
-            orig[r, 0],
-            orig[r, 1],
-            orig[r, 2],
+            orig[o, 0],
+            orig[o, 1],
+            orig[o, 2],
             dirs[r, 0],
             dirs[r, 1],
             dirs[r, 2],

@@ -442,12 +442,21 @@ class WgpuBackend:
         kind, index, t = empty_answers(n) if into is None else into
         if n == 0:
             return CellHits(kind, index, t, info)
-        origins = origin_rows(origins)
         upload = self._upload(occupancy)
         sides = box_sides(occupancy) if method == "exact" and precision == "f64" else None
         if sides is not None:
             self._first_hits(
-                occupancy, sides, upload, origins, directions, cancel, info, kind, index, t, shared_origin
+                occupancy,
+                sides,
+                upload,
+                origin_rows(origins, shared_origin),
+                directions,
+                cancel,
+                info,
+                kind,
+                index,
+                t,
+                shared_origin,
             )
             return CellHits(kind, index, t, info)
         chunks = len(upload.buffers)
@@ -515,7 +524,18 @@ class WgpuBackend:
         if method == "exact":
             # The shader leaves the ground rule to the host (answers.ground_answers).
             nx, ny = float(occupancy.shape[0]), float(occupancy.shape[1])
-            ground_answers(np.flatnonzero(kind == MISS), origins, directions, nx, ny, kind, index, t)
+            no_voxel = np.flatnonzero(kind == MISS)
+            ground_answers(
+                no_voxel,
+                origin_rows(origins, shared_origin),
+                shared_origin,
+                directions,
+                nx,
+                ny,
+                kind,
+                index,
+                t,
+            )
         index[kind == MISS] = -1
         return CellHits(kind, index, t, info)
 

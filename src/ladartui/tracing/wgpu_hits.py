@@ -96,8 +96,9 @@ class FirstHits:
         t,
         shared_origin: bool = False,
     ) -> int:
-        """Answers of contiguous (N, 3) float64 rays into kind/index/t; returns how many
-        rays the adapter cut short (their answers are then not to be used).
+        """Answers of contiguous (N, 3) float64 rays into kind/index/t (``origins`` one
+        row when ``shared_origin``); returns how many rays the adapter cut short
+        (their answers are then not to be used).
         ``sides``: the occupied box's (``box_sides``, not None);
         ``group`` binds ``buffers()`` and the occupancy at HIT_BINDINGS;
         ``params_for(count)`` gives the uniform block of a batch (saying whether
@@ -114,23 +115,28 @@ class FirstHits:
         queue = self._device.queue
         lo = np.asarray(occupancy.bbox_lo, np.int64)
         nx, ny = float(occupancy.shape[0]), float(occupancy.shape[1])
-        firsts = range(0, len(origins), self.batch)
+        n = len(directions)
+        firsts = range(0, n, self.batch)
 
         def rows(k: int) -> slice:
-            return slice(firsts[k], min(len(origins), firsts[k] + self.batch))
+            return slice(firsts[k], min(n, firsts[k] + self.batch))
+
+        def origins_of(k: int):
+            return origins[:1] if shared_origin else origins[rows(k)]
 
         def count(k: int) -> int:
             return rows(k).stop - rows(k).start
 
         def write(k: int) -> None:
-            o, d = origins[rows(k)], directions[rows(k)]
-            queue.write_buffer(buffers["params"], 0, params_for(len(o)))
-            queue.write_buffer(buffers["origins"], 0, o[:1] if shared_origin else o)
+            o, d = origins_of(k), directions[rows(k)]
+            queue.write_buffer(buffers["params"], 0, params_for(len(d)))
+            queue.write_buffer(buffers["origins"], 0, o)
             queue.write_buffer(buffers["directions"], 0, d)
             if self.bundle_starts:
+                every = np.broadcast_to(o, d.shape) if shared_origin else o
                 # SHADER_INF is the shader's "never".
                 queue.write_buffer(
-                    buffers["starts"], 0, np.minimum(bundle_start_array(o, d, halo), SHADER_INF)
+                    buffers["starts"], 0, np.minimum(bundle_start_array(every, d, halo), SHADER_INF)
                 )
                 self._stale_starts = True
             elif self._stale_starts:  # another call's starts, not these rays'
@@ -144,9 +150,19 @@ class FirstHits:
 
         def answer(k: int, words) -> int:
             here = rows(k)
-            o, d = origins[here], directions[here]
             return box_offset_answers(
-                words, lo, sides[0], sides[1], o, d, nx, ny, kind[here], index[here], t[here]
+                words,
+                lo,
+                sides[0],
+                sides[1],
+                origins_of(k),
+                shared_origin,
+                directions[here],
+                nx,
+                ny,
+                kind[here],
+                index[here],
+                t[here],
             )
 
         check_cancelled(cancel, "trace cancelled")
