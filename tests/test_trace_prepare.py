@@ -72,6 +72,25 @@ def test_a_bad_ray_anywhere_in_a_large_batch_is_found():
         assert _bad_ray(broken, directions, 0.5) == (f"origins[{bad}]", "finite numbers")
 
 
+def test_bad_values_are_found_through_the_norm_and_the_cell():
+    """The pass reads badness off what it computes: a direction's norm (NaN or inf
+    for any bad component, also beside a huge one) and each new origin's cell (a
+    bad origin repeated is still named). A finite origin whose cell overflows is
+    no error: the serial pass finds no bad ray and the rays go on."""
+    origins = np.tile([1.0, 2.0, 3.0], (6, 1))
+    directions = np.tile([0.0, 0.0, -1.0], (6, 1))
+    for bad in ([np.nan, 0.0, -1.0], [1e300, np.inf, 0.0], [-np.inf, 0.0, 0.0], [1e200, np.nan, 1e200]):
+        broken = directions.copy()
+        broken[3] = bad
+        assert _bad_ray(origins, broken) == ("directions[3]", "finite numbers"), bad
+    broken = origins.copy()
+    broken[2:5] = [1.0, np.inf, 3.0]  # one bad origin, shared by three rays
+    assert _bad_ray(broken, directions) == ("origins[2]", "finite numbers")
+    huge = np.tile([1e308, 0.0, 10.0], (2, 1))
+    cells, _, _ = rays_to_cells(huge, directions[:2], 1e-3, TINY)
+    assert np.isinf(cells[0, 0]) and cells[0, 2] == 10.0 / 1e-3 + 0.5
+
+
 def test_huge_and_tiny_directions_keep_their_direction():
     # Their squares over- or underflow: scaled by the largest component first, they
     # give the unit vector of the same direction (here bit for bit).

@@ -65,7 +65,10 @@ def _item_rays(item, n, block):
 def _rays_to_cells(origins, directions, voxel_size, tiny, block, cells, unit, bounds, repeats):
     """cells = o / voxel_size + 0.5; unit = d / sqrt(dx*dx + dy*dy + dz*dz), |u| < tiny -> 0
     (d scaled first where its squares would under- or overflow). True when no ray is
-    bad (a non-finite value or a zero-length direction).
+    bad (a non-finite value or a zero-length direction): read off the values the
+    pass makes, the direction's norm (not finite or zero for such a direction) and
+    each new origin's cell, not six tests a ray (1.17-1.2x this pass). A finite
+    origin whose cell overflows says False too; ``_first_bad_ray`` then finds none.
 
     A ray from the same origin as the ray before it gets no cell written (a scan's
     rays often share one): ``repeats[item]`` says that some ray of the work item
@@ -89,17 +92,17 @@ def _rays_to_cells(origins, directions, voxel_size, tiny, block, cells, unit, bo
         first, end = _item_rays(item, n, block)
         for i in range(first, end):
             d = _scaled(directions[i, 0], directions[i, 1], directions[i, 2])
-            if not d[3] > 0:
+            if not 0.0 < d[3] < INF:  # zero, or a component not finite
                 bad[item] = True
             same = origins[i, 0] == last[0] and origins[i, 1] == last[1] and origins[i, 2] == last[2]
             repeated |= same
             for a in range(3):
-                if not (np.isfinite(origins[i, a]) and np.isfinite(directions[i, a])):
-                    bad[item] = True
                 if not same:  # (equal inputs, equal bits: the division is the pass's cost)
                     last[a] = origins[i, a]
                     last_cell[a] = origins[i, a] / voxel_size + 0.5
                     cells[i, a] = last_cell[a]
+                    if not np.isfinite(last_cell[a]):  # (once per origin, not per ray)
+                        bad[item] = True
                 c = last_cell[a]
                 u = d[a] / d[3]
                 u = 0.0 if abs(u) < tiny else u
