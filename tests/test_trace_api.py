@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from ladartui.errors import BackendUnavailable, Cancelled, FieldError
 from ladartui.scene.occupancy import Occupancy
-from ladartui.tracing import GROUND, MISS, VOXEL, TraceResult, trace
+from ladartui.tracing import GROUND, MISS, VOXEL, TraceResult, choose_backend, trace
 from ladartui.tracing.backend import backend_names, backend_status, get_backend
 
 
@@ -33,7 +33,8 @@ def test_ranges_and_indices_in_metres(block):
     o = np.array([[12 * size, 13 * size, 10.0], [30 * size, 30 * size, 10.0]])
     d = np.array([[0.0, 0.0, -1.0], [0.0, 0.0, -1.0]])
     r = trace(block, o, d, voxel_size=size)
-    assert isinstance(r, TraceResult) and r.backend == "numba" and r.method == "exact"
+    # "auto": numba, or wgpu where the adapter is a GPU (tests/test_wgpu_backend.py)
+    assert isinstance(r, TraceResult) and r.backend == choose_backend() and r.method == "exact"
     assert r.kind.tolist() == [VOXEL, GROUND]
     assert r.index.tolist() == [[12, 13, 4], [30, 30, 0]]
     assert r.range[0] == pytest.approx(10.0 - 4.5 * size)
