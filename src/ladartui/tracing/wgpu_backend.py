@@ -14,7 +14,9 @@ Resources:
   2-D grid of workgroups kept within the per-dimension limit. Exact ``f64``
   rays go through trace.wgsl's ``first_hits`` (``tracing/wgpu_hits.py``: the
   rays as the host holds them, one word a ray back); f32 and the march
-  through ``trace_rays`` (rays packed six reals a ray, kind, cell and ``t`` back).
+  through ``trace_rays`` (rays packed six reals a ray, kind, cell and ``t`` back;
+  an exact ray with no voxel gets the ground rule on the host, in float64,
+  ``answers.ground_answers``).
 * The march goes in passes of at most ``MARCH_SAMPLES_PER_PASS`` samples a ray:
   lavapipe ends all loops of a shader invocation after 65,535 iterations in
   total, so a longer march would stop early. Rays without an answer after a
