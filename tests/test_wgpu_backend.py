@@ -20,7 +20,7 @@ import pytest
 
 from ladartui.errors import BackendUnavailable, Cancelled
 from ladartui.tracing import backend as registry
-from ladartui.tracing import wgpu_backend, wgpu_occupancy
+from ladartui.tracing import wgpu_occupancy, wgpu_rays
 from ladartui.tracing.f32_rays import floor_preserving_f32
 from ladartui.tracing.wgpu_adapter import INSTALL_HINT, choose_adapter
 from ladartui.tracing.wgpu_backend import WgpuBackend
@@ -353,7 +353,7 @@ def test_a_loop_ended_by_the_adapter_is_reported_not_taken_for_a_miss(
     exceed the loop guard: the backend says so. Elsewhere the answers are numba's."""
     occupancy, o, d = brick_corridor(70_000)
     march_occupancy, mo, md = long_march_case
-    monkeypatch.setattr(wgpu_backend, "MARCH_SAMPLES_PER_PASS", 1 << 17)
+    monkeypatch.setattr(wgpu_rays, "MARCH_SAMPLES_PER_PASS", 1 << 17)
     calls = [(occupancy, o, d, {}), (march_occupancy, mo[:4], md[:4], {"method": "march", "step": 0.25})]
     for scene, origins, directions, options in calls:
         if on_lavapipe(gpu):
@@ -374,7 +374,7 @@ def test_march_in_many_short_passes_equals_one_pass(gpu, numba_backend, monkeypa
     shape = (40, 30, 20)
     occupancy = random_scene(11, shape, 2000)
     o, d = random_rays(12, shape, 1000)
-    monkeypatch.setattr(wgpu_backend, "MARCH_SAMPLES_PER_PASS", 5)
+    monkeypatch.setattr(wgpu_rays, "MARCH_SAMPLES_PER_PASS", 5)
     reference = numba_backend.trace_cells(occupancy, o, d, method="march", step=0.5)
     assert (reference.kind == 1).sum() > 100
     assert_same(gpu.trace_cells(occupancy, o, d, method="march", step=0.5, precision="f64"), reference)

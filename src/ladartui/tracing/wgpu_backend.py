@@ -14,9 +14,9 @@ Resources:
   2-D grid of workgroups kept within the per-dimension limit. Exact ``f64``
   rays go through trace.wgsl's ``first_hits`` (``tracing/wgpu_hits.py``: the
   rays as the host holds them, one word a ray back); f32 and the march
-  through ``trace_rays`` (rays packed six reals a ray, kind, cell and ``t`` back;
-  an exact ray with no voxel gets the ground rule on the host, in float64,
-  ``answers.ground_answers``).
+  through ``trace_rays`` (``tracing/wgpu_rays.py``: rays packed six reals a
+  ray, kind, cell and ``t`` back; an exact ray with no voxel gets the ground
+  rule on the host, in float64).
 * The march goes in passes of at most ``MARCH_SAMPLES_PER_PASS`` samples a ray:
   lavapipe ends all loops of a shader invocation after 65,535 iterations in
   total, so a longer march would stop early. Rays without an answer after a
@@ -52,33 +52,24 @@ from typing import Any
 
 import numpy as np
 
-from ladartui.errors import BackendUnavailable, FieldError, check_cancelled
-from ladartui.tracing.answers import ground_answers
+from ladartui.errors import BackendUnavailable, FieldError
 from ladartui.tracing.backend import (
-    GROUND,
     METHODS,
-    MISS,
     PRECISIONS,
-    VOXEL,
     CellHits,
     TraceOrder,
     check_order,
     register_backend,
 )
-from ladartui.tracing.bundle import bundle_start_array, halo_arrays
+from ladartui.tracing.bundle import halo_arrays
 from ladartui.tracing.config import (
     BUNDLE,
-    CUT,
     LOOP_BUDGET,
-    MARCH_SAMPLES_PER_PASS,
     MAX_OCCUPANCY_BINDINGS,
     OBJECT_ORDER_TILE_SHIFT,
     RAY_BATCH,
     SCAN_BLOCK,
-    SHADER_INF,
-    UNFINISHED,
 )
-from ladartui.tracing.f32_rays import f32_start_offsets, floor_preserving_f32
 from ladartui.tracing.order_choice import RAY_SAMPLE, OrderChoice, trace_in_blocks
 from ladartui.tracing.prepare import float_rows, one_origin, origin_rows
 from ladartui.tracing.scan_rays import cone_frame
@@ -93,7 +84,8 @@ from ladartui.tracing.wgpu_occupancy import (
     pack_params,
     upload_occupancy,
 )
-from ladartui.tracing.wgpu_scans import ScanDispatcher, dispatch_encoder, rays_per_dispatch
+from ladartui.tracing.wgpu_rays import RayPasses
+from ladartui.tracing.wgpu_scans import ScanDispatcher
 
 NAME = "wgpu"
 
@@ -136,11 +128,11 @@ class WgpuBackend:
         self._pinned_uploads: dict[int, Any] = {}  # for occupancies that cannot be weakly referenced
         self._modules: dict[Any, Any] = {}  # trace.wgsl compiled, by precision and chunks
         self._pipelines: dict[Any, Any] = {}  # its entry points, by the same and entry
-        self._ray_buffers: dict[Any, Any] = {}
         self._sources: dict[str, str] = {}
         self._orders: weakref.WeakKeyDictionary[Any, Any] = weakref.WeakKeyDictionary()  # -> OrderChoice
         self._scans: ScanDispatcher | None = None  # object order on the device, once it is open
         self._hits: FirstHits | None = None  # exact ray order on the device, once it is open
+        self._rays: RayPasses | None = None  # trace_rays: f32, the march, huge boxes
 
     # -- probing and device -------------------------------------------------
 
@@ -212,6 +204,7 @@ class WgpuBackend:
                 self._limits[key] = min(self._limits[key], int(cap))
         self._scans = ScanDispatcher(self._device, self._limits, self._shader_file, self._maps_storage)
         self._hits = FirstHits(self._device, self._limits, self._ray_batch, bundle_starts=self._cpu_adapter)
+        self._rays = RayPasses(self._device, self._limits, self._ray_batch)
         return self._device
 
     def describe(self) -> dict:
@@ -295,30 +288,6 @@ class WgpuBackend:
             )
             self._pipelines[key] = pipeline
         return pipeline
-
-    def _ray_buffers_for(self, precision: str):
-        """Ray input and hit output buffers for one batch, reused across calls."""
-        import wgpu
-
-        buffers = self._ray_buffers.get(precision)
-        if buffers is None:
-            device = self._open_device()
-            real_bytes = 8 if precision == "f64" else 4
-            rays = rays_per_dispatch(self._limits, self._ray_batch, 6 * real_bytes)
-            usage_in = wgpu.BufferUsage.STORAGE | wgpu.BufferUsage.COPY_DST
-            usage_out = wgpu.BufferUsage.STORAGE | wgpu.BufferUsage.COPY_SRC
-            buffers = {
-                "capacity": rays,
-                "params": device.create_buffer(
-                    size=PARAMS_BYTES, usage=wgpu.BufferUsage.UNIFORM | wgpu.BufferUsage.COPY_DST
-                ),
-                "rays": device.create_buffer(size=rays * 6 * real_bytes, usage=usage_in),
-                "cells": device.create_buffer(size=rays * 16, usage=usage_out),
-                "ranges": device.create_buffer(size=rays * real_bytes, usage=usage_out),
-                "starts": device.create_buffer(size=max(1, -(-rays // BUNDLE)) * real_bytes, usage=usage_in),
-            }
-            self._ray_buffers[precision] = buffers
-        return buffers
 
     # -- tracing ------------------------------------------------------------
 
@@ -461,84 +430,25 @@ class WgpuBackend:
                 shared_origin,
             )
             return CellHits(kind, index, t, info)
-        chunks = len(upload.buffers)
-        pipeline = self._pipeline(precision, chunks, upload.chunk_shift)
-        buffers = self._ray_buffers_for(precision)
-        bind_group = self._bind_group(upload, pipeline, buffers, precision)
-        real = np.float64 if precision == "f64" else np.float32
-        top = float(max(int(occupancy.zmax) + 1, 0))
-        halo = halo_arrays(occupancy)
-        if precision == "f32":
-            # f32 moves each origin to its start on the host (the shader sees no starts).
-            ray_starts = None
-            if method == "exact":
-                ray_starts = np.repeat(bundle_start_array(origins, directions, halo), BUNDLE)[:n]
-            offsets = f32_start_offsets(origins, directions, occupancy.shape, top, method, ray_starts)
-        else:
-            offsets = None
-        capacity = buffers["capacity"]
-        pending = None  # None: every ray (the first pass), taken in slices, not copies
-        first_sample = 0
-        while True:
-            total = n if pending is None else len(pending)
-            for start in range(0, total, capacity):
-                check_cancelled(cancel, "trace cancelled")
-                rows: slice | np.ndarray
-                if pending is None:
-                    rows = slice(start, min(total, start + capacity))
-                    count = rows.stop - rows.start
-                else:
-                    rows = pending[start : start + capacity]
-                    count = len(rows)
-                batch_origins, batch_directions = origins[rows], directions[rows]
-                rays = np.empty((count, 6), dtype=real)
-                if offsets is None:
-                    rays[:, :3] = batch_origins
-                else:
-                    rays[:, :3] = floor_preserving_f32(batch_origins + offsets[rows, None] * batch_directions)
-                rays[:, 3:] = batch_directions
-                if offsets is None and method == "exact":
-                    # The shader has no infinity (its INF is 1e30): cap "never" there.
-                    starts = np.minimum(
-                        bundle_start_array(batch_origins, batch_directions, halo), SHADER_INF
-                    ).astype(real)
-                else:
-                    starts = np.zeros(-(-count // BUNDLE), dtype=real)
-                params = pack_params(
-                    occupancy, upload, method, step, count, precision, first_sample, MARCH_SAMPLES_PER_PASS
-                )
-                cells, ranges = self._dispatch(pipeline, bind_group, buffers, params, rays, starts)
-                batch_kind = cells[:, 0]
-                kind[rows] = batch_kind
-                index[rows] = cells[:, 1:]
-                batch_t = ranges.astype(np.float64)
-                if offsets is not None:
-                    batch_t += offsets[rows]
-                batch_t[(batch_kind != VOXEL) & (batch_kind != GROUND)] = np.inf
-                t[rows] = batch_t
-            done = kind if pending is None else kind[pending]
-            if np.any(done == CUT):
-                raise _cut_short(int(np.sum(kind == CUT)), info)
-            pending = np.flatnonzero(done == UNFINISHED) if pending is None else pending[done == UNFINISHED]
-            if len(pending) == 0:
-                break
-            first_sample += MARCH_SAMPLES_PER_PASS
-        if method == "exact":
-            # The shader leaves the ground rule to the host (answers.ground_answers).
-            nx, ny = float(occupancy.shape[0]), float(occupancy.shape[1])
-            no_voxel = np.flatnonzero(kind == MISS)
-            ground_answers(
-                no_voxel,
-                origin_rows(origins, shared_origin),
-                shared_origin,
-                directions,
-                nx,
-                ny,
-                kind,
-                index,
-                t,
-            )
-        index[kind == MISS] = -1
+        assert self._rays is not None  # the device is open
+        pipeline = self._pipeline(precision, len(upload.buffers), upload.chunk_shift)
+        cut = self._rays.trace(
+            occupancy,
+            upload,
+            pipeline,
+            origins,
+            directions,
+            method,
+            step,
+            precision,
+            cancel,
+            kind,
+            index,
+            t,
+            shared_origin,
+        )
+        if cut:
+            raise _cut_short(cut, info)
         return CellHits(kind, index, t, info)
 
     def _first_hits(
@@ -570,30 +480,6 @@ class WgpuBackend:
         )
         if cut:
             raise _cut_short(cut, info)
-
-    def _dispatch(self, pipeline, bind_group, buffers, params, rays, starts):
-        """One dispatch over ``rays`` (count, 6) with their bundle ``starts`` (one per
-        workgroup): their hit cells (count, 4) and ranges."""
-        device = self._device
-        count = len(rays)
-        device.queue.write_buffer(buffers["params"], 0, params)
-        device.queue.write_buffer(buffers["rays"], 0, rays)
-        device.queue.write_buffer(buffers["starts"], 0, starts)
-        device.queue.submit([dispatch_encoder(device, self._limits, pipeline, bind_group, count).finish()])
-        cells = np.frombuffer(
-            device.queue.read_buffer(buffers["cells"], 0, count * 16), dtype=np.int32
-        ).reshape(count, 4)
-        ranges = np.frombuffer(
-            device.queue.read_buffer(buffers["ranges"], 0, count * rays.itemsize), dtype=rays.dtype
-        )
-        return cells, ranges
-
-    def _bind_group(self, upload, pipeline, buffers, precision):
-        names = ("params", "rays", "cells", "ranges", "starts")  # trace_rays' bindings 0-4
-        bound = {b: buffers[name] for b, name in enumerate(names)}
-        return upload.bind_group(
-            self._device, pipeline, (precision, id(pipeline), id(buffers["rays"])), bound
-        )
 
 
 def empty_answers(n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
