@@ -198,7 +198,7 @@ def test_wgpu_scans_match_numba(forest, numba_backend, wgpu_backend):
 
 
 def test_f32_offsets_fall_back_to_the_box_entry_when_the_start_is_past_the_scene():
-    from ladartui.tracing.wgpu_backend import f32_start_offsets
+    from ladartui.tracing.f32_rays import f32_start_offsets
 
     o = np.array([[-1000.0, 50.5, 10.5]])
     d = np.array([[1.0, 0.0, 0.0]])
