@@ -432,20 +432,9 @@ class WgpuBackend:
             return CellHits(kind, index, t, info)
         assert self._rays is not None  # the device is open
         pipeline = self._pipeline(precision, len(upload.buffers), upload.chunk_shift)
+        rays = (origins, directions, shared_origin)
         cut = self._rays.trace(
-            occupancy,
-            upload,
-            pipeline,
-            origins,
-            directions,
-            method,
-            step,
-            precision,
-            cancel,
-            kind,
-            index,
-            t,
-            shared_origin,
+            occupancy, upload, pipeline, rays, method, step, precision, cancel, (kind, index, t)
         )
         if cut:
             raise _cut_short(cut, info)

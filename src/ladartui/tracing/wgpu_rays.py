@@ -70,21 +70,20 @@ class RayPasses:
         occupancy,
         upload,
         pipeline,
-        origins,
-        directions,
+        rays,
         method: str,
         step: float,
         precision: str,
         cancel,
-        kind,
-        index,
-        t,
-        shared_origin: bool = False,
+        into,
     ) -> int:
-        """Every ray's answer into kind/index/t; returns how many rays the adapter cut
-        short (then the answers are not to be used). ``upload``: the occupancy on the
-        device (wgpu_occupancy.Upload); ``pipeline``: trace_rays for its layout and
-        ``precision``; ``shared_origin``: every ray starts at ``origins[0]``."""
+        """The answers of ``rays`` (origins, directions, shared_origin: every ray starts
+        at ``origins[0]``) into ``into`` (kind, index, t); returns how many rays the
+        adapter cut short (then the answers are not to be used). ``upload``: the
+        occupancy on the device (wgpu_occupancy.Upload); ``pipeline``: trace_rays for
+        its layout and ``precision``."""
+        origins, directions, shared_origin = rays
+        kind, index, t = into
         n = len(directions)
         buffers = self.buffers(precision)
         bound = {b: buffers[name] for b, name in enumerate(RAY_BINDINGS)}
@@ -116,12 +115,14 @@ class RayPasses:
                     rows = pending[start : start + capacity]
                     count = len(rows)
                 batch_origins, batch_directions = origins[rows], directions[rows]
-                rays = np.empty((count, 6), dtype=real)
+                packed = np.empty((count, 6), dtype=real)
                 if offsets is None:
-                    rays[:, :3] = batch_origins
+                    packed[:, :3] = batch_origins
                 else:
-                    rays[:, :3] = floor_preserving_f32(batch_origins + offsets[rows, None] * batch_directions)
-                rays[:, 3:] = batch_directions
+                    packed[:, :3] = floor_preserving_f32(
+                        batch_origins + offsets[rows, None] * batch_directions
+                    )
+                packed[:, 3:] = batch_directions
                 if offsets is None and method == "exact":
                     # The shader has no infinity (its INF is 1e30): cap "never" there.
                     starts = np.minimum(
@@ -132,7 +133,7 @@ class RayPasses:
                 params = pack_params(
                     occupancy, upload, method, step, count, precision, first_sample, MARCH_SAMPLES_PER_PASS
                 )
-                cells, ranges = self._dispatch(pipeline, bind_group, buffers, params, rays, starts)
+                cells, ranges = self._dispatch(pipeline, bind_group, buffers, params, packed, starts)
                 batch_kind = cells[:, 0]
                 kind[rows] = batch_kind
                 index[rows] = cells[:, 1:]
