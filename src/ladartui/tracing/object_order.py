@@ -390,10 +390,14 @@ def scan_voxels(occ, frame, grid, nb, max_voxels, tile_shift):
     if found is None:
         return None
     vox, nears = found
-    numbers = np.arange(len(vox), dtype=np.int64)
-    tiles = -(-nb >> tile_shift)
-    tile_starts, listed = voxels_per_tile(vox, tiles, tile_shift, numba.get_num_threads(), numbers)
+    tile_starts, listed = tile_lists(vox, nb, tile_shift, np.arange(len(vox), dtype=np.int64))
     return vox, nears, tile_starts, listed
+
+
+def tile_lists(vox, nb, tile_shift, payload):
+    """(tile_starts, listed) of ``voxels_per_tile`` over an nb x nb grid of bins in
+    tiles of ``1 << tile_shift`` bins a side, on numba's threads."""
+    return voxels_per_tile(vox, -(-nb >> tile_shift), tile_shift, numba.get_num_threads(), payload)
 
 
 def voxels_in_view(occ, frame, grid, nb, max_voxels):

@@ -19,13 +19,12 @@ from __future__ import annotations
 
 from typing import NamedTuple
 
-import numba
 import numpy as np
 from numba import njit, prange
 
 from ladartui.tracing.answers import ray_answer, voxel_entry
 from ladartui.tracing.config import INF, NO_CELL, PARTS
-from ladartui.tracing.object_order import voxels_in_view, voxels_per_tile
+from ladartui.tracing.object_order import tile_lists, voxels_in_view
 from ladartui.tracing.scan_rays import bin_order, scan_grid
 
 PACKED_BITS = 32  # a packed cell is one u32
@@ -161,8 +160,7 @@ def prepare_shader_scan(occ, orig, dirs, frame, max_voxels, tile_shift):
     offset, shifts, _ = packing
     # The lists hold the shader's words themselves (two u32 as one u64 each).
     words = voxel_words(vox, nears, offset, shifts).view(np.uint64).reshape(-1)
-    tiles = -(-nb >> tile_shift)
-    tile_starts, listed = voxels_per_tile(vox, tiles, tile_shift, numba.get_num_threads(), words)
+    tile_starts, listed = tile_lists(vox, nb, tile_shift, words)
     entries = listed.view(np.uint32).reshape(-1, 2)
     tile_rests(tile_starts, entries)
     ray_tiles = ray_tiles_of(bin_starts, tile_shift) if len(bin_starts) else np.empty(0, np.uint32)

@@ -384,12 +384,12 @@ class WgpuBackend:
         if scan is None or np.diff(scan.tile_starts).max(initial=0) >= LOOP_BUDGET:
             return False
         assert self._scans is not None  # the device is open
-        found = self._scans.test_tiles(origins, directions, scan, shared_origin)
+        rows = origin_rows(origins, shared_origin)
+        found = self._scans.test_tiles(rows, directions, scan, shared_origin)
         if found is None:
             return False
         nx, ny = float(occupancy.shape[0]), float(occupancy.shape[1])
         offset, shifts, masks = scan.packing
-        rows = origin_rows(origins, shared_origin)
         entry_answers(found, offset, shifts, masks, rows, shared_origin, directions, nx, ny, kind, index, t)
         return True
 

@@ -109,9 +109,9 @@ class ScanDispatcher:
         ``shared_origin``: every ray starts at ``origins[0]``, the one row sent."""
         import wgpu
 
-        n = len(origins)
+        n = len(directions)
         inputs = {
-            "origins": origin_rows(origins, shared_origin),
+            "origins": origin_rows(origins, shared_origin),  # as given when already so
             "directions": directions,
             "order": scan.order,
             "ray_tiles": scan.ray_tiles,
