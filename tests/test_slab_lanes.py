@@ -8,7 +8,7 @@ from numba.core.errors import TypingError
 
 from ladartui.tracing.axis import cube_start
 from ladartui.tracing.config import INF
-from ladartui.tracing.slab_lanes import LANES, slab_lanes
+from ladartui.tracing.slab_lanes import LANES, slab_lanes, slab_lanes_from
 
 
 @njit
@@ -35,6 +35,11 @@ def lanes_one_by_one(rays, s, x, y, z, near, after, q, todo, cols, s_end, bounds
 @njit
 def vector(rays, s, x, y, z, near, after, q, todo, cols, s_end, bounds, voxels):
     return slab_lanes(rays, s, x, y, z, near, after, q, todo, cols, s_end, bounds, voxels)
+
+
+@njit
+def vector_from(rays, s, ox, oy, oz, x, y, z, near, after, q, todo, cols, s_end, bounds, voxels):
+    return slab_lanes_from(rays, s, ox, oy, oz, x, y, z, near, after, q, todo, cols, s_end, bounds, voxels)
 
 
 def awkward_rays(rng, n):
@@ -76,6 +81,38 @@ def test_eight_lanes_give_the_scalar_rule_bit_for_bit(seed):
         assert np.array_equal(voxels, want_voxels)
 
 
+@pytest.mark.parametrize("seed", range(6))
+def test_lanes_from_one_origin_give_the_scalar_rule_bit_for_bit(seed):
+    # One origin for all lanes (inside the voxel's slabs, on their faces, outside):
+    # slab_lanes_from never reads the origin rows, so they hold garbage here.
+    rng = np.random.default_rng(100 + seed)
+    n = 64 + LANES
+    rays = awkward_rays(rng, n)
+    cols = np.sort(rng.integers(0, 12, n))
+    for _ in range(200):
+        origin = rng.choice([2.5, 3.0, 3.5, 4.0, 4.5, 5.0, 5.5, 6.0, 1.0, 8.0, -2.0], size=3)
+        scalar_rays = rays.copy()
+        scalar_rays[:3] = origin[:, None]
+        rays[:3] = rng.normal(size=(3, n)) * 1e3
+        s = int(rng.integers(0, n - LANES + 1))
+        x, y, z = (float(v) for v in rng.integers(2, 7, 3))
+        near = float(rng.choice([0.0, 0.5, 1.0, 2.0]))
+        after = near + float(rng.choice([0.0, 0.3, 2.0, INF]))
+        todo = int(rng.integers(0, 1 << 12))
+        s_end = s + int(rng.integers(0, LANES + 2))
+        bounds = rng.choice([INF, 0.2, 1.5, 3.0, 6.0, 40.0], n)
+        voxels = rng.integers(-1, 9, n)
+        want_bounds, want_voxels = bounds.copy(), voxels.copy()
+        want = lanes_one_by_one(
+            scalar_rays, s, x, y, z, near, after, 77, todo, cols, s_end, want_bounds, want_voxels
+        )
+        ox, oy, oz = (float(v) for v in origin)
+        got = vector_from(rays, s, ox, oy, oz, x, y, z, near, after, 77, todo, cols, s_end, bounds, voxels)
+        assert got == want
+        assert np.array_equal(bounds.view(np.int64), want_bounds.view(np.int64))
+        assert np.array_equal(voxels, want_voxels)
+
+
 def test_lanes_hit_where_expected_and_leave_the_rest():
     # Eight rays straight down onto voxel (3, 4, 5) from z = 10: lanes 0-5 over it
     # (x = 3.5), lanes 6-7 beside it; lane 2 is not to do, lane 4 already nearer.
@@ -100,6 +137,12 @@ def test_lanes_hit_where_expected_and_leave_the_rest():
 def test_the_intrinsic_is_vector_code_and_rejects_other_layouts():
     ir = vector.inspect_llvm(vector.signatures[0])
     assert "<8 x double>" in ir
+    # With one origin, its rows are not loaded: six rows of eight doubles, not nine.
+    vector_from(np.zeros((9, 16)), 0, 0.5, 0.5, 9.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1, 1,
+                np.zeros(16, np.int64), 8, np.full(16, INF), np.zeros(16, np.int64))  # fmt: skip
+    shared_ir = vector_from.inspect_llvm(vector_from.signatures[0])
+    assert "<8 x double>" in shared_ir
+    assert shared_ir.count("load <8 x double>") == 7 and ir.count("load <8 x double>") == 10
     rays = np.asfortranarray(np.zeros((9, 16)))
     with pytest.raises(TypingError):
         vector(

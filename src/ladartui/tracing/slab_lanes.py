@@ -29,23 +29,41 @@ _F64 = types.Array(types.float64, 1, "C")
 _I64 = types.Array(types.int64, 1, "C")
 
 
-def _typer(typingctx, rays, s, x, y, z, near, after, q, todo, cols, s_end, bounds, voxels):
+def _typed(shared, rays, s, numbers, q, todo, cols, s_end, bounds, voxels):
+    """(signature, codegen) when the arguments have the intrinsic's types, else None."""
     if not (
         rays == types.Array(types.float64, 2, "C")
         and cols == _I64
         and bounds == _F64
         and voxels == _I64
         and all(isinstance(v, types.Integer) for v in (s, q, todo, s_end))
-        and all(isinstance(v, (types.Float, types.Integer)) for v in (x, y, z, near, after))
+        and all(isinstance(v, (types.Float, types.Integer)) for v in numbers)
     ):
         return None
-    signature = types.UniTuple(types.int64, 3)(
-        rays, s, x, y, z, near, after, q, todo, cols, s_end, bounds, voxels
-    )
-    return signature, _codegen
+    signature = types.UniTuple(types.int64, 3)(rays, s, *numbers, q, todo, cols, s_end, bounds, voxels)
+    return signature, _lanes_codegen(shared)
 
 
-def _codegen(context, builder, signature, args):
+# (numba's intrinsics take no *args: one typer per argument list.)
+def _typer(typingctx, rays, s, x, y, z, near, after, q, todo, cols, s_end, bounds, voxels):
+    return _typed(False, rays, s, (x, y, z, near, after), q, todo, cols, s_end, bounds, voxels)
+
+
+def _typer_from(typingctx, rays, s, ox, oy, oz, x, y, z, near, after, q, todo, cols, s_end, bounds, voxels):
+    return _typed(True, rays, s, (ox, oy, oz, x, y, z, near, after), q, todo, cols, s_end, bounds, voxels)
+
+
+def _lanes_codegen(shared):
+    """The intrinsic's code; with ``shared``, one origin (args 2-4) for every lane."""
+    k = 3 if shared else 0  # where the arguments after the origin begin, less 2
+
+    def codegen(context, builder, signature, args):
+        return _emit(context, builder, signature, args, shared, k)
+
+    return codegen
+
+
+def _emit(context, builder, signature, args, shared, k):
     argtypes = signature.args
     f64, i64, i8 = ir.DoubleType(), ir.IntType(64), ir.IntType(8)
     doubles, ints = ir.VectorType(f64, LANES), ir.VectorType(i64, LANES)
@@ -88,14 +106,23 @@ def _codegen(context, builder, signature, args):
     zero, inf, minus_inf = (ir.Constant(doubles, v) for v in (0.0, float("inf"), float("-inf")))
     enters, leaves = [], []
     for axis in range(3):
-        # axis.slab: rows 0-2 hold the origin, 3-5 the direction, 6-8 its inverse.
-        o, d, inv = ray_row(axis), ray_row(3 + axis), ray_row(6 + axis)
-        corner = scalar(2 + axis, types.float64)
-        lo, hi = splat(corner, doubles), splat(builder.fadd(corner, ir.Constant(f64, 1.0)), doubles)
-        t_lo = builder.fmul(builder.fsub(lo, o), inv)
-        t_hi = builder.fmul(builder.fsub(hi, o), inv)
+        # axis.slab: rows 0-2 hold the origin (unless shared), 3-5 the direction, 6-8 its inverse.
+        d, inv = ray_row(3 + axis), ray_row(6 + axis)
+        corner = scalar(2 + k + axis, types.float64)
+        upper = builder.fadd(corner, ir.Constant(f64, 1.0))
+        if shared:  # the lanes' common (b - o) and insideness, once: the same bits in each lane
+            o = scalar(2 + axis, types.float64)
+            from_lo = splat(builder.fsub(corner, o), doubles)
+            from_hi = splat(builder.fsub(upper, o), doubles)
+            inside = builder.and_(builder.fcmp_ordered("<", corner, o), builder.fcmp_ordered("<", o, upper))
+        else:
+            o = ray_row(axis)
+            lo, hi = splat(corner, doubles), splat(upper, doubles)
+            from_lo, from_hi = builder.fsub(lo, o), builder.fsub(hi, o)
+            inside = builder.and_(less(lo, o), less(o, hi))
+        t_lo = builder.fmul(from_lo, inv)
+        t_hi = builder.fmul(from_hi, inv)
         up, down = greater(d, zero), less(d, zero)
-        inside = builder.and_(less(lo, o), less(o, hi))
         flat_enter = builder.select(inside, minus_inf, inf)
         flat_leave = builder.select(inside, inf, minus_inf)
         enters.append(builder.select(up, t_lo, builder.select(down, t_hi, flat_enter)))
@@ -103,22 +130,22 @@ def _codegen(context, builder, signature, args):
     start = numba_max(numba_max(enters[0], numba_max(enters[1], enters[2])), zero)
     leave = numba_min(leaves[0], numba_min(leaves[1], leaves[2]))
 
-    cols = lanes_at(9, [s], ints)[0]
+    cols = lanes_at(9 + k, [s], ints)[0]
     bits = builder.shl(ir.Constant(ints, 1), cols)
     positions = builder.add(splat(s, ints), ir.Constant(ints, list(range(LANES))))
-    in_span = builder.icmp_signed("<", positions, splat(scalar(10, types.intp), ints))
-    todo = splat(scalar(8, types.int64), ints)
+    in_span = builder.icmp_signed("<", positions, splat(scalar(10 + k, types.intp), ints))
+    todo = splat(scalar(8 + k, types.int64), ints)
     on = builder.and_(in_span, builder.icmp_signed("!=", builder.and_(todo, bits), ir.Constant(ints, 0)))
 
-    bound, bound_at = lanes_at(11, [s], doubles)
-    near, after = splat(scalar(5, types.float64), doubles), splat(scalar(6, types.float64), doubles)
+    bound, bound_at = lanes_at(11 + k, [s], doubles)
+    near, after = splat(scalar(5 + k, types.float64), doubles), splat(scalar(6 + k, types.float64), doubles)
     hit = builder.and_(
         builder.and_(on, greater(bound, near)), builder.and_(less(start, leave), less(start, bound))
     )
     new_bound = builder.select(hit, start, bound)
     builder.store(new_bound, bound_at, align=8)
-    voxel, voxel_at = lanes_at(12, [s], ints)
-    builder.store(builder.select(hit, splat(scalar(7, types.int64), ints), voxel), voxel_at, align=8)
+    voxel, voxel_at = lanes_at(12 + k, [s], ints)
+    builder.store(builder.select(hit, splat(scalar(7 + k, types.int64), ints), voxel), voxel_at, align=8)
 
     def mask_byte(mask):
         return builder.bitcast(mask, i8)
@@ -151,3 +178,12 @@ Returns the bits ``1 << cols`` of the taking-part lanes whose bound is above
 ``after`` afterwards, 1 when any lane hit, and how many hits came to a lane
 whose bound was infinite. The caller keeps s + 8 within every array (the
 arrays are padded), since all eight lanes are read and written back."""
+
+slab_lanes_from: Any = intrinsic(_typer_from)
+slab_lanes_from.__doc__ = """slab_lanes_from(rays, s, ox, oy, oz, x, y, z, near, after, q, todo, cols, s_end,
+    bounds, voxels) -> (alive_bins, any_hit, first_hits)
+
+``slab_lanes`` for lanes that all start at (ox, oy, oz): the rays' origin rows
+are not read, and each axis's ``b - o`` and whether the origin lies within the
+voxel's slab are worked out once for the eight lanes (the same operations, so
+the same bits)."""

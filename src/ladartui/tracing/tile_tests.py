@@ -20,7 +20,7 @@ from ladartui.tracing.config import INF, MAX_TILE_SHIFT
 from ladartui.tracing.llvm_ops import prefetch_row, prefetch_row_for_write, trailing_zeros
 from ladartui.tracing.object_order import scan_voxels, spread_stride
 from ladartui.tracing.scan_rays import bin_order, scan_grid
-from ladartui.tracing.slab_lanes import LANES, slab_lanes
+from ladartui.tracing.slab_lanes import LANES, slab_lanes, slab_lanes_from
 
 # Prefetch distances, in tile rays and in list entries. Prefetching the rays' loads and
 # answers made the tile tests 1.11-1.19x faster, and the entries' voxels 2 % more
@@ -30,11 +30,13 @@ ENTRIES_AHEAD = 8
 
 
 @njit(nogil=True, cache=True, inline="always")
-def _load_ray(r, origin_row, orig, dirs, ray, s):
-    """Ray r (its origin from row ``origin_row``) into tile column s: origin and
-    direction (``1 / d`` follows in a pass of its own)."""
+def _load_ray(r, shared_origin, orig, dirs, ray, s):
+    """Ray r into tile column s: its direction, and its origin unless all rays
+    share ``orig[0]`` (``1 / d`` follows in a pass of its own)."""
     for a in range(3):
-        ray[a, s], ray[3 + a, s] = orig[origin_row, a], dirs[r, a]
+        ray[3 + a, s] = dirs[r, a]
+        if not shared_origin:
+            ray[a, s] = orig[r, a]
 
 
 def tile_shift_for(nb):
@@ -94,6 +96,7 @@ def test_tiles(
     """
     tiles = nt * nt
     tile_side = 1 << shift
+    ox, oy, oz = (orig[0, 0], orig[0, 1], orig[0, 2]) if shared_origin else (0.0, 0.0, 0.0)
     single = bin_starts.shape[0] == 0
     for step in prange(tiles):
         tile = (step * stride) % tiles
@@ -129,7 +132,7 @@ def test_tiles(
                         live[r] |= np.int64(1) << c
                     for s in range(starts[b], starts[b + 1]):
                         cols[s] = c
-        # By rows: origin, direction, 1 / d; padded by LANES (slab_lanes reads 8 rays a call).
+        # By rows: origin (unless shared), direction, 1 / d; padded by LANES (8 rays a call).
         ray = np.empty((9, m + LANES))
         ray[:, m:] = 0.0
         best_t = np.full(m + LANES, INF)
@@ -140,7 +143,7 @@ def test_tiles(
                 if not shared_origin:
                     prefetch_row(orig, order[s0 + s + AHEAD])
             r = order[s0 + s]
-            _load_ray(r, 0 if shared_origin else r, orig, dirs, ray, s)
+            _load_ray(r, shared_origin, orig, dirs, ray, s)
         for a in range(3):  # (a pass of its own: vector divisions)
             for s in range(m):
                 d = ray[3 + a, s]
@@ -188,9 +191,14 @@ def test_tiles(
                 s, s_end = starts[row + trailing_zeros(todo)], starts[row + c1 + 1]
                 alive = np.int64(0)
                 while True:  # the row's rays from its first live bin on, 8 at a time
-                    bins, hit, first_hits = slab_lanes(
-                        ray, s, x, y, z, near, after, q, todo, cols, s_end, best_t, best_v
-                    )
+                    if shared_origin:
+                        bins, hit, first_hits = slab_lanes_from(
+                            ray, s, ox, oy, oz, x, y, z, near, after, q, todo, cols, s_end, best_t, best_v
+                        )
+                    else:
+                        bins, hit, first_hits = slab_lanes(
+                            ray, s, x, y, z, near, after, q, todo, cols, s_end, best_t, best_v
+                        )
                     alive |= bins
                     unhit -= first_hits
                     stale = stale or hit != 0
@@ -211,9 +219,9 @@ def test_tiles(
                 best_v[s],
                 best_t[s],
                 vox,
-                ray[0, s],
-                ray[1, s],
-                ray[2, s],
+                ox if shared_origin else ray[0, s],
+                oy if shared_origin else ray[1, s],
+                oz if shared_origin else ray[2, s],
                 ray[3, s],
                 ray[4, s],
                 ray[5, s],
