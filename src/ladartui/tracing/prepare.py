@@ -20,6 +20,8 @@ from ladartui.tracing.config import INF, PARTS, SCAN_BLOCK
 # Outside (NORM_LOW, inf) the squares under- or overflow: such directions are
 # scaled by their largest component first (1e160 along x is still along x).
 NORM_LOW = 1e-150
+# Rays a work item turns into unit directions at a time (``_unit_chunk``).
+UNIT_CHUNK = 64
 
 
 @numba.njit(nogil=True, cache=True, inline="always")
@@ -62,7 +64,32 @@ def _item_rays(item, n, block):
     return first + k * m // PARTS, first + (k + 1) * m // PARTS
 
 
-@numba.njit(parallel=True, nogil=True, cache=True)
+@numba.njit(nogil=True, cache=True, inline="always")
+def _unit_chunk(directions, first, m, tiny, dx, dy, dz, norm):
+    """Unit directions of rays ``first .. first + m`` into dx, dy, dz (``_scaled``, then
+    ``d / norm``, components under ``tiny`` set to 0); False when one is bad (its norm
+    zero or not finite). Loads, square roots and divisions in loops of their own: the
+    last two then run as vector code (1.1-1.2x this pass)."""
+    good = True
+    for k in range(m):
+        dx[k], dy[k], dz[k] = directions[first + k, 0], directions[first + k, 1], directions[first + k, 2]
+    for k in range(m):
+        norm[k] = np.sqrt(dx[k] * dx[k] + dy[k] * dy[k] + dz[k] * dz[k])
+    for k in range(m):
+        if not NORM_LOW < norm[k] < np.inf:  # rare: scale first (or a bad direction)
+            dx[k], dy[k], dz[k], norm[k] = _scaled(dx[k], dy[k], dz[k])
+            good &= 0.0 < norm[k] < np.inf
+    for k in range(m):
+        ux, uy, uz = dx[k] / norm[k], dy[k] / norm[k], dz[k] / norm[k]
+        dx[k] = 0.0 if abs(ux) < tiny else ux
+        dy[k] = 0.0 if abs(uy) < tiny else uy
+        dz[k] = 0.0 if abs(uz) < tiny else uz
+    return good
+
+
+# error_model="numpy": a bad direction's division gives inf or nan (its ray is
+# reported), and without the check the divisions run as vector code.
+@numba.njit(parallel=True, nogil=True, cache=True, error_model="numpy")
 def _rays_to_cells(origins, directions, voxel_size, tiny, block, cells, unit, bounds, repeats):
     """cells = o / voxel_size + 0.5; unit = d / sqrt(dx*dx + dy*dy + dz*dz), |u| < tiny -> 0
     (d scaled first where its squares would under- or overflow). True when no ray is
@@ -90,26 +117,29 @@ def _rays_to_cells(origins, directions, voxel_size, tiny, block, cells, unit, bo
         last = np.full(3, np.nan)  # the previous origin and its cell
         last_cell = np.empty(3)
         repeated = False
+        chunk = np.empty((4, UNIT_CHUNK))  # a chunk's directions (unit when done) and norms
+        dx, dy, dz, norm = chunk[0], chunk[1], chunk[2], chunk[3]
         first, end = _item_rays(item, n, block)
-        for i in range(first, end):
-            d = _scaled(directions[i, 0], directions[i, 1], directions[i, 2])
-            if not 0.0 < d[3] < INF:  # zero, or a component not finite
+        for c0 in range(first, end, UNIT_CHUNK):
+            m = min(end - c0, UNIT_CHUNK)
+            if not _unit_chunk(directions, c0, m, tiny, dx, dy, dz, norm):
                 bad[item] = True
-            same = origins[i, 0] == last[0] and origins[i, 1] == last[1] and origins[i, 2] == last[2]
-            repeated |= same
-            for a in range(3):
+            for k in range(m):
+                i = c0 + k
+                same = origins[i, 0] == last[0] and origins[i, 1] == last[1] and origins[i, 2] == last[2]
+                repeated |= same
                 if not same:  # (equal inputs, equal bits: the division is the pass's cost)
-                    last[a] = origins[i, a]
-                    last_cell[a] = origins[i, a] / voxel_size + 0.5
-                    cells[i, a] = last_cell[a]
-                    if not np.isfinite(last_cell[a]):  # (once per origin, not per ray)
-                        bad[item] = True
-                c = last_cell[a]
-                u = d[a] / d[3]
-                u = 0.0 if abs(u) < tiny else u
-                unit[i, a] = u
-                lo[a], hi[a] = min(lo[a], c), max(hi[a], c)
-                total[a] += u
+                    for a in range(3):
+                        last[a] = origins[i, a]
+                        last_cell[a] = origins[i, a] / voxel_size + 0.5
+                        cells[i, a] = last_cell[a]
+                        if not np.isfinite(last_cell[a]):  # (once per origin, not per ray)
+                            bad[item] = True
+                        lo[a], hi[a] = min(lo[a], last_cell[a]), max(hi[a], last_cell[a])
+                unit[i, 0], unit[i, 1], unit[i, 2] = dx[k], dy[k], dz[k]
+                total[0] += dx[k]
+                total[1] += dy[k]
+                total[2] += dz[k]
         part[item, :3], part[item, 3:6], part[item, 6:] = lo, hi, total
         repeats[item] = repeated  # (once: the items' flags share a cache line)
     for b in range(bounds.shape[0]):
