@@ -230,7 +230,7 @@ def test_directions_that_are_not_unit_go_in_ray_order(forest, numba_backend):
 @pytest.mark.parametrize("shift, tiles", [(4, 6), (1, 300)])
 def test_tile_lists_keep_the_nearest_first_order(shift, tiles, threads):
     # 16: the numba tiles (64 runs of voxels); 2: the shader's, many tiles (fewer runs).
-    from ladartui.tracing.object_order import voxels_per_tile
+    from ladartui.tracing.tile_lists import voxels_per_tile
 
     rng = np.random.default_rng(4)
     n, tile = 5000, 1 << shift

@@ -4,7 +4,7 @@ shaders/object_order.wgsl, and the shader's hits made answers.
 The steps are numba's (tracing/tile_tests.py's ``trace_scan``): the rays in bin
 order (``scan_rays.bin_order``, no copies: the shader reads each ray through
 the order), the voxels in view (``object_order.voxels_in_view``) listed per
-tile (``object_order.voxels_per_tile``). What differs is the shape of the
+tile (``tile_lists.voxels_per_tile``). What differs is the shape of the
 lists. The shader runs one invocation per ray and lavapipe loads storage lane
 by lane, so each word an invocation reads costs: a tile's entry is two u32
 (``voxel_words``, listed as they are, then ``tile_rests``), the least voxel
@@ -24,8 +24,9 @@ from numba import njit, prange
 
 from ladartui.tracing.answers import ray_answer, voxel_entry
 from ladartui.tracing.config import INF, NO_CELL, PARTS
-from ladartui.tracing.object_order import tile_lists, voxels_in_view
+from ladartui.tracing.object_order import voxels_in_view
 from ladartui.tracing.scan_rays import bin_order, scan_grid
+from ladartui.tracing.tile_lists import tile_lists
 
 PACKED_BITS = 32  # a packed cell is one u32
 
