@@ -25,6 +25,12 @@ def _visit_tiles(vox, first, last, shift, nt, slots, listed, payload, place):
     for e in range(first, last):
         if vox[e, 3] > vox[e, 4]:
             continue
+        ti, tj = vox[e, 3] >> shift, vox[e, 5] >> shift
+        if ti == vox[e, 4] >> shift and tj == vox[e, 6] >> shift:  # one tile, as most are: no loops
+            if place:
+                listed[slots[tj * nt + ti]] = payload[e]
+            slots[tj * nt + ti] += 1
+            continue
         for tj in range(vox[e, 5] >> shift, (vox[e, 6] >> shift) + 1):
             for ti in range(vox[e, 3] >> shift, (vox[e, 4] >> shift) + 1):
                 if place:
