@@ -98,6 +98,9 @@ def test_tiles(
     tile_side = 1 << shift
     ox, oy, oz = (orig[0, 0], orig[0, 1], orig[0, 2]) if shared_origin else (0.0, 0.0, 0.0)
     single = bin_starts.shape[0] == 0
+    # One ray per bin: every (whole) tile's bin starts and ray columns are the same.
+    whole_starts = np.arange(tile_side * tile_side + 1) if single else np.empty(0, np.int64)
+    whole_cols = (np.arange(tile_side * tile_side + LANES) & (tile_side - 1)) if single else whole_starts
     for step in prange(tiles):
         tile = (step * stride) % tiles
         bi0 = (tile % nt) * tile_side
@@ -110,19 +113,16 @@ def test_tiles(
         if m == 0:
             continue
         # bin b of the tile: tile rays starts[b] .. starts[b + 1]; cols[s]: tile ray s's column
-        starts = np.empty(tile_side * tile_side + 1, np.int64)
         live = np.zeros(tile_side, np.int64)  # per row: bit c set while bin (bi0 + c) may still change
-        cols = np.zeros(m + LANES, np.int64)
-        if single:  # every bin of the (whole) tile holds one ray: loops without branches
-            for b in range(tile_side * tile_side + 1):
-                starts[b] = b
-            for s in range(m):
-                cols[s] = s & (tile_side - 1)
+        if single:  # every bin of the (whole) tile holds one ray
+            starts, cols = whole_starts, whole_cols
             width = bi1 - bi0 + 1
             full = np.int64(-1) if width >= 64 else (np.int64(1) << width) - 1
             for r in range(bj1 - bj0 + 1):
                 live[r] = full
         else:
+            starts = np.empty(tile_side * tile_side + 1, np.int64)
+            cols = np.zeros(m + LANES, np.int64)
             for b in range(tile_side * tile_side + 1):
                 starts[b] = bin_starts[base + b] - s0
             for r in range(bj1 - bj0 + 1):
