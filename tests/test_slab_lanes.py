@@ -56,44 +56,22 @@ def awkward_rays(rng, n):
     return np.ascontiguousarray(np.hstack([origin, direction, inverse]).T)
 
 
+@pytest.mark.parametrize("shared", [False, True])
 @pytest.mark.parametrize("seed", range(6))
-def test_eight_lanes_give_the_scalar_rule_bit_for_bit(seed):
-    rng = np.random.default_rng(seed)
+def test_eight_lanes_give_the_scalar_rule_bit_for_bit(seed, shared):
+    # shared: one origin for every lane (slab_lanes_from), inside the voxel's slabs,
+    # on their faces or outside; it never reads the origin rows, so they hold garbage.
+    rng = np.random.default_rng(seed + 100 * shared)
     n = 64 + LANES
     rays = awkward_rays(rng, n)
     cols = np.sort(rng.integers(0, 12, n))
     for _ in range(200):
-        s = int(rng.integers(0, n - LANES + 1))
-        x, y, z = (float(v) for v in rng.integers(2, 7, 3))
-        near = float(rng.choice([0.0, 0.5, 1.0, 2.0]))
-        after = near + float(rng.choice([0.0, 0.3, 2.0, INF]))
-        todo = int(rng.integers(0, 1 << 12))
-        s_end = s + int(rng.integers(0, LANES + 2))
-        bounds = rng.choice([INF, 0.2, 1.5, 3.0, 6.0, 40.0], n)
-        voxels = rng.integers(-1, 9, n)
-        want_bounds, want_voxels = bounds.copy(), voxels.copy()
-        want = lanes_one_by_one(
-            rays, s, x, y, z, near, after, 77, todo, cols, s_end, want_bounds, want_voxels
-        )
-        got = vector(rays, s, x, y, z, near, after, 77, todo, cols, s_end, bounds, voxels)
-        assert got == want
-        assert np.array_equal(bounds.view(np.int64), want_bounds.view(np.int64))
-        assert np.array_equal(voxels, want_voxels)
-
-
-@pytest.mark.parametrize("seed", range(6))
-def test_lanes_from_one_origin_give_the_scalar_rule_bit_for_bit(seed):
-    # One origin for all lanes (inside the voxel's slabs, on their faces, outside):
-    # slab_lanes_from never reads the origin rows, so they hold garbage here.
-    rng = np.random.default_rng(100 + seed)
-    n = 64 + LANES
-    rays = awkward_rays(rng, n)
-    cols = np.sort(rng.integers(0, 12, n))
-    for _ in range(200):
-        origin = rng.choice([2.5, 3.0, 3.5, 4.0, 4.5, 5.0, 5.5, 6.0, 1.0, 8.0, -2.0], size=3)
-        scalar_rays = rays.copy()
-        scalar_rays[:3] = origin[:, None]
-        rays[:3] = rng.normal(size=(3, n)) * 1e3
+        scalar_rays = rays
+        if shared:
+            origin = rng.choice([2.5, 3.0, 3.5, 4.0, 4.5, 5.0, 5.5, 6.0, 1.0, 8.0, -2.0], size=3)
+            scalar_rays = rays.copy()
+            scalar_rays[:3] = origin[:, None]
+            rays[:3] = rng.normal(size=(3, n)) * 1e3
         s = int(rng.integers(0, n - LANES + 1))
         x, y, z = (float(v) for v in rng.integers(2, 7, 3))
         near = float(rng.choice([0.0, 0.5, 1.0, 2.0]))
@@ -106,8 +84,13 @@ def test_lanes_from_one_origin_give_the_scalar_rule_bit_for_bit(seed):
         want = lanes_one_by_one(
             scalar_rays, s, x, y, z, near, after, 77, todo, cols, s_end, want_bounds, want_voxels
         )
-        ox, oy, oz = (float(v) for v in origin)
-        got = vector_from(rays, s, ox, oy, oz, x, y, z, near, after, 77, todo, cols, s_end, bounds, voxels)
+        if shared:
+            ox, oy, oz = origin.tolist()
+            got = vector_from(
+                rays, s, ox, oy, oz, x, y, z, near, after, 77, todo, cols, s_end, bounds, voxels
+            )
+        else:
+            got = vector(rays, s, x, y, z, near, after, 77, todo, cols, s_end, bounds, voxels)
         assert got == want
         assert np.array_equal(bounds.view(np.int64), want_bounds.view(np.int64))
         assert np.array_equal(voxels, want_voxels)

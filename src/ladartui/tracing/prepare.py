@@ -69,7 +69,7 @@ def _unit_chunk(directions, first, m, tiny, dx, dy, dz, norm):
     """Unit directions of rays ``first .. first + m`` into dx, dy, dz (``_scaled``, then
     ``d / norm``, components under ``tiny`` set to 0); False when one is bad (its norm
     zero or not finite). Loads, square roots and divisions in loops of their own: the
-    last two then run as vector code (1.1-1.2x this pass)."""
+    last two then run as vector code (1.15-1.3x this pass)."""
     good = True
     for k in range(m):
         dx[k], dy[k], dz[k] = directions[first + k, 0], directions[first + k, 1], directions[first + k, 2]

@@ -12,6 +12,9 @@ operation for operation, so the answers keep their bits: the slab of each axis
 by the sign of the direction (``axis.slab``, ``boundary_t``), numba's
 ``max(a, b)`` as ``b if b > a else a`` and ``min(a, b)`` as ``b if b < a else a``,
 and the hit rule ``bound > near and start < leave and start < bound``.
+``slab_lanes_from`` is the same test for lanes that share one origin (a
+pinhole scan's): each axis's ``b - o`` and insideness are scalars there,
+worked out once for the eight lanes.
 """
 
 from __future__ import annotations

@@ -77,7 +77,8 @@ def test_tiles(
     its answer (``ray_answer``) into kind/index/tout at the ray's own place.
 
     ``shared_origin``: every ray starts at ``orig[0]``, which is then read for all (half
-    the bytes a tile's rays load: at 45 degrees a tenth of the tests' time).
+    the bytes a tile's rays load: at 45 degrees a tenth of the tests' time), and the
+    lanes take it as one point (``slab_lanes_from``: 1.05-1.09x the tile tests).
     Sorted position s is ray ``order[s]``; bin key b holds positions
     ``bin_starts[b] .. bin_starts[b + 1]``, or position b alone when ``bin_starts``
     is empty (one ray per bin, whole tiles). A tile's rays start with no voxel
