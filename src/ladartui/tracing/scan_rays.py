@@ -143,18 +143,26 @@ def bin_key(i, j, tiles_per_side, shift):
 
 
 @njit(nogil=True, cache=True, inline="always")
-def _bin_of(p, q, grid, nb):
-    """(i, j): the bin of gnomonic coordinates (p, q), clamped into the nb x nb grid."""
-    i = min(nb - 1, max(0, np.int64((p - grid[0]) / grid[1])))
-    j = min(nb - 1, max(0, np.int64((q - grid[2]) / grid[3])))
-    return i, j
+def _bin_scales(grid):
+    """(p0, p_scale, q0, q_scale): a ray's position in bins is ``((p - p0) * p_scale,
+    (q - q0) * q_scale)``, its bin the whole part of that (``_bin_at``). By the steps'
+    reciprocals (1.1x the scatter): the measured slack comes from the same products,
+    and the 1e-6 bins ``bin_order`` adds to it dwarf their rounding."""
+    return grid[0], 1.0 / grid[1], grid[2], 1.0 / grid[3]
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _bin_at(position, nb):
+    """The bin of a position in bins, clamped into 0 .. nb - 1."""
+    return min(nb - 1, max(0, np.int64(position)))
 
 
 @njit(parallel=True, nogil=True, cache=True)
 def _bin_keys(p, q, grid, nb, shift, key_of):
     nt = -(-nb >> shift)
+    p0, p_scale, q0, q_scale = _bin_scales(grid)
     for r in prange(p.shape[0]):
-        i, j = _bin_of(p[r], q[r], grid, nb)
+        i, j = _bin_at((p[r] - p0) * p_scale, nb), _bin_at((q[r] - q0) * q_scale, nb)
         key_of[r] = bin_key(i, j, nt, shift)
 
 
@@ -191,15 +199,12 @@ def _scatter_one_per_bin(p, q, grid, nb, shift, order, slack):
     for k in prange(n):
         order[k] = NO_RAY
     far = np.zeros((PARTS, 2))
-    # Positions in bins by the steps' reciprocals (1.1x this pass): a ray's bin and its
-    # measured slack come from the same product, and the 1e-6 bins bin_order adds to
-    # the slack dwarf its rounding.
-    p0, q0, p_scale, q_scale = grid[0], grid[2], 1.0 / grid[1], 1.0 / grid[3]
+    p0, p_scale, q0, q_scale = _bin_scales(grid)
     for part in prange(PARTS):
         far_p, far_q = 0.0, 0.0
         for r in range(part * n // PARTS, (part + 1) * n // PARTS):
             x, y = (p[r] - p0) * p_scale, (q[r] - q0) * q_scale
-            i, j = min(nb - 1, max(0, np.int64(x))), min(nb - 1, max(0, np.int64(y)))
+            i, j = _bin_at(x, nb), _bin_at(y, nb)
             order[bin_key(i, j, nt, shift)] = r
             far_p, far_q = max(far_p, abs(x - (i + 0.5))), max(far_q, abs(y - (j + 0.5)))
         far[part, 0], far[part, 1] = far_p, far_q
