@@ -263,6 +263,69 @@ def test_bench_narrow_view_is_the_peer_geometry(depression):
         assert bearing == pytest.approx(bench.NARROW_BEARING, abs=0.1)
 
 
+def _bench_row(backend, method, view, depression, rate, vs_numba, per_cpu, order="object"):
+    return {
+        "backend": backend,
+        "method": method,
+        "view": view,
+        "depression": depression,
+        "order": order,
+        "rays_per_second": rate,
+        "vs_numba": vs_numba,
+        "rays_per_cpu_second": per_cpu,
+        "voxel_hits": 0.684,
+        "ground_hits": 0.316,
+        "device": "cpu" if backend == "numba" else "a GPU",
+    }
+
+
+def test_bench_table_fits_an_80_column_terminal(monkeypatch, capsys):
+    """Every figure of every row, whole, in 80 columns (an SSH terminal's width)."""
+    from ladartui.cli import bench
+
+    monkeypatch.setenv("COLUMNS", "80")
+    rows = [
+        _bench_row("numba", "exact", "narrow", 45.0, 26.87e6, 1.0, 13.48e6),
+        _bench_row("wgpu", "exact", "narrow", 45.0, 133.27e6, 4.96, 98.65e6),
+        _bench_row("numba", "march", "wide", 90.0, 0.86e6, 1.0, 0.44e6, order="object+ray/ray"),
+        _bench_row("wgpu", "march", "wide", 90.0, 1.08e6, None, None, order="ray"),
+    ]
+    report = {
+        "scene": "reference",
+        "shape": [1500, 1500, 900],
+        "voxels": 3829919,
+        "occupancy_bytes": 18_000_000,
+        "setup_seconds": 1.1,
+        "setup_cpu_seconds": 1.1,
+        "sensor": "128x128 detectors, 4x4 rays each",
+        "runs": 7,
+        "warm_up": {"numba": {"calls": 53, "seconds": 0.5}},
+        "results": rows,
+        "views": {"wide": "wide view", "narrow": "narrow view"},
+        "backends": {"numba": "available", "wgpu": "available"},
+    }
+    bench._print_table(report)
+    lines = capsys.readouterr().out.splitlines()
+    assert max(len(line) for line in lines) <= 80
+    assert not any("\u2026" in line for line in lines)  # nothing cut short
+    rule = next(k for k, line in enumerate(lines) if line.startswith("\u2500"))
+    end = next(k for k, line in enumerate(lines) if line.startswith("views:"))
+    table = [line.split() for line in lines[rule + 1 : end] if line.split()[:1] in (["numba"], ["wgpu"])]
+    assert [cells[:4] for cells in table] == [
+        ["numba", "exact", "narrow", "45"],
+        ["wgpu", "exact", "narrow", "45"],
+        ["numba", "march", "wide", "90"],
+        ["wgpu", "march", "wide", "90"],
+    ]
+    assert [cells[4] for cells in table] == ["obj", "obj", "mix", "ray"]  # the third: mix, then ray below
+    assert [cells[5:] for cells in table] == [
+        ["26.87", "1.00", "13.48", "68.4%", "31.6%"],
+        ["133.27", "4.96", "98.65", "68.4%", "31.6%"],
+        ["0.86", "1.00", "0.44", "68.4%", "31.6%"],
+        ["1.08", "-", "-", "68.4%", "31.6%"],
+    ]
+
+
 def test_bench_rejects_a_run_count_below_one(capsys):
     from ladartui.cli import main
 

@@ -363,6 +363,12 @@ def _add_ratios(results):
         row["vs_numba"] = statistics.median(pairs) if pairs else None
 
 
+def _orders_shown(orders: str) -> str:
+    """A row's orders (``run_bench``'s "object+ray/ray") as the table shows them: "mix ray"."""
+    names = {"object": "obj", "ray": "ray", "object+ray": "mix"}
+    return " ".join(names.get(order, order) for order in orders.split("/"))
+
+
 def _print_table(report):
     from rich import box
     from rich.console import Console
@@ -380,20 +386,13 @@ def _print_table(report):
         )
         + ")"
     )
-    table = Table(box=box.SIMPLE_HEAD, pad_edge=False, collapse_padding=True)
-    for name in (
-        "backend",
-        "method",
-        "view",
-        "depr.",
-        "order",
-        "rays/s",
-        "x numba",
-        "rays/CPU-s",
-        "voxel",
-        "ground",
-    ):
-        table.add_column(name, no_wrap=True, min_width=len(name))
+    # Fits 80 columns (an SSH terminal): millions in the headers, not on every figure;
+    # a row whose timed runs took several orders lists them a line each.
+    table = Table(box=box.SIMPLE_HEAD, pad_edge=False, collapse_padding=True, show_edge=False)
+    for name in ("backend", "method", "view", "depr.", "order"):
+        table.add_column(name, no_wrap=name != "order", min_width=len(name))
+    for name in ("M rays/s", "x numba", "M/CPU-s", "voxel", "ground"):
+        table.add_column(name, no_wrap=True, justify="right", min_width=len(name))
     devices = {}
     for row in report["results"]:
         per_cpu = row["rays_per_cpu_second"]
@@ -403,18 +402,18 @@ def _print_table(report):
             row["method"],
             row["view"],
             f"{row['depression']:g}",
-            row["order"].replace("object", "obj"),
-            f"{row['rays_per_second'] / 1e6:.2f} M",
+            _orders_shown(row["order"]),
+            f"{row['rays_per_second'] / 1e6:.2f}",
             f"{row['vs_numba']:.2f}" if row.get("vs_numba") is not None else "-",
-            f"{per_cpu / 1e6:.2f} M" if per_cpu else "-",
+            f"{per_cpu / 1e6:.2f}" if per_cpu else "-",
             f"{row['voxel_hits']:.1%}",
             f"{row['ground_hits']:.1%}",
         )
     console.print(table)
     console.print(f"views: wide {report['views']['wide']}; narrow {report['views']['narrow']}")
     console.print(
-        "order: obj object, ray ray order (several: the timed runs differed); devices: "
-        + "; ".join(f"{name} {device}" for name, device in devices.items())
+        "order: obj object, ray ray order, mix both in one call (several: the timed runs "
+        "differed); devices: " + "; ".join(f"{name} {device}" for name, device in devices.items())
     )
     for name, status in report["backends"].items():
         if status != "available":
