@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import _thread
+import re
 import sys
 import threading
 
@@ -37,3 +38,28 @@ def test_a_result_that_arrives_before_the_cancel_is_kept():
     cancel = threading.Event()
     assert run_cancellable(lambda: 42, cancel, "test-worker", Cancelled("no")) == 42
     assert not cancel.is_set()
+
+
+def test_the_run_progress_keeps_its_figures_whole_in_80_columns():
+    """A long run's progress line in an 80-column terminal: scan, share, rays and both
+    times whole, the bar taking the room left."""
+    import io
+
+    from rich.console import Console
+
+    from ladartui.cli.progress import progress_display
+    from ladartui.cli.run import progress_columns
+
+    out = io.StringIO()
+    console = Console(file=out, width=80, force_terminal=True, color_system=None)
+    with progress_display(console, progress_columns(), transient=False, auto_refresh=False) as bar:
+        task = bar.add_task("scan 240/240", total=1.0, rays="12,582,912/25,165,824 rays")
+        bar.update(task, completed=0.5)
+        bar.refresh()
+    shown = re.sub(r"\x1b\[[0-9;?]*[A-Za-z]", "", out.getvalue())  # cursor controls
+    line = [line for line in shown.replace("\r", "\n").splitlines() if "scan" in line][-1]
+    assert len(line) <= 80
+    assert "\u2026" not in line
+    for figure in ("scan 240/240", "50.0 %", "12,582,912/25,165,824 rays", "0:00:0", "-:--:--"):
+        assert figure in line
+    assert "\u2501" in line  # the bar is still there

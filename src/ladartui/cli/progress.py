@@ -20,6 +20,15 @@ T = TypeVar("T")
 POLL_SECONDS = 0.1  # how soon a Ctrl-C is noticed while waiting
 
 
+def progress_display(console, columns, **options):
+    """rich's Progress over ``columns`` across the console's width: its bars
+    (``BarColumn(bar_width=None)``) take the room the texts leave, where a fixed
+    40-cell bar cut the texts and times short in an 80-column terminal."""
+    from rich.progress import Progress
+
+    return Progress(*columns, console=console, expand=True, **options)
+
+
 def run_cancellable(work: Callable[[], T], cancel: threading.Event, name: str, cancelled: Cancelled) -> T:
     """``work()`` on a worker thread named ``name``; its result, or its error raised here.
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 import json
 import threading
 
-from ladartui.cli.progress import run_cancellable, sigterm_as_interrupt
+from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt
 from ladartui.errors import Cancelled
 
 
@@ -103,29 +103,33 @@ def run(args) -> int:
     return 0
 
 
-def _simulate_with_progress(scenario, args, console):
-    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+def progress_columns():
+    """The run's progress: scan, bar, share done, rays of both runs, times."""
+    from rich.progress import BarColumn, TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
-    from ladartui.simulation import NOTHING_WRITTEN, simulate
-
-    cancel = threading.Event()
-    columns = (
+    return (
         TextColumn("{task.description}"),
-        BarColumn(),
+        BarColumn(bar_width=None),
         TextColumn("{task.percentage:>5.1f} %"),
         TextColumn("{task.fields[rays]}"),
         TimeElapsedColumn(),
         TimeRemainingColumn(),
     )
-    with Progress(*columns, console=console, transient=False) as bar:
+
+
+def _simulate_with_progress(scenario, args, console):
+    from ladartui.simulation import NOTHING_WRITTEN, simulate
+
+    cancel = threading.Event()
+    with progress_display(console, progress_columns(), transient=False) as bar:
         task = bar.add_task("starting", total=1.0, rays="")
 
         def report(p):
             bar.update(
                 task,
                 completed=p.fraction,
-                description=f"scan {p.scan}/{p.scans} (scene and target runs)",
-                rays=f"{p.rays_done:,}/{p.rays_total:,} rays",
+                description=f"scan {p.scan}/{p.scans}",
+                rays=f"{p.rays_done:,}/{p.rays_total:,} rays",  # both runs: scene and target
             )
 
         # A stop during the write lets the swap finish (or roll back): the files on

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import threading
 
-from ladartui.cli.progress import run_cancellable
+from ladartui.cli.progress import progress_display, run_cancellable
 from ladartui.errors import Cancelled, FieldError
 
 DEFAULT_OUT = "study-results"
@@ -91,7 +91,7 @@ def _positive(flag, value):
 
 
 def _run_with_progress(console, inputs, settings, runs, warmup):
-    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+    from rich.progress import BarColumn, TextColumn, TimeElapsedColumn
 
     from ladartui.study.run import backend_reasons, run_study
 
@@ -105,12 +105,14 @@ def _run_with_progress(console, inputs, settings, runs, warmup):
         f"{len(settings)} settings, median of {runs} runs"
     )
     cancel = threading.Event()
-    progress_bar = Progress(
-        TextColumn("{task.description}"),
-        BarColumn(),
-        TextColumn("{task.completed}/{task.total} traces"),
-        TimeElapsedColumn(),
-        console=console,
+    progress_bar = progress_display(
+        console,
+        (
+            TextColumn("{task.description}"),
+            BarColumn(bar_width=None),
+            TextColumn("{task.completed}/{task.total} traces"),
+            TimeElapsedColumn(),
+        ),
         transient=True,
     )
     task = progress_bar.add_task("starting", total=None)

@@ -11,7 +11,7 @@ import json
 import signal
 import threading
 
-from ladartui.cli.progress import run_cancellable
+from ladartui.cli.progress import progress_display, run_cancellable
 from ladartui.errors import Cancelled, FieldError
 from ladartui.sweep.table import display_cell
 
@@ -181,7 +181,6 @@ def _sweep_with_progress(spec, args, console):
     from rich.progress import (
         BarColumn,
         MofNCompleteColumn,
-        Progress,
         TextColumn,
         TimeElapsedColumn,
         TimeRemainingColumn,
@@ -194,7 +193,7 @@ def _sweep_with_progress(spec, args, console):
     outcome = {}
     columns = (
         TextColumn("{task.description}"),
-        BarColumn(),
+        BarColumn(bar_width=None),
         MofNCompleteColumn(),
         TextColumn("{task.fields[note]}"),
         TimeElapsedColumn(),
@@ -206,7 +205,7 @@ def _sweep_with_progress(spec, args, console):
         else ("this process" if args.serial else "local cluster")
     )
     try:
-        with Progress(*columns, console=console, transient=False) as bar:
+        with progress_display(console, columns, transient=False) as bar:
             task = bar.add_task(f"sweep on {where}", total=len(spec.variants), note="starting")
 
             def report(p):
