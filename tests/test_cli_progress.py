@@ -47,12 +47,11 @@ def test_the_run_progress_keeps_its_figures_whole_in_80_columns():
 
     from rich.console import Console
 
-    from ladartui.cli.progress import progress_display
-    from ladartui.cli.run import progress_columns
+    from ladartui.cli.run import run_progress
 
     out = io.StringIO()
     console = Console(file=out, width=80, force_terminal=True, color_system=None)
-    with progress_display(console, progress_columns(), transient=False, auto_refresh=False) as bar:
+    with run_progress(console, transient=False, auto_refresh=False) as bar:
         task = bar.add_task("scan 240/240", total=1.0, rays="12,582,912/25,165,824 rays")
         bar.update(task, completed=0.5)
         bar.refresh()

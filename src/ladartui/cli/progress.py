@@ -20,13 +20,13 @@ T = TypeVar("T")
 POLL_SECONDS = 0.1  # how soon a Ctrl-C is noticed while waiting
 
 
-def progress_display(console, columns, **options):
-    """rich's Progress over ``columns`` across the console's width: its bars
-    (``BarColumn(bar_width=None)``) take the room the texts leave, where a fixed
-    40-cell bar cut the texts and times short in an 80-column terminal."""
-    from rich.progress import Progress
+def progress_display(console, description, after, **options):
+    """rich's Progress across the console's width: the ``description`` column, a bar
+    taking the room the texts leave, then the columns ``after`` (a fixed 40-cell bar
+    cut the texts and times short in an 80-column terminal)."""
+    from rich.progress import BarColumn, Progress
 
-    return Progress(*columns, console=console, expand=True, **options)
+    return Progress(description, BarColumn(bar_width=None), *after, console=console, expand=True, **options)
 
 
 def run_cancellable(work: Callable[[], T], cancel: threading.Event, name: str, cancelled: Cancelled) -> T:

@@ -117,20 +117,14 @@ def _where(progress) -> str:
 
 
 def _study_with_progress(scenario, pulses, settings, backend, console, state):
-    from rich.progress import BarColumn, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+    from rich.progress import TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
     from ladartui.cli.progress import progress_display, run_cancellable
     from ladartui.detection.pulses import pulse_study
 
     cancel = threading.Event()
-    columns = (
-        TextColumn("{task.description}"),
-        BarColumn(bar_width=None),
-        TextColumn("{task.percentage:>5.1f} %"),
-        TimeElapsedColumn(),
-        TimeRemainingColumn(),
-    )
-    with progress_display(console, columns, transient=False) as bar:
+    after = (TextColumn("{task.percentage:>5.1f} %"), TimeElapsedColumn(), TimeRemainingColumn())
+    with progress_display(console, TextColumn("{task.description}"), after, transient=False) as bar:
         # Until the first scan is done (a first run also compiles the kernels, about a minute).
         task = bar.add_task("tracing scan 1 (compiling kernels on a first run)", total=1.0)
 

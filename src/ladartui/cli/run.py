@@ -103,25 +103,24 @@ def run(args) -> int:
     return 0
 
 
-def progress_columns():
-    """The run's progress: scan, bar, share done, rays of both runs, times."""
-    from rich.progress import BarColumn, TextColumn, TimeElapsedColumn, TimeRemainingColumn
+def run_progress(console, **options):
+    """The run's progress display: scan, bar, share done, rays of both runs, times."""
+    from rich.progress import TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
-    return (
-        TextColumn("{task.description}"),
-        BarColumn(bar_width=None),
+    after = (
         TextColumn("{task.percentage:>5.1f} %"),
         TextColumn("{task.fields[rays]}"),
         TimeElapsedColumn(),
         TimeRemainingColumn(),
     )
+    return progress_display(console, TextColumn("{task.description}"), after, **options)
 
 
 def _simulate_with_progress(scenario, args, console):
     from ladartui.simulation import NOTHING_WRITTEN, simulate
 
     cancel = threading.Event()
-    with progress_display(console, progress_columns(), transient=False) as bar:
+    with run_progress(console, transient=False) as bar:
         task = bar.add_task("starting", total=1.0, rays="")
 
         def report(p):

@@ -91,7 +91,7 @@ def _positive(flag, value):
 
 
 def _run_with_progress(console, inputs, settings, runs, warmup):
-    from rich.progress import BarColumn, TextColumn, TimeElapsedColumn
+    from rich.progress import TextColumn, TimeElapsedColumn
 
     from ladartui.study.run import backend_reasons, run_study
 
@@ -107,12 +107,8 @@ def _run_with_progress(console, inputs, settings, runs, warmup):
     cancel = threading.Event()
     progress_bar = progress_display(
         console,
-        (
-            TextColumn("{task.description}"),
-            BarColumn(bar_width=None),
-            TextColumn("{task.completed}/{task.total} traces"),
-            TimeElapsedColumn(),
-        ),
+        TextColumn("{task.description}"),
+        (TextColumn("{task.completed}/{task.total} traces"), TimeElapsedColumn()),
         transient=True,
     )
     task = progress_bar.add_task("starting", total=None)

@@ -179,7 +179,6 @@ def run(args) -> int:
 
 def _sweep_with_progress(spec, args, console):
     from rich.progress import (
-        BarColumn,
         MofNCompleteColumn,
         TextColumn,
         TimeElapsedColumn,
@@ -191,9 +190,7 @@ def _sweep_with_progress(spec, args, console):
     client = connect(args.scheduler, args.connect_timeout, args.security) if args.scheduler else None
     cancel = threading.Event()
     outcome = {}
-    columns = (
-        TextColumn("{task.description}"),
-        BarColumn(bar_width=None),
+    after = (
         MofNCompleteColumn(),
         TextColumn("{task.fields[note]}"),
         TimeElapsedColumn(),
@@ -205,7 +202,7 @@ def _sweep_with_progress(spec, args, console):
         else ("this process" if args.serial else "local cluster")
     )
     try:
-        with progress_display(console, columns, transient=False) as bar:
+        with progress_display(console, TextColumn("{task.description}"), after, transient=False) as bar:
             task = bar.add_task(f"sweep on {where}", total=len(spec.variants), note="starting")
 
             def report(p):

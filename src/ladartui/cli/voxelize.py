@@ -125,19 +125,17 @@ def run(args) -> int:
 def _work(args, placement, outputs, console, cancel):
     """Read, voxelise (with progress), insert and write; runs on the worker thread."""
     import numpy as np
-    from rich.progress import BarColumn, TextColumn, TimeElapsedColumn
+    from rich.progress import TextColumn, TimeElapsedColumn
 
     from ladartui.scene.insertion import insert_vehicle, load_scene_model, save_model, write_scene_model
     from ladartui.scene.voxelize import CANCELLED, load_mesh, voxelize
 
-    columns = (
-        TextColumn("{task.description}", markup=False),  # paths are not markup
-        BarColumn(bar_width=None),
-        TextColumn("{task.fields[done]}", markup=False),
-        TimeElapsedColumn(),
-    )
+    description = TextColumn("{task.description}", markup=False)  # paths are not markup
+    after = (TextColumn("{task.fields[done]}", markup=False), TimeElapsedColumn())
     # A bar only on a terminal: a log or a pipe gets the summary alone.
-    with progress_display(console, columns, transient=True, disable=not console.is_terminal) as bar:
+    with progress_display(
+        console, description, after, transient=True, disable=not console.is_terminal
+    ) as bar:
         task = bar.add_task(f"reading {args.mesh}", total=None, done="")
         mesh = load_mesh(args.mesh, scale=args.scale, up=args.up)
         for note in mesh.notes:
