@@ -232,6 +232,9 @@ def test_bench_quick_json(monkeypatch, tmp_path, capsys):
     }
     for r in report["results"]:
         assert len(r["run_seconds"]) == 3
+        # Where the time went (``--passes``): median seconds by pass, the rest as "other".
+        assert {"rays to cells", "to metres", "other"} <= set(r["passes"])
+        assert ("march" if r["method"] == "march" else "ray order") in r["passes"] or "bins" in r["passes"]
         assert r["rays_per_second"] == pytest.approx(r["rays"] / sorted(r["run_seconds"])[1])
         base = numba[r["method"], r["view"], r["depression"]]
         assert r["vs_numba"] == pytest.approx(sorted(b / t for b, t in zip(base, r["run_seconds"]))[1])

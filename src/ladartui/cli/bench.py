@@ -9,7 +9,8 @@ the occupancy set-up time and its memory. Two views: ``wide`` (the sensor's
 default 10 degree field of view from 85 m, both methods) and ``narrow`` (a 3
 degree view from 150 m up, looking along bearing 60 degrees, exact only: the
 geometry of the side-by-side comparison with Embree). Backends come from the
-registry, so a new backend appears here by registering itself.
+registry, so a new backend appears here by registering itself. Every row keeps
+its median seconds by pass; ``--passes`` prints them (cli/bench_passes.py).
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.atomic import atomic_path
+from ladartui.cli.bench_passes import pass_medians, print_passes
 from ladartui.errors import BackendUnavailable
 from ladartui.tracing.backend import METHODS
 
@@ -53,6 +55,12 @@ def add_parser(subparsers):
     )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.add_argument("--runs", type=int, default=None, help="timed runs per case (median)")
+    parser.add_argument(
+        "--passes",
+        action="store_true",
+        help="also show where the exact scans spend their time: milliseconds by pass "
+        "(rays to cells, bins, voxels in view, tile lists, tile tests, ...)",
+    )
     parser.add_argument(
         "--orbit",
         action="store_true",
@@ -85,6 +93,10 @@ def run(args):
         print(json.dumps(report, indent=2))
     else:
         _print_table(report)
+        if args.passes:
+            from rich.console import Console
+
+            print_passes(Console(), report)
     return 0
 
 
@@ -281,6 +293,7 @@ def run_bench(quick=False, runs=None) -> dict:
             times: dict[str, list[float]] = {name: [] for name in backends}
             cpu: dict[str, list[float]] = {name: [] for name in backends}
             orders: dict[str, set[str]] = {name: set() for name in backends}  # over the timed runs
+            passes: dict[str, list[dict[str, float]]] = {name: [] for name in backends}
             for _ in range(runs):
                 for name in backends:
                     trace(occupancy, origins, directions, backend=name, **kwargs)
@@ -289,6 +302,7 @@ def run_bench(quick=False, runs=None) -> dict:
                     timed = trace(occupancy, origins, directions, backend=name, **kwargs)
                     times[name].append(time.perf_counter() - t)
                     orders[name].add(timed.info.get("order", "ray"))
+                    passes[name].append(timed.info.get("passes", {}))
                     cpu[name].append(time.process_time() - c)
             for name, backend in backends.items():
                 median = statistics.median(times[name])
@@ -312,6 +326,8 @@ def run_bench(quick=False, runs=None) -> dict:
                         "voxel_hits": float(np.mean(result.kind == 1)),
                         "ground_hits": float(np.mean(result.kind == 2)),
                         "order": "/".join(sorted(orders[name])),
+                        # Median seconds by pass (tracing/passes.py), "other" the rest of a call.
+                        "passes": pass_medians(times[name], passes[name]),
                         "device": _device(backend.describe()),
                     }
                 )

@@ -26,6 +26,7 @@ from ladartui.tracing.backend import (
     get_backend,
 )
 from ladartui.tracing.config import DEFAULT_STEP
+from ladartui.tracing.passes import recording, timed
 
 __all__ = [
     "trace",
@@ -123,25 +124,29 @@ def trace(
     # moves a ray by nothing measurable), origins in cell space.
     from ladartui.tracing.prepare import rays_to_cells  # numba: loaded on first trace
 
-    origin_cells, unit, block_bounds = rays_to_cells(origins, directions, voxel_size, TINY)
-    started = time.perf_counter()
-    cells = engine.trace_cells(
-        occupancy,
-        origin_cells,
-        unit,
-        method=method,
-        step=float(step),
-        precision=precision,
-        cancel=cancel,
-        block_bounds=block_bounds,
-    )
-    info = dict(cells.info)
-    info["seconds_total"] = time.perf_counter() - started
-    metres = cells.t
-    if metres.base is None and metres.flags.writeable:  # the backend's own new array: scaled in place
-        metres *= voxel_size
-    else:
-        metres = metres * voxel_size
+    with recording() as passes:
+        with timed("rays to cells"):
+            origin_cells, unit, block_bounds = rays_to_cells(origins, directions, voxel_size, TINY)
+        started = time.perf_counter()
+        cells = engine.trace_cells(
+            occupancy,
+            origin_cells,
+            unit,
+            method=method,
+            step=float(step),
+            precision=precision,
+            cancel=cancel,
+            block_bounds=block_bounds,
+        )
+        info = dict(cells.info)
+        info["seconds_total"] = time.perf_counter() - started
+        with timed("to metres"):
+            metres = cells.t
+            if metres.base is None and metres.flags.writeable:  # the backend's own new array: scaled in place
+                metres *= voxel_size
+            else:
+                metres = metres * voxel_size
+    info["passes"] = passes
     return TraceResult(cells.kind, cells.index, metres, name, method, info)
 
 

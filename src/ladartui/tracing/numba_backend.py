@@ -28,6 +28,7 @@ from ladartui.tracing.bundle import bundle_start, halo_arrays
 from ladartui.tracing.config import BLOCK, BUNDLE, INF, SCAN_BLOCK
 from ladartui.tracing.march import march_kernel
 from ladartui.tracing.order_choice import RAY_SAMPLE, OrderChoice, trace_in_blocks
+from ladartui.tracing.passes import timed
 from ladartui.tracing.prepare import float_rows, one_origin, origin_rows
 from ladartui.tracing.scan_rays import cone_frame
 from ladartui.tracing.tile_tests import trace_scan
@@ -429,53 +430,54 @@ class NumbaBackend:
         started = time.perf_counter()
 
         def ray_order(a, b):
-            for c in range(a, b, BLOCK):
-                check_cancelled(cancel, "trace cancelled")
-                d = min(b, c + BLOCK)
-                if method == "exact":
-                    _exact_kernel(
-                        origin_rows(orig[c:d]),
-                        dirs[c:d],
-                        occ.root,
-                        occ.regions,
-                        occ.tiles,
-                        occ.bricks,
-                        blocks,
-                        occ.columns,
-                        cubes,
-                        corg,
-                        cdims,
-                        *halo,
-                        lo,
-                        hi,
-                        rorg,
-                        rdims,
-                        nx,
-                        ny,
-                        kind[c:d],
-                        index[c:d],
-                        t[c:d],
-                    )
-                else:
-                    march_kernel(
-                        origin_rows(orig[c:d]),
-                        dirs[c:d],
-                        float(step),
-                        float(occ.zmax),
-                        occ.root,
-                        occ.regions,
-                        occ.tiles,
-                        occ.bricks,
-                        lo,
-                        hi,
-                        rorg,
-                        rdims,
-                        nx,
-                        ny,
-                        kind[c:d],
-                        index[c:d],
-                        t[c:d],
-                    )
+            with timed("ray order" if method == "exact" else "march"):
+                for c in range(a, b, BLOCK):
+                    check_cancelled(cancel, "trace cancelled")
+                    d = min(b, c + BLOCK)
+                    if method == "exact":
+                        _exact_kernel(
+                            origin_rows(orig[c:d]),
+                            dirs[c:d],
+                            occ.root,
+                            occ.regions,
+                            occ.tiles,
+                            occ.bricks,
+                            blocks,
+                            occ.columns,
+                            cubes,
+                            corg,
+                            cdims,
+                            *halo,
+                            lo,
+                            hi,
+                            rorg,
+                            rdims,
+                            nx,
+                            ny,
+                            kind[c:d],
+                            index[c:d],
+                            t[c:d],
+                        )
+                    else:
+                        march_kernel(
+                            origin_rows(orig[c:d]),
+                            dirs[c:d],
+                            float(step),
+                            float(occ.zmax),
+                            occ.root,
+                            occ.regions,
+                            occ.tiles,
+                            occ.bricks,
+                            lo,
+                            hi,
+                            rorg,
+                            rdims,
+                            nx,
+                            ny,
+                            kind[c:d],
+                            index[c:d],
+                            t[c:d],
+                        )
 
         def object_order_block(a, b, max_voxels):
             bounds = None if block_bounds is None else block_bounds[a // SCAN_BLOCK]

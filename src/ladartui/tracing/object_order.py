@@ -46,6 +46,7 @@ from numba import njit, prange
 
 from ladartui.tracing.config import EPS, INF, MIN_COS, NEAR_MARGIN, PARTS
 from ladartui.tracing.llvm_ops import trailing_zeros
+from ladartui.tracing.passes import timed
 from ladartui.tracing.tile_lists import tile_lists
 
 
@@ -377,11 +378,13 @@ def scan_voxels(occ, frame, grid, nb, max_voxels, tile_shift):
     """(vox, nears, tile_starts, listed): the voxels in view of a scan whose rays are
     binned by ``grid`` (``voxels_in_view``), listed per tile of ``1 << tile_shift`` bins
     a side (``voxels_per_tile``); None when ``voxels_in_view`` finds none to give."""
-    found = voxels_in_view(occ, frame, grid, nb, max_voxels)
+    with timed("voxels in view"):
+        found = voxels_in_view(occ, frame, grid, nb, max_voxels)
     if found is None:
         return None
     vox, nears = found
-    tile_starts, listed = tile_lists(vox, nb, tile_shift, np.arange(len(vox), dtype=np.int64))
+    with timed("tile lists"):
+        tile_starts, listed = tile_lists(vox, nb, tile_shift, np.arange(len(vox), dtype=np.int64))
     return vox, nears, tile_starts, listed
 
 

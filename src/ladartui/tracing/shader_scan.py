@@ -25,6 +25,7 @@ from numba import njit, prange
 from ladartui.tracing.answers import ray_answer, voxel_entry
 from ladartui.tracing.config import INF, NO_CELL, PARTS
 from ladartui.tracing.object_order import voxels_in_view
+from ladartui.tracing.passes import timed
 from ladartui.tracing.scan_rays import bin_order, scan_grid
 from ladartui.tracing.tile_lists import tile_lists
 
@@ -146,12 +147,14 @@ def prepare_shader_scan(occ, orig, dirs, frame, max_voxels, tile_shift):
     shader (tiles of ``1 << tile_shift`` bins a side); None when it cannot be
     projected, has more than ``max_voxels`` voxels in view, or its voxels' cells do
     not pack into 32 bits (ray order then)."""
-    binned = scan_grid(dirs, frame)
-    if binned is None:
-        return None
-    nb, p, q, grid = binned
-    order, bin_starts, grid = bin_order(p, q, grid, nb, tile_shift)
-    voxels = voxels_in_view(occ, frame, grid, nb, max_voxels)
+    with timed("bins"):
+        binned = scan_grid(dirs, frame)
+        if binned is None:
+            return None
+        nb, p, q, grid = binned
+        order, bin_starts, grid = bin_order(p, q, grid, nb, tile_shift)
+    with timed("voxels in view"):
+        voxels = voxels_in_view(occ, frame, grid, nb, max_voxels)
     if voxels is None:
         return None
     vox, nears = voxels
@@ -159,12 +162,13 @@ def prepare_shader_scan(occ, orig, dirs, frame, max_voxels, tile_shift):
     if packing is None:
         return None
     offset, shifts, _ = packing
-    # The lists hold the shader's words themselves (two u32 as one u64 each).
-    words = voxel_words(vox, nears, offset, shifts).view(np.uint64).reshape(-1)
-    tile_starts, listed = tile_lists(vox, nb, tile_shift, words)
-    entries = listed.view(np.uint32).reshape(-1, 2)
-    tile_rests(tile_starts, entries)
-    ray_tiles = ray_tiles_of(bin_starts, tile_shift) if len(bin_starts) else np.empty(0, np.uint32)
+    with timed("tile lists"):
+        # The lists hold the shader's words themselves (two u32 as one u64 each).
+        words = voxel_words(vox, nears, offset, shifts).view(np.uint64).reshape(-1)
+        tile_starts, listed = tile_lists(vox, nb, tile_shift, words)
+        entries = listed.view(np.uint32).reshape(-1, 2)
+        tile_rests(tile_starts, entries)
+        ray_tiles = ray_tiles_of(bin_starts, tile_shift) if len(bin_starts) else np.empty(0, np.uint32)
     return ShaderScan(order, ray_tiles, tile_starts.astype(np.uint32), entries, packing, tile_shift)
 
 

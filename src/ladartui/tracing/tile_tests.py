@@ -19,6 +19,7 @@ from ladartui.tracing.answers import put_answer
 from ladartui.tracing.config import INF, MAX_TILE_SHIFT
 from ladartui.tracing.llvm_ops import prefetch_row, prefetch_row_for_write, trailing_zeros
 from ladartui.tracing.object_order import scan_voxels, spread_stride
+from ladartui.tracing.passes import timed
 from ladartui.tracing.scan_rays import bin_order, scan_grid
 from ladartui.tracing.slab_lanes import LANES, slab_lanes, slab_lanes_from
 
@@ -239,35 +240,37 @@ def trace_scan(occ, orig, dirs, frame, max_voxels, nx, ny, kind, index, t, share
     written) when it is no scan for it: its rays cannot be binned (``scan_grid``), or
     ``scan_voxels`` finds a brick it cannot project or more than ``max_voxels`` in view.
     ``shared_origin``: every ray starts at ``orig[0]`` (``prepare.one_origin``)."""
-    binned = scan_grid(dirs, frame)
-    if binned is None:
-        return False
-    nb, p, q, grid = binned
-    shift = tile_shift_for(nb)
-    order, bin_starts, grid = bin_order(p, q, grid, nb, shift)
+    with timed("bins"):
+        binned = scan_grid(dirs, frame)
+        if binned is None:
+            return False
+        nb, p, q, grid = binned
+        shift = tile_shift_for(nb)
+        order, bin_starts, grid = bin_order(p, q, grid, nb, shift)
     voxels = scan_voxels(occ, frame, grid, nb, max_voxels, shift)
     if voxels is None:
         return False
     vox, nears, tile_starts, listed = voxels
     nt = -(-nb >> shift)
-    test_tiles(
-        vox,
-        nears,
-        tile_starts,
-        listed,
-        nt,
-        shift,
-        spread_stride(nt * nt),
-        bin_starts,
-        order,
-        nb,
-        orig,
-        shared_origin,
-        dirs,
-        nx,
-        ny,
-        kind,
-        index,
-        t,
-    )
+    with timed("tile tests"):
+        test_tiles(
+            vox,
+            nears,
+            tile_starts,
+            listed,
+            nt,
+            shift,
+            spread_stride(nt * nt),
+            bin_starts,
+            order,
+            nb,
+            orig,
+            shared_origin,
+            dirs,
+            nx,
+            ny,
+            kind,
+            index,
+            t,
+        )
     return True

@@ -71,6 +71,7 @@ from ladartui.tracing.config import (
     SCAN_BLOCK,
 )
 from ladartui.tracing.order_choice import RAY_SAMPLE, OrderChoice, trace_in_blocks
+from ladartui.tracing.passes import timed
 from ladartui.tracing.prepare import float_rows, one_origin, origin_rows
 from ladartui.tracing.scan_rays import cone_frame
 from ladartui.tracing.shader_scan import entry_answers, prepare_shader_scan
@@ -328,7 +329,8 @@ class WgpuBackend:
                 return self._trace_scans(occupancy, origins, directions, order, cancel, info, block_bounds)
             info["order"] = "ray"
             shared = one_origin(block_bounds, 0, len(origins))
-            return self._trace(occupancy, origins, directions, method, step, used, cancel, info, shared)
+            with timed("ray order" if method == "exact" else "march"):
+                return self._trace(occupancy, origins, directions, method, step, used, cancel, info, shared)
 
     def _trace_scans(self, occupancy, origins, directions, order, cancel, info, block_bounds):
         """Exact f64 in blocks, each in object or ray order (``trace_in_blocks``)."""
@@ -338,9 +340,10 @@ class WgpuBackend:
         def ray_order(a, b):
             shared = one_origin(block_bounds, a, b)
             into = (kind[a:b], index[a:b], t[a:b])
-            self._trace(
-                occupancy, origins[a:b], directions[a:b], "exact", 0.5, "f64", cancel, info, shared, into
-            )
+            with timed("ray order"):
+                self._trace(
+                    occupancy, origins[a:b], directions[a:b], "exact", 0.5, "f64", cancel, info, shared, into
+                )
 
         def object_order_block(a, b, max_voxels):
             bounds = None if block_bounds is None else block_bounds[a // SCAN_BLOCK]
@@ -385,12 +388,16 @@ class WgpuBackend:
             return False
         assert self._scans is not None  # the device is open
         rows = origin_rows(origins, shared_origin)
-        found = self._scans.test_tiles(rows, directions, scan, shared_origin)
+        with timed("device"):  # uploads, the shader, the read-back
+            found = self._scans.test_tiles(rows, directions, scan, shared_origin)
         if found is None:
             return False
         nx, ny = float(occupancy.shape[0]), float(occupancy.shape[1])
         offset, shifts, masks = scan.packing
-        entry_answers(found, offset, shifts, masks, rows, shared_origin, directions, nx, ny, kind, index, t)
+        with timed("answers"):
+            entry_answers(
+                found, offset, shifts, masks, rows, shared_origin, directions, nx, ny, kind, index, t
+            )
         return True
 
     def _trace(
