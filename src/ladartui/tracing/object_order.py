@@ -115,14 +115,16 @@ def voxel_bins(x0, y0, z0, centre, grow, axis, u, v, grid, nb):
     w_low = w_centre - (hx * abs(axis[0]) + hy * abs(axis[1]) + hz * abs(axis[2]))
     if not w_low > 0.0:
         return box_bins(x0, y0, z0, 1, centre, grow, axis, u, v, grid, nb)
-    pc = (cx * u[0] + cy * u[1] + cz * u[2]) / w_centre
-    qc = (cx * v[0] + cy * v[1] + cz * v[2]) / w_centre
+    # Reciprocals, two divisions for four (EPS covers the extra rounding).
+    inv_centre, inv_low = 1.0 / w_centre, 1.0 / w_low
+    pc = (cx * u[0] + cy * u[1] + cz * u[2]) * inv_centre
+    qc = (cx * v[0] + cy * v[1] + cz * v[2]) * inv_centre
     hp = (
         hx * abs(u[0] - pc * axis[0]) + hy * abs(u[1] - pc * axis[1]) + hz * abs(u[2] - pc * axis[2])
-    ) / w_low
+    ) * inv_low
     hq = (
         hx * abs(v[0] - qc * axis[0]) + hy * abs(v[1] - qc * axis[1]) + hz * abs(v[2] - qc * axis[2])
-    ) / w_low
+    ) * inv_low
     return _rectangle_bins(pc - hp, pc + hp, qc - hq, qc + hq, w_low, grid, nb)
 
 
@@ -134,26 +136,28 @@ def _rectangle_bins(pl, ph, ql, qh, depth, grid, nb):
     only lower it)."""
     near = depth - NEAR_MARGIN * (1.0 + depth)
     # Bin numbers clamped as floats first: with a tiny bin step they overflow int64.
-    i0 = _first_bin(pl - EPS, grid[0], grid[1], grid[4], nb)
-    i1 = _last_bin(ph + EPS, grid[0], grid[1], grid[4], nb)
-    j0 = _first_bin(ql - EPS, grid[2], grid[3], grid[5], nb)
-    j1 = _last_bin(qh + EPS, grid[2], grid[3], grid[5], nb)
+    # By the steps' reciprocals, as the rays' bins are (scan_rays._bin_scales).
+    p_scale, q_scale = 1.0 / grid[1], 1.0 / grid[3]
+    i0 = _first_bin(pl - EPS, grid[0], p_scale, grid[4], nb)
+    i1 = _last_bin(ph + EPS, grid[0], p_scale, grid[4], nb)
+    j0 = _first_bin(ql - EPS, grid[2], q_scale, grid[5], nb)
+    j1 = _last_bin(qh + EPS, grid[2], q_scale, grid[5], nb)
     if i1 < 0 or j1 < 0 or i0 >= nb or j0 >= nb:
         return 0, -1, 0, -1, 1, near
     return max(i0, 0), min(i1, nb - 1), max(j0, 0), min(j1, nb - 1), 1, near
 
 
 @njit(nogil=True, cache=True, inline="always")
-def _first_bin(x, x0, step, slack, nb):
+def _first_bin(x, x0, scale, slack, nb):
     """The first bin whose ray can lie at or above x (its middle within ``slack`` of
-    the ray), limited to -1 .. nb."""
-    return np.int64(math.ceil(min(max((x - x0) / step - 0.5 - slack, -1.0), float(nb))))
+    the ray; ``scale`` bins a unit of x), limited to -1 .. nb."""
+    return np.int64(math.ceil(min(max((x - x0) * scale - 0.5 - slack, -1.0), float(nb))))
 
 
 @njit(nogil=True, cache=True, inline="always")
-def _last_bin(x, x0, step, slack, nb):
+def _last_bin(x, x0, scale, slack, nb):
     """The last bin whose ray can lie at or below x, limited to -1 .. nb."""
-    return np.int64(math.floor(min(max((x - x0) / step - 0.5 + slack, -1.0), float(nb))))
+    return np.int64(math.floor(min(max((x - x0) * scale - 0.5 + slack, -1.0), float(nb))))
 
 
 @njit(nogil=True, cache=True, inline="always")
