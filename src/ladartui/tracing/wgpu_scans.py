@@ -4,9 +4,9 @@ read-back of shaders/object_order.wgsl (the host's half is tracing/shader_scan.p
 A scan's arrays go into storage buffers kept from scan to scan (grown when a
 larger scan needs more). On a CPU adapter (lavapipe: the device's memory is the
 host's) the buffers are mapped by the host, which writes and reads them without
-the staging copy each way that ``queue.write_buffer`` and ``read_buffer`` make;
-the inputs are mapped again for the next scan as soon as one ends. Elsewhere
-(a GPU) the queue's copies.
+the staging copy each way that ``queue.write_buffer`` and ``read_buffer`` make
+(``write_mapped`` copies on numba's threads); the inputs are mapped again for
+the next scan as soon as one ends. Elsewhere (a GPU) the queue's copies.
 
 ``wgpu`` is imported only inside the methods, as in tracing/wgpu_backend.py.
 """
