@@ -116,7 +116,7 @@ def test_trace_reports_its_passes(forest):
     wall = time.perf_counter() - started
     passes = result.info["passes"]
     assert {"rays to cells", "to metres"} <= set(passes)
-    if "object" in result.info["order"]:
-        assert OBJECT_ORDER_PASSES | {"tile tests"} <= set(passes)
+    for order in result.info["order"].split("+"):  # each order that ran has its passes
+        assert ({"ray order"} if order == "ray" else OBJECT_ORDER_PASSES | {"tile tests"}) <= set(passes)
     assert sum(passes.values()) <= wall
     assert np.all(np.isfinite(list(passes.values())))

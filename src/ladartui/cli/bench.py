@@ -302,7 +302,7 @@ def run_bench(quick=False, runs=None) -> dict:
                     timed = trace(occupancy, origins, directions, backend=name, **kwargs)
                     times[name].append(time.perf_counter() - t)
                     orders[name].add(timed.info.get("order", "ray"))
-                    passes[name].append(timed.info.get("passes", {}))
+                    passes[name].append(timed.info["passes"])
                     cpu[name].append(time.process_time() - c)
             for name, backend in backends.items():
                 median = statistics.median(times[name])

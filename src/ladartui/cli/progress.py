@@ -20,12 +20,14 @@ T = TypeVar("T")
 POLL_SECONDS = 0.1  # how soon a Ctrl-C is noticed while waiting
 
 
-def progress_display(console, description, after, **options):
-    """rich's Progress across the console's width: the ``description`` column, a bar
-    taking the room the texts leave, then the columns ``after`` (a fixed 40-cell bar
-    cut the texts and times short in an 80-column terminal)."""
-    from rich.progress import BarColumn, Progress
+def progress_display(console, after, description=None, **options):
+    """rich's Progress across the console's width: the ``description`` column (the
+    task's description by default), a bar taking the room the texts leave, then the
+    columns ``after`` (a fixed 40-cell bar cut the texts and times short in an
+    80-column terminal)."""
+    from rich.progress import BarColumn, Progress, TextColumn
 
+    description = description or TextColumn("{task.description}")
     return Progress(description, BarColumn(bar_width=None), *after, console=console, expand=True, **options)
 
 

@@ -124,7 +124,7 @@ def _study_with_progress(scenario, pulses, settings, backend, console, state):
 
     cancel = threading.Event()
     after = (TextColumn("{task.percentage:>5.1f} %"), TimeElapsedColumn(), TimeRemainingColumn())
-    with progress_display(console, TextColumn("{task.description}"), after, transient=False) as bar:
+    with progress_display(console, after, transient=False) as bar:
         # Until the first scan is done (a first run also compiles the kernels, about a minute).
         task = bar.add_task("tracing scan 1 (compiling kernels on a first run)", total=1.0)
 

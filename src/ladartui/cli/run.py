@@ -113,7 +113,7 @@ def run_progress(console, **options):
         TimeElapsedColumn(),
         TimeRemainingColumn(),
     )
-    return progress_display(console, TextColumn("{task.description}"), after, **options)
+    return progress_display(console, after, **options)
 
 
 def _simulate_with_progress(scenario, args, console):

@@ -106,10 +106,7 @@ def _run_with_progress(console, inputs, settings, runs, warmup):
     )
     cancel = threading.Event()
     progress_bar = progress_display(
-        console,
-        TextColumn("{task.description}"),
-        (TextColumn("{task.completed}/{task.total} traces"), TimeElapsedColumn()),
-        transient=True,
+        console, (TextColumn("{task.completed}/{task.total} traces"), TimeElapsedColumn()), transient=True
     )
     task = progress_bar.add_task("starting", total=None)
 

@@ -202,7 +202,7 @@ def _sweep_with_progress(spec, args, console):
         else ("this process" if args.serial else "local cluster")
     )
     try:
-        with progress_display(console, TextColumn("{task.description}"), after, transient=False) as bar:
+        with progress_display(console, after, transient=False) as bar:
             task = bar.add_task(f"sweep on {where}", total=len(spec.variants), note="starting")
 
             def report(p):

@@ -134,7 +134,7 @@ def _work(args, placement, outputs, console, cancel):
     after = (TextColumn("{task.fields[done]}", markup=False), TimeElapsedColumn())
     # A bar only on a terminal: a log or a pipe gets the summary alone.
     with progress_display(
-        console, description, after, transient=True, disable=not console.is_terminal
+        console, after, description, transient=True, disable=not console.is_terminal
     ) as bar:
         task = bar.add_task(f"reading {args.mesh}", total=None, done="")
         mesh = load_mesh(args.mesh, scale=args.scale, up=args.up)

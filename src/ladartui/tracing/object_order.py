@@ -47,6 +47,7 @@ from numba import njit, prange
 from ladartui.tracing.config import EPS, INF, MIN_COS, NEAR_MARGIN, PARTS
 from ladartui.tracing.llvm_ops import trailing_zeros
 from ladartui.tracing.passes import timed
+from ladartui.tracing.scan_rays import bin_scales
 from ladartui.tracing.tile_lists import tile_lists
 
 
@@ -136,8 +137,7 @@ def _rectangle_bins(pl, ph, ql, qh, depth, grid, nb):
     only lower it)."""
     near = depth - NEAR_MARGIN * (1.0 + depth)
     # Bin numbers clamped as floats first: with a tiny bin step they overflow int64.
-    # By the steps' reciprocals, as the rays' bins are (scan_rays._bin_scales).
-    p_scale, q_scale = 1.0 / grid[1], 1.0 / grid[3]
+    _, p_scale, _, q_scale = bin_scales(grid)  # by the rays' rule
     i0 = _first_bin(pl - EPS, grid[0], p_scale, grid[4], nb)
     i1 = _last_bin(ph + EPS, grid[0], p_scale, grid[4], nb)
     j0 = _first_bin(ql - EPS, grid[2], q_scale, grid[5], nb)
@@ -382,8 +382,7 @@ def scan_voxels(occ, frame, grid, nb, max_voxels, tile_shift):
     """(vox, nears, tile_starts, listed): the voxels in view of a scan whose rays are
     binned by ``grid`` (``voxels_in_view``), listed per tile of ``1 << tile_shift`` bins
     a side (``voxels_per_tile``); None when ``voxels_in_view`` finds none to give."""
-    with timed("voxels in view"):
-        found = voxels_in_view(occ, frame, grid, nb, max_voxels)
+    found = voxels_in_view(occ, frame, grid, nb, max_voxels)
     if found is None:
         return None
     vox, nears = found
@@ -392,6 +391,7 @@ def scan_voxels(occ, frame, grid, nb, max_voxels, tile_shift):
     return vox, nears, tile_starts, listed
 
 
+@timed("voxels in view")
 def voxels_in_view(occ, frame, grid, nb, max_voxels):
     """(vox, nears) of ``emit_voxels`` for the voxels in view of a scan whose rays are
     binned by ``grid``; None when a brick straddles the aircraft's plane near it, or

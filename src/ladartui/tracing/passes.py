@@ -3,9 +3,11 @@
 ``trace()`` opens a ``recording`` for its call; the passes inside it (the
 conversion to cell space, a scan's binning, its voxels in view, its tile lists
 and tile tests, ray order, a device's upload and shader, the answers) each run
-under ``timed(name)``, which adds their wall time to the open recording of
-their thread (none open: nothing). Either way it costs about a microsecond a
-pass, against milliseconds a scan, so the backends call it unconditionally.
+under ``timed(name)`` (a block, or a decorator on the pass's function: the
+scan's bins and voxels in view, timed where both backends call them), which
+adds their wall time to the open recording of their thread (none open:
+nothing). Either way it costs about a microsecond a pass, against milliseconds
+a scan, so the backends call it unconditionally.
 ``ladartui bench --passes`` prints the medians: which pass limits a scan.
 """
 

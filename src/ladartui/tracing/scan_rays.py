@@ -18,6 +18,7 @@ import numpy as np
 from numba import njit, prange
 
 from ladartui.tracing.config import INF, MAX_SPREAD, MIN_COS, PARTS
+from ladartui.tracing.passes import timed
 
 # Ray numbers in bin order are u32 (a block holds far fewer rays): half the bytes
 # the tile tests read, and the shader's own type. NO_RAY marks a bin left empty.
@@ -143,7 +144,7 @@ def bin_key(i, j, tiles_per_side, shift):
 
 
 @njit(nogil=True, cache=True, inline="always")
-def _bin_scales(grid):
+def bin_scales(grid):
     """(p0, p_scale, q0, q_scale): a ray's position in bins is ``((p - p0) * p_scale,
     (q - q0) * q_scale)``, its bin the whole part of that (``_bin_at``). By the steps'
     reciprocals (1.1x the scatter): the measured slack comes from the same products,
@@ -160,7 +161,7 @@ def _bin_at(position, nb):
 @njit(parallel=True, nogil=True, cache=True)
 def _bin_keys(p, q, grid, nb, shift, key_of):
     nt = -(-nb >> shift)
-    p0, p_scale, q0, q_scale = _bin_scales(grid)
+    p0, p_scale, q0, q_scale = bin_scales(grid)
     for r in prange(p.shape[0]):
         i, j = _bin_at((p[r] - p0) * p_scale, nb), _bin_at((q[r] - q0) * q_scale, nb)
         key_of[r] = bin_key(i, j, nt, shift)
@@ -199,7 +200,7 @@ def _scatter_one_per_bin(p, q, grid, nb, shift, order, slack):
     for k in prange(n):
         order[k] = NO_RAY
     far = np.zeros((PARTS, 2))
-    p0, p_scale, q0, q_scale = _bin_scales(grid)
+    p0, p_scale, q0, q_scale = bin_scales(grid)
     for part in prange(PARTS):
         far_p, far_q = 0.0, 0.0
         for r in range(part * n // PARTS, (part + 1) * n // PARTS):
@@ -239,6 +240,7 @@ def ray_grid(dirs, axis, u, v, nb):
     return p, q, np.array([pmin - 0.5 * p_step, p_step, qmin - 0.5 * q_step, q_step, 0.5, 0.5])
 
 
+@timed("bins")
 def scan_grid(dirs, frame):
     """(nb, p, q, grid) of a scan with ``frame`` (``cone_frame``): nb = ceil(sqrt(N))
     bins a side over its rays (``ray_grid``); None when a ray is not of unit length
@@ -248,6 +250,7 @@ def scan_grid(dirs, frame):
     return None if gnomonic is None else (nb, *gnomonic)
 
 
+@timed("bins")
 def bin_order(p, q, grid, nb, shift):
     """(order, starts, grid) of the rays in bin order, without copying them: sorted
     position s is ray ``order[s]`` (u32); the rays of the bin with key ``b`` (``bin_key``)

@@ -147,14 +147,12 @@ def prepare_shader_scan(occ, orig, dirs, frame, max_voxels, tile_shift):
     shader (tiles of ``1 << tile_shift`` bins a side); None when it cannot be
     projected, has more than ``max_voxels`` voxels in view, or its voxels' cells do
     not pack into 32 bits (ray order then)."""
-    with timed("bins"):
-        binned = scan_grid(dirs, frame)
-        if binned is None:
-            return None
-        nb, p, q, grid = binned
-        order, bin_starts, grid = bin_order(p, q, grid, nb, tile_shift)
-    with timed("voxels in view"):
-        voxels = voxels_in_view(occ, frame, grid, nb, max_voxels)
+    binned = scan_grid(dirs, frame)
+    if binned is None:
+        return None
+    nb, p, q, grid = binned
+    order, bin_starts, grid = bin_order(p, q, grid, nb, tile_shift)
+    voxels = voxels_in_view(occ, frame, grid, nb, max_voxels)
     if voxels is None:
         return None
     vox, nears = voxels

@@ -240,13 +240,12 @@ def trace_scan(occ, orig, dirs, frame, max_voxels, nx, ny, kind, index, t, share
     written) when it is no scan for it: its rays cannot be binned (``scan_grid``), or
     ``scan_voxels`` finds a brick it cannot project or more than ``max_voxels`` in view.
     ``shared_origin``: every ray starts at ``orig[0]`` (``prepare.one_origin``)."""
-    with timed("bins"):
-        binned = scan_grid(dirs, frame)
-        if binned is None:
-            return False
-        nb, p, q, grid = binned
-        shift = tile_shift_for(nb)
-        order, bin_starts, grid = bin_order(p, q, grid, nb, shift)
+    binned = scan_grid(dirs, frame)
+    if binned is None:
+        return False
+    nb, p, q, grid = binned
+    shift = tile_shift_for(nb)
+    order, bin_starts, grid = bin_order(p, q, grid, nb, shift)
     voxels = scan_voxels(occ, frame, grid, nb, max_voxels, shift)
     if voxels is None:
         return False
