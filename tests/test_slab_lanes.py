@@ -143,3 +143,36 @@ def test_the_intrinsic_is_vector_code_and_rejects_other_layouts():
             np.zeros(16),
             np.zeros(16, np.int64),
         )
+
+
+@pytest.mark.parametrize("shared", [False, True])
+def test_lanes_bound_at_or_before_near_take_no_test_and_keep_their_answers(shared):
+    # Every taking-part lane already has a bound no further than the voxel's near, so
+    # none can hit it (the early way out): nothing is written, and the lanes whose
+    # bound lies beyond ``after`` are still alive. The rays would hit the voxel.
+    rays = np.zeros((9, 2 * LANES))
+    rays[0, :], rays[1, :], rays[2, :] = 3.5, 4.5, 10.0
+    rays[5, :], rays[8, :] = -1.0, -1.0
+    rays[6, :] = rays[7, :] = INF
+    cols = np.arange(2 * LANES)
+    bounds = np.array([3.0, 3.5, 2.0, 3.5, 3.2, 1.0, 5.0, 2.0] + [INF] * LANES)
+    voxels = np.arange(2 * LANES)
+    todo = 0b10111111  # lane 6 is not to do (its bound would let it hit)
+    want_bounds, want_voxels = bounds.copy(), voxels.copy()
+    near, after = 3.5, 3.1  # (later voxels may come nearer than this one)
+
+    def call():
+        if shared:
+            return vector_from(
+                rays, 0, 3.5, 4.5, 10.0, 3.0, 4.0, 5.0, near, after, 9, todo, cols, 8, bounds, voxels
+            )
+        return vector(rays, 0, 3.0, 4.0, 5.0, near, after, 9, todo, cols, 8, bounds, voxels)
+
+    got = call()
+    assert got == (0b00011010, 0, 0)  # lanes 1, 3 and 4 lie beyond after
+    assert np.array_equal(bounds, want_bounds) and np.array_equal(voxels, want_voxels)
+    # One lane beyond near: the call now tests, and that lane alone hits, at t = 4.
+    bounds[4] = 5.5
+    got = call()
+    assert got == (0b00011010, 1, 0) and bounds[4] == 4.0 and voxels[4] == 9
+    assert np.array_equal(np.delete(bounds, 4), np.delete(want_bounds, 4))

@@ -14,7 +14,8 @@ by the sign of the direction (``axis.slab``, ``boundary_t``), numba's
 and the hit rule ``bound > near and start < leave and start < bound``.
 ``slab_lanes_from`` is the same test for lanes that share one origin (a
 pinhole scan's): each axis's ``b - o`` and insideness are scalars there,
-worked out once for the eight lanes.
+worked out once for the eight lanes. When no lane's bound lies beyond the
+voxel's ``near``, none can hit and the slab math is skipped.
 """
 
 from __future__ import annotations
@@ -91,17 +92,77 @@ def _emit(context, builder, signature, args, shared, k):
         )
         return builder.load(pointer, align=8), pointer
 
-    def ray_row(row):
-        return lanes_at(0, [ir.Constant(i64, row), s], doubles)[0]
-
     def less(a, b):
         return builder.fcmp_ordered("<", a, b)
 
     def greater(a, b):
         return builder.fcmp_ordered(">", a, b)
 
+    cols = lanes_at(9 + k, [s], ints)[0]
+    bits = builder.shl(ir.Constant(ints, 1), cols)
+    positions = builder.add(splat(s, ints), ir.Constant(ints, list(range(LANES))))
+    in_span = builder.icmp_signed("<", positions, splat(scalar(10 + k, types.intp), ints))
+    todo = splat(scalar(8 + k, types.int64), ints)
+    on = builder.and_(in_span, builder.icmp_signed("!=", builder.and_(todo, bits), ir.Constant(ints, 0)))
+    bound, bound_at = lanes_at(11 + k, [s], doubles)
+    near, after = splat(scalar(5 + k, types.float64), doubles), splat(scalar(6 + k, types.float64), doubles)
+    either = cgutils.get_or_insert_function(
+        builder.module, ir.FunctionType(i64, [ints]), "llvm.vector.reduce.or.v8i64"
+    )
+
+    def alive_bins(bounds_now):
+        alive = builder.and_(on, greater(bounds_now, after))
+        return builder.call(either, [builder.select(alive, bits, ir.Constant(ints, 0))])
+
+    def mask_byte(mask):
+        return builder.bitcast(mask, i8)
+
+    # A lane whose bound is at or before the voxel's near cannot hit it (most candidates
+    # of a scan are rays behind their hit): when no lane can, the slab math is skipped
+    # (0.95x the tile tests on the peer rays). The answer goes through stack slots.
+    answer = [cgutils.alloca_once(builder, i64) for _ in range(3)]
+    for slot, value in zip(answer, (alive_bins(bound), ir.Constant(i64, 0), ir.Constant(i64, 0))):
+        builder.store(value, slot)
+    can_hit = builder.and_(on, greater(bound, near))
+    with builder.if_then(builder.icmp_unsigned("!=", mask_byte(can_hit), ir.Constant(i8, 0))):
+        start, leave = _start_and_leave(
+            context, builder, args, argtypes, shared, k, scalar, splat, lanes_at, s
+        )
+        hit = builder.and_(can_hit, builder.and_(less(start, leave), less(start, bound)))
+        new_bound = builder.select(hit, start, bound)
+        builder.store(new_bound, bound_at, align=8)
+        voxel, voxel_at = lanes_at(12 + k, [s], ints)
+        builder.store(builder.select(hit, splat(scalar(7 + k, types.int64), ints), voxel), voxel_at, align=8)
+        popcount = cgutils.get_or_insert_function(builder.module, ir.FunctionType(i8, [i8]), "llvm.ctpop.i8")
+        first_hits = builder.call(
+            popcount,
+            [
+                mask_byte(
+                    builder.and_(hit, builder.fcmp_ordered("==", bound, ir.Constant(doubles, float("inf"))))
+                )
+            ],
+        )
+        any_hit = builder.icmp_unsigned("!=", mask_byte(hit), ir.Constant(i8, 0))
+        for slot, value in zip(
+            answer, (alive_bins(new_bound), builder.zext(any_hit, i64), builder.zext(first_hits, i64))
+        ):
+            builder.store(value, slot)
+    return context.make_tuple(builder, signature.return_type, [builder.load(slot) for slot in answer])
+
+
+def _start_and_leave(context, builder, args, argtypes, shared, k, scalar, splat, lanes_at, s):
+    """The lanes' slab test: where each ray enters the voxel (not before 0) and leaves it."""
+    f64 = ir.DoubleType()
+    doubles = ir.VectorType(f64, LANES)
+
+    def ray_row(row):
+        return lanes_at(0, [ir.Constant(ir.IntType(64), row), s], doubles)[0]
+
+    def less(a, b):
+        return builder.fcmp_ordered("<", a, b)
+
     def numba_max(a, b):
-        return builder.select(greater(b, a), b, a)
+        return builder.select(builder.fcmp_ordered(">", b, a), b, a)
 
     def numba_min(a, b):
         return builder.select(less(b, a), b, a)
@@ -125,46 +186,14 @@ def _emit(context, builder, signature, args, shared, k):
             inside = builder.and_(less(lo, o), less(o, hi))
         t_lo = builder.fmul(from_lo, inv)
         t_hi = builder.fmul(from_hi, inv)
-        up, down = greater(d, zero), less(d, zero)
+        up, down = builder.fcmp_ordered(">", d, zero), less(d, zero)
         flat_enter = builder.select(inside, minus_inf, inf)
         flat_leave = builder.select(inside, inf, minus_inf)
         enters.append(builder.select(up, t_lo, builder.select(down, t_hi, flat_enter)))
         leaves.append(builder.select(up, t_hi, builder.select(down, t_lo, flat_leave)))
     start = numba_max(numba_max(enters[0], numba_max(enters[1], enters[2])), zero)
     leave = numba_min(leaves[0], numba_min(leaves[1], leaves[2]))
-
-    cols = lanes_at(9 + k, [s], ints)[0]
-    bits = builder.shl(ir.Constant(ints, 1), cols)
-    positions = builder.add(splat(s, ints), ir.Constant(ints, list(range(LANES))))
-    in_span = builder.icmp_signed("<", positions, splat(scalar(10 + k, types.intp), ints))
-    todo = splat(scalar(8 + k, types.int64), ints)
-    on = builder.and_(in_span, builder.icmp_signed("!=", builder.and_(todo, bits), ir.Constant(ints, 0)))
-
-    bound, bound_at = lanes_at(11 + k, [s], doubles)
-    near, after = splat(scalar(5 + k, types.float64), doubles), splat(scalar(6 + k, types.float64), doubles)
-    hit = builder.and_(
-        builder.and_(on, greater(bound, near)), builder.and_(less(start, leave), less(start, bound))
-    )
-    new_bound = builder.select(hit, start, bound)
-    builder.store(new_bound, bound_at, align=8)
-    voxel, voxel_at = lanes_at(12 + k, [s], ints)
-    builder.store(builder.select(hit, splat(scalar(7 + k, types.int64), ints), voxel), voxel_at, align=8)
-
-    def mask_byte(mask):
-        return builder.bitcast(mask, i8)
-
-    popcount = cgutils.get_or_insert_function(builder.module, ir.FunctionType(i8, [i8]), "llvm.ctpop.i8")
-    first_hits = builder.call(
-        popcount, [mask_byte(builder.and_(hit, builder.fcmp_ordered("==", bound, inf)))]
-    )
-    any_hit = builder.icmp_unsigned("!=", mask_byte(hit), ir.Constant(i8, 0))
-    alive = builder.and_(on, greater(new_bound, after))
-    either = cgutils.get_or_insert_function(
-        builder.module, ir.FunctionType(i64, [ints]), "llvm.vector.reduce.or.v8i64"
-    )
-    alive_bins = builder.call(either, [builder.select(alive, bits, ir.Constant(ints, 0))])
-    answer = [alive_bins, builder.zext(any_hit, i64), builder.zext(first_hits, i64)]
-    return context.make_tuple(builder, signature.return_type, answer)
+    return start, leave
 
 
 slab_lanes: Any = intrinsic(_typer)
