@@ -18,23 +18,54 @@ from ladartui.tracing.config import PARTS
 
 
 @njit(nogil=True, cache=True, inline="always")
-def _visit_tiles(vox, first, last, shift, nt, slots, listed, payload, place):
-    """For voxels first..last, every tile each covers: count it in ``slots[tile]``, or
-    (``place``) put the voxel's ``payload[e]`` at ``listed[slots[tile]]`` and step
-    that slot on."""
+def _count_tiles(vox, first, last, shift, nt, slots):
+    """Count voxels first..last in ``slots[tile]`` of every tile each covers. A voxel in
+    one tile, as most of numba's are, counts there; any other marks the four corners
+    of its rectangle of tiles in a difference array, whose running sums along rows
+    and columns are its counts: four steps however many tiles it covers (the
+    shader's 4 x 4 tiles: 0.78x the lists' time on the peer rays at 45 degrees)."""
+    w = nt + 1
+    corners = np.zeros(w * w, np.int64)
+    spread = False
+    for e in range(first, last):
+        if vox[e, 3] > vox[e, 4]:
+            continue
+        i0, j0 = vox[e, 3] >> shift, vox[e, 5] >> shift
+        i1, j1 = (vox[e, 4] >> shift) + 1, (vox[e, 6] >> shift) + 1
+        if i1 == i0 + 1 and j1 == j0 + 1:
+            slots[j0 * nt + i0] += 1
+            continue
+        spread = True
+        corners[j0 * w + i0] += 1
+        corners[j0 * w + i1] -= 1
+        corners[j1 * w + i0] -= 1
+        corners[j1 * w + i1] += 1
+    if not spread:
+        return
+    column = np.zeros(nt, np.int64)  # per column, the rows' running sums so far
+    for j in range(nt):
+        row = 0
+        for i in range(nt):
+            row += corners[j * w + i]
+            column[i] += row
+            slots[j * nt + i] += column[i]
+
+
+@njit(nogil=True, cache=True, inline="always")
+def _place_in_tiles(vox, first, last, shift, nt, slots, listed, payload):
+    """For voxels first..last, every tile each covers: put the voxel's ``payload[e]`` at
+    ``listed[slots[tile]]`` and step that slot on."""
     for e in range(first, last):
         if vox[e, 3] > vox[e, 4]:
             continue
         ti, tj = vox[e, 3] >> shift, vox[e, 5] >> shift
         if ti == vox[e, 4] >> shift and tj == vox[e, 6] >> shift:  # one tile, as most are: no loops
-            if place:
-                listed[slots[tj * nt + ti]] = payload[e]
+            listed[slots[tj * nt + ti]] = payload[e]
             slots[tj * nt + ti] += 1
             continue
         for tj in range(vox[e, 5] >> shift, (vox[e, 6] >> shift) + 1):
             for ti in range(vox[e, 3] >> shift, (vox[e, 4] >> shift) + 1):
-                if place:
-                    listed[slots[tj * nt + ti]] = payload[e]
+                listed[slots[tj * nt + ti]] = payload[e]
                 slots[tj * nt + ti] += 1
 
 
@@ -82,13 +113,12 @@ def voxels_per_tile(vox, tiles_per_side, shift, threads, payload):
     n = vox.shape[0]
     runs = max(2, min(PARTS, 2 * threads, (1 << 18) // (nt * nt)))
     counts = np.zeros((runs, nt * nt), np.int64)  # each run counts in its own row
-    listed = np.empty(0, payload.dtype)
     for k in prange(runs):
-        _visit_tiles(vox, k * n // runs, (k + 1) * n // runs, shift, nt, counts[k], listed, payload, False)
+        _count_tiles(vox, k * n // runs, (k + 1) * n // runs, shift, nt, counts[k])
     starts = _run_places(counts)
     listed = np.empty(starts[-1], payload.dtype)
     for k in prange(runs):
-        _visit_tiles(vox, k * n // runs, (k + 1) * n // runs, shift, nt, counts[k], listed, payload, True)
+        _place_in_tiles(vox, k * n // runs, (k + 1) * n // runs, shift, nt, counts[k], listed, payload)
     return starts, listed
 
 
