@@ -23,7 +23,7 @@ def _count_tiles(vox, first, last, shift, nt, slots):
     one tile, as most of numba's are, counts there; any other marks the four corners
     of its rectangle of tiles in a difference array, whose running sums along rows
     and columns are its counts: four steps however many tiles it covers (the
-    shader's 4 x 4 tiles: 0.78x the lists' time on the peer rays at 45 degrees)."""
+    shader's 4 x 4 tiles: 0.76-0.82x ``voxels_per_tile``'s time on the peer rays)."""
     w = nt + 1
     corners = np.zeros(w * w, np.int64)
     spread = False
