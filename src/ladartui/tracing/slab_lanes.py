@@ -67,6 +67,21 @@ def _lanes_codegen(shared):
     return codegen
 
 
+def _less(builder, a, b):
+    return builder.fcmp_ordered("<", a, b)
+
+
+def _greater(builder, a, b):
+    return builder.fcmp_ordered(">", a, b)
+
+
+def _splat(builder, value, vector):
+    """``value`` in every lane of ``vector``."""
+    first = builder.insert_element(ir.Constant(vector, ir.Undefined), value, ir.Constant(ir.IntType(32), 0))
+    zeros = ir.Constant(ir.VectorType(ir.IntType(32), LANES), [0] * LANES)
+    return builder.shuffle_vector(first, ir.Constant(vector, ir.Undefined), zeros)
+
+
 def _emit(context, builder, signature, args, shared, k):
     argtypes = signature.args
     f64, i64, i8 = ir.DoubleType(), ir.IntType(64), ir.IntType(8)
@@ -74,13 +89,6 @@ def _emit(context, builder, signature, args, shared, k):
 
     def scalar(n, to):
         return context.cast(builder, args[n], argtypes[n], to)
-
-    def splat(value, vector):
-        first = builder.insert_element(
-            ir.Constant(vector, ir.Undefined), value, ir.Constant(ir.IntType(32), 0)
-        )
-        zeros = ir.Constant(ir.VectorType(ir.IntType(32), LANES), [0] * LANES)
-        return builder.shuffle_vector(first, ir.Constant(vector, ir.Undefined), zeros)
 
     s = scalar(1, types.intp)
 
@@ -92,26 +100,24 @@ def _emit(context, builder, signature, args, shared, k):
         )
         return builder.load(pointer, align=8), pointer
 
-    def less(a, b):
-        return builder.fcmp_ordered("<", a, b)
-
-    def greater(a, b):
-        return builder.fcmp_ordered(">", a, b)
+    def ray_row(row):
+        return lanes_at(0, [ir.Constant(i64, row), s], doubles)[0]
 
     cols = lanes_at(9 + k, [s], ints)[0]
     bits = builder.shl(ir.Constant(ints, 1), cols)
-    positions = builder.add(splat(s, ints), ir.Constant(ints, list(range(LANES))))
-    in_span = builder.icmp_signed("<", positions, splat(scalar(10 + k, types.intp), ints))
-    todo = splat(scalar(8 + k, types.int64), ints)
+    positions = builder.add(_splat(builder, s, ints), ir.Constant(ints, list(range(LANES))))
+    in_span = builder.icmp_signed("<", positions, _splat(builder, scalar(10 + k, types.intp), ints))
+    todo = _splat(builder, scalar(8 + k, types.int64), ints)
     on = builder.and_(in_span, builder.icmp_signed("!=", builder.and_(todo, bits), ir.Constant(ints, 0)))
     bound, bound_at = lanes_at(11 + k, [s], doubles)
-    near, after = splat(scalar(5 + k, types.float64), doubles), splat(scalar(6 + k, types.float64), doubles)
+    near = _splat(builder, scalar(5 + k, types.float64), doubles)
+    after = _splat(builder, scalar(6 + k, types.float64), doubles)
     either = cgutils.get_or_insert_function(
         builder.module, ir.FunctionType(i64, [ints]), "llvm.vector.reduce.or.v8i64"
     )
 
     def alive_bins(bounds_now):
-        alive = builder.and_(on, greater(bounds_now, after))
+        alive = builder.and_(on, _greater(builder, bounds_now, after))
         return builder.call(either, [builder.select(alive, bits, ir.Constant(ints, 0))])
 
     def mask_byte(mask):
@@ -123,25 +129,18 @@ def _emit(context, builder, signature, args, shared, k):
     answer = [cgutils.alloca_once(builder, i64) for _ in range(3)]
     for slot, value in zip(answer, (alive_bins(bound), ir.Constant(i64, 0), ir.Constant(i64, 0))):
         builder.store(value, slot)
-    can_hit = builder.and_(on, greater(bound, near))
+    can_hit = builder.and_(on, _greater(builder, bound, near))
     with builder.if_then(builder.icmp_unsigned("!=", mask_byte(can_hit), ir.Constant(i8, 0))):
-        start, leave = _start_and_leave(
-            context, builder, args, argtypes, shared, k, scalar, splat, lanes_at, s
-        )
-        hit = builder.and_(can_hit, builder.and_(less(start, leave), less(start, bound)))
+        start, leave = _start_and_leave(builder, ray_row, scalar, shared, k)
+        hit = builder.and_(can_hit, builder.and_(_less(builder, start, leave), _less(builder, start, bound)))
         new_bound = builder.select(hit, start, bound)
         builder.store(new_bound, bound_at, align=8)
         voxel, voxel_at = lanes_at(12 + k, [s], ints)
-        builder.store(builder.select(hit, splat(scalar(7 + k, types.int64), ints), voxel), voxel_at, align=8)
+        q = _splat(builder, scalar(7 + k, types.int64), ints)
+        builder.store(builder.select(hit, q, voxel), voxel_at, align=8)
         popcount = cgutils.get_or_insert_function(builder.module, ir.FunctionType(i8, [i8]), "llvm.ctpop.i8")
-        first_hits = builder.call(
-            popcount,
-            [
-                mask_byte(
-                    builder.and_(hit, builder.fcmp_ordered("==", bound, ir.Constant(doubles, float("inf"))))
-                )
-            ],
-        )
+        unbounded = builder.fcmp_ordered("==", bound, ir.Constant(doubles, float("inf")))
+        first_hits = builder.call(popcount, [mask_byte(builder.and_(hit, unbounded))])
         any_hit = builder.icmp_unsigned("!=", mask_byte(hit), ir.Constant(i8, 0))
         for slot, value in zip(
             answer, (alive_bins(new_bound), builder.zext(any_hit, i64), builder.zext(first_hits, i64))
@@ -150,22 +149,17 @@ def _emit(context, builder, signature, args, shared, k):
     return context.make_tuple(builder, signature.return_type, [builder.load(slot) for slot in answer])
 
 
-def _start_and_leave(context, builder, args, argtypes, shared, k, scalar, splat, lanes_at, s):
-    """The lanes' slab test: where each ray enters the voxel (not before 0) and leaves it."""
+def _start_and_leave(builder, ray_row, scalar, shared, k):
+    """The lanes' slab test (``axis.cube_start``): where each ray enters the voxel, not
+    before 0, and where it leaves it; numba's ``max(a, b)`` is ``b if b > a else a``."""
     f64 = ir.DoubleType()
     doubles = ir.VectorType(f64, LANES)
 
-    def ray_row(row):
-        return lanes_at(0, [ir.Constant(ir.IntType(64), row), s], doubles)[0]
-
-    def less(a, b):
-        return builder.fcmp_ordered("<", a, b)
-
     def numba_max(a, b):
-        return builder.select(builder.fcmp_ordered(">", b, a), b, a)
+        return builder.select(_greater(builder, b, a), b, a)
 
     def numba_min(a, b):
-        return builder.select(less(b, a), b, a)
+        return builder.select(_less(builder, b, a), b, a)
 
     zero, inf, minus_inf = (ir.Constant(doubles, v) for v in (0.0, float("inf"), float("-inf")))
     enters, leaves = [], []
@@ -176,17 +170,17 @@ def _start_and_leave(context, builder, args, argtypes, shared, k, scalar, splat,
         upper = builder.fadd(corner, ir.Constant(f64, 1.0))
         if shared:  # the lanes' common (b - o) and insideness, once: the same bits in each lane
             o = scalar(2 + axis, types.float64)
-            from_lo = splat(builder.fsub(corner, o), doubles)
-            from_hi = splat(builder.fsub(upper, o), doubles)
-            inside = builder.and_(builder.fcmp_ordered("<", corner, o), builder.fcmp_ordered("<", o, upper))
+            from_lo = _splat(builder, builder.fsub(corner, o), doubles)
+            from_hi = _splat(builder, builder.fsub(upper, o), doubles)
+            inside = builder.and_(_less(builder, corner, o), _less(builder, o, upper))
         else:
             o = ray_row(axis)
-            lo, hi = splat(corner, doubles), splat(upper, doubles)
+            lo, hi = _splat(builder, corner, doubles), _splat(builder, upper, doubles)
             from_lo, from_hi = builder.fsub(lo, o), builder.fsub(hi, o)
-            inside = builder.and_(less(lo, o), less(o, hi))
+            inside = builder.and_(_less(builder, lo, o), _less(builder, o, hi))
         t_lo = builder.fmul(from_lo, inv)
         t_hi = builder.fmul(from_hi, inv)
-        up, down = builder.fcmp_ordered(">", d, zero), less(d, zero)
+        up, down = _greater(builder, d, zero), _less(builder, d, zero)
         flat_enter = builder.select(inside, minus_inf, inf)
         flat_leave = builder.select(inside, inf, minus_inf)
         enters.append(builder.select(up, t_lo, builder.select(down, t_hi, flat_enter)))

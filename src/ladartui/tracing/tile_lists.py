@@ -26,7 +26,6 @@ def _count_tiles(vox, first, last, shift, nt, slots):
     shader's 4 x 4 tiles: 0.76-0.82x ``voxels_per_tile``'s time on the peer rays)."""
     w = nt + 1
     corners = np.zeros(w * w, np.int64)
-    spread = False
     for e in range(first, last):
         if vox[e, 3] > vox[e, 4]:
             continue
@@ -35,13 +34,10 @@ def _count_tiles(vox, first, last, shift, nt, slots):
         if i1 == i0 + 1 and j1 == j0 + 1:
             slots[j0 * nt + i0] += 1
             continue
-        spread = True
         corners[j0 * w + i0] += 1
         corners[j0 * w + i1] -= 1
         corners[j1 * w + i0] -= 1
         corners[j1 * w + i1] += 1
-    if not spread:
-        return
     column = np.zeros(nt, np.int64)  # per column, the rows' running sums so far
     for j in range(nt):
         row = 0
