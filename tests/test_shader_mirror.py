@@ -133,5 +133,5 @@ def test_every_name_the_shaders_use_from_the_header_is_declared_there():
     for shader in SHADERS:
         code = re.sub(r"//[^\n]*", "", shader.read_text())
         used |= set(re.findall(r"\b[A-Z][A-Z_]{2,}\b", code))
-        used -= set(re.findall(r"const (\w+):", code))
+        used -= set(re.findall(r"(?:const|override) (\w+):", code))  # declared in the shader itself
     assert used <= declared, used - declared

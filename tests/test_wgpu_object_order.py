@@ -367,3 +367,59 @@ def test_one_origin_broadcast_to_every_ray_answers_as_rows_do(forest, f64_backen
     assert gpu.info["order"] == order
     assert_same(numba_backend.trace_cells(occ, np.array(cells), unit, order="ray"), gpu)
     assert (gpu.kind == VOXEL).mean() > 0.5
+
+
+@pytest.mark.parametrize("rays", ["scan", "fan"])
+def test_every_pipeline_finds_the_same_hits(forest, f64_backend, numba_backend, rays, monkeypatch):
+    """The object-order pipelines differ in where a tile's bounds come from (a uniform
+    buffer, or storage: always past UNIFORM_TILES tiles) and in two constants, one ray
+    per bin and one origin. On a pinhole scan (one ray per bin) and on a fan of rays
+    from one point (several a bin) every pipeline finds the same hits, which answer as
+    numba's ray order does."""
+    from ladartui.tracing import wgpu_scans
+    from ladartui.tracing.config import OBJECT_ORDER_TILE_SHIFT
+    from ladartui.tracing.scan_rays import cone_frame, ray_bounds
+    from ladartui.tracing.shader_scan import entry_answers, prepare_shader_scan
+
+    _, occ = forest
+    if rays == "scan":
+        origins, directions = one_scan([120, 120, 20], 45.0, 0.7, 300.0)
+    else:
+        _, _, _, origins, directions = random_scan(np.random.default_rng(3), 0.0, n=4000)
+        origins += [90.0, 90.0, 0.0]  # over the forest
+    origins[:] = origins[0]
+    frame = cone_frame(origins, directions, np.concatenate(ray_bounds(origins, directions)))
+    scan = prepare_shader_scan(occ, origins, directions, frame, np.inf, OBJECT_ORDER_TILE_SHIFT)
+    assert (len(scan.ray_tiles) == 0) == (rays == "scan")
+    f64_backend.trace_cells(occ, origins, directions, order="object")  # opens the device
+    dispatcher = f64_backend._scans
+    used = []
+    real_pipeline = wgpu_scans.ScanDispatcher._pipeline
+
+    def spy(self, *key):
+        used.append(key)
+        return real_pipeline(self, *key)
+
+    monkeypatch.setattr(wgpu_scans.ScanDispatcher, "_pipeline", spy)
+    monkeypatch.setattr(dispatcher, "uniform_tile_bounds", True)
+    found = [dispatcher.test_tiles(origins, directions, scan, shared).copy() for shared in (True, False)]
+    monkeypatch.setattr(dispatcher, "uniform_tile_bounds", False)
+    found += [dispatcher.test_tiles(origins, directions, scan, shared).copy() for shared in (True, False)]
+    monkeypatch.setattr(dispatcher, "uniform_tile_bounds", True)
+    monkeypatch.setattr(wgpu_scans, "UNIFORM_TILES", len(scan.tile_starts) - 2)  # one tile too many
+    found.append(dispatcher.test_tiles(origins, directions, scan, True).copy())
+    one_per_bin = rays == "scan"
+    assert used == [
+        (True, one_per_bin, True),
+        (True, one_per_bin, False),
+        (False, one_per_bin, True),
+        (False, one_per_bin, False),
+        (False, one_per_bin, True),
+    ]
+    assert all(np.array_equal(found[0], other) for other in found[1:])
+    assert (found[0] != NO_CELL).mean() > 0.3  # the comparison has teeth
+    expected = numba_backend.trace_cells(occ, origins, directions, order="ray")
+    n = len(origins)
+    answers = (np.zeros(n, np.uint8), np.zeros((n, 3), np.int32), np.zeros(n))
+    entry_answers(found[0], *scan.packing, origins, False, directions, *map(float, occ.shape[:2]), *answers)
+    assert_same(expected, type(expected)(*answers, {}))

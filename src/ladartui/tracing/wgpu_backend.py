@@ -107,8 +107,9 @@ class WgpuBackend:
     ):
         """Optional caps below the adapter's limits (tests use them to force
         occupancy splitting, several batches and 2-D dispatch grids);
-        ``map_storage=False`` copies object order's arrays through the queue even
-        on a CPU adapter, as on a GPU (tests run that way on lavapipe)."""
+        ``map_storage=False`` runs object order as on a GPU even on a CPU adapter:
+        its arrays copied through the queue, its tile bounds read from storage
+        (tests run that way on lavapipe)."""
         self._caps = {
             "max-storage-buffer-binding-size": max_binding_bytes,
             "max-compute-workgroups-per-dimension": max_workgroups_per_dimension,
@@ -203,7 +204,13 @@ class WgpuBackend:
         for key, cap in self._caps.items():
             if cap is not None:
                 self._limits[key] = min(self._limits[key], int(cap))
-        self._scans = ScanDispatcher(self._device, self._limits, self._shader_file, self._maps_storage)
+        self._scans = ScanDispatcher(
+            self._device,
+            self._limits,
+            self._shader_file,
+            self._maps_storage,
+            uniform_tile_bounds=self._cpu_adapter and self._map_storage,
+        )
         self._hits = FirstHits(self._device, self._limits, self._ray_batch, bundle_starts=self._cpu_adapter)
         self._rays = RayPasses(self._device, self._limits, self._ray_batch)
         return self._device

@@ -55,20 +55,57 @@ def dispatch_encoder(device, limits: dict[str, int], pipeline, group, rays: int)
     return encoder
 
 
-# Bindings of shaders/object_order.wgsl, in order.
+# Bindings of shaders/object_order.wgsl, in order ("tile_starts": tile_bounds_source's).
 SCAN_BINDINGS = ("params", "origins", "directions", "order", "ray_tiles", "tile_starts", "entries", "found")
-# Its uniform block, struct TileParams: four vec4 of 32-bit integers.
-TILE_PARAMS_BYTES = 4 * 16
+# Its uniform block, struct TileParams: two u32 (padded to 16 bytes), three vec4 of
+# 32-bit integers, then the origin (vec4 of f64).
+TILE_PARAMS_BYTES = 4 * 16 + 4 * 8
+# Tiles whose bounds a uniform buffer holds: its 64 KiB (WebGPU's least
+# maxUniformBufferBindingSize) as array<vec4<u32>, 4096>, one end a tile.
+UNIFORM_TILES = 16384
 
 
-def pack_tile_params(rays, scan, shared_origin=False) -> bytes:
+def tile_bounds_source(uniform: bool) -> str:
+    """WGSL of binding 5 and ``tile_bounds(tile)``, tile k's entries as (first, end).
+    ``uniform``: from the ends of the tiles' lists in a uniform buffer (``tile_ends``;
+    at most UNIFORM_TILES tiles), else from the lists' starts in storage."""
+    if not uniform:
+        return (
+            "@group(0) @binding(5) var<storage, read> tile_starts: array<u32>;  // tile k: k .. k + 1\n"
+            "fn tile_bounds(tile: u32) -> vec2<u32> {\n"
+            "    return vec2<u32>(tile_starts[tile], tile_starts[tile + 1u]);\n"
+            "}\n"
+        )
+    return (
+        f"@group(0) @binding(5) var<uniform> tile_ends: array<vec4<u32>, {UNIFORM_TILES // 4}>;\n"
+        "fn tile_end(tile: u32) -> u32 {\n"
+        "    return tile_ends[tile >> 2u][tile & 3u];\n"
+        "}\n"
+        "fn tile_bounds(tile: u32) -> vec2<u32> {\n"
+        "    return vec2<u32>(select(tile_end(max(tile, 1u) - 1u), 0u, tile == 0u), tile_end(tile));\n"
+        "}\n"
+    )
+
+
+def tile_ends(tile_starts) -> np.ndarray:
+    """The uniform buffer's words: the end of each tile's list (``tile_starts[1:]``),
+    zeros after the last tile up to UNIFORM_TILES."""
+    words = np.zeros(UNIFORM_TILES, np.uint32)
+    words[: len(tile_starts) - 1] = tile_starts[1:]
+    return words
+
+
+def pack_tile_params(rays, scan, origin=(0.0, 0.0, 0.0)) -> bytes:
     """The uniform block of one object-order dispatch, laid out as ``struct TileParams``
-    (``shared_origin``: every ray starts at the one origin sent)."""
+    (``origin``: where every ray starts, read when the pipeline's ONE_ORIGIN is set)."""
     offset, shifts, masks = scan.packing
     ints = np.zeros((4, 4), dtype=np.int64)
-    ints[0] = (rays, scan.tile_shift, 0 if len(scan.ray_tiles) else 1, 1 if shared_origin else 0)
+    ints[0, :2] = (rays, scan.tile_shift)
     ints[1, :3], ints[2, :3], ints[3, :3] = shifts, masks, offset
-    return ints.astype(np.uint32).tobytes()  # the i32 fields as their two's complement
+    reals = np.zeros(4, np.float64)
+    reals[:3] = origin
+    # (the i32 fields as their two's complement)
+    return ints.astype(np.uint32).tobytes() + reals.tobytes()
 
 
 def write_mapped(buffer, array) -> None:
@@ -100,35 +137,77 @@ def copy_in_parts(target, source):
 class ScanDispatcher:
     """Runs shaders/object_order.wgsl on one device (``test_tiles``)."""
 
-    def __init__(self, device, limits: dict[str, int], shader_file: Callable[[str], str], maps_storage: bool):
+    def __init__(
+        self,
+        device,
+        limits: dict[str, int],
+        shader_file: Callable[[str], str],
+        maps_storage: bool,
+        uniform_tile_bounds: bool = False,
+    ):
         """``limits`` as the device was opened with (and capped); ``shader_file(name)``
         gives a shader's source; ``maps_storage``: the device maps storage buffers
-        (``mappable-primary-buffers``, asked for on a CPU adapter)."""
+        (``mappable-primary-buffers``, asked for on a CPU adapter);
+        ``uniform_tile_bounds``: scans of up to UNIFORM_TILES tiles read their tiles'
+        bounds from a uniform buffer (``tile_bounds_source``; lavapipe's way)."""
         self._device = device
         self._limits = limits
         self._shader_file = shader_file
         self.maps_storage = maps_storage
-        self._compiled: Any = None
+        self.uniform_tile_bounds = uniform_tile_bounds
+        self._compiled: dict[tuple[bool, bool, bool], Any] = {}  # pipelines by ``_pipeline``'s arguments
+        # By uniform tile bounds: shader modules; bind group and pipeline layouts.
+        self._modules: dict[bool, Any] = {}
+        self._layouts: dict[bool, tuple[Any, Any]] = {}
         self._buffers: dict[str, Any] = {}  # by name
-        self._group: tuple[tuple[int, ...] | None, Any] = (None, None)  # buffer ids, bind group
+        self._groups: dict[bool, tuple[tuple[int, ...], Any]] = {}  # as _layouts: buffer ids, bind group
         self._mapping: dict[str, Any] = {}  # buffers being mapped for the next scan
 
-    def _pipeline(self):
-        """The object-order pipeline (f64 only)."""
-        if self._compiled is None:
-            code = (
-                wgsl_constants("f64")
-                + "\n"
-                + self._shader_file("axis.wgsl")
-                + "\n"
-                + self._shader_file("object_order.wgsl")
+    def _pipeline(self, uniform: bool, one_per_bin: bool, one_origin: bool):
+        """The object-order pipeline (f64 only): its tile bounds from a uniform buffer
+        or from storage, its constants ONE_PER_BIN and ONE_ORIGIN set as given."""
+        key = (uniform, one_per_bin, one_origin)
+        if key not in self._compiled:
+            if uniform not in self._modules:
+                code = "\n".join(
+                    (
+                        wgsl_constants("f64"),
+                        self._shader_file("axis.wgsl"),
+                        tile_bounds_source(uniform),
+                        self._shader_file("object_order.wgsl"),
+                    )
+                )
+                self._modules[uniform] = self._device.create_shader_module(label="tiles", code=code)
+            module = self._modules[uniform]
+            constants = {"ONE_PER_BIN": float(one_per_bin), "ONE_ORIGIN": float(one_origin)}
+            # Pipelines of one tile bounds share a layout, so one bind group serves them.
+            self._compiled[key] = self._device.create_compute_pipeline(
+                label="tiles",
+                layout=self._layout(uniform)[1],
+                compute={"module": module, "entry_point": "test_tiles", "constants": constants},
             )
-            module = self._device.create_shader_module(label="tiles", code=code)
-            pipeline = self._device.create_compute_pipeline(
-                label="tiles", layout="auto", compute={"module": module, "entry_point": "test_tiles"}
-            )
-            self._compiled = pipeline
-        return self._compiled
+        return self._compiled[key]
+
+    def _layout(self, uniform: bool):
+        """The bind group and pipeline layouts of SCAN_BINDINGS (binding 5 a uniform
+        buffer or storage)."""
+        import wgpu
+
+        if uniform not in self._layouts:
+            kinds = {"params": wgpu.BufferBindingType.uniform, "found": wgpu.BufferBindingType.storage}
+            if uniform:
+                kinds["tile_starts"] = wgpu.BufferBindingType.uniform
+            entries = [
+                {
+                    "binding": b,
+                    "visibility": wgpu.ShaderStage.COMPUTE,
+                    "buffer": {"type": kinds.get(name, wgpu.BufferBindingType.read_only_storage)},
+                }
+                for b, name in enumerate(SCAN_BINDINGS)
+            ]
+            group = self._device.create_bind_group_layout(entries=entries)
+            self._layouts[uniform] = (group, self._device.create_pipeline_layout(bind_group_layouts=[group]))
+        return self._layouts[uniform]
 
     def test_tiles(self, origins, directions, scan, shared_origin=False) -> np.ndarray | None:
         """Each ray's hit as its packed cell (``scan.packing``; NO_CELL none), from
@@ -137,14 +216,16 @@ class ScanDispatcher:
         import wgpu
 
         n = len(directions)
+        uniform = self.uniform_tile_bounds and len(scan.tile_starts) - 1 <= UNIFORM_TILES
         inputs = {
             "origins": origin_rows(origins, shared_origin),  # as given when already so
             "directions": directions,
             "order": scan.order,
             "ray_tiles": scan.ray_tiles,
-            "tile_starts": scan.tile_starts,
             "entries": scan.entries,
         }
+        if not uniform:
+            inputs["tile_starts"] = scan.tile_starts
         sizes = {name: array.nbytes for name, array in inputs.items()}
         sizes["found"] = 4 * n
         if max(sizes.values()) > self._buffer_limit():
@@ -152,24 +233,28 @@ class ScanDispatcher:
         buffers = {name: self._buffer(name, size) for name, size in sizes.items()}
         buffers["params"] = self._buffer("params", TILE_PARAMS_BYTES, uniform=True)
         queue = self._device.queue
-        queue.write_buffer(buffers["params"], 0, pack_tile_params(n, scan, shared_origin))
+        origin = origins[0] if shared_origin else (0.0, 0.0, 0.0)
+        queue.write_buffer(buffers["params"], 0, pack_tile_params(n, scan, origin))
+        if uniform:
+            buffers["tile_starts"] = self._buffer("tile_ends", 4 * UNIFORM_TILES, uniform=True)
+            queue.write_buffer(buffers["tile_starts"], 0, tile_ends(scan.tile_starts))
         for name, array in inputs.items():
             self._fill(name, buffers[name], np.ascontiguousarray(array))
-        pipeline = self._pipeline()
+        pipeline = self._pipeline(uniform, not len(scan.ray_tiles), shared_origin)
         key = tuple(id(buffers[name]) for name in SCAN_BINDINGS)
-        if self._group[0] != key:  # made again only when a buffer has grown
-            self._group = (
+        made = self._groups.get(uniform)
+        if made is None or made[0] != key:  # made again only when a buffer has grown
+            made = self._groups[uniform] = (
                 key,
                 self._device.create_bind_group(
-                    layout=pipeline.get_bind_group_layout(0),
+                    layout=self._layout(uniform)[0],
                     entries=[
                         {"binding": b, "resource": {"buffer": buffers[name]}}
                         for b, name in enumerate(SCAN_BINDINGS)
                     ],
                 ),
             )
-        group = self._group[1]
-        queue.submit([dispatch_encoder(self._device, self._limits, pipeline, group, n).finish()])
+        queue.submit([dispatch_encoder(self._device, self._limits, pipeline, made[1], n).finish()])
         found = np.frombuffer(self._read(buffers["found"], 4 * n), dtype=np.uint32)
         if self.maps_storage:
             # Map the inputs for the next scan now, so that the wait for it passes
