@@ -71,7 +71,7 @@ def tile_bounds_source(uniform: bool) -> str:
     at most UNIFORM_TILES tiles), else from the lists' starts in storage."""
     if not uniform:
         return (
-            "@group(0) @binding(5) var<storage, read> tile_starts: array<u32>;  // tile k: k .. k + 1\n"
+            "@group(0) @binding(5) var<storage, read> tile_starts: array<u32>;  // tile k: [k] .. [k + 1]\n"
             "fn tile_bounds(tile: u32) -> vec2<u32> {\n"
             "    return vec2<u32>(tile_starts[tile], tile_starts[tile + 1u]);\n"
             "}\n"
