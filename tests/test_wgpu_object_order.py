@@ -147,7 +147,7 @@ def test_arrays_through_the_queue_give_the_same_answers(forest, f64_backend, num
     _, occ = forest
     queued = WgpuBackend(map_storage=False)
     queued.trace_cells(occ, *one_scan([100, 140, 20], 60.0, 2.0, 180.0), order="object")
-    assert not queued.describe()["maps_storage"]
+    assert not queued.describe()["maps_storage"] and not queued._scans.uniform_tile_bounds
     if f64_backend.describe()["adapter_type"] == "CPU":
         assert f64_backend.describe()["maps_storage"]  # lavapipe: the mapped way
     for depression in (45.0, 80.0):
@@ -393,6 +393,8 @@ def test_every_pipeline_finds_the_same_hits(forest, f64_backend, numba_backend, 
     assert (len(scan.ray_tiles) == 0) == (rays == "scan")
     f64_backend.trace_cells(occ, origins, directions, order="object")  # opens the device
     dispatcher = f64_backend._scans
+    # lavapipe's way by default; a GPU's way keeps storage
+    assert dispatcher.uniform_tile_bounds == (f64_backend.describe()["adapter_type"] == "CPU")
     used = []
     real_pipeline = wgpu_scans.ScanDispatcher._pipeline
 
