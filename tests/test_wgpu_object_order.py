@@ -425,3 +425,20 @@ def test_every_pipeline_finds_the_same_hits(forest, f64_backend, numba_backend, 
     answers = (np.zeros(n, np.uint8), np.zeros((n, 3), np.int32), np.zeros(n))
     entry_answers(found[0], *scan.packing, origins, False, directions, *map(float, occ.shape[:2]), *answers)
     assert_same(expected, type(expected)(*answers, {}))
+
+
+def test_a_storage_cap_under_64_kib_leaves_the_tile_ends_whole(forest, f64_backend, numba_backend):
+    """Tests cap storage bindings (here at 32 KiB, which a small scan's arrays fit);
+    the uniform buffer of tile ends is still bound whole, at the 64 KiB its shader
+    declares, and the scan runs in object order with numba's answers."""
+    from ladartui.tracing.wgpu_backend import WgpuBackend
+
+    _, occ = forest
+    capped = WgpuBackend(max_binding_bytes=32 * 1024)
+    origins, directions = one_scan(
+        [120, 120, 20], 45.0, 0.7, 300.0, sensor=Sensor(grid=8, ray_grid=4, fov=2.0)
+    )
+    gpu = gpu_object_order(capped, occ, origins, directions)
+    assert capped._scans.uniform_tile_bounds == (capped.describe()["adapter_type"] == "CPU")
+    assert_same(numba_backend.trace_cells(occ, origins, directions, order="ray"), gpu)
+    assert (gpu.kind == VOXEL).any()

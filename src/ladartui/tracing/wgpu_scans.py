@@ -318,8 +318,10 @@ class ScanDispatcher:
                 usage |= wgpu.BufferUsage.MAP_READ if name == "found" else wgpu.BufferUsage.MAP_WRITE
             else:
                 usage |= wgpu.BufferUsage.COPY_SRC if name == "found" else wgpu.BufferUsage.COPY_DST
-            # Room to grow, within the limits (which need not be powers of two).
-            size = max(16, min(1 << (max(size, 1) - 1).bit_length(), self._buffer_limit() // 4 * 4))
+            if uniform:  # fixed sizes, bound whole: the uniform block, the tile ends
+                size = max(16, size)
+            else:  # room to grow, within the limits (which need not be powers of two)
+                size = max(16, min(1 << (max(size, 1) - 1).bit_length(), self._buffer_limit() // 4 * 4))
             buffer = self._device.create_buffer(label=f"scan-{name}", size=size, usage=usage)
             self._buffers[name] = buffer
         return buffer
