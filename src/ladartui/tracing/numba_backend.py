@@ -429,55 +429,22 @@ class NumbaBackend:
         blocks = occ.blocks if getattr(occ, "blocks", None) is not None else block_masks(occ.bricks)
         started = time.perf_counter()
 
+        tree = (occ.root, occ.regions, occ.tiles, occ.bricks)
+        extent = (lo, hi, rorg, rdims, nx, ny)
+
         def ray_order(a, b):
             with timed("ray order" if method == "exact" else "march"):
                 for c in range(a, b, BLOCK):
                     check_cancelled(cancel, "trace cancelled")
                     d = min(b, c + BLOCK)
+                    rays = (origin_rows(orig[c:d]), dirs[c:d])
+                    answers = (kind[c:d], index[c:d], t[c:d])
                     if method == "exact":
                         _exact_kernel(
-                            origin_rows(orig[c:d]),
-                            dirs[c:d],
-                            occ.root,
-                            occ.regions,
-                            occ.tiles,
-                            occ.bricks,
-                            blocks,
-                            occ.columns,
-                            cubes,
-                            corg,
-                            cdims,
-                            *halo,
-                            lo,
-                            hi,
-                            rorg,
-                            rdims,
-                            nx,
-                            ny,
-                            kind[c:d],
-                            index[c:d],
-                            t[c:d],
+                            *rays, *tree, blocks, occ.columns, cubes, corg, cdims, *halo, *extent, *answers
                         )
                     else:
-                        march_kernel(
-                            origin_rows(orig[c:d]),
-                            dirs[c:d],
-                            float(step),
-                            float(occ.zmax),
-                            occ.root,
-                            occ.regions,
-                            occ.tiles,
-                            occ.bricks,
-                            lo,
-                            hi,
-                            rorg,
-                            rdims,
-                            nx,
-                            ny,
-                            kind[c:d],
-                            index[c:d],
-                            t[c:d],
-                        )
+                        march_kernel(*rays, float(step), float(occ.zmax), *tree, *extent, *answers)
 
         def object_order_block(a, b, max_voxels):
             bounds = None if block_bounds is None else block_bounds[a // SCAN_BLOCK]

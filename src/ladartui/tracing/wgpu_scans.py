@@ -112,8 +112,8 @@ def write_mapped(buffer, array) -> None:
     """``array`` into the start of ``buffer``, mapped for writing: copied on numba's
     threads into the mapped range where wgpu-py hands it out (its experimental
     ``_experimental_get_mapped_range``; the view is dropped before the caller
-    unmaps), else by ``write_mapped``, on one thread (a scan's 6 MB of directions
-    took 0.65 ms there)."""
+    unmaps), else by the buffer's own ``write_mapped``, on one thread (a scan's
+    6 MB of directions took 0.65 ms there)."""
     mapped_range = getattr(buffer, "_experimental_get_mapped_range", None)
     if mapped_range is None or array.nbytes % 4:
         buffer.write_mapped(array, 0)
