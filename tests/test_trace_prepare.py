@@ -6,7 +6,7 @@ import pytest
 from ladartui.errors import FieldError
 from ladartui.tracing import TINY
 from ladartui.tracing.config import SCAN_BLOCK
-from ladartui.tracing.prepare import one_origin, rays_to_cells
+from ladartui.tracing.prepare import SCALE_IN_PARTS, one_origin, rays_to_cells, scale_in_place
 from ladartui.tracing.scan_rays import ray_bounds
 
 
@@ -146,3 +146,40 @@ def test_one_origin_for_every_ray_is_one_row_broadcast(n):
     moved[n // 2 :] += [0.0, 0.0, 1e-3]  # a second point halfway (two scans, or two blocks)
     cells, _, _ = rays_to_cells(moved, directions, 0.1, TINY)
     assert cells.strides[0] == 24 and np.array_equal(cells, moved / 0.1 + 0.5)
+
+
+@pytest.mark.parametrize("n", [SCALE_IN_PARTS - 1, SCALE_IN_PARTS, 3 * SCALE_IN_PARTS + 5])
+def test_scaling_in_place_is_numpys_product_bit_for_bit(n):
+    """Short rows on one thread, long ones in parts: every value as numpy's own
+    product, inf, nan, -0.0 and subnormals too; strided views scaled where they are."""
+    rng = np.random.default_rng(n)
+    values = rng.uniform(0, 3000, n) * 10.0 ** rng.integers(-310, 300, n)
+    values[:6] = [np.inf, -np.inf, np.nan, -0.0, 5e-324, 1.7e308]
+    for factor in (0.1, 0.25, 3.0e-9):
+        scaled = values.copy()
+        scale_in_place(scaled, factor)
+        assert np.array_equal(scaled.view(np.int64), (values * factor).view(np.int64))
+    grid = values[: n // 2 * 2].reshape(-1, 2).copy()
+    column = grid[:, 1]  # not contiguous: scaled by numpy, in place
+    scale_in_place(column, 0.1)
+    assert np.array_equal(grid[:, 1].view(np.int64), (values[1 : n // 2 * 2 : 2] * 0.1).view(np.int64))
+    assert np.array_equal(grid[:, 0].view(np.int64), values[0 : n // 2 * 2 : 2].view(np.int64))
+
+
+def test_a_long_traces_ranges_are_its_cell_ranges_times_the_voxel_size():
+    """trace() scales a long call's ranges in parts: each is the backend's cell
+    range times the voxel size, bit for bit."""
+    from ladartui.scene.occupancy import Occupancy
+    from ladartui.tracing import trace
+    from ladartui.tracing.numba_backend import NumbaBackend
+
+    rng = np.random.default_rng(5)
+    occupancy = Occupancy.build(rng.integers(0, 40, (3000, 3)).astype(np.int32), (40, 40, 40))
+    n = SCALE_IN_PARTS + 1000
+    origins = rng.uniform(-5, 45, (n, 3)) * 0.3
+    directions = rng.normal(size=(n, 3))
+    got = trace(occupancy, origins, directions, backend="numba", voxel_size=0.3)
+    cells, unit, bounds = rays_to_cells(origins, directions, 0.3, TINY)
+    hits = NumbaBackend().trace_cells(occupancy, cells, unit, block_bounds=bounds)
+    assert (got.kind == 1).sum() > 1000
+    assert np.array_equal(got.range.view(np.int64), (hits.t * 0.3).view(np.int64))

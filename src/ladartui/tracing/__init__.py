@@ -122,7 +122,7 @@ def trace(
     engine = get_backend(name)
     # Unit directions with components below TINY set to 0 (keeps 1 / d finite;
     # moves a ray by nothing measurable), origins in cell space.
-    from ladartui.tracing.prepare import rays_to_cells  # numba: loaded on first trace
+    from ladartui.tracing.prepare import rays_to_cells, scale_in_place  # numba: loaded on first trace
 
     with recording() as passes:
         with timed("rays to cells"):
@@ -143,7 +143,7 @@ def trace(
         with timed("to metres"):
             metres = cells.t
             if metres.base is None and metres.flags.writeable:  # the backend's own new array: scaled in place
-                metres *= voxel_size
+                scale_in_place(metres, voxel_size)
             else:
                 metres = metres * voxel_size
     info["passes"] = passes

@@ -7,7 +7,8 @@ costs a square root and three divisions, so the pass runs on every core (about
 1.0 ms on two for the peer comparison's rays), and a ray from the same origin
 as the one before reuses its cell (a scan's rays often share one); when all
 do, the cells are one row broadcast. A serial pass then finds the first bad
-ray, if any, for the message.
+ray, if any, for the message. ``scale_in_place`` takes the ranges back to
+metres.
 """
 
 import numba
@@ -202,6 +203,31 @@ def rays_to_cells(origins, directions, voxel_size, tiny):
         raise FieldError(f"directions[{first}]", directions[first].tolist(), "finite numbers")
     zero = first - n - 1
     raise FieldError(f"directions[{zero}]", directions[zero].tolist(), "a non-zero vector")
+
+
+# Ranges below this many go to metres by numpy: a parallel region costs more there.
+SCALE_IN_PARTS = 1 << 15
+
+
+@numba.njit(parallel=True, nogil=True, cache=True)
+def _scale_in_parts(values, factor):
+    n = values.shape[0]
+    for part in prange(PARTS):
+        for i in range(part * n // PARTS, (part + 1) * n // PARTS):
+            values[i] *= factor
+
+
+def scale_in_place(values, factor: float) -> None:
+    """``values *= factor`` (trace()'s ranges to metres), on numba's threads for a
+    long contiguous 1-D float64 array: the same product, so the same bits. On an
+    H200 machine's 16-core host a 262,144-ray scan's ranges took 0.135 ms on one
+    thread and 0.035 ms in parts (a wgpu trace 1.016-1.018x, calls alternating);
+    on two cores, 0.074 ms and 0.076 ms."""
+    long_row = values.ndim == 1 and values.dtype == np.float64 and values.flags.c_contiguous
+    if not long_row or len(values) < SCALE_IN_PARTS:
+        values *= factor
+    else:
+        _scale_in_parts(values, float(factor))
 
 
 def float_rows(origins):
