@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from ladartui.errors import Cancelled
-from ladartui.tracing import TINY, wgpu_hits
+from ladartui.tracing import TINY, VOXEL, wgpu_hits
 from ladartui.tracing.prepare import rays_to_cells
 from ladartui.tracing.wgpu_backend import WgpuBackend
 from ladartui.tracing.wgpu_hits import box_sides
@@ -40,6 +40,28 @@ def test_box_sides_fit_an_i32_or_are_refused():
     )  # 2^31 offsets
     assert box_sides(box((0, 0, 0), (1 << 11, 1 << 10, (1 << 10) + 1))) is None
     assert box_sides(box((5, 5, 5), (5, 9, 9))) is None  # empty box
+
+
+def test_offsets_up_to_the_i32_limit_decode_to_their_cells():
+    """box_offset_answers decodes offsets in the largest box whose offsets fit an
+    i32 (2048 x 1024 x 1024), its last one too, to their cells, entered where a
+    ray straight down meets their top faces."""
+    sx, sy, sz = 1 << 11, 1 << 10, 1 << 10
+    lo = np.array([3, -5, 7], np.int64)
+    last = (sx - 1, sy - 1, sz - 1)
+    cells = np.array([[0, 0, 0], last, [sx - 1, 0, sz - 1], [5, sy - 1, 0], [1234, 567, 891]])
+    words = cells[:, 0] + sx * (cells[:, 1] + sy * cells[:, 2])
+    assert words.max() == (1 << 31) - 1
+    n = len(words)
+    origins = cells + lo + [0.5, 0.5, 10.5]
+    directions = np.tile([0.0, 0.0, -1.0], (n, 1))
+    kind, index, t = np.empty(n, np.uint8), np.empty((n, 3), np.int32), np.empty(n)
+    found = words.astype(np.int32)
+    answers = (kind, index, t)
+    cut = wgpu_hits.box_offset_answers(found, lo, sx, sy, origins, False, directions, 1e9, 1e9, *answers)
+    assert cut == 0 and (kind == VOXEL).all()
+    assert np.array_equal(index, cells + lo)
+    assert (t == 9.5).all()
 
 
 def test_batches_in_flight_give_numba_answers(wgpu_backend, numba_backend, case):
