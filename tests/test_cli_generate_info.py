@@ -107,3 +107,7 @@ def test_info_backends_lists_each_backend(capsys):
         if reason is None:
             first_key = next(iter(backend.get_backend(name).describe()))
             assert first_key in out
+    # What auto traces with here, under the table.
+    from ladartui.tracing import auto_summary
+
+    assert f"auto: {auto_summary()}" in " ".join(out.split())

@@ -181,7 +181,7 @@ def _simulate(scenario, backend, method, step, precision, progress, cancel, outp
         scene_per_scan=per_scan["scene"],
         target_per_scan=per_scan["target"],
         measures=measures,
-        backend=runner.backend_used or settings["backend"],
+        backend=runner.backends_used() or settings["backend"],
         method=settings["method"],
         rays_per_scan=scenario.sensor.rays_per_scan,
         timings=timings,
@@ -253,8 +253,12 @@ class _ScanRunner:
         self.rays_total = 2 * sensor.rays_per_scan * scans
         self.done = 0
         self.chunk = _FIRST_CHUNK_RAYS
-        self.backend_used = None
+        self.rays_by_backend: dict[str, int] = {}  # auto may trace some calls on each
         self.geiger = None  # a detection.scan.GeigerRun when the Geiger model is on
+
+    def backends_used(self) -> str:
+        """The backends that traced the run, most rays first ("numba+wgpu")."""
+        return "+".join(sorted(self.rays_by_backend, key=lambda name: -self.rays_by_backend[name]))
 
     def scan(self, scan, pose, attitude=None) -> dict[str, np.ndarray]:
         """Trace one scan for both runs; each run's returned voxels, (K, 3) int32."""
@@ -283,7 +287,7 @@ class _ScanRunner:
                 elapsed = time.perf_counter() - tick
                 timings["trace"] += elapsed
                 slowest = max(slowest, elapsed)
-                self.backend_used = hits.backend
+                self.rays_by_backend[hits.backend] = self.rays_by_backend.get(hits.backend, 0) + len(hits)
                 tick = time.perf_counter()
                 rays = kept_returns(detector, hits.kind, hits.range, sensor.depth_resolution)
                 kept[run].append(hits.index[rays])
@@ -316,16 +320,22 @@ class _ScanRunner:
 
 
 def _trace_settings(scenario, backend, method, step, precision) -> dict:
-    """The scenario's tracing settings with the caller's overrides; "auto" resolved once."""
+    """The scenario's tracing settings with the caller's overrides; "auto" resolved
+    once, unless its calls are left to trace()'s learned choice (a GPU is there)."""
     from ladartui.tracing import choose_backend
+    from ladartui.tracing.backend_choice import learns
 
-    backend = scenario.backend if backend is None else backend
-    return {
-        "backend": choose_backend() if backend == "auto" else backend,
+    settings = {
+        "backend": scenario.backend if backend is None else backend,
         "method": scenario.method if method is None else method,
         "step": scenario.step if step is None else step,
         "precision": scenario.precision if precision is None else precision,
     }
+    if settings["backend"] == "auto":
+        best = choose_backend()
+        if not learns(best, settings["method"], settings["precision"]):
+            settings["backend"] = best
+    return settings
 
 
 def _next_chunk(chunk, traced, elapsed) -> int:

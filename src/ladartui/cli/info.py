@@ -157,13 +157,15 @@ def print_backends() -> None:
     from rich.console import Console
     from rich.table import Table
 
+    from ladartui.tracing import auto_summary
     from ladartui.tracing.backend import backend_status, get_backend
 
     table = Table(title="Tracing backends")
     table.add_column("backend")
     table.add_column("status")
     table.add_column("details")
-    for name, reason in backend_status().items():
+    status = backend_status()
+    for name, reason in status.items():
         if reason is None:
             backend = get_backend(name)
             details = ", ".join(f"{k}: {v}" for k, v in backend.describe().items())
@@ -171,4 +173,6 @@ def print_backends() -> None:
             table.add_row(name, "available", f"{summary}\n{details}" if summary else details)
         else:
             table.add_row(name, "unavailable", reason)
+    if any(reason is None for reason in status.values()):
+        table.caption = f"auto: {auto_summary()}"
     Console().print(table)

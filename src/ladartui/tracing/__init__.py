@@ -25,6 +25,7 @@ from ladartui.tracing.backend import (
     backend_status,
     get_backend,
 )
+from ladartui.tracing.backend_choice import CHOICES, learns
 from ladartui.tracing.config import DEFAULT_STEP
 from ladartui.tracing.passes import recording, timed
 
@@ -32,6 +33,7 @@ __all__ = [
     "trace",
     "TraceResult",
     "choose_backend",
+    "auto_summary",
     "to_cells",
     "MISS",
     "VOXEL",
@@ -66,7 +68,9 @@ class TraceResult:
 
 @functools.cache
 def choose_backend() -> str:
-    """The fastest usable backend: wgpu on a real GPU adapter, else numba (probed once)."""
+    """wgpu on a real GPU adapter, else numba (probed once): auto's backend, except that
+    exact float64 calls then go to whichever of wgpu and numba has traced calls of
+    their size faster (tracing/backend_choice.py)."""
     try:
         gpu = get_backend("wgpu")
         if str(gpu.describe().get("adapter_type", "")).lower() in (
@@ -79,6 +83,14 @@ def choose_backend() -> str:
     except (BackendUnavailable, FieldError):
         pass
     return "numba"
+
+
+def auto_summary() -> str:
+    """One line: what ``backend="auto"`` traces with on this machine."""
+    best = choose_backend()
+    if learns(best, "exact", "f64"):
+        return f"{best} (a GPU) or numba, whichever has traced calls of that size faster"
+    return f"{best}, the fastest here (no GPU adapter)"
 
 
 def to_cells(origins_m, voxel_size):
@@ -118,28 +130,40 @@ def trace(
         raise FieldError("step", step, "a positive number of voxels")
     if precision not in PRECISIONS:
         raise FieldError("precision", precision, " or ".join(PRECISIONS))
-    name = choose_backend() if backend in (None, "auto") else backend
+    learned = None  # auto's learned choice between a GPU and the host's cores (backend_choice)
+    if backend in (None, "auto"):
+        name = choose_backend()
+        if learns(name, method, precision):
+            learned = CHOICES.choice(occupancy, name, len(origins))
+            name = learned.pick()
+    else:
+        name = backend
     engine = get_backend(name)
     # Unit directions with components below TINY set to 0 (keeps 1 / d finite;
     # moves a ray by nothing measurable), origins in cell space.
-    from ladartui.tracing.prepare import rays_to_cells, scale_in_place  # numba: loaded on first trace
+    from ladartui.tracing.order_choice import compile_time  # numba: loaded on first trace
+    from ladartui.tracing.prepare import rays_to_cells, scale_in_place
 
     with recording() as passes:
         with timed("rays to cells"):
             origin_cells, unit, block_bounds = rays_to_cells(origins, directions, voxel_size, TINY)
-        started = time.perf_counter()
-        cells = engine.trace_cells(
-            occupancy,
-            origin_cells,
-            unit,
-            method=method,
-            step=float(step),
-            precision=precision,
-            cancel=cancel,
-            block_bounds=block_bounds,
-        )
+        with compile_time() as compiling:
+            started = time.perf_counter()
+            cells = engine.trace_cells(
+                occupancy,
+                origin_cells,
+                unit,
+                method=method,
+                step=float(step),
+                precision=precision,
+                cancel=cancel,
+                block_bounds=block_bounds,
+            )
+            seconds = time.perf_counter() - started
+        if learned is not None:
+            learned.record(name, seconds - compiling.seconds, len(unit))
         info = dict(cells.info)
-        info["seconds_total"] = time.perf_counter() - started
+        info["seconds_total"] = seconds
         with timed("to metres"):
             metres = cells.t
             if metres.base is None and metres.flags.writeable:  # the backend's own new array: scaled in place

@@ -9,12 +9,14 @@ from __future__ import annotations
 
 import threading
 import time
+from contextlib import contextmanager
 
 import numpy as np
 from numba.core import event as numba_event
 
 from ladartui.errors import check_cancelled
 from ladartui.tracing.config import MIN_SCAN_RAYS, SCAN_BLOCK, VOXELS_PER_RAY
+from ladartui.tracing.learned_choice import TwoWayChoice
 
 RAY_RUN_BLOCKS = 16  # blocks one ray_block call may take: bounds the wait for a cancel
 # Share of a block's rays that times ray order while it does not lead (numba, and
@@ -23,23 +25,21 @@ RAY_RUN_BLOCKS = 16  # blocks one ray_block call may take: bounds the wait for a
 RAY_SAMPLE = 1 / 16
 
 
-class OrderChoice:
-    """Which order traces an occupancy's scans faster, learned from the calls themselves.
+class OrderChoice(TwoWayChoice):
+    """Which order traces an occupancy's scans faster, learned from the calls themselves
+    (``TwoWayChoice`` over "object" and "ray", per ray).
 
     Neither order wins everywhere: object order costs about the same for any
     scene in view, ray order is cheap where rays stop early (dense cover) and
     dear where they pass many gaps (foliage). So the orders take turns until
     each has been timed twice (a process's first calls also start threads and
-    touch new memory; compiling is not counted, ``trace_in_blocks``), except
-    that an order timed at over ``settled_gap`` times the best of an order
-    timed twice is not timed again then (a scan in ray order at 45 degrees on
-    the reference scene costs four object-order scans; the wgpu backend, whose
-    first calls also build pipelines, passes ``settled_gap=inf``). Then the
-    faster by its better recent time per ray goes on, and the other is tried
-    again in case the views have changed: RETRY scans after the lead last
-    changed, then twice as long after each retry that loses, up to MAX_RETRY
-    scans (on the reference orbit, losing retries every 16 scans were a tenth
-    of the numba backend's work).
+    touch new memory; compiling is not counted, ``trace_in_blocks``), object
+    order first, except that an order timed at over ``settled_gap`` times the
+    best of an order timed twice is not timed again then (a scan in ray order
+    at 45 degrees on the reference scene costs four object-order scans; the
+    wgpu backend, whose first calls also build pipelines, passes
+    ``settled_gap=inf``). On the reference orbit, losing retries every 16 scans
+    were a tenth of the numba backend's work.
 
     Ray order's cost is per ray, so while it does not lead it can be timed on
     ``ray_sample`` of a block's rays (spread over the block), object order
@@ -48,67 +48,13 @@ class OrderChoice:
     a GPU, where each call costs a dispatch).
     """
 
-    RETRY = 16
-    MAX_RETRY = 64
-    SAMPLES = 2
-
     def __init__(self, settled_gap: float = 2.0, ray_sample: float | None = None):
-        self.settled_gap = settled_gap
+        super().__init__(("object", "ray"), settled_gap)
         self.ray_sample = ray_sample
-        self.samples: dict[str, list[float]] = {"object": [], "ray": []}  # recent seconds per ray
-        self.calls = 0
-        self.retry_every = self.RETRY
-        self._next_retry = self.RETRY  # the call that retries the other order
-        self._retrying: str | None = None  # the order a retry picked, until it is timed
-        self._leader: str | None = None  # the faster order by the samples so far
-        self._lock = threading.Lock()
-
-    def _best(self) -> str:
-        return min(self.samples, key=lambda order: min(self.samples[order]))
-
-    def _needs_sample(self, order: str) -> bool:
-        mine = self.samples[order]
-        other = self.samples["ray" if order == "object" else "object"]
-        if len(mine) >= self.SAMPLES:
-            return False
-        settled_far_ahead = (
-            len(other) >= self.SAMPLES and bool(mine) and min(mine) > self.settled_gap * min(other)
-        )
-        return not settled_far_ahead
-
-    def pick(self) -> str:
-        with self._lock:
-            self.calls += 1
-            learning = [order for order in ("object", "ray") if self._needs_sample(order)]
-            if learning:  # the less timed first, object order on a tie
-                return min(learning, key=lambda order: len(self.samples[order]))
-            best = self._best()
-            if self.calls >= self._next_retry:
-                self._next_retry = self.calls + self.retry_every
-                self._retrying = "ray" if best == "object" else "object"
-                return self._retrying
-            return best
 
     def times_ray_order_on_a_sample(self) -> bool:
         """Whether a pick of ray order is timed on a sample of the block (``ray_sample``)."""
-        with self._lock:
-            return self.ray_sample is not None and self._leader != "ray"
-
-    def record(self, order: str, seconds: float, rays: int) -> None:
-        with self._lock:
-            recent = self.samples[order]
-            recent.append(seconds / max(1, rays))
-            del recent[: -self.SAMPLES]
-            leader = self._best() if all(self.samples.values()) else None
-            if leader != self._leader:  # the views changed (or a first lead): look again soon
-                self.retry_every = self.RETRY
-                self._next_retry = self.calls + self.RETRY
-            elif order == self._retrying:  # a retry lost: wait twice as long for the next
-                self.retry_every = min(self.MAX_RETRY, 2 * self.retry_every)
-                self._next_retry = self.calls + self.retry_every
-            if order == self._retrying:
-                self._retrying = None
-            self._leader = leader
+        return self.ray_sample is not None and self.leader() != "ray"
 
 
 class CompileTime(numba_event.Listener):
@@ -154,9 +100,16 @@ def trace_in_blocks(n, order, choice, object_block, ray_block, cancel=None, cloc
     and are timed as one. Time spent compiling numba kernels (``CompileTime``) is
     not counted.
     """
+    with compile_time(clock) as compiling:
+        return _trace_blocks(n, order, choice, object_block, ray_block, cancel, clock, compiling)
+
+
+@contextmanager
+def compile_time(clock=time.perf_counter):
+    """A ``CompileTime`` of this thread, listening while the block runs."""
     compiling = CompileTime(clock)
     with numba_event.install_listener("numba:compiler_lock", compiling):
-        return _trace_blocks(n, order, choice, object_block, ray_block, cancel, clock, compiling)
+        yield compiling
 
 
 def sample_spans(first: int, end: int, share: float, spans: int = 4) -> list[tuple[int, int]]:

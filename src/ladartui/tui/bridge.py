@@ -371,6 +371,7 @@ def threshold_value(values: dict) -> float | None:
 
 def backend_choices() -> list[tuple[str, str, bool]]:
     """(name, one-line description, available) for "auto" and each registered backend."""
+    from ladartui.tracing import auto_summary
     from ladartui.tracing.backend import backend_status, get_backend
 
     rows = []
@@ -381,9 +382,9 @@ def backend_choices() -> list[tuple[str, str, bool]]:
             rows.append((name, f"{getattr(backend, 'summary', name)}", True))
         else:
             rows.append((name, reason, False))
-    best = next((n for n, _, ok in rows if ok), None)
-    auto = f"the best available here ({best})" if best else "no backend is available"
-    return [("auto", auto, best is not None), *rows]
+    available = any(ok for _, _, ok in rows)
+    auto = auto_summary() if available else "no backend is available"
+    return [("auto", auto, available), *rows]
 
 
 def export_outputs_las(scenario: Scenario, suffix: str = ".las", scene=None) -> list[Path]:
