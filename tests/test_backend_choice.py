@@ -72,6 +72,18 @@ def with_delays(monkeypatch, gpu_delay, host_delay):
     monkeypatch.setattr(backend_choice, "HOST", "host")
 
 
+def backends_of_auto_calls(calls, occupancy, origins, directions, reference):
+    """The backends that ``calls`` auto calls went to, each answer checked against ``reference``."""
+    used = []
+    for _ in range(calls):
+        result = tracing.trace(occupancy, origins, directions)
+        used.append(result.backend)
+        assert np.array_equal(result.kind, reference.kind)
+        assert np.array_equal(result.index, reference.index)
+        assert np.array_equal(result.range, reference.range)
+    return used
+
+
 def test_size_classes_are_a_factor_of_four_wide():
     assert size_class(1 << 17) == size_class((1 << 19) - 1) == 9
     assert size_class(1 << 19) == 10 and size_class((1 << 17) - 1) == 8
@@ -92,13 +104,7 @@ def test_auto_takes_the_gpu_when_it_is_faster_and_numba_when_it_is_not(monkeypat
     for gpu_delay, host_delay, winner in ((0.0, 0.05, "gpu"), (0.05, 0.0, "host")):
         with_delays(monkeypatch, gpu_delay, host_delay)
         occupancy = dataclasses.replace(occupancy)  # a new occupancy learns afresh
-        used = []
-        for _ in range(8):
-            result = tracing.trace(occupancy, origins, directions)
-            used.append(result.backend)
-            assert np.array_equal(result.kind, reference.kind)
-            assert np.array_equal(result.index, reference.index)
-            assert np.array_equal(result.range, reference.range)
+        used = backends_of_auto_calls(8, occupancy, origins, directions, reference)
         # Turns until each is timed twice, the GPU first; then the faster.
         assert used == ["gpu", "host", "gpu", "host"] + [winner] * 4
 
@@ -125,12 +131,7 @@ def test_lavapipe_standing_in_for_a_gpu_loses_to_numba_with_equal_answers(wgpu_b
     tracing.trace(occupancy, origins, directions, backend="wgpu")  # opens the device, builds pipelines
     occupancy = dataclasses.replace(occupancy)
     gpu_is("wgpu")
-    used = []
-    for _ in range(6):
-        result = tracing.trace(occupancy, origins, directions)
-        used.append(result.backend)
-        assert np.array_equal(result.index, reference.index)
-        assert np.array_equal(result.range, reference.range)
+    used = backends_of_auto_calls(6, occupancy, origins, directions, reference)
     # A dispatch and a wait on lavapipe cost more than numba's whole call.
     assert used == ["wgpu", "numba", "wgpu", "numba", "numba", "numba"]
 
