@@ -189,6 +189,17 @@ async def _loaded(pilot):
     await pilot.pause(0.2)
 
 
+async def _image_drawn_at_size(pilot, view):
+    """Wait (up to 30 s) until ``view``'s image is drawn at its picture size."""
+    start = time.monotonic()
+    while True:
+        image = view.image_view.image
+        if image is not None and (image.height, image.width) == view.picture_size():
+            return
+        assert time.monotonic() - start < 30, "the view's image was not redrawn at its new size"
+        await pilot.pause(0.05)
+
+
 @pytest.mark.parametrize("mode", ["kitty", "sixel", "iterm", "halfblocks-24bit", "halfblocks-256"])
 async def test_the_views_are_images_when_an_image_mode_is_forced_and_half_blocks_otherwise(
     tmp_path, scene_files, mode, monkeypatch
@@ -239,7 +250,9 @@ async def test_the_views_are_images_when_an_image_mode_is_forced_and_half_blocks
             assert ("38;5;" in written) == (colours == "256")
             return
         # the image is the view's picture at the terminal's pixels (10 x 20 a cell when
-        # the terminal cannot be asked), not the half-block picture
+        # the terminal cannot be asked), not the half-block picture; on a busy machine
+        # the new layout's image may come after the pause above
+        await _image_drawn_at_size(pilot, scene3d)
         image = scene3d.image_view.image
         assert scene3d.image_view.display and image is not None
         width, height = scene3d.size
