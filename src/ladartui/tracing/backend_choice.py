@@ -36,21 +36,23 @@ def learns(gpu_backend: str, method: str, precision: str) -> bool:
 
 
 class BackendChoices:
-    """The learned choices, per occupancy (kept while it lives) and size class."""
+    """The learned choices, per occupancy (kept while it lives), GPU backend and size class."""
 
     def __init__(self):
-        self._choices: weakref.WeakKeyDictionary[Any, dict[int, TwoWayChoice]] = weakref.WeakKeyDictionary()
+        self._choices: weakref.WeakKeyDictionary[Any, dict[tuple[str, int], TwoWayChoice]] = (
+            weakref.WeakKeyDictionary()
+        )
         self._lock = threading.Lock()
 
     def choice(self, occupancy, gpu_backend: str, rays: int) -> TwoWayChoice:
         # The GPU first (as before there was a choice); no gap settles the turns
         # early, as its first call also opens the device and builds pipelines.
         with self._lock:
-            per_size = self._choices.setdefault(occupancy, {})
-            key = size_class(rays)
-            if key not in per_size or per_size[key].ways[0] != gpu_backend:
-                per_size[key] = TwoWayChoice((gpu_backend, HOST), settled_gap=float("inf"))
-            return per_size[key]
+            per_key = self._choices.setdefault(occupancy, {})
+            key = (gpu_backend, size_class(rays))
+            if key not in per_key:
+                per_key[key] = TwoWayChoice((gpu_backend, HOST), settled_gap=float("inf"))
+            return per_key[key]
 
 
 CHOICES = BackendChoices()
