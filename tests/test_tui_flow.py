@@ -206,6 +206,9 @@ async def test_setup_parameters_run_and_measures(tmp_path, scene_files, monkeypa
         scenario = app.scenario
         for path in (scenario.scene_output, scenario.target_output, scenario.measures_file):
             assert path.is_file()
+        # the run panel names every file the run wrote, not the measures alone
+        said = str(app.query_one("#run-info").render())
+        assert said.endswith("; wrote trial_Scene.txt, trial_Target.txt, trial.cmf"), said
         written = read_cmf(scenario.measures_file)
         table = app.query_one("#measures")
         shown = [tuple(str(c) for c in table.get_row_at(i)) for i in range(table.row_count)]
@@ -217,6 +220,10 @@ async def test_setup_parameters_run_and_measures(tmp_path, scene_files, monkeypa
         fused = load_voxels(scenario.scene_output)
         assert len(fused) == len(app.result.scene_output)
         assert status(app).state == READY
+        # opening another scenario clears the run line: that run was trial's
+        app.load(first.path)
+        await wait_until(pilot, lambda: loaded(app) and app.scenario.name == "first")
+        assert str(app.query_one("#run-info").render()) == ""
 
 
 async def test_a_run_disables_controls_and_cancel_keeps_earlier_outputs(tmp_path, scene_files):

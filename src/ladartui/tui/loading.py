@@ -62,6 +62,7 @@ class SceneLoading(Host):
         self.output_voxels = done.output
         self.show_output()
         self.show_measures(done.measures)
+        self.run_panel.say("")  # the last run, if any, was another scenario's
         self.set_busy(None)
         if done.warning:
             self.tell(done.warning, severity="warning", timeout=8)

@@ -10,6 +10,7 @@ interpreter lock.
 from __future__ import annotations
 
 import time
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -87,7 +88,8 @@ class RunControl(Host):
         self.show_measures(result.measures)
         total = result.timings.get("total") if isinstance(result.timings, dict) else None
         scenario = self.scenario
-        wrote = f"; wrote {scenario.measures_file.name}" if scenario is not None else ""
+        names = [Path(path).name for path in result.outputs.values()]
+        wrote = f"; wrote {', '.join(names)}" if names else ""
         self.run_panel.say(f"Last run: {result.backend}" + (f", {total:.1f} s" if total else "") + wrote)
         self.file_panel.show(scenario, self.scene, self.modified)
         self.refresh_status()
