@@ -34,6 +34,12 @@ def parse_number(name: str, text: str, integer: bool = False, scale: float = 1.0
     return value * scale
 
 
+def refusal(label: str, typed: str, expected: str) -> str:
+    """The one line for a refused value: the field as the form names it, the text
+    typed there (``empty`` for none) and what is expected."""
+    return f"{label}: {typed.strip() or 'empty'} is not allowed; expected {expected}"
+
+
 def format_number(value, integer: bool = False, scale: float = 1.0) -> str:
     """Text for a field: integers plain, floats to six significant digits."""
     if value is None:

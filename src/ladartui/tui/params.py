@@ -20,7 +20,7 @@ from textual.widgets import Input, Label
 from ladartui.checks import range_text
 from ladartui.errors import FieldError, LadarError
 from ladartui.tui import bridge
-from ladartui.tui.fields import NumberField, format_number
+from ladartui.tui.fields import NumberField, format_number, refusal
 from ladartui.tui.host import AppHost, host_of
 
 
@@ -45,7 +45,7 @@ def field_message(param: bridge.Param, typed: str, error: LadarError) -> str:
             )
             if param.unit:
                 expected += f" {param.unit}"
-        return f"{shown}: {typed.strip() or 'empty'} is not allowed; expected {expected}"
+        return refusal(shown, typed, expected)
     return f"{shown}: {error}"
 
 

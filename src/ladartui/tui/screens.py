@@ -19,7 +19,7 @@ from textual.widgets import Button, DataTable, Input, Label, Select, Static
 from ladartui.errors import FieldError, LadarError
 from ladartui.measures import Measures
 from ladartui.tui import bridge
-from ladartui.tui.fields import NumberField, format_number, parse_number
+from ladartui.tui.fields import NumberField, format_number, parse_number, refusal
 from ladartui.tui.file_tree import FileTree
 from ladartui.tui.measures_view import comparison_rows, level_rows, measure_rows, target_rows
 
@@ -169,7 +169,12 @@ class FormScreen(Dialog):
                         raise
                     out[name] = default
             else:
-                out[name] = _parse_points(name, widget.value, kind)
+                try:
+                    out[name] = _parse_points(name, widget.value, kind)
+                except FieldError:
+                    if not raw:
+                        raise
+                    out[name] = default
         return out
 
     def on_input_blurred(self, event: Input.Blurred) -> None:
@@ -183,15 +188,16 @@ class FormScreen(Dialog):
         if isinstance(widget, NumberField):
             problem = widget.problem()
             if problem:
-                widget.add_class("-bad")
-                self.query_one("#form-message", Static).update(
-                    escape(
-                        f"{self._label(widget.field_name)}: {widget.value.strip() or 'empty'}"
-                        f" is not allowed; expected {problem.split('expected ', 1)[-1]}"
-                    )
-                )
+                self._refuse(widget, widget.field_name, problem.split("expected ", 1)[-1])
                 return False
         return True
+
+    def _refuse(self, widget, name: str, expected: str) -> None:
+        """Mark ``widget`` and say that its text is not allowed, in the form's words."""
+        widget.add_class("-bad")
+        self.query_one("#form-message", Static).update(
+            escape(refusal(self._label(name), widget.value, expected))
+        )
 
     @on(Input.Changed)
     def _typing(self, event: Input.Changed) -> None:
@@ -206,16 +212,17 @@ class FormScreen(Dialog):
             if not self._check(widget):
                 widget.focus()
                 return
-        message = self.query_one("#form-message", Static)
         try:
             result = self.build(self.values())
         except LadarError as error:
-            text = str(error)
-            for name, label, *_ in self.spec:
+            for name, *_ in self.spec:
                 if isinstance(error, FieldError) and _field_matches(error.field, name):
-                    self.query_one(f"#f-{name}").focus()
-                    text = f"{label}: {error.value!r} is not allowed; expected {error.expected}"
-            message.update(escape(text))
+                    wrong = self.query_one(f"#f-{name}")
+                    wrong.focus()
+                    if isinstance(wrong, Input):
+                        self._refuse(wrong, name, error.expected)
+                        return
+            self.query_one("#form-message", Static).update(escape(str(error)))
             return
         self.cancelled = False
         self.dismiss(result)
@@ -342,12 +349,27 @@ class PosesScreen(Dialog):
 
     def on_input_blurred(self, event: Input.Blurred) -> None:
         if isinstance(event.input, NumberField):
-            problem = event.input.problem()
-            if problem:
-                event.input.reset_to_default()
-                self.query_one("#poses-message", Static).update(
-                    escape(f"{problem}; reset to {event.input.value}")
-                )
+            self._check(event.input)
+
+    def _check(self, widget: NumberField) -> bool:
+        """Say why a typed value is refused (the text stays, marked, for correcting)."""
+        problem = widget.problem()
+        if problem:
+            widget.add_class("-bad")
+            expected = problem.split("expected ", 1)[-1]
+            self.query_one("#poses-message", Static).update(
+                escape(refusal(widget.field_name, widget.value, expected))
+            )
+        return problem is None
+
+    def _refused(self) -> bool:
+        """True when a field's text is not allowed: said, and that field focused."""
+        for name in self.COLUMNS:
+            widget = self.query_one(f"#p-{name}", NumberField)
+            if not self._check(widget):
+                widget.focus()
+                return True
+        return False
 
     @on(Input.Changed)
     def _typing(self, event: Input.Changed) -> None:
@@ -356,29 +378,34 @@ class PosesScreen(Dialog):
 
     @on(Input.Submitted)
     @on(Button.Pressed, "#pose-apply")
-    def _apply(self, event=None) -> None:
-        table = self.query_one(DataTable)
-        row = table.cursor_row
+    def _apply(self, event=None) -> bool:
+        """The fields into the selected row (a new one when none is); False, with the
+        reason said, when a field is not allowed."""
+        if self._refused():
+            return False
         message = self.query_one("#poses-message", Static)
-        problems = []
-        for name in self.COLUMNS:
-            widget = self.query_one(f"#p-{name}", NumberField)
-            problem = widget.problem()
-            if problem:
-                widget.reset_to_default()
-                problems.append(escape(f"{problem}; reset to {widget.value}"))
         try:
             pose = bridge.make_pose({c: self._raw(c) for c in self.COLUMNS})
         except LadarError as error:
             message.update(escape(str(error)))
-            return
+            return False
+        row = self.query_one(DataTable).cursor_row
         if 0 <= row < len(self.poses):
             self.poses[row] = pose
         else:
             self.poses.append(pose)
             row = len(self.poses) - 1
-        message.update(escape("\n".join(problems)))
+        message.update("")
         self._fill(row)
+        return True
+
+    def _edited(self) -> bool:
+        """Whether a field holds text not yet applied to its row."""
+        return any(
+            self.query_one(f"#p-{name}", NumberField).value
+            != self.query_one(f"#p-{name}", NumberField).committed
+            for name in self.COLUMNS
+        )
 
     @on(Button.Pressed, "#pose-add")
     def action_add_pose(self) -> None:
@@ -395,6 +422,9 @@ class PosesScreen(Dialog):
 
     @on(Button.Pressed, "#poses-ok")
     def _ok(self) -> None:
+        # typed values are applied first, as Run and Save commit the main form's
+        if self._edited() and not self._apply():
+            return
         self.dismiss(list(self.poses))
 
     @on(Button.Pressed, "#poses-cancel")
