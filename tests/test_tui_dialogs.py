@@ -5,7 +5,10 @@ Each test drives a real app on a tiny generated scene with Pilot.
 
 from __future__ import annotations
 
-from ladartui.tui.screens import FormScreen, PosesScreen
+import shlex
+
+from ladartui.tui.file_dialogs import SaveAsScreen
+from ladartui.tui.screens import CompareScreen, FormScreen, MeasuresScreen, PosesScreen
 from test_tui_flow import LadarApp, loaded, make_scenario, type_into, wait_until
 
 SIZE = (100, 32)
@@ -88,3 +91,65 @@ async def test_the_poses_dialog_keeps_a_refused_value_and_ok_applies_the_row(tmp
         assert app.screen is not screen
         assert app.scenario.flight.segments[-1].kind == "manual"
         assert app.scenario.flight.segments[-1].poses[0].x == 12.5
+
+
+async def test_save_as_refuses_a_folder_and_clears_the_last_run_line(tmp_path, scene_files):
+    scenario = make_scenario(tmp_path, scene_files)
+    folder = tmp_path / "kept"
+    folder.mkdir()
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        app.run_panel.say("Last run cancelled; nothing was written.")
+        await app.run_action("save_as")
+        await pilot.pause()
+        dialog = app.screen
+        assert isinstance(dialog, SaveAsScreen)
+        for typed in (str(folder), "kept", "kept/"):
+            dialog.query_one("#save-as-file").value = typed
+            await pilot.press("enter")
+            await pilot.pause()
+            assert app.screen is dialog, typed
+            said = message(dialog, "#save-as-message")
+            assert said == f"{folder}: is a folder; expected a scenario file name", typed
+        assert list(folder.iterdir()) == [] and not (tmp_path / "kept.toml").exists()
+        dialog.query_one("#save-as-file").value = "kept/copy"
+        await pilot.press("enter")
+        await pilot.pause()
+        assert app.scenario.path == folder / "copy.toml" and (folder / "copy.toml").is_file()
+        # the run line was the old file's: the new one has not been run
+        assert str(app.query_one("#run-info").render()) == ""
+
+
+async def test_markup_in_names_shows_as_typed_and_compare_reads_spaced_paths(tmp_path, scene_files):
+    from rich.text import Text
+
+    scenario = make_scenario(tmp_path, scene_files, name="[bold red]x y")
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        await app.run_action("run")
+        await wait_until(pilot, lambda: isinstance(app.screen, MeasuresScreen))
+        title = app.screen.query_one(".dialog").border_title
+        assert Text.from_markup(title).plain == "Comparison measures: [bold red]x y"
+        await pilot.press("escape")
+        await pilot.pause()
+        # Compare offers this run's measures file, whose name has a space, and reads it
+        app.action_compare()
+        await pilot.pause()
+        compare = app.screen
+        assert isinstance(compare, CompareScreen)
+        assert message(compare, "#compare-message") in ("", "Give two or more .cmf files to compare.")
+        other = tmp_path / "other run.cmf"
+        other.write_bytes(scenario.measures_file.read_bytes())
+        field = compare.query_one("#cmf-files")
+        field.value += " " + shlex.quote(str(other))
+        await pilot.press("enter")
+        await pilot.pause()
+        assert message(compare, "#compare-message") == ""
+        table = compare.query_one("#compare-table")
+        assert [str(c.label) for c in table.columns.values()] == ["Measure", "[bold red]x y", "other run"]
+        field.value = "'unclosed " + str(other)
+        await pilot.press("enter")
+        await pilot.pause()
+        assert message(compare, "#compare-message").startswith(".cmf files: ")

@@ -88,6 +88,7 @@ class FileActions(Host):
             self.output_voxels = None  # the outputs of the old name are not this file's
             self.show_output()
             self.show_measures(None)
+            self.run_panel.say("")  # the last run, if any, was the old file's
         else:
             history.mark_saved(saved)
         self.scenario = saved

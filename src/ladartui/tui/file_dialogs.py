@@ -257,11 +257,11 @@ class SaveAsScreen(TreeDialog):
             message.update("Scenario file: empty; expected a file name")
             return
         path = (self.base / Path(text).expanduser()).resolve()
-        if path.suffix != ".toml":
-            path = path.with_name(path.name + ".toml")
-        if path.is_dir():
+        if path.is_dir():  # before ".toml" is added: a folder's name is not a file's
             message.update(f"{path}: is a folder; expected a scenario file name")
             return
+        if path.suffix != ".toml":
+            path = path.with_name(path.name + ".toml")
         if not path.parent.is_dir():
             message.update(f"{path.parent}: folder not found")
             return

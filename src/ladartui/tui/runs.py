@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
+from rich.markup import escape
 from textual.widgets import TabbedContent
 
 from ladartui.errors import Cancelled
@@ -95,7 +96,7 @@ class RunControl(Host):
         self.refresh_status()
         self.query_one("#tabs", TabbedContent).active = "tab-results"
         name = scenario.name if scenario is not None else ""
-        self.push_screen(MeasuresScreen(result.measures, f"Comparison measures: {name}"))
+        self.push_screen(MeasuresScreen(result.measures, f"Comparison measures: {escape(name)}"))
 
 
 def _run(scenario, scene, fast: bool, warm, cancel, progress):

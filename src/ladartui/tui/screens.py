@@ -3,6 +3,7 @@ measures, comparison and help."""
 
 from __future__ import annotations
 
+import shlex
 from pathlib import Path
 
 from rich.markup import escape
@@ -486,7 +487,7 @@ class CompareScreen(Dialog):
             yield _row(
                 ".cmf files",
                 Input(
-                    " ".join(str(p) for p in self.paths),
+                    shlex.join(str(p) for p in self.paths),
                     id="cmf-files",
                     compact=True,
                     suggester=PathSuggester((".cmf",)),
@@ -494,8 +495,9 @@ class CompareScreen(Dialog):
             )
             yield FileTree(self.folder, (".cmf",), id="cmf-tree")
             yield Static(
-                "Space-separated paths, or pick files in the tree (again to drop "
-                "one); Enter compares. Green best, red worst, yellow differs.",
+                "Paths separated by spaces (quote one that has spaces), or pick files "
+                "in the tree (again to drop one); Enter compares. Green best, red "
+                "worst, yellow differs.",
                 classes="info",
             )
             yield Static("", id="compare-message", classes="message")
@@ -511,18 +513,31 @@ class CompareScreen(Dialog):
     def _picked(self, event: FileTree.FileSelected) -> None:
         event.stop()
         field = self.query_one("#cmf-files", Input)
-        chosen = field.value.split()
+        chosen = self._typed() or []
         picked = str(event.path)
-        field.value = " ".join([c for c in chosen if c != picked] if picked in chosen else chosen + [picked])
+        field.value = shlex.join(
+            [c for c in chosen if c != picked] if picked in chosen else chosen + [picked]
+        )
         self.compare()
+
+    def _typed(self) -> list[str] | None:
+        """The paths in the field, split as a shell would (quotes keep spaces); None,
+        with the reason said, when a quote is not closed."""
+        try:
+            return shlex.split(self.query_one("#cmf-files", Input).value)
+        except ValueError as error:  # shlex's own words: "No closing quotation"
+            self.query_one("#compare-message", Static).update(escape(f".cmf files: {error}"))
+            return None
 
     @on(Input.Submitted, "#cmf-files")
     @on(Button.Pressed, "#compare-go")
     def compare(self) -> None:
-        text = self.query_one("#cmf-files", Input).value.split()
         message = self.query_one("#compare-message", Static)
         table = self.query_one("#compare-table", DataTable)
         table.clear(columns=True)
+        text = self._typed()
+        if text is None:
+            return
         if len(text) < 2:
             message.update("Give two or more .cmf files to compare.")
             return

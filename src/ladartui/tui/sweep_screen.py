@@ -15,6 +15,7 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from rich.text import Text
 from textual import on
 from textual.app import ComposeResult
 from textual.binding import Binding
@@ -639,7 +640,7 @@ class SweepScreen(Screen):
         )
 
     def _announce_best(self, path: Path, how: str) -> None:
-        self.query_one("#sweep-detail", Static).update(f"best path: {path}")
+        self.query_one("#sweep-detail", Static).update(Text(f"best path: {path}"))  # a path: never markup
         self._status(
             self._idle_state(), f"best path ({how}): {path}", self._fraction() if self.running else None
         )
