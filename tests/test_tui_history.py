@@ -257,6 +257,8 @@ async def test_no_sidebar_label_or_button_is_clipped(tmp_path, scene_files, size
 async def test_a_key_remapped_in_keys_toml_changes_the_footer_help_and_palette(
     tmp_path, scene_files, monkeypatch
 ):
+    from textual.widgets import Button
+
     from ladartui.tui.app import help_rows
     from ladartui.tui.app import palette_entries as app_palette
     from ladartui.tui.screens import HelpScreen
@@ -265,7 +267,9 @@ async def test_a_key_remapped_in_keys_toml_changes_the_footer_help_and_palette(
 
     home = tmp_path / "home"
     (home / "config").mkdir(parents=True)
-    (home / "config" / "keys.toml").write_text('[keys]\nrun = "ctrl+r"\nnonsense = "x"\nthreshold = 3\n')
+    (home / "config" / "keys.toml").write_text(
+        '[keys]\nrun = "ctrl+r"\nnonsense = "x"\nthreshold = 3\nlayout = "[bold red]q"\nsave = "ctrl+w"\n'
+    )
     monkeypatch.setenv("LADARTUI_HOME", str(home))
     scenario = make_scenario(tmp_path, scene_files)
     app = LadarApp(scenario.path)
@@ -283,8 +287,15 @@ async def test_a_key_remapped_in_keys_toml_changes_the_footer_help_and_palette(
         assert entries["Run simulation"].endswith("(Ctrl+R)")  # the palette
         # the bad lines are named, and the rest of the file still applies
         problems = [m for m in app.messages if m.startswith("Key not remapped")]
-        assert len(problems) == 2 and "keys.nonsense" in problems[0]
+        assert len(problems) == 3 and "keys.nonsense" in problems[0]
         assert "keys.threshold = 3" in problems[1]
+        assert "keys.layout = '[bold red]q': expected a key name" in problems[2]
+        assert "f6" in shown_keys(app)  # the layout key stays the default
+        # buttons and messages name the keys in force
+        labels = {str(b.id): str(b.label) for b in app.query(Button)}
+        assert labels["btn-run"] == "Run ^R" and labels["btn-save"] == "Save ^W"
+        assert labels["btn-open"] == "Open F3"
+        assert app.query_one(StatusBar).message.endswith("rays. Ctrl+R runs.")
         runs = capture_runs(app)
         await pilot.press("ctrl+r")
         await pilot.pause()

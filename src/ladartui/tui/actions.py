@@ -14,6 +14,7 @@ user's ``keys.toml`` changes the footer, the palette and the help together:
 
 from __future__ import annotations
 
+import re
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -26,6 +27,8 @@ from ladartui.tui.view_area import LAYOUTS
 from ladartui.user_data import config_folder
 
 KEYS_FILE = "keys.toml"
+# A key as Textual names it: modifiers, then one character or a name ("f9", "question_mark").
+KEY_NAME = re.compile(r"((ctrl|shift|alt|meta|super|hyper)\+)*([a-z0-9_]+|[^\s,+\[\]])")
 
 
 @dataclass(frozen=True)
@@ -271,13 +274,22 @@ def load_keymap(folder: Path | None = None) -> tuple[dict[str, str], list[str]]:
                     f"{path}: keys.{command_id}: no such command; expected one of " + ", ".join(sorted(BY_ID))
                 )
             )
-        elif not isinstance(key, str) or not key.strip():
+        elif not isinstance(key, str) or not all(KEY_NAME.fullmatch(k.strip()) for k in key.split(",")):
             problems.append(
                 one_line(f'{path}: keys.{command_id} = {key!r}: expected a key name such as "f9" or "ctrl+r"')
             )
         else:
             keymap[command_id] = key.strip()
     return keymap, problems
+
+
+def key_hint(command_id: str, keymap: dict[str, str] | None = None, short: bool = False) -> str:
+    """The first key in force for a command as messages show it (F5, Ctrl+S), or
+    ``short`` as buttons do (F5, ^S); empty when no key runs it."""
+    key = keys_in_force(keymap).get(command_id, "").split(",")[0].strip()
+    if short and key.startswith("ctrl+") and len(key) == 6:
+        return "^" + key[5:].upper()
+    return key_name(key) if key else ""
 
 
 def key_name(key: str) -> str:

@@ -122,6 +122,15 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         self.keymap, self.keymap_problems = actions.load_keymap()
         self.set_keymap(self.keymap)
 
+    def key_hint(self, command_id: str, short: bool = False) -> str:
+        """The key in force for a command (``actions.key_hint``): F5, Ctrl+S, or ^S when short."""
+        return actions.key_hint(command_id, self.keymap, short)
+
+    def key_says(self, command_id: str, words: str) -> str:
+        """ "F5 runs" for ("run", "runs") with the key in force; empty when no key runs it."""
+        key = self.key_hint(command_id)
+        return f"{key} {words}" if key else ""
+
     def target_m(self) -> tuple[float, ...]:
         if self.prepared is not None:
             return self.prepared["target_m"]
@@ -154,6 +163,8 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         self.run_panel = self.query_one(RunPanel)
         self.results_panel = self.query_one(ResultsPanel)
         self.view_area = self.query_one(ViewArea)
+        runs = self.key_says("run", "runs")
+        self.view_area.no_output = "no output yet" + (f": {runs}" if runs else "")
         for problem in self.keymap_problems:
             self.tell(problem, title="Key not remapped", severity="warning", timeout=10)
         for problem in self.graphics_problems:
@@ -233,14 +244,13 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         poses = len(scenario.poses())
         rays = scenario.sensor.rays_per_scan
         mark = " (modified)" if self.modified else ""
-        text = f"{scenario.path.name}{mark}: {poses} scans x {rays:,} rays. F5 runs."
+        runs = self.key_says("run", "runs")
+        text = f"{scenario.path.name}{mark}: {poses} scans x {rays:,} rays." + (f" {runs}." if runs else "")
         if self.missing_outputs:
             # runnable, but the set on disk is incomplete: yellow until a run rewrites it
             names = ", ".join(p.name for p in self.missing_outputs)
-            bar.show(
-                NOT_READY,
-                f"{scenario.path.name}{mark}: outputs missing ({names}); F5 runs and writes them.",
-            )
+            writes = f"; {runs} and writes them" if runs else ""
+            bar.show(NOT_READY, f"{scenario.path.name}{mark}: outputs missing ({names}){writes}.")
             return
         bar.show(READY, text)
 

@@ -84,6 +84,12 @@ class AppHost(App[None]):
     def set_busy(self, message: str | None, progress: float | None = None) -> None:
         raise NotImplementedError
 
+    def key_hint(self, command_id: str, short: bool = False) -> str:
+        raise NotImplementedError
+
+    def key_says(self, command_id: str, words: str) -> str:
+        raise NotImplementedError
+
     def refresh_status(self) -> None:
         raise NotImplementedError
 

@@ -70,6 +70,7 @@ class ViewArea(Container):
         self.markers: np.ndarray | None = None  # scan positions, voxel units
         self._output_args: tuple[Any, float | None, int, Any, Any] = (None, None, OUTPUT_POINTS, None, None)
         self.per_scan_known = False  # the output shown has per-scan returns ("scans" mode)
+        self.no_output = "no output yet: F5 runs"  # the app's words, with its run key
         self._target_file_cache: tuple | None = None
 
     def compose(self):
@@ -170,7 +171,7 @@ class ViewArea(Container):
         widget.base_title = title
         widget._update_title()
         if voxels is None or self.prepared is None:
-            widget.placeholder = "no output yet: F5 runs"
+            widget.placeholder = self.no_output
             widget.set_points(None)
             return
         if target_output is None:

@@ -21,13 +21,14 @@ class FilePanel(VerticalScroll):
 
     def compose(self):
         yield Static("", id="file-info")
+        hint = host_of(self).key_hint
         with Grid(classes="button-grid file-buttons"):
-            yield Button("New F2", id="btn-new", compact=True)
-            yield Button("Open F3", id="btn-open", compact=True)
-            yield Button("Save ^S", id="btn-save", compact=True)
+            yield Button(f"New {hint('new', True)}".strip(), id="btn-new", compact=True)
+            yield Button(f"Open {hint('open', True)}".strip(), id="btn-open", compact=True)
+            yield Button(f"Save {hint('save', True)}".strip(), id="btn-save", compact=True)
             yield Button("Save as", id="btn-save-as", compact=True)
-            yield Button("Undo ^Z", id="btn-undo", compact=True)
-            yield Button("Redo ^Y", id="btn-redo", compact=True)
+            yield Button(f"Undo {hint('undo', True)}".strip(), id="btn-undo", compact=True)
+            yield Button(f"Redo {hint('redo', True)}".strip(), id="btn-redo", compact=True)
         yield Label("Recent scenarios (Enter opens)", classes="heading", id="recent-heading")
         yield OptionList(id="recent", compact=True)
 
@@ -36,7 +37,9 @@ class FilePanel(VerticalScroll):
 
     def show(self, scenario, scene, modified: bool, missing: Sequence[Path] = ()) -> None:
         if scenario is None:
-            self.query_one("#file-info", Static).update("No scenario: F2 new, F3 open.")
+            host = host_of(self)
+            keys = ", ".join(k for k in (host.key_says("new", "new"), host.key_says("open", "open")) if k)
+            self.query_one("#file-info", Static).update(Text("No scenario" + (f": {keys}." if keys else ".")))
             return
         voxels = f"{len(scene.voxels):,} voxels" if scene is not None else ""
         target = f"{len(scene.target):,} voxels" if scene is not None else ""

@@ -8,16 +8,15 @@ from textual.containers import Grid, VerticalScroll
 from textual.widgets import Button, DataTable, Static
 
 from ladartui.measures import Measures
+from ladartui.tui.host import host_of
 from ladartui.tui.measures_view import compact_rows, level_rows, target_rows
-
-NO_RESULTS = "No results yet: F5 runs the scenario."
 
 
 class ResultsPanel(VerticalScroll):
     DEFAULT_CLASSES = "pane"
 
     def compose(self):
-        yield Static(NO_RESULTS, id="results-info", classes="info", markup=False)
+        yield Static(self._no_results(), id="results-info", classes="info", markup=False)
         yield DataTable(id="measures", cursor_type="row", zebra_stripes=True)
         with Grid(classes="button-grid run-buttons"):
             yield Button("Measures", id="btn-measures", compact=True)
@@ -34,12 +33,16 @@ class ResultsPanel(VerticalScroll):
     def on_mount(self) -> None:
         self.query_one("#measures", DataTable).add_columns("Measure", "Value")
 
+    def _no_results(self) -> str:
+        runs = host_of(self).key_says("run", "runs the scenario")
+        return "No results yet" + (f": {runs}." if runs else ".")
+
     def show_measures(self, measures, name: str = "") -> None:
         table = self.query_one("#measures", DataTable)
         table.clear()
         info = self.query_one("#results-info", Static)
         if measures is None:
-            info.update(NO_RESULTS)
+            info.update(self._no_results())
             return
         info.update(f"Measures of {name}:")
         for label, value in compact_rows(measures):

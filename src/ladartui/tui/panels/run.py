@@ -50,18 +50,22 @@ class RunPanel(ParamPanel):
             tooltip="Show only the final output, not each scan as it lands",
         )
         with Grid(classes="button-grid run-buttons"):
-            yield Button("Run F5", id="btn-run", variant="success", compact=True)
-            yield Button("Save ^S", id="btn-save-run", compact=True)
+            hint = self.host.key_hint
+            yield Button(f"Run {hint('run', True)}".strip(), id="btn-run", variant="success", compact=True)
+            yield Button(f"Save {hint('save', True)}".strip(), id="btn-save-run", compact=True)
             yield Button("Cancel", id="btn-cancel-run", variant="error", compact=True, disabled=True)
         with Grid(classes="button-grid run-buttons two-buttons"):
             yield Button(
-                "Study F11",
+                f"Study {hint('study', True)}".strip(),
                 id="btn-study",
                 compact=True,
                 tooltip="Speed against accuracy of every backend and method",
             )
             yield Button(
-                "Sweep F12", id="btn-sweep", compact=True, tooltip="Launch, open or watch a flight-path sweep"
+                f"Sweep {hint('sweep', True)}".strip(),
+                id="btn-sweep",
+                compact=True,
+                tooltip="Launch, open or watch a flight-path sweep",
             )
         yield Static("", id="run-info", classes="info", markup=False)
         yield Static("probing backends...", id="backend-info", classes="info")
