@@ -373,3 +373,14 @@ def test_flag_errors_escape_what_the_user_typed(capsys):
         main(["validate", "x.toml", "\n\x1b]0;PWNED\x07"])
     err = one_error_line(capsys)
     assert "\\x0a\\x1b]0;PWNED\\x07" in err
+
+
+def test_a_scenario_path_that_is_a_folder_or_not_text_says_so_in_words(tmp_path):
+    with pytest.raises(LadarError) as folder:
+        load_scenario(tmp_path)
+    assert str(folder.value) == f"{tmp_path}: is a folder; expected a scenario file (.toml)"
+    binary = tmp_path / "binary.toml"
+    binary.write_bytes(b"\xff\xfe\x00junk")
+    with pytest.raises(LadarError) as undecodable:
+        load_scenario(binary)
+    assert str(undecodable.value) == f"{binary}: not UTF-8 text; expected a scenario file (.toml)"

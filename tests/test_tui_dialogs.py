@@ -153,3 +153,15 @@ async def test_markup_in_names_shows_as_typed_and_compare_reads_spaced_paths(tmp
         await pilot.press("enter")
         await pilot.pause()
         assert message(compare, "#compare-message").startswith(".cmf files: ")
+
+
+def test_segment_words_read_as_english():
+    from ladartui.flight import Manual, ScanPose
+    from ladartui.tui import bridge
+    from ladartui.tui.actions import palette_entries
+
+    helps = {title: text for title, text, _ in palette_entries()}
+    assert helps["Add orbit segment"].startswith("Append an orbit to")
+    assert helps["Add straight segment"].startswith("Append a straight to")
+    assert bridge.segment_summary(Manual((ScanPose(0.0, 0.0, 50.0),))) == "1 pose"
+    assert bridge.segment_summary(Manual((ScanPose(0.0, 0.0, 50.0),) * 2)) == "2 poses"

@@ -450,8 +450,12 @@ def load_scenario(path, check_files=True) -> Scenario:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise InputFileError(path, "scenario file not found") from None
-    except (OSError, UnicodeDecodeError) as error:
-        raise InputFileError(path, f"cannot read the scenario file: {error}") from None
+    except IsADirectoryError:
+        raise InputFileError(path, "is a folder; expected a scenario file (.toml)") from None
+    except UnicodeDecodeError:
+        raise InputFileError(path, "not UTF-8 text; expected a scenario file (.toml)") from None
+    except OSError as error:
+        raise InputFileError(path, f"cannot read the scenario file: {error.strerror or error}") from None
     scenario = scenario_from_toml(text, path)
     if check_files:
         scenario.check_files()

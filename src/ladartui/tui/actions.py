@@ -151,7 +151,7 @@ COMMANDS = [
             f"add_segment('{kind}')",
             None,
             f"Add {bridge.SEGMENT_LABELS[kind].lower()} segment",
-            f"Append a {bridge.SEGMENT_LABELS[kind].lower()} to the flight path",
+            f"Append {bridge.with_article(bridge.SEGMENT_LABELS[kind].lower())} to the flight path",
         )
         for kind in ("straight", "turn", "orbit", "flypast", "standoff")
     ),

@@ -225,11 +225,16 @@ def segment_builder(kind: str):
     return build
 
 
+def with_article(noun: str) -> str:
+    """The noun with its article: an orbit, a turn."""
+    return ("an " if noun[:1] in "aeiou" else "a ") + noun
+
+
 def segment_summary(segment) -> str:
     """A short description for the segments table."""
     k = segment.kind
     if k == "manual":
-        return f"{len(segment.poses)} poses"
+        return f"{len(segment.poses)} pose" + ("" if len(segment.poses) == 1 else "s")
     if k == "straight":
         return f"{segment.distance:g} m"
     if k == "turn":
