@@ -127,7 +127,7 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         return actions.key_hint(command_id, self.keymap, short)
 
     def key_says(self, command_id: str, words: str) -> str:
-        """ "F5 runs" for ("run", "runs") with the key in force; empty when no key runs it."""
+        """The key in force and ``words``: ("run", "runs") gives F5 runs; empty when no key runs it."""
         key = self.key_hint(command_id)
         return f"{key} {words}" if key else ""
 
