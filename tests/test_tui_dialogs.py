@@ -165,3 +165,27 @@ def test_segment_words_read_as_english():
     assert helps["Add straight segment"].startswith("Append a straight to")
     assert bridge.segment_summary(Manual((ScanPose(0.0, 0.0, 50.0),))) == "1 pose"
     assert bridge.segment_summary(Manual((ScanPose(0.0, 0.0, 50.0),) * 2)) == "2 poses"
+
+
+async def test_the_help_fits_the_terminal_without_sideways_scrolling(tmp_path, scene_files):
+    from ladartui.tui.screens import HelpScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        for size in ((80, 24), (120, 40)):
+            await pilot.resize_terminal(*size)
+            await pilot.press("f1")
+            await pilot.pause()
+            assert isinstance(app.screen, HelpScreen)
+            table = app.screen.query_one("DataTable")
+            assert table.max_scroll_x == 0, size  # every action wraps within the view
+            longest = max(app.screen.rows, key=lambda row: len(row[2]))
+            index = [tuple(map(str, table.get_row_at(i))) for i in range(table.row_count)].index(longest)
+            assert table.rows[table.ordered_rows[index].key].height > 1 or size == (120, 40)
+            await pilot.press("end")
+            await pilot.pause()
+            assert table.scroll_x == 0
+            await pilot.press("escape")
+            await pilot.pause()

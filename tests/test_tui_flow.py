@@ -577,7 +577,10 @@ async def test_study_key_opens_the_study_of_the_open_scenario_and_esc_returns(sh
 
     pilot, app = await fresh(shared)
     assert {"f11", "f12"} <= shown_keys(app)
-    assert {("Anywhere", "F11", "Study"), ("Anywhere", "F12", "Sweep")} <= set(help_rows(app))
+    assert {
+        ("Anywhere", "F11", "Speed-against-accuracy study"),
+        ("Anywhere", "F12", "Flight-path sweep"),
+    } <= set(help_rows(app))
     assert {"study", "sweep"} <= {action for _, _, action in palette_entries()}
     await pilot.press("f11")
     await pilot.pause()

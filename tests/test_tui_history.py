@@ -277,8 +277,8 @@ async def test_a_key_remapped_in_keys_toml_changes_the_footer_help_and_palette(
         await wait_until(pilot, lambda: loaded(app))
         keys = shown_keys(app)
         assert "ctrl+r" in keys and "f5" not in keys  # the footer
-        assert ("Anywhere", "Ctrl+R", "Run") in help_rows(app)  # the help screen
-        assert ("Anywhere", "F5", "Run") not in help_rows(app)
+        assert ("Anywhere", "Ctrl+R", "Run simulation") in help_rows(app)  # the help screen
+        assert ("Anywhere", "F5", "Run simulation") not in help_rows(app)
         await pilot.press("f1")
         await pilot.pause()
         assert isinstance(app.screen, HelpScreen)

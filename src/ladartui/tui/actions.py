@@ -225,7 +225,7 @@ def help_rows(
 ) -> list[tuple[str, str, str]]:
     """(where, key, what) for the help screen, with the keys in force."""
     keys = keys_in_force(keymap)
-    rows = [("Anywhere", key_name(keys[c.id]), c.footer or c.title) for c in COMMANDS if keys.get(c.id)]
+    rows = [("Anywhere", key_name(keys[c.id]), c.title) for c in COMMANDS if keys.get(c.id)]
     rows.append(("Anywhere", "Ctrl+P", "Command palette: every action by name"))
     rows.append(("Anywhere", "Ctrl+Q", "Quit (asks first when there are unsaved edits)"))
     rows.append(("Anywhere", "Tab / Shift+Tab", "Move between controls"))

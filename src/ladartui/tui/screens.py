@@ -604,13 +604,14 @@ class HelpScreen(Dialog):
     """Every key of the app, its views and its dialogs."""
 
     DEFAULT_CSS = """
-    HelpScreen > .dialog { height: 100%; }
+    HelpScreen > .dialog { width: 100%; max-width: 110; height: 100%; }
     HelpScreen DataTable { height: 1fr; }
     """
 
     def __init__(self, rows: list[tuple[str, str, str]]):
         super().__init__()
         self.rows = rows
+        self._filled_width = -1
 
     def compose(self) -> ComposeResult:
         with Vertical(classes="dialog") as box:
@@ -618,8 +619,27 @@ class HelpScreen(Dialog):
             yield DataTable(cursor_type="row", zebra_stripes=True)
 
     def on_mount(self) -> None:
+        self.query_one(DataTable).focus()
+
+    def on_resize(self) -> None:
         table = self.query_one(DataTable)
-        table.add_columns("Where", "Key", "Action")
-        for row in self.rows:
-            table.add_row(*row)
-        table.focus()
+        width = table.scrollable_content_region.width
+        if width > 0 and width != self._filled_width:
+            self._fill(table, width)
+
+    def _fill(self, table: DataTable, width: int) -> None:
+        """The rows with the action column as wide as the rest of ``width`` leaves, its
+        text wrapped there: nothing is cut off or needs scrolling sideways."""
+        self._filled_width = width
+        padding = 2 * table.cell_padding
+        where = max(len("Where"), *(len(r[0]) for r in self.rows))
+        key = max(len("Key"), *(len(r[1]) for r in self.rows))
+        action = max(12, width - where - key - 3 * padding - table.styles.scrollbar_size_vertical)
+        row = table.cursor_row
+        table.clear(columns=True)
+        table.add_column("Where", width=where)
+        table.add_column("Key", width=key)
+        table.add_column("Action", width=action)
+        for place, keys, text in self.rows:
+            table.add_row(Text(place), Text(keys), Text(text), height=None)
+        table.move_cursor(row=row)
