@@ -1,5 +1,6 @@
 """Scenario files: TOML round trips, field limits, unknown keys, model files (report 4.1)."""
 
+import dataclasses
 import math
 import textwrap
 from pathlib import Path
@@ -496,3 +497,13 @@ def test_round_trip_of_arbitrary_values(tmp_path):
         assert again.to_toml() == scenario.to_toml()
 
     check()
+
+
+def test_same_outputs_ignores_only_the_name_backend_and_fast_mode(tmp_path):
+    scenario = load_scenario(write_scenario(tmp_path), check_files=False)
+    assert scenario.same_outputs(scenario.with_changes(path=tmp_path / "other.toml"))
+    assert scenario.same_outputs(scenario.with_changes(backend="numba", fast_mode=not scenario.fast_mode))
+    grid = dataclasses.replace(scenario.sensor, grid=scenario.sensor.grid + 1)
+    assert not scenario.same_outputs(scenario.with_changes(sensor=grid))
+    assert not scenario.same_outputs(scenario.with_changes(speed=scenario.speed + 1.0))
+    assert not scenario.same_outputs(scenario.with_changes(step=scenario.step * 2))

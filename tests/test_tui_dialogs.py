@@ -189,3 +189,38 @@ async def test_the_help_fits_the_terminal_without_sideways_scrolling(tmp_path, s
             assert table.scroll_x == 0
             await pilot.press("escape")
             await pilot.pause()
+
+
+async def test_outputs_from_other_settings_are_said_to_be_out_of_date(tmp_path, scene_files):
+    from ladartui.tui.status import NOT_READY, READY, StatusBar
+    from test_tui_flow import field
+
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        bar = app.query_one(StatusBar)
+        await app.run_action("run")
+        await wait_until(pilot, lambda: isinstance(app.screen, MeasuresScreen))
+        await pilot.press("escape")
+        await pilot.pause()
+        assert bar.state == READY and "before" not in bar.message
+        info = app.query_one("#results-info")
+        assert str(info.render()) == f"Measures of {scenario.name}:"
+        app.action_show_tab("sensor")
+        await type_into(pilot, field(app, "sensor.grid"), "12")
+        # the outputs and measures shown are the 8 x 8 run's: said in the bar and the tab
+        assert bar.state == NOT_READY
+        assert bar.message.endswith(
+            "outputs are from the settings before your edits; F5 runs and rewrites them."
+        )
+        assert str(info.render()) == f"Measures of {scenario.name}, from the settings before your edits:"
+        # back to the settings that ran (undo): up to date again, though not yet saved
+        await pilot.press("ctrl+z")
+        await pilot.pause()
+        assert bar.state == READY and "before your edits" not in bar.message
+        assert str(info.render()) == f"Measures of {scenario.name}:"
+        # the backend and fast mode change nothing that a run writes
+        app.set_scenario(app.scenario.with_changes(fast_mode=not app.scenario.fast_mode))
+        await pilot.pause()
+        assert bar.state == READY

@@ -268,7 +268,9 @@ async def test_a_run_disables_controls_and_cancel_keeps_earlier_outputs(tmp_path
             if w.id != "f-scenario-step" and not w.id.startswith("f-start")
         )
         assert all(w.disabled for w in app.query("#sidebar Input") if w.id.startswith("f-start"))
-        assert status(app).state == READY
+        # the outputs kept are the first run's, with the settings before the edits
+        assert status(app).state == NOT_READY
+        assert "outputs are from the settings before your edits" in status(app).message
 
 
 async def test_progressive_output_during_a_run_unless_fast_mode(tmp_path, scene_files):

@@ -143,6 +143,7 @@ _SECTIONS = {
     "targets": ("names",),
 }
 MAX_TARGET_NAME = 60
+RUN_ONLY_FIELDS = ("path", "backend", "fast_mode")  # change no output (``same_outputs``)
 # Segment kinds a scenario file may use: the flight plan's, and recorded logs.
 _SEGMENT_KINDS = {**SEGMENT_KINDS, LogSegment.kind: LogSegment}
 
@@ -290,6 +291,16 @@ class Scenario:
     def with_changes(self, **fields) -> Scenario:
         """A copy with ``fields`` replaced (checked like a new scenario)."""
         return dataclasses.replace(self, **fields)
+
+    def same_outputs(self, other: Scenario) -> bool:
+        """Whether a run of ``other`` writes what a run of this scenario writes: every
+        field equal but the file's name and what only changes how a run goes (the
+        backend, whose answers are the same, and fast mode, which draws less)."""
+        return all(
+            getattr(self, f.name) == getattr(other, f.name)
+            for f in dataclasses.fields(self)
+            if f.name not in RUN_ONLY_FIELDS
+        )
 
     @classmethod
     def new(cls, path, scene_file, voxel_size=1.0, *, sensor=None, flight=None, **options) -> Scenario:

@@ -33,6 +33,7 @@ from ladartui.tui.file_actions import FileActions
 from ladartui.tui.graphics import Graphics, has_truecolor
 from ladartui.tui.loading import SceneLoading
 from ladartui.tui.panels import FilePanel, FlightPanel, ResultsPanel, RunPanel, SensorPanel
+from ladartui.tui.panels.results import EARLIER_SETTINGS
 from ladartui.tui.params import ParamField
 from ladartui.tui.runs import RunControl
 from ladartui.tui.screens import (
@@ -111,6 +112,8 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         self.result = None
         self.output_voxels = None
         self.missing_outputs: list[Path] = []
+        self.outputs_from: Scenario | None = None  # the settings that made the outputs shown
+        self.run_scenario: Scenario | None = None
         self.threshold: float | None = None
         self.busy: str | None = None
         self.progress: float | None = None
@@ -252,6 +255,10 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
             writes = f"; {runs} and writes them" if runs else ""
             bar.show(NOT_READY, f"{scenario.path.name}{mark}: outputs missing ({names}){writes}.")
             return
+        if self.outputs_stale():
+            rewrites = f"; {runs} and rewrites them" if runs else ""
+            bar.show(NOT_READY, f"{scenario.path.name}{mark}: outputs are from {EARLIER_SETTINGS}{rewrites}.")
+            return
         bar.show(READY, text)
 
     def check_action(self, action: str, parameters) -> bool | None:
@@ -300,7 +307,14 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
 
     def show_measures(self, measures) -> None:
         self.measures = measures
-        self.results_panel.show_measures(measures, self.scenario.name if self.scenario else "")
+        self.results_panel.show_measures(
+            measures, self.scenario.name if self.scenario else "", stale=self.outputs_stale()
+        )
+
+    def outputs_stale(self) -> bool:
+        """Whether the outputs shown came from other settings than the scenario's now."""
+        made, scenario = self.outputs_from, self.scenario
+        return made is not None and scenario is not None and not made.same_outputs(scenario)
 
     def action_layout(self, number: int) -> None:
         self.view_area.set_layout(number)

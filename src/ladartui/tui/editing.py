@@ -91,6 +91,7 @@ class ScenarioEditing(Host):
         self.file_panel.show(scenario, self.scene, self.modified, self.missing_outputs)
         self.view_area.draw_path(scenario)
         self.sub_title = scenario.path.name + (" (modified)" if self.modified else "")
+        self.show_measures(self.measures)  # says whether they are the settings' now
         self.refresh_status()
 
     def _rescale_scene(self, old: Scene, voxel_size: float) -> None:

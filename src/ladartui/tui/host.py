@@ -46,6 +46,8 @@ class AppHost(App[None]):
     result: SimulationResult | None
     output_voxels: np.ndarray | None
     missing_outputs: list[Path]
+    outputs_from: Scenario | None  # the settings that made the outputs shown
+    run_scenario: Scenario | None  # the scenario of the run going or last started
     cwd: Path
     compile_in_child: bool
     # the jobs and the busy state
@@ -118,6 +120,9 @@ class AppHost(App[None]):
         raise NotImplementedError
 
     def show_measures(self, measures: Measures | None) -> None:
+        raise NotImplementedError
+
+    def outputs_stale(self) -> bool:
         raise NotImplementedError
 
     # one mixin's, used by another or by the panels

@@ -55,6 +55,8 @@ class SceneLoading(Host):
         self.prepared = done.prepared
         self.view_area.set_scene(done.prepared, done.scene.voxel_size)
         self.missing_outputs = bridge.missing_outputs(done.scenario)
+        shown = done.output is not None or done.measures is not None
+        self.outputs_from = done.scenario if shown else None  # as saved: what wrote them
         self.set_scenario(done.scenario, modified=False)
         if done.scenario.path.is_file():
             remember_scenario(done.scenario.path)

@@ -46,6 +46,7 @@ class RunControl(Host):
             return
         self.running = True
         self.set_busy("Starting the run...", 0.0)
+        self.run_scenario = self.scenario
         self._run_worker(self.scenario, self.scene, self.scenario.fast_mode)
 
     def _run_worker(self, scenario, scene, fast: bool) -> None:
@@ -84,6 +85,7 @@ class RunControl(Host):
             return
         self.result = result
         self.missing_outputs = []
+        self.outputs_from = self.run_scenario
         self.output_voxels = result.scene_output
         self.show_output()
         self.show_measures(result.measures)
