@@ -169,3 +169,9 @@ def test_sweep_writes_the_pareto_chart_with_the_front_cheapest_first_and_the_bes
     assert vertices[index] == pytest.approx((float(marker.get("x")), float(marker.get("y"))), abs=0.01)
     with Image.open(out / "pareto.png") as image:
         assert image.size == (800, 480)
+
+
+def test_study_chart_from_prints_an_output_folder_with_markup_as_it_is(tmp_path, capsys):
+    out = tmp_path / "a[" / "bold]st"  # the path holds "[/bold]": a closing tag to rich
+    assert main(["study", "--chart-from", str(ROOT / "docs" / "study.json"), "--out", str(out)]) == 0
+    assert str(out) in capsys.readouterr().out.replace("\n", "")

@@ -25,3 +25,24 @@ def test_the_study_package_offers_only_names_that_resolve():
     study = importlib.import_module("ladartui.study")
     for name in study.__all__:
         assert getattr(study, name) is not None, name
+
+
+def test_a_mistyped_command_is_named_not_taken_for_a_scenario(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert cli.main(["valdiate", "x.toml"]) == 2
+    assert capsys.readouterr().err == (
+        "ladartui: error: unknown command 'valdiate'; did you mean 'validate'? (see 'ladartui -h')\n"
+    )
+    assert cli.main(["bogus"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("ladartui: error: unknown command 'bogus'; expected one of run, trace, ")
+    assert err.endswith(", or a scenario file (.toml) (see 'ladartui -h')\n")
+
+
+def test_ctrl_c_while_the_commands_load_is_one_line(monkeypatch, capsys):
+    def interrupted():
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "build_parser", interrupted)
+    assert cli.main(["run", "default"]) == 130
+    assert capsys.readouterr().err == "ladartui: interrupted\n"

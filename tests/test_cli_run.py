@@ -94,3 +94,53 @@ def test_bad_step_names_the_flag(scenario, capsys):
     assert main(["run", str(scenario.path), "--step", "0", "--no-write"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and err.startswith("ladartui: error: --step = 0.0: expected")
+
+
+def test_ctrl_c_after_the_run_wrote_its_outputs_says_what_it_wrote(scenario, capsys, monkeypatch):
+    import ladartui.cli.run as cli_run
+
+    real_show = cli_run.show_result
+
+    def interrupted_while_showing(console, result):
+        real_show(console, result)
+        raise KeyboardInterrupt  # as a Ctrl-C landing once the run had finished
+
+    monkeypatch.setattr(cli_run, "show_result", interrupted_while_showing)
+    assert main(["run", str(scenario.path)]) == 130
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err == (
+        "ladartui: interrupted after the run had finished; it wrote "
+        f"{scenario.scene_output}, {scenario.target_output}, {scenario.measures_file}"
+    )
+    assert scenario.measures_file.is_file()
+
+
+def test_an_unwritable_chart_is_refused_before_anything_runs(scenario, capsys, tmp_path):
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    assert main(["run", str(scenario.path), "--chart", str(blocker / "c.svg")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"ladartui: error: --chart = '{blocker / 'c.svg'}': expected a writable path")
+    assert not scenario.measures_file.exists() and not scenario.scene_output.exists()
+
+
+def test_paths_with_markup_are_printed_as_they_are(tmp_path, capsys):
+    from ladartui.flight import FlightPlan, Manual, ScanPose, aim_at
+
+    folder = tmp_path / "a["
+    folder.mkdir()
+    target = np.array([(x, y, 0) for x in range(8, 12) for y in range(8, 11)], dtype=np.int32)
+    save_voxels(folder / "woods.txt", target)
+    save_voxels(folder / "woods_Target.txt", target)
+    poses = (aim_at(ScanPose(9.5, -10.0, 40.0), (9.5, 9.0, 0.5)),)
+    scenario = Scenario(
+        folder / "bold]b.toml",  # the path holds "[/bold]": a closing tag to rich
+        "woods.txt",
+        1.0,
+        Sensor(grid=8, ray_grid=1, fov=20.0),
+        FlightPlan(segments=[Manual(poses)]),
+        backend="numba",
+    ).save()
+    assert main(["run", str(scenario.path)]) == 0
+    out = capsys.readouterr().out
+    assert f"wrote measures: {scenario.measures_file}" in out.replace("\n", "")

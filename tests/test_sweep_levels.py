@@ -186,3 +186,17 @@ def test_several_targets_survive_the_result_table(tmp_path):
     again = sorted((r.row for r in result.ranking), key=lambda r: r["variant"])
     assert [r["targets.per_target"] for r in again] == [r["targets.per_target"] for r in TWO_TARGETS]
     assert order(result.ranking) == [("q", 1), ("p", 2), ("r", None)]
+
+
+def test_cli_sweep_prints_paths_with_markup_as_they_are(tmp_path, capsys):
+    from ladartui.cli import main
+    from tiny_sweep import write_tiny_scenario
+
+    folder = tmp_path / "a[" / "bold]s"  # the path holds "[/bold]": a closing tag to rich
+    folder.mkdir(parents=True)
+    write_tiny_scenario(folder)
+    spec = folder / "spec.toml"
+    spec.write_text('[sweep]\nscenario = "base.toml"\n[grid]\nradius = [20.0, 30.0]\n')
+    assert main(["sweep", str(spec), "--serial"]) == 0
+    text = capsys.readouterr().out.replace("\n", "")
+    assert f"results  {folder}" in text

@@ -8,8 +8,10 @@ one line on stderr and exit status 2; no traceback reaches the user.
 from __future__ import annotations
 
 import argparse
+import difflib
 import importlib
 import sys
+from pathlib import Path
 
 from ladartui import __version__
 from ladartui.errors import Cancelled, LadarError
@@ -54,14 +56,37 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _names_a_scenario(argument: str) -> bool:
+    """Whether the TUI can take ``argument``: a file, a .toml name or a bundled scenario."""
+    from ladartui.user_data import bundled_scenario_name
+
+    return (
+        Path(argument).exists()
+        or argument.lower().endswith(".toml")
+        or bundled_scenario_name(argument) is not None
+    )
+
+
+def _unknown_command(word: str) -> str:
+    close = difflib.get_close_matches(word, COMMANDS, n=1)
+    if close:
+        return one_line(f"unknown command {word!r}; did you mean {close[0]!r}?")
+    return one_line(
+        f"unknown command {word!r}; expected one of {', '.join(COMMANDS)}, or a scenario file (.toml)"
+    )
+
+
 def main(argv: list[str] | None = None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
     # `ladartui`, `ladartui SCENARIO.toml` and `ladartui --graphics MODE` open the TUI.
     tui_flag = bool(argv) and argv[0].split("=")[0] == "--graphics"
     if not argv or tui_flag or (argv[0] not in COMMANDS and not argv[0].startswith("-")):
+        if argv and not tui_flag and not _names_a_scenario(argv[0]):
+            print(f"ladartui: error: {_unknown_command(argv[0])} (see 'ladartui -h')", file=sys.stderr)
+            return 2
         argv = ["tui", *argv]
-    parser = build_parser()
     try:
+        parser = build_parser()  # (imports every command: a Ctrl-C can land here)
         args = parser.parse_args(argv)
         if getattr(args, "handler", None) is None:
             parser.print_help()

@@ -9,11 +9,16 @@ Progress goes to stderr, the measures to stdout (a table, or JSON with --json).
 
 from __future__ import annotations
 
+import contextlib
 import json
 import threading
+from typing import TYPE_CHECKING
 
 from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt
 from ladartui.errors import Cancelled
+
+if TYPE_CHECKING:
+    from ladartui.simulation import SimulationResult
 
 
 def add_parser(subparsers):
@@ -83,24 +88,41 @@ def run(args) -> int:
 
         check_outputs_spare_inputs(scenario, args.las)
         check_writable(*output_paths(scenario, args.las).values())
-    if args.chart is not None and not args.chart.lower().endswith((".svg", ".png")):
-        raise FieldError("--chart", args.chart, "a file name ending in .svg or .png")
+    if args.chart is not None:
+        from ladartui.outputset import output_problem
+
+        if not args.chart.lower().endswith((".svg", ".png")):
+            raise FieldError("--chart", args.chart, "a file name ending in .svg or .png")
+        problem = output_problem(args.chart)  # before the run, not after its outputs
+        if problem:
+            raise FieldError("--chart", args.chart, f"a writable path; it {problem}")
     errors = Console(stderr=True)
     result = _simulate_with_progress(scenario, args, errors)
-    if args.chart is not None:
-        from ladartui.charts import save_figure
-        from ladartui.charts.coverage import coverage_figure
+    try:
+        if args.chart is not None:
+            from ladartui.charts import save_figure
+            from ladartui.charts.coverage import coverage_figure
 
-        try:
-            path = save_figure(coverage_figure(result.measures), args.chart)
-        except OSError as error:
-            raise FieldError("--chart", args.chart, f"a writable path ({error.strerror})") from None
-        errors.print(f"wrote chart: {path}", highlight=False, markup=False, soft_wrap=True)
-    if args.json:
-        print(json.dumps(result_dict(scenario, result), indent=2, allow_nan=False))
-    else:
-        show_result(Console(), result)
+            try:
+                path = save_figure(coverage_figure(result.measures), args.chart)
+            except OSError as error:
+                raise FieldError("--chart", args.chart, f"a writable path ({error.strerror})") from None
+            errors.print(f"wrote chart: {path}", highlight=False, markup=False, soft_wrap=True)
+        if args.json:
+            print(json.dumps(result_dict(scenario, result), indent=2, allow_nan=False))
+        else:
+            show_result(Console(), result)
+    except KeyboardInterrupt:  # the outputs are written by now: say so
+        raise Cancelled(interrupted_after(result)) from None
     return 0
+
+
+def interrupted_after(result) -> str:
+    """What a Ctrl-C once the run has finished leaves: the files it wrote."""
+    written = ", ".join(str(path) for path in result.outputs.values())
+    return "interrupted after the run had finished; " + (
+        f"it wrote {written}" if written else "nothing was written (--no-write)"
+    )
 
 
 def run_progress(console, **options):
@@ -120,7 +142,8 @@ def _simulate_with_progress(scenario, args, console):
     from ladartui.simulation import NOTHING_WRITTEN, simulate
 
     cancel = threading.Event()
-    with run_progress(console, transient=False) as bar:
+    finished: list[SimulationResult] = []  # the result, once there is one
+    with _told_if_finished(finished), run_progress(console, transient=False) as bar:
         task = bar.add_task("starting", total=1.0, rays="")
 
         def report(p):
@@ -134,12 +157,29 @@ def _simulate_with_progress(scenario, args, console):
         # A stop during the write lets the swap finish (or roll back): the files on
         # disk belong to one run and the result says which.
         with sigterm_as_interrupt():
-            return run_cancellable(
-                lambda: simulate(scenario, progress=report, cancel=cancel, write=args.write, las=args.las),
-                cancel,
-                "ladartui-run",
-                Cancelled(NOTHING_WRITTEN),
+            finished.append(
+                run_cancellable(
+                    lambda: simulate(
+                        scenario, progress=report, cancel=cancel, write=args.write, las=args.las
+                    ),
+                    cancel,
+                    "ladartui-run",
+                    Cancelled(NOTHING_WRITTEN),
+                )
             )
+    return finished[0]
+
+
+@contextlib.contextmanager
+def _told_if_finished(finished: list):
+    """A Ctrl-C once the run has a result (as the progress display closes) says what
+    the run wrote rather than just "interrupted"."""
+    try:
+        yield
+    except KeyboardInterrupt:
+        if not finished:
+            raise
+        raise Cancelled(interrupted_after(finished[0])) from None
 
 
 def result_dict(scenario, result) -> dict:
@@ -192,7 +232,7 @@ def show_result(console, result) -> None:
     )
     if result.outputs:
         for name, path in result.outputs.items():
-            console.print(f"wrote {name}: {path}", highlight=False, soft_wrap=True)
+            console.print(f"wrote {name}: {path}", highlight=False, markup=False, soft_wrap=True)
     else:
         console.print("nothing written (--no-write)")
 

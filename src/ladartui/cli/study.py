@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 import threading
 
+from rich.markup import escape
+
 from ladartui.cli.progress import progress_display, run_cancellable
 from ladartui.errors import Cancelled, FieldError
 
@@ -97,7 +99,7 @@ def _run_with_progress(console, inputs, settings, runs, warmup):
 
     for name, reason in backend_reasons(s.backend for s in settings).items():
         if reason:
-            console.print(f"[yellow]skipping backend {name}:[/] {reason}")
+            console.print(f"[yellow]skipping backend {name}:[/] {escape(reason)}")
     scene = inputs.scene
     console.print(
         f"study on {inputs.name}: {len(scene.voxels):,} voxels, shape {scene.shape}, "
@@ -119,7 +121,7 @@ def _run_with_progress(console, inputs, settings, runs, warmup):
         )
         if plain and last.get("label") != p.label and p.scan == 1:
             last["label"] = p.label
-            console.print(f"[{p.done}/{p.total} traces] {p.label}", highlight=False)
+            console.print(f"[{p.done}/{p.total} traces] {p.label}", highlight=False, markup=False)
 
     with progress_bar:
         return run_cancellable(
@@ -153,5 +155,5 @@ def _report(result, out_dir) -> int:
     console.print(table)
     console.print(result.verdict(), highlight=False)
     paths = write_outputs(result, out_dir, width=CHART_WIDTH, height=CHART_HEIGHT)
-    console.print("wrote " + ", ".join(str(p) for p in paths.values()), highlight=False)
+    console.print("wrote " + ", ".join(str(p) for p in paths.values()), highlight=False, markup=False)
     return 0

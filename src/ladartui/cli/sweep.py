@@ -11,6 +11,8 @@ import json
 import signal
 import threading
 
+from rich.markup import escape
+
 from ladartui.cli.progress import progress_display, run_cancellable
 from ladartui.errors import Cancelled, FieldError
 from ladartui.sweep.table import display_cell
@@ -386,7 +388,7 @@ def show_result(console, result, top) -> None:
     if failures:
         console.print(
             f"[bold]{len(failures)} variant(s) failed[/]; first: "
-            f"{failures[0].get('variant')}: {failures[0].get('error')}",
+            + escape(f"{failures[0].get('variant')}: {failures[0].get('error')}"),
             highlight=False,
         )
     if result.ran or result.resumed:
@@ -397,15 +399,16 @@ def show_result(console, result, top) -> None:
             f"{result.workers} worker(s); {result.resumed} resumed from earlier runs",
             highlight=False,
         )
-    console.print(f"results  {result.results_path}", highlight=False)
+    console.print(f"results  {result.results_path}", highlight=False, markup=False)
     if result.ranking_path:
-        console.print(f"ranking  {result.ranking_path}", highlight=False)
+        console.print(f"ranking  {result.ranking_path}", highlight=False, markup=False)
     for path in result.charts.values():
-        console.print(f"chart    {path}", highlight=False)
+        console.print(f"chart    {path}", highlight=False, markup=False)
     if result.best_scenario_path:
         console.print(
             f"best     {result.best_scenario_path}  (open it with: ladartui {result.best_scenario_path})",
             highlight=False,
+            markup=False,
         )
     if result.best is not None:
         from ladartui.sweep.ranking import levels_text
