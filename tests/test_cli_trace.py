@@ -375,3 +375,34 @@ def test_warm_up_stops_at_its_limit_and_calls_at_least_once():
     assert warm_up(clock.trace_once, most=1.0, window=0.25, clock=clock) == {"calls": 41, "seconds": 1.0}
     clock = FakeClock([3.0])
     assert warm_up(clock.trace_once, most=0.0, clock=clock) == {"calls": 1, "seconds": 0.0}
+
+
+def test_npz_and_object_rays_and_a_bad_out_are_one_line(tmp_path, scene_file, capsys):
+    rays = np.array([[5.0, 5.0, 20.0, 0.0, 0.0, -1.0]])
+    np.savez(tmp_path / "rays.npz", rays=rays)
+    np.save(tmp_path / "objects.npy", np.array([{"a": 1}], dtype=object), allow_pickle=True)
+    np.save(tmp_path / "rays.npy", rays)
+
+    def trace(rays_file, out):
+        code = main(["trace", "--scene", str(scene_file), "--rays", str(rays_file), "--out", str(out)])
+        return code, capsys.readouterr().err.strip()
+
+    code, err = trace(tmp_path / "rays.npz", tmp_path / "h.npy")
+    assert code == 2 and err == (
+        f"ladartui: error: {tmp_path / 'rays.npz'}: a NumPy .npz archive: expected one (N, 6) array in a .npy file"
+    )
+    code, err = trace(tmp_path / "objects.npy", tmp_path / "h.npy")
+    assert code == 2 and err == (
+        f"ladartui: error: {tmp_path / 'objects.npy'}: holds Python objects: expected an (N, 6) array of numbers"
+    )
+    code, err = trace(tmp_path / "rays.npy", tmp_path / "missing" / "h.npy")
+    assert code == 2 and err == (
+        f"ladartui: error: --out = '{tmp_path / 'missing' / 'h.npy'}': expected a file in an existing folder"
+    )
+    assert not (tmp_path / "missing").exists()
+    code, err = trace(tmp_path / "rays.npy", tmp_path / "rays.npy")
+    assert (
+        code == 2
+        and err == f"ladartui: error: --out = '{tmp_path / 'rays.npy'}': expected a file other than --rays"
+    )
+    assert np.array_equal(np.load(tmp_path / "rays.npy"), rays)

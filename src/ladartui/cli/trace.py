@@ -8,6 +8,7 @@ in metres (inf for a miss). The output is written atomically.
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 import numpy as np
 
@@ -49,8 +50,15 @@ def load_rays(path) -> np.ndarray:
         raise InputFileError(path, "no such file") from None
     except EOFError:
         raise InputFileError(path, "empty or cut short: expected a NumPy .npy array") from None
-    except (ValueError, OSError) as error:
-        raise InputFileError(path, f"not a NumPy .npy array ({error})") from None
+    except ValueError as error:
+        if "pickle" in str(error):  # numpy's words for an object array
+            raise InputFileError(path, "holds Python objects: expected an (N, 6) array of numbers") from None
+        raise InputFileError(path, "not a NumPy .npy array") from None
+    except OSError as error:
+        raise InputFileError(path, f"not a NumPy .npy array ({error.strerror or error})") from None
+    if not isinstance(rays, np.ndarray):  # an .npz archive of arrays
+        rays.close()
+        raise InputFileError(path, "a NumPy .npz archive: expected one (N, 6) array in a .npy file")
     if rays.ndim != 2 or rays.shape[1] != 6:
         raise InputFileError(
             path,
@@ -77,7 +85,12 @@ def run(args):
         raise FieldError("--voxel-size", args.voxel_size, "a positive number of metres")
     from ladartui.outputset import check_writable
 
-    check_writable(args.out)  # before the trace, not after it
+    out = Path(args.out)
+    if not out.parent.is_dir():  # a mistyped folder is not made
+        raise FieldError("--out", args.out, "a file in an existing folder")
+    if out.exists() and Path(args.rays).exists() and out.samefile(args.rays):
+        raise FieldError("--out", args.out, "a file other than --rays")
+    check_writable(out)  # before the trace, not after it
     rays = load_rays(args.rays)
     voxels = load_voxels(args.scene)
     occupancy = Occupancy.build(voxels)
