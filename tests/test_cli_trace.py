@@ -389,11 +389,13 @@ def test_npz_and_object_rays_and_a_bad_out_are_one_line(tmp_path, scene_file, ca
 
     code, err = trace(tmp_path / "rays.npz", tmp_path / "h.npy")
     assert code == 2 and err == (
-        f"ladartui: error: {tmp_path / 'rays.npz'}: a NumPy .npz archive: expected one (N, 6) array in a .npy file"
+        f"ladartui: error: {tmp_path / 'rays.npz'}: a NumPy .npz archive: "
+        "expected one (N, 6) array in a .npy file"
     )
     code, err = trace(tmp_path / "objects.npy", tmp_path / "h.npy")
     assert code == 2 and err == (
-        f"ladartui: error: {tmp_path / 'objects.npy'}: holds Python objects: expected an (N, 6) array of numbers"
+        f"ladartui: error: {tmp_path / 'objects.npy'}: holds Python objects: "
+        "expected an (N, 6) array of numbers"
     )
     code, err = trace(tmp_path / "rays.npy", tmp_path / "missing" / "h.npy")
     assert code == 2 and err == (
