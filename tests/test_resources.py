@@ -104,3 +104,17 @@ def test_sparse_huge_voxel_file_is_refused_before_reading(tmp_path, capsys, monk
     assert main(["info", str(path)]) == 2
     err = one_error_line(capsys)
     assert "sparse.txt: a voxel list of 46.6 GiB needs about 93.1 GiB to read, more than the 16 GiB" in err
+
+
+@pytest.mark.parametrize("value", ["abc", "-1", "0", "nan"])
+def test_a_bad_limit_in_the_environment_is_named_not_ignored(monkeypatch, value):
+    from ladartui.resources import available_memory, max_rays
+
+    monkeypatch.setenv("LADARTUI_MAX_RAYS", value)
+    with pytest.raises(ResourceLimitError) as rays:
+        max_rays()
+    assert str(rays.value) == f"LADARTUI_MAX_RAYS = {value!r}: expected a number of rays >= 1"
+    monkeypatch.setenv("LADARTUI_MAX_MEMORY", value)
+    with pytest.raises(ResourceLimitError) as memory:
+        available_memory()
+    assert str(memory.value) == f"LADARTUI_MAX_MEMORY = {value!r}: expected a number of bytes >= 1"

@@ -8,6 +8,7 @@ and ``LADARTUI_MAX_RAYS`` override the limits; ``--max-rays`` on ``run`` too.
 
 from __future__ import annotations
 
+import math
 import os
 
 import numpy as np
@@ -27,12 +28,9 @@ _NODE_BYTES = 512 * 4
 
 def available_memory() -> int:
     """Bytes the run may allocate: ``LADARTUI_MAX_MEMORY``, else the kernel's MemAvailable."""
-    override = os.environ.get("LADARTUI_MAX_MEMORY")
-    if override:
-        try:
-            return int(float(override))
-        except ValueError:
-            pass
+    override = _env_limit("LADARTUI_MAX_MEMORY", "a number of bytes >= 1")
+    if override is not None:
+        return override
     try:
         with open("/proc/meminfo", encoding="ascii") as meminfo:
             for line in meminfo:
@@ -58,13 +56,23 @@ def set_max_rays(limit: int | None) -> None:
 def max_rays() -> int:
     if _max_rays_flag is not None:
         return _max_rays_flag
-    override = os.environ.get("LADARTUI_MAX_RAYS")
-    if override:
-        try:
-            return int(float(override))
-        except ValueError:
-            pass
-    return DEFAULT_MAX_RAYS
+    override = _env_limit("LADARTUI_MAX_RAYS", "a number of rays >= 1")
+    return DEFAULT_MAX_RAYS if override is None else override
+
+
+def _env_limit(name: str, expected: str) -> int | None:
+    """The limit environment variable ``name`` sets (None when unset or empty);
+    ResourceLimitError naming it when it is not a number >= 1: a typo must not lift a limit."""
+    text = os.environ.get(name, "").strip()
+    if not text:
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not 1 <= value < math.inf:  # (not a FieldError: no scenario file holds it)
+        raise ResourceLimitError(f"{name} = {text!r}: expected {expected}")
+    return int(value)
 
 
 def occupancy_bytes(lo, hi, count) -> int:
