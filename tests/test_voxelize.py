@@ -245,7 +245,15 @@ def test_open_mesh_is_refused_in_solid_mode_only(tmp_path):
 @pytest.mark.parametrize(
     ("name", "content", "message"),
     [
-        ("bad.obj", "v 0 0 0\nv 1 0\nf 1 2 3\n", "not a readable OBJ mesh"),
+        ("bad.obj", "v 0 0 0\nv 1 0\nf 1 2 3\n", r"bad\.obj:2: vertex 'v 1 0': expected x, y, z"),
+        ("word.obj", "v 0 0 0\nv x 1 0\n", r"word\.obj:2: vertex 'v x 1 0': expected x, y, z as numbers"),
+        ("nan.obj", "v 0 0 0\nv nan 1 0\n", r"nan\.obj:2: vertex 'v nan 1 0': expected x, y, z as finite"),
+        (
+            "far.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n",
+            r"far\.obj:4: face 'f 1 2 9' refers to vertex 9: expected 1 to 3 \(or -1 to -3\)",
+        ),
+        ("junk.obj", "v 0 0 0\nf 1 a 2\n", r"junk\.obj:2: face 'f 1 a 2': expected vertex numbers"),
         ("noise.ply", "\x00\x07 definitely not a ply header", "not a readable PLY mesh"),
         ("empty.stl", "", "holds no triangles"),
         ("points.obj", "v 0 0 0\nv 1 0 0\n", "holds no triangles"),
@@ -259,6 +267,12 @@ def test_malformed_meshes_name_the_file(tmp_path, name, content, message):
         load_mesh(path)
     assert str(caught.value).startswith(str(path))
     assert "\n" not in str(caught.value)
+
+
+def test_a_folder_is_not_a_mesh(tmp_path):
+    with pytest.raises(InputFileError) as caught:
+        load_mesh(tmp_path)
+    assert str(caught.value) == f"{tmp_path}: is a folder; expected a mesh file (.obj, .stl or .ply)"
 
 
 def test_placement_below_ground_or_off_the_grid_is_refused():

@@ -42,6 +42,7 @@ import numpy as np
 
 from ladartui.errors import FieldError, InputFileError, ResourceLimitError, check_cancelled
 from ladartui.scene.voxels import MAX_INDEX
+from ladartui.textsafe import one_line
 
 MESH_SUFFIXES = (".obj", ".stl", ".ply")
 CANCELLED = "voxelisation cancelled; nothing was written"
@@ -93,11 +94,14 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
     if up not in ("y", "z"):
         raise FieldError("up", up, "'z' or 'y'")
     kind = path.suffix.lower()
+    if path.is_dir():
+        raise InputFileError(path, "is a folder; expected a mesh file (.obj, .stl or .ply)")
     if kind not in MESH_SUFFIXES:
         raise InputFileError(path, f"unsupported mesh type {path.suffix!r}; expected .obj, .stl or .ply")
     if not path.is_file():
-        what = "is a folder" if path.is_dir() else "no such file"
-        raise InputFileError(path, f"{what}; expected a mesh file ({kind})")
+        raise InputFileError(path, f"no such file; expected a mesh file ({kind})")
+    if kind == ".obj":
+        check_obj_lines(path)  # trimesh names neither the line nor the problem
     import trimesh
 
     try:
@@ -123,6 +127,47 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
     if up == "y":
         vertices = np.column_stack([vertices[:, 0], -vertices[:, 2], vertices[:, 1]])
     return Mesh(path, vertices, faces, not problem, problem, tuple(notes))
+
+
+def check_obj_lines(path: Path) -> None:
+    """``InputFileError`` at the first vertex or face line of an OBJ file that is
+    malformed: a vertex without three finite numbers, a face whose vertex numbers
+    are not integers or lie outside the file's vertices (1..V, or -1..-V counting
+    back from the latest)."""
+    try:
+        text = path.read_text(encoding="utf-8", errors="replace")
+    except OSError as error:
+        raise InputFileError(path, f"cannot be read ({error.strerror or error})") from None
+    lines = text.splitlines()
+    total = sum(1 for line in lines if line.split(maxsplit=1)[:1] == ["v"])
+    seen = 0
+    for number, line in enumerate(lines, 1):
+        words = line.split()
+        if not words or words[0] not in ("v", "f"):
+            continue
+        shown = one_line(" ".join(words))[:80]
+        if words[0] == "v":
+            seen += 1
+            try:
+                xyz = [float(w) for w in words[1:4]]
+            except ValueError:
+                raise InputFileError(path, f"vertex {shown!r}: expected x, y, z as numbers", number) from None
+            if len(xyz) < 3:
+                raise InputFileError(path, f"vertex {shown!r}: expected x, y, z", number)
+            if not all(math.isfinite(v) for v in xyz):
+                raise InputFileError(path, f"vertex {shown!r}: expected x, y, z as finite numbers", number)
+            continue
+        for word in words[1:]:
+            try:
+                index = int(word.split("/")[0])
+            except ValueError:
+                raise InputFileError(path, f"face {shown!r}: expected vertex numbers", number) from None
+            if not (1 <= index <= total or -seen <= index <= -1):
+                raise InputFileError(
+                    path,
+                    f"face {shown!r} refers to vertex {index}: expected 1 to {total} (or -1 to -{seen})",
+                    number,
+                )
 
 
 @contextlib.contextmanager
