@@ -144,3 +144,10 @@ def test_paths_with_markup_are_printed_as_they_are(tmp_path, capsys):
     assert main(["run", str(scenario.path)]) == 0
     out = capsys.readouterr().out
     assert f"wrote measures: {scenario.measures_file}" in out.replace("\n", "")
+
+
+def test_las_outputs_are_named_in_words(scenario, capsys):
+    assert main(["run", str(scenario.path), "--las"]) == 0
+    out = capsys.readouterr().out.replace("\n", "")
+    assert f"wrote scene LAS: {scenario.scene_output.with_suffix('.las')}" in out
+    assert f"wrote target LAS: {scenario.target_output.with_suffix('.las')}" in out

@@ -56,7 +56,7 @@ def test_into_a_three_column_target_keeps_it_as_target_1_and_adds_the_new_id(tmp
     assert sorted(map(tuple, scene.target[scene.target_ids == 4].tolist())) == sorted(
         map(tuple, vehicle.tolist())
     )
-    assert "the vehicle is target 4 of 2" in capsys.readouterr().out
+    assert "the vehicle is target 4, one of 2 targets" in capsys.readouterr().out
     # A second vehicle with another id keeps all three, and the earlier ids are untouched.
     assert main([*args, "--at", "3,7", "--into", str(tmp_path / "out.txt"), "--id", "2"]) == 0
     again = Scene.load(tmp_path / "out.txt", SIZE)

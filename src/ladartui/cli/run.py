@@ -232,7 +232,8 @@ def show_result(console, result) -> None:
     )
     if result.outputs:
         for name, path in result.outputs.items():
-            console.print(f"wrote {name}: {path}", highlight=False, markup=False, soft_wrap=True)
+            shown = name.replace("_las", " LAS")  # "scene_las": the scene as a LAS point cloud
+            console.print(f"wrote {shown}: {path}", highlight=False, markup=False, soft_wrap=True)
     else:
         console.print("nothing written (--no-write)")
 

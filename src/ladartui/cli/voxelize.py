@@ -220,7 +220,8 @@ def _report(console, args, mesh, done, outputs, elapsed) -> None:
         f"{target_path} ({len(insertion.target):,} voxels"
         + (", a new target model" if insertion.new_target else "")
         + (
-            f"; the vehicle is target {insertion.vehicle_id} of {len(set(insertion.target_ids.tolist()))}"
+            f"; the vehicle is target {insertion.vehicle_id}, one of "
+            f"{len(set(insertion.target_ids.tolist()))} targets"
             if insertion.target_ids is not None
             else ""
         )
