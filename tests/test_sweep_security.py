@@ -111,3 +111,22 @@ def test_tls_scheduler_on_loopback_refuses_clients_without_its_certificates(tmp_
             assert client.submit(sum, [1, 2, 3]).result(timeout=10) == 6
         finally:
             client.close()
+
+
+@pytest.mark.parametrize("address", ["foo", "tcp://head", "http://10.0.0.1:8786", "tcp://head:port"])
+def test_a_scheduler_that_is_no_address_is_named_as_such(address):
+    with pytest.raises(FieldError) as caught:
+        cluster_security(address)
+    assert str(caught.value) == (
+        f"--scheduler = {address!r}: expected an address such as tcp://127.0.0.1:8786 or tls://HOST:PORT"
+    )
+
+
+def test_a_missing_tls_flag_is_said_to_be_missing(tmp_path):
+    paths = make_certificates(tmp_path)
+    with pytest.raises(FieldError) as caught:
+        cluster_security("tls://10.0.0.1:8786", None, paths["cert"], paths["key"])
+    assert str(caught.value) == (
+        "--tls-ca-file is missing; expected a PEM file (TLS needs --tls-ca-file, --tls-cert "
+        "and --tls-key together; ladartui certs DIR makes them)"
+    )

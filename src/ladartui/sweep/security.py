@@ -34,6 +34,24 @@ def is_loopback(address: str) -> bool:
         return False
 
 
+class MissingFlagError(FieldError):
+    """A flag that must come with others and was left out."""
+
+    def __init__(self, flag: str, expected: str):
+        super().__init__(flag, None, expected)
+        self.args = (f"{flag} is missing; expected {expected}",)
+
+
+def _is_address(address: str) -> bool:
+    """``[tcp|tls://]HOST:PORT`` with a host and a port number."""
+    parts = urlsplit(address if "://" in address else f"tcp://{address}")
+    try:
+        port = parts.port
+    except ValueError:  # not a number
+        return False
+    return parts.scheme in ("tcp", "tls") and bool(parts.hostname) and port is not None
+
+
 def cluster_security(address: str, ca_file=None, cert_file=None, key_file=None, insecure: bool = False):
     """The ``distributed.Security`` for ``address``, or None for a permitted plain address.
 
@@ -42,12 +60,13 @@ def cluster_security(address: str, ca_file=None, cert_file=None, key_file=None, 
     """
     files = {"--tls-ca-file": ca_file, "--tls-cert": cert_file, "--tls-key": key_file}
     scheme = address.split("://", 1)[0] if "://" in address else "tcp"
+    if not _is_address(address):
+        raise FieldError("--scheduler", address, "an address such as tcp://127.0.0.1:8786 or tls://HOST:PORT")
     if any(files.values()):
         for flag, path in files.items():
             if not path:
-                raise FieldError(
+                raise MissingFlagError(
                     flag,
-                    None,
                     "a PEM file (TLS needs --tls-ca-file, --tls-cert "
                     "and --tls-key together; ladartui certs DIR makes them)",
                 )
