@@ -224,3 +224,19 @@ async def test_outputs_from_other_settings_are_said_to_be_out_of_date(tmp_path, 
         app.set_scenario(app.scenario.with_changes(fast_mode=not app.scenario.fast_mode))
         await pilot.pause()
         assert bar.state == READY
+
+
+async def test_a_committed_value_is_shown_and_named_as_a_number(tmp_path, scene_files):
+    from test_tui_flow import field
+
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        app.action_show_tab("sensor")
+        grid = field(app, "sensor.grid")
+        await type_into(pilot, grid, "1.2e1")
+        assert app.scenario.sensor.grid == 12 and grid.value == "12"
+        await pilot.press("ctrl+z")
+        await pilot.pause()
+        assert app.messages[-1].endswith("Sensor grid n 8 -> 12")

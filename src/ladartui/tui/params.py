@@ -137,8 +137,11 @@ class ParamPanel(VerticalScroll):
             )
             app.refresh_status()
             return False
-        before = format_number(bridge.param_value(app.scenario, param.key), param.integer, param.scale)
+        before, after = (
+            format_number(bridge.param_value(version, param.key), param.integer, param.scale)
+            for version in (app.scenario, scenario)
+        )
         field.committed = field.value
         field.remove_class("-bad")
-        app.edit(scenario, f"{param.label} {before} -> {field.value}")
+        app.edit(scenario, f"{param.label} {before} -> {after}")  # as the field shows it: 12, not 1.2e1
         return True
