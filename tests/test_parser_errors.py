@@ -384,3 +384,27 @@ def test_a_scenario_path_that_is_a_folder_or_not_text_says_so_in_words(tmp_path)
     with pytest.raises(LadarError) as undecodable:
         load_scenario(binary)
     assert str(undecodable.value) == f"{binary}: not UTF-8 text; expected a scenario file (.toml)"
+
+
+def test_binary_data_given_as_a_voxel_list_says_so(tmp_path):
+    path = tmp_path / "rays.npy"
+    np.save(path, np.zeros((2, 6)))
+    with pytest.raises(LadarError) as caught:
+        load_voxels(path)
+    assert str(caught.value).startswith(f"{path}:1: binary data, not text; expected three")
+
+
+def test_a_json_that_is_no_study_names_what_it_lacks(tmp_path):
+    from ladartui.study.results import read_study
+
+    (tmp_path / "j.json").write_text('{"a": 1}')
+    (tmp_path / "bad.json").write_text("{\n")
+    with pytest.raises(LadarError) as lacking:
+        read_study(tmp_path / "j.json")
+    assert (
+        str(lacking.value)
+        == f"{tmp_path / 'j.json'}: no 'rows' entry; expected a study.json written by 'ladartui study'"
+    )
+    with pytest.raises(LadarError) as broken:
+        read_study(tmp_path / "bad.json")
+    assert str(broken.value).startswith(f"{tmp_path / 'bad.json'}:2: not JSON (")

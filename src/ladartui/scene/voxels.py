@@ -391,6 +391,8 @@ def describe_bad_line(text: str, columns: int = 3, target: bool = False) -> str:
     """
     expected = EXPECTED_TARGET if target else EXPECTED
     body = text[:-1] if text.endswith("\r") else text  # CR LF line ends are fine
+    if "\x00" in body or "\ufffd" in body:  # NUL bytes, or bytes that are not UTF-8 text
+        return f"binary data, not text; {expected}"
     if "\r" in body:
         shown = body.strip(" \t")
         return f"stray carriage return (\\r) in {shown!r}; {expected}"

@@ -336,6 +336,9 @@ def format_share(value) -> str:
     return f"{value * 100:.2f}%"
 
 
+STUDY_JSON = "expected a study.json written by 'ladartui study'"
+
+
 def read_study(path) -> StudyResult:
     """A ``study.json`` written by a study (the CLI's or the terminal UI's), read back."""
     from ladartui.errors import InputFileError
@@ -345,8 +348,12 @@ def read_study(path) -> StudyResult:
         return StudyResult.from_dict(data)
     except OSError as error:
         raise InputFileError(path, f"cannot read it ({error.strerror})") from None
-    except (ValueError, KeyError, TypeError) as error:
-        raise InputFileError(path, f"not a study.json written by 'ladartui study' ({error})") from None
+    except json.JSONDecodeError as error:
+        raise InputFileError(path, f"not JSON ({error.msg}); {STUDY_JSON}", error.lineno) from None
+    except KeyError as error:
+        raise InputFileError(path, f"no {error.args[0]!r} entry; {STUDY_JSON}") from None
+    except (ValueError, TypeError) as error:
+        raise InputFileError(path, f"a value of the wrong kind ({error}); {STUDY_JSON}") from None
 
 
 def study_folder(scenario_path=None) -> Path:
