@@ -200,3 +200,24 @@ def test_cli_sweep_prints_paths_with_markup_as_they_are(tmp_path, capsys):
     assert main(["sweep", str(spec), "--serial"]) == 0
     text = capsys.readouterr().out.replace("\n", "")
     assert f"results  {folder}" in text
+
+
+def test_cli_sweep_table_folds_headers_never_values_in_a_narrow_terminal(tmp_path, capsys, monkeypatch):
+    from ladartui.cli import main
+    from tiny_sweep import write_tiny_scenario
+
+    write_tiny_scenario(tmp_path)
+    spec = tmp_path / "spec.toml"
+    spec.write_text(
+        '[sweep]\nscenario = "base.toml"\n[grid]\nradius = [20.0, 30.123]\naltitude = [30.0, 40.5]\n'
+        "scans = [3, 4]\n"
+    )
+    assert main(["sweep", str(spec), "--serial"]) == 0
+    capsys.readouterr()
+    monkeypatch.setenv("COLUMNS", "60")
+    assert main(["sweep", str(spec), "--show"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    rows = [r for r in (line.split() for line in lines) if len(r) > 2 and r[0].isdigit() and len(r[1]) == 8]
+    assert len(rows) == 8 and all(len(line) <= 60 for line in lines)
+    assert {r[2] for r in rows} == {"20", "30.12"} and {r[3] for r in rows} == {"30", "40.5"}
+    assert not any("…" in cell for r in rows for cell in r)

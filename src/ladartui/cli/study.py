@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import threading
 
 from rich.markup import escape
@@ -141,7 +142,7 @@ def _report(result, out_dir) -> int:
     from ladartui.study.run import write_outputs
 
     console = Console()
-    if not console.is_terminal:
+    if not console.is_terminal and "COLUMNS" not in os.environ:
         console = Console(width=CHART_WIDTH + 20)  # a log file: no need to wrap at 80
     width = max(60, min(console.width, CHART_WIDTH))
     console.print(Text.from_ansi(chart_text(result, width, CHART_HEIGHT, color=console.is_terminal)))

@@ -8,6 +8,7 @@ command resumes. Progress goes to stderr, the ranking to stdout.
 from __future__ import annotations
 
 import json
+import os
 import signal
 import threading
 
@@ -173,8 +174,8 @@ def run(args) -> int:
         print(json.dumps(result_dict(result, args.top), indent=2, allow_nan=False))
     else:
         console = Console()
-        if not console.is_terminal:  # a file or pipe: do not squeeze the table into 80 columns
-            console = Console(width=160)
+        if not console.is_terminal and "COLUMNS" not in os.environ:
+            console = Console(width=160)  # a file or pipe: do not squeeze the table into 80 columns
         show_result(console, result, args.top)
     return 0
 
@@ -334,20 +335,28 @@ def show_result(console, result, top) -> None:
         box=box.SIMPLE_HEAD,
         pad_edge=False,
     )
+    shown = [r for r in result.ranking if r.rank is not None][:top]
+
+    def number_column(header: str, values) -> None:
+        # A narrow terminal folds the header, never a value: a cut number reads as another one.
+        width = max((len(v) for v in values), default=1)
+        table.add_column(header, justify="right", min_width=width, overflow="fold")
+
     table.add_column("#", justify="right")
     table.add_column("variant", no_wrap=True)
     for name in result.parameter_names:
-        table.add_column(name, justify="right")
+        number_column(name, [display_cell(r.row.get(name)) for r in shown])
     separate = result.objective not in ("obscured-coverage", "coverage-within-budget")
     if separate:
-        table.add_column(short[result.objective], justify="right")
-    shown = [r for r in result.ranking if r.rank is not None][:top]
+        number_column(short[result.objective], [display_cell(r.value) for r in shown])
     # Several targets: how many each path identifies by its last scan, e.g. "2/3".
     several = any(len(target_ids(r.row)) > 1 for r in shown)
     if several:
         table.add_column("targets id.", justify="right")
-    table.add_column("coverage", justify="right")
-    table.add_column(f"{'time' if cost_unit == 's' else 'dist.'} {cost_unit}", justify="right")
+    number_column("coverage", [display_cell(r.coverage, 3) for r in shown])
+    number_column(
+        f"{'time' if cost_unit == 's' else 'dist.'} {cost_unit}", [display_cell(r.cost, 4) for r in shown]
+    )
     table.add_column("front")
     for ranked in shown:
         row = ranked.row
