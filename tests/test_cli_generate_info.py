@@ -52,7 +52,10 @@ def test_generate_rejects_bad_input_on_one_line(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err == "ladartui: error: preset = 'huge': expected one of small, reference\n"
     assert main(["generate", "small", str(tmp_path / "x"), "--density", "2"]) == 2
-    assert "density = 2.0: expected a number from 0 to 0.99" in capsys.readouterr().err
+    assert capsys.readouterr().err == "ladartui: error: --density = 2.0: expected a number from 0 to 0.99\n"
+    assert main(["generate", "small", str(tmp_path / "x"), "--vehicles", "1000"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("ladartui: error: --vehicles = 1000: expected at most ")
     assert not list(tmp_path.iterdir())
 
 

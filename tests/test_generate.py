@@ -211,3 +211,15 @@ def test_reference_preset_matches_the_reports_figure_11_scale():
         + (count_cells(scene.voxels, 6) + count_cells(scene.voxels, 9)) * 2048
     )
     assert nbytes < 32 * 2**20
+
+
+def test_more_vehicles_than_the_scene_holds_apart_are_refused_not_overlapped():
+
+    with pytest.raises(FieldError) as caught:
+        generate_scene("small", seed=2, vehicles=1000)
+    message = str(caught.value)
+    assert message.startswith("vehicles = 1000: expected at most ")
+    assert message.endswith(" m between centres) in a 60 x 60 m scene")
+    most = int(message.split("at most ")[1].split()[0])
+    scene = generate_scene("small", seed=2, vehicles=most)
+    assert len(np.unique(scene.target_ids)) == most  # every one kept, none overwritten

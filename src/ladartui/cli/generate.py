@@ -66,6 +66,7 @@ def overrides_from(args) -> dict:
 def run(args) -> int:
     import numpy as np
 
+    from ladartui.errors import FieldError
     from ladartui.outputset import check_writable
     from ladartui.scene.generate import generate_scene, output_paths
 
@@ -73,7 +74,13 @@ def run(args) -> int:
     las_files = [scene_file.with_suffix(".laz"), target_file.with_suffix(".laz")] if args.las else []
     check_writable(scene_file, target_file, *las_files)
     started = time.perf_counter()
-    scene = generate_scene(args.preset, seed=args.seed, **overrides_from(args))
+    overrides = overrides_from(args)
+    try:
+        scene = generate_scene(args.preset, seed=args.seed, **overrides)
+    except FieldError as error:  # name the flag the user typed, not the parameter
+        if error.field in overrides and getattr(args, error.field, None) is not None:
+            raise FieldError(f"--{error.field.replace('_', '-')}", error.value, error.expected) from None
+        raise
     generated = time.perf_counter() - started
     started = time.perf_counter()
     scene_path, target_path = scene.write(args.out)

@@ -324,13 +324,19 @@ def _place_vehicles(p: SceneParams, nx, ny, ground, rng) -> list[_Vehicle]:
         heading = rng.uniform(0, 2 * np.pi)
         if index == 0:
             cx, cy = nx / 2, ny / 2
-        else:  # others somewhere else, clear of the first and of the border
+        else:  # others somewhere else, clear of the others and of the border
             margin = (length + 2) / vs
-            cx, cy = nx / 2, ny / 2
             for _ in range(100):
                 cx, cy = rng.uniform(margin, nx - margin), rng.uniform(margin, ny - margin)
                 if all(math.hypot(cx - v.cx, cy - v.cy) * vs > 2 * length + 4 for v in vehicles):
                     break
+            else:  # no room left: overlapping vehicles would overwrite each other
+                raise FieldError(
+                    "vehicles",
+                    p.vehicles,
+                    f"at most {index} vehicles kept apart ({2 * length + 4:g} m between centres) "
+                    f"in a {p.width:g} x {p.depth:g} m scene",
+                )
         reach = int(math.ceil(length / 2 / vs))
         x0, x1 = max(int(cx) - reach, 0), min(int(cx) + reach + 1, nx)
         y0, y1 = max(int(cy) - reach, 0), min(int(cy) + reach + 1, ny)
