@@ -57,6 +57,20 @@ def client():
     cluster.close()
 
 
+def _sigint_handler():
+    import signal
+
+    return signal.getsignal(signal.SIGINT)
+
+
+def test_local_workers_ignore_ctrl_c_which_this_process_handles(client):
+    import signal
+
+    # A Ctrl-C reaches the terminal's whole process group: a worker that took it
+    # printed a traceback as it died.
+    assert set(client.run(_sigint_handler).values()) == {signal.SIG_IGN}
+
+
 def test_two_workers_give_the_same_rows_as_serial_runs(spec, serial_rows, client, tmp_path):
     result = run_sweep(spec, client=client, out=tmp_path)
     assert result.workers == 2

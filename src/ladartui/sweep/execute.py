@@ -16,6 +16,7 @@ import importlib.metadata
 import logging
 import math
 import os
+import signal
 import time
 import uuid
 from collections.abc import Callable
@@ -402,7 +403,29 @@ def local_client(workers: int | None = None):
         silence_logs=logging.ERROR,
         env={"NUMBA_NUM_THREADS": str(max(1, cores // count))},
     )
-    return Client(cluster)
+    client = Client(cluster)
+    _workers_ignore_ctrl_c(client)
+    return client
+
+
+def _ignore_ctrl_c() -> None:
+    """In a worker process (on its main thread, where its event loop runs): SIGINT ignored."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _workers_ignore_ctrl_c(client) -> None:
+    """A local cluster's workers ignore Ctrl-C, now and when restarted. The key reaches
+    the terminal's whole process group, and each worker printed a traceback as it
+    died; this process stops them instead, after keeping the finished rows."""
+    from distributed.diagnostics.plugin import WorkerPlugin
+
+    class IgnoreCtrlC(WorkerPlugin):
+        name = "ladartui-ignore-ctrl-c"
+
+        def setup(self, worker):
+            _ignore_ctrl_c()
+
+    client.register_plugin(IgnoreCtrlC())
 
 
 def connect(address: str, timeout: float = 30.0, security=None):
