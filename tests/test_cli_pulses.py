@@ -74,6 +74,11 @@ def test_bad_flag_names_the_flag(scenario, capsys):
     assert capsys.readouterr().err.strip() == (
         "ladartui: error: --n-ref = -1.0: expected a number greater than 0 and at most 1000000"
     )
+    # a bad backend is named before any tracing: no progress drawn on stderr
+    assert main(["pulses", str(scenario.path), "--backend", "abacus"]) == 2
+    assert capsys.readouterr().err == (
+        "ladartui: error: --backend = 'abacus': expected one of 'auto', 'numba', 'wgpu'\n"
+    )
 
 
 def test_ctrl_c_cancels_with_a_truthful_message(scenario, capsys, monkeypatch):

@@ -18,6 +18,8 @@ from ladartui.errors import Cancelled
 T = TypeVar("T")
 
 POLL_SECONDS = 0.1  # how soon a Ctrl-C is noticed while waiting
+# Shown until the first scan is done: a first run also compiles the kernels (about a minute).
+FIRST_SCAN = "scan 1 (compiling kernels on a first run)"
 
 
 def progress_display(console, after, description=None, **options):

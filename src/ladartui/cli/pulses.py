@@ -41,7 +41,9 @@ def add_parser(sub):
         "(default: the scenario's, else 5)",
     )
     p.add_argument("--seed", type=int, default=None, help="random stream (default: the scenario's, else 0)")
-    p.add_argument("--backend", default=None)
+    p.add_argument(
+        "--backend", default=None, help="tracing backend: auto, numba or wgpu (default: the scenario's)"
+    )
     p.add_argument("--json", action="store_true", help="print the results as JSON, no chart")
     p.add_argument("--no-chart", dest="chart", action="store_false", help="table only")
     p.set_defaults(handler=run)
@@ -82,6 +84,11 @@ def run(args) -> int:
     pulses = _pulse_counts(args.pulses)
     scenario = load_scenario(args.scenario or default_scenario_path())
     settings = _settings(scenario, args)
+    if args.backend is not None:  # before any tracing, as run does
+        try:
+            scenario.with_changes(backend=args.backend)
+        except FieldError as error:
+            raise FieldError("--backend", args.backend, error.expected) from None
     errors = Console(stderr=True)
     state = {"last": None}
     try:
@@ -119,14 +126,13 @@ def _where(progress) -> str:
 def _study_with_progress(scenario, pulses, settings, backend, console, state):
     from rich.progress import TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
-    from ladartui.cli.progress import progress_display, run_cancellable
+    from ladartui.cli.progress import FIRST_SCAN, progress_display, run_cancellable
     from ladartui.detection.pulses import pulse_study
 
     cancel = threading.Event()
     after = (TextColumn("{task.percentage:>5.1f} %"), TimeElapsedColumn(), TimeRemainingColumn())
     with progress_display(console, after, transient=False) as bar:
-        # Until the first scan is done (a first run also compiles the kernels, about a minute).
-        task = bar.add_task("tracing scan 1 (compiling kernels on a first run)", total=1.0)
+        task = bar.add_task(FIRST_SCAN, total=1.0)
 
         def report(p):
             state["last"] = p

@@ -14,7 +14,7 @@ import json
 import threading
 from typing import TYPE_CHECKING
 
-from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt
+from ladartui.cli.progress import FIRST_SCAN, progress_display, run_cancellable, sigterm_as_interrupt
 from ladartui.errors import Cancelled
 
 if TYPE_CHECKING:
@@ -144,7 +144,7 @@ def _simulate_with_progress(scenario, args, console):
     cancel = threading.Event()
     finished: list[SimulationResult] = []  # the result, once there is one
     with _told_if_finished(finished), run_progress(console, transient=False) as bar:
-        task = bar.add_task("starting", total=1.0, rays="")
+        task = bar.add_task(FIRST_SCAN, total=1.0, rays="")
 
         def report(p):
             bar.update(
