@@ -408,3 +408,21 @@ def test_a_json_that_is_no_study_names_what_it_lacks(tmp_path):
     with pytest.raises(LadarError) as broken:
         read_study(tmp_path / "bad.json")
     assert str(broken.value).startswith(f"{tmp_path / 'bad.json'}:2: not JSON (")
+
+
+def test_validate_notes_an_empty_or_misplaced_target_model(tmp_path, capsys):
+    from ladartui.resources import gib
+
+    path = write_scenario(tmp_path, b"0,0,0\n1,2,3\n9,4,5\n")
+    (tmp_path / "m_Target.txt").write_text("")
+    assert main(["validate", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "note       m_Target.txt holds no voxels: the target measures will be undefined" in out
+    (tmp_path / "m_Target.txt").write_text("0,0,0\n50,50,50\n60,50,50\n")
+    assert main(["validate", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert (
+        "note       2 of 3 target voxels are not in the scene model m.txt: the scene run cannot see them"
+        in out
+    )
+    assert gib(4096) == "4 KiB" and gib(100) == "100 bytes" and gib(3 * 2**20) == "3 MiB"

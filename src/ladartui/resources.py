@@ -133,4 +133,11 @@ def check_rays(rays, source, limit=None) -> None:
 
 
 def gib(nbytes) -> str:
-    return f"{nbytes / 2**30:.3g} GiB" if nbytes >= 2**27 else f"{nbytes / 2**20:.3g} MiB"
+    """A size in words: GiB from 128 MiB up, then MiB, KiB, bytes."""
+    if nbytes >= 2**27:
+        return f"{nbytes / 2**30:.3g} GiB"
+    if nbytes >= 2**20:
+        return f"{nbytes / 2**20:.3g} MiB"
+    if nbytes >= 2**10:
+        return f"{nbytes / 2**10:.3g} KiB"
+    return f"{int(nbytes)} bytes"

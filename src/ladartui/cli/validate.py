@@ -48,6 +48,7 @@ def scene_summary(scenario) -> list[str]:
         f"scene      {len(scene.voxels):,} voxels, target {len(scene.target):,} voxels{in_targets}; "
         f"extent {nx} x {ny} x {nz} voxels = {nx * vs:g} x {ny * vs:g} x {nz * vs:g} m"
     ]
+    lines.extend(target_notes(scenario, scene))
     unused = [i for i, _ in scenario.target_names if i not in ids]
     if unused:  # a name for an id the target model does not hold: likely a typo
         lines.append(
@@ -66,3 +67,26 @@ def scene_summary(scenario) -> list[str]:
         f"({gib(available_memory())} available)"
     )
     return lines
+
+
+def target_notes(scenario, scene) -> list[str]:
+    """Notes on a target model that will not give measures: empty, or voxels that the
+    scene model lacks (a target voxel is part of the scene: the scene run sees it there)."""
+    import numpy as np
+
+    from ladartui.errors import FieldError
+    from ladartui.scene.keys import voxel_keys
+
+    name = scenario.target_file.name
+    if not len(scene.target):
+        return [f"note       {name} holds no voxels: the target measures will be undefined"]
+    try:
+        missing = int(np.count_nonzero(~np.isin(voxel_keys(scene.target), voxel_keys(scene.voxels))))
+    except FieldError:  # indices beyond the keys' range: the memory check speaks for those
+        return []
+    if not missing:
+        return []
+    return [
+        f"note       {missing:,} of {len(scene.target):,} target voxels are not in the scene model "
+        f"{scenario.scene_file.name}: the scene run cannot see them"
+    ]
