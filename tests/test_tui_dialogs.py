@@ -240,3 +240,17 @@ async def test_a_committed_value_is_shown_and_named_as_a_number(tmp_path, scene_
         await pilot.press("ctrl+z")
         await pilot.pause()
         assert app.messages[-1].endswith("Sensor grid n 8 -> 12")
+
+
+async def test_the_scans_table_fits_the_sidebar_at_120_columns(tmp_path, scene_files):
+    scenario = make_scenario(tmp_path, scene_files, scans=24)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=(120, 40)) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        app.action_show_tab("flight")
+        await pilot.pause()
+        scans = app.query_one("#scans")
+        # no column shown cut: a depression of 44.6 cut to "4" read as a value
+        assert scans.max_scroll_x == 0
+        assert scans.row_count == 24 and scans.size.height > 10
+        assert not any(str(cell) == "-0" for i in range(scans.row_count) for cell in scans.get_row_at(i))

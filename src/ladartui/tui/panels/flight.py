@@ -87,15 +87,10 @@ class FlightPanel(ParamPanel):
         scans = self.query_one("#scans", DataTable)
         scans.clear()
         for i, p in enumerate(pose for poses in per_segment for pose in poses):
-            scans.add_row(
-                str(i + 1),
-                f"{p.x:.1f}",
-                f"{p.y:.1f}",
-                f"{p.z:.1f}",
-                f"{p.heading:.0f}",
-                f"{p.azimuth:.0f}",
-                f"{p.depression:.0f}",
-            )
+            # Whole metres and degrees: the table fits the sidebar, so no column is
+            # shown cut (a depression of 44.6 cut to "4" read as a value).
+            values = (p.x, p.y, p.z, p.heading, p.azimuth, p.depression)
+            scans.add_row(str(i + 1), *(str(round(v)) for v in values))  # (an int: never "-0")
 
     # -- editing segments ------------------------------------------------------------
 
