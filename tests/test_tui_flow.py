@@ -589,6 +589,8 @@ async def test_study_key_opens_the_study_of_the_open_scenario_and_esc_returns(sh
     screen = app.screen
     assert isinstance(screen, StudyScreen)
     assert screen.scenario_path == app.scenario.path
+    bar = screen.query_one("#study-progress")
+    assert bar.total == 1 and bar.progress == 0  # idle reads 0 %, not an animation of work
     # the study screen's keys only: the app's F5 must not start a run underneath
     assert app.check_action("run", ()) is False and "f5" not in shown_keys(app)
     await pilot.press("f5")

@@ -64,7 +64,7 @@ class StudyScreen(Screen):
                 yield Static("", id="study-verdict")
         yield Static(self._idle_text(), id="study-status", markup=False)
         with Horizontal(id="study-bar"):
-            yield ProgressBar(id="study-progress", show_eta=False)
+            yield ProgressBar(total=1, id="study-progress", show_eta=False)  # idle: 0 %, not animated
             yield Button("Quick", id="study-quick", compact=True)
             yield Button("Full", id="study-full", compact=True)
             yield Button("Cancel", id="study-cancel", compact=True, variant="error", disabled=True)

@@ -177,7 +177,7 @@ class SweepScreen(Screen):
                 placeholder="folder from 'ladartui certs' (for a tls:// scheduler)",
             )
         with Horizontal(classes="sweep-row"):
-            yield ProgressBar(id="sweep-progress", show_eta=False)
+            yield ProgressBar(total=1, id="sweep-progress", show_eta=False)  # idle: 0 %, not animated
             yield Static("", id="sweep-counts")
         with Horizontal(id="sweep-body"):
             yield DataTable(id="sweep-table", cursor_type="row", zebra_stripes=True)
