@@ -19,7 +19,7 @@ from textual.widgets import Button, DirectoryTree, Input, RadioButton, RadioSet,
 from ladartui.errors import FieldError, LadarError
 from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField
-from ladartui.tui.file_tree import FileTree
+from ladartui.tui.file_tree import SCENARIO_TABLE, FileTree
 from ladartui.tui.screens import Dialog, PathSuggester, _row
 
 SCENARIO_SUFFIXES = (".toml",)
@@ -42,11 +42,11 @@ class TreeDialog(Dialog):
 
     folder: Path
 
-    def tree_rows(self, suffixes) -> ComposeResult:
+    def tree_rows(self, suffixes, toml_table: str | None = None) -> ComposeResult:
         with Horizontal(classes="tree-row"):
             yield Static("", id="tree-root", markup=False)
             yield Button("Up a folder", id="tree-up", compact=True)
-        yield FileTree(self.folder, suffixes, id="tree")
+        yield FileTree(self.folder, suffixes, toml_table, id="tree")
 
     def on_mount(self) -> None:
         self._show_root()
@@ -89,7 +89,7 @@ class SetupScreen(TreeDialog):
             with RadioSet(id="mode"):
                 yield RadioButton("New scenario", value=self.mode == "new", id="mode-new")
                 yield RadioButton("Open scenario", value=self.mode == "load", id="mode-load")
-            yield from self.tree_rows(SCENARIO_SUFFIXES + SCENE_SUFFIXES)
+            yield from self.tree_rows(SCENARIO_SUFFIXES + SCENE_SUFFIXES, SCENARIO_TABLE)
             yield _row(
                 "Scenario file",
                 Input(
@@ -219,7 +219,7 @@ class SaveAsScreen(TreeDialog):
     def compose(self) -> ComposeResult:
         with Vertical(classes="dialog", id="save-as") as box:
             box.border_title = "Save scenario as"
-            yield from self.tree_rows(SCENARIO_SUFFIXES)
+            yield from self.tree_rows(SCENARIO_SUFFIXES, SCENARIO_TABLE)
             yield _row(
                 "Scenario file",
                 Input(

@@ -6,19 +6,38 @@ from pathlib import Path
 
 from textual.widgets import DirectoryTree
 
+# A scenario file has a [files] table (scenario.py); other .toml files (pyproject.toml,
+# sweep specs) are not scenarios.
+SCENARIO_TABLE = "[files]"
+HEAD_BYTES = 65536  # how much of a .toml is read to find the table
+
 
 class FileTree(DirectoryTree):
-    """Folders, and the files with one of ``suffixes``; hidden entries left out."""
+    """Folders, and the files with one of ``suffixes``; hidden entries left out.
+    ``toml_table``: a .toml file is shown only when a line opens that table."""
 
     DEFAULT_CSS = "FileTree { height: 1fr; min-height: 3; border: round $panel-lighten-2; }"
 
-    def __init__(self, path: Path, suffixes: tuple[str, ...], **kwargs):
+    def __init__(self, path: Path, suffixes: tuple[str, ...], toml_table: str | None = None, **kwargs):
         super().__init__(path, **kwargs)
         self.suffixes = suffixes
+        self.toml_table = toml_table
 
     def filter_paths(self, paths):
-        return [
-            p
-            for p in paths
-            if not p.name.startswith(".") and (p.is_dir() or p.suffix.lower() in self.suffixes)
-        ]
+        return [p for p in paths if not p.name.startswith(".") and (p.is_dir() or self._takes(p))]
+
+    def _takes(self, path: Path) -> bool:
+        suffix = path.suffix.lower()
+        if suffix not in self.suffixes:
+            return False
+        return suffix != ".toml" or self.toml_table is None or opens_table(path, self.toml_table)
+
+
+def opens_table(path: Path, table: str) -> bool:
+    """Whether a line near the start of ``path`` opens TOML table ``table`` ("[files]")."""
+    try:
+        with open(path, encoding="utf-8", errors="replace") as handle:
+            head = handle.read(HEAD_BYTES)
+    except OSError:
+        return False
+    return any(line.strip().startswith(table) for line in head.splitlines())
