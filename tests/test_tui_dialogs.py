@@ -254,3 +254,28 @@ async def test_the_scans_table_fits_the_sidebar_at_120_columns(tmp_path, scene_f
         assert scans.max_scroll_x == 0
         assert scans.row_count == 24 and scans.size.height > 10
         assert not any(str(cell) == "-0" for i in range(scans.row_count) for cell in scans.get_row_at(i))
+
+
+async def test_the_new_scenario_dialog_refuses_in_the_forms_words(tmp_path, scene_files):
+    from ladartui.tui.file_dialogs import SetupScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        await pilot.press("f2")
+        await pilot.pause()
+        dialog = app.screen
+        assert isinstance(dialog, SetupScreen) and dialog.mode == "new"
+        dialog.query_one("#setup-ok").press()
+        await pilot.pause()
+        assert (
+            message(dialog, "#setup-message") == "Scenario file: empty is not allowed; expected a file name"
+        )
+        dialog.query_one("#scenario-file").value = "fresh.toml"
+        dialog.query_one("#scene-file").value = str(scene_files[0])
+        dialog.query_one("#voxel-size").value = "0"
+        dialog.query_one("#setup-ok").press()
+        await pilot.pause()
+        said = message(dialog, "#setup-message")
+        assert said.startswith("Voxel size m: 0 is not allowed; expected "), said

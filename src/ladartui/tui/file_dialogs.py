@@ -16,9 +16,9 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, DirectoryTree, Input, RadioButton, RadioSet, Static
 
-from ladartui.errors import FieldError, LadarError
+from ladartui.errors import LadarError
 from ladartui.tui import bridge
-from ladartui.tui.fields import NumberField
+from ladartui.tui.fields import NumberField, refusal
 from ladartui.tui.file_tree import SCENARIO_TABLE, FileTree
 from ladartui.tui.screens import Dialog, PathSuggester, _row
 
@@ -180,15 +180,18 @@ class SetupScreen(TreeDialog):
         message = self.query_one("#setup-message", Static)
         try:
             if scenario_path is None:
-                raise FieldError("scenario file", "", "a file name")
+                message.update(refusal("Scenario file", "", "a file name"))
+                return
             if self.mode == "new":
                 if scene_path is None:
-                    raise FieldError("scene model", "", "a scene model file (.txt)")
+                    message.update(refusal("3D scene model", "", "a scene model file (.txt)"))
+                    return
                 field = self.query_one("#voxel-size", NumberField)
                 problem = field.problem()
                 if problem:
                     field.focus()
-                    raise FieldError("voxel size m", field.value.strip(), problem.split("expected ", 1)[-1])
+                    message.update(refusal("Voxel size m", field.value, problem.split("expected ", 1)[-1]))
+                    return
                 scenario = bridge.new_scenario(scenario_path, scene_path, field.parsed())
             else:
                 scenario = bridge.load_checked(scenario_path)
@@ -254,7 +257,7 @@ class SaveAsScreen(TreeDialog):
         text = self.query_one("#save-as-file", Input).value.strip()
         message = self.query_one("#save-as-message", Static)
         if not text:
-            message.update("Scenario file: empty; expected a file name")
+            message.update(refusal("Scenario file", "", "a file name"))
             return
         path = (self.base / Path(text).expanduser()).resolve()
         if path.is_dir():  # before ".toml" is added: a folder's name is not a file's
