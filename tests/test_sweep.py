@@ -510,3 +510,25 @@ def test_two_sweeps_never_write_one_folder_at_once(tiny, tmp_path):
             run_sweep(spec, serial=True, out=tmp_path)
     assert not (tmp_path / "results.csv").exists()
     assert run_sweep(spec, serial=True, out=tmp_path).ran == 1
+
+
+def test_the_best_scenario_file_does_not_carry_the_base_files_comments(tmp_path):
+    from ladartui.scenario import load_scenario
+    from ladartui.sweep.execute import write_best_scenario
+
+    base = write_tiny_scenario(tmp_path)
+    text = base.path.read_text().replace("radius = 20.0", "radius = 20.0  # a tight orbit: 20 m")
+    base.path.write_text("# Orbit: 4 looks at 20 m\n" + text)
+    base = load_scenario(base.path)
+    out = tmp_path / "out"
+    out.mkdir()
+    row = {"variant": "abc12345", "radius": 35.0}
+    path = write_best_scenario(out / "base-best.toml", base, row, ["radius"], base.load_scene)
+    written = path.read_text()
+    # the base's comments described the base's values: not this file's
+    assert "20 m" not in written and "4 looks" not in written
+    assert written.startswith(
+        "# The best flight path of a sweep (variant abc12345): base.toml with radius = 35\n"
+    )
+    saved = load_scenario(path)
+    assert saved.flight.segments[0].radius == 35.0 and saved.scene_file == base.scene_file

@@ -14,6 +14,7 @@ import sys
 from pathlib import Path
 
 from ladartui import __version__
+from ladartui.cli.progress import reset_stop, stop_status
 from ladartui.errors import Cancelled, LadarError
 from ladartui.textsafe import one_line
 
@@ -85,6 +86,7 @@ def main(argv: list[str] | None = None) -> int:
             print(f"ladartui: error: {_unknown_command(argv[0])} (see 'ladartui -h')", file=sys.stderr)
             return 2
         argv = ["tui", *argv]
+    reset_stop()
     try:
         parser = build_parser()  # (imports every command: a Ctrl-C can land here)
         args = parser.parse_args(argv)
@@ -97,7 +99,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except Cancelled as error:  # its message says what was (not) written
         print(f"ladartui: {one_line(error)}", file=sys.stderr)
-        return 130
+        return stop_status()
     except KeyboardInterrupt:
         print("ladartui: interrupted", file=sys.stderr)
-        return 130
+        return stop_status()

@@ -71,17 +71,32 @@ def run_cancellable(work: Callable[[], T], cancel: threading.Event, name: str, c
     return outcome["result"]
 
 
+# The signal that stopped the command (SIGINT unless SIGTERM did): its exit status is
+# 128 + its number, as a shell reports a process that signal killed.
+_stopped_by = {"signal": int(signal.SIGINT)}
+
+
+def reset_stop() -> None:
+    _stopped_by["signal"] = int(signal.SIGINT)
+
+
+def stop_status() -> int:
+    """The exit status of a command stopped by a signal: 130 for Ctrl-C, 143 for SIGTERM."""
+    return 128 + _stopped_by["signal"]
+
+
+def _interrupt(signum, frame):
+    _stopped_by["signal"] = int(signum)
+    raise KeyboardInterrupt
+
+
 @contextlib.contextmanager
 def sigterm_as_interrupt():
     """Treat SIGTERM (a batch system's or ``kill``'s stop) like Ctrl-C while inside."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-
-    def interrupt(signum, frame):
-        raise KeyboardInterrupt
-
-    previous = signal.signal(signal.SIGTERM, interrupt)
+    previous = signal.signal(signal.SIGTERM, _interrupt)
     try:
         yield
     finally:

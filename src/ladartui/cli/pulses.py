@@ -13,6 +13,7 @@ import json
 import sys
 import threading
 
+from ladartui.cli.progress import stop_status
 from ladartui.errors import Cancelled, FieldError
 
 CHART_WIDTH = 78
@@ -99,7 +100,7 @@ def run(args) -> int:
             "command writes no files",
             file=sys.stderr,
         )
-        return 130
+        return stop_status()
     if args.json:
         print(json.dumps(result_dict(scenario, settings, ideal, rows), indent=2, allow_nan=False))
         return 0

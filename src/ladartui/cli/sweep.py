@@ -9,12 +9,11 @@ from __future__ import annotations
 
 import json
 import os
-import signal
 import threading
 
 from rich.markup import escape
 
-from ladartui.cli.progress import progress_display, run_cancellable
+from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt, stop_status
 from ladartui.errors import Cancelled, FieldError
 from ladartui.sweep.table import display_cell
 
@@ -166,7 +165,7 @@ def run(args) -> int:
         check_writable_folder(args.out or default_out_dir(spec))
         result = _sweep_with_progress(spec, args, errors)
         if result is None:
-            return 130
+            return stop_status()
     from ladartui.charts.sweep import write_sweep_charts
 
     result.charts = write_sweep_charts(result, result.results_path.parent)
@@ -229,13 +228,11 @@ def _sweep_with_progress(spec, args, console):
                     serial=args.serial,
                 )
 
-            previous = _stop_on_sigterm()
             try:
-                return run_cancellable(work, cancel, "ladartui-sweep", Cancelled())
+                with sigterm_as_interrupt():
+                    return run_cancellable(work, cancel, "ladartui-sweep", Cancelled())
             except Cancelled:
                 pass  # reported below, once the client is closed
-            finally:
-                _restore_sigterm(previous)
     finally:
         if client is not None:
             client.close()
@@ -247,22 +244,6 @@ def _sweep_with_progress(spec, args, console):
         highlight=False,
     )
     return None
-
-
-def _stop_on_sigterm():
-    """Treat SIGTERM (a batch system's stop) like Ctrl-C: finished rows are kept."""
-    if threading.current_thread() is not threading.main_thread():
-        return None
-
-    def interrupt(signum, frame):
-        raise KeyboardInterrupt
-
-    return signal.signal(signal.SIGTERM, interrupt)
-
-
-def _restore_sigterm(previous):
-    if previous is not None:
-        signal.signal(signal.SIGTERM, previous)
 
 
 def result_dict(result, top) -> dict:

@@ -36,6 +36,7 @@ from ladartui.sweep.ranking import (
 from ladartui.sweep.spec import SweepSpec, bundled_name, load_sweep_spec
 from ladartui.sweep.table import read_table, table_text, write_table
 from ladartui.sweep.variant import ScenePayload, apply_parameters, run_variant
+from ladartui.textsafe import one_line
 
 RESULTS_NAME = "results.csv"
 RANKING_NAME = "ranking.csv"
@@ -513,10 +514,22 @@ def write_ranking(path, ranking: list[Ranked], parameter_names) -> Path:
 
 
 def write_best_scenario(path, base, row: dict, parameter_names, scene_loader) -> Path:
-    """Save the scenario of ``row`` (the base with its parameters) as a ready-to-open file."""
+    """Save the scenario of ``row`` (the base with its parameters) as a ready-to-open file.
+
+    Written afresh, not over the base file's text: the base's comments describe its own
+    values (an orbit's looks, an altitude's depression), which a variant may change."""
+    from ladartui.atomic import write_text_atomic
+    from ladartui.sweep.table import display_cell
+
     params = {name: row[name] for name in parameter_names if row.get(name) is not None}
-    scenario = apply_parameters(base, params, scene_loader)
-    return scenario.save(path).path  # atomic; relative scene path and outputs follow the file
+    scenario = apply_parameters(base, params, scene_loader).with_changes(path=Path(path))
+    settings = ", ".join(f"{name} = {display_cell(value)}" for name, value in params.items())
+    header = one_line(
+        f"# The best flight path of a sweep (variant {row.get('variant', '?')}): "
+        f"{base.path.name}" + (f" with {settings}" if settings else "")
+    )
+    write_text_atomic(scenario.path, header + "\n" + scenario.to_toml())
+    return scenario.path  # relative scene path and outputs follow the file
 
 
 def load_sweep_results(
