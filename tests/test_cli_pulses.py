@@ -113,3 +113,12 @@ def test_work_beyond_the_memory_limit_is_refused_up_front(scenario, capsys, monk
         from ladartui.simulation import simulate
 
         simulate(scenario.with_changes(detection=DetectionSettings(model="geiger")), write=False)
+
+
+def test_geiger_markers_stay_visible_where_they_meet_the_ideal_line():
+    # coverage a hair under the ideal: on the same character row as its line
+    rows = [PulseRow(m, 1, 0.2499, 100, 0, 0.5) for m in (1, 10, 30, 100)]
+    text = chart_text(0.25, rows, width=60, height=15, color=False)
+    plot = [line.split("┤", 1)[1].split("├", 1)[0] for line in text.splitlines() if "┤" in line]
+    markers = sum(row.count("o") for row in plot if "obscured coverage" not in row)
+    assert markers >= len(rows)

@@ -175,6 +175,8 @@ def chart_text(ideal, rows, width=CHART_WIDTH, height=CHART_HEIGHT, color=True) 
         plotext.plotsize(width, height)
         plotext.theme("pro" if color else "clear")
         plotext.title("Geiger-mode: coverage and false alarms against pulses per look")
+        # The ideal line first: where the Geiger points fall on its row they are drawn over it.
+        plotext.plot(xs, [100.0 * ideal] * len(xs), color="cyan", label="obscured coverage % (ideal)")
         plotext.plot(
             xs,
             [100.0 * r.obscured_coverage for r in rows],
@@ -182,7 +184,6 @@ def chart_text(ideal, rows, width=CHART_WIDTH, height=CHART_HEIGHT, color=True) 
             color="green",
             label="obscured coverage % (Geiger)",
         )
-        plotext.plot(xs, [100.0 * ideal] * len(xs), color="cyan", label="obscured coverage % (ideal)")
         plotext.plot(
             xs,
             [r.false_alarms for r in rows],
