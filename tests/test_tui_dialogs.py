@@ -211,14 +211,12 @@ async def test_outputs_from_other_settings_are_said_to_be_out_of_date(tmp_path, 
         await type_into(pilot, field(app, "sensor.grid"), "12")
         # the outputs and measures shown are the 8 x 8 run's: said in the bar and the tab
         assert bar.state == NOT_READY
-        assert bar.message.endswith(
-            "outputs are from the settings before your edits; F5 runs and rewrites them."
-        )
+        assert bar.message == f"{scenario.path.name} (modified): outputs out of date; F5 reruns."
         assert str(info.render()) == f"Measures of {scenario.name}, from the settings before your edits:"
         # back to the settings that ran (undo): up to date again, though not yet saved
         await pilot.press("ctrl+z")
         await pilot.pause()
-        assert bar.state == READY and "before your edits" not in bar.message
+        assert bar.state == READY and "out of date" not in bar.message
         assert str(info.render()) == f"Measures of {scenario.name}:"
         # the backend and fast mode change nothing that a run writes
         app.set_scenario(app.scenario.with_changes(fast_mode=not app.scenario.fast_mode))

@@ -270,7 +270,7 @@ async def test_a_run_disables_controls_and_cancel_keeps_earlier_outputs(tmp_path
         assert all(w.disabled for w in app.query("#sidebar Input") if w.id.startswith("f-start"))
         # the outputs kept are the first run's, with the settings before the edits
         assert status(app).state == NOT_READY
-        assert "outputs are from the settings before your edits" in status(app).message
+        assert "outputs out of date; F5 reruns" in status(app).message
 
 
 async def test_progressive_output_during_a_run_unless_fast_mode(tmp_path, scene_files):

@@ -33,7 +33,6 @@ from ladartui.tui.file_actions import FileActions
 from ladartui.tui.graphics import Graphics, has_truecolor
 from ladartui.tui.loading import SceneLoading
 from ladartui.tui.panels import FilePanel, FlightPanel, ResultsPanel, RunPanel, SensorPanel
-from ladartui.tui.panels.results import EARLIER_SETTINGS
 from ladartui.tui.params import ParamField
 from ladartui.tui.runs import RunControl
 from ladartui.tui.screens import (
@@ -256,8 +255,9 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
             bar.show(NOT_READY, f"{scenario.path.name}{mark}: outputs missing ({names}){writes}.")
             return
         if self.outputs_stale():
-            rewrites = f"; {runs} and rewrites them" if runs else ""
-            bar.show(NOT_READY, f"{scenario.path.name}{mark}: outputs are from {EARLIER_SETTINGS}{rewrites}.")
+            # short: the bar is one line (the Results tab says which settings they came from)
+            reruns = f"; {self.key_hint('run')} reruns" if runs else ""
+            bar.show(NOT_READY, f"{scenario.path.name}{mark}: outputs out of date{reruns}.")
             return
         bar.show(READY, text)
 

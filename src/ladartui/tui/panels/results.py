@@ -11,7 +11,7 @@ from ladartui.measures import Measures
 from ladartui.tui.host import host_of
 from ladartui.tui.measures_view import compact_rows, level_rows, target_rows
 
-# What outputs made before the scenario's latest edits are from (status bar, this tab).
+# Where measures made before the scenario's latest edits came from (this tab).
 EARLIER_SETTINGS = "the settings before your edits"
 
 
