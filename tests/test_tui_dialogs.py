@@ -6,6 +6,7 @@ Each test drives a real app on a tiny generated scene with Pilot.
 from __future__ import annotations
 
 import shlex
+from contextlib import asynccontextmanager
 
 from ladartui.tui.file_dialogs import SaveAsScreen
 from ladartui.tui.screens import CompareScreen, FormScreen, MeasuresScreen, PosesScreen
@@ -14,15 +15,22 @@ from test_tui_flow import LadarApp, loaded, make_scenario, type_into, wait_until
 SIZE = (100, 32)
 
 
+@asynccontextmanager
+async def opened(scenario, size=SIZE):
+    """The app on ``scenario``, loaded: (app, pilot)."""
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=size) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        yield app, pilot
+
+
 def message(screen, selector="#form-message") -> str:
     return str(screen.query_one(selector).render())
 
 
 async def test_a_segment_form_names_the_point_field_that_is_wrong(tmp_path, scene_files):
     scenario = make_scenario(tmp_path, scene_files)
-    app = LadarApp(scenario.path)
-    async with app.run_test(size=SIZE) as pilot:
-        await wait_until(pilot, lambda: loaded(app))
+    async with opened(scenario) as (app, pilot):
         app.action_show_tab("flight")
         app.action_add_segment("orbit")
         await pilot.pause()
@@ -50,9 +58,7 @@ async def test_a_segment_form_names_the_point_field_that_is_wrong(tmp_path, scen
 
 async def test_an_empty_list_field_says_empty(tmp_path, scene_files):
     scenario = make_scenario(tmp_path, scene_files)
-    app = LadarApp(scenario.path)
-    async with app.run_test(size=SIZE) as pilot:
-        await wait_until(pilot, lambda: loaded(app))
+    async with opened(scenario) as (app, pilot):
         app.action_show_tab("flight")
         app.action_add_segment("standoff")
         await pilot.pause()
@@ -66,9 +72,7 @@ async def test_an_empty_list_field_says_empty(tmp_path, scene_files):
 
 async def test_the_poses_dialog_keeps_a_refused_value_and_ok_applies_the_row(tmp_path, scene_files):
     scenario = make_scenario(tmp_path, scene_files)
-    app = LadarApp(scenario.path)
-    async with app.run_test(size=SIZE) as pilot:
-        await wait_until(pilot, lambda: loaded(app))
+    async with opened(scenario) as (app, pilot):
         app.action_manual_poses()
         await pilot.pause()
         screen = app.screen
@@ -97,9 +101,7 @@ async def test_save_as_refuses_a_folder_and_clears_the_last_run_line(tmp_path, s
     scenario = make_scenario(tmp_path, scene_files)
     folder = tmp_path / "kept"
     folder.mkdir()
-    app = LadarApp(scenario.path)
-    async with app.run_test(size=SIZE) as pilot:
-        await wait_until(pilot, lambda: loaded(app))
+    async with opened(scenario) as (app, pilot):
         app.run_panel.say("Last run cancelled; nothing was written.")
         await app.run_action("save_as")
         await pilot.pause()
@@ -125,9 +127,7 @@ async def test_markup_in_names_shows_as_typed_and_compare_reads_spaced_paths(tmp
     from rich.text import Text
 
     scenario = make_scenario(tmp_path, scene_files, name="[bold red]x y")
-    app = LadarApp(scenario.path)
-    async with app.run_test(size=SIZE) as pilot:
-        await wait_until(pilot, lambda: loaded(app))
+    async with opened(scenario) as (app, pilot):
         await app.run_action("run")
         await wait_until(pilot, lambda: isinstance(app.screen, MeasuresScreen))
         title = app.screen.query_one(".dialog").border_title
@@ -171,9 +171,7 @@ async def test_the_help_fits_the_terminal_without_sideways_scrolling(tmp_path, s
     from ladartui.tui.screens import HelpScreen
 
     scenario = make_scenario(tmp_path, scene_files)
-    app = LadarApp(scenario.path)
-    async with app.run_test(size=(80, 24)) as pilot:
-        await wait_until(pilot, lambda: loaded(app))
+    async with opened(scenario, size=(80, 24)) as (app, pilot):
         for size in ((80, 24), (120, 40)):
             await pilot.resize_terminal(*size)
             await pilot.press("f1")
@@ -196,9 +194,7 @@ async def test_outputs_from_other_settings_are_said_to_be_out_of_date(tmp_path, 
     from test_tui_flow import field
 
     scenario = make_scenario(tmp_path, scene_files)
-    app = LadarApp(scenario.path)
-    async with app.run_test(size=SIZE) as pilot:
-        await wait_until(pilot, lambda: loaded(app))
+    async with opened(scenario) as (app, pilot):
         bar = app.query_one(StatusBar)
         await app.run_action("run")
         await wait_until(pilot, lambda: isinstance(app.screen, MeasuresScreen))
@@ -228,9 +224,7 @@ async def test_a_committed_value_is_shown_and_named_as_a_number(tmp_path, scene_
     from test_tui_flow import field
 
     scenario = make_scenario(tmp_path, scene_files)
-    app = LadarApp(scenario.path)
-    async with app.run_test(size=SIZE) as pilot:
-        await wait_until(pilot, lambda: loaded(app))
+    async with opened(scenario) as (app, pilot):
         app.action_show_tab("sensor")
         grid = field(app, "sensor.grid")
         await type_into(pilot, grid, "1.2e1")
@@ -242,9 +236,7 @@ async def test_a_committed_value_is_shown_and_named_as_a_number(tmp_path, scene_
 
 async def test_the_scans_table_fits_the_sidebar_at_120_columns(tmp_path, scene_files):
     scenario = make_scenario(tmp_path, scene_files, scans=24)
-    app = LadarApp(scenario.path)
-    async with app.run_test(size=(120, 40)) as pilot:
-        await wait_until(pilot, lambda: loaded(app))
+    async with opened(scenario, size=(120, 40)) as (app, pilot):
         app.action_show_tab("flight")
         await pilot.pause()
         scans = app.query_one("#scans")
@@ -258,9 +250,7 @@ async def test_the_new_scenario_dialog_refuses_in_the_forms_words(tmp_path, scen
     from ladartui.tui.file_dialogs import SetupScreen
 
     scenario = make_scenario(tmp_path, scene_files)
-    app = LadarApp(scenario.path)
-    async with app.run_test(size=SIZE) as pilot:
-        await wait_until(pilot, lambda: loaded(app))
+    async with opened(scenario) as (app, pilot):
         await pilot.press("f2")
         await pilot.pause()
         dialog = app.screen
