@@ -46,3 +46,17 @@ def test_ctrl_c_while_the_commands_load_is_one_line(monkeypatch, capsys):
     monkeypatch.setattr(cli, "build_parser", interrupted)
     assert cli.main(["run", "default"]) == 130
     assert capsys.readouterr().err == "ladartui: interrupted\n"
+
+
+def test_the_commands_load_without_numba_or_dask():
+    import subprocess
+    import sys
+
+    # `ladartui --help` and a mistyped flag answer at once: loading numba alone took 0.7 s
+    code = (
+        "import sys; from ladartui.cli import build_parser; build_parser(); "
+        "print(sorted(m for m in ('numba', 'distributed') if m in sys.modules))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "[]"

@@ -42,7 +42,6 @@ import numpy as np
 
 from ladartui.checks import range_text
 from ladartui.errors import FieldError, InputFileError
-from ladartui.scene.keys import visible_mask, voxel_keys
 
 LEVELS = ("detect", "recognise", "identify")
 NOT_REACHED = "not reached"
@@ -316,6 +315,8 @@ def share_curves(target_voxels, per_scan_returns) -> tuple[list[float], list[flo
     returns that are not target voxels (foliage, ground) are ignored. None
     when the target has no visible voxel.
     """
+    # Here, not at the top: the CLI reads level names without loading numba's kernels.
+    from ladartui.scene.keys import visible_mask, voxel_keys
 
     target = np.unique(np.asarray(target_voxels, dtype=np.int64).reshape(-1, 3), axis=0)
     if target.shape[0] == 0:

@@ -15,7 +15,6 @@ from rich.markup import escape
 
 from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt, stop_status
 from ladartui.errors import Cancelled, FieldError
-from ladartui.sweep.table import display_cell
 
 DEFAULT_TOP = 10
 
@@ -308,6 +307,7 @@ def show_result(console, result, top) -> None:
     from ladartui.sweep.columns import target_ids
     from ladartui.sweep.ranking import OBJECTIVE_HEADERS as short
     from ladartui.sweep.ranking import OBJECTIVES, identified_count, never_identified
+    from ladartui.sweep.table import display_cell
 
     cost_unit = "s" if result.cost == "flight-time" else "m"
     table = Table(

@@ -3,52 +3,38 @@
 ``run_sweep(spec, client=None, progress=None, cancel=None) -> SweepResult`` runs
 a spec (see ``ladartui.sweep.spec`` for the TOML format), resuming from its
 result table; ``load_sweep_results(path)`` reads a finished or partial one.
+Submodules load on first use: the CLI reads a name without starting Dask or numba.
 """
 
-from ladartui.sweep.execute import (
-    SweepProgress,
-    SweepResult,
-    connect,
-    default_out_dir,
-    load_sweep_results,
-    local_client,
-    run_sweep,
-)
-from ladartui.sweep.ranking import OBJECTIVES, Ranked, objective_value, pareto_front, rank_rows
-from ladartui.sweep.spec import (
-    PARAMETERS,
-    SweepSpec,
-    Variant,
-    expand_variants,
-    load_sweep_spec,
-    parse_sweep_spec,
-    variant_id,
-)
-from ladartui.sweep.table import read_table, write_table
-from ladartui.sweep.variant import apply_parameters, run_variant
+from ladartui.lazy import lazy_getattr
 
-__all__ = [
-    "OBJECTIVES",
-    "PARAMETERS",
-    "Ranked",
-    "SweepProgress",
-    "SweepResult",
-    "SweepSpec",
-    "Variant",
-    "apply_parameters",
-    "connect",
-    "default_out_dir",
-    "expand_variants",
-    "load_sweep_results",
-    "load_sweep_spec",
-    "local_client",
-    "objective_value",
-    "pareto_front",
-    "parse_sweep_spec",
-    "rank_rows",
-    "read_table",
-    "run_sweep",
-    "run_variant",
-    "variant_id",
-    "write_table",
-]
+_EXPORTS = {
+    "SweepProgress": "ladartui.sweep.execute",
+    "SweepResult": "ladartui.sweep.execute",
+    "connect": "ladartui.sweep.execute",
+    "default_out_dir": "ladartui.sweep.execute",
+    "load_sweep_results": "ladartui.sweep.execute",
+    "local_client": "ladartui.sweep.execute",
+    "run_sweep": "ladartui.sweep.execute",
+    "OBJECTIVES": "ladartui.sweep.ranking",
+    "Ranked": "ladartui.sweep.ranking",
+    "objective_value": "ladartui.sweep.ranking",
+    "pareto_front": "ladartui.sweep.ranking",
+    "rank_rows": "ladartui.sweep.ranking",
+    "PARAMETERS": "ladartui.sweep.spec",
+    "SweepSpec": "ladartui.sweep.spec",
+    "Variant": "ladartui.sweep.spec",
+    "expand_variants": "ladartui.sweep.spec",
+    "load_sweep_spec": "ladartui.sweep.spec",
+    "parse_sweep_spec": "ladartui.sweep.spec",
+    "variant_id": "ladartui.sweep.spec",
+    "read_table": "ladartui.sweep.table",
+    "write_table": "ladartui.sweep.table",
+    "apply_parameters": "ladartui.sweep.variant",
+    "run_variant": "ladartui.sweep.variant",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+__getattr__ = lazy_getattr("ladartui.sweep", _EXPORTS, globals())
