@@ -132,8 +132,8 @@ def test_malformed_mesh_is_one_line(tmp_path, capsys, name, content, message):
         (["--heading", "30"], "--heading = 30.0: expected --at X,Y too"),
         (["--into", "scene.txt"], "--into = 'scene.txt': expected --at X,Y too"),
         (["--voxel-size", "-1"], "--voxel-size = -1.0: expected a positive number of metres"),
-        (["--at", "0.5,5"], "--at = '0.5,5,0': expected a position keeping the mesh inside the scene"),
-        (["--at", "5,5,-1"], "--at = -1.0: expected a height of 0 m or more above the ground"),
+        (["--at", "0.5,5"], "--at = '0.5,5': expected a position keeping the mesh inside the scene"),
+        (["--at", "5,5,-1"], "--at = '5,5,-1': expected a height of 0 m or more above the ground"),
     ],
 )
 def test_bad_flags_are_one_line(tmp_path, truck, capsys, extra, message):
