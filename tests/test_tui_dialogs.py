@@ -9,7 +9,8 @@ import shlex
 from contextlib import asynccontextmanager
 
 from ladartui.tui.file_dialogs import SaveAsScreen
-from ladartui.tui.screens import CompareScreen, FormScreen, MeasuresScreen, PosesScreen
+from ladartui.tui.poses_screen import PosesScreen
+from ladartui.tui.screens import CompareScreen, FormScreen, MeasuresScreen
 from test_tui_flow import LadarApp, loaded, make_scenario, type_into, wait_until
 
 SIZE = (100, 32)

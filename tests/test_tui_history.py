@@ -13,7 +13,8 @@ from ladartui.recent import recent_scenarios
 from ladartui.scenario import load_scenario
 from ladartui.tui.actions import palette_entries
 from ladartui.tui.file_dialogs import FileTree, SaveAsScreen, SetupScreen
-from ladartui.tui.screens import FormScreen, PosesScreen
+from ladartui.tui.poses_screen import PosesScreen
+from ladartui.tui.screens import FormScreen
 from ladartui.tui.status import StatusBar
 from ladartui.tui.unsaved import UnsavedScreen
 from test_tui_flow import (

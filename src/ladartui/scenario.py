@@ -4,96 +4,15 @@ A scenario ``S.toml`` names a scene model ``X.txt``; the target model is
 ``X_Target.txt`` beside it, and a run writes ``S_Scene.txt``, ``S_Target.txt``
 and ``S.cmf`` beside the scenario (report section 4.1 and table 2).
 
-The file format (every key is checked; an unknown key is an error, so typos
-are caught; keys marked "default" may be left out)::
-
-    [files]
-    scene = "generated/small.txt"   # scene model X.txt, relative to this file's folder
-    voxel_size = 0.25               # metres per voxel (default 1.0)
-
-    [sensor]                        # report section 7.1; every key has a default
-    grid = 64                       # n: n x n detectors, 1..1024
-    ray_grid = 2                    # m: m x m rays per detector, 1..16
-    fov_deg = 8.0                   # full field of view, degrees, > 0 and < 90
-    depth_resolution_m = 1.0        # returns closer than this on one detector merge, 0..1000
-    pixel_pitch_um = 100.0          # detector pitch, micrometres, > 0 and <= 10000
-    mount = "stabilised"            # or "body-fixed": rays turn with roll and pitch
-
-    [flight]
-    speed_mps = 30.0                # for the flight time (default 30)
-
-    [flight.start]                  # needed only if a straight or turn comes first
-    x = 0.0                         # metres east
-    y = -100.0                      # metres north
-    z = 60.0                        # metres up, > 0
-    heading = 0.0                   # degrees clockwise from north
-    azimuth = 0.0                   # sensor, degrees clockwise from the nose
-    depression = 45.0               # sensor, degrees below horizontal, 1..90 (90 nadir)
-
-    [[flight.segments]]             # one table per segment, flown in order
-    kind = "orbit"                  # circle a target point, sensor aimed at it
-    centre = [32.0, 32.0, 1.0]      # [x, y] or [x, y, z] metres
-    radius = 60.0
-    altitude = 60.0
-    scans = 24
-    direction = "right"             # default "right" (clockwise); or "left"
-    start_bearing = 180.0           # default 180: first scan south of the centre
-    arc = 360.0                     # default 360 degrees
-    # aim_at = [x, y, z]            # default: the centre
-
-Other segment kinds and their keys (``aim_at`` is optional on every kind):
-
-* ``kind = "straight"``: ``distance`` (m), ``scans``; optional ``azimuth``,
-  ``depression`` (new sensor pointing from here on).
-* ``kind = "turn"``: ``radius`` (m), ``arc`` (degrees), ``direction``
-  ("left"/"right"), ``scans``; optional ``azimuth``, ``depression``.
-* ``kind = "manual"``: ``poses = [{ x = .., y = .., z = .., heading = ..,
-  azimuth = .., depression = .. }, ...]`` (heading and azimuth default 0,
-  depression 90).
-* ``kind = "flypast"``: ``target``, ``standoff`` (m), ``altitude``, ``length``
-  (m), ``scans``, ``heading`` (default 0), ``side`` (default "right").
-* ``kind = "standoff"``: ``target``, ``standoffs = [100.0, 150.0, ...]`` (m),
-  ``altitude``, ``bearing`` (default 180), ``heading`` (default: towards the
-  target).
-* ``kind = "log"``: a recorded flight log ``file`` (CSV, relative to this
-  file's folder; see ``ladartui.trajectory``), scans at ``rate`` (Hz) or at
-  ``times = [..]`` (s); ``azimuth`` (default 0), ``depression`` (default 90).
-
-Straight and turn segments continue from the previous segment's last scan
-(or from ``[flight.start]``); see ``ladartui.flight``. ::
-
-    [simulation]                    # every key has a default
-    backend = "auto"                # "auto" or a tracing backend name
-    method = "exact"                # "exact" or "march" (the report's fixed step)
-    step = 0.5                      # march step in voxels, > 0 and <= 10
-    precision = "f64"               # "f64" or "f32"
-    fast_mode = false               # true: no progressive views during a run
-
-    [detection]                     # optional; absent: the ideal sensor
-    model = "geiger"                # see ladartui.detection.settings for every key
-
-    [levels]                        # optional; detect / recognise / identify thresholds
-    detect = 0.10                   # share of the target's visible voxels seen (default 0.10)
-    recognise = 0.30                # (default 0.30)
-    identify = 0.50                 # (default 0.50)
-    detect_footprint = 0.10         # share of its footprint cells (x-y columns) seen (default 0.10)
-    recognise_footprint = 0.50      # (default 0.50)
-    identify_footprint = 0.75       # (default 0.75); see ladartui.levels for why
-    [targets]                       # optional: names of the target model's targets
-    names = { 1 = "truck", 2 = "van" }  # id -> name; an unnamed id reads "target N"
-
-Turns and orbits bank as coordinated turns at ``speed_mps``; only a
-``body-fixed`` sensor sees it (``ladartui.attitude``).
+The file format, every key and the reader that checks it: ``ladartui.scenario_file``.
 """
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import os
 import re
 import sys
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -102,20 +21,24 @@ import tomli_w
 from ladartui import defaults
 from ladartui.atomic import write_text_atomic
 from ladartui.checks import choice_field, number_field
-from ladartui.detection.settings import DETECTION_KEYS, DetectionSettings, detection_from_table
+from ladartui.detection.settings import DetectionSettings
 from ladartui.errors import FieldError, InputFileError, LadarError
 from ladartui.fileprobe import file_problem
 from ladartui.flight import (
-    MAX_SCANS,
-    SEGMENT_KINDS,
     FlightPlan,
-    Manual,
     ScanPose,
 )
-from ladartui.levels import LEVEL_KEYS, LEVELS, LevelThresholds, levels_from_table
+from ladartui.levels import LEVELS, LevelThresholds
+from ladartui.scenario_file import (
+    ScenarioReader,
+    check_flight,
+    checked_target_names,
+    parse_document,
+    resolve_path,
+)
 from ladartui.scenario_style import restyle
-from ladartui.sensor import MAX_PIXEL_PITCH, Sensor
-from ladartui.toml_lines import key_lines, key_lines_from_text
+from ladartui.sensor import Sensor
+from ladartui.toml_lines import key_lines
 from ladartui.tracing.backend import METHODS, PRECISIONS
 from ladartui.trajectory import LogSegment
 
@@ -124,28 +47,7 @@ MAX_VOXEL_SIZE = 100.0
 MAX_SPEED = 1000.0
 MAX_STEP = 10.0
 
-_SENSOR_KEYS = {  # TOML key -> (Sensor field, file units per Sensor unit)
-    "grid": ("grid", None),
-    "ray_grid": ("ray_grid", None),
-    "fov_deg": ("fov", None),
-    "depth_resolution_m": ("depth_resolution", None),
-    "pixel_pitch_um": ("pixel_pitch", 1e6),
-    "mount": ("mount", None),
-}
-_POSE_KEYS = ("x", "y", "z", "heading", "azimuth", "depression")
-_SECTIONS = {
-    "files": ("scene", "voxel_size"),
-    "sensor": tuple(_SENSOR_KEYS),
-    "flight": ("speed_mps", "start", "segments"),
-    "simulation": ("backend", "method", "step", "precision", "fast_mode"),
-    "detection": DETECTION_KEYS,
-    "levels": LEVEL_KEYS,
-    "targets": ("names",),
-}
-MAX_TARGET_NAME = 60
 RUN_ONLY_FIELDS = ("path", "backend", "fast_mode")  # change no output (``same_outputs``)
-# Segment kinds a scenario file may use: the flight plan's, and recorded logs.
-_SEGMENT_KINDS = {**SEGMENT_KINDS, LogSegment.kind: LogSegment}
 
 
 def _backend_choices():
@@ -186,7 +88,7 @@ class Scenario:
         set_ = object.__setattr__
         path = _absolute(self.path)
         set_(self, "path", path)
-        set_(self, "scene_file", _resolve(path.parent, self.scene_file))
+        set_(self, "scene_file", resolve_path(path.parent, self.scene_file))
         set_(
             self,
             "voxel_size",
@@ -203,8 +105,8 @@ class Scenario:
         set_(self, "precision", choice_field("simulation.precision", self.precision, PRECISIONS))
         if not isinstance(self.fast_mode, bool):
             raise FieldError("simulation.fast_mode", self.fast_mode, "true or false")
-        _check_flight(self.flight)
-        set_(self, "target_names", _checked_target_names(self.target_names))
+        check_flight(self.flight)
+        set_(self, "target_names", checked_target_names(self.target_names))
         if self.detection is not None:
             if not isinstance(self.detection, DetectionSettings):
                 raise FieldError("detection", self.detection, "a DetectionSettings")
@@ -310,7 +212,7 @@ class Scenario:
         target model to find the target centre; ``sensor`` defaults likewise.
         """
         path = _absolute(path)
-        scene_file = _resolve(path.parent, scene_file)
+        scene_file = resolve_path(path.parent, scene_file)
         if sensor is None:
             sensor = defaults.DEFAULT_SENSOR
         if flight is None:
@@ -473,257 +375,14 @@ def load_scenario(path, check_files=True) -> Scenario:
     return scenario
 
 
-NESTED_TOO_DEEP = "not valid TOML: arrays or tables nested too deep to read"
-
-
 def scenario_from_toml(text: str, path) -> Scenario:
     """Parse scenario TOML ``text`` as if read from ``path`` (errors name that file)."""
     path = _absolute(path)
-    try:
-        doc = tomllib.loads(text)
-    except RecursionError:
-        raise InputFileError(path, NESTED_TOO_DEEP) from None
-    except tomllib.TOMLDecodeError as error:
-        message = str(error)
-        found = re.search(r"\(at line (\d+), column \d+\)", message)
-        line = int(found.group(1)) if found else None
-        message = re.sub(r"\s*\(at line \d+, column \d+\)", "", message)
-        raise InputFileError(path, f"not valid TOML: {message}", line) from None
-    return _Reader(path, text).scenario(doc)
-
-
-# -- reading ------------------------------------------------------------------------
-
-
-class _Reader:
-    """Turns the TOML document into a Scenario; every error names file, line and key."""
-
-    def __init__(self, path: Path, text: str):
-        self.path = path
-        self.lines = key_lines_from_text(text)
-
-    def line(self, key: str):
-        # The exact key, else the nearest enclosing table or array item.
-        while key:
-            if key in self.lines:
-                return self.lines[key]
-            key = re.sub(r"(\.[^.\[]+|\[\d+\])$", "", key) if re.search(r"[.\[]", key) else ""
-        return None
-
-    def source(self, key):
-        line = self.line(key)
-        return f"{self.path}:{line}" if line else str(self.path)
-
-    def field_error(self, key, value, expected):
-        return FieldError(key, value, expected, source=self.source(key))
-
-    def file_error(self, key, message):
-        return InputFileError(self.path, message, self.line(key))
-
-    @contextlib.contextmanager
-    def located(self, prefix, table, rename=None):
-        """Re-raise a FieldError from a constructor with the TOML key, raw value and line."""
-        try:
-            yield
-        except FieldError as error:
-            head = re.split(r"[.\[]", error.field, maxsplit=1)[0]
-            rest = error.field[len(head) :]
-            key = (rename or {}).get(head, head)
-            value = table.get(key, error.value) if isinstance(table, dict) and not rest else error.value
-            raise self.field_error(prefix + key + rest, value, error.expected) from None
-
-    def table(self, doc, key, allowed, required=()):
-        value = doc.get(key.rsplit(".", 1)[-1], {}) if isinstance(doc, dict) else {}
-        if not isinstance(value, dict):
-            raise self.file_error(key, f"'{key}' must be a table ([{key}]), not {type(value).__name__}")
-        self.keys(value, key, allowed, required)
-        return value
-
-    def keys(self, table, where, allowed, required=(), what=""):
-        for name in table:
-            if name not in allowed:
-                raise self.file_error(
-                    f"{where}.{name}", f"unknown key '{where}.{name}'{what} (allowed: {', '.join(allowed)})"
-                )
-        for name in required:
-            if name not in table:
-                raise self.file_error(where, f"missing key '{where}.{name}'{what}")
-
-    def scenario(self, doc) -> Scenario:
-        for name in doc:
-            if name not in _SECTIONS:
-                raise self.file_error(name, f"unknown section [{name}] (allowed: {', '.join(_SECTIONS)})")
-        files = self.table(doc, "files", _SECTIONS["files"], required=("scene",))
-        sensor_table = self.table(doc, "sensor", _SECTIONS["sensor"])
-        flight = self.table(doc, "flight", _SECTIONS["flight"], required=("segments",))
-        sim = self.table(doc, "simulation", _SECTIONS["simulation"])
-        detection = None
-        if "detection" in doc:
-            table = self.table(doc, "detection", _SECTIONS["detection"])
-            try:
-                detection = detection_from_table(table)
-            except FieldError as error:
-                key = error.field.rpartition(".")[2]
-                raise self.field_error(error.field, table.get(key, error.value), error.expected) from None
-
-        levels = None
-        if "levels" in doc:
-            table = self.table(doc, "levels", _SECTIONS["levels"])
-            try:
-                levels = levels_from_table(table)
-            except FieldError as error:
-                key = error.field.rpartition(".")[2]
-                raise self.field_error(error.field, table.get(key, error.value), error.expected) from None
-        target_names: tuple = ()
-        if "targets" in doc:
-            names = self.table(doc, "targets", _SECTIONS["targets"]).get("names", {})
-            try:
-                target_names = _checked_target_names(names)
-            except FieldError as error:
-                raise self.field_error("targets.names", error.value, error.expected) from None
-
-        scene = files["scene"]
-        if not isinstance(scene, str) or not scene.strip():
-            raise self.field_error("files.scene", scene, "the scene model file name (X.txt)")
-
-        if "pixel_pitch_um" in sensor_table:  # checked in the file's unit
-            with self.located("sensor.", sensor_table):
-                number_field(
-                    "pixel_pitch_um",
-                    sensor_table["pixel_pitch_um"],
-                    0.0,
-                    MAX_PIXEL_PITCH * 1e6,
-                    low_open=True,
-                )
-        sensor_args = {}
-        for key, (name, scale) in _SENSOR_KEYS.items():
-            if key in sensor_table:
-                value = sensor_table[key]
-                if scale is not None and isinstance(value, (int, float)) and not isinstance(value, bool):
-                    value = value / scale  # dividing by 1e6 is exact for 100 -> 1e-4
-                sensor_args[name] = value
-        rename = {name: key for key, (name, _) in _SENSOR_KEYS.items()}
-        with self.located("sensor.", sensor_table, rename):
-            sensor = Sensor(**sensor_args)
-
-        plan = self.flight_plan(flight)
-        options = {"voxel_size": files.get("voxel_size", 1.0), "speed": flight.get("speed_mps", 30.0)}
-        for key in _SECTIONS["simulation"]:
-            if key in sim:
-                options[key] = sim[key]
-        try:
-            return Scenario(
-                self.path,
-                Path(scene),
-                sensor=sensor,
-                flight=plan,
-                detection=detection,
-                levels=levels,
-                target_names=target_names,
-                **options,
-            )
-        except FieldError as error:
-            raw = {"files.voxel_size": files.get("voxel_size"), "flight.speed_mps": flight.get("speed_mps")}
-            table, _, key = error.field.rpartition(".")
-            value = raw.get(error.field, sim.get(key, error.value) if table == "simulation" else error.value)
-            raise self.field_error(error.field, value, error.expected) from None
-
-    def pose(self, table, where) -> ScanPose:
-        if not isinstance(table, dict):
-            raise self.file_error(where, f"'{where}' must be a table of {', '.join(_POSE_KEYS)}")
-        self.keys(table, where, _POSE_KEYS, required=("x", "y", "z"))
-        with self.located(where + ".", table):
-            return ScanPose(**table)
-
-    def flight_plan(self, flight) -> FlightPlan:
-        start = self.pose(flight["start"], "flight.start") if "start" in flight else None
-        items = flight["segments"]
-        if not isinstance(items, list) or not items or not all(isinstance(i, dict) for i in items):
-            raise self.file_error(
-                "flight.segments", "'flight.segments' must be one or more [[flight.segments]] tables"
-            )
-        segments = [self.segment(item, f"flight.segments[{index}]") for index, item in enumerate(items)]
-        plan = FlightPlan(start, tuple(segments))
-        try:
-            _check_flight(plan)
-        except FieldError as error:
-            raise self.field_error(error.field, error.value, error.expected) from None
-        return plan
-
-    def segment(self, item, where):
-        if "kind" not in item:
-            raise self.file_error(where, f"missing key '{where}.kind' (one of {', '.join(_SEGMENT_KINDS)})")
-        kind = item["kind"]
-        if not isinstance(kind, str) or kind not in _SEGMENT_KINDS:
-            raise self.field_error(
-                f"{where}.kind", kind, "one of " + ", ".join(repr(k) for k in _SEGMENT_KINDS)
-            )
-        cls = _SEGMENT_KINDS[kind]
-        fields = dataclasses.fields(cls)
-        allowed = ("kind", *(f.name for f in fields))
-        required = [
-            f.name
-            for f in fields
-            if f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING
-        ]
-        self.keys(item, where, allowed, required, what=f" ({kind} segment)")
-        args = {k: v for k, v in item.items() if k != "kind"}
-        if cls is Manual:
-            poses = args["poses"]
-            if not isinstance(poses, list) or not poses:
-                raise self.field_error(
-                    f"{where}.poses",
-                    poses,
-                    "a list of one or more poses "
-                    "{ x = .., y = .., z = .., heading = .., "
-                    "azimuth = .., depression = .. }",
-                )
-            args["poses"] = [self.pose(p, f"{where}.poses[{i}]") for i, p in enumerate(poses)]
-        if cls is LogSegment and isinstance(args["file"], str) and args["file"].strip():
-            args["file"] = str(_resolve(self.path.parent, args["file"]))
-        with self.located(where + ".", item):
-            return cls(**args)
-
-
-def _checked_target_names(names) -> tuple[tuple[int, str], ...]:
-    """``{id: name}`` (ids as TOML keys "1" or ints) as ((id, name), ...) by ascending id."""
-    from ladartui.scene.voxels import MAX_TARGET_ID
-
-    expected = (
-        f'a table of target id (1..{MAX_TARGET_ID}) = "name", e.g. {{ 1 = "truck" }}, '
-        f"names of 1 to {MAX_TARGET_NAME} printable characters"
-    )
-    items = names.items() if isinstance(names, dict) else names
-    try:
-        pairs = [(key, value) for key, value in items]
-    except (TypeError, ValueError):
-        raise FieldError("targets.names", names, expected) from None
-    out = {}
-    for key, value in pairs:
-        text = str(key).strip()
-        if not (text.isascii() and text.isdigit() and 1 <= int(text) <= MAX_TARGET_ID):
-            raise FieldError("targets.names", key, expected)
-        if (
-            not isinstance(value, str)
-            or not value.strip()
-            or len(value) > MAX_TARGET_NAME
-            or not value.isprintable()
-        ):
-            raise FieldError("targets.names", value, expected)
-        out[int(text)] = value
-    return tuple(sorted(out.items()))
-
-
-def _check_flight(plan: FlightPlan) -> None:
-    """Every scan can be built, and there is at least one and at most MAX_SCANS."""
-    if not plan.segments:
-        raise FieldError("flight.segments", [], "at least one segment")
-    try:
-        count = sum(len(p) for p in plan.segment_poses())
-    except FieldError as error:
-        raise FieldError("flight." + error.field, error.value, error.expected) from None
-    if count > MAX_SCANS:
-        raise FieldError("flight.segments", f"{count} scans", f"at most {MAX_SCANS} scans")
+    doc = parse_document(text, path)
+    reader = ScenarioReader(path, text)
+    arguments = reader.arguments(doc)
+    with reader.constructed(doc):
+        return Scenario(path, **arguments)
 
 
 # -- writing ------------------------------------------------------------------------
@@ -764,11 +423,6 @@ def _compact_arrays(text: str) -> str:
 
 def _absolute(path) -> Path:
     return Path(os.path.normpath(Path(path).expanduser().absolute()))
-
-
-def _resolve(folder: Path, file) -> Path:
-    file = Path(file).expanduser()
-    return Path(os.path.normpath(file if file.is_absolute() else folder / file))
 
 
 def _relative(file: Path, folder: Path) -> str:

@@ -34,6 +34,7 @@ from ladartui.tui.graphics import Graphics, has_truecolor
 from ladartui.tui.loading import SceneLoading
 from ladartui.tui.panels import FilePanel, FlightPanel, ResultsPanel, RunPanel, SensorPanel
 from ladartui.tui.params import ParamField
+from ladartui.tui.poses_screen import PosesScreen
 from ladartui.tui.runs import RunControl
 from ladartui.tui.screens import (
     AngleScreen,
@@ -41,7 +42,6 @@ from ladartui.tui.screens import (
     HelpScreen,
     ImageSizeScreen,
     MeasuresScreen,
-    PosesScreen,
     ThresholdScreen,
 )
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar

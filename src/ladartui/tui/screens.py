@@ -1,5 +1,5 @@
-"""Modal screens: file setup, segment and pose editors, view angle, threshold,
-measures, comparison and help."""
+"""Modal screens: the segment editor and other number forms (view angle, threshold,
+image size), measures, comparison and help; the pose editor is tui/poses_screen.py."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from rich.text import Text
 from textual import on
 from textual.app import ComposeResult
 from textual.binding import Binding
-from textual.containers import Grid, Horizontal, Vertical, VerticalScroll
+from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.screen import ModalScreen
 from textual.suggester import Suggester
 from textual.widget import Widget
@@ -147,7 +147,7 @@ class FormScreen(Dialog):
             try:
                 self.build(values)
             except FieldError as error:
-                if _field_matches(error.field, name):
+                if field_matches(error.field, name):
                     raise
 
         return check
@@ -217,7 +217,7 @@ class FormScreen(Dialog):
             result = self.build(self.values())
         except LadarError as error:
             for name, *_ in self.spec:
-                if isinstance(error, FieldError) and _field_matches(error.field, name):
+                if isinstance(error, FieldError) and field_matches(error.field, name):
                     wrong = self.query_one(f"#f-{name}")
                     wrong.focus()
                     if isinstance(wrong, Input):
@@ -233,7 +233,7 @@ class FormScreen(Dialog):
         self.dismiss(None)
 
 
-def _field_matches(field: str, name: str) -> bool:
+def field_matches(field: str, name: str) -> bool:
     return field == name or field.endswith("." + name)
 
 
@@ -254,183 +254,6 @@ def _parse_points(name, text, kind):
     if kind == "point" and len(numbers) == 2:
         numbers = numbers + (0.0,)
     return numbers
-
-
-class PosesScreen(Dialog):
-    """Manual scan poses in an editable table: pick a row, edit its fields, apply."""
-
-    BINDINGS = [
-        Binding("escape", "dismiss_dialog", "Close"),
-        Binding("ctrl+n", "add_pose", "Add pose"),
-        Binding("delete", "delete_pose", "Delete pose"),
-    ]
-    COLUMNS = ("x", "y", "z", "heading", "azimuth", "depression")
-
-    def __init__(self, poses, defaults):
-        super().__init__()
-        self.poses = list(poses)
-        self.defaults = defaults
-        self.shown_row = -1
-
-    def compose(self) -> ComposeResult:
-        with Vertical(classes="dialog") as box:
-            box.border_title = "Manual scan poses"
-            yield DataTable(id="poses-table", cursor_type="row", zebra_stripes=True)
-            with Grid(id="pose-fields"):
-                for name in self.COLUMNS:
-                    yield Label(name)
-                for name in self.COLUMNS:
-                    yield NumberField(
-                        name,
-                        None,
-                        default=getattr(self.defaults, name),
-                        check=self._checker(name),
-                        id=f"p-{name}",
-                    )
-            yield Static("", id="poses-message", classes="message")
-            with Horizontal(classes="buttons"):
-                yield Button("Apply row", id="pose-apply", compact=True)
-                yield Button("Add", id="pose-add", compact=True)
-                yield Button("Delete", id="pose-delete", compact=True)
-                yield Button("OK", id="poses-ok", variant="primary", compact=True)
-                yield Button("Cancel", id="poses-cancel", compact=True)
-
-    DEFAULT_CSS = """
-    PosesScreen #poses-table { height: 10; }
-    PosesScreen #pose-fields { grid-size: 6 2; height: 2; grid-gutter: 0 1; }
-    """
-
-    def on_mount(self) -> None:
-        table = self.query_one(DataTable)
-        table.add_columns("#", *self.COLUMNS)
-        self._fill()
-        table.focus()
-
-    def _fill(self, select: int | None = None) -> None:
-        table = self.query_one(DataTable)
-        table.clear()
-        for i, pose in enumerate(self.poses):
-            table.add_row(str(i + 1), *(f"{getattr(pose, c):.6g}" for c in self.COLUMNS))
-        if self.poses:
-            row = min(select if select is not None else 0, len(self.poses) - 1)
-            table.move_cursor(row=row)
-            self._show(row)
-
-    def _show(self, row: int) -> None:
-        if not 0 <= row < len(self.poses):
-            return
-        self.shown_row = row
-        for name in self.COLUMNS:
-            self.query_one(f"#p-{name}", NumberField).set_number(getattr(self.poses[row], name))
-
-    def _checker(self, name):
-        def check(value):
-            values = {c: self._raw(c) for c in self.COLUMNS}
-            values[name] = value
-            try:
-                bridge.make_pose(values)
-            except FieldError as error:
-                if _field_matches(error.field, name):
-                    raise
-
-        return check
-
-    def _raw(self, name):
-        widget = self.query_one(f"#p-{name}", NumberField)
-        try:
-            return parse_number(name, widget.value)
-        except FieldError:
-            return widget.default
-
-    @on(DataTable.RowHighlighted)
-    def _highlighted(self, event: DataTable.RowHighlighted) -> None:
-        # a refill re-highlights the row already shown: keep what is being typed
-        if event.cursor_row != self.shown_row:
-            self._show(event.cursor_row)
-
-    def on_input_blurred(self, event: Input.Blurred) -> None:
-        if isinstance(event.input, NumberField):
-            self._check(event.input)
-
-    def _check(self, widget: NumberField) -> bool:
-        """Say why a typed value is refused (the text stays, marked, for correcting)."""
-        problem = widget.problem()
-        if problem:
-            widget.add_class("-bad")
-            expected = problem.split("expected ", 1)[-1]
-            self.query_one("#poses-message", Static).update(
-                escape(refusal(widget.field_name, widget.value, expected))
-            )
-        return problem is None
-
-    def _refused(self) -> bool:
-        """True when a field's text is not allowed: said, and that field focused."""
-        for name in self.COLUMNS:
-            widget = self.query_one(f"#p-{name}", NumberField)
-            if not self._check(widget):
-                widget.focus()
-                return True
-        return False
-
-    @on(Input.Changed)
-    def _typing(self, event: Input.Changed) -> None:
-        if isinstance(event.input, NumberField):
-            event.input.set_class(event.input.problem() is not None, "-bad")
-
-    @on(Input.Submitted)
-    @on(Button.Pressed, "#pose-apply")
-    def _apply(self, event=None) -> bool:
-        """The fields into the selected row (a new one when none is); False, with the
-        reason said, when a field is not allowed."""
-        if self._refused():
-            return False
-        message = self.query_one("#poses-message", Static)
-        try:
-            pose = bridge.make_pose({c: self._raw(c) for c in self.COLUMNS})
-        except LadarError as error:
-            message.update(escape(str(error)))
-            return False
-        row = self.query_one(DataTable).cursor_row
-        if 0 <= row < len(self.poses):
-            self.poses[row] = pose
-        else:
-            self.poses.append(pose)
-            row = len(self.poses) - 1
-        message.update("")
-        self._fill(row)
-        return True
-
-    def _edited(self) -> bool:
-        """Whether a field holds text not yet applied to its row."""
-        return any(
-            self.query_one(f"#p-{name}", NumberField).value
-            != self.query_one(f"#p-{name}", NumberField).committed
-            for name in self.COLUMNS
-        )
-
-    @on(Button.Pressed, "#pose-add")
-    def action_add_pose(self) -> None:
-        template = self.poses[-1] if self.poses else self.defaults
-        self.poses.append(template)
-        self._fill(len(self.poses) - 1)
-
-    @on(Button.Pressed, "#pose-delete")
-    def action_delete_pose(self) -> None:
-        row = self.query_one(DataTable).cursor_row
-        if 0 <= row < len(self.poses):
-            del self.poses[row]
-            self._fill(row)
-
-    @on(Button.Pressed, "#poses-ok")
-    def _ok(self) -> None:
-        # typed values are applied first, as Run and Save commit the main form's
-        if self._edited() and not self._apply():
-            return
-        self.dismiss(list(self.poses))
-
-    @on(Button.Pressed, "#poses-cancel")
-    def _cancel(self) -> None:
-        self.dismiss(None)
 
 
 class MeasuresScreen(Dialog):

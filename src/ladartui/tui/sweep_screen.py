@@ -21,7 +21,6 @@ from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal
 from textual.message import Message
-from textual.screen import Screen
 from textual.validation import ValidationResult, Validator
 from textual.widgets import Button, Checkbox, DataTable, Footer, Input, Label, ProgressBar, Static
 from textual_plotext import PlotextPlot
@@ -31,11 +30,9 @@ from ladartui.recent import recent_paths, remember_path
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar, format_eta
 from ladartui.tui.sweep_jobs import sibling_spec, start_resource_tracker, sweep_job, write_best
+from ladartui.tui.sweep_ranking import RankingView
 from ladartui.tui.sweep_view import (
-    detail_text,
-    draw_pareto,
     eta_seconds,
-    fill_ranking_table,
     short_path,
 )
 from ladartui.tui.work import JobDone, JobProgress, start_job
@@ -61,7 +58,7 @@ class ExistingPath(Validator):
         return self.failure(f"{value.strip()}: no such file or folder")
 
 
-class SweepScreen(Screen):
+class SweepScreen(RankingView):
     """Launch a flight-path sweep (or open an earlier one), watch it and rank its variants."""
 
     class OpenScenario(Message):
@@ -489,10 +486,6 @@ class SweepScreen(Screen):
         )
         remember_path("sweeps", path)  # the screen reopens it next time
 
-    def _summary(self) -> str:
-        ok = sum(row.get("status") == "ok" for row in self.rows)
-        return f"{len(self.rows)} variants, {ok} ok, {len(self.rows) - ok} failed"
-
     def _show_stored(self, total: int) -> None:
         """Progress row of opened results: variants in the table out of the spec's."""
         self.query_one("#sweep-progress", ProgressBar).update(total=max(total, 1), progress=len(self.rows))
@@ -568,52 +561,6 @@ class SweepScreen(Screen):
             self._status(NOT_READY, f"sweep cancelled: {kept} in {short_path(self.out)}; F5 resumes")
         else:
             self._status(NOT_READY, f"sweep stopped: {error}")
-
-    def _redraw_if_dirty(self) -> None:
-        if self._dirty:
-            self._rank_quietly()
-            self._redraw()
-
-    def _rank(self) -> None:
-        from ladartui.sweep import rank_rows
-
-        budget = self._budget() if self.objective in BUDGET_OBJECTIVES else None
-        self.ranking = rank_rows(self.rows, self.objective, budget, self.cost)
-
-    def _rank_quietly(self) -> None:
-        try:
-            self._rank()
-        except LadarError:
-            from ladartui.sweep import rank_rows
-
-            self.ranking = rank_rows(self.rows, "obscured-coverage", None, self.cost)
-            self.objective = "obscured-coverage"
-
-    def _redraw(self) -> None:
-        self._dirty = False
-        self._draw_table()
-        self._draw_chart()
-
-    def _draw_table(self) -> None:
-        table = self.query_one("#sweep-table", DataTable)
-        self._shown_ids = fill_ranking_table(
-            table, self.ranking, self.objective, self.cost, self.parameter_names, self._shown_ids
-        )
-        if self.ranking:
-            self._show_detail(table.cursor_row)
-        else:
-            self.query_one("#sweep-detail", Static).update("")
-
-    def _show_detail(self, index: int) -> None:
-        entry = self.ranking[index] if 0 <= index < len(self.ranking) else None
-        self.query_one("#sweep-detail", Static).update(
-            detail_text(entry, self.parameter_names) if entry is not None else ""
-        )
-
-    def _draw_chart(self) -> None:
-        plot = self.query_one("#sweep-chart", PlotextPlot)
-        draw_pareto(plot.plt, self.ranking, self.cost)
-        plot.refresh()
 
     def _fraction(self) -> float | None:
         return self.progress.fraction if self.progress is not None else None

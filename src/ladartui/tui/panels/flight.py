@@ -17,7 +17,8 @@ from ladartui.errors import LadarError
 from ladartui.flight import Manual
 from ladartui.tui import bridge
 from ladartui.tui.params import ParamPanel, field_id
-from ladartui.tui.screens import FormScreen, PosesScreen
+from ladartui.tui.poses_screen import PosesScreen
+from ladartui.tui.screens import FormScreen
 
 if TYPE_CHECKING:
     from ladartui.scenario import Scenario

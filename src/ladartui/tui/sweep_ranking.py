@@ -1,0 +1,87 @@
+"""The sweep screen's ranking: its rows ranked by the objective chosen, drawn as the
+table, the detail line of the selected variant and the Pareto chart.
+
+``SweepScreen`` (tui/sweep_screen.py) is a ``RankingView``: it fills ``rows``
+and chooses the objective, cost and budget; this class ranks and draws.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+from textual.screen import Screen
+from textual.widgets import DataTable, Static
+from textual_plotext import PlotextPlot
+
+from ladartui.errors import LadarError
+from ladartui.sweep.ranking import BUDGET_OBJECTIVES
+from ladartui.tui.sweep_view import detail_text, draw_pareto, fill_ranking_table
+
+if TYPE_CHECKING:
+    from ladartui.sweep.ranking import Ranked
+
+
+class RankingView(Screen):
+    """Ranks ``rows`` by ``objective`` (and ``cost``, the budget) and draws the result."""
+
+    rows: list[dict]
+    parameter_names: list[str]
+    ranking: list[Ranked]
+    objective: str
+    cost: str
+    _dirty: bool  # rows arrived since the last redraw (redrawn a few times a second)
+    _shown_ids: list  # variant ids in table order
+
+    def _budget(self) -> float | None:
+        """The flight-time budget the ranking uses (the screen's field, else the spec's)."""
+        raise NotImplementedError
+
+    def _summary(self) -> str:
+        ok = sum(row.get("status") == "ok" for row in self.rows)
+        return f"{len(self.rows)} variants, {ok} ok, {len(self.rows) - ok} failed"
+
+    def _redraw_if_dirty(self) -> None:
+        if self._dirty:
+            self._rank_quietly()
+            self._redraw()
+
+    def _rank(self) -> None:
+        from ladartui.sweep import rank_rows
+
+        budget = self._budget() if self.objective in BUDGET_OBJECTIVES else None
+        self.ranking = rank_rows(self.rows, self.objective, budget, self.cost)
+
+    def _rank_quietly(self) -> None:
+        try:
+            self._rank()
+        except LadarError:
+            from ladartui.sweep import rank_rows
+
+            self.ranking = rank_rows(self.rows, "obscured-coverage", None, self.cost)
+            self.objective = "obscured-coverage"
+
+    def _redraw(self) -> None:
+        self._dirty = False
+        self._draw_table()
+        self._draw_chart()
+
+    def _draw_table(self) -> None:
+        table = self.query_one("#sweep-table", DataTable)
+        self._shown_ids = fill_ranking_table(
+            table, self.ranking, self.objective, self.cost, self.parameter_names, self._shown_ids
+        )
+        if self.ranking:
+            self._show_detail(table.cursor_row)
+        else:
+            self.query_one("#sweep-detail", Static).update("")
+
+    def _show_detail(self, index: int) -> None:
+        entry = self.ranking[index] if 0 <= index < len(self.ranking) else None
+        self.query_one("#sweep-detail", Static).update(
+            detail_text(entry, self.parameter_names) if entry is not None else ""
+        )
+
+    def _draw_chart(self) -> None:
+        plot = self.query_one("#sweep-chart", PlotextPlot)
+        draw_pareto(plot.plt, self.ranking, self.cost)
+        plot.refresh()
