@@ -209,3 +209,18 @@ async def test_a_view_saves_as_a_png_of_the_requested_size(app_pilot, tmp_path):
     with pytest.raises(LadarError, match="picture size = '5 x 123': expected whole numbers"):
         area.save_png(tmp_path / "bad.png", 5, 123)
     assert not (tmp_path / "bad.png").exists()
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_a_scene_opened_after_a_zoom_is_framed_and_titled_by_its_path(app_pilot):
+    pilot = app_pilot
+    app, area = await reset(pilot)
+    top = app.query_one(TopViewWidget)
+    start = top.frame
+    top.focus()
+    await pilot.press("plus")
+    assert "m across" in top.border_title
+    top.set_scene(top.top, top.target_box)  # as opening a scenario does
+    await pilot.pause()
+    # the window follows the path again, and the title no longer gives the zoom's width
+    assert top.frame == start and top.border_title == "Top view"

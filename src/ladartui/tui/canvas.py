@@ -291,6 +291,7 @@ class TopViewWidget(PictureWidget):
         self.target_box = target_box
         self.framing = "path"
         self._reframe()
+        self._update_title()  # (a zoom's "m across" is the old scene's)
         self.invalidate()
 
     def set_overlay(self, path, scans, footprints) -> None:
