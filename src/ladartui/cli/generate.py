@@ -66,7 +66,7 @@ def overrides_from(args) -> dict:
 def run(args) -> int:
     import numpy as np
 
-    from ladartui.errors import FieldError
+    from ladartui.cli.flags import as_flags
     from ladartui.outputset import check_writable
     from ladartui.scene.generate import generate_scene, output_paths
 
@@ -74,13 +74,9 @@ def run(args) -> int:
     las_files = [scene_file.with_suffix(".laz"), target_file.with_suffix(".laz")] if args.las else []
     check_writable(scene_file, target_file, *las_files)
     started = time.perf_counter()
-    overrides = overrides_from(args)
-    try:
-        scene = generate_scene(args.preset, seed=args.seed, **overrides)
-    except FieldError as error:  # name the flag the user typed, not the parameter
-        if error.field in overrides and getattr(args, error.field, None) is not None:
-            raise FieldError(f"--{error.field.replace('_', '-')}", error.value, error.expected) from None
-        raise
+    typed = {name: getattr(args, name) for name in ("density", "trees", "voxel_size", "vehicles")}
+    with as_flags(typed):  # name the flag the user typed, not the parameter
+        scene = generate_scene(args.preset, seed=args.seed, **overrides_from(args))
     generated = time.perf_counter() - started
     started = time.perf_counter()
     scene_path, target_path = scene.write(args.out)

@@ -13,6 +13,7 @@ import json
 import sys
 import threading
 
+from ladartui.cli.flags import as_flags
 from ladartui.cli.progress import stop_status
 from ladartui.errors import Cancelled, FieldError
 
@@ -69,11 +70,8 @@ def _settings(scenario, args):
         value = getattr(args, flag)
         if value is not None:
             changes[name] = value
-    try:
+    with as_flags({"n_ref": args.n_ref, "seed": args.seed}):
         return dataclasses.replace(settings, **changes)
-    except FieldError as error:  # name the flag the user typed
-        flag = "--" + error.field.rpartition(".")[2].replace("_", "-")
-        raise FieldError(flag, error.value, error.expected) from None
 
 
 def run(args) -> int:
@@ -86,10 +84,8 @@ def run(args) -> int:
     scenario = load_scenario(args.scenario or default_scenario_path())
     settings = _settings(scenario, args)
     if args.backend is not None:  # before any tracing, as run does
-        try:
+        with as_flags({"backend": args.backend}):
             scenario.with_changes(backend=args.backend)
-        except FieldError as error:
-            raise FieldError("--backend", args.backend, error.expected) from None
     errors = Console(stderr=True)
     state = {"last": None}
     try:

@@ -14,6 +14,7 @@ import json
 import threading
 from typing import TYPE_CHECKING
 
+from ladartui.cli.flags import as_flags
 from ladartui.cli.progress import FIRST_SCAN, progress_display, run_cancellable, sigterm_as_interrupt
 from ladartui.errors import Cancelled
 
@@ -74,14 +75,10 @@ def run(args) -> int:
 
     scenario = load_scenario(bundled_or_path(args.scenario))
     # Check the overrides like scenario fields, before any progress is drawn.
-    for name in ("backend", "method", "step", "precision"):
-        value = getattr(args, name)
-        if value is None:
-            continue
-        try:
-            scenario = scenario.with_changes(**{name: value})
-        except FieldError as error:  # name the flag the user typed, not the TOML field
-            raise FieldError(f"--{name}", value, error.expected) from None
+    overrides = {name: getattr(args, name) for name in ("backend", "method", "step", "precision")}
+    overrides = {name: value for name, value in overrides.items() if value is not None}
+    with as_flags(overrides):
+        scenario = scenario.with_changes(**overrides)
     if args.write:  # before any progress is drawn; the run checks again under its lock
         from ladartui.outputset import check_writable
         from ladartui.simulation import check_outputs_spare_inputs, output_paths
@@ -97,8 +94,9 @@ def run(args) -> int:
         if problem:
             raise FieldError("--chart", args.chart, f"a writable path; it {problem}")
     errors = Console(stderr=True)
-    result = _simulate_with_progress(scenario, args, errors)
-    try:
+    finished: list[SimulationResult] = []  # the result, once there is one
+    with _told_if_finished(finished):  # a Ctrl-C from then on says what the run wrote
+        result = _simulate_with_progress(scenario, args, errors, finished)
         if args.chart is not None:
             from ladartui.charts import save_figure
             from ladartui.charts.coverage import coverage_figure
@@ -112,17 +110,7 @@ def run(args) -> int:
             print(json.dumps(result_dict(scenario, result), indent=2, allow_nan=False))
         else:
             show_result(Console(), result)
-    except KeyboardInterrupt:  # the outputs are written by now: say so
-        raise Cancelled(interrupted_after(result)) from None
     return 0
-
-
-def interrupted_after(result) -> str:
-    """What a Ctrl-C once the run has finished leaves: the files it wrote."""
-    written = ", ".join(str(path) for path in result.outputs.values())
-    return "interrupted after the run had finished; " + (
-        f"it wrote {written}" if written else "nothing was written (--no-write)"
-    )
 
 
 def run_progress(console, **options):
@@ -138,12 +126,12 @@ def run_progress(console, **options):
     return progress_display(console, after, **options)
 
 
-def _simulate_with_progress(scenario, args, console):
+def _simulate_with_progress(scenario, args, console, finished: list):
+    """The run's result, also appended to ``finished`` as soon as there is one."""
     from ladartui.simulation import NOTHING_WRITTEN, simulate
 
     cancel = threading.Event()
-    finished: list[SimulationResult] = []  # the result, once there is one
-    with _told_if_finished(finished), run_progress(console, transient=False) as bar:
+    with run_progress(console, transient=False) as bar:
         task = bar.add_task(FIRST_SCAN, total=1.0, rays="")
 
         def report(p):
@@ -172,14 +160,19 @@ def _simulate_with_progress(scenario, args, console):
 
 @contextlib.contextmanager
 def _told_if_finished(finished: list):
-    """A Ctrl-C once the run has a result (as the progress display closes) says what
-    the run wrote rather than just "interrupted"."""
+    """A Ctrl-C once the run has a result (as the progress display closes, or while the
+    chart and the measures are written out) names the files it wrote, not just
+    "interrupted"."""
     try:
         yield
     except KeyboardInterrupt:
         if not finished:
             raise
-        raise Cancelled(interrupted_after(finished[0])) from None
+        written = ", ".join(str(path) for path in finished[0].outputs.values())
+        raise Cancelled(
+            "interrupted after the run had finished; "
+            + (f"it wrote {written}" if written else "nothing was written (--no-write)")
+        ) from None
 
 
 def result_dict(scenario, result) -> dict:

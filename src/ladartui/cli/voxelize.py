@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-import contextlib
 import math
 import threading
 import time
 
+from ladartui.cli.flags import as_flags
 from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt
 from ladartui.errors import Cancelled, FieldError, check_cancelled
 from ladartui.textsafe import one_line
@@ -163,14 +163,14 @@ def _work(args, placement, outputs, console, cancel):
                 done=f"{done:,}/{total:,} {units.get(stage, '')}",
             )
 
-        with _flag_names({"at": args.at} if args.at else {}):
+        with as_flags(_typed(args)):
             result = voxelize(mesh, args.voxel_size, placement, args.solid, progress=report, cancel=cancel)
         check_cancelled(cancel, CANCELLED)
         if not args.into:
             ids = None if args.id is None else np.full(len(result.voxels), args.id, dtype=np.int32)
             save_model(outputs[0], result.voxels, cancel, report, ids)
             return mesh, result, None
-        with _flag_names({"at": args.at} if args.at else {}):
+        with as_flags(_typed(args)):
             insertion = insert_vehicle(
                 scene, target, result.voxels, args.voxel_size, had_target, args.into, target_ids, args.id
             )
@@ -178,17 +178,9 @@ def _work(args, placement, outputs, console, cancel):
         return mesh, result, insertion
 
 
-@contextlib.contextmanager
-def _flag_names(typed: dict):
-    """Name the flag the user typed in the core's field errors (``at`` -> ``--at``), with
-    the text typed (``typed``: field -> text; "-10,-10", not the core's "-10,-10,0")."""
-    try:
-        yield
-    except FieldError as error:
-        if error.field in ("at", "voxel_size", "id"):
-            flag = "--" + error.field.replace("_", "-")
-            raise FieldError(flag, typed.get(error.field, error.value), error.expected) from None
-        raise
+def _typed(args) -> dict:
+    """The flags whose values the core checks (``at``: the text typed, not the position)."""
+    return {"at": args.at, "voxel_size": args.voxel_size, "id": args.id}
 
 
 def _report(console, args, mesh, done, outputs, elapsed) -> None:

@@ -112,7 +112,6 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         self.output_voxels = None
         self.missing_outputs: list[Path] = []
         self.outputs_from: Scenario | None = None  # the settings that made the outputs shown
-        self.run_scenario: Scenario | None = None
         self.threshold: float | None = None
         self.busy: str | None = None
         self.progress: float | None = None
@@ -124,14 +123,15 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         self.keymap, self.keymap_problems = actions.load_keymap()
         self.set_keymap(self.keymap)
 
-    def key_hint(self, command_id: str, short: bool = False) -> str:
-        """The key in force for a command (``actions.key_hint``): F5, Ctrl+S, or ^S when short."""
-        return actions.key_hint(command_id, self.keymap, short)
-
     def key_says(self, command_id: str, words: str) -> str:
         """The key in force and ``words``: ("run", "runs") gives F5 runs; empty when no key runs it."""
-        key = self.key_hint(command_id)
+        key = actions.key_hint(command_id, self.keymap)
         return f"{key} {words}" if key else ""
+
+    def button_text(self, label: str, command_id: str) -> str:
+        """A button's label with the key in force: ("Save", "save") gives Save ^S."""
+        key = actions.key_hint(command_id, self.keymap, short=True)
+        return f"{label} {key}" if key else label
 
     def target_m(self) -> tuple[float, ...]:
         if self.prepared is not None:
@@ -256,8 +256,11 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
             return
         if self.outputs_stale():
             # short: the bar is one line (the Results tab says which settings they came from)
-            reruns = f"; {self.key_hint('run')} reruns" if runs else ""
-            bar.show(NOT_READY, f"{scenario.path.name}{mark}: outputs out of date{reruns}.")
+            reruns = self.key_says("run", "reruns")
+            bar.show(
+                NOT_READY,
+                f"{scenario.path.name}{mark}: outputs out of date" + (f"; {reruns}." if reruns else "."),
+            )
             return
         bar.show(READY, text)
 

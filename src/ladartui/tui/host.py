@@ -47,7 +47,6 @@ class AppHost(App[None]):
     output_voxels: np.ndarray | None
     missing_outputs: list[Path]
     outputs_from: Scenario | None  # the settings that made the outputs shown
-    run_scenario: Scenario | None  # the scenario of the run going or last started
     cwd: Path
     compile_in_child: bool
     # the jobs and the busy state
@@ -86,7 +85,7 @@ class AppHost(App[None]):
     def set_busy(self, message: str | None, progress: float | None = None) -> None:
         raise NotImplementedError
 
-    def key_hint(self, command_id: str, short: bool = False) -> str:
+    def button_text(self, label: str, command_id: str) -> str:
         raise NotImplementedError
 
     def key_says(self, command_id: str, words: str) -> str:

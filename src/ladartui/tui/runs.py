@@ -46,7 +46,6 @@ class RunControl(Host):
             return
         self.running = True
         self.set_busy("Starting the run...", 0.0)
-        self.run_scenario = self.scenario
         self._run_worker(self.scenario, self.scene, self.scenario.fast_mode)
 
     def _run_worker(self, scenario, scene, fast: bool) -> None:
@@ -85,7 +84,7 @@ class RunControl(Host):
             return
         self.result = result
         self.missing_outputs = []
-        self.outputs_from = self.run_scenario
+        self.outputs_from = self.scenario  # (not editable while the run went on)
         self.output_voxels = result.scene_output
         self.show_output()
         self.show_measures(result.measures)

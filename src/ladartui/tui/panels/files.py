@@ -21,14 +21,14 @@ class FilePanel(VerticalScroll):
 
     def compose(self):
         yield Static("", id="file-info")
-        hint = host_of(self).key_hint
+        button = host_of(self).button_text
         with Grid(classes="button-grid file-buttons"):
-            yield Button(f"New {hint('new', True)}".strip(), id="btn-new", compact=True)
-            yield Button(f"Open {hint('open', True)}".strip(), id="btn-open", compact=True)
-            yield Button(f"Save {hint('save', True)}".strip(), id="btn-save", compact=True)
+            yield Button(button("New", "new"), id="btn-new", compact=True)
+            yield Button(button("Open", "open"), id="btn-open", compact=True)
+            yield Button(button("Save", "save"), id="btn-save", compact=True)
             yield Button("Save as", id="btn-save-as", compact=True)
-            yield Button(f"Undo {hint('undo', True)}".strip(), id="btn-undo", compact=True)
-            yield Button(f"Redo {hint('redo', True)}".strip(), id="btn-redo", compact=True)
+            yield Button(button("Undo", "undo"), id="btn-undo", compact=True)
+            yield Button(button("Redo", "redo"), id="btn-redo", compact=True)
         yield Label("Recent scenarios (Enter opens)", classes="heading", id="recent-heading")
         yield OptionList(id="recent", compact=True)
 

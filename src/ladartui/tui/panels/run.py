@@ -50,19 +50,19 @@ class RunPanel(ParamPanel):
             tooltip="Show only the final output, not each scan as it lands",
         )
         with Grid(classes="button-grid run-buttons"):
-            hint = self.host.key_hint
-            yield Button(f"Run {hint('run', True)}".strip(), id="btn-run", variant="success", compact=True)
-            yield Button(f"Save {hint('save', True)}".strip(), id="btn-save-run", compact=True)
+            button = self.host.button_text
+            yield Button(button("Run", "run"), id="btn-run", variant="success", compact=True)
+            yield Button(button("Save", "save"), id="btn-save-run", compact=True)
             yield Button("Cancel", id="btn-cancel-run", variant="error", compact=True, disabled=True)
         with Grid(classes="button-grid run-buttons two-buttons"):
             yield Button(
-                f"Study {hint('study', True)}".strip(),
+                button("Study", "study"),
                 id="btn-study",
                 compact=True,
                 tooltip="Speed against accuracy of every backend and method",
             )
             yield Button(
-                f"Sweep {hint('sweep', True)}".strip(),
+                button("Sweep", "sweep"),
                 id="btn-sweep",
                 compact=True,
                 tooltip="Launch, open or watch a flight-path sweep",
