@@ -149,6 +149,11 @@ async def test_top_view_zooms_pans_and_goes_back_to_the_path(app_pilot):
     x0, y0, x1, y1 = top.frame
     assert x1 - x0 == pytest.approx((start[2] - start[0]) / 1.25)
     assert top.top.to_cells(2 * 5 + 1, 10.5, rows, cols, top.frame) == pytest.approx(under)
+    # a scene opened after a zoom is framed by its path, and the title drops the zoom's width
+    assert "m across" in top.border_title
+    top.set_scene(top.top, top.target_box)  # as opening a scenario does
+    await pilot.pause()
+    assert top.frame == start and top.border_title == "Top view"
 
 
 @pytest.mark.asyncio(loop_scope="module")
@@ -209,18 +214,3 @@ async def test_a_view_saves_as_a_png_of_the_requested_size(app_pilot, tmp_path):
     with pytest.raises(LadarError, match="picture size = '5 x 123': expected whole numbers"):
         area.save_png(tmp_path / "bad.png", 5, 123)
     assert not (tmp_path / "bad.png").exists()
-
-
-@pytest.mark.asyncio(loop_scope="module")
-async def test_a_scene_opened_after_a_zoom_is_framed_and_titled_by_its_path(app_pilot):
-    pilot = app_pilot
-    app, area = await reset(pilot)
-    top = app.query_one(TopViewWidget)
-    start = top.frame
-    top.focus()
-    await pilot.press("plus")
-    assert "m across" in top.border_title
-    top.set_scene(top.top, top.target_box)  # as opening a scenario does
-    await pilot.pause()
-    # the window follows the path again, and the title no longer gives the zoom's width
-    assert top.frame == start and top.border_title == "Top view"
