@@ -41,7 +41,7 @@ def test_json_output_and_files(scenario, capsys):
     out = json.loads(capsys.readouterr().out)
     assert out["backend"] == "numba" and out["scans"] == 2
     assert out["rays_per_scan"] == 32 * 32
-    assert set(out["outputs"]) == {"scene", "target", "measures"}
+    assert set(out["outputs"]) == {"scene", "target", "measures", "record"}
     measures = read_cmf(scenario.measures_file)
     assert out["measures"] == json.loads(json.dumps(measures.to_dict()))
     assert scenario.scene_output.is_file() and scenario.target_output.is_file()
@@ -53,6 +53,7 @@ def test_table_output_and_no_write(scenario, capsys):
     assert "Target coverage" in out and "Shift in mean direction" in out
     assert "numba (march)" in out and "nothing written" in out
     assert not scenario.scene_output.exists() and not scenario.measures_file.exists()
+    assert not scenario.path.with_name("S_Run.toml").exists()
 
 
 def test_ctrl_c_cancels_and_keeps_earlier_outputs(scenario, capsys, monkeypatch):
@@ -110,7 +111,8 @@ def test_ctrl_c_after_the_run_wrote_its_outputs_says_what_it_wrote(scenario, cap
     err = capsys.readouterr().err.strip().splitlines()[-1]
     assert err == (
         "ladartui: interrupted after the run had finished; it wrote "
-        f"{scenario.scene_output}, {scenario.target_output}, {scenario.measures_file}"
+        f"{scenario.scene_output}, {scenario.target_output}, {scenario.measures_file}, "
+        f"{scenario.path.with_name('S_Run.toml')}"
     )
     assert scenario.measures_file.is_file()
 

@@ -209,7 +209,9 @@ async def test_outputs_from_other_settings_are_said_to_be_out_of_date(tmp_path, 
         # the outputs and measures shown are the 8 x 8 run's: said in the bar and the tab
         assert bar.state == NOT_READY
         assert bar.message == f"{scenario.path.name} (modified): outputs out of date; F5 reruns."
-        assert str(info.render()) == f"Measures of {scenario.name}, from the settings before your edits:"
+        assert str(info.render()) == (
+            f"Measures of {scenario.name}, from other settings: the run's are in {scenario.name}_Run.toml"
+        )
         # back to the settings that ran (undo): up to date again, though not yet saved
         await pilot.press("ctrl+z")
         await pilot.pause()
@@ -219,6 +221,42 @@ async def test_outputs_from_other_settings_are_said_to_be_out_of_date(tmp_path, 
         app.set_scenario(app.scenario.with_changes(fast_mode=not app.scenario.fast_mode))
         await pilot.pause()
         assert bar.state == READY
+
+
+async def test_outputs_a_run_made_from_unsaved_settings_are_out_of_date_on_opening(tmp_path, scene_files):
+    from ladartui.sensor import Sensor
+    from ladartui.simulation import simulate
+    from ladartui.tui.status import NOT_READY, READY, StatusBar
+    from test_tui_flow import field
+
+    scenario = make_scenario(tmp_path, scene_files)  # saved with an 8 x 8 grid
+    simulate(scenario.with_changes(sensor=Sensor(grid=12, ray_grid=1, fov=8.0)))  # never saved
+    async with opened(scenario) as (app, pilot):
+        bar = app.query_one(StatusBar)
+        assert bar.state == NOT_READY
+        assert bar.message == f"{scenario.path.name}: outputs out of date; F5 reruns."
+        info = app.query_one("#results-info")
+        assert str(info.render()) == (
+            f"Measures of {scenario.name}, from other settings: the run's are in {scenario.name}_Run.toml"
+        )
+        # typing the settings that ran makes them current again
+        app.action_show_tab("sensor")
+        await type_into(pilot, field(app, "sensor.grid"), "12")
+        assert bar.state == READY and "out of date" not in bar.message
+        assert str(info.render()) == f"Measures of {scenario.name}:"
+
+
+async def test_a_damaged_run_record_is_reported_and_the_outputs_still_shown(tmp_path, scene_files):
+    from ladartui.simulation import simulate
+
+    scenario = make_scenario(tmp_path, scene_files)
+    simulate(scenario)
+    record = scenario.path.with_name(f"{scenario.name}_Run.toml")
+    record.write_text(record.read_text(encoding="utf-8") + "\n[sensor\n", encoding="utf-8")
+    async with opened(scenario) as (app, pilot):
+        assert app.measures is not None and app.output_voxels is not None
+        said = [m for m in app.messages if record.name in m]
+        assert said and "settings of the earlier run not read" in said[-1]
 
 
 async def test_a_committed_value_is_shown_and_named_as_a_number(tmp_path, scene_files):

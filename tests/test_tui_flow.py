@@ -208,7 +208,7 @@ async def test_setup_parameters_run_and_measures(tmp_path, scene_files, monkeypa
             assert path.is_file()
         # the run panel names every file the run wrote, not the measures alone
         said = str(app.query_one("#run-info").render())
-        assert said.endswith("; wrote trial_Scene.txt, trial_Target.txt, trial.cmf"), said
+        assert said.endswith("; wrote trial_Scene.txt, trial_Target.txt, trial.cmf, trial_Run.toml"), said
         written = read_cmf(scenario.measures_file)
         table = app.query_one("#measures")
         shown = [tuple(str(c) for c in table.get_row_at(i)) for i in range(table.row_count)]

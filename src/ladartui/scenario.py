@@ -157,6 +157,11 @@ class Scenario:
     def measures_file(self) -> Path:
         return self.path.with_name(f"{self.path.stem}.cmf")
 
+    @property
+    def run_record(self) -> Path:
+        """The settings a run went with, written with its outputs (ladartui.run_record)."""
+        return self.path.with_name(f"{self.path.stem}_Run.toml")
+
     # -- use --
 
     def poses(self) -> list[ScanPose]:
@@ -270,7 +275,7 @@ class Scenario:
                 else []
             ),
             f"outputs    {self.scene_output.name}, {self.target_output.name}, "
-            f"{self.measures_file.name} in {self.path.parent}",
+            f"{self.measures_file.name}, {self.run_record.name} in {self.path.parent}",
         ]
         return "\n".join(lines)
 
@@ -315,10 +320,14 @@ class Scenario:
     def to_toml(self) -> str:
         header = (
             f"# ladartui scenario. Check it with: ladartui validate {self.path.name}\n"
-            f"# A run writes {self.scene_output.name}, {self.target_output.name} and "
-            f"{self.measures_file.name} beside this file.\n\n"
+            f"# A run writes {self.scene_output.name}, {self.target_output.name}, "
+            f"{self.measures_file.name} and {self.run_record.name} beside this file.\n\n"
         )
-        return header + _compact_arrays(tomli_w.dumps(self.to_dict()))
+        return header + self.toml_body()
+
+    def toml_body(self) -> str:
+        """The TOML document without the header comments."""
+        return _compact_arrays(tomli_w.dumps(self.to_dict()))
 
     def save(self, path=None) -> Scenario:
         """Write the scenario atomically to ``path`` (default: its own path).

@@ -26,6 +26,7 @@ import numpy as np
 from ladartui.errors import check_cancelled
 from ladartui.measures import Measures, compute_measures
 from ladartui.returns import fuse_scans, kept_returns
+from ladartui.run_record import as_run, check_record_spare, record_path, record_text
 from ladartui.tracing.config import SCAN_BLOCK
 
 RUNS = ("scene", "target")
@@ -112,8 +113,9 @@ def simulate(
     per run when a scan is complete; ``cancel`` is checked between chunks and
     stops the run with ``Cancelled`` before anything is written. With
     ``write`` the fused outputs (``S_Scene.txt``, ``S_Target.txt``, and with
-    ``las`` also ``.las`` copies) and the measures (``S.cmf``) are written
-    atomically once both runs are done. ``scene`` may pass the scenario's
+    ``las`` also ``.las`` copies), the measures (``S.cmf``) and the settings
+    as run (``S_Run.toml``, ladartui.run_record) are written atomically once
+    both runs are done. ``scene`` may pass the scenario's
     already loaded ``Scene`` (its occupancy is built once and kept).
     """
     with contextlib.ExitStack() as stack:
@@ -172,7 +174,8 @@ def _simulate(scenario, backend, method, step, precision, progress, cancel, outp
     if output_set is not None:
         check_cancelled(cancel, NOTHING_WRITTEN)
         tick = time.perf_counter()
-        outputs = _write_outputs(output_set, scene_output, target_output, measures, scene, cancel)
+        record = record_text(as_run(scenario, backend, method, step, precision), scenario.path)
+        outputs = _write_outputs(output_set, scene_output, target_output, measures, record, scene, cancel)
         timings["write"] = time.perf_counter() - tick
     timings["total"] = time.perf_counter() - started
     return SimulationResult(
@@ -354,6 +357,7 @@ def output_paths(scenario, las=False) -> dict[str, Path]:
         "scene": Path(scenario.scene_output),
         "target": Path(scenario.target_output),
         "measures": Path(scenario.measures_file),
+        "record": record_path(scenario),
     }
     if las:
         paths["scene_las"] = paths["scene"].with_suffix(".las")
@@ -365,7 +369,8 @@ def check_outputs_spare_inputs(scenario, las=False) -> None:
     """Refuse a run whose outputs would overwrite its own model files.
 
     A scenario ``S.toml`` writes ``S_Target.txt``: with the scene model named
-    ``S.txt`` beside it, that is the target model itself.
+    ``S.txt`` beside it, that is the target model itself. Nor may a run replace
+    a file of its record's name that is not a run record (``run_record``).
     """
     from ladartui.errors import FieldError
 
@@ -379,6 +384,7 @@ def check_outputs_spare_inputs(scenario, las=False) -> None:
                 f"{path.name} would overwrite a model file",
                 source=str(scenario.path),
             )
+    check_record_spare(scenario)
 
 
 def _output_set(scenario, las):
@@ -389,7 +395,7 @@ def _output_set(scenario, las):
     return OutputSet(output_paths(scenario, las), path.with_name(f".{path.stem}.outputs.lock"))
 
 
-def _write_outputs(output_set, scene_output, target_output, measures, scene, cancel) -> dict:
+def _write_outputs(output_set, scene_output, target_output, measures, record, scene, cancel) -> dict:
     """Write every output of the set to a temporary file, then swap them all in together.
 
     LAS outputs carry each voxel's target id as its point source id (0: not a target voxel).
@@ -400,6 +406,7 @@ def _write_outputs(output_set, scene_output, target_output, measures, scene, can
         "scene": lambda tmp: save_voxels(tmp, scene_output),
         "target": lambda tmp: save_voxels(tmp, target_output),
         "measures": lambda tmp: tmp.write_text(measures.to_cmf(), encoding="utf-8"),
+        "record": lambda tmp: tmp.write_text(record, encoding="utf-8"),
     }
     if "scene_las" in output_set.paths:
         from ladartui.scene.las import export_las

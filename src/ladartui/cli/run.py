@@ -27,8 +27,9 @@ def add_parser(subparsers):
         "run",
         help="simulate a scenario's collection and score it",
         description="Trace every scan of the scenario against the scene (obscured) and the "
-        "target alone (unobscured), fuse the returns, write S_Scene.txt, S_Target.txt and "
-        "S.cmf beside the scenario, and show the measures of effectiveness.",
+        "target alone (unobscured), fuse the returns, write S_Scene.txt, S_Target.txt, "
+        "S.cmf and S_Run.toml (the settings the run went with, flags included) beside the "
+        "scenario, and show the measures of effectiveness.",
     )
     parser.add_argument(
         "scenario",

@@ -25,6 +25,7 @@ from textual.screen import Screen
 from textual.widgets import Button, Footer, TabbedContent, TabPane
 
 from ladartui.edit_history import EditHistory
+from ladartui.run_record import record_path
 from ladartui.scenario import Scenario
 from ladartui.tui import actions, bridge
 from ladartui.tui.canvas import ProjectionWidget, TopViewWidget
@@ -311,8 +312,17 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
     def show_measures(self, measures) -> None:
         self.measures = measures
         self.results_panel.show_measures(
-            measures, self.scenario.name if self.scenario else "", stale=self.outputs_stale()
+            measures, self.scenario.name if self.scenario else "", made_with=self.outputs_made_with()
         )
+
+    def outputs_made_with(self) -> str | None:
+        """Which other settings made the outputs shown, in words; None: the scenario's now."""
+        if not self.outputs_stale():
+            return None
+        record = record_path(self.scenario)
+        if record.is_file():  # written by every run since records exist
+            return f"other settings: the run's are in {record.name}"
+        return "the settings before your edits:"
 
     def outputs_stale(self) -> bool:
         """Whether the outputs shown came from other settings than the scenario's now."""

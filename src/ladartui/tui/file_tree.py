@@ -6,8 +6,10 @@ from pathlib import Path
 
 from textual.widgets import DirectoryTree
 
+from ladartui.run_record import is_record
+
 # A scenario file has a [files] table (scenario.py); other .toml files (pyproject.toml,
-# sweep specs) are not scenarios.
+# sweep specs) are not scenarios, nor are run records (outputs, though they have one).
 SCENARIO_TABLE = "[files]"
 HEAD_BYTES = 65536  # how much of a .toml is read to find the table
 
@@ -30,7 +32,11 @@ class FileTree(DirectoryTree):
         suffix = path.suffix.lower()
         if suffix not in self.suffixes:
             return False
-        return suffix != ".toml" or self.toml_table is None or opens_table(path, self.toml_table)
+        if suffix != ".toml" or self.toml_table is None:
+            return True
+        if not opens_table(path, self.toml_table):
+            return False
+        return self.toml_table != SCENARIO_TABLE or not is_record(path)
 
 
 def opens_table(path: Path, table: str) -> bool:

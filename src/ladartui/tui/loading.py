@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 from ladartui.errors import LadarError
 from ladartui.recent import remember_scenario
+from ladartui.run_record import read_run_record
 from ladartui.tui import bridge
 from ladartui.tui.host import Host
 from ladartui.tui.view_area import prepare_views
@@ -37,6 +38,7 @@ class Loaded:
     prepared: dict[str, Any]
     output: np.ndarray | None
     measures: Measures | None
+    ran: Scenario | None  # the settings that made them (the run record), if recorded
     warning: str | None
 
 
@@ -56,7 +58,8 @@ class SceneLoading(Host):
         self.view_area.set_scene(done.prepared, done.scene.voxel_size)
         self.missing_outputs = bridge.missing_outputs(done.scenario)
         shown = done.output is not None or done.measures is not None
-        self.outputs_from = done.scenario if shown else None  # as saved: what wrote them
+        # what made them: the run record, else (a set older than records) the file
+        self.outputs_from = (done.ran or done.scenario) if shown else None
         self.set_scenario(done.scenario, modified=False)
         if done.scenario.path.is_file():
             remember_scenario(done.scenario.path)
@@ -92,12 +95,17 @@ def _load(path: Path | None, scenario) -> Loaded:
         scenario = bridge.load_checked(path)
     scene = scenario.load_scene()
     prepared = prepare_views(scene)
-    warning = None
+    warning, ran = None, None
     try:
         output, measures = _existing_results(scenario)
     except LadarError as error:  # old results must not stop the scenario loading
         output, measures, warning = None, None, f"earlier results not shown: {error}"
-    return Loaded(scenario, scene, prepared, output, measures, warning)
+    if output is not None:
+        try:
+            ran = read_run_record(scenario)
+        except LadarError as error:
+            warning = f"settings of the earlier run not read, taken as the file's: {error}"
+    return Loaded(scenario, scene, prepared, output, measures, ran, warning)
 
 
 def _warm_up(scenario, scene, compile_in_child: bool, cancel) -> None:

@@ -11,9 +11,6 @@ from ladartui.measures import Measures
 from ladartui.tui.host import host_of
 from ladartui.tui.measures_view import compact_rows, level_rows, target_rows
 
-# Where measures made before the scenario's latest edits came from (this tab).
-EARLIER_SETTINGS = "the settings before your edits"
-
 
 class ResultsPanel(VerticalScroll):
     DEFAULT_CLASSES = "pane"
@@ -40,15 +37,16 @@ class ResultsPanel(VerticalScroll):
         runs = host_of(self).key_says("run", "runs the scenario")
         return "No results yet" + (f": {runs}." if runs else ".")
 
-    def show_measures(self, measures, name: str = "", stale: bool = False) -> None:
-        """The measures of ``name``'s outputs; ``stale``: made with other settings."""
+    def show_measures(self, measures, name: str = "", made_with: str | None = None) -> None:
+        """The measures of ``name``'s outputs; ``made_with``: the other settings that
+        made them (None: the scenario's now)."""
         table = self.query_one("#measures", DataTable)
         table.clear()
         info = self.query_one("#results-info", Static)
         if measures is None:
             info.update(self._no_results())
             return
-        info.update(f"Measures of {name}" + (f", from {EARLIER_SETTINGS}:" if stale else ":"))
+        info.update(f"Measures of {name}" + (f", from {made_with}" if made_with else ":"))
         for label, value in compact_rows(measures):
             table.add_row(Text(label), Text(value))  # text from a file: never markup
         if isinstance(measures, Measures):

@@ -1,0 +1,78 @@
+"""The run record: the settings that made a run's outputs, written beside them.
+
+A run of ``S.toml`` writes ``S_Run.toml`` with ``S_Scene.txt``, ``S_Target.txt``
+and ``S.cmf``, in the same all-or-nothing output set. It is a whole scenario
+file: the settings as they ran, which need not be the saved ones (the TUI runs
+unsaved edits; ``ladartui run --method`` overrides the file). Opening ``S.toml``
+compares it with the record to say whether the outputs are out of date. A set
+written before records existed has none; it then counts as the saved file's.
+
+A file of that name that is not a record (its first line is not
+``RECORD_HEADER``) is the analyst's own: a run refuses to replace it.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ladartui.errors import LadarError, OutputFileError
+
+RECORD_HEADER = "# ladartui run record"
+
+
+def record_path(scenario) -> Path:
+    """Where a run of ``scenario`` writes its record."""
+    return scenario.run_record
+
+
+def as_run(scenario, backend=None, method=None, step=None, precision=None):
+    """``scenario`` as a run with these overrides (None: the scenario's own) goes,
+    placed at its record's path."""
+    overrides = {"backend": backend, "method": method, "step": step, "precision": precision}
+    changes = {key: value for key, value in overrides.items() if value is not None}
+    return scenario.with_changes(path=record_path(scenario), **changes)
+
+
+def record_text(ran, scenario_path) -> str:
+    """The record's text for ``ran`` (``as_run``), a run of ``scenario_path``."""
+    name = Path(scenario_path).name
+    stem = Path(scenario_path).stem
+    header = (
+        f"{RECORD_HEADER}: the settings that made {stem}_Scene.txt, {stem}_Target.txt and "
+        f"{stem}.cmf,\n# written with them by a run of {name} (replaced by its next run).\n"
+        f"# They may differ from {name}: a run can go with unsaved edits or flags.\n\n"
+    )
+    return header + ran.toml_body()
+
+
+def is_record(path) -> bool:
+    """Whether ``path`` is a run record (by its first line)."""
+    try:
+        with open(path, encoding="utf-8") as file:
+            return file.readline().startswith(RECORD_HEADER)
+    except (OSError, UnicodeDecodeError):
+        return False
+
+
+def check_record_spare(scenario) -> None:
+    """Refuse a run that would replace a file of the record's name that is not one."""
+    path = record_path(scenario)
+    if path.exists() and not is_record(path):
+        raise OutputFileError(
+            path,
+            f"exists and is not a run record of {Path(scenario.path).name} (a run writes its "
+            "settings there): rename that file",
+        )
+
+
+def read_run_record(scenario):
+    """The settings that made ``scenario``'s outputs, from its record; None when
+    there is none. A record that cannot be read raises ``LadarError`` naming it."""
+    from ladartui.scenario import load_scenario
+
+    path = record_path(scenario)
+    if not path.is_file():
+        return None
+    if not is_record(path):
+        raise LadarError(f"{path}: not a run record (its first line is not {RECORD_HEADER!r})")
+    return load_scenario(path, check_files=False)
