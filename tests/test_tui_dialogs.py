@@ -285,6 +285,26 @@ async def test_the_scans_table_fits_the_sidebar_at_120_columns(tmp_path, scene_f
         assert not any(str(cell) == "-0" for i in range(scans.row_count) for cell in scans.get_row_at(i))
 
 
+async def test_the_segments_table_fits_the_sidebar_and_wraps_a_long_detail(tmp_path, scene_files):
+    from ladartui.flight import FlightPlan, Standoff
+
+    scenario = make_scenario(tmp_path, scene_files)
+    far = Standoff(target=(30.0, 30.0, 1.0), standoffs=(40.0, 55.0, 70.0, 85.0, 100.0), altitude=50.0)
+    scenario = scenario.with_changes(flight=FlightPlan(None, (*scenario.flight.segments, far))).save()
+    for size in ((80, 24), (120, 40)):
+        async with opened(scenario, size=size) as (app, pilot):
+            app.action_show_tab("flight")
+            await pilot.pause()
+            table = app.query_one("#segments")
+            # no sideways scrolling (a detail cut at the edge read "at 6" for "at 60"):
+            # a detail too long for the sidebar goes on over more lines, whole
+            assert table.max_scroll_x == 0, size
+            details = [str(table.get_row_at(i)[3]) for i in range(table.row_count)]
+            assert details == ["r 30 m at 30 m", "40, 55, 70, 85, 100 m"]
+            heights = [table.rows[row.key].height for row in table.ordered_rows]
+            assert heights[1] > 1 and heights[0] == (2 if size == (80, 24) else 1)
+
+
 async def test_the_new_scenario_dialog_refuses_in_the_forms_words(tmp_path, scene_files):
     from ladartui.tui.file_dialogs import SetupScreen
 

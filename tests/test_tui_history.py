@@ -7,6 +7,7 @@ analyst would with the keyboard.
 from __future__ import annotations
 
 import pytest
+from rich.text import Text
 
 from ladartui.flight import FlightPlan, ScanPose, Straight
 from ladartui.recent import recent_scenarios
@@ -314,7 +315,7 @@ async def test_a_flight_log_segment_is_listed_and_says_where_it_is_edited(tmp_pa
 
     from ladartui.trajectory import LogSegment
 
-    log = tmp_path / "flight-log.csv"
+    log = tmp_path / "[b]flight-log.csv"  # brackets: text from a file is never markup
     shutil.copy(Path(__file__).parents[1] / "scenarios" / "flight-log.csv", log)
     scenario = make_scenario(tmp_path, scene_files)
     scenario = scenario.with_changes(
@@ -327,8 +328,10 @@ async def test_a_flight_log_segment_is_listed_and_says_where_it_is_edited(tmp_pa
         await pilot.pause()
         table = app.query_one("#segments")
         assert table.row_count == 2
-        row = [str(cell) for cell in table.get_row_at(1)]
-        assert row[1] == "Flight log" and row[3] == "flight-log.csv, 2 Hz"
+        cells = table.get_row_at(1)
+        row = [str(cell) for cell in cells]
+        assert row[1] == "Flight log" and row[3] == "[b]flight-log.csv, 2 Hz"
+        assert isinstance(cells[3], Text)  # drawn as it is: a str cell would be read as markup
         table.move_cursor(row=1)
         app.action_edit_segment()
         await pilot.pause()
