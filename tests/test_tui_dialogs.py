@@ -259,6 +259,21 @@ async def test_a_damaged_run_record_is_reported_and_the_outputs_still_shown(tmp_
         assert said and "settings of the earlier run not read" in said[-1]
 
 
+async def test_run_says_why_it_is_off_when_pressed(tmp_path, scene_files):
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario) as (app, pilot):
+        await wait_until(pilot, lambda: app.backend_rows is not None)
+        panel = app.run_panel  # the backend the scenario names is not there
+        panel.backend_rows = [
+            (n, note, ok and n != app.scenario.backend) for n, note, ok in panel.backend_rows
+        ]
+        app.refresh_status()
+        await pilot.press("f5")
+        await pilot.pause()
+        assert app.check_action("run", ()) is None and not app.run_in_progress()
+        assert app.messages[-1] == f"Run is off: backend {app.scenario.backend} unavailable."
+
+
 async def test_a_committed_value_is_shown_and_named_as_a_number(tmp_path, scene_files):
     from test_tui_flow import field
 

@@ -254,8 +254,9 @@ async def test_a_run_disables_controls_and_cancel_keeps_earlier_outputs(tmp_path
         assert enabled == ["btn-cancel-run"]
         assert not app.query_one("#status #cancel").disabled
         assert app.check_action("save", ()) is None and app.check_action("run", ()) is None
-        await pilot.press("ctrl+s")  # does nothing while busy
+        await pilot.press("ctrl+s")  # does nothing while busy, and says why
         assert scenario.path.read_bytes() == saved
+        assert app.messages[-1] == "Save scenario is off while the run goes on; Esc cancels the run."
         await pilot.press("escape")
         await wait_until(pilot, lambda: app.busy is None, timeout=30)
         assert "cancelled" in app.messages[-1].lower()

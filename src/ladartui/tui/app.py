@@ -16,7 +16,7 @@ import os
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from textual import on
+from textual import events, on
 from textual.app import App, ComposeResult, SystemCommand
 from textual.containers import Horizontal, Vertical
 from textual.css.query import NoMatches
@@ -276,6 +276,22 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         if action == "run" and self.problems(fields=False):
             return None
         return True
+
+    def on_key(self, event: events.Key) -> None:
+        """A key whose command is off (dimmed in the footer) says why, not nothing."""
+        if len(self.screen_stack) > 1:  # a dialog or tool screen: its own keys
+            return
+        active = self.screen.active_bindings.get(event.key)
+        if active is None or active.enabled:
+            return
+        what = active.binding.description or active.binding.action
+        if self.run_in_progress():
+            cancel = self.key_says("cancel", "cancels the run")
+            self.tell(f"{what} is off while the run goes on" + (f"; {cancel}." if cancel else "."), timeout=3)
+        elif self.busy is not None:
+            self.tell(f"{what} is off while busy: {self.busy}", timeout=3)
+        elif active.binding.action == "run" and (problems := self.problems(fields=False)):
+            self.tell(f"Run is off: {'; '.join(problems)}.", timeout=3)
 
     # -- flight path (the palette and keys reach the flight panel through these) -------
 
