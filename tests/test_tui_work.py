@@ -97,3 +97,39 @@ async def test_a_study_whose_tracer_fails_unexpectedly_reports_it_and_the_app_st
         assert "error: RuntimeError: the tracer fell over" in str(status.render())
         assert app.is_running and app.screen is screen
         assert not screen.query_one("#study-quick").disabled  # ready to try again
+
+
+async def test_ctrl_x_cancels_a_study_as_it_cancels_a_run_and_a_sweep(tmp_path, scene_files, monkeypatch):
+    import threading
+
+    import ladartui.study.run as study_run
+    from ladartui.errors import Cancelled
+    from ladartui.tui.study_screen import StudyScreen
+
+    started = threading.Event()
+
+    def until_cancelled(*args, cancel=None, **kwargs):
+        started.set()
+        while not cancel.wait(0.02):
+            pass
+        raise Cancelled("study cancelled")
+
+    monkeypatch.setattr(study_run, "run_study", until_cancelled)
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=(120, 40)) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        await pilot.press("f11")
+        await pilot.pause()
+        screen = app.screen
+        assert isinstance(screen, StudyScreen)
+        await pilot.press("q")
+        await wait_until(pilot, started.is_set)
+        await pilot.press("ctrl+x")
+        status = screen.query_one("#study-status", Static)
+        await wait_until(pilot, lambda: "study cancelled" in str(status.render()))
+        assert app.screen is screen  # cancelled, still on the study screen
+    # the main screen's Cancel takes Ctrl+X as well as Esc
+    from ladartui.tui.actions import keys_in_force
+
+    assert keys_in_force(None)["cancel"].split(",") == ["escape", "ctrl+x"]

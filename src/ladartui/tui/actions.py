@@ -54,7 +54,10 @@ COMMANDS = [
     Command("undo", "undo", "ctrl+z", "Undo", "Undo the last change to the scenario"),
     Command("redo", "redo", "ctrl+y", "Redo", "Apply the last undone change again"),
     Command("run", "run", "f5", "Run simulation", "Run the scenario", "Run"),
-    Command("cancel", "cancel_run", "escape", "Cancel run", "Stop the run; earlier outputs stay", "Cancel"),
+    # Ctrl+X as on the study and sweep screens, where Esc leaves the screen
+    Command(
+        "cancel", "cancel_run", "escape,ctrl+x", "Cancel run", "Stop the run; earlier outputs stay", "Cancel"
+    ),
     Command("panel", "toggle_panel", "f4", "Toggle parameter panel", "Hide or show the sidebar"),
     Command("layout", "next_layout", "f6", "Next layout", "Cycle the five view layouts", "Layout"),
     Command("angle", "view_angle", "f7", "View angle", "Exact azimuth and elevation of the 3D views"),

@@ -28,7 +28,7 @@ class StudyScreen(Screen):
     BINDINGS = [
         Binding("q", "run('quick')", "Quick study"),
         Binding("f", "run('full')", "Full study"),
-        Binding("c", "cancel", "Cancel"),
+        Binding("ctrl+x", "cancel", "Cancel", priority=True),  # as on the sweep screen and the main one
         Binding("escape", "close", "Back"),
     ]
     DEFAULT_CSS = """
