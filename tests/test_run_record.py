@@ -12,7 +12,7 @@ import pytest
 
 from ladartui.cli import main
 from ladartui.errors import LadarError
-from ladartui.run_record import RECORD_HEADER, read_run_record
+from ladartui.run_record import RECORD_HEADER, read_run_record, setting_changes
 from ladartui.scenario import load_scenario
 from ladartui.simulation import simulate
 from ladartui.tui import bridge
@@ -72,3 +72,41 @@ def test_a_damaged_record_is_reported_naming_the_file(scenario):
     with pytest.raises(LadarError) as caught:
         read_run_record(scenario)
     assert "S_Run.toml" in str(caught.value)
+
+
+def test_the_settings_that_differ_are_named_with_both_values(scenario):
+    simulate(scenario, method="march", step=0.25)
+    ran = read_run_record(scenario)
+    assert setting_changes(ran, scenario) == ["simulation.method march (here exact)"]
+    # the step only counts for the march; in a run of it, it does
+    marched = scenario.with_changes(method="march")
+    assert setting_changes(ran, marched) == ["simulation.step 0.25 (here 0.5)"]
+    assert setting_changes(ran, scenario.with_changes(method="march", step=0.25, backend="auto")) == []
+    wider = scenario.with_changes(sensor=scenario.sensor.__class__(grid=16, ray_grid=2, fov=25.0))
+    assert "sensor.fov_deg 20 (here 25)" in setting_changes(ran, wider)
+
+
+def test_validate_says_whether_the_outputs_came_from_this_file(scenario, capsys):
+    assert main(["validate", str(scenario.path)]) == 0
+    assert "last run" not in capsys.readouterr().out  # nothing run yet
+    assert main(["run", str(scenario.path), "--method", "march"]) == 0
+    capsys.readouterr()
+    assert main(["validate", str(scenario.path)]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("last run"))
+    assert line == (
+        "last run   made the outputs with other settings than this file: "
+        "simulation.method march (here exact); they are in S_Run.toml"
+    )
+    assert main(["run", str(scenario.path)]) == 0
+    capsys.readouterr()
+    assert main(["validate", str(scenario.path)]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("last run"))
+    assert line == "last run   made the outputs with this file's settings (S_Run.toml)"
+
+
+def test_a_step_flag_on_an_exact_run_does_not_make_its_outputs_out_of_date(scenario):
+    simulate(scenario, step=0.25)  # the exact method takes no step
+    ran = read_run_record(scenario)
+    assert ran.same_outputs(scenario) and setting_changes(ran, scenario) == []
+    marched = read_run_record(scenario).with_changes(method="march")
+    assert not marched.same_outputs(scenario.with_changes(method="march"))

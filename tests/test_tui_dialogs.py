@@ -210,7 +210,8 @@ async def test_outputs_from_other_settings_are_said_to_be_out_of_date(tmp_path, 
         assert bar.state == NOT_READY
         assert bar.message == f"{scenario.path.name} (modified): outputs out of date; F5 reruns."
         assert str(info.render()) == (
-            f"Measures of {scenario.name}, from other settings: the run's are in {scenario.name}_Run.toml"
+            f"Measures of {scenario.name}, from other settings: sensor.grid 8 (here 12). "
+            f"The run's are in {scenario.name}_Run.toml."
         )
         # back to the settings that ran (undo): up to date again, though not yet saved
         await pilot.press("ctrl+z")
@@ -237,7 +238,8 @@ async def test_outputs_a_run_made_from_unsaved_settings_are_out_of_date_on_openi
         assert bar.message == f"{scenario.path.name}: outputs out of date; F5 reruns."
         info = app.query_one("#results-info")
         assert str(info.render()) == (
-            f"Measures of {scenario.name}, from other settings: the run's are in {scenario.name}_Run.toml"
+            f"Measures of {scenario.name}, from other settings: sensor.grid 12 (here 8). "
+            f"The run's are in {scenario.name}_Run.toml."
         )
         # typing the settings that ran makes them current again
         app.action_show_tab("sensor")

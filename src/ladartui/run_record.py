@@ -18,6 +18,8 @@ from pathlib import Path
 from ladartui.errors import LadarError, OutputFileError
 
 RECORD_HEADER = "# ladartui run record"
+# Scenario keys that change no output (Scenario.same_outputs says the same).
+RUN_ONLY_KEYS = ("simulation.backend", "simulation.fast_mode")
 
 
 def record_path(scenario) -> Path:
@@ -76,3 +78,42 @@ def read_run_record(scenario):
     if not is_record(path):
         raise LadarError(f"{path}: not a run record (its first line is not {RECORD_HEADER!r})")
     return load_scenario(path, check_files=False)
+
+
+def setting_changes(ran, scenario) -> list[str]:
+    """The settings that made the outputs (``ran``, the record) where they differ from
+    ``scenario``'s, as "sensor.grid 12 (here 8)", in file order; empty when a run of
+    ``scenario`` writes the same (``Scenario.same_outputs``)."""
+    was, now = _flat(ran.to_dict()), _flat(scenario.to_dict())
+    ignored = set(RUN_ONLY_KEYS)
+    if not ran.method == scenario.method == "march":
+        ignored.add("simulation.step")  # as Scenario.same_outputs
+    keys = [*was, *(key for key in now if key not in was)]
+    return [
+        f"{key} {_shown(was.get(key))} (here {_shown(now.get(key))})"
+        for key in keys
+        if key not in ignored and was.get(key) != now.get(key)
+    ]
+
+
+def _flat(data, prefix: str = "") -> dict:
+    """Nested TOML data as dotted keys; a list of tables by index (flight.segments.1.radius)."""
+    out = {}
+    items = data.items() if isinstance(data, dict) else enumerate(data, start=1)
+    for key, value in items:
+        name = f"{prefix}{key}"
+        if isinstance(value, dict) or (isinstance(value, list) and value and isinstance(value[0], dict)):
+            out.update(_flat(value, name + "."))
+        else:
+            out[name] = value
+    return out
+
+
+def _shown(value) -> str:
+    if value is None:
+        return "none"
+    if isinstance(value, float):
+        return f"{value:g}"
+    if isinstance(value, list):
+        return "[" + ", ".join(_shown(v) for v in value) + "]"
+    return str(value)

@@ -202,11 +202,15 @@ class Scenario:
     def same_outputs(self, other: Scenario) -> bool:
         """Whether a run of ``other`` writes what a run of this scenario writes: every
         field equal but the file's name and what only changes how a run goes (the
-        backend, whose answers are the same, and fast mode, which draws less)."""
+        backend, whose answers are the same, and fast mode, which draws less), and
+        the march's step unless both march."""
+        ignored = RUN_ONLY_FIELDS
+        if not self.method == other.method == "march":
+            ignored += ("step",)  # the march's step (methods that differ differ already)
         return all(
             getattr(self, f.name) == getattr(other, f.name)
             for f in dataclasses.fields(self)
-            if f.name not in RUN_ONLY_FIELDS
+            if f.name not in ignored
         )
 
     @classmethod

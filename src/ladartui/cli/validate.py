@@ -10,7 +10,8 @@ def add_parser(subparsers):
         description="Load a scenario, check every field against its limits, read and check its "
         "scene and target model files, estimate the memory the tracing structures need, then "
         "print a summary (sensor, scans, path length, flight time, scene size, memory, "
-        "outputs). A mistake is reported on one line with exit status 2.",
+        "outputs, and whether the outputs on disk came from this file's settings). A mistake "
+        "is reported on one line with exit status 2.",
     )
     parser.add_argument(
         "scenario",
@@ -28,9 +29,30 @@ def run(args) -> int:
     scenario = load_scenario(bundled_or_path(args.scenario))
     scene_lines = scene_summary(scenario)
     print(scenario.summary())
-    for line in scene_lines:
+    for line in [*scene_lines, *last_run_lines(scenario)]:
         print(line)
     return 0
+
+
+def last_run_lines(scenario) -> list[str]:
+    """Whether the outputs on disk came from this file's settings (the run record)."""
+    from ladartui.errors import LadarError
+    from ladartui.run_record import read_run_record, setting_changes
+
+    if not scenario.measures_file.is_file():
+        return []  # not run yet
+    record = scenario.run_record.name
+    try:
+        ran = read_run_record(scenario)
+    except LadarError as error:  # the scenario is still valid: say so, and why not the rest
+        return [f"last run   settings not read: {error}"]
+    if ran is None:
+        return ["last run   settings not recorded (outputs written before run records)"]
+    changes = setting_changes(ran, scenario)
+    if not changes:
+        return [f"last run   made the outputs with this file's settings ({record})"]
+    shown = "; ".join(changes[:4]) + (f"; and {len(changes) - 4} more" if len(changes) > 4 else "")
+    return [f"last run   made the outputs with other settings than this file: {shown}; they are in {record}"]
 
 
 def scene_summary(scenario) -> list[str]:

@@ -25,7 +25,7 @@ from textual.screen import Screen
 from textual.widgets import Button, Footer, TabbedContent, TabPane
 
 from ladartui.edit_history import EditHistory
-from ladartui.run_record import record_path
+from ladartui.run_record import record_path, setting_changes
 from ladartui.scenario import Scenario
 from ladartui.tui import actions, bridge
 from ladartui.tui.canvas import ProjectionWidget, TopViewWidget
@@ -335,10 +335,12 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         """Which other settings made the outputs shown, in words; None: the scenario's now."""
         if not self.outputs_stale():
             return None
+        changes = setting_changes(self.outputs_from, self.scenario)
+        differ = "; ".join(changes[:2]) + ("; ..." if len(changes) > 2 else "")
         record = record_path(self.scenario)
         if record.is_file():  # written by every run since records exist
-            return f"other settings: the run's are in {record.name}"
-        return "the settings before your edits:"
+            return f"other settings: {differ}. The run's are in {record.name}."
+        return f"the settings before your edits: {differ}."
 
     def outputs_stale(self) -> bool:
         """Whether the outputs shown came from other settings than the scenario's now."""

@@ -33,7 +33,7 @@ class SegmentsTable(DataTable):
     """The segments table; a new width (the sidebar's scrollbar coming or going
     changes it too) refits its details."""
 
-    fitted_width = 0  # the width its details were last cut to
+    fitted_width = 0  # the width its details were last wrapped to
 
     def on_resize(self, event: events.Resize) -> None:
         if event.size.width != self.fitted_width:
@@ -69,7 +69,7 @@ class FlightPanel(ParamPanel):
         self.query_one("#scans", DataTable).add_columns("#", "x", "y", "z", "hdg", "az", "dep")
 
     def refit_segments(self) -> None:
-        """The segments table changed width: cut its details to the new one."""
+        """The segments table changed width: wrap its details to the new one."""
         if self.host.scenario is not None:
             self._fill_segments(self.host.scenario)
 
