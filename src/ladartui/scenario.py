@@ -204,7 +204,7 @@ class Scenario:
         field equal but the file's name and what only changes how a run goes (the
         backend, whose answers are the same, and fast mode, which draws less), and
         the march's step unless both march."""
-        ignored = RUN_ONLY_FIELDS
+        ignored: tuple[str, ...] = RUN_ONLY_FIELDS
         if not self.method == other.method == "march":
             ignored += ("step",)  # the march's step (methods that differ differ already)
         return all(
