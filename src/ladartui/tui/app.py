@@ -336,11 +336,11 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         if not self.outputs_stale():
             return None
         changes = setting_changes(self.outputs_from, self.scenario)
-        differ = "; ".join(changes[:2]) + ("; ..." if len(changes) > 2 else "")
+        differ = (": " + "; ".join(changes[:2]) + ("; ..." if len(changes) > 2 else "")) if changes else ""
         record = record_path(self.scenario)
         if record.is_file():  # written by every run since records exist
-            return f"other settings: {differ}. The run's are in {record.name}."
-        return f"the settings before your edits: {differ}."
+            return f"other settings{differ}. The run's are in {record.name}."
+        return f"the settings before your edits{differ}."
 
     def outputs_stale(self) -> bool:
         """Whether the outputs shown came from other settings than the scenario's now."""
