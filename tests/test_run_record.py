@@ -110,3 +110,29 @@ def test_a_step_flag_on_an_exact_run_does_not_make_its_outputs_out_of_date(scena
     assert ran.same_outputs(scenario) and setting_changes(ran, scenario) == []
     marched = read_run_record(scenario).with_changes(method="march")
     assert not marched.same_outputs(scenario.with_changes(method="march"))
+
+
+def test_no_save_replaces_a_run_record_and_a_record_saved_elsewhere_is_a_plain_scenario(scenario):
+    from ladartui.errors import OutputFileError
+    from ladartui.run_record import is_record
+
+    simulate(scenario)
+    record = scenario.path.with_name("S_Run.toml")
+    before = record.read_bytes()
+    with pytest.raises(OutputFileError) as caught:
+        scenario.save(record)  # Save As onto the record: the next run would be refused
+    assert "S_Run.toml" in str(caught.value) and "run record" in str(caught.value)
+    ran = read_run_record(scenario)
+    with pytest.raises(OutputFileError):
+        ran.save()  # a record opened and saved in place would say what never ran
+    assert record.read_bytes() == before
+    copy = ran.save(scenario.path.with_name("T.toml"))
+    assert not is_record(copy.path) and load_scenario(copy.path).same_outputs(scenario)
+
+
+def test_validate_refuses_what_a_run_would_refuse(scenario, capsys):
+    theirs = scenario.path.with_name("S_Run.toml")
+    theirs.write_text("# my own notes\n", encoding="utf-8")
+    assert main(["validate", str(scenario.path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.count("\n") == 0 and "S_Run.toml" in err and "not a run record" in err

@@ -8,6 +8,8 @@ from __future__ import annotations
 import shlex
 from contextlib import asynccontextmanager
 
+from rich.cells import cell_len
+
 from ladartui.tui.file_dialogs import SaveAsScreen
 from ladartui.tui.poses_screen import PosesScreen
 from ladartui.tui.screens import CompareScreen, FormScreen, MeasuresScreen
@@ -122,6 +124,28 @@ async def test_save_as_refuses_a_folder_and_clears_the_last_run_line(tmp_path, s
         assert app.scenario.path == folder / "copy.toml" and (folder / "copy.toml").is_file()
         # the run line was the old file's: the new one has not been run
         assert str(app.query_one("#run-info").render()) == ""
+
+
+async def test_save_as_onto_a_name_with_outputs_shows_them_as_opening_it_would(tmp_path, scene_files):
+    from ladartui.sensor import Sensor
+    from ladartui.simulation import simulate
+    from ladartui.tui.status import NOT_READY, StatusBar
+
+    scenario = make_scenario(tmp_path, scene_files)
+    other = make_scenario(tmp_path, scene_files, name="other")
+    simulate(other.with_changes(sensor=Sensor(grid=12, ray_grid=1, fov=8.0)))  # other's outputs: 12 x 12
+    async with opened(scenario) as (app, pilot):
+        assert app.measures is None
+        await app.run_action("save_as")
+        await pilot.pause()
+        app.screen.query_one("#save-as-file").value = "other"
+        await pilot.press("enter")  # it exists: a second OK replaces it
+        await pilot.pause()
+        await pilot.press("enter")
+        await wait_until(pilot, lambda: app.measures is not None)
+        assert app.scenario.path == other.path and app.output_voxels is not None
+        bar = app.query_one(StatusBar)
+        assert bar.state == NOT_READY and bar.message == "other.toml: outputs out of date; F5 reruns."
 
 
 async def test_markup_in_names_shows_as_typed_and_compare_reads_spaced_paths(tmp_path, scene_files):
@@ -276,6 +300,36 @@ async def test_run_says_why_it_is_off_when_pressed(tmp_path, scene_files):
         assert app.messages[-1] == f"Run is off: backend {app.scenario.backend} unavailable."
 
 
+async def test_a_run_bound_to_be_refused_is_not_ready(tmp_path, scene_files):
+    from ladartui.tui.status import NOT_READY, StatusBar
+
+    scenario = make_scenario(tmp_path, scene_files)
+    theirs = scenario.path.with_name(f"{scenario.name}_Run.toml")
+    theirs.write_text("# my own notes\n", encoding="utf-8")
+    async with opened(scenario) as (app, pilot):
+        bar = app.query_one(StatusBar)
+        assert bar.state == NOT_READY and "is not a run record" in bar.message
+        await pilot.press("f5")
+        await pilot.pause()
+        assert not app.run_in_progress() and app.messages[-1].startswith("Run is off: ")
+    assert theirs.read_text(encoding="utf-8") == "# my own notes\n"
+
+
+async def test_opening_a_run_record_says_what_it_is_and_save_keeps_it(tmp_path, scene_files):
+    from ladartui.simulation import simulate
+
+    scenario = make_scenario(tmp_path, scene_files)
+    simulate(scenario)
+    record = scenario.path.with_name(f"{scenario.name}_Run.toml")
+    before = record.read_bytes()
+    async with opened(scenario.with_changes(path=record)) as (app, pilot):
+        assert any("is a run record" in m and "Save As" in m for m in app.messages)
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        assert "Not saved" in app.messages[-1] and "run record" in app.messages[-1]
+    assert record.read_bytes() == before
+
+
 async def test_a_committed_value_is_shown_and_named_as_a_number(tmp_path, scene_files):
     from test_tui_flow import field
 
@@ -303,11 +357,20 @@ async def test_the_scans_table_fits_the_sidebar_at_120_columns(tmp_path, scene_f
 
 
 async def test_the_segments_table_fits_the_sidebar_and_wraps_a_long_detail(tmp_path, scene_files):
-    from ladartui.flight import FlightPlan, Standoff
+    import shutil
+    from pathlib import Path
 
+    from ladartui.flight import FlightPlan, Manual, ScanPose, Standoff
+    from ladartui.trajectory import LogSegment
+
+    log = tmp_path / "飛行記録.csv"  # wide characters: two cells each
+    shutil.copy(Path(__file__).parent.parent / "scenarios" / "flight-log.csv", log)
     scenario = make_scenario(tmp_path, scene_files)
     far = Standoff(target=(30.0, 30.0, 1.0), standoffs=(40.0, 55.0, 70.0, 85.0, 100.0), altitude=50.0)
-    scenario = scenario.with_changes(flight=FlightPlan(None, (*scenario.flight.segments, far))).save()
+    poses = Manual((ScanPose(0.0, 0.0, 40.0),))
+    segments = (*scenario.flight.segments, far, poses, LogSegment(str(log), rate=2.0))
+    scenario = scenario.with_changes(flight=FlightPlan(None, segments)).save()
+    whole = ["r 30 m at 30 m", "40, 55, 70, 85, 100 m", "1 pose", "飛行記録.csv, 2 Hz"]
     for size in ((80, 24), (120, 40)):
         async with opened(scenario, size=size) as (app, pilot):
             app.action_show_tab("flight")
@@ -316,10 +379,38 @@ async def test_the_segments_table_fits_the_sidebar_and_wraps_a_long_detail(tmp_p
             # no sideways scrolling (a detail cut at the edge read "at 6" for "at 60"):
             # a detail too long for the sidebar goes on over more lines, whole
             assert table.max_scroll_x == 0, size
-            details = [str(table.get_row_at(i)[3]) for i in range(table.row_count)]
-            assert details == ["r 30 m at 30 m", "40, 55, 70, 85, 100 m"]
+            rows = [[str(cell) for cell in table.get_row_at(i)] for i in range(table.row_count)]
+            assert [row[3] for row in rows] == whole
+            assert [row[1] for row in rows] == ["Orbit", "Standoff", "Poses", "Log"]
+            room = list(table.columns.values())[3].width
             heights = [table.rows[row.key].height for row in table.ordered_rows]
-            assert heights[1] > 1 and heights[0] == (2 if size == (80, 24) else 1)
+            for detail, height in zip(whole, heights):
+                assert (height > 1) == (cell_len(detail) > room), (size, detail)
+            assert heights[3] > 1 or size == (120, 40)
+
+
+async def test_the_scans_table_shows_whole_columns_only_and_names_those_left_out(tmp_path, scene_files):
+    from ladartui.flight import FlightPlan, Orbit
+
+    scenario = make_scenario(tmp_path, scene_files)
+    wide = Orbit(centre=(30.0, 30.0, 1.0), radius=1234.5, altitude=987.6, scans=4)
+    scenario = scenario.with_changes(flight=FlightPlan(None, (wide,))).save()
+    async with opened(scenario, size=(80, 24)) as (app, pilot):
+        app.action_show_tab("flight")
+        await pilot.pause()
+        scans = app.query_one("#scans")
+        # a column cut at the edge read as another value ("9" under "a" for an az of 90)
+        assert scans.max_scroll_x == 0
+        shown = [str(column.label) for column in scans.columns.values()]
+        left_out = [c for c in ("#", "x", "y", "z", "hdg", "az", "dep") if c not in shown]
+        assert shown[:3] == ["#", "x", "y"] and left_out
+        heading = str(app.query_one("#scans-heading").render())
+        assert heading == "Scans (no room for " + ", ".join(left_out) + ")"
+    async with opened(make_scenario(tmp_path, scene_files, name="near"), size=(120, 40)) as (app, pilot):
+        app.action_show_tab("flight")
+        await pilot.pause()
+        assert len(app.query_one("#scans").columns) == 7
+        assert str(app.query_one("#scans-heading").render()) == "Scans"
 
 
 async def test_the_new_scenario_dialog_refuses_in_the_forms_words(tmp_path, scene_files):

@@ -16,8 +16,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from ladartui.errors import LadarError, OutputFileError
+from ladartui.scenario_file import RECORD_HEADER, is_record
 
-RECORD_HEADER = "# ladartui run record"
+__all__ = ["RECORD_HEADER", "is_record", "read_run_record", "record_path", "setting_changes"]
 # Scenario keys that change no output (Scenario.same_outputs says the same).
 RUN_ONLY_KEYS = ("simulation.backend", "simulation.fast_mode")
 
@@ -45,15 +46,6 @@ def record_text(ran, scenario_path) -> str:
         f"# They may differ from {name}: a run can go with unsaved edits or flags.\n\n"
     )
     return header + ran.toml_body()
-
-
-def is_record(path) -> bool:
-    """Whether ``path`` is a run record (by its first line)."""
-    try:
-        with open(path, encoding="utf-8") as file:
-            return file.readline().startswith(RECORD_HEADER)
-    except (OSError, UnicodeDecodeError):
-        return False
 
 
 def check_record_spare(scenario) -> None:

@@ -22,7 +22,7 @@ from ladartui import defaults
 from ladartui.atomic import write_text_atomic
 from ladartui.checks import choice_field, number_field
 from ladartui.detection.settings import DetectionSettings
-from ladartui.errors import FieldError, InputFileError, LadarError
+from ladartui.errors import FieldError, InputFileError, LadarError, OutputFileError
 from ladartui.fileprobe import file_problem
 from ladartui.flight import (
     FlightPlan,
@@ -33,6 +33,7 @@ from ladartui.scenario_file import (
     ScenarioReader,
     check_flight,
     checked_target_names,
+    is_record,
     parse_document,
     resolve_path,
 )
@@ -340,8 +341,16 @@ class Scenario:
         outputs sit beside the new file).
         """
         scenario = self if path is None else self.with_changes(path=Path(path))
+        if is_record(scenario.path):  # it would say that settings which never ran made outputs
+            owner = scenario.path.name.removesuffix("_Run.toml") + ".toml"
+            raise OutputFileError(
+                scenario.path,
+                f"is a run record (the settings that made {owner}'s outputs, written by its runs): "
+                "save under another name",
+            )
         text = None
-        if self.path.is_file():  # keep the analyst's comments, key order and layout
+        # keep the analyst's comments, key order and layout (not a record's header)
+        if self.path.is_file() and not is_record(self.path):
             text = restyle(self.path.read_text(encoding="utf-8"), scenario.to_dict(), _saved_data(self.path))
         write_text_atomic(scenario.path, text if text is not None else scenario.to_toml())
         return scenario

@@ -125,6 +125,9 @@ SECTIONS = {
     "targets": ("names",),
 }
 MAX_TARGET_NAME = 60
+# The first line of a run record (ladartui.run_record): a scenario file that a run
+# writes beside its outputs, saying which settings made them. No save replaces one.
+RECORD_HEADER = "# ladartui run record"
 # Segment kinds a scenario file may use: the flight plan's, and recorded logs.
 SEGMENT_FILE_KINDS = {**SEGMENT_KINDS, LogSegment.kind: LogSegment}
 
@@ -390,3 +393,12 @@ def check_flight(plan: FlightPlan) -> None:
 def resolve_path(folder: Path, file) -> Path:
     file = Path(file).expanduser()
     return Path(os.path.normpath(file if file.is_absolute() else folder / file))
+
+
+def is_record(path) -> bool:
+    """Whether ``path`` is a run record (by its first line)."""
+    try:
+        with open(path, encoding="utf-8") as file:
+            return file.readline().startswith(RECORD_HEADER)
+    except (OSError, UnicodeDecodeError):
+        return False

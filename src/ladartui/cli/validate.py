@@ -24,9 +24,11 @@ def add_parser(subparsers):
 
 def run(args) -> int:
     from ladartui.scenario import load_scenario
+    from ladartui.simulation import check_outputs_spare_inputs
     from ladartui.user_data import bundled_or_path
 
     scenario = load_scenario(bundled_or_path(args.scenario))
+    check_outputs_spare_inputs(scenario)  # what a run would refuse before tracing
     scene_lines = scene_summary(scenario)
     print(scenario.summary())
     for line in [*scene_lines, *last_run_lines(scenario)]:

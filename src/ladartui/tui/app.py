@@ -232,6 +232,9 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
             status = {name: ok for name, _, ok in rows}
             if not status.get(self.scenario.backend, True):
                 out.append(f"backend {self.scenario.backend} unavailable")
+        refusal = bridge.run_refusal(self.scenario)
+        if refusal:
+            out.append(refusal)
         return out
 
     def refresh_status(self) -> None:
@@ -495,6 +498,7 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         "warm": "Kernels not compiled",
         "export": "Nothing exported",
         "png": "View not saved",
+        "earlier": "Earlier outputs not read",
     }
 
     def on_job_progress(self, message: JobProgress) -> None:
@@ -534,6 +538,8 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
             )
         elif message.job == "run":
             self.run_finished(message.result, message.cancelled, message.error)
+        elif message.job == "earlier" and message.result is not None:
+            self.earlier_read(message.result)
         elif message.job == "png" and message.result is not None:
             self.tell(f"Wrote {message.result}")
         elif message.job == "export" and message.result is not None:

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ladartui.checks import compass_field, number_field
-from ladartui.errors import FieldError, InputFileError
+from ladartui.errors import FieldError, InputFileError, LadarError
 from ladartui.flight import (
     SEGMENT_KINDS,
     FlightPlan,
@@ -334,6 +334,18 @@ def load_checked(path: Path) -> Scenario:
     writes them); a missing scene or target model does, with the file named.
     """
     return load_scenario(path)
+
+
+def run_refusal(scenario: Scenario) -> str | None:
+    """Why a run of ``scenario`` would be refused before tracing (its outputs would
+    replace a model file, or a file of its record's name that is not one); None if not."""
+    from ladartui.simulation import check_outputs_spare_inputs
+
+    try:
+        check_outputs_spare_inputs(scenario)
+    except LadarError as error:
+        return str(error)
+    return None
 
 
 def missing_outputs(scenario: Scenario) -> list[Path]:

@@ -90,6 +90,7 @@ class FileActions(Host):
             self.show_output()
             self.show_measures(None)
             self.run_panel.say("")  # the last run, if any, was the old file's
+            self.show_outputs_of(saved)  # those of the new name, if it has any
         else:
             history.mark_saved(saved)
         self.scenario = saved

@@ -128,6 +128,9 @@ class AppHost(App[None]):
     def commit_pending(self) -> bool:
         raise NotImplementedError
 
+    def show_outputs_of(self, scenario: Scenario) -> None:
+        raise NotImplementedError
+
     def confirm_discard(self, doing: str, then: Callable[[], None]) -> None:
         raise NotImplementedError
 

@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 from ladartui.errors import LadarError
 from ladartui.recent import remember_scenario
-from ladartui.run_record import read_run_record
+from ladartui.run_record import is_record, read_run_record
 from ladartui.tui import bridge
 from ladartui.tui.host import Host
 from ladartui.tui.view_area import prepare_views
@@ -30,16 +30,34 @@ if TYPE_CHECKING:
 
 
 @dataclass
-class Loaded:
-    """What the load job hands the interface."""
+class Earlier:
+    """The outputs on disk under a scenario's name, from an earlier run."""
 
     scenario: Scenario
-    scene: Scene
-    prepared: dict[str, Any]
     output: np.ndarray | None
     measures: Measures | None
     ran: Scenario | None  # the settings that made them (the run record), if recorded
     warning: str | None
+
+    @property
+    def made_with(self) -> Scenario | None:
+        """What made the outputs: the record, else (a set older than records) the file."""
+        if self.output is None and self.measures is None:
+            return None
+        return self.ran or self.scenario
+
+
+@dataclass
+class Loaded:
+    """What the load job hands the interface."""
+
+    scene: Scene
+    prepared: dict[str, Any]
+    earlier: Earlier
+
+    @property
+    def scenario(self) -> Scenario:
+        return self.earlier.scenario
 
 
 class SceneLoading(Host):
@@ -56,21 +74,28 @@ class SceneLoading(Host):
         self.scene = done.scene
         self.prepared = done.prepared
         self.view_area.set_scene(done.prepared, done.scene.voxel_size)
+        earlier = done.earlier
         self.missing_outputs = bridge.missing_outputs(done.scenario)
-        shown = done.output is not None or done.measures is not None
-        # what made them: the run record, else (a set older than records) the file
-        self.outputs_from = (done.ran or done.scenario) if shown else None
+        self.outputs_from = earlier.made_with
         self.set_scenario(done.scenario, modified=False)
         if done.scenario.path.is_file():
             remember_scenario(done.scenario.path)
         self.file_panel.show_recent(done.scenario.path)
-        self.output_voxels = done.output
+        self.output_voxels = earlier.output
         self.show_output()
-        self.show_measures(done.measures)
+        self.show_measures(earlier.measures)
         self.run_panel.say("")  # the last run, if any, was another scenario's
         self.set_busy(None)
-        if done.warning:
-            self.tell(done.warning, severity="warning", timeout=8)
+        if earlier.warning:
+            self.tell(earlier.warning, severity="warning", timeout=8)
+        if is_record(done.scenario.path):
+            self.tell(
+                f"{done.scenario.path.name} is a run record: the settings that made "
+                f"{done.scenario.path.name.removesuffix('_Run.toml')}.toml's outputs. Its runs "
+                "replace it, and Save does not: Save As keeps these settings as a scenario.",
+                severity="warning",
+                timeout=10,
+            )
         # after the panels are drawn: probing imports the GPU library
         self.call_after_refresh(self._start_background, done.scenario, done.scene)
 
@@ -80,6 +105,24 @@ class SceneLoading(Host):
         self.warm_worker = start_job(
             self, "warm", lambda cancel, progress: _warm_up(scenario, scene, compile_in_child, cancel)
         )
+
+    def show_outputs_of(self, scenario: Scenario) -> None:
+        """After Save As onto a name: the outputs already on disk under it, shown as
+        opening that file would show them (read in a worker)."""
+        self.missing_outputs = bridge.missing_outputs(scenario)
+        if scenario.scene_output.is_file() and scenario.measures_file.is_file():
+            start_job(self, "earlier", lambda cancel, progress: _earlier(scenario))
+
+    def earlier_read(self, earlier: Earlier) -> None:
+        if self.scenario is None or self.scenario.path != earlier.scenario.path:
+            return  # another file since
+        self.outputs_from = earlier.made_with
+        self.output_voxels = earlier.output
+        self.show_output()
+        self.show_measures(earlier.measures)
+        self.scenario_changed()
+        if earlier.warning:
+            self.tell(earlier.warning, severity="warning", timeout=8)
 
     def backends_probed(self, choices) -> None:
         self.run_panel.show_backends(choices, self.scenario.backend if self.scenario else "auto")
@@ -94,7 +137,11 @@ def _load(path: Path | None, scenario) -> Loaded:
             path = default_scenario_path()
         scenario = bridge.load_checked(path)
     scene = scenario.load_scene()
-    prepared = prepare_views(scene)
+    return Loaded(scene, prepare_views(scene), _earlier(scenario))
+
+
+def _earlier(scenario) -> Earlier:
+    """The outputs of an earlier run under ``scenario``'s name, and what made them."""
     warning, ran = None, None
     try:
         output, measures = _existing_results(scenario)
@@ -105,7 +152,7 @@ def _load(path: Path | None, scenario) -> Loaded:
             ran = read_run_record(scenario)
         except LadarError as error:
             warning = f"settings of the earlier run not read, taken as the file's: {error}"
-    return Loaded(scenario, scene, prepared, output, measures, ran, warning)
+    return Earlier(scenario, output, measures, ran, warning)
 
 
 def _warm_up(scenario, scene, compile_in_child: bool, cancel) -> None:

@@ -9,14 +9,21 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from rich.text import Text
-from textual import events, on
+from textual import on
 from textual.containers import Grid
 from textual.widgets import Button, DataTable, Label, Static
 
 from ladartui.errors import LadarError
 from ladartui.flight import Manual
 from ladartui.tui import bridge
+from ladartui.tui.panels.flight_tables import (
+    SCAN_COLUMNS,
+    SEGMENT_COLUMNS,
+    SHORT_KINDS,
+    FittingTable,
+    fill_scans,
+    fill_segments,
+)
 from ladartui.tui.params import ParamPanel, field_id
 from ladartui.tui.poses_screen import PosesScreen
 from ladartui.tui.screens import FormScreen
@@ -24,24 +31,8 @@ from ladartui.tui.screens import FormScreen
 if TYPE_CHECKING:
     from ladartui.scenario import Scenario
 
-SEGMENT_COLUMNS = ("#", "Kind", "Scans", "Detail")
 ADD_BUTTONS = "#add-straight,#add-turn,#add-orbit,#add-flypast,#add-standoff"
 START_UNUSED = "The path starts at its first segment: the start pose is not used."
-
-
-class SegmentsTable(DataTable):
-    """The segments table; a new width (the sidebar's scrollbar coming or going
-    changes it too) refits its details."""
-
-    fitted_width = 0  # the width its details were last wrapped to
-
-    def on_resize(self, event: events.Resize) -> None:
-        if event.size.width != self.fitted_width:
-            panel = self.parent
-            while panel is not None and not isinstance(panel, FlightPanel):
-                panel = panel.parent
-            if panel is not None:
-                panel.refit_segments()
 
 
 class FlightPanel(ParamPanel):
@@ -50,7 +41,7 @@ class FlightPanel(ParamPanel):
             yield self.param_row(param)
         yield Static("", id="start-note", classes="info", markup=False)
         yield Label("Segments (Enter edits)", classes="heading")
-        yield SegmentsTable(id="segments", cursor_type="row", zebra_stripes=True)
+        yield FittingTable(self.refit_tables, id="segments", cursor_type="row", zebra_stripes=True)
         with Grid(classes="button-grid"):
             yield Button("Straight", id="add-straight", compact=True)
             yield Button("Turn", id="add-turn", compact=True)
@@ -61,17 +52,17 @@ class FlightPanel(ParamPanel):
             yield Button("Edit", id="seg-edit", compact=True)
             yield Button("Delete", id="seg-delete", compact=True)
             yield Button("Aim all", id="aim-all", compact=True)
-        yield Label("Scans", classes="heading")
-        yield DataTable(id="scans", cursor_type="row", zebra_stripes=True)
+        yield Label("Scans", id="scans-heading", classes="heading")
+        yield FittingTable(self.refit_tables, id="scans", cursor_type="row", zebra_stripes=True)
 
     def on_mount(self) -> None:
         self.query_one("#segments", DataTable).add_columns(*SEGMENT_COLUMNS)
-        self.query_one("#scans", DataTable).add_columns("#", "x", "y", "z", "hdg", "az", "dep")
+        self.query_one("#scans", DataTable).add_columns(*SCAN_COLUMNS)
 
-    def refit_segments(self) -> None:
-        """The segments table changed width: wrap its details to the new one."""
+    def refit_tables(self) -> None:
+        """A table changed width: draw both to their widths now."""
         if self.host.scenario is not None:
-            self._fill_segments(self.host.scenario)
+            self._fill_tables(self.host.scenario)
 
     # -- showing the scenario --------------------------------------------------------
 
@@ -91,44 +82,28 @@ class FlightPanel(ParamPanel):
         note.display = not used
 
     def _fill_tables(self, scenario) -> None:
-        per_segment = self._fill_segments(scenario)
-        scans = self.query_one("#scans", DataTable)
-        scans.clear()
-        for i, p in enumerate(pose for poses in per_segment for pose in poses):
-            # Whole metres and degrees: the table fits the sidebar, so no column is
-            # shown cut (a depression of 44.6 cut to "4" read as a value).
-            values = (p.x, p.y, p.z, p.heading, p.azimuth, p.depression)
-            scans.add_row(str(i + 1), *(str(round(v)) for v in values))  # (an int: never "-0")
-
-    def _fill_segments(self, scenario) -> list[list]:
-        """The segments table, a detail too long for the sidebar wrapped onto more
-        lines rather than scrolled sideways; returns each segment's poses."""
         try:
             per_segment = scenario.flight.segment_poses()
         except LadarError:
             per_segment = [[] for _ in scenario.flight.segments]
-        rows = [
+        segments = [
             (
                 str(i + 1),
-                bridge.SEGMENT_LABELS.get(segment.kind, segment.kind),
+                SHORT_KINDS.get(segment.kind) or bridge.SEGMENT_LABELS.get(segment.kind, segment.kind),
                 str(len(poses)),
-                bridge.segment_summary(segment),  # may hold a file's name: never markup
+                bridge.segment_summary(segment),
             )
             for i, (segment, poses) in enumerate(zip(scenario.flight.segments, per_segment))
         ]
-        table = self.query_one("#segments", SegmentsTable)
-        row = table.cursor_row
-        table.clear(columns=True)  # a column keeps the widest text it ever held otherwise
-        room = _last_column_room(table, rows)
-        table.fitted_width = table.size.width
-        table.add_columns(*SEGMENT_COLUMNS[:-1])
-        table.add_column(SEGMENT_COLUMNS[-1], width=room)
-        for cells in rows:
-            wraps = room is not None and len(cells[-1]) > room
-            table.add_row(*(Text(cell) for cell in cells), height=None if wraps else 1)
-        if table.row_count:
-            table.move_cursor(row=min(max(row, 0), table.row_count - 1))
-        return per_segment
+        fill_segments(self.query_one("#segments", FittingTable), segments)
+        # Whole metres and degrees (round: an int, never "-0"): more columns fit
+        scans = [
+            (str(i + 1), *(str(round(v)) for v in (p.x, p.y, p.z, p.heading, p.azimuth, p.depression)))
+            for i, p in enumerate(pose for poses in per_segment for pose in poses)
+        ]
+        left_out = fill_scans(self.query_one("#scans", FittingTable), scans)
+        heading = "Scans" + (f" (no room for {', '.join(left_out)})" if left_out else "")
+        self.query_one("#scans-heading", Label).update(heading)
 
     # -- editing segments ------------------------------------------------------------
 
@@ -302,22 +277,3 @@ class FlightPanel(ParamPanel):
             return
         self.host.edit(scenario, "Aim every scan at the target")
         self.host.tell("Every scan now aims at the target centre.")
-
-
-def _last_column_room(table: DataTable, rows) -> int | None:
-    """Cells left for the segments' details once the other columns are drawn whole
-    (and a vertical scrollbar, where the lines will not fit the table's height);
-    None before the table has a width."""
-    if table.size.width <= 0:
-        return None
-    pad = 2 * table.cell_padding
-    others = sum(
-        pad + max([len(label), *(len(cells[c]) for cells in rows)])
-        for c, label in enumerate(SEGMENT_COLUMNS[:-1])
-    )
-    room = max(table.size.width - others - pad, 8)
-    lines = 1 + sum(-(-len(cells[-1]) // room) for cells in rows)  # the header, the rows wrapped
-    tallest = table.styles.max_height
-    if tallest is not None and lines > tallest.value:
-        room = max(room - table.styles.scrollbar_size_vertical, 8)
-    return room

@@ -1,0 +1,109 @@
+"""The Flight tab's two tables, drawn to the sidebar's width and never scrolled sideways.
+
+A column cut at the table's edge reads as another value (a depression of 44.6
+cut to "4", "r 60 m at 6"), so the segments table wraps a long detail onto
+more lines, whole, and the scans table shows whole columns only and names the
+ones there is no room for. Widths are counted in terminal cells (a wide
+character takes two).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+from rich.cells import cell_len
+from rich.text import Text
+from textual import events
+from textual.widgets import DataTable
+
+SEGMENT_COLUMNS = ("#", "Kind", "Scans", "Detail")
+SCAN_COLUMNS = ("#", "x", "y", "z", "hdg", "az", "dep")
+# Kinds whose usual label is too wide for the table (the buttons use these words too).
+SHORT_KINDS = {"manual": "Poses", "log": "Log"}
+
+
+class FittingTable(DataTable):
+    """A table drawn to its own width: a new width (the sidebar's scrollbar coming or
+    going changes it too) calls ``refit`` to draw it again."""
+
+    def __init__(self, refit: Callable[[], None], **kwargs):
+        super().__init__(**kwargs)
+        self.refit = refit
+        self.fitted_width = 0  # the width it was last drawn to
+
+    def on_resize(self, event: events.Resize) -> None:
+        if event.size.width != self.fitted_width:
+            self.refit()
+
+
+def fill_segments(table: FittingTable, rows: Sequence[tuple[str, str, str, str]]) -> None:
+    """The segments' rows (#, kind, scans, detail), each detail wrapped where it is
+    wider than the room the other columns leave."""
+    cursor = table.cursor_row
+    table.clear(columns=True)  # a column keeps the widest text it ever held otherwise
+    room = _detail_room(table, rows)
+    table.fitted_width = table.size.width
+    table.add_columns(*SEGMENT_COLUMNS[:-1])
+    table.add_column(SEGMENT_COLUMNS[-1], width=room)
+    for cells in rows:
+        wraps = room is not None and cell_len(cells[-1]) > room
+        # Text cells: a detail may hold a file's name, never to be read as markup
+        table.add_row(*(Text(cell) for cell in cells), height=None if wraps else 1)
+    if table.row_count:
+        table.move_cursor(row=min(max(cursor, 0), table.row_count - 1))
+
+
+def fill_scans(table: FittingTable, rows: Sequence[tuple[str, ...]]) -> list[str]:
+    """The scans' rows (one cell per ``SCAN_COLUMNS``), with as many whole columns,
+    from the left, as the table's width holds; returns the labels left out."""
+    cursor = table.cursor_row
+    widths = _widths(table, SCAN_COLUMNS, rows)
+    room = _room(table, len(rows))
+    shown = len(SCAN_COLUMNS)
+    if room is not None:
+        used = 0
+        for index, width in enumerate(widths):
+            used += width
+            if used > room:
+                shown = index
+                break
+    table.clear(columns=True)
+    table.fitted_width = table.size.width
+    table.add_columns(*SCAN_COLUMNS[:shown])
+    for cells in rows:
+        table.add_row(*(Text(cell) for cell in cells[:shown]))
+    if table.row_count:
+        table.move_cursor(row=min(max(cursor, 0), table.row_count - 1))
+    return list(SCAN_COLUMNS[shown:])
+
+
+def _widths(table: DataTable, labels: Sequence[str], rows) -> list[int]:
+    """Each column's width in cells, its padding included."""
+    pad = 2 * table.cell_padding
+    return [
+        pad + max([cell_len(label), *(cell_len(cells[c]) for cells in rows)])
+        for c, label in enumerate(labels)
+    ]
+
+
+def _room(table: DataTable, lines: int) -> int | None:
+    """Cells across for the columns: the table's width, less a vertical scrollbar where
+    ``lines`` and the header are more than its height holds; None before it has a width."""
+    if table.size.width <= 0:
+        return None
+    tallest = table.styles.max_height
+    bar = table.styles.scrollbar_size_vertical if tallest is not None and lines + 1 > tallest.value else 0
+    return table.size.width - bar
+
+
+def _detail_room(table: DataTable, rows) -> int | None:
+    """Cells left for the segments' details once the other columns are drawn whole;
+    None before the table has a width."""
+    across = _room(table, len(rows))
+    if across is None:
+        return None
+    others = sum(_widths(table, SEGMENT_COLUMNS[:-1], rows))
+    pad = 2 * table.cell_padding
+    room = max(across - others - pad, 1)
+    lines = sum(-(-cell_len(cells[-1]) // room) for cells in rows)  # the rows, wrapped
+    return max((_room(table, lines) or 0) - others - pad, 1)
