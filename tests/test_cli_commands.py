@@ -60,3 +60,24 @@ def test_the_commands_load_without_numba_or_dask():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "[]"
+
+
+def test_output_into_a_closed_pipe_ends_quietly(tmp_path):
+    # `ladartui info S.toml | head -1`: the reader goes before the writer has written
+    import subprocess
+    import sys
+
+    from tui_support import make_scenario
+
+    scene = tmp_path / "s.txt"
+    scene.write_text("0,0,0\n1,1,0\n", encoding="utf-8")
+    (tmp_path / "s_Target.txt").write_text("0,0,0\n", encoding="utf-8")
+    scenario = make_scenario(tmp_path, (scene, (0.5, 0.5, 0.5), 1.0))
+    child = subprocess.Popen(
+        [sys.executable, "-m", "ladartui", "info", str(scenario.path)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    child.stdout.close()
+    err = child.stderr.read().decode()
+    assert child.wait(timeout=120) == 141 and err == ""  # as a shell reports SIGPIPE, no traceback

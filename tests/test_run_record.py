@@ -136,3 +136,14 @@ def test_validate_refuses_what_a_run_would_refuse(scenario, capsys):
     assert main(["validate", str(scenario.path)]) == 2
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "S_Run.toml" in err and "not a run record" in err
+
+
+def test_the_new_dialog_names_the_record_and_will_not_make_one_a_new_scenario(scenario):
+    from ladartui.errors import FieldError
+
+    simulate(scenario)
+    names = dict(bridge.derived_names(scenario.path.with_name("N.toml"), scenario.scene_file))
+    assert names["Run record (its settings)"] == "N_Run.toml"
+    with pytest.raises(FieldError) as caught:
+        bridge.new_scenario(scenario.path.with_name("S_Run.toml"), scenario.scene_file)
+    assert "is a run record" in str(caught.value)

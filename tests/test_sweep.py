@@ -142,6 +142,7 @@ def test_spec_errors_name_the_file_key_and_what_was_expected(tmp_path, body, key
     assert message.startswith(str(path))
     assert f" {key}" in message or f"{key}:" in message
     assert "expected" in message and "\n" not in message
+    assert "None" not in message  # a key never written is missing, not "got None"
     if line is not None:
         assert caught.value.line == line
 
@@ -499,6 +500,22 @@ def test_cli_serial_sweep_prints_the_ranking_as_json(tiny, tmp_path, capsys):
         row = by_id[entry["variant"]]
         assert entry["objective"] == pytest.approx(row["obscured_coverage"] / (row["path_length_m"] / 1000.0))
     assert os.path.isfile(report["best_scenario"])
+
+
+def test_impossible_values_are_not_called_failures(tiny, tmp_path, capsys):
+    # "failed" rows run again on resume; "error" rows (impossible values) never do
+    import json
+
+    from ladartui.cli import main
+
+    spec = write_spec(tiny, "[grid]\nradius = [10.0]\nsensor_grid = [8, 0]\n", name="impossible.toml")
+    assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "1 variant(s) with impossible values (kept as errors, not run again); first: " in out
+    assert "failed" not in out
+    assert main(["sweep", str(spec), "--show", "--out", str(tmp_path), "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert (report["failed"], report["impossible"]) == (0, 1)
 
 
 def test_two_sweeps_never_write_one_folder_at_once(tiny, tmp_path):

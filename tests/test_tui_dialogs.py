@@ -265,6 +265,8 @@ async def test_outputs_a_run_made_from_unsaved_settings_are_out_of_date_on_openi
             f"Measures of {scenario.name}, from other settings: sensor.grid 12 (here 8). "
             f"The run's are in {scenario.name}_Run.toml."
         )
+        files = str(app.query_one("#file-info").render())
+        assert f"Run record    {scenario.name}_Run.toml" in files
         # typing the settings that ran makes them current again
         app.action_show_tab("sensor")
         await type_into(pilot, field(app, "sensor.grid"), "12")
@@ -328,6 +330,29 @@ async def test_opening_a_run_record_says_what_it_is_and_save_keeps_it(tmp_path, 
         await pilot.pause()
         assert "Not saved" in app.messages[-1] and "run record" in app.messages[-1]
     assert record.read_bytes() == before
+
+
+async def test_reopening_the_file_being_edited_offers_no_save_that_would_be_lost(tmp_path, scene_files):
+    # the sweep's F8 writes the best path over best.toml, then opens it: saving the
+    # edits of best.toml there would replace the best path it had just written
+    from ladartui.tui.unsaved import UnsavedScreen
+    from test_tui_flow import field
+
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario) as (app, pilot):
+        app.action_show_tab("sensor")
+        await type_into(pilot, field(app, "sensor.grid"), "12")
+        saved = scenario.path.read_bytes()
+        app.open_path(scenario.path)
+        await pilot.pause()
+        dialog = app.screen
+        assert isinstance(dialog, UnsavedScreen)
+        assert not dialog.query("#unsaved-save") and dialog.query("#unsaved-discard")
+        said = str(dialog.query_one("Static").render())
+        assert said.startswith(f"{scenario.path.name} has unsaved edits, and opening it reads the file again")
+        await pilot.press("escape")
+        await pilot.pause()
+        assert app.scenario.sensor.grid == 12 and scenario.path.read_bytes() == saved
 
 
 async def test_a_committed_value_is_shown_and_named_as_a_number(tmp_path, scene_files):

@@ -26,7 +26,10 @@ class FieldError(LadarError):
         # range in its own units; None for other checks
         self.limits = limits
         prefix = f"{source}: " if source else ""
-        super().__init__(f"{prefix}{field} = {value!r}: expected {expected}")
+        if value is None:  # never given: say so rather than "= None"
+            super().__init__(f"{prefix}{field} is not set: expected {expected}")
+        else:
+            super().__init__(f"{prefix}{field} = {value!r}: expected {expected}")
 
 
 class Cancelled(Exception):

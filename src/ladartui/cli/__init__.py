@@ -8,8 +8,11 @@ one line on stderr and exit status 2; no traceback reaches the user.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import difflib
 import importlib
+import os
+import signal
 import sys
 from pathlib import Path
 
@@ -103,3 +106,14 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("ladartui: interrupted", file=sys.stderr)
         return stop_status()
+    except BrokenPipeError:
+        return _reader_gone()
+
+
+def _reader_gone() -> int:
+    """Output piped into a reader that has gone (``| head -1``): end quietly, as a
+    shell reports a program ended by SIGPIPE, and never flush into that pipe again."""
+    with contextlib.suppress(OSError, ValueError):
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    return 128 + signal.SIGPIPE

@@ -210,7 +210,8 @@ def _sweep_with_progress(spec, args, console):
                 outcome["progress"] = p
                 ran = p.done - p.resumed
                 rate = f", {60 * ran / p.elapsed:.1f}/min" if ran and p.elapsed > 0 else ""
-                note = f"{p.resumed} resumed, {p.failed} failed{rate}"
+                impossible = f", {p.impossible} impossible" if p.impossible else ""
+                note = f"{p.resumed} resumed, {p.failed} failed{impossible}{rate}"
                 bar.update(task, completed=p.done, total=p.total, note=note)
 
             def work():
@@ -285,7 +286,8 @@ def result_dict(result, top) -> dict:
         "variants": len(result.rows),
         "ran": result.ran,
         "resumed": result.resumed,
-        "failed": len(result.failures),
+        "failed": len(result.failed),
+        "impossible": len(result.impossible),
         "workers": result.workers,
         "elapsed_s": round(result.elapsed, 3),
         "results": str(result.results_path),
@@ -374,13 +376,16 @@ def show_result(console, result, top) -> None:
         missed = never_identified(result.rows)
         if missed and result.objective in ("time-to-identify", "distance-to-identify"):
             console.print("no variant identifies " + ", ".join(missed), highlight=False, markup=False)
-    failures = result.failures
-    if failures:
-        console.print(
-            f"[bold]{len(failures)} variant(s) failed[/]; first: "
-            + escape(f"{failures[0].get('variant')}: {failures[0].get('error')}"),
-            highlight=False,
-        )
+    for rows, what in (
+        (result.impossible, "with impossible values (kept as errors, not run again)"),
+        (result.failed, "failed (run again when the sweep resumes)"),
+    ):
+        if rows:
+            console.print(
+                f"[bold]{len(rows)} variant(s) {what}[/]; first: "
+                + escape(f"{rows[0].get('variant')}: {rows[0].get('error')}"),
+                highlight=False,
+            )
     if result.ran or result.resumed:
         ran = result.ran
         rate = f" ({60 * ran / result.elapsed:.1f} variants/min)" if ran and result.elapsed else ""

@@ -47,7 +47,9 @@ _POLL_SECONDS = 0.05
 
 @dataclass
 class SweepProgress:
-    """Where a sweep stands: variants done (resumed ones included) of total, failures, last row."""
+    """Where a sweep stands: variants done (resumed ones included) of total, those that
+    failed (run again on resume) and those with impossible values (status "error",
+    final), and the last row."""
 
     total: int
     done: int
@@ -55,6 +57,7 @@ class SweepProgress:
     failed: int
     elapsed: float
     row: dict | None = None
+    impossible: int = 0
 
     @property
     def fraction(self) -> float:
@@ -89,7 +92,18 @@ class SweepResult:
 
     @property
     def failures(self) -> list[dict]:
+        """Rows that are not ok: failed (run again on resume) or impossible."""
         return [row for row in self.rows if row.get("status") != "ok"]
+
+    @property
+    def failed(self) -> list[dict]:
+        """Rows that failed (a crash, a lost worker): run again when the sweep resumes."""
+        return [row for row in self.rows if row.get("status") not in FINAL_STATUSES]
+
+    @property
+    def impossible(self) -> list[dict]:
+        """Rows whose values are impossible (status "error"): final, never run again."""
+        return [row for row in self.rows if row.get("status") == "error"]
 
     @property
     def pareto(self) -> list[Ranked]:
@@ -269,7 +283,8 @@ def _run_locked(
             table_rows.append(row)
         write_table(results_path, table_rows, spec.parameter_names)
         state.done += 1
-        state.failed += row.get("status") != "ok"
+        state.failed += row.get("status") not in FINAL_STATUSES
+        state.impossible += row.get("status") == "error"
         state.elapsed = time.perf_counter() - started
         state.row = row
         if progress is not None:

@@ -316,7 +316,7 @@ class _Checker:
         self.lines = text.splitlines()
 
     def fail(self, key: str, expected: str, value: object = ...) -> NoReturn:
-        shown = "" if value is ... else f" (got {value!r})"
+        shown = "" if value is ... else " (not set)" if value is None else f" (got {value!r})"
         table, _, name = key.rpartition(".")
         raise InputFileError(self.path, f"{key}: expected {expected}{shown}", line=self.line(table, name))
 

@@ -27,6 +27,7 @@ from ladartui.flight import (
     altitude_field,
 )
 from ladartui.scenario import Scenario, load_scenario, target_file_for
+from ladartui.scenario_file import is_record
 from ladartui.sensor import Sensor
 
 
@@ -283,15 +284,21 @@ def derived_names(scenario_path: Path | None, scene_path: Path | None) -> list[t
     """The names a new scenario derives (report table 2), for the setup dialog."""
     target = target_file_for(scene_path).name if scene_path else "(from the scene model)"
     if scenario_path is None:
-        outputs = ("(from the scenario file)",) * 3
+        outputs = ("(from the scenario file)",) * 4
     else:
         probe = _probe_scenario(scenario_path, scene_path)
-        outputs = (probe.scene_output.name, probe.target_output.name, probe.measures_file.name)
+        outputs = (
+            probe.scene_output.name,
+            probe.target_output.name,
+            probe.measures_file.name,
+            probe.run_record.name,
+        )
     return [
         ("3D target model", target),
         ("Scene simulation output", outputs[0]),
         ("Target simulation output", outputs[1]),
         ("Comparison measures", outputs[2]),
+        ("Run record (its settings)", outputs[3]),
     ]
 
 
@@ -316,6 +323,8 @@ def new_scenario(scenario_path: Path, scene_path: Path, voxel_size: float = 1.0)
     scenario_path = Path(scenario_path)
     if scenario_path.suffix != ".toml":
         scenario_path = scenario_path.with_name(scenario_path.name + ".toml")
+    if is_record(scenario_path):
+        raise FieldError("scenario file", str(scenario_path), "a new file name (this one is a run record)")
     if scenario_path.exists():
         raise FieldError(
             "scenario file", str(scenario_path), "a new file name (this one exists: load it instead)"

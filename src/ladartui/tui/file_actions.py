@@ -51,7 +51,7 @@ class FileActions(Host):
             self.result = None
             self.load(path)
 
-        self.confirm_discard(f"open {path.name}", load)
+        self.confirm_discard(f"open {path.name}", load, opens=path)
 
     def action_open_recent(self, path: str) -> None:
         self.open_path(Path(path))

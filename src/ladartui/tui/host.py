@@ -131,7 +131,7 @@ class AppHost(App[None]):
     def show_outputs_of(self, scenario: Scenario) -> None:
         raise NotImplementedError
 
-    def confirm_discard(self, doing: str, then: Callable[[], None]) -> None:
+    def confirm_discard(self, doing: str, then: Callable[[], None], opens: Path | None = None) -> None:
         raise NotImplementedError
 
     def action_save(self) -> None:

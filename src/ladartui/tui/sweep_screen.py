@@ -334,17 +334,22 @@ class SweepScreen(RankingView):
 
     def _switch(self, name: str, order) -> None:
         start = order.index(getattr(self, name))
-        skipped = ""
+        skipped = []
         for step in range(1, len(order) + 1):
             setattr(self, name, order[(start + step) % len(order)])
             try:
                 self._rank()
                 break
-            except LadarError as error:  # no usable budget: go on to the next choice
-                skipped = f"{error}; type it in Budget s"
+            except LadarError:  # no usable budget: go on to the next choice
+                skipped.append(getattr(self, name))
         self._redraw()
         if skipped:
-            self._status(self._idle_state(), f"{skipped}; ranking by {self.objective}")
+            # what is ranked now first: a status line is cut at the screen's edge
+            self._status(
+                self._idle_state(),
+                f"ranking by {self.objective}; {', '.join(skipped)} skipped: it needs a budget "
+                "(type one in Budget s)",
+            )
             return
         text = f"ranking by {self.objective}"
         if self.objective in BUDGET_OBJECTIVES:
@@ -531,7 +536,11 @@ class SweepScreen(RankingView):
             self._status(BUSY, f"sweeping into {short_path(self.out)}", p.fraction, cancellable=True)
 
     def _counts_text(self, p) -> str:
-        return f"{p.done}/{p.total}, {p.failed} failed, {p.resumed} resumed, ETA {format_eta(eta_seconds(p))}"
+        impossible = f", {p.impossible} impossible" if p.impossible else ""
+        return (
+            f"{p.done}/{p.total}, {p.failed} failed{impossible}, {p.resumed} resumed, "
+            f"ETA {format_eta(eta_seconds(p))}"
+        )
 
     def _finish(self, result, error: str) -> None:
         self.running = False
@@ -542,7 +551,11 @@ class SweepScreen(RankingView):
             self.objective, self.cost, self.budget = result.objective, result.cost, result.budget
             self.out = result.results_path.parent
             self._redraw()
-            note = "" if not result.failures else f", {len(result.failures)} failed"
+            note = "".join(
+                f", {len(rows)} {what}"
+                for rows, what in ((result.failed, "failed"), (result.impossible, "impossible"))
+                if rows
+            )
             self.query_one("#sweep-progress", ProgressBar).update(
                 total=max(len(result.rows), 1), progress=len(result.rows)
             )

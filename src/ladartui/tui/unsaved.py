@@ -4,6 +4,7 @@ question asked before they would be lost."""
 from __future__ import annotations
 
 from collections.abc import Callable
+from pathlib import Path
 
 from rich.markup import escape
 from textual import on
@@ -29,17 +30,25 @@ class UnsavedScreen(ModalScreen[str | None]):
     UnsavedScreen Button { margin-right: 2; }
     """
 
-    def __init__(self, name: str, doing: str):
+    def __init__(self, name: str, doing: str, rereads: bool = False):
+        """``rereads``: what is being done opens the file being edited, so saving first
+        would only be undone by the file it opens (no Save is offered)."""
         super().__init__()
-        self.scenario_name, self.doing = name, doing
+        self.scenario_name, self.doing, self.rereads = name, doing, rereads
 
     def compose(self) -> ComposeResult:
+        name = escape(self.scenario_name)
         with Vertical():
-            yield Static(
-                f"{escape(self.scenario_name)} has unsaved edits. Save them before you {escape(self.doing)}?"
-            )
+            if self.rereads:
+                yield Static(
+                    f"{name} has unsaved edits, and opening it reads the file again: they would be "
+                    "lost. Discard them, or Cancel (Save As keeps them under another name)."
+                )
+            else:
+                yield Static(f"{name} has unsaved edits. Save them before you {escape(self.doing)}?")
             with Horizontal():
-                yield Button("Save", id="unsaved-save", variant="primary", compact=True)
+                if not self.rereads:
+                    yield Button("Save", id="unsaved-save", variant="primary", compact=True)
                 yield Button("Discard", id="unsaved-discard", variant="error", compact=True)
                 yield Button("Cancel", id="unsaved-cancel", compact=True)
 
@@ -88,8 +97,9 @@ class EditGuard(Host):
             self.modified or any(f.value != f.committed for f in self.query(".param").results(ParamField))
         )
 
-    def confirm_discard(self, doing: str, then: Callable[[], None]) -> None:
-        """Call ``then`` once unsaved edits are saved or the analyst chose to discard them."""
+    def confirm_discard(self, doing: str, then: Callable[[], None], opens: Path | None = None) -> None:
+        """Call ``then`` once unsaved edits are saved or the analyst chose to discard them;
+        ``opens``: the file ``then`` opens (when it is this one, saving is not offered)."""
         scenario = self.scenario
         if scenario is None or not self.unsaved():
             then()
@@ -103,4 +113,5 @@ class EditGuard(Host):
             elif choice == "discard":
                 then()
 
-        self.push_screen(UnsavedScreen(scenario.path.name, doing), chosen)
+        rereads = opens is not None and Path(opens).resolve() == Path(scenario.path).resolve()
+        self.push_screen(UnsavedScreen(scenario.path.name, doing, rereads), chosen)

@@ -53,6 +53,7 @@ class FilePanel(VerticalScroll):
             ("Scene output", scenario.scene_output.name),
             ("Target output", scenario.target_output.name),
             ("Measures", scenario.measures_file.name),
+            ("Run record", scenario.run_record.name),
         ]
         text = Text()
         for key, value in rows:
