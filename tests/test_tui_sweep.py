@@ -110,6 +110,8 @@ async def test_opening_results_shows_the_ranking_failures_and_pareto_front(finis
     app = _Host(screen)
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()
+        # impossible values are final, not failures (which run again on resume)
+        assert str(screen.query_one("#sweep-counts").render()) == "12 variants, 6 ok, 0 failed, 6 impossible"
         table = screen.query_one("#sweep-table", DataTable)
         assert status_of(screen).state == READY
         assert table.row_count == 12
@@ -392,6 +394,24 @@ async def test_the_screen_reopens_the_last_sweep_opened(finished, tmp_path, monk
         await pilot.pause()
         assert again.query_one("#sweep-path").value == str(results.resolve())
         assert again.query_one("#sweep-table", DataTable).row_count == 12
+
+
+async def test_a_spec_opened_shows_only_its_own_variants_from_the_folder(finished, tmp_path):
+    import shutil
+
+    spec, results = finished
+    for path in spec.parent.iterdir():  # a copy: the spec is edited below
+        copy = shutil.copytree if path.is_dir() else shutil.copy
+        copy(path, tmp_path / path.name)
+    # the spec narrowed after its sweep ran: one of its twelve stored variants is still its own
+    narrowed = write_spec(tmp_path, "[grid]\nradius = [8.0]\nscans = [1]\nsensor_grid = [8]\n")
+    screen = SweepScreen(narrowed)
+    app = _Host(screen)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        assert screen.query_one("#sweep-table", DataTable).row_count == 1
+        assert str(screen.query_one("#sweep-counts").render()) == "1 variants, 1 ok, 0 failed"
+        assert "11 rows of other variants in the folder left out" in screen.last_message
 
 
 async def test_a_plain_scheduler_off_this_machine_is_refused_as_the_cli_refuses_it(tmp_path):

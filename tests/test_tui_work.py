@@ -133,3 +133,35 @@ async def test_ctrl_x_cancels_a_study_as_it_cancels_a_run_and_a_sweep(tmp_path, 
     from ladartui.tui.actions import keys_in_force
 
     assert keys_in_force(None)["cancel"].split(",") == ["escape", "ctrl+x"]
+
+
+async def test_the_study_screen_keeps_its_controls_at_80x24(tmp_path, scene_files):
+    from ladartui.tui.study_screen import StudyScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        await pilot.press("f11")
+        await pilot.pause()
+        screen = app.screen
+        assert isinstance(screen, StudyScreen)
+        status = str(screen.query_one("#study-status", Static).render())
+        assert status.endswith("q quick, f full, Ctrl+X cancel, Esc back")
+        # a result's chart, legend, table and verdict leave the controls on screen
+        from pathlib import Path
+
+        from ladartui.study.results import read_study
+
+        screen.show_result(read_study(Path(__file__).parent.parent / "docs" / "study.json"))
+        await pilot.pause()
+        for selector in ("#study-status", "#study-quick", "#study-cancel"):
+            region = screen.query_one(selector).region
+            assert region.height >= 1 and region.bottom <= 23, selector  # above the footer
+        # whole columns only (19.1 ms cut to "19." read as 19), the others named
+        table = screen.query_one("#study-table")
+        assert table.max_scroll_x == 0
+        shown = [str(column.label) for column in table.columns.values()]
+        assert shown[:2] == ["setting", "s/scan"] and len(shown) < 7
+        note = str(screen.query_one("#study-table-note", Static).render())
+        assert note.startswith("no room here for ") and note.endswith(": see study.csv in demo-study")

@@ -9,17 +9,20 @@ shown on the screen while the app stays open.
 from __future__ import annotations
 
 from rich.text import Text
-from textual import on
+from textual import events, on
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.screen import Screen
-from textual.widgets import Button, DataTable, Footer, ProgressBar, Static
+from textual.widgets import Button, Footer, ProgressBar, Static
 from textual.worker import Worker
 from textual_plotext import PlotextPlot
 
 from ladartui.study.chart import TABLE_COLUMNS, draw_chart, label_places, legend_text, table_rows
+from ladartui.tui.fitted_tables import FittingTable, fill_whole_columns
 from ladartui.tui.work import JobDone, JobProgress, running, start_job
+
+NARROW = 100  # columns
 
 
 class StudyScreen(Screen):
@@ -39,6 +42,8 @@ class StudyScreen(Screen):
     StudyScreen #study-legend { height: auto; padding: 0 1; }
     StudyScreen #study-side { width: 2fr; }
     StudyScreen #study-table { height: 1fr; }
+    StudyScreen.-narrow #study-chart-box, StudyScreen.-narrow #study-side { width: 1fr; }
+    StudyScreen #study-table-note { height: auto; padding: 0 1; color: $text-muted; }
     StudyScreen #study-verdict { height: auto; max-height: 12; overflow-y: auto; padding: 0 1; }
     StudyScreen #study-bar { height: 1; }
     StudyScreen #study-bar Button { margin-left: 1; }
@@ -60,7 +65,8 @@ class StudyScreen(Screen):
                 yield PlotextPlot(id="study-chart")
                 yield Static("", id="study-legend")  # beside the points, never over them
             with Vertical(id="study-side"):
-                yield DataTable(id="study-table", zebra_stripes=True, cursor_type="row")
+                yield FittingTable(self._fill_table, id="study-table", zebra_stripes=True, cursor_type="row")
+                yield Static("", id="study-table-note", markup=False)
                 yield Static("", id="study-verdict")
         yield Static(self._idle_text(), id="study-status", markup=False)
         with Horizontal(id="study-bar"):
@@ -70,9 +76,19 @@ class StudyScreen(Screen):
             yield Button("Cancel", id="study-cancel", compact=True, variant="error", disabled=True)
         yield Footer()
 
+    def _fill_table(self) -> None:
+        """The settings' table: whole columns only, those left out named below it."""
+        rows: list[tuple[str, ...]] = table_rows(self.result) if self.result is not None else []
+        left_out = fill_whole_columns(self.query_one("#study-table", FittingTable), TABLE_COLUMNS, rows)
+        note = self.query_one("#study-table-note", Static)
+        from ladartui.study.results import study_folder
+
+        folder = study_folder(self.scenario_path).name
+        note.update(f"no room here for {', '.join(left_out)}: see study.csv in {folder}" if left_out else "")
+        note.display = bool(left_out and rows)
+
     def on_mount(self) -> None:
-        table = self.query_one("#study-table", DataTable)
-        table.add_columns(*TABLE_COLUMNS)
+        self._fill_table()
         plot = self.query_one("#study-chart", PlotextPlot).plt
         plot.title("Speed against accuracy: press q (quick) or f (full)")
         self._reopen()
@@ -96,7 +112,7 @@ class StudyScreen(Screen):
 
     def _idle_text(self) -> str:
         where = self.scenario_path or "the generated scenes"
-        return f"Study on {where}: q quick, f full, c cancel, Esc back"
+        return f"Study on {where}: q quick, f full, Ctrl+X cancel, Esc back"
 
     # -- actions ---------------------------------------------------------------
 
@@ -162,10 +178,7 @@ class StudyScreen(Screen):
         self.result = result
         self._draw_chart()
         self.call_after_refresh(self._draw_chart)  # again once the chart has its size
-        table = self.query_one("#study-table", DataTable)
-        table.clear()
-        for row in table_rows(result):
-            table.add_row(*row)
+        self._fill_table()
         self.query_one("#study-verdict", Static).update(result.verdict())
 
     def _draw_chart(self) -> None:
@@ -179,7 +192,9 @@ class StudyScreen(Screen):
         legend = self.query_one("#study-legend", Static)
         legend.update(Text.from_ansi(legend_text(self.result, max(20, width - 2))))
 
-    def on_resize(self, event) -> None:
+    def on_resize(self, event: events.Resize) -> None:
+        # a narrow terminal: the settings' table takes half the width, not two fifths
+        self.set_class(event.size.width < NARROW, "-narrow")
         self.call_after_refresh(self._draw_chart)
 
     def _set_busy(self, busy: bool, message: str) -> None:

@@ -38,7 +38,11 @@ class RankingView(Screen):
 
     def _summary(self) -> str:
         ok = sum(row.get("status") == "ok" for row in self.rows)
-        return f"{len(self.rows)} variants, {ok} ok, {len(self.rows) - ok} failed"
+        impossible = sum(row.get("status") == "error" for row in self.rows)  # final, never rerun
+        failed = len(self.rows) - ok - impossible
+        return f"{len(self.rows)} variants, {ok} ok, {failed} failed" + (
+            f", {impossible} impossible" if impossible else ""
+        )
 
     def _redraw_if_dirty(self) -> None:
         if self._dirty:

@@ -482,12 +482,23 @@ class SweepScreen(RankingView):
         self.rows, self.ranking = result.rows, result.ranking
         self.objective, self.cost, self.budget = result.objective, result.cost, result.budget
         self.parameter_names = spec.parameter_names if spec else result.parameter_names
+        others = ""
+        if spec is not None and path.suffix.lower() == ".toml":
+            # the spec's own variants: the folder may hold others (another seed, an edit)
+            ids = {variant.id for variant in spec.variants}
+            self.rows = [row for row in result.rows if row.get("variant") in ids]
+            if len(self.rows) < len(result.rows):
+                others = (
+                    f"; {len(result.rows) - len(self.rows)} rows of other variants in the folder left out"
+                )
+                self._rank_quietly()
         self.progress = None
         self._redraw()
         self._show_stored(len(spec.variants) if spec else len(self.rows))
         self.query_one("#sweep-table", DataTable).focus()
         self._status(
-            READY, f"{short_path(result.results_path)}: {self._summary()}; ranked by {self.objective}"
+            READY,
+            f"{short_path(result.results_path)}: {self._summary()}; ranked by {self.objective}{others}",
         )
         remember_path("sweeps", path)  # the screen reopens it next time
 

@@ -16,14 +16,7 @@ from textual.widgets import Button, DataTable, Label, Static
 from ladartui.errors import LadarError
 from ladartui.flight import Manual
 from ladartui.tui import bridge
-from ladartui.tui.panels.flight_tables import (
-    SCAN_COLUMNS,
-    SEGMENT_COLUMNS,
-    SHORT_KINDS,
-    FittingTable,
-    fill_scans,
-    fill_segments,
-)
+from ladartui.tui.fitted_tables import SEGMENT_COLUMNS, FittingTable, fill_segments, fill_whole_columns
 from ladartui.tui.params import ParamPanel, field_id
 from ladartui.tui.poses_screen import PosesScreen
 from ladartui.tui.screens import FormScreen
@@ -31,6 +24,9 @@ from ladartui.tui.screens import FormScreen
 if TYPE_CHECKING:
     from ladartui.scenario import Scenario
 
+SCAN_COLUMNS = ("#", "x", "y", "z", "hdg", "az", "dep")
+# Kinds whose usual label is too wide for the segments table (the buttons use these words).
+SHORT_KINDS = {"manual": "Poses", "log": "Log"}
 ADD_BUTTONS = "#add-straight,#add-turn,#add-orbit,#add-flypast,#add-standoff"
 START_UNUSED = "The path starts at its first segment: the start pose is not used."
 
@@ -101,7 +97,7 @@ class FlightPanel(ParamPanel):
             (str(i + 1), *(str(round(v)) for v in (p.x, p.y, p.z, p.heading, p.azimuth, p.depression)))
             for i, p in enumerate(pose for poses in per_segment for pose in poses)
         ]
-        left_out = fill_scans(self.query_one("#scans", FittingTable), scans)
+        left_out = fill_whole_columns(self.query_one("#scans", FittingTable), SCAN_COLUMNS, scans)
         heading = "Scans" + (f" (no room for {', '.join(left_out)})" if left_out else "")
         self.query_one("#scans-heading", Label).update(heading)
 

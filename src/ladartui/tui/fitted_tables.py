@@ -1,9 +1,10 @@
-"""The Flight tab's two tables, drawn to the sidebar's width and never scrolled sideways.
+"""Tables drawn to their width and never scrolled sideways.
 
-A column cut at the table's edge reads as another value (a depression of 44.6
-cut to "4", "r 60 m at 6"), so the segments table wraps a long detail onto
-more lines, whole, and the scans table shows whole columns only and names the
-ones there is no room for. Widths are counted in terminal cells (a wide
+A column cut at a table's edge reads as another value (a depression of 44.6
+cut to "4", "r 60 m at 6", 19.1 ms as "19."), so these tables either wrap a
+long last column onto more lines, whole (the Flight tab's segments), or show
+whole columns only and name the ones there is no room for (its scans, the
+study screen's settings). Widths are counted in terminal cells (a wide
 character takes two).
 """
 
@@ -16,10 +17,7 @@ from rich.text import Text
 from textual import events
 from textual.widgets import DataTable
 
-SEGMENT_COLUMNS = ("#", "Kind", "Scans", "Detail")
-SCAN_COLUMNS = ("#", "x", "y", "z", "hdg", "az", "dep")
-# Kinds whose usual label is too wide for the table (the buttons use these words too).
-SHORT_KINDS = {"manual": "Poses", "log": "Log"}
+SEGMENT_COLUMNS = ("#", "Kind", "Scans", "Detail")  # the Flight tab's
 
 
 class FittingTable(DataTable):
@@ -53,13 +51,15 @@ def fill_segments(table: FittingTable, rows: Sequence[tuple[str, str, str, str]]
         table.move_cursor(row=min(max(cursor, 0), table.row_count - 1))
 
 
-def fill_scans(table: FittingTable, rows: Sequence[tuple[str, ...]]) -> list[str]:
-    """The scans' rows (one cell per ``SCAN_COLUMNS``), with as many whole columns,
-    from the left, as the table's width holds; returns the labels left out."""
+def fill_whole_columns(
+    table: FittingTable, labels: Sequence[str], rows: Sequence[tuple[str, ...]]
+) -> list[str]:
+    """``rows`` (one cell per label) with as many whole columns, from the left, as the
+    table's width holds; returns the labels left out."""
     cursor = table.cursor_row
-    widths = _widths(table, SCAN_COLUMNS, rows)
+    widths = _widths(table, labels, rows)
     room = _room(table, len(rows))
-    shown = len(SCAN_COLUMNS)
+    shown = len(labels)
     if room is not None:
         used = 0
         for index, width in enumerate(widths):
@@ -69,12 +69,12 @@ def fill_scans(table: FittingTable, rows: Sequence[tuple[str, ...]]) -> list[str
                 break
     table.clear(columns=True)
     table.fitted_width = table.size.width
-    table.add_columns(*SCAN_COLUMNS[:shown])
+    table.add_columns(*labels[:shown])
     for cells in rows:
         table.add_row(*(Text(cell) for cell in cells[:shown]))
     if table.row_count:
         table.move_cursor(row=min(max(cursor, 0), table.row_count - 1))
-    return list(SCAN_COLUMNS[shown:])
+    return list(labels[shown:])
 
 
 def _widths(table: DataTable, labels: Sequence[str], rows) -> list[int]:
