@@ -112,6 +112,10 @@ async def test_opening_results_shows_the_ranking_failures_and_pareto_front(finis
         await pilot.pause()
         # impossible values are final, not failures (which run again on resume)
         assert str(screen.query_one("#sweep-counts").render()) == "12 variants, 6 ok, 0 failed, 6 impossible"
+        # a gap between the table and the chart: a value at the table's edge never runs
+        # into the chart's axis numbers ("2958528.9" was variant 29585... and 28.9)
+        table_box, chart_box = screen.query_one("#sweep-table").region, screen.query_one("#sweep-chart").region
+        assert chart_box.x >= table_box.right + 1
         table = screen.query_one("#sweep-table", DataTable)
         assert status_of(screen).state == READY
         assert table.row_count == 12

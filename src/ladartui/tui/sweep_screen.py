@@ -92,7 +92,7 @@ class SweepScreen(RankingView):
     SweepScreen #sweep-counts { width: 1fr; }
     SweepScreen #sweep-body { height: 1fr; }
     SweepScreen #sweep-table { width: 3fr; height: 1fr; }
-    SweepScreen #sweep-chart { width: 2fr; height: 1fr; }
+    SweepScreen #sweep-chart { width: 2fr; height: 1fr; margin-left: 2; }  /* apart from the table */
     SweepScreen #sweep-body.-table #sweep-chart { display: none; }
     SweepScreen #sweep-body.-chart #sweep-table { display: none; }
     SweepScreen #sweep-detail { height: 1; padding: 0 1; background: $panel; }
