@@ -114,7 +114,10 @@ async def test_opening_results_shows_the_ranking_failures_and_pareto_front(finis
         assert str(screen.query_one("#sweep-counts").render()) == "12 variants, 6 ok, 0 failed, 6 impossible"
         # a gap between the table and the chart: a value at the table's edge never runs
         # into the chart's axis numbers ("2958528.9" was variant 29585... and 28.9)
-        table_box, chart_box = screen.query_one("#sweep-table").region, screen.query_one("#sweep-chart").region
+        table_box, chart_box = (
+            screen.query_one("#sweep-table").region,
+            screen.query_one("#sweep-chart").region,
+        )
         assert chart_box.x >= table_box.right + 1
         table = screen.query_one("#sweep-table", DataTable)
         assert status_of(screen).state == READY
@@ -294,6 +297,9 @@ async def test_a_running_sweep_cancels_keeps_its_rows_and_stays_responsive(tmp_p
         await pilot.press("f5", "escape")
         await pilot.pause()
         assert app.screen is not screen
+        # said where the analyst goes, not only on the screen left behind
+        said = f"sweep cancelled on leaving its screen; the rows so far are kept in {screen.out}; F5 resumes"
+        assert screen.last_message == said and said in [n.message for n in app._notifications]
         await wait_for(pilot, lambda: not any(w.is_running for w in app.workers))
         rows, _ = read_table(results)
         assert done <= len(rows) < 720

@@ -393,6 +393,11 @@ class SweepScreen(RankingView):
     def action_close(self) -> None:
         if self.running and self.worker is not None:
             self.worker.cancel()
+            said = (
+                f"sweep cancelled on leaving its screen; the rows so far are kept in {self.out}; F5 resumes"
+            )
+            self._status(NOT_READY, said)
+            self.app.notify(said, severity="warning", markup=False)  # seen on the screen below
         self.dismiss(None)
 
     @on(Button.Pressed, "#cancel")
