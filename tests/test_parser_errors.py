@@ -288,7 +288,7 @@ def test_stray_carriage_return_is_an_error(tmp_path, text, message):
 def write_scenario(folder, scene_text):
     (folder / "m.txt").write_bytes(scene_text)
     save_voxels(folder / "m_Target.txt", np.array([[0, 0, 0]], np.int32))
-    path = folder / "m.toml"
+    path = folder / "plan.toml"  # (m.toml would write m_Target.txt over the target model)
     path.write_text(VALID_SCENARIO.replace("s.txt", "m.txt"))
     return path
 

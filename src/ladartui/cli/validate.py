@@ -28,8 +28,8 @@ def run(args) -> int:
     from ladartui.user_data import bundled_or_path
 
     scenario = load_scenario(bundled_or_path(args.scenario))
-    check_outputs_spare_inputs(scenario)  # what a run would refuse before tracing
     scene_lines = scene_summary(scenario)
+    check_outputs_spare_inputs(scenario)  # what a run would refuse before tracing
     print(scenario.summary())
     for line in [*scene_lines, *last_run_lines(scenario)]:
         print(line)
