@@ -4,6 +4,7 @@ is shown and none closes the app, cancelling reaches the task through its worker
 from __future__ import annotations
 
 import threading
+from contextlib import asynccontextmanager
 
 from textual.app import App
 from textual.widgets import Static
@@ -11,6 +12,20 @@ from textual.widgets import Static
 from ladartui.errors import Cancelled
 from ladartui.tui.work import JobDone, JobProgress, start_job
 from test_tui_flow import LadarApp, loaded, make_scenario, wait_until
+
+
+@asynccontextmanager
+async def study_screen(tmp_path, scene_files, size=(120, 40)):
+    """The app on a small scenario with its study screen (F11) open: (app, pilot, screen)."""
+    from ladartui.tui.study_screen import StudyScreen
+
+    app = LadarApp(make_scenario(tmp_path, scene_files).path)
+    async with app.run_test(size=size) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        await pilot.press("f11")
+        await pilot.pause()
+        assert isinstance(app.screen, StudyScreen)
+        yield app, pilot, app.screen
 
 
 class Host(App):
@@ -77,20 +92,12 @@ async def test_a_study_whose_tracer_fails_unexpectedly_reports_it_and_the_app_st
     tmp_path, scene_files, monkeypatch
 ):
     import ladartui.study.run as study_run
-    from ladartui.tui.study_screen import StudyScreen
 
     def broken(*args, **kwargs):
         raise RuntimeError("the tracer fell over")
 
     monkeypatch.setattr(study_run, "run_study", broken)
-    scenario = make_scenario(tmp_path, scene_files)
-    app = LadarApp(scenario.path)
-    async with app.run_test(size=(120, 40)) as pilot:
-        await wait_until(pilot, lambda: loaded(app))
-        await pilot.press("f11")
-        await pilot.pause()
-        screen = app.screen
-        assert isinstance(screen, StudyScreen)
+    async with study_screen(tmp_path, scene_files) as (app, pilot, screen):
         await pilot.press("q")
         status = screen.query_one("#study-status", Static)
         await wait_until(pilot, lambda: "fell over" in str(status.render()))
@@ -104,7 +111,6 @@ async def test_ctrl_x_cancels_a_study_as_it_cancels_a_run_and_a_sweep(tmp_path, 
 
     import ladartui.study.run as study_run
     from ladartui.errors import Cancelled
-    from ladartui.tui.study_screen import StudyScreen
 
     started = threading.Event()
 
@@ -115,14 +121,7 @@ async def test_ctrl_x_cancels_a_study_as_it_cancels_a_run_and_a_sweep(tmp_path, 
         raise Cancelled("study cancelled")
 
     monkeypatch.setattr(study_run, "run_study", until_cancelled)
-    scenario = make_scenario(tmp_path, scene_files)
-    app = LadarApp(scenario.path)
-    async with app.run_test(size=(120, 40)) as pilot:
-        await wait_until(pilot, lambda: loaded(app))
-        await pilot.press("f11")
-        await pilot.pause()
-        screen = app.screen
-        assert isinstance(screen, StudyScreen)
+    async with study_screen(tmp_path, scene_files) as (app, pilot, screen):
         await pilot.press("q")
         await wait_until(pilot, started.is_set)
         await pilot.press("ctrl+x")
@@ -136,16 +135,8 @@ async def test_ctrl_x_cancels_a_study_as_it_cancels_a_run_and_a_sweep(tmp_path, 
 
 
 async def test_the_study_screen_keeps_its_controls_at_80x24(tmp_path, scene_files):
-    from ladartui.tui.study_screen import StudyScreen
 
-    scenario = make_scenario(tmp_path, scene_files)
-    app = LadarApp(scenario.path)
-    async with app.run_test(size=(80, 24)) as pilot:
-        await wait_until(pilot, lambda: loaded(app))
-        await pilot.press("f11")
-        await pilot.pause()
-        screen = app.screen
-        assert isinstance(screen, StudyScreen)
+    async with study_screen(tmp_path, scene_files, size=(80, 24)) as (app, pilot, screen):
         status = str(screen.query_one("#study-status", Static).render())
         assert status.endswith("q quick, f full, Ctrl+X cancel, Esc back")
         # a result's chart, legend, table and verdict leave the controls on screen
