@@ -10,7 +10,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from textual.screen import Screen
-from textual.widgets import DataTable, Static
+from textual.widgets import DataTable, ProgressBar, Static
 from textual_plotext import PlotextPlot
 
 from ladartui.errors import LadarError
@@ -44,6 +44,14 @@ class RankingView(Screen):
             f", {impossible} impossible" if impossible else ""
         )
 
+    def _show_stored(self, total: int) -> None:
+        """Progress row of opened results: variants in the table out of the spec's."""
+        self.query_one("#sweep-progress", ProgressBar).update(total=max(total, 1), progress=len(self.rows))
+        text = self._summary()
+        if total != len(self.rows):
+            text = f"{len(self.rows)}/{total} stored: " + text.split(" ", 2)[2]
+        self.query_one("#sweep-counts", Static).update(text)
+
     def _redraw_if_dirty(self) -> None:
         if self._dirty:
             self._rank_quietly()
@@ -63,6 +71,30 @@ class RankingView(Screen):
 
             self.ranking = rank_rows(self.rows, "obscured-coverage", None, self.cost)
             self.objective = "obscured-coverage"
+
+    def _switch_to_next(self, name: str, order) -> str:
+        """Rank by the choice of ``name`` ("objective" or "cost") after the current one in
+        ``order``, passing over objectives that need a budget there is not; returns the
+        status line saying what it ranks by (first: a status line is cut at the edge)."""
+        start = order.index(getattr(self, name))
+        skipped = []
+        for step in range(1, len(order) + 1):
+            setattr(self, name, order[(start + step) % len(order)])
+            try:
+                self._rank()
+                break
+            except LadarError:  # no usable budget: go on to the next choice
+                skipped.append(getattr(self, name))
+        self._redraw()
+        if skipped:
+            return (
+                f"ranking by {self.objective}; {', '.join(skipped)} skipped: it needs a budget "
+                "(type one in Budget s)"
+            )
+        text = f"ranking by {self.objective}"
+        if self.objective in BUDGET_OBJECTIVES:
+            text += f" (budget {self._budget():g} s)"
+        return f"{text}, Pareto front against {self.cost}"
 
     def _redraw(self) -> None:
         self._dirty = False

@@ -333,30 +333,9 @@ class SweepScreen(RankingView):
         self._switch("cost", COST_ORDER)
 
     def _switch(self, name: str, order) -> None:
-        start = order.index(getattr(self, name))
-        skipped = []
-        for step in range(1, len(order) + 1):
-            setattr(self, name, order[(start + step) % len(order)])
-            try:
-                self._rank()
-                break
-            except LadarError:  # no usable budget: go on to the next choice
-                skipped.append(getattr(self, name))
-        self._redraw()
-        if skipped:
-            # what is ranked now first: a status line is cut at the screen's edge
-            self._status(
-                self._idle_state(),
-                f"ranking by {self.objective}; {', '.join(skipped)} skipped: it needs a budget "
-                "(type one in Budget s)",
-            )
-            return
-        text = f"ranking by {self.objective}"
-        if self.objective in BUDGET_OBJECTIVES:
-            text += f" (budget {self._budget():g} s)"
         self._status(
             self._idle_state(),
-            f"{text}, Pareto front against {self.cost}",
+            self._switch_to_next(name, order),
             self._fraction() if self.running else None,
             cancellable=self.running,
         )
@@ -506,14 +485,6 @@ class SweepScreen(RankingView):
             f"{short_path(result.results_path)}: {self._summary()}; ranked by {self.objective}{others}",
         )
         remember_path("sweeps", path)  # the screen reopens it next time
-
-    def _show_stored(self, total: int) -> None:
-        """Progress row of opened results: variants in the table out of the spec's."""
-        self.query_one("#sweep-progress", ProgressBar).update(total=max(total, 1), progress=len(self.rows))
-        text = self._summary()
-        if total != len(self.rows):
-            text = f"{len(self.rows)}/{total} stored: " + text.split(" ", 2)[2]
-        self.query_one("#sweep-counts", Static).update(text)
 
     # -- the sweep worker ---------------------------------------------------------------
 
