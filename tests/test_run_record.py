@@ -147,3 +147,16 @@ def test_the_new_dialog_names_the_record_and_will_not_make_one_a_new_scenario(sc
     with pytest.raises(FieldError) as caught:
         bridge.new_scenario(scenario.path.with_name("S_Run.toml"), scenario.scene_file)
     assert "is a run record" in str(caught.value)
+
+
+def test_validate_reports_a_damaged_record_on_its_line_and_still_passes(scenario, capsys):
+    simulate(scenario)
+    record = scenario.path.with_name("S_Run.toml")
+    record.write_text(RECORD_HEADER + "\n[sensor\n", encoding="utf-8")
+    assert main(["validate", str(scenario.path)]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("last run"))
+    assert line.startswith("last run   settings not read: ") and "S_Run.toml" in line
+    record.unlink()  # a set written before records existed
+    assert main(["validate", str(scenario.path)]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("last run"))
+    assert line == "last run   settings not recorded (outputs written before run records)"
