@@ -459,3 +459,13 @@ async def test_the_new_scenario_dialog_refuses_in_the_forms_words(tmp_path, scen
         await pilot.pause()
         said = message(dialog, "#setup-message")
         assert said.startswith("Voxel size m: 0 is not allowed; expected "), said
+
+
+def test_compare_names_files_of_one_stem_apart_by_their_folders():
+    from pathlib import Path
+
+    from ladartui.tui.screens import column_names
+
+    paths = [Path("home/default/default.cmf"), Path("w/d2/default.cmf"), Path("w/other.cmf")]
+    assert column_names(paths) == ["default/default", "d2/default", "other"]
+    assert column_names([Path("a/x.cmf"), Path("b/y.cmf")]) == ["x", "y"]

@@ -114,7 +114,10 @@ async def test_ctrl_x_cancels_a_study_as_it_cancels_a_run_and_a_sweep(tmp_path, 
 
     started = threading.Event()
 
-    def until_cancelled(*args, cancel=None, **kwargs):
+    def until_cancelled(*args, cancel=None, progress=None, **kwargs):
+        from types import SimpleNamespace
+
+        progress(SimpleNamespace(done=1, total=3, label="numba exact", scan=1, scans=2))  # a third done
         started.set()
         while not cancel.wait(0.02):
             pass
@@ -128,6 +131,7 @@ async def test_ctrl_x_cancels_a_study_as_it_cancels_a_run_and_a_sweep(tmp_path, 
         status = screen.query_one("#study-status", Static)
         await wait_until(pilot, lambda: "study cancelled" in str(status.render()))
         assert app.screen is screen  # cancelled, still on the study screen
+        assert screen.query_one("#study-progress").percentage == 0  # not left at 33 %
     # the main screen's Cancel takes Ctrl+X as well as Esc
     from ladartui.tui.actions import keys_in_force
 

@@ -371,14 +371,28 @@ class CompareScreen(Dialog):
             return
         message.update("")
         table.add_column("Measure")
-        for path in text:
-            table.add_column(Text(Path(path).stem))  # names from files: never markup
+        for name in column_names([Path(t) for t in text]):
+            table.add_column(Text(name))  # names from files: never markup
         for row in comparison_rows(loaded):
             table.add_row(*(Text(c) if isinstance(c, str) else c for c in row))
 
     @on(Button.Pressed, "#compare-close")
     def _close(self) -> None:
         self.dismiss(None)
+
+
+def column_names(paths: list[Path]) -> list[str]:
+    """Each file's stem, with as many of its folders as it takes to tell files of one
+    stem apart ("d2/default" and "default/default" for two default.cmf)."""
+    names = []
+    for path in paths:
+        parts = path.with_suffix("").parts
+        same = [p.with_suffix("").parts for p in paths if p.stem == path.stem and p != path]
+        depth = 1
+        while any(other[-depth:] == parts[-depth:] for other in same) and depth < len(parts):
+            depth += 1
+        names.append("/".join(parts[-depth:]))
+    return names
 
 
 class AngleScreen(FormScreen):

@@ -172,6 +172,8 @@ class StudyScreen(Screen):
         self._set_busy(False, message)
         if result is not None:
             self.show_result(result)
+        else:  # cancelled or failed: the bar goes back to idle, not left part-way
+            self.query_one("#study-progress", ProgressBar).update(total=1, progress=0)
 
     def show_result(self, result) -> None:
         """Draw ``result``'s chart, table and verdict."""
