@@ -13,19 +13,10 @@ A file of that name that is not a record (its first line is not
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from ladartui.errors import LadarError, OutputFileError
 from ladartui.scenario_file import RECORD_HEADER, is_record
 
-__all__ = ["RECORD_HEADER", "is_record", "read_run_record", "record_path", "setting_changes"]
-# Scenario keys that change no output (Scenario.same_outputs says the same).
-RUN_ONLY_KEYS = ("simulation.backend", "simulation.fast_mode")
-
-
-def record_path(scenario) -> Path:
-    """Where a run of ``scenario`` writes its record."""
-    return scenario.run_record
+__all__ = ["RECORD_HEADER", "is_record", "read_run_record", "setting_changes"]
 
 
 def as_run(scenario, backend=None, method=None, step=None, precision=None):
@@ -33,16 +24,16 @@ def as_run(scenario, backend=None, method=None, step=None, precision=None):
     placed at its record's path."""
     overrides = {"backend": backend, "method": method, "step": step, "precision": precision}
     changes = {key: value for key, value in overrides.items() if value is not None}
-    return scenario.with_changes(path=record_path(scenario), **changes)
+    return scenario.with_changes(path=scenario.run_record, **changes)
 
 
-def record_text(ran, scenario_path) -> str:
-    """The record's text for ``ran`` (``as_run``), a run of ``scenario_path``."""
-    name = Path(scenario_path).name
-    stem = Path(scenario_path).stem
+def record_text(scenario, ran) -> str:
+    """The record's text for a run of ``scenario`` that went as ``ran`` (``as_run``)."""
+    name = scenario.path.name
     header = (
-        f"{RECORD_HEADER}: the settings that made {stem}_Scene.txt, {stem}_Target.txt and "
-        f"{stem}.cmf,\n# written with them by a run of {name} (replaced by its next run).\n"
+        f"{RECORD_HEADER}: the settings that made {scenario.scene_output.name}, "
+        f"{scenario.target_output.name} and {scenario.measures_file.name},\n"
+        f"# written with them by a run of {name} (replaced by its next run).\n"
         f"# They may differ from {name}: a run can go with unsaved edits or flags.\n\n"
     )
     return header + ran.toml_body()
@@ -50,11 +41,11 @@ def record_text(ran, scenario_path) -> str:
 
 def check_record_spare(scenario) -> None:
     """Refuse a run that would replace a file of the record's name that is not one."""
-    path = record_path(scenario)
+    path = scenario.run_record
     if path.exists() and not is_record(path):
         raise OutputFileError(
             path,
-            f"exists and is not a run record of {Path(scenario.path).name} (a run writes its "
+            f"exists and is not a run record of {scenario.path.name} (a run writes its "
             "settings there): rename that file",
         )
 
@@ -64,7 +55,7 @@ def read_run_record(scenario):
     there is none. A record that cannot be read raises ``LadarError`` naming it."""
     from ladartui.scenario import load_scenario
 
-    path = record_path(scenario)
+    path = scenario.run_record
     if not path.is_file():
         return None
     if not is_record(path):
@@ -76,15 +67,12 @@ def setting_changes(ran, scenario) -> list[str]:
     """The settings that made the outputs (``ran``, the record) where they differ from
     ``scenario``'s, as "sensor.grid 12 (here 8)", in file order; empty when a run of
     ``scenario`` writes the same (``Scenario.same_outputs``)."""
-    was, now = _flat(ran.to_dict()), _flat(scenario.to_dict())
-    ignored = set(RUN_ONLY_KEYS)
-    if not ran.method == scenario.method == "march":
-        ignored.add("simulation.step")  # as Scenario.same_outputs
+    was, now = _flat(ran.to_dict()), _flat(ran.outputs_alike(scenario).to_dict())
     keys = [*was, *(key for key in now if key not in was)]
     return [
         f"{key} {_shown(was.get(key))} (here {_shown(now.get(key))})"
         for key in keys
-        if key not in ignored and was.get(key) != now.get(key)
+        if was.get(key) != now.get(key)
     ]
 
 

@@ -30,11 +30,13 @@ from ladartui.flight import (
 )
 from ladartui.levels import LEVELS, LevelThresholds
 from ladartui.scenario_file import (
+    RECORD_SUFFIX,
     ScenarioReader,
     check_flight,
     checked_target_names,
     is_record,
     parse_document,
+    record_owner,
     resolve_path,
 )
 from ladartui.scenario_style import restyle
@@ -161,7 +163,7 @@ class Scenario:
     @property
     def run_record(self) -> Path:
         """The settings a run went with, written with its outputs (ladartui.run_record)."""
-        return self.path.with_name(f"{self.path.stem}_Run.toml")
+        return self.path.with_name(f"{self.path.stem}{RECORD_SUFFIX}")
 
     # -- use --
 
@@ -202,16 +204,26 @@ class Scenario:
 
     def same_outputs(self, other: Scenario) -> bool:
         """Whether a run of ``other`` writes what a run of this scenario writes: every
-        field equal but the file's name and what only changes how a run goes (the
-        backend, whose answers are the same, and fast mode, which draws less), and
-        the march's step unless both march."""
-        ignored: tuple[str, ...] = RUN_ONLY_FIELDS
-        if not self.method == other.method == "march":
-            ignored += ("step",)  # the march's step (methods that differ differ already)
+        field equal but those ``no_output_fields`` names."""
+        ignored = self.no_output_fields(other)
         return all(
             getattr(self, f.name) == getattr(other, f.name)
             for f in dataclasses.fields(self)
             if f.name not in ignored
+        )
+
+    def no_output_fields(self, other: Scenario) -> tuple[str, ...]:
+        """The fields in which this scenario and ``other`` may differ and still write the
+        same: the file's name, what only changes how a run goes (the backend, whose
+        answers are the same, and fast mode, which draws less), and the march's step
+        unless both march (methods that differ differ already)."""
+        return RUN_ONLY_FIELDS + (() if self.method == other.method == "march" else ("step",))
+
+    def outputs_alike(self, other: Scenario) -> Scenario:
+        """``other`` with this scenario's values in ``no_output_fields``: where it still
+        differs from this one, a run of it writes something else."""
+        return dataclasses.replace(
+            other, **{name: getattr(self, name) for name in self.no_output_fields(other)}
         )
 
     @classmethod
@@ -342,11 +354,10 @@ class Scenario:
         """
         scenario = self if path is None else self.with_changes(path=Path(path))
         if is_record(scenario.path):  # it would say that settings which never ran made outputs
-            owner = scenario.path.name.removesuffix("_Run.toml") + ".toml"
             raise OutputFileError(
                 scenario.path,
-                f"is a run record (the settings that made {owner}'s outputs, written by its runs): "
-                "save under another name",
+                f"is a run record (the settings that made {record_owner(scenario.path)}'s outputs, "
+                "written by its runs): save under another name",
             )
         text = None
         # keep the analyst's comments, key order and layout (not a record's header)

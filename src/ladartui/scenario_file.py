@@ -128,6 +128,7 @@ MAX_TARGET_NAME = 60
 # The first line of a run record (ladartui.run_record): a scenario file that a run
 # writes beside its outputs, saying which settings made them. No save replaces one.
 RECORD_HEADER = "# ladartui run record"
+RECORD_SUFFIX = "_Run.toml"  # S.toml's record is S_Run.toml
 # Segment kinds a scenario file may use: the flight plan's, and recorded logs.
 SEGMENT_FILE_KINDS = {**SEGMENT_KINDS, LogSegment.kind: LogSegment}
 
@@ -402,3 +403,8 @@ def is_record(path) -> bool:
             return file.readline().startswith(RECORD_HEADER)
     except (OSError, UnicodeDecodeError):
         return False
+
+
+def record_owner(path) -> str:
+    """The name of the scenario file whose runs write the record ``path``."""
+    return Path(path).name.removesuffix(RECORD_SUFFIX) + ".toml"

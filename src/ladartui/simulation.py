@@ -26,7 +26,7 @@ import numpy as np
 from ladartui.errors import check_cancelled
 from ladartui.measures import Measures, compute_measures
 from ladartui.returns import fuse_scans, kept_returns
-from ladartui.run_record import as_run, check_record_spare, record_path, record_text
+from ladartui.run_record import as_run, check_record_spare, record_text
 from ladartui.tracing.config import SCAN_BLOCK
 
 RUNS = ("scene", "target")
@@ -174,7 +174,7 @@ def _simulate(scenario, backend, method, step, precision, progress, cancel, outp
     if output_set is not None:
         check_cancelled(cancel, NOTHING_WRITTEN)
         tick = time.perf_counter()
-        record = record_text(as_run(scenario, backend, method, step, precision), scenario.path)
+        record = record_text(scenario, as_run(scenario, backend, method, step, precision))
         outputs = _write_outputs(output_set, scene_output, target_output, measures, record, scene, cancel)
         timings["write"] = time.perf_counter() - tick
     timings["total"] = time.perf_counter() - started
@@ -357,7 +357,7 @@ def output_paths(scenario, las=False) -> dict[str, Path]:
         "scene": Path(scenario.scene_output),
         "target": Path(scenario.target_output),
         "measures": Path(scenario.measures_file),
-        "record": record_path(scenario),
+        "record": scenario.run_record,
     }
     if las:
         paths["scene_las"] = paths["scene"].with_suffix(".las")

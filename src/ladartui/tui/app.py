@@ -25,7 +25,7 @@ from textual.screen import Screen
 from textual.widgets import Button, Footer, TabbedContent, TabPane
 
 from ladartui.edit_history import EditHistory
-from ladartui.run_record import record_path, setting_changes
+from ladartui.run_record import setting_changes
 from ladartui.scenario import Scenario
 from ladartui.tui import actions, bridge
 from ladartui.tui.canvas import ProjectionWidget, TopViewWidget
@@ -336,11 +336,12 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
 
     def outputs_made_with(self) -> str | None:
         """Which other settings made the outputs shown, in words; None: the scenario's now."""
-        if not self.outputs_stale():
+        made, scenario = self.outputs_from, self.scenario
+        if made is None or scenario is None or not self.outputs_stale():
             return None
-        changes = setting_changes(self.outputs_from, self.scenario)
+        changes = setting_changes(made, scenario)
         differ = (": " + "; ".join(changes[:2]) + ("; ..." if len(changes) > 2 else "")) if changes else ""
-        record = record_path(self.scenario)
+        record = scenario.run_record
         if record.is_file():  # written by every run since records exist
             return f"other settings{differ}. The run's are in {record.name}."
         return f"the settings before your edits{differ}."

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 from ladartui.errors import LadarError
 from ladartui.recent import remember_scenario
 from ladartui.run_record import is_record, read_run_record
+from ladartui.scenario_file import record_owner
 from ladartui.tui import bridge
 from ladartui.tui.host import Host
 from ladartui.tui.view_area import prepare_views
@@ -74,24 +75,19 @@ class SceneLoading(Host):
         self.scene = done.scene
         self.prepared = done.prepared
         self.view_area.set_scene(done.prepared, done.scene.voxel_size)
-        earlier = done.earlier
         self.missing_outputs = bridge.missing_outputs(done.scenario)
-        self.outputs_from = earlier.made_with
+        self.outputs_from = done.earlier.made_with  # before the status is drawn
         self.set_scenario(done.scenario, modified=False)
         if done.scenario.path.is_file():
             remember_scenario(done.scenario.path)
         self.file_panel.show_recent(done.scenario.path)
-        self.output_voxels = earlier.output
-        self.show_output()
-        self.show_measures(earlier.measures)
+        self._show_earlier(done.earlier)
         self.run_panel.say("")  # the last run, if any, was another scenario's
         self.set_busy(None)
-        if earlier.warning:
-            self.tell(earlier.warning, severity="warning", timeout=8)
         if is_record(done.scenario.path):
             self.tell(
                 f"{done.scenario.path.name} is a run record: the settings that made "
-                f"{done.scenario.path.name.removesuffix('_Run.toml')}.toml's outputs. Its runs "
+                f"{record_owner(done.scenario.path)}'s outputs. Its runs "
                 "replace it, and Save does not: Save As keeps these settings as a scenario.",
                 severity="warning",
                 timeout=10,
@@ -116,11 +112,15 @@ class SceneLoading(Host):
     def earlier_read(self, earlier: Earlier) -> None:
         if self.scenario is None or self.scenario.path != earlier.scenario.path:
             return  # another file since
+        self._show_earlier(earlier)
+        self.scenario_changed()
+
+    def _show_earlier(self, earlier: Earlier) -> None:
+        """An earlier run's outputs and measures in the views, and what made them."""
         self.outputs_from = earlier.made_with
         self.output_voxels = earlier.output
         self.show_output()
         self.show_measures(earlier.measures)
-        self.scenario_changed()
         if earlier.warning:
             self.tell(earlier.warning, severity="warning", timeout=8)
 
