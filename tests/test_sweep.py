@@ -531,7 +531,7 @@ def test_two_sweeps_never_write_one_folder_at_once(tiny, tmp_path):
 
 def test_the_best_scenario_file_does_not_carry_the_base_files_comments(tmp_path):
     from ladartui.scenario import load_scenario
-    from ladartui.sweep.execute import write_best_scenario
+    from ladartui.sweep.best_file import write_best_scenario
 
     base = write_tiny_scenario(tmp_path)
     text = base.path.read_text().replace("radius = 20.0", "radius = 20.0  # a tight orbit: 20 m")
@@ -540,7 +540,7 @@ def test_the_best_scenario_file_does_not_carry_the_base_files_comments(tmp_path)
     out = tmp_path / "out"
     out.mkdir()
     row = {"variant": "abc12345", "radius": 35.0}
-    path = write_best_scenario(out / "base-best.toml", base, row, ["radius"], base.load_scene)
+    path = write_best_scenario(out / "base-best.toml", base, row, ["radius"], base.load_scene).path
     written = path.read_text()
     # the base's comments described the base's values: not this file's
     assert "20 m" not in written and "4 looks" not in written

@@ -182,6 +182,14 @@ async def test_opening_results_shows_the_ranking_failures_and_pareto_front(finis
         orbit = best.flight.segments[0]
         assert orbit.radius == per_km[0]["radius"] and orbit.scans == per_km[0]["scans"]
         assert str(app.opened[0]) in screen.last_message
+        # Saved with edits, that file is kept: F8 writes the best path beside it and says so.
+        edited = best.with_changes(speed=best.speed + 1).save()
+        mine = edited.path.read_bytes()
+        await pilot.press("f8")
+        await wait_for(pilot, lambda: len(app.opened) == 2)
+        assert edited.path.read_bytes() == mine
+        assert app.opened[1] == edited.path.with_name(f"{edited.path.stem}-2.toml")
+        assert f"{edited.path.name} kept: edited since a sweep wrote it" in screen.last_message
 
         # The detail line shows a failed variant's whole error.
         table.move_cursor(row=table.row_count - 1)

@@ -293,6 +293,7 @@ def result_dict(result, top) -> dict:
         "results": str(result.results_path),
         "ranking": str(result.ranking_path) if result.ranking_path else None,
         "best_scenario": str(result.best_scenario_path) if result.best_scenario_path else None,
+        "best_scenario_kept": str(result.best_kept) if result.best_kept else None,
         "best_levels": levels_text(result.best.row) if result.best is not None else None,
         "charts": {fmt: str(path) for fmt, path in result.charts.items()},
         "top": [entry(r) for r in result.ranking[:top] if r.rank is not None],
@@ -402,6 +403,12 @@ def show_result(console, result, top) -> None:
     if result.best_scenario_path:
         console.print(
             f"best     {result.best_scenario_path}  (open it with: ladartui {result.best_scenario_path})",
+            highlight=False,
+            markup=False,
+        )
+    if result.best_kept:
+        console.print(
+            f"kept     {result.best_kept}  (edited since a sweep wrote it: not replaced)",
             highlight=False,
             markup=False,
         )

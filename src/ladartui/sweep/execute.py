@@ -25,6 +25,7 @@ from pathlib import Path
 
 from ladartui.atomic import atomic_path
 from ladartui.errors import FieldError, InputFileError, LadarError, check_cancelled
+from ladartui.sweep.best_file import write_best_scenario
 from ladartui.sweep.ranking import (
     BUDGET_OBJECTIVES,
     COSTS,
@@ -35,8 +36,7 @@ from ladartui.sweep.ranking import (
 )
 from ladartui.sweep.spec import SweepSpec, bundled_name, load_sweep_spec
 from ladartui.sweep.table import read_table, table_text, write_table
-from ladartui.sweep.variant import ScenePayload, apply_parameters, run_variant
-from ladartui.textsafe import one_line
+from ladartui.sweep.variant import ScenePayload, run_variant
 
 RESULTS_NAME = "results.csv"
 RANKING_NAME = "ranking.csv"
@@ -77,6 +77,7 @@ class SweepResult:
     results_path: Path
     ranking_path: Path | None = None
     best_scenario_path: Path | None = None
+    best_kept: Path | None = None  # an edited best-path file the sweep wrote beside
     ran: int = 0
     resumed: int = 0
     workers: int = 0
@@ -331,9 +332,10 @@ def _run_locked(
     )
     result.ranking_path = write_ranking(out / RANKING_NAME, ranking, spec.parameter_names)
     if result.best is not None:
-        result.best_scenario_path = write_best_scenario(
+        written = write_best_scenario(
             out / f"{spec.name}-best.toml", base, result.best.row, spec.parameter_names, scene
         )
+        result.best_scenario_path, result.best_kept = written.path, written.kept
     result.elapsed = time.perf_counter() - started
     return result
 
@@ -526,25 +528,6 @@ def write_ranking(path, ranking: list[Ranked], parameter_names) -> Path:
     with atomic_path(path) as tmp:
         tmp.write_text(text, encoding="utf-8")
     return Path(path)
-
-
-def write_best_scenario(path, base, row: dict, parameter_names, scene_loader) -> Path:
-    """Save the scenario of ``row`` (the base with its parameters) as a ready-to-open file.
-
-    Written afresh, not over the base file's text: the base's comments describe its own
-    values (an orbit's looks, an altitude's depression), which a variant may change."""
-    from ladartui.atomic import write_text_atomic
-    from ladartui.sweep.table import display_cell
-
-    params = {name: row[name] for name in parameter_names if row.get(name) is not None}
-    scenario = apply_parameters(base, params, scene_loader).with_changes(path=Path(path))
-    settings = ", ".join(f"{name} = {display_cell(value)}" for name, value in params.items())
-    header = one_line(
-        f"# The best flight path of a sweep (variant {row.get('variant', '?')}): "
-        f"{base.path.name}" + (f" with {settings}" if settings else "")
-    )
-    write_text_atomic(scenario.path, header + "\n" + scenario.to_toml())
-    return scenario.path  # relative scene path and outputs follow the file
 
 
 def load_sweep_results(

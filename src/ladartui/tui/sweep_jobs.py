@@ -6,6 +6,10 @@ from __future__ import annotations
 
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ladartui.sweep.best_file import BestScenario
 
 
 def start_resource_tracker() -> None:
@@ -70,10 +74,11 @@ def sweep_job(
             client.close()
 
 
-def write_best(spec, row: dict, parameter_names, path: Path) -> Path:
+def write_best(spec, row: dict, parameter_names, path: Path) -> BestScenario:
     """The best variant as a scenario file beside the results (worker thread)."""
     from ladartui.scenario import load_scenario
-    from ladartui.sweep.execute import base_scenario_path, write_best_scenario
+    from ladartui.sweep.best_file import write_best_scenario
+    from ladartui.sweep.execute import base_scenario_path
 
     base = load_scenario(base_scenario_path(spec))
     return write_best_scenario(path, base, row, parameter_names, base.load_scene)

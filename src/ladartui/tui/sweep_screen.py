@@ -360,14 +360,16 @@ class SweepScreen(RankingView):
                 self.spec, best.row, list(self.parameter_names), self.out / f"{name}.toml", self.objective
             )
             return
-        found = sorted(self.out.glob("*-best.toml")) if self.out is not None else []
-        if len(found) != 1:
+        from ladartui.sweep.best_file import best_files
+
+        found = best_files(self.out) if self.out is not None else []
+        if not found:
             self._status(
                 self._idle_state(),
                 "no best-path scenario in the results folder; open the sweep spec to save one",
             )
             return
-        self._announce_best(found[0], "as saved by the sweep (its spec's objective)")
+        self._announce_best(found[0], "the newest a sweep saved here")
 
     def action_close(self) -> None:
         if self.running and self.worker is not None:
@@ -499,7 +501,8 @@ class SweepScreen(RankingView):
             if message.error:
                 self._status(NOT_READY, f"cannot save the best path: {message.error}")
             elif message.result is not None:
-                self._announce_best(*message.result)
+                written, how = message.result
+                self._announce_best(written.path, how, written.kept)
         elif message.cancelled:
             self._finish(None, "cancelled")
         else:
@@ -586,9 +589,10 @@ class SweepScreen(RankingView):
             lambda cancel, progress: (write_best(spec, row, parameter_names, path), f"best by {objective}"),
         )
 
-    def _announce_best(self, path: Path, how: str) -> None:
-        self.query_one("#sweep-detail", Static).update(Text(f"best path: {path}"))  # a path: never markup
-        self._status(
-            self._idle_state(), f"best path ({how}): {path}", self._fraction() if self.running else None
-        )
+    def _announce_best(self, path: Path, how: str, kept: Path | None = None) -> None:
+        beside = f"; {kept.name} kept: edited since a sweep wrote it" if kept is not None else ""
+        # paths: never markup
+        self.query_one("#sweep-detail", Static).update(Text(f"best path: {path}{beside}"))
+        said = f"best path ({how}): {path}{beside}"
+        self._status(self._idle_state(), said, self._fraction() if self.running else None)
         self.post_message(self.OpenScenario(path))

@@ -1,0 +1,95 @@
+"""The best flight path of a sweep as a scenario file the analyst can open, edit and run.
+
+A sweep (and the sweep screen's F8) writes ``NAME-best.toml`` beside its results.
+The analyst may open that file, change it and save it: a later sweep must not
+write over those edits. So the file's second line carries a fingerprint of what
+the sweep wrote below it: a file whose text still matches its fingerprint is
+the sweep's own and may be replaced; any other file (edited, or the analyst's
+own) is kept, and the best path goes to the first ``NAME-best-2.toml``,
+``NAME-best-3.toml``, ... that is free or the sweep's own.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from ladartui.errors import OutputFileError
+from ladartui.textsafe import one_line
+
+HEADER = "# The best flight path of a sweep"
+_FINGERPRINT = re.compile(r"\(fingerprint ([0-9a-f]{16})\)")
+_NUMBERED = re.compile(r"-best(-\d+)?$")
+_MOST_NUMBERS = 1000  # NAME-best-2 ... NAME-best-999, then refuse
+
+
+@dataclass(frozen=True)
+class BestScenario:
+    """Where the best path was written, and the edited file it was written beside (if any)."""
+
+    path: Path
+    kept: Path | None = None  # NAME-best.toml left as the analyst saved it
+
+
+def _fingerprint(body: str) -> str:
+    return hashlib.sha256(body.encode("utf-8")).hexdigest()[:16]
+
+
+def _is_own(path: Path) -> bool:
+    """Whether ``path`` holds a best path exactly as a sweep wrote it."""
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return False
+    lines = text.split("\n", 2)
+    if len(lines) < 3 or not lines[0].startswith(HEADER):
+        return False
+    found = _FINGERPRINT.search(lines[1])
+    return found is not None and found.group(1) == _fingerprint(lines[2])
+
+
+def best_target(path) -> BestScenario:
+    """Where a best path meant for ``path`` goes: ``path`` itself when free or the
+    sweep's own, else the first numbered name beside it that is."""
+    path = Path(path)
+    if not path.exists() or _is_own(path):
+        return BestScenario(path)
+    for number in range(2, _MOST_NUMBERS):
+        beside = path.with_name(f"{path.stem}-{number}{path.suffix}")
+        if not beside.exists() or _is_own(beside):
+            return BestScenario(beside, kept=path)
+    raise OutputFileError(path, f"and {_MOST_NUMBERS - 2} numbered files beside it are edited: keep fewer")
+
+
+def best_files(folder) -> list[Path]:
+    """The best-path files in ``folder`` as sweeps wrote them (none edited), newest first."""
+    found = [
+        path for path in Path(folder).glob("*-best*.toml") if _NUMBERED.search(path.stem) and _is_own(path)
+    ]
+    return sorted(found, key=lambda path: path.stat().st_mtime_ns, reverse=True)
+
+
+def write_best_scenario(path, base, row: dict, parameter_names, scene_loader) -> BestScenario:
+    """Save the scenario of ``row`` (the base with its parameters) as a ready-to-open file,
+    at ``path`` or beside it (``best_target``).
+
+    Written afresh, not over the base file's text: the base's comments describe its own
+    values (an orbit's looks, an altitude's depression), which a variant may change."""
+    from ladartui.atomic import write_text_atomic
+    from ladartui.sweep.table import display_cell
+    from ladartui.sweep.variant import apply_parameters
+
+    target = best_target(path)
+    params = {name: row[name] for name in parameter_names if row.get(name) is not None}
+    scenario = apply_parameters(base, params, scene_loader).with_changes(path=target.path)
+    settings = ", ".join(f"{name} = {display_cell(value)}" for name, value in params.items())
+    header = one_line(
+        f"{HEADER} (variant {row.get('variant', '?')}): "
+        f"{base.path.name}" + (f" with {settings}" if settings else "")
+    )
+    body = scenario.to_toml()
+    mark = f"# A later sweep replaces this file until it is edited (fingerprint {_fingerprint(body)})."
+    write_text_atomic(scenario.path, f"{header}\n{mark}\n{body}")
+    return target  # relative scene path and outputs follow the file

@@ -1,0 +1,97 @@
+"""The best flight path's scenario file: a sweep replaces its own, never the analyst's edits."""
+
+import pytest
+
+from ladartui.scenario import load_scenario
+from ladartui.sweep import run_sweep
+from ladartui.sweep.best_file import best_files, write_best_scenario
+from tiny_sweep import write_tiny_scenario
+
+
+@pytest.fixture
+def base(tmp_path):
+    return write_tiny_scenario(tmp_path)
+
+
+def _write(base, out, radius, variant="v1"):
+    row = {"variant": variant, "radius": radius}
+    return write_best_scenario(out / "base-best.toml", base, row, ["radius"], base.load_scene)
+
+
+def _radius(path) -> float:
+    return load_scenario(path).flight.segments[0].radius
+
+
+def test_a_later_best_path_replaces_the_sweeps_own_unedited_file(base, tmp_path):
+    first = _write(base, tmp_path, 35.0)
+    assert first.path == tmp_path / "base-best.toml" and first.kept is None
+    second = _write(base, tmp_path, 45.0, "v2")
+    assert second.path == first.path and second.kept is None
+    assert _radius(second.path) == 45.0
+    assert not (tmp_path / "base-best-2.toml").exists()
+
+
+def test_a_best_path_saved_with_edits_is_kept_and_the_next_goes_beside_it(base, tmp_path):
+    first = _write(base, tmp_path, 35.0)
+    # the analyst opens it, changes the speed and saves (comments and layout kept)
+    edited = load_scenario(first.path)
+    edited.with_changes(speed=edited.speed + 10).save()
+    mine = first.path.read_bytes()
+    again = _write(base, tmp_path, 45.0, "v2")
+    assert first.path.read_bytes() == mine
+    assert again.kept == first.path and again.path == tmp_path / "base-best-2.toml"
+    assert _radius(again.path) == 45.0
+    # the file beside it is the sweep's own: the next best path replaces it
+    third = _write(base, tmp_path, 55.0, "v3")
+    assert third.path == again.path and third.kept == first.path
+    assert _radius(third.path) == 55.0 and first.path.read_bytes() == mine
+
+
+def test_a_file_the_sweep_did_not_write_is_never_replaced(base, tmp_path):
+    own = tmp_path / "base-best.toml"
+    own.write_text(base.path.read_text(encoding="utf-8"), encoding="utf-8")  # no fingerprint
+    before = own.read_bytes()
+    written = _write(base, tmp_path, 35.0)
+    assert own.read_bytes() == before and written.kept == own
+    assert written.path == tmp_path / "base-best-2.toml"
+
+
+def test_best_files_lists_the_sweeps_own_unedited_files_newest_first(base, tmp_path):
+    first = _write(base, tmp_path, 35.0)
+    load_scenario(first.path).with_changes(speed=12.0).save()
+    second = _write(base, tmp_path, 45.0)
+    (tmp_path / "other-best.toml").write_text("# mine\n", encoding="utf-8")
+    assert best_files(tmp_path) == [second.path]
+
+
+def test_a_sweep_keeps_an_edited_best_path_and_says_where_the_new_one_is(base, tmp_path):
+    spec = tmp_path / "spec.toml"
+    spec.write_text('[sweep]\nscenario = "base.toml"\n[grid]\nradius = [20.0, 30.0]\n', encoding="utf-8")
+    out = tmp_path / "out"
+    first = run_sweep(spec, serial=True, out=out)
+    best = first.best_scenario_path
+    assert best == out / "spec-best.toml" and first.best_kept is None
+    load_scenario(best).with_changes(speed=12.0).save()
+    mine = best.read_bytes()
+    second = run_sweep(spec, serial=True, out=out)
+    assert best.read_bytes() == mine
+    assert second.best_kept == best and second.best_scenario_path == out / "spec-best-2.toml"
+
+
+def test_the_cli_names_the_kept_file_in_its_summary_and_json(base, tmp_path, capsys):
+    import json
+
+    from ladartui.cli import main
+
+    spec = tmp_path / "spec.toml"
+    spec.write_text('[sweep]\nscenario = "base.toml"\n[grid]\nradius = [20.0, 30.0]\n', encoding="utf-8")
+    assert main(["sweep", str(spec), "--serial", "--json"]) == 0
+    first = json.loads(capsys.readouterr().out)
+    assert first["best_scenario_kept"] is None
+    best = tmp_path / "spec-results" / "spec-best.toml"
+    assert first["best_scenario"] == str(best)
+    load_scenario(best).with_changes(speed=12.0).save()
+    assert main(["sweep", str(spec), "--serial"]) == 0  # every variant resumed, ranked again
+    text = capsys.readouterr().out.replace("\n", "")
+    assert f"kept     {best}  (edited since a sweep wrote it: not replaced)" in text
+    assert f"best     {best.with_name('spec-best-2.toml')}" in text
