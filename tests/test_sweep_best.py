@@ -95,3 +95,18 @@ def test_the_cli_names_the_kept_file_in_its_summary_and_json(base, tmp_path, cap
     text = capsys.readouterr().out.replace("\n", "")
     assert f"kept     {best}  (edited since a sweep wrote it: not replaced)" in text
     assert f"best     {best.with_name('spec-best-2.toml')}" in text
+
+
+def test_a_missing_base_scenario_is_named_on_its_spec_line_before_the_sweep_starts(tmp_path, capsys):
+    from ladartui.cli import main
+
+    spec = tmp_path / "spec.toml"
+    body = '[sweep]\nname = "x"\nscenario = "nope.toml"\n[grid]\nradius = [20.0]\n'
+    spec.write_text(body, encoding="utf-8")
+    assert main(["sweep", str(spec)]) == 2
+    err = capsys.readouterr().err
+    assert err.strip() == (
+        f"ladartui: error: {spec}:3: sweep.scenario: expected an existing scenario file; "
+        f"{str(tmp_path / 'nope.toml')!r} does not exist"
+    )
+    assert not (tmp_path / "x-results").exists()

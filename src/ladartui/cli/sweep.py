@@ -160,7 +160,10 @@ def run(args) -> int:
         result.parameter_names = spec.parameter_names
     else:
         from ladartui.outputset import check_writable_folder
+        from ladartui.scenario import load_scenario
+        from ladartui.sweep.execute import base_scenario_path
 
+        load_scenario(base_scenario_path(spec))  # a bad base is reported before any cluster starts
         check_writable_folder(args.out or default_out_dir(spec))
         result = _sweep_with_progress(spec, args, errors)
         if result is None:

@@ -34,7 +34,7 @@ from ladartui.sweep.ranking import (
     normal_objective,
     rank_rows,
 )
-from ladartui.sweep.spec import SweepSpec, bundled_name, load_sweep_spec
+from ladartui.sweep.spec import SweepSpec, bundled_name, load_sweep_spec, spec_line
 from ladartui.sweep.table import read_table, table_text, write_table
 from ladartui.sweep.variant import ScenePayload, run_variant
 
@@ -143,6 +143,7 @@ def base_scenario_path(spec: SweepSpec) -> Path:
         raise InputFileError(
             spec.path,
             f"sweep.scenario: expected an existing scenario file; {str(spec.scenario_path)!r} does not exist",
+            line=spec_line(spec.path, "sweep", "scenario"),
         )
     return spec.scenario_path
 

@@ -308,6 +308,15 @@ def _is_number(value) -> bool:
     return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
 
 
+def spec_line(path, table: str, key: str) -> int | None:
+    """1-based line of ``key`` in ``[table]`` of the spec file at ``path`` (None if unreadable)."""
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError):
+        return None
+    return _Checker(Path(path), text).line(table, key)
+
+
 class _Checker:
     """Raises InputFileError naming the spec file, the key and what was expected."""
 
