@@ -62,3 +62,27 @@ def test_the_run_progress_keeps_its_figures_whole_in_80_columns():
     for figure in ("scan 240/240", "50.0 %", "12,582,912/25,165,824 rays", "0:00:0", "-:--:--"):
         assert figure in line
     assert "\u2501" in line  # the bar is still there
+
+
+def test_progress_written_to_a_file_is_never_cut_short(monkeypatch):
+    """stderr sent to a log file: no terminal width to fit, so the last progress line is
+    whole (it was cut at 80 columns, ending in an ellipsis)."""
+    import io
+
+    from rich.console import Console
+    from rich.progress import MofNCompleteColumn, TextColumn, TimeElapsedColumn
+
+    from ladartui.cli.progress import progress_display
+
+    monkeypatch.delenv("COLUMNS", raising=False)
+    out = io.StringIO()
+    console = Console(file=out, color_system=None)
+    assert not console.is_terminal
+    note = "96 resumed, 12 failed, 3 impossible, 328.9/min"
+    after = (MofNCompleteColumn(), TextColumn("{task.fields[note]}"), TimeElapsedColumn())
+    with progress_display(console, after, transient=False) as bar:
+        task = bar.add_task("sweep on local cluster", total=960, note="starting")
+        bar.update(task, completed=960, note=note)
+    line = out.getvalue().strip().splitlines()[-1]
+    assert "\u2026" not in line
+    assert line.startswith("sweep on local cluster") and f"960/960 {note} 0:00:0" in line

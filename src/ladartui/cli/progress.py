@@ -8,6 +8,7 @@ the work's cancel event and waits for the worker to stop between chunks.
 from __future__ import annotations
 
 import contextlib
+import os
 import signal
 import threading
 from collections.abc import Callable
@@ -20,6 +21,7 @@ T = TypeVar("T")
 POLL_SECONDS = 0.1  # how soon a Ctrl-C is noticed while waiting
 # Shown until the first scan is done: a first run also compiles the kernels (about a minute).
 FIRST_SCAN = "scan 1 (compiling kernels on a first run)"
+LOG_WIDTH = 200  # progress written to a file or pipe: wide enough for every line
 
 
 def progress_display(console, after, description=None, **options):
@@ -30,6 +32,10 @@ def progress_display(console, after, description=None, **options):
     from rich.progress import BarColumn, Progress, TextColumn
 
     description = description or TextColumn("{task.description}")
+    if not console.is_terminal and "COLUMNS" not in os.environ:
+        # A file or pipe (a log): no width to fit, so a short bar and nothing cut short.
+        console.width = max(console.width, LOG_WIDTH)
+        return Progress(description, BarColumn(bar_width=20), *after, console=console, **options)
     return Progress(description, BarColumn(bar_width=None), *after, console=console, expand=True, **options)
 
 
