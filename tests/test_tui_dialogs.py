@@ -405,13 +405,27 @@ async def test_the_segments_table_fits_the_sidebar_and_wraps_a_long_detail(tmp_p
             # a detail too long for the sidebar goes on over more lines, whole
             assert table.max_scroll_x == 0, size
             rows = [[str(cell) for cell in table.get_row_at(i)] for i in range(table.row_count)]
-            assert [row[3] for row in rows] == whole
+            assert ["".join(row[3].split()) for row in rows] == ["".join(d.split()) for d in whole]
             assert [row[1] for row in rows] == ["Orbit", "Standoff", "Poses", "Log"]
             room = list(table.columns.values())[3].width
             heights = [table.rows[row.key].height for row in table.ordered_rows]
-            for detail, height in zip(whole, heights):
+            for detail, height, row in zip(whole, heights, rows):
                 assert (height > 1) == (cell_len(detail) > room), (size, detail)
+                assert height == len(row[3].split("\n"))
             assert heights[3] > 1 or size == (120, 40)
+
+
+def test_a_wrapped_detail_keeps_each_unit_beside_its_number():
+    from ladartui.tui.fitted_tables import wrap_detail
+
+    # "300 m" wrapped at its space read as two values: "300" and a lone "m"
+    assert wrap_detail("40, 55, 70, 85, 300 m", 17) == ["40, 55, 70, 85,", "300 m"]
+    assert wrap_detail("r 300 m at 150 m", 9) == ["r 300 m", "at 150 m"]
+    assert wrap_detail("left 90 deg r 25 m", 11) == ["left 90 deg", "r 25 m"]
+    assert wrap_detail("r 300 m at 150 m", 40) == ["r 300 m at 150 m"]
+    # a name wider than the room is cut where it must, in cells (a CJK character takes two)
+    assert wrap_detail("飛行記録.csv, 2 Hz", 6) == ["飛行記", "録.csv", ", 2 Hz"]
+    assert all(cell_len(line) <= 6 for line in wrap_detail("飛行記録.csv, 2 Hz", 6))
 
 
 async def test_the_scans_table_shows_whole_columns_only_and_names_those_left_out(tmp_path, scene_files):

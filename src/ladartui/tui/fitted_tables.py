@@ -18,6 +18,7 @@ from textual import events
 from textual.widgets import DataTable
 
 SEGMENT_COLUMNS = ("#", "Kind", "Scans", "Detail")  # the Flight tab's
+UNITS = frozenset({"m", "deg", "Hz", "times", "pose", "poses"})  # kept beside their numbers
 
 
 class FittingTable(DataTable):
@@ -44,11 +45,40 @@ def fill_segments(table: FittingTable, rows: Sequence[tuple[str, str, str, str]]
     table.add_columns(*SEGMENT_COLUMNS[:-1])
     table.add_column(SEGMENT_COLUMNS[-1], width=room)
     for cells in rows:
-        wraps = room is not None and cell_len(cells[-1]) > room
+        lines = wrap_detail(cells[-1], room) if room is not None else [cells[-1]]
         # Text cells: a detail may hold a file's name, never to be read as markup
-        table.add_row(*(Text(cell) for cell in cells), height=None if wraps else 1)
+        table.add_row(*(Text(cell) for cell in cells[:-1]), Text("\n".join(lines)), height=len(lines))
     if table.row_count:
         table.move_cursor(row=min(max(cursor, 0), table.row_count - 1))
+
+
+def wrap_detail(text: str, room: int) -> list[str]:
+    """``text`` in lines of at most ``room`` cells, broken between words, a unit kept on
+    the line of its number ("300 m", never "300" then "m"); a word wider than the room
+    is broken where it must."""
+    words: list[str] = []
+    for word in text.split(" "):
+        if words and word in UNITS:
+            words[-1] += " " + word
+        elif word:
+            words.append(word)
+    lines: list[str] = []
+    line = ""
+    for word in words:
+        joined = f"{line} {word}" if line else word
+        if cell_len(joined) <= room:
+            line = joined
+            continue
+        if line:
+            lines.append(line)
+        while cell_len(word) > room:  # a long file name: cut it, cell by cell
+            cut = len(word)
+            while cut > 1 and cell_len(word[:cut]) > room:
+                cut -= 1
+            lines.append(word[:cut])
+            word = word[cut:]
+        line = word
+    return [*lines, line] if line or not lines else lines
 
 
 def fill_whole_columns(
