@@ -3,6 +3,7 @@ legend outside the plot, measured on plotext's own output."""
 
 from __future__ import annotations
 
+import math
 import random
 
 import pytest
@@ -123,3 +124,15 @@ def test_each_series_has_its_own_colour_in_the_chart_and_its_legend():
     off_front = {family(row.setting) for row in result.rows if not row.front}
     assert {colour for colour, name in entries.items() if name in off_front} <= marker_colours
     assert len(off_front) >= 4
+
+
+def test_the_time_axis_is_ticked_at_round_seconds():
+    from ladartui.study.chart import seconds_ticks
+
+    where, labels = seconds_ticks(-2.2, 1.3)  # 6.3 ms to 20 s: whole powers of ten
+    assert labels == ["10 ms", "100 ms", "1 s", "10 s"]
+    assert where == pytest.approx([-2.0, -1.0, 0.0, 1.0])
+    where, labels = seconds_ticks(-2.2, -1.1)  # under two powers: 2 and 5 times them too
+    assert labels == ["10 ms", "20 ms", "50 ms"]
+    assert where == pytest.approx([-2.0, math.log10(0.02), math.log10(0.05)])
+    assert seconds_ticks(-6.1, -5.5)[1] == ["1 us", "2 us"]

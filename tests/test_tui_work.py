@@ -160,3 +160,28 @@ async def test_the_study_screen_keeps_its_controls_at_80x24(tmp_path, scene_file
         assert shown[:2] == ["setting", "s/scan"] and len(shown) < 7
         note = str(screen.query_one("#study-table-note", Static).render())
         assert note.startswith("no room here for ") and note.endswith(": see study.csv in demo-study")
+
+
+async def test_the_study_chart_is_drawn_again_without_a_crash(tmp_path, scene_files):
+    """plotext applies its log scale to the data it holds, in place: a second drawing of
+    one chart (a resize, or leaving the screen) took log10 of log10 seconds and the app
+    ended with 'math domain error'."""
+    from pathlib import Path
+
+    from ladartui.study.results import read_study
+    from ladartui.tui.study_screen import StudyScreen
+
+    async with study_screen(tmp_path, scene_files, size=(120, 40)) as (app, pilot, screen):
+        screen.show_result(read_study(Path(__file__).parent.parent / "docs" / "study.json"))
+        await pilot.pause()
+        chart = screen.query_one("#study-chart")
+        for size in ((100, 30), (81, 24), (120, 40)):
+            await pilot.resize_terminal(*size)
+            await pilot.pause()
+            chart.refresh()  # drawn again from the data it holds
+            await pilot.pause()
+        text = "\n".join(line.text for line in chart.render_lines(chart.region.reset_offset))
+        assert "seconds per scan" in text
+        await pilot.press("escape")
+        await pilot.pause()
+        assert not isinstance(app.screen, StudyScreen) and app.is_running

@@ -89,20 +89,44 @@ def draw_chart(plt, result: StudyResult, title: str = TITLE, labels=None) -> Non
     if not points:
         plt.text("no measured settings", 0.5, 0.5)
         return
+    # x in log10 seconds on a linear axis, not plotext's log scale: that takes the log
+    # of the data it holds in place, so a second drawing (a resize) took log10 twice
     for name, color in FAMILIES:
-        xs = [x for x, _, row in points if family(row.setting) == name]
+        xs = [math.log10(x) for x, _, row in points if family(row.setting) == name]
         ys = [y for _, y, row in points if family(row.setting) == name]
         if xs:
             plt.scatter(xs, ys, marker=POINT_MARKER, color=color)
     front = sorted((p for p in points if p[2].front), key=lambda p: p[0])
     if front:
-        plt.scatter([p[0] for p in front], [p[1] for p in front], marker=FRONT_MARKER, color=FRONT_COLOR)
+        plt.scatter(
+            [math.log10(p[0]) for p in front], [p[1] for p in front], marker=FRONT_MARKER, color=FRONT_COLOR
+        )
     for text, x, y in labels or []:
-        plt.text(text, x, y, color=FRONT_COLOR, alignment="left")
+        plt.text(text, math.log10(x), y, color=FRONT_COLOR, alignment="left")
     x_range, y_range = chart_limits(points)
-    plt.xscale("log")
-    plt.xlim(*x_range)  # log10 units on a log axis
+    plt.xlim(*x_range)
     plt.ylim(*y_range)
+    plt.xticks(*seconds_ticks(*x_range))
+
+
+def seconds_ticks(lo: float, hi: float) -> tuple[list[float], list[str]]:
+    """Ticks between log10 seconds ``lo`` and ``hi``: each power of ten ("1 ms",
+    "10 ms"), with 2 and 5 times it where fewer than three powers fall in the range."""
+    steps = (1.0,) if math.floor(hi) - math.ceil(lo) >= 2 else (1.0, 2.0, 5.0)
+    where = [
+        math.log10(step) + power
+        for power in range(math.floor(lo), math.ceil(hi) + 1)
+        for step in steps
+        if lo - 1e-9 <= math.log10(step) + power <= hi + 1e-9
+    ]
+    return where, [_tick_label(10**x) for x in where]
+
+
+def _tick_label(seconds: float) -> str:
+    for scale, unit in ((1.0, "s"), (1e-3, "ms"), (1e-6, "us")):
+        if seconds >= scale * 0.999:
+            return f"{seconds / scale:.3g} {unit}"
+    return f"{seconds * 1e9:.3g} ns"
 
 
 def label_places(result: StudyResult, width: int, height: int) -> list[tuple[str, float, float]]:
