@@ -31,7 +31,8 @@ def parse_number(name: str, text: str, integer: bool = False, scale: float = 1.0
         if value != int(value):
             raise FieldError(name, stripped, "a whole number")
         return int(value)
-    return value * scale
+    # dividing by 1e6 gives the double nearest 50 um; times 1e-6 one a bit off it
+    return value / (1.0 / scale) if 0 < scale < 1 else value * scale
 
 
 def refusal(label: str, typed: str, expected: str) -> str:
