@@ -483,3 +483,19 @@ def test_compare_names_files_of_one_stem_apart_by_their_folders():
     paths = [Path("home/default/default.cmf"), Path("w/d2/default.cmf"), Path("w/other.cmf")]
     assert column_names(paths) == ["default/default", "d2/default", "other"]
     assert column_names([Path("a/x.cmf"), Path("b/y.cmf")]) == ["x", "y"]
+
+
+async def test_every_button_of_the_poses_dialog_is_on_screen(tmp_path, scene_files):
+    scenario = make_scenario(tmp_path, scene_files)
+    for size in ((80, 24), (120, 40)):
+        async with opened(scenario, size=size) as (app, pilot):
+            app.action_manual_poses()
+            await pilot.pause()
+            screen = app.screen
+            assert isinstance(screen, PosesScreen)
+            box = screen.query_one(".dialog").content_region
+            for button in screen.query("Button"):
+                region = button.region
+                # Cancel was drawn past the dialog's right edge, out of sight
+                assert region.width >= len(str(button.label)), (size, button.id)
+                assert box.contains_region(region), (size, button.id, region, box)

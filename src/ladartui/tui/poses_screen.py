@@ -61,6 +61,7 @@ class PosesScreen(Dialog):
     DEFAULT_CSS = """
     PosesScreen #poses-table { height: 10; }
     PosesScreen #pose-fields { grid-size: 6 2; height: 2; grid-gutter: 0 1; }
+    PosesScreen .buttons Button { min-width: 0; width: auto; padding: 0 1; }
     """
 
     def on_mount(self) -> None:
