@@ -549,3 +549,20 @@ def test_the_best_scenario_file_does_not_carry_the_base_files_comments(tmp_path)
     )
     saved = load_scenario(path)
     assert saved.flight.segments[0].radius == 35.0 and saved.scene_file == base.scene_file
+
+
+@pytest.mark.parametrize("model", ["tiny.txt", "tiny_Target.txt"])
+def test_a_changed_model_file_runs_every_variant_again(tmp_path, model):
+    """A resumed sweep reused rows made from an earlier scene or target model: the
+    check read the scene's name and size only, and no part of the target model."""
+    write_tiny_scenario(tmp_path)  # its own models: this test changes one
+    spec = write_spec(tmp_path, "[grid]\nradius = [20.0, 30.0]\n", name="models.toml")
+    out = tmp_path / "out"
+    assert run_sweep(spec, serial=True, out=out).ran == 2
+    path = tmp_path / model
+    text = path.read_text(encoding="utf-8")
+    assert "\n14,15,1\n" in text
+    # the same size, another voxel: one of the vehicle's raised by two
+    path.write_text(text.replace("\n14,15,1\n", "\n14,15,3\n"), encoding="utf-8")
+    again = run_sweep(spec, serial=True, out=out)
+    assert (again.ran, again.resumed) == (2, 0)

@@ -117,17 +117,22 @@ def default_out_dir(spec: SweepSpec) -> Path:
 
 
 def base_digest(scenario_path, scenario) -> str:
-    """Short hash of the base scenario file and its scene file's size.
+    """Short hash of the base scenario file and of its scene and target models' bytes.
 
     Stored in every row: a resumed sweep reuses only rows made from the same
-    base, so editing the base scenario re-runs every variant.
+    base, so editing the base scenario or either model re-runs every variant.
     """
     digest = hashlib.sha256(Path(scenario_path).read_bytes())
-    scene_file = getattr(scenario, "scene_file", None)
-    if scene_file is not None:
+    for role in ("scene_file", "target_file"):
+        model = getattr(scenario, role, None)
+        if model is None:
+            continue
+        digest.update(f"\0{role}\0".encode())
         try:
-            digest.update(f"{Path(scene_file).name}:{Path(scene_file).stat().st_size}".encode())
-        except OSError:
+            with open(model, "rb") as handle:
+                for chunk in iter(lambda: handle.read(1 << 20), b""):
+                    digest.update(chunk)
+        except OSError:  # the run of each variant reports the file
             pass
     return digest.hexdigest()[:12]
 
