@@ -566,3 +566,28 @@ def test_a_changed_model_file_runs_every_variant_again(tmp_path, model):
     path.write_text(text.replace("\n14,15,1\n", "\n14,15,3\n"), encoding="utf-8")
     again = run_sweep(spec, serial=True, out=out)
     assert (again.ran, again.resumed) == (2, 0)
+
+
+def test_show_ranks_the_rows_of_the_current_base_only(tmp_path, capsys):
+    """The table keeps rows from an earlier base; a run ranks only the current base's,
+    and so must --show and load_sweep_results given the spec (each variant was
+    ranked once per base it had run with)."""
+    import json
+
+    from ladartui.cli import main
+
+    write_tiny_scenario(tmp_path)
+    spec = write_spec(tmp_path, "[grid]\nradius = [20.0, 30.0]\n", name="bases.toml")
+    run_sweep(spec, serial=True)
+    base = tmp_path / "base.toml"
+    base.write_text(base.read_text(encoding="utf-8").replace("fov_deg = 20.0", "fov_deg = 18.0"))
+    ran = run_sweep(spec, serial=True)
+    assert ran.ran == 2 and len(ran.rows) == 2
+    out = tmp_path / "bases-results"
+    assert len(read_table(out / "results.csv")[0]) == 4  # both bases' rows are kept
+    shown = load_sweep_results(out, spec=load_sweep_spec(spec))
+    assert [r.row["variant"] for r in shown.ranking] == [r.row["variant"] for r in ran.ranking]
+    assert [r.value for r in shown.ranking] == [r.value for r in ran.ranking]
+    assert main(["sweep", str(spec), "--show", "--json"]) == 0
+    top = json.loads(capsys.readouterr().out)["top"]
+    assert [t["variant"] for t in top] == [r.row["variant"] for r in ran.ranking]

@@ -97,7 +97,7 @@ def test_the_recommended_path_names_the_targets_it_identifies_and_when(sweep):
 
 
 def test_a_bundled_scenario_name_is_a_sweep_base(tmp_path):
-    from ladartui.sweep.execute import base_scenario_path
+    from ladartui.sweep.base import base_scenario_path
     from ladartui.sweep.spec import load_sweep_spec
     from ladartui.user_data import bundled_scenario_path
 

@@ -156,12 +156,13 @@ def run(args) -> int:
             objective=args.objective or spec.objective,
             budget=args.budget if args.budget is not None else spec.budget,
             cost=args.cost or spec.cost,
+            spec=spec,
         )
         result.parameter_names = spec.parameter_names
     else:
         from ladartui.outputset import check_writable_folder
         from ladartui.scenario import load_scenario
-        from ladartui.sweep.execute import base_scenario_path
+        from ladartui.sweep.base import base_scenario_path
 
         load_scenario(base_scenario_path(spec))  # a bad base is reported before any cluster starts
         check_writable_folder(args.out or default_out_dir(spec))

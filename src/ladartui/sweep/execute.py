@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
-import hashlib
 import importlib.metadata
 import logging
 import math
@@ -25,6 +24,7 @@ from pathlib import Path
 
 from ladartui.atomic import atomic_path
 from ladartui.errors import FieldError, InputFileError, LadarError, check_cancelled
+from ladartui.sweep.base import base_digest, base_scenario_path, own_rows, spec_rows
 from ladartui.sweep.best_file import write_best_scenario
 from ladartui.sweep.ranking import (
     BUDGET_OBJECTIVES,
@@ -34,7 +34,7 @@ from ladartui.sweep.ranking import (
     normal_objective,
     rank_rows,
 )
-from ladartui.sweep.spec import SweepSpec, bundled_name, load_sweep_spec, spec_line
+from ladartui.sweep.spec import SweepSpec, load_sweep_spec
 from ladartui.sweep.table import read_table, table_text, write_table
 from ladartui.sweep.variant import ScenePayload, run_variant
 
@@ -114,43 +114,6 @@ class SweepResult:
 
 def default_out_dir(spec: SweepSpec) -> Path:
     return spec.path.parent / f"{spec.path.stem}-results"
-
-
-def base_digest(scenario_path, scenario) -> str:
-    """Short hash of the base scenario file and of its scene and target models' bytes.
-
-    Stored in every row: a resumed sweep reuses only rows made from the same
-    base, so editing the base scenario or either model re-runs every variant.
-    """
-    digest = hashlib.sha256(Path(scenario_path).read_bytes())
-    for role in ("scene_file", "target_file"):
-        model = getattr(scenario, role, None)
-        if model is None:
-            continue
-        digest.update(f"\0{role}\0".encode())
-        try:
-            with open(model, "rb") as handle:
-                for chunk in iter(lambda: handle.read(1 << 20), b""):
-                    digest.update(chunk)
-        except OSError:  # the run of each variant reports the file
-            pass
-    return digest.hexdigest()[:12]
-
-
-def base_scenario_path(spec: SweepSpec) -> Path:
-    """The base scenario file (a bundled one is made on first use)."""
-    bundled = bundled_name(spec.scenario_path)
-    if bundled is not None:
-        from ladartui.user_data import bundled_scenario_path
-
-        return bundled_scenario_path(bundled)
-    if not spec.scenario_path.is_file():
-        raise InputFileError(
-            spec.path,
-            f"sweep.scenario: expected an existing scenario file; {str(spec.scenario_path)!r} does not exist",
-            line=spec_line(spec.path, "sweep", "scenario"),
-        )
-    return spec.scenario_path
 
 
 class _LazyScene:
@@ -320,8 +283,7 @@ def _run_locked(
     # The rows as the file holds them (every column present), so this result
     # and load_sweep_results of the same folder agree.
     table_rows, _ = read_table(results_path)
-    position = {(row["variant"], row.get("base")): i for i, row in enumerate(table_rows)}
-    rows = [row for v in variants if (row := stored(v.id)) is not None]
+    rows = own_rows(table_rows, variants, digest)
     ranking = rank_rows(rows, objective, budget, cost)
     result = SweepResult(
         rows=rows,
@@ -537,11 +499,17 @@ def write_ranking(path, ranking: list[Ranked], parameter_names) -> Path:
 
 
 def load_sweep_results(
-    path, objective: str = "obscured-coverage", budget: float | None = None, cost: str = "flight-time"
+    path,
+    objective: str = "obscured-coverage",
+    budget: float | None = None,
+    cost: str = "flight-time",
+    spec: SweepSpec | None = None,
 ) -> SweepResult:
     """Read a sweep's result table (a results.csv or the folder holding it) and rank its rows.
 
-    Every row in the file is included; when a variant appears more than once
+    With ``spec``, the rows are its variants made from its base as it is now
+    (``sweep.base.spec_rows``), as the sweep itself ranks them. Without, every
+    row in the file is included; when a variant appears more than once
     (several base scenarios) each row is kept.
     """
     path = Path(path)
@@ -550,6 +518,8 @@ def load_sweep_results(
     if not path.exists():
         raise InputFileError(path, "no sweep results here")
     rows, header = read_table(path)
+    if spec is not None:
+        rows = spec_rows(rows, spec)
     objective, cost = normal_objective(objective), normal_cost(cost)
     if objective in BUDGET_OBJECTIVES and budget is None:
         raise FieldError("budget", None, "a flight-time budget in seconds")

@@ -77,8 +77,8 @@ def sweep_job(
 def write_best(spec, row: dict, parameter_names, path: Path) -> BestScenario:
     """The best variant as a scenario file beside the results (worker thread)."""
     from ladartui.scenario import load_scenario
+    from ladartui.sweep.base import base_scenario_path
     from ladartui.sweep.best_file import write_best_scenario
-    from ladartui.sweep.execute import base_scenario_path
 
     base = load_scenario(base_scenario_path(spec))
     return write_best_scenario(path, base, row, parameter_names, base.load_scene)

@@ -223,7 +223,7 @@ class SweepScreen(RankingView):
         """Load and check the spec at ``text`` and its base scenario; LadarError if unusable."""
         from ladartui.scenario import load_scenario
         from ladartui.sweep import load_sweep_spec
-        from ladartui.sweep.execute import base_scenario_path
+        from ladartui.sweep.base import base_scenario_path
         from ladartui.sweep.spec import bundled_name
 
         if not text:
@@ -268,16 +268,17 @@ class SweepScreen(RankingView):
             self._status(NOT_READY, str(error))
             return
         from ladartui.sweep import default_out_dir
+        from ladartui.sweep.base import spec_rows
         from ladartui.sweep.table import read_table
 
         serial = self.query_one("#sweep-serial", Checkbox).value and not scheduler
         self.spec, self.out = spec, default_out_dir(spec)
         self.objective, self.cost, self.budget = objective, cost, spec.budget
         self.parameter_names = spec.parameter_names
-        # Rows already in the table for this spec's variants show at once (they resume).
+        # Rows already in the table for this spec's variants and base show at once (they resume).
         ids = {variant.id for variant in spec.variants}
         stored, _ = read_table(self.out / "results.csv")
-        self.rows = [row for row in stored if row.get("variant") in ids]
+        self.rows = spec_rows(stored, spec)
         self._row_index = {row["variant"]: i for i, row in enumerate(self.rows)}
         self._rank()
         if not serial and not scheduler:
@@ -432,6 +433,7 @@ class SweepScreen(RankingView):
 
     def _open(self, text: str) -> None:
         from ladartui.sweep import default_out_dir, load_sweep_results, load_sweep_spec
+        from ladartui.sweep.base import spec_rows
 
         try:
             if not text:
@@ -460,6 +462,11 @@ class SweepScreen(RankingView):
             budget = spec.budget if spec else None
             cost = spec.cost if spec else "flight-time"
             result = load_sweep_results(results, objective=objective, budget=budget, cost=cost)
+            # opened by its spec: the spec's own variants from its base as it is now (the
+            # folder may hold others: another seed, an edited base or model)
+            own = (
+                spec_rows(result.rows, spec) if spec is not None and path.suffix.lower() == ".toml" else None
+            )
         except LadarError as error:
             self._status(NOT_READY, str(error))
             return
@@ -469,15 +476,13 @@ class SweepScreen(RankingView):
         self.objective, self.cost, self.budget = result.objective, result.cost, result.budget
         self.parameter_names = spec.parameter_names if spec else result.parameter_names
         others = ""
-        if spec is not None and path.suffix.lower() == ".toml":
-            # the spec's own variants: the folder may hold others (another seed, an edit)
-            ids = {variant.id for variant in spec.variants}
-            self.rows = [row for row in result.rows if row.get("variant") in ids]
-            if len(self.rows) < len(result.rows):
-                others = (
-                    f"; {len(result.rows) - len(self.rows)} rows of other variants in the folder left out"
-                )
-                self._rank_quietly()
+        if own is not None and len(own) < len(result.rows):
+            self.rows = own
+            others = (
+                f"; {len(result.rows) - len(own)} rows of other variants or an earlier base "
+                "in the folder left out"
+            )
+            self._rank_quietly()
         self.progress = None
         self._redraw()
         self._show_stored(len(spec.variants) if spec else len(self.rows))
