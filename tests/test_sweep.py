@@ -591,3 +591,39 @@ def test_show_ranks_the_rows_of_the_current_base_only(tmp_path, capsys):
     assert main(["sweep", str(spec), "--show", "--json"]) == 0
     top = json.loads(capsys.readouterr().out)["top"]
     assert [t["variant"] for t in top] == [r.row["variant"] for r in ran.ranking]
+
+
+def test_a_range_of_too_many_values_is_refused_on_its_line_even_past_float_range(tmp_path):
+    write_tiny_scenario(tmp_path)
+    body = "[grid]\naltitude = { start = 0.0, stop = 1e300, step = 1e-300 }\n"
+    spec = write_spec(tmp_path, body, name="huge.toml")
+    with pytest.raises(InputFileError, match=r"huge\.toml:4: grid\.altitude: expected at most 100000 values"):
+        load_sweep_spec(spec)
+
+
+@pytest.mark.parametrize("budget", [-1.0, 0.0, math.nan, math.inf, "abc", True])
+def test_run_sweep_refuses_a_budget_that_is_no_positive_number(tiny, tmp_path, budget):
+    from ladartui.errors import FieldError
+
+    spec = write_spec(tiny, "[grid]\nradius = [20.0]\n", name="budget.toml")
+    with pytest.raises(FieldError, match=r"^budget.*expected a flight-time budget in seconds, > 0"):
+        run_sweep(spec, serial=True, out=tmp_path / "o", objective="coverage-within-budget", budget=budget)
+    assert not (tmp_path / "o").exists()
+
+
+def test_run_sweep_names_a_file_given_as_its_results_folder(tiny, tmp_path):
+    from ladartui.errors import OutputFileError
+
+    spec = write_spec(tiny, "[grid]\nradius = [20.0]\n", name="outfile.toml")
+    with pytest.raises(OutputFileError, match="is a file, expected a folder"):
+        run_sweep(spec, serial=True, out=spec)
+
+
+def test_the_cli_refuses_an_infinite_budget_before_running(tiny, tmp_path, capsys):
+    from ladartui.cli import main
+
+    spec = write_spec(tiny, "[grid]\nradius = [20.0]\n", name="inf.toml")
+    args = ["sweep", str(spec), "--serial", "--objective", "coverage-within-budget", "--budget", "inf"]
+    assert main([*args, "--json", "--out", str(tmp_path / "o")]) == 2
+    assert "--budget" in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()

@@ -8,6 +8,7 @@ command resumes. Progress goes to stderr, the ranking to stdout.
 from __future__ import annotations
 
 import json
+import math
 import os
 import threading
 
@@ -140,7 +141,7 @@ def run(args) -> int:
     spec = load_sweep_spec(args.spec)
     objective = normal_objective(args.objective or spec.objective)
     normal_cost(args.cost or spec.cost)
-    if args.budget is not None and not args.budget > 0:
+    if args.budget is not None and not (math.isfinite(args.budget) and args.budget > 0):
         raise FieldError("--budget", args.budget, "a flight-time budget in seconds, > 0")
     if objective in BUDGET_OBJECTIVES and args.budget is None and spec.budget is None:
         raise FieldError(

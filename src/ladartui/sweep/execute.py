@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ladartui.atomic import atomic_path
-from ladartui.errors import FieldError, InputFileError, LadarError, check_cancelled
+from ladartui.errors import FieldError, InputFileError, LadarError, OutputFileError, check_cancelled
 from ladartui.sweep.base import base_digest, base_scenario_path, own_rows, spec_rows
 from ladartui.sweep.best_file import write_best_scenario
 from ladartui.sweep.ranking import (
@@ -112,6 +112,14 @@ class SweepResult:
         return sorted((r for r in self.ranking if r.pareto), key=_cheapest_first)
 
 
+def checked_budget(budget) -> float:
+    """``budget`` as seconds; FieldError unless it is a finite number > 0."""
+    ok = isinstance(budget, (int, float)) and not isinstance(budget, bool)
+    if not (ok and math.isfinite(budget) and budget > 0):
+        raise FieldError("budget", budget, "a flight-time budget in seconds, > 0")
+    return float(budget)
+
+
 def default_out_dir(spec: SweepSpec) -> Path:
     return spec.path.parent / f"{spec.path.stem}-results"
 
@@ -158,7 +166,10 @@ def run_sweep(
         spec = load_sweep_spec(spec)
     objective = normal_objective(objective or spec.objective)
     cost = normal_cost(cost or spec.cost)
-    budget = spec.budget if budget is None else float(budget)
+    if budget is not None:
+        budget = checked_budget(budget)
+    else:
+        budget = spec.budget
     if objective in BUDGET_OBJECTIVES and budget is None:
         raise FieldError(
             "budget",
@@ -168,6 +179,8 @@ def run_sweep(
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise FieldError("workers", workers, "an integer >= 1")
     out = Path(out) if out is not None else default_out_dir(spec)
+    if out.exists() and not out.is_dir():
+        raise OutputFileError(out, "is a file, expected a folder")
     from ladartui.scenario import load_scenario
 
     base_path = base_scenario_path(spec)
@@ -521,6 +534,8 @@ def load_sweep_results(
     if spec is not None:
         rows = spec_rows(rows, spec)
     objective, cost = normal_objective(objective), normal_cost(cost)
+    if budget is not None:
+        budget = checked_budget(budget)
     if objective in BUDGET_OBJECTIVES and budget is None:
         raise FieldError("budget", None, "a flight-time budget in seconds")
     known = {

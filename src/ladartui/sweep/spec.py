@@ -187,6 +187,7 @@ def _random_draws(spec: SweepSpec) -> list[dict]:
 
 # Variants a sweep may expand to; each is a whole run (and a row of the results table).
 MAX_VARIANTS = 100_000
+MAX_RANGE_VALUES = 100_000  # in one { start, stop, step } range
 # Random bounds beyond this overflow the draws (floats: max - min; integers: int64).
 RANDOM_BOUND = 1e15
 
@@ -402,9 +403,12 @@ class _Checker:
         start, stop, step = (self.scalar(key, name, table[k]) for k in ("start", "stop", "step"))
         if not step > 0 or stop < start:
             self.fail(key, "step > 0 and stop >= start", table)
-        count = int(math.floor((stop - start) / step + 1e-9)) + 1
-        if count > 100_000:
-            self.fail(key, "at most 100000 values in a range", table)
+        span = (stop - start) / step  # inf past float range: never made an int
+        if not span < MAX_RANGE_VALUES:
+            self.fail(key, f"at most {MAX_RANGE_VALUES} values in a range", table)
+        count = int(math.floor(span + 1e-9)) + 1
+        if count > MAX_RANGE_VALUES:
+            self.fail(key, f"at most {MAX_RANGE_VALUES} values in a range", table)
         values = [start + i * step for i in range(count)]
         if PARAMETERS[name].kind == "float":
             # Round away float noise (0.1 * 3) so ids and file names stay readable.
