@@ -254,3 +254,37 @@ def test_an_unreachable_scheduler_is_named_in_one_line():
     message = str(caught.value)
     assert "--scheduler" in message and "tcp://127.0.0.1:9" in message and "\n" not in message
     assert time.monotonic() - started < 15
+
+
+def test_a_script_without_a_main_guard_is_told_what_to_change(tmp_path):
+    """A local cluster's workers import the main script: one that calls run_sweep at its
+    top level started the sweep again in each worker, which the folder lock refused
+    ('another sweep is writing its results here'), pointing the user the wrong way."""
+    write_tiny_spec(tmp_path)
+    script = tmp_path / "unguarded.py"
+    script.write_text(
+        "from ladartui.sweep import run_sweep\n"
+        "result = run_sweep('spec.toml', workers=1)\n"
+        "print('ran', result.ran)\n",
+        encoding="utf-8",
+    )
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).parent.parent / "src")}
+    done = subprocess.run(
+        [sys.executable, str(script)], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300
+    )
+    assert done.returncode != 0 and "ran" not in done.stdout
+    assert f"run_sweep was called while a worker process imported the script {str(script)!r}" in done.stderr
+    assert 'if __name__ == "__main__":' in done.stderr.splitlines()[-1]
+    assert "another sweep" not in done.stderr
+    # as the docs show it, under the guard, the same sweep runs
+    script.write_text(
+        "from ladartui.sweep import run_sweep\n\n"
+        "if __name__ == '__main__':\n"
+        "    result = run_sweep('spec.toml', workers=1)\n"
+        "    print('ran', result.ran)\n",
+        encoding="utf-8",
+    )
+    done = subprocess.run(
+        [sys.executable, str(script)], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300
+    )
+    assert done.returncode == 0 and done.stdout.split() == ["ran", "8"], done.stderr

@@ -112,6 +112,24 @@ class SweepResult:
         return sorted((r for r in self.ranking if r.pareto), key=_cheapest_first)
 
 
+def _refuse_in_worker_start() -> None:
+    """A local cluster starts each worker process by importing the caller's script: a
+    script that calls run_sweep outside ``if __name__ == "__main__":`` would start the
+    sweep again in every worker (each refused by the folder lock, the cluster failing)."""
+    import sys
+    import types
+
+    frame: types.FrameType | None = sys._getframe(1)
+    while frame is not None:  # the script runs as "__mp_main__" while a worker imports it
+        if frame.f_globals.get("__name__") == "__mp_main__":
+            raise LadarError(
+                "run_sweep was called while a worker process imported the script "
+                f"{frame.f_globals.get('__file__', '')!r}: put the sweep under "
+                "'if __name__ == \"__main__\":' (a local cluster's workers import the main script)"
+            )
+        frame = frame.f_back
+
+
 def checked_budget(budget) -> float:
     """``budget`` as seconds; FieldError unless it is a finite number > 0."""
     ok = isinstance(budget, (int, float)) and not isinstance(budget, bool)
@@ -162,6 +180,7 @@ def run_sweep(
     ``out/ranking.csv`` and the best scenario ``out/<name>-best.toml``.
     """
     started = time.perf_counter()
+    _refuse_in_worker_start()
     if not isinstance(spec, SweepSpec):
         spec = load_sweep_spec(spec)
     objective = normal_objective(objective or spec.objective)
@@ -394,14 +413,20 @@ def local_client(workers: int | None = None):
 
     cores = os.cpu_count() or 1
     count = workers or cores
-    cluster = LocalCluster(
-        n_workers=count,
-        threads_per_worker=1,
-        processes=True,
-        dashboard_address=None,
-        silence_logs=logging.ERROR,
-        env={"NUMBA_NUM_THREADS": str(max(1, cores // count))},
-    )
+    try:
+        cluster = LocalCluster(
+            n_workers=count,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            silence_logs=logging.ERROR,
+            env={"NUMBA_NUM_THREADS": str(max(1, cores // count))},
+        )
+    except RuntimeError as error:  # "Nanny failed to start": the worker said why above
+        raise LadarError(
+            f"the local cluster's worker processes failed to start ({error}); their messages above say "
+            "why. From a script, call run_sweep under 'if __name__ == \"__main__\":'"
+        ) from error
     client = Client(cluster)
     _workers_ignore_ctrl_c(client)
     return client
