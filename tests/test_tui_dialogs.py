@@ -235,7 +235,7 @@ async def test_outputs_from_other_settings_are_said_to_be_out_of_date(tmp_path, 
         assert bar.message == f"{scenario.path.name} (modified): outputs out of date; F5 reruns."
         assert str(info.render()) == (
             f"Measures of {scenario.name}, from other settings: sensor.grid 8 (here 12). "
-            f"The run's are in {scenario.name}_Run.toml."
+            f"The run's settings are in {scenario.name}_Run.toml."
         )
         # back to the settings that ran (undo): up to date again, though not yet saved
         await pilot.press("ctrl+z")
@@ -263,7 +263,7 @@ async def test_outputs_a_run_made_from_unsaved_settings_are_out_of_date_on_openi
         info = app.query_one("#results-info")
         assert str(info.render()) == (
             f"Measures of {scenario.name}, from other settings: sensor.grid 12 (here 8). "
-            f"The run's are in {scenario.name}_Run.toml."
+            f"The run's settings are in {scenario.name}_Run.toml."
         )
         files = str(app.query_one("#file-info").render())
         assert f"Run record    {scenario.name}_Run.toml" in files
@@ -499,3 +499,14 @@ async def test_every_button_of_the_poses_dialog_is_on_screen(tmp_path, scene_fil
                 # Cancel was drawn past the dialog's right edge, out of sight
                 assert region.width >= len(str(button.label)), (size, button.id)
                 assert box.contains_region(region), (size, button.id, region, box)
+
+
+def test_the_settings_that_made_the_outputs_are_named_in_a_sentence():
+    from ladartui.tui.app import named_changes
+
+    # a third change read "...; ...." before the next sentence
+    assert named_changes(["a 1 (here 2)", "b 3 (here 4)", "c 5 (here 6)"]) == (
+        ": a 1 (here 2); b 3 (here 4); and 1 more"
+    )
+    assert named_changes(["a 1 (here 2)"]) == ": a 1 (here 2)"
+    assert named_changes([]) == ""

@@ -339,11 +339,10 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         made, scenario = self.outputs_from, self.scenario
         if made is None or scenario is None or not self.outputs_stale():
             return None
-        changes = setting_changes(made, scenario)
-        differ = (": " + "; ".join(changes[:2]) + ("; ..." if len(changes) > 2 else "")) if changes else ""
+        differ = named_changes(setting_changes(made, scenario))
         record = scenario.run_record
         if record.is_file():  # written by every run since records exist
-            return f"other settings{differ}. The run's are in {record.name}."
+            return f"other settings{differ}. The run's settings are in {record.name}."
         return f"the settings before your edits{differ}."
 
     def outputs_stale(self) -> bool:
@@ -567,3 +566,11 @@ def _runner(app, action: str):
         app.call_later(app.run_action, action)
 
     return run
+
+
+def named_changes(changes: list[str], shown: int = 2) -> str:
+    """ ": a; b; and 3 more" for the first ``shown`` changes (empty for none)."""
+    if not changes:
+        return ""
+    more = len(changes) - shown
+    return ": " + "; ".join(changes[:shown]) + (f"; and {more} more" if more > 0 else "")
