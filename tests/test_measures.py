@@ -229,3 +229,20 @@ def test_voxel_keys_round_trip_at_the_limits():
     assert np.argsort(keys).tolist() == [0, 3, 2, 1]
     with pytest.raises(FieldError, match="voxel index"):
         voxel_keys(np.array([[0, 0, 2**19 - 1]]))
+
+
+def test_a_huge_figure_is_written_with_an_exponent_not_hundreds_of_digits():
+    """A speed of 1e-300 m/s made a flight time of 4e301 s, shown as 300 digits that the
+    Results table cut to what read as about 4e13."""
+    from ladartui.levels import LevelReached
+    from ladartui.measures import format_number
+    from ladartui.number_text import fixed
+    from ladartui.tui.measures_view import format_value
+
+    huge = 4.0543261909900e301
+    assert fixed(huge, 1) == "4.054e+301" and fixed(-huge, 3) == "-4.054e+301"
+    assert fixed(12.34, 1) == "12.3" and fixed(9_999_999_999.0, 1) == "9999999999.0"
+    assert format_value(huge, "num1") == "4.054e+301" and format_value(huge, "x") == "4.054e+301"
+    assert format_number(huge, 1, "s") == "4.054e+301 s"
+    reached = LevelReached("detect", True, scan=2, flight_time_s=huge, distance_m=62.8)
+    assert reached.describe() == "scan 2, 4.054e+301 s, 62.8 m"

@@ -42,6 +42,7 @@ import numpy as np
 
 from ladartui.checks import range_text
 from ladartui.errors import FieldError, InputFileError
+from ladartui.number_text import fixed
 
 LEVELS = ("detect", "recognise", "identify")
 NOT_REACHED = "not reached"
@@ -133,7 +134,8 @@ class LevelReached:
         """``scan 3, 4.2 s, 125.7 m`` or ``not reached``."""
         if not self.reached:
             return NOT_REACHED
-        return f"scan {self.scan}, {self.flight_time_s:.1f} s, {self.distance_m:.1f} m"
+        assert self.flight_time_s is not None and self.distance_m is not None  # set when reached
+        return f"scan {self.scan}, {fixed(self.flight_time_s, 1)} s, {fixed(self.distance_m, 1)} m"
 
     def to_dict(self) -> dict:
         return {

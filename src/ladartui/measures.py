@@ -45,6 +45,7 @@ import numpy as np
 from ladartui.atomic import write_text_atomic
 from ladartui.directions import DirectionStats, angle_between, direction_stats
 from ladartui.errors import InputFileError
+from ladartui.number_text import fixed
 from ladartui.scene.keys import member as _member
 from ladartui.scene.keys import sorted_unique, visible_mask, voxel_keys
 
@@ -530,14 +531,14 @@ def format_number(value, digits=3, unit="") -> str:
     """A number with ``digits`` decimals (and a unit), or "undefined"."""
     if value is None:
         return UNDEFINED
-    return f"{value:.{digits}f}{' ' + unit if unit else ''}"
+    return f"{fixed(value, digits)}{' ' + unit if unit else ''}"
 
 
 def format_vector(vector, digits=3) -> str:
     """A 3-vector as "x, y, z", or "undefined"."""
     if vector is None:
         return UNDEFINED
-    return ", ".join(f"{c:.{digits}f}" for c in vector)
+    return ", ".join(fixed(c, digits) for c in vector)
 
 
 def view_rows(measures: Measures) -> list[tuple[str, ...]]:

@@ -6,6 +6,7 @@ from rich.text import Text
 
 from ladartui.colour import target_colour
 from ladartui.levels import LEVELS
+from ladartui.number_text import fixed
 
 UNDEFINED = "undefined"
 
@@ -70,10 +71,10 @@ def format_value(value, kind: str) -> str:
     if kind == "int":
         return f"{int(value):,}"
     if kind == "vec":
-        return ", ".join(f"{float(v):.3f}" for v in value)
+        return ", ".join(fixed(v, 3) for v in value)
     if kind == "num1":
-        return f"{float(value):.1f}"
-    return f"{float(value):.3f}"
+        return fixed(value, 1)
+    return fixed(value, 3)
 
 
 def measure_rows(measures) -> list[tuple[str, str]]:
@@ -155,7 +156,7 @@ def level_rows(measures, short: bool = False) -> list[tuple[str, str]]:
     rows = []
     for item in levels.levels:
         if short and item.reached:
-            text = f"scan {item.scan}, {item.flight_time_s:.1f} s"
+            text = f"scan {item.scan}, {fixed(item.flight_time_s, 1)} s"
         else:
             text = item.describe()
         rows.append((item.level.capitalize(), text))

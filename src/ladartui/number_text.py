@@ -1,0 +1,16 @@
+"""Numbers as text for tables and sentences."""
+
+from __future__ import annotations
+
+import math
+
+FIXED_BELOW = 1e10  # from here on a number is written with an exponent
+
+
+def fixed(value: float, digits: int) -> str:
+    """``value`` with ``digits`` decimals; from 1e10 on with an exponent ("4.054e+301"),
+    never hundreds of digits that a table cuts to a smaller-looking number."""
+    value = float(value)
+    if math.isfinite(value) and abs(value) >= FIXED_BELOW:
+        return f"{value:.4g}"
+    return f"{value:.{digits}f}"
