@@ -86,3 +86,31 @@ def test_progress_written_to_a_file_is_never_cut_short(monkeypatch):
     line = out.getvalue().strip().splitlines()[-1]
     assert "\u2026" not in line
     assert line.startswith("sweep on local cluster") and f"960/960 {note} 0:00:0" in line
+
+
+def test_the_sweep_progress_keeps_its_figures_whole_in_80_columns():
+    """Counts, rate and the times were cut ('0:00:…') in an 80-column terminal."""
+    import io
+    from types import SimpleNamespace
+
+    from rich.console import Console
+
+    from ladartui.cli.sweep import progress_note, sweep_progress
+
+    out = io.StringIO()
+    console = Console(file=out, width=80, force_terminal=True, color_system=None)
+    worst = SimpleNamespace(done=960, total=960, resumed=96, failed=12, impossible=3, elapsed=157.0)
+    note = progress_note(worst)
+    assert note == "96 resumed, 12 failed, 3 impossible, 330.2/min"
+    assert progress_note(SimpleNamespace(done=4, resumed=0, failed=0, impossible=0, elapsed=2.0)) == (
+        "120.0/min"
+    )
+    with sweep_progress(console, auto_refresh=False) as bar:
+        task = bar.add_task("sweep", total=960, note="starting")
+        bar.update(task, completed=480, note=note)
+        bar.refresh()
+    shown = re.sub(r"\x1b\[[0-9;?]*[A-Za-z]", "", out.getvalue())
+    line = [line for line in shown.replace("\r", "\n").splitlines() if "sweep" in line][-1]
+    assert len(line) <= 80 and "\u2026" not in line
+    assert re.search(f"480/960 {re.escape(note)} (-:--:--|\\d:\\d\\d:\\d\\d)$", line.rstrip())
+    assert "\u2501" in line

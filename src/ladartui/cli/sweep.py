@@ -183,41 +183,45 @@ def run(args) -> int:
     return 0
 
 
-def _sweep_with_progress(spec, args, console):
-    from rich.progress import (
-        MofNCompleteColumn,
-        TextColumn,
-        TimeElapsedColumn,
-        TimeRemainingColumn,
-    )
+def sweep_progress(console, **options):
+    """The sweep's progress line: bar, variants done of all, the counts that are not
+    zero and the rate, the time left (every figure whole in 80 columns; the summary
+    says how long it took)."""
+    from rich.progress import MofNCompleteColumn, TextColumn, TimeRemainingColumn
 
+    after = (MofNCompleteColumn(), TextColumn("{task.fields[note]}"), TimeRemainingColumn())
+    return progress_display(console, after, transient=False, **options)
+
+
+def progress_note(p) -> str:
+    """'12 resumed, 2 failed, 1 impossible, 86.0/min', leaving out counts of zero."""
+    ran = p.done - p.resumed
+    counts = ((p.resumed, "resumed"), (p.failed, "failed"), (p.impossible, "impossible"))
+    parts = [f"{count} {what}" for count, what in counts if count]
+    if ran and p.elapsed > 0:
+        parts.append(f"{60 * ran / p.elapsed:.1f}/min")
+    return ", ".join(parts)
+
+
+def _sweep_with_progress(spec, args, console):
     from ladartui.sweep import connect, run_sweep
 
     client = connect(args.scheduler, args.connect_timeout, args.security) if args.scheduler else None
     cancel = threading.Event()
     outcome = {}
-    after = (
-        MofNCompleteColumn(),
-        TextColumn("{task.fields[note]}"),
-        TimeElapsedColumn(),
-        TimeRemainingColumn(),
-    )
     where = (
         f"scheduler {args.scheduler}"
         if args.scheduler
         else ("this process" if args.serial else "local cluster")
     )
+    console.print(f"sweep of {len(spec.variants)} variants on {where}", highlight=False, markup=False)
     try:
-        with progress_display(console, after, transient=False) as bar:
-            task = bar.add_task(f"sweep on {where}", total=len(spec.variants), note="starting")
+        with sweep_progress(console) as bar:
+            task = bar.add_task("sweep", total=len(spec.variants), note="starting")
 
             def report(p):
                 outcome["progress"] = p
-                ran = p.done - p.resumed
-                rate = f", {60 * ran / p.elapsed:.1f}/min" if ran and p.elapsed > 0 else ""
-                impossible = f", {p.impossible} impossible" if p.impossible else ""
-                note = f"{p.resumed} resumed, {p.failed} failed{impossible}{rate}"
-                bar.update(task, completed=p.done, total=p.total, note=note)
+                bar.update(task, completed=p.done, total=p.total, note=progress_note(p))
 
             def work():
                 return run_sweep(
