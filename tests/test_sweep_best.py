@@ -110,3 +110,29 @@ def test_a_missing_base_scenario_is_named_on_its_spec_line_before_the_sweep_star
         f"{str(tmp_path / 'nope.toml')!r} does not exist"
     )
     assert not (tmp_path / "x-results").exists()
+
+
+def test_a_ctrl_c_while_the_charts_are_drawn_waits_for_the_whole_set(base, tmp_path, capsys, monkeypatch):
+    """The charts were drawn after the sweep, outside its cancel: a Ctrl-C then left this
+    run's ranking and best path beside the last run's charts, saying only 'interrupted'."""
+    import _thread
+
+    import ladartui.charts.sweep as charts
+    from ladartui.cli import main
+
+    spec = tmp_path / "spec.toml"
+    spec.write_text('[sweep]\nscenario = "base.toml"\n[grid]\nradius = [20.0, 30.0]\n', encoding="utf-8")
+    draw = charts.write_sweep_charts
+    drawn = []
+
+    def interrupted_while_drawing(result, folder):
+        _thread.interrupt_main()  # as the key lands on the main thread
+        drawn.append(draw(result, folder))
+        return drawn[-1]
+
+    monkeypatch.setattr(charts, "write_sweep_charts", interrupted_while_drawing)
+    assert main(["sweep", str(spec), "--serial"]) == 0
+    out = capsys.readouterr().out.replace("\n", "")
+    assert drawn and all(path.is_file() for path in drawn[0].values())
+    for path in drawn[0].values():
+        assert f"chart    {path}" in out

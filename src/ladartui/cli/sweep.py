@@ -170,9 +170,10 @@ def run(args) -> int:
         result = _sweep_with_progress(spec, args, errors)
         if result is None:
             return stop_status()
-    from ladartui.charts.sweep import write_sweep_charts
+    if not result.charts:  # --show redraws them
+        from ladartui.charts.sweep import write_sweep_charts
 
-    result.charts = write_sweep_charts(result, result.results_path.parent)
+        result.charts = write_sweep_charts(result, result.results_path.parent)
     if args.json:
         print(json.dumps(result_dict(result, args.top), indent=2, allow_nan=False))
     else:
@@ -224,7 +225,7 @@ def _sweep_with_progress(spec, args, console):
                 bar.update(task, completed=p.done, total=p.total, note=progress_note(p))
 
             def work():
-                return run_sweep(
+                result = run_sweep(
                     spec,
                     client=client,
                     progress=report,
@@ -236,6 +237,12 @@ def _sweep_with_progress(spec, args, console):
                     cost=args.cost,
                     serial=args.serial,
                 )
+                # Drawn here, with the ranking and best path written: a Ctrl-C once every
+                # variant is done waits for the whole set (it left the last run's charts).
+                from ladartui.charts.sweep import write_sweep_charts
+
+                result.charts = write_sweep_charts(result, result.results_path.parent)
+                return result
 
             try:
                 with sigterm_as_interrupt():
