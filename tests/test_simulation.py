@@ -223,3 +223,13 @@ def test_fast_chunks_grow_to_a_whole_object_order_scan():
         sizes.append(chunk)
     assert sizes == [4 * simulation._FIRST_CHUNK_RAYS, SCAN_BLOCK, SCAN_BLOCK, SCAN_BLOCK]
     assert simulation._next_chunk(SCAN_BLOCK, SCAN_BLOCK, 10.0) == SCAN_BLOCK // 4
+
+
+def test_simulate_takes_a_scenario_files_path_as_the_scenario_itself(tmp_path):
+    """simulate('S.toml') failed with "'str' object has no attribute 'backend'"."""
+    from tiny_sweep import write_tiny_scenario
+
+    scenario = write_tiny_scenario(tmp_path)
+    by_object = simulate(scenario, write=False).measures
+    for given in (str(scenario.path), scenario.path):
+        assert simulate(given, write=False).measures.to_dict() == by_object.to_dict()

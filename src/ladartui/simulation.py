@@ -116,8 +116,13 @@ def simulate(
     ``las`` also ``.las`` copies), the measures (``S.cmf``) and the settings
     as run (``S_Run.toml``, ladartui.run_record) are written atomically once
     both runs are done. ``scene`` may pass the scenario's
-    already loaded ``Scene`` (its occupancy is built once and kept).
+    already loaded ``Scene`` (its occupancy is built once and kept). ``scenario``
+    may also be a scenario file's path.
     """
+    if isinstance(scenario, (str, os.PathLike)):
+        from ladartui.scenario import load_scenario
+
+        scenario = load_scenario(scenario)
     with contextlib.ExitStack() as stack:
         output_set = stack.enter_context(_output_set(scenario, las)) if write else None
         return _simulate(scenario, backend, method, step, precision, progress, cancel, output_set, scene)
