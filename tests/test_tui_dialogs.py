@@ -53,6 +53,22 @@ async def test_a_segment_form_names_the_point_field_that_is_wrong(tmp_path, scen
         await pilot.pause()
         assert message(form) == "Centre x,y,z m: 1,2,3,4 is not allowed; expected x, y, z in metres"
         await type_into(pilot, centre, "10, 20, 0", commit=None)
+        # a limit is said in the field's unit, as the main form says it ("at most 1000 m/s")
+        await type_into(pilot, radius, "-7", commit=None)
+        form.query_one("#form-ok").press()
+        await pilot.pause()
+        assert message(form) == (
+            "Radius m: -7 is not allowed; expected a number greater than 0 and at most 1000000 m"
+        )
+        await type_into(pilot, radius, "50", commit=None)
+        # whole numbers are called so in every form, whatever the check's own words
+        scans = form.query_one("#f-scans")
+        for typed in ("x", "2.5", "0"):
+            await type_into(pilot, scans, typed, commit=None)
+            form.query_one("#form-ok").press()
+            await pilot.pause()
+            assert message(form).startswith(f"Scans: {typed} is not allowed; expected a whole number"), typed
+        await type_into(pilot, scans, "6", commit=None)
         form.query_one("#form-ok").press()
         await pilot.pause()
         assert app.screen is not form

@@ -24,7 +24,7 @@ def parse_number(name: str, text: str, integer: bool = False, scale: float = 1.0
     try:
         value = float(stripped)
     except ValueError:
-        raise FieldError(name, stripped, "an integer" if integer else "a number") from None
+        raise FieldError(name, stripped, "a whole number" if integer else "a number") from None
     if not math.isfinite(value):
         raise FieldError(name, stripped, "a finite number")
     if integer:

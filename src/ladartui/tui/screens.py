@@ -24,6 +24,8 @@ from ladartui.tui.fields import NumberField, format_number, parse_number, refusa
 from ladartui.tui.file_tree import FileTree
 from ladartui.tui.measures_view import comparison_rows, level_rows, measure_rows, target_rows
 
+FORM_UNITS = frozenset({"m", "deg", "s", "m/s", "um", "Hz"})  # a form label's last word
+
 
 class PathSuggester(Suggester):
     """Completes file paths from what exists on disk."""
@@ -194,11 +196,16 @@ class FormScreen(Dialog):
         return True
 
     def _refuse(self, widget, name: str, expected: str) -> None:
-        """Mark ``widget`` and say that its text is not allowed, in the form's words."""
+        """Mark ``widget`` and say that its text is not allowed, in the form's words (a
+        limit in the unit its label ends with: "Radius m" ... "at most 1000000 m")."""
         widget.add_class("-bad")
-        self.query_one("#form-message", Static).update(
-            escape(refusal(self._label(name), widget.value, expected))
-        )
+        label = self._label(name)
+        if expected.startswith("an integer"):  # the form's word for it, as in the sidebar
+            expected = "a whole number" + expected.removeprefix("an integer")
+        unit = label.rpartition(" ")[2]
+        if unit in FORM_UNITS and expected[-1:].isdigit():
+            expected += f" {unit}"
+        self.query_one("#form-message", Static).update(escape(refusal(label, widget.value, expected)))
 
     @on(Input.Changed)
     def _typing(self, event: Input.Changed) -> None:
