@@ -243,3 +243,19 @@ def test_sweep_out_an_existing_file_is_refused(tmp_path, capsys):
     (tmp_path / "results").write_text("a file")
     assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path / "results")]) == 2
     assert "results: is a file, expected a folder" in last_error_line(capsys)
+
+
+@pytest.mark.parametrize("length", [220, 233, 236, 248])
+def test_a_scenario_name_too_long_for_its_outputs_is_refused_before_tracing(tmp_path, capsys, length):
+    """Names the outputs, their hidden temporaries, the lock and its journal take past
+    the system's limit: refused after tracing, or a traceback, depending on the length."""
+    scenario = make_scenario(tmp_path)
+    long = tmp_path / ("m" * length + ".toml")
+    long.write_bytes(scenario.path.read_bytes())  # as cp makes it
+    for command in ("run", "validate"):
+        assert main([command, str(long)]) == 2, command
+        err = last_error_line(capsys)
+        assert "name too long for this system" in err and "Traceback" not in err, err
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        ["S.toml", "woods.txt", "woods_Target.txt", long.name]
+    )

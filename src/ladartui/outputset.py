@@ -29,15 +29,45 @@ from ladartui.errors import OutputFileError, check_cancelled
 _step_hook: Callable[[str], None] | None = None
 
 
+# A file is written through hidden companions beside it: ".NAME.XXXXXXXX.tmp" (a
+# temporary, 14 bytes more), ".NAME.PID.old" (a backup) and, for a lock,
+# NAME.journal.tmp; in a set, a writer that is atomic itself makes a temporary of
+# the temporary (28 bytes more than the name).
+HIDDEN_EXTRA = 28
+
+
+def name_problem(path) -> str | None:
+    """None when ``path``'s name and its hidden companions' fit this system; else why not."""
+    path = Path(path)
+    name_max = _name_max(path.parent)
+    length = len(os.fsencode(path.name))
+    if length > name_max:
+        return f"name too long for this system ({length} bytes; at most {name_max} a name)"
+    if length + HIDDEN_EXTRA > name_max:
+        return (
+            f"name too long for this system ({length} bytes, and its hidden temporary's "
+            f"{length + HIDDEN_EXTRA}; at most {name_max} a name): use a shorter scenario name"
+        )
+    return None
+
+
+def check_names(*paths) -> None:
+    """Raise ``OutputFileError`` naming the first path ``name_problem`` refuses."""
+    for path in paths:
+        problem = name_problem(path)
+        if problem:
+            raise OutputFileError(path, problem)
+
+
 def output_problem(path) -> str | None:
     """None when ``path`` can be written as a file; else what is wrong, in words."""
     path = Path(path)
     try:
         if path.is_dir():
             return "is a folder, expected a file name"
-        name_max = _name_max(path.parent)
-        if len(os.fsencode(path.name)) > name_max:
-            return f"name too long for this system (at most {name_max} bytes a name)"
+        problem = name_problem(path)
+        if problem:
+            return problem
         folder = path.parent
         while not folder.exists():
             if folder == folder.parent:
@@ -97,6 +127,7 @@ class OutputSet:
 
     def __enter__(self) -> OutputSet:
         check_writable(*self.paths.values())
+        check_names(self.lock)  # and its journal
         self._acquire()
         try:
             recover(self.journal)

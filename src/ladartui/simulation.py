@@ -378,7 +378,10 @@ def check_outputs_spare_inputs(scenario, las=False) -> None:
     a file of its record's name that is not a run record (``run_record``).
     """
     from ladartui.errors import FieldError
+    from ladartui.outputset import check_names
 
+    # before anything looks for them: a name too long fails every call on it
+    check_names(*output_paths(scenario, las).values(), output_lock(scenario))
     inputs = {os.path.normpath(Path(f).absolute()) for f in (scenario.scene_file, scenario.target_file)}
     for name, path in output_paths(scenario, las).items():
         if os.path.normpath(path.absolute()) in inputs:
@@ -396,8 +399,13 @@ def _output_set(scenario, las):
     from ladartui.outputset import OutputSet
 
     check_outputs_spare_inputs(scenario, las)
+    return OutputSet(output_paths(scenario, las), output_lock(scenario))
+
+
+def output_lock(scenario) -> Path:
+    """The lock file of ``scenario``'s output set (a second run is refused while held)."""
     path = Path(scenario.path)
-    return OutputSet(output_paths(scenario, las), path.with_name(f".{path.stem}.outputs.lock"))
+    return path.with_name(f".{path.stem}.outputs.lock")
 
 
 def _write_outputs(output_set, scene_output, target_output, measures, record, scene, cancel) -> dict:
