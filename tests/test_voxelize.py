@@ -369,3 +369,24 @@ def test_voxelize_modules_do_not_import_textual():
     )
     done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
     assert done.stdout.strip() == "[]"
+
+
+TRIANGLE_STL = (
+    b"facet normal 0 0 1\n outer loop\n  vertex 0 0 0\n  vertex 1 0 0\n  vertex 0 1 0\n endloop\nendfacet\n"
+)
+
+
+def test_a_text_mesh_in_latin_1_is_read(tmp_path):
+    """CAD exporters write names in Latin-1: such an ASCII STL was refused with
+    'ModuleNotFoundError: No module named charset_normalizer'."""
+    stl = tmp_path / "caf\u00e9.stl"
+    stl.write_bytes(b"solid caf\xe9\n" + TRIANGLE_STL + b"endsolid caf\xe9\n")
+    assert load_mesh(stl).faces.shape == (1, 3)
+    obj = tmp_path / "tri.obj"
+    obj.write_bytes(b"# modell \xfcber alles\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    assert load_mesh(obj).faces.shape == (1, 3)
+    noise = tmp_path / "noise.stl"
+    noise.write_bytes(bytes(range(256)) * 3)
+    with pytest.raises(InputFileError) as caught:
+        load_mesh(noise)
+    assert "module" not in str(caught.value).lower()

@@ -106,7 +106,7 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
         with _trimesh_notes() as notes:
             # process=True merges repeated vertices (an STL repeats them per triangle),
             # so that closedness can be checked on the shared edges.
-            loaded = trimesh.load(str(path), file_type=kind[1:], force="mesh", process=True)
+            loaded = trimesh.load(_as_utf8(path, kind), file_type=kind[1:], force="mesh", process=True)
     except Exception as error:  # trimesh's parsers raise many kinds on malformed text
         if kind == ".obj":  # trimesh names neither the line nor the problem
             check_obj_lines(path)
@@ -129,6 +129,37 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
     if up == "y":
         vertices = np.column_stack([vertices[:, 0], -vertices[:, 2], vertices[:, 1]])
     return Mesh(path, vertices, faces, not problem, problem, tuple(notes))
+
+
+def _as_utf8(path: Path, kind: str):
+    """The file for trimesh: its path, or for a text mesh (OBJ, ASCII STL) that is not
+    UTF-8, its bytes read as Latin-1 and handed on as UTF-8. Exporters write names in
+    Latin-1, and trimesh would guess the encoding with a package not installed here."""
+    import io
+
+    if kind == ".ply" or (kind == ".stl" and _binary_stl(path)):
+        return str(path)
+    try:
+        data = path.read_bytes()
+    except OSError:
+        return str(path)  # trimesh reports it
+    try:
+        data.decode("utf-8")
+    except UnicodeDecodeError:
+        return io.BytesIO(data.decode("latin-1").encode("utf-8"))
+    return str(path)
+
+
+def _binary_stl(path: Path) -> bool:
+    """Whether ``path`` is sized as a binary STL: an 84-byte header, 50 bytes a triangle."""
+    try:
+        size = path.stat().st_size
+        with open(path, "rb") as stream:
+            stream.seek(80)
+            count = int.from_bytes(stream.read(4), "little")
+    except OSError:
+        return False
+    return size == 84 + 50 * count
 
 
 def check_obj_lines(path: Path) -> None:
