@@ -408,3 +408,39 @@ def test_npz_and_object_rays_and_a_bad_out_are_one_line(tmp_path, scene_file, ca
         and err == f"ladartui: error: --out = '{tmp_path / 'rays.npy'}': expected a file other than --rays"
     )
     assert np.array_equal(np.load(tmp_path / "rays.npy"), rays)
+
+
+def test_a_rays_file_is_checked_from_its_header_before_it_is_read(tmp_path, scene_file, capsys):
+    """A header claiming 10**10 rows ended in a MemoryError traceback; a text file was
+    said to hold Python objects. The header says what the file holds, before loading."""
+    import numpy.lib.format as npy
+
+    huge = tmp_path / "huge.npy"
+    with open(huge, "wb") as handle:
+        npy.write_array_header_1_0(handle, {"descr": "<f8", "fortran_order": False, "shape": (10**10, 6)})
+        handle.write(b"\0" * 48)
+    text = tmp_path / "text.npy"
+    text.write_text("not numpy\n")
+
+    def trace(rays_file):
+        code = main(
+            ["trace", "--scene", str(scene_file), "--rays", str(rays_file), "--out", str(tmp_path / "h")]
+        )
+        return code, capsys.readouterr().err.strip()
+
+    code, err = trace(huge)
+    assert code == 2 and len(err.splitlines()) == 1, err
+    assert f"{huge}: about 1e+10 rays to trace, more than the limit" in err
+    code, err = trace(text)
+    assert code == 2 and err == f"ladartui: error: {text}: not a NumPy .npy file (no .npy header)"
+    assert not (tmp_path / "h").exists()
+
+
+def test_a_scene_too_large_to_trace_is_named_by_its_file(tmp_path, capsys):
+    far = tmp_path / "far.txt"
+    far.write_text("0,0,0\n100000,100000,1000\n")
+    rays = tmp_path / "rays.npy"
+    np.save(rays, np.array([[5.0, 5.0, 50.0, 0.0, 0.0, -1.0]]))
+    code = main(["trace", "--scene", str(far), "--rays", str(rays), "--out", str(tmp_path / "h.npy")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and err.startswith(f"ladartui: error: {far}: 2 voxels spanning 100001 x 100001 x 1001")

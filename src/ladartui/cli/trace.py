@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.atomic import atomic_path
-from ladartui.errors import FieldError, InputFileError
+from ladartui.errors import FieldError, InputFileError, ResourceLimitError
 from ladartui.tracing.backend import METHODS, PRECISIONS
 
 
@@ -42,8 +42,57 @@ def add_parser(subparsers):
     parser.set_defaults(handler=run)
 
 
+# Memory a traced ray takes on the way: the file's row, its float64 copy, the
+# origins and directions handed to the tracer, the answers and the hits written.
+BYTES_PER_TRACED_RAY = 48 * 4 + 24 + 40
+
+
+def check_rays_header(path) -> None:
+    """What a .npy file holds, from its header, before any of it is read: InputFileError
+    for a file that is no .npy array of (N, 6) numbers, ResourceLimitError for more rays
+    than the work or memory limit allows. An .npz archive is left to the loader."""
+    import numpy.lib.format as npy
+
+    from ladartui.resources import available_memory, check_rays, gib
+
+    try:
+        with open(path, "rb") as handle:
+            start = handle.read(len(npy.MAGIC_PREFIX) + 2)
+            if start.startswith(b"PK\x03\x04"):  # a zip: an .npz archive
+                return
+            if len(start) < len(npy.MAGIC_PREFIX) + 2:
+                raise InputFileError(path, "empty or cut short: expected a NumPy .npy array")
+            if not start.startswith(npy.MAGIC_PREFIX):
+                raise InputFileError(path, "not a NumPy .npy file (no .npy header)")
+            handle.seek(0)
+            version = npy.read_magic(handle)
+            read = npy.read_array_header_1_0 if version == (1, 0) else npy.read_array_header_2_0
+            shape, _, dtype = read(handle)
+    except FileNotFoundError:
+        raise InputFileError(path, "no such file") from None
+    except OSError as error:
+        raise InputFileError(path, f"cannot be read ({error.strerror or error})") from None
+    except ValueError as error:
+        raise InputFileError(path, f"not a NumPy .npy array (its header: {error})") from None
+    if dtype.hasobject:
+        raise InputFileError(path, "holds Python objects: expected an (N, 6) array of numbers")
+    if len(shape) != 2 or shape[1] != 6:
+        raise InputFileError(
+            path, f"array of shape {shape}: expected (N, 6): origin x, y, z and direction dx, dy, dz per row"
+        )
+    rows = int(shape[0])
+    check_rays(rows, str(path))
+    need, limit = rows * BYTES_PER_TRACED_RAY, available_memory()
+    if need > limit:
+        raise ResourceLimitError(
+            f"{path}: {rows:,} rays need about {gib(need)} to trace, more than the "
+            f"{gib(limit)} of memory available; trace them in parts"
+        )
+
+
 def load_rays(path) -> np.ndarray:
     """The (N, 6) float64 rays of a .npy file; InputFileError naming what is wrong."""
+    check_rays_header(path)
     try:
         rays = np.load(path, allow_pickle=False)
     except FileNotFoundError:
@@ -93,7 +142,7 @@ def run(args):
     check_writable(out)  # before the trace, not after it
     rays = load_rays(args.rays)
     voxels = load_voxels(args.scene)
-    occupancy = Occupancy.build(voxels)
+    occupancy = Occupancy.build(voxels, source=str(args.scene))
     result = trace(
         occupancy,
         rays[:, :3],
