@@ -51,3 +51,38 @@ def test_scene_that_is_a_folder_is_not_reported_as_missing(tmp_path, capsys):
     assert main(["validate", str(scenario)]) == 2
     err = capsys.readouterr().err
     assert "is a folder, expected a file (files.scene)" in err and "not found" not in err
+
+
+def test_file_names_with_terminal_escapes_reach_the_terminal_escaped(tmp_path, capsys):
+    """Errors escaped them, but the lines of a command that worked printed them raw: a
+    name holding ESC [2J cleared the screen."""
+    import shutil
+
+    from tiny_sweep import write_tiny_scenario
+
+    raw = "\x1b[2J\x1b]0;PWNED\x07"
+    folder = tmp_path / f"d{raw}"
+    folder.mkdir()
+    base = write_tiny_scenario(folder, name=f"s{raw}.toml")
+    shutil.copy(folder / "tiny.txt", folder / f"v{raw}.txt")
+    commands = [
+        ["validate", str(base.path)],
+        ["info", str(base.path)],
+        ["info", str(folder / f"v{raw}.txt")],
+        ["run", str(base.path)],
+        ["generate", "small", str(folder / f"g{raw}"), "--las"],
+        ["sweep", str(_spec(folder, base.path.name)), "--serial"],
+    ]
+    for command in commands:
+        assert main(command) == 0, command
+        out, err = capsys.readouterr()
+        assert "\x1b" not in out + err and "\x07" not in out + err, (command, out + err)
+        assert "\\x1b[2J" in out + err, command
+
+
+def _spec(folder, scenario_name):
+    import json
+
+    spec = folder / "sweep.toml"
+    spec.write_text(f"[sweep]\nscenario = {json.dumps(scenario_name)}\n[grid]\nradius = [20.0]\n")
+    return spec

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from ladartui.errors import LadarError, OutputFileError
 from ladartui.scenario_file import RECORD_HEADER, is_record
+from ladartui.textsafe import one_line
 
 __all__ = ["RECORD_HEADER", "is_record", "read_run_record", "setting_changes"]
 
@@ -29,10 +30,12 @@ def as_run(scenario, backend=None, method=None, step=None, precision=None):
 
 def record_text(scenario, ran) -> str:
     """The record's text for a run of ``scenario`` that went as ``ran`` (``as_run``)."""
-    name = scenario.path.name
+    # names in comments escaped: a control character there is not TOML
+    name = one_line(scenario.path.name)
+    scene, target = one_line(scenario.scene_output.name), one_line(scenario.target_output.name)
     header = (
-        f"{RECORD_HEADER}: the settings that made {scenario.scene_output.name}, "
-        f"{scenario.target_output.name} and {scenario.measures_file.name},\n"
+        f"{RECORD_HEADER}: the settings that made {scene}, "
+        f"{target} and {one_line(scenario.measures_file.name)},\n"
         f"# written with them by a run of {name} (replaced by its next run).\n"
         f"# They may differ from {name}: a run can go with unsaved edits or flags.\n\n"
     )

@@ -41,6 +41,7 @@ from ladartui.scenario_file import (
 )
 from ladartui.scenario_style import restyle
 from ladartui.sensor import Sensor
+from ladartui.textsafe import one_line
 from ladartui.toml_lines import key_lines
 from ladartui.tracing.backend import METHODS, PRECISIONS
 from ladartui.trajectory import LogSegment
@@ -335,10 +336,12 @@ class Scenario:
         return data
 
     def to_toml(self) -> str:
+        # names in comments escaped: a control character there is not TOML
+        name, scene, target = (one_line(p.name) for p in (self.path, self.scene_output, self.target_output))
+        measures, record = one_line(self.measures_file.name), one_line(self.run_record.name)
         header = (
-            f"# ladartui scenario. Check it with: ladartui validate {self.path.name}\n"
-            f"# A run writes {self.scene_output.name}, {self.target_output.name}, "
-            f"{self.measures_file.name} and {self.run_record.name} beside this file.\n\n"
+            f"# ladartui scenario. Check it with: ladartui validate {name}\n"
+            f"# A run writes {scene}, {target}, {measures} and {record} beside this file.\n\n"
         )
         return header + self.toml_body()
 

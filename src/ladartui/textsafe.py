@@ -22,3 +22,9 @@ def one_line(text: object, limit: int = MAX_MESSAGE_CHARS) -> str:
         return safe
     dropped = len(safe) - limit
     return f"{safe[:limit]}... ({dropped} more characters)"
+
+
+def visible(text: object) -> str:
+    """``text`` for a terminal, its lines kept: control characters in each line (a file
+    name's terminal escapes) written as ``\\xNN``, nothing cut."""
+    return "\n".join("".join(_visible(char) for char in line) for line in str(text).split("\n"))

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from ladartui.textsafe import visible
+
 
 def add_parser(subparsers):
     parser = subparsers.add_parser(
@@ -45,5 +47,5 @@ def run(args) -> int:
     except OSError as error:
         raise FieldError("DIR", str(folder), f"a writable folder ({error.strerror})") from None
     for path in paths.values():
-        print(path)
+        print(visible(path))
     return 0

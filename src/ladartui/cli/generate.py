@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import time
 
+from ladartui.textsafe import visible
+
 
 def add_parser(subparsers):
     parser = subparsers.add_parser(
@@ -84,14 +86,17 @@ def run(args) -> int:
     vs = scene.voxel_size
     nx, ny, nz = scene.shape
     print(
-        f"wrote {scene_path} ({len(scene.voxels):,} voxels) and {target_path} ({len(scene.target):,} voxels)"
+        visible(
+            f"wrote {scene_path} ({len(scene.voxels):,} voxels) and {target_path} "
+            f"({len(scene.target):,} voxels)"
+        )
     )
     if args.las:
         from ladartui.scene.las import export_las
 
         export_las(las_files[0], scene.voxels, vs)
         export_las(las_files[1], scene.target, vs, ids=scene.ids())
-        print(f"wrote {las_files[0]} and {las_files[1]} (voxel centres in metres)")
+        print(visible(f"wrote {las_files[0]} and {las_files[1]} (voxel centres in metres)"))
     print(f"preset {scene.preset}, seed {scene.seed}, voxel size {vs:g} m")
     print(f"extent {nx} x {ny} x {nz} voxels = {nx * vs:.1f} x {ny * vs:.1f} x {nz * vs:.1f} m")
     print("parts (before merging): " + ", ".join(f"{k} {v:,}" for k, v in scene.parts.items()))

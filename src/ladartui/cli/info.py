@@ -6,6 +6,7 @@ import time
 from pathlib import Path
 
 from ladartui.errors import LadarError
+from ladartui.textsafe import visible
 
 
 def add_parser(subparsers):
@@ -51,7 +52,7 @@ def print_scenario(path: Path) -> None:
         raise LadarError(
             f"{path}: scenario files cannot be read here (ladartui.scenario is not available)"
         ) from None
-    print(load_scenario(path).summary())
+    print(visible(load_scenario(path).summary()))
 
 
 def print_voxel_list(path: Path, voxel_size=None) -> None:
@@ -104,10 +105,10 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
     else:
         rows.append(("target", f"none ({target_path.name} not found)"))
     rows.append(("occupancy", _occupancy_text(voxels, shape, path)))
-    print(f"{path}: voxel list")
+    print(visible(f"{path}: voxel list"))
     width = max(len(name) for name, _ in rows)
     for name, text in rows:
-        print(f"  {name:<{width}}  {text}")
+        print(visible(f"  {name:<{width}}  {text}"))
 
 
 def _targets_text(ids) -> str:

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 from ladartui.cli.flags import as_flags
 from ladartui.cli.progress import FIRST_SCAN, progress_display, run_cancellable, sigterm_as_interrupt
 from ladartui.errors import Cancelled
+from ladartui.textsafe import visible
 
 if TYPE_CHECKING:
     from ladartui.simulation import SimulationResult
@@ -106,7 +107,7 @@ def run(args) -> int:
                 path = save_figure(coverage_figure(result.measures), args.chart)
             except OSError as error:
                 raise FieldError("--chart", args.chart, f"a writable path ({error.strerror})") from None
-            errors.print(f"wrote chart: {path}", highlight=False, markup=False, soft_wrap=True)
+            errors.print(visible(f"wrote chart: {path}"), highlight=False, markup=False, soft_wrap=True)
         if args.json:
             print(json.dumps(result_dict(scenario, result), indent=2, allow_nan=False))
         else:
@@ -227,7 +228,7 @@ def show_result(console, result) -> None:
     if result.outputs:
         for name, path in result.outputs.items():
             shown = name.replace("_las", " LAS")  # "scene_las": the scene as a LAS point cloud
-            console.print(f"wrote {shown}: {path}", highlight=False, markup=False, soft_wrap=True)
+            console.print(visible(f"wrote {shown}: {path}"), highlight=False, markup=False, soft_wrap=True)
     else:
         console.print("nothing written (--no-write)")
 

@@ -10,6 +10,7 @@ from rich.markup import escape
 
 from ladartui.cli.progress import progress_display, run_cancellable
 from ladartui.errors import Cancelled, FieldError
+from ladartui.textsafe import visible
 
 DEFAULT_OUT = "study-results"
 CHART_WIDTH, CHART_HEIGHT = 120, 34
@@ -156,5 +157,7 @@ def _report(result, out_dir) -> int:
     console.print(table)
     console.print(result.verdict(), highlight=False)
     paths = write_outputs(result, out_dir, width=CHART_WIDTH, height=CHART_HEIGHT)
-    console.print("wrote " + ", ".join(str(p) for p in paths.values()), highlight=False, markup=False)
+    console.print(
+        visible("wrote " + ", ".join(str(p) for p in paths.values())), highlight=False, markup=False
+    )
     return 0

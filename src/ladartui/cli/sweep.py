@@ -16,6 +16,7 @@ from rich.markup import escape
 
 from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt, stop_status
 from ladartui.errors import Cancelled, FieldError
+from ladartui.textsafe import visible
 
 DEFAULT_TOP = 10
 
@@ -411,20 +412,22 @@ def show_result(console, result, top) -> None:
             f"{result.workers} worker(s); {result.resumed} resumed from earlier runs",
             highlight=False,
         )
-    console.print(f"results  {result.results_path}", highlight=False, markup=False)
+    console.print(visible(f"results  {result.results_path}"), highlight=False, markup=False)
     if result.ranking_path:
-        console.print(f"ranking  {result.ranking_path}", highlight=False, markup=False)
+        console.print(visible(f"ranking  {result.ranking_path}"), highlight=False, markup=False)
     for path in result.charts.values():
-        console.print(f"chart    {path}", highlight=False, markup=False)
+        console.print(visible(f"chart    {path}"), highlight=False, markup=False)
     if result.best_scenario_path:
         console.print(
-            f"best     {result.best_scenario_path}  (open it with: ladartui {result.best_scenario_path})",
+            visible(
+                f"best     {result.best_scenario_path}  (open it with: ladartui {result.best_scenario_path})"
+            ),
             highlight=False,
             markup=False,
         )
     if result.best_kept:
         console.print(
-            f"kept     {result.best_kept}  (edited since a sweep wrote it: not replaced)",
+            visible(f"kept     {result.best_kept}  (edited since a sweep wrote it: not replaced)"),
             highlight=False,
             markup=False,
         )

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from ladartui.textsafe import visible
+
 
 def add_parser(subparsers):
     parser = subparsers.add_parser(
@@ -30,9 +32,9 @@ def run(args) -> int:
     scenario = load_scenario(bundled_or_path(args.scenario))
     scene_lines = scene_summary(scenario)
     check_outputs_spare_inputs(scenario)  # what a run would refuse before tracing
-    print(scenario.summary())
+    print(visible(scenario.summary()))
     for line in [*scene_lines, *last_run_lines(scenario)]:
-        print(line)
+        print(visible(line))
     return 0
 
 

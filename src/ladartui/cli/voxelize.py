@@ -9,7 +9,7 @@ import time
 from ladartui.cli.flags import as_flags
 from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt
 from ladartui.errors import Cancelled, FieldError, check_cancelled
-from ladartui.textsafe import one_line
+from ladartui.textsafe import one_line, visible
 
 
 def add_parser(subparsers):
@@ -190,7 +190,7 @@ def _report(console, args, mesh, done, outputs, elapsed) -> None:
     detail = f"{result.surface:,} on the surface"
     if result.solid:
         detail += f", {result.inside:,} with their centre inside"
-    say = lambda text: console.print(text, highlight=False, markup=False, soft_wrap=True)  # noqa: E731
+    say = lambda text: console.print(visible(text), highlight=False, markup=False, soft_wrap=True)  # noqa: E731
     say(
         f"{mesh.path}: {len(mesh.faces):,} triangle{'s' if len(mesh.faces) != 1 else ''}, "
         f"{'closed' if mesh.closed else 'not closed'}; "
