@@ -94,7 +94,7 @@ def run(args):
     else:
         _print_table(report)
         if args.passes:
-            from rich.console import Console
+            from ladartui.cli.console import CliConsole as Console
 
             print_passes(Console(), report)
     return 0
@@ -387,8 +387,9 @@ def _orders_shown(orders: str) -> str:
 
 def _print_table(report):
     from rich import box
-    from rich.console import Console
     from rich.table import Table
+
+    from ladartui.cli.console import CliConsole as Console
 
     console = Console()
     console.print(

@@ -155,9 +155,9 @@ def _occupancy_text(voxels, shape, path) -> str:
 
 
 def print_backends() -> None:
-    from rich.console import Console
     from rich.table import Table
 
+    from ladartui.cli.console import CliConsole as Console
     from ladartui.tracing import auto_summary
     from ladartui.tracing.backend import backend_status, get_backend
 

@@ -75,8 +75,7 @@ def _settings(scenario, args):
 
 
 def run(args) -> int:
-    from rich.console import Console
-
+    from ladartui.cli.console import CliConsole as Console
     from ladartui.scenario import load_scenario
     from ladartui.user_data import default_scenario_path
 

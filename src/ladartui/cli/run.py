@@ -62,8 +62,7 @@ def add_parser(subparsers):
 
 
 def run(args) -> int:
-    from rich.console import Console
-
+    from ladartui.cli.console import CliConsole as Console
     from ladartui.errors import FieldError
     from ladartui.scenario import load_scenario
 

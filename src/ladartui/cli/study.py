@@ -58,8 +58,7 @@ def add_parser(subparsers) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from rich.console import Console
-
+    from ladartui.cli.console import CliConsole as Console
     from ladartui.study import full_settings, quick_settings
     from ladartui.study.inputs import generated_inputs, scenario_inputs
 
@@ -135,10 +134,10 @@ def _run_with_progress(console, inputs, settings, runs, warmup):
 
 
 def _report(result, out_dir) -> int:
-    from rich.console import Console
     from rich.table import Table
     from rich.text import Text
 
+    from ladartui.cli.console import CliConsole as Console
     from ladartui.study.chart import TABLE_COLUMNS, chart_text, table_rows
     from ladartui.study.run import write_outputs
 

@@ -104,8 +104,7 @@ def add_parser(subparsers):
 
 
 def run(args) -> int:
-    from rich.console import Console
-
+    from ladartui.cli.console import CliConsole as Console
     from ladartui.sweep import default_out_dir, load_sweep_results, load_sweep_spec
     from ladartui.sweep.ranking import BUDGET_OBJECTIVES, normal_cost, normal_objective
 

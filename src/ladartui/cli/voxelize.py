@@ -74,8 +74,7 @@ def _position(text: str) -> tuple[float, ...]:
 def run(args) -> int:
     from pathlib import Path
 
-    from rich.console import Console
-
+    from ladartui.cli.console import CliConsole as Console
     from ladartui.outputset import check_writable
     from ladartui.scene.insertion import scene_model_paths
     from ladartui.scene.voxelize import CANCELLED, Placement
