@@ -51,9 +51,20 @@ def test_table_output_and_no_write(scenario, capsys):
     assert main(["run", str(scenario.path), "--no-write", "--method", "march", "--step", "0.25"]) == 0
     out = capsys.readouterr().out
     assert "Target coverage" in out and "Shift in mean direction" in out
-    assert "numba (march)" in out and "nothing written" in out
+    assert "numba (march)" in out and "no scenario outputs written (--no-write)" in out
     assert not scenario.scene_output.exists() and not scenario.measures_file.exists()
     assert not scenario.path.with_name("S_Run.toml").exists()
+
+
+def test_no_write_with_a_chart_says_truly_what_was_written(scenario, capsys):
+    """It said 'wrote chart: c.svg' and then 'nothing written (--no-write)'."""
+    chart = scenario.path.with_name("c.svg")
+    assert main(["run", str(scenario.path), "--no-write", "--chart", str(chart)]) == 0
+    out, err = capsys.readouterr()
+    assert f"wrote chart: {chart}" in err and chart.is_file()
+    assert "nothing written" not in out + err
+    assert "no scenario outputs written (--no-write)" in out
+    assert not scenario.measures_file.exists()
 
 
 def test_ctrl_c_cancels_and_keeps_earlier_outputs(scenario, capsys, monkeypatch):

@@ -229,7 +229,7 @@ def show_result(console, result) -> None:
             shown = name.replace("_las", " LAS")  # "scene_las": the scene as a LAS point cloud
             console.print(visible(f"wrote {shown}: {path}"), highlight=False, markup=False, soft_wrap=True)
     else:
-        console.print("nothing written (--no-write)")
+        console.print("no scenario outputs written (--no-write)")
 
 
 def target_tables(per_target):
