@@ -12,7 +12,7 @@ import pytest
 
 from ladartui.cli import main
 from ladartui.errors import LadarError
-from ladartui.run_record import RECORD_HEADER, read_run_record, setting_changes
+from ladartui.run_record import RECORD_HEADER, missing_outputs, read_run_record, setting_changes
 from ladartui.scenario import load_scenario
 from ladartui.simulation import simulate
 from ladartui.tui import bridge
@@ -51,7 +51,7 @@ def test_no_record_before_a_first_run_and_an_older_set_is_not_incomplete(scenari
     simulate(scenario)
     scenario.path.with_name("S_Run.toml").unlink()  # a set written before records existed
     assert read_run_record(scenario) is None
-    assert bridge.missing_outputs(scenario) == []
+    assert missing_outputs(scenario) == []
 
 
 def test_a_users_own_file_of_that_name_is_never_overwritten(scenario, capsys):
@@ -102,6 +102,11 @@ def test_validate_says_whether_the_outputs_came_from_this_file(scenario, capsys)
     assert main(["validate", str(scenario.path)]) == 0
     line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("last run"))
     assert line == "last run   made the outputs with this file's settings (S_Run.toml)"
+    # a set with a file gone is said to be incomplete (the line was left out)
+    scenario.measures_file.unlink()
+    assert main(["validate", str(scenario.path)]) == 0
+    line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("last run"))
+    assert line == "last run   outputs incomplete: S.cmf missing; a run writes the whole set again"
 
 
 def test_a_step_flag_on_an_exact_run_does_not_make_its_outputs_out_of_date(scenario):

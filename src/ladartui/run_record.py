@@ -100,3 +100,10 @@ def _shown(value) -> str:
     if isinstance(value, list):
         return "[" + ", ".join(_shown(v) for v in value) + "]"
     return str(value)
+
+
+def missing_outputs(scenario) -> list:
+    """The outputs of a partial set: empty when all are on disk or none are (not run)."""
+    outputs = [scenario.scene_output, scenario.target_output, scenario.measures_file]
+    missing = [path for path in outputs if not path.is_file()]
+    return [] if len(missing) == len(outputs) else missing

@@ -41,8 +41,12 @@ def run(args) -> int:
 def last_run_lines(scenario) -> list[str]:
     """Whether the outputs on disk came from this file's settings (the run record)."""
     from ladartui.errors import LadarError
-    from ladartui.run_record import read_run_record, setting_changes
+    from ladartui.run_record import missing_outputs, read_run_record, setting_changes
 
+    missing = missing_outputs(scenario)
+    if missing:
+        names = ", ".join(path.name for path in missing)
+        return [f"last run   outputs incomplete: {names} missing; a run writes the whole set again"]
     if not scenario.measures_file.is_file():
         return []  # not run yet
     record = scenario.run_record.name

@@ -339,7 +339,7 @@ def new_scenario(scenario_path: Path, scene_path: Path, voxel_size: float = 1.0)
 def load_checked(path: Path) -> Scenario:
     """Load a scenario after checking that the model files it names exist.
 
-    Missing outputs do not stop it (``missing_outputs`` lists them; a run
+    Missing outputs do not stop it (``run_record.missing_outputs`` lists them; a run
     writes them); a missing scene or target model does, with the file named.
     """
     return load_scenario(path)
@@ -355,13 +355,6 @@ def run_refusal(scenario: Scenario) -> str | None:
     except LadarError as error:
         return str(error)
     return None
-
-
-def missing_outputs(scenario: Scenario) -> list[Path]:
-    """The outputs of a partial set: empty when all are on disk or none are (not run)."""
-    outputs = [scenario.scene_output, scenario.target_output, scenario.measures_file]
-    missing = [p for p in outputs if not p.is_file()]
-    return [] if len(missing) == len(outputs) else missing
 
 
 def read_measures_files(paths) -> list:

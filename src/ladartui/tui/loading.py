@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 from ladartui.errors import LadarError
 from ladartui.recent import remember_scenario
-from ladartui.run_record import is_record, read_run_record
+from ladartui.run_record import is_record, missing_outputs, read_run_record
 from ladartui.scenario_file import record_owner
 from ladartui.tui import bridge
 from ladartui.tui.host import Host
@@ -75,7 +75,7 @@ class SceneLoading(Host):
         self.scene = done.scene
         self.prepared = done.prepared
         self.view_area.set_scene(done.prepared, done.scene.voxel_size)
-        self.missing_outputs = bridge.missing_outputs(done.scenario)
+        self.missing_outputs = missing_outputs(done.scenario)
         self.outputs_from = done.earlier.made_with  # before the status is drawn
         self.set_scenario(done.scenario, modified=False)
         if done.scenario.path.is_file():
@@ -105,7 +105,7 @@ class SceneLoading(Host):
     def show_outputs_of(self, scenario: Scenario) -> None:
         """After Save As onto a name: the outputs already on disk under it, shown as
         opening that file would show them (read in a worker)."""
-        self.missing_outputs = bridge.missing_outputs(scenario)
+        self.missing_outputs = missing_outputs(scenario)
         if scenario.scene_output.is_file() and scenario.measures_file.is_file():
             start_job(self, "earlier", lambda cancel, progress: _earlier(scenario))
 
