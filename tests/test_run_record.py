@@ -165,3 +165,20 @@ def test_validate_reports_a_damaged_record_on_its_line_and_still_passes(scenario
     assert main(["validate", str(scenario.path)]) == 0
     line = next(x for x in capsys.readouterr().out.splitlines() if x.startswith("last run"))
     assert line == "last run   settings not recorded (outputs written before run records)"
+
+
+def test_validate_says_which_las_files_an_earlier_run_left(scenario, capsys):
+    """run --las, then a run without: the LAS files beside the new set were the first
+    run's, and nothing said so."""
+    assert main(["run", str(scenario.path), "--las"]) == 0
+    capsys.readouterr()
+    assert main(["validate", str(scenario.path)]) == 0
+    assert "LAS" not in capsys.readouterr().out  # this run's own
+    assert main(["run", str(scenario.path), "--method", "march"]) == 0
+    capsys.readouterr()
+    assert main(["validate", str(scenario.path)]) == 0
+    lines = [x for x in capsys.readouterr().out.splitlines() if x.startswith("last run")]
+    assert lines[-1] == (
+        "last run   wrote no LAS: S_Scene.las and S_Target.las are from an earlier run (run --las "
+        "writes them again)"
+    )

@@ -107,3 +107,23 @@ def missing_outputs(scenario) -> list:
     outputs = [scenario.scene_output, scenario.target_output, scenario.measures_file]
     missing = [path for path in outputs if not path.is_file()]
     return [] if len(missing) == len(outputs) else missing
+
+
+def earlier_las(scenario) -> list:
+    """LAS copies of the outputs that an earlier run left (``run --las``) beside a set
+    written without them: older than the set's measures, which a set writes before
+    its LAS copies."""
+    measures = scenario.measures_file
+    try:
+        written = measures.stat().st_mtime_ns
+    except OSError:
+        return []
+    found = []
+    for output in (scenario.scene_output, scenario.target_output):
+        las = output.with_suffix(".las")
+        try:
+            if las.stat().st_mtime_ns < written:
+                found.append(las)
+        except OSError:
+            continue
+    return found

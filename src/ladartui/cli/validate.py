@@ -41,7 +41,7 @@ def run(args) -> int:
 def last_run_lines(scenario) -> list[str]:
     """Whether the outputs on disk came from this file's settings (the run record)."""
     from ladartui.errors import LadarError
-    from ladartui.run_record import missing_outputs, read_run_record, setting_changes
+    from ladartui.run_record import earlier_las, missing_outputs, read_run_record, setting_changes
 
     missing = missing_outputs(scenario)
     if missing:
@@ -58,9 +58,20 @@ def last_run_lines(scenario) -> list[str]:
         return ["last run   settings not recorded (outputs written before run records)"]
     changes = setting_changes(ran, scenario)
     if not changes:
-        return [f"last run   made the outputs with this file's settings ({record})"]
-    shown = "; ".join(changes[:4]) + (f"; and {len(changes) - 4} more" if len(changes) > 4 else "")
-    return [f"last run   made the outputs with other settings than this file: {shown}; they are in {record}"]
+        lines = [f"last run   made the outputs with this file's settings ({record})"]
+    else:
+        shown = "; ".join(changes[:4]) + (f"; and {len(changes) - 4} more" if len(changes) > 4 else "")
+        lines = [
+            f"last run   made the outputs with other settings than this file: {shown}; they are in {record}"
+        ]
+    left = earlier_las(scenario)
+    if left:
+        names = " and ".join(path.name for path in left)
+        verb = "are" if len(left) > 1 else "is"
+        lines.append(
+            f"last run   wrote no LAS: {names} {verb} from an earlier run (run --las writes them again)"
+        )
+    return lines
 
 
 def scene_summary(scenario) -> list[str]:
