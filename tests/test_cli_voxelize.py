@@ -195,3 +195,15 @@ def test_cancelled_writes_leave_the_earlier_files(tmp_path, forest, monkeypatch)
     module.write_scene_model(forest, inserted, cancel)
     np.testing.assert_array_equal(load_voxels(forest), inserted.scene)
     np.testing.assert_array_equal(load_voxels(tmp_path / "forest_Target.txt"), inserted.target)
+
+
+def test_a_mesh_too_large_for_the_grid_is_blamed_in_one_line(tmp_path, capsys):
+    """A vertex at 1e30 printed numpy's cast warning from the mesh reader, then blamed
+    --voxel-size, whose value was fine for the mesh meant."""
+    far = tmp_path / "far.obj"
+    far.write_text("v 1e30 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
+    assert main(["voxelize", str(far), str(tmp_path / "o"), "--voxel-size", "0.25"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "Warning" not in err, err
+    assert err.startswith(f"ladartui: error: {far}: the mesh spans 1e+30 x 1 x 0 m")
+    assert "2147483647" in err and "--scale" in err

@@ -34,6 +34,7 @@ import contextlib
 import logging
 import math
 import threading
+import warnings
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -103,7 +104,10 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
     import trimesh
 
     try:
-        with _trimesh_notes() as notes:
+        # a vertex far out (1e30) makes trimesh's merging warn of a cast: the check
+        # below names the mesh's span instead
+        with _trimesh_notes() as notes, warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
             # process=True merges repeated vertices (an STL repeats them per triangle),
             # so that closedness can be checked on the shared edges.
             loaded = trimesh.load(_as_utf8(path, kind), file_type=kind[1:], force="mesh", process=True)
@@ -307,7 +311,13 @@ def grid_triangles(mesh: Mesh, voxel_size: float, placement: Placement | None = 
                     f"edge at {name} = {-0.5 * vs:g} m (voxel indices start at 0); move it {way}",
                 )
     if grid.max() > MAX_INDEX - 1:
-        raise FieldError("voxel_size", voxel_size, f"a size keeping voxel indices below {MAX_INDEX}")
+        span = " x ".join(f"{side:.4g}" for side in high - low)
+        raise InputFileError(
+            mesh.path,
+            f"the mesh spans {span} m: at voxel size {vs:g} m its voxel indices would pass "
+            f"{MAX_INDEX}; check its units (--scale) and its farthest vertices, or use a coarser "
+            "--voxel-size",
+        )
     return np.ascontiguousarray(grid[mesh.faces])
 
 
