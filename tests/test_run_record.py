@@ -182,3 +182,15 @@ def test_validate_says_which_las_files_an_earlier_run_left(scenario, capsys):
         "last run   wrote no LAS: S_Scene.las and S_Target.las are from an earlier run (run --las "
         "writes them again)"
     )
+
+
+def test_a_segment_is_named_as_errors_name_it(scenario):
+    """The record named the first segment 'flight.segments.1', errors 'flight.segments[0]'."""
+    from ladartui.flight import FlightPlan, Manual
+
+    simulate(scenario)
+    ran = read_run_record(scenario)
+    first = scenario.flight.segments[0]
+    fewer = scenario.with_changes(flight=FlightPlan(segments=[Manual(first.poses[:1])]))
+    changes = setting_changes(ran, fewer)
+    assert changes and all(change.startswith("flight.segments[0].poses[1].") for change in changes), changes

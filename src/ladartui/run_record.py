@@ -80,11 +80,14 @@ def setting_changes(ran, scenario) -> list[str]:
 
 
 def _flat(data, prefix: str = "") -> dict:
-    """Nested TOML data as dotted keys; a list of tables by index (flight.segments.1.radius)."""
+    """Nested TOML data as dotted keys; a list of tables by index from 0, as errors name
+    them (flight.segments[0].radius)."""
     out = {}
-    items = data.items() if isinstance(data, dict) else enumerate(data, start=1)
-    for key, value in items:
-        name = f"{prefix}{key}"
+    if isinstance(data, dict):
+        items = [(f"{prefix}{key}", value) for key, value in data.items()]
+    else:
+        items = [(f"{prefix.removesuffix('.')}[{index}]", value) for index, value in enumerate(data)]
+    for name, value in items:
         if isinstance(value, dict) or (isinstance(value, list) and value and isinstance(value[0], dict)):
             out.update(_flat(value, name + "."))
         else:
