@@ -507,3 +507,21 @@ def test_same_outputs_ignores_only_the_name_backend_and_fast_mode(tmp_path):
     assert not scenario.same_outputs(scenario.with_changes(sensor=grid))
     assert not scenario.same_outputs(scenario.with_changes(speed=scenario.speed + 1.0))
     assert not scenario.same_outputs(scenario.with_changes(step=scenario.step * 2))
+
+
+def test_a_scenario_saved_with_a_byte_order_mark_is_read(tmp_path):
+    """Windows editors start UTF-8 with a BOM: it read as ':1: not valid TOML'."""
+    from tiny_sweep import write_tiny_scenario
+
+    scenario = write_tiny_scenario(tmp_path)
+    text = scenario.path.read_text(encoding="utf-8")
+    scenario.path.write_bytes(b"\xef\xbb\xbf" + text.encode("utf-8"))
+    loaded = load_scenario(scenario.path)
+    assert loaded.sensor == scenario.sensor and loaded.flight == scenario.flight
+    loaded.with_changes(speed=12.0).save()  # saved again as UTF-8 without the mark
+    assert scenario.path.read_bytes()[:1] == b"#" and load_scenario(scenario.path).speed == 12.0
+    spec = tmp_path / "spec.toml"
+    spec.write_bytes(b'\xef\xbb\xbf[sweep]\nscenario = "base.toml"\n[grid]\nradius = [20.0]\n')
+    from ladartui.sweep import load_sweep_spec
+
+    assert load_sweep_spec(spec).scenario_path == tmp_path / "base.toml"

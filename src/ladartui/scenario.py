@@ -365,7 +365,9 @@ class Scenario:
         text = None
         # keep the analyst's comments, key order and layout (not a record's header)
         if self.path.is_file() and not is_record(self.path):
-            text = restyle(self.path.read_text(encoding="utf-8"), scenario.to_dict(), _saved_data(self.path))
+            text = restyle(
+                self.path.read_text(encoding="utf-8-sig"), scenario.to_dict(), _saved_data(self.path)
+            )
         write_text_atomic(scenario.path, text if text is not None else scenario.to_toml())
         return scenario
 
@@ -396,7 +398,7 @@ def load_scenario(path, check_files=True) -> Scenario:
     """Read and check a scenario file; with ``check_files``, its model files must exist."""
     path = _absolute(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")
     except FileNotFoundError:
         raise InputFileError(path, "scenario file not found") from None
     except IsADirectoryError:

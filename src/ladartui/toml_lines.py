@@ -17,7 +17,7 @@ _KEY = re.compile(r"^\s*([A-Za-z0-9_\-]+)\s*=")
 def key_lines(path: Path) -> dict[str, int]:
     """``key_lines_from_text`` of a file; empty when it cannot be read."""
     try:
-        return key_lines_from_text(path.read_text(encoding="utf-8"))
+        return key_lines_from_text(path.read_text(encoding="utf-8-sig"))
     except (OSError, UnicodeDecodeError):
         return {}
 

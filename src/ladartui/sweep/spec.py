@@ -210,7 +210,7 @@ def load_sweep_spec(path) -> SweepSpec:
     """Read and check a sweep spec; mistakes raise InputFileError naming the key."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")
         data = tomllib.loads(text)
     except FileNotFoundError:
         raise InputFileError(path, "no such sweep spec") from None
@@ -312,7 +312,7 @@ def _is_number(value) -> bool:
 def spec_line(path, table: str, key: str) -> int | None:
     """1-based line of ``key`` in ``[table]`` of the spec file at ``path`` (None if unreadable)."""
     try:
-        text = Path(path).read_text(encoding="utf-8")
+        text = Path(path).read_text(encoding="utf-8-sig")
     except (OSError, UnicodeDecodeError):
         return None
     return _Checker(Path(path), text).line(table, key)

@@ -257,7 +257,7 @@ def load_keymap(folder: Path | None = None) -> tuple[dict[str, str], list[str]]:
     """
     path = (folder or config_folder()) / KEYS_FILE
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")
     except FileNotFoundError:
         return {}, []
     except OSError as error:

@@ -135,7 +135,7 @@ def read_setting(folder: Path | None = None) -> tuple[str, list[str]]:
     """The ``[display] graphics`` setting ("auto" when absent) and one line per problem."""
     path = (folder or config_folder()) / SETTINGS_FILE
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")
     except FileNotFoundError:
         return "auto", []
     except (OSError, UnicodeDecodeError) as error:
