@@ -627,3 +627,19 @@ def test_the_cli_refuses_an_infinite_budget_before_running(tiny, tmp_path, capsy
     assert main([*args, "--json", "--out", str(tmp_path / "o")]) == 2
     assert "--budget" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize(
+    "text, line",
+    [
+        ('[sweep]\nscenario = "base.toml"\n[grid]\n\'radius\' = [20.0, "x"]\n', 4),  # single-quoted
+        ('[sweep]\nscenario = "base.toml"\n[grid]\n"radius" = [20.0, "x"]\n', 4),
+        ('grid.radius = [20.0, "x"]\n[sweep]\nscenario = "base.toml"\n', 1),  # dotted, before any table
+    ],
+)
+def test_a_bad_value_is_named_on_its_own_line_however_its_key_is_written(tmp_path, text, line):
+    write_tiny_scenario(tmp_path)
+    spec = tmp_path / "keys.toml"
+    spec.write_text(text, encoding="utf-8")
+    with pytest.raises(InputFileError, match=rf"keys\.toml:{line}: grid\.radius"):
+        load_sweep_spec(spec)

@@ -334,7 +334,9 @@ class _Checker:
         """1-based line of ``key`` in ``[table]`` (or of the table header), None if not found."""
         table = table.strip(".")
         current, header_line = "", None
-        pattern = re.compile(rf"^\s*(\"?){re.escape(key)}\1\s*=")
+        name = rf"(?:{re.escape(key)}|\"{re.escape(key)}\"|'{re.escape(key)}')"  # bare or quoted
+        pattern = re.compile(rf"^\s*{name}\s*=")
+        dotted = re.compile(rf"^\s*{re.escape(table)}\s*\.\s*{name}\s*=") if table else None
         for number, text in enumerate(self.lines, start=1):
             stripped = text.strip()
             if stripped.startswith("["):
@@ -343,6 +345,8 @@ class _Checker:
                     header_line = number
                 continue
             if current == table and pattern.match(text):
+                return number
+            if current == "" and dotted is not None and dotted.match(text):  # grid.radius = ...
                 return number
         return header_line
 
