@@ -1,5 +1,6 @@
 """``ladartui trace`` and ``ladartui bench --quick`` from the command line."""
 
+import contextlib
 import json
 import math
 
@@ -197,15 +198,25 @@ def test_bench_quick_json(monkeypatch, tmp_path, capsys):
     bench = pytest.importorskip("ladartui.cli.bench")
     small = np.array([[i, j, k] for i in range(0, 40, 3) for j in range(0, 40, 2) for k in range(6)])
 
-    def tiny_scene():
+    def tiny_scene(progress=None):
         from ladartui.scene.model import Scene
 
         return Scene(small, small[:1], 0.25, shape=(40, 40, 30), name="tiny"), "tiny"
 
+    heard = []
+
+    @contextlib.contextmanager
+    def status():  # the status line a terminal shows
+        yield heard.append
+
     monkeypatch.setattr(bench, "load_bench_scene", tiny_scene)
     monkeypatch.setattr(bench, "SLANT_RANGE_M", 5.0)
+    monkeypatch.setattr(bench, "_status", status)
     assert main(["bench", "--quick", "--json", "--runs", "3"]) == 0
     report = json.loads(capsys.readouterr().out)
+    # it says what it does: it ran a minute in silence
+    assert heard[0] == "building the occupancy" and "exact wide 45 deg: run 1 of 3" in heard
+    assert heard[-1] == "march wide 90 deg: run 3 of 3"
     assert report["voxels"] == len(small)
     assert report["occupancy_bytes"] > 0
     assert report["warm_up"]["numba"]["calls"] == 1  # --quick: the compiling call alone
@@ -332,9 +343,10 @@ def test_bench_table_fits_an_80_column_terminal(monkeypatch, capsys):
 def test_bench_rejects_a_run_count_below_one(capsys):
     from ladartui.cli import main
 
-    assert main(["bench", "--runs", "0"]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert err == ["ladartui: error: --runs = 0: expected a whole number of at least 1"]
+    for runs in ("0", "1000000000"):  # the latter ran for ever, silently
+        assert main(["bench", "--runs", runs]) == 2
+        err = capsys.readouterr().err.strip().splitlines()
+        assert err == [f"ladartui: error: --runs = {runs}: expected a whole number from 1 to 1000"]
 
 
 class FakeClock:

@@ -15,6 +15,7 @@ its median seconds by pass; ``--passes`` prints them (cli/bench_passes.py).
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import statistics
@@ -71,12 +72,16 @@ def add_parser(subparsers):
 
 
 def run(args):
-    if args.runs is not None and args.runs < 1:
+    if args.runs is not None and not 1 <= args.runs <= MAX_RUNS:
         from ladartui.errors import FieldError
 
-        raise FieldError("--runs", args.runs, "a whole number of at least 1")
+        raise FieldError("--runs", args.runs, f"a whole number from 1 to {MAX_RUNS}")
+    with _status() as say:
+        if args.orbit:
+            report = run_orbit_bench(runs=args.runs or 3, backend="numba", progress=say)
+        else:
+            report = run_bench(quick=args.quick, runs=args.runs, progress=say)
     if args.orbit:
-        report = run_orbit_bench(runs=args.runs or 3, backend="numba")
         if args.json:
             print(json.dumps(report, indent=2))
         else:
@@ -88,7 +93,6 @@ def run(args):
                 f"{report['rays']:,} rays over both runs)"
             )
         return 0
-    report = run_bench(quick=args.quick, runs=args.runs)
     if args.json:
         print(json.dumps(report, indent=2))
     else:
@@ -100,19 +104,37 @@ def run(args):
     return 0
 
 
+MAX_RUNS = 1000  # timed runs per case: more would take hours and tell no more
+
+
+@contextlib.contextmanager
+def _status():
+    """``say(text)``: what the bench does now, on a status line of stderr (a terminal only)."""
+    from ladartui.cli.console import CliConsole
+
+    console = CliConsole(stderr=True)
+    if not console.is_terminal:
+        yield lambda text: None
+        return
+    with console.status("bench: starting", refresh_per_second=2) as status:  # little CPU beside the timing
+        yield lambda text: status.update(f"bench: {text}")
+
+
 ORBIT_SCANS = 36
 ORBIT_SLANT_RANGE_M = 150.0
 ORBIT_DEPRESSION = 45.0
 
 
-def run_orbit_bench(runs=3, backend="numba") -> dict:
-    """Median seconds of a whole orbit simulation (both runs), after one warm-up run."""
+def run_orbit_bench(runs=3, backend="numba", progress=None) -> dict:
+    """Median seconds of a whole orbit simulation (both runs), after one warm-up run;
+    ``progress(text)`` hears what it does."""
+    say = progress or (lambda text: None)
     from ladartui.flight import FlightPlan, Orbit
     from ladartui.scenario import Scenario
     from ladartui.sensor import Sensor
     from ladartui.simulation import simulate
 
-    scene, label = load_bench_scene()
+    scene, label = load_bench_scene(say)
     centre = scene.target.astype(np.float64).mean(axis=0) * scene.voxel_size
     e = math.radians(ORBIT_DEPRESSION)
     orbit = Orbit(
@@ -131,9 +153,11 @@ def run_orbit_bench(runs=3, backend="numba") -> dict:
         FlightPlan(segments=(orbit,)),
         backend=backend,
     )
+    say("orbit warm-up (kernels, occupancy)")
     simulate(scenario, scene=scene, write=False)  # warm-up: kernels, occupancy
     totals, traces = [], []
-    for _ in range(runs):
+    for run in range(runs):
+        say(f"orbit run {run + 1} of {runs}")
         started = time.perf_counter()
         result = simulate(scenario, scene=scene, write=False)
         totals.append(time.perf_counter() - started)
@@ -162,7 +186,7 @@ def cache_dir() -> Path:
     return data_home() / "bench"
 
 
-def load_bench_scene():
+def load_bench_scene(progress=None):
     """(scene, label): the ``reference`` scene, generated into the cache folder when absent."""
     from ladartui.scene.model import Scene
 
@@ -170,6 +194,8 @@ def load_bench_scene():
     if not path.exists():
         from ladartui.scene.generate import generate_scene
 
+        if progress is not None:
+            progress("generating the reference scene (first run only)")
         generated = generate_scene("reference", 0)
         with atomic_path(path) as tmp:
             with open(tmp, "wb") as handle:
@@ -224,15 +250,18 @@ def bench_rays(scene, depression, grid=128, ray_grid=4, view="wide"):
     return origins, directions
 
 
-def run_bench(quick=False, runs=None) -> dict:
-    """Measure every available backend and method; returns the report as a dict."""
+def run_bench(quick=False, runs=None, progress=None) -> dict:
+    """Measure every available backend and method; returns the report as a dict.
+    ``progress(text)`` hears what it does."""
+    say = progress or (lambda text: None)
     from ladartui.scene.occupancy import Occupancy
     from ladartui.tracing import trace
     from ladartui.tracing.backend import backend_status, get_backend
 
     runs = runs or (2 if quick else 7)
     grid = 64 if quick else 128
-    scene, label = load_bench_scene()
+    scene, label = load_bench_scene(say)
+    say("building the occupancy")
     started, cpu_started = time.perf_counter(), time.process_time()
     occupancy = Occupancy.build(scene.voxels, scene.shape)
     setup = time.perf_counter() - started
@@ -267,6 +296,7 @@ def run_bench(quick=False, runs=None) -> dict:
             except BackendUnavailable:
                 continue
     origins, directions = rays[("wide", DEPRESSIONS[0])]
+    say("warming up " + ", ".join(backends) + " (kernels, device clocks)")
     report["warm_up"] = {
         name: warm_up(
             lambda name=name: trace(
@@ -294,7 +324,8 @@ def run_bench(quick=False, runs=None) -> dict:
             cpu: dict[str, list[float]] = {name: [] for name in backends}
             orders: dict[str, set[str]] = {name: set() for name in backends}  # over the timed runs
             passes: dict[str, list[dict[str, float]]] = {name: [] for name in backends}
-            for _ in range(runs):
+            for run in range(runs):
+                say(f"{method} {view} {depression:g} deg: run {run + 1} of {runs}")
                 for name in backends:
                     trace(occupancy, origins, directions, backend=name, **kwargs)
                     c = time.process_time()
