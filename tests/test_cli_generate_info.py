@@ -98,6 +98,13 @@ def test_info_scenario_summary(tmp_path, capsys):
     assert main(["info", str(path)]) == 0
     out = capsys.readouterr().out
     assert out.strip() == scenario.load_scenario(path).summary().strip()
+    # a scenario gives its own voxel size: the option was ignored without a word
+    assert main(["info", str(path), "--voxel-size", "0.5"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        "ladartui: error: --voxel-size = 0.5: expected no --voxel-size with a scenario: "
+        "it gives its own (files.voxel_size); the option is for a voxel list"
+    )
 
 
 def test_info_backends_lists_each_backend(capsys):

@@ -37,6 +37,15 @@ def run(args) -> int:
     if args.file:
         path = Path(args.file)
         if path.suffix.lower() == ".toml":
+            if args.voxel_size is not None:
+                from ladartui.errors import FieldError
+
+                raise FieldError(
+                    "--voxel-size",
+                    args.voxel_size,
+                    "no --voxel-size with a scenario: it gives its own (files.voxel_size); "
+                    "the option is for a voxel list",
+                )
             print_scenario(path)
         else:
             print_voxel_list(path, args.voxel_size)
