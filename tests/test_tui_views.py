@@ -214,3 +214,22 @@ async def test_a_view_saves_as_a_png_of_the_requested_size(app_pilot, tmp_path):
     with pytest.raises(LadarError, match="picture size = '5 x 123': expected whole numbers"):
         area.save_png(tmp_path / "bad.png", 5, 123)
     assert not (tmp_path / "bad.png").exists()
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_a_narrow_view_keeps_its_camera_in_its_title(app_pilot):
+    """At 80 columns '3D scene az 210 el 30' was cut to '3D scene az 210 …'."""
+    pilot = app_pilot
+    app, area = await reset(pilot)
+    scene3d = app.query_one("#scene3d", ProjectionWidget)
+    c = scene3d.camera
+    await pilot.resize_terminal(80, 24)
+    await pilot.pause()
+    try:
+        title = scene3d.border_title
+        assert len(title) <= scene3d.size.width - 4, title
+        assert title.endswith(f"{c.azimuth:.0f}/{c.elevation:.0f}") or title.endswith(f"el {c.elevation:.0f}")
+    finally:
+        await pilot.resize_terminal(*SIZE)
+        await pilot.pause()
+    assert scene3d.border_title == f"3D scene az {c.azimuth:.0f} el {c.elevation:.0f}"

@@ -453,11 +453,22 @@ class ProjectionWidget(PictureWidget):
             self.pending_fit = box
             self.invalidate()
 
+    def on_resize(self, event: events.Resize) -> None:
+        super().on_resize(event)
+        self._update_title()
+
     def _update_title(self) -> None:
+        """The view's name and camera, put shorter where the border is narrow (at 80
+        columns "3D scene az 210 el 30" was cut before the elevation)."""
         c = self.camera
-        self.border_title = f"{self.base_title} az {c.azimuth:.0f} el {c.elevation:.0f}"
-        if abs(c.zoom - 1.0) > 1e-9:
-            self.border_title += f" x{c.zoom:.2g}"
+        zoom = f" x{c.zoom:.2g}" if abs(c.zoom - 1.0) > 1e-9 else ""
+        az, el = f"{c.azimuth:.0f}", f"{c.elevation:.0f}"
+        room = self.size.width - 4  # the border's corners and a space each side
+        titles = (f"{self.base_title} az {az} el {el}{zoom}", f"{self.base_title} {az}/{el}{zoom}")
+        # else the view's name and colouring ("(height)"), cut at the edge, before the camera
+        self.border_title = next(
+            (t for t in titles if len(t) <= room), titles[0] if room <= 0 else self.base_title
+        )
 
     def make_picture(self, rows, cols):
         if not self.voxel_layers or self.bounds is None:
