@@ -218,7 +218,9 @@ def _sweep_with_progress(spec, args, console):
     console.print(f"sweep of {len(spec.variants)} variants on {where}", highlight=False, markup=False)
     try:
         with sweep_progress(console) as bar:
-            task = bar.add_task("sweep", total=len(spec.variants), note="starting")
+            task = bar.add_task(
+                "sweep", total=len(spec.variants), note="starting (a first run also compiles the kernels)"
+            )
 
             def report(p):
                 outcome["progress"] = p

@@ -132,7 +132,7 @@ def _run(scenario, scene, fast: bool, warm, cancel, progress):
         progress(p.fraction, text, live)
 
     if running(warm):
-        progress(0.0, "Compiling the tracing kernels (first run only)...")
+        progress(0.0, "Compiling kernels (first run only)...")
         while running(warm):
             if cancel.is_set():
                 raise Cancelled()

@@ -289,7 +289,10 @@ class SweepScreen(RankingView):
         remember_path("sweeps", spec.path)
         self.query_one("#sweep-progress", ProgressBar).update(total=len(ids), progress=0)
         where = f"scheduler {scheduler}" if scheduler else "this process" if serial else "a local cluster"
-        self.query_one("#sweep-counts", Static).update(f"0/{len(ids)} starting on {where}")
+        # a first sweep's workers compile the kernels before their first variant (minutes)
+        self.query_one("#sweep-counts", Static).update(
+            f"0/{len(ids)} starting on {where} (a first run also compiles the kernels)"
+        )
         self._status(
             BUSY,
             f"starting {len(ids)} variants on {where}; results in {short_path(self.out)}",
@@ -566,7 +569,9 @@ class SweepScreen(RankingView):
         self._redraw()
         kept = f"{p.done} of {p.total} variants kept" if p else "finished variants kept"
         if error == "cancelled":
-            self._status(NOT_READY, f"sweep cancelled: {kept} in {short_path(self.out)}; F5 resumes")
+            # the folder in a note: after the counts on the status line it was cut at 80 columns
+            self.notify(f"Sweep cancelled: its rows are kept in {self.out}; F5 resumes.", markup=False)
+            self._status(NOT_READY, f"sweep cancelled: {kept}; F5 resumes")
         else:
             self._status(NOT_READY, f"sweep stopped: {error}")
 
