@@ -136,3 +136,26 @@ def test_a_ctrl_c_while_the_charts_are_drawn_waits_for_the_whole_set(base, tmp_p
     assert drawn and all(path.is_file() for path in drawn[0].values())
     for path in drawn[0].values():
         assert f"chart    {path}" in out
+
+
+def test_a_ranking_with_no_best_says_the_best_path_file_is_from_an_earlier_one(base, tmp_path, capsys):
+    """An objective that ranked nothing left the earlier objective's best path in the
+    folder, and the summary said nothing of it (JSON: best_scenario null)."""
+    import json
+
+    from ladartui.cli import main
+
+    spec = tmp_path / "spec.toml"
+    spec.write_text('[sweep]\nscenario = "base.toml"\n[grid]\nradius = [20.0, 30.0]\n', encoding="utf-8")
+    assert main(["sweep", str(spec), "--serial"]) == 0
+    best = tmp_path / "spec-results" / "spec-best.toml"
+    assert best.is_file()
+    capsys.readouterr()
+    budget = ["--objective", "identified-within-budget", "--budget", "1e-9"]  # nothing identified so soon
+    assert main(["sweep", str(spec), "--serial", *budget, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["best_scenario"] is None and out["best_scenario_earlier"] == str(best)
+    assert main(["sweep", str(spec), "--serial", *budget]) == 0
+    text = capsys.readouterr().out.replace("\n", "")
+    assert f"earlier  {best}  (the best path of an earlier ranking: none is ranked now)" in text
+    assert best.is_file()  # kept: it is what that ranking found

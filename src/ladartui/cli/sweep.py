@@ -312,6 +312,7 @@ def result_dict(result, top) -> dict:
         "ranking": str(result.ranking_path) if result.ranking_path else None,
         "best_scenario": str(result.best_scenario_path) if result.best_scenario_path else None,
         "best_scenario_kept": str(result.best_kept) if result.best_kept else None,
+        "best_scenario_earlier": str(result.best_earlier) if result.best_earlier else None,
         "best_levels": levels_text(result.best.row) if result.best is not None else None,
         "charts": {fmt: str(path) for fmt, path in result.charts.items()},
         "top": [entry(r) for r in result.ranking[:top] if r.rank is not None],
@@ -422,6 +423,14 @@ def show_result(console, result, top) -> None:
         console.print(
             visible(
                 f"best     {result.best_scenario_path}  (open it with: ladartui {result.best_scenario_path})"
+            ),
+            highlight=False,
+            markup=False,
+        )
+    if result.best_earlier:
+        console.print(
+            visible(
+                f"earlier  {result.best_earlier}  (the best path of an earlier ranking: none is ranked now)"
             ),
             highlight=False,
             markup=False,

@@ -78,6 +78,7 @@ class SweepResult:
     ranking_path: Path | None = None
     best_scenario_path: Path | None = None
     best_kept: Path | None = None  # an edited best-path file the sweep wrote beside
+    best_earlier: Path | None = None  # none ranked now: the best-path file an earlier ranking wrote
     ran: int = 0
     resumed: int = 0
     workers: int = 0
@@ -336,6 +337,8 @@ def _run_locked(
             out / f"{spec.name}-best.toml", base, result.best.row, spec.parameter_names, scene
         )
         result.best_scenario_path, result.best_kept = written.path, written.kept
+    elif (out / f"{spec.name}-best.toml").is_file():  # what an earlier ranking found: kept, named
+        result.best_earlier = out / f"{spec.name}-best.toml"
     result.elapsed = time.perf_counter() - started
     return result
 
