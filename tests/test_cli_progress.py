@@ -105,6 +105,9 @@ def test_the_sweep_progress_keeps_its_figures_whole_in_80_columns():
     assert progress_note(SimpleNamespace(done=4, resumed=0, failed=0, impossible=0, elapsed=2.0)) == (
         "120.0/min"
     )
+    # before the first variant is done: the wait is the workers' start (and first compile)
+    starting = SimpleNamespace(done=12, total=48, resumed=12, failed=0, impossible=0, elapsed=3.0)
+    assert progress_note(starting) == "12 resumed, starting; a first run compiles kernels"
     with sweep_progress(console, auto_refresh=False) as bar:
         task = bar.add_task("sweep", total=960, note="starting")
         bar.update(task, completed=480, note=note)

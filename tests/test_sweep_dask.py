@@ -288,3 +288,27 @@ def test_a_script_without_a_main_guard_is_told_what_to_change(tmp_path):
         [sys.executable, str(script)], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300
     )
     assert done.returncode == 0 and done.stdout.split() == ["ran", "8"], done.stderr
+
+
+def test_workers_started_for_a_local_cluster_never_see_a_ctrl_c_at_start_up():
+    """The key reaches the terminal's whole process group: workers still starting
+    printed KeyboardInterrupt tracebacks before the plugin made them ignore it. They
+    start with SIGINT blocked, inherited from the thread that starts the cluster."""
+    import signal
+
+    from ladartui.sweep.execute import _ctrl_c_blocked
+
+    ask = "import signal; print(signal.SIGINT in signal.pthread_sigmask(signal.SIG_BLOCK, set()))"
+
+    def child_blocks() -> str:
+        return subprocess.run([sys.executable, "-c", ask], capture_output=True, text=True).stdout.strip()
+
+    seen = {}
+    with _ctrl_c_blocked():
+        seen["child"] = child_blocks()
+        started = threading.Thread(target=lambda: seen.update(thread=child_blocks()))
+        started.start()
+        started.join()
+    assert seen == {"child": "True", "thread": "True"}
+    assert child_blocks() == "False"  # only while the cluster starts
+    assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, set())

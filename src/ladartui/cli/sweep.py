@@ -184,6 +184,9 @@ def run(args) -> int:
     return 0
 
 
+STARTING = "starting; a first run compiles kernels"
+
+
 def sweep_progress(console, **options):
     """The sweep's progress line: bar, variants done of all, the counts that are not
     zero and the rate, the time left (every figure whole in 80 columns; the summary
@@ -201,6 +204,8 @@ def progress_note(p) -> str:
     parts = [f"{count} {what}" for count, what in counts if count]
     if ran and p.elapsed > 0:
         parts.append(f"{60 * ran / p.elapsed:.1f}/min")
+    elif not ran and p.done < p.total:  # the workers' first variant also compiles the kernels
+        parts.append(STARTING)
     return ", ".join(parts)
 
 
@@ -218,9 +223,7 @@ def _sweep_with_progress(spec, args, console):
     console.print(f"sweep of {len(spec.variants)} variants on {where}", highlight=False, markup=False)
     try:
         with sweep_progress(console) as bar:
-            task = bar.add_task(
-                "sweep", total=len(spec.variants), note="starting (a first run also compiles the kernels)"
-            )
+            task = bar.add_task("sweep", total=len(spec.variants), note=STARTING)
 
             def report(p):
                 outcome["progress"] = p

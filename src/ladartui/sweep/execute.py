@@ -417,14 +417,15 @@ def local_client(workers: int | None = None):
     cores = os.cpu_count() or 1
     count = workers or cores
     try:
-        cluster = LocalCluster(
-            n_workers=count,
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=None,
-            silence_logs=logging.ERROR,
-            env={"NUMBA_NUM_THREADS": str(max(1, cores // count))},
-        )
+        with _ctrl_c_blocked():
+            cluster = LocalCluster(
+                n_workers=count,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=None,
+                silence_logs=logging.ERROR,
+                env={"NUMBA_NUM_THREADS": str(max(1, cores // count))},
+            )
     except RuntimeError as error:  # "Nanny failed to start": the worker said why above
         raise LadarError(
             f"the local cluster's worker processes failed to start ({error}); their messages above say "
@@ -433,6 +434,23 @@ def local_client(workers: int | None = None):
     client = Client(cluster)
     _workers_ignore_ctrl_c(client)
     return client
+
+
+@contextlib.contextmanager
+def _ctrl_c_blocked():
+    """SIGINT blocked in this thread while a local cluster starts. Threads started here
+    (the cluster's) and the worker processes they spawn inherit the block, so a Ctrl-C
+    while they start up reaches this process's main thread alone: each worker printed
+    a KeyboardInterrupt traceback from its start-up before. (The plugin below makes the
+    workers ignore the key once running.)"""
+    if not hasattr(signal, "pthread_sigmask"):
+        yield
+        return
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, before)
 
 
 def _ignore_ctrl_c() -> None:
