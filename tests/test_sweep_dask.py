@@ -296,7 +296,7 @@ def test_workers_started_for_a_local_cluster_never_see_a_ctrl_c_at_start_up():
     start with SIGINT blocked, inherited from the thread that starts the cluster."""
     import signal
 
-    from ladartui.sweep.execute import _ctrl_c_blocked
+    from ladartui.sweep.cluster import _ctrl_c_blocked
 
     ask = "import signal; print(signal.SIGINT in signal.pthread_sigmask(signal.SIG_BLOCK, set()))"
 

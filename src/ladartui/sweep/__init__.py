@@ -11,10 +11,10 @@ from ladartui.lazy import lazy_getattr
 _EXPORTS = {
     "SweepProgress": "ladartui.sweep.execute",
     "SweepResult": "ladartui.sweep.execute",
-    "connect": "ladartui.sweep.execute",
+    "connect": "ladartui.sweep.cluster",
     "default_out_dir": "ladartui.sweep.execute",
     "load_sweep_results": "ladartui.sweep.execute",
-    "local_client": "ladartui.sweep.execute",
+    "local_client": "ladartui.sweep.cluster",
     "run_sweep": "ladartui.sweep.execute",
     "OBJECTIVES": "ladartui.sweep.ranking",
     "Ranked": "ladartui.sweep.ranking",

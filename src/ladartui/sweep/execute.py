@@ -11,11 +11,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
-import importlib.metadata
-import logging
 import math
-import os
-import signal
 import time
 import uuid
 from collections.abc import Callable
@@ -26,6 +22,7 @@ from ladartui.atomic import atomic_path
 from ladartui.errors import FieldError, InputFileError, LadarError, OutputFileError, check_cancelled
 from ladartui.sweep.base import base_digest, base_scenario_path, own_rows, spec_rows
 from ladartui.sweep.best_file import write_best_scenario
+from ladartui.sweep.cluster import close_client, local_client
 from ladartui.sweep.ranking import (
     BUDGET_OBJECTIVES,
     COSTS,
@@ -311,7 +308,7 @@ def _run_locked(
                 _run_on_dask(client, todo, base, digest, scene(), options, record, cancel)
             finally:
                 if owned:
-                    _close(client)
+                    close_client(client)
 
     # The rows as the file holds them (every column present), so this result
     # and load_sweep_results of the same folder agree.
@@ -404,123 +401,6 @@ def _run_on_dask(client, todo, base, digest, scene, options, record, cancel):
         if pending:
             client.cancel(list(pending))
         scene_future.release()
-
-
-def local_client(workers: int | None = None):
-    """A client of a new LocalCluster: ``workers`` processes (default one per core), 1 thread each.
-
-    The tracing kernels are parallel themselves, so each worker's numba pool
-    gets an even share of the cores instead of every worker using them all.
-    """
-    from distributed import Client, LocalCluster
-
-    cores = os.cpu_count() or 1
-    count = workers or cores
-    try:
-        with _ctrl_c_blocked():
-            cluster = LocalCluster(
-                n_workers=count,
-                threads_per_worker=1,
-                processes=True,
-                dashboard_address=None,
-                silence_logs=logging.ERROR,
-                env={"NUMBA_NUM_THREADS": str(max(1, cores // count))},
-            )
-    except RuntimeError as error:  # "Nanny failed to start": the worker said why above
-        raise LadarError(
-            f"the local cluster's worker processes failed to start ({error}); their messages above say "
-            "why. From a script, call run_sweep under 'if __name__ == \"__main__\":'"
-        ) from error
-    client = Client(cluster)
-    _workers_ignore_ctrl_c(client)
-    return client
-
-
-@contextlib.contextmanager
-def _ctrl_c_blocked():
-    """SIGINT blocked in this thread while a local cluster starts. Threads started here
-    (the cluster's) and the worker processes they spawn inherit the block, so a Ctrl-C
-    while they start up reaches this process's main thread alone: each worker printed
-    a KeyboardInterrupt traceback from its start-up before. (The plugin below makes the
-    workers ignore the key once running.)"""
-    if not hasattr(signal, "pthread_sigmask"):
-        yield
-        return
-    before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, before)
-
-
-def _ignore_ctrl_c() -> None:
-    """In a worker process (on its main thread, where its event loop runs): SIGINT ignored."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-
-
-def _workers_ignore_ctrl_c(client) -> None:
-    """A local cluster's workers ignore Ctrl-C, now and when restarted. The key reaches
-    the terminal's whole process group, and each worker printed a traceback as it
-    died; this process stops them instead, after keeping the finished rows."""
-    from distributed.diagnostics.plugin import WorkerPlugin
-
-    class IgnoreCtrlC(WorkerPlugin):
-        name = "ladartui-ignore-ctrl-c"
-
-        def setup(self, worker):
-            _ignore_ctrl_c()
-
-    client.register_plugin(IgnoreCtrlC())
-
-
-def connect(address: str, timeout: float = 30.0, security=None):
-    """A client of the Dask scheduler at ``address`` that has ladartui on every worker.
-
-    ``security``: a ``distributed.Security`` for a TLS scheduler (see ``sweep.security``).
-    """
-    from distributed import Client
-
-    try:
-        client = Client(address, timeout=f"{timeout}s", security=security)
-    except (OSError, TimeoutError, ValueError, TypeError) as error:  # TypeError: tls:// sans TLS
-        raise FieldError(
-            "--scheduler",
-            address,
-            f"the address of a running Dask scheduler (tcp://HOST:PORT); connecting failed: {error}",
-        ) from None
-    try:
-        client.wait_for_workers(1, timeout=timeout)
-    except (TimeoutError, OSError):
-        _close(client)
-        raise FieldError(
-            "--scheduler", address, f"a scheduler with workers; none joined within {timeout:g} s"
-        ) from None
-    check_workers(client)
-    return client
-
-
-def check_workers(client) -> None:
-    """Raise LadarError when a worker lacks ladartui or runs another version of it."""
-    mine = importlib.metadata.version("ladartui")
-    answers = client.run(importlib.metadata.version, "ladartui", on_error="return")
-    for worker, answer in answers.items():
-        if isinstance(answer, BaseException):
-            raise LadarError(
-                f"worker {worker} cannot import ladartui ({answer}); install this "
-                f"version ({mine}) in the workers' environment"
-            )
-        if answer != mine:
-            raise LadarError(
-                f"worker {worker} runs ladartui {answer}, this client {mine}; "
-                "install the same version everywhere"
-            )
-
-
-def _close(client):
-    cluster = getattr(client, "cluster", None)
-    client.close()
-    if cluster is not None:
-        cluster.close()
 
 
 def write_ranking(path, ranking: list[Ranked], parameter_names) -> Path:

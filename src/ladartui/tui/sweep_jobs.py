@@ -1,12 +1,15 @@
 """The sweep screen's work outside the interface thread: the sweep job, writing the
-best variant as a scenario, and the paths and process set-up they need. Nothing
-here draws; tui/sweep_screen.py starts these and shows what they report."""
+best variant as a scenario, checking a spec to run, and the paths and process
+set-up they need. Nothing here draws; tui/sweep_screen.py starts these and shows
+what they report."""
 
 from __future__ import annotations
 
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
+
+from ladartui.errors import FieldError, InputFileError
 
 if TYPE_CHECKING:
     from ladartui.sweep.best_file import BestScenario
@@ -82,3 +85,24 @@ def write_best(spec, row: dict, parameter_names, path: Path) -> BestScenario:
 
     base = load_scenario(base_scenario_path(spec))
     return write_best_scenario(path, base, row, parameter_names, base.load_scene)
+
+
+def spec_to_run(text: str):
+    """Load and check the spec at ``text`` and its base scenario; LadarError if unusable."""
+    from ladartui.scenario import load_scenario
+    from ladartui.sweep import load_sweep_spec
+    from ladartui.sweep.base import base_scenario_path
+    from ladartui.sweep.spec import bundled_name
+
+    if not text:
+        raise FieldError("spec", text, "the path of a sweep spec (.toml)")
+    path = Path(text).expanduser()
+    if path.is_dir() or path.suffix.lower() == ".csv":
+        sibling = sibling_spec(path)
+        if sibling is None:
+            raise InputFileError(path, "expected a sweep spec (.toml) to run; F3 opens results")
+        path = sibling
+    spec = load_sweep_spec(path)
+    if bundled_name(spec.scenario_path) is None:
+        load_scenario(base_scenario_path(spec))
+    return spec

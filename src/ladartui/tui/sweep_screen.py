@@ -25,11 +25,11 @@ from textual.validation import ValidationResult, Validator
 from textual.widgets import Button, Checkbox, DataTable, Footer, Input, Label, ProgressBar, Static
 from textual_plotext import PlotextPlot
 
-from ladartui.errors import FieldError, InputFileError, LadarError
+from ladartui.errors import FieldError, LadarError
 from ladartui.recent import recent_paths, remember_path
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar, format_eta
-from ladartui.tui.sweep_jobs import sibling_spec, start_resource_tracker, sweep_job, write_best
+from ladartui.tui.sweep_jobs import sibling_spec, spec_to_run, start_resource_tracker, sweep_job, write_best
 from ladartui.tui.sweep_ranking import RankingView
 from ladartui.tui.sweep_view import (
     eta_seconds,
@@ -219,26 +219,6 @@ class SweepScreen(RankingView):
         typed = self._typed_budget()
         return typed if typed is not None else self.budget
 
-    def _check_spec(self, text: str):
-        """Load and check the spec at ``text`` and its base scenario; LadarError if unusable."""
-        from ladartui.scenario import load_scenario
-        from ladartui.sweep import load_sweep_spec
-        from ladartui.sweep.base import base_scenario_path
-        from ladartui.sweep.spec import bundled_name
-
-        if not text:
-            raise FieldError("spec", text, "the path of a sweep spec (.toml)")
-        path = Path(text).expanduser()
-        if path.is_dir() or path.suffix.lower() == ".csv":
-            sibling = sibling_spec(path)
-            if sibling is None:
-                raise InputFileError(path, "expected a sweep spec (.toml) to run; F3 opens results")
-            path = sibling
-        spec = load_sweep_spec(path)
-        if bundled_name(spec.scenario_path) is None:
-            load_scenario(base_scenario_path(spec))
-        return spec
-
     # -- actions ------------------------------------------------------------------
 
     def action_run(self) -> None:
@@ -247,7 +227,7 @@ class SweepScreen(RankingView):
             self._status(BUSY, "a sweep is already running: Ctrl+X cancels it", cancellable=True)
             return
         try:
-            spec = self._check_spec(self._path_text())
+            spec = spec_to_run(self._path_text())
             typed = self._typed_budget()
             budget = typed if typed is not None else spec.budget
             # The objective and cost chosen here carry over when the same spec runs again.
