@@ -288,15 +288,35 @@ def test_a_script_without_a_main_guard_is_told_what_to_change(tmp_path):
         [sys.executable, str(script)], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300
     )
     assert done.returncode == 0 and done.stdout.split() == ["ran", "8"], done.stderr
+    # a function of a guarded script, run in a spawned process of a pool, is not that import
+    script.write_text(
+        "from concurrent.futures import ProcessPoolExecutor\n"
+        "import multiprocessing\n"
+        "from ladartui.sweep import run_sweep\n\n"
+        "def job():\n"
+        "    return run_sweep('spec.toml', serial=True, out='pooled').ran\n\n"
+        "if __name__ == '__main__':\n"
+        "    spawn = multiprocessing.get_context('spawn')\n"
+        "    with ProcessPoolExecutor(1, mp_context=spawn) as pool:\n"
+        "        print('ran', pool.submit(job).result())\n",
+        encoding="utf-8",
+    )
+    done = subprocess.run(
+        [sys.executable, str(script)], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300
+    )
+    assert done.returncode == 0 and done.stdout.split() == ["ran", "8"], done.stderr
 
 
-def test_workers_started_for_a_local_cluster_never_see_a_ctrl_c_at_start_up():
+def test_workers_started_for_a_local_cluster_never_see_a_ctrl_c_at_start_up(monkeypatch):
     """The key reaches the terminal's whole process group: workers still starting
-    printed KeyboardInterrupt tracebacks before the plugin made them ignore it. They
-    start with SIGINT blocked, inherited from the thread that starts the cluster."""
+    printed KeyboardInterrupt tracebacks before the plugin made them ignore it. The
+    cluster starts with SIGINT blocked in its thread, which the processes it spawns
+    (and the threads it starts) inherit."""
     import signal
 
-    from ladartui.sweep.cluster import _ctrl_c_blocked
+    import distributed
+
+    from ladartui.sweep import cluster
 
     ask = "import signal; print(signal.SIGINT in signal.pthread_sigmask(signal.SIG_BLOCK, set()))"
 
@@ -304,11 +324,18 @@ def test_workers_started_for_a_local_cluster_never_see_a_ctrl_c_at_start_up():
         return subprocess.run([sys.executable, "-c", ask], capture_output=True, text=True).stdout.strip()
 
     seen = {}
-    with _ctrl_c_blocked():
-        seen["child"] = child_blocks()
-        started = threading.Thread(target=lambda: seen.update(thread=child_blocks()))
-        started.start()
-        started.join()
-    assert seen == {"child": "True", "thread": "True"}
+
+    class StartingCluster:  # what LocalCluster does as it starts: threads, worker processes
+        def __init__(self, **options):
+            seen["worker"] = child_blocks()
+            started = threading.Thread(target=lambda: seen.update(thread_worker=child_blocks()))
+            started.start()
+            started.join()
+
+    monkeypatch.setattr(distributed, "LocalCluster", StartingCluster)
+    monkeypatch.setattr(distributed, "Client", lambda cluster: cluster)
+    monkeypatch.setattr(cluster, "_workers_ignore_ctrl_c", lambda client: None)
+    cluster.local_client(1)
+    assert seen == {"worker": "True", "thread_worker": "True"}
     assert child_blocks() == "False"  # only while the cluster starts
     assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, set())

@@ -118,8 +118,8 @@ def _refuse_in_worker_start() -> None:
     import types
 
     frame: types.FrameType | None = sys._getframe(1)
-    while frame is not None:  # the script runs as "__mp_main__" while a worker imports it
-        if frame.f_globals.get("__name__") == "__mp_main__":
+    while frame is not None:  # the script's top level runs as "__mp_main__" while a worker imports it
+        if frame.f_globals.get("__name__") == "__mp_main__" and frame.f_code.co_name == "<module>":
             raise LadarError(
                 "run_sweep was called while a worker process imported the script "
                 f"{frame.f_globals.get('__file__', '')!r}: put the sweep under "
