@@ -24,16 +24,10 @@ from ladartui.sweep import (
     write_table,
 )
 from ladartui.sweep.table import TEXT_COLUMNS
-from tiny_sweep import CENTRE, write_tiny_scenario
+from tiny_sweep import CENTRE, tiny_folder, write_spec, write_tiny_scenario
 
 # Columns that depend on where and when a variant ran, not on what it computed.
 VOLATILE = {"run_time_s", "worker"}
-
-
-def write_spec(folder, body, name="spec.toml", scenario="base.toml"):
-    path = folder / name
-    path.write_text(f'[sweep]\nscenario = "{scenario}"\n{body}', encoding="utf-8")
-    return path
 
 
 TINY_GRID = """
@@ -46,9 +40,7 @@ sensor_grid = [8, 0]
 
 @pytest.fixture(scope="module")
 def tiny(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("tiny")
-    write_tiny_scenario(folder)
-    return folder
+    return tiny_folder(tmp_path_factory)
 
 
 # -- specs ---------------------------------------------------------------------------
@@ -549,97 +541,3 @@ def test_the_best_scenario_file_does_not_carry_the_base_files_comments(tmp_path)
     )
     saved = load_scenario(path)
     assert saved.flight.segments[0].radius == 35.0 and saved.scene_file == base.scene_file
-
-
-@pytest.mark.parametrize("model", ["tiny.txt", "tiny_Target.txt"])
-def test_a_changed_model_file_runs_every_variant_again(tmp_path, model):
-    """A resumed sweep reused rows made from an earlier scene or target model: the
-    check read the scene's name and size only, and no part of the target model."""
-    write_tiny_scenario(tmp_path)  # its own models: this test changes one
-    spec = write_spec(tmp_path, "[grid]\nradius = [20.0, 30.0]\n", name="models.toml")
-    out = tmp_path / "out"
-    assert run_sweep(spec, serial=True, out=out).ran == 2
-    path = tmp_path / model
-    text = path.read_text(encoding="utf-8")
-    assert "\n14,15,1\n" in text
-    # the same size, another voxel: one of the vehicle's raised by two
-    path.write_text(text.replace("\n14,15,1\n", "\n14,15,3\n"), encoding="utf-8")
-    again = run_sweep(spec, serial=True, out=out)
-    assert (again.ran, again.resumed) == (2, 0)
-
-
-def test_show_ranks_the_rows_of_the_current_base_only(tmp_path, capsys):
-    """The table keeps rows from an earlier base; a run ranks only the current base's,
-    and so must --show and load_sweep_results given the spec (each variant was
-    ranked once per base it had run with)."""
-    import json
-
-    from ladartui.cli import main
-
-    write_tiny_scenario(tmp_path)
-    spec = write_spec(tmp_path, "[grid]\nradius = [20.0, 30.0]\n", name="bases.toml")
-    run_sweep(spec, serial=True)
-    base = tmp_path / "base.toml"
-    base.write_text(base.read_text(encoding="utf-8").replace("fov_deg = 20.0", "fov_deg = 18.0"))
-    ran = run_sweep(spec, serial=True)
-    assert ran.ran == 2 and len(ran.rows) == 2
-    out = tmp_path / "bases-results"
-    assert len(read_table(out / "results.csv")[0]) == 4  # both bases' rows are kept
-    shown = load_sweep_results(out, spec=load_sweep_spec(spec))
-    assert [r.row["variant"] for r in shown.ranking] == [r.row["variant"] for r in ran.ranking]
-    assert [r.value for r in shown.ranking] == [r.value for r in ran.ranking]
-    assert main(["sweep", str(spec), "--show", "--json"]) == 0
-    top = json.loads(capsys.readouterr().out)["top"]
-    assert [t["variant"] for t in top] == [r.row["variant"] for r in ran.ranking]
-
-
-def test_a_range_of_too_many_values_is_refused_on_its_line_even_past_float_range(tmp_path):
-    write_tiny_scenario(tmp_path)
-    body = "[grid]\naltitude = { start = 0.0, stop = 1e300, step = 1e-300 }\n"
-    spec = write_spec(tmp_path, body, name="huge.toml")
-    with pytest.raises(InputFileError, match=r"huge\.toml:4: grid\.altitude: expected at most 100000 values"):
-        load_sweep_spec(spec)
-
-
-@pytest.mark.parametrize("budget", [-1.0, 0.0, math.nan, math.inf, "abc", True])
-def test_run_sweep_refuses_a_budget_that_is_no_positive_number(tiny, tmp_path, budget):
-    from ladartui.errors import FieldError
-
-    spec = write_spec(tiny, "[grid]\nradius = [20.0]\n", name="budget.toml")
-    with pytest.raises(FieldError, match=r"^budget.*expected a flight-time budget in seconds, > 0"):
-        run_sweep(spec, serial=True, out=tmp_path / "o", objective="coverage-within-budget", budget=budget)
-    assert not (tmp_path / "o").exists()
-
-
-def test_run_sweep_names_a_file_given_as_its_results_folder(tiny, tmp_path):
-    from ladartui.errors import OutputFileError
-
-    spec = write_spec(tiny, "[grid]\nradius = [20.0]\n", name="outfile.toml")
-    with pytest.raises(OutputFileError, match="is a file, expected a folder"):
-        run_sweep(spec, serial=True, out=spec)
-
-
-def test_the_cli_refuses_an_infinite_budget_before_running(tiny, tmp_path, capsys):
-    from ladartui.cli import main
-
-    spec = write_spec(tiny, "[grid]\nradius = [20.0]\n", name="inf.toml")
-    args = ["sweep", str(spec), "--serial", "--objective", "coverage-within-budget", "--budget", "inf"]
-    assert main([*args, "--json", "--out", str(tmp_path / "o")]) == 2
-    assert "--budget" in capsys.readouterr().err
-    assert not (tmp_path / "o").exists()
-
-
-@pytest.mark.parametrize(
-    "text, line",
-    [
-        ('[sweep]\nscenario = "base.toml"\n[grid]\n\'radius\' = [20.0, "x"]\n', 4),  # single-quoted
-        ('[sweep]\nscenario = "base.toml"\n[grid]\n"radius" = [20.0, "x"]\n', 4),
-        ('grid.radius = [20.0, "x"]\n[sweep]\nscenario = "base.toml"\n', 1),  # dotted, before any table
-    ],
-)
-def test_a_bad_value_is_named_on_its_own_line_however_its_key_is_written(tmp_path, text, line):
-    write_tiny_scenario(tmp_path)
-    spec = tmp_path / "keys.toml"
-    spec.write_text(text, encoding="utf-8")
-    with pytest.raises(InputFileError, match=rf"keys\.toml:{line}: grid\.radius"):
-        load_sweep_spec(spec)

@@ -25,6 +25,20 @@ def write_tiny_scenario(folder, name="base.toml"):
     return scenario.save()
 
 
+def tiny_folder(tmp_path_factory):
+    """A new folder holding the tiny base scenario (for a module-scoped fixture)."""
+    folder = tmp_path_factory.mktemp("tiny")
+    write_tiny_scenario(folder)
+    return folder
+
+
+def write_spec(folder, body, name="spec.toml", scenario="base.toml"):
+    """A sweep spec over ``scenario`` with ``body`` after its [sweep] table."""
+    path = folder / name
+    path.write_text(f'[sweep]\nscenario = "{scenario}"\n{body}', encoding="utf-8")
+    return path
+
+
 TWO_CENTRE = (15.5, 15.5, 0.5)
 
 

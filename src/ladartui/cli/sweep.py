@@ -11,12 +11,16 @@ import json
 import math
 import os
 import threading
+from typing import TYPE_CHECKING
 
 from rich.markup import escape
 
 from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt, stop_status
 from ladartui.errors import Cancelled, FieldError
 from ladartui.textsafe import visible
+
+if TYPE_CHECKING:
+    from ladartui.sweep.spec import SweepSpec
 
 DEFAULT_TOP = 10
 
@@ -151,13 +155,29 @@ def run(args) -> int:
         )
     errors = Console(stderr=True)
     if args.show:
+        from ladartui.errors import InputFileError
+        from ladartui.sweep.base import base_scenario_path
+
         out = args.out or default_out_dir(spec)
+        own: SweepSpec | None = spec  # rank its variants from its base as it is now
+        try:
+            base_scenario_path(spec)
+        except InputFileError as error:  # gone: nothing to tell this base's rows by
+            errors.print(
+                visible(
+                    f"ladartui: the base scenario is not there ({error}); every row of the table is ranked"
+                ),
+                highlight=False,
+                markup=False,
+                soft_wrap=True,
+            )
+            own = None
         result = load_sweep_results(
             out,
             objective=args.objective or spec.objective,
             budget=args.budget if args.budget is not None else spec.budget,
             cost=args.cost or spec.cost,
-            spec=spec,
+            spec=own,
         )
         result.parameter_names = spec.parameter_names
     else:
@@ -170,7 +190,7 @@ def run(args) -> int:
         result = _sweep_with_progress(spec, args, errors)
         if result is None:
             return stop_status()
-    if not result.charts:  # --show redraws them
+    if not result.charts and result.rows:  # --show redraws them (from rows: not empty ones)
         from ladartui.charts.sweep import write_sweep_charts
 
         result.charts = write_sweep_charts(result, result.results_path.parent)
@@ -316,6 +336,7 @@ def result_dict(result, top) -> dict:
         "best_scenario": str(result.best_scenario_path) if result.best_scenario_path else None,
         "best_scenario_kept": str(result.best_kept) if result.best_kept else None,
         "best_scenario_earlier": str(result.best_earlier) if result.best_earlier else None,
+        "left_out": result.left_out,
         "best_levels": levels_text(result.best.row) if result.best is not None else None,
         "charts": {fmt: str(path) for fmt, path in result.charts.items()},
         "top": [entry(r) for r in result.ranking[:top] if r.rank is not None],
@@ -415,6 +436,12 @@ def show_result(console, result, top) -> None:
         console.print(
             f"{ran} variant(s) run in {result.elapsed:.1f} s{rate} on "
             f"{result.workers} worker(s); {result.resumed} resumed from earlier runs",
+            highlight=False,
+        )
+    if result.left_out:
+        console.print(
+            f"{result.left_out} rows of other variants or an earlier base left out (a run of this "
+            "spec runs its variants again for the base as it is now)",
             highlight=False,
         )
     console.print(visible(f"results  {result.results_path}"), highlight=False, markup=False)

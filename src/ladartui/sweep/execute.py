@@ -76,6 +76,7 @@ class SweepResult:
     best_scenario_path: Path | None = None
     best_kept: Path | None = None  # an edited best-path file the sweep wrote beside
     best_earlier: Path | None = None  # none ranked now: the best-path file an earlier ranking wrote
+    left_out: int = 0  # rows of the table not ranked: other variants, or an earlier base
     ran: int = 0
     resumed: int = 0
     workers: int = 0
@@ -314,6 +315,7 @@ def _run_locked(
     # and load_sweep_results of the same folder agree.
     table_rows, _ = read_table(results_path)
     rows = own_rows(table_rows, variants, digest)
+    left_out = len(table_rows) - len(rows)
     ranking = rank_rows(rows, objective, budget, cost)
     result = SweepResult(
         rows=rows,
@@ -327,6 +329,7 @@ def _run_locked(
         resumed=resumed,
         workers=result_workers,
         scheduler=scheduler,
+        left_out=left_out,
     )
     result.ranking_path = write_ranking(out / RANKING_NAME, ranking, spec.parameter_names)
     if result.best is not None:
@@ -457,6 +460,7 @@ def load_sweep_results(
     if not path.exists():
         raise InputFileError(path, "no sweep results here")
     rows, header = read_table(path)
+    every = len(rows)
     if spec is not None:
         rows = spec_rows(rows, spec)
     objective, cost = normal_objective(objective), normal_cost(cost)
@@ -487,6 +491,7 @@ def load_sweep_results(
         budget=budget,
         parameter_names=parameter_names,
         results_path=path,
+        left_out=every - len(rows),
     )
 
 
