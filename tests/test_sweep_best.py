@@ -56,12 +56,28 @@ def test_a_file_the_sweep_did_not_write_is_never_replaced(base, tmp_path):
     assert written.path == tmp_path / "base-best-2.toml"
 
 
-def test_best_files_lists_the_sweeps_own_unedited_files_newest_first(base, tmp_path):
+def test_best_files_lists_the_files_sweeps_wrote_newest_first(base, tmp_path):
+    import os
+
     first = _write(base, tmp_path, 35.0)
-    load_scenario(first.path).with_changes(speed=12.0).save()
+    load_scenario(first.path).with_changes(speed=12.0).save()  # edited: still a best path
     second = _write(base, tmp_path, 45.0)
+    os.utime(first.path, ns=(1, 1))  # the older of the two
     (tmp_path / "other-best.toml").write_text("# mine\n", encoding="utf-8")
-    assert best_files(tmp_path) == [second.path]
+    assert best_files(tmp_path) == [second.path, first.path]
+    assert best_files(tmp_path, "base") == [second.path, first.path]
+    assert best_files(tmp_path, "other") == []
+
+
+def test_a_best_path_an_earlier_version_wrote_is_kept_and_said_to_be_unmarked(base, tmp_path):
+    """Files written before fingerprints were called 'edited since a sweep wrote it'."""
+    written = _write(base, tmp_path, 35.0)
+    header, _, body = written.path.read_text(encoding="utf-8").split("\n", 2)
+    written.path.write_text(f"{header}\n{body}", encoding="utf-8")  # as earlier versions wrote it
+    again = _write(base, tmp_path, 45.0)
+    assert again.kept == written.path and again.path.name == "base-best-2.toml"
+    assert again.kept_why == "written before sweeps marked their own files; it may hold edits"
+    assert best_files(tmp_path)[-1] == written.path
 
 
 def test_a_sweep_keeps_an_edited_best_path_and_says_where_the_new_one_is(base, tmp_path):

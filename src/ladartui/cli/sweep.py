@@ -467,7 +467,7 @@ def show_result(console, result, top) -> None:
         )
     if result.best_kept:
         console.print(
-            visible(f"kept     {result.best_kept}  (edited since a sweep wrote it: not replaced)"),
+            visible(f"kept     {result.best_kept}  ({result.best_kept_why}: not replaced)"),
             highlight=False,
             markup=False,
         )

@@ -31,42 +31,60 @@ class BestScenario:
 
     path: Path
     kept: Path | None = None  # NAME-best.toml left as the analyst saved it
+    kept_why: str = ""  # why it was not replaced, in words
 
 
 def _fingerprint(body: str) -> str:
     return hashlib.sha256(body.encode("utf-8")).hexdigest()[:16]
 
 
-def _is_own(path: Path) -> bool:
-    """Whether ``path`` holds a best path exactly as a sweep wrote it."""
+def _state(path: Path) -> str:
+    """ "own" (a best path as a sweep wrote it), "edited" (its fingerprint no longer
+    matches), "unmarked" (a sweep's header without a fingerprint: an earlier version's,
+    which may hold edits), or "other" (not a sweep's best path)."""
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")
     except (OSError, UnicodeDecodeError):
-        return False
+        return "other"
     lines = text.split("\n", 2)
-    if len(lines) < 3 or not lines[0].startswith(HEADER):
-        return False
-    found = _FINGERPRINT.search(lines[1])
-    return found is not None and found.group(1) == _fingerprint(lines[2])
+    if not lines[0].startswith(HEADER):
+        return "other"
+    found = _FINGERPRINT.search(lines[1]) if len(lines) > 1 else None
+    if found is None:
+        return "unmarked"
+    return "own" if len(lines) == 3 and found.group(1) == _fingerprint(lines[2]) else "edited"
+
+
+_KEPT_WHY = {
+    "edited": "edited since a sweep wrote it",
+    "unmarked": "written before sweeps marked their own files; it may hold edits",
+    "other": "not a best path a sweep wrote",
+}
 
 
 def best_target(path) -> BestScenario:
     """Where a best path meant for ``path`` goes: ``path`` itself when free or the
     sweep's own, else the first numbered name beside it that is."""
     path = Path(path)
-    if not path.exists() or _is_own(path):
+    state = _state(path) if path.exists() else "own"
+    if state == "own":
         return BestScenario(path)
     for number in range(2, _MOST_NUMBERS):
         beside = path.with_name(f"{path.stem}-{number}{path.suffix}")
-        if not beside.exists() or _is_own(beside):
-            return BestScenario(beside, kept=path)
+        if not beside.exists() or _state(beside) == "own":
+            return BestScenario(beside, kept=path, kept_why=_KEPT_WHY[state])
     raise OutputFileError(path, f"and {_MOST_NUMBERS - 2} numbered files beside it are edited: keep fewer")
 
 
-def best_files(folder) -> list[Path]:
-    """The best-path files in ``folder`` as sweeps wrote them (none edited), newest first."""
+def best_files(folder, name: str | None = None) -> list[Path]:
+    """The best-path files sweeps wrote in ``folder`` (``name``'s only, if given: NAME-best
+    and NAME-best-N), edited or not, newest first."""
     found = [
-        path for path in Path(folder).glob("*-best*.toml") if _NUMBERED.search(path.stem) and _is_own(path)
+        path
+        for path in Path(folder).glob(f"{name or '*'}-best*.toml")
+        if _NUMBERED.search(path.stem)
+        and (name is None or _NUMBERED.sub("", path.stem) == name)
+        and _state(path) != "other"
     ]
     return sorted(found, key=lambda path: path.stat().st_mtime_ns, reverse=True)
 

@@ -21,7 +21,7 @@ from pathlib import Path
 from ladartui.atomic import atomic_path
 from ladartui.errors import FieldError, InputFileError, LadarError, OutputFileError, check_cancelled
 from ladartui.sweep.base import base_digest, base_scenario_path, own_rows, spec_rows
-from ladartui.sweep.best_file import write_best_scenario
+from ladartui.sweep.best_file import best_files, write_best_scenario
 from ladartui.sweep.cluster import close_client, local_client
 from ladartui.sweep.ranking import (
     BUDGET_OBJECTIVES,
@@ -75,6 +75,7 @@ class SweepResult:
     ranking_path: Path | None = None
     best_scenario_path: Path | None = None
     best_kept: Path | None = None  # an edited best-path file the sweep wrote beside
+    best_kept_why: str = ""  # why it was not replaced
     best_earlier: Path | None = None  # none ranked now: the best-path file an earlier ranking wrote
     left_out: int = 0  # rows of the table not ranked: other variants, or an earlier base
     ran: int = 0
@@ -337,8 +338,9 @@ def _run_locked(
             out / f"{spec.name}-best.toml", base, result.best.row, spec.parameter_names, scene
         )
         result.best_scenario_path, result.best_kept = written.path, written.kept
-    elif (out / f"{spec.name}-best.toml").is_file():  # what an earlier ranking found: kept, named
-        result.best_earlier = out / f"{spec.name}-best.toml"
+        result.best_kept_why = written.kept_why
+    else:  # what an earlier ranking found: kept, named
+        result.best_earlier = next(iter(best_files(out, spec.name)), None)
     result.elapsed = time.perf_counter() - started
     return result
 

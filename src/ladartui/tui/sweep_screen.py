@@ -128,6 +128,7 @@ class SweepScreen(RankingView):
         self.progress = None  # the last SweepProgress
         self.last_message = ""
         self.running = False
+        self.left_running = False  # Esc left the screen while a sweep ran (and cancelled it)
         self.worker: Worker | None = None  # the sweep job while it runs
         self._dirty = False  # rows arrived since the last redraw (redrawn a few times a second)
         self._row_index: dict[str, int] = {}  # variant id -> position in rows, while running
@@ -263,7 +264,7 @@ class SweepScreen(RankingView):
         self._rank()
         if not serial and not scheduler:
             start_resource_tracker()
-        self.running = True
+        self.running, self.left_running = True, False
         self.refresh_bindings()
         self.progress = None
         remember_path("sweeps", spec.path)
@@ -357,6 +358,7 @@ class SweepScreen(RankingView):
 
     def action_close(self) -> None:
         if self.running and self.worker is not None:
+            self.left_running = True  # what the cancel left is said here, once
             self.worker.cancel()
             said = (
                 f"sweep cancelled on leaving its screen; the rows so far are kept in {self.out}; F5 resumes"
@@ -490,7 +492,8 @@ class SweepScreen(RankingView):
                 self._status(NOT_READY, f"cannot save the best path: {message.error}")
             elif message.result is not None:
                 written, how = message.result
-                self._announce_best(written.path, how, written.kept)
+                kept = f"{written.kept.name} kept: {written.kept_why}" if written.kept is not None else ""
+                self._announce_best(written.path, how, kept)
         elif message.cancelled:
             self._finish(None, "cancelled")
         else:
@@ -548,6 +551,8 @@ class SweepScreen(RankingView):
         self._rank_quietly()
         self._redraw()
         kept = f"{p.done} of {p.total} variants kept" if p else "finished variants kept"
+        if error == "cancelled" and self.left_running:
+            return  # said on leaving the screen
         if error == "cancelled":
             # the folder in a note: after the counts on the status line it was cut at 80 columns
             self.notify(f"Sweep cancelled: its rows are kept in {self.out}; F5 resumes.", markup=False)
@@ -579,8 +584,8 @@ class SweepScreen(RankingView):
             lambda cancel, progress: (write_best(spec, row, parameter_names, path), f"best by {objective}"),
         )
 
-    def _announce_best(self, path: Path, how: str, kept: Path | None = None) -> None:
-        beside = f"; {kept.name} kept: edited since a sweep wrote it" if kept is not None else ""
+    def _announce_best(self, path: Path, how: str, kept: str = "") -> None:
+        beside = f"; {kept}" if kept else ""
         # paths: never markup
         self.query_one("#sweep-detail", Static).update(Text(f"best path: {path}{beside}"))
         said = f"best path ({how}): {path}{beside}"
