@@ -136,3 +136,26 @@ def test_the_time_axis_is_ticked_at_round_seconds():
     assert labels == ["10 ms", "20 ms", "50 ms"]
     assert where == pytest.approx([-2.0, math.log10(0.02), math.log10(0.05)])
     assert seconds_ticks(-6.1, -5.5)[1] == ["1 us", "2 us"]
+
+
+def test_a_narrow_time_range_still_has_ticks_and_a_zero_time_draws():
+    """12 to 18 ms holds no 1, 2 or 5 times a power of ten: the axis had no numbers."""
+    from ladartui.study.chart import _tick_label, draw_chart, seconds_ticks
+
+    lo, hi = math.log10(0.012), math.log10(0.018)
+    where, labels = seconds_ticks(lo, hi)
+    assert len(where) >= 3 and lo <= min(where) and max(where) <= hi
+    assert labels == [_tick_label(10**x) for x in where] and labels[0] == "12 ms"
+
+    class Recorder:  # a plotext-like object that keeps what is drawn
+        def __getattr__(self, name):
+            return lambda *args, **kwargs: None
+
+    result = crowded_result()
+    fastest = result.rows[0]
+    fastest.timing = type(fastest.timing)()
+    for _ in range(3):
+        fastest.timing.add(0.0)  # a clock too coarse for it
+    assert fastest.seconds_per_scan == 0.0
+    draw_chart(Recorder(), result)  # log10 of 0 s raised 'math domain error'
+    assert chart_text(result, 100, 30, color=False)  # the labels placed too

@@ -14,6 +14,7 @@ import io
 import math
 import threading
 
+from ladartui.study.chart_layout import log_seconds
 from ladartui.study.results import OK, StudyResult, format_points, format_seconds, format_share
 
 # Series by tracer family, each with its own colour: fixed xterm-256 colours, not the
@@ -66,7 +67,7 @@ def chart_points(result: StudyResult):
 
 def chart_limits(points) -> tuple[tuple[float, float], tuple[float, float]]:
     """(log10 seconds at the left and right edges, error points at the bottom and top)."""
-    xs = [math.log10(max(x, 1e-9)) for x, _, _ in points]
+    xs = [log_seconds(x) for x, _, _ in points]
     lo, hi = (min(xs), max(xs)) if xs else (0.0, 1.0)
     if hi - lo < 1e-6:
         lo, hi = lo - 0.5, hi + 0.5
@@ -92,17 +93,17 @@ def draw_chart(plt, result: StudyResult, title: str = TITLE, labels=None) -> Non
     # x in log10 seconds on a linear axis, not plotext's log scale: that takes the log
     # of the data it holds in place, so a second drawing (a resize) took log10 twice
     for name, color in FAMILIES:
-        xs = [math.log10(x) for x, _, row in points if family(row.setting) == name]
+        xs = [log_seconds(x) for x, _, row in points if family(row.setting) == name]
         ys = [y for _, y, row in points if family(row.setting) == name]
         if xs:
             plt.scatter(xs, ys, marker=POINT_MARKER, color=color)
     front = sorted((p for p in points if p[2].front), key=lambda p: p[0])
     if front:
         plt.scatter(
-            [math.log10(p[0]) for p in front], [p[1] for p in front], marker=FRONT_MARKER, color=FRONT_COLOR
+            [log_seconds(p[0]) for p in front], [p[1] for p in front], marker=FRONT_MARKER, color=FRONT_COLOR
         )
     for text, x, y in labels or []:
-        plt.text(text, math.log10(x), y, color=FRONT_COLOR, alignment="left")
+        plt.text(text, log_seconds(x), y, color=FRONT_COLOR, alignment="left")
     x_range, y_range = chart_limits(points)
     plt.xlim(*x_range)
     plt.ylim(*y_range)
@@ -119,6 +120,8 @@ def seconds_ticks(lo: float, hi: float) -> tuple[list[float], list[str]]:
         for step in steps
         if lo - 1e-9 <= math.log10(step) + power <= hi + 1e-9
     ]
+    if len(where) < 2:  # within a factor of about two: no round time falls in it
+        where = [lo + (hi - lo) * k / 3 for k in range(4)]
     return where, [_tick_label(10**x) for x in where]
 
 

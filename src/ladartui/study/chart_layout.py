@@ -15,6 +15,11 @@ import math
 from dataclasses import dataclass
 
 
+def log_seconds(seconds: float) -> float:
+    """log10 of a time, a nanosecond at least (a coarse clock can time a scan at 0 s)."""
+    return math.log10(max(seconds, 1e-9))
+
+
 @dataclass(frozen=True)
 class PlotArea:
     """The cells inside the chart's frame, and the data range they show (x as log10)."""
@@ -26,7 +31,7 @@ class PlotArea:
 
     def column(self, x: float) -> float:
         lo, hi = self.x_range
-        return (math.log10(x) - lo) / (hi - lo) * (self.width - 1)
+        return (log_seconds(x) - lo) / (hi - lo) * (self.width - 1)
 
     def row(self, y: float) -> float:
         lo, hi = self.y_range
