@@ -207,3 +207,12 @@ def test_a_mesh_too_large_for_the_grid_is_blamed_in_one_line(tmp_path, capsys):
     assert len(err.splitlines()) == 1 and "Warning" not in err, err
     assert err.startswith(f"ladartui: error: {far}: the mesh spans 1e+30 x 1 x 0 m")
     assert "2147483647" in err and "--scale" in err
+
+
+def test_a_placement_off_the_grid_is_blamed_on_at_not_the_mesh(tmp_path, capsys):
+    tri = tmp_path / "tri.obj"
+    tri.write_text("v 0 0 0\nv 3 0 0\nv 0 3 2\nf 1 2 3\n")
+    code = main(["voxelize", str(tri), str(tmp_path / "o"), "--voxel-size", "0.5", "--at", "1e12,5"])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1
+    assert err.startswith("ladartui: error: --at = ") and "2147483647" in err and "the mesh spans" not in err

@@ -311,6 +311,12 @@ def grid_triangles(mesh: Mesh, voxel_size: float, placement: Placement | None = 
                     f"edge at {name} = {-0.5 * vs:g} m (voxel indices start at 0); move it {way}",
                 )
     if grid.max() > MAX_INDEX - 1:
+        if placement is not None and float((high - low).max()) / vs < MAX_INDEX - 1:  # the mesh fits
+            raise FieldError(
+                "at",
+                f"{placement.x:g},{placement.y:g},{placement.z:g}",
+                f"a position within the scene's grid: voxel indices there would pass {MAX_INDEX}",
+            )
         span = " x ".join(f"{side:.4g}" for side in high - low)
         raise InputFileError(
             mesh.path,
