@@ -259,3 +259,20 @@ def test_a_scenario_name_too_long_for_its_outputs_is_refused_before_tracing(tmp_
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
         ["S.toml", "woods.txt", "woods_Target.txt", long.name]
     )
+
+
+def test_names_are_measured_with_what_each_file_writes_beside_it(tmp_path, capsys):
+    """A chart has one temporary (14 bytes more than its name), not an output set's
+    two (28), and is not a scenario name; a stem whose outputs fit is not refused for
+    its lock (12 more)."""
+    scenario = make_scenario(tmp_path)
+    chart = tmp_path / ("c" * 235 + ".svg")
+    assert main(["run", str(scenario.path), "--no-write", "--chart", str(chart)]) == 0
+    assert chart.is_file()
+    capsys.readouterr()
+    fits = tmp_path / ("m" * 216 + ".toml")  # its longest output: 216 + len("_Target.txt") + 28 = 255
+    fits.write_bytes(scenario.path.read_bytes())
+    assert main(["validate", str(fits)]) == 0
+    capsys.readouterr()
+    assert outputset.name_problem(tmp_path / ("c" * 242), extra=14) is not None
+    assert "scenario" not in outputset.output_problem(tmp_path / ("c" * 242))

@@ -29,34 +29,38 @@ from ladartui.errors import OutputFileError, check_cancelled
 _step_hook: Callable[[str], None] | None = None
 
 
-# A file is written through hidden companions beside it: ".NAME.XXXXXXXX.tmp" (a
-# temporary, 14 bytes more), ".NAME.PID.old" (a backup) and, for a lock,
-# NAME.journal.tmp; in a set, a writer that is atomic itself makes a temporary of
-# the temporary (28 bytes more than the name).
-HIDDEN_EXTRA = 28
+# A file is written through hidden companions beside it: ".NAME.XXXXXXXX.tmp" (its
+# temporary, 14 bytes more than the name) and ".NAME.PID.old" (a backup). In an
+# output set a writer that is atomic itself makes a temporary of the temporary (28
+# more); a set's lock has its journal and the journal's temporary (12 more).
+TEMPORARY_EXTRA = 14
+SET_MEMBER_EXTRA = 28
+LOCK_EXTRA = 12
 
 
-def name_problem(path) -> str | None:
-    """None when ``path``'s name and its hidden companions' fit this system; else why not."""
+def name_problem(path, extra: int = TEMPORARY_EXTRA) -> str | None:
+    """None when ``path``'s name, and its hidden companions' ``extra`` bytes more, fit
+    this system; else why not."""
     path = Path(path)
     name_max = _name_max(path.parent)
     length = len(os.fsencode(path.name))
     if length > name_max:
         return f"name too long for this system ({length} bytes; at most {name_max} a name)"
-    if length + HIDDEN_EXTRA > name_max:
+    if length + extra > name_max:
         return (
-            f"name too long for this system ({length} bytes, and its hidden temporary's "
-            f"{length + HIDDEN_EXTRA}; at most {name_max} a name): use a shorter scenario name"
+            f"name too long for this system ({length} bytes, and {length + extra} for the hidden "
+            f"file written beside it; at most {name_max} a name)"
         )
     return None
 
 
-def check_names(*paths) -> None:
-    """Raise ``OutputFileError`` naming the first path ``name_problem`` refuses."""
+def check_names(*paths, extra: int = TEMPORARY_EXTRA, advice: str = "") -> None:
+    """Raise ``OutputFileError`` naming the first path ``name_problem`` refuses (``advice``
+    added to the message)."""
     for path in paths:
-        problem = name_problem(path)
+        problem = name_problem(path, extra)
         if problem:
-            raise OutputFileError(path, problem)
+            raise OutputFileError(path, problem + advice)
 
 
 def output_problem(path) -> str | None:
@@ -127,7 +131,8 @@ class OutputSet:
 
     def __enter__(self) -> OutputSet:
         check_writable(*self.paths.values())
-        check_names(self.lock)  # and its journal
+        check_names(*self.paths.values(), extra=SET_MEMBER_EXTRA)
+        check_names(self.lock, extra=LOCK_EXTRA)
         self._acquire()
         try:
             recover(self.journal)
