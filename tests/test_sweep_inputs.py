@@ -90,6 +90,14 @@ def test_run_sweep_refuses_a_budget_that_is_no_positive_number(tiny, tmp_path, b
     assert not (tmp_path / "o").exists()
 
 
+def test_a_numpy_number_is_a_budget():
+    import numpy as np
+
+    from ladartui.sweep.execute import checked_budget
+
+    assert checked_budget(np.int64(30)) == 30.0 and checked_budget(np.float32(2.5)) == 2.5
+
+
 def test_run_sweep_names_a_file_given_as_its_results_folder(tiny, tmp_path):
     from ladartui.errors import OutputFileError
 

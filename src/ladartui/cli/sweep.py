@@ -8,7 +8,6 @@ command resumes. Progress goes to stderr, the ranking to stdout.
 from __future__ import annotations
 
 import json
-import math
 import os
 import threading
 from typing import TYPE_CHECKING
@@ -145,8 +144,10 @@ def run(args) -> int:
     spec = load_sweep_spec(args.spec)
     objective = normal_objective(args.objective or spec.objective)
     normal_cost(args.cost or spec.cost)
-    if args.budget is not None and not (math.isfinite(args.budget) and args.budget > 0):
-        raise FieldError("--budget", args.budget, "a flight-time budget in seconds, > 0")
+    if args.budget is not None:
+        from ladartui.sweep.execute import checked_budget
+
+        checked_budget(args.budget, "--budget")
     if objective in BUDGET_OBJECTIVES and args.budget is None and spec.budget is None:
         raise FieldError(
             "--budget",

@@ -12,6 +12,7 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import math
+import numbers
 import time
 import uuid
 from collections.abc import Callable
@@ -130,11 +131,12 @@ def _refuse_in_worker_start() -> None:
         frame = frame.f_back
 
 
-def checked_budget(budget) -> float:
-    """``budget`` as seconds; FieldError unless it is a finite number > 0."""
-    ok = isinstance(budget, (int, float)) and not isinstance(budget, bool)
+def checked_budget(budget, name: str = "budget") -> float:
+    """``budget`` as seconds; FieldError naming ``name`` unless it is a finite number > 0
+    (numpy's numbers too)."""
+    ok = isinstance(budget, numbers.Real) and not isinstance(budget, bool)
     if not (ok and math.isfinite(budget) and budget > 0):
-        raise FieldError("budget", budget, "a flight-time budget in seconds, > 0")
+        raise FieldError(name, budget, "a flight-time budget in seconds, > 0")
     return float(budget)
 
 
