@@ -525,3 +525,13 @@ def test_a_scenario_saved_with_a_byte_order_mark_is_read(tmp_path):
     from ladartui.sweep import load_sweep_spec
 
     assert load_sweep_spec(spec).scenario_path == tmp_path / "base.toml"
+    # the open dialog lists it, and a run record with a mark is still a record
+    from ladartui.scenario_file import RECORD_HEADER, is_record
+    from ladartui.tui.file_tree import opens_table
+
+    plain = tmp_path / "plain.toml"
+    plain.write_bytes(b"\xef\xbb\xbf[files]\nscene = 'tiny.txt'\n")
+    assert opens_table(plain, "[files]")
+    record = tmp_path / "base_Run.toml"
+    record.write_bytes(b"\xef\xbb\xbf" + (RECORD_HEADER + "\n").encode("utf-8"))
+    assert is_record(record)

@@ -399,7 +399,7 @@ def resolve_path(folder: Path, file) -> Path:
 def is_record(path) -> bool:
     """Whether ``path`` is a run record (by its first line)."""
     try:
-        with open(path, encoding="utf-8") as file:
+        with open(path, encoding="utf-8-sig") as file:
             return file.readline().startswith(RECORD_HEADER)
     except (OSError, UnicodeDecodeError):
         return False

@@ -42,7 +42,7 @@ class FileTree(DirectoryTree):
 def opens_table(path: Path, table: str) -> bool:
     """Whether a line near the start of ``path`` opens TOML table ``table`` ("[files]")."""
     try:
-        with open(path, encoding="utf-8", errors="replace") as handle:
+        with open(path, encoding="utf-8-sig", errors="replace") as handle:
             head = handle.read(HEAD_BYTES)
     except OSError:
         return False
