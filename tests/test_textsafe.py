@@ -72,6 +72,15 @@ def test_file_names_with_terminal_escapes_reach_the_terminal_escaped(tmp_path, c
         ["run", str(base.path)],
         ["generate", "small", str(folder / f"g{raw}"), "--las"],
         ["sweep", str(_spec(folder, base.path.name)), "--serial"],
+        [
+            "trace",
+            "--scene",
+            str(folder / "tiny.txt"),
+            "--rays",
+            str(_rays(folder)),
+            "--out",
+            str(folder / f"h{raw}.npy"),
+        ],
     ]
     for command in commands:
         assert main(command) == 0, command
@@ -86,3 +95,11 @@ def _spec(folder, scenario_name):
     spec = folder / "sweep.toml"
     spec.write_text(f"[sweep]\nscenario = {json.dumps(scenario_name)}\n[grid]\nradius = [20.0]\n")
     return spec
+
+
+def _rays(folder):
+    import numpy as np
+
+    path = folder / "rays.npy"
+    np.save(path, np.array([[5.0, 5.0, 30.0, 0.0, 0.0, -1.0]]))
+    return path

@@ -172,7 +172,7 @@ def _told_if_finished(finished: list):
         written = ", ".join(str(path) for path in finished[0].outputs.values())
         raise Cancelled(
             "interrupted after the run had finished; "
-            + (f"it wrote {written}" if written else "nothing was written (--no-write)")
+            + (f"it wrote {written}" if written else "no scenario outputs were written (--no-write)")
         ) from None
 
 

@@ -14,6 +14,7 @@ import numpy as np
 
 from ladartui.atomic import atomic_path
 from ladartui.errors import FieldError, InputFileError, ResourceLimitError
+from ladartui.textsafe import visible
 from ladartui.tracing.backend import METHODS, PRECISIONS
 
 
@@ -159,8 +160,10 @@ def run(args):
     counts = np.bincount(result.kind, minlength=3)
     used = result.info.get("precision", args.precision)
     print(
-        f"{len(rays)} rays ({result.backend}, {result.method}, {used}): {counts[1]} voxel, "
-        f"{counts[2]} ground, {counts[0]} miss -> {args.out}",
+        visible(
+            f"{len(rays)} rays ({result.backend}, {result.method}, {used}): {counts[1]} voxel, "
+            f"{counts[2]} ground, {counts[0]} miss -> {args.out}"
+        ),
         file=sys.stderr,
     )
     return 0
