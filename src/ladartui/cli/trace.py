@@ -77,6 +77,8 @@ def check_rays_header(path) -> None:
         raise InputFileError(path, f"not a NumPy .npy array (its header: {error})") from None
     if dtype.hasobject:
         raise InputFileError(path, "holds Python objects: expected an (N, 6) array of numbers")
+    if dtype.kind not in "fiu":
+        raise InputFileError(path, f"dtype {dtype}: expected numbers")
     if len(shape) != 2 or shape[1] != 6:
         raise InputFileError(
             path, f"array of shape {shape}: expected (N, 6): origin x, y, z and direction dx, dy, dz per row"
@@ -93,29 +95,16 @@ def check_rays_header(path) -> None:
 
 def load_rays(path) -> np.ndarray:
     """The (N, 6) float64 rays of a .npy file; InputFileError naming what is wrong."""
-    check_rays_header(path)
+    check_rays_header(path)  # what it holds: an (N, 6) array of numbers, not too many
     try:
         rays = np.load(path, allow_pickle=False)
-    except FileNotFoundError:
-        raise InputFileError(path, "no such file") from None
     except EOFError:
         raise InputFileError(path, "empty or cut short: expected a NumPy .npy array") from None
-    except ValueError as error:
-        if "pickle" in str(error):  # numpy's words for an object array
-            raise InputFileError(path, "holds Python objects: expected an (N, 6) array of numbers") from None
-        raise InputFileError(path, "not a NumPy .npy array") from None
-    except OSError as error:
-        raise InputFileError(path, f"not a NumPy .npy array ({error.strerror or error})") from None
+    except (ValueError, OSError) as error:  # a body that does not match its header
+        raise InputFileError(path, f"not a NumPy .npy array ({error})") from None
     if not isinstance(rays, np.ndarray):  # an .npz archive of arrays
         rays.close()
         raise InputFileError(path, "a NumPy .npz archive: expected one (N, 6) array in a .npy file")
-    if rays.ndim != 2 or rays.shape[1] != 6:
-        raise InputFileError(
-            path,
-            f"array of shape {rays.shape}: expected (N, 6): origin x, y, z and direction dx, dy, dz per row",
-        )
-    if rays.dtype.kind not in "fiu":
-        raise InputFileError(path, f"dtype {rays.dtype}: expected numbers")
     rays = rays.astype(np.float64)
     if not np.all(np.isfinite(rays)):
         row = int(np.flatnonzero(~np.all(np.isfinite(rays), axis=1))[0])
