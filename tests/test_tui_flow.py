@@ -644,15 +644,3 @@ async def test_study_and_sweep_are_not_offered_while_busy(shared, tmp_path, scen
         app.set_busy(None)
     await pilot.pause()
     assert not app.query_one("#btn-study").disabled
-
-
-def test_a_value_typed_in_other_units_is_saved_as_typed():
-    """A pitch of 50 um typed in the form was saved as 49.99999999999999: 50 * 1e-6 is
-    not the double nearest 50 um, so the file could not write it back as 50."""
-    from ladartui.scenario import _to_micrometres
-    from ladartui.tui.fields import format_number, parse_number
-
-    for typed in ("50", "57", "0.3", "12.3", "100", "9999"):
-        metres = parse_number("pixel_pitch", typed, scale=1e-6)
-        assert _to_micrometres(metres) == float(typed), typed
-        assert format_number(metres, scale=1e-6) == f"{float(typed):g}"
