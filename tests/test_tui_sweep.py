@@ -190,6 +190,9 @@ async def test_opening_results_shows_the_ranking_failures_and_pareto_front(finis
         assert edited.path.read_bytes() == mine
         assert app.opened[1] == edited.path.with_name(f"{edited.path.stem}-2.toml")
         assert f"{edited.path.name} kept: edited since a sweep wrote it" in screen.last_message
+        # said where the analyst goes next too: the app opens the best path over this screen
+        notes = [n.message for n in app._notifications]
+        assert any(f"{edited.path.name} kept: edited since a sweep wrote it" in n for n in notes)
 
         # The detail line shows a failed variant's whole error.
         table.move_cursor(row=table.row_count - 1)
@@ -238,6 +241,24 @@ async def test_budget_objective_ranks_only_paths_within_the_typed_budget(finishe
         assert (
             table_column(table, "variant")[0] == max(within, key=lambda r: r["obscured_coverage"])["variant"]
         )
+
+
+async def test_a_bad_budget_is_one_line_whatever_the_ranking(finished):
+    """With a ranking that reads no budget, -5 in Budget s ended the app with a traceback
+    (the status line read the budget outside the check)."""
+    spec, _ = finished
+    screen = SweepScreen(spec)
+    app = _Host(screen)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        budget = screen.query_one("#sweep-budget")
+        for typed in ("-5", "0", "abc"):
+            budget.value = typed
+            budget.focus()
+            await pilot.press("enter")
+            await pilot.pause()
+            assert app.is_running
+            assert screen.last_message == f"budget = '{typed}': expected a flight-time budget in seconds, > 0"
 
 
 async def test_a_missing_spec_gives_one_line_and_starts_nothing(tmp_path):

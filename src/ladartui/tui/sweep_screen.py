@@ -400,14 +400,14 @@ class SweepScreen(RankingView):
     @on(Input.Submitted, "#sweep-budget")
     def _budget_submitted(self) -> None:
         try:
+            budget = self._budget()  # checked whether or not the ranking reads it
             self._rank()
         except LadarError as error:
             self._status(self._idle_state(), str(error))
             return
         self._redraw()
         self._status(
-            self._idle_state(),
-            f"budget {self._budget():g} s" if self._budget() is not None else "budget from the spec",
+            self._idle_state(), f"budget {budget:g} s" if budget is not None else "budget from the spec"
         )
 
     @on(DataTable.RowHighlighted, "#sweep-table")
@@ -586,6 +586,8 @@ class SweepScreen(RankingView):
 
     def _announce_best(self, path: Path, how: str, kept: str = "") -> None:
         beside = f"; {kept}" if kept else ""
+        if kept:  # the app opens the best path next, over this screen's status line
+            self.app.notify(f"Best path written to {path.name}; {kept}.", markup=False, timeout=10)
         # paths: never markup
         self.query_one("#sweep-detail", Static).update(Text(f"best path: {path}{beside}"))
         said = f"best path ({how}): {path}{beside}"
