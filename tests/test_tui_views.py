@@ -178,7 +178,7 @@ async def test_output_colours_show_what_the_foliage_hid_and_switch_to_height(app
     # with each scan's returns, a third colouring counts the scans that saw each target voxel
     area.show_output(np.vstack([canopy, seen]), None, target_output=target, per_scan=[seen, seen[:3]])
     await pilot.press("c", "c")
-    assert "scans that saw it" in output3d.border_title
+    assert "scans" in output3d.border_title  # "(target: scans that saw it)", or "Out scans" where narrow
     values = output3d.voxel_layers[1].values
     assert sorted(values.tolist()) == sorted([2] * 3 + [1] * (len(seen) - 3))
     await pilot.press("c")
@@ -233,3 +233,24 @@ async def test_a_narrow_view_keeps_its_camera_in_its_title(app_pilot):
         await pilot.resize_terminal(*SIZE)
         await pilot.pause()
     assert scene3d.border_title == f"3D scene az {c.azimuth:.0f} el {c.elevation:.0f}"
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_a_narrow_output_view_keeps_its_threshold_whole(app_pilot):
+    """At 80 columns the output view read '3D output <= 12.…' and lost its camera."""
+    pilot = app_pilot
+    app, area = await reset(pilot)
+    target = area.prepared["target"]
+    area.show_output(target, 12.5, target_output=target, per_scan=[target])
+    output3d = app.query_one("#output3d", ProjectionWidget)
+    output3d.focus()
+    await pilot.resize_terminal(80, 24)
+    await pilot.pause()
+    try:
+        for _ in range(3):  # class, height, scans colourings
+            title = output3d.border_title
+            assert len(title) <= output3d.size.width - 4 and "12.5" in title, title
+            await pilot.press("c")
+    finally:
+        await pilot.resize_terminal(*SIZE)
+        await pilot.pause()

@@ -395,6 +395,7 @@ class ProjectionWidget(PictureWidget):
     def __init__(self, title: str, **kwargs):
         super().__init__(title, **kwargs)
         self.base_title = title
+        self.short_title = ""  # the title where the border is narrow ("Out <=12.5 scans"); "" the same
         self.points = None  # (N, 3) voxel indices of the drawn voxels, already downsampled
         self.voxel_layers: list[Layer] = []
         self.height_range = None  # voxel layers shaded from bottom to top colour
@@ -464,11 +465,15 @@ class ProjectionWidget(PictureWidget):
         zoom = f" x{c.zoom:.2g}" if abs(c.zoom - 1.0) > 1e-9 else ""
         az, el = f"{c.azimuth:.0f}", f"{c.elevation:.0f}"
         room = self.size.width - 4  # the border's corners and a space each side
-        titles = (f"{self.base_title} az {az} el {el}{zoom}", f"{self.base_title} {az}/{el}{zoom}")
-        # else the view's name and colouring ("(height)"), cut at the edge, before the camera
-        self.border_title = next(
-            (t for t in titles if len(t) <= room), titles[0] if room <= 0 else self.base_title
+        base, short = self.base_title, self.short_title or self.base_title
+        titles = (
+            f"{base} az {az} el {el}{zoom}",
+            f"{base} {az}/{el}{zoom}",
+            f"{short} {az}/{el}{zoom}",
+            short,
         )
+        # else the short name and colouring ("Out <=12.5 scans"), cut at the edge, before the camera
+        self.border_title = next((t for t in titles if len(t) <= room), titles[0] if room <= 0 else short)
 
     def make_picture(self, rows, cols):
         if not self.voxel_layers or self.bounds is None:

@@ -161,14 +161,17 @@ class ViewArea(Container):
         if self.output_mode == "scans" and per_scan is None:
             self.output_mode = "class"
         widget = self.query_one("#output3d", ProjectionWidget)
-        title = "3D output"
+        title, short = "3D output", "Out"  # the short title where the border is narrow
         if threshold is not None:
             title += f" <= {threshold:g} m"
+            short += f" <={threshold:g}"
         if self.output_mode == "height":
             title += " (height)"
+            short += " height"
         elif self.output_mode == "scans":
             title += " (target: scans that saw it)"
-        widget.base_title = title
+            short += " scans"
+        widget.base_title, widget.short_title = title, short
         widget._update_title()
         if voxels is None or self.prepared is None:
             widget.placeholder = self.no_output
