@@ -407,6 +407,19 @@ async def test_view_commands_reach_every_view_and_a_view_saves_as_png(tmp_path, 
         await wait_until(pilot, lambda: any(m.startswith("Wrote") for m in app.messages))
         written = tmp_path / "demo-scene3d.png"
         assert Image.open(written).size == (320, 200)
+        # a second picture of the view goes beside the first: it replaced it without a word
+        first = written.read_bytes()
+        app.messages.clear()
+        await app.run_action("save_png")
+        await pilot.pause()
+        assert "3D scene" in str(app.screen.query_one(".dialog").border_title)  # the view's name alone
+        assert " az " not in str(app.screen.query_one(".dialog").border_title)
+        app.screen.query_one("#f-width").value = "160"
+        app.screen.query_one("#f-height").value = "100"
+        app.screen.query_one("#form-ok").press()
+        await wait_until(pilot, lambda: any(m.startswith("Wrote") for m in app.messages))
+        assert written.read_bytes() == first
+        assert Image.open(tmp_path / "demo-scene3d-2.png").size == (160, 100)
 
 
 async def test_the_top_view_draws_footprints_as_they_fall_with_attitude(tmp_path, scene_files):

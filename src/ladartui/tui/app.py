@@ -409,8 +409,9 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         if self.scenario is None or self.scene is None:
             return
         view = self.view_area.current_view(self.focused)
-        name = (view.border_title or view.id or "view").split(" az ")[0]
-        path = self.scenario.path.with_name(f"{self.scenario.path.stem}-{view.id}.png")
+        name = getattr(view, "base_title", None) or view.border_title or view.id or "view"  # not its camera
+        # beside an earlier picture, never over it
+        path = unused_path(self.scenario.path.with_name(f"{self.scenario.path.stem}-{view.id}.png"))
 
         def chosen(size: tuple[int, int] | None) -> None:
             if size is not None:
@@ -574,3 +575,11 @@ def named_changes(changes: list[str], shown: int = 2) -> str:
         return ""
     more = len(changes) - shown
     return ": " + "; ".join(changes[:shown]) + (f"; and {more} more" if more > 0 else "")
+
+
+def unused_path(path: Path) -> Path:
+    """``path``, or the first of ``STEM-2.SUFFIX``, ``STEM-3.SUFFIX``, ... not on disk."""
+    candidate, number = path, 2
+    while candidate.exists():
+        candidate, number = path.with_name(f"{path.stem}-{number}{path.suffix}"), number + 1
+    return candidate
