@@ -185,3 +185,17 @@ async def test_the_study_chart_is_drawn_again_without_a_crash(tmp_path, scene_fi
         await pilot.press("escape")
         await pilot.pause()
         assert not isinstance(app.screen, StudyScreen) and app.is_running
+
+
+async def test_f1_on_the_study_screen_lists_every_key_its_own_too(tmp_path, scene_files):
+    """F1 did nothing on the study and sweep screens, and help never listed their keys."""
+    from ladartui.tui.screens import HelpScreen
+
+    async with study_screen(tmp_path, scene_files, size=(120, 40)) as (app, pilot, screen):
+        await pilot.press("f1")
+        await pilot.pause()
+        assert isinstance(app.screen, HelpScreen)
+        table = app.screen.query_one("DataTable")
+        rows = [[str(cell) for cell in table.get_row_at(i)] for i in range(table.row_count)]
+        assert ["Study screen", "q", "Quick study"] in rows
+        assert any(row[0] == "Sweep screen" and row[2] == "Best" for row in rows)

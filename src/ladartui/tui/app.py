@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 
 from textual import events, on
 from textual.app import App, ComposeResult, SystemCommand
+from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.css.query import NoMatches
 from textual.notifications import SeverityLevel
@@ -75,6 +76,12 @@ def help_rows(app=None) -> list[tuple[str, str, str]]:
         PosesScreen.BINDINGS,
         TopViewWidget.BINDINGS,
     )
+    from ladartui.tui.study_screen import StudyScreen  # (plotting: loaded for help, shown on demand)
+    from ladartui.tui.sweep_screen import SweepScreen
+
+    for where, screen in (("Study screen", StudyScreen), ("Sweep screen", SweepScreen)):
+        bindings = [b for b in screen.BINDINGS if isinstance(b, Binding) and b.description]
+        rows.extend((where, actions.key_name(b.key), b.description) for b in bindings)
     if app is not None:
         rows.append(("Views", "settings.toml", "Drawn as " + app.graphics.describe()))
     return rows
@@ -270,8 +277,8 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
 
     def check_action(self, action: str, parameters) -> bool | None:
         if self.tool_screen is not None and self.screen is self.tool_screen:
-            # that screen has its own keys; textual's own actions (focus, quit) stay
-            return False if action in own_actions() else True
+            # that screen has its own keys (its F1 asks for help); textual's own (focus, quit) stay
+            return False if action in own_actions() and action != "help" else True
         if action == "cancel_run":  # in the footer only while there is a run to cancel
             return True if self.run_in_progress() else False
         if self.busy is not None and action not in actions.DISPLAY_ACTIONS:
