@@ -35,7 +35,7 @@ from ladartui.tracing.backend import VOXEL
 
 # Rays per trace call: the cancel event is checked between calls.
 CHUNK_RAYS = 1 << 18
-# Warm-up calls trace this many rays: enough to compile and upload everything.
+# A march's warm-up calls trace this many rays: enough to compile and upload everything.
 WARMUP_RAYS = 4096
 # Repeats of the first scan (to reach ``runs`` timings) stop once a setting has
 # spent this long: a slow setting is timed once per scan instead.
@@ -127,10 +127,13 @@ def run_study(
                 done_before = done  # a failure counts this scan's calls as done
                 try:
                     if scan == 0:
-                        # Warm-up: compile and upload on a slice of the scan's rays.
+                        # Warm-up: compile and upload. An exact setting traces the whole
+                        # scan: a slice misses what a scan compiles (object order; 30 s
+                        # timed on a cold cache). A march, slow, traces a slice.
+                        rays = len(origins) if s.method == "exact" else WARMUP_RAYS
                         for _ in range(warmup):
                             check_cancelled(cancel, "study cancelled")
-                            _trace(scene, origins[:WARMUP_RAYS], directions[:WARMUP_RAYS], s, cancel)
+                            _trace(scene, origins[:rays], directions[:rays], s, cancel)
                             done += 1
                     repeats = 1 + (extra if scan == 0 else 0)
                     for call in range(repeats):
