@@ -7,6 +7,7 @@ import io
 import json
 import math
 import threading
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -420,3 +421,23 @@ def test_an_exact_settings_warm_up_traces_the_whole_scan(monkeypatch):
     assert traced[0] == ("exact", scan) and traced[1] == ("exact", scan)  # warm-up, then timed
     march = [count for method, count in traced if method == "march"]
     assert march[0] == 10 and set(march[1:]) == {scan}  # a march's warm-up stays short
+
+
+def test_cli_refuses_a_file_for_out_before_it_studies_and_shows_file_text_escaped(tmp_path, capsys):
+    """--out naming a file ended in a FileExistsError traceback after the whole study; a
+    reason read from --chart-from reached the terminal raw (ESC [2J cleared the screen)."""
+    from ladartui.cli import main
+
+    source = Path(__file__).parent.parent / "docs" / "study.json"
+    taken = tmp_path / "o.toml"
+    taken.write_text("x = 1\n")
+    assert main(["study", "--chart-from", str(source), "--out", str(taken)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == f"ladartui: error: {taken}: is a file, expected a folder"
+    data = json.loads(source.read_text())
+    data["rows"][1]["status"], data["rows"][1]["reason"] = "skipped", "no gpu\x1b[2J [b]here[/b]"
+    tampered = tmp_path / "e.json"
+    tampered.write_text(json.dumps(data))
+    assert main(["study", "--chart-from", str(tampered), "--out", str(tmp_path / "rp")]) == 0
+    out = capsys.readouterr().out
+    assert "\x1b" not in out and "no gpu\\x1b[2J [b]here[/b]" in out.replace("\n", "")

@@ -199,3 +199,21 @@ async def test_f1_on_the_study_screen_lists_every_key_its_own_too(tmp_path, scen
         rows = [[str(cell) for cell in table.get_row_at(i)] for i in range(table.row_count)]
         assert ["Study screen", "q", "Quick study"] in rows
         assert any(row[0] == "Sweep screen" and row[2] == "Best" for row in rows)
+
+
+async def test_the_study_screen_shows_text_from_a_study_file_as_it_is(tmp_path, scene_files):
+    """A reason in study.json reached the verdict as markup ('[b]') and raw escapes."""
+    import json
+    from pathlib import Path
+
+    from ladartui.study.results import read_study
+
+    data = json.loads((Path(__file__).parent.parent / "docs" / "study.json").read_text())
+    data["rows"][1]["status"], data["rows"][1]["reason"] = "skipped", "no gpu\x1b[2J [b]here[/b] [/x]"
+    tampered = tmp_path / "e.json"
+    tampered.write_text(json.dumps(data))
+    async with study_screen(tmp_path, scene_files, size=(120, 40)) as (app, pilot, screen):
+        screen.show_result(read_study(tampered))
+        await pilot.pause()
+        verdict = str(screen.query_one("#study-verdict", Static).render())
+        assert "no gpu\\x1b[2J [b]here[/b] [/x]" in verdict.replace("\n", " ")

@@ -59,9 +59,11 @@ def add_parser(subparsers) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ladartui.cli.console import CliConsole as Console
+    from ladartui.outputset import check_writable_folder
     from ladartui.study import full_settings, quick_settings
     from ladartui.study.inputs import generated_inputs, scenario_inputs
 
+    check_writable_folder(args.out)  # before the study, not after it
     if args.chart_from:
         return _report(_load_result(args.chart_from), args.out)
     runs = _positive("--runs", args.runs if args.runs is not None else (3 if args.quick else 5))
@@ -152,9 +154,9 @@ def _report(result, out_dir) -> int:
             column, justify="right" if column in ("s/scan", "rays/s", "differ", "cov. error") else "left"
         )
     for row in table_rows(result):
-        table.add_row(*row)
+        table.add_row(*(Text(visible(cell)) for cell in row))  # a reason read from a file: never markup
     console.print(table)
-    console.print(result.verdict(), highlight=False)
+    console.print(visible(result.verdict()), highlight=False, markup=False)
     paths = write_outputs(result, out_dir, width=CHART_WIDTH, height=CHART_HEIGHT)
     console.print(
         visible("wrote " + ", ".join(str(p) for p in paths.values())), highlight=False, markup=False

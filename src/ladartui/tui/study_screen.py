@@ -19,6 +19,7 @@ from textual.worker import Worker
 from textual_plotext import PlotextPlot
 
 from ladartui.study.chart import TABLE_COLUMNS, draw_chart, label_places, legend_text, table_rows
+from ladartui.textsafe import visible
 from ladartui.tui.fitted_tables import FittingTable, fill_whole_columns
 from ladartui.tui.work import JobDone, JobProgress, running, start_job
 
@@ -182,7 +183,8 @@ class StudyScreen(Screen):
         self._draw_chart()
         self.call_after_refresh(self._draw_chart)  # again once the chart has its size
         self._fill_table()
-        self.query_one("#study-verdict", Static).update(result.verdict())
+        # its reasons may come from a study.json: never markup, escapes shown
+        self.query_one("#study-verdict", Static).update(Text(visible(result.verdict())))
 
     def _draw_chart(self) -> None:
         # labels are placed for the chart's size, so that none covers another or a point
@@ -207,7 +209,7 @@ class StudyScreen(Screen):
         self._set_status(message)
 
     def _set_status(self, message: str) -> None:
-        self.query_one("#study-status", Static).update(message)
+        self.query_one("#study-status", Static).update(Text(visible(message)))  # it may name files
 
 
 def _study(mode: str, scenario_path, scans, runs, cancel, progress):
