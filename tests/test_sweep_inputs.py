@@ -130,3 +130,18 @@ def test_a_bad_value_is_named_on_its_own_line_however_its_key_is_written(tmp_pat
     spec.write_text(text, encoding="utf-8")
     with pytest.raises(InputFileError, match=rf"keys\.toml:{line}: grid\.radius"):
         load_sweep_spec(spec)
+
+
+def test_a_variant_refused_by_this_machines_limits_runs_again_on_resume(tmp_path, monkeypatch):
+    """A ray limit refusal was stored as an impossible value ('error'), never run again,
+    though the limit belongs to the machine, not to the variant."""
+    write_tiny_scenario(tmp_path)
+    spec = write_spec(tmp_path, "[grid]\nscans = [2, 40]\n", name="limits.toml")
+    monkeypatch.setenv("LADARTUI_MAX_RAYS", "5000")  # the base: 2,048 rays; 40 scans: 20,480
+    first = run_sweep(spec, serial=True, out=tmp_path / "o")
+    refused = [row for row in first.rows if row["status"] != "ok"]
+    assert len(refused) == 1 and refused[0]["status"] == "failed" and "limit" in refused[0]["error"]
+    assert not first.impossible
+    monkeypatch.delenv("LADARTUI_MAX_RAYS")
+    again = run_sweep(spec, serial=True, out=tmp_path / "o")
+    assert (again.ran, again.resumed) == (1, 1) and all(row["status"] == "ok" for row in again.rows)

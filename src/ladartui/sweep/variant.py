@@ -34,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ladartui.errors import Cancelled, FieldError, LadarError
+from ladartui.errors import BackendUnavailable, Cancelled, FieldError, LadarError, ResourceLimitError
 from ladartui.sweep.columns import PER_TARGET_KEY, per_target_columns
 
 PRESET_KINDS = ("orbit", "flypast", "standoff")
@@ -293,8 +293,9 @@ def run_variant(
 
     ``scene`` is the loaded base scene (shared by every variant on a worker);
     without it the scenario loads its own. Impossible parameters give a row
-    with status "error" and the message; any other failure a row with status
-    "failed" (tried again when the sweep resumes). Never raises for a variant.
+    with status "error" and the message; a refusal by this machine's limits or
+    backends, or any other failure, a row with status "failed" (tried again when the
+    sweep resumes). Never raises for a variant.
     """
     from ladartui.simulation import simulate
 
@@ -323,6 +324,9 @@ def run_variant(
             row["scan_count"] = len(scenario.flight.poses())
     except Cancelled:
         raise  # a cancelled run is no result
+    except (ResourceLimitError, BackendUnavailable) as error:
+        # this machine's limits or backends, not the variant's values: run it again on resume
+        row.update(status="failed", error=str(error))
     except LadarError as error:
         row.update(status="error", error=str(error))
     except Exception as error:  # noqa: BLE001 - one variant's crash must not end the sweep
