@@ -102,3 +102,22 @@ def test_a_log_in_latitude_and_longitude_flies_the_same_poses_as_its_local_copy(
         LogSegment(str(geo), rate=2.0)  # a geodetic log without its origin
     with pytest.raises(FieldError, match="origin latitude"):
         LogSegment(str(geo), rate=2.0, origin=[95.0, 0.0, 0.0])
+
+
+def test_scan_times_out_of_order_are_refused(tmp_path):
+    """times = [0.9, 0.1, 0.5] was taken: the aircraft flew backwards along its log."""
+    from pathlib import Path
+
+    from ladartui.trajectory import LogSegment
+
+    log = Path(__file__).parent.parent / "scenarios" / "flight-log.csv"
+    assert LogSegment(str(log), times=[0.1, 0.5, 0.9]).times == (0.1, 0.5, 0.9)
+    with pytest.raises(FieldError, match=r"times .*expected .*increasing"):
+        LogSegment(str(log), times=[0.9, 0.1, 0.5])
+
+
+def test_a_log_saved_with_a_byte_order_mark_is_read(tmp_path):
+    """Excel writes CSV with a BOM: it read as 'header lacks time'."""
+    path = tmp_path / "log.csv"
+    path.write_bytes(b"\xef\xbb\xbftime,x,y,z,heading\n0,20,64,60,90\n1,50,64,60,90\n")
+    assert list(load_flight_log(path).time) == [0.0, 1.0]

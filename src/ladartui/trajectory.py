@@ -81,7 +81,7 @@ def load_flight_log(path, origin=None) -> FlightLog:
     """The log at ``path``; ``origin`` (lat, lon, alt) places a geodetic log in the scene."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")
     except (OSError, UnicodeDecodeError) as error:
         raise TrajectoryError(f"{path}: cannot read flight log ({error})") from None
     rows = [
@@ -261,6 +261,8 @@ class LogSegment:
                 times = tuple(number_field("times", t, log.time[0], log.time[-1]) for t in items)
             except FieldError:
                 raise FieldError("times", self.times, expected) from None
+            if any(later <= earlier for earlier, later in zip(times, times[1:])):  # it would fly backwards
+                raise FieldError("times", self.times, f"{expected}, increasing")
             set_("times", times)
 
     @property
