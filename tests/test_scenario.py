@@ -535,3 +535,15 @@ def test_a_scenario_saved_with_a_byte_order_mark_is_read(tmp_path):
     record = tmp_path / "base_Run.toml"
     record.write_bytes(b"\xef\xbb\xbf" + (RECORD_HEADER + "\n").encode("utf-8"))
     assert is_record(record)
+
+
+def test_a_target_id_named_twice_is_refused(tmp_path):
+    """names = { 1 = "alpha", 01 = "beta" }: "beta" won without a word."""
+    from ladartui.errors import LadarError
+    from tiny_sweep import write_tiny_scenario
+
+    scenario = write_tiny_scenario(tmp_path)
+    text = scenario.path.read_text(encoding="utf-8")
+    scenario.path.write_text(text + '\n[targets]\nnames = { 1 = "alpha", 01 = "beta" }\n', encoding="utf-8")
+    with pytest.raises(LadarError, match=r"targets\.names.*each target id once \(id 1 is named twice\)"):
+        load_scenario(scenario.path)

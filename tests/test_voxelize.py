@@ -254,6 +254,12 @@ def test_open_mesh_is_refused_in_solid_mode_only(tmp_path):
             r"far\.obj:4: face 'f 1 2 9' refers to vertex 9: expected 1 to 3 \(or -1 to -3\)",
         ),
         ("junk.obj", "v 0 0 0\nf 1 a 2\n", r"junk\.obj:2: face 'f 1 a 2': expected vertex numbers"),
+        # escaped once: its repr wrote 'v 0 1 \\x1b[31m'
+        (
+            "esc.obj",
+            "v 0 0 0\nv 0 1 \x1b[31m\n",
+            r"esc\.obj:2: vertex 'v 0 1 \\x1b\[31m': expected x, y, z as numbers$",
+        ),
         ("noise.ply", "\x00\x07 definitely not a ply header", "not a readable PLY mesh"),
         ("empty.stl", "", "holds no triangles"),
         ("points.obj", "v 0 0 0\nv 1 0 0\n", "holds no triangles"),

@@ -375,6 +375,8 @@ def checked_target_names(names) -> tuple[tuple[int, str], ...]:
             or not value.isprintable()
         ):
             raise FieldError("targets.names", value, expected)
+        if int(text) in out:  # "1" and "01": one id named twice
+            raise FieldError("targets.names", key, f"each target id once (id {int(text)} is named twice)")
         out[int(text)] = value
     return tuple(sorted(out.items()))
 

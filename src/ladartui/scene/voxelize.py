@@ -189,21 +189,21 @@ def check_obj_lines(path: Path) -> None:
             try:
                 xyz = [float(w) for w in words[1:4]]
             except ValueError:
-                raise InputFileError(path, f"vertex {shown!r}: expected x, y, z as numbers", number) from None
+                raise InputFileError(path, f"vertex '{shown}': expected x, y, z as numbers", number) from None
             if len(xyz) < 3:
-                raise InputFileError(path, f"vertex {shown!r}: expected x, y, z", number)
+                raise InputFileError(path, f"vertex '{shown}': expected x, y, z", number)
             if not all(math.isfinite(v) for v in xyz):
-                raise InputFileError(path, f"vertex {shown!r}: expected x, y, z as finite numbers", number)
+                raise InputFileError(path, f"vertex '{shown}': expected x, y, z as finite numbers", number)
             continue
         for word in words[1:]:
             try:
                 index = int(word.split("/")[0])
             except ValueError:
-                raise InputFileError(path, f"face {shown!r}: expected vertex numbers", number) from None
+                raise InputFileError(path, f"face '{shown}': expected vertex numbers", number) from None
             if not (1 <= index <= total or -seen <= index <= -1):
                 raise InputFileError(
                     path,
-                    f"face {shown!r} refers to vertex {index}: expected 1 to {total} (or -1 to -{seen})",
+                    f"face '{shown}' refers to vertex {index}: expected 1 to {total} (or -1 to -{seen})",
                     number,
                 )
 
