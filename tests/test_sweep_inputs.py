@@ -145,3 +145,12 @@ def test_a_variant_refused_by_this_machines_limits_runs_again_on_resume(tmp_path
     monkeypatch.delenv("LADARTUI_MAX_RAYS")
     again = run_sweep(spec, serial=True, out=tmp_path / "o")
     assert (again.ran, again.resumed) == (1, 1) and all(row["status"] == "ok" for row in again.rows)
+
+
+def test_show_names_a_file_given_as_its_results_folder(tiny, tmp_path, capsys):
+    from ladartui.cli import main
+
+    spec = write_spec(tiny, "[grid]\nradius = [20.0]\n", name="showfile.toml")
+    assert main(["sweep", str(spec), "--show", "--out", str(spec)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == f"ladartui: error: --out = '{spec}': expected a sweep's results folder; it is a file"

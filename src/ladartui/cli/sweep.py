@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import os
 import threading
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from rich.markup import escape
@@ -160,6 +161,8 @@ def run(args) -> int:
         from ladartui.sweep.base import base_scenario_path
 
         out = args.out or default_out_dir(spec)
+        if Path(out).is_file():  # read as a table, it said "not a sweep result table"
+            raise FieldError("--out", str(out), "a sweep's results folder; it is a file")
         own: SweepSpec | None = spec  # rank its variants from its base as it is now
         try:
             base_scenario_path(spec)
