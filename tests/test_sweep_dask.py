@@ -261,48 +261,39 @@ def test_a_script_without_a_main_guard_is_told_what_to_change(tmp_path):
     top level started the sweep again in each worker, which the folder lock refused
     ('another sweep is writing its results here'), pointing the user the wrong way."""
     write_tiny_spec(tmp_path)
-    script = tmp_path / "unguarded.py"
-    script.write_text(
-        "from ladartui.sweep import run_sweep\n"
-        "result = run_sweep('spec.toml', workers=1)\n"
-        "print('ran', result.ran)\n",
-        encoding="utf-8",
-    )
+    script = tmp_path / "script.py"
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).parent.parent / "src")}
-    done = subprocess.run(
-        [sys.executable, str(script)], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300
+
+    def run_script(*lines: str):
+        script.write_text("\n".join(lines) + "\n", encoding="utf-8")
+        command = [sys.executable, str(script)]
+        return subprocess.run(command, cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
+
+    done = run_script(
+        "from ladartui.sweep import run_sweep", "print('ran', run_sweep('spec.toml', workers=1).ran)"
     )
     assert done.returncode != 0 and "ran" not in done.stdout
     assert f"run_sweep was called while a worker process imported the script {str(script)!r}" in done.stderr
     assert 'if __name__ == "__main__":' in done.stderr.splitlines()[-1]
     assert "another sweep" not in done.stderr
     # as the docs show it, under the guard, the same sweep runs
-    script.write_text(
-        "from ladartui.sweep import run_sweep\n\n"
-        "if __name__ == '__main__':\n"
-        "    result = run_sweep('spec.toml', workers=1)\n"
-        "    print('ran', result.ran)\n",
-        encoding="utf-8",
-    )
-    done = subprocess.run(
-        [sys.executable, str(script)], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300
+    done = run_script(
+        "from ladartui.sweep import run_sweep",
+        "if __name__ == '__main__':",
+        "    print('ran', run_sweep('spec.toml', workers=1).ran)",
     )
     assert done.returncode == 0 and done.stdout.split() == ["ran", "8"], done.stderr
     # a function of a guarded script, run in a spawned process of a pool, is not that import
-    script.write_text(
-        "from concurrent.futures import ProcessPoolExecutor\n"
-        "import multiprocessing\n"
-        "from ladartui.sweep import run_sweep\n\n"
-        "def job():\n"
-        "    return run_sweep('spec.toml', serial=True, out='pooled').ran\n\n"
-        "if __name__ == '__main__':\n"
-        "    spawn = multiprocessing.get_context('spawn')\n"
-        "    with ProcessPoolExecutor(1, mp_context=spawn) as pool:\n"
-        "        print('ran', pool.submit(job).result())\n",
-        encoding="utf-8",
-    )
-    done = subprocess.run(
-        [sys.executable, str(script)], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300
+    done = run_script(
+        "import multiprocessing",
+        "from concurrent.futures import ProcessPoolExecutor",
+        "from ladartui.sweep import run_sweep",
+        "def job():",
+        "    return run_sweep('spec.toml', serial=True, out='pooled').ran",
+        "if __name__ == '__main__':",
+        "    spawn = multiprocessing.get_context('spawn')",
+        "    with ProcessPoolExecutor(1, mp_context=spawn) as pool:",
+        "        print('ran', pool.submit(job).result())",
     )
     assert done.returncode == 0 and done.stdout.split() == ["ran", "8"], done.stderr
 
