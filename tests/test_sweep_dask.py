@@ -260,7 +260,8 @@ def test_a_script_without_a_main_guard_is_told_what_to_change(tmp_path):
     """A local cluster's workers import the main script: one that calls run_sweep at its
     top level started the sweep again in each worker, which the folder lock refused
     ('another sweep is writing its results here'), pointing the user the wrong way."""
-    write_tiny_spec(tmp_path)
+    write_tiny_scenario(tmp_path)
+    (tmp_path / "spec.toml").write_text('[sweep]\nscenario = "base.toml"\n[grid]\nradius = [10.0]\n')
     script = tmp_path / "script.py"
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).parent.parent / "src")}
 
@@ -282,7 +283,7 @@ def test_a_script_without_a_main_guard_is_told_what_to_change(tmp_path):
         "if __name__ == '__main__':",
         "    print('ran', run_sweep('spec.toml', workers=1).ran)",
     )
-    assert done.returncode == 0 and done.stdout.split() == ["ran", "8"], done.stderr
+    assert done.returncode == 0 and done.stdout.split() == ["ran", "1"], done.stderr
     # a function of a guarded script, run in a spawned process of a pool, is not that import
     done = run_script(
         "import multiprocessing",
@@ -295,7 +296,7 @@ def test_a_script_without_a_main_guard_is_told_what_to_change(tmp_path):
         "    with ProcessPoolExecutor(1, mp_context=spawn) as pool:",
         "        print('ran', pool.submit(job).result())",
     )
-    assert done.returncode == 0 and done.stdout.split() == ["ran", "8"], done.stderr
+    assert done.returncode == 0 and done.stdout.split() == ["ran", "1"], done.stderr
 
 
 def test_workers_started_for_a_local_cluster_never_see_a_ctrl_c_at_start_up(monkeypatch):
