@@ -138,6 +138,8 @@ async def test_opening_results_shows_the_ranking_failures_and_pareto_front(finis
             assert region.width > 0 and region.right <= SIZE[0], binding.action
         assert table.region.height >= 12 and screen.query_one("#sweep-chart").region.width >= 28
         # Ranked by the spec's objective (obscured coverage): best first, ties to the cheaper.
+        # Said first: after the folder and the counts it was cut at the screen's edge.
+        assert screen.last_message.startswith("ranked by obscured-coverage: ")
         expected = sorted(ok, key=lambda r: (-r["obscured_coverage"], r["flight_time_s"]))
         shown = table_column(table, "variant")
         assert shown[: len(ok)] == [r["variant"] for r in expected]

@@ -475,7 +475,7 @@ class SweepScreen(RankingView):
         self.query_one("#sweep-table", DataTable).focus()
         self._status(
             READY,
-            f"{short_path(result.results_path)}: {self._summary()}; ranked by {self.objective}{others}",
+            f"ranked by {self.objective}: {self._summary()}{others}; {short_path(result.results_path)}",
         )
         remember_path("sweeps", path)  # the screen reopens it next time
 
