@@ -229,6 +229,13 @@ async def test_a_narrow_view_keeps_its_camera_in_its_title(app_pilot):
         title = scene3d.border_title
         assert len(title) <= scene3d.size.width - 4, title
         assert title.endswith(f"{c.azimuth:.0f}/{c.elevation:.0f}") or title.endswith(f"el {c.elevation:.0f}")
+        # zoomed in, it dropped its camera with its zoom ("3D scene" alone)
+        from dataclasses import replace
+
+        scene3d.set_camera(replace(c, zoom=11.0))
+        await pilot.pause()
+        assert scene3d.border_title.endswith(f"{c.azimuth:.0f}/{c.elevation:.0f}"), scene3d.border_title
+        scene3d.set_camera(c)
     finally:
         await pilot.resize_terminal(*SIZE)
         await pilot.pause()

@@ -470,6 +470,7 @@ class ProjectionWidget(PictureWidget):
             f"{base} az {az} el {el}{zoom}",
             f"{base} {az}/{el}{zoom}",
             f"{short} {az}/{el}{zoom}",
+            f"{short} {az}/{el}",  # the zoom goes before the camera
             short,
         )
         # else the short name and colouring ("Out <=12.5 scans"), cut at the edge, before the camera
