@@ -154,3 +154,49 @@ def test_show_names_a_file_given_as_its_results_folder(tiny, tmp_path, capsys):
     assert main(["sweep", str(spec), "--show", "--out", str(spec)]) == 2
     err = capsys.readouterr().err.strip()
     assert err == f"ladartui: error: --out = '{spec}': expected a sweep's results folder; it is a file"
+
+
+def _straight_base(folder):
+    """The tiny scenario flown along a straight line: no orbit, fly-past or standoff to vary."""
+    from ladartui.flight import FlightPlan, ScanPose, Straight
+
+    base = write_tiny_scenario(folder)
+    start = ScanPose(0.0, 15.5, 20.0, heading=90.0, depression=45.0)
+    flight = FlightPlan(start=start, segments=(Straight(distance=30.0, scans=3),))
+    return base.with_changes(flight=flight).save()
+
+
+@pytest.mark.parametrize(
+    ("body", "key", "line"),
+    [
+        ("[grid]\naltitude = [40.0, 50.0]\n", "grid.altitude", 4),
+        ("[random]\nsamples = 2\nradius = { min = 5.0, max = 9.0 }\n", "random.radius", 5),
+        ('[grid]\npreset = ["orbit"]\nradius = [9.0]\n', "grid.preset", 4),
+    ],
+)
+def test_a_spec_no_variant_of_which_can_run_is_refused_before_anything_runs(tmp_path, body, key, line):
+    """Flight parameters over a base with nothing to vary made every variant an error
+    row, after a cluster started; docs/sweeps.md promises a refusal on the key's line."""
+    _straight_base(tmp_path)
+    spec = write_spec(tmp_path, body)
+    with pytest.raises(InputFileError) as refused:
+        run_sweep(spec, serial=True, out=tmp_path / "out")
+    message = str(refused.value)
+    assert f"spec.toml:{line}: {key}:" in message and "no variant can run" in message
+    assert "\n" not in message and not (tmp_path / "out").exists()
+
+
+def test_a_spec_whose_some_variants_are_impossible_still_runs(tiny, tmp_path):
+    spec = write_spec(tiny, "[grid]\nsensor_grid = [0, 4]\n", name="some.toml")
+    result = run_sweep(spec, serial=True, out=tmp_path / "out")
+    assert sorted(r["status"] for r in result.rows) == ["error", "ok"]
+
+
+def test_the_cli_refuses_a_spec_no_variant_of_which_can_run_before_its_progress(tmp_path, capsys):
+    from ladartui.cli import main
+
+    _straight_base(tmp_path)
+    spec = write_spec(tmp_path, "[grid]\naltitude = [40.0, 50.0]\n")
+    assert main(["sweep", str(spec), "--serial"]) == 2
+    out, err = capsys.readouterr()
+    assert "spec.toml:4: grid.altitude: no variant can run" in err and "sweep of" not in out + err

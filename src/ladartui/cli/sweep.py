@@ -187,9 +187,10 @@ def run(args) -> int:
     else:
         from ladartui.outputset import check_writable_folder
         from ladartui.scenario import load_scenario
-        from ladartui.sweep.base import base_scenario_path
+        from ladartui.sweep.base import base_scenario_path, check_some_variant_runs
 
-        load_scenario(base_scenario_path(spec))  # a bad base is reported before any cluster starts
+        base = load_scenario(base_scenario_path(spec))  # a bad base is reported before any cluster starts
+        check_some_variant_runs(spec, base, base.load_scene)
         check_writable_folder(args.out or default_out_dir(spec))
         result = _sweep_with_progress(spec, args, errors)
         if result is None:

@@ -65,3 +65,32 @@ def spec_rows(table_rows: list[dict], spec: SweepSpec) -> list[dict]:
 
     path = base_scenario_path(spec)
     return own_rows(table_rows, spec.variants, base_digest(path, load_scenario(path, check_files=False)))
+
+
+def check_some_variant_runs(spec: SweepSpec, base, scene_loader) -> None:
+    """Refuse a spec none of whose variants the base can take (flight parameters over a
+    base with no orbit, fly-past or standoff, a preset the base cannot complete): that
+    is a mistake in the spec, named on its key's line, not one error row per variant.
+    Stops at the first variant that can be built, so a good spec costs one build."""
+    from ladartui.errors import FieldError
+    from ladartui.sweep.variant import apply_parameters
+
+    first = None
+    for variant in spec.variants:
+        try:
+            apply_parameters(base, variant.params, scene_loader)
+            return
+        except FieldError as error:
+            first = first or error
+    if first is None:
+        return  # a spec of no variants
+    # The key to blame: the one in error, else the preset that needs what is missing.
+    name = first.field if first.field in spec.parameter_names else "preset"
+    table = "grid" if name in spec.grid else "random" if name in spec.random else "sweep"
+    if table == "sweep":
+        name = "scenario"
+    raise InputFileError(
+        spec.path,
+        f"{table}.{name}: no variant can run on base {spec.scenario_path.name}: {first}",
+        line=spec_line(spec.path, table, name),
+    )

@@ -21,7 +21,7 @@ from pathlib import Path
 
 from ladartui.atomic import atomic_path
 from ladartui.errors import FieldError, InputFileError, LadarError, OutputFileError, check_cancelled
-from ladartui.sweep.base import base_digest, base_scenario_path, own_rows, spec_rows
+from ladartui.sweep.base import base_digest, base_scenario_path, check_some_variant_runs, own_rows, spec_rows
 from ladartui.sweep.best_file import best_files, write_best_scenario
 from ladartui.sweep.cluster import close_client, local_client
 from ladartui.sweep.ranking import (
@@ -206,11 +206,14 @@ def run_sweep(
 
     base_path = base_scenario_path(spec)
     base = load_scenario(base_path)
+    scene = _LazyScene(base)
+    check_some_variant_runs(spec, base, scene)
     with _exclusive(out):
         return _run_locked(
             spec,
             base_path,
             base,
+            scene,
             client,
             progress,
             cancel,
@@ -251,6 +254,7 @@ def _run_locked(
     spec,
     base_path,
     base,
+    scene,
     client,
     progress,
     cancel,
@@ -264,7 +268,6 @@ def _run_locked(
     started,
 ) -> SweepResult:
     digest = base_digest(base_path, base)
-    scene = _LazyScene(base)
     variants = spec.variants
     results_path = out / RESULTS_NAME
     table_rows, _ = read_table(results_path)
