@@ -28,16 +28,44 @@ def test_generate_writes_the_pair_and_reports_it(tmp_path, capsys):
 
 def test_generate_accepts_a_txt_stem_and_options(tmp_path, capsys):
     out_path = tmp_path / "plain.txt"
-    assert (
-        main(
-            ["generate", "small", str(out_path), "--no-target", "--terrain", "--camouflage", "--trees", "10"]
-        )
-        == 0
-    )
+    assert main(["generate", "small", str(out_path), "--no-target", "--terrain", "--trees", "10"]) == 0
     assert (tmp_path / "plain.txt").is_file()
     assert load_voxels(tmp_path / "plain_Target.txt").shape == (0, 3)
     out = capsys.readouterr().out
     assert "no target" in out and "terrain" in out
+
+
+@pytest.mark.parametrize(
+    ("flags", "message"),
+    [
+        (["--no-target", "--vehicles", "3"], "--no-target: no vehicle, but --vehicles 3 asks for 3"),
+        (
+            ["--no-target", "--camouflage"],
+            "--camouflage: the net is draped over a vehicle, and there is none",
+        ),
+        (
+            ["--vehicles", "0", "--camouflage"],
+            "--camouflage: the net is draped over a vehicle, and there is none",
+        ),
+    ],
+)
+def test_generate_refuses_flags_it_would_ignore(tmp_path, capsys, flags, message):
+    """--no-target dropped --vehicles and --camouflage without a word."""
+    assert main(["generate", "small", str(tmp_path / "x"), *flags]) == 2
+    assert capsys.readouterr().err == f"ladartui: error: {message}\n"
+    assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("folder", ["g/", "existing"])
+def test_generate_into_a_folder_names_the_files_after_the_preset(tmp_path, capsys, monkeypatch, folder):
+    """'generate small g/' wrote g.txt beside the folder."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "existing").mkdir()
+    assert main(["generate", "small", folder, "--trees", "3"]) == 0
+    where = tmp_path / folder.rstrip("/")
+    assert sorted(p.name for p in where.iterdir()) == ["small.txt", "small_Target.txt"]
+    assert not (tmp_path / f"{folder.rstrip('/')}.txt").exists()
+    assert f"wrote {where.name}/small.txt" in capsys.readouterr().out
 
 
 def test_generate_las_copy(tmp_path, capsys):

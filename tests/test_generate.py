@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from ladartui.errors import FieldError
+from ladartui.errors import FieldError, OutputFileError
 from ladartui.scene.generate import generate_scene, output_paths, scene_params
 from ladartui.scene.model import Scene
 
@@ -223,3 +223,50 @@ def test_more_vehicles_than_the_scene_holds_apart_are_refused_not_overlapped():
     most = int(message.split("at most ")[1].split()[0])
     scene = generate_scene("small", seed=2, vehicles=most)
     assert len(np.unique(scene.target_ids)) == most  # every one kept, none overwritten
+
+
+def test_progress_names_each_stage_in_order_and_cancel_stops_between_them():
+    """A --trees 100000 scene took two minutes without a word (generate_scene had no progress)."""
+    import threading
+
+    from ladartui.errors import Cancelled
+
+    seen = []
+    generate_scene("small", seed=0, trees=5, progress=lambda *step: seen.append(step))
+    stages = [stage for stage, _, _ in seen]
+    assert stages[0] == "ground" and "foliage" in stages and stages[-1] == "merging"
+    assert [done for _, done, _ in seen] == list(range(1, len(seen) + 1))
+    assert {total for _, _, total in seen} == {len(seen)}
+
+    cancel = threading.Event()
+
+    def stop_at_foliage(stage, done, total):
+        if stage == "foliage":
+            cancel.set()
+
+    with pytest.raises(Cancelled):
+        generate_scene("small", seed=0, trees=5, progress=stop_at_foliage, cancel=cancel)
+
+
+def test_write_replaces_both_files_or_neither(tmp_path, small, monkeypatch):
+    """The pair was written one file after the other: a failure between left a new scene
+    beside an old target model."""
+    from ladartui.scene import insertion
+
+    scene_path, target_path = small.write(tmp_path / "forest")
+    before = scene_path.read_bytes(), target_path.read_bytes()
+    other = generate_scene("small", seed=1, trees=5)
+    real = insertion.write_voxel_lines
+    calls = []
+
+    def fail_on_second(path, voxels, *rest, **options):
+        calls.append(path)
+        if len(calls) == 2:
+            raise OSError(28, "No space left on device")
+        real(path, voxels, *rest, **options)
+
+    monkeypatch.setattr(insertion, "write_voxel_lines", fail_on_second)
+    with pytest.raises(OutputFileError):
+        other.write(tmp_path / "forest")
+    assert (scene_path.read_bytes(), target_path.read_bytes()) == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["forest.txt", "forest_Target.txt"]

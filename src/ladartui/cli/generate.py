@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import os
 import time
+from pathlib import Path
 
+from ladartui.errors import LadarError
 from ladartui.textsafe import visible
 
 
@@ -21,7 +24,8 @@ def add_parser(subparsers):
     parser.add_argument(
         "out",
         metavar="OUT",
-        help="output stem: dir/name or dir/name.txt (writes name.txt and name_Target.txt)",
+        help="output stem: dir/name or dir/name.txt (writes name.txt and name_Target.txt); "
+        "a folder (dir/ or one that exists) gets PRESET.txt and PRESET_Target.txt",
     )
     parser.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     parser.add_argument(
@@ -42,6 +46,22 @@ def add_parser(subparsers):
     )
     parser.set_defaults(handler=run)
     return parser
+
+
+def out_stem(out: str, preset: str) -> Path:
+    """OUT as the stem to write: a folder (one that exists, or written with a
+    trailing slash) gets PRESET.txt and PRESET_Target.txt inside it."""
+    if out.endswith(("/", os.sep)) or Path(out).is_dir():
+        return Path(out) / preset
+    return Path(out)
+
+
+def check_flags_used(args) -> None:
+    """Refuse flags the scene would ignore, rather than drop them without a word."""
+    if args.no_target and args.vehicles:
+        raise LadarError(f"--no-target: no vehicle, but --vehicles {args.vehicles} asks for {args.vehicles}")
+    if args.camouflage and (args.no_target or args.vehicles == 0):
+        raise LadarError("--camouflage: the net is draped over a vehicle, and there is none")
 
 
 def overrides_from(args) -> dict:
@@ -66,23 +86,29 @@ def overrides_from(args) -> dict:
 
 
 def run(args) -> int:
-    import numpy as np
+    import threading
 
-    from ladartui.cli.flags import as_flags
+    from ladartui.cli.console import CliConsole as Console
+    from ladartui.cli.progress import run_cancellable, sigterm_as_interrupt
+    from ladartui.errors import Cancelled
     from ladartui.outputset import check_writable
-    from ladartui.scene.generate import generate_scene, output_paths
+    from ladartui.scene.generate import GENERATE_CANCELLED, output_paths
 
-    scene_file, target_file = output_paths(args.out)
+    check_flags_used(args)
+    stem = out_stem(args.out, args.preset)
+    scene_file, target_file = output_paths(stem)
     las_files = [scene_file.with_suffix(".laz"), target_file.with_suffix(".laz")] if args.las else []
     check_writable(scene_file, target_file, *las_files)
-    started = time.perf_counter()
-    typed = {name: getattr(args, name) for name in ("density", "trees", "voxel_size", "vehicles")}
-    with as_flags(typed):  # name the flag the user typed, not the parameter
-        scene = generate_scene(args.preset, seed=args.seed, **overrides_from(args))
-    generated = time.perf_counter() - started
-    started = time.perf_counter()
-    scene_path, target_path = scene.write(args.out)
-    written = time.perf_counter() - started
+    cancel = threading.Event()
+    with sigterm_as_interrupt():
+        scene, scene_path, target_path, (generated, written) = run_cancellable(
+            lambda: _work(args, stem, las_files, Console(stderr=True), cancel),
+            cancel,
+            "ladartui-generate",
+            Cancelled(GENERATE_CANCELLED),
+        )
+    import numpy as np
+
     vs = scene.voxel_size
     nx, ny, nz = scene.shape
     print(
@@ -91,11 +117,7 @@ def run(args) -> int:
             f"({len(scene.target):,} voxels)"
         )
     )
-    if args.las:
-        from ladartui.scene.las import export_las
-
-        export_las(las_files[0], scene.voxels, vs)
-        export_las(las_files[1], scene.target, vs, ids=scene.ids())
+    if las_files:
         print(visible(f"wrote {las_files[0]} and {las_files[1]} (voxel centres in metres)"))
     print(f"preset {scene.preset}, seed {scene.seed}, voxel size {vs:g} m")
     print(f"extent {nx} x {ny} x {nz} voxels = {nx * vs:.1f} x {ny * vs:.1f} x {nz * vs:.1f} m")
@@ -110,3 +132,43 @@ def run(args) -> int:
         print("no target")
     print(f"generated in {generated:.2f} s, written in {written:.2f} s")
     return 0
+
+
+def _work(args, stem, las_files, console, cancel):
+    """Generate (with a stage bar on a terminal), write the pair, then the LAS copies
+    (once the pair is written they are written too: a Ctrl-C then waits for them);
+    on the worker thread."""
+    from rich.progress import TextColumn, TimeElapsedColumn
+
+    from ladartui.cli.flags import as_flags
+    from ladartui.cli.progress import progress_display
+    from ladartui.scene.generate import generate_scene
+
+    after = (TextColumn("{task.fields[done]}", markup=False), TimeElapsedColumn())
+    with progress_display(console, after, transient=True, disable=not console.is_terminal) as bar:
+        task = bar.add_task("generating", total=1.0, done="")
+
+        def report(stage: str, done: int, total: int) -> None:
+            if stage == "writing":  # rows written, as they go
+                bar.update(task, description=stage, completed=done / total, done=f"{done:,}/{total:,} lines")
+            else:  # stage ``done`` starts: the ones before it are over
+                shown = f"stage {done} of {total}"
+                bar.update(task, description=stage, completed=(done - 1) / total, done=shown)
+
+        started = time.perf_counter()
+        typed = {name: getattr(args, name) for name in ("density", "trees", "voxel_size", "vehicles")}
+        with as_flags(typed):  # name the flag the user typed, not the parameter
+            scene = generate_scene(
+                args.preset, seed=args.seed, progress=report, cancel=cancel, **overrides_from(args)
+            )
+        generated = time.perf_counter() - started
+        started = time.perf_counter()
+        scene_path, target_path = scene.write(stem, cancel, report)
+        written = time.perf_counter() - started
+        if las_files:
+            from ladartui.scene.las import export_las
+
+            bar.update(task, description="writing LAS copies", done="")
+            export_las(las_files[0], scene.voxels, scene.voxel_size)
+            export_las(las_files[1], scene.target, scene.voxel_size, ids=scene.ids())
+        return scene, scene_path, target_path, (generated, written)

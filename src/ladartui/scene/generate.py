@@ -33,9 +33,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ladartui.errors import FieldError
+from ladartui.errors import FieldError, check_cancelled
 from ladartui.scene.trees import branch_voxels, concat_voxels, foliage_voxels, place_trees, trunk_voxels
-from ladartui.scene.voxels import save_voxels
 
 
 @dataclass(frozen=True)
@@ -104,15 +103,18 @@ class GeneratedScene:
             return np.ones(len(self.target), dtype=np.int32)
         return self.target_ids
 
-    def write(self, stem) -> tuple[Path, Path]:
-        """Write ``stem.txt`` and ``stem_Target.txt`` (each atomically); returns both paths.
+    def write(self, stem, cancel=None, progress=None) -> tuple[Path, Path]:
+        """Write ``stem.txt`` and ``stem_Target.txt`` as one set (both or neither); returns
+        both paths. ``progress("writing", rows, of)`` and ``cancel`` as in
+        ``scene.insertion.write_model_pair``.
 
         The target model carries an id column when there is more than one vehicle.
         """
+        from ladartui.scene.insertion import write_model_pair
+
         scene_path, target_path = output_paths(stem)
-        save_voxels(scene_path, self.voxels)
-        labelled = self.params.vehicles > 1
-        save_voxels(target_path, self.target, ids=self.ids() if labelled else None)
+        ids = self.ids() if self.params.vehicles > 1 else None
+        write_model_pair(scene_path, target_path, self.voxels, self.target, ids, cancel, progress)
         return scene_path, target_path
 
     def to_scene(self, name=None, path=None):
@@ -154,11 +156,17 @@ def scene_params(preset="small", **overrides) -> SceneParams:
     return params
 
 
-def generate_scene(preset="small", seed=0, **overrides) -> GeneratedScene:
+GENERATE_STAGES = ("ground", "vehicles", "trees", "trunks", "branches", "foliage", "clearing", "merging")
+GENERATE_CANCELLED = "generating cancelled; nothing was written"
+
+
+def generate_scene(preset="small", seed=0, progress=None, cancel=None, **overrides) -> GeneratedScene:
     """Build a scene from a preset ("small" or "reference"), deterministic from ``seed``.
 
     ``overrides`` replace fields of :class:`SceneParams`, e.g. ``density=0.8``,
-    ``vehicles=0``, ``terrain=True``, ``camouflage=True``.
+    ``vehicles=0``, ``terrain=True``, ``camouflage=True``. ``progress(stage, k,
+    len(GENERATE_STAGES))`` is called as each stage starts; a set ``cancel``
+    (``threading.Event``) raises ``Cancelled`` there.
     """
     params = scene_params(preset, **overrides)
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
@@ -166,24 +174,39 @@ def generate_scene(preset="small", seed=0, **overrides) -> GeneratedScene:
     rng = np.random.default_rng(int(seed))
     vs = params.voxel_size
     nx, ny = round(params.width / vs), round(params.depth / vs)
+    stages = iter(enumerate(GENERATE_STAGES, start=1))
 
+    def stage() -> None:
+        k, name = next(stages)
+        if progress is not None:
+            progress(name, k, len(GENERATE_STAGES))
+        check_cancelled(cancel, GENERATE_CANCELLED)
+
+    stage()
     ground = _terrain(params, nx, ny, rng)  # (nx, ny) int32: first free layer per column
     parts: dict[str, np.ndarray] = {}
     if params.terrain:
         parts["terrain"] = _terrain_voxels(ground - 1)
 
+    stage()
     vehicles = _place_vehicles(params, nx, ny, ground, rng)
     vehicle_voxels = [_vehicle_voxels(v, params, nx, ny) for v in vehicles]
+    stage()
     trees = place_trees(params, nx, ny, ground, vehicles, rng)
+    stage()
     parts["trunks"] = trunk_voxels(trees, vs)
+    stage()
     parts["branches"] = branch_voxels(trees, params, rng)
+    stage()
     parts["foliage"] = foliage_voxels(trees, params, rng)
+    stage()
     for name in ("trunks", "branches", "foliage"):
         parts[name] = _clip(parts[name], nx, ny)
         for vehicle in vehicles:
             parts[name] = _carve_clearance(parts[name], vehicle, vs)
     if params.camouflage and vehicles:
         parts["net"] = _clip(_net_voxels(vehicles[0], params, ground, rng), nx, ny)
+    stage()
     target, target_ids = _merge_labelled(vehicle_voxels)
     parts["vehicles"] = target
     voxels = _merge(list(parts.values()))

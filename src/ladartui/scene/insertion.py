@@ -161,19 +161,33 @@ def write_scene_model(
     progress: Callable[[str, int, int], None] | None = None,
 ) -> tuple[Path, Path]:
     """Write ``X.txt`` and ``X_Target.txt`` as one set (both or neither); returns their paths."""
+    scene_path, target_path = scene_model_paths(out)
+    model = (insertion.scene, insertion.target, insertion.target_ids)
+    write_model_pair(scene_path, target_path, *model, cancel, progress)
+    return scene_path, target_path
+
+
+def write_model_pair(
+    scene_path: Path,
+    target_path: Path,
+    scene: np.ndarray,
+    target: np.ndarray,
+    target_ids: np.ndarray | None = None,
+    cancel: threading.Event | None = None,
+    progress: Callable[[str, int, int], None] | None = None,
+) -> None:
+    """A scene model and its target model (``x,y,z,id`` lines with ``target_ids``) written
+    as one output set: both replaced or neither."""
     from ladartui.outputset import OutputSet
 
-    scene_path, target_path = scene_model_paths(out)
     paths = {"scene": scene_path, "target": target_path}
     lock = scene_path.with_name(f".{scene_path.stem}.model.lock")
 
     def writer(voxels: np.ndarray, ids: np.ndarray | None = None) -> Callable[[Path], None]:
         return lambda tmp: write_voxel_lines(tmp, voxels, cancel, progress, ids)
 
-    target = writer(insertion.target, insertion.target_ids)
     with OutputSet(paths, lock) as output_set:
-        output_set.write({"scene": writer(insertion.scene), "target": target}, cancel)
-    return scene_path, target_path
+        output_set.write({"scene": writer(scene), "target": writer(target, target_ids)}, cancel)
 
 
 def save_model(
