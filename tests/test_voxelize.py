@@ -396,3 +396,20 @@ def test_a_text_mesh_in_latin_1_is_read(tmp_path):
     with pytest.raises(InputFileError) as caught:
         load_mesh(noise)
     assert "module" not in str(caught.value).lower()
+
+
+@pytest.mark.parametrize("header", [b"solid exported by CAD", b"binary"])
+def test_a_binary_stl_cut_short_says_so(tmp_path, header):
+    """A binary STL whose header begins 'solid' and which was cut short was read as text:
+    'holds no triangles'."""
+    whole = tmp_path / "whole.stl"
+    trimesh.creation.box(extents=(1.0, 2.0, 3.0)).export(whole)
+    data = header.ljust(80, b" ") + whole.read_bytes()[80:]
+    cut = tmp_path / "cut.stl"
+    cut.write_bytes(data[: 84 + 50 * 5 + 20])
+    with pytest.raises(InputFileError) as caught:
+        load_mesh(cut)
+    assert str(caught.value) == (
+        f"{cut}: a binary STL cut short: its header counts 12 triangles (684 bytes), "
+        f"the file has {84 + 50 * 5 + 20} bytes"
+    )

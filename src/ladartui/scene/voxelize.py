@@ -101,6 +101,8 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
         raise InputFileError(path, f"unsupported mesh type {path.suffix!r}; expected .obj, .stl or .ply")
     if not path.is_file():
         raise InputFileError(path, f"no such file; expected a mesh file ({kind})")
+    if kind == ".stl":
+        _check_stl_whole(path)
     import trimesh
 
     try:
@@ -164,6 +166,33 @@ def _binary_stl(path: Path) -> bool:
     except OSError:
         return False
     return size == 84 + 50 * count
+
+
+# Control bytes a text STL never holds, where a binary one's floats and attribute
+# words (usually zero) hold some in every triangle.
+_BINARY_BYTES = frozenset(range(32)) - frozenset(b"\t\n\v\f\r")
+
+
+def _check_stl_whole(path: Path) -> None:
+    """``InputFileError`` for a binary STL shorter than its header's triangle count says
+    (read as text when its header begins "solid", it would hold no triangles)."""
+    try:
+        size = path.stat().st_size
+        with open(path, "rb") as stream:
+            head = stream.read(84 + 50)
+    except OSError:
+        return  # the reader reports it
+    if size < 84:
+        return
+    count = int.from_bytes(head[80:84], "little")
+    need = 84 + 50 * count
+    if count == 0 or size >= need or not _BINARY_BYTES & set(head[84:]):
+        return  # whole, or text: an ASCII STL
+    raise InputFileError(
+        path,
+        f"a binary STL cut short: its header counts {count:,} triangles ({need:,} bytes), "
+        f"the file has {size:,} bytes",
+    )
 
 
 def check_obj_lines(path: Path) -> None:
