@@ -100,7 +100,7 @@ def test_a_log_in_latitude_and_longitude_flies_the_same_poses_as_its_local_copy(
     assert 90.0 < local[2, 0] < 92.0 and 55.0 < local[2, 1] < 56.0  # 0.001 deg E, 0.0005 deg N
     with pytest.raises(LadarError, match="origin"):
         LogSegment(str(geo), rate=2.0)  # a geodetic log without its origin
-    with pytest.raises(FieldError, match="origin latitude"):
+    with pytest.raises(FieldError, match=r"origin\[0\] = 95.0: expected a latitude from -90 to 90"):
         LogSegment(str(geo), rate=2.0, origin=[95.0, 0.0, 0.0])
 
 
@@ -121,3 +121,28 @@ def test_a_log_saved_with_a_byte_order_mark_is_read(tmp_path):
     path = tmp_path / "log.csv"
     path.write_bytes(b"\xef\xbb\xbftime,x,y,z,heading\n0,20,64,60,90\n1,50,64,60,90\n")
     assert list(load_flight_log(path).time) == [0.0, 1.0]
+
+
+@pytest.mark.parametrize(
+    ("origin", "found"),
+    [("[95.0, 0.0, 0.0]", "origin[0] = 95.0"), ("[0.0, 200.0, 0.0]", "origin[1] = 200.0")],
+)
+def test_a_bad_origin_in_a_scenario_is_named_on_its_line(tmp_path, origin, found):
+    """The error named 'origin latitude' on the segment's [[flight.segments]] line."""
+    from ladartui.scenario import load_scenario
+
+    geo = tmp_path / "geo.csv"
+    geo.write_text(
+        "time,latitude,longitude,altitude,heading\n0,-35.28,149.13,660,45\n1,-35.27,149.13,660,45\n"
+    )
+    (tmp_path / "s.txt").write_text("0,0,0\n")
+    path = tmp_path / "s.toml"
+    path.write_text(
+        '[files]\nscene = "s.txt"\nvoxel_size = 1.0\n\n[flight]\n[[flight.segments]]\n'
+        f'kind = "log"\nfile = "geo.csv"\nrate = 1.0\norigin = {origin}\n'
+    )
+    with pytest.raises(FieldError) as caught:
+        load_scenario(path)
+    message = str(caught.value)
+    assert message.startswith(f"{path}:10: flight.segments[0].{found}: expected ")
+    assert ("latitude" if "[0]" in found else "longitude") in message

@@ -230,14 +230,16 @@ class LogSegment:
                 raise FieldError(
                     "origin", self.origin, "[latitude, longitude, altitude] of the scene frame's origin"
                 ) from None
-            set_(
-                "origin",
-                (
-                    number_field("origin latitude", lat, -90.0, 90.0),
-                    number_field("origin longitude", lon, -180.0, 180.0),
-                    number_field("origin altitude", alt, -1e4, 1e5),
-                ),
-            )
+            parts = (("latitude", lat, 90.0, "degrees"), ("longitude", lon, 180.0, "degrees"))
+            parts += (("altitude", alt, None, "metres"),)
+            checked = []
+            for i, (what, value, limit, unit) in enumerate(parts):
+                low, high = (-limit, limit) if limit else (-1e4, 1e5)
+                if not (isinstance(value, float) and low <= value <= high):
+                    # named origin[i] so the scenario's error points at the origin line
+                    raise FieldError(f"origin[{i}]", value, f"a {what} from {low:g} to {high:g} {unit}")
+                checked.append(value)
+            set_("origin", tuple(checked))
         log = load_flight_log(self.file, self.origin)
         set_("_log", log)
         span = f"times from {log.time[0]:g} to {log.time[-1]:g} s (the log's span)"
