@@ -230,11 +230,13 @@ class LogSegment:
                 raise FieldError(
                     "origin", self.origin, "[latitude, longitude, altitude] of the scene frame's origin"
                 ) from None
-            parts = (("latitude", lat, 90.0, "degrees"), ("longitude", lon, 180.0, "degrees"))
-            parts += (("altitude", alt, None, "metres"),)
+            parts = (
+                ("latitude", lat, -90.0, 90.0, "degrees"),
+                ("longitude", lon, -180.0, 180.0, "degrees"),
+                ("altitude", alt, -1e4, 1e5, "metres"),
+            )
             checked = []
-            for i, (what, value, limit, unit) in enumerate(parts):
-                low, high = (-limit, limit) if limit else (-1e4, 1e5)
+            for i, (what, value, low, high, unit) in enumerate(parts):
                 if not (isinstance(value, float) and low <= value <= high):
                     # named origin[i] so the scenario's error points at the origin line
                     raise FieldError(f"origin[{i}]", value, f"a {what} from {low:g} to {high:g} {unit}")
