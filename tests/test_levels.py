@@ -264,6 +264,30 @@ def test_bad_levels_name_the_file_line_field_value_and_range(tmp_path, old, new,
     assert expected in message and "\n" not in message
 
 
+@pytest.mark.parametrize(
+    ("written", "head", "expected"),
+    [
+        ("detect = 0.6", "levels.detect = 0.6", "at most levels.recognise (0.3, its default"),
+        (
+            "detect_footprint = 0.9",
+            "levels.detect_footprint = 0.9",
+            "at most levels.recognise_footprint (0.5, its default",
+        ),
+    ],
+)
+def test_a_level_above_the_default_of_the_next_names_the_key_written(tmp_path, written, head, expected):
+    """'detect = 0.6' alone was reported as 'levels.recognise = 0.3', a key not in the file,
+    on the [levels] line."""
+    base = write_tiny_scenario(tmp_path)
+    text = base.path.read_text() + f"\n[levels]\n{written}\n"
+    base.path.write_text(text)
+    with pytest.raises(FieldError) as caught:
+        load_scenario(base.path)
+    line = text.splitlines().index(written) + 1
+    message = str(caught.value)
+    assert message.startswith(f"{base.path}:{line}: {head}: expected ") and expected in message
+
+
 def test_unknown_levels_key_is_named(tmp_path):
     base = write_tiny_scenario(tmp_path)
     base.path.write_text(base.path.read_text() + "\n[levels]\nidentfy = 0.5\n")

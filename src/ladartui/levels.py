@@ -115,6 +115,14 @@ class LevelThresholds:
 LEVEL_KEYS = tuple(f.name for f in fields(LevelThresholds))
 
 
+def level_below(key: str) -> str | None:
+    """The threshold a level key must not fall below: ``recognise_footprint`` ->
+    ``detect_footprint``; None for the lowest level."""
+    level, _, suffix = key.partition("_")
+    at = LEVELS.index(level)
+    return f"{LEVELS[at - 1]}{'_' + suffix if suffix else ''}" if at else None
+
+
 def levels_from_table(table: dict) -> LevelThresholds:
     """A ``[levels]`` table (keys already checked against LEVEL_KEYS) as thresholds."""
     return LevelThresholds(**table)

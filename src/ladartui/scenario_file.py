@@ -101,7 +101,7 @@ from ladartui.checks import number_field
 from ladartui.detection.settings import DETECTION_KEYS, detection_from_table
 from ladartui.errors import FieldError, InputFileError
 from ladartui.flight import MAX_SCANS, SEGMENT_KINDS, FlightPlan, Manual, ScanPose
-from ladartui.levels import LEVEL_KEYS, levels_from_table
+from ladartui.levels import LEVEL_KEYS, level_below, levels_from_table
 from ladartui.sensor import MAX_PIXEL_PITCH, Sensor
 from ladartui.toml_lines import key_lines_from_text
 from ladartui.trajectory import LogSegment
@@ -204,6 +204,23 @@ class ScenarioReader:
             if name not in table:
                 raise self.file_error(where, f"missing key '{where}.{name}'{what}")
 
+    def _levels_error(self, error: FieldError, table: dict) -> FieldError:
+        """A [levels] error named by the key written: a default that falls below the
+        level under it (``detect = 0.6`` alone, against recognise's 0.3) blames that
+        level, the one in the file."""
+        key = error.field.rpartition(".")[2]
+        if key in table:
+            return self.field_error(error.field, table[key], error.expected)
+        below = level_below(key)
+        if below is None or below not in table:
+            return self.field_error(error.field, error.value, error.expected)
+        return self.field_error(
+            f"levels.{below}",
+            table[below],
+            f"at most levels.{key} ({error.value:g}, its default: set it too; "
+            "a higher level needs at least as much)",
+        )
+
     def arguments(self, doc) -> dict:
         """The Scenario's keyword arguments from the document (all but its path), each
         checked where its table or key can be named; ``constructed`` names the rest."""
@@ -229,8 +246,7 @@ class ScenarioReader:
             try:
                 levels = levels_from_table(table)
             except FieldError as error:
-                key = error.field.rpartition(".")[2]
-                raise self.field_error(error.field, table.get(key, error.value), error.expected) from None
+                raise self._levels_error(error, table) from None
         target_names: tuple = ()
         if "targets" in doc:
             names = self.table(doc, "targets", SECTIONS["targets"]).get("names", {})
