@@ -526,3 +526,26 @@ def test_the_settings_that_made_the_outputs_are_named_in_a_sentence():
     )
     assert named_changes(["a 1 (here 2)"]) == ": a 1 (here 2)"
     assert named_changes([]) == ""
+
+
+def test_the_png_and_compare_dialogs_name_what_is_wrong(tmp_path):
+    """A width of 0 was 'picture size = ...' (no field of the dialog has that name, so the
+    error stood under none); Compare called a folder 'measures file not found'."""
+    import pytest
+
+    from ladartui.errors import FieldError, InputFileError
+    from ladartui.tui import bridge
+
+    with pytest.raises(FieldError) as caught:
+        bridge.image_size({"width": "0", "height": "300"})
+    assert caught.value.field == "width"
+    assert str(caught.value) == "width = 0: expected a whole number of pixels from 16 to 8192"
+    with pytest.raises(FieldError) as caught:
+        bridge.image_size({"width": "400", "height": "tall"})
+    assert caught.value.field == "height" and "'tall'" in str(caught.value)
+    with pytest.raises(InputFileError) as caught:
+        bridge.read_measures_files([tmp_path])
+    assert str(caught.value) == f"{tmp_path}: is a folder; expected a .cmf measures file"
+    with pytest.raises(InputFileError) as caught:
+        bridge.read_measures_files([tmp_path / "gone.cmf"])
+    assert str(caught.value) == f"{tmp_path / 'gone.cmf'}: measures file not found"

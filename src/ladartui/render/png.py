@@ -14,15 +14,18 @@ MAX_SIDE = 8192  # pixels: a larger picture is refused before it is drawn
 
 
 def check_size(width, height) -> tuple[int, int]:
-    """The requested picture size as ints, or a FieldError naming what was wrong."""
-    expected = f"whole numbers of pixels 16..{MAX_SIDE} (width x height)"
-    try:
-        w, h = int(width), int(height)
-    except (TypeError, ValueError):
-        raise FieldError("picture size", f"{width} x {height}", expected) from None
-    if not (16 <= w <= MAX_SIDE and 16 <= h <= MAX_SIDE):
-        raise FieldError("picture size", f"{w} x {h}", expected)
-    return w, h
+    """The requested picture size as ints, or a FieldError naming ``width`` or ``height``."""
+    sides = []
+    for name, value in (("width", width), ("height", height)):
+        expected = f"a whole number of pixels from 16 to {MAX_SIDE}"
+        try:
+            side = int(value)
+        except (TypeError, ValueError):
+            raise FieldError(name, value, expected) from None
+        if not 16 <= side <= MAX_SIDE:
+            raise FieldError(name, side, expected)
+        sides.append(side)
+    return sides[0], sides[1]
 
 
 def png_bytes(rgb: np.ndarray) -> bytes:

@@ -362,6 +362,8 @@ def read_measures_files(paths) -> list:
 
     out = []
     for path in paths:
+        if Path(path).is_dir():
+            raise InputFileError(path, "is a folder; expected a .cmf measures file")
         if not Path(path).is_file():
             raise InputFileError(path, "measures file not found")
         out.append(read_cmf(path))
