@@ -8,6 +8,7 @@ are shown literally.
 
 from __future__ import annotations
 
+import re
 import shutil
 
 from ladartui.scenario import load_scenario, target_file_for
@@ -192,3 +193,25 @@ def test_a_value_typed_in_other_units_is_saved_as_typed():
         metres = parse_number("pixel_pitch", typed, scale=1e-6)
         assert _to_micrometres(metres) == float(typed), typed
         assert format_number(metres, scale=1e-6) == f"{float(typed):g}"
+
+
+async def test_a_long_scenario_name_is_shortened_in_the_status_line_not_what_follows(tmp_path, scene_files):
+    """At 80 columns a long name pushed '(modified)' and the scan count off the bar."""
+    from rich.cells import cell_len
+
+    name = "night-approach-" + "x" * 50 + "-final"
+    scenario = make_scenario(tmp_path, scene_files, name=name)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        await type_into(pilot, field(app, "sensor.grid"), "12")
+        bar = app.query_one(StatusBar)
+        text = app.query_one("#status-text")
+        shown = str(text.render())
+        assert re.search(r"\(modified\): \d+ scans x [\d,]+ rays\. F5 runs\.$", shown)
+        assert shown.startswith("nigh") and "\u2026" in shown and "nal.toml (modified)" in shown
+        assert cell_len(shown) <= text.content_size.width
+        assert bar.message.startswith(f"{name}.toml (modified)")  # the message itself whole
+        await pilot.resize_terminal(160, 30)
+        await pilot.pause()
+        assert str(text.render()) == bar.message  # room for all of it: nothing shortened

@@ -5,6 +5,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from rich.cells import cell_len
+from rich.text import Text
 from textual.app import ComposeResult
 from textual.containers import Horizontal
 from textual.widgets import Button, Static
@@ -25,6 +27,23 @@ def format_eta(seconds: float | None) -> str:
     if minutes:
         return f"{minutes}m{secs:02d}s"
     return f"{secs}s"
+
+
+class StatusText(Static):
+    """The message, in one line at any width: a scenario name (its longest word)
+    shortened in the middle so that what follows it (modified, scans, keys) stays."""
+
+    def __init__(self, **kwargs: Any) -> None:
+        super().__init__("", markup=False, **kwargs)  # names from files: plain text
+        self.message = ""
+
+    def show(self, message: str) -> None:
+        self.message = message
+        self.refresh()
+
+    def render(self) -> Text:
+        room = self.content_size.width
+        return Text(self.message if room <= 0 else shortened_name(self.message, room))
 
 
 class StatusBar(Horizontal):
@@ -51,7 +70,7 @@ class StatusBar(Horizontal):
 
     def compose(self) -> ComposeResult:
         yield Static(LABELS[NOT_READY], id="status-word")
-        yield Static("", id="status-text", markup=False)  # names from files: plain text
+        yield StatusText(id="status-text")
         yield Button("Cancel", id="cancel", compact=True, variant="error", disabled=True)
 
     def on_mount(self) -> None:
@@ -68,5 +87,22 @@ class StatusBar(Horizontal):
         if progress is not None:
             word = f"{word} {100 * progress:3.0f}%"
         self.query_one("#status-word", Static).update(word)
-        self.query_one("#status-text", Static).update(message)
         self.query_one("#cancel", Button).disabled = not cancellable
+        self.query_one(StatusText).show(message)
+
+
+MIN_NAME = 10  # cells a shortened name keeps
+
+
+def shortened_name(message: str, room: int) -> str:
+    """``message`` with its longest word cut in the middle (``night-app…final.toml``) so
+    that the whole fits ``room`` cells, the word keeping at least ``MIN_NAME``."""
+    over = cell_len(message) - room
+    if over <= 0:
+        return message
+    word = max(message.split(" "), key=cell_len)
+    keep = max(MIN_NAME, cell_len(word) - over - 1)  # one cell for the ellipsis
+    if keep >= len(word):
+        return message
+    head = keep // 3  # the end tells names apart more often (a suffix, the extension)
+    return message.replace(word, word[:head] + "\u2026" + word[len(word) - (keep - head) :], 1)
