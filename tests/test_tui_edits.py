@@ -215,3 +215,23 @@ async def test_a_long_scenario_name_is_shortened_in_the_status_line_not_what_fol
         await pilot.resize_terminal(160, 30)
         await pilot.pause()
         assert str(text.render()) == bar.message  # room for all of it: nothing shortened
+
+
+async def test_the_palette_over_a_prompt_offers_none_of_the_apps_commands(tmp_path, scene_files):
+    """With the Save/Discard prompt open, the palette still offered Run, Open, New..."""
+    from ladartui.tui.app import palette_entries
+    from ladartui.tui.unsaved import UnsavedScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        ours = {title for title, _, _ in palette_entries(app)}
+        offered = {command.title for command in app.get_system_commands(app.screen)}
+        assert ours <= offered  # the main screen offers every command
+        await type_into(pilot, field(app, "sensor.grid"), "12")
+        await pilot.press("f3")
+        await pilot.pause()
+        assert isinstance(app.screen, UnsavedScreen)
+        offered = {command.title for command in app.get_system_commands(app.screen)}
+        assert not ours & offered and offered  # Textual's own (keys, screenshot) stay

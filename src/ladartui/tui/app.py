@@ -22,7 +22,7 @@ from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.css.query import NoMatches
 from textual.notifications import SeverityLevel
-from textual.screen import Screen
+from textual.screen import ModalScreen, Screen
 from textual.widgets import Button, Footer, TabbedContent, TabPane
 
 from ladartui.edit_history import EditHistory
@@ -565,6 +565,8 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         yield from super().get_system_commands(screen)
         if self.tool_screen is not None and screen is self.tool_screen:
             return  # the study and sweep screens have their own keys
+        if isinstance(screen, ModalScreen):
+            return  # a dialog or prompt waits for its answer: nothing may start under it
         for title, help_text, action in palette_entries(self):
             yield SystemCommand(title, help_text, _runner(self, action))
 
