@@ -358,6 +358,9 @@ async def test_an_unreachable_scheduler_gives_one_line_and_writes_nothing(tmp_pa
         assert status_of(screen).state == NOT_READY
         assert "--scheduler" in message and "tcp://127.0.0.1:9" in message and "\n" not in message
         assert not (tmp_path / "spec-results" / "results.csv").exists()
+        # too long for the status line: cut there, so the whole of it comes as a note too
+        room = screen.query_one("#sweep-status #status-text").content_size.width
+        assert len(message) > room and message in [n.message for n in app._notifications]
 
 
 TRACKER_SCRIPT = """

@@ -15,6 +15,7 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from rich.cells import cell_len
 from rich.text import Text
 from textual import on
 from textual.app import ComposeResult
@@ -28,7 +29,7 @@ from textual_plotext import PlotextPlot
 from ladartui.errors import FieldError, LadarError
 from ladartui.recent import recent_paths, remember_path
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
-from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar, format_eta
+from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar, StatusText, format_eta
 from ladartui.tui.sweep_jobs import sibling_spec, spec_to_run, start_resource_tracker, sweep_job, write_best
 from ladartui.tui.sweep_ranking import RankingView
 from ladartui.tui.sweep_view import (
@@ -247,7 +248,7 @@ class SweepScreen(RankingView):
 
                 security = folder_security(scheduler, self.query_one("#sweep-certs", Input).value.strip())
         except LadarError as error:
-            self._status(NOT_READY, str(error))
+            self._status(NOT_READY, str(error), problem=True)
             return
         from ladartui.sweep import default_out_dir
         from ladartui.sweep.base import spec_rows
@@ -404,7 +405,7 @@ class SweepScreen(RankingView):
             budget = self._budget()  # checked whether or not the ranking reads it
             self._rank()
         except LadarError as error:
-            self._status(self._idle_state(), str(error))
+            self._status(self._idle_state(), str(error), problem=True)
             return
         self._redraw()
         self._status(
@@ -454,7 +455,7 @@ class SweepScreen(RankingView):
                 spec_rows(result.rows, spec) if spec is not None and path.suffix.lower() == ".toml" else None
             )
         except LadarError as error:
-            self._status(NOT_READY, str(error))
+            self._status(NOT_READY, str(error), problem=True)
             return
         self.spec = spec
         self.out = result.results_path.parent
@@ -559,7 +560,7 @@ class SweepScreen(RankingView):
             self.notify(f"Sweep cancelled: its rows are kept in {self.out}; F5 resumes.", markup=False)
             self._status(NOT_READY, f"sweep cancelled: {kept}; F5 resumes")
         else:
-            self._status(NOT_READY, f"sweep stopped: {error}")
+            self._status(NOT_READY, f"sweep stopped: {error}", problem=True)
 
     def _fraction(self) -> float | None:
         return self.progress.fraction if self.progress is not None else None
@@ -570,11 +571,21 @@ class SweepScreen(RankingView):
         return READY if self.ranking else NOT_READY
 
     def _status(
-        self, state: str, message: str, progress: float | None = None, cancellable: bool = False
+        self,
+        state: str,
+        message: str,
+        progress: float | None = None,
+        cancellable: bool = False,
+        problem: bool = False,
     ) -> None:
+        """``problem``: an error, whose whole text also comes as a note when the status
+        line has to cut it (a scheduler's error runs to 200 characters)."""
         message = " ".join(message.split())  # always one line
         self.last_message = message
-        self.query_one("#sweep-status", StatusBar).show(state, message, progress, cancellable or self.running)
+        bar = self.query_one("#sweep-status", StatusBar)
+        bar.show(state, message, progress, cancellable or self.running)
+        if problem and cell_len(message) > bar.query_one(StatusText).content_size.width:
+            self.notify(message, severity="error", markup=False, timeout=15)
 
     # -- best path ----------------------------------------------------------------
 
