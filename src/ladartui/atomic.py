@@ -42,3 +42,14 @@ def write_bytes_atomic(target, data: bytes):
 
 def write_text_atomic(target, text: str):
     write_bytes_atomic(target, text.encode("utf-8"))
+
+
+def numbered_paths(path, most: int | None = None):
+    """``path``, then ``STEM-2.SUFFIX``, ``STEM-3.SUFFIX`` ... (up to ``STEM-most`` when
+    given): the names a file goes to beside one it must not replace."""
+    path = Path(path)
+    yield path
+    number = 2
+    while most is None or number <= most:
+        yield path.with_name(f"{path.stem}-{number}{path.suffix}")
+        number += 1

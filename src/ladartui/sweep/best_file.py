@@ -12,10 +12,12 @@ own) is kept, and the best path goes to the first ``NAME-best-2.toml``,
 from __future__ import annotations
 
 import hashlib
+import itertools
 import re
 from dataclasses import dataclass
 from pathlib import Path
 
+from ladartui.atomic import numbered_paths
 from ladartui.errors import OutputFileError
 from ladartui.textsafe import one_line
 
@@ -69,8 +71,7 @@ def best_target(path) -> BestScenario:
     state = _state(path) if path.exists() else "own"
     if state == "own":
         return BestScenario(path)
-    for number in range(2, _MOST_NUMBERS):
-        beside = path.with_name(f"{path.stem}-{number}{path.suffix}")
+    for beside in itertools.islice(numbered_paths(path, _MOST_NUMBERS - 1), 1, None):
         if not beside.exists() or _state(beside) == "own":
             return BestScenario(beside, kept=path, kept_why=_KEPT_WHY[state])
     raise OutputFileError(path, f"and {_MOST_NUMBERS - 2} numbered files beside it are edited: keep fewer")

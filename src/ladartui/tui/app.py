@@ -588,7 +588,6 @@ def named_changes(changes: list[str], shown: int = 2) -> str:
 
 def unused_path(path: Path) -> Path:
     """``path``, or the first of ``STEM-2.SUFFIX``, ``STEM-3.SUFFIX``, ... not on disk."""
-    candidate, number = path, 2
-    while candidate.exists():
-        candidate, number = path.with_name(f"{path.stem}-{number}{path.suffix}"), number + 1
-    return candidate
+    from ladartui.atomic import numbered_paths
+
+    return next(candidate for candidate in numbered_paths(path) if not candidate.exists())
