@@ -235,3 +235,20 @@ async def test_the_palette_over_a_prompt_offers_none_of_the_apps_commands(tmp_pa
         assert isinstance(app.screen, UnsavedScreen)
         offered = {command.title for command in app.get_system_commands(app.screen)}
         assert not ours & offered and offered  # Textual's own (keys, screenshot) stay
+
+
+def test_the_new_scenario_preview_takes_any_partial_path():
+    """Typing '/' as the scene model ended the app: Path('/') has an empty name."""
+    from pathlib import Path
+
+    from ladartui.tui import bridge
+
+    for scenario, scene in [(None, Path("/")), (Path("/"), Path("x.txt")), (Path("/"), Path("/"))]:
+        names = dict(bridge.derived_names(scenario, scene))
+        assert len(names) == 5
+        if scene == Path("/"):
+            assert names["3D target model"] == "(from the scene model)"
+        if scenario == Path("/"):
+            assert names["Comparison measures"] == "(from the scenario file)"
+    names = dict(bridge.derived_names(Path("/tmp/a.toml"), Path("/tmp/x.txt")))
+    assert names["3D target model"] == "x_Target.txt" and names["Comparison measures"] == "a.cmf"

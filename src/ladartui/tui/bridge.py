@@ -281,7 +281,10 @@ def make_pose(values: dict) -> ScanPose:
 
 
 def derived_names(scenario_path: Path | None, scene_path: Path | None) -> list[tuple[str, str]]:
-    """The names a new scenario derives (report table 2), for the setup dialog."""
+    """The names a new scenario derives (report table 2), for the setup dialog: any
+    path typed so far, so a folder ("/", "dir/") derives nothing yet."""
+    scene_path = scene_path if scene_path is not None and scene_path.name else None
+    scenario_path = scenario_path if scenario_path is not None and scenario_path.name else None
     target = target_file_for(scene_path).name if scene_path else "(from the scene model)"
     if scenario_path is None:
         outputs = ("(from the scenario file)",) * 4

@@ -17,6 +17,7 @@ from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, DirectoryTree, Input, RadioButton, RadioSet, Static
 
 from ladartui.errors import LadarError
+from ladartui.textsafe import visible
 from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField, refusal
 from ladartui.tui.file_tree import SCENARIO_TABLE, FileTree
@@ -165,7 +166,7 @@ class SetupScreen(TreeDialog):
         scenario_path, scene_path = self._paths()
         if self.mode == "new":
             names = bridge.derived_names(scenario_path, scene_path)
-            text = escape("\n".join(f"{label:<26}{value}" for label, value in names))
+            text = escape("\n".join(f"{label:<26}{visible(value)}" for label, value in names))
         else:
             text = (
                 "Every model file of the scenario is checked before anything is loaded; "
