@@ -252,3 +252,19 @@ def test_the_new_scenario_preview_takes_any_partial_path():
             assert names["Comparison measures"] == "(from the scenario file)"
     names = dict(bridge.derived_names(Path("/tmp/a.toml"), Path("/tmp/x.txt")))
     assert names["3D target model"] == "x_Target.txt" and names["Comparison measures"] == "a.cmf"
+
+
+def test_a_point_or_list_with_an_empty_part_is_refused_not_shortened():
+    """'29.881,,0.926' was taken as (29.881, 0.926, 0): every scan moved."""
+    import pytest
+
+    from ladartui.errors import FieldError
+    from ladartui.tui.screens import _parse_points
+
+    for kind, text in [("point", "29.881,,0.926"), ("points", "50,,100"), ("points", ",50")]:
+        with pytest.raises(FieldError) as caught:
+            _parse_points("centre", text, kind)
+        assert "empty" in caught.value.expected
+    assert _parse_points("centre", "1, 2, 3,", "point") == (1.0, 2.0, 3.0)  # a trailing comma
+    assert _parse_points("centre", "1; 2", "point") == (1.0, 2.0, 0.0)
+    assert _parse_points("standoffs", "50, 100", "points") == (50.0, 100.0)

@@ -254,7 +254,12 @@ def _parse_points(name, text, kind):
     text = text.strip()
     if not text:
         return None
-    parts = [p for p in text.replace(";", ",").split(",") if p.strip()]
+    parts = [p.strip() for p in text.replace(";", ",").split(",")]
+    if len(parts) > 1 and not parts[-1]:
+        parts.pop()  # one trailing comma
+    if not all(parts):
+        expected = "x, y, z in metres" if kind == "point" else "numbers separated by commas"
+        raise FieldError(name, text, expected + ", none of them empty")
     numbers = tuple(parse_number(name, p) for p in parts)
     if kind == "point" and len(numbers) not in (2, 3):
         raise FieldError(name, text, "x, y, z in metres")
