@@ -171,8 +171,9 @@ def test_cancelled_writes_leave_the_earlier_files(tmp_path, forest, monkeypatch)
 
     from ladartui.errors import Cancelled
     from ladartui.scene import insertion as module
+    from ladartui.scene import model_files
 
-    monkeypatch.setattr(module, "_WRITE_ROWS", 100)
+    monkeypatch.setattr(model_files, "WRITE_ROWS", 100)
     vehicle = np.array([[i, j, 0] for i in range(20, 40) for j in range(20, 40)], dtype=np.int32)
     scene, target, _, had = module.load_scene_model(forest)
     inserted = module.insert_vehicle(scene, target, vehicle, 0.1, had)
@@ -188,7 +189,7 @@ def test_cancelled_writes_leave_the_earlier_files(tmp_path, forest, monkeypatch)
     with pytest.raises(Cancelled):
         module.write_scene_model(forest, inserted, cancel, cancel_on_second_chunk)
     with pytest.raises(Cancelled):
-        module.save_model(tmp_path / "forest_Target.txt", vehicle, cancel)
+        model_files.save_model(tmp_path / "forest_Target.txt", vehicle, cancel)
     assert stages[:2] == [("writing", 100, len(inserted.scene)), ("writing", 200, len(inserted.scene))]
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before  # no temporaries left either
     cancel.clear()

@@ -251,12 +251,12 @@ def test_progress_names_each_stage_in_order_and_cancel_stops_between_them():
 def test_write_replaces_both_files_or_neither(tmp_path, small, monkeypatch):
     """The pair was written one file after the other: a failure between left a new scene
     beside an old target model."""
-    from ladartui.scene import insertion
+    from ladartui.scene import model_files
 
     scene_path, target_path = small.write(tmp_path / "forest")
     before = scene_path.read_bytes(), target_path.read_bytes()
     other = generate_scene("small", seed=1, trees=5)
-    real = insertion.write_voxel_lines
+    real = model_files.write_voxel_lines
     calls = []
 
     def fail_on_second(path, voxels, *rest, **options):
@@ -265,7 +265,7 @@ def test_write_replaces_both_files_or_neither(tmp_path, small, monkeypatch):
             raise OSError(28, "No space left on device")
         real(path, voxels, *rest, **options)
 
-    monkeypatch.setattr(insertion, "write_voxel_lines", fail_on_second)
+    monkeypatch.setattr(model_files, "write_voxel_lines", fail_on_second)
     with pytest.raises(OutputFileError):
         other.write(tmp_path / "forest")
     assert (scene_path.read_bytes(), target_path.read_bytes()) == before

@@ -126,7 +126,8 @@ def _work(args, placement, outputs, console, cancel):
     import numpy as np
     from rich.progress import TextColumn, TimeElapsedColumn
 
-    from ladartui.scene.insertion import insert_vehicle, load_scene_model, save_model, write_scene_model
+    from ladartui.scene.insertion import insert_vehicle, load_scene_model, write_scene_model
+    from ladartui.scene.model_files import save_model
     from ladartui.scene.voxelize import CANCELLED, load_mesh, voxelize
 
     description = TextColumn("{task.description}", markup=False)  # paths are not markup

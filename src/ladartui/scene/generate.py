@@ -1,7 +1,8 @@
 """Synthetic forest scenes with a vehicle under the canopy.
 
-``generate_scene(preset, seed, **overrides)`` builds a scene model and its
-target model, the same every time for the same seed and parameters:
+``generate_scene(preset, seed, progress, cancel, **overrides)`` builds a scene
+model and its target model, the same every time for the same seed and
+parameters (``progress`` and ``cancel`` act between its stages):
 
 - trees: a trunk (a hollow tapering tube: only its skin can be seen), a few
   branches, and a crown that is a shell of leaf clumps with real gaps
@@ -106,11 +107,11 @@ class GeneratedScene:
     def write(self, stem, cancel=None, progress=None) -> tuple[Path, Path]:
         """Write ``stem.txt`` and ``stem_Target.txt`` as one set (both or neither); returns
         both paths. ``progress("writing", rows, of)`` and ``cancel`` as in
-        ``scene.insertion.write_model_pair``.
+        ``scene.model_files.write_model_pair``.
 
         The target model carries an id column when there is more than one vehicle.
         """
-        from ladartui.scene.insertion import write_model_pair
+        from ladartui.scene.model_files import write_model_pair
 
         scene_path, target_path = output_paths(stem)
         ids = self.ids() if self.params.vehicles > 1 else None

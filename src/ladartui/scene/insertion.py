@@ -17,6 +17,7 @@ import numpy as np
 
 from ladartui.errors import InputFileError, LadarError
 from ladartui.scene.model import target_path_for
+from ladartui.scene.model_files import write_model_pair
 from ladartui.scene.voxelize import merge_voxels
 
 
@@ -165,72 +166,3 @@ def write_scene_model(
     model = (insertion.scene, insertion.target, insertion.target_ids)
     write_model_pair(scene_path, target_path, *model, cancel, progress)
     return scene_path, target_path
-
-
-def write_model_pair(
-    scene_path: Path,
-    target_path: Path,
-    scene: np.ndarray,
-    target: np.ndarray,
-    target_ids: np.ndarray | None = None,
-    cancel: threading.Event | None = None,
-    progress: Callable[[str, int, int], None] | None = None,
-) -> None:
-    """A scene model and its target model (``x,y,z,id`` lines with ``target_ids``) written
-    as one output set: both replaced or neither."""
-    from ladartui.outputset import OutputSet
-
-    paths = {"scene": scene_path, "target": target_path}
-    lock = scene_path.with_name(f".{scene_path.stem}.model.lock")
-
-    def writer(voxels: np.ndarray, ids: np.ndarray | None = None) -> Callable[[Path], None]:
-        return lambda tmp: write_voxel_lines(tmp, voxels, cancel, progress, ids)
-
-    with OutputSet(paths, lock) as output_set:
-        output_set.write({"scene": writer(scene), "target": writer(target, target_ids)}, cancel)
-
-
-def save_model(
-    path,
-    voxels: np.ndarray,
-    cancel: threading.Event | None = None,
-    progress: Callable[[str, int, int], None] | None = None,
-    ids: np.ndarray | None = None,
-) -> None:
-    """Write one voxel list atomically (``x,y,z,id`` lines with ``ids``); cancelled, it leaves
-    ``path`` as it was."""
-    from ladartui.atomic import atomic_path
-
-    with atomic_path(path) as tmp:
-        write_voxel_lines(tmp, voxels, cancel, progress, ids)
-
-
-_WRITE_ROWS = 1_000_000  # rows formatted at a time: cancel is checked between them
-
-
-def write_voxel_lines(
-    path: Path,
-    voxels: np.ndarray,
-    cancel: threading.Event | None = None,
-    progress: Callable[[str, int, int], None] | None = None,
-    ids: np.ndarray | None = None,
-) -> None:
-    """``x,y,z`` lines of (N, 3) non-negative voxels into ``path`` (a temporary the caller swaps in);
-    ``x,y,z,id`` lines with ``ids`` (one target id per voxel).
-
-    Formatted a million rows at a time, so a large model needs no text
-    buffer of its own size and a set ``cancel`` stops it (``Cancelled``).
-    """
-    from ladartui.errors import check_cancelled
-    from ladartui.scene.voxelize import CANCELLED
-    from ladartui.scene.voxels import format_voxel_lines
-
-    if ids is not None:
-        voxels = np.column_stack([np.asarray(voxels, np.int64), np.asarray(ids, np.int64)])
-    with open(path, "wb") as stream:
-        for start in range(0, len(voxels), _WRITE_ROWS):
-            check_cancelled(cancel, CANCELLED)
-            stop = min(start + _WRITE_ROWS, len(voxels))
-            stream.write(format_voxel_lines(voxels[start:stop]))
-            if progress is not None:
-                progress("writing", stop, len(voxels))
