@@ -172,6 +172,7 @@ def _straight_base(folder):
         ("[grid]\naltitude = [40.0, 50.0]\n", "grid.altitude", 4),
         ("[random]\nsamples = 2\nradius = { min = 5.0, max = 9.0 }\n", "random.radius", 5),
         ('[grid]\npreset = ["orbit"]\nradius = [9.0]\n', "grid.preset", 4),
+        ("[grid]\nsensor_grid = [0]\n", "grid.sensor_grid", 4),
     ],
 )
 def test_a_spec_no_variant_of_which_can_run_is_refused_before_anything_runs(tmp_path, body, key, line):
@@ -182,7 +183,7 @@ def test_a_spec_no_variant_of_which_can_run_is_refused_before_anything_runs(tmp_
     with pytest.raises(InputFileError) as refused:
         run_sweep(spec, serial=True, out=tmp_path / "out")
     message = str(refused.value)
-    assert f"spec.toml:{line}: {key}:" in message and "no variant can run" in message
+    assert f"spec.toml:{line}: {key}: no variant can run: " in message
     assert "\n" not in message and not (tmp_path / "out").exists()
 
 
@@ -200,3 +201,36 @@ def test_the_cli_refuses_a_spec_no_variant_of_which_can_run_before_its_progress(
     assert main(["sweep", str(spec), "--serial"]) == 2
     out, err = capsys.readouterr()
     assert "spec.toml:4: grid.altitude: no variant can run" in err and "sweep of" not in out + err
+
+
+def test_a_refusal_for_a_field_the_spec_does_not_name_blames_the_parameter_varied(tmp_path):
+    """An aim point above every altitude tried was blamed on sweep.scenario (line 2)."""
+    from ladartui.flight import FlightPlan, Orbit
+
+    base = write_tiny_scenario(tmp_path)
+    orbit = Orbit(centre=(15.5, 15.5, 0.5), radius=20.0, altitude=20.0, scans=4, aim_at=(15.5, 15.5, 10.0))
+    base.with_changes(flight=FlightPlan(segments=(orbit,))).save()
+    spec = write_spec(tmp_path, "[grid]\naltitude = [5.0, 8.0]\n")
+    with pytest.raises(InputFileError) as refused:
+        run_sweep(spec, serial=True, out=tmp_path / "out")
+    assert "spec.toml:4: grid.altitude: no variant can run: " in str(refused.value)
+
+
+def test_the_check_reads_the_target_model_not_the_scene(tmp_path, monkeypatch):
+    """The CLI's check loaded the whole scene again for each variant that failed, and a
+    good spec's scene twice."""
+    from ladartui.cli import main
+    from ladartui.scenario import Scenario
+
+    _straight_base(tmp_path)
+    loads = []
+    real = Scenario.load_scene
+    monkeypatch.setattr(Scenario, "load_scene", lambda self: loads.append(1) or real(self))
+    bad = write_spec(tmp_path, '[grid]\npreset = ["orbit", "flypast"]\nradius = [5.0, 6.0]\n')
+    assert main(["sweep", str(bad), "--serial", "--out", str(tmp_path / "bad")]) == 2
+    assert loads == []
+    good = write_spec(
+        tmp_path, '[grid]\npreset = ["orbit"]\nradius = [9.0]\naltitude = [20.0]\nscans = [2]\n', "good.toml"
+    )
+    assert main(["sweep", str(good), "--serial", "--out", str(tmp_path / "good"), "--json"]) == 0
+    assert loads == [1]  # the sweep's own

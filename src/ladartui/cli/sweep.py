@@ -190,7 +190,7 @@ def run(args) -> int:
         from ladartui.sweep.base import base_scenario_path, check_some_variant_runs
 
         base = load_scenario(base_scenario_path(spec))  # a bad base is reported before any cluster starts
-        check_some_variant_runs(spec, base, base.load_scene)
+        check_some_variant_runs(spec, base)
         check_writable_folder(args.out or default_out_dir(spec))
         result = _sweep_with_progress(spec, args, errors)
         if result is None:

@@ -11,6 +11,8 @@ from __future__ import annotations
 import hashlib
 from pathlib import Path
 
+import numpy as np
+
 from ladartui.errors import InputFileError
 from ladartui.sweep.spec import SweepSpec, bundled_name, spec_line
 
@@ -67,30 +69,59 @@ def spec_rows(table_rows: list[dict], spec: SweepSpec) -> list[dict]:
     return own_rows(table_rows, spec.variants, base_digest(path, load_scenario(path, check_files=False)))
 
 
-def check_some_variant_runs(spec: SweepSpec, base, scene_loader) -> None:
-    """Refuse a spec none of whose variants the base can take (flight parameters over a
-    base with no orbit, fly-past or standoff, a preset the base cannot complete): that
-    is a mistake in the spec, named on its key's line, not one error row per variant.
-    Stops at the first variant that can be built, so a good spec costs one build."""
-    from ladartui.errors import FieldError
+def check_some_variant_runs(spec: SweepSpec, base) -> None:
+    """Refuse a spec none of whose variants can be built from the base (flight parameters
+    over a base with no orbit, fly-past or standoff, a preset the base cannot complete,
+    every value out of range): a mistake in the spec, named on its key's line, not
+    one error row per variant. Stops at the first variant that builds; a preset's
+    aim point comes from the target model alone, never the whole scene."""
+    from ladartui.errors import LadarError
     from ladartui.sweep.variant import apply_parameters
 
+    target = _TargetCentre(base)
     first = None
     for variant in spec.variants:
         try:
-            apply_parameters(base, variant.params, scene_loader)
+            apply_parameters(base, variant.params, lambda: target)
             return
-        except FieldError as error:
+        except LadarError as error:
             first = first or error
     if first is None:
         return  # a spec of no variants
-    # The key to blame: the one in error, else the preset that needs what is missing.
-    name = first.field if first.field in spec.parameter_names else "preset"
-    table = "grid" if name in spec.grid else "random" if name in spec.random else "sweep"
-    if table == "sweep":
-        name = "scenario"
+    key = _blamed_key(spec, getattr(first, "field", ""))
     raise InputFileError(
-        spec.path,
-        f"{table}.{name}: no variant can run on base {spec.scenario_path.name}: {first}",
-        line=spec_line(spec.path, table, name),
+        spec.path, f"{key}: no variant can run: {first}", line=spec_line(spec.path, *key.split("."))
     )
+
+
+def _blamed_key(spec: SweepSpec, field: str) -> str:
+    """``table.key`` of the spec to blame for ``field``'s error: that parameter, else
+    the preset (it needs what is missing), else the first parameter varied."""
+    names = spec.parameter_names
+    if field in names:
+        name = field
+    elif "preset" in names:
+        name = "preset"
+    elif names:
+        name = names[0]
+    else:
+        return "sweep.scenario"
+    return f"{'grid' if name in spec.grid else 'random'}.{name}"
+
+
+class _TargetCentre:
+    """The scene as a preset without an aim point needs it: its target's centre, read
+    from the target model file once (a scene file can run to gigabytes)."""
+
+    def __init__(self, base):
+        self.base, self.centre = base, None
+
+    def target_centre_m(self):
+        if self.centre is None:
+            from ladartui.scene.model import Scene
+            from ladartui.scene.target_model import load_target
+
+            voxels, _ = load_target(self.base.target_file)
+            empty = Scene(np.zeros((0, 3), np.int32), voxels, self.base.voxel_size, name=self.base.name)
+            self.centre = empty.target_centre_m()
+        return self.centre

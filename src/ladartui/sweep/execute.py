@@ -206,8 +206,8 @@ def run_sweep(
 
     base_path = base_scenario_path(spec)
     base = load_scenario(base_path)
+    check_some_variant_runs(spec, base)
     scene = _LazyScene(base)
-    check_some_variant_runs(spec, base, scene)
     with _exclusive(out):
         return _run_locked(
             spec,
