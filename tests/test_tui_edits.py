@@ -268,3 +268,24 @@ def test_a_point_or_list_with_an_empty_part_is_refused_not_shortened():
     assert _parse_points("centre", "1, 2, 3,", "point") == (1.0, 2.0, 3.0)  # a trailing comma
     assert _parse_points("centre", "1; 2", "point") == (1.0, 2.0, 0.0)
     assert _parse_points("standoffs", "50, 100", "points") == (50.0, 100.0)
+
+
+def test_fitted_shortens_the_name_given_then_cuts_the_end_in_cells():
+    """The longest word was cut, which need not be the name ('(mo…ified):'), and wide
+    characters were counted as one cell each, so the line still overflowed."""
+    from rich.cells import cell_len
+
+    from ladartui.tui.status import fitted
+
+    spaced = "My Night Approach Over The Long Valley Final Plan.toml"
+    message = f"{spaced} (modified): 6 scans x 144 rays. F5 runs."
+    shown = fitted(message, 60, spaced)
+    assert shown.endswith(" (modified): 6 scans x 144 rays. F5 runs.") and cell_len(shown) <= 60
+    assert shown.startswith("My N") and "\u2026" in shown and "Plan.toml" in shown
+    wide = "\u591c\u9593\u9032\u5165" * 6 + ".toml"  # 48 cells of CJK
+    shown = fitted(f"{wide} (modified): 6 scans x 144 rays. F5 runs.", 60, wide)
+    assert cell_len(shown) <= 60 and shown.endswith("(modified): 6 scans x 144 rays. F5 runs.")
+    # no name given (or the name alone not enough): the end is cut, marked
+    shown = fitted("sweep stopped: " + "x" * 100, 40)
+    assert cell_len(shown) == 40 and shown.endswith("\u2026")
+    assert fitted("short", 40, "short") == "short"

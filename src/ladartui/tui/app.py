@@ -246,13 +246,18 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
 
     def refresh_status(self) -> None:
         bar = self.query_one(StatusBar)
+        scenario = self.scenario
+        name = scenario.path.name if scenario is not None else None
+
+        def show(state: str, message: str, progress: float | None = None, cancellable: bool = False):
+            bar.show(state, message, progress, cancellable, name=name)  # the name is what shortens
+
         if self.busy is not None:
-            bar.show(BUSY, self.busy, self.progress, cancellable=self.run_in_progress())
+            show(BUSY, self.busy, self.progress, cancellable=self.run_in_progress())
             return
         problems = self.problems()
-        scenario = self.scenario
         if problems or scenario is None:  # no scenario is one of the problems
-            bar.show(NOT_READY, "; ".join(problems))
+            show(NOT_READY, "; ".join(problems))
             return
         poses = len(scenario.poses())
         rays = scenario.sensor.rays_per_scan
@@ -263,17 +268,17 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
             # runnable, but the set on disk is incomplete: yellow until a run rewrites it
             names = ", ".join(p.name for p in self.missing_outputs)
             writes = f"; {runs} and writes them" if runs else ""
-            bar.show(NOT_READY, f"{scenario.path.name}{mark}: outputs missing ({names}){writes}.")
+            show(NOT_READY, f"{scenario.path.name}{mark}: outputs missing ({names}){writes}.")
             return
         if self.outputs_stale():
             # short: the bar is one line (the Results tab says which settings they came from)
             reruns = self.key_says("run", "reruns")
-            bar.show(
+            show(
                 NOT_READY,
                 f"{scenario.path.name}{mark}: outputs out of date" + (f"; {reruns}." if reruns else "."),
             )
             return
-        bar.show(READY, text)
+        show(READY, text)
 
     def check_action(self, action: str, parameters) -> bool | None:
         if self.tool_screen is not None and self.screen is self.tool_screen:

@@ -30,20 +30,21 @@ def format_eta(seconds: float | None) -> str:
 
 
 class StatusText(Static):
-    """The message, in one line at any width: a scenario name (its longest word)
-    shortened in the middle so that what follows it (modified, scans, keys) stays."""
+    """The message, in one line at any width: the scenario's name shortened in its
+    middle so that what follows it (modified, scans, keys) stays, else the end cut."""
 
     def __init__(self, **kwargs: Any) -> None:
         super().__init__("", markup=False, **kwargs)  # names from files: plain text
         self.message = ""
+        self.name_shown: str | None = None
 
-    def show(self, message: str) -> None:
-        self.message = message
+    def show(self, message: str, name: str | None = None) -> None:
+        self.message, self.name_shown = message, name
         self.refresh()
 
     def render(self) -> Text:
         room = self.content_size.width
-        return Text(self.message if room <= 0 else shortened_name(self.message, room))
+        return Text(self.message if room <= 0 else fitted(self.message, room, self.name_shown))
 
 
 class StatusBar(Horizontal):
@@ -77,32 +78,57 @@ class StatusBar(Horizontal):
         self.set_class(True, f"-{self.state}")
 
     def show(
-        self, state: str, message: str, progress: float | None = None, cancellable: bool = False
+        self,
+        state: str,
+        message: str,
+        progress: float | None = None,
+        cancellable: bool = False,
+        name: str | None = None,
     ) -> None:
-        """Show ``state`` with ``message``; ``progress`` 0..1 adds a percentage."""
-        for name in LABELS:
-            self.set_class(name == state, f"-{name}")
+        """Show ``state`` with ``message``; ``progress`` 0..1 adds a percentage; ``name``
+        (the scenario's, in the message) is what gets shortened when the line is short."""
+        for label in LABELS:
+            self.set_class(label == state, f"-{label}")
         self.state, self.message, self.progress = state, message, progress
         word = LABELS[state]
         if progress is not None:
             word = f"{word} {100 * progress:3.0f}%"
         self.query_one("#status-word", Static).update(word)
         self.query_one("#cancel", Button).disabled = not cancellable
-        self.query_one(StatusText).show(message)
+        self.query_one(StatusText).show(message, name)
 
 
 MIN_NAME = 10  # cells a shortened name keeps
+ELLIPSIS = "\u2026"
 
 
-def shortened_name(message: str, room: int) -> str:
-    """``message`` with its longest word cut in the middle (``night-app…final.toml``) so
-    that the whole fits ``room`` cells, the word keeping at least ``MIN_NAME``."""
+def fitted(message: str, room: int, name: str | None = None) -> str:
+    """``message`` in ``room`` cells: ``name`` (where it occurs) cut in its middle
+    (``nigh…final.toml``, keeping at least ``MIN_NAME`` cells), then the end cut if
+    that is not enough."""
     over = cell_len(message) - room
     if over <= 0:
         return message
-    word = max(message.split(" "), key=cell_len)
-    keep = max(MIN_NAME, cell_len(word) - over - 1)  # one cell for the ellipsis
-    if keep >= len(word):
-        return message
-    head = keep // 3  # the end tells names apart more often (a suffix, the extension)
-    return message.replace(word, word[:head] + "\u2026" + word[len(word) - (keep - head) :], 1)
+    if name and name in message and cell_len(name) > MIN_NAME:
+        keep = max(MIN_NAME, cell_len(name) - over - 1)  # one cell for the ellipsis
+        head = keep // 3  # the end tells names apart more often (a suffix, the extension)
+        short = _first_cells(name, head) + ELLIPSIS + _last_cells(name, keep - head)
+        message = message.replace(name, short, 1)
+    if cell_len(message) > room:
+        message = _first_cells(message, room - 1) + ELLIPSIS
+    return message
+
+
+def _first_cells(text: str, cells: int) -> str:
+    """The longest start of ``text`` at most ``cells`` wide."""
+    out, used = [], 0
+    for char in text:
+        used += cell_len(char)
+        if used > cells:
+            break
+        out.append(char)
+    return "".join(out)
+
+
+def _last_cells(text: str, cells: int) -> str:
+    return _first_cells(text[::-1], cells)[::-1]
