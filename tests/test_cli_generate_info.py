@@ -38,7 +38,7 @@ def test_generate_accepts_a_txt_stem_and_options(tmp_path, capsys):
 @pytest.mark.parametrize(
     ("flags", "message"),
     [
-        (["--no-target", "--vehicles", "3"], "--no-target: no vehicle, but --vehicles 3 asks for 3"),
+        (["--no-target", "--vehicles", "3"], "--no-target and --vehicles 3 contradict each other: drop one"),
         (
             ["--no-target", "--camouflage"],
             "--camouflage: the net is draped over a vehicle, and there is none",

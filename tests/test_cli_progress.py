@@ -34,6 +34,29 @@ def test_a_ctrl_c_that_lands_while_the_worker_starts_is_a_cancel():
     assert stopped_by_cancel == [True]
 
 
+def test_work_that_stops_between_long_steps_says_it_is_stopping():
+    """generate stops at the end of a stage, up to a minute later: a Ctrl-C was met
+    with silence."""
+    cancel, said = threading.Event(), []
+    started = threading.Event()
+
+    def work():
+        started.set()
+        cancel.wait(10)
+        raise Cancelled("stopped")
+
+    def interrupt():
+        started.wait(10)
+        _thread.interrupt_main()
+
+    threading.Thread(target=interrupt).start()
+    with pytest.raises(Cancelled, match="nothing written"):
+        run_cancellable(work, cancel, "test-worker", Cancelled("nothing written"), lambda: said.append(1))
+    assert said == [1]
+    assert run_cancellable(lambda: 42, threading.Event(), "w", Cancelled("no"), lambda: said.append(2)) == 42
+    assert said == [1]  # nothing to say without a Ctrl-C
+
+
 def test_a_result_that_arrives_before_the_cancel_is_kept():
     cancel = threading.Event()
     assert run_cancellable(lambda: 42, cancel, "test-worker", Cancelled("no")) == 42

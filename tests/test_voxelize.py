@@ -406,10 +406,11 @@ def test_a_binary_stl_cut_short_says_so(tmp_path, header):
     trimesh.creation.box(extents=(1.0, 2.0, 3.0)).export(whole)
     data = header.ljust(80, b" ") + whole.read_bytes()[80:]
     cut = tmp_path / "cut.stl"
-    cut.write_bytes(data[: 84 + 50 * 5 + 20])
-    with pytest.raises(InputFileError) as caught:
-        load_mesh(cut)
-    assert str(caught.value) == (
-        f"{cut}: a binary STL cut short: its header counts 12 triangles (684 bytes), "
-        f"the file has {84 + 50 * 5 + 20} bytes"
-    )
+    for size in (84 + 50 * 5 + 20, 84):  # cut inside the triangles, or right after the header
+        cut.write_bytes(data[:size])
+        with pytest.raises(InputFileError) as caught:
+            load_mesh(cut)
+        assert str(caught.value) == (
+            f"{cut}: a binary STL cut short: its header counts 12 triangles (684 bytes), "
+            f"the file has {size} bytes"
+        )

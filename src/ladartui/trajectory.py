@@ -237,7 +237,7 @@ class LogSegment:
             )
             checked = []
             for i, (what, value, low, high, unit) in enumerate(parts):
-                if not (isinstance(value, float) and low <= value <= high):
+                if not low <= value <= high:  # nan too
                     # named origin[i] so the scenario's error points at the origin line
                     raise FieldError(f"origin[{i}]", value, f"a {what} from {low:g} to {high:g} {unit}")
                 checked.append(value)

@@ -59,7 +59,7 @@ def out_stem(out: str, preset: str) -> Path:
 def check_flags_used(args) -> None:
     """Refuse flags the scene would ignore, rather than drop them without a word."""
     if args.no_target and args.vehicles:
-        raise LadarError(f"--no-target: no vehicle, but --vehicles {args.vehicles} asks for {args.vehicles}")
+        raise LadarError(f"--no-target and --vehicles {args.vehicles} contradict each other: drop one")
     if args.camouflage and (args.no_target or args.vehicles == 0):
         raise LadarError("--camouflage: the net is draped over a vehicle, and there is none")
 
@@ -100,12 +100,18 @@ def run(args) -> int:
     las_files = [scene_file.with_suffix(".laz"), target_file.with_suffix(".laz")] if args.las else []
     check_writable(scene_file, target_file, *las_files)
     cancel = threading.Event()
+    errors = Console(stderr=True)
+
+    def stopping() -> None:  # a stage of a large scene can run for a minute
+        errors.print("stopping at the end of this stage...", highlight=False, markup=False)
+
     with sigterm_as_interrupt():
         scene, scene_path, target_path, (generated, written) = run_cancellable(
-            lambda: _work(args, stem, las_files, Console(stderr=True), cancel),
+            lambda: _work(args, stem, las_files, errors, cancel),
             cancel,
             "ladartui-generate",
             Cancelled(GENERATE_CANCELLED),
+            stopping,
         )
     import numpy as np
 
@@ -142,18 +148,21 @@ def _work(args, stem, las_files, console, cancel):
 
     from ladartui.cli.flags import as_flags
     from ladartui.cli.progress import progress_display
-    from ladartui.scene.generate import generate_scene
+    from ladartui.scene.generate import GENERATE_STAGES, generate_scene
 
     after = (TextColumn("{task.fields[done]}", markup=False), TimeElapsedColumn())
     with progress_display(console, after, transient=True, disable=not console.is_terminal) as bar:
         task = bar.add_task("generating", total=1.0, done="")
 
+        steps = len(GENERATE_STAGES) + 1  # the stages, then writing
+
         def report(stage: str, done: int, total: int) -> None:
-            if stage == "writing":  # rows written, as they go
-                bar.update(task, description=stage, completed=done / total, done=f"{done:,}/{total:,} lines")
+            if stage == "writing":  # rows of one file, then the other: the bar only moves on
+                share = max(bar.tasks[0].completed, (steps - 1 + done / max(total, 1)) / steps)
+                bar.update(task, description=stage, completed=share, done=f"{done:,}/{total:,} lines")
             else:  # stage ``done`` starts: the ones before it are over
                 shown = f"stage {done} of {total}"
-                bar.update(task, description=stage, completed=(done - 1) / total, done=shown)
+                bar.update(task, description=stage, completed=(done - 1) / steps, done=shown)
 
         started = time.perf_counter()
         typed = {name: getattr(args, name) for name in ("density", "trees", "voxel_size", "vehicles")}

@@ -39,12 +39,19 @@ def progress_display(console, after, description=None, **options):
     return Progress(description, BarColumn(bar_width=None), *after, console=console, expand=True, **options)
 
 
-def run_cancellable(work: Callable[[], T], cancel: threading.Event, name: str, cancelled: Cancelled) -> T:
+def run_cancellable(
+    work: Callable[[], T],
+    cancel: threading.Event,
+    name: str,
+    cancelled: Cancelled,
+    stopping: Callable[[], None] | None = None,
+) -> T:
     """``work()`` on a worker thread named ``name``; its result, or its error raised here.
 
-    On Ctrl-C the ``cancel`` event is set and the worker is awaited; if it had
-    not finished by then, ``cancelled`` is raised (a result that arrived first
-    is returned).
+    On Ctrl-C the ``cancel`` event is set, ``stopping()`` called (work that stops
+    only between long steps says so) and the worker awaited; if it had not
+    finished by then, ``cancelled`` is raised (a result that arrived first is
+    returned).
     """
     outcome: dict[str, Any] = {}  # "result" or "error"
     # Waited on instead of join(): a join interrupted by Ctrl-C can report the
@@ -68,6 +75,8 @@ def run_cancellable(work: Callable[[], T], cancel: threading.Event, name: str, c
             pass
     except KeyboardInterrupt:
         cancel.set()
+        if stopping is not None and not finished.is_set():
+            stopping()
         if worker.ident is not None:  # else it never ran a line: with cancel set, it writes nothing
             finished.wait()
         if "result" not in outcome:  # else it finished before it saw the cancel

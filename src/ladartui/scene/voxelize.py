@@ -179,15 +179,15 @@ def _check_stl_whole(path: Path) -> None:
     try:
         size = path.stat().st_size
         with open(path, "rb") as stream:
-            head = stream.read(84 + 50)
+            head = stream.read(84 + 50 * 10)
     except OSError:
         return  # the reader reports it
     if size < 84:
         return
     count = int.from_bytes(head[80:84], "little")
     need = 84 + 50 * count
-    if count == 0 or size >= need or not _BINARY_BYTES & set(head[84:]):
-        return  # whole, or text: an ASCII STL
+    if count == 0 or size >= need or (size > 84 and not _BINARY_BYTES & set(head[84:])):
+        return  # whole, or text: an ASCII STL (a bare header holds no triangle either way)
     raise InputFileError(
         path,
         f"a binary STL cut short: its header counts {count:,} triangles ({need:,} bytes), "
