@@ -567,11 +567,14 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
     # -- command palette -------------------------------------------------------------
 
     def get_system_commands(self, screen):
-        yield from super().get_system_commands(screen)
+        waiting = isinstance(screen, ModalScreen)  # a dialog or prompt waits for its answer
+        for command in super().get_system_commands(screen):
+            if not (waiting and command.callback == self.action_quit):  # quit would ask again
+                yield command
         if self.tool_screen is not None and screen is self.tool_screen:
             return  # the study and sweep screens have their own keys
-        if isinstance(screen, ModalScreen):
-            return  # a dialog or prompt waits for its answer: nothing may start under it
+        if waiting:
+            return  # nothing may start under it
         for title, help_text, action in palette_entries(self):
             yield SystemCommand(title, help_text, _runner(self, action))
 
