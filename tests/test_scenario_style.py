@@ -79,3 +79,41 @@ def test_save_as_keeps_the_comments_and_points_at_the_same_scene(folder, tmp_pat
 def test_text_that_is_not_toml_is_not_restyled():
     assert restyle("grid = = 3", {"grid": 3}) is None
     assert restyle("# kept\ngrid = 3\n", {"grid": 4}) == "# kept\ngrid = 4\n"
+
+
+def test_adding_a_segment_adds_its_lines_and_changes_no_other(folder):
+    """Adding a segment rewrote every segment: the orbit lost its comments and gained
+    'arc = 360.0', and an unused [flight.start] with float noise came after it."""
+    from ladartui.flight import Straight
+    from ladartui.tui import bridge
+
+    path = folder / "orbit.toml"
+    shutil.copy(SHIPPED / "orbit.toml", path)
+    before = path.read_text()
+    scenario = load_scenario(path)
+    segments = [*scenario.flight.segments, Straight(distance=100.0, scans=3)]
+    bridge.with_segments(scenario, segments).save()
+    added = changed_lines(before, path.read_text())
+    assert all(line.startswith("+") for line in added), added
+    assert [line for line in added if line.strip("+")] == [
+        "+[[flight.segments]]",
+        '+kind = "straight"',
+        "+distance = 100.0",
+        "+scans = 3",
+    ]
+    assert load_scenario(path).flight.start is None
+
+
+def test_deleting_or_editing_one_segment_keeps_the_others_comments(folder):
+    path = folder / "manoeuvres.toml"
+    shutil.copy(SHIPPED / "manoeuvres.toml", path)
+    before = path.read_text()
+    scenario = load_scenario(path)
+    first, turn, last = scenario.flight.segments
+    flight = dataclasses.replace(scenario.flight, segments=(first, dataclasses.replace(last, scans=5)))
+    scenario.with_changes(flight=flight).save()
+    changed = changed_lines(before, path.read_text())
+    assert "-scans = 4" in changed and "+scans = 5" in changed
+    assert all(line.startswith("-") for line in changed if line != "+scans = 5")  # the turn's lines went
+    assert "# at 30, 60 and 90 m along the run" in path.read_text()
+    assert load_scenario(path).flight.segments == flight.segments

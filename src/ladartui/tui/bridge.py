@@ -255,7 +255,7 @@ def segment_summary(segment) -> str:
 def with_segments(scenario: Scenario, segments) -> Scenario:
     """The scenario with a new segment list (checked by the scenario)."""
     start = scenario.flight.start
-    if start is None and any(s.relative for s in segments):
+    if start is None and segments and segments[0].relative:  # else no segment starts from it
         start = start_pose(scenario)
     return scenario.with_changes(flight=FlightPlan(start, tuple(segments)))
 
