@@ -117,3 +117,20 @@ def test_deleting_or_editing_one_segment_keeps_the_others_comments(folder):
     assert all(line.startswith("-") for line in changed if line != "+scans = 5")  # the turn's lines went
     assert "# at 30, 60 and 90 m along the run" in path.read_text()
     assert load_scenario(path).flight.segments == flight.segments
+
+
+def test_save_as_renames_the_files_the_programs_header_names(folder, tmp_path):
+    """'Check it with: ladartui validate noext.toml' stayed in the copy's header."""
+    scenario = load_scenario(SHIPPED / "orbit.toml", check_files=False)
+    first = scenario.with_changes(path=tmp_path / "noext.toml")
+    first.path.write_text(first.to_toml())
+    copy = load_scenario(first.path, check_files=False).save(tmp_path / "s1.toml")
+    text = copy.path.read_text()
+    assert text.startswith(copy.to_toml().split("\n\n")[0]) and "noext" not in text
+    # an analyst's own header stays as written
+    own = tmp_path / "own.toml"
+    own.write_text("# my notes on noext\n" + first.toml_body())
+    assert (
+        "# my notes on noext"
+        in load_scenario(own, check_files=False).save(tmp_path / "s2.toml").path.read_text()
+    )

@@ -336,14 +336,17 @@ class Scenario:
         return data
 
     def to_toml(self) -> str:
+        return self.header() + self.toml_body()
+
+    def header(self) -> str:
+        """The comment a new file starts with: how to check it, what a run writes."""
         # names in comments escaped: a control character there is not TOML
         name, scene, target = (one_line(p.name) for p in (self.path, self.scene_output, self.target_output))
         measures, record = one_line(self.measures_file.name), one_line(self.run_record.name)
-        header = (
+        return (
             f"# ladartui scenario. Check it with: ladartui validate {name}\n"
             f"# A run writes {scene}, {target}, {measures} and {record} beside this file.\n\n"
         )
-        return header + self.toml_body()
 
     def toml_body(self) -> str:
         """The TOML document without the header comments."""
@@ -368,6 +371,8 @@ class Scenario:
             text = restyle(
                 self.path.read_text(encoding="utf-8-sig"), scenario.to_dict(), _saved_data(self.path)
             )
+        if text is not None and text.startswith(self.header()):  # its names follow the file's
+            text = scenario.header() + text[len(self.header()) :]
         write_text_atomic(scenario.path, text if text is not None else scenario.to_toml())
         return scenario
 
