@@ -134,3 +134,13 @@ def test_save_as_renames_the_files_the_programs_header_names(folder, tmp_path):
         "# my notes on noext"
         in load_scenario(own, check_files=False).save(tmp_path / "s2.toml").path.read_text()
     )
+
+
+def test_a_save_that_cannot_be_written_names_the_file_not_its_temporary(tmp_path):
+    """'[Errno 2] No such file or directory: /proc/.a.toml.v5ert5rs.tmp'."""
+    from ladartui.errors import OutputFileError
+
+    scenario = load_scenario(SHIPPED / "orbit.toml", check_files=False)
+    with pytest.raises(OutputFileError) as caught:
+        scenario.save(Path("/proc/a.toml"))
+    assert str(caught.value).startswith("/proc/a.toml: cannot be written") and ".tmp" not in str(caught.value)

@@ -134,6 +134,12 @@ async def test_save_as_refuses_a_folder_and_clears_the_last_run_line(tmp_path, s
             said = message(dialog, "#save-as-message")
             assert said == f"{folder}: is a folder; expected a scenario file name", typed
         assert list(folder.iterdir()) == [] and not (tmp_path / "kept.toml").exists()
+        # a place that cannot be written keeps the dialog open, the error naming the file
+        dialog.query_one("#save-as-file").value = "/proc/a.toml"
+        await pilot.press("enter")
+        await pilot.pause()
+        assert app.screen is dialog
+        assert message(dialog, "#save-as-message").startswith("/proc/a.toml: cannot be written")
         dialog.query_one("#save-as-file").value = "kept/copy"
         await pilot.press("enter")
         await pilot.pause()

@@ -373,7 +373,11 @@ class Scenario:
             )
         if text is not None and text.startswith(self.header()):  # its names follow the file's
             text = scenario.header() + text[len(self.header()) :]
-        write_text_atomic(scenario.path, text if text is not None else scenario.to_toml())
+        try:
+            write_text_atomic(scenario.path, text if text is not None else scenario.to_toml())
+        except OSError as error:  # named as the file, not the temporary beside it
+            reason = os.strerror(error.errno) if error.errno else str(error)
+            raise OutputFileError(scenario.path, f"cannot be written ({reason.lower()})") from None
         return scenario
 
 

@@ -269,6 +269,12 @@ class SaveAsScreen(TreeDialog):
         if not path.parent.is_dir():
             message.update(f"{path.parent}: folder not found")
             return
+        from ladartui.outputset import output_problem
+
+        problem = output_problem(path)
+        if problem:  # said here, where the name can be changed
+            message.update(f"{path}: {problem}")
+            return
         if path.exists() and path != self.current.resolve() and self.confirmed != path:
             self.confirmed = path
             message.update(f"{path.name} exists: OK again replaces it")
