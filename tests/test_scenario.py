@@ -547,3 +547,28 @@ def test_a_target_id_named_twice_is_refused(tmp_path):
     scenario.path.write_text(text + '\n[targets]\nnames = { 1 = "alpha", 01 = "beta" }\n', encoding="utf-8")
     with pytest.raises(LadarError, match=r"targets\.names.*each target id once \(id 1 is named twice\)"):
         load_scenario(scenario.path)
+
+
+@pytest.mark.parametrize("key", ['"a[b"', '"[bold red]key"', '"x.y"'])
+def test_a_quoted_unknown_key_is_named_on_its_line_and_does_not_hang(tmp_path, key):
+    """A quoted key holding '[' sent the line finder into an endless loop."""
+    import threading
+
+    orbit = Path(__file__).resolve().parent.parent / "scenarios" / "orbit.toml"
+    path = tmp_path / "s.toml"
+    text = orbit.read_text().replace("[simulation]\n", f"[simulation]\n{key} = 1\n", 1)
+    path.write_text(text)
+    line = text.splitlines().index(f"{key} = 1") + 1
+    raised = []
+
+    def load():
+        try:
+            load_scenario(path, check_files=False)
+        except InputFileError as error:
+            raised.append(str(error))
+
+    worker = threading.Thread(target=load, daemon=True)
+    worker.start()
+    worker.join(20)
+    assert not worker.is_alive(), "load_scenario hung"
+    assert raised and raised[0].startswith(f"{path}:{line}: unknown key"), raised

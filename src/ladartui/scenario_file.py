@@ -162,7 +162,10 @@ class ScenarioReader:
         while key:
             if key in self.lines:
                 return self.lines[key]
-            key = re.sub(r"(\.[^.\[]+|\[\d+\])$", "", key) if re.search(r"[.\[]", key) else ""
+            shorter = re.sub(r"(\.[^.\[]+|\[\d+\])$", "", key)
+            if shorter == key:  # a part the pattern cannot take off ('a[b'): cut at its dot
+                shorter = key.rpartition(".")[0]
+            key = shorter
         return None
 
     def source(self, key):

@@ -11,7 +11,7 @@ import re
 from pathlib import Path
 
 _HEADER = re.compile(r"^\s*(\[\[?)\s*([A-Za-z0-9_.\-]+)\s*\]\]?")
-_KEY = re.compile(r"^\s*([A-Za-z0-9_\-]+)\s*=")
+_KEY = re.compile(r"""^\s*(?:([A-Za-z0-9_\-]+)|"([^"\\]*)"|'([^']*)')\s*=""")  # bare or quoted
 
 
 def key_lines(path: Path) -> dict[str, int]:
@@ -43,7 +43,8 @@ def key_lines_from_text(text: str) -> dict[str, int]:
             continue
         key = _KEY.match(line)
         if key:
-            lines.setdefault(f"{current}.{key.group(1)}" if current else key.group(1), number)
+            name = next(part for part in key.groups() if part is not None)
+            lines.setdefault(f"{current}.{name}" if current else name, number)
     return lines
 
 
