@@ -5,7 +5,9 @@ property-based fuzzers (hypothesis) over the voxel parser, the scenario
 loader, the sweep spec and the command line.
 """
 
+import json
 import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -408,6 +410,23 @@ def test_a_json_that_is_no_study_names_what_it_lacks(tmp_path):
     with pytest.raises(LadarError) as broken:
         read_study(tmp_path / "bad.json")
     assert str(broken.value).startswith(f"{tmp_path / 'bad.json'}:2: not JSON (")
+    # a RecursionError, an AttributeError and 'list indices' traceback or words before
+    good = json.loads((Path(__file__).parent.parent / "docs" / "study.json").read_text())
+    good["rows"][0]["misses"] = "x"
+    cases = {
+        "deep.json": "[" * 3000 + "]" * 3000,
+        "misses.json": json.dumps(good),
+        "list.json": "[1, 2]",
+        "latin.json": b'{"a": "\xe9"}',
+    }
+    for name, text in cases.items():
+        path = tmp_path / name
+        path.write_bytes(text if isinstance(text, bytes) else text.encode())
+        with pytest.raises(LadarError) as caught:
+            read_study(path)
+        said = str(caught.value)
+        assert said.startswith(f"{path}: ") and "\n" not in said and "list indices" not in said, said
+    assert "not UTF-8" in str(pytest.raises(LadarError, read_study, tmp_path / "latin.json").value)
 
 
 def test_validate_notes_an_empty_or_misplaced_target_model(tmp_path, capsys):

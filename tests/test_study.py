@@ -441,3 +441,16 @@ def test_cli_refuses_a_file_for_out_before_it_studies_and_shows_file_text_escape
     assert main(["study", "--chart-from", str(tampered), "--out", str(tmp_path / "rp")]) == 0
     out = capsys.readouterr().out
     assert "\x1b" not in out and "no gpu\\x1b[2J [b]here[/b]" in out.replace("\n", "")
+
+
+def test_every_text_of_a_study_file_reaches_the_terminal_escaped(tmp_path, capsys):
+    """The reference label went into the table's title raw: ESC [31m coloured the terminal."""
+    from ladartui.cli import main
+
+    data = json.loads((Path(__file__).parent.parent / "docs" / "study.json").read_text())
+    data["reference"]["label"] = "\x1b[31mX [b]y[/b]"
+    tampered = tmp_path / "label.json"
+    tampered.write_text(json.dumps(data))
+    assert main(["study", "--chart-from", str(tampered), "--out", str(tmp_path / "o")]) == 0
+    out = capsys.readouterr().out
+    assert "\x1b" not in out and "[b]y[/b]" in out

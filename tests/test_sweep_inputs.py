@@ -234,3 +234,22 @@ def test_the_check_reads_the_target_model_not_the_scene(tmp_path, monkeypatch):
     )
     assert main(["sweep", str(good), "--serial", "--out", str(tmp_path / "good"), "--json"]) == 0
     assert loads == [1]  # the sweep's own
+
+
+def test_show_prints_text_from_the_results_table_as_text(tmp_path, capsys):
+    """A cell holding an escape sequence reached the terminal raw (a window title change,
+    a colour), and one holding [markup] was read as markup."""
+    from ladartui.cli import main
+
+    write_tiny_scenario(tmp_path)
+    spec = write_spec(tmp_path, "[grid]\nradius = [20.0, 30.0]\nsensor_grid = [0, 8]\n", name="esc.toml")
+    run_sweep(spec, serial=True)
+    results = tmp_path / "esc-results" / "results.csv"
+    rows = results.read_text(encoding="utf-8").splitlines()
+    rows[1:] = [row.replace(",20.0,", ",\x1b]0;pwn\x07[bold]20,") for row in rows[1:]]
+    rows[1:] = [row.replace("expected", "expected \x1b[31m[red]") for row in rows[1:]]
+    results.write_text("\n".join(rows) + "\n", encoding="utf-8")
+    assert main(["sweep", str(spec), "--show"]) == 0
+    out = capsys.readouterr().out
+    assert "\x1b" not in out and "\x07" not in out
+    assert "[bold]" in out and "[red]" in out  # shown as typed, not taken as markup

@@ -148,7 +148,8 @@ def _report(result, out_dir) -> int:
         console = Console(width=CHART_WIDTH + 20)  # a log file: no need to wrap at 80
     width = max(60, min(console.width, CHART_WIDTH))
     console.print(Text.from_ansi(chart_text(result, width, CHART_HEIGHT, color=console.is_terminal)))
-    table = Table(title="Settings (coverage error against " + (result.reference_label or "-") + ")")
+    label = Text(visible(f"Settings (coverage error against {result.reference_label or '-'})"))
+    table = Table(title=label)  # the label is read from a file: never markup
     for column in TABLE_COLUMNS:
         table.add_column(
             column, justify="right" if column in ("s/scan", "rays/s", "differ", "cov. error") else "left"

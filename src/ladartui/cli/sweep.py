@@ -354,6 +354,7 @@ def show_result(console, result, top) -> None:
     """The top of the ranking, the Pareto front, failures and the files written."""
     from rich import box
     from rich.table import Table
+    from rich.text import Text
 
     from ladartui.sweep.columns import target_ids
     from ladartui.sweep.ranking import OBJECTIVE_HEADERS as short
@@ -390,12 +391,16 @@ def show_result(console, result, top) -> None:
         f"{'time' if cost_unit == 's' else 'dist.'} {cost_unit}", [display_cell(r.cost, 4) for r in shown]
     )
     table.add_column("front")
+
+    def read(value) -> Text:  # text read from the results table: never markup or escapes
+        return Text(visible(value))
+
     for ranked in shown:
         row = ranked.row
         table.add_row(
             str(ranked.rank),
-            str(row.get("variant", ""))[:8],
-            *(display_cell(row.get(n)) for n in result.parameter_names),
+            read(str(row.get("variant", ""))[:8]),
+            *(read(display_cell(row.get(n))) for n in result.parameter_names),
             *([display_cell(ranked.value)] if separate else []),
             *([f"{identified_count(row)}/{len(target_ids(row))}"] if several else []),
             display_cell(ranked.coverage, 3),
@@ -411,8 +416,9 @@ def show_result(console, result, top) -> None:
             for r in front
         )
         console.print(
-            f"Pareto front of obscured coverage against {result.cost}, cheapest first: {points}",
+            visible(f"Pareto front of obscured coverage against {result.cost}, cheapest first: {points}"),
             highlight=False,
+            markup=False,
         )
     unranked = sum(1 for r in result.ranking if r.rank is None and r.row.get("status") == "ok")
     if unranked:
@@ -424,7 +430,9 @@ def show_result(console, result, top) -> None:
         console.print(f"{unranked} finished variant(s) not ranked ({reason})", highlight=False)
         missed = never_identified(result.rows)
         if missed and result.objective in ("time-to-identify", "distance-to-identify"):
-            console.print("no variant identifies " + ", ".join(missed), highlight=False, markup=False)
+            console.print(
+                visible("no variant identifies " + ", ".join(missed)), highlight=False, markup=False
+            )
     for rows, what in (
         (result.impossible, "with impossible values (kept as errors, not run again)"),
         (result.failed, "failed (run again when the sweep resumes)"),
@@ -432,7 +440,7 @@ def show_result(console, result, top) -> None:
         if rows:
             console.print(
                 f"[bold]{len(rows)} variant(s) {what}[/]; first: "
-                + escape(f"{rows[0].get('variant')}: {rows[0].get('error')}"),
+                + escape(visible(f"{rows[0].get('variant')}: {rows[0].get('error')}")),
                 highlight=False,
             )
     if result.ran or result.resumed:

@@ -345,14 +345,20 @@ def read_study(path) -> StudyResult:
 
     try:
         data = json.loads(Path(path).read_text(encoding="utf-8"))
+        if not isinstance(data, dict):
+            raise InputFileError(path, f"a JSON {type(data).__name__}, not an object; {STUDY_JSON}")
         return StudyResult.from_dict(data)
     except OSError as error:
         raise InputFileError(path, f"cannot read it ({error.strerror})") from None
+    except UnicodeDecodeError:
+        raise InputFileError(path, f"not UTF-8 text; {STUDY_JSON}") from None
     except json.JSONDecodeError as error:
         raise InputFileError(path, f"not JSON ({error.msg}); {STUDY_JSON}", error.lineno) from None
+    except RecursionError:
+        raise InputFileError(path, f"nested too deep to read; {STUDY_JSON}") from None
     except KeyError as error:
         raise InputFileError(path, f"no {error.args[0]!r} entry; {STUDY_JSON}") from None
-    except (ValueError, TypeError) as error:
+    except (ValueError, TypeError, AttributeError, IndexError) as error:
         raise InputFileError(path, f"a value of the wrong kind ({error}); {STUDY_JSON}") from None
 
 
