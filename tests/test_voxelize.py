@@ -414,3 +414,38 @@ def test_a_binary_stl_cut_short_says_so(tmp_path, header):
             f"{cut}: a binary STL cut short: its header counts 12 triangles (684 bytes), "
             f"the file has {size} bytes"
         )
+
+
+CUBE_OBJ = "".join(f"v {x} {y} {z}\n" for x in (0, 1) for y in (0, 1) for z in (0, 1)) + "".join(
+    f"f {a} {b} {c}\n"
+    for a, b, c in [
+        (1, 3, 2), (2, 3, 4), (5, 6, 7), (6, 8, 7), (1, 2, 5), (2, 6, 5),
+        (3, 7, 4), (4, 7, 8), (1, 5, 3), (3, 5, 7), (2, 4, 6), (4, 8, 6),
+    ]
+)  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("change", "said"),
+    [
+        (("v 0 0 1\n", "v nan 0 1\n"), ":2: vertex 'v nan 0 1': expected x, y, z as finite numbers"),
+        (("f 1 3 2\n", "f 0 3 2\n"), ":9: face 'f 0 3 2' refers to vertex 0: expected 1 to 8"),
+        (("v 0 0 1\n", "v 0 0\n"), ":2: vertex 'v 0 0': expected x, y, z"),
+    ],
+)
+def test_a_bad_obj_line_is_named_even_where_the_reader_gets_past_it(tmp_path, change, said):
+    """A nan vertex lost its faces without a word, a face index 0 was taken, and a
+    vertex of two numbers ended in 'cannot reshape array' (the reader read on)."""
+    path = tmp_path / "cube.obj"
+    assert change[0] in CUBE_OBJ
+    path.write_text(CUBE_OBJ.replace(change[0], change[1], 1))
+    with pytest.raises(InputFileError) as caught:
+        load_mesh(path)
+    assert str(caught.value).startswith(f"{path}{said}")
+
+
+def test_a_good_obj_cube_is_read_whole(tmp_path):
+    path = tmp_path / "cube.obj"
+    path.write_text(CUBE_OBJ)
+    mesh = load_mesh(path)
+    assert mesh.faces.shape == (12, 3) and mesh.closed

@@ -103,6 +103,8 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
         raise InputFileError(path, f"no such file; expected a mesh file ({kind})")
     if kind == ".stl":
         _check_stl_whole(path)
+    if kind == ".obj":  # the reader drops a nan vertex's faces and takes face index 0
+        check_obj_lines(path)
     import trimesh
 
     try:
@@ -114,16 +116,12 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
             # so that closedness can be checked on the shared edges.
             loaded = trimesh.load(_as_utf8(path, kind), file_type=kind[1:], force="mesh", process=True)
     except Exception as error:  # trimesh's parsers raise many kinds on malformed text
-        if kind == ".obj":  # trimesh names neither the line nor the problem
-            check_obj_lines(path)
         raise InputFileError(
             path, f"not a readable {kind[1:].upper()} mesh ({type(error).__name__}: {error})"
         ) from None
     faces = np.asarray(getattr(loaded, "faces", np.zeros((0, 3))), dtype=np.int64).reshape(-1, 3)
     vertices = np.asarray(getattr(loaded, "vertices", np.zeros((0, 3))), dtype=np.float64).reshape(-1, 3)
     if len(faces) == 0:
-        if kind == ".obj":  # a vertex that is not finite leaves trimesh no triangles
-            check_obj_lines(path)
         raise InputFileError(path, "holds no triangles; expected a triangle mesh")
     if not np.all(np.isfinite(vertices)):
         bad = int(np.count_nonzero(~np.all(np.isfinite(vertices), axis=1)))
@@ -199,8 +197,8 @@ def check_obj_lines(path: Path) -> None:
     """``InputFileError`` at the first vertex or face line of an OBJ file that is
     malformed: a vertex without three finite numbers, a face whose vertex numbers
     are not integers or lie outside the file's vertices (1..V, or -1..-V counting
-    back from the latest). Called once the mesh reader has failed, so a good file
-    is read once."""
+    back from the latest). Called before the mesh reader, which reads past such
+    lines (a nan vertex's faces dropped, index 0 taken) or fails naming none."""
     try:
         text = path.read_text(encoding="utf-8", errors="replace")
     except OSError as error:
