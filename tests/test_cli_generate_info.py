@@ -35,6 +35,15 @@ def test_generate_accepts_a_txt_stem_and_options(tmp_path, capsys):
     assert "no target" in out and "terrain" in out
 
 
+def test_generate_refuses_an_empty_out(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert main(["generate", "small", ""]) == 2
+    assert (
+        capsys.readouterr().err == "ladartui: error: OUT = '': expected a name such as dir/name or a folder\n"
+    )
+    assert not list(tmp_path.iterdir())
+
+
 @pytest.mark.parametrize(
     ("flags", "message"),
     [

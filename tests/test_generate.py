@@ -172,6 +172,9 @@ def test_to_scene_keeps_the_grid(small):
         ({"crown_radius": (4.0, 2.0)}, "crown_radius = (4.0, 2.0): expected (low, high) positive"),
         ({"leaves": 3}, "leaves = 3: expected a scene parameter: "),
         ({"width": 5.0}, "width = 5.0: expected room for the vehicle"),
+        # a vehicle lost at 30 m voxels ('no target'), nothing left at 1000 m (a traceback)
+        ({"voxel_size": 30.0}, "voxel_size = 30.0: expected at most 1.1 m (half the vehicle's"),
+        ({"voxel_size": 1000.0, "vehicles": 0}, "voxel_size = 1000.0: expected at most 7.5 m (an eighth"),
     ],
 )
 def test_bad_overrides_name_the_field(overrides, message):

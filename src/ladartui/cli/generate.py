@@ -6,7 +6,7 @@ import os
 import time
 from pathlib import Path
 
-from ladartui.errors import LadarError
+from ladartui.errors import FieldError, LadarError
 from ladartui.textsafe import visible
 
 
@@ -95,6 +95,8 @@ def run(args) -> int:
     from ladartui.scene.generate import GENERATE_CANCELLED, output_paths
 
     check_flags_used(args)
+    if not args.out.strip():
+        raise FieldError("OUT", args.out, "a name such as dir/name or a folder")
     stem = out_stem(args.out, args.preset)
     scene_file, target_file = output_paths(stem)
     las_files = [scene_file.with_suffix(".laz"), target_file.with_suffix(".laz")] if args.las else []

@@ -284,6 +284,10 @@ def _check(p: SceneParams):
         or not all(isinstance(v, (int, float)) and v > 0 for v in p.vehicle_size)
     ):
         raise FieldError("vehicle_size", p.vehicle_size, "(length, width, height) positive metres")
+    coarsest = min(p.vehicle_size) / 2 if p.vehicles else min(p.width, p.depth) / 8
+    if p.voxel_size > coarsest:
+        why = "half the vehicle's smallest side" if p.vehicles else "an eighth of the scene's side"
+        raise FieldError("voxel_size", p.voxel_size, f"at most {coarsest:g} m ({why})")
     cells = (p.width / p.voxel_size) * (p.depth / p.voxel_size)
     if cells > 1e8:
         raise FieldError("voxel_size", p.voxel_size, "a size giving at most 1e8 ground cells")
