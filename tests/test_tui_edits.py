@@ -290,3 +290,24 @@ def test_fitted_shortens_the_name_given_then_cuts_the_end_in_cells():
     shown = fitted("sweep stopped: " + "x" * 100, 40)
     assert cell_len(shown) == 40 and shown.endswith("\u2026")
     assert fitted("short", 40, "short") == "short"
+
+
+def test_keys_toml_problems_are_named_on_their_line_never_a_crash(tmp_path):
+    """A keys.toml not in UTF-8 ended the app with a traceback, one nested 3000 deep in a
+    RecursionError; two commands on one key, and a misspelt [keyz], passed without a word."""
+    from ladartui.tui.actions import load_keymap
+
+    keys = tmp_path / "keys.toml"
+    keys.write_bytes(b'[keys]\nrun = "\xe9"\n')
+    keymap, problems = load_keymap(tmp_path)
+    assert keymap == {} and len(problems) == 1 and "not UTF-8" in problems[0]
+    keys.write_text("a = " + "[" * 3000 + "]" * 3000 + "\n")
+    keymap, problems = load_keymap(tmp_path)
+    assert keymap == {} and len(problems) == 1 and "nested too deep" in problems[0]
+    keys.write_text('[keyz]\nrun = "f9"\n\n[keys]\n\nrun = "ctrl+s"\nlayout = "ctrl+l"\n')
+    keymap, problems = load_keymap(tmp_path)
+    assert problems[0] == f"{keys}:1: [keyz]: no such table; expected [keys]"
+    assert (
+        problems[1].startswith(f"{keys}:6: keys.run = 'ctrl+s': also the key of ") and "save" in problems[1]
+    )
+    assert keymap == {"layout": "ctrl+l"}  # the clash is left out: the default stays

@@ -8,7 +8,7 @@ user's ``keys.toml`` changes the footer, the palette and the help together:
 
     # ~/.config/ladartui/keys.toml  ($LADARTUI_HOME/config/keys.toml)
     [keys]
-    run = "f9"            # binding id = key (or "key1,key2")
+    run = "ctrl+r"        # binding id = key (or "key1,key2")
     threshold = "t"
 """
 
@@ -22,6 +22,7 @@ from pathlib import Path
 from textual.binding import Binding, BindingType
 
 from ladartui.textsafe import one_line
+from ladartui.toml_lines import key_lines_from_text
 from ladartui.tui import bridge
 from ladartui.tui.view_area import LAYOUTS
 from ladartui.user_data import config_folder
@@ -252,38 +253,71 @@ def help_rows(
 def load_keymap(folder: Path | None = None) -> tuple[dict[str, str], list[str]]:
     """The user's key remapping from ``keys.toml``, and one line per problem found.
 
-    A missing file is no remapping; a damaged one, an unknown command id or a
-    key that is not text is reported and left out, never fatal.
+    A missing file is no remapping; a damaged one, an unknown table or command
+    id, a key that is not text, or one another command has, is reported (on its
+    line) and left out, never fatal.
     """
     path = (folder or config_folder()) / KEYS_FILE
     try:
         text = path.read_text(encoding="utf-8-sig")
     except FileNotFoundError:
         return {}, []
+    except UnicodeDecodeError:
+        return {}, [f"{path}: not UTF-8 text"]
     except OSError as error:
         return {}, [one_line(f"{path}: {error.strerror or error}")]
     try:
         document = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
         return {}, [one_line(f"{path}: {error}")]
+    except RecursionError:
+        return {}, [f"{path}: nested too deep to read"]
+    lines = key_lines_from_text(text)
+
+    def at(key: str) -> str:
+        return f"{path}:{lines[key]}" if key in lines else str(path)
+
+    problems = [
+        one_line(f"{at(name)}: [{name}]: no such table; expected [keys]")
+        for name in document
+        if name != "keys"
+    ]
     table = document.get("keys", {})
     if not isinstance(table, dict):
-        return {}, [f"{path}: [keys] must be a table of command id = key"]
-    keymap, problems = {}, []
+        return {}, [*problems, f"{at('keys')}: [keys] must be a table of command id = key"]
+    keymap = {}
     for command_id, key in table.items():
+        where = at(f"keys.{command_id}")
         if command_id not in BY_ID:
             problems.append(
                 one_line(
-                    f"{path}: keys.{command_id}: no such command; expected one of " + ", ".join(sorted(BY_ID))
+                    f"{where}: keys.{command_id}: no such command; expected one of "
+                    + ", ".join(sorted(BY_ID))
                 )
             )
         elif not isinstance(key, str) or not all(KEY_NAME.fullmatch(k.strip()) for k in key.split(",")):
             problems.append(
-                one_line(f'{path}: keys.{command_id} = {key!r}: expected a key name such as "f9" or "ctrl+r"')
+                one_line(
+                    f'{where}: keys.{command_id} = {key!r}: expected a key name such as "f9" or "ctrl+r"'
+                )
             )
         else:
             keymap[command_id] = key.strip()
+    for command_id in list(keymap):  # in file order: a later remap may free a key
+        mine = _key_set(keymap[command_id])
+        taken = [c for c, keys in keys_in_force(keymap).items() if c != command_id and mine & _key_set(keys)]
+        if taken:
+            problems.append(
+                one_line(
+                    f"{at(f'keys.{command_id}')}: keys.{command_id} = {keymap.pop(command_id)!r}: also the key "
+                    f"of {', '.join(taken)}; remap that too, or choose another"
+                )
+            )
     return keymap, problems
+
+
+def _key_set(keys: str) -> set[str]:
+    return {key.strip() for key in keys.split(",")}
 
 
 def key_hint(command_id: str, keymap: dict[str, str] | None = None, short: bool = False) -> str:
