@@ -307,9 +307,10 @@ def load_keymap(folder: Path | None = None) -> tuple[dict[str, str], list[str]]:
         mine = _key_set(keymap[command_id])
         taken = [c for c, keys in keys_in_force(keymap).items() if c != command_id and mine & _key_set(keys)]
         if taken:
+            key = keymap.pop(command_id)
             problems.append(
                 one_line(
-                    f"{at(f'keys.{command_id}')}: keys.{command_id} = {keymap.pop(command_id)!r}: also the key "
+                    f"{at(f'keys.{command_id}')}: keys.{command_id} = {key!r}: also the key "
                     f"of {', '.join(taken)}; remap that too, or choose another"
                 )
             )
