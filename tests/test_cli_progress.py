@@ -57,6 +57,31 @@ def test_work_that_stops_between_long_steps_says_it_is_stopping():
     assert said == [1]  # nothing to say without a Ctrl-C
 
 
+def test_a_second_ctrl_c_waits_for_the_work_it_would_cut_short():
+    """Two Ctrl-C's (or timeout's SIGINT to the whole group) let the command exit while
+    the writer still renamed files: 'interrupted', and yet a new set in place."""
+    cancel, seen = threading.Event(), []
+    started = threading.Event()
+
+    def work():  # a write that, once begun, finishes whatever the cancel says
+        started.set()
+        cancel.wait(10)
+        _thread.interrupt_main()  # the second Ctrl-C, while it finishes
+        seen.append(cancel.is_set())
+        import time
+
+        time.sleep(0.3)
+        return "written"
+
+    def interrupt():
+        started.wait(10)
+        _thread.interrupt_main()
+
+    threading.Thread(target=interrupt).start()
+    assert run_cancellable(work, cancel, "test-worker", Cancelled("nothing written")) == "written"
+    assert seen == [True]
+
+
 def test_a_result_that_arrives_before_the_cancel_is_kept():
     cancel = threading.Event()
     assert run_cancellable(lambda: 42, cancel, "test-worker", Cancelled("no")) == 42

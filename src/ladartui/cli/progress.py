@@ -75,15 +75,28 @@ def run_cancellable(
             pass
     except KeyboardInterrupt:
         cancel.set()
-        if stopping is not None and not finished.is_set():
-            stopping()
         if worker.ident is not None:  # else it never ran a line: with cancel set, it writes nothing
-            finished.wait()
+            _wait_out_interrupts(finished, stopping)
         if "result" not in outcome:  # else it finished before it saw the cancel
             raise cancelled from None
     if "error" in outcome:
         raise outcome["error"]
     return outcome["result"]
+
+
+def _wait_out_interrupts(finished: threading.Event, stopping: Callable[[], None] | None) -> None:
+    """Wait for cancelled work to stop, whatever more Ctrl-C's come (a second key, or
+    timeout's SIGINT to the whole group): leaving while it writes would cut a set's
+    renames short, and the message would not say what was written."""
+    while True:
+        try:
+            if stopping is not None and not finished.is_set():
+                say, stopping = stopping, None
+                say()
+            finished.wait()
+            return
+        except KeyboardInterrupt:
+            continue
 
 
 # The signal that stopped the command (SIGINT unless SIGTERM did): its exit status is
