@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import dataclasses
 import io
 import json
 import math
@@ -454,3 +455,25 @@ def test_every_text_of_a_study_file_reaches_the_terminal_escaped(tmp_path, capsy
     assert main(["study", "--chart-from", str(tampered), "--out", str(tmp_path / "o")]) == 0
     out = capsys.readouterr().out
     assert "\x1b" not in out and "[b]y[/b]" in out
+
+
+def test_a_study_is_written_as_one_set(tmp_path, monkeypatch):
+    """study.csv and study.json were replaced before the charts were drawn: a Ctrl-C or a
+    failure then left this study's tables beside the last one's charts."""
+    from ladartui.study.results import read_study
+    from ladartui.study.run import write_outputs
+
+    result = read_study(Path(__file__).parent.parent / "docs" / "study.json")
+    paths = write_outputs(result, tmp_path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(p.name for p in paths.values())
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    from ladartui.study import figure
+
+    def broken(result):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(figure, "speed_accuracy_figure", broken)
+    changed = dataclasses.replace(result, reference_label="another")
+    with pytest.raises(OSError):
+        write_outputs(changed, tmp_path)
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before

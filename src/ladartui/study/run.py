@@ -15,6 +15,7 @@ its error is taken against exact float64 numba at the largest ray grid.
 from __future__ import annotations
 
 import datetime
+import json
 import os
 import platform
 import threading
@@ -260,19 +261,29 @@ def _context(inputs: StudyInputs, runs, warmup, reasons) -> dict:
 def write_outputs(
     result: StudyResult, out_dir, chart_stem="speed-accuracy", stem="study", width=100, height=30
 ) -> dict[str, Path]:
-    """Write the CSV, JSON, plotted chart (SVG, PNG) and plain-text chart atomically into ``out_dir``."""
-    from ladartui.atomic import write_text_atomic
-    from ladartui.charts import save_figure
+    """Write the CSV, JSON, plotted chart (SVG, PNG) and plain-text chart into ``out_dir``
+    as one output set: all five replaced, or none (a Ctrl-C while they are written
+    leaves the earlier study whole)."""
+    from ladartui.charts import figure_bytes
+    from ladartui.outputset import OutputSet
     from ladartui.study.chart import chart_text
     from ladartui.study.figure import speed_accuracy_figure
 
-    paths = result.write(out_dir, stem)
     out_dir = Path(out_dir)
     figure = speed_accuracy_figure(result)
-    for fmt in ("svg", "png"):
-        paths[fmt] = save_figure(figure, out_dir / f"{chart_stem}.{fmt}")
-    paths["txt"] = out_dir / f"{chart_stem}.txt"
-    write_text_atomic(
-        paths["txt"], chart_text(result, width, height, color=False) + "\n\n" + result.verdict() + "\n"
-    )
+    contents = {
+        "csv": result.to_csv().encode("utf-8"),
+        "json": (json.dumps(result.to_dict(), indent=1, allow_nan=False) + "\n").encode("utf-8"),
+        "svg": figure_bytes(figure, "svg"),
+        "png": figure_bytes(figure, "png"),
+        "txt": (chart_text(result, width, height, color=False) + "\n\n" + result.verdict() + "\n").encode(),
+    }
+    names = {"csv": f"{stem}.csv", "json": f"{stem}.json", "txt": f"{chart_stem}.txt"}
+    paths = {kind: out_dir / names.get(kind, f"{chart_stem}.{kind}") for kind in contents}
+
+    def writer(kind: str):
+        return lambda tmp: Path(tmp).write_bytes(contents[kind])
+
+    with OutputSet(paths, out_dir / f".{stem}.outputs.lock") as output_set:
+        output_set.write({kind: writer(kind) for kind in paths})
     return paths
