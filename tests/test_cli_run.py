@@ -137,6 +137,24 @@ def test_an_unwritable_chart_is_refused_before_anything_runs(scenario, capsys, t
     assert not scenario.measures_file.exists() and not scenario.scene_output.exists()
 
 
+def test_a_chart_that_fails_after_the_run_says_the_outputs_were_written(scenario, capsys, monkeypatch):
+    """A full disk at the chart said only '--chart: expected a writable path', with the
+    run's four outputs already replaced and its measures never shown."""
+    from ladartui import charts
+
+    def full(figure, path):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(charts, "save_figure", full)
+    chart = scenario.path.with_name("c.svg")
+    assert main(["run", str(scenario.path), "--chart", str(chart)]) == 2
+    captured = capsys.readouterr()
+    assert "obscured" in captured.out.lower()  # the measures are shown
+    err = captured.err.strip().splitlines()[-1]
+    assert err.startswith(f"ladartui: error: {chart}: the chart was not written (no space left on device);")
+    assert f"the run wrote {scenario.scene_output}" in err and scenario.measures_file.is_file()
+
+
 def test_paths_with_markup_are_printed_as_they_are(tmp_path, capsys):
     from ladartui.flight import FlightPlan, Manual, ScanPose, aim_at
 

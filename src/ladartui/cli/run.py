@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 
 from ladartui.cli.flags import as_flags
 from ladartui.cli.progress import FIRST_SCAN, progress_display, run_cancellable, sigterm_as_interrupt
-from ladartui.errors import Cancelled
+from ladartui.errors import Cancelled, OutputFileError
 from ladartui.textsafe import visible
 
 if TYPE_CHECKING:
@@ -98,19 +98,28 @@ def run(args) -> int:
     finished: list[SimulationResult] = []  # the result, once there is one
     with _told_if_finished(finished):  # a Ctrl-C from then on says what the run wrote
         result = _simulate_with_progress(scenario, args, errors, finished)
+        chart_error = None
         if args.chart is not None:
-            from ladartui.charts import save_figure
+            from ladartui import charts
             from ladartui.charts.coverage import coverage_figure
 
             try:
-                path = save_figure(coverage_figure(result.measures), args.chart)
-            except OSError as error:
-                raise FieldError("--chart", args.chart, f"a writable path ({error.strerror})") from None
-            errors.print(visible(f"wrote chart: {path}"), highlight=False, markup=False, soft_wrap=True)
+                path = charts.save_figure(coverage_figure(result.measures), args.chart)
+                errors.print(visible(f"wrote chart: {path}"), highlight=False, markup=False, soft_wrap=True)
+            except OSError as error:  # the run's outputs are written: say so, and show them
+                reason = (error.strerror or str(error)).lower()
+                written = (
+                    ", ".join(str(p) for p in result.outputs.values()) or "no scenario outputs (--no-write)"
+                )
+                chart_error = OutputFileError(
+                    args.chart, f"the chart was not written ({reason}); the run wrote {written}"
+                )
         if args.json:
             print(json.dumps(result_dict(scenario, result), indent=2, allow_nan=False))
         else:
             show_result(Console(), result)
+        if chart_error is not None:
+            raise chart_error
     return 0
 
 
