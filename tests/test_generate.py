@@ -273,3 +273,22 @@ def test_write_replaces_both_files_or_neither(tmp_path, small, monkeypatch):
         other.write(tmp_path / "forest")
     assert (scene_path.read_bytes(), target_path.read_bytes()) == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["forest.txt", "forest_Target.txt"]
+
+
+def test_a_scene_too_large_for_the_memory_is_refused_before_its_trees_are_made(monkeypatch):
+    """--trees 100000 ran past 8 GB (about 11 GB at its peak) with no estimate."""
+    from ladartui.errors import ResourceLimitError
+    from ladartui.scene import trees
+
+    made = []
+    monkeypatch.setattr(trees, "foliage_voxels", lambda *a: made.append(1))
+    monkeypatch.setenv("LADARTUI_MAX_MEMORY", str(200 * 2**20))
+    with pytest.raises(ResourceLimitError) as caught:
+        generate_scene("small", trees=5000)
+    message = str(caught.value)
+    assert (
+        message.startswith("generating 5,000 trees (about ")
+        and "more than the 0.195 GiB of memory" in message
+    )
+    assert made == []
+    generate_scene("small", trees=20)  # a small one fits
