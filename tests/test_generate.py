@@ -292,3 +292,29 @@ def test_a_scene_too_large_for_the_memory_is_refused_before_its_trees_are_made(m
     )
     assert made == []
     generate_scene("small", trees=20)  # a small one fits
+
+
+def test_las_copies_are_part_of_the_set(tmp_path, small, monkeypatch):
+    """The .laz copies were written after the models, outside their set: a Ctrl-C there
+    left new models beside old copies (and a killed run a temporary no run removed)."""
+    laspy = pytest.importorskip("laspy")
+    from ladartui.scene import las
+
+    small.write(tmp_path / "forest", las=True)
+    names = ["forest.laz", "forest.txt", "forest_Target.laz", "forest_Target.txt"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == names
+    with laspy.open(tmp_path / "forest.laz") as reader:
+        assert reader.header.are_points_compressed and reader.header.point_count == len(small.voxels)
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    real, calls = las.export_las, []
+
+    def fail_on_second(*args, **options):
+        calls.append(1)
+        if len(calls) == 2:
+            raise OSError(28, "No space left on device")
+        real(*args, **options)
+
+    monkeypatch.setattr(las, "export_las", fail_on_second)
+    with pytest.raises(OutputFileError):
+        generate_scene("small", seed=3, trees=5).write(tmp_path / "forest", las=True)
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before

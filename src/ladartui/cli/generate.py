@@ -143,9 +143,8 @@ def run(args) -> int:
 
 
 def _work(args, stem, las_files, console, cancel):
-    """Generate (with a stage bar on a terminal), write the pair, then the LAS copies
-    (once the pair is written they are written too: a Ctrl-C then waits for them);
-    on the worker thread."""
+    """Generate (with a stage bar on a terminal) and write the models, with their LAS
+    copies when asked, as one set; on the worker thread."""
     from rich.progress import TextColumn, TimeElapsedColumn
 
     from ladartui.cli.flags import as_flags
@@ -174,12 +173,6 @@ def _work(args, stem, las_files, console, cancel):
             )
         generated = time.perf_counter() - started
         started = time.perf_counter()
-        scene_path, target_path = scene.write(stem, cancel, report)
+        scene_path, target_path = scene.write(stem, cancel, report, las=bool(las_files))
         written = time.perf_counter() - started
-        if las_files:
-            from ladartui.scene.las import export_las
-
-            bar.update(task, description="writing LAS copies", done="")
-            export_las(las_files[0], scene.voxels, scene.voxel_size)
-            export_las(las_files[1], scene.target, scene.voxel_size, ids=scene.ids())
         return scene, scene_path, target_path, (generated, written)

@@ -104,10 +104,11 @@ class GeneratedScene:
             return np.ones(len(self.target), dtype=np.int32)
         return self.target_ids
 
-    def write(self, stem, cancel=None, progress=None) -> tuple[Path, Path]:
-        """Write ``stem.txt`` and ``stem_Target.txt`` as one set (both or neither); returns
-        both paths. ``progress("writing", rows, of)`` and ``cancel`` as in
-        ``scene.model_files.write_model_pair``.
+    def write(self, stem, cancel=None, progress=None, las=False) -> tuple[Path, Path]:
+        """Write ``stem.txt`` and ``stem_Target.txt`` (with ``las``, ``stem.laz`` and
+        ``stem_Target.laz`` too: voxel centres, target ids as point source ids) as one set:
+        all or none. Returns the two models' paths. ``progress("writing", rows, of)`` and
+        ``cancel`` as in ``scene.model_files.write_model_pair``.
 
         The target model carries an id column when there is more than one vehicle.
         """
@@ -115,7 +116,16 @@ class GeneratedScene:
 
         scene_path, target_path = output_paths(stem)
         ids = self.ids() if self.params.vehicles > 1 else None
-        write_model_pair(scene_path, target_path, self.voxels, self.target, ids, cancel, progress)
+        also = {}
+        if las:
+            from ladartui.scene.las import export_las
+
+            vs = self.voxel_size
+            also[scene_path.with_suffix(".laz")] = lambda tmp: export_las(tmp, self.voxels, vs, compress=True)
+            also[target_path.with_suffix(".laz")] = lambda tmp: export_las(
+                tmp, self.target, vs, ids=self.ids(), compress=True
+            )
+        write_model_pair(scene_path, target_path, self.voxels, self.target, ids, cancel, progress, also)
         return scene_path, target_path
 
     def to_scene(self, name=None, path=None):

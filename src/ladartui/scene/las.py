@@ -147,11 +147,12 @@ def _voxel_indices(path, voxel_size, origin) -> tuple[np.ndarray, np.ndarray, np
     return indices.astype(np.int32), np.asarray(cloud.point_source_id), origin
 
 
-def export_las(path, voxels, voxel_size, origin=(0.0, 0.0, 0.0), ids=None) -> None:
+def export_las(path, voxels, voxel_size, origin=(0.0, 0.0, 0.0), ids=None, compress=None) -> None:
     """Write voxel centres (metres) as a LAS 1.2 file, or LAZ for a ``.laz`` path, atomically.
 
     ``ids`` (one target id 1..65535 per voxel, or 0 for a voxel of no target)
-    are written as point_source_id.
+    are written as point_source_id. ``compress`` (LAZ) follows the suffix unless
+    given (an output set writes to a temporary).
     """
     import laspy
 
@@ -174,7 +175,8 @@ def export_las(path, voxels, voxel_size, origin=(0.0, 0.0, 0.0), ids=None) -> No
         if ids.shape != (len(centres),) or (len(ids) and (ids.min() < 0 or ids.max() > MAX_TARGET_ID)):
             raise ValueError(f"ids must be {len(centres)} target ids in 0..{MAX_TARGET_ID}")
         cloud.point_source_id = ids.astype(np.uint16)
-    compress = path.suffix.lower() == ".laz"
+    if compress is None:
+        compress = path.suffix.lower() == ".laz"
     # Write to a stream: given a path, laspy picks compression from the suffix (.tmp here).
     with atomic_path(path) as tmp, open(tmp, "wb+") as stream:
         cloud.write(stream, do_compress=compress)

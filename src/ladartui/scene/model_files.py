@@ -68,9 +68,11 @@ def write_model_pair(
     target_ids: np.ndarray | None = None,
     cancel: threading.Event | None = None,
     progress: Progress | None = None,
+    also: dict[Path, Callable[[Path], None]] | None = None,
 ) -> None:
     """A scene model and its target model (``x,y,z,id`` lines with ``target_ids``) written
-    as one output set: both replaced or neither. ``progress("writing", rows, of)`` per file."""
+    as one output set: both replaced or neither. ``progress("writing", rows, of)`` per file.
+    ``also``: more files of the set (path -> writer of a temporary), e.g. LAS copies."""
     from ladartui.outputset import OutputSet
 
     paths = {"scene": scene_path, "target": target_path}
@@ -79,5 +81,8 @@ def write_model_pair(
     def writer(voxels: np.ndarray, ids: np.ndarray | None = None) -> Callable[[Path], None]:
         return lambda tmp: write_voxel_lines(tmp, voxels, cancel, progress, ids)
 
+    writers = {"scene": writer(scene), "target": writer(target, target_ids)}
+    for number, (path, write) in enumerate((also or {}).items()):
+        paths[f"also-{number}"], writers[f"also-{number}"] = Path(path), write
     with OutputSet(paths, lock) as output_set:
-        output_set.write({"scene": writer(scene), "target": writer(target, target_ids)}, cancel)
+        output_set.write(writers, cancel)
