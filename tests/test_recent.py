@@ -43,3 +43,20 @@ def test_a_config_folder_that_cannot_be_written_is_not_an_error(tmp_path, monkey
     scenario.write_text("")
     assert remember_scenario(scenario) == [scenario.resolve()]
     assert recent_scenarios() == []
+
+
+def test_a_list_nested_too_deep_or_holding_an_overlong_name_is_not_fatal(tmp_path, monkeypatch):
+    """recent.json nested 3000 deep raised RecursionError; an entry longer than a name may
+    be raised 'File name too long' from exists() and ended the app (exit 0)."""
+    import json
+
+    monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))
+    kept = tmp_path / "kept.toml"
+    kept.write_text("")
+    remember_scenario(kept)
+    recent = config_folder() / "recent.json"
+    recent.write_text("[" * 3000 + "]" * 3000)
+    assert recent_scenarios() == []
+    recent.write_text(json.dumps({"scenarios": ["/tmp/" + "x" * 300 + ".toml", str(kept)]}))
+    assert recent_scenarios() == [kept]
+    assert remember_scenario(kept)[0] == kept.resolve()

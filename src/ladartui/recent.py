@@ -24,7 +24,7 @@ KINDS = ("scenarios", "sweeps")
 def _read() -> dict[str, list[str]]:
     try:
         data = json.loads((config_folder() / RECENT_FILE).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
+    except (OSError, ValueError, RecursionError):
         return {}
     if isinstance(data, list):  # the first format: scenarios only
         data = {"scenarios": data}
@@ -40,7 +40,16 @@ def _read() -> dict[str, list[str]]:
 def recent_paths(kind: str, existing_only: bool = True) -> list[Path]:
     """The remembered files of ``kind``, newest first (those still on disk, by default)."""
     paths = [Path(name) for name in _read().get(kind, [])]
-    return [p for p in paths if p.exists()] if existing_only else paths
+    return [p for p in paths if _exists(p)] if existing_only else paths
+
+
+def _exists(path: Path, is_file: bool = False) -> bool:
+    """Whether ``path`` is there; False for a name the system cannot even look up
+    (longer than a name may be), which ``Path.exists`` raises for."""
+    try:
+        return path.is_file() if is_file else path.exists()
+    except OSError:
+        return False
 
 
 def remember_path(kind: str, path) -> list[Path]:
@@ -62,7 +71,7 @@ def remember_path(kind: str, path) -> list[Path]:
 
 
 def recent_scenarios(existing_only: bool = True) -> list[Path]:
-    return [p for p in recent_paths("scenarios", existing_only) if not existing_only or p.is_file()]
+    return [p for p in recent_paths("scenarios", existing_only) if not existing_only or _exists(p, True)]
 
 
 def remember_scenario(path) -> list[Path]:
