@@ -311,3 +311,24 @@ def test_keys_toml_problems_are_named_on_their_line_never_a_crash(tmp_path):
         problems[1].startswith(f"{keys}:6: keys.run = 'ctrl+s': also the key of ") and "save" in problems[1]
     )
     assert keymap == {"layout": "ctrl+l"}  # the clash is left out: the default stays
+
+
+def test_the_app_ending_on_an_error_exits_non_zero(monkeypatch):
+    """A crash in the interface (the traceback screen) exited 0, as if all went well."""
+    from ladartui import tui
+    from ladartui.tui import app as app_module
+
+    class Crashed:
+        return_code = 1
+
+        def __init__(self, *args, **options):
+            pass
+
+        def run(self):
+            return None
+
+    monkeypatch.setattr(app_module, "LadarApp", Crashed)
+    monkeypatch.setattr("ladartui.tui.graphics.detect", lambda mode: (type("G", (), {"image": False})(), []))
+    assert tui.run_app() == 1
+    Crashed.return_code = 0
+    assert tui.run_app() == 0

@@ -18,5 +18,6 @@ def run_app(scenario_path=None, graphics_mode: str | None = None) -> int:
 
     from ladartui.tui.app import LadarApp
 
-    LadarApp(scenario_path, graphics=graphics, graphics_problems=problems).run()
-    return 0
+    app = LadarApp(scenario_path, graphics=graphics, graphics_problems=problems)
+    app.run()
+    return app.return_code or 0  # 1 when the app ended on an error (its traceback shown)
