@@ -572,3 +572,28 @@ def test_a_quoted_unknown_key_is_named_on_its_line_and_does_not_hang(tmp_path, k
     worker.join(20)
     assert not worker.is_alive(), "load_scenario hung"
     assert raised and raised[0].startswith(f"{path}:{line}: unknown key"), raised
+
+
+def test_a_pipe_given_as_a_scenario_or_model_is_named_not_waited_on(tmp_path):
+    """validate and info blocked for ever reading a FIFO; a FIFO scene said 'not found'."""
+    import os
+    import threading
+
+    from ladartui.fileprobe import file_problem
+
+    pipe = tmp_path / "s.toml"
+    os.mkfifo(pipe)
+    said = []
+
+    def load():
+        try:
+            load_scenario(pipe)
+        except InputFileError as error:
+            said.append(str(error))
+
+    worker = threading.Thread(target=load, daemon=True)
+    worker.start()
+    worker.join(10)
+    assert not worker.is_alive(), "load_scenario waited on the pipe"
+    assert said == [f"{pipe}: is not a regular file (a pipe or device); expected a scenario file (.toml)"]
+    assert file_problem(pipe) == "is not a regular file (a pipe or device)"

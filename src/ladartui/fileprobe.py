@@ -12,6 +12,8 @@ def file_problem(path: Path) -> str | None:
             return None
         if Path(path).is_dir():
             return "is a folder, expected a file"
+        if Path(path).exists():
+            return "is not a regular file (a pipe or device)"
         return "not found"
     except OSError as error:
         if error.errno == errno.ENAMETOOLONG:

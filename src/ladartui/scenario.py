@@ -406,6 +406,10 @@ def target_file_for(scene_file) -> Path:
 def load_scenario(path, check_files=True) -> Scenario:
     """Read and check a scenario file; with ``check_files``, its model files must exist."""
     path = _absolute(path)
+    if path.exists() and not path.is_file() and not path.is_dir():  # reading a pipe would wait for ever
+        raise InputFileError(
+            path, "is not a regular file (a pipe or device); expected a scenario file (.toml)"
+        )
     try:
         text = path.read_text(encoding="utf-8-sig")
     except FileNotFoundError:
