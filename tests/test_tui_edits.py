@@ -332,3 +332,41 @@ def test_the_app_ending_on_an_error_exits_non_zero(monkeypatch):
     assert tui.run_app() == 1
     Crashed.return_code = 0
     assert tui.run_app() == 0
+
+
+async def test_the_poses_dialog_keeps_what_is_typed_across_add_and_rows(tmp_path, scene_files):
+    """z typed and then Add: the new row copied the old z and the typed one was lost; so
+    was an edit when another row was clicked. A fixed value's error stayed on screen, and
+    OK with every pose deleted closed the dialog, changing nothing."""
+    from ladartui.tui.poses_screen import PosesScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        app.action_manual_poses()
+        await pilot.pause()
+        screen = app.screen
+        assert isinstance(screen, PosesScreen)
+        z = screen.query_one("#p-z")
+        await type_into(pilot, z, "99", commit=None)
+        screen.query_one("#pose-add").press()
+        await pilot.pause()
+        assert [p.z for p in screen.poses] == [99.0, 99.0]
+        table = screen.query_one("#poses-table")
+        await type_into(pilot, z, "70", commit=None)  # row 2, then row 1 chosen
+        table.move_cursor(row=0)
+        await pilot.pause()
+        assert [p.z for p in screen.poses] == [99.0, 70.0] and z.value == "99"
+        message = screen.query_one("#poses-message")
+        await type_into(pilot, z, "", commit="tab")
+        assert "empty" in str(message.render())
+        await type_into(pilot, z, "80", commit=None)
+        assert str(message.render()) == ""  # fixed: the error goes
+        for _ in range(2):
+            screen.query_one("#pose-delete").press()
+            await pilot.pause()
+        assert screen.poses == []
+        screen.query_one("#poses-ok").press()
+        await pilot.pause()
+        assert app.screen is screen and "at least one pose" in str(message.render())

@@ -109,8 +109,14 @@ class PosesScreen(Dialog):
     @on(DataTable.RowHighlighted)
     def _highlighted(self, event: DataTable.RowHighlighted) -> None:
         # a refill re-highlights the row already shown: keep what is being typed
-        if event.cursor_row != self.shown_row:
-            self._show(event.cursor_row)
+        if event.cursor_row == self.shown_row:
+            return
+        if self._edited() and 0 <= self.shown_row < len(self.poses):
+            # what was typed goes to the row it was typed for, or the choice waits
+            if not self._apply(row=self.shown_row, select=event.cursor_row):
+                self.query_one(DataTable).move_cursor(row=self.shown_row)
+            return
+        self._show(event.cursor_row)
 
     def on_input_blurred(self, event: Input.Blurred) -> None:
         if isinstance(event.input, NumberField):
@@ -140,12 +146,18 @@ class PosesScreen(Dialog):
     def _typing(self, event: Input.Changed) -> None:
         if isinstance(event.input, NumberField):
             event.input.set_class(event.input.problem() is not None, "-bad")
+            if not any(self.query_one(f"#p-{name}").has_class("-bad") for name in self.COLUMNS):
+                self.query_one("#poses-message", Static).update("")  # nothing left to say
 
     @on(Input.Submitted)
     @on(Button.Pressed, "#pose-apply")
-    def _apply(self, event=None) -> bool:
-        """The fields into the selected row (a new one when none is); False, with the
-        reason said, when a field is not allowed."""
+    def _pressed_apply(self) -> None:
+        self._apply()
+
+    def _apply(self, row: int | None = None, select: int | None = None) -> bool:
+        """The fields into ``row`` (default: the selected one; a new one when none is),
+        then ``select`` shown (default: that row); False, with the reason said, when a
+        field is not allowed."""
         if self._refused():
             return False
         message = self.query_one("#poses-message", Static)
@@ -154,14 +166,15 @@ class PosesScreen(Dialog):
         except LadarError as error:
             message.update(escape(str(error)))
             return False
-        row = self.query_one(DataTable).cursor_row
+        row = self.query_one(DataTable).cursor_row if row is None else row
         if 0 <= row < len(self.poses):
             self.poses[row] = pose
         else:
             self.poses.append(pose)
             row = len(self.poses) - 1
         message.update("")
-        self._fill(row)
+        self.shown_row = -1  # the fields are shown again from the rows
+        self._fill(row if select is None else select)
         return True
 
     def _edited(self) -> bool:
@@ -174,7 +187,11 @@ class PosesScreen(Dialog):
 
     @on(Button.Pressed, "#pose-add")
     def action_add_pose(self) -> None:
-        template = self.poses[-1] if self.poses else self.defaults
+        """A new last row, a copy of the selected one with what is typed applied."""
+        if self._edited() and not self._apply():
+            return
+        row = self.query_one(DataTable).cursor_row
+        template = self.poses[row] if 0 <= row < len(self.poses) else self.defaults
         self.poses.append(template)
         self._fill(len(self.poses) - 1)
 
@@ -188,7 +205,12 @@ class PosesScreen(Dialog):
     @on(Button.Pressed, "#poses-ok")
     def _ok(self) -> None:
         # typed values are applied first, as Run and Save commit the main form's
-        if self._edited() and not self._apply():
+        if self.poses and self._edited() and not self._apply():
+            return
+        if not self.poses:  # stays open, as every dialog does while a value is not allowed
+            self.query_one("#poses-message", Static).update(
+                "A manual segment needs at least one pose: Add one, or Cancel."
+            )
             return
         self.dismiss(list(self.poses))
 
