@@ -594,6 +594,13 @@ async def test_study_key_opens_the_study_of_the_open_scenario_and_esc_returns(sh
     assert bar.total == 1 and bar.progress == 0  # idle reads 0 %, not an animation of work
     # the study screen's keys only: the app's F5 must not start a run underneath
     assert app.check_action("run", ()) is False and "f5" not in shown_keys(app)
+    # one Help in its footer, which shows one key per action (it showed 'f1 Help' and '? Help')
+    helps = {
+        b.binding.action
+        for b in app.active_bindings.values()
+        if b.binding.show and "help" in b.binding.action
+    }
+    assert helps == {"app.help"}
     await pilot.press("f5")
     await pilot.pause()
     assert not app.running and app.screen is screen

@@ -30,7 +30,7 @@ class StudyScreen(Screen):
     """Run the study on the open scenario (or the generated scenes) and show its chart."""
 
     BINDINGS = [
-        Binding("f1", "app.help", "Help"),  # every key, this screen's too
+        Binding("f1,question_mark", "app.help", "Help"),  # every key, this screen's too; ? as elsewhere
         Binding("q", "run('quick')", "Quick study"),
         Binding("f", "run('full')", "Full study"),
         Binding("ctrl+x", "cancel", "Cancel", priority=True),  # as on the sweep screen and the main one

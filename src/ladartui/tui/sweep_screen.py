@@ -70,7 +70,7 @@ class SweepScreen(RankingView):
             self.path = Path(path)
 
     BINDINGS = [
-        Binding("f1", "app.help", "Help"),  # every key, this screen's too
+        Binding("f1,question_mark", "app.help", "Help"),  # every key, this screen's too; ? as elsewhere
         Binding("f5", "run", "Run", priority=True),
         Binding("f3", "open_results", "Open", priority=True),
         Binding("f2", "browse", "Browse", priority=True),
