@@ -163,8 +163,8 @@ def test_log_segment_errors(tmp_path):
     assert _error(tmp_path, segment='kind = "log"\nfile = "bad.csv"\nrate = 1.0\n').endswith(
         "bad.csv:3: x = 'zz': expected a number"
     )
-    assert "cannot read flight log" in _error(
-        tmp_path, segment='kind = "log"\nfile = "missing.csv"\nrate = 1.0\n'
+    assert _error(tmp_path, segment='kind = "log"\nfile = "missing.csv"\nrate = 1.0\n').endswith(
+        "file = 'missing.csv': expected a flight log file (CSV): not found"
     )
 
 

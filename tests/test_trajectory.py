@@ -146,3 +146,48 @@ def test_a_bad_origin_in_a_scenario_is_named_on_its_line(tmp_path, origin, found
     message = str(caught.value)
     assert message.startswith(f"{path}:10: flight.segments[0].{found}: expected ")
     assert ("latitude" if "[0]" in found else "longitude") in message
+
+
+@pytest.mark.parametrize(
+    ("header", "record", "said"),
+    [
+        ("time,x,y,z,heading,x", "1,0,0,60,0,5", "log.csv:1: header names x twice (columns 2 and 6)"),
+        ("time,x,y,z,heading", "1,1e300,0,60,0", "log.csv:3: x = '1e300': expected a coordinate within"),
+        (
+            "time,latitude,longitude,altitude,heading",
+            "1,-35.28,1000,660,0",
+            "log.csv:3: longitude = 1000.0: expected -180..180",
+        ),
+    ],
+)
+def test_a_bad_log_column_or_value_is_named_in_the_log(tmp_path, header, record, said):
+    """A repeated column was taken without a word, 1e300 was blamed on the scenario's
+    flight.segments[0].x, a longitude of 1000 was taken (and np.float64 reached a message)."""
+    from ladartui.trajectory import TrajectoryError
+
+    path = tmp_path / "log.csv"
+    first = "0," + ",".join(
+        ["-35.28", "149.13", "660", "0"] if "latitude" in header else ["0", "0", "60", "0"]
+    )
+    if header.endswith(",x"):
+        first += ",5"
+    path.write_text(f"{header}\n{first}\n{record}\n")
+    with pytest.raises(TrajectoryError) as caught:
+        load_flight_log(path, origin=(-35.28, 149.13, 560.0))
+    assert str(caught.value).startswith(f"{path.parent}/{said}")
+
+
+def test_a_missing_log_is_named_on_its_scenario_line(tmp_path):
+    from ladartui.scenario import load_scenario
+
+    (tmp_path / "s.txt").write_text("0,0,0\n")
+    path = tmp_path / "s.toml"
+    path.write_text(
+        '[files]\nscene = "s.txt"\nvoxel_size = 1.0\n\n[flight]\n[[flight.segments]]\n'
+        'kind = "log"\nfile = "nope.csv"\nrate = 1.0\n'
+    )
+    with pytest.raises(FieldError) as caught:
+        load_scenario(path, check_files=False)
+    assert str(caught.value).startswith(
+        f"{path}:8: flight.segments[0].file = 'nope.csv': expected a flight log"
+    )

@@ -24,6 +24,7 @@ from typing import ClassVar
 
 import numpy as np
 
+from ladartui.checks import MAX_COORDINATE
 from ladartui.errors import FieldError, LadarError
 from ladartui.flight import ScanPose
 
@@ -93,6 +94,12 @@ def load_flight_log(path, origin=None) -> FlightLog:
         raise TrajectoryError(f"{path}: empty flight log: expected a header and records")
     header_line, header = rows[0]
     names = [name.strip().lower() for name in next(csv.reader([header]))]
+    for column, name in enumerate(names):
+        if name and name in names[:column]:
+            raise TrajectoryError(
+                f"{path}:{header_line}: header names {name} twice "
+                f"(columns {names.index(name) + 1} and {column + 1})"
+            )
     geodetic = all(c in names for c in GEODETIC)
     required = ("time", *GEODETIC, "heading") if geodetic else REQUIRED
     missing = [c for c in required if c not in names]
@@ -125,6 +132,11 @@ def load_flight_log(path, origin=None) -> FlightLog:
                 raise TrajectoryError(f"{path}:{number}: {name} = {raw!r}: expected a number") from None
             if not np.isfinite(value):
                 raise TrajectoryError(f"{path}:{number}: {name} = {raw!r}: expected a finite number")
+            if name in ("x", "y", "z") and abs(value) > MAX_COORDINATE:
+                raise TrajectoryError(
+                    f"{path}:{number}: {name} = {raw!r}: expected a coordinate within "
+                    f"{MAX_COORDINATE:g} m of the scene's origin"
+                )
             values[name].append(value)
         if len(values["time"]) > 1 and values["time"][-1] <= values["time"][-2]:
             raise TrajectoryError(
@@ -132,9 +144,11 @@ def load_flight_log(path, origin=None) -> FlightLog:
                 f"expected times increasing (previous {values['time'][-2]!r})"
             )
         if geodetic:
-            lat = values["latitude"][-1]
+            lat, lon = values["latitude"][-1], values["longitude"][-1]
             if not -90.0 <= lat <= 90.0:
                 raise TrajectoryError(f"{path}:{number}: latitude = {lat!r}: expected -90..90")
+            if not -180.0 <= lon <= 180.0:
+                raise TrajectoryError(f"{path}:{number}: longitude = {lon!r}: expected -180..180")
         elif values["z"][-1] <= 0:
             raise TrajectoryError(f"{path}:{number}: z = {values['z'][-1]!r}: expected > 0")
     if len(values["time"]) < 2:
@@ -146,7 +160,7 @@ def load_flight_log(path, origin=None) -> FlightLog:
         if xyz[low, 2] <= 0:
             raise TrajectoryError(
                 f"{path}:{rows[1 + low][0]}: altitude = "
-                f"{arr['altitude'][low]!r} puts the aircraft at "
+                f"{float(arr['altitude'][low])!r} puts the aircraft at "
                 f"{xyz[low, 2]:.1f} m above the origin: expected above it"
             )
     else:
@@ -215,6 +229,15 @@ class LogSegment:
         if not isinstance(self.file, (str, Path)) or not str(self.file).strip():
             raise FieldError("file", self.file, "the flight log's file name (.csv)")
         set_("file", str(self.file))
+        from ladartui.fileprobe import file_problem
+
+        problem = file_problem(Path(self.file))
+        if problem:  # named on the segment's file line, not as the log's own error
+            raise FieldError(
+                "file",
+                self.file,
+                f"a flight log file (CSV): {problem}",
+            )
         if (self.rate is None) == (self.times is None):
             raise FieldError(
                 "rate", self.rate, "either a scan rate (Hz) or a list of scan times (s), not both"
