@@ -597,3 +597,17 @@ def test_a_pipe_given_as_a_scenario_or_model_is_named_not_waited_on(tmp_path):
     assert not worker.is_alive(), "load_scenario waited on the pipe"
     assert said == [f"{pipe}: is not a regular file (a pipe or device); expected a scenario file (.toml)"]
     assert file_problem(pipe) == "is not a regular file (a pipe or device)"
+
+
+@pytest.mark.parametrize("names", ['""', "[]", "3"])
+def test_target_names_that_are_no_table_are_refused(tmp_path, names):
+    """names = "" and names = [] passed validate as no names at all."""
+    from tiny_sweep import write_tiny_scenario
+
+    scenario = write_tiny_scenario(tmp_path)
+    text = scenario.path.read_text(encoding="utf-8") + f"\n[targets]\nnames = {names}\n"
+    scenario.path.write_text(text, encoding="utf-8")
+    with pytest.raises(FieldError) as caught:
+        load_scenario(scenario.path)
+    line = text.splitlines().index(f"names = {names}") + 1
+    assert str(caught.value).startswith(f"{scenario.path}:{line}: targets.names = ")

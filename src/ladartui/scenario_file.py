@@ -254,9 +254,12 @@ class ScenarioReader:
         if "targets" in doc:
             names = self.table(doc, "targets", SECTIONS["targets"]).get("names", {})
             try:
+                if not isinstance(names, dict):  # the file's form: a table (the API also takes pairs)
+                    checked_target_names(None)
                 target_names = checked_target_names(names)
             except FieldError as error:
-                raise self.field_error("targets.names", error.value, error.expected) from None
+                value = error.value if isinstance(names, dict) else names
+                raise self.field_error("targets.names", value, error.expected) from None
 
         scene = files["scene"]
         if not isinstance(scene, str) or not scene.strip():
