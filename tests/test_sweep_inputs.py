@@ -141,6 +141,8 @@ def test_a_variant_refused_by_this_machines_limits_runs_again_on_resume(tmp_path
     first = run_sweep(spec, serial=True, out=tmp_path / "o")
     refused = [row for row in first.rows if row["status"] != "ok"]
     assert len(refused) == 1 and refused[0]["status"] == "failed" and "limit" in refused[0]["error"]
+    # the advice a sweep can follow: it has no --max-rays, its workers read the variable
+    assert "--max-rays" not in refused[0]["error"] and "LADARTUI_MAX_RAYS" in refused[0]["error"]
     assert not first.impossible
     monkeypatch.delenv("LADARTUI_MAX_RAYS")
     again = run_sweep(spec, serial=True, out=tmp_path / "o")
@@ -253,3 +255,26 @@ def test_show_prints_text_from_the_results_table_as_text(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "\x1b" not in out and "\x07" not in out
     assert "[bold]" in out and "[red]" in out  # shown as typed, not taken as markup
+
+
+def test_the_cli_exits_non_zero_when_no_variant_finished(tmp_path, monkeypatch, capsys):
+    """Every variant failed (its backend unavailable): an empty ranking, exit 0. A spec
+    whose every variant is over the ray limit is refused first, with a sweep's advice."""
+    from ladartui import simulation
+    from ladartui.cli import main
+    from ladartui.errors import BackendUnavailable
+
+    write_tiny_scenario(tmp_path)
+    spec = write_spec(tmp_path, "[grid]\nscans = [40, 41]\n", name="none.toml")
+    monkeypatch.setenv("LADARTUI_MAX_RAYS", "5000")
+    assert main(["sweep", str(spec), "--serial"]) == 2
+    err = capsys.readouterr().err
+    assert "no variant can run" in err and "--max-rays" not in err and "LADARTUI_MAX_RAYS" in err
+    monkeypatch.delenv("LADARTUI_MAX_RAYS")
+
+    def unavailable(*args, **options):
+        raise BackendUnavailable("backend 'wgpu' is unavailable: no adapter")
+
+    monkeypatch.setattr(simulation, "simulate", unavailable)
+    assert main(["sweep", str(spec), "--serial"]) == 1
+    assert "ladartui: no variant finished (2 failed)" in capsys.readouterr().err

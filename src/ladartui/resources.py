@@ -122,13 +122,22 @@ def check_occupancy(lo, hi, count, source="voxels") -> int:
     return need
 
 
+RAISE_RAYS = "--max-rays or LADARTUI_MAX_RAYS"  # how a command raises the ray limit
+
+
+def sweep_advice(message: str) -> str:
+    """A limit's message as a sweep can follow it: it has no --max-rays, its workers
+    (started from this process's environment) read the variable."""
+    return message.replace(RAISE_RAYS, "LADARTUI_MAX_RAYS (a sweep's workers read it)")
+
+
 def check_rays(rays, source, limit=None) -> None:
     """``ResourceLimitError`` when ``rays`` exceeds the work limit."""
     limit = max_rays() if limit is None else limit
     if rays > limit:
         raise ResourceLimitError(
             f"{source}: about {rays:.3g} rays to trace, more than the limit of {limit:.3g} "
-            "(raise it with --max-rays or LADARTUI_MAX_RAYS if this is meant)"
+            f"(raise it with {RAISE_RAYS} if this is meant)"
         )
 
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 import os
 import threading
+from collections import Counter
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -206,6 +207,13 @@ def run(args) -> int:
         if not console.is_terminal and "COLUMNS" not in os.environ:
             console = Console(width=160)  # a file or pipe: do not squeeze the table into 80 columns
         show_result(console, result, args.top)
+    if result.rows and not any(row.get("status") == "ok" for row in result.rows):
+        counts = Counter(str(row.get("status")) for row in result.rows)
+        said = ", ".join(
+            f"{n} {'impossible' if status == 'error' else status}" for status, n in counts.items()
+        )
+        errors.print(f"ladartui: no variant finished ({said})", highlight=False, markup=False)
+        return 1  # a script must not take an empty ranking for a result
     return 0
 
 

@@ -88,10 +88,11 @@ def check_some_variant_runs(spec: SweepSpec, base) -> None:
             first = first or error
     if first is None:
         return  # a spec of no variants
+    from ladartui.resources import sweep_advice
+
     key = _blamed_key(spec, getattr(first, "field", ""))
-    raise InputFileError(
-        spec.path, f"{key}: no variant can run: {first}", line=spec_line(spec.path, *key.split("."))
-    )
+    said = f"{key}: no variant can run: {sweep_advice(str(first))}"
+    raise InputFileError(spec.path, said, line=spec_line(spec.path, *key.split(".")))
 
 
 def _blamed_key(spec: SweepSpec, field: str) -> str:

@@ -326,7 +326,9 @@ def run_variant(
         raise  # a cancelled run is no result
     except (ResourceLimitError, BackendUnavailable) as error:
         # this machine's limits or backends, not the variant's values: run it again on resume
-        row.update(status="failed", error=str(error))
+        from ladartui.resources import sweep_advice
+
+        row.update(status="failed", error=sweep_advice(str(error)))
     except LadarError as error:
         row.update(status="error", error=str(error))
     except Exception as error:  # noqa: BLE001 - one variant's crash must not end the sweep
