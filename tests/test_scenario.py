@@ -221,12 +221,12 @@ LIMITS = [
     ("grid = 32", "grid = 2000", "sensor.grid = 2000", "an integer from 1 to 1024"),
     ("grid = 32", "grid = 32.5", "sensor.grid = 32.5", "an integer from 1 to 1024"),
     ("ray_grid = 2", "ray_grid = 0", "sensor.ray_grid = 0", "an integer from 1 to 16"),
-    ("fov_deg = 12.0", "fov_deg = 90.0", "sensor.fov_deg = 90.0", "a number greater than 0 and less than 90"),
+    ("fov_deg = 12.0", "fov_deg = 90.0", "sensor.fov_deg = 90.0", "a number at least 0.001 and less than 90"),
     (
         "fov_deg = 12.0",
         'fov_deg = "wide"',
         "sensor.fov_deg = 'wide'",
-        "a number greater than 0 and less than 90",
+        "a number at least 0.001 and less than 90",
     ),
     (
         "depth_resolution_m = 1.5",
@@ -238,19 +238,19 @@ LIMITS = [
         "pixel_pitch_um = 100.0",
         "pixel_pitch_um = 0",
         "sensor.pixel_pitch_um = 0",
-        "a number greater than 0 and at most 10000",
+        "a number from 0.1 to 10000",
     ),
     (
         "pixel_pitch_um = 100.0",
         "pixel_pitch_um = 20000.0",
         "sensor.pixel_pitch_um = 20000.0",
-        "a number greater than 0 and at most 10000",
+        "a number from 0.1 to 10000",
     ),
     (
         "pixel_pitch_um = 100.0",
         "pixel_pitch_um = true",
         "sensor.pixel_pitch_um = True",
-        "a number greater than 0 and at most 10000",
+        "a number from 0.1 to 10000",
     ),
     (
         "speed_mps = 25.0",

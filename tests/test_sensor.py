@@ -179,12 +179,12 @@ def test_footprint_at_nadir_and_tilted():
         ("grid", True, "grid = True: expected an integer from 1 to 1024"),
         ("ray_grid", 17, "ray_grid = 17: expected an integer from 1 to 16"),
         ("ray_grid", 0, "ray_grid = 0: expected an integer from 1 to 16"),
-        ("fov", 0, "fov = 0: expected a number greater than 0 and less than 90"),
-        ("fov", 90, "fov = 90: expected a number greater than 0 and less than 90"),
+        ("fov", 0, "fov = 0: expected a number at least 0.001 and less than 90"),
+        ("fov", 90, "fov = 90: expected a number at least 0.001 and less than 90"),
         ("depth_resolution", -0.1, "depth_resolution = -0.1: expected a number from 0 to 1000"),
         ("depth_resolution", 1001, "depth_resolution = 1001: expected a number from 0 to 1000"),
-        ("pixel_pitch", 0.0, "pixel_pitch = 0.0: expected a number greater than 0 and at most 0.01"),
-        ("pixel_pitch", float("inf"), "pixel_pitch = inf: expected a number greater than 0 and at most 0.01"),
+        ("pixel_pitch", 0.0, "pixel_pitch = 0.0: expected a number from 1e-07 to 0.01"),
+        ("pixel_pitch", float("inf"), "pixel_pitch = inf: expected a number from 1e-07 to 0.01"),
     ],
 )
 def test_sensor_field_limits(field, value, message):
@@ -194,7 +194,43 @@ def test_sensor_field_limits(field, value, message):
 
 
 def test_limits_are_accepted():
-    sensor = Sensor(grid=1, ray_grid=16, fov=89.9, depth_resolution=0.0, pixel_pitch=1e-9)
+    sensor = Sensor(grid=1, ray_grid=16, fov=89.9, depth_resolution=0.0, pixel_pitch=1e-7)
     origins, directions, detector = sensor.rays(ScanPose(0, 0, 10, depression=1.0))
     assert origins.shape == (256, 3) and (detector == 0).all()
     assert Sensor(grid=1024, ray_grid=1).rays_per_scan == 1024**2
+
+
+def test_a_field_of_view_or_pixel_pitch_too_small_to_mean_a_sensor_is_refused(tmp_path):
+    """fov 1e-300 deg and pixel pitch 1e-300 um were taken (IFOV 1e-299 mdeg, READY); a
+    pitch of 1e-320 um in a file was refused as 'at most 0.01', in metres."""
+    import pytest
+
+    from ladartui.errors import FieldError
+    from ladartui.scenario import load_scenario
+    from ladartui.sensor import MIN_FOV, Sensor
+
+    for field, value in (("fov", 1e-300), ("pixel_pitch", 1e-300)):
+        with pytest.raises(FieldError) as caught:
+            Sensor(**{field: value})
+        assert caught.value.field == field and (
+            "from " in caught.value.expected or "least" in caught.value.expected
+        )
+    assert Sensor(fov=MIN_FOV).fov == MIN_FOV
+    orbit = __import__("pathlib").Path(__file__).resolve().parent.parent / "scenarios" / "orbit.toml"
+    path = tmp_path / "s.toml"
+    path.write_text(orbit.read_text().replace("pixel_pitch_um = 100.0", "pixel_pitch_um = 1e-320"))
+    with pytest.raises(FieldError) as caught:
+        load_scenario(path, check_files=False)
+    assert "sensor.pixel_pitch_um = 1e-320: expected a number from 0.1 to 10000" in str(caught.value)
+
+
+def test_too_many_manual_poses_are_counted_in_the_message_not_listed():
+    """10,001 poses: the message listed them all and was cut before 'expected'."""
+    import pytest
+
+    from ladartui.errors import FieldError
+    from ladartui.flight import MAX_SCANS, Manual, ScanPose
+
+    with pytest.raises(FieldError) as caught:
+        Manual((ScanPose(0.0, 0.0, 50.0),) * (MAX_SCANS + 1))
+    assert str(caught.value) == "poses = '10,001 items': expected a list of 1 to 10,000 scan poses"

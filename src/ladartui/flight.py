@@ -388,7 +388,9 @@ class Manual:
     def __post_init__(self):
         poses = tuple(self.poses)
         if not 1 <= len(poses) <= MAX_SCANS or not all(isinstance(p, ScanPose) for p in poses):
-            raise FieldError("poses", self.poses, f"a list of 1 to {MAX_SCANS} scan poses")
+            # the count, not the list: 10,001 poses made a message of 300,000 characters
+            shown = f"{len(poses):,} items" if len(poses) > 3 else self.poses
+            raise FieldError("poses", shown, f"a list of 1 to {MAX_SCANS:,} scan poses")
         _set(self, "poses", poses)
 
     def build(self, current: ScanPose | None) -> list[ScanPose]:

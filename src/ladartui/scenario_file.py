@@ -102,7 +102,7 @@ from ladartui.detection.settings import DETECTION_KEYS, detection_from_table
 from ladartui.errors import FieldError, InputFileError
 from ladartui.flight import MAX_SCANS, SEGMENT_KINDS, FlightPlan, Manual, ScanPose
 from ladartui.levels import LEVEL_KEYS, level_below, levels_from_table
-from ladartui.sensor import MAX_PIXEL_PITCH, Sensor
+from ladartui.sensor import MAX_PIXEL_PITCH, MIN_PIXEL_PITCH, Sensor
 from ladartui.toml_lines import key_lines_from_text
 from ladartui.trajectory import LogSegment
 
@@ -270,9 +270,8 @@ class ScenarioReader:
                 number_field(
                     "pixel_pitch_um",
                     sensor_table["pixel_pitch_um"],
-                    0.0,
+                    MIN_PIXEL_PITCH * 1e6,
                     MAX_PIXEL_PITCH * 1e6,
-                    low_open=True,
                 )
         sensor_args = {}
         for key, (name, scale) in SENSOR_KEYS.items():

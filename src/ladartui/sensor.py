@@ -36,6 +36,8 @@ MAX_GRID = 1024
 MAX_RAY_GRID = 16
 MAX_DEPTH_RESOLUTION = 1000.0  # metres
 MAX_PIXEL_PITCH = 0.01  # metres; the focal plane spans grid * pitch
+MIN_PIXEL_PITCH = 1e-7  # metres (0.1 um): below any detector's
+MIN_FOV = 1e-3  # degrees (17 urad): below it the array sees one point
 # "stabilised": a gimbal holds azimuth and depression against the horizon (the
 # report's model, the default); "body-fixed": the rays turn with the aircraft's
 # roll and pitch (ladartui.attitude).
@@ -146,7 +148,7 @@ class Sensor:
         set_ = object.__setattr__
         set_(self, "grid", integer_field("grid", self.grid, 1, MAX_GRID))
         set_(self, "ray_grid", integer_field("ray_grid", self.ray_grid, 1, MAX_RAY_GRID))
-        set_(self, "fov", number_field("fov", self.fov, 0.0, 90.0, low_open=True, high_open=True))
+        set_(self, "fov", number_field("fov", self.fov, MIN_FOV, 90.0, high_open=True))
         set_(
             self,
             "depth_resolution",
@@ -155,7 +157,7 @@ class Sensor:
         set_(
             self,
             "pixel_pitch",
-            number_field("pixel_pitch", self.pixel_pitch, 0.0, MAX_PIXEL_PITCH, low_open=True),
+            number_field("pixel_pitch", self.pixel_pitch, MIN_PIXEL_PITCH, MAX_PIXEL_PITCH),
         )
         if not isinstance(self.mount, str) or self.mount not in MOUNTS:
             raise FieldError("mount", self.mount, "one of " + ", ".join(repr(m) for m in MOUNTS))
