@@ -182,3 +182,14 @@ def test_las_outputs_are_named_in_words(scenario, capsys):
     out = capsys.readouterr().out.replace("\n", "")
     assert f"wrote scene LAS: {scenario.scene_output.with_suffix('.las')}" in out
     assert f"wrote target LAS: {scenario.target_output.with_suffix('.las')}" in out
+
+
+def test_flags_the_run_would_ignore_or_round_are_refused(scenario, capsys):
+    """--las with --no-write wrote nothing without a word; --max-rays 1.5 became 'the
+    limit of 1'."""
+    assert main(["run", str(scenario.path), "--las", "--no-write"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("ladartui: error: --las: ") and "--no-write" in err
+    assert main(["run", str(scenario.path), "--max-rays", "1.5"]) == 2
+    assert "--max-rays = 1.5: expected a whole number of rays >= 1" in capsys.readouterr().err
+    assert not scenario.measures_file.exists()

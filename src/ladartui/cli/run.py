@@ -63,15 +63,17 @@ def add_parser(subparsers):
 
 def run(args) -> int:
     from ladartui.cli.console import CliConsole as Console
-    from ladartui.errors import FieldError
+    from ladartui.errors import FieldError, LadarError
     from ladartui.scenario import load_scenario
 
     if args.max_rays is not None:
         from ladartui.resources import set_max_rays
 
-        if not args.max_rays >= 1:
-            raise FieldError("--max-rays", args.max_rays, "a number of rays >= 1")
+        if not (args.max_rays >= 1 and float(args.max_rays).is_integer()):
+            raise FieldError("--max-rays", args.max_rays, "a whole number of rays >= 1")
         set_max_rays(int(args.max_rays))
+    if args.las and not args.write:
+        raise LadarError("--las: it copies the outputs as LAS files, which --no-write does not write")
     from ladartui.user_data import bundled_or_path
 
     scenario = load_scenario(bundled_or_path(args.scenario))
