@@ -477,3 +477,19 @@ def test_a_study_is_written_as_one_set(tmp_path, monkeypatch):
     with pytest.raises(OSError):
         write_outputs(changed, tmp_path)
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+
+
+def test_chart_from_refuses_the_flags_of_a_new_study(tmp_path, capsys):
+    """'--runs 3 --chart-from J' redrew J, the runs ignored without a word."""
+    from ladartui.cli import main
+
+    source = str(Path(__file__).parent.parent / "docs" / "study.json")
+    assert (
+        main(["study", "--chart-from", source, "--runs", "3", "--quick", "--out", str(tmp_path / "o")]) == 2
+    )
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        "ladartui: error: --chart-from redraws a study already run: --quick, --runs would shape a new one; "
+        "drop them"
+    )
+    assert not (tmp_path / "o").exists()

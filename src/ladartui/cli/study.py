@@ -59,10 +59,28 @@ def add_parser(subparsers) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from ladartui.cli.console import CliConsole as Console
+    from ladartui.errors import LadarError
     from ladartui.outputset import check_writable_folder
     from ladartui.study import full_settings, quick_settings
     from ladartui.study.inputs import generated_inputs, scenario_inputs
 
+    if args.chart_from:  # a study already run: what would shape a new one does not apply
+        given = [
+            flag
+            for flag, value in (
+                ("SCENARIO", args.scenario),
+                ("--quick", args.quick or None),
+                ("--runs", args.runs),
+                ("--scans", args.scans),
+                ("--warmup", args.warmup if args.warmup != 1 else None),
+            )
+            if value is not None
+        ]
+        if given:
+            raise LadarError(
+                f"--chart-from redraws a study already run: {', '.join(given)} would shape a new one; drop "
+                + ("it" if len(given) == 1 else "them")
+            )
     check_writable_folder(args.out)  # before the study, not after it
     if args.chart_from:
         return _report(_load_result(args.chart_from), args.out)
