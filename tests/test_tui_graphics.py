@@ -342,3 +342,18 @@ def test_detect_puts_the_flag_over_the_settings_file(tmp_path, monkeypatch):
     graphics, problems = detect(folder=tmp_path)
     assert graphics.mode == "halfblocks"  # auto
     assert len(problems) == 1 and "settings.toml:2:" in problems[0]
+
+
+def test_a_misspelt_setting_or_a_file_nested_too_deep_is_reported(tmp_path):
+    """'graphic = "sixel"' and [displays] were ignored without a word; a file nested 3000
+    deep printed a RecursionError traceback of 3000 lines."""
+    path = tmp_path / "settings.toml"
+    path.write_text('[displays]\nx = 1\n\n[display]\ngraphic = "sixel"\n')
+    setting, problems = read_setting(tmp_path)
+    assert setting == "auto"
+    assert problems == [
+        f"{path}:1: [displays]: no such table; expected [display]",
+        f"{path}:5: display.graphic: no such setting; expected graphics",
+    ]
+    path.write_text("a = " + "[" * 3000 + "]" * 3000 + "\n")
+    assert read_setting(tmp_path) == ("auto", [f"{path}: nested too deep to read"])

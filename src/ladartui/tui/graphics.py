@@ -144,17 +144,35 @@ def read_setting(folder: Path | None = None) -> tuple[str, list[str]]:
         document = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
         return "auto", [one_line(f"{path}: {error}")]
+    except RecursionError:
+        return "auto", [f"{path}: nested too deep to read"]
+    lines = key_lines_from_text(text)
+
+    def at(key: str) -> str:
+        return f"{path}:{lines[key]}" if key in lines else str(path)
+
+    # a misspelt table or setting is said, not ignored
+    problems = [
+        one_line(f"{at(name)}: [{name}]: no such table; expected [display]")
+        for name in document
+        if name != "display"
+    ]
     display = document.get("display", {})
-    line = key_lines_from_text(text).get(SETTING)
-    where = f"{path}:{line}" if line else str(path)
+    where = at(SETTING)
     if not isinstance(display, dict):
         return "auto", [f"{where}: display must be a table, [display]"]
+    problems += [
+        one_line(f"{at(f'display.{name}')}: display.{name}: no such setting; expected graphics")
+        for name in display
+        if name != "graphics"
+    ]
     value = display.get("graphics", "auto")
     if not isinstance(value, str) or value.strip().lower() not in MODES:
         return "auto", [
-            one_line(f"{where}: {SETTING} = {value!r}: expected one of {', '.join(MODES)}; using auto")
+            *problems,
+            one_line(f"{where}: {SETTING} = {value!r}: expected one of {', '.join(MODES)}; using auto"),
         ]
-    return value.strip().lower(), []
+    return value.strip().lower(), problems
 
 
 def detect(forced: str | None = None, folder: Path | None = None) -> tuple[Graphics, list[str]]:
