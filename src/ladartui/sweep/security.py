@@ -71,7 +71,7 @@ def cluster_security(address: str, ca_file=None, cert_file=None, key_file=None, 
                     "and --tls-key together; ladartui certs DIR makes them)",
                 )
             if problem := file_problem(Path(path)):
-                raise FieldError(flag, str(path), f"a readable PEM file; it {problem}")
+                raise FieldError(flag, str(path), f"a readable PEM file: {problem}")
         if scheme != "tls":
             raise FieldError(
                 "--scheduler",
