@@ -78,6 +78,13 @@ def test_levels_text_says_which_level_the_path_reaches_and_when():
         "reaches recognise at scan 3 of 6 (4.0 s, 120.0 m from the first scan); identify not reached"
     )
     assert levels_text(row("n", 0.0)) == "reaches no level (not detected)"
+    # every level above the one reached is named ('identify not reached' left recognise out)
+    detected = row("t", 0.1)
+    detected.update({"levels.detect.reached": True, "levels.detect.scan": 1})
+    detected.update({"levels.detect.flight_time_s": 0.0, "levels.detect.distance_m": 0.0})
+    assert levels_text(detected) == (
+        "reaches detect at scan 1 of 6 (0.0 s, 0.0 m from the first scan); recognise, identify not reached"
+    )
     assert levels_text({"variant": "old", "status": "ok", "obscured_coverage": 0.5}) == "levels unknown"
 
 

@@ -179,8 +179,9 @@ def levels_text(row: dict) -> str:
             f"{prefix}reaches {level} at scan {scan}{of} ({_amount(time, 's')}, {_amount(distance, 'm')} "
             "from the first scan)"
         )
-        if level != LEVEL_NAMES[-1]:
-            text += "; identify not reached"
+        above = LEVEL_NAMES[LEVEL_NAMES.index(level) + 1 :]
+        if above:
+            text += f"; {', '.join(above)} not reached"
         texts.append(text)
     if count > 1:
         identified = sum(t[0] for t in per_level["identify"])
