@@ -6,7 +6,7 @@ import sys
 
 import pytest
 
-from ladartui.errors import FieldError
+from ladartui.errors import FieldError, OutputFileError
 from ladartui.sweep.security import cluster_security, is_loopback, make_certificates
 
 
@@ -130,3 +130,25 @@ def test_a_missing_tls_flag_is_said_to_be_missing(tmp_path):
         "--tls-ca-file is missing; expected a PEM file (TLS needs --tls-ca-file, --tls-cert "
         "and --tls-key together; ladartui certs DIR makes them)"
     )
+
+
+def test_new_certificates_replace_the_old_three_together_or_not_at_all(tmp_path, monkeypatch):
+    """--force rewrote the authority, the certificate and the key one after another: a
+    failure between left an authority beside a certificate it did not sign."""
+    from pathlib import Path
+
+    paths = make_certificates(tmp_path)
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    real = Path.write_bytes
+
+    def full_on_the_key(self, data):
+        if self.name.startswith(f".{paths['key'].name}"):
+            raise OSError(28, "No space left on device")
+        return real(self, data)
+
+    monkeypatch.setattr(Path, "write_bytes", full_on_the_key)
+    with pytest.raises(OutputFileError, match=r"no space left on device\); nothing was replaced"):
+        make_certificates(tmp_path)
+    monkeypatch.undo()
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    assert (paths["key"].stat().st_mode & 0o077) == 0

@@ -150,14 +150,27 @@ def make_certificates(folder, days: int = 365) -> dict[str, Path]:
         )
         .sign(ca_key, hashes.SHA256())
     )
+    from ladartui.outputset import OutputSet
+
     pem = serialization.Encoding.PEM
     paths = {"ca": folder / CA_FILE, "cert": folder / CERT_FILE, "key": folder / KEY_FILE}
-    paths["ca"].write_bytes(ca_cert.public_bytes(pem))
-    paths["cert"].write_bytes(cert.public_bytes(pem))
-    descriptor = os.open(paths["key"], os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
-    with os.fdopen(descriptor, "wb") as out:
-        out.write(key.private_bytes(pem, serialization.PrivateFormat.PKCS8, serialization.NoEncryption()))
-    os.chmod(paths["key"], 0o600)
+    contents = {
+        "ca": ca_cert.public_bytes(pem),
+        "cert": cert.public_bytes(pem),
+        "key": key.private_bytes(pem, serialization.PrivateFormat.PKCS8, serialization.NoEncryption()),
+    }
+
+    def writer(kind: str):
+        def write(tmp: Path) -> None:
+            if kind == "key":
+                os.chmod(tmp, 0o600)  # before the key is in it: owner only
+            tmp.write_bytes(contents[kind])
+
+        return write
+
+    # one set: an authority and a certificate it did not sign must never sit together
+    with OutputSet(paths, folder / ".certs.lock") as output_set:
+        output_set.write({kind: writer(kind) for kind in paths})
     return paths
 
 
