@@ -127,6 +127,7 @@ class SetupScreen(TreeDialog):
     @on(RadioSet.Changed, "#mode")
     def _mode_changed(self, event: RadioSet.Changed) -> None:
         self.mode = "new" if event.pressed.id == "mode-new" else "load"
+        self.query_one("#setup-message", Static).update("")  # the other mode's error
         self._apply_mode()
 
     def _apply_mode(self) -> None:
