@@ -370,3 +370,24 @@ async def test_the_poses_dialog_keeps_what_is_typed_across_add_and_rows(tmp_path
         screen.query_one("#poses-ok").press()
         await pilot.pause()
         assert app.screen is screen and "at least one pose" in str(message.render())
+
+
+async def test_switching_the_setup_dialogs_mode_clears_the_other_modes_error(tmp_path, scene_files):
+    from ladartui.tui.file_dialogs import SetupScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        await pilot.press("f3")
+        await pilot.pause()
+        dialog = app.screen
+        assert isinstance(dialog, SetupScreen) and dialog.mode == "load"
+        dialog.query_one("#scenario-file").value = "missing.toml"
+        dialog.query_one("#setup-ok").press()
+        await pilot.pause()
+        message = dialog.query_one("#setup-message")
+        assert "missing.toml" in str(message.render())
+        dialog.query_one("#mode-new").value = True
+        await pilot.pause()
+        assert dialog.mode == "new" and str(message.render()) == ""
