@@ -194,3 +194,20 @@ def test_a_segment_is_named_as_errors_name_it(scenario):
     fewer = scenario.with_changes(flight=FlightPlan(segments=[Manual(first.poses[:1])]))
     changes = setting_changes(ran, fewer)
     assert changes and all(change.startswith("flight.segments[0].poses[1].") for change in changes), changes
+
+
+def test_validate_says_a_set_a_killed_run_left_half_replaced(scenario, capsys):
+    """With the swap's journal on disk the next run rolls the files back; validate
+    described those files as the last run's."""
+    from ladartui.simulation import output_lock
+
+    assert main(["run", str(scenario.path)]) == 0
+    lock = output_lock(scenario)
+    lock.with_name(lock.name + ".journal").write_text("[]")
+    capsys.readouterr()
+    assert main(["validate", str(scenario.path)]) == 0
+    lines = [x for x in capsys.readouterr().out.splitlines() if x.startswith("last run")]
+    assert lines == [
+        "last run   was stopped while it replaced the outputs: the next run puts the earlier set "
+        "back first, so the files now on disk are not to be read"
+    ]

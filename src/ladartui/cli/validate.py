@@ -43,6 +43,14 @@ def last_run_lines(scenario) -> list[str]:
     from ladartui.errors import LadarError
     from ladartui.run_record import earlier_las, missing_outputs, read_run_record, setting_changes
 
+    from ladartui.simulation import output_lock
+
+    lock = output_lock(scenario)
+    if lock.with_name(lock.name + ".journal").exists():  # a swap a killed run left (outputset)
+        return [
+            "last run   was stopped while it replaced the outputs: the next run puts the earlier set "
+            "back first, so the files now on disk are not to be read"
+        ]
     missing = missing_outputs(scenario)
     if missing:
         names = ", ".join(path.name for path in missing)
