@@ -42,7 +42,6 @@ def last_run_lines(scenario) -> list[str]:
     """Whether the outputs on disk came from this file's settings (the run record)."""
     from ladartui.errors import LadarError
     from ladartui.run_record import earlier_las, missing_outputs, read_run_record, setting_changes
-
     from ladartui.simulation import output_lock
 
     lock = output_lock(scenario)
