@@ -391,3 +391,19 @@ async def test_switching_the_setup_dialogs_mode_clears_the_other_modes_error(tmp
         dialog.query_one("#mode-new").value = True
         await pilot.pause()
         assert dialog.mode == "new" and str(message.render()) == ""
+
+
+async def test_the_sensor_summary_keeps_each_figure_with_its_unit_at_80_columns(tmp_path, scene_files):
+    """'IFOV 125' ended one line and 'mdeg' began the next."""
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        app.action_show_tab("sensor")
+        await pilot.pause()
+        info = app.query_one("#sensor-info")
+        shown = [
+            "".join(segment.text for segment in strip).rstrip()
+            for strip in info.render_lines(info.content_region.reset_offset)
+        ]
+        assert any(line.startswith("IFOV ") and line.endswith(" mdeg") for line in shown), shown

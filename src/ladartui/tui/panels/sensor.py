@@ -18,6 +18,7 @@ class SensorPanel(ParamPanel):
         self.fill_fields(scenario)
         s = scenario.sensor
         self.query_one("#sensor-info", Static).update(
+            # a line each: at 80 columns 'IFOV 125' and 'mdeg' fell on two lines
             f"{s.grid}x{s.grid} detectors, {s.ray_grid}x{s.ray_grid} rays each\n"
-            f"{s.rays_per_scan:,} rays per scan, IFOV {s.ifov * 1000:.3g} mdeg"
+            f"{s.rays_per_scan:,} rays per scan\nIFOV {s.ifov * 1000:.3g} mdeg"
         )
