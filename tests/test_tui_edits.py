@@ -3,7 +3,9 @@
 Pilot tests on a tiny generated scene: a value typed but not confirmed with
 Enter is committed by Run and Save (or stops them when invalid), an invalid
 value goes back to the scenario's value, and names or lines read from files
-are shown literally.
+are shown literally. Also what is typed in dialogs is kept (poses, points,
+partial paths), the status line fits its name, the palette waits under a
+prompt, and the user's keys.toml is checked line by line.
 """
 
 from __future__ import annotations

@@ -1,0 +1,73 @@
+"""Scenario files given things they cannot hold: quoted keys, a pipe for a file, target
+names that are no table. Each is one line naming the file and line, never a hang."""
+
+from pathlib import Path
+
+import pytest
+
+from ladartui.errors import FieldError, InputFileError
+from ladartui.scenario import load_scenario
+
+
+@pytest.mark.parametrize("key", ['"a[b"', '"[bold red]key"', '"x.y"'])
+def test_a_quoted_unknown_key_is_named_on_its_line_and_does_not_hang(tmp_path, key):
+    """A quoted key holding '[' sent the line finder into an endless loop."""
+    import threading
+
+    orbit = Path(__file__).resolve().parent.parent / "scenarios" / "orbit.toml"
+    path = tmp_path / "s.toml"
+    text = orbit.read_text().replace("[simulation]\n", f"[simulation]\n{key} = 1\n", 1)
+    path.write_text(text)
+    line = text.splitlines().index(f"{key} = 1") + 1
+    raised = []
+
+    def load():
+        try:
+            load_scenario(path, check_files=False)
+        except InputFileError as error:
+            raised.append(str(error))
+
+    worker = threading.Thread(target=load, daemon=True)
+    worker.start()
+    worker.join(20)
+    assert not worker.is_alive(), "load_scenario hung"
+    assert raised and raised[0].startswith(f"{path}:{line}: unknown key"), raised
+
+
+def test_a_pipe_given_as_a_scenario_or_model_is_named_not_waited_on(tmp_path):
+    """validate and info blocked for ever reading a FIFO; a FIFO scene said 'not found'."""
+    import os
+    import threading
+
+    from ladartui.fileprobe import file_problem
+
+    pipe = tmp_path / "s.toml"
+    os.mkfifo(pipe)
+    said = []
+
+    def load():
+        try:
+            load_scenario(pipe)
+        except InputFileError as error:
+            said.append(str(error))
+
+    worker = threading.Thread(target=load, daemon=True)
+    worker.start()
+    worker.join(10)
+    assert not worker.is_alive(), "load_scenario waited on the pipe"
+    assert said == [f"{pipe}: is not a regular file (a pipe or device); expected a scenario file (.toml)"]
+    assert file_problem(pipe) == "is not a regular file (a pipe or device)"
+
+
+@pytest.mark.parametrize("names", ['""', "[]", "3"])
+def test_target_names_that_are_no_table_are_refused(tmp_path, names):
+    """names = "" and names = [] passed validate as no names at all."""
+    from tiny_sweep import write_tiny_scenario
+
+    scenario = write_tiny_scenario(tmp_path)
+    text = scenario.path.read_text(encoding="utf-8") + f"\n[targets]\nnames = {names}\n"
+    scenario.path.write_text(text, encoding="utf-8")
+    with pytest.raises(FieldError) as caught:
+        load_scenario(scenario.path)
+    line = text.splitlines().index(f"names = {names}") + 1
+    assert str(caught.value).startswith(f"{scenario.path}:{line}: targets.names = ")
