@@ -142,7 +142,7 @@ def test_the_setting_is_read_from_settings_toml(tmp_path):
         ),
         ("[display]\ngraphics = 3\n", r"settings\.toml:2: display\.graphics = 3: expected one of "),
         ('[display\ngraphics = "kitty"\n', r"settings\.toml: .*line 1"),
-        ('display = "kitty"\n', r"settings\.toml: display must be a table"),
+        ('display = "kitty"\n', r"settings\.toml:1: display must be a table"),
     ],
 )
 def test_a_bad_setting_is_one_line_naming_the_file_and_line(tmp_path, text, expected):

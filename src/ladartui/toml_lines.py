@@ -8,6 +8,8 @@ value in a scenario or a settings file is reported as ``file:line``.
 from __future__ import annotations
 
 import re
+import tomllib
+from dataclasses import dataclass
 from pathlib import Path
 
 _HEADER = re.compile(r"^\s*(\[\[?)\s*([A-Za-z0-9_.\-]+)\s*\]\]?")
@@ -58,3 +60,55 @@ def _indexed(dotted: str, arrays: dict[str, int]) -> str:
         if i < len(parts) - 1 and prefix in arrays:
             out[-1] = f"{part}[{arrays[prefix]}]"
     return ".".join(out)
+
+
+@dataclass
+class ConfigTable:
+    """One ``[name]`` table of a user's config file, with what was wrong, file and line."""
+
+    table: dict  # empty when the file or the table is absent or unreadable
+    problems: list[str]
+    lines: dict[str, int]
+    path: Path
+
+    def at(self, key: str) -> str:
+        """``path:line`` of a dotted key (the path alone when it is not found)."""
+        return f"{self.path}:{self.lines[key]}" if key in self.lines else str(self.path)
+
+
+def read_config_table(path: Path, name: str, what: str) -> ConfigTable:
+    """``[name]`` of the config file at ``path``; a missing file is an empty table. A file
+    that cannot be read, is not UTF-8 or TOML, is nested too deep, holds other tables
+    (a misspelt one) or a ``name`` that is not a table is reported, never fatal.
+    ``what`` says what the table holds ("command id = key")."""
+    from ladartui.textsafe import one_line
+
+    def failed(problem: str) -> ConfigTable:
+        return ConfigTable({}, [one_line(f"{path}: {problem}")], {}, path)
+
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except FileNotFoundError:
+        return ConfigTable({}, [], {}, path)
+    except UnicodeDecodeError:
+        return failed("not UTF-8 text")
+    except OSError as error:
+        return failed(f"{error.strerror or error}")
+    try:
+        document = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        return failed(f"{error}")
+    except RecursionError:
+        return failed("nested too deep to read")
+    config = ConfigTable({}, [], key_lines_from_text(text), path)
+    config.problems = [
+        one_line(f"{config.at(other)}: [{other}]: no such table; expected [{name}]")
+        for other in document
+        if other != name
+    ]
+    table = document.get(name, {})
+    if isinstance(table, dict):
+        config.table = table
+    else:
+        config.problems.append(f"{config.at(name)}: {name} must be a table, [{name}], of {what}")
+    return config

@@ -15,14 +15,13 @@ user's ``keys.toml`` changes the footer, the palette and the help together:
 from __future__ import annotations
 
 import re
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
 from textual.binding import Binding, BindingType
 
 from ladartui.textsafe import one_line
-from ladartui.toml_lines import key_lines_from_text
+from ladartui.toml_lines import read_config_table
 from ladartui.tui import bridge
 from ladartui.tui.view_area import LAYOUTS
 from ladartui.user_data import config_folder
@@ -257,34 +256,8 @@ def load_keymap(folder: Path | None = None) -> tuple[dict[str, str], list[str]]:
     id, a key that is not text, or one another command has, is reported (on its
     line) and left out, never fatal.
     """
-    path = (folder or config_folder()) / KEYS_FILE
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except FileNotFoundError:
-        return {}, []
-    except UnicodeDecodeError:
-        return {}, [f"{path}: not UTF-8 text"]
-    except OSError as error:
-        return {}, [one_line(f"{path}: {error.strerror or error}")]
-    try:
-        document = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as error:
-        return {}, [one_line(f"{path}: {error}")]
-    except RecursionError:
-        return {}, [f"{path}: nested too deep to read"]
-    lines = key_lines_from_text(text)
-
-    def at(key: str) -> str:
-        return f"{path}:{lines[key]}" if key in lines else str(path)
-
-    problems = [
-        one_line(f"{at(name)}: [{name}]: no such table; expected [keys]")
-        for name in document
-        if name != "keys"
-    ]
-    table = document.get("keys", {})
-    if not isinstance(table, dict):
-        return {}, [*problems, f"{at('keys')}: [keys] must be a table of command id = key"]
+    config = read_config_table((folder or config_folder()) / KEYS_FILE, "keys", "command id = key")
+    table, problems, at = config.table, config.problems, config.at
     keymap = {}
     for command_id, key in table.items():
         where = at(f"keys.{command_id}")

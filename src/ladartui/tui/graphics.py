@@ -32,13 +32,12 @@ from __future__ import annotations
 import os
 import sys
 import time
-import tomllib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
 from ladartui.textsafe import one_line
-from ladartui.toml_lines import key_lines_from_text
+from ladartui.toml_lines import read_config_table
 from ladartui.user_data import config_folder
 
 MODES = ("auto", "halfblocks", "characters", "sixel", "kitty", "iterm")
@@ -133,34 +132,9 @@ def probe_terminal() -> str | None:
 
 def read_setting(folder: Path | None = None) -> tuple[str, list[str]]:
     """The ``[display] graphics`` setting ("auto" when absent) and one line per problem."""
-    path = (folder or config_folder()) / SETTINGS_FILE
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except FileNotFoundError:
-        return "auto", []
-    except (OSError, UnicodeDecodeError) as error:
-        return "auto", [one_line(f"{path}: {getattr(error, 'strerror', None) or error}")]
-    try:
-        document = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as error:
-        return "auto", [one_line(f"{path}: {error}")]
-    except RecursionError:
-        return "auto", [f"{path}: nested too deep to read"]
-    lines = key_lines_from_text(text)
-
-    def at(key: str) -> str:
-        return f"{path}:{lines[key]}" if key in lines else str(path)
-
-    # a misspelt table or setting is said, not ignored
-    problems = [
-        one_line(f"{at(name)}: [{name}]: no such table; expected [display]")
-        for name in document
-        if name != "display"
-    ]
-    display = document.get("display", {})
+    config = read_config_table((folder or config_folder()) / SETTINGS_FILE, "display", "graphics = mode")
+    display, problems, at = config.table, config.problems, config.at
     where = at(SETTING)
-    if not isinstance(display, dict):
-        return "auto", [f"{where}: display must be a table, [display]"]
     problems += [
         one_line(f"{at(f'display.{name}')}: display.{name}: no such setting; expected graphics")
         for name in display
