@@ -221,12 +221,12 @@ LIMITS = [
     ("grid = 32", "grid = 2000", "sensor.grid = 2000", "an integer from 1 to 1024"),
     ("grid = 32", "grid = 32.5", "sensor.grid = 32.5", "an integer from 1 to 1024"),
     ("ray_grid = 2", "ray_grid = 0", "sensor.ray_grid = 0", "an integer from 1 to 16"),
-    ("fov_deg = 12.0", "fov_deg = 90.0", "sensor.fov_deg = 90.0", "a number at least 0.001 and less than 90"),
+    ("fov_deg = 12.0", "fov_deg = 90.0", "sensor.fov_deg = 90.0", "a number at least 1e-14 and less than 90"),
     (
         "fov_deg = 12.0",
         'fov_deg = "wide"',
         "sensor.fov_deg = 'wide'",
-        "a number at least 0.001 and less than 90",
+        "a number at least 1e-14 and less than 90",
     ),
     (
         "depth_resolution_m = 1.5",

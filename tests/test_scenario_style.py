@@ -102,21 +102,36 @@ def test_adding_a_segment_adds_its_lines_and_changes_no_other(folder):
         "+scans = 3",
     ]
     assert load_scenario(path).flight.start is None
+    lines = path.read_text().splitlines()
+    assert all(lines[n - 1] == "" for n, line in enumerate(lines) if n and line.startswith("["))
 
 
-def test_deleting_or_editing_one_segment_keeps_the_others_comments(folder):
+def test_deleting_moving_or_inserting_segments_saves_a_file_that_reads_back_the_same(folder):
+    """tomlkit keeps a table's comment line with the table before it: matching tables to
+    segments put comments on the wrong segment, and an inline array took a standard
+    table, which is not TOML. Such lists are written afresh."""
+    from ladartui.flight import Straight
+
     path = folder / "manoeuvres.toml"
-    shutil.copy(SHIPPED / "manoeuvres.toml", path)
-    before = path.read_text()
-    scenario = load_scenario(path)
-    first, turn, last = scenario.flight.segments
-    flight = dataclasses.replace(scenario.flight, segments=(first, dataclasses.replace(last, scans=5)))
-    scenario.with_changes(flight=flight).save()
-    changed = changed_lines(before, path.read_text())
-    assert "-scans = 4" in changed and "+scans = 5" in changed
-    assert all(line.startswith("-") for line in changed if line != "+scans = 5")  # the turn's lines went
-    assert "# at 30, 60 and 90 m along the run" in path.read_text()
-    assert load_scenario(path).flight.segments == flight.segments
+    inline = folder / "inline.toml"
+    manoeuvres = SHIPPED.joinpath("manoeuvres.toml").read_text()
+    inline.write_text(  # the same plan, its segments an inline array under [flight]
+        manoeuvres.split("[flight.start]")[0]
+        + "start = { x = -30.0, y = -60.0, z = 60.0, azimuth = 90.0, depression = 45.0 }\n"
+        + 'segments = [ { kind = "straight", distance = 90.0, scans = 3 },\n'
+        + '  { kind = "turn", radius = 40.0, arc = 90.0, direction = "right", scans = 3 },\n'
+        + '  { kind = "straight", distance = 30.0, scans = 2 } ]\n'
+    )
+    for source in (path, inline):
+        if source is path:
+            shutil.copy(SHIPPED / "manoeuvres.toml", path)
+        scenario = load_scenario(source)
+        first, *rest = scenario.flight.segments
+        for segments in ((first, rest[-1]), (rest[-1], first, *rest[:-1]), (first, Straight(5.0, 2), *rest)):
+            flight = dataclasses.replace(scenario.flight, segments=tuple(segments))
+            scenario.with_changes(flight=flight).save()
+            assert load_scenario(source).flight.segments == flight.segments
+            scenario = load_scenario(source)
 
 
 def test_save_as_renames_the_files_the_programs_header_names(folder, tmp_path):

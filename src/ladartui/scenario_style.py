@@ -9,12 +9,11 @@ has are removed; new keys are appended to their table.
 
 from __future__ import annotations
 
-import json
-from difflib import SequenceMatcher
 from typing import TypeGuard
 
 import tomlkit
 from tomlkit.exceptions import TOMLKitError
+from tomlkit.items import AoT
 
 
 def restyle(old_text: str, data: dict, old_data: dict | None = None) -> str | None:
@@ -51,59 +50,36 @@ def _merge_table(table, data: dict, old_data: dict | None) -> None:
             and _is_table_list(_plain(table[key]))
             and _merge_list(table[key], value, before)
         ):
-            pass  # segments keep their comments, added or deleted ones beside them
+            pass  # segments keep their comments, appended ones after them
         elif not _same(_plain(table[key]), value):
             table[key] = value
 
 
 def _merge_list(tables, values: list[dict], befores) -> bool:
-    """New values into a list of tables (``[[flight.segments]]``), each table kept where
-    it stands for the same item: an added item inserts its table, a deleted one's
-    table goes, an edited one changes its values only. False (the caller rewrites
-    the list) when the file's meaning is unknown and the lengths differ."""
-    if not (_is_table_list(befores) and len(befores) == len(tables)):
-        if len(values) != len(tables):
-            return False
-        befores = [None] * len(values)
-        pairs = dict(zip(range(len(values)), range(len(values))))
-    else:
-        pairs = dict((j, i) for i, j in _aligned(befores, values))
-    kept = set(pairs.values())
-    for i in reversed(range(len(tables))):
-        if i not in kept:
-            del tables[i]
-    at = 0
-    for j, value in enumerate(values):
-        if j in pairs:
-            _merge_table(tables[at], value, befores[pairs[j]])
-        elif at < len(tables):  # between tables: a blank line after it, as between the others
-            table = tomlkit.item(value)
-            table.add(tomlkit.nl())
-            tables.insert(at, table)
-        else:
-            tables.append(value)
-        at += 1
+    """New values into a list of tables (``[[flight.segments]]``): of the same length,
+    each table takes its item's values (its comments stay); longer by items appended
+    after an unchanged list (the TUI's Add segment), those go after the last table.
+    False otherwise (the caller rewrites the list): a table's comment line is kept by
+    tomlkit with the table before it, so a deleted or moved table would take the
+    wrong comments along, and an inline array holds no tables to add."""
+    if len(values) == len(tables):
+        befores = befores if _is_table_list(befores) and len(befores) == len(values) else [None] * len(values)
+        for table, value, before in zip(tables, values, befores):
+            _merge_table(table, value, before)
+        return True
+    appended = (
+        isinstance(tables, AoT)
+        and _is_table_list(befores)
+        and len(befores) == len(tables) < len(values)
+        and all(_same(b, v) for b, v in zip(befores, values))
+    )
+    if not appended:
+        return False
+    for value in values[len(tables) :]:
+        table = tomlkit.item(value)
+        table.add(tomlkit.nl())  # a blank line before whatever table follows, as the others have
+        tables.append(table)
     return True
-
-
-def _aligned(befores: list[dict], values: list[dict]) -> list[tuple[int, int]]:
-    """(old, new) index pairs of the items that stand for the same one, in order:
-    equal items first, then, between them, items of the same kind."""
-    pairs: list[tuple[int, int]] = []
-    exact = SequenceMatcher(None, [_key(b) for b in befores], [_key(v) for v in values], autojunk=False)
-    for tag, i1, i2, j1, j2 in exact.get_opcodes():
-        if tag == "equal":
-            pairs += zip(range(i1, i2), range(j1, j2))
-            continue
-        old_kinds = [str(b.get("kind")) for b in befores[i1:i2]]
-        new_kinds = [str(v.get("kind")) for v in values[j1:j2]]
-        for block in SequenceMatcher(None, old_kinds, new_kinds, autojunk=False).get_matching_blocks():
-            pairs += [(i1 + block.a + k, j1 + block.b + k) for k in range(block.size)]
-    return pairs
-
-
-def _key(item: dict) -> str:
-    return json.dumps(item, sort_keys=True, default=str)
 
 
 def _is_table_list(value: object) -> TypeGuard[list[dict]]:

@@ -37,7 +37,9 @@ MAX_RAY_GRID = 16
 MAX_DEPTH_RESOLUTION = 1000.0  # metres
 MAX_PIXEL_PITCH = 0.01  # metres; the focal plane spans grid * pitch
 MIN_PIXEL_PITCH = 1e-7  # metres (0.1 um): below any detector's
-MIN_FOV = 1e-3  # degrees (17 urad): below it the array sees one point
+# degrees: the narrowest pencil of rays the tracers are tested with (its rays already
+# coincide in float64); 1e-300 was taken before
+MIN_FOV = 1e-14
 # "stabilised": a gimbal holds azimuth and depression against the horizon (the
 # report's model, the default); "body-fixed": the rays turn with the aircraft's
 # roll and pitch (ladartui.attitude).
