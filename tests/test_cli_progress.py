@@ -82,6 +82,33 @@ def test_a_second_ctrl_c_waits_for_the_work_it_would_cut_short():
     assert seen == [True]
 
 
+def test_a_third_ctrl_c_leaves_work_that_never_stops(capsys):
+    """A step that never checks the cancel (a compile, a cluster closing) held the
+    command however often Ctrl-C or SIGTERM came."""
+    cancel, started = threading.Event(), threading.Event()
+    never = threading.Event()
+
+    def work():
+        started.set()
+        never.wait(30)
+
+    def interrupt():
+        import os
+        import signal
+        import time
+
+        started.wait(10)
+        for _ in range(3):
+            os.kill(os.getpid(), signal.SIGINT)  # as the terminal sends it
+            time.sleep(0.3)
+
+    threading.Thread(target=interrupt).start()
+    with pytest.raises(KeyboardInterrupt):
+        run_cancellable(work, cancel, "test-worker", Cancelled("nothing written"))
+    never.set()
+    assert "still stopping" in capsys.readouterr().err and cancel.is_set()
+
+
 def test_a_result_that_arrives_before_the_cancel_is_kept():
     cancel = threading.Event()
     assert run_cancellable(lambda: 42, cancel, "test-worker", Cancelled("no")) == 42

@@ -10,6 +10,7 @@ from __future__ import annotations
 import contextlib
 import os
 import signal
+import sys
 import threading
 from collections.abc import Callable
 from typing import Any, TypeVar
@@ -84,19 +85,30 @@ def run_cancellable(
     return outcome["result"]
 
 
+STILL_STOPPING = "ladartui: still stopping (a step under way finishes first); Ctrl-C again to leave at once\n"
+
+
 def _wait_out_interrupts(finished: threading.Event, stopping: Callable[[], None] | None) -> None:
-    """Wait for cancelled work to stop, whatever more Ctrl-C's come (a second key, or
-    timeout's SIGINT to the whole group): leaving while it writes would cut a set's
-    renames short, and the message would not say what was written."""
+    """Wait for cancelled work to stop. A second Ctrl-C (or timeout's SIGINT to the whole
+    group) is answered and waited out: leaving while the work writes would cut a set's
+    renames short, and the message would not say what was written. A third leaves at
+    once (a step that never checks for the cancel must not hold the terminal; a set
+    cut short in its renames is rolled back by the next run from its journal)."""
+    presses = 1
     while True:
         try:
             if stopping is not None and not finished.is_set():
                 say, stopping = stopping, None
                 say()
-            finished.wait()
+            while not finished.wait(POLL_SECONDS):  # short waits: a Ctrl-C is seen at once
+                pass
             return
         except KeyboardInterrupt:
-            continue
+            presses += 1
+            if presses > 2:
+                raise
+            sys.stderr.write(STILL_STOPPING)
+            sys.stderr.flush()
 
 
 # The signal that stopped the command (SIGINT unless SIGTERM did): its exit status is
