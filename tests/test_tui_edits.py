@@ -297,7 +297,7 @@ def test_fitted_shortens_the_name_given_then_cuts_the_end_in_cells():
 def test_keys_toml_problems_are_named_on_their_line_never_a_crash(tmp_path):
     """A keys.toml not in UTF-8 ended the app with a traceback, one nested 3000 deep in a
     RecursionError; two commands on one key, and a misspelt [keyz], passed without a word."""
-    from ladartui.tui.actions import load_keymap
+    from ladartui.tui.actions import keys_in_force, load_keymap
 
     keys = tmp_path / "keys.toml"
     keys.write_bytes(b'[keys]\nrun = "\xe9"\n')
@@ -313,6 +313,13 @@ def test_keys_toml_problems_are_named_on_their_line_never_a_crash(tmp_path):
         problems[1].startswith(f"{keys}:6: keys.run = 'ctrl+s': also the key of ") and "save" in problems[1]
     )
     assert keymap == {"layout": "ctrl+l"}  # the clash is left out: the default stays
+    # a remap refused puts its default back, which may clash with one taken before it
+    keys.write_text('[keys]\nhelp = "escape"\ncancel = "f5"\n')
+    keymap, problems = load_keymap(tmp_path)
+    in_force = keys_in_force(keymap)
+    used = [key.strip() for keys_of in in_force.values() for key in keys_of.split(",")]
+    assert len(used) == len(set(used)), in_force
+    assert len(problems) == 2 and "help" not in keymap and "cancel" not in keymap
 
 
 def test_the_app_ending_on_an_error_exits_non_zero(monkeypatch):
@@ -372,6 +379,17 @@ async def test_the_poses_dialog_keeps_what_is_typed_across_add_and_rows(tmp_path
         screen.query_one("#poses-ok").press()
         await pilot.pause()
         assert app.screen is screen and "at least one pose" in str(message.render())
+        # with none left, what is typed makes the one row: Add does not copy it again
+        await type_into(pilot, z, "42", commit=None)
+        screen.query_one("#pose-add").press()
+        await pilot.pause()
+        assert [p.z for p in screen.poses] == [42.0]
+        screen.query_one("#pose-delete").press()
+        await pilot.pause()
+        await type_into(pilot, z, "43", commit=None)
+        screen.query_one("#poses-ok").press()  # OK keeps it too
+        await pilot.pause()
+        assert app.screen is not screen and app.scenario.flight.segments[-1].poses[0].z == 43.0
 
 
 async def test_switching_the_setup_dialogs_mode_clears_the_other_modes_error(tmp_path, scene_files):

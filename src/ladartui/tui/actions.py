@@ -276,17 +276,23 @@ def load_keymap(folder: Path | None = None) -> tuple[dict[str, str], list[str]]:
             )
         else:
             keymap[command_id] = key.strip()
-    for command_id in list(keymap):  # in file order: a later remap may free a key
-        mine = _key_set(keymap[command_id])
-        taken = [c for c, keys in keys_in_force(keymap).items() if c != command_id and mine & _key_set(keys)]
-        if taken:
-            key = keymap.pop(command_id)
-            problems.append(
-                one_line(
-                    f"{at(f'keys.{command_id}')}: keys.{command_id} = {key!r}: also the key "
-                    f"of {', '.join(taken)}; remap that too, or choose another"
+    # In file order, again until none is left out: a remap refused puts its command's
+    # default key back, which may be one a remap taken earlier uses.
+    clashed = True
+    while clashed:
+        clashed = False
+        for command_id in list(keymap):
+            mine = _key_set(keymap[command_id])
+            in_force = keys_in_force(keymap)
+            taken = [c for c, keys in in_force.items() if c != command_id and mine & _key_set(keys)]
+            if taken:
+                key, clashed = keymap.pop(command_id), True
+                problems.append(
+                    one_line(
+                        f"{at(f'keys.{command_id}')}: keys.{command_id} = {key!r}: also the key "
+                        f"of {', '.join(taken)}; remap that too, or choose another"
+                    )
                 )
-            )
     return keymap, problems
 
 

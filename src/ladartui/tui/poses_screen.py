@@ -188,8 +188,11 @@ class PosesScreen(Dialog):
     @on(Button.Pressed, "#pose-add")
     def action_add_pose(self) -> None:
         """A new last row, a copy of the selected one with what is typed applied."""
+        rows = len(self.poses)
         if self._edited() and not self._apply():
             return
+        if len(self.poses) > rows:
+            return  # what was typed went in as a new row (there was none to apply it to)
         row = self.query_one(DataTable).cursor_row
         template = self.poses[row] if 0 <= row < len(self.poses) else self.defaults
         self.poses.append(template)
@@ -205,7 +208,7 @@ class PosesScreen(Dialog):
     @on(Button.Pressed, "#poses-ok")
     def _ok(self) -> None:
         # typed values are applied first, as Run and Save commit the main form's
-        if self.poses and self._edited() and not self._apply():
+        if self._edited() and not self._apply():
             return
         if not self.poses:  # stays open, as every dialog does while a value is not allowed
             self.query_one("#poses-message", Static).update(
