@@ -291,6 +291,10 @@ def test_fitted_shortens_the_name_given_then_cuts_the_end_in_cells():
     # no name given (or the name alone not enough): the end is cut, marked
     shown = fitted("sweep stopped: " + "x" * 100, 40)
     assert cell_len(shown) == 40 and shown.endswith("\u2026")
+    # no name given, a path in the message: the path gives way, 'F5 resumes' stays
+    said = "sweep cancelled: 12 rows kept in ~/projects/night-approach/final-sweep-results; F5 resumes"
+    shown = fitted(said, 60)
+    assert cell_len(shown) <= 60 and shown.endswith("results; F5 resumes") and "\u2026" in shown
     assert fitted("short", 40, "short") == "short"
 
 

@@ -103,12 +103,15 @@ ELLIPSIS = "\u2026"
 
 
 def fitted(message: str, room: int, name: str | None = None) -> str:
-    """``message`` in ``room`` cells: ``name`` (where it occurs) cut in its middle
-    (``nigh…final.toml``, keeping at least ``MIN_NAME`` cells), then the end cut if
-    that is not enough."""
+    """``message`` in ``room`` cells: ``name`` (where it occurs; by default the longest
+    path in it) cut in its middle (``nigh…final.toml``, keeping at least ``MIN_NAME``
+    cells), then the end cut if that is not enough."""
     over = cell_len(message) - room
     if over <= 0:
         return message
+    if name is None:  # a message of the sweep screen: its longest path, if it names one
+        paths = [word.strip(";,:()") for word in message.split(" ") if "/" in word]
+        name = max(paths, key=cell_len, default=None)
     if name and name in message and cell_len(name) > MIN_NAME:
         keep = max(MIN_NAME, cell_len(name) - over - 1)  # one cell for the ellipsis
         head = keep // 3  # the end tells names apart more often (a suffix, the extension)
