@@ -60,9 +60,11 @@ def test_show_ranks_the_rows_of_the_current_base_only(tmp_path, capsys):
     base.write_text(base.read_text(encoding="utf-8").replace("fov_deg = 18.0", "fov_deg = 16.0"))
     charts = {p: p.read_bytes() for p in out.glob("pareto.*")}
     assert charts
-    assert main(["sweep", str(spec), "--show"]) == 0
-    text = capsys.readouterr().out.replace("\n", " ")
+    assert main(["sweep", str(spec), "--show"]) == 1  # nothing to rank: a script must know
+    captured = capsys.readouterr()
+    text = captured.out.replace("\n", " ")
     assert "4 rows of other variants or an earlier base left out" in text
+    assert "no variant finished (no row of this spec's variants from its base as it is now)" in captured.err
     assert {p: p.read_bytes() for p in out.glob("pareto.*")} == charts  # not redrawn empty
     # the base gone: every row of the table, said so
     base.unlink()

@@ -207,12 +207,13 @@ def run(args) -> int:
         if not console.is_terminal and "COLUMNS" not in os.environ:
             console = Console(width=160)  # a file or pipe: do not squeeze the table into 80 columns
         show_result(console, result, args.top)
-    if result.rows and not any(row.get("status") == "ok" for row in result.rows):
+    if not any(row.get("status") == "ok" for row in result.rows):
         counts = Counter(str(row.get("status")) for row in result.rows)
         said = ", ".join(
             f"{n} {'impossible' if status == 'error' else status}" for status, n in counts.items()
         )
-        errors.print(f"ladartui: no variant finished ({said})", highlight=False, markup=False)
+        said = f"({said})" if said else "(no row of this spec's variants from its base as it is now)"
+        errors.print(f"ladartui: no variant finished {said}", highlight=False, markup=False, soft_wrap=True)
         return 1  # a script must not take an empty ranking for a result
     return 0
 
