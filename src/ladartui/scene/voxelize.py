@@ -37,6 +37,7 @@ import threading
 import warnings
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -204,35 +205,53 @@ def check_obj_lines(path: Path) -> None:
     except OSError as error:
         raise InputFileError(path, f"cannot be read ({error.strerror or error})") from None
     lines = text.splitlines()
-    total = sum(1 for line in lines if line.split(maxsplit=1)[:1] == ["v"])
+    records = ("v ", "v\t", "f ", "f\t")
+
+    def record(line: str) -> str:
+        """'v', 'f' or '' (another record); the common case without splitting the line."""
+        if line[:2] in records:
+            return line[0]
+        if line[:1] in (" ", "\t"):  # indented
+            first = line.split(maxsplit=1)[:1]
+            return first[0] if first in (["v"], ["f"]) else ""
+        return ""
+
+    total = sum(1 for line in lines if record(line) == "v")
     seen = 0
+    isfinite = math.isfinite
     for number, line in enumerate(lines, 1):
-        words = line.split()
-        if not words or words[0] not in ("v", "f"):
+        if not record(line):
             continue
-        shown = one_line(" ".join(words))[:80]
+        words = line.split()
+        shown = partial(_shown_line, words)  # made only for a message: millions of lines pass
         if words[0] == "v":
             seen += 1
             try:
                 xyz = [float(w) for w in words[1:4]]
             except ValueError:
-                raise InputFileError(path, f"vertex '{shown}': expected x, y, z as numbers", number) from None
+                raise InputFileError(
+                    path, f"vertex '{shown()}': expected x, y, z as numbers", number
+                ) from None
             if len(xyz) < 3:
-                raise InputFileError(path, f"vertex '{shown}': expected x, y, z", number)
-            if not all(math.isfinite(v) for v in xyz):
-                raise InputFileError(path, f"vertex '{shown}': expected x, y, z as finite numbers", number)
+                raise InputFileError(path, f"vertex '{shown()}': expected x, y, z", number)
+            if not (isfinite(xyz[0]) and isfinite(xyz[1]) and isfinite(xyz[2])):
+                raise InputFileError(path, f"vertex '{shown()}': expected x, y, z as finite numbers", number)
             continue
         for word in words[1:]:
             try:
-                index = int(word.split("/")[0])
+                index = int(word.split("/", 1)[0])
             except ValueError:
-                raise InputFileError(path, f"face '{shown}': expected vertex numbers", number) from None
+                raise InputFileError(path, f"face '{shown()}': expected vertex numbers", number) from None
             if not (1 <= index <= total or -seen <= index <= -1):
                 raise InputFileError(
                     path,
-                    f"face '{shown}' refers to vertex {index}: expected 1 to {total} (or -1 to -{seen})",
+                    f"face '{shown()}' refers to vertex {index}: expected 1 to {total} (or -1 to -{seen})",
                     number,
                 )
+
+
+def _shown_line(words: list[str]) -> str:
+    return one_line(" ".join(words))[:80]
 
 
 @contextlib.contextmanager
