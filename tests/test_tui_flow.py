@@ -149,7 +149,7 @@ async def test_invalid_values_go_back_to_the_scenarios_value_with_a_message(shar
     pitch = field(app, "sensor.pixel_pitch")
     await type_into(pilot, pitch, "50000")
     assert "Pixel pitch um: 50000 is not allowed" in app.messages[-1]
-    assert "at most 10000 um" in app.messages[-1]  # micrometres, as typed, not metres
+    assert "from 0.1 to 10000 um" in app.messages[-1]  # micrometres, as typed, not metres
     # a good value is kept
     await type_into(pilot, field(app, "sensor.ray_grid"), "3")
     assert app.scenario.sensor.ray_grid == 3

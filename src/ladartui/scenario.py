@@ -406,7 +406,11 @@ def target_file_for(scene_file) -> Path:
 def load_scenario(path, check_files=True) -> Scenario:
     """Read and check a scenario file; with ``check_files``, its model files must exist."""
     path = _absolute(path)
-    if path.exists() and not path.is_file() and not path.is_dir():  # reading a pipe would wait for ever
+    try:
+        special = path.exists() and not path.is_file() and not path.is_dir()
+    except OSError:  # a name the system cannot look up: reading it says why
+        special = False
+    if special:  # reading a pipe would wait for ever
         raise InputFileError(
             path, "is not a regular file (a pipe or device); expected a scenario file (.toml)"
         )
