@@ -477,6 +477,22 @@ def test_a_study_is_written_as_one_set(tmp_path, monkeypatch):
     with pytest.raises(OSError):
         write_outputs(changed, tmp_path)
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    # a failure while the set is written (the PNG's temporary): nothing replaced either
+    monkeypatch.undo()
+    real = Path.write_bytes
+
+    def full_at_the_png(self, data):
+        if ".png." in self.name:
+            raise OSError(28, "No space left on device")
+        return real(self, data)
+
+    monkeypatch.setattr(Path, "write_bytes", full_at_the_png)
+    from ladartui.errors import OutputFileError
+
+    with pytest.raises(OutputFileError, match="nothing was replaced"):
+        write_outputs(changed, tmp_path)
+    monkeypatch.undo()
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
 
 
 def test_chart_from_refuses_the_flags_of_a_new_study(tmp_path, capsys):

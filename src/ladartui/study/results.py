@@ -238,8 +238,12 @@ class StudyResult:
         out_dir = Path(out_dir)
         paths = {"csv": out_dir / f"{stem}.csv", "json": out_dir / f"{stem}.json"}
         write_text_atomic(paths["csv"], self.to_csv())
-        write_text_atomic(paths["json"], json.dumps(self.to_dict(), indent=1, allow_nan=False) + "\n")
+        write_text_atomic(paths["json"], self.to_json())
         return paths
+
+    def to_json(self) -> str:
+        """The study as ``study.json`` holds it."""
+        return json.dumps(self.to_dict(), indent=1, allow_nan=False) + "\n"
 
 
 def _csv_record(row: StudyRow) -> list:

@@ -15,7 +15,6 @@ its error is taken against exact float64 numba at the largest ray grid.
 from __future__ import annotations
 
 import datetime
-import json
 import os
 import platform
 import threading
@@ -273,7 +272,7 @@ def write_outputs(
     figure = speed_accuracy_figure(result)
     contents = {
         "csv": result.to_csv().encode("utf-8"),
-        "json": (json.dumps(result.to_dict(), indent=1, allow_nan=False) + "\n").encode("utf-8"),
+        "json": result.to_json().encode("utf-8"),
         "svg": figure_bytes(figure, "svg"),
         "png": figure_bytes(figure, "png"),
         "txt": (chart_text(result, width, height, color=False) + "\n\n" + result.verdict() + "\n").encode(),
