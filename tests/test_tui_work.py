@@ -217,3 +217,16 @@ async def test_the_study_screen_shows_text_from_a_study_file_as_it_is(tmp_path, 
         await pilot.pause()
         verdict = str(screen.query_one("#study-verdict", Static).render())
         assert "no gpu\\x1b[2J [b]here[/b] [/x]" in verdict.replace("\n", " ")
+
+
+async def test_the_study_status_shortens_a_long_path_and_keeps_the_keys(tmp_path, scene_files):
+    """At 80 columns 'Study on /a/long/path.toml: q quick, f full, ...' lost its keys."""
+    from rich.cells import cell_len
+
+    folder = tmp_path / ("a-long-folder-name-" * 3)
+    folder.mkdir()
+    async with study_screen(folder, scene_files, size=(80, 24)) as (app, pilot, screen):
+        status = screen.query_one("#study-status", Static)
+        shown = str(status.render())
+        assert shown.endswith("q quick, f full, Ctrl+X cancel, Esc back"), shown
+        assert "\u2026" in shown and cell_len(shown) <= status.content_size.width

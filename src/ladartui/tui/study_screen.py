@@ -21,6 +21,7 @@ from textual_plotext import PlotextPlot
 from ladartui.study.chart import TABLE_COLUMNS, draw_chart, label_places, legend_text, table_rows
 from ladartui.textsafe import visible
 from ladartui.tui.fitted_tables import FittingTable, fill_whole_columns
+from ladartui.tui.status import StatusText
 from ladartui.tui.work import JobDone, JobProgress, running, start_job
 
 NARROW = 100  # columns
@@ -70,7 +71,7 @@ class StudyScreen(Screen):
                 yield FittingTable(self._fill_table, id="study-table", zebra_stripes=True, cursor_type="row")
                 yield Static("", id="study-table-note", markup=False)
                 yield Static("", id="study-verdict")
-        yield Static(self._idle_text(), id="study-status", markup=False)
+        yield StatusText(id="study-status")  # one line: a long path gives way, not the keys
         with Horizontal(id="study-bar"):
             yield ProgressBar(total=1, id="study-progress", show_eta=False)  # idle: 0 %, not animated
             yield Button("Quick", id="study-quick", compact=True)
@@ -91,6 +92,7 @@ class StudyScreen(Screen):
 
     def on_mount(self) -> None:
         self._fill_table()
+        self._set_status(self._idle_text())
         plot = self.query_one("#study-chart", PlotextPlot).plt
         plot.title("Speed against accuracy: press q (quick) or f (full)")
         self._reopen()
@@ -209,7 +211,9 @@ class StudyScreen(Screen):
         self._set_status(message)
 
     def _set_status(self, message: str) -> None:
-        self.query_one("#study-status", Static).update(Text(visible(message)))  # it may name files
+        # it may name files: shown as text, the scenario's path shortened first
+        path = visible(str(self.scenario_path)) if self.scenario_path else None
+        self.query_one("#study-status", StatusText).show(visible(message), path)
 
 
 def _study(mode: str, scenario_path, scans, runs, cancel, progress):
