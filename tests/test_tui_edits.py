@@ -431,3 +431,24 @@ async def test_the_sensor_summary_keeps_each_figure_with_its_unit_at_80_columns(
             for strip in info.render_lines(info.content_region.reset_offset)
         ]
         assert any(line.startswith("IFOV ") and line.endswith(" mdeg") for line in shown), shown
+
+
+async def test_outputs_another_run_writes_on_disk_are_shown_not_the_old_ones(tmp_path, scene_files):
+    """A second instance (or the CLI) ran the same file: this one kept showing its own
+    measures as current, and Export LAS wrote the other run's files under them."""
+    from ladartui.sensor import Sensor
+    from ladartui.simulation import simulate
+    from ladartui.tui.status import NOT_READY, StatusBar
+
+    scenario = make_scenario(tmp_path, scene_files)
+    simulate(scenario)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app) and app.measures is not None)
+        app.check_outputs_on_disk()  # nothing changed: nothing happens
+        assert not app.outputs_stale() and not any("changed on disk" in m for m in app.messages)
+        simulate(scenario.with_changes(sensor=Sensor(grid=12, ray_grid=1, fov=8.0)))  # elsewhere
+        app.check_outputs_on_disk()
+        await wait_until(pilot, lambda: app.outputs_from is not None and app.outputs_from.sensor.grid == 12)
+        assert app.query_one(StatusBar).state == NOT_READY  # out of date for this file's settings
+        assert any("changed on disk" in m for m in app.messages)

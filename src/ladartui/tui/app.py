@@ -87,6 +87,9 @@ def help_rows(app=None) -> list[tuple[str, str, str]]:
     return rows
 
 
+OUTPUTS_CHECK_SECONDS = 2.0  # how often the outputs on disk are compared with those shown
+
+
 class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl, App):
     """Plan a foliage-penetrating LADAR collection: set up, fly, run, compare."""
 
@@ -120,6 +123,7 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         self.output_voxels = None
         self.missing_outputs: list[Path] = []
         self.outputs_from: Scenario | None = None  # the settings that made the outputs shown
+        self.outputs_seen: tuple[int, int] | None = None  # (mtime, size) of the measures read
         self.threshold: float | None = None
         self.busy: str | None = None
         self.progress: float | None = None
@@ -180,6 +184,7 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         for problem in self.graphics_problems:
             self.tell(problem, title="Settings", severity="warning", timeout=10)
         self.refresh_status()
+        self.set_interval(OUTPUTS_CHECK_SECONDS, self.check_outputs_on_disk)  # another run's outputs
         if self.start_scenario is not None:
             self.load(None, scenario=self.start_scenario)
         else:

@@ -47,6 +47,7 @@ class AppHost(App[None]):
     output_voxels: np.ndarray | None
     missing_outputs: list[Path]
     outputs_from: Scenario | None  # the settings that made the outputs shown
+    outputs_seen: tuple[int, int] | None  # the measures file's (mtime, size) when they were read
     cwd: Path
     compile_in_child: bool
     # the jobs and the busy state
@@ -129,6 +130,9 @@ class AppHost(App[None]):
         raise NotImplementedError
 
     def show_outputs_of(self, scenario: Scenario) -> None:
+        raise NotImplementedError
+
+    def note_outputs_seen(self) -> None:
         raise NotImplementedError
 
     def confirm_discard(self, doing: str, then: Callable[[], None], opens: Path | None = None) -> None:

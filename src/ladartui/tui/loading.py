@@ -115,8 +115,29 @@ class SceneLoading(Host):
         self._show_earlier(earlier)
         self.scenario_changed()
 
+    def check_outputs_on_disk(self) -> None:
+        """Every few seconds: outputs another run of this file wrote (a second instance, the
+        CLI) are read and shown, said in a note; the ones shown are no longer on disk."""
+        scenario = self.scenario
+        if scenario is None or self.busy is not None or self.running:
+            return
+        now = outputs_on_disk(scenario)
+        if now == self.outputs_seen or self.outputs_seen is None and now is None:
+            return
+        self.outputs_seen = now
+        self.tell(
+            f"The outputs of {scenario.path.name} changed on disk (another run?): shown as they are now."
+        )
+        self.show_outputs_of(scenario)
+        self.scenario_changed()
+
+    def note_outputs_seen(self) -> None:
+        """The outputs on disk are the ones shown (read, or written by this app's run)."""
+        self.outputs_seen = outputs_on_disk(self.scenario) if self.scenario is not None else None
+
     def _show_earlier(self, earlier: Earlier) -> None:
         """An earlier run's outputs and measures in the views, and what made them."""
+        self.note_outputs_seen()
         self.outputs_from = earlier.made_with
         self.output_voxels = earlier.output
         self.show_output()
@@ -176,3 +197,13 @@ def _existing_results(scenario):
     from ladartui.scene.voxels import load_voxels
 
     return load_voxels(scenario.scene_output), read_cmf(scenario.measures_file)
+
+
+def outputs_on_disk(scenario) -> tuple[int, int] | None:
+    """When and how large the measures file is (a run replaces it with the rest of its
+    set), or None when there is none: what tells another run's outputs apart."""
+    try:
+        status = scenario.measures_file.stat()
+    except OSError:
+        return None
+    return status.st_mtime_ns, status.st_size

@@ -85,6 +85,7 @@ class RunControl(Host):
         self.result = result
         self.missing_outputs = []
         self.outputs_from = self.scenario  # (not editable while the run went on)
+        self.note_outputs_seen()  # this run's own: not another's
         self.output_voxels = result.scene_output
         self.show_output()
         self.show_measures(result.measures)
