@@ -452,3 +452,8 @@ async def test_outputs_another_run_writes_on_disk_are_shown_not_the_old_ones(tmp
         await wait_until(pilot, lambda: app.outputs_from is not None and app.outputs_from.sensor.grid == 12)
         assert app.query_one(StatusBar).state == NOT_READY  # out of date for this file's settings
         assert any("changed on disk" in m for m in app.messages)
+        scenario.measures_file.unlink()  # gone: said, and named in the status bar
+        app.check_outputs_on_disk()
+        await pilot.pause()
+        assert any("gone from disk" in m for m in app.messages)
+        assert "outputs missing" in app.query_one(StatusBar).message

@@ -122,13 +122,18 @@ class SceneLoading(Host):
         if scenario is None or self.busy is not None or self.running:
             return
         now = outputs_on_disk(scenario)
-        if now == self.outputs_seen or self.outputs_seen is None and now is None:
+        if now == self.outputs_seen:
             return
         self.outputs_seen = now
-        self.tell(
-            f"The outputs of {scenario.path.name} changed on disk (another run?): shown as they are now."
-        )
-        self.show_outputs_of(scenario)
+        if now is None:
+            self.tell(
+                f"The outputs of {scenario.path.name} are gone from disk: those shown were read before."
+            )
+        else:
+            self.tell(
+                f"The outputs of {scenario.path.name} changed on disk (another run?): shown as they are now."
+            )
+        self.show_outputs_of(scenario)  # reads them, or names the files missing
         self.scenario_changed()
 
     def note_outputs_seen(self) -> None:
