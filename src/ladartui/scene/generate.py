@@ -169,11 +169,11 @@ def scene_params(preset="small", **overrides) -> SceneParams:
 
 # Peak bytes of a generation: a base, per ground cell (the height maps), and per voxel
 # its trees are expected to make (their arrays and the clipping, carving and merging
-# copies). An upper estimate: /usr/bin/time -v gave 52 bytes per expected voxel on the
-# small preset (2,000 and 8,000 trees) and 95 on the reference one (400 trees).
+# copies). An upper estimate: /usr/bin/time -v gave peaks of 0.51x it on the small
+# preset at 8,000 trees and 0.89x on the reference one at 400 trees.
 BASE_BYTES = 64 * 2**20
 BYTES_PER_CELL = 16
-BYTES_PER_TREE_VOXEL = 100
+BYTES_PER_TREE_VOXEL = 90
 
 
 def check_memory(params: SceneParams, trees, nx: int, ny: int) -> int:
