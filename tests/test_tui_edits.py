@@ -457,3 +457,19 @@ async def test_outputs_another_run_writes_on_disk_are_shown_not_the_old_ones(tmp
         await pilot.pause()
         assert any("gone from disk" in m for m in app.messages)
         assert "outputs missing" in app.query_one(StatusBar).message
+
+
+async def test_save_as_is_not_taken_for_another_run(tmp_path, scene_files):
+    """After Save As the outputs compared were the old name's: a note said another run
+    had changed them."""
+    from ladartui.simulation import simulate
+
+    scenario = make_scenario(tmp_path, scene_files)
+    simulate(scenario)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app) and app.measures is not None)
+        assert app._save_to(tmp_path / "copy.toml")
+        app.check_outputs_on_disk()
+        await pilot.pause()
+        assert not any("changed on disk" in m or "gone from disk" in m for m in app.messages)

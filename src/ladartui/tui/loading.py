@@ -105,6 +105,7 @@ class SceneLoading(Host):
     def show_outputs_of(self, scenario: Scenario) -> None:
         """After Save As onto a name: the outputs already on disk under it, shown as
         opening that file would show them (read in a worker)."""
+        self.outputs_seen = outputs_on_disk(scenario)  # the ones about to be shown: no other run's
         self.missing_outputs = missing_outputs(scenario)
         if scenario.scene_output.is_file() and scenario.measures_file.is_file():
             start_job(self, "earlier", lambda cancel, progress: _earlier(scenario))
