@@ -14,11 +14,9 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from textual import events, on
 from textual.app import App, ComposeResult, SystemCommand
-from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.css.query import NoMatches
 from textual.notifications import SeverityLevel
@@ -29,14 +27,13 @@ from ladartui.edit_history import EditHistory
 from ladartui.run_record import setting_changes
 from ladartui.scenario import Scenario
 from ladartui.tui import actions, bridge
-from ladartui.tui.canvas import ProjectionWidget, TopViewWidget
 from ladartui.tui.editing import ScenarioEditing
 from ladartui.tui.file_actions import FileActions
 from ladartui.tui.graphics import Graphics, has_truecolor
+from ladartui.tui.help_rows import help_rows, palette_entries
 from ladartui.tui.loading import SceneLoading
 from ladartui.tui.panels import FilePanel, FlightPanel, ResultsPanel, RunPanel, SensorPanel
 from ladartui.tui.params import ParamField
-from ladartui.tui.poses_screen import PosesScreen
 from ladartui.tui.runs import RunControl
 from ladartui.tui.screens import (
     AngleScreen,
@@ -57,35 +54,6 @@ CONTROLS = (
     "#sidebar DataTable, #sidebar OptionList"
 )
 own_actions = actions.own_actions
-
-if TYPE_CHECKING:
-    pass
-
-
-def palette_entries(app=None) -> list[tuple[str, str, str]]:
-    """The command palette's entries, with the keys in force in ``app``."""
-    return actions.palette_entries(app.keymap if app is not None else None)
-
-
-def help_rows(app=None) -> list[tuple[str, str, str]]:
-    """The help screen's rows: the app's keys (as remapped), the views' and the dialogs',
-    and how the views are drawn (``graphics`` in settings.toml forces it)."""
-    rows = actions.help_rows(
-        app.keymap if app is not None else None,
-        ProjectionWidget.BINDINGS,
-        PosesScreen.BINDINGS,
-        TopViewWidget.BINDINGS,
-    )
-    from ladartui.tui.study_screen import StudyScreen  # (plotting: loaded for help, shown on demand)
-    from ladartui.tui.sweep_screen import SweepScreen
-
-    for where, screen in (("Study screen", StudyScreen), ("Sweep screen", SweepScreen)):
-        bindings = [b for b in screen.BINDINGS if isinstance(b, Binding) and b.description]
-        rows.extend((where, actions.key_name(b.key), b.description) for b in bindings)
-    if app is not None:
-        rows.append(("Views", "settings.toml", "Drawn as " + app.graphics.describe()))
-    return rows
-
 
 OUTPUTS_CHECK_SECONDS = 2.0  # how often the outputs on disk are compared with those shown
 

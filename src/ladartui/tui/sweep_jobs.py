@@ -6,8 +6,9 @@ what they report."""
 from __future__ import annotations
 
 import sys
+from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from ladartui.errors import FieldError, InputFileError
 
@@ -106,3 +107,42 @@ def spec_to_run(text: str):
     if bundled_name(spec.scenario_path) is None:
         load_scenario(base_scenario_path(spec))
     return spec
+
+
+@dataclass
+class OpenedSweep:
+    """What the sweep screen opened: a spec (with its results, once run) or results."""
+
+    path: Path  # as typed
+    spec: Any  # SweepSpec, or None for results without a spec beside them
+    out: Path  # the results folder
+    result: Any = None  # SweepResult; None: the spec has no results yet
+    own: list[dict] | None = None  # opened by its spec: its variants from its base as it is now
+
+
+def open_sweep(text: str) -> OpenedSweep:
+    """Read a sweep spec, a results folder or a results.csv; ``LadarError`` naming what
+    is wrong. A spec opened ranks only its own variants from its base as it is now (the
+    folder may hold others: another seed, an edited base or model)."""
+    from ladartui.sweep import default_out_dir, load_sweep_results, load_sweep_spec
+    from ladartui.sweep.base import spec_rows
+
+    if not text:
+        raise FieldError("spec", text, "a sweep spec, a results.csv or a results folder")
+    path = Path(text).expanduser()
+    by_spec = path.suffix.lower() == ".toml"
+    if by_spec:
+        spec = load_sweep_spec(path)
+        results = default_out_dir(spec)
+        if not (results / "results.csv").exists():
+            return OpenedSweep(path, spec, results)
+    else:
+        results = path
+        sibling = sibling_spec(path)
+        spec = load_sweep_spec(sibling) if sibling is not None else None
+    objective = spec.objective if spec else "obscured-coverage"
+    budget = spec.budget if spec else None
+    cost = spec.cost if spec else "flight-time"
+    result = load_sweep_results(results, objective=objective, budget=budget, cost=cost)
+    own = spec_rows(result.rows, spec) if spec is not None and by_spec else None
+    return OpenedSweep(path, spec, result.results_path.parent, result, own)

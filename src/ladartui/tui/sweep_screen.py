@@ -30,7 +30,13 @@ from ladartui.errors import FieldError, LadarError
 from ladartui.recent import recent_paths, remember_path
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar, StatusText, format_eta
-from ladartui.tui.sweep_jobs import sibling_spec, spec_to_run, start_resource_tracker, sweep_job, write_best
+from ladartui.tui.sweep_jobs import (
+    open_sweep,
+    spec_to_run,
+    start_resource_tracker,
+    sweep_job,
+    write_best,
+)
 from ladartui.tui.sweep_ranking import RankingView
 from ladartui.tui.sweep_view import (
     eta_seconds,
@@ -419,46 +425,25 @@ class SweepScreen(RankingView):
     # -- opening results ------------------------------------------------------------
 
     def _open(self, text: str) -> None:
-        from ladartui.sweep import default_out_dir, load_sweep_results, load_sweep_spec
-        from ladartui.sweep.base import spec_rows
-
         try:
-            if not text:
-                raise FieldError("spec", text, "a sweep spec, a results.csv or a results folder")
-            path = Path(text).expanduser()
-            spec = None
-            if path.suffix.lower() == ".toml":
-                spec = load_sweep_spec(path)
-                results = default_out_dir(spec)
-                if not (results / "results.csv").exists():
-                    self.spec, self.out, self.rows, self.ranking = spec, results, [], []
-                    self.objective, self.cost, self.budget = spec.objective, spec.cost, spec.budget
-                    self.parameter_names = spec.parameter_names
-                    self._redraw()
-                    self._show_stored(len(spec.variants))
-                    self._status(
-                        NOT_READY, f"{path}: {len(spec.variants)} variants, no results yet: F5 runs the sweep"
-                    )
-                    remember_path("sweeps", path)
-                    return
-            else:
-                results = path
-                sibling = sibling_spec(path)
-                spec = load_sweep_spec(sibling) if sibling is not None else None
-            objective = spec.objective if spec else "obscured-coverage"
-            budget = spec.budget if spec else None
-            cost = spec.cost if spec else "flight-time"
-            result = load_sweep_results(results, objective=objective, budget=budget, cost=cost)
-            # opened by its spec: the spec's own variants from its base as it is now (the
-            # folder may hold others: another seed, an edited base or model)
-            own = (
-                spec_rows(result.rows, spec) if spec is not None and path.suffix.lower() == ".toml" else None
-            )
+            opened = open_sweep(text)
         except LadarError as error:
             self._status(NOT_READY, str(error), problem=True)
             return
+        spec, result, own, path = opened.spec, opened.result, opened.own, opened.path
+        if result is None:  # a spec not run yet
+            self.spec, self.out, self.rows, self.ranking = spec, opened.out, [], []
+            self.objective, self.cost, self.budget = spec.objective, spec.cost, spec.budget
+            self.parameter_names = spec.parameter_names
+            self._redraw()
+            self._show_stored(len(spec.variants))
+            self._status(
+                NOT_READY, f"{path}: {len(spec.variants)} variants, no results yet: F5 runs the sweep"
+            )
+            remember_path("sweeps", path)
+            return
         self.spec = spec
-        self.out = result.results_path.parent
+        self.out = opened.out
         self.rows, self.ranking = result.rows, result.ranking
         self.objective, self.cost, self.budget = result.objective, result.cost, result.budget
         self.parameter_names = spec.parameter_names if spec else result.parameter_names

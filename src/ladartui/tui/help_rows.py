@@ -1,0 +1,36 @@
+"""What the help screen lists and the palette offers: every key in force (as the user's
+keys.toml remaps them), the views', the dialogs' and the study and sweep screens', and
+how the views are drawn."""
+
+from __future__ import annotations
+
+from textual.binding import Binding
+
+from ladartui.tui import actions
+from ladartui.tui.canvas import ProjectionWidget, TopViewWidget
+from ladartui.tui.poses_screen import PosesScreen
+
+
+def palette_entries(app=None) -> list[tuple[str, str, str]]:
+    """The command palette's entries, with the keys in force in ``app``."""
+    return actions.palette_entries(app.keymap if app is not None else None)
+
+
+def help_rows(app=None) -> list[tuple[str, str, str]]:
+    """The help screen's rows: the app's keys (as remapped), the views' and the dialogs',
+    and how the views are drawn (``graphics`` in settings.toml forces it)."""
+    rows = actions.help_rows(
+        app.keymap if app is not None else None,
+        ProjectionWidget.BINDINGS,
+        PosesScreen.BINDINGS,
+        TopViewWidget.BINDINGS,
+    )
+    from ladartui.tui.study_screen import StudyScreen  # (plotting: loaded for help, shown on demand)
+    from ladartui.tui.sweep_screen import SweepScreen
+
+    for where, screen in (("Study screen", StudyScreen), ("Sweep screen", SweepScreen)):
+        bindings = [b for b in screen.BINDINGS if isinstance(b, Binding) and b.description]
+        rows.extend((where, actions.key_name(b.key), b.description) for b in bindings)
+    if app is not None:
+        rows.append(("Views", "settings.toml", "Drawn as " + app.graphics.describe()))
+    return rows
