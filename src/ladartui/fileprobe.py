@@ -4,6 +4,8 @@ import errno
 import os
 from pathlib import Path
 
+SPECIAL_FILE = "is not a regular file (a pipe or device)"
+
 
 def file_problem(path: Path) -> str | None:
     """None when ``path`` is a regular file; else what is wrong ("not found", "is a folder", ...)."""
@@ -13,7 +15,7 @@ def file_problem(path: Path) -> str | None:
         if Path(path).is_dir():
             return "is a folder, expected a file"
         if Path(path).exists():
-            return "is not a regular file (a pipe or device)"
+            return SPECIAL_FILE
         return "not found"
     except OSError as error:
         if error.errno == errno.ENAMETOOLONG:

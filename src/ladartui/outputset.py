@@ -126,7 +126,7 @@ class OutputSet:
     def __init__(self, paths: dict[str, Path], lock: Path):
         self.paths = {name: Path(path) for name, path in paths.items()}
         self.lock = Path(lock)
-        self.journal = self.lock.with_name(self.lock.name + ".journal")
+        self.journal = journal_path(self.lock)
         self._lock_fd: int | None = None
 
     def __enter__(self) -> OutputSet:
@@ -223,6 +223,25 @@ class OutputSet:
                     temp.unlink()
         return {name: str(path) for name, path in self.paths.items()}
 
+    def write_contents(
+        self,
+        contents: dict[str, bytes],
+        cancel: threading.Event | None = None,
+        modes: dict[str, int] | None = None,
+    ) -> dict[str, str]:
+        """``write`` for files whose bytes are made already; ``modes`` gives a file its
+        permissions before its bytes go in (a private key: owner only)."""
+
+        def writer(name: str) -> Callable[[Path], None]:
+            def write(tmp: Path) -> None:
+                if modes and name in modes:
+                    os.chmod(tmp, modes[name])
+                Path(tmp).write_bytes(contents[name])
+
+            return write
+
+        return self.write({name: writer(name) for name in contents}, cancel)
+
     def _swap(self, temps):
         entries: list[dict[str, Any]] = []  # the journal's: path, backup, existed
         for path in self.paths.values():
@@ -248,6 +267,11 @@ class OutputSet:
         for entry in entries:
             with contextlib.suppress(OSError):
                 os.unlink(entry["backup"])
+
+
+def journal_path(lock: Path) -> Path:
+    """Where a set's swap keeps its journal while it runs (left there by a killed run)."""
+    return Path(lock).with_name(Path(lock).name + ".journal")
 
 
 def recover(journal: Path) -> bool:

@@ -23,7 +23,7 @@ from ladartui.atomic import write_text_atomic
 from ladartui.checks import choice_field, number_field
 from ladartui.detection.settings import DetectionSettings
 from ladartui.errors import FieldError, InputFileError, LadarError, OutputFileError
-from ladartui.fileprobe import file_problem
+from ladartui.fileprobe import SPECIAL_FILE, file_problem
 from ladartui.flight import (
     FlightPlan,
     ScanPose,
@@ -406,14 +406,8 @@ def target_file_for(scene_file) -> Path:
 def load_scenario(path, check_files=True) -> Scenario:
     """Read and check a scenario file; with ``check_files``, its model files must exist."""
     path = _absolute(path)
-    try:
-        special = path.exists() and not path.is_file() and not path.is_dir()
-    except OSError:  # a name the system cannot look up: reading it says why
-        special = False
-    if special:  # reading a pipe would wait for ever
-        raise InputFileError(
-            path, "is not a regular file (a pipe or device); expected a scenario file (.toml)"
-        )
+    if file_problem(path) == SPECIAL_FILE:  # reading a pipe would wait for ever
+        raise InputFileError(path, f"{SPECIAL_FILE}; expected a scenario file (.toml)")
     try:
         text = path.read_text(encoding="utf-8-sig")
     except FileNotFoundError:

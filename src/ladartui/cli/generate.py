@@ -92,14 +92,14 @@ def run(args) -> int:
     from ladartui.cli.progress import run_cancellable, sigterm_as_interrupt
     from ladartui.errors import Cancelled
     from ladartui.outputset import check_writable
-    from ladartui.scene.generate import GENERATE_CANCELLED, output_paths
+    from ladartui.scene.generate import GENERATE_CANCELLED, las_paths, output_paths
 
     check_flags_used(args)
     if not args.out.strip():
         raise FieldError("OUT", args.out, "a name such as dir/name or a folder")
     stem = out_stem(args.out, args.preset)
     scene_file, target_file = output_paths(stem)
-    las_files = [scene_file.with_suffix(".laz"), target_file.with_suffix(".laz")] if args.las else []
+    las_files = list(las_paths(stem)) if args.las else []
     check_writable(scene_file, target_file, *las_files)
     cancel = threading.Event()
     errors = Console(stderr=True)

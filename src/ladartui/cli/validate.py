@@ -41,11 +41,11 @@ def run(args) -> int:
 def last_run_lines(scenario) -> list[str]:
     """Whether the outputs on disk came from this file's settings (the run record)."""
     from ladartui.errors import LadarError
+    from ladartui.outputset import journal_path
     from ladartui.run_record import earlier_las, missing_outputs, read_run_record, setting_changes
     from ladartui.simulation import output_lock
 
-    lock = output_lock(scenario)
-    if lock.with_name(lock.name + ".journal").exists():  # a swap a killed run left (outputset)
+    if journal_path(output_lock(scenario)).exists():  # a swap a killed run left (outputset)
         return [
             "last run   was stopped while it replaced the outputs: the next run puts the earlier set "
             "back first, so the files now on disk are not to be read"

@@ -121,10 +121,9 @@ class GeneratedScene:
             from ladartui.scene.las import export_las
 
             vs = self.voxel_size
-            also[scene_path.with_suffix(".laz")] = lambda tmp: export_las(tmp, self.voxels, vs, compress=True)
-            also[target_path.with_suffix(".laz")] = lambda tmp: export_las(
-                tmp, self.target, vs, ids=self.ids(), compress=True
-            )
+            scene_las, target_las = las_paths(stem)
+            also[scene_las] = lambda tmp: export_las(tmp, self.voxels, vs, compress=True)
+            also[target_las] = lambda tmp: export_las(tmp, self.target, vs, ids=self.ids(), compress=True)
         write_model_pair(scene_path, target_path, self.voxels, self.target, ids, cancel, progress, also)
         return scene_path, target_path
 
@@ -149,6 +148,12 @@ def output_paths(stem) -> tuple[Path, Path]:
     if stem.suffix.lower() == ".txt":
         stem = stem.with_suffix("")
     return stem.with_name(stem.name + ".txt"), stem.with_name(stem.name + "_Target.txt")
+
+
+def las_paths(stem) -> tuple[Path, Path]:
+    """The LAS copies beside ``output_paths(stem)``: ``name.laz`` and ``name_Target.laz``."""
+    scene_path, target_path = output_paths(stem)
+    return scene_path.with_suffix(".laz"), target_path.with_suffix(".laz")
 
 
 MAX_TREES = 100_000

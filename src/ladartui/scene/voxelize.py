@@ -155,16 +155,22 @@ def _as_utf8(path: Path, kind: str):
     return str(path)
 
 
-def _binary_stl(path: Path) -> bool:
-    """Whether ``path`` is sized as a binary STL: an 84-byte header, 50 bytes a triangle."""
+def _stl_head(path: Path) -> tuple[int, int, bytes] | None:
+    """(file size, the triangle count a binary header gives, the first 584 bytes); None
+    when it cannot be read (the reader says why) or is shorter than a header."""
     try:
         size = path.stat().st_size
         with open(path, "rb") as stream:
-            stream.seek(80)
-            count = int.from_bytes(stream.read(4), "little")
+            head = stream.read(84 + 50 * 10)
     except OSError:
-        return False
-    return size == 84 + 50 * count
+        return None
+    return (size, int.from_bytes(head[80:84], "little"), head) if size >= 84 else None
+
+
+def _binary_stl(path: Path) -> bool:
+    """Whether ``path`` is sized as a binary STL: an 84-byte header, 50 bytes a triangle."""
+    head = _stl_head(path)
+    return head is not None and head[0] == 84 + 50 * head[1]
 
 
 # Control bytes a text STL never holds, where a binary one's floats and attribute
@@ -175,15 +181,10 @@ _BINARY_BYTES = frozenset(range(32)) - frozenset(b"\t\n\v\f\r")
 def _check_stl_whole(path: Path) -> None:
     """``InputFileError`` for a binary STL shorter than its header's triangle count says
     (read as text when its header begins "solid", it would hold no triangles)."""
-    try:
-        size = path.stat().st_size
-        with open(path, "rb") as stream:
-            head = stream.read(84 + 50 * 10)
-    except OSError:
-        return  # the reader reports it
-    if size < 84:
+    read = _stl_head(path)
+    if read is None:
         return
-    count = int.from_bytes(head[80:84], "little")
+    size, count, head = read
     need = 84 + 50 * count
     if count == 0 or size >= need or (size > 84 and not _BINARY_BYTES & set(head[84:])):
         return  # whole, or text: an ASCII STL (a bare header holds no triangle either way)

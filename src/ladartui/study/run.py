@@ -280,9 +280,6 @@ def write_outputs(
     names = {"csv": f"{stem}.csv", "json": f"{stem}.json", "txt": f"{chart_stem}.txt"}
     paths = {kind: out_dir / names.get(kind, f"{chart_stem}.{kind}") for kind in contents}
 
-    def writer(kind: str):
-        return lambda tmp: Path(tmp).write_bytes(contents[kind])
-
     with OutputSet(paths, out_dir / f".{stem}.outputs.lock") as output_set:
-        output_set.write({kind: writer(kind) for kind in paths})
+        output_set.write_contents(contents)
     return paths

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import datetime
 import ipaddress
-import os
 from pathlib import Path
 from urllib.parse import urlsplit
 
@@ -160,17 +159,10 @@ def make_certificates(folder, days: int = 365) -> dict[str, Path]:
         "key": key.private_bytes(pem, serialization.PrivateFormat.PKCS8, serialization.NoEncryption()),
     }
 
-    def writer(kind: str):
-        def write(tmp: Path) -> None:
-            if kind == "key":
-                os.chmod(tmp, 0o600)  # before the key is in it: owner only
-            tmp.write_bytes(contents[kind])
-
-        return write
-
-    # one set: an authority and a certificate it did not sign must never sit together
+    # one set: an authority and a certificate it did not sign must never sit together; the
+    # key owner-only before it is in its file
     with OutputSet(paths, folder / ".certs.lock") as output_set:
-        output_set.write({kind: writer(kind) for kind in paths})
+        output_set.write_contents(contents, modes={"key": 0o600})
     return paths
 
 

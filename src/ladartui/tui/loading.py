@@ -125,7 +125,6 @@ class SceneLoading(Host):
         now = outputs_on_disk(scenario)
         if now == self.outputs_seen:
             return
-        self.outputs_seen = now
         if now is None:
             self.tell(
                 f"The outputs of {scenario.path.name} are gone from disk: those shown were read before."

@@ -118,7 +118,9 @@ def fitted(message: str, room: int, name: str | None = None) -> str:
         short = _first_cells(name, head) + ELLIPSIS + _last_cells(name, keep - head)
         message = message.replace(name, short, 1)
     if cell_len(message) > room:
-        message = _first_cells(message, room - 1) + ELLIPSIS
+        cut = Text(message)
+        cut.truncate(room, overflow="ellipsis")  # rich's cut, by cells
+        message = cut.plain
     return message
 
 
