@@ -6,7 +6,7 @@ import pytest
 from ladartui.errors import FieldError
 from ladartui.tracing import TINY
 from ladartui.tracing.config import SCAN_BLOCK
-from ladartui.tracing.prepare import SCALE_IN_PARTS, one_origin, rays_to_cells, scale_in_place
+from ladartui.tracing.prepare import SCALE_IN_PARTS, Scratch, one_origin, rays_to_cells, scale_in_place
 from ladartui.tracing.scan_rays import ray_bounds
 
 
@@ -183,3 +183,47 @@ def test_a_long_traces_ranges_are_its_cell_ranges_times_the_voxel_size():
     hits = NumbaBackend().trace_cells(occupancy, cells, unit, block_bounds=bounds)
     assert (got.kind == 1).sum() > 1000
     assert np.array_equal(got.range.view(np.int64), (hits.t * 0.3).view(np.int64))
+
+
+def test_kept_arrays_hold_any_earlier_values_and_give_the_same_answers():
+    """Rays written into arrays that held another call's rays (a scan from one origin,
+    whose rows ``rays_to_cells`` mostly leaves unwritten, then rays of many
+    origins, then the scan again): the same cells and directions as new arrays."""
+    rng = np.random.default_rng(9)
+    many = rng.uniform(-50, 50, (3000, 3)), rng.normal(size=(3000, 3))
+    scan = np.tile([1.0, 2.0, 30.0], (3000, 1)), rng.normal(size=(3000, 3))
+    scratch = Scratch(most=4096)
+    for origins, directions in (scan, many, scan, (many[0][:100], many[1][:100])):
+        fresh = rays_to_cells(origins, directions, 0.1, TINY)
+        with scratch.arrays(len(origins)) as into:
+            assert into is not None and into[0].flags.c_contiguous and into[1].shape == (len(origins), 3)
+            kept = rays_to_cells(origins, directions, 0.1, TINY, into)
+            for a, b in zip(fresh, kept):
+                assert np.array_equal(a, b)
+    with scratch.arrays(3000) as first:
+        assert first is not None
+        with scratch.arrays(3000) as second:  # another thread's trace meanwhile
+            assert second is None
+    with scratch.arrays(5000) as over:
+        assert over is None
+    with scratch.arrays(4000) as grown:
+        assert grown is not None and len(grown[0]) == 4000
+    with scratch.arrays(10) as again:
+        assert again is not None and np.shares_memory(again[0], grown[0])
+
+
+def test_a_traces_results_are_its_own_after_the_next_call():
+    """trace() keeps its cell-space arrays between calls; the answers it returned
+    do not share them, so a later call leaves them as they were."""
+    from ladartui.scene.occupancy import Occupancy
+    from ladartui.tracing import trace
+
+    rng = np.random.default_rng(11)
+    occupancy = Occupancy.build(rng.integers(0, 40, (3000, 3)), shape=(40, 40, 40))
+    first_rays = rng.uniform(0, 40, (2000, 3)) + [0, 0, 50], rng.normal(size=(2000, 3)) - [0, 0, 2]
+    other_rays = rng.uniform(0, 40, (2000, 3)) + [0, 0, 50], rng.normal(size=(2000, 3)) - [0, 0, 2]
+    first = trace(occupancy, *first_rays, backend="numba")
+    kept = [first.kind.copy(), first.index.copy(), first.range.copy()]
+    trace(occupancy, *other_rays, backend="numba")
+    assert all(np.array_equal(a, b) for a, b in zip(kept, (first.kind, first.index, first.range)))
+    assert (first.kind == 1).sum() > 100

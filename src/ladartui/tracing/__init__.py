@@ -144,9 +144,9 @@ def trace(
     from ladartui.tracing.order_choice import compile_time  # numba: loaded on first trace
     from ladartui.tracing.prepare import rays_to_cells, scale_in_place
 
-    with recording() as passes:
+    with recording() as passes, _scratch().arrays(len(origins)) as scratch:
         with timed("rays to cells"):
-            origin_cells, unit, block_bounds = rays_to_cells(origins, directions, voxel_size, TINY)
+            origin_cells, unit, block_bounds = rays_to_cells(origins, directions, voxel_size, TINY, scratch)
         with compile_time() as compiling:
             started = time.perf_counter()
             cells = engine.trace_cells(
@@ -172,6 +172,15 @@ def trace(
                 metres = metres * voxel_size
     info["passes"] = passes
     return TraceResult(cells.kind, cells.index, metres, name, method, info)
+
+
+@functools.cache
+def _scratch():
+    """The cell-space rays' arrays kept between calls (``prepare.Scratch``): up to four
+    scans' worth (48 MB), so a sweep's long calls do not hold more for good."""
+    from ladartui.tracing.prepare import Scratch
+
+    return Scratch(most=4 * 262_144)
 
 
 def _occupancy_and_size(target, voxel_size):

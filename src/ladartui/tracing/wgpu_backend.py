@@ -104,18 +104,22 @@ class WgpuBackend:
         ray_batch: int = RAY_BATCH,
         max_workgroups_per_dimension: int | None = None,
         map_storage: bool = True,
+        staged_upload: bool | None = None,
     ):
         """Optional caps below the adapter's limits (tests use them to force
         occupancy splitting, several batches and 2-D dispatch grids);
         ``map_storage=False`` runs object order as on a GPU even on a CPU adapter:
         its arrays copied through the queue, its tile bounds read from storage
-        (tests run that way on lavapipe)."""
+        (tests run that way on lavapipe); ``staged_upload``: exact ray order writes
+        its rays through staging buffers of its own (``FirstHits``), by default
+        on a GPU only."""
         self._caps = {
             "max-storage-buffer-binding-size": max_binding_bytes,
             "max-compute-workgroups-per-dimension": max_workgroups_per_dimension,
         }
         self._ray_batch = int(ray_batch)
         self._map_storage = map_storage
+        self._staged_upload = staged_upload
         self._lock = threading.RLock()
         self._probed = False
         self._reason: str | None = None
@@ -211,7 +215,10 @@ class WgpuBackend:
             self._maps_storage,
             uniform_tile_bounds=self._cpu_adapter and self._map_storage,
         )
-        self._hits = FirstHits(self._device, self._limits, self._ray_batch, bundle_starts=self._cpu_adapter)
+        staged = (not self._cpu_adapter) if self._staged_upload is None else self._staged_upload
+        self._hits = FirstHits(
+            self._device, self._limits, self._ray_batch, bundle_starts=self._cpu_adapter, staged=staged
+        )
         self._rays = RayPasses(self._device, self._limits, self._ray_batch)
         return self._device
 

@@ -8,7 +8,10 @@ and the ground rule where no voxel was hit. Per ray that moves 48 bytes in and
 4 out, against trace_rays' 48 and 24 (24 in when the rays share one origin,
 as a scan's do), and the host makes no numpy pass over
 the rays besides the bundle starts (on a CPU adapter only) and the answers.
-Batches are as large as the buffers allow (on an H200, four dispatches of
+On a GPU a batch's inputs go through one staging buffer of the backend's own
+(``FirstHits``' ``staged``), and the read-back is mapped without wgpu-py's
+extra submit (``map_for_reading``): one submit a batch. Batches are as large
+as the buffers allow (on an H200, four dispatches of
 65,536 rays one after the other took twice as long as one of 262,144), and
 overlap: the host writes one batch and answers another while the device traces.
 trace_rays stays for the march, f32, and boxes whose offsets do not fit an i32.
@@ -29,7 +32,7 @@ from ladartui.errors import check_cancelled
 from ladartui.tracing.answers import box_offset_answers
 from ladartui.tracing.bundle import Halos, bundle_start_array
 from ladartui.tracing.config import BUNDLE, SHADER_INF
-from ladartui.tracing.wgpu_scans import dispatch_encoder, rays_per_dispatch
+from ladartui.tracing.wgpu_scans import dispatch_encoder, rays_per_dispatch, write_pieces
 
 # Bindings of first_hits besides the occupancy chunks (trace.wgsl).
 HIT_BINDINGS = {"params": 0, "starts": 4, "origins": 5, "directions": 6, "found": 7}
@@ -44,14 +47,33 @@ def box_sides(occupancy) -> tuple[int, int, int] | None:
     return sides[0], sides[1], sides[2]
 
 
+# wgpu-py submits an empty command buffer before each map for reading (a buffer
+# written by queue.write_buffer with no submit after it could read as zeros); its
+# own mode "READ_NOSYNC" skips that. Ours are written by copies we submitted, so
+# it is used where the installed wgpu-py knows it: one submit a call, not two.
+_READ_WITHOUT_SUBMIT = ["READ_NOSYNC"]
+
+
+def map_for_reading(buffer, size: int) -> None:
+    """Map the first ``size`` bytes of ``buffer`` for reading, once the device has
+    written them (a wait for all submitted work)."""
+    import wgpu
+
+    if _READ_WITHOUT_SUBMIT:
+        try:
+            buffer.map_sync(_READ_WITHOUT_SUBMIT[0], 0, size)
+            return
+        except (AttributeError, KeyError, TypeError, ValueError):  # (checked before anything is mapped)
+            _READ_WITHOUT_SUBMIT.clear()
+    buffer.map_sync(wgpu.MapMode.READ, 0, size)
+
+
 @contextmanager
 def mapped_words(back, count: int):
     """The first ``count`` i32 words of read-back buffer ``back``, mapped once the
-    device has written them (a wait for all submitted work), read in place and
-    unmapped after the block."""
-    import wgpu
-
-    back.map_sync(wgpu.MapMode.READ, 0, 4 * count)
+    device has written them (``map_for_reading``), read in place and unmapped after
+    the block."""
+    map_for_reading(back, 4 * count)
     try:
         view = back.read_mapped(0, 4 * count, copy=False)
         try:
@@ -66,17 +88,29 @@ class FirstHits:
     """Exact f64 rays through ``first_hits`` on one device, up to ``batch`` rays a
     dispatch."""
 
-    def __init__(self, device, limits: dict[str, int], ray_batch: int, bundle_starts: bool):
+    def __init__(
+        self, device, limits: dict[str, int], ray_batch: int, bundle_starts: bool, staged: bool = False
+    ):
         """``bundle_starts``: compute them on the host. On lavapipe they save a fifth
         of the shader's time; on an H200 the shader ran as fast without them and
         they cost the host 0.6 ms a 262,144-ray scan, so a scan took 3.8 ms with
         them and 3.1 ms without. Without, the starts buffer stays zero: every ray
-        starts at its entry into the occupied box."""
+        starts at its entry into the occupied box.
+
+        ``staged``: a batch's inputs (uniform block, origins, directions) go to the
+        device through one staging buffer of our own, mapped for writing and filled
+        on numba's threads (``write_pieces``), then copied on the device ahead of
+        the dispatch; else ``queue.write_buffer`` copies each into staging memory
+        of its own on one thread, and the submit carries its copies in a command
+        buffer of their own."""
         self._device = device
         self._limits = limits
         self.batch = rays_per_dispatch(limits, ray_batch, 24)  # the directions' binding
         self.bundle_starts = bundle_starts
+        self.staged = staged
+        self._mapping: dict[int, Any] = {}  # staging buffer number -> its pending map for writing
         self._stale_starts = False  # the starts buffer holds starts (else zeros)
+        self._origins_at = self._directions_at = 0  # where they start in a staging buffer
         self._buffers: dict[str, Any] = {}
         self._answer_thread: ThreadPoolExecutor | None = None
 
@@ -111,6 +145,8 @@ class FirstHits:
         read in place. A wait waits for all submitted work, so k + 1 is submitted
         only once k's words are there.
         """
+        import wgpu
+
         buffers = self._buffers
         queue = self._device.queue
         lo = np.asarray(occupancy.bbox_lo, np.int64)
@@ -129,9 +165,13 @@ class FirstHits:
 
         def write(k: int) -> None:
             o, d = origins_of(k), directions[rows(k)]
-            queue.write_buffer(buffers["params"], 0, params_for(len(d)))
-            queue.write_buffer(buffers["origins"], 0, o)
-            queue.write_buffer(buffers["directions"], 0, d)
+            if self.staged:
+                params = np.frombuffer(params_for(len(d)), np.uint8)
+                self._stage(k % 2, [(0, params), (self._origins_at, o), (self._directions_at, d)])
+            else:
+                queue.write_buffer(buffers["params"], 0, params_for(len(d)))
+                queue.write_buffer(buffers["origins"], 0, o)
+                queue.write_buffer(buffers["directions"], 0, d)
             if self.bundle_starts:
                 every = np.broadcast_to(o, d.shape) if shared_origin else o
                 # SHADER_INF is the shader's "never".
@@ -144,9 +184,19 @@ class FirstHits:
                 self._stale_starts = False
 
         def submit(k: int) -> None:
-            encoder = dispatch_encoder(self._device, self._limits, pipeline, group, count(k))
+            copies = []
+            if self.staged:
+                stage = buffers["staging"][k % 2]
+                copies = [
+                    (stage, 0, buffers["params"], buffers["params"].size),
+                    (stage, self._origins_at, buffers["origins"], 24 * len(origins_of(k))),
+                    (stage, self._directions_at, buffers["directions"], 24 * count(k)),
+                ]
+            encoder = dispatch_encoder(self._device, self._limits, pipeline, group, count(k), copies)
             encoder.copy_buffer_to_buffer(buffers["found"], 0, buffers["back"][k % 2], 0, 4 * count(k))
             queue.submit([encoder.finish()])
+            if self.staged:  # mapped again for batch k + 2 (or the next call) once copied
+                self._mapping[k % 2] = buffers["staging"][k % 2].map_async(wgpu.MapMode.WRITE)
 
         def answer(k: int, words) -> int:
             here = rows(k)
@@ -193,6 +243,22 @@ class FirstHits:
                 write(k + 2)
         return cut
 
+    def _stage(self, number: int, pieces) -> None:
+        """``pieces`` ((offset, array) pairs) into staging buffer ``number`` through its
+        mapping, left unmapped for the device's copies."""
+        import wgpu
+
+        buffer = self._buffers["staging"][number]
+        mapping = self._mapping.pop(number, None)
+        if mapping is not None:
+            mapping.sync_wait()
+        else:
+            buffer.map_sync(wgpu.MapMode.WRITE)
+        try:
+            write_pieces(buffer, pieces)
+        finally:
+            buffer.unmap()
+
     def _answerer(self) -> ThreadPoolExecutor:
         """The thread that makes one batch's answers while this one writes the next."""
         if self._answer_thread is None:
@@ -227,4 +293,10 @@ class FirstHits:
                 ),
                 "back": [create(label=f"hits-back-{k}", size=rays * 4, usage=back) for k in (0, 1)],
             }
+            if self.staged:  # the uniform block, origins, directions; batches take them in turn
+                self._origins_at = -(-params_bytes // 8) * 8
+                self._directions_at = self._origins_at + rays * 24
+                up = wgpu.BufferUsage.MAP_WRITE | wgpu.BufferUsage.COPY_SRC
+                size = self._directions_at + rays * 24
+                self._buffers["staging"] = [create(label=f"hits-up-{k}", size=size, usage=up) for k in (0, 1)]
         return self._buffers

@@ -42,11 +42,15 @@ def rays_per_dispatch(limits: dict[str, int], ray_batch: int, binding_bytes_per_
     return max(1, min(ray_batch, by_binding, groups * groups * BUNDLE))
 
 
-def dispatch_encoder(device, limits: dict[str, int], pipeline, group, rays: int):
+def dispatch_encoder(device, limits: dict[str, int], pipeline, group, rays: int, copies=()):
     """A command encoder holding one dispatch of ``pipeline`` with bind group 0
-    ``group`` over ``rays`` rays (BUNDLE a workgroup), to be finished by the caller."""
+    ``group`` over ``rays`` rays (BUNDLE a workgroup), to be finished by the caller;
+    ``copies``: (source, offset, target, bytes) copies to the start of ``target``
+    made before the dispatch."""
     groups = dispatch_grid(-(-rays // BUNDLE), limits["max-compute-workgroups-per-dimension"])
     encoder = device.create_command_encoder()
+    for source, offset, target, size in copies:
+        encoder.copy_buffer_to_buffer(source, offset, target, 0, size)
     compute = encoder.begin_compute_pass()
     compute.set_pipeline(pipeline)
     compute.set_bind_group(0, group)
@@ -109,18 +113,38 @@ def pack_tile_params(rays, scan, origin=(0.0, 0.0, 0.0)) -> bytes:
 
 
 def write_mapped(buffer, array) -> None:
-    """``array`` into the start of ``buffer``, mapped for writing: copied on numba's
-    threads into the mapped range where wgpu-py hands it out (its experimental
-    ``_experimental_get_mapped_range``; the view is dropped before the caller
-    unmaps), else by the buffer's own ``write_mapped``, on one thread (a scan's
-    6 MB of directions took 0.65 ms there)."""
+    """``array`` into the start of ``buffer``, mapped for writing (``write_pieces``)."""
+    write_pieces(buffer, [(0, array)])
+
+
+# Pieces this large are copied on numba's threads; smaller ones cost less than waking them.
+PARALLEL_COPY_BYTES = 1 << 16
+
+
+def write_pieces(buffer, pieces) -> None:
+    """Each ``(offset, array)`` of ``pieces`` into ``buffer``, mapped for writing:
+    copied into the mapped range where wgpu-py hands it out (its experimental
+    ``_experimental_get_mapped_range``, asked for once; the view is dropped before
+    the caller unmaps), large pieces on numba's threads; else by the buffer's own
+    ``write_mapped``, on one thread (a scan's 6 MB of directions took 0.65 ms
+    there)."""
     mapped_range = getattr(buffer, "_experimental_get_mapped_range", None)
-    if mapped_range is None or array.nbytes % 4:
-        buffer.write_mapped(array, 0)
+    whole_words = all(offset % 4 == 0 and np.asarray(array).nbytes % 4 == 0 for offset, array in pieces)
+    if mapped_range is None or not whole_words:
+        for offset, array in pieces:
+            buffer.write_mapped(array, offset)
         return
-    view = mapped_range(0, array.nbytes)
+    end = max(offset + np.asarray(array).nbytes for offset, array in pieces)
+    view = mapped_range(0, end)
     try:
-        copy_in_parts(np.frombuffer(view, np.uint32), np.ascontiguousarray(array).reshape(-1).view(np.uint32))
+        words = np.frombuffer(view, np.uint32)
+        for offset, array in pieces:
+            source = np.ascontiguousarray(array).reshape(-1).view(np.uint32)
+            target = words[offset // 4 : offset // 4 + len(source)]
+            if source.nbytes >= PARALLEL_COPY_BYTES:
+                copy_in_parts(target, source)
+            else:
+                target[:] = source
     finally:
         view.release()
 
