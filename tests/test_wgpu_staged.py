@@ -164,3 +164,67 @@ def test_reading_maps_skip_wgpus_extra_submit_where_it_knows_how(monkeypatch):
     wgpu_hits.map_for_reading(older, 32)  # not asked again
     assert older.maps == [(wgpu.MapMode.READ, 0, 64), (wgpu.MapMode.READ, 0, 32)]
     assert wgpu_hits._READ_WITHOUT_SUBMIT == []
+
+
+# --- numba's workqueue layer, and a wait for a mapping cut short ---------------------
+
+WORKQUEUE_SCRIPT = """
+import sys
+import numpy as np
+import numba
+sys.path.insert(0, {tests!r})
+from ladartui.tracing.numba_backend import NumbaBackend
+from ladartui.tracing.wgpu_backend import WgpuBackend
+from test_wgpu_backend import random_rays, random_scene
+from test_wgpu_hits import SHAPE
+
+occupancy = random_scene(41, SHAPE, 5000)
+origins, directions = random_rays(42, SHAPE, 40000)
+backend = WgpuBackend(staged_upload=True, ray_batch=8192)  # five batches, staged in parts on threads
+backend.trace_cells(occupancy, origins[:10], directions[:10], order="ray")
+backend._hits.bundle_starts = False  # as on a GPU: batches answered on the thread
+hits = backend.trace_cells(occupancy, origins, directions, order="ray")
+reference = NumbaBackend().trace_cells(occupancy, origins, directions, order="ray")
+assert numba.threading_layer() == "workqueue"
+assert np.array_equal(hits.kind, reference.kind) and np.array_equal(hits.t, reference.t)
+print("same")
+"""
+
+
+def test_staged_batches_do_not_overlap_numba_regions_under_workqueue(wgpu_backend, tmp_path):
+    """Under numba's workqueue layer two parallel regions at once end the process:
+    staging a batch (numba's threads) must not run while the thread answers another."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    tests = str(Path(__file__).parent)
+    script = tmp_path / "workqueue.py"
+    script.write_text(WORKQUEUE_SCRIPT.format(tests=tests))
+    env = {**os.environ, "NUMBA_THREADING_LAYER": "workqueue"}
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, env=env, timeout=600)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert done.stdout.strip().endswith("same")
+
+
+def test_a_wait_for_a_staging_map_cut_short_leaves_the_backend_usable(
+    wgpu_backend, numba_backend, case, monkeypatch
+):
+    """Ctrl-C (or a failed map) while waiting for a staging buffer's mapping: the next
+    calls still map it and answer in full."""
+    occupancy, origins, directions = case
+    backend = staged_backend(wgpu_backend, ray_batch=640)
+    backend.trace_cells(occupancy, origins, directions, order="ray")
+    pending = backend._hits._mapping[0]
+
+    def interrupted():
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(pending, "sync_wait", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        backend.trace_cells(occupancy, origins, directions, order="ray")
+    monkeypatch.undo()
+    reference = numba_backend.trace_cells(occupancy, origins, directions, order="ray")
+    for _ in range(2):
+        assert_same(backend.trace_cells(occupancy, origins, directions, order="ray"), reference)

@@ -68,6 +68,17 @@ def map_for_reading(buffer, size: int) -> None:
     buffer.map_sync(wgpu.MapMode.READ, 0, size)
 
 
+def regions_may_overlap() -> bool:
+    """Whether two of numba's parallel regions may run at once on two threads: under
+    TBB and OpenMP, not under the workqueue layer (it ends the process)."""
+    import numba
+
+    try:
+        return numba.threading_layer() != "workqueue"
+    except ValueError:  # no parallel region has run yet: the layer is not chosen
+        return False
+
+
 @contextmanager
 def mapped_words(back, count: int):
     """The first ``count`` i32 words of read-back buffer ``back``, mapped once the
@@ -216,6 +227,10 @@ class FirstHits:
             )
 
         check_cancelled(cancel, "trace cancelled")
+        # Writing runs numba where it computes bundle starts or stages the rays: then
+        # not beside the answers (two parallel regions at once end the process under
+        # numba's workqueue layer; the others take them).
+        overlap = not self.bundle_starts and (not self.staged or regions_may_overlap())
         write(0)
         submit(0)
         if len(firsts) > 1:
@@ -226,10 +241,8 @@ class FirstHits:
             with mapped_words(buffers["back"][k % 2], count(k)) as words:
                 if k + 1 < len(firsts):
                     submit(k + 1)  # traced while batch k's answers are made
-                if later and not self.bundle_starts:
+                if later and overlap:
                     # Batch k answered on the thread while this one writes batch k + 2.
-                    # Only where writing runs no numba (bundle starts do): two parallel
-                    # regions at once would abort under numba's workqueue layer.
                     answering = self._answerer().submit(answer, k, words)
                     try:
                         check_cancelled(cancel, "trace cancelled")
@@ -249,9 +262,10 @@ class FirstHits:
         import wgpu
 
         buffer = self._buffers["staging"][number]
-        mapping = self._mapping.pop(number, None)
+        mapping = self._mapping.get(number)
         if mapping is not None:
-            mapping.sync_wait()
+            mapping.sync_wait()  # (a wait cut short leaves it here for the next call)
+            del self._mapping[number]
         else:
             buffer.map_sync(wgpu.MapMode.WRITE)
         try:
