@@ -48,12 +48,40 @@ class Host(App):
         self.heard.append(("done", message.result, message.cancelled, message.error))
 
 
-def test_a_newer_progress_replaces_an_older_one_of_the_same_job_unless_it_drops_a_detail():
-    old, new = JobProgress("run", 0.1, "a"), JobProgress("run", 0.2, "b")
-    assert new.can_replace(old)
-    assert not JobProgress("study", 0.2, "b").can_replace(old)
-    live = JobProgress("run", 0.1, "a", detail=[1])
-    assert not new.can_replace(live) and JobProgress("run", 0.3, "c", [2]).can_replace(live)
+async def test_queued_reports_give_way_to_newer_ones_except_kept_ones_and_live_views():
+    """Reports queued before the app reads them, as a fast job posts them: Textual asks
+    the older one whether the newer may take its place. A newer report replaces an
+    older one of the same job, but never a kept one (a sweep's finished row, its
+    stored rows) and never one with a detail (a live view) by one without."""
+    heard = []
+
+    class Listener(App):
+        def compose(self):
+            yield Static("")
+
+        def on_job_progress(self, message: JobProgress) -> None:
+            heard.append((message.text, message.detail))
+
+    app = Listener()
+    async with app.run_test() as pilot:
+        for report in (
+            JobProgress("run", 0.1, "a"),  # replaced by b
+            JobProgress("run", 0.2, "b"),  # replaced by the kept row
+            JobProgress("run", 0.3, "kept row", ["row"], keep=True),
+            JobProgress("run", 0.4, "c", ["view"]),  # replaced by d (a detail for a detail)
+            JobProgress("run", 0.5, "d", ["view 2"]),
+            JobProgress("run", 0.6, "e"),  # no detail: does not replace d
+            JobProgress("study", 0.7, "f"),  # another job's: replaces nothing of run's
+        ):
+            app.post_message(report)
+        await pilot.pause()
+        await pilot.pause()
+    assert heard == [
+        ("kept row", ["row"]),
+        ("d", ["view 2"]),
+        ("e", None),
+        ("f", None),
+    ]
 
 
 async def test_an_unexpected_exception_is_reported_and_the_app_stays_open():

@@ -42,12 +42,14 @@ class JobProgress(Message):
     keep: bool = False  # a report that must arrive (a finished row), never replaced
 
     def can_replace(self, message: Message) -> bool:
-        # a queued report with a detail (a live view) is only replaced by one with a detail
+        """Whether newer ``message``, queued behind this report, may take its place:
+        Textual asks the older message (its docstring reads the other way round).
+        Not for a kept report; a report with a detail (a live view) only by one with one."""
         return (
             isinstance(message, JobProgress)
             and message.job == self.job
-            and not message.keep
-            and (message.detail is None or self.detail is not None)
+            and not self.keep
+            and (self.detail is None or message.detail is not None)
         )
 
 
