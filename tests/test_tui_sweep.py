@@ -92,6 +92,13 @@ async def wait_for(pilot, condition, timeout=300.0):
         await pilot.pause(0.05)
 
 
+async def opened(pilot, screen=None):
+    """Wait until the screen's open (read in a worker) is shown."""
+    screen = screen or pilot.app.sweep_screen
+    await wait_for(pilot, lambda: screen.opening is None or screen.opening.is_finished)
+    await pilot.pause()
+
+
 def table_column(table: DataTable, key: str) -> list[str]:
     return [str(cell) for cell in table.get_column(key)]
 
@@ -109,7 +116,7 @@ async def test_opening_results_shows_the_ranking_failures_and_pareto_front(finis
     screen = SweepScreen(results)
     app = _Host(screen)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+        await opened(pilot)
         # impossible values are final, not failures (which run again on resume)
         assert str(screen.query_one("#sweep-counts").render()) == "12 variants, 6 ok, 0 failed, 6 impossible"
         # a gap between the table and the chart: a value at the table's edge never runs
@@ -231,7 +238,7 @@ async def test_budget_objective_ranks_only_paths_within_the_typed_budget(finishe
     screen = SweepScreen(spec)
     app = _Host(screen)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+        await opened(pilot)
         screen.query_one("#sweep-budget").value = f"{budget}"
         await pilot.press("f6", "f6")
         assert screen.objective == "coverage-within-budget"
@@ -252,7 +259,7 @@ async def test_a_bad_budget_is_one_line_whatever_the_ranking(finished):
     screen = SweepScreen(spec)
     app = _Host(screen)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+        await opened(pilot)
         budget = screen.query_one("#sweep-budget")
         for typed in ("-5", "0", "abc"):
             budget.value = typed
@@ -268,7 +275,7 @@ async def test_a_missing_spec_gives_one_line_and_starts_nothing(tmp_path):
     screen = SweepScreen(missing, serial=True)
     app = _Host(screen)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+        await opened(pilot)
         await pilot.press("f5")
         await pilot.pause()
         assert status_of(screen).state == NOT_READY
@@ -283,7 +290,7 @@ async def test_a_spec_mistake_names_its_line_and_starts_nothing(tmp_path):
     screen = SweepScreen(spec, serial=True)
     app = _Host(screen)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+        await opened(pilot)
         await pilot.press("f5")
         await pilot.pause()
         message = screen.last_message
@@ -305,7 +312,7 @@ async def test_a_running_sweep_cancels_keeps_its_rows_and_stays_responsive(tmp_p
     screen = SweepScreen(spec, serial=True)
     app = _Host(screen)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+        await opened(pilot)
         await pilot.press("f5")
         assert screen.running and status_of(screen).state == BUSY
         await wait_for(pilot, lambda: screen.progress is not None and screen.progress.done >= 2)
@@ -352,7 +359,7 @@ async def test_an_unreachable_scheduler_gives_one_line_and_writes_nothing(tmp_pa
     notify = app.notify
     app.notify = lambda message, **options: (notes.append(message), notify(message, **options))[1]
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+        await opened(pilot)
         await pilot.press("f5")
         # A refused connection may end the run before the key press returns: wait for
         # its end, whether or not it is still running here.
@@ -407,7 +414,7 @@ async def test_browse_picks_a_results_folder_in_a_tree_and_opens_it(finished):
     screen = SweepScreen(serial=True)
     app = _Host(screen)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+        await opened(pilot)
         screen.query_one("#sweep-path").value = str(results.parent) + "/"
         await pilot.press("f2")
         await pilot.pause()
@@ -424,7 +431,7 @@ async def test_browse_picks_a_results_folder_in_a_tree_and_opens_it(finished):
         assert picker.query_one("#pick-path").value == str(results)
         picker.query_one("#pick-ok").press()
         await pilot.pause()
-        await pilot.pause()
+        await opened(pilot)
         assert app.screen is screen
         assert screen.query_one("#sweep-table", DataTable).row_count == 12
 
@@ -435,13 +442,13 @@ async def test_the_screen_reopens_the_last_sweep_opened(finished, tmp_path, monk
     first = SweepScreen(results)
     app = _Host(first)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+        await opened(pilot)
         assert first.query_one("#sweep-table", DataTable).row_count == 12
         app.pop_screen()
         again = SweepScreen()  # no path: the last sweep opened comes back
         app.push_screen(again)
         await pilot.pause()
-        await pilot.pause()
+        await opened(pilot, again)
         assert again.query_one("#sweep-path").value == str(results.resolve())
         assert again.query_one("#sweep-table", DataTable).row_count == 12
 
@@ -458,7 +465,7 @@ async def test_a_spec_opened_shows_only_its_own_variants_from_the_folder(finishe
     screen = SweepScreen(narrowed)
     app = _Host(screen)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+        await opened(pilot)
         assert screen.query_one("#sweep-table", DataTable).row_count == 1
         assert str(screen.query_one("#sweep-counts").render()) == "1 variants, 1 ok, 0 failed"
         assert "11 rows of other variants or an earlier base in the folder left out" in screen.last_message
@@ -470,7 +477,7 @@ async def test_a_plain_scheduler_off_this_machine_is_refused_as_the_cli_refuses_
     screen = SweepScreen(spec, scheduler="tcp://192.0.2.10:8786", connect_timeout=0.5)
     app = _Host(screen)
     async with app.run_test(size=SIZE) as pilot:
-        await pilot.pause()
+        await opened(pilot)
         await pilot.press("f5")
         await pilot.pause()
         assert not screen.running and not list(screen.workers)
@@ -482,3 +489,79 @@ async def test_a_plain_scheduler_off_this_machine_is_refused_as_the_cli_refuses_
         await pilot.pause()
         assert not screen.running
         assert "certificates" in screen.last_message and "ca.pem" in screen.last_message
+
+
+async def test_opening_reads_off_the_ui_thread_and_keeps_only_the_last_asked(finished, monkeypatch, tmp_path):
+    """open_sweep (the table read, the base's models hashed) runs in a worker: the
+    screen says it is opening and takes keys meanwhile. Of two opens, a slow first
+    one finishing after the second is not shown over it."""
+    import shutil
+    import threading
+
+    from ladartui.tui import sweep_screen
+
+    spec, results = finished
+    real = sweep_screen.open_sweep
+    threads, release = [], threading.Event()
+
+    def slow_open(text):
+        threads.append(threading.current_thread())
+        if text == "slow":
+            release.wait(30)
+            return real(str(results))  # (would show the whole folder)
+        return real(text)
+
+    monkeypatch.setattr(sweep_screen, "open_sweep", slow_open)
+    monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))  # no sweep opened before
+    for path in spec.parent.iterdir():  # a copy: the spec is narrowed below
+        copy = shutil.copytree if path.is_dir() else shutil.copy
+        copy(path, tmp_path / path.name)
+    narrowed = write_spec(tmp_path, "[grid]\nradius = [8.0]\nscans = [1]\nsensor_grid = [8]\n")
+    screen = SweepScreen(serial=True)
+    app = _Host(screen)
+    try:
+        async with app.run_test(size=SIZE) as pilot:
+            await opened(pilot)
+            answers: list[int] = []
+            shown = screen._opened
+            screen._opened = lambda answer: (answers.append(answer[0]), shown(answer))[1]
+            screen._open("slow")
+            await pilot.pause()
+            assert status_of(screen).state == BUSY and screen.last_message == "opening slow ..."
+            budget = screen.query_one("#sweep-budget")
+            budget.focus()
+            await pilot.press("4", "2")  # keys are taken while it reads
+            assert budget.value.endswith("42")
+            screen._open(str(narrowed))
+            await wait_for(pilot, lambda: screen.query_one("#sweep-table", DataTable).row_count == 1)
+            release.set()
+            await wait_for(pilot, lambda: len(answers) == 2)
+            await pilot.pause()
+            assert answers[0] > answers[1]  # the slow one answered last, and was dropped
+            assert screen.query_one("#sweep-table", DataTable).row_count == 1
+            assert threading.main_thread() not in threads and len(threads) == 2
+    finally:
+        release.set()
+
+
+async def test_a_sweep_run_again_shows_its_stored_rows_first(finished, tmp_path):
+    """Run again over a finished folder, the stored rows come from the job before any
+    variant (none left to run here: all resume)."""
+    import shutil
+
+    spec, _ = finished
+    for path in spec.parent.iterdir():  # a copy: running again rewrites the table
+        copy = shutil.copytree if path.is_dir() else shutil.copy
+        copy(path, tmp_path / path.name)
+    screen = SweepScreen(tmp_path / spec.name, serial=True)
+    app = _Host(screen)
+    seen: list[int] = []
+    show = screen._show_stored_rows
+    screen._show_stored_rows = lambda rows: (seen.append(len(rows)), show(rows))[1]
+    async with app.run_test(size=SIZE) as pilot:
+        await opened(pilot)
+        await pilot.press("f5")
+        await wait_for(pilot, lambda: not screen.running)
+        assert seen == [12], screen.last_message
+        assert screen.query_one("#sweep-table", DataTable).row_count == 12
+        assert "12 resumed" in screen.last_message

@@ -43,6 +43,15 @@ def sibling_spec(results: Path) -> Path | None:
     return spec if spec.is_file() else None
 
 
+@dataclass
+class StoredRows:
+    """The rows a sweep's table already holds for its variants from its base as it is
+    now: shown at once when it starts (they resume), read off the UI thread (the
+    base's models are hashed)."""
+
+    rows: list[dict]
+
+
 def sweep_job(
     spec,
     scheduler: str,
@@ -55,9 +64,14 @@ def sweep_job(
     cancel,
     progress,
 ):
-    """The sweep job (worker thread): every finished variant is a kept progress report."""
-    from ladartui.sweep import connect, run_sweep
+    """The sweep job (worker thread): first the rows already stored (``StoredRows``),
+    then every finished variant, each a kept progress report."""
+    from ladartui.sweep import connect, default_out_dir, run_sweep
+    from ladartui.sweep.base import spec_rows
+    from ladartui.sweep.table import read_table
 
+    stored, _ = read_table(default_out_dir(spec) / "results.csv")
+    progress(0.0, "", StoredRows(spec_rows(stored, spec)), keep=True)
     client = None
     try:
         if scheduler:

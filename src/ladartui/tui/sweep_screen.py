@@ -31,6 +31,7 @@ from ladartui.recent import recent_paths, remember_path
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar, StatusText, format_eta
 from ladartui.tui.sweep_jobs import (
+    StoredRows,
     open_sweep,
     spec_to_run,
     start_resource_tracker,
@@ -138,6 +139,8 @@ class SweepScreen(RankingView):
         self.running = False
         self.left_running = False  # Esc left the screen while a sweep ran (and cancelled it)
         self.worker: Worker | None = None  # the sweep job while it runs
+        self.opening: Worker | None = None  # the last open asked for (read off the UI thread)
+        self._opens = 0  # opens asked for: an answer to an earlier one is dropped
         self._dirty = False  # rows arrived since the last redraw (redrawn a few times a second)
         self._row_index: dict[str, int] = {}  # variant id -> position in rows, while running
         self._shown_ids: list = []  # variant ids in table order
@@ -257,18 +260,15 @@ class SweepScreen(RankingView):
             self._status(NOT_READY, str(error), problem=True)
             return
         from ladartui.sweep import default_out_dir
-        from ladartui.sweep.base import spec_rows
-        from ladartui.sweep.table import read_table
 
         serial = self.query_one("#sweep-serial", Checkbox).value and not scheduler
         self.spec, self.out = spec, default_out_dir(spec)
         self.objective, self.cost, self.budget = objective, cost, spec.budget
         self.parameter_names = spec.parameter_names
-        # Rows already in the table for this spec's variants and base show at once (they resume).
+        # The rows already stored for this spec come first from the job (StoredRows).
         ids = {variant.id for variant in spec.variants}
-        stored, _ = read_table(self.out / "results.csv")
-        self.rows = spec_rows(stored, spec)
-        self._row_index = {row["variant"]: i for i, row in enumerate(self.rows)}
+        self.rows, self._row_index = [], {}
+        self._opens += 1  # an open still being read is not shown over the sweep
         self._rank()
         if not serial and not scheduler:
             start_resource_tracker()
@@ -425,11 +425,30 @@ class SweepScreen(RankingView):
     # -- opening results ------------------------------------------------------------
 
     def _open(self, text: str) -> None:
-        try:
-            opened = open_sweep(text)
-        except LadarError as error:
-            self._status(NOT_READY, str(error), problem=True)
+        """Open a spec or results in a worker (``open_sweep`` reads the table and hashes
+        the base's models, which can take seconds); ``_show_opened`` shows them."""
+        self._opens += 1
+        number = self._opens
+
+        def read(cancel, progress):
+            try:
+                return number, open_sweep(text), None
+            except LadarError as error:
+                return number, None, str(error)
+
+        self._status(BUSY, f"opening {text} ...")
+        self.opening = start_job(self, "open", read)
+
+    def _opened(self, answer) -> None:
+        number, opened, error = answer
+        if number != self._opens or self.running:  # another open, or a sweep, came after it
             return
+        if error is not None:
+            self._status(NOT_READY, error, problem=True)
+            return
+        self._show_opened(opened)
+
+    def _show_opened(self, opened) -> None:
         spec, result, own, path = opened.spec, opened.result, opened.own, opened.path
         if result is None:  # a spec not run yet
             self.spec, self.out, self.rows, self.ranking = spec, opened.out, [], []
@@ -468,13 +487,20 @@ class SweepScreen(RankingView):
     # -- the sweep worker ---------------------------------------------------------------
 
     def on_job_progress(self, message: JobProgress) -> None:
-        if message.detail is not None:
+        if isinstance(message.detail, StoredRows):
+            self._show_stored_rows(message.detail.rows)
+        elif message.detail is not None:
             self._show_progress(message.detail)
         else:
             self._status(BUSY, message.text, 0.0, True)
 
     def on_job_done(self, message: JobDone) -> None:
-        if message.job == "best":
+        if message.job == "open":
+            if message.result is not None:
+                self._opened(message.result)
+            elif message.error:  # not a LadarError: something broke while reading
+                self._status(NOT_READY, f"cannot open: {message.error}", problem=True)
+        elif message.job == "best":
             if message.error:
                 self._status(NOT_READY, f"cannot save the best path: {message.error}")
             elif message.result is not None:
@@ -487,6 +513,13 @@ class SweepScreen(RankingView):
             self._finish(message.result, message.error or "")
 
     # -- updates on the UI thread ------------------------------------------------
+
+    def _show_stored_rows(self, rows: list[dict]) -> None:
+        """The rows already stored for the running spec, shown at once (they resume):
+        the job's first report, before any variant finishes."""
+        self.rows = list(rows)
+        self._row_index = {row["variant"]: i for i, row in enumerate(self.rows)}
+        self._rank()
 
     def _show_progress(self, p) -> None:
         self.progress = p
