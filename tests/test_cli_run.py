@@ -103,9 +103,11 @@ def test_bad_backend_is_one_line(scenario, capsys):
 
 
 def test_bad_step_names_the_flag(scenario, capsys):
-    assert main(["run", str(scenario.path), "--step", "0", "--no-write"]) == 2
-    err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and err.startswith("ladartui: error: --step = 0.0: expected")
+    for step in ("0", "1e-9"):  # (a march that fine ran without end)
+        assert main(["run", str(scenario.path), "--step", step, "--no-write"]) == 2
+        err = capsys.readouterr().err.strip()
+        assert len(err.splitlines()) == 1
+        assert err.startswith(f"ladartui: error: --step = {float(step)!r}: expected")
 
 
 def test_ctrl_c_after_the_run_wrote_its_outputs_says_what_it_wrote(scenario, capsys, monkeypatch):

@@ -456,3 +456,14 @@ def test_a_scene_too_large_to_trace_is_named_by_its_file(tmp_path, capsys):
     code = main(["trace", "--scene", str(far), "--rays", str(rays), "--out", str(tmp_path / "h.npy")])
     err = capsys.readouterr().err.strip()
     assert code == 2 and err.startswith(f"ladartui: error: {far}: 2 voxels spanning 100001 x 100001 x 1001")
+
+
+def test_a_march_step_too_fine_names_the_flag(tmp_path, scene_file, capsys):
+    """At 1e-7 voxels wgpu's march answered misses and numba's ran without end."""
+    rays = _three_rays(tmp_path)
+    out = tmp_path / "hits.npy"
+    command = ["trace", "--scene", str(scene_file), "--rays", str(rays), "--out", str(out)]
+    assert main([*command, "--method", "march", "--step", "1e-7", "--voxel-size", "0.25"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == "ladartui: error: --step = 1e-07: expected a number of voxels from 0.001"
+    assert not out.exists()

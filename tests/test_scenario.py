@@ -286,7 +286,8 @@ LIMITS = [
         "one of 'manual', 'straight', 'turn', 'orbit', 'flypast', 'standoff', 'log'",
     ),
     ('method = "march"', 'method = "fast"', "simulation.method = 'fast'", "one of 'exact', 'march'"),
-    ("step = 0.25", "step = 0", "simulation.step = 0", "a number greater than 0 and at most 10"),
+    ("step = 0.25", "step = 0", "simulation.step = 0", "a number from 0.001 to 10"),
+    ("step = 0.25", "step = 1e-12", "simulation.step = 1e-12", "a number from 0.001 to 10"),
     ('precision = "f32"', 'precision = "f16"', "simulation.precision = 'f16'", "one of 'f64', 'f32'"),
     ("fast_mode = true", "fast_mode = 1", "simulation.fast_mode = 1", "true or false"),
 ]

@@ -63,6 +63,9 @@ def test_top_level_export_is_the_function():
         ({"method": "bogus"}, "method"),
         ({"method": "march", "step": 0}, "step"),
         ({"method": "march", "step": -1.0}, "step"),
+        # a march this fine never ends (or its sample count overflows: misses)
+        ({"method": "march", "step": 1e-12}, "step"),
+        ({"method": "march", "step": 1e-7}, "step"),
         ({"voxel_size": 0}, "voxel_size"),
         ({"precision": "f16"}, "precision"),
     ],
@@ -213,3 +216,30 @@ def test_ranges_are_scaled_without_touching_a_backends_own_arrays(block, monkeyp
     viewed = trace(block, origins, directions, backend="keeps", voxel_size=0.5, step=0.25)
     assert np.array_equal(viewed.range, [0.0, 0.5, 1.0])
     assert np.array_equal(kept, np.arange(6.0))
+
+
+def test_the_finest_march_step_is_taken_and_named_when_refused(block):
+    from ladartui.tracing.config import MIN_STEP
+
+    origins, directions = np.zeros((2, 3)) + [1.5, 1.5, 9.0], np.tile([0.0, 0.0, -1.0], (2, 1))
+    fine = trace(block, origins, directions, method="march", step=MIN_STEP, backend="numba")
+    exact = trace(block, origins, directions, backend="numba")
+    assert np.array_equal(fine.kind, exact.kind) and np.array_equal(fine.index, exact.index)
+    with pytest.raises(FieldError) as error:
+        trace(block, origins, directions, method="march", step=MIN_STEP / 2)
+    assert str(error.value) == f"step = {MIN_STEP / 2!r}: expected a number of voxels from 0.001"
+
+
+@pytest.mark.parametrize("name", ["numba", "wgpu"])
+def test_each_backend_refuses_a_march_step_too_fine_itself(block, name):
+    """Backends are called directly too (trace_cells): the same floor as trace()'s."""
+    from ladartui.tracing import get_backend
+    from ladartui.tracing.backend import BackendUnavailable
+
+    try:
+        backend = get_backend(name)
+    except BackendUnavailable:
+        pytest.skip(f"{name} unavailable here")
+    origins, directions = np.zeros((2, 3)) + [1.5, 1.5, 9.0], np.tile([0.0, 0.0, -1.0], (2, 1))
+    with pytest.raises(FieldError, match="from 0.001"):
+        backend.trace_cells(block, origins, directions, method="march", step=1e-7)

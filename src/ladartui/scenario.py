@@ -44,6 +44,7 @@ from ladartui.sensor import Sensor
 from ladartui.textsafe import one_line
 from ladartui.toml_lines import key_lines
 from ladartui.tracing.backend import METHODS, PRECISIONS
+from ladartui.tracing.config import MIN_STEP
 from ladartui.trajectory import LogSegment
 
 BUILTIN_BACKENDS = ("numba", "wgpu")
@@ -105,7 +106,7 @@ class Scenario:
         set_(self, "speed", number_field("flight.speed_mps", self.speed, 0.0, MAX_SPEED, low_open=True))
         set_(self, "backend", choice_field("simulation.backend", self.backend, _backend_choices()))
         set_(self, "method", choice_field("simulation.method", self.method, METHODS))
-        set_(self, "step", number_field("simulation.step", self.step, 0.0, MAX_STEP, low_open=True))
+        set_(self, "step", number_field("simulation.step", self.step, MIN_STEP, MAX_STEP))
         set_(self, "precision", choice_field("simulation.precision", self.precision, PRECISIONS))
         if not isinstance(self.fast_mode, bool):
             raise FieldError("simulation.fast_mode", self.fast_mode, "true or false")

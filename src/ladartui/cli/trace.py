@@ -116,6 +116,7 @@ def load_rays(path) -> np.ndarray:
 
 
 def run(args):
+    from ladartui.cli.flags import as_flags
     from ladartui.scene.occupancy import Occupancy
     from ladartui.scene.voxels import load_voxels
     from ladartui.tracing import trace
@@ -133,16 +134,18 @@ def run(args):
     rays = load_rays(args.rays)
     voxels = load_voxels(args.scene)
     occupancy = Occupancy.build(voxels, source=str(args.scene))
-    result = trace(
-        occupancy,
-        rays[:, :3],
-        rays[:, 3:],
-        backend=args.backend,
-        method=args.method,
-        step=args.step,
-        precision=args.precision,
-        voxel_size=args.voxel_size,
-    )
+    typed = {"backend": args.backend, "method": args.method, "step": args.step, "precision": args.precision}
+    with as_flags(typed):  # name the flag typed, not trace()'s parameter
+        result = trace(
+            occupancy,
+            rays[:, :3],
+            rays[:, 3:],
+            backend=args.backend,
+            method=args.method,
+            step=args.step,
+            precision=args.precision,
+            voxel_size=args.voxel_size,
+        )
     with atomic_path(args.out) as tmp:
         with open(tmp, "wb") as handle:
             np.save(handle, result.as_array())

@@ -26,7 +26,7 @@ from ladartui.tracing.backend import (
     get_backend,
 )
 from ladartui.tracing.backend_choice import CHOICES, learns
-from ladartui.tracing.config import DEFAULT_STEP
+from ladartui.tracing.config import DEFAULT_STEP, MIN_STEP
 from ladartui.tracing.passes import recording, timed
 
 __all__ = [
@@ -126,8 +126,9 @@ def trace(
         raise FieldError("method", method, "one of " + ", ".join(METHODS))
     if step is None:
         step = DEFAULT_STEP
-    if not (isinstance(step, (int, float, np.floating, np.integer)) and np.isfinite(step) and step > 0):
-        raise FieldError("step", step, "a positive number of voxels")
+    number = isinstance(step, (int, float, np.floating, np.integer))
+    if not (number and np.isfinite(step) and step >= MIN_STEP):
+        raise FieldError("step", step, f"a number of voxels from {MIN_STEP:g}")
     if precision not in PRECISIONS:
         raise FieldError("precision", precision, " or ".join(PRECISIONS))
     learned = None  # auto's learned choice between a GPU and the host's cores (backend_choice)

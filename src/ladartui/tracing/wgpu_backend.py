@@ -66,6 +66,7 @@ from ladartui.tracing.config import (
     BUNDLE,
     LOOP_BUDGET,
     MAX_OCCUPANCY_BINDINGS,
+    MIN_STEP,
     OBJECT_ORDER_TILE_SHIFT,
     RAY_BATCH,
     SCAN_BLOCK,
@@ -331,8 +332,8 @@ class WgpuBackend:
         if origins.shape != directions.shape:
             raise ValueError("origins and directions differ in length")
         step = float(step) if step is not None else 0.5
-        if method == "march" and not step > 0:
-            raise FieldError("step", step, "a positive number of voxels")
+        if method == "march" and not step >= MIN_STEP:
+            raise FieldError("step", step, f"a number of voxels from {MIN_STEP:g}")
         with self._lock:
             self._open_device()
             used = precision if (precision == "f32" or self._has_f64) else "f32"
