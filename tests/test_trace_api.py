@@ -243,3 +243,18 @@ def test_each_backend_refuses_a_march_step_too_fine_itself(block, name):
     origins, directions = np.zeros((2, 3)) + [1.5, 1.5, 9.0], np.tile([0.0, 0.0, -1.0], (2, 1))
     with pytest.raises(FieldError, match="from 0.001"):
         backend.trace_cells(block, origins, directions, method="march", step=1e-7)
+
+
+def test_complex_rays_and_a_cancel_that_is_no_event_are_field_errors(block):
+    """Complex rays lost their imaginary parts with only numpy's warning; cancel=True
+    ended in an AttributeError from deep inside the backend."""
+    origins, directions = np.zeros((2, 3)) + [1.5, 1.5, 9.0], np.tile([0.0, 0.0, -1.0], (2, 1))
+    with pytest.raises(FieldError) as error:
+        trace(block, origins + 1j, directions)
+    assert error.value.field == "origins" and "real numbers" in str(error.value)
+    with pytest.raises(FieldError) as error:
+        trace(block, origins, directions.astype(complex))
+    assert error.value.field == "directions"
+    with pytest.raises(FieldError) as error:
+        trace(block, origins, directions, cancel=True)
+    assert str(error.value) == "cancel = True: expected a threading.Event (or None)"

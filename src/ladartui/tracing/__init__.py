@@ -116,6 +116,8 @@ def trace(
     ``backend`` is a registered name or "auto". Ranges come back in metres.
     """
     occupancy, voxel_size = _occupancy_and_size(scene_or_occupancy, voxel_size)
+    if cancel is not None and not callable(getattr(cancel, "is_set", None)):
+        raise FieldError("cancel", cancel, "a threading.Event (or None)")
     origins = _rays("origins", origins)
     directions = _rays("directions", directions)
     if origins.shape != directions.shape:
@@ -205,6 +207,8 @@ def _occupancy_and_size(target, voxel_size):
 
 
 def _rays(name, values):
+    if np.iscomplexobj(values):  # (numpy would drop the imaginary parts with a warning)
+        raise FieldError(name, "a complex array", "an (N, 3) array of real numbers")
     try:
         array = np.asarray(values, dtype=np.float64)
     except (TypeError, ValueError):
