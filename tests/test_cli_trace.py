@@ -467,3 +467,38 @@ def test_a_march_step_too_fine_names_the_flag(tmp_path, scene_file, capsys):
     err = capsys.readouterr().err.strip()
     assert err == "ladartui: error: --step = 1e-07: expected a number of voxels from 0.001"
     assert not out.exists()
+
+
+def test_bench_says_when_a_backend_traced_in_f32(monkeypatch, capsys):
+    """An adapter without shader-f64 traces wgpu's exact rows in f32: the ratios then
+    compare f32 with numba's f64, and the table says so (it did not)."""
+    from ladartui.cli import bench
+
+    monkeypatch.setenv("COLUMNS", "80")
+    rows = [
+        _bench_row("numba", "exact", "wide", 45.0, 26.87e6, 1.0, 13.48e6),
+        _bench_row("wgpu", "exact", "wide", 45.0, 33.27e6, 1.24, 18.65e6),
+    ]
+    rows[1]["precision"] = "f32"
+    report = {
+        "scene": "reference",
+        "shape": [1500, 1500, 900],
+        "voxels": 3829919,
+        "occupancy_bytes": 18_000_000,
+        "setup_seconds": 1.1,
+        "setup_cpu_seconds": 1.1,
+        "sensor": "128x128 detectors, 4x4 rays each",
+        "runs": 7,
+        "warm_up": {"numba": {"calls": 53, "seconds": 0.5}},
+        "results": rows,
+        "views": {"wide": "wide view", "narrow": "narrow view"},
+        "backends": {"numba": "available", "wgpu": "available"},
+    }
+    bench._print_table(report)
+    out = capsys.readouterr().out
+    assert "wgpu traced in f32 (its adapter has no float64): its x numba compares f32 with f64" in " ".join(
+        out.split()
+    )
+    rows[1]["precision"] = "f64"
+    bench._print_table(report)
+    assert "traced in f32" not in capsys.readouterr().out

@@ -360,6 +360,8 @@ def run_bench(quick=False, runs=None, progress=None) -> dict:
                         # Median seconds by pass (tracing/passes.py), "other" the rest of a call.
                         "passes": pass_medians(times[name], passes[name]),
                         "device": _device(backend.describe()),
+                        # f32 where an adapter without shader-f64 traced "f64" calls
+                        "precision": result.info.get("precision", "f64"),
                     }
                 )
     _add_ratios(report["results"])
@@ -463,6 +465,12 @@ def _print_table(report):
         "order: obj object, ray ray order, mix both in one call (several: the timed runs "
         "differed); devices: " + "; ".join(f"{name} {device}" for name, device in devices.items())
     )
+    in_f32 = sorted({row["backend"] for row in report["results"] if row.get("precision") == "f32"})
+    for name in in_f32:
+        console.print(
+            f"{name} traced in f32 (its adapter has no float64): its x numba compares f32 with f64",
+            markup=False,
+        )
     for name, status in report["backends"].items():
         if status != "available":
             console.print(f"[dim]{name}: {status}[/dim]")
