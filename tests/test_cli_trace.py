@@ -293,18 +293,9 @@ def _bench_row(backend, method, view, depression, rate, vs_numba, per_cpu, order
     }
 
 
-def test_bench_table_fits_an_80_column_terminal(monkeypatch, capsys):
-    """Every figure of every row, whole, in 80 columns (an SSH terminal's width)."""
-    from ladartui.cli import bench
-
-    monkeypatch.setenv("COLUMNS", "80")
-    rows = [
-        _bench_row("numba", "exact", "narrow", 45.0, 26.87e6, 1.0, 13.48e6),
-        _bench_row("wgpu", "exact", "narrow", 45.0, 133.27e6, 4.96, 98.65e6),
-        _bench_row("numba", "march", "wide", 90.0, 0.86e6, 1.0, 0.44e6, order="object+ray/ray"),
-        _bench_row("wgpu", "march", "wide", 90.0, 1.08e6, None, None, order="ray"),
-    ]
-    report = {
+def _bench_report(rows):
+    """A bench report of ``rows`` on the reference scene, as run_bench makes it."""
+    return {
         "scene": "reference",
         "shape": [1500, 1500, 900],
         "voxels": 3829919,
@@ -318,6 +309,20 @@ def test_bench_table_fits_an_80_column_terminal(monkeypatch, capsys):
         "views": {"wide": "wide view", "narrow": "narrow view"},
         "backends": {"numba": "available", "wgpu": "available"},
     }
+
+
+def test_bench_table_fits_an_80_column_terminal(monkeypatch, capsys):
+    """Every figure of every row, whole, in 80 columns (an SSH terminal's width)."""
+    from ladartui.cli import bench
+
+    monkeypatch.setenv("COLUMNS", "80")
+    rows = [
+        _bench_row("numba", "exact", "narrow", 45.0, 26.87e6, 1.0, 13.48e6),
+        _bench_row("wgpu", "exact", "narrow", 45.0, 133.27e6, 4.96, 98.65e6),
+        _bench_row("numba", "march", "wide", 90.0, 0.86e6, 1.0, 0.44e6, order="object+ray/ray"),
+        _bench_row("wgpu", "march", "wide", 90.0, 1.08e6, None, None, order="ray"),
+    ]
+    report = _bench_report(rows)
     bench._print_table(report)
     lines = capsys.readouterr().out.splitlines()
     assert max(len(line) for line in lines) <= 80
@@ -480,20 +485,7 @@ def test_bench_says_when_a_backend_traced_in_f32(monkeypatch, capsys):
         _bench_row("wgpu", "exact", "wide", 45.0, 33.27e6, 1.24, 18.65e6),
     ]
     rows[1]["precision"] = "f32"
-    report = {
-        "scene": "reference",
-        "shape": [1500, 1500, 900],
-        "voxels": 3829919,
-        "occupancy_bytes": 18_000_000,
-        "setup_seconds": 1.1,
-        "setup_cpu_seconds": 1.1,
-        "sensor": "128x128 detectors, 4x4 rays each",
-        "runs": 7,
-        "warm_up": {"numba": {"calls": 53, "seconds": 0.5}},
-        "results": rows,
-        "views": {"wide": "wide view", "narrow": "narrow view"},
-        "backends": {"numba": "available", "wgpu": "available"},
-    }
+    report = _bench_report(rows)
     bench._print_table(report)
     out = capsys.readouterr().out
     assert "wgpu traced in f32 (its adapter has no float64): its x numba compares f32 with f64" in " ".join(

@@ -130,11 +130,13 @@ def test_a_box_too_large_for_i32_offsets_goes_through_trace_rays(
     assert not used
 
 
-def test_cancelled_with_batches_in_flight_leaves_the_backend_usable(numba_backend, case, monkeypatch):
+@pytest.mark.parametrize("staged", [False, True])
+def test_cancelled_with_batches_in_flight_leaves_the_backend_usable(numba_backend, case, monkeypatch, staged):
     """Cancelled after the first batch's answers: Cancelled, the read-back buffer
-    not left mapped, and the next call answers in full."""
+    not left mapped, and the next call answers in full (staged too: its staging
+    buffers were being mapped again)."""
     occupancy, origins, directions = case
-    backend = WgpuBackend(ray_batch=640)
+    backend = WgpuBackend(ray_batch=640, staged_upload=staged)
     cancel = threading.Event()
     answers = wgpu_hits.box_offset_answers
 

@@ -6,16 +6,12 @@ bit for bit, on the adapter here (lavapipe runs the same path when asked)."""
 
 from __future__ import annotations
 
-import threading
-
 import numpy as np
 import pytest
 
-from ladartui.errors import Cancelled
 from ladartui.tracing import TINY, wgpu_hits, wgpu_scans
 from ladartui.tracing.prepare import rays_to_cells
 from ladartui.tracing.wgpu_backend import WgpuBackend
-from ladartui.tracing.wgpu_occupancy import PARAMS_BYTES
 from test_wgpu_backend import assert_same, random_rays, random_scene
 from test_wgpu_hits import SHAPE, scan_from
 from test_wgpu_mapped_writes import RangedBuffer, WriteOnlyBuffer
@@ -74,29 +70,6 @@ def test_staged_rays_use_no_queue_writes_and_one_submit_a_batch(wgpu_backend, ca
         )
     backend.trace_cells(occupancy, origins, directions, order="ray")
     assert calls == ["submit"] * 5
-
-
-def test_a_cancelled_staged_call_leaves_the_backend_usable(wgpu_backend, numba_backend, case, monkeypatch):
-    """Cancelled after the first batch's answers: no read-back buffer left mapped,
-    and the next call (whose staging buffers were being mapped again) answers in full."""
-    occupancy, origins, directions = case
-    backend = staged_backend(wgpu_backend, ray_batch=640)
-    cancel = threading.Event()
-    answers = wgpu_hits.box_offset_answers
-
-    def answer_then_cancel(*args):
-        cancel.set()
-        return answers(*args)
-
-    monkeypatch.setattr(wgpu_hits, "box_offset_answers", answer_then_cancel)
-    with pytest.raises(Cancelled):
-        backend.trace_cells(occupancy, origins, directions, order="ray", cancel=cancel)
-    assert [b.map_state for b in backend._hits.buffers(PARAMS_BYTES)["back"]] == ["unmapped"] * 2
-    monkeypatch.setattr(wgpu_hits, "box_offset_answers", answers)
-    assert_same(
-        backend.trace_cells(occupancy, origins, directions, order="ray"),
-        numba_backend.trace_cells(occupancy, origins, directions, order="ray"),
-    )
 
 
 def test_a_cpu_adapter_writes_through_the_queue_by_default(wgpu_backend, case):
