@@ -84,9 +84,24 @@ class NumberField(Input):
         if self.optional and not self.value.strip():
             value = None
         else:
-            value = parse_number(self.field_name, self.value, self.integer, self.scale)
+            try:
+                value = parse_number(self.field_name, self.value, self.integer, self.scale)
+            except FieldError as error:
+                raise self._with_limits(error) from None
         self.check(value)
         return value
+
+    def _with_limits(self, error: FieldError) -> FieldError:
+        """For text that is no number (or no whole one): the core's expectation with its
+        limits, asked of the check with NaN (inside no range), else ``error`` as it is."""
+        try:
+            self.check(math.nan)
+        except FieldError as core:
+            if core.limits is not None:
+                return FieldError(error.field, error.value, core.expected, limits=core.limits)
+        except LadarError:
+            pass
+        return error
 
     def problem(self) -> str | None:
         """Why the current text is not allowed, or None."""
