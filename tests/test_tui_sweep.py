@@ -498,10 +498,10 @@ async def test_opening_reads_off_the_ui_thread_and_keeps_only_the_last_asked(fin
     import shutil
     import threading
 
-    from ladartui.tui import sweep_screen
+    from ladartui.tui import sweep_opening
 
     spec, results = finished
-    real = sweep_screen.open_sweep
+    real = sweep_opening.open_sweep
     threads, release = [], threading.Event()
 
     def slow_open(text):
@@ -511,7 +511,7 @@ async def test_opening_reads_off_the_ui_thread_and_keeps_only_the_last_asked(fin
             return real(str(results))  # (would show the whole folder)
         return real(text)
 
-    monkeypatch.setattr(sweep_screen, "open_sweep", slow_open)
+    monkeypatch.setattr(sweep_opening, "open_sweep", slow_open)
     monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))  # no sweep opened before
     for path in spec.parent.iterdir():  # a copy: the spec is narrowed below
         copy = shutil.copytree if path.is_dir() else shutil.copy

@@ -32,13 +32,12 @@ from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar, StatusText, format_eta
 from ladartui.tui.sweep_jobs import (
     StoredRows,
-    open_sweep,
     spec_to_run,
     start_resource_tracker,
     sweep_job,
     write_best,
 )
-from ladartui.tui.sweep_ranking import RankingView
+from ladartui.tui.sweep_opening import SweepOpening
 from ladartui.tui.sweep_view import (
     eta_seconds,
     short_path,
@@ -66,7 +65,7 @@ class ExistingPath(Validator):
         return self.failure(f"{value.strip()}: no such file or folder")
 
 
-class SweepScreen(RankingView):
+class SweepScreen(SweepOpening):
     """Launch a flight-path sweep (or open an earlier one), watch it and rank its variants."""
 
     class OpenScenario(Message):
@@ -421,68 +420,6 @@ class SweepScreen(RankingView):
     @on(DataTable.RowHighlighted, "#sweep-table")
     def _row_highlighted(self, event: DataTable.RowHighlighted) -> None:
         self._show_detail(event.cursor_row)
-
-    # -- opening results ------------------------------------------------------------
-
-    def _open(self, text: str) -> None:
-        """Open a spec or results in a worker (``open_sweep`` reads the table and hashes
-        the base's models, which can take seconds); ``_show_opened`` shows them."""
-        self._opens += 1
-        number = self._opens
-
-        def read(cancel, progress):
-            try:
-                return number, open_sweep(text), None
-            except LadarError as error:
-                return number, None, str(error)
-
-        self._status(BUSY, f"opening {text} ...")
-        self.opening = start_job(self, "open", read)
-
-    def _opened(self, answer) -> None:
-        number, opened, error = answer
-        if number != self._opens or self.running:  # another open, or a sweep, came after it
-            return
-        if error is not None:
-            self._status(NOT_READY, error, problem=True)
-            return
-        self._show_opened(opened)
-
-    def _show_opened(self, opened) -> None:
-        spec, result, own, path = opened.spec, opened.result, opened.own, opened.path
-        if result is None:  # a spec not run yet
-            self.spec, self.out, self.rows, self.ranking = spec, opened.out, [], []
-            self.objective, self.cost, self.budget = spec.objective, spec.cost, spec.budget
-            self.parameter_names = spec.parameter_names
-            self._redraw()
-            self._show_stored(len(spec.variants))
-            self._status(
-                NOT_READY, f"{path}: {len(spec.variants)} variants, no results yet: F5 runs the sweep"
-            )
-            remember_path("sweeps", path)
-            return
-        self.spec = spec
-        self.out = opened.out
-        self.rows, self.ranking = result.rows, result.ranking
-        self.objective, self.cost, self.budget = result.objective, result.cost, result.budget
-        self.parameter_names = spec.parameter_names if spec else result.parameter_names
-        others = ""
-        if own is not None and len(own) < len(result.rows):
-            self.rows = own
-            others = (
-                f"; {len(result.rows) - len(own)} rows of other variants or an earlier base "
-                "in the folder left out"
-            )
-            self._rank_quietly()
-        self.progress = None
-        self._redraw()
-        self._show_stored(len(spec.variants) if spec else len(self.rows))
-        self.query_one("#sweep-table", DataTable).focus()
-        self._status(
-            READY,
-            f"ranked by {self.objective}: {self._summary()}{others}; {short_path(result.results_path)}",
-        )
-        remember_path("sweeps", path)  # the screen reopens it next time
 
     # -- the sweep worker ---------------------------------------------------------------
 

@@ -1,0 +1,110 @@
+"""The sweep screen's opening of a spec or results: read in a worker, shown when read.
+
+``open_sweep`` reads the results table and hashes the base's models, which can
+take seconds, so it runs as a job (tui/work.py); of several opens only the last
+asked for is shown, and none over a sweep started meanwhile.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+from textual.widgets import DataTable
+
+from ladartui.errors import LadarError
+from ladartui.recent import remember_path
+from ladartui.tui.status import BUSY, NOT_READY, READY
+from ladartui.tui.sweep_jobs import open_sweep
+from ladartui.tui.sweep_ranking import RankingView
+from ladartui.tui.sweep_view import short_path
+from ladartui.tui.work import start_job
+
+if TYPE_CHECKING:
+    from pathlib import Path
+
+    from textual.worker import Worker
+
+    from ladartui.sweep.spec import SweepSpec
+
+
+class SweepOpening(RankingView):
+    """Opens a spec, a results.csv or a results folder into the ranking (``_open``)."""
+
+    spec: SweepSpec | None
+    out: Path | None
+    budget: float | None
+    progress: Any  # the last SweepProgress, None before one
+    running: bool
+    opening: Worker | None  # the last open asked for
+    _opens: int  # opens asked for: an answer to an earlier one is dropped
+
+    def _status(
+        self,
+        state: str,
+        message: str,
+        progress: float | None = None,
+        cancellable: bool = False,
+        problem: bool = False,
+    ) -> None:
+        """The screen's status bar (``SweepScreen._status``)."""
+        raise NotImplementedError
+
+    def _open(self, text: str) -> None:
+        """Open a spec or results in a worker (``open_sweep`` reads the table and hashes
+        the base's models, which can take seconds); ``_show_opened`` shows them."""
+        self._opens += 1
+        number = self._opens
+
+        def read(cancel, progress):
+            try:
+                return number, open_sweep(text), None
+            except LadarError as error:
+                return number, None, str(error)
+
+        self._status(BUSY, f"opening {text} ...")
+        self.opening = start_job(self, "open", read)
+
+    def _opened(self, answer) -> None:
+        number, opened, error = answer
+        if number != self._opens or self.running:  # another open, or a sweep, came after it
+            return
+        if error is not None:
+            self._status(NOT_READY, error, problem=True)
+            return
+        self._show_opened(opened)
+
+    def _show_opened(self, opened) -> None:
+        spec, result, own, path = opened.spec, opened.result, opened.own, opened.path
+        if result is None:  # a spec not run yet
+            self.spec, self.out, self.rows, self.ranking = spec, opened.out, [], []
+            self.objective, self.cost, self.budget = spec.objective, spec.cost, spec.budget
+            self.parameter_names = spec.parameter_names
+            self._redraw()
+            self._show_stored(len(spec.variants))
+            self._status(
+                NOT_READY, f"{path}: {len(spec.variants)} variants, no results yet: F5 runs the sweep"
+            )
+            remember_path("sweeps", path)
+            return
+        self.spec = spec
+        self.out = opened.out
+        self.rows, self.ranking = result.rows, result.ranking
+        self.objective, self.cost, self.budget = result.objective, result.cost, result.budget
+        self.parameter_names = spec.parameter_names if spec else result.parameter_names
+        others = ""
+        if own is not None and len(own) < len(result.rows):
+            self.rows = own
+            others = (
+                f"; {len(result.rows) - len(own)} rows of other variants or an earlier base "
+                "in the folder left out"
+            )
+            self._rank_quietly()
+        self.progress = None
+        self._redraw()
+        self._show_stored(len(spec.variants) if spec else len(self.rows))
+        self.query_one("#sweep-table", DataTable).focus()
+        self._status(
+            READY,
+            f"ranked by {self.objective}: {self._summary()}{others}; {short_path(result.results_path)}",
+        )
+        remember_path("sweeps", path)  # the screen reopens it next time
