@@ -23,10 +23,11 @@ from ladartui.tracing.backend import (
     VOXEL,
     backend_names,
     backend_status,
+    check_step,
     get_backend,
 )
 from ladartui.tracing.backend_choice import CHOICES, learns
-from ladartui.tracing.config import DEFAULT_STEP, MIN_STEP
+from ladartui.tracing.config import DEFAULT_STEP
 from ladartui.tracing.passes import recording, timed
 
 __all__ = [
@@ -128,9 +129,7 @@ def trace(
         raise FieldError("method", method, "one of " + ", ".join(METHODS))
     if step is None:
         step = DEFAULT_STEP
-    number = isinstance(step, (int, float, np.floating, np.integer))
-    if not (number and np.isfinite(step) and step >= MIN_STEP):
-        raise FieldError("step", step, f"a number of voxels from {MIN_STEP:g}")
+    check_step(step)
     if precision not in PRECISIONS:
         raise FieldError("precision", precision, " or ".join(PRECISIONS))
     learned = None  # auto's learned choice between a GPU and the host's cores (backend_choice)

@@ -16,7 +16,7 @@ from typing import Literal, Protocol
 import numpy as np
 
 from ladartui.errors import BackendUnavailable, FieldError
-from ladartui.tracing.config import GROUND, MISS, VOXEL  # noqa: F401  (the kinds of CellHits)
+from ladartui.tracing.config import GROUND, MIN_STEP, MISS, VOXEL  # noqa: F401  (the kinds of CellHits)
 
 METHODS = ("exact", "march")  # the exact traversal; the report's fixed-step march
 PRECISIONS = ("f64", "f32")  # float64 everywhere; float32 on adapters without shader-f64
@@ -33,6 +33,14 @@ def check_order(order: str) -> TraceOrder:
     if order not in ORDERS:
         raise FieldError("order", order, "one of " + ", ".join(ORDERS))
     return order
+
+
+def check_step(step) -> None:
+    """FieldError unless ``step`` is a number of voxels of at least MIN_STEP (the march's
+    floor: finer never ended, or overflowed its count of samples)."""
+    number = isinstance(step, (int, float, np.floating, np.integer))
+    if not (number and np.isfinite(step) and step >= MIN_STEP):
+        raise FieldError("step", step, f"a number of voxels from {MIN_STEP:g}")
 
 
 @dataclass

@@ -19,13 +19,13 @@ import numba
 import numpy as np
 from numba import njit, prange
 
-from ladartui.errors import FieldError, check_cancelled
+from ladartui.errors import check_cancelled
 from ladartui.scene.occupancy import block_masks
 from ladartui.tracing.answers import ray_answer
 from ladartui.tracing.axis import boundary_t, cell_at, clamp, node_slot, slab
-from ladartui.tracing.backend import CellHits, TraceOrder, check_order, register_backend
+from ladartui.tracing.backend import CellHits, TraceOrder, check_order, check_step, register_backend
 from ladartui.tracing.bundle import bundle_start, halo_arrays
-from ladartui.tracing.config import BLOCK, BUNDLE, INF, MIN_STEP, SCAN_BLOCK
+from ladartui.tracing.config import BLOCK, BUNDLE, INF, SCAN_BLOCK
 from ladartui.tracing.march import march_kernel
 from ladartui.tracing.order_choice import RAY_SAMPLE, OrderChoice, trace_in_blocks
 from ladartui.tracing.passes import timed
@@ -413,8 +413,8 @@ class NumbaBackend:
         """See ``Backend`` (``order`` there). For tests: ``bundles=False`` starts every
         ray at its box entry."""
         check_order(order)
-        if method == "march" and not step >= MIN_STEP:
-            raise FieldError("step", step, f"a number of voxels from {MIN_STEP:g}")
+        if method == "march":
+            check_step(step)
         n = len(origins)
         orig = float_rows(origins)  # one row broadcast stays so: ray order makes rows per block
         dirs = np.ascontiguousarray(directions, dtype=np.float64)

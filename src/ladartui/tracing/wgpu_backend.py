@@ -59,6 +59,7 @@ from ladartui.tracing.backend import (
     CellHits,
     TraceOrder,
     check_order,
+    check_step,
     register_backend,
 )
 from ladartui.tracing.bundle import halo_arrays
@@ -66,7 +67,6 @@ from ladartui.tracing.config import (
     BUNDLE,
     LOOP_BUDGET,
     MAX_OCCUPANCY_BINDINGS,
-    MIN_STEP,
     OBJECT_ORDER_TILE_SHIFT,
     RAY_BATCH,
     SCAN_BLOCK,
@@ -332,8 +332,8 @@ class WgpuBackend:
         if origins.shape != directions.shape:
             raise ValueError("origins and directions differ in length")
         step = float(step) if step is not None else 0.5
-        if method == "march" and not step >= MIN_STEP:
-            raise FieldError("step", step, f"a number of voxels from {MIN_STEP:g}")
+        if method == "march":
+            check_step(step)
         with self._lock:
             self._open_device()
             used = precision if (precision == "f32" or self._has_f64) else "f32"
