@@ -299,35 +299,69 @@ def test_a_script_without_a_main_guard_is_told_what_to_change(tmp_path):
     assert done.returncode == 0 and done.stdout.split() == ["ran", "1"], done.stderr
 
 
-def test_workers_started_for_a_local_cluster_never_see_a_ctrl_c_at_start_up(monkeypatch):
+def test_workers_started_for_a_local_cluster_never_see_a_ctrl_c_at_start_up(tmp_path):
     """The key reaches the terminal's whole process group: workers still starting
-    printed KeyboardInterrupt tracebacks before the plugin made them ignore it. The
-    cluster starts with SIGINT blocked in its thread, which the processes it spawns
-    (and the threads it starts) inherit."""
+    printed KeyboardInterrupt tracebacks and died. A script (its own process group)
+    starts a real 2-worker local cluster on a thread, as the CLI does, while its main
+    thread sends SIGINT to the whole group every 20 ms."""
+    script = tmp_path / "start.py"
+    script.write_text(
+        "\n".join(
+            (
+                "import os, signal, threading, time",
+                "from ladartui.sweep import local_client",
+                "if __name__ == '__main__':",
+                "    signal.signal(signal.SIGINT, lambda *a: None)  # this process takes the key",
+                "    started = {}",
+                "    starting = threading.Thread(target=lambda: started.update(client=local_client(2)))",
+                "    starting.start()",
+                "    sent = 0",
+                "    while starting.is_alive():",
+                "        os.killpg(0, signal.SIGINT)",
+                "        sent += 1",
+                "        time.sleep(0.02)",
+                "    client = started['client']",
+                "    print('workers', len(client.scheduler_info()['workers']), 'sent', sent)",
+                "    cluster = client.cluster",
+                "    client.close()",
+                "    cluster.close()",
+            )
+        ),
+        encoding="utf-8",
+    )
+    done = subprocess.run(
+        [sys.executable, str(script)],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=300,
+        start_new_session=True,
+    )
+    assert done.returncode == 0, done.stderr
+    words = done.stdout.split()
+    assert words[:2] == ["workers", "2"] and int(words[3]) > 10, done.stdout
+    assert "KeyboardInterrupt" not in done.stderr and "Traceback" not in done.stderr, done.stderr
+
+
+def test_ctrl_c_while_the_local_cluster_starts_says_it_is_stopping(tmp_path):
+    """As a terminal sends it, to the whole process group: the command says it is
+    stopping, the workers print nothing, and the interruption is reported."""
     import signal
 
-    import distributed
-
-    from ladartui.sweep import cluster
-
-    ask = "import signal; print(signal.SIGINT in signal.pthread_sigmask(signal.SIG_BLOCK, set()))"
-
-    def child_blocks() -> str:
-        return subprocess.run([sys.executable, "-c", ask], capture_output=True, text=True).stdout.strip()
-
-    seen = {}
-
-    class StartingCluster:  # what LocalCluster does as it starts: threads, worker processes
-        def __init__(self, **options):
-            seen["worker"] = child_blocks()
-            started = threading.Thread(target=lambda: seen.update(thread_worker=child_blocks()))
-            started.start()
-            started.join()
-
-    monkeypatch.setattr(distributed, "LocalCluster", StartingCluster)
-    monkeypatch.setattr(distributed, "Client", lambda cluster: cluster)
-    monkeypatch.setattr(cluster, "_workers_ignore_ctrl_c", lambda client: None)
-    cluster.local_client(1)
-    assert seen == {"worker": "True", "thread_worker": "True"}
-    assert child_blocks() == "False"  # only while the cluster starts
-    assert signal.SIGINT not in signal.pthread_sigmask(signal.SIG_BLOCK, set())
+    spec = write_tiny_spec(tmp_path)
+    ladartui = Path(sys.executable).parent / "ladartui"
+    log = tmp_path / "sweep.log"
+    command = [str(ladartui), "sweep", str(spec), "--workers", "2", "--out", str(tmp_path / "out")]
+    process, handle = _start(command, log, dict(os.environ))
+    try:
+        _wait_for("sweep of 8 variants on local cluster", log, process)
+        time.sleep(0.5)  # the cluster is starting (a few seconds)
+        os.killpg(process.pid, signal.SIGINT)
+        assert process.wait(timeout=120) == 130
+    finally:
+        _stop(process)
+        handle.close()
+    said = log.read_text(errors="replace")
+    assert "stopping; finished variants are kept" in said
+    assert "sweep interrupted" in said and "run the same command again to resume" in said
+    assert "Traceback" not in said and "KeyboardInterrupt" not in said, said

@@ -283,9 +283,12 @@ def _sweep_with_progress(spec, args, console):
                 result.charts = write_sweep_charts(result, result.results_path.parent)
                 return result
 
+            def stopping() -> None:  # a cluster still starting finishes first (seconds)
+                bar.update(task, note="stopping; finished variants are kept")
+
             try:
                 with sigterm_as_interrupt():
-                    return run_cancellable(work, cancel, "ladartui-sweep", Cancelled())
+                    return run_cancellable(work, cancel, "ladartui-sweep", Cancelled(), stopping)
             except Cancelled:
                 pass  # reported below, once the client is closed
     finally:
