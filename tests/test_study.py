@@ -509,3 +509,17 @@ def test_chart_from_refuses_the_flags_of_a_new_study(tmp_path, capsys):
         "drop them"
     )
     assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize("warmup", ["1", "0", "3"])
+def test_chart_from_refuses_warmup_even_at_its_default_value(tmp_path, capsys, warmup):
+    """'--warmup 1 --chart-from J' slipped through: 1 was taken for 'not given'."""
+    from ladartui.cli import main
+
+    source = str(Path(__file__).parent.parent / "docs" / "study.json")
+    assert main(["study", "--chart-from", source, "--warmup", warmup, "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        "ladartui: error: --chart-from redraws a study already run: --warmup would shape a new one; drop it"
+    )
+    assert not (tmp_path / "o").exists()

@@ -13,6 +13,7 @@ from ladartui.errors import Cancelled, FieldError
 from ladartui.textsafe import visible
 
 DEFAULT_OUT = "study-results"
+DEFAULT_WARMUP = 1
 CHART_WIDTH, CHART_HEIGHT = 120, 34
 
 
@@ -41,7 +42,9 @@ def add_parser(subparsers) -> None:
         default=None,
         help="timed runs per setting, median quoted (default 5; 3 with --quick)",
     )
-    parser.add_argument("--warmup", type=int, default=1, help="untimed calls first (default 1)")
+    parser.add_argument(
+        "--warmup", type=int, default=None, help=f"untimed calls first (default {DEFAULT_WARMUP})"
+    )
     parser.add_argument(
         "--chart-from",
         metavar="JSON",
@@ -65,6 +68,7 @@ def run(args: argparse.Namespace) -> int:
     from ladartui.study.inputs import generated_inputs, scenario_inputs
 
     if args.chart_from:  # a study already run: what would shape a new one does not apply
+        # every flag here defaults to None (or False), so one given at its default value is refused too
         given = [
             flag
             for flag, value in (
@@ -72,7 +76,7 @@ def run(args: argparse.Namespace) -> int:
                 ("--quick", args.quick or None),
                 ("--runs", args.runs),
                 ("--scans", args.scans),
-                ("--warmup", args.warmup if args.warmup != 1 else None),
+                ("--warmup", args.warmup),
             )
             if value is not None
         ]
@@ -86,7 +90,7 @@ def run(args: argparse.Namespace) -> int:
         return _report(_load_result(args.chart_from), args.out)
     runs = _positive("--runs", args.runs if args.runs is not None else (3 if args.quick else 5))
     scans = _positive("--scans", args.scans if args.scans is not None else (2 if args.quick else 3))
-    warmup = args.warmup
+    warmup = args.warmup if args.warmup is not None else DEFAULT_WARMUP
     if warmup < 0:
         raise FieldError("--warmup", warmup, "0 or more")
     console = Console(stderr=True)
