@@ -118,3 +118,25 @@ def test_a_bad_limit_in_the_environment_is_named_not_ignored(monkeypatch, value)
     with pytest.raises(ResourceLimitError) as memory:
         available_memory()
     assert str(memory.value) == f"LADARTUI_MAX_MEMORY = {value!r}: expected a number of bytes >= 1"
+
+
+def test_a_ray_limit_names_how_its_caller_raises_it_and_a_sweep_its_own_way(monkeypatch):
+    """A sweep's advice was made by replacing text in the message: a reworded message
+    would have kept advising --max-rays, which a sweep does not have."""
+    import pickle
+
+    from ladartui.resources import RAISE_RAYS, SWEEP_RAISE_RAYS, RayLimitError, check_rays, sweep_advice
+
+    with pytest.raises(RayLimitError) as command:
+        check_rays(3e6, "s.toml", limit=1e6)
+    assert str(command.value) == (
+        f"s.toml: about 3e+06 rays to trace, more than the limit of 1e+06 (raise it with {RAISE_RAYS} "
+        "if this is meant)"
+    )
+    with pytest.raises(RayLimitError) as own:
+        check_rays(3e6, "s.toml", limit=1e6, raise_with=SWEEP_RAISE_RAYS)
+    assert sweep_advice(command.value) == str(own.value) != str(command.value)
+    assert "--max-rays" not in str(own.value) and SWEEP_RAISE_RAYS in str(own.value)
+    assert str(pickle.loads(pickle.dumps(own.value))) == str(own.value)
+    other = ResourceLimitError(f"x.txt: too big; use {RAISE_RAYS}")  # not a ray limit: as it is
+    assert sweep_advice(other) == str(other)

@@ -123,22 +123,41 @@ def check_occupancy(lo, hi, count, source="voxels") -> int:
 
 
 RAISE_RAYS = "--max-rays or LADARTUI_MAX_RAYS"  # how a command raises the ray limit
+# a sweep has no --max-rays; its workers, started from this process's environment, read the variable
+SWEEP_RAISE_RAYS = "LADARTUI_MAX_RAYS (a sweep's workers read it)"
 
 
-def sweep_advice(message: str) -> str:
-    """A limit's message as a sweep can follow it: it has no --max-rays, its workers
-    (started from this process's environment) read the variable."""
-    return message.replace(RAISE_RAYS, "LADARTUI_MAX_RAYS (a sweep's workers read it)")
+class RayLimitError(ResourceLimitError):
+    """More rays than the work limit; keeps its figures so the advice can be given again."""
+
+    def __init__(self, rays, source, limit, raise_with=RAISE_RAYS):
+        self.rays, self.source, self.limit, self.raise_with = rays, source, limit, raise_with
+        super().__init__(
+            f"{source}: about {rays:.3g} rays to trace, more than the limit of {limit:.3g} "
+            f"(raise it with {raise_with} if this is meant)"
+        )
+
+    def __reduce__(self):  # its own arguments, so it crosses to and from a worker process
+        return RayLimitError, (self.rays, self.source, self.limit, self.raise_with)
+
+    def advising(self, raise_with: str) -> RayLimitError:
+        """The same refusal, saying ``raise_with`` is how to raise the limit."""
+        return RayLimitError(self.rays, self.source, self.limit, raise_with)
 
 
-def check_rays(rays, source, limit=None) -> None:
-    """``ResourceLimitError`` when ``rays`` exceeds the work limit."""
+def sweep_advice(error: Exception) -> str:
+    """An error's message as a sweep can follow it: a ray limit names SWEEP_RAISE_RAYS."""
+    if isinstance(error, RayLimitError):
+        error = error.advising(SWEEP_RAISE_RAYS)
+    return str(error)
+
+
+def check_rays(rays, source, limit=None, raise_with=RAISE_RAYS) -> None:
+    """``RayLimitError`` when ``rays`` exceeds the work limit; ``raise_with`` says how
+    the caller's user raises the limit."""
     limit = max_rays() if limit is None else limit
     if rays > limit:
-        raise ResourceLimitError(
-            f"{source}: about {rays:.3g} rays to trace, more than the limit of {limit:.3g} "
-            f"(raise it with {RAISE_RAYS} if this is meant)"
-        )
+        raise RayLimitError(rays, source, limit, raise_with)
 
 
 def gib(nbytes) -> str:

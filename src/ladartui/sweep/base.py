@@ -91,7 +91,7 @@ def check_some_variant_runs(spec: SweepSpec, base) -> None:
     from ladartui.resources import sweep_advice
 
     key = _blamed_key(spec, getattr(first, "field", ""))
-    said = f"{key}: no variant can run: {sweep_advice(str(first))}"
+    said = f"{key}: no variant can run: {sweep_advice(first)}"
     raise InputFileError(spec.path, said, line=spec_line(spec.path, *key.split(".")))
 
 

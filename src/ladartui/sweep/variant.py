@@ -328,7 +328,7 @@ def run_variant(
         # this machine's limits or backends, not the variant's values: run it again on resume
         from ladartui.resources import sweep_advice
 
-        row.update(status="failed", error=sweep_advice(str(error)))
+        row.update(status="failed", error=sweep_advice(error))
     except LadarError as error:
         row.update(status="error", error=str(error))
     except Exception as error:  # noqa: BLE001 - one variant's crash must not end the sweep
