@@ -306,7 +306,7 @@ def test_las_copies_are_part_of_the_set(tmp_path, small, monkeypatch):
     with laspy.open(tmp_path / "forest.laz") as reader:
         assert reader.header.are_points_compressed and reader.header.point_count == len(small.voxels)
     before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
-    real, calls = las.export_las, []
+    real, calls = las.write_las, []
 
     def fail_on_second(*args, **options):
         calls.append(1)
@@ -314,7 +314,25 @@ def test_las_copies_are_part_of_the_set(tmp_path, small, monkeypatch):
             raise OSError(28, "No space left on device")
         real(*args, **options)
 
-    monkeypatch.setattr(las, "export_las", fail_on_second)
+    monkeypatch.setattr(las, "write_las", fail_on_second)
     with pytest.raises(OutputFileError):
         generate_scene("small", seed=3, trees=5).write(tmp_path / "forest", las=True)
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+
+
+def test_las_copies_are_written_straight_into_the_sets_temporaries(tmp_path, small, monkeypatch):
+    """Each .laz copy went to a temporary of the set's temporary: the exporter, atomic
+    itself, made a second one beside the first and renamed it over."""
+    pytest.importorskip("laspy")
+    import tempfile
+
+    real, made = tempfile.mkstemp, []
+
+    def recording(*args, **options):
+        if options.get("suffix") == ".tmp":  # a temporary, not a writability probe
+            made.append(options.get("prefix", ""))
+        return real(*args, **options)
+
+    monkeypatch.setattr(tempfile, "mkstemp", recording)
+    small.write(tmp_path / "forest", las=True)
+    assert sorted(prefix for prefix in made if ".laz" in prefix) == [".forest.laz.", ".forest_Target.laz."]

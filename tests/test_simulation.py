@@ -183,6 +183,27 @@ def test_las_outputs_hold_the_fused_voxels(forest):
         assert as_set(voxels) == as_set(fused)
 
 
+def test_las_outputs_are_written_straight_into_the_sets_temporaries(forest, monkeypatch):
+    """Each .las output went to a temporary of the set's temporary: the exporter, atomic
+    itself, made a second one beside the first and renamed it over."""
+    import tempfile
+
+    import laspy
+
+    real, made = tempfile.mkstemp, []
+
+    def recording(*args, **options):
+        if options.get("suffix") == ".tmp":  # a temporary, not a writability probe
+            made.append(options.get("prefix", ""))
+        return real(*args, **options)
+
+    monkeypatch.setattr(tempfile, "mkstemp", recording)
+    simulate(forest, las=True)
+    assert sorted(prefix for prefix in made if ".las" in prefix) == [".S_Scene.las.", ".S_Target.las."]
+    with laspy.open(forest.path.with_name("S_Scene.las")) as reader:
+        assert not reader.header.are_points_compressed  # a .las name: plain LAS
+
+
 def test_every_available_backend_gives_the_same_run(forest):
     from ladartui.tracing import backend_status
 

@@ -424,13 +424,14 @@ def _write_outputs(output_set, scene_output, target_output, measures, record, sc
         "record": lambda tmp: tmp.write_text(record, encoding="utf-8"),
     }
     if "scene_las" in output_set.paths:
-        from ladartui.scene.las import export_las
+        from ladartui.scene.las import compressed_suffix, write_las
 
         size = scene.voxel_size
-        writers["scene_las"] = lambda tmp: export_las(
-            tmp, scene_output, size, ids=scene.target_ids_of(scene_output)
+        laz = {name: compressed_suffix(output_set.paths[name]) for name in ("scene_las", "target_las")}
+        writers["scene_las"] = lambda tmp: write_las(
+            tmp, scene_output, size, ids=scene.target_ids_of(scene_output), compress=laz["scene_las"]
         )
-        writers["target_las"] = lambda tmp: export_las(
-            tmp, target_output, size, ids=scene.target_ids_of(target_output)
+        writers["target_las"] = lambda tmp: write_las(
+            tmp, target_output, size, ids=scene.target_ids_of(target_output), compress=laz["target_las"]
         )
     return output_set.write(writers, cancel)

@@ -118,12 +118,12 @@ class GeneratedScene:
         ids = self.ids() if self.params.vehicles > 1 else None
         also = {}
         if las:
-            from ladartui.scene.las import export_las
+            from ladartui.scene.las import write_las
 
             vs = self.voxel_size
             scene_las, target_las = las_paths(stem)
-            also[scene_las] = lambda tmp: export_las(tmp, self.voxels, vs, compress=True)
-            also[target_las] = lambda tmp: export_las(tmp, self.target, vs, ids=self.ids(), compress=True)
+            also[scene_las] = lambda tmp: write_las(tmp, self.voxels, vs, compress=True)
+            also[target_las] = lambda tmp: write_las(tmp, self.target, vs, ids=self.ids(), compress=True)
         write_model_pair(scene_path, target_path, self.voxels, self.target, ids, cancel, progress, also)
         return scene_path, target_path
 

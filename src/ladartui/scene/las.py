@@ -147,16 +147,33 @@ def _voxel_indices(path, voxel_size, origin) -> tuple[np.ndarray, np.ndarray, np
     return indices.astype(np.int32), np.asarray(cloud.point_source_id), origin
 
 
-def export_las(path, voxels, voxel_size, origin=(0.0, 0.0, 0.0), ids=None, compress=None) -> None:
+def export_las(path, voxels, voxel_size, origin=(0.0, 0.0, 0.0), ids=None) -> None:
     """Write voxel centres (metres) as a LAS 1.2 file, or LAZ for a ``.laz`` path, atomically.
 
     ``ids`` (one target id 1..65535 per voxel, or 0 for a voxel of no target)
-    are written as point_source_id. ``compress`` (LAZ) follows the suffix unless
-    given (an output set writes to a temporary).
+    are written as point_source_id.
     """
+    path = Path(path)
+    cloud = _voxel_cloud(voxels, voxel_size, origin, ids)
+    with atomic_path(path) as tmp:
+        _write_cloud(tmp, cloud, compressed_suffix(path))
+
+
+def write_las(path, voxels, voxel_size, origin=(0.0, 0.0, 0.0), ids=None, *, compress: bool) -> None:
+    """``export_las`` into ``path`` itself: a temporary its caller swaps in (an output set's),
+    so LAZ or not is said by ``compress``, not by the suffix."""
+    _write_cloud(path, _voxel_cloud(voxels, voxel_size, origin, ids), compress)
+
+
+def compressed_suffix(path) -> bool:
+    """True for a ``.laz`` name: LAZ, else plain LAS."""
+    return Path(path).suffix.lower() == ".laz"
+
+
+def _voxel_cloud(voxels, voxel_size, origin, ids):
+    """The voxel centres (metres) as a laspy cloud, ``ids`` as point source ids."""
     import laspy
 
-    path = Path(path)
     size = _check_voxel_size(voxel_size)
     voxels = np.asarray(voxels)
     if voxels.size and (voxels.ndim != 2 or voxels.shape[1] != 3):
@@ -175,10 +192,12 @@ def export_las(path, voxels, voxel_size, origin=(0.0, 0.0, 0.0), ids=None, compr
         if ids.shape != (len(centres),) or (len(ids) and (ids.min() < 0 or ids.max() > MAX_TARGET_ID)):
             raise ValueError(f"ids must be {len(centres)} target ids in 0..{MAX_TARGET_ID}")
         cloud.point_source_id = ids.astype(np.uint16)
-    if compress is None:
-        compress = path.suffix.lower() == ".laz"
+    return cloud
+
+
+def _write_cloud(path, cloud, compress: bool) -> None:
     # Write to a stream: given a path, laspy picks compression from the suffix (.tmp here).
-    with atomic_path(path) as tmp, open(tmp, "wb+") as stream:
+    with open(path, "wb+") as stream:
         cloud.write(stream, do_compress=compress)
 
 
