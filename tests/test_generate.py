@@ -336,3 +336,17 @@ def test_las_copies_are_written_straight_into_the_sets_temporaries(tmp_path, sma
     monkeypatch.setattr(tempfile, "mkstemp", recording)
     small.write(tmp_path / "forest", las=True)
     assert sorted(prefix for prefix in made if ".laz" in prefix) == [".forest.laz.", ".forest_Target.laz."]
+
+
+@pytest.mark.parametrize("radius", [0.5, 1.0, 1.5, 2.5, 4.0])
+def test_the_memory_estimates_clump_size_is_the_stamped_clumps_mean_size(radius):
+    """The estimate rebuilt the clump's shape beside the template's: had one changed,
+    the memory estimate would have drifted from the trees it estimates."""
+    from ladartui.scene.trees import _clump_chances, _clump_template, expected_clump_voxels
+
+    rng = np.random.default_rng(7)
+    draws = 4000
+    sizes = [len(_clump_template(radius, rng)) for _ in range(draws)]
+    chance = _clump_chances(radius)[1]
+    spread = math.sqrt(float(np.sum(chance * (1 - chance))) / draws)  # of the mean of the draws
+    assert abs(np.mean(sizes) - expected_clump_voxels(radius)) <= 4 * spread + 1e-9

@@ -181,17 +181,10 @@ WOOD_SHARE = 1.2
 def expected_tree_voxels(trees: _Trees, p: SceneParams) -> float:
     """About how many voxels the trees' parts make before merging (for a memory estimate
     ahead of the work): the clumps times a clump template's expected size."""
-    # a clump's expected voxels, over its radii as _stamp_clumps rounds them (the volume
-    # goes as the cube: the mean radius alone undercounted large clumps by a fifth)
-    sizes = []
-    for radius in np.linspace(*p.clump_radius, 9) / p.voxel_size:
-        radius = max(round(radius * 2) / 2, 0.5)
-        reach = int(math.ceil(radius))
-        o = np.arange(-reach, reach + 1)
-        ox, oy, oz = np.meshgrid(o, o, o, indexing="ij")
-        r = np.sqrt((ox**2 + oy**2) / radius**2 + oz**2 / max(radius * 0.35, 0.5) ** 2)
-        sizes.append(np.count_nonzero(r <= 0.6) + 0.6 * np.count_nonzero((r > 0.6) & (r <= 1.0)))
-    template = max(float(np.mean(sizes)), 1.0)
+    # over the radii as _stamp_clumps rounds them (the volume goes as the cube: the
+    # mean radius alone undercounted large clumps by a fifth)
+    classes = _size_classes(np.linspace(*p.clump_radius, 9) / p.voxel_size)
+    template = max(float(np.mean([expected_clump_voxels(size) for size in classes])), 1.0)
     return float(clumps_per_tree(trees, p).sum()) * template * WOOD_SHARE
 
 
@@ -241,7 +234,7 @@ def foliage_voxels(trees: _Trees, p: SceneParams, rng) -> np.ndarray:
 
 def _stamp_clumps(centres, radii, rng, variants=6) -> np.ndarray:
     """Place a ragged flattened blob at every centre; blobs grouped by size class."""
-    classes = np.maximum(np.round(radii * 2) / 2, 0.5)  # half-voxel size classes
+    classes = _size_classes(radii)
     variant = rng.integers(0, variants, len(centres))
     pieces = []
     for size in np.unique(classes):
@@ -254,16 +247,39 @@ def _stamp_clumps(centres, radii, rng, variants=6) -> np.ndarray:
     return concat_voxels(pieces)
 
 
-def _clump_template(radius, rng, flatness=0.35) -> np.ndarray:
-    """Offsets of one leaf clump: an oblate blob whose rim is thinned at random."""
+def _size_classes(radii) -> np.ndarray:
+    """Clump radii (voxels) rounded to the half-voxel size classes clumps are stamped at."""
+    return np.maximum(np.round(np.asarray(radii) * 2) / 2, 0.5)
+
+
+# A leaf clump: an oblate blob (height over width CLUMP_FLATNESS), whole out to
+# CLUMP_CORE of its radius, each voxel beyond it to the rim kept with CLUMP_RIM_KEPT.
+CLUMP_FLATNESS = 0.35
+CLUMP_CORE = 0.6
+CLUMP_RIM_KEPT = 0.6
+
+
+def _clump_chances(radius) -> tuple[np.ndarray, np.ndarray]:
+    """(M, 3) int32 offsets around a leaf clump's centre and each one's chance of being in
+    the clump. The one definition of its shape: templates draw from it, the estimate sums it."""
     reach = int(math.ceil(radius))
     o = np.arange(-reach, reach + 1)
     ox, oy, oz = (a.ravel() for a in np.meshgrid(o, o, o, indexing="ij"))
-    vertical = max(radius * flatness, 0.5)
+    vertical = max(radius * CLUMP_FLATNESS, 0.5)
     r = np.sqrt((ox**2 + oy**2) / radius**2 + oz**2 / vertical**2)
-    keep = (r <= 1.0) & ((r <= 0.6) | (rng.random(r.size) < 0.6))
-    keep[(ox == 0) & (oy == 0) & (oz == 0)] = True
-    return np.stack([ox[keep], oy[keep], oz[keep]], axis=1).astype(np.int32)
+    chance = np.where(r <= CLUMP_CORE, 1.0, np.where(r <= 1.0, CLUMP_RIM_KEPT, 0.0))
+    return np.stack([ox, oy, oz], axis=1).astype(np.int32), chance
+
+
+def expected_clump_voxels(radius) -> float:
+    """The expected voxels of a leaf clump of ``radius`` (a size class, voxels)."""
+    return float(_clump_chances(radius)[1].sum())
+
+
+def _clump_template(radius, rng) -> np.ndarray:
+    """Offsets of one leaf clump: an oblate blob whose rim is thinned at random."""
+    offsets, chance = _clump_chances(radius)
+    return offsets[rng.random(len(chance)) < chance]  # a draw is below 1: the core is whole
 
 
 # ---- assembly -----------------------------------------------------------------
