@@ -448,6 +448,7 @@ def test_a_rays_file_is_checked_from_its_header_before_it_is_read(tmp_path, scen
     code, err = trace(huge)
     assert code == 2 and len(err.splitlines()) == 1, err
     assert f"{huge}: about 1e+10 rays to trace, more than the limit" in err
+    assert err.endswith("(raise it with LADARTUI_MAX_RAYS if this is meant)")  # trace has no --max-rays
     code, err = trace(text)
     assert code == 2 and err == f"ladartui: error: {text}: not a NumPy .npy file (no .npy header)"
     assert not (tmp_path / "h").exists()

@@ -122,7 +122,9 @@ def check_occupancy(lo, hi, count, source="voxels") -> int:
     return need
 
 
-RAISE_RAYS = "--max-rays or LADARTUI_MAX_RAYS"  # how a command raises the ray limit
+# How a scenario's ray limit is raised: validate, info and the TUI read the variable
+# too, and have no --max-rays.
+RAISE_RAYS = "LADARTUI_MAX_RAYS or run's --max-rays"
 # a sweep has no --max-rays; its workers, started from this process's environment, read the variable
 SWEEP_RAISE_RAYS = "LADARTUI_MAX_RAYS (a sweep's workers read it)"
 

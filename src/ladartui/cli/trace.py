@@ -84,7 +84,7 @@ def check_rays_header(path) -> None:
             path, f"array of shape {shape}: expected (N, 6): origin x, y, z and direction dx, dy, dz per row"
         )
     rows = int(shape[0])
-    check_rays(rows, str(path))
+    check_rays(rows, str(path), raise_with="LADARTUI_MAX_RAYS")  # trace has no --max-rays
     need, limit = rows * BYTES_PER_TRACED_RAY, available_memory()
     if need > limit:
         raise ResourceLimitError(
