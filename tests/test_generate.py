@@ -251,6 +251,36 @@ def test_progress_names_each_stage_in_order_and_cancel_stops_between_them():
         generate_scene("small", seed=0, trees=5, progress=stop_at_foliage, cancel=cancel)
 
 
+def test_a_cancel_during_the_foliage_stops_it_before_its_end(monkeypatch):
+    """Ctrl-C was seen only as the next stage started: the foliage of 100,000 trees
+    took about a minute first. Clump groups are now stamped one by one, each after a
+    check; the same seed still gives the same scene."""
+    import threading
+
+    from ladartui.errors import Cancelled
+    from ladartui.scene import trees
+
+    cancel = threading.Event()
+    stamped = []
+    real_template = trees._clump_template
+
+    def template_then_cancel(radius, rng):  # a Ctrl-C as the first group is stamped
+        stamped.append(radius)
+        if len(stamped) == 1:
+            cancel.set()
+        return real_template(radius, rng)
+
+    monkeypatch.setattr(trees, "_clump_template", template_then_cancel)
+    with pytest.raises(Cancelled):
+        generate_scene("small", seed=0, trees=40, cancel=cancel)
+    assert len(set(stamped)) == 1  # stopped within the first size class
+    stamped.clear()
+    checked = generate_scene("small", seed=0, trees=40, cancel=threading.Event())
+    assert len(set(stamped)) > 1  # (uncancelled, the foliage has several)
+    monkeypatch.setattr(trees, "_clump_template", real_template)
+    assert np.array_equal(checked.voxels, generate_scene("small", seed=0, trees=40).voxels)
+
+
 def test_write_replaces_both_files_or_neither(tmp_path, small, monkeypatch):
     """The pair was written one file after the other: a failure between left a new scene
     beside an old target model."""

@@ -105,7 +105,7 @@ def run(args) -> int:
     errors = Console(stderr=True)
 
     def stopping() -> None:  # a stage of a large scene can run for a minute
-        errors.print("stopping at the end of this stage...", highlight=False, markup=False)
+        errors.print("stopping at the end of this step...", highlight=False, markup=False)
 
     with sigterm_as_interrupt():
         scene, scene_path, target_path, (generated, written) = run_cancellable(

@@ -220,11 +220,14 @@ def generate_scene(preset="small", seed=0, progress=None, cancel=None, **overrid
     nx, ny = round(params.width / vs), round(params.depth / vs)
     stages = iter(enumerate(GENERATE_STAGES, start=1))
 
+    def between_steps() -> None:  # within the long stages too
+        check_cancelled(cancel, GENERATE_CANCELLED)
+
     def stage() -> None:
         k, name = next(stages)
         if progress is not None:
             progress(name, k, len(GENERATE_STAGES))
-        check_cancelled(cancel, GENERATE_CANCELLED)
+        between_steps()
 
     stage()
     ground = _terrain(params, nx, ny, rng)  # (nx, ny) int32: first free layer per column
@@ -243,9 +246,10 @@ def generate_scene(preset="small", seed=0, progress=None, cancel=None, **overrid
     stage()
     parts["branches"] = branch_voxels(trees, params, rng)
     stage()
-    parts["foliage"] = foliage_voxels(trees, params, rng)
+    parts["foliage"] = foliage_voxels(trees, params, rng, between_steps)
     stage()
     for name in ("trunks", "branches", "foliage"):
+        between_steps()
         parts[name] = _clip(parts[name], nx, ny)
         for vehicle in vehicles:
             parts[name] = _carve_clearance(parts[name], vehicle, vs)
