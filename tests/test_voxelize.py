@@ -449,3 +449,62 @@ def test_a_good_obj_cube_is_read_whole(tmp_path):
     path.write_text(CUBE_OBJ)
     mesh = load_mesh(path)
     assert mesh.faces.shape == (12, 3) and mesh.closed
+
+
+def count_opens(monkeypatch, path: Path) -> list[str]:
+    """Every opening of ``path`` (by pathlib or by trimesh), its mode each."""
+    import builtins
+    import io
+
+    opened: list[str] = []
+    real_open = io.open
+
+    def spy(file, mode="r", *args, **kwargs):
+        if isinstance(file, (str, Path)) and Path(file).resolve() == path.resolve():
+            opened.append(mode)
+        return real_open(file, mode, *args, **kwargs)
+
+    monkeypatch.setattr(io, "open", spy)
+    monkeypatch.setattr(builtins, "open", spy)
+    return opened
+
+
+@pytest.mark.parametrize(
+    ("name", "content", "triangles"),
+    [
+        ("cube.obj", CUBE_OBJ.encode(), 12),
+        ("cube.obj", b"# modell \xfcber alles\n" + CUBE_OBJ.encode(), 12),  # Latin-1
+        ("tri.stl", b"solid tri\n" + TRIANGLE_STL + b"endsolid tri\n", 1),
+        ("box.stl", trimesh.creation.box(extents=(1.0, 2.0, 3.0)).export(file_type="stl"), 12),
+    ],
+)
+def test_a_mesh_file_is_read_from_disk_once(tmp_path, monkeypatch, name, content, triangles):
+    """An OBJ was opened three times (its line check, the encoding check, the mesh
+    reader), an STL four (its header twice, then as text, then by the reader): one
+    read now serves the checks and the reader."""
+    path = tmp_path / name
+    path.write_bytes(content)
+    opened = count_opens(monkeypatch, path)
+    assert len(load_mesh(path).faces) == triangles
+    assert opened == ["rb"]
+
+
+def test_a_textured_obj_read_from_memory_is_the_mesh_read_from_its_path(tmp_path):
+    """Handed over as bytes, a textured OBJ with its material file beside it gives the
+    vertices (split at texture seams) that trimesh gives opening the file itself."""
+    folder = tmp_path / "model"
+    folder.mkdir()
+    (folder / "cube.mtl").write_text("newmtl paint\nKd 0.8 0.1 0.1\n")
+    uvs = "".join(f"vt {u} {v}\n" for u in (0, 1) for v in (0, 1))
+    faces = "".join(
+        f"f {line.split()[1]}/1 {line.split()[2]}/2 {line.split()[3]}/3\n"
+        for line in CUBE_OBJ.splitlines()
+        if line.startswith("f ")
+    )
+    vertices = "".join(line + "\n" for line in CUBE_OBJ.splitlines() if line.startswith("v "))
+    path = folder / "cube.obj"
+    path.write_text(f"mtllib cube.mtl\n{vertices}{uvs}usemtl paint\n{faces}")
+    mesh = load_mesh(path)
+    expected = trimesh.load(str(path), force="mesh", process=True)
+    np.testing.assert_array_equal(mesh.vertices, expected.vertices)
+    assert mesh.closed == bool(expected.is_watertight) and mesh.notes == ()

@@ -102,10 +102,7 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
         raise InputFileError(path, f"unsupported mesh type {path.suffix!r}; expected .obj, .stl or .ply")
     if not path.is_file():
         raise InputFileError(path, f"no such file; expected a mesh file ({kind})")
-    if kind == ".stl":
-        _check_stl_whole(path)
-    if kind == ".obj":  # the reader drops a nan vertex's faces and takes face index 0
-        check_obj_lines(path)
+    source, resolver = _mesh_source(path, kind)
     import trimesh
 
     try:
@@ -115,7 +112,7 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
             warnings.simplefilter("ignore", RuntimeWarning)
             # process=True merges repeated vertices (an STL repeats them per triangle),
             # so that closedness can be checked on the shared edges.
-            loaded = trimesh.load(_as_utf8(path, kind), file_type=kind[1:], force="mesh", process=True)
+            loaded = trimesh.load(source, file_type=kind[1:], resolver=resolver, force="mesh", process=True)
     except Exception as error:  # trimesh's parsers raise many kinds on malformed text
         raise InputFileError(
             path, f"not a readable {kind[1:].upper()} mesh ({type(error).__name__}: {error})"
@@ -136,40 +133,44 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
     return Mesh(path, vertices, faces, not problem, problem, tuple(notes))
 
 
-def _as_utf8(path: Path, kind: str):
-    """The file for trimesh: its path, or for a text mesh (OBJ, ASCII STL) that is not
-    UTF-8, its bytes read as Latin-1 and handed on as UTF-8. Exporters write names in
-    Latin-1, and trimesh would guess the encoding with a package not installed here."""
+def _mesh_source(path: Path, kind: str):
+    """What trimesh reads, and where it finds the files a mesh names (an OBJ's
+    materials): a PLY by its path; an OBJ or STL read here once, its bytes serving
+    the checks of its lines or length and then the reader."""
     import io
 
-    if kind == ".ply" or (kind == ".stl" and _binary_stl(path)):
-        return str(path)
+    if kind == ".ply":
+        return str(path), None
     try:
         data = path.read_bytes()
-    except OSError:
-        return str(path)  # trimesh reports it
+    except OSError as error:
+        raise InputFileError(path, f"cannot be read ({error.strerror or error})") from None
+    if kind == ".stl":
+        _check_stl_whole(path, data)
+        if _binary_stl(data):
+            return io.BytesIO(data), None
     try:
-        data.decode("utf-8")
-    except UnicodeDecodeError:
-        return io.BytesIO(data.decode("latin-1").encode("utf-8"))
-    return str(path)
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:  # exporters write names in Latin-1, and trimesh would
+        text = data.decode("latin-1")  # guess the encoding with a package not installed here
+        data = text.encode("utf-8")
+    if kind == ".obj":  # the reader drops a nan vertex's faces and takes face index 0
+        check_obj_lines(path, text)
+    from trimesh.resolvers import FilePathResolver
+
+    return io.BytesIO(data), FilePathResolver(str(path))
 
 
-def _stl_head(path: Path) -> tuple[int, int, bytes] | None:
+def _stl_head(data: bytes) -> tuple[int, int, bytes] | None:
     """(file size, the triangle count a binary header gives, the first 584 bytes); None
-    when it cannot be read (the reader says why) or is shorter than a header."""
-    try:
-        size = path.stat().st_size
-        with open(path, "rb") as stream:
-            head = stream.read(84 + 50 * 10)
-    except OSError:
-        return None
-    return (size, int.from_bytes(head[80:84], "little"), head) if size >= 84 else None
+    when it is shorter than a header."""
+    size = len(data)
+    return (size, int.from_bytes(data[80:84], "little"), data[: 84 + 50 * 10]) if size >= 84 else None
 
 
-def _binary_stl(path: Path) -> bool:
-    """Whether ``path`` is sized as a binary STL: an 84-byte header, 50 bytes a triangle."""
-    head = _stl_head(path)
+def _binary_stl(data: bytes) -> bool:
+    """Whether ``data`` is sized as a binary STL: an 84-byte header, 50 bytes a triangle."""
+    head = _stl_head(data)
     return head is not None and head[0] == 84 + 50 * head[1]
 
 
@@ -178,10 +179,10 @@ def _binary_stl(path: Path) -> bool:
 _BINARY_BYTES = frozenset(range(32)) - frozenset(b"\t\n\v\f\r")
 
 
-def _check_stl_whole(path: Path) -> None:
+def _check_stl_whole(path: Path, data: bytes) -> None:
     """``InputFileError`` for a binary STL shorter than its header's triangle count says
     (read as text when its header begins "solid", it would hold no triangles)."""
-    read = _stl_head(path)
+    read = _stl_head(data)
     if read is None:
         return
     size, count, head = read
@@ -195,16 +196,12 @@ def _check_stl_whole(path: Path) -> None:
     )
 
 
-def check_obj_lines(path: Path) -> None:
-    """``InputFileError`` at the first vertex or face line of an OBJ file that is
-    malformed: a vertex without three finite numbers, a face whose vertex numbers
+def check_obj_lines(path: Path, text: str) -> None:
+    """``InputFileError`` at the first vertex or face line of an OBJ file's ``text`` that
+    is malformed: a vertex without three finite numbers, a face whose vertex numbers
     are not integers or lie outside the file's vertices (1..V, or -1..-V counting
     back from the latest). Called before the mesh reader, which reads past such
     lines (a nan vertex's faces dropped, index 0 taken) or fails naming none."""
-    try:
-        text = path.read_text(encoding="utf-8", errors="replace")
-    except OSError as error:
-        raise InputFileError(path, f"cannot be read ({error.strerror or error})") from None
     lines = text.splitlines()
     records = ("v ", "v\t", "f ", "f\t")
 
