@@ -240,6 +240,33 @@ def test_the_check_reads_the_target_model_not_the_scene(tmp_path, monkeypatch):
     assert loads == [1]  # the sweep's own
 
 
+def test_the_cli_checks_the_variants_and_loads_the_base_once(tiny, tmp_path, monkeypatch):
+    """The CLI loaded the base and checked the spec's variants before the cluster
+    started, and run_sweep did both again."""
+    from ladartui import scenario as scenario_module
+    from ladartui.cli import main
+    from ladartui.sweep import base, execute
+
+    checks, loads = [], []
+    real_check, real_load = base.check_some_variant_runs, scenario_module.load_scenario
+
+    def check(spec, scenario):
+        checks.append(spec.path)
+        return real_check(spec, scenario)
+
+    def load(path, *args, **options):
+        loads.append(path)
+        return real_load(path, *args, **options)
+
+    monkeypatch.setattr(base, "check_some_variant_runs", check)
+    monkeypatch.setattr(execute, "check_some_variant_runs", check, raising=False)
+    monkeypatch.setattr(scenario_module, "load_scenario", load)
+    spec = write_spec(tiny, "[grid]\nradius = [20.0, 30.0]\n", name="once.toml")
+    assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path / "out"), "--json"]) == 0
+    assert checks == [spec]
+    assert loads.count(tiny / "base.toml") == 1
+
+
 def test_show_prints_text_from_the_results_table_as_text(tmp_path, capsys):
     """A cell holding an escape sequence reached the terminal raw (a window title change,
     a colour), and one holding [markup] was read as markup."""

@@ -187,13 +187,11 @@ def run(args) -> int:
         result.parameter_names = spec.parameter_names
     else:
         from ladartui.outputset import check_writable_folder
-        from ladartui.scenario import load_scenario
-        from ladartui.sweep.base import base_scenario_path, check_some_variant_runs
+        from ladartui.sweep.base import checked_base
 
-        base = load_scenario(base_scenario_path(spec))  # a bad base is reported before any cluster starts
-        check_some_variant_runs(spec, base)
+        checked = checked_base(spec)  # a bad base or spec is reported before any cluster starts
         check_writable_folder(args.out or default_out_dir(spec))
-        result = _sweep_with_progress(spec, args, errors)
+        result = _sweep_with_progress(checked, args, errors)
         if result is None:
             return stop_status()
     if not result.charts and result.rows:  # --show redraws them (from rows: not empty ones)
@@ -243,8 +241,10 @@ def progress_note(p) -> str:
     return ", ".join(parts)
 
 
-def _sweep_with_progress(spec, args, console):
+def _sweep_with_progress(checked, args, console):
     from ladartui.sweep import connect, run_sweep
+
+    spec = checked.spec
 
     client = connect(args.scheduler, args.connect_timeout, args.security) if args.scheduler else None
     cancel = threading.Event()
@@ -275,6 +275,7 @@ def _sweep_with_progress(spec, args, console):
                     budget=args.budget,
                     cost=args.cost,
                     serial=args.serial,
+                    checked=checked,
                 )
                 # Drawn here, with the ranking and best path written: a Ctrl-C once every
                 # variant is done waits for the whole set (it left the last run's charts).

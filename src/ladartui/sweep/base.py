@@ -9,12 +9,17 @@ base as it is now.
 from __future__ import annotations
 
 import hashlib
+from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ladartui.errors import InputFileError
 from ladartui.sweep.spec import SweepSpec, bundled_name, spec_line
+
+if TYPE_CHECKING:
+    from ladartui.scenario import Scenario
 
 
 def base_scenario_path(spec: SweepSpec) -> Path:
@@ -67,6 +72,27 @@ def spec_rows(table_rows: list[dict], spec: SweepSpec) -> list[dict]:
 
     path = base_scenario_path(spec)
     return own_rows(table_rows, spec.variants, base_digest(path, load_scenario(path, check_files=False)))
+
+
+@dataclass(frozen=True)
+class CheckedBase:
+    """A spec's base scenario, read and found to take some variant of the spec: made
+    once by ``checked_base`` for the caller's early refusal and the run alike."""
+
+    spec: SweepSpec
+    path: Path
+    scenario: Scenario
+
+
+def checked_base(spec: SweepSpec) -> CheckedBase:
+    """Read the spec's base scenario (``InputFileError`` for a missing or bad one) and
+    refuse the spec when none of its variants can run on it."""
+    from ladartui.scenario import load_scenario
+
+    path = base_scenario_path(spec)
+    scenario = load_scenario(path)
+    check_some_variant_runs(spec, scenario)
+    return CheckedBase(spec, path, scenario)
 
 
 def check_some_variant_runs(spec: SweepSpec, base) -> None:

@@ -21,7 +21,7 @@ from pathlib import Path
 
 from ladartui.atomic import atomic_path
 from ladartui.errors import FieldError, InputFileError, LadarError, OutputFileError, check_cancelled
-from ladartui.sweep.base import base_digest, base_scenario_path, check_some_variant_runs, own_rows, spec_rows
+from ladartui.sweep.base import CheckedBase, base_digest, checked_base, own_rows, spec_rows
 from ladartui.sweep.best_file import best_files, write_best_scenario
 from ladartui.sweep.cluster import close_client, local_client
 from ladartui.sweep.ranking import (
@@ -169,6 +169,7 @@ def run_sweep(
     cost: str | None = None,
     serial: bool = False,
     simulate_options: dict | None = None,
+    checked: CheckedBase | None = None,
 ) -> SweepResult:
     """Run every variant of ``spec`` not already in the result table, then rank them all.
 
@@ -180,6 +181,8 @@ def run_sweep(
     (a ``threading.Event``) stops the sweep with ``Cancelled``, keeping the rows
     written so far for a later resume. Writes ``out/results.csv`` (row by row),
     ``out/ranking.csv`` and the best scenario ``out/<name>-best.toml``.
+    ``checked`` is ``checked_base(spec)`` where the caller refused a bad base or
+    spec before this call; without it (or for another spec) this call makes it.
     """
     started = time.perf_counter()
     _refuse_in_worker_start()
@@ -202,16 +205,14 @@ def run_sweep(
     out = Path(out) if out is not None else default_out_dir(spec)
     if out.exists() and not out.is_dir():
         raise OutputFileError(out, "is a file, expected a folder")
-    from ladartui.scenario import load_scenario
-
-    base_path = base_scenario_path(spec)
-    base = load_scenario(base_path)
-    check_some_variant_runs(spec, base)
+    if checked is None or checked.spec is not spec:
+        checked = checked_base(spec)
+    base = checked.scenario
     scene = _LazyScene(base)
     with _exclusive(out):
         return _run_locked(
             spec,
-            base_path,
+            checked.path,
             base,
             scene,
             client,
