@@ -479,3 +479,46 @@ async def test_save_as_is_not_taken_for_another_run(tmp_path, scene_files):
         app.check_outputs_on_disk()
         await pilot.pause()
         assert not any("changed on disk" in m or "gone from disk" in m for m in app.messages)
+
+
+def count_output_stats(monkeypatch, scenario) -> dict:
+    """How often each output file's status is asked (``stat``, which ``is_file`` uses)."""
+    from pathlib import Path
+
+    outputs = (scenario.scene_output, scenario.target_output, scenario.measures_file)
+    stats = dict.fromkeys(outputs, 0)
+    real_stat = Path.stat
+
+    def stat(self, *args, **options):
+        if self in stats:
+            stats[self] += 1
+        return real_stat(self, *args, **options)
+
+    monkeypatch.setattr(Path, "stat", stat)
+    return stats
+
+
+async def test_earlier_outputs_are_shown_from_one_stat_of_each_file(tmp_path, scene_files, monkeypatch):
+    """Opening a file with outputs asked each output's status twice or three times (to
+    read them, to name a partial set, to note those shown), and an on-disk change up
+    to six times."""
+    from ladartui.sensor import Sensor
+    from ladartui.simulation import simulate
+    from ladartui.tui.view_area import ViewArea
+
+    scenario = make_scenario(tmp_path, scene_files)
+    simulate(scenario)
+    stats = count_output_stats(monkeypatch, scenario)
+    # the view's own read of the target output checks the file's time at every redraw
+    monkeypatch.setattr(ViewArea, "_known_target_output", lambda self, voxels: None)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app) and app.measures is not None)
+        assert list(stats.values()) == [1, 1, 1]
+        simulate(scenario.with_changes(sensor=Sensor(grid=12, ray_grid=1, fov=8.0)))  # elsewhere
+        stats.update(dict.fromkeys(stats, 0))
+        app.check_outputs_on_disk()
+        await wait_until(pilot, lambda: app.outputs_from is not None and app.outputs_from.sensor.grid == 12)
+        assert list(stats.values()) == [1, 1, 1]
+        status = scenario.measures_file.stat()
+        assert app.outputs_seen == (status.st_mtime_ns, status.st_size)  # those shown, as on disk

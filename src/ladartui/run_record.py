@@ -13,6 +13,9 @@ A file of that name that is not a record (its first line is not
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from pathlib import Path
+
 from ladartui.errors import LadarError, OutputFileError
 from ladartui.scenario_file import RECORD_HEADER, is_record
 from ladartui.textsafe import one_line
@@ -105,10 +108,11 @@ def _shown(value) -> str:
     return str(value)
 
 
-def missing_outputs(scenario) -> list:
-    """The outputs of a partial set: empty when all are on disk or none are (not run)."""
+def missing_outputs(scenario, is_file: Callable[[Path], bool] = Path.is_file) -> list:
+    """The outputs of a partial set: empty when all are on disk or none are (not run).
+    ``is_file`` answers from a look already taken (the TUI's one stat of each)."""
     outputs = [scenario.scene_output, scenario.target_output, scenario.measures_file]
-    missing = [path for path in outputs if not path.is_file()]
+    missing = [path for path in outputs if not is_file(path)]
     return [] if len(missing) == len(outputs) else missing
 
 

@@ -9,6 +9,8 @@ freeze the interface), then loads them from numba's disk cache.
 
 from __future__ import annotations
 
+import os
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -30,6 +32,16 @@ if TYPE_CHECKING:
     from ladartui.scene.model import Scene
 
 
+@dataclass(frozen=True)
+class OutputFiles:
+    """What one ``stat`` of each of a scenario's output files found: enough to read
+    them, name a partial set and tell another run's outputs apart without asking again."""
+
+    readable: bool  # the scene output and the measures are files: an earlier run to show
+    missing: list[Path]  # those of a partial set (run_record.missing_outputs)
+    seen: tuple[int, int] | None  # the measures file's (mtime, size): outputs_on_disk
+
+
 @dataclass
 class Earlier:
     """The outputs on disk under a scenario's name, from an earlier run."""
@@ -39,6 +51,7 @@ class Earlier:
     measures: Measures | None
     ran: Scenario | None  # the settings that made them (the run record), if recorded
     warning: str | None
+    files: OutputFiles  # the look they were read after
 
     @property
     def made_with(self) -> Scenario | None:
@@ -75,7 +88,7 @@ class SceneLoading(Host):
         self.scene = done.scene
         self.prepared = done.prepared
         self.view_area.set_scene(done.prepared, done.scene.voxel_size)
-        self.missing_outputs = missing_outputs(done.scenario)
+        self.missing_outputs = done.earlier.files.missing
         self.outputs_from = done.earlier.made_with  # before the status is drawn
         self.set_scenario(done.scenario, modified=False)
         if done.scenario.path.is_file():
@@ -102,13 +115,16 @@ class SceneLoading(Host):
             self, "warm", lambda cancel, progress: _warm_up(scenario, scene, compile_in_child, cancel)
         )
 
-    def show_outputs_of(self, scenario: Scenario) -> None:
+    def show_outputs_of(self, scenario: Scenario, files: OutputFiles | None = None) -> None:
         """After Save As onto a name: the outputs already on disk under it, shown as
-        opening that file would show them (read in a worker)."""
-        self.outputs_seen = outputs_on_disk(scenario)  # the ones about to be shown: no other run's
-        self.missing_outputs = missing_outputs(scenario)
-        if scenario.scene_output.is_file() and scenario.measures_file.is_file():
-            start_job(self, "earlier", lambda cancel, progress: _earlier(scenario))
+        opening that file would show them (read in a worker). ``files``: the look
+        at them already taken."""
+        if files is None:
+            files = look_at_outputs(scenario)
+        self.outputs_seen = files.seen  # the ones about to be shown: no other run's
+        self.missing_outputs = files.missing
+        if files.readable:
+            start_job(self, "earlier", lambda cancel, progress: _earlier(scenario, files))
 
     def earlier_read(self, earlier: Earlier) -> None:
         if self.scenario is None or self.scenario.path != earlier.scenario.path:
@@ -122,7 +138,8 @@ class SceneLoading(Host):
         scenario = self.scenario
         if scenario is None or self.busy is not None or self.running:
             return
-        now = outputs_on_disk(scenario)
+        measures = _file_status(scenario.measures_file)
+        now = _stamp(measures)
         if now == self.outputs_seen:
             return
         if now is None:
@@ -133,7 +150,8 @@ class SceneLoading(Host):
             self.tell(
                 f"The outputs of {scenario.path.name} changed on disk (another run?): shown as they are now."
             )
-        self.show_outputs_of(scenario)  # reads them, or names the files missing
+        # reads them, or names the files missing; the measures file as just found
+        self.show_outputs_of(scenario, outputs_with(scenario, measures))
         self.scenario_changed()
 
     def note_outputs_seen(self) -> None:
@@ -142,7 +160,7 @@ class SceneLoading(Host):
 
     def _show_earlier(self, earlier: Earlier) -> None:
         """An earlier run's outputs and measures in the views, and what made them."""
-        self.note_outputs_seen()
+        self.outputs_seen = earlier.files.seen  # as found before they were read
         self.outputs_from = earlier.made_with
         self.output_voxels = earlier.output
         self.show_output()
@@ -166,11 +184,14 @@ def _load(path: Path | None, scenario) -> Loaded:
     return Loaded(scene, prepare_views(scene), _earlier(scenario))
 
 
-def _earlier(scenario) -> Earlier:
-    """The outputs of an earlier run under ``scenario``'s name, and what made them."""
+def _earlier(scenario, files: OutputFiles | None = None) -> Earlier:
+    """The outputs of an earlier run under ``scenario``'s name, and what made them;
+    ``files``: the look at them already taken."""
+    if files is None:
+        files = look_at_outputs(scenario)
     warning, ran = None, None
     try:
-        output, measures = _existing_results(scenario)
+        output, measures = _existing_results(scenario, files)
     except LadarError as error:  # old results must not stop the scenario loading
         output, measures, warning = None, None, f"earlier results not shown: {error}"
     if output is not None:
@@ -178,7 +199,7 @@ def _earlier(scenario) -> Earlier:
             ran = read_run_record(scenario)
         except LadarError as error:
             warning = f"settings of the earlier run not read, taken as the file's: {error}"
-    return Earlier(scenario, output, measures, ran, warning)
+    return Earlier(scenario, output, measures, ran, warning, files)
 
 
 def _warm_up(scenario, scene, compile_in_child: bool, cancel) -> None:
@@ -194,9 +215,9 @@ def _warm_up(scenario, scene, compile_in_child: bool, cancel) -> None:
         pass
 
 
-def _existing_results(scenario):
+def _existing_results(scenario, files: OutputFiles):
     """The scene output and measures of an earlier run, if both are on disk."""
-    if not (scenario.scene_output.is_file() and scenario.measures_file.is_file()):
+    if not files.readable:
         return None, None
     from ladartui.cmf import read_cmf
     from ladartui.scene.voxels import load_voxels
@@ -207,8 +228,35 @@ def _existing_results(scenario):
 def outputs_on_disk(scenario) -> tuple[int, int] | None:
     """When and how large the measures file is (a run replaces it with the rest of its
     set), or None when there is none: what tells another run's outputs apart."""
+    return _stamp(_file_status(scenario.measures_file))
+
+
+def look_at_outputs(scenario) -> OutputFiles:
+    """One ``stat`` of each output file of ``scenario``."""
+    return outputs_with(scenario, _file_status(scenario.measures_file))
+
+
+def outputs_with(scenario, measures: os.stat_result | None) -> OutputFiles:
+    """The look at ``scenario``'s outputs, the measures file's status already taken."""
+    found = {
+        scenario.scene_output: _file_status(scenario.scene_output),
+        scenario.target_output: _file_status(scenario.target_output),
+        scenario.measures_file: measures,
+    }
+    is_file = {path: status is not None and stat.S_ISREG(status.st_mode) for path, status in found.items()}
+    return OutputFiles(
+        readable=is_file[scenario.scene_output] and is_file[scenario.measures_file],
+        missing=missing_outputs(scenario, is_file.__getitem__),
+        seen=_stamp(measures),
+    )
+
+
+def _file_status(path: Path) -> os.stat_result | None:
     try:
-        status = scenario.measures_file.stat()
-    except OSError:
+        return path.stat()
+    except (OSError, ValueError):  # ValueError: a name Path.is_file also takes as no file
         return None
-    return status.st_mtime_ns, status.st_size
+
+
+def _stamp(status: os.stat_result | None) -> tuple[int, int] | None:
+    return None if status is None else (status.st_mtime_ns, status.st_size)
