@@ -405,7 +405,9 @@ def target_file_for(scene_file) -> Path:
 
 
 def load_scenario(path, check_files=True) -> Scenario:
-    """Read and check a scenario file; with ``check_files``, its model files must exist."""
+    """Read and check a scenario file; with ``check_files``, its model files must exist.
+    A flight log is read either way: its records are the flight's poses, which the
+    scenario's checks (scan count, work limit) need."""
     path = _absolute(path)
     if file_problem(path) == SPECIAL_FILE:  # reading a pipe would wait for ever
         raise InputFileError(path, f"{SPECIAL_FILE}; expected a scenario file (.toml)")
