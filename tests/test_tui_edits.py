@@ -326,7 +326,7 @@ def test_keys_toml_problems_are_named_on_their_line_never_a_crash(tmp_path):
     assert len(problems) == 2 and "help" not in keymap and "cancel" not in keymap
 
 
-def test_the_app_ending_on_an_error_exits_non_zero(monkeypatch, tmp_path, scene_files):
+def test_the_app_ending_on_an_error_exits_non_zero(monkeypatch, tmp_path, scene_files, capsys):
     """A crash in the interface (the traceback screen) exited 0, as if all went well.
     The real app runs (headless) on a scenario; once mounted, a callback raises, as a
     handler with a bug would, or the app quits as the user would."""
@@ -336,7 +336,6 @@ def test_the_app_ending_on_an_error_exits_non_zero(monkeypatch, tmp_path, scene_
     scenario = make_scenario(tmp_path, scene_files)
     real_run, real_mount = LadarApp.run, LadarApp.on_mount
     monkeypatch.setattr(LadarApp, "run", lambda self: real_run(self, headless=True, size=SIZE))
-    monkeypatch.setattr("ladartui.tui.graphics.detect", lambda mode: (type("G", (), {"image": False})(), []))
 
     def ends_by(then):
         def on_mount(self):
@@ -344,13 +343,15 @@ def test_the_app_ending_on_an_error_exits_non_zero(monkeypatch, tmp_path, scene_
             self.call_after_refresh(then, self)
 
         monkeypatch.setattr(LadarApp, "on_mount", on_mount)
-        return tui.run_app(scenario.path)
+        code = tui.run_app(scenario.path, "characters")  # (no terminal to ask)
+        return code, capsys.readouterr().err
 
     def handler_with_a_bug(app):
         raise RuntimeError("a bug in a handler")
 
-    assert ends_by(handler_with_a_bug) == 1
-    assert ends_by(lambda app: app.exit()) == 0
+    code, said = ends_by(handler_with_a_bug)
+    assert code == 1 and "a bug in a handler" in said
+    assert ends_by(lambda app: app.exit()) == (0, "")
 
 
 async def test_the_poses_dialog_keeps_what_is_typed_across_add_and_rows(tmp_path, scene_files):
