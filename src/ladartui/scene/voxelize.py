@@ -110,9 +110,16 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
         # below names the mesh's span instead
         with _trimesh_notes() as notes, warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
-            # process=True merges repeated vertices (an STL repeats them per triangle),
-            # so that closedness can be checked on the shared edges.
-            loaded = trimesh.load(source, file_type=kind[1:], resolver=resolver, force="mesh", process=True)
+            # Vertices merged by position alone, so that closedness is checked on the
+            # shared edges: an STL repeats a vertex per triangle, an OBJ keeps one apart
+            # per texture coordinate or normal, and per material or object (its parts,
+            # each merged on reading, are joined without merging).
+            scene = trimesh.load_scene(
+                source, file_type=kind[1:], resolver=resolver, process=True, merge_tex=True, merge_norm=True
+            )
+            loaded = scene.to_mesh()
+            if len(scene.graph.nodes_geometry) > 1:
+                loaded.merge_vertices(merge_tex=True, merge_norm=True)
     except Exception as error:  # trimesh's parsers raise many kinds on malformed text
         raise InputFileError(
             path, f"not a readable {kind[1:].upper()} mesh ({type(error).__name__}: {error})"
