@@ -380,3 +380,18 @@ def test_the_memory_estimates_clump_size_is_the_stamped_clumps_mean_size(radius)
     chance = _clump_chances(radius)[1]
     spread = math.sqrt(float(np.sum(chance * (1 - chance))) / draws)  # of the mean of the draws
     assert abs(np.mean(sizes) - expected_clump_voxels(radius)) <= 4 * spread + 1e-9
+
+
+def test_merging_by_flags_and_by_sorting_give_the_same_sorted_union(monkeypatch):
+    """A merge whose box is no larger than its lists flags cells instead of sorting (9.3 s
+    to sort 67 million voxels of a 30,000-tree scene); both give each voxel once, by x, y, z."""
+    from ladartui.scene import generate
+
+    rng = np.random.default_rng(7)
+    lists = [rng.integers(0, (30, 20, 10), (n, 3)).astype(np.int32) for n in (5000, 3000, 0)]
+    flagged = generate._merge(lists)
+    monkeypatch.setattr(generate, "DENSE_MERGE", 0)  # always sort
+    sorted_ = generate._merge(lists)
+    expected = np.unique(np.concatenate(lists), axis=0)  # (rows sorted by x, then y, then z)
+    assert np.array_equal(flagged, expected) and np.array_equal(sorted_, expected)
+    assert len(expected) < 8000  # (repeats were there to drop)

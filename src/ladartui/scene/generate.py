@@ -556,6 +556,10 @@ def _merge_labelled(lists) -> tuple[np.ndarray, np.ndarray]:
     return voxels[order[first]], labels[order[first]]
 
 
+# Cells a voxel of the lists may bring to a merge's flags before it sorts instead.
+DENSE_MERGE = 8
+
+
 def _merge(lists) -> np.ndarray:
     """Union of voxel lists, sorted by x, then y, then z."""
     voxels = concat_voxels(lists)
@@ -563,8 +567,18 @@ def _merge(lists) -> np.ndarray:
         return voxels
     top = voxels.max(axis=0).astype(np.int64) + 1
     keys = (voxels[:, 0].astype(np.int64) * top[1] + voxels[:, 1]) * top[2] + voxels[:, 2]
-    keys.sort()  # np.unique's hashing is many times slower on millions of keys
-    keys = keys[np.concatenate(([True], keys[1:] != keys[:-1]))]
+    cells = int(top[0] * top[1] * top[2])
+    if cells <= DENSE_MERGE * len(keys) and voxels.min() >= 0:
+        # The box is no larger than the list: a flag a cell (at most as many bytes as the
+        # keys), read back in order. Sorting took 9.3 s for the 67 million voxels of a
+        # 30,000-tree scene, 4.55 million cells.
+        seen = np.zeros(cells, np.bool_)
+        seen[keys] = True
+        del keys
+        keys = np.flatnonzero(seen)
+    else:
+        keys.sort()  # np.unique's hashing is many times slower on millions of keys
+        keys = keys[np.concatenate(([True], keys[1:] != keys[:-1]))]
     z = keys % top[2]
     y = (keys // top[2]) % top[1]
     x = keys // (top[1] * top[2])
