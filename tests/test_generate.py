@@ -8,6 +8,7 @@ import pytest
 from ladartui.errors import FieldError, OutputFileError
 from ladartui.scene.generate import generate_scene, output_paths, scene_params
 from ladartui.scene.model import Scene
+from temporaries import record_temporaries
 
 
 def as_set(voxels):
@@ -354,16 +355,7 @@ def test_las_copies_are_written_straight_into_the_sets_temporaries(tmp_path, sma
     """Each .laz copy went to a temporary of the set's temporary: the exporter, atomic
     itself, made a second one beside the first and renamed it over."""
     pytest.importorskip("laspy")
-    import tempfile
-
-    real, made = tempfile.mkstemp, []
-
-    def recording(*args, **options):
-        if options.get("suffix") == ".tmp":  # a temporary, not a writability probe
-            made.append(options.get("prefix", ""))
-        return real(*args, **options)
-
-    monkeypatch.setattr(tempfile, "mkstemp", recording)
+    made = record_temporaries(monkeypatch)
     small.write(tmp_path / "forest", las=True)
     assert sorted(prefix for prefix in made if ".laz" in prefix) == [".forest.laz.", ".forest_Target.laz."]
 

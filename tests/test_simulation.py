@@ -14,6 +14,7 @@ from ladartui.scenario import Scenario
 from ladartui.scene.voxels import load_voxels, save_voxels
 from ladartui.sensor import Sensor
 from ladartui.simulation import simulate
+from temporaries import record_temporaries
 
 TARGET_CENTRE = (22.5, 21.5, 1.0)
 
@@ -186,18 +187,9 @@ def test_las_outputs_hold_the_fused_voxels(forest):
 def test_las_outputs_are_written_straight_into_the_sets_temporaries(forest, monkeypatch):
     """Each .las output went to a temporary of the set's temporary: the exporter, atomic
     itself, made a second one beside the first and renamed it over."""
-    import tempfile
-
     import laspy
 
-    real, made = tempfile.mkstemp, []
-
-    def recording(*args, **options):
-        if options.get("suffix") == ".tmp":  # a temporary, not a writability probe
-            made.append(options.get("prefix", ""))
-        return real(*args, **options)
-
-    monkeypatch.setattr(tempfile, "mkstemp", recording)
+    made = record_temporaries(monkeypatch)
     simulate(forest, las=True)
     assert sorted(prefix for prefix in made if ".las" in prefix) == [".S_Scene.las.", ".S_Target.las."]
     with laspy.open(forest.path.with_name("S_Scene.las")) as reader:
