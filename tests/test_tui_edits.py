@@ -499,19 +499,50 @@ def count_output_stats(monkeypatch, scenario) -> dict:
     return stats
 
 
+async def test_earlier_outputs_are_read_off_the_ui_thread_target_output_too(
+    tmp_path, scene_files, monkeypatch
+):
+    """The target output of an earlier run (what marks the target voxels the foliage
+    hid) was read by the view on the UI thread, and its file looked at on every redraw."""
+    import threading
+    from pathlib import Path
+
+    import numpy as np
+
+    from ladartui.scene import voxels as voxel_files
+    from ladartui.simulation import simulate
+
+    scenario = make_scenario(tmp_path, scene_files)
+    simulate(scenario)
+    real_load, reads = voxel_files.load_voxels, []
+
+    def load_voxels(path, *args, **options):
+        reads.append((Path(path).name, threading.current_thread() is threading.main_thread()))
+        return real_load(path, *args, **options)
+
+    monkeypatch.setattr(voxel_files, "load_voxels", load_voxels)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app) and app.measures is not None)
+        app.show_output()
+        app.show_output()
+        await pilot.pause()
+        target_output = app.view_area._known_target_output(app.output_voxels)
+        assert np.array_equal(target_output, real_load(scenario.target_output))
+    assert (scenario.target_output.name, False) in reads
+    assert not [name for name, on_ui_thread in reads if on_ui_thread and "Target" in name], reads
+
+
 async def test_earlier_outputs_are_shown_from_one_stat_of_each_file(tmp_path, scene_files, monkeypatch):
     """Opening a file with outputs asked each output's status twice or three times (to
     read them, to name a partial set, to note those shown), and an on-disk change up
     to six times."""
     from ladartui.sensor import Sensor
     from ladartui.simulation import simulate
-    from ladartui.tui.view_area import ViewArea
 
     scenario = make_scenario(tmp_path, scene_files)
     simulate(scenario)
     stats = count_output_stats(monkeypatch, scenario)
-    # the view's own read of the target output checks the file's time at every redraw
-    monkeypatch.setattr(ViewArea, "_known_target_output", lambda self, voxels: None)
     app = LadarApp(scenario.path)
     async with app.run_test(size=SIZE) as pilot:
         await wait_until(pilot, lambda: loaded(app) and app.measures is not None)

@@ -89,6 +89,8 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         self.measures = None
         self.result = None
         self.output_voxels = None
+        # An earlier run's scene and target outputs as read from disk (in a worker).
+        self.disk_outputs: tuple = (None, None)
         self.missing_outputs: list[Path] = []
         self.outputs_from: Scenario | None = None  # the settings that made the outputs shown
         self.outputs_seen: tuple[int, int] | None = None  # (mtime, size) of the measures read

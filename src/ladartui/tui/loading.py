@@ -52,6 +52,7 @@ class Earlier:
     ran: Scenario | None  # the settings that made them (the run record), if recorded
     warning: str | None
     files: OutputFiles  # the look they were read after
+    target_output: np.ndarray | None = None  # the target traced without foliage, if on disk
 
     @property
     def made_with(self) -> Scenario | None:
@@ -163,6 +164,7 @@ class SceneLoading(Host):
         self.outputs_seen = earlier.files.seen  # as found before they were read
         self.outputs_from = earlier.made_with
         self.output_voxels = earlier.output
+        self.disk_outputs = (earlier.output, earlier.target_output)
         self.show_output()
         self.show_measures(earlier.measures)
         if earlier.warning:
@@ -190,6 +192,7 @@ def _earlier(scenario, files: OutputFiles | None = None) -> Earlier:
     if files is None:
         files = look_at_outputs(scenario)
     warning, ran = None, None
+    target_output = None
     try:
         output, measures = _existing_results(scenario, files)
     except LadarError as error:  # old results must not stop the scenario loading
@@ -199,7 +202,19 @@ def _earlier(scenario, files: OutputFiles | None = None) -> Earlier:
             ran = read_run_record(scenario)
         except LadarError as error:
             warning = f"settings of the earlier run not read, taken as the file's: {error}"
-    return Earlier(scenario, output, measures, ran, warning, files)
+        target_output = _target_output(scenario)
+    return Earlier(scenario, output, measures, ran, warning, files, target_output)
+
+
+def _target_output(scenario) -> np.ndarray | None:
+    """The earlier run's target output (it marks the target voxels the foliage hid in
+    the output view), or None when it cannot be read: the view then marks none."""
+    from ladartui.scene.voxels import load_voxels
+
+    try:
+        return load_voxels(scenario.target_output)
+    except (OSError, LadarError):
+        return None
 
 
 def _warm_up(scenario, scene, compile_in_child: bool, cancel) -> None:

@@ -71,7 +71,6 @@ class ViewArea(Container):
         self._output_args: tuple[Any, float | None, int, Any, Any] = (None, None, OUTPUT_POINTS, None, None)
         self.per_scan_known = False  # the output shown has per-scan returns ("scans" mode)
         self.no_output = "no output yet: F5 runs"  # the app's words, with its run key
-        self._target_file_cache: tuple | None = None
 
     def compose(self):
         yield ProjectionWidget("3D scene", id="scene3d")
@@ -211,22 +210,12 @@ class ViewArea(Container):
         return None
 
     def _known_target_output(self, voxels):
-        # the run's own target output, or the file written beside the scene output
+        # the run's own target output, or the one read from disk with the scene output
         result = getattr(self.app, "result", None)
         if result is not None and result.scene_output is voxels:
             return result.target_output
-        if getattr(self.app, "running", False) or self.scenario is None:
-            return None
-        path = self.scenario.target_output
-        try:
-            key = (str(path), path.stat().st_mtime_ns)
-            if self._target_file_cache is None or self._target_file_cache[0] != key:
-                from ladartui.scene.voxels import load_voxels
-
-                self._target_file_cache = (key, load_voxels(path))
-            return self._target_file_cache[1]
-        except (OSError, LadarError):
-            return None
+        scene_output, target_output = getattr(self.app, "disk_outputs", (None, None))
+        return target_output if voxels is not None and scene_output is voxels else None
 
     def _redraw_output(self) -> None:
         self.show_output(*self._output_args)
