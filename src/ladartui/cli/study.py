@@ -85,6 +85,8 @@ def run(args: argparse.Namespace) -> int:
                 f"--chart-from redraws a study already run: {', '.join(given)} would shape a new one; drop "
                 + ("it" if len(given) == 1 else "them")
             )
+    if not args.out.strip():  # "" would be the current folder
+        raise FieldError("--out", args.out, f"a folder name, such as {DEFAULT_OUT}")
     check_writable_folder(args.out)  # before the study, not after it
     if args.chart_from:
         return _report(_load_result(args.chart_from), args.out)

@@ -1,0 +1,29 @@
+"""``ladartui study``'s flags: refused before any scene is loaded or file written."""
+
+from __future__ import annotations
+
+import pytest
+
+from ladartui.cli import main
+from ladartui.study import inputs as study_inputs
+
+
+@pytest.fixture
+def no_scene(monkeypatch):
+    """A study that got past its flags would load a scene: fail loudly instead."""
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("a scene was loaded")
+
+    monkeypatch.setattr(study_inputs, "cached_scene", refuse)
+    monkeypatch.setattr(study_inputs, "generated_inputs", refuse)
+
+
+@pytest.mark.parametrize("out", ["", "  "])
+def test_an_empty_out_is_refused_and_nothing_is_written_here(tmp_path, monkeypatch, capsys, no_scene, out):
+    """'study --quick --out ""' wrote its five files into the current folder."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["study", "--quick", "--out", out]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == f"ladartui: error: --out = {out!r}: expected a folder name, such as study-results"
+    assert list(tmp_path.iterdir()) == []
