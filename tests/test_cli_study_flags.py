@@ -27,3 +27,19 @@ def test_an_empty_out_is_refused_and_nothing_is_written_here(tmp_path, monkeypat
     err = capsys.readouterr().err.strip()
     assert err == f"ladartui: error: --out = {out!r}: expected a folder name, such as study-results"
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    "flag, value, expected",
+    [
+        ("--runs", "100000", "a whole number from 1 to 1000"),
+        ("--runs", "0", "a whole number from 1 to 1000"),
+        ("--warmup", "100000", "a whole number from 0 to 1000"),
+        ("--warmup", "-1", "a whole number from 0 to 1000"),
+    ],
+)
+def test_runs_and_warmup_have_the_bench_limits(tmp_path, capsys, no_scene, flag, value, expected):
+    """'--warmup 100000' and '--runs 100000' were taken: the study ran until Ctrl-C."""
+    assert main(["study", "--quick", flag, value, "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == f"ladartui: error: {flag} = {value}: expected {expected}"

@@ -26,6 +26,7 @@ import numpy as np
 
 from ladartui.atomic import atomic_path
 from ladartui.cli.bench_passes import pass_medians, print_passes
+from ladartui.cli.flags import run_count
 from ladartui.errors import BackendUnavailable
 from ladartui.tracing.backend import METHODS
 
@@ -72,10 +73,8 @@ def add_parser(subparsers):
 
 
 def run(args):
-    if args.runs is not None and not 1 <= args.runs <= MAX_RUNS:
-        from ladartui.errors import FieldError
-
-        raise FieldError("--runs", args.runs, f"a whole number from 1 to {MAX_RUNS}")
+    if args.runs is not None:
+        run_count("--runs", args.runs)
     with _status() as say:
         if args.orbit:
             report = run_orbit_bench(runs=args.runs or 3, backend="numba", progress=say)
@@ -102,9 +101,6 @@ def run(args):
 
             print_passes(Console(), report)
     return 0
-
-
-MAX_RUNS = 1000  # timed runs per case: more would take hours and tell no more
 
 
 @contextlib.contextmanager

@@ -1,8 +1,9 @@
-"""Core field errors named as the flags the user typed.
+"""Core field errors named as the flags the user typed; the limits of run counts.
 
 The core names a field as the scenario file does (``simulation.backend``,
 ``detection.n_ref``, ``at``); a command that passed a flag's value on says
 ``--backend``, ``--n-ref``, ``--at`` instead, with the value as typed.
+``run_count`` bounds the timed runs and warm-up calls of bench and study.
 """
 
 from __future__ import annotations
@@ -24,3 +25,13 @@ def as_flags(typed: dict):
         if typed.get(name) is None:
             raise
         raise FieldError("--" + name.replace("_", "-"), typed[name], error.expected) from None
+
+
+MAX_RUNS = 1000  # timed runs or warm-up calls: more would take hours and tell no more
+
+
+def run_count(flag: str, value: int, low: int = 1, high: int = MAX_RUNS) -> int:
+    """``value`` when it is from ``low`` to ``high``; else a FieldError naming ``flag``."""
+    if not low <= value <= high:
+        raise FieldError(flag, value, f"a whole number from {low} to {high}")
+    return value

@@ -8,6 +8,7 @@ import threading
 
 from rich.markup import escape
 
+from ladartui.cli.flags import MAX_RUNS, run_count
 from ladartui.cli.progress import progress_display, run_cancellable
 from ladartui.errors import Cancelled, FieldError
 from ladartui.textsafe import visible
@@ -40,10 +41,13 @@ def add_parser(subparsers) -> None:
         "--runs",
         type=int,
         default=None,
-        help="timed runs per setting, median quoted (default 5; 3 with --quick)",
+        help=f"timed runs per setting, 1 to {MAX_RUNS}, median quoted (default 5; 3 with --quick)",
     )
     parser.add_argument(
-        "--warmup", type=int, default=None, help=f"untimed calls first (default {DEFAULT_WARMUP})"
+        "--warmup",
+        type=int,
+        default=None,
+        help=f"untimed calls first, 0 to {MAX_RUNS} (default {DEFAULT_WARMUP})",
     )
     parser.add_argument(
         "--chart-from",
@@ -90,11 +94,9 @@ def run(args: argparse.Namespace) -> int:
     check_writable_folder(args.out)  # before the study, not after it
     if args.chart_from:
         return _report(_load_result(args.chart_from), args.out)
-    runs = _positive("--runs", args.runs if args.runs is not None else (3 if args.quick else 5))
+    runs = run_count("--runs", args.runs if args.runs is not None else (3 if args.quick else 5))
     scans = _positive("--scans", args.scans if args.scans is not None else (2 if args.quick else 3))
-    warmup = args.warmup if args.warmup is not None else DEFAULT_WARMUP
-    if warmup < 0:
-        raise FieldError("--warmup", warmup, "0 or more")
+    warmup = run_count("--warmup", args.warmup if args.warmup is not None else DEFAULT_WARMUP, low=0)
     console = Console(stderr=True)
     if args.scenario:
         inputs = scenario_inputs(args.scenario, scans)
