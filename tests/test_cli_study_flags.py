@@ -43,3 +43,48 @@ def test_runs_and_warmup_have_the_bench_limits(tmp_path, capsys, no_scene, flag,
     assert main(["study", "--quick", flag, value, "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err.strip()
     assert err == f"ladartui: error: {flag} = {value}: expected {expected}"
+
+
+def test_more_scans_than_the_default_orbit_has_are_refused_before_the_scene_loads(
+    tmp_path, monkeypatch, capsys
+):
+    """'--scans 100000' was cut to 24 in silence, said only by the last line."""
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("a scene was loaded")
+
+    monkeypatch.setattr(study_inputs, "cached_scene", refuse)
+    assert main(["study", "--quick", "--scans", "100000", "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == "ladartui: error: --scans = 100000: expected at most 24: the default orbit has 24 scans"
+
+
+def test_more_scans_than_a_scenario_has_are_refused_naming_its_count(tmp_path, monkeypatch, capsys):
+    from ladartui.scenario import Scenario, load_scenario
+    from ladartui.user_data import default_scenario_path
+
+    path = default_scenario_path()
+    available = len(load_scenario(path).poses())
+
+    def refuse(self):
+        raise AssertionError("the scene was loaded")
+
+    monkeypatch.setattr(Scenario, "load_scene", refuse)
+    asked = available + 1
+    assert main(["study", str(path), "--scans", str(asked), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        f"ladartui: error: --scans = {asked}: expected at most {available}: "
+        f"the flight of {path} has {available} scans"
+    )
+
+
+def test_the_scans_a_flight_has_are_all_taken_and_a_default_above_them_is_not_refused(tmp_path):
+    from ladartui.scenario import load_scenario
+    from ladartui.user_data import default_scenario_path
+
+    path = default_scenario_path()
+    available = len(load_scenario(path).poses())
+    assert len(study_inputs.scenario_inputs(path, available, refuse_as="--scans").poses) == available
+    # the study screen and a default count keep taking what the flight has
+    assert len(study_inputs.scenario_inputs(path, available + 5).poses) == available

@@ -59,7 +59,8 @@ def add_parser(subparsers) -> None:
         "--scans",
         type=int,
         default=None,
-        help="scans traced, evenly spread over the flight (default 3; 2 with --quick)",
+        help="scans traced, evenly spread over the flight; no more than it has "
+        "(default 3, or all when it has fewer; 2 with --quick)",
     )
     parser.set_defaults(handler=run)
 
@@ -98,12 +99,14 @@ def run(args: argparse.Namespace) -> int:
     scans = _positive("--scans", args.scans if args.scans is not None else (2 if args.quick else 3))
     warmup = run_count("--warmup", args.warmup if args.warmup is not None else DEFAULT_WARMUP, low=0)
     console = Console(stderr=True)
+    # --scans above the flight's count is refused; the default (3) takes what there is
+    refuse_as = "--scans" if args.scans is not None else None
     if args.scenario:
-        inputs = scenario_inputs(args.scenario, scans)
+        inputs = scenario_inputs(args.scenario, scans, refuse_as=refuse_as)
     else:
         preset = "small" if args.quick else "reference"
         with console.status(f"loading the {preset!r} scene ..."):
-            inputs = generated_inputs(preset, scans, progress=console.print)
+            inputs = generated_inputs(preset, scans, progress=console.print, refuse_as=refuse_as)
     settings = quick_settings() if args.quick else full_settings()
     result = _run_with_progress(console, inputs, settings, runs, warmup)
     return _report(result, args.out)

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ladartui.atomic import write_text_atomic
+from ladartui.errors import FieldError
 from ladartui.user_data import data_home
 
 if TYPE_CHECKING:
@@ -63,13 +64,22 @@ def pick_scans(poses, limit: int | None):
     return [poses[i] for i in sorted(set(picks.tolist()))]
 
 
-def scenario_inputs(path, scans: int | None = DEFAULT_SCANS) -> StudyInputs:
-    """The scene, sensor and poses of the scenario file at ``path``."""
+def check_scans(field: str, scans: int | None, available: int, flight: str) -> None:
+    """FieldError ``field`` when more scans are asked for than ``flight`` has."""
+    if scans is not None and scans > available:
+        raise FieldError(field, scans, f"at most {available}: {flight} has {available} scans")
+
+
+def scenario_inputs(path, scans: int | None = DEFAULT_SCANS, refuse_as: str | None = None) -> StudyInputs:
+    """The scene, sensor and poses of the scenario file at ``path``. More ``scans`` than
+    the flight has: all of them, or with ``refuse_as`` (a flag) a FieldError naming it."""
     from ladartui.scenario import load_scenario
 
     scenario = load_scenario(path)
-    scene = scenario.load_scene()
     all_poses = list(scenario.poses())
+    if refuse_as:
+        check_scans(refuse_as, scans, len(all_poses), f"the flight of {path}")  # before the scene loads
+    scene = scenario.load_scene()
     poses = pick_scans(all_poses, scans)
     inputs = StudyInputs(scene, scenario.sensor, poses, str(path))
     if len(poses) < len(all_poses):
@@ -80,16 +90,21 @@ def scenario_inputs(path, scans: int | None = DEFAULT_SCANS) -> StudyInputs:
     return inputs
 
 
-def generated_inputs(preset: str = "reference", scans: int = DEFAULT_SCANS, progress=None) -> StudyInputs:
+def generated_inputs(
+    preset: str = "reference", scans: int = DEFAULT_SCANS, progress=None, refuse_as: str | None = None
+) -> StudyInputs:
     """A cached generated scene, the full-size sensor and the default orbit aimed at the target.
 
     The sensor is the default ``Sensor()`` (128 x 128 detectors, 10 degree view);
     the flight is the default scenario's orbit at 45 degrees depression, of which
-    ``scans`` evenly spread scans are traced.
+    ``scans`` evenly spread scans are traced (``refuse_as`` as for ``scenario_inputs``).
     """
+    from ladartui import defaults
     from ladartui.defaults import default_flight
     from ladartui.sensor import Sensor
 
+    if refuse_as:  # the orbit's scan count needs no scene: checked before one is loaded or made
+        check_scans(refuse_as, scans, defaults.DEFAULT_SCANS, "the default orbit")
     scene = cached_scene(preset, progress=progress)
     sensor = Sensor()
     all_poses = default_flight(scene.target, scene.voxel_size, sensor).poses()
