@@ -523,3 +523,53 @@ def test_chart_from_refuses_warmup_even_at_its_default_value(tmp_path, capsys, w
         "ladartui: error: --chart-from redraws a study already run: --warmup would shape a new one; drop it"
     )
     assert not (tmp_path / "o").exists()
+
+
+def test_the_progress_log_ends_at_its_total(tmp_path, monkeypatch, capsys):
+    """A log of 'study --quick' went 1, 4, 7 ... 40 and ended '[40/48 traces]': the
+    last line was the last setting's start, never the end."""
+    import re
+
+    import ladartui.study as study_package
+    from ladartui.cli import main
+    from ladartui.study import inputs as study_inputs
+
+    pytest.importorskip("numba")
+    monkeypatch.setattr(study_inputs, "generated_inputs", lambda *a, **k: _tiny_inputs(1.0))
+    settings = [Setting("numba", "exact", "f64", None, 1), Setting("numba", "march", "f64", 1.0, 1)]
+    monkeypatch.setattr(study_package, "quick_settings", lambda: settings)
+    assert main(["study", "--quick", "--runs", "3", "--out", str(tmp_path)]) == 0
+    counts = re.findall(r"^\[(\d+)/(\d+) traces\]", capsys.readouterr().err, re.MULTILINE)
+    # 2 settings x (2 scans + 1 warm-up + 1 repeat of the first scan)
+    assert counts[-1] == ("8", "8")
+    done = [int(d) for d, _ in counts]
+    assert done == sorted(done) and len(set(done)) == len(done)
+
+
+def test_a_failed_setting_counts_its_later_scans_as_done(monkeypatch):
+    """A setting that failed on its first scan left its later scans out of the count:
+    the counter fell behind and leapt to its total at the end."""
+    import ladartui.study.run as study_run
+    from ladartui.study import run_study
+
+    pytest.importorskip("numba")
+    real = study_run._trace
+
+    def failing(scene, origins, directions, setting, cancel):
+        if setting.method == "march":
+            raise RuntimeError("out of device memory")
+        return real(scene, origins, directions, setting, cancel)
+
+    monkeypatch.setattr(study_run, "_trace", failing)
+    settings = [Setting("numba", "exact", "f64", None, 1), Setting("numba", "march", "f64", 1.0, 1)]
+    seen: list = []
+    result = run_study(_tiny_inputs(), settings, runs=1, warmup=0, progress=seen.append)
+    assert {row.label: row.status for row in result.rows}["numba march 1 f64 m=1"] == "failed"
+    # 2 settings x 2 scans; the last call traced is the reference's second scan
+    assert [(p.done, p.label) for p in seen] == [
+        (0, "numba exact f64 m=1"),
+        (1, "numba march 1 f64 m=1"),
+        (3, "numba exact f64 m=1"),
+        (4, "scoring"),
+    ]
+    assert seen[-1].total == 4

@@ -151,7 +151,8 @@ def _run_with_progress(console, inputs, settings, runs, warmup):
         progress_bar.update(
             task, completed=p.done, total=p.total, description=f"{p.label} scan {p.scan}/{p.scans}"
         )
-        if plain and last.get("label") != p.label and p.scan == 1:
+        # a line as each setting starts, and the last one at the end: N/N
+        if plain and ((last.get("label") != p.label and p.scan == 1) or p.done == p.total):
             last["label"] = p.label
             console.print(f"[{p.done}/{p.total} traces] {p.label}", highlight=False, markup=False)
 

@@ -153,7 +153,8 @@ def run_study(
                     if s.is_reference:
                         raise
                     row.status, row.reason = FAILED, f"{type(error).__name__}: {error}"
-                    done = done_before + calls
+                    # its later scans (a call each) are not traced: done too, so the count keeps up
+                    done = done_before + calls + len(poses) - scan - 1
                     continue
                 note = hits.info.get("precision_note")
                 if note:
