@@ -77,7 +77,9 @@ def run(args):
         run_count("--runs", args.runs)
     with _status() as say:
         if args.orbit:
-            report = run_orbit_bench(runs=args.runs or 3, backend="numba", progress=say)
+            runs = args.runs or (QUICK_ORBIT_RUNS if args.quick else ORBIT_RUNS)
+            grid = 64 if args.quick else 128
+            report = run_orbit_bench(runs=runs, backend="numba", progress=say, grid=grid)
         else:
             report = run_bench(quick=args.quick, runs=args.runs, progress=say)
     if args.orbit:
@@ -117,13 +119,14 @@ def _status():
 
 
 ORBIT_SCANS = 36
+ORBIT_RUNS, QUICK_ORBIT_RUNS = 3, 1
 ORBIT_SLANT_RANGE_M = 150.0
 ORBIT_DEPRESSION = 45.0
 
 
-def run_orbit_bench(runs=3, backend="numba", progress=None) -> dict:
-    """Median seconds of a whole orbit simulation (both runs), after one warm-up run;
-    ``progress(text)`` hears what it does."""
+def run_orbit_bench(runs=ORBIT_RUNS, backend="numba", progress=None, grid=128) -> dict:
+    """Median seconds of a whole orbit simulation (both runs), after one warm-up run, with
+    a ``grid`` x ``grid`` sensor; ``progress(text)`` hears what it does."""
     say = progress or (lambda text: None)
     from ladartui.flight import FlightPlan, Orbit
     from ladartui.scenario import Scenario
@@ -139,7 +142,7 @@ def run_orbit_bench(runs=3, backend="numba", progress=None) -> dict:
         altitude=ORBIT_SLANT_RANGE_M * math.sin(e),
         scans=ORBIT_SCANS,
     )
-    sensor = Sensor(grid=128, ray_grid=4, fov=5.0)
+    sensor = Sensor(grid=grid, ray_grid=4, fov=5.0)
     folder = cache_dir()
     scenario = Scenario(
         folder / "orbit-bench.toml",
@@ -160,7 +163,8 @@ def run_orbit_bench(runs=3, backend="numba", progress=None) -> dict:
         traces.append(result.timings.get("trace", float("nan")))
     return {
         "scene": label,
-        "sensor": "128x128 detectors, 4x4 rays each, 5 degree field of view",
+        "sensor": f"{sensor.grid}x{sensor.grid} detectors, {sensor.ray_grid}x{sensor.ray_grid} rays each, "
+        f"{sensor.fov:g} degree field of view",
         "scans": ORBIT_SCANS,
         "slant_range_m": ORBIT_SLANT_RANGE_M,
         "depression": ORBIT_DEPRESSION,

@@ -1,0 +1,42 @@
+"""``ladartui bench``: the orbit bench's sensor and its flags."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+
+import numpy as np
+import pytest
+
+from ladartui.cli import main
+
+
+@pytest.fixture
+def tiny_bench(monkeypatch):
+    """The bench on a small scene and a 2-scan orbit, with no status line."""
+    bench = pytest.importorskip("ladartui.cli.bench")
+    pytest.importorskip("numba")
+    small = np.array([[i, j, k] for i in range(0, 40, 3) for j in range(0, 40, 2) for k in range(6)])
+
+    def tiny_scene(progress=None):
+        from ladartui.scene.model import Scene
+
+        return Scene(small, small[:4], 0.25, shape=(40, 40, 30), name="tiny"), "tiny"
+
+    @contextlib.contextmanager
+    def status():
+        yield lambda text: None
+
+    monkeypatch.setattr(bench, "load_bench_scene", tiny_scene)
+    monkeypatch.setattr(bench, "ORBIT_SCANS", 2)
+    monkeypatch.setattr(bench, "_status", status)
+    return bench
+
+
+def test_quick_orbit_traces_the_64x64_sensor_quick_promises(tiny_bench, capsys):
+    """'bench --quick --orbit' said '128x128 detectors': the orbit ignored --quick."""
+    assert main(["bench", "--quick", "--orbit", "--json"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert report["sensor"].startswith("64x64 detectors, 4x4 rays each")
+    assert report["rays"] == 2 * 2 * 64 * 64 * 16  # both runs of each scan: the sensor traced
+    assert report["runs"] == 1  # fewer runs too
