@@ -40,3 +40,19 @@ def test_quick_orbit_traces_the_64x64_sensor_quick_promises(tiny_bench, capsys):
     assert report["sensor"].startswith("64x64 detectors, 4x4 rays each")
     assert report["rays"] == 2 * 2 * 64 * 64 * 16  # both runs of each scan: the sensor traced
     assert report["runs"] == 1  # fewer runs too
+
+
+def test_passes_with_orbit_is_refused_before_any_tracing(monkeypatch, capsys):
+    """'bench --orbit --passes' timed the orbit and dropped --passes without a word."""
+    from ladartui.cli import bench
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("the bench ran")
+
+    monkeypatch.setattr(bench, "load_bench_scene", refuse)
+    assert main(["bench", "--orbit", "--passes"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == (
+        "ladartui: error: --passes and --orbit do not combine: --orbit times whole orbits, "
+        "with no time by pass; drop one"
+    )

@@ -61,7 +61,7 @@ def add_parser(subparsers):
         "--passes",
         action="store_true",
         help="also show where the exact scans spend their time: milliseconds by pass "
-        "(rays to cells, bins, voxels in view, tile lists, tile tests, ...)",
+        "(rays to cells, bins, voxels in view, tile lists, tile tests, ...); not with --orbit",
     )
     parser.add_argument(
         "--orbit",
@@ -73,6 +73,12 @@ def add_parser(subparsers):
 
 
 def run(args):
+    if args.passes and args.orbit:
+        from ladartui.errors import LadarError
+
+        raise LadarError(
+            "--passes and --orbit do not combine: --orbit times whole orbits, with no time by pass; drop one"
+        )
     if args.runs is not None:
         run_count("--runs", args.runs)
     with _status() as say:
