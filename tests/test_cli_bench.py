@@ -56,3 +56,23 @@ def test_passes_with_orbit_is_refused_before_any_tracing(monkeypatch, capsys):
         "ladartui: error: --passes and --orbit do not combine: --orbit times whole orbits, "
         "with no time by pass; drop one"
     )
+
+
+@pytest.mark.parametrize("command", ["bench", "study", "pulses"])
+def test_every_flag_that_takes_a_value_states_its_default(command):
+    """'pulses -h' did not say --pulses was 1,10,100, nor 'bench -h' what --runs was."""
+    import argparse
+
+    from ladartui.cli import build_parser
+
+    subparsers = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    parser = subparsers.choices[command]
+    for action in parser._actions:
+        if action.nargs == 0 or action.required:  # switches, -h, required values
+            continue
+        if (command, action.dest) == ("study", "chart_from"):  # a mode: without it, a new study
+            continue
+        text = " ".join((action.help or "").split())
+        assert "default" in text, f"{command} {action.dest}: {text!r}"
+        if action.default is not None:
+            assert str(action.default) in text, f"{command} {action.dest}: {text!r}"

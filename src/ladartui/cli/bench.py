@@ -26,7 +26,7 @@ import numpy as np
 
 from ladartui.atomic import atomic_path
 from ladartui.cli.bench_passes import pass_medians, print_passes
-from ladartui.cli.flags import run_count
+from ladartui.cli.flags import MAX_RUNS, run_count
 from ladartui.errors import BackendUnavailable
 from ladartui.tracing.backend import METHODS
 
@@ -37,6 +37,9 @@ NARROW_FOV = 3.0
 NARROW_ALTITUDE_M = 150.0
 NARROW_BEARING = 60.0  # compass bearing from the aircraft to the target
 VIEWS = ("wide", "narrow")
+# Timed runs (median quoted): a case, and a whole orbit; fewer with --quick.
+RUNS, QUICK_RUNS = 7, 2
+ORBIT_RUNS, QUICK_ORBIT_RUNS = 3, 1
 # Before the first timed run each backend traces until its speed settles: its first
 # calls compile kernels and try both orders, and a device may raise its clocks under
 # load (an H200 that stayed at 345-525 MHz, not 1,980, traced at half the rays/s).
@@ -56,7 +59,13 @@ def add_parser(subparsers):
         "--quick", action="store_true", help="fewer runs and a 64x64 sensor (a smoke test, not a measurement)"
     )
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
-    parser.add_argument("--runs", type=int, default=None, help="timed runs per case (median)")
+    parser.add_argument(
+        "--runs",
+        type=int,
+        default=None,
+        help=f"timed runs per case, 1 to {MAX_RUNS}, median quoted (default {RUNS}, "
+        f"{QUICK_RUNS} with --quick; with --orbit {ORBIT_RUNS}, {QUICK_ORBIT_RUNS} with --quick)",
+    )
     parser.add_argument(
         "--passes",
         action="store_true",
@@ -125,7 +134,6 @@ def _status():
 
 
 ORBIT_SCANS = 36
-ORBIT_RUNS, QUICK_ORBIT_RUNS = 3, 1
 ORBIT_SLANT_RANGE_M = 150.0
 ORBIT_DEPRESSION = 45.0
 
@@ -264,7 +272,7 @@ def run_bench(quick=False, runs=None, progress=None) -> dict:
     from ladartui.tracing import trace
     from ladartui.tracing.backend import backend_status, get_backend
 
-    runs = runs or (2 if quick else 7)
+    runs = runs or (QUICK_RUNS if quick else RUNS)
     grid = 64 if quick else 128
     scene, label = load_bench_scene(say)
     say("building the occupancy")

@@ -34,7 +34,11 @@ def add_parser(sub):
         "set. Writes no files.",
     )
     p.add_argument("scenario", nargs="?", help="scenario TOML (default: the default scenario)")
-    p.add_argument("--pulses", default="1,10,100", help="comma-separated pulses per look")
+    p.add_argument(
+        "--pulses",
+        default="1,10,100",
+        help="comma-separated pulses per look, each 1 to 100000 (default 1,10,100)",
+    )
     p.add_argument(
         "--n-ref",
         type=float,
