@@ -76,3 +76,54 @@ def test_every_flag_that_takes_a_value_states_its_default(command):
         assert "default" in text, f"{command} {action.dest}: {text!r}"
         if action.default is not None:
             assert str(action.default) in text, f"{command} {action.dest}: {text!r}"
+
+
+def test_one_call_and_one_run_are_singular(monkeypatch, capsys):
+    """The bench said 'numba 1 calls' (a --quick warm-up) and 'median of 1 runs'."""
+    from rich.console import Console
+
+    from ladartui.cli import bench
+    from ladartui.cli.bench_passes import print_passes
+
+    monkeypatch.setenv("COLUMNS", "200")
+    report = {
+        "scene": "tiny",
+        "shape": [40, 40, 30],
+        "voxels": 1200,
+        "occupancy_bytes": 2**20,
+        "setup_seconds": 0.1,
+        "setup_cpu_seconds": 0.1,
+        "sensor": "64x64 detectors, 4x4 rays each",
+        "runs": 1,
+        "warm_up": {"numba": {"calls": 1, "seconds": 0.5}, "wgpu": {"calls": 12, "seconds": 0.3}},
+        "results": [
+            {
+                "backend": "numba",
+                "method": "exact",
+                "view": "wide",
+                "depression": 45.0,
+                "order": "ray",
+                "rays_per_second": 1e6,
+                "vs_numba": 1.0,
+                "rays_per_cpu_second": 1e6,
+                "voxel_hits": 0.5,
+                "ground_hits": 0.5,
+                "device": "cpu",
+                "passes": {"bins": 0.001},
+                "median_seconds": 0.002,
+            }
+        ],
+        "views": {"wide": "wide view", "narrow": "narrow view"},
+        "backends": {"numba": "available"},
+    }
+    bench._print_table(report)
+    print_passes(Console(), report)
+    out = " ".join(capsys.readouterr().out.split())
+    assert "median of 1 run after a warm-up (numba 1 call in 0.5 s, wgpu 12 calls in 0.3 s)" in out
+    assert "milliseconds by pass (medians of 1 run)" in out
+
+
+def test_the_orbit_line_says_one_run(tiny_bench, capsys):
+    assert main(["bench", "--quick", "--orbit"]) == 0
+    out = " ".join(capsys.readouterr().out.split())
+    assert "over 1 run after a warm-up" in out

@@ -329,6 +329,8 @@ def test_cli_quick_writes_data_and_chart_files(tmp_path, monkeypatch, capsys):
     out = capsys.readouterr()
     assert status == 0, out.err
     assert "Pareto front" in out.out
+    err = " ".join(out.err.split())
+    assert "median of 1 run" in err and "1 runs" not in err
     names = sorted(p.name for p in tmp_path.iterdir())
     assert names == [
         "speed-accuracy.png",

@@ -14,3 +14,8 @@ def fixed(value: float, digits: int) -> str:
     if math.isfinite(value) and abs(value) >= FIXED_BELOW:
         return f"{value:.4g}"
     return f"{value:.{digits}f}"
+
+
+def counted(count: int, noun: str) -> str:
+    """``count`` and ``noun``, plural but for one: "1 call", "12 calls"."""
+    return f"{count:,} {noun}" if count == 1 else f"{count:,} {noun}s"

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import statistics
 
+from ladartui.number_text import counted
+
 # The passes in the order a scan runs them (tracing/passes.py names them).
 PASS_ORDER = (
     "rays to cells",
@@ -46,7 +48,8 @@ def print_passes(console, report) -> None:
     for backend in dict.fromkeys(row["backend"] for row in rows):
         cases = [row for row in rows if row["backend"] == backend]
         names = list(dict.fromkeys(name for row in cases for name in row["passes"]))
-        console.print(f"{backend}, exact scans: milliseconds by pass (medians of {report['runs']} runs)")
+        runs = counted(report["runs"], "run")
+        console.print(f"{backend}, exact scans: milliseconds by pass (medians of {runs})")
         table = Table(
             box=box.SIMPLE_HEAD,
             pad_edge=False,
