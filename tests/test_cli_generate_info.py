@@ -87,7 +87,9 @@ def test_generate_las_copy(tmp_path, capsys):
 def test_generate_rejects_bad_input_on_one_line(tmp_path, capsys):
     assert main(["generate", "huge", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err
-    assert err == "ladartui: error: preset = 'huge': expected one of small, reference\n"
+    assert err == "ladartui: error: PRESET = 'huge': expected one of small, reference\n"  # as the usage line
+    assert main(["generate", "small", str(tmp_path / "x"), "--seed", "-1"]) == 2
+    assert capsys.readouterr().err == "ladartui: error: --seed = -1: expected a non-negative whole number\n"
     assert main(["generate", "small", str(tmp_path / "x"), "--density", "2"]) == 2
     assert capsys.readouterr().err == "ladartui: error: --density = 2.0: expected a number from 0 to 0.99\n"
     assert main(["generate", "small", str(tmp_path / "x"), "--vehicles", "1000"]) == 2

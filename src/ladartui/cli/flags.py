@@ -2,7 +2,8 @@
 
 The core names a field as the scenario file does (``simulation.backend``,
 ``detection.n_ref``, ``at``); a command that passed a flag's value on says
-``--backend``, ``--n-ref``, ``--at`` instead, with the value as typed.
+``--backend``, ``--n-ref``, ``--at`` instead, with the value as typed; a
+positional argument is named as its usage line names it (``PRESET``).
 ``run_count`` bounds the timed runs and warm-up calls of bench and study.
 """
 
@@ -14,17 +15,18 @@ from ladartui.errors import FieldError
 
 
 @contextlib.contextmanager
-def as_flags(typed: dict):
+def as_flags(typed: dict, labels: dict | None = None):
     """Re-raise a FieldError whose field ends in one of ``typed``'s names (``n_ref``) as
-    that flag (``--n-ref``) with the value typed; names whose value is None were not
-    typed and pass the error on as it is."""
+    that flag (``--n-ref``), or as ``labels[name]`` where given (``PRESET``), with the
+    value typed; names whose value is None were not typed and pass the error on as it is."""
     try:
         yield
     except FieldError as error:
         name = error.field.rpartition(".")[2]
         if typed.get(name) is None:
             raise
-        raise FieldError("--" + name.replace("_", "-"), typed[name], error.expected) from None
+        label = (labels or {}).get(name) or "--" + name.replace("_", "-")
+        raise FieldError(label, typed[name], error.expected) from None
 
 
 MAX_RUNS = 1000  # timed runs or warm-up calls: more would take hours and tell no more

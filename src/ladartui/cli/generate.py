@@ -166,8 +166,9 @@ def _work(args, stem, las_files, console, cancel):
                 bar.update(task, description=stage, completed=(done - 1) / steps, done=shown)
 
         started = time.perf_counter()
-        typed = {name: getattr(args, name) for name in ("density", "trees", "voxel_size", "vehicles")}
-        with as_flags(typed):  # name the flag the user typed, not the parameter
+        names = ("preset", "seed", "density", "trees", "voxel_size", "vehicles")
+        typed = {name: getattr(args, name) for name in names}
+        with as_flags(typed, {"preset": "PRESET"}):  # name the flag the user typed, not the parameter
             scene = generate_scene(
                 args.preset, seed=args.seed, progress=report, cancel=cancel, **overrides_from(args)
             )
