@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from cli_support import one_error_line
 from ladartui.cli import main
 
 
@@ -495,3 +496,21 @@ def test_bench_says_when_a_backend_traced_in_f32(monkeypatch, capsys):
     rows[1]["precision"] = "f64"
     bench._print_table(report)
     assert "traced in f32" not in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("size", ["inf", "nan", "-1", "0", "1e308", "101"])
+def test_trace_and_info_refuse_the_same_voxel_sizes(tmp_path, scene_file, capsys, size):
+    """'--voxel-size inf' was named 'voxel_size'; info took inf and 1e308 and showed an
+    extent of 'inf x inf x inf' m. Both refuse what a scenario's files.voxel_size refuses."""
+    rays = _three_rays(tmp_path)
+    out = tmp_path / "hits.npy"
+    expected = (
+        f"ladartui: error: --voxel-size = {float(size)!r}: "
+        "expected a number of metres greater than 0 and at most 100"
+    )
+    command = ["trace", "--scene", str(scene_file), "--rays", str(rays), "--out", str(out)]
+    assert main([*command, "--voxel-size", size]) == 2
+    assert one_error_line(capsys) == expected
+    assert not out.exists()
+    assert main(["info", str(scene_file), "--voxel-size", size]) == 2
+    assert one_error_line(capsys) == expected

@@ -10,6 +10,7 @@ positional argument is named as its usage line names it (``PRESET``).
 from __future__ import annotations
 
 import contextlib
+import math
 
 from ladartui.errors import FieldError
 
@@ -36,4 +37,15 @@ def run_count(flag: str, value: int, low: int = 1, high: int = MAX_RUNS) -> int:
     """``value`` when it is from ``low`` to ``high``; else a FieldError naming ``flag``."""
     if not low <= value <= high:
         raise FieldError(flag, value, f"a whole number from {low} to {high}")
+    return value
+
+
+def voxel_size_flag(value: float, flag: str = "--voxel-size") -> float:
+    """A voxel size typed as a flag, held to what a scenario's ``files.voxel_size`` takes:
+    finite, above 0, at most MAX_VOXEL_SIZE metres; else FieldError naming the flag."""
+    from ladartui.checks import range_text
+    from ladartui.scenario import MAX_VOXEL_SIZE
+
+    if not (math.isfinite(value) and 0 < value <= MAX_VOXEL_SIZE):
+        raise FieldError(flag, value, range_text("a number of metres", 0, MAX_VOXEL_SIZE, True, False))
     return value

@@ -69,10 +69,10 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
     from ladartui.scene.target_model import load_target
     from ladartui.scene.voxels import load_voxels_counted
 
-    if voxel_size is not None and not voxel_size > 0:
-        from ladartui.errors import FieldError
+    if voxel_size is not None:
+        from ladartui.cli.flags import voxel_size_flag
 
-        raise FieldError("--voxel-size", voxel_size, "a positive number of metres")
+        voxel_size_flag(voxel_size)  # as trace takes it: not inf, not 1e308
     started = time.perf_counter()
     ids = None
     if path.stem.endswith("_Target"):  # a target model: x,y,z or x,y,z,id lines

@@ -116,13 +116,12 @@ def load_rays(path) -> np.ndarray:
 
 
 def run(args):
-    from ladartui.cli.flags import as_flags
+    from ladartui.cli.flags import as_flags, voxel_size_flag
     from ladartui.scene.occupancy import Occupancy
     from ladartui.scene.voxels import load_voxels
     from ladartui.tracing import trace
 
-    if not args.voxel_size > 0:
-        raise FieldError("--voxel-size", args.voxel_size, "a positive number of metres")
+    voxel_size_flag(args.voxel_size)
     from ladartui.outputset import check_writable
 
     out = Path(args.out)
