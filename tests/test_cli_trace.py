@@ -514,3 +514,20 @@ def test_trace_and_info_refuse_the_same_voxel_sizes(tmp_path, scene_file, capsys
     assert not out.exists()
     assert main(["info", str(scene_file), "--voxel-size", size]) == 2
     assert one_error_line(capsys) == expected
+
+
+def test_an_empty_or_folder_path_names_its_flag(tmp_path, scene_file, capsys, monkeypatch):
+    """'--out ""' said '.: is a folder, expected a file name', naming no flag."""
+    monkeypatch.chdir(tmp_path)
+    rays = _three_rays(tmp_path)
+    given = {"--scene": str(scene_file), "--rays": str(rays), "--out": str(tmp_path / "hits.npy")}
+    for flag in given:
+        command = ["trace"] + [
+            part for name, value in given.items() for part in (name, "" if name == flag else value)
+        ]
+        assert main(command) == 2
+        assert one_error_line(capsys) == f"ladartui: error: {flag} = '': expected a file name"
+    (tmp_path / "folder").mkdir()
+    assert main(["trace", "--scene", str(scene_file), "--rays", str(rays), "--out", "folder"]) == 2
+    assert one_error_line(capsys) == "ladartui: error: --out = 'folder': expected a file name, not a folder"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["X.txt", "folder", "rays.npy"]

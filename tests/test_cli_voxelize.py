@@ -144,6 +144,18 @@ def test_bad_flags_are_one_line(tmp_path, truck, capsys, extra, message):
     assert not (tmp_path / "t.txt").exists()
 
 
+@pytest.mark.parametrize("empty", ["MESH", "OUT", "--into"])
+def test_an_empty_path_names_its_argument(tmp_path, truck, forest, capsys, monkeypatch, empty):
+    """An empty OUT ended in a ValueError traceback; an empty MESH was '.: is a folder' and
+    an empty --into was taken as no --into."""
+    monkeypatch.chdir(tmp_path)
+    mesh, out = ("" if empty == "MESH" else str(truck)), ("" if empty == "OUT" else "t")
+    into = "" if empty == "--into" else str(forest)
+    assert main(["voxelize", mesh, out, "--voxel-size", "0.1", "--at", "3,3", "--into", into]) == 2
+    assert one_error_line(capsys) == f"ladartui: error: {empty} = '': expected a file name"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["forest.txt", "forest_Target.txt", "truck.stl"]
+
+
 def test_memory_beyond_the_machine_is_refused_with_its_estimate(tmp_path, truck, capsys, monkeypatch):
     monkeypatch.setenv("LADARTUI_MAX_MEMORY", str(64 * 2**20))
     assert main(["voxelize", str(truck), str(tmp_path / "t"), "--voxel-size", "0.005", "--solid"]) == 2

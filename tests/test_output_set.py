@@ -205,7 +205,9 @@ def test_trace_out_a_folder_is_refused_before_tracing(tmp_path, capsys):
         )
         == 2
     )
-    assert "hits.npy: is a folder" in last_error_line(capsys)
+    assert last_error_line(capsys) == (
+        f"ladartui: error: --out = '{tmp_path / 'hits.npy'}': expected a file name, not a folder"
+    )
 
 
 def test_trace_of_an_empty_npy_is_one_line(tmp_path, capsys):

@@ -49,3 +49,12 @@ def voxel_size_flag(value: float, flag: str = "--voxel-size") -> float:
     if not (math.isfinite(value) and 0 < value <= MAX_VOXEL_SIZE):
         raise FieldError(flag, value, range_text("a number of metres", 0, MAX_VOXEL_SIZE, True, False))
     return value
+
+
+def check_file_names(given: dict) -> None:
+    """FieldError for the first of ``given`` (flag or argument as the usage line names
+    it: value typed, None if not given) that is empty or blank: "" names no file, and
+    as a Path it is the current folder."""
+    for name, value in given.items():
+        if value is not None and not value.strip():
+            raise FieldError(name, value, "a file name")

@@ -116,17 +116,20 @@ def load_rays(path) -> np.ndarray:
 
 
 def run(args):
-    from ladartui.cli.flags import as_flags, voxel_size_flag
+    from ladartui.cli.flags import as_flags, check_file_names, voxel_size_flag
     from ladartui.scene.occupancy import Occupancy
     from ladartui.scene.voxels import load_voxels
     from ladartui.tracing import trace
 
+    check_file_names({"--scene": args.scene, "--rays": args.rays, "--out": args.out})
     voxel_size_flag(args.voxel_size)
     from ladartui.outputset import check_writable
 
     out = Path(args.out)
     if not out.parent.is_dir():  # a mistyped folder is not made
         raise FieldError("--out", args.out, "a file in an existing folder")
+    if out.is_dir():
+        raise FieldError("--out", args.out, "a file name, not a folder")
     if out.exists() and Path(args.rays).exists() and out.samefile(args.rays):
         raise FieldError("--out", args.out, "a file other than --rays")
     check_writable(out)  # before the trace, not after it

@@ -6,7 +6,7 @@ import math
 import threading
 import time
 
-from ladartui.cli.flags import as_flags, voxel_size_flag
+from ladartui.cli.flags import as_flags, check_file_names, voxel_size_flag
 from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt
 from ladartui.errors import Cancelled, FieldError, check_cancelled
 from ladartui.textsafe import one_line, visible
@@ -80,6 +80,7 @@ def run(args) -> int:
     from ladartui.scene.voxelize import CANCELLED, Placement
     from ladartui.scene.voxels import MAX_TARGET_ID
 
+    check_file_names({"MESH": args.mesh, "OUT": args.out, "--into": args.into})
     voxel_size_flag(args.voxel_size)  # the scene's, so one a scenario takes
     if not (args.scale > 0 and math.isfinite(args.scale)):
         raise FieldError("--scale", args.scale, "a positive number of metres per mesh unit")
