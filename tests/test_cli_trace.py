@@ -531,3 +531,18 @@ def test_an_empty_or_folder_path_names_its_flag(tmp_path, scene_file, capsys, mo
     assert main(["trace", "--scene", str(scene_file), "--rays", str(rays), "--out", "folder"]) == 2
     assert one_error_line(capsys) == "ladartui: error: --out = 'folder': expected a file name, not a folder"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["X.txt", "folder", "rays.npy"]
+
+
+def test_a_step_without_the_march_is_refused_naming_both_flags(tmp_path, scene_file, capsys):
+    """'--step 0.3' without '--method march' was dropped without a word."""
+    rays = _three_rays(tmp_path)
+    out = tmp_path / "hits.npy"
+    command = ["trace", "--scene", str(scene_file), "--rays", str(rays), "--out", str(out), "--step", "0.3"]
+    for method in ([], ["--method", "exact"]):
+        assert main([*command, *method]) == 2
+        assert one_error_line(capsys) == (
+            "ladartui: error: --step 0.3 sets the march's step, and this trace is --method exact: "
+            "add --method march, or drop --step"
+        )
+    assert not out.exists()
+    assert main([*command, "--method", "march"]) == 0 and out.is_file()

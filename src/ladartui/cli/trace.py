@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.atomic import atomic_path
-from ladartui.errors import FieldError, InputFileError, ResourceLimitError
+from ladartui.errors import FieldError, InputFileError, LadarError, ResourceLimitError
 from ladartui.textsafe import visible
 from ladartui.tracing.backend import METHODS, PRECISIONS
 
@@ -31,7 +31,12 @@ def add_parser(subparsers):
     parser.add_argument("--out", required=True, metavar="HITS.npy", help="output (N, 5) float64")
     parser.add_argument("--backend", default="auto", help="backend name or 'auto' (default)")
     parser.add_argument("--method", default=METHODS[0], help=" or ".join(METHODS) + " (default: exact)")
-    parser.add_argument("--step", type=float, default=None, help="march step in voxels (0.5)")
+    parser.add_argument(
+        "--step",
+        type=float,
+        default=None,
+        help="the march's step in voxels (default 0.5; needs --method march)",
+    )
     parser.add_argument("--voxel-size", type=float, default=1.0, help="metres per voxel (1.0)")
     parser.add_argument(
         "--precision",
@@ -123,6 +128,11 @@ def run(args):
 
     check_file_names({"--scene": args.scene, "--rays": args.rays, "--out": args.out})
     voxel_size_flag(args.voxel_size)
+    if args.step is not None and args.method in METHODS and args.method != "march":
+        raise LadarError(
+            f"--step {args.step:g} sets the march's step, and this trace is --method {args.method}: "
+            "add --method march, or drop --step"
+        )
     from ladartui.outputset import check_writable
 
     out = Path(args.out)
