@@ -47,10 +47,15 @@ def test_trace_writes_hits(tmp_path, scene_file, capsys):
     assert hits[0, :4].tolist() == [1, 5, 5, 1] and hits[0, 4] == pytest.approx(18.5)
     assert hits[1, :4].tolist() == [2, 2, 2, 0] and hits[1, 4] == pytest.approx(20.5)
     assert hits[2, 0] == 0 and np.isinf(hits[2, 4])
-    assert "3 rays" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    # the voxel size was not given: a user of a 0.25 m scene must see 1 m was assumed
+    assert err == (
+        "3 rays (numba, exact, f64), voxel size 1 m (assumed; --voxel-size sets it): "
+        f"1 voxel, 1 ground, 1 miss -> {out}\n"
+    )
 
 
-def test_trace_march_with_voxel_size(tmp_path, scene_file):
+def test_trace_march_with_voxel_size(tmp_path, scene_file, capsys):
     rays = np.array([[1.25, 1.25, 10.0, 0.0, 0.0, -1.0]])  # 0.25 m voxels: cell (5, 5)
     np.save(tmp_path / "rays.npy", rays)
     out = tmp_path / "hits.npy"
@@ -75,6 +80,7 @@ def test_trace_march_with_voxel_size(tmp_path, scene_file):
         == 0
     )
     assert np.load(out)[0, :4].tolist() == [1, 5, 5, 1]
+    assert ", voxel size 0.25 m: 1 voxel," in capsys.readouterr().err  # given: not "assumed"
 
 
 def _three_rays(tmp_path):
@@ -141,8 +147,8 @@ def test_trace_precision_reported_and_checked(tmp_path, scene_file, capsys):
         )
         == 0
     )
-    # numba has only f64 kernels: the line says what was traced, not what was asked
-    assert "numba, exact, f64" in capsys.readouterr().err
+    # numba has only f64 kernels: the line says what was traced, and that f32 was asked
+    assert "(numba, exact, f64, not the f32 asked for)" in capsys.readouterr().err
     with pytest.raises(SystemExit) as stop:
         main(
             [

@@ -37,13 +37,16 @@ def add_parser(subparsers):
         default=None,
         help="the march's step in voxels (default 0.5; needs --method march)",
     )
-    parser.add_argument("--voxel-size", type=float, default=1.0, help="metres per voxel (1.0)")
+    parser.add_argument(
+        "--voxel-size", type=float, help="metres per voxel (1 when not given, and the summary says so)"
+    )
     parser.add_argument(
         "--precision",
         default=PRECISIONS[0],
         choices=PRECISIONS,
         help="arithmetic of the trace: f64 (default) or f32, as in the API; "
-        "a backend without f32 kernels traces in f64 and says so",
+        "a backend without f32 kernels (numba) traces in f64, and one without f64 (a wgpu adapter "
+        "lacking float64) in f32; the summary then names both",
     )
     parser.set_defaults(handler=run)
 
@@ -127,7 +130,8 @@ def run(args):
     from ladartui.tracing import trace
 
     check_file_names({"--scene": args.scene, "--rays": args.rays, "--out": args.out})
-    voxel_size_flag(args.voxel_size)
+    # A scene list holds no voxel size: without the flag, 1 m, said in the summary.
+    voxel_size = 1.0 if args.voxel_size is None else voxel_size_flag(args.voxel_size)
     if args.step is not None and args.method in METHODS and args.method != "march":
         raise LadarError(
             f"--step {args.step:g} sets the march's step, and this trace is --method {args.method}: "
@@ -156,16 +160,21 @@ def run(args):
             method=args.method,
             step=args.step,
             precision=args.precision,
-            voxel_size=args.voxel_size,
+            voxel_size=voxel_size,
         )
     with atomic_path(args.out) as tmp:
         with open(tmp, "wb") as handle:
             np.save(handle, result.as_array())
     counts = np.bincount(result.kind, minlength=3)
     used = result.info.get("precision", args.precision)
+    if used != args.precision:  # a backend without the arithmetic asked for
+        used += f", not the {args.precision} asked for"
+    size = f"voxel size {voxel_size:g} m" + (
+        " (assumed; --voxel-size sets it)" if args.voxel_size is None else ""
+    )
     print(
         visible(
-            f"{len(rays)} rays ({result.backend}, {result.method}, {used}): {counts[1]} voxel, "
+            f"{len(rays)} rays ({result.backend}, {result.method}, {used}), {size}: {counts[1]} voxel, "
             f"{counts[2]} ground, {counts[0]} miss -> {args.out}"
         ),
         file=sys.stderr,
