@@ -552,3 +552,16 @@ def test_a_step_without_the_march_is_refused_naming_both_flags(tmp_path, scene_f
         )
     assert not out.exists()
     assert main([*command, "--method", "march"]) == 0 and out.is_file()
+
+
+def test_a_bad_ray_is_named_by_its_row_from_1_and_its_index(tmp_path, scene_file, capsys):
+    """The second row was 'row 1': file lines are counted from 1 everywhere else."""
+    good = [5.0, 5.0, 20.0, 0.0, 0.0, -1.0]
+    for bad, says in (
+        ([2.0, 2.0, 20.0, 0.0, 0.0, 0.0], "has a zero direction: expected a unit vector"),
+        ([np.nan, 2.0, 20.0, 0.0, 0.0, -1.0], "is not finite: expected finite numbers"),
+    ):
+        np.save(tmp_path / "rays.npy", np.array([good, bad, bad]))
+        command = ["trace", "--scene", str(scene_file), "--rays", str(tmp_path / "rays.npy")]
+        assert main([*command, "--out", str(tmp_path / "h.npy")]) == 2
+        assert one_error_line(capsys) == f"ladartui: error: {tmp_path / 'rays.npy'}: row 2 (index 1) {says}"

@@ -116,11 +116,16 @@ def load_rays(path) -> np.ndarray:
     rays = rays.astype(np.float64)
     if not np.all(np.isfinite(rays)):
         row = int(np.flatnonzero(~np.all(np.isfinite(rays), axis=1))[0])
-        raise InputFileError(path, f"row {row} is not finite: expected finite numbers")
+        raise InputFileError(path, f"{_row(row)} is not finite: expected finite numbers")
     zero = np.flatnonzero(~np.any(rays[:, 3:] != 0, axis=1))
     if len(zero):
-        raise InputFileError(path, f"row {int(zero[0])} has a zero direction: expected a unit vector")
+        raise InputFileError(path, f"{_row(int(zero[0]))} has a zero direction: expected a unit vector")
     return rays
+
+
+def _row(index: int) -> str:
+    """A row counted from 1, as file lines are, with the index that finds it in numpy."""
+    return f"row {index + 1} (index {index})"
 
 
 def run(args):
