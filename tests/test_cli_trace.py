@@ -565,3 +565,45 @@ def test_a_bad_ray_is_named_by_its_row_from_1_and_its_index(tmp_path, scene_file
         command = ["trace", "--scene", str(scene_file), "--rays", str(tmp_path / "rays.npy")]
         assert main([*command, "--out", str(tmp_path / "h.npy")]) == 2
         assert one_error_line(capsys) == f"ladartui: error: {tmp_path / 'rays.npy'}: row 2 (index 1) {says}"
+
+
+def test_ctrl_c_or_sigterm_says_what_was_written(tmp_path, scene_file, capsys, monkeypatch):
+    """A Ctrl-C said only 'interrupted', where run and voxelize say nothing was written."""
+    import signal
+
+    import ladartui.cli.trace as cli_trace
+    import ladartui.tracing as tracing
+
+    rays = _three_rays(tmp_path)
+    out = tmp_path / "hits.npy"
+    out.write_bytes(b"earlier")
+    command = ["trace", "--scene", str(scene_file), "--rays", str(rays), "--out", str(out)]
+    real_trace = tracing.trace
+
+    def stopped(*args, **kwargs):
+        handler = signal.getsignal(signal.SIGTERM)
+        assert callable(handler), "SIGTERM is not taken as a stop while tracing"
+        handler(signal.SIGTERM, None)  # as `kill` would
+
+    monkeypatch.setattr(tracing, "trace", stopped)
+    assert main(command) == 143
+    assert capsys.readouterr().err == f"ladartui: trace cancelled; nothing was written, {out} is unchanged\n"
+    assert out.read_bytes() == b"earlier"
+    out.unlink()
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(tracing, "trace", interrupted)
+    assert main(command) == 130
+    assert capsys.readouterr().err == "ladartui: trace cancelled; nothing was written\n"
+    assert sorted(tmp_path.iterdir()) == sorted([scene_file, rays])  # no temporary left either
+
+    def interrupted_while_saying(text):
+        raise KeyboardInterrupt  # a Ctrl-C landing once the hits were written
+
+    monkeypatch.setattr(tracing, "trace", real_trace)
+    monkeypatch.setattr(cli_trace, "visible", interrupted_while_saying)
+    assert main(command) == 130
+    assert capsys.readouterr().err == f"ladartui: interrupted after the trace; it wrote {out}\n"
+    assert np.load(out).shape == (3, 5)

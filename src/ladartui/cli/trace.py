@@ -7,13 +7,14 @@ in metres (inf for a miss). The output is written atomically.
 
 from __future__ import annotations
 
+import os
 import sys
 from pathlib import Path
 
 import numpy as np
 
 from ladartui.atomic import atomic_path
-from ladartui.errors import FieldError, InputFileError, LadarError, ResourceLimitError
+from ladartui.errors import Cancelled, FieldError, InputFileError, LadarError, ResourceLimitError
 from ladartui.textsafe import visible
 from ladartui.tracing.backend import METHODS, PRECISIONS
 
@@ -129,10 +130,8 @@ def _row(index: int) -> str:
 
 
 def run(args):
-    from ladartui.cli.flags import as_flags, check_file_names, voxel_size_flag
-    from ladartui.scene.occupancy import Occupancy
-    from ladartui.scene.voxels import load_voxels
-    from ladartui.tracing import trace
+    from ladartui.cli.flags import check_file_names, voxel_size_flag
+    from ladartui.cli.progress import sigterm_as_interrupt
 
     check_file_names({"--scene": args.scene, "--rays": args.rays, "--out": args.out})
     # A scene list holds no voxel size: without the flag, 1 m, said in the summary.
@@ -152,6 +151,35 @@ def run(args):
     if out.exists() and Path(args.rays).exists() and out.samefile(args.rays):
         raise FieldError("--out", args.out, "a file other than --rays")
     check_writable(out)  # before the trace, not after it
+    earlier = _identity(out)
+    try:
+        with sigterm_as_interrupt():
+            _trace_and_write(args, voxel_size)
+    except KeyboardInterrupt:
+        # The hits replace --out in one rename: a new file there means they were written.
+        if _identity(out) != earlier:
+            raise Cancelled(f"interrupted after the trace; it wrote {args.out}") from None
+        unchanged = f", {args.out} is unchanged" if earlier is not None else ""
+        raise Cancelled(f"trace cancelled; nothing was written{unchanged}") from None
+    return 0
+
+
+def _identity(path) -> tuple[int, int] | None:
+    """Which file ``path`` is (device, inode); None where there is none."""
+    try:
+        status = os.stat(path)
+    except OSError:
+        return None
+    return status.st_dev, status.st_ino
+
+
+def _trace_and_write(args, voxel_size: float) -> None:
+    """Read the rays and the scene, trace, write the hits, say what was traced."""
+    from ladartui.cli.flags import as_flags
+    from ladartui.scene.occupancy import Occupancy
+    from ladartui.scene.voxels import load_voxels
+    from ladartui.tracing import trace
+
     rays = load_rays(args.rays)
     voxels = load_voxels(args.scene)
     occupancy = Occupancy.build(voxels, source=str(args.scene))
@@ -184,4 +212,3 @@ def run(args):
         ),
         file=sys.stderr,
     )
-    return 0
