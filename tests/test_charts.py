@@ -112,7 +112,7 @@ def test_run_chart_plots_coverage_after_each_scan_with_the_90_percent_point(
     assert main(["run", str(three_scan_scenario.path), "--no-write", "--json", "--chart", str(svg)]) == 0
     measures = json.loads(capsys.readouterr().out)["measures"]
     assert main(["run", str(three_scan_scenario.path), "--no-write", "--chart", str(png)]) == 0
-    assert f"wrote chart: {png}" in capsys.readouterr().err
+    assert f"wrote chart: {png}" in capsys.readouterr().out
 
     series = _groups(svg, "series-")
     assert sorted(g.get("id") for g in series) == ["series-obscured", "series-unobscured"]

@@ -61,9 +61,14 @@ def test_no_write_with_a_chart_says_truly_what_was_written(scenario, capsys):
     chart = scenario.path.with_name("c.svg")
     assert main(["run", str(scenario.path), "--no-write", "--chart", str(chart)]) == 0
     out, err = capsys.readouterr()
-    assert f"wrote chart: {chart}" in err and chart.is_file()
+    # with the run's other lines on stdout (it was on stderr), after what the run wrote
+    assert out.endswith(f"no scenario outputs written (--no-write)\nwrote chart: {chart}\n")
+    assert chart.is_file() and "chart" not in err
     assert "nothing written" not in out + err
-    assert "no scenario outputs written (--no-write)" in out
+    # --json keeps stdout JSON: the chart's line goes to stderr
+    assert main(["run", str(scenario.path), "--no-write", "--json", "--chart", str(chart)]) == 0
+    out, err = capsys.readouterr()
+    assert json.loads(out)["outputs"] == {} and err.endswith(f"wrote chart: {chart}\n")
     assert not scenario.measures_file.exists()
 
 

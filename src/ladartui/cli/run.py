@@ -4,7 +4,8 @@ The run happens on a worker thread so that Ctrl-C (or SIGTERM) on the main
 thread can set the cancel event; the run then stops between chunks and writes
 nothing, or, when the outputs were already being swapped in, finishes the swap
 and reports the files written.
-Progress goes to stderr, the measures to stdout (a table, or JSON with --json).
+Progress goes to stderr, the measures to stdout (a table, or JSON with --json), and
+the files written after them (with --json, the chart's line goes to stderr).
 """
 
 from __future__ import annotations
@@ -100,14 +101,14 @@ def run(args) -> int:
     finished: list[SimulationResult] = []  # the result, once there is one
     with _told_if_finished(finished):  # a Ctrl-C from then on says what the run wrote
         result = _simulate_with_progress(scenario, args, errors, finished)
-        chart_error = None
+        chart_error = chart_line = None
         if args.chart is not None:
             from ladartui import charts
             from ladartui.charts.coverage import coverage_figure
 
             try:
                 path = charts.save_figure(coverage_figure(result.measures), args.chart)
-                errors.print(visible(f"wrote chart: {path}"), highlight=False, markup=False, soft_wrap=True)
+                chart_line = visible(f"wrote chart: {path}")
             except OSError as error:  # the run's outputs are written: say so, and show them
                 reason = (error.strerror or str(error)).lower()
                 written = (
@@ -116,10 +117,14 @@ def run(args) -> int:
                 chart_error = OutputFileError(
                     args.chart, f"the chart was not written ({reason}); the run wrote {written}"
                 )
+        # The chart's line follows the run's own "wrote" lines; --json keeps stdout JSON.
+        said = errors if args.json else Console()
         if args.json:
             print(json.dumps(result_dict(scenario, result), indent=2, allow_nan=False))
         else:
-            show_result(Console(), result)
+            show_result(said, result)
+        if chart_line is not None:
+            said.print(chart_line, highlight=False, markup=False, soft_wrap=True)
         if chart_error is not None:
             raise chart_error
     return 0
