@@ -109,13 +109,19 @@ def test_info_describes_a_voxel_list_and_its_target(tmp_path, capsys):
     assert "s_Target.txt: 2 voxels, 1 of them in the scene" in out
     assert "centre (3.5, 5.5, 2.5) voxels = (1.75, 2.75, 1.25) m" in out
     pytest.importorskip("ladartui.scene.occupancy")
-    assert re.search(r"occupancy\s+\d+\.\d MiB \(2 bricks, 1 tiles, 1 regions\), built in", out)
+    assert re.search(r"occupancy\s+\d+\.\d MiB \(2 bricks, 1 tile, 1 region\), built in", out)
 
 
 def test_info_without_target_file(tmp_path, capsys):
     (tmp_path / "lonely.txt").write_text("1,1,1\n")
     assert main(["info", str(tmp_path / "lonely.txt")]) == 0
-    assert "none (lonely_Target.txt not found)" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "none (lonely_Target.txt not found)" in out
+    pytest.importorskip("ladartui.scene.occupancy")
+    assert "(1 brick, 1 tile, 1 region)" in out  # not "1 bricks, 1 tiles, 1 regions"
+    (tmp_path / "lonely_Target.txt").write_text("1,1,1\n")
+    assert main(["info", str(tmp_path / "lonely.txt")]) == 0
+    assert "lonely_Target.txt: 1 voxel, 1 of them in the scene" in capsys.readouterr().out
 
 
 def test_info_bad_file_is_one_line(tmp_path, capsys):

@@ -80,7 +80,8 @@ def test_trace_march_with_voxel_size(tmp_path, scene_file, capsys):
         == 0
     )
     assert np.load(out)[0, :4].tolist() == [1, 5, 5, 1]
-    assert ", voxel size 0.25 m: 1 voxel," in capsys.readouterr().err  # given: not "assumed"
+    # given: not "assumed"; one ray, not "1 rays"
+    assert capsys.readouterr().err.startswith("1 ray (numba, march, f64), voxel size 0.25 m: 1 voxel,")
 
 
 def _three_rays(tmp_path):

@@ -156,6 +156,13 @@ def test_an_empty_path_names_its_argument(tmp_path, truck, forest, capsys, monke
     assert sorted(p.name for p in tmp_path.iterdir()) == ["forest.txt", "forest_Target.txt", "truck.stl"]
 
 
+def test_one_voxel_is_said_in_the_singular(tmp_path, truck, capsys):
+    """A voxel as large as the truck: '1 voxels'."""
+    assert main(["voxelize", str(truck), str(tmp_path / "t"), "--voxel-size", "5"]) == 0
+    out = capsys.readouterr().out
+    assert "surface model of 1 voxel at 5 m (1 on the surface)" in out
+
+
 def test_memory_beyond_the_machine_is_refused_with_its_estimate(tmp_path, truck, capsys, monkeypatch):
     monkeypatch.setenv("LADARTUI_MAX_MEMORY", str(64 * 2**20))
     assert main(["voxelize", str(truck), str(tmp_path / "t"), "--voxel-size", "0.005", "--solid"]) == 2

@@ -16,6 +16,7 @@ def fixed(value: float, digits: int) -> str:
     return f"{value:.{digits}f}"
 
 
-def counted(count: int, noun: str) -> str:
-    """``count`` and ``noun``, plural but for one: "1 call", "12 calls"."""
-    return f"{count:,} {noun}" if count == 1 else f"{count:,} {noun}s"
+def plural(count: int, noun: str, nouns: str | None = None) -> str:
+    """``count`` with thousands separators and ``noun``, plural unless it is 1:
+    "1 voxel", "2,048 voxels"; ``nouns`` where the plural is not noun + "s"."""
+    return f"{count:,} {noun if count == 1 else nouns or noun + 's'}"

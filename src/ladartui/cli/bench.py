@@ -28,7 +28,7 @@ from ladartui.atomic import atomic_path
 from ladartui.cli.bench_passes import pass_medians, print_passes
 from ladartui.cli.flags import MAX_RUNS, run_count
 from ladartui.errors import BackendUnavailable
-from ladartui.number_text import counted
+from ladartui.number_text import plural
 from ladartui.tracing.backend import METHODS
 
 DEPRESSIONS = (45.0, 90.0)
@@ -105,7 +105,7 @@ def run(args):
             print(
                 f"{report['scans']}-scan orbit on {report['scene']}, {report['sensor']}, "
                 f"{report['backend']}: median {report['median_seconds']:.2f} s end to end "
-                f"over {counted(report['runs'], 'run')} after a warm-up "
+                f"over {plural(report['runs'], 'run')} after a warm-up "
                 f"(trace {report['median_trace_seconds']:.2f} s; "
                 f"{report['rays']:,} rays over both runs)"
             )
@@ -445,9 +445,9 @@ def _print_table(report):
         f"occupancy {report['occupancy_bytes'] / 2**20:.1f} MiB built in "
         f"{report['setup_seconds']:.2f} s ({report['setup_cpu_seconds']:.2f} CPU-s); "
         f"{report['sensor']}; median of "
-        f"{counted(report['runs'], 'run')} after a warm-up ("
+        f"{plural(report['runs'], 'run')} after a warm-up ("
         + ", ".join(
-            f"{name} {counted(w['calls'], 'call')} in {w['seconds']:.1f} s"
+            f"{name} {plural(w['calls'], 'call')} in {w['seconds']:.1f} s"
             for name, w in report["warm_up"].items()
         )
         + ")"

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import statistics
 
-from ladartui.number_text import counted
+from ladartui.number_text import plural
 
 # The passes in the order a scan runs them (tracing/passes.py names them).
 PASS_ORDER = (
@@ -48,7 +48,7 @@ def print_passes(console, report) -> None:
     for backend in dict.fromkeys(row["backend"] for row in rows):
         cases = [row for row in rows if row["backend"] == backend]
         names = list(dict.fromkeys(name for row in cases for name in row["passes"]))
-        runs = counted(report["runs"], "run")
+        runs = plural(report["runs"], "run")
         console.print(f"{backend}, exact scans: milliseconds by pass (medians of {runs})")
         table = Table(
             box=box.SIMPLE_HEAD,

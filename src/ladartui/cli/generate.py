@@ -7,6 +7,7 @@ import time
 from pathlib import Path
 
 from ladartui.errors import FieldError, LadarError
+from ladartui.number_text import plural
 from ladartui.textsafe import visible
 
 
@@ -121,8 +122,8 @@ def run(args) -> int:
     nx, ny, nz = scene.shape
     print(
         visible(
-            f"wrote {scene_path} ({len(scene.voxels):,} voxels) and {target_path} "
-            f"({len(scene.target):,} voxels)"
+            f"wrote {scene_path} ({plural(len(scene.voxels), 'voxel')}) and {target_path} "
+            f"({plural(len(scene.target), 'voxel')})"
         )
     )
     if las_files:

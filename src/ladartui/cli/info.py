@@ -6,6 +6,7 @@ import time
 from pathlib import Path
 
 from ladartui.errors import LadarError
+from ladartui.number_text import plural
 from ladartui.textsafe import visible
 
 
@@ -100,7 +101,7 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
     target_path = target_path_for(path)
     if target_path.is_file() and target_path != path:
         target, ids = load_target(target_path)
-        text = f"{target_path.name}: {len(target):,} voxels"
+        text = f"{target_path.name}: {plural(len(target), 'voxel')}"
         if len(target):
             inside = _count_inside(target, voxels)
             text += f", {inside:,} of them in the scene; {_targets_text(ids)}"
@@ -157,8 +158,8 @@ def _occupancy_text(voxels, shape, path) -> str:
     occupancy = Occupancy.build(voxels, shape, source=str(path))
     built = time.perf_counter() - started
     return (
-        f"{occupancy.nbytes / 2**20:.1f} MiB ({occupancy.n_bricks:,} bricks, "
-        f"{occupancy.n_tiles:,} tiles, {occupancy.n_regions:,} regions), "
+        f"{occupancy.nbytes / 2**20:.1f} MiB ({plural(occupancy.n_bricks, 'brick')}, "
+        f"{plural(occupancy.n_tiles, 'tile')}, {plural(occupancy.n_regions, 'region')}), "
         f"built in {built:.2f} s"
     )
 

@@ -253,12 +253,11 @@ def target_tables(per_target):
     from rich.markup import escape
     from rich.table import Table
 
+    from ladartui.number_text import plural
     from ladartui.target_measures import TABLE_HEADER, TABLE_NOTE, after_scan_rows, table_rows
 
     count = len(per_target.targets)
-    table = Table(
-        title=f"Measures per target ({count} target{'' if count == 1 else 's'})", caption=TABLE_NOTE
-    )
+    table = Table(title=f"Measures per target ({plural(count, 'target')})", caption=TABLE_NOTE)
     for index, name in enumerate(TABLE_HEADER):
         table.add_column(name, justify="left" if index == 0 else "right")
     rows = table_rows(per_target)

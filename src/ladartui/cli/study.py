@@ -127,7 +127,7 @@ def _positive(flag, value):
 def _run_with_progress(console, inputs, settings, runs, warmup):
     from rich.progress import TextColumn, TimeElapsedColumn
 
-    from ladartui.number_text import counted
+    from ladartui.number_text import plural
     from ladartui.study.run import backend_reasons, run_study
 
     for name, reason in backend_reasons(s.backend for s in settings).items():
@@ -137,7 +137,7 @@ def _run_with_progress(console, inputs, settings, runs, warmup):
     console.print(
         f"study on {inputs.name}: {len(scene.voxels):,} voxels, shape {scene.shape}, "
         f"{len(inputs.poses)} scans, sensor {inputs.sensor.grid}x{inputs.sensor.grid}, "
-        f"{len(settings)} settings, median of {counted(runs, 'run')}"
+        f"{len(settings)} settings, median of {plural(runs, 'run')}"
     )
     cancel = threading.Event()
     progress_bar = progress_display(

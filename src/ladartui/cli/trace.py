@@ -15,6 +15,7 @@ import numpy as np
 
 from ladartui.atomic import atomic_path
 from ladartui.errors import Cancelled, FieldError, InputFileError, LadarError, ResourceLimitError
+from ladartui.number_text import plural
 from ladartui.textsafe import visible
 from ladartui.tracing.backend import METHODS, PRECISIONS
 
@@ -207,8 +208,8 @@ def _trace_and_write(args, voxel_size: float) -> None:
     )
     print(
         visible(
-            f"{len(rays)} rays ({result.backend}, {result.method}, {used}), {size}: {counts[1]} voxel, "
-            f"{counts[2]} ground, {counts[0]} miss -> {args.out}"
+            f"{plural(len(rays), 'ray')} ({result.backend}, {result.method}, {used}), {size}: "
+            f"{counts[1]} voxel, {counts[2]} ground, {counts[0]} miss -> {args.out}"
         ),
         file=sys.stderr,
     )

@@ -9,6 +9,7 @@ import time
 from ladartui.cli.flags import as_flags, check_file_names, voxel_size_flag
 from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt
 from ladartui.errors import Cancelled, FieldError, check_cancelled
+from ladartui.number_text import plural
 from ladartui.textsafe import one_line, visible
 
 
@@ -192,9 +193,9 @@ def _report(console, args, mesh, done, outputs, elapsed) -> None:
         detail += f", {result.inside:,} with their centre inside"
     say = lambda text: console.print(visible(text), highlight=False, markup=False, soft_wrap=True)  # noqa: E731
     say(
-        f"{mesh.path}: {len(mesh.faces):,} triangle{'s' if len(mesh.faces) != 1 else ''}, "
+        f"{mesh.path}: {plural(len(mesh.faces), 'triangle')}, "
         f"{'closed' if mesh.closed else 'not closed'}; "
-        f"{kind} model of {len(result.voxels):,} voxels at {vs:g} m ({detail}) in {elapsed:.2f} s"
+        f"{kind} model of {plural(len(result.voxels), 'voxel')} at {vs:g} m ({detail}) in {elapsed:.2f} s"
     )
     if len(result.voxels):
         low, high = result.voxels.min(axis=0), result.voxels.max(axis=0)
@@ -209,8 +210,8 @@ def _report(console, args, mesh, done, outputs, elapsed) -> None:
         return
     scene_path, target_path = outputs
     say(
-        f"wrote {scene_path} ({len(insertion.scene):,} voxels, {insertion.added:,} new) and "
-        f"{target_path} ({len(insertion.target):,} voxels"
+        f"wrote {scene_path} ({plural(len(insertion.scene), 'voxel')}, {insertion.added:,} new) and "
+        f"{target_path} ({plural(len(insertion.target), 'voxel')}"
         + (", a new target model" if insertion.new_target else "")
         + (
             f"; the vehicle is target {insertion.vehicle_id}, one of "
