@@ -105,11 +105,31 @@ def test_info_describes_a_voxel_list_and_its_target(tmp_path, capsys):
     out = capsys.readouterr().out
     assert re.search(r"voxels\s+3 \(1 duplicate lines dropped\)", out)
     assert "x 0..5, y 0..7, z 0..9  (shape 6 x 8 x 10)" in out
-    assert "3.0 x 4.0 x 5.0 at 0.5 m" in out
+    assert "3 x 4 x 5 at 0.5 m" in out
     assert "s_Target.txt: 2 voxels, 1 of them in the scene" in out
     assert "centre (3.5, 5.5, 2.5) voxels = (1.75, 2.75, 1.25) m" in out
     pytest.importorskip("ladartui.scene.occupancy")
     assert re.search(r"occupancy\s+\d+\.\d MiB \(2 bricks, 1 tile, 1 region\), built in", out)
+
+
+def test_info_and_validate_give_a_scene_the_same_extent(tmp_path, capsys):
+    """info said 18.2 m where validate said 18.25 m for the same scene."""
+    scenario = pytest.importorskip("ladartui.scenario")
+    (tmp_path / "s.txt").write_text("5,5,0\n9,9,72\n")
+    (tmp_path / "s_Target.txt").write_text("5,5,0\n")
+    assert main(["info", str(tmp_path / "s.txt"), "--voxel-size", "0.25"]) == 0
+    assert re.search(r"extent \(m\)\s+2.5 x 2.5 x 18.25 at 0.25 m\n", capsys.readouterr().out)
+    path = tmp_path / "plan.toml"
+    scenario.Scenario.new(path, tmp_path / "s.txt", 0.25).save()
+    assert main(["validate", str(path)]) == 0
+    assert "extent 10 x 10 x 73 voxels = 2.5 x 2.5 x 18.25 m" in capsys.readouterr().out
+
+
+def test_an_extent_in_metres_is_written_as_people_write_it():
+    from ladartui.number_text import extent_metres
+
+    assert extent_metres((1500, 1501, 73), 0.1) == "150 x 150.1 x 7.3"  # not 150.00000000000003
+    assert extent_metres((3, 2_000_000, 2**31 - 1), 50.0) == "150 x 100000000 x 1.074e+11"
 
 
 def test_info_without_target_file(tmp_path, capsys):

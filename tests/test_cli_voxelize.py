@@ -39,7 +39,7 @@ def test_writes_a_target_model_that_loads_back(tmp_path, truck, capsys):
     np.testing.assert_array_equal(voxels, voxelize(load_mesh(truck), 0.1, solid=True).voxels)
     text = capsys.readouterr().out
     assert "12 triangles, closed; solid model of 12,000 voxels at 0.1 m" in text
-    assert "voxels x 0..19, y 0..39, z 0..14 (2.00 x 4.00 x 1.50 m)" in text
+    assert "voxels x 0..19, y 0..39, z 0..14 (2 x 4 x 1.5 m)" in text
     assert f"wrote {out}" in text
 
 

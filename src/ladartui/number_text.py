@@ -16,6 +16,22 @@ def fixed(value: float, digits: int) -> str:
     return f"{value:.{digits}f}"
 
 
+def trimmed(value: float, digits: int = 6) -> str:
+    """``value`` to ``digits`` significant digits without trailing zeros ("18.25", "150",
+    not 150.00000000000003); from 1e10 on with an exponent, as ``fixed`` writes it."""
+    value = float(value)
+    if not math.isfinite(value) or abs(value) >= FIXED_BELOW:
+        return f"{value:.4g}"
+    text = f"{value:.{digits}g}"
+    return f"{value:.0f}" if "e+" in text else text  # a million and up: written out
+
+
+def extent_metres(shape, voxel_size: float) -> str:
+    """The sides of a box of ``shape`` voxels in metres, "2.5 x 2.5 x 18.25": one
+    wording for every command that shows a scene's extent."""
+    return " x ".join(trimmed(n * voxel_size) for n in shape)
+
+
 def plural(count: int, noun: str, nouns: str | None = None) -> str:
     """``count`` with thousands separators and ``noun``, plural unless it is 1:
     "1 voxel", "2,048 voxels"; ``nouns`` where the plural is not noun + "s"."""

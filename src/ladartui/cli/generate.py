@@ -7,7 +7,7 @@ import time
 from pathlib import Path
 
 from ladartui.errors import FieldError, LadarError
-from ladartui.number_text import plural
+from ladartui.number_text import extent_metres, plural
 from ladartui.textsafe import visible
 
 
@@ -129,7 +129,7 @@ def run(args) -> int:
     if las_files:
         print(visible(f"wrote {las_files[0]} and {las_files[1]} (voxel centres in metres)"))
     print(f"preset {scene.preset}, seed {scene.seed}, voxel size {vs:g} m")
-    print(f"extent {nx} x {ny} x {nz} voxels = {nx * vs:.1f} x {ny * vs:.1f} x {nz * vs:.1f} m")
+    print(f"extent {nx} x {ny} x {nz} voxels = {extent_metres(scene.shape, vs)} m")
     print("parts (before merging): " + ", ".join(f"{k} {v:,}" for k, v in scene.parts.items()))
     if scene.target_centre is not None:
         x, y, z = scene.target_centre

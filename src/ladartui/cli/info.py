@@ -6,7 +6,7 @@ import time
 from pathlib import Path
 
 from ladartui.errors import LadarError
-from ladartui.number_text import plural
+from ladartui.number_text import extent_metres, plural
 from ladartui.textsafe import visible
 
 
@@ -95,9 +95,7 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
         ranges = ", ".join(f"{axis} {int(low)}..{int(high)}" for axis, low, high in zip("xyz", lo, hi))
         rows.append(("extent", f"{ranges}  (shape {shape[0]} x {shape[1]} x {shape[2]})"))
         if voxel_size:
-            rows.append(
-                ("extent (m)", " x ".join(f"{n * voxel_size:.1f}" for n in shape) + f" at {voxel_size:g} m")
-            )
+            rows.append(("extent (m)", f"{extent_metres(shape, voxel_size)} at {voxel_size:g} m"))
     target_path = target_path_for(path)
     if target_path.is_file() and target_path != path:
         target, ids = load_target(target_path)

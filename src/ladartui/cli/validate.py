@@ -85,6 +85,7 @@ def scene_summary(scenario) -> list[str]:
     """Read both model files (errors name file and line) and size the tracing structures."""
     import numpy as np
 
+    from ladartui.number_text import extent_metres
     from ladartui.resources import available_memory, check_occupancy, gib
 
     scene = scenario.load_scene()
@@ -94,7 +95,7 @@ def scene_summary(scenario) -> list[str]:
     in_targets = f" in {len(ids)} targets" if len(ids) > 1 else ""
     lines = [
         f"scene      {len(scene.voxels):,} voxels, target {len(scene.target):,} voxels{in_targets}; "
-        f"extent {nx} x {ny} x {nz} voxels = {nx * vs:g} x {ny * vs:g} x {nz * vs:g} m"
+        f"extent {nx} x {ny} x {nz} voxels = {extent_metres(scene.shape, vs)} m"
     ]
     lines.extend(target_notes(scenario, scene))
     unused = [i for i, _ in scenario.target_names if i not in ids]

@@ -9,7 +9,7 @@ import time
 from ladartui.cli.flags import as_flags, check_file_names, voxel_size_flag
 from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt
 from ladartui.errors import Cancelled, FieldError, check_cancelled
-from ladartui.number_text import plural
+from ladartui.number_text import extent_metres, plural
 from ladartui.textsafe import one_line, visible
 
 
@@ -202,8 +202,7 @@ def _report(console, args, mesh, done, outputs, elapsed) -> None:
         say(
             "voxels "
             + ", ".join(f"{n} {lo}..{hi}" for n, lo, hi in zip("xyz", low, high))
-            + f" ({(high[0] - low[0] + 1) * vs:.2f} x {(high[1] - low[1] + 1) * vs:.2f} x "
-            f"{(high[2] - low[2] + 1) * vs:.2f} m)"
+            + f" ({extent_metres(high - low + 1, vs)} m)"
         )
     if insertion is None:
         say(f"wrote {outputs[0]}" + (f" (target {args.id})" if args.id is not None else ""))
