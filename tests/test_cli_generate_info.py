@@ -103,7 +103,7 @@ def test_info_describes_a_voxel_list_and_its_target(tmp_path, capsys):
     (tmp_path / "s_Target.txt").write_text("3,7,1\n4,4,4\n")
     assert main(["info", str(tmp_path / "s.txt"), "--voxel-size", "0.5"]) == 0
     out = capsys.readouterr().out
-    assert re.search(r"voxels\s+3 \(1 duplicate lines dropped\)", out)
+    assert re.search(r"voxels\s+3 \(1 duplicate line dropped\)", out)
     assert "x 0..5, y 0..7, z 0..9  (shape 6 x 8 x 10)" in out
     assert "3 x 4 x 5 at 0.5 m" in out
     assert "s_Target.txt: 2 voxels, 1 of them in the scene" in out

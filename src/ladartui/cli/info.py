@@ -83,7 +83,10 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
         voxels, duplicates = load_voxels_counted(path)
     loaded = time.perf_counter() - started
     rows = [
-        ("voxels", f"{len(voxels):,}" + (f" ({duplicates:,} duplicate lines dropped)" if duplicates else ""))
+        (
+            "voxels",
+            f"{len(voxels):,}" + (f" ({plural(duplicates, 'duplicate line')} dropped)" if duplicates else ""),
+        )
     ]
     if ids is not None and len(ids):
         rows.append(("targets", _targets_text(ids)))
