@@ -1,5 +1,7 @@
 """``ladartui voxelize``: target models from meshes, inserted into scene models, and its errors."""
 
+import warnings
+
 import numpy as np
 import pytest
 import trimesh
@@ -238,3 +240,34 @@ def test_a_placement_off_the_grid_is_blamed_on_at_not_the_mesh(tmp_path, capsys)
     err = capsys.readouterr().err.strip()
     assert code == 2 and len(err.splitlines()) == 1
     assert err.startswith("ladartui: error: --at = ") and "2147483647" in err and "the mesh spans" not in err
+
+
+@pytest.mark.parametrize(
+    ("mesh", "extra", "starts"),
+    [
+        ("cube", ["--scale", "1e308"], "{mesh}: the mesh spans 1e+308 x 1e+308 x 1e+308 m"),
+        ("cube", ["--scale", "1e308", "--at", "5,5"], "{mesh}: the mesh spans 1e+308 x 1e+308 x 1e+308 m"),
+        ("cube", ["--scale", "1e300", "--at", "5,5", "--heading", "30"], "{mesh}: the mesh spans 1e+300"),
+        ("huge", ["--at", "5,5"], "{mesh}: the mesh spans "),
+        ("huge", ["--scale", "2"], "{mesh}: at --scale 2 its vertices pass the largest number"),
+        ("cube", ["--at", "1e308,5"], "--at = '1e308,5': expected a position within the scene's grid"),
+        ("cube", ["--at", "5,-1e308"], "--at = '5,-1e308': expected a position within the scene's grid"),
+    ],
+)
+def test_absurd_sizes_and_places_are_one_line(tmp_path, capsys, mesh, extra, starts):
+    """--scale 1e308 and --at 1e308,0 printed numpy's overflow warnings before the error; a
+    mesh spanning 1e308 m placed --at 5,5 blamed --at with a 300-digit distance."""
+    files = {
+        "cube": "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
+        "huge": "v -1e308 -1e308 0\nv 1e308 -1e308 0\nv 0 1e308 1\nf 1 2 3\n",
+    }
+    path = tmp_path / f"{mesh}.obj"
+    path.write_text(files[mesh])
+    with warnings.catch_warnings(record=True) as caught:  # printed on stderr outside pytest
+        warnings.simplefilter("always")
+        assert main(["voxelize", str(path), str(tmp_path / "o"), "--voxel-size", "0.5", *extra]) == 2
+    assert not caught, [str(w.message) for w in caught]
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1, err
+    assert err.startswith("ladartui: error: " + starts.format(mesh=path)), err
+    assert len(err) < 400

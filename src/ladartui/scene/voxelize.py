@@ -134,7 +134,12 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
     problem = _closed_problem(loaded, len(vertices))
     if not problem and _signed_volume(vertices, faces) < 0:
         faces = faces[:, ::-1].copy()  # wound inside out: turn the normals outward
-    vertices = vertices * scale
+    with np.errstate(over="ignore"):  # past the float range: inf, refused below
+        vertices = vertices * scale
+    if not np.all(np.isfinite(vertices)):
+        raise InputFileError(
+            path, f"at --scale {scale:g} its vertices pass the largest number (about 1.8e308 m)"
+        )
     if up == "y":
         vertices = np.column_stack([vertices[:, 0], -vertices[:, 2], vertices[:, 1]])
     return Mesh(path, vertices, faces, not problem, problem, tuple(notes))
@@ -328,6 +333,17 @@ def grid_triangles(mesh: Mesh, voxel_size: float, placement: Placement | None = 
     vertices = mesh.vertices
     used = vertices[np.unique(mesh.faces)]  # stray vertices in no triangle do not move the mesh
     low, high = used.min(axis=0), used.max(axis=0)
+    with np.errstate(over="ignore"):  # a side past the float range is inf
+        sides = high - low
+    # The mesh first, then where it goes: from here on no sum or quotient overflows.
+    if float(sides.max()) / vs >= MAX_INDEX - 1:
+        span = " x ".join(f"{side:.4g}" for side in sides)
+        raise InputFileError(
+            mesh.path,
+            f"the mesh spans {span} m: at voxel size {vs:g} m its voxel indices would pass "
+            f"{MAX_INDEX}; check its units (--scale) and its farthest vertices, or use a coarser "
+            "--voxel-size",
+        )
     if placement is None:
         grid = _snap((vertices - low) / vs - 0.5)
     else:
@@ -335,7 +351,13 @@ def grid_triangles(mesh: Mesh, voxel_size: float, placement: Placement | None = 
             raise FieldError("at", placement, "finite x, y, z metres and heading degrees")
         if placement.z < 0:
             raise FieldError("at", placement.z, "a height of 0 m or more above the ground (z)")
-        centre = np.array([(low[0] + high[0]) / 2, (low[1] + high[1]) / 2, low[2]])
+        if max(abs(placement.x), abs(placement.y), placement.z) / vs >= MAX_INDEX - 1:
+            raise FieldError(
+                "at",
+                f"{placement.x:g},{placement.y:g},{placement.z:g}",
+                f"a position within the scene's grid: voxel indices there would pass {MAX_INDEX}",
+            )
+        centre = np.array([low[0] + sides[0] / 2, low[1] + sides[1] / 2, low[2]])
         local = vertices - centre
         cos, sin = _turn(placement.heading)
         # Clockwise from north: the mesh's +y (forward) goes to (sin h, cos h).
@@ -361,19 +383,11 @@ def grid_triangles(mesh: Mesh, voxel_size: float, placement: Placement | None = 
                     f"it reaches {name} = {lowest[axis] * vs:.3f} m, {short:.3f} m past the scene's "
                     f"edge at {name} = {-0.5 * vs:g} m (voxel indices start at 0); move it {way}",
                 )
-    if grid.max() > MAX_INDEX - 1:
-        if placement is not None and float((high - low).max()) / vs < MAX_INDEX - 1:  # the mesh fits
-            raise FieldError(
-                "at",
-                f"{placement.x:g},{placement.y:g},{placement.z:g}",
-                f"a position within the scene's grid: voxel indices there would pass {MAX_INDEX}",
-            )
-        span = " x ".join(f"{side:.4g}" for side in high - low)
-        raise InputFileError(
-            mesh.path,
-            f"the mesh spans {span} m: at voxel size {vs:g} m its voxel indices would pass "
-            f"{MAX_INDEX}; check its units (--scale) and its farthest vertices, or use a coarser "
-            "--voxel-size",
+    if placement is not None and grid.max() > MAX_INDEX - 1:  # the mesh fits; where it goes does not
+        raise FieldError(
+            "at",
+            f"{placement.x:g},{placement.y:g},{placement.z:g}",
+            f"a position within the scene's grid: voxel indices there would pass {MAX_INDEX}",
         )
     return np.ascontiguousarray(grid[mesh.faces])
 
