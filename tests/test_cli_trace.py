@@ -479,7 +479,7 @@ def test_a_march_step_too_fine_names_the_flag(tmp_path, scene_file, capsys):
     command = ["trace", "--scene", str(scene_file), "--rays", str(rays), "--out", str(out)]
     assert main([*command, "--method", "march", "--step", "1e-7", "--voxel-size", "0.25"]) == 2
     err = capsys.readouterr().err.strip()
-    assert err == "ladartui: error: --step = 1e-07: expected a number of voxels from 0.001"
+    assert err == "ladartui: error: --step = 1e-07: expected a number from 0.001 to 10"
     assert not out.exists()
 
 
@@ -608,3 +608,17 @@ def test_ctrl_c_or_sigterm_says_what_was_written(tmp_path, scene_file, capsys, m
     assert main(command) == 130
     assert capsys.readouterr().err == f"ladartui: interrupted after the trace; it wrote {out}\n"
     assert np.load(out).shape == (3, 5)
+
+
+@pytest.mark.parametrize("step", ["inf", "11", "0"])
+def test_a_march_step_is_held_to_the_limits_run_holds_it_to(tmp_path, scene_file, capsys, step):
+    """trace took --step 50 where run refuses past 10, and said 'from 0.001' of inf."""
+    rays = _three_rays(tmp_path)
+    out = tmp_path / "hits.npy"
+    command = ["trace", "--scene", str(scene_file), "--rays", str(rays), "--out", str(out)]
+    assert main([*command, "--method", "march", "--step", step]) == 2
+    assert (
+        one_error_line(capsys)
+        == f"ladartui: error: --step = {float(step)!r}: expected a number from 0.001 to 10"
+    )
+    assert not out.exists()

@@ -142,6 +142,12 @@ def run(args):
             f"--step {args.step:g} sets the march's step, and this trace is --method {args.method}: "
             "add --method march, or drop --step"
         )
+    if args.step is not None:
+        from ladartui.checks import number_field
+        from ladartui.scenario import MAX_STEP
+        from ladartui.tracing.config import MIN_STEP
+
+        number_field("--step", args.step, MIN_STEP, MAX_STEP)  # the limits run holds a step to
     from ladartui.outputset import check_writable
 
     out = Path(args.out)
