@@ -249,7 +249,7 @@ def test_a_placement_off_the_grid_is_blamed_on_at_not_the_mesh(tmp_path, capsys)
         ("cube", ["--scale", "1e308", "--at", "5,5"], "{mesh}: the mesh spans 1e+308 x 1e+308 x 1e+308 m"),
         ("cube", ["--scale", "1e300", "--at", "5,5", "--heading", "30"], "{mesh}: the mesh spans 1e+300"),
         ("huge", ["--at", "5,5"], "{mesh}: the mesh spans "),
-        ("huge", ["--scale", "2"], "{mesh}: at --scale 2 its vertices pass the largest number"),
+        ("huge", ["--scale", "2"], "{mesh}: scaled by 2 its vertices pass the largest number"),
         ("cube", ["--at", "1e308,5"], "--at = '1e308,5': expected a position within the scene's grid"),
         ("cube", ["--at", "5,-1e308"], "--at = '5,-1e308': expected a position within the scene's grid"),
     ],

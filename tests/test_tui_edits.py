@@ -542,6 +542,8 @@ async def test_earlier_outputs_are_shown_from_one_stat_of_each_file(tmp_path, sc
 
     scenario = make_scenario(tmp_path, scene_files)
     simulate(scenario)
+    # (the app's own look every 2 s would add a stat whenever a tick fell in the waits)
+    monkeypatch.setattr("ladartui.tui.app.OUTPUTS_CHECK_SECONDS", 3600.0)
     stats = count_output_stats(monkeypatch, scenario)
     app = LadarApp(scenario.path)
     async with app.run_test(size=SIZE) as pilot:

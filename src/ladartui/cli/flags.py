@@ -4,7 +4,9 @@ The core names a field as the scenario file does (``simulation.backend``,
 ``detection.n_ref``, ``at``); a command that passed a flag's value on says
 ``--backend``, ``--n-ref``, ``--at`` instead, with the value as typed; a
 positional argument is named as its usage line names it (``PRESET``).
-``run_count`` bounds the timed runs and warm-up calls of bench and study.
+``run_count`` bounds the timed runs and warm-up calls of bench and study;
+``voxel_size_flag`` holds a ``--voxel-size`` to what a scenario takes;
+``check_file_names`` refuses empty file names.
 """
 
 from __future__ import annotations

@@ -136,7 +136,7 @@ def _run_with_progress(console, inputs, settings, runs, warmup):
     scene = inputs.scene
     console.print(
         f"study on {inputs.name}: {len(scene.voxels):,} voxels, shape {scene.shape}, "
-        f"{len(inputs.poses)} scans, sensor {inputs.sensor.grid}x{inputs.sensor.grid}, "
+        f"{plural(len(inputs.poses), 'scan')}, sensor {inputs.sensor.grid}x{inputs.sensor.grid}, "
         f"{len(settings)} settings, median of {plural(runs, 'run')}"
     )
     cancel = threading.Event()

@@ -138,7 +138,7 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
         vertices = vertices * scale
     if not np.all(np.isfinite(vertices)):
         raise InputFileError(
-            path, f"at --scale {scale:g} its vertices pass the largest number (about 1.8e308 m)"
+            path, f"scaled by {scale:g} its vertices pass the largest number (about 1.8e308 m)"
         )
     if up == "y":
         vertices = np.column_stack([vertices[:, 0], -vertices[:, 2], vertices[:, 1]])
@@ -352,11 +352,7 @@ def grid_triangles(mesh: Mesh, voxel_size: float, placement: Placement | None = 
         if placement.z < 0:
             raise FieldError("at", placement.z, "a height of 0 m or more above the ground (z)")
         if max(abs(placement.x), abs(placement.y), placement.z) / vs >= MAX_INDEX - 1:
-            raise FieldError(
-                "at",
-                f"{placement.x:g},{placement.y:g},{placement.z:g}",
-                f"a position within the scene's grid: voxel indices there would pass {MAX_INDEX}",
-            )
+            raise _past_the_grid(placement)
         centre = np.array([low[0] + sides[0] / 2, low[1] + sides[1] / 2, low[2]])
         local = vertices - centre
         cos, sin = _turn(placement.heading)
@@ -384,12 +380,17 @@ def grid_triangles(mesh: Mesh, voxel_size: float, placement: Placement | None = 
                     f"edge at {name} = {-0.5 * vs:g} m (voxel indices start at 0); move it {way}",
                 )
     if placement is not None and grid.max() > MAX_INDEX - 1:  # the mesh fits; where it goes does not
-        raise FieldError(
-            "at",
-            f"{placement.x:g},{placement.y:g},{placement.z:g}",
-            f"a position within the scene's grid: voxel indices there would pass {MAX_INDEX}",
-        )
+        raise _past_the_grid(placement)
     return np.ascontiguousarray(grid[mesh.faces])
+
+
+def _past_the_grid(placement) -> FieldError:
+    """The refusal of a placement whose voxel indices would pass MAX_INDEX."""
+    return FieldError(
+        "at",
+        f"{placement.x:g},{placement.y:g},{placement.z:g}",
+        f"a position within the scene's grid: voxel indices there would pass {MAX_INDEX}",
+    )
 
 
 # Grid coordinates within this much of a voxel of a voxel boundary or centre (a

@@ -86,6 +86,7 @@ class FileActions(Host):
             history.reset(saved)  # undo must not bring back the old file name
             self.result = None
             self.output_voxels = None  # the outputs of the old name are not this file's
+            self.disk_outputs = (None, None)
             self.outputs_from = None
             self.show_output()
             self.show_measures(None)

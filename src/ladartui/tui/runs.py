@@ -60,6 +60,7 @@ class RunControl(Host):
         self.set_busy(text + " (Esc cancels)", fraction)
         if live is not None:
             self.output_voxels = live
+            self.disk_outputs = (None, None)  # (not kept alive beside the run's)
             self.show_output(limit=LIVE_POINTS)
 
     def action_cancel_run(self) -> None:
@@ -87,6 +88,7 @@ class RunControl(Host):
         self.outputs_from = self.scenario  # (not editable while the run went on)
         self.note_outputs_seen()  # this run's own: not another's
         self.output_voxels = result.scene_output
+        self.disk_outputs = (None, None)
         self.show_output()
         self.show_measures(result.measures)
         total = result.timings.get("total") if isinstance(result.timings, dict) else None
