@@ -1,4 +1,4 @@
-"""``ladartui trace`` and ``ladartui bench --quick`` from the command line."""
+"""``ladartui trace`` from the command line: its outputs, flags and messages."""
 
 import numpy as np
 import pytest
