@@ -4,6 +4,8 @@ import errno
 import os
 from pathlib import Path
 
+from ladartui.errors import InputFileError
+
 SPECIAL_FILE = "is not a regular file (a pipe or device)"
 
 
@@ -28,3 +30,10 @@ def _name_max(path: Path) -> int:
         return os.pathconf(Path(path).anchor or ".", "PC_NAME_MAX")
     except (OSError, ValueError):
         return 255
+
+
+def refuse_special_file(path, expected: str) -> None:
+    """``InputFileError`` "PATH: is not a regular file (a pipe or device); ``expected``"
+    for a pipe or device: opening a pipe waits for a writer, so check before opening."""
+    if file_problem(Path(path)) == SPECIAL_FILE:
+        raise InputFileError(path, f"{SPECIAL_FILE}; {expected}")

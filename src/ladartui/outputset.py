@@ -23,6 +23,7 @@ from pathlib import Path
 from typing import Any
 
 from ladartui.errors import OutputFileError, check_cancelled
+from ladartui.fileprobe import SPECIAL_FILE
 
 # Called with a step name ("temporaries", "swap", "backups") at each stage of the
 # write; None in use. Tests set it to pause a run there and kill it.
@@ -69,6 +70,8 @@ def output_problem(path) -> str | None:
     try:
         if path.is_dir():
             return "is a folder, expected a file name"
+        if path.exists() and not path.is_file():  # a pipe would be replaced, a device written over
+            return f"{SPECIAL_FILE}, expected a file name"
         problem = name_problem(path)
         if problem:
             return problem

@@ -23,7 +23,7 @@ from ladartui.atomic import write_text_atomic
 from ladartui.checks import choice_field, number_field
 from ladartui.detection.settings import DetectionSettings
 from ladartui.errors import FieldError, InputFileError, LadarError, OutputFileError
-from ladartui.fileprobe import SPECIAL_FILE, file_problem
+from ladartui.fileprobe import file_problem, refuse_special_file
 from ladartui.flight import (
     FlightPlan,
     ScanPose,
@@ -409,8 +409,7 @@ def load_scenario(path, check_files=True) -> Scenario:
     A flight log is read either way: its records are the flight's poses, which the
     scenario's checks (scan count, work limit) need."""
     path = _absolute(path)
-    if file_problem(path) == SPECIAL_FILE:  # reading a pipe would wait for ever
-        raise InputFileError(path, f"{SPECIAL_FILE}; expected a scenario file (.toml)")
+    refuse_special_file(path, "expected a scenario file (.toml)")  # a pipe would wait for ever
     try:
         text = path.read_text(encoding="utf-8-sig")
     except FileNotFoundError:

@@ -421,6 +421,8 @@ def resolve_path(folder: Path, file) -> Path:
 
 def is_record(path) -> bool:
     """Whether ``path`` is a run record (by its first line)."""
+    if not Path(path).is_file():  # a pipe would wait for ever
+        return False
     try:
         with open(path, encoding="utf-8-sig") as file:
             return file.readline().startswith(RECORD_HEADER)

@@ -12,6 +12,8 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
+from ladartui.fileprobe import SPECIAL_FILE, file_problem
+
 _HEADER = re.compile(r"^\s*(\[\[?)\s*([A-Za-z0-9_.\-]+)\s*\]\]?")
 _KEY = re.compile(r"""^\s*(?:([A-Za-z0-9_\-]+)|"([^"\\]*)"|'([^']*)')\s*=""")  # bare or quoted
 
@@ -86,6 +88,8 @@ def read_config_table(path: Path, name: str, what: str) -> ConfigTable:
     def failed(problem: str) -> ConfigTable:
         return ConfigTable({}, [one_line(f"{path}: {problem}")], {}, path)
 
+    if file_problem(path) == SPECIAL_FILE:  # a pipe would wait for ever
+        return failed(SPECIAL_FILE)
     try:
         text = path.read_text(encoding="utf-8-sig")
     except FileNotFoundError:

@@ -26,6 +26,7 @@ import numpy as np
 
 from ladartui.checks import MAX_COORDINATE
 from ladartui.errors import FieldError, LadarError
+from ladartui.fileprobe import file_problem, refuse_special_file
 from ladartui.flight import ScanPose
 
 REQUIRED = ("time", "x", "y", "z", "heading")
@@ -81,6 +82,7 @@ class FlightLog:
 def load_flight_log(path, origin=None) -> FlightLog:
     """The log at ``path``; ``origin`` (lat, lon, alt) places a geodetic log in the scene."""
     path = Path(path)
+    refuse_special_file(path, "expected a flight log (CSV)")
     try:
         text = path.read_text(encoding="utf-8-sig")
     except (OSError, UnicodeDecodeError) as error:
@@ -229,8 +231,6 @@ class LogSegment:
         if not isinstance(self.file, (str, Path)) or not str(self.file).strip():
             raise FieldError("file", self.file, "the flight log's file name (.csv)")
         set_("file", str(self.file))
-        from ladartui.fileprobe import file_problem
-
         problem = file_problem(Path(self.file))
         if problem:  # named on the segment's file line, not as the log's own error
             raise FieldError(

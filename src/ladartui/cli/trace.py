@@ -15,6 +15,7 @@ import numpy as np
 
 from ladartui.atomic import atomic_path
 from ladartui.errors import Cancelled, FieldError, InputFileError, LadarError, ResourceLimitError
+from ladartui.fileprobe import refuse_special_file
 from ladartui.number_text import plural
 from ladartui.textsafe import visible
 from ladartui.tracing.backend import METHODS, PRECISIONS
@@ -66,6 +67,7 @@ def check_rays_header(path) -> None:
 
     from ladartui.resources import available_memory, check_rays, gib
 
+    refuse_special_file(path, "expected a NumPy .npy array")
     try:
         with open(path, "rb") as handle:
             start = handle.read(len(npy.MAGIC_PREFIX) + 2)

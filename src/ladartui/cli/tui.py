@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ladartui.errors import InputFileError
+from ladartui.fileprobe import refuse_special_file
 from ladartui.tui.graphics import MODES  # no textual: the mode is chosen before the app loads
 
 
@@ -37,6 +38,8 @@ def run(args) -> int:
         from ladartui.user_data import bundled_or_path
 
         path = bundled_or_path(path)  # "convoy": the bundled scenario, made on first use
+    if path is not None:
+        refuse_special_file(path, "expected a scenario file (.toml)")
     if path is not None and not path.is_file():
         raise InputFileError(path, "scenario file not found")
     from ladartui.tui import run_app

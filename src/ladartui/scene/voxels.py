@@ -24,6 +24,7 @@ import numpy as np
 
 from ladartui.atomic import atomic_path
 from ladartui.errors import InputFileError
+from ladartui.fileprobe import refuse_special_file
 
 log = logging.getLogger(__name__)
 
@@ -350,6 +351,7 @@ def _blocks(path: Path):
 
 def _read_bytes(path: Path, limit: int | None = None) -> np.ndarray:
     """The file's bytes (the first ``limit`` with a limit), after the memory check."""
+    refuse_special_file(path, "expected a voxel-list file")
     try:
         _check_read_size(path)
         if limit is not None:

@@ -346,7 +346,9 @@ STUDY_JSON = "expected a study.json written by 'ladartui study'"
 def read_study(path) -> StudyResult:
     """A ``study.json`` written by a study (the CLI's or the terminal UI's), read back."""
     from ladartui.errors import InputFileError
+    from ladartui.fileprobe import refuse_special_file
 
+    refuse_special_file(path, STUDY_JSON)
     try:
         data = json.loads(Path(path).read_text(encoding="utf-8"))
         if not isinstance(data, dict):

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ladartui.errors import InputFileError
+from ladartui.fileprobe import SPECIAL_FILE
 from ladartui.sweep.spec import SweepSpec, bundled_name, spec_line
 
 if TYPE_CHECKING:
@@ -31,6 +32,8 @@ def base_scenario_path(spec: SweepSpec) -> Path:
         return bundled_scenario_path(bundled)
     if not spec.scenario_path.is_file():
         found = "is a folder" if spec.scenario_path.is_dir() else "does not exist"
+        if spec.scenario_path.exists() and not spec.scenario_path.is_dir():
+            found = SPECIAL_FILE
         raise InputFileError(
             spec.path,
             f"sweep.scenario: expected an existing scenario file; {str(spec.scenario_path)!r} {found}",

@@ -41,6 +41,8 @@ class FileTree(DirectoryTree):
 
 def opens_table(path: Path, table: str) -> bool:
     """Whether a line near the start of ``path`` opens TOML table ``table`` ("[files]")."""
+    if not path.is_file():  # a pipe would wait for ever
+        return False
     try:
         with open(path, encoding="utf-8-sig", errors="replace") as handle:
             head = handle.read(HEAD_BYTES)
