@@ -5,6 +5,7 @@ import re
 import numpy as np
 import pytest
 
+from cli_support import one_error_line
 from ladartui.cli import main
 from ladartui.scene.generate import generate_scene
 from ladartui.scene.voxels import load_voxels
@@ -152,6 +153,18 @@ def test_info_bad_file_is_one_line(tmp_path, capsys):
     assert err.count("\n") == 1
     assert main(["info"]) == 2
     assert "needs a FILE" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("name", ["truck.obj", "truck.STL", "truck.ply"])
+def test_info_on_a_mesh_says_what_it_takes_and_how_a_mesh_is_voxelised(tmp_path, capsys, name):
+    """An OBJ was read as a voxel list: "1 comma-separated values in 'v -1 -2.5 0'"."""
+    mesh = tmp_path / name
+    mesh.write_text("v -1 -2.5 0\nv 1 -2.5 0\nv 0 2.5 0\nf 1 2 3\n")
+    assert main(["info", str(mesh)]) == 2
+    assert one_error_line(capsys) == (
+        f"ladartui: error: {mesh}: a mesh ({mesh.suffix}); info takes a voxel list (.txt) or a "
+        "scenario (.toml): voxelise the mesh first with 'ladartui voxelize MESH OUT --voxel-size V'"
+    )
 
 
 def test_info_scenario_summary(tmp_path, capsys):

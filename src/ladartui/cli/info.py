@@ -49,8 +49,23 @@ def run(args) -> int:
                 )
             print_scenario(path)
         else:
+            refuse_mesh(path)
             print_voxel_list(path, args.voxel_size)
     return 0
+
+
+def refuse_mesh(path: Path) -> None:
+    """A mesh would be read as a voxel list and fail on its first line: say what to do."""
+    from ladartui.scene.voxelize import MESH_SUFFIXES
+
+    if path.suffix.lower() in MESH_SUFFIXES:
+        from ladartui.errors import InputFileError
+
+        raise InputFileError(
+            path,
+            f"a mesh ({path.suffix}); info takes a voxel list (.txt) or a scenario (.toml): "
+            "voxelise the mesh first with 'ladartui voxelize MESH OUT --voxel-size V'",
+        )
 
 
 def print_scenario(path: Path) -> None:
