@@ -429,6 +429,37 @@ def test_a_json_that_is_no_study_names_what_it_lacks(tmp_path):
     assert "not UTF-8" in str(pytest.raises(LadarError, read_study, tmp_path / "latin.json").value)
 
 
+@pytest.mark.parametrize(
+    ("command", "missing"),
+    [
+        ("study --chart-from {d}/nope.json --out {d}/out", "nope.json"),
+        ("validate {d}/nope.toml", "nope.toml"),
+        ("run {d}/nope.toml", "nope.toml"),
+        ("tui {d}/nope.toml", "nope.toml"),
+        ("sweep {d}/nope.toml", "nope.toml"),
+        ("info {d}/nope.txt", "nope.txt"),
+        ("trace --scene {d}/s.txt --rays {d}/nope.npy --out {d}/h.npy", "nope.npy"),
+        ("voxelize {d}/nope.obj {d}/v.txt --voxel-size 1", "nope.obj"),
+    ],
+)
+def test_a_missing_input_file_says_no_such_file_in_every_command(tmp_path, capsys, command, missing):
+    """study said "cannot read it (No such file or directory)", scenarios "scenario file not
+    found", sweep "no such sweep spec", trace --rays "no such file" with nothing expected."""
+    (tmp_path / "s.txt").write_text("0,0,0\n")
+    assert main(command.format(d=tmp_path).split()) == 2
+    assert one_error_line(capsys).startswith(
+        f"ladartui: error: {tmp_path / missing}: no such file; expected "
+    )
+
+
+def test_a_folder_given_as_a_study_json_is_named_a_folder(tmp_path, capsys):
+    """It said "cannot read it (Is a directory)"."""
+    assert main(["study", "--chart-from", str(tmp_path), "--out", str(tmp_path / "out")]) == 2
+    assert one_error_line(capsys) == (
+        f"ladartui: error: {tmp_path}: is a folder; expected a study.json written by 'ladartui study'"
+    )
+
+
 def test_validate_notes_an_empty_or_misplaced_target_model(tmp_path, capsys):
     from ladartui.resources import gib
 

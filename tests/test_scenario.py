@@ -204,7 +204,7 @@ def test_missing_target_model_is_named(tmp_path):
 def test_missing_scenario_file(tmp_path):
     with pytest.raises(InputFileError) as caught:
         load_scenario(tmp_path / "nope.toml")
-    assert str(caught.value) == f"{tmp_path / 'nope.toml'}: scenario file not found"
+    assert str(caught.value) == f"{tmp_path / 'nope.toml'}: no such file; expected a scenario file (.toml)"
 
 
 # -- field limits ----------------------------------------------------------------------

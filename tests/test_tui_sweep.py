@@ -279,7 +279,10 @@ async def test_a_missing_spec_gives_one_line_and_starts_nothing(tmp_path):
         await pilot.press("f5")
         await pilot.pause()
         assert status_of(screen).state == NOT_READY
-        assert str(missing) in screen.last_message and "no such sweep spec" in screen.last_message
+        assert (
+            str(missing) in screen.last_message
+            and "no such file; expected a sweep spec" in screen.last_message
+        )
         assert not screen.running and not list(screen.workers)
         assert not (tmp_path / "nowhere-results").exists()
 

@@ -7,6 +7,7 @@ from pathlib import Path
 from ladartui.errors import InputFileError
 
 SPECIAL_FILE = "is not a regular file (a pipe or device)"
+NO_SUCH_FILE = "no such file"  # an input file that is missing, in every reader's words
 
 
 def file_problem(path: Path) -> str | None:

@@ -23,7 +23,7 @@ from ladartui.atomic import write_text_atomic
 from ladartui.checks import choice_field, number_field
 from ladartui.detection.settings import DetectionSettings
 from ladartui.errors import FieldError, InputFileError, LadarError, OutputFileError
-from ladartui.fileprobe import file_problem, refuse_special_file
+from ladartui.fileprobe import NO_SUCH_FILE, file_problem, refuse_special_file
 from ladartui.flight import (
     FlightPlan,
     ScanPose,
@@ -413,7 +413,7 @@ def load_scenario(path, check_files=True) -> Scenario:
     try:
         text = path.read_text(encoding="utf-8-sig")
     except FileNotFoundError:
-        raise InputFileError(path, "scenario file not found") from None
+        raise InputFileError(path, f"{NO_SUCH_FILE}; expected a scenario file (.toml)") from None
     except IsADirectoryError:
         raise InputFileError(path, "is a folder; expected a scenario file (.toml)") from None
     except UnicodeDecodeError:

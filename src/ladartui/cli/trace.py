@@ -15,7 +15,7 @@ import numpy as np
 
 from ladartui.atomic import atomic_path
 from ladartui.errors import Cancelled, FieldError, InputFileError, LadarError, ResourceLimitError
-from ladartui.fileprobe import refuse_special_file
+from ladartui.fileprobe import NO_SUCH_FILE, refuse_special_file
 from ladartui.number_text import plural
 from ladartui.textsafe import visible
 from ladartui.tracing.backend import METHODS, PRECISIONS
@@ -82,7 +82,7 @@ def check_rays_header(path) -> None:
             read = npy.read_array_header_1_0 if version == (1, 0) else npy.read_array_header_2_0
             shape, _, dtype = read(handle)
     except FileNotFoundError:
-        raise InputFileError(path, "no such file") from None
+        raise InputFileError(path, f"{NO_SUCH_FILE}; expected a NumPy .npy array") from None
     except OSError as error:
         raise InputFileError(path, f"cannot be read ({error.strerror or error})") from None
     except ValueError as error:

@@ -43,7 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.errors import FieldError, InputFileError, ResourceLimitError, check_cancelled
-from ladartui.fileprobe import refuse_special_file
+from ladartui.fileprobe import NO_SUCH_FILE, refuse_special_file
 from ladartui.scene.voxels import MAX_INDEX
 from ladartui.textsafe import one_line
 
@@ -103,7 +103,7 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
         raise InputFileError(path, f"unsupported mesh type {path.suffix!r}; expected .obj, .stl or .ply")
     refuse_special_file(path, f"expected a mesh file ({kind})")
     if not path.is_file():
-        raise InputFileError(path, f"no such file; expected a mesh file ({kind})")
+        raise InputFileError(path, f"{NO_SUCH_FILE}; expected a mesh file ({kind})")
     source, resolver = _mesh_source(path, kind)
     import trimesh
 

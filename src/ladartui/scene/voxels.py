@@ -24,7 +24,7 @@ import numpy as np
 
 from ladartui.atomic import atomic_path
 from ladartui.errors import InputFileError
-from ladartui.fileprobe import refuse_special_file
+from ladartui.fileprobe import NO_SUCH_FILE, refuse_special_file
 
 log = logging.getLogger(__name__)
 
@@ -359,7 +359,7 @@ def _read_bytes(path: Path, limit: int | None = None) -> np.ndarray:
                 return np.frombuffer(handle.read(limit), dtype=np.uint8)
         return np.fromfile(path, dtype=np.uint8)
     except FileNotFoundError:
-        raise InputFileError(path, f"no such file; {EXPECTED} per line") from None
+        raise InputFileError(path, f"{NO_SUCH_FILE}; {EXPECTED} per line") from None
     except IsADirectoryError:
         raise InputFileError(path, "is a folder; expected a voxel-list file") from None
     except PermissionError:

@@ -346,7 +346,7 @@ STUDY_JSON = "expected a study.json written by 'ladartui study'"
 def read_study(path) -> StudyResult:
     """A ``study.json`` written by a study (the CLI's or the terminal UI's), read back."""
     from ladartui.errors import InputFileError
-    from ladartui.fileprobe import refuse_special_file
+    from ladartui.fileprobe import NO_SUCH_FILE, refuse_special_file
 
     refuse_special_file(path, STUDY_JSON)
     try:
@@ -354,8 +354,12 @@ def read_study(path) -> StudyResult:
         if not isinstance(data, dict):
             raise InputFileError(path, f"a JSON {type(data).__name__}, not an object; {STUDY_JSON}")
         return StudyResult.from_dict(data)
+    except FileNotFoundError:
+        raise InputFileError(path, f"{NO_SUCH_FILE}; {STUDY_JSON}") from None
+    except IsADirectoryError:
+        raise InputFileError(path, f"is a folder; {STUDY_JSON}") from None
     except OSError as error:
-        raise InputFileError(path, f"cannot read it ({error.strerror})") from None
+        raise InputFileError(path, f"cannot be read ({error.strerror or error})") from None
     except UnicodeDecodeError:
         raise InputFileError(path, f"not UTF-8 text; {STUDY_JSON}") from None
     except json.JSONDecodeError as error:

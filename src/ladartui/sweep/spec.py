@@ -41,7 +41,7 @@ from typing import NoReturn
 import numpy as np
 
 from ladartui.errors import InputFileError
-from ladartui.fileprobe import refuse_special_file
+from ladartui.fileprobe import NO_SUCH_FILE, refuse_special_file
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.sweep.variant import applicable
 from ladartui.user_data import bundled_scenario_name
@@ -215,7 +215,7 @@ def load_sweep_spec(path) -> SweepSpec:
         text = path.read_text(encoding="utf-8-sig")
         data = tomllib.loads(text)
     except FileNotFoundError:
-        raise InputFileError(path, "no such sweep spec") from None
+        raise InputFileError(path, f"{NO_SUCH_FILE}; expected a sweep spec (.toml)") from None
     except RecursionError:
         raise InputFileError(path, "not valid TOML: arrays or tables nested too deep to read") from None
     except (OSError, UnicodeDecodeError) as error:
