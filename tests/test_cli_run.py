@@ -98,7 +98,7 @@ def test_ctrl_c_cancels_and_keeps_earlier_outputs(scenario, capsys, monkeypatch)
 def test_bad_input_is_one_line(tmp_path, capsys):
     assert main(["run", str(tmp_path / "missing.toml")]) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "missing.toml" in err and "not found" in err
+    assert len(err.splitlines()) == 1 and "missing.toml" in err and "no such file" in err
 
 
 def test_bad_backend_is_one_line(scenario, capsys):
