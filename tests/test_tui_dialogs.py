@@ -559,3 +559,18 @@ def test_the_png_and_compare_dialogs_name_what_is_wrong(tmp_path):
     with pytest.raises(InputFileError) as caught:
         bridge.read_measures_files([tmp_path / "gone.cmf"])
     assert str(caught.value) == f"{tmp_path / 'gone.cmf'}: measures file not found"
+    import os
+
+    os.mkfifo(tmp_path / "pipe.cmf")  # it exists: not 'not found'
+    with pytest.raises(InputFileError) as caught:
+        bridge.read_measures_files([tmp_path / "pipe.cmf"])
+    assert (
+        str(caught.value)
+        == f"{tmp_path / 'pipe.cmf'}: measures file is not a regular file (a pipe or device)"
+    )
+    with pytest.raises(InputFileError) as caught:
+        bridge.new_scenario(tmp_path / "new.toml", tmp_path / "pipe.cmf")
+    assert (
+        str(caught.value)
+        == f"{tmp_path / 'pipe.cmf'}: scene model file is not a regular file (a pipe or device)"
+    )

@@ -13,6 +13,7 @@ from pathlib import Path
 
 from ladartui.checks import compass_field, number_field
 from ladartui.errors import FieldError, InputFileError, LadarError
+from ladartui.fileprobe import file_problem
 from ladartui.flight import (
     SEGMENT_KINDS,
     FlightPlan,
@@ -333,8 +334,8 @@ def new_scenario(scenario_path: Path, scene_path: Path, voxel_size: float = 1.0)
             "scenario file", str(scenario_path), "a new file name (this one exists: load it instead)"
         )
     for path, what in ((scene_path, "scene model"), (target_file_for(scene_path), "target model")):
-        if not Path(path).is_file():
-            raise InputFileError(path, f"{what} file not found")
+        if problem := file_problem(Path(path)):  # (a pipe exists: it is not 'not found')
+            raise InputFileError(path, f"{what} file {problem}")
     scenario = Scenario.new(scenario_path, scene_path, voxel_size)
     return scenario.save()
 
@@ -367,8 +368,8 @@ def read_measures_files(paths) -> list:
     for path in paths:
         if Path(path).is_dir():
             raise InputFileError(path, "is a folder; expected a .cmf measures file")
-        if not Path(path).is_file():
-            raise InputFileError(path, "measures file not found")
+        if problem := file_problem(Path(path)):
+            raise InputFileError(path, f"measures file {problem}")
         out.append(read_cmf(path))
     return out
 
@@ -424,8 +425,10 @@ def export_outputs_las(scenario: Scenario, suffix: str = ".las", scene=None) -> 
 
     outputs = [scenario.scene_output, scenario.target_output]
     for path in outputs:
-        if not path.is_file():
+        if (problem := file_problem(path)) == "not found":
             raise InputFileError(path, "output not found: run the scenario first (F5)")
+        if problem:
+            raise InputFileError(path, f"output {problem}")
     clouds = [(path.with_suffix(suffix), load_voxels(path)) for path in outputs]
     for path, voxels in clouds:
         ids = None if scene is None else scene.target_ids_of(voxels)
