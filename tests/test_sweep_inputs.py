@@ -307,3 +307,31 @@ def test_the_cli_exits_non_zero_when_no_variant_finished(tmp_path, monkeypatch, 
     monkeypatch.setattr(simulation, "simulate", unavailable)
     assert main(["sweep", str(spec), "--serial"]) == 1
     assert "ladartui: no variant finished (2 failed)" in capsys.readouterr().err
+
+
+def test_the_tui_sweep_job_reads_and_hashes_the_base_once(tmp_path, monkeypatch):
+    """The TUI's sweep job hashed the base's models for its stored rows, then run_sweep
+    read, checked and hashed them again."""
+    from ladartui.sweep import base
+    from ladartui.tui.sweep_jobs import StoredRows, sweep_job
+
+    write_tiny_scenario(tmp_path)
+    spec = load_sweep_spec(write_spec(tmp_path, "[grid]\nscans = [2, 3]\n"))
+    from ladartui.sweep import execute
+
+    real_digest, digests = base.base_digest, []
+
+    def counted_digest(*args):
+        digests.append(1)
+        return real_digest(*args)
+
+    for module in (base, execute):  # wherever the name is imported
+        monkeypatch.setattr(module, "base_digest", counted_digest, raising=False)
+    reports = []
+    args = ("", None, True, "obscured-coverage", "flight-time", None, 5.0, None)
+    result = sweep_job(spec, *args, lambda fraction, text, report=None, keep=False: reports.append(report))
+    assert result.ran == 2 and len(digests) == 1
+    assert isinstance(reports[0], StoredRows) and reports[0].rows == []
+    digests.clear()
+    again = sweep_job(spec, *args, lambda fraction, text, report=None, keep=False: reports.append(report))
+    assert again.resumed == 2 and len(digests) == 1

@@ -8,6 +8,7 @@ base as it is now.
 
 from __future__ import annotations
 
+import functools
 import hashlib
 from dataclasses import dataclass
 from pathlib import Path
@@ -85,6 +86,12 @@ class CheckedBase:
     spec: SweepSpec
     path: Path
     scenario: Scenario
+
+    @functools.cached_property
+    def digest(self) -> str:
+        """``base_digest`` of the base: hashed once however many ask (the TUI's stored
+        rows, then the run)."""
+        return base_digest(self.path, self.scenario)
 
 
 def checked_base(spec: SweepSpec) -> CheckedBase:

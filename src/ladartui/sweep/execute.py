@@ -21,7 +21,7 @@ from pathlib import Path
 
 from ladartui.atomic import atomic_path
 from ladartui.errors import FieldError, InputFileError, LadarError, OutputFileError, check_cancelled
-from ladartui.sweep.base import CheckedBase, base_digest, checked_base, own_rows, spec_rows
+from ladartui.sweep.base import CheckedBase, checked_base, own_rows, spec_rows
 from ladartui.sweep.best_file import best_files, write_best_scenario
 from ladartui.sweep.cluster import close_client, local_client
 from ladartui.sweep.ranking import (
@@ -212,7 +212,7 @@ def run_sweep(
     with _exclusive(out):
         return _run_locked(
             spec,
-            checked.path,
+            checked.digest,
             base,
             scene,
             client,
@@ -253,7 +253,7 @@ def _exclusive(out: Path):
 
 def _run_locked(
     spec,
-    base_path,
+    digest,
     base,
     scene,
     client,
@@ -268,7 +268,6 @@ def _run_locked(
     simulate_options,
     started,
 ) -> SweepResult:
-    digest = base_digest(base_path, base)
     variants = spec.variants
     results_path = out / RESULTS_NAME
     table_rows, _ = read_table(results_path)

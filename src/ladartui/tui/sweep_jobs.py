@@ -67,11 +67,12 @@ def sweep_job(
     """The sweep job (worker thread): first the rows already stored (``StoredRows``),
     then every finished variant, each a kept progress report."""
     from ladartui.sweep import connect, default_out_dir, run_sweep
-    from ladartui.sweep.base import spec_rows
+    from ladartui.sweep.base import checked_base, own_rows
     from ladartui.sweep.table import read_table
 
+    checked = checked_base(spec)  # the base read and hashed once, for these rows and the run
     stored, _ = read_table(default_out_dir(spec) / "results.csv")
-    progress(0.0, "", StoredRows(spec_rows(stored, spec)), keep=True)
+    progress(0.0, "", StoredRows(own_rows(stored, spec.variants, checked.digest)), keep=True)
     client = None
     try:
         if scheduler:
@@ -79,6 +80,7 @@ def sweep_job(
             client = connect(scheduler, connect_timeout, security)
         return run_sweep(
             spec,
+            checked=checked,
             client=client,
             cancel=cancel,
             objective=objective,
