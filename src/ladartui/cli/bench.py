@@ -93,9 +93,7 @@ def run(args):
         run_count("--runs", args.runs)
     with _status() as say:
         if args.orbit:
-            runs = args.runs or (QUICK_ORBIT_RUNS if args.quick else ORBIT_RUNS)
-            grid = 64 if args.quick else 128
-            report = run_orbit_bench(runs=runs, backend="numba", progress=say, grid=grid)
+            report = run_orbit_bench(quick=args.quick, runs=args.runs, progress=say)
         else:
             report = run_bench(quick=args.quick, runs=args.runs, progress=say)
     if args.orbit:
@@ -139,10 +137,17 @@ ORBIT_SLANT_RANGE_M = 150.0
 ORBIT_DEPRESSION = 45.0
 
 
-def run_orbit_bench(runs=ORBIT_RUNS, backend="numba", progress=None, grid=128) -> dict:
+def bench_grid(quick: bool) -> int:
+    """Detectors a side of the bench's sensor: 64 with --quick, else 128."""
+    return 64 if quick else 128
+
+
+def run_orbit_bench(quick=False, runs=None, backend="numba", progress=None) -> dict:
     """Median seconds of a whole orbit simulation (both runs), after one warm-up run, with
-    a ``grid`` x ``grid`` sensor; ``progress(text)`` hears what it does."""
+    ``bench_grid(quick)`` detectors a side; ``progress(text)`` hears what it does."""
     say = progress or (lambda text: None)
+    runs = runs or (QUICK_ORBIT_RUNS if quick else ORBIT_RUNS)
+    grid = bench_grid(quick)
     from ladartui.flight import FlightPlan, Orbit
     from ladartui.scenario import Scenario
     from ladartui.sensor import Sensor
@@ -274,7 +279,7 @@ def run_bench(quick=False, runs=None, progress=None) -> dict:
     from ladartui.tracing.backend import backend_status, get_backend
 
     runs = runs or (QUICK_RUNS if quick else RUNS)
-    grid = 64 if quick else 128
+    grid = bench_grid(quick)
     scene, label = load_bench_scene(say)
     say("building the occupancy")
     started, cpu_started = time.perf_counter(), time.process_time()
