@@ -53,10 +53,10 @@ def voxel_size_flag(value: float, flag: str = "--voxel-size") -> float:
     return value
 
 
-def check_file_names(given: dict) -> None:
+def check_file_names(given: dict, expected: str = "a file name") -> None:
     """FieldError for the first of ``given`` (flag or argument as the usage line names
     it: value typed, None if not given) that is empty or blank: "" names no file, and
     as a Path it is the current folder."""
     for name, value in given.items():
         if value is not None and not value.strip():
-            raise FieldError(name, value, "a file name")
+            raise FieldError(name, value, expected)

@@ -8,7 +8,7 @@ import threading
 
 from rich.markup import escape
 
-from ladartui.cli.flags import MAX_RUNS, run_count
+from ladartui.cli.flags import MAX_RUNS, check_file_names, run_count
 from ladartui.cli.progress import progress_display, run_cancellable
 from ladartui.errors import Cancelled, FieldError
 from ladartui.textsafe import visible
@@ -90,8 +90,7 @@ def run(args: argparse.Namespace) -> int:
                 f"--chart-from redraws a study already run: {', '.join(given)} would shape a new one; drop "
                 + ("it" if len(given) == 1 else "them")
             )
-    if not args.out.strip():  # "" would be the current folder
-        raise FieldError("--out", args.out, f"a folder name, such as {DEFAULT_OUT}")
+    check_file_names({"--out": args.out}, f"a folder name, such as {DEFAULT_OUT}")
     check_writable_folder(args.out)  # before the study, not after it
     if args.chart_from:
         return _report(_load_result(args.chart_from), args.out)

@@ -20,6 +20,7 @@ from ladartui.tui.sweep_view import short_path
 from ladartui.tui.work import start_job
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
     from pathlib import Path
 
     from textual.worker import Worker
@@ -37,17 +38,7 @@ class SweepOpening(RankingView):
     running: bool
     opening: Worker | None  # the last open asked for
     _opens: int  # opens asked for: an answer to an earlier one is dropped
-
-    def _status(
-        self,
-        state: str,
-        message: str,
-        progress: float | None = None,
-        cancellable: bool = False,
-        problem: bool = False,
-    ) -> None:
-        """The screen's status bar (``SweepScreen._status``)."""
-        raise NotImplementedError
+    _status: Callable[..., None]  # the screen's status bar (SweepScreen._status)
 
     def _open(self, text: str) -> None:
         """Open a spec or results in a worker (``open_sweep`` reads the table and hashes
