@@ -33,6 +33,16 @@ def _name_max(path: Path) -> int:
         return 255
 
 
+def require_file(path, expected: str) -> None:
+    """``refuse_special_file``, and "PATH: no such file; ``expected``" for anything else
+    that is no regular file, from one look (for readers that ask before opening)."""
+    problem = file_problem(Path(path))
+    if problem == SPECIAL_FILE:
+        raise InputFileError(path, f"{SPECIAL_FILE}; {expected}")
+    if problem:
+        raise InputFileError(path, f"{NO_SUCH_FILE}; {expected}")
+
+
 def refuse_special_file(path, expected: str) -> None:
     """``InputFileError`` "PATH: is not a regular file (a pipe or device); ``expected``"
     for a pipe or device: opening a pipe waits for a writer, so check before opening."""

@@ -4,8 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ladartui.errors import InputFileError
-from ladartui.fileprobe import NO_SUCH_FILE, refuse_special_file
+from ladartui.fileprobe import require_file
 from ladartui.tui.graphics import MODES  # no textual: the mode is chosen before the app loads
 
 
@@ -39,9 +38,7 @@ def run(args) -> int:
 
         path = bundled_or_path(path)  # "convoy": the bundled scenario, made on first use
     if path is not None:
-        refuse_special_file(path, "expected a scenario file (.toml)")
-    if path is not None and not path.is_file():
-        raise InputFileError(path, f"{NO_SUCH_FILE}; expected a scenario file (.toml)")
+        require_file(path, "expected a scenario file (.toml)")
     from ladartui.tui import run_app
 
     return run_app(path, args.graphics)

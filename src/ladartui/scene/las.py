@@ -25,7 +25,7 @@ import numpy as np
 
 from ladartui.atomic import atomic_path
 from ladartui.errors import FieldError, InputFileError
-from ladartui.fileprobe import NO_SUCH_FILE, refuse_special_file
+from ladartui.fileprobe import require_file
 from ladartui.scene.voxels import MAX_INDEX, MAX_TARGET_ID, unique_voxels
 
 
@@ -118,9 +118,7 @@ def _voxel_indices(path, voxel_size, origin) -> tuple[np.ndarray, np.ndarray, np
 
     path = Path(path)
     size = _check_voxel_size(voxel_size)
-    refuse_special_file(path, "expected a LAS or LAZ point cloud")
-    if not path.is_file():
-        raise InputFileError(path, f"{NO_SUCH_FILE}; expected a LAS or LAZ point cloud")
+    require_file(path, "expected a LAS or LAZ point cloud")
     try:
         cloud = laspy.read(path)
     except Exception as error:  # laspy raises several kinds for a damaged or foreign file

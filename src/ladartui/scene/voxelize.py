@@ -43,7 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.errors import FieldError, InputFileError, ResourceLimitError, check_cancelled
-from ladartui.fileprobe import NO_SUCH_FILE, refuse_special_file
+from ladartui.fileprobe import require_file
 from ladartui.scene.voxels import MAX_INDEX
 from ladartui.textsafe import one_line
 
@@ -101,9 +101,7 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
         raise InputFileError(path, "is a folder; expected a mesh file (.obj, .stl or .ply)")
     if kind not in MESH_SUFFIXES:
         raise InputFileError(path, f"unsupported mesh type {path.suffix!r}; expected .obj, .stl or .ply")
-    refuse_special_file(path, f"expected a mesh file ({kind})")
-    if not path.is_file():
-        raise InputFileError(path, f"{NO_SUCH_FILE}; expected a mesh file ({kind})")
+    require_file(path, f"expected a mesh file ({kind})")
     source, resolver = _mesh_source(path, kind)
     import trimesh
 
