@@ -382,8 +382,72 @@ def test_merging_by_flags_and_by_sorting_give_the_same_sorted_union(monkeypatch)
     rng = np.random.default_rng(7)
     lists = [rng.integers(0, (30, 20, 10), (n, 3)).astype(np.int32) for n in (5000, 3000, 0)]
     flagged = generate._merge(lists)
+    monkeypatch.setattr(generate, "VOXEL_CHUNK", 333)  # flags set a chunk at a time
+    flagged_in_chunks = generate._merge(lists)
     monkeypatch.setattr(generate, "DENSE_MERGE", 0)  # always sort
     sorted_ = generate._merge(lists)
     expected = np.unique(np.concatenate(lists), axis=0)  # (rows sorted by x, then y, then z)
-    assert np.array_equal(flagged, expected) and np.array_equal(sorted_, expected)
+    for merged in (flagged, flagged_in_chunks, sorted_):
+        assert np.array_equal(merged, expected)
     assert len(expected) < 8000  # (repeats were there to drop)
+
+
+def test_a_cancel_during_the_clearing_stops_it_before_its_end(monkeypatch):
+    """Ctrl-C waited for the whole clearing stage (13 s for 30,000 trees): its plant
+    voxels are now clipped and carved a chunk at a time, each after a check, and
+    chunks of any size give the same scene."""
+    import threading
+
+    from ladartui.errors import Cancelled
+    from ladartui.scene import generate
+
+    whole = generate_scene("small", seed=3, trees=30, camouflage=True, vehicles=2)
+    monkeypatch.setattr(generate, "VOXEL_CHUNK", 997)  # many chunks, none aligned to a part
+    chunked = generate_scene("small", seed=3, trees=30, camouflage=True, vehicles=2)
+    assert np.array_equal(chunked.voxels, whole.voxels)
+    assert np.array_equal(chunked.target, whole.target)
+
+    cancel = threading.Event()
+    checks = []
+    real_inside = generate._inside_and_clear
+
+    def cancel_in_first_chunk(*args):
+        checks.append(1)
+        cancel.set()
+        return real_inside(*args)
+
+    monkeypatch.setattr(generate, "_inside_and_clear", cancel_in_first_chunk)
+    with pytest.raises(Cancelled):
+        generate_scene("small", seed=3, trees=30, vehicles=2, cancel=cancel)
+    assert len(checks) == 1  # the chunk after it was never cleared
+
+
+def test_a_cancel_during_the_merging_stops_it_before_its_end(monkeypatch):
+    """The merging stage (8 s for 100,000 trees) ran as one step: its flags are now set
+    a chunk of voxels at a time, each after the stage's cancel check."""
+    from ladartui.errors import Cancelled
+    from ladartui.scene import generate
+
+    monkeypatch.setattr(generate, "VOXEL_CHUNK", 1000)
+    rng = np.random.default_rng(9)
+    lists = [rng.integers(0, (30, 20, 10), (n, 3)).astype(np.int32) for n in (5000, 3000)]
+    keyed = []
+    real_keys = generate._merge_keys
+    monkeypatch.setattr(generate, "_merge_keys", lambda v, top: keyed.append(len(v)) or real_keys(v, top))
+
+    def cancel_after(checks):
+        def checkpoint():
+            checks.append(1)
+            if len(checks) > 1:
+                raise Cancelled("generating cancelled")
+
+        return checkpoint
+
+    with pytest.raises(Cancelled):
+        generate._merge(lists, cancel_after([]))
+    assert keyed == [1000]  # of 8,000 voxels in eight chunks, one was keyed
+    keyed.clear()
+    monkeypatch.setattr(generate, "DENSE_MERGE", 0)  # the sorting way: checked before its sort
+    with pytest.raises(Cancelled):
+        generate._merge(lists, cancel_after([None]))
+    assert keyed == [5000, 3000]

@@ -97,6 +97,61 @@ def test_column_tops_give_the_highest_brick_of_each_brick_column():
     assert np.array_equal(occ.columns, expected)
 
 
+def _layout_by_sorting(vox, lo, hi):
+    """The layout docs/architecture.md gives, built the plain way: every voxel's key
+    (root cell, region slot, tile slot, brick bit) made, sorted and counted."""
+    root_origin = (lo >> 9) << 9
+    root_dims = ((hi - 1) >> 9) - (lo >> 9) + 1
+    rel = vox.astype(np.int64) - root_origin
+    key = (rel[:, 0] >> 9) + root_dims[0] * ((rel[:, 1] >> 9) + root_dims[1] * (rel[:, 2] >> 9))
+    for shift in (6, 3, 0):
+        local = (
+            ((rel[:, 0] >> shift) & 7) | (((rel[:, 1] >> shift) & 7) << 3) | (((rel[:, 2] >> shift) & 7) << 6)
+        )
+        key = (key << 9) | local
+    key = np.unique(key)
+    nodes = {}
+    child_keys, child_of = np.unique(key >> 9, return_inverse=True)
+    bit = key & 511
+    bricks = np.zeros(len(child_keys) * 16, np.uint32)
+    np.bitwise_or.at(bricks, child_of * 16 + (bit >> 5), np.uint32(1) << (bit & 31).astype(np.uint32))
+    for level in ("tiles", "regions"):
+        parent_keys, parent_of = np.unique(child_keys >> 9, return_inverse=True)
+        slots = np.zeros(len(parent_keys) * 512, np.uint32)
+        slots[parent_of * 512 + (child_keys & 511)] = np.arange(1, len(child_keys) + 1)
+        nodes[level], child_keys = slots, parent_keys
+    root = np.zeros(int(np.prod(root_dims)), np.uint32)
+    root[child_keys] = np.arange(1, len(child_keys) + 1)
+    return {"root": root, "regions": nodes["regions"], "tiles": nodes["tiles"], "bricks": bricks}, len(key)
+
+
+@pytest.mark.parametrize("kind", ["dense", "scattered", "across root cells"])
+def test_the_hierarchy_is_the_documented_layout_of_the_sorted_voxel_keys(kind):
+    """The build sets each voxel's bit through its brick cell's number rather than
+    sorting every voxel's key: the arrays must be those the sorted keys give."""
+    rng = np.random.default_rng(21)
+    if kind == "dense":
+        vox = rng.integers(0, (90, 70, 40), size=(30_000, 3))
+    elif kind == "scattered":
+        vox = rng.integers(0, 40, size=(3_000, 3)) * np.array([37, 29, 11]) + 5
+    else:
+        vox = rng.integers(0, (1300, 1100, 600), size=(20_000, 3))
+    vox = np.concatenate([vox, vox[:700]])  # with duplicates
+    occ = Occupancy.build(vox.astype(np.int32))
+    lo, hi = vox.min(axis=0), vox.max(axis=0) + 1
+    expected, count = _layout_by_sorting(vox, lo, hi)
+    assert occ.count == count
+    for field, array in expected.items():
+        assert np.array_equal(getattr(occ, field), array), field
+    # a brick cell's empty-cube side is 0 exactly where a brick holds a voxel
+    cells = np.unique((vox >> 3) - occ.cube_origin, axis=0)
+    dims = occ.cube_dims
+    sides = occ.cubes.reshape(int(dims[2]), int(dims[1]), int(dims[0]), 4)
+    full = np.zeros(sides.shape[:3], bool)
+    full[cells[:, 2], cells[:, 1], cells[:, 0]] = True
+    assert np.array_equal((sides == 0).all(axis=3), full)
+
+
 @pytest.mark.parametrize("dtype", [np.int32, np.int64, np.uint16, np.int16])
 def test_the_same_voxels_in_any_integer_type_and_order_build_the_same_occupancy(dtype):
     rng = np.random.default_rng(8)
@@ -135,8 +190,8 @@ def test_the_memory_estimate_bounds_what_the_build_takes(kind):
 
 
 def test_build_holds_few_bytes_per_voxel_beyond_its_result():
-    """The build's temporaries stay near the sorted keys (8 bytes a voxel); the build
-    before holding a dozen per-voxel arrays took 125."""
+    """The build's temporaries are a few bytes a brick cell of the box, none a voxel; a
+    build holding a dozen per-voxel arrays took 125 bytes a voxel."""
     import tracemalloc
 
     rng = np.random.default_rng(11)

@@ -18,11 +18,11 @@ from ladartui.errors import ResourceLimitError
 # About two days of tracing on one core at ~10 M rays/s (a week of the 2.7e12 rays case
 # is far past it); a real study stays well under.
 DEFAULT_MAX_RAYS = 2 * 10**12 // 1000  # 2e9
-# Content-sized parts of the occupancy build: the sort key of each voxel, then per node
-# (at most one per voxel, at most one per cell of its level over the extent): a brick's
-# 16 words and block mask, a tile's or a region's 512 slots.
-_KEY_BYTES = 8
-_BRICK_BYTES = 16 * 4 + 8
+# Content-sized parts of the occupancy build, per node (at most one per voxel, at most
+# one per cell of its level over the extent): a brick's 16 words and block mask, and
+# the int64 temporaries that work out the bricks' keys, order and cells (92 bytes a
+# brick measured, 16 words allowed); a tile's or a region's 512 slots.
+_BRICK_BYTES = 16 * 4 + 8 + 16 * 8
 _NODE_BYTES = 512 * 4
 
 
@@ -89,7 +89,8 @@ def occupancy_bytes(lo, hi, count) -> int:
     cells4 = [int(b >> 2) - int(a >> 2) + 3 for a, b in zip(lo, last)]
     size = 4 * root[0] * root[1] * root[2]
     size += 4 * (root[0] * 64) * (root[1] * 64)  # column tops
-    size += 5 * cubes[0] * cubes[1] * cubes[2]  # empty cubes: the 0/1 grid and 4 octants
+    # the brick cells: a 0/1 grid (kept for the empty cubes' 4 octants) and a brick number each
+    size += (1 + 4 + 4) * cubes[0] * cubes[1] * cubes[2]
     # halos: a bool grid, its grown copy and a temporary of the growing, then the bits
     size += 3 * (cubes[0] + 2) * (cubes[1] + 2) * (cubes[2] + 2)  # brick halo
     size += 3 * cells4[0] * cells4[1] * cells4[2]  # 4-voxel halo
@@ -97,7 +98,7 @@ def occupancy_bytes(lo, hi, count) -> int:
     nodes = _BRICK_BYTES * min(count, _cells(lo, last, 3)) + _NODE_BYTES * (
         min(count, _cells(lo, last, 6)) + min(count, _cells(lo, last, 9))
     )
-    return int(size + _KEY_BYTES * count + nodes)
+    return int(size + nodes)
 
 
 def _cells(lo, last, shift) -> int:

@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.errors import FieldError, check_cancelled
+from ladartui.scene.occupancy import column_bounds
 from ladartui.scene.trees import branch_voxels, concat_voxels, foliage_voxels, place_trees, trunk_voxels
 
 
@@ -249,16 +250,13 @@ def generate_scene(preset="small", seed=0, progress=None, cancel=None, **overrid
     parts["foliage"] = foliage_voxels(trees, params, rng, between_steps)
     stage()
     for name in ("trunks", "branches", "foliage"):
-        between_steps()
-        parts[name] = _clip(parts[name], nx, ny)
-        for vehicle in vehicles:
-            parts[name] = _carve_clearance(parts[name], vehicle, vs)
+        parts[name] = _clear(parts[name], nx, ny, vehicles, vs, between_steps)
     if params.camouflage and vehicles:
         parts["net"] = _clip(_net_voxels(vehicles[0], params, ground, rng), nx, ny)
     stage()
     target, target_ids = _merge_labelled(vehicle_voxels)
     parts["vehicles"] = target
-    voxels = _merge(list(parts.values()))
+    voxels = _merge(list(parts.values()), between_steps)
 
     top = int(voxels[:, 2].max()) + 1 if len(voxels) else 1
     nz = max(top, round(params.height / vs) if params.height else 0)
@@ -478,22 +476,61 @@ def _vehicle_voxels(vehicle: _Vehicle, p: SceneParams, nx, ny) -> np.ndarray:
     return _clip(solid, nx, ny)
 
 
-def _carve_clearance(voxels, vehicle: _Vehicle, vs, margin=0.3, headroom=0.5):
-    """Drop plant voxels inside the box around a vehicle: it stands in a clearing."""
-    if not len(voxels):
-        return voxels
+# Voxels the clearing and merging stages take between cancel checks: a whole part at
+# once held Ctrl-C for the clearing's 13 s (30,000 trees, 67 million voxels).
+VOXEL_CHUNK = 1 << 20
+
+
+def _clear(voxels, nx, ny, vehicles, vs, checkpoint) -> np.ndarray:
+    """The plant voxels inside the grid's columns and outside every vehicle's clearing,
+    in their order, a chunk at a time with ``checkpoint()`` before each."""
+    voxels = np.asarray(voxels, dtype=np.int32).reshape(-1, 3)
+    kept = []
+    for first in range(0, len(voxels), VOXEL_CHUNK):
+        checkpoint()
+        chunk = voxels[first : first + VOXEL_CHUNK]
+        kept.append(_voxel_rows(chunk, _inside_and_clear(chunk, nx, ny, vehicles, vs)))
+    return concat_voxels(kept)
+
+
+def _voxel_rows(voxels, keep) -> np.ndarray:
+    """``voxels[keep]`` for a boolean ``keep``, each row taken as one 12-byte item: 5x
+    numpy's row-wise boolean indexing of an (N, 3) array (46 ms against 233 for 8
+    million rows)."""
+    rows = np.ascontiguousarray(voxels, dtype=np.int32).view("V12").ravel()
+    return rows[keep].view(np.int32).reshape(-1, 3)
+
+
+def _inside_and_clear(voxels, nx, ny, vehicles, vs) -> np.ndarray:
+    """Which voxels ``_clip`` keeps and no vehicle's clearing holds."""
+    keep = _inside(voxels, nx, ny)
+    for vehicle in vehicles:
+        keep[_in_clearing(voxels, vehicle, vs)] = False
+    return keep
+
+
+def _in_clearing(voxels, vehicle: _Vehicle, vs, margin=0.3, headroom=0.5) -> np.ndarray:
+    """Indices of the voxels inside the box around a vehicle: it stands in a clearing,
+    free of plants."""
     length, width, height = vehicle.size
     reach = (math.hypot(length, width) / 2 + margin) / vs + 1
-    near = np.nonzero(
-        (np.abs(voxels[:, 0] - vehicle.cx) <= reach)
-        & (np.abs(voxels[:, 1] - vehicle.cy) <= reach)
-        & (voxels[:, 2] <= vehicle.base + (height + headroom) / vs + 1)
-    )[0]
+    top = vehicle.base + (height + headroom) / vs + 1
+    # Candidates by whole-voxel bounds a voxel wider each way (integer compares, no
+    # float columns over millions of voxels); the tests in metres then decide.
+    x, y = voxels[:, 0], voxels[:, 1]
+    near = np.flatnonzero(
+        (x >= math.floor(vehicle.cx - reach) - 1)
+        & (x <= math.ceil(vehicle.cx + reach) + 1)
+        & (y >= math.floor(vehicle.cy - reach) - 1)
+        & (y <= math.ceil(vehicle.cy + reach) + 1)
+        & (voxels[:, 2] <= math.floor(top))  # (the same test for whole numbers)
+    )
+    near = near[
+        (np.abs(voxels[near, 0] - vehicle.cx) <= reach) & (np.abs(voxels[near, 1] - vehicle.cy) <= reach)
+    ]
     u, v, w = _local_frame(vehicle, voxels[near], vs)
     inside = (np.abs(u) <= length / 2 + margin) & (np.abs(v) <= width / 2 + margin) & (w <= height + headroom)
-    keep = np.ones(len(voxels), dtype=bool)
-    keep[near[inside]] = False
-    return voxels[keep]
+    return near[inside]
 
 
 def _net_voxels(vehicle: _Vehicle, p: SceneParams, ground, rng) -> np.ndarray:
@@ -530,15 +567,19 @@ def _net_voxels(vehicle: _Vehicle, p: SceneParams, ground, rng) -> np.ndarray:
 
 
 def _clip(voxels, nx, ny) -> np.ndarray:
+    """The voxels inside the grid's columns and above its floor."""
     voxels = np.asarray(voxels, dtype=np.int32).reshape(-1, 3)
-    inside = (
+    return _voxel_rows(voxels, _inside(voxels, nx, ny))
+
+
+def _inside(voxels, nx, ny) -> np.ndarray:
+    return (
         (voxels[:, 0] >= 0)
         & (voxels[:, 0] < nx)
         & (voxels[:, 1] >= 0)
         & (voxels[:, 1] < ny)
         & (voxels[:, 2] >= 0)
     )
-    return voxels[inside]
 
 
 def _merge_labelled(lists) -> tuple[np.ndarray, np.ndarray]:
@@ -560,26 +601,40 @@ def _merge_labelled(lists) -> tuple[np.ndarray, np.ndarray]:
 DENSE_MERGE = 8
 
 
-def _merge(lists) -> np.ndarray:
-    """Union of voxel lists, sorted by x, then y, then z."""
-    voxels = concat_voxels(lists)
-    if not len(voxels):
-        return voxels
-    top = voxels.max(axis=0).astype(np.int64) + 1
-    keys = (voxels[:, 0].astype(np.int64) * top[1] + voxels[:, 1]) * top[2] + voxels[:, 2]
-    cells = int(top[0] * top[1] * top[2])
-    if cells <= DENSE_MERGE * len(keys) and voxels.min() >= 0:
-        # The box is no larger than the list: a flag a cell (at most as many bytes as the
-        # keys), read back in order. Sorting took 9.3 s for the 67 million voxels of a
-        # 30,000-tree scene, 4.55 million cells.
+def _merge(lists, checkpoint=lambda: None) -> np.ndarray:
+    """Union of voxel lists, sorted by x, then y, then z; ``checkpoint()`` runs between
+    chunks of the work."""
+    pieces = [np.asarray(v, dtype=np.int32).reshape(-1, 3) for v in lists if len(v)]
+    if not pieces:
+        return np.zeros((0, 3), np.int32)
+    bounds = [column_bounds(piece) for piece in pieces]
+    least = np.min([lo for lo, _ in bounds], axis=0)
+    top = np.max([hi for _, hi in bounds], axis=0) + 1
+    cells = int(top[0]) * int(top[1]) * int(top[2])
+    if cells <= DENSE_MERGE * sum(map(len, pieces)) and least.min() >= 0:
+        # The box is no larger than the lists: a flag a cell (at most as many bytes as the
+        # keys), read back in order, set a chunk at a time (the lists are not joined
+        # first). Sorting took 9.3 s for the 67 million voxels of a 30,000-tree scene,
+        # 4.55 million cells.
         seen = np.zeros(cells, np.bool_)
-        seen[keys] = True
-        del keys
+        for piece in pieces:
+            for first in range(0, len(piece), VOXEL_CHUNK):
+                checkpoint()
+                seen[_merge_keys(piece[first : first + VOXEL_CHUNK], top)] = True
+        checkpoint()
         keys = np.flatnonzero(seen)
+        del seen
     else:
+        keys = np.concatenate([_merge_keys(piece, top) for piece in pieces])
+        checkpoint()
         keys.sort()  # np.unique's hashing is many times slower on millions of keys
         keys = keys[np.concatenate(([True], keys[1:] != keys[:-1]))]
     z = keys % top[2]
     y = (keys // top[2]) % top[1]
     x = keys // (top[1] * top[2])
     return np.stack([x, y, z], axis=1).astype(np.int32)
+
+
+def _merge_keys(voxels, top) -> np.ndarray:
+    """One int64 a voxel, ordered by x, then y, then z, inside a ``top`` box."""
+    return (voxels[:, 0].astype(np.int64) * top[1] + voxels[:, 1]) * top[2] + voxels[:, 2]

@@ -14,6 +14,7 @@ import numpy as np
 
 from ladartui.errors import FieldError, InputFileError, LadarError
 from ladartui.scene.keys import voxel_keys
+from ladartui.scene.occupancy import Occupancy, column_bounds
 from ladartui.scene.target_model import load_target
 from ladartui.scene.voxels import MAX_TARGET_ID, load_voxels
 
@@ -160,8 +161,6 @@ def top_height_map(voxels, nx, ny) -> np.ndarray:
 
 
 def _build_occupancy(voxels, shape, source):
-    from ladartui.scene.occupancy import Occupancy  # built by its own module
-
     return Occupancy.build(voxels, shape, source=str(source))
 
 
@@ -205,5 +204,5 @@ def _extent(*lists) -> tuple[int, int, int]:
     filled = [v for v in lists if len(v)]
     if not filled:
         return (0, 0, 0)
-    x, y, z = np.max([v.max(axis=0) for v in filled], axis=0)
+    x, y, z = np.max([column_bounds(v)[1] for v in filled], axis=0)
     return (int(x) + 1, int(y) + 1, int(z) + 1)

@@ -39,6 +39,15 @@ VOXEL_SHIFT, BRICK_SHIFT, TILE_SHIFT, REGION_SHIFT = 0, 3, 6, 9
 CUBE_CAP = 255  # largest stored empty-cube side (uint8)
 
 
+def column_bounds(voxels) -> tuple[np.ndarray, np.ndarray]:
+    """The least and greatest index of each axis of a non-empty (N, 3) integer voxel
+    list, as int64. Axis by axis: numpy's ``min(axis=0)`` over rows of three ran 13x
+    slower (94 ms against 7 for the 3.8 million voxels of the reference scene)."""
+    lo = np.array([voxels[:, a].min() for a in range(3)], np.int64)
+    hi = np.array([voxels[:, a].max() for a in range(3)], np.int64)
+    return lo, hi
+
+
 @dataclass(frozen=True, eq=False)
 class Occupancy:
     """Which voxels are occupied, as a sparse hierarchy sized to the content.
@@ -73,7 +82,7 @@ class Occupancy:
     def build(cls, voxels, shape=None, source="voxels") -> Occupancy:
         """Build from an (N, 3) integer voxel list (duplicates allowed) and the scene shape.
 
-        ``shape`` is (nx, ny, nz); by default ``voxels.max(axis=0) + 1``. Voxels
+        ``shape`` is (nx, ny, nz); by default the greatest index on each axis + 1. Voxels
         outside ``[0, shape)`` raise FieldError; a build whose extent-sized arrays
         would not fit in memory raises ResourceLimitError naming ``source``.
         """
@@ -86,22 +95,21 @@ class Occupancy:
             raise FieldError("voxels", f"dtype {vox.dtype}", "integer voxel indices")
         if vox.dtype not in (np.int32, np.int64):  # the kernels are compiled for these two
             vox = vox.astype(np.int64)
+        lo, last = column_bounds(vox) if len(vox) else (np.zeros(3, np.int64), np.full(3, -1, np.int64))
+        hi = last + 1
         if shape is None:
-            shape = tuple(int(v) + 1 for v in vox.max(axis=0)) if len(vox) else (0, 0, 0)
+            shape = tuple(int(v) for v in hi)
         shape = tuple(int(s) for s in shape)
         if len(shape) != 3 or min(shape) < 0:
             raise FieldError("shape", shape, "three non-negative integers (nx, ny, nz)")
-        if len(vox):
-            lo = vox.min(axis=0).astype(np.int64)
-            hi = vox.max(axis=0).astype(np.int64) + 1
-            if lo.min() < 0 or np.any(hi > np.array(shape)):
-                raise FieldError(
-                    "voxels",
-                    f"indices spanning {lo.tolist()}..{(hi - 1).tolist()}",
-                    f"indices inside the scene shape {list(shape)}",
-                )
-        else:
+        if not len(vox):
             return cls._empty(shape)
+        if lo.min() < 0 or np.any(hi > np.array(shape)):
+            raise FieldError(
+                "voxels",
+                f"indices spanning {lo.tolist()}..{last.tolist()}",
+                f"indices inside the scene shape {list(shape)}",
+            )
         from ladartui.resources import check_occupancy
 
         # Some arrays are sized by extent: refuse before allocating what cannot fit.
@@ -140,19 +148,29 @@ class Occupancy:
     def _from_nonempty(cls, vox, lo, hi, shape):
         root_origin = (lo >> REGION_SHIFT) << REGION_SHIFT
         root_dims = ((hi - 1) >> REGION_SHIFT) - (lo >> REGION_SHIFT) + 1
-        # One sort key ordering voxels root cell first, then region slot, tile slot,
-        # voxel bit: bricks of a tile and tiles of a region end up adjacent in memory.
-        # Per-voxel work runs in kernels over this one int64 array: the build's peak
-        # memory is the voxel list plus 8 bytes a voxel, not several per-voxel temporaries.
-        key = np.empty(len(vox), np.int64)
-        _voxel_keys(vox, root_origin.astype(np.int64), root_dims.astype(np.int64), key)
-        key.sort()
-        count = _compact_unique(key)  # drop duplicate voxels
-        n_bricks = _count_bricks(key, count)
+        cube_origin = lo >> BRICK_SHIFT
+        cube_dims = ((hi - 1) >> BRICK_SHIFT) - cube_origin + 1
+        # Bricks without sorting the voxels (a sort of 3.8 million keys was half the
+        # reference scene's build): the brick cells holding a voxel are marked, their
+        # keys (root cell, region slot, tile slot) sorted, one a brick, and each voxel's
+        # bit set through its cell's brick number. Bricks of a tile and tiles of a
+        # region end up adjacent in memory. Besides the voxels the build holds 5 bytes
+        # a brick cell of the box, as the empty cubes do, not bytes a voxel.
+        occupied = np.zeros((int(cube_dims[2]), int(cube_dims[1]), int(cube_dims[0])), np.bool_)
+        _mark_cells(vox, BRICK_SHIFT, cube_origin.astype(np.int64), occupied)
+        cells = np.flatnonzero(occupied)
+        bkeys = _brick_keys(cells, cube_dims, cube_origin - (root_origin >> BRICK_SHIFT), root_dims)
+        order = np.argsort(bkeys)
+        bkeys = bkeys[order]
+        n_bricks = len(bkeys)
+        brick_of_cell = np.empty(occupied.size, np.int32)  # read at occupied cells only
+        brick_of_cell[cells[order]] = np.arange(n_bricks, dtype=np.int32)
+        del cells, order
         bricks = np.zeros(n_bricks * BRICK_WORDS, np.uint32)
-        bkeys = np.empty(n_bricks, np.int64)  # one per brick, in brick order
-        _fill_bricks(key, count, bricks, bkeys)
-        del key
+        count = _set_voxel_bits(
+            vox, cube_origin.astype(np.int64), cube_dims.astype(np.int64), brick_of_cell, bricks
+        )
+        del brick_of_cell
 
         tiles, tkeys = _parents(bkeys, n_bricks)
         regions, rkeys = _parents(tkeys, len(tkeys))
@@ -160,9 +178,8 @@ class Occupancy:
         root[rkeys] = np.arange(1, len(rkeys) + 1, dtype=np.uint32)
         columns = _column_tops(bkeys, root_dims)
         brick_cells = _brick_cells(bkeys, root_dims) + (root_origin >> BRICK_SHIFT)
-        cube_origin = lo >> BRICK_SHIFT
-        cube_dims = ((hi - 1) >> BRICK_SHIFT) - cube_origin + 1
-        cubes = _empty_cubes(brick_cells - cube_origin, cube_dims)
+        cubes = _empty_cubes(occupied)
+        del occupied
         halo_origin, halo_dims = cube_origin - 1, cube_dims + 2
         halo = _halo_bits(brick_cells - halo_origin, halo_dims)
         halo4_origin = (lo >> 2) - 1
@@ -256,58 +273,35 @@ class Occupancy:
         }
 
 
+def _brick_keys(cells, cube_dims, root_offset, root_dims):
+    """The key of each brick cell (``cells``: indices ``x + dims.x * (y + dims.y * z)``
+    into a ``cube_dims`` box whose cell 0 is brick ``root_offset`` from the root
+    origin): root cell << 18 | region slot << 9 | tile slot, the order of bricks."""
+    dx, dy = int(cube_dims[0]), int(cube_dims[1])
+    q = [cells % dx + root_offset[0], cells // dx % dy + root_offset[1], cells // (dx * dy) + root_offset[2]]
+    key = (q[0] >> 6) + root_dims[0] * ((q[1] >> 6) + root_dims[1] * (q[2] >> 6))
+    for shift in (3, 0):
+        key = (key << 9) | ((q[0] >> shift) & 7) | (((q[1] >> shift) & 7) << 3) | (((q[2] >> shift) & 7) << 6)
+    return key
+
+
 @njit(nogil=True, cache=True)
-def _voxel_keys(vox, root_origin, root_dims, key):
-    # root cell << 27 | region slot << 18 | tile slot << 9 | brick bit, in one pass.
+def _set_voxel_bits(vox, cube_origin, cube_dims, brick_of_cell, bricks):
+    # Each voxel's bit (l = lx + 8 ly + 64 lz) in the brick of its cell; returns the
+    # number of distinct voxels (a bit already set is a duplicate).
+    count = 0
     for i in range(vox.shape[0]):
-        x = vox[i, 0] - root_origin[0]
-        y = vox[i, 1] - root_origin[1]
-        z = vox[i, 2] - root_origin[2]
-        k = (x >> 9) + root_dims[0] * ((y >> 9) + root_dims[1] * (z >> 9))
-        for shift in (6, 3, 0):
-            k = (k << 9) | ((x >> shift) & 7) | (((y >> shift) & 7) << 3) | (((z >> shift) & 7) << 6)
-        key[i] = k
-
-
-@njit(nogil=True, cache=True)
-def _compact_unique(sorted_keys):
-    # Distinct values to the front, in place; returns how many.
-    n = sorted_keys.shape[0]
-    if n == 0:
-        return 0
-    count = 1
-    for i in range(1, n):
-        if sorted_keys[i] != sorted_keys[count - 1]:
-            sorted_keys[count] = sorted_keys[i]
+        x, y, z = vox[i, 0], vox[i, 1], vox[i, 2]
+        cell = ((x >> 3) - cube_origin[0]) + cube_dims[0] * (
+            ((y >> 3) - cube_origin[1]) + cube_dims[1] * ((z >> 3) - cube_origin[2])
+        )
+        bit = (x & 7) | ((y & 7) << 3) | ((z & 7) << 6)
+        word = np.int64(brick_of_cell[cell]) * BRICK_WORDS + (bit >> 5)
+        mask = np.uint32(1) << np.uint32(bit & 31)
+        if not bricks[word] & mask:
+            bricks[word] |= mask
             count += 1
     return count
-
-
-@njit(nogil=True, cache=True)
-def _count_bricks(keys, count):
-    bricks = 0
-    previous = -1
-    for i in range(count):
-        b = keys[i] >> 9
-        if b != previous:
-            bricks += 1
-            previous = b
-    return bricks
-
-
-@njit(nogil=True, cache=True)
-def _fill_bricks(keys, count, bricks, brick_keys):
-    # Sorted distinct voxel keys: brick key = key >> 9, the voxel's bit = key & 511.
-    n = -1
-    previous = -1
-    for i in range(count):
-        b = keys[i] >> 9
-        if b != previous:
-            n += 1
-            brick_keys[n] = b
-            previous = b
-        bit = keys[i] & 511
-        bricks[n * BRICK_WORDS + (bit >> 5)] |= np.uint32(1) << np.uint32(bit & 31)
 
 
 @njit(nogil=True, cache=True)
@@ -365,9 +359,10 @@ def block_masks(bricks):
     return masks
 
 
-def _empty_cubes(cells, dims):
-    """Per downward octant and brick cell of a ``dims`` box, the side of the largest cube of
-    empty bricks having that cell as the corner facing away from the octant, capped at CUBE_CAP.
+def _empty_cubes(full):
+    """Per downward octant and brick cell of the box ``full`` covers ((z, y, x), true
+    at bricks holding a voxel), the side of the largest cube of empty bricks having
+    that cell as the corner facing away from the octant, capped at CUBE_CAP.
 
     uint8, octant ``o = (d_x <= 0) + 2 (d_y <= 0)`` for rays with ``d_z <= 0`` (sensor rays
     look down; climbing rays get no jumps, which halves the memory), indexed
@@ -376,11 +371,8 @@ def _empty_cubes(cells, dims):
     empty bricks until it leaves the ``k``-brick cube starting at that brick and reaching
     along its direction.
     """
-    dx, dy, dz = (int(v) for v in dims)
-    full = np.zeros((dz, dy, dx), np.uint8)
-    full[cells[:, 2], cells[:, 1], cells[:, 0]] = 1
-    out = np.zeros((dz, dy, dx, 4), np.uint8)
-    _fill_empty_cubes(full, CUBE_CAP, out)
+    out = np.zeros((*full.shape, 4), np.uint8)
+    _fill_empty_cubes(full.view(np.uint8), CUBE_CAP, out)
     return out.reshape(-1)
 
 
