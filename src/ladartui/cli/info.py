@@ -82,6 +82,7 @@ def print_scenario(path: Path) -> None:
 
 def print_voxel_list(path: Path, voxel_size=None) -> None:
     from ladartui.scene.model import target_path_for
+    from ladartui.scene.occupancy import column_bounds
     from ladartui.scene.target_model import load_target
     from ladartui.scene.voxels import load_voxels_counted
 
@@ -108,7 +109,7 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
     rows.append(("read in", f"{loaded:.2f} s"))
     shape: tuple[int, ...] = (0, 0, 0)
     if len(voxels):
-        lo, hi = voxels.min(axis=0), voxels.max(axis=0)
+        lo, hi = column_bounds(voxels)
         shape = tuple(int(h) + 1 for h in hi)
         ranges = ", ".join(f"{axis} {int(low)}..{int(high)}" for axis, low, high in zip("xyz", lo, hi))
         rows.append(("extent", f"{ranges}  (shape {shape[0]} x {shape[1]} x {shape[2]})"))

@@ -87,6 +87,7 @@ def scene_summary(scenario) -> list[str]:
 
     from ladartui.number_text import extent_metres
     from ladartui.resources import available_memory, check_occupancy, gib
+    from ladartui.scene.occupancy import column_bounds
 
     scene = scenario.load_scene()
     nx, ny, nz = scene.shape
@@ -107,8 +108,8 @@ def scene_summary(scenario) -> list[str]:
     need = 0
     for voxels, source in ((scene.voxels, scenario.scene_file), (scene.target, scenario.target_file)):
         if len(voxels):
-            # int64: the far corner + 1 of a voxel at 2**31 - 1 overflows int32.
-            lo, hi = voxels.min(axis=0).astype(np.int64), voxels.max(axis=0).astype(np.int64) + 1
+            lo, last = column_bounds(voxels)  # int64: the far corner + 1 of 2**31 - 1 fits
+            hi = last + 1
             need += check_occupancy(lo, hi, len(voxels), str(source))
     need += scene.voxels.nbytes + scene.target.nbytes + np.dtype(np.int32).itemsize
     lines.append(
