@@ -258,3 +258,38 @@ async def test_the_study_status_shortens_a_long_path_and_keeps_the_keys(tmp_path
         shown = str(status.render())
         assert shown.endswith("q quick, f full, Ctrl+X cancel, Esc back"), shown
         assert "\u2026" in shown and cell_len(shown) <= status.content_size.width
+
+
+async def test_tab_reaches_the_views_while_a_run_goes_on(tmp_path, scene_files, monkeypatch):
+    """A long run leaves the views to look at: Tab moves the focus to them, and the arrow
+    keys turn them, as a click would."""
+    import ladartui.simulation as simulation
+    from ladartui.tui.canvas import ProjectionWidget
+
+    started = threading.Event()
+
+    def until_cancelled(*args, cancel=None, **kwargs):
+        started.set()
+        while not cancel.wait(0.02):
+            pass
+        raise Cancelled()
+
+    monkeypatch.setattr(simulation, "simulate", until_cancelled)
+    app = LadarApp(make_scenario(tmp_path, scene_files).path)
+    async with app.run_test(size=(120, 40)) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        await pilot.press("f5")
+        await wait_until(pilot, started.is_set)
+        await pilot.pause()
+        assert app.run_in_progress()
+        view = app.query_one("#scene3d", ProjectionWidget)
+        for _ in range(5):
+            if app.focused is view:
+                break
+            await pilot.press("tab")
+        assert app.focused is view
+        azimuth = view.camera.azimuth
+        await pilot.press("left")
+        assert view.camera.azimuth != azimuth
+        await pilot.press("escape")
+        await wait_until(pilot, lambda: app.busy is None)

@@ -178,6 +178,8 @@ DISPLAY_ACTIONS = {
     "show_tab",
     "cancel_run",
     "view",
+    "focus_next",  # Tab and Shift+Tab: the views stay reachable from the keyboard
+    "focus_previous",
 }
 
 
