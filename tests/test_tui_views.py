@@ -261,3 +261,19 @@ async def test_a_narrow_output_view_keeps_its_threshold_whole(app_pilot):
     finally:
         await pilot.resize_terminal(*SIZE)
         await pilot.pause()
+
+
+async def test_a_message_leaves_the_status_bar_in_sight(scenario_path):
+    """A toast sits above the status bar, so its colour, its text and Cancel stay readable."""
+    from textual.widgets._toast import Toast
+
+    from ladartui.tui.status import StatusBar
+
+    app = LadarApp(scenario_path, compile_in_child=False)
+    async with app.run_test(size=(80, 24), notifications=True) as pilot:
+        app.tell("a message long enough to need a few lines of the toast " * 2)
+        await pilot.pause(0.3)
+        bar = app.query_one(StatusBar)
+        toasts = list(app.screen.query(Toast))
+        assert toasts
+        assert all(toast.region.bottom <= bar.region.y for toast in toasts)
