@@ -568,3 +568,23 @@ async def test_a_sweep_run_again_shows_its_stored_rows_first(finished, tmp_path)
         assert seen == [12], screen.last_message
         assert screen.query_one("#sweep-table", DataTable).row_count == 12
         assert "12 resumed" in screen.last_message
+
+
+async def test_a_finished_sweep_shows_its_whole_100_percent(finished, tmp_path):
+    """At 80x24 the progress reads "100%", not "100" cut by the row's label padding."""
+    import shutil
+
+    spec, _ = finished
+    for path in spec.parent.iterdir():  # a copy: running again rewrites the table
+        copy = shutil.copytree if path.is_dir() else shutil.copy
+        copy(path, tmp_path / path.name)
+    screen = SweepScreen(tmp_path / spec.name, serial=True)
+    app = _Host(screen)
+    async with app.run_test(size=SIZE) as pilot:
+        await opened(pilot)
+        await pilot.press("f5")
+        await wait_for(pilot, lambda: not screen.running)
+        await pilot.pause()
+        percent = screen.query_one("#sweep-progress PercentageStatus")
+        assert str(percent.render()) == "100%"
+        assert percent.content_region.width >= len("100%")

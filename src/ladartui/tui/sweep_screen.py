@@ -90,7 +90,7 @@ class SweepScreen(SweepOpening):
     DEFAULT_CSS = """
     SweepScreen { layout: vertical; }
     SweepScreen .sweep-row { height: 1; }
-    SweepScreen .sweep-row Label { padding: 0 1; }
+    SweepScreen .sweep-row > Label { padding: 0 1; }  /* not the progress bar's percentage */
     SweepScreen #sweep-path { width: 1fr; }
     SweepScreen #sweep-scheduler, SweepScreen #sweep-certs { width: 1fr; }
     SweepScreen #sweep-budget { width: 9; }
