@@ -8,12 +8,14 @@ from __future__ import annotations
 
 import pytest
 from rich.text import Text
+from textual.widgets import Button, Input
 
 from ladartui.flight import FlightPlan, ScanPose, Straight
 from ladartui.recent import recent_scenarios
 from ladartui.scenario import load_scenario
 from ladartui.tui.actions import palette_entries
-from ladartui.tui.file_dialogs import FileTree, SaveAsScreen, SetupScreen
+from ladartui.tui.file_dialogs import SaveAsScreen, SetupScreen
+from ladartui.tui.file_tree import FileTree
 from ladartui.tui.poses_screen import PosesScreen
 from ladartui.tui.screens import FormScreen
 from ladartui.tui.status import StatusBar
@@ -234,6 +236,37 @@ async def test_compare_takes_files_picked_in_the_tree(tmp_path, scene_files):
             await pilot.pause()
             picks.append(chosen.value.split())
         assert picks == [[b], [b, a], [a]]
+
+
+async def test_compare_moves_its_tree_up_to_pick_a_run_in_the_folder_beside(tmp_path, scene_files):
+    """As in Open and Save As, "Up a folder" reaches the measures of a scenario kept beside."""
+    from ladartui.tui.screens import CompareScreen
+
+    here, beside = tmp_path / "here", tmp_path / "beside"
+    here.mkdir()
+    beside.mkdir()
+    (beside / "other.cmf").write_text("")
+    app = LadarApp(make_scenario(here, scene_files).path)
+    async with app.run_test(size=(120, 40)) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        await app.run_action("compare")
+        await pilot.pause()
+        screen = app.screen
+        assert isinstance(screen, CompareScreen)
+        screen.query_one("#tree-up", Button).press()
+        await pilot.pause()
+        tree = screen.query_one(FileTree)
+        assert tree.path == tmp_path
+        await wait_until(pilot, lambda: len(tree.root.children) == 2)
+        folder = next(node for node in tree.root.children if node.data.path == beside)
+        tree.focus()
+        tree.move_cursor(folder)
+        await pilot.press("enter")  # opens the folder
+        await wait_until(pilot, lambda: len(folder.children) == 1)
+        tree.move_cursor(folder.children[0])
+        await pilot.press("enter")
+        await pilot.pause()
+        assert screen.query_one("#cmf-files", Input).value.split()[-1] == str(beside / "other.cmf")
 
 
 @pytest.mark.parametrize("size", [(80, 24), (120, 40)])

@@ -20,54 +20,11 @@ from ladartui.errors import LadarError
 from ladartui.textsafe import visible
 from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField, refusal
-from ladartui.tui.file_tree import SCENARIO_TABLE, FileTree
-from ladartui.tui.screens import Dialog, PathSuggester, _row
+from ladartui.tui.file_tree import SCENARIO_TABLE
+from ladartui.tui.screens import PathSuggester, TreeDialog, _row
 
 SCENARIO_SUFFIXES = (".toml",)
 SCENE_SUFFIXES = (".txt", ".las", ".laz")
-
-
-class TreeDialog(Dialog):
-    """A dialog with a folder tree whose root can move up a folder.
-
-    The dialog takes the screen's height (up to a limit) and the tree what the
-    fields leave, so OK and Cancel stay visible on a 24-line terminal.
-    """
-
-    DEFAULT_CSS = """
-    TreeDialog > .dialog { height: 100%; max-height: 34; }
-    TreeDialog .tree-row { height: 1; }
-    TreeDialog #tree-root { width: 1fr; margin: 0; color: $text-muted; }
-    TreeDialog #tree-up { margin-left: 1; }
-    """
-
-    folder: Path
-
-    def tree_rows(self, suffixes, toml_table: str | None = None) -> ComposeResult:
-        with Horizontal(classes="tree-row"):
-            yield Static("", id="tree-root", markup=False)
-            yield Button("Up a folder", id="tree-up", compact=True)
-        yield FileTree(self.folder, suffixes, toml_table, id="tree")
-
-    def on_mount(self) -> None:
-        self._show_root()
-
-    def _show_root(self) -> None:
-        self.query_one("#tree-root", Static).update(f"Folder: {self.folder}")
-
-    @on(Button.Pressed, "#tree-up")
-    def _up(self) -> None:
-        self.folder = self.folder.parent
-        self.query_one(FileTree).path = self.folder
-        self._show_root()
-
-    def relative(self, path: Path) -> str:
-        try:
-            return str(path.relative_to(self.base))
-        except ValueError:
-            return str(path)
-
-    base: Path
 
 
 class SetupScreen(TreeDialog):

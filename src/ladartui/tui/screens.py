@@ -1,5 +1,6 @@
 """Modal screens: the segment editor and other number forms (view angle, threshold,
-image size), measures, comparison and help; the pose editor is tui/poses_screen.py."""
+image size), measures, comparison and help, and the base of the dialogs with a folder
+tree; the pose editor is tui/poses_screen.py, the file dialogs tui/file_dialogs.py."""
 
 from __future__ import annotations
 
@@ -78,6 +79,49 @@ class Dialog(ModalScreen):
 
 def _row(label: str, widget) -> Horizontal:
     return Horizontal(Label(label), widget, classes="row")
+
+
+class TreeDialog(Dialog):
+    """A dialog with a folder tree whose root can move up a folder.
+
+    The dialog takes the screen's height (up to a limit) and the tree what the
+    fields leave, so OK and Cancel stay visible on a 24-line terminal.
+    """
+
+    DEFAULT_CSS = """
+    TreeDialog > .dialog { height: 100%; max-height: 34; }
+    TreeDialog .tree-row { height: 1; }
+    TreeDialog #tree-root { width: 1fr; margin: 0; color: $text-muted; }
+    TreeDialog #tree-up { margin-left: 1; }
+    """
+
+    folder: Path
+
+    def tree_rows(self, suffixes, toml_table: str | None = None) -> ComposeResult:
+        with Horizontal(classes="tree-row"):
+            yield Static("", id="tree-root", markup=False)
+            yield Button("Up a folder", id="tree-up", compact=True)
+        yield FileTree(self.folder, suffixes, toml_table, id="tree")
+
+    def on_mount(self) -> None:
+        self._show_root()
+
+    def _show_root(self) -> None:
+        self.query_one("#tree-root", Static).update(f"Folder: {self.folder}")
+
+    @on(Button.Pressed, "#tree-up")
+    def _up(self) -> None:
+        self.folder = self.folder.parent
+        self.query_one(FileTree).path = self.folder
+        self._show_root()
+
+    def relative(self, path: Path) -> str:
+        try:
+            return str(path.relative_to(self.base))
+        except ValueError:
+            return str(path)
+
+    base: Path
 
 
 class FormScreen(Dialog):
@@ -302,7 +346,7 @@ class MeasuresScreen(Dialog):
         self.dismiss(None)
 
 
-class CompareScreen(Dialog):
+class CompareScreen(TreeDialog):
     """Two or more scenarios' measures (.cmf files) side by side, differences highlighted."""
 
     def __init__(self, paths: list[Path], folder: Path | None = None):
@@ -311,7 +355,7 @@ class CompareScreen(Dialog):
         self.folder = folder or (self.paths[0].parent if self.paths else Path.cwd())
 
     DEFAULT_CSS = """
-    CompareScreen > .dialog { width: 100%; height: 100%; }
+    CompareScreen > .dialog { width: 100%; height: 100%; max-height: 100%; }
     CompareScreen DataTable { height: 1fr; }
     CompareScreen FileTree { height: 8; min-height: 3; }
     """
@@ -328,7 +372,7 @@ class CompareScreen(Dialog):
                     suggester=PathSuggester((".cmf",)),
                 ),
             )
-            yield FileTree(self.folder, (".cmf",), id="cmf-tree")
+            yield from self.tree_rows((".cmf",))
             yield Static(
                 "Paths separated by spaces (quote one that has spaces), or pick files "
                 "in the tree (again to drop one); Enter compares. Green best, red "
@@ -342,9 +386,10 @@ class CompareScreen(Dialog):
                 yield Button("Close", id="compare-close", compact=True)
 
     def on_mount(self) -> None:
+        super().on_mount()
         self.compare()
 
-    @on(FileTree.FileSelected, "#cmf-tree")
+    @on(FileTree.FileSelected, "#tree")
     def _picked(self, event: FileTree.FileSelected) -> None:
         event.stop()
         field = self.query_one("#cmf-files", Input)
