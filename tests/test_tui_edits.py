@@ -90,6 +90,22 @@ async def test_an_invalid_value_typed_stops_run_and_save_and_focuses_the_field(t
         assert grid.value == "0"  # the typed text stays for the analyst to correct
 
 
+async def test_run_stopped_by_a_typed_value_names_the_field_as_the_form_does(tmp_path, scene_files):
+    """F5 over a value typed without Enter says what Enter would: the form's label, the text
+    typed and the limits in the field's unit, not the file's key in metres."""
+    app = LadarApp(make_scenario(tmp_path, scene_files).path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        app.action_show_tab("sensor")
+        await type_into(pilot, field(app, "sensor.pixel_pitch"), "50000", commit=None)
+        await pilot.press("f5")
+        await pilot.pause()
+        assert app.messages[-1] == (
+            "Not done: invalid value: Pixel pitch um: 50000 is not allowed; expected a number "
+            "from 0.1 to 10000 um. Correct the value and try again."
+        )
+
+
 async def test_an_invalid_value_goes_back_to_the_scenarios_value(tmp_path, scene_files):
     scenario = make_scenario(tmp_path, scene_files, grid=8, ray_grid=2)
     app = LadarApp(scenario.path)

@@ -14,8 +14,9 @@ from textual.containers import Horizontal, Vertical
 from textual.screen import ModalScreen
 from textual.widgets import Button, Static
 
+from ladartui.errors import LadarError
 from ladartui.tui.host import Host
-from ladartui.tui.params import ParamField
+from ladartui.tui.params import ParamField, field_message
 
 
 class UnsavedScreen(ModalScreen[str | None]):
@@ -78,11 +79,12 @@ class EditGuard(Host):
         for field in self.query(".param").results(ParamField):
             if field.value == field.committed:
                 continue
-            problem = field.problem()
-            if problem is not None:
+            try:
+                field.parsed()
+            except LadarError as error:  # said as Enter says it: the form's label and units
                 field.focus()
                 self.tell(
-                    f"{problem}. Correct the value and try again.",
+                    f"{field_message(field.param, field.value, error)}. Correct the value and try again.",
                     title="Not done: invalid value",
                     severity="error",
                     timeout=8,
