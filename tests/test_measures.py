@@ -246,3 +246,24 @@ def test_a_huge_figure_is_written_with_an_exponent_not_hundreds_of_digits():
     assert format_number(huge, 1, "s") == "4.054e+301 s"
     reached = LevelReached("detect", True, scan=2, flight_time_s=huge, distance_m=62.8)
     assert reached.describe() == "scan 2, 4.054e+301 s, 62.8 m"
+
+
+def test_bad_voxel_lists_and_figures_are_field_errors_not_a_wrong_answer():
+    """A (K, 2) or float list was reshaped or truncated into other voxels and scored."""
+    from ladartui.errors import FieldError
+
+    target = box(3, 2, 1)
+    with pytest.raises(FieldError, match=r"^target_model = 'array of shape \(6, 2\)'"):
+        compute_measures(target[:, :2], target, target)
+    with pytest.raises(FieldError, match=r"^scene_output = 'array of float64'"):
+        compute_measures(target, target + 0.5, target)
+    with pytest.raises(FieldError, match=r"^target_per_scan\[1\] = 'array of shape \(1, 2\)'"):
+        compute_measures(target, target, target, [target, target], [target, target[:1, :2]])
+    with pytest.raises(
+        FieldError, match=r"^len\(target_per_scan\) = 1: expected as many scans as scene_per_scan \(2\)"
+    ):
+        compute_measures(target, target, target, [target, target], [target])
+    with pytest.raises(FieldError, match=r"^path_length_m = nan"):
+        compute_measures(target, target, target, path_length_m=float("nan"))
+    with pytest.raises(FieldError, match=r"^voxel_size = -1"):
+        compute_measures(target, target, target, voxel_size=-1)

@@ -127,13 +127,17 @@ def test_occupancy_is_built_once_and_matches_the_lists():
     assert target.contains(TARGET).all() and not target.contains(np.array([[0, 0, 0]])).any()
 
 
-def test_bad_arrays_are_rejected():
-    with pytest.raises(ValueError, match="negative"):
-        Scene(np.array([[0, -1, 0]]), TARGET, 1.0)
-    with pytest.raises(ValueError, match=r"\(N, 3\)"):
-        Scene(np.array([[0, 1]]), TARGET, 1.0)
-    with pytest.raises(ValueError, match="integers"):
+def test_bad_arrays_are_field_errors_naming_the_argument():
+    with pytest.raises(FieldError, match=r"^voxels\[1\] = \(0, -1, 0\): expected non-negative"):
+        Scene(np.array([[0, 0, 0], [0, -1, 0]]), TARGET, 1.0)
+    with pytest.raises(FieldError, match=r"^target = 'array of shape \(1, 2\)': expected an \(N, 3\)"):
+        Scene(SCENE, np.array([[0, 1]]), 1.0)
+    with pytest.raises(FieldError, match=r"^voxels = 'array of float64': expected .*integer"):
         Scene(np.array([[0.5, 1, 1]]), TARGET, 1.0)
+    with pytest.raises(FieldError, match=r"^target_ids = 'array of shape \(2,\)': expected"):
+        Scene(SCENE, TARGET[:1], 1.0, target_ids=[1, 2])
+    with pytest.raises(FieldError, match=r"^target_ids\[0\] = 0: expected a target id from 1 to 65535"):
+        Scene(SCENE, TARGET[:2], 1.0, target_ids=[0, 1])
 
 
 def test_scene_survives_pickling():

@@ -5,7 +5,7 @@ import os
 import numpy as np
 import pytest
 
-from ladartui.errors import InputFileError
+from ladartui.errors import FieldError, InputFileError
 from ladartui.scene.voxels import load_voxels, load_voxels_counted, save_voxels, unique_voxels
 
 
@@ -192,12 +192,14 @@ def test_unique_voxels_with_keys_too_large_to_pack():
 def test_save_is_atomic_when_the_data_is_bad(tmp_path):
     path = tmp_path / "keep.txt"
     path.write_text("1,2,3\n")
-    with pytest.raises(ValueError):
+    with pytest.raises(FieldError, match=r"^voxels\[0\] = \(1, -2, 3\)"):
         save_voxels(path, np.array([[1, -2, 3]]))
-    with pytest.raises(ValueError):
+    with pytest.raises(FieldError, match=r"^voxels = 'array of float64'"):
         save_voxels(path, np.array([[1.5, 2, 3]]))
-    with pytest.raises(ValueError):
+    with pytest.raises(FieldError, match=r"^voxels = 'array of shape \(3,\)'"):
         save_voxels(path, np.array([1, 2, 3]))
+    with pytest.raises(FieldError, match=r"^ids = 'array of shape \(2,\)'"):
+        save_voxels(path, np.array([[1, 2, 3]]), ids=[1, 2])
     assert path.read_text() == "1,2,3\n"
     assert os.listdir(tmp_path) == ["keep.txt"]
 

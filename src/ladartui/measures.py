@@ -43,11 +43,13 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ladartui.atomic import write_text_atomic
+from ladartui.checks import number_field
 from ladartui.directions import DirectionStats, angle_between, direction_stats
-from ladartui.errors import InputFileError
+from ladartui.errors import FieldError, InputFileError
 from ladartui.number_text import fixed
 from ladartui.scene.keys import member as _member
 from ladartui.scene.keys import sorted_unique, visible_mask, voxel_keys
+from ladartui.scene.voxel_arrays import voxel_list_field
 
 if TYPE_CHECKING:
     from ladartui.levels import LevelResult
@@ -176,8 +178,26 @@ def compute_measures(
     All voxel arguments are (K, 3) integer index arrays; outputs may hold
     non-target voxels (foliage, ground), which are ignored. ``*_per_scan`` are
     lists of each scan's returns, in flight order, for coverage after each scan.
+    Bad arrays or figures raise ``FieldError`` naming the argument.
     """
-    target = np.asarray(target_model, dtype=np.int64).reshape(-1, 3)
+    target = voxel_list_field("target_model", target_model).astype(np.int64, copy=False)
+    scene_output = _voxels_or_none("scene_output", scene_output)
+    target_output = _voxels_or_none("target_output", target_output)
+    scene_per_scan = _checked_scans("scene_per_scan", scene_per_scan)
+    target_per_scan = _checked_scans("target_per_scan", target_per_scan)
+    if (
+        scene_per_scan is not None
+        and target_per_scan is not None
+        and len(scene_per_scan) != len(target_per_scan)
+    ):
+        raise FieldError(
+            "len(target_per_scan)",
+            len(target_per_scan),
+            f"as many scans as scene_per_scan ({len(scene_per_scan)})",
+        )
+    path_length_m = None if path_length_m is None else number_field("path_length_m", path_length_m, 0)
+    flight_time_s = None if flight_time_s is None else number_field("flight_time_s", flight_time_s, 0)
+    voxel_size = None if voxel_size is None else number_field("voxel_size", voxel_size, 0, low_open=True)
     target_keys, first = np.unique(voxel_keys(target), return_index=True)
     target = target[first]
     total = int(target.shape[0])
@@ -227,10 +247,20 @@ def compute_measures(
         unobscured_after_scan=unobscured_after,
         scans_for_enough=_scans_for_enough(obscured_after),
         scans=scans,
-        path_length_m=None if path_length_m is None else float(path_length_m),
-        flight_time_s=None if flight_time_s is None else float(flight_time_s),
-        voxel_size=None if voxel_size is None else float(voxel_size),
+        path_length_m=path_length_m,
+        flight_time_s=flight_time_s,
+        voxel_size=voxel_size,
     )
+
+
+def _voxels_or_none(name, voxels):
+    return None if voxels is None else voxel_list_field(name, voxels)
+
+
+def _checked_scans(name, per_scan):
+    if per_scan is None:
+        return None
+    return [voxel_list_field(f"{name}[{scan}]", returns) for scan, returns in enumerate(per_scan)]
 
 
 def _cumulative_coverage(target_keys, per_scan) -> tuple[float, ...] | None:

@@ -16,7 +16,8 @@ from ladartui.errors import FieldError, InputFileError, LadarError
 from ladartui.scene.keys import voxel_keys
 from ladartui.scene.occupancy import Occupancy, column_bounds
 from ladartui.scene.target_model import load_target
-from ladartui.scene.voxels import MAX_TARGET_ID, load_voxels
+from ladartui.scene.voxel_arrays import target_ids_field, voxel_list_field
+from ladartui.scene.voxels import load_voxels
 
 
 def target_path_for(scene_path) -> Path:
@@ -174,30 +175,14 @@ def _checked_voxel_size(voxel_size) -> float:
     return size
 
 
-def _as_voxel_array(voxels, name) -> np.ndarray:
-    array = np.asarray(voxels)
-    if array.size == 0:
-        return np.zeros((0, 3), dtype=np.int32)
-    if array.ndim != 2 or array.shape[1] != 3:
-        raise ValueError(f"{name} must be an (N, 3) array, got shape {array.shape}")
-    if not np.issubdtype(array.dtype, np.integer):
-        raise ValueError(f"{name} must hold integers, got {array.dtype}")
-    if array.min() < 0:
-        raise ValueError(f"{name} holds negative indices; voxel indices start at 0")
-    if array.max() > np.iinfo(np.int32).max:
-        raise ValueError(f"{name} holds indices beyond the int32 range")
-    return np.ascontiguousarray(array, dtype=np.int32)
-
-
 def _as_target_ids(ids, count: int) -> np.ndarray:
     if ids is None:
         return np.ones(count, dtype=np.int32)
-    array = np.asarray(ids)
-    if array.shape != (count,) or (count and not np.issubdtype(array.dtype, np.integer)):
-        raise ValueError(f"target_ids must be {count} integers, got shape {array.shape}")
-    if count and (array.min() < 1 or array.max() > MAX_TARGET_ID):
-        raise ValueError(f"target_ids must lie in 1..{MAX_TARGET_ID}")
-    return np.ascontiguousarray(array, dtype=np.int32)
+    return np.ascontiguousarray(target_ids_field("target_ids", ids, count), dtype=np.int32)
+
+
+def _as_voxel_array(voxels, name) -> np.ndarray:
+    return np.ascontiguousarray(voxel_list_field(name, voxels, np.iinfo(np.int32).max), dtype=np.int32)
 
 
 def _extent(*lists) -> tuple[int, int, int]:

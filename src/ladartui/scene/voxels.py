@@ -25,6 +25,7 @@ import numpy as np
 from ladartui.atomic import atomic_path
 from ladartui.errors import InputFileError
 from ladartui.fileprobe import NO_SUCH_FILE, refuse_special_file
+from ladartui.scene.voxel_arrays import MAX_TARGET_ID, target_ids_field, voxel_list_field
 
 log = logging.getLogger(__name__)
 
@@ -233,7 +234,6 @@ def _parse_checked(path: Path, buf: np.ndarray, start: int, columns: int, target
     return out[:rows]
 
 
-MAX_TARGET_ID = 65535  # a LAS point source id is an unsigned 16-bit number
 EXPECTED_TARGET = (
     "expected x,y,z or x,y,z,id: three non-negative integers and an optional target id "
     f"1..{MAX_TARGET_ID}, the same number of values on every line"
@@ -540,21 +540,9 @@ def save_voxels(path, voxels, ids=None) -> None:
 
     With ``ids`` ((N,) target ids 1..``MAX_TARGET_ID``) the lines are ``x,y,z,id``.
     """
-    voxels = np.asarray(voxels)
-    if voxels.ndim != 2 or voxels.shape[1] != 3:
-        raise ValueError(f"voxels must be an (N, 3) array, got shape {voxels.shape}")
-    if len(voxels) and not np.issubdtype(voxels.dtype, np.integer):
-        raise ValueError(f"voxels must be integers, got {voxels.dtype}")
-    voxels = np.ascontiguousarray(voxels, dtype=np.int64)
-    if len(voxels) and (voxels.min() < 0 or voxels.max() > MAX_INDEX):
-        raise ValueError(f"voxel indices must lie in 0..{MAX_INDEX}")
+    voxels = np.ascontiguousarray(voxel_list_field("voxels", voxels, MAX_INDEX), dtype=np.int64)
     if ids is not None:
-        ids = np.asarray(ids)
-        if ids.shape != (len(voxels),) or (len(ids) and not np.issubdtype(ids.dtype, np.integer)):
-            raise ValueError(f"ids must be {len(voxels)} integers, got shape {ids.shape}")
-        if len(ids) and (ids.min() < 1 or ids.max() > MAX_TARGET_ID):
-            raise ValueError(f"target ids must lie in 1..{MAX_TARGET_ID}")
-        voxels = np.column_stack([voxels, ids.astype(np.int64)])
+        voxels = np.column_stack([voxels, target_ids_field("ids", ids, len(voxels)).astype(np.int64)])
     data = format_voxel_lines(voxels)
     with atomic_path(path) as tmp, open(tmp, "wb") as stream:
         stream.write(data)
