@@ -342,6 +342,29 @@ async def test_a_key_remapped_in_keys_toml_changes_the_footer_help_and_palette(
         assert len(runs) == 1
 
 
+async def test_a_key_given_in_keys_toml_to_a_palette_only_command_runs_it(tmp_path, scene_files, monkeypatch):
+    """Commands without a default key (the tabs, fit scene, ...) took a key in keys.toml
+    and showed it in the help, but pressing it did nothing."""
+    from textual.widgets import TabbedContent
+
+    from ladartui.tui.app import help_rows
+
+    home = tmp_path / "home"
+    (home / "config").mkdir(parents=True)
+    (home / "config" / "keys.toml").write_text('[keys]\ntab-sensor = "ctrl+k"\n')
+    monkeypatch.setenv("LADARTUI_HOME", str(home))
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=(120, 40)) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        assert ("Anywhere", "Ctrl+K", "Show sensor panel") in help_rows(app)
+        tabs = app.query_one("#tabs", TabbedContent)
+        assert tabs.active != "tab-sensor"
+        await pilot.press("ctrl+k")
+        await pilot.pause()
+        assert tabs.active == "tab-sensor"
+
+
 async def test_a_flight_log_segment_is_listed_and_says_where_it_is_edited(tmp_path, scene_files):
     import shutil
     from pathlib import Path

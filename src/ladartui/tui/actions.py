@@ -195,6 +195,14 @@ def bindings() -> list[BindingType]:
 BINDINGS = bindings()
 
 
+def keymap_only_bindings(keymap: dict[str, str]) -> list[tuple[str, str, str]]:
+    """(key, action, title) of each command with no default key that ``keymap`` gives one.
+
+    Such a command has no entry in ``BINDINGS``, so a keymap alone cannot reach it.
+    """
+    return [(keymap[c.id], c.action, c.title) for c in COMMANDS if not c.key and c.id in keymap]
+
+
 def keys_in_force(keymap: dict[str, str] | None = None) -> dict[str, str]:
     """Command id -> the keys that run it: the default, or the user's."""
     keymap = keymap or {}

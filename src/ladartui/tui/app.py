@@ -104,6 +104,8 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         self.tool_screen: Screen[None] | None = None  # the study or sweep screen while it is open
         self.keymap, self.keymap_problems = actions.load_keymap()
         self.set_keymap(self.keymap)
+        for key, action, title in actions.keymap_only_bindings(self.keymap):
+            self.bind(key, action, description=title, show=False)
 
     def key_says(self, command_id: str, words: str) -> str:
         """The key in force and ``words``: ("run", "runs") gives F5 runs; empty when no key runs it."""
