@@ -193,6 +193,23 @@ def test_sensor_field_limits(field, value, message):
     assert str(caught.value) == message
 
 
+@pytest.mark.parametrize(
+    "attitude", [(float("nan"), 0.0), (0.0, float("inf")), (5.0,), "level", (1, 2, 3, 4)]
+)
+def test_an_attitude_that_is_not_two_or_three_finite_angles_is_refused(attitude):
+    """A NaN roll made every ray NaN, silently; a short tuple failed inside numpy."""
+    sensor = Sensor(grid=2, ray_grid=1)
+    pose = ScanPose(0, 0, 50)
+    for call in (
+        lambda: sensor.rays(pose, attitude=attitude),
+        lambda: sensor.footprint(pose, attitude=attitude),
+    ):
+        with pytest.raises(FieldError, match=r"^attitude = .*: expected \(roll, pitch\)"):
+            call()
+    turned = sensor.rays(pose, attitude=(10.0, -5.0, 2.0))[1]  # yaw may follow
+    assert np.isfinite(turned).all()
+
+
 def test_limits_are_accepted():
     sensor = Sensor(grid=1, ray_grid=16, fov=89.9, depth_resolution=0.0, pixel_pitch=1e-7)
     origins, directions, detector = sensor.rays(ScanPose(0, 0, 10, depression=1.0))

@@ -66,11 +66,29 @@ def pose_rotation(pose: ScanPose) -> np.ndarray:
 def _rotation(pose: ScanPose, attitude) -> np.ndarray:
     """``pose_rotation``, turned by the aircraft's (roll, pitch) for a body-fixed sensor."""
     rotation = pose_rotation(pose)
-    if attitude is None or not any(attitude):  # level flight: the report's rays exactly
+    if attitude is None:
+        return rotation
+    angles = _attitude_angles(attitude)
+    if not any(angles):  # level flight: the report's rays exactly
         return rotation
     from ladartui.attitude import body_rotation
 
-    return body_rotation(pose.heading, *attitude) @ rotation
+    return body_rotation(pose.heading, *angles) @ rotation
+
+
+def _attitude_angles(attitude) -> tuple[float, ...]:
+    """(roll, pitch) or (roll, pitch, yaw) degrees as finite floats, else FieldError."""
+    expected = "(roll, pitch) or (roll, pitch, yaw): finite angles in degrees"
+    try:
+        angles = None if isinstance(attitude, (str, bytes)) else tuple(attitude)
+    except TypeError:
+        angles = None
+    if angles is None or len(angles) not in (2, 3):
+        raise FieldError("attitude", attitude, expected)
+    try:
+        return tuple(number_field("attitude", a) for a in angles)
+    except FieldError:
+        raise FieldError("attitude", attitude, expected) from None
 
 
 _KERNEL = None
@@ -191,8 +209,9 @@ class Sensor:
     def rays(self, pose: ScanPose, rows: range | slice | None = None, attitude=None):
         """The rays of one scan at ``pose``: (origins, directions, detector).
 
-        ``attitude``: the aircraft's (roll, pitch) in degrees, turning the rays
-        of a body-fixed sensor (None: stabilised, the report's rays exactly).
+        ``attitude``: the aircraft's (roll, pitch), or (roll, pitch, yaw), in
+        degrees, turning the rays of a body-fixed sensor (None: stabilised, the
+        report's rays exactly); anything else is a ``FieldError``.
 
         origins (N, 3) float64 metres in the scene frame; directions (N, 3)
         float64 unit vectors; detector (N,) int32, row-major; N = (n m)^2, or
