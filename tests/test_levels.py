@@ -86,8 +86,20 @@ def test_nothing_visible_reaches_nothing():
 
 
 def test_curves_must_match_the_scans():
-    with pytest.raises(ValueError, match="3 visible shares for 2 scans"):
+    with pytest.raises(FieldError, match=r"^len\(visible_share\) = 3: expected one per scan time \(2\)"):
         levels_from_curves([0.1, 0.2, 0.3], [0.1, 0.2], [0.0, 1.0], [0.0, 1.0])
+    with pytest.raises(FieldError, match=r"^len\(scan_distances\) = 1: expected one per scan time \(2\)"):
+        levels_from_curves([0.1, 0.2], [0.1, 0.2], [0.0, 1.0], [0.0])
+    with pytest.raises(FieldError, match=r"^scan_times\[1\] = nan: expected a number >= 0"):
+        levels_from_curves([0.1, 0.2], [0.1, 0.2], [0.0, math.nan], [0.0, 1.0])
+
+
+def test_bad_voxel_lists_are_refused_not_reshaped_into_other_voxels():
+    target = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]])
+    with pytest.raises(FieldError, match=r"^target_voxels = 'array of shape \(4, 2\)'"):
+        target_levels(target[:, :2], [target], [0.0], [0.0])
+    with pytest.raises(FieldError, match=r"^per_scan_returns\[0\] = 'array of float64'"):
+        target_levels(target, [target + 0.5], [0.0], [0.0])
 
 
 def test_scan_distances_follow_the_path_and_end_at_its_length():

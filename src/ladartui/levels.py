@@ -40,9 +40,10 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from ladartui.checks import range_text
+from ladartui.checks import number_field, range_text
 from ladartui.errors import FieldError, InputFileError
 from ladartui.number_text import fixed
+from ladartui.scene.voxel_arrays import voxel_list_field
 
 LEVELS = ("detect", "recognise", "identify")
 NOT_REACHED = "not reached"
@@ -287,11 +288,16 @@ def levels_from_curves(
     """
     thresholds = thresholds or LevelThresholds()
     count = len(scan_times)
-    if len(scan_distances) != count:
-        raise ValueError(f"{len(scan_distances)} scan distances for {count} scan times")
-    for name, curve in (("visible", visible_share), ("footprint", footprint_share)):
-        if curve is not None and len(curve) != count:
-            raise ValueError(f"{len(curve)} {name} shares for {count} scans")
+    for name, values in (
+        ("scan_distances", scan_distances),
+        ("visible_share", visible_share),
+        ("footprint_share", footprint_share),
+    ):
+        if values is not None and len(values) != count:
+            raise FieldError(f"len({name})", len(values), f"one per scan time ({count})")
+    # a NaN here would reach the .cmf and the JSON as "reached after nan s"
+    scan_times = [number_field(f"scan_times[{k}]", t, 0) for k, t in enumerate(scan_times)]
+    scan_distances = [number_field(f"scan_distances[{k}]", d, 0) for k, d in enumerate(scan_distances)]
     usable = visible_share is not None and footprint_share is not None and count > 0
     results = []
     for level in LEVELS:
@@ -328,7 +334,7 @@ def share_curves(target_voxels, per_scan_returns) -> tuple[list[float], list[flo
     # Here, not at the top: the CLI reads level names without loading numba's kernels.
     from ladartui.scene.keys import visible_mask, voxel_keys
 
-    target = np.unique(np.asarray(target_voxels, dtype=np.int64).reshape(-1, 3), axis=0)
+    target = np.unique(voxel_list_field("target_voxels", target_voxels).astype(np.int64), axis=0)
     if target.shape[0] == 0:
         return None
     visible = visible_mask(target)
@@ -341,8 +347,8 @@ def share_curves(target_voxels, per_scan_returns) -> tuple[list[float], list[flo
     seen = np.zeros(target.shape[0], dtype=bool)
     column_seen = np.zeros(cells, dtype=bool)
     voxel_curve, footprint_curve = [], []
-    for returns in per_scan_returns:
-        keys = voxel_keys(np.asarray(returns).reshape(-1, 3))
+    for scan, returns in enumerate(per_scan_returns):
+        keys = voxel_keys(voxel_list_field(f"per_scan_returns[{scan}]", returns))
         if keys.size:
             pos = np.minimum(np.searchsorted(target_keys, keys), target_keys.size - 1)
             hit = pos[target_keys[pos] == keys]
