@@ -92,6 +92,26 @@ def test_run_sweep_refuses_a_budget_that_is_no_positive_number(tiny, tmp_path, b
     assert not (tmp_path / "o").exists()
 
 
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        ({"backend": "cuda"}, r"^simulation\.backend = 'cuda': expected one of"),
+        ({"step": -1.0}, r"^simulation\.step = -1\.0: expected"),
+        ({"write": True}, r"^simulate_options = \{'write': True\}: expected a dict of backend, method"),
+        (["numba"], r"^simulate_options = \['numba'\]: expected a dict of backend, method"),
+    ],
+)
+def test_run_sweep_refuses_bad_simulate_options_before_any_variant(tiny, tmp_path, options, message):
+    """Every variant became an error row that a later sweep, with good options, skipped."""
+    from ladartui.errors import FieldError
+
+    spec = write_spec(tiny, "[grid]\nradius = [20.0]\n", name="options.toml")
+    with pytest.raises(FieldError, match=message):
+        run_sweep(spec, serial=True, out=tmp_path / "o", simulate_options=options)
+    assert not (tmp_path / "o").exists()
+    assert run_sweep(spec, serial=True, out=tmp_path / "o", simulate_options={"backend": "numba"}).ran == 1
+
+
 def test_a_numpy_number_is_a_budget():
     import numpy as np
 

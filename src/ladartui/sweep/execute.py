@@ -15,7 +15,7 @@ import math
 import numbers
 import time
 import uuid
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -181,6 +181,8 @@ def run_sweep(
     (a ``threading.Event``) stops the sweep with ``Cancelled``, keeping the rows
     written so far for a later resume. Writes ``out/results.csv`` (row by row),
     ``out/ranking.csv`` and the best scenario ``out/<name>-best.toml``.
+    ``simulate_options`` (``backend``, ``method``, ``step``, ``precision``) go to
+    every variant's ``simulate``; they are checked before any variant runs.
     ``checked`` is ``checked_base(spec)`` where the caller refused a bad base or
     spec before this call; without it (or for another spec) this call makes it.
     """
@@ -208,6 +210,7 @@ def run_sweep(
     if checked is None or checked.spec is not spec:
         checked = checked_base(spec)
     base = checked.scenario
+    simulate_options = _checked_simulate_options(simulate_options, base)
     scene = _LazyScene(base)
     with _exclusive(out):
         return _run_locked(
@@ -227,6 +230,20 @@ def run_sweep(
             simulate_options,
             started,
         )
+
+
+SIMULATE_OPTIONS = ("backend", "method", "step", "precision")
+
+
+def _checked_simulate_options(options, base) -> dict:
+    """``simulate_options`` checked before any variant runs: a bad one made every
+    variant an ``error`` row, which a later sweep with good options skipped."""
+    if options is None:
+        return {}
+    if not isinstance(options, Mapping) or not set(options) <= set(SIMULATE_OPTIONS):
+        raise FieldError("simulate_options", options, "a dict of " + ", ".join(SIMULATE_OPTIONS))
+    base.with_changes(**{key: value for key, value in options.items() if value is not None})
+    return dict(options)
 
 
 @contextlib.contextmanager
