@@ -173,6 +173,27 @@ def test_no_write_writes_nothing(forest):
     assert not forest.scene_output.exists() and not forest.measures_file.exists()
 
 
+def test_bad_arguments_are_field_errors_before_anything_runs(forest):
+    """A bool cancel, a number as progress or scenario, or another scene failed deep
+    inside the run with an AttributeError or TypeError, or scored the other scene."""
+    from ladartui.errors import FieldError
+    from ladartui.scene.model import Scene
+
+    other = Scene(box(0, 2, 0, 2, 0, 2), box(0, 1, 0, 1, 0, 1), 0.5)
+    cases = [
+        (dict(cancel=True), r"^cancel = True: expected a threading\.Event"),
+        (dict(progress=3), r"^progress = 3: expected a function"),
+        (dict(scene="forest.txt"), r"^scene = 'str': expected the scenario's Scene"),
+        (dict(scene=other), r"^scene\.voxel_size = 0\.5: expected the scenario's voxel size \(1\.0\)"),
+    ]
+    for arguments, message in cases:
+        with pytest.raises(FieldError, match=message):
+            simulate(forest, **arguments)
+    with pytest.raises(FieldError, match=r"^scenario = 'int': expected a Scenario or a scenario file's path"):
+        simulate(42)
+    assert not forest.scene_output.exists() and not forest.measures_file.exists()
+
+
 def test_las_outputs_hold_the_fused_voxels(forest):
     from ladartui.scene.las import import_las
 

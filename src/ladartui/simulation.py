@@ -23,10 +23,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ladartui.errors import check_cancelled
+from ladartui.errors import FieldError, check_cancelled
 from ladartui.measures import Measures, compute_measures
 from ladartui.returns import fuse_scans, kept_returns
 from ladartui.run_record import as_run, check_record_spare, record_text
+from ladartui.scenario import Scenario
+from ladartui.scene.model import Scene
 from ladartui.tracing.config import SCAN_BLOCK
 
 RUNS = ("scene", "target")
@@ -123,9 +125,27 @@ def simulate(
         from ladartui.scenario import load_scenario
 
         scenario = load_scenario(scenario)
+    _check_arguments(scenario, progress, cancel, scene)
     with contextlib.ExitStack() as stack:
         output_set = stack.enter_context(_output_set(scenario, las)) if write else None
         return _simulate(scenario, backend, method, step, precision, progress, cancel, output_set, scene)
+
+
+def _check_arguments(scenario, progress, cancel, scene) -> None:
+    """Refuse, naming it, what would otherwise fail deep in the run or score another scene."""
+    if not isinstance(scenario, Scenario):
+        raise FieldError("scenario", type(scenario).__name__, "a Scenario or a scenario file's path")
+    if progress is not None and not callable(progress):
+        raise FieldError("progress", progress, "a function of RunProgress (or None)")
+    if cancel is not None and not callable(getattr(cancel, "is_set", None)):
+        raise FieldError("cancel", cancel, "a threading.Event (or None)")
+    if scene is not None:
+        if not isinstance(scene, Scene):
+            raise FieldError("scene", type(scene).__name__, "the scenario's Scene (scenario.load_scene())")
+        if scene.voxel_size != scenario.voxel_size:
+            raise FieldError(
+                "scene.voxel_size", scene.voxel_size, f"the scenario's voxel size ({scenario.voxel_size})"
+            )
 
 
 def _simulate(scenario, backend, method, step, precision, progress, cancel, output_set, scene):
