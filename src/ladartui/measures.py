@@ -126,7 +126,8 @@ class Measures:
 
     @classmethod
     def from_dict(cls, data: dict) -> Measures:
-        """The inverse of ``to_dict`` (JSON written by ``ladartui run --json``)."""
+        """``to_dict``'s JSON back, less ``levels`` and ``targets`` (left None): the whole
+        inverse, with those, is ``ladartui.cmf.measures_from_dict``."""
         values: dict[str, object] = {}
         for f in fields(cls):
             if f.name not in data:
