@@ -162,6 +162,13 @@ def test_a_scene_supplies_its_voxel_size():
     r = trace(scene, np.array([[2.0, 2.0, 5.0]]), np.array([[0.0, 0.0, -1.0]]))
     assert r.kind[0] == VOXEL and r.index[0].tolist() == [4, 4, 1]
     assert r.range[0] == pytest.approx(5.0 - 1.5 * 0.5)  # top face of voxel 1 at z = 0.75 m
+    same = trace(scene, np.array([[2.0, 2.0, 5.0]]), np.array([[0.0, 0.0, -1.0]]), voxel_size=0.5)
+    assert same.range[0] == r.range[0]
+    # another size put the scene's voxels elsewhere in metres: a wrong answer, silently
+    with pytest.raises(
+        FieldError, match=r"^voxel_size = 2\.0: expected the scene's voxel size \(0\.5\) or None"
+    ):
+        trace(scene, np.array([[2.0, 2.0, 5.0]]), np.array([[0.0, 0.0, -1.0]]), voxel_size=2.0)
 
 
 def test_registry_lists_every_builtin_backend_even_after_a_direct_import():

@@ -115,6 +115,9 @@ def trace(
     ``method`` is "exact" (first voxel whose interior the ray enters) or "march"
     (the report's fixed-step sampling, ``step`` in voxels, default 0.5).
     ``backend`` is a registered name or "auto". Ranges come back in metres.
+    A Scene gives its own voxel size; an Occupancy takes ``voxel_size`` (default
+    1.0). ``precision`` is "f64" or "f32" (numba always computes in float64);
+    ``cancel`` (a threading.Event) is checked between chunks of rays.
     """
     occupancy, voxel_size = _occupancy_and_size(scene_or_occupancy, voxel_size)
     if cancel is not None and not callable(getattr(cancel, "is_set", None)):
@@ -193,7 +196,9 @@ def _occupancy_and_size(target, voxel_size):
         size = 1.0 if voxel_size is None else voxel_size
     elif hasattr(target, "occupancy") and hasattr(target, "voxel_size"):
         occupancy = target.occupancy
-        size = target.voxel_size if voxel_size is None else voxel_size
+        size = target.voxel_size
+        if voxel_size is not None and voxel_size != size:  # would move its voxels in metres
+            raise FieldError("voxel_size", voxel_size, f"the scene's voxel size ({size}) or None")
     else:
         raise FieldError("scene", type(target).__name__, "a Scene or an Occupancy")
     try:
