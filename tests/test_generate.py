@@ -176,6 +176,10 @@ def test_to_scene_keeps_the_grid(small):
         # a vehicle lost at 30 m voxels ('no target'), nothing left at 1000 m (a traceback)
         ({"voxel_size": 30.0}, "voxel_size = 30.0: expected at most 1.1 m (half the vehicle's"),
         ({"voxel_size": 1000.0, "vehicles": 0}, "voxel_size = 1000.0: expected at most 7.5 m (an eighth"),
+        # any text was true: terrain = "false" made terrain
+        ({"terrain": "false"}, "terrain = 'false': expected True or False"),
+        ({"camouflage": 1}, "camouflage = 1: expected True or False"),
+        ({"density": float("nan")}, "density = nan: expected a number from 0 to 0.99"),
     ],
 )
 def test_bad_overrides_name_the_field(overrides, message):
@@ -189,6 +193,10 @@ def test_unknown_preset_and_bad_seed():
         generate_scene("huge")
     with pytest.raises(FieldError, match="seed = -3"):
         generate_scene("small", seed=-3)
+    with pytest.raises(FieldError, match=r"^progress = 3: expected a function"):
+        generate_scene("small", progress=3)
+    with pytest.raises(FieldError, match=r"^cancel = True: expected a threading\.Event"):
+        generate_scene("small", cancel=True)
 
 
 def packed(voxels, shift=0):

@@ -45,6 +45,15 @@ def check_cancelled(cancel, message: str) -> None:
         raise Cancelled(message)
 
 
+def check_callbacks(progress=None, cancel=None) -> None:
+    """FieldError for a ``progress`` that cannot be called or a ``cancel`` with no ``is_set``:
+    long work checks both before it starts, not when it first reports or checks."""
+    if progress is not None and not callable(progress):
+        raise FieldError("progress", progress, "a function (or None)")
+    if cancel is not None and not callable(getattr(cancel, "is_set", None)):
+        raise FieldError("cancel", cancel, "a threading.Event (or None)")
+
+
 class BackendUnavailable(LadarError):
     """A tracing backend that cannot run here, with the reason and what to install."""
 

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ladartui.errors import FieldError, check_cancelled
+from ladartui.errors import FieldError, check_callbacks, check_cancelled
 from ladartui.measures import Measures, compute_measures
 from ladartui.returns import fuse_scans, kept_returns
 from ladartui.run_record import as_run, check_record_spare, record_text
@@ -135,10 +135,7 @@ def _check_arguments(scenario, progress, cancel, scene) -> None:
     """Refuse, naming it, what would otherwise fail deep in the run or score another scene."""
     if not isinstance(scenario, Scenario):
         raise FieldError("scenario", type(scenario).__name__, "a Scenario or a scenario file's path")
-    if progress is not None and not callable(progress):
-        raise FieldError("progress", progress, "a function of RunProgress (or None)")
-    if cancel is not None and not callable(getattr(cancel, "is_set", None)):
-        raise FieldError("cancel", cancel, "a threading.Event (or None)")
+    check_callbacks(progress, cancel)
     if scene is not None:
         if not isinstance(scene, Scene):
             raise FieldError("scene", type(scene).__name__, "the scenario's Scene (scenario.load_scene())")

@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ladartui.errors import FieldError, check_cancelled
+from ladartui.errors import FieldError, check_callbacks, check_cancelled
 from ladartui.scene.occupancy import column_bounds
 from ladartui.scene.trees import branch_voxels, concat_voxels, foliage_voxels, place_trees, trunk_voxels
 
@@ -214,6 +214,7 @@ def generate_scene(preset="small", seed=0, progress=None, cancel=None, **overrid
     (``threading.Event``) raises ``Cancelled`` there.
     """
     params = scene_params(preset, **overrides)
+    check_callbacks(progress, cancel)
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise FieldError("seed", seed, "a non-negative whole number")
     rng = np.random.default_rng(int(seed))
@@ -316,6 +317,9 @@ def _check(p: SceneParams):
     share("density", p.density, 0.99)
     for name in ("trees", "branches", "vehicles"):
         count(name, getattr(p, name))
+    for name in ("terrain", "camouflage"):
+        if not isinstance(getattr(p, name), (bool, np.bool_)):  # "false" is true
+            raise FieldError(name, getattr(p, name), "True or False")
     # Each tree costs tens of kilobytes while it is built; refuse before allocating.
     if p.trees > MAX_TREES:
         raise FieldError(

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ladartui.errors import BackendUnavailable, FieldError
+from ladartui.errors import BackendUnavailable, FieldError, check_callbacks
 from ladartui.tracing.backend import (
     GROUND,
     METHODS,
@@ -120,8 +120,7 @@ def trace(
     ``cancel`` (a threading.Event) is checked between chunks of rays.
     """
     occupancy, voxel_size = _occupancy_and_size(scene_or_occupancy, voxel_size)
-    if cancel is not None and not callable(getattr(cancel, "is_set", None)):
-        raise FieldError("cancel", cancel, "a threading.Event (or None)")
+    check_callbacks(cancel=cancel)
     origins = _rays("origins", origins)
     directions = _rays("directions", directions)
     if origins.shape != directions.shape:
