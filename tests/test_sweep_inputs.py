@@ -112,6 +112,22 @@ def test_run_sweep_refuses_bad_simulate_options_before_any_variant(tiny, tmp_pat
     assert run_sweep(spec, serial=True, out=tmp_path / "o", simulate_options={"backend": "numba"}).ran == 1
 
 
+@pytest.mark.parametrize(
+    "arguments, message",
+    [
+        (dict(progress=3), r"^progress = 3: expected a function"),
+        (dict(cancel=True), r"^cancel = True: expected"),
+    ],
+)
+def test_run_sweep_refuses_a_progress_or_cancel_of_the_wrong_kind_first(tiny, tmp_path, arguments, message):
+    from ladartui.errors import FieldError
+
+    spec = write_spec(tiny, "[grid]\nradius = [20.0]\n", name="callbacks.toml")
+    with pytest.raises(FieldError, match=message):
+        run_sweep(spec, serial=True, out=tmp_path / "o", **arguments)
+    assert not (tmp_path / "o").exists()
+
+
 def test_a_numpy_number_is_a_budget():
     import numpy as np
 

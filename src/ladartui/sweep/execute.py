@@ -20,7 +20,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ladartui.atomic import atomic_path
-from ladartui.errors import FieldError, InputFileError, LadarError, OutputFileError, check_cancelled
+from ladartui.errors import (
+    FieldError,
+    InputFileError,
+    LadarError,
+    OutputFileError,
+    check_callbacks,
+    check_cancelled,
+)
 from ladartui.sweep.base import CheckedBase, checked_base, own_rows, spec_rows
 from ladartui.sweep.best_file import best_files, write_best_scenario
 from ladartui.sweep.cluster import close_client, local_client
@@ -188,6 +195,7 @@ def run_sweep(
     """
     started = time.perf_counter()
     _refuse_in_worker_start()
+    check_callbacks(progress, cancel)
     if not isinstance(spec, SweepSpec):
         spec = load_sweep_spec(spec)
     objective = normal_objective(objective or spec.objective)
