@@ -548,3 +548,10 @@ def test_a_target_id_named_twice_is_refused(tmp_path):
     scenario.path.write_text(text + '\n[targets]\nnames = { 1 = "alpha", 01 = "beta" }\n', encoding="utf-8")
     with pytest.raises(LadarError, match=r"targets\.names.*each target id once \(id 1 is named twice\)"):
         load_scenario(scenario.path)
+
+
+@pytest.mark.parametrize("bad", [3, None, b"orbit.toml"])
+def test_load_scenario_names_a_path_that_is_no_path(bad):
+    """load_scenario(3) failed inside pathlib with a TypeError naming no argument."""
+    with pytest.raises(FieldError, match=r"^path (= .*|is not set): expected a scenario file's path"):
+        load_scenario(bad)

@@ -408,6 +408,8 @@ def load_scenario(path, check_files=True) -> Scenario:
     """Read and check a scenario file; with ``check_files``, its model files must exist.
     A flight log is read either way: its records are the flight's poses, which the
     scenario's checks (scan count, work limit) need."""
+    if not isinstance(path, (str, os.PathLike)) or isinstance(path, bytes):
+        raise FieldError("path", path, "a scenario file's path (str or pathlib.Path)")
     path = _absolute(path)
     refuse_special_file(path, "expected a scenario file (.toml)")  # a pipe would wait for ever
     try:
