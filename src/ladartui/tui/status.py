@@ -105,7 +105,8 @@ ELLIPSIS = "\u2026"
 def fitted(message: str, room: int, name: str | None = None) -> str:
     """``message`` in ``room`` cells: ``name`` (where it occurs; by default the longest
     path in it) cut in its middle (``nigh…final.toml``, keeping at least ``MIN_NAME``
-    cells), then the end cut if that is not enough."""
+    cells), then the end cut if that is not enough, unless that cut would fall in the
+    name: then only the end is cut (a name cut twice, ``sw/…resu…``, reads as neither)."""
     over = cell_len(message) - room
     if over <= 0:
         return message
@@ -116,7 +117,10 @@ def fitted(message: str, room: int, name: str | None = None) -> str:
         keep = max(MIN_NAME, cell_len(name) - over - 1)  # one cell for the ellipsis
         head = keep // 3  # the end tells names apart more often (a suffix, the extension)
         short = _first_cells(name, head) + ELLIPSIS + _last_cells(name, keep - head)
-        message = message.replace(name, short, 1)
+        shortened = message.replace(name, short, 1)
+        through_name = cell_len(shortened[: shortened.index(short) + len(short)])
+        if cell_len(shortened) <= room or through_name < room:  # the end cut, if any, after it
+            message = shortened
     if cell_len(message) > room:
         cut = Text(message)
         cut.truncate(room, overflow="ellipsis")  # rich's cut, by cells

@@ -283,7 +283,8 @@ class SweepScreen(SweepOpening):
         )
         self._status(
             BUSY,
-            f"starting {len(ids)} variants on {where}; results in {short_path(self.out)}",
+            # the folder before the rest: a line cut at 80 columns loses its end
+            f"starting {len(ids)} variants into {short_path(self.out)} on {where}",
             0.0,
             cancellable=True,
         )
@@ -500,8 +501,8 @@ class SweepScreen(SweepOpening):
             self.query_one("#sweep-counts", Static).update(self._summary())
             self._status(
                 READY,
-                f"sweep done: {result.ran} run, {result.resumed} resumed{note} "
-                f"in {format_eta(result.elapsed)}; results in {short_path(self.out)}",
+                f"swept into {short_path(self.out)}: {result.ran} run, {result.resumed} resumed{note} "
+                f"in {format_eta(result.elapsed)}",
                 1.0,
             )
             return

@@ -1,0 +1,93 @@
+"""The sweep screen at 80 x 24: its status line, table and chart read whole and clearly.
+
+A two-variant sweep over the tiny scenario runs once, serially; each test opens or
+runs it again (every variant resumes) in a copy under the test's own folder.
+"""
+
+from __future__ import annotations
+
+import shutil
+import time
+
+import pytest
+from rich.cells import cell_len
+from textual.app import App
+
+from ladartui.sweep import run_sweep
+from ladartui.tui.status import StatusText
+from ladartui.tui.sweep_screen import SweepScreen
+from tiny_sweep import write_spec, write_tiny_scenario
+
+SIZE = (80, 24)
+
+
+class _Host(App):
+    """A bare app showing one SweepScreen."""
+
+    def __init__(self, screen: SweepScreen):
+        super().__init__()
+        self.sweep_screen = screen
+
+    def on_mount(self) -> None:
+        self.push_screen(self.sweep_screen)
+
+
+@pytest.fixture(scope="module")
+def swept(tmp_path_factory):
+    """A folder holding the base, the spec and its finished two-variant results."""
+    folder = tmp_path_factory.mktemp("swept")
+    write_tiny_scenario(folder)
+    spec = write_spec(folder, "[grid]\nradius = [15.0, 25.0]\n")
+    run_sweep(spec, serial=True)
+    return folder
+
+
+def copy_of(swept, folder):
+    """``swept`` copied into ``folder`` (a run rewrites its table); the spec there."""
+    shutil.copytree(swept, folder)
+    return folder / "spec.toml"
+
+
+async def wait_for(pilot, condition, timeout=300.0):
+    start = time.monotonic()
+    while not condition():
+        assert time.monotonic() - start < timeout, pilot.app.sweep_screen.last_message
+        await pilot.pause(0.05)
+
+
+async def opened(pilot):
+    screen = pilot.app.sweep_screen
+    await wait_for(pilot, lambda: screen.opening is None or screen.opening.is_finished)
+    await pilot.pause()
+
+
+async def test_a_finished_sweep_names_its_results_folder_whole_on_the_status_line(
+    swept, tmp_path, monkeypatch
+):
+    """It read 'results in sw/…resu…': the folder cut in its middle, then the line's end
+    cut through what was left of it."""
+    monkeypatch.chdir(tmp_path)  # the folder is shown relative to the working one
+    spec = copy_of(swept, tmp_path / "sw")
+    screen = SweepScreen(spec, serial=True)
+    async with _Host(screen).run_test(size=SIZE) as pilot:
+        await opened(pilot)
+        await pilot.press("f5")
+        await wait_for(pilot, lambda: not screen.running)
+        await pilot.pause()
+        line = screen.query_one("#sweep-status StatusText", StatusText)
+        shown = line.render().plain
+        assert "sw/spec-results" in shown and "\u2026" not in shown, shown
+        assert cell_len(shown) <= line.content_size.width
+        assert "2 resumed" in screen.last_message
+
+
+def test_a_path_that_cannot_be_shortened_enough_is_cut_once_at_the_end():
+    from ladartui.tui.status import fitted
+
+    said = "sweep done: 2 run, 0 resumed in 2m46s; results in sw/tiny-results"
+    shown = fitted(said, 57)
+    assert shown == said[:56] + "\u2026"  # not 'sw/…resu…'
+    # where the end cut falls after the name, the name is still cut in its middle too
+    name = "My Night Approach Over The Long Valley Final Plan.toml"
+    shown = fitted(f"{name} (modified): 6 scans x 144 rays. F5 runs.", 40, name)
+    assert shown.startswith("My \u2026an.toml (modified): 6 scans") and shown.endswith("\u2026")
