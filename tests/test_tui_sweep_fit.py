@@ -6,6 +6,7 @@ runs it again (every variant resumes) in a copy under the test's own folder.
 
 from __future__ import annotations
 
+import re
 import shutil
 import time
 
@@ -91,3 +92,30 @@ def test_a_path_that_cannot_be_shortened_enough_is_cut_once_at_the_end():
     name = "My Night Approach Over The Long Valley Final Plan.toml"
     shown = fitted(f"{name} (modified): 6 scans x 144 rays. F5 runs.", 40, name)
     assert shown.startswith("My \u2026an.toml (modified): 6 scans") and shown.endswith("\u2026")
+
+
+async def test_the_chart_names_each_axis_apart_for_either_cost(swept, tmp_path, monkeypatch):
+    """Under the chart 'coverage % flight time (s)' read as one phrase, and the distance
+    axis's longer name was left out for want of room."""
+    from textual_plotext import PlotextPlot
+
+    monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))  # no sweep to reopen
+    screen = SweepScreen()
+    async with _Host(screen).run_test(size=SIZE) as pilot:
+        await opened(pilot)
+        # empty, with no tick labels to push them apart: the names ran together
+        labels = screen.query_one("#sweep-chart", PlotextPlot).render().plain.splitlines()[-1]
+        assert "cov" not in labels or len(re.split(r" {2,}", labels.strip())) == 2, labels
+    screen = SweepScreen(swept / "spec-results")
+    async with _Host(screen).run_test(size=SIZE) as pilot:
+        await opened(pilot)
+        chart = screen.query_one("#sweep-chart", PlotextPlot)
+        for cost, word in (("flight-time", "time (s)"), ("distance", "distance (m)")):
+            assert screen.cost == cost
+            labels = chart.render().plain.splitlines()[-1]
+            # two labels, apart, each with the arrow of its axis
+            y_label, x_label = re.split(r" {2,}", labels.strip())
+            assert "cov" in y_label and "\u2191" in y_label, labels
+            assert word in x_label and "\u2192" in x_label, labels
+            await pilot.press("f7")
+            await pilot.pause()

@@ -11,7 +11,10 @@ from ladartui.sweep.ranking import OBJECTIVE_HEADERS
 from ladartui.sweep.table import display_cell
 
 COST_HEADERS = {"flight-time": "time s", "distance": "dist m"}
-COST_LABELS = {"flight-time": "flight time (s)", "distance": "distance flown (m)"}
+# Each label with its axis's arrow: plotext sets them side by side on one line, which
+# read as one phrase; short, so that both fit a chart 30 columns wide.
+COST_LABELS = {"flight-time": "flight time (s) \u2192", "distance": "distance (m) \u2192"}
+COVERAGE_LABEL = "\u2191 cov %"
 FRONT_MARKER = "◆"
 ERROR_WIDTH = 60  # error text in the table; the detail line shows it whole
 
@@ -105,9 +108,10 @@ def draw_pareto(plt, ranking, cost: str) -> None:
     joining its points, the best marked."""
     plt.clear_data()
     plt.title(f"{FRONT_MARKER} Pareto front  ★ best")
-    plt.xlabel(COST_LABELS[cost])
-    plt.ylabel("coverage %")
     points = [(e.cost, 100 * e.coverage, e) for e in ranking if e.cost is not None and e.coverage is not None]
+    # named beside their tick labels only: with none, the names ran together
+    plt.xlabel(COST_LABELS[cost] if points else None)
+    plt.ylabel(COVERAGE_LABEL if points else None)
     if not points:
         return
     others = [p for p in points if not p[2].pareto]
