@@ -119,3 +119,24 @@ async def test_the_chart_names_each_axis_apart_for_either_cost(swept, tmp_path, 
             assert word in x_label and "\u2192" in x_label, labels
             await pilot.press("f7")
             await pilot.pause()
+
+
+async def test_the_empty_table_fits_without_a_sideways_scrollbar(swept, tmp_path, monkeypatch):
+    """Before any results its last header was cut to 'erro' over a horizontal scrollbar;
+    the error column comes only with a row that has an error."""
+    from textual.widgets import DataTable
+
+    monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))  # no sweep to reopen
+    screen = SweepScreen()
+    async with _Host(screen).run_test(size=SIZE) as pilot:
+        await opened(pilot)
+        table = screen.query_one("#sweep-table", DataTable)
+        assert table.row_count == 0
+        assert table.virtual_size.width <= table.scrollable_content_region.width
+        assert not table.show_horizontal_scrollbar
+    screen = SweepScreen(swept / "spec-results")  # every variant ok: no error column
+    async with _Host(screen).run_test(size=SIZE) as pilot:
+        await opened(pilot)
+        table = screen.query_one("#sweep-table", DataTable)
+        labels = [column.label.plain for column in table.ordered_columns]
+        assert table.row_count == 2 and "status" in labels and "error" not in labels

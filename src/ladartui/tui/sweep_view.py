@@ -56,17 +56,20 @@ def fill_ranking_table(table, ranking, objective: str, cost: str, parameter_name
     for name in parameter_names:
         table.add_column(Text(name), key=f"param:{name}")
     table.add_column("variant", key="variant")
-    table.add_column("error", key="error")
+    # only with an error to show: an empty column ran past 80 columns before any results
+    errors = any(entry.row.get("error") for entry in ranking)
+    if errors:
+        table.add_column("error", key="error")
     for index, entry in enumerate(ranking):
-        table.add_row(*ranking_cells(entry, objective, parameter_names), key=str(index))
+        table.add_row(*ranking_cells(entry, objective, parameter_names, errors), key=str(index))
     if ranking:
         table.move_cursor(row=cursor)
     return ids
 
 
-def ranking_cells(entry, objective: str, parameter_names) -> list:
+def ranking_cells(entry, objective: str, parameter_names, errors: bool) -> list:
     """One table row: rank, front marker, objective, (coverage), cost, status, parameters,
-    variant and error; text from the results file is never markup."""
+    variant and (with ``errors``) error; text from the results file is never markup."""
     row = entry.row
     status = row.get("status") or "?"
     if objective == "obscured-coverage":
@@ -84,8 +87,9 @@ def ranking_cells(entry, objective: str, parameter_names) -> list:
     cells.append(Text(status, style="green" if status == "ok" else "bold red"))
     cells.extend(Text(display_cell(row.get(name))) for name in parameter_names)
     cells.append(Text(str(row.get("variant") or "")))
-    error = str(row.get("error") or "")
-    cells.append(Text(error[:ERROR_WIDTH] + ("…" if len(error) > ERROR_WIDTH else ""), style="red"))
+    if errors:
+        error = str(row.get("error") or "")
+        cells.append(Text(error[:ERROR_WIDTH] + ("…" if len(error) > ERROR_WIDTH else ""), style="red"))
     return cells
 
 
