@@ -140,3 +140,25 @@ async def test_the_empty_table_fits_without_a_sideways_scrollbar(swept, tmp_path
         table = screen.query_one("#sweep-table", DataTable)
         labels = [column.label.plain for column in table.ordered_columns]
         assert table.row_count == 2 and "status" in labels and "error" not in labels
+
+
+async def test_the_table_marks_the_best_variant_as_the_chart_and_its_legend_do(swept):
+    """The best variant was '◆' (the front's mark) in the table's P column but '★' on
+    the chart, whose legend reads '◆ Pareto front  ★ best'."""
+    from textual.widgets import DataTable
+    from textual_plotext import PlotextPlot
+
+    screen = SweepScreen(swept / "spec-results")
+    async with _Host(screen).run_test(size=SIZE) as pilot:
+        await opened(pilot)
+        chart = screen.query_one("#sweep-chart", PlotextPlot).render().plain.splitlines()
+        legend = chart[0]
+        front = legend[legend.index(" Pareto front") - 1]
+        best = legend[legend.index(" best") - 1]
+        assert best in "".join(chart[1:])  # the best point, drawn with the legend's mark
+        table = screen.query_one("#sweep-table", DataTable)
+        marks = [str(cell) for cell in table.get_column("pareto")]
+        assert screen.ranking[0].rank == 1 and marks[0] == best
+        for entry, mark in zip(screen.ranking[1:], marks[1:]):
+            assert mark == (front if entry.pareto else "")
+        assert f"{best} best" in str(screen.query_one("#sweep-detail").render())  # the cursor's row

@@ -16,6 +16,7 @@ COST_HEADERS = {"flight-time": "time s", "distance": "dist m"}
 COST_LABELS = {"flight-time": "flight time (s) \u2192", "distance": "distance (m) \u2192"}
 COVERAGE_LABEL = "\u2191 cov %"
 FRONT_MARKER = "◆"
+BEST_MARKER = "★"  # the best variant's, in the table as on the chart (over its front mark)
 ERROR_WIDTH = 60  # error text in the table; the detail line shows it whole
 
 
@@ -68,7 +69,7 @@ def fill_ranking_table(table, ranking, objective: str, cost: str, parameter_name
 
 
 def ranking_cells(entry, objective: str, parameter_names, errors: bool) -> list:
-    """One table row: rank, front marker, objective, (coverage), cost, status, parameters,
+    """One table row: rank, mark (``row_mark``), objective, (coverage), cost, status, parameters,
     variant and (with ``errors``) error; text from the results file is never markup."""
     row = entry.row
     status = row.get("status") or "?"
@@ -78,7 +79,7 @@ def ranking_cells(entry, objective: str, parameter_names, errors: bool) -> list:
         value = display_cell(entry.value)
     cells = [
         "-" if entry.rank is None else str(entry.rank),
-        Text(FRONT_MARKER, style="bold #ffaf00") if entry.pareto else "",
+        row_mark(entry),
         value,
     ]
     if objective != "obscured-coverage":
@@ -93,8 +94,16 @@ def ranking_cells(entry, objective: str, parameter_names, errors: bool) -> list:
     return cells
 
 
+def row_mark(entry) -> Text | str:
+    """The P column's mark, as on the chart: the best variant's star, else the front's."""
+    if entry.rank == 1:
+        return Text(BEST_MARKER, style="bold green")
+    return Text(FRONT_MARKER, style="bold #ffaf00") if entry.pareto else ""
+
+
 def detail_text(entry, parameter_names) -> Text:
-    """The detail line of one ranked variant: its parameters, and why it failed."""
+    """The detail line of one ranked variant: its parameters, and why it failed or
+    what its mark says."""
     row = entry.row
     params = ", ".join(
         f"{name}={display_cell(row.get(name))}" for name in parameter_names if row.get(name) is not None
@@ -102,7 +111,10 @@ def detail_text(entry, parameter_names) -> Text:
     text = Text(f"{row.get('variant')}: {params or 'base scenario'}")
     if row.get("status") != "ok":
         text.append(f"  {row.get('status')}: {row.get('error') or ''}", style="bold red")
-    elif entry.pareto:
+        return text
+    if entry.rank == 1:
+        text.append(f"  {BEST_MARKER} best", style="green")
+    if entry.pareto:
         text.append("  on the Pareto front", style="#ffaf00")
     return text
 
@@ -111,7 +123,7 @@ def draw_pareto(plt, ranking, cost: str) -> None:
     """Coverage against cost on a plotext figure: every variant, the front as a line
     joining its points, the best marked."""
     plt.clear_data()
-    plt.title(f"{FRONT_MARKER} Pareto front  ★ best")
+    plt.title(f"{FRONT_MARKER} Pareto front  {BEST_MARKER} best")
     points = [(e.cost, 100 * e.coverage, e) for e in ranking if e.cost is not None and e.coverage is not None]
     # named beside their tick labels only: with none, the names ran together
     plt.xlabel(COST_LABELS[cost] if points else None)
@@ -128,4 +140,4 @@ def draw_pareto(plt, ranking, cost: str) -> None:
     plt.scatter([p[0] for p in front], [p[1] for p in front], marker=FRONT_MARKER, color="orange")
     best = [p for p in points if p[2].rank == 1]
     if best:
-        plt.scatter([best[0][0]], [best[0][1]], marker="★", color="green")
+        plt.scatter([best[0][0]], [best[0][1]], marker=BEST_MARKER, color="green")
