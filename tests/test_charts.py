@@ -150,6 +150,9 @@ def test_sweep_writes_the_pareto_chart_with_the_front_cheapest_first_and_the_bes
     assert main(["sweep", str(spec), "--serial", "--out", str(out), "--json", "--top", "6"]) == 0
     report = json.loads(capsys.readouterr().out)
     assert report["charts"] == {"svg": str(out / "pareto.svg"), "png": str(out / "pareto.png")}
+    from ladartui.sweep.execute import CHART_NAMES  # checked before a sweep runs
+
+    assert sorted(Path(path).name for path in report["charts"].values()) == sorted(CHART_NAMES)
 
     svg = out / "pareto.svg"
     (variants,) = _groups(svg, "series-variants")

@@ -37,6 +37,7 @@ INPUTS = [
     ("pulses {d}/pipe.toml", "pipe.toml"),
     ("sweep {d}/pipe.toml", "pipe.toml"),
     ("sweep {d}/spec.toml --serial --out {d}/sw", "pipe.toml"),
+    ("sweep {d}/ok.toml --show --out {d}/sw", "sw/results.csv"),
     ("tui {d}/pipe.toml", "pipe.toml"),
 ]
 OUTPUTS = [
@@ -47,19 +48,24 @@ OUTPUTS = [
     ("voxelize {d}/truck.obj {d}/pipe --voxel-size 1 --at 15,15 --into {d}/tiny.txt", "pipe.txt"),
     ("run {d}/base.toml --chart {d}/pipe.svg", "pipe.svg"),
     ("run {d}/base.toml", "base.cmf"),
+] + [  # a sweep's own files in its results folder: refused before any variant runs
+    ("sweep {d}/ok.toml --serial --out {d}/sw", f"sw/{name}")
+    for name in ("results.csv", ".lock", "ranking.csv", "ok-best.toml", "pareto.svg", "pareto.png")
 ]
 
 
 def _free(folder) -> None:
-    """Open the other end of every pipe in ``folder``, ending a wait on it."""
-    for entry in os.scandir(folder):
-        if not stat.S_ISFIFO(entry.stat().st_mode):
-            continue
-        for flags in (os.O_RDONLY | os.O_NONBLOCK, os.O_WRONLY | os.O_NONBLOCK):
-            try:  # a writer end opens only while a reader waits (ENXIO otherwise)
-                os.close(os.open(entry.path, flags))
-            except OSError:
-                pass
+    """Open the other end of every pipe in ``folder`` and below, ending a wait on it."""
+    for parent, _, names in os.walk(folder):
+        for name in names:
+            path = os.path.join(parent, name)
+            if not stat.S_ISFIFO(os.stat(path).st_mode):
+                continue
+            for flags in (os.O_RDONLY | os.O_NONBLOCK, os.O_WRONLY | os.O_NONBLOCK):
+                try:  # a writer end opens only while a reader waits (ENXIO otherwise)
+                    os.close(os.open(path, flags))
+                except OSError:
+                    pass
 
 
 def _main_watched(argv, folder) -> tuple[int, bool]:
@@ -90,6 +96,7 @@ def folder(tmp_path):
     trimesh.creation.box(extents=(2.0, 4.0, 1.5)).export(tmp_path / "truck.obj")
     np.save(tmp_path / "rays.npy", np.array([[15.5, 15.5, 20.0, 0.0, 0.0, -1.0]]))
     write_spec(tmp_path, "[grid]\nradius = [20.0, 25.0]\n", scenario="pipe.toml")
+    write_spec(tmp_path, "[grid]\nradius = [20.0, 25.0]\n", name="ok.toml")
     for name in ("pipe.npy", "pipe.txt", "pipe_Target.txt", "pipe.toml", "pipe.json", "pipe.obj"):
         os.mkfifo(tmp_path / name)
     return tmp_path
@@ -98,6 +105,7 @@ def folder(tmp_path):
 @pytest.mark.parametrize(("command", "pipe"), INPUTS + OUTPUTS, ids=[c for c, _ in INPUTS + OUTPUTS])
 def test_a_pipe_for_a_file_is_refused_not_waited_on(folder, capsys, command, pipe):
     if not (folder / pipe).exists():  # an output's pipe
+        (folder / pipe).parent.mkdir(exist_ok=True)
         os.mkfifo(folder / pipe)
     status, waited = _main_watched(command.format(d=folder).split(), folder)
     assert not waited, f"waited on the pipe {pipe}"
@@ -144,6 +152,17 @@ def test_a_pipe_is_no_run_record_and_no_scenario_in_the_file_tree(tmp_path):
     os.mkfifo(pipe)
     assert _call_watched(lambda: is_record(pipe), tmp_path) == (False, False)
     assert _call_watched(lambda: opens_table(pipe, "[files]"), tmp_path) == (False, False)
+
+
+def test_a_pipe_named_as_a_best_path_is_not_read_as_one(tmp_path):
+    """Telling a sweep's best-path file from an edited one reads its first lines: a pipe
+    named NAME-best.toml waited for ever (the sweep screen lists them)."""
+    from ladartui.sweep.best_file import best_files, best_target
+
+    os.mkfifo(tmp_path / "forest-best.toml")
+    assert _call_watched(lambda: best_files(tmp_path), tmp_path) == (False, [])
+    waited, target = _call_watched(lambda: best_target(tmp_path / "forest-best.toml"), tmp_path)
+    assert not waited and target.path == tmp_path / "forest-best-2.toml"
 
 
 def _call_watched(call, folder):

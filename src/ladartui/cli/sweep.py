@@ -188,9 +188,11 @@ def run(args) -> int:
     else:
         from ladartui.outputset import check_writable_folder
         from ladartui.sweep.base import checked_base
+        from ladartui.sweep.execute import check_sweep_files
 
         checked = checked_base(spec)  # a bad base or spec is reported before any cluster starts
         check_writable_folder(args.out or default_out_dir(spec))
+        check_sweep_files(Path(args.out or default_out_dir(spec)), spec.name)
         result = _sweep_with_progress(checked, args, errors)
         if result is None:
             return stop_status()

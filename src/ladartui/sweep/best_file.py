@@ -19,6 +19,7 @@ from pathlib import Path
 
 from ladartui.atomic import numbered_paths
 from ladartui.errors import OutputFileError
+from ladartui.fileprobe import SPECIAL_FILE, file_problem
 from ladartui.textsafe import one_line
 
 HEADER = "# The best flight path of a sweep"
@@ -43,7 +44,10 @@ def _fingerprint(body: str) -> str:
 def _state(path: Path) -> str:
     """ "own" (a best path as a sweep wrote it), "edited" (its fingerprint no longer
     matches), "unmarked" (a sweep's header without a fingerprint: an earlier version's,
-    which may hold edits), or "other" (not a sweep's best path)."""
+    which may hold edits), "special" (a pipe or device: not read, a pipe would wait for
+    ever) or "other" (not a sweep's best path)."""
+    if file_problem(path) == SPECIAL_FILE:
+        return "special"
     try:
         text = path.read_text(encoding="utf-8-sig")
     except (OSError, UnicodeDecodeError):
@@ -61,6 +65,7 @@ _KEPT_WHY = {
     "edited": "edited since a sweep wrote it",
     "unmarked": "written before sweeps marked their own files; it may hold edits",
     "other": "not a best path a sweep wrote",
+    "special": SPECIAL_FILE,
 }
 
 
@@ -85,7 +90,7 @@ def best_files(folder, name: str | None = None) -> list[Path]:
         for path in Path(folder).glob(f"{name or '*'}-best*.toml")
         if _NUMBERED.search(path.stem)
         and (name is None or _NUMBERED.sub("", path.stem) == name)
-        and _state(path) != "other"
+        and _state(path) not in ("other", "special")
     ]
     return sorted(found, key=lambda path: path.stat().st_mtime_ns, reverse=True)
 

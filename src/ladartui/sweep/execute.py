@@ -13,6 +13,7 @@ import contextlib
 import dataclasses
 import math
 import numbers
+import os
 import time
 import uuid
 from collections.abc import Callable, Mapping
@@ -28,6 +29,7 @@ from ladartui.errors import (
     check_callbacks,
     check_cancelled,
 )
+from ladartui.fileprobe import file_problem
 from ladartui.sweep.base import CheckedBase, checked_base, own_rows, spec_rows
 from ladartui.sweep.best_file import best_files, write_best_scenario
 from ladartui.sweep.cluster import close_client, local_client
@@ -45,6 +47,7 @@ from ladartui.sweep.variant import ScenePayload, run_variant
 
 RESULTS_NAME = "results.csv"
 RANKING_NAME = "ranking.csv"
+LOCK_NAME = ".lock"  # held while a sweep writes the folder's tables
 # Rows with these statuses are final; "failed" rows (a crash, a lost worker) run again.
 FINAL_STATUSES = ("ok", "error")
 _POLL_SECONDS = 0.05
@@ -215,6 +218,7 @@ def run_sweep(
     out = Path(out) if out is not None else default_out_dir(spec)
     if out.exists() and not out.is_dir():
         raise OutputFileError(out, "is a file, expected a folder")
+    check_sweep_files(out, spec.name)
     if checked is None or checked.spec is not spec:
         checked = checked_base(spec)
     base = checked.scenario
@@ -240,6 +244,20 @@ def run_sweep(
         )
 
 
+# The sweep command's Pareto charts beside the tables (charts/sweep.py writes them).
+CHART_NAMES = ("pareto.svg", "pareto.png")
+
+
+def check_sweep_files(out: Path, name: str) -> None:
+    """``OutputFileError`` naming a file the sweep keeps in ``out`` that is a folder, a
+    pipe or a device, before any variant runs: a pipe would be waited on for ever when
+    read, or replaced by a file when written."""
+    for file in (LOCK_NAME, RESULTS_NAME, RANKING_NAME, f"{name}-best.toml", *CHART_NAMES):
+        path = out / file
+        if os.path.lexists(path) and (problem := file_problem(path)):
+            raise OutputFileError(path, f"{problem}; the sweep keeps its own {file} in its results folder")
+
+
 SIMULATE_OPTIONS = ("backend", "method", "step", "precision")
 
 
@@ -263,7 +281,7 @@ def _exclusive(out: Path):
     except ImportError:  # not POSIX: nothing to lock with
         yield
         return
-    with open(out / ".lock", "a+b") as handle:
+    with open(out / LOCK_NAME, "a+b") as handle:
         try:
             fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:

@@ -21,6 +21,7 @@ from pathlib import Path
 
 from ladartui.atomic import atomic_path
 from ladartui.errors import InputFileError
+from ladartui.fileprobe import refuse_special_file
 
 # Columns that lead every table, in this order; parameters and measures follow.
 LEAD_COLUMNS = ("variant", "status", "base")
@@ -118,6 +119,7 @@ def read_table(path) -> tuple[list[dict], list[str]]:
     variant id are dropped (a torn or hand-edited line), never fatal.
     """
     path = Path(path)
+    refuse_special_file(path, "expected a sweep result table (.csv)")  # a pipe would wait for ever
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
