@@ -5,6 +5,7 @@ for a file hung until killed; a pipe given as an output was replaced by a file.
 """
 
 import os
+import re
 import stat
 import subprocess
 import sys
@@ -48,6 +49,7 @@ OUTPUTS = [
     ("voxelize {d}/truck.obj {d}/pipe --voxel-size 1 --at 15,15 --into {d}/tiny.txt", "pipe.txt"),
     ("run {d}/base.toml --chart {d}/pipe.svg", "pipe.svg"),
     ("run {d}/base.toml", "base.cmf"),
+    ("study --quick --out {d}/st", "st/study.json"),  # refused before the study, not after it
 ] + [  # a sweep's own files in its results folder: refused before any variant runs
     ("sweep {d}/ok.toml --serial --out {d}/sw", f"sw/{name}")
     for name in ("results.csv", ".lock", "ranking.csv", "ok-best.toml", "pareto.svg", "pareto.png")
@@ -185,3 +187,17 @@ def _call_watched(call, folder):
     _free(folder)  # ends the wait of a reader that hung
     worker.join(WAIT)
     return waited, said[0] if said else None
+
+
+def test_the_terminal_ui_study_refuses_a_pipe_in_its_folder_before_it_runs(tmp_path, monkeypatch):
+    """The study screen's job found a pipe among its outputs only once the study was done."""
+    from ladartui.errors import OutputFileError
+    from ladartui.study import run as study_run
+    from ladartui.tui.study_screen import _study
+
+    write_tiny_scenario(tmp_path)
+    (tmp_path / "base-study").mkdir()
+    os.mkfifo(tmp_path / "base-study" / "speed-accuracy.png")
+    monkeypatch.setattr(study_run, "run_study", lambda *a, **k: pytest.fail("the study ran"))
+    with pytest.raises(OutputFileError, match=re.escape(SPECIAL_FILE)):
+        _study("quick", tmp_path / "base.toml", None, None, threading.Event(), lambda *a: None)

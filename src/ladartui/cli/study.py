@@ -71,6 +71,7 @@ def run(args: argparse.Namespace) -> int:
     from ladartui.outputset import check_writable_folder
     from ladartui.study import full_settings, quick_settings
     from ladartui.study.inputs import generated_inputs, scenario_inputs
+    from ladartui.study.run import check_outputs
 
     if args.chart_from:  # a study already run: what would shape a new one does not apply
         # every flag here defaults to None (or False), so one given at its default value is refused too
@@ -92,6 +93,7 @@ def run(args: argparse.Namespace) -> int:
             )
     check_file_names({"--out": args.out}, f"a folder name, such as {DEFAULT_OUT}")
     check_writable_folder(args.out)  # before the study, not after it
+    check_outputs(args.out)
     if args.chart_from:
         return _report(_load_result(args.chart_from), args.out)
     runs = run_count("--runs", args.runs if args.runs is not None else (3 if args.quick else 5))

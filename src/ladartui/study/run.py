@@ -258,6 +258,24 @@ def _context(inputs: StudyInputs, runs, warmup, reasons) -> dict:
     }
 
 
+def output_paths(out_dir, chart_stem="speed-accuracy", stem="study") -> dict[str, Path]:
+    """The files ``write_outputs`` writes into ``out_dir``, by kind."""
+    out_dir = Path(out_dir)
+    names = {"csv": f"{stem}.csv", "json": f"{stem}.json", "txt": f"{chart_stem}.txt"}
+    return {
+        kind: out_dir / names.get(kind, f"{chart_stem}.{kind}")
+        for kind in ("csv", "json", "svg", "png", "txt")
+    }
+
+
+def check_outputs(out_dir) -> None:
+    """``OutputFileError`` naming a file of ``write_outputs`` that could not be written
+    (a folder, pipe or device there, say): asked before a study, not after it."""
+    from ladartui.outputset import check_writable
+
+    check_writable(*output_paths(out_dir).values())
+
+
 def write_outputs(
     result: StudyResult, out_dir, chart_stem="speed-accuracy", stem="study", width=100, height=30
 ) -> dict[str, Path]:
@@ -278,9 +296,7 @@ def write_outputs(
         "png": figure_bytes(figure, "png"),
         "txt": (chart_text(result, width, height, color=False) + "\n\n" + result.verdict() + "\n").encode(),
     }
-    names = {"csv": f"{stem}.csv", "json": f"{stem}.json", "txt": f"{chart_stem}.txt"}
-    paths = {kind: out_dir / names.get(kind, f"{chart_stem}.{kind}") for kind in contents}
-
+    paths = output_paths(out_dir, chart_stem, stem)
     with OutputSet(paths, out_dir / f".{stem}.outputs.lock") as output_set:
         output_set.write_contents(contents)
     return paths

@@ -220,8 +220,11 @@ def _study(mode: str, scenario_path, scans, runs, cancel, progress):
     """The study job (worker thread): (result, what was done)."""
     from ladartui.study import full_settings, quick_settings
     from ladartui.study.inputs import generated_inputs, scenario_inputs
-    from ladartui.study.run import run_study
+    from ladartui.study.results import study_folder
+    from ladartui.study.run import check_outputs, run_study, write_outputs
 
+    folder = study_folder(scenario_path)
+    check_outputs(folder)  # before the study, not after it
     quick = mode == "quick"
     scans = scans or (2 if quick else 3)
     runs = runs or (3 if quick else 5)
@@ -239,9 +242,5 @@ def _study(mode: str, scenario_path, scans, runs, cancel, progress):
         cancel=cancel,
         progress=lambda p: progress(p.done / max(p.total, 1), p.label, p),
     )
-    from ladartui.study.results import study_folder
-    from ladartui.study.run import write_outputs
-
-    folder = study_folder(scenario_path)
     write_outputs(result, folder)  # kept, so the screen reopens it next time
     return result, f"{mode} study done on {inputs.name}; kept in {folder}"
