@@ -54,6 +54,13 @@ def test_json_rows_use_the_scenario_settings(scenario, capsys):
     assert rows[1]["false_alarms"] > rows[0]["false_alarms"] > 0
 
 
+def test_pulse_counts_are_traced_once_each_in_increasing_order(scenario, capsys):
+    # A repeated or out-of-order list made repeated rows and a chart line that doubled back.
+    assert main(["pulses", str(scenario.path), "--pulses", "20,1,5,1", "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)["rows"]
+    assert [r["pulses"] for r in rows] == [1, 5, 20]
+
+
 def test_table_and_chart(scenario, capsys):
     assert main(["pulses", str(scenario.path), "--pulses", "1,20", "--seed", "5"]) == 0
     out = capsys.readouterr().out

@@ -37,7 +37,8 @@ def add_parser(sub):
     p.add_argument(
         "--pulses",
         default="1,10,100",
-        help="comma-separated pulses per look, each 1 to 100000 (default 1,10,100)",
+        help="comma-separated pulses per look, each 1 to 100000 (default 1,10,100); "
+        "each is studied once, in increasing order",
     )
     p.add_argument(
         "--n-ref",
@@ -62,7 +63,7 @@ def _pulse_counts(text):
         raise FieldError("--pulses", text, "comma-separated whole numbers") from None
     if any(p < 1 or p > 100_000 for p in pulses):
         raise FieldError("--pulses", text, "pulse counts in 1..100000")
-    return pulses
+    return sorted(set(pulses))  # each count once, in the order the chart's line is drawn
 
 
 def _settings(scenario, args):
