@@ -346,3 +346,33 @@ def test_the_scenario_file_names_the_radius_line(tmp_path):
     )
     with pytest.raises(FieldError, match=r"far.toml:7: flight.segments\[0\].radius"):
         load_scenario(path, check_files=False)
+
+
+def test_a_scan_past_the_coordinate_limit_is_blamed_on_the_distance_the_user_wrote(tmp_path):
+    # The message named the pose's "y", a key no segment has, at the segment's first line.
+    from ladartui.flight import flypast, standoff_sweep, straight, turn
+    from ladartui.scenario import load_scenario
+
+    path = tmp_path / "far.toml"
+    path.write_text(
+        '[files]\nscene = "scene.txt"\nvoxel_size = 1.0\n[[flight.segments]]\n'
+        'kind = "orbit"\ncentre = [10.0, 0.0, 0.0]\nradius = 1e6\naltitude = 20000.0\n'
+        "scans = 4\n"
+    )
+    with pytest.raises(FieldError) as caught:
+        load_scenario(path, check_files=False)
+    assert str(caught.value) == (
+        f"{path}:7: flight.segments[0].radius = 1000000.0: expected a radius that puts every "
+        "scan within 1000000 m of the scene's origin in x and y (a scan would be at x = 1000010.0 m)"
+    )
+    start = ScanPose(999_990.0, 0.0, 100.0, heading=90.0)
+    for build, field in (
+        (lambda: flypast((999_990.0, 0.0, 0.0), 10.0, 100.0, 200.0, 3, 90.0), "standoff"),
+        (lambda: standoff_sweep((999_990.0, 0.0, 0.0), (50.0,), 100.0, bearing=90.0), "standoffs"),
+        (lambda: straight(start, 50.0, 2), "distance"),
+        (lambda: turn(start, 50.0, 90.0, "left", 2), "radius"),
+    ):
+        with pytest.raises(FieldError) as caught:
+            build()
+        assert caught.value.field == field
+        assert "within 1000000 m of the scene's origin in x and y" in str(caught.value)

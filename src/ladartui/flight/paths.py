@@ -67,6 +67,22 @@ def _aimed_at_default(poses, target, altitude, field: str, value, what: str):
         ) from None
 
 
+def _within_bounds(build, field: str, value, what: str) -> list[ScanPose]:
+    """``build()``'s poses; a scan placed past the coordinate limit is blamed on the
+    distance the user wrote (``field``), not on the pose's own x or y, which no file has."""
+    try:
+        return build()
+    except FieldError as error:
+        if error.field not in ("x", "y"):
+            raise
+        raise FieldError(
+            field,
+            value,
+            f"{what} that puts every scan within {number_text(MAX_COORDINATE)} m of the "
+            f"scene's origin in x and y (a scan would be at {error.field} = {error.value:.1f} m)",
+        ) from None
+
+
 def _with_sensor(pose, azimuth, depression):
     changes = {}
     if azimuth is not None:
@@ -89,10 +105,15 @@ def straight(start: ScanPose, distance: float, scans: int) -> list[ScanPose]:
     distance = _length("distance", distance)
     scans = _scans(scans)
     fx, fy = _forward(start.heading)
-    return [
-        replace(start, x=start.x + fx * distance * k / scans, y=start.y + fy * distance * k / scans)
-        for k in range(1, scans + 1)
-    ]
+    return _within_bounds(
+        lambda: [
+            replace(start, x=start.x + fx * distance * k / scans, y=start.y + fy * distance * k / scans)
+            for k in range(1, scans + 1)
+        ],
+        "distance",
+        distance,
+        "a distance",
+    )
 
 
 def _turn_centre(start, radius, clockwise):
@@ -124,10 +145,15 @@ def turn(start: ScanPose, radius: float, arc: float, direction: str, scans: int)
     centre = _turn_centre(start, radius, clockwise)
     sign = 1.0 if clockwise else -1.0
     first_bearing = start.heading - sign * 90.0
-    return [
-        _on_circle(start, centre, radius, first_bearing + sign * arc * k / scans, clockwise)
-        for k in range(1, scans + 1)
-    ]
+    return _within_bounds(
+        lambda: [
+            _on_circle(start, centre, radius, first_bearing + sign * arc * k / scans, clockwise)
+            for k in range(1, scans + 1)
+        ],
+        "radius",
+        radius,
+        "a radius",
+    )
 
 
 # -- presets (report figure 1) --------------------------------------------------------
@@ -165,7 +191,14 @@ def orbit(
     clockwise = direction == "right"
     step = _arc_steps(arc, scans) * (1.0 if clockwise else -1.0)
     template = _template(altitude)
-    poses = [_on_circle(template, centre, radius, start_bearing + step * k, clockwise) for k in range(scans)]
+    poses = _within_bounds(
+        lambda: [
+            _on_circle(template, centre, radius, start_bearing + step * k, clockwise) for k in range(scans)
+        ],
+        "radius",
+        radius,
+        "a radius",
+    )
     if aim_at is None:
         return _aimed_at_default(poses, centre, altitude, "radius", radius, "a radius")
     return _aimed(poses, aim_at)
@@ -194,7 +227,12 @@ def flypast(
     cx, cy = target[0] + away * standoff * fy, target[1] - away * standoff * fx
     template = _template(altitude, heading)
     offsets = [0.0] if scans == 1 else [length * (k / (scans - 1) - 0.5) for k in range(scans)]
-    poses = [replace(template, x=cx + fx * s, y=cy + fy * s) for s in offsets]
+    poses = _within_bounds(
+        lambda: [replace(template, x=cx + fx * s, y=cy + fy * s) for s in offsets],
+        "standoff",
+        standoff,
+        "a standoff (with the target and half the length)",
+    )
     if aim_at is None:  # the line's ends are the farthest: blame the standoff and length
         return _aimed_at_default(
             poses, target, altitude, "standoff", standoff, "a standoff (with half the length)"
@@ -218,7 +256,12 @@ def standoff_sweep(
     heading = bearing + 180.0 if heading is None else number_field("heading", heading)
     bx, by = _forward(bearing)
     template = _template(altitude, heading)
-    poses = [replace(template, x=target[0] + bx * s, y=target[1] + by * s) for s in distances]
+    poses = _within_bounds(
+        lambda: [replace(template, x=target[0] + bx * s, y=target[1] + by * s) for s in distances],
+        "standoffs",
+        list(distances),
+        "a list of standoffs",
+    )
     if aim_at is None:
         return _aimed_at_default(poses, target, altitude, "standoffs", list(distances), "standoffs")
     return _aimed(poses, aim_at)
