@@ -123,6 +123,16 @@ def test_a_log_saved_with_a_byte_order_mark_is_read(tmp_path):
     assert list(load_flight_log(path).time) == [0.0, 1.0]
 
 
+def test_a_log_that_is_not_utf8_is_named_on_its_line(tmp_path):
+    """It said "cannot read flight log ('utf-8' codec can't decode byte 0xff in position 48:
+    invalid start byte)": no line, and Python's words for what was expected."""
+    path = tmp_path / "log.csv"
+    path.write_bytes(b"time,x,y,z,heading\n0,20,64,60,90\n1,50,64,\xb060,90\n")
+    with pytest.raises(TrajectoryError) as caught:
+        load_flight_log(path)
+    assert str(caught.value) == f"{path}:3: not UTF-8 text (byte 0xb0); expected a flight log (CSV)"
+
+
 @pytest.mark.parametrize(
     ("origin", "found"),
     [("[95.0, 0.0, 0.0]", "origin[0] = 95.0"), ("[0.0, 200.0, 0.0]", "origin[1] = 200.0")],

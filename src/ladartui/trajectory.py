@@ -84,9 +84,16 @@ def load_flight_log(path, origin=None) -> FlightLog:
     path = Path(path)
     refuse_special_file(path, "expected a flight log (CSV)")
     try:
-        text = path.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as error:
-        raise TrajectoryError(f"{path}: cannot read flight log ({error})") from None
+        data = path.read_bytes()
+    except OSError as error:
+        raise TrajectoryError(f"{path}: cannot read flight log ({error.strerror or error})") from None
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as error:
+        line = data.count(b"\n", 0, error.start) + 1
+        raise TrajectoryError(
+            f"{path}:{line}: not UTF-8 text (byte 0x{data[error.start]:02x}); expected a flight log (CSV)"
+        ) from None
     rows = [
         (n, line)
         for n, line in enumerate(text.splitlines(), start=1)
