@@ -385,7 +385,28 @@ def test_a_scenario_path_that_is_a_folder_or_not_text_says_so_in_words(tmp_path)
     binary.write_bytes(b"\xff\xfe\x00junk")
     with pytest.raises(LadarError) as undecodable:
         load_scenario(binary)
-    assert str(undecodable.value) == f"{binary}: not UTF-8 text; expected a scenario file (.toml)"
+    assert (
+        str(undecodable.value) == f"{binary}:1: not UTF-8 text (byte 0xff); expected a scenario file (.toml)"
+    )
+
+
+def test_text_that_is_not_utf8_is_named_on_its_line(tmp_path):
+    """A Latin-1 comment said only "not UTF-8 text" of a scenario, and Python's "'utf-8' codec
+    can't decode byte 0xe9 in position 24" of a sweep spec or its results table."""
+    from ladartui.sweep.table import read_table
+
+    latin = b"# made by hand\n# caf\xe9\n"
+    readers = (
+        (load_scenario, "s.toml", "expected a scenario file (.toml)"),
+        (load_sweep_spec, "spec.toml", "expected a sweep spec (.toml)"),
+        (read_table, "results.csv", "expected the sweep results table (CSV)"),
+    )
+    for read, name, expected in readers:
+        path = tmp_path / name
+        path.write_bytes(latin)
+        with pytest.raises(LadarError) as caught:
+            read(path)
+        assert str(caught.value) == f"{path}:2: not UTF-8 text (byte 0xe9); {expected}"
 
 
 def test_binary_data_given_as_a_voxel_list_says_so(tmp_path):

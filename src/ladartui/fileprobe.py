@@ -26,6 +26,22 @@ def file_problem(path: Path) -> str | None:
         return f"cannot be read ({os.strerror(error.errno) if error.errno else error})"
 
 
+def not_utf8(data: bytes, error: UnicodeDecodeError) -> tuple[int, str]:
+    """Where ``data`` stops being UTF-8 text: the line (from 1) and "not UTF-8 text (byte 0xNN)"."""
+    return data.count(b"\n", 0, error.start) + 1, f"not UTF-8 text (byte 0x{data[error.start]:02x})"
+
+
+def read_utf8(path, expected: str) -> str:
+    """The text of ``path`` (a byte order mark dropped); bytes that are not UTF-8 raise
+    "PATH:LINE: not UTF-8 text (byte 0xNN); ``expected``". OSError is the caller's."""
+    data = Path(path).read_bytes()
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as error:
+        line, problem = not_utf8(data, error)
+        raise InputFileError(path, f"{problem}; {expected}", line) from None
+
+
 def _name_max(path: Path) -> int:
     try:
         return os.pathconf(Path(path).anchor or ".", "PC_NAME_MAX")

@@ -23,7 +23,7 @@ from ladartui.atomic import write_text_atomic
 from ladartui.checks import choice_field, number_field
 from ladartui.detection.settings import DetectionSettings
 from ladartui.errors import FieldError, InputFileError, LadarError, OutputFileError
-from ladartui.fileprobe import NO_SUCH_FILE, file_problem, refuse_special_file
+from ladartui.fileprobe import NO_SUCH_FILE, file_problem, read_utf8, refuse_special_file
 from ladartui.flight import (
     FlightPlan,
     ScanPose,
@@ -413,13 +413,11 @@ def load_scenario(path, check_files=True) -> Scenario:
     path = _absolute(path)
     refuse_special_file(path, "expected a scenario file (.toml)")  # a pipe would wait for ever
     try:
-        text = path.read_text(encoding="utf-8-sig")
+        text = read_utf8(path, "expected a scenario file (.toml)")
     except FileNotFoundError:
         raise InputFileError(path, f"{NO_SUCH_FILE}; expected a scenario file (.toml)") from None
     except IsADirectoryError:
         raise InputFileError(path, "is a folder; expected a scenario file (.toml)") from None
-    except UnicodeDecodeError:
-        raise InputFileError(path, "not UTF-8 text; expected a scenario file (.toml)") from None
     except OSError as error:
         raise InputFileError(path, f"cannot read the scenario file: {error.strerror or error}") from None
     scenario = scenario_from_toml(text, path)

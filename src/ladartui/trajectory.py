@@ -26,7 +26,7 @@ import numpy as np
 
 from ladartui.checks import MAX_COORDINATE
 from ladartui.errors import FieldError, LadarError
-from ladartui.fileprobe import file_problem, refuse_special_file
+from ladartui.fileprobe import file_problem, not_utf8, refuse_special_file
 from ladartui.flight import ScanPose
 
 REQUIRED = ("time", "x", "y", "z", "heading")
@@ -90,10 +90,8 @@ def load_flight_log(path, origin=None) -> FlightLog:
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as error:
-        line = data.count(b"\n", 0, error.start) + 1
-        raise TrajectoryError(
-            f"{path}:{line}: not UTF-8 text (byte 0x{data[error.start]:02x}); expected a flight log (CSV)"
-        ) from None
+        line, problem = not_utf8(data, error)
+        raise TrajectoryError(f"{path}:{line}: {problem}; expected a flight log (CSV)") from None
     rows = [
         (n, line)
         for n, line in enumerate(text.splitlines(), start=1)

@@ -41,7 +41,7 @@ from typing import NoReturn
 import numpy as np
 
 from ladartui.errors import InputFileError
-from ladartui.fileprobe import NO_SUCH_FILE, refuse_special_file
+from ladartui.fileprobe import NO_SUCH_FILE, read_utf8, refuse_special_file
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.sweep.variant import applicable
 from ladartui.user_data import bundled_scenario_name
@@ -212,14 +212,14 @@ def load_sweep_spec(path) -> SweepSpec:
     path = Path(path)
     refuse_special_file(path, "expected a sweep spec (.toml)")
     try:
-        text = path.read_text(encoding="utf-8-sig")
+        text = read_utf8(path, "expected a sweep spec (.toml)")
         data = tomllib.loads(text)
     except FileNotFoundError:
         raise InputFileError(path, f"{NO_SUCH_FILE}; expected a sweep spec (.toml)") from None
     except RecursionError:
         raise InputFileError(path, "not valid TOML: arrays or tables nested too deep to read") from None
-    except (OSError, UnicodeDecodeError) as error:
-        raise InputFileError(path, f"cannot read: {error}") from None
+    except OSError as error:
+        raise InputFileError(path, f"cannot read: {error.strerror or error}") from None
     except tomllib.TOMLDecodeError as error:
         line = getattr(error, "lineno", None)
         raise InputFileError(path, f"not valid TOML: {error}", line=line) from None

@@ -21,7 +21,7 @@ from pathlib import Path
 
 from ladartui.atomic import atomic_path
 from ladartui.errors import InputFileError
-from ladartui.fileprobe import refuse_special_file
+from ladartui.fileprobe import read_utf8, refuse_special_file
 
 # Columns that lead every table, in this order; parameters and measures follow.
 LEAD_COLUMNS = ("variant", "status", "base")
@@ -119,13 +119,13 @@ def read_table(path) -> tuple[list[dict], list[str]]:
     variant id are dropped (a torn or hand-edited line), never fatal.
     """
     path = Path(path)
-    refuse_special_file(path, "expected a sweep result table (.csv)")  # a pipe would wait for ever
+    refuse_special_file(path, "expected the sweep results table (CSV)")  # a pipe would wait for ever
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_utf8(path, "expected the sweep results table (CSV)")
     except FileNotFoundError:
         return [], []
-    except (OSError, UnicodeDecodeError) as error:
-        raise InputFileError(path, f"cannot read the sweep results: {error}") from None
+    except OSError as error:
+        raise InputFileError(path, f"cannot read the sweep results: {error.strerror or error}") from None
     reader = csv.reader(io.StringIO(text))
     try:
         header = next(reader)
