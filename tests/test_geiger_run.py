@@ -92,6 +92,18 @@ def test_run_agrees_with_the_pulse_study_row(woods):
     assert row.target_detection == d.target_detection and ideal == d.ideal_obscured_coverage
 
 
+def test_with_no_target_return_the_run_and_the_pulse_study_leave_p_d_undefined(woods, capsys):
+    """The pulse study said P_d 0.000 (0.0 in its JSON) where the run said undefined."""
+    away = aim_at(ScanPose(60.0, 60.0, 40.0), (70.0, 70.0, 0.0))  # sees only ground
+    scenario = _geiger(woods, pulses=10, coincidence=2)
+    scenario = scenario.with_changes(flight=FlightPlan(segments=[Manual((away,))])).save()
+    d = simulate(scenario, write=False).measures.detection
+    _, (row,) = pulse_study(scenario, [10])
+    assert d.target_detection is None and row.target_detection is None
+    assert main(["pulses", str(scenario.path), "--pulses", "10", "--no-chart"]) == 0
+    assert capsys.readouterr().out.splitlines()[-1].split()[-1] == "undefined"
+
+
 def test_cli_run_writes_and_reads_back_the_detection_measures(woods, capsys):
     scenario = _geiger(woods, pulses=5, coincidence=2).save()
     assert "[detection]" in scenario.path.read_text()

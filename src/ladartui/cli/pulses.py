@@ -107,9 +107,10 @@ def run(args) -> int:
     print(f"ideal model: obscured coverage {ideal:.4f}")
     print(f"{'pulses':>7} {'k':>4} {'coverage':>9} {'declared':>9} {'false':>7} {'P_d(target)':>11}")
     for r in rows:
+        detection = "undefined" if r.target_detection is None else f"{r.target_detection:.3f}"
         print(
             f"{r.pulses:>7} {r.threshold:>4} {r.obscured_coverage:>9.4f} {r.declared_points:>9} "
-            f"{r.false_alarms:>7} {r.target_detection:>11.3f}"
+            f"{r.false_alarms:>7} {detection:>11}"
         )
     if args.chart:
         print(chart_text(ideal, rows, color=sys.stdout.isatty()))

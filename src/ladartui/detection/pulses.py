@@ -35,7 +35,9 @@ class PulseRow:
     obscured_coverage: float
     declared_points: int
     false_alarms: int
-    target_detection: float  # declared / ideal distinct target voxels, summed over looks
+    # declared / ideal distinct target voxels, summed over looks; None (as in a run's
+    # measures) when the ideal model saw no target voxel
+    target_detection: float | None
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -139,7 +141,7 @@ def pulse_study(
                 covered / total if total else 0.0,
                 points,
                 false_alarms,
-                target_declared / target_ideal if target_ideal else 0.0,
+                target_declared / target_ideal if target_ideal else None,
             )
         )
     return float(ideal_cov), rows
