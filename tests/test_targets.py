@@ -345,6 +345,31 @@ def test_run_prints_a_table_per_target_and_info_counts_them(tmp_path, capsys):
     assert "2 targets (ids 1, 2)" in capsys.readouterr().out
 
 
+def test_run_prints_each_targets_levels_as_its_json_holds_them(tmp_path, capsys):
+    """With several targets the table showed only the levels of all targets together:
+    a target never detected went unmentioned, though --json held each target's levels."""
+    from ladartui.cli import main
+
+    scenario = two_box_scenario(tmp_path, names=((2, "roofed"),)).save()
+    assert main(["run", str(scenario.path), "--no-write", "--json"]) == 0
+    per_target = json.loads(capsys.readouterr().out)["measures"]["targets"]["per_target"]
+    assert main(["run", str(scenario.path), "--no-write"]) == 0
+    out = capsys.readouterr().out
+    assert "Levels of all targets together" in out
+    section = out[out.index("Levels per target") :]
+    for target in per_target:
+        levels = [target["measures"]["levels"][level] for level in ("detect", "recognise", "identify")]
+        expected = [
+            f"scan {level['scan']} ({level['flight_time_s']:.1f} s)" if level["reached"] else "not reached"
+            for level in levels
+        ]
+        row = next(
+            line for line in section.splitlines() if line.startswith(f"│ {target['id']} {target['name']} ")
+        )
+        assert [cell.strip() for cell in row.split("│")[2:-1]] == expected
+    assert "not reached" in section
+
+
 def test_convoy_is_made_on_first_use_with_three_named_targets():
     from ladartui.user_data import bundled_or_path
 

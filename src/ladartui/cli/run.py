@@ -234,7 +234,12 @@ def show_result(console, result) -> None:
     if result.measures.detection is not None:
         console.print(detection_table(result.measures.detection))
     if result.measures.levels is not None:
-        console.print(levels_table(result.measures.levels))
+        several = targets is not None and len(targets.targets) > 1
+        console.print(
+            levels_table(result.measures.levels, "Levels of all targets together" if several else "Levels")
+        )
+        if several:  # the levels each target reached on its own, as --json holds them
+            console.print(target_levels_table(targets))
     total = result.timings.get("total", 0.0)
     console.print(
         f"backend: {result.backend} ({result.method}); {result.scans} scans x "
@@ -306,14 +311,14 @@ def detection_table(detection):
     return table
 
 
-def levels_table(levels):
+def levels_table(levels, title="Levels"):
     """Detect / recognise / identify: each level's thresholds and the scan that reached it."""
     from rich.table import Table
 
     from ladartui.measures import format_share
 
     table = Table(
-        title=f"Levels: {format_share(levels.visible_share)} of {levels.visible_voxels or 0} "
+        title=f"{title}: {format_share(levels.visible_share)} of {levels.visible_voxels or 0} "
         f"visible voxels, {format_share(levels.footprint_share)} of {levels.footprint_cells or 0} "
         "footprint cells seen"
     )
@@ -322,4 +327,27 @@ def levels_table(levels):
     table.add_column("reached at")
     for row in levels.rows():
         table.add_row(*row)
+    return table
+
+
+def target_levels_table(per_target):
+    """Each target's detect / recognise / identify: the scan and flight time that reached it."""
+    from rich.markup import escape
+    from rich.table import Table
+
+    from ladartui.levels import LEVELS, NOT_REACHED
+
+    table = Table(title="Levels per target")
+    table.add_column("Target")
+    for level in LEVELS:
+        table.add_column(level.capitalize())
+    for target in per_target.targets:
+        levels = target.measures.levels
+        if levels is None:
+            continue
+        cells = [
+            f"scan {item.scan} ({item.flight_time_s:.1f} s)" if item.reached else NOT_REACHED
+            for item in levels.levels
+        ]
+        table.add_row(escape(f"{target.target_id} {target.name}"), *cells)  # a name is text, not markup
     return table
