@@ -200,3 +200,16 @@ def test_flags_the_run_would_ignore_or_round_are_refused(scenario, capsys):
     assert main(["run", str(scenario.path), "--max-rays", "1.5"]) == 2
     assert "--max-rays = 1.5: expected a whole number of rays >= 1" in capsys.readouterr().err
     assert not scenario.measures_file.exists()
+
+
+def test_a_step_an_exact_run_would_ignore_is_refused(scenario, capsys):
+    """--step 3 on an exact scenario traced exactly, without a word, and its record kept the
+    step (trace refuses the same flags)."""
+    assert main(["run", str(scenario.path), "--step", "3"]) == 2
+    assert capsys.readouterr().err == (
+        "ladartui: error: --step 3 sets the march's step, and this run is exact (the scenario's "
+        "simulation.method): add --method march, or drop --step\n"
+    )
+    assert main(["run", str(scenario.path), "--method", "exact", "--step", "3"]) == 2
+    assert "and this run is --method exact: add --method march" in capsys.readouterr().err
+    assert not scenario.measures_file.exists()

@@ -42,7 +42,9 @@ def add_parser(subparsers):
         "--backend", metavar="B", help="tracing backend: auto, numba or wgpu (default: the scenario's)"
     )
     parser.add_argument("--method", metavar="M", help="tracing method: exact or march")
-    parser.add_argument("--step", metavar="S", type=float, help="march step in voxels")
+    parser.add_argument(
+        "--step", metavar="S", type=float, help="march step in voxels (needs a march: --method march)"
+    )
     parser.add_argument("--precision", metavar="P", help="tracing precision: f32 or f64")
     parser.add_argument("--las", action="store_true", help="also write the outputs as LAS point clouds")
     parser.add_argument(
@@ -83,6 +85,16 @@ def run(args) -> int:
     overrides = {name: value for name, value in overrides.items() if value is not None}
     with as_flags(overrides):
         scenario = scenario.with_changes(**overrides)
+    if args.step is not None and scenario.method != "march":  # as trace: a step the run would ignore
+        how = (
+            f"--method {args.method}"
+            if args.method
+            else f"{scenario.method} (the scenario's simulation.method)"
+        )
+        raise LadarError(
+            f"--step {args.step:g} sets the march's step, and this run is {how}: "
+            "add --method march, or drop --step"
+        )
     if args.write:  # before any progress is drawn; the run checks again under its lock
         from ladartui.outputset import check_writable
         from ladartui.simulation import check_outputs_spare_inputs, output_paths
