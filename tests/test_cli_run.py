@@ -213,3 +213,13 @@ def test_a_step_an_exact_run_would_ignore_is_refused(scenario, capsys):
     assert main(["run", str(scenario.path), "--method", "exact", "--step", "3"]) == 2
     assert "and this run is --method exact: add --method march" in capsys.readouterr().err
     assert not scenario.measures_file.exists()
+
+
+def test_a_one_scan_run_and_its_summary_say_one_scan(scenario, capsys):
+    """They said "1 scans x 1,024 rays" and "flight     1 scans: manual (1)"."""
+    first = scenario.flight.segments[0].poses[:1]
+    one = scenario.with_changes(flight=FlightPlan(segments=[Manual(first)])).save()
+    assert main(["run", str(one.path), "--no-write"]) == 0
+    assert "; 1 scan x 1,024 rays, two runs, in " in capsys.readouterr().out
+    assert main(["validate", str(one.path)]) == 0
+    assert "\nflight     1 scan: manual (1)\n" in capsys.readouterr().out

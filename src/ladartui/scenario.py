@@ -29,6 +29,7 @@ from ladartui.flight import (
     ScanPose,
 )
 from ladartui.levels import LEVELS, LevelThresholds
+from ladartui.number_text import plural
 from ladartui.scenario_file import (
     RECORD_SUFFIX,
     ScenarioReader,
@@ -269,7 +270,7 @@ class Scenario:
             f"sensor     {s.grid}x{s.grid} detectors, {s.ray_grid}x{s.ray_grid} rays each, "
             f"FOV {s.fov:g} deg ({s.ifov:.3g} deg per detector), "
             f"depth resolution {s.depth_resolution:g} m, pitch {s.pixel_pitch * 1e6:g} um",
-            f"flight     {len(poses)} scans: {kinds}",
+            f"flight     {plural(len(poses), 'scan')}: {kinds}",
             f"           altitude {min(altitudes):g}..{max(altitudes):g} m, depression "
             f"{min(depressions):.3g}..{max(depressions):.3g} deg",
             f"           path {length:.1f} m, {self.flight_time():.1f} s at {self.speed:g} m/s",
@@ -508,5 +509,5 @@ def _check_work(scenario):
     check_rays(
         2 * sensor.rays_per_scan * scans,
         f"{scenario.path.name}: sensor.grid = {sensor.grid}, sensor.ray_grid = "
-        f"{sensor.ray_grid}, {scans:,} scans",
+        f"{sensor.ray_grid}, {plural(scans, 'scan')}",
     )

@@ -28,6 +28,7 @@ from ladartui.checks import MAX_COORDINATE
 from ladartui.errors import FieldError, LadarError
 from ladartui.fileprobe import file_problem, not_utf8, refuse_special_file
 from ladartui.flight import ScanPose
+from ladartui.number_text import plural
 
 REQUIRED = ("time", "x", "y", "z", "heading")
 GEODETIC = ("latitude", "longitude", "altitude")
@@ -159,7 +160,7 @@ def load_flight_log(path, origin=None) -> FlightLog:
         elif values["z"][-1] <= 0:
             raise TrajectoryError(f"{path}:{number}: z = {values['z'][-1]!r}: expected > 0")
     if len(values["time"]) < 2:
-        raise TrajectoryError(f"{path}: {len(values['time'])} records: expected at least 2")
+        raise TrajectoryError(f"{path}: {plural(len(values['time']), 'record')}: expected at least 2")
     arr = {k: np.array(v, dtype=np.float64) for k, v in values.items()}
     if geodetic:
         xyz = geodetic_to_local(arr["latitude"], arr["longitude"], arr["altitude"], origin)

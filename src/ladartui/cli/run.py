@@ -225,6 +225,7 @@ def show_result(console, result) -> None:
     from rich.table import Table
 
     from ladartui.measures import comparison_rows, view_rows
+    from ladartui.number_text import plural
 
     views = Table(title="Measures of effectiveness")
     views.add_column("")
@@ -254,7 +255,7 @@ def show_result(console, result) -> None:
             console.print(target_levels_table(targets))
     total = result.timings.get("total", 0.0)
     console.print(
-        f"backend: {result.backend} ({result.method}); {result.scans} scans x "
+        f"backend: {result.backend} ({result.method}); {plural(result.scans, 'scan')} x "
         f"{result.rays_per_scan:,} rays, two runs, in {total:.2f} s"
     )
     if result.outputs:

@@ -17,6 +17,7 @@ import numpy as np
 
 from ladartui.atomic import write_text_atomic
 from ladartui.errors import FieldError
+from ladartui.number_text import plural
 from ladartui.user_data import data_home
 
 if TYPE_CHECKING:
@@ -67,7 +68,7 @@ def pick_scans(poses, limit: int | None):
 def check_scans(field: str, scans: int | None, available: int, flight: str) -> None:
     """FieldError ``field`` when more scans are asked for than ``flight`` has."""
     if scans is not None and scans > available:
-        raise FieldError(field, scans, f"at most {available}: {flight} has {available} scans")
+        raise FieldError(field, scans, f"at most {available}: {flight} has {plural(available, 'scan')}")
 
 
 def scenario_inputs(path, scans: int | None = DEFAULT_SCANS, refuse_as: str | None = None) -> StudyInputs:
