@@ -145,6 +145,14 @@ def test_info_without_target_file(tmp_path, capsys):
     assert "lonely_Target.txt: 1 voxel, 1 of them in the scene" in capsys.readouterr().out
 
 
+def test_info_on_a_target_model_looks_for_no_target_model_of_it(tmp_path, capsys):
+    """It said "target  none (lonely_Target_Target.txt not found)"."""
+    (tmp_path / "lonely_Target.txt").write_text("1,1,1,1\n2,1,1,2\n")
+    assert main(["info", str(tmp_path / "lonely_Target.txt")]) == 0
+    rows = {line.split()[0]: line for line in capsys.readouterr().out.splitlines()[1:]}
+    assert "target" not in rows and rows["targets"].split(None, 1)[1] == "2 targets (ids 1, 2)"
+
+
 def test_info_bad_file_is_one_line(tmp_path, capsys):
     (tmp_path / "bad.txt").write_text("1,2,3\n1,2\n")
     assert main(["info", str(tmp_path / "bad.txt")]) == 2

@@ -92,7 +92,8 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
         voxel_size_flag(voxel_size)  # as trace takes it: not inf, not 1e308
     started = time.perf_counter()
     ids = None
-    if path.stem.endswith("_Target"):  # a target model: x,y,z or x,y,z,id lines
+    is_target_model = path.stem.endswith("_Target")
+    if is_target_model:  # x,y,z or x,y,z,id lines
         voxels, ids = load_target(path)
         duplicates = 0
     else:
@@ -115,8 +116,9 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
         rows.append(("extent", f"{ranges}  (shape {shape[0]} x {shape[1]} x {shape[2]})"))
         if voxel_size:
             rows.append(("extent (m)", f"{extent_metres(shape, voxel_size)} at {voxel_size:g} m"))
-    target_path = target_path_for(path)
-    if target_path.is_file() and target_path != path:
+    # A target model's own targets are counted above: it has no target model of its own.
+    target_path = None if is_target_model else target_path_for(path)
+    if target_path is not None and target_path.is_file():
         target, ids = load_target(target_path)
         text = f"{target_path.name}: {plural(len(target), 'voxel')}"
         if len(target):
@@ -129,7 +131,7 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
                 text += f" = ({m[0]:.2f}, {m[1]:.2f}, {m[2]:.2f}) m"
             shape = tuple(max(s, int(t) + 1) for s, t in zip(shape, target.max(axis=0)))
         rows.append(("target", text))
-    else:
+    elif target_path is not None:
         rows.append(("target", f"none ({target_path.name} not found)"))
     rows.append(("occupancy", _occupancy_text(voxels, shape, path)))
     print(visible(f"{path}: voxel list"))
