@@ -175,6 +175,22 @@ def test_info_on_a_mesh_says_what_it_takes_and_how_a_mesh_is_voxelised(tmp_path,
     )
 
 
+@pytest.mark.parametrize(
+    ("name", "what"), [("S_Scene.laz", "a LAS point cloud (.laz)"), ("S.cmf", "a measures file (.cmf)")]
+)
+def test_info_on_a_point_cloud_or_measures_file_says_what_it_takes(tmp_path, capsys, name, what):
+    """Outputs written beside the voxel lists were read as voxel lists: "S_Scene.laz:1:
+    binary data, not text" and "S.cmf:1: 2 comma-separated values in '# ladartui ..."."""
+    path = tmp_path / name
+    path.write_bytes(
+        b"LASF\x00\x01" if name.endswith(".laz") else b"# ladartui comparison measures, format cmf 2\n"
+    )
+    assert main(["info", str(path)]) == 2
+    assert one_error_line(capsys) == (
+        f"ladartui: error: {path}: {what}; info takes a voxel list (.txt) or a scenario (.toml)"
+    )
+
+
 def test_info_scenario_summary(tmp_path, capsys):
     scenario = pytest.importorskip("ladartui.scenario")
     generated = generate_scene("small", seed=0, trees=4)

@@ -50,6 +50,7 @@ def run(args) -> int:
             print_scenario(path)
         else:
             refuse_mesh(path)
+            refuse_other_outputs(path)
             print_voxel_list(path, args.voxel_size)
     return 0
 
@@ -65,6 +66,21 @@ def refuse_mesh(path: Path) -> None:
             path,
             f"a mesh ({path.suffix}); info takes a voxel list (.txt) or a scenario (.toml): "
             "voxelise the mesh first with 'ladartui voxelize MESH OUT --voxel-size V'",
+        )
+
+
+# Files ladartui writes beside its voxel lists, which would be read as voxel lists
+# and fail on their first line.
+OTHER_OUTPUTS = {".las": "a LAS point cloud", ".laz": "a LAS point cloud", ".cmf": "a measures file"}
+
+
+def refuse_other_outputs(path: Path) -> None:
+    what = OTHER_OUTPUTS.get(path.suffix.lower())
+    if what is not None:
+        from ladartui.errors import InputFileError
+
+        raise InputFileError(
+            path, f"{what} ({path.suffix}); info takes a voxel list (.txt) or a scenario (.toml)"
         )
 
 
