@@ -401,6 +401,19 @@ def test_a_run_never_overwrites_its_own_model_files(tmp_path):
     assert not (tmp_path / "boxes.cmf").exists()
 
 
+def test_a_scene_named_after_its_scenario_is_refused_on_its_line(tmp_path, capsys):
+    """The refusal named the scenario file but not the line of files.scene."""
+    from ladartui.cli import main
+
+    saved = two_box_scenario(tmp_path).with_changes(path=tmp_path / "boxes.toml").save()
+    lines = saved.path.read_text().splitlines()
+    line = next(number for number, text in enumerate(lines, start=1) if text.startswith("scene ="))
+    assert main(["validate", str(saved.path)]) == 2
+    assert capsys.readouterr().err.startswith(
+        f"ladartui: error: {saved.path}:{line}: files.scene = 'boxes.txt': expected a scene model"
+    )
+
+
 def test_las_outputs_mark_each_voxel_with_its_target(tmp_path):
     laspy = pytest.importorskip("laspy")
     scenario = two_box_scenario(tmp_path)
