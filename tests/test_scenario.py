@@ -464,6 +464,26 @@ def test_validate_command(tmp_path, capsys):
     )
 
 
+def test_validate_notes_a_start_pose_the_path_does_not_use(tmp_path, capsys):
+    """A [flight.start] before an orbit went unmentioned; the TUI greys it out and says why."""
+    from ladartui.cli import main
+
+    write_models(tmp_path / "models")
+    straight = BASE[
+        BASE.index('[[flight.segments]]\nkind = "straight"') : BASE.index(
+            '[[flight.segments]]\nkind = "orbit"'
+        )
+    ]
+    unused = write_scenario(tmp_path, BASE.replace(straight, ""), name="orbit.toml")
+    assert main(["validate", str(unused)]) == 0
+    assert (
+        "\nnote       [flight.start] is not used: the path starts at its first segment (orbit), "
+        "which places its own scans\n"
+    ) in capsys.readouterr().out
+    assert main(["validate", str(write_scenario(tmp_path))]) == 0  # a straight run flies from it
+    assert "[flight.start]" not in capsys.readouterr().out
+
+
 def test_text_parses_like_a_file(tmp_path):
     scenario = scenario_from_toml(BASE, tmp_path / "x.toml")
     assert scenario.path == tmp_path / "x.toml"

@@ -33,9 +33,20 @@ def run(args) -> int:
     scene_lines = scene_summary(scenario)
     check_outputs_spare_inputs(scenario)  # what a run would refuse before tracing
     print(visible(scenario.summary()))
-    for line in [*scene_lines, *last_run_lines(scenario)]:
+    for line in [*scene_lines, *flight_notes(scenario.flight), *last_run_lines(scenario)]:
         print(visible(line))
     return 0
+
+
+def flight_notes(flight) -> list[str]:
+    """A start pose the path never flies from (the TUI greys its fields out)."""
+    if flight.start is None or flight.uses_start:
+        return []
+    first = flight.segments[0].kind
+    return [
+        f"note       [flight.start] is not used: the path starts at its first segment ({first}), "
+        "which places its own scans"
+    ]
 
 
 def last_run_lines(scenario) -> list[str]:
