@@ -45,6 +45,18 @@ def test_generate_refuses_an_empty_out(tmp_path, capsys, monkeypatch):
     assert not list(tmp_path.iterdir())
 
 
+@pytest.mark.parametrize("name", ["forest.toml", "forest.laz", "forest.obj"])
+def test_generate_refuses_an_out_named_as_another_kind_of_file(tmp_path, capsys, monkeypatch, name):
+    """'forest.toml' wrote forest.toml.txt and forest.toml_Target.txt."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["generate", "small", name]) == 2
+    assert capsys.readouterr().err == (
+        f"ladartui: error: OUT = {name!r}: expected a stem such as dir/name or dir/name.txt "
+        f"(it writes name.txt and name_Target.txt), not a .{name.rsplit('.', 1)[1]} file name\n"
+    )
+    assert not list(tmp_path.iterdir())
+
+
 @pytest.mark.parametrize(
     ("flags", "message"),
     [

@@ -49,6 +49,10 @@ def add_parser(subparsers):
     return parser
 
 
+# Names of other kinds of file: a scenario, a point cloud, a mesh, a measures file.
+NOT_VOXEL_LISTS = (".toml", ".las", ".laz", ".obj", ".stl", ".ply", ".cmf")
+
+
 def out_stem(out: str, preset: str) -> Path:
     """OUT as the stem to write: a folder (one that exists, or written with a
     trailing slash) gets PRESET.txt and PRESET_Target.txt inside it."""
@@ -99,6 +103,13 @@ def run(args) -> int:
     if not args.out.strip():
         raise FieldError("OUT", args.out, "a name such as dir/name or a folder")
     stem = out_stem(args.out, args.preset)
+    if stem.suffix.lower() in NOT_VOXEL_LISTS:  # 'forest.toml' wrote forest.toml.txt
+        raise FieldError(
+            "OUT",
+            args.out,
+            "a stem such as dir/name or dir/name.txt (it writes name.txt and name_Target.txt), "
+            f"not a {stem.suffix} file name",
+        )
     scene_file, target_file = output_paths(stem)
     las_files = list(las_paths(stem)) if args.las else []
     check_writable(scene_file, target_file, *las_files)
