@@ -318,6 +318,7 @@ def test_the_command_line_flag_forces_the_mode_for_one_session(monkeypatch, caps
 
     calls = []
     monkeypatch.setattr(ladartui.tui, "run_app", lambda path, graphics=None: calls.append((path, graphics)))
+    monkeypatch.setattr("ladartui.cli.tui.on_a_terminal", lambda: True)
     assert cli.main(["--graphics", "kitty"]) == 0
     assert cli.main(["--graphics=halfblocks"]) == 0
     assert cli.main(["tui", "--graphics", "sixel"]) == 0
@@ -327,6 +328,25 @@ def test_the_command_line_flag_forces_the_mode_for_one_session(monkeypatch, caps
     assert stop.value.code == 2
     error = capsys.readouterr().err.strip()
     assert "\n" not in error and "invalid choice: 'retina'" in error and "iterm" in error
+
+
+def test_the_interface_without_a_terminal_is_refused_in_one_line(monkeypatch, capsys):
+    """'ladartui S.toml > log' (or with no terminal at all) drew the interface's escape
+    codes into the file and waited for keys that never came."""
+    import sys
+
+    import ladartui.tui
+    from ladartui import cli
+
+    calls = []
+    monkeypatch.setattr(ladartui.tui, "run_app", lambda path, graphics=None: calls.append(path))
+    monkeypatch.setattr(sys, "__stdout__", io.StringIO())  # a file or pipe: no terminal
+    assert cli.main([]) == 2
+    assert capsys.readouterr().err == (
+        "ladartui: error: the terminal UI needs a terminal, and its input or output is a file "
+        "or pipe; for a run without one: ladartui run SCENARIO\n"
+    )
+    assert calls == []
 
 
 def test_detect_puts_the_flag_over_the_settings_file(tmp_path, monkeypatch):

@@ -31,6 +31,13 @@ def add_parser(subparsers) -> None:
     parser.set_defaults(handler=run)
 
 
+def on_a_terminal() -> bool:
+    """Whether the process reads keys from, and draws on, a terminal."""
+    import sys
+
+    return all(stream is not None and stream.isatty() for stream in (sys.__stdin__, sys.__stdout__))
+
+
 def run(args) -> int:
     path = args.scenario
     if path is not None:
@@ -39,6 +46,13 @@ def run(args) -> int:
         path = bundled_or_path(path)  # "convoy": the bundled scenario, made on first use
     if path is not None:
         require_file(path, "expected a scenario file (.toml)")
+    if not on_a_terminal():  # the app would draw into a file or pipe and wait for keys for ever
+        from ladartui.errors import LadarError
+
+        raise LadarError(
+            "the terminal UI needs a terminal, and its input or output is a file or pipe; "
+            "for a run without one: ladartui run SCENARIO"
+        )
     from ladartui.tui import run_app
 
     return run_app(path, args.graphics)
