@@ -120,7 +120,7 @@ def test_ctrl_c_after_the_run_wrote_its_outputs_says_what_it_wrote(scenario, cap
 
     real_show = cli_run.show_result
 
-    def interrupted_while_showing(console, result):
+    def interrupted_while_showing(console, result, **options):
         real_show(console, result)
         raise KeyboardInterrupt  # as a Ctrl-C landing once the run had finished
 
@@ -223,3 +223,14 @@ def test_a_one_scan_run_and_its_summary_say_one_scan(scenario, capsys):
     assert "; 1 scan x 1,024 rays, two runs, in " in capsys.readouterr().out
     assert main(["validate", str(one.path)]) == 0
     assert "\nflight     1 scan: manual (1)\n" in capsys.readouterr().out
+
+
+def test_a_precision_the_backend_lacks_is_named_in_the_summary_and_json(scenario, capsys):
+    """--precision f32 on numba (no f32 kernels) traced in f64 and said only 'numba (exact)';
+    the JSON had no precision (trace says 'f64, not the f32 asked for')."""
+    assert main(["run", str(scenario.path), "--no-write", "--precision", "f32"]) == 0
+    assert "backend: numba (exact, f64, not the f32 asked for); 2 scans x" in capsys.readouterr().out
+    assert main(["run", str(scenario.path), "--no-write", "--precision", "f32", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["precision"] == "f64"
+    assert main(["run", str(scenario.path), "--no-write"]) == 0
+    assert "backend: numba (exact); 2 scans x" in capsys.readouterr().out

@@ -75,7 +75,8 @@ class SimulationResult:
     ``timings`` holds seconds spent per stage (``setup``: backend choice and
     scene loading, ``rays``, ``trace``, ``depth_rule``, ``fusion``,
     ``measures``, ``write``, and ``total``);
-    ``outputs`` the files written (empty when nothing was written).
+    ``outputs`` the files written (empty when nothing was written); ``precision`` the
+    arithmetic the tracing used ("f64" where a backend lacks the f32 asked for).
     """
 
     scene_output: np.ndarray
@@ -88,6 +89,7 @@ class SimulationResult:
     rays_per_scan: int
     timings: dict = field(default_factory=dict)
     outputs: dict = field(default_factory=dict)
+    precision: str = ""
 
     @property
     def scans(self) -> int:
@@ -211,6 +213,7 @@ def _simulate(scenario, backend, method, step, precision, progress, cancel, outp
         rays_per_scan=scenario.sensor.rays_per_scan,
         timings=timings,
         outputs=outputs,
+        precision="+".join(sorted(runner.precisions)) or settings["precision"],
     )
 
 
@@ -279,6 +282,7 @@ class _ScanRunner:
         self.done = 0
         self.chunk = _FIRST_CHUNK_RAYS
         self.rays_by_backend: dict[str, int] = {}  # auto may trace some calls on each
+        self.precisions: set[str] = set()  # as traced: numba has no f32 kernels
         self.geiger = None  # a detection.scan.GeigerRun when the Geiger model is on
 
     def backends_used(self) -> str:
@@ -313,6 +317,7 @@ class _ScanRunner:
                 timings["trace"] += elapsed
                 slowest = max(slowest, elapsed)
                 self.rays_by_backend[hits.backend] = self.rays_by_backend.get(hits.backend, 0) + len(hits)
+                self.precisions.add(hits.info.get("precision", self.settings["precision"]))
                 tick = time.perf_counter()
                 rays = kept_returns(detector, hits.kind, hits.range, sensor.depth_resolution)
                 kept[run].append(hits.index[rays])

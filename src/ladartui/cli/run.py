@@ -134,7 +134,7 @@ def run(args) -> int:
         if args.json:
             print(json.dumps(result_dict(scenario, result), indent=2, allow_nan=False))
         else:
-            show_result(said, result)
+            show_result(said, result, asked_precision=scenario.precision)
         if chart_line is not None:
             said.print(chart_line, highlight=False, markup=False, soft_wrap=True)
         if chart_error is not None:
@@ -210,6 +210,7 @@ def result_dict(scenario, result) -> dict:
         "scenario": str(getattr(scenario, "path", "")),
         "backend": result.backend,
         "method": result.method,
+        "precision": result.precision,
         "scans": result.scans,
         "rays_per_scan": result.rays_per_scan,
         "scene_output_voxels": int(len(result.scene_output)),
@@ -220,8 +221,9 @@ def result_dict(scenario, result) -> dict:
     }
 
 
-def show_result(console, result) -> None:
-    """The measures as tables in the layout of the report's figure 10."""
+def show_result(console, result, asked_precision=None) -> None:
+    """The measures as tables in the layout of the report's figure 10; the summary names
+    the precision traced where it is not ``asked_precision`` (a backend without it)."""
     from rich.table import Table
 
     from ladartui.measures import comparison_rows, view_rows
@@ -254,8 +256,11 @@ def show_result(console, result) -> None:
         if several:  # the levels each target reached on its own, as --json holds them
             console.print(target_levels_table(targets))
     total = result.timings.get("total", 0.0)
+    how = result.method
+    if asked_precision and result.precision and result.precision != asked_precision:
+        how += f", {result.precision}, not the {asked_precision} asked for"
     console.print(
-        f"backend: {result.backend} ({result.method}); {plural(result.scans, 'scan')} x "
+        f"backend: {result.backend} ({how}); {plural(result.scans, 'scan')} x "
         f"{result.rays_per_scan:,} rays, two runs, in {total:.2f} s"
     )
     if result.outputs:
