@@ -547,16 +547,22 @@ async def test_opening_reads_off_the_ui_thread_and_keeps_only_the_last_asked(fin
         release.set()
 
 
-async def test_a_sweep_run_again_shows_its_stored_rows_first(finished, tmp_path):
-    """Run again over a finished folder, the stored rows come from the job before any
-    variant (none left to run here: all resume)."""
+def _copy_of_finished(finished, folder):
+    """The finished sweep's spec, copied with its results into ``folder`` (running again
+    rewrites the table)."""
     import shutil
 
     spec, _ = finished
-    for path in spec.parent.iterdir():  # a copy: running again rewrites the table
+    for path in spec.parent.iterdir():
         copy = shutil.copytree if path.is_dir() else shutil.copy
-        copy(path, tmp_path / path.name)
-    screen = SweepScreen(tmp_path / spec.name, serial=True)
+        copy(path, folder / path.name)
+    return folder / spec.name
+
+
+async def test_a_sweep_run_again_shows_its_stored_rows_first(finished, tmp_path):
+    """Run again over a finished folder, the stored rows come from the job before any
+    variant (none left to run here: all resume)."""
+    screen = SweepScreen(_copy_of_finished(finished, tmp_path), serial=True)
     app = _Host(screen)
     seen: list[int] = []
     show = screen._show_stored_rows
@@ -572,13 +578,7 @@ async def test_a_sweep_run_again_shows_its_stored_rows_first(finished, tmp_path)
 
 async def test_a_finished_sweep_shows_its_whole_100_percent(finished, tmp_path):
     """At 80x24 the progress reads "100%", not "100" cut by the row's label padding."""
-    import shutil
-
-    spec, _ = finished
-    for path in spec.parent.iterdir():  # a copy: running again rewrites the table
-        copy = shutil.copytree if path.is_dir() else shutil.copy
-        copy(path, tmp_path / path.name)
-    screen = SweepScreen(tmp_path / spec.name, serial=True)
+    screen = SweepScreen(_copy_of_finished(finished, tmp_path), serial=True)
     app = _Host(screen)
     async with app.run_test(size=SIZE) as pilot:
         await opened(pilot)
