@@ -211,3 +211,83 @@ def test_validate_says_a_set_a_killed_run_left_half_replaced(scenario, capsys):
         "last run   was stopped while it replaced the outputs: the next run puts the earlier set "
         "back first, so the files now on disk are not to be read"
     ]
+
+
+def _last_run_lines(capsys, scenario) -> list[str]:
+    capsys.readouterr()
+    assert main(["validate", str(scenario.path)]) == 0
+    return [x for x in capsys.readouterr().out.splitlines() if x.startswith("last run")]
+
+
+def test_validate_names_a_model_file_changed_since_the_run(scenario, capsys):
+    """The record held settings only: a scene model regenerated after the run still
+    read 'made with this file's settings'."""
+    simulate(scenario)
+    assert _last_run_lines(capsys, scenario) == [
+        "last run   made the outputs with this file's settings (S_Run.toml)"
+    ]
+    scene_model = scenario.scene_file
+    scene_model.write_text(scene_model.read_text() + "0,0,9\n")
+    assert _last_run_lines(capsys, scenario)[1:] == [
+        "last run   the scene model woods.txt changed since the run"
+    ]
+    simulate(scenario)  # the next run records the file as it is now
+    target_model = scenario.target_file
+    target_model.write_text(target_model.read_text().replace("8,8,0\n", ""))
+    assert _last_run_lines(capsys, scenario)[1:] == [
+        "last run   the target model woods_Target.txt changed since the run"
+    ]
+
+
+def test_validate_names_a_flight_log_changed_since_the_run(scenario, capsys):
+    from ladartui.flight import FlightPlan
+    from ladartui.trajectory import LogSegment
+
+    log = scenario.path.with_name("pass.csv")
+    log.write_text("time,x,y,z,heading\n0,0,9,40,90\n2,20,9,40,90\n", encoding="utf-8")
+    segment = LogSegment(file=str(log), times=(1.0,), aim_at=(9.5, 9.0, 0.5))
+    flown = scenario.with_changes(flight=FlightPlan(segments=[*scenario.flight.segments, segment])).save()
+    simulate(flown)
+    assert _last_run_lines(capsys, flown) == [
+        "last run   made the outputs with this file's settings (S_Run.toml)"
+    ]
+    log.write_text("time,x,y,z,heading\n0,0,9,40,90\n2,24,9,40,90\n", encoding="utf-8")
+    assert _last_run_lines(capsys, flown)[1:] == ["last run   the flight log pass.csv changed since the run"]
+
+
+def test_a_record_older_than_model_fingerprints_is_read_and_says_so(scenario, capsys):
+    simulate(scenario)
+    record = scenario.path.with_name("S_Run.toml")
+    text = record.read_text(encoding="utf-8")
+    record.write_text(text[: text.index("\n# The files the run read")] + "\n", encoding="utf-8")
+    assert read_run_record(scenario).same_outputs(scenario)
+    assert _last_run_lines(capsys, scenario) == [
+        "last run   made the outputs with this file's settings (S_Run.toml)",
+        "last run   the record does not say which model files the run read (written before records did)",
+    ]
+
+
+def test_the_record_fingerprints_the_bytes_the_run_read(scenario):
+    """Size and SHA-256 of each model file as loaded: a scene loaded before the file
+    changed is what the run used, so the record must not hash the file anew."""
+    import hashlib
+
+    from ladartui.run_record import recorded_inputs
+
+    scene = scenario.load_scene()
+    before = scenario.scene_file.read_bytes()
+    scenario.scene_file.write_text(before.decode() + "0,0,9\n")
+    simulate(scenario, scene=scene)
+    read = {entry.role: entry for entry in recorded_inputs(scenario)}
+    assert sorted(read) == ["scene model", "target model"]
+    assert read["scene model"].path == scenario.scene_file
+    assert read["scene model"].fingerprint.size == len(before)
+    assert read["scene model"].fingerprint.sha256 == hashlib.sha256(before).hexdigest()
+
+
+def test_only_a_record_may_hold_the_files_its_run_read(scenario):
+    simulate(scenario)
+    record = scenario.path.with_name("S_Run.toml").read_text(encoding="utf-8")
+    scenario.path.write_text(record.split("\n", 1)[1], encoding="utf-8")  # without the record's first line
+    with pytest.raises(LadarError, match=r"unknown section \[run\]"):
+        load_scenario(scenario.path)

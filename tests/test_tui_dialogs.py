@@ -300,6 +300,23 @@ async def test_outputs_a_run_made_from_unsaved_settings_are_out_of_date_on_openi
         assert str(info.render()) == f"Measures of {scenario.name}:"
 
 
+async def test_opening_outputs_whose_scene_model_changed_since_their_run_says_so(tmp_path, scene_files):
+    import shutil
+
+    from ladartui.simulation import simulate
+
+    scene_path, centre, voxel_size = scene_files
+    for model in (scene_path, scene_path.with_name(f"{scene_path.stem}_Target.txt")):
+        shutil.copy(model, tmp_path)  # the module's files stay as they are
+    scenario = make_scenario(tmp_path, (tmp_path / scene_path.name, centre, voxel_size))
+    simulate(scenario)
+    with open(scenario.scene_file, "a", encoding="utf-8") as model:
+        model.write("0,0,0\n")
+    async with opened(scenario) as (app, pilot):
+        said = f"Earlier outputs: the scene model {scene_path.name} changed since the run."
+        assert said in app.messages
+
+
 async def test_a_damaged_run_record_is_reported_and_the_outputs_still_shown(tmp_path, scene_files):
     from ladartui.simulation import simulate
 

@@ -7,20 +7,53 @@ unsaved edits; ``ladartui run --method`` overrides the file). Opening ``S.toml``
 compares it with the record to say whether the outputs are out of date. A set
 written before records existed has none; it then counts as the saved file's.
 
+After the settings, ``[[run.inputs]]`` tables fingerprint each file the run
+read (``run_inputs``: scene model, target model, flight logs) by size and
+SHA-256, as the loaders read them; ``input_changes`` names one whose contents
+differ now. A record older than that has no ``[run]`` section.
+
 A file of that name that is not a record (its first line is not
 ``RECORD_HEADER``) is the analyst's own: a run refuses to replace it.
 """
 
 from __future__ import annotations
 
+import re
+import tomllib
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
-from ladartui.errors import LadarError, OutputFileError
-from ladartui.scenario_file import RECORD_HEADER, is_record
-from ladartui.textsafe import one_line
+import tomli_w
 
-__all__ = ["RECORD_HEADER", "is_record", "read_run_record", "setting_changes"]
+from ladartui.errors import LadarError, OutputFileError
+from ladartui.fingerprint import Fingerprint
+from ladartui.scenario_file import RECORD_HEADER, is_record, relative_path, resolve_path
+from ladartui.textsafe import one_line
+from ladartui.trajectory import LogSegment
+
+__all__ = [
+    "RECORD_HEADER",
+    "InputFile",
+    "input_changes",
+    "is_record",
+    "read_run_record",
+    "recorded_inputs",
+    "run_inputs",
+    "setting_changes",
+]
+
+INPUT_ROLES = ("scene model", "target model", "flight log")
+_INPUTS_COMMENT = "# The files the run read: size in bytes and SHA-256 of their contents.\n"
+
+
+@dataclass(frozen=True)
+class InputFile:
+    """A file a run read, with the fingerprint of its bytes as read."""
+
+    role: str  # one of INPUT_ROLES
+    path: Path
+    fingerprint: Fingerprint
 
 
 def as_run(scenario, backend=None, method=None, step=None, precision=None):
@@ -31,8 +64,9 @@ def as_run(scenario, backend=None, method=None, step=None, precision=None):
     return scenario.with_changes(path=scenario.run_record, **changes)
 
 
-def record_text(scenario, ran) -> str:
-    """The record's text for a run of ``scenario`` that went as ``ran`` (``as_run``)."""
+def record_text(scenario, ran, inputs=()) -> str:
+    """The record's text for a run of ``scenario`` that went as ``ran`` (``as_run``),
+    having read ``inputs`` (``run_inputs``)."""
     # names in comments escaped: a control character there is not TOML
     name = one_line(scenario.path.name)
     scene, target = one_line(scenario.scene_output.name), one_line(scenario.target_output.name)
@@ -42,7 +76,82 @@ def record_text(scenario, ran) -> str:
         f"# written with them by a run of {name} (replaced by its next run).\n"
         f"# They may differ from {name}: a run can go with unsaved edits or flags.\n\n"
     )
-    return header + ran.toml_body()
+    folder = scenario.run_record.parent
+    read = [
+        {
+            "role": entry.role,
+            "file": relative_path(entry.path, folder),
+            "bytes": entry.fingerprint.size,
+            "sha256": entry.fingerprint.sha256,
+        }
+        for entry in inputs
+    ]
+    return header + ran.toml_body() + "\n" + _INPUTS_COMMENT + tomli_w.dumps({"run": {"inputs": read}})
+
+
+def run_inputs(scenario, scene) -> list[InputFile]:
+    """The files a run of ``scenario`` over ``scene`` reads, fingerprinted as they
+    were read: the scene's model files (none for a scene made from arrays) and the
+    scenario's flight logs."""
+    found = {}
+    for path, fingerprint in scene.fingerprints.items():
+        role = "scene model" if path == scene.path else "target model"
+        found[path] = InputFile(role, path, fingerprint)
+    for segment in scenario.flight.segments:
+        if isinstance(segment, LogSegment) and segment.log.fingerprint is not None:
+            path = Path(segment.file)
+            found.setdefault(path, InputFile("flight log", path, segment.log.fingerprint))
+    return list(found.values())
+
+
+def recorded_inputs(scenario) -> list[InputFile] | None:
+    """The files the record says its run read; None when it does not say (a record
+    older than that, or none). ``LadarError`` naming the record when it cannot be read."""
+    path = scenario.run_record
+    if not path.is_file():
+        return None
+    try:
+        run = tomllib.loads(path.read_text(encoding="utf-8-sig")).get("run")
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as error:
+        raise LadarError(f"{path}: cannot be read: {one_line(str(error))}") from None
+    if run is None:
+        return None
+    entries = run.get("inputs") if isinstance(run, dict) else None
+    if not isinstance(entries, list):
+        raise LadarError(f"{path}: [run] inputs: expected a list of [[run.inputs]] tables")
+    return [_recorded_input(path, index, entry) for index, entry in enumerate(entries)]
+
+
+def _recorded_input(path: Path, index: int, entry) -> InputFile:
+    entry = entry if isinstance(entry, dict) else {}
+    role, file, size, sha256 = (entry.get(key) for key in ("role", "file", "bytes", "sha256"))
+    if (
+        role not in INPUT_ROLES
+        or not isinstance(file, str)
+        or not file
+        or not isinstance(size, int)
+        or size < 0
+        or not isinstance(sha256, str)
+        or not re.fullmatch(r"[0-9a-f]{64}", sha256)
+    ):
+        raise LadarError(
+            f"{path}: run.inputs[{index}]: expected role ({', '.join(INPUT_ROLES)}), file, "
+            "bytes and sha256 (64 hex digits)"
+        )
+    return InputFile(role, resolve_path(path.parent, file), Fingerprint(size, sha256))
+
+
+def input_changes(recorded, now) -> list[str]:
+    """Each file in ``recorded`` (``recorded_inputs``) whose contents differ from
+    ``now`` (``run_inputs`` of the scenario as it is), as "the scene model small.txt
+    changed since the run". A recorded file not read now is another setting
+    (``setting_changes`` names it)."""
+    current = {entry.path: entry.fingerprint for entry in now}
+    return [
+        f"the {entry.role} {entry.path.name} changed since the run"
+        for entry in recorded
+        if entry.path in current and current[entry.path] != entry.fingerprint
+    ]
 
 
 def check_record_spare(scenario) -> None:

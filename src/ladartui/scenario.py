@@ -38,6 +38,7 @@ from ladartui.scenario_file import (
     is_record,
     parse_document,
     record_owner,
+    relative_path,
     resolve_path,
 )
 from ladartui.scenario_style import restyle
@@ -318,7 +319,10 @@ class Scenario:
         if s.mount != "stabilised":  # written only when chosen: older files stay as they were
             sensor["mount"] = s.mount
         data = {
-            "files": {"scene": _relative(self.scene_file, self.path.parent), "voxel_size": self.voxel_size},
+            "files": {
+                "scene": relative_path(self.scene_file, self.path.parent),
+                "voxel_size": self.voxel_size,
+            },
             "sensor": sensor,
             "flight": flight,
             "simulation": {
@@ -449,7 +453,7 @@ def _segment_to_dict(segment, folder: Path) -> dict:
         if f.name == "poses":
             value = [p.to_dict() for p in value]
         elif isinstance(segment, LogSegment) and f.name == "file":
-            value = _relative(Path(value), folder)
+            value = relative_path(Path(value), folder)
         elif isinstance(value, tuple):
             value = list(value)
         data[f.name] = value
@@ -475,17 +479,6 @@ def _compact_arrays(text: str) -> str:
 
 def _absolute(path) -> Path:
     return Path(os.path.normpath(Path(path).expanduser().absolute()))
-
-
-def _relative(file: Path, folder: Path) -> str:
-    """``file`` relative to ``folder`` unless they share nothing but the root."""
-    try:
-        common = os.path.commonpath([file, folder])
-    except ValueError:  # different drives
-        return str(file)
-    if common == file.anchor:
-        return str(file)
-    return os.path.relpath(file, folder)
 
 
 __all__ = ["Scenario", "load_scenario", "scenario_from_toml", "target_file_for"]

@@ -86,6 +86,10 @@ Straight and turn segments continue from the previous segment's last scan
 
 Turns and orbits bank as coordinated turns at ``speed_mps``; only a
 ``body-fixed`` sensor sees it (``ladartui.attitude``).
+
+A run record (``S_Run.toml``, first line ``RECORD_HEADER``) is such a file
+with ``[[run.inputs]]`` tables after the settings, the files its run read
+(``ladartui.run_record``); in any other file ``[run]`` is an unknown section.
 """
 
 from __future__ import annotations
@@ -129,6 +133,8 @@ MAX_TARGET_NAME = 60
 # writes beside its outputs, saying which settings made them. No save replaces one.
 RECORD_HEADER = "# ladartui run record"
 RECORD_SUFFIX = "_Run.toml"  # S.toml's record is S_Run.toml
+# A record's own section, after the settings: [[run.inputs]], the files the run read.
+RECORD_SECTIONS = {"run": ("inputs",)}
 # Segment kinds a scenario file may use: the flight plan's, and recorded logs.
 SEGMENT_FILE_KINDS = {**SEGMENT_KINDS, LogSegment.kind: LogSegment}
 
@@ -156,6 +162,7 @@ class ScenarioReader:
     def __init__(self, path: Path, text: str):
         self.path = path
         self.lines = key_lines_from_text(text)
+        self.sections = {**SECTIONS, **(RECORD_SECTIONS if text.startswith(RECORD_HEADER) else {})}
 
     def line(self, key: str):
         # The exact key, else the nearest enclosing table or array item.
@@ -228,8 +235,10 @@ class ScenarioReader:
         """The Scenario's keyword arguments from the document (all but its path), each
         checked where its table or key can be named; ``constructed`` names the rest."""
         for name in doc:
-            if name not in SECTIONS:
-                raise self.file_error(name, f"unknown section [{name}] (allowed: {', '.join(SECTIONS)})")
+            if name not in self.sections:
+                raise self.file_error(name, f"unknown section [{name}] (allowed: {', '.join(self.sections)})")
+        for name in RECORD_SECTIONS.keys() & doc.keys():  # read by ladartui.run_record
+            self.table(doc, name, RECORD_SECTIONS[name])
         files = self.table(doc, "files", SECTIONS["files"], required=("scene",))
         sensor_table = self.table(doc, "sensor", SECTIONS["sensor"])
         flight = self.table(doc, "flight", SECTIONS["flight"], required=("segments",))
@@ -417,6 +426,17 @@ def check_flight(plan: FlightPlan) -> None:
 def resolve_path(folder: Path, file) -> Path:
     file = Path(file).expanduser()
     return Path(os.path.normpath(file if file.is_absolute() else folder / file))
+
+
+def relative_path(file: Path, folder: Path) -> str:
+    """``file`` relative to ``folder`` unless they share nothing but the root."""
+    try:
+        common = os.path.commonpath([file, folder])
+    except ValueError:  # different drives
+        return str(file)
+    if common == file.anchor:
+        return str(file)
+    return os.path.relpath(file, folder)
 
 
 def is_record(path) -> bool:

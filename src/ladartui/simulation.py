@@ -26,7 +26,7 @@ import numpy as np
 from ladartui.errors import FieldError, check_callbacks, check_cancelled
 from ladartui.measures import Measures, compute_measures
 from ladartui.returns import fuse_scans, kept_returns
-from ladartui.run_record import as_run, check_record_spare, record_text
+from ladartui.run_record import as_run, check_record_spare, record_text, run_inputs
 from ladartui.scenario import Scenario
 from ladartui.scene.model import Scene
 from ladartui.tracing.config import SCAN_BLOCK
@@ -198,7 +198,8 @@ def _simulate(scenario, backend, method, step, precision, progress, cancel, outp
     if output_set is not None:
         check_cancelled(cancel, NOTHING_WRITTEN)
         tick = time.perf_counter()
-        record = record_text(scenario, as_run(scenario, backend, method, step, precision))
+        ran = as_run(scenario, backend, method, step, precision)
+        record = record_text(scenario, ran, run_inputs(scenario, scene))
         outputs = _write_outputs(output_set, scene_output, target_output, measures, record, scene, cancel)
         timings["write"] = time.perf_counter() - tick
     timings["total"] = time.perf_counter() - started

@@ -27,6 +27,7 @@ import numpy as np
 from ladartui.checks import MAX_COORDINATE
 from ladartui.errors import FieldError, LadarError
 from ladartui.fileprobe import file_problem, not_utf8, refuse_special_file
+from ladartui.fingerprint import Fingerprint, fingerprint_of
 from ladartui.flight import ScanPose
 from ladartui.number_text import plural
 
@@ -78,6 +79,7 @@ class FlightLog:
     heading: np.ndarray
     roll: np.ndarray
     pitch: np.ndarray
+    fingerprint: Fingerprint | None = None  # of the file as read (a run records it)
 
 
 def load_flight_log(path, origin=None) -> FlightLog:
@@ -173,7 +175,7 @@ def load_flight_log(path, origin=None) -> FlightLog:
             )
     else:
         xyz = np.stack([arr["x"], arr["y"], arr["z"]], axis=1)
-    return FlightLog(arr["time"], xyz, arr["heading"], arr["roll"], arr["pitch"])
+    return FlightLog(arr["time"], xyz, arr["heading"], arr["roll"], arr["pitch"], fingerprint_of(data))
 
 
 def _angle(times, angles, t):

@@ -12,7 +12,8 @@ def add_parser(subparsers):
         description="Load a scenario, check every field against its limits, read and check its "
         "scene and target model files, estimate the memory the tracing structures need, then "
         "print a summary (sensor, scans, path length, flight time, scene size, memory, "
-        "outputs, and whether the outputs on disk came from this file's settings). A mistake "
+        "outputs, and whether the outputs on disk came from this file's settings and its "
+        "model files as they are now). A mistake "
         "is reported on one line with exit status 2.",
     )
     parser.add_argument(
@@ -30,10 +31,11 @@ def run(args) -> int:
     from ladartui.user_data import bundled_or_path
 
     scenario = load_scenario(bundled_or_path(args.scenario))
-    scene_lines = scene_summary(scenario)
+    scene = scenario.load_scene()
+    scene_lines = scene_summary(scenario, scene)
     check_outputs_spare_inputs(scenario)  # what a run would refuse before tracing
     print(visible(scenario.summary()))
-    for line in [*scene_lines, *flight_notes(scenario.flight), *last_run_lines(scenario)]:
+    for line in [*scene_lines, *flight_notes(scenario.flight), *last_run_lines(scenario, scene)]:
         print(visible(line))
     return 0
 
@@ -49,8 +51,9 @@ def flight_notes(flight) -> list[str]:
     ]
 
 
-def last_run_lines(scenario) -> list[str]:
-    """Whether the outputs on disk came from this file's settings (the run record)."""
+def last_run_lines(scenario, scene) -> list[str]:
+    """Whether the outputs on disk came from this file's settings and its model files as
+    they are now (``scene``, as just loaded), from the run record."""
     from ladartui.errors import LadarError
     from ladartui.outputset import journal_path
     from ladartui.run_record import earlier_las, missing_outputs, read_run_record, setting_changes
@@ -82,6 +85,7 @@ def last_run_lines(scenario) -> list[str]:
         lines = [
             f"last run   made the outputs with other settings than this file: {shown}; they are in {record}"
         ]
+    lines.extend(f"last run   {line}" for line in _input_lines(scenario, scene))
     left = earlier_las(scenario)
     if left:
         names = " and ".join(path.name for path in left)
@@ -92,15 +96,28 @@ def last_run_lines(scenario) -> list[str]:
     return lines
 
 
-def scene_summary(scenario) -> list[str]:
-    """Read both model files (errors name file and line) and size the tracing structures."""
+def _input_lines(scenario, scene) -> list[str]:
+    """The model files and flight logs changed since the run, by their fingerprints."""
+    from ladartui.errors import LadarError
+    from ladartui.run_record import input_changes, recorded_inputs, run_inputs
+
+    try:
+        recorded = recorded_inputs(scenario)
+    except LadarError as error:
+        return [f"model files of the run not read: {error}"]
+    if recorded is None:
+        return ["the record does not say which model files the run read (written before records did)"]
+    return input_changes(recorded, run_inputs(scenario, scene))
+
+
+def scene_summary(scenario, scene) -> list[str]:
+    """Size the tracing structures of ``scenario``'s ``scene`` (its model files, read)."""
     import numpy as np
 
     from ladartui.number_text import extent_metres
     from ladartui.resources import available_memory, check_occupancy, gib
     from ladartui.scene.occupancy import column_bounds
 
-    scene = scenario.load_scene()
     nx, ny, nz = scene.shape
     vs = scene.voxel_size
     ids = scene.target_id_list if len(scene.target) else []

@@ -13,11 +13,12 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.errors import FieldError, InputFileError, LadarError
+from ladartui.fingerprint import Digest, Fingerprint
 from ladartui.scene.keys import voxel_keys
 from ladartui.scene.occupancy import Occupancy, column_bounds
 from ladartui.scene.target_model import load_target
 from ladartui.scene.voxel_arrays import target_ids_field, voxel_list_field
-from ladartui.scene.voxels import load_voxels
+from ladartui.scene.voxels import load_voxels_counted
 
 
 def target_path_for(scene_path) -> Path:
@@ -35,9 +36,13 @@ class Scene:
     ``(nx, ny, nz)``, by default the largest index + 1 over both lists.
     ``target_ids`` (one int32 per target voxel, 1..65535) says which target
     each target voxel belongs to; by default all belong to target 1.
+    ``fingerprints``: the model files' fingerprints by path, as ``load`` read
+    them (a run records them); empty for a scene made from arrays.
     """
 
-    def __init__(self, voxels, target, voxel_size, shape=None, name=None, path=None, target_ids=None):
+    def __init__(
+        self, voxels, target, voxel_size, shape=None, name=None, path=None, target_ids=None, fingerprints=None
+    ):
         self.voxels = _as_voxel_array(voxels, "voxels")
         self.target = _as_voxel_array(target, "target")
         self.target_ids = _as_target_ids(target_ids, len(self.target))
@@ -51,6 +56,7 @@ class Scene:
         self.shape = shape
         self.path = Path(path) if path is not None else None
         self.name = name if name is not None else (self.path.stem if self.path else "scene")
+        self.fingerprints: dict[Path, Fingerprint] = dict(fingerprints or {})
         self._occupancy = None
         self._target_occupancy = None
         self._init_locks()
@@ -75,16 +81,25 @@ class Scene:
         _checked_voxel_size(voxel_size)  # before reading what may be large files
         scene_path = Path(scene_path)
         target_path = target_path_for(scene_path)
-        voxels = load_voxels(scene_path)
+        scene_digest, target_digest = Digest(), Digest()
+        voxels, _ = load_voxels_counted(scene_path, digest=scene_digest)
         if not target_path.is_file():
             raise InputFileError(
                 target_path,
                 f"target model not found; expected it beside the scene model {scene_path.name} "
                 f"(named {target_path.name})",
             )
-        target, ids = load_target(target_path)  # may be empty: a scene without a target
+        target, ids = load_target(target_path, target_digest)  # may be empty: a scene without a target
+        fingerprints = {scene_path: scene_digest.fingerprint(), target_path: target_digest.fingerprint()}
         return cls(
-            voxels, target, voxel_size, shape=shape, name=scene_path.stem, path=scene_path, target_ids=ids
+            voxels,
+            target,
+            voxel_size,
+            shape=shape,
+            name=scene_path.stem,
+            path=scene_path,
+            target_ids=ids,
+            fingerprints=fingerprints,
         )
 
     def target_ids_of(self, voxels) -> np.ndarray:

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.errors import InputFileError
+from ladartui.fingerprint import Digest
 from ladartui.scene.voxels import (
     _BOM,
     EXPECTED_TARGET,
@@ -27,21 +28,22 @@ from ladartui.scene.voxels import (
 log = logging.getLogger(__name__)
 
 
-def load_target(path) -> tuple[np.ndarray, np.ndarray]:
+def load_target(path, digest: Digest | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Read a target model: ``((N, 3) int32 unique voxels, (N,) int32 target ids)``.
 
     Lines are ``x,y,z`` (one target, id 1: the report's layout) or
     ``x,y,z,id`` with ``id`` in 1..``MAX_TARGET_ID``; every line has the
     same number of values. A repeated voxel line is dropped; the same voxel
-    given two different ids is an error naming the later line.
+    given two different ids is an error naming the later line. ``digest`` is fed
+    the file's bytes as they are read.
     """
     path = Path(path)
     head = _read_bytes(path, limit=4096)
     start = len(_BOM) if head[: len(_BOM)].tobytes() == _BOM else 0
     if _first_line_columns(head, start) == 3:  # the report's layout: the scene parser as it is
-        voxels, _ = load_voxels_counted(path, _target=True)
+        voxels, _ = load_voxels_counted(path, _target=True, digest=digest)
         return voxels, np.ones(len(voxels), dtype=np.int32)
-    rows = _read_rows(path, 4, target=True)
+    rows = _read_rows(path, 4, target=True, digest=digest)
     ids = rows[:, 3]
     bad = np.flatnonzero((ids < 1) | (ids > MAX_TARGET_ID))
     if len(bad):  # blank lines come only at the end: row r is line r + 1

@@ -25,6 +25,7 @@ import numpy as np
 from ladartui.atomic import atomic_path
 from ladartui.errors import InputFileError
 from ladartui.fileprobe import NO_SUCH_FILE, refuse_special_file
+from ladartui.fingerprint import Digest
 from ladartui.scene.voxel_arrays import MAX_TARGET_ID, target_ids_field, voxel_list_field
 
 log = logging.getLogger(__name__)
@@ -192,10 +193,11 @@ def load_voxels(path) -> np.ndarray:
     return voxels
 
 
-def load_voxels_counted(path, _target=False) -> tuple[np.ndarray, int]:
-    """Like :func:`load_voxels`, also returning how many duplicate lines were dropped."""
+def load_voxels_counted(path, _target=False, digest: Digest | None = None) -> tuple[np.ndarray, int]:
+    """Like :func:`load_voxels`, also returning how many duplicate lines were dropped;
+    ``digest`` is fed the file's bytes as they are read."""
     path = Path(path)
-    parsed = _read_rows(path, 3, _target)
+    parsed = _read_rows(path, 3, _target, digest)
     voxels, duplicates = unique_voxels(parsed)
     if duplicates:
         log.info("%s: dropped %d duplicate voxel lines", path, duplicates)
@@ -294,11 +296,14 @@ def _parse_plain_lines(data: np.ndarray, columns: int = 3) -> np.ndarray | None:
 _BLOCK_BYTES = 4 << 20
 
 
-def _read_rows(path: Path, columns: int, target: bool) -> np.ndarray:
+def _read_rows(path: Path, columns: int, target: bool, digest: Digest | None = None) -> np.ndarray:
     """The rows of a voxel list (``columns`` values a line), read whole when small,
-    else streamed block by block; ``InputFileError`` naming the first bad line."""
+    else streamed block by block; ``InputFileError`` naming the first bad line.
+    ``digest`` is fed every byte of the file once."""
     head = _read_bytes(path, limit=_PLAIN_BYTES + 1)
     if len(head) <= _PLAIN_BYTES:  # the whole file
+        if digest is not None:
+            digest.update(head)
         return _parse_file(path, head, columns, target)
     size = os.stat(path).st_size
     # At most one row per 6 bytes ("0,0,0\n"); pages never written are never taken.
@@ -307,7 +312,7 @@ def _read_rows(path: Path, columns: int, target: bool) -> np.ndarray:
     lines = 0  # lines before the current block
     blank_line = 0  # a blank line at the end of the blocks read so far (0: none)
     first = True
-    for block in _blocks(path):
+    for block in _blocks(path, digest):
         start = len(_BOM) if first and block[: len(_BOM)].tobytes() == _BOM else 0
         first = False
         got, bad_line, bad_offset = _parse_voxel_bytes(block, start, out[rows:])
@@ -328,9 +333,9 @@ def _read_rows(path: Path, columns: int, target: bool) -> np.ndarray:
     return out
 
 
-def _blocks(path: Path):
+def _blocks(path: Path, digest: Digest | None = None):
     """The file's bytes in blocks of about _BLOCK_BYTES, each ending at a line end
-    (the last may not), as uint8 arrays."""
+    (the last may not), as uint8 arrays; ``digest`` is fed them as read."""
     try:
         with open(path, "rb") as handle:
             carry = b""
@@ -340,6 +345,8 @@ def _blocks(path: Path):
                     if carry:
                         yield np.frombuffer(carry, dtype=np.uint8)
                     return
+                if digest is not None:
+                    digest.update(data)
                 data = carry + data
                 cut = data.rfind(b"\n") + 1
                 carry = data[cut:]

@@ -17,8 +17,16 @@ from typing import TYPE_CHECKING, Any
 
 from ladartui.errors import LadarError
 from ladartui.recent import remember_scenario
-from ladartui.run_record import is_record, missing_outputs, read_run_record
+from ladartui.run_record import (
+    input_changes,
+    is_record,
+    missing_outputs,
+    read_run_record,
+    recorded_inputs,
+    run_inputs,
+)
 from ladartui.scenario_file import record_owner
+from ladartui.textsafe import visible
 from ladartui.tui import bridge
 from ladartui.tui.host import Host
 from ladartui.tui.view_area import prepare_views
@@ -125,7 +133,8 @@ class SceneLoading(Host):
         self.outputs_seen = files.seen  # the ones about to be shown: no other run's
         self.missing_outputs = files.missing
         if files.readable:
-            start_job(self, "earlier", lambda cancel, progress: _earlier(scenario, files))
+            scene = self.scene
+            start_job(self, "earlier", lambda cancel, progress: _earlier(scenario, files, scene))
 
     def earlier_read(self, earlier: Earlier) -> None:
         if self.scenario is None or self.scenario.path != earlier.scenario.path:
@@ -183,12 +192,13 @@ def _load(path: Path | None, scenario) -> Loaded:
             path = default_scenario_path()
         scenario = bridge.load_checked(path)
     scene = scenario.load_scene()
-    return Loaded(scene, prepare_views(scene), _earlier(scenario))
+    return Loaded(scene, prepare_views(scene), _earlier(scenario, scene=scene))
 
 
-def _earlier(scenario, files: OutputFiles | None = None) -> Earlier:
+def _earlier(scenario, files: OutputFiles | None = None, scene: Scene | None = None) -> Earlier:
     """The outputs of an earlier run under ``scenario``'s name, and what made them;
-    ``files``: the look at them already taken."""
+    ``files``: the look at them already taken; ``scene``: the scenario's, as loaded
+    (a model file it read that changed since the run is named)."""
     if files is None:
         files = look_at_outputs(scenario)
     warning, ran = None, None
@@ -202,8 +212,20 @@ def _earlier(scenario, files: OutputFiles | None = None) -> Earlier:
             ran = read_run_record(scenario)
         except LadarError as error:
             warning = f"settings of the earlier run not read, taken as the file's: {error}"
+        if ran is not None and scene is not None:
+            warning = _inputs_changed(scenario, scene)
         target_output = _target_output(scenario)
     return Earlier(scenario, output, measures, ran, warning, files, target_output)
+
+
+def _inputs_changed(scenario, scene) -> str | None:
+    """The earlier outputs' model files or flight logs that changed since their run."""
+    try:
+        recorded = recorded_inputs(scenario)
+    except LadarError as error:
+        return visible(f"model files of the earlier run not read: {error}")
+    changes = input_changes(recorded or [], run_inputs(scenario, scene))
+    return visible(f"Earlier outputs: {'; '.join(changes)}.") if changes else None
 
 
 def _target_output(scenario) -> np.ndarray | None:

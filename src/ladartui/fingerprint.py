@@ -1,0 +1,40 @@
+"""Content fingerprints of input files: the size and SHA-256 of their bytes.
+
+A run record keeps one for each file the run read (scene and target models,
+flight logs), so that ``validate`` can name a file changed since the run. The
+loaders hash the bytes as they read them (``Digest``): nothing is read twice.
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Fingerprint:
+    size: int  # bytes
+    sha256: str  # hex digest of the contents
+
+
+class Digest:
+    """The fingerprint of bytes fed in pieces, in file order."""
+
+    def __init__(self) -> None:
+        self._hash = hashlib.sha256()
+        self._size = 0
+
+    def update(self, data) -> None:
+        view = memoryview(data)
+        self._hash.update(view)
+        self._size += view.nbytes
+
+    def fingerprint(self) -> Fingerprint:
+        return Fingerprint(self._size, self._hash.hexdigest())
+
+
+def fingerprint_of(data) -> Fingerprint:
+    """The fingerprint of bytes read whole."""
+    digest = Digest()
+    digest.update(data)
+    return digest.fingerprint()
