@@ -5,6 +5,7 @@ import math
 
 import pytest
 
+from cli_support import one_error_line
 from ladartui.errors import InputFileError
 from ladartui.sweep import load_sweep_results, load_sweep_spec, read_table, run_sweep
 from tiny_sweep import tiny_folder, write_spec, write_tiny_scenario
@@ -194,6 +195,43 @@ def test_show_names_a_file_given_as_its_results_folder(tiny, tmp_path, capsys):
     assert main(["sweep", str(spec), "--show", "--out", str(spec)]) == 2
     err = capsys.readouterr().err.strip()
     assert err == f"ladartui: error: --out = '{spec}': expected a sweep's results folder; it is a file"
+
+
+@pytest.mark.parametrize(
+    "flags, named",
+    [
+        (["--workers", "2"], "--workers"),
+        (["--serial"], "--serial"),
+        (["--scheduler", "tcp://127.0.0.1:8786"], "--scheduler"),
+        (["--tls-ca-file", "ca.pem", "--insecure"], "--tls-ca-file, --insecure"),
+        (["--connect-timeout", "5"], "--connect-timeout"),
+    ],
+)
+def test_show_refuses_the_flags_of_a_run_it_does_not_start(tiny, tmp_path, capsys, flags, named):
+    """--show --workers 2 ranked the table and exited 0, the --workers taken without a word."""
+    from ladartui.cli import main
+
+    spec = write_spec(tiny, "[grid]\nradius = [20.0]\n", name="showflags.toml")
+    assert main(["sweep", str(spec), "--show", "--out", str(tmp_path / "o"), *flags]) == 2
+    assert one_error_line(capsys) == (
+        f"ladartui: error: {named}: only a run uses "
+        f"{'it' if ',' not in named else 'them'}; --show ranks the results in OUT and runs nothing"
+    )
+
+
+@pytest.mark.parametrize("mode", ["--serial", "--show"])
+def test_a_budget_for_an_objective_that_uses_none_is_refused(tiny, tmp_path, capsys, mode):
+    """--budget 5 under coverage-per-km was taken and ignored: that ranking has no budget."""
+    from ladartui.cli import main
+
+    spec = write_spec(tiny, "[grid]\nradius = [20.0]\n", name="budget.toml")
+    args = ["sweep", str(spec), mode, "--objective", "coverage-per-km", "--budget", "5"]
+    assert main([*args, "--out", str(tmp_path / "o")]) == 2
+    assert one_error_line(capsys) == (
+        "ladartui: error: --budget = 5.0: expected no --budget with objective 'coverage-per-km' "
+        "(only coverage-within-budget and identified-within-budget use a budget)"
+    )
+    assert not (tmp_path / "o").exists()
 
 
 def _straight_base(folder):

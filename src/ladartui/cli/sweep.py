@@ -17,13 +17,25 @@ from typing import TYPE_CHECKING
 from rich.markup import escape
 
 from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt, stop_status
-from ladartui.errors import Cancelled, FieldError
+from ladartui.errors import Cancelled, FieldError, LadarError
 from ladartui.textsafe import visible
 
 if TYPE_CHECKING:
     from ladartui.sweep.spec import SweepSpec
 
 DEFAULT_TOP = 10
+DEFAULT_CONNECT_TIMEOUT = 30.0
+# Flags that only shape a run (its cluster and workers): --show starts none.
+RUN_ONLY_FLAGS = {
+    "workers": "--workers",
+    "serial": "--serial",
+    "scheduler": "--scheduler",
+    "tls_ca_file": "--tls-ca-file",
+    "tls_cert": "--tls-cert",
+    "tls_key": "--tls-key",
+    "insecure": "--insecure",
+    "connect_timeout": "--connect-timeout",
+}
 
 
 def add_parser(subparsers):
@@ -59,8 +71,7 @@ def add_parser(subparsers):
         "--connect-timeout",
         metavar="SECONDS",
         type=float,
-        default=30.0,
-        help="how long to wait for the scheduler and a first worker (default 30)",
+        help=f"how long to wait for the scheduler and a first worker (default {DEFAULT_CONNECT_TIMEOUT:g})",
     )
     parser.add_argument(
         "--workers",
@@ -113,6 +124,14 @@ def run(args) -> int:
     from ladartui.sweep import default_out_dir, load_sweep_results, load_sweep_spec
     from ladartui.sweep.ranking import BUDGET_OBJECTIVES, normal_cost, normal_objective
 
+    given = [flag for name, flag in RUN_ONLY_FLAGS.items() if getattr(args, name) not in (None, False)]
+    if args.show and given:
+        raise LadarError(
+            f"{', '.join(given)}: only a run uses {'it' if len(given) == 1 else 'them'}; "
+            "--show ranks the results in OUT and runs nothing"
+        )
+    if args.connect_timeout is None:
+        args.connect_timeout = DEFAULT_CONNECT_TIMEOUT
     if args.workers is not None and args.workers < 1:
         raise FieldError("--workers", args.workers, "an integer >= 1")
     if args.serial and args.workers is not None:
@@ -150,6 +169,13 @@ def run(args) -> int:
         from ladartui.sweep.execute import checked_budget
 
         checked_budget(args.budget, "--budget")
+        if objective not in BUDGET_OBJECTIVES:  # it would be taken and never used
+            raise FieldError(
+                "--budget",
+                args.budget,
+                f"no --budget with objective '{objective}' (only "
+                f"{' and '.join(sorted(BUDGET_OBJECTIVES))} use a budget)",
+            )
     if objective in BUDGET_OBJECTIVES and args.budget is None and spec.budget is None:
         raise FieldError(
             "--budget",
