@@ -152,3 +152,23 @@ def test_same_seed_same_answer_on_both_backends(woods, wgpu_backend):
     np.testing.assert_array_equal(on_numba.scene_output, on_wgpu.scene_output)
     np.testing.assert_array_equal(on_numba.target_output, on_wgpu.target_output)
     assert on_numba.measures == on_wgpu.measures
+
+
+@pytest.mark.parametrize("model", ['model = "ideal"\n', "# no model: ideal\n"])
+def test_validate_notes_geiger_keys_that_the_ideal_model_does_not_use(woods, capsys, model):
+    """[detection] model = "ideal" with pulses = 10 was taken without a word: a run
+    used the ideal sensor and no pulses at all."""
+    path = woods.save().path
+    text = path.read_text(encoding="utf-8")
+    line = text.count("\n") + 4  # pulses: after a blank line, the header and the model line
+    path.write_text(text + f"\n[detection]\n{model}pulses = 10\nn_ref = 3.0\n", "utf-8")
+    assert main(["validate", str(path)]) == 0
+    default = "" if model.startswith("model") else " (the default)"
+    assert (
+        f"\nnote       {path}:{line}: detection.pulses, detection.n_ref: Geiger-mode keys that "
+        f'model "ideal"{default} does not use (model = "geiger" runs them; ladartui pulses '
+        "reads them as they are)\n"
+    ) in capsys.readouterr().out
+    path.write_text(text + '\n[detection]\nmodel = "geiger"\npulses = 10\n', "utf-8")
+    assert main(["validate", str(path)]) == 0
+    assert "note       " not in capsys.readouterr().out

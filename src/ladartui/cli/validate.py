@@ -35,7 +35,8 @@ def run(args) -> int:
     scene_lines = scene_summary(scenario, scene)
     check_outputs_spare_inputs(scenario)  # what a run would refuse before tracing
     print(visible(scenario.summary()))
-    for line in [*scene_lines, *flight_notes(scenario.flight), *last_run_lines(scenario, scene)]:
+    notes = [*flight_notes(scenario.flight), *detection_notes(scenario)]
+    for line in [*scene_lines, *notes, *last_run_lines(scenario, scene)]:
         print(visible(line))
     return 0
 
@@ -48,6 +49,32 @@ def flight_notes(flight) -> list[str]:
     return [
         f"note       [flight.start] is not used: the path starts at its first segment ({first}), "
         "which places its own scans"
+    ]
+
+
+def detection_notes(scenario) -> list[str]:
+    """Geiger-mode keys set under the ideal model: a run uses none of them, though
+    ``ladartui pulses`` (which forces the model to geiger) does, so they are not refused."""
+    import tomllib
+
+    from ladartui.toml_lines import key_lines_from_text
+
+    if scenario.detection is None or scenario.detection.geiger:
+        return []
+    text = scenario.path.read_text(encoding="utf-8-sig")
+    table = tomllib.loads(text).get("detection", {})
+    unused = [f"detection.{key}" for key in table if key != "model"]
+    if not unused:
+        return []
+    lines = key_lines_from_text(text)
+    line = lines.get(unused[0], lines.get("detection"))  # a dotted key outside [detection]: no line
+    where = f"{scenario.path}:{line}" if line else str(scenario.path)
+    model = 'model "ideal"' + ("" if "model" in table else " (the default)")
+    keys = "a Geiger-mode key" if len(unused) == 1 else "Geiger-mode keys"
+    return [
+        f"note       {where}: {', '.join(unused)}: {keys} that {model} does not use "
+        f'(model = "geiger" runs {"it" if len(unused) == 1 else "them"}; ladartui pulses reads '
+        f"{'it' if len(unused) == 1 else 'them'} as {'it is' if len(unused) == 1 else 'they are'})"
     ]
 
 
