@@ -146,6 +146,21 @@ def test_bad_flags_are_one_line(tmp_path, truck, capsys, extra, message):
     assert not (tmp_path / "t.txt").exists()
 
 
+@pytest.mark.parametrize(
+    "flags", [["--at", "-5,-5"], ["--at", "1,1", "--heading", "-1e1"], ["--at", "-.5,5"]]
+)
+def test_a_negative_value_is_taken_as_the_value_of_its_flag(tmp_path, truck, capsys, flags):
+    """--at -5,-5 and --heading -1e1 stopped in argparse with 'argument --at: expected one
+    argument' (only -5 and -0.5 read as numbers); --at=-5,-5 reached the command."""
+    args = ["voxelize", str(truck), str(tmp_path / "t"), "--voxel-size", "0.25"]
+    joined = [f"{flag}={value}" for flag, value in zip(flags[::2], flags[1::2])]
+    assert main([*args, *joined]) == 2
+    with_equals = one_error_line(capsys)
+    assert main([*args, *flags]) == 2
+    assert one_error_line(capsys) == with_equals
+    assert with_equals.startswith("ladartui: error: --at = ") and "expected a position" in with_equals
+
+
 @pytest.mark.parametrize("empty", ["MESH", "OUT", "--into"])
 def test_an_empty_path_names_its_argument(tmp_path, truck, forest, capsys, monkeypatch, empty):
     """An empty OUT ended in a ValueError traceback; an empty MESH was '.: is a folder' and

@@ -12,6 +12,7 @@ import contextlib
 import difflib
 import importlib
 import os
+import re
 import signal
 import sys
 from pathlib import Path
@@ -39,6 +40,12 @@ COMMANDS = {
 
 
 class _Parser(argparse.ArgumentParser):
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        # A word that starts like a negative number is a value ("--at -5,-5", "--heading
+        # -1e1"): argparse's own test took all but "-5" and "-0.5" for an unknown flag.
+        self._negative_number_matcher = re.compile(r"-\.?\d")
+
     def error(self, message):
         # One line naming the flag, no usage dump: the user asked for -h if they want it.
         # Arguments are echoed in the message: escape them like any user text.
