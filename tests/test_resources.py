@@ -6,7 +6,7 @@ import pytest
 from cli_support import one_error_line
 from ladartui.cli import main
 from ladartui.errors import ResourceLimitError
-from ladartui.resources import occupancy_bytes, set_max_rays
+from ladartui.resources import gib, occupancy_bytes, set_max_rays
 from ladartui.scene.occupancy import Occupancy
 from ladartui.scene.voxels import save_voxels
 
@@ -28,6 +28,16 @@ def test_memory_limit_is_configurable(tmp_path, monkeypatch):
         Occupancy.build(voxels, source="woods.txt")
     monkeypatch.setenv("LADARTUI_MAX_MEMORY", str(need))
     assert Occupancy.build(voxels).count == len(voxels)
+
+
+def test_a_memory_limit_of_one_byte_is_said_in_the_singular(tmp_path, capsys, monkeypatch):
+    """LADARTUI_MAX_MEMORY=1 read 'more than the 1 bytes of memory available'."""
+    path = tmp_path / "f.txt"
+    path.write_text("0,0,0\n1,1,1\n")
+    monkeypatch.setenv("LADARTUI_MAX_MEMORY", "1")
+    assert main(["info", str(path)]) == 2
+    assert one_error_line(capsys).endswith("more than the 1 byte of memory available")
+    assert [gib(n) for n in (0, 2, 1023, 1024)] == ["0 bytes", "2 bytes", "1,023 bytes", "1 KiB"]
 
 
 @pytest.mark.parametrize(

@@ -14,6 +14,7 @@ import os
 import numpy as np
 
 from ladartui.errors import ResourceLimitError
+from ladartui.number_text import plural
 
 # About two days of tracing on one core at ~10 M rays/s (a week of the 2.7e12 rays case
 # is far past it); a real study stays well under.
@@ -164,11 +165,11 @@ def check_rays(rays, source, limit=None, raise_with=RAISE_RAYS) -> None:
 
 
 def gib(nbytes) -> str:
-    """A size in words: GiB from 128 MiB up, then MiB, KiB, bytes."""
+    """A size in words: GiB from 128 MiB up, then MiB, KiB, bytes ("1 byte")."""
     if nbytes >= 2**27:
         return f"{nbytes / 2**30:.3g} GiB"
     if nbytes >= 2**20:
         return f"{nbytes / 2**20:.3g} MiB"
     if nbytes >= 2**10:
         return f"{nbytes / 2**10:.3g} KiB"
-    return f"{int(nbytes)} bytes"
+    return plural(int(nbytes), "byte")
