@@ -48,6 +48,25 @@ def test_each_level_is_reached_at_the_first_scan_crossing_both_thresholds():
     assert result.highest is identify
 
 
+def test_counts_in_the_run_tables_have_thousands_separators():
+    """The convoy's levels title read 'of 1124 visible voxels', its voxels row '1124 of 2424'."""
+    import dataclasses
+
+    from rich.console import Console
+
+    from ladartui.cli.run import levels_table
+    from ladartui.measures import view_rows
+
+    result = levels_from_curves([0.5], [0.6], [0.0], [0.0])
+    result = dataclasses.replace(result, visible_voxels=1124, footprint_cells=1600)
+    console = Console(width=200, record=True)
+    console.print(levels_table(result))
+    title = " ".join(console.export_text().split())  # the title wraps to the table's width
+    assert "Levels: 50.0 % of 1,124 visible voxels, 60.0 % of 1,600 footprint cells seen" in title
+    measures = Measures(visible_voxels=1124, target_voxels=2424, unobscured_voxels=1001, obscured_voxels=574)
+    assert view_rows(measures)[1] == ("Voxels", "1,124 of 2,424", "1,001", "574")
+
+
 def test_a_share_equal_to_its_threshold_reaches_it_and_the_first_scan_counts_as_one():
     # 3 of 10 voxels: 3 / 10 and the threshold 0.3 meet exactly (and within rounding).
     result = levels_from_curves([3 / 10, 0.5], [1.0, 1.0], [0.0, 1.5], [0.0, 45.0], LevelThresholds())

@@ -585,9 +585,9 @@ def view_rows(measures: Measures) -> list[tuple[str, ...]]:
         ),
         (
             "Voxels",
-            f"{m.visible_voxels} of {m.target_voxels}",
-            str(m.unobscured_voxels),
-            str(m.obscured_voxels),
+            f"{m.visible_voxels:,} of {m.target_voxels:,}",
+            f"{m.unobscured_voxels:,}",
+            f"{m.obscured_voxels:,}",
         ),
         ("Sample mean vector", *(format_vector(v.mean_vector) for v in views)),
         ("Mean resultant length", *(format_number(v.resultant_length) for v in views)),

@@ -336,8 +336,8 @@ def levels_table(levels, title="Levels"):
     from ladartui.measures import format_share
 
     table = Table(
-        title=f"{title}: {format_share(levels.visible_share)} of {levels.visible_voxels or 0} "
-        f"visible voxels, {format_share(levels.footprint_share)} of {levels.footprint_cells or 0} "
+        title=f"{title}: {format_share(levels.visible_share)} of {levels.visible_voxels or 0:,} "
+        f"visible voxels, {format_share(levels.footprint_share)} of {levels.footprint_cells or 0:,} "
         "footprint cells seen"
     )
     table.add_column("level")
