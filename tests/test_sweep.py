@@ -4,6 +4,7 @@ import itertools
 import math
 import os
 import random
+import re
 import subprocess
 import sys
 import threading
@@ -503,11 +504,25 @@ def test_impossible_values_are_not_called_failures(tiny, tmp_path, capsys):
     spec = write_spec(tiny, "[grid]\nradius = [10.0]\nsensor_grid = [8, 0]\n", name="impossible.toml")
     assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path)]) == 0
     out = capsys.readouterr().out
-    assert "1 variant(s) with impossible values (kept as errors, not run again); first: " in out
+    assert "\n1 variant with impossible values (kept as errors, not run again); first: " in out
     assert "failed" not in out
     assert main(["sweep", str(spec), "--show", "--out", str(tmp_path), "--json"]) == 0
     report = json.loads(capsys.readouterr().out)
     assert (report["failed"], report["impossible"]) == (0, 1)
+
+
+def test_the_summary_counts_in_words_and_says_when_every_variant_was_resumed(tiny, tmp_path, capsys):
+    """A fully resumed sweep said '0 variant(s) run in 0.0 s on 0 worker(s); 2 resumed'."""
+    from ladartui.cli import main
+
+    spec = write_spec(tiny, "[grid]\nradius = [10.0, 12.0]\n", name="words.toml")
+    assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert re.search(r"\n2 variants run in [\d.]+ s \([\d.]+ variants/min\) on 1 worker\n", out), out
+    assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "\nnothing to run: all 2 variants resumed from earlier runs\n" in out
+    assert " run in " not in out and "(s)" not in out
 
 
 def test_two_sweeps_never_write_one_folder_at_once(tiny, tmp_path):

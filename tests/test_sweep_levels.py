@@ -140,7 +140,8 @@ def test_cli_sweep_says_which_level_the_recommended_path_reaches(tmp_path, capsy
         == 0
     )
     text = capsys.readouterr().out
-    assert f"{len(late)} finished variant(s) not ranked (no target identified within the budget)" in text
+    said = f"{len(late)} finished {'variant' if len(late) == 1 else 'variants'} not ranked"
+    assert f"{said} (no target identified within the budget)" in text
 
 
 def two_target_row(variant, identify_times, coverages, names=("truck", "van")):

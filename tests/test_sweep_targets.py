@@ -119,7 +119,7 @@ def test_cli_sweep_shows_targets_identified_and_names_them(tmp_path, capsys):
     assert main(["sweep", str(spec), "--serial"]) == 0
     text = capsys.readouterr().out
     assert "targets id." in text and text.count(" 2/2 ") == 2  # the two ranked paths
-    assert "2 finished variant(s) not ranked (a target not identified)" in text
+    assert "2 finished variants not ranked (a target not identified)" in text
     line = next(s for s in text.splitlines() if s.startswith("best path "))
     assert line.startswith("best path identifies all 2 targets: open reaches identify at scan 4 of 4")
     assert main(["sweep", str(spec), "--show", "--json"]) == 0

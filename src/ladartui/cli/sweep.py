@@ -18,6 +18,7 @@ from rich.markup import escape
 
 from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt, stop_status
 from ladartui.errors import Cancelled, FieldError, LadarError
+from ladartui.number_text import plural
 from ladartui.textsafe import visible
 
 if TYPE_CHECKING:
@@ -468,7 +469,7 @@ def show_result(console, result, top) -> None:
             "distance-to-identify": "a target not identified",
             "identified-within-budget": "no target identified within the budget",
         }.get(result.objective, "objective undefined or over the budget")
-        console.print(f"{unranked} finished variant(s) not ranked ({reason})", highlight=False)
+        console.print(f"{plural(unranked, 'finished variant')} not ranked ({reason})", highlight=False)
         missed = never_identified(result.rows)
         if missed and result.objective in ("time-to-identify", "distance-to-identify"):
             console.print(
@@ -480,21 +481,25 @@ def show_result(console, result, top) -> None:
     ):
         if rows:
             console.print(
-                f"[bold]{len(rows)} variant(s) {what}[/]; first: "
+                f"[bold]{plural(len(rows), 'variant')} {what}[/]; first: "
                 + escape(visible(f"{rows[0].get('variant')}: {rows[0].get('error')}")),
                 highlight=False,
             )
-    if result.ran or result.resumed:
-        ran = result.ran
-        rate = f" ({60 * ran / result.elapsed:.1f} variants/min)" if ran and result.elapsed else ""
+    ran, resumed = result.ran, result.resumed
+    if ran:
+        rate = f" ({60 * ran / result.elapsed:.1f} variants/min)" if result.elapsed else ""
+        earlier = f"; {resumed:,} resumed from earlier runs" if resumed else ""
         console.print(
-            f"{ran} variant(s) run in {result.elapsed:.1f} s{rate} on "
-            f"{result.workers} worker(s); {result.resumed} resumed from earlier runs",
+            f"{plural(ran, 'variant')} run in {result.elapsed:.1f} s{rate} on "
+            f"{plural(result.workers, 'worker')}{earlier}",
             highlight=False,
         )
+    elif resumed:  # no worker started: "0 variants run ... on 0 workers" said nothing
+        every = "the variant" if resumed == 1 else f"all {resumed:,} variants"
+        console.print(f"nothing to run: {every} resumed from earlier runs", highlight=False)
     if result.left_out:
         console.print(
-            f"{result.left_out} rows of other variants or an earlier base left out (a run of this "
+            f"{plural(result.left_out, 'row')} of other variants or an earlier base left out (a run of this "
             "spec runs its variants again for the base as it is now)",
             highlight=False,
         )
