@@ -172,3 +172,21 @@ def test_validate_notes_geiger_keys_that_the_ideal_model_does_not_use(woods, cap
     path.write_text(text + '\n[detection]\nmodel = "geiger"\npulses = 10\n', "utf-8")
     assert main(["validate", str(path)]) == 0
     assert "note       " not in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    "probability, shown",
+    [(3.2e-8, "3.20e-08"), (0.0, "0.000000"), (0.0123, "0.012300"), (None, "undefined")],
+)
+def test_a_false_alarm_probability_below_the_shown_decimals_is_not_shown_as_zero(probability, shown):
+    """A per-bin probability of 3.2e-8 read 0.000000: as if noise never fired."""
+    from rich.console import Console
+
+    from ladartui.cli.run import detection_table
+    from ladartui.detection.measures import DetectionMeasures
+
+    console = Console(width=120, record=True)
+    counts = {"pulses": 100, "coincidence": 10, "seed": 0, "declared_points": 5, "false_alarms": 1}
+    console.print(detection_table(DetectionMeasures(**counts, false_alarm_probability=probability)))
+    row = next(line for line in console.export_text().splitlines() if "false-alarm probability" in line)
+    assert row.split()[-2] == shown

@@ -302,7 +302,11 @@ def detection_table(detection):
     from ladartui.measures import format_share
 
     def number(value, digits=1):
-        return "undefined" if value is None else f"{value:,.{digits}f}"
+        if value is None:
+            return "undefined"
+        if 0 < abs(value) < 0.5 * 10**-digits:  # a tiny chance is not none: never "0.000000"
+            return f"{value:.2e}"
+        return f"{value:,.{digits}f}"
 
     table = Table(
         title=f"Geiger-mode detection: {detection.pulses} pulses per look, "
