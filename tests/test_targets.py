@@ -414,6 +414,21 @@ def test_a_scene_named_after_its_scenario_is_refused_on_its_line(tmp_path, capsy
     )
 
 
+@pytest.mark.parametrize(
+    "names, said",
+    [
+        (((1, "open"), (3, "van")), "names id 3, which is not in"),
+        (((3, "van"), (4, "car"), (5, "bus")), "names ids 3, 4 and 5, which are not in"),
+    ],
+)
+def test_validate_notes_names_of_ids_the_target_model_lacks_in_good_grammar(tmp_path, capsys, names, said):
+    """It said '[targets] names ids 3 are not in boxes_Target.txt'."""
+    from ladartui.cli import main
+
+    assert main(["validate", str(two_box_scenario(tmp_path, names).save().path)]) == 0
+    assert f"\nnote       [targets] {said} boxes_Target.txt (its ids: 1, 2)\n" in capsys.readouterr().out
+
+
 def test_las_outputs_mark_each_voxel_with_its_target(tmp_path):
     laspy = pytest.importorskip("laspy")
     scenario = two_box_scenario(tmp_path)

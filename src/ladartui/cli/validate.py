@@ -156,8 +156,10 @@ def scene_summary(scenario, scene) -> list[str]:
     lines.extend(target_notes(scenario, scene))
     unused = [i for i, _ in scenario.target_names if i not in ids]
     if unused:  # a name for an id the target model does not hold: likely a typo
+        listed = ", ".join(map(str, unused[:-1])) + (" and " if len(unused) > 1 else "") + str(unused[-1])
+        named = f"id {listed}, which is" if len(unused) == 1 else f"ids {listed}, which are"
         lines.append(
-            f"note       [targets] names ids {', '.join(map(str, unused))} are not in "
+            f"note       [targets] names {named} not in "
             f"{scenario.target_file.name} (its ids: {', '.join(map(str, ids)) or 'none'})"
         )
     need = 0
