@@ -198,6 +198,24 @@ def test_missing_and_non_npy_rays(tmp_path, scene_file, capsys):
     assert not (tmp_path / "h.npy").exists()
 
 
+@pytest.mark.parametrize(
+    "content, said",
+    [
+        (b"hello\n\n", "not a NumPy .npy file (no .npy header)"),  # 7 bytes of text
+        (b"\x93NUM", "empty or cut short: expected a NumPy .npy array"),  # the magic, cut
+        (b"", "empty or cut short: expected a NumPy .npy array"),
+    ],
+)
+def test_a_short_file_of_other_bytes_is_not_called_cut_short(tmp_path, scene_file, capsys, content, said):
+    """A 7-byte text file was 'empty or cut short', as if it were a .npy file cut short."""
+    rays = tmp_path / "rays.npy"
+    rays.write_bytes(content[:7])
+    out = tmp_path / "h.npy"
+    assert main(["trace", "--scene", str(scene_file), "--rays", str(rays), "--out", str(out)]) == 2
+    assert one_error_line(capsys) == f"ladartui: error: {rays}: {said}"
+    assert not out.exists()
+
+
 def test_npz_and_object_rays_and_a_bad_out_are_one_line(tmp_path, scene_file, capsys):
     rays = np.array([[5.0, 5.0, 20.0, 0.0, 0.0, -1.0]])
     np.savez(tmp_path / "rays.npz", rays=rays)

@@ -73,10 +73,11 @@ def check_rays_header(path) -> None:
             start = handle.read(len(npy.MAGIC_PREFIX) + 2)
             if start.startswith(b"PK\x03\x04"):  # a zip: an .npz archive
                 return
+            # Other bytes, however few, are no .npy file; only the magic's own start is one cut short.
+            if not npy.MAGIC_PREFIX.startswith(start[: len(npy.MAGIC_PREFIX)]):
+                raise InputFileError(path, "not a NumPy .npy file (no .npy header)")
             if len(start) < len(npy.MAGIC_PREFIX) + 2:
                 raise InputFileError(path, "empty or cut short: expected a NumPy .npy array")
-            if not start.startswith(npy.MAGIC_PREFIX):
-                raise InputFileError(path, "not a NumPy .npy file (no .npy header)")
             handle.seek(0)
             version = npy.read_magic(handle)
             read = npy.read_array_header_1_0 if version == (1, 0) else npy.read_array_header_2_0
