@@ -7,11 +7,20 @@ import tempfile
 
 import pytest
 
+# pytest-xdist starts its workers with COLUMNS=80 and LINES=24 set; the CLI takes
+# COLUMNS as the width the user chose, so every test runs without them, in a worker
+# as in one process.
+for _name in ("COLUMNS", "LINES"):
+    os.environ.pop(_name, None)
+
 # The default scenario and benchmark scenes live under LADARTUI_HOME; point it
 # at a throw-away folder before any test imports ladartui, removed at exit.
 if "LADARTUI_HOME" not in os.environ:
     os.environ["LADARTUI_HOME"] = tempfile.mkdtemp(prefix="ladartui-test-home-")
     atexit.register(shutil.rmtree, os.environ["LADARTUI_HOME"], ignore_errors=True)
+if "PYTEST_XDIST_WORKER" in os.environ:  # a home of its own (recent files, settings)
+    os.environ["LADARTUI_HOME"] = os.path.join(os.environ["LADARTUI_HOME"], os.environ["PYTEST_XDIST_WORKER"])
+    os.makedirs(os.environ["LADARTUI_HOME"], exist_ok=True)
 
 
 @pytest.fixture(scope="module")
