@@ -367,3 +367,23 @@ def test_ctrl_c_early_in_a_local_sweep_says_it_is_stopping(tmp_path):
     assert "stopping; finished variants are kept" in said
     assert "sweep interrupted" in said and "run the same command again to resume" in said
     assert "Traceback" not in said and "KeyboardInterrupt" not in said, said
+
+
+def test_a_second_local_cluster_starts_quietly_and_serves_http_on_loopback_alone(client):
+    """Each local cluster's scheduler served HTTP on port 8787 of every interface: a
+    second sweep at once (another terminal, the sweep screen) printed distributed's
+    'Port 8787 is already in use' warning."""
+    import warnings
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        second = local_client(1)
+    try:
+        assert not [w for w in caught if "already in use" in str(w.message)]
+        for cluster in (client.cluster, second.cluster):
+            http = cluster.scheduler.services["dashboard"]
+            assert http.address == "127.0.0.1" and http.port != 8787
+    finally:
+        cluster = second.cluster
+        second.close()
+        cluster.close()

@@ -32,7 +32,10 @@ def local_client(workers: int | None = None):
                 n_workers=count,
                 threads_per_worker=1,
                 processes=True,
-                dashboard_address=None,
+                # The scheduler serves HTTP even without a dashboard, by default on port
+                # 8787 of every interface: a second sweep at once warned that the port
+                # was taken. A free port of the loopback alone.
+                dashboard_address="127.0.0.1:0",
                 silence_logs=logging.ERROR,
                 env={"NUMBA_NUM_THREADS": str(max(1, cores // count))},
             )
