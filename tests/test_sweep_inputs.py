@@ -409,3 +409,19 @@ def test_the_tui_sweep_job_reads_and_hashes_the_base_once(tmp_path, monkeypatch)
     digests.clear()
     again = sweep_job(spec, *args, lambda fraction, text, report=None, keep=False: reports.append(report))
     assert again.resumed == 2 and len(digests) == 1
+
+
+@pytest.mark.parametrize("mode", [[], ["--serial"], ["--workers", "1"]])
+def test_a_connect_timeout_without_a_scheduler_is_refused(tiny, tmp_path, capsys, mode):
+    """--connect-timeout 5 on a local sweep was taken and ignored: only a connection to a
+    scheduler waits for it."""
+    from ladartui.cli import main
+
+    spec = write_spec(tiny, "[grid]\nradius = [20.0]\n", name="timeout.toml")
+    args = ["sweep", str(spec), *mode, "--connect-timeout", "5", "--out", str(tmp_path / "o")]
+    assert main(args) == 2
+    assert one_error_line(capsys) == (
+        "ladartui: error: --scheduler is not set: expected an address with --connect-timeout "
+        "(only a connection to a scheduler waits for it)"
+    )
+    assert not (tmp_path / "o").exists()  # refused before anything ran

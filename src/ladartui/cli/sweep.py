@@ -72,7 +72,8 @@ def add_parser(subparsers):
         "--connect-timeout",
         metavar="SECONDS",
         type=float,
-        help=f"how long to wait for the scheduler and a first worker (default {DEFAULT_CONNECT_TIMEOUT:g})",
+        help="with --scheduler: how long to wait for the scheduler and a first worker "
+        f"(default {DEFAULT_CONNECT_TIMEOUT:g})",
     )
     parser.add_argument(
         "--workers",
@@ -130,6 +131,12 @@ def run(args) -> int:
         raise LadarError(
             f"{', '.join(given)}: only a run uses {'it' if len(given) == 1 else 'them'}; "
             "--show ranks the results in OUT and runs nothing"
+        )
+    if args.connect_timeout is not None and not args.scheduler:
+        raise FieldError(
+            "--scheduler",
+            None,
+            "an address with --connect-timeout (only a connection to a scheduler waits for it)",
         )
     if args.connect_timeout is None:
         args.connect_timeout = DEFAULT_CONNECT_TIMEOUT
