@@ -55,7 +55,7 @@ def test_counts_in_the_run_tables_have_thousands_separators():
     from rich.console import Console
 
     from ladartui.cli.run import levels_table
-    from ladartui.measures import view_rows
+    from ladartui.measures_table import view_rows
 
     result = levels_from_curves([0.5], [0.6], [0.0], [0.0])
     result = dataclasses.replace(result, visible_voxels=1124, footprint_cells=1600)

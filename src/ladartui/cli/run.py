@@ -226,7 +226,7 @@ def show_result(console, result, asked_precision=None) -> None:
     the precision traced where it is not ``asked_precision`` (a backend without it)."""
     from rich.table import Table
 
-    from ladartui.measures import comparison_rows, view_rows
+    from ladartui.measures_table import comparison_rows, view_rows
     from ladartui.number_text import plural
 
     views = Table(title="Measures of effectiveness")
@@ -299,7 +299,7 @@ def detection_table(detection):
     """The Geiger-mode measures (``[detection] model = "geiger"``) as a table."""
     from rich.table import Table
 
-    from ladartui.measures import format_share
+    from ladartui.measures_table import format_share
 
     def number(value, digits=1):
         if value is None:
@@ -337,7 +337,7 @@ def levels_table(levels, title="Levels"):
     """Detect / recognise / identify: each level's thresholds and the scan that reached it."""
     from rich.table import Table
 
-    from ladartui.measures import format_share
+    from ladartui.measures_table import format_share
 
     table = Table(
         title=f"{title}: {format_share(levels.visible_share)} of {levels.visible_voxels or 0:,} "
