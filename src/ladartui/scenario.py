@@ -23,7 +23,7 @@ from ladartui.atomic import write_text_atomic
 from ladartui.checks import choice_field, number_field
 from ladartui.detection.settings import DetectionSettings
 from ladartui.errors import FieldError, InputFileError, LadarError, OutputFileError
-from ladartui.fileprobe import NO_SUCH_FILE, file_problem, read_utf8, refuse_special_file
+from ladartui.fileprobe import NO_SUCH_FILE, file_problem, read_utf8
 from ladartui.flight import (
     FlightPlan,
     ScanPose,
@@ -416,7 +416,6 @@ def load_scenario(path, check_files=True) -> Scenario:
     if not isinstance(path, (str, os.PathLike)) or isinstance(path, bytes):
         raise FieldError("path", path, "a scenario file's path (str or pathlib.Path)")
     path = _absolute(path)
-    refuse_special_file(path, "expected a scenario file (.toml)")  # a pipe would wait for ever
     try:
         text = read_utf8(path, "expected a scenario file (.toml)")
     except FileNotFoundError:

@@ -41,7 +41,7 @@ from typing import NoReturn
 import numpy as np
 
 from ladartui.errors import InputFileError
-from ladartui.fileprobe import NO_SUCH_FILE, read_utf8, refuse_special_file
+from ladartui.fileprobe import NO_SUCH_FILE, read_utf8
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.sweep.variant import applicable
 from ladartui.user_data import bundled_scenario_name
@@ -210,7 +210,6 @@ def _check_variant_count(path, grid, samples):
 def load_sweep_spec(path) -> SweepSpec:
     """Read and check a sweep spec; mistakes raise InputFileError naming the key."""
     path = Path(path)
-    refuse_special_file(path, "expected a sweep spec (.toml)")
     try:
         text = read_utf8(path, "expected a sweep spec (.toml)")
         data = tomllib.loads(text)

@@ -21,7 +21,7 @@ from pathlib import Path
 
 from ladartui.atomic import atomic_path
 from ladartui.errors import InputFileError
-from ladartui.fileprobe import read_utf8, refuse_special_file
+from ladartui.fileprobe import read_utf8
 
 # Columns that lead every table, in this order; parameters and measures follow.
 LEAD_COLUMNS = ("variant", "status", "base")
@@ -119,7 +119,6 @@ def read_table(path) -> tuple[list[dict], list[str]]:
     variant id are dropped (a torn or hand-edited line), never fatal.
     """
     path = Path(path)
-    refuse_special_file(path, "expected the sweep results table (CSV)")  # a pipe would wait for ever
     try:
         text = read_utf8(path, "expected the sweep results table (CSV)")
     except FileNotFoundError:
