@@ -199,8 +199,12 @@ class Scenario:
                 f"{self.target_file.name})"
             )
         if missing:
-            line = key_lines(self.path).get("files.scene") if self.path.is_file() else None
-            raise InputFileError(self.path, missing, line)
+            raise InputFileError(self.path, missing, self.key_line("files.scene"))
+
+    def key_line(self, key: str) -> int | None:
+        """The line of ``key`` ("files.scene") in the scenario's file; None when the file
+        is not there (not saved yet) or does not hold the key."""
+        return key_lines(self.path).get(key) if self.path.is_file() else None
 
     def with_changes(self, **fields) -> Scenario:
         """A copy with ``fields`` replaced (checked like a new scenario)."""

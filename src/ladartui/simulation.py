@@ -410,16 +410,13 @@ def check_outputs_spare_inputs(scenario, las=False) -> None:
     inputs = {os.path.normpath(Path(f).absolute()) for f in (scenario.scene_file, scenario.target_file)}
     for name, path in output_paths(scenario, las).items():
         if os.path.normpath(path.absolute()) in inputs:
-            from ladartui.toml_lines import key_lines
-
-            scenario_path = Path(scenario.path)
-            line = key_lines(scenario_path).get("files.scene") if scenario_path.is_file() else None
+            line = scenario.key_line("files.scene")
             raise FieldError(
                 "files.scene",
                 Path(scenario.scene_file).name,
                 f"a scene model not named after the scenario: the run's {name} output "
                 f"{path.name} would overwrite a model file",
-                source=f"{scenario_path}:{line}" if line else str(scenario_path),
+                source=f"{scenario.path}:{line}" if line else str(scenario.path),
             )
     check_record_spare(scenario)
 
