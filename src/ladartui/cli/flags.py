@@ -14,7 +14,7 @@ from __future__ import annotations
 import contextlib
 import math
 
-from ladartui.errors import FieldError
+from ladartui.errors import FieldError, LadarError
 
 
 @contextlib.contextmanager
@@ -60,3 +60,13 @@ def check_file_names(given: dict, expected: str = "a file name") -> None:
     for name, value in given.items():
         if value is not None and not value.strip():
             raise FieldError(name, value, expected)
+
+
+def refuse_step_without_march(step: float | None, method: str, what: str) -> None:
+    """A ``--step`` given where the tracing is not a march (``method``) would be ignored:
+    refused in one line, saying what the trace is (``what``: "this run is exact (...)")."""
+    if step is not None and method != "march":
+        raise LadarError(
+            f"--step {step:g} sets the march's step, and {what}: add --method march, or drop --step"
+        )
+

@@ -15,7 +15,7 @@ import json
 import threading
 from typing import TYPE_CHECKING
 
-from ladartui.cli.flags import as_flags
+from ladartui.cli.flags import as_flags, refuse_step_without_march
 from ladartui.cli.progress import FIRST_SCAN, progress_display, run_cancellable, sigterm_as_interrupt
 from ladartui.errors import Cancelled, OutputFileError
 from ladartui.textsafe import visible
@@ -85,16 +85,10 @@ def run(args) -> int:
     overrides = {name: value for name, value in overrides.items() if value is not None}
     with as_flags(overrides):
         scenario = scenario.with_changes(**overrides)
-    if args.step is not None and scenario.method != "march":  # as trace: a step the run would ignore
-        how = (
-            f"--method {args.method}"
-            if args.method
-            else f"{scenario.method} (the scenario's simulation.method)"
-        )
-        raise LadarError(
-            f"--step {args.step:g} sets the march's step, and this run is {how}: "
-            "add --method march, or drop --step"
-        )
+    how = (
+        f"--method {args.method}" if args.method else f"{scenario.method} (the scenario's simulation.method)"
+    )
+    refuse_step_without_march(args.step, scenario.method, f"this run is {how}")
     if args.write:  # before any progress is drawn; the run checks again under its lock
         from ladartui.outputset import check_writable
         from ladartui.simulation import check_outputs_spare_inputs, output_paths

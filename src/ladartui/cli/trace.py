@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.atomic import atomic_path
-from ladartui.errors import Cancelled, FieldError, InputFileError, LadarError, ResourceLimitError
+from ladartui.errors import Cancelled, FieldError, InputFileError, ResourceLimitError
 from ladartui.fileprobe import NO_SUCH_FILE, refuse_special_file
 from ladartui.number_text import plural
 from ladartui.textsafe import visible
@@ -134,17 +134,14 @@ def _row(index: int) -> str:
 
 
 def run(args):
-    from ladartui.cli.flags import check_file_names, voxel_size_flag
+    from ladartui.cli.flags import check_file_names, refuse_step_without_march, voxel_size_flag
     from ladartui.cli.progress import sigterm_as_interrupt
 
     check_file_names({"--scene": args.scene, "--rays": args.rays, "--out": args.out})
     # A scene list holds no voxel size: without the flag, 1 m, said in the summary.
     voxel_size = 1.0 if args.voxel_size is None else voxel_size_flag(args.voxel_size)
-    if args.step is not None and args.method in METHODS and args.method != "march":
-        raise LadarError(
-            f"--step {args.step:g} sets the march's step, and this trace is --method {args.method}: "
-            "add --method march, or drop --step"
-        )
+    if args.method in METHODS:  # (another method is refused as the trace starts)
+        refuse_step_without_march(args.step, args.method, f"this trace is --method {args.method}")
     if args.step is not None:
         from ladartui.checks import number_field
         from ladartui.scenario import MAX_STEP
