@@ -70,3 +70,21 @@ def refuse_step_without_march(step: float | None, method: str, what: str) -> Non
             f"--step {step:g} sets the march's step, and {what}: add --method march, or drop --step"
         )
 
+
+# The files of other kinds a command may be given (or name) where it takes a voxel list.
+OTHER_FILE_KINDS = {
+    ".toml": "a scenario",
+    ".las": "a LAS point cloud",
+    ".laz": "a LAS point cloud",
+    ".cmf": "a measures file",
+    ".obj": "a mesh",
+    ".stl": "a mesh",
+    ".ply": "a mesh",
+}
+
+
+def other_file_kind(path) -> str | None:
+    """What a file of ``path``'s suffix is when that is no voxel list ("a mesh"), else None."""
+    from pathlib import Path
+
+    return OTHER_FILE_KINDS.get(Path(path).suffix.lower())

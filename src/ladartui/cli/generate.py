@@ -49,10 +49,6 @@ def add_parser(subparsers):
     return parser
 
 
-# Names of other kinds of file: a scenario, a point cloud, a mesh, a measures file.
-NOT_VOXEL_LISTS = (".toml", ".las", ".laz", ".obj", ".stl", ".ply", ".cmf")
-
-
 def out_stem(out: str, preset: str) -> Path:
     """OUT as the stem to write: a folder (one that exists, or written with a
     trailing slash) gets PRESET.txt and PRESET_Target.txt inside it."""
@@ -94,6 +90,7 @@ def run(args) -> int:
     import threading
 
     from ladartui.cli.console import CliConsole as Console
+    from ladartui.cli.flags import other_file_kind
     from ladartui.cli.progress import run_cancellable, sigterm_as_interrupt
     from ladartui.errors import Cancelled
     from ladartui.outputset import check_writable
@@ -103,7 +100,7 @@ def run(args) -> int:
     if not args.out.strip():
         raise FieldError("OUT", args.out, "a name such as dir/name or a folder")
     stem = out_stem(args.out, args.preset)
-    if stem.suffix.lower() in NOT_VOXEL_LISTS:  # 'forest.toml' wrote forest.toml.txt
+    if other_file_kind(stem) is not None:  # 'forest.toml' wrote forest.toml.txt
         raise FieldError(
             "OUT",
             args.out,

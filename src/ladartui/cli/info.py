@@ -49,38 +49,27 @@ def run(args) -> int:
                 )
             print_scenario(path)
         else:
-            refuse_mesh(path)
-            refuse_other_outputs(path)
+            refuse_other_kinds(path)
             print_voxel_list(path, args.voxel_size)
     return 0
 
 
-def refuse_mesh(path: Path) -> None:
-    """A mesh would be read as a voxel list and fail on its first line: say what to do."""
-    from ladartui.scene.voxelize import MESH_SUFFIXES
+def refuse_other_kinds(path: Path) -> None:
+    """A mesh, point cloud or measures file would be read as a voxel list and fail on its
+    first line: say what it is, and for a mesh what to do."""
+    from ladartui.cli.flags import other_file_kind
 
-    if path.suffix.lower() in MESH_SUFFIXES:
-        from ladartui.errors import InputFileError
-
-        raise InputFileError(
-            path,
-            f"a mesh ({path.suffix}); info takes a voxel list (.txt) or a scenario (.toml): "
-            "voxelise the mesh first with 'ladartui voxelize MESH OUT --voxel-size V'",
-        )
-
-
-# Files ladartui writes beside its voxel lists, which would be read as voxel lists
-# and fail on their first line.
-OTHER_OUTPUTS = {".las": "a LAS point cloud", ".laz": "a LAS point cloud", ".cmf": "a measures file"}
-
-
-def refuse_other_outputs(path: Path) -> None:
-    what = OTHER_OUTPUTS.get(path.suffix.lower())
+    what = other_file_kind(path)
     if what is not None:
         from ladartui.errors import InputFileError
 
+        advice = (
+            ": voxelise the mesh first with 'ladartui voxelize MESH OUT --voxel-size V'"
+            if what == "a mesh"
+            else ""
+        )
         raise InputFileError(
-            path, f"{what} ({path.suffix}); info takes a voxel list (.txt) or a scenario (.toml)"
+            path, f"{what} ({path.suffix}); info takes a voxel list (.txt) or a scenario (.toml){advice}"
         )
 
 
