@@ -36,6 +36,7 @@ __all__ = [
     "RECORD_HEADER",
     "InputFile",
     "input_changes",
+    "inputs_changed",
     "is_record",
     "read_run_record",
     "recorded_inputs",
@@ -139,6 +140,14 @@ def _recorded_input(path: Path, index: int, entry) -> InputFile:
             "bytes and sha256 (64 hex digits)"
         )
     return InputFile(role, resolve_path(path.parent, file), Fingerprint(size, sha256))
+
+
+def inputs_changed(scenario, scene) -> list[str] | None:
+    """``input_changes`` between the files the record beside ``scenario`` lists and
+    ``scene`` as loaded (with the scenario's flight logs); None when the record lists
+    none (older than that, or none). ``LadarError`` naming the record when it cannot be read."""
+    recorded = recorded_inputs(scenario)
+    return None if recorded is None else input_changes(recorded, run_inputs(scenario, scene))
 
 
 def input_changes(recorded, now) -> list[str]:

@@ -126,15 +126,15 @@ def last_run_lines(scenario, scene) -> list[str]:
 def _input_lines(scenario, scene) -> list[str]:
     """The model files and flight logs changed since the run, by their fingerprints."""
     from ladartui.errors import LadarError
-    from ladartui.run_record import input_changes, recorded_inputs, run_inputs
+    from ladartui.run_record import inputs_changed
 
     try:
-        recorded = recorded_inputs(scenario)
+        changes = inputs_changed(scenario, scene)
     except LadarError as error:
         return [f"model files of the run not read: {error}"]
-    if recorded is None:
+    if changes is None:
         return ["the record does not say which model files the run read (written before records did)"]
-    return input_changes(recorded, run_inputs(scenario, scene))
+    return changes
 
 
 def scene_summary(scenario, scene) -> list[str]:

@@ -17,14 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 from ladartui.errors import LadarError
 from ladartui.recent import remember_scenario
-from ladartui.run_record import (
-    input_changes,
-    is_record,
-    missing_outputs,
-    read_run_record,
-    recorded_inputs,
-    run_inputs,
-)
+from ladartui.run_record import inputs_changed, is_record, missing_outputs, read_run_record
 from ladartui.scenario_file import record_owner
 from ladartui.textsafe import visible
 from ladartui.tui import bridge
@@ -221,10 +214,9 @@ def _earlier(scenario, files: OutputFiles | None = None, scene: Scene | None = N
 def _inputs_changed(scenario, scene) -> str | None:
     """The earlier outputs' model files or flight logs that changed since their run."""
     try:
-        recorded = recorded_inputs(scenario)
+        changes = inputs_changed(scenario, scene)
     except LadarError as error:
         return visible(f"model files of the earlier run not read: {error}")
-    changes = input_changes(recorded or [], run_inputs(scenario, scene))
     return visible(f"Earlier outputs: {'; '.join(changes)}.") if changes else None
 
 
