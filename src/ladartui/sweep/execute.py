@@ -13,7 +13,6 @@ import contextlib
 import dataclasses
 import math
 import numbers
-import os
 import time
 import uuid
 from collections.abc import Callable, Mapping
@@ -29,7 +28,6 @@ from ladartui.errors import (
     check_callbacks,
     check_cancelled,
 )
-from ladartui.fileprobe import file_problem
 from ladartui.sweep.base import CheckedBase, checked_base, own_rows, spec_rows
 from ladartui.sweep.best_file import best_files, write_best_scenario
 from ladartui.sweep.cluster import close_client, local_client
@@ -249,13 +247,14 @@ CHART_NAMES = ("pareto.svg", "pareto.png")
 
 
 def check_sweep_files(out: Path, name: str) -> None:
-    """``OutputFileError`` naming a file the sweep keeps in ``out`` that is a folder, a
-    pipe or a device, before any variant runs: a pipe would be waited on for ever when
-    read, or replaced by a file when written."""
-    for file in (LOCK_NAME, RESULTS_NAME, RANKING_NAME, f"{name}-best.toml", *CHART_NAMES):
-        path = out / file
-        if os.path.lexists(path) and (problem := file_problem(path)):
-            raise OutputFileError(path, f"{problem}; the sweep keeps its own {file} in its results folder")
+    """``OutputFileError`` naming a file the sweep keeps in ``out`` that it could not
+    write (a folder, a pipe or a device there, say), before any variant runs: a pipe
+    would be waited on for ever when read, or replaced by a file when written."""
+    from ladartui.outputset import check_writable
+
+    check_writable(
+        *(out / file for file in (LOCK_NAME, RESULTS_NAME, RANKING_NAME, f"{name}-best.toml", *CHART_NAMES))
+    )
 
 
 SIMULATE_OPTIONS = ("backend", "method", "step", "precision")
