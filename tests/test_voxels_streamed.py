@@ -95,6 +95,37 @@ def test_a_large_file_is_read_in_blocks_not_whole(tmp_path, monkeypatch):
     assert len(seen) >= 10 and max(seen) < 256 + 20  # a block and the line it cut
 
 
+def test_a_large_file_is_read_once(tmp_path, monkeypatch):
+    """The first bytes, read to tell a small file from a large one, are not read again."""
+    path = tmp_path / "model.txt"
+    path.write_text(CASES["plain"], encoding="utf-8")
+    monkeypatch.setattr(voxels_module, "_PLAIN_BYTES", 100)
+    monkeypatch.setattr(voxels_module, "_BLOCK_BYTES", 64)
+    read = []
+
+    class CountingFile:
+        def __init__(self, *args):
+            self._file = open(*args)  # noqa: SIM115 (closed by __exit__)
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            self._file.close()
+
+        def read(self, size=-1):
+            data = self._file.read(size)
+            read.append(len(data))
+            return data
+
+        def seek(self, offset):
+            return self._file.seek(offset)
+
+    monkeypatch.setattr(voxels_module, "open", CountingFile, raising=False)
+    assert len(load_voxels(path)) == len(set(LINES))
+    assert sum(read) == path.stat().st_size
+
+
 def test_large_lists_are_checked_for_order_in_place_and_repeats_still_dropped():
     from ladartui.scene.voxels import unique_voxels
 

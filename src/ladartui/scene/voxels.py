@@ -312,7 +312,7 @@ def _read_rows(path: Path, columns: int, target: bool, digest: Digest | None = N
     lines = 0  # lines before the current block
     blank_line = 0  # a blank line at the end of the blocks read so far (0: none)
     first = True
-    for block in _blocks(path, digest):
+    for block in _blocks(path, digest, head.tobytes()):
         start = len(_BOM) if first and block[: len(_BOM)].tobytes() == _BOM else 0
         first = False
         got, bad_line, bad_offset = _parse_voxel_bytes(block, start, out[rows:])
@@ -333,14 +333,18 @@ def _read_rows(path: Path, columns: int, target: bool, digest: Digest | None = N
     return out
 
 
-def _blocks(path: Path, digest: Digest | None = None):
+def _blocks(path: Path, digest: Digest | None = None, head: bytes = b""):
     """The file's bytes in blocks of about _BLOCK_BYTES, each ending at a line end
-    (the last may not), as uint8 arrays; ``digest`` is fed them as read."""
+    (the last may not), as uint8 arrays; ``digest`` is fed them as read. ``head``:
+    the file's first bytes, already read (they are not read again)."""
     try:
         with open(path, "rb") as handle:
+            handle.seek(len(head))
             carry = b""
+            data = head
             while True:
-                data = handle.read(_BLOCK_BYTES)
+                if not data:
+                    data = handle.read(_BLOCK_BYTES)
                 if not data:
                     if carry:
                         yield np.frombuffer(carry, dtype=np.uint8)
@@ -352,6 +356,7 @@ def _blocks(path: Path, digest: Digest | None = None):
                 carry = data[cut:]
                 if cut:
                     yield np.frombuffer(data[:cut], dtype=np.uint8)
+                data = b""
     except OSError as error:
         raise InputFileError(path, f"cannot be read: {error.strerror or error}") from None
 
