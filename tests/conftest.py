@@ -48,13 +48,13 @@ def scene_files(tmp_path_factory):
 
     Module-scoped; it also compiles the kernels once, so the apps skip their warm-up.
     """
+    from ladartui.precompile import one_ray_run
     from ladartui.scene.generate import generate_scene
-    from ladartui.tui.warmup import tiny_run
     from tui_support import make_scenario
 
     folder = tmp_path_factory.mktemp("scene")
     generated = generate_scene("small", seed=11, width=16.0, depth=16.0, trees=5)
     scene_path, _ = generated.write(folder / "forest")
     files = scene_path, tuple(float(v) for v in generated.target_centre), generated.voxel_size
-    tiny_run(make_scenario(folder, files, name="warm"))
+    one_ray_run(make_scenario(folder, files, name="warm"))
     return files

@@ -2,9 +2,10 @@
 
 Three jobs (``tui/work.py``): "load" reads the scenario, its scene and any
 earlier results and prepares the views; once they are shown, "probe" lists
-the backends and "warm" has a child process compile the tracing kernels
-for the first Run (compiling here would hold the interpreter lock and
-freeze the interface), then loads them from numba's disk cache.
+the backends and "warm" has two child processes compile the tracing kernels
+for the first Run (``ladartui.precompile``: compiling here would hold the
+interpreter lock and freeze the interface), then loads them from numba's
+disk cache.
 """
 
 from __future__ import annotations
@@ -232,16 +233,17 @@ def _target_output(scenario) -> np.ndarray | None:
 
 
 def _warm_up(scenario, scene, compile_in_child: bool, cancel) -> None:
-    from ladartui.tui.warmup import tiny_run, warm_in_child
+    from ladartui.precompile import HALVES, compile_half, compile_in_children
 
     if compile_in_child and scenario.path.is_file():
-        warm_in_child(scenario.path, stop=cancel)
-    if cancel.is_set():
-        return
-    try:
-        tiny_run(scenario, scene, cancel=cancel)
-    except Exception:  # a warm-up only; the real run reports any problem
-        pass
+        compile_in_children(scenario.path, stop=cancel)
+    for half in HALVES:  # loaded from the cache the children filled
+        if cancel.is_set():
+            return
+        try:
+            compile_half(half, scenario, scene, cancel=cancel)
+        except Exception:  # a warm-up only; the real run reports any problem
+            pass
 
 
 def _existing_results(scenario, files: OutputFiles):

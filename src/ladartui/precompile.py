@@ -1,0 +1,151 @@
+"""Compile the numba kernels a run uses before it needs them, two halves at once.
+
+numba compiles a kernel on its first call, holding the interpreter lock, and
+keeps it in its on-disk cache. With that cache empty, `ladartui run default`
+spent 3 min 23 s compiling on two busy cores. Child processes compile the two
+halves of the kernels side by side instead (``compile_in_children``), each
+into the cache, and the caller then loads them in moments:
+
+- "object": a scan in object order (its bins, the voxels in view, the tile
+  lists and tests), on a small made-up scene, for each backend the scenario
+  may trace with;
+- "run": a one-ray run of the scenario itself (sensor rays, its scene's
+  occupancy, rays to cells, ray order or the march, the depth rule, the
+  measures), and the depth rule of a whole scan's rays.
+
+Run as ``python -m ladartui.precompile HALF SCENARIO.toml``. Failing here fails
+nothing: a run compiles what it still needs.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+HALVES = ("object", "run")
+SCAN_SIDE = 64  # rays a side of the made-up scan: 4,096, enough for object order
+
+
+def compile_half(half: str, scenario, scene=None, cancel=None) -> None:
+    """Compile (or load from the cache) the kernels of ``half`` for ``scenario``."""
+    if half == "object":
+        _object_order(scenario)
+    elif half == "run":
+        one_ray_run(scenario, scene, cancel)
+    else:
+        raise ValueError(f"half {half!r}: expected one of {', '.join(HALVES)}")
+
+
+def _object_order(scenario) -> None:
+    if scenario.method != "exact" or scenario.precision != "f64":
+        return  # only exact f64 scans go in object order
+    from ladartui.scene.model import Scene
+    from ladartui.tracing import TINY
+    from ladartui.tracing.prepare import rays_to_cells
+
+    slab = np.stack(np.meshgrid(np.arange(24), np.arange(24), np.arange(3), indexing="ij"), -1).reshape(-1, 3)
+    occupancy = Scene(slab, slab[:10], 1.0).occupancy
+    origins, directions = _pinhole_scan(np.array([12.0, 12.0, 40.0]))
+    for engine in _engines(scenario.backend):
+        # a whole scan (one ray a bin), then one ray short of it (the bins' sort)
+        for rays in (len(directions), len(directions) - 1):
+            cells, unit, bounds = rays_to_cells(origins[:rays], directions[:rays], 1.0, TINY)
+            engine.trace_cells(occupancy, cells, unit, block_bounds=bounds, order="object")
+
+
+def _pinhole_scan(origin):
+    """A SCAN_SIDE x SCAN_SIDE grid of unit rays looking down, each from its own point
+    of a focal plane around ``origin`` as a sensor's are (rays from one shared
+    point take kernels of another type)."""
+    tangents = np.tan(np.radians(np.linspace(-10.0, 10.0, SCAN_SIDE)))
+    across, along = np.meshgrid(tangents, tangents, indexing="ij")
+    directions = np.stack([across.ravel(), along.ravel(), -np.ones(across.size)], axis=1)
+    directions /= np.linalg.norm(directions, axis=1)[:, None]
+    return origin + 1e-3 * directions * [1.0, 1.0, 0.0], directions
+
+
+def _engines(backend: str) -> list:
+    """The backends a scenario's run may trace with: its own, or under auto the one
+    chosen here and, beside a GPU, numba (auto learns which is faster)."""
+    from ladartui.errors import BackendUnavailable
+    from ladartui.tracing import choose_backend
+    from ladartui.tracing.backend import get_backend
+
+    names = [choose_backend(), "numba"] if backend in (None, "auto") else [backend]
+    engines = []
+    for name in dict.fromkeys(names):
+        try:
+            engines.append(get_backend(name))
+        except BackendUnavailable:
+            pass
+    return engines
+
+
+def one_ray_run(scenario, scene=None, cancel=None) -> None:
+    """Simulate one ray of the scenario's first scan, then a whole scan's depth rule:
+    every kernel of a run but the object order's."""
+    from ladartui.flight import FlightPlan, Manual
+    from ladartui.returns import kept_returns
+    from ladartui.sensor import Sensor
+    from ladartui.simulation import simulate
+
+    tiny = scenario.with_changes(
+        sensor=Sensor(grid=1, ray_grid=1, fov=scenario.sensor.fov),
+        flight=FlightPlan(None, (Manual((scenario.poses()[0],)),)),
+    )
+    simulate(tiny, write=False, scene=scene, cancel=cancel)
+    # A whole scan's depth rule runs in parallel parts (one ray above takes the serial one).
+    rays = 1 << 14
+    detector = np.repeat(np.arange(rays // 4, dtype=np.int32), 4)  # the sensor's ids are int32
+    kept_returns(
+        detector, np.ones(rays, np.uint8), np.linspace(1.0, 2.0, rays), scenario.sensor.depth_resolution
+    )
+
+
+def compile_in_children(scenario_path, stop=None, timeout: float = 600.0) -> bool:
+    """Compile both halves in child processes at once; True when both finished cleanly.
+
+    ``stop`` (a threading.Event) ends them early, e.g. when the app quits.
+    """
+    children = []
+    try:
+        for half in HALVES:
+            children.append(
+                subprocess.Popen(
+                    [sys.executable, "-m", "ladartui.precompile", half, str(scenario_path)],
+                    stdout=subprocess.DEVNULL,
+                    stderr=subprocess.DEVNULL,
+                )
+            )
+    except OSError:
+        _end(children)
+        return False
+    deadline = time.monotonic() + timeout
+    while any(child.poll() is None for child in children):
+        if (stop is not None and stop.is_set()) or time.monotonic() > deadline:
+            _end(children)
+            return False
+        time.sleep(0.05)
+    return all(child.returncode == 0 for child in children)
+
+
+def _end(children) -> None:
+    for child in children:
+        if child.poll() is None:
+            child.kill()
+        child.wait()
+
+
+def main(argv=None) -> int:
+    from ladartui.scenario import load_scenario
+
+    half, path = sys.argv[1:] if argv is None else argv
+    compile_half(half, load_scenario(path))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
