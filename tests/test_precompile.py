@@ -3,13 +3,17 @@ the two halves must leave the run nothing to compile."""
 
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
 import textwrap
 import threading
 import time
+import types
 from pathlib import Path
+
+import pytest
 
 SRC = Path(__file__).resolve().parents[1] / "src"
 
@@ -62,6 +66,10 @@ def test_the_two_halves_leave_a_run_nothing_to_compile(tmp_path):
     assert lines == ["object-order kernels ready: True"], done.stdout
 
 
+def _settings(path):
+    return types.SimpleNamespace(path=path, backend="numba", method="exact", precision="f64")
+
+
 def test_the_children_end_when_asked(tmp_path):
     from ladartui.precompile import compile_in_children
 
@@ -70,7 +78,7 @@ def test_the_children_end_when_asked(tmp_path):
     stop = threading.Event()
     stop.set()
     started = time.monotonic()
-    assert compile_in_children(scenario, stop=stop) is False
+    assert compile_in_children(_settings(scenario), stop=stop) is False
     assert time.monotonic() - started < 10.0
 
 
@@ -78,4 +86,77 @@ def test_a_child_that_fails_says_so(tmp_path):
     from ladartui.precompile import compile_in_children
 
     missing = tmp_path / "missing.toml"  # each child fails to load it
-    assert compile_in_children(missing, timeout=120.0) is False
+    assert compile_in_children(_settings(missing), timeout=120.0) is False
+
+
+CACHED = textwrap.dedent(
+    """
+    from types import SimpleNamespace
+    from ladartui.precompile import kernels_cached
+    print(kernels_cached(SimpleNamespace(method="exact")), kernels_cached(SimpleNamespace(method="march")))
+    """
+)
+
+
+def test_an_empty_kernel_cache_is_told_from_a_filled_one(tmp_path):
+    from ladartui.precompile import compile_half, kernels_cached
+
+    compile_half("object", _settings(tmp_path / "unused.toml"))  # fills this cache, if need be
+    assert kernels_cached(types.SimpleNamespace(method="exact")) is True
+    env = dict(os.environ, PYTHONPATH=str(SRC), NUMBA_CACHE_DIR=str(tmp_path / "empty"))
+    done = subprocess.run(
+        [sys.executable, "-c", CACHED], capture_output=True, text=True, env=env, timeout=300
+    )
+    assert done.stdout.split() == ["False", "False"], done.stderr[-2000:]
+
+
+@pytest.fixture
+def ahead(monkeypatch):
+    """An empty kernel cache, as the commands see it: the scenarios they compile ahead for."""
+    import ladartui.precompile as precompile
+
+    asked = []
+    monkeypatch.setattr(precompile, "kernels_cached", lambda scenario: False)
+    monkeypatch.setattr(precompile, "compile_in_children", lambda scenario, stop=None: asked.append(scenario))
+    return asked
+
+
+def test_a_run_on_an_empty_cache_compiles_ahead_with_its_flags(ahead, tmp_path, capsys):
+    from ladartui.cli import main
+    from tiny_sweep import write_tiny_scenario
+
+    path = write_tiny_scenario(tmp_path).path
+    assert main(["run", str(path), "--no-write", "--method", "march", "--json"]) == 0
+    assert [(s.path, s.method) for s in ahead] == [(path, "march")]
+    assert json.loads(capsys.readouterr().out)["method"] == "march"
+
+
+def test_a_pulse_study_compiles_ahead_for_its_backend(ahead, tmp_path, capsys):
+    from ladartui.cli import main
+    from tiny_sweep import write_tiny_scenario
+
+    path = write_tiny_scenario(tmp_path).path
+    assert main(["pulses", str(path), "--pulses", "1", "--backend", "numba", "--json"]) == 0
+    assert [(s.path, s.backend) for s in ahead] == [(path, "numba")]
+
+
+def test_a_sweep_compiles_ahead_once_for_its_variants(ahead, tmp_path):
+    from ladartui.sweep import run_sweep
+    from tiny_sweep import write_spec, write_tiny_scenario
+
+    write_tiny_scenario(tmp_path)
+    spec = write_spec(tmp_path, "[grid]\nscans = [1, 2]\n")
+    run_sweep(spec, serial=True, out=tmp_path / "out", simulate_options={"method": "march"})
+    assert [(s.path.name, s.method) for s in ahead] == [("base.toml", "march")]
+    run_sweep(spec, serial=True, out=tmp_path / "out", simulate_options={"method": "march"})
+    assert len(ahead) == 1  # every variant resumed: nothing to run, nothing to compile
+
+
+def test_a_filled_cache_is_not_compiled_again(monkeypatch, tmp_path, capsys):
+    import ladartui.precompile as precompile
+    from ladartui.cli import main
+    from tiny_sweep import write_tiny_scenario
+
+    monkeypatch.setattr(precompile, "kernels_cached", lambda scenario: True)
+    monkeypatch.setattr(precompile, "compile_in_children", lambda *a, **k: pytest.fail("compiled again"))
+    assert main(["run", str(write_tiny_scenario(tmp_path).path), "--no-write"]) == 0

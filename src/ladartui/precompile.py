@@ -13,8 +13,8 @@ into the cache, and the caller then loads them in moments:
   occupancy, rays to cells, ray order or the march, the depth rule, the
   measures), and the depth rule of a whole scan's rays.
 
-Run as ``python -m ladartui.precompile HALF SCENARIO.toml``. Failing here fails
-nothing: a run compiles what it still needs.
+Run as ``python -m ladartui.precompile HALF SCENARIO.toml BACKEND METHOD
+PRECISION``. Failing here fails nothing: a run compiles what it still needs.
 """
 
 from __future__ import annotations
@@ -22,6 +22,8 @@ from __future__ import annotations
 import subprocess
 import sys
 import time
+from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -105,31 +107,60 @@ def one_ray_run(scenario, scene=None, cancel=None) -> None:
     )
 
 
-def compile_in_children(scenario_path, stop=None, timeout: float = 600.0) -> bool:
-    """Compile both halves in child processes at once; True when both finished cleanly.
+def kernels_cached(scenario) -> bool:
+    """Whether numba's cache already holds the scenario's largest kernels for this
+    source (then a run loads them in moments); True when it cannot tell."""
+    try:
+        if scenario.method == "march":
+            from ladartui.tracing.march import march_kernel
+
+            kernels: list[Any] = [march_kernel]
+        else:
+            from ladartui.tracing.numba_backend import _exact_kernel
+            from ladartui.tracing.tile_tests import test_tiles
+
+            kernels = [_exact_kernel, test_tiles]
+        # (numba's own index: empty when missing or made from another source)
+        return all(bool(kernel._cache._cache_file._load_index()) for kernel in kernels)
+    except Exception:
+        return True
+
+
+def compile_ahead(scenario, stop=None) -> None:
+    """Before a run in this process: when the cache lacks the scenario's kernels, the
+    two halves in child processes side by side (on two cores about half the wait
+    of compiling them here one by one)."""
+    if not kernels_cached(scenario) and Path(scenario.path).is_file():
+        compile_in_children(scenario, stop=stop)
+
+
+def compile_in_children(scenario, stop=None, timeout: float = 600.0) -> bool:
+    """Compile both halves for ``scenario`` (its file, with its tracing settings as
+    they are now) in child processes at once; True when both finished cleanly.
 
     ``stop`` (a threading.Event) ends them early, e.g. when the app quits.
     """
+    settings = [scenario.backend, scenario.method, scenario.precision]
     children = []
     try:
         for half in HALVES:
             children.append(
                 subprocess.Popen(
-                    [sys.executable, "-m", "ladartui.precompile", half, str(scenario_path)],
+                    [sys.executable, "-m", "ladartui.precompile", half, str(scenario.path), *settings],
                     stdout=subprocess.DEVNULL,
                     stderr=subprocess.DEVNULL,
                 )
             )
+        deadline = time.monotonic() + timeout
+        while any(child.poll() is None for child in children):
+            if (stop is not None and stop.is_set()) or time.monotonic() > deadline:
+                return False
+            time.sleep(0.05)
+        return all(child.returncode == 0 for child in children)
     except OSError:
-        _end(children)
         return False
-    deadline = time.monotonic() + timeout
-    while any(child.poll() is None for child in children):
-        if (stop is not None and stop.is_set()) or time.monotonic() > deadline:
-            _end(children)
-            return False
-        time.sleep(0.05)
-    return all(child.returncode == 0 for child in children)
+    finally:  # (a Ctrl-C here too)
+        _end(children)
 
 
 def _end(children) -> None:
@@ -142,8 +173,9 @@ def _end(children) -> None:
 def main(argv=None) -> int:
     from ladartui.scenario import load_scenario
 
-    half, path = sys.argv[1:] if argv is None else argv
-    compile_half(half, load_scenario(path))
+    half, path, backend, method, precision = sys.argv[1:] if argv is None else argv
+    scenario = load_scenario(path).with_changes(backend=backend, method=method, precision=precision)
+    compile_half(half, scenario)
     return 0
 
 

@@ -20,7 +20,7 @@ from ladartui.errors import Cancelled
 T = TypeVar("T")
 
 POLL_SECONDS = 0.1  # how soon a Ctrl-C is noticed while waiting
-# Shown until the first scan is done: a first run also compiles the kernels (about a minute).
+# Shown until the first scan is done: a first run also compiles the kernels (minutes on two cores).
 FIRST_SCAN = "scan 1 (compiling kernels on a first run)"
 LOG_WIDTH = 200  # progress written to a file or pipe: wide enough for every line
 

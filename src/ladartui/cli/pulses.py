@@ -130,6 +130,7 @@ def _study_with_progress(scenario, pulses, settings, backend, console, state):
 
     from ladartui.cli.progress import FIRST_SCAN, progress_display, run_cancellable
     from ladartui.detection.pulses import pulse_study
+    from ladartui.precompile import compile_ahead
 
     cancel = threading.Event()
     after = (TextColumn("{task.percentage:>5.1f} %"), TimeElapsedColumn(), TimeRemainingColumn())
@@ -145,8 +146,12 @@ def _study_with_progress(scenario, pulses, settings, backend, console, state):
             )
             bar.update(task, completed=p.units_done / p.units_total, description=what)
 
+        def work():
+            compile_ahead(scenario if backend is None else scenario.with_changes(backend=backend), cancel)
+            return pulse_study(scenario, pulses, settings, backend=backend, progress=report, cancel=cancel)
+
         return run_cancellable(
-            lambda: pulse_study(scenario, pulses, settings, backend=backend, progress=report, cancel=cancel),
+            work,
             cancel,
             "ladartui-pulses",
             Cancelled("pulse study cancelled"),

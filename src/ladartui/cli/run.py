@@ -151,6 +151,7 @@ def run_progress(console, **options):
 
 def _simulate_with_progress(scenario, args, console, finished: list):
     """The run's result, also appended to ``finished`` as soon as there is one."""
+    from ladartui.precompile import compile_ahead
     from ladartui.simulation import NOTHING_WRITTEN, simulate
 
     cancel = threading.Event()
@@ -167,12 +168,14 @@ def _simulate_with_progress(scenario, args, console, finished: list):
 
         # A stop during the write lets the swap finish (or roll back): the files on
         # disk belong to one run and the result says which.
+        def work():
+            compile_ahead(scenario, cancel)
+            return simulate(scenario, progress=report, cancel=cancel, write=args.write, las=args.las)
+
         with sigterm_as_interrupt():
             finished.append(
                 run_cancellable(
-                    lambda: simulate(
-                        scenario, progress=report, cancel=cancel, write=args.write, las=args.las
-                    ),
+                    work,
                     cancel,
                     "ladartui-run",
                     Cancelled(NOTHING_WRITTEN),

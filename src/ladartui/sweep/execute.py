@@ -28,6 +28,7 @@ from ladartui.errors import (
     check_callbacks,
     check_cancelled,
 )
+from ladartui.precompile import compile_ahead
 from ladartui.sweep.base import CheckedBase, checked_base, own_rows, spec_rows
 from ladartui.sweep.best_file import best_files, write_best_scenario
 from ladartui.sweep.cluster import close_client, local_client
@@ -344,6 +345,8 @@ def _run_locked(
     result_workers, scheduler = 0, "serial"
     if todo:
         options = dict(simulate_options or {})
+        if serial or client is None:  # here or on this machine's workers: its cache
+            compile_ahead(base.with_changes(**{k: v for k, v in options.items() if v is not None}), cancel)
         if serial:
             result_workers = 1
             _run_serial(todo, base, digest, scene(), options, record, cancel)

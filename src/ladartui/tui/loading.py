@@ -236,7 +236,7 @@ def _warm_up(scenario, scene, compile_in_child: bool, cancel) -> None:
     from ladartui.precompile import HALVES, compile_half, compile_in_children
 
     if compile_in_child and scenario.path.is_file():
-        compile_in_children(scenario.path, stop=cancel)
+        compile_in_children(scenario, stop=cancel)
     for half in HALVES:  # loaded from the cache the children filled
         if cancel.is_set():
             return
