@@ -160,3 +160,16 @@ def test_a_filled_cache_is_not_compiled_again(monkeypatch, tmp_path, capsys):
     monkeypatch.setattr(precompile, "kernels_cached", lambda scenario: True)
     monkeypatch.setattr(precompile, "compile_in_children", lambda *a, **k: pytest.fail("compiled again"))
     assert main(["run", str(write_tiny_scenario(tmp_path).path), "--no-write"]) == 0
+
+
+def test_the_tuis_warm_up_compiles_ahead_only_on_an_empty_cache(ahead, monkeypatch, tmp_path):
+    import ladartui.precompile as precompile
+    from ladartui.tui.loading import _warm_up
+    from tiny_sweep import write_tiny_scenario
+
+    scenario = write_tiny_scenario(tmp_path)
+    _warm_up(scenario, None, True, threading.Event())
+    assert [s.path for s in ahead] == [scenario.path]
+    monkeypatch.setattr(precompile, "kernels_cached", lambda scenario: True)
+    _warm_up(scenario, None, True, threading.Event())
+    assert len(ahead) == 1

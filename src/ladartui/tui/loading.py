@@ -233,10 +233,10 @@ def _target_output(scenario) -> np.ndarray | None:
 
 
 def _warm_up(scenario, scene, compile_in_child: bool, cancel) -> None:
-    from ladartui.precompile import HALVES, compile_half, compile_in_children
+    from ladartui.precompile import HALVES, compile_ahead, compile_half
 
-    if compile_in_child and scenario.path.is_file():
-        compile_in_children(scenario, stop=cancel)
+    if compile_in_child:
+        compile_ahead(scenario, stop=cancel)
     for half in HALVES:  # loaded from the cache the children filled
         if cancel.is_set():
             return
