@@ -14,7 +14,7 @@ CORE = [
     "ladartui.flight",
     "ladartui.sensor",
     "ladartui.scene.model",
-    "ladartui.tui.warmup",
+    "ladartui.precompile",
 ]
 
 

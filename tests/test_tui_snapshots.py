@@ -12,11 +12,11 @@ import time
 import pytest
 
 from ladartui.flight import FlightPlan, Orbit
+from ladartui.precompile import one_ray_run
 from ladartui.scenario import Scenario
 from ladartui.scene.generate import generate_scene
 from ladartui.sensor import Sensor
 from ladartui.tui.app import LadarApp as _App
-from ladartui.tui.warmup import tiny_run
 
 
 def LadarApp(path):
@@ -38,7 +38,7 @@ def scenario_path(tmp_path, monkeypatch):
         FlightPlan(None, (Orbit(centre=centre, radius=20.0, altitude=20.0, scans=6),)),
     )
     scenario = scenario.save()
-    tiny_run(scenario)  # compile the kernels here rather than in a child of each app
+    one_ray_run(scenario)  # compile the kernels here rather than in a child of each app
     return scenario.path
 
 
