@@ -37,6 +37,7 @@ def compile_half(half: str, scenario, scene=None, cancel=None) -> None:
         _object_order(scenario)
     elif half == "run":
         one_ray_run(scenario, scene, cancel)
+        _made_up_scan(scenario, "ray", SCAN_SIDE**2)  # what one ray skips (a GPU's bundles)
     else:
         raise ValueError(f"half {half!r}: expected one of {', '.join(HALVES)}")
 
@@ -44,6 +45,14 @@ def compile_half(half: str, scenario, scene=None, cancel=None) -> None:
 def _object_order(scenario) -> None:
     if scenario.method != "exact" or scenario.precision != "f64":
         return  # only exact f64 scans go in object order
+    # a whole scan (one ray a bin), then one ray short of it (the bins' sort)
+    for rays in (SCAN_SIDE**2, SCAN_SIDE**2 - 1):
+        _made_up_scan(scenario, "object", rays)
+
+
+def _made_up_scan(scenario, order: str, rays: int) -> None:
+    """``rays`` of a scan over a small slab, traced in ``order`` by each backend the
+    scenario may use."""
     from ladartui.scene.model import Scene
     from ladartui.tracing import TINY
     from ladartui.tracing.prepare import rays_to_cells
@@ -51,11 +60,17 @@ def _object_order(scenario) -> None:
     slab = np.stack(np.meshgrid(np.arange(24), np.arange(24), np.arange(3), indexing="ij"), -1).reshape(-1, 3)
     occupancy = Scene(slab, slab[:10], 1.0).occupancy
     origins, directions = _pinhole_scan(np.array([12.0, 12.0, 40.0]))
+    cells, unit, bounds = rays_to_cells(origins[:rays], directions[:rays], 1.0, TINY)
     for engine in _engines(scenario.backend):
-        # a whole scan (one ray a bin), then one ray short of it (the bins' sort)
-        for rays in (len(directions), len(directions) - 1):
-            cells, unit, bounds = rays_to_cells(origins[:rays], directions[:rays], 1.0, TINY)
-            engine.trace_cells(occupancy, cells, unit, block_bounds=bounds, order="object")
+        engine.trace_cells(
+            occupancy,
+            cells,
+            unit,
+            method=scenario.method,
+            precision=scenario.precision,
+            block_bounds=bounds,
+            order=order,
+        )
 
 
 def _pinhole_scan(origin):
