@@ -293,3 +293,41 @@ async def test_tab_reaches_the_views_while_a_run_goes_on(tmp_path, scene_files, 
         assert view.camera.azimuth != azimuth
         await pilot.press("escape")
         await wait_until(pilot, lambda: app.busy is None)
+
+
+async def test_a_cancelled_run_shows_again_the_earlier_outputs_read_from_disk(
+    tmp_path, scene_files, monkeypatch
+):
+    """The outputs on disk stay as they were when a run is cancelled, and so does the
+    view: the earlier run's output comes back in place of the live one."""
+    import numpy as np
+
+    import ladartui.simulation as simulation
+    from ladartui.simulation import RunProgress
+    from ladartui.tui.canvas import ProjectionWidget
+
+    scenario = make_scenario(tmp_path, scene_files)
+    simulation.simulate(scenario)  # the earlier outputs, on disk before the app opens
+    live = threading.Event()
+
+    def live_then_until_cancelled(*args, progress=None, cancel=None, **kwargs):
+        returns = np.array([[1, 2, 3]], dtype=np.int32)
+        progress(RunProgress("scene", 1, 6, 1, 12, 1 / 12, returns))
+        live.set()
+        while not cancel.wait(0.02):
+            pass
+        raise Cancelled()
+
+    monkeypatch.setattr(simulation, "simulate", live_then_until_cancelled)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=(120, 40)) as pilot:
+        await wait_until(pilot, lambda: loaded(app) and app.output_voxels is not None)
+        earlier = app.output_voxels
+        output = app.query_one("#output3d", ProjectionWidget)
+        await pilot.press("f5")
+        await wait_until(pilot, lambda: live.is_set() and app.output_voxels is not earlier)
+        await pilot.press("escape")
+        await wait_until(pilot, lambda: app.busy is None)
+        assert app.output_voxels is earlier
+        assert output.points is not None and len(output.points)
+        assert app.disk_outputs[0] is earlier  # its hidden target voxels are marked again

@@ -91,6 +91,7 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         self.output_voxels = None
         # An earlier run's scene and target outputs as read from disk (in a worker).
         self.disk_outputs: tuple = (None, None)
+        self.shown_before_run: tuple = (None, None)  # the outputs a cancelled run shows again
         self.missing_outputs: list[Path] = []
         self.outputs_from: Scenario | None = None  # the settings that made the outputs shown
         self.outputs_seen: tuple[int, int] | None = None  # (mtime, size) of the measures read

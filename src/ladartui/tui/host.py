@@ -46,6 +46,7 @@ class AppHost(App[None]):
     result: SimulationResult | None
     output_voxels: np.ndarray | None
     disk_outputs: tuple  # (scene output, target output) of an earlier run, read from disk
+    shown_before_run: tuple  # (output_voxels, disk_outputs) while a run goes on
     missing_outputs: list[Path]
     outputs_from: Scenario | None  # the settings that made the outputs shown
     outputs_seen: tuple[int, int] | None  # the measures file's (mtime, size) when they were read

@@ -45,6 +45,8 @@ class RunControl(Host):
             self.tell("; ".join(problems), title="Not ready", severity="warning")
             return
         self.running = True
+        # shown again if the run ends without outputs (its live output replaces them)
+        self.shown_before_run = (self.output_voxels, self.disk_outputs)
         self.set_busy("Starting the run...", 0.0)
         self._run_worker(self.scenario, self.scene, self.scenario.fast_mode)
 
@@ -60,7 +62,7 @@ class RunControl(Host):
         self.set_busy(text + " (Esc cancels)", fraction)
         if live is not None:
             self.output_voxels = live
-            self.disk_outputs = (None, None)  # (not kept alive beside the run's)
+            self.disk_outputs = (None, None)  # the live output is no earlier run's
             self.show_output(limit=LIVE_POINTS)
 
     def action_cancel_run(self) -> None:
@@ -74,11 +76,14 @@ class RunControl(Host):
     ) -> None:
         self.running = False
         self.set_busy(None)
+        shown_before, self.shown_before_run = self.shown_before_run, (None, None)
+        if cancelled or error or result is None:
+            # nothing was written: the outputs shown before the run, not its partial live one
+            self.output_voxels, self.disk_outputs = shown_before
+            self.show_output()
         if cancelled:
             self.tell("Run cancelled; earlier outputs are unchanged.", severity="warning")
             self.run_panel.say("Last run cancelled; nothing was written.")
-            self.output_voxels = self.result.scene_output if self.result else None
-            self.show_output()
             return
         if error or result is None:
             self.run_panel.say(error or "Run failed: no result.")
