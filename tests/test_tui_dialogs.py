@@ -300,10 +300,11 @@ async def test_outputs_a_run_made_from_unsaved_settings_are_out_of_date_on_openi
         assert str(info.render()) == f"Measures of {scenario.name}:"
 
 
-async def test_opening_outputs_whose_scene_model_changed_since_their_run_says_so(tmp_path, scene_files):
+async def test_outputs_whose_scene_model_changed_since_their_run_are_out_of_date(tmp_path, scene_files):
     import shutil
 
     from ladartui.simulation import simulate
+    from ladartui.tui.status import NOT_READY, READY, StatusBar
 
     scene_path, centre, voxel_size = scene_files
     for model in (scene_path, scene_path.with_name(f"{scene_path.stem}_Target.txt")):
@@ -315,6 +316,17 @@ async def test_opening_outputs_whose_scene_model_changed_since_their_run_says_so
     async with opened(scenario) as (app, pilot):
         said = f"Earlier outputs: the scene model {scene_path.name} changed since the run."
         assert said in app.messages
+        # the settings are those that ran, the model is not: yellow until a rerun
+        bar = app.query_one(StatusBar)
+        assert bar.state == NOT_READY
+        assert bar.message == f"{scenario.path.name}: outputs out of date; F5 reruns."
+        assert str(app.query_one("#results-info").render()) == (
+            f"Measures of {scenario.name}, from other inputs: the scene model {scene_path.name} "
+            f"changed since the run. The run's settings are in {scenario.name}_Run.toml."
+        )
+        await app.run_action("run")
+        await wait_until(pilot, lambda: isinstance(app.screen, MeasuresScreen))
+        assert bar.state == READY
 
 
 async def test_a_damaged_run_record_is_reported_and_the_outputs_still_shown(tmp_path, scene_files):

@@ -94,6 +94,7 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         self.shown_before_run: tuple = (None, None)  # the outputs a cancelled run shows again
         self.missing_outputs: list[Path] = []
         self.outputs_from: Scenario | None = None  # the settings that made the outputs shown
+        self.inputs_changed: list[str] = []  # the files they read that changed since their run
         self.outputs_seen: tuple[int, int] | None = None  # (mtime, size) of the measures read
         self.threshold: float | None = None
         self.busy: str | None = None
@@ -329,16 +330,23 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         made, scenario = self.outputs_from, self.scenario
         if made is None or scenario is None or not self.outputs_stale():
             return None
-        differ = named_changes(setting_changes(made, scenario))
+        settings = setting_changes(made, scenario)
+        differ = named_changes(settings + self.inputs_changed)
         record = scenario.run_record
         if record.is_file():  # written by every run since records exist
-            return f"other settings{differ}. The run's settings are in {record.name}."
+            other = " and ".join(
+                word for word, changed in (("settings", settings), ("inputs", self.inputs_changed)) if changed
+            )
+            return f"other {other}{differ}. The run's settings are in {record.name}."
         return f"the settings before your edits{differ}."
 
     def outputs_stale(self) -> bool:
-        """Whether the outputs shown came from other settings than the scenario's now."""
+        """Whether the outputs shown came from other settings than the scenario's now, or
+        from model files or flight logs that changed since their run."""
         made, scenario = self.outputs_from, self.scenario
-        return made is not None and scenario is not None and not made.same_outputs(scenario)
+        if made is None or scenario is None:
+            return False
+        return bool(self.inputs_changed) or not made.same_outputs(scenario)
 
     def action_layout(self, number: int) -> None:
         self.view_area.set_layout(number)

@@ -88,6 +88,7 @@ class FileActions(Host):
             self.output_voxels = None  # the outputs of the old name are not this file's
             self.disk_outputs = (None, None)
             self.outputs_from = None
+            self.inputs_changed = []
             self.show_output()
             self.show_measures(None)
             self.run_panel.say("")  # the last run, if any, was the old file's

@@ -49,6 +49,7 @@ class AppHost(App[None]):
     shown_before_run: tuple  # (output_voxels, disk_outputs) while a run goes on
     missing_outputs: list[Path]
     outputs_from: Scenario | None  # the settings that made the outputs shown
+    inputs_changed: list[str]  # their model files and flight logs changed since (out of date)
     outputs_seen: tuple[int, int] | None  # the measures file's (mtime, size) when they were read
     cwd: Path
     compile_in_child: bool

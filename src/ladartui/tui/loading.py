@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import os
 import stat
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -55,6 +55,7 @@ class Earlier:
     warning: str | None
     files: OutputFiles  # the look they were read after
     target_output: np.ndarray | None = None  # the target traced without foliage, if on disk
+    inputs_changed: list[str] = field(default_factory=list)  # run_record.inputs_changed
 
     @property
     def made_with(self) -> Scenario | None:
@@ -93,6 +94,7 @@ class SceneLoading(Host):
         self.view_area.set_scene(done.prepared, done.scene.voxel_size)
         self.missing_outputs = done.earlier.files.missing
         self.outputs_from = done.earlier.made_with  # before the status is drawn
+        self.inputs_changed = done.earlier.inputs_changed
         self.set_scenario(done.scenario, modified=False)
         if done.scenario.path.is_file():
             remember_scenario(done.scenario.path)
@@ -166,6 +168,7 @@ class SceneLoading(Host):
         """An earlier run's outputs and measures in the views, and what made them."""
         self.outputs_seen = earlier.files.seen  # as found before they were read
         self.outputs_from = earlier.made_with
+        self.inputs_changed = earlier.inputs_changed
         self.output_voxels = earlier.output
         self.disk_outputs = (earlier.output, earlier.target_output)
         self.show_output()
@@ -197,6 +200,7 @@ def _earlier(scenario, files: OutputFiles | None = None, scene: Scene | None = N
         files = look_at_outputs(scenario)
     warning, ran = None, None
     target_output = None
+    changed: list[str] = []
     try:
         output, measures = _existing_results(scenario, files)
     except LadarError as error:  # old results must not stop the scenario loading
@@ -207,18 +211,19 @@ def _earlier(scenario, files: OutputFiles | None = None, scene: Scene | None = N
         except LadarError as error:
             warning = f"settings of the earlier run not read, taken as the file's: {error}"
         if ran is not None and scene is not None:
-            warning = _inputs_changed(scenario, scene)
+            changed, warning = _inputs_changed(scenario, scene)
         target_output = _target_output(scenario)
-    return Earlier(scenario, output, measures, ran, warning, files, target_output)
+    return Earlier(scenario, output, measures, ran, warning, files, target_output, changed)
 
 
-def _inputs_changed(scenario, scene) -> str | None:
-    """The earlier outputs' model files or flight logs that changed since their run."""
+def _inputs_changed(scenario, scene) -> tuple[list[str], str | None]:
+    """The earlier outputs' model files or flight logs that changed since their run,
+    and the note that says so (or that the record could not tell)."""
     try:
-        changes = inputs_changed(scenario, scene)
+        changes = [visible(change) for change in inputs_changed(scenario, scene) or []]
     except LadarError as error:
-        return visible(f"model files of the earlier run not read: {error}")
-    return visible(f"Earlier outputs: {'; '.join(changes)}.") if changes else None
+        return [], visible(f"model files of the earlier run not read: {error}")
+    return changes, f"Earlier outputs: {'; '.join(changes)}." if changes else None
 
 
 def _target_output(scenario) -> np.ndarray | None:
