@@ -53,6 +53,26 @@ async def test_a_value_typed_without_enter_is_used_by_run(tmp_path, scene_files)
         assert [run.sensor.grid for run in runs] == [12]
 
 
+async def test_a_run_after_a_voxel_size_edit_still_reads_and_records_the_model_files(tmp_path, scene_files):
+    """A run's record fingerprints the models it read, so that a later change to them
+    puts its outputs out of date; a new voxel size rescales the scene, not its files."""
+    from ladartui.run_record import run_inputs
+
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        runs = []
+        app._run_worker = lambda scenario, scene, fast: runs.append((scenario, scene))
+        app.action_show_tab("run")
+        await type_into(pilot, field(app, "scenario.voxel_size"), "0.3")
+        await pilot.press("f5")
+        await pilot.pause()
+        [(ran, scene)] = runs
+        assert ran.voxel_size == scene.voxel_size == 0.3
+        assert sorted(entry.role for entry in run_inputs(ran, scene)) == ["scene model", "target model"]
+
+
 async def test_a_value_typed_without_enter_is_what_ctrl_s_saves(tmp_path, scene_files):
     scenario = make_scenario(tmp_path, scene_files)
     app = LadarApp(scenario.path)

@@ -105,6 +105,7 @@ class ScenarioEditing(Host):
             name=old.name,
             path=old.path,
             target_ids=old.target_ids,
+            fingerprints=old.fingerprints,  # the same files: a run records them
         )
         self.view_area.rescale(voxel_size, tuple(float(v) for v in scene.target_centre_m()))
 
