@@ -35,6 +35,16 @@ def parse_number(name: str, text: str, integer: bool = False, scale: float = 1.0
     return value / (1.0 / scale) if 0 < scale < 1 else value * scale
 
 
+FORM_UNITS = frozenset({"m", "deg", "s", "m/s", "um", "Hz"})  # a form label's last word
+
+
+def in_label_unit(label: str, expected: str) -> str:
+    """``expected`` with its last number in the unit ``label`` ends with ("Radius m":
+    "... at most 1000000 m"), as a form's message gives limits."""
+    unit = label.rpartition(" ")[2]
+    return f"{expected} {unit}" if unit in FORM_UNITS and expected[-1:].isdigit() else expected
+
+
 def refusal(label: str, typed: str, expected: str) -> str:
     """The one line for a refused value: the field as the form names it, the text
     typed there (``empty`` for none) and what is expected."""

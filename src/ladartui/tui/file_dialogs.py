@@ -19,7 +19,7 @@ from textual.widgets import Button, DirectoryTree, Input, RadioButton, RadioSet,
 from ladartui.errors import LadarError
 from ladartui.textsafe import visible
 from ladartui.tui import bridge
-from ladartui.tui.fields import NumberField, refusal
+from ladartui.tui.fields import NumberField, in_label_unit, refusal
 from ladartui.tui.file_tree import SCENARIO_TABLE
 from ladartui.tui.screens import PathSuggester, TreeDialog, _row
 
@@ -149,7 +149,8 @@ class SetupScreen(TreeDialog):
                 problem = field.problem()
                 if problem:
                     field.focus()
-                    message.update(refusal("Voxel size m", field.value, problem.split("expected ", 1)[-1]))
+                    expected = in_label_unit("Voxel size m", problem.split("expected ", 1)[-1])
+                    message.update(refusal("Voxel size m", field.value, expected))
                     return
                 scenario = bridge.new_scenario(scenario_path, scene_path, field.parsed())
             else:

@@ -21,11 +21,9 @@ from textual.widgets import Button, DataTable, Input, Label, Select, Static
 from ladartui.errors import FieldError, LadarError
 from ladartui.measures import Measures
 from ladartui.tui import bridge
-from ladartui.tui.fields import NumberField, format_number, parse_number, refusal
+from ladartui.tui.fields import NumberField, format_number, in_label_unit, parse_number, refusal
 from ladartui.tui.file_tree import FileTree
 from ladartui.tui.measures_view import comparison_rows, level_rows, measure_rows, target_rows
-
-FORM_UNITS = frozenset({"m", "deg", "s", "m/s", "um", "Hz"})  # a form label's last word
 
 
 class PathSuggester(Suggester):
@@ -246,9 +244,7 @@ class FormScreen(Dialog):
         label = self._label(name)
         if expected.startswith("an integer"):  # the form's word for it, as in the sidebar
             expected = "a whole number" + expected.removeprefix("an integer")
-        unit = label.rpartition(" ")[2]
-        if unit in FORM_UNITS and expected[-1:].isdigit():
-            expected += f" {unit}"
+        expected = in_label_unit(label, expected)
         self.query_one("#form-message", Static).update(escape(refusal(label, widget.value, expected)))
 
     @on(Input.Changed)
