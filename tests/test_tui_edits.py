@@ -362,6 +362,22 @@ def test_keys_toml_problems_are_named_on_their_line_never_a_crash(tmp_path):
     assert len(problems) == 2 and "help" not in keymap and "cancel" not in keymap
 
 
+def test_an_unknown_command_id_in_keys_toml_is_told_with_every_id_there_is(tmp_path):
+    """The ids to choose from were cut at the message's length limit, after save-as:
+    zoom-target, threshold, undo and the tabs were never named. The id read from the
+    file is still written safely and cut."""
+    from ladartui.tui.actions import BY_ID, load_keymap
+
+    keys = tmp_path / "keys.toml"
+    keys.write_text('[keys]\nzoom-targt = "f9"\n"\\u001b[31m' + "x" * 500 + '" = "f9"\n')
+    keymap, problems = load_keymap(tmp_path)
+    ids = ", ".join(sorted(BY_ID))
+    assert keymap == {} and len(problems) == 2
+    assert problems[0] == f"{keys}:2: keys.zoom-targt: no such command; expected one of {ids}"
+    assert "keys.\\x1b[31mxxx" in problems[1] and problems[1].endswith(ids)
+    assert "more characters)" in problems[1] and "\x1b" not in problems[1]
+
+
 def test_the_app_ending_on_an_error_exits_non_zero(monkeypatch, tmp_path, scene_files, capsys):
     """A crash in the interface (the traceback screen) exited 0, as if all went well.
     The real app runs (headless) on a scenario; once mounted, a callback raises, as a

@@ -272,11 +272,10 @@ def load_keymap(folder: Path | None = None) -> tuple[dict[str, str], list[str]]:
     for command_id, key in table.items():
         where = at(f"keys.{command_id}")
         if command_id not in BY_ID:
+            # only what the file says is cut: the ids to choose from are all told
+            ids = ", ".join(sorted(BY_ID))
             problems.append(
-                one_line(
-                    f"{where}: keys.{command_id}: no such command; expected one of "
-                    + ", ".join(sorted(BY_ID))
-                )
+                f"{one_line(f'{where}: keys.{command_id}')}: no such command; expected one of {ids}"
             )
         elif not isinstance(key, str) or not all(KEY_NAME.fullmatch(k.strip()) for k in key.split(",")):
             problems.append(
