@@ -497,3 +497,30 @@ async def test_the_top_view_draws_footprints_as_they_fall_with_attitude(tmp_path
         assert len(drawn) == len(expected)
         assert all(np.allclose(d, e) for d, e in zip(drawn, expected))
         assert not all(np.allclose(d, e) for d, e in zip(drawn, level))  # the bank shows
+
+
+async def test_the_flight_tables_are_drawn_to_their_new_cells_at_once(tmp_path, scene_files):
+    """After a segment was deleted the scans table showed x -12 as "-" and y 82 as "8"
+    until the next change: its columns took their widths from the cells only when
+    Textual next measured them, and a frame drawn before that cut every value."""
+    from rich.cells import cell_len
+
+    from ladartui.flight import Turn
+
+    scenario = make_scenario(tmp_path, scene_files)
+    turn = Turn(radius=100.0, arc=90.0, direction="right", scans=4)
+    scenario = scenario.with_changes(flight=FlightPlan(None, (*scenario.flight.segments, turn))).save()
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=(120, 40)) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        app.action_show_tab("flight")
+        await pilot.pause()
+        app.query_one("#segments").move_cursor(row=0)
+        app.flight_panel.delete_selected()
+        # no pause: the frame drawn next must already have the widths
+        for table in (app.query_one("#scans"), app.query_one("#segments")):
+            columns = list(table.columns.values())
+            rows = [[str(cell) for cell in table.get_row_at(i)] for i in range(table.row_count)]
+            for index, column in enumerate(columns[: len(columns) if table.id == "scans" else 3]):
+                widest = max(cell_len(str(column.label)), *(cell_len(row[index]) for row in rows))
+                assert column.get_render_width(table) == widest + 2 * table.cell_padding, (table.id, index)

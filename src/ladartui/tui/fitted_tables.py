@@ -42,7 +42,7 @@ def fill_segments(table: FittingTable, rows: Sequence[tuple[str, str, str, str]]
     table.clear(columns=True)  # a column keeps the widest text it ever held otherwise
     room = _detail_room(table, rows)
     table.fitted_width = table.size.width
-    table.add_columns(*SEGMENT_COLUMNS[:-1])
+    _add_columns(table, SEGMENT_COLUMNS[:-1], _widths(table, SEGMENT_COLUMNS[:-1], rows))
     table.add_column(SEGMENT_COLUMNS[-1], width=room)
     for cells in rows:
         lines = wrap_detail(cells[-1], room) if room is not None else [cells[-1]]
@@ -99,12 +99,21 @@ def fill_whole_columns(
                 break
     table.clear(columns=True)
     table.fitted_width = table.size.width
-    table.add_columns(*labels[:shown])
+    _add_columns(table, labels[:shown], widths)
     for cells in rows:
         table.add_row(*(Text(cell) for cell in cells[:shown]))
     if table.row_count:
         table.move_cursor(row=min(max(cursor, 0), table.row_count - 1))
     return list(labels[shown:])
+
+
+def _add_columns(table: DataTable, labels: Sequence[str], widths: Sequence[int]) -> None:
+    """Columns of the given widths (``_widths``, padding included). Sized from their
+    cells only when Textual next measures them, a frame drawn before that (a resize
+    does) would cut every value to its label's width, and stay so."""
+    pad = 2 * table.cell_padding
+    for label, width in zip(labels, widths):
+        table.add_column(label, width=width - pad)
 
 
 def _widths(table: DataTable, labels: Sequence[str], rows) -> list[int]:
