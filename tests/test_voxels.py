@@ -143,6 +143,29 @@ def test_malformed_lines_name_file_line_and_expectation(tmp_path, data, line, me
     assert caught.value.line == line
 
 
+def test_a_long_bad_line_is_quoted_short_and_the_expectation_kept(tmp_path):
+    # A CSV table read as a voxel list: its header is thousands of characters long.
+    header = ",".join(f"column_{i}" for i in range(300))
+    path = write(tmp_path, f"{header}\n1,2,3\n".encode())
+    with pytest.raises(InputFileError) as caught:
+        load_voxels(path)
+    message = str(caught.value)
+    assert message.startswith(f"{path}:1: 300 comma-separated values in 'column_0,column_1,")
+    assert f"... ({len(header)} characters)'" in message
+    assert message.endswith("; expected three non-negative integers x,y,z separated by commas")
+    assert len(message) < 200 + len(str(path))
+
+
+def test_a_long_bad_value_is_quoted_short(tmp_path):
+    path = write(tmp_path, b"1,2,3\n" + b"a" * 5000 + b",2,3\n")
+    with pytest.raises(InputFileError) as caught:
+        load_voxels(path)
+    assert str(caught.value).endswith(
+        "x = 'aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa... (5000 characters)' "
+        "is not a whole number; expected three non-negative integers x,y,z separated by commas"
+    )
+
+
 def test_error_line_number_counts_from_the_start_deep_in_a_large_file(tmp_path):
     lines = [f"{i},{i % 7},{i % 11}\n" for i in range(100_000)]
     lines[87_654] = "5,6\n"

@@ -397,6 +397,16 @@ def _check_read_size(path: Path) -> None:
         )
 
 
+QUOTE_CHARS = 60  # of a rejected line or value: the message keeps room for what was expected
+
+
+def _quoted(text: str) -> str:
+    """``text`` in quotes, cut to its first QUOTE_CHARS characters when longer."""
+    if len(text) <= QUOTE_CHARS:
+        return repr(text)
+    return repr(f"{text[:QUOTE_CHARS]}... ({len(text)} characters)")
+
+
 def describe_bad_line(text: str, columns: int = 3, target: bool = False) -> str:
     """What is wrong with one rejected line, and what was expected.
 
@@ -409,34 +419,34 @@ def describe_bad_line(text: str, columns: int = 3, target: bool = False) -> str:
         return f"binary data, not text; {expected}"
     if "\r" in body:
         shown = body.strip(" \t")
-        return f"stray carriage return (\\r) in {shown!r}; {expected}"
+        return f"stray carriage return (\\r) in {_quoted(shown)}; {expected}"
     if not body.strip(" \t"):
         return "blank line before more voxels; blank lines are allowed only at the end of the file"
     fields = body.split(",")
     if len(fields) != columns:
         if target and len(fields) in (3, 4):
             return (
-                f"{len(fields)} comma-separated values in {body.strip()!r} but the file's first "
+                f"{len(fields)} comma-separated values in {_quoted(body.strip())} but the file's first "
                 f"line has {columns}; {EXPECTED_TARGET}"
             )
-        return f"{len(fields)} comma-separated values in {body.strip()!r}; {expected}"
+        return f"{len(fields)} comma-separated values in {_quoted(body.strip())}; {expected}"
     for axis, field in zip((*_AXES, "id"), fields):
         token = field.strip(" \t")
         if not token:
-            return f"{axis} is empty in {body.strip()!r}; {expected}"
+            return f"{axis} is empty in {_quoted(body.strip())}; {expected}"
         if token.startswith("-") and token[1:].isascii() and token[1:].isdigit():
             if axis == "id":
                 return f"id = {token} is not a target id; {EXPECTED_TARGET}"
             return f"{axis} = {token} is negative; voxel indices start at 0"
         if not (token.isascii() and token.isdigit()):
-            return f"{axis} = {token!r} is not a whole number; {expected}"
+            return f"{axis} = {_quoted(token)} is not a whole number; {expected}"
         # Length first: int() refuses strings of more than 4,300 digits.
         if len(token.lstrip("0")) > len(str(MAX_INDEX)) or int(token) > MAX_INDEX:
             shown = token if len(token) <= 24 else f"{token[:12]}...({len(token)} digits)"
             if axis == "id":
                 return f"id = {shown} is not a target id; {EXPECTED_TARGET}"
             return f"{axis} = {shown} is too large; expected at most {MAX_INDEX}"
-    return f"cannot read {body.strip()!r}; {expected}"
+    return f"cannot read {_quoted(body.strip())}; {expected}"
 
 
 def unique_voxels(voxels: np.ndarray) -> tuple[np.ndarray, int]:
