@@ -335,6 +335,31 @@ def test_a_centre_too_near_the_horizon_is_blamed_on_the_distance_the_user_wrote(
     assert caught.value.field == "aim_at"
 
 
+def test_an_altitude_at_or_below_the_target_is_blamed_on_the_altitude(tmp_path):
+    # No radius can help here; the message asked for "a radius of at most 0 m".
+    from ladartui.flight import flypast, orbit
+    from ladartui.scenario import load_scenario
+
+    with pytest.raises(FieldError) as caught:
+        orbit((0.0, 0.0, 5.0), 50.0, 3.0, 4)
+    assert caught.value.field == "altitude"
+    assert str(caught.value) == (
+        "altitude = 3.0: expected an altitude above the centre's height of 5 m, so the centre "
+        "is at least 1 degree below the horizon (or an aim_at point)"
+    )
+    with pytest.raises(FieldError) as caught:
+        flypast((0.0, 0.0, 5.0), 30.0, 5.0, 100.0, 4, 0.0)
+    assert caught.value.field == "altitude" and "above the target's height of 5 m" in str(caught.value)
+    path = tmp_path / "low.toml"
+    path.write_text(
+        '[files]\nscene = "scene.txt"\nvoxel_size = 1.0\n[[flight.segments]]\n'
+        'kind = "orbit"\ncentre = [0.0, 0.0, 0.926]\nradius = 50.0\naltitude = 0.5\n'
+        "scans = 4\n"
+    )
+    with pytest.raises(FieldError, match=r"low.toml:8: flight.segments\[0\].altitude = 0.5"):
+        load_scenario(path, check_files=False)
+
+
 def test_the_scenario_file_names_the_radius_line(tmp_path):
     from ladartui.scenario import load_scenario
 

@@ -56,14 +56,18 @@ def _aimed_at_default(poses, target, altitude, field: str, value, what: str):
     except FieldError as error:
         if error.field != "aim_at":
             raise
+        point = "centre" if field == "radius" else "target"
+        reason = f"so the {point} is at least 1 degree below the horizon (or an aim_at point)"
         height = altitude - target[2]
-        limit = height / math.tan(math.radians(1.0)) if height > 0 else 0.0
+        if height <= 0:  # no distance helps: the altitude is what to change
+            raise FieldError(
+                "altitude",
+                altitude,
+                f"an altitude above the {point}'s height of {target[2]:g} m, {reason}",
+            ) from None
+        limit = height / math.tan(math.radians(1.0))
         raise FieldError(
-            field,
-            value,
-            f"{what} of at most {limit:.0f} m at altitude "
-            f"{altitude:g} m, so the {'centre' if field == 'radius' else 'target'} "
-            "is at least 1 degree below the horizon (or an aim_at point)",
+            field, value, f"{what} of at most {limit:.0f} m at altitude {altitude:g} m, {reason}"
         ) from None
 
 
