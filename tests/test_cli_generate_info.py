@@ -57,6 +57,20 @@ def test_generate_refuses_an_out_named_as_another_kind_of_file(tmp_path, capsys,
     assert not list(tmp_path.iterdir())
 
 
+@pytest.mark.parametrize("name", ["forest_Target", "forest_Target.txt"])
+def test_generate_refuses_an_out_named_as_a_target_model(tmp_path, capsys, monkeypatch, name):
+    """'forest_Target.txt' wrote a scene over forest.txt's target model."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "forest_Target.txt").write_text("1,2,3\n")
+    assert main(["generate", "small", name]) == 2
+    assert capsys.readouterr().err == (
+        f"ladartui: error: OUT = {name!r}: expected the scene's stem, such as forest "
+        "(it writes forest.txt and forest_Target.txt), not a target model's name\n"
+    )
+    assert [p.name for p in tmp_path.iterdir()] == ["forest_Target.txt"]
+    assert (tmp_path / "forest_Target.txt").read_text() == "1,2,3\n"
+
+
 @pytest.mark.parametrize(
     ("flags", "message"),
     [

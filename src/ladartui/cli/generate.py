@@ -108,6 +108,14 @@ def run(args) -> int:
             f"not a {stem.suffix} file name",
         )
     scene_file, target_file = output_paths(stem)
+    if scene_file.stem.endswith("_Target"):  # the scene would go over X.txt's target model
+        name = scene_file.stem.removesuffix("_Target")
+        raise FieldError(
+            "OUT",
+            args.out,
+            f"the scene's stem, such as {name} (it writes {name}.txt and {name}_Target.txt), "
+            "not a target model's name",
+        )
     las_files = list(las_paths(stem)) if args.las else []
     check_writable(scene_file, target_file, *las_files)
     cancel = threading.Event()
