@@ -173,6 +173,25 @@ def test_an_empty_path_names_its_argument(tmp_path, truck, forest, capsys, monke
     assert sorted(p.name for p in tmp_path.iterdir()) == ["forest.txt", "forest_Target.txt", "truck.stl"]
 
 
+def test_a_scene_named_as_a_target_model_is_refused(tmp_path, truck, forest, capsys):
+    """OUT forest_Target.txt wrote the scene over forest.txt's target model (and its own target
+    as forest_Target_Target.txt); --into forest_Target.txt took the target model as a scene."""
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    target = str(tmp_path / "forest_Target.txt")
+    args = ["voxelize", str(truck), "--voxel-size", "0.1", "--at", "3,3"]
+    assert main([*args, target, "--into", str(forest)]) == 2
+    assert one_error_line(capsys) == (
+        f"ladartui: error: OUT = {target!r}: expected the scene's stem, such as forest "
+        "(it writes forest.txt and forest_Target.txt), not a target model's name"
+    )
+    assert main([*args, str(tmp_path / "out"), "--into", target]) == 2
+    assert one_error_line(capsys) == (
+        f"ladartui: error: --into = {target!r}: expected a scene model, such as forest.txt "
+        "(its target model forest_Target.txt is read beside it), not a target model"
+    )
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+
+
 def test_one_voxel_is_said_in_the_singular(tmp_path, truck, capsys):
     """A voxel as large as the truck: '1 voxels'."""
     assert main(["voxelize", str(truck), str(tmp_path / "t"), "--voxel-size", "5"]) == 0

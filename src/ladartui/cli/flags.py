@@ -6,7 +6,8 @@ The core names a field as the scenario file does (``simulation.backend``,
 positional argument is named as its usage line names it (``PRESET``).
 ``run_count`` bounds the timed runs and warm-up calls of bench and study;
 ``voxel_size_flag`` holds a ``--voxel-size`` to what a scenario takes;
-``check_file_names`` refuses empty file names.
+``check_file_names`` refuses empty file names; ``check_scene_stem`` a scene to write
+named as a target model.
 """
 
 from __future__ import annotations
@@ -88,3 +89,19 @@ def other_file_kind(path) -> str | None:
     from pathlib import Path
 
     return OTHER_FILE_KINDS.get(Path(path).suffix.lower())
+
+
+def check_scene_stem(flag: str, value: str, scene_file) -> None:
+    """Refuse a scene to write named as a target model (``forest_Target.txt``): it would go
+    over ``forest.txt``'s target model, with its own target beside it as ``..._Target_Target``."""
+    from pathlib import Path
+
+    stem = Path(scene_file).stem
+    if stem.endswith("_Target"):
+        name = stem.removesuffix("_Target")
+        raise FieldError(
+            flag,
+            value,
+            f"the scene's stem, such as {name} (it writes {name}.txt and {name}_Target.txt), "
+            "not a target model's name",
+        )

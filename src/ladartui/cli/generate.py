@@ -90,7 +90,7 @@ def run(args) -> int:
     import threading
 
     from ladartui.cli.console import CliConsole as Console
-    from ladartui.cli.flags import other_file_kind
+    from ladartui.cli.flags import check_scene_stem, other_file_kind
     from ladartui.cli.progress import run_cancellable, sigterm_as_interrupt
     from ladartui.errors import Cancelled
     from ladartui.outputset import check_writable
@@ -108,14 +108,7 @@ def run(args) -> int:
             f"not a {stem.suffix} file name",
         )
     scene_file, target_file = output_paths(stem)
-    if scene_file.stem.endswith("_Target"):  # the scene would go over X.txt's target model
-        name = scene_file.stem.removesuffix("_Target")
-        raise FieldError(
-            "OUT",
-            args.out,
-            f"the scene's stem, such as {name} (it writes {name}.txt and {name}_Target.txt), "
-            "not a target model's name",
-        )
+    check_scene_stem("OUT", args.out, scene_file)
     las_files = list(las_paths(stem)) if args.las else []
     check_writable(scene_file, target_file, *las_files)
     cancel = threading.Event()

@@ -6,7 +6,7 @@ import math
 import threading
 import time
 
-from ladartui.cli.flags import as_flags, check_file_names, voxel_size_flag
+from ladartui.cli.flags import as_flags, check_file_names, check_scene_stem, voxel_size_flag
 from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt
 from ladartui.errors import Cancelled, FieldError, check_cancelled
 from ladartui.number_text import extent_metres, plural
@@ -99,6 +99,16 @@ def run(args) -> int:
     outputs: tuple[Path, ...]
     if args.into:
         outputs = scene_model_paths(args.out)
+        check_scene_stem("OUT", args.out, outputs[0])
+        into = Path(args.into)
+        if into.stem.endswith("_Target"):  # a target model read as the scene
+            name = into.stem.removesuffix("_Target")
+            raise FieldError(
+                "--into",
+                args.into,
+                f"a scene model, such as {name}.txt (its target model {into.name} is read "
+                "beside it), not a target model",
+            )
     else:
         target = Path(args.out)
         if target.suffix.lower() != ".txt":
