@@ -201,6 +201,21 @@ def test_missing_target_model_is_named(tmp_path):
     )
 
 
+def test_a_scene_file_naming_the_target_model_says_which_file_to_name(tmp_path):
+    # It asked for forest_Target_Target.txt, a file no one should make.
+    write_models(tmp_path / "models")
+    path = write_scenario(
+        tmp_path, edited('scene = "models/forest.txt"', 'scene = "models/forest_Target.txt"')
+    )
+    with pytest.raises(InputFileError) as caught:
+        load_scenario(path)
+    models = tmp_path / "models"
+    assert str(caught.value) == (
+        f"{path}:2: scene model file {models / 'forest_Target.txt'} is a target model "
+        f"(files.scene): expected the scene model {models / 'forest.txt'}, whose target model it is"
+    )
+
+
 def test_missing_scenario_file(tmp_path):
     with pytest.raises(InputFileError) as caught:
         load_scenario(tmp_path / "nope.toml")

@@ -192,7 +192,13 @@ class Scenario:
         missing = None
         if problem := file_problem(self.scene_file):
             missing = f"scene model file {self.scene_file} {problem} (files.scene)"
-        elif problem := file_problem(self.target_file):
+        elif (problem := file_problem(self.target_file)) and self.scene_file.stem.endswith("_Target"):
+            scene = self.scene_file.with_stem(self.scene_file.stem.removesuffix("_Target"))
+            missing = (
+                f"scene model file {self.scene_file} is a target model (files.scene): "
+                f"expected the scene model {scene}, whose target model it is"
+            )
+        elif problem:
             missing = (
                 f"target model file {self.target_file} {problem} (the target model of "
                 f"{self.scene_file.name} must sit beside it, named "
