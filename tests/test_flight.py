@@ -360,6 +360,23 @@ def test_an_altitude_at_or_below_the_target_is_blamed_on_the_altitude(tmp_path):
         load_scenario(path, check_files=False)
 
 
+@pytest.mark.parametrize(
+    ("call", "field", "shown"),
+    [
+        (lambda: straight(None, 100.0, 4), "start", "start is not set"),
+        (lambda: turn((0.0, 0.0, 50.0), 50.0, 90.0, "right", 3), "start", "start = (0.0, 0.0, 50.0)"),
+        (lambda: aim_at("pose", (0.0, 0.0, 0.0)), "pose", "pose = 'pose'"),
+        (lambda: path_length([1, 2, 3]), "poses[0]", "poses[0] = 1"),
+    ],
+)
+def test_a_pose_that_is_no_scan_pose_is_a_field_error(call, field, shown):
+    # These raised AttributeError ('NoneType' object has no attribute 'heading').
+    with pytest.raises(FieldError) as caught:
+        call()
+    assert caught.value.field == field
+    assert str(caught.value) == f"{shown}: expected a ScanPose"
+
+
 def test_the_scenario_file_names_the_radius_line(tmp_path):
     from ladartui.scenario import load_scenario
 

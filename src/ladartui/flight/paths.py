@@ -18,7 +18,15 @@ from ladartui.checks import (
     point_field,
 )
 from ladartui.errors import FieldError
-from ladartui.flight.pose import DIRECTIONS, MAX_FLIGHT_ALTITUDE, MAX_SCANS, ScanPose, _forward, aim_at
+from ladartui.flight.pose import (
+    DIRECTIONS,
+    MAX_FLIGHT_ALTITUDE,
+    MAX_SCANS,
+    ScanPose,
+    _forward,
+    aim_at,
+    pose_field,
+)
 
 
 def _length(name, value):
@@ -106,6 +114,7 @@ def straight(start: ScanPose, distance: float, scans: int) -> list[ScanPose]:
     (1..scans) sits ``distance * k / scans`` along the path, so the last scan is
     at the end of the manoeuvre. Sensor azimuth and depression are kept.
     """
+    start = pose_field("start", start)
     distance = _length("distance", distance)
     scans = _scans(scans)
     fx, fy = _forward(start.heading)
@@ -141,6 +150,7 @@ def turn(start: ScanPose, radius: float, arc: float, direction: str, scans: int)
     evenly spaced along the arc (scan k after ``arc * k / scans`` degrees), each
     heading along the tangent. Sensor azimuth and depression are kept.
     """
+    start = pose_field("start", start)
     radius = _length("radius", radius)
     arc = _arc(arc)
     direction = choice_field("direction", direction, DIRECTIONS)

@@ -41,7 +41,7 @@ from ladartui.flight.paths import (
     straight,
     turn,
 )
-from ladartui.flight.pose import DIRECTIONS, MAX_SCANS, ScanPose, _heading
+from ladartui.flight.pose import DIRECTIONS, MAX_SCANS, ScanPose, _heading, pose_field
 
 
 def _optional_point(name, value):
@@ -375,7 +375,7 @@ def path_length(poses: Sequence[ScanPose]) -> float:
     This knows only the scan positions, so a turn counts its chords;
     ``FlightPlan.path_length`` measures turns and orbits along their arcs.
     """
-    return sum(_chords(list(poses)))
+    return sum(_chords([pose_field(f"poses[{i}]", pose) for i, pose in enumerate(poses)]))
 
 
 def flight_time(distance: float, speed: float) -> float:

@@ -87,12 +87,20 @@ def _bearing(dx, dy):
     return _heading(math.degrees(math.atan2(dx, dy)))
 
 
+def pose_field(name: str, value) -> ScanPose:
+    """``value`` when it is a ScanPose; else a FieldError naming ``name``."""
+    if not isinstance(value, ScanPose):
+        raise FieldError(name, value, "a ScanPose")
+    return value
+
+
 def aim_at(pose: ScanPose, target_xyz) -> ScanPose:
     """``pose`` with azimuth and depression set so the central ray passes through the target.
 
     A target straight below gives depression 90 and keeps the pose's azimuth.
     A target less than 1 degree below the horizon cannot be aimed at (FieldError).
     """
+    pose = pose_field("pose", pose)
     tx, ty, tz = point_field("aim_at", target_xyz)
     dx, dy, dz = tx - pose.x, ty - pose.y, tz - pose.z
     horizontal = math.hypot(dx, dy)
