@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from ladartui.cmf import read_cmf
-from ladartui.errors import InputFileError
+from ladartui.errors import InputFileError, OutputFileError
 from ladartui.measures import CMF_HEADER, Measures, compute_measures, visible_mask
 
 
@@ -181,6 +181,19 @@ def test_cmf_round_trip(tmp_path):
     empty = compute_measures(np.zeros((0, 3)), None, None)
     empty.write_cmf(path)
     assert read_cmf(path) == empty
+
+
+def test_a_cmf_that_cannot_be_written_is_named_as_itself(tmp_path):
+    # The errors named the temporary file beside it ('.x.cmf.w02usrzc.tmp'), as plain OSErrors.
+    measures = compute_measures(box(2, 2, 2), None, None)
+    with pytest.raises(OutputFileError) as caught:
+        measures.write_cmf(tmp_path)
+    assert str(caught.value) == f"{tmp_path}: cannot be written (is a directory)"
+    (tmp_path / "file").write_text("")
+    with pytest.raises(OutputFileError) as caught:
+        measures.write_cmf(tmp_path / "file" / "S.cmf")
+    assert str(caught.value) == f"{tmp_path / 'file' / 'S.cmf'}: cannot be written (file exists)"
+    assert [p.name for p in tmp_path.iterdir()] == ["file"]
 
 
 def test_bad_cmf_names_the_line(tmp_path):

@@ -77,14 +77,14 @@ def test_failed_write_replaces_nothing(scenario, capsys, monkeypatch):
     old = write_old_set(scenario)
     import ladartui.scene.voxels as voxels
 
-    real = voxels.save_voxels
+    real = voxels.write_voxels
 
     def disk_full(path, data):
         if ".S_Target.txt." in str(path):
             raise OSError(errno.ENOSPC, "No space left on device")
         return real(path, data)
 
-    monkeypatch.setattr(voxels, "save_voxels", disk_full)
+    monkeypatch.setattr(voxels, "write_voxels", disk_full)
     assert main(["run", str(scenario.path)]) == 2
     err = capsys.readouterr().err.strip().splitlines()[-1]  # after the progress bar
     assert err.startswith("ladartui: error:") and "S_Target.txt" in err and "no space left" in err

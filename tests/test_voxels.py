@@ -5,7 +5,7 @@ import os
 import numpy as np
 import pytest
 
-from ladartui.errors import FieldError, InputFileError
+from ladartui.errors import FieldError, InputFileError, OutputFileError
 from ladartui.scene.voxels import load_voxels, load_voxels_counted, save_voxels, unique_voxels
 
 
@@ -225,6 +225,14 @@ def test_save_is_atomic_when_the_data_is_bad(tmp_path):
         save_voxels(path, np.array([[1, 2, 3]]), ids=[1, 2])
     assert path.read_text() == "1,2,3\n"
     assert os.listdir(tmp_path) == ["keep.txt"]
+
+
+def test_a_voxel_list_that_cannot_be_written_is_named_as_itself(tmp_path):
+    # The error was an IsADirectoryError naming the temporary file beside the folder.
+    with pytest.raises(OutputFileError) as caught:
+        save_voxels(tmp_path, np.array([[1, 2, 3]]))
+    assert str(caught.value) == f"{tmp_path}: cannot be written (is a directory)"
+    assert os.listdir(tmp_path) == []
 
 
 def test_python_and_compiled_formatting_agree(monkeypatch):

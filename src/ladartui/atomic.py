@@ -5,6 +5,8 @@ import os
 import tempfile
 from pathlib import Path
 
+from ladartui.errors import OutputFileError
+
 
 @contextlib.contextmanager
 def atomic_path(target):
@@ -25,6 +27,17 @@ def atomic_path(target):
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
         raise
+
+
+@contextlib.contextmanager
+def write_errors_named(target):
+    """An OSError inside as an ``OutputFileError`` naming ``target``, not the temporary
+    file beside it that ``atomic_path`` was writing."""
+    try:
+        yield
+    except OSError as error:
+        reason = os.strerror(error.errno) if error.errno else str(error)
+        raise OutputFileError(target, f"cannot be written ({reason.lower()})") from None
 
 
 def _default_mode(target: Path) -> int:

@@ -42,7 +42,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ladartui.atomic import write_text_atomic
+from ladartui.atomic import write_errors_named, write_text_atomic
 from ladartui.checks import number_field
 from ladartui.directions import DirectionStats, angle_between, direction_stats
 from ladartui.errors import FieldError, InputFileError
@@ -160,7 +160,8 @@ class Measures:
 
     def write_cmf(self, path) -> None:
         """Write ``to_cmf()`` to ``path`` atomically."""
-        write_text_atomic(path, self.to_cmf())
+        with write_errors_named(path):
+            write_text_atomic(path, self.to_cmf())
 
 
 def compute_measures(

@@ -19,7 +19,7 @@ from pathlib import Path
 import tomli_w
 
 from ladartui import defaults
-from ladartui.atomic import write_text_atomic
+from ladartui.atomic import write_errors_named, write_text_atomic
 from ladartui.checks import choice_field, number_field
 from ladartui.detection.settings import DetectionSettings
 from ladartui.errors import FieldError, InputFileError, LadarError, OutputFileError
@@ -389,11 +389,8 @@ class Scenario:
             )
         if text is not None and text.startswith(self.header()):  # its names follow the file's
             text = scenario.header() + text[len(self.header()) :]
-        try:
+        with write_errors_named(scenario.path):
             write_text_atomic(scenario.path, text if text is not None else scenario.to_toml())
-        except OSError as error:  # named as the file, not the temporary beside it
-            reason = os.strerror(error.errno) if error.errno else str(error)
-            raise OutputFileError(scenario.path, f"cannot be written ({reason.lower()})") from None
         return scenario
 
 

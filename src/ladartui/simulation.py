@@ -439,11 +439,11 @@ def _write_outputs(output_set, scene_output, target_output, measures, record, sc
 
     LAS outputs carry each voxel's target id as its point source id (0: not a target voxel).
     """
-    from ladartui.scene.voxels import save_voxels
+    from ladartui.scene.voxels import write_voxels
 
     writers = {
-        "scene": lambda tmp: save_voxels(tmp, scene_output),
-        "target": lambda tmp: save_voxels(tmp, target_output),
+        "scene": lambda tmp: write_voxels(tmp, scene_output),
+        "target": lambda tmp: write_voxels(tmp, target_output),
         "measures": lambda tmp: tmp.write_text(measures.to_cmf(), encoding="utf-8"),
         "record": lambda tmp: tmp.write_text(record, encoding="utf-8"),
     }

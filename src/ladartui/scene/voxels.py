@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ladartui.atomic import atomic_path
+from ladartui.atomic import atomic_path, write_errors_named
 from ladartui.errors import InputFileError
 from ladartui.fileprobe import NO_SUCH_FILE, refuse_special_file
 from ladartui.fingerprint import Digest
@@ -560,8 +560,16 @@ def _column_max(voxels: np.ndarray) -> np.ndarray:
 def save_voxels(path, voxels, ids=None) -> None:
     """Write ``voxels`` ((N, 3) non-negative integers) as an ``x,y,z`` list, atomically.
 
-    With ``ids`` ((N,) target ids 1..``MAX_TARGET_ID``) the lines are ``x,y,z,id``.
+    With ``ids`` ((N,) target ids 1..``MAX_TARGET_ID``) the lines are ``x,y,z,id``. A path
+    that cannot be written is an ``OutputFileError`` naming it.
     """
+    with write_errors_named(path):
+        write_voxels(path, voxels, ids)
+
+
+def write_voxels(path, voxels, ids=None) -> None:
+    """``save_voxels`` with its OSErrors as raised: an output set's writer, given the set's
+    temporary file, leaves the set to name the output."""
     voxels = np.ascontiguousarray(voxel_list_field("voxels", voxels, MAX_INDEX), dtype=np.int64)
     if ids is not None:
         voxels = np.column_stack([voxels, target_ids_field("ids", ids, len(voxels)).astype(np.int64)])
