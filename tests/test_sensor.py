@@ -210,6 +210,15 @@ def test_an_attitude_that_is_not_two_or_three_finite_angles_is_refused(attitude)
     assert np.isfinite(turned).all()
 
 
+@pytest.mark.parametrize("method", ["rays", "central_ray", "corner_directions", "footprint"])
+@pytest.mark.parametrize("pose", [None, (0.0, 0.0, 50.0)])
+def test_a_pose_that_is_no_scan_pose_is_refused(method, pose):
+    # They raised AttributeError ('NoneType' object has no attribute 'heading').
+    with pytest.raises(FieldError) as caught:
+        getattr(Sensor(grid=4, ray_grid=1), method)(pose)
+    assert caught.value.field == "pose" and "expected a ScanPose" in str(caught.value)
+
+
 def test_limits_are_accepted():
     sensor = Sensor(grid=1, ray_grid=16, fov=89.9, depth_resolution=0.0, pixel_pitch=1e-7)
     origins, directions, detector = sensor.rays(ScanPose(0, 0, 10, depression=1.0))

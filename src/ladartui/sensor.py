@@ -31,6 +31,7 @@ import numpy as np
 from ladartui.checks import integer_field, number_field
 from ladartui.errors import FieldError
 from ladartui.flight import ScanPose
+from ladartui.flight.pose import pose_field
 
 MAX_GRID = 1024
 MAX_RAY_GRID = 16
@@ -65,7 +66,7 @@ def pose_rotation(pose: ScanPose) -> np.ndarray:
 
 def _rotation(pose: ScanPose, attitude) -> np.ndarray:
     """``pose_rotation``, turned by the aircraft's (roll, pitch) for a body-fixed sensor."""
-    rotation = pose_rotation(pose)
+    rotation = pose_rotation(pose_field("pose", pose))
     if attitude is None:
         return rotation
     angles = _attitude_angles(attitude)
@@ -218,6 +219,7 @@ class Sensor:
         only the detector rows in ``rows`` (a slice of detector rows, for
         tracing a scan in chunks: the result is that contiguous part).
         """
+        pose = pose_field("pose", pose)
         row0, row1 = 0, self.grid
         if rows is not None:
             if isinstance(rows, range):
@@ -246,7 +248,8 @@ class Sensor:
 
     def central_ray(self, pose: ScanPose, attitude=None):
         """(origin (3,), unit direction (3,)) of the sensor's boresight at ``pose``."""
-        return np.array(pose.position), _rotation(pose, attitude) @ np.array([0.0, 0.0, -1.0])
+        rotation = _rotation(pose, attitude)
+        return np.array(pose.position), rotation @ np.array([0.0, 0.0, -1.0])
 
     def corner_directions(self, pose: ScanPose, attitude=None) -> np.ndarray:
         """Unit directions (4, 3) of the field-of-view corners: far-left, far-right,
