@@ -377,6 +377,21 @@ def test_a_pose_that_is_no_scan_pose_is_a_field_error(call, field, shown):
     assert str(caught.value) == f"{shown}: expected a ScanPose"
 
 
+@pytest.mark.parametrize(
+    ("segments", "shown"),
+    [(None, "segments is not set"), (["orbit"], "segments[0] = 'orbit'"), (Straight, "segments = ")],
+)
+def test_segments_that_are_no_flight_segments_are_refused(segments, shown):
+    # They raised TypeError ('NoneType' object is not iterable) or, on poses(), AttributeError.
+    with pytest.raises(FieldError) as caught:
+        FlightPlan(ScanPose(0, 0, 10), segments)
+    assert str(caught.value).startswith(shown)
+    assert str(caught.value).endswith(
+        "expected a list of flight segments (Manual, Straight, Turn, Orbit, FlyPast, Standoff "
+        "or a flight log's LogSegment)"
+    )
+
+
 def test_the_scenario_file_names_the_radius_line(tmp_path):
     from ladartui.scenario import load_scenario
 

@@ -281,6 +281,12 @@ SEGMENT_KINDS = {cls.kind: cls for cls in (Manual, Straight, Turn, Orbit, FlyPas
 Segment = Manual | Straight | Turn | Orbit | FlyPast | Standoff
 
 
+SEGMENTS_EXPECTED = (
+    "a list of flight segments (Manual, Straight, Turn, Orbit, FlyPast, Standoff "
+    "or a flight log's LogSegment)"
+)
+
+
 @dataclass(frozen=True)
 class FlightPlan:
     """A start pose and an ordered list of segments; each continues from the last one's end.
@@ -293,7 +299,14 @@ class FlightPlan:
     segments: tuple = field(default_factory=tuple)
 
     def __post_init__(self):
-        _set(self, "segments", tuple(self.segments))
+        try:
+            segments = tuple(self.segments)
+        except TypeError:
+            raise FieldError("segments", self.segments, SEGMENTS_EXPECTED) from None
+        for index, segment in enumerate(segments):
+            if not callable(getattr(segment, "build", None)):  # the segments' one shared method
+                raise FieldError(f"segments[{index}]", segment, SEGMENTS_EXPECTED)
+        _set(self, "segments", segments)
         if self.start is not None and not isinstance(self.start, ScanPose):
             raise FieldError("start", self.start, "a ScanPose")
 
