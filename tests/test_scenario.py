@@ -216,6 +216,15 @@ def test_a_scene_file_naming_the_target_model_says_which_file_to_name(tmp_path):
     )
 
 
+def test_with_changes_names_a_field_it_does_not_have(tmp_path):
+    # A typo raised TypeError from the dataclass machinery.
+    scenario = load_scenario(write_scenario(tmp_path), check_files=False)
+    with pytest.raises(FieldError) as caught:
+        scenario.with_changes(sped=20.0)
+    assert caught.value.field == "sped"
+    assert str(caught.value).startswith("sped = 20.0: expected a Scenario field: path, scene_file, ")
+
+
 def test_missing_scenario_file(tmp_path):
     with pytest.raises(InputFileError) as caught:
         load_scenario(tmp_path / "nope.toml")

@@ -214,6 +214,10 @@ class Scenario:
 
     def with_changes(self, **fields) -> Scenario:
         """A copy with ``fields`` replaced (checked like a new scenario)."""
+        names = [f.name for f in dataclasses.fields(self) if f.init]
+        for name, value in fields.items():
+            if name not in names:
+                raise FieldError(name, value, f"a Scenario field: {', '.join(names)}")
         return dataclasses.replace(self, **fields)
 
     def same_outputs(self, other: Scenario) -> bool:
