@@ -225,6 +225,33 @@ def test_with_changes_names_a_field_it_does_not_have(tmp_path):
     assert str(caught.value).startswith("sped = 20.0: expected a Scenario field: path, scene_file, ")
 
 
+@pytest.mark.parametrize(
+    ("old", "new", "key", "message"),
+    [
+        (
+            "[files]\n",
+            "",
+            "scene = ",
+            "key 'scene' outside any section: expected it under [files]",
+        ),
+        (
+            "[files]\n",
+            "speed = 3\n",
+            "speed = ",
+            "key 'speed' outside any section: expected a section "
+            "(files, sensor, flight, simulation, detection, levels, targets)",
+        ),
+    ],
+)
+def test_a_key_outside_any_section_is_not_called_a_section(tmp_path, old, new, key, message):
+    # A file missing its [files] line was told "unknown section [scene]".
+    text = edited(old, new)
+    path = write_scenario(tmp_path, text)
+    with pytest.raises(InputFileError) as caught:
+        load_scenario(path, check_files=False)
+    assert str(caught.value) == f"{path}:{line_of(text, key)}: {message}"
+
+
 def test_missing_scenario_file(tmp_path):
     with pytest.raises(InputFileError) as caught:
         load_scenario(tmp_path / "nope.toml")

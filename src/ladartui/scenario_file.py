@@ -235,6 +235,12 @@ class ScenarioReader:
         """The Scenario's keyword arguments from the document (all but its path), each
         checked where its table or key can be named; ``constructed`` names the rest."""
         for name in doc:
+            value = doc[name]
+            tables = isinstance(value, list) and value and all(isinstance(v, dict) for v in value)
+            if name not in self.sections and not (isinstance(value, dict) or tables):  # a key
+                homes = [section for section, keys in self.sections.items() if name in keys]
+                expected = f"it under [{homes[0]}]" if homes else f"a section ({', '.join(self.sections)})"
+                raise self.file_error(name, f"key '{name}' outside any section: expected {expected}")
             if name not in self.sections:
                 raise self.file_error(name, f"unknown section [{name}] (allowed: {', '.join(self.sections)})")
         for name in RECORD_SECTIONS.keys() & doc.keys():  # read by ladartui.run_record
