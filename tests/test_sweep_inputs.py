@@ -234,6 +234,23 @@ def test_a_budget_for_an_objective_that_uses_none_is_refused(tiny, tmp_path, cap
     assert not (tmp_path / "o").exists()
 
 
+@pytest.mark.parametrize(
+    ("flag", "value", "expected"),
+    [
+        ("--objective", "coverage", "one of obscured-coverage, coverage-per-km, "),
+        ("--cost", "miles", "one of flight-time, distance"),
+    ],
+)
+def test_a_bad_objective_or_cost_flag_is_named_as_the_flag(tiny, tmp_path, capsys, flag, value, expected):
+    """The errors said 'objective = ...' and 'cost = ...', a key the spec has, not the flag typed."""
+    from ladartui.cli import main
+
+    spec = write_spec(tiny, "[grid]\nradius = [20.0]\n", name="flags.toml")
+    assert main(["sweep", str(spec), "--serial", flag, value, "--out", str(tmp_path / "o")]) == 2
+    assert one_error_line(capsys).startswith(f"ladartui: error: {flag} = {value!r}: expected {expected}")
+    assert not (tmp_path / "o").exists()
+
+
 def _straight_base(folder):
     """The tiny scenario flown along a straight line: no orbit, fly-past or standoff to vary."""
     from ladartui.flight import FlightPlan, ScanPose, Straight

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 
 from rich.markup import escape
 
+from ladartui.cli.flags import as_flags
 from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt, stop_status
 from ladartui.errors import Cancelled, FieldError, LadarError
 from ladartui.number_text import plural
@@ -171,8 +172,9 @@ def run(args) -> int:
         )
     args.security = security
     spec = load_sweep_spec(args.spec)
-    objective = normal_objective(args.objective or spec.objective)
-    normal_cost(args.cost or spec.cost)
+    with as_flags({"objective": args.objective, "cost": args.cost}):
+        objective = normal_objective(args.objective or spec.objective)
+        normal_cost(args.cost or spec.cost)
     if args.budget is not None:
         from ladartui.sweep.execute import checked_budget
 
