@@ -6,7 +6,7 @@ import math
 import pytest
 
 from cli_support import one_error_line
-from ladartui.errors import InputFileError
+from ladartui.errors import FieldError, InputFileError
 from ladartui.sweep import load_sweep_results, load_sweep_spec, read_table, run_sweep
 from tiny_sweep import tiny_folder, write_spec, write_tiny_scenario
 
@@ -249,6 +249,28 @@ def test_a_bad_objective_or_cost_flag_is_named_as_the_flag(tiny, tmp_path, capsy
     assert main(["sweep", str(spec), "--serial", flag, value, "--out", str(tmp_path / "o")]) == 2
     assert one_error_line(capsys).startswith(f"ladartui: error: {flag} = {value!r}: expected {expected}")
     assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda: load_sweep_spec(None), "path is not set: expected a sweep spec file's path"),
+        (lambda: load_sweep_spec(123), "path = 123: expected a sweep spec file's path"),
+        (
+            lambda: run_sweep(None, serial=True),
+            "spec is not set: expected a SweepSpec or a sweep spec file's path",
+        ),
+        (
+            lambda: load_sweep_results(None),
+            "path is not set: expected a sweep's results folder or its results.csv",
+        ),
+    ],
+)
+def test_a_path_that_is_no_path_is_a_field_error(call, message):
+    # They raised TypeError from pathlib.
+    with pytest.raises(FieldError) as caught:
+        call()
+    assert str(caught.value) == f"{message} (str or pathlib.Path)"
 
 
 def _straight_base(folder):

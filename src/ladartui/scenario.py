@@ -20,7 +20,7 @@ import tomli_w
 
 from ladartui import defaults
 from ladartui.atomic import write_errors_named, write_text_atomic
-from ladartui.checks import choice_field, number_field
+from ladartui.checks import choice_field, number_field, path_field
 from ladartui.detection.settings import DetectionSettings
 from ladartui.errors import FieldError, InputFileError, LadarError, OutputFileError
 from ladartui.fileprobe import NO_SUCH_FILE, file_problem, read_utf8
@@ -424,9 +424,7 @@ def load_scenario(path, check_files=True) -> Scenario:
     """Read and check a scenario file; with ``check_files``, its model files must exist.
     A flight log is read either way: its records are the flight's poses, which the
     scenario's checks (scan count, work limit) need."""
-    if not isinstance(path, (str, os.PathLike)) or isinstance(path, bytes):
-        raise FieldError("path", path, "a scenario file's path (str or pathlib.Path)")
-    path = _absolute(path)
+    path = _absolute(path_field("path", path, "a scenario file's path"))
     try:
         text = read_utf8(path, "expected a scenario file (.toml)")
     except FileNotFoundError:

@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ladartui.atomic import atomic_path
+from ladartui.checks import path_field
 from ladartui.errors import (
     FieldError,
     InputFileError,
@@ -199,7 +200,7 @@ def run_sweep(
     _refuse_in_worker_start()
     check_callbacks(progress, cancel)
     if not isinstance(spec, SweepSpec):
-        spec = load_sweep_spec(spec)
+        spec = load_sweep_spec(path_field("spec", spec, "a SweepSpec or a sweep spec file's path"))
     objective = normal_objective(objective or spec.objective)
     cost = normal_cost(cost or spec.cost)
     if budget is not None:
@@ -506,7 +507,7 @@ def load_sweep_results(
     row in the file is included; when a variant appears more than once
     (several base scenarios) each row is kept.
     """
-    path = Path(path)
+    path = path_field("path", path, "a sweep's results folder or its results.csv")
     if path.is_dir():
         path = path / RESULTS_NAME
     if not path.exists():

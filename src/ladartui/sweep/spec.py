@@ -40,6 +40,7 @@ from typing import NoReturn
 
 import numpy as np
 
+from ladartui.checks import path_field
 from ladartui.errors import InputFileError
 from ladartui.fileprobe import NO_SUCH_FILE, read_utf8
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
@@ -209,7 +210,7 @@ def _check_variant_count(path, grid, samples):
 
 def load_sweep_spec(path) -> SweepSpec:
     """Read and check a sweep spec; mistakes raise InputFileError naming the key."""
-    path = Path(path)
+    path = path_field("path", path, "a sweep spec file's path")
     try:
         text = read_utf8(path, "expected a sweep spec (.toml)")
         data = tomllib.loads(text)
