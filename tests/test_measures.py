@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from ladartui.cmf import read_cmf
-from ladartui.errors import InputFileError, OutputFileError
+from ladartui.errors import FieldError, InputFileError, OutputFileError
 from ladartui.measures import CMF_HEADER, Measures, compute_measures, visible_mask
 
 
@@ -194,6 +194,14 @@ def test_a_cmf_that_cannot_be_written_is_named_as_itself(tmp_path):
         measures.write_cmf(tmp_path / "file" / "S.cmf")
     assert str(caught.value) == f"{tmp_path / 'file' / 'S.cmf'}: cannot be written (file exists)"
     assert [p.name for p in tmp_path.iterdir()] == ["file"]
+
+
+def test_a_cmf_path_that_is_no_path_is_a_field_error():
+    # They raised TypeError from pathlib.
+    with pytest.raises(FieldError, match=r"^path is not set: expected a measures file's path \(\.cmf\)"):
+        compute_measures(box(2, 2, 2), None, None).write_cmf(None)
+    with pytest.raises(FieldError, match=r"^path = 3: expected a measures file's path \(\.cmf\)"):
+        read_cmf(3)
 
 
 def test_bad_cmf_names_the_line(tmp_path):

@@ -252,6 +252,16 @@ def test_a_key_outside_any_section_is_not_called_a_section(tmp_path, old, new, k
     assert str(caught.value) == f"{path}:{line_of(text, key)}: {message}"
 
 
+def test_save_to_a_path_that_is_no_path_is_a_field_error(tmp_path):
+    # It raised TypeError from pathlib.
+    scenario = load_scenario(write_scenario(tmp_path), check_files=False)
+    with pytest.raises(FieldError) as caught:
+        scenario.save(5)
+    assert str(caught.value) == (
+        "path = 5: expected a scenario file's path, or None for its own (str or pathlib.Path)"
+    )
+
+
 def test_missing_scenario_file(tmp_path):
     with pytest.raises(InputFileError) as caught:
         load_scenario(tmp_path / "nope.toml")

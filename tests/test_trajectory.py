@@ -6,6 +6,15 @@ from ladartui.flight import ScanPose, straight
 from ladartui.trajectory import TrajectoryError, load_flight_log, log_attitude, log_poses
 
 
+def test_a_log_path_that_is_no_path_is_a_field_error():
+    # It raised TypeError from pathlib.
+    with pytest.raises(FieldError) as caught:
+        load_flight_log(None)
+    assert (
+        str(caught.value) == "path is not set: expected a flight log file's path (CSV) (str or pathlib.Path)"
+    )
+
+
 def test_straight_log_reproduces_straight_poses(tmp_path):
     start = ScanPose(10.0, 20.0, 60.0, heading=30.0, depression=45.0)
     poses = straight(start, 120.0, 4)

@@ -6,6 +6,8 @@ import numpy as np
 import pytest
 
 from ladartui.errors import FieldError, InputFileError, OutputFileError
+from ladartui.scene.model import Scene
+from ladartui.scene.target_model import load_target
 from ladartui.scene.voxels import load_voxels, load_voxels_counted, save_voxels, unique_voxels
 
 
@@ -233,6 +235,22 @@ def test_a_voxel_list_that_cannot_be_written_is_named_as_itself(tmp_path):
         save_voxels(tmp_path, np.array([[1, 2, 3]]))
     assert str(caught.value) == f"{tmp_path}: cannot be written (is a directory)"
     assert os.listdir(tmp_path) == []
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda: load_voxels(None), "path is not set: expected a voxel-list file's path"),
+        (lambda: save_voxels(7, [[1, 2, 3]]), "path = 7: expected a voxel-list file's path"),
+        (lambda: load_target(None), "path is not set: expected a target model file's path"),
+        (lambda: Scene.load(None, 0.5), "scene_path is not set: expected a scene model file's path"),
+    ],
+)
+def test_a_path_that_is_no_path_is_a_field_error(call, message):
+    # They raised TypeError from pathlib.
+    with pytest.raises(FieldError) as caught:
+        call()
+    assert str(caught.value) == f"{message} (str or pathlib.Path)"
 
 
 def test_python_and_compiled_formatting_agree(monkeypatch):

@@ -9,8 +9,6 @@ from __future__ import annotations
 import math
 import numbers
 import operator
-import os
-from pathlib import Path
 
 import numpy as np
 
@@ -76,14 +74,6 @@ def point_field(name, value):
     except FieldError:
         raise FieldError(name, value, expected) from None
     return (xyz[0], xyz[1], xyz[2] if len(xyz) == 3 else 0.0)
-
-
-def path_field(name, value, what: str) -> Path:
-    """``value`` as a Path when it is a str or os.PathLike (not bytes); else FieldError
-    expecting ``what`` ("a scenario file's path")."""
-    if not isinstance(value, (str, os.PathLike)) or isinstance(value, bytes):
-        raise FieldError(name, value, f"{what} (str or pathlib.Path)")
-    return Path(value)
 
 
 def range_text(kind, low, high, low_open, high_open):

@@ -1,13 +1,22 @@
-"""Why an input path cannot be read as a file, in words, without raising."""
+"""Why an input path cannot be read as a file, in words, without raising; path_field:
+a path argument that is no path (None, a number) as a FieldError."""
 
 import errno
 import os
 from pathlib import Path
 
-from ladartui.errors import InputFileError
+from ladartui.errors import FieldError, InputFileError
 
 SPECIAL_FILE = "is not a regular file (a pipe or device)"
 NO_SUCH_FILE = "no such file"  # an input file that is missing, in every reader's words
+
+
+def path_field(name, value, what: str) -> Path:
+    """``value`` as a Path when it is a str or os.PathLike (not bytes); else FieldError
+    expecting ``what`` ("a scenario file's path")."""
+    if not isinstance(value, (str, os.PathLike)) or isinstance(value, bytes):
+        raise FieldError(name, value, f"{what} (str or pathlib.Path)")
+    return Path(value)
 
 
 def file_problem(path: Path) -> str | None:

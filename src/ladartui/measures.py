@@ -46,6 +46,7 @@ from ladartui.atomic import write_errors_named, write_text_atomic
 from ladartui.checks import number_field
 from ladartui.directions import DirectionStats, angle_between, direction_stats
 from ladartui.errors import FieldError, InputFileError
+from ladartui.fileprobe import path_field
 from ladartui.scene.keys import member as _member
 from ladartui.scene.keys import sorted_unique, visible_mask, voxel_keys
 from ladartui.scene.voxel_arrays import voxel_list_field
@@ -160,6 +161,7 @@ class Measures:
 
     def write_cmf(self, path) -> None:
         """Write ``to_cmf()`` to ``path`` atomically."""
+        path = path_field("path", path, "a measures file's path (.cmf)")
         with write_errors_named(path):
             write_text_atomic(path, self.to_cmf())
 

@@ -20,10 +20,10 @@ import tomli_w
 
 from ladartui import defaults
 from ladartui.atomic import write_errors_named, write_text_atomic
-from ladartui.checks import choice_field, number_field, path_field
+from ladartui.checks import choice_field, number_field
 from ladartui.detection.settings import DetectionSettings
 from ladartui.errors import FieldError, InputFileError, LadarError, OutputFileError
-from ladartui.fileprobe import NO_SUCH_FILE, file_problem, read_utf8
+from ladartui.fileprobe import NO_SUCH_FILE, file_problem, path_field, read_utf8
 from ladartui.flight import (
     FlightPlan,
     ScanPose,
@@ -378,7 +378,9 @@ class Scenario:
         Returns the scenario as saved (with ``path`` as its path, so its
         outputs sit beside the new file).
         """
-        scenario = self if path is None else self.with_changes(path=Path(path))
+        if path is not None:
+            path = path_field("path", path, "a scenario file's path, or None for its own")
+        scenario = self if path is None else self.with_changes(path=path)
         if is_record(scenario.path):  # it would say that settings which never ran made outputs
             raise OutputFileError(
                 scenario.path,

@@ -26,7 +26,7 @@ import numpy as np
 
 from ladartui.checks import MAX_COORDINATE
 from ladartui.errors import FieldError, LadarError
-from ladartui.fileprobe import file_problem, not_utf8, refuse_special_file
+from ladartui.fileprobe import file_problem, not_utf8, path_field, refuse_special_file
 from ladartui.fingerprint import Fingerprint, fingerprint_of
 from ladartui.flight import ScanPose
 from ladartui.number_text import plural
@@ -84,7 +84,7 @@ class FlightLog:
 
 def load_flight_log(path, origin=None) -> FlightLog:
     """The log at ``path``; ``origin`` (lat, lon, alt) places a geodetic log in the scene."""
-    path = Path(path)
+    path = path_field("path", path, "a flight log file's path (CSV)")
     refuse_special_file(path, "expected a flight log (CSV)")
     try:
         data = path.read_bytes()

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.errors import FieldError, InputFileError, LadarError
+from ladartui.fileprobe import path_field
 from ladartui.fingerprint import Digest, Fingerprint
 from ladartui.scene.keys import voxel_keys
 from ladartui.scene.occupancy import Occupancy, column_bounds
@@ -79,7 +80,7 @@ class Scene:
     def load(cls, scene_path, voxel_size, shape=None) -> Scene:
         """Read ``X.txt`` and its target ``X_Target.txt``."""
         _checked_voxel_size(voxel_size)  # before reading what may be large files
-        scene_path = Path(scene_path)
+        scene_path = path_field("scene_path", scene_path, "a scene model file's path")
         target_path = target_path_for(scene_path)
         scene_digest, target_digest = Digest(), Digest()
         voxels, _ = load_voxels_counted(scene_path, digest=scene_digest)

@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.errors import InputFileError
+from ladartui.fileprobe import path_field
 from ladartui.fingerprint import Digest
 from ladartui.scene.voxels import (
     _BOM,
@@ -37,7 +38,7 @@ def load_target(path, digest: Digest | None = None) -> tuple[np.ndarray, np.ndar
     given two different ids is an error naming the later line. ``digest`` is fed
     the file's bytes as they are read.
     """
-    path = Path(path)
+    path = path_field("path", path, "a target model file's path")
     head = _read_bytes(path, limit=4096)
     start = len(_BOM) if head[: len(_BOM)].tobytes() == _BOM else 0
     if _first_line_columns(head, start) == 3:  # the report's layout: the scene parser as it is

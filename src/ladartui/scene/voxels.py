@@ -24,7 +24,7 @@ import numpy as np
 
 from ladartui.atomic import atomic_path, write_errors_named
 from ladartui.errors import InputFileError
-from ladartui.fileprobe import NO_SUCH_FILE, refuse_special_file
+from ladartui.fileprobe import NO_SUCH_FILE, path_field, refuse_special_file
 from ladartui.fingerprint import Digest
 from ladartui.scene.voxel_arrays import MAX_TARGET_ID, target_ids_field, voxel_list_field
 
@@ -196,7 +196,7 @@ def load_voxels(path) -> np.ndarray:
 def load_voxels_counted(path, _target=False, digest: Digest | None = None) -> tuple[np.ndarray, int]:
     """Like :func:`load_voxels`, also returning how many duplicate lines were dropped;
     ``digest`` is fed the file's bytes as they are read."""
-    path = Path(path)
+    path = path_field("path", path, "a voxel-list file's path")
     parsed = _read_rows(path, 3, _target, digest)
     voxels, duplicates = unique_voxels(parsed)
     if duplicates:
@@ -563,6 +563,7 @@ def save_voxels(path, voxels, ids=None) -> None:
     With ``ids`` ((N,) target ids 1..``MAX_TARGET_ID``) the lines are ``x,y,z,id``. A path
     that cannot be written is an ``OutputFileError`` naming it.
     """
+    path = path_field("path", path, "a voxel-list file's path")
     with write_errors_named(path):
         write_voxels(path, voxels, ids)
 

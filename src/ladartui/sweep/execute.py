@@ -20,7 +20,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ladartui.atomic import atomic_path
-from ladartui.checks import path_field
 from ladartui.errors import (
     FieldError,
     InputFileError,
@@ -29,6 +28,7 @@ from ladartui.errors import (
     check_callbacks,
     check_cancelled,
 )
+from ladartui.fileprobe import path_field
 from ladartui.precompile import compile_ahead
 from ladartui.sweep.base import CheckedBase, checked_base, own_rows, spec_rows
 from ladartui.sweep.best_file import best_files, write_best_scenario

@@ -40,9 +40,8 @@ from typing import NoReturn
 
 import numpy as np
 
-from ladartui.checks import path_field
 from ladartui.errors import InputFileError
-from ladartui.fileprobe import NO_SUCH_FILE, read_utf8
+from ladartui.fileprobe import NO_SUCH_FILE, path_field, read_utf8
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.sweep.variant import applicable
 from ladartui.user_data import bundled_scenario_name
