@@ -107,6 +107,22 @@ def test_ctrl_c_cancels_with_a_truthful_message(scenario, capsys, monkeypatch):
     assert "ideal model" not in captured.out
 
 
+def test_a_bundled_scenario_is_taken_by_name_as_run_takes_it(tmp_path, capsys, monkeypatch):
+    """'pulses convoy' said '/cwd/convoy: no such file', where 'run convoy' runs it."""
+    from ladartui.user_data import bundled_scenario_path
+
+    studied = []
+
+    def study(scenario, *args, **kwargs):
+        studied.append(scenario.path)
+        return 0.5, []
+
+    monkeypatch.setattr(pulses_module, "pulse_study", study)
+    monkeypatch.chdir(tmp_path)
+    assert main(["pulses", "convoy", "--pulses", "1", "--json"]) == 0
+    assert studied == [bundled_scenario_path("convoy")]
+
+
 def test_work_beyond_the_memory_limit_is_refused_up_front(scenario, capsys, monkeypatch):
     import ladartui.detection.scan as scan
 

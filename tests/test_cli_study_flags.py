@@ -79,6 +79,24 @@ def test_more_scans_than_a_scenario_has_are_refused_naming_its_count(tmp_path, m
     )
 
 
+def test_a_bundled_scenario_is_taken_by_name_as_run_takes_it(tmp_path, monkeypatch, capsys):
+    """'study convoy' said '/cwd/convoy: no such file', where 'run convoy' runs it."""
+    from ladartui.scenario import Scenario
+    from ladartui.user_data import bundled_scenario_path
+
+    path = bundled_scenario_path("convoy")
+
+    def refuse(self):
+        raise AssertionError("the scene was loaded")
+
+    monkeypatch.setattr(Scenario, "load_scene", refuse)
+    monkeypatch.chdir(tmp_path)
+    assert main(["study", "convoy", "--scans", "1000", "--out", str(tmp_path / "o")]) == 2
+    assert capsys.readouterr().err.strip() == (
+        f"ladartui: error: --scans = 1000: expected at most 24: the flight of {path} has 24 scans"
+    )
+
+
 def test_the_scans_a_flight_has_are_all_taken_and_a_default_above_them_is_not_refused(tmp_path):
     from ladartui.scenario import load_scenario
     from ladartui.user_data import default_scenario_path

@@ -33,7 +33,12 @@ def add_parser(sub):
         "per M and a chart. The scenario's [detection] numbers are used where "
         "set. Writes no files.",
     )
-    p.add_argument("scenario", nargs="?", help="scenario TOML (default: the default scenario)")
+    p.add_argument(
+        "scenario",
+        nargs="?",
+        help="scenario file (.toml), or a bundled one by name: default, convoy "
+        "(default: the default scenario)",
+    )
     p.add_argument(
         "--pulses",
         default="1,10,100",
@@ -82,10 +87,10 @@ def _settings(scenario, args):
 def run(args) -> int:
     from ladartui.cli.console import CliConsole as Console
     from ladartui.scenario import load_scenario
-    from ladartui.user_data import default_scenario_path
+    from ladartui.user_data import bundled_or_path, default_scenario_path
 
     pulses = _pulse_counts(args.pulses)
-    scenario = load_scenario(args.scenario or default_scenario_path())
+    scenario = load_scenario(bundled_or_path(args.scenario) if args.scenario else default_scenario_path())
     settings = _settings(scenario, args)
     if args.backend is not None:  # before any tracing, as run does
         with as_flags({"backend": args.backend}):

@@ -28,7 +28,11 @@ def add_parser(subparsers) -> None:
         "chart speed against accuracy with the Pareto front. Without a scenario, uses the "
         "generated 'reference' scene (cached under LADARTUI_HOME). Ctrl-C cancels.",
     )
-    parser.add_argument("scenario", nargs="?", help="scenario .toml (default: generated scene)")
+    parser.add_argument(
+        "scenario",
+        nargs="?",
+        help="scenario file (.toml), or a bundled one by name: default, convoy (default: a generated scene)",
+    )
     parser.add_argument(
         "--quick", action="store_true", help="small scene, few settings and scans: a fast check"
     )
@@ -103,7 +107,9 @@ def run(args: argparse.Namespace) -> int:
     # --scans above the flight's count is refused; the default (3) takes what there is
     refuse_as = "--scans" if args.scans is not None else None
     if args.scenario:
-        inputs = scenario_inputs(args.scenario, scans, refuse_as=refuse_as)
+        from ladartui.user_data import bundled_or_path
+
+        inputs = scenario_inputs(bundled_or_path(args.scenario), scans, refuse_as=refuse_as)
     else:
         preset = "small" if args.quick else "reference"
         with console.status(f"loading the {preset!r} scene ..."):
