@@ -500,6 +500,16 @@ def test_summary_describes_the_collection(tmp_path):
     assert "case_Scene.txt, case_Target.txt, case.cmf" in text
 
 
+def test_summary_writes_a_huge_flight_time_with_an_exponent(tmp_path):
+    # At speed_mps = 1e-300 validate printed the time as 300 digits; run's table said 3.6e+302 s.
+    scenario = load_scenario(write_scenario(tmp_path), check_files=False).with_changes(speed=1e-300)
+    line = next(line for line in scenario.summary().splitlines() if " s at " in line)
+    assert (
+        line.strip() == f"path {scenario.path_length():.1f} m, {scenario.flight_time():.4g} s at 1e-300 m/s"
+    )
+    assert "e+" in line and len(line) < 80
+
+
 @pytest.mark.parametrize("name", ["orbit", "flypast", "standoff", "manoeuvres"])
 def test_example_scenarios_are_valid(name):
     example = PROJECT / "scenarios" / f"{name}.toml"

@@ -29,7 +29,7 @@ from ladartui.flight import (
     ScanPose,
 )
 from ladartui.levels import LEVELS, LevelThresholds
-from ladartui.number_text import plural
+from ladartui.number_text import fixed, plural
 from ladartui.scenario_file import (
     RECORD_SUFFIX,
     ScenarioReader,
@@ -288,7 +288,7 @@ class Scenario:
             f"flight     {plural(len(poses), 'scan')}: {kinds}",
             f"           altitude {min(altitudes):g}..{max(altitudes):g} m, depression "
             f"{min(depressions):.3g}..{max(depressions):.3g} deg",
-            f"           path {length:.1f} m, {self.flight_time():.1f} s at {self.speed:g} m/s",
+            f"           path {fixed(length, 1)} m, {fixed(self.flight_time(), 1)} s at {self.speed:g} m/s",
             f"rays       {s.rays_per_scan:,} per scan, {s.rays_per_scan * len(poses):,} in all",
             f"run        backend {self.backend}, method {self.method}"
             + (f" (step {self.step:g} voxel)" if self.method == "march" else "")
