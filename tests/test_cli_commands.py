@@ -39,6 +39,14 @@ def test_a_mistyped_command_is_named_not_taken_for_a_scenario(tmp_path, capsys, 
     assert err.endswith(", or a scenario file (.toml) (see 'ladartui -h')\n")
 
 
+def test_the_terminal_ui_on_a_folder_names_it_a_folder(tmp_path, capsys):
+    """'ladartui tui FOLDER' said 'no such file', where run says 'is a folder'."""
+    assert cli.main(["tui", str(tmp_path)]) == 2
+    assert capsys.readouterr().err == (
+        f"ladartui: error: {tmp_path}: is a folder; expected a scenario file (.toml)\n"
+    )
+
+
 def test_ctrl_c_while_the_commands_load_is_one_line(monkeypatch, capsys):
     def interrupted():
         raise KeyboardInterrupt

@@ -80,6 +80,13 @@ def test_missing_and_foreign_files(tmp_path):
         import_las(junk, 0.1)
 
 
+def test_a_folder_is_named_as_a_folder(tmp_path):
+    # It was "no such file", of a folder that is there.
+    with pytest.raises(InputFileError) as caught:
+        import_las(tmp_path, 0.1)
+    assert str(caught.value) == f"{tmp_path}: is a folder; expected a LAS or LAZ point cloud"
+
+
 def test_bad_voxel_size(tmp_path):
     with pytest.raises(FieldError, match="voxel_size = 0: expected a positive number of metres"):
         export_las(tmp_path / "a.las", VOXELS, 0)

@@ -8,6 +8,7 @@ from pathlib import Path
 from ladartui.errors import FieldError, InputFileError
 
 SPECIAL_FILE = "is not a regular file (a pipe or device)"
+FOLDER = "is a folder, expected a file"  # file_problem's words for a folder
 NO_SUCH_FILE = "no such file"  # an input file that is missing, in every reader's words
 
 
@@ -25,7 +26,7 @@ def file_problem(path: Path) -> str | None:
         if Path(path).is_file():
             return None
         if Path(path).is_dir():
-            return "is a folder, expected a file"
+            return FOLDER
         if Path(path).exists():
             return SPECIAL_FILE
         return "not found"
@@ -61,11 +62,14 @@ def _name_max(path: Path) -> int:
 
 
 def require_file(path, expected: str) -> None:
-    """``refuse_special_file``, and "PATH: no such file; ``expected``" for anything else
-    that is no regular file, from one look (for readers that ask before opening)."""
+    """``refuse_special_file``, "PATH: is a folder; ``expected``", and "PATH: no such file;
+    ``expected``" for anything else that is no regular file, from one look (for readers
+    that ask before opening)."""
     problem = file_problem(Path(path))
     if problem == SPECIAL_FILE:
         raise InputFileError(path, f"{SPECIAL_FILE}; {expected}")
+    if problem == FOLDER:
+        raise InputFileError(path, f"is a folder; {expected}")
     if problem:
         raise InputFileError(path, f"{NO_SUCH_FILE}; {expected}")
 
