@@ -5,7 +5,7 @@ import pytest
 
 laspy = pytest.importorskip("laspy")
 
-from ladartui.errors import FieldError, InputFileError  # noqa: E402
+from ladartui.errors import FieldError, InputFileError, OutputFileError  # noqa: E402
 from ladartui.scene.las import export_las, import_las  # noqa: E402
 
 
@@ -85,6 +85,33 @@ def test_a_folder_is_named_as_a_folder(tmp_path):
     with pytest.raises(InputFileError) as caught:
         import_las(tmp_path, 0.1)
     assert str(caught.value) == f"{tmp_path}: is a folder; expected a LAS or LAZ point cloud"
+
+
+@pytest.mark.parametrize(
+    ("voxels", "ids", "message"),
+    [
+        ([[1, -2, 3]], None, r"^voxels\[0\] = \(1, -2, 3\): expected non-negative voxel indices"),
+        ([[1, 2]], None, r"^voxels = 'array of shape \(1, 2\)': expected an \(N, 3\) array"),
+        ([[1, 2, 3]], [70000], r"^ids\[0\] = 70000: expected a target id from 0 \(no target\) to 65535"),
+        ([[1, 2, 3]], [1, 2], r"^ids = 'array of shape \(2,\)': expected 1 target ids"),
+    ],
+)
+def test_export_refuses_bad_voxels_and_ids_naming_them(tmp_path, voxels, ids, message):
+    # A negative index was written as a point below the origin; shapes and ids raised ValueError.
+    with pytest.raises(FieldError, match=message):
+        export_las(tmp_path / "a.las", voxels, 0.25, ids=ids)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_export_to_a_place_that_cannot_be_written_names_it(tmp_path):
+    # IsADirectoryError or FileNotFoundError named the temporary file beside it.
+    with pytest.raises(OutputFileError) as caught:
+        export_las(tmp_path, VOXELS, 0.25)
+    assert str(caught.value) == f"{tmp_path}: cannot be written (is a directory)"
+    with pytest.raises(FieldError, match=r"^path is not set: expected a LAS or LAZ file's path"):
+        export_las(None, VOXELS, 0.25)
+    with pytest.raises(FieldError, match=r"^path is not set: expected a LAS or LAZ point cloud's path"):
+        import_las(None, 0.25)
 
 
 def test_bad_voxel_size(tmp_path):

@@ -23,9 +23,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ladartui.atomic import atomic_path
+from ladartui.atomic import atomic_path, write_errors_named
 from ladartui.errors import FieldError, InputFileError
-from ladartui.fileprobe import require_file
+from ladartui.fileprobe import path_field, require_file
+from ladartui.scene.voxel_arrays import voxel_list_field
 from ladartui.scene.voxels import MAX_INDEX, MAX_TARGET_ID, unique_voxels
 
 
@@ -85,7 +86,7 @@ def import_las_target(path, voxel_size, origin=None) -> tuple[np.ndarray, np.nda
     voxel holding points of two targets is refused (a smaller voxel size
     keeps them apart), as is a source id 0 beside labelled points.
     """
-    path = Path(path)
+    path = path_field("path", path, "a LAS or LAZ point cloud's path")
     indices, source_ids, origin = _voxel_indices(path, voxel_size, origin)
     ids = source_ids.astype(np.int32)
     if not ids.any():
@@ -116,7 +117,7 @@ def _voxel_indices(path, voxel_size, origin) -> tuple[np.ndarray, np.ndarray, np
     """Each point's voxel ((P, 3) int32), its point_source_id (P,), and the origin."""
     import laspy
 
-    path = Path(path)
+    path = path_field("path", path, "a LAS or LAZ point cloud's path")
     size = _check_voxel_size(voxel_size)
     require_file(path, "expected a LAS or LAZ point cloud")
     try:
@@ -153,9 +154,9 @@ def export_las(path, voxels, voxel_size, origin=(0.0, 0.0, 0.0), ids=None) -> No
     ``ids`` (one target id 1..65535 per voxel, or 0 for a voxel of no target)
     are written as point_source_id.
     """
-    path = Path(path)
+    path = path_field("path", path, "a LAS or LAZ file's path")
     cloud = _voxel_cloud(voxels, voxel_size, origin, ids)
-    with atomic_path(path) as tmp:
+    with write_errors_named(path), atomic_path(path) as tmp:
         _write_cloud(tmp, cloud, compressed_suffix(path))
 
 
@@ -175,9 +176,7 @@ def _voxel_cloud(voxels, voxel_size, origin, ids):
     import laspy
 
     size = _check_voxel_size(voxel_size)
-    voxels = np.asarray(voxels)
-    if voxels.size and (voxels.ndim != 2 or voxels.shape[1] != 3):
-        raise ValueError(f"voxels must be an (N, 3) array, got shape {voxels.shape}")
+    voxels = voxel_list_field("voxels", voxels, MAX_INDEX)
     origin = np.asarray(origin, dtype=np.float64).reshape(3)
     centres = origin + voxels.reshape(-1, 3).astype(np.float64) * size
     header = laspy.LasHeader(version="1.2", point_format=0)
@@ -189,8 +188,16 @@ def _voxel_cloud(voxels, voxel_size, origin, ids):
     cloud.x, cloud.y, cloud.z = centres[:, 0], centres[:, 1], centres[:, 2]
     if ids is not None:
         ids = np.asarray(ids)
-        if ids.shape != (len(centres),) or (len(ids) and (ids.min() < 0 or ids.max() > MAX_TARGET_ID)):
-            raise ValueError(f"ids must be {len(centres)} target ids in 0..{MAX_TARGET_ID}")
+        if ids.shape != (len(centres),):
+            raise FieldError(
+                "ids", f"array of shape {ids.shape}", f"{len(centres)} target ids, one per voxel"
+            )
+        wrong = np.flatnonzero((ids < 0) | (ids > MAX_TARGET_ID))
+        if len(wrong):
+            row = int(wrong[0])
+            raise FieldError(
+                f"ids[{row}]", int(ids[row]), f"a target id from 0 (no target) to {MAX_TARGET_ID}"
+            )
         cloud.point_source_id = ids.astype(np.uint16)
     return cloud
 
