@@ -20,6 +20,15 @@ def small():
     return generate_scene("small", seed=0)
 
 
+def test_writing_to_a_stem_that_is_no_path_is_a_field_error(small):
+    # It raised TypeError from pathlib.
+    with pytest.raises(FieldError) as caught:
+        small.write(None)
+    assert str(caught.value) == (
+        "stem is not set: expected the scene's file stem, dir/name or dir/name.txt (str or pathlib.Path)"
+    )
+
+
 def test_same_seed_same_scene_other_seed_other_scene(small):
     again = generate_scene("small", seed=0)
     np.testing.assert_array_equal(again.voxels, small.voxels)

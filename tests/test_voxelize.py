@@ -275,6 +275,14 @@ def test_malformed_meshes_name_the_file(tmp_path, name, content, message):
     assert "\n" not in str(caught.value)
 
 
+def test_voxelize_given_a_path_asks_for_a_loaded_mesh(tmp_path):
+    # A mesh file's path raised AttributeError ('str' object has no attribute 'vertices').
+    with pytest.raises(FieldError) as caught:
+        voxelize(str(tmp_path / "truck.stl"), 0.1)
+    assert caught.value.field == "mesh"
+    assert str(caught.value).endswith("expected a Mesh, as load_mesh(path) reads it")
+
+
 def test_a_folder_is_not_a_mesh(tmp_path):
     with pytest.raises(InputFileError) as caught:
         load_mesh(tmp_path)

@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.errors import FieldError, check_callbacks, check_cancelled
+from ladartui.fileprobe import path_field
 from ladartui.scene.occupancy import column_bounds
 from ladartui.scene.trees import branch_voxels, concat_voxels, foliage_voxels, place_trees, trunk_voxels
 from ladartui.scene.vehicles import in_clearing, net_voxels, place_vehicles, vehicle_voxels
@@ -116,6 +117,7 @@ class GeneratedScene:
         """
         from ladartui.scene.model_files import write_model_pair
 
+        stem = path_field("stem", stem, "the scene's file stem, dir/name or dir/name.txt")
         scene_path, target_path = output_paths(stem)
         ids = self.ids() if self.params.vehicles > 1 else None
         also = {}

@@ -493,6 +493,8 @@ def voxelize(
     """
     from ladartui.resources import available_memory, gib
 
+    if not isinstance(mesh, Mesh):
+        raise FieldError("mesh", mesh, "a Mesh, as load_mesh(path) reads it")
     if solid:
         require_closed(mesh)
     triangles = grid_triangles(mesh, voxel_size, placement)
