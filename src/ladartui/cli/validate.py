@@ -169,9 +169,12 @@ def scene_summary(scenario, scene) -> list[str]:
             hi = last + 1
             need += check_occupancy(lo, hi, len(voxels), str(source))
     need += scene.voxels.nbytes + scene.target.nbytes + np.dtype(np.int32).itemsize
+    available = available_memory()
+    # Each structure is refused alone when too large; together they may still not fit.
+    short = ": more than this machine has; a run may fail for want of memory" if need > available else ""
     lines.append(
         f"memory     about {gib(need)} for the scene and its tracing structures "
-        f"({gib(available_memory())} available)"
+        f"({gib(available)} available){short}"
     )
     return lines
 
