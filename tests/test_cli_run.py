@@ -191,6 +191,21 @@ def test_las_outputs_are_named_in_words(scenario, capsys):
     assert f"wrote target LAS: {scenario.target_output.with_suffix('.las')}" in out
 
 
+def test_a_run_without_las_names_the_las_copies_an_earlier_run_left(scenario, capsys):
+    """Validate said the LAS copies were from an earlier run; the run that made them so did not."""
+    assert main(["run", str(scenario.path), "--las"]) == 0
+    capsys.readouterr()
+    assert main(["run", str(scenario.path)]) == 0
+    out = capsys.readouterr().out
+    stem = scenario.path.stem
+    assert out.splitlines()[-1] == (
+        f"note: {stem}_Scene.las and {stem}_Target.las are from an earlier run, not this one "
+        "(run --las writes them again)"
+    )
+    assert main(["run", str(scenario.path), "--las"]) == 0
+    assert "earlier run" not in capsys.readouterr().out
+
+
 def test_flags_the_run_would_ignore_or_round_are_refused(scenario, capsys):
     """--las with --no-write wrote nothing without a word; --max-rays 1.5 became 'the
     limit of 1'."""

@@ -131,9 +131,27 @@ def run(args) -> int:
             show_result(said, result, asked_precision=scenario.precision)
         if chart_line is not None:
             said.print(chart_line, highlight=False, markup=False, soft_wrap=True)
+        if result.outputs and not args.las:
+            _note_earlier_las(said, scenario)
         if chart_error is not None:
             raise chart_error
     return 0
+
+
+def _note_earlier_las(console, scenario) -> None:
+    """Name the LAS copies an earlier ``run --las`` left beside the outputs just written."""
+    from ladartui.run_record import earlier_las
+
+    left = earlier_las(scenario)
+    if left:
+        names = " and ".join(path.name for path in left)
+        verb = "are" if len(left) > 1 else "is"
+        console.print(
+            visible(f"note: {names} {verb} from an earlier run, not this one (run --las writes them again)"),
+            highlight=False,
+            markup=False,
+            soft_wrap=True,
+        )
 
 
 def run_progress(console, **options):
