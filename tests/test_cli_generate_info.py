@@ -111,6 +111,16 @@ def test_generate_las_copy(tmp_path, capsys):
     assert len(cloud.x) == len(load_voxels(tmp_path / "f.txt"))
 
 
+def test_generate_without_las_names_the_copies_an_earlier_scene_left(tmp_path, capsys):
+    """f.laz and f_Target.laz of an earlier scene stayed beside the new f.txt without a word."""
+    assert main(["generate", "small", str(tmp_path / "f"), "--las", "--trees", "5"]) == 0
+    capsys.readouterr()
+    assert main(["generate", "small", str(tmp_path / "f"), "--trees", "3"]) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == (
+        "note: f.laz and f_Target.laz are from an earlier scene, not this one (--las writes them again)"
+    )
+
+
 def test_generate_rejects_bad_input_on_one_line(tmp_path, capsys):
     assert main(["generate", "huge", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err

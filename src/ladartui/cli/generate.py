@@ -149,6 +149,11 @@ def run(args) -> int:
     else:
         print("no target")
     print(f"generated in {generated:.2f} s, written in {written:.2f} s")
+    left = [path for path in las_paths(stem) if path.exists()] if not las_files else []
+    if left:  # LAS copies of an earlier scene, which this one no longer matches
+        names = " and ".join(path.name for path in left)
+        verb = "are" if len(left) > 1 else "is"
+        print(visible(f"note: {names} {verb} from an earlier scene, not this one (--las writes them again)"))
     return 0
 
 
