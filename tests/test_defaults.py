@@ -24,6 +24,25 @@ def test_data_home_follows_the_environment(monkeypatch, tmp_path):
     assert defaults.default_folder() == user_share / "ladartui" / "default"
 
 
+@pytest.mark.parametrize(("variable", "home"), [("LADARTUI_HOME", "file"), ("XDG_DATA_HOME", "file")])
+def test_a_data_folder_that_cannot_be_made_is_one_line_naming_its_variable(
+    monkeypatch, tmp_path, capsys, variable, home
+):
+    """'run default' with LADARTUI_HOME naming a file ended in a NotADirectoryError traceback."""
+    from cli_support import one_error_line
+    from ladartui.cli import main
+
+    (tmp_path / "file").write_text("")
+    monkeypatch.delenv("LADARTUI_HOME")
+    monkeypatch.setenv(variable, str(tmp_path / home))
+    data = tmp_path / "file" if variable == "LADARTUI_HOME" else tmp_path / "file" / "ladartui"
+    for argv in (["run", "default", "--no-write"], ["bench", "--quick"]):
+        assert main(argv) == 2
+        line = one_error_line(capsys)
+        assert line.startswith(f"ladartui: error: {data}/") and ": cannot be made (not a directory); " in line
+        assert line.endswith(f"it is in the user data folder {data}, set by {variable}")
+
+
 def test_packaged_default_is_an_orbit_with_a_relative_scene(tmp_path):
     scenario = scenario_from_toml(defaults.default_scenario_text(), tmp_path / "default.toml")
     assert scenario.scene_file == tmp_path / "small.txt"

@@ -54,6 +54,27 @@ def data_home() -> Path:
     return Path(base).expanduser() / "ladartui"
 
 
+def made_folder(folder: Path) -> Path:
+    """``folder``, a folder in the user data folder, made when missing; an OutputFileError
+    naming it and the variable that placed the data folder when it cannot be made."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        from ladartui.errors import OutputFileError
+
+        reason = os.strerror(error.errno) if error.errno else str(error)
+        source = next(
+            (name for name in ("LADARTUI_HOME", "XDG_DATA_HOME") if os.environ.get(name)),
+            "default (~/.local/share/ladartui)",
+        )
+        raise OutputFileError(
+            folder,
+            f"cannot be made ({reason.lower()}); it is in the user data folder {data_home()}, "
+            f"set by {source}",
+        ) from None
+    return folder
+
+
 def default_folder() -> Path:
     return data_home() / "default"
 
@@ -86,7 +107,7 @@ def bundled_scenario_path(name: str) -> Path:
     scenario_path = folder / f"{name}.toml"
     if _complete(folder, name):
         return scenario_path
-    folder.mkdir(parents=True, exist_ok=True)
+    made_folder(folder)
     with _lock(folder / ".lock"):
         if not _complete(folder, name):  # another process may have finished meanwhile
             _materialise(folder, name)

@@ -200,10 +200,10 @@ def run_orbit_bench(quick=False, runs=None, backend="numba", progress=None) -> d
 
 
 def cache_dir() -> Path:
-    """Where the generated benchmark scene is kept between runs."""
-    from ladartui.user_data import data_home
+    """Where the generated benchmark scene is kept between runs (made when missing)."""
+    from ladartui.user_data import data_home, made_folder
 
-    return data_home() / "bench"
+    return made_folder(data_home() / "bench")
 
 
 def load_bench_scene(progress=None):
