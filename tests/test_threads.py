@@ -54,6 +54,38 @@ def test_the_users_layer_stands():
     assert _run(LAYER_AFTER_TRACE, NUMBA_THREADING_LAYER="omp") == "omp"
 
 
+@pytest.mark.parametrize(
+    ("name", "value", "message"),
+    [
+        (
+            "NUMBA_THREADING_LAYER",
+            "opm",
+            "NUMBA_THREADING_LAYER = 'opm': expected one of default, safe, threadsafe, forksafe, "
+            "tbb, omp, workqueue",
+        ),
+        ("NUMBA_NUM_THREADS", "0", "NUMBA_NUM_THREADS = '0': expected a whole number of threads, 1 or more"),
+        (
+            "NUMBA_NUM_THREADS",
+            "two",
+            "NUMBA_NUM_THREADS = 'two': expected a whole number of threads, 1 or more",
+        ),
+    ],
+)
+def test_a_bad_numba_thread_setting_is_one_line_naming_it(
+    monkeypatch, capsys, tmp_path, name, value, message
+):
+    """A misspelt layer or a thread count of 0 ended a run in numba's ValueError traceback."""
+    from cli_support import one_error_line
+    from ladartui.cli import main
+
+    monkeypatch.setenv(name, value)
+    assert main(["trace", "--scene", str(tmp_path / "s.txt"), "--rays", "r.npy", "--out", "h.npy"]) == 2
+    assert one_error_line(capsys) == f"ladartui: error: {message}"
+    for good in ("OMP", "tbb", "") if name == "NUMBA_THREADING_LAYER" else ("1", "16", ""):
+        monkeypatch.setenv(name, good)
+        assert threads.environment_problem() is None
+
+
 def test_no_runtime_no_load(tmp_path, monkeypatch):
     monkeypatch.setattr(sys, "prefix", str(tmp_path))
     monkeypatch.setattr(sys, "base_prefix", str(tmp_path))

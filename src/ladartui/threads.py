@@ -45,6 +45,23 @@ def load_tbb() -> bool:
     return True
 
 
+# The layers numba's NUMBA_THREADING_LAYER names (any case); another ends a parallel run.
+NUMBA_LAYERS = ("default", "safe", "threadsafe", "forksafe", "tbb", "omp", "workqueue")
+
+
+def environment_problem() -> str | None:
+    """What is wrong with numba's NUMBA_THREADING_LAYER or NUMBA_NUM_THREADS, in one line:
+    numba raises on the first parallel kernel (an unknown layer, a count under 1) or
+    drops a count it cannot read without a word. None when both are fine or unset."""
+    layer = os.environ.get("NUMBA_THREADING_LAYER", "")
+    if layer.strip() and layer.lower() not in NUMBA_LAYERS:
+        return f"NUMBA_THREADING_LAYER = {layer!r}: expected one of {', '.join(NUMBA_LAYERS)}"
+    count = os.environ.get("NUMBA_NUM_THREADS", "")
+    if count.strip() and not (count.strip().isdigit() and int(count) >= 1):
+        return f"NUMBA_NUM_THREADS = {count!r}: expected a whole number of threads, 1 or more"
+    return None
+
+
 def configure() -> None:
     """Prefer TBB; shorten OpenMP's spin for where numba falls back to it.
 

@@ -21,6 +21,7 @@ from ladartui import __version__
 from ladartui.cli.progress import reset_stop, stop_status
 from ladartui.errors import Cancelled, LadarError
 from ladartui.textsafe import one_line
+from ladartui.threads import environment_problem
 
 # Command name -> module under ladartui.cli. Modules load only when needed.
 COMMANDS = {
@@ -103,6 +104,9 @@ def main(argv: list[str] | None = None) -> int:
         if getattr(args, "handler", None) is None:
             parser.print_help()
             return 2
+        problem = environment_problem()  # before numba fails on it mid-command
+        if problem:
+            raise LadarError(problem)
         return int(args.handler(args) or 0)
     except LadarError as error:
         print(f"ladartui: error: {one_line(error)}", file=sys.stderr)
