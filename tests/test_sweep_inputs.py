@@ -450,6 +450,27 @@ def test_the_tui_sweep_job_reads_and_hashes_the_base_once(tmp_path, monkeypatch)
     assert again.resumed == 2 and len(digests) == 1
 
 
+def test_more_local_workers_than_the_machine_can_hold_are_refused(tiny, tmp_path, capsys, monkeypatch):
+    """--workers 99999999999999999999999 started worker processes until the command was killed."""
+    import os
+
+    import ladartui.sweep.execute as execute
+    from ladartui.cli import main
+
+    def refuse(workers=None):
+        raise AssertionError("a cluster was started")
+
+    monkeypatch.setattr(execute, "local_client", refuse)
+    limit = 4 * (os.cpu_count() or 1)
+    spec = write_spec(tiny, "[grid]\nradius = [20.0]\n", name="workers.toml")
+    assert main(["sweep", str(spec), "--workers", str(limit + 1), "--out", str(tmp_path / "o")]) == 2
+    assert one_error_line(capsys) == (
+        f"ladartui: error: --workers = {limit + 1}: expected at most {limit} local worker processes "
+        f"(4 per core of this machine's {os.cpu_count()})"
+    )
+    assert not (tmp_path / "o").exists()
+
+
 @pytest.mark.parametrize("mode", [[], ["--serial"], ["--workers", "1"]])
 def test_a_connect_timeout_without_a_scheduler_is_refused(tiny, tmp_path, capsys, mode):
     """--connect-timeout 5 on a local sweep was taken and ignored: only a connection to a

@@ -80,7 +80,7 @@ def add_parser(subparsers):
         "--workers",
         metavar="N",
         type=int,
-        help="worker processes of the local cluster (default: one per core)",
+        help="worker processes of the local cluster (default: one per core; at most 4 per core)",
     )
     parser.add_argument(
         "--serial", action="store_true", help="run the variants one by one in this process, without Dask"
@@ -143,6 +143,9 @@ def run(args) -> int:
         args.connect_timeout = DEFAULT_CONNECT_TIMEOUT
     if args.workers is not None and args.workers < 1:
         raise FieldError("--workers", args.workers, "an integer >= 1")
+    from ladartui.sweep.cluster import check_local_workers
+
+    check_local_workers(args.workers, "--workers")
     if args.serial and args.workers is not None:
         raise FieldError(
             "--workers", args.workers, "no --workers with --serial (one process runs every variant)"

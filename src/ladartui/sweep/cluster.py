@@ -16,6 +16,18 @@ import signal
 from ladartui.errors import FieldError, LadarError
 
 
+def check_local_workers(workers: int | None, name: str = "workers") -> None:
+    """FieldError naming ``name`` for more local worker processes than 4 per core: a
+    mistyped count started workers until the machine gave out."""
+    cores = os.cpu_count() or 1
+    if workers is not None and workers > 4 * cores:
+        raise FieldError(
+            name,
+            workers,
+            f"at most {4 * cores} local worker processes (4 per core of this machine's {cores})",
+        )
+
+
 def local_client(workers: int | None = None):
     """A client of a new LocalCluster: ``workers`` processes (default one per core), 1 thread each.
 

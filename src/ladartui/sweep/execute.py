@@ -32,7 +32,7 @@ from ladartui.fileprobe import path_field
 from ladartui.precompile import compile_ahead
 from ladartui.sweep.base import CheckedBase, checked_base, own_rows, spec_rows
 from ladartui.sweep.best_file import best_files, write_best_scenario
-from ladartui.sweep.cluster import close_client, local_client
+from ladartui.sweep.cluster import check_local_workers, close_client, local_client
 from ladartui.sweep.ranking import (
     BUDGET_OBJECTIVES,
     COSTS,
@@ -215,6 +215,8 @@ def run_sweep(
         )
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise FieldError("workers", workers, "an integer >= 1")
+    if client is None and not serial:
+        check_local_workers(workers)
     out = Path(out) if out is not None else default_out_dir(spec)
     if out.exists() and not out.is_dir():
         raise OutputFileError(out, "is a file, expected a folder")
