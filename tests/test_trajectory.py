@@ -113,6 +113,29 @@ def test_a_log_in_latitude_and_longitude_flies_the_same_poses_as_its_local_copy(
         LogSegment(str(geo), rate=2.0, origin=[95.0, 0.0, 0.0])
 
 
+def test_an_origin_for_a_log_in_scene_metres_is_refused(tmp_path):
+    """origin = [lat, lon, alt] beside an x,y,z log was taken and ignored without a word."""
+    from pathlib import Path
+
+    from ladartui.scenario import load_scenario
+    from ladartui.trajectory import LogSegment
+
+    log = Path(__file__).parent.parent / "scenarios" / "flight-log.csv"
+    with pytest.raises(FieldError) as caught:
+        LogSegment(str(log), rate=2.0, origin=[51.0, -1.0, 0.0])
+    assert str(caught.value) == (
+        f"origin = (51.0, -1.0, 0.0): expected none: {log.name} is in scene metres (x, y, z); "
+        "an origin places a log in latitude and longitude"
+    )
+    path = tmp_path / "s.toml"
+    path.write_text(
+        '[files]\nscene = "s.txt"\n[[flight.segments]]\nkind = "log"\n'
+        f'file = "{log}"\nrate = 2.0\norigin = [51.0, -1.0, 0.0]\n'
+    )
+    with pytest.raises(FieldError, match=r"s\.toml:7: flight\.segments\[0\]\.origin = "):
+        load_scenario(path, check_files=False)
+
+
 def test_scan_times_out_of_order_are_refused(tmp_path):
     """times = [0.9, 0.1, 0.5] was taken: the aircraft flew backwards along its log."""
     from pathlib import Path
@@ -192,7 +215,7 @@ def test_a_bad_log_column_or_value_is_named_in_the_log(tmp_path, header, record,
         first += ",5"
     path.write_text(f"{header}\n{first}\n{record}\n")
     with pytest.raises(TrajectoryError) as caught:
-        load_flight_log(path, origin=(-35.28, 149.13, 560.0))
+        load_flight_log(path, origin=(-35.28, 149.13, 560.0) if "latitude" in header else None)
     assert str(caught.value).startswith(f"{path.parent}/{said}")
 
 

@@ -119,6 +119,13 @@ def load_flight_log(path, origin=None) -> FlightLog:
             f"expected columns {', '.join(REQUIRED)}, or time, latitude, "
             "longitude, altitude, heading (optional roll, pitch)"
         )
+    if origin is not None and not geodetic:  # it would be taken and never used
+        raise FieldError(
+            "origin",
+            tuple(origin),
+            f"none: {path.name} is in scene metres (x, y, z); an origin places a log in "
+            "latitude and longitude",
+        )
     if geodetic and origin is None:
         raise TrajectoryError(
             f"{path}:{header_line}: a log in latitude and longitude needs "
