@@ -189,6 +189,28 @@ def test_info_on_a_target_model_looks_for_no_target_model_of_it(tmp_path, capsys
     assert "target" not in rows and rows["targets"].split(None, 1)[1] == "2 targets (ids 1, 2)"
 
 
+def test_info_on_a_runs_outputs_says_they_are_a_runs_outputs(tmp_path, capsys):
+    """S_Scene.txt was said to have no target model (S_Scene_Target.txt not found), and
+    S_Target.txt, the voxels the target-only run saw, was read as a target model."""
+    (tmp_path / "S_Run.toml").write_text("# ladartui run record: the settings that made ...\n")
+    (tmp_path / "S_Scene.txt").write_text("1,1,1\n2,2,2\n")
+    (tmp_path / "S_Target.txt").write_text("1,1,1\n")
+    assert main(["info", str(tmp_path / "S_Scene.txt")]) == 0
+    rows = {line.split()[0]: line.split(None, 1)[1] for line in capsys.readouterr().out.splitlines()[1:]}
+    assert "target" not in rows
+    assert (
+        rows["output"]
+        == "the scene run's returns of a run of S.toml (S_Run.toml); S_Target.txt: the target run's"
+    )
+    assert main(["info", str(tmp_path / "S_Target.txt")]) == 0
+    rows = {line.split()[0]: line.split(None, 1)[1] for line in capsys.readouterr().out.splitlines()[1:]}
+    assert "targets" not in rows
+    assert (
+        rows["output"]
+        == "the target run's returns of a run of S.toml (S_Run.toml); S_Scene.txt: the scene run's"
+    )
+
+
 def test_info_bad_file_is_one_line(tmp_path, capsys):
     (tmp_path / "bad.txt").write_text("1,2,3\n1,2\n")
     assert main(["info", str(tmp_path / "bad.txt")]) == 2

@@ -97,7 +97,8 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
         voxel_size_flag(voxel_size)  # as trace takes it: not inf, not 1e308
     started = time.perf_counter()
     ids = None
-    is_target_model = path.stem.endswith("_Target")
+    output = _run_output(path)
+    is_target_model = path.stem.endswith("_Target") and output is None
     if is_target_model:  # x,y,z or x,y,z,id lines
         voxels, ids = load_target(path)
         duplicates = 0
@@ -121,8 +122,11 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
         rows.append(("extent", f"{ranges}  (shape {shape[0]} x {shape[1]} x {shape[2]})"))
         if voxel_size:
             rows.append(("extent (m)", f"{extent_metres(shape, voxel_size)} at {voxel_size:g} m"))
-    # A target model's own targets are counted above: it has no target model of its own.
-    target_path = None if is_target_model else target_path_for(path)
+    if output is not None:
+        rows.append(("output", output))
+    # A target model's own targets are counted above: it has no target model of its own;
+    # a run's outputs are a pair of their own.
+    target_path = None if is_target_model or output is not None else target_path_for(path)
     if target_path is not None and target_path.is_file():
         target, ids = load_target(target_path)
         text = f"{target_path.name}: {plural(len(target), 'voxel')}"
@@ -143,6 +147,26 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
     width = max(len(name) for name, _ in rows)
     for name, text in rows:
         print(visible(f"  {name:<{width}}  {text}"))
+
+
+def _run_output(path: Path) -> str | None:
+    """What a run's output S_Scene.txt or S_Target.txt is, where its record S_Run.toml lies
+    beside it; None for any other voxel list."""
+    from ladartui.scenario_file import RECORD_SUFFIX, is_record
+
+    for run, other, what, others in (
+        ("_Scene", "_Target", "scene", "target"),
+        ("_Target", "_Scene", "target", "scene"),
+    ):
+        if path.stem.endswith(run):
+            stem = path.stem.removesuffix(run)
+            record = path.with_name(stem + RECORD_SUFFIX)
+            if is_record(record):
+                return (
+                    f"the {what} run's returns of a run of {stem}.toml ({record.name}); "
+                    f"{stem}{other}{path.suffix}: the {others} run's"
+                )
+    return None
 
 
 def _targets_text(ids) -> str:
