@@ -51,6 +51,18 @@ def test_trace_writes_hits(tmp_path, scene_file, capsys):
     )
 
 
+def test_the_summary_writes_every_count_with_thousands_separators(tmp_path, scene_file, capsys):
+    """It read '4,000,000 rays ...: 1032144 voxel, 1595342 ground, ...'."""
+    rays = np.repeat(
+        [[5.0, 5.0, 20.0, 0.0, 0.0, -1.0], [2.0, 2.0, 20.0, 0.0, 0.0, -1.0]], [1200, 3400], axis=0
+    )
+    np.save(tmp_path / "rays.npy", rays)
+    out = tmp_path / "hits.npy"
+    args = ["trace", "--scene", str(scene_file), "--rays", str(tmp_path / "rays.npy"), "--out", str(out)]
+    assert main([*args, "--voxel-size", "1"]) == 0
+    assert capsys.readouterr().err.endswith(f": 1,200 voxel, 3,400 ground, 0 miss -> {out}\n")
+
+
 def test_trace_march_with_voxel_size(tmp_path, scene_file, capsys):
     rays = np.array([[1.25, 1.25, 10.0, 0.0, 0.0, -1.0]])  # 0.25 m voxels: cell (5, 5)
     np.save(tmp_path / "rays.npy", rays)

@@ -215,7 +215,7 @@ def _trace_and_write(args, voxel_size: float) -> None:
     print(
         visible(
             f"{plural(len(rays), 'ray')} ({result.backend}, {result.method}, {used}), {size}: "
-            f"{counts[1]} voxel, {counts[2]} ground, {counts[0]} miss -> {args.out}"
+            f"{counts[1]:,} voxel, {counts[2]:,} ground, {counts[0]:,} miss -> {args.out}"
         ),
         file=sys.stderr,
     )
