@@ -92,3 +92,14 @@ def test_output_into_a_closed_pipe_ends_quietly(tmp_path, command):
     err = child.stderr.read().decode()
     assert child.wait(timeout=120) == 141  # as a shell reports SIGPIPE
     assert "Traceback" not in err and "rror" not in err  # said nothing of it (run: its progress)
+
+
+@pytest.mark.parametrize("command", ["run", "validate", "pulses", "study"])
+def test_a_mistyped_bundled_name_names_the_bundled_scenarios(tmp_path, capsys, monkeypatch, command):
+    """'run defualt' said only 'no such file; expected a scenario file (.toml)'."""
+    monkeypatch.chdir(tmp_path)
+    assert cli.main([command, "defualt"]) == 2
+    assert capsys.readouterr().err == (
+        f"ladartui: error: {tmp_path / 'defualt'}: no such file; "
+        "expected a scenario file (.toml) or a bundled scenario: default, convoy\n"
+    )

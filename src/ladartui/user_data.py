@@ -128,6 +128,13 @@ def bundled_or_path(argument) -> Path:
     name = bundled_scenario_name(argument)
     if name is not None and not path.exists():
         return bundled_scenario_path(name)
+    if path.parent == Path(".") and path.suffix in ("", ".toml") and not path.exists():
+        from ladartui.errors import InputFileError
+        from ladartui.fileprobe import NO_SUCH_FILE
+
+        # a bare name: perhaps a bundled one mistyped
+        expected = "expected a scenario file (.toml) or a bundled scenario: " + ", ".join(BUNDLED)
+        raise InputFileError(path.absolute(), f"{NO_SUCH_FILE}; {expected}")
     return path
 
 
