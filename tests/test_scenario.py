@@ -420,6 +420,18 @@ def test_relative_segment_first_needs_a_start(tmp_path):
             "headin = 0.0",
             "unknown key 'flight.start.headin' (allowed: x, y, z, heading, azimuth, depression)",
         ),
+        # arrays of tables had no line ("[[flight.segmnts]]" was named without one)
+        (
+            "[[flight.segments]]",
+            "[[flight.segmnts]]",
+            "unknown key 'flight.segmnts' (allowed: speed_mps, start, segments)",
+        ),
+        (
+            "[simulation]",
+            "[[simulatoin]]",
+            "unknown section [simulatoin] "
+            "(allowed: files, sensor, flight, simulation, detection, levels, targets)",
+        ),
     ],
 )
 def test_unknown_keys_are_named_with_their_line(tmp_path, old, new, message):

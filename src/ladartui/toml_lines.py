@@ -40,6 +40,7 @@ def key_lines_from_text(text: str) -> dict[str, int]:
         if header:
             name = _indexed(header.group(2), arrays)
             if header.group(1) == "[[":
+                lines.setdefault(name, number)  # the array itself: its first table
                 arrays[header.group(2)] = arrays.get(header.group(2), -1) + 1
                 name = f"{name}[{arrays[header.group(2)]}]"
             current = name
