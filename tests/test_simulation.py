@@ -185,6 +185,9 @@ def test_bad_arguments_are_field_errors_before_anything_runs(forest):
         (dict(progress=3), r"^progress = 3: expected a function"),
         (dict(scene="forest.txt"), r"^scene = 'str': expected the scenario's Scene"),
         (dict(scene=other), r"^scene\.voxel_size = 0\.5: expected the scenario's voxel size \(1\.0\)"),
+        # a string is true: write="no" wrote the outputs
+        (dict(write="no"), r"^write = 'no': expected True or False"),
+        (dict(las="no"), r"^las = 'no': expected True or False"),
     ]
     for arguments, message in cases:
         with pytest.raises(FieldError, match=message):

@@ -128,6 +128,9 @@ def simulate(
 
         scenario = load_scenario(scenario)
     _check_arguments(scenario, progress, cancel, scene)
+    for name, value in (("write", write), ("las", las)):
+        if not isinstance(value, (bool, np.bool_)):
+            raise FieldError(name, value, "True or False")
     with contextlib.ExitStack() as stack:
         output_set = stack.enter_context(_output_set(scenario, las)) if write else None
         return _simulate(scenario, backend, method, step, precision, progress, cancel, output_set, scene)
