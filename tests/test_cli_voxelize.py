@@ -138,6 +138,8 @@ def test_malformed_mesh_is_one_line(tmp_path, capsys, name, content, message):
         (["--voxel-size", "1e308"], "--voxel-size = 1e+308: expected a number of metres greater than 0"),
         (["--at", "0.5,5"], "--at = '0.5,5': expected a position keeping the mesh inside the scene"),
         (["--at", "5,5,-1"], "--at = '5,5,-1': expected a height of 0 m or more above the ground"),
+        # 1e23 degrees was taken: at that size a float holds no angle
+        (["--at", "5,5", "--heading", "1e23"], "--heading = 1e+23: expected degrees clockwise from north, "),
     ],
 )
 def test_bad_flags_are_one_line(tmp_path, truck, capsys, extra, message):

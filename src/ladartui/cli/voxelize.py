@@ -85,8 +85,8 @@ def run(args) -> int:
     voxel_size_flag(args.voxel_size)  # the scene's, so one a scenario takes
     if not (args.scale > 0 and math.isfinite(args.scale)):
         raise FieldError("--scale", args.scale, "a positive number of metres per mesh unit")
-    if not math.isfinite(args.heading):
-        raise FieldError("--heading", args.heading, "degrees clockwise from north")
+    if not (math.isfinite(args.heading) and abs(args.heading) <= 360.0):
+        raise FieldError("--heading", args.heading, "degrees clockwise from north, -360 to 360")
     if args.id is not None and not 1 <= args.id <= MAX_TARGET_ID:
         raise FieldError("--id", args.id, f"a target id from 1 to {MAX_TARGET_ID}")
     if args.at is None and (args.heading or args.into):
