@@ -38,12 +38,16 @@ class SweepOpening(RankingView):
     running: bool
     opening: Worker | None  # the last open asked for
     _opens: int  # opens asked for: an answer to an earlier one is dropped
+    _focus_table: bool  # the last open was asked for, so its table takes the focus
     _status: Callable[..., None]  # the screen's status bar (SweepScreen._status)
 
-    def _open(self, text: str) -> None:
+    def _open(self, text: str, focus_table: bool = True) -> None:
         """Open a spec or results in a worker (``open_sweep`` reads the table and hashes
-        the base's models, which can take seconds); ``_show_opened`` shows them."""
+        the base's models, which can take seconds); ``_show_opened`` shows them.
+        ``focus_table``: False for the screen's own reopen, which leaves the focus (and
+        what is typed next) in the Spec field."""
         self._opens += 1
+        self._focus_table = focus_table
         number = self._opens
 
         def read(cancel, progress):
@@ -93,7 +97,8 @@ class SweepOpening(RankingView):
         self.progress = None
         self._redraw()
         self._show_stored(len(spec.variants) if spec else len(self.rows))
-        self.query_one("#sweep-table", DataTable).focus()
+        if self._focus_table and (self.focused is None or self.focused.id == "sweep-path"):
+            self.query_one("#sweep-table", DataTable).focus()
         self._status(
             READY,
             f"ranked by {self.objective}: {self._summary()}{others}; {short_path(result.results_path)}",

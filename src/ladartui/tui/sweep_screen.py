@@ -140,6 +140,7 @@ class SweepScreen(SweepOpening):
         self.worker: Worker | None = None  # the sweep job while it runs
         self.opening: Worker | None = None  # the last open asked for (read off the UI thread)
         self._opens = 0  # opens asked for: an answer to an earlier one is dropped
+        self._focus_table = False  # the last open was asked for: its table takes the focus
         self._dirty = False  # rows arrived since the last redraw (redrawn a few times a second)
         self._row_index: dict[str, int] = {}  # variant id -> position in rows, while running
         self._shown_ids: list = []  # variant ids in table order
@@ -205,8 +206,8 @@ class SweepScreen(SweepOpening):
             if last:
                 self.initial_path = str(last[0])
                 self.query_one("#sweep-path", Input).value = self.initial_path
-        if self.initial_path:
-            self._open(self.initial_path)
+        if self.initial_path:  # not asked for by a key: typing still goes to the Spec field
+            self._open(self.initial_path, focus_table=False)
 
     # -- paths and checks -------------------------------------------------------
 
