@@ -162,3 +162,17 @@ async def test_the_table_marks_the_best_variant_as_the_chart_and_its_legend_do(s
         for entry, mark in zip(screen.ranking[1:], marks[1:]):
             assert mark == (front if entry.pareto else "")
         assert f"{best} best" in str(screen.query_one("#sweep-detail").render())  # the cursor's row
+
+
+async def test_rows_left_out_of_the_ranking_are_said_first_on_the_status_line(swept, tmp_path):
+    """A spec narrowed after its run opened as '...: 1 variants, 1 ok, 0 failed; 1…' at
+    80 columns: the rows of other variants left out of the ranking were cut away."""
+    spec = copy_of(swept, tmp_path / "sw")
+    narrowed = write_spec(spec.parent, "[grid]\nradius = [15.0]\n")
+    screen = SweepScreen(narrowed)
+    async with _Host(screen).run_test(size=SIZE) as pilot:
+        await opened(pilot)
+        await wait_for(pilot, lambda: "ranked by" in screen.last_message)
+        shown = screen.query_one("#sweep-status StatusText", StatusText).render().plain
+        assert shown.startswith("1 row not ranked: other variants or an earlier base;"), shown
+        assert "ranked by obscured-coverage: 1 variants, 1 ok" in screen.last_message

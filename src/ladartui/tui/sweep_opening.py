@@ -86,13 +86,13 @@ class SweepOpening(RankingView):
         self.rows, self.ranking = result.rows, result.ranking
         self.objective, self.cost, self.budget = result.objective, result.cost, result.budget
         self.parameter_names = spec.parameter_names if spec else result.parameter_names
-        others = ""
+        left_out = ""
         if own is not None and len(own) < len(result.rows):
             self.rows = own
-            others = (
-                f"; {len(result.rows) - len(own)} rows of other variants or an earlier base "
-                "in the folder left out"
-            )
+            count = len(result.rows) - len(own)
+            # said first: after the ranking's words it was cut off at 80 columns
+            rows = "row" if count == 1 else "rows"
+            left_out = f"{count} {rows} not ranked: other variants or an earlier base; "
             self._rank_quietly()
         self.progress = None
         self._redraw()
@@ -101,6 +101,6 @@ class SweepOpening(RankingView):
             self.query_one("#sweep-table", DataTable).focus()
         self._status(
             READY,
-            f"ranked by {self.objective}: {self._summary()}{others}; {short_path(result.results_path)}",
+            f"{left_out}ranked by {self.objective}: {self._summary()}; {short_path(result.results_path)}",
         )
         remember_path("sweeps", path)  # the screen reopens it next time
