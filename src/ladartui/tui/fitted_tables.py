@@ -2,7 +2,8 @@
 
 A column cut at a table's edge reads as another value (a depression of 44.6
 cut to "4", "r 60 m at 6", 19.1 ms as "19."), so these tables either wrap a
-long last column onto more lines, whole (the Flight tab's segments), or show
+long last column onto more lines, whole (the Flight tab's segments; a file
+name breaks after a hyphen or a dot), or show
 whole columns only and name the ones there is no room for (its scans, the
 study screen's settings). Widths are counted in terminal cells (a wide
 character takes two).
@@ -19,6 +20,8 @@ from textual.widgets import DataTable
 
 SEGMENT_COLUMNS = ("#", "Kind", "Scans", "Detail")  # the Flight tab's
 UNITS = frozenset({"m", "deg", "Hz", "times", "pose", "poses"})  # kept beside their numbers
+BREAK_AFTER = ("-_/", ".")  # where a long file name breaks, the first kind preferred
+PUNCTUATION = ",;:."  # never a line's start on its own
 
 
 class FittingTable(DataTable):
@@ -71,14 +74,26 @@ def wrap_detail(text: str, room: int) -> list[str]:
             continue
         if line:
             lines.append(line)
-        while cell_len(word) > room:  # a long file name: cut it, cell by cell
-            cut = len(word)
-            while cut > 1 and cell_len(word[:cut]) > room:
-                cut -= 1
+        while cell_len(word) > room:  # a long file name: cut where it reads best
+            cut = _cut(word, room)
             lines.append(word[:cut])
             word = word[cut:]
         line = word
     return [*lines, line] if line or not lines else lines
+
+
+def _cut(word: str, room: int) -> int:
+    """Where to break ``word``, wider than ``room``: after the last hyphen, underscore or
+    slash that fits, else a dot, else at the room's edge, but never leaving only
+    punctuation for the next line (a file name's comma began one: ", 2 Hz")."""
+    fits = len(word)
+    while fits > 1 and cell_len(word[:fits]) > room:
+        fits -= 1
+    for marks in BREAK_AFTER:
+        after = max((i + 1 for i, char in enumerate(word[:fits]) if char in marks), default=0)
+        if after:
+            return after
+    return fits - 1 if fits > 1 and not word[fits:].strip(PUNCTUATION) else fits
 
 
 def fill_whole_columns(
