@@ -106,7 +106,7 @@ async def test_the_poses_dialog_keeps_a_refused_value_and_ok_applies_the_row(tmp
         assert app.screen is screen and app.focused is x
         assert (
             message(screen, "#poses-message")
-            == "x: xyz is not allowed; expected a number from -1000000 to 1000000"
+            == "x m: xyz is not allowed; expected a number from -1000000 to 1000000 m"
         )
         screen.query_one("#pose-apply").press()
         await pilot.pause()

@@ -15,7 +15,7 @@ from textual.widgets import Button, DataTable, Input, Label, Static
 
 from ladartui.errors import FieldError, LadarError
 from ladartui.tui import bridge
-from ladartui.tui.fields import NumberField, parse_number, refusal
+from ladartui.tui.fields import NumberField, in_label_unit, parse_number, refusal
 from ladartui.tui.screens import Dialog, field_matches
 
 
@@ -28,20 +28,31 @@ class PosesScreen(Dialog):
         Binding("delete", "delete_pose", "Delete pose"),
     ]
     COLUMNS = ("x", "y", "z", "heading", "azimuth", "depression")
+    # with their units, as the segment forms and the sidebar name them (limits in messages too)
+    LABELS = {
+        "x": "x m",
+        "y": "y m",
+        "z": "z m",
+        "heading": bridge.FIELD_LABELS["heading"],
+        "azimuth": bridge.FIELD_LABELS["azimuth"],
+        "depression": bridge.FIELD_LABELS["depression"],
+    }
 
-    def __init__(self, poses, defaults):
+    def __init__(self, poses, defaults, new: bool = False):
+        """``new``: the poses of a segment not yet in the path (the title says so)."""
         super().__init__()
         self.poses = list(poses)
         self.defaults = defaults
+        self.new = new
         self.shown_row = -1
 
     def compose(self) -> ComposeResult:
         with Vertical(classes="dialog") as box:
-            box.border_title = "Manual scan poses"
+            box.border_title = "Manual scan poses" + (" (new)" if self.new else "")
             yield DataTable(id="poses-table", cursor_type="row", zebra_stripes=True)
             with Grid(id="pose-fields"):
                 for name in self.COLUMNS:
-                    yield Label(name)
+                    yield Label(self.LABELS[name])
                 for name in self.COLUMNS:
                     yield NumberField(
                         name,
@@ -60,13 +71,16 @@ class PosesScreen(Dialog):
 
     DEFAULT_CSS = """
     PosesScreen #poses-table { height: 10; }
-    PosesScreen #pose-fields { grid-size: 6 2; height: 2; grid-gutter: 0 1; }
+    PosesScreen #pose-fields {
+        grid-size: 6 2; height: 2; grid-gutter: 0 1;
+        grid-columns: 1fr 1fr 1fr 14 14 14;  /* "Depression deg" whole at 80 columns */
+    }
     PosesScreen .buttons Button { min-width: 0; width: auto; padding: 0 1; }
     """
 
     def on_mount(self) -> None:
         table = self.query_one(DataTable)
-        table.add_columns("#", *self.COLUMNS)
+        table.add_columns("#", *(self.LABELS[name] for name in self.COLUMNS))
         self._fill()
         table.focus()
 
@@ -127,10 +141,9 @@ class PosesScreen(Dialog):
         problem = widget.problem()
         if problem:
             widget.add_class("-bad")
-            expected = problem.split("expected ", 1)[-1]
-            self.query_one("#poses-message", Static).update(
-                escape(refusal(widget.field_name, widget.value, expected))
-            )
+            label = self.LABELS[widget.field_name]
+            expected = in_label_unit(label, problem.split("expected ", 1)[-1])
+            self.query_one("#poses-message", Static).update(escape(refusal(label, widget.value, expected)))
         return problem is None
 
     def _refused(self) -> bool:

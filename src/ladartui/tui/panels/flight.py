@@ -203,7 +203,7 @@ class FlightPanel(ParamPanel):
             what = "add manual poses" if index is None else f"edit poses of segment {index + 1}"
             self._put_segment(index, Manual(tuple(result)), what)
 
-        self.app.push_screen(PosesScreen(poses, bridge.start_pose(scenario)), done)
+        self.app.push_screen(PosesScreen(poses, bridge.start_pose(scenario), new=index is None), done)
 
     @on(Button.Pressed, "#seg-edit")
     def _edit_pressed(self, event: Button.Pressed) -> None:

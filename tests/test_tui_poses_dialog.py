@@ -1,0 +1,47 @@
+"""The manual poses dialog reads as the segment forms do: "(new)" in its title for a
+new segment, and its fields' units in their labels, so a refusal gives its limits in
+metres or degrees."""
+
+from __future__ import annotations
+
+from ladartui.flight import FlightPlan, Manual, ScanPose
+from ladartui.tui.poses_screen import PosesScreen
+from test_tui_dialogs import opened
+from test_tui_flow import make_scenario, type_into, wait_until
+
+
+def title_of(screen) -> str:
+    return str(screen.query_one(".dialog").border_title)
+
+
+async def test_the_poses_dialog_says_new_and_gives_its_fields_units(tmp_path, scene_files):
+    """Its title was 'Manual scan poses' for a new segment too, and 'x: abc is not
+    allowed; expected a number from -1000000 to 1000000' had no unit."""
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario, size=(80, 24)) as (app, pilot):
+        app.action_manual_poses()
+        await wait_until(
+            pilot, lambda: isinstance(app.screen, PosesScreen) and app.screen.query("#p-x"), timeout=10.0
+        )
+        screen = app.screen
+        assert title_of(screen) == "Manual scan poses (new)"
+        labels = [str(label.render()) for label in screen.query("#pose-fields Label")]
+        assert labels == ["x m", "y m", "z m", "Heading deg", "Sensor az deg", "Depression deg"]
+        await type_into(pilot, screen.query_one("#p-x"), "abc", commit="tab")
+        said = str(screen.query_one("#poses-message").render())
+        assert said == "x m: abc is not allowed; expected a number from -1000000 to 1000000 m", said
+        await type_into(pilot, screen.query_one("#p-depression"), "200", commit="tab")
+        said = str(screen.query_one("#poses-message").render())
+        assert said.startswith("Depression deg: 200 is not allowed") and said.endswith(" deg"), said
+
+
+async def test_the_poses_dialog_for_a_manual_segment_is_not_new(tmp_path, scene_files):
+    scenario = make_scenario(tmp_path, scene_files)
+    segments = (Manual((ScanPose(0.0, 0.0, 40.0),)),)
+    scenario = scenario.with_changes(flight=FlightPlan(None, segments)).save()
+    async with opened(scenario, size=(80, 24)) as (app, pilot):
+        app.action_manual_poses()  # the selected segment is the manual one
+        await wait_until(
+            pilot, lambda: isinstance(app.screen, PosesScreen) and app.screen.query("#p-x"), timeout=10.0
+        )
+        assert title_of(app.screen) == "Manual scan poses"
