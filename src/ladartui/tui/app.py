@@ -387,7 +387,12 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         if self.measures is None:
             self.tell("No measures yet: run the scenario first (F5).", severity="warning")
             return
-        self.push_screen(MeasuresScreen(self.measures))
+        made_with = self.outputs_made_with()
+        stale = ""
+        if made_with is not None:  # as the Results tab and the status bar say it
+            reruns = self.key_says("run", "reruns")
+            stale = f"Out of date: made from {made_with}" + (f" {reruns}." if reruns else "")
+        self.push_screen(MeasuresScreen(self.measures, stale=stale))
 
     def action_compare(self) -> None:
         paths = []

@@ -311,16 +311,24 @@ def _parse_points(name, text, kind):
 class MeasuresScreen(Dialog):
     """The measures of the last run (report figure 10)."""
 
-    def __init__(self, measures, title="Comparison measures"):
+    def __init__(self, measures, title="Comparison measures", stale: str = ""):
+        """``stale``: why the measures are out of date, said above them (empty: they are not)."""
         super().__init__()
         self.measures = measures
-        self.title_text = title
+        self.title_text = title + (" (out of date)" if stale else "")
+        self.stale = stale
 
-    DEFAULT_CSS = "MeasuresScreen DataTable { height: auto; max-height: 18; }"
+    DEFAULT_CSS = """
+    MeasuresScreen DataTable { height: auto; max-height: 18; }
+    /* the status bar's not-ready colours: out of date reads the same everywhere */
+    MeasuresScreen #measures-stale { height: auto; padding: 0 1; background: #3a3000; color: #ffffd7; }
+    """
 
     def compose(self) -> ComposeResult:
         with Vertical(classes="dialog") as box:
             box.border_title = self.title_text
+            if self.stale:  # words from settings and file names: never markup
+                yield Static(self.stale, id="measures-stale", markup=False)
             yield DataTable(cursor_type="row", zebra_stripes=True)
             with Horizontal(classes="buttons"):
                 yield Button("Close", id="measures-close", variant="primary", compact=True)
