@@ -43,10 +43,12 @@ from ladartui.tui.screens import (
     MeasuresScreen,
     ThresholdScreen,
 )
+from ladartui.tui.startup_problems import startup_notice
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
 from ladartui.tui.unsaved import EditGuard
 from ladartui.tui.view_area import LAYOUTS, OUTPUT_POINTS, ViewArea
 from ladartui.tui.work import JobDone, JobProgress, start_job
+from ladartui.user_data import config_folder
 
 # everything the analyst can change; disabled while busy (Cancel is re-enabled)
 CONTROLS = (
@@ -153,10 +155,12 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         self.view_area = self.query_one(ViewArea)
         runs = self.key_says("run", "runs")
         self.view_area.no_output = "no output yet" + (f": {runs}" if runs else "")
-        for problem in self.keymap_problems:
-            self.tell(problem, title="Key not remapped", severity="warning", timeout=10)
-        for problem in self.graphics_problems:
-            self.tell(problem, title="Settings", severity="warning", timeout=10)
+        problems = [("Key not remapped", p) for p in self.keymap_problems]
+        problems += [("Settings", p) for p in self.graphics_problems]
+        if problems:  # one notice: several stacked ran off the top at 80 x 24
+            self.messages += [f"{title}: {problem}" for title, problem in problems]
+            title, said = startup_notice(problems, config_folder(), (self.size.width, self.size.height))
+            self.notify(said, title=title, severity="warning", timeout=10, markup=False)
         self.refresh_status()
         self.set_interval(OUTPUTS_CHECK_SECONDS, self.check_outputs_on_disk)  # another run's outputs
         if self.start_scenario is not None:
