@@ -35,3 +35,34 @@ async def test_the_measures_dialog_says_when_its_measures_are_out_of_date(tmp_pa
         await pilot.pause()
         assert "out of date" not in str(app.screen.query_one(".dialog").border_title)
         assert stale_note(app.screen) == ""
+
+
+async def test_a_model_changed_on_disk_since_opening_is_said_so_not_changed_since_the_run(
+    tmp_path, scene_files
+):
+    """The scene model edited while the app had it open, then run by the CLI: reading that
+    run's outputs, the app called them out of date, 'the scene model changed since the
+    run', and offered F5, which would have run its old copy of the model."""
+    import shutil
+
+    from ladartui.scenario import load_scenario
+    from ladartui.tui.status import NOT_READY, StatusBar
+
+    scene_path, centre, voxel_size = scene_files
+    for model in (scene_path, scene_path.with_name(f"{scene_path.stem}_Target.txt")):
+        shutil.copy(model, tmp_path)  # the module's files stay as they are
+    scenario = make_scenario(tmp_path, (tmp_path / scene_path.name, centre, voxel_size))
+    async with opened(scenario) as (app, pilot):
+        with open(scenario.scene_file, "a", encoding="utf-8") as model:
+            model.write("0,0,0\n")
+        simulate(load_scenario(scenario.path))  # the CLI's run, of the model as it is now
+        app.check_outputs_on_disk()
+        said = f"the scene model {scene_path.name} changed on disk since it was opened"
+        await wait_until(pilot, lambda: any(said in m for m in app.messages), timeout=60.0)
+        await pilot.pause()
+        assert not any("changed since the run" in m for m in app.messages), app.messages
+        bar = app.query_one(StatusBar)
+        assert bar.state == NOT_READY
+        assert bar.message == f"{scenario.path.name}: {scene_path.name} changed on disk; reopen to read it."
+        info = str(app.query_one("#results-info").render())
+        assert f"other inputs: {said} (reopen to read it)." in info, info

@@ -97,6 +97,7 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         self.missing_outputs: list[Path] = []
         self.outputs_from: Scenario | None = None  # the settings that made the outputs shown
         self.inputs_changed: list[str] = []  # the files they read that changed since their run
+        self.changed_since_opened: list[str] = []  # read here before they changed (reopen)
         self.outputs_seen: tuple[int, int] | None = None  # (mtime, size) of the measures read
         self.threshold: float | None = None
         self.busy: str | None = None
@@ -256,10 +257,11 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         if self.outputs_stale():
             # short: the bar is one line (the Results tab says which settings they came from)
             reruns = self.key_says("run", "reruns")
-            show(
-                NOT_READY,
-                f"{scenario.path.name}{mark}: outputs out of date" + (f"; {reruns}." if reruns else "."),
-            )
+            stale = "outputs out of date" + (f"; {reruns}." if reruns else ".")
+            if self.changed_since_opened:  # a rerun would read the copies from before
+                files = self.changed_since_opened
+                stale = f"{', '.join(files)} changed on disk; reopen to read {'them' if files[1:] else 'it'}."
+            show(NOT_READY, f"{scenario.path.name}{mark}: {stale}")
             return
         show(READY, text)
 

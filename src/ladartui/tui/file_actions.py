@@ -89,6 +89,7 @@ class FileActions(Host):
             self.disk_outputs = (None, None)
             self.outputs_from = None
             self.inputs_changed = []
+            self.changed_since_opened = []
             self.show_output()
             self.show_measures(None)
             self.run_panel.say("")  # the last run, if any, was the old file's

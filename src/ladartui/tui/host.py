@@ -50,6 +50,7 @@ class AppHost(App[None]):
     missing_outputs: list[Path]
     outputs_from: Scenario | None  # the settings that made the outputs shown
     inputs_changed: list[str]  # their model files and flight logs changed since (out of date)
+    changed_since_opened: list[str]  # names of those the app read before they changed on disk
     outputs_seen: tuple[int, int] | None  # the measures file's (mtime, size) when they were read
     cwd: Path
     compile_in_child: bool

@@ -17,8 +17,16 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ladartui.errors import LadarError
+from ladartui.fingerprint import Digest
 from ladartui.recent import remember_scenario
-from ladartui.run_record import inputs_changed, is_record, missing_outputs, read_run_record
+from ladartui.run_record import (
+    input_changes,
+    is_record,
+    missing_outputs,
+    read_run_record,
+    recorded_inputs,
+    run_inputs,
+)
 from ladartui.scenario_file import record_owner
 from ladartui.textsafe import visible
 from ladartui.tui import bridge
@@ -56,6 +64,9 @@ class Earlier:
     files: OutputFiles  # the look they were read after
     target_output: np.ndarray | None = None  # the target traced without foliage, if on disk
     inputs_changed: list[str] = field(default_factory=list)  # run_record.inputs_changed
+    # the names of those read by the run as they are on disk now, which the app read
+    # before they changed: only reopening brings them in
+    changed_since_opened: list[str] = field(default_factory=list)
 
     @property
     def made_with(self) -> Scenario | None:
@@ -95,6 +106,7 @@ class SceneLoading(Host):
         self.missing_outputs = done.earlier.files.missing
         self.outputs_from = done.earlier.made_with  # before the status is drawn
         self.inputs_changed = done.earlier.inputs_changed
+        self.changed_since_opened = done.earlier.changed_since_opened
         self.set_scenario(done.scenario, modified=False)
         if done.scenario.path.is_file():
             remember_scenario(done.scenario.path)
@@ -169,6 +181,7 @@ class SceneLoading(Host):
         self.outputs_seen = earlier.files.seen  # as found before they were read
         self.outputs_from = earlier.made_with
         self.inputs_changed = earlier.inputs_changed
+        self.changed_since_opened = earlier.changed_since_opened
         self.output_voxels = earlier.output
         self.disk_outputs = (earlier.output, earlier.target_output)
         self.show_output()
@@ -201,6 +214,7 @@ def _earlier(scenario, files: OutputFiles | None = None, scene: Scene | None = N
     warning, ran = None, None
     target_output = None
     changed: list[str] = []
+    since_opened: list[str] = []
     try:
         output, measures = _existing_results(scenario, files)
     except LadarError as error:  # old results must not stop the scenario loading
@@ -211,19 +225,48 @@ def _earlier(scenario, files: OutputFiles | None = None, scene: Scene | None = N
         except LadarError as error:
             warning = f"settings of the earlier run not read, taken as the file's: {error}"
         if ran is not None and scene is not None:
-            changed, warning = _inputs_changed(scenario, scene)
+            changed, since_opened, warning = _inputs_changed(scenario, scene)
         target_output = _target_output(scenario)
-    return Earlier(scenario, output, measures, ran, warning, files, target_output, changed)
+    return Earlier(scenario, output, measures, ran, warning, files, target_output, changed, since_opened)
 
 
-def _inputs_changed(scenario, scene) -> tuple[list[str], str | None]:
-    """The earlier outputs' model files or flight logs that changed since their run,
-    and the note that says so (or that the record could not tell)."""
+def _inputs_changed(scenario, scene) -> tuple[list[str], list[str], str | None]:
+    """The earlier outputs' model files or flight logs that differ from those read here,
+    the names of those the run read as they are on disk now (changed since they were
+    opened here, not since the run), and the note that says so (or that the record
+    could not tell)."""
     try:
-        changes = [visible(change) for change in inputs_changed(scenario, scene) or []]
+        recorded = recorded_inputs(scenario) or []
     except LadarError as error:
-        return [], visible(f"model files of the earlier run not read: {error}")
-    return changes, f"Earlier outputs: {'; '.join(changes)}." if changes else None
+        return [], [], visible(f"model files of the earlier run not read: {error}")
+    here = run_inputs(scenario, scene)
+    read_here = {entry.path: entry.fingerprint for entry in here}
+    newer = [
+        entry
+        for entry in recorded
+        if entry.path in read_here
+        and read_here[entry.path] != entry.fingerprint
+        and _fingerprint_on_disk(entry.path) == entry.fingerprint
+    ]
+    changes = [visible(change) for change in input_changes([e for e in recorded if e not in newer], here)]
+    changes += [
+        visible(f"the {entry.role} {entry.path.name} changed on disk since it was opened (reopen to read it)")
+        for entry in newer
+    ]
+    names = [visible(entry.path.name) for entry in newer]
+    return changes, names, f"Earlier outputs: {'; '.join(changes)}." if changes else None
+
+
+def _fingerprint_on_disk(path: Path):
+    """The file's fingerprint as it is now, or None when it cannot be read."""
+    digest = Digest()
+    try:
+        with open(path, "rb") as file:
+            for block in iter(lambda: file.read(1 << 20), b""):
+                digest.update(block)
+    except OSError:
+        return None
+    return digest.fingerprint()
 
 
 def _target_output(scenario) -> np.ndarray | None:

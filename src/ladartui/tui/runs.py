@@ -92,6 +92,7 @@ class RunControl(Host):
         self.missing_outputs = []
         self.outputs_from = self.scenario  # (not editable while the run went on)
         self.inputs_changed = []  # read as they are now
+        self.changed_since_opened = []
         self.note_outputs_seen()  # this run's own: not another's
         self.output_voxels = result.scene_output
         self.disk_outputs = (None, None)
