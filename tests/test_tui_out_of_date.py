@@ -66,3 +66,7 @@ async def test_a_model_changed_on_disk_since_opening_is_said_so_not_changed_sinc
         assert bar.message == f"{scenario.path.name}: {scene_path.name} changed on disk; reopen to read it."
         info = str(app.query_one("#results-info").render())
         assert f"other inputs: {said} (reopen to read it)." in info, info
+        await pilot.press("f9")  # the measures dialog says the same, and offers no rerun
+        await wait_until(pilot, lambda: isinstance(app.screen, MeasuresScreen), timeout=10.0)
+        note = stale_note(app.screen)
+        assert f"{said} (reopen to read it)." in note and "F5" not in note, note

@@ -396,7 +396,8 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         made_with = self.outputs_made_with()
         stale = ""
         if made_with is not None:  # as the Results tab and the status bar say it
-            reruns = self.key_says("run", "reruns")
+            # a rerun would read the app's old copies of files changed on disk since
+            reruns = "" if self.changed_since_opened else self.key_says("run", "reruns")
             stale = f"Out of date: made from {made_with}" + (f" {reruns}." if reruns else "")
         self.push_screen(MeasuresScreen(self.measures, stale=stale))
 
