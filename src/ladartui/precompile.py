@@ -1,10 +1,11 @@
 """Compile the numba kernels a run uses before it needs them, two halves at once.
 
 numba compiles a kernel on its first call, holding the interpreter lock, and
-keeps it in its on-disk cache. With that cache empty, `ladartui run default`
-spent 3 min 23 s compiling on two busy cores. Child processes compile the two
-halves of the kernels side by side instead (``compile_in_children``), each
-into the cache, and the caller then loads them in moments:
+keeps it in its on-disk cache. Child processes compile the two halves of the
+kernels side by side instead (``compile_in_children``), each into the cache,
+and the caller then loads them in moments. With an empty cache on two cores,
+`ladartui run default` took 131-151 s compiling in its own process, 67-81 s
+this way:
 
 - "object": a scan in object order (its bins, the voxels in view, the tile
   lists and tests), on a small made-up scene, for each backend the scenario
