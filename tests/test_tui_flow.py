@@ -493,7 +493,7 @@ async def test_manual_poses_are_edited_in_a_table(shared, tmp_path, scene_files)
     screen.query_one("#pose-apply").press()
     await pilot.pause()
     await pilot.pause()
-    assert str(screen.query_one("#poses-message").render()).startswith("z: 0 is not allowed; expected ")
+    assert str(screen.query_one("#poses-message").render()).startswith("z m: 0 is not allowed; expected ")
     await pilot.pause()
     assert screen.query_one("#p-z").value == "0"  # kept for correcting, and nothing applied
     assert app.screen is screen and screen.poses[0].x != 12.5
