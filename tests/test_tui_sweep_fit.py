@@ -8,58 +8,26 @@ from __future__ import annotations
 
 import re
 import shutil
-import time
 
 import pytest
 from rich.cells import cell_len
-from textual.app import App
 
-from ladartui.sweep import run_sweep
 from ladartui.tui.status import StatusText
 from ladartui.tui.sweep_screen import SweepScreen
-from tiny_sweep import write_spec, write_tiny_scenario
-
-SIZE = (80, 24)
-
-
-class _Host(App):
-    """A bare app showing one SweepScreen."""
-
-    def __init__(self, screen: SweepScreen):
-        super().__init__()
-        self.sweep_screen = screen
-
-    def on_mount(self) -> None:
-        self.push_screen(self.sweep_screen)
+from sweep_screen_support import SIZE, SweepHost, opened, swept_folder, wait_for
+from tiny_sweep import write_spec
 
 
 @pytest.fixture(scope="module")
 def swept(tmp_path_factory):
     """A folder holding the base, the spec and its finished two-variant results."""
-    folder = tmp_path_factory.mktemp("swept")
-    write_tiny_scenario(folder)
-    spec = write_spec(folder, "[grid]\nradius = [15.0, 25.0]\n")
-    run_sweep(spec, serial=True)
-    return folder
+    return swept_folder(tmp_path_factory)
 
 
 def copy_of(swept, folder):
     """``swept`` copied into ``folder`` (a run rewrites its table); the spec there."""
     shutil.copytree(swept, folder)
     return folder / "spec.toml"
-
-
-async def wait_for(pilot, condition, timeout=300.0):
-    start = time.monotonic()
-    while not condition():
-        assert time.monotonic() - start < timeout, pilot.app.sweep_screen.last_message
-        await pilot.pause(0.05)
-
-
-async def opened(pilot):
-    screen = pilot.app.sweep_screen
-    await wait_for(pilot, lambda: screen.opening is None or screen.opening.is_finished)
-    await pilot.pause()
 
 
 async def test_a_finished_sweep_names_its_results_folder_whole_on_the_status_line(
@@ -70,7 +38,7 @@ async def test_a_finished_sweep_names_its_results_folder_whole_on_the_status_lin
     monkeypatch.chdir(tmp_path)  # the folder is shown relative to the working one
     spec = copy_of(swept, tmp_path / "sw")
     screen = SweepScreen(spec, serial=True)
-    async with _Host(screen).run_test(size=SIZE) as pilot:
+    async with SweepHost(screen).run_test(size=SIZE) as pilot:
         await opened(pilot)
         await pilot.press("f5")
         await wait_for(pilot, lambda: not screen.running)
@@ -101,13 +69,13 @@ async def test_the_chart_names_each_axis_apart_for_either_cost(swept, tmp_path, 
 
     monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))  # no sweep to reopen
     screen = SweepScreen()
-    async with _Host(screen).run_test(size=SIZE) as pilot:
+    async with SweepHost(screen).run_test(size=SIZE) as pilot:
         await opened(pilot)
         # empty, with no tick labels to push them apart: the names ran together
         labels = screen.query_one("#sweep-chart", PlotextPlot).render().plain.splitlines()[-1]
         assert "cov" not in labels or len(re.split(r" {2,}", labels.strip())) == 2, labels
     screen = SweepScreen(swept / "spec-results")
-    async with _Host(screen).run_test(size=SIZE) as pilot:
+    async with SweepHost(screen).run_test(size=SIZE) as pilot:
         await opened(pilot)
         chart = screen.query_one("#sweep-chart", PlotextPlot)
         for cost, word in (("flight-time", "time (s)"), ("distance", "distance (m)")):
@@ -128,14 +96,14 @@ async def test_the_empty_table_fits_without_a_sideways_scrollbar(swept, tmp_path
 
     monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))  # no sweep to reopen
     screen = SweepScreen()
-    async with _Host(screen).run_test(size=SIZE) as pilot:
+    async with SweepHost(screen).run_test(size=SIZE) as pilot:
         await opened(pilot)
         table = screen.query_one("#sweep-table", DataTable)
         assert table.row_count == 0
         assert table.virtual_size.width <= table.scrollable_content_region.width
         assert not table.show_horizontal_scrollbar
     screen = SweepScreen(swept / "spec-results")  # every variant ok: no error column
-    async with _Host(screen).run_test(size=SIZE) as pilot:
+    async with SweepHost(screen).run_test(size=SIZE) as pilot:
         await opened(pilot)
         table = screen.query_one("#sweep-table", DataTable)
         labels = [column.label.plain for column in table.ordered_columns]
@@ -149,7 +117,7 @@ async def test_the_table_marks_the_best_variant_as_the_chart_and_its_legend_do(s
     from textual_plotext import PlotextPlot
 
     screen = SweepScreen(swept / "spec-results")
-    async with _Host(screen).run_test(size=SIZE) as pilot:
+    async with SweepHost(screen).run_test(size=SIZE) as pilot:
         await opened(pilot)
         chart = screen.query_one("#sweep-chart", PlotextPlot).render().plain.splitlines()
         legend = chart[0]
@@ -170,7 +138,7 @@ async def test_rows_left_out_of_the_ranking_are_said_first_on_the_status_line(sw
     spec = copy_of(swept, tmp_path / "sw")
     narrowed = write_spec(spec.parent, "[grid]\nradius = [15.0]\n")
     screen = SweepScreen(narrowed)
-    async with _Host(screen).run_test(size=SIZE) as pilot:
+    async with SweepHost(screen).run_test(size=SIZE) as pilot:
         await opened(pilot)
         await wait_for(pilot, lambda: "ranked by" in screen.last_message)
         shown = screen.query_one("#sweep-status StatusText", StatusText).render().plain
