@@ -76,12 +76,28 @@ def test_the_two_halves_leave_a_run_nothing_to_compile(tmp_path, backend, method
     assert done.stdout.splitlines() == [f"object-order kernels ready: {numba_scans}"], done.stdout
 
 
-def _settings(path):
-    return types.SimpleNamespace(path=path, backend="numba", method="exact", precision="f64")
+def _settings(path, backend="numba", method="exact"):
+    return types.SimpleNamespace(path=path, backend=backend, method=method, precision="f64")
 
 
-def test_the_children_end_when_asked(tmp_path):
-    from ladartui.precompile import compile_in_children
+@pytest.fixture
+def children(monkeypatch):
+    """The child processes compile_in_children starts."""
+    import ladartui.precompile as precompile
+
+    started = []
+    popen = subprocess.Popen
+
+    def recorded(*args, **kwargs):
+        started.append(popen(*args, **kwargs))
+        return started[-1]
+
+    monkeypatch.setattr(precompile.subprocess, "Popen", recorded)
+    return started
+
+
+def test_the_children_end_when_asked(tmp_path, children):
+    from ladartui.precompile import HALVES, compile_in_children
 
     scenario = tmp_path / "none.toml"
     scenario.write_text("", encoding="utf-8")
@@ -90,34 +106,59 @@ def test_the_children_end_when_asked(tmp_path):
     started = time.monotonic()
     assert compile_in_children(_settings(scenario), stop=stop) is False
     assert time.monotonic() - started < 10.0
+    assert len(children) == len(HALVES) and all(child.poll() is not None for child in children)
 
 
-def test_a_child_that_fails_says_so(tmp_path):
+def test_a_child_that_fails_says_so(tmp_path, children):
     from ladartui.precompile import compile_in_children
 
     missing = tmp_path / "missing.toml"  # each child fails to load it
     assert compile_in_children(_settings(missing), timeout=120.0) is False
+    assert [child.returncode != 0 for child in children] == [True, True]
+
+
+def test_the_children_compile_a_scenario_of_theirs(tmp_path, children):
+    from ladartui.precompile import compile_in_children
+    from tiny_sweep import write_tiny_scenario
+
+    path = write_tiny_scenario(tmp_path).path
+    assert compile_in_children(_settings(path), timeout=600.0) is True
+    assert [child.returncode for child in children] == [0, 0]
 
 
 CACHED = textwrap.dedent(
     """
+    import sys
     from types import SimpleNamespace
     from ladartui.precompile import kernels_cached
-    print(kernels_cached(SimpleNamespace(method="exact")), kernels_cached(SimpleNamespace(method="march")))
+    for backend, method in (("numba", "exact"), ("numba", "march"), ("wgpu", "exact")):
+        print(kernels_cached(SimpleNamespace(backend=backend, method=method, precision="f64")))
     """
 )
 
 
 def test_an_empty_kernel_cache_is_told_from_a_filled_one(tmp_path):
-    from ladartui.precompile import compile_half, kernels_cached
+    from ladartui.errors import BackendUnavailable
+    from ladartui.precompile import HALVES, compile_half, kernels_cached
+    from ladartui.tracing.backend import get_backend
+    from tiny_sweep import write_tiny_scenario
 
-    compile_half("object", _settings(tmp_path / "unused.toml"))  # fills this cache, if need be
-    assert kernels_cached(types.SimpleNamespace(method="exact")) is True
+    scenario = write_tiny_scenario(tmp_path)
+    for backend, method in (("numba", "exact"), ("numba", "march"), ("wgpu", "exact")):
+        if backend == "wgpu":
+            try:
+                get_backend("wgpu")
+            except BackendUnavailable:
+                continue
+        chosen = scenario.with_changes(backend=backend, method=method)
+        for half in HALVES:  # fills this cache, if need be
+            compile_half(half, chosen)
+        assert kernels_cached(chosen) is True, (backend, method)
     env = dict(os.environ, PYTHONPATH=str(SRC), NUMBA_CACHE_DIR=str(tmp_path / "empty"))
     done = subprocess.run(
         [sys.executable, "-c", CACHED], capture_output=True, text=True, env=env, timeout=300
     )
-    assert done.stdout.split() == ["False", "False"], done.stderr[-2000:]
+    assert done.stdout.split() == ["False", "False", "False"], done.stderr[-2000:]
 
 
 @pytest.fixture
@@ -183,3 +224,16 @@ def test_the_tuis_warm_up_compiles_ahead_only_on_an_empty_cache(ahead, monkeypat
     monkeypatch.setattr(precompile, "kernels_cached", lambda scenario: True)
     _warm_up(scenario, None, True, threading.Event())
     assert len(ahead) == 1
+
+
+def test_a_mistake_in_the_scene_is_told_before_any_compiling(ahead, tmp_path, capsys):
+    """It came after the compiling: over a minute on two cores with an empty cache."""
+    from ladartui.cli import main
+    from tiny_sweep import write_tiny_scenario
+
+    scenario = write_tiny_scenario(tmp_path)
+    with open(scenario.scene_file, "a", encoding="utf-8") as model:
+        model.write("1,2,oops\n")
+    assert main(["run", str(scenario.path), "--no-write"]) == 2
+    assert "oops" in capsys.readouterr().err
+    assert ahead == []

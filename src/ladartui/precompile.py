@@ -85,16 +85,20 @@ def _pinhole_scan(origin):
     return origin + 1e-3 * directions * [1.0, 1.0, 0.0], directions
 
 
-def _engines(backend: str) -> list:
+def _backend_names(backend) -> list[str]:
     """The backends a scenario's run may trace with: its own, or under auto the one
     chosen here and, beside a GPU, numba (auto learns which is faster)."""
-    from ladartui.errors import BackendUnavailable
     from ladartui.tracing import choose_backend
+
+    return list(dict.fromkeys([choose_backend(), "numba"] if backend in (None, "auto") else [backend]))
+
+
+def _engines(backend) -> list:
+    from ladartui.errors import BackendUnavailable
     from ladartui.tracing.backend import get_backend
 
-    names = [choose_backend(), "numba"] if backend in (None, "auto") else [backend]
     engines = []
-    for name in dict.fromkeys(names):
+    for name in _backend_names(backend):
         try:
             engines.append(get_backend(name))
         except BackendUnavailable:
@@ -124,30 +128,46 @@ def one_ray_run(scenario, scene=None, cancel=None) -> None:
 
 
 def kernels_cached(scenario) -> bool:
-    """Whether numba's cache already holds the scenario's largest kernels for this
-    source (then a run loads them in moments); True when it cannot tell."""
+    """Whether numba's cache already holds the largest kernels a run of ``scenario``
+    compiles, for this source (then a run loads them in moments); True when it
+    cannot tell."""
     try:
-        if scenario.method == "march":
-            from ladartui.tracing.march import march_kernel
+        from ladartui.tracing.prepare import _rays_to_cells
 
-            kernels: list[Any] = [march_kernel]
-        else:
-            from ladartui.tracing.numba_backend import _exact_kernel
-            from ladartui.tracing.tile_tests import test_tiles
+        kernels: list[Any] = [_rays_to_cells]  # every run's
+        exact = scenario.method == "exact"
+        for name in _backend_names(scenario.backend):
+            if name == "numba" and exact:
+                from ladartui.tracing.numba_backend import _exact_kernel
+                from ladartui.tracing.tile_tests import test_tiles
 
-            kernels = [_exact_kernel, test_tiles]
+                kernels += [_exact_kernel, test_tiles]
+            elif name == "numba":
+                from ladartui.tracing.march import march_kernel
+
+                kernels.append(march_kernel)
+            elif name == "wgpu" and exact and scenario.precision == "f64":
+                from ladartui.tracing.shader_scan import entry_answers
+
+                kernels.append(entry_answers)
         # (numba's own index: empty when missing or made from another source)
         return all(bool(kernel._cache._cache_file._load_index()) for kernel in kernels)
     except Exception:
         return True
 
 
-def compile_ahead(scenario, stop=None) -> None:
+def compile_ahead(scenario, stop=None, load_scene: bool = False):
     """Before a run in this process: when the cache lacks the scenario's kernels, the
     two halves in child processes side by side (on two cores about half the wait
-    of compiling them here one by one)."""
-    if not kernels_cached(scenario) and Path(scenario.path).is_file():
-        compile_in_children(scenario, stop=stop)
+    of compiling them here one by one). With ``load_scene`` the scenario's scene is
+    read first then, and returned (a mistake in a model file is told before the
+    minutes of compiling, not after them); else, and when nothing was compiled, None.
+    """
+    if kernels_cached(scenario) or not Path(scenario.path).is_file():
+        return None
+    scene = scenario.load_scene() if load_scene else None
+    compile_in_children(scenario, stop=stop)
+    return scene
 
 
 def compile_in_children(scenario, stop=None, timeout: float = 600.0) -> bool:
@@ -162,7 +182,8 @@ def compile_in_children(scenario, stop=None, timeout: float = 600.0) -> bool:
         for half in HALVES:
             children.append(
                 subprocess.Popen(
-                    [sys.executable, "-m", "ladartui.precompile", half, str(scenario.path), *settings],
+                    # -P: never a ladartui module in the working folder
+                    [sys.executable, "-P", "-m", "ladartui.precompile", half, str(scenario.path), *settings],
                     stdout=subprocess.DEVNULL,
                     stderr=subprocess.DEVNULL,
                 )
@@ -186,9 +207,25 @@ def _end(children) -> None:
         child.wait()
 
 
+def _end_with_parent() -> None:
+    """Exit when the process that started this one ends (killed, it cannot end us)."""
+    import os
+    import threading
+
+    parent = os.getppid()
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(0.5)
+        os._exit(1)
+
+    threading.Thread(target=watch, daemon=True).start()
+
+
 def main(argv=None) -> int:
     from ladartui.scenario import load_scenario
 
+    _end_with_parent()
     half, path, backend, method, precision = sys.argv[1:] if argv is None else argv
     scenario = load_scenario(path).with_changes(backend=backend, method=method, precision=precision)
     compile_half(half, scenario)

@@ -133,7 +133,7 @@ def _where(progress) -> str:
 def _study_with_progress(scenario, pulses, settings, backend, console, state):
     from rich.progress import TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
-    from ladartui.cli.progress import FIRST_SCAN, progress_display, run_cancellable
+    from ladartui.cli.progress import FIRST_SCAN, progress_display, run_cancellable, sigterm_as_interrupt
     from ladartui.detection.pulses import pulse_study
     from ladartui.precompile import compile_ahead
 
@@ -152,15 +152,19 @@ def _study_with_progress(scenario, pulses, settings, backend, console, state):
             bar.update(task, completed=p.units_done / p.units_total, description=what)
 
         def work():
-            compile_ahead(scenario if backend is None else scenario.with_changes(backend=backend), cancel)
-            return pulse_study(scenario, pulses, settings, backend=backend, progress=report, cancel=cancel)
+            chosen = scenario if backend is None else scenario.with_changes(backend=backend)
+            scene = compile_ahead(chosen, cancel, load_scene=True)
+            return pulse_study(
+                scenario, pulses, settings, scene=scene, backend=backend, progress=report, cancel=cancel
+            )
 
-        return run_cancellable(
-            work,
-            cancel,
-            "ladartui-pulses",
-            Cancelled("pulse study cancelled"),
-        )
+        with sigterm_as_interrupt():  # as run does: the work (and any compiling children) ends
+            return run_cancellable(
+                work,
+                cancel,
+                "ladartui-pulses",
+                Cancelled("pulse study cancelled"),
+            )
 
 
 def result_dict(scenario, settings, ideal, rows) -> dict:

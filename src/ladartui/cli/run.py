@@ -187,8 +187,10 @@ def _simulate_with_progress(scenario, args, console, finished: list):
         # A stop during the write lets the swap finish (or roll back): the files on
         # disk belong to one run and the result says which.
         def work():
-            compile_ahead(scenario, cancel)
-            return simulate(scenario, progress=report, cancel=cancel, write=args.write, las=args.las)
+            scene = compile_ahead(scenario, cancel, load_scene=True)
+            return simulate(
+                scenario, progress=report, cancel=cancel, write=args.write, las=args.las, scene=scene
+            )
 
         with sigterm_as_interrupt():
             finished.append(

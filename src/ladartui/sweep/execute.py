@@ -349,6 +349,7 @@ def _run_locked(
     if todo:
         options = dict(simulate_options or {})
         if serial or client is None:  # here or on this machine's workers: its cache
+            scene()  # read first: a mistake in its model is told before any compiling
             compile_ahead(base.with_changes(**{k: v for k, v in options.items() if v is not None}), cancel)
         if serial:
             result_workers = 1
