@@ -469,6 +469,12 @@ def test_more_local_workers_than_the_machine_can_hold_are_refused(tiny, tmp_path
         f"(4 per core of this machine's {os.cpu_count()})"
     )
     assert not (tmp_path / "o").exists()
+    # with --serial no worker runs at all: that is what is wrong, not their number
+    assert main(["sweep", str(spec), "--serial", "--workers", str(limit + 1)]) == 2
+    assert one_error_line(capsys) == (
+        f"ladartui: error: --workers = {limit + 1}: expected no --workers with --serial "
+        "(one process runs every variant)"
+    )
 
 
 @pytest.mark.parametrize("mode", [[], ["--serial"], ["--workers", "1"]])

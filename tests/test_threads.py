@@ -69,6 +69,12 @@ def test_the_users_layer_stands():
             "two",
             "NUMBA_NUM_THREADS = 'two': expected a whole number of threads, 1 or more",
         ),
+        # a digit that is not 0-9 passed the check, and int() then raised
+        (
+            "NUMBA_NUM_THREADS",
+            "\u00b2",
+            "NUMBA_NUM_THREADS = '\u00b2': expected a whole number of threads, 1 or more",
+        ),
     ],
 )
 def test_a_bad_numba_thread_setting_is_one_line_naming_it(

@@ -57,7 +57,8 @@ def environment_problem() -> str | None:
     if layer.strip() and layer.lower() not in NUMBA_LAYERS:
         return f"NUMBA_THREADING_LAYER = {layer!r}: expected one of {', '.join(NUMBA_LAYERS)}"
     count = os.environ.get("NUMBA_NUM_THREADS", "")
-    if count.strip() and not (count.strip().isdigit() and int(count) >= 1):
+    whole = count.strip()
+    if whole and not (whole.isascii() and whole.isdigit() and int(whole) >= 1):
         return f"NUMBA_NUM_THREADS = {count!r}: expected a whole number of threads, 1 or more"
     return None
 

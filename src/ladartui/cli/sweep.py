@@ -143,13 +143,13 @@ def run(args) -> int:
         args.connect_timeout = DEFAULT_CONNECT_TIMEOUT
     if args.workers is not None and args.workers < 1:
         raise FieldError("--workers", args.workers, "an integer >= 1")
-    from ladartui.sweep.cluster import check_local_workers
-
-    check_local_workers(args.workers, "--workers")
     if args.serial and args.workers is not None:
         raise FieldError(
             "--workers", args.workers, "no --workers with --serial (one process runs every variant)"
         )
+    from ladartui.sweep.cluster import check_local_workers
+
+    check_local_workers(args.workers, "--workers")
     if not args.connect_timeout > 0:
         raise FieldError("--connect-timeout", args.connect_timeout, "a number of seconds > 0")
     if args.top < 0:
