@@ -46,3 +46,20 @@ async def test_a_sweep_opened_on_enter_gives_its_table_the_focus(swept, tmp_path
         await opened(pilot)
         await wait_for(pilot, lambda: screen.query_one("#sweep-table", DataTable).row_count == 2)
         assert screen.focused is screen.query_one("#sweep-table", DataTable)
+
+
+async def test_a_sweep_opened_on_f3_from_another_field_gives_its_table_the_focus(
+    swept, tmp_path, monkeypatch
+):
+    """Only a sweep opened from the Spec field got the focus on its table; F3 from the
+    Budget field (or a click on Browse) left it where it was, as docs/tui.md says it is not."""
+    monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))  # no sweep to reopen
+    screen = SweepScreen()
+    async with SweepHost(screen).run_test(size=SIZE) as pilot:
+        await opened(pilot)
+        screen.query_one("#sweep-path", Input).value = str(swept / "spec-results")
+        screen.query_one("#sweep-budget", Input).focus()
+        await pilot.press("f3")
+        await opened(pilot)
+        await wait_for(pilot, lambda: screen.query_one("#sweep-table", DataTable).row_count == 2)
+        assert screen.focused is screen.query_one("#sweep-table", DataTable)

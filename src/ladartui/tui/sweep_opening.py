@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from textual.widget import Widget
 from textual.widgets import DataTable
 
 from ladartui.errors import LadarError
@@ -39,6 +40,7 @@ class SweepOpening(RankingView):
     opening: Worker | None  # the last open asked for
     _opens: int  # opens asked for: an answer to an earlier one is dropped
     _focus_table: bool  # the last open was asked for, so its table takes the focus
+    _focused_at_open: Widget | None  # where the focus was when it was asked for
     _status: Callable[..., None]  # the screen's status bar (SweepScreen._status)
 
     def _open(self, text: str, focus_table: bool = True) -> None:
@@ -48,6 +50,7 @@ class SweepOpening(RankingView):
         what is typed next) in the Spec field."""
         self._opens += 1
         self._focus_table = focus_table
+        self._focused_at_open = self.focused
         number = self._opens
 
         def read(cancel, progress):
@@ -97,7 +100,8 @@ class SweepOpening(RankingView):
         self.progress = None
         self._redraw()
         self._show_stored(len(spec.variants) if spec else len(self.rows))
-        if self._focus_table and (self.focused is None or self.focused.id == "sweep-path"):
+        # (unless the analyst has moved the focus since: Enter, F3 or Browse left it put)
+        if self._focus_table and self.focused in (None, self._focused_at_open):
             self.query_one("#sweep-table", DataTable).focus()
         self._status(
             READY,

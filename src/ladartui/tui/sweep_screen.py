@@ -141,6 +141,7 @@ class SweepScreen(SweepOpening):
         self.opening: Worker | None = None  # the last open asked for (read off the UI thread)
         self._opens = 0  # opens asked for: an answer to an earlier one is dropped
         self._focus_table = False  # the last open was asked for: its table takes the focus
+        self._focused_at_open = None
         self._dirty = False  # rows arrived since the last redraw (redrawn a few times a second)
         self._row_index: dict[str, int] = {}  # variant id -> position in rows, while running
         self._shown_ids: list = []  # variant ids in table order
