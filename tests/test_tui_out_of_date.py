@@ -70,3 +70,11 @@ async def test_a_model_changed_on_disk_since_opening_is_said_so_not_changed_sinc
         await wait_until(pilot, lambda: isinstance(app.screen, MeasuresScreen), timeout=10.0)
         note = stale_note(app.screen)
         assert f"{said} (reopen to read it)." in note and "F5" not in note, note
+        # F5 runs the app's own copy: the model on disk is still not the one run
+        await pilot.press("escape")
+        await app.run_action("run")
+        await wait_until(pilot, lambda: isinstance(app.screen, MeasuresScreen), timeout=120.0)
+        await pilot.press("escape")
+        await pilot.pause()
+        assert bar.state == NOT_READY
+        assert bar.message == f"{scenario.path.name}: {scene_path.name} changed on disk; reopen to read it."

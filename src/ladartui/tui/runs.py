@@ -91,8 +91,8 @@ class RunControl(Host):
         self.result = result
         self.missing_outputs = []
         self.outputs_from = self.scenario  # (not editable while the run went on)
-        self.inputs_changed = []  # read as they are now
-        self.changed_since_opened = []
+        # read as the app holds them: a model changed on disk since it was opened still is
+        self.inputs_changed = list(self.changed_since_opened)
         self.note_outputs_seen()  # this run's own: not another's
         self.output_voxels = result.scene_output
         self.disk_outputs = (None, None)
