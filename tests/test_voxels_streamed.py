@@ -118,12 +118,54 @@ def test_a_large_file_is_read_once(tmp_path, monkeypatch):
             read.append(len(data))
             return data
 
-        def seek(self, offset):
-            return self._file.seek(offset)
+        def fileno(self):
+            return self._file.fileno()
 
     monkeypatch.setattr(voxels_module, "open", CountingFile, raising=False)
     assert len(load_voxels(path)) == len(set(LINES))
     assert sum(read) == path.stat().st_size
+
+
+def test_a_file_replaced_while_read_is_read_whole_as_it_was(tmp_path, monkeypatch):
+    """The first bytes and the rest came from two opens: a model replaced in between (as
+    generate writes its files) was read as part of each, parsed without a word."""
+    import os
+
+    path = tmp_path / "model.txt"
+    path.write_text(CASES["plain"], encoding="utf-8")
+    other = tmp_path / "other.txt"
+    other.write_text("\n".join(f"{i},{i},{i}" for i in range(400)) + "\n", encoding="utf-8")
+    monkeypatch.setattr(voxels_module, "_PLAIN_BYTES", 100)
+    monkeypatch.setattr(voxels_module, "_BLOCK_BYTES", 64)
+
+    reads = []
+
+    class ReplacedAfterFirstRead:
+        def __init__(self, *args):
+            self._file = open(*args)  # noqa: SIM115 (closed by __exit__)
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            self._file.close()
+
+        def read(self, size=-1):
+            data = self._file.read(size)
+            reads.append(len(data))
+            if len(reads) == 1:  # the first bytes are read: the file is replaced
+                os.replace(other, path)
+            return data
+
+        def fileno(self):
+            return self._file.fileno()
+
+        def seek(self, offset):
+            return self._file.seek(offset)
+
+    monkeypatch.setattr(voxels_module, "open", ReplacedAfterFirstRead, raising=False)
+    rows = load_voxels(path).tolist()
+    assert rows == [list(map(int, line.split(","))) for line in dict.fromkeys(LINES)]
 
 
 def test_large_lists_are_checked_for_order_in_place_and_repeats_still_dropped():

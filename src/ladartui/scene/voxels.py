@@ -13,6 +13,7 @@ Anything else stops at the first bad line with ``file:line: what was wrong``.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import logging
 import os
@@ -299,66 +300,96 @@ _BLOCK_BYTES = 4 << 20
 def _read_rows(path: Path, columns: int, target: bool, digest: Digest | None = None) -> np.ndarray:
     """The rows of a voxel list (``columns`` values a line), read whole when small,
     else streamed block by block; ``InputFileError`` naming the first bad line.
-    ``digest`` is fed every byte of the file once."""
-    head = _read_bytes(path, limit=_PLAIN_BYTES + 1)
-    if len(head) <= _PLAIN_BYTES:  # the whole file
-        if digest is not None:
-            digest.update(head)
-        return _parse_file(path, head, columns, target)
-    size = os.stat(path).st_size
-    # At most one row per 6 bytes ("0,0,0\n"); pages never written are never taken.
-    out = np.empty((size // (2 * columns) + 1, columns), dtype=np.int32)
-    rows = 0
-    lines = 0  # lines before the current block
-    blank_line = 0  # a blank line at the end of the blocks read so far (0: none)
-    first = True
-    for block in _blocks(path, digest, head.tobytes()):
-        start = len(_BOM) if first and block[: len(_BOM)].tobytes() == _BOM else 0
-        first = False
-        got, bad_line, bad_offset = _parse_voxel_bytes(block, start, out[rows:])
-        if blank_line and (got or bad_line):  # voxels after a blank line of an earlier block
-            raise InputFileError(path, describe_bad_line("", columns, target), line=blank_line)
-        if bad_line:
-            end = bad_offset
-            while end < len(block) and block[end] != _NEWLINE:
-                end += 1
-            text = block[bad_offset:end].tobytes().decode("utf-8", errors="replace")
-            raise InputFileError(path, describe_bad_line(text, columns, target), line=lines + int(bad_line))
-        in_block = int(np.count_nonzero(block == _NEWLINE)) + (1 if block[-1] != _NEWLINE else 0)
-        if in_block > got and not blank_line:  # the block ended in blank lines
-            blank_line = lines + got + 1
-        rows += got
-        lines += in_block
+    ``digest`` is fed every byte of the file once. One open file throughout: a file
+    replaced meanwhile (written atomically, as generate does) is read whole, old or
+    new, never part of each."""
+    with _opened(path) as handle:
+        head = _read_from(path, handle, _PLAIN_BYTES + 1)
+        if len(head) <= _PLAIN_BYTES:  # the whole file
+            if digest is not None:
+                digest.update(head)
+            return _parse_file(path, np.frombuffer(head, dtype=np.uint8), columns, target)
+        # At most one row per 6 bytes ("0,0,0\n"); pages never written are never taken.
+        # Bytes past the size seen here (appended meanwhile) are not read: no room for them.
+        size = max(os.fstat(handle.fileno()).st_size, len(head))
+        out = np.empty((size // (2 * columns) + 1, columns), dtype=np.int32)
+        rows = 0
+        lines = 0  # lines before the current block
+        blank_line = 0  # a blank line at the end of the blocks read so far (0: none)
+        first = True
+        for block in _blocks(path, handle, size, digest, head):
+            start = len(_BOM) if first and block[: len(_BOM)].tobytes() == _BOM else 0
+            first = False
+            got, bad_line, bad_offset = _parse_voxel_bytes(block, start, out[rows:])
+            if blank_line and (got or bad_line):  # voxels after a blank line of an earlier block
+                raise InputFileError(path, describe_bad_line("", columns, target), line=blank_line)
+            if bad_line:
+                end = bad_offset
+                while end < len(block) and block[end] != _NEWLINE:
+                    end += 1
+                text = block[bad_offset:end].tobytes().decode("utf-8", errors="replace")
+                raise InputFileError(
+                    path, describe_bad_line(text, columns, target), line=lines + int(bad_line)
+                )
+            in_block = int(np.count_nonzero(block == _NEWLINE)) + (1 if block[-1] != _NEWLINE else 0)
+            if in_block > got and not blank_line:  # the block ended in blank lines
+                blank_line = lines + got + 1
+            rows += got
+            lines += in_block
     out.resize((rows, columns), refcheck=False)  # in place: no copy of the rows
     return out
 
 
-def _blocks(path: Path, digest: Digest | None = None, head: bytes = b""):
-    """The file's bytes in blocks of about _BLOCK_BYTES, each ending at a line end
-    (the last may not), as uint8 arrays; ``digest`` is fed them as read. ``head``:
-    the file's first bytes, already read (they are not read again)."""
+def _blocks(path: Path, handle, size: int, digest: Digest | None, head: bytes):
+    """The file's first ``size`` bytes in blocks of about _BLOCK_BYTES, each ending at a
+    line end (the last may not), as uint8 arrays; ``digest`` is fed them as read.
+    ``head``: the first bytes, already read from ``handle``, which reads the rest."""
+    left = size - len(head)
+    carry = b""
+    data = head
+    while True:
+        if not data and left > 0:
+            data = _read_from(path, handle, min(_BLOCK_BYTES, left))
+            left -= len(data)
+        if not data:
+            if carry:
+                yield np.frombuffer(carry, dtype=np.uint8)
+            return
+        if digest is not None:
+            digest.update(data)
+        data = carry + data
+        cut = data.rfind(b"\n") + 1
+        carry = data[cut:]
+        if cut:
+            yield np.frombuffer(data[:cut], dtype=np.uint8)
+        data = b""
+
+
+def _read_from(path: Path, handle, limit: int) -> bytes:
     try:
-        with open(path, "rb") as handle:
-            handle.seek(len(head))
-            carry = b""
-            data = head
-            while True:
-                if not data:
-                    data = handle.read(_BLOCK_BYTES)
-                if not data:
-                    if carry:
-                        yield np.frombuffer(carry, dtype=np.uint8)
-                    return
-                if digest is not None:
-                    digest.update(data)
-                data = carry + data
-                cut = data.rfind(b"\n") + 1
-                carry = data[cut:]
-                if cut:
-                    yield np.frombuffer(data[:cut], dtype=np.uint8)
-                data = b""
+        return handle.read(limit)
     except OSError as error:
         raise InputFileError(path, f"cannot be read: {error.strerror or error}") from None
+
+
+@contextlib.contextmanager
+def _opened(path: Path):
+    """The voxel list open for reading, after the checks (a special file, its size
+    against memory); ``InputFileError`` for one that cannot be opened."""
+    refuse_special_file(path, "expected a voxel-list file")
+    try:
+        _check_read_size(path)
+        handle = open(path, "rb")  # noqa: SIM115 (closed below)
+    except FileNotFoundError:
+        raise InputFileError(path, f"{NO_SUCH_FILE}; {EXPECTED} per line") from None
+    except IsADirectoryError:
+        raise InputFileError(path, "is a folder; expected a voxel-list file") from None
+    except PermissionError:
+        raise InputFileError(path, "cannot be read: permission denied") from None
+    except OSError as error:
+        raise InputFileError(path, f"cannot be read: {error.strerror or error}") from None
+    with handle:
+        yield handle
 
 
 def _read_bytes(path: Path, limit: int | None = None) -> np.ndarray:
