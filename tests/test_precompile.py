@@ -38,8 +38,11 @@ AFTER_THE_HALVES = textwrap.dedent(
                         found[value.py_func.__module__ + "." + name] = set(value.signatures)
         return found
 
-    backend, method = sys.argv[1:]
+    backend, method, model = sys.argv[1:]
     scenario = load_scenario(bundled_or_path("default")).with_changes(backend=backend, method=method)
+    if model == "geiger":
+        from ladartui.detection.settings import DetectionSettings
+        scenario = scenario.with_changes(detection=DetectionSettings(model="geiger", pulses=10))
     for half in HALVES:
         compile_half(half, scenario)
     before = kernels()
@@ -52,8 +55,16 @@ AFTER_THE_HALVES = textwrap.dedent(
 )
 
 
-@pytest.mark.parametrize("backend, method", [("auto", "exact"), ("wgpu", "exact"), ("numba", "march")])
-def test_the_two_halves_leave_a_run_nothing_to_compile(tmp_path, backend, method):
+@pytest.mark.parametrize(
+    "backend, method, model",
+    [
+        ("auto", "exact", "ideal"),
+        ("wgpu", "exact", "ideal"),
+        ("numba", "march", "ideal"),
+        ("auto", "exact", "geiger"),
+    ],
+)
+def test_the_two_halves_leave_a_run_nothing_to_compile(tmp_path, backend, method, model):
     if backend == "wgpu":
         from ladartui.errors import BackendUnavailable
         from ladartui.tracing.backend import get_backend
@@ -64,7 +75,7 @@ def test_the_two_halves_leave_a_run_nothing_to_compile(tmp_path, backend, method
             pytest.skip(str(error))
     env = dict(os.environ, PYTHONPATH=str(SRC))
     done = subprocess.run(
-        [sys.executable, "-c", AFTER_THE_HALVES, backend, method],
+        [sys.executable, "-c", AFTER_THE_HALVES, backend, method, model],
         capture_output=True,
         text=True,
         env=env,
@@ -188,7 +199,7 @@ def test_a_pulse_study_compiles_ahead_for_its_backend(ahead, tmp_path, capsys):
 
     path = write_tiny_scenario(tmp_path).path
     assert main(["pulses", str(path), "--pulses", "1", "--backend", "numba", "--json"]) == 0
-    assert [(s.path, s.backend) for s in ahead] == [(path, "numba")]
+    assert [(s.path, s.backend, s.geiger) for s in ahead] == [(path, "numba", True)]
 
 
 def test_a_sweep_compiles_ahead_once_for_its_variants(ahead, tmp_path):

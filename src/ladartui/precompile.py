@@ -15,7 +15,8 @@ this way:
   measures), and the depth rule of a whole scan's rays.
 
 Run as ``python -m ladartui.precompile HALF SCENARIO.toml BACKEND METHOD
-PRECISION``. Failing here fails nothing: a run compiles what it still needs.
+PRECISION MODEL`` (MODEL: the detection model, "geiger" for Geiger-mode
+looks). Failing here fails nothing: a run compiles what it still needs.
 """
 
 from __future__ import annotations
@@ -150,6 +151,10 @@ def kernels_cached(scenario) -> bool:
                 from ladartui.tracing.shader_scan import entry_answers
 
                 kernels.append(entry_answers)
+        if getattr(scenario, "geiger", False):
+            from ladartui.detection.geiger import _fire_kernel
+
+            kernels.append(_fire_kernel)
         # (numba's own index: empty when missing or made from another source)
         return all(bool(kernel._cache._cache_file._load_index()) for kernel in kernels)
     except Exception:
@@ -176,7 +181,8 @@ def compile_in_children(scenario, stop=None, timeout: float = 600.0) -> bool:
 
     ``stop`` (a threading.Event) ends them early, e.g. when the app quits.
     """
-    settings = [scenario.backend, scenario.method, scenario.precision]
+    model = "geiger" if getattr(scenario, "geiger", False) else "ideal"
+    settings = [scenario.backend, scenario.method, scenario.precision, model]
     children = []
     try:
         for half in HALVES:
@@ -226,8 +232,15 @@ def main(argv=None) -> int:
     from ladartui.scenario import load_scenario
 
     _end_with_parent()
-    half, path, backend, method, precision = sys.argv[1:] if argv is None else argv
+    half, path, backend, method, precision, model = sys.argv[1:] if argv is None else argv
     scenario = load_scenario(path).with_changes(backend=backend, method=method, precision=precision)
+    if model == "geiger" and not scenario.geiger:  # a pulse study's looks
+        from dataclasses import replace
+
+        from ladartui.detection.settings import DetectionSettings
+
+        detection = replace(scenario.detection or DetectionSettings(), model="geiger")
+        scenario = scenario.with_changes(detection=detection)
     compile_half(half, scenario)
     return 0
 

@@ -152,7 +152,8 @@ def _study_with_progress(scenario, pulses, settings, backend, console, state):
             bar.update(task, completed=p.units_done / p.units_total, description=what)
 
         def work():
-            chosen = scenario if backend is None else scenario.with_changes(backend=backend)
+            chosen = scenario.with_changes(detection=settings)  # Geiger-mode looks
+            chosen = chosen if backend is None else chosen.with_changes(backend=backend)
             scene = compile_ahead(chosen, cancel, load_scene=True)
             return pulse_study(
                 scenario, pulses, settings, scene=scene, backend=backend, progress=report, cancel=cancel
