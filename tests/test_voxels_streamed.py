@@ -95,15 +95,10 @@ def test_a_large_file_is_read_in_blocks_not_whole(tmp_path, monkeypatch):
     assert len(seen) >= 10 and max(seen) < 256 + 20  # a block and the line it cut
 
 
-def test_a_large_file_is_read_once(tmp_path, monkeypatch):
-    """The first bytes, read to tell a small file from a large one, are not read again."""
-    path = tmp_path / "model.txt"
-    path.write_text(CASES["plain"], encoding="utf-8")
-    monkeypatch.setattr(voxels_module, "_PLAIN_BYTES", 100)
-    monkeypatch.setattr(voxels_module, "_BLOCK_BYTES", 64)
-    read = []
+def watched_open(on_read):
+    """An ``open`` for the reader whose files call ``on_read(bytes read)`` after each read."""
 
-    class CountingFile:
+    class WatchedFile:
         def __init__(self, *args):
             self._file = open(*args)  # noqa: SIM115 (closed by __exit__)
 
@@ -115,13 +110,23 @@ def test_a_large_file_is_read_once(tmp_path, monkeypatch):
 
         def read(self, size=-1):
             data = self._file.read(size)
-            read.append(len(data))
+            on_read(len(data))
             return data
 
         def fileno(self):
             return self._file.fileno()
 
-    monkeypatch.setattr(voxels_module, "open", CountingFile, raising=False)
+    return WatchedFile
+
+
+def test_a_large_file_is_read_once(tmp_path, monkeypatch):
+    """The first bytes, read to tell a small file from a large one, are not read again."""
+    path = tmp_path / "model.txt"
+    path.write_text(CASES["plain"], encoding="utf-8")
+    monkeypatch.setattr(voxels_module, "_PLAIN_BYTES", 100)
+    monkeypatch.setattr(voxels_module, "_BLOCK_BYTES", 64)
+    read = []
+    monkeypatch.setattr(voxels_module, "open", watched_open(read.append), raising=False)
     assert len(load_voxels(path)) == len(set(LINES))
     assert sum(read) == path.stat().st_size
 
@@ -137,33 +142,14 @@ def test_a_file_replaced_while_read_is_read_whole_as_it_was(tmp_path, monkeypatc
     other.write_text("\n".join(f"{i},{i},{i}" for i in range(400)) + "\n", encoding="utf-8")
     monkeypatch.setattr(voxels_module, "_PLAIN_BYTES", 100)
     monkeypatch.setattr(voxels_module, "_BLOCK_BYTES", 64)
-
     reads = []
 
-    class ReplacedAfterFirstRead:
-        def __init__(self, *args):
-            self._file = open(*args)  # noqa: SIM115 (closed by __exit__)
+    def replace_after_the_first_read(size):
+        reads.append(size)
+        if len(reads) == 1:  # the first bytes are read: the file is replaced
+            os.replace(other, path)
 
-        def __enter__(self):
-            return self
-
-        def __exit__(self, *exc):
-            self._file.close()
-
-        def read(self, size=-1):
-            data = self._file.read(size)
-            reads.append(len(data))
-            if len(reads) == 1:  # the first bytes are read: the file is replaced
-                os.replace(other, path)
-            return data
-
-        def fileno(self):
-            return self._file.fileno()
-
-        def seek(self, offset):
-            return self._file.seek(offset)
-
-    monkeypatch.setattr(voxels_module, "open", ReplacedAfterFirstRead, raising=False)
+    monkeypatch.setattr(voxels_module, "open", watched_open(replace_after_the_first_read), raising=False)
     rows = load_voxels(path).tolist()
     assert rows == [list(map(int, line.split(","))) for line in dict.fromkeys(LINES)]
 

@@ -392,23 +392,10 @@ def _opened(path: Path):
         yield handle
 
 
-def _read_bytes(path: Path, limit: int | None = None) -> np.ndarray:
-    """The file's bytes (the first ``limit`` with a limit), after the memory check."""
-    refuse_special_file(path, "expected a voxel-list file")
-    try:
-        _check_read_size(path)
-        if limit is not None:
-            with open(path, "rb") as handle:
-                return np.frombuffer(handle.read(limit), dtype=np.uint8)
-        return np.fromfile(path, dtype=np.uint8)
-    except FileNotFoundError:
-        raise InputFileError(path, f"{NO_SUCH_FILE}; {EXPECTED} per line") from None
-    except IsADirectoryError:
-        raise InputFileError(path, "is a folder; expected a voxel-list file") from None
-    except PermissionError:
-        raise InputFileError(path, "cannot be read: permission denied") from None
-    except OSError as error:
-        raise InputFileError(path, f"cannot be read: {error.strerror or error}") from None
+def _read_bytes(path: Path, limit: int) -> np.ndarray:
+    """The file's first ``limit`` bytes, after the checks of ``_opened``."""
+    with _opened(path) as handle:
+        return np.frombuffer(_read_from(path, handle, limit), dtype=np.uint8)
 
 
 def _check_read_size(path: Path) -> None:
