@@ -9,6 +9,7 @@ import threading
 
 import pytest
 
+from cli_support import ctrl_c
 from ladartui.cli.progress import run_cancellable
 from ladartui.errors import Cancelled
 
@@ -22,8 +23,7 @@ def test_a_ctrl_c_that_lands_while_the_worker_starts_is_a_cancel():
     stopped_by_cancel = []
 
     def work():
-        _thread.interrupt_main()  # as Ctrl-C would, on the main thread
-        stopped_by_cancel.append(cancel.wait(10))
+        stopped_by_cancel.append(ctrl_c(cancel))  # as Ctrl-C would, on the main thread
         raise Cancelled("stopped")
 
     try:
@@ -47,7 +47,7 @@ def test_work_that_stops_between_long_steps_says_it_is_stopping():
 
     def interrupt():
         started.wait(10)
-        _thread.interrupt_main()
+        ctrl_c(cancel)
 
     threading.Thread(target=interrupt).start()
     with pytest.raises(Cancelled, match="nothing written"):
@@ -75,7 +75,7 @@ def test_a_second_ctrl_c_waits_for_the_work_it_would_cut_short():
 
     def interrupt():
         started.wait(10)
-        _thread.interrupt_main()
+        ctrl_c(cancel)
 
     threading.Thread(target=interrupt).start()
     assert run_cancellable(work, cancel, "test-worker", Cancelled("nothing written")) == "written"

@@ -1,12 +1,12 @@
 """``ladartui pulses``: JSON rows, the terminal chart, the scenario's settings, Ctrl-C."""
 
-import _thread
 import json
 
 import numpy as np
 import pytest
 
 import ladartui.detection.pulses as pulses_module
+from cli_support import ctrl_c
 from ladartui.cli import main
 from ladartui.cli.pulses import chart_text
 from ladartui.detection.pulses import PulseRow
@@ -95,8 +95,7 @@ def test_ctrl_c_cancels_with_a_truthful_message(scenario, capsys, monkeypatch):
         def report(p):
             progress(p)
             if p.stage == "trace" and p.done == 2:
-                _thread.interrupt_main()  # as Ctrl-C would, on the main thread
-                assert cancel.wait(10), "Ctrl-C did not set the cancel event"
+                assert ctrl_c(cancel), "Ctrl-C did not set the cancel event"
 
         return real(*args, progress=report, cancel=cancel, **kwargs)
 

@@ -1,12 +1,12 @@
 """``ladartui run``: JSON and table output, --no-write, Ctrl-C, bad input."""
 
-import _thread
 import json
 
 import numpy as np
 import pytest
 
 import ladartui.simulation as simulation
+from cli_support import ctrl_c
 from ladartui.cli import main
 from ladartui.cmf import read_cmf
 from ladartui.flight import FlightPlan, Manual, ScanPose, aim_at
@@ -83,8 +83,7 @@ def test_ctrl_c_cancels_and_keeps_earlier_outputs(scenario, capsys, monkeypatch)
         def report(p):
             progress(p)
             if p.run == "target" and p.returns is not None:
-                _thread.interrupt_main()  # as Ctrl-C would, on the main thread
-                assert cancel.wait(10), "Ctrl-C did not set the cancel event"
+                assert ctrl_c(cancel), "Ctrl-C did not set the cancel event"
 
         return real_simulate(*args, progress=report, cancel=cancel, **kwargs)
 
