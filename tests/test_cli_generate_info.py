@@ -281,3 +281,12 @@ def test_info_backends_lists_each_backend(capsys):
     from ladartui.tracing import auto_summary
 
     assert f"auto: {auto_summary()}" in " ".join(out.split())
+
+
+def test_info_takes_a_bundled_scenario_by_name(tmp_path, capsys, monkeypatch):
+    """'info convoy' read the name as a voxel list: 'no such file; expected three
+    non-negative integers'. run, validate and the TUI take the name."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["info", "default"]) == 0
+    out = capsys.readouterr().out
+    assert "default_Scene.txt, default_Target.txt, default.cmf" in out, out

@@ -19,7 +19,12 @@ def add_parser(subparsers):
         "structure. For a scenario (.toml): its summary. With --backends: each tracing "
         "backend, whether it can run here (or why not) and what runs the work.",
     )
-    parser.add_argument("file", metavar="FILE", nargs="?", help="voxel list (.txt) or scenario (.toml)")
+    parser.add_argument(
+        "file",
+        metavar="FILE",
+        nargs="?",
+        help="voxel list (.txt), scenario (.toml) or a bundled one by name: default, convoy",
+    )
     parser.add_argument("--backends", action="store_true", help="list the tracing backends")
     parser.add_argument(
         "--voxel-size",
@@ -36,7 +41,11 @@ def run(args) -> int:
     if args.backends:
         print_backends()
     if args.file:
+        from ladartui.user_data import bundled_or_path, bundled_scenario_name
+
         path = Path(args.file)
+        if not path.exists() and bundled_scenario_name(args.file) is not None:
+            path = bundled_or_path(args.file)  # "convoy", as run takes it
         if path.suffix.lower() == ".toml":
             if args.voxel_size is not None:
                 from ladartui.errors import FieldError
