@@ -26,8 +26,9 @@ import numpy as np
 from ladartui.atomic import atomic_path, write_errors_named
 from ladartui.errors import FieldError, InputFileError
 from ladartui.fileprobe import path_field, require_file
+from ladartui.scene.unique_rows import unique_voxels
 from ladartui.scene.voxel_arrays import voxel_list_field
-from ladartui.scene.voxels import MAX_INDEX, MAX_TARGET_ID, unique_voxels
+from ladartui.scene.voxels import MAX_INDEX, MAX_TARGET_ID
 
 
 def _check_header(path, header):

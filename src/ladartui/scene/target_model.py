@@ -15,12 +15,12 @@ import numpy as np
 from ladartui.errors import InputFileError
 from ladartui.fileprobe import path_field
 from ladartui.fingerprint import Digest
+from ladartui.scene.unique_rows import row_keys
 from ladartui.scene.voxels import (
     _BOM,
     EXPECTED_TARGET,
     MAX_TARGET_ID,
     _first_line_columns,
-    _numpy_keys,
     _read_bytes,
     _read_rows,
     load_voxels_counted,
@@ -60,7 +60,7 @@ def _unique_labelled(path: Path, voxels: np.ndarray, ids: np.ndarray) -> tuple[n
     """Drop repeated voxels (first kept); refuse a voxel given two different ids."""
     if len(voxels) < 2:
         return voxels, ids
-    keys = _numpy_keys(voxels)
+    keys = row_keys(voxels)
     if keys is not None and bool(np.all(keys[1:] > keys[:-1])):  # sorted (ours are): no repeats
         return voxels, ids
     rows = voxels if keys is None else keys  # one int64 a voxel sorts faster than rows

@@ -14,11 +14,8 @@ Anything else stops at the first bad line with ``file:line: what was wrong``.
 from __future__ import annotations
 
 import contextlib
-import functools
 import logging
 import os
-import threading
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -27,6 +24,8 @@ from ladartui.atomic import atomic_path, write_errors_named
 from ladartui.errors import InputFileError
 from ladartui.fileprobe import NO_SUCH_FILE, path_field, refuse_special_file
 from ladartui.fingerprint import Digest
+from ladartui.scene.lazy_kernels import NUMPY_BYTES, LazyKernels
+from ladartui.scene.unique_rows import unique_voxels
 from ladartui.scene.voxel_arrays import MAX_TARGET_ID, target_ids_field, voxel_list_field
 
 log = logging.getLogger(__name__)
@@ -39,38 +38,7 @@ _BOM = b"\xef\xbb\xbf"
 _NEWLINE, _CR, _SPACE, _TAB, _COMMA, _ZERO, _NINE = 10, 13, 32, 9, 44, 48, 57
 _MAX_DIGITS = len(str(MAX_INDEX))
 
-_KERNELS: dict[str, Callable] = {}  # this module's numba kernels (Python functions), callees first
-_kernels_lock = threading.Lock()
-_compiled = False
-
-
-def _kernel(func):
-    """Mark ``func`` as a numba kernel (nogil, cached), compiled on its first call.
-
-    numba is imported only then; compiling rebinds every kernel of the module
-    at once, so kernels calling kernels see compiled callees.
-    """
-    _KERNELS[func.__name__] = func
-
-    @functools.wraps(func)
-    def first_call(*args):
-        _compile_kernels()
-        return globals()[func.__name__](*args)
-
-    return first_call
-
-
-def _compile_kernels() -> None:
-    with _kernels_lock:
-        global _compiled
-        if _compiled:
-            return  # another thread got here first
-        import numba
-
-        module = globals()
-        for name, py_func in _KERNELS.items():
-            module[name] = numba.njit(nogil=True, cache=True)(py_func)
-        _compiled = True
+_kernel = LazyKernels(globals())
 
 
 @_kernel
@@ -243,8 +211,7 @@ EXPECTED_TARGET = (
 )
 
 
-# Up to this size the array passes beat loading the compiled kernel (~45 ms a megabyte).
-_PLAIN_BYTES = 4_000_000
+_PLAIN_BYTES = NUMPY_BYTES  # up to this size: array passes, no compiled kernel
 # byte -> 0 digit, 1 comma, 2 newline, 3 anything else
 _BYTE_CLASS = np.full(256, 3, dtype=np.uint8)
 _BYTE_CLASS[_ZERO : _NINE + 1] = 0
@@ -465,114 +432,6 @@ def describe_bad_line(text: str, columns: int = 3, target: bool = False) -> str:
                 return f"id = {shown} is not a target id; {EXPECTED_TARGET}"
             return f"{axis} = {shown} is too large; expected at most {MAX_INDEX}"
     return f"cannot read {_quoted(body.strip())}; {expected}"
-
-
-def unique_voxels(voxels: np.ndarray) -> tuple[np.ndarray, int]:
-    """Drop repeated rows, keeping first occurrences in order; returns (voxels, dropped)."""
-    voxels = np.ascontiguousarray(voxels, dtype=np.int32)
-    if len(voxels) < 2:
-        return voxels, 0
-    # Sorted files (ours are) cannot repeat a voxel: checked in place for large lists
-    # (no key array); small ones (start-up files) stay in numpy, without loading numba.
-    if voxels.nbytes > _PLAIN_BYTES and _rows_increasing(voxels):
-        return voxels, 0
-    keys = _numpy_keys(voxels)
-    if keys is None:  # indices too large to pack into one int64
-        _, first = np.unique(voxels, axis=0, return_index=True)
-        first.sort()
-        return voxels[first], len(voxels) - len(first)
-    if bool(np.all(keys[1:] > keys[:-1])):  # sorted files (ours are) cannot repeat a voxel
-        return voxels, 0
-    keep = _first_occurrences(keys, int(keys.max()).bit_length())
-    kept = int(np.count_nonzero(keep))
-    if kept == len(voxels):
-        return voxels, 0
-    return _select_rows(voxels, keep, kept), len(voxels) - kept
-
-
-@_kernel
-def _rows_increasing(voxels):
-    # Strictly increasing rows in (x, y, z) order, checked in place (no key array).
-    for i in range(1, voxels.shape[0]):
-        for axis in range(3):
-            a, b = voxels[i - 1, axis], voxels[i, axis]
-            if a < b:
-                break
-            if a > b or axis == 2:
-                return False
-    return True
-
-
-@_kernel
-def _select_rows(voxels, keep, kept):
-    # voxels[keep] in one pass; numpy's boolean row indexing is several times slower here.
-    out = np.empty((kept, 3), dtype=voxels.dtype)
-    row = 0
-    for i in range(voxels.shape[0]):
-        if keep[i]:
-            out[row, 0] = voxels[i, 0]
-            out[row, 1] = voxels[i, 1]
-            out[row, 2] = voxels[i, 2]
-            row += 1
-    return out
-
-
-_RADIX_BITS = 11
-
-
-@_kernel
-def _first_occurrences(keys, bits):
-    """Mask of the rows whose key has not appeared earlier.
-
-    A stable LSD radix sort (11-bit digits) groups equal keys with their
-    earliest row first; it costs a few passes over the data whatever the
-    scene's extent, several times faster than a comparison sort here.
-    """
-    n = keys.shape[0]
-    order = np.arange(n)
-    sorted_keys = keys.copy()
-    order_scratch = np.empty(n, dtype=np.int64)
-    keys_scratch = np.empty(n, dtype=np.int64)
-    passes = max(1, (bits + _RADIX_BITS - 1) // _RADIX_BITS)
-    digit_bits = max(1, (bits + passes - 1) // passes)  # equal-width digits
-    buckets = 1 << digit_bits
-    mask = buckets - 1
-    for p in range(passes):
-        shift = p * digit_bits
-        counts = np.zeros(buckets + 1, dtype=np.int64)
-        for i in range(n):
-            counts[((sorted_keys[i] >> shift) & mask) + 1] += 1
-        for b in range(buckets):
-            counts[b + 1] += counts[b]
-        for i in range(n):
-            key = sorted_keys[i]
-            digit = (key >> shift) & mask
-            slot = counts[digit]
-            keys_scratch[slot] = key
-            order_scratch[slot] = order[i]
-            counts[digit] = slot + 1
-        order, order_scratch = order_scratch, order
-        sorted_keys, keys_scratch = keys_scratch, sorted_keys
-    keep = np.ones(n, dtype=np.bool_)
-    for i in range(1, n):
-        if sorted_keys[i] == sorted_keys[i - 1]:
-            keep[order[i]] = False
-    return keep
-
-
-def _numpy_keys(voxels: np.ndarray) -> np.ndarray | None:
-    """One int64 per row, ``(x * ny + y) * nz + z`` over the rows' own extent; None past 63 bits.
-
-    Spans every index a file may hold (``scene.keys`` covers those of a scene in memory).
-    """
-    nx, ny, nz = (int(s) for s in _column_max(voxels) + 1)
-    if nx * ny * nz >= 2**63:
-        return None
-    return (voxels[:, 0].astype(np.int64) * ny + voxels[:, 1]) * nz + voxels[:, 2]
-
-
-def _column_max(voxels: np.ndarray) -> np.ndarray:
-    return np.array([voxels[:, axis].max() for axis in range(3)], dtype=np.int64)
 
 
 def save_voxels(path, voxels, ids=None) -> None:
