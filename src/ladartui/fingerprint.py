@@ -38,3 +38,16 @@ def fingerprint_of(data) -> Fingerprint:
     digest = Digest()
     digest.update(data)
     return digest.fingerprint()
+
+
+def file_fingerprint(path) -> Fingerprint | None:
+    """The fingerprint of a file's bytes as they are on disk now; None when it cannot
+    be read (read in 1 MB pieces, not whole)."""
+    digest = Digest()
+    try:
+        with open(path, "rb") as file:
+            for block in iter(lambda: file.read(1 << 20), b""):
+                digest.update(block)
+    except OSError:
+        return None
+    return digest.fingerprint()

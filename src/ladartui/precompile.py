@@ -21,6 +21,7 @@ looks). Failing here fails nothing: a run compiles what it still needs.
 
 from __future__ import annotations
 
+import functools
 import subprocess
 import sys
 import time
@@ -55,12 +56,10 @@ def _object_order(scenario) -> None:
 def _made_up_scan(scenario, order: str, rays: int) -> None:
     """``rays`` of a scan over a small slab, traced in ``order`` by each backend the
     scenario may use."""
-    from ladartui.scene.model import Scene
     from ladartui.tracing import TINY
     from ladartui.tracing.prepare import rays_to_cells
 
-    slab = np.stack(np.meshgrid(np.arange(24), np.arange(24), np.arange(3), indexing="ij"), -1).reshape(-1, 3)
-    occupancy = Scene(slab, slab[:10], 1.0).occupancy
+    occupancy = _slab()
     origins, directions = _pinhole_scan(np.array([12.0, 12.0, 40.0]))
     cells, unit, bounds = rays_to_cells(origins[:rays], directions[:rays], 1.0, TINY)
     for engine in _engines(scenario.backend):
@@ -73,6 +72,15 @@ def _made_up_scan(scenario, order: str, rays: int) -> None:
             block_bounds=bounds,
             order=order,
         )
+
+
+@functools.cache
+def _slab():
+    """The occupancy of a 24 x 24 x 3 slab of voxels (built once a process)."""
+    from ladartui.scene.model import Scene
+
+    slab = np.stack(np.meshgrid(np.arange(24), np.arange(24), np.arange(3), indexing="ij"), -1).reshape(-1, 3)
+    return Scene(slab, slab[:10], 1.0).occupancy
 
 
 def _pinhole_scan(origin):

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ladartui.errors import LadarError
-from ladartui.fingerprint import Digest
+from ladartui.fingerprint import file_fingerprint
 from ladartui.recent import remember_scenario
 from ladartui.run_record import (
     input_changes,
@@ -246,7 +246,7 @@ def _inputs_changed(scenario, scene) -> tuple[list[str], list[str], str | None]:
         for entry in recorded
         if entry.path in read_here
         and read_here[entry.path] != entry.fingerprint
-        and _fingerprint_on_disk(entry.path) == entry.fingerprint
+        and file_fingerprint(entry.path) == entry.fingerprint
     ]
     changes = [visible(change) for change in input_changes([e for e in recorded if e not in newer], here)]
     changes += [
@@ -255,18 +255,6 @@ def _inputs_changed(scenario, scene) -> tuple[list[str], list[str], str | None]:
     ]
     names = [visible(entry.path.name) for entry in newer]
     return changes, names, f"Earlier outputs: {'; '.join(changes)}." if changes else None
-
-
-def _fingerprint_on_disk(path: Path):
-    """The file's fingerprint as it is now, or None when it cannot be read."""
-    digest = Digest()
-    try:
-        with open(path, "rb") as file:
-            for block in iter(lambda: file.read(1 << 20), b""):
-                digest.update(block)
-    except OSError:
-        return None
-    return digest.fingerprint()
 
 
 def _target_output(scenario) -> np.ndarray | None:
