@@ -271,8 +271,13 @@ def _checked_simulate_options(options, base) -> dict:
         return {}
     if not isinstance(options, Mapping) or not set(options) <= set(SIMULATE_OPTIONS):
         raise FieldError("simulate_options", options, "a dict of " + ", ".join(SIMULATE_OPTIONS))
-    base.with_changes(**{key: value for key, value in options.items() if value is not None})
+    _with_options(base, options)
     return dict(options)
+
+
+def _with_options(base, options: Mapping):
+    """The base scenario as its variants run it: with the options that are set."""
+    return base.with_changes(**{key: value for key, value in options.items() if value is not None})
 
 
 @contextlib.contextmanager
@@ -350,7 +355,7 @@ def _run_locked(
         options = dict(simulate_options or {})
         if serial or client is None:  # here or on this machine's workers: its cache
             scene()  # read first: a mistake in its model is told before any compiling
-            compile_ahead(base.with_changes(**{k: v for k, v in options.items() if v is not None}), cancel)
+            compile_ahead(_with_options(base, options), cancel)
         if serial:
             result_workers = 1
             _run_serial(todo, base, digest, scene(), options, record, cancel)
