@@ -13,6 +13,7 @@ from textual.widget import Widget
 from textual.widgets import DataTable
 
 from ladartui.errors import LadarError
+from ladartui.number_text import plural
 from ladartui.recent import remember_path
 from ladartui.tui.status import BUSY, NOT_READY, READY
 from ladartui.tui.sweep_jobs import open_sweep
@@ -92,10 +93,9 @@ class SweepOpening(RankingView):
         left_out = ""
         if own is not None and len(own) < len(result.rows):
             self.rows = own
-            count = len(result.rows) - len(own)
             # said first: after the ranking's words it was cut off at 80 columns
-            rows = "row" if count == 1 else "rows"
-            left_out = f"{count} {rows} not ranked: other variants or an earlier base; "
+            count = plural(len(result.rows) - len(own), "row")
+            left_out = f"{count} not ranked: other variants or an earlier base; "
             self._rank_quietly()
         self.progress = None
         self._redraw()
