@@ -5,7 +5,7 @@ import os
 import tempfile
 from pathlib import Path
 
-from ladartui.errors import OutputFileError
+from ladartui.errors import OutputFileError, os_reason
 
 
 @contextlib.contextmanager
@@ -36,7 +36,7 @@ def write_errors_named(target):
     try:
         yield
     except OSError as error:
-        reason = os.strerror(error.errno) if error.errno else str(error)
+        reason = os_reason(error)
         raise OutputFileError(target, f"cannot be written ({reason.lower()})") from None
 
 

@@ -66,5 +66,12 @@ class OutputFileError(LadarError):
         super().__init__(f"{self.path}: {message}")
 
 
+def os_reason(error: OSError) -> str:
+    """An OSError's reason in words, without the path it names ("Permission denied")."""
+    import os
+
+    return os.strerror(error.errno) if error.errno else str(error)
+
+
 class ResourceLimitError(LadarError):
     """Work refused up front: its estimated memory or rays exceed the limit."""

@@ -5,7 +5,7 @@ import errno
 import os
 from pathlib import Path
 
-from ladartui.errors import FieldError, InputFileError
+from ladartui.errors import FieldError, InputFileError, os_reason
 
 SPECIAL_FILE = "is not a regular file (a pipe or device)"
 FOLDER = "is a folder, expected a file"  # file_problem's words for a folder
@@ -33,7 +33,7 @@ def file_problem(path: Path) -> str | None:
     except OSError as error:
         if error.errno == errno.ENAMETOOLONG:
             return f"name too long for this system (at most {_name_max(path)} characters a name)"
-        return f"cannot be read ({os.strerror(error.errno) if error.errno else error})"
+        return f"cannot be read ({os_reason(error)})"
 
 
 def not_utf8(data: bytes, error: UnicodeDecodeError) -> tuple[int, str]:

@@ -22,7 +22,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from ladartui.errors import OutputFileError, check_cancelled
+from ladartui.errors import OutputFileError, check_cancelled, os_reason
 from ladartui.fileprobe import SPECIAL_FILE
 
 # Called with a step name ("temporaries", "swap", "backups") at each stage of the
@@ -87,7 +87,7 @@ def output_problem(path) -> str | None:
         os.close(fd)
         os.unlink(probe)
     except OSError as error:
-        reason = os.strerror(error.errno) if error.errno else str(error)
+        reason = os_reason(error)
         return f"cannot be written ({reason.lower()})"
     return None
 
@@ -312,7 +312,7 @@ def _write_journal(journal: Path, entries):
 
 
 def _write_error(path, error: OSError) -> OutputFileError:
-    reason = os.strerror(error.errno) if error.errno else str(error)
+    reason = os_reason(error)
     return OutputFileError(
         path, f"could not be written ({reason.lower()}); nothing was replaced, earlier outputs are unchanged"
     )

@@ -60,9 +60,9 @@ def made_folder(folder: Path) -> Path:
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as error:
-        from ladartui.errors import OutputFileError
+        from ladartui.errors import OutputFileError, os_reason
 
-        reason = os.strerror(error.errno) if error.errno else str(error)
+        reason = os_reason(error)
         source = next(
             (name for name in ("LADARTUI_HOME", "XDG_DATA_HOME") if os.environ.get(name)),
             "default (~/.local/share/ladartui)",
