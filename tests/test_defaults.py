@@ -106,3 +106,24 @@ def test_default_orbit_circles_the_generated_target_and_keeps_it_in_view(materia
     slant = math.dist(scenario.poses()[0].position, centre)
     spacing = slant * math.radians(scenario.sensor.fov) / (scenario.sensor.grid * scenario.sensor.ray_grid)
     assert spacing < scenario.voxel_size / 2
+
+
+def test_load_scenario_takes_a_bundled_name_as_the_commands_do(materialised, tmp_path, monkeypatch):
+    """`ladartui run default` ran, but ladartui.load_scenario("default") said no such file."""
+    import ladartui
+    from ladartui.errors import InputFileError
+
+    load_scenario = ladartui.load_scenario
+    _, path = materialised
+    monkeypatch.chdir(tmp_path)
+    assert load_scenario("default").path == path
+    assert load_scenario("default.toml").path == path
+    # A file of that name here wins, as with the commands.
+    (tmp_path / "default.toml").write_text(path.read_text(encoding="utf-8"), encoding="utf-8")
+    assert load_scenario("default.toml", check_files=False).path == tmp_path / "default.toml"
+    with pytest.raises(InputFileError) as caught:
+        load_scenario("defualt")
+    assert str(caught.value) == (
+        f"{tmp_path / 'defualt'}: no such file; expected a scenario file (.toml) "
+        "or a bundled scenario: default, convoy"
+    )

@@ -34,7 +34,7 @@ _EXPORTS = {
     "path_length": "ladartui.flight",
     "Sensor": "ladartui.sensor",
     "Scenario": "ladartui.scenario",
-    "load_scenario": "ladartui.scenario",
+    "load_scenario": "ladartui.user_data",  # also takes a bundled name
     "trace": "ladartui.tracing",
     "simulate": "ladartui.simulation",
     "compute_measures": "ladartui.measures",

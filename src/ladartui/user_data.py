@@ -28,8 +28,10 @@ import platformdirs
 
 from ladartui.atomic import write_text_atomic
 from ladartui.defaults import target_centre
+from ladartui.fileprobe import path_field
 from ladartui.flight import Orbit
-from ladartui.scenario import scenario_from_toml
+from ladartui.scenario import Scenario, scenario_from_toml
+from ladartui.scenario import load_scenario as load_scenario_file
 
 DEFAULT_PRESET = "small"
 DEFAULT_SCENARIO_NAME = "default.toml"
@@ -136,6 +138,15 @@ def bundled_or_path(argument) -> Path:
         expected = "expected a scenario file (.toml) or a bundled scenario: " + ", ".join(BUNDLED)
         raise InputFileError(path.absolute(), f"{NO_SUCH_FILE}; {expected}")
     return path
+
+
+def load_scenario(path, check_files=True) -> Scenario:
+    """``ladartui.load_scenario``: ``scenario.load_scenario``, taking a bundled scenario's
+    bare name ("default", "convoy") as the commands do, made ready on first use (a
+    file of that name where Python runs wins)."""
+    return load_scenario_file(
+        bundled_or_path(path_field("path", path, "a scenario file's path")), check_files
+    )
 
 
 def _model_files(folder: Path, name: str):
