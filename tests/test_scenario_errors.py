@@ -1,0 +1,202 @@
+"""Scenario files' mistakes: field limits, unknown and missing keys, TOML syntax."""
+
+import pytest
+
+from ladartui.errors import FieldError, InputFileError
+from ladartui.scenario import load_scenario
+from scenario_support import BASE, edited, line_of, write_scenario
+
+# -- field limits ----------------------------------------------------------------------
+
+LIMITS = [
+    ("voxel_size = 0.5", "voxel_size = 0", "files.voxel_size = 0", "a number greater than 0 and at most 100"),
+    (
+        "voxel_size = 0.5",
+        "voxel_size = 250.0",
+        "files.voxel_size = 250.0",
+        "a number greater than 0 and at most 100",
+    ),
+    ('scene = "models/forest.txt"', "scene = 3", "files.scene = 3", "the scene model file name (X.txt)"),
+    ("grid = 32", "grid = 2000", "sensor.grid = 2000", "an integer from 1 to 1024"),
+    ("grid = 32", "grid = 32.5", "sensor.grid = 32.5", "an integer from 1 to 1024"),
+    ("ray_grid = 2", "ray_grid = 0", "sensor.ray_grid = 0", "an integer from 1 to 16"),
+    ("fov_deg = 12.0", "fov_deg = 90.0", "sensor.fov_deg = 90.0", "a number at least 1e-14 and less than 90"),
+    (
+        "fov_deg = 12.0",
+        'fov_deg = "wide"',
+        "sensor.fov_deg = 'wide'",
+        "a number at least 1e-14 and less than 90",
+    ),
+    (
+        "depth_resolution_m = 1.5",
+        "depth_resolution_m = -1",
+        "sensor.depth_resolution_m = -1",
+        "a number from 0 to 1000",
+    ),
+    (
+        "pixel_pitch_um = 100.0",
+        "pixel_pitch_um = 0",
+        "sensor.pixel_pitch_um = 0",
+        "a number from 0.1 to 10000",
+    ),
+    (
+        "pixel_pitch_um = 100.0",
+        "pixel_pitch_um = 20000.0",
+        "sensor.pixel_pitch_um = 20000.0",
+        "a number from 0.1 to 10000",
+    ),
+    (
+        "pixel_pitch_um = 100.0",
+        "pixel_pitch_um = true",
+        "sensor.pixel_pitch_um = True",
+        "a number from 0.1 to 10000",
+    ),
+    (
+        "speed_mps = 25.0",
+        "speed_mps = 0.0",
+        "flight.speed_mps = 0.0",
+        "a number greater than 0 and at most 1000",
+    ),
+    ("depression = 45.0", "depression = 0.0", "flight.start.depression = 0.0", "a number from 1 to 90"),
+    ("z = 80.0", "z = -5.0", "flight.start.z = -5.0", "a number greater than 0 and at most 100000"),
+    (
+        "distance = 50.0",
+        "distance = 0.0",
+        "flight.segments[0].distance = 0.0",
+        "a number greater than 0 and at most 1000000",
+    ),
+    ("scans = 8", "scans = 0", "flight.segments[1].scans = 0", "an integer from 1 to 10000"),
+    (
+        "radius = 60.0",
+        "radius = -60.0",
+        "flight.segments[1].radius = -60.0",
+        "a number greater than 0 and at most 1000000",
+    ),
+    (
+        "centre = [10.0, 10.0, 1.0]",
+        "centre = [10.0]",
+        "flight.segments[1].centre = [10.0]",
+        "a point [x, y] or [x, y, z] in metres, each within +-1000000",
+    ),
+    (
+        'kind = "orbit"',
+        'kind = "circle"',
+        "flight.segments[1].kind = 'circle'",
+        "one of 'manual', 'straight', 'turn', 'orbit', 'flypast', 'standoff', 'log'",
+    ),
+    ('method = "march"', 'method = "fast"', "simulation.method = 'fast'", "one of 'exact', 'march'"),
+    ("step = 0.25", "step = 0", "simulation.step = 0", "a number from 0.001 to 10"),
+    ("step = 0.25", "step = 1e-12", "simulation.step = 1e-12", "a number from 0.001 to 10"),
+    ('precision = "f32"', 'precision = "f16"', "simulation.precision = 'f16'", "one of 'f64', 'f32'"),
+    ("fast_mode = true", "fast_mode = 1", "simulation.fast_mode = 1", "true or false"),
+]
+
+
+@pytest.mark.parametrize("old,new,head,expected", LIMITS, ids=[row[2] for row in LIMITS])
+def test_every_field_limit_names_file_line_field_value_and_range(tmp_path, old, new, head, expected):
+    text = edited(old, new)
+    path = write_scenario(tmp_path, text)
+    with pytest.raises(FieldError) as caught:
+        load_scenario(path, check_files=False)
+    line = line_of(text, new)
+    assert str(caught.value) == f"{path}:{line}: {head}: expected {expected}"
+
+
+def test_backend_must_be_known(tmp_path):
+    path = write_scenario(tmp_path, edited('backend = "auto"', 'backend = "cuda"'))
+    with pytest.raises(FieldError) as caught:
+        load_scenario(path, check_files=False)
+    message = str(caught.value)
+    assert message.startswith(
+        f"{path}:{line_of(BASE, 'backend')}: simulation.backend = 'cuda': expected one of 'auto', "
+    )
+
+
+def test_aim_above_the_horizon_names_the_segment(tmp_path):
+    text = edited("scans = 2\n", "scans = 2\naim_at = [0.0, 5000.0, 0.0]\n")
+    path = write_scenario(tmp_path, text)
+    with pytest.raises(FieldError) as caught:
+        load_scenario(path, check_files=False)
+    assert caught.value.field == "flight.segments[0].aim_at"
+    assert str(caught.value).startswith(f"{path}:{line_of(text, 'aim_at')}: ")
+
+
+def test_relative_segment_first_needs_a_start(tmp_path):
+    start = BASE[BASE.index("[flight.start]") : BASE.index("[[flight.segments]]")]
+    path = write_scenario(tmp_path, BASE.replace(start, ""))
+    with pytest.raises(FieldError) as caught:
+        load_scenario(path, check_files=False)
+    assert caught.value.field == "flight.start"
+
+
+# -- unknown and missing keys, syntax ------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "old,new,message",
+    [
+        (
+            "grid = 32",
+            "gird = 32",
+            "unknown key 'sensor.gird' (allowed: grid, ray_grid, fov_deg, "
+            "depth_resolution_m, pixel_pitch_um, mount)",
+        ),
+        (
+            "radius = 60.0",
+            "raduis = 60.0",
+            "unknown key 'flight.segments[1].raduis' (orbit segment) "
+            "(allowed: kind, centre, radius, altitude, scans, direction, start_bearing, arc, aim_at)",
+        ),
+        (
+            "[simulation]",
+            "[simulatoin]",
+            "unknown section [simulatoin] "
+            "(allowed: files, sensor, flight, simulation, detection, levels, targets)",
+        ),
+        (
+            "heading = 0.0",
+            "headin = 0.0",
+            "unknown key 'flight.start.headin' (allowed: x, y, z, heading, azimuth, depression)",
+        ),
+        # arrays of tables had no line ("[[flight.segmnts]]" was named without one)
+        (
+            "[[flight.segments]]",
+            "[[flight.segmnts]]",
+            "unknown key 'flight.segmnts' (allowed: speed_mps, start, segments)",
+        ),
+        (
+            "[simulation]",
+            "[[simulatoin]]",
+            "unknown section [simulatoin] "
+            "(allowed: files, sensor, flight, simulation, detection, levels, targets)",
+        ),
+    ],
+)
+def test_unknown_keys_are_named_with_their_line(tmp_path, old, new, message):
+    text = edited(old, new)
+    path = write_scenario(tmp_path, text)
+    with pytest.raises(InputFileError) as caught:
+        load_scenario(path, check_files=False)
+    assert str(caught.value) == f"{path}:{line_of(text, new)}: {message}"
+
+
+def test_missing_keys(tmp_path):
+    path = write_scenario(tmp_path, edited('scene = "models/forest.txt"\n', ""))
+    with pytest.raises(InputFileError) as caught:
+        load_scenario(path, check_files=False)
+    assert str(caught.value) == f"{path}:1: missing key 'files.scene'"
+    text = edited("radius = 60.0\n", "")
+    path = write_scenario(tmp_path, text)
+    with pytest.raises(InputFileError) as caught:
+        load_scenario(path, check_files=False)
+    header = line_of(text, 'kind = "orbit"') - 1
+    assert str(caught.value) == (f"{path}:{header}: missing key 'flight.segments[1].radius' (orbit segment)")
+
+
+def test_toml_syntax_error_gives_the_line(tmp_path):
+    text = edited("grid = 32", "grid = = 32")
+    path = write_scenario(tmp_path, text)
+    with pytest.raises(InputFileError) as caught:
+        load_scenario(path, check_files=False)
+    assert caught.value.line == line_of(text, "grid = = 32")
+    assert str(caught.value).startswith(f"{path}:{caught.value.line}: not valid TOML: ")
