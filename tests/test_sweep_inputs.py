@@ -491,3 +491,36 @@ def test_a_connect_timeout_without_a_scheduler_is_refused(tiny, tmp_path, capsys
         "(only a connection to a scheduler waits for it)"
     )
     assert not (tmp_path / "o").exists()  # refused before anything ran
+
+
+@pytest.mark.parametrize(
+    "body,made,sizes",
+    [
+        (
+            "[grid]\nradius = { start = 1, stop = 401, step = 1 }\naltitude = { start = 1, stop = 301, step = 1 }\n",
+            "[grid] makes 120,701",
+            "401 radius x 301 altitude",
+        ),
+        (
+            "[random]\nsamples = 200000\nradius = { min = 10, max = 90 }\n",
+            "[random] makes 200,000",
+            "200,000 random draws",
+        ),
+        (
+            "[grid]\nradius = [10, 20, 30]\n[random]\nsamples = 50000\naltitude = { min = 50, max = 90 }\n",
+            "[grid] and [random] make 150,000",
+            "3 radius x 50,000 random draws",
+        ),
+    ],
+)
+def test_too_many_variants_names_the_spec_line_and_the_sizes(tmp_path, body, made, sizes):
+    """The limit of 100,000 variants named the file but no line."""
+    from ladartui.errors import ResourceLimitError
+
+    spec = write_spec(tmp_path, body)
+    with pytest.raises(ResourceLimitError) as caught:
+        load_sweep_spec(spec)
+    assert str(caught.value) == (
+        f"{spec}:3: {made} variants ({sizes}), more than the limit of 100,000; use fewer values or samples"
+    )
+    assert made.split()[0] == spec.read_text(encoding="utf-8").splitlines()[2]  # line 3, the table's

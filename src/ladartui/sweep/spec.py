@@ -193,17 +193,20 @@ MAX_RANGE_VALUES = 100_000  # in one { start, stop, step } range
 RANDOM_BOUND = 1e15
 
 
-def _check_variant_count(path, grid, samples):
+def _check_variant_count(checker, grid, samples):
     from ladartui.errors import ResourceLimitError
 
     count = math.prod(len(values) for values in grid.values()) * max(samples, 1)
     if count > MAX_VARIANTS:
         sizes = " x ".join(f"{len(v)} {k}" for k, v in grid.items())
         draws = f"{samples:,} random draws" if samples else ""
+        tables = [name for name, used in (("grid", grid), ("random", samples)) if used]
+        line = checker.line("", tables[0])
+        where = f"{checker.path}:{line}" if line else str(checker.path)
+        made = " and ".join(f"[{name}]" for name in tables) + (" make" if len(tables) > 1 else " makes")
         raise ResourceLimitError(
-            f"{path}: [grid] and [random] make {count:,} variants "
-            f"({' x '.join(filter(None, (sizes, draws)))}), more than the "
-            f"limit of {MAX_VARIANTS:,}; use fewer values or samples"
+            f"{where}: {made} {count:,} variants ({' x '.join(filter(None, (sizes, draws)))}), "
+            f"more than the limit of {MAX_VARIANTS:,}; use fewer values or samples"
         )
 
 
@@ -287,7 +290,7 @@ def parse_sweep_spec(data: dict, path, text: str = "") -> SweepSpec:
             "at least one parameter to vary in [grid] or [random]; known: " + ", ".join(PARAMETERS),
             None,
         )
-    _check_variant_count(path, grid, samples)
+    _check_variant_count(checker, grid, samples)
     scenario_path = path.parent / scenario
     bundled = bundled_scenario_name(scenario)  # "convoy" or "convoy.toml" with no such file here
     if bundled is not None and not scenario_path.exists():
