@@ -18,7 +18,7 @@ are caught; keys marked "default" may be left out)::
     ray_grid = 2                    # m: m x m rays per detector, 1..16
     fov_deg = 8.0                   # full field of view, degrees, > 0 and < 90
     depth_resolution_m = 1.0        # returns closer than this on one detector merge, 0..1000
-    pixel_pitch_um = 100.0          # detector pitch, micrometres, > 0 and <= 10000
+    pixel_pitch_um = 100.0          # detector pitch, micrometres, 0.1..10000
     mount = "stabilised"            # or "body-fixed": rays turn with roll and pitch
 
     [flight]
@@ -59,7 +59,8 @@ Other segment kinds and their keys (``aim_at`` is optional on every kind):
   target).
 * ``kind = "log"``: a recorded flight log ``file`` (CSV, relative to this
   file's folder; see ``ladartui.trajectory``), scans at ``rate`` (Hz) or at
-  ``times = [..]`` (s); ``azimuth`` (default 0), ``depression`` (default 90).
+  ``times = [..]`` (s); ``azimuth`` (default 0), ``depression`` (default 90);
+  ``origin = [lat, lon, alt]`` places a geodetic (latitude, longitude) log.
 
 Straight and turn segments continue from the previous segment's last scan
 (or from ``[flight.start]``); see ``ladartui.flight``. ::
