@@ -218,3 +218,26 @@ def test_settings_and_cli_reject_bad_values(capsys):
     assert [settings.threshold(m) for m in (1, 10, 25, 100, 1000)] == [1, 1, 3, 10, 100]
     assert main(["pulses", "--pulses", "1,x"]) == 2
     assert "--pulses = '1,x': expected comma-separated whole numbers" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "pulses, k, a, b",
+    [(10, 4, 3, 10), (40, 1, 1, 10**6), (2000, 1000, 1, 2), (3000, 40, 1, 100), (3000, 2, 1, 10**5)],
+)
+def test_binomial_tail_matches_exact_sums_past_a_thousand_pulses(pulses, k, a, b):
+    """Above about 1,030 pulses C(M, j) no longer fits a float and the sum raised
+    OverflowError, though [detection] pulses may be up to 100,000."""
+    tail = sum(math.comb(pulses, j) * a**j * (b - a) ** (pulses - j) for j in range(k, pulses + 1))
+    exact = tail / b**pulses  # int / int: correctly rounded
+    assert binomial_at_least(pulses, k, a / b) == pytest.approx(exact, rel=1e-9)
+
+
+def test_binomial_tail_at_the_largest_pulse_count_and_its_ends():
+    # k at the mean M p: about a half (a normal tail, 0.5 within 0.2 %).
+    assert binomial_at_least(100_000, 10_000, 0.1) == pytest.approx(0.5, abs=0.003)
+    assert binomial_at_least(100_000, 1, 1e-9) == pytest.approx(-math.expm1(100_000 * math.log1p(-1e-9)))
+    assert binomial_at_least(100_000, 50_000, 0.1) == 0.0  # below the smallest float
+    assert binomial_at_least(2000, 1, 0.0) == 0.0
+    assert binomial_at_least(2000, 2000, 1.0) == 1.0
+    assert binomial_at_least(2000, 0, 0.3) == 1.0
+    assert binomial_at_least(2000, 2001, 0.3) == 0.0

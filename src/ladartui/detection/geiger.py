@@ -120,10 +120,26 @@ def noise_per_bin(rate_hz: float, bin_width_m: float) -> float:
 
 
 def binomial_at_least(pulses: int, threshold: int, p: float) -> float:
-    """P(at least ``threshold`` of ``pulses`` Bernoulli(p) trials succeed)."""
-    return float(
-        sum(math.comb(pulses, j) * p**j * (1.0 - p) ** (pulses - j) for j in range(threshold, pulses + 1))
-    )
+    """P(at least ``threshold`` of ``pulses`` Bernoulli(p) trials succeed).
+
+    Each term ``C(M, j) p^j (1 - p)^(M - j)`` is taken through its logarithm:
+    past about 1,030 pulses ``C(M, j)`` alone is beyond the largest float.
+    """
+    if threshold <= 0:
+        return 1.0
+    if threshold > pulses or p <= 0.0:
+        return 0.0
+    if p >= 1.0:
+        return 1.0
+    log_p, log_q = math.log(p), math.log1p(-p)
+    log_whole = math.lgamma(pulses + 1)
+    terms = [
+        math.exp(
+            log_whole - math.lgamma(j + 1) - math.lgamma(pulses - j + 1) + j * log_p + (pulses - j) * log_q
+        )
+        for j in range(threshold, pulses + 1)
+    ]
+    return min(1.0, math.fsum(terms))
 
 
 def optimal_energy_scale(n_target: float, n_foliage: float) -> float:
