@@ -288,3 +288,19 @@ def test_bad_voxel_lists_and_figures_are_field_errors_not_a_wrong_answer():
         compute_measures(target, target, target, path_length_m=float("nan"))
     with pytest.raises(FieldError, match=r"^voxel_size = -1"):
         compute_measures(target, target, target, voxel_size=-1)
+
+
+def test_the_same_coverage_in_both_views_has_no_shift():
+    """Two voxels of a 5 x 3 x 2 box, seen in both views: the shift read 1.49e-08 rad,
+    acos of a dot product a rounding step below 1."""
+    from ladartui.directions import angle_between
+
+    target = box(5, 3, 2)
+    seen = np.array([[0, 0, 0], [0, 0, 1]])
+    measures = compute_measures(target, seen, seen)
+    assert measures.direction_shift_rad == 0.0
+    # Small angles come out as they are (acos gave 0 for 1e-9 rad, 9.996e-08 for 1e-07).
+    for angle in (1e-9, 1e-7, 1e-4, 1.0, math.pi / 2, 3.0):
+        tilted = (math.cos(angle), math.sin(angle), 0.0)
+        assert angle_between((1.0, 0.0, 0.0), tilted) == pytest.approx(angle, rel=1e-12)
+    assert angle_between((0.0, 0.0, 1.0), (0.0, 0.0, -1.0)) == pytest.approx(math.pi, rel=1e-15)

@@ -67,11 +67,16 @@ def _clean(vector) -> tuple[float, float, float]:
 
 
 def angle_between(a, b) -> float | None:
-    """Angle in radians between two unit vectors; None if either is undefined."""
+    """Angle in radians between two unit vectors; None if either is undefined.
+
+    ``atan2(|a x b|, a . b)``: acos of the dot product loses half the digits
+    near 0 and pi (a rounding step below 1 read as 1.5e-8 rad).
+    """
     if a is None or b is None:
         return None
-    cosine = float(np.clip(np.dot(a, b), -1.0, 1.0))
-    return float(math.acos(cosine))
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    sine = float(np.linalg.norm(np.cross(a, b)))
+    return float(math.atan2(sine, float(np.dot(a, b))))
 
 
 def _list_or_none(vector):
