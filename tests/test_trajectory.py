@@ -233,3 +233,18 @@ def test_a_missing_log_is_named_on_its_scenario_line(tmp_path):
     assert str(caught.value).startswith(
         f"{path}:8: flight.segments[0].file = 'nope.csv': expected a flight log"
     )
+
+
+def test_scans_at_a_rate_end_on_the_last_record_when_its_time_rounds_short(tmp_path):
+    """A log from 0.1 to 0.3 s at 5 Hz: 0.1 + 1/5 is 0.30000000000000004 in floating
+    point, a rounding step past the log's last time, and the log was refused."""
+    from ladartui.trajectory import LogSegment
+
+    path = tmp_path / "log.csv"
+    path.write_text("time,x,y,z,heading\n0.1,0,0,50,90\n0.3,10,0,50,90\n")
+    poses = log_poses(load_flight_log(path), ScanPose(0, 0, 50), rate=5.0)
+    assert [p.x for p in poses] == pytest.approx([0.0, 10.0])
+    segment = LogSegment(str(path), rate=5.0)
+    assert list(segment.scan_times()) == [0.1, 0.3]
+    assert [p.x for p in segment.build(None)] == pytest.approx([0.0, 10.0])
+    assert len(segment.attitudes()) == 2

@@ -196,8 +196,7 @@ def log_poses(log: FlightLog, template: ScanPose, rate: float | None = None, tim
     if times is None:
         if rate is None or not rate > 0:
             raise TrajectoryError(f"scan rate = {rate!r}: expected a number > 0 (Hz)")
-        count = int(np.floor((log.time[-1] - log.time[0]) * rate + 1e-9)) + 1
-        times = log.time[0] + np.arange(count) / rate
+        times = rate_times(log, rate)
     times = np.asarray(times, dtype=np.float64)
     if np.any(times < log.time[0]) or np.any(times > log.time[-1]):
         raise TrajectoryError(f"scan times must lie within the log's {log.time[0]}..{log.time[-1]} s")
@@ -207,6 +206,17 @@ def log_poses(log: FlightLog, template: ScanPose, rate: float | None = None, tim
         replace(template, x=float(p[0]), y=float(p[1]), z=float(p[2]), heading=float(h) % 360.0)
         for p, h in zip(xyz, heading)
     ]
+
+
+def rate_times(log: FlightLog, rate: float) -> np.ndarray:
+    """Scan times at ``rate`` Hz from the log's first record, as many as fit in its span.
+
+    The count forgives rounding (records at 0.1 and 0.3 s span 0.9999999999999999
+    periods of 5 Hz), and a time a rounding step past the last record is that
+    record's time (0.1 + 1/5 is 0.30000000000000004).
+    """
+    count = int(np.floor((log.time[-1] - log.time[0]) * rate + 1e-9)) + 1
+    return np.minimum(log.time[0] + np.arange(count) / rate, log.time[-1])
 
 
 def log_attitude(log: FlightLog, times) -> tuple[np.ndarray, np.ndarray]:
@@ -318,8 +328,7 @@ class LogSegment:
             return np.asarray(self.times, dtype=np.float64)
         rate = self.rate
         assert rate is not None  # __post_init__ requires a rate when there are no times
-        count = int(np.floor((log.time[-1] - log.time[0]) * rate + 1e-9)) + 1
-        return log.time[0] + np.arange(count) / rate
+        return rate_times(log, rate)
 
     def build(self, current) -> list[ScanPose]:
         from ladartui.flight import ScanPose as Pose
