@@ -248,3 +248,17 @@ def test_scans_at_a_rate_end_on_the_last_record_when_its_time_rounds_short(tmp_p
     assert list(segment.scan_times()) == [0.1, 0.3]
     assert [p.x for p in segment.build(None)] == pytest.approx([0.0, 10.0])
     assert len(segment.attitudes()) == 2
+
+
+def test_a_rate_giving_the_most_scans_allowed_is_taken(tmp_path):
+    """999.95 s at 10 Hz is 10,000 scans (0 .. 999.9 s), the limit, yet the check
+    counted span x rate + 1 = 10,000.5 of them and refused the rate."""
+    from ladartui.flight import MAX_SCANS
+    from ladartui.trajectory import LogSegment
+
+    path = tmp_path / "log.csv"
+    path.write_text("time,x,y,z,heading\n0,0,0,50,90\n999.95,9999.5,0,50,90\n")
+    assert len(LogSegment(str(path), rate=10.0).scan_times()) == MAX_SCANS == 10_000
+    path.write_text("time,x,y,z,heading\n0,0,0,50,90\n1000,10000,0,50,90\n")
+    with pytest.raises(FieldError, match="at most 10000 scans over the log"):
+        LogSegment(str(path), rate=10.0)

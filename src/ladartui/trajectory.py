@@ -215,8 +215,12 @@ def rate_times(log: FlightLog, rate: float) -> np.ndarray:
     periods of 5 Hz), and a time a rounding step past the last record is that
     record's time (0.1 + 1/5 is 0.30000000000000004).
     """
-    count = int(np.floor((log.time[-1] - log.time[0]) * rate + 1e-9)) + 1
-    return np.minimum(log.time[0] + np.arange(count) / rate, log.time[-1])
+    return np.minimum(log.time[0] + np.arange(rate_count(log, rate)) / rate, log.time[-1])
+
+
+def rate_count(log: FlightLog, rate: float) -> int:
+    """How many scans ``rate_times`` gives (without making them: a rate may ask for millions)."""
+    return int(np.floor((log.time[-1] - log.time[0]) * rate + 1e-9)) + 1
 
 
 def log_attitude(log: FlightLog, times) -> tuple[np.ndarray, np.ndarray]:
@@ -296,7 +300,7 @@ class LogSegment:
         if self.rate is not None:
             rate = number_field("rate", self.rate, 0.0, MAX_SCAN_RATE_HZ, low_open=True)
             set_("rate", rate)
-            if (log.time[-1] - log.time[0]) * rate + 1 > MAX_SCANS:
+            if rate_count(log, rate) > MAX_SCANS:
                 raise FieldError("rate", self.rate, f"at most {MAX_SCANS} scans over the log")
         else:
             expected = f"a list of 1 to {MAX_SCANS} {span}"
