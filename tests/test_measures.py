@@ -304,3 +304,13 @@ def test_the_same_coverage_in_both_views_has_no_shift():
         tilted = (math.cos(angle), math.sin(angle), 0.0)
         assert angle_between((1.0, 0.0, 0.0), tilted) == pytest.approx(angle, rel=1e-12)
     assert angle_between((0.0, 0.0, 1.0), (0.0, 0.0, -1.0)) == pytest.approx(math.pi, rel=1e-15)
+
+
+def test_a_cmf_that_is_not_utf8_is_named_on_its_line(tmp_path):
+    """It raised UnicodeDecodeError, no LadarError: opening a scenario whose earlier
+    measures file was damaged stopped the loading (it should only be noted)."""
+    path = tmp_path / "bad.cmf"
+    path.write_bytes(CMF_HEADER.encode() + b"\n\n[3d target model]\ntarget_voxels = 8\xff\n")
+    with pytest.raises(InputFileError) as error:
+        read_cmf(path)
+    assert str(error.value).startswith(f"{path}:4: not UTF-8 text (byte 0xff)")

@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from ladartui.errors import InputFileError
-from ladartui.fileprobe import path_field, refuse_special_file
+from ladartui.fileprobe import path_field, read_utf8
 from ladartui.levels import level_result_from_dict
 from ladartui.measures import CMF_HEADER, CMF_HEADERS, Measures, measures_from_lines
 from ladartui.target_measures import PerTarget, is_target_section, read_target_lines
@@ -20,9 +20,8 @@ from ladartui.target_measures import PerTarget, is_target_section, read_target_l
 def read_cmf(path) -> Measures:
     """Read a ``.cmf`` file written by ``Measures.write_cmf``."""
     path = path_field("path", path, "a measures file's path (.cmf)")
-    refuse_special_file(path, "expected a measures file (.cmf)")
-    try:
-        text = open(path, encoding="utf-8").read()
+    try:  # a pipe is refused unread; bytes that are not UTF-8 are named on their line
+        text = read_utf8(path, "expected a measures file (.cmf)")
     except OSError as error:
         raise InputFileError(path, f"cannot read: {error.strerror or error}") from None
     lines = text.splitlines()
