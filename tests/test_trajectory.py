@@ -200,11 +200,26 @@ def test_a_bad_origin_in_a_scenario_is_named_on_its_line(tmp_path, origin, found
             "1,-35.28,1000,660,0",
             "log.csv:3: longitude = 1000.0: expected -180..180",
         ),
+        ("time,x,y,z,heading", "1,0,0,150000,0", "log.csv:3: z = '150000': expected at most 100000 m"),
+        (
+            "time,latitude,longitude,altitude,heading",
+            "1,-25.28,149.13,660,0",
+            "log.csv:3: latitude = -25.28, longitude = 149.13 put the aircraft 0 km east and "
+            "1103 km north of the origin: expected within 1000 km of it each way",
+        ),
+        (
+            "time,latitude,longitude,altitude,heading",
+            "1,-35.28,149.13,200000,0",
+            "log.csv:3: altitude = 200000.0 puts the aircraft 199440.0 m above the origin: "
+            "expected at most 100000 m above it",
+        ),
     ],
 )
 def test_a_bad_log_column_or_value_is_named_in_the_log(tmp_path, header, record, said):
     """A repeated column was taken without a word, 1e300 was blamed on the scenario's
-    flight.segments[0].x, a longitude of 1000 was taken (and np.float64 reached a message)."""
+    flight.segments[0].x, a longitude of 1000 was taken (and np.float64 reached a message);
+    a z of 150 km, and a point 1,100 km from a geodetic log's origin or 200 km above it,
+    were still blamed on the scenario's segment, not the log's line."""
     from ladartui.trajectory import TrajectoryError
 
     path = tmp_path / "log.csv"

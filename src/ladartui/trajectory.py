@@ -28,7 +28,7 @@ from ladartui.checks import MAX_COORDINATE
 from ladartui.errors import FieldError, LadarError
 from ladartui.fileprobe import file_problem, not_utf8, path_field, refuse_special_file
 from ladartui.fingerprint import Fingerprint, fingerprint_of
-from ladartui.flight import ScanPose
+from ladartui.flight import MAX_ALTITUDE, ScanPose
 from ladartui.number_text import plural
 
 REQUIRED = ("time", "x", "y", "z", "heading")
@@ -168,11 +168,31 @@ def load_flight_log(path, origin=None) -> FlightLog:
                 raise TrajectoryError(f"{path}:{number}: longitude = {lon!r}: expected -180..180")
         elif values["z"][-1] <= 0:
             raise TrajectoryError(f"{path}:{number}: z = {values['z'][-1]!r}: expected > 0")
+        elif values["z"][-1] > MAX_ALTITUDE:  # a scan pose's limit, named here on the log's line
+            raise TrajectoryError(
+                f"{path}:{number}: z = {fields[columns['z']].strip()!r}: expected at most {MAX_ALTITUDE:g} m"
+            )
     if len(values["time"]) < 2:
         raise TrajectoryError(f"{path}: {plural(len(values['time']), 'record')}: expected at least 2")
     arr = {k: np.array(v, dtype=np.float64) for k, v in values.items()}
     if geodetic:
         xyz = geodetic_to_local(arr["latitude"], arr["longitude"], arr["altitude"], origin)
+        far = np.flatnonzero(np.abs(xyz[:, :2]).max(axis=1) > MAX_COORDINATE)
+        if far.size:  # first: so far away the earth's curve also takes it below the origin
+            at = int(far[0])
+            raise TrajectoryError(
+                f"{path}:{rows[1 + at][0]}: latitude = {float(arr['latitude'][at])!r}, "
+                f"longitude = {float(arr['longitude'][at])!r} put the aircraft "
+                f"{xyz[at, 0] / 1000:.0f} km east and {xyz[at, 1] / 1000:.0f} km north of the "
+                f"origin: expected within {MAX_COORDINATE / 1000:g} km of it each way"
+            )
+        high = int(np.argmax(xyz[:, 2]))
+        if xyz[high, 2] > MAX_ALTITUDE:
+            raise TrajectoryError(
+                f"{path}:{rows[1 + high][0]}: altitude = "
+                f"{float(arr['altitude'][high])!r} puts the aircraft "
+                f"{xyz[high, 2]:.1f} m above the origin: expected at most {MAX_ALTITUDE:g} m above it"
+            )
         low = int(np.argmin(xyz[:, 2]))
         if xyz[low, 2] <= 0:
             raise TrajectoryError(
