@@ -497,7 +497,8 @@ def test_a_connect_timeout_without_a_scheduler_is_refused(tiny, tmp_path, capsys
     "body,made,sizes",
     [
         (
-            "[grid]\nradius = { start = 1, stop = 401, step = 1 }\naltitude = { start = 1, stop = 301, step = 1 }\n",
+            "[grid]\nradius = { start = 1, stop = 401, step = 1 }\n"
+            "altitude = { start = 1, stop = 301, step = 1 }\n",
             "[grid] makes 120,701",
             "401 radius x 301 altitude",
         ),
