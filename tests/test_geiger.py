@@ -241,3 +241,19 @@ def test_binomial_tail_at_the_largest_pulse_count_and_its_ends():
     assert binomial_at_least(2000, 2000, 1.0) == 1.0
     assert binomial_at_least(2000, 0, 0.3) == 1.0
     assert binomial_at_least(2000, 2001, 0.3) == 0.0
+
+
+def test_incidence_cosine_takes_a_face_the_ray_can_enter():
+    """The face was the plane nearest the hit point, so a range a float32 rounding long
+    (1e-6 m) put a hit on the top face, close to its far x edge, on the x face the ray
+    leaves by: cos |d_x| 0.29 for |d_z| 0.96."""
+    from ladartui.detection.look import incidence_cosines
+
+    d = np.array([0.3, 0.0, -1.0]) / np.hypot(0.3, 1.0)
+    hit = np.array([1.0 - 1e-9, 0.5, 1.0])  # cell space: voxel (0, 0, 0)'s top face, at its +x edge
+    origin = hit - 9.0 * d - 0.5  # metres (voxel size 1), 9 m before the hit
+    for error in (0.0, 1e-6, -1e-6):
+        cos = incidence_cosines(
+            origin[None], d[None], np.array([1]), np.array([[0, 0, 0]]), np.array([9.0 + error]), 1.0
+        )
+        assert cos[0] == pytest.approx(abs(d[2])), error

@@ -48,10 +48,14 @@ def incidence_cosines(origins, directions, kind, index, ranges, voxel_size) -> n
         along = (np.asarray(ranges)[voxel] / voxel_size)[:, None]
         p = np.asarray(origins)[voxel] / voxel_size + 0.5 + d[voxel] * along
         c = np.asarray(index)[voxel].astype(np.float64)
-        # The entry face is the one whose plane the hit point lies closest to.
-        gap = np.minimum(np.abs(p - c), np.abs(p - c - 1.0))
+        # The entry face: of the three the ray can enter by (the low side of an axis it
+        # goes up, the high side of one it goes down), the one whose plane the hit point
+        # lies closest to; never a face it leaves by, which a range rounded long (float32)
+        # put nearest a hit close to an edge.
+        dv = d[voxel]
+        gap = np.where(dv == 0.0, np.inf, np.abs(p - c - (dv < 0.0)))
         axis = np.argmin(gap, axis=1)
-        cos[voxel] = np.abs(d[voxel][np.arange(axis.size), axis])
+        cos[voxel] = np.abs(dv[np.arange(axis.size), axis])
     return cos
 
 
