@@ -426,3 +426,17 @@ def test_a_march_step_is_held_to_the_limits_run_holds_it_to(tmp_path, scene_file
         == f"ladartui: error: --step = {float(step)!r}: expected a number from 0.001 to 10"
     )
     assert not out.exists()
+
+
+def test_out_may_not_be_the_scene_it_traces(tmp_path, scene_file, capsys):
+    """--out naming the --scene file wrote the hits over the scene model."""
+    np.save(tmp_path / "rays.npy", np.array([[5.0, 5.0, 20.0, 0.0, 0.0, -1.0]]))
+    before = scene_file.read_bytes()
+    code = main(
+        ["trace", "--scene", str(scene_file), "--rays", str(tmp_path / "rays.npy"), "--out", str(scene_file)]
+    )
+    assert code == 2
+    assert one_error_line(capsys) == (
+        f"ladartui: error: --out = '{scene_file}': expected a file other than --scene"
+    )
+    assert scene_file.read_bytes() == before

@@ -155,8 +155,9 @@ def run(args):
         raise FieldError("--out", args.out, "a file in an existing folder")
     if out.is_dir():
         raise FieldError("--out", args.out, "a file name, not a folder")
-    if out.exists() and Path(args.rays).exists() and out.samefile(args.rays):
-        raise FieldError("--out", args.out, "a file other than --rays")
+    for flag, read in (("--rays", args.rays), ("--scene", args.scene)):
+        if out.exists() and Path(read).exists() and out.samefile(read):
+            raise FieldError("--out", args.out, f"a file other than {flag}")
     check_writable(out)  # before the trace, not after it
     earlier = _identity(out)
     try:
