@@ -144,3 +144,18 @@ def test_geiger_markers_stay_visible_where_they_meet_the_ideal_line():
     plot = [line.split("┤", 1)[1].split("├", 1)[0] for line in text.splitlines() if "┤" in line]
     markers = sum(row.count("o") for row in plot if "obscured coverage" not in row)
     assert markers >= len(rows)
+
+
+def test_the_chart_fits_a_narrow_terminal_and_keeps_its_title(scenario, capsys, monkeypatch):
+    """The chart was 78 columns whatever the width: on a 60-column terminal every line
+    wrapped onto the next, and at 60 plotext dropped the title, too long to fit."""
+    monkeypatch.setenv("COLUMNS", "60")
+    assert main(["pulses", str(scenario.path), "--pulses", "1,20"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines and max(len(line) for line in lines) <= 60
+    assert any("false alarms against pulses per look" in line for line in lines)
+    monkeypatch.setenv("COLUMNS", "200")  # wider: the chart as drawn before
+    assert main(["pulses", str(scenario.path), "--pulses", "1,20"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert max(len(line) for line in lines) == 78
+    assert any("Geiger-mode: coverage and false alarms against pulses per look" in line for line in lines)

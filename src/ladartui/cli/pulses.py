@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import shutil
 import sys
 import threading
 
@@ -18,7 +19,10 @@ from ladartui.cli.progress import stop_status
 from ladartui.errors import Cancelled, FieldError
 
 CHART_WIDTH = 78
+CHART_MIN_WIDTH = 52  # the legend's longest entry still fits inside the axes
 CHART_HEIGHT = 20
+TITLE = "Geiger-mode: coverage and false alarms against pulses per look"
+SHORT_TITLE = "coverage and false alarms against pulses per look"
 LEGEND_HEADROOM = 1.5
 
 
@@ -118,7 +122,9 @@ def run(args) -> int:
             f"{r.false_alarms:>7} {detection:>11}"
         )
     if args.chart:
-        print(chart_text(ideal, rows, color=sys.stdout.isatty()))
+        columns = shutil.get_terminal_size((CHART_WIDTH, CHART_HEIGHT)).columns  # COLUMNS first
+        width = max(CHART_MIN_WIDTH, min(columns, CHART_WIDTH))
+        print(chart_text(ideal, rows, width=width, color=sys.stdout.isatty()))
     return 0
 
 
@@ -190,7 +196,8 @@ def chart_text(ideal, rows, width=CHART_WIDTH, height=CHART_HEIGHT, color=True) 
         plotext.limit_size(False, False)
         plotext.plotsize(width, height)
         plotext.theme("pro" if color else "clear")
-        plotext.title("Geiger-mode: coverage and false alarms against pulses per look")
+        # plotext drops a title wider than the chart: a shorter one where the full one is
+        plotext.title(TITLE if len(TITLE) <= width else SHORT_TITLE)
         # The ideal line first: where the Geiger points fall on its row they are drawn over it.
         plotext.plot(xs, [100.0 * ideal] * len(xs), color="cyan", label="obscured coverage % (ideal)")
         plotext.plot(
