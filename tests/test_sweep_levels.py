@@ -88,6 +88,12 @@ def test_levels_text_says_which_level_the_path_reaches_and_when():
     assert levels_text({"variant": "old", "status": "ok", "obscured_coverage": 0.5}) == "levels unknown"
 
 
+def test_levels_text_writes_a_huge_time_with_an_exponent():
+    """A speed of 1e-300 m/s printed the time to identify as 300 digits (run's table wrote 3.142e+301 s)."""
+    slow = row("s", 0.9, identify=(4, 4e301), recognise=(2, 2e301))
+    assert levels_text(slow) == "reaches identify at scan 4 of 6 (4e+301 s, 1.2e+303 m from the first scan)"
+
+
 def test_objectives_survive_the_result_table(tmp_path):
     path = tmp_path / "results.csv"
     write_table(path, ROWS, [])

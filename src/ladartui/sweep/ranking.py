@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 from ladartui.errors import FieldError
 from ladartui.levels import LEVELS as LEVEL_NAMES
+from ladartui.number_text import fixed
 from ladartui.pareto import Sense, pareto_front
 from ladartui.sweep.columns import LEVEL_FIELDS
 from ladartui.sweep.columns import target_names as target_names
@@ -195,7 +196,7 @@ def levels_text(row: dict) -> str:
 
 
 def _amount(value, unit) -> str:
-    return "?" if value is None else f"{value:.1f} {unit}"
+    return "?" if value is None else f"{fixed(value, 1)} {unit}"  # 1e10 s and up: an exponent
 
 
 def objective_value(row: dict, objective: str, budget: float | None = None) -> float | None:
