@@ -117,6 +117,13 @@ def test_huge_sweep_and_generate_are_refused(tmp_path, capsys):
     )
     assert main(["sweep", str(spec), "--serial"]) == 2
     assert "1,000,000 variants (100 radius x 100 altitude x 100 scans)" in one_error_line(capsys)
+    # each list's length written as the total is: '2,000 radius', not '2000 radius'
+    spec.write_text(
+        '[sweep]\nscenario = "default"\n[grid]\nradius = { start = 1, stop = 2000, step = 1 }\n'
+        "altitude = { start = 1, stop = 100, step = 1 }\n"
+    )
+    assert main(["sweep", str(spec), "--serial"]) == 2
+    assert "200,000 variants (2,000 radius x 100 altitude)" in one_error_line(capsys)
     assert main(["generate", "small", str(tmp_path / "x"), "--trees", "100000000"]) == 2
     assert "trees = 100000000: expected at most 100,000 trees" in one_error_line(capsys)
 

@@ -198,7 +198,7 @@ def _check_variant_count(checker, grid, samples):
 
     count = math.prod(len(values) for values in grid.values()) * max(samples, 1)
     if count > MAX_VARIANTS:
-        sizes = " x ".join(f"{len(v)} {k}" for k, v in grid.items())
+        sizes = " x ".join(f"{len(v):,} {k}" for k, v in grid.items())
         draws = f"{samples:,} random draws" if samples else ""
         tables = [name for name, used in (("grid", grid), ("random", samples)) if used]
         line = checker.line("", tables[0])
