@@ -194,6 +194,26 @@ def test_a_scene_named_as_a_target_model_is_refused(tmp_path, truck, forest, cap
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
 
 
+@pytest.mark.parametrize("slash", ["", "/"])
+def test_a_folder_as_out_is_refused(tmp_path, truck, forest, capsys, slash):
+    """OUT naming a folder ('models' or 'models/') wrote models.txt beside it, and with --into
+    models.txt and models_Target.txt: the folder was taken as a file's stem."""
+    (tmp_path / "models").mkdir()
+    before = sorted(p.name for p in tmp_path.iterdir())
+    out = str(tmp_path / "models") + slash
+    args = ["voxelize", str(truck), out, "--voxel-size", "0.1", "--at", "3,3"]
+    assert main(args) == 2
+    assert one_error_line(capsys) == (
+        f"ladartui: error: OUT = {out!r}: expected a target model's file name (X.txt), not a folder"
+    )
+    assert main([*args, "--into", str(forest)]) == 2
+    assert one_error_line(capsys) == (
+        f"ladartui: error: OUT = {out!r}: expected the scene's stem (X writes X.txt and X_Target.txt), "
+        "not a folder"
+    )
+    assert sorted(p.name for p in tmp_path.iterdir()) == before and not any((tmp_path / "models").iterdir())
+
+
 def test_one_voxel_is_said_in_the_singular(tmp_path, truck, capsys):
     """A voxel as large as the truck: '1 voxels'."""
     assert main(["voxelize", str(truck), str(tmp_path / "t"), "--voxel-size", "5"]) == 0

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 import threading
 import time
 
@@ -96,6 +97,13 @@ def run(args) -> int:
     if args.at is not None:
         x, y, *rest = _position(args.at)
         placement = Placement(x, y, rest[0] if rest else 0.0, args.heading)
+    if args.out.endswith(("/", os.sep)) or Path(args.out).is_dir():  # not a stem: "models" + ".txt"
+        wanted = (
+            "the scene's stem (X writes X.txt and X_Target.txt)"
+            if args.into
+            else "a target model's file name (X.txt)"
+        )
+        raise FieldError("OUT", args.out, f"{wanted}, not a folder")
     outputs: tuple[Path, ...]
     if args.into:
         outputs = scene_model_paths(args.out)
