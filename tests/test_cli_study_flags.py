@@ -106,3 +106,44 @@ def test_the_scans_a_flight_has_are_all_taken_and_a_default_above_them_is_not_re
     assert len(study_inputs.scenario_inputs(path, available, refuse_as="--scans").poses) == available
     # the study screen and a default count keep taking what the flight has
     assert len(study_inputs.scenario_inputs(path, available + 5).poses) == available
+
+
+@pytest.mark.parametrize("signum, status", [(2, 130), (15, 143)], ids=["Ctrl-C", "SIGTERM"])
+def test_a_stopped_study_says_nothing_was_written(tmp_path, monkeypatch, capsys, signum, status):
+    """A Ctrl-C said only 'study cancelled', not whether the earlier study in --out was kept,
+    and SIGTERM ended the command without a word."""
+    import _thread
+    import types
+
+    import numpy as np
+
+    import ladartui.study.run as study_run
+    from ladartui.errors import Cancelled
+
+    inputs = types.SimpleNamespace(
+        name="tiny",
+        scene=types.SimpleNamespace(voxels=np.zeros((1, 3)), shape=(1, 1, 1)),
+        poses=[None],
+        sensor=types.SimpleNamespace(grid=4),
+    )
+    monkeypatch.setattr(study_inputs, "generated_inputs", lambda *a, **k: inputs)
+    monkeypatch.setattr(study_run, "backend_reasons", lambda backends: {})
+
+    def stopped(*args, cancel, **kwargs):
+        _thread.interrupt_main(signum)  # as the key, or `kill`, would
+        assert cancel.wait(10), "the stop did not cancel the study"
+        raise Cancelled("study cancelled")
+
+    monkeypatch.setattr(study_run, "run_study", stopped)
+    out = tmp_path / "results"
+    assert main(["study", "--quick", "--out", str(out)]) == status
+    assert (
+        capsys.readouterr().err.splitlines()[-1] == f"ladartui: study cancelled; nothing was written to {out}"
+    )
+    out.mkdir(exist_ok=True)
+    (out / "study.csv").write_text("earlier")
+    assert main(["study", "--quick", "--out", str(out)]) == status
+    assert capsys.readouterr().err.splitlines()[-1] == (
+        f"ladartui: study cancelled; nothing was written, the earlier study in {out} is unchanged"
+    )
+    assert [p.name for p in out.iterdir()] == ["study.csv"] and (out / "study.csv").read_text() == "earlier"

@@ -9,7 +9,7 @@ import threading
 from rich.markup import escape
 
 from ladartui.cli.flags import MAX_RUNS, check_file_names, run_count
-from ladartui.cli.progress import progress_display, run_cancellable
+from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt
 from ladartui.errors import Cancelled, FieldError
 from ladartui.textsafe import visible
 
@@ -106,17 +106,30 @@ def run(args: argparse.Namespace) -> int:
     console = Console(stderr=True)
     # --scans above the flight's count is refused; the default (3) takes what there is
     refuse_as = "--scans" if args.scans is not None else None
-    if args.scenario:
-        from ladartui.user_data import bundled_or_path
+    try:
+        with sigterm_as_interrupt():
+            if args.scenario:
+                from ladartui.user_data import bundled_or_path
 
-        inputs = scenario_inputs(bundled_or_path(args.scenario), scans, refuse_as=refuse_as)
-    else:
-        preset = "small" if args.quick else "reference"
-        with console.status(f"loading the {preset!r} scene ..."):
-            inputs = generated_inputs(preset, scans, progress=console.print, refuse_as=refuse_as)
-    settings = quick_settings() if args.quick else full_settings()
-    result = _run_with_progress(console, inputs, settings, runs, warmup)
+                inputs = scenario_inputs(bundled_or_path(args.scenario), scans, refuse_as=refuse_as)
+            else:
+                preset = "small" if args.quick else "reference"
+                with console.status(f"loading the {preset!r} scene ..."):
+                    inputs = generated_inputs(preset, scans, progress=console.print, refuse_as=refuse_as)
+            settings = quick_settings() if args.quick else full_settings()
+            result = _run_with_progress(console, inputs, settings, runs, warmup)
+    except (Cancelled, KeyboardInterrupt):  # the latter: before the study's worker started
+        raise Cancelled(_nothing_written(args.out)) from None
     return _report(result, args.out)
+
+
+def _nothing_written(out_dir) -> str:
+    """What a study stopped before its outputs were written says of them."""
+    from ladartui.study.run import output_paths
+
+    if any(path.exists() for path in output_paths(out_dir).values()):
+        return f"study cancelled; nothing was written, the earlier study in {out_dir} is unchanged"
+    return f"study cancelled; nothing was written to {out_dir}"
 
 
 def _load_result(path):
