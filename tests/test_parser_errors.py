@@ -390,6 +390,22 @@ def test_a_scenario_path_that_is_a_folder_or_not_text_says_so_in_words(tmp_path)
     )
 
 
+def test_a_folder_given_as_a_sweep_spec_results_table_or_measures_file_says_so_in_words(tmp_path):
+    """'sweep /tmp' said '/tmp: cannot read: Is a directory', with nothing of what was expected."""
+    from ladartui.cmf import read_cmf
+    from ladartui.sweep.table import read_table
+
+    readers = (
+        (load_sweep_spec, "expected a sweep spec (.toml)"),
+        (read_table, "expected the sweep results table (CSV)"),
+        (read_cmf, "expected a measures file (.cmf)"),
+    )
+    for read, expected in readers:
+        with pytest.raises(LadarError) as caught:
+            read(tmp_path)
+        assert str(caught.value) == f"{tmp_path}: is a folder; {expected}"
+
+
 def test_text_that_is_not_utf8_is_named_on_its_line(tmp_path):
     """A Latin-1 comment said only "not UTF-8 text" of a scenario, and Python's "'utf-8' codec
     can't decode byte 0xe9 in position 24" of a sweep spec or its results table."""

@@ -44,9 +44,13 @@ def not_utf8(data: bytes, error: UnicodeDecodeError) -> tuple[int, str]:
 def read_utf8(path, expected: str) -> str:
     """The text of ``path`` (a byte order mark dropped); a pipe or device is refused
     unread (``refuse_special_file``) and bytes that are not UTF-8 raise "PATH:LINE: not
-    UTF-8 text (byte 0xNN); ``expected``". OSError is the caller's."""
+    UTF-8 text (byte 0xNN); ``expected``", a folder "PATH: is a folder; ``expected``".
+    Any other OSError is the caller's."""
     refuse_special_file(path, expected)  # a pipe would wait for ever
-    data = Path(path).read_bytes()
+    try:
+        data = Path(path).read_bytes()
+    except IsADirectoryError:
+        raise InputFileError(path, f"is a folder; {expected}") from None
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as error:
