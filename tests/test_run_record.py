@@ -109,6 +109,27 @@ def test_validate_says_whether_the_outputs_came_from_this_file(scenario, capsys)
     assert line == "last run   outputs incomplete: S.cmf missing; a run writes the whole set again"
 
 
+def test_validate_names_an_output_a_run_would_refuse_to_write(scenario, capsys):
+    """An S.cmf folder was 'outputs incomplete: S.cmf missing; a run writes the whole set
+    again', and a run refused it; before a first run, an S_Scene.txt folder went unsaid."""
+    scenario.scene_output.mkdir()
+    assert main(["validate", str(scenario.path)]) == 0
+    lines = [x for x in capsys.readouterr().out.splitlines() if x.startswith("last run")]
+    assert lines == [
+        "last run   S_Scene.txt is a folder, expected a file name: a run is refused before it traces"
+    ]
+    scenario.scene_output.rmdir()
+    assert main(["run", str(scenario.path)]) == 0
+    scenario.measures_file.unlink()
+    scenario.measures_file.mkdir()
+    capsys.readouterr()
+    assert main(["validate", str(scenario.path)]) == 0
+    lines = [x for x in capsys.readouterr().out.splitlines() if x.startswith("last run")]
+    assert lines == ["last run   S.cmf is a folder, expected a file name: a run is refused before it traces"]
+    assert main(["run", str(scenario.path)]) == 2
+    assert "S.cmf: is a folder, expected a file name" in capsys.readouterr().err
+
+
 def test_a_step_flag_on_an_exact_run_does_not_make_its_outputs_out_of_date(scenario):
     simulate(scenario, step=0.25)  # the exact method takes no step
     ran = read_run_record(scenario)

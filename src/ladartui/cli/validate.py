@@ -82,15 +82,19 @@ def last_run_lines(scenario, scene) -> list[str]:
     """Whether the outputs on disk came from this file's settings and its model files as
     they are now (``scene``, as just loaded), from the run record."""
     from ladartui.errors import LadarError
-    from ladartui.outputset import journal_path
+    from ladartui.outputset import journal_path, output_problem
     from ladartui.run_record import earlier_las, missing_outputs, read_run_record, setting_changes
-    from ladartui.simulation import output_lock
+    from ladartui.simulation import output_lock, output_paths
 
     if journal_path(output_lock(scenario)).exists():  # a swap a killed run left (outputset)
         return [
             "last run   was stopped while it replaced the outputs: the next run puts the earlier set "
             "back first, so the files now on disk are not to be read"
         ]
+    for path in output_paths(scenario).values():  # as a run checks them before tracing
+        problem = output_problem(path)
+        if problem:
+            return [f"last run   {path.name} {problem}: a run is refused before it traces"]
     missing = missing_outputs(scenario)
     if missing:
         names = ", ".join(path.name for path in missing)
