@@ -65,6 +65,18 @@ def test_a_users_own_file_of_that_name_is_never_overwritten(scenario, capsys):
     assert snapshot(scenario) == before  # nothing was written
 
 
+def test_a_folder_of_the_records_name_is_called_a_folder(scenario, capsys):
+    """It was said to be a file that 'is not a run record', to be renamed."""
+    record = scenario.path.with_name("S_Run.toml")
+    record.mkdir()
+    for command in ("run", "validate"):
+        assert main([command, str(scenario.path)]) == 2
+        assert capsys.readouterr().err == (
+            f"ladartui: error: {record}: is a folder, expected a file name "
+            "(a run writes its settings there)\n"
+        )
+
+
 def test_a_damaged_record_is_reported_naming_the_file(scenario):
     simulate(scenario)
     record = scenario.path.with_name("S_Run.toml")

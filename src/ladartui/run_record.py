@@ -166,6 +166,8 @@ def input_changes(recorded, now) -> list[str]:
 def check_record_spare(scenario) -> None:
     """Refuse a run that would replace a file of the record's name that is not one."""
     path = scenario.run_record
+    if path.is_dir():
+        raise OutputFileError(path, "is a folder, expected a file name (a run writes its settings there)")
     if path.exists() and not is_record(path):
         raise OutputFileError(
             path,
