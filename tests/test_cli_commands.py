@@ -6,6 +6,7 @@ import importlib
 
 import pytest
 
+from cli_support import one_error_line
 from ladartui import cli
 
 
@@ -103,3 +104,41 @@ def test_a_mistyped_bundled_name_names_the_bundled_scenarios(tmp_path, capsys, m
         f"ladartui: error: {tmp_path / 'defualt'}: no such file; "
         "expected a scenario file (.toml) or a bundled scenario: default, convoy\n"
     )
+
+
+BUNDLED = "a scenario file (.toml) or a bundled scenario: default, convoy"
+
+
+@pytest.mark.parametrize(
+    "command, name, expected",
+    [
+        (["run", ""], "SCENARIO", BUNDLED),
+        (["validate", ""], "SCENARIO", BUNDLED),
+        (["tui", ""], "SCENARIO", BUNDLED),
+        ([""], "SCENARIO", BUNDLED),
+        (["info", ""], "FILE", "a voxel list (.txt) or a scenario (.toml)"),
+        (["pulses", ""], "SCENARIO", BUNDLED),
+        (["study", ""], "SCENARIO", BUNDLED),
+        (["study", "--chart-from", ""], "--chart-from", "a study.json written by 'ladartui study'"),
+        (["sweep", ""], "SPEC", "a sweep spec (.toml)"),
+        (["sweep", "sp.toml", "--out", ""], "--out", "a folder name, such as sp-results"),
+        (["sweep", "sp.toml", "--show", "--out", ""], "--out", "a folder name, such as sp-results"),
+    ],
+)
+def test_an_empty_path_is_refused_naming_its_argument(tmp_path, capsys, monkeypatch, command, name, expected):
+    """An empty path was the current folder ('/cwd: is a folder', '.: is a folder'), or no
+    path at all: pulses '' and study '' took their default scenes, study --chart-from ''
+    ran a whole new study, and sweep --out '' wrote its results into the current folder."""
+    import ladartui.detection.pulses as pulses_module
+    from ladartui.study import inputs as study_inputs
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("the work started")
+
+    monkeypatch.setattr(pulses_module, "pulse_study", refuse)
+    monkeypatch.setattr(study_inputs, "generated_inputs", refuse)
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "sp.toml").write_text('[sweep]\nscenario = "default"\n[grid]\nscans = [2]\n')
+    assert cli.main(command) == 2
+    assert one_error_line(capsys) == f"ladartui: error: {name} = '': expected {expected}"
+    assert [p.name for p in tmp_path.iterdir()] == ["sp.toml"]

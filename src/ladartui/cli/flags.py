@@ -63,6 +63,16 @@ def check_file_names(given: dict, expected: str = "a file name") -> None:
             raise FieldError(name, value, expected)
 
 
+def check_scenario_name(value) -> None:
+    """FieldError for an empty or blank SCENARIO: as a path it is the current folder, and
+    where a command has a default scenario "" must not quietly mean it."""
+    from ladartui.user_data import BUNDLED
+
+    check_file_names(
+        {"SCENARIO": value}, "a scenario file (.toml) or a bundled scenario: " + ", ".join(BUNDLED)
+    )
+
+
 def refuse_step_without_march(step: float | None, method: str, what: str) -> None:
     """A ``--step`` given where the tracing is not a march (``method``) would be ignored:
     refused in one line, saying what the trace is (``what``: "this run is exact (...)")."""

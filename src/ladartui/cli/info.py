@@ -36,6 +36,9 @@ def add_parser(subparsers):
 
 
 def run(args) -> int:
+    from ladartui.cli.flags import check_file_names
+
+    check_file_names({"FILE": args.file}, "a voxel list (.txt) or a scenario (.toml)")
     if not args.backends and not args.file:
         raise LadarError("info needs a FILE (voxel list or scenario .toml) or --backends")
     if args.backends:

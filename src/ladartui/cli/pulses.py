@@ -14,7 +14,7 @@ import shutil
 import sys
 import threading
 
-from ladartui.cli.flags import as_flags
+from ladartui.cli.flags import as_flags, check_scenario_name
 from ladartui.cli.progress import stop_status
 from ladartui.errors import Cancelled, FieldError
 
@@ -93,8 +93,12 @@ def run(args) -> int:
     from ladartui.scenario import load_scenario
     from ladartui.user_data import bundled_or_path, default_scenario_path
 
+    if args.scenario is not None:  # "" is not the default scenario
+        check_scenario_name(args.scenario)
     pulses = _pulse_counts(args.pulses)
-    scenario = load_scenario(bundled_or_path(args.scenario) if args.scenario else default_scenario_path())
+    scenario = load_scenario(
+        default_scenario_path() if args.scenario is None else bundled_or_path(args.scenario)
+    )
     settings = _settings(scenario, args)
     if args.backend is not None:  # before any tracing, as run does
         with as_flags({"backend": args.backend}):

@@ -15,7 +15,7 @@ import json
 import threading
 from typing import TYPE_CHECKING
 
-from ladartui.cli.flags import as_flags, refuse_step_without_march
+from ladartui.cli.flags import as_flags, check_scenario_name, refuse_step_without_march
 from ladartui.cli.progress import FIRST_SCAN, progress_display, run_cancellable, sigterm_as_interrupt
 from ladartui.errors import Cancelled, OutputFileError
 from ladartui.textsafe import visible
@@ -79,6 +79,7 @@ def run(args) -> int:
         raise LadarError("--las: it copies the outputs as LAS files, which --no-write does not write")
     from ladartui.user_data import bundled_or_path
 
+    check_scenario_name(args.scenario)
     scenario = load_scenario(bundled_or_path(args.scenario))
     # Check the overrides like scenario fields, before any progress is drawn.
     overrides = {name: getattr(args, name) for name in ("backend", "method", "step", "precision")}

@@ -8,7 +8,7 @@ import threading
 
 from rich.markup import escape
 
-from ladartui.cli.flags import MAX_RUNS, check_file_names, run_count
+from ladartui.cli.flags import MAX_RUNS, check_file_names, check_scenario_name, run_count
 from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt
 from ladartui.errors import Cancelled, FieldError
 from ladartui.textsafe import visible
@@ -77,7 +77,10 @@ def run(args: argparse.Namespace) -> int:
     from ladartui.study.inputs import generated_inputs, scenario_inputs
     from ladartui.study.run import check_outputs
 
-    if args.chart_from:  # a study already run: what would shape a new one does not apply
+    if args.scenario is not None:  # "" is not the generated scene
+        check_scenario_name(args.scenario)
+    check_file_names({"--chart-from": args.chart_from}, "a study.json written by 'ladartui study'")
+    if args.chart_from is not None:  # a study already run: what would shape a new one does not apply
         # every flag here defaults to None (or False), so one given at its default value is refused too
         given = [
             flag

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 
 from rich.markup import escape
 
-from ladartui.cli.flags import as_flags
+from ladartui.cli.flags import as_flags, check_file_names
 from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt, stop_status
 from ladartui.errors import Cancelled, FieldError, LadarError
 from ladartui.number_text import plural
@@ -127,6 +127,8 @@ def run(args) -> int:
     from ladartui.sweep import default_out_dir, load_sweep_results, load_sweep_spec
     from ladartui.sweep.ranking import BUDGET_OBJECTIVES, normal_cost, normal_objective
 
+    check_file_names({"SPEC": args.spec}, "a sweep spec (.toml)")
+    check_file_names({"--out": args.out}, f"a folder name, such as {Path(args.spec).stem}-results")
     given = [flag for name, flag in RUN_ONLY_FLAGS.items() if getattr(args, name) not in (None, False)]
     if args.show and given:
         raise LadarError(

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from ladartui.fileprobe import require_file
 from ladartui.tui.graphics import MODES  # no textual: the mode is chosen before the app loads
 
@@ -17,8 +15,7 @@ def add_parser(subparsers) -> None:
     )
     parser.add_argument(
         "scenario",
-        nargs="?",
-        type=Path,
+        nargs="?",  # a str: as a Path, "" would be the current folder
         help="a scenario file (.toml), or a bundled one by name (default, convoy)",
     )
     parser.add_argument(
@@ -41,8 +38,10 @@ def on_a_terminal() -> bool:
 def run(args) -> int:
     path = args.scenario
     if path is not None:
+        from ladartui.cli.flags import check_scenario_name
         from ladartui.user_data import bundled_or_path
 
+        check_scenario_name(path)
         path = bundled_or_path(path)  # "convoy": the bundled scenario, made on first use
     if path is not None:
         require_file(path, "expected a scenario file (.toml)")

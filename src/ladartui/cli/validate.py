@@ -26,10 +26,12 @@ def add_parser(subparsers):
 
 
 def run(args) -> int:
+    from ladartui.cli.flags import check_scenario_name
     from ladartui.scenario import load_scenario
     from ladartui.simulation import check_outputs_spare_inputs
     from ladartui.user_data import bundled_or_path
 
+    check_scenario_name(args.scenario)
     scenario = load_scenario(bundled_or_path(args.scenario))
     scene = scenario.load_scene()
     scene_lines = scene_summary(scenario, scene)
