@@ -121,6 +121,7 @@ BUNDLED = "a scenario file (.toml) or a bundled scenario: default, convoy"
         (["study", ""], "SCENARIO", BUNDLED),
         (["study", "--chart-from", ""], "--chart-from", "a study.json written by 'ladartui study'"),
         (["sweep", ""], "SPEC", "a sweep spec (.toml)"),
+        (["certs", ""], "DIR", "a folder name, such as certs"),
         (["sweep", "sp.toml", "--out", ""], "--out", "a folder name, such as sp-results"),
         (["sweep", "sp.toml", "--show", "--out", ""], "--out", "a folder name, such as sp-results"),
     ],

@@ -26,9 +26,11 @@ def add_parser(subparsers):
 def run(args) -> int:
     from pathlib import Path
 
+    from ladartui.cli.flags import check_file_names
     from ladartui.errors import FieldError
     from ladartui.sweep.security import CA_FILE, CERT_FILE, KEY_FILE, make_certificates
 
+    check_file_names({"DIR": args.folder}, "a folder name, such as certs")  # "" is the current folder
     if not 1 <= args.days <= 36500:
         raise FieldError("--days", args.days, "an integer from 1 to 36500")
     folder = Path(args.folder)
