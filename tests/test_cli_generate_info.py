@@ -267,6 +267,18 @@ def test_info_scenario_summary(tmp_path, capsys):
     )
 
 
+def test_a_voxel_size_with_no_voxel_list_is_refused(capsys, monkeypatch):
+    """'info --backends --voxel-size 1' listed the backends and dropped the size without a word."""
+    import ladartui.cli.info as info
+
+    monkeypatch.setattr(info, "print_backends", lambda: print("backends"))
+    assert main(["info", "--backends", "--voxel-size", "1"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == "" and captured.err == (
+        "ladartui: error: --voxel-size = 1.0: expected a FILE too: it sets a voxel list's size\n"
+    )
+
+
 def test_info_backends_lists_each_backend(capsys):
     backend = pytest.importorskip("ladartui.tracing.backend")
     status = backend.backend_status()

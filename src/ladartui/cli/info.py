@@ -41,6 +41,10 @@ def run(args) -> int:
     check_file_names({"FILE": args.file}, "a voxel list (.txt) or a scenario (.toml)")
     if not args.backends and not args.file:
         raise LadarError("info needs a FILE (voxel list or scenario .toml) or --backends")
+    if args.voxel_size is not None and not args.file:  # --backends alone: it would be dropped
+        from ladartui.errors import FieldError
+
+        raise FieldError("--voxel-size", args.voxel_size, "a FILE too: it sets a voxel list's size")
     if args.backends:
         print_backends()
     if args.file:
