@@ -440,3 +440,47 @@ def test_out_may_not_be_the_scene_it_traces(tmp_path, scene_file, capsys):
         f"ladartui: error: --out = '{scene_file}': expected a file other than --scene"
     )
     assert scene_file.read_bytes() == before
+
+
+def test_a_long_trace_shows_its_progress_in_blocks_of_rays(tmp_path, scene_file, capsys, monkeypatch):
+    """20 million rays traced for seconds, after seconds of reading, with nothing on the
+    terminal: the rays are now traced in blocks, the bar counting them (same hits)."""
+    import io
+
+    from rich.console import Console
+
+    import ladartui.cli.console as cli_console
+    import ladartui.cli.trace as cli_trace
+    import ladartui.tracing as tracing
+
+    rays = np.array([[x + 0.5, 5.0, 20.0, 0.0, 0.0, -1.0] for x in range(5)])
+    np.save(tmp_path / "rays.npy", rays)
+    command = [
+        "trace",
+        "--scene",
+        str(scene_file),
+        "--rays",
+        str(tmp_path / "rays.npy"),
+        "--backend",
+        "numba",
+    ]
+    assert main([*command, "--out", str(tmp_path / "whole.npy")]) == 0
+    terminal = io.StringIO()
+    monkeypatch.setattr(
+        cli_console, "CliConsole", lambda **kwargs: Console(file=terminal, force_terminal=True, width=80)
+    )
+    monkeypatch.setattr(cli_trace, "TRACE_BLOCK", 2)
+    calls = []
+    real_trace = tracing.trace
+
+    def counted(occupancy, origins, directions, **kwargs):
+        calls.append(len(origins))
+        return real_trace(occupancy, origins, directions, **kwargs)
+
+    monkeypatch.setattr(tracing, "trace", counted)
+    capsys.readouterr()
+    assert main([*command, "--out", str(tmp_path / "blocks.npy")]) == 0
+    assert calls == [2, 2, 1]
+    assert np.array_equal(np.load(tmp_path / "blocks.npy"), np.load(tmp_path / "whole.npy"), equal_nan=True)
+    assert "5/5 rays" in terminal.getvalue()
+    assert capsys.readouterr().err.startswith("5 rays (numba, exact, f64)")

@@ -20,6 +20,9 @@ from ladartui.number_text import plural
 from ladartui.textsafe import visible
 from ladartui.tracing.backend import METHODS, PRECISIONS
 
+# Rays a trace call: the bar moves, and Ctrl-C is seen, between calls (a second or so).
+TRACE_BLOCK = 1 << 20
+
 
 def add_parser(subparsers):
     parser = subparsers.add_parser(
@@ -181,32 +184,67 @@ def _identity(path) -> tuple[int, int] | None:
     return status.st_dev, status.st_ino
 
 
+def _shown(text: str) -> str:
+    """A file name in the bar: one line, its markup ("[red]") shown as typed."""
+    from rich.markup import escape
+
+    from ladartui.textsafe import one_line
+
+    return escape(one_line(text))
+
+
 def _trace_and_write(args, voxel_size: float) -> None:
-    """Read the rays and the scene, trace, write the hits, say what was traced."""
+    """Read the rays and the scene, trace, write the hits, say what was traced; a bar on
+    a terminal shows each step, and the rays traced."""
+    from rich.progress import TextColumn, TimeElapsedColumn
+
+    import ladartui.tracing as tracing
+    from ladartui.cli.console import CliConsole
     from ladartui.cli.flags import as_flags
+    from ladartui.cli.progress import progress_display
     from ladartui.scene.occupancy import Occupancy
     from ladartui.scene.voxels import load_voxels
-    from ladartui.tracing import trace
 
-    rays = load_rays(args.rays)
-    voxels = load_voxels(args.scene)
-    occupancy = Occupancy.build(voxels, source=str(args.scene))
-    typed = {"backend": args.backend, "method": args.method, "step": args.step, "precision": args.precision}
-    with as_flags(typed):  # name the flag typed, not trace()'s parameter
-        result = trace(
-            occupancy,
-            rays[:, :3],
-            rays[:, 3:],
-            backend=args.backend,
-            method=args.method,
-            step=args.step,
-            precision=args.precision,
-            voxel_size=voxel_size,
-        )
-    with atomic_path(args.out) as tmp:
-        with open(tmp, "wb") as handle:
-            np.save(handle, result.as_array())
-    counts = np.bincount(result.kind, minlength=3)
+    console = CliConsole(stderr=True)
+    after = (TextColumn("{task.fields[done]}"), TimeElapsedColumn())
+    with progress_display(console, after, transient=True, disable=not console.is_terminal) as bar:
+        task = bar.add_task(_shown(f"reading {args.rays}"), total=None, done="")
+        rays = load_rays(args.rays)
+        bar.update(task, description=_shown(f"reading {args.scene}"))
+        voxels = load_voxels(args.scene)
+        occupancy = Occupancy.build(voxels, source=str(args.scene))
+        bar.update(task, description="tracing", total=max(len(rays), 1), completed=0)
+        typed = {
+            "backend": args.backend,
+            "method": args.method,
+            "step": args.step,
+            "precision": args.precision,
+        }
+        results = []
+        with as_flags(typed):  # name the flag typed, not trace()'s parameter
+            for start in range(0, max(len(rays), 1), TRACE_BLOCK):
+                block = rays[start : start + TRACE_BLOCK]
+                results.append(
+                    tracing.trace(
+                        occupancy,
+                        block[:, :3],
+                        block[:, 3:],
+                        backend=args.backend,
+                        method=args.method,
+                        step=args.step,
+                        precision=args.precision,
+                        voxel_size=voxel_size,
+                    )
+                )
+                done = start + len(block)
+                bar.update(task, completed=done, done=f"{done:,}/{len(rays):,} rays")
+        bar.update(task, description=_shown(f"writing {args.out}"))
+        with atomic_path(args.out) as tmp:
+            with open(tmp, "wb") as handle:
+                np.save(handle, np.concatenate([result.as_array() for result in results]))
+    counts = np.bincount(np.concatenate([result.kind for result in results]), minlength=3)
+    result = results[-1]
+    backends = ", ".join(dict.fromkeys(r.backend for r in results))  # auto may choose by block
     used = result.info.get("precision", args.precision)
     if used != args.precision:  # a backend without the arithmetic asked for
         used += f", not the {args.precision} asked for"
@@ -215,7 +253,7 @@ def _trace_and_write(args, voxel_size: float) -> None:
     )
     print(
         visible(
-            f"{plural(len(rays), 'ray')} ({result.backend}, {result.method}, {used}), {size}: "
+            f"{plural(len(rays), 'ray')} ({backends}, {result.method}, {used}), {size}: "
             f"{counts[1]:,} voxel, {counts[2]:,} ground, {counts[0]:,} miss -> {args.out}"
         ),
         file=sys.stderr,
