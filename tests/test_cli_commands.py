@@ -143,3 +143,20 @@ def test_an_empty_path_is_refused_naming_its_argument(tmp_path, capsys, monkeypa
     assert cli.main(command) == 2
     assert one_error_line(capsys) == f"ladartui: error: {name} = '': expected {expected}"
     assert [p.name for p in tmp_path.iterdir()] == ["sp.toml"]
+
+
+def test_output_that_cannot_be_written_is_one_line_not_a_traceback(tmp_path, capsys, monkeypatch):
+    """'ladartui run S.toml --json > out.json' on a full disk (or '> /dev/full') ended in an
+    OSError traceback from print()."""
+    import errno
+    import io
+    import sys
+
+    class Full(io.StringIO):
+        def write(self, text):
+            raise OSError(errno.ENOSPC, "No space left on device")
+
+    (tmp_path / "v.txt").write_text("1,2,3\n")
+    monkeypatch.setattr(sys, "stdout", Full())
+    assert cli.main(["info", str(tmp_path / "v.txt")]) == 1
+    assert one_error_line(capsys) == "ladartui: error: could not write the output: No space left on device"

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import difflib
+import errno
 import importlib
 import os
 import re
@@ -19,7 +20,7 @@ from pathlib import Path
 
 from ladartui import __version__
 from ladartui.cli.progress import reset_stop, stop_status
-from ladartui.errors import Cancelled, LadarError
+from ladartui.errors import Cancelled, LadarError, os_reason
 from ladartui.textsafe import one_line
 from ladartui.threads import environment_problem
 
@@ -119,6 +120,17 @@ def main(argv: list[str] | None = None) -> int:
         return stop_status()
     except BrokenPipeError:
         return _reader_gone()
+    except OSError as error:
+        # Standard output on a full disk (`> out.json`, `> /dev/full`): print() names no
+        # file. An error naming one, or of another kind, is no failed write: raised as it is.
+        if error.filename is not None or error.errno not in _WRITE_ERRORS:
+            raise
+        print(f"ladartui: error: could not write the output: {os_reason(error)}", file=sys.stderr)
+        _reader_gone()  # no second failure as Python flushes standard output at exit
+        return 1
+
+
+_WRITE_ERRORS = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO}
 
 
 def _reader_gone() -> int:
