@@ -18,7 +18,7 @@ from cli_support import one_error_line
 from ladartui.cli import main
 from ladartui.errors import LadarError
 from ladartui.scenario import load_scenario, scenario_from_toml
-from ladartui.scene.voxels import load_voxels, save_voxels
+from ladartui.scene.voxels import EXPECTED, load_voxels, save_voxels
 from ladartui.sweep.spec import load_sweep_spec
 
 # More examples for a long search by hand: LADARTUI_FUZZ_EXAMPLES=2000.
@@ -423,6 +423,35 @@ def test_text_that_is_not_utf8_is_named_on_its_line(tmp_path):
         with pytest.raises(LadarError) as caught:
             read(path)
         assert str(caught.value) == f"{path}:2: not UTF-8 text (byte 0xe9); {expected}"
+
+
+@pytest.mark.parametrize(
+    "name, data, what",
+    [
+        ("forest.laz", b"LASF\x00\x00\x01\x02binary", "a LAS point cloud (.laz)"),
+        ("truck.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "a mesh (.obj)"),
+    ],
+)
+def test_a_point_cloud_or_mesh_given_as_a_voxel_list_is_named(tmp_path, capsys, name, data, what):
+    """A scenario's files.scene, trace --scene or voxelize --into naming a .laz said
+    'binary data, not text', and an .obj "1 comma-separated values in 'v 0 0 0'"."""
+    path = tmp_path / name
+    path.write_bytes(data)
+    with pytest.raises(LadarError) as caught:
+        load_voxels(path)
+    assert str(caught.value) == f"{path}: {what}, not a voxel list; {EXPECTED}"
+    np.save(tmp_path / "rays.npy", np.array([[1.0, 1.0, 9.0, 0.0, 0.0, -1.0]]))
+    command = [
+        "trace",
+        "--scene",
+        str(path),
+        "--rays",
+        str(tmp_path / "rays.npy"),
+        "--out",
+        str(tmp_path / "h.npy"),
+    ]
+    assert main(command) == 2
+    assert capsys.readouterr().err == f"ladartui: error: {path}: {what}, not a voxel list; {EXPECTED}\n"
 
 
 def test_binary_data_given_as_a_voxel_list_says_so(tmp_path):

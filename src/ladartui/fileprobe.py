@@ -12,6 +12,23 @@ FOLDER = "is a folder, expected a file"  # file_problem's words for a folder
 NO_SUCH_FILE = "no such file"  # an input file that is missing, in every reader's words
 
 
+# The files of other kinds a command may be given (or name) where it takes a voxel list.
+OTHER_FILE_KINDS = {
+    ".toml": "a scenario",
+    ".las": "a LAS point cloud",
+    ".laz": "a LAS point cloud",
+    ".cmf": "a measures file",
+    ".obj": "a mesh",
+    ".stl": "a mesh",
+    ".ply": "a mesh",
+}
+
+
+def other_file_kind(path) -> str | None:
+    """What a file of ``path``'s suffix is when that is no voxel list ("a mesh"), else None."""
+    return OTHER_FILE_KINDS.get(Path(path).suffix.lower())
+
+
 def path_field(name, value, what: str) -> Path:
     """``value`` as a Path when it is a str or os.PathLike (not bytes); else FieldError
     expecting ``what`` ("a scenario file's path")."""

@@ -82,25 +82,6 @@ def refuse_step_without_march(step: float | None, method: str, what: str) -> Non
         )
 
 
-# The files of other kinds a command may be given (or name) where it takes a voxel list.
-OTHER_FILE_KINDS = {
-    ".toml": "a scenario",
-    ".las": "a LAS point cloud",
-    ".laz": "a LAS point cloud",
-    ".cmf": "a measures file",
-    ".obj": "a mesh",
-    ".stl": "a mesh",
-    ".ply": "a mesh",
-}
-
-
-def other_file_kind(path) -> str | None:
-    """What a file of ``path``'s suffix is when that is no voxel list ("a mesh"), else None."""
-    from pathlib import Path
-
-    return OTHER_FILE_KINDS.get(Path(path).suffix.lower())
-
-
 def check_scene_stem(flag: str, value: str, scene_file) -> None:
     """Refuse a scene to write named as a target model (``forest_Target.txt``): it would go
     over ``forest.txt``'s target model, with its own target beside it as ``..._Target_Target``."""

@@ -90,9 +90,10 @@ def run(args) -> int:
     import threading
 
     from ladartui.cli.console import CliConsole as Console
-    from ladartui.cli.flags import check_scene_stem, other_file_kind
+    from ladartui.cli.flags import check_scene_stem
     from ladartui.cli.progress import run_cancellable, sigterm_as_interrupt
     from ladartui.errors import Cancelled
+    from ladartui.fileprobe import other_file_kind
     from ladartui.outputset import check_writable
     from ladartui.scene.generate import GENERATE_CANCELLED, las_paths, output_paths
 

@@ -73,7 +73,7 @@ def run(args) -> int:
 def refuse_other_kinds(path: Path) -> None:
     """A mesh, point cloud or measures file would be read as a voxel list and fail on its
     first line: say what it is, and for a mesh what to do."""
-    from ladartui.cli.flags import other_file_kind
+    from ladartui.fileprobe import other_file_kind
 
     what = other_file_kind(path)
     if what is not None:

@@ -22,7 +22,7 @@ import numpy as np
 
 from ladartui.atomic import atomic_path, write_errors_named
 from ladartui.errors import InputFileError
-from ladartui.fileprobe import NO_SUCH_FILE, path_field, refuse_special_file
+from ladartui.fileprobe import NO_SUCH_FILE, other_file_kind, path_field, refuse_special_file
 from ladartui.fingerprint import Digest
 from ladartui.scene.lazy_kernels import NUMPY_BYTES, LazyKernels
 from ladartui.scene.unique_rows import unique_voxels
@@ -270,6 +270,17 @@ def _read_rows(path: Path, columns: int, target: bool, digest: Digest | None = N
     ``digest`` is fed every byte of the file once. One open file throughout: a file
     replaced meanwhile (written atomically, as generate does) is read whole, old or
     new, never part of each."""
+    try:
+        return _read_opened(path, columns, target, digest)
+    except InputFileError:
+        kind = other_file_kind(path)  # a point cloud or mesh fails on its first line: say what it is
+        if kind is None:
+            raise
+        expected = EXPECTED_TARGET if target else EXPECTED
+        raise InputFileError(path, f"{kind} ({path.suffix}), not a voxel list; {expected}") from None
+
+
+def _read_opened(path: Path, columns: int, target: bool, digest: Digest | None) -> np.ndarray:
     with _opened(path) as handle:
         head = _read_from(path, handle, _PLAIN_BYTES + 1)
         if len(head) <= _PLAIN_BYTES:  # the whole file
