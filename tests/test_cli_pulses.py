@@ -159,3 +159,19 @@ def test_the_chart_fits_a_narrow_terminal_and_keeps_its_title(scenario, capsys, 
     lines = capsys.readouterr().out.splitlines()
     assert max(len(line) for line in lines) == 78
     assert any("Geiger-mode: coverage and false alarms against pulses per look" in line for line in lines)
+
+
+def test_the_table_writes_counts_with_thousands_separators(scenario, capsys, monkeypatch):
+    """'declared' and 'false' were bare digits (195447), where every other count has commas."""
+    rows = [
+        PulseRow(1, 1, 0.4, 93_376, 7_066, 0.674),
+        PulseRow(100_000, 10, 0.41, 12_345_678, 1_234_567, 0.9),
+    ]
+    monkeypatch.setattr(pulses_module, "pulse_study", lambda *a, **k: (0.41, rows))
+    assert main(["pulses", str(scenario.path), "--pulses", "1,100000", "--no-chart"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[1:] == [
+        " pulses     k  coverage    declared      false P_d(target)",
+        "      1     1    0.4000      93,376      7,066       0.674",
+        "100,000    10    0.4100  12,345,678  1,234,567       0.900",
+    ]

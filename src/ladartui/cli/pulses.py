@@ -118,12 +118,12 @@ def run(args) -> int:
         print(json.dumps(result_dict(scenario, settings, ideal, rows), indent=2, allow_nan=False))
         return 0
     print(f"ideal model: obscured coverage {ideal:.4f}")
-    print(f"{'pulses':>7} {'k':>4} {'coverage':>9} {'declared':>9} {'false':>7} {'P_d(target)':>11}")
+    print(f"{'pulses':>7} {'k':>5} {'coverage':>9} {'declared':>11} {'false':>10} {'P_d(target)':>11}")
     for r in rows:
         detection = "undefined" if r.target_detection is None else f"{r.target_detection:.3f}"
         print(
-            f"{r.pulses:>7} {r.threshold:>4} {r.obscured_coverage:>9.4f} {r.declared_points:>9} "
-            f"{r.false_alarms:>7} {detection:>11}"
+            f"{r.pulses:>7,} {r.threshold:>5,} {r.obscured_coverage:>9.4f} {r.declared_points:>11,} "
+            f"{r.false_alarms:>10,} {detection:>11}"
         )
     if args.chart:
         columns = shutil.get_terminal_size((CHART_WIDTH, CHART_HEIGHT)).columns  # COLUMNS first
