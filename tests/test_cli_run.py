@@ -143,6 +143,15 @@ def test_an_unwritable_chart_is_refused_before_anything_runs(scenario, capsys, t
     assert not scenario.measures_file.exists() and not scenario.scene_output.exists()
 
 
+def test_a_chart_in_a_missing_folder_is_refused_as_trace_refuses_its_out(scenario, capsys, tmp_path):
+    """run --chart made the folders of a mistyped path (trace --out refuses it)."""
+    chart = tmp_path / "chrats" / "c.svg"
+    assert main(["run", str(scenario.path), "--chart", str(chart)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == f"ladartui: error: --chart = '{chart}': expected a file in an existing folder"
+    assert not chart.parent.exists() and not scenario.measures_file.exists()
+
+
 def test_a_chart_that_fails_after_the_run_says_the_outputs_were_written(scenario, capsys, monkeypatch):
     """A full disk at the chart said only '--chart: expected a writable path', with the
     run's four outputs already replaced and its measures never shown."""

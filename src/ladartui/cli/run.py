@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import os
 import threading
 from typing import TYPE_CHECKING
 
@@ -101,6 +102,8 @@ def run(args) -> int:
 
         if not args.chart.lower().endswith((".svg", ".png")):
             raise FieldError("--chart", args.chart, "a file name ending in .svg or .png")
+        if not os.path.exists(os.path.dirname(args.chart) or "."):  # a mistyped folder is not made
+            raise FieldError("--chart", args.chart, "a file in an existing folder")
         problem = output_problem(args.chart)  # before the run, not after its outputs
         if problem:
             raise FieldError("--chart", args.chart, f"a writable path; it {problem}")
