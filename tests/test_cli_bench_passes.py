@@ -84,3 +84,22 @@ def test_the_pass_tables_fit_an_80_column_terminal(monkeypatch, capsys):
     assert rows[0].split()[2:] == ["2.81"] * 4
     assert rows[1].split()[1:] == ["12.28"] * 4
     assert not any(line.startswith("march") for line in lines)  # exact scans only
+
+
+@pytest.mark.parametrize("signum, status", [(2, 130), (15, 143)], ids=["Ctrl-C", "SIGTERM"])
+def test_a_stopped_bench_says_it_measured_nothing(monkeypatch, capsys, signum, status):
+    """Ctrl-C said only 'interrupted'; SIGTERM ended the bench without a word."""
+    import signal
+
+    import ladartui.cli.bench as bench
+    from ladartui.cli import main
+
+    def stopped(*args, **kwargs):
+        handler = signal.getsignal(signum)
+        if signum == signal.SIGINT or not callable(handler):
+            raise KeyboardInterrupt
+        handler(signum, None)  # as `kill` would
+
+    monkeypatch.setattr(bench, "run_bench", stopped)
+    assert main(["bench", "--quick"]) == status
+    assert capsys.readouterr().err.splitlines()[-1] == "ladartui: bench cancelled; nothing was measured"

@@ -91,11 +91,17 @@ def run(args):
         )
     if args.runs is not None:
         run_count("--runs", args.runs)
-    with _status() as say:
-        if args.orbit:
-            report = run_orbit_bench(quick=args.quick, runs=args.runs, progress=say)
-        else:
-            report = run_bench(quick=args.quick, runs=args.runs, progress=say)
+    from ladartui.cli.progress import sigterm_as_interrupt
+    from ladartui.errors import Cancelled
+
+    try:
+        with sigterm_as_interrupt(), _status() as say:
+            if args.orbit:
+                report = run_orbit_bench(quick=args.quick, runs=args.runs, progress=say)
+            else:
+                report = run_bench(quick=args.quick, runs=args.runs, progress=say)
+    except KeyboardInterrupt:  # Ctrl-C or SIGTERM: its exit status says which
+        raise Cancelled("bench cancelled; nothing was measured") from None
     if args.orbit:
         if args.json:
             print(json.dumps(report, indent=2))
