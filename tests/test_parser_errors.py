@@ -306,7 +306,7 @@ def test_validate_summary_gives_scene_size_and_memory(tmp_path, capsys):
     path = write_scenario(tmp_path, b"0,0,0\n1,2,3\n9,4,5\n")
     assert main(["validate", str(path)]) == 0
     out = capsys.readouterr().out
-    assert "scene      3 voxels, target 1 voxels; extent 10 x 5 x 6 voxels" in out
+    assert "scene      3 voxels, target 1 voxel; extent 10 x 5 x 6 voxels" in out  # not "1 voxels"
     assert "memory     about " in out and "available" in out
 
 
@@ -540,5 +540,11 @@ def test_validate_notes_an_empty_or_misplaced_target_model(tmp_path, capsys):
     assert (
         "note       2 of 3 target voxels are not in the scene model m.txt: the scene run cannot see them"
         in out
+    )
+    (tmp_path / "m_Target.txt").write_text("50,50,50\n")  # said '1 of 1 target voxels are not'
+    assert main(["validate", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert (
+        "note       1 of 1 target voxel is not in the scene model m.txt: the scene run cannot see it" in out
     )
     assert gib(4096) == "4 KiB" and gib(100) == "100 bytes" and gib(3 * 2**20) == "3 MiB"

@@ -147,7 +147,7 @@ def scene_summary(scenario, scene) -> list[str]:
     """Size the tracing structures of ``scenario``'s ``scene`` (its model files, read)."""
     import numpy as np
 
-    from ladartui.number_text import extent_metres
+    from ladartui.number_text import extent_metres, plural
     from ladartui.resources import available_memory, check_occupancy, gib
     from ladartui.scene.occupancy import column_bounds
 
@@ -156,7 +156,8 @@ def scene_summary(scenario, scene) -> list[str]:
     ids = scene.target_id_list if len(scene.target) else []
     in_targets = f" in {len(ids)} targets" if len(ids) > 1 else ""
     lines = [
-        f"scene      {len(scene.voxels):,} voxels, target {len(scene.target):,} voxels{in_targets}; "
+        f"scene      {plural(len(scene.voxels), 'voxel')}, "
+        f"target {plural(len(scene.target), 'voxel')}{in_targets}; "
         f"extent {nx} x {ny} x {nz} voxels = {extent_metres(scene.shape, vs)} m"
     ]
     lines.extend(target_notes(scenario, scene))
@@ -191,6 +192,7 @@ def target_notes(scenario, scene) -> list[str]:
     import numpy as np
 
     from ladartui.errors import FieldError
+    from ladartui.number_text import plural
     from ladartui.scene.keys import voxel_keys
 
     name = scenario.target_file.name
@@ -202,7 +204,8 @@ def target_notes(scenario, scene) -> list[str]:
         return []
     if not missing:
         return []
+    is_, them = ("is", "it") if missing == 1 else ("are", "them")
     return [
-        f"note       {missing:,} of {len(scene.target):,} target voxels are not in the scene model "
-        f"{scenario.scene_file.name}: the scene run cannot see them"
+        f"note       {missing:,} of {plural(len(scene.target), 'target voxel')} {is_} "
+        f"not in the scene model {scenario.scene_file.name}: the scene run cannot see {them}"
     ]
