@@ -295,6 +295,19 @@ def write_scenario(folder, scene_text):
     return path
 
 
+def test_a_huge_value_is_cut_so_that_what_was_expected_shows(tmp_path, capsys):
+    """20,000 manual poses filled the 400-character line with the list, and what was
+    expected (at most 10,000 poses) was cut off."""
+    pose = "{ x = 1, y = 0, z = 60, heading = 0, azimuth = 0, depression = 45 }"
+    orbit = VALID_SCENARIO[VALID_SCENARIO.index("[[flight.segments]]") :]
+    manual = f'[[flight.segments]]\nkind = "manual"\nposes = [{", ".join([pose] * 20_000)}]\n'
+    path = tmp_path / "plan.toml"
+    path.write_text(VALID_SCENARIO.replace(orbit, manual))
+    assert main(["validate", str(path)]) == 2
+    line = one_error_line(capsys)
+    assert "... (20,000 items): expected " in line and "more characters)" not in line, line
+
+
 def test_validate_reads_the_model_files(tmp_path, capsys):
     path = write_scenario(tmp_path, b"0,0,0\n1,x,2\n")
     assert main(["validate", str(path)]) == 2

@@ -29,7 +29,21 @@ class FieldError(LadarError):
         if value is None:  # never given: say so rather than "= None"
             super().__init__(f"{prefix}{field} is not set: expected {expected}")
         else:
-            super().__init__(f"{prefix}{field} = {value!r}: expected {expected}")
+            super().__init__(f"{prefix}{field} = {_shown(value)}: expected {expected}")
+
+
+VALUE_CHARS = 60  # of a long list or text quoted in a FieldError: room is left for what was expected
+
+
+def _shown(value) -> str:
+    """``repr(value)``; a long list, table or text cut to its start with its size, so that
+    the one-line message keeps what was expected (20,000 poses filled it)."""
+    text = repr(value)
+    if isinstance(value, list | tuple | dict) and len(text) > 2 * VALUE_CHARS:
+        return f"{text[:VALUE_CHARS]}... ({len(value):,} {'item' if len(value) == 1 else 'items'})"
+    if isinstance(value, str) and len(text) > 4 * VALUE_CHARS:
+        return f"{text[:VALUE_CHARS]}... ({len(value):,} characters)"
+    return text
 
 
 class Cancelled(Exception):
