@@ -408,7 +408,7 @@ def test_ctrl_c_or_sigterm_says_what_was_written(tmp_path, scene_file, capsys, m
         raise KeyboardInterrupt  # a Ctrl-C landing once the hits were written
 
     monkeypatch.setattr(tracing, "trace", real_trace)
-    monkeypatch.setattr(cli_trace, "visible", interrupted_while_saying)
+    monkeypatch.setattr(cli_trace, "single_line", interrupted_while_saying)
     assert main(command) == 130
     assert capsys.readouterr().err == f"ladartui: interrupted after the trace; it wrote {out}\n"
     assert np.load(out).shape == (3, 5)

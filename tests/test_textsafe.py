@@ -1,5 +1,7 @@
 from pathlib import Path
 
+import pytest
+
 import ladartui
 from ladartui.cli import main
 from ladartui.textsafe import one_line
@@ -53,14 +55,17 @@ def test_scene_that_is_a_folder_is_not_reported_as_missing(tmp_path, capsys):
     assert "is a folder, expected a file (files.scene)" in err and "not found" not in err
 
 
-def test_file_names_with_terminal_escapes_reach_the_terminal_escaped(tmp_path, capsys):
+@pytest.mark.parametrize(
+    "raw", ["\x1b[2J\x1b]0;PWNED\x07", "\nladartui: forged\n"], ids=["escapes", "newlines"]
+)
+def test_file_names_with_terminal_escapes_reach_the_terminal_escaped(tmp_path, capsys, raw):
     """Errors escaped them, but the lines of a command that worked printed them raw: a
-    name holding ESC [2J cleared the screen."""
+    name holding ESC [2J cleared the screen; one holding a line break broke the line it
+    was written on, and what followed it stood as a line of its own."""
     import shutil
 
     from tiny_sweep import write_tiny_scenario
 
-    raw = "\x1b[2J\x1b]0;PWNED\x07"
     folder = tmp_path / f"d{raw}"
     folder.mkdir()
     base = write_tiny_scenario(folder, name=f"s{raw}.toml")
@@ -86,7 +91,8 @@ def test_file_names_with_terminal_escapes_reach_the_terminal_escaped(tmp_path, c
         assert main(command) == 0, command
         out, err = capsys.readouterr()
         assert "\x1b" not in out + err and "\x07" not in out + err, (command, out + err)
-        assert "\\x1b[2J" in out + err, command
+        assert not any(line.startswith("ladartui: forged") for line in (out + err).splitlines()), command
+        assert f"\\x{ord(raw[0]):02x}" in out + err, command
 
 
 def _spec(folder, scenario_name):

@@ -43,7 +43,7 @@ from ladartui.scenario_file import (
 )
 from ladartui.scenario_style import restyle
 from ladartui.sensor import Sensor
-from ladartui.textsafe import one_line
+from ladartui.textsafe import one_line, single_line
 from ladartui.toml_lines import key_lines
 from ladartui.tracing.backend import METHODS, PRECISIONS
 from ladartui.tracing.config import MIN_STEP
@@ -312,7 +312,7 @@ class Scenario:
             f"outputs    {self.scene_output.name}, {self.target_output.name}, "
             f"{self.measures_file.name}, {self.run_record.name} in {self.path.parent}",
         ]
-        return "\n".join(lines)
+        return "\n".join(single_line(line) for line in lines)  # a path's line break kept in its line
 
     # -- TOML --
 

@@ -24,6 +24,12 @@ def one_line(text: object, limit: int = MAX_MESSAGE_CHARS) -> str:
     return f"{safe[:limit]}... ({dropped} more characters)"
 
 
+def single_line(text: object) -> str:
+    """``text`` for a terminal as one line, nothing cut: control characters, line breaks
+    included, written as ``\\xNN`` (a file name's newline must not start a line of its own)."""
+    return "".join(_visible(char) for char in str(text))
+
+
 def visible(text: object) -> str:
     """``text`` for a terminal, its lines kept: control characters in each line (a file
     name's terminal escapes) written as ``\\xNN``, nothing cut."""

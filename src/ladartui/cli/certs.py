@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ladartui.textsafe import visible
+from ladartui.textsafe import single_line
 
 
 def add_parser(subparsers):
@@ -49,5 +49,5 @@ def run(args) -> int:
     except OSError as error:
         raise FieldError("DIR", str(folder), f"a writable folder ({error.strerror})") from None
     for path in paths.values():
-        print(visible(path))
+        print(single_line(path))
     return 0

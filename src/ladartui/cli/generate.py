@@ -8,7 +8,7 @@ from pathlib import Path
 
 from ladartui.errors import FieldError, LadarError
 from ladartui.number_text import extent_metres, plural
-from ladartui.textsafe import visible
+from ladartui.textsafe import single_line
 
 
 def add_parser(subparsers):
@@ -131,13 +131,13 @@ def run(args) -> int:
     vs = scene.voxel_size
     nx, ny, nz = scene.shape
     print(
-        visible(
+        single_line(
             f"wrote {scene_path} ({plural(len(scene.voxels), 'voxel')}) and {target_path} "
             f"({plural(len(scene.target), 'voxel')})"
         )
     )
     if las_files:
-        print(visible(f"wrote {las_files[0]} and {las_files[1]} (voxel centres in metres)"))
+        print(single_line(f"wrote {las_files[0]} and {las_files[1]} (voxel centres in metres)"))
     print(f"preset {scene.preset}, seed {scene.seed}, voxel size {vs:g} m")
     print(f"extent {nx} x {ny} x {nz} voxels = {extent_metres(scene.shape, vs)} m")
     print("parts (before merging): " + ", ".join(f"{k} {v:,}" for k, v in scene.parts.items()))
@@ -154,7 +154,9 @@ def run(args) -> int:
     if left:  # LAS copies of an earlier scene, which this one no longer matches
         names = " and ".join(path.name for path in left)
         verb = "are" if len(left) > 1 else "is"
-        print(visible(f"note: {names} {verb} from an earlier scene, not this one (--las writes them again)"))
+        print(
+            single_line(f"note: {names} {verb} from an earlier scene, not this one (--las writes them again)")
+        )
     return 0
 
 

@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ladartui.errors import LadarError
 from ladartui.number_text import extent_metres, plural
-from ladartui.textsafe import visible
+from ladartui.textsafe import single_line, visible
 
 
 def add_parser(subparsers):
@@ -159,10 +159,10 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
     elif target_path is not None:
         rows.append(("target", f"none ({target_path.name} not found)"))
     rows.append(("occupancy", _occupancy_text(voxels, shape, path)))
-    print(visible(f"{path}: voxel list"))
+    print(single_line(f"{path}: voxel list"))
     width = max(len(name) for name, _ in rows)
     for name, text in rows:
-        print(visible(f"  {name:<{width}}  {text}"))
+        print(single_line(f"  {name:<{width}}  {text}"))
 
 
 def _run_output(path: Path) -> str | None:

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 from ladartui.cli.flags import as_flags, check_scenario_name, refuse_step_without_march
 from ladartui.cli.progress import FIRST_SCAN, progress_display, run_cancellable, sigterm_as_interrupt
 from ladartui.errors import Cancelled, OutputFileError
-from ladartui.textsafe import visible
+from ladartui.textsafe import single_line
 
 if TYPE_CHECKING:
     from ladartui.simulation import SimulationResult
@@ -118,7 +118,7 @@ def run(args) -> int:
 
             try:
                 path = charts.save_figure(coverage_figure(result.measures), args.chart)
-                chart_line = visible(f"wrote chart: {path}")
+                chart_line = single_line(f"wrote chart: {path}")
             except OSError as error:  # the run's outputs are written: say so, and show them
                 reason = (error.strerror or str(error)).lower()
                 written = (
@@ -151,7 +151,9 @@ def _note_earlier_las(console, scenario) -> None:
         names = " and ".join(path.name for path in left)
         verb = "are" if len(left) > 1 else "is"
         console.print(
-            visible(f"note: {names} {verb} from an earlier run, not this one (run --las writes them again)"),
+            single_line(
+                f"note: {names} {verb} from an earlier run, not this one (run --las writes them again)"
+            ),
             highlight=False,
             markup=False,
             soft_wrap=True,
@@ -287,7 +289,9 @@ def show_result(console, result, asked_precision=None) -> None:
     if result.outputs:
         for name, path in result.outputs.items():
             shown = name.replace("_las", " LAS")  # "scene_las": the scene as a LAS point cloud
-            console.print(visible(f"wrote {shown}: {path}"), highlight=False, markup=False, soft_wrap=True)
+            console.print(
+                single_line(f"wrote {shown}: {path}"), highlight=False, markup=False, soft_wrap=True
+            )
     else:
         console.print("no scenario outputs written (--no-write)")
 

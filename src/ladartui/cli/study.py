@@ -11,7 +11,7 @@ from rich.markup import escape
 from ladartui.cli.flags import MAX_RUNS, check_file_names, check_scenario_name, run_count
 from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt
 from ladartui.errors import Cancelled, FieldError
-from ladartui.textsafe import visible
+from ladartui.textsafe import single_line, visible
 
 DEFAULT_OUT = "study-results"
 DEFAULT_WARMUP = 1
@@ -202,18 +202,18 @@ def _report(result, out_dir) -> int:
         console = Console(width=CHART_WIDTH + 20)  # a log file: no need to wrap at 80
     width = max(60, min(console.width, CHART_WIDTH))
     console.print(Text.from_ansi(chart_text(result, width, CHART_HEIGHT, color=console.is_terminal)))
-    label = Text(visible(f"Settings (coverage error against {result.reference_label or '-'})"))
+    label = Text(single_line(f"Settings (coverage error against {result.reference_label or '-'})"))
     table = Table(title=label)  # the label is read from a file: never markup
     for column in TABLE_COLUMNS:
         table.add_column(
             column, justify="right" if column in ("s/scan", "rays/s", "differ", "cov. error") else "left"
         )
     for row in table_rows(result):
-        table.add_row(*(Text(visible(cell)) for cell in row))  # a reason read from a file: never markup
+        table.add_row(*(Text(single_line(cell)) for cell in row))  # a reason read from a file: never markup
     console.print(table)
     console.print(visible(result.verdict()), highlight=False, markup=False)
     paths = write_outputs(result, out_dir, width=CHART_WIDTH, height=CHART_HEIGHT)
     console.print(
-        visible("wrote " + ", ".join(str(p) for p in paths.values())), highlight=False, markup=False
+        single_line("wrote " + ", ".join(str(p) for p in paths.values())), highlight=False, markup=False
     )
     return 0

@@ -20,7 +20,7 @@ from ladartui.cli.flags import as_flags, check_file_names
 from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt, stop_status
 from ladartui.errors import Cancelled, FieldError, LadarError
 from ladartui.number_text import plural
-from ladartui.textsafe import visible
+from ladartui.textsafe import single_line
 
 if TYPE_CHECKING:
     from ladartui.sweep.spec import SweepSpec
@@ -210,7 +210,7 @@ def run(args) -> int:
             base_scenario_path(spec)
         except InputFileError as error:  # gone: nothing to tell this base's rows by
             errors.print(
-                visible(
+                single_line(
                     f"ladartui: the base scenario is not there ({error}); every row of the table is ranked"
                 ),
                 highlight=False,
@@ -449,7 +449,7 @@ def show_result(console, result, top) -> None:
     table.add_column("front")
 
     def read(value) -> Text:  # text read from the results table: never markup or escapes
-        return Text(visible(value))
+        return Text(single_line(value))
 
     for ranked in shown:
         row = ranked.row
@@ -472,7 +472,7 @@ def show_result(console, result, top) -> None:
             for r in front
         )
         console.print(
-            visible(f"Pareto front of obscured coverage against {result.cost}, cheapest first: {points}"),
+            single_line(f"Pareto front of obscured coverage against {result.cost}, cheapest first: {points}"),
             highlight=False,
             markup=False,
         )
@@ -487,7 +487,7 @@ def show_result(console, result, top) -> None:
         missed = never_identified(result.rows)
         if missed and result.objective in ("time-to-identify", "distance-to-identify"):
             console.print(
-                visible("no variant identifies " + ", ".join(missed)), highlight=False, markup=False
+                single_line("no variant identifies " + ", ".join(missed)), highlight=False, markup=False
             )
     for rows, what in (
         (result.impossible, "with impossible values (kept as errors, not run again)"),
@@ -496,7 +496,7 @@ def show_result(console, result, top) -> None:
         if rows:
             console.print(
                 f"[bold]{plural(len(rows), 'variant')} {what}[/]; first: "
-                + escape(visible(f"{rows[0].get('variant')}: {rows[0].get('error')}")),
+                + escape(single_line(f"{rows[0].get('variant')}: {rows[0].get('error')}")),
                 highlight=False,
             )
     ran, resumed = result.ran, result.resumed
@@ -517,14 +517,14 @@ def show_result(console, result, top) -> None:
             "spec runs its variants again for the base as it is now)",
             highlight=False,
         )
-    console.print(visible(f"results  {result.results_path}"), highlight=False, markup=False)
+    console.print(single_line(f"results  {result.results_path}"), highlight=False, markup=False)
     if result.ranking_path:
-        console.print(visible(f"ranking  {result.ranking_path}"), highlight=False, markup=False)
+        console.print(single_line(f"ranking  {result.ranking_path}"), highlight=False, markup=False)
     for path in result.charts.values():
-        console.print(visible(f"chart    {path}"), highlight=False, markup=False)
+        console.print(single_line(f"chart    {path}"), highlight=False, markup=False)
     if result.best_scenario_path:
         console.print(
-            visible(
+            single_line(
                 f"best     {result.best_scenario_path}  (open it with: ladartui {result.best_scenario_path})"
             ),
             highlight=False,
@@ -532,7 +532,7 @@ def show_result(console, result, top) -> None:
         )
     if result.best_earlier:
         console.print(
-            visible(
+            single_line(
                 f"earlier  {result.best_earlier}  (the best path of an earlier ranking: none is ranked now)"
             ),
             highlight=False,
@@ -540,7 +540,7 @@ def show_result(console, result, top) -> None:
         )
     if result.best_kept:
         console.print(
-            visible(f"kept     {result.best_kept}  ({result.best_kept_why}: not replaced)"),
+            single_line(f"kept     {result.best_kept}  ({result.best_kept_why}: not replaced)"),
             highlight=False,
             markup=False,
         )

@@ -17,7 +17,7 @@ from ladartui.atomic import atomic_path
 from ladartui.errors import Cancelled, FieldError, InputFileError, ResourceLimitError
 from ladartui.fileprobe import NO_SUCH_FILE, refuse_special_file
 from ladartui.number_text import plural
-from ladartui.textsafe import visible
+from ladartui.textsafe import single_line
 from ladartui.tracing.backend import METHODS, PRECISIONS
 
 # Rays a trace call: the bar moves, and Ctrl-C is seen, between calls (a second or so).
@@ -252,7 +252,7 @@ def _trace_and_write(args, voxel_size: float) -> None:
         " (assumed; --voxel-size sets it)" if args.voxel_size is None else ""
     )
     print(
-        visible(
+        single_line(
             f"{plural(len(rays), 'ray')} ({backends}, {result.method}, {used}), {size}: "
             f"{counts[1]:,} voxel, {counts[2]:,} ground, {counts[0]:,} miss -> {args.out}"
         ),

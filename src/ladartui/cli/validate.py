@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from ladartui.textsafe import visible
+from ladartui.textsafe import single_line, visible
 
 
 def add_parser(subparsers):
@@ -39,7 +39,7 @@ def run(args) -> int:
     print(visible(scenario.summary()))
     notes = [*flight_notes(scenario.flight), *detection_notes(scenario)]
     for line in [*scene_lines, *notes, *last_run_lines(scenario, scene)]:
-        print(visible(line))
+        print(single_line(line))
     return 0
 
 

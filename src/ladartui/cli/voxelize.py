@@ -11,7 +11,7 @@ from ladartui.cli.flags import as_flags, check_file_names, check_scene_stem, vox
 from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt
 from ladartui.errors import Cancelled, FieldError, check_cancelled
 from ladartui.number_text import extent_metres, plural
-from ladartui.textsafe import one_line, visible
+from ladartui.textsafe import one_line, single_line
 
 
 def add_parser(subparsers):
@@ -209,7 +209,7 @@ def _report(console, args, mesh, done, outputs, elapsed) -> None:
     detail = f"{result.surface:,} on the surface"
     if result.solid:
         detail += f", {result.inside:,} with their centre inside"
-    say = lambda text: console.print(visible(text), highlight=False, markup=False, soft_wrap=True)  # noqa: E731
+    say = lambda text: console.print(single_line(text), highlight=False, markup=False, soft_wrap=True)  # noqa: E731
     say(
         f"{mesh.path}: {plural(len(mesh.faces), 'triangle')}, "
         f"{'closed' if mesh.closed else 'not closed'}; "
