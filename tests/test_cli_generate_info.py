@@ -8,7 +8,7 @@ import pytest
 from cli_support import one_error_line
 from ladartui.cli import main
 from ladartui.scene.generate import generate_scene
-from ladartui.scene.voxels import load_voxels
+from ladartui.scene.voxels import load_voxels, save_voxels
 
 
 def test_generate_writes_the_pair_and_reports_it(tmp_path, capsys):
@@ -302,3 +302,24 @@ def test_info_takes_a_bundled_scenario_by_name(tmp_path, capsys, monkeypatch):
     assert main(["info", "default"]) == 0
     out = capsys.readouterr().out
     assert "default_Scene.txt, default_Target.txt, default.cmf" in out, out
+
+
+def test_info_and_validate_count_target_voxels_in_the_scene_by_sorted_keys(tmp_path, capsys, monkeypatch):
+    """np.isin took 4.4 of info's 6 s on the 3.8-million-voxel reference scene (its hashed
+    unique of both key arrays); the scene's keys sorted once and searched take 0.2 s."""
+    import numpy as np
+
+    from ladartui.scenario import Scenario
+
+    save_voxels(tmp_path / "s.txt", np.array([[0, 0, 0], [1, 2, 3], [4, 4, 4]], np.int32))
+    save_voxels(tmp_path / "s_Target.txt", np.array([[1, 2, 3], [9, 9, 9]], np.int32))
+    Scenario.new(tmp_path / "plan.toml", tmp_path / "s.txt", 1.0).save()
+
+    def slow(*args, **kwargs):
+        raise AssertionError("np.isin")
+
+    monkeypatch.setattr(np, "isin", slow)
+    assert main(["info", str(tmp_path / "s.txt")]) == 0
+    assert "s_Target.txt: 2 voxels, 1 of them in the scene" in capsys.readouterr().out
+    assert main(["validate", str(tmp_path / "plan.toml")]) == 0
+    assert "1 of 2 target voxels is not in the scene model s.txt" in capsys.readouterr().out

@@ -200,7 +200,7 @@ def _count_inside(target, voxels) -> int:
     import numpy as np
 
     from ladartui.errors import FieldError
-    from ladartui.scene.keys import voxel_keys
+    from ladartui.scene.keys import member, sorted_unique, voxel_keys
 
     try:
         scene_keys = voxel_keys(voxels)
@@ -208,7 +208,8 @@ def _count_inside(target, voxels) -> int:
     except FieldError:  # indices too large to pack: compare rows
         scene_rows = set(map(tuple, voxels.tolist()))
         return sum(1 for row in map(tuple, target.tolist()) if row in scene_rows)
-    return int(np.isin(target_keys, scene_keys).sum())
+    # (np.isin's hashed unique of both arrays took seconds on millions of voxels)
+    return int(np.count_nonzero(member(target_keys, sorted_unique(scene_keys))))
 
 
 def _occupancy_text(voxels, shape, path) -> str:

@@ -193,13 +193,16 @@ def target_notes(scenario, scene) -> list[str]:
 
     from ladartui.errors import FieldError
     from ladartui.number_text import plural
-    from ladartui.scene.keys import voxel_keys
+    from ladartui.scene.keys import member, sorted_unique, voxel_keys
 
     name = scenario.target_file.name
     if not len(scene.target):
         return [f"note       {name} holds no voxels: the target measures will be undefined"]
     try:
-        missing = int(np.count_nonzero(~np.isin(voxel_keys(scene.target), voxel_keys(scene.voxels))))
+        inside = member(
+            voxel_keys(scene.target), sorted_unique(voxel_keys(scene.voxels))
+        )  # not np.isin: slow
+        missing = int(np.count_nonzero(~inside))
     except FieldError:  # indices beyond the keys' range: the memory check speaks for those
         return []
     if not missing:
