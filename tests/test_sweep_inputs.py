@@ -525,3 +525,19 @@ def test_too_many_variants_names_the_spec_line_and_the_sizes(tmp_path, body, mad
         f"{spec}:3: {made} variants ({sizes}), more than the limit of 100,000; use fewer values or samples"
     )
     assert made.split()[0] == spec.read_text(encoding="utf-8").splitlines()[2]  # line 3, the table's
+
+
+@pytest.mark.parametrize("value", ["inf", "nan", "1e300", "0", "-5"])
+def test_a_connect_timeout_beyond_a_day_or_not_finite_is_refused(tiny, tmp_path, capsys, value):
+    """--connect-timeout inf ended in dask's KeyError traceback ('Invalid time unit: infs');
+    1e300 waited for ever."""
+    from ladartui.cli import main
+
+    spec = write_spec(tiny, "[grid]\nradius = [20.0]\n", name="timeout.toml")
+    args = ["sweep", str(spec), "--scheduler", "tcp://127.0.0.1:1", "--connect-timeout", value]
+    assert main([*args, "--out", str(tmp_path / "o")]) == 2
+    assert one_error_line(capsys) == (
+        f"ladartui: error: --connect-timeout = {float(value)!r}: expected a number of seconds "
+        "greater than 0 and at most 86400"
+    )
+    assert not (tmp_path / "o").exists()

@@ -27,6 +27,7 @@ if TYPE_CHECKING:
 
 DEFAULT_TOP = 10
 DEFAULT_CONNECT_TIMEOUT = 30.0
+MAX_CONNECT_TIMEOUT = 86400  # seconds: a day
 # Flags that only shape a run (its cluster and workers): --show starts none.
 RUN_ONLY_FLAGS = {
     "workers": "--workers",
@@ -152,8 +153,12 @@ def run(args) -> int:
     from ladartui.sweep.cluster import check_local_workers
 
     check_local_workers(args.workers, "--workers")
-    if not args.connect_timeout > 0:
-        raise FieldError("--connect-timeout", args.connect_timeout, "a number of seconds > 0")
+    if not 0 < args.connect_timeout <= MAX_CONNECT_TIMEOUT:  # inf: a traceback in dask; 1e300: for ever
+        raise FieldError(
+            "--connect-timeout",
+            args.connect_timeout,
+            f"a number of seconds greater than 0 and at most {MAX_CONNECT_TIMEOUT}",
+        )
     if args.top < 0:
         raise FieldError("--top", args.top, "an integer >= 0")
     if args.scheduler and (args.workers is not None or args.serial):
