@@ -147,3 +147,13 @@ def test_a_stopped_study_says_nothing_was_written(tmp_path, monkeypatch, capsys,
         f"ladartui: study cancelled; nothing was written, the earlier study in {out} is unchanged"
     )
     assert [p.name for p in out.iterdir()] == ["study.csv"] and (out / "study.csv").read_text() == "earlier"
+
+
+def test_a_folder_where_the_lock_goes_is_refused_before_the_study(tmp_path, capsys, no_scene):
+    """It ended the study, after all its tracing, in an IsADirectoryError traceback."""
+    (tmp_path / ".study.outputs.lock").mkdir(parents=True)
+    assert main(["study", "--quick", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(
+        f"ladartui: error: {tmp_path / '.study.outputs.lock'}: is a folder, expected the lock file"
+    )

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import ladartui.outputset as outputset
+from cli_support import one_error_line
 from ladartui.cli import main
 from ladartui.errors import OutputFileError
 from ladartui.flight import FlightPlan, Manual, ScanPose, aim_at
@@ -121,6 +122,23 @@ def test_second_writer_is_refused(scenario, capsys):
     assert snapshot(scenario) == old
     assert main(["run", str(scenario.path)]) == 0  # the lock is let go
     assert hidden(scenario.path.parent) == []
+
+
+def test_a_folder_where_the_lock_goes_is_one_line(scenario, capsys):
+    """A folder of the set's lock file's name (.S.outputs.lock) ended a run in an
+    IsADirectoryError traceback, from os.open."""
+    from ladartui.simulation import output_lock
+
+    lock = output_lock(scenario)
+    lock.mkdir()
+    assert main(["run", str(scenario.path)]) == 2
+    assert one_error_line(capsys) == (
+        f"ladartui: error: {lock}: is a folder, expected the lock file of this set of outputs "
+        "(made while they are written): remove the folder"
+    )
+    assert snapshot(scenario) == [None] * len(snapshot(scenario))
+    assert main(["validate", str(scenario.path)]) == 2  # what a run would refuse
+    assert "is a folder, expected the lock file" in one_error_line(capsys)
 
 
 def test_stale_temporaries_are_removed_by_the_next_run(scenario):

@@ -119,6 +119,18 @@ def check_writable_folder(folder) -> None:
         raise OutputFileError(folder, problem.replace("probe", str(folder)))
 
 
+LOCK_FOLDER = (
+    "is a folder, expected the lock file of this set of outputs (made while they are written): "
+    "remove the folder"
+)
+
+
+def check_lock(lock) -> None:
+    """``OutputFileError`` for a folder where a set's lock file goes (asked before the work)."""
+    if Path(lock).is_dir():
+        raise OutputFileError(lock, LOCK_FOLDER)
+
+
 class OutputSet:
     """The files of one run, written together; use as a context manager around the work.
 
@@ -155,7 +167,10 @@ class OutputSet:
 
         self.lock.parent.mkdir(parents=True, exist_ok=True)
         while True:
-            fd = os.open(self.lock, os.O_RDWR | os.O_CREAT, 0o644)
+            try:
+                fd = os.open(self.lock, os.O_RDWR | os.O_CREAT, 0o644)
+            except IsADirectoryError:
+                raise OutputFileError(self.lock, LOCK_FOLDER) from None
             try:
                 fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except OSError as error:

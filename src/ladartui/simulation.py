@@ -404,12 +404,13 @@ def check_outputs_spare_inputs(scenario, las=False) -> None:
     a file of its record's name that is not a run record (``run_record``).
     """
     from ladartui.errors import FieldError
-    from ladartui.outputset import LOCK_EXTRA, SET_MEMBER_EXTRA, check_names
+    from ladartui.outputset import LOCK_EXTRA, SET_MEMBER_EXTRA, check_lock, check_names
 
     # before anything looks for them: a name too long fails every call on it
     shorter = "; use a shorter scenario name"
     check_names(*output_paths(scenario, las).values(), extra=SET_MEMBER_EXTRA, advice=shorter)
     check_names(output_lock(scenario), extra=LOCK_EXTRA, advice=shorter)
+    check_lock(output_lock(scenario))
     inputs = {os.path.normpath(Path(f).absolute()) for f in (scenario.scene_file, scenario.target_file)}
     for name, path in output_paths(scenario, las).items():
         if os.path.normpath(path.absolute()) in inputs:

@@ -271,9 +271,14 @@ def output_paths(out_dir, chart_stem="speed-accuracy", stem="study") -> dict[str
 def check_outputs(out_dir) -> None:
     """``OutputFileError`` naming a file of ``write_outputs`` that could not be written
     (a folder, pipe or device there, say): asked before a study, not after it."""
-    from ladartui.outputset import check_writable
+    from ladartui.outputset import check_lock, check_writable
 
     check_writable(*output_paths(out_dir).values())
+    check_lock(_lock_path(out_dir))
+
+
+def _lock_path(out_dir, stem="study") -> Path:
+    return Path(out_dir) / f".{stem}.outputs.lock"
 
 
 def write_outputs(
@@ -297,6 +302,6 @@ def write_outputs(
         "txt": (chart_text(result, width, height, color=False) + "\n\n" + result.verdict() + "\n").encode(),
     }
     paths = output_paths(out_dir, chart_stem, stem)
-    with OutputSet(paths, out_dir / f".{stem}.outputs.lock") as output_set:
+    with OutputSet(paths, _lock_path(out_dir, stem)) as output_set:
         output_set.write_contents(contents)
     return paths
