@@ -109,3 +109,19 @@ def _rays(folder):
     path = folder / "rays.npy"
     np.save(path, np.array([[5.0, 5.0, 30.0, 0.0, 0.0, -1.0]]))
     return path
+
+
+def test_a_file_name_that_is_not_utf8_is_written_escaped(tmp_path, capsys):
+    """Bytes of a file name that are not UTF-8 (b'\\xff', a lone surrogate in Python) reached
+    standard output as they were: where its encoding is strict (an en_US.UTF-8 locale,
+    PYTHONIOENCODING=utf-8), validate ended in a UnicodeEncodeError traceback."""
+    import os
+
+    from tiny_sweep import write_tiny_scenario
+
+    base = write_tiny_scenario(tmp_path, name="bad\udcffname.toml")
+    assert main(["validate", os.fsdecode(base.path)]) == 0
+    out = capsys.readouterr().out
+    out.encode("utf-8")  # strict: no lone surrogate left
+    assert "bad\\udcffname.toml" in out
+    assert one_line("a\udcffb") == "a\\udcffb"

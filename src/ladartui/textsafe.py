@@ -10,7 +10,8 @@ MAX_MESSAGE_CHARS = 400
 
 def _visible(char: str) -> str:
     code = ord(char)
-    if code < 0x20 or 0x7F <= code < 0xA0 or code in (0x2028, 0x2029):
+    # (a lone surrogate: a file name's byte that is not UTF-8, which a strict stdout refuses)
+    if code < 0x20 or 0x7F <= code < 0xA0 or code in (0x2028, 0x2029) or 0xD800 <= code < 0xE000:
         return f"\\x{code:02x}" if code < 0x100 else f"\\u{code:04x}"
     return char
 
