@@ -467,6 +467,25 @@ def test_a_point_cloud_or_mesh_given_as_a_voxel_list_is_named(tmp_path, capsys, 
     assert capsys.readouterr().err == f"ladartui: error: {path}: {what}, not a voxel list; {EXPECTED}\n"
 
 
+@pytest.mark.parametrize(
+    "name, data, what",
+    [
+        ("small.txt", b"0,0,0\n1,2,3\n", "a voxel list (.txt)"),
+        ("truck.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "a mesh (.obj)"),
+        ("forest.laz", b"LASF\x00\xff\x01\x02binary", "a LAS point cloud (.laz)"),
+    ],
+)
+def test_a_voxel_list_mesh_or_point_cloud_given_as_a_scenario_is_named(tmp_path, capsys, name, data, what):
+    """'run small.txt' said "not valid TOML: Expected '=' after a key", and a .laz
+    'not UTF-8 text (byte 0xff)'."""
+    path = tmp_path / name
+    path.write_bytes(data)
+    assert main(["run", str(path)]) == 2
+    assert one_error_line(capsys) == (
+        f"ladartui: error: {path}: {what}, not a scenario; expected a scenario file (.toml)"
+    )
+
+
 def test_binary_data_given_as_a_voxel_list_says_so(tmp_path):
     path = tmp_path / "rays.npy"
     np.save(path, np.zeros((2, 6)))

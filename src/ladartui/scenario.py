@@ -13,6 +13,7 @@ import dataclasses
 import os
 import re
 import sys
+import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,7 +24,7 @@ from ladartui.atomic import write_errors_named, write_text_atomic
 from ladartui.checks import choice_field, number_field
 from ladartui.detection.settings import DetectionSettings
 from ladartui.errors import FieldError, InputFileError, LadarError, OutputFileError
-from ladartui.fileprobe import NO_SUCH_FILE, file_problem, path_field, read_utf8
+from ladartui.fileprobe import NO_SUCH_FILE, OTHER_FILE_KINDS, file_problem, path_field, read_utf8
 from ladartui.flight import (
     FlightPlan,
     ScanPose,
@@ -428,7 +429,12 @@ def load_scenario(path, check_files=True) -> Scenario:
     scenario's checks (scan count, work limit) need."""
     path = _absolute(path_field("path", path, "a scenario file's path"))
     try:
-        text = read_utf8(path, "expected a scenario file (.toml)")
+        try:
+            text = read_utf8(path, "expected a scenario file (.toml)")
+        except InputFileError:  # no UTF-8 text: a point cloud, say
+            _refuse_other_kind(path, None)
+            raise
+        _refuse_other_kind(path, text)
     except FileNotFoundError:
         raise InputFileError(path, f"{NO_SUCH_FILE}; expected a scenario file (.toml)") from None
     except IsADirectoryError:
@@ -439,6 +445,28 @@ def load_scenario(path, check_files=True) -> Scenario:
     if check_files:
         scenario.check_files()
     return scenario
+
+
+# What a file of another kind given as a scenario is, by its suffix.
+_NOT_SCENARIOS = {".txt": "a voxel list", ".npy": "a NumPy array", **OTHER_FILE_KINDS}
+_NOT_SCENARIOS.pop(".toml")
+
+
+def _refuse_other_kind(path: Path, text: str | None) -> None:
+    """A voxel list, mesh or point cloud given as a scenario fails on its first line as
+    TOML (or as text): say what it is. ``text``: None where it was no UTF-8 text."""
+    kind = _NOT_SCENARIOS.get(path.suffix.lower())
+    if kind is None:
+        return
+    if text is not None:
+        try:
+            tomllib.loads(text)
+            return  # TOML after all: its keys are checked as a scenario's
+        except tomllib.TOMLDecodeError:
+            pass
+        except RecursionError:
+            return
+    raise InputFileError(path, f"{kind} ({path.suffix}), not a scenario; expected a scenario file (.toml)")
 
 
 def scenario_from_toml(text: str, path) -> Scenario:
