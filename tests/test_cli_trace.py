@@ -467,7 +467,7 @@ def test_a_long_trace_shows_its_progress_in_blocks_of_rays(tmp_path, scene_file,
     assert main([*command, "--out", str(tmp_path / "whole.npy")]) == 0
     terminal = io.StringIO()
     monkeypatch.setattr(
-        cli_console, "CliConsole", lambda **kwargs: Console(file=terminal, force_terminal=True, width=80)
+        cli_console, "CliConsole", lambda **kwargs: Console(file=terminal, force_terminal=True, width=400)
     )
     monkeypatch.setattr(cli_trace, "TRACE_BLOCK", 2)
     calls = []
