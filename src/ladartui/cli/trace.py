@@ -185,7 +185,8 @@ def _identity(path) -> tuple[int, int] | None:
 
 
 def _shown(text: str) -> str:
-    """A file name in the bar: one line, its markup ("[red]") shown as typed."""
+    """A file name in the bar: one line, its markup ("[red]") shown as typed. The bar
+    names a file without its folder, so a long path leaves room for the count."""
     from rich.markup import escape
 
     from ladartui.textsafe import one_line
@@ -208,9 +209,9 @@ def _trace_and_write(args, voxel_size: float) -> None:
     console = CliConsole(stderr=True)
     after = (TextColumn("{task.fields[done]}"), TimeElapsedColumn())
     with progress_display(console, after, transient=True, disable=not console.is_terminal) as bar:
-        task = bar.add_task(_shown(f"reading {args.rays}"), total=None, done="")
+        task = bar.add_task(_shown(f"reading {Path(args.rays).name}"), total=None, done="")
         rays = load_rays(args.rays)
-        bar.update(task, description=_shown(f"reading {args.scene}"))
+        bar.update(task, description=_shown(f"reading {Path(args.scene).name}"))
         voxels = load_voxels(args.scene)
         occupancy = Occupancy.build(voxels, source=str(args.scene))
         bar.update(task, description="tracing", total=max(len(rays), 1), completed=0)
@@ -238,7 +239,7 @@ def _trace_and_write(args, voxel_size: float) -> None:
                 )
                 done = start + len(block)
                 bar.update(task, completed=done, done=f"{done:,}/{len(rays):,} rays")
-        bar.update(task, description=_shown(f"writing {args.out}"))
+        bar.update(task, description=_shown(f"writing {Path(args.out).name}"))
         with atomic_path(args.out) as tmp:
             with open(tmp, "wb") as handle:
                 np.save(handle, np.concatenate([result.as_array() for result in results]))
