@@ -106,6 +106,16 @@ def test_a_mistyped_bundled_name_names_the_bundled_scenarios(tmp_path, capsys, m
     )
 
 
+@pytest.mark.parametrize("argument", ["./convoy", "./convoy.toml"])
+def test_a_path_with_a_folder_is_never_a_bundled_name(tmp_path, capsys, monkeypatch, argument):
+    """'validate ./convoy', a path to no file, opened the bundled convoy scenario."""
+    monkeypatch.chdir(tmp_path)
+    assert cli.main(["validate", argument]) == 2
+    assert capsys.readouterr().err == (
+        f"ladartui: error: {tmp_path / argument[2:]}: no such file; expected a scenario file (.toml)\n"
+    )
+
+
 BUNDLED = "a scenario file (.toml) or a bundled scenario: default, convoy"
 
 

@@ -117,10 +117,18 @@ def bundled_scenario_path(name: str) -> Path:
 
 
 def bundled_scenario_name(argument) -> str | None:
-    """The bundled scenario ``argument`` names (``convoy`` or ``convoy.toml``, no folder), else None."""
+    """The bundled scenario ``argument`` names (``convoy`` or ``convoy.toml``, no folder), else None.
+    A folder written in it (``./convoy``) makes it a path, never a name."""
+    if _names_a_folder(argument):
+        return None
     path = Path(argument)
     stem = path.stem if path.suffix == ".toml" else path.name
     return stem if path.parent == Path(".") and stem in BUNDLED else None
+
+
+def _names_a_folder(argument) -> bool:
+    text = os.fspath(argument)
+    return any(sep in text for sep in (os.sep, os.altsep) if sep)
 
 
 def bundled_or_path(argument) -> Path:
@@ -130,7 +138,8 @@ def bundled_or_path(argument) -> Path:
     name = bundled_scenario_name(argument)
     if name is not None and not path.exists():
         return bundled_scenario_path(name)
-    if path.parent == Path(".") and path.suffix in ("", ".toml") and not path.exists():
+    bare = path.parent == Path(".") and not _names_a_folder(argument)
+    if bare and path.suffix in ("", ".toml") and not path.exists():
         from ladartui.errors import InputFileError
         from ladartui.fileprobe import NO_SUCH_FILE
 
@@ -144,9 +153,8 @@ def load_scenario(path, check_files=True) -> Scenario:
     """``ladartui.load_scenario``: ``scenario.load_scenario``, taking a bundled scenario's
     bare name ("default", "convoy") as the commands do, made ready on first use (a
     file of that name where Python runs wins)."""
-    return load_scenario_file(
-        bundled_or_path(path_field("path", path, "a scenario file's path")), check_files
-    )
+    checked = path_field("path", path, "a scenario file's path")
+    return load_scenario_file(bundled_or_path(path if isinstance(path, str) else checked), check_files)
 
 
 def _model_files(folder: Path, name: str):
