@@ -133,9 +133,9 @@ def test_malformed_mesh_is_one_line(tmp_path, capsys, name, content, message):
         (["--at", "1,x"], "--at = '1,x': expected X,Y or X,Y,Z in metres"),
         (["--heading", "30"], "--heading = 30.0: expected --at X,Y too"),
         (["--into", "scene.txt"], "--into = 'scene.txt': expected --at X,Y too"),
-        (["--voxel-size", "-1"], "--voxel-size = -1.0: expected a number of metres greater than 0 and"),
+        (["--voxel-size", "-1"], "--voxel-size = -1.0: expected a number of metres from 0.001 to 100"),
         # the scene's voxel size: at most what a scenario takes
-        (["--voxel-size", "1e308"], "--voxel-size = 1e+308: expected a number of metres greater than 0"),
+        (["--voxel-size", "1e308"], "--voxel-size = 1e+308: expected a number of metres from 0.001 to 100"),
         (["--at", "0.5,5"], "--at = '0.5,5': expected a position keeping the mesh inside the scene"),
         (["--at", "5,5,-1"], "--at = '5,5,-1': expected a height of 0 m or more above the ground"),
         # 1e23 degrees was taken: at that size a float holds no angle

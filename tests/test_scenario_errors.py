@@ -9,13 +9,15 @@ from scenario_support import BASE, edited, line_of, write_scenario
 # -- field limits ----------------------------------------------------------------------
 
 LIMITS = [
-    ("voxel_size = 0.5", "voxel_size = 0", "files.voxel_size = 0", "a number greater than 0 and at most 100"),
+    ("voxel_size = 0.5", "voxel_size = 0", "files.voxel_size = 0", "a number from 0.001 to 100"),
     (
         "voxel_size = 0.5",
         "voxel_size = 250.0",
         "files.voxel_size = 250.0",
-        "a number greater than 0 and at most 100",
+        "a number from 0.001 to 100",
     ),
+    # a scene 1e-298 m wide, which every ray missed
+    ("voxel_size = 0.5", "voxel_size = 1e-300", "files.voxel_size = 1e-300", "a number from 0.001 to 100"),
     ('scene = "models/forest.txt"', "scene = 3", "files.scene = 3", "the scene model file name (X.txt)"),
     ("grid = 32", "grid = 2000", "sensor.grid = 2000", "an integer from 1 to 1024"),
     ("grid = 32", "grid = 32.5", "sensor.grid = 32.5", "an integer from 1 to 1024"),

@@ -529,7 +529,7 @@ async def test_the_new_scenario_dialog_refuses_in_the_forms_words(tmp_path, scen
         dialog.query_one("#setup-ok").press()
         await pilot.pause()
         assert message(dialog, "#setup-message") == (  # the limit in the label's unit, as in the forms
-            "Voxel size m: 0 is not allowed; expected a number greater than 0 and at most 100 m"
+            "Voxel size m: 0 is not allowed; expected a number from 0.001 to 100 m"
         )
 
 

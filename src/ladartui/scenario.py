@@ -52,6 +52,7 @@ from ladartui.trajectory import LogSegment
 
 BUILTIN_BACKENDS = ("numba", "wgpu")
 MAX_VOXEL_SIZE = 100.0
+MIN_VOXEL_SIZE = 0.001  # a millimetre: finer than any LADAR resolves; 1e-300 m passed
 MAX_SPEED = 1000.0
 MAX_STEP = 10.0
 
@@ -100,7 +101,7 @@ class Scenario:
         set_(
             self,
             "voxel_size",
-            number_field("files.voxel_size", self.voxel_size, 0.0, MAX_VOXEL_SIZE, low_open=True),
+            number_field("files.voxel_size", self.voxel_size, MIN_VOXEL_SIZE, MAX_VOXEL_SIZE),
         )
         if not isinstance(self.sensor, Sensor):
             raise FieldError("sensor", self.sensor, "a Sensor")

@@ -11,7 +11,7 @@ are caught; keys marked "default" may be left out)::
 
     [files]
     scene = "generated/small.txt"   # scene model X.txt, relative to this file's folder
-    voxel_size = 0.25               # metres per voxel (default 1.0)
+    voxel_size = 0.25               # metres per voxel, 0.001..100 (default 1.0)
 
     [sensor]                        # report section 7.1; every key has a default
     grid = 64                       # n: n x n detectors, 1..1024

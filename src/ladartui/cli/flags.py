@@ -45,12 +45,14 @@ def run_count(flag: str, value: int, low: int = 1, high: int = MAX_RUNS) -> int:
 
 def voxel_size_flag(value: float, flag: str = "--voxel-size") -> float:
     """A voxel size typed as a flag, held to what a scenario's ``files.voxel_size`` takes:
-    finite, above 0, at most MAX_VOXEL_SIZE metres; else FieldError naming the flag."""
+    finite, MIN_VOXEL_SIZE to MAX_VOXEL_SIZE metres; else FieldError naming the flag."""
     from ladartui.checks import range_text
-    from ladartui.scenario import MAX_VOXEL_SIZE
+    from ladartui.scenario import MAX_VOXEL_SIZE, MIN_VOXEL_SIZE
 
-    if not (math.isfinite(value) and 0 < value <= MAX_VOXEL_SIZE):
-        raise FieldError(flag, value, range_text("a number of metres", 0, MAX_VOXEL_SIZE, True, False))
+    if not (math.isfinite(value) and MIN_VOXEL_SIZE <= value <= MAX_VOXEL_SIZE):
+        raise FieldError(
+            flag, value, range_text("a number of metres", MIN_VOXEL_SIZE, MAX_VOXEL_SIZE, False, False)
+        )
     return value
 
 
