@@ -155,6 +155,19 @@ def test_an_empty_path_is_refused_naming_its_argument(tmp_path, capsys, monkeypa
     assert [p.name for p in tmp_path.iterdir()] == ["sp.toml"]
 
 
+def test_a_closed_standard_output_is_a_failure_said_on_standard_error(tmp_path, capsys, monkeypatch):
+    """'ladartui info v.txt >&-' wrote nothing and exited 0: Python sets sys.stdout to
+    None, and print() then drops what it is given."""
+    import sys
+
+    (tmp_path / "v.txt").write_text("1,2,3\n")
+    monkeypatch.setattr(sys, "stdout", None)
+    assert cli.main(["info", str(tmp_path / "v.txt")]) == 1
+    assert one_error_line(capsys) == (
+        "ladartui: error: standard output is closed; expected it open (> /dev/null drops the output)"
+    )
+
+
 def test_output_that_cannot_be_written_is_one_line_not_a_traceback(tmp_path, capsys, monkeypatch):
     """'ladartui run S.toml --json > out.json' on a full disk (or '> /dev/full') ended in an
     OSError traceback from print()."""

@@ -98,6 +98,12 @@ def main(argv: list[str] | None = None) -> int:
             print(f"ladartui: error: {_unknown_command(argv[0])} (see 'ladartui -h')", file=sys.stderr)
             return 2
         argv = ["tui", *argv]
+    if sys.stdout is None:  # started with it closed (`>&-`): print() would drop every line
+        print(
+            "ladartui: error: standard output is closed; expected it open (> /dev/null drops the output)",
+            file=sys.stderr,
+        )
+        return 1
     reset_stop()
     try:
         parser = build_parser()  # (imports every command: a Ctrl-C can land here)
