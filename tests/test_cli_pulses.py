@@ -175,3 +175,19 @@ def test_the_table_writes_counts_with_thousands_separators(scenario, capsys, mon
         "      1     1    0.4000      93,376      7,066       0.674",
         "100,000    10    0.4100  12,345,678  1,234,567       0.900",
     ]
+
+
+def test_coverage_of_a_target_model_with_no_voxels_is_undefined(scenario, capsys):
+    """A target model holding no voxels read as 0.0000 coverage (none of it seen), where
+    a run's measures call it undefined; the false alarms are still counted."""
+    (scenario.path.parent / "woods_Target.txt").write_text("", encoding="utf-8")
+    assert main(["pulses", str(scenario.path), "--pulses", "1,20", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["ideal_obscured_coverage"] is None
+    assert [r["obscured_coverage"] for r in out["rows"]] == [None, None]
+    assert out["rows"][0]["false_alarms"] > 0
+    assert main(["pulses", str(scenario.path), "--pulses", "1,20"]) == 0
+    out = capsys.readouterr().out
+    assert "ideal model: obscured coverage undefined (the target model holds no voxels)" in out
+    assert out.splitlines()[2].split()[2] == "undefined"  # the first row's coverage column
+    assert "false alarms (right)" in out and "obscured coverage % (Geiger)" not in out

@@ -117,12 +117,16 @@ def run(args) -> int:
     if args.json:
         print(json.dumps(result_dict(scenario, settings, ideal, rows), indent=2, allow_nan=False))
         return 0
-    print(f"ideal model: obscured coverage {ideal:.4f}")
+    if ideal is None:
+        print("ideal model: obscured coverage undefined (the target model holds no voxels)")
+    else:
+        print(f"ideal model: obscured coverage {ideal:.4f}")
     print(f"{'pulses':>7} {'k':>5} {'coverage':>9} {'declared':>11} {'false':>10} {'P_d(target)':>11}")
     for r in rows:
         detection = "undefined" if r.target_detection is None else f"{r.target_detection:.3f}"
+        coverage = "undefined" if r.obscured_coverage is None else f"{r.obscured_coverage:.4f}"
         print(
-            f"{r.pulses:>7,} {r.threshold:>5,} {r.obscured_coverage:>9.4f} {r.declared_points:>11,} "
+            f"{r.pulses:>7,} {r.threshold:>5,} {coverage:>9} {r.declared_points:>11,} "
             f"{r.false_alarms:>10,} {detection:>11}"
         )
     if args.chart:
@@ -202,15 +206,16 @@ def chart_text(ideal, rows, width=CHART_WIDTH, height=CHART_HEIGHT, color=True) 
         plotext.theme("pro" if color else "clear")
         # plotext drops a title wider than the chart: a shorter one where the full one is
         plotext.title(TITLE if len(TITLE) <= width else SHORT_TITLE)
-        # The ideal line first: where the Geiger points fall on its row they are drawn over it.
-        plotext.plot(xs, [100.0 * ideal] * len(xs), color="cyan", label="obscured coverage % (ideal)")
-        plotext.plot(
-            xs,
-            [100.0 * r.obscured_coverage for r in rows],
-            marker="o",
-            color="green",
-            label="obscured coverage % (Geiger)",
-        )
+        if ideal is not None:  # else no target voxels: coverage is undefined, not drawn
+            # The ideal line first: where the Geiger points fall on its row they are drawn over it.
+            plotext.plot(xs, [100.0 * ideal] * len(xs), color="cyan", label="obscured coverage % (ideal)")
+            plotext.plot(
+                xs,
+                [100.0 * (r.obscured_coverage or 0.0) for r in rows],
+                marker="o",
+                color="green",
+                label="obscured coverage % (Geiger)",
+            )
         plotext.plot(
             xs,
             [r.false_alarms for r in rows],
@@ -220,7 +225,7 @@ def chart_text(ideal, rows, width=CHART_WIDTH, height=CHART_HEIGHT, color=True) 
             label="false alarms (right)",
         )
         # Head room above the data for the legend, which plotext puts top left.
-        top = max([100.0 * ideal, *(100.0 * r.obscured_coverage for r in rows)])
+        top = max([100.0 * (ideal or 0.0), *(100.0 * (r.obscured_coverage or 0.0) for r in rows)])
         plotext.ylim(0.0, (top or 1.0) * LEGEND_HEADROOM)
         plotext.ylim(0.0, (max(r.false_alarms for r in rows) or 1.0) * LEGEND_HEADROOM, yside="right")
         if len(xs) > 1 and min(xs) > 0:

@@ -32,7 +32,7 @@ GeigerSettings = DetectionSettings
 class PulseRow:
     pulses: int
     threshold: int
-    obscured_coverage: float
+    obscured_coverage: float | None  # None: the target model holds no voxels
     declared_points: int
     false_alarms: int
     # declared / ideal distinct target voxels, summed over looks; None (as in a run's
@@ -64,8 +64,9 @@ def pulse_study(
     backend=None,
     progress: Callable[[PulseProgress], None] | None = None,
     cancel: threading.Event | None = None,
-) -> tuple[float, list[PulseRow]]:
-    """Ideal obscured coverage and one ``PulseRow`` per pulse count.
+) -> tuple[float | None, list[PulseRow]]:
+    """Ideal obscured coverage and one ``PulseRow`` per pulse count; coverages are None
+    (undefined, as in a run's measures) when the target model holds no voxels.
 
     ``settings`` default to the scenario's ``[detection]`` section (or its
     defaults). ``progress`` is called after each traced scan and each scan's
@@ -118,7 +119,7 @@ def pulse_study(
         )
         units += 1.0
         report("trace", scan + 1, len(poses))
-    ideal_cov = np.isin(target_keys, np.concatenate(ideal)).sum() / total if total else 0.0
+    ideal_cov = float(np.isin(target_keys, np.concatenate(ideal)).sum() / total) if total else None
     rows = []
     for row, pulses in enumerate(pulses_list):
         k = settings.threshold(pulses)
@@ -138,10 +139,10 @@ def pulse_study(
             PulseRow(
                 pulses,
                 k,
-                covered / total if total else 0.0,
+                float(covered / total) if total else None,
                 points,
                 false_alarms,
                 target_declared / target_ideal if target_ideal else None,
             )
         )
-    return float(ideal_cov), rows
+    return ideal_cov, rows
