@@ -208,7 +208,7 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         typed values, which Run commits (or refuses, focusing the field) itself."""
         if self.scenario is None:
             return ["no scenario: F2 new or F3 open"]
-        out = []
+        out = [problem] if (problem := self.scenario_file_problem()) else []  # changed on disk
         if self.scene is None:
             out.append("scene model not loaded")
         bad = [

@@ -97,6 +97,7 @@ class FileActions(Host):
         else:
             history.mark_saved(saved)
         self.scenario = saved
+        self.note_scenario_saved()  # what is on disk now is this app's
         remember_scenario(saved.path)
         self.scenario_changed()
         self.file_panel.show_recent(saved.path)

@@ -53,6 +53,7 @@ class AppHost(App[None]):
     changed_since_opened: list[str]  # names of those the app read before they changed on disk
     outputs_seen: tuple[int, int] | None  # the measures file's (mtime, size) when they were read
     cwd: Path
+    keymap: dict[str, str]  # the user's keys.toml remapping (actions.load_keymap)
     compile_in_child: bool
     # the jobs and the busy state
     busy: str | None
@@ -137,6 +138,12 @@ class AppHost(App[None]):
         raise NotImplementedError
 
     def note_outputs_seen(self) -> None:
+        raise NotImplementedError
+
+    def note_scenario_saved(self) -> None:
+        raise NotImplementedError
+
+    def scenario_file_problem(self) -> str:
         raise NotImplementedError
 
     def confirm_discard(self, doing: str, then: Callable[[], None], opens: Path | None = None) -> None:

@@ -29,7 +29,7 @@ from ladartui.run_record import (
 )
 from ladartui.scenario_file import record_owner
 from ladartui.textsafe import visible
-from ladartui.tui import bridge
+from ladartui.tui import actions, bridge
 from ladartui.tui.host import Host
 from ladartui.tui.view_area import prepare_views
 from ladartui.tui.work import start_job
@@ -76,6 +76,15 @@ class Earlier:
         return self.ran or self.scenario
 
 
+@dataclass(frozen=True)
+class FileSeen:
+    """A scenario file as opened or last saved: its (mtime, size) and its bytes (None:
+    no file), so that a touch is told apart from a change."""
+
+    stamp: tuple[int, int] | None
+    text: bytes | None
+
+
 @dataclass
 class Loaded:
     """What the load job hands the interface."""
@@ -83,6 +92,7 @@ class Loaded:
     scene: Scene
     prepared: dict[str, Any]
     earlier: Earlier
+    file_seen: FileSeen | None = None  # the scenario file, read before the scenario was
 
     @property
     def scenario(self) -> Scenario:
@@ -91,6 +101,9 @@ class Loaded:
 
 class SceneLoading(Host):
     """The app's load, probe and warm-up jobs (mixed into ``LadarApp``)."""
+
+    scenario_seen: FileSeen | None = None  # the scenario file as opened or last saved
+    scenario_on_disk: str | None = None  # "changed" or "gone" since then; None: as it was
 
     def load(self, path: Path | None, scenario: Scenario | None = None) -> None:
         """Load a scenario and its scene in a worker (the default scenario when no path)."""
@@ -107,6 +120,7 @@ class SceneLoading(Host):
         self.outputs_from = done.earlier.made_with  # before the status is drawn
         self.inputs_changed = done.earlier.inputs_changed
         self.changed_since_opened = done.earlier.changed_since_opened
+        self.scenario_seen, self.scenario_on_disk = done.file_seen, None
         self.set_scenario(done.scenario, modified=False)
         if done.scenario.path.is_file():
             remember_scenario(done.scenario.path)
@@ -152,7 +166,9 @@ class SceneLoading(Host):
 
     def check_outputs_on_disk(self) -> None:
         """Every few seconds: outputs another run of this file wrote (a second instance, the
-        CLI) are read and shown, said in a note; the ones shown are no longer on disk."""
+        CLI) are read and shown, said in a note; the ones shown are no longer on disk.
+        The scenario file itself is looked at first (``check_scenario_on_disk``)."""
+        self.check_scenario_on_disk()
         scenario = self.scenario
         if scenario is None or self.busy is not None or self.running:
             return
@@ -171,6 +187,44 @@ class SceneLoading(Host):
         # reads them, or names the files missing; the measures file as just found
         self.show_outputs_of(scenario, outputs_with(scenario, measures))
         self.scenario_changed()
+
+    def check_scenario_on_disk(self) -> None:
+        """The scenario file changed (or went) on disk since it was opened or saved: Run
+        would go with settings the file no longer holds, so it is off until a reopen or
+        a save (``scenario_file_problem``); said once, when found."""
+        scenario, seen = self.scenario, self.scenario_seen
+        if scenario is None or seen is None:
+            return
+        stamp = _stamp(_file_status(scenario.path))
+        if stamp == seen.stamp:
+            return
+        now = file_seen(scenario.path)
+        self.scenario_seen = FileSeen(now.stamp, seen.text)  # the bytes compared stay those opened
+        change = None if now.text == seen.text else "gone" if now.text is None else "changed"
+        if change == self.scenario_on_disk:
+            return
+        self.scenario_on_disk = change
+        if change is not None:
+            self.tell(f"{self.scenario_file_problem()}.", severity="warning", timeout=8)
+        self.scenario_changed()
+
+    def note_scenario_saved(self) -> None:
+        """The scenario file as just written by this app: the one compared from now on."""
+        self.scenario_seen = file_seen(self.scenario.path) if self.scenario is not None else None
+        self.scenario_on_disk = None
+
+    def scenario_file_problem(self) -> str:
+        """What stops a run while the scenario file differs from the one opened ("" if none)."""
+        if self.scenario is None or self.scenario_on_disk is None:
+            return ""
+        name = self.scenario.path.name
+        save, reopen = (actions.key_hint(command, self.keymap, short=True) for command in ("save", "open"))
+        if self.scenario_on_disk == "gone":
+            return f"{name} is gone from disk; save it" + (f" ({save})" if save else "")
+        ways = " or ".join(
+            f"{word} ({key})" if key else word for word, key in (("reopen", reopen), ("save", save))
+        )
+        return f"{name} changed on disk; {ways}"
 
     def note_outputs_seen(self) -> None:
         """The outputs on disk are the ones shown (read, or written by this app's run)."""
@@ -200,9 +254,23 @@ def _load(path: Path | None, scenario) -> Loaded:
             from ladartui.user_data import default_scenario_path
 
             path = default_scenario_path()
+        seen = file_seen(path)  # before it is read: a change after is found, not missed
         scenario = bridge.load_checked(path)
+    else:
+        seen = file_seen(scenario.path)
     scene = scenario.load_scene()
-    return Loaded(scene, prepare_views(scene), _earlier(scenario, scene=scene))
+    return Loaded(scene, prepare_views(scene), _earlier(scenario, scene=scene), seen)
+
+
+def file_seen(path: Path) -> FileSeen:
+    """The scenario file at ``path`` as it is now (no text when it is no readable file)."""
+    status = _file_status(path)
+    if status is None or not stat.S_ISREG(status.st_mode):
+        return FileSeen(None, None)
+    try:
+        return FileSeen(_stamp(status), path.read_bytes())
+    except OSError:
+        return FileSeen(_stamp(status), None)
 
 
 def _earlier(scenario, files: OutputFiles | None = None, scene: Scene | None = None) -> Earlier:

@@ -1,0 +1,102 @@
+"""The scenario file changed on disk while it is open: Run is refused until it is
+reopened or saved over, and the status bar says so; the same bytes written again
+(or only touched) change nothing."""
+
+from __future__ import annotations
+
+import os
+
+from ladartui.tui.status import NOT_READY, READY, StatusBar
+from test_tui_dialogs import opened
+from test_tui_edits import capture_runs
+from test_tui_flow import make_scenario, wait_until
+
+
+def bar(app) -> StatusBar:
+    return app.query_one(StatusBar)
+
+
+async def test_run_is_refused_while_the_scenario_file_changed_on_disk(tmp_path, scene_files):
+    """F5 ran the settings held in the app and recorded them as the file's run, while the
+    file on disk said otherwise: validate then called the fresh outputs out of date."""
+    scenario = make_scenario(tmp_path, scene_files)  # an 8 x 8 grid
+    async with opened(scenario, size=(80, 24)) as (app, pilot):
+        runs = capture_runs(app)
+        text = scenario.path.read_text(encoding="utf-8")
+        stamp = scenario.path.stat().st_mtime_ns
+        os.utime(scenario.path, ns=(stamp + 10**9, stamp + 10**9))  # touched: no change
+        app.check_outputs_on_disk()
+        await pilot.pause()
+        assert bar(app).state == READY
+        scenario.path.write_text(text.replace("grid = 8", "grid = 12"), encoding="utf-8")
+        app.check_outputs_on_disk()
+        await pilot.pause()
+        said = f"{scenario.path.name} changed on disk; reopen (F3) or save (^S)"
+        assert bar(app).state == NOT_READY
+        assert bar(app).message == said
+        assert any(said in m for m in app.messages)  # told once, as it is found
+        await pilot.press("f5")
+        await pilot.pause()
+        assert runs == []
+        assert app.messages[-1] == f"Run is off: {said}."
+        scenario.path.write_text(text, encoding="utf-8")  # put back as it was opened
+        app.check_outputs_on_disk()
+        await pilot.pause()
+        assert bar(app).state == READY
+        await pilot.press("f5")
+        await pilot.pause()
+        assert [run.sensor.grid for run in runs] == [8]
+
+
+async def test_saving_over_a_scenario_changed_on_disk_makes_it_runnable_again(tmp_path, scene_files):
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario, size=(80, 24)) as (app, pilot):
+        runs = capture_runs(app)
+        text = scenario.path.read_text(encoding="utf-8")
+        scenario.path.write_text(text.replace("grid = 8", "grid = 12"), encoding="utf-8")
+        app.check_outputs_on_disk()
+        await pilot.pause()
+        assert bar(app).state == NOT_READY
+        await pilot.press("ctrl+s")
+        await pilot.pause()
+        app.check_outputs_on_disk()
+        await pilot.pause()
+        assert bar(app).state == READY
+        assert "grid = 8" in scenario.path.read_text(encoding="utf-8")
+        await pilot.press("f5")
+        await pilot.pause()
+        assert [run.sensor.grid for run in runs] == [8]
+
+
+async def test_a_scenario_file_gone_from_disk_is_said_so_and_save_writes_it_again(tmp_path, scene_files):
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario, size=(80, 24)) as (app, pilot):
+        runs = capture_runs(app)
+        scenario.path.unlink()
+        app.check_outputs_on_disk()
+        await pilot.pause()
+        assert bar(app).state == NOT_READY
+        assert bar(app).message == f"{scenario.path.name} is gone from disk; save it (^S)"
+        await pilot.press("f5")
+        await pilot.pause()
+        assert runs == []
+        await pilot.press("ctrl+s")
+        await wait_until(pilot, lambda: scenario.path.is_file())
+        app.check_outputs_on_disk()
+        await pilot.pause()
+        assert bar(app).state == READY
+
+
+async def test_reopening_a_scenario_changed_on_disk_reads_it(tmp_path, scene_files):
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario, size=(80, 24)) as (app, pilot):
+        text = scenario.path.read_text(encoding="utf-8")
+        scenario.path.write_text(text.replace("grid = 8", "grid = 12"), encoding="utf-8")
+        app.check_outputs_on_disk()
+        await pilot.pause()
+        assert bar(app).state == NOT_READY
+        app.open_path(scenario.path)
+        await wait_until(pilot, lambda: app.busy is None and app.scenario.sensor.grid == 12)
+        app.check_outputs_on_disk()
+        await pilot.pause()
+        assert bar(app).state == READY
