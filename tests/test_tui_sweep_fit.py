@@ -144,3 +144,29 @@ async def test_rows_left_out_of_the_ranking_are_said_first_on_the_status_line(sw
         shown = screen.query_one("#sweep-status StatusText", StatusText).render().plain
         assert shown.startswith("1 row not ranked: other variants or an earlier base;"), shown
         assert "ranked by obscured-coverage: 1 variants, 1 ok" in screen.last_message
+
+
+async def test_a_failed_variants_whole_error_is_on_the_detail_line_at_80_columns(tmp_path):
+    """The detail line was one row: at 80 columns a failed variant's error read
+    'radius = -60.0: expected a number greater', the rest cut with no mark."""
+    from ladartui.sweep import run_sweep
+    from tiny_sweep import write_tiny_scenario
+
+    write_tiny_scenario(tmp_path)
+    spec = write_spec(tmp_path, "[grid]\nradius = [15.0, -60.0]\n")
+    run_sweep(spec, serial=True)
+    screen = SweepScreen(spec.with_name("spec-results"))
+    async with SweepHost(screen).run_test(size=SIZE) as pilot:
+        await opened(pilot)
+        table = screen.query_one("#sweep-table")
+        table.move_cursor(row=table.row_count - 1)
+        await pilot.pause()
+        detail = screen.query_one("#sweep-detail")
+        error = "radius = -60.0: expected a number greater than 0 and at most 1000000"
+        assert error in str(detail.render())
+        shown = " ".join(
+            "".join(segment.text for segment in strip).strip()
+            for strip in detail.render_lines(detail.region.reset_offset)
+        )
+        assert error in " ".join(shown.split()), shown
+        assert screen.query_one("#sweep-table").size.height >= 4  # the table keeps its rows

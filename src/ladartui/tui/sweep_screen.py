@@ -103,7 +103,8 @@ class SweepScreen(SweepOpening):
     SweepScreen #sweep-chart { width: 2fr; height: 1fr; margin-left: 2; }  /* apart from the table */
     SweepScreen #sweep-body.-table #sweep-chart { display: none; }
     SweepScreen #sweep-body.-chart #sweep-table { display: none; }
-    SweepScreen #sweep-detail { height: 1; padding: 0 1; background: $panel; }
+    /* a failed variant's error wraps rather than being cut at 80 columns */
+    SweepScreen #sweep-detail { height: auto; max-height: 3; padding: 0 1; background: $panel; }
     """
 
     def __init__(
