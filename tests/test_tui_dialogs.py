@@ -606,3 +606,37 @@ def test_the_png_and_compare_dialogs_name_what_is_wrong(tmp_path):
         str(caught.value)
         == f"{tmp_path / 'pipe.cmf'}: scene model file is not a regular file (a pipe or device)"
     )
+
+
+async def test_compare_reads_names_typed_in_the_folder_it_shows(tmp_path, scene_files, monkeypatch):
+    """The dialog shows 'Folder: <the scenario's>' and its .cmf files in the tree, but a
+    name typed there ('a.cmf b.cmf') was looked for in the working folder: 'a.cmf:
+    measures file not found'. Open and Save As read typed names in their folder."""
+    from ladartui.measures import Measures
+
+    here, elsewhere = tmp_path / "here", tmp_path / "elsewhere"
+    here.mkdir()
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    for name, coverage in (("a", 0.2), ("b", 0.3)):
+        Measures(target_voxels=100, obscured_coverage=coverage, scans=10).write_cmf(here / f"{name}.cmf")
+    scenario = make_scenario(here, scene_files)
+    async with opened(scenario) as (app, pilot):
+        app.action_compare()
+        await pilot.pause()
+        compare = app.screen
+        assert isinstance(compare, CompareScreen)
+        field = compare.query_one("#cmf-files")
+        field.value = "a.cmf b.cmf"
+        await pilot.press("enter")
+        await pilot.pause()
+        assert message(compare, "#compare-message") == ""
+        table = compare.query_one("#compare-table")
+        assert [str(c.label) for c in table.columns.values()] == ["Measure", "a", "b"]
+        field.value = "a.cmf 'b.cmf"
+        await pilot.press("enter")
+        await pilot.pause()
+        assert message(compare, "#compare-message") == (
+            ".cmf files: a quotation mark is not closed; expected paths separated by spaces, "
+            "one with spaces in quotes"
+        )

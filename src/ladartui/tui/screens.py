@@ -357,6 +357,7 @@ class CompareScreen(TreeDialog):
         super().__init__()
         self.paths = list(paths)
         self.folder = folder or (self.paths[0].parent if self.paths else Path.cwd())
+        self.base = self.folder  # typed names are read here, as Open and Save As read them
 
     DEFAULT_CSS = """
     CompareScreen > .dialog { width: 100%; height: 100%; max-height: 100%; }
@@ -409,8 +410,11 @@ class CompareScreen(TreeDialog):
         with the reason said, when a quote is not closed."""
         try:
             return shlex.split(self.query_one("#cmf-files", Input).value)
-        except ValueError as error:  # shlex's own words: "No closing quotation"
-            self.query_one("#compare-message", Static).update(escape(f".cmf files: {error}"))
+        except ValueError:  # shlex's only complaint: "No closing quotation"
+            self.query_one("#compare-message", Static).update(
+                ".cmf files: a quotation mark is not closed; expected paths separated by spaces, "
+                "one with spaces in quotes"
+            )
             return None
 
     @on(Input.Submitted, "#cmf-files")
@@ -426,7 +430,7 @@ class CompareScreen(TreeDialog):
             message.update("Give two or more .cmf files to compare.")
             return
         try:
-            loaded = bridge.read_measures_files([Path(t).expanduser() for t in text])
+            loaded = bridge.read_measures_files([self.base / Path(t).expanduser() for t in text])
         except LadarError as error:
             message.update(escape(str(error)))
             return
