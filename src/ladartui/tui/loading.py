@@ -259,7 +259,21 @@ def _load(path: Path | None, scenario) -> Loaded:
     else:
         seen = file_seen(scenario.path)
     scene = scenario.load_scene()
+    _check_memory(scenario, scene)
     return Loaded(scene, prepare_views(scene), _earlier(scenario, scene=scene), seen)
+
+
+def _check_memory(scenario, scene) -> None:
+    """Refuse, with its estimate, a scene whose tracing structures the memory cannot
+    hold, as validate and run do: the views' height map (its x-y extent, one cell a
+    column) is one of them, and was allocated whatever its size."""
+    from ladartui.resources import check_occupancy
+    from ladartui.scene.occupancy import column_bounds
+
+    for voxels, source in ((scene.voxels, scenario.scene_file), (scene.target, scenario.target_file)):
+        if len(voxels):
+            lo, last = column_bounds(voxels)  # int64: the far corner + 1 of 2**31 - 1 fits
+            check_occupancy(lo, last + 1, len(voxels), str(source))
 
 
 def file_seen(path: Path) -> FileSeen:

@@ -1,0 +1,30 @@
+"""Opening a scenario whose scene cannot be held: refused in one line, as validate and
+run refuse it, and the scenario open before stays."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ladartui.scene.voxels import save_voxels
+from test_tui_dialogs import opened
+from test_tui_flow import make_scenario, wait_until
+
+
+async def test_a_scene_too_large_for_memory_is_refused_with_its_estimate(tmp_path, scene_files, monkeypatch):
+    """Two voxels 20 million apart: the views' height map was allocated whatever its size,
+    and a wider scene ended in numpy's 'Unable to allocate 44.7 GiB for an array with
+    shape (2000000001, 6) and data type int32', naming no file."""
+    scenario = make_scenario(tmp_path, scene_files)
+    wide = tmp_path / "wide.txt"
+    save_voxels(wide, np.array([[1, 2, 3], [20_000_000, 5, 5]], np.int32))
+    save_voxels(tmp_path / "wide_Target.txt", np.array([[1, 2, 3]], np.int32))
+    far = scenario.with_changes(path=tmp_path / "far.toml", scene_file=wide).save()
+    async with opened(scenario, size=(80, 24)) as (app, pilot):
+        monkeypatch.setenv("LADARTUI_MAX_MEMORY", str(100 * 2**20))
+        app.open_path(far.path)
+        await wait_until(
+            pilot, lambda: app.busy is None and (app.messages or app.scenario.path == far.path), 60
+        )
+        said = [m for m in app.messages if "Could not load" in m][-1]
+        assert f"{wide}: 2 voxels spanning" in said and "crop the scene or use a coarser voxel size" in said
+        assert app.scenario.path == scenario.path  # the one open before stays
