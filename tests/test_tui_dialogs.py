@@ -640,3 +640,23 @@ async def test_compare_reads_names_typed_in_the_folder_it_shows(tmp_path, scene_
             ".cmf files: a quotation mark is not closed; expected paths separated by spaces, "
             "one with spaces in quotes"
         )
+
+
+async def test_a_scenario_file_given_as_the_new_scenarios_scene_model_is_named_so(tmp_path, scene_files):
+    """It said 'default_Target.toml: target model file not found', of a file no one named."""
+    from ladartui.tui.file_dialogs import SetupScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario) as (app, pilot):
+        await pilot.press("f2")
+        await pilot.pause()
+        dialog = app.screen
+        assert isinstance(dialog, SetupScreen) and dialog.mode == "new"
+        dialog.query_one("#scenario-file").value = "fresh.toml"
+        dialog.query_one("#scene-file").value = scenario.path.name
+        dialog.query_one("#setup-ok").press()
+        await pilot.pause()
+        assert message(dialog, "#setup-message") == (
+            f"{scenario.path}: scene model file is a scenario file (.toml); expected a scene model (.txt)"
+        )
+        assert not (tmp_path / "fresh.toml").exists()

@@ -336,6 +336,8 @@ def new_scenario(scenario_path: Path, scene_path: Path, voxel_size: float = 1.0)
     for path, what in ((scene_path, "scene model"), (target_file_for(scene_path), "target model")):
         if problem := file_problem(Path(path)):  # (a pipe exists: it is not 'not found')
             raise InputFileError(path, f"{what} file {problem}")
+        if Path(path).suffix.lower() == ".toml":  # else: 'S_Target.toml: ... not found'
+            raise InputFileError(path, f"{what} file is a scenario file (.toml); expected a {what} (.txt)")
     scenario = Scenario.new(scenario_path, scene_path, voxel_size)
     return scenario.save()
 
