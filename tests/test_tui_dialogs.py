@@ -660,3 +660,27 @@ async def test_a_scenario_file_given_as_the_new_scenarios_scene_model_is_named_s
             f"{scenario.path}: scene model file is a scenario file (.toml); expected a scene model (.txt)"
         )
         assert not (tmp_path / "fresh.toml").exists()
+
+
+async def test_a_segment_the_whole_path_refuses_keeps_its_form_open(tmp_path, scene_files):
+    """A straight of 9999 scans after a 6-scan orbit: each field was allowed, the form
+    closed, and the path's own limit was said after it ('Flight path not changed'),
+    with what had been typed gone."""
+    scenario = make_scenario(tmp_path, scene_files)  # 6 scans
+    async with opened(scenario) as (app, pilot):
+        app.action_show_tab("flight")
+        app.action_add_segment("straight")
+        await pilot.pause()
+        form = app.screen
+        assert isinstance(form, FormScreen)
+        await type_into(pilot, form.query_one("#f-scans"), "9999", commit="tab")
+        form.query_one("#form-ok").press()
+        await pilot.pause()
+        assert app.screen is form
+        assert message(form) == "flight.segments = '10005 scans': expected at most 10000 scans"
+        assert form.query_one("#f-scans").value == "9999"
+        assert len(app.scenario.flight.segments) == 1
+        await type_into(pilot, form.query_one("#f-scans"), "9994", commit="tab")
+        form.query_one("#form-ok").press()
+        await pilot.pause()
+        assert app.screen is not form and len(app.scenario.poses()) == 10000

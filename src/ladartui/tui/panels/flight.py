@@ -128,6 +128,16 @@ class FlightPanel(ParamPanel):
         spec = bridge.segment_spec(segment, defaults)
         label = bridge.SEGMENT_LABELS[segment.kind]
         title = label + (" (new)" if index is None else "")
+        build = bridge.segment_builder(segment.kind)
+
+        def build_in_path(values):
+            """The segment, refused while the form is open (what was typed kept) when the
+            path it makes is not allowed (more scans in all than the limit)."""
+            built = build(values)
+            scenario = self.host.scenario
+            if scenario is not None:
+                bridge.with_segments(scenario, _placed(scenario.flight.segments, index, built))
+            return built
 
         def done(result):
             if result is not None:
@@ -138,7 +148,7 @@ class FlightPanel(ParamPanel):
             FormScreen(
                 title,
                 spec,
-                bridge.segment_builder(segment.kind),
+                build_in_path,
                 note="Empty optional fields keep the current pointing.",
             ),
             done,
@@ -149,12 +159,7 @@ class FlightPanel(ParamPanel):
         scenario = self.host.scenario
         if scenario is None:
             return False
-        segments = list(scenario.flight.segments)
-        if index is None:
-            segments.append(segment)
-        else:
-            segments[index] = segment
-        return self._apply_segments(segments, what)
+        return self._apply_segments(_placed(scenario.flight.segments, index, segment), what)
 
     def _apply_segments(self, segments, what: str) -> bool:
         scenario = self.host.scenario
@@ -273,3 +278,13 @@ class FlightPanel(ParamPanel):
             return
         self.host.edit(scenario, "Aim every scan at the target")
         self.host.tell("Every scan now aims at the target centre.")
+
+
+def _placed(segments, index: int | None, segment) -> list:
+    """``segments`` with ``segment`` in place of segment ``index``, or after them (None)."""
+    out = list(segments)
+    if index is None:
+        out.append(segment)
+    else:
+        out[index] = segment
+    return out
