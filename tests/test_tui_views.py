@@ -277,3 +277,33 @@ async def test_a_message_leaves_the_status_bar_in_sight(scenario_path):
         toasts = list(app.screen.query(Toast))
         assert toasts
         assert all(toast.region.bottom <= bar.region.y for toast in toasts)
+
+
+async def test_the_top_views_width_reads_whole_at_80_columns_at_any_zoom(scenario_path):
+    """Zoomed out, the title read 'Top view 3.07e+0…' at 80 columns: a number cut inside
+    its exponent (3070 m read as 3.07), and '3.07e+03 m across' where it had room."""
+    from ladartui.tui.canvas import top_view_width
+
+    assert [top_view_width(w) for w in (5.784, 61.44, 999.4, 999.6, 3072.0, 2.5e6)] == [
+        "5.78 m",
+        "61.4 m",
+        "999 m",
+        "1 km",
+        "3.07 km",
+        "2,500 km",
+    ]
+    app = LadarApp(scenario_path, compile_in_child=False)
+    async with app.run_test(size=(80, 24)) as pilot:
+        start = time.monotonic()
+        while app.scene is None or app.busy is not None:
+            assert time.monotonic() - start < 120, "the app did not load the scene"
+            await pilot.pause(0.05)
+        top = app.query_one(TopViewWidget)
+        top.focus()
+        for _ in range(40):
+            await pilot.press("minus")
+        await pilot.pause()
+        width = (top.frame[2] - top.frame[0]) * top.top.voxel_size
+        title = str(top.border_title)
+        assert title.endswith(top_view_width(width)) and "e+" not in title, title
+        assert len(title) <= top.size.width - 4, title  # drawn whole, not cut at the border

@@ -257,6 +257,14 @@ class PictureWidget(Widget, can_focus=True):
         return Strip.blank(width)
 
 
+def top_view_width(metres: float) -> str:
+    """A width as the top view's title gives it: three figures in m or km, no exponent."""
+    if metres < 999.5:
+        return f"{metres:.3g} m"
+    km = metres / 1000
+    return f"{km:.3g} km" if km < 999.5 else f"{km:,.0f} km"
+
+
 class TopViewWidget(PictureWidget):
     """The scene from above, with the flight path, scans and footprints over it.
 
@@ -317,11 +325,19 @@ class TopViewWidget(PictureWidget):
         self._update_title()
         self.invalidate()
 
+    def on_resize(self, event: events.Resize) -> None:
+        super().on_resize(event)
+        self._update_title()
+
     def _update_title(self) -> None:
+        """ "Top view", and once zoomed or fitted how wide it is, put shorter where the
+        border is narrow (at 80 columns "Top view 3.07e+0…" was cut inside the number)."""
         title = "Top view"
         if self.top is not None and self.frame is not None and self.framing != "path":
-            width = self.frame[2] - self.frame[0]
-            title += f" {width * self.top.voxel_size:.3g} m across"
+            width = top_view_width((self.frame[2] - self.frame[0]) * self.top.voxel_size)
+            titles = (f"{title} {width} across", f"{title} {width}", f"Top {width}")
+            room = self.size.width - 4  # the border's corners and a space each side
+            title = next((t for t in titles if len(t) <= room), titles[0] if room <= 0 else titles[-1])
         self.border_title = title
 
     def action_zoom(self, factor: float, about=None) -> None:
