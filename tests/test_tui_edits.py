@@ -221,6 +221,36 @@ async def test_quit_without_edits_does_not_ask(tmp_path, scene_files):
         assert not app.is_running
 
 
+async def test_quit_while_a_run_goes_on_asks_first(tmp_path, scene_files):
+    """Ctrl+Q in the middle of a run quit at once, with no edits to ask about: a run of
+    many minutes was gone on one key."""
+    from ladartui.tui.unsaved import QuitRunScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        capture_runs(app)  # the run never reports back: it goes on
+        await pilot.press("f5")
+        await pilot.pause()
+        assert app.run_in_progress()
+        await pilot.press("ctrl+q")
+        await pilot.pause()
+        assert isinstance(app.screen, QuitRunScreen)
+        said = str(app.screen.query_one("#quit-run-question").render())
+        assert said == (
+            "A run of demo.toml is going on (0%). Quit and cancel it? The outputs on disk stay as they were."
+        )
+        await pilot.press("escape")  # keeps it running
+        await pilot.pause()
+        assert app.is_running and app.run_in_progress() and not isinstance(app.screen, QuitRunScreen)
+        await pilot.press("ctrl+q")
+        await pilot.pause()
+        await pilot.click("#quit-run-quit")
+        await pilot.pause()
+        assert not app.is_running
+
+
 def test_a_value_typed_in_other_units_is_saved_as_typed():
     """A pitch of 50 um typed in the form was saved as 49.99999999999999: 50 * 1e-6 is
     not the double nearest 50 um, so the file could not write it back as 50."""

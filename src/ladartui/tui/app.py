@@ -315,7 +315,7 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         self.action_cancel_run()
 
     async def action_quit(self) -> None:
-        self.confirm_discard("quit", self.exit)
+        self.confirm_quit()  # asks first about a run going on, then about unsaved edits
 
     # -- results and views -----------------------------------------------------------
 

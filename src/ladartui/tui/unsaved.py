@@ -1,5 +1,6 @@
 """Unsaved edits: fields typed but not committed, and the save / discard / cancel
-question asked before they would be lost."""
+question asked before they would be lost; and the question before quitting cancels
+a run."""
 
 from __future__ import annotations
 
@@ -62,6 +63,43 @@ class UnsavedScreen(ModalScreen[str | None]):
         self.dismiss(None)
 
 
+class QuitRunScreen(ModalScreen[bool]):
+    """Dismissed with True to quit (cancelling the run), False to keep it running (Esc)."""
+
+    BINDINGS = [Binding("escape", "keep", "Keep running")]
+    DEFAULT_CSS = """
+    QuitRunScreen { align: center middle; }
+    QuitRunScreen > Vertical { width: 60; height: auto; border: thick $warning;
+                               background: $surface; padding: 1 2; }
+    QuitRunScreen Horizontal { height: auto; margin-top: 1; }
+    QuitRunScreen Button { margin-right: 2; }
+    """
+
+    def __init__(self, name: str, progress: float | None):
+        super().__init__()
+        self.scenario_name, self.progress = name, progress
+
+    def compose(self) -> ComposeResult:
+        done = f" ({100 * self.progress:.0f}%)" if self.progress is not None else ""
+        with Vertical():
+            yield Static(
+                f"A run of {self.scenario_name} is going on{done}. Quit and cancel it? "
+                "The outputs on disk stay as they were.",
+                id="quit-run-question",
+                markup=False,
+            )
+            with Horizontal():
+                yield Button("Keep running", id="quit-run-keep", variant="primary", compact=True)
+                yield Button("Quit", id="quit-run-quit", variant="error", compact=True)
+
+    @on(Button.Pressed)
+    def _chosen(self, event: Button.Pressed) -> None:
+        self.dismiss(event.button.id == "quit-run-quit")
+
+    def action_keep(self) -> None:
+        self.dismiss(False)
+
+
 class EditGuard(Host):
     """The app's guard over pending and unsaved edits (mixed into ``LadarApp``, which
     provides ``scenario``, ``modified``, ``commit_field``, ``tell`` and ``action_save``)."""
@@ -98,6 +136,20 @@ class EditGuard(Host):
         return self.scenario is not None and (
             self.modified or any(f.value != f.committed for f in self.query(".param").results(ParamField))
         )
+
+    def confirm_quit(self) -> None:
+        """Quit: a run going on is cancelled only when the analyst says so, then unsaved
+        edits are asked about as ever."""
+        scenario = self.scenario
+        if not self.run_in_progress() or scenario is None:
+            self.confirm_discard("quit", self.exit)
+            return
+
+        def chosen(quit_anyway: bool | None) -> None:
+            if quit_anyway:
+                self.confirm_discard("quit", self.exit)
+
+        self.push_screen(QuitRunScreen(scenario.path.name, self.progress), chosen)
 
     def confirm_discard(self, doing: str, then: Callable[[], None], opens: Path | None = None) -> None:
         """Call ``then`` once unsaved edits are saved or the analyst chose to discard them;
