@@ -240,7 +240,7 @@ def help_rows(
     keys = keys_in_force(keymap)
     rows = [("Anywhere", key_name(keys[c.id]), c.title) for c in COMMANDS if keys.get(c.id)]
     rows.append(("Anywhere", "Ctrl+P", "Command palette: every action by name"))
-    rows.append(("Anywhere", "Ctrl+Q", "Quit (asks first when there are unsaved edits)"))
+    rows.append(("Anywhere", "Ctrl+Q", "Quit (asks first while a run goes on or edits are unsaved)"))
     rows.append(("Anywhere", "Tab / Shift+Tab", "Move between controls"))
     for binding in view_bindings:
         rows.append(("3D view", key_name(binding.key), binding.description))
