@@ -170,3 +170,20 @@ async def test_a_failed_variants_whole_error_is_on_the_detail_line_at_80_columns
         )
         assert error in " ".join(shown.split()), shown
         assert screen.query_one("#sweep-table").size.height >= 4  # the table keeps its rows
+
+
+async def test_a_results_table_with_no_rows_is_not_ready(tmp_path, monkeypatch):
+    """A table of a header and a torn line opened green: 'READY ranked by
+    obscured-coverage: 0 variants, 0 ok, 0 failed', with nothing ranked or to open."""
+    from ladartui.tui.status import NOT_READY, StatusBar
+
+    monkeypatch.chdir(tmp_path)  # the table is named relative to the working folder
+    folder = tmp_path / "torn-results"
+    folder.mkdir()
+    (folder / "results.csv").write_text('variant,status,radius\n"abc,ok\n', encoding="utf-8")
+    screen = SweepScreen(folder)
+    async with SweepHost(screen).run_test(size=SIZE) as pilot:
+        await opened(pilot)
+        bar = screen.query_one("#sweep-status", StatusBar)
+        assert bar.state == NOT_READY
+        assert screen.last_message == "no variant rows to rank in torn-results/results.csv"

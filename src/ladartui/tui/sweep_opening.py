@@ -103,8 +103,9 @@ class SweepOpening(RankingView):
         # (unless the analyst has moved the focus since: Enter, F3 or Browse left it put)
         if self._focus_table and self.focused in (None, self._focused_at_open):
             self.query_one("#sweep-table", DataTable).focus()
-        self._status(
-            READY,
-            f"{left_out}ranked by {self.objective}: {self._summary()}; {short_path(result.results_path)}",
-        )
+        table = short_path(result.results_path)
+        if not self.rows:  # a header alone, or lines torn or edited by hand (left out)
+            self._status(NOT_READY, f"{left_out}no variant rows to rank in {table}")
+        else:
+            self._status(READY, f"{left_out}ranked by {self.objective}: {self._summary()}; {table}")
         remember_path("sweeps", path)  # the screen reopens it next time
