@@ -684,3 +684,21 @@ async def test_a_segment_the_whole_path_refuses_keeps_its_form_open(tmp_path, sc
         form.query_one("#form-ok").press()
         await pilot.pause()
         assert app.screen is not form and len(app.scenario.poses()) == 10000
+
+
+async def test_the_threshold_form_says_why_an_infinite_height_is_refused(tmp_path, scene_files):
+    """'Max height (m): 1e400 is not allowed; expected a number >= 0': 1e400 is >= 0;
+    what it is not is finite. Its limit is in metres, as the other forms give theirs."""
+    from ladartui.tui.screens import ThresholdScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario) as (app, pilot):
+        await pilot.press("f8")
+        await pilot.pause()
+        form = app.screen
+        assert isinstance(form, ThresholdScreen)
+        threshold = form.query_one("#f-threshold")
+        await type_into(pilot, threshold, "1e400", commit="enter")
+        assert message(form) == "Max height m: 1e400 is not allowed; expected a finite number >= 0 m"
+        await type_into(pilot, threshold, "-5", commit="enter")
+        assert message(form) == "Max height m: -5 is not allowed; expected a number >= 0 m"

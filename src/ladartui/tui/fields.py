@@ -108,7 +108,11 @@ class NumberField(Input):
             self.check(math.nan)
         except FieldError as core:
             if core.limits is not None:
-                return FieldError(error.field, error.value, core.expected, limits=core.limits)
+                expected = core.expected
+                if error.expected == "a finite number" and core.limits[1] is None:
+                    # "1e400": "a number >= 0" would not say what is wrong with it
+                    expected = "a finite " + expected.removeprefix("a ")
+                return FieldError(error.field, error.value, expected, limits=core.limits)
         except LadarError:
             pass
         return error

@@ -480,7 +480,7 @@ class ThresholdScreen(FormScreen):
     """Height threshold for the output view (report section 3.5.2)."""
 
     def __init__(self, threshold: float | None):
-        spec = [("threshold", "Max height (m)", "optional", threshold, None)]
+        spec = [("threshold", "Max height m", "optional", threshold, None)]
         super().__init__(
             "Output height threshold",
             spec,
