@@ -339,6 +339,17 @@ def test_a_point_or_list_with_an_empty_part_is_refused_not_shortened():
     assert _parse_points("standoffs", "50, 100", "points") == (50.0, 100.0)
 
 
+def test_a_short_name_is_not_cut_for_a_line_whose_end_is_cut_anyway():
+    """At 80 columns the status line read 'def…lt.toml (modified): 24 scans x 1,048,576
+    rays. F5 ru…': the name cut for one cell while the end was cut all the same."""
+    from ladartui.tui.status import fitted
+
+    said = "default.toml (modified): 24 scans x 1,048,576 rays. F5 runs."
+    assert fitted(said, 57, "default.toml") == said[:56] + "\u2026"
+    said = "default.toml (modified): 24 scans x 16,384 rays. F5 runs."  # 57: the name gives way
+    assert fitted(said, 56, "default.toml") == "def\u2026lt.toml (modified): 24 scans x 16,384 rays. F5 runs."
+
+
 def test_fitted_shortens_the_name_given_then_cuts_the_end_in_cells():
     """The longest word was cut, which need not be the name ('(mo…ified):'), and wide
     characters were counted as one cell each, so the line still overflowed."""

@@ -99,6 +99,7 @@ class StatusBar(Horizontal):
 
 
 MIN_NAME = 10  # cells a shortened name keeps
+LONG_NAME = 2 * MIN_NAME  # longer: cut in its middle even when the line's end is cut too
 ELLIPSIS = "\u2026"
 
 
@@ -106,7 +107,8 @@ def fitted(message: str, room: int, name: str | None = None) -> str:
     """``message`` in ``room`` cells: ``name`` (where it occurs; by default the longest
     path in it) cut in its middle (``nigh…final.toml``, keeping at least ``MIN_NAME``
     cells), then the end cut if that is not enough, unless that cut would fall in the
-    name: then only the end is cut (a name cut twice, ``sw/…resu…``, reads as neither)."""
+    name (a name cut twice, ``sw/…resu…``, reads as neither) or the name is no longer
+    than ``LONG_NAME``: then only the end is cut."""
     over = cell_len(message) - room
     if over <= 0:
         return message
@@ -119,7 +121,10 @@ def fitted(message: str, room: int, name: str | None = None) -> str:
         short = _first_cells(name, head) + ELLIPSIS + _last_cells(name, keep - head)
         shortened = message.replace(name, short, 1)
         through_name = cell_len(shortened[: shortened.index(short) + len(short)])
-        if cell_len(shortened) <= room or through_name < room:  # the end cut, if any, after it
+        fits = cell_len(shortened) <= room
+        # the end cut, if any, after it; a short name ("default.toml") is kept whole then:
+        # cut for a cell or two, it read "def…lt.toml" while the end was cut all the same
+        if fits or (through_name < room and cell_len(name) > LONG_NAME):
             message = shortened
     if cell_len(message) > room:
         cut = Text(message)
