@@ -263,6 +263,27 @@ def test_a_value_typed_in_other_units_is_saved_as_typed():
         assert format_number(metres, scale=1e-6) == f"{float(typed):g}"
 
 
+async def test_a_reason_the_status_line_cuts_is_told_whole_once(tmp_path, scene_files):
+    """At 80 columns the bar read 'NOT READY  /tmp/…/forest.toml:5: files.scene =
+    'forest.t…': why Run was off was cut away, and said nowhere until F5 was pressed."""
+    from ladartui.tui.status import NOT_READY
+    from test_tui_dialogs import opened
+
+    scene = tmp_path / "forest.txt"
+    copy_scene(scene_files[0], scene)
+    scenario = make_scenario(tmp_path, (scene, scene_files[1], scene_files[2]), name="forest")
+    async with opened(scenario, size=(80, 24)) as (app, pilot):
+        await pilot.pause()
+        message = app.query_one(StatusBar).message
+        assert app.query_one(StatusBar).state == NOT_READY and "would overwrite a model file" in message
+        assert message.endswith("would overwrite a model file")
+        told = [m for m in app.messages if message in m]
+        assert len(told) == 1
+        app.refresh_status()
+        await pilot.pause()
+        assert len([m for m in app.messages if message in m]) == 1  # once, not at each refresh
+
+
 async def test_a_long_scenario_name_is_shortened_in_the_status_line_not_what_follows(tmp_path, scene_files):
     """At 80 columns a long name pushed '(modified)' and the scan count off the bar."""
     from rich.cells import cell_len

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any
 
 from rich.cells import cell_len
@@ -63,11 +64,15 @@ class StatusBar(Horizontal):
     StatusBar #cancel { min-width: 10; }
     """
 
-    def __init__(self, **kwargs: Any) -> None:
+    def __init__(self, tell: Callable[[str], None] | None = None, **kwargs: Any) -> None:
+        """``tell``: says a not-ready message whole, once, when the line has to cut it
+        (why Run is off must not be cut away)."""
         super().__init__(**kwargs)
         self.state = NOT_READY
         self.message = ""
         self.progress: float | None = None
+        self.tell = tell
+        self.told = ""  # the cut message last said whole
 
     def compose(self) -> ComposeResult:
         yield Static(LABELS[NOT_READY], id="status-word")
@@ -96,6 +101,18 @@ class StatusBar(Horizontal):
         self.query_one("#status-word", Static).update(word)
         self.query_one("#cancel", Button).disabled = not cancellable
         self.query_one(StatusText).show(message, name)
+        if state != NOT_READY:
+            self.told = ""
+        elif self.tell is not None and message != self.told:
+            self.call_after_refresh(self._tell_if_cut, message)
+
+    def _tell_if_cut(self, message: str) -> None:
+        room = self.query_one(StatusText).content_size.width
+        if self.tell is None or message != self.message or message == self.told or room <= 0:
+            return
+        if cell_len(message) > room:
+            self.told = message
+            self.tell(message)
 
 
 MIN_NAME = 10  # cells a shortened name keeps
