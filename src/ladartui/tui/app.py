@@ -144,7 +144,7 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
                     with TabPane("Results", id="tab-results"):
                         yield ResultsPanel(id="results-panel")
             yield ViewArea(id="views")
-        yield StatusBar(id="status", tell=lambda said: self.tell(said, title="Not ready", severity="warning"))
+        yield StatusBar(id="status", tell=lambda said: self.tell(said, severity="warning", timeout=10))
         yield Footer(compact=True)
 
     def on_mount(self) -> None:
