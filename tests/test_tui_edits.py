@@ -671,3 +671,30 @@ async def test_earlier_outputs_are_shown_from_one_stat_of_each_file(tmp_path, sc
         assert list(stats.values()) == [2, 2, 2]
         status = scenario.measures_file.stat()
         assert app.outputs_seen == (status.st_mtime_ns, status.st_size)  # those shown, as on disk
+
+
+async def test_the_file_tab_says_which_key_writes_missing_outputs_only_when_it_would(
+    tmp_path, scene_files, monkeypatch
+):
+    """'Not on disk yet: ... (F5 writes them)': F5 even where keys.toml had moved the run
+    to Ctrl+R, and where the run was off (its outputs would overwrite a model file)."""
+    home = tmp_path / "home"
+    (home / "config").mkdir(parents=True)
+    (home / "config" / "keys.toml").write_text('[keys]\nrun = "ctrl+r"\n')
+    monkeypatch.setenv("LADARTUI_HOME", str(home))
+    scenario = make_scenario(tmp_path, scene_files)
+    scenario.scene_output.write_text("1,2,3\n")  # a partial set: the rest is missing
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        info = str(app.query_one("#file-info").render())
+        assert "(Ctrl+R writes them)" in info and "F5" not in info
+    scene = tmp_path / "forest.txt"
+    copy_scene(scene_files[0], scene)
+    refused = make_scenario(tmp_path, (scene, scene_files[1], scene_files[2]), name="forest")
+    refused.measures_file.write_text("")
+    app = LadarApp(refused.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        info = str(app.query_one("#file-info").render())
+        assert "Not on disk yet: forest_Scene.txt" in info and "writes them" not in info, info

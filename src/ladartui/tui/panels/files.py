@@ -64,10 +64,10 @@ class FilePanel(VerticalScroll):
             text.append(f"{key:<14}", style="bold")
             text.append(value)  # names from files and fields: plain text, never markup
         if missing:
-            text.append(
-                "\nNot on disk yet: " + ", ".join(p.name for p in missing) + " (F5 writes them)",
-                style="yellow",
-            )
+            host = host_of(self)  # the key in force, and only while a run would write them
+            writes = "" if host.problems(fields=False) else host.key_says("run", "writes them")
+            names = ", ".join(p.name for p in missing)
+            text.append(f"\nNot on disk yet: {names}" + (f" ({writes})" if writes else ""), style="yellow")
         self.query_one("#file-info", Static).update(text)
 
     def show_recent(self, current: Path | None = None) -> None:
