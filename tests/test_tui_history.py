@@ -524,3 +524,25 @@ async def test_the_flight_tables_are_drawn_to_their_new_cells_at_once(tmp_path, 
             for index, column in enumerate(columns[: len(columns) if table.id == "scans" else 3]):
                 widest = max(cell_len(str(column.label)), *(cell_len(row[index]) for row in rows))
                 assert column.get_render_width(table) == widest + 2 * table.cell_padding, (table.id, index)
+
+
+async def test_messages_that_name_a_key_name_the_one_in_force(tmp_path, scene_files, monkeypatch):
+    """With the run on Ctrl+R, F9 before a run said 'run the scenario first (F5)', and the
+    Open dialog 'missing outputs are listed, and F5 writes them'."""
+    from ladartui.tui.file_dialogs import SetupScreen
+
+    home = tmp_path / "home"
+    (home / "config").mkdir(parents=True)
+    (home / "config" / "keys.toml").write_text('[keys]\nrun = "ctrl+r"\nsave = "ctrl+w"\n')
+    monkeypatch.setenv("LADARTUI_HOME", str(home))
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=(120, 40)) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        app.action_measures()
+        assert app.messages[-1] == "No measures yet: run the scenario first (Ctrl+R)."
+        await pilot.press("f3")
+        await pilot.pause()
+        assert isinstance(app.screen, SetupScreen)
+        said = str(app.screen.query_one("#derived").render())
+        assert "a run (Ctrl+R) writes them" in said and "F5" not in said

@@ -318,6 +318,13 @@ def key_hint(command_id: str, keymap: dict[str, str] | None = None, short: bool 
     return key_name(key) if key else ""
 
 
+def key_note(command_id: str, keymap: dict[str, str] | None = None) -> str:
+    """ " (F5)": the first key in force for a command, to follow the advice that names
+    it ("run the scenario first (F5)"); empty when no key runs it."""
+    key = key_hint(command_id, keymap)
+    return f" ({key})" if key else ""
+
+
 def key_name(key: str) -> str:
     """How a key is written for people: F5, Ctrl+S, ?, +."""
     names = {

@@ -31,6 +31,7 @@ from ladartui.tui.editing import ScenarioEditing
 from ladartui.tui.file_actions import FileActions
 from ladartui.tui.graphics import Graphics, has_truecolor
 from ladartui.tui.help_rows import help_rows, palette_entries
+from ladartui.tui.key_words import KeyWords
 from ladartui.tui.loading import SceneLoading
 from ladartui.tui.panels import FilePanel, FlightPanel, ResultsPanel, RunPanel, SensorPanel
 from ladartui.tui.params import ParamField
@@ -60,7 +61,7 @@ own_actions = actions.own_actions
 OUTPUTS_CHECK_SECONDS = 2.0  # how often the outputs on disk are compared with those shown
 
 
-class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl, App):
+class LadarApp(KeyWords, ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl, App):
     """Plan a foliage-penetrating LADAR collection: set up, fly, run, compare."""
 
     TITLE = "ladartui"
@@ -111,16 +112,6 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         self.set_keymap(self.keymap)
         for key, action, title in actions.keymap_only_bindings(self.keymap):
             self.bind(key, action, description=title, show=False)
-
-    def key_says(self, command_id: str, words: str) -> str:
-        """The key in force and ``words``: ("run", "runs") gives F5 runs; empty when no key runs it."""
-        key = actions.key_hint(command_id, self.keymap)
-        return f"{key} {words}" if key else ""
-
-    def button_text(self, label: str, command_id: str) -> str:
-        """A button's label with the key in force: ("Save", "save") gives Save ^S."""
-        key = actions.key_hint(command_id, self.keymap, short=True)
-        return f"{label} {key}" if key else label
 
     def target_m(self) -> tuple[float, ...]:
         if self.prepared is not None:
@@ -207,7 +198,7 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
         """What is missing before a run (empty: ready); ``fields=False`` leaves out
         typed values, which Run commits (or refuses, focusing the field) itself."""
         if self.scenario is None:
-            return ["no scenario: F2 new or F3 open"]
+            return [f"no scenario: new{self.key_note('new')} or open{self.key_note('open')}"]
         out = [problem] if (problem := self.scenario_file_problem()) else []  # changed on disk
         if self.scene is None:
             out.append("scene model not loaded")
@@ -391,7 +382,7 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
 
     def action_measures(self) -> None:
         if self.measures is None:
-            self.tell("No measures yet: run the scenario first (F5).", severity="warning")
+            self.tell(f"No measures yet: run the scenario first{self.key_note('run')}.", severity="warning")
             return
         made_with = self.outputs_made_with()
         stale = ""
@@ -454,7 +445,8 @@ class LadarApp(ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl
             path = self.scenario.path
             if self.modified:
                 self.tell(
-                    "The study reads the saved scenario file; save (Ctrl+S) to include your changes.",
+                    f"The study reads the saved scenario file; save{self.key_note('save')} to include "
+                    "your changes.",
                     severity="warning",
                     timeout=8,
                 )

@@ -428,7 +428,7 @@ def export_outputs_las(scenario: Scenario, suffix: str = ".las", scene=None) -> 
     outputs = [scenario.scene_output, scenario.target_output]
     for path in outputs:
         if (problem := file_problem(path)) == "not found":
-            raise InputFileError(path, "output not found: run the scenario first (F5)")
+            raise InputFileError(path, "output not found: run the scenario first")
         if problem:
             raise InputFileError(path, f"output {problem}")
     clouds = [(path.with_suffix(suffix), load_voxels(path)) for path in outputs]

@@ -21,6 +21,7 @@ from ladartui.textsafe import visible
 from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField, in_label_unit, refusal
 from ladartui.tui.file_tree import SCENARIO_TABLE
+from ladartui.tui.host import host_of
 from ladartui.tui.screens import PathSuggester, TreeDialog, _row
 
 SCENARIO_SUFFIXES = (".toml",)
@@ -128,7 +129,7 @@ class SetupScreen(TreeDialog):
         else:
             text = (
                 "Every model file of the scenario is checked before anything is loaded; "
-                "missing outputs are listed, and F5 writes them."
+                f"missing outputs are listed, and a run{host_of(self).key_note('run')} writes them."
             )
         self.query_one("#derived", Static).update(text)
 

@@ -1,6 +1,6 @@
 """The app as its parts see it: the state and services ``LadarApp`` gives its
-mixins (``EditGuard``, ``FileActions``, ``SceneLoading``, ``RunControl``) and
-its sidebar panels.
+mixins (``KeyWords``, ``EditGuard``, ``FileActions``, ``SceneLoading``, ``RunControl``)
+and its sidebar panels.
 
 ``AppHost`` declares them with their types so each part is checked against
 what the app really provides: a mixin derives from it for the type checker
@@ -95,6 +95,9 @@ class AppHost(App[None]):
         raise NotImplementedError
 
     def key_says(self, command_id: str, words: str) -> str:
+        raise NotImplementedError
+
+    def key_note(self, command_id: str) -> str:
         raise NotImplementedError
 
     def refresh_status(self) -> None:
