@@ -100,3 +100,22 @@ async def test_reopening_a_scenario_changed_on_disk_reads_it(tmp_path, scene_fil
         app.check_outputs_on_disk()
         await pilot.pause()
         assert bar(app).state == READY
+
+
+async def test_a_study_of_a_scenario_changed_on_disk_says_what_it_reads(tmp_path, scene_files):
+    """F11 studies the file on disk: changed there since it was opened, it studied other
+    settings than those shown with no word of it (edits made here were said)."""
+    from ladartui.tui.study_screen import StudyScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario, size=(80, 24)) as (app, pilot):
+        text = scenario.path.read_text(encoding="utf-8")
+        scenario.path.write_text(text.replace("grid = 8", "grid = 12"), encoding="utf-8")
+        app.check_outputs_on_disk()
+        await pilot.pause()
+        await pilot.press("f11")
+        await wait_until(pilot, lambda: isinstance(app.screen, StudyScreen))
+        assert app.messages[-1] == (
+            "The study reads demo.toml as it is on disk, not as shown here; save (Ctrl+S) first "
+            "to study what is shown."
+        )

@@ -443,10 +443,10 @@ class LadarApp(KeyWords, ScenarioEditing, EditGuard, FileActions, SceneLoading, 
         path = None
         if self.scenario is not None and self.scenario.path.is_file():
             path = self.scenario.path
-            if self.modified:
+            if self.modified or self.scenario_on_disk:  # edited here, or changed there since
                 self.tell(
-                    f"The study reads the saved scenario file; save{self.key_note('save')} to include "
-                    "your changes.",
+                    f"The study reads {path.name} as it is on disk, not as shown here; "
+                    f"save{self.key_note('save')} first to study what is shown.",
                     severity="warning",
                     timeout=8,
                 )

@@ -54,6 +54,7 @@ class AppHost(App[None]):
     outputs_seen: tuple[int, int] | None  # the measures file's (mtime, size) when they were read
     cwd: Path
     keymap: dict[str, str]  # the user's keys.toml remapping (actions.load_keymap)
+    scenario_on_disk: str | None  # "changed" or "gone" since opened or saved (SceneLoading)
     compile_in_child: bool
     # the jobs and the busy state
     busy: str | None
