@@ -187,3 +187,21 @@ async def test_a_results_table_with_no_rows_is_not_ready(tmp_path, monkeypatch):
         bar = screen.query_one("#sweep-status", StatusBar)
         assert bar.state == NOT_READY
         assert screen.last_message == "no variant rows to rank in torn-results/results.csv"
+
+
+async def test_a_finished_sweep_is_ready_without_a_percentage(swept, tmp_path, monkeypatch):
+    """The bar read 'READY 100%' once a sweep was done: green with a progress figure, as
+    only a busy (red) bar has; the progress row above already says 100%."""
+    from ladartui.tui.status import READY, StatusBar
+
+    monkeypatch.chdir(tmp_path)
+    spec = copy_of(swept, tmp_path / "sw")
+    screen = SweepScreen(spec, serial=True)
+    async with SweepHost(screen).run_test(size=SIZE) as pilot:
+        await opened(pilot)
+        await pilot.press("f5")
+        await wait_for(pilot, lambda: not screen.running)
+        await pilot.pause()
+        bar = screen.query_one("#sweep-status", StatusBar)
+        assert bar.state == READY and bar.progress is None
+        assert str(bar.query_one("#status-word").render()) == "READY"

@@ -502,11 +502,10 @@ class SweepScreen(SweepOpening):
                 total=max(len(result.rows), 1), progress=len(result.rows)
             )
             self.query_one("#sweep-counts", Static).update(self._summary())
-            self._status(
+            self._status(  # no percentage: only a busy bar has one (the progress row says 100%)
                 READY,
                 f"swept into {short_path(self.out)}: {result.ran} run, {result.resumed} resumed{note} "
                 f"in {format_eta(result.elapsed)}",
-                1.0,
             )
             return
         self._rank_quietly()
