@@ -702,3 +702,20 @@ async def test_the_threshold_form_says_why_an_infinite_height_is_refused(tmp_pat
         assert message(form) == "Max height m: 1e400 is not allowed; expected a finite number >= 0 m"
         await type_into(pilot, threshold, "-5", commit="enter")
         assert message(form) == "Max height m: -5 is not allowed; expected a number >= 0 m"
+
+
+async def test_compare_names_the_files_in_its_folder_by_their_names(tmp_path, scene_files):
+    """The field held whole paths: at 80 columns it showed '…/default/[red.cmf'
+    /tmp/h2home/default/default.cmf', scrolled; names in the folder shown read whole."""
+    from ladartui.measures import Measures
+
+    scenario = make_scenario(tmp_path, scene_files)
+    Measures(target_voxels=100, obscured_coverage=0.2, scans=10).write_cmf(scenario.measures_file)
+    Measures(target_voxels=100, obscured_coverage=0.3, scans=10).write_cmf(tmp_path / "other run.cmf")
+    async with opened(scenario, size=(80, 24)) as (app, pilot):
+        app.action_compare()
+        await pilot.pause()
+        compare = app.screen
+        assert compare.query_one("#cmf-files").value == "demo.cmf 'other run.cmf'"
+        table = compare.query_one("#compare-table")
+        assert [str(c.label) for c in table.columns.values()] == ["Measure", "demo", "other run"]

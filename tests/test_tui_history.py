@@ -226,7 +226,7 @@ async def test_compare_takes_files_picked_in_the_tree(tmp_path, scene_files):
         names = [node.data.path.name for node in tree.root.children]
         assert {"a.cmf", "b.cmf"} <= set(names) and "demo.toml" not in names
         chosen = screen.query_one("#cmf-files")
-        a, b = str(tmp_path / "a.cmf"), str(tmp_path / "b.cmf")
+        a, b = "a.cmf", "b.cmf"  # in the dialog's folder: by name
         assert chosen.value.split() == [a, b]  # the folder's .cmf files to start with
         tree.focus()
         picks = []
@@ -266,7 +266,9 @@ async def test_compare_moves_its_tree_up_to_pick_a_run_in_the_folder_beside(tmp_
         tree.move_cursor(folder.children[0])
         await pilot.press("enter")
         await pilot.pause()
-        assert screen.query_one("#cmf-files", Input).value.split()[-1] == str(beside / "other.cmf")
+        assert screen.query_one("#cmf-files", Input).value.split()[-1] == str(
+            beside / "other.cmf"
+        )  # outside: whole
 
 
 @pytest.mark.parametrize("size", [(80, 24), (120, 40)])

@@ -371,7 +371,7 @@ class CompareScreen(TreeDialog):
             yield _row(
                 ".cmf files",
                 Input(
-                    shlex.join(str(p) for p in self.paths),
+                    shlex.join(self.relative(p) for p in self.paths),  # in the folder: by name
                     id="cmf-files",
                     compact=True,
                     suggester=PathSuggester((".cmf",)),
@@ -399,7 +399,7 @@ class CompareScreen(TreeDialog):
         event.stop()
         field = self.query_one("#cmf-files", Input)
         chosen = self._typed() or []
-        picked = str(event.path)
+        picked = self.relative(Path(event.path))
         field.value = shlex.join(
             [c for c in chosen if c != picked] if picked in chosen else chosen + [picked]
         )
