@@ -221,36 +221,6 @@ async def test_quit_without_edits_does_not_ask(tmp_path, scene_files):
         assert not app.is_running
 
 
-async def test_quit_while_a_run_goes_on_asks_first(tmp_path, scene_files):
-    """Ctrl+Q in the middle of a run quit at once, with no edits to ask about: a run of
-    many minutes was gone on one key."""
-    from ladartui.tui.unsaved import QuitRunScreen
-
-    scenario = make_scenario(tmp_path, scene_files)
-    app = LadarApp(scenario.path)
-    async with app.run_test(size=(80, 24)) as pilot:
-        await wait_until(pilot, lambda: loaded(app))
-        capture_runs(app)  # the run never reports back: it goes on
-        await pilot.press("f5")
-        await pilot.pause()
-        assert app.run_in_progress()
-        await pilot.press("ctrl+q")
-        await pilot.pause()
-        assert isinstance(app.screen, QuitRunScreen)
-        said = str(app.screen.query_one("#quit-run-question").render())
-        assert said == (
-            "A run of demo.toml is going on (0%). Quit and cancel it? The outputs on disk stay as they were."
-        )
-        await pilot.press("escape")  # keeps it running
-        await pilot.pause()
-        assert app.is_running and app.run_in_progress() and not isinstance(app.screen, QuitRunScreen)
-        await pilot.press("ctrl+q")
-        await pilot.pause()
-        await pilot.click("#quit-run-quit")
-        await pilot.pause()
-        assert not app.is_running
-
-
 def test_a_value_typed_in_other_units_is_saved_as_typed():
     """A pitch of 50 um typed in the form was saved as 49.99999999999999: 50 * 1e-6 is
     not the double nearest 50 um, so the file could not write it back as 50."""
@@ -261,27 +231,6 @@ def test_a_value_typed_in_other_units_is_saved_as_typed():
         metres = parse_number("pixel_pitch", typed, scale=1e-6)
         assert _to_micrometres(metres) == float(typed), typed
         assert format_number(metres, scale=1e-6) == f"{float(typed):g}"
-
-
-async def test_a_reason_the_status_line_cuts_is_told_whole_once(tmp_path, scene_files):
-    """At 80 columns the bar read 'NOT READY  /tmp/…/forest.toml:5: files.scene =
-    'forest.t…': why Run was off was cut away, and said nowhere until F5 was pressed."""
-    from ladartui.tui.status import NOT_READY
-    from test_tui_dialogs import opened
-
-    scene = tmp_path / "forest.txt"
-    copy_scene(scene_files[0], scene)
-    scenario = make_scenario(tmp_path, (scene, scene_files[1], scene_files[2]), name="forest")
-    async with opened(scenario, size=(80, 24)) as (app, pilot):
-        await pilot.pause()
-        message = app.query_one(StatusBar).message
-        assert app.query_one(StatusBar).state == NOT_READY and "would overwrite a model file" in message
-        assert message.endswith("would overwrite a model file")
-        told = [m for m in app.messages if message in m]
-        assert len(told) == 1
-        app.refresh_status()
-        await pilot.pause()
-        assert len([m for m in app.messages if message in m]) == 1  # once, not at each refresh
 
 
 async def test_a_long_scenario_name_is_shortened_in_the_status_line_not_what_follows(tmp_path, scene_files):
@@ -358,17 +307,6 @@ def test_a_point_or_list_with_an_empty_part_is_refused_not_shortened():
     assert _parse_points("centre", "1, 2, 3,", "point") == (1.0, 2.0, 3.0)  # a trailing comma
     assert _parse_points("centre", "1; 2", "point") == (1.0, 2.0, 0.0)
     assert _parse_points("standoffs", "50, 100", "points") == (50.0, 100.0)
-
-
-def test_a_short_name_is_not_cut_for_a_line_whose_end_is_cut_anyway():
-    """At 80 columns the status line read 'def…lt.toml (modified): 24 scans x 1,048,576
-    rays. F5 ru…': the name cut for one cell while the end was cut all the same."""
-    from ladartui.tui.status import fitted
-
-    said = "default.toml (modified): 24 scans x 1,048,576 rays. F5 runs."
-    assert fitted(said, 57, "default.toml") == said[:56] + "\u2026"
-    said = "default.toml (modified): 24 scans x 16,384 rays. F5 runs."  # 57: the name gives way
-    assert fitted(said, 56, "default.toml") == "def\u2026lt.toml (modified): 24 scans x 16,384 rays. F5 runs."
 
 
 def test_fitted_shortens_the_name_given_then_cuts_the_end_in_cells():
@@ -671,30 +609,3 @@ async def test_earlier_outputs_are_shown_from_one_stat_of_each_file(tmp_path, sc
         assert list(stats.values()) == [2, 2, 2]
         status = scenario.measures_file.stat()
         assert app.outputs_seen == (status.st_mtime_ns, status.st_size)  # those shown, as on disk
-
-
-async def test_the_file_tab_says_which_key_writes_missing_outputs_only_when_it_would(
-    tmp_path, scene_files, monkeypatch
-):
-    """'Not on disk yet: ... (F5 writes them)': F5 even where keys.toml had moved the run
-    to Ctrl+R, and where the run was off (its outputs would overwrite a model file)."""
-    home = tmp_path / "home"
-    (home / "config").mkdir(parents=True)
-    (home / "config" / "keys.toml").write_text('[keys]\nrun = "ctrl+r"\n')
-    monkeypatch.setenv("LADARTUI_HOME", str(home))
-    scenario = make_scenario(tmp_path, scene_files)
-    scenario.scene_output.write_text("1,2,3\n")  # a partial set: the rest is missing
-    app = LadarApp(scenario.path)
-    async with app.run_test(size=SIZE) as pilot:
-        await wait_until(pilot, lambda: loaded(app))
-        info = str(app.query_one("#file-info").render())
-        assert "(Ctrl+R writes them)" in info and "F5" not in info
-    scene = tmp_path / "forest.txt"
-    copy_scene(scene_files[0], scene)
-    refused = make_scenario(tmp_path, (scene, scene_files[1], scene_files[2]), name="forest")
-    refused.measures_file.write_text("")
-    app = LadarApp(refused.path)
-    async with app.run_test(size=SIZE) as pilot:
-        await wait_until(pilot, lambda: loaded(app))
-        info = str(app.query_one("#file-info").render())
-        assert "Not on disk yet: forest_Scene.txt" in info and "writes them" not in info, info

@@ -1,0 +1,122 @@
+"""Dialogs that read what is typed: Compare's files, New scenario's scene model, a
+segment form the whole path refuses, the threshold form; each says what is wrong in
+its own words and keeps what was typed."""
+
+from __future__ import annotations
+
+from ladartui.tui.screens import CompareScreen, FormScreen
+from test_tui_dialogs import message, opened
+from test_tui_flow import make_scenario, type_into
+
+
+async def test_compare_reads_names_typed_in_the_folder_it_shows(tmp_path, scene_files, monkeypatch):
+    """The dialog shows 'Folder: <the scenario's>' and its .cmf files in the tree, but a
+    name typed there ('a.cmf b.cmf') was looked for in the working folder: 'a.cmf:
+    measures file not found'. Open and Save As read typed names in their folder."""
+    from ladartui.measures import Measures
+
+    here, elsewhere = tmp_path / "here", tmp_path / "elsewhere"
+    here.mkdir()
+    elsewhere.mkdir()
+    monkeypatch.chdir(elsewhere)
+    for name, coverage in (("a", 0.2), ("b", 0.3)):
+        Measures(target_voxels=100, obscured_coverage=coverage, scans=10).write_cmf(here / f"{name}.cmf")
+    scenario = make_scenario(here, scene_files)
+    async with opened(scenario) as (app, pilot):
+        app.action_compare()
+        await pilot.pause()
+        compare = app.screen
+        assert isinstance(compare, CompareScreen)
+        field = compare.query_one("#cmf-files")
+        field.value = "a.cmf b.cmf"
+        await pilot.press("enter")
+        await pilot.pause()
+        assert message(compare, "#compare-message") == ""
+        table = compare.query_one("#compare-table")
+        assert [str(c.label) for c in table.columns.values()] == ["Measure", "a", "b"]
+        field.value = "a.cmf 'b.cmf"
+        await pilot.press("enter")
+        await pilot.pause()
+        assert message(compare, "#compare-message") == (
+            ".cmf files: a quotation mark is not closed; expected paths separated by spaces, "
+            "one with spaces in quotes"
+        )
+
+
+async def test_a_scenario_file_given_as_the_new_scenarios_scene_model_is_named_so(tmp_path, scene_files):
+    """It said 'default_Target.toml: target model file not found', of a file no one named."""
+    from ladartui.tui.file_dialogs import SetupScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario) as (app, pilot):
+        await pilot.press("f2")
+        await pilot.pause()
+        dialog = app.screen
+        assert isinstance(dialog, SetupScreen) and dialog.mode == "new"
+        dialog.query_one("#scenario-file").value = "fresh.toml"
+        dialog.query_one("#scene-file").value = scenario.path.name
+        dialog.query_one("#setup-ok").press()
+        await pilot.pause()
+        assert message(dialog, "#setup-message") == (
+            f"{scenario.path}: scene model file is a scenario file (.toml); expected a scene model (.txt)"
+        )
+        assert not (tmp_path / "fresh.toml").exists()
+
+
+async def test_a_segment_the_whole_path_refuses_keeps_its_form_open(tmp_path, scene_files):
+    """A straight of 9999 scans after a 6-scan orbit: each field was allowed, the form
+    closed, and the path's own limit was said after it ('Flight path not changed'),
+    with what had been typed gone."""
+    scenario = make_scenario(tmp_path, scene_files)  # 6 scans
+    async with opened(scenario) as (app, pilot):
+        app.action_show_tab("flight")
+        app.action_add_segment("straight")
+        await pilot.pause()
+        form = app.screen
+        assert isinstance(form, FormScreen)
+        await type_into(pilot, form.query_one("#f-scans"), "9999", commit="tab")
+        form.query_one("#form-ok").press()
+        await pilot.pause()
+        assert app.screen is form
+        assert message(form) == "flight.segments = '10005 scans': expected at most 10000 scans"
+        assert form.query_one("#f-scans").value == "9999"
+        assert len(app.scenario.flight.segments) == 1
+        await type_into(pilot, form.query_one("#f-scans"), "9994", commit="tab")
+        form.query_one("#form-ok").press()
+        await pilot.pause()
+        assert app.screen is not form and len(app.scenario.poses()) == 10000
+
+
+async def test_the_threshold_form_says_why_an_infinite_height_is_refused(tmp_path, scene_files):
+    """'Max height (m): 1e400 is not allowed; expected a number >= 0': 1e400 is >= 0;
+    what it is not is finite. Its limit is in metres, as the other forms give theirs."""
+    from ladartui.tui.screens import ThresholdScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario) as (app, pilot):
+        await pilot.press("f8")
+        await pilot.pause()
+        form = app.screen
+        assert isinstance(form, ThresholdScreen)
+        threshold = form.query_one("#f-threshold")
+        await type_into(pilot, threshold, "1e400", commit="enter")
+        assert message(form) == "Max height m: 1e400 is not allowed; expected a finite number >= 0 m"
+        await type_into(pilot, threshold, "-5", commit="enter")
+        assert message(form) == "Max height m: -5 is not allowed; expected a number >= 0 m"
+
+
+async def test_compare_names_the_files_in_its_folder_by_their_names(tmp_path, scene_files):
+    """The field held whole paths: at 80 columns it showed '…/default/[red.cmf'
+    /tmp/h2home/default/default.cmf', scrolled; names in the folder shown read whole."""
+    from ladartui.measures import Measures
+
+    scenario = make_scenario(tmp_path, scene_files)
+    Measures(target_voxels=100, obscured_coverage=0.2, scans=10).write_cmf(scenario.measures_file)
+    Measures(target_voxels=100, obscured_coverage=0.3, scans=10).write_cmf(tmp_path / "other run.cmf")
+    async with opened(scenario, size=(80, 24)) as (app, pilot):
+        app.action_compare()
+        await pilot.pause()
+        compare = app.screen
+        assert compare.query_one("#cmf-files").value == "demo.cmf 'other run.cmf'"
+        table = compare.query_one("#compare-table")
+        assert [str(c.label) for c in table.columns.values()] == ["Measure", "demo", "other run"]
