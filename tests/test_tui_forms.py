@@ -120,3 +120,36 @@ async def test_compare_names_the_files_in_its_folder_by_their_names(tmp_path, sc
         assert compare.query_one("#cmf-files").value == "demo.cmf 'other run.cmf'"
         table = compare.query_one("#compare-table")
         assert [str(c.label) for c in table.columns.values()] == ["Measure", "demo", "other run"]
+
+
+async def test_open_offers_the_open_scenario_so_enter_reopens_it(tmp_path, scene_files):
+    """'changed on disk; reopen (F3)' left the user to find and pick the file again in an
+    empty Open dialog. Open now holds the open scenario's name, selected (typing replaces
+    it), so F3 then Enter reads the file as it is on disk."""
+    from ladartui.tui.file_dialogs import SetupScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario) as (app, pilot):
+        text = scenario.path.read_text(encoding="utf-8")
+        assert "speed_mps = " in text
+        before = app.scenario.speed
+        scenario.path.write_text(text.replace("speed_mps = ", "speed_mps = 1"), encoding="utf-8")
+        await pilot.press("f3")
+        await pilot.pause()
+        dialog = app.screen
+        assert isinstance(dialog, SetupScreen) and dialog.mode == "load"
+        field = dialog.query_one("#scenario-file")
+        assert field.value == scenario.path.name and field.selected_text == scenario.path.name
+        await pilot.press("enter")
+        await pilot.pause()
+        for _ in range(100):
+            if not isinstance(app.screen, SetupScreen) and app.busy is None and app.scenario is not None:
+                break
+            await pilot.pause(0.05)
+        assert app.scenario.speed == load_speed(scenario.path) != before
+
+
+def load_speed(path):
+    from ladartui.scenario import load_scenario
+
+    return load_scenario(path).speed

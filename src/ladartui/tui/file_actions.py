@@ -40,7 +40,8 @@ class FileActions(Host):
                 self.result = None
                 self.load(None, scenario=scenario)
 
-        self.push_screen(SetupScreen(mode, self._folder()), done)
+        current = self.scenario.path if self.scenario is not None else None
+        self.push_screen(SetupScreen(mode, self._folder(), current), done)
 
     def open_path(self, path: Path) -> None:
         """Open a scenario file (recent list, best sweep path), asking about unsaved edits."""

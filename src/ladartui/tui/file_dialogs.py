@@ -34,11 +34,14 @@ class SetupScreen(TreeDialog):
     New: choose the scenario file and the scene model; the target model and the
     output names are derived and shown. Load: every file is checked; a missing
     model is named and nothing is loaded. Dismisses with the loaded Scenario.
+    Load opens holding ``current`` (the open scenario), selected: Enter reopens it
+    as it is on disk, typing replaces it.
     """
 
-    def __init__(self, mode: str = "new", folder: Path | None = None):
+    def __init__(self, mode: str = "new", folder: Path | None = None, current: Path | None = None):
         super().__init__()
         self.mode = mode
+        self.current = current
         self.base = folder or Path.cwd()
         self.folder = self.base
 
@@ -80,7 +83,10 @@ class SetupScreen(TreeDialog):
     def on_mount(self) -> None:
         super().on_mount()
         self._apply_mode()
-        self.query_one("#scenario-file", Input).focus()
+        field = self.query_one("#scenario-file", Input)
+        if self.mode == "load" and self.current is not None:
+            field.value = self.relative(self.current)
+        field.focus()
 
     @on(RadioSet.Changed, "#mode")
     def _mode_changed(self, event: RadioSet.Changed) -> None:
