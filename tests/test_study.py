@@ -390,7 +390,7 @@ async def test_study_screen_runs_in_a_worker_and_shows_chart_table_and_verdict(m
         await pilot.pause()
         assert again.result is not None and not list(again.workers)
         assert again.query_one("#study-table", DataTable).row_count == 2
-        assert "last study" in str(again.query_one("#study-status", Static).render())
+        assert "last study" in str(again.query_one("#study-status StatusText", Static).render())
 
 
 def test_a_study_json_reads_back_to_the_same_table_and_verdict(tmp_path):

@@ -127,7 +127,7 @@ async def test_a_study_whose_tracer_fails_unexpectedly_reports_it_and_the_app_st
     monkeypatch.setattr(study_run, "run_study", broken)
     async with study_screen(tmp_path, scene_files) as (app, pilot, screen):
         await pilot.press("q")
-        status = screen.query_one("#study-status", Static)
+        status = screen.query_one("#study-status StatusText", Static)
         await wait_until(pilot, lambda: "fell over" in str(status.render()))
         assert "error: RuntimeError: the tracer fell over" in str(status.render())
         assert app.is_running and app.screen is screen
@@ -153,13 +153,21 @@ async def test_ctrl_x_cancels_a_study_as_it_cancels_a_run_and_a_sweep(tmp_path, 
 
     monkeypatch.setattr(study_run, "run_study", until_cancelled)
     async with study_screen(tmp_path, scene_files) as (app, pilot, screen):
+        from ladartui.tui.status import BUSY, READY, StatusBar
+
+        # the colour bar as on the main and sweep screens: green, red with progress, green
+        bar = screen.query_one("#study-status", StatusBar)
+        assert bar.state == READY
         await pilot.press("q")
         await wait_until(pilot, started.is_set)
+        await wait_until(pilot, lambda: bar.progress is not None)
+        assert bar.state == BUSY and abs(bar.progress - 1 / 3) < 1e-9
         await pilot.press("ctrl+x")
-        status = screen.query_one("#study-status", Static)
+        status = screen.query_one("#study-status StatusText", Static)
         await wait_until(pilot, lambda: "study cancelled" in str(status.render()))
         assert app.screen is screen  # cancelled, still on the study screen
         assert screen.query_one("#study-progress").percentage == 0  # not left at 33 %
+        assert bar.state == READY and bar.progress is None
     # the main screen's Cancel takes Ctrl+X as well as Esc
     from ladartui.tui.actions import keys_in_force
 
@@ -169,7 +177,7 @@ async def test_ctrl_x_cancels_a_study_as_it_cancels_a_run_and_a_sweep(tmp_path, 
 async def test_the_study_screen_keeps_its_controls_at_80x24(tmp_path, scene_files):
 
     async with study_screen(tmp_path, scene_files, size=(80, 24)) as (app, pilot, screen):
-        status = str(screen.query_one("#study-status", Static).render())
+        status = str(screen.query_one("#study-status StatusText", Static).render())
         assert status.endswith("q quick, f full, Ctrl+X cancel, Esc back")
         # a result's chart, legend, table and verdict leave the controls on screen
         from pathlib import Path
@@ -254,7 +262,7 @@ async def test_the_study_status_shortens_a_long_path_and_keeps_the_keys(tmp_path
     folder = tmp_path / ("a-long-folder-name-" * 3)
     folder.mkdir()
     async with study_screen(folder, scene_files, size=(80, 24)) as (app, pilot, screen):
-        status = screen.query_one("#study-status", Static)
+        status = screen.query_one("#study-status StatusText", Static)
         shown = str(status.render())
         assert shown.endswith("q quick, f full, Ctrl+X cancel, Esc back"), shown
         assert "\u2026" in shown and cell_len(shown) <= status.content_size.width

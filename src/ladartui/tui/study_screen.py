@@ -21,7 +21,7 @@ from textual_plotext import PlotextPlot
 from ladartui.study.chart import TABLE_COLUMNS, draw_chart, label_places, legend_text, table_rows
 from ladartui.textsafe import visible
 from ladartui.tui.fitted_tables import FittingTable, fill_whole_columns
-from ladartui.tui.status import StatusText
+from ladartui.tui.status import BUSY, READY, StatusBar
 from ladartui.tui.work import JobDone, JobProgress, running, start_job
 
 NARROW = 100  # columns
@@ -50,7 +50,7 @@ class StudyScreen(Screen):
     StudyScreen #study-verdict { height: auto; max-height: 12; overflow-y: auto; padding: 0 1; }
     StudyScreen #study-bar { height: 1; }
     StudyScreen #study-bar Button { margin-left: 1; }
-    StudyScreen #study-status { height: 1; padding: 0 1; }
+    StudyScreen #study-status #cancel { display: none; }  /* the row below has the screen's */
     StudyScreen ProgressBar { width: 1fr; }
     """
 
@@ -71,7 +71,9 @@ class StudyScreen(Screen):
                 yield FittingTable(self._fill_table, id="study-table", zebra_stripes=True, cursor_type="row")
                 yield Static("", id="study-table-note", markup=False)
                 yield Static("", id="study-verdict")
-        yield StatusText(id="study-status")  # one line: a long path gives way, not the keys
+        # green ready, red busy with its progress, as on the main and sweep screens; one
+        # line: a long path gives way, not the keys
+        yield StatusBar(id="study-status")
         with Horizontal(id="study-bar"):
             yield ProgressBar(total=1, id="study-progress", show_eta=False)  # idle: 0 %, not animated
             yield Button("Quick", id="study-quick", compact=True)
@@ -135,7 +137,7 @@ class StudyScreen(Screen):
     def action_run(self, mode: str) -> None:
         if running(self.worker):
             return
-        self._set_busy(True, f"preparing the {mode} study ...")
+        self._set_busy(True, f"preparing the {mode} study ...", progress=0.0)
         scenario_path, scans, runs = self.scenario_path, self.scans, self.runs
         self.worker = start_job(
             self, "study", lambda cancel, progress: _study(mode, scenario_path, scans, runs, cancel, progress)
@@ -144,7 +146,8 @@ class StudyScreen(Screen):
     def action_cancel(self) -> None:
         if running(self.worker):
             self.worker.cancel()
-            self._set_status("cancelling after the current trace ...")
+            bar = self.query_one("#study-status", StatusBar)
+            self._set_status("cancelling after the current trace ...", BUSY, bar.progress)
 
     def action_close(self) -> None:
         if running(self.worker):
@@ -155,13 +158,14 @@ class StudyScreen(Screen):
         if message.detail is not None:
             self._show_progress(message.detail)
         else:
-            self._set_status(message.text)
+            self._set_status(message.text, BUSY, self.query_one("#study-status", StatusBar).progress)
 
     def on_job_done(self, message: JobDone) -> None:
         if message.cancelled:
             self._finish(None, "study cancelled")
         elif message.error:
             self._finish(None, f"error: {message.error}")
+            self.notify(f"Study failed: {message.error}", severity="error", markup=False, timeout=15)
         else:
             result, text = message.result
             self._finish(result, text)
@@ -170,7 +174,7 @@ class StudyScreen(Screen):
 
     def _show_progress(self, p) -> None:
         self.query_one("#study-progress", ProgressBar).update(total=max(p.total, 1), progress=p.done)
-        self._set_status(f"{p.label}, scan {p.scan}/{p.scans}")
+        self._set_status(f"{p.label}, scan {p.scan}/{p.scans}", BUSY, p.done / max(p.total, 1))
 
     def _finish(self, result, message: str) -> None:
         self._set_busy(False, message)
@@ -204,16 +208,16 @@ class StudyScreen(Screen):
         self.set_class(event.size.width < NARROW, "-narrow")
         self.call_after_refresh(self._draw_chart)
 
-    def _set_busy(self, busy: bool, message: str) -> None:
+    def _set_busy(self, busy: bool, message: str, progress: float | None = None) -> None:
         self.query_one("#study-cancel", Button).disabled = not busy
         self.query_one("#study-quick", Button).disabled = busy
         self.query_one("#study-full", Button).disabled = busy
-        self._set_status(message)
+        self._set_status(message, BUSY if busy else READY, progress)
 
-    def _set_status(self, message: str) -> None:
+    def _set_status(self, message: str, state: str = READY, progress: float | None = None) -> None:
         # it may name files: shown as text, the scenario's path shortened first
         path = visible(str(self.scenario_path)) if self.scenario_path else None
-        self.query_one("#study-status", StatusText).show(visible(message), path)
+        self.query_one("#study-status", StatusBar).show(state, visible(message), progress, name=path)
 
 
 def _study(mode: str, scenario_path, scans, runs, cancel, progress):
