@@ -556,3 +556,18 @@ def test_the_best_scenario_file_does_not_carry_the_base_files_comments(tmp_path)
     )
     saved = load_scenario(path)
     assert saved.flight.segments[0].radius == 35.0 and saved.scene_file == base.scene_file
+
+
+def test_a_columns_numbers_share_their_decimals():
+    """The time column read '4', '8.029', '10.04': each cell to four significant figures,
+    so the decimals wandered and whole numbers lost theirs."""
+    from ladartui.sweep.table import column_format
+
+    shown = column_format([4.0, 8.029, 10.04, None, 12])
+    assert [shown(v) for v in (4.0, 8.029, 10.04, None, 12)] == ["4.00", "8.03", "10.04", "-", "12"]
+    assert column_format([0.5, 0.25], 3)(0.25) == "0.250"  # a share: three figures of the largest
+    # past what fixed decimals show well, each cell keeps its own figures
+    assert [column_format([1e7, 3.5])(v) for v in (1e7, 3.5)] == ["1e+07", "3.5"]
+    assert column_format([0.0001, 0.0002])(0.0001) == "0.0001"
+    assert column_format([float("nan"), 2.5])(float("nan")) == "nan"
+    assert column_format(["text", 1.5])("text") == "text"

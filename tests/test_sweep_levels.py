@@ -234,5 +234,8 @@ def test_cli_sweep_table_folds_headers_never_values_in_a_narrow_terminal(tmp_pat
     lines = capsys.readouterr().out.splitlines()
     rows = [r for r in (line.split() for line in lines) if len(r) > 2 and r[0].isdigit() and len(r[1]) == 8]
     assert len(rows) == 8 and all(len(line) <= 60 for line in lines)
-    assert {r[2] for r in rows} == {"20", "30.12"} and {r[3] for r in rows} == {"30", "40.5"}
+    assert {r[2] for r in rows} == {"20.00", "30.12"} and {r[3] for r in rows} == {
+        "30.00",
+        "40.50",
+    }  # decimals shared
     assert not any("…" in cell for r in rows for cell in r)

@@ -129,6 +129,9 @@ async def test_opening_results_shows_the_ranking_failures_and_pareto_front(finis
         table = screen.query_one("#sweep-table", DataTable)
         assert status_of(screen).state == READY
         assert table.row_count == 12
+        # a column's numbers share their decimals ('4', '8.029', '10.04' did not line up)
+        costs = [str(cell) for cell in table.get_column("cost") if str(cell) != "-"]
+        assert costs and len({len(c.partition(".")[2]) for c in costs}) == 1, costs
         # At 80 x 24 every key is in the footer, and the table and chart share the body.
         from textual.widgets._footer import FooterKey
 

@@ -420,7 +420,7 @@ def show_result(console, result, top) -> None:
     from ladartui.sweep.columns import target_ids
     from ladartui.sweep.ranking import OBJECTIVE_HEADERS as short
     from ladartui.sweep.ranking import OBJECTIVES, identified_count, never_identified
-    from ladartui.sweep.table import display_cell
+    from ladartui.sweep.table import column_format, display_cell
 
     cost_unit = "s" if result.cost == "flight-time" else "m"
     table = Table(
@@ -430,6 +430,11 @@ def show_result(console, result, top) -> None:
         pad_edge=False,
     )
     shown = [r for r in result.ranking if r.rank is not None][:top]
+    # each column's numbers with its decimals, so that they line up
+    formats = {name: column_format([r.row.get(name) for r in shown]) for name in result.parameter_names}
+    value_cell = column_format([r.value for r in shown])
+    coverage_cell = column_format([r.coverage for r in shown], 3)
+    cost_cell = column_format([r.cost for r in shown], 4)
 
     def number_column(header: str, values) -> None:
         # A narrow terminal folds the header, never a value: a cut number reads as another one.
@@ -439,18 +444,17 @@ def show_result(console, result, top) -> None:
     table.add_column("#", justify="right")
     table.add_column("variant", no_wrap=True)
     for name in result.parameter_names:
-        number_column(name, [display_cell(r.row.get(name)) for r in shown])
+        number_column(name, [formats[name](r.row.get(name)) for r in shown])
     separate = result.objective not in ("obscured-coverage", "coverage-within-budget")
     if separate:
-        number_column(short[result.objective], [display_cell(r.value) for r in shown])
+        number_column(short[result.objective], [value_cell(r.value) for r in shown])
     # Several targets: how many each path identifies by its last scan, e.g. "2/3".
     several = any(len(target_ids(r.row)) > 1 for r in shown)
     if several:
         table.add_column("targets id.", justify="right")
-    number_column("coverage", [display_cell(r.coverage, 3) for r in shown])
-    number_column(
-        f"{'time' if cost_unit == 's' else 'dist.'} {cost_unit}", [display_cell(r.cost, 4) for r in shown]
-    )
+    number_column("coverage", [coverage_cell(r.coverage) for r in shown])
+    cost_header = f"{'time' if cost_unit == 's' else 'dist.'} {cost_unit}"
+    number_column(cost_header, [cost_cell(r.cost) for r in shown])
     table.add_column("front")
 
     def read(value) -> Text:  # text read from the results table: never markup or escapes
@@ -461,11 +465,11 @@ def show_result(console, result, top) -> None:
         table.add_row(
             str(ranked.rank),
             read(str(row.get("variant", ""))[:8]),
-            *(read(display_cell(row.get(n))) for n in result.parameter_names),
-            *([display_cell(ranked.value)] if separate else []),
+            *(read(formats[n](row.get(n))) for n in result.parameter_names),
+            *([value_cell(ranked.value)] if separate else []),
             *([f"{identified_count(row)}/{len(target_ids(row))}"] if several else []),
-            display_cell(ranked.coverage, 3),
-            display_cell(ranked.cost, 4),
+            coverage_cell(ranked.coverage),
+            cost_cell(ranked.cost),
             "*" if ranked.pareto else "",
         )
     console.print(table)

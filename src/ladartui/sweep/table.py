@@ -57,6 +57,29 @@ def display_cell(value, digits=4) -> str:
     return str(value)
 
 
+# Magnitudes fixed decimals show well in a column; beyond them each cell keeps its figures.
+FIXED_RANGE = (1e-3, 1e6)
+
+
+def column_format(values, digits=4):
+    """A formatter for the cells of one column holding ``values``: its floats with the
+    decimals that give the largest ``digits`` significant figures, so that they line
+    up (4.00, 8.03, 10.04, not 4, 8.029, 10.04); ``display_cell`` where the largest
+    lies outside ``FIXED_RANGE`` (an exponent reads better) and for other values."""
+    floats = [abs(v) for v in values if isinstance(v, float) and math.isfinite(v)]
+    top = max(floats, default=0.0)
+    if not FIXED_RANGE[0] <= top < FIXED_RANGE[1]:
+        return lambda value: display_cell(value, digits)
+    decimals = max(0, digits - (math.floor(math.log10(top)) + 1))
+
+    def shown(value) -> str:
+        if isinstance(value, float) and math.isfinite(value):
+            return f"{value:.{decimals}f}"
+        return display_cell(value, digits)
+
+    return shown
+
+
 def parse_cell(text: str):
     """The value a cell was written from (numbers, booleans, lists, None, text)."""
     if text == "":

@@ -8,7 +8,7 @@ from pathlib import Path
 from rich.text import Text
 
 from ladartui.sweep.ranking import OBJECTIVE_HEADERS
-from ladartui.sweep.table import display_cell
+from ladartui.sweep.table import column_format, display_cell
 
 COST_HEADERS = {"flight-time": "time s", "distance": "dist m"}
 # Each label with its axis's arrow: plotext sets them side by side on one line, which
@@ -61,22 +61,34 @@ def fill_ranking_table(table, ranking, objective: str, cost: str, parameter_name
     errors = any(entry.row.get("error") for entry in ranking)
     if errors:
         table.add_column("error", key="error")
+    formats = column_formats(ranking, parameter_names)
     for index, entry in enumerate(ranking):
-        table.add_row(*ranking_cells(entry, objective, parameter_names, errors), key=str(index))
+        table.add_row(*ranking_cells(entry, objective, parameter_names, errors, formats), key=str(index))
     if ranking:
         table.move_cursor(row=cursor)
     return ids
 
 
-def ranking_cells(entry, objective: str, parameter_names, errors: bool) -> list:
+def column_formats(ranking, parameter_names) -> dict:
+    """A formatter per number column ("value", "cost", each parameter), so that each
+    column's numbers share their decimals (``column_format``)."""
+    formats = {name: column_format([e.row.get(name) for e in ranking]) for name in parameter_names}
+    formats["value"] = column_format([e.value for e in ranking])
+    formats["cost"] = column_format([e.cost for e in ranking])
+    return formats
+
+
+def ranking_cells(entry, objective: str, parameter_names, errors: bool, formats=None) -> list:
     """One table row: rank, mark (``row_mark``), objective, (coverage), cost, status, parameters,
-    variant and (with ``errors``) error; text from the results file is never markup."""
+    variant and (with ``errors``) error; text from the results file is never markup.
+    ``formats``: ``column_formats`` of the whole ranking (else each cell its own figures)."""
+    formats = formats or {}
     row = entry.row
     status = row.get("status") or "?"
     if objective == "obscured-coverage":
         value = "-" if entry.value is None else f"{100 * entry.value:.2f}%"
     else:
-        value = display_cell(entry.value)
+        value = formats.get("value", display_cell)(entry.value)
     cells = [
         "-" if entry.rank is None else str(entry.rank),
         row_mark(entry),
@@ -84,9 +96,9 @@ def ranking_cells(entry, objective: str, parameter_names, errors: bool) -> list:
     ]
     if objective != "obscured-coverage":
         cells.append("-" if entry.coverage is None else f"{100 * entry.coverage:.2f}")
-    cells.append(Text(display_cell(entry.cost)))
+    cells.append(Text(formats.get("cost", display_cell)(entry.cost)))
     cells.append(Text(status, style="green" if status == "ok" else "bold red"))
-    cells.extend(Text(display_cell(row.get(name))) for name in parameter_names)
+    cells.extend(Text(formats.get(name, display_cell)(row.get(name))) for name in parameter_names)
     cells.append(Text(str(row.get("variant") or "")))
     if errors:
         error = str(row.get("error") or "")
