@@ -580,3 +580,24 @@ def test_validate_notes_an_empty_or_misplaced_target_model(tmp_path, capsys):
         "note       1 of 1 target voxel is not in the scene model m.txt: the scene run cannot see it" in out
     )
     assert gib(4096) == "4 KiB" and gib(100) == "100 bytes" and gib(3 * 2**20) == "3 MiB"
+
+
+def test_a_missing_or_folder_path_is_said_so_whatever_its_suffix(tmp_path, capsys):
+    """The suffix named the kind of any file that failed: a mistyped 'nothere.laz' read
+    'a LAS point cloud (.laz), not a voxel list', a folder 'dir.txt' given as a scenario
+    'a voxel list (.txt), not a scenario'."""
+    import os
+
+    with pytest.raises(LadarError) as caught:
+        load_voxels(tmp_path / "nothere.laz")
+    assert str(caught.value).startswith(f"{tmp_path / 'nothere.laz'}: no such file; ")
+    (tmp_path / "dir.obj").mkdir()
+    with pytest.raises(LadarError) as caught:
+        load_voxels(tmp_path / "dir.obj")
+    assert str(caught.value) == f"{tmp_path / 'dir.obj'}: is a folder; expected a voxel-list file"
+    (tmp_path / "dir.txt").mkdir()
+    os.mkfifo(tmp_path / "pipe.txt")
+    for name, said in (("dir.txt", "is a folder"), ("pipe.txt", "is not a regular file")):
+        assert main(["validate", str(tmp_path / name)]) == 2
+        err = one_error_line(capsys)
+        assert err.startswith(f"ladartui: error: {tmp_path / name}: {said}"), err

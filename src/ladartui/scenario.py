@@ -432,8 +432,9 @@ def load_scenario(path, check_files=True) -> Scenario:
     try:
         try:
             text = read_utf8(path, "expected a scenario file (.toml)")
-        except InputFileError:  # no UTF-8 text: a point cloud, say
-            _refuse_other_kind(path, None)
+        except InputFileError as error:  # no UTF-8 text (a point cloud, say), on its line
+            if error.line is not None:  # not a folder or a pipe, whatever its suffix
+                _refuse_other_kind(path, None)
             raise
         _refuse_other_kind(path, text)
     except FileNotFoundError:

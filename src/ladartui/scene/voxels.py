@@ -272,8 +272,10 @@ def _read_rows(path: Path, columns: int, target: bool, digest: Digest | None = N
     new, never part of each."""
     try:
         return _read_opened(path, columns, target, digest)
-    except InputFileError:
-        kind = other_file_kind(path)  # a point cloud or mesh fails on its first line: say what it is
+    except InputFileError as error:
+        # A point cloud or mesh fails on a line: say what it is. An error of no line (no
+        # such file, a folder, too large) is about the path, whatever its suffix.
+        kind = other_file_kind(path) if error.line is not None else None
         if kind is None:
             raise
         expected = EXPECTED_TARGET if target else EXPECTED
