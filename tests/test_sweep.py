@@ -564,10 +564,15 @@ def test_a_columns_numbers_share_their_decimals():
     from ladartui.sweep.table import column_format
 
     shown = column_format([4.0, 8.029, 10.04, None, 12])
-    assert [shown(v) for v in (4.0, 8.029, 10.04, None, 12)] == ["4.00", "8.03", "10.04", "-", "12"]
+    assert [shown(v) for v in (4.0, 8.029, 10.04, None, 12)] == ["4.00", "8.03", "10.04", "-", "12.00"]
     assert column_format([0.5, 0.25], 3)(0.25) == "0.250"  # a share: three figures of the largest
     # past what fixed decimals show well, each cell keeps its own figures
     assert [column_format([1e7, 3.5])(v) for v in (1e7, 3.5)] == ["1e+07", "3.5"]
     assert column_format([0.0001, 0.0002])(0.0001) == "0.0001"
     assert column_format([float("nan"), 2.5])(float("nan")) == "nan"
     assert column_format(["text", 1.5])("text") == "text"
+    # whole numbers beside fractions take the decimals too
+    assert [column_format([64, 128.5])(v) for v in (64, 128.5)] == ["64.0", "128.5"]
+    # decimals that would show distinct values alike, or one as nought: each its own figures
+    assert [column_format([0.25, 0.5, 1000.0])(v) for v in (0.25, 0.5, 1000.0)] == ["0.25", "0.5", "1000"]
+    assert column_format([-0.0001, 0.5], 3)(-0.0001) == "-0.0001"

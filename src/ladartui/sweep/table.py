@@ -62,22 +62,33 @@ FIXED_RANGE = (1e-3, 1e6)
 
 
 def column_format(values, digits=4):
-    """A formatter for the cells of one column holding ``values``: its floats with the
+    """A formatter for the cells of one column holding ``values``: its numbers with the
     decimals that give the largest ``digits`` significant figures, so that they line
-    up (4.00, 8.03, 10.04, not 4, 8.029, 10.04); ``display_cell`` where the largest
-    lies outside ``FIXED_RANGE`` (an exponent reads better) and for other values."""
-    floats = [abs(v) for v in values if isinstance(v, float) and math.isfinite(v)]
-    top = max(floats, default=0.0)
+    up (4.00, 8.03, 10.04, not 4, 8.029, 10.04); ``display_cell`` (each cell its own
+    figures) where the largest lies outside ``FIXED_RANGE`` (an exponent reads
+    better), where those decimals would show two values alike or one as nought, and
+    for other values."""
+    numbers = {
+        float(v)
+        for v in values
+        if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
+    }
+    if not any(isinstance(v, float) for v in values):
+        return lambda value: display_cell(value, digits)
+    top = max((abs(v) for v in numbers), default=0.0)
     if not FIXED_RANGE[0] <= top < FIXED_RANGE[1]:
         return lambda value: display_cell(value, digits)
     decimals = max(0, digits - (math.floor(math.log10(top)) + 1))
+    shown = {v: f"{v:.{decimals}f}" for v in numbers}
+    if len(set(shown.values())) < len(shown) or any(v and not float(text) for v, text in shown.items()):
+        return lambda value: display_cell(value, digits)
 
-    def shown(value) -> str:
-        if isinstance(value, float) and math.isfinite(value):
-            return f"{value:.{decimals}f}"
+    def cell(value) -> str:
+        if isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value):
+            return f"{float(value):.{decimals}f}"
         return display_cell(value, digits)
 
-    return shown
+    return cell
 
 
 def parse_cell(text: str):
