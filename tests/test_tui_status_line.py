@@ -96,3 +96,32 @@ async def test_the_file_tab_says_which_key_writes_missing_outputs_only_when_it_w
         await wait_until(pilot, lambda: loaded(app))
         info = str(app.query_one("#file-info").render())
         assert "Not on disk yet: forest_Scene.txt" in info and "writes them" not in info, info
+
+
+async def test_quit_during_a_run_saves_the_edits_when_asked(tmp_path, scene_files):
+    """Quit during a run, then Save for the unsaved edits: Save was refused while the
+    run was busy, so nothing was saved, the app stayed, and nothing said why."""
+    from ladartui.scenario import load_scenario
+    from ladartui.tui.unsaved import QuitRunScreen, UnsavedScreen
+    from test_tui_flow import field, type_into
+
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        capture_runs(app)  # the run never reports back: it goes on
+        app.action_show_tab("sensor")
+        await type_into(pilot, field(app, "sensor.grid"), "12")
+        await pilot.press("f5")
+        await pilot.pause()
+        assert app.run_in_progress() and app.unsaved()
+        await pilot.press("ctrl+q")
+        await pilot.pause()
+        assert isinstance(app.screen, QuitRunScreen)
+        await pilot.click("#quit-run-quit")
+        await pilot.pause()
+        assert isinstance(app.screen, UnsavedScreen)
+        await pilot.click("#unsaved-save")
+        await pilot.pause()
+        assert not app.is_running
+    assert load_scenario(scenario.path).sensor.grid == 12

@@ -62,6 +62,12 @@ class FileActions(Host):
             return
         self._save_to(None)
 
+    def save_before_leaving(self) -> None:
+        """Save, as asked when leaving with unsaved edits: also while a run goes on, which
+        quitting cancels (opening and New are refused while busy before they ask)."""
+        if self.scenario is not None and self.commit_pending():
+            self._save_to(None)
+
     def action_save_as(self) -> None:
         if self.scenario is None or self.busy or not self.commit_pending():
             return

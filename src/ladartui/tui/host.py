@@ -156,6 +156,9 @@ class AppHost(App[None]):
     def action_save(self) -> None:
         raise NotImplementedError
 
+    def save_before_leaving(self) -> None:
+        raise NotImplementedError
+
     def open_path(self, path: Path) -> None:
         raise NotImplementedError
 

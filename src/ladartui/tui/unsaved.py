@@ -161,7 +161,7 @@ class EditGuard(Host):
 
         def chosen(choice):
             if choice == "save":
-                self.action_save()
+                self.save_before_leaving()
                 if not self.unsaved():
                     then()
             elif choice == "discard":
