@@ -267,13 +267,27 @@ def _check_memory(scenario, scene) -> None:
     """Refuse, with its estimate, a scene whose tracing structures the memory cannot
     hold, as validate and run do: the views' height map (its x-y extent, one cell a
     column) is one of them, and was allocated whatever its size."""
-    from ladartui.resources import check_occupancy
+    from ladartui.errors import ResourceLimitError
+    from ladartui.resources import available_memory, check_occupancy, gib
     from ladartui.scene.occupancy import column_bounds
 
     for voxels, source in ((scene.voxels, scenario.scene_file), (scene.target, scenario.target_file)):
         if len(voxels):
             lo, last = column_bounds(voxels)  # int64: the far corner + 1 of 2**31 - 1 fits
             check_occupancy(lo, last + 1, len(voxels), str(source))
+    # The views' height map spans every column from the origin, not just the voxels'.
+    nx, ny = int(scene.shape[0]), int(scene.shape[1])
+    need = VIEW_BYTES_PER_COLUMN * nx * ny
+    if need > available_memory():
+        raise ResourceLimitError(
+            f"{scenario.scene_file}: the views' height map of {nx:,} x {ny:,} columns needs about "
+            f"{gib(need)}, more than the {gib(available_memory())} of memory available; crop the "
+            "scene to where its voxels are, or use a coarser voxel size"
+        )
+
+
+# The height map (int32) and a temporary of its size as the top view is made.
+VIEW_BYTES_PER_COLUMN = 8
 
 
 def file_seen(path: Path) -> FileSeen:
