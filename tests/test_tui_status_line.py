@@ -125,3 +125,20 @@ async def test_quit_during_a_run_saves_the_edits_when_asked(tmp_path, scene_file
         await pilot.pause()
         assert not app.is_running
     assert load_scenario(scenario.path).sensor.grid == 12
+
+
+async def test_a_scenario_changed_on_disk_is_told_once_where_the_line_cuts_it(tmp_path, scene_files):
+    """With a long file name at 80 columns the change was told twice: by the check that
+    found it, then again by the status bar, which tells a reason it cuts."""
+    from test_tui_dialogs import opened
+
+    scenario = make_scenario(tmp_path, scene_files)
+    longer = scenario.with_changes(path=tmp_path / ("a-rather-long-scenario-name-" * 2 + ".toml")).save()
+    async with opened(longer, size=(80, 24)) as (app, pilot):
+        text = longer.path.read_text(encoding="utf-8")
+        longer.path.write_text(text.replace("speed_mps = ", "speed_mps = 1"), encoding="utf-8")
+        app.check_outputs_on_disk()
+        for _ in range(10):
+            await pilot.pause()
+        told = [m for m in app.messages if "changed on disk" in m]
+        assert len(told) == 1, told

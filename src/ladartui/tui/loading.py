@@ -31,6 +31,7 @@ from ladartui.scenario_file import record_owner
 from ladartui.textsafe import visible
 from ladartui.tui import actions, bridge
 from ladartui.tui.host import Host
+from ladartui.tui.status import StatusBar
 from ladartui.tui.view_area import prepare_views
 from ladartui.tui.work import start_job
 
@@ -205,7 +206,9 @@ class SceneLoading(Host):
             return
         self.scenario_on_disk = change
         if change is not None:
-            self.tell(f"{self.scenario_file_problem()}.", severity="warning", timeout=8)
+            problem = self.scenario_file_problem()
+            self.tell(f"{problem}.", severity="warning", timeout=8)
+            self.query_one("#status", StatusBar).told = problem  # told: not again as a cut line
         self.scenario_changed()
 
     def note_scenario_saved(self) -> None:
