@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
+from typing import TypeVar
 
 from rich.markup import escape
 from textual import on
@@ -19,18 +20,25 @@ from ladartui.errors import LadarError
 from ladartui.tui.host import Host
 from ladartui.tui.params import ParamField, field_message
 
+Answer = TypeVar("Answer")
 
-class UnsavedScreen(ModalScreen[str | None]):
+
+class QuestionScreen(ModalScreen[Answer]):
+    """A question about the scenario in a warning box, its answers as buttons below."""
+
+    DEFAULT_CSS = """
+    QuestionScreen { align: center middle; }
+    QuestionScreen > Vertical { width: 60; height: auto; border: thick $warning;
+                                background: $surface; padding: 1 2; }
+    QuestionScreen Horizontal { height: auto; margin-top: 1; }
+    QuestionScreen Button { margin-right: 2; }
+    """
+
+
+class UnsavedScreen(QuestionScreen[str | None]):
     """Dismissed with "save", "discard" or None (cancel, Esc)."""
 
     BINDINGS = [Binding("escape", "cancel", "Cancel")]
-    DEFAULT_CSS = """
-    UnsavedScreen { align: center middle; }
-    UnsavedScreen > Vertical { width: 60; height: auto; border: thick $warning;
-                               background: $surface; padding: 1 2; }
-    UnsavedScreen Horizontal { height: auto; margin-top: 1; }
-    UnsavedScreen Button { margin-right: 2; }
-    """
 
     def __init__(self, name: str, doing: str, rereads: bool = False):
         """``rereads``: what is being done opens the file being edited, so saving first
@@ -63,17 +71,10 @@ class UnsavedScreen(ModalScreen[str | None]):
         self.dismiss(None)
 
 
-class QuitRunScreen(ModalScreen[bool]):
+class QuitRunScreen(QuestionScreen[bool]):
     """Dismissed with True to quit (cancelling the run), False to keep it running (Esc)."""
 
     BINDINGS = [Binding("escape", "keep", "Keep running")]
-    DEFAULT_CSS = """
-    QuitRunScreen { align: center middle; }
-    QuitRunScreen > Vertical { width: 60; height: auto; border: thick $warning;
-                               background: $surface; padding: 1 2; }
-    QuitRunScreen Horizontal { height: auto; margin-top: 1; }
-    QuitRunScreen Button { margin-right: 2; }
-    """
 
     def __init__(self, name: str, progress: float | None):
         super().__init__()
