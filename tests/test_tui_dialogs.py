@@ -180,7 +180,7 @@ async def test_markup_in_names_shows_as_typed_and_compare_reads_spaced_paths(tmp
     scenario = make_scenario(tmp_path, scene_files, name="[bold red]x y")
     async with opened(scenario) as (app, pilot):
         await app.run_action("run")
-        await wait_until(pilot, lambda: isinstance(app.screen, MeasuresScreen))
+        await wait_until(pilot, lambda: isinstance(app.screen, MeasuresScreen) and app.screen.is_mounted)
         title = app.screen.query_one(".dialog").border_title
         assert Text.from_markup(title).plain == "Comparison measures: [bold red]x y"
         await pilot.press("escape")
@@ -248,7 +248,7 @@ async def test_outputs_from_other_settings_are_said_to_be_out_of_date(tmp_path, 
     async with opened(scenario) as (app, pilot):
         bar = app.query_one(StatusBar)
         await app.run_action("run")
-        await wait_until(pilot, lambda: isinstance(app.screen, MeasuresScreen))
+        await wait_until(pilot, lambda: isinstance(app.screen, MeasuresScreen) and app.screen.is_mounted)
         await pilot.press("escape")
         await pilot.pause()
         assert bar.state == READY and "before" not in bar.message
@@ -325,7 +325,7 @@ async def test_outputs_whose_scene_model_changed_since_their_run_are_out_of_date
             f"changed since the run. The run's settings are in {scenario.name}_Run.toml."
         )
         await app.run_action("run")
-        await wait_until(pilot, lambda: isinstance(app.screen, MeasuresScreen))
+        await wait_until(pilot, lambda: isinstance(app.screen, MeasuresScreen) and app.screen.is_mounted)
         assert bar.state == READY
 
 

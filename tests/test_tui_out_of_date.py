@@ -31,7 +31,7 @@ async def test_the_measures_dialog_says_when_its_measures_are_out_of_date(tmp_pa
         )
         await pilot.press("escape")
         await app.run_action("run")  # up to date: nothing more is said
-        await wait_until(pilot, lambda: isinstance(app.screen, MeasuresScreen))
+        await wait_until(pilot, lambda: isinstance(app.screen, MeasuresScreen) and app.screen.is_mounted)
         await pilot.pause()
         assert "out of date" not in str(app.screen.query_one(".dialog").border_title)
         assert stale_note(app.screen) == ""

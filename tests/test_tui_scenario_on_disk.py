@@ -114,7 +114,7 @@ async def test_a_study_of_a_scenario_changed_on_disk_says_what_it_reads(tmp_path
         app.check_outputs_on_disk()
         await pilot.pause()
         await pilot.press("f11")
-        await wait_until(pilot, lambda: isinstance(app.screen, StudyScreen))
+        await wait_until(pilot, lambda: isinstance(app.screen, StudyScreen) and app.screen.is_mounted)
         assert app.messages[-1] == (
             "The study reads demo.toml as it is on disk, not as shown here; save (Ctrl+S) first "
             "to study what is shown."
