@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from ladartui.tui.screens import CompareScreen, FormScreen
 from test_tui_dialogs import message, opened
-from test_tui_flow import make_scenario, type_into
+from test_tui_flow import make_scenario, type_into, wait_until
 
 
 async def test_compare_reads_names_typed_in_the_folder_it_shows(tmp_path, scene_files, monkeypatch):
@@ -153,3 +153,42 @@ def load_speed(path):
     from ladartui.scenario import load_scenario
 
     return load_scenario(path).speed
+
+
+async def test_names_typed_after_up_a_folder_are_read_in_the_folder_shown(tmp_path, scene_files):
+    """'Up a folder' moved the tree and the Folder line, but names typed were still read
+    in the folder the dialog opened in; what the fields held is now put in the new
+    folder's terms, and typed names are read there."""
+    from ladartui.measures import Measures
+    from ladartui.tui.file_dialogs import SetupScreen
+
+    here = tmp_path / "here"
+    here.mkdir()
+    scenario = make_scenario(here, scene_files)
+    for name in ("a", "b"):
+        Measures(target_voxels=100, obscured_coverage=0.2, scans=10).write_cmf(here / f"{name}.cmf")
+    async with opened(scenario) as (app, pilot):
+        await pilot.press("f3")
+        await pilot.pause()
+        dialog = app.screen
+        assert isinstance(dialog, SetupScreen) and dialog.query_one("#scenario-file").value == "demo.toml"
+        dialog.query_one("#tree-up").press()
+        await pilot.pause()
+        assert str(dialog.query_one("#tree-root").render()) == f"Folder: {tmp_path}"
+        assert dialog.query_one("#scenario-file").value == "here/demo.toml"
+        dialog.query_one("#setup-ok").press()
+        await wait_until(pilot, lambda: not isinstance(app.screen, SetupScreen) and app.busy is None)
+        assert app.scenario.path == scenario.path
+        app.action_compare()
+        await pilot.pause()
+        compare = app.screen
+        assert isinstance(compare, CompareScreen)
+        field = compare.query_one("#cmf-files")
+        field.value = "a.cmf 'b.cmf'"
+        compare.query_one("#tree-up").press()
+        await pilot.pause()
+        assert field.value == "here/a.cmf here/b.cmf"
+        field.focus()
+        await pilot.press("enter")
+        await pilot.pause()
+        assert message(compare, "#compare-message") == ""

@@ -107,11 +107,36 @@ class TreeDialog(Dialog):
     def _show_root(self) -> None:
         self.query_one("#tree-root", Static).update(f"Folder: {self.folder}")
 
+    # Fields holding several paths (shell words), not one.
+    path_list_fields: frozenset[str] = frozenset()
+
     @on(Button.Pressed, "#tree-up")
     def _up(self) -> None:
+        """The tree's root goes up a folder, and names typed are read there from now on
+        (the Folder line names it): what the path fields hold is put in its terms."""
+        old = self.base
         self.folder = self.folder.parent
+        self.base = self.folder
+        for field in self.query(Input):
+            if isinstance(field.suggester, PathSuggester) and field.value.strip():
+                field.value = self._rebased(field.value, old, field.id in self.path_list_fields)
         self.query_one(FileTree).path = self.folder
         self._show_root()
+
+    def _rebased(self, text: str, old: Path, several: bool) -> str:
+        """``text`` (one path, or shell words) read in ``old``, as read in ``self.base``."""
+
+        def moved(name: str) -> str:
+            path = Path(name).expanduser()
+            return name if path.is_absolute() or name.startswith("~") else self.relative(old / path)
+
+        if not several:
+            return moved(text.strip())
+        try:
+            words = shlex.split(text)
+        except ValueError:  # an open quote: left as typed, and said on Enter
+            return text
+        return shlex.join(moved(word) for word in words)
 
     def relative(self, path: Path) -> str:
         try:
@@ -352,6 +377,8 @@ class MeasuresScreen(Dialog):
 
 class CompareScreen(TreeDialog):
     """Two or more scenarios' measures (.cmf files) side by side, differences highlighted."""
+
+    path_list_fields = frozenset({"cmf-files"})
 
     def __init__(self, paths: list[Path], folder: Path | None = None):
         super().__init__()
