@@ -147,7 +147,7 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
         target, ids = load_target(target_path)
         text = f"{target_path.name}: {plural(len(target), 'voxel')}"
         if len(target):
-            inside = _count_inside(target, voxels)
+            inside = count_inside(target, voxels)
             text += f", {inside:,} of them in the scene; {_targets_text(ids)}"
             centre = target.mean(axis=0)
             text += f"; centre ({centre[0]:.1f}, {centre[1]:.1f}, {centre[2]:.1f}) voxels"
@@ -196,7 +196,8 @@ def _targets_text(ids) -> str:
     return f"{len(distinct)} targets (ids {shown})"
 
 
-def _count_inside(target, voxels) -> int:
+def count_inside(target, voxels) -> int:
+    """How many of the ``target`` rows are voxels of ``voxels`` (info's and validate's count)."""
     import numpy as np
 
     from ladartui.errors import FieldError

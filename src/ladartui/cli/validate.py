@@ -189,22 +189,14 @@ def scene_summary(scenario, scene) -> list[str]:
 def target_notes(scenario, scene) -> list[str]:
     """Notes on a target model that will not give measures: empty, or voxels that the
     scene model lacks (a target voxel is part of the scene: the scene run sees it there)."""
-    import numpy as np
 
-    from ladartui.errors import FieldError
+    from ladartui.cli.info import count_inside
     from ladartui.number_text import plural
-    from ladartui.scene.keys import member, sorted_unique, voxel_keys
 
     name = scenario.target_file.name
     if not len(scene.target):
         return [f"note       {name} holds no voxels: the target measures will be undefined"]
-    try:
-        inside = member(
-            voxel_keys(scene.target), sorted_unique(voxel_keys(scene.voxels))
-        )  # not np.isin: slow
-        missing = int(np.count_nonzero(~inside))
-    except FieldError:  # indices beyond the keys' range: the memory check speaks for those
-        return []
+    missing = len(scene.target) - count_inside(scene.target, scene.voxels)
     if not missing:
         return []
     is_, them = ("is", "it") if missing == 1 else ("are", "them")
