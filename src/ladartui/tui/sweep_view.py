@@ -78,17 +78,16 @@ def column_formats(ranking, parameter_names) -> dict:
     return formats
 
 
-def ranking_cells(entry, objective: str, parameter_names, errors: bool, formats=None) -> list:
+def ranking_cells(entry, objective: str, parameter_names, errors: bool, formats: dict) -> list:
     """One table row: rank, mark (``row_mark``), objective, (coverage), cost, status, parameters,
     variant and (with ``errors``) error; text from the results file is never markup.
-    ``formats``: ``column_formats`` of the whole ranking (else each cell its own figures)."""
-    formats = formats or {}
+    ``formats``: ``column_formats`` of the whole ranking."""
     row = entry.row
     status = row.get("status") or "?"
     if objective == "obscured-coverage":
         value = "-" if entry.value is None else f"{100 * entry.value:.2f}%"
     else:
-        value = formats.get("value", display_cell)(entry.value)
+        value = formats["value"](entry.value)
     cells = [
         "-" if entry.rank is None else str(entry.rank),
         row_mark(entry),
@@ -96,9 +95,9 @@ def ranking_cells(entry, objective: str, parameter_names, errors: bool, formats=
     ]
     if objective != "obscured-coverage":
         cells.append("-" if entry.coverage is None else f"{100 * entry.coverage:.2f}")
-    cells.append(Text(formats.get("cost", display_cell)(entry.cost)))
+    cells.append(Text(formats["cost"](entry.cost)))
     cells.append(Text(status, style="green" if status == "ok" else "bold red"))
-    cells.extend(Text(formats.get(name, display_cell)(row.get(name))) for name in parameter_names)
+    cells.extend(Text(formats[name](row.get(name))) for name in parameter_names)
     cells.append(Text(str(row.get("variant") or "")))
     if errors:
         error = str(row.get("error") or "")
