@@ -99,11 +99,23 @@ def test_top_height_map_against_a_dense_grid():
             if len(filled):
                 expected[x, y] = filled.max()
     np.testing.assert_array_equal(top_height_map(voxels, 30, 20), expected)
+    origin = (1000, 2000)
+    shifted = voxels + [*origin, 0]
+    np.testing.assert_array_equal(top_height_map(shifted, 30, 20, origin), expected)
+
+
+def test_column_tops_span_the_voxels_own_columns():
     scene = Scene(SCENE, TARGET, 1.0)
-    heights = scene.top_height_map()
-    assert heights.shape == (10, 4)
+    origin, heights = scene.column_tops()
+    assert origin == (0, 0) and heights.shape == (10, 4)
     assert heights[4, 1] == 7 and heights[0, 0] == 0 and heights[1, 1] == -1
-    assert scene.top_height_map(target=True)[4, 1] == 2
+    origin, heights = scene.column_tops(target=True)  # columns x 2..4, y 1..3
+    assert origin == (2, 1) and heights.shape == (3, 3)
+    assert heights[2, 0] == 2 and heights[0, 2] == 5 and (heights >= 0).sum() == 2
+    far = Scene(SCENE + [5_000_000, 9, 0], TARGET + [5_000_000, 9, 0], 1.0)
+    origin, heights = far.column_tops()
+    assert origin == (5_000_000, 9) and heights.shape == (10, 4) and heights[4, 1] == 7
+    assert Scene(SCENE[:0], TARGET[:0], 1.0).column_tops()[1].tolist() == [[-1]]
 
 
 def test_occupancy_is_built_once_and_matches_the_lists():
@@ -148,4 +160,4 @@ def test_scene_survives_pickling():
     np.testing.assert_array_equal(copy.voxels, SCENE)
     np.testing.assert_array_equal(copy.target, TARGET)
     assert (copy.shape, copy.voxel_size, copy.name) == ((10, 4, 20), 0.5, "p")
-    np.testing.assert_array_equal(copy.top_height_map(), scene.top_height_map())
+    np.testing.assert_array_equal(copy.column_tops()[1], scene.column_tops()[1])

@@ -37,11 +37,31 @@ async def test_a_scene_too_large_for_memory_is_refused_with_its_estimate(tmp_pat
     assert f"{scene}: 2 voxels spanning" in said and "crop the scene or use a coarser voxel size" in said
 
 
-async def test_a_small_scene_far_from_the_origin_is_refused_for_its_views(tmp_path, scene_files, monkeypatch):
-    """Two neighbouring voxels 40 million voxels from the origin: the tracing structures
-    follow the voxels and fit, but the views' height map spans every column from the
-    origin (160 MB here), and was allocated unchecked."""
-    voxels = [[40_000_000, 0, 0], [40_000_001, 0, 0]]
-    said, scene = await refusal_on_opening(tmp_path, scene_files, monkeypatch, voxels, 100 * 10**6)
-    assert f"{scene}: the views' height map of 40,000,002 x 1 columns needs about" in said
-    assert "crop the scene to where its voxels are, or use a coarser voxel size" in said
+async def test_a_small_scene_far_from_the_origin_opens_with_views_on_its_voxels(tmp_path, scene_files):
+    """Two neighbouring voxels 40 million voxels from the origin: the views' height map
+    spanned every column from the origin (320 MB here) and such a scene was refused
+    under a memory limit that run traces it in. The map now spans the voxels' columns."""
+    from ladartui.tui.canvas import TopViewWidget
+
+    scenario = make_scenario(tmp_path, scene_files)
+    voxels = np.array([[40_000_000, 7, 0], [40_000_001, 7, 3]], np.int32)
+    save_voxels(tmp_path / "far.txt", voxels)
+    save_voxels(tmp_path / "far_Target.txt", voxels[:1])
+    far = scenario.with_changes(path=tmp_path / "far.toml", scene_file=tmp_path / "far.txt").save()
+    async with opened(far, size=(80, 24)) as (app, pilot):
+        top = app.query_one(TopViewWidget).top
+        assert top.heights.shape == (2, 1) and top.heights.tolist() == [[0], [3]]
+        assert top.scene_frame() == (40_000_000.0, 7.0, 40_000_002.0, 8.0)
+        lo, hi = app.query_one("#views").prepared["bounds"]
+        assert lo.tolist() == [40_000_000, 7, 0] and hi.tolist() == [40_000_001, 7, 3]
+
+
+async def test_a_scene_whose_views_cannot_be_held_is_refused_with_their_estimate(
+    tmp_path, scene_files, monkeypatch
+):
+    """Two voxels at opposite corners of a flat 20,001 x 20,001 column square: the tracing
+    structures fit in 1 GB, the views' height map (8 bytes a column, 3.2 GB) does not."""
+    voxels = [[0, 0, 0], [20_000, 20_000, 0]]
+    said, scene = await refusal_on_opening(tmp_path, scene_files, monkeypatch, voxels, 10**9)
+    assert f"{scene}: the views' height map of 20,001 x 20,001 columns needs about" in said
+    assert "crop the scene or use a coarser voxel size" in said

@@ -55,6 +55,34 @@ def test_top_view_downsampling_keeps_the_highest_voxel_of_each_block():
     assert tuple(pic.rgb[0, 1]) == views.GROUND_RGB
 
 
+def test_a_map_far_from_the_origin_draws_as_it_would_at_the_origin():
+    """The map spans the voxels' own columns from ``origin``; its scene frame is
+    theirs, and every pixel, over the scene or over a frame past its edges, is what
+    the same map at the origin draws in the frame shifted back."""
+    origin = (3_000_000, 41)
+    near, far = TopView(_heights(), 0.5), TopView(_heights(), 0.5, origin=origin)
+    assert far.scene_frame() == (3_000_000.0, 41.0, 3_000_012.0, 49.0)
+    for frame in (None, (-5.0, -3.0, 9.0, 6.0)):
+        shifted = None if frame is None else np.add(frame, [*origin, *origin]).tolist()
+        a, b = near.scene_layer(6, 10, frame), far.scene_layer(6, 10, shifted)
+        assert a.mask.any() and not a.mask.all()  # letterboxed, or past the edges
+        np.testing.assert_array_equal(a.rgb, b.rgb)
+        np.testing.assert_array_equal(a.mask, b.mask)
+
+
+def test_the_ground_plane_beyond_the_maps_columns_is_drawn_as_ground():
+    """Tracing returns ground over [0, nx) x [0, ny) from the origin; the map spans only
+    the voxels' columns, so the rest of that plane is drawn as bare ground, and what
+    lies past it (a miss) is not drawn."""
+    top = TopView(_heights(), 1.0, origin=(100, 0), ground=(112, 8))
+    pic = top.scene_layer(8, 24, (88.0, 0.0, 124.0, 12.0))  # 1.5 cells a pixel
+    ground = (pic.rgb == np.array(views.GROUND_RGB, np.uint8)).all(axis=2) & pic.mask
+    assert ground[6, 0] and ground[6, 7]  # x 88.75 and 99.25: the plane west of the map
+    assert not pic.mask[6, 16] and not pic.mask[6, 23]  # x 112.75 on: past the plane
+    assert not pic.mask[0, 4]  # y 11.25: north of the plane
+    assert tuple(pic.rgb[4, 9]) == tuple(views.height_ramp()[-1])  # x 101..103, y 4..6: the tall column
+
+
 def test_top_view_letterboxes_a_wide_scene_and_leaves_the_margin_undrawn():
     top = TopView(np.zeros((10, 5), np.int32))
     pic = top.scene_layer(10, 10)  # 10 x 5 scene into 10 x 10 pixels: rows 2.5..7.5 drawn
@@ -177,6 +205,7 @@ def test_surface_points_follow_the_height_map():
     h[1, 2] = 7
     pts = views.surface_points(h)
     assert pts.tolist() == [[1, 2, 7]]
+    assert views.surface_points(h, origin=(500, 60)).tolist() == [[501, 62, 7]]
 
 
 def test_half_block_cells_pair_rows_and_pad_an_odd_last_row():

@@ -96,8 +96,9 @@ class TopView:
     """The height-shaded top view of a scene, with a cached scene layer.
 
     ``heights`` is the scene's top height map, (nx, ny) voxel layers with a
-    negative value where a column is empty (bare ground); ``voxel_size``
-    converts metres to voxels. A *frame* is the window shown, in cell units
+    negative value where a column is empty (bare ground), whose entry (0, 0)
+    is column ``origin`` (the map spans the voxels' columns, not the grid from
+    (0, 0)); ``voxel_size`` converts metres to voxels. A *frame* is the window shown, in cell units
     (x0, y0, x1, y1) where voxel i spans [i, i + 1); by default the scene's
     extent. Overlays (flight path, scans, footprints) are drawn on a copy of
     the cached layer, so changing parameters never re-renders the scene; only
@@ -106,6 +107,10 @@ class TopView:
 
     heights: np.ndarray
     voxel_size: float = 1.0
+    origin: tuple[int, int] = (0, 0)  # the column of heights[0, 0]
+    # The ground plane's (nx, ny) from (0, 0), drawn as bare ground where the map
+    # holds no columns (None: the map's own columns only).
+    ground: tuple[int, int] | None = None
     target_columns: np.ndarray | None = None  # (K, 2) voxel x, y of target voxels
     target_column_rgb: np.ndarray | None = None  # (K, 3) colour of each (default TARGET_RGB)
     colour_map: str = "height"  # or "grey": the report's 56 shades
@@ -118,7 +123,8 @@ class TopView:
 
     def scene_frame(self) -> tuple[float, float, float, float]:
         nx, ny = self.extent
-        return (0.0, 0.0, float(nx), float(ny))
+        x0, y0 = (float(v) for v in self.origin)
+        return (x0, y0, x0 + nx, y0 + ny)
 
     def frame_for(self, xy_metres=None, margin: float = 0.05) -> tuple[float, float, float, float]:
         """A frame holding the scene and the given points (metres), padded by ``margin``.
@@ -191,13 +197,18 @@ class TopView:
         y_hi = np.maximum(np.floor(fy1 - (r - off_r) * scale).astype(np.int64), y_lo + 1)
         centre_x = fx0 + (c + 0.5 - off_c) * scale
         centre_y = fy1 - (r + 0.5 - off_r) * scale
-        inside_c = (centre_x >= 0) & (centre_x < nx)
-        inside_r = (centre_y >= 0) & (centre_y < ny)
-        inside = inside_r[:, None] & inside_c[None, :]
+        if self.ground is not None:
+            on_ground = (
+                _within(centre_y, 0, self.ground[1])[:, None] & _within(centre_x, 0, self.ground[0])[None, :]
+            )
+            picture.rgb[on_ground] = GROUND_RGB
+            picture.mask[on_ground] = True
+        ox, oy = self.origin
+        inside = _within(centre_y, oy, oy + ny)[:, None] & _within(centre_x, ox, ox + nx)[None, :]
         if not inside.any():
             return picture
         heights = self.heights
-        pooled = _block_max(heights, x_lo, x_hi, y_lo, y_hi)
+        pooled = _block_max(heights, x_lo - ox, x_hi - ox, y_lo - oy, y_hi - oy)
         top = max(int(heights.max()), 1)
         ramp = colour_map(self.colour_map)
         shade = ramp[shade_indices(pooled, 0, top, len(ramp))]
@@ -256,6 +267,10 @@ class TopView:
             draw_points(picture, pix, SCAN_RGB)
             draw_points(picture, pix[:1], START_RGB)
         return picture
+
+
+def _within(centres, lo: float, hi: float) -> np.ndarray:
+    return (centres >= lo) & (centres < hi)
 
 
 def _block_max(heights, x0, x1, y_lo, y_hi):
@@ -397,17 +412,19 @@ def subsample(voxels, limit: int, seed: int = 0) -> np.ndarray:
     return voxels[chosen]
 
 
-def surface_points(heights: np.ndarray, limit: int = 250_000) -> np.ndarray:
+def surface_points(heights: np.ndarray, limit: int = 250_000, origin=(0, 0)) -> np.ndarray:
     """Top surface voxels (x, y, top z) from a height map, strided to at most ``limit``.
 
     The canopy top is what an overhead view sees; adding it to a random voxel
-    sample keeps the 3D scene view solid at any sample size.
+    sample keeps the 3D scene view solid at any sample size. ``origin`` is the
+    column of ``heights[0, 0]``.
     """
     heights = np.asarray(heights)
     stride = max(1, int(np.ceil(np.sqrt(heights.size / max(limit, 1)))))
     sub = heights[::stride, ::stride]
     xs, ys = np.nonzero(sub >= 0)
-    return np.stack([xs * stride, ys * stride, sub[xs, ys]], axis=1).astype(np.int32)
+    x, y = xs * stride + origin[0], ys * stride + origin[1]
+    return np.stack([x, y, sub[xs, ys]], axis=1).astype(np.int32)
 
 
 def threshold_points(voxels, voxel_size: float, max_height_m: float | None) -> np.ndarray:

@@ -152,9 +152,21 @@ class Scene:
             raise LadarError(f"scene {self.name!r} has no target voxels{where}")
         return self.target.astype(np.float64).mean(axis=0) * self.voxel_size
 
-    def top_height_map(self, target=False) -> np.ndarray:
-        """(nx, ny) int32: highest occupied z in each column, -1 where empty."""
-        return top_height_map(self.target if target else self.voxels, self.shape[0], self.shape[1])
+    def column_tops(self, target=False) -> tuple[tuple[int, int], np.ndarray]:
+        """The highest occupied z of each column the voxels span: ``(origin, heights)``.
+
+        ``heights`` is (nx, ny) int32, -1 where a column is empty, and covers the
+        voxels' own x-y extent from column ``origin``, not the grid from (0, 0): a
+        small scene far from the origin costs what it holds. An empty list gives
+        one empty column at (0, 0).
+        """
+        voxels = self.target if target else self.voxels
+        if not len(voxels):
+            return (0, 0), np.full((1, 1), -1, np.int32)
+        lo, hi = column_bounds(voxels)
+        origin = (int(lo[0]), int(lo[1]))
+        nx, ny = int(hi[0] - lo[0]) + 1, int(hi[1] - lo[1]) + 1
+        return origin, top_height_map(voxels, nx, ny, origin)
 
     def __repr__(self):
         return (
@@ -163,8 +175,9 @@ class Scene:
         )
 
 
-def top_height_map(voxels, nx, ny) -> np.ndarray:
-    """(nx, ny) int32 of the highest occupied z per column, -1 for an empty column.
+def top_height_map(voxels, nx, ny, origin=(0, 0)) -> np.ndarray:
+    """(nx, ny) int32 of the highest occupied z per column, -1 for an empty column;
+    entry (i, j) is column (origin x + i, origin y + j), and every voxel must fall in.
 
     One pass over the voxel list: memory is the map itself, never nx*ny*nz.
     Plain numpy (0.06 s for 3.8 M voxels): a numba kernel here would put
@@ -173,7 +186,8 @@ def top_height_map(voxels, nx, ny) -> np.ndarray:
     voxels = np.asarray(voxels)
     heights = np.full((int(nx), int(ny)), -1, dtype=np.int32)
     if len(voxels):
-        np.maximum.at(heights, (voxels[:, 0], voxels[:, 1]), voxels[:, 2].astype(np.int32))
+        columns = (voxels[:, 0] - origin[0], voxels[:, 1] - origin[1])
+        np.maximum.at(heights, columns, voxels[:, 2].astype(np.int32))
     return heights
 
 

@@ -268,24 +268,27 @@ def _load(path: Path | None, scenario) -> Loaded:
 
 def _check_memory(scenario, scene) -> None:
     """Refuse, with its estimate, a scene whose tracing structures the memory cannot
-    hold, as validate and run do: the views' height map (its x-y extent, one cell a
-    column) is one of them, and was allocated whatever its size."""
+    hold, as validate and run do, and one whose views' height map (one cell a
+    column over the voxels' x-y extent) it cannot hold."""
     from ladartui.errors import ResourceLimitError
     from ladartui.resources import available_memory, check_occupancy, gib
     from ladartui.scene.occupancy import column_bounds
 
+    spans = []
     for voxels, source in ((scene.voxels, scenario.scene_file), (scene.target, scenario.target_file)):
         if len(voxels):
             lo, last = column_bounds(voxels)  # int64: the far corner + 1 of 2**31 - 1 fits
             check_occupancy(lo, last + 1, len(voxels), str(source))
-    # The views' height map spans every column from the origin, not just the voxels'.
-    nx, ny = int(scene.shape[0]), int(scene.shape[1])
+            spans.append(last - lo + 1)
+    if not spans:
+        return
+    nx, ny = int(spans[0][0]), int(spans[0][1])  # the map spans the scene's voxels
     need = VIEW_BYTES_PER_COLUMN * nx * ny
     if need > available_memory():
         raise ResourceLimitError(
             f"{scenario.scene_file}: the views' height map of {nx:,} x {ny:,} columns needs about "
-            f"{gib(need)}, more than the {gib(available_memory())} of memory available; crop the "
-            "scene to where its voxels are, or use a coarser voxel size"
+            f"{gib(need)}, more than the {gib(available_memory())} of memory available; its "
+            "voxels spread too far apart for the views: crop the scene or use a coarser voxel size"
         )
 
 

@@ -35,14 +35,23 @@ LAYOUTS = {
 
 def prepare_views(scene) -> dict:
     """View data that depends only on the scene: top view, 3D sample, bounds (worker thread)."""
-    heights = scene.top_height_map()
+    origin, heights = scene.column_tops()
     columns, column_rgb = views.target_columns(scene.target, scene.target_ids)
-    top = views.TopView(heights, scene.voxel_size, target_columns=columns, target_column_rgb=column_rgb)
+    top = views.TopView(
+        heights,
+        scene.voxel_size,
+        origin=origin,
+        ground=(scene.shape[0], scene.shape[1]),
+        target_columns=columns,
+        target_column_rgb=column_rgb,
+    )
     sample = views.subsample(scene.voxels, SCENE_POINTS, seed=0)
-    points = np.concatenate([sample, views.surface_points(heights, SCENE_POINTS // 3)])
-    nx, ny, nz = scene.shape
-    top_z = int(heights.max()) if heights.size and heights.max() >= 0 else nz - 1
-    bounds = (np.zeros(3), np.array([nx - 1, ny - 1, max(top_z, 1)], float))
+    points = np.concatenate([sample, views.surface_points(heights, SCENE_POINTS // 3, origin)])
+    top_z = int(heights.max()) if heights.max() >= 0 else scene.shape[2] - 1
+    # the voxels' own columns, heights from the ground (z = 0) up
+    x0, y0 = origin
+    nx, ny = heights.shape
+    bounds = (np.array([x0, y0, 0.0]), np.array([x0 + nx - 1, y0 + ny - 1, max(top_z, 1)], float))
     top.scene_layer(48, 96)  # warm the cache at a typical size
     return {
         "top": top,
