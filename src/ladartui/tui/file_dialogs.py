@@ -22,7 +22,7 @@ from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField, in_label_unit, refusal
 from ladartui.tui.file_tree import SCENARIO_TABLE
 from ladartui.tui.host import host_of
-from ladartui.tui.screens import PathSuggester, TreeDialog, _row
+from ladartui.tui.screens import TreeDialog, _row
 
 SCENARIO_SUFFIXES = (".toml",)
 SCENE_SUFFIXES = (".txt", ".las", ".laz")
@@ -58,7 +58,7 @@ class SetupScreen(TreeDialog):
                     placeholder="name.toml",
                     id="scenario-file",
                     compact=True,
-                    suggester=PathSuggester(SCENARIO_SUFFIXES),
+                    suggester=self.path_suggester(SCENARIO_SUFFIXES),
                 ),
             )
             yield _row(
@@ -67,7 +67,7 @@ class SetupScreen(TreeDialog):
                     placeholder="scene.txt",
                     id="scene-file",
                     compact=True,
-                    suggester=PathSuggester(SCENE_SUFFIXES),
+                    suggester=self.path_suggester(SCENE_SUFFIXES),
                 ),
             )
             yield _row(
@@ -196,7 +196,7 @@ class SaveAsScreen(TreeDialog):
                     self.current.name,
                     id="save-as-file",
                     compact=True,
-                    suggester=PathSuggester(SCENARIO_SUFFIXES),
+                    suggester=self.path_suggester(SCENARIO_SUFFIXES),
                 ),
             )
             yield Static("Outputs are named after the scenario and sit beside it.", classes="info")
@@ -270,7 +270,9 @@ class PickPathScreen(TreeDialog):
         with Vertical(classes="dialog", id="pick") as box:
             box.border_title = self.title_text
             yield from self.tree_rows(self.suffixes)
-            yield _row("Path", Input(id="pick-path", compact=True, suggester=PathSuggester(self.suffixes)))
+            yield _row(
+                "Path", Input(id="pick-path", compact=True, suggester=self.path_suggester(self.suffixes))
+            )
             yield Static("", id="pick-message", classes="message", markup=False)
             with Horizontal(classes="buttons"):
                 yield Button("OK", id="pick-ok", variant="primary", compact=True)

@@ -4,7 +4,9 @@ tree; the pose editor is tui/poses_screen.py, the file dialogs tui/file_dialogs.
 
 from __future__ import annotations
 
+import os
 import shlex
+from collections.abc import Callable
 from pathlib import Path
 
 from rich.markup import escape
@@ -27,30 +29,38 @@ from ladartui.tui.measures_view import comparison_rows, level_rows, measure_rows
 
 
 class PathSuggester(Suggester):
-    """Completes file paths from what exists on disk."""
+    """Completes the path being typed from what exists on disk.
 
-    def __init__(self, suffixes: tuple[str, ...] = ()):
+    A relative path is read in ``base()``, the folder its dialog reads typed names
+    in (the working folder by default); in a field of ``several`` paths the last
+    word is completed.
+    """
+
+    def __init__(
+        self, suffixes: tuple[str, ...] = (), base: Callable[[], Path] = Path.cwd, several: bool = False
+    ):
         super().__init__(use_cache=False, case_sensitive=True)
         self.suffixes = suffixes
+        self.base = base
+        self.several = several
 
     async def get_suggestion(self, value: str) -> str | None:
-        if not value:
+        word = value[value.rfind(" ") + 1 :] if self.several else value
+        if not word:
             return None
-        path = Path(value).expanduser()
-        folder = path if value.endswith("/") else path.parent
-        stem = "" if value.endswith("/") else path.name
+        folder_text, stem = os.path.split(word)  # "sub/" -> ("sub", ""); "." -> ("", ".")
+        folder = Path(folder_text or ".").expanduser()
         try:
             names = sorted(
                 p.name + ("/" if p.is_dir() else "")
-                for p in folder.iterdir()
+                for p in (folder if folder.is_absolute() else self.base() / folder).iterdir()
                 if p.name.startswith(stem) and not p.name.startswith(".")
             )
         except OSError:
             return None
         for name in names:
             if name.endswith("/") or not self.suffixes or name.endswith(self.suffixes):
-                prefix = value if value.endswith("/") else value[: len(value) - len(stem)]
-                return prefix + name
+                return value + name[len(stem) :]
         return None
 
 
@@ -107,9 +117,6 @@ class TreeDialog(Dialog):
     def _show_root(self) -> None:
         self.query_one("#tree-root", Static).update(f"Folder: {self.folder}")
 
-    # Fields holding several paths (shell words), not one.
-    path_list_fields: frozenset[str] = frozenset()
-
     @on(Button.Pressed, "#tree-up")
     def _up(self) -> None:
         """The tree's root goes up a folder, and names typed are read there from now on
@@ -119,7 +126,7 @@ class TreeDialog(Dialog):
         self.base = self.folder
         for field in self.query(Input):
             if isinstance(field.suggester, PathSuggester) and field.value.strip():
-                field.value = self._rebased(field.value, old, field.id in self.path_list_fields)
+                field.value = self._rebased(field.value, old, field.suggester.several)
         self.query_one(FileTree).path = self.folder
         self._show_root()
 
@@ -137,6 +144,10 @@ class TreeDialog(Dialog):
         except ValueError:  # an open quote: left as typed, and said on Enter
             return text
         return shlex.join(moved(word) for word in words)
+
+    def path_suggester(self, suffixes: tuple[str, ...], several: bool = False) -> PathSuggester:
+        """Completion read in the folder this dialog reads typed names in."""
+        return PathSuggester(suffixes, lambda: self.base, several)
 
     def relative(self, path: Path) -> str:
         try:
@@ -378,8 +389,6 @@ class MeasuresScreen(Dialog):
 class CompareScreen(TreeDialog):
     """Two or more scenarios' measures (.cmf files) side by side, differences highlighted."""
 
-    path_list_fields = frozenset({"cmf-files"})
-
     def __init__(self, paths: list[Path], folder: Path | None = None):
         super().__init__()
         self.paths = list(paths)
@@ -401,7 +410,7 @@ class CompareScreen(TreeDialog):
                     shlex.join(self.relative(p) for p in self.paths),  # in the folder: by name
                     id="cmf-files",
                     compact=True,
-                    suggester=PathSuggester((".cmf",)),
+                    suggester=self.path_suggester((".cmf",), several=True),
                 ),
             )
             yield from self.tree_rows((".cmf",))
