@@ -126,9 +126,9 @@ def test_validate_names_an_output_a_run_would_refuse_to_write(scenario, capsys):
     again', and a run refused it; before a first run, an S_Scene.txt folder went unsaid."""
     scenario.scene_output.mkdir()
     assert main(["validate", str(scenario.path)]) == 0
-    lines = [x for x in capsys.readouterr().out.splitlines() if x.startswith("last run")]
+    lines = [x for x in capsys.readouterr().out.splitlines() if x.startswith(("last run", "next run"))]
     assert lines == [
-        "last run   S_Scene.txt is a folder, expected a file name: a run is refused before it traces"
+        "next run   S_Scene.txt is a folder, expected a file name: it is refused before it traces"
     ]
     scenario.scene_output.rmdir()
     assert main(["run", str(scenario.path)]) == 0
@@ -136,10 +136,41 @@ def test_validate_names_an_output_a_run_would_refuse_to_write(scenario, capsys):
     scenario.measures_file.mkdir()
     capsys.readouterr()
     assert main(["validate", str(scenario.path)]) == 0
-    lines = [x for x in capsys.readouterr().out.splitlines() if x.startswith("last run")]
-    assert lines == ["last run   S.cmf is a folder, expected a file name: a run is refused before it traces"]
+    lines = [x for x in capsys.readouterr().out.splitlines() if x.startswith(("last run", "next run"))]
+    assert lines == [
+        "last run   outputs incomplete: S.cmf missing",
+        "next run   S.cmf is a folder, expected a file name: it is refused before it traces",
+    ]
     assert main(["run", str(scenario.path)]) == 2
     assert "S.cmf: is a folder, expected a file name" in capsys.readouterr().err
+
+
+def test_validate_says_whether_outputs_it_cannot_replace_are_up_to_date(scenario, capsys, monkeypatch):
+    """An output a run cannot write (a read-only folder) was said in place of whether the
+    outputs on disk came from this file's settings, which still matters to read them."""
+    from ladartui import outputset
+
+    assert main(["run", str(scenario.path)]) == 0
+    capsys.readouterr()
+    real = outputset.output_problem
+    monkeypatch.setattr(
+        outputset,
+        "output_problem",
+        lambda path: "cannot be written (permission denied)" if path.name == "S_Scene.txt" else real(path),
+    )
+    assert main(["validate", str(scenario.path)]) == 0
+    lines = [x for x in capsys.readouterr().out.splitlines() if x.startswith(("last run", "next run"))]
+    assert lines == [
+        "last run   made the outputs with this file's settings (S_Run.toml)",
+        "next run   S_Scene.txt cannot be written (permission denied): it is refused before it traces",
+    ]
+    scenario.measures_file.unlink()  # incomplete: but a run would not write the set again
+    assert main(["validate", str(scenario.path)]) == 0
+    lines = [x for x in capsys.readouterr().out.splitlines() if x.startswith(("last run", "next run"))]
+    assert lines == [
+        "last run   outputs incomplete: S.cmf missing",
+        "next run   S_Scene.txt cannot be written (permission denied): it is refused before it traces",
+    ]
 
 
 def test_a_step_flag_on_an_exact_run_does_not_make_its_outputs_out_of_date(scenario):

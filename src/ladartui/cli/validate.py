@@ -82,25 +82,33 @@ def detection_notes(scenario) -> list[str]:
 
 def last_run_lines(scenario, scene) -> list[str]:
     """Whether the outputs on disk came from this file's settings and its model files as
-    they are now (``scene``, as just loaded), from the run record."""
-    from ladartui.errors import LadarError
-    from ladartui.outputset import journal_path, output_problem
-    from ladartui.run_record import earlier_las, missing_outputs, read_run_record, setting_changes
+    they are now (``scene``, as just loaded), from the run record; then an output the
+    next run would refuse to write, as a run checks them before tracing."""
+    from ladartui import outputset
     from ladartui.simulation import output_lock, output_paths
 
-    if journal_path(output_lock(scenario)).exists():  # a swap a killed run left (outputset)
+    if outputset.journal_path(output_lock(scenario)).exists():  # a swap a killed run left
         return [
             "last run   was stopped while it replaced the outputs: the next run puts the earlier set "
             "back first, so the files now on disk are not to be read"
         ]
-    for path in output_paths(scenario).values():  # as a run checks them before tracing
-        problem = output_problem(path)
-        if problem:
-            return [f"last run   {path.name} {problem}: a run is refused before it traces"]
+    refusals = [
+        f"next run   {path.name} {problem}: it is refused before it traces"
+        for path in output_paths(scenario).values()
+        if (problem := outputset.output_problem(path))
+    ]
+    return _earlier_outputs(scenario, scene, writable=not refusals) + refusals[:1]
+
+
+def _earlier_outputs(scenario, scene, writable: bool) -> list[str]:
+    from ladartui.errors import LadarError
+    from ladartui.run_record import earlier_las, missing_outputs, read_run_record, setting_changes
+
     missing = missing_outputs(scenario)
     if missing:
         names = ", ".join(path.name for path in missing)
-        return [f"last run   outputs incomplete: {names} missing; a run writes the whole set again"]
+        advice = "; a run writes the whole set again" if writable else ""
+        return [f"last run   outputs incomplete: {names} missing{advice}"]
     if not scenario.measures_file.is_file():
         return []  # not run yet
     record = scenario.run_record.name
