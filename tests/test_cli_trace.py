@@ -487,3 +487,15 @@ def test_a_long_trace_shows_its_progress_in_blocks_of_rays(tmp_path, scene_file,
     assert np.array_equal(np.load(deep / "blocks.npy"), np.load(tmp_path / "whole.npy"), equal_nan=True)
     assert "5/5 rays" in terminal.getvalue() and "writing blocks.npy" in terminal.getvalue()
     assert capsys.readouterr().err.startswith("5 rays (numba, exact, f64)")
+
+    def last_block_in_f32(occupancy, origins, directions, **kwargs):
+        # as auto may choose by block: a GPU's f32 for one, numba's f64 for another
+        result = real_trace(occupancy, origins, directions, **kwargs)
+        if len(origins) == 1:
+            result.info["precision"] = "f32"
+        return result
+
+    monkeypatch.setattr(tracing, "trace", last_block_in_f32)
+    assert main([*command, "--out", str(deep / "mixed.npy")]) == 0
+    # the summary gave the last block's precision as the whole run's: "f32, not the f64 asked for"
+    assert capsys.readouterr().err.startswith("5 rays (numba, exact, f64 for 4 rays, f32 for 1)")

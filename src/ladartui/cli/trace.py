@@ -246,9 +246,9 @@ def _trace_and_write(args, voxel_size: float) -> None:
     counts = np.bincount(np.concatenate([result.kind for result in results]), minlength=3)
     result = results[-1]
     backends = ", ".join(dict.fromkeys(r.backend for r in results))  # auto may choose by block
-    used = result.info.get("precision", args.precision)
-    if used != args.precision:  # a backend without the arithmetic asked for
-        used += f", not the {args.precision} asked for"
+    used = _precisions_used(
+        [(r.info.get("precision", args.precision), len(r.kind)) for r in results], args.precision
+    )
     size = f"voxel size {voxel_size:g} m" + (
         " (assumed; --voxel-size sets it)" if args.voxel_size is None else ""
     )
@@ -259,3 +259,16 @@ def _trace_and_write(args, voxel_size: float) -> None:
         ),
         file=sys.stderr,
     )
+
+
+def _precisions_used(blocks: list[tuple[str, int]], asked: str) -> str:
+    """ "f64", or where blocks went to backends of different arithmetic (auto chooses
+    by block) each with its rays: "f64 for 4 rays, f32 for 1"; then whether a backend
+    lacked the arithmetic asked for."""
+    rays: dict[str, int] = {}
+    for precision, count in blocks:
+        rays[precision] = rays.get(precision, 0) + count
+    (first, count), *rest = rays.items()
+    text = first if not rest else f"{first} for {plural(count, 'ray')}"
+    text = ", ".join([text, *(f"{precision} for {n:,}" for precision, n in rest)])
+    return text if asked in rays else f"{text}, not the {asked} asked for"
