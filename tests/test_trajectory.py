@@ -41,6 +41,16 @@ def test_headings_and_roll_interpolate_along_the_shortest_arc(tmp_path):
     assert roll[0] == pytest.approx(0.0) and pitch[0] == 0.0
 
 
+def test_roll_across_180_degrees_comes_back_between_minus_180_and_180(tmp_path):
+    """Interpolated along the shortest arc, 170 to -170 degrees gave 185 at three
+    quarters of the way: the same rotation, but not how a roll is written."""
+    path = tmp_path / "log.csv"
+    path.write_text("time,x,y,z,heading,roll,pitch\n0,0,0,50,0,170,-100\n1,10,0,50,0,-170,100\n")
+    roll, pitch = log_attitude(load_flight_log(path), [0.0, 0.75, 1.0])
+    assert roll.tolist() == pytest.approx([170.0, -175.0, -170.0])
+    assert pitch.tolist() == pytest.approx([-100.0, 140.0, 100.0])  # -100 down through -180 to 100
+
+
 @pytest.mark.parametrize(
     "text, where, what",
     [

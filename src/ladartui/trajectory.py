@@ -206,9 +206,9 @@ def load_flight_log(path, origin=None) -> FlightLog:
 
 
 def _angle(times, angles, t):
-    """Interpolate angles (degrees) along the shortest arc between records."""
+    """Interpolate angles (degrees) along the shortest arc between records, in [-180, 180)."""
     unwrapped = np.degrees(np.unwrap(np.radians(angles)))
-    return np.interp(t, times, unwrapped)
+    return (np.interp(t, times, unwrapped) + 180.0) % 360.0 - 180.0
 
 
 def log_poses(log: FlightLog, template: ScanPose, rate: float | None = None, times=None) -> list[ScanPose]:
