@@ -98,9 +98,9 @@ class TopView:
     ``heights`` is the scene's top height map, (nx, ny) voxel layers with a
     negative value where a column is empty (bare ground), whose entry (0, 0)
     is column ``origin`` (the map spans the voxels' columns, not the grid from
-    (0, 0)); ``voxel_size`` converts metres to voxels. A *frame* is the window shown, in cell units
-    (x0, y0, x1, y1) where voxel i spans [i, i + 1); by default the scene's
-    extent. Overlays (flight path, scans, footprints) are drawn on a copy of
+    (0, 0)); ``voxel_size`` converts metres to voxels. A *frame* is the window
+    shown, in cell units (x0, y0, x1, y1) where voxel i spans [i, i + 1); by
+    default the map's extent. Overlays (flight path, scans, footprints) are drawn on a copy of
     the cached layer, so changing parameters never re-renders the scene; only
     a new picture size or frame does.
     """

@@ -262,9 +262,9 @@ def _trace_and_write(args, voxel_size: float) -> None:
 
 
 def _precisions_used(blocks: list[tuple[str, int]], asked: str) -> str:
-    """ "f64", or where blocks went to backends of different arithmetic (auto chooses
-    by block) each with its rays: "f64 for 4 rays, f32 for 1"; then whether a backend
-    lacked the arithmetic asked for."""
+    """The arithmetic the blocks were traced in, "f64", or each with its rays where auto
+    chose backends of different arithmetic by block, "f64 for 4 rays, f32 for 1"; then
+    whether a backend lacked the arithmetic asked for."""
     rays: dict[str, int] = {}
     for precision, count in blocks:
         rays[precision] = rays.get(precision, 0) + count

@@ -274,15 +274,14 @@ def _check_memory(scenario, scene) -> None:
     from ladartui.resources import available_memory, check_occupancy, gib
     from ladartui.scene.occupancy import column_bounds
 
-    spans = []
+    map_columns = (0, 0)  # the height map spans the scene's voxels' columns
     for voxels, source in ((scene.voxels, scenario.scene_file), (scene.target, scenario.target_file)):
         if len(voxels):
             lo, last = column_bounds(voxels)  # int64: the far corner + 1 of 2**31 - 1 fits
             check_occupancy(lo, last + 1, len(voxels), str(source))
-            spans.append(last - lo + 1)
-    if not spans:
-        return
-    nx, ny = int(spans[0][0]), int(spans[0][1])  # the map spans the scene's voxels
+            if voxels is scene.voxels:
+                map_columns = (int(last[0] - lo[0]) + 1, int(last[1] - lo[1]) + 1)
+    nx, ny = map_columns
     need = VIEW_BYTES_PER_COLUMN * nx * ny
     if need > available_memory():
         raise ResourceLimitError(
