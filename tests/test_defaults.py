@@ -87,6 +87,23 @@ def test_second_use_is_idempotent(materialised):
     assert {p: p.stat().st_mtime_ns for p in (home / "default").iterdir()} == stamps
 
 
+@pytest.mark.parametrize("lost", ["small.txt", "small_Target.txt"])
+def test_a_lost_scene_is_made_again_and_the_users_edits_kept(tmp_path, monkeypatch, lost):
+    """With a model file gone, the whole folder was made again: the scenario file, with
+    the user's edits, was replaced by the packaged one without a word."""
+    pytest.importorskip("ladartui.scene.generate")
+    monkeypatch.setenv("LADARTUI_HOME", str(tmp_path))
+    path = defaults.default_scenario_path()
+    made = (path.parent / lost).read_bytes()
+    edited = path.read_text().replace("scans = 24", "scans = 12") + "# my notes\n"
+    assert edited != path.read_text() + "# my notes\n"  # the edit changed a setting
+    path.write_text(edited)
+    (path.parent / lost).unlink()
+    assert defaults.default_scenario_path() == path
+    assert path.read_text() == edited
+    assert (path.parent / lost).read_bytes() == made  # the same scene: the same generator
+
+
 def test_default_orbit_circles_the_generated_target_and_keeps_it_in_view(materialised):
     _, path = materialised
     scenario = load_scenario(path)

@@ -4,7 +4,8 @@ Bundled scenarios ship as package data (``ladartui/scenarios/NAME.toml``:
 ``default``, and ``convoy``, three vehicles, one under a camouflage net);
 their scenes are generated, never shipped. ``bundled_scenario_path(NAME)``
 (``default_scenario_path()`` for the default) puts a scenario and its scene in
-the user data folder on first use and returns the scenario's path:
+the user data folder on first use and returns the scenario's path (a model file
+lost later is generated again; the scenario file, perhaps edited, is kept):
 
     $LADARTUI_HOME/NAME/                         if LADARTUI_HOME is set
     $XDG_DATA_HOME/ladartui/NAME/                else, if XDG_DATA_HOME is set
@@ -171,11 +172,15 @@ def _complete(folder: Path, name: str) -> bool:
 
 
 def _materialise(folder: Path, name: str) -> None:
+    """Generate the scene, then write the scenario file unless the user's copy is there
+    (perhaps edited: a lost model file is made again, never the user's settings)."""
     from ladartui.scene.generate import generate_scene
 
     preset, overrides = BUNDLED[name]
     scene = generate_scene(preset, **overrides)
     scene.write(_model_files(folder, name)[0])
+    if (folder / f"{name}.toml").is_file():
+        return
     text = bundled_scenario_text(name)
     packaged = scenario_from_toml(text, folder / f"{name}.toml")
     # The packaged orbit names the small scene's target centre; follow the
