@@ -188,6 +188,20 @@ def test_a_variant_refused_by_this_machines_limits_runs_again_on_resume(tmp_path
     assert (again.ran, again.resumed) == (1, 1) and all(row["status"] == "ok" for row in again.rows)
 
 
+def test_a_base_over_the_ray_limit_can_be_swept_down_to_variants_under_it(tmp_path, monkeypatch):
+    """The base was refused for the limit before any variant was built, though no
+    variant flies the base's own 4 scans: the limit is each variant's."""
+    write_tiny_scenario(tmp_path)
+    spec = write_spec(tmp_path, "[grid]\nscans = [2, 3]\n", name="down.toml")
+    monkeypatch.setenv("LADARTUI_MAX_RAYS", "1300")  # 256 rays a scan, two runs: 2 scans 1,024
+    result = run_sweep(spec, serial=True, out=tmp_path / "o")
+    status = {row["scans"]: (row["status"], row["error"]) for row in result.rows}
+    assert status[2][0] == "ok"
+    assert (
+        status[3][0] == "failed" and "1.54e+03 rays" in status[3][1] and "LADARTUI_MAX_RAYS" in status[3][1]
+    )
+
+
 def test_show_names_a_file_given_as_its_results_folder(tiny, tmp_path, capsys):
     from ladartui.cli import main
 

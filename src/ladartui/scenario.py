@@ -9,6 +9,8 @@ The file format, every key and the reader that checks it: ``ladartui.scenario_fi
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import dataclasses
 import os
 import re
@@ -534,10 +536,27 @@ def _segment_scans(segment) -> int:
     return len(segment.build(None))  # a recorded log: its scans come from the file
 
 
+# Set inside ``work_unchecked()``: scenarios made there are not held to the work limit.
+_WORK_UNCHECKED = contextvars.ContextVar("work_unchecked", default=False)
+
+
+@contextlib.contextmanager
+def work_unchecked():
+    """Scenarios made inside are not refused for the work limit: a sweep's base, whose
+    variants (made from it outside) are each held to the limit instead."""
+    token = _WORK_UNCHECKED.set(True)
+    try:
+        yield
+    finally:
+        _WORK_UNCHECKED.reset(token)
+
+
 def _check_work(scenario):
     """Refuse a scenario whose rays (two runs of every scan) exceed the work limit."""
     from ladartui.resources import check_rays
 
+    if _WORK_UNCHECKED.get():
+        return
     sensor, scans = scenario.sensor, scenario.scan_count()
     check_rays(
         2 * sensor.rays_per_scan * scans,

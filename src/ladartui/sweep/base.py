@@ -70,12 +70,19 @@ def own_rows(table_rows: list[dict], variants, digest: str) -> list[dict]:
     return [row for variant in variants if (row := by_key.get((variant.id, digest))) is not None]
 
 
+def load_base(spec: SweepSpec, check_files: bool = True) -> Scenario:
+    """The spec's base scenario. It is not held to the ray limit, each variant is: a
+    base too large for the limit can be swept down (fewer scans, a smaller sensor)."""
+    from ladartui.scenario import load_scenario, work_unchecked
+
+    with work_unchecked():
+        return load_scenario(base_scenario_path(spec), check_files)
+
+
 def spec_rows(table_rows: list[dict], spec: SweepSpec) -> list[dict]:
     """The rows of ``spec``'s variants made from its base as it is now."""
-    from ladartui.scenario import load_scenario
-
-    path = base_scenario_path(spec)
-    return own_rows(table_rows, spec.variants, base_digest(path, load_scenario(path, check_files=False)))
+    base = load_base(spec, check_files=False)
+    return own_rows(table_rows, spec.variants, base_digest(base.path, base))
 
 
 @dataclass(frozen=True)
@@ -97,12 +104,9 @@ class CheckedBase:
 def checked_base(spec: SweepSpec) -> CheckedBase:
     """Read the spec's base scenario (``InputFileError`` for a missing or bad one) and
     refuse the spec when none of its variants can run on it."""
-    from ladartui.scenario import load_scenario
-
-    path = base_scenario_path(spec)
-    scenario = load_scenario(path)
+    scenario = load_base(spec)
     check_some_variant_runs(spec, scenario)
-    return CheckedBase(spec, path, scenario)
+    return CheckedBase(spec, scenario.path, scenario)
 
 
 def check_some_variant_runs(spec: SweepSpec, base) -> None:

@@ -96,19 +96,17 @@ def sweep_job(
 
 def write_best(spec, row: dict, parameter_names, path: Path) -> BestScenario:
     """The best variant as a scenario file beside the results (worker thread)."""
-    from ladartui.scenario import load_scenario
-    from ladartui.sweep.base import base_scenario_path
+    from ladartui.sweep.base import load_base
     from ladartui.sweep.best_file import write_best_scenario
 
-    base = load_scenario(base_scenario_path(spec))
+    base = load_base(spec)
     return write_best_scenario(path, base, row, parameter_names, base.load_scene)
 
 
 def spec_to_run(text: str):
     """Load and check the spec at ``text`` and its base scenario; LadarError if unusable."""
-    from ladartui.scenario import load_scenario
     from ladartui.sweep import load_sweep_spec
-    from ladartui.sweep.base import base_scenario_path
+    from ladartui.sweep.base import load_base
     from ladartui.sweep.spec import bundled_name
 
     if not text:
@@ -121,7 +119,7 @@ def spec_to_run(text: str):
         path = sibling
     spec = load_sweep_spec(path)
     if bundled_name(spec.scenario_path) is None:
-        load_scenario(base_scenario_path(spec))
+        load_base(spec)
     return spec
 
 
