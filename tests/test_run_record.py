@@ -69,12 +69,15 @@ def test_a_folder_of_the_records_name_is_called_a_folder(scenario, capsys):
     """It was said to be a file that 'is not a run record', to be renamed."""
     record = scenario.path.with_name("S_Run.toml")
     record.mkdir()
-    for command in ("run", "validate"):
-        assert main([command, str(scenario.path)]) == 2
-        assert capsys.readouterr().err == (
-            f"ladartui: error: {record}: is a folder, expected a file name "
-            "(a run writes its settings there)\n"
-        )
+    assert main(["run", str(scenario.path)]) == 2
+    assert capsys.readouterr().err == (
+        f"ladartui: error: {record}: is a folder, expected a file name (a run writes its settings there)\n"
+    )
+    assert main(["validate", str(scenario.path)]) == 1  # the summary, then why a run is refused
+    assert capsys.readouterr().out.splitlines()[-1] == (
+        "next run   S_Run.toml: is a folder, expected a file name (a run writes its settings there); "
+        "the run is refused before it traces"
+    )
 
 
 def test_a_damaged_record_is_reported_naming_the_file(scenario):
@@ -125,7 +128,7 @@ def test_validate_names_an_output_a_run_would_refuse_to_write(scenario, capsys):
     """An S.cmf folder was 'outputs incomplete: S.cmf missing; a run writes the whole set
     again', and a run refused it; before a first run, an S_Scene.txt folder went unsaid."""
     scenario.scene_output.mkdir()
-    assert main(["validate", str(scenario.path)]) == 0
+    assert main(["validate", str(scenario.path)]) == 1
     lines = [x for x in capsys.readouterr().out.splitlines() if x.startswith(("last run", "next run"))]
     assert lines == [
         "next run   S_Scene.txt is a folder, expected a file name: it is refused before it traces"
@@ -135,7 +138,7 @@ def test_validate_names_an_output_a_run_would_refuse_to_write(scenario, capsys):
     scenario.measures_file.unlink()
     scenario.measures_file.mkdir()
     capsys.readouterr()
-    assert main(["validate", str(scenario.path)]) == 0
+    assert main(["validate", str(scenario.path)]) == 1
     lines = [x for x in capsys.readouterr().out.splitlines() if x.startswith(("last run", "next run"))]
     assert lines == [
         "last run   outputs incomplete: S.cmf missing",
@@ -158,18 +161,35 @@ def test_validate_says_whether_outputs_it_cannot_replace_are_up_to_date(scenario
         "output_problem",
         lambda path: "cannot be written (permission denied)" if path.name == "S_Scene.txt" else real(path),
     )
-    assert main(["validate", str(scenario.path)]) == 0
+    assert main(["validate", str(scenario.path)]) == 1
     lines = [x for x in capsys.readouterr().out.splitlines() if x.startswith(("last run", "next run"))]
     assert lines == [
         "last run   made the outputs with this file's settings (S_Run.toml)",
         "next run   S_Scene.txt cannot be written (permission denied): it is refused before it traces",
     ]
     scenario.measures_file.unlink()  # incomplete: but a run would not write the set again
-    assert main(["validate", str(scenario.path)]) == 0
+    assert main(["validate", str(scenario.path)]) == 1
     lines = [x for x in capsys.readouterr().out.splitlines() if x.startswith(("last run", "next run"))]
     assert lines == [
         "last run   outputs incomplete: S.cmf missing",
         "next run   S_Scene.txt cannot be written (permission denied): it is refused before it traces",
+    ]
+
+
+def test_validate_reports_a_file_in_the_run_records_place_and_goes_on(scenario, capsys):
+    """A file of the run record's name that is not one stopped validate with exit 2 and no
+    summary, though the scenario is sound: only the next run is refused for it."""
+    assert main(["run", str(scenario.path)]) == 0
+    scenario.run_record.write_text("garbage [")
+    capsys.readouterr()
+    assert main(["validate", str(scenario.path)]) == 1
+    out = capsys.readouterr().out
+    assert out.startswith("scenario   ") and "memory     about" in out
+    lines = [x for x in out.splitlines() if x.startswith(("last run", "next run"))]
+    assert lines[0].startswith("last run   settings not read: ")
+    assert lines[1:] == [
+        "next run   S_Run.toml: exists and is not a run record of S.toml (a run writes its settings "
+        "there): rename that file; the run is refused before it traces"
     ]
 
 
@@ -199,12 +219,12 @@ def test_no_save_replaces_a_run_record_and_a_record_saved_elsewhere_is_a_plain_s
     assert not is_record(copy.path) and load_scenario(copy.path).same_outputs(scenario)
 
 
-def test_validate_refuses_what_a_run_would_refuse(scenario, capsys):
+def test_validate_says_what_a_run_would_refuse_and_exits_1(scenario, capsys):
     theirs = scenario.path.with_name("S_Run.toml")
     theirs.write_text("# my own notes\n", encoding="utf-8")
-    assert main(["validate", str(scenario.path)]) == 2
-    err = capsys.readouterr().err.strip()
-    assert err.count("\n") == 0 and "S_Run.toml" in err and "not a run record" in err
+    assert main(["validate", str(scenario.path)]) == 1
+    out = capsys.readouterr().out.splitlines()
+    assert out[-1].startswith("next run   S_Run.toml: exists and is not a run record of S.toml")
 
 
 def test_the_new_dialog_names_the_record_and_will_not_make_one_a_new_scenario(scenario):

@@ -77,6 +77,7 @@ class OutputFileError(LadarError):
 
     def __init__(self, path, message):
         self.path = str(path)
+        self.reason = message
         super().__init__(f"{self.path}: {message}")
 
 

@@ -396,6 +396,16 @@ def output_paths(scenario, las=False) -> dict[str, Path]:
     return paths
 
 
+def check_output_names(scenario, las=False) -> None:
+    """Refuse output names too long for the file system, before anything looks for them:
+    a name too long fails every call on it."""
+    from ladartui.outputset import LOCK_EXTRA, SET_MEMBER_EXTRA, check_names
+
+    shorter = "; use a shorter scenario name"
+    check_names(*output_paths(scenario, las).values(), extra=SET_MEMBER_EXTRA, advice=shorter)
+    check_names(output_lock(scenario), extra=LOCK_EXTRA, advice=shorter)
+
+
 def check_outputs_spare_inputs(scenario, las=False) -> None:
     """Refuse a run whose outputs would overwrite its own model files.
 
@@ -404,12 +414,9 @@ def check_outputs_spare_inputs(scenario, las=False) -> None:
     a file of its record's name that is not a run record (``run_record``).
     """
     from ladartui.errors import FieldError
-    from ladartui.outputset import LOCK_EXTRA, SET_MEMBER_EXTRA, check_lock, check_names
+    from ladartui.outputset import check_lock
 
-    # before anything looks for them: a name too long fails every call on it
-    shorter = "; use a shorter scenario name"
-    check_names(*output_paths(scenario, las).values(), extra=SET_MEMBER_EXTRA, advice=shorter)
-    check_names(output_lock(scenario), extra=LOCK_EXTRA, advice=shorter)
+    check_output_names(scenario, las)
     check_lock(output_lock(scenario))
     inputs = {os.path.normpath(Path(f).absolute()) for f in (scenario.scene_file, scenario.target_file)}
     for name, path in output_paths(scenario, las).items():

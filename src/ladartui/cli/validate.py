@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from ladartui.textsafe import single_line, visible
 
 
@@ -14,7 +16,9 @@ def add_parser(subparsers):
         "print a summary (sensor, scans, path length, flight time, scene size, memory, "
         "outputs, and whether the outputs on disk came from this file's settings and its "
         "model files as they are now). A mistake "
-        "is reported on one line with exit status 2.",
+        "is reported on one line with exit status 2. A sound scenario that a run would "
+        "still refuse before tracing (a folder or a file of another kind where an output "
+        "goes) gets its summary, a 'next run' line saying why, and exit status 1.",
     )
     parser.add_argument(
         "scenario",
@@ -27,20 +31,28 @@ def add_parser(subparsers):
 
 def run(args) -> int:
     from ladartui.cli.flags import check_scenario_name
+    from ladartui.errors import OutputFileError
     from ladartui.scenario import load_scenario
-    from ladartui.simulation import check_outputs_spare_inputs
+    from ladartui.simulation import check_output_names, check_outputs_spare_inputs
     from ladartui.user_data import bundled_or_path
 
     check_scenario_name(args.scenario)
     scenario = load_scenario(bundled_or_path(args.scenario))
     scene = scenario.load_scene()
     scene_lines = scene_summary(scenario, scene)
-    check_outputs_spare_inputs(scenario)  # what a run would refuse before tracing
+    check_output_names(scenario)  # too long: the scenario's own name is the mistake
+    try:
+        check_outputs_spare_inputs(scenario)  # what a run would refuse before tracing
+        refused = None
+    except OutputFileError as error:  # a file where an output goes: the scenario is sound
+        refused = error
     print(visible(scenario.summary()))
     notes = [*flight_notes(scenario.flight), *detection_notes(scenario)]
-    for line in [*scene_lines, *notes, *last_run_lines(scenario, scene)]:
+    refusals = next_run_refusals(scenario, refused)
+    earlier = last_run_lines(scenario, scene, writable=not refusals)
+    for line in [*scene_lines, *notes, *earlier, *refusals[:1]]:
         print(single_line(line))
-    return 0
+    return 1 if refusals else 0  # a script must not take a run bound to be refused as ready
 
 
 def flight_notes(flight) -> list[str]:
@@ -80,30 +92,37 @@ def detection_notes(scenario) -> list[str]:
     ]
 
 
-def last_run_lines(scenario, scene) -> list[str]:
-    """Whether the outputs on disk came from this file's settings and its model files as
-    they are now (``scene``, as just loaded), from the run record; then an output the
-    next run would refuse to write, as a run checks them before tracing."""
-    from ladartui import outputset
-    from ladartui.simulation import output_lock, output_paths
+def next_run_refusals(scenario, refused=None) -> list[str]:
+    """Why the next run would be refused before it traces, for its outputs' paths
+    (``refused``: the ``OutputFileError`` its first check gave, if any)."""
+    from ladartui.outputset import output_problem
+    from ladartui.simulation import output_paths
 
-    if outputset.journal_path(output_lock(scenario)).exists():  # a swap a killed run left
+    refusals = [
+        f"next run   {path.name} {problem}: it is refused before it traces"
+        for path in output_paths(scenario).values()
+        if (problem := output_problem(path))
+    ]
+    if refused is not None:
+        name = Path(refused.path).name
+        refusals.insert(0, f"next run   {name}: {refused.reason}; the run is refused before it traces")
+    return refusals
+
+
+def last_run_lines(scenario, scene, writable: bool = True) -> list[str]:
+    """Whether the outputs on disk came from this file's settings and its model files as
+    they are now (``scene``, as just loaded), from the run record; ``writable``: whether
+    the next run can write its outputs."""
+    from ladartui.errors import LadarError
+    from ladartui.outputset import journal_path
+    from ladartui.run_record import earlier_las, missing_outputs, read_run_record, setting_changes
+    from ladartui.simulation import output_lock
+
+    if journal_path(output_lock(scenario)).exists():  # a swap a killed run left (outputset)
         return [
             "last run   was stopped while it replaced the outputs: the next run puts the earlier set "
             "back first, so the files now on disk are not to be read"
         ]
-    refusals = [
-        f"next run   {path.name} {problem}: it is refused before it traces"
-        for path in output_paths(scenario).values()
-        if (problem := outputset.output_problem(path))
-    ]
-    return _earlier_outputs(scenario, scene, writable=not refusals) + refusals[:1]
-
-
-def _earlier_outputs(scenario, scene, writable: bool) -> list[str]:
-    from ladartui.errors import LadarError
-    from ladartui.run_record import earlier_las, missing_outputs, read_run_record, setting_changes
-
     missing = missing_outputs(scenario)
     if missing:
         names = ", ".join(path.name for path in missing)
