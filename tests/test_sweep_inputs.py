@@ -202,6 +202,24 @@ def test_a_base_over_the_ray_limit_can_be_swept_down_to_variants_under_it(tmp_pa
     )
 
 
+def test_a_spec_file_name_that_cannot_name_the_best_path_file_asks_for_sweep_name(tmp_path):
+    """'my sweep.toml' was refused as 'sweep.name: ... (got 'my sweep')', a key not in the
+    file: the default comes from the file name, which the message now says."""
+    write_tiny_scenario(tmp_path)
+    spec = write_spec(tmp_path, "[grid]\nscans = [2]\n", name="my sweep.toml")
+    with pytest.raises(InputFileError) as caught:
+        load_sweep_spec(spec)
+    assert str(caught.value) == (
+        f"{spec}:1: sweep.name: expected a file-name stem of letters, digits, '.', '_' or '-' to "
+        "name the best-path scenario file: the spec's file name 'my sweep' is not one, so set sweep.name"
+    )
+    spec.write_text(spec.read_text().replace("[grid]", 'name = "my-sweep"\n[grid]'), encoding="utf-8")
+    assert load_sweep_spec(spec).name == "my-sweep"
+    spec.write_text(spec.read_text().replace('"my-sweep"', '"../up"'), encoding="utf-8")
+    with pytest.raises(InputFileError, match=r":3: sweep\.name: .* \(got '\.\./up'\)$"):
+        load_sweep_spec(spec)
+
+
 def test_show_names_a_file_given_as_its_results_folder(tiny, tmp_path, capsys):
     from ladartui.cli import main
 

@@ -248,12 +248,15 @@ def parse_sweep_spec(data: dict, path, text: str = "") -> SweepSpec:
     if objective in BUDGET_OBJECTIVE_NAMES and budget is None:
         checker.fail("sweep.budget", f"a flight-time budget in seconds for objective '{objective}'", None)
     name = head.get("name", path.stem)
+    stem_rule = "a file-name stem of letters, digits, '.', '_' or '-'"
     if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9][A-Za-z0-9._-]*", name):
-        checker.fail(
-            "sweep.name",
-            "a file-name stem of letters, digits, '.', '_' or '-' (it names the best-path scenario file)",
-            name,
-        )
+        if "name" not in head:  # the spec's own file name, which the user never wrote as a name
+            checker.fail(
+                "sweep.name",
+                f"{stem_rule} to name the best-path scenario file: the spec's file name "
+                f"{path.stem!r} is not one, so set sweep.name",
+            )
+        checker.fail("sweep.name", f"{stem_rule} (it names the best-path scenario file)", name)
 
     grid = {}
     table = data.get("grid", {})
