@@ -106,6 +106,34 @@ def test_ctrl_c_cancels_with_a_truthful_message(scenario, capsys, monkeypatch):
     assert "ideal model" not in captured.out
 
 
+def test_ctrl_c_during_a_pulse_count_shows_the_rows_finished(scenario, capsys, monkeypatch):
+    """The rows finished were thrown away ('no results'), and the bar named the count
+    finished, not the one being fired, until that one's first scan was done."""
+    real = pulses_module.pulse_study
+    seen = []
+
+    def interrupted(*args, progress=None, cancel=None, **kwargs):
+        def report(p):
+            progress(p)
+            seen.append((p.stage, p.done, len(p.rows)))
+            if p.stage == "pulses" and p.done == 2:
+                assert ctrl_c(cancel), "Ctrl-C did not set the cancel event"
+
+        return real(*args, progress=report, cancel=cancel, **kwargs)
+
+    monkeypatch.setattr(pulses_module, "pulse_study", interrupted)
+    assert main(["pulses", str(scenario.path), "--pulses", "1,20", "--no-chart"]) == 130
+    captured = capsys.readouterr()
+    assert ("pulses", 1, 0) in seen and seen[-1] == ("pulses", 2, 1)  # told at once, row 1 done
+    assert captured.err.strip().endswith(
+        "pulse study cancelled after tracing every scan, during pulse count 2 of 2; the 1 row "
+        "finished is above, and this command writes no files"
+    )
+    lines = captured.out.splitlines()
+    assert lines[0].startswith("ideal model: obscured coverage 0.") and len(lines) == 3
+    assert lines[2].split()[:2] == ["1", "1"]  # 1 pulse, k = 1
+
+
 def test_a_bundled_scenario_is_taken_by_name_as_run_takes_it(tmp_path, capsys, monkeypatch):
     """'pulses convoy' said '/cwd/convoy: no such file', where 'run convoy' runs it."""
     from ladartui.user_data import bundled_scenario_path

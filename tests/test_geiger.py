@@ -80,6 +80,28 @@ def test_same_seed_same_result_and_detector_subsets_agree():
     assert 0 <= uniform(1, 2, 3, 4, 5) < 1
 
 
+def test_pulses_fired_in_blocks_give_the_same_counts_and_a_cancel_stops_between_them(monkeypatch):
+    """All pulses were fired in one kernel call: a Ctrl-C waited out 100,000 pulses of a
+    look (20 s and more). Each pulse has its own random numbers, so blocks change nothing."""
+    import threading
+
+    from ladartui.detection import geiger
+    from ladartui.errors import Cancelled
+
+    mean = np.random.default_rng(2).uniform(0, 1, size=(16, 10))
+    whole = fire_counts(mean, 37, dead_bins=3, seed=9, scan=1)
+    monkeypatch.setattr(geiger, "FIRE_BLOCK_VISITS", 160 * 5)  # 5 pulses a block: 8 blocks
+    calls = []
+    real = geiger._fire_kernel
+    monkeypatch.setattr(geiger, "_fire_kernel", lambda *a: calls.append(a[2:4]) or real(*a))
+    assert np.array_equal(fire_counts(mean, 37, dead_bins=3, seed=9, scan=1), whole)
+    assert calls == [(0, 5), (5, 10), (10, 15), (15, 20), (20, 25), (25, 30), (30, 35), (35, 37)]
+    cancel = threading.Event()
+    cancel.set()
+    with pytest.raises(Cancelled):
+        fire_counts(mean, 37, dead_bins=3, seed=9, scan=1, cancel=cancel)
+
+
 def test_same_seed_identical_with_one_and_two_threads():
     import numba
 

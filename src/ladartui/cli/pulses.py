@@ -17,6 +17,7 @@ import threading
 from ladartui.cli.flags import as_flags, check_scenario_name
 from ladartui.cli.progress import stop_status
 from ladartui.errors import Cancelled, FieldError
+from ladartui.number_text import plural
 
 CHART_WIDTH = 78
 CHART_MIN_WIDTH = 52  # the legend's longest entry still fits inside the axes
@@ -108,15 +109,30 @@ def run(args) -> int:
     try:
         ideal, rows = _study_with_progress(scenario, pulses, settings, args.backend, errors, state)
     except (Cancelled, KeyboardInterrupt):  # the latter: Ctrl-C before the worker started
+        last = state["last"]
+        finished = () if last is None or args.json else last.rows
+        if finished:  # what a cancelled study has to show: the rows it finished
+            _print_table(last.ideal, finished)
+        shown = f"; the {plural(len(finished), 'row')} finished {'is' if len(finished) == 1 else 'are'} above"
         print(
-            f"ladartui: pulse study cancelled {_where(state['last'])}; no results, and this "
-            "command writes no files",
+            f"ladartui: pulse study cancelled {_where(last)}"
+            + (shown if finished else "; no results")
+            + ", and this command writes no files",
             file=sys.stderr,
         )
         return stop_status()
     if args.json:
         print(json.dumps(result_dict(scenario, settings, ideal, rows), indent=2, allow_nan=False))
         return 0
+    _print_table(ideal, rows)
+    if args.chart:
+        columns = shutil.get_terminal_size((CHART_WIDTH, CHART_HEIGHT)).columns  # COLUMNS first
+        width = max(CHART_MIN_WIDTH, min(columns, CHART_WIDTH))
+        print(chart_text(ideal, rows, width=width, color=sys.stdout.isatty()))
+    return 0
+
+
+def _print_table(ideal, rows) -> None:
     if ideal is None:
         print("ideal model: obscured coverage undefined (the target model holds no voxels)")
     else:
@@ -129,11 +145,6 @@ def run(args) -> int:
             f"{r.pulses:>7,} {r.threshold:>5,} {coverage:>9} {r.declared_points:>11,} "
             f"{r.false_alarms:>10,} {detection:>11}"
         )
-    if args.chart:
-        columns = shutil.get_terminal_size((CHART_WIDTH, CHART_HEIGHT)).columns  # COLUMNS first
-        width = max(CHART_MIN_WIDTH, min(columns, CHART_WIDTH))
-        print(chart_text(ideal, rows, width=width, color=sys.stdout.isatty()))
-    return 0
 
 
 def _where(progress) -> str:

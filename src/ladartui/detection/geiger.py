@@ -29,6 +29,8 @@ import math
 import numba
 import numpy as np
 
+from ladartui.errors import check_cancelled
+
 SPEED_OF_LIGHT = 299_792_458.0
 _MASK = (1 << 64) - 1
 
@@ -61,11 +63,12 @@ def uniform(seed: int, scan: int, detector: int, pulse: int, bin_: int) -> float
 
 
 @numba.njit(cache=True, nogil=True, parallel=True)
-def _fire_kernel(fire_prob, detectors, pulses, dead_bins, seed, scan, counts):
+def _fire_kernel(fire_prob, detectors, first_pulse, end_pulse, dead_bins, seed, scan, counts):
+    """Add the fires of pulses ``first_pulse`` to ``end_pulse`` (exclusive) to ``counts``."""
     n_det, n_bins = fire_prob.shape
     for d in numba.prange(n_det):
         det_id = detectors[d]
-        for p in range(pulses):
+        for p in range(first_pulse, end_pulse):
             armed_at = 0
             for b in range(n_bins):
                 if b < armed_at:
@@ -78,15 +81,22 @@ def _fire_kernel(fire_prob, detectors, pulses, dead_bins, seed, scan, counts):
                     armed_at = b + dead_bins
 
 
+# Bin visits (detectors x bins x pulses) between two cancel checks: well under a
+# second of firing, so a cancel is answered promptly whatever the pulse count.
+FIRE_BLOCK_VISITS = 1 << 25
+
+
 def fire_counts(
-    mean_counts, pulses: int, dead_bins: int, seed: int, scan: int = 0, detectors=None
+    mean_counts, pulses: int, dead_bins: int, seed: int, scan: int = 0, detectors=None, cancel=None
 ) -> np.ndarray:
     """Times each bin fired over ``pulses`` pulses.
 
     ``mean_counts``: (D, B) mean primary counts per detector and range bin
     (signal plus noise), bins in range order. ``detectors``: (D,) detector ids
     keying the generator (default 0..D-1), so a subset of detectors gives the
-    same answers as the whole array. Returns (D, B) int32.
+    same answers as the whole array. Returns (D, B) int32. The pulses are fired
+    in blocks, ``cancel`` (a threading.Event) checked between them: each pulse
+    has its own random numbers, so blocks never change an answer.
     """
     mean = np.ascontiguousarray(mean_counts, dtype=np.float64)
     if mean.ndim != 2:
@@ -101,9 +111,14 @@ def fire_counts(
         else np.ascontiguousarray(detectors, dtype=np.uint64)
     )
     counts = np.zeros(mean.shape, dtype=np.int32)
-    _fire_kernel(
-        -np.expm1(-mean), ids, int(pulses), int(dead_bins), np.uint64(seed & _MASK), np.uint64(scan), counts
-    )
+    fire_prob = -np.expm1(-mean)
+    block = max(1, FIRE_BLOCK_VISITS // max(mean.size, 1))
+    for first in range(0, int(pulses), block):
+        check_cancelled(cancel, "cancelled while firing pulses")
+        end = min(int(pulses), first + block)
+        _fire_kernel(
+            fire_prob, ids, first, end, int(dead_bins), np.uint64(seed & _MASK), np.uint64(scan), counts
+        )
     return counts
 
 

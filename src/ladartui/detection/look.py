@@ -77,6 +77,7 @@ def geiger_look(
     dead_bins: int,
     seed: int,
     scan: int,
+    cancel=None,
 ) -> GeigerLook:
     detector = np.asarray(detector, dtype=np.int64)
     ranges = np.asarray(ranges, dtype=np.float64)
@@ -102,7 +103,7 @@ def geiger_look(
     np.add.at(mean, (row, b), signal)
     has_return = np.zeros((ids.size, bins), dtype=bool)
     has_return[row, b] = True
-    counts = fire_counts(mean, pulses, dead_bins, seed, scan, detectors=ids)
+    counts = fire_counts(mean, pulses, dead_bins, seed, scan, detectors=ids, cancel=cancel)
     declared = declare_points(counts, threshold)
     ray_declared[np.flatnonzero(hit)] = declared[row, b]
     return GeigerLook(

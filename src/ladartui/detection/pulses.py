@@ -54,6 +54,10 @@ class PulseProgress:
     # per 10), for one overall bar.
     units_done: float
     units_total: float
+    # Once every scan is traced: the ideal model's coverage and the rows finished so far
+    # (what a study cancelled now has to show).
+    ideal: float | None = None
+    rows: tuple[PulseRow, ...] = ()
 
 
 def pulse_study(
@@ -93,9 +97,12 @@ def pulse_study(
     units_total = len(poses) * (1.0 + sum(per_scan_units))
     units = 0.0
 
+    rows: list[PulseRow] = []
+    ideal_cov: float | None = None
+
     def report(stage, done, count):
         if progress is not None:
-            progress(PulseProgress(stage, done, count, units, units_total))
+            progress(PulseProgress(stage, done, count, units, units_total, ideal_cov, tuple(rows)))
 
     looks, ideal = [], []
     for scan, pose in enumerate(poses):
@@ -120,13 +127,13 @@ def pulse_study(
         units += 1.0
         report("trace", scan + 1, len(poses))
     ideal_cov = float(np.isin(target_keys, np.concatenate(ideal)).sum() / total) if total else None
-    rows = []
     for row, pulses in enumerate(pulses_list):
+        report("pulses", row + 1, len(pulses_list))  # the count now fired, before its first scan
         k = settings.threshold(pulses)
         declared_keys, points, false_alarms, target_ideal, target_declared = [], 0, 0, 0, 0
         for scan, look in enumerate(looks):
             check_cancelled(cancel, "pulse study cancelled; nothing was written")
-            outcome = declare_look(look, settings, sensor, pulses, k, scan_key=scan)
+            outcome = declare_look(look, settings, sensor, pulses, k, scan_key=scan, cancel=cancel)
             points += outcome.declared_points
             false_alarms += outcome.false_alarms
             declared_keys.append(voxel_keys(outcome.declared_voxels))

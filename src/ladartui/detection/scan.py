@@ -96,9 +96,10 @@ def prepare_look(
 
 
 def declare_look(
-    look: LookInputs, settings, sensor, pulses: int, threshold: int, scan_key: int
+    look: LookInputs, settings, sensor, pulses: int, threshold: int, scan_key: int, cancel=None
 ) -> LookOutcome:
-    """Fire ``pulses`` pulses at one scan (random stream keyed by ``scan_key``)."""
+    """Fire ``pulses`` pulses at one scan (random stream keyed by ``scan_key``); ``cancel``
+    is checked between blocks of pulses."""
     bin_width = settings.bin_width(sensor.depth_resolution)
     hit = look.kind != 0
     if hit.any():
@@ -127,6 +128,7 @@ def declare_look(
         dead_bins=settings.dead_bins(bin_width),
         seed=settings.seed,
         scan=scan_key,
+        cancel=cancel,
     )
     declared_rays = result.ray_declared & look.kept
     ideal_target = np.unique(voxel_keys(look.index[look.kept & look.is_target]))
@@ -151,7 +153,7 @@ class GeigerRun:
 
     TARGET_RUN_KEY = 1 << 32
 
-    def __init__(self, settings, sensor, scene):
+    def __init__(self, settings, sensor, scene, cancel=None):
         from ladartui.detection.measures import DetectionTally
 
         check_memory(
@@ -161,6 +163,7 @@ class GeigerRun:
         )
         self.settings = settings
         self.sensor = sensor
+        self.cancel = cancel  # checked between blocks of pulses
         self.voxel_size = scene.voxel_size
         self.target_model = scene.target
         self.target_keys = np.unique(voxel_keys(scene.target))
@@ -196,7 +199,13 @@ class GeigerRun:
         )
         key = scan - 1 + (self.TARGET_RUN_KEY if run == "target" else 0)
         outcome = declare_look(
-            look, self.settings, self.sensor, self.settings.pulses, self.settings.coincidence, scan_key=key
+            look,
+            self.settings,
+            self.sensor,
+            self.settings.pulses,
+            self.settings.coincidence,
+            scan_key=key,
+            cancel=self.cancel,
         )
         if run == "scene":
             self.tally.add(outcome)
