@@ -81,6 +81,18 @@ def test_zoomed_in_far_beyond_the_splat_budget_the_squares_still_cover_what_is_i
     assert image.voxel_mask.all()  # 36-pixel squares, no gaps: only voxels in view count
 
 
+def test_a_voxel_near_the_edge_whose_square_misses_the_picture_draws_nothing():
+    """Zoomed far in, a voxel within a square's reach of the edge counted as near the
+    picture though none of its pixels fell inside: the TUI died with an IndexError."""
+    bounds = (np.zeros(3), np.array([9.0, 9.0, 0.0]))
+    voxel = np.array([[0, 0, 0]])
+    camera = Camera(180.0, 90.0, 50.0, 0.0, 0.0, (0.0, 0.65, 0.0))  # the voxel just below the picture
+    row, _, _, scale = screen_coordinates(voxel.astype(float), camera, 20, 20, bounds)
+    assert 20 + scale / 2 < row[0] < 20 + scale  # near, yet its square starts past the last row
+    image = render([Layer(voxel, (200, 200, 200))], camera, 20, 20, bounds)
+    assert not image.voxel_mask.any()
+
+
 def test_a_threshold_rescales_the_colours_to_the_heights_that_remain():
     column = np.array([[0, 0, z] for z in range(21)])
     layers, (lo, hi) = output_layers(column, np.zeros((0, 3)), mode="height")

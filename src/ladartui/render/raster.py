@@ -140,6 +140,8 @@ def _splat(image: Rendering, parts, camera, bounds) -> None:
     owner = np.repeat(np.arange(len(r0)), side * side)
     inside = (rr >= 0) & (rr < rows) & (cc >= 0) & (cc < cols)
     linear = (rr * cols + cc)[inside]
+    if not len(linear):  # near the edge, within a square's reach, yet none lands inside
+        return
     owner = owner[inside]
     # nearest first within each pixel, then the later layer; keep the last of each pixel
     order = np.lexsort((priority[owner], depth[owner], linear))
