@@ -63,6 +63,44 @@ async def test_a_scenario_file_given_as_the_new_scenarios_scene_model_is_named_s
         assert not (tmp_path / "fresh.toml").exists()
 
 
+async def test_a_new_scenario_whose_scene_cannot_be_read_is_not_written_and_its_form_comes_back(
+    tmp_path, scene_files
+):
+    """A scene model with a bad line: the dialog closed, the new .toml was written anyway
+    and its load failed; what was typed was gone, and the name was then refused as taken."""
+    from ladartui.tui.file_dialogs import SetupScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    (tmp_path / "bad.txt").write_text("1,2,3\n1,2,abc\n", encoding="utf-8")
+    (tmp_path / "bad_Target.txt").write_text("1,2,3\n", encoding="utf-8")
+    async with opened(scenario) as (app, pilot):
+        await pilot.press("f2")
+        await wait_until(pilot, lambda: isinstance(app.screen, SetupScreen) and app.screen.is_mounted)
+        dialog = app.screen
+        dialog.query_one("#scenario-file").value = "fresh.toml"
+        dialog.query_one("#scene-file").value = "bad.txt"
+        dialog.query_one("#voxel-size").value = "0.25"
+        dialog.query_one("#setup-ok").press()
+        await wait_until(
+            pilot,
+            lambda: app.busy is None and isinstance(app.screen, SetupScreen) and app.screen is not dialog,
+            60,
+        )
+        again = app.screen
+        await wait_until(pilot, lambda: again.is_mounted, 10)
+        assert not (tmp_path / "fresh.toml").exists()
+        assert again.mode == "new"
+        assert [
+            again.query_one(f"#{name}").value for name in ("scenario-file", "scene-file", "voxel-size")
+        ] == [
+            "fresh.toml",
+            "bad.txt",
+            "0.25",
+        ]
+        assert message(again, "#setup-message").startswith(f"{tmp_path / 'bad.txt'}:2: z = 'abc'")
+        assert app.scenario.path == scenario.path  # the one open before stays
+
+
 async def test_a_segment_the_whole_path_refuses_keeps_its_form_open(tmp_path, scene_files):
     """A straight of 9999 scans after a 6-scan orbit: each field was allowed, the form
     closed, and the path's own limit was said after it ('Flight path not changed'),

@@ -104,6 +104,7 @@ class LadarApp(KeyWords, ScenarioEditing, EditGuard, FileActions, SceneLoading, 
         self.busy: str | None = None
         self.progress: float | None = None
         self.load_worker = self.warm_worker = self.run_worker_handle = None  # the jobs
+        self.new_pending: Scenario | None = None
         self.messages: list[str] = []
         self.leaving = False  # set by exit: news from jobs is no longer shown
         self.running = False
@@ -496,6 +497,7 @@ class LadarApp(KeyWords, ScenarioEditing, EditGuard, FileActions, SceneLoading, 
 
     JOB_FAILED = {
         "load": "Could not load",
+        "new": "New scenario not written",
         "run": "Run failed",
         "probe": "Backends not probed",
         "warm": "Kernels not compiled",
@@ -526,13 +528,15 @@ class LadarApp(KeyWords, ScenarioEditing, EditGuard, FileActions, SceneLoading, 
                 severity="error",
                 timeout=10,
             )
-        if message.job == "load":
+        if message.job in ("load", "new"):
             if message.result is not None:
                 self.loaded(message.result)
             else:
                 self.set_busy(None)
                 if message.error:
                     self.run_panel.say(message.error)
+                if message.job == "new" and message.error and self.new_pending is not None:
+                    self.new_refused(self.new_pending, message.error)
         elif message.job == "probe":
             self.backends_probed(
                 message.result

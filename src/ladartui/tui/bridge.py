@@ -323,7 +323,9 @@ def check_voxel_size(value) -> None:
 
 
 def new_scenario(scenario_path: Path, scene_path: Path, voxel_size: float = 1.0) -> Scenario:
-    """Create and save a new scenario for a scene model (its target model must exist)."""
+    """A new scenario for a scene model (its target model must exist), not yet saved:
+    the app writes it once its scene has been read (``loading``), so a scene model that
+    cannot be read leaves no file behind."""
     scenario_path = Path(scenario_path)
     if scenario_path.suffix != ".toml":
         scenario_path = scenario_path.with_name(scenario_path.name + ".toml")
@@ -338,8 +340,7 @@ def new_scenario(scenario_path: Path, scene_path: Path, voxel_size: float = 1.0)
             raise InputFileError(path, f"{what} file {problem}")
         if Path(path).suffix.lower() == ".toml":  # else: 'S_Target.toml: ... not found'
             raise InputFileError(path, f"{what} file is a scenario file (.toml); expected a {what} (.txt)")
-    scenario = Scenario.new(scenario_path, scene_path, voxel_size)
-    return scenario.save()
+    return Scenario.new(scenario_path, scene_path, voxel_size)
 
 
 def load_checked(path: Path) -> Scenario:

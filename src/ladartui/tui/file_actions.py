@@ -11,6 +11,7 @@ from pathlib import Path
 
 from ladartui.errors import LadarError
 from ladartui.recent import remember_scenario
+from ladartui.tui.fields import format_number
 from ladartui.tui.file_dialogs import SaveAsScreen, SetupScreen
 from ladartui.tui.host import Host
 
@@ -34,14 +35,25 @@ class FileActions(Host):
             "open another scenario" if mode == "load" else "start a new one", lambda: self._open_setup(mode)
         )
 
-    def _open_setup(self, mode: str) -> None:
+    def _open_setup(self, mode: str, folder: Path | None = None, typed=None, said: str = "") -> None:
         def done(scenario):
             if scenario is not None:
                 self.result = None
-                self.load(None, scenario=scenario)
+                self.load(None, scenario=scenario, new=mode == "new")
 
         current = self.scenario.path if self.scenario is not None else None
-        self.push_screen(SetupScreen(mode, self._folder(), current), done)
+        self.push_screen(SetupScreen(mode, folder or self._folder(), current, typed, said), done)
+
+    def new_refused(self, scenario, error: str) -> None:
+        """A new scenario whose scene could not be read (nothing was written): its form
+        again, as it was typed, saying why."""
+        folder = scenario.path.parent
+        try:
+            scene = str(Path(scenario.scene_file).relative_to(folder))
+        except ValueError:
+            scene = str(scenario.scene_file)
+        typed = (scenario.path.name, scene, format_number(scenario.voxel_size))
+        self._open_setup("new", folder, typed, error)
 
     def open_path(self, path: Path) -> None:
         """Open a scenario file (recent list, best sweep path), asking about unsaved edits."""

@@ -35,13 +35,23 @@ class SetupScreen(TreeDialog):
     output names are derived and shown. Load: every file is checked; a missing
     model is named and nothing is loaded. Dismisses with the loaded Scenario.
     Load opens holding ``current`` (the open scenario), selected: Enter reopens it
-    as it is on disk, typing replaces it.
+    as it is on disk, typing replaces it. New opens holding ``typed`` (scenario file,
+    scene model, voxel size) and ``said`` when a new scenario's scene could not be read.
     """
 
-    def __init__(self, mode: str = "new", folder: Path | None = None, current: Path | None = None):
+    def __init__(
+        self,
+        mode: str = "new",
+        folder: Path | None = None,
+        current: Path | None = None,
+        typed: tuple[str, str, str] | None = None,
+        said: str = "",
+    ):
         super().__init__()
         self.mode = mode
         self.current = current
+        self.typed = typed
+        self.said = said
         self.base = folder or Path.cwd()
         self.folder = self.base
 
@@ -86,6 +96,11 @@ class SetupScreen(TreeDialog):
         field = self.query_one("#scenario-file", Input)
         if self.mode == "load" and self.current is not None:
             field.value = self.relative(self.current)
+        if self.typed is not None:
+            for name, text in zip(("scenario-file", "scene-file", "voxel-size"), self.typed):
+                self.query_one(f"#{name}", Input).value = text
+            # after the fields' Changed events, which clear the message
+            self.call_after_refresh(self.query_one("#setup-message", Static).update, self.said)
         field.focus()
 
     @on(RadioSet.Changed, "#mode")

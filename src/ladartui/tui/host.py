@@ -61,6 +61,7 @@ class AppHost(App[None]):
     progress: float | None
     running: bool
     load_worker: Worker[Any] | None
+    new_pending: Scenario | None  # New's scenario while its scene is read (written after)
     warm_worker: Worker[Any] | None
     run_worker_handle: Worker[Any] | None
     # the widgets, found once mounted
@@ -162,7 +163,10 @@ class AppHost(App[None]):
     def open_path(self, path: Path) -> None:
         raise NotImplementedError
 
-    def load(self, path: Path | None, scenario: Scenario | None = None) -> None:
+    def load(self, path: Path | None, scenario: Scenario | None = None, new: bool = False) -> None:
+        raise NotImplementedError
+
+    def new_refused(self, scenario: Scenario, error: str) -> None:
         raise NotImplementedError
 
 

@@ -1,7 +1,9 @@
 """Loading a scenario and its scene, probing the backends and warming the kernels.
 
 Three jobs (``tui/work.py``): "load" reads the scenario, its scene and any
-earlier results and prepares the views; once they are shown, "probe" lists
+earlier results and prepares the views ("new" does so for New's scenario and
+writes it only then, so a scene model that cannot be read leaves no file and
+brings New's form back as typed); once they are shown, "probe" lists
 the backends and "warm" has two child processes compile the tracing kernels
 for the first Run (``ladartui.precompile``: compiling here would hold the
 interpreter lock and freeze the interface), then loads them from numba's
@@ -106,11 +108,15 @@ class SceneLoading(Host):
     scenario_seen: FileSeen | None = None  # the scenario file as opened or last saved
     scenario_on_disk: str | None = None  # "changed" or "gone" since then; None: as it was
 
-    def load(self, path: Path | None, scenario: Scenario | None = None) -> None:
-        """Load a scenario and its scene in a worker (the default scenario when no path)."""
+    def load(self, path: Path | None, scenario: Scenario | None = None, new: bool = False) -> None:
+        """Load a scenario and its scene in a worker (the default scenario when no path).
+        ``new``: ``scenario`` is New's, written once its scene has been read (job "new")."""
         name = path.name if path else (scenario.path.name if scenario else "default scenario")
         self.set_busy(f"Loading {name}...")
-        self.load_worker = start_job(self, "load", lambda cancel, progress: _load(path, scenario))
+        self.new_pending = scenario if new else None
+        self.load_worker = start_job(
+            self, "new" if new else "load", lambda cancel, progress: _load(path, scenario, new)
+        )
 
     def loaded(self, done: Loaded) -> None:
         """The load job's result: show it, then probe the backends and warm the kernels."""
@@ -251,7 +257,12 @@ class SceneLoading(Host):
         self.refresh_status()
 
 
-def _load(path: Path | None, scenario) -> Loaded:
+def _load(path: Path | None, scenario, new: bool = False) -> Loaded:
+    if new:  # written only once its scene is read and fits: a bad model leaves no file
+        scene = scenario.load_scene()
+        _check_memory(scenario, scene)
+        scenario = scenario.save()
+        return Loaded(scene, prepare_views(scene), _earlier(scenario, scene=scene), file_seen(scenario.path))
     if scenario is None:
         if path is None:
             from ladartui.user_data import default_scenario_path
