@@ -257,20 +257,25 @@ async def test_budget_objective_ranks_only_paths_within_the_typed_budget(finishe
 
 async def test_a_bad_budget_is_one_line_whatever_the_ranking(finished):
     """With a ranking that reads no budget, -5 in Budget s ended the app with a traceback
-    (the status line read the budget outside the check)."""
+    (the status line read the budget outside the check). Then the refusal came on a green
+    READY bar, in the spec's words (budget = '-5'), and 1e400 was said not to be > 0."""
     spec, _ = finished
     screen = SweepScreen(spec)
     app = _Host(screen)
     async with app.run_test(size=SIZE) as pilot:
         await opened(pilot)
         budget = screen.query_one("#sweep-budget")
-        for typed in ("-5", "0", "abc"):
+        for typed in ("-5", "0", "abc", "1e400"):
             budget.value = typed
             budget.focus()
             await pilot.press("enter")
             await pilot.pause()
             assert app.is_running
-            assert screen.last_message == f"budget = '{typed}': expected a flight-time budget in seconds, > 0"
+            assert screen.last_message == (
+                f"Budget s: {typed} is not allowed; expected a flight time in seconds, greater than 0 "
+                "and finite (empty: the spec's budget)"
+            )
+            assert status_of(screen).state == NOT_READY
 
 
 async def test_a_missing_spec_gives_one_line_and_starts_nothing(tmp_path):

@@ -26,9 +26,10 @@ from textual.validation import ValidationResult, Validator
 from textual.widgets import Button, Checkbox, DataTable, Footer, Input, Label, ProgressBar, Static
 from textual_plotext import PlotextPlot
 
-from ladartui.errors import FieldError, LadarError
+from ladartui.errors import LadarError
 from ladartui.recent import recent_paths, remember_path
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
+from ladartui.tui.fields import refusal
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar, StatusText, format_eta
 from ladartui.tui.sweep_jobs import (
     StoredRows,
@@ -43,6 +44,8 @@ from ladartui.tui.sweep_view import (
     short_path,
 )
 from ladartui.tui.work import JobDone, JobProgress, start_job
+
+BUDGET_LABEL = "Budget s"  # the field as its label names it, in messages too
 
 if TYPE_CHECKING:
     from textual.worker import Worker
@@ -170,7 +173,7 @@ class SweepScreen(SweepOpening):
                 compact=True,
                 placeholder="tcp://HOST:8786 (empty: this machine)",
             )
-            yield Label("Budget s")
+            yield Label(BUDGET_LABEL)
             yield Input(id="sweep-budget", compact=True, type="number", placeholder="spec", valid_empty=True)
             yield Checkbox(
                 "serial",
@@ -217,7 +220,8 @@ class SweepScreen(SweepOpening):
         return self.query_one("#sweep-path", Input).value.strip()
 
     def _typed_budget(self) -> float | None:
-        """The Budget field (seconds), or None when empty; FieldError when not a positive number."""
+        """The Budget field (seconds), or None when empty; LadarError naming the field when
+        not a finite number above 0."""
         text = self.query_one("#sweep-budget", Input).value.strip()
         if not text:
             return None
@@ -226,7 +230,8 @@ class SweepScreen(SweepOpening):
         except ValueError:
             value = math.nan
         if not (math.isfinite(value) and value > 0):
-            raise FieldError("budget", text, "a flight-time budget in seconds, > 0")
+            expected = "a flight time in seconds, greater than 0 and finite (empty: the spec's budget)"
+            raise LadarError(refusal(BUDGET_LABEL, text, expected))
         return value
 
     def _budget(self) -> float | None:
@@ -249,9 +254,8 @@ class SweepScreen(SweepOpening):
             objective = self.objective if same else spec.objective
             cost = self.cost if same else spec.cost
             if objective in BUDGET_OBJECTIVES and budget is None:
-                raise FieldError(
-                    "budget", None, f"a flight-time budget in seconds for objective '{objective}'"
-                )
+                expected = f"a flight time in seconds: ranking by {objective} needs a budget"
+                raise LadarError(refusal(BUDGET_LABEL, "", expected))
             scheduler = self.query_one("#sweep-scheduler", Input).value.strip()
             security = None
             if scheduler:  # the same rules as the CLI: no plain scheduler off this machine
@@ -414,7 +418,7 @@ class SweepScreen(SweepOpening):
             budget = self._budget()  # checked whether or not the ranking reads it
             self._rank()
         except LadarError as error:
-            self._status(self._idle_state(), str(error), problem=True)
+            self._status(BUSY if self.running else NOT_READY, str(error), problem=True)
             return
         self._redraw()
         self._status(
