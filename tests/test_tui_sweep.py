@@ -220,6 +220,8 @@ async def test_opening_results_shows_the_ranking_failures_and_pareto_front(finis
             "ranking by time-to-identify; coverage-within-budget skipped: "
             "it needs a budget (type one in Budget s)"
         )
+        # cut at the screen's edge (the reason is the part cut): told whole as a note too
+        assert screen.last_message in [n.message for n in app._notifications]
         # then the objectives on identification, each with its own column
         assert "identify s" in [c.label.plain for c in table.ordered_columns]
         for expected in ("distance-to-identify", "worst-target-coverage"):

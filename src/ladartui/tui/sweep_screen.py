@@ -540,14 +540,17 @@ class SweepScreen(SweepOpening):
         cancellable: bool = False,
         problem: bool = False,
     ) -> None:
-        """``problem``: an error, whose whole text also comes as a note when the status
-        line has to cut it (a scheduler's error runs to 200 characters)."""
+        """A message the status line has to cut also comes whole as a note (a
+        scheduler's error runs to 200 characters; why F6 skipped an objective comes
+        last), unless it is a running sweep's progress; ``problem``: an error."""
         message = " ".join(message.split())  # always one line
         self.last_message = message
         bar = self.query_one("#sweep-status", StatusBar)
         bar.show(state, message, progress, cancellable or self.running)
-        if problem and cell_len(message) > bar.query_one(StatusText).content_size.width:
-            self.notify(message, severity="error", markup=False, timeout=15)
+        cut = cell_len(message) > bar.query_one(StatusText).content_size.width
+        if cut and (problem or state != BUSY):
+            severity = "error" if problem else "information"
+            self.notify(message, severity=severity, markup=False, timeout=15 if problem else 8)
 
     # -- best path ----------------------------------------------------------------
 
