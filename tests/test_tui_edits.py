@@ -196,6 +196,19 @@ async def test_quit_new_and_open_with_unsaved_edits_ask_first(tmp_path, scene_fi
         await pilot.click("#unsaved-cancel")
         await pilot.pause()
         assert app.scenario.path == scenario.path and app.scenario.sensor.grid == 12
+        # from the sweep screen itself: Cancel goes back to it, not to the main screen
+        await pilot.press("f12")
+        await pilot.pause()
+        sweep = app.screen
+        assert isinstance(sweep, SweepScreen)
+        sweep.post_message(SweepScreen.OpenScenario(other.path))
+        await pilot.pause()
+        assert isinstance(app.screen, UnsavedScreen)
+        await pilot.click("#unsaved-cancel")
+        await pilot.pause()
+        assert app.screen is sweep and app.tool_screen is sweep
+        await pilot.press("escape")
+        await pilot.pause()
         await pilot.press("f3")
         await pilot.pause()
         await pilot.click("#unsaved-discard")

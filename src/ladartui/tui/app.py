@@ -478,12 +478,15 @@ class LadarApp(KeyWords, ScenarioEditing, EditGuard, FileActions, SceneLoading, 
         if self.run_in_progress():
             self.tell("A run is in progress; the best path was not opened.", severity="warning")
             return
-        screen = self.tool_screen
-        if screen is not None and self.screen is screen and not getattr(screen, "running", False):
-            screen.dismiss(None)
-        else:
-            self.tell(f"Opening {message.path.name}; Esc leaves the sweep screen to see it.")
-        self.open_path(message.path)
+
+        def leave_the_sweep() -> None:  # once unsaved edits are dealt with: Cancel stays
+            screen = self.tool_screen
+            if screen is not None and self.screen is screen and not getattr(screen, "running", False):
+                screen.dismiss(None)
+            else:
+                self.tell(f"Opening {message.path.name}; Esc leaves the sweep screen to see it.")
+
+        self.open_path(message.path, before=leave_the_sweep)
 
     def tell(
         self, message: str, *, title: str = "", severity: SeverityLevel = "information", timeout: float = 5

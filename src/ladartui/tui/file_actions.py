@@ -7,6 +7,7 @@ the fields (``commit_pending``), so what is written is what is on screen.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 from ladartui.errors import LadarError
@@ -55,12 +56,15 @@ class FileActions(Host):
         typed = (scenario.path.name, scene, format_number(scenario.voxel_size))
         self._open_setup("new", folder, typed, error)
 
-    def open_path(self, path: Path) -> None:
-        """Open a scenario file (recent list, best sweep path), asking about unsaved edits."""
+    def open_path(self, path: Path, before: Callable[[], None] | None = None) -> None:
+        """Open a scenario file (recent list, best sweep path), asking about unsaved edits;
+        ``before`` is called once the analyst goes on (not on Cancel)."""
         if self.busy:
             return
 
         def load():
+            if before is not None:
+                before()
             self.result = None
             self.load(path)
 

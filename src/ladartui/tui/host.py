@@ -160,7 +160,7 @@ class AppHost(App[None]):
     def save_before_leaving(self) -> None:
         raise NotImplementedError
 
-    def open_path(self, path: Path) -> None:
+    def open_path(self, path: Path, before: Callable[[], None] | None = None) -> None:
         raise NotImplementedError
 
     def load(self, path: Path | None, scenario: Scenario | None = None, new: bool = False) -> None:

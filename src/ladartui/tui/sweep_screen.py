@@ -548,9 +548,10 @@ class SweepScreen(SweepOpening):
         bar = self.query_one("#sweep-status", StatusBar)
         bar.show(state, message, progress, cancellable or self.running)
         cut = cell_len(message) > bar.query_one(StatusText).content_size.width
-        if cut and (problem or state != BUSY):
-            severity = "error" if problem else "information"
-            self.notify(message, severity=severity, markup=False, timeout=15 if problem else 8)
+        if cut and problem:
+            self.notify(message, severity="error", markup=False, timeout=15)
+        elif cut and state != BUSY:
+            self.notify(message, markup=False, timeout=8)
 
     # -- best path ----------------------------------------------------------------
 
