@@ -289,6 +289,23 @@ async def test_the_palette_over_a_prompt_offers_none_of_the_apps_commands(tmp_pa
         assert "Quit" not in offered  # it would ask the same question again
 
 
+async def test_a_palette_command_that_is_off_says_why(tmp_path, scene_files):
+    """Save from the palette during a run did nothing and said nothing, where its key
+    says it is off while the run goes on."""
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        commands = {command.title: command for command in app.get_system_commands(app.screen)}
+        app.set_busy("Working...")
+        await pilot.pause()
+        commands["Save scenario"].callback()
+        await pilot.pause()
+        assert app.messages[-1] == "Save scenario is off while busy: Working..."
+        app.set_busy(None)
+        await pilot.pause()
+
+
 def test_the_new_scenario_preview_takes_any_partial_path():
     """Typing '/' as the scene model ended the app: Path('/') has an empty name."""
     from pathlib import Path

@@ -276,13 +276,16 @@ class LadarApp(KeyWords, ScenarioEditing, EditGuard, FileActions, SceneLoading, 
         active = self.screen.active_bindings.get(event.key)
         if active is None or active.enabled:
             return
-        what = active.binding.description or active.binding.action
+        self.tell_why_off(active.binding.description or active.binding.action, active.binding.action)
+
+    def tell_why_off(self, what: str, action: str) -> None:
+        """Why the command ``what`` (its ``action``) is off, from its key or the palette."""
         if self.run_in_progress():
             cancel = self.key_says("cancel", "cancels the run")
             self.tell(f"{what} is off while the run goes on" + (f"; {cancel}." if cancel else "."), timeout=3)
         elif self.busy is not None:
             self.tell(f"{what} is off while busy: {self.busy}", timeout=3)
-        elif active.binding.action == "run" and (problems := self.problems(fields=False)):
+        elif action == "run" and (problems := self.problems(fields=False)):
             self.tell(f"Run is off: {'; '.join(problems)}.", timeout=3)
 
     # -- flight path (the palette and keys reach the flight panel through these) -------
@@ -573,11 +576,15 @@ class LadarApp(KeyWords, ScenarioEditing, EditGuard, FileActions, SceneLoading, 
         if waiting:
             return  # nothing may start under it
         for title, help_text, action in palette_entries(self):
-            yield SystemCommand(title, help_text, _runner(self, action))
+            yield SystemCommand(title, help_text, _runner(self, action, title))
 
 
-def _runner(app, action: str):
+def _runner(app, action: str, title: str):
     def run():
+        name = action.split("(")[0]
+        if not app.check_action(name, ()):  # off (busy, or Run not ready): say why, as its key does
+            app.tell_why_off(title, name)
+            return
         app.call_later(app.run_action, action)
 
     return run
