@@ -157,6 +157,13 @@ async def test_recent_scenarios_are_listed_and_open_after_asking(tmp_path, scene
         assert isinstance(app.screen, UnsavedScreen)  # the edit is not lost unasked
         await pilot.click("#unsaved-discard")
         await wait_until(pilot, lambda: app.scenario.path == first.path and app.busy is None)
+        # one deleted since: opening it fails, and it leaves the list (it stayed, to fail again)
+        second.path.unlink()
+        assert listing.get_option_at_index(0).id == str(second.path.resolve())
+        app.open_path(second.path)
+        await wait_until(pilot, lambda: app.busy is None and any("Could not load" in m for m in app.messages))
+        await pilot.pause()
+        assert listing.option_count == 0
 
 
 async def test_the_folder_tree_fills_the_scenario_field(tmp_path, scene_files):

@@ -541,6 +541,8 @@ class LadarApp(KeyWords, ScenarioEditing, EditGuard, FileActions, SceneLoading, 
                 self.set_busy(None)
                 if message.error:
                     self.run_panel.say(message.error)
+                    # a recent scenario deleted since leaves the list (it lists files there are)
+                    self.file_panel.show_recent(self.scenario.path if self.scenario else None)
                 if message.job == "new" and message.error and self.new_pending is not None:
                     self.new_refused(self.new_pending, message.error)
         elif message.job == "probe":
