@@ -239,6 +239,20 @@ def test_new_scenario_orbits_the_target_centre(tmp_path):
     assert load_scenario(saved.path) == scenario
 
 
+def test_points_a_new_scenario_and_aim_all_write_are_rounded_to_millimetres(tmp_path):
+    """The centroid went into the file as 29.88051470588235 beside hand-written 29.881."""
+    pytest.importorskip("ladartui.scene.voxels")
+    from ladartui.tui import bridge
+
+    target = ((10, 20, 0), (12, 20, 0), (11, 23, 1))  # centroid (11, 21, 1/3) voxels
+    write_models(tmp_path, "woods", target)
+    scenario = Scenario.new(tmp_path / "new.toml", "woods.txt", 0.3)
+    assert scenario.flight.segments[0].centre == (3.3, 6.3, 0.1)  # (3.3, 6.3, 0.0999...) m
+    aimed = bridge.aim_all(scenario, (29.88051470588235, 29.902573529411764, 0.9264705882352942))
+    assert aimed.flight.segments[0].aim_at == (29.881, 29.903, 0.926)
+    assert "29.88051" not in aimed.save().path.read_text()
+
+
 def test_summary_describes_the_collection(tmp_path):
     write_models(tmp_path / "models")
     scenario = load_scenario(write_scenario(tmp_path))

@@ -31,6 +31,12 @@ def target_centre(target_voxels, voxel_size) -> tuple[float, float, float]:
     return (float(x), float(y), float(z))
 
 
+def to_millimetres(point) -> tuple[float, ...]:
+    """A point (metres) as scenario files write the points the program chooses: to the
+    millimetre, as a person would (29.881, not 29.88051470588235)."""
+    return tuple(round(float(v), 3) for v in point)
+
+
 def default_flight(target_voxels, voxel_size, sensor: Sensor = DEFAULT_SENSOR) -> FlightPlan:
     """A 24-scan clockwise orbit at 45 degrees depression around the target's centre.
 
@@ -44,5 +50,10 @@ def default_flight(target_voxels, voxel_size, sensor: Sensor = DEFAULT_SENSOR) -
     slant = max(MIN_SLANT_RANGE, VIEW_MARGIN * size / (2 * math.tan(math.radians(sensor.fov / 2))))
     radius = slant * math.cos(math.radians(DEFAULT_DEPRESSION))
     altitude = centre[2] + slant * math.sin(math.radians(DEFAULT_DEPRESSION))
-    orbit = Orbit(centre=centre, radius=round(radius, 1), altitude=round(altitude, 1), scans=DEFAULT_SCANS)
+    orbit = Orbit(
+        centre=to_millimetres(centre),
+        radius=round(radius, 1),
+        altitude=round(altitude, 1),
+        scans=DEFAULT_SCANS,
+    )
     return FlightPlan(None, (orbit,))

@@ -28,7 +28,7 @@ from pathlib import Path
 import platformdirs
 
 from ladartui.atomic import write_text_atomic
-from ladartui.defaults import target_centre
+from ladartui.defaults import target_centre, to_millimetres
 from ladartui.fileprobe import path_field
 from ladartui.flight import Orbit
 from ladartui.scenario import Scenario, scenario_from_toml
@@ -201,7 +201,7 @@ def _materialise(folder: Path, name: str) -> None:
 def _recentred(segment, centre):
     # The packaged centre is rounded to millimetres.
     if isinstance(segment, Orbit) and math.dist(segment.centre, centre) > 0.01:
-        return replace(segment, centre=tuple(round(c, 3) for c in centre), aim_at=None)
+        return replace(segment, centre=to_millimetres(centre), aim_at=None)
     return segment
 
 

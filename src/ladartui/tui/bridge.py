@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ladartui.checks import compass_field, number_field
+from ladartui.defaults import to_millimetres
 from ladartui.errors import FieldError, InputFileError, LadarError
 from ladartui.fileprobe import file_problem
 from ladartui.flight import (
@@ -264,7 +265,7 @@ def with_segments(scenario: Scenario, segments) -> Scenario:
 def aim_all(scenario: Scenario, target_xyz) -> Scenario:
     """Every segment aimed at the target point: presets and manoeuvres get ``aim_at``,
     manual poses are turned to look at it."""
-    target = tuple(float(v) for v in target_xyz)
+    target = to_millimetres(target_xyz)
     segments = []
     for segment in scenario.flight.segments:
         if isinstance(segment, Manual):
