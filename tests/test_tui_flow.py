@@ -465,6 +465,13 @@ async def test_flight_segments_are_added_edited_and_checked(shared, tmp_path, sc
     await pilot.pause()
     kinds = [s.kind for s in app.scenario.flight.segments]
     assert kinds == ["orbit", "straight"]
+    # an edit's form names the segment it edits (two alike read the same)
+    app.query_one("#segments").move_cursor(row=1)
+    app.action_edit_segment()
+    await pilot.pause()
+    assert isinstance(app.screen, FormScreen) and app.screen.title_text == "Straight (segment 2 of 2)"
+    await pilot.press("escape")
+    await pilot.pause()
     assert len(app.scenario.poses()) == 6 + 3
     assert app.query_one("#scans").row_count == 9
     # aim every scan at the target centre: the central ray passes through it (to the

@@ -127,7 +127,8 @@ class FlightPanel(ParamPanel):
         defaults = bridge.default_segment(segment.kind, self.host.target_m(), None)
         spec = bridge.segment_spec(segment, defaults)
         label = bridge.SEGMENT_LABELS[segment.kind]
-        title = label + (" (new)" if index is None else "")
+        count = len(self.host.scenario.flight.segments) if self.host.scenario is not None else 0
+        title = label + (" (new)" if index is None else f" (segment {index + 1} of {count})")
         build = bridge.segment_builder(segment.kind)
 
         def build_in_path(values):
