@@ -379,7 +379,8 @@ async def test_an_unreachable_scheduler_gives_one_line_and_writes_nothing(tmp_pa
         await wait_for(pilot, lambda: not screen.running, timeout=60)
         message = screen.last_message
         assert status_of(screen).state == NOT_READY
-        assert "--scheduler" in message and "tcp://127.0.0.1:9" in message and "\n" not in message
+        # in the form's words, as its other fields say theirs: not the command's --scheduler
+        assert "Scheduler: tcp://127.0.0.1:9 is not allowed; expected" in message and "\n" not in message
         assert not (tmp_path / "spec-results" / "results.csv").exists()
         # too long for the status line: cut there, so the whole of it comes as a note too
         room = screen.query_one("#sweep-status #status-text").content_size.width
@@ -495,14 +496,16 @@ async def test_a_plain_scheduler_off_this_machine_is_refused_as_the_cli_refuses_
         await pilot.press("f5")
         await pilot.pause()
         assert not screen.running and not list(screen.workers)
-        assert "run code on it" in screen.last_message  # says why
+        assert "run code on it" in screen.last_message  # says why, in the form's words
+        assert screen.last_message.startswith("Scheduler: tcp://192.0.2.10:8786 is not allowed; expected")
         # a tls:// scheduler needs the certificates folder, named when incomplete
         screen.query_one("#sweep-scheduler").value = "tls://192.0.2.10:8786"
         screen.query_one("#sweep-certs").value = str(tmp_path)
         await pilot.press("f5")
         await pilot.pause()
         assert not screen.running
-        assert "certificates" in screen.last_message and "ca.pem" in screen.last_message
+        assert screen.last_message.startswith(f"Certificates: {tmp_path} is not allowed; expected a folder")
+        assert "ca.pem" in screen.last_message
 
 
 async def test_opening_reads_off_the_ui_thread_and_keeps_only_the_last_asked(finished, monkeypatch, tmp_path):

@@ -10,10 +10,24 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ladartui.errors import FieldError, InputFileError
+from ladartui.errors import FieldError, InputFileError, LadarError
+from ladartui.tui.fields import refusal
 
 if TYPE_CHECKING:
     from ladartui.sweep.best_file import BestScenario
+
+
+# The sweep screen's fields, as the cluster's refusals name them (some name the CLI's flags).
+FORM_LABELS = {"scheduler": "Scheduler", "--scheduler": "Scheduler", "certificates": "Certificates"}
+
+
+def in_form_words(error: FieldError) -> LadarError:
+    """A refusal of the scheduler or certificates as the sweep screen's other fields say
+    theirs ("Scheduler: X is not allowed; expected ..."); others as they are."""
+    label = FORM_LABELS.get(error.field)
+    if label is None:
+        return error
+    return LadarError(refusal(label, str(error.value), error.expected))
 
 
 def start_resource_tracker() -> None:
@@ -77,7 +91,10 @@ def sweep_job(
     try:
         if scheduler:
             progress(0.0, f"connecting to {scheduler} ...")
-            client = connect(scheduler, connect_timeout, security)
+            try:
+                client = connect(scheduler, connect_timeout, security)
+            except FieldError as error:
+                raise in_form_words(error) from None
         return run_sweep(
             spec,
             checked=checked,

@@ -26,13 +26,14 @@ from textual.validation import ValidationResult, Validator
 from textual.widgets import Button, Checkbox, DataTable, Footer, Input, Label, ProgressBar, Static
 from textual_plotext import PlotextPlot
 
-from ladartui.errors import LadarError
+from ladartui.errors import FieldError, LadarError
 from ladartui.recent import recent_paths, remember_path
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.tui.fields import refusal
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar, StatusText, format_eta
 from ladartui.tui.sweep_jobs import (
     StoredRows,
+    in_form_words,
     spec_to_run,
     start_resource_tracker,
     sweep_job,
@@ -263,7 +264,8 @@ class SweepScreen(SweepOpening):
 
                 security = folder_security(scheduler, self.query_one("#sweep-certs", Input).value.strip())
         except LadarError as error:
-            self._status(NOT_READY, str(error), problem=True)
+            said = in_form_words(error) if isinstance(error, FieldError) else error
+            self._status(NOT_READY, str(said), problem=True)
             return
         from ladartui.sweep import default_out_dir
 
