@@ -71,6 +71,21 @@ def test_local_workers_ignore_ctrl_c_which_this_process_handles(client):
     assert set(client.run(_sigint_handler).values()) == {signal.SIG_IGN}
 
 
+def test_a_local_schedulers_lost_scattered_data_is_not_logged(client, caplog):
+    """SIGTERM to the process group reaches the workers too: every stop printed the
+    scheduler's 'caused the cluster to lose scattered data' ERROR line."""
+    import logging
+
+    log = logging.getLogger("distributed.scheduler")
+    with caplog.at_level(logging.ERROR, logger="distributed.scheduler"):
+        log.error(
+            "Removing worker 'tcp://127.0.0.1:1' caused the cluster to lose scattered data, "
+            "which can't be recovered: {'ScenePayload-1'} (stimulus_id='x')"
+        )
+        log.error("another scheduler error")
+    assert [r.getMessage() for r in caplog.records] == ["another scheduler error"]
+
+
 def test_two_workers_give_the_same_rows_as_serial_runs(spec, serial_rows, client, tmp_path):
     result = run_sweep(spec, client=client, out=tmp_path)
     assert result.workers == 2

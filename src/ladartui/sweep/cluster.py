@@ -58,7 +58,27 @@ def local_client(workers: int | None = None):
         ) from error
     client = Client(cluster)
     _set_up_local_workers(client)
+    _quiet_lost_scattered_data()
     return client
+
+
+# distributed's scheduler's message for a worker gone with data scattered to it.
+LOST_SCATTERED = "lose scattered data, which can't be recovered"
+
+
+class _DropLostScattered(logging.Filter):
+    def filter(self, record):
+        return LOST_SCATTERED not in record.getMessage()
+
+
+def _quiet_lost_scattered_data() -> None:
+    """The scheduler of a local cluster (in this process) does not log a worker lost with
+    the scene scattered to it. SIGTERM to the terminal's process group reaches the workers
+    too, and every stop printed that ERROR line; a worker lost mid-sweep is told by the
+    sweep itself (its rows are 'failed', run again on resume)."""
+    scheduler_log = logging.getLogger("distributed.scheduler")
+    if not any(isinstance(f, _DropLostScattered) for f in scheduler_log.filters):
+        scheduler_log.addFilter(_DropLostScattered())
 
 
 @contextlib.contextmanager
