@@ -67,6 +67,16 @@ def test_show_ranks_the_rows_of_the_current_base_only(tmp_path, capsys):
     assert "4 rows of other variants or an earlier base left out" in text
     assert "no variant finished (no row of this spec's variants from its base as it is now)" in captured.err
     assert {p: p.read_bytes() for p in out.glob("pareto.*")} == charts  # not redrawn empty
+    # base as it ran: ranked by another objective, the charts stay the sweep's, as its
+    # ranking.csv and best path do (they starred the other ranking's best)
+    base.write_text(base.read_text(encoding="utf-8").replace("fov_deg = 16.0", "fov_deg = 18.0"))
+    assert main(["sweep", str(spec), "--show", "--objective", "time-to-identify", "--cost", "distance"]) == 0
+    said = capsys.readouterr().err
+    assert (
+        f"the charts in {out} are left as the sweep drew them (by obscured-coverage, against flight-time)"
+        in said
+    )
+    assert {p: p.read_bytes() for p in out.glob("pareto.*")} == charts
     # the base gone: every row of the table, said so
     base.unlink()
     assert main(["sweep", str(spec), "--show", "--json"]) == 0
