@@ -69,6 +69,9 @@ def test_no_write_with_a_chart_says_truly_what_was_written(scenario, capsys):
     assert main(["run", str(scenario.path), "--no-write", "--json", "--chart", str(chart)]) == 0
     out, err = capsys.readouterr()
     assert json.loads(out)["outputs"] == {} and err.endswith(f"wrote chart: {chart}\n")
+    assert json.loads(out)["chart"] == str(chart)  # a script reads what was written from the JSON
+    assert main(["run", str(scenario.path), "--no-write", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["chart"] is None
     assert not scenario.measures_file.exists()
 
 

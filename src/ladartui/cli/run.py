@@ -111,14 +111,14 @@ def run(args) -> int:
     finished: list[SimulationResult] = []  # the result, once there is one
     with _told_if_finished(finished):  # a Ctrl-C from then on says what the run wrote
         result = _simulate_with_progress(scenario, args, errors, finished)
-        chart_error = chart_line = None
+        chart_error = chart_line = chart_path = None
         if args.chart is not None:
             from ladartui import charts
             from ladartui.charts.coverage import coverage_figure
 
             try:
-                path = charts.save_figure(coverage_figure(result.measures), args.chart)
-                chart_line = single_line(f"wrote chart: {path}")
+                chart_path = charts.save_figure(coverage_figure(result.measures), args.chart)
+                chart_line = single_line(f"wrote chart: {chart_path}")
             except OSError as error:  # the run's outputs are written: say so, and show them
                 reason = (error.strerror or str(error)).lower()
                 written = (
@@ -130,7 +130,7 @@ def run(args) -> int:
         # The chart's line follows the run's own "wrote" lines; --json keeps stdout JSON.
         said = errors if args.json else Console()
         if args.json:
-            print(json.dumps(result_dict(scenario, result), indent=2, allow_nan=False))
+            print(json.dumps(result_dict(scenario, result, chart_path), indent=2, allow_nan=False))
         else:
             show_result(said, result, asked_precision=scenario.precision)
         if chart_line is not None:
@@ -227,8 +227,9 @@ def _told_if_finished(finished: list):
         ) from None
 
 
-def result_dict(scenario, result) -> dict:
-    """The run as a JSON-safe dict: backend, outputs, timings and measures."""
+def result_dict(scenario, result, chart=None) -> dict:
+    """The run as a JSON-safe dict: backend, outputs, the chart written (None: none),
+    timings and measures."""
     return {
         "scenario": str(getattr(scenario, "path", "")),
         "backend": result.backend,
@@ -239,6 +240,7 @@ def result_dict(scenario, result) -> dict:
         "scene_output_voxels": int(len(result.scene_output)),
         "target_output_voxels": int(len(result.target_output)),
         "outputs": dict(result.outputs),
+        "chart": None if chart is None else str(chart),
         "timings_s": {k: round(v, 4) for k, v in result.timings.items()},
         "measures": result.measures.to_dict(),
     }
