@@ -174,6 +174,10 @@ def test_info_without_target_file(tmp_path, capsys):
     assert main(["info", str(tmp_path / "lonely.txt")]) == 0
     out = capsys.readouterr().out
     assert "none (lonely_Target.txt not found)" in out
+    (tmp_path / "lonely_Target.txt").mkdir()  # it was said 'not found' too
+    assert main(["info", str(tmp_path / "lonely.txt")]) == 0
+    assert "none (lonely_Target.txt is a folder" in capsys.readouterr().out
+    (tmp_path / "lonely_Target.txt").rmdir()
     pytest.importorskip("ladartui.scene.occupancy")
     assert "(1 brick, 1 tile, 1 region)" in out  # not "1 bricks, 1 tiles, 1 regions"
     (tmp_path / "lonely_Target.txt").write_text("1,1,1\n")

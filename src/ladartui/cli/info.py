@@ -6,6 +6,7 @@ import time
 from pathlib import Path
 
 from ladartui.errors import LadarError
+from ladartui.fileprobe import file_problem
 from ladartui.number_text import extent_metres, plural
 from ladartui.textsafe import single_line, visible
 
@@ -156,8 +157,8 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
                 text += f" = ({m[0]:.2f}, {m[1]:.2f}, {m[2]:.2f}) m"
             shape = tuple(max(s, int(t) + 1) for s, t in zip(shape, target.max(axis=0)))
         rows.append(("target", text))
-    elif target_path is not None:
-        rows.append(("target", f"none ({target_path.name} not found)"))
+    elif target_path is not None:  # not found, or a folder or a pipe of that name
+        rows.append(("target", f"none ({target_path.name} {file_problem(target_path)})"))
     rows.append(("occupancy", _occupancy_text(voxels, shape, path)))
     print(single_line(f"{path}: voxel list"))
     width = max(len(name) for name, _ in rows)
