@@ -260,3 +260,15 @@ def test_a_precision_the_backend_lacks_is_named_in_the_summary_and_json(scenario
     assert json.loads(capsys.readouterr().out)["precision"] == "f64"
     assert main(["run", str(scenario.path), "--no-write"]) == 0
     assert "backend: numba (exact); 2 scans x" in capsys.readouterr().out
+
+
+def test_the_bar_names_compiling_only_when_the_cache_lacks_the_kernels(scenario, monkeypatch):
+    """Every run's bar said 'compiling kernels on a first run' until its first scan,
+    with the kernels cached too."""
+    from ladartui import precompile
+    from ladartui.cli.progress import FIRST_SCAN, first_scan
+
+    assert main(["run", str(scenario.path), "--no-write"]) == 0  # the kernels are cached now
+    assert first_scan(scenario) == "scan 1"
+    monkeypatch.setattr(precompile, "kernels_cached", lambda scenario: False)
+    assert first_scan(scenario) == FIRST_SCAN == "scan 1 (compiling kernels on a first run)"

@@ -20,8 +20,19 @@ from ladartui.errors import Cancelled
 T = TypeVar("T")
 
 POLL_SECONDS = 0.1  # how soon a Ctrl-C is noticed while waiting
-# Shown until the first scan is done: a first run also compiles the kernels (minutes on two cores).
+# Shown until the first scan is done when numba's cache lacks the kernels: a first run
+# compiles them (minutes on two cores).
 FIRST_SCAN = "scan 1 (compiling kernels on a first run)"
+
+
+def first_scan(scenario) -> str:
+    """What the bar says until a run of ``scenario`` finishes its first scan: compiling
+    is named only when the cache lacks its kernels (``precompile.kernels_cached``)."""
+    from ladartui.precompile import kernels_cached
+
+    return "scan 1" if kernels_cached(scenario) else FIRST_SCAN
+
+
 LOG_WIDTH = 200  # progress written to a file or pipe: wide enough for every line
 
 

@@ -158,14 +158,16 @@ def _where(progress) -> str:
 def _study_with_progress(scenario, pulses, settings, backend, console, state):
     from rich.progress import TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
-    from ladartui.cli.progress import FIRST_SCAN, progress_display, run_cancellable, sigterm_as_interrupt
+    from ladartui.cli.progress import first_scan, progress_display, run_cancellable, sigterm_as_interrupt
     from ladartui.detection.pulses import pulse_study
     from ladartui.precompile import compile_ahead
 
     cancel = threading.Event()
     after = (TextColumn("{task.percentage:>5.1f} %"), TimeElapsedColumn(), TimeRemainingColumn())
     with progress_display(console, after, transient=False) as bar:
-        task = bar.add_task(FIRST_SCAN, total=1.0)
+        chosen = scenario.with_changes(detection=settings)  # Geiger-mode looks
+        chosen = chosen if backend is None else chosen.with_changes(backend=backend)
+        task = bar.add_task(first_scan(chosen), total=1.0)
 
         def report(p):
             state["last"] = p
@@ -177,8 +179,6 @@ def _study_with_progress(scenario, pulses, settings, backend, console, state):
             bar.update(task, completed=p.units_done / p.units_total, description=what)
 
         def work():
-            chosen = scenario.with_changes(detection=settings)  # Geiger-mode looks
-            chosen = chosen if backend is None else chosen.with_changes(backend=backend)
             scene = compile_ahead(chosen, cancel, load_scene=True)
             return pulse_study(
                 scenario, pulses, settings, scene=scene, backend=backend, progress=report, cancel=cancel

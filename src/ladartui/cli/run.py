@@ -17,7 +17,7 @@ import threading
 from typing import TYPE_CHECKING
 
 from ladartui.cli.flags import as_flags, check_scenario_name, refuse_step_without_march
-from ladartui.cli.progress import FIRST_SCAN, progress_display, run_cancellable, sigterm_as_interrupt
+from ladartui.cli.progress import first_scan, progress_display, run_cancellable, sigterm_as_interrupt
 from ladartui.errors import Cancelled, OutputFileError
 from ladartui.textsafe import single_line
 
@@ -180,7 +180,7 @@ def _simulate_with_progress(scenario, args, console, finished: list):
 
     cancel = threading.Event()
     with run_progress(console, transient=False) as bar:
-        task = bar.add_task(FIRST_SCAN, total=1.0, rays="")
+        task = bar.add_task(first_scan(scenario), total=1.0, rays="")
 
         def report(p):
             bar.update(
