@@ -172,6 +172,12 @@ def test_relative_segment_first_needs_a_start(tmp_path):
             "unknown section [simulatoin] "
             "(allowed: files, sensor, flight, simulation, detection, levels, targets)",
         ),
+        # a sweep spec given as a scenario: said to be one, with the command that runs it
+        (
+            "[simulation]",
+            "[sweep]",
+            "a sweep spec ([sweep]), not a scenario: 'ladartui sweep FILE' runs it",
+        ),
     ],
 )
 def test_unknown_keys_are_named_with_their_line(tmp_path, old, new, message):

@@ -242,6 +242,10 @@ class ScenarioReader:
                 homes = [section for section, keys in self.sections.items() if name in keys]
                 expected = f"it under [{homes[0]}]" if homes else f"a section ({', '.join(self.sections)})"
                 raise self.file_error(name, f"key '{name}' outside any section: expected {expected}")
+            if name == "sweep":  # a sweep spec given where a scenario goes
+                raise self.file_error(
+                    name, "a sweep spec ([sweep]), not a scenario: 'ladartui sweep FILE' runs it"
+                )
             if name not in self.sections:
                 raise self.file_error(name, f"unknown section [{name}] (allowed: {', '.join(self.sections)})")
         for name in RECORD_SECTIONS.keys() & doc.keys():  # read by ladartui.run_record
