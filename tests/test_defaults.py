@@ -138,6 +138,10 @@ def test_load_scenario_takes_a_bundled_name_as_the_commands_do(materialised, tmp
     # A file of that name here wins, as with the commands.
     (tmp_path / "default.toml").write_text(path.read_text(encoding="utf-8"), encoding="utf-8")
     assert load_scenario("default.toml", check_files=False).path == tmp_path / "default.toml"
+    # A folder of that name (a run's own, say) is no scenario file: the bundled one is meant
+    # ('validate default' said '.../default: is a folder', with no way to reach it from here).
+    (tmp_path / "default").mkdir()
+    assert load_scenario("default").path == path
     with pytest.raises(InputFileError) as caught:
         load_scenario("defualt")
     assert str(caught.value) == (

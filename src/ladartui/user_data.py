@@ -137,7 +137,7 @@ def bundled_or_path(argument) -> Path:
     (``convoy`` or ``convoy.toml``, with no folder) made ready in the user data folder."""
     path = Path(argument)
     name = bundled_scenario_name(argument)
-    if name is not None and not path.exists():
+    if name is not None and not path.is_file():  # a folder of that name is no scenario file
         return bundled_scenario_path(name)
     bare = path.parent == Path(".") and not _names_a_folder(argument)
     if bare and path.suffix in ("", ".toml") and not path.exists():
