@@ -223,6 +223,22 @@ def test_a_bad_origin_in_a_scenario_is_named_on_its_line(tmp_path, origin, found
             "log.csv:3: altitude = 200000.0 puts the aircraft 199440.0 m above the origin: "
             "expected at most 100000 m above it",
         ),
+        # angles past any a log holds were taken (a body-fixed sensor turned by them)
+        (
+            "time,x,y,z,heading",
+            "1,0,0,60,1e20",
+            "log.csv:3: heading = '1e20': expected degrees within +-36000",
+        ),
+        (
+            "time,x,y,z,heading,roll",
+            "1,0,0,60,0,1e6",
+            "log.csv:3: roll = '1e6': expected degrees within +-360",
+        ),
+        (
+            "time,x,y,z,heading,pitch",
+            "1,0,0,60,0,-400",
+            "log.csv:3: pitch = '-400': expected degrees within +-360",
+        ),
     ],
 )
 def test_a_bad_log_column_or_value_is_named_in_the_log(tmp_path, header, record, said):
@@ -238,6 +254,8 @@ def test_a_bad_log_column_or_value_is_named_in_the_log(tmp_path, header, record,
     )
     if header.endswith(",x"):
         first += ",5"
+    elif header.endswith(("roll", "pitch")):
+        first += ",0"
     path.write_text(f"{header}\n{first}\n{record}\n")
     with pytest.raises(TrajectoryError) as caught:
         load_flight_log(path, origin=(-35.28, 149.13, 560.0) if "latitude" in header else None)

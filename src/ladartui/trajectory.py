@@ -149,6 +149,11 @@ def load_flight_log(path, origin=None) -> FlightLog:
                 raise TrajectoryError(f"{path}:{number}: {name} = {raw!r}: expected a number") from None
             if not np.isfinite(value):
                 raise TrajectoryError(f"{path}:{number}: {name} = {raw!r}: expected a finite number")
+            if name in LOG_ANGLE_LIMITS and abs(value) > LOG_ANGLE_LIMITS[name]:
+                raise TrajectoryError(
+                    f"{path}:{number}: {name} = {raw!r}: expected degrees within "
+                    f"+-{LOG_ANGLE_LIMITS[name]:g}"
+                )
             if name in ("x", "y", "z") and abs(value) > MAX_COORDINATE:
                 raise TrajectoryError(
                     f"{path}:{number}: {name} = {raw!r}: expected a coordinate within "
@@ -203,6 +208,11 @@ def load_flight_log(path, origin=None) -> FlightLog:
     else:
         xyz = np.stack([arr["x"], arr["y"], arr["z"]], axis=1)
     return FlightLog(arr["time"], xyz, arr["heading"], arr["roll"], arr["pitch"], fingerprint_of(data))
+
+
+# Angles a log may hold, in degrees: a heading unwrapped over up to a hundred turns, a
+# roll or pitch either way round once; past them a value is no angle (1e20 was taken).
+LOG_ANGLE_LIMITS = {"heading": 36_000.0, "roll": 360.0, "pitch": 360.0}
 
 
 def _angle(times, angles, t):
