@@ -364,6 +364,13 @@ def test_a_bad_ray_is_named_by_its_row_from_1_and_its_index(tmp_path, scene_file
     for bad, says in (
         ([2.0, 2.0, 20.0, 0.0, 0.0, 0.0], "has a zero direction: expected a unit vector"),
         ([np.nan, 2.0, 20.0, 0.0, 0.0, -1.0], "is not finite: expected finite numbers"),
+        # so far that f64 has no room left for the voxels: at 1e16 m the hit was the wrong
+        # voxel, from 1e17 m ground (where the f32 GPU shader was still right)
+        (
+            [5.0, 5.0, 1e16, 0.0, 0.0, -1.0],
+            "has its origin 1e+16 m from the scene's origin: expected within 1,000,000 m, "
+            "as a scenario's points",
+        ),
     ):
         np.save(tmp_path / "rays.npy", np.array([good, bad, bad]))
         command = ["trace", "--scene", str(scene_file), "--rays", str(tmp_path / "rays.npy")]

@@ -151,8 +151,7 @@ def load_flight_log(path, origin=None) -> FlightLog:
                 raise TrajectoryError(f"{path}:{number}: {name} = {raw!r}: expected a finite number")
             if name in LOG_ANGLE_LIMITS and abs(value) > LOG_ANGLE_LIMITS[name]:
                 raise TrajectoryError(
-                    f"{path}:{number}: {name} = {raw!r}: expected degrees within "
-                    f"+-{LOG_ANGLE_LIMITS[name]:g}"
+                    f"{path}:{number}: {name} = {raw!r}: expected degrees within +-{LOG_ANGLE_LIMITS[name]:g}"
                 )
             if name in ("x", "y", "z") and abs(value) > MAX_COORDINATE:
                 raise TrajectoryError(

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.atomic import atomic_path
+from ladartui.checks import MAX_COORDINATE
 from ladartui.errors import Cancelled, FieldError, InputFileError, ResourceLimitError
 from ladartui.fileprobe import NO_SUCH_FILE, refuse_special_file
 from ladartui.number_text import plural
@@ -128,6 +129,14 @@ def load_rays(path) -> np.ndarray:
     zero = np.flatnonzero(~np.any(rays[:, 3:] != 0, axis=1))
     if len(zero):
         raise InputFileError(path, f"{_row(int(zero[0]))} has a zero direction: expected a unit vector")
+    far = np.flatnonzero(np.abs(rays[:, :3]).max(axis=1) > MAX_COORDINATE)
+    if len(far):  # past it f64 cell coordinates lose the voxels (wrong hits, then none)
+        row = int(far[0])
+        raise InputFileError(
+            path,
+            f"{_row(row)} has its origin {np.abs(rays[row, :3]).max():.3g} m from the scene's "
+            f"origin: expected within {MAX_COORDINATE:,.0f} m, as a scenario's points",
+        )
     return rays
 
 
