@@ -255,8 +255,10 @@ async def test_the_study_screen_shows_text_from_a_study_file_as_it_is(tmp_path, 
         assert "no gpu\\x1b[2J [b]here[/b] [/x]" in verdict.replace("\n", " ")
 
 
-async def test_the_study_status_shortens_a_long_path_and_keeps_the_keys(tmp_path, scene_files):
-    """At 80 columns 'Study on /a/long/path.toml: q quick, f full, ...' lost its keys."""
+async def test_the_study_status_names_the_scenario_and_keeps_the_keys(tmp_path, scene_files):
+    """At 80 columns 'Study on /a/long/path.toml: q quick, f full, ...' lost its keys; then
+    the path cut to fit cut the file's name ('/tmp/...fault.toml'). And the chart's title,
+    wider than half the screen, was dropped by plotext, leaving its row blank."""
     from rich.cells import cell_len
 
     folder = tmp_path / ("a-long-folder-name-" * 3)
@@ -264,8 +266,10 @@ async def test_the_study_status_shortens_a_long_path_and_keeps_the_keys(tmp_path
     async with study_screen(folder, scene_files, size=(80, 24)) as (app, pilot, screen):
         status = screen.query_one("#study-status StatusText", Static)
         shown = str(status.render())
-        assert shown.endswith("q quick, f full, Ctrl+X cancel, Esc back"), shown
-        assert "\u2026" in shown and cell_len(shown) <= status.content_size.width
+        assert shown == f"Study on {screen.scenario_path.name}: q quick, f full, Ctrl+X cancel, Esc back"
+        assert cell_len(shown) <= status.content_size.width
+        chart = screen.query_one("#study-chart")
+        assert len("Speed vs accuracy: q quick, f full") <= chart.content_size.width
 
 
 async def test_tab_reaches_the_views_while_a_run_goes_on(tmp_path, scene_files, monkeypatch):

@@ -8,6 +8,8 @@ shown on the screen while the app stays open.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from rich.text import Text
 from textual import events, on
 from textual.app import ComposeResult
@@ -96,7 +98,8 @@ class StudyScreen(Screen):
         self._fill_table()
         self._set_status(self._idle_text())
         plot = self.query_one("#study-chart", PlotextPlot).plt
-        plot.title("Speed against accuracy: press q (quick) or f (full)")
+        # short: plotext drops a title wider than the chart (half of 80 columns)
+        plot.title("Speed vs accuracy: q quick, f full")
         self._reopen()
 
     def _reopen(self) -> None:
@@ -117,7 +120,8 @@ class StudyScreen(Screen):
         self._set_status(f"last study{' of ' + when if when else ''} ({path}): q quick, f full to run again")
 
     def _idle_text(self) -> str:
-        where = self.scenario_path or "the generated scenes"
+        # the file's name: a folder cut to fit cut the name too ("/tmp/...fault.toml")
+        where = Path(self.scenario_path).name if self.scenario_path else "the generated scenes"
         return f"Study on {where}: q quick, f full, Ctrl+X cancel, Esc back"
 
     # -- actions ---------------------------------------------------------------
