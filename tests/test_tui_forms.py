@@ -101,6 +101,25 @@ async def test_a_new_scenario_whose_scene_cannot_be_read_is_not_written_and_its_
         assert app.scenario.path == scenario.path  # the one open before stays
 
 
+async def test_open_shows_only_the_fields_it_reads(tmp_path, scene_files):
+    """Open showed New's scene model and voxel size, the voxel size in plain text as if
+    it were read; they show again on switching to New."""
+    from textual.widgets import RadioButton
+
+    from ladartui.tui.file_dialogs import SetupScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario) as (app, pilot):
+        await pilot.press("f3")
+        await wait_until(pilot, lambda: isinstance(app.screen, SetupScreen) and app.screen.is_mounted, 10)
+        dialog = app.screen
+        rows = [dialog.query_one(name).parent for name in ("#scene-file", "#voxel-size")]
+        assert not any(row.display for row in rows)
+        dialog.query_one("#mode-new", RadioButton).value = True
+        await pilot.pause()
+        assert dialog.mode == "new" and all(row.display for row in rows)
+
+
 async def test_a_segment_the_whole_path_refuses_keeps_its_form_open(tmp_path, scene_files):
     """A straight of 9999 scans after a 6-scan orbit: each field was allowed, the form
     closed, and the path's own limit was said after it ('Flight path not changed'),

@@ -110,8 +110,11 @@ class SetupScreen(TreeDialog):
         self._apply_mode()
 
     def _apply_mode(self) -> None:
-        self.query_one("#scene-file", Input).disabled = self.mode != "new"
-        self.query_one("#voxel-size", Input).disabled = self.mode != "new"
+        for name in ("#scene-file", "#voxel-size"):  # New's alone: Open hides them
+            field = self.query_one(name, Input)
+            field.disabled = self.mode != "new"
+            if field.parent is not None:
+                field.parent.display = self.mode == "new"
         self._show_derived()
 
     @on(DirectoryTree.FileSelected, "#tree")
