@@ -50,8 +50,9 @@ class SetupScreen(TreeDialog):
         super().__init__()
         self.mode = mode
         self.current = current
-        self.typed = typed
         self.said = said
+        # field id -> the text New's form comes back with; its Changed event clears nothing
+        self.prefilled = dict(zip(("scenario-file", "scene-file", "voxel-size"), typed or ()))
         self.base = folder or Path.cwd()
         self.folder = self.base
 
@@ -65,6 +66,7 @@ class SetupScreen(TreeDialog):
             yield _row(
                 "Scenario file",
                 Input(
+                    self.prefilled.get("scenario-file", ""),
                     placeholder="name.toml",
                     id="scenario-file",
                     compact=True,
@@ -74,6 +76,7 @@ class SetupScreen(TreeDialog):
             yield _row(
                 "3D scene model",
                 Input(
+                    self.prefilled.get("scene-file", ""),
                     placeholder="scene.txt",
                     id="scene-file",
                     compact=True,
@@ -82,7 +85,13 @@ class SetupScreen(TreeDialog):
             )
             yield _row(
                 "Voxel size m",
-                NumberField("voxel size", 1.0, default=1.0, check=bridge.check_voxel_size, id="voxel-size"),
+                NumberField(
+                    "voxel size",
+                    float(self.prefilled.get("voxel-size", 1.0)),
+                    default=1.0,
+                    check=bridge.check_voxel_size,
+                    id="voxel-size",
+                ),
             )
             yield Static("", id="derived", classes="info")
             yield Static("", id="setup-message", classes="message", markup=False)
@@ -96,11 +105,7 @@ class SetupScreen(TreeDialog):
         field = self.query_one("#scenario-file", Input)
         if self.mode == "load" and self.current is not None:
             field.value = self.relative(self.current)
-        if self.typed is not None:
-            for name, text in zip(("scenario-file", "scene-file", "voxel-size"), self.typed):
-                self.query_one(f"#{name}", Input).value = text
-            # after the fields' Changed events, which clear the message
-            self.call_after_refresh(self.query_one("#setup-message", Static).update, self.said)
+        self.query_one("#setup-message", Static).update(self.said)
         field.focus()
 
     @on(RadioSet.Changed, "#mode")
@@ -133,7 +138,11 @@ class SetupScreen(TreeDialog):
 
     @on(Input.Changed)
     def _typed(self, event: Input.Changed) -> None:
-        self.query_one("#setup-message", Static).update("")
+        # what the analyst types clears the message; the form's own filling does not
+        if self.prefilled.get(event.input.id or "") == event.value:
+            del self.prefilled[event.input.id or ""]
+        else:
+            self.query_one("#setup-message", Static).update("")
         if isinstance(event.input, NumberField):
             event.input.set_class(event.input.problem() is not None, "-bad")
         self._show_derived()
