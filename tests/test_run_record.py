@@ -339,6 +339,35 @@ def test_validate_names_a_flight_log_changed_since_the_run(scenario, capsys):
     assert _last_run_lines(capsys, flown)[1:] == ["last run   the flight log pass.csv changed since the run"]
 
 
+def test_validate_names_an_output_changed_since_the_run_wrote_it(scenario, capsys):
+    """Outputs overwritten after their run (echo x > S.cmf) still read 'made the outputs
+    with this file's settings': the record fingerprinted the files read, not written."""
+    import hashlib
+
+    from ladartui.run_record import recorded_outputs
+
+    simulate(scenario)
+    recorded = {entry.role: entry for entry in recorded_outputs(scenario)}
+    assert set(recorded) == {"scene output", "target output", "measures"}
+    for entry in recorded.values():
+        data = entry.path.read_bytes()
+        assert (entry.fingerprint.size, entry.fingerprint.sha256) == (
+            len(data),
+            hashlib.sha256(data).hexdigest(),
+        )
+    assert _last_run_lines(capsys, scenario) == [
+        "last run   made the outputs with this file's settings (S_Run.toml)"
+    ]
+    scenario.measures_file.write_text("x\n")
+    scenario.scene_output.write_text("1,1,1\n")
+    assert _last_run_lines(capsys, scenario)[1:] == [
+        "last run   S_Scene.txt changed since the run wrote it: it is not the run's output",
+        "last run   S.cmf changed since the run wrote it: it is not the run's output",
+    ]
+    simulate(scenario)  # the next run's are its own
+    assert _last_run_lines(capsys, scenario)[1:] == []
+
+
 def test_a_record_older_than_model_fingerprints_is_read_and_says_so(scenario, capsys):
     simulate(scenario)
     record = scenario.path.with_name("S_Run.toml")

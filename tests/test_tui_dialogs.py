@@ -329,6 +329,21 @@ async def test_outputs_whose_scene_model_changed_since_their_run_are_out_of_date
         assert bar.state == READY
 
 
+async def test_outputs_replaced_since_their_run_are_said_to_be_so_on_opening(tmp_path, scene_files):
+    """A scene output overwritten after its run was shown as the run's, without a word."""
+    from ladartui.simulation import simulate
+
+    scenario = make_scenario(tmp_path, scene_files)
+    simulate(scenario)
+    scenario.scene_output.write_text("1,1,1\n", encoding="utf-8")
+    async with opened(scenario) as (app, pilot):
+        said = (
+            f"Earlier outputs: {scenario.scene_output.name} changed since the run wrote it: "
+            "it is not the run's output."
+        )
+        assert said in app.messages
+
+
 async def test_a_damaged_run_record_is_reported_and_the_outputs_still_shown(tmp_path, scene_files):
     from ladartui.simulation import simulate
 

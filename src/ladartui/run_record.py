@@ -10,7 +10,10 @@ written before records existed has none; it then counts as the saved file's.
 After the settings, ``[[run.inputs]]`` tables fingerprint each file the run
 read (``run_inputs``: scene model, target model, flight logs) by size and
 SHA-256, as the loaders read them; ``input_changes`` names one whose contents
-differ now. A record older than that has no ``[run]`` section.
+differ now. ``[[run.outputs]]`` fingerprint the scene and target outputs and
+the measures as the run wrote them; ``outputs_changed`` names one replaced
+since. A record older than inputs has no ``[run]`` section; one older than
+outputs has no ``outputs``.
 
 A file of that name that is not a record (its first line is not
 ``RECORD_HEADER``) is the analyst's own: a run refuses to replace it.
@@ -40,19 +43,24 @@ __all__ = [
     "is_record",
     "read_run_record",
     "recorded_inputs",
+    "recorded_outputs",
+    "outputs_changed",
     "run_inputs",
     "setting_changes",
 ]
 
 INPUT_ROLES = ("scene model", "target model", "flight log")
 _INPUTS_COMMENT = "# The files the run read: size in bytes and SHA-256 of their contents.\n"
+# The outputs a record fingerprints, by their name in ``simulation.output_paths``.
+OUTPUT_ROLES = {"scene": "scene output", "target": "target output", "measures": "measures"}
+_OUTPUTS_COMMENT = "# The files the run wrote, as it wrote them.\n"
 
 
 @dataclass(frozen=True)
 class InputFile:
-    """A file a run read, with the fingerprint of its bytes as read."""
+    """A file a run read (or wrote), with the fingerprint of its bytes as read (written)."""
 
-    role: str  # one of INPUT_ROLES
+    role: str  # one of INPUT_ROLES, or of OUTPUT_ROLES for an output
     path: Path
     fingerprint: Fingerprint
 
@@ -65,9 +73,10 @@ def as_run(scenario, backend=None, method=None, step=None, precision=None):
     return scenario.with_changes(path=scenario.run_record, **changes)
 
 
-def record_text(scenario, ran, inputs=()) -> str:
+def record_text(scenario, ran, inputs=(), outputs=()) -> str:
     """The record's text for a run of ``scenario`` that went as ``ran`` (``as_run``),
-    having read ``inputs`` (``run_inputs``)."""
+    having read ``inputs`` (``run_inputs``) and written ``outputs`` (``InputFile`` entries
+    of the ``OUTPUT_ROLES``)."""
     # names in comments escaped: a control character there is not TOML
     name = one_line(scenario.path.name)
     scene, target = one_line(scenario.scene_output.name), one_line(scenario.target_output.name)
@@ -78,16 +87,24 @@ def record_text(scenario, ran, inputs=()) -> str:
         f"# They may differ from {name}: a run can go with unsaved edits or flags.\n\n"
     )
     folder = scenario.run_record.parent
-    read = [
-        {
-            "role": entry.role,
-            "file": relative_path(entry.path, folder),
-            "bytes": entry.fingerprint.size,
-            "sha256": entry.fingerprint.sha256,
-        }
-        for entry in inputs
-    ]
-    return header + ran.toml_body() + "\n" + _INPUTS_COMMENT + tomli_w.dumps({"run": {"inputs": read}})
+
+    def listed(entries) -> list[dict]:
+        return [
+            {
+                "role": entry.role,
+                "file": relative_path(entry.path, folder),
+                "bytes": entry.fingerprint.size,
+                "sha256": entry.fingerprint.sha256,
+            }
+            for entry in entries
+        ]
+
+    text = (
+        header + ran.toml_body() + "\n" + _INPUTS_COMMENT + tomli_w.dumps({"run": {"inputs": listed(inputs)}})
+    )
+    if outputs:
+        text += "\n" + _OUTPUTS_COMMENT + tomli_w.dumps({"run": {"outputs": listed(outputs)}})
+    return text
 
 
 def run_inputs(scenario, scene) -> list[InputFile]:
@@ -108,6 +125,16 @@ def run_inputs(scenario, scene) -> list[InputFile]:
 def recorded_inputs(scenario) -> list[InputFile] | None:
     """The files the record says its run read; None when it does not say (a record
     older than that, or none). ``LadarError`` naming the record when it cannot be read."""
+    return _recorded(scenario, "inputs", INPUT_ROLES)
+
+
+def recorded_outputs(scenario) -> list[InputFile] | None:
+    """The outputs the record says its run wrote, as it wrote them; None when it does
+    not say. ``LadarError`` naming the record when it cannot be read."""
+    return _recorded(scenario, "outputs", tuple(OUTPUT_ROLES.values()))
+
+
+def _recorded(scenario, key: str, roles) -> list[InputFile] | None:
     path = scenario.run_record
     if not path.is_file():
         return None
@@ -115,19 +142,31 @@ def recorded_inputs(scenario) -> list[InputFile] | None:
         run = tomllib.loads(path.read_text(encoding="utf-8-sig")).get("run")
     except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as error:
         raise LadarError(f"{path}: cannot be read: {one_line(str(error))}") from None
-    if run is None:
+    if run is None or (key == "outputs" and isinstance(run, dict) and key not in run):
         return None
-    entries = run.get("inputs") if isinstance(run, dict) else None
+    entries = run.get(key) if isinstance(run, dict) else None
     if not isinstance(entries, list):
-        raise LadarError(f"{path}: [run] inputs: expected a list of [[run.inputs]] tables")
-    return [_recorded_input(path, index, entry) for index, entry in enumerate(entries)]
+        raise LadarError(f"{path}: [run] {key}: expected a list of [[run.{key}]] tables")
+    return [_recorded_file(path, key, roles, index, entry) for index, entry in enumerate(entries)]
 
 
-def _recorded_input(path: Path, index: int, entry) -> InputFile:
+def outputs_changed(scenario) -> list[str]:
+    """Each output the record fingerprints whose bytes on disk differ now, as "S.cmf
+    changed since the run wrote it" (none when the record does not say)."""
+    from ladartui.fingerprint import file_fingerprint
+
+    return [
+        f"{entry.path.name} changed since the run wrote it: it is not the run's output"
+        for entry in recorded_outputs(scenario) or ()
+        if file_fingerprint(entry.path) != entry.fingerprint
+    ]
+
+
+def _recorded_file(path: Path, key: str, roles, index: int, entry) -> InputFile:
     entry = entry if isinstance(entry, dict) else {}
-    role, file, size, sha256 = (entry.get(key) for key in ("role", "file", "bytes", "sha256"))
+    role, file, size, sha256 = (entry.get(name) for name in ("role", "file", "bytes", "sha256"))
     if (
-        role not in INPUT_ROLES
+        role not in roles
         or not isinstance(file, str)
         or not file
         or not isinstance(size, int)
@@ -136,7 +175,7 @@ def _recorded_input(path: Path, index: int, entry) -> InputFile:
         or not re.fullmatch(r"[0-9a-f]{64}", sha256)
     ):
         raise LadarError(
-            f"{path}: run.inputs[{index}]: expected role ({', '.join(INPUT_ROLES)}), file, "
+            f"{path}: run.{key}[{index}]: expected role ({', '.join(roles)}), file, "
             "bytes and sha256 (64 hex digits)"
         )
     return InputFile(role, resolve_path(path.parent, file), Fingerprint(size, sha256))

@@ -135,7 +135,7 @@ MAX_TARGET_NAME = 60
 RECORD_HEADER = "# ladartui run record"
 RECORD_SUFFIX = "_Run.toml"  # S.toml's record is S_Run.toml
 # A record's own section, after the settings: [[run.inputs]], the files the run read.
-RECORD_SECTIONS = {"run": ("inputs",)}
+RECORD_SECTIONS = {"run": ("inputs", "outputs")}
 # Segment kinds a scenario file may use: the flight plan's, and recorded logs.
 SEGMENT_FILE_KINDS = {**SEGMENT_KINDS, LogSegment.kind: LogSegment}
 

@@ -202,8 +202,16 @@ def _simulate(scenario, backend, method, step, precision, progress, cancel, outp
         check_cancelled(cancel, NOTHING_WRITTEN)
         tick = time.perf_counter()
         ran = as_run(scenario, backend, method, step, precision)
-        record = record_text(scenario, ran, run_inputs(scenario, scene))
-        outputs = _write_outputs(output_set, scene_output, target_output, measures, record, scene, cancel)
+        inputs = run_inputs(scenario, scene)
+        outputs = _write_outputs(
+            output_set,
+            scene_output,
+            target_output,
+            measures,
+            lambda written: record_text(scenario, ran, inputs, written),
+            scene,
+            cancel,
+        )
         timings["write"] = time.perf_counter() - tick
     timings["total"] = time.perf_counter() - started
     return SimulationResult(
@@ -448,15 +456,37 @@ def output_lock(scenario) -> Path:
 def _write_outputs(output_set, scene_output, target_output, measures, record, scene, cancel) -> dict:
     """Write every output of the set to a temporary file, then swap them all in together.
 
-    LAS outputs carry each voxel's target id as its point source id (0: not a target voxel).
+    ``record(outputs)`` is the run record's text, given the fingerprints of the scene
+    and target outputs and the measures as written (``output_paths`` puts them before
+    the record). LAS outputs carry each voxel's target id as its point source id (0:
+    not a target voxel).
     """
+    from ladartui.fingerprint import file_fingerprint
+    from ladartui.run_record import OUTPUT_ROLES, InputFile
     from ladartui.scene.voxels import write_voxels
 
+    temps: dict[str, Path] = {}
+
+    def kept(name: str, write):
+        def writer(tmp: Path) -> None:
+            write(tmp)
+            temps[name] = tmp
+
+        return writer
+
+    def write_record(tmp: Path) -> None:
+        written = []
+        for name, role in OUTPUT_ROLES.items():
+            fingerprint = file_fingerprint(temps[name]) if name in temps else None
+            if fingerprint is not None:
+                written.append(InputFile(role, output_set.paths[name], fingerprint))
+        tmp.write_text(record(written), encoding="utf-8")
+
     writers = {
-        "scene": lambda tmp: write_voxels(tmp, scene_output),
-        "target": lambda tmp: write_voxels(tmp, target_output),
-        "measures": lambda tmp: tmp.write_text(measures.to_cmf(), encoding="utf-8"),
-        "record": lambda tmp: tmp.write_text(record, encoding="utf-8"),
+        "scene": kept("scene", lambda tmp: write_voxels(tmp, scene_output)),
+        "target": kept("target", lambda tmp: write_voxels(tmp, target_output)),
+        "measures": kept("measures", lambda tmp: tmp.write_text(measures.to_cmf(), encoding="utf-8")),
+        "record": write_record,
     }
     if "scene_las" in output_set.paths:
         from ladartui.scene.las import compressed_suffix, write_las

@@ -146,6 +146,7 @@ def last_run_lines(scenario, scene, writable: bool = True) -> list[str]:
             f"last run   made the outputs with other settings than this file: {shown}; they are in {record}"
         ]
     lines.extend(f"last run   {line}" for line in _input_lines(scenario, scene))
+    lines.extend(f"last run   {line}" for line in _output_lines(scenario))
     left = earlier_las(scenario)
     if left:
         names = " and ".join(path.name for path in left)
@@ -154,6 +155,17 @@ def last_run_lines(scenario, scene, writable: bool = True) -> list[str]:
             f"last run   wrote no LAS: {names} {verb} from an earlier run (run --las writes them again)"
         )
     return lines
+
+
+def _output_lines(scenario) -> list[str]:
+    """The outputs replaced since their run wrote them (a record that says how it wrote them)."""
+    from ladartui.errors import LadarError
+    from ladartui.run_record import outputs_changed
+
+    try:
+        return outputs_changed(scenario)
+    except LadarError as error:
+        return [f"outputs of the run not read: {error}"]
 
 
 def _input_lines(scenario, scene) -> list[str]:

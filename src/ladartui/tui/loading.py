@@ -338,6 +338,8 @@ def _earlier(scenario, files: OutputFiles | None = None, scene: Scene | None = N
             warning = f"settings of the earlier run not read, taken as the file's: {error}"
         if ran is not None and scene is not None:
             changed, since_opened, warning = _inputs_changed(scenario, scene)
+        if ran is not None:  # (a record that cannot be read is said above)
+            warning = _with_replaced_outputs(scenario, warning)
         target_output = _target_output(scenario)
     return Earlier(scenario, output, measures, ran, warning, files, target_output, changed, since_opened)
 
@@ -367,6 +369,20 @@ def _inputs_changed(scenario, scene) -> tuple[list[str], list[str], str | None]:
     ]
     names = [visible(entry.path.name) for entry in newer]
     return changes, names, f"Earlier outputs: {'; '.join(changes)}." if changes else None
+
+
+def _with_replaced_outputs(scenario, warning: str | None) -> str | None:
+    """``warning`` and then the outputs replaced since their run wrote them, if any."""
+    from ladartui.run_record import outputs_changed
+
+    try:
+        replaced = [visible(change) for change in outputs_changed(scenario)]
+    except LadarError as error:
+        replaced = [visible(f"outputs of the earlier run not read: {error}")]
+    if not replaced:
+        return warning
+    said = f"Earlier outputs: {'; '.join(replaced)}."
+    return said if warning is None else f"{warning} {said}"
 
 
 def _target_output(scenario) -> np.ndarray | None:
