@@ -46,6 +46,7 @@ from ladartui.tui.screens import (
 )
 from ladartui.tui.startup_problems import startup_notice
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
+from ladartui.tui.tool_screens import ToolScreens
 from ladartui.tui.unsaved import EditGuard
 from ladartui.tui.view_area import LAYOUTS, OUTPUT_POINTS, ViewArea
 from ladartui.tui.work import JobDone, JobProgress, start_job
@@ -61,7 +62,7 @@ own_actions = actions.own_actions
 OUTPUTS_CHECK_SECONDS = 2.0  # how often the outputs on disk are compared with those shown
 
 
-class LadarApp(KeyWords, ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl, App):
+class LadarApp(KeyWords, ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl, ToolScreens, App):
     """Plan a foliage-penetrating LADAR collection: set up, fly, run, compare."""
 
     TITLE = "ladartui"
@@ -433,63 +434,6 @@ class LadarApp(KeyWords, ScenarioEditing, EditGuard, FileActions, SceneLoading, 
 
     def action_help(self) -> None:
         self.push_screen(HelpScreen(help_rows(self)))
-
-    # -- study and sweep screens -------------------------------------------------------
-
-    def action_study(self) -> None:
-        """The speed-against-accuracy study of the open scenario (its saved file)."""
-        if self.busy or self.tool_screen is not None:
-            return
-        from ladartui.tui.study_screen import StudyScreen  # plotting loads only when used
-
-        if not self.commit_pending():
-            return
-        path = None
-        if self.scenario is not None and self.scenario.path.is_file():
-            path = self.scenario.path
-            if self.modified or self.scenario_on_disk:  # edited here, or changed there since
-                self.tell(
-                    f"The study reads {path.name} as it is on disk, not as shown here; "
-                    f"save{self.key_note('save')} first to study what is shown.",
-                    severity="warning",
-                    timeout=8,
-                )
-
-        def closed(_result) -> None:
-            self.tool_screen = None
-            self.refresh_bindings()
-
-        self.tool_screen = screen = StudyScreen(scenario_path=path)
-        self.push_screen(screen, closed)
-
-    def action_sweep(self) -> None:
-        """Launch, open or watch flight-path sweeps."""
-        if self.busy or self.tool_screen is not None:
-            return
-        from ladartui.tui.sweep_screen import SweepScreen  # Dask loads only when used
-
-        def closed(_result) -> None:
-            self.tool_screen = None
-            self.refresh_bindings()
-
-        self.tool_screen = screen = SweepScreen()
-        self.push_screen(screen, closed)
-
-    def on_sweep_screen_open_scenario(self, message) -> None:
-        """The sweep's best flight path: open its scenario as F3 would (leaving the sweep
-        screen unless a sweep is still running there)."""
-        if self.run_in_progress():
-            self.tell("A run is in progress; the best path was not opened.", severity="warning")
-            return
-
-        def leave_the_sweep() -> None:  # once unsaved edits are dealt with: Cancel stays
-            screen = self.tool_screen
-            if screen is not None and self.screen is screen and not getattr(screen, "running", False):
-                screen.dismiss(None)
-            else:
-                self.tell(f"Opening {message.path.name}; Esc leaves the sweep screen to see it.")
-
-        self.open_path(message.path, before=leave_the_sweep)
 
     def tell(
         self, message: str, *, title: str = "", severity: SeverityLevel = "information", timeout: float = 5

@@ -22,6 +22,7 @@ from ladartui.tui.view_area import OUTPUT_POINTS
 if TYPE_CHECKING:
     import numpy as np
     from textual.notifications import SeverityLevel
+    from textual.screen import Screen
     from textual.widget import Widget
     from textual.worker import Worker
 
@@ -64,6 +65,7 @@ class AppHost(App[None]):
     new_pending: Scenario | None  # New's scenario while its scene is read (written after)
     warm_worker: Worker[Any] | None
     run_worker_handle: Worker[Any] | None
+    tool_screen: Screen[None] | None  # the study or sweep screen while it is open
     # the widgets, found once mounted
     file_panel: FilePanel
     sensor_panel: SensorPanel
