@@ -14,6 +14,7 @@ from ladartui.tui.file_dialogs import SaveAsScreen
 from ladartui.tui.poses_screen import PosesScreen
 from ladartui.tui.screens import CompareScreen, FormScreen, MeasuresScreen
 from test_tui_flow import LadarApp, loaded, make_scenario, type_into, wait_until
+from tui_support import screen_after
 
 SIZE = (100, 32)
 
@@ -186,10 +187,7 @@ async def test_markup_in_names_shows_as_typed_and_compare_reads_spaced_paths(tmp
         await pilot.press("escape")
         await pilot.pause()
         # Compare offers this run's measures file, whose name has a space, and reads it
-        app.action_compare()
-        await pilot.pause()
-        compare = app.screen
-        assert isinstance(compare, CompareScreen)
+        compare = await screen_after(pilot, app.action_compare, CompareScreen)
         assert message(compare, "#compare-message") in ("", "Give two or more .cmf files to compare.")
         other = tmp_path / "other run.cmf"
         other.write_bytes(scenario.measures_file.read_bytes())
@@ -529,10 +527,8 @@ async def test_the_new_scenario_dialog_refuses_in_the_forms_words(tmp_path, scen
 
     scenario = make_scenario(tmp_path, scene_files)
     async with opened(scenario) as (app, pilot):
-        await pilot.press("f2")
-        await pilot.pause()
-        dialog = app.screen
-        assert isinstance(dialog, SetupScreen) and dialog.mode == "new"
+        dialog = await screen_after(pilot, "f2", SetupScreen)
+        assert dialog.mode == "new"
         dialog.query_one("#setup-ok").press()
         await pilot.pause()
         assert (

@@ -7,6 +7,7 @@ from __future__ import annotations
 from ladartui.tui.screens import CompareScreen, FormScreen
 from test_tui_dialogs import message, opened
 from test_tui_flow import make_scenario, type_into, wait_until
+from tui_support import screen_after
 
 
 async def test_compare_reads_names_typed_in_the_folder_it_shows(tmp_path, scene_files, monkeypatch):
@@ -23,10 +24,7 @@ async def test_compare_reads_names_typed_in_the_folder_it_shows(tmp_path, scene_
         Measures(target_voxels=100, obscured_coverage=coverage, scans=10).write_cmf(here / f"{name}.cmf")
     scenario = make_scenario(here, scene_files)
     async with opened(scenario) as (app, pilot):
-        app.action_compare()
-        await pilot.pause()
-        compare = app.screen
-        assert isinstance(compare, CompareScreen)
+        compare = await screen_after(pilot, app.action_compare, CompareScreen)
         field = compare.query_one("#cmf-files")
         field.value = "a.cmf b.cmf"
         await pilot.press("enter")
@@ -49,10 +47,8 @@ async def test_a_scenario_file_given_as_the_new_scenarios_scene_model_is_named_s
 
     scenario = make_scenario(tmp_path, scene_files)
     async with opened(scenario) as (app, pilot):
-        await pilot.press("f2")
-        await pilot.pause()
-        dialog = app.screen
-        assert isinstance(dialog, SetupScreen) and dialog.mode == "new"
+        dialog = await screen_after(pilot, "f2", SetupScreen)
+        assert dialog.mode == "new"
         dialog.query_one("#scenario-file").value = "fresh.toml"
         dialog.query_one("#scene-file").value = scenario.path.name
         dialog.query_one("#setup-ok").press()
@@ -74,9 +70,7 @@ async def test_a_new_scenario_whose_scene_cannot_be_read_is_not_written_and_its_
     (tmp_path / "bad.txt").write_text("1,2,3\n1,2,abc\n", encoding="utf-8")
     (tmp_path / "bad_Target.txt").write_text("1,2,3\n", encoding="utf-8")
     async with opened(scenario) as (app, pilot):
-        await pilot.press("f2")
-        await wait_until(pilot, lambda: isinstance(app.screen, SetupScreen) and app.screen.is_mounted)
-        dialog = app.screen
+        dialog = await screen_after(pilot, "f2", SetupScreen)
         dialog.query_one("#scenario-file").value = "fresh.toml"
         dialog.query_one("#scene-file").value = "bad.txt"
         dialog.query_one("#voxel-size").value = "0.25"
@@ -110,9 +104,7 @@ async def test_open_shows_only_the_fields_it_reads(tmp_path, scene_files):
 
     scenario = make_scenario(tmp_path, scene_files)
     async with opened(scenario) as (app, pilot):
-        await pilot.press("f3")
-        await wait_until(pilot, lambda: isinstance(app.screen, SetupScreen) and app.screen.is_mounted, 10)
-        dialog = app.screen
+        dialog = await screen_after(pilot, "f3", SetupScreen)
         rows = [dialog.query_one(name).parent for name in ("#scene-file", "#voxel-size")]
         assert not any(row.display for row in rows)
         dialog.query_one("#mode-new", RadioButton).value = True
@@ -171,9 +163,7 @@ async def test_compare_names_the_files_in_its_folder_by_their_names(tmp_path, sc
     Measures(target_voxels=100, obscured_coverage=0.2, scans=10).write_cmf(scenario.measures_file)
     Measures(target_voxels=100, obscured_coverage=0.3, scans=10).write_cmf(tmp_path / "other run.cmf")
     async with opened(scenario, size=(80, 24)) as (app, pilot):
-        app.action_compare()
-        await pilot.pause()
-        compare = app.screen
+        compare = await screen_after(pilot, app.action_compare, CompareScreen)
         assert compare.query_one("#cmf-files").value == "demo.cmf 'other run.cmf'"
         table = compare.query_one("#compare-table")
         assert [str(c.label) for c in table.columns.values()] == ["Measure", "demo", "other run"]
@@ -191,10 +181,8 @@ async def test_open_offers_the_open_scenario_so_enter_reopens_it(tmp_path, scene
         assert "speed_mps = " in text
         before = app.scenario.speed
         scenario.path.write_text(text.replace("speed_mps = ", "speed_mps = 1"), encoding="utf-8")
-        await pilot.press("f3")
-        await pilot.pause()
-        dialog = app.screen
-        assert isinstance(dialog, SetupScreen) and dialog.mode == "load"
+        dialog = await screen_after(pilot, "f3", SetupScreen)
+        assert dialog.mode == "load"
         field = dialog.query_one("#scenario-file")
         assert field.value == scenario.path.name and field.selected_text == scenario.path.name
         await pilot.press("enter")
@@ -225,10 +213,8 @@ async def test_names_typed_after_up_a_folder_are_read_in_the_folder_shown(tmp_pa
     for name in ("a", "b"):
         Measures(target_voxels=100, obscured_coverage=0.2, scans=10).write_cmf(here / f"{name}.cmf")
     async with opened(scenario) as (app, pilot):
-        await pilot.press("f3")
-        await pilot.pause()
-        dialog = app.screen
-        assert isinstance(dialog, SetupScreen) and dialog.query_one("#scenario-file").value == "demo.toml"
+        dialog = await screen_after(pilot, "f3", SetupScreen)
+        assert dialog.query_one("#scenario-file").value == "demo.toml"
         dialog.query_one("#tree-up").press()
         await pilot.pause()
         assert str(dialog.query_one("#tree-root").render()) == f"Folder: {tmp_path}"
@@ -236,10 +222,7 @@ async def test_names_typed_after_up_a_folder_are_read_in_the_folder_shown(tmp_pa
         dialog.query_one("#setup-ok").press()
         await wait_until(pilot, lambda: not isinstance(app.screen, SetupScreen) and app.busy is None)
         assert app.scenario.path == scenario.path
-        app.action_compare()
-        await pilot.pause()
-        compare = app.screen
-        assert isinstance(compare, CompareScreen)
+        compare = await screen_after(pilot, app.action_compare, CompareScreen)
         field = compare.query_one("#cmf-files")
         field.value = "a.cmf 'b.cmf'"
         compare.query_one("#tree-up").press()

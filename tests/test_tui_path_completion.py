@@ -6,6 +6,7 @@ from __future__ import annotations
 from ladartui.tui.screens import PathSuggester
 from test_tui_dialogs import opened
 from test_tui_flow import make_scenario, wait_until
+from tui_support import screen_after
 
 
 async def test_a_relative_name_is_completed_in_the_base_folder(tmp_path, monkeypatch):
@@ -51,9 +52,7 @@ async def test_the_open_dialog_completes_in_the_folder_it_shows(tmp_path, scene_
     monkeypatch.chdir(elsewhere)
     scenario = make_scenario(here, scene_files)
     async with opened(scenario) as (app, pilot):
-        await pilot.press("f3")
-        await wait_until(pilot, lambda: isinstance(app.screen, SetupScreen) and app.screen.is_mounted)
-        dialog = app.screen
+        dialog = await screen_after(pilot, "f3", SetupScreen)
         field = dialog.query_one("#scenario-file")
         field.focus()
         field.value = ""

@@ -16,6 +16,19 @@ def bar(app) -> StatusBar:
     return app.query_one(StatusBar)
 
 
+async def look_at_disk(app, pilot) -> None:
+    """The app's timed look at the files on disk, now, and its status redrawn."""
+    app.check_outputs_on_disk()
+    await pilot.pause()
+
+
+async def change_on_disk(app, pilot, scenario) -> None:
+    """The scenario file edited elsewhere (grid 8 to 12), and the app's look at it."""
+    text = scenario.path.read_text(encoding="utf-8")
+    scenario.path.write_text(text.replace("grid = 8", "grid = 12"), encoding="utf-8")
+    await look_at_disk(app, pilot)
+
+
 async def test_run_is_refused_while_the_scenario_file_changed_on_disk(tmp_path, scene_files):
     """F5 ran the settings held in the app and recorded them as the file's run, while the
     file on disk said otherwise: validate then called the fresh outputs out of date."""
@@ -25,12 +38,10 @@ async def test_run_is_refused_while_the_scenario_file_changed_on_disk(tmp_path, 
         text = scenario.path.read_text(encoding="utf-8")
         stamp = scenario.path.stat().st_mtime_ns
         os.utime(scenario.path, ns=(stamp + 10**9, stamp + 10**9))  # touched: no change
-        app.check_outputs_on_disk()
-        await pilot.pause()
+        await look_at_disk(app, pilot)
         assert bar(app).state == READY
         scenario.path.write_text(text.replace("grid = 8", "grid = 12"), encoding="utf-8")
-        app.check_outputs_on_disk()
-        await pilot.pause()
+        await look_at_disk(app, pilot)
         said = f"{scenario.path.name} changed on disk; reopen (F3) or save (^S)"
         assert bar(app).state == NOT_READY
         assert bar(app).message == said
@@ -40,8 +51,7 @@ async def test_run_is_refused_while_the_scenario_file_changed_on_disk(tmp_path, 
         assert runs == []
         assert app.messages[-1] == f"Run is off: {said}."
         scenario.path.write_text(text, encoding="utf-8")  # put back as it was opened
-        app.check_outputs_on_disk()
-        await pilot.pause()
+        await look_at_disk(app, pilot)
         assert bar(app).state == READY
         await pilot.press("f5")
         await pilot.pause()
@@ -52,15 +62,11 @@ async def test_saving_over_a_scenario_changed_on_disk_makes_it_runnable_again(tm
     scenario = make_scenario(tmp_path, scene_files)
     async with opened(scenario, size=(80, 24)) as (app, pilot):
         runs = capture_runs(app)
-        text = scenario.path.read_text(encoding="utf-8")
-        scenario.path.write_text(text.replace("grid = 8", "grid = 12"), encoding="utf-8")
-        app.check_outputs_on_disk()
-        await pilot.pause()
+        await change_on_disk(app, pilot, scenario)
         assert bar(app).state == NOT_READY
         await pilot.press("ctrl+s")
         await pilot.pause()
-        app.check_outputs_on_disk()
-        await pilot.pause()
+        await look_at_disk(app, pilot)
         assert bar(app).state == READY
         assert "grid = 8" in scenario.path.read_text(encoding="utf-8")
         await pilot.press("f5")
@@ -73,8 +79,7 @@ async def test_a_scenario_file_gone_from_disk_is_said_so_and_save_writes_it_agai
     async with opened(scenario, size=(80, 24)) as (app, pilot):
         runs = capture_runs(app)
         scenario.path.unlink()
-        app.check_outputs_on_disk()
-        await pilot.pause()
+        await look_at_disk(app, pilot)
         assert bar(app).state == NOT_READY
         assert bar(app).message == f"{scenario.path.name} is gone from disk; save it (^S)"
         await pilot.press("f5")
@@ -82,23 +87,18 @@ async def test_a_scenario_file_gone_from_disk_is_said_so_and_save_writes_it_agai
         assert runs == []
         await pilot.press("ctrl+s")
         await wait_until(pilot, lambda: scenario.path.is_file())
-        app.check_outputs_on_disk()
-        await pilot.pause()
+        await look_at_disk(app, pilot)
         assert bar(app).state == READY
 
 
 async def test_reopening_a_scenario_changed_on_disk_reads_it(tmp_path, scene_files):
     scenario = make_scenario(tmp_path, scene_files)
     async with opened(scenario, size=(80, 24)) as (app, pilot):
-        text = scenario.path.read_text(encoding="utf-8")
-        scenario.path.write_text(text.replace("grid = 8", "grid = 12"), encoding="utf-8")
-        app.check_outputs_on_disk()
-        await pilot.pause()
+        await change_on_disk(app, pilot, scenario)
         assert bar(app).state == NOT_READY
         app.open_path(scenario.path)
         await wait_until(pilot, lambda: app.busy is None and app.scenario.sensor.grid == 12)
-        app.check_outputs_on_disk()
-        await pilot.pause()
+        await look_at_disk(app, pilot)
         assert bar(app).state == READY
 
 
@@ -109,10 +109,7 @@ async def test_a_study_of_a_scenario_changed_on_disk_says_what_it_reads(tmp_path
 
     scenario = make_scenario(tmp_path, scene_files)
     async with opened(scenario, size=(80, 24)) as (app, pilot):
-        text = scenario.path.read_text(encoding="utf-8")
-        scenario.path.write_text(text.replace("grid = 8", "grid = 12"), encoding="utf-8")
-        app.check_outputs_on_disk()
-        await pilot.pause()
+        await change_on_disk(app, pilot, scenario)
         await pilot.press("f11")
         await wait_until(pilot, lambda: isinstance(app.screen, StudyScreen) and app.screen.is_mounted)
         assert app.messages[-1] == (
