@@ -32,6 +32,14 @@ from test_tui_flow import (
 SIZE = (100, 32)
 
 
+def keys_in(tmp_path, monkeypatch, text: str) -> None:
+    """A user home under ``tmp_path`` whose keys.toml holds ``text``."""
+    home = tmp_path / "home"
+    (home / "config").mkdir(parents=True)
+    (home / "config" / "keys.toml").write_text(text)
+    monkeypatch.setenv("LADARTUI_HOME", str(home))
+
+
 def modified(app) -> bool:
     return "(modified)" in app.query_one(StatusBar).message
 
@@ -313,12 +321,11 @@ async def test_a_key_remapped_in_keys_toml_changes_the_footer_help_and_palette(
     from test_tui_edits import capture_runs
     from test_tui_flow import shown_keys
 
-    home = tmp_path / "home"
-    (home / "config").mkdir(parents=True)
-    (home / "config" / "keys.toml").write_text(
-        '[keys]\nrun = "ctrl+r"\nnonsense = "x"\nthreshold = 3\nlayout = "[bold red]q"\nsave = "ctrl+w"\n'
+    keys_in(
+        tmp_path,
+        monkeypatch,
+        '[keys]\nrun = "ctrl+r"\nnonsense = "x"\nthreshold = 3\nlayout = "[bold red]q"\nsave = "ctrl+w"\n',
     )
-    monkeypatch.setenv("LADARTUI_HOME", str(home))
     scenario = make_scenario(tmp_path, scene_files)
     app = LadarApp(scenario.path)
     async with app.run_test(size=(120, 40)) as pilot:
@@ -357,10 +364,7 @@ async def test_a_key_given_in_keys_toml_to_a_palette_only_command_runs_it(tmp_pa
 
     from ladartui.tui.app import help_rows
 
-    home = tmp_path / "home"
-    (home / "config").mkdir(parents=True)
-    (home / "config" / "keys.toml").write_text('[keys]\ntab-sensor = "ctrl+k"\n')
-    monkeypatch.setenv("LADARTUI_HOME", str(home))
+    keys_in(tmp_path, monkeypatch, '[keys]\ntab-sensor = "ctrl+k"\n')
     scenario = make_scenario(tmp_path, scene_files)
     app = LadarApp(scenario.path)
     async with app.run_test(size=(120, 40)) as pilot:
@@ -539,10 +543,7 @@ async def test_messages_that_name_a_key_name_the_one_in_force(tmp_path, scene_fi
     Open dialog 'missing outputs are listed, and F5 writes them'."""
     from ladartui.tui.file_dialogs import SetupScreen
 
-    home = tmp_path / "home"
-    (home / "config").mkdir(parents=True)
-    (home / "config" / "keys.toml").write_text('[keys]\nrun = "ctrl+r"\nsave = "ctrl+w"\n')
-    monkeypatch.setenv("LADARTUI_HOME", str(home))
+    keys_in(tmp_path, monkeypatch, '[keys]\nrun = "ctrl+r"\nsave = "ctrl+w"\n')
     scenario = make_scenario(tmp_path, scene_files)
     app = LadarApp(scenario.path)
     async with app.run_test(size=(120, 40)) as pilot:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import re
 import shutil
+from contextlib import asynccontextmanager
 
 import pytest
 from rich.cells import cell_len
@@ -30,19 +31,26 @@ def copy_of(swept, folder):
     return folder / "spec.toml"
 
 
-async def test_a_finished_sweep_names_its_results_folder_whole_on_the_status_line(
-    swept, tmp_path, monkeypatch
-):
-    """It read 'results in sw/…resu…': the folder cut in its middle, then the line's end
-    cut through what was left of it."""
-    monkeypatch.chdir(tmp_path)  # the folder is shown relative to the working one
-    spec = copy_of(swept, tmp_path / "sw")
-    screen = SweepScreen(spec, serial=True)
+@asynccontextmanager
+async def run_again(swept, tmp_path, monkeypatch):
+    """A copy of ``swept`` under ``tmp_path`` (the working folder) run again serially
+    (every variant resumes) on its screen at 80 x 24; the screen once it is done."""
+    monkeypatch.chdir(tmp_path)  # folders are shown relative to the working one
+    screen = SweepScreen(copy_of(swept, tmp_path / "sw"), serial=True)
     async with SweepHost(screen).run_test(size=SIZE) as pilot:
         await opened(pilot)
         await pilot.press("f5")
         await wait_for(pilot, lambda: not screen.running)
         await pilot.pause()
+        yield screen
+
+
+async def test_a_finished_sweep_names_its_results_folder_whole_on_the_status_line(
+    swept, tmp_path, monkeypatch
+):
+    """It read 'results in sw/…resu…': the folder cut in its middle, then the line's end
+    cut through what was left of it."""
+    async with run_again(swept, tmp_path, monkeypatch) as screen:
         line = screen.query_one("#sweep-status StatusText", StatusText)
         shown = line.render().plain
         assert "sw/spec-results" in shown and "\u2026" not in shown, shown
@@ -194,14 +202,7 @@ async def test_a_finished_sweep_is_ready_without_a_percentage(swept, tmp_path, m
     only a busy (red) bar has; the progress row above already says 100%."""
     from ladartui.tui.status import READY, StatusBar
 
-    monkeypatch.chdir(tmp_path)
-    spec = copy_of(swept, tmp_path / "sw")
-    screen = SweepScreen(spec, serial=True)
-    async with SweepHost(screen).run_test(size=SIZE) as pilot:
-        await opened(pilot)
-        await pilot.press("f5")
-        await wait_for(pilot, lambda: not screen.running)
-        await pilot.pause()
+    async with run_again(swept, tmp_path, monkeypatch) as screen:
         bar = screen.query_one("#sweep-status", StatusBar)
         assert bar.state == READY and bar.progress is None
         assert str(bar.query_one("#status-word").render()) == "READY"
