@@ -2,6 +2,7 @@
 
 import errno
 import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -76,16 +77,14 @@ def test_target_output_a_folder_is_refused_before_tracing(scenario, capsys, monk
 
 def test_failed_write_replaces_nothing(scenario, capsys, monkeypatch):
     old = write_old_set(scenario)
-    import ladartui.scene.voxels as voxels
+    real = Path.write_bytes
 
-    real = voxels.write_voxels
-
-    def disk_full(path, data):
+    def disk_full(path, data):  # the set's writers put each output's bytes in its temporary
         if ".S_Target.txt." in str(path):
             raise OSError(errno.ENOSPC, "No space left on device")
         return real(path, data)
 
-    monkeypatch.setattr(voxels, "write_voxels", disk_full)
+    monkeypatch.setattr(Path, "write_bytes", disk_full)
     assert main(["run", str(scenario.path)]) == 2
     err = capsys.readouterr().err.strip().splitlines()[-1]  # after the progress bar
     assert err.startswith("ladartui: error:") and "S_Target.txt" in err and "no space left" in err

@@ -456,38 +456,29 @@ def output_lock(scenario) -> Path:
 def _write_outputs(output_set, scene_output, target_output, measures, record, scene, cancel) -> dict:
     """Write every output of the set to a temporary file, then swap them all in together.
 
-    ``record(outputs)`` is the run record's text, given the fingerprints of the scene
-    and target outputs and the measures as written (``output_paths`` puts them before
-    the record). LAS outputs carry each voxel's target id as its point source id (0:
-    not a target voxel).
+    ``record(outputs)`` is the run record's text, given the fingerprints of the bytes the
+    scene and target outputs and the measures are written as. LAS outputs carry each
+    voxel's target id as its point source id (0: not a target voxel).
     """
-    from ladartui.fingerprint import file_fingerprint
+    from ladartui.fingerprint import fingerprint_of
     from ladartui.run_record import OUTPUT_ROLES, InputFile
-    from ladartui.scene.voxels import write_voxels
+    from ladartui.scene.voxels import voxel_file_bytes
 
-    temps: dict[str, Path] = {}
-
-    def kept(name: str, write):
-        def writer(tmp: Path) -> None:
-            write(tmp)
-            temps[name] = tmp
-
-        return writer
-
-    def write_record(tmp: Path) -> None:
-        written = []
-        for name, role in OUTPUT_ROLES.items():
-            fingerprint = file_fingerprint(temps[name]) if name in temps else None
-            if fingerprint is not None:
-                written.append(InputFile(role, output_set.paths[name], fingerprint))
-        tmp.write_text(record(written), encoding="utf-8")
-
-    writers = {
-        "scene": kept("scene", lambda tmp: write_voxels(tmp, scene_output)),
-        "target": kept("target", lambda tmp: write_voxels(tmp, target_output)),
-        "measures": kept("measures", lambda tmp: tmp.write_text(measures.to_cmf(), encoding="utf-8")),
-        "record": write_record,
+    contents = {
+        "scene": voxel_file_bytes(scene_output),
+        "target": voxel_file_bytes(target_output),
+        "measures": measures.to_cmf().encode("utf-8"),
     }
+    written = [
+        InputFile(role, output_set.paths[name], fingerprint_of(contents[name]))
+        for name, role in OUTPUT_ROLES.items()
+    ]
+
+    def put(data):
+        return lambda tmp: tmp.write_bytes(data)
+
+    writers = {name: put(data) for name, data in contents.items()}
+    writers["record"] = put(record(written).encode("utf-8"))
     if "scene_las" in output_set.paths:
         from ladartui.scene.las import compressed_suffix, write_las
 

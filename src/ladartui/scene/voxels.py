@@ -461,12 +461,18 @@ def save_voxels(path, voxels, ids=None) -> None:
 def write_voxels(path, voxels, ids=None) -> None:
     """``save_voxels`` with its OSErrors as raised: an output set's writer, given the set's
     temporary file, leaves the set to name the output."""
+    data = voxel_file_bytes(voxels, ids)
+    with atomic_path(path) as tmp, open(tmp, "wb") as stream:
+        stream.write(data)
+
+
+def voxel_file_bytes(voxels, ids=None) -> bytes | memoryview:
+    """The bytes ``write_voxels`` writes: checked rows as ``x,y,z`` lines (``x,y,z,id``
+    with ``ids``)."""
     voxels = np.ascontiguousarray(voxel_list_field("voxels", voxels, MAX_INDEX), dtype=np.int64)
     if ids is not None:
         voxels = np.column_stack([voxels, target_ids_field("ids", ids, len(voxels)).astype(np.int64)])
-    data = format_voxel_lines(voxels)
-    with atomic_path(path) as tmp, open(tmp, "wb") as stream:
-        stream.write(data)
+    return format_voxel_lines(voxels)
 
 
 # Below this many rows plain Python formats faster than the compiled kernel's first load.
