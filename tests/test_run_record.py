@@ -366,6 +366,11 @@ def test_validate_names_an_output_changed_since_the_run_wrote_it(scenario, capsy
     ]
     simulate(scenario)  # the next run's are its own
     assert _last_run_lines(capsys, scenario)[1:] == []
+    # one gone is missing (said as such), not 'changed since the run wrote it'
+    from ladartui.run_record import outputs_changed
+
+    scenario.target_output.unlink()
+    assert outputs_changed(scenario) == []
 
 
 def test_a_record_older_than_model_fingerprints_is_read_and_says_so(scenario, capsys):

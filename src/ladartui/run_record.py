@@ -125,16 +125,18 @@ def run_inputs(scenario, scene) -> list[InputFile]:
 def recorded_inputs(scenario) -> list[InputFile] | None:
     """The files the record says its run read; None when it does not say (a record
     older than that, or none). ``LadarError`` naming the record when it cannot be read."""
-    return _recorded(scenario, "inputs", INPUT_ROLES)
+    return _recorded(scenario, "inputs", INPUT_ROLES, optional=False)
 
 
 def recorded_outputs(scenario) -> list[InputFile] | None:
     """The outputs the record says its run wrote, as it wrote them; None when it does
     not say. ``LadarError`` naming the record when it cannot be read."""
-    return _recorded(scenario, "outputs", tuple(OUTPUT_ROLES.values()))
+    return _recorded(scenario, "outputs", tuple(OUTPUT_ROLES.values()), optional=True)
 
 
-def _recorded(scenario, key: str, roles) -> list[InputFile] | None:
+def _recorded(scenario, key: str, roles, optional: bool) -> list[InputFile] | None:
+    """The record's ``[[run.KEY]]`` files; None without a record or ``[run]`` (or, where
+    ``optional``, without the key: records written before it existed)."""
     path = scenario.run_record
     if not path.is_file():
         return None
@@ -142,7 +144,7 @@ def _recorded(scenario, key: str, roles) -> list[InputFile] | None:
         run = tomllib.loads(path.read_text(encoding="utf-8-sig")).get("run")
     except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as error:
         raise LadarError(f"{path}: cannot be read: {one_line(str(error))}") from None
-    if run is None or (key == "outputs" and isinstance(run, dict) and key not in run):
+    if run is None or (optional and isinstance(run, dict) and key not in run):
         return None
     entries = run.get(key) if isinstance(run, dict) else None
     if not isinstance(entries, list):
@@ -152,14 +154,16 @@ def _recorded(scenario, key: str, roles) -> list[InputFile] | None:
 
 def outputs_changed(scenario) -> list[str]:
     """Each output the record fingerprints whose bytes on disk differ now, as "S.cmf
-    changed since the run wrote it" (none when the record does not say)."""
+    changed since the run wrote it" (none when the record does not say; one that cannot
+    be read is not named here: ``missing_outputs`` names it)."""
     from ladartui.fingerprint import file_fingerprint
 
-    return [
-        f"{entry.path.name} changed since the run wrote it: it is not the run's output"
-        for entry in recorded_outputs(scenario) or ()
-        if file_fingerprint(entry.path) != entry.fingerprint
-    ]
+    changed = []
+    for entry in recorded_outputs(scenario) or ():
+        now = file_fingerprint(entry.path)
+        if now is not None and now != entry.fingerprint:
+            changed.append(f"{entry.path.name} changed since the run wrote it: it is not the run's output")
+    return changed
 
 
 def _recorded_file(path: Path, key: str, roles, index: int, entry) -> InputFile:
