@@ -22,8 +22,6 @@ def read_cmf(path) -> Measures:
     path = path_field("path", path, "a measures file's path (.cmf)")
     try:  # a pipe is refused unread; bytes that are not UTF-8 are named on their line
         text = read_utf8(path, "expected a measures file (.cmf)")
-    except IsADirectoryError:
-        raise InputFileError(path, "is a folder; expected a measures file (.cmf)") from None
     except OSError as error:
         raise InputFileError(path, f"cannot read: {error.strerror or error}") from None
     lines = text.splitlines()

@@ -441,8 +441,6 @@ def load_scenario(path, check_files=True) -> Scenario:
         _refuse_other_kind(path, text)
     except FileNotFoundError:
         raise InputFileError(path, f"{NO_SUCH_FILE}; expected a scenario file (.toml)") from None
-    except IsADirectoryError:
-        raise InputFileError(path, "is a folder; expected a scenario file (.toml)") from None
     except OSError as error:
         raise InputFileError(path, f"cannot read the scenario file: {error.strerror or error}") from None
     scenario = scenario_from_toml(text, path)
