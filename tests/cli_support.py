@@ -1,19 +1,21 @@
 """Helpers shared by the CLI tests."""
 
 import _thread
+import signal
 import threading
 import time
 
 
-def ctrl_c(until: threading.Event, timeout: float = 10.0) -> bool:
+def ctrl_c(until: threading.Event, timeout: float = 10.0, signum: int = signal.SIGINT) -> bool:
     """Ctrl-C as the key gives it (KeyboardInterrupt on the main thread), again each
     second until ``until`` is set; whether it was. Python drops an interrupt that lands
     while the main thread runs a finalizer (a GPU object's, freed by the garbage
     collector), and a user would press the key again. (A second, the main thread
-    polls ten times as often: one that arrived has been seen by then.)"""
+    polls ten times as often: one that arrived has been seen by then.) ``signum``: the
+    signal it stands for (SIGTERM as ``kill`` sends it)."""
     deadline = time.monotonic() + timeout
     while True:
-        _thread.interrupt_main()
+        _thread.interrupt_main(signum)
         if until.wait(1.0):
             return True
         if time.monotonic() > deadline:

@@ -265,10 +265,21 @@ def test_a_precision_the_backend_lacks_is_named_in_the_summary_and_json(scenario
 def test_the_bar_names_compiling_only_when_the_cache_lacks_the_kernels(scenario, monkeypatch):
     """Every run's bar said 'compiling kernels on a first run' until its first scan,
     with the kernels cached too."""
+    from rich.progress import Progress
+
     from ladartui import precompile
     from ladartui.cli.progress import FIRST_SCAN, first_scan
 
     assert main(["run", str(scenario.path), "--no-write"]) == 0  # the kernels are cached now
-    assert first_scan(scenario) == "scan 1"
+    started = []
+    real = Progress.add_task
+
+    def add_task(self, description, *args, **kwargs):
+        started.append(description)
+        return real(self, description, *args, **kwargs)
+
+    monkeypatch.setattr(Progress, "add_task", add_task)
+    assert main(["run", str(scenario.path), "--no-write"]) == 0
+    assert started == ["scan 1"]  # what the bar says until the first scan is done
     monkeypatch.setattr(precompile, "kernels_cached", lambda scenario: False)
     assert first_scan(scenario) == FIRST_SCAN == "scan 1 (compiling kernels on a first run)"

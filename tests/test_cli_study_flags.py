@@ -112,12 +112,12 @@ def test_the_scans_a_flight_has_are_all_taken_and_a_default_above_them_is_not_re
 def test_a_stopped_study_says_nothing_was_written(tmp_path, monkeypatch, capsys, signum, status):
     """A Ctrl-C said only 'study cancelled', not whether the earlier study in --out was kept,
     and SIGTERM ended the command without a word."""
-    import _thread
     import types
 
     import numpy as np
 
     import ladartui.study.run as study_run
+    from cli_support import ctrl_c
     from ladartui.errors import Cancelled
 
     inputs = types.SimpleNamespace(
@@ -130,8 +130,7 @@ def test_a_stopped_study_says_nothing_was_written(tmp_path, monkeypatch, capsys,
     monkeypatch.setattr(study_run, "backend_reasons", lambda backends: {})
 
     def stopped(*args, cancel, **kwargs):
-        _thread.interrupt_main(signum)  # as the key, or `kill`, would
-        assert cancel.wait(10), "the stop did not cancel the study"
+        assert ctrl_c(cancel, signum=signum), "the stop did not cancel the study"  # the key, or `kill`
         raise Cancelled("study cancelled")
 
     monkeypatch.setattr(study_run, "run_study", stopped)

@@ -23,6 +23,7 @@ from test_tui_flow import (
     type_into,
     wait_until,
 )
+from tui_support import screen_after
 
 SIZE = (100, 32)
 
@@ -197,13 +198,10 @@ async def test_quit_new_and_open_with_unsaved_edits_ask_first(tmp_path, scene_fi
         await pilot.pause()
         assert app.scenario.path == scenario.path and app.scenario.sensor.grid == 12
         # from the sweep screen itself: Cancel goes back to it, not to the main screen
-        await pilot.press("f12")
-        await pilot.pause()
-        sweep = app.screen
-        assert isinstance(sweep, SweepScreen)
-        sweep.post_message(SweepScreen.OpenScenario(other.path))
-        await pilot.pause()
-        assert isinstance(app.screen, UnsavedScreen)
+        sweep = await screen_after(pilot, "f12", SweepScreen)
+        await screen_after(
+            pilot, lambda: sweep.post_message(SweepScreen.OpenScenario(other.path)), UnsavedScreen
+        )
         await pilot.click("#unsaved-cancel")
         await pilot.pause()
         assert app.screen is sweep and app.tool_screen is sweep

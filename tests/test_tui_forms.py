@@ -119,10 +119,7 @@ async def test_a_segment_the_whole_path_refuses_keeps_its_form_open(tmp_path, sc
     scenario = make_scenario(tmp_path, scene_files)  # 6 scans
     async with opened(scenario) as (app, pilot):
         app.action_show_tab("flight")
-        app.action_add_segment("straight")
-        await pilot.pause()
-        form = app.screen
-        assert isinstance(form, FormScreen)
+        form = await screen_after(pilot, lambda: app.action_add_segment("straight"), FormScreen)
         await type_into(pilot, form.query_one("#f-scans"), "9999", commit="tab")
         form.query_one("#form-ok").press()
         await pilot.pause()
@@ -143,10 +140,7 @@ async def test_the_threshold_form_says_why_an_infinite_height_is_refused(tmp_pat
 
     scenario = make_scenario(tmp_path, scene_files)
     async with opened(scenario) as (app, pilot):
-        await pilot.press("f8")
-        await pilot.pause()
-        form = app.screen
-        assert isinstance(form, ThresholdScreen)
+        form = await screen_after(pilot, "f8", ThresholdScreen)
         threshold = form.query_one("#f-threshold")
         await type_into(pilot, threshold, "1e400", commit="enter")
         assert message(form) == "Max height m: 1e400 is not allowed; expected a finite number >= 0 m"
@@ -186,11 +180,7 @@ async def test_open_offers_the_open_scenario_so_enter_reopens_it(tmp_path, scene
         field = dialog.query_one("#scenario-file")
         assert field.value == scenario.path.name and field.selected_text == scenario.path.name
         await pilot.press("enter")
-        await pilot.pause()
-        for _ in range(100):
-            if not isinstance(app.screen, SetupScreen) and app.busy is None and app.scenario is not None:
-                break
-            await pilot.pause(0.05)
+        await wait_until(pilot, lambda: not isinstance(app.screen, SetupScreen) and app.busy is None, 10)
         assert app.scenario.speed == load_speed(scenario.path) != before
 
 

@@ -28,6 +28,7 @@ from test_tui_flow import (
     type_into,
     wait_until,
 )
+from tui_support import screen_after
 
 SIZE = (100, 32)
 
@@ -172,6 +173,7 @@ async def test_recent_scenarios_are_listed_and_open_after_asking(tmp_path, scene
         await wait_until(pilot, lambda: app.busy is None and any("Could not load" in m for m in app.messages))
         await pilot.pause()
         assert listing.option_count == 0
+        assert second.path.resolve() not in recent_scenarios()  # nor offered to the next session
 
 
 async def test_the_folder_tree_fills_the_scenario_field(tmp_path, scene_files):
@@ -550,8 +552,6 @@ async def test_messages_that_name_a_key_name_the_one_in_force(tmp_path, scene_fi
         await wait_until(pilot, lambda: loaded(app))
         app.action_measures()
         assert app.messages[-1] == "No measures yet: run the scenario first (Ctrl+R)."
-        await pilot.press("f3")
-        await pilot.pause()
-        assert isinstance(app.screen, SetupScreen)
-        said = str(app.screen.query_one("#derived").render())
+        dialog = await screen_after(pilot, "f3", SetupScreen)
+        said = str(dialog.query_one("#derived").render())
         assert "a run (Ctrl+R) writes them" in said and "F5" not in said
