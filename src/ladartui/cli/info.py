@@ -103,6 +103,7 @@ def print_scenario(path: Path) -> None:
 
 
 def print_voxel_list(path: Path, voxel_size=None) -> None:
+    from ladartui.scene.keys import count_inside
     from ladartui.scene.model import target_path_for
     from ladartui.scene.occupancy import column_bounds
     from ladartui.scene.target_model import load_target
@@ -195,23 +196,6 @@ def _targets_text(ids) -> str:
         return f"1 target (id {distinct[0]})"
     shown = ", ".join(map(str, distinct[:8])) + (", ..." if len(distinct) > 8 else "")
     return f"{len(distinct)} targets (ids {shown})"
-
-
-def count_inside(target, voxels) -> int:
-    """How many of the ``target`` rows are voxels of ``voxels`` (info's and validate's count)."""
-    import numpy as np
-
-    from ladartui.errors import FieldError
-    from ladartui.scene.keys import member, sorted_unique, voxel_keys
-
-    try:
-        scene_keys = voxel_keys(voxels)
-        target_keys = voxel_keys(target)
-    except FieldError:  # indices too large to pack: compare rows
-        scene_rows = set(map(tuple, voxels.tolist()))
-        return sum(1 for row in map(tuple, target.tolist()) if row in scene_rows)
-    # (np.isin's hashed unique of both arrays took seconds on millions of voxels)
-    return int(np.count_nonzero(member(target_keys, sorted_unique(scene_keys))))
 
 
 def _occupancy_text(voxels, shape, path) -> str:

@@ -187,8 +187,7 @@ def scene_summary(scenario, scene) -> list[str]:
     import numpy as np
 
     from ladartui.number_text import extent_metres, plural
-    from ladartui.resources import available_memory, check_occupancy, gib
-    from ladartui.scene.occupancy import column_bounds
+    from ladartui.resources import available_memory, gib
 
     nx, ny, nz = scene.shape
     vs = scene.voxel_size
@@ -208,12 +207,7 @@ def scene_summary(scenario, scene) -> list[str]:
             f"note       [targets] names {named} not in "
             f"{scenario.target_file.name} (its ids: {', '.join(map(str, ids)) or 'none'})"
         )
-    need = 0
-    for voxels, source in ((scene.voxels, scenario.scene_file), (scene.target, scenario.target_file)):
-        if len(voxels):
-            lo, last = column_bounds(voxels)  # int64: the far corner + 1 of 2**31 - 1 fits
-            hi = last + 1
-            need += check_occupancy(lo, hi, len(voxels), str(source))
+    need = scene.tracing_bytes()
     need += scene.voxels.nbytes + scene.target.nbytes + np.dtype(np.int32).itemsize
     available = available_memory()
     # Each structure is refused alone when too large; together they may still not fit.
@@ -229,8 +223,8 @@ def target_notes(scenario, scene) -> list[str]:
     """Notes on a target model that will not give measures: empty, or voxels that the
     scene model lacks (a target voxel is part of the scene: the scene run sees it there)."""
 
-    from ladartui.cli.info import count_inside
     from ladartui.number_text import plural
+    from ladartui.scene.keys import count_inside
 
     name = scenario.target_file.name
     if not len(scene.target):

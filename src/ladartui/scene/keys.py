@@ -112,3 +112,15 @@ def visible_mask(target_model) -> np.ndarray:
     for offset in VISIBLE_FACE_OFFSETS:
         visible |= ~member(voxel_keys(target + offset), keys)
     return visible
+
+
+def count_inside(target, voxels) -> int:
+    """How many of the ``target`` rows are voxels of ``voxels`` (info's and validate's count)."""
+    try:
+        scene_keys = voxel_keys(voxels)
+        target_keys = voxel_keys(target)
+    except FieldError:  # indices too large to pack: compare rows
+        scene_rows = set(map(tuple, voxels.tolist()))
+        return sum(1 for row in map(tuple, target.tolist()) if row in scene_rows)
+    # (np.isin's hashed unique of both arrays took seconds on millions of voxels)
+    return int(np.count_nonzero(member(target_keys, sorted_unique(scene_keys))))

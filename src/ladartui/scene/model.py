@@ -168,6 +168,19 @@ class Scene:
         nx, ny = int(hi[0] - lo[0]) + 1, int(hi[1] - lo[1]) + 1
         return origin, top_height_map(voxels, nx, ny, origin)
 
+    def tracing_bytes(self) -> int:
+        """About the memory the tracing structures of both models take, before
+        building them; ``ResourceLimitError`` naming the model file when one alone
+        cannot fit in the memory available."""
+        from ladartui.resources import check_occupancy
+
+        need = 0
+        for voxels, source in ((self.voxels, self.path), (self.target, self.target_path)):
+            if len(voxels):
+                lo, last = column_bounds(voxels)  # int64: the far corner + 1 of 2**31 - 1 fits
+                need += check_occupancy(lo, last + 1, len(voxels), str(source or self.name))
+        return need
+
     def __repr__(self):
         return (
             f"Scene({self.name!r}, voxels={len(self.voxels)}, target={len(self.target)}, "

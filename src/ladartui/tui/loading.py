@@ -282,17 +282,14 @@ def _check_memory(scenario, scene) -> None:
     hold, as validate and run do, and one whose views' height map (one cell a
     column over the voxels' x-y extent) it cannot hold."""
     from ladartui.errors import ResourceLimitError
-    from ladartui.resources import available_memory, check_occupancy, gib
+    from ladartui.resources import available_memory, gib
     from ladartui.scene.occupancy import column_bounds
 
-    map_columns = (0, 0)  # the height map spans the scene's voxels' columns
-    for voxels, source in ((scene.voxels, scenario.scene_file), (scene.target, scenario.target_file)):
-        if len(voxels):
-            lo, last = column_bounds(voxels)  # int64: the far corner + 1 of 2**31 - 1 fits
-            check_occupancy(lo, last + 1, len(voxels), str(source))
-            if voxels is scene.voxels:
-                map_columns = (int(last[0] - lo[0]) + 1, int(last[1] - lo[1]) + 1)
-    nx, ny = map_columns
+    scene.tracing_bytes()
+    nx, ny = 0, 0  # the height map spans the scene's voxels' columns
+    if len(scene.voxels):
+        lo, last = column_bounds(scene.voxels)
+        nx, ny = int(last[0] - lo[0]) + 1, int(last[1] - lo[1]) + 1
     need = VIEW_BYTES_PER_COLUMN * nx * ny
     if need > available_memory():
         raise ResourceLimitError(
