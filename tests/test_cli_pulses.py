@@ -219,3 +219,54 @@ def test_coverage_of_a_target_model_with_no_voxels_is_undefined(scenario, capsys
     assert "ideal model: obscured coverage undefined (the target model holds no voxels)" in out
     assert out.splitlines()[2].split()[2] == "undefined"  # the first row's coverage column
     assert "false alarms (right)" in out and "obscured coverage % (Geiger)" not in out
+
+
+def _count_visits(monkeypatch):
+    """Record the detector range-bin visits each firing makes (detectors x bins x pulses)."""
+    import ladartui.detection.look as look
+
+    visits = []
+    real = look.fire_counts
+
+    def counting(mean, pulses, *args, **kwargs):
+        visits.append(np.asarray(mean).size * pulses)
+        return real(mean, pulses, *args, **kwargs)
+
+    monkeypatch.setattr(look, "fire_counts", counting)
+    return visits
+
+
+def test_firing_beyond_the_work_limit_is_refused_before_a_pulse(scenario, capsys, monkeypatch):
+    """100,000 pulses per look on a large sensor fired for hours; the estimate after
+    tracing is exactly the work the firing does, and over the limit nothing is fired."""
+    visits = _count_visits(monkeypatch)
+    assert main(["pulses", str(scenario.path), "--pulses", "5,20", "--json"]) == 0
+    capsys.readouterr()
+    work = sum(visits)
+    assert work > 0
+    visits.clear()
+    monkeypatch.setenv("LADARTUI_MAX_BIN_VISITS", str(work - 1))
+    assert main(["pulses", str(scenario.path), "--pulses", "5,20"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "Traceback" not in err and not visits
+    err = err.splitlines()[-1]  # after the tracing's bar
+    assert err.startswith(f"ladartui: error: {scenario.path}: about {work:.3g} detector range-bin visits")
+    assert "25 pulses in all on each of 3 looks" in err and "LADARTUI_MAX_BIN_VISITS" in err
+    monkeypatch.setenv("LADARTUI_MAX_BIN_VISITS", str(work))
+    assert main(["pulses", str(scenario.path), "--pulses", "5,20", "--json"]) == 0
+    assert sum(visits) == work
+
+
+def test_a_geiger_run_beyond_the_work_limit_is_refused_at_its_first_look(scenario, capsys, monkeypatch):
+    visits = _count_visits(monkeypatch)
+    monkeypatch.setenv("LADARTUI_MAX_BIN_VISITS", "1000")
+    geiger = scenario.with_changes(detection=DetectionSettings(model="geiger", pulses=20, coincidence=4))
+    geiger.save()
+    assert main(["run", str(scenario.path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "Traceback" not in err and not visits
+    assert "detector range-bin visits to fire" in err.splitlines()[-1] and "20 pulses on each of 3 looks" in err
+    assert not scenario.scene_output.exists() and not scenario.target_output.exists()
+    monkeypatch.setenv("LADARTUI_MAX_BIN_VISITS", "a lot")
+    assert main(["run", str(scenario.path)]) == 2
+    assert "LADARTUI_MAX_BIN_VISITS = 'a lot': expected a number of visits >= 1" in capsys.readouterr().err

@@ -1,9 +1,11 @@
 """Up-front estimates of memory and work, and the limits they are checked against.
 
-Work whose estimate exceeds the machine (memory) or the work limit (rays) is
-refused with ``ResourceLimitError`` naming the input, the estimate and the
-limit, before anything is allocated or traced. ``LADARTUI_MAX_MEMORY`` (bytes)
-and ``LADARTUI_MAX_RAYS`` override the limits; ``--max-rays`` on ``run`` too.
+Work whose estimate exceeds the machine (memory) or the work limits (rays to
+trace, Geiger-mode range-bin visits to fire) is refused with
+``ResourceLimitError`` naming the input, the estimate and the limit, before
+anything is allocated, traced or fired. ``LADARTUI_MAX_MEMORY`` (bytes),
+``LADARTUI_MAX_RAYS`` and ``LADARTUI_MAX_BIN_VISITS`` override the limits;
+``--max-rays`` on ``run`` too.
 """
 
 from __future__ import annotations
@@ -20,6 +22,9 @@ from ladartui.number_text import plural
 # rays: a mistyped scan count or sensor grid (2.7e12 rays, days) is refused, a real
 # study stays well under.
 DEFAULT_MAX_RAYS = 2 * 10**9
+# Minutes of firing too: the bundled default scenario's pulse study at 1,000 pulses
+# fires 5.8e9 detector range-bin visits, in about 12 s on two cores.
+DEFAULT_MAX_BIN_VISITS = 5 * 10**10
 # Content-sized parts of the occupancy build, per node (at most one per voxel, at most
 # one per cell of its level over the extent): a brick's 16 words and block mask, and
 # the int64 temporaries that work out the bricks' keys, order and cells (92 bytes a
@@ -60,6 +65,24 @@ def max_rays() -> int:
         return _max_rays_flag
     override = _env_limit("LADARTUI_MAX_RAYS", "a number of rays >= 1")
     return DEFAULT_MAX_RAYS if override is None else override
+
+
+def max_bin_visits() -> int:
+    override = _env_limit("LADARTUI_MAX_BIN_VISITS", "a number of visits >= 1")
+    return DEFAULT_MAX_BIN_VISITS if override is None else override
+
+
+def check_bin_visits(visits: int, source, what: str) -> None:
+    """``ResourceLimitError`` when firing ``visits`` detector range-bin visits (detectors x
+    range bins x pulses, over every look) would pass the work limit; ``what`` says
+    where they come from."""
+    limit = max_bin_visits()
+    if visits > limit:
+        raise ResourceLimitError(
+            f"{source}: about {visits:.3g} detector range-bin visits to fire ({what}), more than "
+            f"the limit of {limit:.3g}; use fewer pulses, fewer scans or a wider "
+            "detection.bin_width_m, or raise the limit with LADARTUI_MAX_BIN_VISITS if this is meant"
+        )
 
 
 def _env_limit(name: str, expected: str) -> int | None:

@@ -164,7 +164,9 @@ def _simulate(scenario, backend, method, step, precision, progress, cancel, outp
     if getattr(scenario, "geiger", False):
         from ladartui.detection.scan import GeigerRun
 
-        runner.geiger = GeigerRun(scenario.detection, scenario.sensor, scene, cancel)
+        runner.geiger = GeigerRun(
+            scenario.detection, scenario.sensor, scene, cancel, scans=len(poses), source=scenario.path
+        )
     timings["setup"] = time.perf_counter() - started
 
     per_scan: dict[str, list[np.ndarray]] = {run: [] for run in RUNS}

@@ -59,6 +59,14 @@ def incidence_cosines(origins, directions, kind, index, ranges, voxel_size) -> n
     return cos
 
 
+def range_gate(hit_ranges, bin_width: float) -> tuple[float, int]:
+    """A look's range gate over its (non-empty) hit ranges: its start, on a whole
+    number of bins, and how many bins of ``bin_width`` it holds."""
+    r = np.asarray(hit_ranges, dtype=np.float64)
+    gate_start = float(np.floor(r.min() / bin_width) * bin_width)
+    return gate_start, int(np.floor((r.max() - gate_start) / bin_width)) + 1
+
+
 def geiger_look(
     detector,
     kind,
@@ -90,8 +98,7 @@ def geiger_look(
         )
     ids, row = np.unique(detector[hit], return_inverse=True)
     r = ranges[hit]
-    gate_start = float(np.floor(r.min() / bin_width) * bin_width)
-    bins = int(np.floor((r.max() - gate_start) / bin_width)) + 1
+    gate_start, bins = range_gate(r, bin_width)
     b = np.minimum(((r - gate_start) / bin_width).astype(np.int64), bins - 1)
     signal = (
         (n_ref / rays_per_detector)

@@ -127,6 +127,7 @@ def pulse_study(
         units += 1.0
         report("trace", scan + 1, len(poses))
     ideal_cov = float(np.isin(target_keys, np.concatenate(ideal)).sum() / total) if total else None
+    _check_work(scenario, looks, pulses_list, settings.bin_width(sensor.depth_resolution))
     for row, pulses in enumerate(pulses_list):
         report("pulses", row + 1, len(pulses_list))  # the count now fired, before its first scan
         k = settings.threshold(pulses)
@@ -153,3 +154,17 @@ def pulse_study(
             )
         )
     return ideal_cov, rows
+
+
+def _check_work(scenario, looks, pulses_list, bin_width) -> None:
+    """Refuse, before the first pulse, firing whose work would pass the limit."""
+    from ladartui.detection.scan import look_cells
+    from ladartui.resources import check_bin_visits
+
+    cells = sum(d * b for d, b in (look_cells(look, bin_width) for look in looks))
+    fired = sum(pulses_list)
+    check_bin_visits(
+        cells * fired,
+        scenario.path,
+        f"{fired:,} pulses in all on each of {len(looks):,} looks, {cells:,} detector range bins among them",
+    )

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ladartui.detection.geiger import noise_per_bin
-from ladartui.detection.look import geiger_look, incidence_cosines
+from ladartui.detection.look import geiger_look, incidence_cosines, range_gate
 from ladartui.errors import LadarError
 from ladartui.returns import unique_voxels
 from ladartui.scene.keys import voxel_keys
@@ -95,22 +95,27 @@ def prepare_look(
     )
 
 
+def look_cells(look: LookInputs, bin_width: float) -> tuple[int, int]:
+    """The detectors with a hit and the range bins of ``look``'s gate, as the model
+    fires them: each pulse visits every such (detector, bin) cell once."""
+    hit = look.kind != 0
+    if not hit.any():
+        return 0, 0
+    return int(np.unique(look.detector[hit]).size), range_gate(look.range[hit], bin_width)[1]
+
+
 def declare_look(
     look: LookInputs, settings, sensor, pulses: int, threshold: int, scan_key: int, cancel=None
 ) -> LookOutcome:
     """Fire ``pulses`` pulses at one scan (random stream keyed by ``scan_key``); ``cancel``
     is checked between blocks of pulses."""
     bin_width = settings.bin_width(sensor.depth_resolution)
-    hit = look.kind != 0
-    if hit.any():
-        span = float(look.range[hit].max() - look.range[hit].min())
-        bins = span / bin_width + 2
-        detectors = np.unique(look.detector[hit]).size
-        check_memory(
-            detectors * bins * BYTES_PER_BIN,
-            f"{detectors:,} detectors x {bins:,.0f} range bins in one look",
-            "use a wider detection.bin_width_m or a smaller sensor grid",
-        )
+    detectors, bins = look_cells(look, bin_width)
+    check_memory(
+        detectors * bins * BYTES_PER_BIN,
+        f"{detectors:,} detectors x {bins:,} range bins in one look",
+        "use a wider detection.bin_width_m or a smaller sensor grid",
+    )
     result = geiger_look(
         look.detector,
         look.kind,
@@ -153,7 +158,7 @@ class GeigerRun:
 
     TARGET_RUN_KEY = 1 << 32
 
-    def __init__(self, settings, sensor, scene, cancel=None):
+    def __init__(self, settings, sensor, scene, cancel=None, scans=1, source="scenario"):
         from ladartui.detection.measures import DetectionTally
 
         check_memory(
@@ -164,6 +169,7 @@ class GeigerRun:
         self.settings = settings
         self.sensor = sensor
         self.cancel = cancel  # checked between blocks of pulses
+        self.scans, self.source = scans, source  # the firing's work, estimated at the first look
         self.voxel_size = scene.voxel_size
         self.target_model = scene.target
         self.target_keys = np.unique(voxel_keys(scene.target))
@@ -197,6 +203,8 @@ class GeigerRun:
         look = prepare_look(
             join(0), join(1), join(2), hits, kept, self.target_keys, self.settings, self.voxel_size
         )
+        if run == "scene" and scan == 1:
+            self._check_work(look)
         key = scan - 1 + (self.TARGET_RUN_KEY if run == "target" else 0)
         outcome = declare_look(
             look,
@@ -210,6 +218,21 @@ class GeigerRun:
         if run == "scene":
             self.tally.add(outcome)
         return unique_voxels(outcome.declared_voxels)
+
+    def _check_work(self, look: LookInputs) -> None:
+        """Refuse, before its first pulse, a run whose firing would pass the work
+        limit: the first look's cells for every scan (the target-alone run's looks,
+        its hits alone, are far smaller)."""
+        from ladartui.resources import check_bin_visits
+
+        detectors, bins = look_cells(look, self.settings.bin_width(self.sensor.depth_resolution))
+        pulses = self.settings.pulses
+        check_bin_visits(
+            detectors * bins * pulses * self.scans,
+            self.source,
+            f"{pulses:,} pulses on each of {self.scans:,} looks of about {detectors:,} detectors "
+            f"x {bins:,} range bins, as the first",
+        )
 
     def measures(self):
         from ladartui.detection.measures import coverage
