@@ -265,7 +265,9 @@ def test_a_geiger_run_beyond_the_work_limit_is_refused_at_its_first_look(scenari
     assert main(["run", str(scenario.path)]) == 2
     err = capsys.readouterr().err.strip()
     assert "Traceback" not in err and not visits
-    assert "detector range-bin visits to fire" in err.splitlines()[-1] and "20 pulses on each of 3 looks" in err
+    assert (
+        "detector range-bin visits to fire" in err.splitlines()[-1] and "20 pulses on each of 3 looks" in err
+    )
     assert not scenario.scene_output.exists() and not scenario.target_output.exists()
     monkeypatch.setenv("LADARTUI_MAX_BIN_VISITS", "a lot")
     assert main(["run", str(scenario.path)]) == 2

@@ -443,7 +443,7 @@ def show_result(console, result, top) -> None:
     from ladartui.sweep.columns import target_ids
     from ladartui.sweep.ranking import OBJECTIVE_HEADERS as short
     from ladartui.sweep.ranking import OBJECTIVES, identified_count, never_identified
-    from ladartui.sweep.table import column_format, display_cell
+    from ladartui.sweep.table import column_formats, display_cell
 
     cost_unit = "s" if result.cost == "flight-time" else "m"
     table = Table(
@@ -454,10 +454,8 @@ def show_result(console, result, top) -> None:
     )
     shown = [r for r in result.ranking if r.rank is not None][:top]
     # each column's numbers with its decimals, so that they line up
-    formats = {name: column_format([r.row.get(name) for r in shown]) for name in result.parameter_names}
-    value_cell = column_format([r.value for r in shown])
-    coverage_cell = column_format([r.coverage for r in shown], 3)
-    cost_cell = column_format([r.cost for r in shown], 4)
+    formats = column_formats(shown, result.parameter_names)
+    value_cell, coverage_cell, cost_cell = formats["value"], formats["coverage"], formats["cost"]
 
     def number_column(header: str, values) -> None:
         # A narrow terminal folds the header, never a value: a cut number reads as another one.

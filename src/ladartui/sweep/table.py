@@ -91,6 +91,17 @@ def column_format(values, digits=4):
     return cell
 
 
+def column_formats(ranking, parameter_names) -> dict:
+    """A formatter per number column of a ranking table ("value", "coverage", "cost",
+    each parameter), so that each column's numbers share their decimals
+    (``column_format``); the CLI and the TUI draw their tables with the same."""
+    formats = {name: column_format([e.row.get(name) for e in ranking]) for name in parameter_names}
+    formats["value"] = column_format([e.value for e in ranking])
+    formats["coverage"] = column_format([e.coverage for e in ranking], 3)
+    formats["cost"] = column_format([e.cost for e in ranking])
+    return formats
+
+
 def parse_cell(text: str):
     """The value a cell was written from (numbers, booleans, lists, None, text)."""
     if text == "":

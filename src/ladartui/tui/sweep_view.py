@@ -8,7 +8,7 @@ from pathlib import Path
 from rich.text import Text
 
 from ladartui.sweep.ranking import OBJECTIVE_HEADERS
-from ladartui.sweep.table import column_format, display_cell
+from ladartui.sweep.table import column_formats, display_cell
 
 COST_HEADERS = {"flight-time": "time s", "distance": "dist m"}
 # Each label with its axis's arrow: plotext sets them side by side on one line, which
@@ -67,15 +67,6 @@ def fill_ranking_table(table, ranking, objective: str, cost: str, parameter_name
     if ranking:
         table.move_cursor(row=cursor)
     return ids
-
-
-def column_formats(ranking, parameter_names) -> dict:
-    """A formatter per number column ("value", "cost", each parameter), so that each
-    column's numbers share their decimals (``column_format``)."""
-    formats = {name: column_format([e.row.get(name) for e in ranking]) for name in parameter_names}
-    formats["value"] = column_format([e.value for e in ranking])
-    formats["cost"] = column_format([e.cost for e in ranking])
-    return formats
 
 
 def ranking_cells(entry, objective: str, parameter_names, errors: bool, formats: dict) -> list:
