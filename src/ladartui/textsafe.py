@@ -18,7 +18,7 @@ def _visible(char: str) -> str:
 
 def one_line(text: object, limit: int = MAX_MESSAGE_CHARS) -> str:
     """``text`` as one line: control characters written as ``\\xNN``, at most ``limit`` characters."""
-    safe = "".join(_visible(char) for char in str(text))
+    safe = single_line(text)
     if len(safe) <= limit:
         return safe
     dropped = len(safe) - limit
@@ -34,4 +34,4 @@ def single_line(text: object) -> str:
 def visible(text: object) -> str:
     """``text`` for a terminal, its lines kept: control characters in each line (a file
     name's terminal escapes) written as ``\\xNN``, nothing cut."""
-    return "\n".join("".join(_visible(char) for char in line) for line in str(text).split("\n"))
+    return "\n".join(single_line(line) for line in str(text).split("\n"))
