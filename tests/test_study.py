@@ -459,6 +459,25 @@ def test_every_text_of_a_study_file_reaches_the_terminal_escaped(tmp_path, capsy
     assert "\x1b" not in out and "[b]y[/b]" in out
 
 
+@pytest.mark.parametrize(
+    ("value", "said"),
+    [(math.nan, "NaN"), (math.inf, "Infinity"), (-0.5, "a time of -0.5 s")],
+)
+def test_a_study_file_with_a_time_no_study_writes_is_refused_in_one_line(tmp_path, capsys, value, said):
+    """NaN seconds (json.dump writes them by default) crashed the chart with a
+    ValueError traceback; a negative time was drawn on the log axis."""
+    from ladartui.cli import main
+
+    data = json.loads((Path(__file__).parent.parent / "docs" / "study.json").read_text())
+    data["rows"][0]["seconds"][0] = value
+    tampered = tmp_path / "t.json"
+    tampered.write_text(json.dumps(data))
+    assert main(["study", "--chart-from", str(tampered), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(f"ladartui: error: {tampered}") and said in err and "\n" not in err
+    assert "expected a study.json written by 'ladartui study'" in err and not (tmp_path / "o").exists()
+
+
 def test_a_study_is_written_as_one_set(tmp_path, monkeypatch):
     """study.csv and study.json were replaced before the charts were drawn: a Ctrl-C or a
     failure then left this study's tables beside the last one's charts."""

@@ -200,7 +200,7 @@ class StudyResult:
                 reason=item.get("reason"),
                 rays_per_scan=item.get("rays_per_scan"),
                 scans=item.get("scans", 0),
-                timing=Timing(list(item.get("seconds") or [])),
+                timing=Timing(_durations(item.get("seconds") or [])),
                 misses=MissSummary(
                     rays=misses.get("rays", 0),
                     voxel_rays=misses.get("voxel_rays", 0),
@@ -343,6 +343,18 @@ def format_share(value) -> str:
 STUDY_JSON = "expected a study.json written by 'ladartui study'"
 
 
+def _durations(seconds) -> list[float]:
+    """A row's timed runs as read: durations, each a finite number of seconds >= 0."""
+    for value in seconds:
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value < math.inf:
+            raise ValueError(f"a time of {value!r} s, where a duration is expected")
+    return [float(value) for value in seconds]
+
+
+def _no_constant(name: str):
+    raise ValueError(f"{name}, which a study never writes")
+
+
 def read_study(path) -> StudyResult:
     """A ``study.json`` written by a study (the CLI's or the terminal UI's), read back."""
     from ladartui.errors import InputFileError
@@ -350,7 +362,7 @@ def read_study(path) -> StudyResult:
 
     refuse_special_file(path, STUDY_JSON)
     try:
-        data = json.loads(Path(path).read_text(encoding="utf-8"))
+        data = json.loads(Path(path).read_text(encoding="utf-8"), parse_constant=_no_constant)
         if not isinstance(data, dict):
             raise InputFileError(path, f"a JSON {type(data).__name__}, not an object; {STUDY_JSON}")
         return StudyResult.from_dict(data)
