@@ -148,6 +148,18 @@ async def test_the_threshold_form_says_why_an_infinite_height_is_refused(tmp_pat
         assert message(form) == "Max height m: -5 is not allowed; expected a number >= 0 m"
 
 
+async def test_a_field_without_limits_says_finite_once(tmp_path, scene_files):
+    """'Azimuth (deg): nan is not allowed; expected a finite finite number'."""
+    from ladartui.tui.screens import AngleScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario) as (app, pilot):
+        form = await screen_after(pilot, "f7", AngleScreen)
+        for typed in ("nan", "1e400"):
+            await type_into(pilot, form.query_one("#f-azimuth"), typed, commit="enter")
+            assert message(form) == f"Azimuth (deg): {typed} is not allowed; expected a finite number"
+
+
 async def test_compare_names_the_files_in_its_folder_by_their_names(tmp_path, scene_files):
     """The field held whole paths: at 80 columns it showed '…/default/[red.cmf'
     /tmp/h2home/default/default.cmf', scrolled; names in the folder shown read whole."""

@@ -109,7 +109,7 @@ class NumberField(Input):
         except FieldError as core:
             if core.limits is not None:
                 expected = core.expected
-                if error.expected == "a finite number" and core.limits[1] is None:
+                if error.expected == "a finite number" and not expected.startswith("a finite"):
                     # "1e400": "a number >= 0" would not say what is wrong with it
                     expected = "a finite " + expected.removeprefix("a ")
                 return FieldError(error.field, error.value, expected, limits=core.limits)
