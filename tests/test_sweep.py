@@ -24,7 +24,7 @@ from ladartui.sweep import (
     variant_id,
     write_table,
 )
-from ladartui.sweep.table import TEXT_COLUMNS
+from ladartui.sweep.table import LEAD_COLUMNS, TEXT_COLUMNS, TableWriter, order_columns, table_text
 from tiny_sweep import CENTRE, tiny_folder, write_spec, write_tiny_scenario
 
 # Columns that depend on where and when a variant ran, not on what it computed.
@@ -214,6 +214,63 @@ def test_reader_drops_a_torn_last_line(tmp_path):
         handle.write("bbbbbbbbbbbbbbbb,ok")  # a line cut short by a crash elsewhere
     rows, _ = read_table(path)
     assert [r["variant"] for r in rows] == ["a" * 16]
+
+
+def test_the_table_writer_writes_what_write_table_writes_row_by_row(tmp_path):
+    """Each row is formatted once, and again only when a later row changes the columns;
+    the file is the table of every row so far, in order, a row replaced in place."""
+    rng = random.Random(5)
+    extra = ["coverage", "levels", "path_length_m", "obscured_coverage"]
+    rows = []
+    path = tmp_path / "results.csv"
+    path.write_bytes(b"")
+    writer = TableWriter(path, [], ["radius"], spacing=0.0)
+    for i in range(60):
+        variant = f"{rng.randrange(25):016x}"  # some variants again: a failed row retried
+        row = {"variant": variant, "status": rng.choice(["ok", "failed"]), "base": "b", "radius": i / 7}
+        row.update({key: rng.random() for key in rng.sample(extra, rng.randrange(len(extra)))})
+        at = next((k for k, r in enumerate(rows) if r["variant"] == variant), None)
+        if at is None:
+            rows.append(row)
+        else:
+            rows[at] = row
+        writer.put(row)
+        back, header = read_table(path)
+        assert set(header) == set(order_columns(rows, ["radius"])) and header[:4] == [*LEAD_COLUMNS, "radius"]
+        assert [{k: v for k, v in r.items() if v is not None} for r in back] == rows
+    assert writer.rows == rows
+    assert path.read_text() == table_text(rows, ["radius"], columns=header)
+
+
+def test_the_table_writer_spaces_its_rewrites_and_loses_no_row(tmp_path, monkeypatch):
+    """Rewriting the whole table after every variant grew with the table (20,000 rows:
+    seconds a variant); the rewrites are spaced to a share of the time, and flush
+    writes the rows held back."""
+    import ladartui.sweep.table as table
+
+    now = [0.0]
+    monkeypatch.setattr(table.time, "monotonic", lambda: now[0])
+    writes = []
+    real = table.write_text_atomically
+
+    def slow_write(path, text):
+        writes.append(text.count("\n") - 1)
+        now[0] += 1.0  # each rewrite takes a second
+        real(path, text)
+
+    monkeypatch.setattr(table, "write_text_atomically", slow_write)
+    path = tmp_path / "results.csv"
+    writer = TableWriter(path, [], [], spacing=9.0)
+    for i in range(40):
+        writer.put({"variant": f"{i:016x}", "status": "ok", "base": "b"})
+        now[0] += 0.5  # half a second a variant
+    assert writes[0] == 1 and len(writes) <= 40 * 1.5 / 10 + 1  # at most a tenth of the time
+    assert len(read_table(path)[0]) < 40
+    writer.flush()
+    assert len(read_table(path)[0]) == 40 and writes[-1] == 40
+    count = len(writes)
+    writer.flush()  # nothing new: not written again
+    assert len(writes) == count
 
 
 # -- ranking -------------------------------------------------------------------------

@@ -103,6 +103,23 @@ def test_two_workers_give_the_same_rows_as_serial_runs(spec, serial_rows, client
     assert set(client.run(scenes_built).values()) == {1}
 
 
+def test_only_a_few_variants_wait_submitted_ahead_of_the_workers(spec, serial_rows, client, tmp_path, monkeypatch):
+    """Every variant was submitted at once: 100,000 futures held 800 MB and a Ctrl-C
+    waited while the scheduler cancelled them all."""
+    import ladartui.sweep.execute as execute
+
+    monkeypatch.setattr(execute, "_tasks_ahead", lambda client: 3)
+    held = []
+
+    def count_futures(progress):
+        variants = [key for key in client.futures if str(key).startswith("ladartui-variant-")]
+        held.append(len(variants))
+
+    result = run_sweep(spec, client=client, out=tmp_path, progress=count_futures)
+    assert len(held) == 9 and max(held) <= 3  # the first report, then one per variant
+    assert comparable(result.rows) == comparable(serial_rows)
+
+
 def test_cluster_sweep_resumes_after_an_interruption(spec, serial_rows, client, tmp_path):
     cancel = threading.Event()
 

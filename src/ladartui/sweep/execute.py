@@ -42,7 +42,7 @@ from ladartui.sweep.ranking import (
     rank_rows,
 )
 from ladartui.sweep.spec import SweepSpec, load_sweep_spec
-from ladartui.sweep.table import read_table, table_text, write_table
+from ladartui.sweep.table import TableWriter, read_table, table_text
 from ladartui.sweep.variant import ScenePayload, run_variant
 
 RESULTS_NAME = "results.csv"
@@ -336,14 +336,10 @@ def _run_locked(
     resumed = len(variants) - len(todo)
     state = SweepProgress(total=len(variants), done=resumed, resumed=resumed, failed=0, elapsed=0.0)
 
+    table = TableWriter(results_path, table_rows, spec.parameter_names)
+
     def record(row):
-        key = (row["variant"], row["base"])
-        if key in position:
-            table_rows[position[key]] = row
-        else:
-            position[key] = len(table_rows)
-            table_rows.append(row)
-        write_table(results_path, table_rows, spec.parameter_names)
+        table.put(row)
         state.done += 1
         state.failed += row.get("status") not in FINAL_STATUSES
         state.impossible += row.get("status") == "error"
@@ -354,26 +350,12 @@ def _run_locked(
 
     if progress is not None:
         progress(dataclasses.replace(state))
-    result_workers, scheduler = 0, "serial"
-    if todo:
-        options = dict(simulate_options or {})
-        if serial or client is None:  # here or on this machine's workers: its cache
-            scene()  # read first: a mistake in its model is told before any compiling
-            compile_ahead(_with_options(base, options), cancel)
-        if serial:
-            result_workers = 1
-            _run_serial(todo, base, digest, scene(), options, record, cancel)
-        else:
-            owned = client is None
-            if owned:
-                client = local_client(workers)
-            try:
-                result_workers = len(client.scheduler_info(n_workers=-1).get("workers", {}))
-                scheduler = client.scheduler.address
-                _run_on_dask(client, todo, base, digest, scene(), options, record, cancel)
-            finally:
-                if owned:
-                    close_client(client)
+    try:
+        result_workers, scheduler = _run_todo(
+            todo, digest, base, scene, client, cancel, workers, serial, simulate_options, record
+        )
+    finally:  # however it ends, the rows held back are written: finished variants are kept
+        table.flush()
 
     # The rows as the file holds them (every column present), so this result
     # and load_sweep_results of the same folder agree.
@@ -408,6 +390,29 @@ def _run_locked(
     return result
 
 
+def _run_todo(todo, digest, base, scene, client, cancel, workers, serial, simulate_options, record):
+    """Run the variants not yet in the table; the number of workers and the scheduler that ran them."""
+    if not todo:
+        return 0, "serial"
+    options = dict(simulate_options or {})
+    if serial or client is None:  # here or on this machine's workers: its cache
+        scene()  # read first: a mistake in its model is told before any compiling
+        compile_ahead(_with_options(base, options), cancel)
+    if serial:
+        _run_serial(todo, base, digest, scene(), options, record, cancel)
+        return 1, "serial"
+    owned = client is None
+    if owned:
+        client = local_client(workers)
+    try:
+        ran_on = len(client.scheduler_info(n_workers=-1).get("workers", {}))
+        _run_on_dask(client, todo, base, digest, scene(), options, record, cancel)
+        return ran_on, client.scheduler.address
+    finally:
+        if owned:
+            close_client(client)
+
+
 def _run_serial(todo, base, digest, scene, options, record, cancel):
     for variant in todo:
         check_cancelled(cancel, "sweep cancelled")
@@ -427,15 +432,22 @@ def _lost_row(variant, digest, future) -> dict:
 
 
 def _run_on_dask(client, todo, base, digest, scene, options, record, cancel):
+    """Run ``todo`` on ``client``'s workers, a few tasks ahead of them: submitting
+    every variant at once held 100,000 futures (800 MB here) and made a Ctrl-C wait
+    while the scheduler cancelled them all."""
     from distributed import as_completed
 
     # Plain arrays once to every worker; each rebuilds the Scene once per token.
     payload = ScenePayload.of(scene, uuid.uuid4().hex)
     scene_future = client.scatter(payload, broadcast=True, hash=False)
     tag = uuid.uuid4().hex[:8]
-    pending = {}
-    try:
-        for variant in todo:
+    waiting = iter(todo)
+    pending: dict = {}
+    completed = as_completed()
+
+    def submit_more():
+        ahead = _tasks_ahead(client)
+        while len(pending) < ahead and (variant := next(waiting, None)) is not None:
             future = client.submit(
                 run_variant,
                 base,
@@ -448,7 +460,10 @@ def _run_on_dask(client, todo, base, digest, scene, options, record, cancel):
                 key=f"ladartui-variant-{variant.id}-{tag}",
             )
             pending[future] = variant
-        completed = as_completed(list(pending))
+            completed.add(future)
+
+    try:
+        submit_more()
         while pending:
             check_cancelled(cancel, "sweep cancelled")
             batch = completed.next_batch(block=False)
@@ -465,10 +480,18 @@ def _run_on_dask(client, todo, base, digest, scene, options, record, cancel):
                 else:
                     row = _lost_row(variant, digest, future)
                 record(row)
+            submit_more()
     finally:
         if pending:
             client.cancel(list(pending))
         scene_future.release()
+
+
+def _tasks_ahead(client) -> int:
+    """Tasks kept submitted: four per worker thread the cluster has now (workers that
+    join later get theirs as tasks finish), at least 16."""
+    workers = client.scheduler_info(n_workers=-1).get("workers", {})
+    return max(16, 4 * sum(int(w.get("nthreads", 1)) for w in workers.values()))
 
 
 def write_ranking(path, ranking: list[Ranked], parameter_names) -> Path:
