@@ -8,6 +8,7 @@ import re
 import subprocess
 import sys
 import threading
+import time
 from dataclasses import replace
 
 import pytest
@@ -580,6 +581,30 @@ def test_the_summary_counts_in_words_and_says_when_every_variant_was_resumed(tin
     out = capsys.readouterr().out
     assert "\nnothing to run: all 2 variants resumed from earlier runs\n" in out
     assert " run in " not in out and "(s)" not in out
+
+
+def test_a_ctrl_c_after_the_last_variant_says_the_sweep_finished(tiny, tmp_path, capsys, monkeypatch):
+    """A Ctrl-C once every variant had run left 'stopping; finished variants are kept'
+    on the bar and exited 0 with the whole set written, the interrupt not mentioned."""
+    import _thread
+
+    import ladartui.sweep.execute as execute
+    from ladartui.cli import main
+
+    real = execute.write_ranking
+
+    def interrupted_first(*args, **kwargs):
+        _thread.interrupt_main()
+        time.sleep(1.0)  # the main thread sees the Ctrl-C and waits for this one
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(execute, "write_ranking", interrupted_first)
+    spec = write_spec(tiny, "[grid]\nradius = [10.0, 12.0]\n", name="late.toml")
+    assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path)]) == 0
+    captured = capsys.readouterr()
+    said = captured.out + captured.err
+    assert "the interrupt came after the last variant: the sweep finished" in said
+    assert "sweep interrupted" not in said and (tmp_path / "ranking.csv").exists()
 
 
 def test_two_sweeps_never_write_one_folder_at_once(tiny, tmp_path):

@@ -103,7 +103,9 @@ def test_two_workers_give_the_same_rows_as_serial_runs(spec, serial_rows, client
     assert set(client.run(scenes_built).values()) == {1}
 
 
-def test_only_a_few_variants_wait_submitted_ahead_of_the_workers(spec, serial_rows, client, tmp_path, monkeypatch):
+def test_only_a_few_variants_wait_submitted_ahead_of_the_workers(
+    spec, serial_rows, client, tmp_path, monkeypatch
+):
     """Every variant was submitted at once: 100,000 futures held 800 MB and a Ctrl-C
     waited while the scheduler cancelled them all."""
     import ladartui.sweep.execute as execute

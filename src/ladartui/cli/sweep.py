@@ -302,6 +302,9 @@ def progress_note(p) -> str:
     return ", ".join(parts)
 
 
+LATE_INTERRUPT = "the interrupt came after the last variant: the sweep finished"
+
+
 def _sweep_with_progress(checked, args, console):
     from ladartui.sweep import connect, run_sweep
 
@@ -350,9 +353,13 @@ def _sweep_with_progress(checked, args, console):
 
             try:
                 with sigterm_as_interrupt():
-                    return run_cancellable(work, cancel, "ladartui-sweep", Cancelled(), stopping)
+                    result = run_cancellable(work, cancel, "ladartui-sweep", Cancelled(), stopping)
             except Cancelled:
                 pass  # reported below, once the client is closed
+            else:
+                if cancel.is_set():  # every variant had run: the whole set was written
+                    bar.update(task, note=LATE_INTERRUPT)
+                return result
     finally:
         if client is not None:
             client.close()
