@@ -49,6 +49,9 @@ def test_show_ranks_the_rows_of_the_current_base_only(tmp_path, capsys):
     ran = run_sweep(spec, serial=True)
     assert ran.ran == 2 and len(ran.rows) == 2
     out = tmp_path / "bases-results"
+    from ladartui.charts.sweep import write_sweep_charts
+
+    write_sweep_charts(ran, out)  # as the command draws them
     assert len(read_table(out / "results.csv")[0]) == 4  # both bases' rows are kept
     shown = load_sweep_results(out, spec=load_sweep_spec(spec))
     assert [r.row["variant"] for r in shown.ranking] == [r.row["variant"] for r in ran.ranking]
@@ -66,16 +69,13 @@ def test_show_ranks_the_rows_of_the_current_base_only(tmp_path, capsys):
     text = captured.out.replace("\n", " ")
     assert "4 rows of other variants or an earlier base left out" in text
     assert "no variant finished (no row of this spec's variants from its base as it is now)" in captured.err
-    assert {p: p.read_bytes() for p in out.glob("pareto.*")} == charts  # not redrawn empty
+    assert {p: p.read_bytes() for p in out.glob("pareto.*")} == charts  # never redrawn by --show
     # base as it ran: ranked by another objective, the charts stay the sweep's, as its
     # ranking.csv and best path do (they starred the other ranking's best)
     base.write_text(base.read_text(encoding="utf-8").replace("fov_deg = 16.0", "fov_deg = 18.0"))
     assert main(["sweep", str(spec), "--show", "--objective", "time-to-identify", "--cost", "distance"]) == 0
     said = capsys.readouterr().err
-    assert (
-        f"the charts in {out} are left as the sweep drew them (by obscured-coverage, against flight-time)"
-        in said
-    )
+    assert f"the charts, ranking.csv and best path in {out} stay as the last sweep wrote them" in said
     assert {p: p.read_bytes() for p in out.glob("pareto.*")} == charts
     # the base gone: every row of the table, said so
     base.unlink()
@@ -83,6 +83,26 @@ def test_show_ranks_the_rows_of_the_current_base_only(tmp_path, capsys):
     out_err = capsys.readouterr()
     assert len(json.loads(out_err.out)["top"]) == 4
     assert "base scenario" in out_err.err and "every row of the table is ranked" in out_err.err
+
+
+def test_show_writes_nothing_and_leaves_the_folder_as_the_sweep_ranked_it(tmp_path, capsys):
+    """A sweep ranked with --objective coverage-per-km, then --show without it: the
+    charts were redrawn by the spec's objective, starring another best than the
+    folder's ranking.csv and best path, without a word."""
+    from ladartui.cli import main
+
+    write_tiny_scenario(tmp_path)
+    spec = write_spec(tmp_path, "[grid]\nradius = [20.0, 30.0]\nscans = [2, 4]\n", name="terms.toml")
+    out = tmp_path / "terms-results"
+    assert main(["sweep", str(spec), "--serial", "--objective", "coverage-per-km"]) == 0
+    capsys.readouterr()
+    written = {p.name: p.read_bytes() for p in out.iterdir()}
+    assert {"pareto.svg", "pareto.png", "ranking.csv", "terms-best.toml"} <= set(written)
+    assert main(["sweep", str(spec), "--show"]) == 0
+    captured = capsys.readouterr()
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == written
+    assert "chart " not in captured.out
+    assert "stay as the last sweep wrote them" in captured.err
 
 
 def test_a_range_of_too_many_values_is_refused_on_its_line_even_past_float_range(tmp_path):

@@ -242,23 +242,8 @@ def run(args) -> int:
         result = _sweep_with_progress(checked, args, errors)
         if result is None:
             return stop_status()
-    # --show redraws them (from rows: not empty ones), unless it ranks otherwise than the
-    # sweep did: the folder's ranking.csv and best path stay the spec's, and so do they
-    otherwise = args.show and _ranked_otherwise(spec, result)
-    if not result.charts and result.rows and not otherwise:
-        from ladartui.charts.sweep import write_sweep_charts
-
-        result.charts = write_sweep_charts(result, result.results_path.parent)
-    elif otherwise and result.rows:
-        errors.print(
-            single_line(
-                f"ladartui: the charts in {result.results_path.parent} are left as the sweep drew them "
-                f"(by {spec.objective}, against {spec.cost}), as its ranking.csv and best path are"
-            ),
-            highlight=False,
-            markup=False,
-            soft_wrap=True,
-        )
+    if args.show:  # it ranks as asked, and writes nothing: the folder stays one set
+        _say_folder_unchanged(errors, result.results_path.parent)
     if args.json:
         print(json.dumps(result_dict(result, args.top), indent=2, allow_nan=False))
     else:
@@ -431,14 +416,19 @@ def result_dict(result, top) -> dict:
     }
 
 
-def _ranked_otherwise(spec, result) -> bool:
-    """Whether ``result`` is ranked by another objective, cost or (where the objective
-    reads one) budget than its spec's."""
-    from ladartui.sweep.ranking import BUDGET_OBJECTIVES
-
-    if (result.objective, result.cost) != (spec.objective, spec.cost):
-        return True
-    return result.objective in BUDGET_OBJECTIVES and result.budget != spec.budget
+def _say_folder_unchanged(errors, folder: Path) -> None:
+    """What --show leaves, where the folder holds a ranking: as the last sweep wrote it
+    (by the terms it ranked by, which --show's may not be)."""
+    if any((folder / name).exists() for name in ("ranking.csv", "pareto.svg", "pareto.png")):
+        errors.print(
+            single_line(
+                f"ladartui: the charts, ranking.csv and best path in {folder} stay as the last "
+                "sweep wrote them (--show writes nothing; the sweep again redraws them)"
+            ),
+            highlight=False,
+            markup=False,
+            soft_wrap=True,
+        )
 
 
 def show_result(console, result, top) -> None:
