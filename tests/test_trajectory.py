@@ -305,3 +305,21 @@ def test_a_rate_giving_the_most_scans_allowed_is_taken(tmp_path):
     path.write_text("time,x,y,z,heading\n0,0,0,50,90\n1000,10000,0,50,90\n")
     with pytest.raises(FieldError, match="at most 10000 scans over the log"):
         LogSegment(str(path), rate=10.0)
+
+
+def test_a_log_keeps_its_own_clock_for_scan_times_and_flight_time(tmp_path):
+    """A log spanning 3 s at 30 m/s flew 90 m; the plan said 9 s (90 m at the scenario's
+    10 m/s), and the levels' times came from the same division."""
+    from ladartui.flight import FlightPlan, Straight
+    from ladartui.trajectory import LogSegment
+
+    path = tmp_path / "log.csv"
+    path.write_text("time,x,y,z,heading\n" + "".join(f"{t},{30 * t},0,60,90\n" for t in range(4)))
+    log = LogSegment(str(path), rate=2.0)
+    plan = FlightPlan(segments=(log,))
+    assert plan.scan_times(10.0) == pytest.approx([0.0, 0.5, 1.0, 1.5, 2.0, 2.5, 3.0])
+    assert plan.flight_time(10.0) == pytest.approx(3.0) and plan.path_length() == pytest.approx(90.0)
+    # a straight after it flies at the plan's speed, from the log's last scan
+    both = FlightPlan(segments=(log, Straight(distance=50.0, scans=2)))
+    assert both.scan_times(10.0)[-3:] == pytest.approx([3.0, 5.5, 8.0])
+    assert both.flight_time(10.0) == pytest.approx(8.0)

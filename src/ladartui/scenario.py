@@ -185,6 +185,15 @@ class Scenario:
     def flight_time(self) -> float:
         return self.flight.flight_time(self.speed)
 
+    def _clock_text(self) -> str:
+        """How the flight time is reckoned: at the speed, or by a flight log's own clock."""
+        logs = [hasattr(segment, "leg_seconds") for segment in self.flight.segments]
+        if not any(logs):
+            return f"at {self.speed:g} m/s"
+        if all(logs) and len(logs) == 1:
+            return "by the flight log's clock"
+        return f"by the flight logs' clock, other legs at {self.speed:g} m/s"
+
     def load_scene(self):
         """The scene model and its target model as a ``ladartui.scene.model.Scene``."""
         from ladartui.scene.model import Scene
@@ -292,7 +301,7 @@ class Scenario:
             f"flight     {plural(len(poses), 'scan')}: {kinds}",
             f"           altitude {min(altitudes):g}..{max(altitudes):g} m, depression "
             f"{min(depressions):.3g}..{max(depressions):.3g} deg",
-            f"           path {fixed(length, 1)} m, {fixed(self.flight_time(), 1)} s at {self.speed:g} m/s",
+            f"           path {fixed(length, 1)} m, {fixed(self.flight_time(), 1)} s {self._clock_text()}",
             f"rays       {s.rays_per_scan:,} per scan, {s.rays_per_scan * len(poses):,} in all",
             f"run        backend {self.backend}, method {self.method}"
             + (f" (step {self.step:g} voxel)" if self.method == "march" else "")

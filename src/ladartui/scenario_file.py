@@ -22,7 +22,7 @@ are caught; keys marked "default" may be left out)::
     mount = "stabilised"            # or "body-fixed": rays turn with roll and pitch
 
     [flight]
-    speed_mps = 30.0                # for the flight time (default 30)
+    speed_mps = 30.0                # for the flight time (default 30; a log's scans keep its clock)
 
     [flight.start]                  # needed only if a straight or turn comes first
     x = 0.0                         # metres east
@@ -61,6 +61,7 @@ Other segment kinds and their keys (``aim_at`` is optional on every kind):
   file's folder; see ``ladartui.trajectory``), scans at ``rate`` (Hz) or at
   ``times = [..]`` (s); ``azimuth`` (default 0), ``depression`` (default 90);
   ``origin = [lat, lon, alt]`` places a geodetic (latitude, longitude) log.
+  Its scans are timed by the log's own clock, not by ``speed_mps``.
 
 Straight and turn segments continue from the previous segment's last scan
 (or from ``[flight.start]``); see ``ladartui.flight``. ::

@@ -377,3 +377,7 @@ class LogSegment:
 
     def legs(self, poses):
         return [float(np.linalg.norm(np.subtract(a.position, b.position))) for a, b in zip(poses, poses[1:])]
+
+    def leg_seconds(self, poses) -> list[float]:
+        """Seconds between consecutive scans by the log's own clock, not the plan's speed."""
+        return np.diff(self.scan_times()).tolist()

@@ -14,6 +14,7 @@ Segments come in two families:
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -352,30 +353,49 @@ class FlightPlan:
         """Metres flown from the first scan to each scan (0 for the first), in flying order.
 
         The one source of distance along the path: ``path_length`` is its last
-        value and ``scan_times`` divides it by the speed.
+        value and ``scan_times`` divides its steps by the speed.
         """
-        distances: list[float] = []
-        total = 0.0
+        return list(itertools.accumulate(metres for metres, _ in self._steps()))
+
+    def _steps(self):
+        """Per scan in flying order: the metres from the scan before, and the seconds
+        where the segment keeps its own clock (a flight log's records), else None."""
         previous = None
         for segment, poses in zip(self.segments, self.segment_poses()):
-            if previous is not None:
-                total += (
-                    segment.lead_in() if segment.relative else math.dist(previous.position, poses[0].position)
+            if previous is None:
+                yield 0.0, 0.0
+            else:
+                yield (
+                    (
+                        segment.lead_in()
+                        if segment.relative
+                        else math.dist(previous.position, poses[0].position)
+                    ),
+                    None,
                 )
-            distances.append(total)
-            for leg in segment.legs(poses):
-                total += leg
-                distances.append(total)
+            legs = segment.legs(poses)
+            clock = getattr(segment, "leg_seconds", None)
+            yield from zip(legs, clock(poses) if clock is not None else [None] * len(legs))
             previous = poses[-1]
-        return distances
 
     def scan_times(self, speed: float) -> list[float]:
-        """Seconds flown from the first scan to each scan at ``speed`` metres per second."""
-        return [flight_time(distance, speed) for distance in self.scan_distances()]
+        """Seconds flown from the first scan to each scan: a flight log's scans at the
+        log's own times, every other step at ``speed`` metres per second."""
+        flight_time(0.0, speed)  # the speed checked, scans or none
+        times, metres_at_speed, clocked = [], 0.0, 0.0
+        for metres, seconds in self._steps():
+            if seconds is None:
+                metres_at_speed += metres
+            else:
+                clocked += seconds
+            # the metres summed, then divided: without a log, exactly scan_distances / speed
+            times.append(metres_at_speed / speed + clocked)
+        return times
 
     def flight_time(self, speed: float) -> float:
-        """Seconds to fly ``path_length()`` at ``speed`` metres per second."""
-        return flight_time(self.path_length(), speed)
+        """Seconds from the first scan to the last (``scan_times``)."""
+        times = self.scan_times(speed)
+        return times[-1] if times else 0.0
 
 
 def _prefixed(error: FieldError, prefix: str) -> FieldError:
