@@ -323,3 +323,26 @@ def test_a_log_keeps_its_own_clock_for_scan_times_and_flight_time(tmp_path):
     both = FlightPlan(segments=(log, Straight(distance=50.0, scans=2)))
     assert both.scan_times(10.0)[-3:] == pytest.approx([3.0, 5.5, 8.0])
     assert both.flight_time(10.0) == pytest.approx(8.0)
+
+
+def test_a_run_whose_output_would_replace_its_flight_log_is_refused(tmp_path, capsys):
+    """A log named lg.cmf beside lg.toml was replaced by the run's measures, and the
+    next run failed on it; the models were already spared, the log was not."""
+    from ladartui.cli import main
+    from ladartui.scene.voxels import save_voxels
+
+    target = np.array([(x, y, 0) for x in range(4) for y in range(4)], np.int32)
+    save_voxels(tmp_path / "woods.txt", target)
+    save_voxels(tmp_path / "woods_Target.txt", target)
+    log_text = "time,x,y,z,heading\n" + "".join(f"{t},{t},2,30,90\n" for t in range(3))
+    (tmp_path / "lg.cmf").write_text(log_text)
+    scenario = tmp_path / "lg.toml"
+    scenario.write_text(
+        '[files]\nscene = "woods.txt"\nvoxel_size = 1.0\n[sensor]\ngrid = 4\nray_grid = 1\n'
+        '[[flight.segments]]\nkind = "log"\nfile = "lg.cmf"\nrate = 1.0\n'
+    )
+    assert main(["run", str(scenario)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err.startswith(f"ladartui: error: {scenario}:9: flight.segments[0].file = 'lg.cmf'")
+    assert "would overwrite the flight log" in err
+    assert (tmp_path / "lg.cmf").read_text() == log_text and not (tmp_path / "lg_Scene.txt").exists()

@@ -429,16 +429,31 @@ def check_outputs_spare_inputs(scenario, las=False) -> None:
     check_output_names(scenario, las)
     check_lock(output_lock(scenario))
     inputs = {os.path.normpath(Path(f).absolute()) for f in (scenario.scene_file, scenario.target_file)}
+    logs = {
+        os.path.normpath(Path(segment.file).absolute()): index
+        for index, segment in enumerate(scenario.flight.segments)
+        if segment.kind == "log"
+    }
     for name, path in output_paths(scenario, las).items():
-        if os.path.normpath(path.absolute()) in inputs:
-            line = scenario.key_line("files.scene")
-            raise FieldError(
-                "files.scene",
-                Path(scenario.scene_file).name,
+        where = os.path.normpath(path.absolute())
+        if where in inputs:
+            key, found = "files.scene", Path(scenario.scene_file).name
+            expected = (
                 f"a scene model not named after the scenario: the run's {name} output "
-                f"{path.name} would overwrite a model file",
-                source=f"{scenario.path}:{line}" if line else str(scenario.path),
+                f"{path.name} would overwrite a model file"
             )
+        elif where in logs:
+            key, found = f"flight.segments[{logs[where]}].file", path.name
+            expected = (
+                f"a flight log not named as a run output: the run's {name} output would "
+                "overwrite the flight log"
+            )
+        else:
+            continue
+        line = scenario.key_line(key)
+        raise FieldError(
+            key, found, expected, source=f"{scenario.path}:{line}" if line else str(scenario.path)
+        )
     check_record_spare(scenario)
 
 
