@@ -303,7 +303,7 @@ def _sweep_with_progress(checked, args, console):
         if args.scheduler
         else ("this process" if args.serial else "local cluster")
     )
-    console.print(f"sweep of {len(spec.variants)} variants on {where}", highlight=False, markup=False)
+    console.print(f"sweep of {len(spec.variants):,} variants on {where}", highlight=False, markup=False)
     try:
         with sweep_progress(console) as bar:
             task = bar.add_task("sweep", total=len(spec.variants), note=STARTING)

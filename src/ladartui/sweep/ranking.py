@@ -212,7 +212,7 @@ def objective_value(row: dict, objective: str, budget: float | None = None) -> f
         return worst_target_coverage(row)
     if objective == "identified-within-budget":
         count = identified_within(row, _need_budget(budget, objective))[0]
-        return float(count) if count else None
+        return count if count else None  # a count: shown as 2, not 2.000
     coverage = coverage_of(row)
     if coverage is None:
         return None
