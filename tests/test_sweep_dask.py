@@ -399,7 +399,7 @@ def test_ctrl_c_early_in_a_local_sweep_says_it_is_stopping(tmp_path):
         handle.close()
     said = log.read_text(errors="replace")
     assert "stopping; finished variants are kept" in said
-    assert "sweep interrupted" in said and "run the same command again to resume" in said
+    assert "sweep interrupted before any variant finished; run the same command again to start it" in said
     assert "Traceback" not in said and "KeyboardInterrupt" not in said, said
 
 

@@ -349,12 +349,14 @@ def _sweep_with_progress(checked, args, console):
         if client is not None:
             client.close()
     last = outcome.get("progress")
-    kept = f"{last.done} of {last.total} variants are" if last else "finished variants are"
-    console.print(
-        f"ladartui: sweep interrupted; {kept} kept in the results table; run the "
-        "same command again to resume",
-        highlight=False,
-    )
+    if last is None or not last.done:
+        said = "sweep interrupted before any variant finished; run the same command again to start it"
+    else:
+        said = (
+            f"sweep interrupted; {last.done:,} of {last.total:,} variants are kept in the results "
+            "table; run the same command again to resume"
+        )
+    console.print(f"ladartui: {said}", highlight=False)
     return None
 
 
