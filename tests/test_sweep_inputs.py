@@ -603,3 +603,15 @@ def test_a_connect_timeout_beyond_a_day_or_not_finite_is_refused(tiny, tmp_path,
         "greater than 0 and at most 86400"
     )
     assert not (tmp_path / "o").exists()
+
+
+def test_a_mistyped_limit_is_named_alone_not_on_a_spec_line(tmp_path, capsys, monkeypatch):
+    """LADARTUI_MAX_RAYS=abc read 'spec.toml:5: grid.radius: no variant can run: ...'."""
+    from ladartui.cli import main
+
+    write_tiny_scenario(tmp_path)
+    spec = write_spec(tmp_path, "[grid]\nradius = [20.0]\n", name="limit.toml")
+    monkeypatch.setenv("LADARTUI_MAX_RAYS", "abc")
+    assert main(["sweep", str(spec), "--serial"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == "ladartui: error: LADARTUI_MAX_RAYS = 'abc': expected a number of rays >= 1"

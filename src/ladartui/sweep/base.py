@@ -104,6 +104,9 @@ class CheckedBase:
 def checked_base(spec: SweepSpec) -> CheckedBase:
     """Read the spec's base scenario (``InputFileError`` for a missing or bad one) and
     refuse the spec when none of its variants can run on it."""
+    from ladartui.resources import max_bin_visits, max_rays
+
+    max_rays(), max_bin_visits()  # a limit mistyped is its own error, not every variant's
     scenario = load_base(spec)
     check_some_variant_runs(spec, scenario)
     return CheckedBase(spec, scenario.path, scenario)
