@@ -615,3 +615,15 @@ def test_a_mistyped_limit_is_named_alone_not_on_a_spec_line(tmp_path, capsys, mo
     assert main(["sweep", str(spec), "--serial"]) == 2
     err = capsys.readouterr().err.strip()
     assert err == "ladartui: error: LADARTUI_MAX_RAYS = 'abc': expected a number of rays >= 1"
+
+
+def test_a_spec_naming_itself_as_its_scenario_is_told_on_that_line(tmp_path, capsys):
+    """It read 'self.toml:1: a sweep spec ([sweep]), not a scenario', the key unnamed."""
+    from ladartui.cli import main
+
+    spec = write_spec(tmp_path, "[grid]\nradius = [20.0]\n", name="self.toml", scenario="self.toml")
+    assert main(["sweep", str(spec), "--serial"]) == 2
+    assert capsys.readouterr().err.strip() == (
+        f"ladartui: error: {spec}:2: sweep.scenario: expected the base scenario's file; "
+        "'self.toml' is this sweep spec"
+    )

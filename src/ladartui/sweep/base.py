@@ -40,6 +40,13 @@ def base_scenario_path(spec: SweepSpec) -> Path:
             f"sweep.scenario: expected an existing scenario file; {str(spec.scenario_path)!r} {found}",
             line=spec_line(spec.path, "sweep", "scenario"),
         )
+    if spec.scenario_path.resolve() == Path(spec.path).resolve():
+        raise InputFileError(
+            spec.path,
+            f"sweep.scenario: expected the base scenario's file; {spec.scenario_path.name!r} "
+            "is this sweep spec",
+            line=spec_line(spec.path, "sweep", "scenario"),
+        )
     return spec.scenario_path
 
 
