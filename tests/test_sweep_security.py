@@ -48,6 +48,25 @@ def test_tls_flags_must_come_together_and_with_a_tls_address(tmp_path):
     assert (paths["key"].stat().st_mode & 0o077) == 0
 
 
+def test_tls_files_that_hold_no_certificate_or_key_are_named_by_their_flag(tmp_path):
+    """A CA file holding no certificate was reported as '--scheduler = ...: connecting
+    failed: [X509: NO_CERTIFICATE_OR_CRL_FOUND]'."""
+    paths = make_certificates(tmp_path / "a")
+    other = make_certificates(tmp_path / "b")
+    text = tmp_path / "notes.pem"
+    text.write_text("not a certificate\n")
+    address = "tls://10.0.0.1:8786"
+    with pytest.raises(
+        FieldError, match=r"^--tls-ca-file = '.*notes.pem': expected a PEM certificate authority"
+    ):
+        cluster_security(address, text, paths["cert"], paths["key"])
+    with pytest.raises(FieldError, match=r"^--tls-cert = '.*notes.pem': expected a PEM certificate"):
+        cluster_security(address, paths["ca"], text, paths["key"])
+    with pytest.raises(FieldError, match=r"^--tls-key = '.*key.pem': expected the private key of --tls-cert"):
+        cluster_security(address, paths["ca"], paths["cert"], other["key"])
+    assert cluster_security(address, paths["ca"], paths["cert"], paths["key"]) is not None
+
+
 def _server_security(paths):
     from distributed.security import Security
 

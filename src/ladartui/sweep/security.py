@@ -78,6 +78,7 @@ def cluster_security(address: str, ca_file=None, cert_file=None, key_file=None, 
                 "a tls://HOST:PORT address with the TLS "
                 "files (the scheduler must be started with the same certificates)",
             )
+        _check_tls_files(ca_file, cert_file, key_file)
         from distributed.security import Security
 
         return Security(
@@ -100,6 +101,28 @@ def cluster_security(address: str, ca_file=None, cert_file=None, key_file=None, 
             "and this machine (see docs/sweeps.md; --insecure to use it anyway)",
         )
     return None
+
+
+def _check_tls_files(ca_file, cert_file, key_file) -> None:
+    """FieldError naming the flag whose file holds no certificate authority, no
+    certificate, or no key of that certificate: said before connecting, where the
+    TLS library's words would be blamed on the address."""
+    import ssl
+
+    try:
+        ssl.create_default_context(cafile=str(ca_file))
+    except (ssl.SSLError, ValueError):
+        raise FieldError("--tls-ca-file", str(ca_file), "a PEM certificate authority (ca.pem)") from None
+    try:  # read as a list of certificates: a chain, or text around them, is taken
+        ssl.SSLContext(ssl.PROTOCOL_TLS_CLIENT).load_verify_locations(cafile=str(cert_file))
+    except (ssl.SSLError, ValueError):
+        raise FieldError("--tls-cert", str(cert_file), "a PEM certificate") from None
+    try:  # (an empty password: an encrypted key is refused, never asked for on the terminal)
+        ssl.SSLContext(ssl.PROTOCOL_TLS_CLIENT).load_cert_chain(str(cert_file), str(key_file), password=b"")
+    except (ssl.SSLError, ValueError):
+        raise FieldError(
+            "--tls-key", str(key_file), "the private key of --tls-cert, unencrypted PEM"
+        ) from None
 
 
 def make_certificates(folder, days: int = 365) -> dict[str, Path]:
