@@ -627,3 +627,24 @@ def test_a_spec_naming_itself_as_its_scenario_is_told_on_that_line(tmp_path, cap
         f"ladartui: error: {spec}:2: sweep.scenario: expected the base scenario's file; "
         "'self.toml' is this sweep spec"
     )
+
+
+def test_rows_the_table_cannot_read_are_named_not_dropped_silently(tmp_path, capsys):
+    """A row cut short in results.csv vanished from --show without a word."""
+    import json
+
+    from ladartui.cli import main
+
+    write_tiny_scenario(tmp_path)
+    spec = write_spec(tmp_path, "[grid]\nradius = [20.0, 30.0]\n", name="torn.toml")
+    assert main(["sweep", str(spec), "--serial"]) == 0
+    results = tmp_path / "torn-results" / "results.csv"
+    lines = results.read_text(encoding="utf-8").splitlines()
+    lines[2] = lines[2][:40]  # the second row, torn
+    results.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    capsys.readouterr()
+    assert main(["sweep", str(spec), "--show"]) == 0
+    out = capsys.readouterr().out
+    assert "1 row of results.csv could not be read (line 3) and is left out" in out
+    assert main(["sweep", str(spec), "--show", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["unreadable_lines"] == [3]

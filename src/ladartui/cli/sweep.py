@@ -410,6 +410,7 @@ def result_dict(result, top) -> dict:
         "best_scenario_kept": str(result.best_kept) if result.best_kept else None,
         "best_scenario_earlier": str(result.best_earlier) if result.best_earlier else None,
         "left_out": result.left_out,
+        "unreadable_lines": result.unreadable_lines,
         "best_levels": levels_text(result.best.row) if result.best is not None else None,
         "charts": {fmt: str(path) for fmt, path in result.charts.items()},
         "top": [entry(r) for r in result.ranking[:top] if r.rank is not None],
@@ -544,6 +545,14 @@ def show_result(console, result, top) -> None:
         console.print(
             f"{plural(result.left_out, 'row')} of other variants or an earlier base left out (a run of this "
             "spec runs its variants again for the base as it is now)",
+            highlight=False,
+        )
+    if lines := result.unreadable_lines:
+        listed = ", ".join(map(str, lines[:5])) + (", ..." if len(lines) > 5 else "")
+        which = f"{plural(len(lines), 'row')} of {result.results_path.name} could not be read"
+        console.print(
+            f"{which} (line{'s' if len(lines) > 1 else ''} {listed}) and "
+            f"{'is' if len(lines) == 1 else 'are'} left out",
             highlight=False,
         )
     console.print(single_line(f"results  {result.results_path}"), highlight=False, markup=False)

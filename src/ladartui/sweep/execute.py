@@ -89,6 +89,7 @@ class SweepResult:
     best_kept_why: str = ""  # why it was not replaced
     best_earlier: Path | None = None  # none ranked now: the best-path file an earlier ranking wrote
     left_out: int = 0  # rows of the table not ranked: other variants, or an earlier base
+    unreadable_lines: list[int] = field(default_factory=list)  # of rows the table could not read
     ran: int = 0
     resumed: int = 0
     workers: int = 0
@@ -359,7 +360,8 @@ def _run_locked(
 
     # The rows as the file holds them (every column present), so this result
     # and load_sweep_results of the same folder agree.
-    table_rows, _ = read_table(results_path)
+    unreadable: list[int] = []
+    table_rows, _ = read_table(results_path, unreadable)
     rows = own_rows(table_rows, variants, digest)
     left_out = len(table_rows) - len(rows)
     ranking = rank_rows(rows, objective, budget, cost)
@@ -376,6 +378,7 @@ def _run_locked(
         workers=result_workers,
         scheduler=scheduler,
         left_out=left_out,
+        unreadable_lines=unreadable,
     )
     result.ranking_path = write_ranking(out / RANKING_NAME, ranking, spec.parameter_names)
     if result.best is not None:
@@ -547,7 +550,8 @@ def load_sweep_results(
         path = path / RESULTS_NAME
     if not path.exists():
         raise InputFileError(path, "no sweep results here")
-    rows, header = read_table(path)
+    unreadable: list[int] = []
+    rows, header = read_table(path, unreadable)
     every = len(rows)
     if spec is not None:
         rows = spec_rows(rows, spec)
@@ -580,6 +584,7 @@ def load_sweep_results(
         parameter_names=parameter_names,
         results_path=path,
         left_out=every - len(rows),
+        unreadable_lines=unreadable,
     )
 
 

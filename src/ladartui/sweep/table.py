@@ -230,11 +230,12 @@ class TableWriter:
         self._held = False
 
 
-def read_table(path) -> tuple[list[dict], list[str]]:
+def read_table(path, unreadable: list[int] | None = None) -> tuple[list[dict], list[str]]:
     """Rows (dicts of parsed values) and the header of a result table.
 
     A missing file gives no rows. Rows with the wrong number of cells or no
-    variant id are dropped (a torn or hand-edited line), never fatal.
+    variant id are dropped (a torn or hand-edited line), never fatal; their
+    line numbers are added to ``unreadable`` when given.
     """
     path = Path(path)
     try:
@@ -257,14 +258,22 @@ def read_table(path) -> tuple[list[dict], list[str]]:
         except StopIteration:
             break
         except csv.Error:
+            _note(unreadable, reader.line_num)
             continue
         if len(cells) != len(header):
+            _note(unreadable, reader.line_num)
             continue
         row = {
             column: (cell or None) if column in TEXT_COLUMNS else parse_cell(cell)
             for column, cell in zip(header, cells)
         }
         if not row.get("variant"):
+            _note(unreadable, reader.line_num)
             continue
         rows.append(row)
     return rows, header
+
+
+def _note(unreadable: list[int] | None, line: int) -> None:
+    if unreadable is not None:
+        unreadable.append(line)
