@@ -404,8 +404,9 @@ def _device(described: dict) -> str:
 def warm_up(trace_once, most=WARM_MOST_S, window=WARM_WINDOW_S, clock=time.perf_counter) -> dict:
     """Call ``trace_once`` once (that call compiles: it may take most of a minute),
     then until the median call of a ``window`` of seconds is within 5 % of the
-    window's before, or ``most`` seconds have passed. Returns the calls made and
-    the seconds they took after the first."""
+    window's before, or ``most`` seconds have passed after it. Returns the calls
+    made and the seconds they took, the first's included."""
+    first = clock()
     trace_once()
     calls, before, times = 1, None, []
     started = clock()
@@ -419,7 +420,7 @@ def warm_up(trace_once, most=WARM_MOST_S, window=WARM_WINDOW_S, clock=time.perf_
             if before is not None and abs(median - before) <= 0.05 * before:
                 break
             before, times = median, []
-    return {"calls": calls, "seconds": clock() - started}
+    return {"calls": calls, "seconds": clock() - first}
 
 
 def _add_ratios(results):
