@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import ladartui.simulation as simulation
-from cli_support import ctrl_c
+from cli_support import ctrl_c, one_error_line
 from ladartui.cli import main
 from ladartui.cmf import read_cmf
 from ladartui.flight import FlightPlan, Manual, ScanPose, aim_at
@@ -144,6 +144,20 @@ def test_an_unwritable_chart_is_refused_before_anything_runs(scenario, capsys, t
     err = capsys.readouterr().err.strip()
     assert err.startswith(f"ladartui: error: --chart = '{blocker / 'c.svg'}': expected a writable path")
     assert not scenario.measures_file.exists() and not scenario.scene_output.exists()
+
+
+@pytest.mark.parametrize("name", [".svg", "c.svg/.png", ".PNG"])
+def test_a_chart_name_with_no_suffix_is_refused_before_anything_runs(scenario, capsys, tmp_path, name):
+    """'.svg' ends in .svg but is a name with no suffix: the run traced and replaced its
+    outputs, then the chart died with a ValueError traceback."""
+    chart = tmp_path / name
+    chart.parent.mkdir(exist_ok=True)
+    for write in ([], ["--no-write"]):
+        assert main(["run", str(scenario.path), "--chart", str(chart), *write]) == 2
+        err = one_error_line(capsys)
+        assert err == f"ladartui: error: --chart = '{chart}': expected a file name ending in .svg or .png"
+    assert not scenario.measures_file.exists() and not scenario.scene_output.exists()
+    assert not chart.exists()
 
 
 def test_a_chart_in_a_missing_folder_is_refused_as_trace_refuses_its_out(scenario, capsys, tmp_path):

@@ -14,6 +14,7 @@ import contextlib
 import json
 import os
 import threading
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ladartui.cli.flags import as_flags, check_scenario_name, refuse_step_without_march
@@ -100,7 +101,8 @@ def run(args) -> int:
     if args.chart is not None:
         from ladartui.outputset import output_problem
 
-        if not args.chart.lower().endswith((".svg", ".png")):
+        # the suffix, as the chart's writer reads it: ".svg" alone is a name with none
+        if Path(args.chart).suffix.lower() not in (".svg", ".png"):
             raise FieldError("--chart", args.chart, "a file name ending in .svg or .png")
         if not os.path.exists(os.path.dirname(args.chart) or "."):  # a mistyped folder is not made
             raise FieldError("--chart", args.chart, "a file in an existing folder")
