@@ -1,6 +1,8 @@
 """Helpers shared by the CLI tests."""
 
 import _thread
+import contextlib
+import resource
 import signal
 import threading
 import time
@@ -27,3 +29,15 @@ def one_error_line(capsys) -> str:
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and err.startswith("ladartui: error:") and "Traceback" not in err, err
     return err
+
+
+@contextlib.contextmanager
+def file_size_limit(most: int):
+    """Files of this process held to ``most`` bytes, as ``ulimit -f`` holds them: a write
+    past it fails with "File too large" (Python ignores SIGXFSZ), a real failed write."""
+    soft, hard = resource.getrlimit(resource.RLIMIT_FSIZE)
+    resource.setrlimit(resource.RLIMIT_FSIZE, (most, hard))
+    try:
+        yield
+    finally:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (soft, hard))

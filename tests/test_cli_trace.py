@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from cli_support import one_error_line
+from cli_support import file_size_limit, one_error_line
 from ladartui.cli import main
 
 
@@ -506,3 +506,21 @@ def test_a_long_trace_shows_its_progress_in_blocks_of_rays(tmp_path, scene_file,
     assert main([*command, "--out", str(deep / "mixed.npy")]) == 0
     # the summary gave the last block's precision as the whole run's: "f32, not the f64 asked for"
     assert capsys.readouterr().err.startswith("5 rays (numba, exact, f64 for 4 rays, f32 for 1)")
+
+
+def test_hits_that_cannot_be_written_are_one_line_naming_the_out_file(tmp_path, scene_file, capsys):
+    """A write failing part way (a file size limit) ended in numpy's traceback, 'OSError:
+    400000 requested and 65408 written'; the earlier hits are kept."""
+    rays = np.repeat([[5.0, 5.0, 20.0, 0.0, 0.0, -1.0]], 10_000, axis=0)  # 400,000 bytes of hits
+    np.save(tmp_path / "rays.npy", rays)
+    out = tmp_path / "hits.npy"
+    command = ["trace", "--scene", str(scene_file), "--rays", str(tmp_path / "rays.npy"), "--out", str(out)]
+    assert main([*command, "--backend", "numba"]) == 0  # the earlier hits, the kernels compiled
+    capsys.readouterr()
+    earlier = out.read_bytes()
+    with file_size_limit(100_000):
+        code = main([*command, "--backend", "numba"])
+    assert code == 2
+    assert one_error_line(capsys) == f"ladartui: error: {out}: cannot be written (file too large)"
+    assert out.read_bytes() == earlier
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["X.txt", "hits.npy", "rays.npy"]

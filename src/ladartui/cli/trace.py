@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ladartui.atomic import atomic_path
+from ladartui.atomic import atomic_path, write_errors_named
 from ladartui.checks import MAX_COORDINATE
 from ladartui.errors import Cancelled, FieldError, InputFileError, ResourceLimitError
 from ladartui.fileprobe import NO_SUCH_FILE, refuse_special_file
@@ -249,9 +249,8 @@ def _trace_and_write(args, voxel_size: float) -> None:
                 done = start + len(block)
                 bar.update(task, completed=done, done=f"{done:,}/{len(rays):,} rays")
         bar.update(task, description=_shown(f"writing {Path(args.out).name}"))
-        with atomic_path(args.out) as tmp:
-            with open(tmp, "wb") as handle:
-                np.save(handle, np.concatenate([result.as_array() for result in results]))
+        with write_errors_named(args.out), atomic_path(args.out) as tmp:
+            _save_npy(tmp, np.concatenate([result.as_array() for result in results]))
     counts = np.bincount(np.concatenate([result.kind for result in results]), minlength=3)
     result = results[-1]
     backends = ", ".join(dict.fromkeys(r.backend for r in results))  # auto may choose by block
@@ -268,6 +267,16 @@ def _trace_and_write(args, voxel_size: float) -> None:
         ),
         file=sys.stderr,
     )
+
+
+def _save_npy(path, array: np.ndarray) -> None:
+    """``array`` as a .npy file, its bytes written by Python's file object: a failed write
+    then says why ("File too large"), where numpy's own says only how many bytes it wrote."""
+    from numpy.lib import format as npy
+
+    with open(path, "wb") as handle:
+        npy.write_array_header_1_0(handle, npy.header_data_from_array_1_0(array))
+        handle.write(np.ascontiguousarray(array).data)
 
 
 def _precisions_used(blocks: list[tuple[str, int]], asked: str) -> str:
