@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from cli_support import one_error_line
+from cli_support import file_size_limit, one_error_line
 from ladartui.cli import main
 from ladartui.scene.model import Scene
 from ladartui.scene.voxelize import Placement, load_mesh, merge_voxels, voxelize
@@ -235,6 +235,25 @@ def test_unwritable_output_is_refused_before_the_work(tmp_path, truck, forest, c
     assert main([*args, "--into", str(forest)]) == 2
     assert "out_Target.txt: is a folder" in one_error_line(capsys)
     assert not (tmp_path / "out.txt").exists()
+
+
+def test_a_failed_write_names_the_file_as_with_into(tmp_path, truck, forest, capsys):
+    """A target model that could not be written said only 'could not write the output:
+    File too large', exit 1; with --into the file was named."""
+    out = tmp_path / "truck_Target.txt"
+    args = ["voxelize", str(truck), str(out), "--voxel-size", "0.1", "--solid", "--at", "3,3"]
+    into = [*args[:2], str(tmp_path / "out"), *args[3:], "--into", str(forest)]
+    assert main(args) == main(into) == 0  # the earlier files, the kernels compiled
+    capsys.readouterr()
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    with file_size_limit(20_000):  # 12,000 voxels: about 100 kB of lines
+        assert main(args) == 2
+        assert one_error_line(capsys) == f"ladartui: error: {out}: cannot be written (file too large)"
+        assert main(into) == 2
+        assert one_error_line(capsys).startswith(
+            f"ladartui: error: {tmp_path / 'out.txt'}: could not be written"
+        )
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
 
 
 def test_a_bad_scene_file_is_one_line_naming_its_line(tmp_path, truck, forest, capsys):

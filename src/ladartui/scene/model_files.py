@@ -53,10 +53,10 @@ def save_model(
     ids: np.ndarray | None = None,
 ) -> None:
     """Write one voxel list atomically (``x,y,z,id`` lines with ``ids``); cancelled, it leaves
-    ``path`` as it was."""
-    from ladartui.atomic import atomic_path
+    ``path`` as it was. A path that cannot be written is an ``OutputFileError`` naming it."""
+    from ladartui.atomic import atomic_path, write_errors_named
 
-    with atomic_path(path) as tmp:
+    with write_errors_named(path), atomic_path(path) as tmp:
         write_voxel_lines(tmp, voxels, cancel, progress, ids)
 
 
