@@ -81,12 +81,27 @@ def test_validate_says_when_the_scene_and_target_together_pass_the_memory(tmp_pa
     assert line.endswith("available)")
 
 
-def test_huge_ray_count_is_refused_at_validation(tmp_path, capsys):
+def test_a_run_over_the_ray_limit_is_a_next_run_line_after_the_summary(tmp_path, capsys, monkeypatch):
+    """validate gave one error line and exit 2, naming 'big.toml:' without its folder,
+    though its --help promises a sound scenario a run would refuse before tracing its
+    summary, a 'next run' line saying why, and exit 1."""
     path = write_big_scenario(tmp_path, 1024, 16, 10000)
-    assert main(["validate", str(path)]) == 2
-    err = one_error_line(capsys)
-    assert "sensor.grid = 1024, sensor.ray_grid = 16, 10,000 scans" in err
-    assert "5.37e+12 rays" in err and "--max-rays" in err
+    assert main(["validate", str(path)]) == 1
+    out, err = capsys.readouterr()
+    assert err == "" and out.startswith(f"scenario   {path}\n")
+    assert "\nrays       268,435,456 per scan, 2,684,354,560,000 in all\n" in out
+    assert out.splitlines()[-1] == (
+        f"next run   {path}: sensor.grid = 1024, sensor.ray_grid = 16, 10,000 scans: about 5.37e+12 "
+        "rays to trace, more than the limit of 2e+09 (raise it with LADARTUI_MAX_RAYS or run's "
+        "--max-rays if this is meant); the run is refused before it traces"
+    )
+    monkeypatch.setenv("LADARTUI_MAX_RAYS", "6e12")
+    assert main(["validate", str(path)]) == 0
+    assert "next run" not in capsys.readouterr().out
+    # a run still refuses it, in one line naming the file with its folder
+    monkeypatch.delenv("LADARTUI_MAX_RAYS")
+    assert main(["run", str(path), "--no-write"]) == 2
+    assert one_error_line(capsys).startswith(f"ladartui: error: {path}: sensor.grid = 1024,")
 
 
 def test_max_rays_flag(tmp_path, capsys):

@@ -125,7 +125,7 @@ class Scenario:
                 self.detection.bin_width(self.sensor.depth_resolution)
         if self.levels is not None and not isinstance(self.levels, LevelThresholds):
             raise FieldError("levels", self.levels, "a LevelThresholds")
-        _check_work(self)
+        check_work(self)
 
     @property
     def geiger(self) -> bool:
@@ -558,8 +558,9 @@ def work_unchecked():
         _WORK_UNCHECKED.reset(token)
 
 
-def _check_work(scenario):
-    """Refuse a scenario whose rays (two runs of every scan) exceed the work limit."""
+def check_work(scenario):
+    """Refuse a scenario whose rays (two runs of every scan) exceed the work limit
+    (``RayLimitError``), outside ``work_unchecked()``."""
     from ladartui.resources import check_rays
 
     if _WORK_UNCHECKED.get():
@@ -567,6 +568,6 @@ def _check_work(scenario):
     sensor, scans = scenario.sensor, scenario.scan_count()
     check_rays(
         2 * sensor.rays_per_scan * scans,
-        f"{scenario.path.name}: sensor.grid = {sensor.grid}, sensor.ray_grid = "
+        f"{scenario.path}: sensor.grid = {sensor.grid}, sensor.ray_grid = "
         f"{sensor.ray_grid}, {plural(scans, 'scan')}",
     )

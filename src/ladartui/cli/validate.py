@@ -18,7 +18,8 @@ def add_parser(subparsers):
         "model files as they are now). A mistake "
         "is reported on one line with exit status 2. A sound scenario that a run would "
         "still refuse before tracing (a folder or a file of another kind where an output "
-        "goes) gets its summary, a 'next run' line saying why, and exit status 1.",
+        "goes, more rays than LADARTUI_MAX_RAYS allows) gets its summary, a 'next run' "
+        "line saying why, and exit status 1.",
     )
     parser.add_argument(
         "scenario",
@@ -32,12 +33,13 @@ def add_parser(subparsers):
 def run(args) -> int:
     from ladartui.cli.flags import check_scenario_name
     from ladartui.errors import OutputFileError
-    from ladartui.scenario import load_scenario
+    from ladartui.scenario import load_scenario, work_unchecked
     from ladartui.simulation import check_output_names, check_outputs_spare_inputs
     from ladartui.user_data import bundled_or_path
 
     check_scenario_name(args.scenario)
-    scenario = load_scenario(bundled_or_path(args.scenario))
+    with work_unchecked():  # the ray limit is the machine's, not a mistake: a "next run" line
+        scenario = load_scenario(bundled_or_path(args.scenario))
     scene = scenario.load_scene()
     scene_lines = scene_summary(scenario, scene)
     check_output_names(scenario)  # too long: the scenario's own name is the mistake
@@ -48,7 +50,7 @@ def run(args) -> int:
         refused = error
     print(visible(scenario.summary()))
     notes = [*flight_notes(scenario.flight), *detection_notes(scenario)]
-    refusals = next_run_refusals(scenario, refused)
+    refusals = [*ray_limit_refusals(scenario), *next_run_refusals(scenario, refused)]
     earlier = last_run_lines(scenario, scene, writable=not refusals)
     for line in [*scene_lines, *notes, *earlier, *refusals[:1]]:
         print(single_line(line))
@@ -90,6 +92,18 @@ def detection_notes(scenario) -> list[str]:
         f'(model = "geiger" runs {"it" if len(unused) == 1 else "them"}; ladartui pulses reads '
         f"{'it' if len(unused) == 1 else 'them'} as {'it is' if len(unused) == 1 else 'they are'})"
     ]
+
+
+def ray_limit_refusals(scenario) -> list[str]:
+    """The work limit a run checks first, as its refusal (none when the rays are within it)."""
+    from ladartui.resources import RayLimitError
+    from ladartui.scenario import check_work
+
+    try:
+        check_work(scenario)
+    except RayLimitError as error:
+        return [f"next run   {error}; the run is refused before it traces"]
+    return []
 
 
 def next_run_refusals(scenario, refused=None) -> list[str]:
