@@ -215,6 +215,32 @@ def test_info_on_a_runs_outputs_says_they_are_a_runs_outputs(tmp_path, capsys):
     )
 
 
+def test_info_on_a_run_output_changed_since_the_run_does_not_claim_it_as_validate(tmp_path, capsys):
+    """An output changed after its run (a line appended) was still 'the scene run's
+    returns of a run of S.toml' in info, while validate said it was not the run's output."""
+    from ladartui.simulation import simulate
+    from test_output_set import make_scenario
+
+    scenario = make_scenario(tmp_path)
+    simulate(scenario)
+    with open(scenario.scene_output, "a", encoding="utf-8") as handle:
+        handle.write("1,2,3\n")
+
+    def output_row(path):
+        assert main(["info", str(path)]) == 0
+        rows = capsys.readouterr().out.splitlines()[1:]
+        return next(row.split(None, 1)[1] for row in rows if row.split()[0] == "output")
+
+    assert output_row(scenario.scene_output) == (
+        "changed since the run of S.toml wrote it (S_Run.toml): it is not the run's output"
+    )
+    assert output_row(scenario.target_output).startswith("the target run's returns of a run of S.toml")
+    assert main(["validate", str(scenario.path)]) == 0
+    assert "last run   S_Scene.txt changed since the run wrote it: it is not the run's output" in (
+        capsys.readouterr().out.splitlines()
+    )
+
+
 def test_info_bad_file_is_one_line(tmp_path, capsys):
     (tmp_path / "bad.txt").write_text("1,2,3\n1,2\n")
     assert main(["info", str(tmp_path / "bad.txt")]) == 2

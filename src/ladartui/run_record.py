@@ -38,6 +38,7 @@ from ladartui.trajectory import LogSegment
 __all__ = [
     "RECORD_HEADER",
     "InputFile",
+    "changed_outputs",
     "input_changes",
     "inputs_changed",
     "is_record",
@@ -125,19 +126,18 @@ def run_inputs(scenario, scene) -> list[InputFile]:
 def recorded_inputs(scenario) -> list[InputFile] | None:
     """The files the record says its run read; None when it does not say (a record
     older than that, or none). ``LadarError`` naming the record when it cannot be read."""
-    return _recorded(scenario, "inputs", INPUT_ROLES, optional=False)
+    return _recorded(scenario.run_record, "inputs", INPUT_ROLES, optional=False)
 
 
 def recorded_outputs(scenario) -> list[InputFile] | None:
     """The outputs the record says its run wrote, as it wrote them; None when it does
     not say. ``LadarError`` naming the record when it cannot be read."""
-    return _recorded(scenario, "outputs", tuple(OUTPUT_ROLES.values()), optional=True)
+    return _recorded(scenario.run_record, "outputs", tuple(OUTPUT_ROLES.values()), optional=True)
 
 
-def _recorded(scenario, key: str, roles, optional: bool) -> list[InputFile] | None:
-    """The record's ``[[run.KEY]]`` files; None without a record or ``[run]`` (or, where
-    ``optional``, without the key: records written before it existed)."""
-    path = scenario.run_record
+def _recorded(path: Path, key: str, roles, optional: bool) -> list[InputFile] | None:
+    """The ``[[run.KEY]]`` files of the record at ``path``; None without a record or
+    ``[run]`` (or, where ``optional``, without the key: records written before it existed)."""
     if not path.is_file():
         return None
     try:
@@ -156,13 +156,23 @@ def outputs_changed(scenario) -> list[str]:
     """Each output the record fingerprints whose bytes on disk differ now, as "S.cmf
     changed since the run wrote it" (none when the record does not say; one that cannot
     be read is not named here: ``missing_outputs`` names it)."""
+    return [
+        f"{path.name} changed since the run wrote it: it is not the run's output"
+        for path in changed_outputs(scenario.run_record)
+    ]
+
+
+def changed_outputs(record: Path) -> list[Path]:
+    """The outputs the record at ``record`` fingerprints whose bytes on disk differ now
+    (``outputs_changed``), for a reader holding an output rather than its scenario.
+    ``LadarError`` naming the record when it cannot be read."""
     from ladartui.fingerprint import file_fingerprint
 
     changed = []
-    for entry in recorded_outputs(scenario) or ():
+    for entry in _recorded(record, "outputs", tuple(OUTPUT_ROLES.values()), optional=True) or ():
         now = file_fingerprint(entry.path)
         if now is not None and now != entry.fingerprint:
-            changed.append(f"{entry.path.name} changed since the run wrote it: it is not the run's output")
+            changed.append(entry.path)
     return changed
 
 

@@ -180,10 +180,26 @@ def _run_output(path: Path) -> str | None:
             stem = path.stem.removesuffix(run)
             record = path.with_name(stem + RECORD_SUFFIX)
             if is_record(record):
-                return (
+                return _not_the_runs(path, record, stem) or (
                     f"the {what} run's returns of a run of {stem}.toml ({record.name}); "
                     f"{stem}{other}{path.suffix}: the {others} run's"
                 )
+    return None
+
+
+def _not_the_runs(path: Path, record: Path, stem: str) -> str | None:
+    """Why ``path`` is no longer its run's output, from the fingerprints its record keeps
+    (as validate says it); None where it is, or the record does not say."""
+    import os
+
+    from ladartui.run_record import changed_outputs
+
+    try:
+        changed = changed_outputs(record)
+    except LadarError as error:
+        return f"named as an output of a run of {stem}.toml, but {error}"
+    if any(os.path.abspath(output) == os.path.abspath(path) for output in changed):
+        return f"changed since the run of {stem}.toml wrote it ({record.name}): it is not the run's output"
     return None
 
 
