@@ -155,11 +155,24 @@ def test_info_and_validate_give_a_scene_the_same_extent(tmp_path, capsys):
     (tmp_path / "s.txt").write_text("5,5,0\n9,9,72\n")
     (tmp_path / "s_Target.txt").write_text("5,5,0\n")
     assert main(["info", str(tmp_path / "s.txt"), "--voxel-size", "0.25"]) == 0
-    assert re.search(r"extent \(m\)\s+2.5 x 2.5 x 18.25 at 0.25 m\n", capsys.readouterr().out)
+    assert re.search(
+        r"extent \(m\)\s+1.25 x 1.25 x 18.25 at 0.25 m \(shape 2.5 x 2.5 x 18.25\)\n",
+        capsys.readouterr().out,
+    )
     path = tmp_path / "plan.toml"
     scenario.Scenario.new(path, tmp_path / "s.txt", 0.25).save()
     assert main(["validate", str(path)]) == 0
     assert "extent 10 x 10 x 73 voxels = 2.5 x 2.5 x 18.25 m" in capsys.readouterr().out
+
+
+def test_info_gives_in_metres_the_span_its_index_line_gives(tmp_path, capsys):
+    """'extent x 35..190, ...' was followed by 'extent (m) 47.75 x ...', the shape from
+    the origin in metres, not the 39 m the voxels span."""
+    (tmp_path / "s.txt").write_text("35,43,0\n190,195,70\n")
+    assert main(["info", str(tmp_path / "s.txt"), "--voxel-size", "0.25"]) == 0
+    rows = [line.split(None, 1)[1] for line in capsys.readouterr().out.splitlines()[1:]]
+    assert "x 35..190, y 43..195, z 0..70  (shape 191 x 196 x 71)" in rows
+    assert "(m)  39 x 38.25 x 17.75 at 0.25 m (shape 47.75 x 49 x 17.75)" in rows
 
 
 def test_an_extent_in_metres_is_written_as_people_write_it():

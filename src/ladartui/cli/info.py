@@ -138,8 +138,11 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
         shape = tuple(int(h) + 1 for h in hi)
         ranges = ", ".join(f"{axis} {int(low)}..{int(high)}" for axis, low, high in zip("xyz", lo, hi))
         rows.append(("extent", f"{ranges}  (shape {shape[0]} x {shape[1]} x {shape[2]})"))
-        if voxel_size:
-            rows.append(("extent (m)", f"{extent_metres(shape, voxel_size)} at {voxel_size:g} m"))
+        if voxel_size:  # the span the ranges give, then the shape as validate gives a scene's
+            span = extent_metres(hi - lo + 1, voxel_size)
+            rows.append(
+                ("extent (m)", f"{span} at {voxel_size:g} m (shape {extent_metres(shape, voxel_size)})")
+            )
     if output is not None:
         rows.append(("output", output))
     # A target model's own targets are counted above: it has no target model of its own;
