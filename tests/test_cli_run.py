@@ -160,6 +160,24 @@ def test_a_chart_name_with_no_suffix_is_refused_before_anything_runs(scenario, c
     assert not chart.exists()
 
 
+def test_a_name_the_fonts_cannot_draw_is_one_note_not_matplotlibs_warnings(
+    scenario, capsys, tmp_path, recwarn
+):
+    """A CJK target name printed matplotlib's raw warnings with its source paths on
+    stderr ('UserWarning: Glyph 28450 ... missing from font(s) DejaVu Sans.')."""
+    target = np.loadtxt(tmp_path / "woods_Target.txt", delimiter=",", dtype=np.int32)
+    save_voxels(tmp_path / "woods_Target.txt", target, ids=np.where(target[:, 0] < 10, 1, 2))
+    with open(scenario.path, "a", encoding="utf-8") as handle:  # none of the chart's fonts has them
+        handle.write('\n[targets]\nnames = { 1 = "\u6f22\u5b57", 2 = "truck B" }\n')
+    chart = tmp_path / "c.png"
+    assert main(["run", str(scenario.path), "--no-write", "--chart", str(chart)]) == 0
+    out, err = capsys.readouterr()
+    assert chart.is_file() and "Glyph" not in err and "Warning" not in err
+    assert [str(warning.message) for warning in recwarn] == []  # none left to reach stderr
+    note = out.splitlines()[-1]
+    assert note == "note: the chart draws a box for each of \u6f22, \u5b57: no font here has them"
+
+
 def test_a_chart_in_a_missing_folder_is_refused_as_trace_refuses_its_out(scenario, capsys, tmp_path):
     """run --chart made the folders of a mistyped path (trace --out refuses it)."""
     chart = tmp_path / "chrats" / "c.svg"

@@ -7,7 +7,11 @@ the same charts in the terminal (``ladartui.study.chart``).
 
 from __future__ import annotations
 
+import contextlib
 import io
+import re
+import warnings
+from collections.abc import Iterator
 from pathlib import Path
 
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -17,6 +21,8 @@ from ladartui.atomic import write_bytes_atomic
 
 DPI = 100
 FORMATS = ("svg", "png")
+# matplotlib's warning for a character none of its fonts has (it draws a box instead)
+_MISSING_GLYPH = re.compile(r"Glyph (\d+) .*missing from font")
 
 
 def new_figure(width_px: int = 900, height_px: int = 560) -> Figure:
@@ -41,3 +47,31 @@ def save_figure(figure: Figure, path) -> Path:
     path = Path(path)
     write_bytes_atomic(path, figure_bytes(figure, path.suffix.lower().lstrip(".")))
     return path
+
+
+@contextlib.contextmanager
+def undrawn_characters() -> Iterator[list[str]]:
+    """The characters no font has (each drawn as a box) in the charts made and written
+    inside, in the order drawn, gathered into the list yielded rather than warned of on stderr, with
+    matplotlib's own source lines. Other warnings are shown as they would have been."""
+    missing: list[str] = []
+    with warnings.catch_warnings(record=True) as caught:
+        # every one, not only the first from each line: laying out and saving both warn
+        warnings.filterwarnings("always", message=_MISSING_GLYPH.pattern, category=UserWarning)
+        try:
+            yield missing
+        finally:
+            others = [warning for warning in caught if not _missing_glyph(warning, missing)]
+    for warning in others:
+        warnings.showwarning(warning.message, warning.category, warning.filename, warning.lineno)
+
+
+def _missing_glyph(warning: warnings.WarningMessage, missing: list[str]) -> bool:
+    """Whether ``warning`` says a character is missing from the fonts; it goes into ``missing``."""
+    found = _MISSING_GLYPH.match(str(warning.message))
+    if found is None or not issubclass(warning.category, UserWarning):
+        return False
+    character = chr(int(found.group(1)))
+    if character not in missing:
+        missing.append(character)
+    return True

@@ -113,14 +113,16 @@ def run(args) -> int:
     finished: list[SimulationResult] = []  # the result, once there is one
     with _told_if_finished(finished):  # a Ctrl-C from then on says what the run wrote
         result = _simulate_with_progress(scenario, args, errors, finished)
-        chart_error = chart_line = chart_path = None
+        chart_error = chart_line = chart_path = undrawn_line = None
         if args.chart is not None:
             from ladartui import charts
             from ladartui.charts.coverage import coverage_figure
 
             try:
-                chart_path = charts.save_figure(coverage_figure(result.measures), args.chart)
+                with charts.undrawn_characters() as undrawn:
+                    chart_path = charts.save_figure(coverage_figure(result.measures), args.chart)
                 chart_line = single_line(f"wrote chart: {chart_path}")
+                undrawn_line = _undrawn_note(undrawn)
             except OSError as error:  # the run's outputs are written: say so, and show them
                 reason = (error.strerror or str(error)).lower()
                 written = (
@@ -135,13 +137,23 @@ def run(args) -> int:
             print(json.dumps(result_dict(scenario, result, chart_path), indent=2, allow_nan=False))
         else:
             show_result(said, result, asked_precision=scenario.precision)
-        if chart_line is not None:
-            said.print(chart_line, highlight=False, markup=False, soft_wrap=True)
+        for line in (chart_line, undrawn_line):
+            if line is not None:
+                said.print(line, highlight=False, markup=False, soft_wrap=True)
         if result.outputs and not args.las:
             _note_earlier_las(said, scenario)
         if chart_error is not None:
             raise chart_error
     return 0
+
+
+def _undrawn_note(characters: list[str]) -> str | None:
+    """A line saying which characters of the chart's names no font here has, if any."""
+    if not characters:
+        return None
+    return single_line(
+        f"note: the chart draws a box for each of {', '.join(characters)}: no font here has them"
+    )
 
 
 def _note_earlier_las(console, scenario) -> None:
