@@ -254,6 +254,17 @@ def test_info_on_a_run_output_changed_since_the_run_does_not_claim_it_as_validat
     )
 
 
+def test_a_missing_voxel_list_is_said_missing_without_the_line_format(tmp_path, capsys):
+    """'nothere.txt: no such file; expected three non-negative integers x,y,z ...': the
+    format of lines of a file that is not there."""
+    for name in ("nothere.txt", "nothere_Target.txt"):
+        assert main(["info", str(tmp_path / name)]) == 2
+        assert (
+            one_error_line(capsys)
+            == f"ladartui: error: {tmp_path / name}: no such file; expected a voxel-list file"
+        )
+
+
 def test_info_bad_file_is_one_line(tmp_path, capsys):
     (tmp_path / "bad.txt").write_text("1,2,3\n1,2\n")
     assert main(["info", str(tmp_path / "bad.txt")]) == 2

@@ -228,6 +228,14 @@ def test_a_short_file_of_other_bytes_is_not_called_cut_short(tmp_path, scene_fil
     assert not out.exists()
 
 
+def test_a_missing_scene_is_said_missing_without_the_line_format(tmp_path, capsys):
+    """--scene naming no file was told the format of a voxel list's lines."""
+    rays = _three_rays(tmp_path)
+    scene = tmp_path / "nothere.txt"
+    assert main(["trace", "--scene", str(scene), "--rays", str(rays), "--out", str(tmp_path / "h.npy")]) == 2
+    assert one_error_line(capsys) == f"ladartui: error: {scene}: no such file; expected a voxel-list file"
+
+
 def test_npz_and_object_rays_and_a_bad_out_are_one_line(tmp_path, scene_file, capsys):
     rays = np.array([[5.0, 5.0, 20.0, 0.0, 0.0, -1.0]])
     np.savez(tmp_path / "rays.npz", rays=rays)

@@ -256,6 +256,15 @@ def test_a_failed_write_names_the_file_as_with_into(tmp_path, truck, forest, cap
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
 
 
+def test_a_missing_scene_is_said_missing_without_the_line_format(tmp_path, truck, capsys):
+    """--into naming no file was told the format of a voxel list's lines."""
+    scene = tmp_path / "nothere.txt"
+    args = ["voxelize", str(truck), str(tmp_path / "out"), "--voxel-size", "0.1", "--at", "3,3"]
+    assert main([*args, "--into", str(scene)]) == 2
+    assert one_error_line(capsys) == f"ladartui: error: {scene}: no such file; expected a voxel-list file"
+    assert not (tmp_path / "out.txt").exists()
+
+
 def test_a_bad_scene_file_is_one_line_naming_its_line(tmp_path, truck, forest, capsys):
     forest.write_text("1,2,3\n4,five,6\n")
     args = ["voxelize", str(truck), str(tmp_path / "out"), "--voxel-size", "0.1", "--at", "3,3"]

@@ -180,9 +180,7 @@ def test_missing_file_is_named(tmp_path):
     path = tmp_path / "nowhere.txt"
     with pytest.raises(InputFileError) as caught:
         load_voxels(path)
-    assert str(caught.value) == (
-        f"{path}: no such file; expected three non-negative integers x,y,z separated by commas per line"
-    )
+    assert str(caught.value) == f"{path}: no such file; expected a voxel-list file"
 
 
 def test_folder_instead_of_file(tmp_path):

@@ -361,7 +361,7 @@ def _opened(path: Path):
         _check_read_size(path)
         handle = open(path, "rb")  # noqa: SIM115 (closed below)
     except FileNotFoundError:
-        raise InputFileError(path, f"{NO_SUCH_FILE}; {EXPECTED} per line") from None
+        raise InputFileError(path, f"{NO_SUCH_FILE}; expected a voxel-list file") from None
     except IsADirectoryError:
         raise InputFileError(path, "is a folder; expected a voxel-list file") from None
     except PermissionError:
