@@ -183,3 +183,17 @@ def test_output_that_cannot_be_written_is_one_line_not_a_traceback(tmp_path, cap
     monkeypatch.setattr(sys, "stdout", Full())
     assert cli.main(["info", str(tmp_path / "v.txt")]) == 1
     assert one_error_line(capsys) == "ladartui: error: could not write the output: No space left on device"
+
+
+def test_certs_that_cannot_be_written_leave_no_lock_behind(tmp_path, capsys):
+    """A failed write left an empty DIR/.certs.lock: the lock's own write failed after
+    the file was made, before the set held it to remove it."""
+    from cli_support import file_size_limit
+
+    folder = tmp_path / "certs"
+    with file_size_limit(0):  # no byte can be written: the lock's pid first
+        assert cli.main(["certs", str(folder)]) == 2
+    assert one_error_line(capsys).startswith(f"ladartui: error: DIR = '{folder}': expected a writable folder")
+    assert list(folder.iterdir()) == []
+    assert cli.main(["certs", str(folder)]) == 0  # and a second try writes them
+    assert sorted(p.name for p in folder.iterdir()) == ["ca.pem", "cluster-key.pem", "cluster.pem"]

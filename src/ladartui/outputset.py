@@ -189,9 +189,13 @@ class OutputSet:
             except FileNotFoundError:
                 pass
             os.close(fd)
-        os.ftruncate(fd, 0)
-        os.write(fd, str(os.getpid()).encode("ascii"))
-        self._lock_fd = fd
+        self._lock_fd = fd  # held: released (the file removed) however the rest goes
+        try:
+            os.ftruncate(fd, 0)
+            os.write(fd, str(os.getpid()).encode("ascii"))
+        except BaseException:
+            self._release()
+            raise
 
     def _release(self):
         if self._lock_fd is not None:
