@@ -274,9 +274,10 @@ def _save_npy(path, array: np.ndarray) -> None:
     then says why ("File too large"), where numpy's own says only how many bytes it wrote."""
     from numpy.lib import format as npy
 
+    array = np.ascontiguousarray(array)  # the header then says C order, as the bytes are
     with open(path, "wb") as handle:
         npy.write_array_header_1_0(handle, npy.header_data_from_array_1_0(array))
-        handle.write(np.ascontiguousarray(array).data)
+        handle.write(array.data)
 
 
 def _precisions_used(blocks: list[tuple[str, int]], asked: str) -> str:
