@@ -257,7 +257,7 @@ def test_firing_beyond_the_work_limit_is_refused_before_a_pulse(scenario, capsys
     assert sum(visits) == work
 
 
-def test_a_geiger_run_beyond_the_work_limit_is_refused_at_its_first_look(scenario, capsys, monkeypatch):
+def test_a_geiger_run_beyond_the_work_limit_is_refused_before_its_first_pulse(scenario, capsys, monkeypatch):
     visits = _count_visits(monkeypatch)
     monkeypatch.setenv("LADARTUI_MAX_BIN_VISITS", "1000")
     geiger = scenario.with_changes(detection=DetectionSettings(model="geiger", pulses=20, coincidence=4))
@@ -269,6 +269,14 @@ def test_a_geiger_run_beyond_the_work_limit_is_refused_at_its_first_look(scenari
         "detector range-bin visits to fire" in err.splitlines()[-1] and "20 pulses on each of 3 looks" in err
     )
     assert not scenario.scene_output.exists() and not scenario.target_output.exists()
+    # a first look that misses everything fires nothing: the next one is checked
+    away = ScanPose(500.0, 500.0, 40.0, depression=90.0)
+    poses = (away, *geiger.flight.segments[0].poses)
+    geiger.with_changes(flight=FlightPlan(segments=[Manual(poses)])).save()
+    assert main(["run", str(scenario.path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "Traceback" not in err and not visits
+    assert "20 pulses on each of 4 looks, those to come taken as look 2's" in err.splitlines()[-1]
     monkeypatch.setenv("LADARTUI_MAX_BIN_VISITS", "a lot")
     assert main(["run", str(scenario.path)]) == 2
     assert "LADARTUI_MAX_BIN_VISITS = 'a lot': expected a number of visits >= 1" in capsys.readouterr().err

@@ -250,7 +250,6 @@ def test_the_table_writer_spaces_its_rewrites_and_loses_no_row(tmp_path, monkeyp
     import ladartui.sweep.table as table
 
     now = [0.0]
-    monkeypatch.setattr(table.time, "monotonic", lambda: now[0])
     writes = []
     real = table.write_text_atomically
 
@@ -261,7 +260,7 @@ def test_the_table_writer_spaces_its_rewrites_and_loses_no_row(tmp_path, monkeyp
 
     monkeypatch.setattr(table, "write_text_atomically", slow_write)
     path = tmp_path / "results.csv"
-    writer = TableWriter(path, [], [], spacing=9.0)
+    writer = TableWriter(path, [], [], spacing=9.0, clock=lambda: now[0])
     for i in range(40):
         writer.put({"variant": f"{i:016x}", "status": "ok", "base": "b"})
         now[0] += 0.5  # half a second a variant
@@ -272,6 +271,44 @@ def test_the_table_writer_spaces_its_rewrites_and_loses_no_row(tmp_path, monkeyp
     count = len(writes)
     writer.flush()  # nothing new: not written again
     assert len(writes) == count
+
+
+def test_rows_read_back_are_replaced_without_formatting_the_table_again(tmp_path, monkeypatch):
+    """Rows read from the file hold every column, empty ones as None: replacing one (a
+    failed variant run again on resume) formatted the whole table each time."""
+    import ladartui.sweep.table as table
+
+    path = tmp_path / "results.csv"
+    rows = [
+        {"variant": f"{i:016x}", "status": "failed" if i % 2 else "ok", "base": "b", "coverage": 0.5}
+        for i in range(20)
+    ]
+    rows[0]["error"] = "x"
+    write_table(path, rows)
+    formats = []
+    real = table.TableWriter._format_all
+    monkeypatch.setattr(table.TableWriter, "_format_all", lambda self: formats.append(1) or real(self))
+    read, _ = read_table(path)
+    writer = TableWriter(path, read, [], spacing=0.0)
+    assert not formats  # nothing formatted before a row comes
+    for i in range(1, 20, 2):
+        writer.put({"variant": f"{i:016x}", "status": "ok", "base": "b", "coverage": 0.25})
+    assert len(formats) == 1
+    back, _ = read_table(path)
+    assert [r["status"] for r in back] == ["ok"] * 20 and back[0]["error"] == "x"
+    writer.put({"variant": f"{0:016x}", "status": "ok", "base": "b", "coverage": 0.5})  # its error gone
+    assert len(formats) == 2 and read_table(path)[0][0]["error"] is None
+
+
+def test_the_table_reader_names_a_torn_row_by_its_first_line(tmp_path):
+    path = tmp_path / "results.csv"
+    write_table(path, [{"variant": f"{i:016x}", "status": "ok", "base": "b"} for i in range(6)])
+    lines = path.read_text().splitlines()
+    lines[2] = lines[2].replace("ok", '"ok')  # a stray quote swallows the lines after it
+    path.write_text("\n".join(lines[:4] + [""] + lines[4:]) + "\n")  # and a blank line
+    unreadable = []
+    rows, _ = read_table(path, unreadable)
+    assert unreadable == [3] and [r["variant"] for r in rows] == [f"{i:016x}" for i in (0,)]
 
 
 # -- ranking -------------------------------------------------------------------------

@@ -75,7 +75,7 @@ def test_show_ranks_the_rows_of_the_current_base_only(tmp_path, capsys):
     base.write_text(base.read_text(encoding="utf-8").replace("fov_deg = 16.0", "fov_deg = 18.0"))
     assert main(["sweep", str(spec), "--show", "--objective", "time-to-identify", "--cost", "distance"]) == 0
     said = capsys.readouterr().err
-    assert f"the charts, ranking.csv and best path in {out} stay as the last sweep wrote them" in said
+    assert f"ranking.csv, pareto.svg, pareto.png, bases-best.toml in {out} stay as the last sweep" in said
     assert {p: p.read_bytes() for p in out.glob("pareto.*")} == charts
     # the base gone: every row of the table, said so
     base.unlink()
@@ -102,7 +102,7 @@ def test_show_writes_nothing_and_leaves_the_folder_as_the_sweep_ranked_it(tmp_pa
     captured = capsys.readouterr()
     assert {p.name: p.read_bytes() for p in out.iterdir()} == written
     assert "chart " not in captured.out
-    assert "stay as the last sweep wrote them" in captured.err
+    assert "ranking.csv, pareto.svg, pareto.png, terms-best.toml in " in captured.err
 
 
 def test_a_range_of_too_many_values_is_refused_on_its_line_even_past_float_range(tmp_path):
@@ -605,16 +605,21 @@ def test_a_connect_timeout_beyond_a_day_or_not_finite_is_refused(tiny, tmp_path,
     assert not (tmp_path / "o").exists()
 
 
-def test_a_mistyped_limit_is_named_alone_not_on_a_spec_line(tmp_path, capsys, monkeypatch):
+@pytest.mark.parametrize(
+    ("variable", "expected"),
+    [("LADARTUI_MAX_RAYS", "a number of rays >= 1"), ("LADARTUI_MAX_BIN_VISITS", "a number of visits >= 1")],
+)
+def test_a_mistyped_limit_is_named_alone_not_on_a_spec_line(
+    tmp_path, capsys, monkeypatch, variable, expected
+):
     """LADARTUI_MAX_RAYS=abc read 'spec.toml:5: grid.radius: no variant can run: ...'."""
     from ladartui.cli import main
 
     write_tiny_scenario(tmp_path)
     spec = write_spec(tmp_path, "[grid]\nradius = [20.0]\n", name="limit.toml")
-    monkeypatch.setenv("LADARTUI_MAX_RAYS", "abc")
+    monkeypatch.setenv(variable, "abc")
     assert main(["sweep", str(spec), "--serial"]) == 2
-    err = capsys.readouterr().err.strip()
-    assert err == "ladartui: error: LADARTUI_MAX_RAYS = 'abc': expected a number of rays >= 1"
+    assert capsys.readouterr().err.strip() == f"ladartui: error: {variable} = 'abc': expected {expected}"
 
 
 def test_a_spec_naming_itself_as_its_scenario_is_told_on_that_line(tmp_path, capsys):
@@ -648,3 +653,10 @@ def test_rows_the_table_cannot_read_are_named_not_dropped_silently(tmp_path, cap
     assert "1 row of results.csv could not be read (line 3) and is left out" in out
     assert main(["sweep", str(spec), "--show", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["unreadable_lines"] == [3]
+    # a run that rewrites the table says so too: the line is gone from the file after it
+    spec.write_text(spec.read_text().replace("[20.0, 30.0]", "[20.0, 30.0, 40.0]"))
+    assert main(["sweep", str(spec), "--serial"]) == 0
+    out = capsys.readouterr().out
+    assert "(line 3) and is left out; the table was rewritten without it" in out
+    unreadable = []
+    assert len(read_table(results, unreadable)[0]) == 3 and not unreadable  # the torn one ran again

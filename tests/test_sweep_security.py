@@ -67,6 +67,40 @@ def test_tls_files_that_hold_no_certificate_or_key_are_named_by_their_flag(tmp_p
     assert cluster_security(address, paths["ca"], paths["cert"], paths["key"]) is not None
 
 
+def test_an_encrypted_key_is_refused_without_asking_for_its_password(tmp_path):
+    """The TLS library asks on the terminal for the password of an encrypted key: the
+    check must refuse it instead (a sweep has no one to answer, a TUI no terminal)."""
+    from cryptography.hazmat.primitives import serialization
+
+    paths = make_certificates(tmp_path)
+    key = serialization.load_pem_private_key(paths["key"].read_bytes(), password=None)
+    locked = tmp_path / "locked-key.pem"
+    locked.write_bytes(
+        key.private_bytes(
+            serialization.Encoding.PEM,
+            serialization.PrivateFormat.PKCS8,
+            serialization.BestAvailableEncryption(b"secret"),
+        )
+    )
+    run = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "from ladartui.sweep.security import cluster_security as c; import sys; "
+            "c('tls://10.0.0.1:8786', *sys.argv[1:])",
+            str(paths["ca"]),
+            str(paths["cert"]),
+            str(locked),
+        ],
+        stdin=subprocess.DEVNULL,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert "--tls-key = " in run.stderr and "the private key of --tls-cert, unencrypted PEM" in run.stderr
+    assert "pass phrase" not in (run.stdout + run.stderr).lower()
+
+
 def _server_security(paths):
     from distributed.security import Security
 

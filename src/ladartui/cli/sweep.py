@@ -420,13 +420,19 @@ def result_dict(result, top) -> dict:
 
 
 def _say_folder_unchanged(errors, folder: Path) -> None:
-    """What --show leaves, where the folder holds a ranking: as the last sweep wrote it
-    (by the terms it ranked by, which --show's may not be)."""
-    if any((folder / name).exists() for name in ("ranking.csv", "pareto.svg", "pareto.png")):
+    """What --show leaves: the ranking files the folder holds, as the last sweep wrote
+    them (by the terms it ranked by, which --show's may not be)."""
+    names = [
+        path.name
+        for path in (folder / "ranking.csv", folder / "pareto.svg", folder / "pareto.png")
+        if path.exists()
+    ]
+    names += sorted(path.name for path in folder.glob("*-best.toml"))
+    if names:
         errors.print(
             single_line(
-                f"ladartui: the charts, ranking.csv and best path in {folder} stay as the last "
-                "sweep wrote them (--show writes nothing; the sweep again redraws them)"
+                f"ladartui: {', '.join(names)} in {folder} stay as the last sweep wrote them "
+                "(--show writes nothing; the sweep again redraws them)"
             ),
             highlight=False,
             markup=False,
@@ -550,9 +556,10 @@ def show_result(console, result, top) -> None:
     if lines := result.unreadable_lines:
         listed = ", ".join(map(str, lines[:5])) + (", ..." if len(lines) > 5 else "")
         which = f"{plural(len(lines), 'row')} of {result.results_path.name} could not be read"
+        gone = "; the table was rewritten without " + ("it" if len(lines) == 1 else "them")
         console.print(
             f"{which} (line{'s' if len(lines) > 1 else ''} {listed}) and "
-            f"{'is' if len(lines) == 1 else 'are'} left out",
+            f"{'is' if len(lines) == 1 else 'are'} left out{gone if result.unreadable_removed else ''}",
             highlight=False,
         )
     console.print(single_line(f"results  {result.results_path}"), highlight=False, markup=False)

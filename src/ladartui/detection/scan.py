@@ -169,7 +169,8 @@ class GeigerRun:
         self.settings = settings
         self.sensor = sensor
         self.cancel = cancel  # checked between blocks of pulses
-        self.scans, self.source = scans, source  # the firing's work, estimated at the first look
+        self.scans, self.source = scans, source  # the firing's work, checked at each look
+        self.cells_fired = 0  # detector range bins of the scene looks so far
         self.voxel_size = scene.voxel_size
         self.target_model = scene.target
         self.target_keys = np.unique(voxel_keys(scene.target))
@@ -203,8 +204,8 @@ class GeigerRun:
         look = prepare_look(
             join(0), join(1), join(2), hits, kept, self.target_keys, self.settings, self.voxel_size
         )
-        if run == "scene" and scan == 1:
-            self._check_work(look)
+        if run == "scene":
+            self._check_work(look, scan)
         key = scan - 1 + (self.TARGET_RUN_KEY if run == "target" else 0)
         outcome = declare_look(
             look,
@@ -219,19 +220,21 @@ class GeigerRun:
             self.tally.add(outcome)
         return unique_voxels(outcome.declared_voxels)
 
-    def _check_work(self, look: LookInputs) -> None:
-        """Refuse, before its first pulse, a run whose firing would pass the work
-        limit: the first look's cells for every scan (the target-alone run's looks,
-        its hits alone, are far smaller)."""
+    def _check_work(self, look: LookInputs, scan: int) -> None:
+        """Refuse, before a scene look's first pulse, a run whose firing would pass the
+        work limit: the looks fired so far, this one, and the looks to come taken as
+        this one (the target-alone run's looks, its hits alone, are far smaller). A
+        look with no hit fires nothing and the next look is checked."""
         from ladartui.resources import check_bin_visits
 
         detectors, bins = look_cells(look, self.settings.bin_width(self.sensor.depth_resolution))
+        self.cells_fired += detectors * bins
         pulses = self.settings.pulses
         check_bin_visits(
-            detectors * bins * pulses * self.scans,
+            (self.cells_fired + detectors * bins * (self.scans - scan)) * pulses,
             self.source,
-            f"{pulses:,} pulses on each of {self.scans:,} looks of about {detectors:,} detectors "
-            f"x {bins:,} range bins, as the first",
+            f"{pulses:,} pulses on each of {self.scans:,} looks, those to come taken as look "
+            f"{scan}'s {detectors:,} detectors x {bins:,} range bins",
         )
 
     def measures(self):

@@ -51,6 +51,7 @@ LOCK_NAME = ".lock"  # held while a sweep writes the folder's tables
 # Rows with these statuses are final; "failed" rows (a crash, a lost worker) run again.
 FINAL_STATUSES = ("ok", "error")
 _POLL_SECONDS = 0.05
+_AHEAD_SECONDS = 1.0  # how often the cluster's threads are counted again
 
 
 @dataclass
@@ -90,6 +91,7 @@ class SweepResult:
     best_earlier: Path | None = None  # none ranked now: the best-path file an earlier ranking wrote
     left_out: int = 0  # rows of the table not ranked: other variants, or an earlier base
     unreadable_lines: list[int] = field(default_factory=list)  # of rows the table could not read
+    unreadable_removed: bool = False  # the table rewritten since: those lines are gone from it
     ran: int = 0
     resumed: int = 0
     workers: int = 0
@@ -326,18 +328,16 @@ def _run_locked(
 ) -> SweepResult:
     variants = spec.variants
     results_path = out / RESULTS_NAME
-    table_rows, _ = read_table(results_path)
-    position = {(row["variant"], row.get("base")): i for i, row in enumerate(table_rows)}
-
-    def stored(variant_id):
-        i = position.get((variant_id, digest))
-        return None if i is None else table_rows[i]
-
-    todo = [v for v in variants if (row := stored(v.id)) is None or row.get("status") not in FINAL_STATUSES]
+    unreadable: list[int] = []  # read once: a rewrite leaves such lines out of the file
+    table_rows, _ = read_table(results_path, unreadable)
+    table = TableWriter(results_path, table_rows, spec.parameter_names)
+    todo = [
+        v
+        for v in variants
+        if (row := table.held(v.id, digest)) is None or row.get("status") not in FINAL_STATUSES
+    ]
     resumed = len(variants) - len(todo)
     state = SweepProgress(total=len(variants), done=resumed, resumed=resumed, failed=0, elapsed=0.0)
-
-    table = TableWriter(results_path, table_rows, spec.parameter_names)
 
     def record(row):
         table.put(row)
@@ -355,13 +355,17 @@ def _run_locked(
         result_workers, scheduler = _run_todo(
             todo, digest, base, scene, client, cancel, workers, serial, simulate_options, record
         )
-    finally:  # however it ends, the rows held back are written: finished variants are kept
-        table.flush()
+    except BaseException as error:  # the rows held back are written: finished variants are kept
+        try:
+            table.flush()
+        except LadarError as also:  # the first error is the one to tell
+            error.add_note(f"and the results table could not be written: {also}")
+        raise
+    table.flush()
 
     # The rows as the file holds them (every column present), so this result
     # and load_sweep_results of the same folder agree.
-    unreadable: list[int] = []
-    table_rows, _ = read_table(results_path, unreadable)
+    table_rows, _ = read_table(results_path)
     rows = own_rows(table_rows, variants, digest)
     left_out = len(table_rows) - len(rows)
     ranking = rank_rows(rows, objective, budget, cost)
@@ -379,6 +383,7 @@ def _run_locked(
         scheduler=scheduler,
         left_out=left_out,
         unreadable_lines=unreadable,
+        unreadable_removed=table.written,
     )
     result.ranking_path = write_ranking(out / RANKING_NAME, ranking, spec.parameter_names)
     if result.best is not None:
@@ -446,11 +451,13 @@ def _run_on_dask(client, todo, base, digest, scene, options, record, cancel):
     tag = uuid.uuid4().hex[:8]
     waiting = iter(todo)
     pending: dict = {}
-    completed = as_completed()
+    completed = as_completed(loop=client.loop)  # this client's, not the default one's
+    ahead = {"tasks": 0, "asked": -math.inf}
 
     def submit_more():
-        ahead = _tasks_ahead(client)
-        while len(pending) < ahead and (variant := next(waiting, None)) is not None:
+        if time.monotonic() - ahead["asked"] >= _AHEAD_SECONDS:  # a round trip: not every batch
+            ahead.update(tasks=_tasks_ahead(client), asked=time.monotonic())
+        while len(pending) < ahead["tasks"] and (variant := next(waiting, None)) is not None:
             future = client.submit(
                 run_variant,
                 base,

@@ -22,7 +22,7 @@ import os
 import time
 from pathlib import Path
 
-from ladartui.atomic import atomic_path
+from ladartui.atomic import atomic_path, write_errors_named
 from ladartui.errors import InputFileError
 from ladartui.fileprobe import read_utf8
 
@@ -181,53 +181,67 @@ class TableWriter:
     A row is formatted once, and again only when a later row changes the columns.
     A row for a variant and base already held replaces it in place. Rewrites are
     spaced ``spacing`` times their own duration apart; ``flush`` writes what is
-    held back (a sweep calls it however it ends).
+    held back (a sweep calls it however it ends). Nothing is formatted before the
+    first row is put.
     """
 
-    def __init__(self, path, rows, parameter_names=(), spacing: float = REWRITE_SPACING):
+    def __init__(
+        self, path, rows, parameter_names=(), spacing: float = REWRITE_SPACING, clock=time.monotonic
+    ):
         self.path = Path(path)
         self.rows = list(rows)
         self.parameter_names = tuple(parameter_names)
         self.spacing = spacing
+        self.clock = clock
         self._position = {(row["variant"], row.get("base")): i for i, row in enumerate(self.rows)}
-        self._format_all()
+        self._lines: list[str] | None = None  # formatted on the first put
         self._held = False  # rows put since the last write
-        self._next_write = 0.0  # time.monotonic() from which a rewrite may start
+        self._next_write = 0.0  # clock() from which a rewrite may start
+        self.written = False  # whether the file was rewritten
 
-    def _format_all(self) -> None:
+    def held(self, variant: str, base: str | None) -> dict | None:
+        """The row held for ``variant`` made from ``base``, if any."""
+        at = self._position.get((variant, base))
+        return None if at is None else self.rows[at]
+
+    def _format_all(self) -> list[str]:
         self._columns = order_columns(self.rows, self.parameter_names)
         self._known = set(self._columns)
         self._lines = [_row_line(row, self._columns) for row in self.rows]
+        return self._lines
 
     def put(self, row: dict) -> None:
         key = (row["variant"], row.get("base"))
         at = self._position.get(key)
+        lines = self._lines if self._lines is not None else self._format_all()
+        # a key a replaced row held (a value, not a column read back empty) may leave the columns
+        dropped = at is not None and any(v is not None and k not in row for k, v in self.rows[at].items())
         if at is None:
             self._position[key] = len(self.rows)
             self.rows.append(row)
         else:
-            dropped = self.rows[at].keys() - row.keys()
             self.rows[at] = row
-        # columns change only with a key not yet a column, or one a replaced row took away
-        if not row.keys() <= self._known or (at is not None and dropped):
+        if dropped or not row.keys() <= self._known:  # the columns change
             self._format_all()
         elif at is None:
-            self._lines.append(_row_line(row, self._columns))
+            lines.append(_row_line(row, self._columns))
         else:
-            self._lines[at] = _row_line(row, self._columns)
+            lines[at] = _row_line(row, self._columns)
         self._held = True
-        if time.monotonic() >= self._next_write:
+        if self.clock() >= self._next_write:
             self.flush()
 
     def flush(self) -> None:
-        """Write the rows held back, if any."""
-        if not self._held:
+        """Write the rows held back, if any; ``OutputFileError`` naming the table when it
+        cannot be written."""
+        if not self._held or self._lines is None:
             return
-        started = time.monotonic()
-        write_text_atomically(self.path, _csv_line(self._columns) + "".join(self._lines))
-        finished = time.monotonic()
+        started = self.clock()
+        with write_errors_named(self.path):
+            write_text_atomically(self.path, _csv_line(self._columns) + "".join(self._lines))
+        finished = self.clock()
         self._next_write = finished + self.spacing * (finished - started)
-        self._held = False
+        self._held, self.written = False, True
 
 
 def read_table(path, unreadable: list[int] | None = None) -> tuple[list[dict], list[str]]:
@@ -253,22 +267,25 @@ def read_table(path, unreadable: list[int] | None = None) -> tuple[list[dict], l
         raise InputFileError(path, "not a sweep result table: expected a 'variant' column", line=1)
     rows = []
     while True:
+        start = reader.line_num + 1  # the record's first line (a stray quote spans several)
         try:
             cells = next(reader)
         except StopIteration:
             break
         except csv.Error:
-            _note(unreadable, reader.line_num)
+            _note(unreadable, start)
+            continue
+        if not cells:  # a blank line
             continue
         if len(cells) != len(header):
-            _note(unreadable, reader.line_num)
+            _note(unreadable, start)
             continue
         row = {
             column: (cell or None) if column in TEXT_COLUMNS else parse_cell(cell)
             for column, cell in zip(header, cells)
         }
         if not row.get("variant"):
-            _note(unreadable, reader.line_num)
+            _note(unreadable, start)
             continue
         rows.append(row)
     return rows, header
