@@ -234,3 +234,42 @@ async def test_names_typed_after_up_a_folder_are_read_in_the_folder_shown(tmp_pa
         await pilot.press("enter")
         await pilot.pause()
         assert message(compare, "#compare-message") == ""
+
+
+async def new_scenario_said(app, pilot, scene: str, voxel_size: str) -> str:
+    """What New's form says on OK with ``scene`` and ``voxel_size`` typed ('' once it closed)."""
+    from ladartui.tui.file_dialogs import SetupScreen
+
+    dialog = await screen_after(pilot, "f2", SetupScreen)
+    dialog.query_one("#scenario-file").value = "fresh.toml"
+    dialog.query_one("#scene-file").value = scene
+    dialog.query_one("#voxel-size").value = voxel_size
+    dialog.query_one("#setup-ok").press()
+    await pilot.pause()
+    return message(dialog, "#setup-message") if app.screen is dialog else ""
+
+
+async def test_a_new_scenario_at_the_largest_voxel_size_gets_a_flight_it_can_fly(tmp_path, scene_files):
+    """Voxel size 100 (the form allows 0.001 to 100 m) was refused with 'altitude =
+    22894.1: expected ... at most 20000', a field the form has not: the default orbit
+    climbed with the scene's size in metres. It now stays at or below that ceiling."""
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario) as (app, pilot):
+        assert await new_scenario_said(app, pilot, str(scene_files[0]), "100") == ""
+        await wait_until(pilot, lambda: app.busy is None and app.scenario.path.name == "fresh.toml", 60)
+        assert app.scenario.voxel_size == 100
+        (orbit,) = app.scenario.flight.segments
+        assert 0 < orbit.altitude <= 20000 and orbit.altitude > orbit.centre[2]
+
+
+async def test_a_target_too_high_to_orbit_is_blamed_on_the_voxel_size(tmp_path, scene_files):
+    """A target whose centre is above the highest altitude a flight may have at this voxel
+    size cannot be orbited from above: the form names its voxel size and says why."""
+    scenario = make_scenario(tmp_path, scene_files)
+    (tmp_path / "high.txt").write_text("0,0,0\n1,1,250\n", encoding="utf-8")
+    (tmp_path / "high_Target.txt").write_text("1,1,250\n", encoding="utf-8")
+    async with opened(scenario) as (app, pilot):
+        said = await new_scenario_said(app, pilot, "high.txt", "100")
+        assert said.startswith("Voxel size m: 100 is not allowed; expected a voxel size that puts ")
+        assert "25000 m" in said and "20000 m" in said and "\n" not in said
+        assert not (tmp_path / "fresh.toml").exists()

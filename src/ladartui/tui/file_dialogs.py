@@ -16,7 +16,7 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, DirectoryTree, Input, RadioButton, RadioSet, Static
 
-from ladartui.errors import LadarError
+from ladartui.errors import FieldError, LadarError
 from ladartui.textsafe import visible
 from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField, in_label_unit, refusal
@@ -189,10 +189,20 @@ class SetupScreen(TreeDialog):
                 scenario = bridge.new_scenario(scenario_path, scene_path, field.parsed())
             else:
                 scenario = bridge.load_checked(scenario_path)
+        except FieldError as error:
+            message.update(self._field_said(error))
+            return
         except LadarError as error:
             message.update(str(error))
             return
         self.dismiss(scenario)
+
+    def _field_said(self, error: FieldError) -> str:
+        """A new scenario refused for its voxel size (its default flight cannot be flown)
+        is said of the form's field; other fields are the scenario's own."""
+        if error.field != "voxel_size":
+            return str(error)
+        return refusal("Voxel size m", self.query_one("#voxel-size", Input).value, error.expected)
 
     @on(Button.Pressed, "#setup-cancel")
     def _cancel(self) -> None:
