@@ -405,7 +405,7 @@ def test_the_scenario_file_names_the_radius_line(tmp_path):
         load_scenario(path, check_files=False)
 
 
-def test_a_scan_past_the_coordinate_limit_is_blamed_on_the_distance_the_user_wrote(tmp_path):
+def test_a_scan_past_the_coordinate_limit_is_blamed_on_a_field_the_user_wrote(tmp_path):
     # The message named the pose's "y", a key no segment has, at the segment's first line.
     from ladartui.flight import flypast, standoff_sweep, straight, turn
     from ladartui.scenario import load_scenario
@@ -424,8 +424,12 @@ def test_a_scan_past_the_coordinate_limit_is_blamed_on_the_distance_the_user_wro
     )
     start = ScanPose(999_990.0, 0.0, 100.0, heading=90.0)
     for build, field in (
-        (lambda: flypast((999_990.0, 0.0, 0.0), 10.0, 100.0, 200.0, 3, 90.0), "standoff"),
-        (lambda: standoff_sweep((999_990.0, 0.0, 0.0), (50.0,), 100.0, bearing=90.0), "standoffs"),
+        (lambda: flypast((0.0, 10.0, 0.0), 1e6, 100.0, 200.0, 3, 90.0), "standoff"),
+        (lambda: standoff_sweep((0.0, 10.0, 0.0), (1e6,), 100.0, bearing=0.0), "standoffs"),
+        # a target farther out than its scans reach is the one to move
+        (lambda: flypast((999_990.0, 0.0, 0.0), 10.0, 100.0, 200.0, 3, 90.0), "target"),
+        (lambda: standoff_sweep((999_990.0, 0.0, 0.0), (50.0,), 100.0, bearing=90.0), "target"),
+        (lambda: orbit((1e6, 1.0, 2.0), 60.0, 100.0, 12), "centre"),
         (lambda: straight(start, 50.0, 2), "distance"),
         (lambda: turn(start, 50.0, 90.0, "left", 2), "radius"),
     ):

@@ -80,8 +80,8 @@ def _aimed_at_default(poses, target, altitude, field: str, value, what: str):
 
 
 def _within_bounds(build, field: str, value, what: str) -> list[ScanPose]:
-    """``build()``'s poses; a scan placed past the coordinate limit is blamed on the
-    distance the user wrote (``field``), not on the pose's own x or y, which no file has."""
+    """``build()``'s poses; a scan placed past the coordinate limit is blamed on a field
+    the user wrote (``field``), not on the pose's own x or y, which no file has."""
     try:
         return build()
     except FieldError as error:
@@ -93,6 +93,17 @@ def _within_bounds(build, field: str, value, what: str) -> list[ScanPose]:
             f"{what} that puts every scan within {number_text(MAX_COORDINATE)} m of the "
             f"scene's origin in x and y (a scan would be at {error.field} = {error.value:.1f} m)",
         ) from None
+
+
+def _blamed_distance(point, reach: float, field: str, value, what: str):
+    """(field, value, what) of the field to blame for a scan past the coordinate limit:
+    ``point`` (a preset's centre or target) when it lies farther from the origin in x
+    or y than its scans ``reach`` from it (no shorter distance would help much), else
+    the distance the user wrote."""
+    if max(abs(point[0]), abs(point[1])) >= reach:
+        name = "centre" if field == "radius" else "target"
+        return name, point, f"a {name} (with scans {number_text(reach)} m from it)"
+    return field, value, what
 
 
 def _with_sensor(pose, azimuth, depression):
@@ -209,9 +220,7 @@ def orbit(
         lambda: [
             _on_circle(template, centre, radius, start_bearing + step * k, clockwise) for k in range(scans)
         ],
-        "radius",
-        radius,
-        "a radius",
+        *_blamed_distance(centre, radius, "radius", radius, "a radius"),
     )
     if aim_at is None:
         return _aimed_at_default(poses, centre, altitude, "radius", radius, "a radius")
@@ -243,9 +252,13 @@ def flypast(
     offsets = [0.0] if scans == 1 else [length * (k / (scans - 1) - 0.5) for k in range(scans)]
     poses = _within_bounds(
         lambda: [replace(template, x=cx + fx * s, y=cy + fy * s) for s in offsets],
-        "standoff",
-        standoff,
-        "a standoff (with the target and half the length)",
+        *_blamed_distance(
+            target,
+            math.hypot(standoff, length / 2),
+            "standoff",
+            standoff,
+            "a standoff (with the target and half the length)",
+        ),
     )
     if aim_at is None:  # the line's ends are the farthest: blame the standoff and length
         return _aimed_at_default(
@@ -272,9 +285,7 @@ def standoff_sweep(
     template = _template(altitude, heading)
     poses = _within_bounds(
         lambda: [replace(template, x=target[0] + bx * s, y=target[1] + by * s) for s in distances],
-        "standoffs",
-        list(distances),
-        "a list of standoffs",
+        *_blamed_distance(target, max(distances), "standoffs", list(distances), "a list of standoffs"),
     )
     if aim_at is None:
         return _aimed_at_default(poses, target, altitude, "standoffs", list(distances), "standoffs")

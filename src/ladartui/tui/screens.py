@@ -291,10 +291,10 @@ class FormScreen(Dialog):
     @on(Input.Submitted)
     @on(Button.Pressed, "#form-ok")
     def _ok(self, event=None) -> None:
-        # nothing is replaced behind the analyst's back: an invalid field stops OK
-        for widget in self.query(NumberField):
-            if not self._check(widget):
-                widget.focus()
+        # nothing is replaced behind the analyst's back: an invalid field stops OK,
+        # the topmost first, as the analyst reads the form
+        for name, _label, kind, *_ in self.spec:
+            if not self._typed_allowed(name, kind):
                 return
         try:
             result = self.build(self.values())
@@ -310,6 +310,25 @@ class FormScreen(Dialog):
             return
         self.cancelled = False
         self.dismiss(result)
+
+    def _typed_allowed(self, name: str, kind) -> bool:
+        """Whether the text of field ``name`` is allowed on its own; if not, it is
+        focused and the form says why."""
+        widget = self.query_one(f"#f-{name}")
+        if isinstance(widget, NumberField):
+            allowed = self._check(widget)
+        elif isinstance(widget, Input):
+            try:
+                _parse_points(name, widget.value, kind)
+                allowed = True
+            except FieldError as error:
+                self._refuse(widget, name, error.expected)
+                allowed = False
+        else:
+            return True
+        if not allowed:
+            widget.focus()
+        return allowed
 
     @on(Button.Pressed, "#form-cancel")
     def _cancel(self) -> None:

@@ -1,0 +1,58 @@
+"""The segment dialogs as an analyst meets them: which field a refusal names, in what
+order, and where the dialog stays while its message changes."""
+
+from __future__ import annotations
+
+from ladartui.tui.screens import FormScreen
+from test_tui_dialogs import message, opened
+from test_tui_flow import make_scenario, type_into
+from tui_support import screen_after
+
+
+async def edited_first_segment(app, pilot) -> FormScreen:
+    app.action_show_tab("flight")
+    await pilot.pause()
+    return await screen_after(pilot, app.action_edit_segment, FormScreen)
+
+
+async def pressed_ok(form, pilot) -> str:
+    form.query_one("#form-ok").press()
+    await pilot.pause()
+    return message(form)
+
+
+async def test_an_orbit_centred_past_the_limit_names_the_centre(tmp_path, scene_files):
+    """Centre 1e6,1,2 said 'Radius m: 60 is not allowed; expected a radius that puts
+    every scan within 1000000 m of the scene's origin': the radius was fine."""
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario) as (app, pilot):
+        form = await edited_first_segment(app, pilot)
+        centre, radius = form.query_one("#f-centre"), form.query_one("#f-radius")
+        await type_into(pilot, centre, "1e6,1,2", commit="enter")
+        said = message(form)
+        assert said.startswith("Centre x,y,z m: 1e6,1,2 is not allowed; expected a centre"), said
+        assert "Radius" not in said and app.focused is centre
+        assert centre.has_class("-bad") and not radius.has_class("-bad")
+        # a radius past the limit around a centre near the origin is still the radius's
+        await type_into(pilot, centre, "1,1,2", commit=None)
+        await type_into(pilot, radius, "1000000", commit=None)
+        assert (await pressed_ok(form, pilot)).startswith("Radius m: 1000000 is not allowed;")
+
+
+async def test_several_wrong_fields_are_named_top_first(tmp_path, scene_files):
+    """A wrong radius was named before a wrong centre above it: the number fields were
+    checked before the points."""
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario) as (app, pilot):
+        form = await edited_first_segment(app, pilot)
+        centre, radius = form.query_one("#f-centre"), form.query_one("#f-radius")
+        await type_into(pilot, radius, "-7", commit=None)
+        await type_into(pilot, form.query_one("#f-altitude"), "0", commit=None)
+        await type_into(pilot, centre, "a,b,c", commit=None)
+        assert (await pressed_ok(form, pilot)).startswith("Centre x,y,z m: a,b,c is not allowed;")
+        assert app.focused is centre
+        await type_into(pilot, centre, "1,1,2", commit=None)
+        assert (await pressed_ok(form, pilot)).startswith("Radius m: -7 is not allowed;")
+        assert app.focused is radius
+        await type_into(pilot, radius, "30", commit=None)
+        assert (await pressed_ok(form, pilot)).startswith("Altitude m: 0 is not allowed;")
