@@ -33,6 +33,7 @@ from ladartui.tui.graphics import Graphics, has_truecolor
 from ladartui.tui.help_rows import help_rows, palette_entries
 from ladartui.tui.key_words import KeyWords
 from ladartui.tui.loading import SceneLoading
+from ladartui.tui.notes import NoteKeeping
 from ladartui.tui.panels import FilePanel, FlightPanel, ResultsPanel, RunPanel, SensorPanel
 from ladartui.tui.params import ParamField
 from ladartui.tui.runs import RunControl
@@ -62,7 +63,9 @@ own_actions = actions.own_actions
 OUTPUTS_CHECK_SECONDS = 2.0  # how often the outputs on disk are compared with those shown
 
 
-class LadarApp(KeyWords, ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl, ToolScreens, App):
+class LadarApp(
+    KeyWords, ScenarioEditing, EditGuard, FileActions, SceneLoading, RunControl, ToolScreens, NoteKeeping, App
+):
     """Plan a foliage-penetrating LADAR collection: set up, fly, run, compare."""
 
     TITLE = "ladartui"
@@ -107,6 +110,7 @@ class LadarApp(KeyWords, ScenarioEditing, EditGuard, FileActions, SceneLoading, 
         self.load_worker = self.warm_worker = self.run_worker_handle = None  # the jobs
         self.new_pending: Scenario | None = None
         self.messages: list[str] = []
+        self.notes_shown, self.notes_held = [], []  # notes wait while a dialog is open
         self.leaving = False  # set by exit: news from jobs is no longer shown
         self.running = False
         self.tool_screen: Screen[None] | None = None  # the study or sweep screen while it is open
@@ -146,6 +150,7 @@ class LadarApp(KeyWords, ScenarioEditing, EditGuard, FileActions, SceneLoading, 
         self.flight_panel = self.query_one(FlightPanel)
         self.run_panel = self.query_one(RunPanel)
         self.results_panel = self.query_one(ResultsPanel)
+        self.keep_notes_off_dialogs()
         self.view_area = self.query_one(ViewArea)
         runs = self.key_says("run", "runs")
         self.view_area.no_output = "no output yet" + (f": {runs}" if runs else "")

@@ -1,0 +1,85 @@
+"""Notes (toasts) never cover an open dialog: at 80 x 24 one sat over its OK and Cancel.
+
+Notes on screen when a dialog (a modal screen) opens, and those told while one is
+open, wait and show, for their whole time, once the analyst is back on a screen
+that is no dialog. Meanwhile what they said stays where it matters: a refused
+field keeps its mark, the status bar its colour and reason.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+from textual.notifications import SeverityLevel
+from textual.screen import ModalScreen, Screen
+
+from ladartui.tui.host import Host
+
+
+@dataclass(frozen=True)
+class Note:
+    message: str
+    title: str
+    severity: SeverityLevel
+    timeout: float
+    markup: bool
+    until: float  # time.monotonic() when its toast goes
+
+
+class NoteKeeping(Host):
+    """Mixed into ``LadarApp``: its notes wait while a dialog is open."""
+
+    notes_shown: list[Note]
+    notes_held: list[Note]
+
+    def keep_notes_off_dialogs(self) -> None:
+        """Start holding notes while a dialog is open (the app calls it on mount)."""
+        self.screen_change_signal.subscribe(self, self._screen_changed)
+
+    def notify(
+        self,
+        message: str,
+        *,
+        title: str = "",
+        severity: SeverityLevel = "information",
+        timeout: float | None = None,
+        markup: bool = True,
+    ) -> None:
+        seconds = self.NOTIFICATION_TIMEOUT if timeout is None else timeout
+        note = Note(message, title, severity, seconds, markup, time.monotonic() + seconds)
+        if self._dialog_open():
+            self.notes_held.append(note)
+            return
+        self.notes_shown = [n for n in self.notes_shown if n.until > time.monotonic()] + [note]
+        super().notify(message, title=title, severity=severity, timeout=seconds, markup=markup)
+
+    def _dialog_open(self) -> bool:
+        stack = self.screen_stack
+        return bool(stack) and isinstance(stack[-1], ModalScreen)
+
+    def _screen_changed(self, screen: Screen) -> None:
+        if isinstance(screen, ModalScreen):
+            # after the notes already posted, which would otherwise land on the dialog
+            self.call_later(self._hold_notes_shown)
+        else:
+            self._show_notes_held()
+
+    def _hold_notes_shown(self) -> None:
+        if not self._dialog_open():
+            return
+        now = time.monotonic()
+        self.notes_held = [n for n in self.notes_shown if n.until > now] + self.notes_held
+        self.notes_shown = []
+        self.clear_notifications()
+
+    def _show_notes_held(self) -> None:
+        held, self.notes_held = self.notes_held, []
+        for note in held:
+            self.notify(
+                note.message,
+                title=note.title,
+                severity=note.severity,
+                timeout=note.timeout,
+                markup=note.markup,
+            )

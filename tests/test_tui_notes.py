@@ -1,0 +1,65 @@
+"""Notes (toasts) and dialogs: a note never covers an open dialog."""
+
+from __future__ import annotations
+
+from contextlib import asynccontextmanager
+
+from textual.widgets._toast import Toast
+
+from ladartui.tui.screens import FormScreen, MeasuresScreen
+from test_tui_flow import LadarApp, field, loaded, make_scenario, type_into, wait_until
+from tui_support import screen_after
+
+
+@asynccontextmanager
+async def opened_with_notes(scenario):
+    """The app on ``scenario`` at 80 x 24, loaded, its notes drawn: (app, pilot)."""
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=(80, 24), notifications=True) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        yield app, pilot
+
+
+def toasts(app) -> list[str]:
+    """The notes drawn on the screen shown."""
+    return [str(toast.render()) for toast in app.screen.query(Toast) if toast.region.area]
+
+
+def shown(app, words: str) -> bool:
+    return any(words in text for text in toasts(app))
+
+
+async def test_a_note_waits_while_a_dialog_is_open(tmp_path, scene_files):
+    """'Pixel pitch um: 0 is not allowed...' sat over the Turn dialog's OK and Cancel for
+    seconds at 80 x 24. Notes on screen when a dialog opens, and notes told while it is
+    open, now show once it has closed."""
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened_with_notes(scenario) as (app, pilot):
+        app.action_show_tab("sensor")
+        await pilot.pause()
+        await type_into(pilot, field(app, "sensor.pixel_pitch"), "0", commit="enter")
+        await wait_until(pilot, lambda: shown(app, "Pixel pitch um: 0 is not allowed"), 10)
+        app.action_show_tab("flight")
+        form = await screen_after(pilot, lambda: app.action_add_segment("turn"), FormScreen)
+        await pilot.pause(0.2)
+        assert toasts(app) == []
+        app.tell("told while the dialog is open")
+        await pilot.pause(0.2)
+        assert toasts(app) == [] and app.screen is form
+        form.query_one("#form-cancel").press()
+        await wait_until(pilot, lambda: not isinstance(app.screen, FormScreen), 10)
+        await wait_until(pilot, lambda: shown(app, "Pixel pitch um: 0 is not allowed"), 10)
+        await wait_until(pilot, lambda: shown(app, "told while the dialog is open"), 10)
+
+
+async def test_the_measures_dialog_opens_clear_of_notes(tmp_path, scene_files):
+    from ladartui.measures import Measures
+
+    measures = Measures(target_voxels=100, obscured_coverage=0.2, scans=10)
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened_with_notes(scenario) as (app, pilot):
+        app.tell("a note about the main screen")
+        await wait_until(pilot, lambda: shown(app, "a note about the main screen"), 10)
+        await screen_after(pilot, lambda: app.push_screen(MeasuresScreen(measures)), MeasuresScreen)
+        await pilot.pause(0.2)
+        assert toasts(app) == []
