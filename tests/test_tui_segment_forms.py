@@ -56,3 +56,56 @@ async def test_several_wrong_fields_are_named_top_first(tmp_path, scene_files):
         assert app.focused is radius
         await type_into(pilot, radius, "30", commit=None)
         assert (await pressed_ok(form, pilot)).startswith("Altitude m: 0 is not allowed;")
+
+
+async def added(app, pilot, kind: str) -> FormScreen:
+    app.action_show_tab("flight")
+    await pilot.pause()
+    return await screen_after(pilot, lambda: app.action_add_segment(kind), FormScreen)
+
+
+async def test_an_aim_point_with_a_sensor_pointing_is_refused_naming_both(tmp_path, scene_files):
+    """Sensor az 3 and Depression 45 with Aim 1,2: OK took all three and the scans looked
+    at the aim (az 114, dep 35), the pointing typed dropped without a word."""
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario) as (app, pilot):
+        for kind in ("straight", "turn"):
+            form = await added(app, pilot, kind)
+            aim = form.query_one("#f-aim_at")
+            assert "z 0 if left out" in str(aim.placeholder)  # '1,2' is kept as 1, 2, 0
+            await type_into(pilot, form.query_one("#f-azimuth"), "3", commit=None)
+            await type_into(pilot, form.query_one("#f-depression"), "45", commit=None)
+            await type_into(pilot, aim, "1,2", commit=None)
+            said = await pressed_ok(form, pilot)
+            assert said == (
+                "Aim at x,y,z m: 1,2 is not allowed; expected no aim point while Sensor az deg "
+                "and Depression deg are given (an aim point sets both)"
+            )
+            assert app.screen is form and app.focused is aim and len(app.scenario.flight.segments) == 1
+            await type_into(pilot, form.query_one("#f-depression"), "", commit=None)
+            assert (await pressed_ok(form, pilot)).endswith(
+                "while Sensor az deg is given (an aim point sets both)"
+            )
+            await type_into(pilot, form.query_one("#f-azimuth"), "", commit=None)
+            form.query_one("#form-ok").press()
+            await pilot.pause()
+            assert app.screen is not form
+            segment = app.scenario.flight.segments[-1]
+            assert segment.aim_at == (1.0, 2.0, 0.0) and segment.azimuth is None is segment.depression
+            app.action_undo()
+            await pilot.pause()
+
+
+async def test_aim_all_leaves_no_sensor_pointing_beside_the_aim(tmp_path, scene_files):
+    """Aim all gave a straight with a sensor pointing an aim point too: its form then
+    refused its own values on OK."""
+    from ladartui.flight import Straight
+    from ladartui.tui import bridge
+
+    scenario = make_scenario(tmp_path, scene_files)
+    pointed = bridge.with_segments(scenario, [*scenario.flight.segments, Straight(50.0, 2, 10.0, 30.0)])
+    aimed = bridge.aim_all(pointed, (1.0, 2.0, 0.0))
+    straight = aimed.flight.segments[-1]
+    assert straight.aim_at == (1.0, 2.0, 0.0) and straight.azimuth is None is straight.depression
+    unpointed = bridge.with_segments(scenario, [*scenario.flight.segments, Straight(50.0, 2)])
+    assert aimed.poses() == bridge.aim_all(unpointed, (1.0, 2.0, 0.0)).poses()  # the scans are the same

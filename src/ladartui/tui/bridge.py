@@ -223,9 +223,24 @@ def segment_builder(kind: str):
     cls = SEGMENT_KINDS[kind]
 
     def build(values):
+        refuse_two_pointings(values)
         return cls(**values)
 
     return build
+
+
+def refuse_two_pointings(values: dict) -> None:
+    """FieldError on the aim point when a sensor azimuth or depression is given too: the
+    aim point sets both, so what was typed there would be dropped without a word."""
+    given = [FIELD_LABELS[name] for name in ("azimuth", "depression") if values.get(name) is not None]
+    if values.get("aim_at") is None or not given:
+        return
+    verb = "is" if len(given) == 1 else "are"
+    raise FieldError(
+        "aim_at",
+        values["aim_at"],
+        f"no aim point while {' and '.join(given)} {verb} given (an aim point sets both)",
+    )
 
 
 def with_article(noun: str) -> str:
@@ -271,8 +286,14 @@ def aim_all(scenario: Scenario, target_xyz) -> Scenario:
         if isinstance(segment, Manual):
             segments.append(Manual(tuple(aim_at(p, target) for p in segment.poses)))
         else:
-            segments.append(dataclasses.replace(segment, aim_at=target))
+            segments.append(dataclasses.replace(segment, aim_at=target, **_no_pointing(segment)))
     return with_segments(scenario, segments)
+
+
+def _no_pointing(segment) -> dict:
+    """A manoeuvre's optional sensor pointing cleared: an aim point sets it (the scans
+    are the same); a flight log's own pointing is no option and stays."""
+    return {"azimuth": None, "depression": None} if segment.relative else {}
 
 
 def make_pose(values: dict) -> ScanPose:

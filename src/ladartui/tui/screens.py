@@ -203,7 +203,7 @@ class FormScreen(Dialog):
                             _point_text(value),
                             id=f"f-{name}",
                             compact=True,
-                            placeholder="x, y, z" if kind == "point" else "a, b, c",
+                            placeholder="x, y, z (z 0 if left out)" if kind == "point" else "a, b, c",
                         )
                     yield _row(label, widget)
             if self.note:

@@ -150,7 +150,7 @@ class FlightPanel(ParamPanel):
                 title,
                 spec,
                 build_in_path,
-                note="Empty optional fields keep the current pointing.",
+                note="Empty optional fields keep the current pointing; x, y alone sets z = 0.",
             ),
             done,
         )
