@@ -109,3 +109,26 @@ async def test_aim_all_leaves_no_sensor_pointing_beside_the_aim(tmp_path, scene_
     assert straight.aim_at == (1.0, 2.0, 0.0) and straight.azimuth is None is straight.depression
     unpointed = bridge.with_segments(scenario, [*scenario.flight.segments, Straight(50.0, 2)])
     assert aimed.poses() == bridge.aim_all(unpointed, (1.0, 2.0, 0.0)).poses()  # the scans are the same
+
+
+async def test_a_segment_form_stays_put_as_its_message_changes(tmp_path, scene_files):
+    """A two-line message, then a one-line one, moved the whole dialog up and down a row,
+    so a click meant for one field landed on the next."""
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario, size=(80, 24)) as (app, pilot):
+        form = await added(app, pilot, "straight")
+        widgets = [*form.query(".form Input"), *form.query("Button")]
+
+        def places():
+            return [(w.id, w.region.x, w.region.y) for w in widgets]
+
+        await pilot.pause()
+        before = places()
+        await type_into(pilot, form.query_one("#f-distance"), "-100", commit=None)
+        said = await pressed_ok(form, pilot)
+        assert len(said) > 72  # two lines in the dialog
+        assert places() == before
+        await type_into(pilot, form.query_one("#f-distance"), "100", commit=None)
+        await type_into(pilot, form.query_one("#f-scans"), "0", commit=None)
+        assert len(await pressed_ok(form, pilot)) < 72
+        assert places() == before

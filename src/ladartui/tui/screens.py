@@ -213,7 +213,14 @@ class FormScreen(Dialog):
                 yield Button("OK", id="form-ok", variant="primary", compact=True)
                 yield Button("Cancel", id="form-cancel", compact=True)
 
-    DEFAULT_CSS = "FormScreen .form { height: auto; max-height: 16; }"
+    # Anchored at the top, with two lines kept for the message: a message that grows or
+    # shrinks moved the centred dialog a row, and a click meant for a field hit the next.
+    DEFAULT_CSS = """
+    FormScreen { align: center top; }
+    FormScreen > .dialog { margin-top: 2; }
+    FormScreen .form { height: auto; max-height: 16; }
+    FormScreen #form-message { min-height: 2; }
+    """
 
     def on_mount(self) -> None:
         fields = self.query(".form Input, .form Select")
