@@ -11,8 +11,9 @@ from contextlib import asynccontextmanager
 from rich.cells import cell_len
 
 from ladartui.tui.file_dialogs import SaveAsScreen
+from ladartui.tui.measures_screens import CompareScreen, MeasuresScreen
 from ladartui.tui.poses_screen import PosesScreen
-from ladartui.tui.screens import CompareScreen, FormScreen, MeasuresScreen
+from ladartui.tui.screens import FormScreen
 from test_tui_flow import LadarApp, loaded, make_scenario, type_into, wait_until
 from tui_support import screen_after
 
@@ -547,7 +548,7 @@ async def test_the_new_scenario_dialog_refuses_in_the_forms_words(tmp_path, scen
 def test_compare_names_files_of_one_stem_apart_by_their_folders():
     from pathlib import Path
 
-    from ladartui.tui.screens import column_names
+    from ladartui.tui.measures_screens import column_names
 
     paths = [Path("home/default/default.cmf"), Path("w/d2/default.cmf"), Path("w/other.cmf")]
     assert column_names(paths) == ["default/default", "d2/default", "other"]

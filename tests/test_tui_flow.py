@@ -25,8 +25,9 @@ from ladartui.tui.canvas import ProjectionWidget, TopViewWidget
 from ladartui.tui.fields import NumberField
 from ladartui.tui.file_dialogs import SetupScreen
 from ladartui.tui.host import AppHost
+from ladartui.tui.measures_screens import CompareScreen
 from ladartui.tui.measures_view import compact_rows, level_rows
-from ladartui.tui.screens import AngleScreen, CompareScreen, FormScreen, HelpScreen
+from ladartui.tui.screens import AngleScreen, FormScreen, HelpScreen
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
 from tui_support import make_scenario
 

@@ -4,7 +4,8 @@ its own words and keeps what was typed."""
 
 from __future__ import annotations
 
-from ladartui.tui.screens import CompareScreen, FormScreen
+from ladartui.tui.measures_screens import CompareScreen
+from ladartui.tui.screens import FormScreen
 from test_tui_dialogs import message, opened
 from test_tui_flow import make_scenario, type_into, wait_until
 from tui_support import screen_after

@@ -226,7 +226,7 @@ async def test_start_pose_fields_follow_the_path_kind_and_refuse_impractical_val
 
 
 async def test_compare_takes_files_picked_in_the_tree(tmp_path, scene_files):
-    from ladartui.tui.screens import CompareScreen
+    from ladartui.tui.measures_screens import CompareScreen
 
     scenario = make_scenario(tmp_path, scene_files)
     app = LadarApp(scenario.path)
@@ -257,7 +257,7 @@ async def test_compare_takes_files_picked_in_the_tree(tmp_path, scene_files):
 
 async def test_compare_moves_its_tree_up_to_pick_a_run_in_the_folder_beside(tmp_path, scene_files):
     """As in Open and Save As, "Up a folder" reaches the measures of a scenario kept beside."""
-    from ladartui.tui.screens import CompareScreen
+    from ladartui.tui.measures_screens import CompareScreen
 
     here, beside = tmp_path / "here", tmp_path / "beside"
     here.mkdir()

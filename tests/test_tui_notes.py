@@ -6,7 +6,8 @@ from contextlib import asynccontextmanager
 
 from textual.widgets._toast import Toast
 
-from ladartui.tui.screens import FormScreen, MeasuresScreen
+from ladartui.tui.measures_screens import MeasuresScreen
+from ladartui.tui.screens import FormScreen
 from test_tui_flow import LadarApp, field, loaded, make_scenario, type_into, wait_until
 from tui_support import screen_after
 

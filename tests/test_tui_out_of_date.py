@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from ladartui.sensor import Sensor
 from ladartui.simulation import simulate
-from ladartui.tui.screens import MeasuresScreen
+from ladartui.tui.measures_screens import MeasuresScreen
 from test_tui_dialogs import opened
 from test_tui_flow import make_scenario, wait_until
 

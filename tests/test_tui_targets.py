@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from ladartui.colour import TARGET_PALETTE
 from ladartui.tui.canvas import PictureWidget
-from ladartui.tui.screens import CompareScreen, MeasuresScreen
+from ladartui.tui.measures_screens import CompareScreen, MeasuresScreen
 from test_targets import two_box_scenario
 from test_tui_flow import LadarApp, loaded, wait_until
 

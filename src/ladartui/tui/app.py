@@ -33,18 +33,12 @@ from ladartui.tui.graphics import Graphics, has_truecolor
 from ladartui.tui.help_rows import help_rows, palette_entries
 from ladartui.tui.key_words import KeyWords
 from ladartui.tui.loading import SceneLoading
+from ladartui.tui.measures_screens import CompareScreen, MeasuresScreen
 from ladartui.tui.notes import NoteKeeping
 from ladartui.tui.panels import FilePanel, FlightPanel, ResultsPanel, RunPanel, SensorPanel
 from ladartui.tui.params import ParamField
 from ladartui.tui.runs import RunControl
-from ladartui.tui.screens import (
-    AngleScreen,
-    CompareScreen,
-    HelpScreen,
-    ImageSizeScreen,
-    MeasuresScreen,
-    ThresholdScreen,
-)
+from ladartui.tui.screens import AngleScreen, HelpScreen, ImageSizeScreen, ThresholdScreen
 from ladartui.tui.startup_problems import startup_notice
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
 from ladartui.tui.tool_screens import ToolScreens

@@ -19,7 +19,7 @@ from textual.widgets import TabbedContent
 
 from ladartui.errors import Cancelled
 from ladartui.tui.host import Host
-from ladartui.tui.screens import MeasuresScreen
+from ladartui.tui.measures_screens import MeasuresScreen
 from ladartui.tui.status import format_eta
 from ladartui.tui.work import running, start_job
 

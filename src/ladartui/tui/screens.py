@@ -1,6 +1,7 @@
 """Modal screens: the segment editor and other number forms (view angle, threshold,
-image size), measures, comparison and help, and the base of the dialogs with a folder
-tree; the pose editor is tui/poses_screen.py, the file dialogs tui/file_dialogs.py."""
+image size) and help, and the base of the dialogs with a folder tree; the measures
+and comparison dialogs are tui/measures_screens.py, the pose editor
+tui/poses_screen.py, the file dialogs tui/file_dialogs.py."""
 
 from __future__ import annotations
 
@@ -21,11 +22,9 @@ from textual.widget import Widget
 from textual.widgets import Button, DataTable, Input, Label, Select, Static
 
 from ladartui.errors import FieldError, LadarError
-from ladartui.measures import Measures
 from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField, format_number, in_label_unit, parse_number, refusal
 from ladartui.tui.file_tree import FileTree
-from ladartui.tui.measures_view import comparison_rows, level_rows, measure_rows, target_rows
 
 
 class PathSuggester(Suggester):
@@ -368,158 +367,6 @@ def _parse_points(name, text, kind):
     if kind == "point" and len(numbers) == 2:
         numbers = numbers + (0.0,)
     return numbers
-
-
-class MeasuresScreen(Dialog):
-    """The measures of the last run (report figure 10)."""
-
-    def __init__(self, measures, title="Comparison measures", stale: str = ""):
-        """``stale``: why the measures are out of date, said above them (empty: they are not)."""
-        super().__init__()
-        self.measures = measures
-        self.title_text = title + (" (out of date)" if stale else "")
-        self.stale = stale
-
-    DEFAULT_CSS = """
-    MeasuresScreen DataTable { height: auto; max-height: 18; }
-    /* the status bar's not-ready colours: out of date reads the same everywhere */
-    MeasuresScreen #measures-stale { height: auto; padding: 0 1; background: #3a3000; color: #ffffd7; }
-    """
-
-    def compose(self) -> ComposeResult:
-        with Vertical(classes="dialog") as box:
-            box.border_title = self.title_text
-            if self.stale:  # words from settings and file names: never markup
-                yield Static(self.stale, id="measures-stale", markup=False)
-            yield DataTable(cursor_type="row", zebra_stripes=True)
-            with Horizontal(classes="buttons"):
-                yield Button("Close", id="measures-close", variant="primary", compact=True)
-
-    def on_mount(self) -> None:
-        table = self.query_one(DataTable)
-        table.add_columns("Measure", "Value")
-        for label, value in measure_rows(self.measures):
-            table.add_row(label, value)
-        if isinstance(self.measures, Measures):
-            for label, value in level_rows(self.measures):
-                table.add_row(label, value)
-            for target, coverage, level in target_rows(self.measures):
-                table.add_row(target, f"{coverage} obscured" + (f", {level}" if level else ""))
-        table.focus()
-
-    @on(Button.Pressed, "#measures-close")
-    def _close(self) -> None:
-        self.dismiss(None)
-
-
-class CompareScreen(TreeDialog):
-    """Two or more scenarios' measures (.cmf files) side by side, differences highlighted."""
-
-    def __init__(self, paths: list[Path], folder: Path | None = None):
-        super().__init__()
-        self.paths = list(paths)
-        self.folder = folder or (self.paths[0].parent if self.paths else Path.cwd())
-        self.base = self.folder  # typed names are read here, as Open and Save As read them
-
-    DEFAULT_CSS = """
-    CompareScreen > .dialog { width: 100%; height: 100%; max-height: 100%; }
-    CompareScreen DataTable { height: 1fr; }
-    CompareScreen FileTree { height: 8; min-height: 3; }
-    """
-
-    def compose(self) -> ComposeResult:
-        with Vertical(classes="dialog") as box:
-            box.border_title = "Compare scenarios"
-            yield _row(
-                ".cmf files",
-                Input(
-                    shlex.join(self.relative(p) for p in self.paths),  # in the folder: by name
-                    id="cmf-files",
-                    compact=True,
-                    suggester=self.path_suggester((".cmf",), several=True),
-                ),
-            )
-            yield from self.tree_rows((".cmf",))
-            yield Static(
-                "Paths separated by spaces (quote one that has spaces), or pick files "
-                "in the tree (again to drop one); Enter compares. Green best, red "
-                "worst, yellow differs.",
-                classes="info",
-            )
-            yield Static("", id="compare-message", classes="message")
-            yield DataTable(id="compare-table", zebra_stripes=True)
-            with Horizontal(classes="buttons"):
-                yield Button("Compare", id="compare-go", compact=True, variant="primary")
-                yield Button("Close", id="compare-close", compact=True)
-
-    def on_mount(self) -> None:
-        super().on_mount()
-        self.compare()
-
-    @on(FileTree.FileSelected, "#tree")
-    def _picked(self, event: FileTree.FileSelected) -> None:
-        event.stop()
-        field = self.query_one("#cmf-files", Input)
-        chosen = self._typed() or []
-        picked = self.relative(Path(event.path))
-        field.value = shlex.join(
-            [c for c in chosen if c != picked] if picked in chosen else chosen + [picked]
-        )
-        self.compare()
-
-    def _typed(self) -> list[str] | None:
-        """The paths in the field, split as a shell would (quotes keep spaces); None,
-        with the reason said, when a quote is not closed."""
-        try:
-            return shlex.split(self.query_one("#cmf-files", Input).value)
-        except ValueError:  # shlex's only complaint: "No closing quotation"
-            self.query_one("#compare-message", Static).update(
-                ".cmf files: a quotation mark is not closed; expected paths separated by spaces, "
-                "one with spaces in quotes"
-            )
-            return None
-
-    @on(Input.Submitted, "#cmf-files")
-    @on(Button.Pressed, "#compare-go")
-    def compare(self) -> None:
-        message = self.query_one("#compare-message", Static)
-        table = self.query_one("#compare-table", DataTable)
-        table.clear(columns=True)
-        text = self._typed()
-        if text is None:
-            return
-        if len(text) < 2:
-            message.update("Give two or more .cmf files to compare.")
-            return
-        try:
-            loaded = bridge.read_measures_files([self.base / Path(t).expanduser() for t in text])
-        except LadarError as error:
-            message.update(escape(str(error)))
-            return
-        message.update("")
-        table.add_column("Measure")
-        for name in column_names([Path(t) for t in text]):
-            table.add_column(Text(name))  # names from files: never markup
-        for row in comparison_rows(loaded):
-            table.add_row(*(Text(c) if isinstance(c, str) else c for c in row))
-
-    @on(Button.Pressed, "#compare-close")
-    def _close(self) -> None:
-        self.dismiss(None)
-
-
-def column_names(paths: list[Path]) -> list[str]:
-    """Each file's stem, with as many of its folders as it takes to tell files of one
-    stem apart ("d2/default" and "default/default" for two default.cmf)."""
-    names = []
-    for path in paths:
-        parts = path.with_suffix("").parts
-        same = [p.with_suffix("").parts for p in paths if p.stem == path.stem and p != path]
-        depth = 1
-        while any(other[-depth:] == parts[-depth:] for other in same) and depth < len(parts):
-            depth += 1
-        names.append("/".join(parts[-depth:]))
-    return names
 
 
 class AngleScreen(FormScreen):
