@@ -317,9 +317,10 @@ async def test_a_spec_mistake_names_its_line_and_starts_nothing(tmp_path):
 async def test_a_running_sweep_cancels_keeps_its_rows_and_stays_responsive(tmp_path, finished):
     # ``finished`` ran a sweep in this process already, so the kernels are compiled.
     write_base(tmp_path)
-    # 720 variants: far more than run while the test waits, so only Cancel can end it early.
+    # 7,200 variants: far more than run while the test waits (a few hundred a second
+    # here), so only Cancel can end it early.
     spec = write_spec(
-        tmp_path, "[grid]\nheading_offset = { start = 0, stop = 359.5, step = 0.5 }\nscans = [1]\n"
+        tmp_path, "[grid]\nheading_offset = { start = 0, stop = 359.95, step = 0.05 }\nscans = [1]\n"
     )
     results = tmp_path / "spec-results" / "results.csv"
     screen = SweepScreen(spec, serial=True)
@@ -339,12 +340,12 @@ async def test_a_running_sweep_cancels_keeps_its_rows_and_stays_responsive(tmp_p
         assert screen.last_message.endswith("kept; F5 resumes") and str(screen.out) not in screen.last_message
         assert any(f"rows are kept in {screen.out}" in n.message for n in screen.app._notifications)
         done = screen.progress.done
-        assert 2 <= done < 720
+        assert 2 <= done < 7200
         kept, _ = read_table(results)
         assert len(kept) == done and all(r["status"] == "ok" for r in kept)
         assert screen.query_one("#sweep-table", DataTable).row_count == done
         counts = str(screen.query_one("#sweep-counts").render())
-        assert counts.startswith(f"{done}/720, 0 failed, 0 resumed") and "ETA" in counts
+        assert counts.startswith(f"{done}/7200, 0 failed, 0 resumed") and "ETA" in counts
         await pilot.press("f6")
         assert screen.objective == "coverage-per-km"
         # Run again and leave at once: Escape closes the screen and cancels the run.
@@ -356,7 +357,7 @@ async def test_a_running_sweep_cancels_keeps_its_rows_and_stays_responsive(tmp_p
         assert screen.last_message == said and said in [n.message for n in app._notifications]
         await wait_for(pilot, lambda: not any(w.is_running for w in app.workers))
         rows, _ = read_table(results)
-        assert done <= len(rows) < 720
+        assert done <= len(rows) < 7200
         # The kept variants were resumed, not run again: their rows are as they were.
         again = {r["variant"]: r for r in rows}
         assert len(again) == len(rows)
