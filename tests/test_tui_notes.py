@@ -64,3 +64,23 @@ async def test_the_measures_dialog_opens_clear_of_notes(tmp_path, scene_files):
         await screen_after(pilot, lambda: app.push_screen(MeasuresScreen(measures)), MeasuresScreen)
         await pilot.pause(0.2)
         assert toasts(app) == []
+
+
+async def test_a_note_held_by_dialogs_shows_for_the_time_it_had_left(tmp_path, scene_files):
+    """A note shown, then held by a dialog, came back for its whole time after each
+    dialog: 'Invalid value' reappeared minutes later, after a run and a threshold."""
+    from ladartui.tui.screens import ThresholdScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened_with_notes(scenario) as (app, pilot):
+        app.notify("a short note", timeout=2.0)
+        await wait_until(pilot, lambda: shown(app, "a short note"), 10)
+        await pilot.pause(1.5)
+        form = await screen_after(pilot, "f8", ThresholdScreen)
+        await pilot.pause(0.2)
+        assert toasts(app) == []
+        form.query_one("#form-cancel").press()
+        await wait_until(pilot, lambda: not isinstance(app.screen, ThresholdScreen), 10)
+        await pilot.pause(0.1)
+        back = [n for n in app._notifications if n.message == "a short note"]
+        assert len(back) == 1 and back[0].timeout <= 0.6

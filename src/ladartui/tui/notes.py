@@ -1,15 +1,15 @@
 """Notes (toasts) never cover an open dialog: at 80 x 24 one sat over its OK and Cancel.
 
-Notes on screen when a dialog (a modal screen) opens, and those told while one is
-open, wait and show, for their whole time, once the analyst is back on a screen
-that is no dialog. Meanwhile what they said stays where it matters: a refused
+Notes on screen when a dialog (a modal screen) opens wait, for the time they had
+left, and those told while one is open for their whole time, and show once the
+analyst is back on a screen that is no dialog. Meanwhile what they said stays where it matters: a refused
 field keeps its mark, the status bar its colour and reason.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from textual.notifications import SeverityLevel
 from textual.screen import ModalScreen, Screen
@@ -69,7 +69,9 @@ class NoteKeeping(Host):
         if not self._dialog_open():
             return
         now = time.monotonic()
-        self.notes_held = [n for n in self.notes_shown if n.until > now] + self.notes_held
+        # a note shown a while is held for the time it had left, not shown anew each time
+        left = [replace(n, timeout=n.until - now) for n in self.notes_shown if n.until > now]
+        self.notes_held = left + self.notes_held
         self.notes_shown = []
         self.clear_notifications()
 
