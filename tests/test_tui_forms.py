@@ -274,3 +274,23 @@ async def test_a_target_too_high_to_orbit_is_blamed_on_the_voxel_size(tmp_path, 
         assert said.startswith("Voxel size m: 100 is not allowed; expected a voxel size that puts ")
         assert "25000 m" in said and "20000 m" in said and "\n" not in said
         assert not (tmp_path / "fresh.toml").exists()
+
+
+async def test_a_value_just_under_a_limit_is_not_shown_rounded_onto_it(tmp_path, scene_files):
+    """fov 89.99999 was shown as 90, a value the field refuses: committing the field as
+    shown then failed. Six digits stay where they show an allowed value."""
+    import dataclasses
+
+    from test_tui_flow import field
+
+    scenario = make_scenario(tmp_path, scene_files)
+    sensor = dataclasses.replace(scenario.sensor, fov=89.99999)
+    scenario = scenario.with_changes(sensor=sensor).save()
+    async with opened(scenario) as (app, pilot):
+        app.action_show_tab("sensor")
+        await pilot.pause()
+        fov = field(app, "sensor.fov")
+        assert fov.value == "89.99999" and fov.parsed() == 89.99999
+        assert field(app, "sensor.ray_grid").value == "1"
+        await type_into(pilot, fov, "12.3456789", commit="enter")
+        assert fov.value == "12.3457" and app.scenario.sensor.fov == 12.3456789  # six digits shown

@@ -80,13 +80,14 @@ class NumberField(Input):
         **kwargs,
     ):
         kwargs.setdefault("compact", True)
-        super().__init__(value=format_number(value, integer, scale), **kwargs)
+        super().__init__(**kwargs)
         self.field_name = name
         self.default = default
         self.check = check
         self.integer = integer
         self.scale = scale
         self.optional = optional
+        self.value = self._text(value)
         self.committed = self.value
 
     def parsed(self):
@@ -125,8 +126,22 @@ class NumberField(Input):
             return str(error)
         return None
 
+    def _text(self, value) -> str:
+        """``format_number``'s text, or more digits where its six would round the value
+        onto one the field refuses (fov 89.99999 shown as 90, which is not allowed)."""
+        text = format_number(value, self.integer, self.scale)
+        if value is None or self.integer or float(text) * self.scale == float(value):
+            return text  # shown as it is: nothing to check
+        for digits in (9, 12, 17):
+            try:
+                self.check(parse_number(self.field_name, text, self.integer, self.scale))
+                return text
+            except LadarError:
+                text = f"{float(value) / self.scale:.{digits}g}"
+        return text
+
     def set_number(self, value) -> None:
-        self.value = format_number(value, self.integer, self.scale)
+        self.value = self._text(value)
         self.committed = self.value
         self.remove_class("-bad")
 
