@@ -307,3 +307,23 @@ async def test_the_top_views_width_reads_whole_at_80_columns_at_any_zoom(scenari
         title = str(top.border_title)
         assert title.endswith(top_view_width(width)) and "e+" not in title, title
         assert len(title) <= top.size.width - 4, title  # drawn whole, not cut at the border
+
+
+async def test_a_view_too_narrow_for_its_placeholder_wraps_it_whole():
+    """'no output yet: F5 runs' was cut to 'no output yet: F5 run' in a narrow view."""
+    from textual.app import App
+
+    class One(App):
+        def compose(self):
+            view = ProjectionWidget("Out")
+            view.placeholder = "no output yet: F5 runs"
+            yield view
+
+    app = One()
+    async with app.run_test(size=(18, 9)) as pilot:
+        await pilot.pause()
+        view = app.query_one(ProjectionWidget)
+        width, height = view.size
+        assert width < len(view.placeholder)
+        lines = [view.render_line(y).text.strip() for y in range(height)]
+        assert " ".join(line for line in lines if line) == "no output yet: F5 runs"

@@ -9,6 +9,7 @@ pixel) in 24-bit colour, or in the xterm-256 palette when the terminal has no
 
 from __future__ import annotations
 
+import textwrap
 from typing import Any
 
 import numpy as np
@@ -244,10 +245,12 @@ class PictureWidget(Widget, can_focus=True):
                 picture = self.make_picture(*size) if width and height and all(size) else None
             if picture is None:
                 shown = self.image_view is not None and self.image_view.display
-                text = "" if shown else self.placeholder[:width]
+                # wrapped, not cut: "no output yet: F5 run" read as another key's word
+                lines = [] if shown or width < 1 else textwrap.wrap(self.placeholder, width)[:height]
                 blank = [Strip.blank(width)] * height
-                if height:
-                    blank[height // 2] = Strip([Segment(text.center(width), Style(dim=True))], width)
+                top = (height - len(lines)) // 2
+                for row, text in enumerate(lines, start=top):
+                    blank[row] = Strip([Segment(text.center(width), Style(dim=True))], width)
                 self._strips = blank
             else:
                 draw = character_strips if self.characters else picture_strips
