@@ -254,6 +254,12 @@ def test_open_mesh_is_refused_in_solid_mode_only(tmp_path):
             r"far\.obj:4: face 'f 1 2 9' refers to vertex 9: expected 1 to 3 \(or -1 to -3\)",
         ),
         ("junk.obj", "v 0 0 0\nf 1 a 2\n", r"junk\.obj:2: face 'f 1 a 2': expected vertex numbers"),
+        # it said 'expected 1 to 0 (or -1 to -0)'
+        (
+            "novertex.obj",
+            "f 1 2 3\n",
+            r"novertex\.obj:1: face 'f 1 2 3' refers to vertex 1: expected vertices \('v x y z'\) in the file",
+        ),
         # escaped once: its repr wrote 'v 0 1 \\x1b[31m'
         (
             "esc.obj",

@@ -253,10 +253,12 @@ def check_obj_lines(path: Path, text: str) -> None:
             except ValueError:
                 raise InputFileError(path, f"face '{shown()}': expected vertex numbers", number) from None
             if not (1 <= index <= total or -seen <= index <= -1):
+                if not total:  # no vertex at all: no range to name
+                    expected = "vertices ('v x y z') in the file; it has none"
+                else:
+                    expected = f"1 to {total}" + (f" (or -1 to -{seen})" if seen else "")
                 raise InputFileError(
-                    path,
-                    f"face '{shown()}' refers to vertex {index}: expected 1 to {total} (or -1 to -{seen})",
-                    number,
+                    path, f"face '{shown()}' refers to vertex {index}: expected {expected}", number
                 )
 
 
