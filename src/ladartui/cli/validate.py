@@ -150,7 +150,10 @@ def last_run_lines(scenario, scene, writable: bool = True) -> list[str]:
     except LadarError as error:  # the scenario is still valid: say so, and why not the rest
         return [f"last run   settings not read: {error}"]
     if ran is None:
-        return ["last run   settings not recorded (outputs written before run records)"]
+        return [
+            f"last run   settings not recorded: no {record} beside the outputs "
+            "(removed since, or written before runs kept records)"
+        ]
     changes = setting_changes(ran, scenario)
     if not changes:
         lines = [f"last run   made the outputs with this file's settings ({record})"]
