@@ -315,3 +315,12 @@ def test_the_bar_names_compiling_only_when_the_cache_lacks_the_kernels(scenario,
     assert started == ["scan 1"]  # what the bar says until the first scan is done
     monkeypatch.setattr(precompile, "kernels_cached", lambda scenario: False)
     assert first_scan(scenario) == FIRST_SCAN == "scan 1 (compiling kernels on a first run)"
+
+
+def test_a_scene_model_refused_in_setting_up_leaves_no_progress_line(scenario, capsys):
+    """A bad line in the scene model printed 'scan 1  0.0 %' above the error."""
+    with open(scenario.scene_file, "a", encoding="utf-8") as handle:
+        handle.write("1,2\n")
+    assert main(["run", str(scenario.path)]) == 2
+    err = one_error_line(capsys)
+    assert "1,2" in err and "expected three non-negative integers" in err

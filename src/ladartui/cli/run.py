@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 from ladartui.cli.flags import as_flags, check_scenario_name, refuse_step_without_march
 from ladartui.cli.progress import first_scan, progress_display, run_cancellable, sigterm_as_interrupt
-from ladartui.errors import Cancelled, OutputFileError
+from ladartui.errors import Cancelled, LadarError, OutputFileError
 from ladartui.textsafe import single_line
 
 if TYPE_CHECKING:
@@ -68,7 +68,7 @@ def add_parser(subparsers):
 
 def run(args) -> int:
     from ladartui.cli.console import CliConsole as Console
-    from ladartui.errors import FieldError, LadarError
+    from ladartui.errors import FieldError
     from ladartui.scenario import load_scenario
 
     if args.max_rays is not None:
@@ -195,8 +195,10 @@ def _simulate_with_progress(scenario, args, console, finished: list):
     cancel = threading.Event()
     with run_progress(console, transient=False) as bar:
         task = bar.add_task(first_scan(scenario), total=1.0, rays="")
+        traced = []  # whether a scan's progress came
 
         def report(p):
+            traced.append(True)
             bar.update(
                 task,
                 completed=p.fraction,
@@ -212,15 +214,13 @@ def _simulate_with_progress(scenario, args, console, finished: list):
                 scenario, progress=report, cancel=cancel, write=args.write, las=args.las, scene=scene
             )
 
-        with sigterm_as_interrupt():
-            finished.append(
-                run_cancellable(
-                    work,
-                    cancel,
-                    "ladartui-run",
-                    Cancelled(NOTHING_WRITTEN),
-                )
-            )
+        try:
+            with sigterm_as_interrupt():
+                finished.append(run_cancellable(work, cancel, "ladartui-run", Cancelled(NOTHING_WRITTEN)))
+        except LadarError:
+            if not traced:  # refused in setting up (a model file, memory): no bar left above why
+                bar.update(task, visible=False)
+            raise
     return finished[0]
 
 
