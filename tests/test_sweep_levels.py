@@ -244,15 +244,11 @@ def test_cli_sweep_table_folds_headers_never_values_in_a_narrow_terminal(tmp_pat
 def test_targets_identified_are_shown_as_a_count(tmp_path, capsys):
     """The ranking's 'identified' column read 1.000 for one target."""
     from ladartui.cli import main
-    from tiny_sweep import write_tiny_scenario
+    from tiny_sweep import write_spec, write_tiny_scenario
 
     write_tiny_scenario(tmp_path)
-    spec = tmp_path / "spec.toml"
-    spec.write_text(
-        '[sweep]\nscenario = "base.toml"\nobjective = "identified-within-budget"\nbudget = 1000.0\n'
-        "[grid]\nradius = [20.0, 30.0]\n"
-    )
-    assert main(["sweep", str(spec), "--serial"]) == 0
+    body = 'objective = "identified-within-budget"\nbudget = 1000.0\n[grid]\nradius = [20.0, 30.0]\n'
+    assert main(["sweep", str(write_spec(tmp_path, body)), "--serial"]) == 0
     rows = [line.split() for line in capsys.readouterr().out.splitlines()]
     ranked = [row for row in rows if row[:1] in (["1"], ["2"]) and row[1] != "variants"]
     assert ranked and all(row[3] == "1" for row in ranked), ranked
