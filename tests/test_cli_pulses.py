@@ -280,3 +280,13 @@ def test_a_geiger_run_beyond_the_work_limit_is_refused_before_its_first_pulse(sc
     monkeypatch.setenv("LADARTUI_MAX_BIN_VISITS", "a lot")
     assert main(["run", str(scenario.path)]) == 2
     assert "LADARTUI_MAX_BIN_VISITS = 'a lot': expected a number of visits >= 1" in capsys.readouterr().err
+
+
+def test_a_scene_model_refused_in_setting_up_leaves_no_progress_line(scenario, capsys):
+    """A bad line in the scene model printed 'scan 1  0.0 %' above the error, as run did."""
+    from cli_support import one_error_line
+
+    with open(scenario.scene_file, "a", encoding="utf-8") as handle:
+        handle.write("1,2\n")
+    assert main(["pulses", str(scenario.path), "--pulses", "1"]) == 2
+    assert "expected three non-negative integers" in one_error_line(capsys)

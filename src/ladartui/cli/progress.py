@@ -15,7 +15,7 @@ import threading
 from collections.abc import Callable
 from typing import Any, TypeVar
 
-from ladartui.errors import Cancelled
+from ladartui.errors import Cancelled, LadarError
 
 T = TypeVar("T")
 
@@ -49,6 +49,18 @@ def progress_display(console, after, description=None, **options):
         console.width = max(console.width, LOG_WIDTH)
         return Progress(description, BarColumn(bar_width=20), *after, console=console, **options)
     return Progress(description, BarColumn(bar_width=None), *after, console=console, expand=True, **options)
+
+
+@contextlib.contextmanager
+def bar_hidden_if_refused(bar, task, started: Callable[[], bool]):
+    """A refusal before the work reported progress (a model file's bad line, memory)
+    hides the bar: no "scan 1  0.0 %" line is left above the one-line error."""
+    try:
+        yield
+    except LadarError:
+        if not started():
+            bar.update(task, visible=False)
+        raise
 
 
 def run_cancellable(

@@ -158,7 +158,13 @@ def _where(progress) -> str:
 def _study_with_progress(scenario, pulses, settings, backend, console, state):
     from rich.progress import TextColumn, TimeElapsedColumn, TimeRemainingColumn
 
-    from ladartui.cli.progress import first_scan, progress_display, run_cancellable, sigterm_as_interrupt
+    from ladartui.cli.progress import (
+        bar_hidden_if_refused,
+        first_scan,
+        progress_display,
+        run_cancellable,
+        sigterm_as_interrupt,
+    )
     from ladartui.detection.pulses import pulse_study
     from ladartui.precompile import compile_ahead
 
@@ -184,7 +190,8 @@ def _study_with_progress(scenario, pulses, settings, backend, console, state):
                 scenario, pulses, settings, scene=scene, backend=backend, progress=report, cancel=cancel
             )
 
-        with sigterm_as_interrupt():  # as run does: the work (and any compiling children) ends
+        # as run does: the work (and any compiling children) ends
+        with sigterm_as_interrupt(), bar_hidden_if_refused(bar, task, lambda: state["last"] is not None):
             return run_cancellable(
                 work,
                 cancel,

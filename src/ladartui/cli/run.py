@@ -18,7 +18,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ladartui.cli.flags import as_flags, check_scenario_name, refuse_step_without_march
-from ladartui.cli.progress import first_scan, progress_display, run_cancellable, sigterm_as_interrupt
+from ladartui.cli.progress import (
+    bar_hidden_if_refused,
+    first_scan,
+    progress_display,
+    run_cancellable,
+    sigterm_as_interrupt,
+)
 from ladartui.errors import Cancelled, LadarError, OutputFileError
 from ladartui.textsafe import single_line
 
@@ -214,13 +220,8 @@ def _simulate_with_progress(scenario, args, console, finished: list):
                 scenario, progress=report, cancel=cancel, write=args.write, las=args.las, scene=scene
             )
 
-        try:
-            with sigterm_as_interrupt():
-                finished.append(run_cancellable(work, cancel, "ladartui-run", Cancelled(NOTHING_WRITTEN)))
-        except LadarError:
-            if not traced:  # refused in setting up (a model file, memory): no bar left above why
-                bar.update(task, visible=False)
-            raise
+        with sigterm_as_interrupt(), bar_hidden_if_refused(bar, task, lambda: bool(traced)):
+            finished.append(run_cancellable(work, cancel, "ladartui-run", Cancelled(NOTHING_WRITTEN)))
     return finished[0]
 
 
