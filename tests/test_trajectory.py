@@ -346,3 +346,11 @@ def test_a_run_whose_output_would_replace_its_flight_log_is_refused(tmp_path, ca
     assert err.startswith(f"ladartui: error: {scenario}:9: flight.segments[0].file = 'lg.cmf'")
     assert "would overwrite the flight log" in err
     assert (tmp_path / "lg.cmf").read_text() == log_text and not (tmp_path / "lg_Scene.txt").exists()
+    # the same file reached through a link is the same file
+    (tmp_path / "lg.cmf").rename(tmp_path / "kept.cmf")
+    (tmp_path / "link.csv").symlink_to("lg.cmf")
+    (tmp_path / "kept.cmf").rename(tmp_path / "lg.cmf")
+    scenario.write_text(scenario.read_text().replace('file = "lg.cmf"', 'file = "link.csv"'))
+    assert main(["run", str(scenario)]) == 2
+    assert "would overwrite the flight log" in capsys.readouterr().err
+    assert (tmp_path / "lg.cmf").read_text() == log_text

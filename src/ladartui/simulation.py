@@ -428,14 +428,15 @@ def check_outputs_spare_inputs(scenario, las=False) -> None:
 
     check_output_names(scenario, las)
     check_lock(output_lock(scenario))
-    inputs = {os.path.normpath(Path(f).absolute()) for f in (scenario.scene_file, scenario.target_file)}
+    # resolved: a model or log reached through a link is the file the link names
+    inputs = {os.path.realpath(f) for f in (scenario.scene_file, scenario.target_file)}
     logs = {
-        os.path.normpath(Path(segment.file).absolute()): index
+        os.path.realpath(segment.file): index
         for index, segment in enumerate(scenario.flight.segments)
         if segment.kind == "log"
     }
     for name, path in output_paths(scenario, las).items():
-        where = os.path.normpath(path.absolute())
+        where = os.path.realpath(path)
         if where in inputs:
             key, found = "files.scene", Path(scenario.scene_file).name
             expected = (
