@@ -290,3 +290,15 @@ def test_a_scene_model_refused_in_setting_up_leaves_no_progress_line(scenario, c
         handle.write("1,2\n")
     assert main(["pulses", str(scenario.path), "--pulses", "1"]) == 2
     assert "expected three non-negative integers" in one_error_line(capsys)
+
+
+def test_validate_names_a_mistyped_firing_limit_of_a_geiger_scenario(scenario, capsys, monkeypatch):
+    """validate passed a Geiger scenario with LADARTUI_MAX_BIN_VISITS=abc, which run refused."""
+    from cli_support import one_error_line
+
+    monkeypatch.setenv("LADARTUI_MAX_BIN_VISITS", "abc")
+    scenario.with_changes(detection=DetectionSettings(model="geiger", pulses=20, coincidence=4)).save()
+    assert main(["validate", str(scenario.path)]) == 2
+    assert one_error_line(capsys).endswith(
+        "LADARTUI_MAX_BIN_VISITS = 'abc': expected a number of visits >= 1"
+    )

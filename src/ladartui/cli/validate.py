@@ -40,6 +40,10 @@ def run(args) -> int:
     check_scenario_name(args.scenario)
     with work_unchecked():  # the ray limit is the machine's, not a mistake: a "next run" line
         scenario = load_scenario(bundled_or_path(args.scenario))
+    if scenario.geiger:  # its firing is checked as a run traces its looks; the limit read now
+        from ladartui.resources import max_bin_visits
+
+        max_bin_visits()
     scene = scenario.load_scene()
     scene_lines = scene_summary(scenario, scene)
     check_output_names(scenario)  # too long: the scenario's own name is the mistake
