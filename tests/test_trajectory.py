@@ -354,3 +354,25 @@ def test_a_run_whose_output_would_replace_its_flight_log_is_refused(tmp_path, ca
     assert main(["run", str(scenario)]) == 2
     assert "would overwrite the flight log" in capsys.readouterr().err
     assert (tmp_path / "lg.cmf").read_text() == log_text
+
+
+def test_a_sweep_over_speed_of_a_flight_log_alone_is_refused(tmp_path, capsys):
+    """Three speeds over a log's own clock gave three identical rows, all on the front."""
+    from ladartui.cli import main
+    from ladartui.scene.voxels import save_voxels
+
+    target = np.array([(x, y, 0) for x in range(4) for y in range(4)], np.int32)
+    save_voxels(tmp_path / "woods.txt", target)
+    save_voxels(tmp_path / "woods_Target.txt", target)
+    (tmp_path / "log.csv").write_text(
+        "time,x,y,z,heading\n" + "".join(f"{t},{t},2,30,90\n" for t in range(3))
+    )
+    (tmp_path / "lg.toml").write_text(
+        '[files]\nscene = "woods.txt"\nvoxel_size = 1.0\n[sensor]\ngrid = 4\nray_grid = 1\n'
+        '[[flight.segments]]\nkind = "log"\nfile = "log.csv"\nrate = 1.0\n'
+    )
+    spec = tmp_path / "sl.toml"
+    spec.write_text('[sweep]\nscenario = "lg.toml"\n[grid]\nspeed = [10.0, 30.0]\n')
+    assert main(["sweep", str(spec), "--serial"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert f"{spec}:4: grid.speed: no variant can run" in err and "keeps the log's own clock" in err

@@ -233,10 +233,24 @@ def apply_parameters(base, params: dict, scene_loader=lambda: None):
             changes["flight"] = flight
             flight.poses()  # build now, so a bad segment fails here with its field
         if "speed" in params:
+            _check_speed_matters(flight, params["speed"])
             changes["speed"] = params["speed"]
         return base.with_changes(**changes) if changes else base
     except FieldError as error:
         raise _as_parameter(error, params) from None
+
+
+def _check_speed_matters(flight, speed) -> None:
+    """A flight that is one flight log keeps the log's clock: every speed gives the same
+    variant, ranked as many."""
+    segments = flight.segments
+    if len(segments) == 1 and hasattr(segments[0], "leg_seconds"):
+        raise FieldError(
+            "speed",
+            speed,
+            "a base flown at its speed: its one flight log keeps the log's own clock, so the "
+            "speed changes nothing",
+        )
 
 
 def _as_parameter(error: FieldError, params: dict) -> FieldError:
