@@ -205,3 +205,27 @@ def test_new_certificates_replace_the_old_three_together_or_not_at_all(tmp_path,
     monkeypatch.undo()
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
     assert (paths["key"].stat().st_mode & 0o077) == 0
+
+
+def test_a_handshake_that_fails_blames_the_tls_flags_not_the_address(tmp_path):
+    """A scheduler made with other certificates was reported as '--scheduler = ...:
+    expected the address of a running Dask scheduler; connecting failed: TLS certificate
+    does not match'."""
+    import ssl
+
+    from ladartui.sweep.cluster import tls_refusal
+
+    paths = make_certificates(tmp_path)
+    security = cluster_security("tls://10.0.0.1:8786", paths["ca"], paths["cert"], paths["key"])
+    try:
+        try:
+            raise ssl.SSLCertVerificationError("certificate verify failed")
+        except ssl.SSLError as cause:
+            raise OSError("TLS certificate does not match. Check your security settings.") from cause
+    except OSError as error:
+        refused = tls_refusal(error, security)
+    assert refused is not None and str(refused).startswith(f"--tls-ca-file = '{paths['ca']}': expected")
+    rejected = OSError("closed")
+    rejected.__context__ = ssl.SSLError("sslv3 alert bad certificate")
+    assert str(tls_refusal(rejected, security)).startswith(f"--tls-cert = '{paths['cert']}'")
+    assert tls_refusal(OSError("Timed out trying to connect"), security) is None

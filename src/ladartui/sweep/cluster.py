@@ -158,6 +158,8 @@ def connect(address: str, timeout: float = 30.0, security=None):
     try:
         client = Client(address, timeout=f"{timeout}s", security=security)
     except (OSError, TimeoutError, ValueError, TypeError) as error:  # TypeError: tls:// sans TLS
+        if security is not None and (refusal := tls_refusal(error, security)) is not None:
+            raise refusal from None
         raise FieldError(
             "--scheduler",
             address,
@@ -172,6 +174,35 @@ def connect(address: str, timeout: float = 30.0, security=None):
         ) from None
     check_workers(client)
     return client
+
+
+def tls_refusal(error: BaseException, security) -> FieldError | None:
+    """The TLS flag to blame when connecting failed in the TLS handshake (the address
+    was right, the certificates not), or None: a certificate of the scheduler that does
+    not verify against --tls-ca-file, else this client's certificate refused."""
+    import ssl
+
+    seen: BaseException | None = error
+    while seen is not None:
+        verify = isinstance(seen, ssl.SSLCertVerificationError) or "TLS certificate does not match" in str(
+            seen
+        )
+        if verify:
+            return FieldError(
+                "--tls-ca-file",
+                str(security.tls_ca_file),
+                "the certificate authority the scheduler's certificate was made with; the "
+                "scheduler's certificate does not verify against this one",
+            )
+        if isinstance(seen, ssl.SSLError):
+            return FieldError(
+                "--tls-cert",
+                str(security.tls_client_cert),
+                "a certificate the scheduler trusts (made with its ca.pem); the TLS handshake "
+                f"failed ({seen})",
+            )
+        seen = seen.__cause__ or seen.__context__
+    return None
 
 
 def check_workers(client) -> None:
