@@ -229,3 +229,19 @@ def test_a_handshake_that_fails_blames_the_tls_flags_not_the_address(tmp_path):
     rejected.__context__ = ssl.SSLError("sslv3 alert bad certificate")
     assert str(tls_refusal(rejected, security)).startswith(f"--tls-cert = '{paths['cert']}'")
     assert tls_refusal(OSError("Timed out trying to connect"), security) is None
+
+
+def test_the_sweep_screen_names_its_certificates_field_for_a_bad_tls_file(tmp_path):
+    """The screen has one Certificates folder, not three flags: a CA file holding no
+    certificate was told as '--tls-ca-file = ...'."""
+    from ladartui.sweep.security import folder_security
+    from ladartui.tui.sweep_jobs import in_form_words
+
+    paths = make_certificates(tmp_path)
+    paths["ca"].write_text("not a certificate\n")
+    with pytest.raises(FieldError) as caught:
+        folder_security("tls://10.0.0.1:8786", tmp_path)
+    said = str(in_form_words(caught.value))
+    assert said.startswith(
+        f"Certificates: {paths['ca']} is not allowed; expected a PEM certificate authority"
+    )

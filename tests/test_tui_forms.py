@@ -294,3 +294,30 @@ async def test_a_value_just_under_a_limit_is_not_shown_rounded_onto_it(tmp_path,
         assert field(app, "sensor.ray_grid").value == "1"
         await type_into(pilot, fov, "12.3456789", commit="enter")
         assert fov.value == "12.3457" and app.scenario.sensor.fov == 12.3456789  # six digits shown
+
+
+async def test_forms_open_on_values_of_many_digits(tmp_path, scene_files):
+    """A view angle of 10.1234567, or an orbit radius of 60.1234567 (a sweep's best path
+    writes such), crashed the app as its form opened: the field asked the form to check
+    its value before the form's other fields were built."""
+    import dataclasses
+
+    from ladartui.tui.screens import AngleScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    orbit = dataclasses.replace(scenario.flight.segments[0], radius=60.1234567)
+    scenario = scenario.with_changes(flight=dataclasses.replace(scenario.flight, segments=(orbit,))).save()
+    async with opened(scenario) as (app, pilot):
+        form = await screen_after(pilot, "f7", AngleScreen)
+        await type_into(pilot, form.query_one("#f-azimuth"), "10.1234567", commit="enter")
+        await wait_until(pilot, lambda: app.screen is not form)
+        form = await screen_after(pilot, "f7", AngleScreen)
+        await pilot.pause()
+        assert form.query_one("#f-azimuth").value == "10.1235"
+        form.query_one("#form-cancel").press()
+        await wait_until(pilot, lambda: app.screen is not form)
+        app.action_show_tab("flight")
+        await pilot.pause()
+        form = await screen_after(pilot, app.action_edit_segment, FormScreen)
+        await pilot.pause()
+        assert form.query_one("#f-radius").value == "60.1235"

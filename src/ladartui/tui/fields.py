@@ -80,15 +80,25 @@ class NumberField(Input):
         **kwargs,
     ):
         kwargs.setdefault("compact", True)
-        super().__init__(**kwargs)
+        # six digits until mounted: a form's check reads fields not built yet
+        super().__init__(value=format_number(value, integer, scale), **kwargs)
         self.field_name = name
         self.default = default
         self.check = check
         self.integer = integer
         self.scale = scale
         self.optional = optional
-        self.value = self._text(value)
         self.committed = self.value
+        self._first = value
+
+    def on_mount(self) -> None:
+        self.call_after_refresh(self._show_first)
+
+    def _show_first(self) -> None:
+        """The first value with the digits ``_text`` gives, once the form around is built
+        (unless typing has begun)."""
+        if self.value == self.committed:
+            self.value = self.committed = self._text(self._first)
 
     def parsed(self):
         """The typed value (None for an empty optional field); FieldError if not allowed."""
@@ -141,6 +151,7 @@ class NumberField(Input):
         return text
 
     def set_number(self, value) -> None:
+        self._first = value  # (shown so already, should the first showing come later)
         self.value = self._text(value)
         self.committed = self.value
         self.remove_class("-bad")

@@ -18,7 +18,15 @@ if TYPE_CHECKING:
 
 
 # The sweep screen's fields, as the cluster's refusals name them (some name the CLI's flags).
-FORM_LABELS = {"scheduler": "Scheduler", "--scheduler": "Scheduler", "certificates": "Certificates"}
+# the sweep screen's fields for the core's: its Certificates folder holds the three TLS files
+FORM_LABELS = {
+    "scheduler": "Scheduler",
+    "--scheduler": "Scheduler",
+    "certificates": "Certificates",
+    "--tls-ca-file": "Certificates",
+    "--tls-cert": "Certificates",
+    "--tls-key": "Certificates",
+}
 
 
 def in_form_words(error: FieldError) -> LadarError:
