@@ -11,8 +11,9 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, replace
 
-from textual.notifications import SeverityLevel
+from textual.notifications import Notifications, SeverityLevel
 from textual.screen import ModalScreen, Screen
+from textual.widgets._toast import ToastRack  # (the rack of each screen: no public name)
 
 from ladartui.tui.host import Host
 
@@ -74,6 +75,11 @@ class NoteKeeping(Host):
         self.notes_held = left + self.notes_held
         self.notes_shown = []
         self.clear_notifications()
+        # the screens under the dialog keep drawing their toasts (Textual clears the top
+        # one's only): behind a dialog near the top they showed, half covered
+        for screen in self.screen_stack[:-1]:
+            for rack in screen.query(ToastRack):
+                rack.show(Notifications())
 
     def _show_notes_held(self) -> None:
         held, self.notes_held = self.notes_held, []
