@@ -603,3 +603,20 @@ async def test_a_finished_sweep_shows_its_whole_100_percent(finished, tmp_path):
         percent = screen.query_one("#sweep-progress PercentageStatus")
         assert str(percent.render()) == "100%"
         assert percent.content_region.width >= len("100%")
+
+
+async def test_opening_a_sweep_leaves_no_note_of_the_empty_screen(finished):
+    """The screen's first words ('type a sweep spec ...') came as a note, read as cut
+    before the status line was laid out, and stayed over the chart of the sweep it had
+    opened, then followed onto the main screen."""
+    spec, results = finished
+    screen = SweepScreen(results)
+    app = _Host(screen)
+    notes: list[str] = []
+    notify = app.notify
+    app.notify = lambda message, **options: (notes.append(message), notify(message, **options))[1]
+    async with app.run_test(size=(120, 40)) as pilot:
+        await opened(pilot)
+        await pilot.pause(0.3)
+        assert screen.last_message.startswith("ranked by")
+        assert not [note for note in notes if "type a sweep spec" in note], notes

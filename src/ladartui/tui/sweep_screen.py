@@ -549,7 +549,17 @@ class SweepScreen(SweepOpening):
         self.last_message = message
         bar = self.query_one("#sweep-status", StatusBar)
         bar.show(state, message, progress, cancellable or self.running)
-        cut = cell_len(message) > bar.query_one(StatusText).content_size.width
+        self._note_if_cut(state, message, problem)
+
+    def _note_if_cut(self, state: str, message: str, problem: bool, tries: int = 3) -> None:
+        if message != self.last_message:  # another came since: this one is gone
+            return
+        width = self.query_one("#sweep-status", StatusBar).query_one(StatusText).content_size.width
+        if not width:  # not laid out yet (on mount): every message would read as cut
+            if tries:
+                self.call_after_refresh(self._note_if_cut, state, message, problem, tries - 1)
+            return
+        cut = cell_len(message) > width
         if cut and problem:
             self.notify(message, severity="error", markup=False, timeout=15)
         elif cut and state != BUSY:
