@@ -557,6 +557,9 @@ async def test_help_lists_the_keys_and_the_palette_offers_every_action(shared, t
     assert bound <= actions
     for action in actions:
         assert callable(getattr(app, f"action_{action}", None)), action
+    # found by the words of its button: 'Aim all' matched no palette command
+    names = {name: action for name, _, action in palette_entries()}
+    assert names.get("Aim all scans at the target") == "aim_all"
 
 
 def test_pictures_use_24_bit_colour_or_the_256_colour_palette():

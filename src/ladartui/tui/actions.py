@@ -131,7 +131,7 @@ COMMANDS = [
         "Write the scene and target outputs as LAS point clouds beside them",
     ),
     Command(
-        "aim-all", "aim_all", None, "Aim every scan at the target", "Point the sensor at the target centre"
+        "aim-all", "aim_all", None, "Aim all scans at the target", "Point the sensor at the target centre"
     ),
     Command(
         "edit-segment", "edit_segment", None, "Edit selected segment", "Open the selected flight segment"
