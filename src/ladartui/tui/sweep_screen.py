@@ -522,7 +522,7 @@ class SweepScreen(SweepOpening):
         if error == "cancelled":
             # the folder in a note: after the counts on the status line it was cut at 80 columns
             self.notify(f"Sweep cancelled: its rows are kept in {self.out}; F5 resumes.", markup=False)
-            self._status(NOT_READY, f"sweep cancelled: {kept}; F5 resumes")
+            self._status(READY, f"sweep cancelled: {kept}; F5 resumes")  # F5 runs: ready
         else:
             self._status(NOT_READY, f"sweep stopped: {error}", problem=True)
 
