@@ -53,7 +53,12 @@ async def test_a_segment_form_names_the_point_field_that_is_wrong(tmp_path, scen
         await type_into(pilot, centre, "1,2,3,4", commit=None)
         form.query_one("#form-ok").press()
         await pilot.pause()
-        assert message(form) == "Centre x,y,z m: 1,2,3,4 is not allowed; expected x, y, z in metres"
+        assert message(form) == (
+            "Centre x,y,z m: 1,2,3,4 is not allowed; expected x, y, z in metres (z 0 if left out)"
+        )
+        # 'x y' without commas said 'expected a number': spaces part the numbers too
+        await type_into(pilot, centre, "10 20", commit=None)
+        assert form.values()["centre"] == (10.0, 20.0, 0.0)
         await type_into(pilot, centre, "10, 20, 0", commit=None)
         # a limit is said in the field's unit, as the main form says it ("at most 1000 m/s")
         await type_into(pilot, radius, "-7", commit=None)

@@ -355,15 +355,20 @@ def _parse_points(name, text, kind):
     text = text.strip()
     if not text:
         return None
-    parts = [p.strip() for p in text.replace(";", ",").split(",")]
+    joined = text.replace(";", ",")
+    # "10 20" too: without a comma, spaces part the numbers
+    parts = [p.strip() for p in joined.split(",")] if "," in joined else joined.split()
     if len(parts) > 1 and not parts[-1]:
         parts.pop()  # one trailing comma
+    expected = "x, y, z in metres (z 0 if left out)" if kind == "point" else "numbers separated by commas"
     if not all(parts):
-        expected = "x, y, z in metres" if kind == "point" else "numbers separated by commas"
         raise FieldError(name, text, expected + ", none of them empty")
-    numbers = tuple(parse_number(name, p) for p in parts)
+    try:
+        numbers = tuple(parse_number(name, p) for p in parts)
+    except FieldError:  # "10 x": the field's form, not "a number"
+        raise FieldError(name, text, expected) from None
     if kind == "point" and len(numbers) not in (2, 3):
-        raise FieldError(name, text, "x, y, z in metres")
+        raise FieldError(name, text, expected)
     if kind == "point" and len(numbers) == 2:
         numbers = numbers + (0.0,)
     return numbers
