@@ -637,3 +637,15 @@ async def test_earlier_outputs_are_shown_from_one_stat_of_each_file(tmp_path, sc
         assert list(stats.values()) == [2, 2, 2]
         status = scenario.measures_file.stat()
         assert app.outputs_seen == (status.st_mtime_ns, status.st_size)  # those shown, as on disk
+
+
+def test_the_ifov_is_said_in_degrees_from_one_degree_up():
+    """A 90 degree view on 64 detectors read 'IFOV 1.41e+03 mdeg'."""
+    from ladartui.tui.panels.sensor import ifov_text
+
+    assert [ifov_text(fov / 64) for fov in (8.0, 63.0, 64.0, 90.0)] == [
+        "125 mdeg",
+        "984 mdeg",
+        "1 deg",
+        "1.41 deg",
+    ]

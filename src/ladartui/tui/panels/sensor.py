@@ -20,5 +20,11 @@ class SensorPanel(ParamPanel):
         self.query_one("#sensor-info", Static).update(
             # a line each: at 80 columns 'IFOV 125' and 'mdeg' fell on two lines
             f"{s.grid}x{s.grid} detectors, {s.ray_grid}x{s.ray_grid} rays each\n"
-            f"{s.rays_per_scan:,} rays per scan\nIFOV {s.ifov * 1000:.3g} mdeg"
+            f"{s.rays_per_scan:,} rays per scan\nIFOV {ifov_text(s.ifov)}"
         )
+
+
+def ifov_text(degrees: float) -> str:
+    """A detector's field of view: millidegrees below a degree, degrees from one up
+    (a 90 degree view on 64 detectors read '1.41e+03 mdeg')."""
+    return f"{degrees:.3g} deg" if degrees >= 1 else f"{degrees * 1000:.3g} mdeg"
