@@ -185,6 +185,28 @@ def test_output_that_cannot_be_written_is_one_line_not_a_traceback(tmp_path, cap
     assert one_error_line(capsys) == "ladartui: error: could not write the output: No space left on device"
 
 
+def test_a_full_disk_under_numbas_cache_is_not_called_the_output(tmp_path, capsys, monkeypatch):
+    """A first run's kernels written to numba's cache on a full disk said 'could not write
+    the output', with --no-write too."""
+    import errno
+
+    import ladartui.cli.info as info
+
+    numba_code = compile(
+        "def save(*args, **kwargs):\n    raise OSError(errno.EFBIG, 'File too large')\n",
+        str(tmp_path / "numba" / "core" / "caching.py"),
+        "exec",
+    )
+    space = {"errno": errno}
+    exec(numba_code, space)
+    monkeypatch.setattr(info, "print_voxel_list", space["save"])
+    (tmp_path / "v.txt").write_text("1,2,3\n")
+    assert cli.main(["info", str(tmp_path / "v.txt")]) == 1
+    assert one_error_line(capsys) == (
+        "ladartui: error: could not write numba's cache of the compiled kernels: File too large"
+    )
+
+
 def test_certs_that_cannot_be_written_leave_no_lock_behind(tmp_path, capsys):
     """A failed write left an empty DIR/.certs.lock: the lock's own write failed after
     the file was made, before the set held it to remove it."""

@@ -131,12 +131,22 @@ def main(argv: list[str] | None = None) -> int:
         # file. An error naming one, or of another kind, is no failed write: raised as it is.
         if error.filename is not None or error.errno not in _WRITE_ERRORS:
             raise
-        print(f"ladartui: error: could not write the output: {os_reason(error)}", file=sys.stderr)
+        what = "numba's cache of the compiled kernels" if _in_numba(error) else "the output"
+        print(f"ladartui: error: could not write {what}: {os_reason(error)}", file=sys.stderr)
         _reader_gone()  # no second failure as Python flushes standard output at exit
         return 1
 
 
 _WRITE_ERRORS = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO}
+
+
+def _in_numba(error: BaseException) -> bool:
+    """Whether ``error`` came from numba's own code: a first run's kernels written to its
+    cache (beside the modules, or NUMBA_CACHE_DIR) on a full disk, not the command's output."""
+    import traceback
+
+    part = f"{os.sep}numba{os.sep}"
+    return any(part in frame.filename for frame in traceback.extract_tb(error.__traceback__))
 
 
 def _reader_gone() -> int:
