@@ -172,37 +172,39 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
 
 def _run_output(path: Path) -> str | None:
     """What a run's output S_Scene.txt or S_Target.txt is, where its record S_Run.toml lies
-    beside it; None for any other voxel list."""
+    beside it (and whether it, or its fellow, changed since the run wrote it, as validate
+    says); None for any other voxel list."""
+    import os
+
+    from ladartui.run_record import changed_outputs
     from ladartui.scenario_file import RECORD_SUFFIX, is_record
 
     for run, other, what, others in (
         ("_Scene", "_Target", "scene", "target"),
         ("_Target", "_Scene", "target", "scene"),
     ):
-        if path.stem.endswith(run):
-            stem = path.stem.removesuffix(run)
-            record = path.with_name(stem + RECORD_SUFFIX)
-            if is_record(record):
-                return _not_the_runs(path, record, stem) or (
-                    f"the {what} run's returns of a run of {stem}.toml ({record.name}); "
-                    f"{stem}{other}{path.suffix}: the {others} run's"
-                )
-    return None
-
-
-def _not_the_runs(path: Path, record: Path, stem: str) -> str | None:
-    """Why ``path`` is no longer its run's output, from the fingerprints its record keeps
-    (as validate says it); None where it is, or the record does not say."""
-    import os
-
-    from ladartui.run_record import changed_outputs
-
-    try:
-        changed = changed_outputs(record)
-    except LadarError as error:
-        return f"named as an output of a run of {stem}.toml, but {error}"
-    if any(os.path.abspath(output) == os.path.abspath(path) for output in changed):
-        return f"changed since the run of {stem}.toml wrote it ({record.name}): it is not the run's output"
+        if not path.stem.endswith(run):
+            continue
+        stem = path.stem.removesuffix(run)
+        record = path.with_name(stem + RECORD_SUFFIX)
+        if not is_record(record):
+            return None
+        try:
+            changed = {os.path.abspath(output) for output in changed_outputs(record)}
+        except LadarError as error:
+            return f"named as an output of a run of {stem}.toml, but {error}"
+        if os.path.abspath(path) in changed:
+            return (
+                f"changed since the run of {stem}.toml wrote it ({record.name}): it is not the run's output"
+            )
+        fellow = path.with_name(f"{stem}{other}{path.suffix}")
+        if not fellow.is_file():
+            said = f"{fellow.name}, the {others} run's, is not there"
+        elif os.path.abspath(fellow) in changed:
+            said = f"{fellow.name}, the {others} run's, changed since"
+        else:
+            said = f"{fellow.name}: the {others} run's"
+        return f"the {what} run's returns of a run of {stem}.toml ({record.name}); {said}"
     return None
 
 
