@@ -660,3 +660,20 @@ def test_rows_the_table_cannot_read_are_named_not_dropped_silently(tmp_path, cap
     assert "(line 3) and is left out; the table was rewritten without it" in out
     unreadable = []
     assert len(read_table(results, unreadable)[0]) == 3 and not unreadable  # the torn one ran again
+
+
+def test_a_row_of_a_status_no_sweep_writes_says_so_not_none(tmp_path, capsys):
+    """A status edited by hand ('okay') read '1 variant failed ...; first: ID: None'."""
+    from ladartui.cli import main
+
+    write_tiny_scenario(tmp_path)
+    spec = write_spec(tmp_path, "[grid]\nradius = [20.0, 30.0]\n", name="edited.toml")
+    assert main(["sweep", str(spec), "--serial"]) == 0
+    results = tmp_path / "edited-results" / "results.csv"
+    lines = results.read_text(encoding="utf-8").splitlines()
+    lines[1] = lines[1].replace(",ok,", ",okay,", 1)
+    results.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    capsys.readouterr()
+    assert main(["sweep", str(spec), "--show"]) == 0
+    out = capsys.readouterr().out.replace("\n", " ")
+    assert "status 'okay', not one a sweep writes (ok, failed, error)" in out and ": None" not in out

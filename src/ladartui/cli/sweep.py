@@ -440,6 +440,13 @@ def _say_folder_unchanged(errors, folder: Path) -> None:
         )
 
 
+def _why_not_ok(row: dict) -> str:
+    """A failed row's error, or, with none (a hand-edited table), the status it holds."""
+    if row.get("error"):
+        return str(row["error"])
+    return f"no error given; status {row.get('status')!r}, not one a sweep writes (ok, failed, error)"
+
+
 def show_result(console, result, top) -> None:
     """The top of the ranking, the Pareto front, failures and the files written."""
     from rich import box
@@ -532,7 +539,7 @@ def show_result(console, result, top) -> None:
         if rows:
             console.print(
                 f"[bold]{plural(len(rows), 'variant')} {what}[/]; first: "
-                + escape(single_line(f"{rows[0].get('variant')}: {rows[0].get('error')}")),
+                + escape(single_line(f"{rows[0].get('variant')}: {_why_not_ok(rows[0])}")),
                 highlight=False,
             )
     ran, resumed = result.ran, result.resumed
