@@ -155,7 +155,10 @@ def test_a_chart_name_with_no_suffix_is_refused_before_anything_runs(scenario, c
     for write in ([], ["--no-write"]):
         assert main(["run", str(scenario.path), "--chart", str(chart), *write]) == 2
         err = one_error_line(capsys)
-        assert err == f"ladartui: error: --chart = '{chart}': expected a file name ending in .svg or .png"
+        assert err == (
+            f"ladartui: error: --chart = '{chart}': expected a file name ending in .svg or .png, "
+            "a name before it"
+        )
     assert not scenario.measures_file.exists() and not scenario.scene_output.exists()
     assert not chart.exists()
 

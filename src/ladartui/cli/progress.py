@@ -15,7 +15,7 @@ import threading
 from collections.abc import Callable
 from typing import Any, TypeVar
 
-from ladartui.errors import Cancelled, LadarError
+from ladartui.errors import Cancelled, LadarError, ResourceLimitError
 
 T = TypeVar("T")
 
@@ -53,12 +53,13 @@ def progress_display(console, after, description=None, **options):
 
 @contextlib.contextmanager
 def bar_hidden_if_refused(bar, task, started: Callable[[], bool]):
-    """A refusal before the work reported progress (a model file's bad line, memory)
-    hides the bar: no "scan 1  0.0 %" line is left above the one-line error."""
+    """A refusal before the work reported progress (a model file's bad line, memory),
+    or work refused for its size once traced (Geiger-mode firing), hides the bar: no
+    "scan 1  0.0 %" line is left above the one-line error."""
     try:
         yield
-    except LadarError:
-        if not started():
+    except LadarError as error:
+        if not started() or isinstance(error, ResourceLimitError):  # refused, not stopped
             bar.update(task, visible=False)
         raise
 

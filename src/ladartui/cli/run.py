@@ -109,7 +109,7 @@ def run(args) -> int:
 
         # the suffix, as the chart's writer reads it: ".svg" alone is a name with none
         if Path(args.chart).suffix.lower() not in (".svg", ".png"):
-            raise FieldError("--chart", args.chart, "a file name ending in .svg or .png")
+            raise FieldError("--chart", args.chart, "a file name ending in .svg or .png, a name before it")
         if not os.path.exists(os.path.dirname(args.chart) or "."):  # a mistyped folder is not made
             raise FieldError("--chart", args.chart, "a file in an existing folder")
         problem = output_problem(args.chart)  # before the run, not after its outputs
