@@ -89,7 +89,10 @@ def test_a_run_over_the_ray_limit_is_a_next_run_line_after_the_summary(tmp_path,
     assert main(["validate", str(path)]) == 1
     out, err = capsys.readouterr()
     assert err == "" and out.startswith(f"scenario   {path}\n")
-    assert "\nrays       268,435,456 per scan, 2,684,354,560,000 in all\n" in out
+    assert (
+        "\nrays       268,435,456 per scan, 2,684,354,560,000 in all; 5,368,709,120,000 traced with "
+        "the target-alone run\n"
+    ) in out
     assert out.splitlines()[-1] == (
         f"next run   {path}: sensor.grid = 1024, sensor.ray_grid = 16, 10,000 scans: about 5.37e+12 "
         "rays to trace, more than the limit of 2e+09 (raise it with LADARTUI_MAX_RAYS or run's "

@@ -302,7 +302,9 @@ class Scenario:
             f"           altitude {min(altitudes):g}..{max(altitudes):g} m, depression "
             f"{min(depressions):.3g}..{max(depressions):.3g} deg",
             f"           path {fixed(length, 1)} m, {fixed(self.flight_time(), 1)} s {self._clock_text()}",
-            f"rays       {s.rays_per_scan:,} per scan, {s.rays_per_scan * len(poses):,} in all",
+            # the ray limit counts what is traced: both runs
+            f"rays       {s.rays_per_scan:,} per scan, {s.rays_per_scan * len(poses):,} in all; "
+            f"{2 * s.rays_per_scan * len(poses):,} traced with the target-alone run",
             f"run        backend {self.backend}, method {self.method}"
             + (f" (step {self.step:g} voxel)" if self.method == "march" else "")
             + f", {self.precision}"
