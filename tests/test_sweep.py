@@ -655,6 +655,20 @@ def test_two_sweeps_never_write_one_folder_at_once(tiny, tmp_path):
     assert run_sweep(spec, serial=True, out=tmp_path).ran == 1
 
 
+def test_a_folder_another_sweep_holds_is_refused_before_the_bar(tiny, tmp_path, capsys):
+    """The second sweep drew 'sweep 0/1 starting; a first run compiles kernels' before
+    it was refused."""
+    fcntl = pytest.importorskip("fcntl")
+    from cli_support import one_error_line
+    from ladartui.cli import main
+
+    spec = write_spec(tiny, "[grid]\nscans = [2]\n", name="held.toml")
+    with open(tmp_path / ".lock", "a+b") as held:
+        fcntl.flock(held, fcntl.LOCK_EX)
+        assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path)]) == 2
+    assert "another sweep is writing its results here" in one_error_line(capsys)
+
+
 def test_the_best_scenario_file_does_not_carry_the_base_files_comments(tmp_path):
     from ladartui.scenario import load_scenario
     from ladartui.sweep.best_file import write_best_scenario

@@ -256,12 +256,16 @@ CHART_NAMES = ("pareto.svg", "pareto.png")
 def check_sweep_files(out: Path, name: str) -> None:
     """``OutputFileError`` naming a file the sweep keeps in ``out`` that it could not
     write (a folder, a pipe or a device there, say), before any variant runs: a pipe
-    would be waited on for ever when read, or replaced by a file when written."""
+    would be waited on for ever when read, or replaced by a file when written; and
+    ``InputFileError`` when another sweep holds the folder now."""
     from ladartui.outputset import check_writable
 
     check_writable(
         *(out / file for file in (LOCK_NAME, RESULTS_NAME, RANKING_NAME, f"{name}-best.toml", *CHART_NAMES))
     )
+    if (out / LOCK_NAME).is_file():  # held now: said before a bar or a cluster starts
+        with _exclusive(out):
+            pass
 
 
 SIMULATE_OPTIONS = ("backend", "method", "step", "precision")
