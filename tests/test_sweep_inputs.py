@@ -634,20 +634,32 @@ def test_a_spec_naming_itself_as_its_scenario_is_told_on_that_line(tmp_path, cap
     )
 
 
+def _swept_then_edited(folder, capsys, name, edit):
+    """A two-variant sweep NAME.toml run in ``folder``, then its results.csv lines
+    changed by ``edit(lines)`` as a hand or a crash would: (spec, results path)."""
+    from ladartui.cli import main
+
+    write_tiny_scenario(folder)
+    spec = write_spec(folder, "[grid]\nradius = [20.0, 30.0]\n", name=f"{name}.toml")
+    assert main(["sweep", str(spec), "--serial"]) == 0
+    results = folder / f"{name}-results" / "results.csv"
+    lines = results.read_text(encoding="utf-8").splitlines()
+    edit(lines)
+    results.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    capsys.readouterr()
+    return spec, results
+
+
 def test_rows_the_table_cannot_read_are_named_not_dropped_silently(tmp_path, capsys):
     """A row cut short in results.csv vanished from --show without a word."""
     import json
 
     from ladartui.cli import main
 
-    write_tiny_scenario(tmp_path)
-    spec = write_spec(tmp_path, "[grid]\nradius = [20.0, 30.0]\n", name="torn.toml")
-    assert main(["sweep", str(spec), "--serial"]) == 0
-    results = tmp_path / "torn-results" / "results.csv"
-    lines = results.read_text(encoding="utf-8").splitlines()
-    lines[2] = lines[2][:40]  # the second row, torn
-    results.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    capsys.readouterr()
+    def torn(lines):
+        lines[2] = lines[2][:40]  # the second row, torn
+
+    spec, results = _swept_then_edited(tmp_path, capsys, "torn", torn)
     assert main(["sweep", str(spec), "--show"]) == 0
     out = capsys.readouterr().out
     assert "1 row of results.csv could not be read (line 3) and is left out" in out
@@ -666,14 +678,10 @@ def test_a_row_of_a_status_no_sweep_writes_says_so_not_none(tmp_path, capsys):
     """A status edited by hand ('okay') read '1 variant failed ...; first: ID: None'."""
     from ladartui.cli import main
 
-    write_tiny_scenario(tmp_path)
-    spec = write_spec(tmp_path, "[grid]\nradius = [20.0, 30.0]\n", name="edited.toml")
-    assert main(["sweep", str(spec), "--serial"]) == 0
-    results = tmp_path / "edited-results" / "results.csv"
-    lines = results.read_text(encoding="utf-8").splitlines()
-    lines[1] = lines[1].replace(",ok,", ",okay,", 1)
-    results.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    capsys.readouterr()
+    def edited(lines):
+        lines[1] = lines[1].replace(",ok,", ",okay,", 1)
+
+    spec, _ = _swept_then_edited(tmp_path, capsys, "edited", edit=edited)
     assert main(["sweep", str(spec), "--show"]) == 0
     out = capsys.readouterr().out.replace("\n", " ")
     assert "status 'okay', not one a sweep writes (ok, failed, error)" in out and ": None" not in out
