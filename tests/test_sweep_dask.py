@@ -108,9 +108,9 @@ def test_only_a_few_variants_wait_submitted_ahead_of_the_workers(
 ):
     """Every variant was submitted at once: 100,000 futures held 800 MB and a Ctrl-C
     waited while the scheduler cancelled them all."""
-    import ladartui.sweep.execute as execute
+    import ladartui.sweep.dask_runs as dask_runs
 
-    monkeypatch.setattr(execute, "_tasks_ahead", lambda client: 3)
+    monkeypatch.setattr(dask_runs, "tasks_ahead", lambda client: 3)
     held = []
 
     def count_futures(progress):

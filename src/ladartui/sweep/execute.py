@@ -1,10 +1,11 @@
 """Running a sweep: resume, Dask (a local cluster or a scheduler address), the result files.
 
 Every variant runs the same function, ``run_variant``, whether in this process
-(``serial=True``) or on a Dask worker, so both give the same rows. The base
-scene is loaded once here and scattered to every worker once (broadcast); each
-task gets a reference to the worker's copy, never the arrays themselves, and
-the occupancy built by the first variant on a worker is reused by the rest.
+(``serial=True``) or on a Dask worker (``dask_runs``), so both give the same
+rows. The base scene is loaded once here and scattered to every worker once
+(broadcast); each task gets a reference to the worker's copy, never the arrays
+themselves, and the occupancy built by the first variant on a worker is reused
+by the rest.
 """
 
 from __future__ import annotations
@@ -14,7 +15,6 @@ import dataclasses
 import math
 import numbers
 import time
-import uuid
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -33,6 +33,7 @@ from ladartui.precompile import compile_ahead
 from ladartui.sweep.base import CheckedBase, checked_base, own_rows, spec_rows
 from ladartui.sweep.best_file import best_files, write_best_scenario
 from ladartui.sweep.cluster import check_local_workers, close_client, local_client
+from ladartui.sweep.dask_runs import run_on_dask
 from ladartui.sweep.ranking import (
     BUDGET_OBJECTIVES,
     COSTS,
@@ -43,15 +44,13 @@ from ladartui.sweep.ranking import (
 )
 from ladartui.sweep.spec import SweepSpec, load_sweep_spec
 from ladartui.sweep.table import TableWriter, read_table, table_text
-from ladartui.sweep.variant import ScenePayload, run_variant
+from ladartui.sweep.variant import run_variant
 
 RESULTS_NAME = "results.csv"
 RANKING_NAME = "ranking.csv"
 LOCK_NAME = ".lock"  # held while a sweep writes the folder's tables
 # Rows with these statuses are final; "failed" rows (a crash, a lost worker) run again.
 FINAL_STATUSES = ("ok", "error")
-_POLL_SECONDS = 0.05
-_AHEAD_SECONDS = 1.0  # how often the cluster's threads are counted again
 
 
 @dataclass
@@ -418,7 +417,7 @@ def _run_todo(todo, digest, base, scene, client, cancel, workers, serial, simula
         client = local_client(workers)
     try:
         ran_on = len(client.scheduler_info(n_workers=-1).get("workers", {}))
-        _run_on_dask(client, todo, base, digest, scene(), options, record, cancel)
+        run_on_dask(client, todo, base, digest, scene(), options, record, cancel)
         return ran_on, client.scheduler.address
     finally:
         if owned:
@@ -432,80 +431,6 @@ def _run_serial(todo, base, digest, scene, options, record, cancel):
         if cancel is not None:
             run_options["cancel"] = cancel
         record(run_variant(base, variant.params, variant.id, digest, scene, run_options))
-
-
-def _lost_row(variant, digest, future) -> dict:
-    try:
-        error = future.exception(timeout=5)
-        message = f"{type(error).__name__}: {error}"
-    except Exception as reason:  # noqa: BLE001 - the future itself may be gone
-        message = f"task {future.status}: {reason}"
-    return {"variant": variant.id, "status": "failed", "base": digest, **variant.params, "error": message}
-
-
-def _run_on_dask(client, todo, base, digest, scene, options, record, cancel):
-    """Run ``todo`` on ``client``'s workers, a few tasks ahead of them: submitting
-    every variant at once held 100,000 futures (800 MB here) and made a Ctrl-C wait
-    while the scheduler cancelled them all."""
-    from distributed import as_completed
-
-    # Plain arrays once to every worker; each rebuilds the Scene once per token.
-    payload = ScenePayload.of(scene, uuid.uuid4().hex)
-    scene_future = client.scatter(payload, broadcast=True, hash=False)
-    tag = uuid.uuid4().hex[:8]
-    waiting = iter(todo)
-    pending: dict = {}
-    completed = as_completed(loop=client.loop)  # this client's, not the default one's
-    ahead = {"tasks": 0, "asked": -math.inf}
-
-    def submit_more():
-        if time.monotonic() - ahead["asked"] >= _AHEAD_SECONDS:  # a round trip: not every batch
-            ahead.update(tasks=_tasks_ahead(client), asked=time.monotonic())
-        while len(pending) < ahead["tasks"] and (variant := next(waiting, None)) is not None:
-            future = client.submit(
-                run_variant,
-                base,
-                variant.params,
-                variant.id,
-                digest,
-                scene_future,
-                options,
-                pure=False,
-                key=f"ladartui-variant-{variant.id}-{tag}",
-            )
-            pending[future] = variant
-            completed.add(future)
-
-    try:
-        submit_more()
-        while pending:
-            check_cancelled(cancel, "sweep cancelled")
-            batch = completed.next_batch(block=False)
-            if not batch:
-                time.sleep(_POLL_SECONDS)
-                continue
-            for future in batch:
-                # A batch may hold many finished variants: honour a cancel set
-                # while recording them (they run again on resume).
-                check_cancelled(cancel, "sweep cancelled")
-                variant = pending.pop(future)
-                if future.status == "finished":
-                    row = future.result()
-                else:
-                    row = _lost_row(variant, digest, future)
-                record(row)
-            submit_more()
-    finally:
-        if pending:
-            client.cancel(list(pending))
-        scene_future.release()
-
-
-def _tasks_ahead(client) -> int:
-    """Tasks kept submitted: four per worker thread the cluster has now (workers that
-    join later get theirs as tasks finish), at least 16."""
-    workers = client.scheduler_info(n_workers=-1).get("workers", {})
-    return max(16, 4 * sum(int(w.get("nthreads", 1)) for w in workers.values()))
 
 
 def write_ranking(path, ranking: list[Ranked], parameter_names) -> Path:
