@@ -251,14 +251,14 @@ def test_the_table_writer_spaces_its_rewrites_and_loses_no_row(tmp_path, monkeyp
 
     now = [0.0]
     writes = []
-    real = table.write_text_atomically
+    real = table.write_text_atomic
 
-    def slow_write(path, text):
+    def slow_write(path, text, durable=False):
         writes.append(text.count("\n") - 1)
         now[0] += 1.0  # each rewrite takes a second
-        real(path, text)
+        real(path, text, durable)
 
-    monkeypatch.setattr(table, "write_text_atomically", slow_write)
+    monkeypatch.setattr(table, "write_text_atomic", slow_write)
     path = tmp_path / "results.csv"
     writer = TableWriter(path, [], [], spacing=9.0, clock=lambda: now[0])
     for i in range(40):

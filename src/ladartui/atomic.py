@@ -48,13 +48,19 @@ def _default_mode(target: Path) -> int:
     return 0o666 & ~umask
 
 
-def write_bytes_atomic(target, data: bytes):
+def write_bytes_atomic(target, data: bytes, durable: bool = False):
+    """``data`` as ``target``, whole or not at all; ``durable``: on the disk (fsync)
+    before it takes the name, so a crash of the machine leaves the old file or the new."""
     with atomic_path(target) as tmp:
-        tmp.write_bytes(data)
+        with open(tmp, "wb") as handle:
+            handle.write(data)
+            if durable:
+                handle.flush()
+                os.fsync(handle.fileno())
 
 
-def write_text_atomic(target, text: str):
-    write_bytes_atomic(target, text.encode("utf-8"))
+def write_text_atomic(target, text: str, durable: bool = False):
+    write_bytes_atomic(target, text.encode("utf-8"), durable)
 
 
 def numbered_paths(path, most: int | None = None):

@@ -18,11 +18,10 @@ import csv
 import io
 import json
 import math
-import os
 import time
 from pathlib import Path
 
-from ladartui.atomic import atomic_path, write_errors_named
+from ladartui.atomic import write_errors_named, write_text_atomic
 from ladartui.errors import InputFileError
 from ladartui.fileprobe import read_utf8
 
@@ -157,16 +156,7 @@ def _row_line(row, columns) -> str:
 
 def write_table(path, rows, parameter_names=()) -> None:
     """Replace ``path`` with the table of ``rows``: temporary file, fsync, rename."""
-    write_text_atomically(path, table_text(rows, parameter_names))
-
-
-def write_text_atomically(path, text: str) -> None:
-    data = text.encode("utf-8")
-    with atomic_path(path) as tmp:
-        with open(tmp, "wb") as handle:
-            handle.write(data)
-            handle.flush()
-            os.fsync(handle.fileno())
+    write_text_atomic(path, table_text(rows, parameter_names), durable=True)
 
 
 # A rewrite waits this many times the last one's duration after it: at most a tenth
@@ -195,6 +185,8 @@ class TableWriter:
         self.clock = clock
         self._position = {(row["variant"], row.get("base")): i for i, row in enumerate(self.rows)}
         self._lines: list[str] | None = None  # formatted on the first put
+        self._columns: list[str] = []
+        self._known: set[str] = set()  # the columns, to look up
         self._held = False  # rows put since the last write
         self._next_write = 0.0  # clock() from which a rewrite may start
         self.written = False  # whether the file was rewritten
@@ -234,11 +226,12 @@ class TableWriter:
     def flush(self) -> None:
         """Write the rows held back, if any; ``OutputFileError`` naming the table when it
         cannot be written."""
-        if not self._held or self._lines is None:
+        if not self._held:  # (rows are held only once put formatted them)
             return
         started = self.clock()
         with write_errors_named(self.path):
-            write_text_atomically(self.path, _csv_line(self._columns) + "".join(self._lines))
+            text = _csv_line(self._columns) + "".join(self._lines or ())
+            write_text_atomic(self.path, text, durable=True)
         finished = self.clock()
         self._next_write = finished + self.spacing * (finished - started)
         self._held, self.written = False, True
