@@ -228,6 +228,8 @@ def run(args) -> int:
             spec=own,
         )
         result.parameter_names = spec.parameter_names
+        # it ranks as asked, and writes nothing: the folder stays one set
+        _say_folder_unchanged(errors, result.results_path.parent, spec.name)
     else:
         from ladartui.outputset import check_writable_folder
         from ladartui.sweep.base import checked_base
@@ -239,8 +241,6 @@ def run(args) -> int:
         result = _sweep_with_progress(checked, args, errors)
         if result is None:
             return stop_status()
-    if args.show:  # it ranks as asked, and writes nothing: the folder stays one set
-        _say_folder_unchanged(errors, result.results_path.parent)
     from ladartui.cli.sweep_report import result_dict, show_result
 
     if args.json:
@@ -359,15 +359,14 @@ def _sweep_with_progress(checked, args, console):
     return None
 
 
-def _say_folder_unchanged(errors, folder: Path) -> None:
+def _say_folder_unchanged(errors, folder: Path, name: str) -> None:
     """What --show leaves: the ranking files the folder holds, as the last sweep wrote
     them (by the terms it ranked by, which --show's may not be)."""
-    names = [
-        path.name
-        for path in (folder / "ranking.csv", folder / "pareto.svg", folder / "pareto.png")
-        if path.exists()
-    ]
-    names += sorted(path.name for path in folder.glob("*-best.toml"))
+    from ladartui.sweep.best_file import best_files
+    from ladartui.sweep.execute import CHART_NAMES, RANKING_NAME
+
+    names = [file for file in (RANKING_NAME, *CHART_NAMES) if (folder / file).exists()]
+    names += [path.name for path in best_files(folder, name)]
     if names:
         errors.print(
             single_line(
