@@ -187,10 +187,11 @@ class Scenario:
 
     def _clock_text(self) -> str:
         """How the flight time is reckoned: at the speed, or by a flight log's own clock."""
-        logs = [hasattr(segment, "leg_seconds") for segment in self.flight.segments]
-        if not any(logs):
+        from ladartui.flight.plan import keeps_own_clock
+
+        if not any(map(keeps_own_clock, self.flight.segments)):
             return f"at {self.speed:g} m/s"
-        if all(logs) and len(logs) == 1:
+        if self.flight.one_log:
             return "by the flight log's clock"
         return f"by the flight logs' clock, other legs at {self.speed:g} m/s"
 

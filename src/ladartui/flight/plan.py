@@ -374,14 +374,19 @@ class FlightPlan:
                     None,
                 )
             legs = segment.legs(poses)
-            clock = getattr(segment, "leg_seconds", None)
-            yield from zip(legs, clock(poses) if clock is not None else [None] * len(legs))
+            seconds = segment.leg_seconds(poses) if keeps_own_clock(segment) else [None] * len(legs)
+            yield from zip(legs, seconds)
             previous = poses[-1]
+
+    @property
+    def one_log(self) -> bool:
+        """Whether the plan is one flight log alone: its times are the log's whatever the speed."""
+        return len(self.segments) == 1 and keeps_own_clock(self.segments[0])
 
     def scan_times(self, speed: float) -> list[float]:
         """Seconds flown from the first scan to each scan: a flight log's scans at the
         log's own times, every other step at ``speed`` metres per second."""
-        flight_time(0.0, speed)  # the speed checked, scans or none
+        speed = number_field("speed", speed, 0.0, None, low_open=True)  # scans or none
         times, metres_at_speed, clocked = [], 0.0, 0.0
         for metres, seconds in self._steps():
             if seconds is None:
@@ -396,6 +401,12 @@ class FlightPlan:
         """Seconds from the first scan to the last (``scan_times``)."""
         times = self.scan_times(speed)
         return times[-1] if times else 0.0
+
+
+def keeps_own_clock(segment) -> bool:
+    """Whether ``segment`` times its scans itself (a flight log's ``leg_seconds``), not by
+    the plan's speed."""
+    return callable(getattr(segment, "leg_seconds", None))
 
 
 def _prefixed(error: FieldError, prefix: str) -> FieldError:

@@ -243,8 +243,7 @@ def apply_parameters(base, params: dict, scene_loader=lambda: None):
 def _check_speed_matters(flight, speed) -> None:
     """A flight that is one flight log keeps the log's clock: every speed gives the same
     variant, ranked as many."""
-    segments = flight.segments
-    if len(segments) == 1 and hasattr(segments[0], "leg_seconds"):
+    if flight.one_log:
         raise FieldError(
             "speed",
             speed,
