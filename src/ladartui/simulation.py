@@ -417,7 +417,8 @@ def check_output_names(scenario, las=False) -> None:
 
 
 def check_outputs_spare_inputs(scenario, las=False) -> None:
-    """Refuse a run whose outputs would overwrite its own model files.
+    """Refuse a run whose outputs would overwrite its own model files or flight logs
+    (paths compared resolved: a link to an output's name is that output).
 
     A scenario ``S.toml`` writes ``S_Target.txt``: with the scene model named
     ``S.txt`` beside it, that is the target model itself. Nor may a run replace

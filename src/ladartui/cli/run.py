@@ -201,10 +201,10 @@ def _simulate_with_progress(scenario, args, console, finished: list):
     cancel = threading.Event()
     with run_progress(console, transient=False) as bar:
         task = bar.add_task(first_scan(scenario), total=1.0, rays="")
-        traced = []  # whether a scan's progress came
+        traced = threading.Event()  # a scan's progress came
 
         def report(p):
-            traced.append(True)
+            traced.set()
             bar.update(
                 task,
                 completed=p.fraction,
@@ -220,7 +220,7 @@ def _simulate_with_progress(scenario, args, console, finished: list):
                 scenario, progress=report, cancel=cancel, write=args.write, las=args.las, scene=scene
             )
 
-        with sigterm_as_interrupt(), bar_hidden_if_refused(bar, task, lambda: bool(traced)):
+        with sigterm_as_interrupt(), bar_hidden_if_refused(bar, task, traced.is_set):
             finished.append(run_cancellable(work, cancel, "ladartui-run", Cancelled(NOTHING_WRITTEN)))
     return finished[0]
 
