@@ -1,8 +1,9 @@
 """Content fingerprints of input files: the size and SHA-256 of their bytes.
 
 A run record keeps one for each file the run read (scene and target models,
-flight logs), so that ``validate`` can name a file changed since the run. The
-loaders hash the bytes as they read them (``Digest``): nothing is read twice.
+flight logs) and wrote (its outputs), so that ``validate`` can name a file
+changed since the run. The loaders hash the bytes as they read them
+(``Digest``): nothing is read twice.
 """
 
 from __future__ import annotations

@@ -21,6 +21,7 @@ A file of that name that is not a record (its first line is not
 
 from __future__ import annotations
 
+import os
 import re
 import tomllib
 from collections.abc import Callable
@@ -38,7 +39,6 @@ from ladartui.trajectory import LogSegment
 __all__ = [
     "RECORD_HEADER",
     "InputFile",
-    "changed_outputs",
     "input_changes",
     "inputs_changed",
     "is_record",
@@ -46,6 +46,7 @@ __all__ = [
     "recorded_inputs",
     "recorded_outputs",
     "outputs_changed",
+    "replaced_outputs",
     "run_inputs",
     "setting_changes",
 ]
@@ -158,19 +159,26 @@ def outputs_changed(scenario) -> list[str]:
     be read is not named here: ``missing_outputs`` names it)."""
     return [
         f"{path.name} changed since the run wrote it: it is not the run's output"
-        for path in changed_outputs(scenario.run_record)
+        for path in replaced_outputs(scenario.run_record)
     ]
 
 
-def changed_outputs(record: Path) -> list[Path]:
-    """The outputs the record at ``record`` fingerprints whose bytes on disk differ now
-    (``outputs_changed``), for a reader holding an output rather than its scenario.
-    ``LadarError`` naming the record when it cannot be read."""
+def replaced_outputs(record: Path, only=None, known=None) -> list[Path]:
+    """The outputs the record at ``record`` fingerprints whose bytes on disk differ now,
+    for a reader holding an output rather than its scenario: ``only`` those of these
+    paths, if given (the others are not read); ``known``: fingerprints already taken,
+    by path (a file just read is not read again). ``LadarError`` naming the record
+    when it cannot be read."""
     from ladartui.fingerprint import file_fingerprint
 
+    wanted = None if only is None else {os.path.abspath(path) for path in only}
+    known = {os.path.abspath(path): fingerprint for path, fingerprint in (known or {}).items()}
     changed = []
     for entry in _recorded(record, "outputs", tuple(OUTPUT_ROLES.values()), optional=True) or ():
-        now = file_fingerprint(entry.path)
+        where = os.path.abspath(entry.path)
+        if wanted is not None and where not in wanted:
+            continue
+        now = known[where] if where in known else file_fingerprint(entry.path)
         if now is not None and now != entry.fingerprint:
             changed.append(entry.path)
     return changed

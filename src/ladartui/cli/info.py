@@ -103,6 +103,7 @@ def print_scenario(path: Path) -> None:
 
 
 def print_voxel_list(path: Path, voxel_size=None) -> None:
+    from ladartui.fingerprint import Digest
     from ladartui.scene.keys import count_inside
     from ladartui.scene.model import target_path_for
     from ladartui.scene.occupancy import column_bounds
@@ -113,16 +114,18 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
         from ladartui.cli.flags import voxel_size_flag
 
         voxel_size_flag(voxel_size)  # as trace takes it: not inf, not 1e308
-    started = time.perf_counter()
     ids = None
-    output = _run_output(path)
-    is_target_model = path.stem.endswith("_Target") and output is None
+    record = _run_record_beside(path)
+    is_target_model = path.stem.endswith("_Target") and record is None
+    started = time.perf_counter()
+    digest = Digest()  # the bytes hashed as they are read: an output is read once
     if is_target_model:  # x,y,z or x,y,z,id lines
-        voxels, ids = load_target(path)
+        voxels, ids = load_target(path, digest)
         duplicates = 0
     else:
-        voxels, duplicates = load_voxels_counted(path)
+        voxels, duplicates = load_voxels_counted(path, digest=digest)
     loaded = time.perf_counter() - started
+    output = None if record is None else _run_output(path, record, digest.fingerprint())
     rows = [
         (
             "voxels",
@@ -170,42 +173,43 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
         print(single_line(f"  {name:<{width}}  {text}"))
 
 
-def _run_output(path: Path) -> str | None:
-    """What a run's output S_Scene.txt or S_Target.txt is, where its record S_Run.toml lies
-    beside it (and whether it, or its fellow, changed since the run wrote it, as validate
-    says); None for any other voxel list."""
-    import os
-
-    from ladartui.run_record import changed_outputs
+def _run_record_beside(path: Path) -> Path | None:
+    """The run record S_Run.toml beside a run's output S_Scene.txt or S_Target.txt; None
+    for any other voxel list."""
     from ladartui.scenario_file import RECORD_SUFFIX, is_record
 
-    for run, other, what, others in (
-        ("_Scene", "_Target", "scene", "target"),
-        ("_Target", "_Scene", "target", "scene"),
-    ):
-        if not path.stem.endswith(run):
-            continue
-        stem = path.stem.removesuffix(run)
-        record = path.with_name(stem + RECORD_SUFFIX)
-        if not is_record(record):
-            return None
-        try:
-            changed = {os.path.abspath(output) for output in changed_outputs(record)}
-        except LadarError as error:
-            return f"named as an output of a run of {stem}.toml, but {error}"
-        if os.path.abspath(path) in changed:
-            return (
-                f"changed since the run of {stem}.toml wrote it ({record.name}): it is not the run's output"
-            )
-        fellow = path.with_name(f"{stem}{other}{path.suffix}")
-        if not fellow.is_file():
-            said = f"{fellow.name}, the {others} run's, is not there"
-        elif os.path.abspath(fellow) in changed:
-            said = f"{fellow.name}, the {others} run's, changed since"
-        else:
-            said = f"{fellow.name}: the {others} run's"
-        return f"the {what} run's returns of a run of {stem}.toml ({record.name}); {said}"
+    for run in ("_Scene", "_Target"):
+        if path.stem.endswith(run):
+            record = path.with_name(path.stem.removesuffix(run) + RECORD_SUFFIX)
+            return record if is_record(record) else None
     return None
+
+
+def _run_output(path: Path, record: Path, fingerprint) -> str:
+    """What the run output ``path`` (its bytes' ``fingerprint`` as just read) is, and
+    whether it, or its fellow, changed since the run wrote it, as validate says."""
+    import os
+
+    from ladartui.run_record import replaced_outputs
+
+    scene = path.stem.endswith("_Scene")
+    stem = path.stem.removesuffix("_Scene" if scene else "_Target")
+    what, others = ("scene", "target") if scene else ("target", "scene")
+    fellow = path.with_name(f"{stem}{'_Target' if scene else '_Scene'}{path.suffix}")
+    try:
+        replaced = replaced_outputs(record, only=(path, fellow), known={path: fingerprint})
+    except LadarError as error:
+        return f"named as an output of a run of {stem}.toml, but {error}"
+    changed = {os.path.abspath(output) for output in replaced}
+    if os.path.abspath(path) in changed:
+        return f"changed since the run of {stem}.toml wrote it ({record.name}): it is not the run's output"
+    if not fellow.is_file():
+        said = f"{fellow.name}, the {others} run's, is not there"
+    elif os.path.abspath(fellow) in changed:
+        said = f"{fellow.name}, the {others} run's, changed since"
+    else:
+        said = f"{fellow.name}: the {others} run's"
+    return f"the {what} run's returns of a run of {stem}.toml ({record.name}); {said}"
 
 
 def _targets_text(ids) -> str:
