@@ -80,7 +80,7 @@ class NumberField(Input):
         **kwargs,
     ):
         kwargs.setdefault("compact", True)
-        # six digits until mounted: a form's check reads fields not built yet
+        # six digits: a form's check reads fields not built yet (set_number, once they are)
         super().__init__(value=format_number(value, integer, scale), **kwargs)
         self.field_name = name
         self.default = default
@@ -89,16 +89,7 @@ class NumberField(Input):
         self.scale = scale
         self.optional = optional
         self.committed = self.value
-        self._first = value
-
-    def on_mount(self) -> None:
-        self.call_after_refresh(self._show_first)
-
-    def _show_first(self) -> None:
-        """The first value with the digits ``_text`` gives, once the form around is built
-        (unless typing has begun)."""
-        if self.value == self.committed:
-            self.value = self.committed = self._text(self._first)
+        self._shown: tuple[Any, str] | None = None  # the last value set and its text
 
     def parsed(self):
         """The typed value (None for an empty optional field); FieldError if not allowed."""
@@ -140,8 +131,10 @@ class NumberField(Input):
         """``format_number``'s text, or more digits where its six would round the value
         onto one the field refuses (fov 89.99999 shown as 90, which is not allowed)."""
         text = format_number(value, self.integer, self.scale)
-        if value is None or self.integer or float(text) * self.scale == float(value):
-            return text  # shown as it is: nothing to check
+        if value is None or self.integer or float(text) == float(f"{float(value) / self.scale:.15g}"):
+            return text  # the value as it is (to the digits a float holds): nothing to check
+        if self._shown is not None and self._shown[0] == value:
+            return self._shown[1]  # a refresh of the same value: not checked again
         for digits in (9, 12, 17):
             try:
                 self.check(parse_number(self.field_name, text, self.integer, self.scale))
@@ -151,8 +144,8 @@ class NumberField(Input):
         return text
 
     def set_number(self, value) -> None:
-        self._first = value  # (shown so already, should the first showing come later)
         self.value = self._text(value)
+        self._shown = (value, self.value)
         self.committed = self.value
         self.remove_class("-bad")
 

@@ -225,6 +225,11 @@ class FormScreen(Dialog):
         fields = self.query(".form Input, .form Select")
         if fields:
             fields.first().focus()
+        # the values again, now that the checks can read every field: one that six digits
+        # would round onto a refused value gets more
+        for name, _label, kind, value, _default in self.spec:
+            if kind in ("int", "float", "optional"):
+                self.query_one(f"#f-{name}", NumberField).set_number(value)
 
     def _checker(self, name):
         def check(value):
