@@ -64,10 +64,13 @@ class StatusBar(Horizontal):
     StatusBar #cancel { min-width: 10; }
     """
 
-    def __init__(self, tell: Callable[[str], None] | None = None, **kwargs: Any) -> None:
-        """``tell``: says a not-ready message whole, once, when the line has to cut it
-        (why Run is off must not be cut away)."""
+    def __init__(
+        self, tell: Callable[[str], None] | None = None, tell_states=(NOT_READY,), **kwargs: Any
+    ) -> None:
+        """``tell``: says a message of one of ``tell_states`` whole, once, when the line
+        has to cut it (why Run is off must not be cut away)."""
         super().__init__(**kwargs)
+        self.tell_states = frozenset(tell_states)
         self.state = NOT_READY
         self.message = ""
         self.progress: float | None = None
@@ -101,7 +104,7 @@ class StatusBar(Horizontal):
         self.query_one("#status-word", Static).update(word)
         self.query_one("#cancel", Button).disabled = not cancellable
         self.query_one(StatusText).show(message, name)
-        if state != NOT_READY:
+        if state not in self.tell_states:
             self.told = ""
         elif self.tell is not None and message != self.told:
             self.call_after_refresh(self._tell_if_cut, message)

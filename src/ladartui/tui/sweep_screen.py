@@ -15,7 +15,6 @@ import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from rich.cells import cell_len
 from rich.text import Text
 from textual import on
 from textual.app import ComposeResult
@@ -30,7 +29,7 @@ from ladartui.errors import FieldError, LadarError
 from ladartui.recent import recent_paths, remember_path
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.tui.fields import refusal
-from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar, StatusText, format_eta
+from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar, format_eta
 from ladartui.tui.sweep_jobs import (
     StoredRows,
     in_form_words,
@@ -140,6 +139,7 @@ class SweepScreen(SweepOpening):
         self.view = "both"
         self.progress = None  # the last SweepProgress
         self.last_message = ""
+        self._problem = False  # the message shown is an error
         self.running = False
         self.left_running = False  # Esc left the screen while a sweep ran (and cancelled it)
         self.worker: Worker | None = None  # the sweep job while it runs
@@ -198,7 +198,9 @@ class SweepScreen(SweepOpening):
             yield DataTable(id="sweep-table", cursor_type="row", zebra_stripes=True)
             yield PlotextPlot(id="sweep-chart")
         yield Static("", id="sweep-detail")
-        yield StatusBar(id="sweep-status")
+        # a message the line cuts comes whole as a note (a scheduler's error runs to 200
+        # characters; why F6 skipped an objective comes last), a busy sweep's progress aside
+        yield StatusBar(id="sweep-status", tell=self._tell_cut, tell_states=(NOT_READY, READY))
         yield Footer(compact=True)
 
     def on_mount(self) -> None:
@@ -542,27 +544,17 @@ class SweepScreen(SweepOpening):
         cancellable: bool = False,
         problem: bool = False,
     ) -> None:
-        """A message the status line has to cut also comes whole as a note (a
-        scheduler's error runs to 200 characters; why F6 skipped an objective comes
-        last), unless it is a running sweep's progress; ``problem``: an error."""
+        """Show ``message`` on the status line; ``problem``: an error (its note, should
+        the line cut it, says so)."""
         message = " ".join(message.split())  # always one line
-        self.last_message = message
+        self.last_message, self._problem = message, problem
         bar = self.query_one("#sweep-status", StatusBar)
         bar.show(state, message, progress, cancellable or self.running)
-        self._note_if_cut(state, message, problem)
 
-    def _note_if_cut(self, state: str, message: str, problem: bool, tries: int = 3) -> None:
-        if message != self.last_message:  # another came since: this one is gone
-            return
-        width = self.query_one("#sweep-status", StatusBar).query_one(StatusText).content_size.width
-        if not width:  # not laid out yet (on mount): every message would read as cut
-            if tries:
-                self.call_after_refresh(self._note_if_cut, state, message, problem, tries - 1)
-            return
-        cut = cell_len(message) > width
-        if cut and problem:
+    def _tell_cut(self, message: str) -> None:
+        if self._problem:
             self.notify(message, severity="error", markup=False, timeout=15)
-        elif cut and state != BUSY:
+        else:
             self.notify(message, markup=False, timeout=8)
 
     # -- best path ----------------------------------------------------------------
