@@ -104,7 +104,6 @@ class LadarApp(
         self.load_worker = self.warm_worker = self.run_worker_handle = None  # the jobs
         self.new_pending: Scenario | None = None
         self.messages: list[str] = []
-        self.notes_shown, self.notes_held = [], []  # notes wait while a dialog is open
         self.leaving = False  # set by exit: news from jobs is no longer shown
         self.running = False
         self.tool_screen: Screen[None] | None = None  # the study or sweep screen while it is open

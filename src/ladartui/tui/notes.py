@@ -2,40 +2,28 @@
 
 Notes on screen when a dialog (a modal screen) opens wait, for the time they had
 left, and those told while one is open for their whole time, and show once the
-analyst is back on a screen that is no dialog. Meanwhile what they said stays where it matters: a refused
-field keeps its mark, the status bar its colour and reason.
+analyst is back on a screen that is no dialog. Meanwhile what they said stays
+where it matters: a refused field keeps its mark, the status bar its colour and
+reason.
 """
 
 from __future__ import annotations
 
-import time
-from dataclasses import dataclass, replace
-
-from textual.notifications import Notifications, SeverityLevel
+from textual.notifications import Notification, Notifications, SeverityLevel
 from textual.screen import ModalScreen, Screen
 from textual.widgets._toast import ToastRack  # (the rack of each screen: no public name)
 
 from ladartui.tui.host import Host
 
 
-@dataclass(frozen=True)
-class Note:
-    message: str
-    title: str
-    severity: SeverityLevel
-    timeout: float
-    markup: bool
-    until: float  # time.monotonic() when its toast goes
-
-
 class NoteKeeping(Host):
     """Mixed into ``LadarApp``: its notes wait while a dialog is open."""
 
-    notes_shown: list[Note]
-    notes_held: list[Note]
+    notes_held: list[Notification]
 
     def keep_notes_off_dialogs(self) -> None:
         """Start holding notes while a dialog is open (the app calls it on mount)."""
+        self.notes_held = []
         self.screen_change_signal.subscribe(self, self._screen_changed)
 
     def notify(
@@ -48,11 +36,9 @@ class NoteKeeping(Host):
         markup: bool = True,
     ) -> None:
         seconds = self.NOTIFICATION_TIMEOUT if timeout is None else timeout
-        note = Note(message, title, severity, seconds, markup, time.monotonic() + seconds)
         if self._dialog_open():
-            self.notes_held.append(note)
+            self.notes_held.append(Notification(message, title, severity, seconds, markup))
             return
-        self.notes_shown = [n for n in self.notes_shown if n.until > time.monotonic()] + [note]
         super().notify(message, title=title, severity=severity, timeout=seconds, markup=markup)
 
     def _dialog_open(self) -> bool:
@@ -69,11 +55,13 @@ class NoteKeeping(Host):
     def _hold_notes_shown(self) -> None:
         if not self._dialog_open():
             return
-        now = time.monotonic()
         # a note shown a while is held for the time it had left, not shown anew each time
-        left = [replace(n, timeout=n.until - now) for n in self.notes_shown if n.until > now]
+        left = [
+            Notification(n.message, n.title, n.severity, n.time_left, n.markup)
+            for n in self._notifications
+            if not n.has_expired
+        ]
         self.notes_held = left + self.notes_held
-        self.notes_shown = []
         self.clear_notifications()
         # the screens under the dialog keep drawing their toasts (Textual clears the top
         # one's only): behind a dialog near the top they showed, half covered
