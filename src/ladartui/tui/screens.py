@@ -219,6 +219,7 @@ class FormScreen(Dialog):
     FormScreen > .dialog { margin-top: 2; }
     FormScreen .form { height: auto; max-height: 16; }
     FormScreen #form-message { min-height: 2; }
+    FormScreen .buttons { margin-top: 0; }  /* the message keeps two lines above them */
     """
 
     def on_mount(self) -> None:
