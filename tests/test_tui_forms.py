@@ -72,7 +72,7 @@ async def test_a_new_scenario_whose_scene_cannot_be_read_is_not_written_and_its_
     (tmp_path / "bad_Target.txt").write_text("1,2,3\n", encoding="utf-8")
     async with opened(scenario) as (app, pilot):
         dialog = await screen_after(pilot, "f2", SetupScreen)
-        dialog.query_one("#scenario-file").value = "fresh.toml"
+        dialog.query_one("#scenario-file").value = "fresh"  # came back as "fresh.toml"
         dialog.query_one("#scene-file").value = "bad.txt"
         dialog.query_one("#voxel-size").value = "0.25"
         dialog.query_one("#setup-ok").press()
@@ -87,11 +87,7 @@ async def test_a_new_scenario_whose_scene_cannot_be_read_is_not_written_and_its_
         assert again.mode == "new"
         assert [
             again.query_one(f"#{name}").value for name in ("scenario-file", "scene-file", "voxel-size")
-        ] == [
-            "fresh.toml",
-            "bad.txt",
-            "0.25",
-        ]
+        ] == ["fresh", "bad.txt", "0.25"]
         assert message(again, "#setup-message").startswith(f"{tmp_path / 'bad.txt'}:2: z = 'abc'")
         assert app.scenario.path == scenario.path  # the one open before stays
 

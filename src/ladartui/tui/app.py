@@ -102,7 +102,7 @@ class LadarApp(
         self.busy: str | None = None
         self.progress: float | None = None
         self.load_worker = self.warm_worker = self.run_worker_handle = None  # the jobs
-        self.new_pending: Scenario | None = None
+        self.new_pending: tuple[Path, tuple[str, ...]] | None = None  # New's folder and fields
         self.messages: list[str] = []
         self.leaving = False  # set by exit: news from jobs is no longer shown
         self.running = False
@@ -485,8 +485,8 @@ class LadarApp(
                     self.run_panel.say(message.error)
                     # a recent scenario deleted since leaves the list (it lists files there are)
                     self.file_panel.show_recent(self.scenario.path if self.scenario else None)
-                if message.job == "new" and message.error and self.new_pending is not None:
-                    self.new_refused(self.new_pending, message.error)
+                if message.job == "new" and message.error:
+                    self.new_refused(message.error)
         elif message.job == "probe":
             self.backends_probed(
                 message.result

@@ -12,7 +12,6 @@ from pathlib import Path
 
 from ladartui.errors import LadarError
 from ladartui.recent import remember_scenario
-from ladartui.tui.fields import format_number
 from ladartui.tui.file_dialogs import SaveAsScreen, SetupScreen
 from ladartui.tui.host import Host
 
@@ -37,24 +36,24 @@ class FileActions(Host):
         )
 
     def _open_setup(self, mode: str, folder: Path | None = None, typed=None, said: str = "") -> None:
+        current = self.scenario.path if self.scenario is not None else None
+        setup = SetupScreen(mode, folder or self._folder(), current, typed, said)
+
         def done(scenario):
             if scenario is not None:
                 self.result = None
-                self.load(None, scenario=scenario, new=mode == "new")
+                # New's form comes back as typed should its scene prove unreadable
+                self.new_pending = (setup.folder, setup.typed) if setup.mode == "new" else None
+                self.load(None, scenario=scenario, new=setup.mode == "new")
 
-        current = self.scenario.path if self.scenario is not None else None
-        self.push_screen(SetupScreen(mode, folder or self._folder(), current, typed, said), done)
+        self.push_screen(setup, done)
 
-    def new_refused(self, scenario, error: str) -> None:
+    def new_refused(self, error: str) -> None:
         """A new scenario whose scene could not be read (nothing was written): its form
         again, as it was typed, saying why."""
-        folder = scenario.path.parent
-        try:
-            scene = str(Path(scenario.scene_file).relative_to(folder))
-        except ValueError:
-            scene = str(scenario.scene_file)
-        typed = (scenario.path.name, scene, format_number(scenario.voxel_size))
-        self._open_setup("new", folder, typed, error)
+        if self.new_pending is not None:
+            folder, typed = self.new_pending
+            self._open_setup("new", folder, typed, error)
 
     def open_path(self, path: Path, before: Callable[[], None] | None = None) -> None:
         """Open a scenario file (recent list, best sweep path), asking about unsaved edits;

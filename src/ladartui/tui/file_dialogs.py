@@ -39,12 +39,14 @@ class SetupScreen(TreeDialog):
     scene model, voxel size) and ``said`` when a new scenario's scene could not be read.
     """
 
+    prefilled_ids = ("scenario-file", "scene-file", "voxel-size")
+
     def __init__(
         self,
         mode: str = "new",
         folder: Path | None = None,
         current: Path | None = None,
-        typed: tuple[str, str, str] | None = None,
+        typed: tuple[str, ...] | None = None,
         said: str = "",
     ):
         super().__init__()
@@ -52,7 +54,8 @@ class SetupScreen(TreeDialog):
         self.current = current
         self.said = said
         # field id -> the text New's form comes back with; its Changed event clears nothing
-        self.prefilled = dict(zip(("scenario-file", "scene-file", "voxel-size"), typed or ()))
+        self.prefilled = dict(zip(self.prefilled_ids, typed or ()))
+        self.typed: tuple[str, ...] = ()  # the fields as OK took them
         self.base = folder or Path.cwd()
         self.folder = self.base
 
@@ -195,6 +198,8 @@ class SetupScreen(TreeDialog):
         except LadarError as error:
             message.update(str(error))
             return
+        # as typed, for the form to come back with should the scene prove unreadable
+        self.typed = tuple(self.query_one(f"#{name}", Input).value for name in self.prefilled_ids)
         self.dismiss(scenario)
 
     def _field_said(self, error: FieldError) -> str:

@@ -62,7 +62,7 @@ class AppHost(App[None]):
     progress: float | None
     running: bool
     load_worker: Worker[Any] | None
-    new_pending: Scenario | None  # New's scenario while its scene is read (written after)
+    new_pending: tuple[Path, tuple[str, ...]] | None  # New's folder and fields, as typed
     warm_worker: Worker[Any] | None
     run_worker_handle: Worker[Any] | None
     tool_screen: Screen[None] | None  # the study or sweep screen while it is open
@@ -168,7 +168,7 @@ class AppHost(App[None]):
     def load(self, path: Path | None, scenario: Scenario | None = None, new: bool = False) -> None:
         raise NotImplementedError
 
-    def new_refused(self, scenario: Scenario, error: str) -> None:
+    def new_refused(self, error: str) -> None:
         raise NotImplementedError
 
 

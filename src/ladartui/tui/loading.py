@@ -113,7 +113,6 @@ class SceneLoading(Host):
         ``new``: ``scenario`` is New's, written once its scene has been read (job "new")."""
         name = path.name if path else (scenario.path.name if scenario else "default scenario")
         self.set_busy(f"Loading {name}...")
-        self.new_pending = scenario if new else None
         self.load_worker = start_job(
             self, "new" if new else "load", lambda cancel, progress: _load(path, scenario, new)
         )
