@@ -161,3 +161,19 @@ def test_scene_survives_pickling():
     np.testing.assert_array_equal(copy.target, TARGET)
     assert (copy.shape, copy.voxel_size, copy.name) == ((10, 4, 20), 0.5, "p")
     np.testing.assert_array_equal(copy.column_tops()[1], scene.column_tops()[1])
+
+
+def test_a_scenes_bounds_are_found_once_however_many_ask(monkeypatch):
+    """Opening a scene passed over its voxels for their bounds three times: the memory
+    check, the views' memory check and the height map."""
+    import ladartui.scene.model as model
+
+    passes = []
+    real = model.column_bounds
+    monkeypatch.setattr(model, "column_bounds", lambda voxels: passes.append(len(voxels)) or real(voxels))
+    voxels = np.array([(5, 6, 1), (9, 2, 4), (7, 7, 0)], np.int32)
+    scene = model.Scene(voxels, voxels[:1], 1.0)
+    scene.tracing_bytes()
+    origin, heights = scene.column_tops()
+    assert scene.bounds()[0].tolist() == [5, 2, 0] and origin == (5, 2) and heights.shape == (5, 6)
+    assert sorted(passes) == [1, 3]  # the voxels once, the target once

@@ -48,7 +48,13 @@ class Scene:
         self.target = _as_voxel_array(target, "target")
         self.target_ids = _as_target_ids(target_ids, len(self.target))
         self.voxel_size = _checked_voxel_size(voxel_size)
-        needed = _extent(self.voxels, self.target)
+        # (lo, hi) by target or not: one pass over each list, however many ask (the
+        # extent here, the memory checks, the views)
+        self._bounds: dict[bool, tuple[np.ndarray, np.ndarray]] = {
+            target: column_bounds(v) for target, v in ((False, self.voxels), (True, self.target)) if len(v)
+        }
+        highest = [hi for _, hi in self._bounds.values()]
+        needed = tuple(int(v) + 1 for v in np.max(highest, axis=0)) if highest else (0, 0, 0)
         if shape is None:
             shape = needed
         shape = tuple(int(s) for s in shape)
@@ -163,7 +169,7 @@ class Scene:
         voxels = self.target if target else self.voxels
         if not len(voxels):
             return (0, 0), np.full((1, 1), -1, np.int32)
-        lo, hi = column_bounds(voxels)
+        lo, hi = self.bounds(target)
         origin = (int(lo[0]), int(lo[1]))
         nx, ny = int(hi[0] - lo[0]) + 1, int(hi[1] - lo[1]) + 1
         return origin, top_height_map(voxels, nx, ny, origin)
@@ -175,11 +181,19 @@ class Scene:
         from ladartui.resources import check_occupancy
 
         need = 0
-        for voxels, source in ((self.voxels, self.path), (self.target, self.target_path)):
+        for target, voxels, source in (
+            (False, self.voxels, self.path),
+            (True, self.target, self.target_path),
+        ):
             if len(voxels):
-                lo, last = column_bounds(voxels)  # int64: the far corner + 1 of 2**31 - 1 fits
+                lo, last = self.bounds(target)  # int64: the far corner + 1 of 2**31 - 1 fits
                 need += check_occupancy(lo, last + 1, len(voxels), str(source or self.name))
         return need
+
+    def bounds(self, target: bool = False) -> tuple[np.ndarray, np.ndarray]:
+        """The least and greatest index on each axis of the (non-empty) voxels, or of the
+        target's, as int64 (``column_bounds``, found as the scene was made)."""
+        return self._bounds[target]
 
     def __repr__(self):
         return (
@@ -226,11 +240,3 @@ def _as_target_ids(ids, count: int) -> np.ndarray:
 
 def _as_voxel_array(voxels, name) -> np.ndarray:
     return np.ascontiguousarray(voxel_list_field(name, voxels, np.iinfo(np.int32).max), dtype=np.int32)
-
-
-def _extent(*lists) -> tuple[int, int, int]:
-    filled = [v for v in lists if len(v)]
-    if not filled:
-        return (0, 0, 0)
-    x, y, z = np.max([column_bounds(v)[1] for v in filled], axis=0)
-    return (int(x) + 1, int(y) + 1, int(z) + 1)

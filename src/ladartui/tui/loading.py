@@ -257,11 +257,6 @@ class SceneLoading(Host):
 
 
 def _load(path: Path | None, scenario, new: bool = False) -> Loaded:
-    if new:  # written only once its scene is read and fits: a bad model leaves no file
-        scene = scenario.load_scene()
-        _check_memory(scenario, scene)
-        scenario = scenario.save()
-        return Loaded(scene, prepare_views(scene), _earlier(scenario, scene=scene), file_seen(scenario.path))
     if scenario is None:
         if path is None:
             from ladartui.user_data import default_scenario_path
@@ -273,6 +268,9 @@ def _load(path: Path | None, scenario, new: bool = False) -> Loaded:
         seen = file_seen(scenario.path)
     scene = scenario.load_scene()
     _check_memory(scenario, scene)
+    if new:  # written only once its scene is read and fits: a bad model leaves no file
+        scenario = scenario.save()
+        seen = file_seen(scenario.path)
     return Loaded(scene, prepare_views(scene), _earlier(scenario, scene=scene), seen)
 
 
@@ -282,12 +280,11 @@ def _check_memory(scenario, scene) -> None:
     column over the voxels' x-y extent) it cannot hold."""
     from ladartui.errors import ResourceLimitError
     from ladartui.resources import available_memory, gib
-    from ladartui.scene.occupancy import column_bounds
 
     scene.tracing_bytes()
     nx, ny = 0, 0  # the height map spans the scene's voxels' columns
     if len(scene.voxels):
-        lo, last = column_bounds(scene.voxels)
+        lo, last = scene.bounds()
         nx, ny = int(last[0] - lo[0]) + 1, int(last[1] - lo[1]) + 1
     need = VIEW_BYTES_PER_COLUMN * nx * ny
     if need > available_memory():
