@@ -21,10 +21,10 @@ SIZE = (100, 32)
 
 
 @asynccontextmanager
-async def opened(scenario, size=SIZE):
-    """The app on ``scenario``, loaded: (app, pilot)."""
+async def opened(scenario, size=SIZE, notifications=False):
+    """The app on ``scenario``, loaded: (app, pilot); ``notifications``: its notes drawn."""
     app = LadarApp(scenario.path)
-    async with app.run_test(size=size) as pilot:
+    async with app.run_test(size=size, notifications=notifications) as pilot:
         await wait_until(pilot, lambda: loaded(app))
         yield app, pilot
 

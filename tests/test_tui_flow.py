@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import dataclasses
 import re
-import time
 from pathlib import Path
 
 import numpy as np
@@ -29,7 +28,7 @@ from ladartui.tui.measures_screens import CompareScreen
 from ladartui.tui.measures_view import compact_rows, level_rows
 from ladartui.tui.screens import AngleScreen, FormScreen, HelpScreen
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar
-from tui_support import make_scenario
+from tui_support import make_scenario, wait_until
 
 
 class LadarApp(LadarApp):
@@ -41,18 +40,6 @@ class LadarApp(LadarApp):
 
 
 SIZE = (100, 32)
-
-
-async def wait_until(pilot, condition, timeout=300.0):
-    # generous: a cold numba cache compiles the tracing kernels during the first run
-    start = time.monotonic()
-    while not condition():
-        if time.monotonic() - start > timeout:
-            app = pilot.app
-            raise AssertionError(
-                f"timed out waiting for the app; busy={app.busy!r}, messages={app.messages[-3:]}"
-            )
-        await pilot.pause(0.05)
 
 
 @pytest_asyncio.fixture(loop_scope="module", scope="module")

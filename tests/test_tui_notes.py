@@ -2,23 +2,18 @@
 
 from __future__ import annotations
 
-from contextlib import asynccontextmanager
-
 from textual.widgets._toast import Toast
 
 from ladartui.tui.measures_screens import MeasuresScreen
 from ladartui.tui.screens import FormScreen
-from test_tui_flow import LadarApp, field, loaded, make_scenario, type_into, wait_until
+from test_tui_dialogs import opened
+from test_tui_flow import field, make_scenario, type_into, wait_until
 from tui_support import screen_after
 
 
-@asynccontextmanager
-async def opened_with_notes(scenario):
+def opened_with_notes(scenario):
     """The app on ``scenario`` at 80 x 24, loaded, its notes drawn: (app, pilot)."""
-    app = LadarApp(scenario.path)
-    async with app.run_test(size=(80, 24), notifications=True) as pilot:
-        await wait_until(pilot, lambda: loaded(app))
-        yield app, pilot
+    return opened(scenario, size=(80, 24), notifications=True)
 
 
 def toasts(app) -> list[str]:
@@ -77,7 +72,7 @@ async def test_a_note_held_by_dialogs_shows_for_the_time_it_had_left(tmp_path, s
     async with opened_with_notes(scenario) as (app, pilot):
         app.notify("a short note", timeout=60.0)
         await wait_until(pilot, lambda: shown(app, "a short note"), 10)
-        (note,) = app._notifications
+        note = next(n for n in app._notifications if n.message == "a short note")
         note.raised_at -= 45.0  # shown for 45 of its 60 s: no race with a slow machine
         form = await screen_after(pilot, "f8", ThresholdScreen)
         await pilot.pause(0.2)

@@ -107,7 +107,10 @@ class StatusBar(Horizontal):
         if state not in self.tell_states:
             self.told = ""
         elif self.tell is not None and message != self.told:
-            self.call_after_refresh(self._tell_if_cut, message)
+            if self.query_one(StatusText).content_size.width > 0:
+                self._tell_if_cut(message)  # laid out: told now, with the message it explains
+            else:  # (not yet, on mount: its width is known after a refresh)
+                self.call_after_refresh(self._tell_if_cut, message)
 
     def _tell_if_cut(self, message: str) -> None:
         room = self.query_one(StatusText).content_size.width
