@@ -17,8 +17,8 @@ if TYPE_CHECKING:
     from ladartui.sweep.best_file import BestScenario
 
 
-# The sweep screen's fields, as the cluster's refusals name them (some name the CLI's flags).
-# the sweep screen's fields for the core's: its Certificates folder holds the three TLS files
+# The sweep screen's fields, as the cluster's refusals name them (some name the CLI's
+# flags); its Certificates folder holds the three TLS files.
 FORM_LABELS = {
     "scheduler": "Scheduler",
     "--scheduler": "Scheduler",
