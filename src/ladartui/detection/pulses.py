@@ -93,6 +93,7 @@ def pulse_study(
     target_keys = np.unique(voxel_keys(scene.target))
     total = target_keys.size
     attitudes = plan_attitudes(scenario.flight, scenario.speed, sensor)
+    bin_width = settings.bin_width(sensor.depth_resolution)
     per_scan_units = [max(1.0, p / 10.0) for p in pulses_list]
     units_total = len(poses) * (1.0 + sum(per_scan_units))
     units = 0.0
@@ -122,12 +123,14 @@ def pulse_study(
         kept = kept_returns(detector, hits.kind, hits.range, sensor.depth_resolution)
         ideal.append(voxel_keys(hits.index[kept]))
         looks.append(
-            prepare_look(origins, directions, detector, hits, kept, target_keys, settings, scene.voxel_size)
+            prepare_look(
+                origins, directions, detector, hits, kept, target_keys, settings, scene.voxel_size, bin_width
+            )
         )
         units += 1.0
         report("trace", scan + 1, len(poses))
     ideal_cov = float(np.isin(target_keys, np.concatenate(ideal)).sum() / total) if total else None
-    _check_work(scenario, looks, pulses_list, settings.bin_width(sensor.depth_resolution))
+    _check_work(scenario, looks, pulses_list)
     for row, pulses in enumerate(pulses_list):
         report("pulses", row + 1, len(pulses_list))  # the count now fired, before its first scan
         k = settings.threshold(pulses)
@@ -156,12 +159,11 @@ def pulse_study(
     return ideal_cov, rows
 
 
-def _check_work(scenario, looks, pulses_list, bin_width) -> None:
+def _check_work(scenario, looks, pulses_list) -> None:
     """Refuse, before the first pulse, firing whose work would pass the limit."""
-    from ladartui.detection.scan import look_cells
     from ladartui.resources import check_bin_visits
 
-    cells = sum(d * b for d, b in (look_cells(look, bin_width) for look in looks))
+    cells = sum(detectors * bins for detectors, bins in (look.cells for look in looks))
     fired = sum(pulses_list)
     check_bin_visits(
         cells * fired,

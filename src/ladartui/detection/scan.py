@@ -61,6 +61,9 @@ class LookInputs:
     cos_incidence: np.ndarray
     is_target: np.ndarray  # (N,) bool: the hit is a target-model voxel
     kept: np.ndarray  # (N,) bool: the hit survives the depth rule
+    # the detectors with a hit and the range bins of the gate, as the model fires them:
+    # each pulse visits every such (detector, bin) cell once
+    cells: tuple[int, int]
 
 
 @dataclass(frozen=True)
@@ -76,9 +79,10 @@ class LookOutcome:
 
 
 def prepare_look(
-    origins, directions, detector, hits, kept_rays, target_keys, settings, voxel_size
+    origins, directions, detector, hits, kept_rays, target_keys, settings, voxel_size, bin_width
 ) -> LookInputs:
-    """The model's inputs for one scan; ``kept_rays`` indexes the rays the depth rule keeps."""
+    """The model's inputs for one scan; ``kept_rays`` indexes the rays the depth rule keeps;
+    ``bin_width``: the range bins' (settings.bin_width of the sensor's depth resolution)."""
     kind = np.asarray(hits.kind)
     index = np.asarray(hits.index)
     is_target = (kind == VOXEL) & np.isin(voxel_keys(np.maximum(index, 0)), target_keys)
@@ -90,18 +94,12 @@ def prepare_look(
     cos = incidence_cosines(origins, directions, kind, index, hits.range, voxel_size)
     kept = np.zeros(kind.shape[0], dtype=bool)
     kept[kept_rays] = True
-    return LookInputs(
-        np.asarray(detector), kind, np.asarray(hits.range), index, reflectance, cos, is_target, kept
+    detector, ranges = np.asarray(detector), np.asarray(hits.range)
+    hit = kind != 0
+    cells = (
+        (int(np.unique(detector[hit]).size), range_gate(ranges[hit], bin_width)[1]) if hit.any() else (0, 0)
     )
-
-
-def look_cells(look: LookInputs, bin_width: float) -> tuple[int, int]:
-    """The detectors with a hit and the range bins of ``look``'s gate, as the model
-    fires them: each pulse visits every such (detector, bin) cell once."""
-    hit = look.kind != 0
-    if not hit.any():
-        return 0, 0
-    return int(np.unique(look.detector[hit]).size), range_gate(look.range[hit], bin_width)[1]
+    return LookInputs(detector, kind, ranges, index, reflectance, cos, is_target, kept, cells)
 
 
 def declare_look(
@@ -110,7 +108,7 @@ def declare_look(
     """Fire ``pulses`` pulses at one scan (random stream keyed by ``scan_key``); ``cancel``
     is checked between blocks of pulses."""
     bin_width = settings.bin_width(sensor.depth_resolution)
-    detectors, bins = look_cells(look, bin_width)
+    detectors, bins = look.cells
     check_memory(
         detectors * bins * BYTES_PER_BIN,
         f"{detectors:,} detectors x {bins:,} range bins in one look",
@@ -202,7 +200,15 @@ class GeigerRun:
         kept = np.concatenate([c[6] + o for c, o in zip(chunks, offsets)])
         self.ideal[run].append(unique_voxels(hits.index[kept]))
         look = prepare_look(
-            join(0), join(1), join(2), hits, kept, self.target_keys, self.settings, self.voxel_size
+            join(0),
+            join(1),
+            join(2),
+            hits,
+            kept,
+            self.target_keys,
+            self.settings,
+            self.voxel_size,
+            self.settings.bin_width(self.sensor.depth_resolution),
         )
         if run == "scene":
             self._check_work(look, scan)
@@ -227,7 +233,7 @@ class GeigerRun:
         look with no hit fires nothing and the next look is checked."""
         from ladartui.resources import check_bin_visits
 
-        detectors, bins = look_cells(look, self.settings.bin_width(self.sensor.depth_resolution))
+        detectors, bins = look.cells
         self.cells_fired += detectors * bins
         pulses = self.settings.pulses
         check_bin_visits(
