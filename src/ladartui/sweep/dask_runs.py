@@ -34,15 +34,19 @@ def run_on_dask(client, todo, base, digest, scene, options, record, cancel):
     payload = ScenePayload.of(scene, uuid.uuid4().hex)
     scene_future = client.scatter(payload, broadcast=True, hash=False)
     tag = uuid.uuid4().hex[:8]
-    waiting = iter(todo)
+    waiting = list(reversed(todo))  # popped from the end: the first variant first
     pending: dict = {}
     completed = as_completed(loop=client.loop)  # this client's, not the default one's
-    ahead = {"tasks": 0, "asked": -math.inf}
+    ahead, asked = 0, -math.inf
 
     def submit_more():
-        if time.monotonic() - ahead["asked"] >= _AHEAD_SECONDS:  # a round trip: not every batch
-            ahead.update(tasks=tasks_ahead(client), asked=time.monotonic())
-        while len(pending) < ahead["tasks"] and (variant := next(waiting, None)) is not None:
+        nonlocal ahead, asked
+        if not waiting:  # all submitted: no more asking the scheduler
+            return
+        if time.monotonic() - asked >= _AHEAD_SECONDS:  # a round trip: not every batch
+            ahead, asked = tasks_ahead(client), time.monotonic()
+        while len(pending) < ahead and waiting:
+            variant = waiting.pop()
             future = client.submit(
                 run_variant,
                 base,
