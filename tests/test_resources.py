@@ -190,3 +190,55 @@ def test_a_ray_limit_names_how_its_caller_raises_it_and_a_sweep_its_own_way(monk
     assert str(pickle.loads(pickle.dumps(own.value))) == str(own.value)
     other = ResourceLimitError(f"x.txt: too big; use {RAISE_RAYS}")  # not a ray limit: as it is
     assert sweep_advice(other) == str(other)
+
+
+def test_a_scenario_over_the_ray_limit_opens_and_only_work_on_it_is_refused(tmp_path, monkeypatch):
+    """Reading a scenario over the limit was refused, so the TUI could not open it to cut
+    it down, nor a script shrink it: the limit is the work's, checked where work starts."""
+    from ladartui import load_scenario, simulate
+    from ladartui.detection.pulses import pulse_study
+    from ladartui.flight import FlightPlan, Orbit
+    from ladartui.resources import RayLimitError
+    from tiny_sweep import CENTRE, write_tiny_scenario
+
+    path = write_tiny_scenario(tmp_path).path  # 8 x 8 detectors, 2 x 2 rays each: 256 rays a scan
+    monkeypatch.setenv("LADARTUI_MAX_RAYS", "2000")  # two runs of 4 scans: 2,048
+    scenario = load_scenario(path)
+    with pytest.raises(RayLimitError) as refused:
+        simulate(scenario)
+    assert str(refused.value).startswith(
+        f"{path}: sensor.grid = 8, sensor.ray_grid = 2, 4 scans: about 2.05e+03 rays to trace"
+    )
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["base.toml", "tiny.txt", "tiny_Target.txt"]
+    three = scenario.with_changes(
+        flight=FlightPlan(segments=(Orbit(centre=CENTRE, radius=20.0, altitude=20.0, scans=3),))
+    )
+    assert len(simulate(three, write=False).measures.obscured_after_scan) == 3
+    monkeypatch.setenv("LADARTUI_MAX_RAYS", "1000")  # a pulse study traces each scan once: 1,024
+    with pytest.raises(RayLimitError, match=r"about 1\.02e\+03 rays to trace, more than the limit of 1e\+03"):
+        pulse_study(scenario, [1])
+    assert pulse_study(three, [1])[1][0].pulses == 1  # 768 rays
+
+
+def test_a_study_over_the_ray_limit_is_refused_before_it_traces(tmp_path, monkeypatch):
+    """A study's traces were not counted: one over a scenario of a large sensor ran on
+    until Ctrl-C (and one over a scenario whose own run was over the limit was refused
+    though it traces a few of its scans)."""
+    from ladartui.resources import RayLimitError
+    from ladartui.study.inputs import scenario_inputs
+    from ladartui.study.run import run_study
+    from ladartui.study.settings import Setting, reference_setting
+    from tiny_sweep import write_tiny_scenario
+
+    inputs = scenario_inputs(write_tiny_scenario(tmp_path).path, scans=2)  # 64 detectors
+    march = Setting("numba", "march", "f64", 0.5, 1)
+    # the reference at ray grids 1 and 2, a march at 1; each 2 scans, 1 warm-up, 3 repeats
+    # of the first scan (runs=5): 64 x 6 + 256 x 6 + 64 x 5 + the march's warm-up, 64 rays
+    rays = 64 * 6 + 256 * 6 + 64 * 5 + 64
+    monkeypatch.setenv("LADARTUI_MAX_RAYS", str(rays - 1))
+    traced = []
+    monkeypatch.setattr("ladartui.study.run._trace", lambda *args: traced.append(args))
+    with pytest.raises(RayLimitError) as refused:
+        run_study(inputs, [march, reference_setting(2)], runs=5, warmup=1)
+    assert f"about {rays:.3g} rays to trace" in str(refused.value) and traced == []
+    assert "LADARTUI_MAX_RAYS if" in str(refused.value) and "--max-rays" not in str(refused.value)

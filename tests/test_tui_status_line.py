@@ -142,3 +142,34 @@ async def test_a_scenario_changed_on_disk_is_told_once_where_the_line_cuts_it(tm
             await pilot.pause()
         told = [m for m in app.messages if "changed on disk" in m]
         assert len(told) == 1, told
+
+
+async def test_a_scenario_over_the_ray_limit_opens_not_ready_and_runs_once_cut_down(
+    tmp_path, scene_files, monkeypatch
+):
+    """It was refused as it loaded ('Could not load ...: about 7.86e+05 rays to trace'),
+    so it could not be opened to fly a smaller sensor or fewer scans."""
+    from ladartui.tui.status import NOT_READY
+    from test_tui_flow import field, type_into
+
+    scenario = make_scenario(tmp_path, scene_files, scans=6)  # 8 x 8 rays a scan, two runs: 768
+    monkeypatch.setenv("LADARTUI_MAX_RAYS", "700")
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=(120, 40)) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        runs = capture_runs(app)
+        bar = app.query_one(StatusBar)
+        assert bar.state == NOT_READY
+        assert bar.message.endswith(
+            "6 scans: about 768 rays to trace, more than the limit of 700 (raise it with "
+            "LADARTUI_MAX_RAYS, set before ladartui starts, if this is meant)"
+        )
+        await pilot.press("f5")
+        await pilot.pause()
+        assert runs == [] and "about 768 rays to trace" in app.messages[-1]
+        app.action_show_tab("sensor")
+        await type_into(pilot, field(app, "sensor.grid"), "7")  # 49 rays a scan: 588
+        assert "rays to trace" not in bar.message
+        await pilot.press("f5")
+        await pilot.pause()
+        assert [run.sensor.grid for run in runs] == [7]

@@ -148,9 +148,13 @@ def check_occupancy(lo, hi, count, source="voxels") -> int:
     return need
 
 
-# How a scenario's ray limit is raised: validate, info and the TUI read the variable
-# too, and have no --max-rays.
+# How a scenario's ray limit is raised: validate reads the variable too, and has no
+# --max-rays.
 RAISE_RAYS = "LADARTUI_MAX_RAYS or run's --max-rays"
+# work with no --max-rays of its own (trace, pulses, study)
+RAISE_BY_ENV = "LADARTUI_MAX_RAYS"
+# the TUI's process takes the variable from the shell that started it
+RAISE_IN_TUI = "LADARTUI_MAX_RAYS, set before ladartui starts,"
 # a sweep has no --max-rays; its workers, started from this process's environment, read the variable
 SWEEP_RAISE_RAYS = "LADARTUI_MAX_RAYS (a sweep's workers read it)"
 

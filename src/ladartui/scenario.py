@@ -9,8 +9,6 @@ The file format, every key and the reader that checks it: ``ladartui.scenario_fi
 
 from __future__ import annotations
 
-import contextlib
-import contextvars
 import dataclasses
 import os
 import re
@@ -125,7 +123,6 @@ class Scenario:
                 self.detection.bin_width(self.sensor.depth_resolution)
         if self.levels is not None and not isinstance(self.levels, LevelThresholds):
             raise FieldError("levels", self.levels, "a LevelThresholds")
-        check_work(self)
 
     @property
     def geiger(self) -> bool:
@@ -546,31 +543,17 @@ def _segment_scans(segment) -> int:
     return len(segment.build(None))  # a recorded log: its scans come from the file
 
 
-# Set inside ``work_unchecked()``: scenarios made there are not held to the work limit.
-_WORK_UNCHECKED = contextvars.ContextVar("work_unchecked", default=False)
+def check_work(scenario, raise_with=None):
+    """Refuse a run of ``scenario`` whose rays (two runs of every scan) exceed the work
+    limit (``RayLimitError``; ``raise_with`` says how its user raises the limit). Checked
+    where work starts, not as a scenario is read: one over the limit can still be opened,
+    shown and cut down."""
+    from ladartui.resources import RAISE_RAYS, check_rays
 
-
-@contextlib.contextmanager
-def work_unchecked():
-    """Scenarios made inside are not refused for the work limit: a sweep's base, whose
-    variants (made from it outside) are each held to the limit instead."""
-    token = _WORK_UNCHECKED.set(True)
-    try:
-        yield
-    finally:
-        _WORK_UNCHECKED.reset(token)
-
-
-def check_work(scenario):
-    """Refuse a scenario whose rays (two runs of every scan) exceed the work limit
-    (``RayLimitError``), outside ``work_unchecked()``."""
-    from ladartui.resources import check_rays
-
-    if _WORK_UNCHECKED.get():
-        return
     sensor, scans = scenario.sensor, scenario.scan_count()
     check_rays(
         2 * sensor.rays_per_scan * scans,
         f"{scenario.path}: sensor.grid = {sensor.grid}, sensor.ray_grid = "
         f"{sensor.ray_grid}, {plural(scans, 'scan')}",
+        raise_with=raise_with or RAISE_RAYS,
     )

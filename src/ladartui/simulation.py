@@ -27,7 +27,7 @@ from ladartui.errors import FieldError, check_callbacks, check_cancelled
 from ladartui.measures import Measures, compute_measures
 from ladartui.returns import fuse_scans, kept_returns
 from ladartui.run_record import as_run, check_record_spare, record_text, run_inputs
-from ladartui.scenario import Scenario
+from ladartui.scenario import Scenario, check_work
 from ladartui.scene.model import Scene
 from ladartui.tracing.config import SCAN_BLOCK
 
@@ -128,6 +128,7 @@ def simulate(
 
         scenario = load_scenario(scenario)
     _check_arguments(scenario, progress, cancel, scene)
+    check_work(scenario)  # before the output set is locked and before any tracing
     for name, value in (("write", write), ("las", las)):
         if not isinstance(value, (bool, np.bool_)):
             raise FieldError(name, value, "True or False")

@@ -91,6 +91,7 @@ def _settings(scenario, args):
 
 def run(args) -> int:
     from ladartui.cli.console import CliConsole as Console
+    from ladartui.detection.pulses import check_study_rays
     from ladartui.scenario import load_scenario
     from ladartui.user_data import bundled_or_path, default_scenario_path
 
@@ -104,6 +105,7 @@ def run(args) -> int:
     if args.backend is not None:  # before any tracing, as run does
         with as_flags({"backend": args.backend}):
             scenario.with_changes(backend=args.backend)
+    check_study_rays(scenario)  # before the kernels compile and the bar is drawn
     errors = Console(stderr=True)
     state = {"last": None}
     try:

@@ -75,7 +75,7 @@ def add_parser(subparsers):
 def run(args) -> int:
     from ladartui.cli.console import CliConsole as Console
     from ladartui.errors import FieldError
-    from ladartui.scenario import load_scenario
+    from ladartui.scenario import check_work, load_scenario
 
     if args.max_rays is not None:
         from ladartui.resources import set_max_rays
@@ -94,6 +94,7 @@ def run(args) -> int:
     overrides = {name: value for name, value in overrides.items() if value is not None}
     with as_flags(overrides):
         scenario = scenario.with_changes(**overrides)
+    check_work(scenario)  # before the kernels compile and the bar is drawn
     how = (
         f"--method {args.method}" if args.method else f"{scenario.method} (the scenario's simulation.method)"
     )

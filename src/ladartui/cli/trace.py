@@ -69,7 +69,7 @@ def check_rays_header(path) -> None:
     than the work or memory limit allows. An .npz archive is left to the loader."""
     import numpy.lib.format as npy
 
-    from ladartui.resources import available_memory, check_rays, gib
+    from ladartui.resources import RAISE_BY_ENV, available_memory, check_rays, gib
 
     refuse_special_file(path, "expected a NumPy .npy array")
     try:
@@ -101,7 +101,7 @@ def check_rays_header(path) -> None:
             path, f"array of shape {shape}: expected (N, 6): origin x, y, z and direction dx, dy, dz per row"
         )
     rows = int(shape[0])
-    check_rays(rows, str(path), raise_with="LADARTUI_MAX_RAYS")  # trace has no --max-rays
+    check_rays(rows, str(path), raise_with=RAISE_BY_ENV)  # trace has no --max-rays
     need, limit = rows * BYTES_PER_TRACED_RAY, available_memory()
     if need > limit:
         raise ResourceLimitError(

@@ -33,13 +33,12 @@ def add_parser(subparsers):
 def run(args) -> int:
     from ladartui.cli.flags import check_scenario_name
     from ladartui.errors import OutputFileError
-    from ladartui.scenario import load_scenario, work_unchecked
+    from ladartui.scenario import load_scenario
     from ladartui.simulation import check_output_names, check_outputs_spare_inputs
     from ladartui.user_data import bundled_or_path
 
     check_scenario_name(args.scenario)
-    with work_unchecked():  # the ray limit is the machine's, not a mistake: a "next run" line
-        scenario = load_scenario(bundled_or_path(args.scenario))
+    scenario = load_scenario(bundled_or_path(args.scenario))
     if scenario.geiger:  # its firing is checked as a run traces its looks; the limit read now
         from ladartui.resources import max_bin_visits
 

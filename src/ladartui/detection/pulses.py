@@ -21,6 +21,7 @@ import numpy as np
 from ladartui.detection.scan import BYTES_PER_HELD_RAY, check_memory, declare_look, prepare_look
 from ladartui.detection.settings import DetectionSettings
 from ladartui.errors import check_cancelled
+from ladartui.number_text import plural
 from ladartui.returns import kept_returns
 from ladartui.scene.keys import voxel_keys
 
@@ -80,6 +81,7 @@ def pulse_study(
     from ladartui.tracing import trace
 
     settings = settings or scenario.detection or DetectionSettings()
+    check_study_rays(scenario)
     poses = scenario.poses()
     # Every scan's rays are kept (traced once, fired at for each pulse count).
     check_memory(
@@ -157,6 +159,17 @@ def pulse_study(
             )
         )
     return ideal_cov, rows
+
+
+def check_study_rays(scenario) -> None:
+    """Refuse a pulse study whose tracing (each scan once, against the scene alone)
+    would pass the ray limit (``RayLimitError``)."""
+    from ladartui.resources import RAISE_BY_ENV, check_rays
+
+    scans, each = scenario.scan_count(), scenario.sensor.rays_per_scan
+    check_rays(
+        scans * each, f"{scenario.path}: {plural(scans, 'scan')} of {each:,} rays", raise_with=RAISE_BY_ENV
+    )
 
 
 def _check_work(scenario, looks, pulses_list) -> None:

@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.errors import BackendUnavailable, Cancelled, LadarError, check_cancelled
+from ladartui.number_text import plural
 from ladartui.study.inputs import StudyInputs, with_ray_grid
 from ladartui.study.misses import summarise, voxel_geometry
 from ladartui.study.results import FAILED, SKIPPED, StudyResult, StudyRow
@@ -105,6 +106,7 @@ def run_study(
     poses = inputs.poses
     extra = max(0, runs - len(poses))
     active = [s for s in ordered if rows[s].status != SKIPPED]
+    _check_rays(inputs, active, warmup, extra)
     total = sum(len(poses) + warmup + extra for _ in active)
     done = 0
     returns: dict[Setting, list[np.ndarray]] = {s: [] for s in ordered}
@@ -197,6 +199,24 @@ def run_study(
         )
     result.finish()
     return result
+
+
+def _check_rays(inputs: StudyInputs, active: list[Setting], warmup: int, extra: int) -> None:
+    """Refuse, before the first trace, a study whose calls would trace more rays than the
+    work limit: every scan and repeat of each setting, and its warm-up calls."""
+    from ladartui.resources import RAISE_BY_ENV, check_rays
+
+    rays = 0
+    for s in active:
+        scan = with_ray_grid(inputs.sensor, s.ray_grid).rays_per_scan
+        warm = scan if s.method == "exact" else min(scan, WARMUP_RAYS)
+        rays += (len(inputs.poses) + extra) * scan + warmup * warm
+    settings = plural(len(active), "setting")
+    check_rays(
+        rays,
+        f"{inputs.name}: a study of {settings} on {plural(len(inputs.poses), 'scan')}",
+        raise_with=RAISE_BY_ENV,
+    )
 
 
 def _trace(scene, origins, directions, setting: Setting, cancel):

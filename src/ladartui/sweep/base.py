@@ -78,12 +78,12 @@ def own_rows(table_rows: list[dict], variants, digest: str) -> list[dict]:
 
 
 def load_base(spec: SweepSpec, check_files: bool = True) -> Scenario:
-    """The spec's base scenario. It is not held to the ray limit, each variant is: a
-    base too large for the limit can be swept down (fewer scans, a smaller sensor)."""
-    from ladartui.scenario import load_scenario, work_unchecked
+    """The spec's base scenario. Each variant is held to the ray limit as it runs, the
+    base never: a base too large for the limit can be swept down (fewer scans, a
+    smaller sensor)."""
+    from ladartui.scenario import load_scenario
 
-    with work_unchecked():
-        return load_scenario(base_scenario_path(spec), check_files)
+    return load_scenario(base_scenario_path(spec), check_files)
 
 
 def spec_rows(table_rows: list[dict], spec: SweepSpec) -> list[dict]:
@@ -126,13 +126,14 @@ def check_some_variant_runs(spec: SweepSpec, base) -> None:
     one error row per variant. Stops at the first variant that builds; a preset's
     aim point comes from the target model alone, never the whole scene."""
     from ladartui.errors import LadarError
+    from ladartui.scenario import check_work
     from ladartui.sweep.variant import apply_parameters
 
     target = _TargetCentre(base)
     first = None
     for variant in spec.variants:
         try:
-            apply_parameters(base, variant.params, lambda: target)
+            check_work(apply_parameters(base, variant.params, lambda: target))
             return
         except LadarError as error:
             first = first or error

@@ -282,12 +282,8 @@ def _checked_simulate_options(options, base) -> dict:
 
 
 def _with_options(base, options: Mapping):
-    """The base scenario as its variants run it: with the options that are set (held, as
-    the base is, to no ray limit: each variant is)."""
-    from ladartui.scenario import work_unchecked
-
-    with work_unchecked():
-        return base.with_changes(**{key: value for key, value in options.items() if value is not None})
+    """The base scenario as its variants run it: with the options that are set."""
+    return base.with_changes(**{key: value for key, value in options.items() if value is not None})
 
 
 @contextlib.contextmanager

@@ -375,11 +375,15 @@ def load_checked(path: Path) -> Scenario:
 
 
 def run_refusal(scenario: Scenario) -> str | None:
-    """Why a run of ``scenario`` would be refused before tracing (its outputs would
-    replace a model file, or a file of its record's name that is not one); None if not."""
+    """Why a run of ``scenario`` would be refused before tracing (more rays than the work
+    limit, its outputs would replace a model file, or a file of its record's name that
+    is not one); None if not."""
+    from ladartui.resources import RAISE_IN_TUI
+    from ladartui.scenario import check_work
     from ladartui.simulation import check_outputs_spare_inputs
 
     try:
+        check_work(scenario, raise_with=RAISE_IN_TUI)
         check_outputs_spare_inputs(scenario)
     except LadarError as error:
         return str(error)
