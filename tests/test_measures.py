@@ -156,6 +156,40 @@ def test_coverage_after_each_scan_is_cumulative():
     assert measures.path_length_m == 1200.0 and measures.flight_time_s == 30.0
 
 
+@pytest.mark.parametrize(
+    ("new_per_scan", "after", "enough"),
+    [
+        # 9 of 10 at scan 2 is exactly 90 % of the final 10 of 10: scan 2, not 3.
+        ((4, 5, 1), (0.4, 0.9, 1.0), 2),
+        # The goal is 90 % of the final 5 of 10 (4.5 voxels), not of the whole target.
+        ((2, 2, 1, 0), (0.2, 0.4, 0.5, 0.5), 3),
+        # Reached at the first scan, later scans adding little.
+        ((19, 0, 1), None, 1),
+    ],
+)
+def test_scans_for_enough_is_the_first_scan_reaching_90_percent_of_the_final_coverage(
+    new_per_scan, after, enough
+):
+    size = sum(new_per_scan)
+    target = box(20 if after is None else 10, 1, 1)
+    seen = iter(target.tolist())
+    scans = [np.array([next(seen) for _ in range(n)]).reshape(-1, 3) for n in new_per_scan]
+    measures = compute_measures(
+        target, np.vstack(scans), target, scene_per_scan=scans, target_per_scan=[target] * len(scans)
+    )
+    counted = np.cumsum(new_per_scan) / len(target)
+    assert measures.obscured_after_scan == pytest.approx(tuple(counted))
+    if after is not None:
+        assert measures.obscured_after_scan == pytest.approx(after)
+    # By hand: the first k whose count reaches 0.9 of the final count.
+    assert enough == next(k for k, c in enumerate(np.cumsum(new_per_scan), 1) if c >= 0.9 * size)
+    assert measures.scans_for_enough == enough
+    nothing = compute_measures(
+        target, None, target, scene_per_scan=[np.zeros((0, 3))] * 2, target_per_scan=[target] * 2
+    )
+    assert nothing.obscured_after_scan == (0.0, 0.0) and nothing.scans_for_enough is None
+
+
 def test_cmf_round_trip(tmp_path):
     target = box(4, 3, 3)
     scans = [top_layer(target)[:5], target[target[:, 1] == 0]]
