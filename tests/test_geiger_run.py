@@ -1,6 +1,7 @@
 """The Geiger-mode model inside ``ladartui run``: declared points, measures, reproducibility."""
 
 import json
+import math
 
 import numba
 import numpy as np
@@ -76,6 +77,30 @@ def test_weak_signal_and_noise_lose_coverage_and_add_false_alarms(woods):
     # Noise never counts as coverage: every declared voxel is a voxel the ideal model returns.
     ideal_keys = {tuple(v) for v in ideal.scene_output}
     assert {tuple(v) for v in run.scene_output} <= ideal_keys
+
+
+def test_false_alarm_probability_per_bin_is_the_noise_rates_poisson_share(woods):
+    """One pulse, k = 1 and a detector that re-arms after each bin: a bin holding no return
+    fires alone, with probability 1 - exp(-N), N = rate x 2 x bin width / c (3 sigma)."""
+    from ladartui.detection import noise_per_bin
+
+    rate, width = 4e7, 1.0  # N = 0.267 counts a bin
+    assert woods.sensor.depth_resolution == width  # the default bin width
+    run = simulate(
+        _geiger(
+            woods, n_ref=0.5, solar_rate_hz=rate, dark_rate_hz=0.0, dead_time_m=width, pulses=1, coincidence=1
+        ),
+        write=False,
+    )
+    d = run.measures.detection
+    p = 1 - math.exp(-rate * 2 * width / 299_792_458.0)
+    assert p == pytest.approx(1 - math.exp(-noise_per_bin(rate, width)))
+    noise_bins = round(d.false_alarms / d.false_alarm_probability)
+    assert noise_bins > 2000  # enough trials that 3 sigma is a few per cent of p
+    sigma = math.sqrt(p * (1 - p) / noise_bins)
+    assert abs(d.false_alarm_probability - p) <= 3 * sigma, (d.false_alarm_probability, p, sigma)
+    # Per look: the false alarms over the run's three looks.
+    assert d.false_alarms_per_look == pytest.approx(d.false_alarms / 3)
 
 
 def test_run_agrees_with_the_pulse_study_row(woods):
