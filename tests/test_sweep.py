@@ -13,7 +13,7 @@ from dataclasses import replace
 
 import pytest
 
-from ladartui.errors import Cancelled, InputFileError, LadarError
+from ladartui.errors import Cancelled, FieldError, InputFileError
 from ladartui.sweep import (
     apply_parameters,
     load_sweep_results,
@@ -362,8 +362,9 @@ def test_objectives_rank_by_coverage_per_km_and_within_budget():
     assert best[0].row["variant"] == "c"
     # Pareto front (time against coverage): e (0 s), b, a and c each buy more coverage.
     assert {r.row["variant"] for r in best if r.pareto} == {"e", "b", "a", "c"}
-    with pytest.raises(LadarError, match="objective"):
+    with pytest.raises(FieldError) as caught:
         rank_rows(rows, "speed")
+    assert str(caught.value).startswith("objective = 'speed': expected one of obscured-coverage, ")
 
 
 # -- applying parameters -------------------------------------------------------------
@@ -434,10 +435,15 @@ def test_impossible_parameters_raise_naming_the_sweep_parameter(tiny):
     from ladartui.scenario import load_scenario
 
     base = load_scenario(tiny / "base.toml")
-    with pytest.raises(LadarError, match="sensor_grid = 0"):
+    with pytest.raises(FieldError) as caught:
         apply_parameters(base, {"sensor_grid": 0})
-    with pytest.raises(LadarError, match="standoff"):
+    assert str(caught.value) == "sensor_grid = 0: expected an integer from 1 to 1024"
+    with pytest.raises(FieldError) as caught:
         apply_parameters(base, {"standoff": 5.0})  # the base flies an orbit, not a fly-past
+    assert str(caught.value) == (
+        "standoff = 5.0: expected a parameter of the base's orbit "
+        "(altitude, arc, heading_offset, radius, scans)"
+    )
 
 
 # -- serial runs ---------------------------------------------------------------------
