@@ -159,10 +159,20 @@ def test_work_beyond_the_memory_limit_is_refused_up_front(scenario, capsys, monk
     assert main(["pulses", str(scenario.path), "--pulses", "1"]) == 2
     err = capsys.readouterr().err
     assert "would need about" in err and "3 scans of 1,024 rays" in err and not traced
-    with pytest.raises(Exception, match="one scan's 1,024 rays in two runs"):
-        from ladartui.simulation import simulate
+    # A run of the same scenario refuses before its first scan: one scan's rays held in both
+    # runs, 2 x 1,024 rays x 110 bytes, are more than the 64 KiB allowed.
+    from ladartui.errors import LadarError
+    from ladartui.simulation import _ScanRunner, simulate
 
-        simulate(scenario.with_changes(detection=DetectionSettings(model="geiger")), write=False)
+    monkeypatch.setattr(_ScanRunner, "scan", lambda *a, **k: traced.append(1))
+    with pytest.raises(LadarError) as caught:
+        simulate(scenario.with_changes(detection=DetectionSettings(model="geiger")))
+    assert str(caught.value) == (
+        f"the Geiger-mode model would need about {2 * 1024 * 110 / 2**30:.1f} GiB for one scan's "
+        "1,024 rays in two runs, more than the 0.0 GiB it may use here: use a smaller sensor grid "
+        "or fewer rays per detector"
+    )
+    assert not traced and not scenario.scene_output.exists() and not scenario.measures_file.exists()
 
 
 def test_geiger_markers_stay_visible_where_they_meet_the_ideal_line():
