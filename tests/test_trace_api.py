@@ -11,6 +11,7 @@ from ladartui.errors import BackendUnavailable, Cancelled, FieldError
 from ladartui.scene.occupancy import Occupancy
 from ladartui.tracing import GROUND, MISS, VOXEL, TraceResult, choose_backend, trace
 from ladartui.tracing.backend import backend_names, backend_status, get_backend
+from ladartui.tracing.reference import reference_trace_cells
 
 
 def make_block():
@@ -123,11 +124,20 @@ def test_every_available_backend_agrees_with_numba():
     d = rng.normal(size=(500, 3))
     d[:, 2] = -np.abs(d[:, 2])
     base = trace(occ, o, d, backend="numba")
-    for name, reason in backend_status().items():
-        if reason is None and name != "numba":
-            other = trace(occ, o, d, backend=name, precision="f64")
-            assert np.array_equal(other.kind, base.kind), name
-            assert np.array_equal(other.index, base.index), name
+    # numba against the slab reference, in cell space (a voxel's centre is its index in
+    # metres at voxel size 1, its cell [i, i + 1)): kinds, cells and ranges.
+    unit = d / np.linalg.norm(d, axis=1)[:, None]
+    exact = reference_trace_cells(vox, (30, 30, 12), o + 0.5, unit)
+    assert np.array_equal(base.kind, exact.kind) and np.array_equal(base.index, exact.index)
+    assert np.allclose(base.range, exact.t, rtol=0, atol=1e-9)
+    assert {VOXEL, GROUND} <= set(base.kind.tolist())  # the comparison covers both kinds of hit
+    others = [name for name, reason in backend_status().items() if reason is None and name != "numba"]
+    for name in others:
+        other = trace(occ, o, d, backend=name, precision="f64")
+        assert other.backend == name
+        assert np.array_equal(other.kind, base.kind), name
+        assert np.array_equal(other.index, base.index), name
+        assert np.allclose(other.range, base.range, rtol=1e-12, atol=1e-9), name
 
 
 @settings(max_examples=30, deadline=None)
