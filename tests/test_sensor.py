@@ -166,8 +166,29 @@ def test_footprint_at_nadir_and_tilted():
     assert tilted[0, 1] > tilted[3, 1] > 0  # far edge beyond the near edge, both ahead
     # Far edge: centre line at 45 - 10 = 35 degrees below horizontal (projected angles).
     assert np.mean(tilted[:2, 1]) > 95.0 / math.tan(math.radians(35.0)) - 1e-9
+    # Each corner where the report's rotations (equations 1, 2) take the view's corner
+    # ray (tan 10 degrees off the boresight on both axes) down 95 m to z = 5.
+    np.testing.assert_allclose(tilted, hand_footprint((0.0, 0.0, 100.0), 0.0, 45.0, 20.0, 5.0), atol=1e-9)
+    turned = ScanPose(30.0, -40.0, 80.0, heading=120.0, azimuth=-25.0, depression=35.0)
+    np.testing.assert_allclose(
+        sensor.footprint(turned), hand_footprint((30.0, -40.0, 80.0), 95.0, 35.0, 20.0, 0.0), atol=1e-9
+    )
     above = sensor.footprint(ScanPose(0.0, 0.0, 100.0, depression=5.0))
     assert np.isnan(above[:2]).all() and np.isfinite(above[2:]).all()
+    np.testing.assert_allclose(above[2:], hand_footprint((0.0, 0.0, 100.0), 0.0, 5.0, 20.0, 0.0)[2:])
+
+
+def hand_footprint(position, bearing, depression, fov, ground_z):
+    """The four corners (far left, far right, near right, near left) by hand: the corner
+    rays of a down-looking view, turned by equations 1 and 2, met with z = ground_z."""
+    rotation = report_rz(bearing, 0.0) @ report_rx(depression)
+    half = math.tan(math.radians(fov / 2))
+    corners = []
+    for sx, sy in ((-1, 1), (1, 1), (1, -1), (-1, -1)):
+        d = rotation @ np.array([sx * half, sy * half, -1.0])
+        t = (ground_z - position[2]) / d[2] if d[2] < 0 else math.nan
+        corners.append(np.array(position) + t * d)
+    return np.array(corners)
 
 
 @pytest.mark.parametrize(
