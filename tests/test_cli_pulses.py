@@ -151,26 +151,29 @@ def test_a_bundled_scenario_is_taken_by_name_as_run_takes_it(tmp_path, capsys, m
 
 
 def test_work_beyond_the_memory_limit_is_refused_up_front(scenario, capsys, monkeypatch):
-    import ladartui.detection.scan as scan
+    """The Geiger model's limit ignored LADARTUI_MAX_MEMORY, which the README says sets the
+    memory limit, and said a small need as "about 0.0 GiB ... more than the 0.0 GiB"."""
+    from ladartui.errors import ResourceLimitError
+    from ladartui.simulation import _ScanRunner, simulate
 
-    monkeypatch.setattr(scan, "memory_limit", lambda: 1 << 16)
+    monkeypatch.setenv("LADARTUI_MAX_MEMORY", str(1 << 16))
     traced = []
     monkeypatch.setattr("ladartui.tracing.trace", lambda *a, **k: traced.append(1))
     assert main(["pulses", str(scenario.path), "--pulses", "1"]) == 2
     err = capsys.readouterr().err
-    assert "would need about" in err and "3 scans of 1,024 rays" in err and not traced
+    assert (  # 3 x 1,024 rays x 110 bytes
+        "the Geiger-mode model would need about 330 KiB for 3 scans of 1,024 rays, more than the "
+        "64 KiB it may use here: use fewer scans" in err
+    )
+    assert not traced
     # A run of the same scenario refuses before its first scan: one scan's rays held in both
     # runs, 2 x 1,024 rays x 110 bytes, are more than the 64 KiB allowed.
-    from ladartui.errors import LadarError
-    from ladartui.simulation import _ScanRunner, simulate
-
     monkeypatch.setattr(_ScanRunner, "scan", lambda *a, **k: traced.append(1))
-    with pytest.raises(LadarError) as caught:
+    with pytest.raises(ResourceLimitError) as caught:
         simulate(scenario.with_changes(detection=DetectionSettings(model="geiger")))
     assert str(caught.value) == (
-        f"the Geiger-mode model would need about {2 * 1024 * 110 / 2**30:.1f} GiB for one scan's "
-        "1,024 rays in two runs, more than the 0.0 GiB it may use here: use a smaller sensor grid "
-        "or fewer rays per detector"
+        "the Geiger-mode model would need about 220 KiB for one scan's 1,024 rays in two runs, more "
+        "than the 64 KiB it may use here: use a smaller sensor grid or fewer rays per detector"
     )
     assert not traced and not scenario.scene_output.exists() and not scenario.measures_file.exists()
 

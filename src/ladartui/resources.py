@@ -33,9 +33,14 @@ _BRICK_BYTES = 16 * 4 + 8 + 16 * 8
 _NODE_BYTES = 512 * 4
 
 
+def memory_override() -> int | None:
+    """``LADARTUI_MAX_MEMORY`` in bytes, None when unset."""
+    return _env_limit("LADARTUI_MAX_MEMORY", "a number of bytes >= 1")
+
+
 def available_memory() -> int:
     """Bytes the run may allocate: ``LADARTUI_MAX_MEMORY``, else the kernel's MemAvailable."""
-    override = _env_limit("LADARTUI_MAX_MEMORY", "a number of bytes >= 1")
+    override = memory_override()
     if override is not None:
         return override
     try:

@@ -17,7 +17,7 @@ import numpy as np
 
 from ladartui.detection.geiger import noise_per_bin
 from ladartui.detection.look import geiger_look, incidence_cosines, range_gate
-from ladartui.errors import LadarError
+from ladartui.errors import ResourceLimitError
 from ladartui.returns import unique_voxels
 from ladartui.scene.keys import voxel_keys
 
@@ -32,7 +32,13 @@ BYTES_PER_BIN = 22
 
 
 def memory_limit() -> int:
-    """Bytes the model may hold at once: half the machine's physical memory."""
+    """Bytes the model may hold at once: ``LADARTUI_MAX_MEMORY`` where set, as for the
+    tracing structures, else half the machine's physical memory."""
+    from ladartui.resources import memory_override
+
+    override = memory_override()
+    if override is not None:
+        return override
     try:
         return os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE") // 2
     except (ValueError, OSError, AttributeError):
@@ -40,12 +46,14 @@ def memory_limit() -> int:
 
 
 def check_memory(nbytes: float, what: str, advice: str) -> None:
-    """LadarError up front when ``nbytes`` would exceed ``memory_limit()``."""
+    """``ResourceLimitError`` up front when ``nbytes`` would exceed ``memory_limit()``."""
+    from ladartui.resources import gib
+
     limit = memory_limit()
     if nbytes > limit:
-        raise LadarError(
-            f"the Geiger-mode model would need about {nbytes / 2**30:.1f} GiB for "
-            f"{what}, more than the {limit / 2**30:.1f} GiB it may use here: {advice}"
+        raise ResourceLimitError(
+            f"the Geiger-mode model would need about {gib(nbytes)} for {what}, more than the "
+            f"{gib(limit)} it may use here: {advice}"
         )
 
 
