@@ -72,10 +72,29 @@ def test_shape_covers_both_lists_and_can_be_larger():
         Scene(SCENE, TARGET, 1.0, shape=(9, 4, 8))
 
 
-@pytest.mark.parametrize("size", [0, -1.0, "big", float("nan")])
-def test_voxel_size_must_be_positive(size):
-    with pytest.raises(FieldError, match="voxel_size"):
+@pytest.mark.parametrize("size", [0, -1.0, "big", float("nan"), True, np.True_, "0.25"])
+def test_voxel_size_must_be_a_positive_number(size, tmp_path):
+    """True was taken as 1 m, and the text "0.25" as a number, by the API's Scene, trace(),
+    voxelize and LAS import alike; a scenario file or compute_measures refused them."""
+    from ladartui.scene.las import export_las, import_las
+    from ladartui.scene.occupancy import Occupancy
+    from ladartui.scene.voxelize import grid_triangles
+    from ladartui.tracing import trace
+
+    said = f"voxel_size = {size!r}: expected a positive number of metres"
+    with pytest.raises(FieldError) as refused:
         Scene(SCENE, TARGET, size)
+    assert str(refused.value) == said
+    ray = np.array([[0.5, 0.5, 9.0]]), np.array([[0.0, 0.0, -1.0]])
+    for call in (
+        lambda: trace(Occupancy.build(SCENE), *ray, voxel_size=size),
+        lambda: grid_triangles(None, size),  # refused before the mesh is read
+        lambda: import_las(tmp_path / "none.las", size),  # before the file is
+        lambda: export_las(tmp_path / "out.las", SCENE, size),
+    ):
+        with pytest.raises(FieldError) as refused:
+            call()
+        assert str(refused.value) == said
 
 
 def test_target_centre_is_the_centroid_in_metres():

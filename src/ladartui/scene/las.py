@@ -18,7 +18,6 @@ every other voxel (foliage, ground) with 0.
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
@@ -27,7 +26,7 @@ from ladartui.atomic import atomic_path, write_errors_named
 from ladartui.errors import FieldError, InputFileError
 from ladartui.fileprobe import path_field, require_file
 from ladartui.scene.unique_rows import unique_voxels
-from ladartui.scene.voxel_arrays import voxel_list_field
+from ladartui.scene.voxel_arrays import voxel_list_field, voxel_size_field
 from ladartui.scene.voxels import MAX_INDEX, MAX_TARGET_ID
 
 
@@ -119,7 +118,7 @@ def _voxel_indices(path, voxel_size, origin) -> tuple[np.ndarray, np.ndarray, np
     import laspy
 
     path = path_field("path", path, "a LAS or LAZ point cloud's path")
-    size = _check_voxel_size(voxel_size)
+    size = voxel_size_field(voxel_size)
     require_file(path, "expected a LAS or LAZ point cloud")
     try:
         cloud = laspy.read(path)
@@ -176,7 +175,7 @@ def _voxel_cloud(voxels, voxel_size, origin, ids):
     """The voxel centres (metres) as a laspy cloud, ``ids`` as point source ids."""
     import laspy
 
-    size = _check_voxel_size(voxel_size)
+    size = voxel_size_field(voxel_size)
     voxels = voxel_list_field("voxels", voxels, MAX_INDEX)
     origin = np.asarray(origin, dtype=np.float64).reshape(3)
     centres = origin + voxels.reshape(-1, 3).astype(np.float64) * size
@@ -207,13 +206,3 @@ def _write_cloud(path, cloud, compress: bool) -> None:
     # Write to a stream: given a path, laspy picks compression from the suffix (.tmp here).
     with open(path, "wb+") as stream:
         cloud.write(stream, do_compress=compress)
-
-
-def _check_voxel_size(voxel_size) -> float:
-    try:
-        size = float(voxel_size)
-    except (TypeError, ValueError):
-        size = math.nan
-    if not (size > 0 and math.isfinite(size)):
-        raise FieldError("voxel_size", voxel_size, "a positive number of metres")
-    return size

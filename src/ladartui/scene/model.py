@@ -18,7 +18,7 @@ from ladartui.fingerprint import Digest, Fingerprint
 from ladartui.scene.keys import voxel_keys
 from ladartui.scene.occupancy import Occupancy, column_bounds
 from ladartui.scene.target_model import load_target
-from ladartui.scene.voxel_arrays import target_ids_field, voxel_list_field
+from ladartui.scene.voxel_arrays import target_ids_field, voxel_list_field, voxel_size_field
 from ladartui.scene.voxels import load_voxels_counted
 
 
@@ -47,7 +47,7 @@ class Scene:
         self.voxels = _as_voxel_array(voxels, "voxels")
         self.target = _as_voxel_array(target, "target")
         self.target_ids = _as_target_ids(target_ids, len(self.target))
-        self.voxel_size = _checked_voxel_size(voxel_size)
+        self.voxel_size = voxel_size_field(voxel_size)
         # (lo, hi) by target or not: one pass over each list, however many ask (the
         # extent here, the memory checks, the views)
         self._bounds: dict[bool, tuple[np.ndarray, np.ndarray]] = {
@@ -85,7 +85,7 @@ class Scene:
     @classmethod
     def load(cls, scene_path, voxel_size, shape=None) -> Scene:
         """Read ``X.txt`` and its target ``X_Target.txt``."""
-        _checked_voxel_size(voxel_size)  # before reading what may be large files
+        voxel_size_field(voxel_size)  # before reading what may be large files
         scene_path = path_field("scene_path", scene_path, "a scene model file's path")
         target_path = target_path_for(scene_path)
         scene_digest, target_digest = Digest(), Digest()
@@ -220,16 +220,6 @@ def top_height_map(voxels, nx, ny, origin=(0, 0)) -> np.ndarray:
 
 def _build_occupancy(voxels, shape, source):
     return Occupancy.build(voxels, shape, source=str(source))
-
-
-def _checked_voxel_size(voxel_size) -> float:
-    try:
-        size = float(voxel_size)
-    except (TypeError, ValueError):
-        size = float("nan")
-    if not size > 0 or not np.isfinite(size):
-        raise FieldError("voxel_size", voxel_size, "a positive number of metres")
-    return size
 
 
 def _as_target_ids(ids, count: int) -> np.ndarray:

@@ -1,10 +1,13 @@
-"""Voxel arrays given to the API: checked, or refused with a FieldError naming the argument.
+"""Voxel arrays and sizes given to the API: checked, or refused with a FieldError naming the argument.
 
 A wrong shape or type would otherwise be reshaped or truncated into other
 voxels and give a wrong answer, or fail deep inside numpy with no name.
 """
 
 from __future__ import annotations
+
+import math
+import numbers
 
 import numpy as np
 
@@ -59,3 +62,12 @@ def target_ids_field(name, ids, count: int) -> np.ndarray:
         row = int(np.argmax((array < 1) | (array > MAX_TARGET_ID)))
         raise FieldError(f"{name}[{row}]", int(array[row]), f"a target id from 1 to {MAX_TARGET_ID}")
     return array
+
+
+def voxel_size_field(value, name="voxel_size") -> float:
+    """A voxel size in metres: a finite number above 0 (not True, not text), else FieldError."""
+    ok = isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+    size = float(value) if ok else math.nan
+    if not (size > 0 and math.isfinite(size)):
+        raise FieldError(name, value, "a positive number of metres")
+    return size

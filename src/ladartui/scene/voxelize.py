@@ -44,6 +44,7 @@ import numpy as np
 
 from ladartui.errors import FieldError, InputFileError, ResourceLimitError, check_cancelled
 from ladartui.fileprobe import require_file
+from ladartui.scene.voxel_arrays import voxel_size_field
 from ladartui.scene.voxels import MAX_INDEX
 from ladartui.textsafe import one_line
 
@@ -331,7 +332,7 @@ def grid_triangles(mesh: Mesh, voxel_size: float, placement: Placement | None = 
     Raises ``FieldError`` on ``placement`` when part of the mesh would fall
     below the ground or at negative voxel indices.
     """
-    vs = _checked_size(voxel_size)
+    vs = voxel_size_field(voxel_size)
     vertices = mesh.vertices
     used = vertices[np.unique(mesh.faces)]  # stray vertices in no triangle do not move the mesh
     low, high = used.min(axis=0), used.max(axis=0)
@@ -415,16 +416,6 @@ def _turn(heading: float) -> tuple[float, float]:
         return ((1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0))[int(round(quarter)) % 4]
     radians = math.radians(heading)
     return math.cos(radians), math.sin(radians)
-
-
-def _checked_size(voxel_size) -> float:
-    try:
-        size = float(voxel_size)
-    except (TypeError, ValueError):
-        size = float("nan")
-    if not (size > 0 and math.isfinite(size)):
-        raise FieldError("voxel_size", voxel_size, "a positive number of metres")
-    return size
 
 
 @dataclass(frozen=True)

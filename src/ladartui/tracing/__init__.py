@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ladartui.errors import BackendUnavailable, FieldError, check_callbacks
+from ladartui.scene.voxel_arrays import voxel_size_field
 from ladartui.tracing.backend import (
     GROUND,
     METHODS,
@@ -200,13 +201,7 @@ def _occupancy_and_size(target, voxel_size):
             raise FieldError("voxel_size", voxel_size, f"the scene's voxel size ({size}) or None")
     else:
         raise FieldError("scene", type(target).__name__, "a Scene or an Occupancy")
-    try:
-        size = float(size)
-    except (TypeError, ValueError):
-        raise FieldError("voxel_size", size, "a positive number of metres") from None
-    if not (np.isfinite(size) and size > 0):
-        raise FieldError("voxel_size", size, "a positive number of metres")
-    return occupancy, size
+    return occupancy, voxel_size_field(size)
 
 
 def _rays(name, values):
