@@ -410,3 +410,32 @@ def test_load_scenario_names_a_path_that_is_no_path(bad):
     """load_scenario(3) failed inside pathlib with a TypeError naming no argument."""
     with pytest.raises(FieldError, match=r"^path (= .*|is not set): expected a scenario file's path"):
         load_scenario(bad)
+
+
+@pytest.mark.parametrize(
+    ("field", "bad", "message"),
+    [
+        ("path", None, "path is not set: expected a scenario file's path (str or pathlib.Path)"),
+        ("path", 3, "path = 3: expected a scenario file's path (str or pathlib.Path)"),
+        ("scene_file", 3, "files.scene = 3: expected a scene model's path (str or pathlib.Path)"),
+        ("scene_file", None, "files.scene is not set: expected a scene model's path (str or pathlib.Path)"),
+    ],
+)
+def test_a_scenario_path_that_is_no_path_is_a_field_error(tmp_path, field, bad, message):
+    """Scenario(path=None) and with_changes(scene_file=3) failed inside pathlib with a
+    TypeError naming no field."""
+    scenario = load_scenario(write_scenario(tmp_path), check_files=False)
+    with pytest.raises(FieldError) as caught:
+        scenario.with_changes(**{field: bad})
+    assert str(caught.value) == message
+    with pytest.raises(FieldError) as caught:
+        dataclasses.replace(scenario, **{field: bad})
+    assert str(caught.value) == message
+
+
+def test_a_new_scenario_checks_its_voxel_size_before_the_default_orbit(tmp_path):
+    """Scenario.new(..., voxel_size="a") raised ValueError from the default orbit's sums."""
+    write_models(tmp_path / "models")
+    with pytest.raises(FieldError) as caught:
+        Scenario.new(tmp_path / "new.toml", "models/forest.txt", "a")
+    assert str(caught.value) == "files.voxel_size = 'a': expected a number from 0.001 to 100"

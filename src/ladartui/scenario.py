@@ -95,9 +95,10 @@ class Scenario:
 
     def __post_init__(self):
         set_ = object.__setattr__
-        path = _absolute(self.path)
+        path = _absolute(path_field("path", self.path, "a scenario file's path"))
         set_(self, "path", path)
-        set_(self, "scene_file", resolve_path(path.parent, self.scene_file))
+        scene_file = path_field("files.scene", self.scene_file, "a scene model's path")
+        set_(self, "scene_file", resolve_path(path.parent, scene_file))
         set_(
             self,
             "voxel_size",
@@ -262,8 +263,10 @@ class Scenario:
         The default orbit (see ``ladartui.defaults.default_flight``) reads the
         target model to find the target centre; ``sensor`` defaults likewise.
         """
-        path = _absolute(path)
-        scene_file = resolve_path(path.parent, scene_file)
+        path = _absolute(path_field("path", path, "a scenario file's path"))
+        scene_file = resolve_path(path.parent, path_field("files.scene", scene_file, "a scene model's path"))
+        # before the default orbit reads it: a bad size is the field's error, not the sums'
+        voxel_size = number_field("files.voxel_size", voxel_size, MIN_VOXEL_SIZE, MAX_VOXEL_SIZE)
         if sensor is None:
             sensor = defaults.DEFAULT_SENSOR
         if flight is None:
