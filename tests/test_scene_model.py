@@ -72,6 +72,30 @@ def test_shape_covers_both_lists_and_can_be_larger():
         Scene(SCENE, TARGET, 1.0, shape=(9, 4, 8))
 
 
+@pytest.mark.parametrize(
+    ("shape", "shown"),
+    [
+        ("abc", "'abc'"),
+        (12, "12"),
+        ((None, 4, 8), r"\(None, 4, 8\)"),
+        ((float("nan"), 4, 8), r"\(nan, 4, 8\)"),
+        ((10.5, 4, 8), r"\(10.5, 4, 8\)"),
+        ((10, 4), r"\(10, 4\)"),
+    ],
+)
+def test_a_shape_that_is_no_three_whole_numbers_is_a_field_error(shape, shown):
+    """shape="abc" or (None, 4, 8) raised ValueError or TypeError from int(), and
+    (10.5, 4, 8) was cut to (10, 4, 8) without a word."""
+    expected = rf"^shape = {shown}: expected \(nx, ny, nz\) at least \(10, 4, 8\)$"
+    with pytest.raises(FieldError, match=expected):
+        Scene(SCENE, TARGET, 1.0, shape=shape)
+
+
+def test_a_shape_of_numpy_integers_is_taken():
+    assert Scene(SCENE, TARGET, 1.0, shape=np.array([10, 4, 9])).shape == (10, 4, 9)
+    assert Scene(SCENE, TARGET, 1.0, shape=(np.int64(10), np.int32(4), 8)).shape == (10, 4, 8)
+
+
 @pytest.mark.parametrize("size", [0, -1.0, "big", float("nan"), True, np.True_, "0.25"])
 def test_voxel_size_must_be_a_positive_number(size, tmp_path):
     """True was taken as 1 m, and the text "0.25" as a number, by the API's Scene, trace(),

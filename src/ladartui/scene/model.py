@@ -7,6 +7,7 @@ units, so its centre in metres is ``(i, j, k) * voxel_size``.
 
 from __future__ import annotations
 
+import operator
 import threading
 from pathlib import Path
 
@@ -55,12 +56,7 @@ class Scene:
         }
         highest = [hi for _, hi in self._bounds.values()]
         needed = tuple(int(v) + 1 for v in np.max(highest, axis=0)) if highest else (0, 0, 0)
-        if shape is None:
-            shape = needed
-        shape = tuple(int(s) for s in shape)
-        if len(shape) != 3 or any(s < n for s, n in zip(shape, needed)):
-            raise FieldError("shape", shape, f"(nx, ny, nz) at least {needed}")
-        self.shape = shape
+        self.shape = needed if shape is None else _checked_shape(shape, needed)
         self.path = Path(path) if path is not None else None
         self.name = name if name is not None else (self.path.stem if self.path else "scene")
         self.fingerprints: dict[Path, Fingerprint] = dict(fingerprints or {})
@@ -220,6 +216,24 @@ def top_height_map(voxels, nx, ny, origin=(0, 0)) -> np.ndarray:
 
 def _build_occupancy(voxels, shape, source):
     return Occupancy.build(voxels, shape, source=str(source))
+
+
+def _checked_shape(shape, needed: tuple[int, ...]) -> tuple[int, ...]:
+    """``shape`` as three ints, each at least the extent ``needed``; else FieldError.
+    Whole numbers only: int() took "abc" to a ValueError and cut 10.5 to 10."""
+    try:
+        sides = None if isinstance(shape, (str, bytes)) else [_whole(side) for side in shape]
+    except TypeError:
+        sides = None
+    if sides is None or len(sides) != 3 or any(s < n for s, n in zip(sides, needed)):
+        raise FieldError("shape", shape, f"(nx, ny, nz) at least {needed}")
+    return tuple(sides)
+
+
+def _whole(side) -> int:
+    if isinstance(side, bool):
+        raise TypeError("a truth value is no side")
+    return operator.index(side)  # numpy's integers too, never a float
 
 
 def _as_target_ids(ids, count: int) -> np.ndarray:
