@@ -217,9 +217,13 @@ def run_sweep(
         )
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise FieldError("workers", workers, "an integer >= 1")
+    if not isinstance(serial, bool):  # "no" is truthy: it ran the sweep serially
+        raise FieldError("serial", serial, "True or False")
+    if client is not None:
+        _check_client(client)
     if client is None and not serial:
         check_local_workers(workers)
-    out = Path(out) if out is not None else default_out_dir(spec)
+    out = path_field("out", out, "a results folder's path") if out is not None else default_out_dir(spec)
     if out.exists() and not out.is_dir():
         raise OutputFileError(out, "is a file, expected a folder")
     check_sweep_files(out, spec.name)
@@ -246,6 +250,15 @@ def run_sweep(
             simulate_options,
             started,
         )
+
+
+def _check_client(client) -> None:
+    """FieldError unless ``client`` is a ``distributed.Client``: a scheduler's address given
+    in its place failed with AttributeError only once the variants were due to run."""
+    from distributed import Client
+
+    if not isinstance(client, Client):
+        raise FieldError("client", client, "a distributed.Client (or None)")
 
 
 # The sweep command's Pareto charts beside the tables (charts/sweep.py writes them).
