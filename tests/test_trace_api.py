@@ -93,6 +93,14 @@ def test_unknown_backend_is_a_field_error(block):
         trace(block, np.zeros((1, 3)), np.ones((1, 3)), backend="nope")
 
 
+@pytest.mark.parametrize("name", [["numba"], {"numba": 1}])
+def test_a_backend_that_is_no_name_is_a_field_error(block, name):
+    """backend=["numba"] failed with "unhashable type: 'list'" from the registry."""
+    with pytest.raises(FieldError) as caught:
+        trace(block, np.zeros((1, 3)), np.ones((1, 3)), backend=name)
+    assert str(caught.value) == f"backend = {name!r}: expected one of auto, " + ", ".join(backend_names())
+
+
 def test_registry_lists_numba_and_explains_unavailable_backends():
     assert "numba" in backend_names()
     status = backend_status()

@@ -104,7 +104,7 @@ def backend_names() -> list[str]:
 def get_backend(name: str) -> Backend:
     """The usable backend ``name``; raises BackendUnavailable with the reason."""
     _load_builtin()
-    if name not in _FACTORIES:
+    if not isinstance(name, str) or name not in _FACTORIES:  # (a list is unhashable)
         raise FieldError("backend", name, "one of " + ", ".join(["auto", *_FACTORIES]))
     with _lock:
         if name not in _INSTANCES:
