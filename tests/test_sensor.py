@@ -191,6 +191,17 @@ def hand_footprint(position, bearing, depression, fov, ground_z):
     return np.array(corners)
 
 
+def test_a_ground_plane_above_the_sensor_has_no_footprint():
+    """ground_z above the aircraft gave four corners behind the sensor (each ray run
+    backwards up to the plane), mirrored through the aircraft, as if seen."""
+    sensor = Sensor(grid=4, ray_grid=1, fov=10.0)
+    pose = ScanPose(0.0, 0.0, 10.0, depression=60.0)
+    assert np.isnan(sensor.footprint(pose, ground_z=20.0)).all()
+    np.testing.assert_allclose(sensor.footprint(pose, ground_z=10.0)[:, :2], 0.0, atol=1e-12)
+    with pytest.raises(FieldError, match=r"^ground_z = 'low': expected a finite number$"):
+        sensor.footprint(pose, ground_z="low")
+
+
 @pytest.mark.parametrize(
     "field,value,message",
     [

@@ -264,11 +264,13 @@ class Sensor:
 
         The corners are the edges of the view (angles +-fov/2 on both axes), in
         the order of ``corner_directions``. A corner that never reaches the
-        ground (at or above the horizon) is NaN.
+        ground (at or above the horizon, or a plane above the sensor) is NaN.
         """
+        ground_z = number_field("ground_z", ground_z)
         directions = self.corner_directions(pose, attitude)
         origin = np.array(pose.position)
         drop = origin[2] - ground_z
         with np.errstate(divide="ignore", invalid="ignore"):
-            t = np.where(directions[:, 2] < 0, drop / -directions[:, 2], np.nan)
+            # a plane above the sensor lies behind every downward ray: no corner meets it
+            t = np.where((directions[:, 2] < 0) & (drop >= 0), drop / -directions[:, 2], np.nan)
         return origin + t[:, None] * directions
