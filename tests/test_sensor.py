@@ -148,6 +148,15 @@ def test_row_chunks_are_slices_of_the_whole_scan():
             np.testing.assert_array_equal(got, full[start:stop])
 
 
+@pytest.mark.parametrize("rows", [3, "0:2", slice("a", 2), [0, 1]])
+def test_rows_that_are_no_slice_or_range_are_a_field_error(rows):
+    """rows=3 failed with "'int' object has no attribute 'indices'", slice("a", 2)
+    with a TypeError from inside Python's slice arithmetic."""
+    with pytest.raises(FieldError) as caught:
+        Sensor(grid=4, ray_grid=1).rays(ScanPose(0.0, 0.0, 50.0), rows=rows)
+    assert str(caught.value) == f"rows = {rows!r}: expected a contiguous range of detector rows"
+
+
 def test_footprint_at_nadir_and_tilted():
     sensor = Sensor(grid=16, ray_grid=1, fov=20.0)
     corners = sensor.footprint(ScanPose(10.0, 20.0, 100.0, depression=90.0))

@@ -77,6 +77,19 @@ def _rotation(pose: ScanPose, attitude) -> np.ndarray:
     return body_rotation(pose.heading, *angles) @ rotation
 
 
+def _row_span(rows, grid: int) -> tuple[int, int, int]:
+    """``rows`` (a slice or range of detector rows, step 1) as (first, stop, 1)."""
+    span = None
+    if isinstance(rows, (range, slice)):
+        try:
+            span = slice(rows.start, rows.stop, rows.step).indices(grid)
+        except TypeError:  # a bound that is no integer: slice("a", 2)
+            span = None
+    if span is None or span[2] != 1:
+        raise FieldError("rows", rows, "a contiguous range of detector rows")
+    return span
+
+
 def _attitude_angles(attitude) -> tuple[float, ...]:
     """(roll, pitch) or (roll, pitch, yaw) degrees as finite floats, else FieldError."""
     expected = "(roll, pitch) or (roll, pitch, yaw): finite angles in degrees"
@@ -222,11 +235,7 @@ class Sensor:
         pose = pose_field("pose", pose)
         row0, row1 = 0, self.grid
         if rows is not None:
-            if isinstance(rows, range):
-                rows = slice(rows.start, rows.stop, rows.step)
-            row0, row1, step = rows.indices(self.grid)
-            if step != 1:
-                raise FieldError("rows", rows, "a contiguous range of detector rows")
+            row0, row1, step = _row_span(rows, self.grid)
             row1 = max(row0, row1)
         count = (row1 - row0) * self.grid * self.ray_grid**2
         origins = np.empty((count, 3))
