@@ -208,3 +208,18 @@ def test_toml_syntax_error_gives_the_line(tmp_path):
         load_scenario(path, check_files=False)
     assert caught.value.line == line_of(text, "grid = = 32")
     assert str(caught.value).startswith(f"{path}:{caught.value.line}: not valid TOML: ")
+
+
+@pytest.mark.parametrize("mark", ["\u2028", "\u2029", "\x85"])
+def test_a_comment_holding_a_unicode_line_separator_keeps_the_lines_that_follow(tmp_path, mark):
+    """TOML ends a line at a newline alone; a line separator pasted into a comment
+    (from a document or a web page) counted as one more line, and every error
+    below it named the line after its own."""
+    text = f"# flown as the report's figure 9{mark} (orbit, then straight)\n" + edited(
+        "grid = 32", "grid = 0"
+    )
+    path = write_scenario(tmp_path, text)
+    with pytest.raises(FieldError) as caught:
+        load_scenario(path, check_files=False)
+    line = text[: text.index("grid = 0")].count("\n") + 1  # 7: the file's line, as an editor numbers it
+    assert str(caught.value).startswith(f"{path}:{line}: sensor.grid = 0")

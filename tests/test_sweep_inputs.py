@@ -201,6 +201,15 @@ def test_a_bad_value_is_named_on_its_own_line_however_its_key_is_written(tmp_pat
         load_sweep_spec(spec)
 
 
+def test_a_bad_value_after_a_comment_holding_a_line_separator_is_named_on_its_own_line(tmp_path):
+    """U+2028 in a comment counted as a line break: the error named line 5 for line 4."""
+    write_tiny_scenario(tmp_path)
+    spec = tmp_path / "spec.toml"
+    spec.write_text('[sweep]  # radius\u2028sweep\nscenario = "base.toml"\n[grid]\nradius = [20.0, "x"]\n')
+    with pytest.raises(InputFileError, match=r"spec\.toml:4: grid\.radius"):
+        load_sweep_spec(spec)
+
+
 def test_a_variant_refused_by_this_machines_limits_runs_again_on_resume(tmp_path, monkeypatch):
     """A ray limit refusal was stored as an impossible value ('error'), never run again,
     though the limit belongs to the machine, not to the variant."""

@@ -376,3 +376,14 @@ def test_a_sweep_over_speed_of_a_flight_log_alone_is_refused(tmp_path, capsys):
     assert main(["sweep", str(spec), "--serial"]) == 2
     err = capsys.readouterr().err.strip().splitlines()[-1]
     assert f"{spec}:4: grid.speed: no variant can run" in err and "keeps the log's own clock" in err
+
+
+@pytest.mark.parametrize("mark", ["\u2028", "\x85", "\x0c"])
+def test_a_line_separator_inside_a_comment_keeps_the_log_s_line_numbers(tmp_path, mark):
+    """A comment holding a line separator (or a form feed) was counted as two lines,
+    so a bad record below it was named on the line after its own."""
+    path = tmp_path / "log.csv"
+    path.write_text(f"# pass 2{mark} east\ntime,x,y,z,heading\n0,0,0,60,0\n1,0,abc,60,0\n", encoding="utf-8")
+    with pytest.raises(TrajectoryError) as caught:
+        load_flight_log(path)
+    assert str(caught.value) == f"{path}:4: y = 'abc': expected a number"

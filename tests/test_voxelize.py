@@ -458,6 +458,18 @@ def test_a_bad_obj_line_is_named_even_where_the_reader_gets_past_it(tmp_path, ch
     assert str(caught.value).startswith(f"{path}{said}")
 
 
+@pytest.mark.parametrize("name", [b"caf\xe9 \x85 2", "dune\u2028buggy".encode()])
+def test_a_bad_obj_line_is_named_on_its_own_line_after_a_name_holding_a_line_break_character(tmp_path, name):
+    """An object name in Latin-1 ('...' is byte 0x85 in Windows' code page, a line
+    break once read) or holding U+2028 counted as two lines: every line below was
+    named one too far on."""
+    path = tmp_path / "cube.obj"
+    path.write_bytes(b"o " + name + b"\n" + CUBE_OBJ.replace("f 1 3 2\n", "f 0 3 2\n", 1).encode())
+    with pytest.raises(InputFileError) as caught:
+        load_mesh(path)
+    assert str(caught.value).startswith(f"{path}:10: face 'f 0 3 2' refers to vertex 0")
+
+
 def test_a_good_obj_cube_is_read_whole(tmp_path):
     path = tmp_path / "cube.obj"
     path.write_text(CUBE_OBJ)

@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from ladartui.errors import InputFileError
-from ladartui.fileprobe import path_field, read_utf8
+from ladartui.fileprobe import path_field, read_utf8, text_lines
 from ladartui.levels import level_result_from_dict
 from ladartui.measures import CMF_HEADER, CMF_HEADERS, Measures, measures_from_lines
 from ladartui.target_measures import PerTarget, is_target_section, read_target_lines
@@ -24,7 +24,7 @@ def read_cmf(path) -> Measures:
         text = read_utf8(path, "expected a measures file (.cmf)")
     except OSError as error:
         raise InputFileError(path, f"cannot read: {error.strerror or error}") from None
-    lines = text.splitlines()
+    lines = text_lines(text)
     version = CMF_HEADERS.get(lines[0].strip()) if lines else None
     if version is None:
         raise InputFileError(path, f"not a measures file: expected first line {CMF_HEADER!r}", line=1)

@@ -3,6 +3,7 @@ a path argument that is no path (None, a number) as a FieldError."""
 
 import errno
 import os
+import re
 from pathlib import Path
 
 from ladartui.errors import FieldError, InputFileError, os_reason
@@ -56,6 +57,20 @@ def file_problem(path: Path) -> str | None:
 def not_utf8(data: bytes, error: UnicodeDecodeError) -> tuple[int, str]:
     """Where ``data`` stops being UTF-8 text: the line (from 1) and "not UTF-8 text (byte 0xNN)"."""
     return data.count(b"\n", 0, error.start) + 1, f"not UTF-8 text (byte 0x{data[error.start]:02x})"
+
+
+_LINE_END = re.compile(r"\r\n|\r|\n")
+
+
+def text_lines(text: str) -> list[str]:
+    """The lines of a file's ``text`` as an editor numbers them: ended by LF, CR LF or CR
+    alone, and by nothing else. ``str.splitlines`` also ends one at a form feed, at
+    U+0085 (Windows' '...' read as Latin-1) and at U+2028/U+2029, which a comment pasted
+    from a document may hold: every line below would be named one too far on."""
+    lines = _LINE_END.split(text)
+    if lines[-1] == "":  # the final line end ends a line; it starts none
+        lines.pop()
+    return lines
 
 
 def read_utf8(path, expected: str) -> str:

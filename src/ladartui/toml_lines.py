@@ -12,7 +12,7 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from ladartui.fileprobe import SPECIAL_FILE, file_problem
+from ladartui.fileprobe import SPECIAL_FILE, file_problem, text_lines
 
 _HEADER = re.compile(r"^\s*(\[\[?)\s*([A-Za-z0-9_.\-]+)\s*\]\]?")
 _KEY = re.compile(r"""^\s*(?:([A-Za-z0-9_\-]+)|"([^"\\]*)"|'([^']*)')\s*=""")  # bare or quoted
@@ -35,7 +35,7 @@ def key_lines_from_text(text: str) -> dict[str, int]:
     lines: dict[str, int] = {}
     arrays: dict[str, int] = {}  # array-of-tables name -> current index
     current = ""
-    for number, line in enumerate(text.splitlines(), start=1):
+    for number, line in enumerate(text_lines(text), start=1):
         header = _HEADER.match(line)
         if header:
             name = _indexed(header.group(2), arrays)

@@ -26,7 +26,7 @@ import numpy as np
 
 from ladartui.checks import MAX_COORDINATE
 from ladartui.errors import FieldError, LadarError
-from ladartui.fileprobe import file_problem, not_utf8, path_field, refuse_special_file
+from ladartui.fileprobe import file_problem, not_utf8, path_field, refuse_special_file, text_lines
 from ladartui.fingerprint import Fingerprint, fingerprint_of
 from ladartui.flight import MAX_ALTITUDE, ScanPose
 from ladartui.number_text import plural
@@ -93,11 +93,11 @@ def load_flight_log(path, origin=None) -> FlightLog:
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as error:
-        line, problem = not_utf8(data, error)
-        raise TrajectoryError(f"{path}:{line}: {problem}; expected a flight log (CSV)") from None
+        at, problem = not_utf8(data, error)
+        raise TrajectoryError(f"{path}:{at}: {problem}; expected a flight log (CSV)") from None
     rows = [
         (n, line)
-        for n, line in enumerate(text.splitlines(), start=1)
+        for n, line in enumerate(text_lines(text), start=1)
         if line.strip() and not line.lstrip().startswith("#")
     ]
     if not rows:

@@ -43,7 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.errors import FieldError, InputFileError, ResourceLimitError, check_cancelled
-from ladartui.fileprobe import require_file
+from ladartui.fileprobe import require_file, text_lines
 from ladartui.scene.voxel_arrays import voxel_size_field
 from ladartui.scene.voxels import MAX_INDEX
 from ladartui.textsafe import one_line
@@ -215,7 +215,7 @@ def check_obj_lines(path: Path, text: str) -> None:
     are not integers or lie outside the file's vertices (1..V, or -1..-V counting
     back from the latest). Called before the mesh reader, which reads past such
     lines (a nan vertex's faces dropped, index 0 taken) or fails naming none."""
-    lines = text.splitlines()
+    lines = text_lines(text)
     records = ("v ", "v\t", "f ", "f\t")
 
     def record(line: str) -> str:

@@ -41,7 +41,7 @@ from typing import NoReturn
 import numpy as np
 
 from ladartui.errors import InputFileError
-from ladartui.fileprobe import NO_SUCH_FILE, path_field, read_utf8
+from ladartui.fileprobe import NO_SUCH_FILE, path_field, read_utf8, text_lines
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.sweep.variant import applicable
 from ladartui.user_data import bundled_scenario_name
@@ -330,7 +330,7 @@ class _Checker:
 
     def __init__(self, path: Path, text: str = ""):
         self.path = path
-        self.lines = text.splitlines()
+        self.lines = text_lines(text)
 
     def fail(self, key: str, expected: str, value: object = ...) -> NoReturn:
         shown = "" if value is ... else " (not set)" if value is None else f" (got {value!r})"
