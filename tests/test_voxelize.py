@@ -470,6 +470,18 @@ def test_a_bad_obj_line_is_named_on_its_own_line_after_a_name_holding_a_line_bre
     assert str(caught.value).startswith(f"{path}:10: face 'f 0 3 2' refers to vertex 0")
 
 
+def test_an_obj_saved_with_a_byte_order_mark_is_read_whole(tmp_path):
+    """Saved with a UTF-8 byte order mark (as Windows editors may), the mark hid the
+    first vertex: "face 'f 6 8 7' refers to vertex 8: expected 1 to 7"."""
+    path = tmp_path / "cube.obj"
+    path.write_text(CUBE_OBJ, encoding="utf-8-sig")
+    mesh = load_mesh(path)
+    assert mesh.faces.shape == (12, 3) and mesh.closed
+    assert sorted(map(tuple, mesh.vertices.tolist())) == [
+        (x, y, z) for x in (0.0, 1.0) for y in (0.0, 1.0) for z in (0.0, 1.0)
+    ]
+
+
 def test_a_good_obj_cube_is_read_whole(tmp_path):
     path = tmp_path / "cube.obj"
     path.write_text(CUBE_OBJ)

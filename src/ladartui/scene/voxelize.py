@@ -30,6 +30,7 @@ put on it first: mesh files round (an STL holds float32).
 
 from __future__ import annotations
 
+import codecs
 import contextlib
 import logging
 import math
@@ -162,6 +163,8 @@ def _mesh_source(path: Path, kind: str):
         _check_stl_whole(path, data)
         if _binary_stl(data):
             return io.BytesIO(data), None
+    if data.startswith(codecs.BOM_UTF8):  # saved by a Windows editor: no part of the first line
+        data = data[len(codecs.BOM_UTF8) :]
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError:  # exporters write names in Latin-1, and trimesh would
