@@ -223,6 +223,12 @@ def test_a_bad_origin_in_a_scenario_is_named_on_its_line(tmp_path, origin, found
             "log.csv:3: altitude = 200000.0 puts the aircraft 199440.0 m above the origin: "
             "expected at most 100000 m above it",
         ),
+        # times whose span passes the float range ended in OverflowError at the scan count
+        (
+            "time,x,y,z,heading",
+            "1.7e308,0,0,60,0",
+            "log.csv:3: time = '1.7e308': expected seconds within +-1e+15",
+        ),
         # angles past any a log holds were taken (a body-fixed sensor turned by them)
         (
             "time,x,y,z,heading",

@@ -149,6 +149,10 @@ def load_flight_log(path, origin=None) -> FlightLog:
                 raise TrajectoryError(f"{path}:{number}: {name} = {raw!r}: expected a number") from None
             if not np.isfinite(value):
                 raise TrajectoryError(f"{path}:{number}: {name} = {raw!r}: expected a finite number")
+            if name == "time" and abs(value) > MAX_LOG_TIME:
+                raise TrajectoryError(
+                    f"{path}:{number}: time = {raw!r}: expected seconds within +-{MAX_LOG_TIME:g}"
+                )
             if name in LOG_ANGLE_LIMITS and abs(value) > LOG_ANGLE_LIMITS[name]:
                 raise TrajectoryError(
                     f"{path}:{number}: {name} = {raw!r}: expected degrees within +-{LOG_ANGLE_LIMITS[name]:g}"
@@ -208,6 +212,10 @@ def load_flight_log(path, origin=None) -> FlightLog:
         xyz = np.stack([arr["x"], arr["y"], arr["z"]], axis=1)
     return FlightLog(arr["time"], xyz, arr["heading"], arr["roll"], arr["pitch"], fingerprint_of(data))
 
+
+# A record's time, in seconds either way of 0: milliseconds since 1970 fit (1.7e12); past
+# it a log's span could pass the float range (-1e308 to 1e308), which no scan count takes.
+MAX_LOG_TIME = 1e15
 
 # Angles a log may hold, in degrees: a heading unwrapped over up to a hundred turns, a
 # roll or pitch either way round once; past them a value is no angle (1e20 was taken).
