@@ -69,6 +69,22 @@ def test_malformed_lines_name_file_and_line(tmp_path, text, where, what):
     assert f"{path}{where}" in str(error.value) and what in str(error.value)
 
 
+@pytest.mark.parametrize("separator", [";", "\t"])
+def test_a_log_of_another_separator_is_told_so_not_that_its_header_lacks_every_column(tmp_path, separator):
+    """A spreadsheet's semicolon CSV (or a tab-separated export) was refused with 'header
+    lacks time, x, y, z, heading', a header that plainly names them."""
+    path = tmp_path / "log.csv"
+    header = separator.join(["time", "x", "y", "z", "heading"])
+    path.write_text(f"{header}\n" + separator.join("00060") + "\n")
+    with pytest.raises(TrajectoryError) as caught:
+        load_flight_log(path)
+    assert str(caught.value) == (
+        f"{path}:1: header {header!r} is one column, separated by {separator!r}: expected columns "
+        "separated by commas: time, x, y, z, heading, or time, latitude, longitude, altitude, "
+        "heading (optional roll, pitch)"
+    )
+
+
 def test_example_log_loads():
     from pathlib import Path
 

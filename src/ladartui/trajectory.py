@@ -34,6 +34,10 @@ from ladartui.number_text import plural
 REQUIRED = ("time", "x", "y", "z", "heading")
 GEODETIC = ("latitude", "longitude", "altitude")
 OPTIONAL = ("roll", "pitch")
+LOG_COLUMNS = (
+    f"{', '.join(REQUIRED)}, or time, {', '.join(GEODETIC)}, heading (optional {', '.join(OPTIONAL)})"
+)
+LOG_SEPARATORS = (";", "\t", "|")  # what other exports separate columns with
 WGS84_A = 6378137.0  # semi-major axis, metres
 WGS84_F = 1 / 298.257223563  # flattening
 WGS84_E2 = WGS84_F * (2 - WGS84_F)  # first eccentricity squared
@@ -104,6 +108,12 @@ def load_flight_log(path, origin=None) -> FlightLog:
         raise TrajectoryError(f"{path}: empty flight log: expected a header and records")
     header_line, header = rows[0]
     names = [name.strip().lower() for name in next(csv.reader([header]))]
+    separator = next((s for s in LOG_SEPARATORS if len(names) == 1 and s in header), None)
+    if separator is not None:  # a spreadsheet's semicolon CSV, a tab-separated export
+        raise TrajectoryError(
+            f"{path}:{header_line}: header {header.strip()!r} is one column, separated by "
+            f"{separator!r}: expected columns separated by commas: {LOG_COLUMNS}"
+        )
     for column, name in enumerate(names):
         if name and name in names[:column]:
             raise TrajectoryError(
@@ -115,9 +125,7 @@ def load_flight_log(path, origin=None) -> FlightLog:
     missing = [c for c in required if c not in names]
     if missing:
         raise TrajectoryError(
-            f"{path}:{header_line}: header lacks {', '.join(missing)}: "
-            f"expected columns {', '.join(REQUIRED)}, or time, latitude, "
-            "longitude, altitude, heading (optional roll, pitch)"
+            f"{path}:{header_line}: header lacks {', '.join(missing)}: expected columns {LOG_COLUMNS}"
         )
     if origin is not None and not geodetic:  # it would be taken and never used
         raise FieldError(
