@@ -148,6 +148,17 @@ def test_a_spec_that_is_not_toml_names_its_line(tmp_path):
         load_sweep_spec(path)
 
 
+def test_a_toml_mistake_in_a_spec_is_named_as_file_and_line_as_a_scenario_s_is(tmp_path):
+    """It read 'spec.toml: not valid TOML: Expected '=' after a key in a key/value pair
+    (at line 3, column 8)': the line inside the message, not where editors look for it."""
+    path = tmp_path / "spec.toml"
+    path.write_text('[sweep]\nscenario = "a.toml"\nradius 20\n', encoding="utf-8")
+    with pytest.raises(InputFileError) as caught:
+        load_sweep_spec(path)
+    assert caught.value.line == 3
+    assert str(caught.value) == f"{path}:3: not valid TOML: Expected '=' after a key in a key/value pair"
+
+
 # -- variant ids ---------------------------------------------------------------------
 
 

@@ -141,7 +141,7 @@ def test_the_setting_is_read_from_settings_toml(tmp_path):
             r"settings\.toml:3: display\.graphics = .retina.: expected one of ",
         ),
         ("[display]\ngraphics = 3\n", r"settings\.toml:2: display\.graphics = 3: expected one of "),
-        ('[display\ngraphics = "kitty"\n', r"settings\.toml: .*line 1"),
+        ('[display\ngraphics = "kitty"\n', r"settings\.toml:1: not valid TOML: [^(]*$"),
         ('display = "kitty"\n', r"settings\.toml:1: display must be a table"),
     ],
 )

@@ -109,7 +109,7 @@ from ladartui.errors import FieldError, InputFileError
 from ladartui.flight import MAX_SCANS, SEGMENT_KINDS, FlightPlan, Manual, ScanPose
 from ladartui.levels import LEVEL_KEYS, level_below, levels_from_table
 from ladartui.sensor import MAX_PIXEL_PITCH, MIN_PIXEL_PITCH, Sensor
-from ladartui.toml_lines import key_lines_from_text
+from ladartui.toml_lines import key_lines_from_text, toml_mistake
 from ladartui.trajectory import LogSegment
 
 SENSOR_KEYS = {  # TOML key -> (Sensor field, file units per Sensor unit)
@@ -151,10 +151,7 @@ def parse_document(text: str, path: Path) -> dict:
     except RecursionError:
         raise InputFileError(path, NESTED_TOO_DEEP) from None
     except tomllib.TOMLDecodeError as error:
-        message = str(error)
-        found = re.search(r"\(at line (\d+), column \d+\)", message)
-        line = int(found.group(1)) if found else None
-        message = re.sub(r"\s*\(at line \d+, column \d+\)", "", message)
+        message, line = toml_mistake(error)
         raise InputFileError(path, f"not valid TOML: {message}", line) from None
 
 

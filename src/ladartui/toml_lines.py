@@ -18,6 +18,16 @@ _HEADER = re.compile(r"^\s*(\[\[?)\s*([A-Za-z0-9_.\-]+)\s*\]\]?")
 _KEY = re.compile(r"""^\s*(?:([A-Za-z0-9_\-]+)|"([^"\\]*)"|'([^']*)')\s*=""")  # bare or quoted
 
 
+_AT_LINE = re.compile(r"\s*\(at line (\d+), column \d+\)")
+
+
+def toml_mistake(error: tomllib.TOMLDecodeError) -> tuple[str, int | None]:
+    """What a TOML syntax error says, less its "(at line L, column C)", and L (None when
+    it names no line: "at end of document"): so every message reads ``file:line: ...``."""
+    found = _AT_LINE.search(str(error))
+    return _AT_LINE.sub("", str(error)), int(found.group(1)) if found else None
+
+
 def key_lines(path: Path) -> dict[str, int]:
     """``key_lines_from_text`` of a file; empty when it cannot be read."""
     try:
@@ -86,8 +96,9 @@ def read_config_table(path: Path, name: str, what: str) -> ConfigTable:
     ``what`` says what the table holds ("command id = key")."""
     from ladartui.textsafe import one_line
 
-    def failed(problem: str) -> ConfigTable:
-        return ConfigTable({}, [one_line(f"{path}: {problem}")], {}, path)
+    def failed(problem: str, line: int | None = None) -> ConfigTable:
+        where = f"{path}:{line}" if line else str(path)
+        return ConfigTable({}, [one_line(f"{where}: {problem}")], {}, path)
 
     if file_problem(path) == SPECIAL_FILE:  # a pipe would wait for ever
         return failed(SPECIAL_FILE)
@@ -102,7 +113,8 @@ def read_config_table(path: Path, name: str, what: str) -> ConfigTable:
     try:
         document = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
-        return failed(f"{error}")
+        said, line = toml_mistake(error)
+        return failed(f"not valid TOML: {said}", line)
     except RecursionError:
         return failed("nested too deep to read")
     config = ConfigTable({}, [], key_lines_from_text(text), path)

@@ -44,6 +44,7 @@ from ladartui.errors import InputFileError
 from ladartui.fileprobe import NO_SUCH_FILE, path_field, read_utf8, text_lines
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.sweep.variant import applicable
+from ladartui.toml_lines import toml_mistake
 from ladartui.user_data import bundled_scenario_name
 
 PRESETS = ("orbit", "flypast", "standoff")
@@ -223,8 +224,8 @@ def load_sweep_spec(path) -> SweepSpec:
     except OSError as error:
         raise InputFileError(path, f"cannot read: {error.strerror or error}") from None
     except tomllib.TOMLDecodeError as error:
-        line = getattr(error, "lineno", None)
-        raise InputFileError(path, f"not valid TOML: {error}", line=line) from None
+        message, line = toml_mistake(error)
+        raise InputFileError(path, f"not valid TOML: {message}", line=line) from None
     return parse_sweep_spec(data, path, text)
 
 
