@@ -148,6 +148,20 @@ def test_a_spec_that_is_not_toml_names_its_line(tmp_path):
         load_sweep_spec(path)
 
 
+def test_a_scenario_given_as_the_spec_is_told_so(tmp_path):
+    """'ladartui sweep orbit.toml' said 'orbit.toml:1: files: unknown key; expected one of
+    grid, random, sweep', as if the scenario were a spec with a typing mistake; the
+    scenario reader tells the other way round ('a sweep spec ([sweep]), not a scenario')."""
+    path = tmp_path / "orbit.toml"
+    path.write_text('# an orbit\n[files]\nscene = "s.txt"\n[flight]\nspeed_mps = 30.0\n')
+    with pytest.raises(InputFileError) as caught:
+        load_sweep_spec(path)
+    assert str(caught.value) == (
+        f"{path}:2: a scenario ([files]), not a sweep spec: a spec's [sweep] names it "
+        "(scenario = \"orbit.toml\"), see docs/sweeps.md; 'ladartui run FILE' runs it"
+    )
+
+
 def test_a_toml_mistake_in_a_spec_is_named_as_file_and_line_as_a_scenario_s_is(tmp_path):
     """It read 'spec.toml: not valid TOML: Expected '=' after a key in a key/value pair
     (at line 3, column 8)': the line inside the message, not where editors look for it."""

@@ -42,6 +42,7 @@ import numpy as np
 
 from ladartui.errors import InputFileError
 from ladartui.fileprobe import NO_SUCH_FILE, path_field, read_utf8, text_lines
+from ladartui.scenario_file import SECTIONS as SCENARIO_SECTIONS
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.sweep.variant import applicable
 from ladartui.toml_lines import toml_mistake
@@ -233,6 +234,14 @@ def parse_sweep_spec(data: dict, path, text: str = "") -> SweepSpec:
     """Check a spec already read from TOML (``path`` names it in errors; ``text`` finds lines)."""
     path = Path(path)
     checker = _Checker(path, text)
+    scenario_table = next((key for key in data if key in SCENARIO_SECTIONS), None)
+    if "sweep" not in data and scenario_table is not None:  # a scenario given where a spec goes
+        raise InputFileError(
+            path,
+            f"a scenario ([{scenario_table}]), not a sweep spec: a spec's [sweep] names it "
+            f"(scenario = \"{path.name}\"), see docs/sweeps.md; 'ladartui run FILE' runs it",
+            line=checker.line("", scenario_table),
+        )
     checker.known_keys(data, "", {"sweep", "grid", "random"})
     head = data.get("sweep")
     if not isinstance(head, dict):
