@@ -4,6 +4,8 @@ its own words and keeps what was typed."""
 
 from __future__ import annotations
 
+import pytest
+
 from ladartui.tui.measures_screens import CompareScreen
 from ladartui.tui.screens import FormScreen
 from test_tui_dialogs import message, opened
@@ -57,6 +59,24 @@ async def test_a_scenario_file_given_as_the_new_scenarios_scene_model_is_named_s
         assert message(dialog, "#setup-message") == (
             f"{scenario.path}: scene model file is a scenario file (.toml); expected a scene model (.txt)"
         )
+        assert not (tmp_path / "fresh.toml").exists()
+
+
+@pytest.mark.parametrize(
+    ("scene", "kind"), [("cloud.las", "a LAS point cloud (.las)"), ("truck.obj", "a mesh (.obj)")]
+)
+async def test_a_point_cloud_or_mesh_given_as_the_new_scenarios_scene_model_is_named_so(
+    tmp_path, scene_files, scene, kind
+):
+    """The tree and the completion offered .las and .laz files as scene models, which no
+    scenario reads: picked, it said 'cloud_Target.las: a LAS point cloud (.las), not a voxel
+    list', of a file no one named (a mesh: 'truck.obj: scene model file not found')."""
+    scenario = make_scenario(tmp_path, scene_files)
+    for name in (scene, scene.replace(".", "_Target.")):
+        (tmp_path / name).write_bytes(b"\x00")
+    async with opened(scenario) as (app, pilot):
+        said = await new_scenario_said(app, pilot, scene, "0.25")
+        assert said == f"{tmp_path / scene}: scene model file is {kind}; expected a scene model (.txt)"
         assert not (tmp_path / "fresh.toml").exists()
 
 

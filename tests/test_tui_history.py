@@ -179,6 +179,7 @@ async def test_recent_scenarios_are_listed_and_open_after_asking(tmp_path, scene
 async def test_the_folder_tree_fills_the_scenario_field(tmp_path, scene_files):
     scenario = make_scenario(tmp_path, scene_files)
     (tmp_path / "pyproject.toml").write_text('[project]\nname = "x"\n')  # .toml, no scenario
+    (tmp_path / "cloud.las").write_bytes(b"")  # a point cloud: no scene model a scenario reads
     from ladartui.simulation import simulate
 
     simulate(scenario)  # writes demo_Run.toml: an output, not a scenario to open
@@ -193,8 +194,8 @@ async def test_the_folder_tree_fills_the_scenario_field(tmp_path, scene_files):
         await wait_until(pilot, lambda: len(tree.root.children) > 0)
         names = [node.data.path.name for node in tree.root.children]
         assert "demo.toml" in names and all(not n.startswith(".") for n in names)
-        assert "pyproject.toml" not in names and "demo_Run.toml" not in names
-        assert all(n.endswith((".toml", ".txt", ".las", ".laz")) or (tmp_path / n).is_dir() for n in names)
+        assert "pyproject.toml" not in names and "demo_Run.toml" not in names and "cloud.las" not in names
+        assert all(n.endswith((".toml", ".txt")) or (tmp_path / n).is_dir() for n in names)
         tree.focus()
         tree.move_cursor(tree.root.children[names.index("demo.toml")])
         await pilot.press("enter")

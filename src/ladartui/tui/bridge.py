@@ -14,7 +14,7 @@ from pathlib import Path
 from ladartui.checks import compass_field, number_field
 from ladartui.defaults import to_millimetres
 from ladartui.errors import FieldError, InputFileError, LadarError
-from ladartui.fileprobe import file_problem
+from ladartui.fileprobe import file_problem, other_file_kind
 from ladartui.flight import (
     SEGMENT_KINDS,
     FlightPlan,
@@ -360,8 +360,13 @@ def new_scenario(scenario_path: Path, scene_path: Path, voxel_size: float = 1.0)
     for path, what in ((scene_path, "scene model"), (target_file_for(scene_path), "target model")):
         if problem := file_problem(Path(path)):  # (a pipe exists: it is not 'not found')
             raise InputFileError(path, f"{what} file {problem}")
-        if Path(path).suffix.lower() == ".toml":  # else: 'S_Target.toml: ... not found'
-            raise InputFileError(path, f"{what} file is a scenario file (.toml); expected a {what} (.txt)")
+        # another kind of file, by its suffix: else 'S_Target.las: ... not a voxel list' or
+        # 'S_Target.toml: ... not found', of a file no one named
+        if kind := other_file_kind(path):
+            kind = "a scenario file" if Path(path).suffix.lower() == ".toml" else kind
+            raise InputFileError(
+                path, f"{what} file is {kind} ({Path(path).suffix}); expected a {what} (.txt)"
+            )
     return Scenario.new(scenario_path, scene_path, voxel_size)
 
 

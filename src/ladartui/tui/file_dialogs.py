@@ -25,7 +25,7 @@ from ladartui.tui.host import host_of
 from ladartui.tui.screens import TreeDialog, _row
 
 SCENARIO_SUFFIXES = (".toml",)
-SCENE_SUFFIXES = (".txt", ".las", ".laz")
+SCENE_SUFFIXES = (".txt",)  # voxel lists: a scenario reads no point cloud or mesh
 
 
 class SetupScreen(TreeDialog):
