@@ -132,3 +132,24 @@ async def test_a_segment_form_stays_put_as_its_message_changes(tmp_path, scene_f
         await type_into(pilot, form.query_one("#f-scans"), "0", commit=None)
         assert len(await pressed_ok(form, pilot)) < 72
         assert places() == before
+
+
+async def test_enter_in_a_lower_wrong_field_names_the_upper_one_it_focuses(tmp_path, scene_files):
+    """Distance -5 and Depression '[red]x', Enter in the depression: the cursor went to
+    the distance while the message named the depression (the field it left said why
+    over the refusal)."""
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario) as (app, pilot):
+        form = await added(app, pilot, "straight")
+        distance, depression = form.query_one("#f-distance"), form.query_one("#f-depression")
+        await type_into(pilot, distance, "-5", commit=None)
+        await type_into(pilot, depression, "[red]x", commit="enter")
+        await pilot.pause()
+        assert app.focused is distance
+        assert message(form).startswith("Distance m: -5 is not allowed;"), message(form)
+        assert distance.has_class("-bad") and depression.has_class("-bad")
+        # the depression is named once the distance is right
+        await type_into(pilot, distance, "50", commit="enter")
+        await pilot.pause()
+        assert app.focused is depression
+        assert message(form) == "Depression deg: [red]x is not allowed; expected a number from 1 to 90 deg"

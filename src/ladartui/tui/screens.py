@@ -172,6 +172,7 @@ class FormScreen(Dialog):
         self.build = build
         self.note = note
         self.cancelled = True
+        self._left_for_refusal: Widget | None = None  # the field OK's refusal moved from
 
     def compose(self) -> ComposeResult:
         with Vertical(classes="dialog") as box:
@@ -271,7 +272,18 @@ class FormScreen(Dialog):
         return out
 
     def on_input_blurred(self, event: Input.Blurred) -> None:
+        if event.input is self._left_for_refusal:
+            # OK named another field and focused it: this one stays marked (typing
+            # marks it) without saying why over that refusal
+            self._left_for_refusal = None
+            return
         self._check(event.input)
+
+    def _focus_refused(self, widget: Widget) -> None:
+        """Focus the field a refusal names, the message staying that refusal."""
+        if self.app.focused is not widget:
+            self._left_for_refusal = self.app.focused
+        widget.focus()
 
     def _label(self, name: str) -> str:
         return next((label for n, label, *_ in self.spec if n == name), name)
@@ -314,7 +326,7 @@ class FormScreen(Dialog):
             for name, *_ in self.spec:
                 if isinstance(error, FieldError) and field_matches(error.field, name):
                     wrong = self.query_one(f"#f-{name}")
-                    wrong.focus()
+                    self._focus_refused(wrong)
                     if isinstance(wrong, Input):
                         self._refuse(wrong, name, error.expected)
                         return
@@ -339,7 +351,7 @@ class FormScreen(Dialog):
         else:
             return True
         if not allowed:
-            widget.focus()
+            self._focus_refused(widget)
         return allowed
 
     @on(Button.Pressed, "#form-cancel")
