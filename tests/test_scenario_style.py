@@ -159,3 +159,24 @@ def test_a_save_that_cannot_be_written_names_the_file_not_its_temporary(tmp_path
     with pytest.raises(OutputFileError) as caught:
         scenario.save(Path("/proc/a.toml"))
     assert str(caught.value).startswith("/proc/a.toml: cannot be written") and ".tmp" not in str(caught.value)
+
+
+def test_the_header_command_works_as_written_for_a_name_with_spaces(tmp_path):
+    """'Check it with: ladartui validate new [b]x.toml' ran validate on 'new' and '[b]x.toml'."""
+    import shlex
+
+    scenario = load_scenario(SHIPPED / "orbit.toml", check_files=False)
+    named = scenario.with_changes(path=tmp_path / "my [b]x plan.toml")
+    first = named.header().splitlines()[0]
+    command = first.split("Check it with: ", 1)[1]
+    assert shlex.split(command) == ["ladartui", "validate", "my [b]x plan.toml"]
+    # a plain name stays plain
+    plain = scenario.with_changes(path=tmp_path / "plan.toml").header().splitlines()[0]
+    assert plain.endswith("ladartui validate plan.toml")
+    # a file whose header was written before the name was quoted is renamed on Save As too
+    old = tmp_path / "old plan.toml"
+    unquoted = scenario.with_changes(path=old)
+    old.write_text(unquoted.header(quoted=False) + unquoted.toml_body())
+    assert (
+        "old plan" not in load_scenario(old, check_files=False).save(tmp_path / "new.toml").path.read_text()
+    )

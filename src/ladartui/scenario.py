@@ -12,6 +12,7 @@ from __future__ import annotations
 import dataclasses
 import os
 import re
+import shlex
 import sys
 import tomllib
 from dataclasses import dataclass
@@ -374,13 +375,15 @@ class Scenario:
     def to_toml(self) -> str:
         return self.header() + self.toml_body()
 
-    def header(self) -> str:
-        """The comment a new file starts with: how to check it, what a run writes."""
+    def header(self, quoted: bool = True) -> str:
+        """The comment a new file starts with: how to check it, what a run writes
+        (``quoted=False``: as written before its command quoted the file's name)."""
         # names in comments escaped: a control character there is not TOML
         name, scene, target = (one_line(p.name) for p in (self.path, self.scene_output, self.target_output))
         measures, record = one_line(self.measures_file.name), one_line(self.run_record.name)
+        command = f"ladartui validate {shlex.quote(name) if quoted else name}"  # runs as written
         return (
-            f"# ladartui scenario. Check it with: ladartui validate {name}\n"
+            f"# ladartui scenario. Check it with: {command}\n"
             f"# A run writes {scene}, {target}, {measures} and {record} beside this file.\n\n"
         )
 
@@ -409,8 +412,11 @@ class Scenario:
             text = restyle(
                 self.path.read_text(encoding="utf-8-sig"), scenario.to_dict(), _saved_data(self.path)
             )
-        if text is not None and text.startswith(self.header()):  # its names follow the file's
-            text = scenario.header() + text[len(self.header()) :]
+        if text is not None:  # the program's header: its names follow the file's
+            for old in (self.header(), self.header(quoted=False)):
+                if text.startswith(old):
+                    text = scenario.header() + text[len(old) :]
+                    break
         with write_errors_named(scenario.path):
             write_text_atomic(scenario.path, text if text is not None else scenario.to_toml())
         return scenario
