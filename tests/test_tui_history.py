@@ -142,6 +142,32 @@ async def test_save_as_writes_a_new_file_and_keeps_the_old_one(tmp_path, scene_f
         assert scenario.path.read_bytes() == before
 
 
+async def test_save_as_onto_a_run_record_is_refused_in_the_dialog(tmp_path, scene_files):
+    """'S_Run.toml exists: OK again replaces it'; OK again closed the dialog and the
+    note said it was a run record, the name typed lost."""
+    from ladartui.simulation import simulate
+
+    scenario = make_scenario(tmp_path, scene_files)
+    simulate(scenario)
+    record = scenario.run_record
+    before = record.read_bytes()
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        dialog = await screen_after(pilot, app.action_save_as, SaveAsScreen)
+        dialog.query_one("#save-as-file").value = record.name
+        for _ in range(2):
+            await pilot.press("enter")
+            await pilot.pause()
+            assert app.screen is dialog
+            said = str(dialog.query_one("#save-as-message").render())
+            assert said == (
+                f"{record}: is a run record (the settings that made {scenario.path.name}'s "
+                "outputs, written by its runs): save under another name"
+            ), said
+    assert record.read_bytes() == before
+
+
 async def test_recent_scenarios_are_listed_and_open_after_asking(tmp_path, scene_files, monkeypatch):
     monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))
     first = make_scenario(tmp_path, scene_files, name="first")

@@ -400,12 +400,8 @@ class Scenario:
         if path is not None:
             path = path_field("path", path, "a scenario file's path, or None for its own")
         scenario = self if path is None else self.with_changes(path=path)
-        if is_record(scenario.path):  # it would say that settings which never ran made outputs
-            raise OutputFileError(
-                scenario.path,
-                f"is a run record (the settings that made {record_owner(scenario.path)}'s outputs, "
-                "written by its runs): save under another name",
-            )
+        if refused := record_refusal(scenario.path):
+            raise OutputFileError(scenario.path, refused)
         text = None
         # keep the analyst's comments, key order and layout (not a record's header)
         if self.path.is_file() and not is_record(self.path):
@@ -420,6 +416,17 @@ class Scenario:
         with write_errors_named(scenario.path):
             write_text_atomic(scenario.path, text if text is not None else scenario.to_toml())
         return scenario
+
+
+def record_refusal(path) -> str | None:
+    """Why no scenario is saved at ``path``: it is a run record (it would say that settings
+    which never ran made outputs); None where one may be."""
+    if not is_record(path):
+        return None
+    return (
+        f"is a run record (the settings that made {record_owner(path)}'s outputs, "
+        "written by its runs): save under another name"
+    )
 
 
 def _levels_text(thresholds: LevelThresholds, default: bool) -> str:

@@ -278,8 +278,9 @@ class SaveAsScreen(TreeDialog):
             message.update(f"{path.parent}: folder not found")
             return
         from ladartui.outputset import output_problem
+        from ladartui.scenario import record_refusal
 
-        problem = output_problem(path)
+        problem = output_problem(path) or record_refusal(path)
         if problem:  # said here, where the name can be changed
             message.update(f"{path}: {problem}")
             return
