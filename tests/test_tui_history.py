@@ -168,6 +168,32 @@ async def test_save_as_onto_a_run_record_is_refused_in_the_dialog(tmp_path, scen
     assert record.read_bytes() == before
 
 
+async def test_save_as_a_name_whose_runs_would_replace_a_model_is_refused_in_the_dialog(
+    tmp_path, scene_files
+):
+    """Save As forest.toml beside forest.txt wrote a file whose run would write
+    forest_Target.txt over the target model: 'Saved', then Run off for good."""
+    scenario = make_scenario(tmp_path, scene_files)
+    scene_path = scene_files[0]
+    beside = scene_path.with_suffix(".toml")
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        dialog = await screen_after(pilot, app.action_save_as, SaveAsScreen)
+        dialog.query_one("#save-as-file").value = str(beside)
+        await pilot.press("enter")
+        await pilot.pause()
+        assert app.screen is dialog and not beside.exists()
+        said = str(dialog.query_one("#save-as-message").render())
+        assert said.startswith(f"{beside}: files.scene = '{scene_path.name}': expected a scene model"), said
+        assert f"{scene_path.stem}_Target.txt would overwrite a model file" in said
+        # another name is saved
+        dialog.query_one("#save-as-file").value = "plan"
+        await pilot.press("enter")
+        await pilot.pause()
+        assert app.scenario.path == tmp_path / "plan.toml" and not beside.exists()
+
+
 async def test_recent_scenarios_are_listed_and_open_after_asking(tmp_path, scene_files, monkeypatch):
     monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))
     first = make_scenario(tmp_path, scene_files, name="first")

@@ -425,11 +425,19 @@ def check_outputs_spare_inputs(scenario, las=False) -> None:
     ``S.txt`` beside it, that is the target model itself. Nor may a run replace
     a file of its record's name that is not a run record (``run_record``).
     """
-    from ladartui.errors import FieldError
     from ladartui.outputset import check_lock
 
     check_output_names(scenario, las)
     check_lock(output_lock(scenario))
+    check_outputs_named_apart(scenario, las)
+
+
+def check_outputs_named_apart(scenario, las=False) -> None:
+    """Refuse outputs named as the scenario's own model files or flight logs, or as a file
+    of its record's name that is not a record: its name alone, no lock asked about (Save
+    As says so before it writes a file that could never run)."""
+    from ladartui.errors import FieldError
+
     # resolved: a model or log reached through a link is the file the link names
     inputs = {os.path.realpath(f) for f in (scenario.scene_file, scenario.target_file)}
     logs = {

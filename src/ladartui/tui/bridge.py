@@ -395,6 +395,21 @@ def run_refusal(scenario: Scenario) -> str | None:
     return None
 
 
+def save_as_refusal(scenario: Scenario, path: Path) -> str | None:
+    """Why ``scenario`` saved as ``path`` could never run (its outputs there would replace
+    its own model files or flight logs, or be named past the file system's limit), said
+    in the Save As dialog where the name can still be changed; None if it could."""
+    from ladartui.simulation import check_output_names, check_outputs_named_apart
+
+    moved = scenario.with_changes(path=Path(path))
+    try:
+        check_output_names(moved)
+        check_outputs_named_apart(moved)
+    except LadarError as error:
+        return str(error)
+    return None
+
+
 def read_measures_files(paths) -> list:
     from ladartui.cmf import read_cmf
 

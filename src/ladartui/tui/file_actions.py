@@ -12,6 +12,7 @@ from pathlib import Path
 
 from ladartui.errors import LadarError
 from ladartui.recent import remember_scenario
+from ladartui.tui import bridge
 from ladartui.tui.file_dialogs import SaveAsScreen, SetupScreen
 from ladartui.tui.host import Host
 
@@ -91,7 +92,10 @@ class FileActions(Host):
             if path is not None:
                 self._save_to(path)
 
-        self.push_screen(SaveAsScreen(self.scenario.path), chosen)
+        scenario = self.scenario
+        self.push_screen(
+            SaveAsScreen(scenario.path, lambda path: bridge.save_as_refusal(scenario, path)), chosen
+        )
 
     def _save_to(self, path: Path | None) -> bool:
         """Write the scenario (to ``path`` for Save As); True when written."""

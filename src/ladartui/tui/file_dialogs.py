@@ -8,6 +8,7 @@ exists is refused with the file named.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 from rich.markup import escape
@@ -221,8 +222,9 @@ class SaveAsScreen(TreeDialog):
     second time with the same name.
     """
 
-    def __init__(self, current: Path):
+    def __init__(self, current: Path, name_refusal: Callable[[Path], str | None] | None = None):
         super().__init__()
+        self.name_refusal = name_refusal  # why a name cannot take this scenario, or None
         self.base = current.parent
         self.folder = self.base
         self.current = current
@@ -283,6 +285,9 @@ class SaveAsScreen(TreeDialog):
         problem = output_problem(path) or record_refusal(path)
         if problem:  # said here, where the name can be changed
             message.update(f"{path}: {problem}")
+            return
+        if self.name_refusal is not None and (refused := self.name_refusal(path)):
+            message.update(refused)
             return
         if path.exists() and path != self.current.resolve() and self.confirmed != path:
             self.confirmed = path
