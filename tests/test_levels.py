@@ -262,6 +262,21 @@ def test_levels_section_round_trips_and_keeps_the_analysts_comments(tmp_path):
     assert load_scenario(fresh.path).levels == changed.levels
 
 
+def test_summary_says_thresholds_as_written_as_the_run_table_does(tmp_path):
+    """validate said 'detect 12% / 0%' and 'identify 50% / 88%' for thresholds of 0.125,
+    0.004 and 0.875, which the run's levels table gives as 12.5 %, 0.4 % and 87.5 %."""
+    base = write_tiny_scenario(tmp_path)
+    thresholds = LevelThresholds(0.125, 0.3, 0.5, 0.004, 0.5, 0.875)
+    scenario = base.with_changes(levels=thresholds).save()
+    line = next(s for s in load_scenario(scenario.path).summary().splitlines() if s.startswith("levels"))
+    assert "detect 12.5% / 0.4%" in line
+    assert "recognise 30% / 50%" in line
+    assert "identify 50% / 87.5%" in line
+    result = levels_from_curves([1.0], [1.0], [0.0], [0.0], thresholds)
+    table = {level.lower(): needs for level, needs, _ in result.rows()}
+    assert table["detect"] == "12.5 % / 0.4 %" and table["identify"] == "50 % / 87.5 %"
+
+
 BAD_LEVELS = [
     ("identify = 0.6", "identify = 1.5", "levels.identify = 1.5", "from levels.recognise (0.25) to 1"),
     ("detect = 0.05", "detect = 0", "levels.detect = 0", "visible voxels greater than 0 and at most 1"),

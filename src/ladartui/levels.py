@@ -116,6 +116,12 @@ class LevelThresholds:
 LEVEL_KEYS = tuple(f.name for f in fields(LevelThresholds))
 
 
+def percent_text(share: float) -> str:
+    """A threshold share as a percentage, as written ("12.5" for 0.125, "0.4" for 0.004):
+    the one wording of thresholds in the run's table and the scenario's summary."""
+    return f"{100 * share:g}"
+
+
 def level_below(key: str) -> str | None:
     """The threshold a level key must not fall below: ``recognise_footprint`` ->
     ``detect_footprint``; None for the lowest level."""
@@ -212,7 +218,8 @@ class LevelResult:
         return [
             (
                 item.level.capitalize(),
-                f"{100 * t.voxel_share(item.level):g} % / {100 * t.footprint_share(item.level):g} %",
+                f"{percent_text(t.voxel_share(item.level))} % / "
+                f"{percent_text(t.footprint_share(item.level))} %",
                 item.describe(),
             )
             for item in self.levels

@@ -30,7 +30,7 @@ from ladartui.flight import (
     FlightPlan,
     ScanPose,
 )
-from ladartui.levels import LEVELS, LevelThresholds
+from ladartui.levels import LEVELS, LevelThresholds, percent_text
 from ladartui.number_text import fixed, plural
 from ladartui.scenario_file import (
     RECORD_SUFFIX,
@@ -431,7 +431,8 @@ def record_refusal(path) -> str | None:
 
 def _levels_text(thresholds: LevelThresholds, default: bool) -> str:
     shares = ", ".join(
-        f"{level} {thresholds.voxel_share(level):.0%} / {thresholds.footprint_share(level):.0%}"
+        f"{level} {percent_text(thresholds.voxel_share(level))}% / "
+        f"{percent_text(thresholds.footprint_share(level))}%"
         for level in LEVELS
     )
     return f"{shares} of visible voxels / footprint" + (" (defaults)" if default else "")
