@@ -348,3 +348,19 @@ def test_a_cmf_that_is_not_utf8_is_named_on_its_line(tmp_path):
     with pytest.raises(InputFileError) as error:
         read_cmf(path)
     assert str(error.value).startswith(f"{path}:4: not UTF-8 text (byte 0xff)")
+
+
+def test_coverage_after_each_scan_never_reads_0_for_a_glimpse_nor_100_short_of_all():
+    """The convoy's netted truck read '0 0 0 ... 0 1': 3 of its 816 voxels (0.37 %) were
+    seen from scan 2 on, and an analyst read the zeros as never hit."""
+    from ladartui.measures_table import comparison_rows
+    from ladartui.target_measures import PerTarget, TargetMeasures, after_scan_rows
+
+    curve = (0.0, 3 / 816, 0.005, 0.01, 0.5, 0.99, 0.995, 0.999, 1.0)
+    said = "0 <1 <1 1 50 99 >99 >99 100"
+    measures = Measures(obscured_after_scan=curve, unobscured_after_scan=curve)
+    rows = dict(comparison_rows(measures))
+    assert rows["Obscured coverage after each scan"] == said + " (%)"
+    assert rows["Unobscured coverage after each scan"] == said + " (%)"
+    per_target = PerTarget((TargetMeasures(1, "truck", measures),))
+    assert dict(after_scan_rows(per_target))["1 truck"] == said

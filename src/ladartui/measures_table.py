@@ -6,7 +6,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from ladartui.measures import ENOUGH_SHARE
-from ladartui.number_text import fixed
+from ladartui.number_text import coverage_steps, fixed
 
 if TYPE_CHECKING:
     from ladartui.measures import Measures
@@ -61,7 +61,7 @@ def comparison_rows(measures: Measures) -> list[tuple[str, str]]:
     m = measures
 
     def after(values):
-        return UNDEFINED if values is None else " ".join(f"{100.0 * v:.0f}" for v in values) + " (%)"
+        return UNDEFINED if values is None else coverage_steps(values) + " (%)"
 
     return [
         ("Shift in mean direction", format_number(m.direction_shift_rad, unit="rad")),

@@ -36,3 +36,18 @@ def plural(count: int, noun: str, nouns: str | None = None) -> str:
     """``count`` with thousands separators and ``noun``, plural unless it is 1:
     "1 voxel", "2,048 voxels"; ``nouns`` where the plural is not noun + "s"."""
     return f"{count:,} {noun if count == 1 else nouns or noun + 's'}"
+
+
+def coverage_steps(shares) -> str:
+    """Coverage shares (0..1) as whole percents, "0 <1 12 >99 100": a glimpse never
+    reads 0 (never hit) nor a near miss 100 (all of it)."""
+
+    def step(share: float) -> str:
+        percent = 100.0 * share
+        if 0 < percent < 1:
+            return "<1"
+        if 99 < percent < 100:
+            return ">99"
+        return f"{percent:.0f}"
+
+    return " ".join(step(share) for share in shares)

@@ -45,6 +45,7 @@ from ladartui.measures import (
     measures_from_lines,
     section_lines,
 )
+from ladartui.number_text import coverage_steps
 from ladartui.scene.keys import keys_to_voxels, member, sorted_unique, voxel_keys
 
 HIGH, LOW = "high", "low"  # which way is better
@@ -396,7 +397,7 @@ def after_scan_rows(per_target: PerTarget) -> list[tuple[str, str]]:
     """(target, obscured coverage after each scan in %) per target, then worst and mean."""
 
     def curve(values):
-        return _UNDEFINED if values is None else " ".join(f"{100.0 * v:.0f}" for v in values)
+        return _UNDEFINED if values is None else coverage_steps(values)
 
     rows = [(f"{t.target_id} {t.name}", curve(t.measures.obscured_after_scan)) for t in per_target.targets]
     rows.append(("worst", curve(per_target.worst.obscured_after_scan)))
