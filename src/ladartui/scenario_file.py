@@ -16,8 +16,10 @@ are caught; keys marked "default" may be left out)::
     [sensor]                        # report section 7.1; every key has a default
     grid = 64                       # n: n x n detectors, 1..1024
     ray_grid = 2                    # m: m x m rays per detector, 1..16
-    fov_deg = 8.0                   # full field of view, degrees, > 0 and < 90
+    fov_deg = 8.0                   # full field of view, degrees, 1e-14 up to 90 (not 90)
     depth_resolution_m = 1.0        # returns closer than this on one detector merge, 0..1000
+                                    # (metres of range: a dead time t is c t / 2; the
+                                    # report's c t counts the light's way there and back)
     pixel_pitch_um = 100.0          # detector pitch, micrometres, 0.1..10000
     mount = "stabilised"            # or "body-fixed": rays turn with roll and pitch
 
