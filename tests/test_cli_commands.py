@@ -219,3 +219,36 @@ def test_certs_that_cannot_be_written_leave_no_lock_behind(tmp_path, capsys):
     assert list(folder.iterdir()) == []
     assert cli.main(["certs", str(folder)]) == 0  # and a second try writes them
     assert sorted(p.name for p in folder.iterdir()) == ["ca.pem", "cluster-key.pem", "cluster.pem"]
+
+
+@pytest.mark.parametrize("status", [0, 3])
+def test_a_ctrl_c_as_a_finished_command_exits_keeps_its_status(status):
+    """'ladartui run --json' ended as killed by SIGINT (-2 to the script that ran it, 130
+    in a shell) when a Ctrl-C came while Python shut down after the command: its outputs
+    written and said, its status a failure. Shutting down is made slow here."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    script = (
+        "import time\n"
+        "class Slow:\n"
+        "    def __del__(self):\n"
+        "        time.sleep(3)\n"
+        "keep = Slow()\n"
+        "import ladartui.cli as cli\n"
+        "def finished(argv=None):\n"
+        "    print('done')\n"
+        f"    return {status}\n"
+        "cli.main = finished\n"
+        "cli.entry()\n"
+    )
+    child = subprocess.Popen(
+        [sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+    assert child.stdout.readline() == "done\n"
+    time.sleep(0.5)  # shutting down
+    child.send_signal(signal.SIGINT)
+    out, err = child.communicate(timeout=60)
+    assert (child.returncode, out, err) == (status, "", "")

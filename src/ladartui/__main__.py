@@ -1,3 +1,3 @@
-from ladartui.cli import main
+from ladartui.cli import entry
 
-raise SystemExit(main())
+entry()

@@ -8,6 +8,7 @@ one line on stderr and exit status 2; no traceback reaches the user.
 from __future__ import annotations
 
 import argparse
+import atexit
 import contextlib
 import difflib
 import errno
@@ -156,3 +157,22 @@ def _reader_gone() -> int:
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())
     return 128 + signal.SIGPIPE
+
+
+def entry() -> None:
+    """The ``ladartui`` command and ``python -m ladartui``: ``main``, then an exit that a
+    Ctrl-C can no longer turn into a failure (status 130, or killed by SIGINT): the
+    command's work is done and said, only Python's shutting down is left."""
+    status = main()
+    with contextlib.suppress(OSError, ValueError):  # all it printed, before any quick exit
+        sys.stdout.flush()
+        sys.stderr.flush()
+
+    def finished(signum, frame) -> None:  # threads still being joined: end at once
+        os._exit(status)
+
+    signal.signal(signal.SIGINT, finished)
+    # Python takes its own handlers away before its modules are torn down (a Ctrl-C then
+    # killed the process): from its exit handlers on, a Ctrl-C is ignored
+    atexit.register(signal.signal, signal.SIGINT, signal.SIG_IGN)
+    raise SystemExit(status)
