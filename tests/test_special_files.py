@@ -201,3 +201,19 @@ def test_the_terminal_ui_study_refuses_a_pipe_in_its_folder_before_it_runs(tmp_p
     monkeypatch.setattr(study_run, "run_study", lambda *a, **k: pytest.fail("the study ran"))
     with pytest.raises(OutputFileError, match=re.escape(SPECIAL_FILE)):
         _study("quick", tmp_path / "base.toml", None, None, threading.Event(), lambda *a: None)
+
+
+@pytest.mark.parametrize("command", ["validate", "run", "tui"])
+def test_a_scenario_link_that_loops_is_named_as_such_not_as_missing(tmp_path, capsys, monkeypatch, command):
+    """'validate loop.toml', a link to a link back to it, said 'no such file; expected a
+    scenario file (.toml) or a bundled scenario' of a file that is there."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "loop.toml").symlink_to("back.toml")
+    (tmp_path / "back.toml").symlink_to("loop.toml")
+    assert main([command, "loop.toml"]) == 2
+    said = one_error_line(capsys)
+    assert re.fullmatch(
+        r"ladartui: error: (\S*/)?loop\.toml: cannot (read the scenario file: |be read \()Too many "
+        r"levels of symbolic links(\); expected a scenario file \(\.toml\))?",
+        said,
+    ), said

@@ -47,6 +47,8 @@ def file_problem(path: Path) -> str | None:
             return FOLDER
         if Path(path).exists():
             return SPECIAL_FILE
+        if os.path.islink(path):  # a link that loops, or names a missing file
+            os.stat(path)
         return "not found"
     except OSError as error:
         if error.errno == errno.ENAMETOOLONG:
@@ -107,7 +109,8 @@ def require_file(path, expected: str) -> None:
     if problem == FOLDER:
         raise InputFileError(path, f"is a folder; {expected}")
     if problem:
-        raise InputFileError(path, f"{NO_SUCH_FILE}; {expected}")
+        said = NO_SUCH_FILE if problem == "not found" else problem  # (a link that loops)
+        raise InputFileError(path, f"{said}; {expected}")
 
 
 def refuse_special_file(path, expected: str) -> None:

@@ -140,7 +140,7 @@ def bundled_or_path(argument) -> Path:
     if name is not None and not path.is_file():  # a folder of that name is no scenario file
         return bundled_scenario_path(name)
     bare = path.parent == Path(".") and not _names_a_folder(argument)
-    if bare and path.suffix in ("", ".toml") and not path.exists():
+    if bare and path.suffix in ("", ".toml") and not os.path.lexists(path):  # (a link that loops is there)
         from ladartui.errors import InputFileError
         from ladartui.fileprobe import NO_SUCH_FILE
 
