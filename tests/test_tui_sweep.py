@@ -420,6 +420,8 @@ def test_eta_counts_only_the_variants_run_here():
     assert eta_seconds(SweepProgress(10, 2, 2, 0, 1.0)) is None
     assert format_eta(125) == "2m05s" and format_eta(3725) == "1h02m" and format_eta(None) == "--"
     assert format_eta(math.inf) == "--"
+    # the last half second of a run read "about 0s left"
+    assert [format_eta(s) for s in (0.0, 0.49, 0.5, 59.6)] == ["<1s", "<1s", "1s", "1m00s"]
 
 
 async def test_browse_picks_a_results_folder_in_a_tree_and_opens_it(finished):

@@ -17,10 +17,12 @@ LABELS = {NOT_READY: "NOT READY", READY: "READY", BUSY: "BUSY"}
 
 
 def format_eta(seconds: float | None) -> str:
-    """``1h02m``, ``3m05s`` or ``12s``; ``--`` when unknown."""
+    """``1h02m``, ``3m05s``, ``12s`` or ``<1s``; ``--`` when unknown."""
     if seconds is None or not math.isfinite(seconds):
         return "--"
-    seconds = max(0, int(round(seconds)))
+    if seconds < 0.5:  # not "about 0s left" of work still going
+        return "<1s"
+    seconds = int(seconds + 0.5)  # half up: 0.5 is "1s", never "0s"
     hours, rest = divmod(seconds, 3600)
     minutes, secs = divmod(rest, 60)
     if hours:
