@@ -106,8 +106,30 @@ def test_failure_during_the_swap_rolls_back(scenario, monkeypatch):
         return real(src, dst)
 
     monkeypatch.setattr(outputset.os, "rename", failing)
-    with pytest.raises(OSError):
+    with pytest.raises(OutputFileError, match="S_Target.txt: could not be replaced"):
         simulate(scenario)
+    assert snapshot(scenario) == old
+    assert hidden(scenario.path.parent) == []
+
+
+def test_an_output_that_cannot_be_moved_aside_is_one_line(scenario, capsys, monkeypatch):
+    """An earlier output the folder will not let go (immutable, or another user's in a
+    sticky folder) ended the run in a PermissionError traceback from the swap."""
+    old = write_old_set(scenario)
+    real = os.rename
+
+    def refused(src, dst):
+        if str(src) == str(scenario.target_output):
+            raise PermissionError(errno.EPERM, "Operation not permitted", str(src), str(dst))
+        return real(src, dst)
+
+    monkeypatch.setattr(outputset.os, "rename", refused)
+    assert main(["run", str(scenario.path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]  # after the progress bar
+    assert err == (
+        f"ladartui: error: {scenario.target_output}: could not be replaced (operation not "
+        "permitted); nothing was replaced, earlier outputs are unchanged"
+    )
     assert snapshot(scenario) == old
     assert hidden(scenario.path.parent) == []
 

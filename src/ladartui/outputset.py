@@ -270,20 +270,36 @@ class OutputSet:
             backup = path.with_name(f".{path.name}.{os.getpid()}.old")
             entries.append({"path": str(path), "backup": str(backup), "existed": os.path.lexists(path)})
         _write_journal(self.journal, entries)
+        replacing = self.journal  # the file being replaced when a rename fails
         try:
             for entry, tmp in zip(entries, temps.values()):
+                replacing = Path(entry["path"])
                 if entry["existed"]:
                     os.rename(entry["path"], entry["backup"])
                 _step("swap")
                 os.rename(tmp, entry["path"])
+            replacing = self.journal
             for folder in {Path(e["path"]).parent for e in entries}:
                 _fsync_dir(folder)
             os.unlink(self.journal)  # the commit point
             _fsync_dir(self.journal.parent)
-        except BaseException:
-            _roll_back(entries)
+        except BaseException as error:
+            try:
+                _roll_back(entries)
+            except OSError as also:  # the journal stays: the next run puts them back
+                raise OutputFileError(
+                    replacing,
+                    f"could not be replaced ({_reason(error)}), and the earlier outputs could "
+                    f"not be put back ({os_reason(also).lower()}); the next run puts them back first",
+                ) from None
             with contextlib.suppress(OSError):
                 os.unlink(self.journal)
+            if isinstance(error, OSError):  # a rename the folder refused: one line, not a traceback
+                raise OutputFileError(
+                    replacing,
+                    f"could not be replaced ({_reason(error)}); nothing was replaced, earlier "
+                    "outputs are unchanged",
+                ) from None
             raise
         _step("backups")
         for entry in entries:
@@ -328,6 +344,10 @@ def _write_journal(journal: Path, entries):
         os.fsync(handle.fileno())
     os.replace(tmp, journal)
     _fsync_dir(journal.parent)
+
+
+def _reason(error: BaseException) -> str:
+    return os_reason(error).lower() if isinstance(error, OSError) else type(error).__name__
 
 
 def _write_error(path, error: OSError) -> OutputFileError:
