@@ -175,3 +175,37 @@ def test_a_ranking_with_no_best_says_the_best_path_file_is_from_an_earlier_one(b
     text = capsys.readouterr().out.replace("\n", "")
     assert f"earlier  {best}  (the best path of an earlier ranking: none is ranked now)" in text
     assert best.is_file()  # kept: it is what that ranking found
+
+
+@pytest.mark.parametrize("name", ["ranking.csv", "spec-best.toml", "pareto.png"])
+def test_a_ranking_file_the_folder_will_not_replace_is_one_line(base, tmp_path, capsys, monkeypatch, name):
+    """A ranking, best path or chart the folder would not let be replaced (immutable, or
+    another user's in a sticky folder) ended the sweep in a PermissionError traceback."""
+    import errno
+    import os
+
+    import ladartui.atomic
+    from ladartui.cli import main
+
+    spec = tmp_path / "spec.toml"
+    spec.write_text('[sweep]\nscenario = "base.toml"\n[grid]\nradius = [20.0, 30.0]\n', encoding="utf-8")
+    assert main(["sweep", str(spec), "--serial"]) == 0
+    capsys.readouterr()
+    refused = tmp_path / "spec-results" / name
+    before = refused.read_bytes()
+    real = os.replace
+
+    def replace(src, dst):
+        if os.path.abspath(dst) == str(refused):
+            raise PermissionError(errno.EPERM, "Operation not permitted", str(src), str(dst))
+        return real(src, dst)
+
+    monkeypatch.setattr(ladartui.atomic.os, "replace", replace)
+    assert main(["sweep", str(spec), "--serial", "--objective", "obscured-coverage"]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert err.strip().splitlines()[-1] == (
+        f"ladartui: error: {refused}: cannot be written (operation not permitted)"
+    )
+    assert refused.read_bytes() == before
+    assert not [p.name for p in refused.parent.iterdir() if p.name.endswith(".tmp")]

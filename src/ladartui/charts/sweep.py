@@ -70,7 +70,13 @@ def write_sweep_charts(result, out_dir, stem: str = "pareto") -> dict:
     """pareto.svg and pareto.png beside results.csv; returns {format: path}."""
     from pathlib import Path
 
+    from ladartui.atomic import write_errors_named
     from ladartui.charts import FORMATS, save_figure
 
     figure = sweep_figure(result)
-    return {fmt: save_figure(figure, Path(out_dir) / f"{stem}.{fmt}") for fmt in FORMATS}
+    written = {}
+    for fmt in FORMATS:
+        path = Path(out_dir) / f"{stem}.{fmt}"
+        with write_errors_named(path):  # one line naming the chart, not a traceback
+            written[fmt] = save_figure(figure, path)
+    return written

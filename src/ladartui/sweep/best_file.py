@@ -101,7 +101,7 @@ def write_best_scenario(path, base, row: dict, parameter_names, scene_loader) ->
 
     Written afresh, not over the base file's text: the base's comments describe its own
     values (an orbit's looks, an altitude's depression), which a variant may change."""
-    from ladartui.atomic import write_text_atomic
+    from ladartui.atomic import write_errors_named, write_text_atomic
     from ladartui.sweep.table import display_cell
     from ladartui.sweep.variant import apply_parameters
 
@@ -115,5 +115,6 @@ def write_best_scenario(path, base, row: dict, parameter_names, scene_loader) ->
     )
     body = scenario.to_toml()
     mark = f"# A later sweep replaces this file until it is edited (fingerprint {_fingerprint(body)})."
-    write_text_atomic(scenario.path, f"{header}\n{mark}\n{body}")
+    with write_errors_named(scenario.path):
+        write_text_atomic(scenario.path, f"{header}\n{mark}\n{body}")
     return target  # relative scene path and outputs follow the file

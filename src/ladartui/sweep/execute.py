@@ -19,7 +19,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ladartui.atomic import atomic_path
+from ladartui.atomic import atomic_path, write_errors_named
 from ladartui.errors import (
     FieldError,
     InputFileError,
@@ -471,7 +471,7 @@ def write_ranking(path, ranking: list[Ranked], parameter_names) -> Path:
             }
         )
     text = table_text(rows, columns=columns)
-    with atomic_path(path) as tmp:
+    with write_errors_named(path), atomic_path(path) as tmp:
         tmp.write_text(text, encoding="utf-8")
     return Path(path)
 
