@@ -134,6 +134,48 @@ def test_an_output_that_cannot_be_moved_aside_is_one_line(scenario, capsys, monk
     assert hidden(scenario.path.parent) == []
 
 
+def test_a_full_disk_at_the_lock_names_it_and_replaces_nothing(scenario, capsys):
+    """The lock's pid was the first byte written: on a full disk the run said only "could
+    not write the output", and simulate raised a bare OSError."""
+    from cli_support import file_size_limit
+    from ladartui.simulation import output_lock
+
+    old = write_old_set(scenario)
+    with file_size_limit(0):
+        assert main(["run", str(scenario.path)]) == 2
+        with pytest.raises(OutputFileError, match=".S.outputs.lock: could not be written"):
+            simulate(scenario)
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert err.strip().splitlines()[-1] == (
+        f"ladartui: error: {output_lock(scenario)}: could not be written (file too large); "
+        "nothing was replaced, earlier outputs are unchanged"
+    )
+    assert snapshot(scenario) == old
+    assert hidden(scenario.path.parent) == []
+
+
+def test_a_full_disk_at_the_journal_names_it_and_replaces_nothing(scenario, capsys, monkeypatch):
+    import json
+    from types import SimpleNamespace
+
+    old = write_old_set(scenario)
+
+    def disk_full(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(outputset, "json", SimpleNamespace(dump=disk_full, loads=json.loads))
+    assert main(["run", str(scenario.path)]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert err.strip().splitlines()[-1] == (
+        f"ladartui: error: {scenario.path.parent / '.S.outputs.lock.journal'}: could not be "
+        "written (no space left on device); nothing was replaced, earlier outputs are unchanged"
+    )
+    assert snapshot(scenario) == old
+    assert hidden(scenario.path.parent) == []
+
+
 def test_second_writer_is_refused(scenario, capsys):
     old = write_old_set(scenario)
     with _output_set(scenario, las=False):

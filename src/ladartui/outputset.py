@@ -193,6 +193,9 @@ class OutputSet:
         try:
             os.ftruncate(fd, 0)
             os.write(fd, str(os.getpid()).encode("ascii"))
+        except OSError as error:  # a full disk: the pid is the set's first byte written
+            self._release()
+            raise _write_error(self.lock, error) from None
         except BaseException:
             self._release()
             raise
@@ -269,7 +272,12 @@ class OutputSet:
         for path in self.paths.values():
             backup = path.with_name(f".{path.name}.{os.getpid()}.old")
             entries.append({"path": str(path), "backup": str(backup), "existed": os.path.lexists(path)})
-        _write_journal(self.journal, entries)
+        try:
+            _write_journal(self.journal, entries)
+        except OSError as error:  # no rename has started
+            with contextlib.suppress(OSError):
+                os.unlink(self.journal.with_name(self.journal.name + ".tmp"))
+            raise _write_error(self.journal, error) from None
         replacing = self.journal  # the file being replaced when a rename fails
         try:
             for entry, tmp in zip(entries, temps.values()):
