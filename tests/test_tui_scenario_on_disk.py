@@ -116,3 +116,36 @@ async def test_a_study_of_a_scenario_changed_on_disk_says_what_it_reads(tmp_path
             "The study reads demo.toml as it is on disk, not as shown here; save (Ctrl+S) first "
             "to study what is shown."
         )
+
+
+async def test_outputs_a_killed_run_left_half_replaced_are_not_read_as_a_run(tmp_path, scene_files):
+    """A run killed between its renames leaves the new scene output, the old target output
+    aside under the journal: the TUI read them as a run's ("outputs missing
+    (S_Target.txt); F5 runs and writes them") though validate said they are not to be read."""
+    import signal
+    import subprocess
+    import sys
+
+    from ladartui.simulation import simulate
+    from test_output_kill import PAUSING_RUN
+
+    scenario = make_scenario(tmp_path, scene_files)
+    simulate(scenario)  # the earlier set
+    scenario.with_changes(sensor=scenario.sensor.__class__(grid=6, ray_grid=1, fov=8.0)).save()
+    run = subprocess.Popen(
+        [sys.executable, "-c", PAUSING_RUN, "swap", "2", str(scenario.path)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert run.stdout.readline().strip() == "paused"
+    run.send_signal(signal.SIGKILL)
+    run.communicate(timeout=60)
+    assert not scenario.target_output.exists()  # aside, under the journal
+    async with opened(scenario) as (app, pilot):
+        assert bar(app).state == NOT_READY
+        assert bar(app).message == (
+            "demo.toml: the last run was stopped while it replaced the outputs; F5 runs and puts "
+            "the earlier set back first."
+        )
+        assert app.output_voxels is None and app.missing_outputs == []

@@ -481,6 +481,15 @@ def output_lock(scenario) -> Path:
     return path.with_name(f".{path.stem}.outputs.lock")
 
 
+def swap_interrupted(scenario) -> bool:
+    """Whether a run was stopped while it replaced ``scenario``'s outputs (its journal is
+    on disk): the files there now are part new, part aside, and not to be read; the
+    next run puts the earlier set back first (``outputset.recover``)."""
+    from ladartui.outputset import journal_path
+
+    return journal_path(output_lock(scenario)).exists()
+
+
 def _write_outputs(output_set, scene_output, target_output, measures, record, scene, cancel) -> dict:
     """Write every output of the set to a temporary file, then swap them all in together.
 

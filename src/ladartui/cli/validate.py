@@ -131,11 +131,10 @@ def last_run_lines(scenario, scene, writable: bool = True) -> list[str]:
     they are now (``scene``, as just loaded), from the run record; ``writable``: whether
     the next run can write its outputs."""
     from ladartui.errors import LadarError
-    from ladartui.outputset import journal_path
     from ladartui.run_record import earlier_las, missing_outputs, read_run_record, setting_changes
-    from ladartui.simulation import output_lock
+    from ladartui.simulation import swap_interrupted
 
-    if journal_path(output_lock(scenario)).exists():  # a swap a killed run left (outputset)
+    if swap_interrupted(scenario):  # a swap a killed run left (outputset)
         return [
             "last run   was stopped while it replaced the outputs: the next run puts the earlier set "
             "back first, so the files now on disk are not to be read"

@@ -94,6 +94,7 @@ class LadarApp(
         self.disk_outputs: tuple = (None, None)
         self.shown_before_run: tuple = (None, None)  # the outputs a cancelled run shows again
         self.missing_outputs: list[Path] = []
+        self.outputs_interrupted = False  # a killed run's swap is on disk (not read)
         self.outputs_from: Scenario | None = None  # the settings that made the outputs shown
         self.inputs_changed: list[str] = []  # the files they read that changed since their run
         self.changed_since_opened: list[str] = []  # read here before they changed (reopen)
@@ -239,6 +240,13 @@ class LadarApp(
         mark = " (modified)" if self.modified else ""
         runs = self.key_says("run", "runs")
         text = f"{scenario.path.name}{mark}: {poses} scans x {rays:,} rays." + (f" {runs}." if runs else "")
+        if self.outputs_interrupted:
+            puts = f"; {runs} and puts the earlier set back first" if runs else ""
+            show(
+                NOT_READY,
+                f"{scenario.path.name}{mark}: the last run was stopped while it replaced the outputs{puts}.",
+            )
+            return
         if self.missing_outputs:
             # runnable, but the set on disk is incomplete: yellow until a run rewrites it
             names = ", ".join(p.name for p in self.missing_outputs)

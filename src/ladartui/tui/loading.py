@@ -53,6 +53,9 @@ class OutputFiles:
     readable: bool  # the scene output and the measures are files: an earlier run to show
     missing: list[Path]  # those of a partial set (run_record.missing_outputs)
     seen: tuple[int, int] | None  # the measures file's (mtime, size): outputs_on_disk
+    # a run was stopped while it replaced them (simulation.swap_interrupted): neither
+    # read nor called missing; the next run puts the earlier set back first
+    interrupted: bool = False
 
 
 @dataclass
@@ -123,6 +126,7 @@ class SceneLoading(Host):
         self.prepared = done.prepared
         self.view_area.set_scene(done.prepared, done.scene.voxel_size)
         self.missing_outputs = done.earlier.files.missing
+        self.outputs_interrupted = done.earlier.files.interrupted
         self.outputs_from = done.earlier.made_with  # before the status is drawn
         self.inputs_changed = done.earlier.inputs_changed
         self.changed_since_opened = done.earlier.changed_since_opened
@@ -160,6 +164,7 @@ class SceneLoading(Host):
             files = look_at_outputs(scenario)
         self.outputs_seen = files.seen  # the ones about to be shown: no other run's
         self.missing_outputs = files.missing
+        self.outputs_interrupted = files.interrupted
         if files.readable:
             scene = self.scene
             start_job(self, "earlier", lambda cancel, progress: _earlier(scenario, files, scene))
@@ -426,12 +431,16 @@ def look_at_outputs(scenario) -> OutputFiles:
 
 def outputs_with(scenario, measures: os.stat_result | None) -> OutputFiles:
     """The look at ``scenario``'s outputs, the measures file's status already taken."""
+    from ladartui.simulation import swap_interrupted
+
     found = {
         scenario.scene_output: _file_status(scenario.scene_output),
         scenario.target_output: _file_status(scenario.target_output),
         scenario.measures_file: measures,
     }
     is_file = {path: status is not None and stat.S_ISREG(status.st_mode) for path, status in found.items()}
+    if swap_interrupted(scenario):
+        return OutputFiles(readable=False, missing=[], seen=_stamp(measures), interrupted=True)
     return OutputFiles(
         readable=is_file[scenario.scene_output] and is_file[scenario.measures_file],
         missing=missing_outputs(scenario, is_file.__getitem__),

@@ -89,7 +89,7 @@ class RunControl(Host):
             self.run_panel.say(error or "Run failed: no result.")
             return
         self.result = result
-        self.missing_outputs = []
+        self.missing_outputs, self.outputs_interrupted = [], False  # (it put the earlier set back first)
         self.outputs_from = self.scenario  # (not editable while the run went on)
         # read as the app holds them: a model changed on disk since it was opened still is
         self.inputs_changed = list(self.changed_since_opened)
