@@ -390,6 +390,28 @@ def test_keys_toml_problems_are_named_on_their_line_never_a_crash(tmp_path):
     assert len(problems) == 2 and "help" not in keymap and "cancel" not in keymap
 
 
+def test_a_key_the_views_take_is_refused_in_keys_toml(tmp_path):
+    """docs/tui.md's own example, threshold = "t", was taken without a word, and the help
+    said t opens the threshold 'Anywhere'; in a 3D or top view t zooms to the target, so
+    there it never did. A remap onto a view's key is now refused on its line, naming the
+    view's action, and the command keeps its default key."""
+    from ladartui.tui.actions import keys_in_force, load_keymap
+
+    keys = tmp_path / "keys.toml"
+    keys.write_text('[keys]\nthreshold = "t"\nrun = "f5,w"\nmeasures = "ctrl+t"\n')
+    keymap, problems = load_keymap(tmp_path)
+    assert keymap == {"measures": "ctrl+t"}
+    assert len(problems) == 2
+    assert problems[0].startswith(f"{keys}:2: keys.threshold = 't': in the views t is ")
+    assert "Zoom to target" in problems[0]
+    assert problems[1].startswith(f"{keys}:3: keys.run = 'f5,w': in the views w is ")
+    assert keys_in_force(keymap)["threshold"] == "f8"
+    # a command that does in every view what the view's key does there may take it
+    keys.write_text('[keys]\nzoom-target = "t"\nfit-scene = "f"\ngrey = "g"\n')
+    keymap, problems = load_keymap(tmp_path)
+    assert problems == [] and keymap == {"zoom-target": "t", "fit-scene": "f", "grey": "g"}
+
+
 def test_an_unknown_command_id_in_keys_toml_is_told_with_every_id_there_is(tmp_path):
     """The ids to choose from were cut at the message's length limit, after save-as:
     zoom-target, threshold, undo and the tabs were never named. The id read from the

@@ -23,6 +23,7 @@ from textual.binding import Binding, BindingType
 from ladartui.textsafe import one_line
 from ladartui.toml_lines import read_config_table
 from ladartui.tui import bridge
+from ladartui.tui.canvas import ProjectionWidget, TopViewWidget
 from ladartui.tui.view_area import LAYOUTS
 from ladartui.user_data import config_folder
 
@@ -259,12 +260,34 @@ def help_rows(
     return rows
 
 
+def _view_keys() -> dict[str, tuple[str, str]]:
+    """Key -> (what it does in a 3D or top view, the app action doing the same in every
+    view, or ""), the first view that has the key deciding."""
+    keys: dict[str, tuple[str, str]] = {}
+    for widget in (ProjectionWidget, TopViewWidget):
+        for binding in widget.BINDINGS:
+            if isinstance(binding, Binding):
+                # the views' shared keys ask for view_request('X'); the palette's view('X')
+                same = binding.action.replace("view_request(", "view(", 1)
+                for key in binding.key.split(","):
+                    keys.setdefault(
+                        key.strip(), (binding.description, same if same != binding.action else "")
+                    )
+    return keys
+
+
+# The views' own keys: a view with the focus takes them before the app's, so no
+# command is remapped onto one (it would run everywhere but in the views), unless
+# the command does what the view's key does.
+VIEW_KEYS = _view_keys()
+
+
 def load_keymap(folder: Path | None = None) -> tuple[dict[str, str], list[str]]:
     """The user's key remapping from ``keys.toml``, and one line per problem found.
 
     A missing file is no remapping; a damaged one, an unknown table or command
-    id, a key that is not text, or one another command has, is reported (on its
-    line) and left out, never fatal.
+    id, a key that is not text, one the views take (``VIEW_KEYS``), or one
+    another command has, is reported (on its line) and left out, never fatal.
     """
     config = read_config_table((folder or config_folder()) / KEYS_FILE, "keys", "command id = key")
     table, problems, at = config.table, config.problems, config.at
@@ -281,6 +304,19 @@ def load_keymap(folder: Path | None = None) -> tuple[dict[str, str], list[str]]:
             problems.append(
                 one_line(
                     f'{where}: keys.{command_id} = {key!r}: expected a key name such as "f9" or "ctrl+r"'
+                )
+            )
+        elif taken_by_views := [
+            k.strip()
+            for k in key.split(",")
+            if k.strip() in VIEW_KEYS and VIEW_KEYS[k.strip()][1] != BY_ID[command_id].action
+        ]:
+            # a focused view's own key wins over the app's: the command would not run there
+            view_key = taken_by_views[0]
+            problems.append(
+                one_line(
+                    f"{where}: keys.{command_id} = {key!r}: in the views {key_name(view_key)} is "
+                    f"{VIEW_KEYS[view_key][0]}; choose another key"
                 )
             )
         else:
