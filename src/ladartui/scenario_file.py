@@ -71,7 +71,7 @@ Straight and turn segments continue from the previous segment's last scan
     [simulation]                    # every key has a default
     backend = "auto"                # "auto" or a tracing backend name
     method = "exact"                # "exact" or "march" (the report's fixed step)
-    step = 0.5                      # march step in voxels, > 0 and <= 10
+    step = 0.5                      # march step in voxels, 0.001..10
     precision = "f64"               # "f64" or "f32"
     fast_mode = false               # true: no progressive views during a run
 

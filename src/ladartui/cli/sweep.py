@@ -53,8 +53,8 @@ def add_parser(subparsers):
     parser.add_argument(
         "--scheduler",
         metavar="ADDRESS",
-        help="address of a running Dask scheduler (tcp://HOST:PORT); default: "
-        "a local cluster on this machine",
+        help="address of a running Dask scheduler: tls://HOST:PORT with the --tls flags, "
+        "or tcp://HOST:PORT on this machine (see --insecure); default: a local cluster on this machine",
     )
     parser.add_argument(
         "--tls-ca-file", metavar="PEM", help="certificate authority of a TLS scheduler (ladartui certs DIR)"
