@@ -47,12 +47,12 @@ def test_trace_writes_hits(tmp_path, scene_file, capsys):
     # the voxel size was not given: a user of a 0.25 m scene must see 1 m was assumed
     assert err == (
         "3 rays (numba, exact, f64), voxel size 1 m (assumed; --voxel-size sets it): "
-        f"1 voxel, 1 ground, 1 miss -> {out}\n"
+        f"1 voxel hit, 1 ground hit, 1 miss -> {out}\n"
     )
 
 
 def test_the_summary_writes_every_count_with_thousands_separators(tmp_path, scene_file, capsys):
-    """It read '4,000,000 rays ...: 1032144 voxel, 1595342 ground, ...'."""
+    """It read '4,000,000 rays ...: 1032144 voxel, 1595342 ground, ...', and '2 voxel'."""
     rays = np.repeat(
         [[5.0, 5.0, 20.0, 0.0, 0.0, -1.0], [2.0, 2.0, 20.0, 0.0, 0.0, -1.0]], [1200, 3400], axis=0
     )
@@ -60,7 +60,7 @@ def test_the_summary_writes_every_count_with_thousands_separators(tmp_path, scen
     out = tmp_path / "hits.npy"
     args = ["trace", "--scene", str(scene_file), "--rays", str(tmp_path / "rays.npy"), "--out", str(out)]
     assert main([*args, "--voxel-size", "1"]) == 0
-    assert capsys.readouterr().err.endswith(f": 1,200 voxel, 3,400 ground, 0 miss -> {out}\n")
+    assert capsys.readouterr().err.endswith(f": 1,200 voxel hits, 3,400 ground hits, 0 misses -> {out}\n")
 
 
 def test_trace_march_with_voxel_size(tmp_path, scene_file, capsys):
@@ -89,7 +89,7 @@ def test_trace_march_with_voxel_size(tmp_path, scene_file, capsys):
     )
     assert np.load(out)[0, :4].tolist() == [1, 5, 5, 1]
     # given: not "assumed"; one ray, not "1 rays"
-    assert capsys.readouterr().err.startswith("1 ray (numba, march, f64), voxel size 0.25 m: 1 voxel,")
+    assert capsys.readouterr().err.startswith("1 ray (numba, march, f64), voxel size 0.25 m: 1 voxel hit,")
 
 
 def _three_rays(tmp_path):

@@ -263,7 +263,8 @@ def _trace_and_write(args, voxel_size: float) -> None:
     print(
         single_line(
             f"{plural(len(rays), 'ray')} ({backends}, {result.method}, {used}), {size}: "
-            f"{counts[1]:,} voxel, {counts[2]:,} ground, {counts[0]:,} miss -> {args.out}"
+            f"{plural(counts[1], 'voxel hit')}, {plural(counts[2], 'ground hit')}, "
+            f"{plural(counts[0], 'miss', 'misses')} -> {args.out}"
         ),
         file=sys.stderr,
     )
