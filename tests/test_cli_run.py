@@ -51,7 +51,7 @@ def test_table_output_and_no_write(scenario, capsys):
     assert main(["run", str(scenario.path), "--no-write", "--method", "march", "--step", "0.25"]) == 0
     out = capsys.readouterr().out
     assert "Target coverage" in out and "Shift in mean direction" in out
-    assert "numba (march)" in out and "no scenario outputs written (--no-write)" in out
+    assert "numba (march, f64)" in out and "no scenario outputs written (--no-write)" in out
     assert not scenario.scene_output.exists() and not scenario.measures_file.exists()
     assert not scenario.path.with_name("S_Run.toml").exists()
 
@@ -294,7 +294,10 @@ def test_a_precision_the_backend_lacks_is_named_in_the_summary_and_json(scenario
     assert main(["run", str(scenario.path), "--no-write", "--precision", "f32", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["precision"] == "f64"
     assert main(["run", str(scenario.path), "--no-write"]) == 0
-    assert "backend: numba (exact); 2 scans x" in capsys.readouterr().out
+    assert "backend: numba (exact, f64); 2 scans x" in capsys.readouterr().out
+    # an f32 run said only "wgpu (exact)", as if it were the default f64
+    assert main(["run", str(scenario.path), "--no-write", "--backend", "wgpu", "--precision", "f32"]) == 0
+    assert "backend: wgpu (exact, f32); 2 scans x" in capsys.readouterr().out
 
 
 def test_the_bar_names_compiling_only_when_the_cache_lacks_the_kernels(scenario, monkeypatch):

@@ -297,9 +297,9 @@ def show_result(console, result, asked_precision=None) -> None:
         if several:  # the levels each target reached on its own, as --json holds them
             console.print(target_levels_table(targets))
     total = result.timings.get("total", 0.0)
-    how = result.method
+    how = f"{result.method}, {result.precision}" if result.precision else result.method
     if asked_precision and result.precision and result.precision != asked_precision:
-        how += f", {result.precision}, not the {asked_precision} asked for"
+        how += f", not the {asked_precision} asked for"
     console.print(
         f"backend: {result.backend} ({how}); {plural(result.scans, 'scan')} x "
         f"{result.rays_per_scan:,} rays, two runs, in {total:.2f} s"
