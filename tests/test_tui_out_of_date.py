@@ -78,3 +78,43 @@ async def test_a_model_changed_on_disk_since_opening_is_said_so_not_changed_sinc
         await pilot.pause()
         assert bar.state == NOT_READY
         assert bar.message == f"{scenario.path.name}: {scene_path.name} changed on disk; reopen to read it."
+
+
+async def test_a_model_edited_on_disk_while_open_is_said_so_before_any_other_run(tmp_path, scene_files):
+    """The scene model edited while the app had it open, and no other run since: the bar
+    stayed green, and F5 ran the app's old copy, recorded it as the run's model and still
+    said ready, while validate called those fresh outputs out of date."""
+    import shutil
+
+    from ladartui.tui.status import NOT_READY, READY, StatusBar
+
+    scene_path, centre, voxel_size = scene_files
+    for model in (scene_path, scene_path.with_name(f"{scene_path.stem}_Target.txt")):
+        shutil.copy(model, tmp_path)  # the module's files stay as they are
+    scenario = make_scenario(tmp_path, (tmp_path / scene_path.name, centre, voxel_size))
+    simulate(scenario)  # outputs of the model as opened
+    async with opened(scenario) as (app, pilot):
+        bar = app.query_one(StatusBar)
+        app.check_outputs_on_disk()
+        await pilot.pause()
+        assert bar.state == READY, bar.message
+        text = scenario.scene_file.read_bytes()
+        with open(scenario.scene_file, "a", encoding="utf-8") as model:
+            model.write("0,0,0\n")
+        app.check_outputs_on_disk()
+        await pilot.pause()
+        said = f"{scenario.path.name}: {scene_path.name} changed on disk; reopen to read it."
+        assert (bar.state, bar.message) == (NOT_READY, said)
+        assert any(f"{scene_path.name} changed on disk" in m for m in app.messages), app.messages
+        info = str(app.query_one("#results-info").render())
+        assert f"the scene model {scene_path.name} changed on disk since it was opened" in info, info
+        await app.run_action("run")  # runs the app's copy: the model on disk is still another
+        await wait_until(pilot, lambda: isinstance(app.screen, MeasuresScreen), timeout=120.0)
+        await pilot.press("escape")
+        app.check_outputs_on_disk()
+        await pilot.pause()
+        assert (bar.state, bar.message) == (NOT_READY, said)
+        scenario.scene_file.write_bytes(text)  # put back as it was opened
+        app.check_outputs_on_disk()
+        await pilot.pause()
+        assert bar.state == READY, bar.message

@@ -98,6 +98,8 @@ class LadarApp(
         self.outputs_from: Scenario | None = None  # the settings that made the outputs shown
         self.inputs_changed: list[str] = []  # the files they read that changed since their run
         self.changed_since_opened: list[str] = []  # read here before they changed (reopen)
+        self.inputs_drifted: list[tuple[str, str]] = []  # those found changed on disk since
+        self.inputs_seen = {}  # when each was last looked at (SceneLoading.check_inputs_on_disk)
         self.outputs_seen: tuple[int, int] | None = None  # (mtime, size) of the measures read
         self.threshold: float | None = None
         self.busy: str | None = None
@@ -253,12 +255,11 @@ class LadarApp(
             writes = f"; {runs} and writes them" if runs else ""
             show(NOT_READY, f"{scenario.path.name}{mark}: outputs missing ({names}){writes}.")
             return
-        if self.outputs_stale():
+        if self.outputs_stale() or self.inputs_drifted:
             # short: the bar is one line (the Results tab says which settings they came from)
             reruns = self.key_says("run", "reruns")
             stale = "outputs out of date" + (f"; {reruns}." if reruns else ".")
-            if self.changed_since_opened:  # a rerun would read the copies from before
-                files = self.changed_since_opened
+            if files := self.changed_on_disk():  # a rerun would read the copies from before
                 stale = f"{', '.join(files)} changed on disk; reopen to read {'them' if files[1:] else 'it'}."
             show(NOT_READY, f"{scenario.path.name}{mark}: {stale}")
             return
@@ -339,22 +340,27 @@ class LadarApp(
         if made is None or scenario is None or not self.outputs_stale():
             return None
         settings = setting_changes(made, scenario)
-        differ = named_changes(settings + self.inputs_changed)
+        inputs = list(self.inputs_changed)
+        for role, name in self.inputs_drifted:  # the outputs came from the copies read here
+            said = f"the {role} {name} changed on disk since it was opened (reopen to read it)"
+            inputs += [] if said in inputs else [said]
+        differ = named_changes(settings + inputs)
         record = scenario.run_record
         if record.is_file():  # written by every run since records exist
             other = " and ".join(
-                word for word, changed in (("settings", settings), ("inputs", self.inputs_changed)) if changed
+                word for word, changed in (("settings", settings), ("inputs", inputs)) if changed
             )
             return f"other {other}{differ}. The run's settings are in {record.name}."
         return f"the settings before your edits{differ}."
 
     def outputs_stale(self) -> bool:
         """Whether the outputs shown came from other settings than the scenario's now, or
-        from model files or flight logs that changed since their run."""
+        from model files or flight logs that changed since their run, or on disk since
+        the app read them."""
         made, scenario = self.outputs_from, self.scenario
         if made is None or scenario is None:
             return False
-        return bool(self.inputs_changed) or not made.same_outputs(scenario)
+        return bool(self.inputs_changed or self.inputs_drifted) or not made.same_outputs(scenario)
 
     def action_layout(self, number: int) -> None:
         self.view_area.set_layout(number)
@@ -399,7 +405,7 @@ class LadarApp(
         stale = ""
         if made_with is not None:  # as the Results tab and the status bar say it
             # a rerun would read the app's old copies of files changed on disk since
-            reruns = "" if self.changed_since_opened else self.key_says("run", "reruns")
+            reruns = "" if self.changed_on_disk() else self.key_says("run", "reruns")
             stale = f"Out of date: made from {made_with}" + (f" {reruns}." if reruns else "")
         self.push_screen(MeasuresScreen(self.measures, stale=stale))
 

@@ -53,6 +53,7 @@ class AppHost(App[None]):
     outputs_from: Scenario | None  # the settings that made the outputs shown
     inputs_changed: list[str]  # their model files and flight logs changed since (out of date)
     changed_since_opened: list[str]  # names of those the app read before they changed on disk
+    inputs_drifted: list[tuple[str, str]]  # (role, name) of files read here changed on disk since
     outputs_seen: tuple[int, int] | None  # the measures file's (mtime, size) when they were read
     cwd: Path
     keymap: dict[str, str]  # the user's keys.toml remapping (actions.load_keymap)
@@ -136,6 +137,9 @@ class AppHost(App[None]):
         raise NotImplementedError
 
     def outputs_stale(self) -> bool:
+        raise NotImplementedError
+
+    def changed_on_disk(self) -> list[str]:
         raise NotImplementedError
 
     # one mixin's, used by another or by the panels

@@ -99,6 +99,8 @@ class Loaded:
     prepared: dict[str, Any]
     earlier: Earlier
     file_seen: FileSeen | None = None  # the scenario file, read before the scenario was
+    # the (mtime, size) of each model file and flight log, taken before the scene was read
+    inputs_seen: dict[Path, tuple[int, int] | None] = field(default_factory=dict)
 
     @property
     def scenario(self) -> Scenario:
@@ -110,6 +112,9 @@ class SceneLoading(Host):
 
     scenario_seen: FileSeen | None = None  # the scenario file as opened or last saved
     scenario_on_disk: str | None = None  # "changed" or "gone" since then; None: as it was
+    # each model file and flight log read here: its (mtime, size) when last looked at, and
+    # whether its bytes on disk then differed from those read
+    inputs_seen: dict[Path, tuple[tuple[int, int] | None, bool]]
 
     def load(self, path: Path | None, scenario: Scenario | None = None, new: bool = False) -> None:
         """Load a scenario and its scene in a worker (the default scenario when no path).
@@ -131,6 +136,8 @@ class SceneLoading(Host):
         self.inputs_changed = done.earlier.inputs_changed
         self.changed_since_opened = done.earlier.changed_since_opened
         self.scenario_seen, self.scenario_on_disk = done.file_seen, None
+        self.inputs_seen = {path: (stamp, False) for path, stamp in done.inputs_seen.items()}
+        self.inputs_drifted = []
         self.set_scenario(done.scenario, modified=False)
         if done.scenario.path.is_file():
             remember_scenario(done.scenario.path)
@@ -183,6 +190,7 @@ class SceneLoading(Host):
         scenario = self.scenario
         if scenario is None or self.busy is not None or self.running:
             return
+        self.check_inputs_on_disk()
         measures = _file_status(scenario.measures_file)
         now = _stamp(measures)
         if now == self.outputs_seen:
@@ -220,6 +228,44 @@ class SceneLoading(Host):
             self.tell(f"{problem}.", severity="warning", timeout=8)
             self.query_one("#status", StatusBar).told = problem  # told: not again as a cut line
         self.scenario_changed()
+
+    def check_inputs_on_disk(self) -> None:
+        """A model file or flight log read here that changed on disk since: the app holds
+        its old copy, which a run would read, so only reopening brings the new one in;
+        said once, when found, and on the status bar while it lasts. A file only touched,
+        or put back as it was read, changes nothing."""
+        scenario, scene = self.scenario, self.scene
+        if scenario is None or scene is None:
+            return
+        drifted = []
+        for entry in run_inputs(scenario, scene):
+            stamp = _stamp(_file_status(entry.path))
+            seen = self.inputs_seen.get(entry.path)
+            if seen is None or seen[0] != stamp:  # read its bytes only when it was written
+                seen = (stamp, file_fingerprint(entry.path) != entry.fingerprint)
+                self.inputs_seen[entry.path] = seen
+            if seen[1]:
+                drifted.append((entry.role, visible(entry.path.name)))
+        if drifted == self.inputs_drifted:
+            return
+        new = [name for _, name in drifted if name not in self.changed_on_disk()]
+        self.inputs_drifted = drifted
+        if new:
+            reopen = self.key_note("open")
+            self.tell(
+                f"{', '.join(new)} changed on disk since it was opened; reopen{reopen} to read "
+                f"{'them' if new[1:] else 'it'}.",
+                severity="warning",
+                timeout=8,
+            )
+        self.scenario_changed()
+
+    def changed_on_disk(self) -> list[str]:
+        """The names of the model files and flight logs read here that changed on disk
+        since (found by a run that read them, or by looking): a run would read the old
+        copies, so only reopening the scenario brings them in."""
+        names = list(self.changed_since_opened)
+        return names + [name for _, name in self.inputs_drifted if name not in names]
 
     def note_scenario_saved(self) -> None:
         """The scenario file as just written by this app: the one compared from now on."""
@@ -271,12 +317,21 @@ def _load(path: Path | None, scenario, new: bool = False) -> Loaded:
         scenario = bridge.load_checked(path)
     else:
         seen = file_seen(scenario.path)
+    inputs_seen = {path: _stamp(_file_status(path)) for path in _input_paths(scenario)}
     scene = scenario.load_scene()
     _check_memory(scenario, scene)
     if new:  # written only once its scene is read and fits: a bad model leaves no file
         scenario = scenario.save()
         seen = file_seen(scenario.path)
-    return Loaded(scene, prepare_views(scene), _earlier(scenario, scene=scene), seen)
+    return Loaded(scene, prepare_views(scene), _earlier(scenario, scene=scene), seen, inputs_seen)
+
+
+def _input_paths(scenario) -> list[Path]:
+    """The model files and flight logs a run of ``scenario`` reads (``run_inputs``' paths)."""
+    from ladartui.trajectory import LogSegment
+
+    logs = [Path(s.file) for s in scenario.flight.segments if isinstance(s, LogSegment)]
+    return [scenario.scene_file, scenario.target_file, *logs]
 
 
 def _check_memory(scenario, scene) -> None:
