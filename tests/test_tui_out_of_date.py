@@ -95,14 +95,12 @@ async def test_a_model_edited_on_disk_while_open_is_said_so_before_any_other_run
     simulate(scenario)  # outputs of the model as opened
     async with opened(scenario) as (app, pilot):
         bar = app.query_one(StatusBar)
-        app.check_outputs_on_disk()
-        await pilot.pause()
+        await look_at_disk(app, pilot)
         assert bar.state == READY, bar.message
         text = scenario.scene_file.read_bytes()
         with open(scenario.scene_file, "a", encoding="utf-8") as model:
             model.write("0,0,0\n")
-        app.check_outputs_on_disk()
-        await pilot.pause()
+        await look_at_disk(app, pilot)
         said = f"{scenario.path.name}: {scene_path.name} changed on disk; reopen to read it."
         assert (bar.state, bar.message) == (NOT_READY, said)
         assert any(f"{scene_path.name} changed on disk" in m for m in app.messages), app.messages
@@ -111,10 +109,17 @@ async def test_a_model_edited_on_disk_while_open_is_said_so_before_any_other_run
         await app.run_action("run")  # runs the app's copy: the model on disk is still another
         await wait_until(pilot, lambda: isinstance(app.screen, MeasuresScreen), timeout=120.0)
         await pilot.press("escape")
-        app.check_outputs_on_disk()
-        await pilot.pause()
+        await look_at_disk(app, pilot)
         assert (bar.state, bar.message) == (NOT_READY, said)
         scenario.scene_file.write_bytes(text)  # put back as it was opened
-        app.check_outputs_on_disk()
-        await pilot.pause()
+        await look_at_disk(app, pilot)
         assert bar.state == READY, bar.message
+
+
+async def look_at_disk(app, pilot) -> None:
+    """The app's timed look at the files on disk, now, its hashing job done."""
+    from ladartui.tui.work import running
+
+    app.check_outputs_on_disk()
+    await wait_until(pilot, lambda: not running(app.inputs_worker))
+    await pilot.pause()

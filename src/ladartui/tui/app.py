@@ -466,6 +466,7 @@ class LadarApp(
         "export": "Nothing exported",
         "png": "View not saved",
         "earlier": "Earlier outputs not read",
+        "inputs": "Model files not checked",
     }
 
     def on_job_progress(self, message: JobProgress) -> None:
@@ -511,6 +512,8 @@ class LadarApp(
             self.run_finished(message.result, message.cancelled, message.error)
         elif message.job == "earlier" and message.result is not None:
             self.earlier_read(message.result)
+        elif message.job == "inputs" and message.result is not None:
+            self.inputs_looked_at(message.result)
         elif message.job == "png" and message.result is not None:
             self.tell(f"Wrote {message.result}")
         elif message.job == "export" and message.result is not None:

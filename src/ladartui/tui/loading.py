@@ -35,7 +35,7 @@ from ladartui.tui import actions, bridge
 from ladartui.tui.host import Host
 from ladartui.tui.status import StatusBar
 from ladartui.tui.view_area import prepare_views
-from ladartui.tui.work import start_job
+from ladartui.tui.work import running, start_job
 
 if TYPE_CHECKING:
     import numpy as np
@@ -115,6 +115,7 @@ class SceneLoading(Host):
     # each model file and flight log read here: its (mtime, size) when last looked at, and
     # whether its bytes on disk then differed from those read
     inputs_seen: dict[Path, tuple[tuple[int, int] | None, bool]]
+    inputs_worker = None  # the job hashing the files written since (check_inputs_on_disk)
 
     def load(self, path: Path | None, scenario: Scenario | None = None, new: bool = False) -> None:
         """Load a scenario and its scene in a worker (the default scenario when no path).
@@ -233,19 +234,40 @@ class SceneLoading(Host):
         """A model file or flight log read here that changed on disk since: the app holds
         its old copy, which a run would read, so only reopening brings the new one in;
         said once, when found, and on the status bar while it lasts. A file only touched,
-        or put back as it was read, changes nothing."""
+        or put back as it was read, changes nothing. Its bytes are hashed in a worker
+        (job "inputs"), and only once its (mtime, size) moved."""
         scenario, scene = self.scenario, self.scene
-        if scenario is None or scene is None:
+        if scenario is None or scene is None or running(self.inputs_worker):
             return
-        drifted = []
+        written = []  # (path, stamp now, fingerprint as read) of those written since looked at
         for entry in run_inputs(scenario, scene):
             stamp = _stamp(_file_status(entry.path))
             seen = self.inputs_seen.get(entry.path)
-            if seen is None or seen[0] != stamp:  # read its bytes only when it was written
-                seen = (stamp, file_fingerprint(entry.path) != entry.fingerprint)
-                self.inputs_seen[entry.path] = seen
-            if seen[1]:
-                drifted.append((entry.role, visible(entry.path.name)))
+            if seen is None or seen[0] != stamp:
+                written.append((entry.path, stamp, entry.fingerprint))
+        if written:
+            self.inputs_worker = start_job(
+                self,
+                "inputs",
+                lambda cancel, progress: (
+                    scenario.path,
+                    {path: (stamp, file_fingerprint(path) != read) for path, stamp, read in written},
+                ),
+            )
+
+    def inputs_looked_at(self, looked: tuple[Path, dict]) -> None:
+        """The inputs job's answer: for each file written since, its stamp and whether its
+        bytes differ from those read; the files now changed are said and shown."""
+        scenario, scene = self.scenario, self.scene
+        path, seen = looked
+        if scenario is None or scene is None or scenario.path != path:
+            return  # another file since
+        self.inputs_seen.update(seen)
+        drifted = [
+            (entry.role, visible(entry.path.name))
+            for entry in run_inputs(scenario, scene)
+            if self.inputs_seen.get(entry.path, (None, False))[1]
+        ]
         if drifted == self.inputs_drifted:
             return
         new = [name for _, name in drifted if name not in self.changed_on_disk()]
