@@ -255,3 +255,20 @@ def test_a_ctrl_c_as_a_finished_command_exits_keeps_its_status(status):
     child.send_signal(signal.SIGINT)
     out, err = child.communicate(timeout=60)
     assert (child.returncode, out, err) == (status, "", "")
+
+
+def test_the_ladartui_command_and_python_m_go_through_entry():
+    """The exit a Ctrl-C cannot turn into a failure is entry's: main alone does not give it."""
+    import tomllib
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    scripts = tomllib.loads((root / "pyproject.toml").read_text(encoding="utf-8"))["project"]["scripts"]
+    assert scripts == {"ladartui": "ladartui.cli:entry"}
+    assert (root / "src" / "ladartui" / "__main__.py").read_text(encoding="utf-8").split() == [
+        "from",
+        "ladartui.cli",
+        "import",
+        "entry",
+        "entry()",
+    ]
