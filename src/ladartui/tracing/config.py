@@ -58,9 +58,13 @@ MAX_SPREAD = 1.0  # largest origin half-spread (cells) handled in object order
 MIN_COS = 0.5  # every ray within 60 degrees of the cone's axis
 SCAN_BLOCK = 1 << 18  # rays per object-order call (one 512 x 512 scan)
 MIN_SCAN_RAYS = 4096  # fewer rays: ray order, whose set-up is nil
-# At most this many occupied voxels in view per ray (more, and walking the rays is
-# cheaper: the measured crossover on the reference scene).
-VOXELS_PER_RAY = 0.6
+# At most this many occupied voxels in view per ray for object order to be tried (more,
+# and walking the rays is cheaper). numba: object order took 0.5-0.7x ray order's time
+# at 0.3-1.3 voxels a ray and about 1.0x at 2-3, on the generated small and reference
+# scenes at 45 degrees and at nadir; the learned choice (OrderChoice) picks between the
+# two where both may run. wgpu: the crossover measured on the reference scene before.
+VOXELS_PER_RAY = 2.0
+WGPU_VOXELS_PER_RAY = 0.6
 
 # -- wgpu (tracing.wgpu_backend) ----------------------------------------------------
 

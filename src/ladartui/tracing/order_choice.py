@@ -48,9 +48,15 @@ class OrderChoice(TwoWayChoice):
     a GPU, where each call costs a dispatch).
     """
 
-    def __init__(self, settled_gap: float = 2.0, ray_sample: float | None = None):
+    def __init__(
+        self,
+        settled_gap: float = 2.0,
+        ray_sample: float | None = None,
+        voxels_per_ray: float = VOXELS_PER_RAY,
+    ):
         super().__init__(("object", "ray"), settled_gap)
         self.ray_sample = ray_sample
+        self.voxels_per_ray = voxels_per_ray  # object order is tried for a scan with at most these in view
 
     def times_ray_order_on_a_sample(self) -> bool:
         """Whether a pick of ray order is timed on a sample of the block (``ray_sample``)."""
@@ -147,7 +153,7 @@ def _trace_blocks(n, order, choice, object_block, ray_block, cancel, clock, comp
             pick = "object"  # which answers the block
             started, compiled = clock(), compiling.seconds
         if order == "object" or pick == "object":
-            limit = np.inf if order == "object" else VOXELS_PER_RAY * (b - a)
+            limit = np.inf if learning is None else learning.voxels_per_ray * (b - a)
             if object_block(a, b, limit):
                 orders.add("object")
                 if learning is not None:

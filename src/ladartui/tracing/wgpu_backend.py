@@ -70,6 +70,7 @@ from ladartui.tracing.config import (
     OBJECT_ORDER_TILE_SHIFT,
     RAY_BATCH,
     SCAN_BLOCK,
+    WGPU_VOXELS_PER_RAY,
 )
 from ladartui.tracing.order_choice import RAY_SAMPLE, OrderChoice, trace_in_blocks
 from ladartui.tracing.passes import timed
@@ -383,7 +384,11 @@ class WgpuBackend:
         while it does not lead (there a dispatch costs little beside the work: on
         lavapipe a sixteenth in four runs read 1.27x the per-ray time of whole
         blocks, against ray order's 4.5-5x object order's), on a GPU on whole blocks."""
-        return OrderChoice(settled_gap=math.inf, ray_sample=RAY_SAMPLE if self._cpu_adapter else None)
+        return OrderChoice(
+            settled_gap=math.inf,
+            ray_sample=RAY_SAMPLE if self._cpu_adapter else None,
+            voxels_per_ray=WGPU_VOXELS_PER_RAY,
+        )
 
     def _object_order(
         self, occupancy, origins, directions, bounds, shared_origin, max_voxels, kind, index, t
