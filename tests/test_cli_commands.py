@@ -238,7 +238,7 @@ def test_a_ctrl_c_as_a_finished_command_exits_keeps_its_status(status):
         "import time\n"
         "class Slow:\n"
         "    def __del__(self):\n"
-        "        time.sleep(3)\n"
+        "        time.sleep(1.5)\n"
         "keep = Slow()\n"
         "import ladartui.cli as cli\n"
         "def finished(argv=None):\n"
@@ -272,3 +272,60 @@ def test_the_ladartui_command_and_python_m_go_through_entry():
         "entry",
         "entry()",
     ]
+
+
+def _entry_script(status: int, body: str = "") -> str:
+    """A child that runs cli.entry over a command that does ``body``, prints a line and
+    returns ``status``."""
+    return (
+        "import ladartui.cli as cli\n"
+        "def finished(argv=None):\n"
+        f"{body}"
+        "    print('done', flush=True)\n"
+        f"    return {status}\n"
+        "cli.main = finished\n"
+        "cli.entry()\n"
+    )
+
+
+@pytest.mark.parametrize("closed", [1, 2])
+def test_entry_with_standard_output_or_error_closed_keeps_the_status(closed):
+    """With stdout closed ('>&-') entry's flush raised AttributeError after the command's
+    own one-line error; with stderr closed ('2>&-') a finished command exited 1."""
+    import os
+    import subprocess
+    import sys
+
+    child = subprocess.run(
+        [sys.executable, "-c", _entry_script(0).replace("print('done', flush=True)", "pass")],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        preexec_fn=lambda: os.close(closed),
+    )
+    assert child.returncode == 0 and "Traceback" not in child.stderr and "Error" not in child.stderr, (
+        child.stderr
+    )
+
+
+def test_a_slow_exit_handler_still_ends_at_a_ctrl_c_with_the_status():
+    """The handler that ignores Ctrl-C ran first of the exit handlers: a slow clean-up
+    registered during the command (a cluster's close) could not be stopped."""
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    body = "    import atexit, time\n    atexit.register(time.sleep, 30)\n"
+    child = subprocess.Popen(
+        [sys.executable, "-c", _entry_script(3, body)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert child.stdout.readline() == "done\n"
+    time.sleep(0.5)  # in the exit handler's sleep
+    started = time.monotonic()
+    child.send_signal(signal.SIGINT)
+    child.communicate(timeout=60)
+    assert child.returncode == 3 and time.monotonic() - started < 10

@@ -163,16 +163,18 @@ def entry() -> None:
     """The ``ladartui`` command and ``python -m ladartui``: ``main``, then an exit that a
     Ctrl-C can no longer turn into a failure (status 130, or killed by SIGINT): the
     command's work is done and said, only Python's shutting down is left."""
+    # Python takes its own handlers away before its modules are torn down (a Ctrl-C then
+    # killed the process): after every other exit handler (they run newest first, so
+    # this one, registered first, runs last), a Ctrl-C is ignored
+    atexit.register(signal.signal, signal.SIGINT, signal.SIG_IGN)
     status = main()
-    with contextlib.suppress(OSError, ValueError):  # all it printed, before any quick exit
-        sys.stdout.flush()
-        sys.stderr.flush()
+    for stream in (sys.stdout, sys.stderr):  # all it printed, before any quick exit
+        if stream is not None:  # (started with it closed: main said so, or could not)
+            with contextlib.suppress(OSError, ValueError):
+                stream.flush()
 
-    def finished(signum, frame) -> None:  # threads still being joined: end at once
+    def finished(signum, frame) -> None:  # threads joined, exit handlers run: end at once
         os._exit(status)
 
     signal.signal(signal.SIGINT, finished)
-    # Python takes its own handlers away before its modules are torn down (a Ctrl-C then
-    # killed the process): from its exit handlers on, a Ctrl-C is ignored
-    atexit.register(signal.signal, signal.SIGINT, signal.SIG_IGN)
     raise SystemExit(status)
