@@ -217,3 +217,14 @@ def test_a_scenario_link_that_loops_is_named_as_such_not_as_missing(tmp_path, ca
         r"levels of symbolic links(\); expected a scenario file \(\.toml\))?",
         said,
     ), said
+
+
+def test_a_link_to_a_missing_file_is_not_found_and_one_that_loops_cannot_be_read(tmp_path):
+    """A link to a missing file read 'cannot be read (No such file or directory)' once
+    links were looked into for loops; it is missing, as every reader says."""
+    from ladartui.fileprobe import file_problem
+
+    (tmp_path / "gone.txt").symlink_to(tmp_path / "nowhere.txt")
+    (tmp_path / "loop.txt").symlink_to(tmp_path / "loop.txt")
+    assert file_problem(tmp_path / "gone.txt") == "not found"
+    assert file_problem(tmp_path / "loop.txt") == "cannot be read (Too many levels of symbolic links)"

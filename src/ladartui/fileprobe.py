@@ -47,8 +47,12 @@ def file_problem(path: Path) -> str | None:
             return FOLDER
         if Path(path).exists():
             return SPECIAL_FILE
-        if os.path.islink(path):  # a link that loops, or names a missing file
-            os.stat(path)
+        if os.path.islink(path):  # a link that loops is there, unlike one to a missing file
+            try:
+                os.stat(path)
+            except OSError as error:
+                if error.errno == errno.ELOOP:
+                    raise
         return "not found"
     except OSError as error:
         if error.errno == errno.ENAMETOOLONG:
