@@ -1,3 +1,5 @@
+import re
+
 import numpy as np
 import pytest
 
@@ -409,3 +411,17 @@ def test_a_line_separator_inside_a_comment_keeps_the_log_s_line_numbers(tmp_path
     with pytest.raises(TrajectoryError) as caught:
         load_flight_log(path)
     assert str(caught.value) == f"{path}:4: y = 'abc': expected a number"
+
+
+@pytest.mark.parametrize("end", ["\r", "\r\n", "\n"])
+def test_bytes_that_are_not_utf8_are_named_on_the_line_a_bad_number_would_be(tmp_path, end):
+    """In a log whose lines end in CR alone, a bad number on line 3 was named at :3: but
+    a byte that is not UTF-8 on line 3 at :1: (only LF was counted for it)."""
+    path = tmp_path / "log.csv"
+    lines = ["time,x,y,z,heading", "0,0,0,60,0", "1,0,abc,60,0"]
+    path.write_bytes(end.join(lines).encode() + end.encode())
+    with pytest.raises(TrajectoryError, match=rf"^{re.escape(str(path))}:3: y = 'abc'"):
+        load_flight_log(path)
+    path.write_bytes(end.join(lines).replace("abc", "a\xffc").encode("latin-1") + end.encode())
+    with pytest.raises(TrajectoryError, match=rf"^{re.escape(str(path))}:3: not UTF-8 text \(byte 0xff\)"):
+        load_flight_log(path)

@@ -60,12 +60,16 @@ def file_problem(path: Path) -> str | None:
         return f"cannot be read ({os_reason(error)})"
 
 
-def not_utf8(data: bytes, error: UnicodeDecodeError) -> tuple[int, str]:
-    """Where ``data`` stops being UTF-8 text: the line (from 1) and "not UTF-8 text (byte 0xNN)"."""
-    return data.count(b"\n", 0, error.start) + 1, f"not UTF-8 text (byte 0x{data[error.start]:02x})"
-
-
+# A line ends at LF, CR LF or CR alone, and nothing else (text_lines, not_utf8).
 _LINE_END = re.compile(r"\r\n|\r|\n")
+_LINE_END_BYTES = re.compile(_LINE_END.pattern.encode("ascii"))
+
+
+def not_utf8(data: bytes, error: UnicodeDecodeError) -> tuple[int, str]:
+    """Where ``data`` stops being UTF-8 text: the line (from 1, as ``text_lines`` numbers
+    them) and "not UTF-8 text (byte 0xNN)"."""
+    line = len(_LINE_END_BYTES.findall(data, 0, error.start)) + 1
+    return line, f"not UTF-8 text (byte 0x{data[error.start]:02x})"
 
 
 def text_lines(text: str) -> list[str]:
