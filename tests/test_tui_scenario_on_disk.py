@@ -118,22 +118,18 @@ async def test_a_study_of_a_scenario_changed_on_disk_says_what_it_reads(tmp_path
         )
 
 
-async def test_outputs_a_killed_run_left_half_replaced_are_not_read_as_a_run(tmp_path, scene_files):
-    """A run killed between its renames leaves the new scene output, the old target output
-    aside under the journal: the TUI read them as a run's ("outputs missing
-    (S_Target.txt); F5 runs and writes them") though validate said they are not to be read."""
+def killed_mid_swap(scenario) -> None:
+    """A run of ``scenario`` killed between its renames: the new scene output in place,
+    the old target output aside under the journal."""
     import signal
     import subprocess
     import sys
 
-    from ladartui.simulation import simulate
     from test_output_kill import PAUSING_RUN
 
-    scenario = make_scenario(tmp_path, scene_files)
-    simulate(scenario)  # the earlier set
-    scenario.with_changes(sensor=scenario.sensor.__class__(grid=6, ray_grid=1, fov=8.0)).save()
+    held = PAUSING_RUN.replace("time.sleep(0.5)", "time.sleep(120)")  # until killed, however slow
     run = subprocess.Popen(
-        [sys.executable, "-c", PAUSING_RUN, "swap", "2", str(scenario.path)],
+        [sys.executable, "-c", held, "swap", "2", str(scenario.path)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
@@ -142,10 +138,57 @@ async def test_outputs_a_killed_run_left_half_replaced_are_not_read_as_a_run(tmp
     run.send_signal(signal.SIGKILL)
     run.communicate(timeout=60)
     assert not scenario.target_output.exists()  # aside, under the journal
+
+
+STOPPED = (
+    "the last run was stopped while it replaced the outputs; F5 runs and puts the earlier set back first."
+)
+
+
+async def test_outputs_a_killed_run_left_half_replaced_are_not_read_as_a_run(tmp_path, scene_files):
+    """A run killed between its renames leaves the new scene output, the old target output
+    aside under the journal: the TUI read them as a run's ("outputs missing
+    (S_Target.txt); F5 runs and writes them") though validate said they are not to be read."""
+    from ladartui.simulation import simulate
+
+    scenario = make_scenario(tmp_path, scene_files)
+    simulate(scenario)  # the earlier set
+    killed_mid_swap(scenario)
     async with opened(scenario) as (app, pilot):
         assert bar(app).state == NOT_READY
-        assert bar(app).message == (
-            "demo.toml: the last run was stopped while it replaced the outputs; F5 runs and puts "
-            "the earlier set back first."
-        )
+        assert bar(app).message == f"demo.toml: {STOPPED}"
         assert app.output_voxels is None and app.missing_outputs == []
+        # a run puts the earlier set back as it takes the lock; cancelled after, its
+        # outputs are the earlier set's again, read and shown (the bar said so until F5)
+        from ladartui.outputset import recover
+
+        assert recover(app_journal(scenario))
+        app.run_finished(cancelled=True)
+        await wait_until(pilot, lambda: app.output_voxels is not None, timeout=30)
+        assert not app.outputs_interrupted and STOPPED not in bar(app).message
+
+
+async def test_a_run_killed_mid_swap_while_the_app_is_open_is_told(tmp_path, scene_files):
+    """Another run of the file killed between its renames while the app had it open: the
+    bar stayed green (the measures file had not moved), or a note said the outputs
+    'changed on disk: shown as they are now' of files it did not read."""
+    from ladartui.simulation import simulate
+
+    scenario = make_scenario(tmp_path, scene_files)
+    simulate(scenario)
+    async with opened(scenario) as (app, pilot):
+        await look_at_disk(app, pilot)
+        assert bar(app).state == READY
+        shown = app.output_voxels
+        killed_mid_swap(scenario)
+        await look_at_disk(app, pilot)
+        assert (bar(app).state, bar(app).message) == (NOT_READY, f"demo.toml: {STOPPED}")
+        assert any("was stopped while it replaced the outputs" in m for m in app.messages)
+        assert app.output_voxels is shown  # the earlier set's, read before: the run puts it back
+
+
+def app_journal(scenario):
+    from ladartui.outputset import journal_path
+    from ladartui.simulation import output_lock
+
+    return journal_path(output_lock(scenario))

@@ -192,6 +192,8 @@ class SceneLoading(Host):
         if scenario is None or self.busy is not None or self.running:
             return
         self.check_inputs_on_disk()
+        if self.check_swap_on_disk(scenario):
+            return
         measures = _file_status(scenario.measures_file)
         now = _stamp(measures)
         if now == self.outputs_seen:
@@ -207,6 +209,27 @@ class SceneLoading(Host):
         # reads them, or names the files missing; the measures file as just found
         self.show_outputs_of(scenario, outputs_with(scenario, measures))
         self.scenario_changed()
+
+    def check_swap_on_disk(self, scenario) -> bool:
+        """Another run of this file stopped while it replaced the outputs (or the earlier
+        set since put back): said, and the outputs looked at again once it is back.
+        True while the files on disk are not to be read."""
+        from ladartui.simulation import swap_interrupted
+
+        interrupted = swap_interrupted(scenario)
+        if interrupted and not self.outputs_interrupted:
+            self.outputs_interrupted, self.missing_outputs = True, []
+            self.tell(
+                f"A run of {scenario.path.name} was stopped while it replaced the outputs: those "
+                "shown were read before it, and the next run puts them back first.",
+                severity="warning",
+                timeout=8,
+            )
+            self.scenario_changed()
+        elif self.outputs_interrupted and not interrupted:
+            self.show_outputs_of(scenario)  # put back (a run of it elsewhere): read again
+            self.scenario_changed()
+        return interrupted
 
     def check_scenario_on_disk(self) -> None:
         """The scenario file changed (or went) on disk since it was opened or saved: Run

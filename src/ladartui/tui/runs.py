@@ -81,6 +81,8 @@ class RunControl(Host):
             # nothing was written: the outputs shown before the run, not its partial live one
             self.output_voxels, self.disk_outputs = shown_before
             self.show_output()
+            if self.outputs_interrupted and self.scenario is not None:  # it put the earlier set back
+                self.show_outputs_of(self.scenario)
         if cancelled:
             self.tell("Run cancelled; earlier outputs are unchanged.", severity="warning")
             self.run_panel.say("Last run cancelled; nothing was written.")
