@@ -410,6 +410,15 @@ def test_a_key_the_views_take_is_refused_in_keys_toml(tmp_path):
     keys.write_text('[keys]\nzoom-target = "t"\nfit-scene = "f"\ngrey = "g"\n')
     keymap, problems = load_keymap(tmp_path)
     assert problems == [] and keymap == {"zoom-target": "t", "fit-scene": "f", "grey": "g"}
+    # "=" and "-" are bound as equals_sign and minus, the views' zoom keys: they passed
+    keys.write_text('[keys]\nthreshold = "="\nrun = "-"\nundo = "equals_sign"\n')
+    keymap, problems = load_keymap(tmp_path)
+    assert keymap == {} and [p.split(": ")[1] for p in problems] == [
+        "keys.threshold = '='",
+        "keys.run = '-'",
+        "keys.undo = 'equals_sign'",
+    ]
+    assert all("in the views" in p and "Zoom" in p for p in problems)
 
 
 def test_an_unknown_command_id_in_keys_toml_is_told_with_every_id_there_is(tmp_path):

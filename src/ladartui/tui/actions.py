@@ -307,9 +307,7 @@ def load_keymap(folder: Path | None = None) -> tuple[dict[str, str], list[str]]:
                 )
             )
         elif taken_by_views := [
-            k.strip()
-            for k in key.split(",")
-            if k.strip() in VIEW_KEYS and VIEW_KEYS[k.strip()][1] != BY_ID[command_id].action
+            k for k in _bound_keys(key) if k in VIEW_KEYS and VIEW_KEYS[k][1] != BY_ID[command_id].action
         ]:
             # a focused view's own key wins over the app's: the command would not run there
             view_key = taken_by_views[0]
@@ -341,8 +339,15 @@ def load_keymap(folder: Path | None = None) -> tuple[dict[str, str], list[str]]:
     return keymap, problems
 
 
+def _bound_keys(keys: str) -> list[str]:
+    """The keys of a binding, in order, as Textual binds them: "=" is equals_sign, "-" minus."""
+    from textual.keys import _character_to_key  # (what Textual's own bindings do to a character)
+
+    return [_character_to_key(key) if len(key) == 1 else key for key in (k.strip() for k in keys.split(","))]
+
+
 def _key_set(keys: str) -> set[str]:
-    return {key.strip() for key in keys.split(",")}
+    return set(_bound_keys(keys))
 
 
 def key_hint(command_id: str, keymap: dict[str, str] | None = None, short: bool = False) -> str:
