@@ -236,9 +236,28 @@ def test_a_study_over_the_ray_limit_is_refused_before_it_traces(tmp_path, monkey
     # of the first scan (runs=5): 64 x 6 + 256 x 6 + 64 x 5 + the march's warm-up, 64 rays
     rays = 64 * 6 + 256 * 6 + 64 * 5 + 64
     monkeypatch.setenv("LADARTUI_MAX_RAYS", str(rays - 1))
-    traced = []
-    monkeypatch.setattr("ladartui.study.run._trace", lambda *args: traced.append(args))
+    import ladartui.study.run as study_run
+
+    traced, real = [], study_run._trace
+    monkeypatch.setattr(study_run, "_trace", lambda *args: traced.append(args) or real(*args))
     with pytest.raises(RayLimitError) as refused:
         run_study(inputs, [march, reference_setting(2)], runs=5, warmup=1)
     assert f"about {rays:.3g} rays to trace" in str(refused.value) and traced == []
     assert "LADARTUI_MAX_RAYS if" in str(refused.value) and "--max-rays" not in str(refused.value)
+    monkeypatch.setenv("LADARTUI_MAX_RAYS", str(rays))  # exactly the count: it runs
+    result = run_study(inputs, [march, reference_setting(2)], runs=5, warmup=1)
+    assert traced and all(row.status == "ok" for row in result.rows)
+
+
+def test_the_tui_study_says_how_to_raise_the_ray_limit_as_its_run_does(tmp_path, monkeypatch):
+    """The study screen said "raise it with LADARTUI_MAX_RAYS if this is meant", the
+    command's advice; F5 says the variable is set before ladartui starts."""
+    from ladartui.resources import RAISE_IN_TUI, RayLimitError
+    from ladartui.tui.study_screen import _study
+    from tiny_sweep import write_tiny_scenario
+
+    path = write_tiny_scenario(tmp_path).path
+    monkeypatch.setenv("LADARTUI_MAX_RAYS", "1000")
+    with pytest.raises(RayLimitError) as refused:
+        _study("quick", path, 2, 3, None, lambda *args: None)
+    assert f"(raise it with {RAISE_IN_TUI} if this is meant)" in str(refused.value)

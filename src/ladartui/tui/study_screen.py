@@ -226,6 +226,7 @@ class StudyScreen(Screen):
 
 def _study(mode: str, scenario_path, scans, runs, cancel, progress):
     """The study job (worker thread): (result, what was done)."""
+    from ladartui.resources import RAISE_IN_TUI, RayLimitError
     from ladartui.study import full_settings, quick_settings
     from ladartui.study.inputs import generated_inputs, scenario_inputs
     from ladartui.study.results import study_folder
@@ -243,12 +244,15 @@ def _study(mode: str, scenario_path, scans, runs, cancel, progress):
             "small" if quick else "reference", scans, progress=lambda text: progress(None, text)
         )
     settings = quick_settings() if quick else full_settings()
-    result = run_study(
-        inputs,
-        settings,
-        runs=runs,
-        cancel=cancel,
-        progress=lambda p: progress(p.done / max(p.total, 1), p.label, p),
-    )
+    try:
+        result = run_study(
+            inputs,
+            settings,
+            runs=runs,
+            cancel=cancel,
+            progress=lambda p: progress(p.done / max(p.total, 1), p.label, p),
+        )
+    except RayLimitError as refused:  # raised here as F5 says it: the variable, set before starting
+        raise refused.advising(RAISE_IN_TUI) from None
     write_outputs(result, folder)  # kept, so the screen reopens it next time
     return result, f"{mode} study done on {inputs.name}; kept in {folder}"
