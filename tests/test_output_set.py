@@ -134,6 +134,32 @@ def test_an_output_that_cannot_be_moved_aside_is_one_line(scenario, capsys, monk
     assert hidden(scenario.path.parent) == []
 
 
+def test_a_commit_that_cannot_remove_its_journal_is_said_as_such(scenario, capsys, monkeypatch):
+    """The journal's removal (the commit point) refused read "…outputs.lock.journal: could
+    not be replaced", of a file that is no output."""
+    from ladartui.outputset import journal_path
+    from ladartui.simulation import output_lock
+
+    old = write_old_set(scenario)
+    journal = journal_path(output_lock(scenario))
+    real, refusals = os.unlink, []
+
+    def refused(path, *args, **kwargs):
+        if str(path) == str(journal) and not refusals:  # the commit; the roll back may
+            refusals.append(path)
+            raise PermissionError(errno.EPERM, "Operation not permitted", str(path))
+        return real(path, *args, **kwargs)
+
+    monkeypatch.setattr(outputset.os, "unlink", refused)
+    assert main(["run", str(scenario.path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err == (
+        f"ladartui: error: {journal}: could not be removed (operation not permitted); nothing "
+        "was replaced, earlier outputs are unchanged"
+    )
+    assert snapshot(scenario) == old
+
+
 def test_a_full_disk_at_the_lock_names_it_and_replaces_nothing(scenario, capsys):
     """The lock's pid was the first byte written: on a full disk the run said only "could
     not write the output", and simulate raised a bare OSError."""

@@ -292,21 +292,22 @@ class OutputSet:
             os.unlink(self.journal)  # the commit point
             _fsync_dir(self.journal.parent)
         except BaseException as error:
+            # what failed: a rename of an output, or (the journal) the commit after them
+            failed = "could not be removed" if replacing == self.journal else "could not be replaced"
             try:
                 _roll_back(entries)
             except OSError as also:  # the journal stays: the next run puts them back
                 raise OutputFileError(
                     replacing,
-                    f"could not be replaced ({_reason(error)}), and the earlier outputs could "
-                    f"not be put back ({os_reason(also).lower()}); the next run puts them back first",
+                    f"{failed} ({_reason(error)}), and the earlier outputs could not be put back "
+                    f"({os_reason(also).lower()}); the next run puts them back first",
                 ) from None
             with contextlib.suppress(OSError):
                 os.unlink(self.journal)
             if isinstance(error, OSError):  # a rename the folder refused: one line, not a traceback
                 raise OutputFileError(
                     replacing,
-                    f"could not be replaced ({_reason(error)}); nothing was replaced, earlier "
-                    "outputs are unchanged",
+                    f"{failed} ({_reason(error)}); nothing was replaced, earlier outputs are unchanged",
                 ) from None
             raise
         _step("backups")
@@ -355,7 +356,8 @@ def _write_journal(journal: Path, entries):
 
 
 def _reason(error: BaseException) -> str:
-    return os_reason(error).lower() if isinstance(error, OSError) else type(error).__name__
+    """Why a swap stopped, in words: the system's reason, or "interrupted" (Ctrl-C, SIGTERM)."""
+    return os_reason(error).lower() if isinstance(error, OSError) else "interrupted"
 
 
 def _write_error(path, error: OSError) -> OutputFileError:
