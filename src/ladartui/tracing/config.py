@@ -59,10 +59,11 @@ MIN_COS = 0.5  # every ray within 60 degrees of the cone's axis
 SCAN_BLOCK = 1 << 18  # rays per object-order call (one 512 x 512 scan)
 MIN_SCAN_RAYS = 4096  # fewer rays: ray order, whose set-up is nil
 # At most this many occupied voxels in view per ray for object order to be tried (more,
-# and walking the rays is cheaper). numba: object order took 0.5-0.7x ray order's time
-# at 0.3-1.3 voxels a ray and about 1.0x at 2-3, on the generated small and reference
-# scenes at 45 degrees and at nadir; the learned choice (OrderChoice) picks between the
-# two where both may run. wgpu: the crossover measured on the reference scene before.
+# and walking the rays is cheaper). numba: object order took 0.25-0.65x ray order's time
+# at 0.3-1.3 voxels a ray, 0.8-0.9x at 2.0-2.4 and 1.07x at 3.2, on the generated small
+# and reference scenes at 45 degrees and at nadir; the learned choice (OrderChoice)
+# picks between the two where both may run. wgpu: the crossover measured before on the
+# reference scene.
 VOXELS_PER_RAY = 2.0
 WGPU_VOXELS_PER_RAY = 0.6
 
