@@ -234,21 +234,19 @@ def test_a_ctrl_c_as_a_finished_command_exits_keeps_its_status(status):
     import sys
     import time
 
-    script = (
-        "import time\n"
-        "class Slow:\n"
-        "    def __del__(self):\n"
-        "        time.sleep(1.5)\n"
-        "keep = Slow()\n"
-        "import ladartui.cli as cli\n"
-        "def finished(argv=None):\n"
-        "    print('done')\n"
-        f"    return {status}\n"
-        "cli.main = finished\n"
-        "cli.entry()\n"
+    slow_teardown = (  # an object torn down with the modules, slowly
+        "    import time\n"
+        "    class Slow:\n"
+        "        def __del__(self):\n"
+        "            time.sleep(1.5)\n"
+        "    global keep\n"
+        "    keep = Slow()\n"
     )
     child = subprocess.Popen(
-        [sys.executable, "-c", script], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        [sys.executable, "-c", _entry_script(status, slow_teardown)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
     )
     assert child.stdout.readline() == "done\n"
     time.sleep(0.5)  # shutting down
