@@ -189,12 +189,15 @@ def test_a_full_disk_under_numbas_cache_is_not_called_the_output(tmp_path, capsy
     """A first run's kernels written to numba's cache on a full disk said 'could not write
     the output', with --no-write too."""
     import errno
+    import os
+
+    import numba
 
     import ladartui.cli.info as info
 
-    numba_code = compile(
+    numba_code = compile(  # code that names itself numba's own cache module
         "def save(*args, **kwargs):\n    raise OSError(errno.EFBIG, 'File too large')\n",
-        str(tmp_path / "numba" / "core" / "caching.py"),
+        os.path.join(os.path.dirname(numba.__file__), "core", "caching.py"),
         "exec",
     )
     space = {"errno": errno}
@@ -327,3 +330,24 @@ def test_a_slow_exit_handler_still_ends_at_a_ctrl_c_with_the_status():
     child.send_signal(signal.SIGINT)
     child.communicate(timeout=60)
     assert child.returncode == 3 and time.monotonic() - started < 10
+
+
+def test_only_numbas_own_frames_blame_its_kernel_cache():
+    """Any frame under a folder named numba counted, so a checkout in ~/work/numba/ said
+    "could not write numba's cache of the compiled kernels" of every full disk."""
+    import os
+
+    import numba
+
+    from ladartui.cli import _in_numba
+
+    def raised_in(filename: str) -> OSError:
+        try:
+            exec(compile("raise OSError(28, 'No space left on device')", filename, "exec"))
+        except OSError as error:
+            return error
+        raise AssertionError("nothing raised")
+
+    ours = os.path.join(os.sep, "home", "u", "work", "numba", "ladartui", "cli", "run.py")
+    assert not _in_numba(raised_in(ours))
+    assert _in_numba(raised_in(os.path.join(os.path.dirname(numba.__file__), "core", "caching.py")))

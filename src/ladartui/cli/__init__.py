@@ -146,8 +146,11 @@ def _in_numba(error: BaseException) -> bool:
     cache (beside the modules, or NUMBA_CACHE_DIR) on a full disk, not the command's output."""
     import traceback
 
-    part = f"{os.sep}numba{os.sep}"
-    return any(part in frame.filename for frame in traceback.extract_tb(error.__traceback__))
+    numba = sys.modules.get("numba")
+    if numba is None or numba.__file__ is None:
+        return False  # never imported: none of its code ran
+    package = os.path.dirname(numba.__file__) + os.sep  # its own files, not any folder named numba
+    return any(frame.filename.startswith(package) for frame in traceback.extract_tb(error.__traceback__))
 
 
 def _reader_gone() -> int:
