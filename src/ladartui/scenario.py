@@ -140,6 +140,10 @@ class Scenario:
         """The name ``[targets] names`` gives a target id, else "target N"."""
         return dict(self.target_names).get(int(target_id), f"target {int(target_id)}")
 
+    def traced_rays(self) -> int:
+        """Rays a run traces, the ray limit's count: every scan's, in both runs."""
+        return 2 * self.sensor.rays_per_scan * self.scan_count()
+
     def scan_count(self) -> int:
         """Scans of the flight plan, counted without building the poses where it can be."""
         return sum(_segment_scans(seg) for seg in self.flight.segments)
@@ -306,7 +310,7 @@ class Scenario:
             f"           path {fixed(length, 1)} m, {fixed(self.flight_time(), 1)} s {self._clock_text()}",
             # the ray limit counts what is traced: both runs
             f"rays       {s.rays_per_scan:,} per scan, {s.rays_per_scan * len(poses):,} in all; "
-            f"{2 * s.rays_per_scan * len(poses):,} traced with the target-alone run",
+            f"{self.traced_rays():,} traced with the target-alone run",
             f"run        backend {self.backend}, method {self.method}"
             + (f" (step {self.step:g} voxel)" if self.method == "march" else "")
             + f", {self.precision}"
@@ -569,7 +573,7 @@ def check_work(scenario, raise_with=None):
 
     sensor, scans = scenario.sensor, scenario.scan_count()
     check_rays(
-        2 * sensor.rays_per_scan * scans,
+        scenario.traced_rays(),
         f"{scenario.path}: sensor.grid = {sensor.grid}, sensor.ray_grid = "
         f"{sensor.ray_grid}, {plural(scans, 'scan')}",
         raise_with=raise_with or RAISE_RAYS,

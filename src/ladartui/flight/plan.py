@@ -404,9 +404,9 @@ class FlightPlan:
 
 
 def keeps_own_clock(segment) -> bool:
-    """Whether ``segment`` times its scans itself (a flight log's ``leg_seconds``), not by
-    the plan's speed."""
-    return callable(getattr(segment, "leg_seconds", None))
+    """Whether ``segment`` times its scans itself (a flight log, kind "log": its
+    ``leg_seconds``), not by the plan's speed."""
+    return segment.kind == "log"
 
 
 def _prefixed(error: FieldError, prefix: str) -> FieldError:

@@ -19,7 +19,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ladartui.atomic import atomic_path, write_errors_named
+from ladartui.atomic import write_errors_named, write_text_atomic
 from ladartui.errors import (
     FieldError,
     InputFileError,
@@ -471,8 +471,8 @@ def write_ranking(path, ranking: list[Ranked], parameter_names) -> Path:
             }
         )
     text = table_text(rows, columns=columns)
-    with write_errors_named(path), atomic_path(path) as tmp:
-        tmp.write_text(text, encoding="utf-8")
+    with write_errors_named(path):
+        write_text_atomic(path, text)
     return Path(path)
 
 
