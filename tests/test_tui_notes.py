@@ -79,5 +79,9 @@ async def test_a_note_held_by_dialogs_shows_for_the_time_it_had_left(tmp_path, s
         assert toasts(app) == []
         form.query_one("#form-cancel").press()
         await wait_until(pilot, lambda: not isinstance(app.screen, ThresholdScreen), 10)
-        back = [n for n in app._notifications if n.message == "a short note"]
-        assert len(back) == 1 and 5.0 < back[0].timeout <= 15.0  # what it had left, not its 60 s
+
+        def back():  # shown again once the screen under the dialog is back (a loaded machine: later)
+            return [n for n in app._notifications if n.message == "a short note"]
+
+        await wait_until(pilot, lambda: back(), 10)
+        assert len(back()) == 1 and 5.0 < back()[0].timeout <= 15.0  # what it had left, not its 60 s
