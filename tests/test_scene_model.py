@@ -208,15 +208,23 @@ def test_scene_survives_pickling():
 
 def test_a_scenes_bounds_are_found_once_however_many_ask(monkeypatch):
     """Opening a scene passed over its voxels for their bounds three times: the memory
-    check, the views' memory check and the height map."""
+    check, the views' memory check and the height map; building its occupancy, once more."""
     import ladartui.scene.model as model
+    import ladartui.scene.occupancy as occupancy
 
     passes = []
     real = model.column_bounds
-    monkeypatch.setattr(model, "column_bounds", lambda voxels: passes.append(len(voxels)) or real(voxels))
+    counted = lambda voxels: passes.append(len(voxels)) or real(voxels)  # noqa: E731
+    monkeypatch.setattr(model, "column_bounds", counted)
+    monkeypatch.setattr(occupancy, "column_bounds", counted)
     voxels = np.array([(5, 6, 1), (9, 2, 4), (7, 7, 0)], np.int32)
     scene = model.Scene(voxels, voxels[:1], 1.0)
     scene.tracing_bytes()
     origin, heights = scene.column_tops()
     assert scene.bounds()[0].tolist() == [5, 2, 0] and origin == (5, 2) and heights.shape == (5, 6)
+    built = scene.occupancy, scene.target_occupancy  # (nor for the tracing structures)
+    assert [(b.bbox_lo.tolist(), b.bbox_hi.tolist()) for b in built] == [
+        ([5, 2, 0], [10, 8, 5]),
+        ([5, 6, 1], [6, 7, 2]),
+    ]
     assert sorted(passes) == [1, 3]  # the voxels once, the target once

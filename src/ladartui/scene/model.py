@@ -134,7 +134,7 @@ class Scene:
         """The sparse occupancy of the scene voxels (built once, on first use)."""
         with self._lock:
             if self._occupancy is None:
-                self._occupancy = _build_occupancy(self.voxels, self.shape, self.path or self.name)
+                self._occupancy = self._build_occupancy(target=False)
             return self._occupancy
 
     @property
@@ -142,10 +142,13 @@ class Scene:
         """The sparse occupancy of the target voxels alone, over the scene's shape."""
         with self._target_lock:
             if self._target_occupancy is None:
-                self._target_occupancy = _build_occupancy(
-                    self.target, self.shape, self.target_path or self.name
-                )
+                self._target_occupancy = self._build_occupancy(target=True)
             return self._target_occupancy
+
+    def _build_occupancy(self, target: bool):
+        voxels, source = (self.target, self.target_path) if target else (self.voxels, self.path)
+        bounds = self._bounds.get(target)  # (found as the scene was made)
+        return Occupancy.build(voxels, self.shape, source=str(source or self.name), bounds=bounds)
 
     def target_centre_m(self) -> np.ndarray:
         """Centroid of the target voxel centres, metres (x, y, z)."""
@@ -212,10 +215,6 @@ def top_height_map(voxels, nx, ny, origin=(0, 0)) -> np.ndarray:
         columns = (voxels[:, 0] - origin[0], voxels[:, 1] - origin[1])
         np.maximum.at(heights, columns, voxels[:, 2].astype(np.int32))
     return heights
-
-
-def _build_occupancy(voxels, shape, source):
-    return Occupancy.build(voxels, shape, source=str(source))
 
 
 def _checked_shape(shape, needed: tuple[int, ...]) -> tuple[int, ...]:

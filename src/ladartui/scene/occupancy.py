@@ -79,12 +79,14 @@ class Occupancy:
     halo4_dims: np.ndarray | None = None
 
     @classmethod
-    def build(cls, voxels, shape=None, source="voxels") -> Occupancy:
+    def build(cls, voxels, shape=None, source="voxels", bounds=None) -> Occupancy:
         """Build from an (N, 3) integer voxel list (duplicates allowed) and the scene shape.
 
         ``shape`` is (nx, ny, nz); by default the greatest index on each axis + 1. Voxels
         outside ``[0, shape)`` raise FieldError; a build whose extent-sized arrays
         would not fit in memory raises ResourceLimitError naming ``source``.
+        ``bounds``: the voxels' ``column_bounds`` where the caller has them (a Scene
+        finds them as it is made), so they are not found again.
         """
         vox = np.asarray(voxels)
         if vox.size == 0:
@@ -95,7 +97,10 @@ class Occupancy:
             raise FieldError("voxels", f"dtype {vox.dtype}", "integer voxel indices")
         if vox.dtype not in (np.int32, np.int64):  # the kernels are compiled for these two
             vox = vox.astype(np.int64)
-        lo, last = column_bounds(vox) if len(vox) else (np.zeros(3, np.int64), np.full(3, -1, np.int64))
+        if not len(vox):
+            lo, last = np.zeros(3, np.int64), np.full(3, -1, np.int64)
+        else:
+            lo, last = column_bounds(vox) if bounds is None else bounds
         hi = last + 1
         if shape is None:
             shape = tuple(int(v) for v in hi)
