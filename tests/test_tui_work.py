@@ -198,6 +198,36 @@ async def test_the_study_screen_keeps_its_controls_at_80x24(tmp_path, scene_file
         assert note.startswith("no room here for ") and note.endswith(": see study.csv in demo-study")
 
 
+async def test_a_finished_study_shows_its_whole_100_percent(tmp_path, scene_files, monkeypatch):
+    """At 80x24 the progress row's buttons left the bar 29 columns, less than its
+    32-column bar and percentage: a finished study's "100%" was cut off the screen."""
+    from pathlib import Path
+    from types import SimpleNamespace
+
+    import ladartui.study.run as study_run
+    from ladartui.study.results import read_study
+
+    kept = read_study(Path(__file__).parent.parent / "docs" / "study.json")
+
+    def finished(*args, progress=None, **kwargs):
+        progress(SimpleNamespace(done=3, total=3, label="numba exact", scan=2, scans=2))
+        return kept
+
+    monkeypatch.setattr(study_run, "run_study", finished)
+    for size in ((80, 24), (120, 40)):
+        async with study_screen(tmp_path, scene_files, size=size) as (app, pilot, screen):
+            await pilot.press("q")
+            await wait_until(pilot, lambda: screen.result is kept)
+            await pilot.pause()
+            bar = screen.query_one("#study-progress")
+            percent = screen.query_one("#study-progress PercentageStatus")
+            assert str(percent.render()) == "100%", size
+            # all of it inside the bar's row, left of the buttons
+            assert percent.content_region.width >= len("100%"), size
+            assert percent.region.right <= bar.region.right <= screen.query_one("#study-quick").region.x, size
+            assert screen.query_one("#study-progress Bar").region.width >= 10, size  # still a bar
+
+
 async def test_the_study_chart_is_drawn_again_without_a_crash(tmp_path, scene_files):
     """plotext applies its log scale to the data it holds, in place: a second drawing of
     one chart (a resize, or leaving the screen) took log10 of log10 seconds and the app

@@ -54,6 +54,9 @@ class StudyScreen(Screen):
     StudyScreen #study-bar Button { margin-left: 1; }
     StudyScreen #study-status #cancel { display: none; }  /* the row below has the screen's */
     StudyScreen ProgressBar { width: 1fr; }
+    /* the bar gives way to its percentage: at 80 columns the buttons leave the row 29,
+    less than Textual's 32-column bar, and "100%" fell off its end */
+    StudyScreen #study-progress Bar { width: 1fr; max-width: 32; }
     """
 
     def __init__(self, scenario_path=None, scans: int | None = None, runs: int | None = None, **kwargs):
