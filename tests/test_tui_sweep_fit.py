@@ -140,6 +140,43 @@ async def test_the_table_marks_the_best_variant_as_the_chart_and_its_legend_do(s
         assert f"{best} best" in str(screen.query_one("#sweep-detail").render())  # the cursor's row
 
 
+async def test_a_finished_sweep_puts_the_cursor_on_its_best_variant(tmp_path):
+    """The cursor stayed on the variant that came first, wherever the ranking moved it:
+    a sweep whose first variant was its worst ended with the cursor on the last row."""
+    from textual.widgets import DataTable
+
+    from tiny_sweep import write_tiny_scenario
+
+    write_tiny_scenario(tmp_path)
+    # the widest orbit first: it sees the least of the target
+    spec = write_spec(tmp_path, "[grid]\nradius = [40.0, 25.0, 15.0]\n")
+    screen = SweepScreen(spec, serial=True)
+    shown = screen._show_progress
+
+    def redrawn(progress):  # drawn between rows, as the timer does on a longer sweep
+        shown(progress)
+        screen._redraw_if_dirty()
+
+    screen._show_progress = redrawn
+    async with SweepHost(screen).run_test(size=SIZE) as pilot:
+        await opened(pilot)
+        await pilot.press("f5")
+        await wait_for(pilot, lambda: not screen.running)
+        await pilot.pause()
+        table = screen.query_one("#sweep-table", DataTable)
+        variants = [str(cell) for cell in table.get_column("variant")]
+        ranks = [str(cell) for cell in table.get_column("rank")]
+        first = next(row for row in screen.rows if row["radius"] == 40.0)["variant"]
+        assert variants.index(first) != ranks.index("1")  # the first to come is not the best
+        assert ranks[table.cursor_row] == "1", (variants[table.cursor_row], first)
+        assert "\u2605 best" in str(screen.query_one("#sweep-detail").render())
+        # opened again after the analyst moved down the table: the best again
+        table.move_cursor(row=table.row_count - 1)
+        await pilot.press("f3")
+        await opened(pilot)
+        assert ranks[table.cursor_row] == "1"
+
+
 async def test_rows_left_out_of_the_ranking_are_said_first_on_the_status_line(swept, tmp_path):
     """A spec narrowed after its run opened as '...: 1 variants, 1 ok, 0 failed; 1…' at
     80 columns: the rows of other variants left out of the ranking were cut away."""

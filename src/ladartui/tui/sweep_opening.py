@@ -98,7 +98,7 @@ class SweepOpening(RankingView):
             left_out = f"{count} not ranked: other variants or an earlier base; "
             self._rank_quietly()
         self.progress = None
-        self._redraw()
+        self._redraw(best=True)
         self._show_stored(len(spec.variants) if spec else len(self.rows))
         # (unless the analyst has moved the focus since: Enter, F3 or Browse left it put)
         if self._focus_table and self.focused in (None, self._focused_at_open):

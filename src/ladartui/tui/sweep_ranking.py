@@ -96,15 +96,17 @@ class RankingView(Screen):
             text += f" (budget {self._budget():g} s)"
         return f"{text}, Pareto front against {self.cost}"
 
-    def _redraw(self) -> None:
+    def _redraw(self, best: bool = False) -> None:
+        """Draw the ranking; ``best``: results arrived (a sweep done, a folder opened),
+        so the cursor goes to the best variant, not the one it was on."""
         self._dirty = False
-        self._draw_table()
+        self._draw_table(best)
         self._draw_chart()
 
-    def _draw_table(self) -> None:
+    def _draw_table(self, best: bool = False) -> None:
         table = self.query_one("#sweep-table", DataTable)
         self._shown_ids = fill_ranking_table(
-            table, self.ranking, self.objective, self.cost, self.parameter_names, self._shown_ids
+            table, self.ranking, self.objective, self.cost, self.parameter_names, self._shown_ids, best
         )
         if self.ranking:
             self._show_detail(table.cursor_row)

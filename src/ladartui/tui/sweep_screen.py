@@ -500,7 +500,7 @@ class SweepScreen(SweepOpening):
             self.rows, self.ranking = result.rows, result.ranking
             self.objective, self.cost, self.budget = result.objective, result.cost, result.budget
             self.out = result.results_path.parent
-            self._redraw()
+            self._redraw(best=True)
             note = "".join(
                 f", {len(rows)} {what}"
                 for rows, what in ((result.failed, "failed"), (result.impossible, "impossible"))

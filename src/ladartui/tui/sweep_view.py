@@ -40,12 +40,18 @@ def short_path(path) -> str:
         return str(path)
 
 
-def fill_ranking_table(table, ranking, objective: str, cost: str, parameter_names, shown_ids: list) -> list:
-    """Refill ``table`` with ``ranking``, keeping the cursor on the same variant; the
+def fill_ranking_table(
+    table, ranking, objective: str, cost: str, parameter_names, shown_ids: list, best: bool = False
+) -> list:
+    """Refill ``table`` with ``ranking``, keeping the cursor on the same variant, or with
+    ``best`` (results just arrived) putting it on the best one (``row_mark``'s star); the
     variant ids in table order."""
     current = shown_ids[table.cursor_row] if 0 <= table.cursor_row < len(shown_ids) else None
     ids = [entry.row.get("variant") for entry in ranking]
-    cursor = ids.index(current) if current in ids else 0
+    if best:
+        cursor = next((i for i, entry in enumerate(ranking) if entry.rank == 1), 0)
+    else:
+        cursor = ids.index(current) if current in ids else 0
     table.clear(columns=True)
     table.add_column("#", key="rank")
     table.add_column("P", key="pareto")
