@@ -177,6 +177,30 @@ async def test_a_finished_sweep_puts_the_cursor_on_its_best_variant(tmp_path):
         assert ranks[table.cursor_row] == "1"
 
 
+async def test_every_coverage_column_reads_in_percent_as_cov_percent_does(swept):
+    """Ranked by worst-target coverage or coverage within a budget, the objective's column
+    read 0.6875 beside 'cov %' 68.75 (and the coverage objective's own 68.75%): a share
+    among percentages, read as under one percent."""
+    from textual.widgets import DataTable
+
+    screen = SweepScreen(swept / "spec-results")
+    async with SweepHost(screen).run_test(size=SIZE) as pilot:
+        await opened(pilot)
+        screen.query_one("#sweep-budget").value = "1000"  # every variant within it
+        table = screen.query_one("#sweep-table", DataTable)
+        for objective in ("coverage-within-budget", "worst-target-coverage"):
+            while screen.objective != objective:
+                await pilot.press("f6")
+            await pilot.pause()
+            values = [str(cell) for cell in table.get_column("objective")]
+            percents = [str(cell) for cell in table.get_column("coverage")]
+            # one target: its worst coverage, and within the budget its coverage, is the
+            # coverage itself
+            assert all(entry.value == entry.coverage for entry in screen.ranking), objective
+            assert values == [f"{100 * e.value:.2f}%" for e in screen.ranking], objective
+            assert values == [f"{p}%" for p in percents], objective
+
+
 async def test_rows_left_out_of_the_ranking_are_said_first_on_the_status_line(swept, tmp_path):
     """A spec narrowed after its run opened as '...: 1 variants, 1 ok, 0 failed; 1…' at
     80 columns: the rows of other variants left out of the ranking were cut away."""

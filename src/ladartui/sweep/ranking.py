@@ -44,6 +44,8 @@ OBJECTIVES = {
 # Objectives whose smaller values are better; the rest rank larger values first.
 LOWER_IS_BETTER = frozenset({"time-to-identify", "distance-to-identify"})
 BUDGET_OBJECTIVES = frozenset({"coverage-within-budget", "identified-within-budget"})
+# Objectives whose value is itself a coverage, a share of target voxels (0..1).
+COVERAGE_OBJECTIVES = frozenset({"obscured-coverage", "coverage-within-budget", "worst-target-coverage"})
 # Short column headers of each objective's value, for the CLI's and the TUI's tables.
 OBJECTIVE_HEADERS = {
     "obscured-coverage": "coverage",

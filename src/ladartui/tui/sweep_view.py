@@ -7,7 +7,7 @@ from pathlib import Path
 
 from rich.text import Text
 
-from ladartui.sweep.ranking import OBJECTIVE_HEADERS
+from ladartui.sweep.ranking import COVERAGE_OBJECTIVES, OBJECTIVE_HEADERS
 from ladartui.sweep.table import column_formats, display_cell
 
 COST_HEADERS = {"flight-time": "time s", "distance": "dist m"}
@@ -78,10 +78,11 @@ def fill_ranking_table(
 def ranking_cells(entry, objective: str, parameter_names, errors: bool, formats: dict) -> list:
     """One table row: rank, mark (``row_mark``), objective, (coverage), cost, status, parameters,
     variant and (with ``errors``) error; text from the results file is never markup.
+    Coverages read in percent: the objective's when it is one ("68.75%"), the cov % column's.
     ``formats``: ``column_formats`` of the whole ranking."""
     row = entry.row
     status = row.get("status") or "?"
-    if objective == "obscured-coverage":
+    if objective in COVERAGE_OBJECTIVES:  # in percent, as the cov % column and the chart
         value = "-" if entry.value is None else f"{100 * entry.value:.2f}%"
     else:
         value = formats["value"](entry.value)
