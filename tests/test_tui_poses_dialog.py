@@ -45,3 +45,21 @@ async def test_the_poses_dialog_for_a_manual_segment_is_not_new(tmp_path, scene_
             pilot, lambda: isinstance(app.screen, PosesScreen) and app.screen.query("#p-x"), timeout=10.0
         )
         assert title_of(app.screen) == "Manual scan poses"
+
+
+async def test_the_poses_dialog_takes_altitudes_up_to_the_flight_limit(tmp_path, scene_files):
+    """The dialog took z = 50000 (its limit was 100000 m), where the start field, the
+    segment forms and New allow at most 20000 m up."""
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario, size=(80, 24)) as (app, pilot):
+        app.action_manual_poses()
+        await wait_until(
+            pilot, lambda: isinstance(app.screen, PosesScreen) and app.screen.query("#p-z"), timeout=10.0
+        )
+        screen = app.screen
+        await type_into(pilot, screen.query_one("#p-z"), "50000", commit="tab")
+        said = str(screen.query_one("#poses-message").render())
+        assert said == "z m: 50000 is not allowed; expected a number greater than 0 and at most 20000 m", said
+        assert screen.query_one("#p-z").has_class("-bad")
+        await type_into(pilot, screen.query_one("#p-z"), "20000", commit="tab")
+        assert str(screen.query_one("#poses-message").render()) == ""

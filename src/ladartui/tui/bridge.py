@@ -297,7 +297,12 @@ def _no_pointing(segment) -> dict:
 
 
 def make_pose(values: dict) -> ScanPose:
-    return ScanPose(**{k: values[k] for k in _POSE_FIELDS})
+    """A pose typed in the poses dialog: its z is an altitude asked for, so at most
+    MAX_FLIGHT_ALTITUDE, as the start field's is (ScanPose alone allows the wide bound
+    of computed poses)."""
+    pose = {k: values[k] for k in _POSE_FIELDS}
+    pose["z"] = altitude_field("z", pose["z"])
+    return ScanPose(**pose)
 
 
 # -- files -----------------------------------------------------------------------------
