@@ -2,6 +2,7 @@
 
 import json
 import math
+import re
 import warnings
 
 import numpy as np
@@ -264,6 +265,49 @@ def test_bad_cmf_names_the_line(tmp_path):
     path.write_text("something else\n")
     with pytest.raises(InputFileError, match="bad.cmf:1:"):
         read_cmf(path)
+
+
+def test_a_cut_off_cmf_names_the_file_line_and_what_it_lacks(tmp_path):
+    """A .cmf cut short (a copy stopped part-way) read as a whole run: what it lacked
+    showed as 'undefined' in Compare, and a file cut before its first section as a
+    target of 0 voxels."""
+    two = [box(2, 2, 2)] * 2
+    measures = compute_measures(
+        box(2, 2, 2),
+        box(2, 2, 2),
+        box(2, 2, 2),
+        scene_per_scan=two,
+        target_per_scan=two,
+        path_length_m=10.0,
+        flight_time_s=0.5,
+        voxel_size=0.25,
+    )
+    lines = measures.to_cmf().splitlines(keepends=True)
+    path = tmp_path / "cut.cmf"
+    for end in range(1, len(lines)):  # cut after every line but the last
+        path.write_text("".join(lines[:end]))
+        with pytest.raises(InputFileError, match=rf"^{re.escape(str(path))}:\d+: "):
+            read_cmf(path)
+    header = lines.index("[comparison]\n") + 1
+    path.write_text("".join(lines[: header + 2]))  # its header, the shift and the missed share
+    with pytest.raises(InputFileError) as error:
+        read_cmf(path)
+    assert str(error.value) == f"{path}:{header}: [comparison] lacks coverage_ratio, obscured_only_voxels"
+    path.write_text("".join(lines[:7]))  # the first line and the notes under it
+    with pytest.raises(InputFileError) as error:
+        read_cmf(path)
+    assert str(error.value) == f"{path}:7: lacks the [3d target model] section"
+    path.write_text("".join(line for line in lines if not line.startswith("scan_1 ")))
+    with pytest.raises(InputFileError, match="scan_1 missing"):  # named first, as before
+        read_cmf(path)
+    path.write_text("".join(line for line in lines if not line.startswith("scan_2 ")))
+    with pytest.raises(InputFileError) as error:
+        read_cmf(path)
+    scans_line = next(i for i, line in enumerate(lines) if line.startswith("scans = ")) + 1
+    assert (
+        str(error.value)
+        == f"{path}:{scans_line}: [coverage after each scan] scans = 2 but 1 scan_k line follows"
+    )
 
 
 def test_measures_dict_is_json_safe():

@@ -310,6 +310,37 @@ def test_target_count_must_match_in_cmf(tmp_path):
         read_cmf(scenario.measures_file)
 
 
+def test_a_cmf_cut_short_in_a_targets_measures_names_that_target(tmp_path):
+    """A file cut in a target's sections read that target as undefined measures."""
+    scenario = two_box_scenario(tmp_path)
+    simulate(scenario)
+    lines = scenario.measures_file.read_text().splitlines(keepends=True)
+    path = tmp_path / "cut.cmf"
+    header = lines.index("[target 2 / comparison]\n") + 1
+    path.write_text("".join(lines[: header + 1]))
+    with pytest.raises(InputFileError) as error:
+        read_cmf(path)
+    said = (
+        f"{path}:{header}: [target 2 / comparison] lacks missed_share, coverage_ratio, obscured_only_voxels"
+    )
+    assert str(error.value) == said
+    section = lines.index("[target 2 / coverage after each scan]\n")
+    first_scan = next(i for i in range(section, len(lines)) if lines[i].startswith("scan_1 "))
+    path.write_text("".join(lines[: first_scan + 1]))
+    with pytest.raises(InputFileError) as error:
+        read_cmf(path)
+    scans_line = section + 2
+    assert lines[scans_line - 1] == "scans = 2\n"
+    said = f"{path}:{scans_line}: [target 2 / coverage after each scan] scans = 2 but 1 scan_k line follows"
+    assert str(error.value) == said
+    path.write_text("".join(lines[:section]))  # ends with a blank line after the comparison
+    with pytest.raises(InputFileError) as error:
+        read_cmf(path)
+    last = section - 1  # the comparison's last key: where target 2's measures end
+    assert lines[last - 1].startswith("obscured_only_voxels = ")
+    assert str(error.value) == f"{path}:{last}: lacks the [target 2 / coverage after each scan] section"
+
+
 # --------------------------------------------------------------------------- names
 
 

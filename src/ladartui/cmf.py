@@ -39,7 +39,8 @@ def read_cmf(path) -> Measures:
             ),
             split,
         )
-    measures = measures_from_lines(path, numbered[:split])
+    # nothing before the targets' sections: what it lacks is named at the first line
+    measures = measures_from_lines(path, numbered[:split], end_line=None if split else 1)
     if split < len(numbered):
         measures = replace(measures, targets=read_target_lines(path, numbered[split:], measures))
     return measures

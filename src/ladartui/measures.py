@@ -477,8 +477,15 @@ def _parse_value(text: str, kind: str):
     return tuple(_parse_value(item.strip(), "float") for item in items)
 
 
-def measures_from_lines(path, numbered_lines) -> Measures:
-    """``Measures`` from the (line number, text) pairs of the figure-10 and detection sections."""
+def measures_from_lines(path, numbered_lines, prefix: str = "", end_line: int | None = None) -> Measures:
+    """``Measures`` from the (line number, text) pairs of the figure-10 and detection sections.
+
+    Every key those sections are written with must be there: a file cut short is named
+    with what it lacks, never read as undefined measures. ``prefix`` names the block's
+    sections in messages ("target 2 / "; such a block has no flight section, as
+    ``section_lines`` writes it); ``end_line`` is the line the block ends at (default
+    its last).
+    """
     kinds: dict[tuple[str | None, str], tuple[str, str]] = {
         (section, key): (attr, kind) for section, entries in _CMF_SECTIONS for key, attr, kind in entries
     }
@@ -493,12 +500,14 @@ def measures_from_lines(path, numbered_lines) -> Measures:
     per_scan: dict[int, tuple] = {}
     levels: dict[str, tuple[int, str]] | None = None
     section = None
+    found: dict[str | None, tuple[int, dict[str, int]]] = {}  # section: its line, its keys' lines
     for number, raw in numbered_lines:
         line = raw.strip()
         if not line or line.startswith("#"):
             continue
         if line.startswith("[") and line.endswith("]"):
             section = line[1:-1].strip()
+            found.setdefault(section, (number, {}))
             if section == levels_section:
                 levels = {}
             elif not any(section == name for name, _ in _CMF_SECTIONS) and section != detection_section:
@@ -528,6 +537,11 @@ def measures_from_lines(path, numbered_lines) -> Measures:
             values[attr] = _parse_value(value.strip(), kind)
         except ValueError as error:
             raise InputFileError(path, f"{key}: {error}", line=number) from None
+        found[section][1][key] = number
+    after_scan = _per_scan_lists(path, per_scan)  # a scan_k missing is named first
+    if end_line is None and numbered_lines:
+        end_line = numbered_lines[-1][0]
+    _check_complete(path, found, per_scan, values.get("scans"), prefix, end_line)
     plain: dict[str, Any] = {}
     nested: dict[str, dict[str, Any]] = {}
     for attr, parsed in values.items():
@@ -543,8 +557,30 @@ def measures_from_lines(path, numbered_lines) -> Measures:
             plain[head] = DetectionMeasures(**parts)
         else:
             plain[head] = DirectionStats(**parts)
-    plain.update(_per_scan_lists(path, per_scan))
+    plain.update(after_scan)
     measures = Measures(**plain)
     if levels is not None:
         measures = replace(measures, levels=levels_from_cmf(path, levels))
     return measures
+
+
+def _check_complete(path, found, per_scan, scans, prefix: str, end_line: int | None) -> None:
+    """Every figure-10 section with every key, and a ``scan_k`` line for each scan when
+    there are any (``found``: section -> (its line, {key: line}))."""
+    expected = [
+        (name, entries) for name, entries in _CMF_SECTIONS if not (prefix and name == CMF_FLIGHT_SECTION)
+    ]
+    for index, (name, entries) in enumerate(expected):
+        if name not in found:
+            later = [found[other][0] for other, _ in expected[index + 1 :] if other in found]
+            raise InputFileError(
+                path, f"lacks the [{prefix}{name}] section", line=min(later, default=end_line)
+            )
+        line, keys = found[name]
+        missing = [key for key, _attr, _kind in entries if key not in keys]
+        if missing:
+            raise InputFileError(path, f"[{prefix}{name}] lacks {', '.join(missing)}", line=line)
+    if per_scan and scans is not None and len(per_scan) != scans:
+        count = "1 scan_k line follows" if len(per_scan) == 1 else f"{len(per_scan)} scan_k lines follow"
+        line = found[_PER_SCAN_SECTION][1]["scans"]
+        raise InputFileError(path, f"[{prefix}{_PER_SCAN_SECTION}] scans = {scans} but {count}", line=line)

@@ -274,6 +274,7 @@ def read_target_lines(path, lines: list[tuple[int, str]], overall: Measures) -> 
     """The per-target part of a ``.cmf`` file: ``lines`` are (number, text) from the first
     per-target section on. Each target's flight figures are the overall ones."""
     blocks: dict[int, list[tuple[int, str]]] = {}
+    headers: dict[int, int] = {}  # each target's first section line
     names: dict[int, str] = {}
     count = None
     section = ""
@@ -287,6 +288,7 @@ def read_target_lines(path, lines: list[tuple[int, str]], overall: Measures) -> 
             found = _TARGET_SECTION.match(section)
             if found:
                 target_id = int(found.group(1))
+                headers.setdefault(target_id, number)
                 if found.group(2) is not None:
                     blocks.setdefault(target_id, []).append((number, f"[{found.group(2)}]"))
                 else:
@@ -320,7 +322,10 @@ def read_target_lines(path, lines: list[tuple[int, str]], overall: Measures) -> 
     targets = []
     flight = {name: getattr(overall, name) for name in ("path_length_m", "flight_time_s", "voxel_size")}
     for target_id in sorted(blocks):
-        measures = dataclasses.replace(measures_from_lines(path, blocks[target_id]), **flight)
+        # a target with no sections but its [target N] line: what it lacks is named there
+        end = None if blocks[target_id] else headers[target_id]
+        block = measures_from_lines(path, blocks[target_id], f"target {target_id} / ", end)
+        measures = dataclasses.replace(block, **flight)
         targets.append(TargetMeasures(target_id, names.get(target_id, f"target {target_id}"), measures))
     if count is not None and count != len(targets):
         raise InputFileError(path, f"[{TARGETS_SECTION}] count = {count} but {len(targets)} targets follow")
