@@ -8,6 +8,8 @@ whether the outputs it opens match the scenario.
 
 from __future__ import annotations
 
+import os
+
 import pytest
 
 from ladartui.cli import main
@@ -297,6 +299,34 @@ def test_validate_says_a_set_a_killed_run_left_half_replaced(scenario, capsys):
     assert lines == [
         "last run   was stopped while it replaced the outputs: the next run puts the earlier set "
         "back first, so the files now on disk are not to be read"
+    ]
+
+
+def test_validate_says_a_run_is_writing_the_set_now(scenario, capsys):
+    """While a run held the set (the TUI's or another ``ladartui run``), validate said
+    nothing of it and exited 0, though a run started then is refused; and it told of
+    that run's swap under way as of a run stopped part-way."""
+    from ladartui.simulation import _output_set, output_lock
+
+    assert main(["run", str(scenario.path)]) == 0
+    capsys.readouterr()
+    writing = f"another run (pid {os.getpid()}) is writing this output set now"
+    with _output_set(scenario, las=False):
+        assert main(["validate", str(scenario.path)]) == 1  # as for any run bound to be refused
+        out = capsys.readouterr().out.splitlines()
+        assert out[-1] == f"next run   {writing}: a run is refused until it ends"
+        # the files on disk are still the earlier run's, and said as such
+        assert "last run   made the outputs with this file's settings (S_Run.toml)" in out
+        journal = output_lock(scenario).with_name(output_lock(scenario).name + ".journal")
+        journal.write_text("[]")  # its swap under way
+        assert main(["validate", str(scenario.path)]) == 1
+        out = capsys.readouterr().out.splitlines()
+        assert [x for x in out if x.startswith("last run")] == [
+            f"last run   {writing}: until it ends the files on disk are part earlier, part new"
+        ]
+        journal.unlink()
+    assert _last_run_lines(capsys, scenario) == [
+        "last run   made the outputs with this file's settings (S_Run.toml)"
     ]
 
 

@@ -131,6 +131,31 @@ def check_lock(lock) -> None:
         raise OutputFileError(lock, LOCK_FOLDER)
 
 
+def lock_holder(lock) -> str | None:
+    """The pid of the run that holds ``lock`` now (as it wrote it; "?" before it has),
+    or None when no run does (no file, or one a killed run left). The lock is only
+    asked for, shared and let go at once: it is never held, nor its file made."""
+    try:
+        import fcntl
+    except ImportError:  # not POSIX: no lock to ask
+        return None
+    try:
+        fd = os.open(lock, os.O_RDONLY)
+    except OSError:  # none (or a folder, said where the run would be refused)
+        return None
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
+        except OSError as error:
+            if error.errno not in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+                return None
+            return os.read(fd, 32).decode("ascii", "replace").strip() or "?"
+        fcntl.flock(fd, fcntl.LOCK_UN)
+        return None
+    finally:
+        os.close(fd)
+
+
 class OutputSet:
     """The files of one run, written together; use as a context manager around the work.
 

@@ -18,7 +18,8 @@ def add_parser(subparsers):
         "model files as they are now). A mistake "
         "is reported on one line with exit status 2. A sound scenario that a run would "
         "still refuse before tracing (a folder or a file of another kind where an output "
-        "goes, more rays than LADARTUI_MAX_RAYS allows) gets its summary, a 'next run' "
+        "goes, more rays than LADARTUI_MAX_RAYS allows, another run writing its outputs now) "
+        "gets its summary, a 'next run' "
         "line saying why, and exit status 1.",
     )
     parser.add_argument(
@@ -53,8 +54,9 @@ def run(args) -> int:
         refused = error
     print(visible(scenario.summary()))
     notes = [*flight_notes(scenario.flight), *detection_notes(scenario)]
-    refusals = [*ray_limit_refusals(scenario), *next_run_refusals(scenario, refused)]
-    earlier = last_run_lines(scenario, scene, writable=not refusals)
+    writer = run_writing(scenario)
+    refusals = [*ray_limit_refusals(scenario), *next_run_refusals(scenario, refused, writer)]
+    earlier = last_run_lines(scenario, scene, writable=not refusals, writer=writer)
     for line in [*scene_lines, *notes, *earlier, *refusals[:1]]:
         print(single_line(line))
     return 1 if refusals else 0  # a script must not take a run bound to be refused as ready
@@ -109,13 +111,25 @@ def ray_limit_refusals(scenario) -> list[str]:
     return []
 
 
-def next_run_refusals(scenario, refused=None) -> list[str]:
+def run_writing(scenario) -> str | None:
+    """What says that a run (the TUI's, another ``ladartui run``) holds ``scenario``'s
+    output set now, naming its pid; None when none does."""
+    from ladartui.outputset import lock_holder
+    from ladartui.simulation import output_lock
+
+    holder = lock_holder(output_lock(scenario))
+    return None if holder is None else f"another run (pid {visible(holder)}) is writing this output set now"
+
+
+def next_run_refusals(scenario, refused=None, writer: str | None = None) -> list[str]:
     """Why the next run would be refused before it traces, for its outputs' paths
-    (``refused``: the ``OutputFileError`` its first check gave, if any)."""
+    (``refused``: the ``OutputFileError`` its first check gave, if any; ``writer``: the
+    run holding the set now, as ``run_writing`` says it)."""
     from ladartui.outputset import output_problem
     from ladartui.simulation import output_paths
 
-    refusals = [
+    refusals = [] if writer is None else [f"next run   {writer}: a run is refused until it ends"]
+    refusals += [
         f"next run   {path.name} {problem}: it is refused before it traces"
         for path in output_paths(scenario).values()
         if (problem := output_problem(path))
@@ -126,14 +140,17 @@ def next_run_refusals(scenario, refused=None) -> list[str]:
     return refusals
 
 
-def last_run_lines(scenario, scene, writable: bool = True) -> list[str]:
+def last_run_lines(scenario, scene, writable: bool = True, writer: str | None = None) -> list[str]:
     """Whether the outputs on disk came from this file's settings and its model files as
     they are now (``scene``, as just loaded), from the run record; ``writable``: whether
-    the next run can write its outputs."""
+    the next run can write its outputs; ``writer``: the run holding the set now, if one
+    does (``run_writing``: until its swap the files are the earlier run's)."""
     from ladartui.errors import LadarError
     from ladartui.run_record import earlier_las, missing_outputs, read_run_record, setting_changes
     from ladartui.simulation import swap_interrupted
 
+    if swap_interrupted(scenario) and writer is not None:  # its swap, under way
+        return [f"last run   {writer}: until it ends the files on disk are part earlier, part new"]
     if swap_interrupted(scenario):  # a swap a killed run left (outputset)
         return [
             "last run   was stopped while it replaced the outputs: the next run puts the earlier set "
