@@ -433,6 +433,18 @@ def test_a_scenario_path_that_is_no_path_is_a_field_error(tmp_path, field, bad, 
     assert str(caught.value) == message
 
 
+def test_a_new_scenario_on_a_scene_without_a_target_names_its_empty_target_model(tmp_path):
+    """A scene made with 'generate --no-target' (an empty target model) raised ValueError
+    from the default orbit's sums ('zero-size array to reduction operation maximum')."""
+    write_models(tmp_path, "woods", target=())
+    with pytest.raises(InputFileError) as caught:
+        Scenario.new(tmp_path / "new.toml", "woods.txt", 0.5)
+    assert str(caught.value) == (
+        f"{tmp_path / 'woods_Target.txt'}: target model holds no voxels; expected a target "
+        "to circle (a new scenario's default orbit circles the target of X_Target.txt)"
+    )
+
+
 def test_a_new_scenario_checks_its_voxel_size_before_the_default_orbit(tmp_path):
     """Scenario.new(..., voxel_size="a") raised ValueError from the default orbit's sums."""
     write_models(tmp_path / "models")

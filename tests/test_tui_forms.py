@@ -253,6 +253,18 @@ async def test_names_typed_after_up_a_folder_are_read_in_the_folder_shown(tmp_pa
         assert message(compare, "#compare-message") == ""
 
 
+async def test_a_new_scenario_on_a_scene_without_a_target_is_refused_in_its_form(tmp_path, scene_files):
+    """A scene made with 'generate --no-target': OK ended the app in a ValueError
+    traceback from the default orbit's sums. The form now names the empty target model."""
+    scenario = make_scenario(tmp_path, scene_files)
+    (tmp_path / "bare.txt").write_text("1,2,3\n", encoding="utf-8")
+    (tmp_path / "bare_Target.txt").write_text("", encoding="utf-8")
+    async with opened(scenario) as (app, pilot):
+        said = await new_scenario_said(app, pilot, "bare.txt", "0.25")
+        assert said.startswith(f"{tmp_path / 'bare_Target.txt'}: target model holds no voxels; ")
+        assert not (tmp_path / "fresh.toml").exists()
+
+
 async def new_scenario_said(app, pilot, scene: str, voxel_size: str) -> str:
     """What New's form says on OK with ``scene`` and ``voxel_size`` typed ('' once it closed)."""
     from ladartui.tui.file_dialogs import SetupScreen

@@ -284,7 +284,14 @@ class Scenario:
                 )
             from ladartui.scene.target_model import load_target
 
-            flight = defaults.default_flight(load_target(target_file)[0], voxel_size)
+            target = load_target(target_file)[0]
+            if len(target) == 0:  # a scene made without one ('generate --no-target')
+                raise InputFileError(
+                    target_file,
+                    "target model holds no voxels; expected a target to circle (a new "
+                    "scenario's default orbit circles the target of X_Target.txt)",
+                )
+            flight = defaults.default_flight(target, voxel_size)
         return cls(path, scene_file, voxel_size, sensor, flight, **options)
 
     def summary(self) -> str:
