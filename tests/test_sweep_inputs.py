@@ -301,6 +301,20 @@ def test_a_refusal_for_a_field_the_spec_does_not_name_blames_the_parameter_varie
     assert "spec.toml:4: grid.altitude: no variant can run: " in str(refused.value)
 
 
+def test_a_preset_over_a_scene_without_a_target_names_its_target_model(tmp_path):
+    """It read 'no variant can run: scene 'base' has no target voxels', naming the base
+    scenario as a scene; the scene is tiny.txt and its empty target model tiny_Target.txt."""
+    _straight_base(tmp_path)
+    (tmp_path / "tiny_Target.txt").write_text("", encoding="utf-8")
+    spec = write_spec(tmp_path, '[grid]\npreset = ["orbit"]\nradius = [9.0]\naltitude = [20.0]\n')
+    with pytest.raises(InputFileError) as refused:
+        run_sweep(spec, serial=True, out=tmp_path / "out")
+    assert str(refused.value) == (
+        f"{spec}:4: grid.preset: no variant can run: scene 'tiny' has no target voxels "
+        f"({tmp_path / 'tiny_Target.txt'} is empty)"
+    )
+
+
 def test_the_check_reads_the_target_model_not_the_scene(tmp_path, monkeypatch):
     """The CLI's check loaded the whole scene again for each variant that failed, and a
     good spec's scene twice."""

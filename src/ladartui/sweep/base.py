@@ -174,6 +174,7 @@ class _TargetCentre:
             from ladartui.scene.target_model import load_target
 
             voxels, _ = load_target(self.base.target_file)
-            empty = Scene(np.zeros((0, 3), np.int32), voxels, self.base.voxel_size, name=self.base.name)
+            # the scene's path names it and its target model in an error, as a loaded scene's does
+            empty = Scene(np.zeros((0, 3), np.int32), voxels, self.base.voxel_size, path=self.base.scene_file)
             self.centre = empty.target_centre_m()
         return self.centre
