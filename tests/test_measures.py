@@ -310,6 +310,39 @@ def test_a_cut_off_cmf_names_the_file_line_and_what_it_lacks(tmp_path):
     )
 
 
+@pytest.mark.parametrize(
+    ("key", "written", "said"),
+    [
+        ("target_voxels", "many", "target_voxels: expected an integer, got 'many'"),
+        (
+            "scans_for_90_percent_of_final",
+            "1.5",
+            "scans_for_90_percent_of_final: expected an integer, got '1.5'",
+        ),
+        ("maximum_target_coverage", "most", "maximum_target_coverage: expected a number, got 'most'"),
+        ("sample_mean_vector", "1, 2, z", "sample_mean_vector: expected a number, got 'z'"),
+        ("scan_2", "a, 0.5", "scan_2: expected a number, got 'a'"),
+    ],
+)
+def test_a_bad_cmf_value_says_what_was_expected(tmp_path, key, written, said):
+    """A value that is no number read 'target_voxels: invalid literal for int() with base
+    10: 'many'', Python's words, where the levels section says 'expected int, got ...'."""
+    good = compute_measures(
+        box(2, 2, 2),
+        box(2, 2, 2),
+        box(2, 2, 2),
+        scene_per_scan=[box(2, 2, 2)] * 2,
+        target_per_scan=[box(2, 2, 2)] * 2,
+    ).to_cmf()
+    lines = [f"{key} = {written}" if line.startswith(f"{key} =") else line for line in good.splitlines()]
+    path = tmp_path / "bad.cmf"
+    path.write_text("\n".join(lines) + "\n")
+    with pytest.raises(InputFileError) as error:
+        read_cmf(path)
+    number = lines.index(f"{key} = {written}") + 1
+    assert str(error.value) == f"{path}:{number}: {said}"
+
+
 def test_measures_dict_is_json_safe():
     measures = compute_measures(box(3, 3, 2), top_layer(box(3, 3, 2)), box(3, 3, 2))
     data = json.loads(json.dumps(measures.to_dict(), allow_nan=False))

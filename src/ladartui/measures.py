@@ -462,14 +462,21 @@ def _format_value(value) -> str:
 
 
 def _parse_value(text: str, kind: str):
+    """A value as ``.cmf`` writes it; ValueError says what was expected and what was found."""
     if text == "undefined":
         return None
     if kind == "int":
-        return int(text)
+        try:
+            return int(text)
+        except ValueError:
+            raise ValueError(f"expected an integer, got {text!r}") from None
     if kind == "float":
-        value = float(text)
+        try:
+            value = float(text)
+        except ValueError:
+            raise ValueError(f"expected a number, got {text!r}") from None
         if not math.isfinite(value):
-            raise ValueError("not a finite number")
+            raise ValueError(f"expected a finite number, got {text!r}")
         return value
     items = text.split(",")
     if len(items) != 3:
