@@ -123,6 +123,26 @@ def test_aim_above_the_horizon_names_the_segment(tmp_path):
     assert str(caught.value).startswith(f"{path}:{line_of(text, 'aim_at')}: ")
 
 
+@pytest.mark.parametrize(
+    ("pointing", "given"),
+    [
+        ("depression = 30.0", "depression is"),
+        ("azimuth = 90.0\ndepression = 30.0", "azimuth and depression are"),
+    ],
+)
+def test_a_manoeuvre_with_an_aim_point_and_a_sensor_pointing_is_refused(tmp_path, pointing, given):
+    """A straight with depression = 30 and an aim point flew its scans aimed, the depression
+    dropped without a word (the TUI's form refuses the two together for that reason)."""
+    text = edited("scans = 2\n", f"scans = 2\n{pointing}\naim_at = [10.0, 10.0, 1.0]\n")
+    path = write_scenario(tmp_path, text)
+    with pytest.raises(FieldError) as caught:
+        load_scenario(path, check_files=False)
+    assert str(caught.value) == (
+        f"{path}:{line_of(text, 'aim_at')}: flight.segments[0].aim_at = [10.0, 10.0, 1.0]: "
+        f"expected no aim point while {given} given (an aim point sets both)"
+    )
+
+
 def test_relative_segment_first_needs_a_start(tmp_path):
     start = BASE[BASE.index("[flight.start]") : BASE.index("[[flight.segments]]")]
     path = write_scenario(tmp_path, BASE.replace(start, ""))

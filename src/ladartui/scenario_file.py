@@ -48,9 +48,11 @@ are caught; keys marked "default" may be left out)::
 Other segment kinds and their keys (``aim_at`` is optional on every kind):
 
 * ``kind = "straight"``: ``distance`` (m), ``scans``; optional ``azimuth``,
-  ``depression`` (new sensor pointing from here on).
+  ``depression`` (new sensor pointing from here on; not with ``aim_at``, which
+  sets both).
 * ``kind = "turn"``: ``radius`` (m), ``arc`` (degrees), ``direction``
-  ("left"/"right"), ``scans``; optional ``azimuth``, ``depression``.
+  ("left"/"right"), ``scans``; optional ``azimuth``, ``depression`` (not with
+  ``aim_at``).
 * ``kind = "manual"``: ``poses = [{ x = .., y = .., z = .., heading = ..,
   azimuth = .., depression = .. }, ...]`` (heading and azimuth default 0,
   depression 90).

@@ -62,6 +62,14 @@ def _check_pointing(segment):
     _set(segment, "azimuth", _optional_number("azimuth", segment.azimuth))
     _set(segment, "depression", _optional_number("depression", segment.depression, 1.0, 90.0))
     _set(segment, "aim_at", _optional_point("aim_at", segment.aim_at))
+    given = [name for name in ("azimuth", "depression") if getattr(segment, name) is not None]
+    if segment.aim_at is not None and given:  # the aim point sets both: what was given would be dropped
+        verb = "is" if len(given) == 1 else "are"
+        raise FieldError(
+            "aim_at",
+            segment.aim_at,
+            f"no aim point while {' and '.join(given)} {verb} given (an aim point sets both)",
+        )
 
 
 def _pointed(segment, current, fly):
