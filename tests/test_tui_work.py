@@ -84,6 +84,44 @@ async def test_queued_reports_give_way_to_newer_ones_except_kept_ones_and_live_v
     ]
 
 
+async def test_a_jobs_reports_reach_the_node_that_started_it_and_not_the_app():
+    """Reports said they did not bubble, but Textual set every message class's
+    ``bubble`` as it was made: a job of the study screen that failed reached the app
+    too, which told its error a second time under the title 'study'."""
+
+    class Starter(Static):
+        heard: list = []
+
+        def on_mount(self) -> None:
+            start_job(self, "study", lambda cancel, progress: progress(0.5, "half") or 1 / 0)
+
+        def on_job_progress(self, message: JobProgress) -> None:
+            self.heard.append(("progress", message.text))
+
+        def on_job_done(self, message: JobDone) -> None:
+            self.heard.append(("done", message.error))
+
+    class Above(App):
+        heard: list = []
+
+        def compose(self):
+            yield Starter("")
+
+        def on_job_progress(self, message: JobProgress) -> None:
+            self.heard.append(message)
+
+        def on_job_done(self, message: JobDone) -> None:
+            self.heard.append(message)
+
+    app = Above()
+    async with app.run_test() as pilot:
+        starter = app.query_one(Starter)
+        await wait_until(pilot, lambda: len(starter.heard) == 2)
+        await pilot.pause()
+        assert starter.heard == [("progress", "half"), ("done", "ZeroDivisionError: division by zero")]
+        assert app.heard == []
+
+
 async def test_an_unexpected_exception_is_reported_and_the_app_stays_open():
     def task(cancel, progress):
         progress(0.5, "half way")

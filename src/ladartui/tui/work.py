@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, ClassVar, TypeGuard
+from typing import Any, TypeGuard
 
 from textual.message import Message
 from textual.worker import Worker, get_current_worker
@@ -26,14 +26,14 @@ from ladartui.errors import Cancelled, LadarError
 from ladartui.textsafe import one_line
 
 
+# bubble=False: for the node that started the job only (Textual sets ``bubble`` from
+# the class's arguments as it makes the class: a class attribute would be overwritten).
 @dataclass
-class JobProgress(Message):
+class JobProgress(Message, bubble=False):
     """How far job ``job`` has come: ``fraction`` 0..1 (None: unknown) and a line of text.
 
     ``detail`` is whatever else the job reports (a live view, a progress record).
     """
-
-    bubble: ClassVar[bool] = False  # for the node that started the job only
 
     job: str
     fraction: float | None
@@ -54,10 +54,8 @@ class JobProgress(Message):
 
 
 @dataclass
-class JobDone(Message):
+class JobDone(Message, bubble=False):
     """Job ``job`` ended: with ``result``, or ``cancelled``, or ``error`` (one line)."""
-
-    bubble: ClassVar[bool] = False
 
     job: str
     result: Any = None
