@@ -266,6 +266,46 @@ async def test_a_finished_study_shows_its_whole_100_percent(tmp_path, scene_file
             assert screen.query_one("#study-progress Bar").region.width >= 10, size  # still a bar
 
 
+async def test_a_study_line_cut_at_80_columns_comes_whole_as_a_note(tmp_path, scene_files, monkeypatch):
+    """At 80x24 "quick study done on default.toml; kept in /tmp/.../default-study" lost
+    where the study was kept, and nothing said it whole."""
+    from pathlib import Path
+
+    import ladartui.study.run as study_run
+    from ladartui.study.results import read_study
+
+    kept = read_study(Path(__file__).parent.parent / "docs" / "study.json")
+    monkeypatch.setattr(study_run, "run_study", lambda *args, **kwargs: kept)
+    monkeypatch.setattr(study_run, "write_outputs", lambda result, folder: None)
+    async with study_screen(tmp_path, scene_files, size=(80, 24)) as (app, pilot, screen):
+        await pilot.press("q")
+        await wait_until(pilot, lambda: screen.result is kept)
+        await pilot.pause()
+        said = screen.query_one("#study-status").message
+        assert said.startswith("quick study done on ") and "; kept in " in said
+        await wait_until(pilot, lambda: any(note.message == said for note in app._notifications))
+    # as on the sweep and main screens, a line that fits is not said again
+    async with study_screen(tmp_path, scene_files, size=(len(said) + 80, 40)) as (app, pilot, screen):
+        await pilot.press("q")
+        await wait_until(pilot, lambda: screen.result is kept)
+        await pilot.pause()
+        assert not [note for note in app._notifications if "kept in" in note.message]
+    # a failed study's error is said once, as a note of its own, not twice
+    from ladartui.errors import LadarError
+
+    def failing(*args, **kwargs):
+        raise LadarError("the study could not go on: " + "a long reason " * 8)
+
+    monkeypatch.setattr(study_run, "run_study", failing)
+    async with study_screen(tmp_path, scene_files, size=(80, 24)) as (app, pilot, screen):
+        await pilot.press("q")
+        await wait_until(pilot, lambda: screen.query_one("#study-status").message.startswith("error: "))
+        await pilot.pause()
+        assert [note.message[:30] for note in app._notifications if "could not go on" in note.message] == [
+            "Study failed: the study could "
+        ]
+
+
 async def test_the_study_chart_is_drawn_again_without_a_crash(tmp_path, scene_files):
     """plotext applies its log scale to the data it holds, in place: a second drawing of
     one chart (a resize, or leaving the screen) took log10 of log10 seconds and the app

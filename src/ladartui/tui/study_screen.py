@@ -77,8 +77,9 @@ class StudyScreen(Screen):
                 yield Static("", id="study-table-note", markup=False)
                 yield Static("", id="study-verdict")
         # green ready, red busy with its progress, as on the main and sweep screens; one
-        # line: a long path gives way, not the keys
-        yield StatusBar(id="study-status")
+        # line: a long path gives way, not the keys, and a line cut short (where the study
+        # was kept, why the last one is not shown) comes whole as a note
+        yield StatusBar(id="study-status", tell=self._tell_cut, tell_states=(READY,))
         with Horizontal(id="study-bar"):
             yield ProgressBar(total=1, id="study-progress", show_eta=False)  # idle: 0 %, not animated
             yield Button("Quick", id="study-quick", compact=True)
@@ -171,8 +172,10 @@ class StudyScreen(Screen):
         if message.cancelled:
             self._finish(None, "study cancelled")
         elif message.error:
-            self._finish(None, f"error: {message.error}")
             self.notify(f"Study failed: {message.error}", severity="error", markup=False, timeout=15)
+            said = f"error: {message.error}"
+            self.query_one("#study-status", StatusBar).told = visible(said)  # (said whole just now)
+            self._finish(None, said)
         else:
             result, text = message.result
             self._finish(result, text)
@@ -220,6 +223,9 @@ class StudyScreen(Screen):
         self.query_one("#study-quick", Button).disabled = busy
         self.query_one("#study-full", Button).disabled = busy
         self._set_status(message, BUSY if busy else READY, progress)
+
+    def _tell_cut(self, message: str) -> None:
+        self.notify(message, markup=False, timeout=8)
 
     def _set_status(self, message: str, state: str = READY, progress: float | None = None) -> None:
         # it may name files: shown as text, the scenario's path shortened first
