@@ -67,6 +67,26 @@ def test_a_segment_edit_keeps_the_comments_beside_its_keys(folder):
     assert "# horizontal distance at the closest point" in path.read_text()
 
 
+def test_a_segment_made_another_kind_leaves_the_old_kinds_comments_behind(folder):
+    """An orbit made a fly-past kept the orbit's notes beside the keys both share:
+    'scans = 6  # one look every 15 degrees' under a straight pass. A segment of the
+    same kind keeps its comments (above), one of another kind starts bare."""
+    from ladartui.flight.plan import FlyPast
+
+    path = folder / "orbit.toml"
+    shutil.copy(SHIPPED / "orbit.toml", path)
+    scenario = load_scenario(path)
+    orbit = scenario.flight.segments[0]
+    pass_by = FlyPast(orbit.centre, 60.0, orbit.altitude, 160.0, orbit.scans)
+    scenario.with_changes(flight=dataclasses.replace(scenario.flight, segments=(pass_by,))).save()
+    text = path.read_text()
+    segment = text[text.index("[[flight.segments]]") : text.index("[simulation]")]
+    assert 'kind = "flypast"' in segment and "#" not in segment  # was: 'altitude = 70.0  # steeper ...'
+    assert text.startswith("# Orbit (report figure 1a)")  # the file's own notes stay
+    assert 'scene = "generated/small.txt"   # its target model is' in text
+    assert load_scenario(path).flight.segments == (pass_by,)
+
+
 def test_save_as_keeps_the_comments_and_points_at_the_same_scene(folder, tmp_path):
     path = folder / "orbit.toml"
     shutil.copy(SHIPPED / "orbit.toml", path)

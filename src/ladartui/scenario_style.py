@@ -57,15 +57,19 @@ def _merge_table(table, data: dict, old_data: dict | None) -> None:
 
 def _merge_list(tables, values: list[dict], befores) -> bool:
     """New values into a list of tables (``[[flight.segments]]``): of the same length,
-    each table takes its item's values (its comments stay); longer by items appended
+    each table takes its item's values (its comments stay), or is made anew where the
+    item is of another kind (an orbit's notes are no fly-past's); longer by items appended
     after an unchanged list (the TUI's Add segment), those go after the last table.
     False otherwise (the caller rewrites the list): a table's comment line is kept by
     tomlkit with the table before it, so a deleted or moved table would take the
     wrong comments along, and an inline array holds no tables to add."""
     if len(values) == len(tables):
         befores = befores if _is_table_list(befores) and len(befores) == len(values) else [None] * len(values)
-        for table, value, before in zip(tables, values, befores):
-            _merge_table(table, value, before)
+        for k, (table, value, before) in enumerate(zip(tables, values, befores)):
+            if isinstance(tables, AoT) and _plain(table).get("kind") != value.get("kind"):
+                tables[k] = _new_table(value)  # another kind: the old one's notes are not its own
+            else:
+                _merge_table(table, value, before)
         return True
     appended = (
         isinstance(tables, AoT)
@@ -76,10 +80,14 @@ def _merge_list(tables, values: list[dict], befores) -> bool:
     if not appended:
         return False
     for value in values[len(tables) :]:
-        table = tomlkit.item(value)
-        table.add(tomlkit.nl())  # a blank line before whatever table follows, as the others have
-        tables.append(table)
+        tables.append(_new_table(value))
     return True
+
+
+def _new_table(value: dict):
+    table = tomlkit.item(value)
+    table.add(tomlkit.nl())  # a blank line before whatever table follows, as the others have
+    return table
 
 
 def _is_table_list(value: object) -> TypeGuard[list[dict]]:
