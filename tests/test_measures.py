@@ -367,9 +367,9 @@ def test_a_huge_figure_is_written_with_an_exponent_not_hundreds_of_digits():
     """A speed of 1e-300 m/s made a flight time of 4e301 s, shown as 300 digits that the
     Results table cut to what read as about 4e13."""
     from ladartui.levels import LevelReached
+    from ladartui.measures_compare import format_value
     from ladartui.measures_table import format_number
     from ladartui.number_text import fixed
-    from ladartui.tui.measures_view import format_value
 
     huge = 4.0543261909900e301
     assert fixed(huge, 1) == "4.054e+301" and fixed(-huge, 3) == "-4.054e+301"

@@ -553,7 +553,7 @@ async def test_the_new_scenario_dialog_refuses_in_the_forms_words(tmp_path, scen
 def test_compare_names_files_of_one_stem_apart_by_their_folders():
     from pathlib import Path
 
-    from ladartui.tui.measures_screens import column_names
+    from ladartui.measures_compare import column_names
 
     paths = [Path("home/default/default.cmf"), Path("w/d2/default.cmf"), Path("w/other.cmf")]
     assert column_names(paths) == ["default/default", "d2/default", "other"]
@@ -593,6 +593,7 @@ def test_the_png_and_compare_dialogs_name_what_is_wrong(tmp_path):
     import pytest
 
     from ladartui.errors import FieldError, InputFileError
+    from ladartui.measures_compare import read_measures_files
     from ladartui.tui import bridge
 
     with pytest.raises(FieldError) as caught:
@@ -603,16 +604,16 @@ def test_the_png_and_compare_dialogs_name_what_is_wrong(tmp_path):
         bridge.image_size({"width": "400", "height": "tall"})
     assert caught.value.field == "height" and "'tall'" in str(caught.value)
     with pytest.raises(InputFileError) as caught:
-        bridge.read_measures_files([tmp_path])
+        read_measures_files([tmp_path])
     assert str(caught.value) == f"{tmp_path}: is a folder; expected a .cmf measures file"
     with pytest.raises(InputFileError) as caught:
-        bridge.read_measures_files([tmp_path / "gone.cmf"])
+        read_measures_files([tmp_path / "gone.cmf"])
     assert str(caught.value) == f"{tmp_path / 'gone.cmf'}: measures file not found"
     import os
 
     os.mkfifo(tmp_path / "pipe.cmf")  # it exists: not 'not found'
     with pytest.raises(InputFileError) as caught:
-        bridge.read_measures_files([tmp_path / "pipe.cmf"])
+        read_measures_files([tmp_path / "pipe.cmf"])
     assert (
         str(caught.value)
         == f"{tmp_path / 'pipe.cmf'}: measures file is not a regular file (a pipe or device)"

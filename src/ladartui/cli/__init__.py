@@ -32,6 +32,7 @@ COMMANDS = {
     "generate": "generate",
     "info": "info",
     "validate": "validate",
+    "compare": "compare",
     "bench": "bench",
     "study": "study",
     "sweep": "sweep",

@@ -415,19 +415,6 @@ def save_as_refusal(scenario: Scenario, path: Path) -> str | None:
     return None
 
 
-def read_measures_files(paths) -> list:
-    from ladartui.cmf import read_cmf
-
-    out = []
-    for path in paths:
-        if Path(path).is_dir():
-            raise InputFileError(path, "is a folder; expected a .cmf measures file")
-        if problem := file_problem(Path(path)):
-            raise InputFileError(path, f"measures file {problem}")
-        out.append(read_cmf(path))
-    return out
-
-
 def view_angles(values: dict) -> tuple[float, float]:
     azimuth = number_field("azimuth", values["azimuth"])
     elevation = number_field("elevation", values["elevation"], -90.0, 90.0)

@@ -15,9 +15,9 @@ from textual.widgets import Button, DataTable, Input, Static
 
 from ladartui.errors import LadarError
 from ladartui.measures import Measures
-from ladartui.tui import bridge
+from ladartui.measures_compare import column_names, read_measures_files, side_by_side, styled
 from ladartui.tui.file_tree import FileTree
-from ladartui.tui.measures_view import comparison_rows, level_rows, measure_rows, target_rows
+from ladartui.tui.measures_view import level_rows, measure_rows, target_rows
 from ladartui.tui.screens import Dialog, TreeDialog, _row
 
 
@@ -143,7 +143,7 @@ class CompareScreen(TreeDialog):
             message.update("Give two or more .cmf files to compare.")
             return
         try:
-            loaded = bridge.read_measures_files([self.base / Path(t).expanduser() for t in text])
+            loaded = read_measures_files([self.base / Path(t).expanduser() for t in text])
         except LadarError as error:
             message.update(escape(str(error)))
             return
@@ -151,23 +151,9 @@ class CompareScreen(TreeDialog):
         table.add_column("Measure")
         for name in column_names([Path(t) for t in text]):
             table.add_column(Text(name))  # names from files: never markup
-        for row in comparison_rows(loaded):
-            table.add_row(*(Text(c) if isinstance(c, str) else c for c in row))
+        for row in side_by_side(loaded):
+            table.add_row(*styled(row))
 
     @on(Button.Pressed, "#compare-close")
     def _close(self) -> None:
         self.dismiss(None)
-
-
-def column_names(paths: list[Path]) -> list[str]:
-    """Each file's stem, with as many of its folders as it takes to tell files of one
-    stem apart ("d2/default" and "default/default" for two default.cmf)."""
-    names = []
-    for path in paths:
-        parts = path.with_suffix("").parts
-        same = [p.with_suffix("").parts for p in paths if p.stem == path.stem and p != path]
-        depth = 1
-        while any(other[-depth:] == parts[-depth:] for other in same) and depth < len(parts):
-            depth += 1
-        names.append("/".join(parts[-depth:]))
-    return names

@@ -1,42 +1,13 @@
-"""Measures as table rows: the report's figure 10 layout and the side-by-side comparison."""
+"""Measures as table rows: the report's figure 10 layout, the sidebar's short list, levels and
+targets (the side-by-side comparison is ladartui.measures_compare's)."""
 
 from __future__ import annotations
 
 from rich.text import Text
 
 from ladartui.colour import target_colour
-from ladartui.levels import LEVELS
+from ladartui.measures_compare import ROWS, format_value, lookup
 from ladartui.number_text import fixed
-
-UNDEFINED = "undefined"
-
-# (label, Measures.to_dict path, kind, better): better is "high", "low" or None
-ROWS = [
-    ("Maximum target coverage", "maximum_coverage", "pct", "high"),
-    ("Unobscured target coverage", "unobscured_coverage", "pct", "high"),
-    ("Obscured target coverage", "obscured_coverage", "pct", "high"),
-    ("Target voxels", "target_voxels", "int", None),
-    ("Visible target voxels", "visible_voxels", "int", None),
-    ("Unobscured voxels", "unobscured_voxels", "int", "high"),
-    ("Obscured voxels", "obscured_voxels", "int", "high"),
-    ("Model mean vector", "model_directions.mean_vector", "vec", None),
-    ("Model resultant length", "model_directions.resultant_length", "num", None),
-    ("Model mean direction", "model_directions.mean_direction", "vec", None),
-    ("Unobscured mean vector", "unobscured_directions.mean_vector", "vec", None),
-    ("Unobscured resultant length", "unobscured_directions.resultant_length", "num", None),
-    ("Unobscured mean direction", "unobscured_directions.mean_direction", "vec", None),
-    ("Obscured mean vector", "obscured_directions.mean_vector", "vec", None),
-    ("Obscured resultant length", "obscured_directions.resultant_length", "num", None),
-    ("Obscured mean direction", "obscured_directions.mean_direction", "vec", None),
-    ("Shift in mean direction (rad)", "direction_shift_rad", "num", "low"),
-    ("Missed share", "missed_share", "pct", "low"),
-    ("Coverage ratio", "coverage_ratio", "num", "high"),
-    ("Scans", "scans", "int", None),
-    ("Scans for 90% of final", "scans_for_enough", "int", "low"),
-    ("Path length (m)", "path_length_m", "num1", "low"),
-    ("Flight time (s)", "flight_time_s", "num1", "low"),
-]
-
 
 # the sidebar's short list (F9 shows every measure)
 COMPACT = [
@@ -53,30 +24,6 @@ COMPACT = [
 ]
 
 
-def lookup(data: dict, path: str):
-    value = data
-    for part in path.split("."):
-        if not isinstance(value, dict) or part not in value:
-            return None
-        value = value[part]
-    return value
-
-
-def format_value(value, kind: str) -> str:
-    """Text for one measure; None is shown as "undefined"."""
-    if value is None:
-        return UNDEFINED
-    if kind == "pct":
-        return f"{100 * float(value):.1f}%"
-    if kind == "int":
-        return f"{int(value):,}"
-    if kind == "vec":
-        return ", ".join(fixed(v, 3) for v in value)
-    if kind == "num1":
-        return fixed(value, 1)
-    return fixed(value, 3)
-
-
 def measure_rows(measures) -> list[tuple[str, str]]:
     """(label, text) for each measure of one run (``Measures`` or its dict)."""
     data = measures if isinstance(measures, dict) else measures.to_dict()
@@ -87,65 +34,6 @@ def compact_rows(measures) -> list[tuple[str, str]]:
     """The sidebar's short list of measures."""
     data = measures if isinstance(measures, dict) else measures.to_dict()
     return [(label, format_value(lookup(data, path), kind)) for label, path, kind in COMPACT]
-
-
-def comparison_rows(all_measures: list) -> list[list]:
-    """One row per measure: label then one cell per scenario, differences highlighted.
-
-    Where the scenarios disagree the row label is bold yellow; for a measure
-    with a direction of goodness the best value is green and the worst red.
-    When every run holds the same several targets, rows per target follow.
-    """
-    dicts = [m if isinstance(m, dict) else m.to_dict() for m in all_measures]
-    rows = [
-        _compare_row(label, [lookup(d, path) for d in dicts], kind, better)
-        for label, path, kind, better in ROWS
-    ]
-    for level in LEVELS:
-        scans = [lookup(d, f"levels.{level}.scan") for d in dicts]
-        rows.append(_compare_row(f"{level.capitalize()} at scan", scans, "int", "low"))
-    targets = [d.get("targets") for d in dicts]
-    if all(isinstance(t, dict) for t in targets):
-        per = [{t["id"]: t for t in tt["per_target"]} for tt in targets if isinstance(tt, dict)]
-        ids = sorted(per[0]) if per else []
-        if len(ids) > 1 and all(sorted(p) == ids for p in per):
-            for target_id in ids:
-                name = per[0][target_id]["name"]
-                for label, path, kind, better in TARGET_ROWS:
-                    values = [lookup(p[target_id]["measures"], path) for p in per]
-                    rows.append(_compare_row(f"{name}: {label}", values, kind, better))
-    return rows
-
-
-def _compare_row(label: str, values: list, kind: str, better) -> list:
-    texts = [format_value(v, kind) for v in values]
-    differ = len(set(texts)) > 1
-    cells = [Text(t) for t in texts]
-    if differ:
-        numeric = [
-            (float(v), i) for i, v in enumerate(values) if v is not None and not isinstance(v, (list, tuple))
-        ]
-        for cell in cells:
-            cell.stylize("yellow")
-        if better and len(numeric) >= 2:
-            best = max(numeric) if better == "high" else min(numeric)
-            worst = min(numeric) if better == "high" else max(numeric)
-            if best[0] != worst[0]:
-                for v, i in numeric:
-                    if v == best[0]:
-                        cells[i] = Text(texts[i], style="bold green")
-                    elif v == worst[0]:
-                        cells[i] = Text(texts[i], style="bold red")
-    return [Text(label, style="bold yellow" if differ else ""), *cells]
-
-
-# per target, in the comparison and the measures dialog
-TARGET_ROWS = [
-    ("obscured coverage", "obscured_coverage", "pct", "high"),
-    ("unobscured coverage", "unobscured_coverage", "pct", "high"),
-    ("maximum coverage", "maximum_coverage", "pct", "high"),
-    ("identify at scan", "levels.identify.scan", "int", "low"),
-]
 
 
 def level_rows(measures, short: bool = False) -> list[tuple[str, str]]:

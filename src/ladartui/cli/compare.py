@@ -1,0 +1,92 @@
+"""``ladartui compare A.cmf B.cmf ...``: several runs' measures side by side, as the TUI's Compare."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+
+def add_parser(subparsers):
+    parser = subparsers.add_parser(
+        "compare",
+        help="put two or more runs' measures side by side",
+        description="Read the measures files (.cmf) two or more runs wrote, or the scenarios "
+        "(.toml) whose last runs wrote them, and print every measure side by side: where the "
+        "runs differ the row is yellow, and for a measure with a better direction the best "
+        "value is green and the worst red (the TUI's Compare, F10, shows the same).",
+    )
+    parser.add_argument(
+        "files", metavar="FILE", nargs="+", help="measures file (.cmf) or scenario (.toml); two or more"
+    )
+    parser.add_argument(
+        "--json",
+        action="store_true",
+        help="print JSON instead: the columns, and per measure its values, their text and the "
+        "best and worst columns",
+    )
+    parser.set_defaults(handler=run)
+    return parser
+
+
+def run(args) -> int:
+    from ladartui.cli.flags import check_file_names
+    from ladartui.errors import FieldError
+    from ladartui.measures_compare import column_names, read_measures_files, side_by_side
+
+    for file in args.files:
+        check_file_names({"FILE": file}, "a measures file (.cmf) or a scenario (.toml)")
+    if len(args.files) < 2:
+        raise FieldError("FILE", args.files[0], "two or more files to compare")
+    paths = [Path(file).expanduser() for file in args.files]
+    rows = side_by_side(read_measures_files(paths))  # a folder is refused before it is named
+    names = column_names(paths)
+    if args.json:
+        print(json.dumps(as_json(names, paths, rows), indent=2, allow_nan=False))
+    else:
+        show(names, rows)
+    return 0
+
+
+def as_json(names, paths, rows) -> dict:
+    return {
+        "columns": names,
+        "files": [str(path) for path in paths],
+        "measures": [
+            {
+                "measure": row.label,
+                "values": [_plain(value) for value in row.values],
+                "text": list(row.texts),
+                "differ": row.differ,
+                "best": [names[i] for i in row.best],
+                "worst": [names[i] for i in row.worst],
+            }
+            for row in rows
+        ],
+    }
+
+
+def _plain(value):
+    """A value as JSON holds it: vectors as lists, a non-finite number as None."""
+    import math
+
+    if isinstance(value, list | tuple):
+        return [_plain(v) for v in value]
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def show(names, rows) -> None:
+    from rich.table import Table
+    from rich.text import Text
+
+    from ladartui.cli.console import CliConsole
+    from ladartui.measures_compare import styled
+
+    table = Table(title="Measures side by side")
+    table.add_column("Measure")
+    for name in names:
+        table.add_column(Text(name), justify="right")  # names from files: never markup
+    for row in rows:
+        table.add_row(*styled(row))
+    CliConsole().print(table)

@@ -1,0 +1,191 @@
+"""Several runs' measures side by side: the TUI's Compare (F10) and ``ladartui compare``.
+
+``side_by_side`` gives one ``CompareRow`` per measure (then per level, then per
+target when every run holds the same several targets): the runs' values, their
+text, whether the runs differ, and which columns are best and worst for a
+measure with a direction of goodness. ``styled`` colours a row for a terminal
+(rich): differing labels and values yellow, the best bold green, the worst
+bold red.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from rich.text import Text
+
+from ladartui.errors import InputFileError
+from ladartui.fileprobe import file_problem
+from ladartui.levels import LEVELS
+from ladartui.measures_table import UNDEFINED
+from ladartui.number_text import fixed
+
+# (label, Measures.to_dict path, kind, better): better is "high", "low" or None
+ROWS = [
+    ("Maximum target coverage", "maximum_coverage", "pct", "high"),
+    ("Unobscured target coverage", "unobscured_coverage", "pct", "high"),
+    ("Obscured target coverage", "obscured_coverage", "pct", "high"),
+    ("Target voxels", "target_voxels", "int", None),
+    ("Visible target voxels", "visible_voxels", "int", None),
+    ("Unobscured voxels", "unobscured_voxels", "int", "high"),
+    ("Obscured voxels", "obscured_voxels", "int", "high"),
+    ("Model mean vector", "model_directions.mean_vector", "vec", None),
+    ("Model resultant length", "model_directions.resultant_length", "num", None),
+    ("Model mean direction", "model_directions.mean_direction", "vec", None),
+    ("Unobscured mean vector", "unobscured_directions.mean_vector", "vec", None),
+    ("Unobscured resultant length", "unobscured_directions.resultant_length", "num", None),
+    ("Unobscured mean direction", "unobscured_directions.mean_direction", "vec", None),
+    ("Obscured mean vector", "obscured_directions.mean_vector", "vec", None),
+    ("Obscured resultant length", "obscured_directions.resultant_length", "num", None),
+    ("Obscured mean direction", "obscured_directions.mean_direction", "vec", None),
+    ("Shift in mean direction (rad)", "direction_shift_rad", "num", "low"),
+    ("Missed share", "missed_share", "pct", "low"),
+    ("Coverage ratio", "coverage_ratio", "num", "high"),
+    ("Scans", "scans", "int", None),
+    ("Scans for 90% of final", "scans_for_enough", "int", "low"),
+    ("Path length (m)", "path_length_m", "num1", "low"),
+    ("Flight time (s)", "flight_time_s", "num1", "low"),
+]
+
+# per target, in the comparison
+TARGET_ROWS = [
+    ("obscured coverage", "obscured_coverage", "pct", "high"),
+    ("unobscured coverage", "unobscured_coverage", "pct", "high"),
+    ("maximum coverage", "maximum_coverage", "pct", "high"),
+    ("identify at scan", "levels.identify.scan", "int", "low"),
+]
+
+
+def lookup(data: dict, path: str):
+    """The value at dotted ``path`` of a measures dict, or None where it has none."""
+    value = data
+    for part in path.split("."):
+        if not isinstance(value, dict) or part not in value:
+            return None
+        value = value[part]
+    return value
+
+
+def format_value(value, kind: str) -> str:
+    """Text for one measure; None is shown as "undefined"."""
+    if value is None:
+        return UNDEFINED
+    if kind == "pct":
+        return f"{100 * float(value):.1f}%"
+    if kind == "int":
+        return f"{int(value):,}"
+    if kind == "vec":
+        return ", ".join(fixed(v, 3) for v in value)
+    if kind == "num1":
+        return fixed(value, 1)
+    return fixed(value, 3)
+
+
+@dataclass(frozen=True)
+class CompareRow:
+    """One measure across the runs: ``best`` and ``worst`` are column numbers (empty
+    where the measure has no better way, or every run has the same value)."""
+
+    label: str
+    values: tuple
+    texts: tuple[str, ...]
+    differ: bool
+    best: tuple[int, ...]
+    worst: tuple[int, ...]
+
+
+def side_by_side(all_measures: list) -> list[CompareRow]:
+    """One row per measure of ``all_measures`` (``Measures`` or their dicts), then the
+    scan each level was reached at, then rows per target when every run holds the
+    same several targets."""
+    dicts = [m if isinstance(m, dict) else m.to_dict() for m in all_measures]
+    rows = [
+        _compare_row(label, [lookup(d, path) for d in dicts], kind, better)
+        for label, path, kind, better in ROWS
+    ]
+    for level in LEVELS:
+        scans = [lookup(d, f"levels.{level}.scan") for d in dicts]
+        rows.append(_compare_row(f"{level.capitalize()} at scan", scans, "int", "low"))
+    targets = [d.get("targets") for d in dicts]
+    if all(isinstance(t, dict) for t in targets):
+        per = [{t["id"]: t for t in tt["per_target"]} for tt in targets if isinstance(tt, dict)]
+        ids = sorted(per[0]) if per else []
+        if len(ids) > 1 and all(sorted(p) == ids for p in per):
+            for target_id in ids:
+                name = per[0][target_id]["name"]
+                for label, path, kind, better in TARGET_ROWS:
+                    values = [lookup(p[target_id]["measures"], path) for p in per]
+                    rows.append(_compare_row(f"{name}: {label}", values, kind, better))
+    return rows
+
+
+def _compare_row(label: str, values: list, kind: str, better) -> CompareRow:
+    texts = tuple(format_value(v, kind) for v in values)
+    differ = len(set(texts)) > 1
+    best: tuple[int, ...] = ()
+    worst: tuple[int, ...] = ()
+    numeric = [
+        (float(v), i) for i, v in enumerate(values) if v is not None and not isinstance(v, (list, tuple))
+    ]
+    if differ and better and len(numeric) >= 2:
+        high, low = max(numeric)[0], min(numeric)[0]
+        top, bottom = (high, low) if better == "high" else (low, high)
+        if top != bottom:
+            best = tuple(i for v, i in numeric if v == top)
+            worst = tuple(i for v, i in numeric if v == bottom)
+    return CompareRow(label, tuple(values), texts, differ, best, worst)
+
+
+def styled(row: CompareRow) -> list[Text]:
+    """The row as rich text, label first: names from files are text, never markup."""
+    cells = []
+    for i, text in enumerate(row.texts):
+        if i in row.best:
+            cells.append(Text(text, style="bold green"))
+        elif i in row.worst:
+            cells.append(Text(text, style="bold red"))
+        else:
+            cells.append(Text(text, style="yellow" if row.differ else ""))
+    return [Text(row.label, style="bold yellow" if row.differ else ""), *cells]
+
+
+def column_names(paths: list[Path]) -> list[str]:
+    """Each file's stem, with as many of its folders as it takes to tell files of one
+    stem apart ("d2/default" and "default/default" for two default.cmf)."""
+    names = []
+    for path in paths:
+        parts = path.with_suffix("").parts
+        same = [p.with_suffix("").parts for p in paths if p.stem == path.stem and p != path]
+        depth = 1
+        while any(other[-depth:] == parts[-depth:] for other in same) and depth < len(parts):
+            depth += 1
+        names.append("/".join(parts[-depth:]))
+    return names
+
+
+def read_measures_files(paths) -> list:
+    """The ``Measures`` of each .cmf file (a scenario's .toml: its run's measures file);
+    ``InputFileError`` naming the first that cannot be read."""
+    from ladartui.cmf import read_cmf
+
+    out = []
+    for path in map(Path, paths):
+        if path.is_dir():
+            raise InputFileError(path, "is a folder; expected a .cmf measures file")
+        if problem := file_problem(path):
+            raise InputFileError(path, f"measures file {problem}")
+        out.append(read_cmf(measures_file_of(path)))
+    return out
+
+
+def measures_file_of(path: Path) -> Path:
+    """``path``, or for a scenario (.toml) the measures file its runs write."""
+    if path.suffix.lower() != ".toml":
+        return path
+    from ladartui.scenario import load_scenario
+
+    measures = load_scenario(path, check_files=False).measures_file
+    if problem := file_problem(measures):
+        raise InputFileError(measures, f"measures file of {path.name} {problem}: run it first")
+    return measures

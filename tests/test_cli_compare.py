@@ -1,0 +1,100 @@
+"""``ladartui compare``: several runs' measures side by side, as the TUI's Compare shows them."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from cli_support import one_error_line
+from ladartui import cli
+from ladartui.measures import compute_measures
+
+
+def box(nx, ny, nz):
+    return np.array([(i, j, k) for i in range(nx) for j in range(ny) for k in range(nz)], np.int32)
+
+
+def write_run(path, seen_layers: int, scans: int):
+    """A .cmf of a 4 x 4 x 4 target of which the top ``seen_layers`` layers were seen,
+    over ``scans`` scans; the path flown is 100 m a scan."""
+    target = box(4, 4, 4)
+    seen = target[target[:, 2] >= 4 - seen_layers]
+    measures = compute_measures(
+        target,
+        seen,
+        seen,
+        scene_per_scan=[seen] * scans,
+        target_per_scan=[seen] * scans,
+        path_length_m=100.0 * scans,
+        flight_time_s=4.0 * scans,
+    )
+    path.write_text(measures.to_cmf())
+    return measures
+
+
+def test_two_runs_side_by_side_with_the_best_and_worst_named(tmp_path, capsys):
+    orbit = write_run(tmp_path / "orbit.cmf", seen_layers=3, scans=12)
+    flypast = write_run(tmp_path / "flypast.cmf", seen_layers=1, scans=6)
+    assert cli.main(["compare", str(tmp_path / "orbit.cmf"), str(tmp_path / "flypast.cmf"), "--json"]) == 0
+    said = json.loads(capsys.readouterr().out)
+    assert said["columns"] == ["orbit", "flypast"]
+    rows = {row["measure"]: row for row in said["measures"]}
+    coverage = rows["Obscured target coverage"]
+    assert coverage["values"] == [orbit.obscured_coverage, flypast.obscured_coverage] == [48 / 64, 16 / 64]
+    assert coverage["text"] == ["75.0%", "25.0%"] and coverage["differ"]
+    assert (coverage["best"], coverage["worst"]) == (["orbit"], ["flypast"])
+    path = rows["Path length (m)"]  # shorter is better
+    assert path["values"] == [1200.0, 600.0] and (path["best"], path["worst"]) == (["flypast"], ["orbit"])
+    target = rows["Target voxels"]  # the same in both: no best, no worst
+    assert target["values"] == [64, 64] and not target["differ"] and target["best"] == target["worst"] == []
+    assert rows["Scans"]["values"] == [12, 6] and rows["Scans"]["best"] == []  # no better way
+
+
+def test_the_table_reads_as_the_json_says(tmp_path, capsys, monkeypatch):
+    monkeypatch.setenv("COLUMNS", "120")
+    write_run(tmp_path / "a.cmf", seen_layers=2, scans=3)
+    (tmp_path / "other").mkdir()
+    write_run(tmp_path / "other" / "a.cmf", seen_layers=4, scans=3)
+    assert cli.main(["compare", str(tmp_path / "a.cmf"), str(tmp_path / "other" / "a.cmf")]) == 0
+    out = capsys.readouterr().out
+    # two files of one name are told apart by their folders
+    header = next(line for line in out.splitlines() if "┃ Measure " in line)
+    assert f"{tmp_path.name}/a" in header and "other/a" in header
+    line = next(line for line in out.splitlines() if "Obscured target coverage" in line)
+    assert [cell.strip() for cell in line.split("│")[2:4]] == ["50.0%", "100.0%"]
+
+
+def test_a_scenario_is_compared_by_the_measures_its_run_wrote(tmp_path, capsys):
+    from scenario_support import BASE, write_scenario
+
+    write_scenario(tmp_path, BASE, "orbit.toml")  # its run wrote orbit.cmf beside it
+    write_run(tmp_path / "orbit.cmf", seen_layers=3, scans=10)
+    write_run(tmp_path / "flypast.cmf", seen_layers=2, scans=10)
+    files = [str(tmp_path / "orbit.toml"), str(tmp_path / "flypast.cmf"), "--json"]
+    assert cli.main(["compare", *files]) == 0
+    said = json.loads(capsys.readouterr().out)
+    assert said["columns"] == ["orbit", "flypast"]
+    assert said["measures"][2]["measure"] == "Obscured target coverage"
+    assert said["measures"][2]["values"] == [0.75, 0.5]
+
+
+@pytest.mark.parametrize(
+    ("files", "said"),
+    [
+        (["one.cmf"], "FILE = 'one.cmf': expected two or more files to compare"),
+        (["one.cmf", "gone.cmf"], "gone.cmf: measures file not found"),
+        (["one.cmf", "."], ".: is a folder; expected a .cmf measures file"),
+        (["one.cmf", ""], "FILE = '': expected a measures file (.cmf) or a scenario (.toml)"),
+        (["one.cmf", "never.toml"], "never.cmf: measures file of never.toml not found: run it first"),
+    ],
+)
+def test_what_cannot_be_compared_is_said_in_one_line(tmp_path, capsys, monkeypatch, files, said):
+    from scenario_support import write_scenario
+
+    monkeypatch.chdir(tmp_path)
+    write_run(tmp_path / "one.cmf", seen_layers=1, scans=1)
+    write_scenario(tmp_path, name="never.toml")  # never run: no never.cmf
+    assert cli.main(["compare", *files]) == 2
+    assert one_error_line(capsys).endswith(said)
