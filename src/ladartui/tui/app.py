@@ -21,7 +21,7 @@ from textual.containers import Horizontal, Vertical
 from textual.css.query import NoMatches
 from textual.notifications import SeverityLevel
 from textual.screen import ModalScreen, Screen
-from textual.widgets import Button, Footer, TabbedContent, TabPane
+from textual.widgets import Button, Footer, TabbedContent, TabPane, Tabs
 
 from ladartui.edit_history import EditHistory
 from ladartui.run_record import setting_changes
@@ -375,7 +375,18 @@ class LadarApp(
 
     def action_show_tab(self, tab: str) -> None:
         self.query_one("#sidebar").display = True
-        self.query_one("#tabs", TabbedContent).active = f"tab-{tab}"
+        tabs = self.query_one("#tabs", TabbedContent)
+        shown, focused = tabs.active_pane, tabs.screen.focused
+        if (
+            shown is not None
+            and shown.id != f"tab-{tab}"
+            and focused is not None
+            and shown in focused.ancestors
+        ):
+            # hidden, it would hand the focus to a neighbour in its tab, which then takes
+            # over again: the tab bar takes it, as a click on a tab leaves it
+            tabs.screen.set_focus(tabs.query_one(Tabs))
+        tabs.active = f"tab-{tab}"
 
     def action_view_angle(self) -> None:
         widget = self.view_area.focused_projection(self.focused)
