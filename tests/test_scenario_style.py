@@ -200,3 +200,29 @@ def test_the_header_command_works_as_written_for_a_name_with_spaces(tmp_path):
     assert (
         "old plan" not in load_scenario(old, check_files=False).save(tmp_path / "new.toml").path.read_text()
     )
+
+
+@pytest.mark.parametrize("edit", ["deleted", "straight"])
+def test_a_segment_list_written_anew_keeps_a_blank_line_before_every_table(folder, edit):
+    """A segment deleted (the list is written anew) left '[simulation]' straight under
+    the last segment's keys; the orbit replaced by a straight, which brings a start pose,
+    put '[simulation]' straight under '[flight.start]': the blank lines the file had
+    between its tables were lost."""
+    from ladartui.flight import Straight
+    from ladartui.tui import bridge
+
+    path = folder / "orbit.toml"
+    shutil.copy(SHIPPED / "orbit.toml", path)
+    scenario = load_scenario(path)
+    orbit, straight = scenario.flight.segments[0], Straight(distance=100.0, scans=5)
+    if edit == "deleted":  # a straight after the orbit, saved; then the orbit deleted
+        bridge.with_segments(scenario, [orbit, straight]).save()
+        scenario = load_scenario(path)
+    saved = bridge.with_segments(scenario, [straight])
+    saved.save()
+    text = path.read_text()
+    lines = text.splitlines()
+    headers = [n for n, line in enumerate(lines) if line.startswith("[")]
+    assert [lines[n - 1] for n in headers] == [""] * len(headers), text
+    assert text.endswith("fast_mode = false\n")  # and the file ends as it did
+    assert load_scenario(path).flight == saved.flight

@@ -13,7 +13,7 @@ from typing import TypeGuard
 
 import tomlkit
 from tomlkit.exceptions import TOMLKitError
-from tomlkit.items import AoT
+from tomlkit.items import AoT, InlineTable, Table
 
 
 def restyle(old_text: str, data: dict, old_data: dict | None = None) -> str | None:
@@ -27,7 +27,10 @@ def restyle(old_text: str, data: dict, old_data: dict | None = None) -> str | No
     except TOMLKitError:
         return None
     _merge_table(document, data, old_data)
-    return tomlkit.dumps(document)
+    text = tomlkit.dumps(document)
+    if old_text.endswith("\n") and not old_text.endswith("\n\n"):
+        text = text.rstrip("\n") + "\n"  # the blank line after a table written last
+    return text
 
 
 def _plain(item):
@@ -42,7 +45,7 @@ def _merge_table(table, data: dict, old_data: dict | None) -> None:
         if before is not None and _same(before, value):
             continue  # unchanged: as the file has it, even if left out there
         if key not in table:
-            table[key] = value
+            table[key] = _spaced(table, value)
         elif isinstance(value, dict) and isinstance(_plain(table[key]), dict):
             _merge_table(table[key], value, before)
         elif (
@@ -52,7 +55,7 @@ def _merge_table(table, data: dict, old_data: dict | None) -> None:
         ):
             pass  # segments keep their comments, appended ones after them
         elif not _same(_plain(table[key]), value):
-            table[key] = value
+            table[key] = _spaced(table, value)
 
 
 def _merge_list(tables, values: list[dict], befores) -> bool:
@@ -88,6 +91,19 @@ def _new_table(value: dict):
     table = tomlkit.item(value)
     table.add(tomlkit.nl())  # a blank line before whatever table follows, as the others have
     return table
+
+
+def _spaced(container, value):
+    """A new table, or list of tables, written as its own lines with a blank line after
+    each, as the file's tables have (tomlkit keeps that line with the table before the
+    next one, so a list written afresh would lose it); anything else as it is."""
+    if isinstance(container, InlineTable) or not (_is_table_list(value) or isinstance(value, dict)):
+        return value
+    written = tomlkit.item(value)  # a list's tables come apart by a blank line already
+    last = written[-1] if isinstance(written, AoT) else written
+    if isinstance(last, Table):
+        last.add(tomlkit.nl())
+    return written
 
 
 def _is_table_list(value: object) -> TypeGuard[list[dict]]:
