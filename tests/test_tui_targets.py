@@ -78,5 +78,5 @@ async def test_rows_colours_and_comparison_per_target(tmp_path):
         by_label = {row[0]: row[1:] for row in table}
         assert by_label[f"{NAME}: obscured coverage"] == ("33.3%", "33.3%")
         assert by_label["roofed: unobscured coverage"] == ("50.0%", "50.0%")
-        assert by_label["Identify at scan"] == ("undefined", "undefined")
+        assert by_label["Identify at scan"] == ("not reached", "not reached")
         assert all(len(row) == 3 for row in table)

@@ -10,6 +10,7 @@ bold red.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -17,7 +18,7 @@ from rich.text import Text
 
 from ladartui.errors import InputFileError
 from ladartui.fileprobe import file_problem
-from ladartui.levels import LEVELS
+from ladartui.levels import LEVELS, NOT_REACHED
 from ladartui.measures_table import UNDEFINED
 from ladartui.number_text import fixed
 
@@ -53,7 +54,7 @@ TARGET_ROWS = [
     ("obscured coverage", "obscured_coverage", "pct", "high"),
     ("unobscured coverage", "unobscured_coverage", "pct", "high"),
     ("maximum coverage", "maximum_coverage", "pct", "high"),
-    ("identify at scan", "levels.identify.scan", "int", "low"),
+    ("identify at scan", "levels.identify", "level", "low"),
 ]
 
 
@@ -105,8 +106,9 @@ def side_by_side(all_measures: list) -> list[CompareRow]:
         for label, path, kind, better in ROWS
     ]
     for level in LEVELS:
-        scans = [lookup(d, f"levels.{level}.scan") for d in dicts]
-        rows.append(_compare_row(f"{level.capitalize()} at scan", scans, "int", "low"))
+        rows.append(
+            _level_row(f"{level.capitalize()} at scan", [lookup(d, f"levels.{level}") for d in dicts])
+        )
     targets = [d.get("targets") for d in dicts]
     if all(isinstance(t, dict) for t in targets):
         per = [{t["id"]: t for t in tt["per_target"]} for tt in targets if isinstance(tt, dict)]
@@ -116,18 +118,22 @@ def side_by_side(all_measures: list) -> list[CompareRow]:
                 name = per[0][target_id]["name"]
                 for label, path, kind, better in TARGET_ROWS:
                     values = [lookup(p[target_id]["measures"], path) for p in per]
-                    rows.append(_compare_row(f"{name}: {label}", values, kind, better))
+                    if kind == "level":
+                        rows.append(_level_row(f"{name}: {label}", values))
+                    else:
+                        rows.append(_compare_row(f"{name}: {label}", values, kind, better))
     return rows
 
 
-def _compare_row(label: str, values: list, kind: str, better) -> CompareRow:
-    texts = tuple(format_value(v, kind) for v in values)
+def _compare_row(label: str, values: list, kind: str, better, texts=None, numeric=None) -> CompareRow:
+    texts = tuple(format_value(v, kind) for v in values) if texts is None else texts
     differ = len(set(texts)) > 1
     best: tuple[int, ...] = ()
     worst: tuple[int, ...] = ()
-    numeric = [
-        (float(v), i) for i, v in enumerate(values) if v is not None and not isinstance(v, (list, tuple))
-    ]
+    if numeric is None:
+        numeric = [
+            (float(v), i) for i, v in enumerate(values) if v is not None and not isinstance(v, (list, tuple))
+        ]
     if differ and better and len(numeric) >= 2:
         high, low = max(numeric)[0], min(numeric)[0]
         top, bottom = (high, low) if better == "high" else (low, high)
@@ -135,6 +141,27 @@ def _compare_row(label: str, values: list, kind: str, better) -> CompareRow:
             best = tuple(i for v, i in numeric if v == top)
             worst = tuple(i for v, i in numeric if v == bottom)
     return CompareRow(label, tuple(values), texts, differ, best, worst)
+
+
+def _level_row(label: str, levels: list) -> CompareRow:
+    """The scan each run reached a level at (``levels``: each run's level dict, None where
+    its file has no levels): one never reached reads "not reached" and ranks after
+    every scan, as the Results tab and the .cmf say it."""
+    scans = [level.get("scan") if isinstance(level, dict) else None for level in levels]
+    texts = tuple(
+        UNDEFINED
+        if not isinstance(level, dict)
+        else format_value(scan, "int")
+        if level.get("reached")
+        else NOT_REACHED
+        for level, scan in zip(levels, scans)
+    )
+    ranks = [
+        (float(scan) if level.get("reached") and scan is not None else math.inf, i)
+        for i, (level, scan) in enumerate(zip(levels, scans))
+        if isinstance(level, dict)
+    ]
+    return _compare_row(label, scans, "int", "low", texts=texts, numeric=ranks)
 
 
 def styled(row: CompareRow) -> list[Text]:
