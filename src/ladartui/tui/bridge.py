@@ -260,7 +260,7 @@ def segment_summary(segment) -> str:
     if k == "orbit":
         return f"r {segment.radius:g} m at {segment.altitude:g} m"
     if k == "flypast":
-        return f"{segment.length:g} m at {segment.standoff:g} m"
+        return f"{segment.length:g} m, {segment.standoff:g} m off at {segment.altitude:g} m"
     if k == "standoff":
         return ", ".join(f"{s:g}" for s in segment.standoffs) + " m"
     if k == "log":

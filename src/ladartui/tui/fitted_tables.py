@@ -19,7 +19,8 @@ from textual import events
 from textual.widgets import DataTable
 
 SEGMENT_COLUMNS = ("#", "Kind", "Scans", "Detail")  # the Flight tab's
-UNITS = frozenset({"m", "deg", "Hz", "times", "pose", "poses"})  # kept beside their numbers
+# kept beside their numbers ("off": a fly-past's standoff, "80 m off")
+UNITS = frozenset({"m", "deg", "Hz", "times", "pose", "poses", "off"})
 BREAK_AFTER = ("-_/", ".")  # where a long file name breaks, the first kind preferred
 PUNCTUATION = ",;:."  # never a line's start on its own
 
@@ -57,11 +58,11 @@ def fill_segments(table: FittingTable, rows: Sequence[tuple[str, str, str, str]]
 
 def wrap_detail(text: str, room: int) -> list[str]:
     """``text`` in lines of at most ``room`` cells, broken between words, a unit kept on
-    the line of its number ("300 m", never "300" then "m"); a word wider than the room
-    is broken where it must."""
+    the line of its number ("300 m", never "300" then "m") and "at" on the line of the
+    number it goes with; a word wider than the room is broken where it must."""
     words: list[str] = []
     for word in text.split(" "):
-        if words and word in UNITS:
+        if words and word.rstrip(PUNCTUATION) in UNITS:
             words[-1] += " " + word
         elif word:
             words.append(word)
@@ -79,7 +80,11 @@ def wrap_detail(text: str, room: int) -> list[str]:
             lines.append(word[:cut])
             word = word[cut:]
         line = word
-    return [*lines, line] if line or not lines else lines
+    lines = [*lines, line] if line or not lines else lines
+    for n in range(len(lines) - 1):  # "at" goes with the number after it: "at 60 m"
+        if lines[n].endswith(" at") and cell_len("at " + lines[n + 1]) <= room:
+            lines[n], lines[n + 1] = lines[n][:-3], "at " + lines[n + 1]
+    return lines
 
 
 def _cut(word: str, room: int) -> int:
