@@ -94,7 +94,8 @@ def test_a_run_over_the_ray_limit_is_a_next_run_line_after_the_summary(tmp_path,
         "the target-alone run\n"
     ) in out
     assert out.splitlines()[-1] == (
-        f"next run   {path}: sensor.grid = 1024, sensor.ray_grid = 16, 10,000 scans: about 5.37e+12 "
+        f"next run   {path}: sensor.grid = 1024, sensor.ray_grid = 16, 10,000 scans x 2 runs "
+        "(scene and target alone): about 5.37e+12 "
         "rays to trace, more than the limit of 2e+09 (raise it with LADARTUI_MAX_RAYS or run's "
         "--max-rays if this is meant); the run is refused before it traces"
     )
@@ -207,7 +208,8 @@ def test_a_scenario_over_the_ray_limit_opens_and_only_work_on_it_is_refused(tmp_
     with pytest.raises(RayLimitError) as refused:
         simulate(scenario)
     assert str(refused.value).startswith(
-        f"{path}: sensor.grid = 8, sensor.ray_grid = 2, 4 scans: about 2.05e+03 rays to trace"
+        f"{path}: sensor.grid = 8, sensor.ray_grid = 2, 4 scans x 2 runs (scene and target alone): "
+        "about 2.05e+03 rays to trace"
     )
     assert sorted(p.name for p in tmp_path.iterdir()) == ["base.toml", "tiny.txt", "tiny_Target.txt"]
     three = scenario.with_changes(

@@ -582,6 +582,6 @@ def check_work(scenario, raise_with=None):
     check_rays(
         scenario.traced_rays(),
         f"{scenario.path}: sensor.grid = {sensor.grid}, sensor.ray_grid = "
-        f"{sensor.ray_grid}, {plural(scans, 'scan')}",
+        f"{sensor.ray_grid}, {plural(scans, 'scan')} x 2 runs (scene and target alone)",
         raise_with=raise_with or RAISE_RAYS,
     )
