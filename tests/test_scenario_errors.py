@@ -230,6 +230,19 @@ def test_toml_syntax_error_gives_the_line(tmp_path):
     assert str(caught.value).startswith(f"{path}:{caught.value.line}: not valid TOML: ")
 
 
+@pytest.mark.parametrize("tail", ["x = [\n", "x = [\n\n\n", "x = [1,"])
+def test_a_toml_mistake_at_the_end_of_the_file_names_its_last_line(tmp_path, tail):
+    """A file cut off in a value read 'not valid TOML: Invalid value (at end of
+    document)': no line where every other mistake has one."""
+    text = BASE + tail
+    path = write_scenario(tmp_path, text)
+    with pytest.raises(InputFileError) as caught:
+        load_scenario(path, check_files=False)
+    last = line_of(text, tail.strip())
+    assert str(caught.value).startswith(f"{path}:{last}: not valid TOML: ")
+    assert str(caught.value).endswith(" at the end of the file")
+
+
 @pytest.mark.parametrize("mark", ["\u2028", "\u2029", "\x85"])
 def test_a_comment_holding_a_unicode_line_separator_keeps_the_lines_that_follow(tmp_path, mark):
     """TOML ends a line at a newline alone; a line separator pasted into a comment

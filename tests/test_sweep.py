@@ -170,6 +170,10 @@ def test_a_toml_mistake_in_a_spec_is_named_as_file_and_line_as_a_scenario_s_is(t
         load_sweep_spec(path)
     assert caught.value.line == 3
     assert str(caught.value) == f"{path}:3: not valid TOML: Expected '=' after a key in a key/value pair"
+    path.write_text('[sweep]\nscenario = "a.toml"\nradius = [20,\n', encoding="utf-8")  # cut off
+    with pytest.raises(InputFileError) as caught:
+        load_sweep_spec(path)
+    assert str(caught.value).startswith(f"{path}:3: not valid TOML: ")
 
 
 # -- variant ids ---------------------------------------------------------------------

@@ -155,7 +155,7 @@ def parse_document(text: str, path: Path) -> dict:
     except RecursionError:
         raise InputFileError(path, NESTED_TOO_DEEP) from None
     except tomllib.TOMLDecodeError as error:
-        message, line = toml_mistake(error)
+        message, line = toml_mistake(error, text)
         raise InputFileError(path, f"not valid TOML: {message}", line) from None
 
 

@@ -19,13 +19,21 @@ _KEY = re.compile(r"""^\s*(?:([A-Za-z0-9_\-]+)|"([^"\\]*)"|'([^']*)')\s*=""")  #
 
 
 _AT_LINE = re.compile(r"\s*\(at line (\d+), column \d+\)")
+_AT_END = " (at end of document)"  # tomllib's words for a mistake it met at the end
 
 
-def toml_mistake(error: tomllib.TOMLDecodeError) -> tuple[str, int | None]:
-    """What a TOML syntax error says, less its "(at line L, column C)", and L (None when
-    it names no line: "at end of document"): so every message reads ``file:line: ...``."""
-    found = _AT_LINE.search(str(error))
-    return _AT_LINE.sub("", str(error)), int(found.group(1)) if found else None
+def toml_mistake(error: tomllib.TOMLDecodeError, text: str) -> tuple[str, int | None]:
+    """What a TOML syntax error in ``text`` says, less its "(at line L, column C)", and L:
+    so every message reads ``file:line: ...``. One "at end of document" (a value cut
+    off) is at the last line holding anything, "at the end of the file"."""
+    said = str(error)
+    found = _AT_LINE.search(said)
+    if found:
+        return _AT_LINE.sub("", said), int(found.group(1))
+    if said.endswith(_AT_END):
+        held = [number for number, line in enumerate(text_lines(text), start=1) if line.strip()]
+        return said.removesuffix(_AT_END) + " at the end of the file", held[-1] if held else None
+    return said, None
 
 
 def key_lines(path: Path) -> dict[str, int]:
@@ -113,7 +121,7 @@ def read_config_table(path: Path, name: str, what: str) -> ConfigTable:
     try:
         document = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
-        said, line = toml_mistake(error)
+        said, line = toml_mistake(error, text)
         return failed(f"not valid TOML: {said}", line)
     except RecursionError:
         return failed("nested too deep to read")

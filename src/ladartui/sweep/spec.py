@@ -225,7 +225,7 @@ def load_sweep_spec(path) -> SweepSpec:
     except OSError as error:
         raise InputFileError(path, f"cannot read: {error.strerror or error}") from None
     except tomllib.TOMLDecodeError as error:
-        message, line = toml_mistake(error)
+        message, line = toml_mistake(error, text)
         raise InputFileError(path, f"not valid TOML: {message}", line=line) from None
     return parse_sweep_spec(data, path, text)
 
