@@ -500,6 +500,33 @@ async def test_the_outputs_export_as_las_point_clouds_after_a_run(tmp_path, scen
             assert len(cloud.points) == len(load_voxels(output)) > 0
 
 
+async def test_las_exported_from_outputs_out_of_date_says_so(tmp_path, scene_files):
+    """Outputs made with other settings were exported with no more than 'Wrote ...': the
+    point clouds read as the scenario's while the status bar called them out of date."""
+    from ladartui.sensor import Sensor
+    from ladartui.simulation import simulate
+
+    scenario = make_scenario(tmp_path, scene_files, scans=2)
+    simulate(scenario.with_changes(sensor=Sensor(grid=12, ray_grid=1, fov=8.0)))  # not this file's grid
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app) and app.measures is not None)
+        assert app.outputs_stale()
+        await app.run_action("export_las")
+        await wait_until(pilot, lambda: any(m.startswith("Wrote") for m in app.messages))
+        said = next(m for m in app.messages if m.startswith("Wrote"))
+        assert said.startswith(f"Wrote {scenario.scene_output.with_suffix('.las')}")
+        assert "from outputs out of date: made from other settings" in said and "sensor.grid" in said
+        # as they are made again: the export says nothing more
+        await pilot.press("f5")
+        await wait_until(pilot, lambda: app.result is not None and not app.running)
+        await pilot.press("escape")
+        app.messages.clear()
+        await app.run_action("export_las")
+        await wait_until(pilot, lambda: any(m.startswith("Wrote") for m in app.messages))
+        assert "out of date" not in next(m for m in app.messages if m.startswith("Wrote"))
+
+
 async def test_view_commands_reach_every_view_and_a_view_saves_as_png(tmp_path, scene_files):
     from PIL import Image
 

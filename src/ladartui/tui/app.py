@@ -453,7 +453,12 @@ class LadarApp(
         if self.scenario is None or self.busy:
             return
         scenario, scene = self.scenario, self.scene
-        start_job(self, "export", lambda cancel, progress: bridge.export_outputs_las(scenario, scene=scene))
+        made_with = self.outputs_made_with()  # outputs out of date: the note says so
+
+        def export(cancel, progress):
+            return bridge.export_outputs_las(scenario, scene=scene), made_with
+
+        start_job(self, "export", export)
 
     def action_help(self) -> None:
         self.push_screen(HelpScreen(help_rows(self)))
@@ -528,7 +533,12 @@ class LadarApp(
         elif message.job == "png" and message.result is not None:
             self.tell(f"Wrote {message.result}")
         elif message.job == "export" and message.result is not None:
-            self.tell("Wrote " + ", ".join(str(p) for p in message.result))
+            paths, made_with = message.result
+            wrote = "Wrote " + ", ".join(str(p) for p in paths)
+            if made_with is None:
+                self.tell(wrote)
+            else:  # as the status bar and the Results tab call them
+                self.tell(f"{wrote} from outputs out of date: made from {made_with}", severity="warning")
 
     def exit(self, *args, **kwargs) -> None:
         # a thread cannot be killed: cancelling tells every job to stop, so quitting is quick
