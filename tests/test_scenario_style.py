@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 import difflib
 import shutil
+import tomllib
 from pathlib import Path
 
 import pytest
@@ -85,6 +86,28 @@ def test_a_segment_made_another_kind_leaves_the_old_kinds_comments_behind(folder
     assert text.startswith("# Orbit (report figure 1a)")  # the file's own notes stay
     assert 'scene = "generated/small.txt"   # its target model is' in text
     assert load_scenario(path).flight.segments == (pass_by,)
+
+
+def test_a_segment_made_another_kind_keeps_the_note_above_the_next_table():
+    """tomlkit keeps a comment line above a table with the table before it: a segment
+    written anew as another kind took away the note over the segment after it."""
+    old = (
+        "[flight]\nspeed_mps = 30.0\n\n"
+        '[[flight.segments]]\nkind = "orbit"\nradius = 60.0  # wide\n\n'
+        "# second: the run out north, keep it short\n"
+        '[[flight.segments]]\nkind = "straight"\ndistance = 50.0\n\n'
+        "# the run's settings\n[simulation]\nfast_mode = true\n"
+    )
+    data = tomllib.loads(old)
+    new = {**data, "flight": {**data["flight"], "segments": [{"kind": "flypast", "standoff": 40.0}]}}
+    new["flight"]["segments"].append(data["flight"]["segments"][1])
+    text = restyle(old, new, data)
+    assert "# wide" not in text  # the orbit's own note went with it
+    assert "\n\n# second: the run out north, keep it short\n[[flight.segments]]\n" in text
+    assert tomllib.loads(text) == new
+    new["flight"]["segments"] = [{"kind": "flypast", "standoff": 40.0}, {"kind": "turn", "arc": 90.0}]
+    text = restyle(old, new, data)
+    assert "\n\n# the run's settings\n[simulation]\n" in text and tomllib.loads(text) == new
 
 
 def test_save_as_keeps_the_comments_and_points_at_the_same_scene(folder, tmp_path):

@@ -13,7 +13,7 @@ from typing import TypeGuard
 
 import tomlkit
 from tomlkit.exceptions import TOMLKitError
-from tomlkit.items import AoT, InlineTable, Table
+from tomlkit.items import AoT, Comment, InlineTable, Table, Whitespace
 
 
 def restyle(old_text: str, data: dict, old_data: dict | None = None) -> str | None:
@@ -70,7 +70,9 @@ def _merge_list(tables, values: list[dict], befores) -> bool:
         befores = befores if _is_table_list(befores) and len(befores) == len(values) else [None] * len(values)
         for k, (table, value, before) in enumerate(zip(tables, values, befores)):
             if isinstance(tables, AoT) and _plain(table).get("kind") != value.get("kind"):
-                tables[k] = _new_table(value)  # another kind: the old one's notes are not its own
+                # another kind: the old one's notes are not its own, but the lines after its
+                # keys (a note over the next table) are the file's
+                tables[k] = _new_table(value, _trailing(table))
             else:
                 _merge_table(table, value, before)
         return True
@@ -87,10 +89,21 @@ def _merge_list(tables, values: list[dict], befores) -> bool:
     return True
 
 
-def _new_table(value: dict):
+def _new_table(value: dict, after=()):
+    """``value`` as a table followed by the lines ``after`` (items of the table it
+    replaces), else by a blank line before whatever table follows, as the others have."""
     table = tomlkit.item(value)
-    table.add(tomlkit.nl())  # a blank line before whatever table follows, as the others have
+    for item in after or [tomlkit.nl()]:
+        table.add(item)
     return table
+
+
+def _trailing(table) -> list:
+    """The comments and blank lines after a table's last key: tomlkit keeps a note over
+    the next table's header there."""
+    body = table.value.body
+    last_key = max((n for n, (key, _) in enumerate(body) if key is not None), default=-1)
+    return [item for key, item in body[last_key + 1 :] if isinstance(item, Comment | Whitespace)]
 
 
 def _spaced(container, value):
