@@ -330,6 +330,46 @@ def test_validate_says_a_run_is_writing_the_set_now(scenario, capsys):
     ]
 
 
+def test_the_look_at_a_runs_lock_never_waits_on_a_pipe(tmp_path):
+    """validate asked whether a run held the set by opening its lock file to read: a
+    pipe there left it waiting for ever after its summary."""
+    import threading
+
+    from ladartui.outputset import lock_holder
+
+    pipe = tmp_path / ".case.outputs.lock"
+    os.mkfifo(pipe)
+    said = []
+    looking = threading.Thread(target=lambda: said.append(lock_holder(pipe)), daemon=True)
+    looking.start()
+    looking.join(10)
+    if looking.is_alive():  # (let the thread go: a writer ends its wait)
+        os.close(os.open(pipe, os.O_WRONLY | os.O_NONBLOCK))
+    assert said == [None]
+
+
+def test_a_run_is_not_refused_for_a_look_at_its_lock(scenario):
+    """validate's look takes the lock shared for a moment: a run that came to lock it
+    then was refused as 'another run (pid ?) is writing this output set'."""
+    import fcntl
+    import threading
+
+    from ladartui.simulation import _output_set, output_lock
+
+    lock = output_lock(scenario)
+    lock.parent.mkdir(parents=True, exist_ok=True)
+    fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)  # as the look finds it: no pid in it
+    fcntl.flock(fd, fcntl.LOCK_SH)
+    letting_go = threading.Timer(0.02, lambda: fcntl.flock(fd, fcntl.LOCK_UN))
+    letting_go.start()
+    try:
+        with _output_set(scenario, las=False):
+            assert lock.read_text() == str(os.getpid())
+    finally:
+        letting_go.join()
+        os.close(fd)
+
+
 def _last_run_lines(capsys, scenario) -> list[str]:
     capsys.readouterr()
     assert main(["validate", str(scenario.path)]) == 0

@@ -16,8 +16,10 @@ import contextlib
 import errno
 import json
 import os
+import stat
 import tempfile
 import threading
+import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -131,6 +133,11 @@ def check_lock(lock) -> None:
         raise OutputFileError(lock, LOCK_FOLDER)
 
 
+# How long a run waits on a lock held with no pid in it: ``lock_holder`` holds it shared
+# for microseconds, and a run writes its pid at once after locking.
+LOOK_SECONDS = 0.2
+
+
 def lock_holder(lock) -> str | None:
     """The pid of the run that holds ``lock`` now (as it wrote it; "?" before it has),
     or None when no run does (no file, or one a killed run left). The lock is only
@@ -139,11 +146,13 @@ def lock_holder(lock) -> str | None:
         import fcntl
     except ImportError:  # not POSIX: no lock to ask
         return None
-    try:
-        fd = os.open(lock, os.O_RDONLY)
+    try:  # (not waiting: a pipe there would hold an open for reading until written)
+        fd = os.open(lock, os.O_RDONLY | os.O_NONBLOCK)
     except OSError:  # none (or a folder, said where the run would be refused)
         return None
     try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):  # no run's lock
+            return None
         try:
             fcntl.flock(fd, fcntl.LOCK_SH | fcntl.LOCK_NB)
         except OSError as error:
@@ -191,6 +200,7 @@ class OutputSet:
         import fcntl
 
         self.lock.parent.mkdir(parents=True, exist_ok=True)
+        looked_at_until = time.monotonic() + LOOK_SECONDS
         while True:
             try:
                 fd = os.open(self.lock, os.O_RDWR | os.O_CREAT, 0o644)
@@ -199,9 +209,14 @@ class OutputSet:
             try:
                 fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
             except OSError as error:
-                holder = os.read(fd, 32).decode("ascii", "replace").strip() or "?"
+                holder = os.read(fd, 32).decode("ascii", "replace").strip()
                 os.close(fd)
-                if error.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+                busy = error.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES)
+                if busy and not holder and time.monotonic() < looked_at_until:
+                    time.sleep(0.002)  # a look at the lock (``lock_holder``), or a run about to say its pid
+                    continue
+                if busy:
+                    holder = holder or "?"
                     raise OutputFileError(
                         self.lock,
                         f"another run (pid {holder}) is writing this output set; wait for it to finish",
