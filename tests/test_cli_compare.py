@@ -52,7 +52,7 @@ def test_two_runs_side_by_side_with_the_best_and_worst_named(tmp_path, capsys):
     assert rows["Scans"]["values"] == [12, 6] and rows["Scans"]["best"] == []  # no better way
 
 
-def test_the_table_reads_as_the_json_says(tmp_path, capsys, monkeypatch):
+def test_the_table_names_its_columns_apart_and_reads_in_percent(tmp_path, capsys, monkeypatch):
     monkeypatch.setenv("COLUMNS", "120")
     write_run(tmp_path / "a.cmf", seen_layers=2, scans=3)
     (tmp_path / "other").mkdir()
@@ -85,9 +85,14 @@ def test_a_scenario_is_compared_by_the_measures_its_run_wrote(tmp_path, capsys):
     [
         (["one.cmf"], "FILE = 'one.cmf': expected two or more files to compare"),
         (["one.cmf", "gone.cmf"], "gone.cmf: measures file not found"),
-        (["one.cmf", "."], ".: is a folder; expected a .cmf measures file"),
+        (["one.cmf", "."], ".: is a folder; expected a .cmf measures file or a scenario (.toml)"),
         (["one.cmf", ""], "FILE = '': expected a measures file (.cmf) or a scenario (.toml)"),
         (["one.cmf", "never.toml"], "never.cmf: measures file of never.toml not found: run it first"),
+        (["one.cmf", "gone.toml"], "gone.toml: scenario not found"),
+        (
+            ["one.cmf", "never.toml", "--json"],
+            "never.cmf: measures file of never.toml not found: run it first",
+        ),
     ],
 )
 def test_what_cannot_be_compared_is_said_in_one_line(tmp_path, capsys, monkeypatch, files, said):
@@ -98,3 +103,18 @@ def test_what_cannot_be_compared_is_said_in_one_line(tmp_path, capsys, monkeypat
     write_scenario(tmp_path, name="never.toml")  # never run: no never.cmf
     assert cli.main(["compare", *files]) == 2
     assert one_error_line(capsys).endswith(said)
+
+
+def test_columns_of_one_name_are_told_apart_in_the_table_and_the_json(tmp_path, capsys):
+    """'compare a.cmf a.cmf' headed both columns 'a', and a scenario beside its own
+    measures file both 'orbit': the JSON's best and worst named no column."""
+    from scenario_support import BASE, write_scenario
+
+    write_scenario(tmp_path, BASE, "orbit.toml")
+    write_run(tmp_path / "orbit.cmf", seen_layers=3, scans=10)
+    for files, columns in (
+        (["orbit.cmf", "orbit.cmf"], ["orbit", "orbit (2)"]),
+        (["orbit.toml", "orbit.cmf"], ["orbit.toml", "orbit.cmf"]),
+    ):
+        assert cli.main(["compare", *(str(tmp_path / f) for f in files), "--json"]) == 0
+        assert json.loads(capsys.readouterr().out)["columns"] == columns

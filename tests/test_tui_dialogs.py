@@ -605,7 +605,9 @@ def test_the_png_and_compare_dialogs_name_what_is_wrong(tmp_path):
     assert caught.value.field == "height" and "'tall'" in str(caught.value)
     with pytest.raises(InputFileError) as caught:
         read_measures_files([tmp_path])
-    assert str(caught.value) == f"{tmp_path}: is a folder; expected a .cmf measures file"
+    assert (
+        str(caught.value) == f"{tmp_path}: is a folder; expected a .cmf measures file or a scenario (.toml)"
+    )
     with pytest.raises(InputFileError) as caught:
         read_measures_files([tmp_path / "gone.cmf"])
     assert str(caught.value) == f"{tmp_path / 'gone.cmf'}: measures file not found"

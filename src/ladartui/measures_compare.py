@@ -179,15 +179,26 @@ def styled(row: CompareRow) -> list[Text]:
 
 def column_names(paths: list[Path]) -> list[str]:
     """Each file's stem, with as many of its folders as it takes to tell files of one
-    stem apart ("d2/default" and "default/default" for two default.cmf)."""
+    stem apart ("d2/default" and "default/default" for two default.cmf), its suffix
+    where that tells them ("orbit.toml", "orbit.cmf"), and a count for a file given
+    twice ("orbit (2)")."""
+
+    def parts_of(path: Path) -> tuple[str, ...]:
+        bare = path.with_suffix("")
+        twin = any(other != path and other.with_suffix("") == bare for other in paths)
+        return path.parts if twin else bare.parts  # a twin: told apart by the suffix
+
+    keyed = [parts_of(path) for path in paths]
     names = []
-    for path in paths:
-        parts = path.with_suffix("").parts
-        same = [p.with_suffix("").parts for p in paths if p.stem == path.stem and p != path]
+    for k, parts in enumerate(keyed):
+        same = [o for j, o in enumerate(keyed) if o[-1] == parts[-1] and paths[j] != paths[k]]
         depth = 1
         while any(other[-depth:] == parts[-depth:] for other in same) and depth < len(parts):
             depth += 1
         names.append("/".join(parts[-depth:]))
+    for k, name in enumerate(names):
+        if name in names[:k]:
+            names[k] = f"{name} ({names[: k + 1].count(name)})"
     return names
 
 
@@ -198,11 +209,12 @@ def read_measures_files(paths) -> list:
 
     out = []
     for path in map(Path, paths):
+        scenario = path.suffix.lower() == ".toml"
         if path.is_dir():
-            raise InputFileError(path, "is a folder; expected a .cmf measures file")
+            raise InputFileError(path, "is a folder; expected a .cmf measures file or a scenario (.toml)")
         if problem := file_problem(path):
-            raise InputFileError(path, f"measures file {problem}")
-        out.append(read_cmf(measures_file_of(path)))
+            raise InputFileError(path, f"{'scenario' if scenario else 'measures file'} {problem}")
+        out.append(read_cmf(measures_file_of(path) if scenario else path))
     return out
 
 
@@ -214,5 +226,6 @@ def measures_file_of(path: Path) -> Path:
 
     measures = load_scenario(path, check_files=False).measures_file
     if problem := file_problem(measures):
-        raise InputFileError(measures, f"measures file of {path.name} {problem}: run it first")
+        first = ": run it first" if problem == "not found" else ""
+        raise InputFileError(measures, f"measures file of {path.name} {problem}{first}")
     return measures
