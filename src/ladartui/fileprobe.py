@@ -38,6 +38,13 @@ def path_field(name, value, what: str) -> Path:
     return Path(value)
 
 
+def user_path(path) -> Path:
+    """``path`` with a leading ``~`` or ``~user`` made that home, as the shell makes it;
+    as it is where there is no such home (pathlib's ``expanduser`` raised RuntimeError
+    there, a traceback for a typing slip)."""
+    return Path(os.path.expanduser(os.fspath(path)))
+
+
 def file_problem(path: Path) -> str | None:
     """None when ``path`` is a regular file; else what is wrong ("not found", "is a folder", ...)."""
     try:

@@ -14,6 +14,7 @@ import json
 from pathlib import Path
 
 from ladartui.atomic import write_text_atomic
+from ladartui.fileprobe import user_path
 from ladartui.user_data import config_folder
 
 RECENT_LIMIT = 10
@@ -58,7 +59,7 @@ def remember_path(kind: str, path) -> list[Path]:
     A folder that cannot be written is not an error: the list is returned
     as it would have been.
     """
-    path = Path(path).expanduser().resolve()
+    path = user_path(path).resolve()
     data = _read()
     paths = [path] + [p for p in recent_paths(kind, existing_only=False) if p != path]
     paths = paths[:RECENT_LIMIT]

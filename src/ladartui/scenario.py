@@ -25,7 +25,7 @@ from ladartui.atomic import write_errors_named, write_text_atomic
 from ladartui.checks import choice_field, number_field
 from ladartui.detection.settings import DetectionSettings
 from ladartui.errors import FieldError, InputFileError, LadarError, OutputFileError
-from ladartui.fileprobe import NO_SUCH_FILE, OTHER_FILE_KINDS, file_problem, path_field, read_utf8
+from ladartui.fileprobe import NO_SUCH_FILE, OTHER_FILE_KINDS, file_problem, path_field, read_utf8, user_path
 from ladartui.flight import (
     FlightPlan,
     ScanPose,
@@ -555,7 +555,7 @@ def _compact_arrays(text: str) -> str:
 
 
 def _absolute(path) -> Path:
-    return Path(os.path.normpath(Path(path).expanduser().absolute()))
+    return Path(os.path.normpath(user_path(path).absolute()))
 
 
 __all__ = ["Scenario", "load_scenario", "scenario_from_toml", "target_file_for"]

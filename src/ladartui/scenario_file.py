@@ -110,6 +110,7 @@ from pathlib import Path
 from ladartui.checks import number_field
 from ladartui.detection.settings import DETECTION_KEYS, detection_from_table
 from ladartui.errors import FieldError, InputFileError
+from ladartui.fileprobe import user_path
 from ladartui.flight import MAX_SCANS, SEGMENT_KINDS, FlightPlan, Manual, ScanPose
 from ladartui.levels import LEVEL_KEYS, level_below, levels_from_table
 from ladartui.sensor import MAX_PIXEL_PITCH, MIN_PIXEL_PITCH, Sensor
@@ -437,7 +438,7 @@ def check_flight(plan: FlightPlan) -> None:
 
 
 def resolve_path(folder: Path, file) -> Path:
-    file = Path(file).expanduser()
+    file = user_path(file)
     return Path(os.path.normpath(file if file.is_absolute() else folder / file))
 
 

@@ -29,7 +29,7 @@ import platformdirs
 
 from ladartui.atomic import write_text_atomic
 from ladartui.defaults import target_centre, to_millimetres
-from ladartui.fileprobe import path_field
+from ladartui.fileprobe import path_field, user_path
 from ladartui.flight import Orbit
 from ladartui.scenario import Scenario, scenario_from_toml
 from ladartui.scenario import load_scenario as load_scenario_file
@@ -45,16 +45,16 @@ BUNDLED = {
 
 def config_folder() -> Path:
     if os.environ.get("LADARTUI_HOME"):
-        return Path(os.environ["LADARTUI_HOME"]).expanduser() / "config"
+        return user_path(os.environ["LADARTUI_HOME"]) / "config"
     return platformdirs.user_config_path("ladartui")
 
 
 def data_home() -> Path:
     """The user data folder of ladartui (default scenario, benchmark scenes)."""
     if os.environ.get("LADARTUI_HOME"):
-        return Path(os.environ["LADARTUI_HOME"]).expanduser()
+        return user_path(os.environ["LADARTUI_HOME"])
     base = os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share"
-    return Path(base).expanduser() / "ladartui"
+    return user_path(base) / "ladartui"
 
 
 def made_folder(folder: Path) -> Path:

@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import json
-from pathlib import Path
+
+from ladartui.fileprobe import user_path
 
 
 def add_parser(subparsers):
@@ -37,7 +38,7 @@ def run(args) -> int:
         check_file_names({"FILE": file}, "a measures file (.cmf) or a scenario (.toml)")
     if len(args.files) < 2:
         raise FieldError("FILE", args.files[0], "two or more files to compare")
-    paths = [Path(file).expanduser() for file in args.files]
+    paths = [user_path(file) for file in args.files]
     rows = side_by_side(read_measures_files(paths))  # a folder is refused before it is named
     names = column_names(paths)
     if args.json:

@@ -15,7 +15,7 @@ from pathlib import Path
 from urllib.parse import urlsplit
 
 from ladartui.errors import FieldError
-from ladartui.fileprobe import file_problem
+from ladartui.fileprobe import file_problem, user_path
 
 CA_FILE = "ca.pem"
 CERT_FILE = "cluster.pem"
@@ -195,7 +195,7 @@ def folder_security(address: str, folder=None, insecure: bool = False):
     address. For the terminal UI, where one folder is simpler than three files."""
     scheme = address.split("://", 1)[0] if "://" in address else "tcp"
     if folder:
-        folder = Path(folder).expanduser()
+        folder = user_path(folder)
         missing = [name for name in (CA_FILE, CERT_FILE, KEY_FILE) if not (folder / name).is_file()]
         if missing:
             raise FieldError(

@@ -18,6 +18,7 @@ from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, DirectoryTree, Input, RadioButton, RadioSet, Static
 
 from ladartui.errors import FieldError, LadarError
+from ladartui.fileprobe import user_path
 from ladartui.textsafe import visible
 from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField, in_label_unit, refusal
@@ -154,8 +155,8 @@ class SetupScreen(TreeDialog):
     def _paths(self):
         scenario = self.query_one("#scenario-file", Input).value.strip()
         scene = self.query_one("#scene-file", Input).value.strip()
-        scenario_path = self.base / Path(scenario).expanduser() if scenario else None
-        scene_path = self.base / Path(scene).expanduser() if scene else None
+        scenario_path = self.base / user_path(scenario) if scenario else None
+        scene_path = self.base / user_path(scene) if scene else None
         return scenario_path, scene_path
 
     def _show_derived(self) -> None:
@@ -270,7 +271,7 @@ class SaveAsScreen(TreeDialog):
         if not text:
             message.update(refusal("Scenario file", "", "a file name"))
             return
-        path = (self.base / Path(text).expanduser()).resolve()
+        path = (self.base / user_path(text)).resolve()
         if path.is_dir():  # before ".toml" is added: a folder's name is not a file's
             message.update(f"{path}: is a folder; expected a scenario file name")
             return
@@ -344,7 +345,7 @@ class PickPathScreen(TreeDialog):
     @on(Button.Pressed, "#pick-ok")
     def _ok(self) -> None:
         text = self.query_one("#pick-path", Input).value.strip()
-        path = (self.base / Path(text).expanduser()) if text else None
+        path = (self.base / user_path(text)) if text else None
         message = self.query_one("#pick-message", Static)
         if path is None or not path.exists():
             message.update(f"{text or 'Path'}: not found; pick a file in the tree or type its path")

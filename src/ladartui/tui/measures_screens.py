@@ -14,6 +14,7 @@ from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, DataTable, Input, Static
 
 from ladartui.errors import LadarError
+from ladartui.fileprobe import user_path
 from ladartui.measures import Measures
 from ladartui.measures_compare import column_names, read_measures_files, side_by_side, styled
 from ladartui.tui.file_tree import FileTree
@@ -143,7 +144,7 @@ class CompareScreen(TreeDialog):
             message.update("Give two or more .cmf files to compare.")
             return
         try:
-            loaded = read_measures_files([self.base / Path(t).expanduser() for t in text])
+            loaded = read_measures_files([self.base / user_path(t) for t in text])
         except LadarError as error:
             message.update(escape(str(error)))
             return

@@ -22,6 +22,7 @@ from textual.widget import Widget
 from textual.widgets import Button, DataTable, Input, Label, Select, Static
 
 from ladartui.errors import FieldError, LadarError
+from ladartui.fileprobe import user_path
 from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField, format_number, in_label_unit, parse_number, refusal
 from ladartui.tui.file_tree import FileTree
@@ -48,7 +49,7 @@ class PathSuggester(Suggester):
         if not word:
             return None
         folder_text, stem = os.path.split(word)  # "sub/" -> ("sub", ""); "." -> ("", ".")
-        folder = Path(folder_text or ".").expanduser()
+        folder = user_path(folder_text or ".")
         try:
             names = sorted(
                 p.name + ("/" if p.is_dir() else "")
@@ -133,7 +134,7 @@ class TreeDialog(Dialog):
         """``text`` (one path, or shell words) read in ``old``, as read in ``self.base``."""
 
         def moved(name: str) -> str:
-            path = Path(name).expanduser()
+            path = user_path(name)
             return name if path.is_absolute() or name.startswith("~") else self.relative(old / path)
 
         if not several:

@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ladartui.errors import FieldError, InputFileError, LadarError
+from ladartui.fileprobe import user_path
 from ladartui.tui.fields import refusal
 
 if TYPE_CHECKING:
@@ -136,7 +137,7 @@ def spec_to_run(text: str):
 
     if not text:
         raise FieldError("spec", text, "the path of a sweep spec (.toml)")
-    path = Path(text).expanduser()
+    path = user_path(text)
     if path.is_dir() or path.suffix.lower() == ".csv":
         sibling = sibling_spec(path)
         if sibling is None:
@@ -168,7 +169,7 @@ def open_sweep(text: str) -> OpenedSweep:
 
     if not text:
         raise FieldError("spec", text, "a sweep spec, a results.csv or a results folder")
-    path = Path(text).expanduser()
+    path = user_path(text)
     by_spec = path.suffix.lower() == ".toml"
     if by_spec:
         spec = load_sweep_spec(path)

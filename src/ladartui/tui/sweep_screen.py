@@ -26,6 +26,7 @@ from textual.widgets import Button, Checkbox, DataTable, Footer, Input, Label, P
 from textual_plotext import PlotextPlot
 
 from ladartui.errors import FieldError, LadarError
+from ladartui.fileprobe import user_path
 from ladartui.recent import recent_paths, remember_path
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.tui.fields import refusal
@@ -63,7 +64,7 @@ class ExistingPath(Validator):
     """An Input validator: the path must exist (a spec, a results.csv or a results folder)."""
 
     def validate(self, value: str) -> ValidationResult:
-        if not value.strip() or Path(value.strip()).expanduser().exists():
+        if not value.strip() or user_path(value.strip()).exists():
             return self.success()
         return self.failure(f"{value.strip()}: no such file or folder")
 
@@ -397,7 +398,7 @@ class SweepScreen(SweepOpening):
             return
         from ladartui.tui.file_dialogs import PickPathScreen
 
-        typed = Path(self._path_text()).expanduser() if self._path_text() else None
+        typed = user_path(self._path_text()) if self._path_text() else None
         start = (
             typed if typed is not None and typed.is_dir() else (typed.parent if typed is not None else None)
         )
