@@ -22,8 +22,8 @@ def add_parser(subparsers):
     parser.add_argument(
         "--json",
         action="store_true",
-        help="print JSON instead: the columns, and per measure its values, their text and the "
-        "best and worst columns",
+        help="print JSON instead: the columns and files, and per measure its values, their "
+        "text, whether they differ and the best and worst columns",
     )
     parser.set_defaults(handler=run)
     return parser

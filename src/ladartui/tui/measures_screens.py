@@ -65,7 +65,8 @@ class MeasuresScreen(Dialog):
 
 
 class CompareScreen(TreeDialog):
-    """Two or more scenarios' measures (.cmf files) side by side, differences highlighted."""
+    """Two or more runs' measures side by side, differences highlighted: .cmf files, or
+    scenarios (.toml, typed) for the measures their last runs wrote."""
 
     def __init__(self, paths: list[Path], folder: Path | None = None):
         super().__init__()
@@ -93,9 +94,9 @@ class CompareScreen(TreeDialog):
             )
             yield from self.tree_rows((".cmf",))
             yield Static(
-                "Paths separated by spaces (quote one that has spaces), or pick files "
-                "in the tree (again to drop one); Enter compares. Green best, red "
-                "worst, yellow differs.",
+                "Paths separated by spaces (quote one that has spaces; a scenario's "
+                ".toml stands for its last run's), or pick files in the tree (again "
+                "to drop one); Enter compares. Green best, red worst, yellow differs.",
                 classes="info",
             )
             yield Static("", id="compare-message", classes="message")
