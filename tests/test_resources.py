@@ -95,7 +95,7 @@ def test_a_run_over_the_ray_limit_is_a_next_run_line_after_the_summary(tmp_path,
     ) in out
     assert out.splitlines()[-1] == (
         f"next run   {path}: sensor.grid = 1024, sensor.ray_grid = 16, 10,000 scans x 2 runs "
-        "(scene and target alone): about 5.37e+12 "
+        "(the scene run and the target-alone run): about 5.37e+12 "
         "rays to trace, more than the limit of 2e+09 (raise it with LADARTUI_MAX_RAYS or run's "
         "--max-rays if this is meant); the run is refused before it traces"
     )
@@ -208,7 +208,7 @@ def test_a_scenario_over_the_ray_limit_opens_and_only_work_on_it_is_refused(tmp_
     with pytest.raises(RayLimitError) as refused:
         simulate(scenario)
     assert str(refused.value).startswith(
-        f"{path}: sensor.grid = 8, sensor.ray_grid = 2, 4 scans x 2 runs (scene and target alone): "
+        f"{path}: sensor.grid = 8, sensor.ray_grid = 2, 4 scans x 2 runs (the scene run and the target-alone run): "
         "about 2.05e+03 rays to trace"
     )
     assert sorted(p.name for p in tmp_path.iterdir()) == ["base.toml", "tiny.txt", "tiny_Target.txt"]

@@ -441,7 +441,7 @@ def test_a_new_scenario_on_a_scene_without_a_target_names_its_empty_target_model
         Scenario.new(tmp_path / "new.toml", "woods.txt", 0.5)
     assert str(caught.value) == (
         f"{tmp_path / 'woods_Target.txt'}: target model holds no voxels; expected a target "
-        "to circle (a new scenario's default orbit circles the target of X_Target.txt)"
+        "to circle (a new scenario's default orbit circles the target this file holds)"
     )
 
 

@@ -280,7 +280,7 @@ class Scenario:
                 raise InputFileError(
                     target_file,
                     "target model not found (a new scenario's "
-                    "default orbit circles the target of X_Target.txt)",
+                    "default orbit circles the target this file holds)",
                 )
             from ladartui.scene.target_model import load_target
 
@@ -289,7 +289,7 @@ class Scenario:
                 raise InputFileError(
                     target_file,
                     "target model holds no voxels; expected a target to circle (a new "
-                    "scenario's default orbit circles the target of X_Target.txt)",
+                    "scenario's default orbit circles the target this file holds)",
                 )
             flight = defaults.default_flight(target, voxel_size)
         return cls(path, scene_file, voxel_size, sensor, flight, **options)
@@ -582,6 +582,6 @@ def check_work(scenario, raise_with=None):
     check_rays(
         scenario.traced_rays(),
         f"{scenario.path}: sensor.grid = {sensor.grid}, sensor.ray_grid = "
-        f"{sensor.ray_grid}, {plural(scans, 'scan')} x 2 runs (scene and target alone)",
+        f"{sensor.ray_grid}, {plural(scans, 'scan')} x 2 runs (the scene run and the target-alone run)",
         raise_with=raise_with or RAISE_RAYS,
     )

@@ -19,8 +19,9 @@ from textual import events
 from textual.widgets import DataTable
 
 SEGMENT_COLUMNS = ("#", "Kind", "Scans", "Detail")  # the Flight tab's
-# kept beside their numbers ("off": a fly-past's standoff, "80 m off")
-UNITS = frozenset({"m", "deg", "Hz", "times", "pose", "poses", "off"})
+# words kept on the line of the number before them: units, and "off" (a fly-past's
+# standoff, "80 m off")
+KEPT_WITH_NUMBER = frozenset({"m", "deg", "Hz", "times", "pose", "poses", "off"})
 BREAK_AFTER = ("-_/", ".")  # where a long file name breaks, the first kind preferred
 PUNCTUATION = ",;:."  # never a line's start on its own
 
@@ -62,7 +63,7 @@ def wrap_detail(text: str, room: int) -> list[str]:
     number it goes with; a word wider than the room is broken where it must."""
     words: list[str] = []
     for word in text.split(" "):
-        if words and word.rstrip(PUNCTUATION) in UNITS:
+        if words and word.rstrip(PUNCTUATION) in KEPT_WITH_NUMBER:
             words[-1] += " " + word
         elif word:
             words.append(word)
