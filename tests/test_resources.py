@@ -208,7 +208,8 @@ def test_a_scenario_over_the_ray_limit_opens_and_only_work_on_it_is_refused(tmp_
     with pytest.raises(RayLimitError) as refused:
         simulate(scenario)
     assert str(refused.value).startswith(
-        f"{path}: sensor.grid = 8, sensor.ray_grid = 2, 4 scans x 2 runs (the scene run and the target-alone run): "
+        f"{path}: sensor.grid = 8, sensor.ray_grid = 2, 4 scans x 2 runs "
+        "(the scene run and the target-alone run): "
         "about 2.05e+03 rays to trace"
     )
     assert sorted(p.name for p in tmp_path.iterdir()) == ["base.toml", "tiny.txt", "tiny_Target.txt"]

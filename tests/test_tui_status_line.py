@@ -162,7 +162,8 @@ async def test_a_scenario_over_the_ray_limit_opens_not_ready_and_runs_once_cut_d
         assert bar.state == NOT_READY
         # both runs' rays: '6 scans: about 768' read as a miscount of the 6 x 64 the bar shows
         assert bar.message.endswith(
-            "6 scans x 2 runs (the scene run and the target-alone run): about 768 rays to trace, more than the limit of 700 "
+            "6 scans x 2 runs (the scene run and the target-alone run): about 768 rays to trace, "
+            "more than the limit of 700 "
             "(raise it with "
             "LADARTUI_MAX_RAYS, set before ladartui starts, if this is meant)"
         )
