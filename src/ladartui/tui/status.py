@@ -94,9 +94,11 @@ class StatusBar(Horizontal):
         progress: float | None = None,
         cancellable: bool = False,
         name: str | None = None,
+        said: bool = False,
     ) -> None:
         """Show ``state`` with ``message``; ``progress`` 0..1 adds a percentage; ``name``
-        (the scenario's, in the message) is what gets shortened when the line is short."""
+        (the scenario's, in the message) is what gets shortened when the line is short;
+        ``said``: the message was just said whole elsewhere, so a cut is not told again."""
         for label in LABELS:
             self.set_class(label == state, f"-{label}")
         self.state, self.message, self.progress = state, message, progress
@@ -106,6 +108,8 @@ class StatusBar(Horizontal):
         self.query_one("#status-word", Static).update(word)
         self.query_one("#cancel", Button).disabled = not cancellable
         self.query_one(StatusText).show(message, name)
+        if said:
+            self.told = message
         if state not in self.tell_states:
             self.told = ""
         elif self.tell is not None and message != self.told:

@@ -173,9 +173,7 @@ class StudyScreen(Screen):
             self._finish(None, "study cancelled")
         elif message.error:
             self.notify(f"Study failed: {message.error}", severity="error", markup=False, timeout=15)
-            said = f"error: {message.error}"
-            self.query_one("#study-status", StatusBar).told = visible(said)  # (said whole just now)
-            self._finish(None, said)
+            self._finish(None, f"error: {message.error}", said=True)
         else:
             result, text = message.result
             self._finish(result, text)
@@ -186,8 +184,8 @@ class StudyScreen(Screen):
         self.query_one("#study-progress", ProgressBar).update(total=max(p.total, 1), progress=p.done)
         self._set_status(f"{p.label}, scan {p.scan}/{p.scans}", BUSY, p.done / max(p.total, 1))
 
-    def _finish(self, result, message: str) -> None:
-        self._set_busy(False, message)
+    def _finish(self, result, message: str, said: bool = False) -> None:
+        self._set_busy(False, message, said=said)
         if result is not None:
             self.show_result(result)
         else:  # cancelled or failed: the bar goes back to idle, not left part-way
@@ -218,19 +216,24 @@ class StudyScreen(Screen):
         self.set_class(event.size.width < NARROW, "-narrow")
         self.call_after_refresh(self._draw_chart)
 
-    def _set_busy(self, busy: bool, message: str, progress: float | None = None) -> None:
+    def _set_busy(self, busy: bool, message: str, progress: float | None = None, said: bool = False) -> None:
         self.query_one("#study-cancel", Button).disabled = not busy
         self.query_one("#study-quick", Button).disabled = busy
         self.query_one("#study-full", Button).disabled = busy
-        self._set_status(message, BUSY if busy else READY, progress)
+        self._set_status(message, BUSY if busy else READY, progress, said)
 
     def _tell_cut(self, message: str) -> None:
         self.notify(message, markup=False, timeout=8)
 
-    def _set_status(self, message: str, state: str = READY, progress: float | None = None) -> None:
+    def _set_status(
+        self, message: str, state: str = READY, progress: float | None = None, said: bool = False
+    ) -> None:
+        """``said``: the message was just said whole in a note of its own."""
         # it may name files: shown as text, the scenario's path shortened first
         path = visible(str(self.scenario_path)) if self.scenario_path else None
-        self.query_one("#study-status", StatusBar).show(state, visible(message), progress, name=path)
+        self.query_one("#study-status", StatusBar).show(
+            state, visible(message), progress, name=path, said=said
+        )
 
 
 def _study(mode: str, scenario_path, scans, runs, cancel, progress):
