@@ -14,8 +14,7 @@ from ladartui.tui.file_dialogs import SaveAsScreen
 from ladartui.tui.measures_screens import CompareScreen, MeasuresScreen
 from ladartui.tui.poses_screen import PosesScreen
 from ladartui.tui.screens import FormScreen
-from test_tui_flow import LadarApp, loaded, make_scenario, type_into, wait_until
-from tui_support import screen_after
+from tui_support import LadarApp, loaded, make_scenario, screen_after, type_into, wait_until
 
 SIZE = (100, 32)
 
@@ -246,7 +245,7 @@ async def test_the_help_fits_the_terminal_without_sideways_scrolling(tmp_path, s
 
 async def test_outputs_from_other_settings_are_said_to_be_out_of_date(tmp_path, scene_files):
     from ladartui.tui.status import NOT_READY, READY, StatusBar
-    from test_tui_flow import field
+    from tui_support import field
 
     scenario = make_scenario(tmp_path, scene_files)
     async with opened(scenario) as (app, pilot):
@@ -282,7 +281,7 @@ async def test_outputs_a_run_made_from_unsaved_settings_are_out_of_date_on_openi
     from ladartui.sensor import Sensor
     from ladartui.simulation import simulate
     from ladartui.tui.status import NOT_READY, READY, StatusBar
-    from test_tui_flow import field
+    from tui_support import field
 
     scenario = make_scenario(tmp_path, scene_files)  # saved with an 8 x 8 grid
     simulate(scenario.with_changes(sensor=Sensor(grid=12, ray_grid=1, fov=8.0)))  # never saved
@@ -410,7 +409,7 @@ async def test_reopening_the_file_being_edited_offers_no_save_that_would_be_lost
     # the sweep's F8 writes the best path over best.toml, then opens it: saving the
     # edits of best.toml there would replace the best path it had just written
     from ladartui.tui.unsaved import UnsavedScreen
-    from test_tui_flow import field
+    from tui_support import field
 
     scenario = make_scenario(tmp_path, scene_files)
     async with opened(scenario) as (app, pilot):
@@ -430,7 +429,7 @@ async def test_reopening_the_file_being_edited_offers_no_save_that_would_be_lost
 
 
 async def test_a_committed_value_is_shown_and_named_as_a_number(tmp_path, scene_files):
-    from test_tui_flow import field
+    from tui_support import field
 
     scenario = make_scenario(tmp_path, scene_files)
     async with opened(scenario) as (app, pilot):

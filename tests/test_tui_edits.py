@@ -15,15 +15,7 @@ import shutil
 
 from ladartui.scenario import load_scenario, target_file_for
 from ladartui.tui.status import StatusBar
-from test_tui_flow import (
-    LadarApp,
-    field,
-    loaded,
-    make_scenario,
-    type_into,
-    wait_until,
-)
-from tui_support import screen_after
+from tui_support import LadarApp, field, loaded, make_scenario, screen_after, type_into, wait_until
 
 SIZE = (100, 32)
 

@@ -9,8 +9,7 @@ import pytest
 from ladartui.tui.measures_screens import CompareScreen
 from ladartui.tui.screens import FormScreen
 from test_tui_dialogs import message, opened
-from test_tui_flow import make_scenario, type_into, wait_until
-from tui_support import screen_after
+from tui_support import make_scenario, screen_after, type_into, wait_until
 
 
 async def test_compare_reads_names_typed_in_the_folder_it_shows(tmp_path, scene_files, monkeypatch):
@@ -309,7 +308,7 @@ async def test_a_value_just_under_a_limit_is_not_shown_rounded_onto_it(tmp_path,
     shown then failed. Six digits stay where they show an allowed value."""
     import dataclasses
 
-    from test_tui_flow import field
+    from tui_support import field
 
     scenario = make_scenario(tmp_path, scene_files)
     sensor = dataclasses.replace(scenario.sensor, fov=89.99999)

@@ -20,15 +20,7 @@ from ladartui.tui.poses_screen import PosesScreen
 from ladartui.tui.screens import FormScreen
 from ladartui.tui.status import StatusBar
 from ladartui.tui.unsaved import UnsavedScreen
-from test_tui_flow import (
-    LadarApp,
-    field,
-    loaded,
-    make_scenario,
-    type_into,
-    wait_until,
-)
-from tui_support import screen_after
+from tui_support import LadarApp, field, loaded, make_scenario, screen_after, type_into, wait_until
 
 SIZE = (100, 32)
 

@@ -7,7 +7,7 @@ import pytest
 from textual.widgets import TabbedContent
 
 from test_tui_dialogs import opened
-from test_tui_flow import make_scenario
+from tui_support import make_scenario
 
 
 @pytest.mark.parametrize("focus", ["#btn-new", "#btn-save-as"])

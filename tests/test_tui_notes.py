@@ -7,8 +7,7 @@ from textual.widgets._toast import Toast
 from ladartui.tui.measures_screens import MeasuresScreen
 from ladartui.tui.screens import FormScreen
 from test_tui_dialogs import opened
-from test_tui_flow import field, make_scenario, type_into, wait_until
-from tui_support import screen_after
+from tui_support import field, make_scenario, screen_after, type_into, wait_until
 
 
 def opened_with_notes(scenario):

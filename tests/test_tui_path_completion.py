@@ -5,8 +5,7 @@ from __future__ import annotations
 
 from ladartui.tui.screens import PathSuggester
 from test_tui_dialogs import opened
-from test_tui_flow import make_scenario, wait_until
-from tui_support import screen_after
+from tui_support import make_scenario, screen_after, wait_until
 
 
 async def test_a_relative_name_is_completed_in_the_base_folder(tmp_path, monkeypatch):

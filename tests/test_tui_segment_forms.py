@@ -5,8 +5,7 @@ from __future__ import annotations
 
 from ladartui.tui.screens import FormScreen
 from test_tui_dialogs import message, opened
-from test_tui_flow import make_scenario, type_into
-from tui_support import screen_after
+from tui_support import make_scenario, screen_after, type_into
 
 
 async def edited_first_segment(app, pilot) -> FormScreen:

@@ -6,7 +6,7 @@ from __future__ import annotations
 from textual.widgets._toast import Toast
 
 from ladartui.tui.actions import BY_ID
-from test_tui_flow import LadarApp, make_scenario, wait_until
+from tui_support import LadarApp, make_scenario, wait_until
 
 
 def write_config(home):

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from ladartui.tui.status import StatusBar
 from test_tui_edits import SIZE, capture_runs, copy_scene
-from test_tui_flow import LadarApp, loaded, make_scenario, wait_until
+from tui_support import LadarApp, loaded, make_scenario, wait_until
 
 
 async def test_quit_while_a_run_goes_on_asks_first(tmp_path, scene_files):
@@ -103,7 +103,7 @@ async def test_quit_during_a_run_saves_the_edits_when_asked(tmp_path, scene_file
     run was busy, so nothing was saved, the app stayed, and nothing said why."""
     from ladartui.scenario import load_scenario
     from ladartui.tui.unsaved import QuitRunScreen, UnsavedScreen
-    from test_tui_flow import field, type_into
+    from tui_support import field, type_into
 
     scenario = make_scenario(tmp_path, scene_files)
     app = LadarApp(scenario.path)
@@ -150,7 +150,7 @@ async def test_a_scenario_over_the_ray_limit_opens_not_ready_and_runs_once_cut_d
     """It was refused as it loaded ('Could not load ...: about 7.86e+05 rays to trace'),
     so it could not be opened to fly a smaller sensor or fewer scans."""
     from ladartui.tui.status import NOT_READY
-    from test_tui_flow import field, type_into
+    from tui_support import field, type_into
 
     scenario = make_scenario(tmp_path, scene_files, scans=6)  # 8 x 8 rays a scan, two runs: 768
     monkeypatch.setenv("LADARTUI_MAX_RAYS", "700")

@@ -7,7 +7,7 @@ from ladartui.colour import TARGET_PALETTE
 from ladartui.tui.canvas import PictureWidget
 from ladartui.tui.measures_screens import CompareScreen, MeasuresScreen
 from test_targets import two_box_scenario
-from test_tui_flow import LadarApp, loaded, wait_until
+from tui_support import LadarApp, loaded, wait_until
 
 SIZE = (120, 40)
 NAME = "[b]open[/b] box"  # markup characters in a name from a file: shown as written

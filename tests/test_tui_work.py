@@ -11,7 +11,7 @@ from textual.widgets import Static
 
 from ladartui.errors import Cancelled
 from ladartui.tui.work import JobDone, JobProgress, start_job
-from test_tui_flow import LadarApp, loaded, make_scenario, wait_until
+from tui_support import LadarApp, loaded, make_scenario, wait_until
 
 
 @asynccontextmanager
