@@ -12,8 +12,7 @@ from rich.cells import cell_len
 from ladartui.flight import FlightPlan
 from ladartui.trajectory import LogSegment
 from ladartui.tui.fitted_tables import wrap_detail
-from test_tui_dialogs import opened
-from tui_support import make_scenario, wait_until
+from tui_support import make_scenario, opened, wait_until
 
 
 def test_a_file_name_wider_than_the_room_breaks_after_a_hyphen_or_a_dot():

@@ -8,8 +8,8 @@ import pytest
 
 from ladartui.tui.measures_screens import CompareScreen
 from ladartui.tui.screens import FormScreen
-from test_tui_dialogs import message, opened
-from tui_support import make_scenario, screen_after, type_into, wait_until
+from test_tui_dialogs import message
+from tui_support import make_scenario, opened, screen_after, type_into, wait_until
 
 
 async def test_compare_reads_names_typed_in_the_folder_it_shows(tmp_path, scene_files, monkeypatch):

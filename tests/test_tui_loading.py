@@ -6,8 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ladartui.scene.voxels import save_voxels
-from test_tui_dialogs import opened
-from tui_support import make_scenario, wait_until
+from tui_support import make_scenario, opened, wait_until
 
 
 async def refusal_on_opening(tmp_path, scene_files, monkeypatch, voxels, limit) -> tuple[str, object]:

@@ -6,8 +6,7 @@ from __future__ import annotations
 import pytest
 from textual.widgets import TabbedContent
 
-from test_tui_dialogs import opened
-from tui_support import make_scenario
+from tui_support import make_scenario, opened
 
 
 @pytest.mark.parametrize("focus", ["#btn-new", "#btn-save-as"])

@@ -6,8 +6,7 @@ from textual.widgets._toast import Toast
 
 from ladartui.tui.measures_screens import MeasuresScreen
 from ladartui.tui.screens import FormScreen
-from test_tui_dialogs import opened
-from tui_support import field, make_scenario, screen_after, type_into, wait_until
+from tui_support import field, make_scenario, opened, screen_after, type_into, wait_until
 
 
 def opened_with_notes(scenario):

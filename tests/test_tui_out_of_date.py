@@ -6,8 +6,7 @@ from __future__ import annotations
 from ladartui.sensor import Sensor
 from ladartui.simulation import simulate
 from ladartui.tui.measures_screens import MeasuresScreen
-from test_tui_dialogs import opened
-from tui_support import make_scenario, wait_until
+from tui_support import make_scenario, opened, wait_until
 
 
 def stale_note(screen) -> str:

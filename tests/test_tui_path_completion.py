@@ -4,8 +4,7 @@ reads typed names in (its Folder line), not from the working folder."""
 from __future__ import annotations
 
 from ladartui.tui.screens import PathSuggester
-from test_tui_dialogs import opened
-from tui_support import make_scenario, screen_after, wait_until
+from tui_support import make_scenario, opened, screen_after, wait_until
 
 
 async def test_a_relative_name_is_completed_in_the_base_folder(tmp_path, monkeypatch):

@@ -6,8 +6,7 @@ from __future__ import annotations
 
 from ladartui.flight import FlightPlan, Manual, ScanPose
 from ladartui.tui.poses_screen import PosesScreen
-from test_tui_dialogs import opened
-from tui_support import make_scenario, type_into, wait_until
+from tui_support import make_scenario, opened, type_into, wait_until
 
 
 def title_of(screen) -> str:

@@ -7,9 +7,8 @@ from __future__ import annotations
 import os
 
 from ladartui.tui.status import NOT_READY, READY, StatusBar
-from test_tui_dialogs import opened
 from test_tui_edits import capture_runs
-from tui_support import make_scenario, wait_until
+from tui_support import make_scenario, opened, wait_until
 
 
 def bar(app) -> StatusBar:

@@ -4,8 +4,8 @@ order, and where the dialog stays while its message changes."""
 from __future__ import annotations
 
 from ladartui.tui.screens import FormScreen
-from test_tui_dialogs import message, opened
-from tui_support import make_scenario, screen_after, type_into
+from test_tui_dialogs import message
+from tui_support import make_scenario, opened, screen_after, type_into
 
 
 async def edited_first_segment(app, pilot) -> FormScreen:

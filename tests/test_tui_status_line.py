@@ -54,7 +54,7 @@ async def test_a_reason_the_status_line_cuts_is_told_whole_once(tmp_path, scene_
     """At 80 columns the bar read 'NOT READY  /tmp/…/forest.toml:5: files.scene =
     'forest.t…': why Run was off was cut away, and said nowhere until F5 was pressed."""
     from ladartui.tui.status import NOT_READY
-    from test_tui_dialogs import opened
+    from tui_support import opened
 
     scene = tmp_path / "forest.txt"
     copy_scene(scene_files[0], scene)
@@ -130,7 +130,7 @@ async def test_quit_during_a_run_saves_the_edits_when_asked(tmp_path, scene_file
 async def test_a_scenario_changed_on_disk_is_told_once_where_the_line_cuts_it(tmp_path, scene_files):
     """With a long file name at 80 columns the change was told twice: by the check that
     found it, then again by the status bar, which tells a reason it cuts."""
-    from test_tui_dialogs import opened
+    from tui_support import opened
 
     scenario = make_scenario(tmp_path, scene_files)
     longer = scenario.with_changes(path=tmp_path / ("a-rather-long-scenario-name-" * 2 + ".toml")).save()

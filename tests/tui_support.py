@@ -71,6 +71,15 @@ async def screen_after(pilot, start, kind, timeout: float = 10.0):
     return app.screen
 
 
+@asynccontextmanager
+async def opened(scenario, size=SIZE, notifications=False):
+    """The app on ``scenario``, loaded: (app, pilot); ``notifications``: its notes drawn."""
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=size, notifications=notifications) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        yield app, pilot
+
+
 def loaded(app):
     return app.scene is not None and app.busy is None
 
