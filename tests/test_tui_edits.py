@@ -4,13 +4,14 @@ Pilot tests on a tiny generated scene: a value typed but not confirmed with
 Enter is committed by Run and Save (or stops them when invalid), an invalid
 value goes back to the scenario's value, and names or lines read from files
 are shown literally. Also what is typed in dialogs is kept (poses, points,
-partial paths), the status line fits its name, the palette waits under a
-prompt (the user's keys.toml: test_tui_keys.py).
+partial paths), the palette waits under a prompt, unsaved edits are asked
+about (the user's keys.toml: test_tui_keys.py; outputs changed on disk:
+test_tui_outputs_on_disk.py; the status line fitting its name:
+test_tui_text_fit.py).
 """
 
 from __future__ import annotations
 
-import re
 import shutil
 
 from ladartui.scenario import load_scenario, target_file_for
@@ -236,28 +237,6 @@ def test_a_value_typed_in_other_units_is_saved_as_typed():
         assert format_number(metres, scale=1e-6) == f"{float(typed):g}"
 
 
-async def test_a_long_scenario_name_is_shortened_in_the_status_line_not_what_follows(tmp_path, scene_files):
-    """At 80 columns a long name pushed '(modified)' and the scan count off the bar."""
-    from rich.cells import cell_len
-
-    name = "night-approach-" + "x" * 50 + "-final"
-    scenario = make_scenario(tmp_path, scene_files, name=name)
-    app = LadarApp(scenario.path)
-    async with app.run_test(size=(80, 24)) as pilot:
-        await wait_until(pilot, lambda: loaded(app))
-        await type_into(pilot, field(app, "sensor.grid"), "12")
-        bar = app.query_one(StatusBar)
-        text = app.query_one("#status-text")
-        shown = str(text.render())
-        assert re.search(r"\(modified\): \d+ scans x [\d,]+ rays\. F5 runs\.$", shown)
-        assert shown.startswith("nigh") and "\u2026" in shown and "nal.toml (modified)" in shown
-        assert cell_len(shown) <= text.content_size.width
-        assert bar.message.startswith(f"{name}.toml (modified)")  # the message itself whole
-        await pilot.resize_terminal(160, 30)
-        await pilot.pause()
-        assert str(text.render()) == bar.message  # room for all of it: nothing shortened
-
-
 async def test_the_palette_over_a_prompt_offers_none_of_the_apps_commands(tmp_path, scene_files):
     """With the Save/Discard prompt open, the palette still offered Run, Open, New..."""
     from ladartui.tui.app import palette_entries
@@ -327,31 +306,6 @@ def test_a_point_or_list_with_an_empty_part_is_refused_not_shortened():
     assert _parse_points("centre", "1, 2, 3,", "point") == (1.0, 2.0, 3.0)  # a trailing comma
     assert _parse_points("centre", "1; 2", "point") == (1.0, 2.0, 0.0)
     assert _parse_points("standoffs", "50, 100", "points") == (50.0, 100.0)
-
-
-def test_fitted_shortens_the_name_given_then_cuts_the_end_in_cells():
-    """The longest word was cut, which need not be the name ('(mo…ified):'), and wide
-    characters were counted as one cell each, so the line still overflowed."""
-    from rich.cells import cell_len
-
-    from ladartui.tui.status import fitted
-
-    spaced = "My Night Approach Over The Long Valley Final Plan.toml"
-    message = f"{spaced} (modified): 6 scans x 144 rays. F5 runs."
-    shown = fitted(message, 60, spaced)
-    assert shown.endswith(" (modified): 6 scans x 144 rays. F5 runs.") and cell_len(shown) <= 60
-    assert shown.startswith("My N") and "\u2026" in shown and "Plan.toml" in shown
-    wide = "\u591c\u9593\u9032\u5165" * 6 + ".toml"  # 48 cells of CJK
-    shown = fitted(f"{wide} (modified): 6 scans x 144 rays. F5 runs.", 60, wide)
-    assert cell_len(shown) <= 60 and shown.endswith("(modified): 6 scans x 144 rays. F5 runs.")
-    # no name given (or the name alone not enough): the end is cut, marked
-    shown = fitted("sweep stopped: " + "x" * 100, 40)
-    assert cell_len(shown) == 40 and shown.endswith("\u2026")
-    # no name given, a path in the message: the path gives way, 'F5 resumes' stays
-    said = "sweep cancelled: 12 rows kept in ~/projects/night-approach/final-sweep-results; F5 resumes"
-    shown = fitted(said, 60)
-    assert cell_len(shown) <= 60 and shown.endswith("results; F5 resumes") and "\u2026" in shown
-    assert fitted("short", 40, "short") == "short"
 
 
 def test_the_app_ending_on_an_error_exits_non_zero(monkeypatch, tmp_path, scene_files, capsys):
@@ -450,150 +404,3 @@ async def test_switching_the_setup_dialogs_mode_clears_the_other_modes_error(tmp
         dialog.query_one("#mode-new").value = True
         await pilot.pause()
         assert dialog.mode == "new" and str(message.render()) == ""
-
-
-async def test_the_sensor_summary_keeps_each_figure_with_its_unit_at_80_columns(tmp_path, scene_files):
-    """'IFOV 125' ended one line and 'mdeg' began the next."""
-    scenario = make_scenario(tmp_path, scene_files)
-    app = LadarApp(scenario.path)
-    async with app.run_test(size=(80, 24)) as pilot:
-        await wait_until(pilot, lambda: loaded(app))
-        app.action_show_tab("sensor")
-        await pilot.pause()
-        info = app.query_one("#sensor-info")
-        shown = [
-            "".join(segment.text for segment in strip).rstrip()
-            for strip in info.render_lines(info.content_region.reset_offset)
-        ]
-        assert any(re.fullmatch(r"IFOV [\d.e+-]+ m?deg", line) for line in shown), shown
-
-
-async def test_outputs_another_run_writes_on_disk_are_shown_not_the_old_ones(tmp_path, scene_files):
-    """A second instance (or the CLI) ran the same file: this one kept showing its own
-    measures as current, and Export LAS wrote the other run's files under them."""
-    from ladartui.sensor import Sensor
-    from ladartui.simulation import simulate
-    from ladartui.tui.status import NOT_READY, StatusBar
-
-    scenario = make_scenario(tmp_path, scene_files)
-    simulate(scenario)
-    app = LadarApp(scenario.path)
-    async with app.run_test(size=SIZE) as pilot:
-        await wait_until(pilot, lambda: loaded(app) and app.measures is not None)
-        app.check_outputs_on_disk()  # nothing changed: nothing happens
-        assert not app.outputs_stale() and not any("changed on disk" in m for m in app.messages)
-        simulate(scenario.with_changes(sensor=Sensor(grid=12, ray_grid=1, fov=8.0)))  # elsewhere
-        app.check_outputs_on_disk()
-        await wait_until(pilot, lambda: app.outputs_from is not None and app.outputs_from.sensor.grid == 12)
-        assert app.query_one(StatusBar).state == NOT_READY  # out of date for this file's settings
-        assert any("changed on disk" in m for m in app.messages)
-        scenario.measures_file.unlink()  # gone: said, and named in the status bar
-        app.check_outputs_on_disk()
-        await pilot.pause()
-        assert any("gone from disk" in m for m in app.messages)
-        assert "outputs missing" in app.query_one(StatusBar).message
-
-
-async def test_save_as_is_not_taken_for_another_run(tmp_path, scene_files):
-    """After Save As the outputs compared were the old name's: a note said another run
-    had changed them."""
-    from ladartui.simulation import simulate
-
-    scenario = make_scenario(tmp_path, scene_files)
-    simulate(scenario)
-    app = LadarApp(scenario.path)
-    async with app.run_test(size=SIZE) as pilot:
-        await wait_until(pilot, lambda: loaded(app) and app.measures is not None)
-        assert app._save_to(tmp_path / "copy.toml")
-        app.check_outputs_on_disk()
-        await pilot.pause()
-        assert not any("changed on disk" in m or "gone from disk" in m for m in app.messages)
-
-
-def count_output_stats(monkeypatch, scenario) -> dict:
-    """How often each output file's status is asked (``stat``, which ``is_file`` uses)."""
-    from pathlib import Path
-
-    outputs = (scenario.scene_output, scenario.target_output, scenario.measures_file)
-    stats = dict.fromkeys(outputs, 0)
-    real_stat = Path.stat
-
-    def stat(self, *args, **options):
-        if self in stats:
-            stats[self] += 1
-        return real_stat(self, *args, **options)
-
-    monkeypatch.setattr(Path, "stat", stat)
-    return stats
-
-
-async def test_earlier_outputs_are_read_off_the_ui_thread_target_output_too(
-    tmp_path, scene_files, monkeypatch
-):
-    """The target output of an earlier run (what marks the target voxels the foliage
-    hid) was read by the view on the UI thread, and its file looked at on every redraw."""
-    import threading
-    from pathlib import Path
-
-    import numpy as np
-
-    from ladartui.scene import voxels as voxel_files
-    from ladartui.simulation import simulate
-
-    scenario = make_scenario(tmp_path, scene_files)
-    simulate(scenario)
-    real_load, reads = voxel_files.load_voxels, []
-
-    def load_voxels(path, *args, **options):
-        reads.append((Path(path).name, threading.current_thread() is threading.main_thread()))
-        return real_load(path, *args, **options)
-
-    monkeypatch.setattr(voxel_files, "load_voxels", load_voxels)
-    app = LadarApp(scenario.path)
-    async with app.run_test(size=SIZE) as pilot:
-        await wait_until(pilot, lambda: loaded(app) and app.measures is not None)
-        app.show_output()
-        app.show_output()
-        await pilot.pause()
-        target_output = app.view_area._known_target_output(app.output_voxels)
-        assert np.array_equal(target_output, real_load(scenario.target_output))
-    assert (scenario.target_output.name, False) in reads
-    assert not [name for name, on_ui_thread in reads if on_ui_thread and "Target" in name], reads
-
-
-async def test_earlier_outputs_are_shown_from_one_stat_of_each_file(tmp_path, scene_files, monkeypatch):
-    """Opening a file with outputs asked each output's status twice or three times (to
-    read them, to name a partial set, to note those shown), and an on-disk change up
-    to six times. Now: one look at the set, and the reader's own check that the file
-    is no pipe before it opens it (the target output is read too, for the view)."""
-    from ladartui.sensor import Sensor
-    from ladartui.simulation import simulate
-
-    scenario = make_scenario(tmp_path, scene_files)
-    simulate(scenario)
-    # (the app's own look every 2 s would add a stat whenever a tick fell in the waits)
-    monkeypatch.setattr("ladartui.tui.app.OUTPUTS_CHECK_SECONDS", 3600.0)
-    stats = count_output_stats(monkeypatch, scenario)
-    app = LadarApp(scenario.path)
-    async with app.run_test(size=SIZE) as pilot:
-        await wait_until(pilot, lambda: loaded(app) and app.measures is not None)
-        assert list(stats.values()) == [2, 2, 2]
-        simulate(scenario.with_changes(sensor=Sensor(grid=12, ray_grid=1, fov=8.0)))  # elsewhere
-        stats.update(dict.fromkeys(stats, 0))
-        app.check_outputs_on_disk()
-        await wait_until(pilot, lambda: app.outputs_from is not None and app.outputs_from.sensor.grid == 12)
-        assert list(stats.values()) == [2, 2, 2]
-        status = scenario.measures_file.stat()
-        assert app.outputs_seen == (status.st_mtime_ns, status.st_size)  # those shown, as on disk
-
-
-def test_the_ifov_is_said_in_degrees_from_one_degree_up():
-    """A 90 degree view on 64 detectors read 'IFOV 1.41e+03 mdeg'."""
-    from ladartui.tui.panels.sensor import ifov_text
-
-    assert [ifov_text(fov / 64) for fov in (8.0, 63.0, 64.0, 90.0)] == [
-        "125 mdeg",
-        "984 mdeg",
-        "1 deg",
-        "1.41 deg",
-    ]
