@@ -1,6 +1,6 @@
 """The flight tab's tables in the sidebar: the scans table fitting at 120 columns and
 showing whole columns only, naming those left out; the segments table wrapping a long
-detail whole, each unit kept beside its number.
+detail whole, each unit kept beside its number; both drawn to their new cells at once.
 
 Each test drives a real app on a tiny generated scene with Pilot.
 """
@@ -9,7 +9,8 @@ from __future__ import annotations
 
 from rich.cells import cell_len
 
-from tui_support import make_scenario, opened, wait_until
+from ladartui.flight import FlightPlan
+from tui_support import LadarApp, loaded, make_scenario, opened, wait_until
 
 
 async def test_the_scans_table_fits_the_sidebar_at_120_columns(tmp_path, scene_files):
@@ -95,3 +96,30 @@ async def test_the_scans_table_shows_whole_columns_only_and_names_those_left_out
         await pilot.pause()
         assert len(app.query_one("#scans").columns) == 7
         assert str(app.query_one("#scans-heading").render()) == "Scans"
+
+
+async def test_the_flight_tables_are_drawn_to_their_new_cells_at_once(tmp_path, scene_files):
+    """After a segment was deleted the scans table showed x -12 as "-" and y 82 as "8"
+    until the next change: its columns took their widths from the cells only when
+    Textual next measured them, and a frame drawn before that cut every value."""
+    from rich.cells import cell_len
+
+    from ladartui.flight import Turn
+
+    scenario = make_scenario(tmp_path, scene_files)
+    turn = Turn(radius=100.0, arc=90.0, direction="right", scans=4)
+    scenario = scenario.with_changes(flight=FlightPlan(None, (*scenario.flight.segments, turn))).save()
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=(120, 40)) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        app.action_show_tab("flight")
+        await pilot.pause()
+        app.query_one("#segments").move_cursor(row=0)
+        app.flight_panel.delete_selected()
+        # no pause: the frame drawn next must already have the widths
+        for table in (app.query_one("#scans"), app.query_one("#segments")):
+            columns = list(table.columns.values())
+            rows = [[str(cell) for cell in table.get_row_at(i)] for i in range(table.row_count)]
+            for index, column in enumerate(columns[: len(columns) if table.id == "scans" else 3]):
+                widest = max(cell_len(str(column.label)), *(cell_len(row[index]) for row in rows))
+                assert column.get_render_width(table) == widest + 2 * table.cell_padding, (table.id, index)
