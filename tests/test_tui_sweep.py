@@ -1,4 +1,7 @@
-"""The sweep screen driven by a Pilot: open results, reject bad specs, run and cancel a sweep.
+"""The sweep screen driven by a Pilot: a finished sweep's results opened, ranked by each
+objective with its failures and Pareto front, the best path handed to the app; a budget
+typed; results picked in a tree, the last sweep reopened, a narrowed spec's own rows;
+opening off the UI thread (running a sweep: test_tui_sweep_run.py).
 
 Every sweep here runs serially in this process on a hand-made 24 x 24 scene
 with an 8 x 8 detector sensor, so each variant takes milliseconds.
@@ -6,105 +9,24 @@ with an 8 x 8 detector sensor, so each variant takes milliseconds.
 
 from __future__ import annotations
 
-import math
-import subprocess
-import sys
-import time
-
-import numpy as np
 import pytest
-from textual.app import App
 from textual.widgets import DataTable
 
 from ladartui.scenario import load_scenario
-from ladartui.sweep import read_table, run_sweep
-from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar, format_eta
+from ladartui.sweep import read_table
+from ladartui.tui.status import BUSY, NOT_READY, READY
 from ladartui.tui.sweep_screen import SweepScreen
-from ladartui.tui.sweep_view import eta_seconds
-
-SIZE = (80, 24)
-CENTRE = (11.5, 11.5, 0.5)
-
-
-class _Host(App):
-    """A bare app that shows one SweepScreen and records the scenarios it asks to open."""
-
-    def __init__(self, screen: SweepScreen):
-        super().__init__()
-        self.sweep_screen = screen
-        self.opened = []
-
-    def on_mount(self) -> None:
-        self.push_screen(self.sweep_screen)
-
-    def on_sweep_screen_open_scenario(self, message: SweepScreen.OpenScenario) -> None:
-        self.opened.append(message.path)
-
-
-def write_base(folder):
-    """A 24 x 24 canopy with gaps over a 4 x 2 x 2 vehicle; a 2-scan orbit, 8 x 8 detectors."""
-    from ladartui.flight import FlightPlan, Orbit
-    from ladartui.scenario import Scenario
-    from ladartui.scene.voxels import save_voxels
-    from ladartui.sensor import Sensor
-
-    target = np.array([(i, j, k) for i in range(10, 14) for j in range(11, 13) for k in range(2)], np.int32)
-    canopy = np.array([(i, j, 5) for i in range(24) for j in range(24) if (i * 5 + j * 3) % 4 == 0], np.int32)
-    save_voxels(folder / "tiny.txt", np.concatenate([target, canopy]))
-    save_voxels(folder / "tiny_Target.txt", target)
-    flight = FlightPlan(segments=(Orbit(centre=CENTRE, radius=15.0, altitude=15.0, scans=2),))
-    Scenario(
-        folder / "base.toml", "tiny.txt", 1.0, Sensor(grid=8, ray_grid=1, fov=25.0), flight, backend="numba"
-    ).save()
-
-
-def write_spec(folder, body, name="spec.toml"):
-    path = folder / name
-    path.write_text(f'[sweep]\nscenario = "base.toml"\nname = "tiny"\n{body}', encoding="utf-8")
-    return path
-
-
-SMALL_GRID = """
-[grid]
-radius = [8.0, 15.0, 30.0]
-scans = [1, 3]
-sensor_grid = [8, 0]
-"""
+from sweep_screen_support import SIZE, SweepHost, finished_sweep, opened, status_of, wait_for, write_spec
 
 
 @pytest.fixture(scope="module")
 def finished(tmp_path_factory):
     """A sweep run to the end by the core (serially): its spec and results folder."""
-    folder = tmp_path_factory.mktemp("sweep")
-    write_base(folder)
-    spec = write_spec(folder, SMALL_GRID)
-    result = run_sweep(spec, serial=True)
-    return spec, result.results_path.parent
-
-
-# Generous: a numba kernel recompiled after an edit elsewhere can take minutes on a busy machine.
-async def wait_for(pilot, condition, timeout=300.0):
-    start = time.monotonic()
-    while not condition():
-        if time.monotonic() - start > timeout:
-            screen = pilot.app.sweep_screen
-            raise AssertionError(f"timed out; status: {screen.last_message!r}")
-        await pilot.pause(0.05)
-
-
-async def opened(pilot, screen=None):
-    """Wait until the screen's open (read in a worker) is shown."""
-    screen = screen or pilot.app.sweep_screen
-    await wait_for(pilot, lambda: screen.opening is None or screen.opening.is_finished)
-    await pilot.pause()
+    return finished_sweep(tmp_path_factory)
 
 
 def table_column(table: DataTable, key: str) -> list[str]:
     return [str(cell) for cell in table.get_column(key)]
-
-
-def status_of(screen) -> StatusBar:
-    return screen.query_one("#sweep-status", StatusBar)
 
 
 async def test_opening_results_shows_the_ranking_failures_and_pareto_front(finished):
@@ -114,7 +36,7 @@ async def test_opening_results_shows_the_ranking_failures_and_pareto_front(finis
     failed = [r for r in rows if r["status"] != "ok"]
     assert len(rows) == 12 and len(failed) == 6  # sensor_grid = 0 is impossible
     screen = SweepScreen(results)
-    app = _Host(screen)
+    app = SweepHost(screen)
     async with app.run_test(size=SIZE) as pilot:
         await opened(pilot)
         # impossible values are final, not failures (which run again on resume)
@@ -241,7 +163,7 @@ async def test_budget_objective_ranks_only_paths_within_the_typed_budget(finishe
     times = sorted({r["flight_time_s"] for r in ok})
     budget = (times[0] + times[1]) / 2  # between the two shortest flight times
     screen = SweepScreen(spec)
-    app = _Host(screen)
+    app = SweepHost(screen)
     async with app.run_test(size=SIZE) as pilot:
         await opened(pilot)
         screen.query_one("#sweep-budget").value = f"{budget}"
@@ -263,7 +185,7 @@ async def test_a_bad_budget_is_one_line_whatever_the_ranking(finished):
     READY bar, in the spec's words (budget = '-5'), and 1e400 was said not to be > 0."""
     spec, _ = finished
     screen = SweepScreen(spec)
-    app = _Host(screen)
+    app = SweepHost(screen)
     async with app.run_test(size=SIZE) as pilot:
         await opened(pilot)
         budget = screen.query_one("#sweep-budget")
@@ -280,157 +202,13 @@ async def test_a_bad_budget_is_one_line_whatever_the_ranking(finished):
             assert status_of(screen).state == NOT_READY
 
 
-async def test_a_missing_spec_gives_one_line_and_starts_nothing(tmp_path):
-    missing = tmp_path / "nowhere.toml"
-    screen = SweepScreen(missing, serial=True)
-    app = _Host(screen)
-    async with app.run_test(size=SIZE) as pilot:
-        await opened(pilot)
-        await pilot.press("f5")
-        await pilot.pause()
-        assert status_of(screen).state == NOT_READY
-        assert (
-            str(missing) in screen.last_message
-            and "no such file; expected a sweep spec" in screen.last_message
-        )
-        assert not screen.running and not list(screen.workers)
-        assert not (tmp_path / "nowhere-results").exists()
-
-
-async def test_a_spec_mistake_names_its_line_and_starts_nothing(tmp_path):
-    write_base(tmp_path)
-    spec = write_spec(tmp_path, "[grid]\nradius = [10.0]\nscans = [2, 2.5]\n")
-    screen = SweepScreen(spec, serial=True)
-    app = _Host(screen)
-    async with app.run_test(size=SIZE) as pilot:
-        await opened(pilot)
-        await pilot.press("f5")
-        await pilot.pause()
-        message = screen.last_message
-        assert status_of(screen).state == NOT_READY
-        assert message.startswith(f"{spec}:6: grid.scans") and "2.5" in message
-        assert "\n" not in message
-        assert not screen.running and not list(screen.workers)
-        assert not (tmp_path / "spec-results").exists()
-
-
-async def test_a_running_sweep_cancels_keeps_its_rows_and_stays_responsive(tmp_path, finished):
-    # ``finished`` ran a sweep in this process already, so the kernels are compiled.
-    write_base(tmp_path)
-    # 7,200 variants: far more than run while the test waits (a few hundred a second
-    # here), so only Cancel can end it early.
-    spec = write_spec(
-        tmp_path, "[grid]\nheading_offset = { start = 0, stop = 359.95, step = 0.05 }\nscans = [1]\n"
-    )
-    results = tmp_path / "spec-results" / "results.csv"
-    screen = SweepScreen(spec, serial=True)
-    app = _Host(screen)
-    async with app.run_test(size=SIZE) as pilot:
-        await opened(pilot)
-        await pilot.press("f5")
-        assert screen.running and status_of(screen).state == BUSY
-        await wait_for(pilot, lambda: screen.progress is not None and screen.progress.done >= 2)
-        # Keys still act while the worker runs.
-        await pilot.press("f9")
-        assert screen.running and screen.query_one("#sweep-body").has_class("-table")
-        await pilot.press("ctrl+x")
-        await wait_for(pilot, lambda: not screen.running)
-        # F5 resumes it: ready, not the yellow of a sweep that cannot run
-        assert "cancelled" in screen.last_message and status_of(screen).state == READY
-        # the status line is short enough for 80 columns; a note names the folder
-        assert screen.last_message.endswith("kept; F5 resumes") and str(screen.out) not in screen.last_message
-        assert any(f"rows are kept in {screen.out}" in n.message for n in screen.app._notifications)
-        done = screen.progress.done
-        assert 2 <= done < 7200
-        kept, _ = read_table(results)
-        assert len(kept) == done and all(r["status"] == "ok" for r in kept)
-        assert screen.query_one("#sweep-table", DataTable).row_count == done
-        counts = str(screen.query_one("#sweep-counts").render())
-        assert counts.startswith(f"{done}/7200, 0 failed, 0 resumed") and "ETA" in counts
-        await pilot.press("f6")
-        assert screen.objective == "coverage-per-km"
-        # Run again and leave at once: Escape closes the screen and cancels the run.
-        await pilot.press("f5", "escape")
-        await pilot.pause()
-        assert app.screen is not screen
-        # said where the analyst goes, not only on the screen left behind
-        said = f"sweep cancelled on leaving its screen; the rows so far are kept in {screen.out}; F5 resumes"
-        assert screen.last_message == said and said in [n.message for n in app._notifications]
-        await wait_for(pilot, lambda: not any(w.is_running for w in app.workers))
-        rows, _ = read_table(results)
-        assert done <= len(rows) < 7200
-        # The kept variants were resumed, not run again: their rows are as they were.
-        again = {r["variant"]: r for r in rows}
-        assert len(again) == len(rows)
-        assert all(again[r["variant"]] == r for r in kept)
-
-
-async def test_an_unreachable_scheduler_gives_one_line_and_writes_nothing(tmp_path):
-    write_base(tmp_path)
-    spec = write_spec(tmp_path, "[grid]\nradius = [10.0, 20.0]\n")
-    screen = SweepScreen(spec, scheduler="tcp://127.0.0.1:9", connect_timeout=0.5)
-    app = _Host(screen)
-    notes: list[str] = []  # recorded as made: a note in the app expires by the wall clock
-    notify = app.notify
-    app.notify = lambda message, **options: (notes.append(message), notify(message, **options))[1]
-    async with app.run_test(size=SIZE) as pilot:
-        await opened(pilot)
-        await pilot.press("f5")
-        # A refused connection may end the run before the key press returns: wait for
-        # its end, whether or not it is still running here.
-        await wait_for(pilot, lambda: not screen.running, timeout=60)
-        message = screen.last_message
-        assert status_of(screen).state == NOT_READY
-        # in the form's words, as its other fields say theirs: not the command's --scheduler
-        assert "Scheduler: tcp://127.0.0.1:9 is not allowed; expected" in message and "\n" not in message
-        assert not (tmp_path / "spec-results" / "results.csv").exists()
-        # too long for the status line: cut there, so the whole of it comes as a note too
-        room = screen.query_one("#sweep-status #status-text").content_size.width
-        assert len(message) > room and message in notes
-
-
-TRACKER_SCRIPT = """
-import asyncio, multiprocessing, sys
-from textual.app import App
-from ladartui.tui.sweep_jobs import start_resource_tracker
-
-async def main():
-    async with App().run_test():
-        assert sys.stderr.fileno() == -1, "the app no longer captures stderr"
-        start_resource_tracker()
-        multiprocessing.get_context("spawn").Lock()  # registers with the tracker
-        print("lock made")
-
-asyncio.run(main())
-"""
-
-
-def test_a_local_cluster_can_start_while_the_interface_captures_stderr():
-    # Without the tracker started first, making the lock fails: bad value(s) in fds_to_keep.
-    done = subprocess.run([sys.executable, "-c", TRACKER_SCRIPT], capture_output=True, text=True, timeout=120)
-    assert done.returncode == 0, done.stderr[-2000:]
-    assert "lock made" in done.stdout
-
-
-def test_eta_counts_only_the_variants_run_here():
-    from ladartui.sweep import SweepProgress
-
-    progress = SweepProgress(total=10, done=6, resumed=2, failed=0, elapsed=8.0)
-    assert eta_seconds(progress) == pytest.approx(8.0 / 4 * 4)
-    assert eta_seconds(SweepProgress(10, 2, 2, 0, 1.0)) is None
-    assert format_eta(125) == "2m05s" and format_eta(3725) == "1h02m" and format_eta(None) == "--"
-    assert format_eta(math.inf) == "--"
-    # the last half second of a run read "about 0s left"
-    assert [format_eta(s) for s in (0.0, 0.49, 0.5, 59.6)] == ["<1s", "<1s", "1s", "1m00s"]
-
-
 async def test_browse_picks_a_results_folder_in_a_tree_and_opens_it(finished):
     from ladartui.tui.file_dialogs import PickPathScreen
     from ladartui.tui.file_tree import FileTree
 
     _spec, results = finished
     screen = SweepScreen(serial=True)
-    app = _Host(screen)
+    app = SweepHost(screen)
     async with app.run_test(size=SIZE) as pilot:
         await opened(pilot)
         screen.query_one("#sweep-path").value = str(results.parent) + "/"
@@ -458,7 +236,7 @@ async def test_the_screen_reopens_the_last_sweep_opened(finished, tmp_path, monk
     monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))
     _spec, results = finished
     first = SweepScreen(results)
-    app = _Host(first)
+    app = SweepHost(first)
     async with app.run_test(size=SIZE) as pilot:
         await opened(pilot)
         assert first.query_one("#sweep-table", DataTable).row_count == 12
@@ -481,35 +259,13 @@ async def test_a_spec_opened_shows_only_its_own_variants_from_the_folder(finishe
     # the spec narrowed after its sweep ran: one of its twelve stored variants is still its own
     narrowed = write_spec(tmp_path, "[grid]\nradius = [8.0]\nscans = [1]\nsensor_grid = [8]\n")
     screen = SweepScreen(narrowed)
-    app = _Host(screen)
+    app = SweepHost(screen)
     async with app.run_test(size=SIZE) as pilot:
         await opened(pilot)
         assert screen.query_one("#sweep-table", DataTable).row_count == 1
         assert str(screen.query_one("#sweep-counts").render()) == "1 variants, 1 ok, 0 failed"
         said = "11 rows not ranked: other variants or an earlier base;"
         assert status_of(screen).query_one("#status-text").render().plain.startswith(said)  # whole at 80
-
-
-async def test_a_plain_scheduler_off_this_machine_is_refused_as_the_cli_refuses_it(tmp_path):
-    write_base(tmp_path)
-    spec = write_spec(tmp_path, "[grid]\nradius = [10.0, 20.0]\n")
-    screen = SweepScreen(spec, scheduler="tcp://192.0.2.10:8786", connect_timeout=0.5)
-    app = _Host(screen)
-    async with app.run_test(size=SIZE) as pilot:
-        await opened(pilot)
-        await pilot.press("f5")
-        await pilot.pause()
-        assert not screen.running and not list(screen.workers)
-        assert "run code on it" in screen.last_message  # says why, in the form's words
-        assert screen.last_message.startswith("Scheduler: tcp://192.0.2.10:8786 is not allowed; expected")
-        # a tls:// scheduler needs the certificates folder, named when incomplete
-        screen.query_one("#sweep-scheduler").value = "tls://192.0.2.10:8786"
-        screen.query_one("#sweep-certs").value = str(tmp_path)
-        await pilot.press("f5")
-        await pilot.pause()
-        assert not screen.running
-        assert screen.last_message.startswith(f"Certificates: {tmp_path} is not allowed; expected a folder")
-        assert "ca.pem" in screen.last_message
 
 
 async def test_opening_reads_off_the_ui_thread_and_keeps_only_the_last_asked(finished, monkeypatch, tmp_path):
@@ -539,7 +295,7 @@ async def test_opening_reads_off_the_ui_thread_and_keeps_only_the_last_asked(fin
         copy(path, tmp_path / path.name)
     narrowed = write_spec(tmp_path, "[grid]\nradius = [8.0]\nscans = [1]\nsensor_grid = [8]\n")
     screen = SweepScreen(serial=True)
-    app = _Host(screen)
+    app = SweepHost(screen)
     try:
         async with app.run_test(size=SIZE) as pilot:
             await opened(pilot)
@@ -565,56 +321,13 @@ async def test_opening_reads_off_the_ui_thread_and_keeps_only_the_last_asked(fin
         release.set()
 
 
-def _copy_of_finished(finished, folder):
-    """The finished sweep's spec, copied with its results into ``folder`` (running again
-    rewrites the table)."""
-    import shutil
-
-    spec, _ = finished
-    for path in spec.parent.iterdir():
-        copy = shutil.copytree if path.is_dir() else shutil.copy
-        copy(path, folder / path.name)
-    return folder / spec.name
-
-
-async def test_a_sweep_run_again_shows_its_stored_rows_first(finished, tmp_path):
-    """Run again over a finished folder, the stored rows come from the job before any
-    variant (none left to run here: all resume)."""
-    screen = SweepScreen(_copy_of_finished(finished, tmp_path), serial=True)
-    app = _Host(screen)
-    seen: list[int] = []
-    show = screen._show_stored_rows
-    screen._show_stored_rows = lambda rows: (seen.append(len(rows)), show(rows))[1]
-    async with app.run_test(size=SIZE) as pilot:
-        await opened(pilot)
-        await pilot.press("f5")
-        await wait_for(pilot, lambda: not screen.running)
-        assert seen == [12], screen.last_message
-        assert screen.query_one("#sweep-table", DataTable).row_count == 12
-        assert "12 resumed" in screen.last_message
-
-
-async def test_a_finished_sweep_shows_its_whole_100_percent(finished, tmp_path):
-    """At 80x24 the progress reads "100%", not "100" cut by the row's label padding."""
-    screen = SweepScreen(_copy_of_finished(finished, tmp_path), serial=True)
-    app = _Host(screen)
-    async with app.run_test(size=SIZE) as pilot:
-        await opened(pilot)
-        await pilot.press("f5")
-        await wait_for(pilot, lambda: not screen.running)
-        await pilot.pause()
-        percent = screen.query_one("#sweep-progress PercentageStatus")
-        assert str(percent.render()) == "100%"
-        assert percent.content_region.width >= len("100%")
-
-
 async def test_opening_a_sweep_leaves_no_note_of_the_empty_screen(finished):
     """The screen's first words ('type a sweep spec ...') came as a note, read as cut
     before the status line was laid out, and stayed over the chart of the sweep it had
     opened, then followed onto the main screen."""
     spec, results = finished
     screen = SweepScreen(results)
-    app = _Host(screen)
+    app = SweepHost(screen)
     notes: list[str] = []
     notify = app.notify
     app.notify = lambda message, **options: (notes.append(message), notify(message, **options))[1]
