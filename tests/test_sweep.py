@@ -1,29 +1,25 @@
-"""Sweeps without a cluster: specs, variant ids, ranking, serial runs, resume (the result
+"""Sweeps without a cluster: ranking, parameters applied to the base, serial runs,
+resume, the best scenario file, a column's decimals (specs and variant ids:
+test_sweep_spec.py; the command and its folder lock: test_sweep_cli.py; the result
 table itself: test_sweep_table.py)."""
 
-import itertools
 import math
-import os
 import random
-import re
 import subprocess
 import sys
 import threading
-import time
 from dataclasses import replace
 
 import pytest
 
-from ladartui.errors import Cancelled, FieldError, InputFileError
+from ladartui.errors import Cancelled, FieldError
 from ladartui.sweep import (
     apply_parameters,
     load_sweep_results,
-    load_sweep_spec,
     pareto_front,
     rank_rows,
     read_table,
     run_sweep,
-    variant_id,
 )
 from tiny_sweep import CENTRE, tiny_folder, write_spec, write_tiny_scenario
 
@@ -42,161 +38,6 @@ sensor_grid = [8, 0]
 @pytest.fixture(scope="module")
 def tiny(tmp_path_factory):
     return tiny_folder(tmp_path_factory)
-
-
-# -- specs ---------------------------------------------------------------------------
-
-
-def test_grid_is_the_product_of_its_axes(tmp_path):
-    spec = load_sweep_spec(
-        write_spec(
-            tmp_path,
-            """
-[grid]
-radius = [100, 150.5]
-altitude = { start = 100, stop = 300, step = 100 }
-fov = 10
-""",
-        )
-    )
-    points = [v.params for v in spec.variants]
-    expected = [
-        {"radius": r, "altitude": a, "fov": 10.0}
-        for r, a in itertools.product([100.0, 150.5], [100.0, 200.0, 300.0])
-    ]
-    assert points == expected
-    assert spec.scenario_path == tmp_path / "base.toml"
-
-
-def test_random_draws_follow_the_seed_and_the_bounds(tmp_path):
-    body = """
-[grid]
-preset = ["orbit"]
-[random]
-samples = 20
-seed = {seed}
-heading_offset = {{ min = 10, max = 20 }}
-scans = {{ min = 3, max = 5 }}
-fov = [5.0, 7.5]
-"""
-    first = load_sweep_spec(write_spec(tmp_path, body.format(seed=7), "a.toml")).variants
-    again = load_sweep_spec(write_spec(tmp_path, body.format(seed=7), "b.toml")).variants
-    other = load_sweep_spec(write_spec(tmp_path, body.format(seed=8), "c.toml")).variants
-    assert [v.params for v in first] == [v.params for v in again]
-    assert [v.params for v in first] != [v.params for v in other]
-    for variant in first:
-        p = variant.params
-        assert 10 <= p["heading_offset"] <= 20
-        assert p["scans"] in (3, 4, 5) and isinstance(p["scans"], int)
-        assert p["fov"] in (5.0, 7.5)
-    assert {v.params["scans"] for v in first} == {3, 4, 5}  # 20 draws reach every integer
-
-
-def test_parameters_that_do_not_apply_to_a_preset_make_no_extra_variants(tmp_path):
-    spec = load_sweep_spec(
-        write_spec(
-            tmp_path,
-            """
-[grid]
-preset = ["orbit", "flypast"]
-radius = [50, 60, 70]
-standoff = [10, 20]
-""",
-        )
-    )
-    # 3 orbits (radius only) + 2 fly-pasts (standoff only), not 2 x 3 x 2.
-    assert sorted(
-        (p["preset"], p.get("radius"), p.get("standoff")) for p in (v.params for v in spec.variants)
-    ) == sorted(
-        [("orbit", r, None) for r in (50.0, 60.0, 70.0)] + [("flypast", None, s) for s in (10.0, 20.0)]
-    )
-
-
-@pytest.mark.parametrize(
-    "body, key, line",
-    [
-        ("[grid]\nradius = []\n", "grid.radius", 4),
-        ("[grid]\nscans = [2, 2.5]\n", "grid.scans", 4),
-        ("[grid]\nradious = [1]\n", "grid.radious", 4),
-        ("[grid]\npreset = ['circle']\n", "grid.preset", 4),
-        ("objective = 'fastest'\n[grid]\nradius = [1]\n", "sweep.objective", 3),
-        ("objective = 'coverage-within-budget'\n[grid]\nradius = [1]\n", "sweep.budget", None),
-        ("[random]\nseed = 1\nfov = { min = 5, max = 1 }\n", "random.samples", None),
-        ("[random]\nsamples = 2\nfov = { min = 5, max = 1 }\n", "random.fov", 5),
-        ("[grid]\nfov = [1]\n[random]\nsamples = 2\nfov = [1, 2]\n", "random.fov", 7),
-        ("", "grid", None),
-    ],
-)
-def test_spec_errors_name_the_file_key_and_what_was_expected(tmp_path, body, key, line):
-    path = write_spec(tmp_path, body)
-    with pytest.raises(InputFileError) as caught:
-        load_sweep_spec(path)
-    message = str(caught.value)
-    assert message.startswith(str(path))
-    assert f" {key}" in message or f"{key}:" in message
-    assert "expected" in message and "\n" not in message
-    assert "None" not in message  # a key never written is missing, not "got None"
-    if line is not None:
-        assert caught.value.line == line
-
-
-def test_a_spec_that_is_not_toml_names_its_line(tmp_path):
-    path = tmp_path / "bad.toml"
-    path.write_text('[sweep]\nscenario = "a.toml"\n[grid]\nradius = [1,\n', encoding="utf-8")
-    with pytest.raises(InputFileError, match="not valid TOML"):
-        load_sweep_spec(path)
-
-
-def test_a_scenario_given_as_the_spec_is_told_so(tmp_path):
-    """'ladartui sweep orbit.toml' said 'orbit.toml:1: files: unknown key; expected one of
-    grid, random, sweep', as if the scenario were a spec with a typing mistake; the
-    scenario reader tells the other way round ('a sweep spec ([sweep]), not a scenario')."""
-    path = tmp_path / "orbit.toml"
-    path.write_text('# an orbit\n[files]\nscene = "s.txt"\n[flight]\nspeed_mps = 30.0\n')
-    with pytest.raises(InputFileError) as caught:
-        load_sweep_spec(path)
-    assert str(caught.value) == (
-        f"{path}:2: a scenario ([files]), not a sweep spec: a spec's [sweep] names it "
-        "(scenario = \"orbit.toml\"), see docs/sweeps.md; 'ladartui run FILE' runs it"
-    )
-
-
-def test_a_toml_mistake_in_a_spec_is_named_as_file_and_line_as_a_scenario_s_is(tmp_path):
-    """It read 'spec.toml: not valid TOML: Expected '=' after a key in a key/value pair
-    (at line 3, column 8)': the line inside the message, not where editors look for it."""
-    path = tmp_path / "spec.toml"
-    path.write_text('[sweep]\nscenario = "a.toml"\nradius 20\n', encoding="utf-8")
-    with pytest.raises(InputFileError) as caught:
-        load_sweep_spec(path)
-    assert caught.value.line == 3
-    assert str(caught.value) == f"{path}:3: not valid TOML: Expected '=' after a key in a key/value pair"
-    path.write_text('[sweep]\nscenario = "a.toml"\nradius = [20,\n', encoding="utf-8")  # cut off
-    with pytest.raises(InputFileError) as caught:
-        load_sweep_spec(path)
-    assert str(caught.value).startswith(f"{path}:3: not valid TOML: ")
-
-
-# -- variant ids ---------------------------------------------------------------------
-
-
-def test_variant_ids_ignore_order_and_number_spelling_but_not_values():
-    a = variant_id({"radius": 100, "scans": 4, "preset": "orbit"})
-    assert a == variant_id({"preset": "orbit", "scans": 4, "radius": 100.0})
-    assert a != variant_id({"preset": "orbit", "scans": 4, "radius": 100.5})
-    assert a != variant_id({"preset": "flypast", "scans": 4, "radius": 100.0})
-    assert len(a) == 16 and int(a, 16) >= 0
-
-
-def test_variant_ids_are_stable_across_processes():
-    params = {"radius": 0.1 + 0.2, "scans": 7, "preset": "standoff"}
-    code = f"from ladartui.sweep import variant_id; print(variant_id({params!r}))"
-    # Another process with another string-hash seed computes the same id.
-    seed = "2" if os.environ.get("PYTHONHASHSEED") == "1" else "1"
-    env = dict(os.environ, PYTHONHASHSEED=seed)
-    other = subprocess.run(
-        [sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True
-    ).stdout.strip()
-    assert other == variant_id(params)
 
 
 # -- ranking -------------------------------------------------------------------------
@@ -440,127 +281,6 @@ def test_the_sweep_core_and_command_import_without_textual_or_dask():
         [sys.executable, "-c", code], capture_output=True, text=True, check=True
     ).stdout.strip()
     assert loaded == "[]"  # Dask loads only when a sweep runs on it
-
-
-def test_cli_reports_a_spec_error_in_one_line(tmp_path, capsys):
-    from ladartui.cli import main
-
-    spec = write_spec(tmp_path, "[grid]\nscans = ['many']\n")
-    assert main(["sweep", str(spec), "--serial"]) == 2
-    err = capsys.readouterr().err.strip()
-    assert err.count("\n") == 0 and "grid.scans" in err and str(spec) in err
-
-
-def test_cli_serial_sweep_prints_the_ranking_as_json(tiny, tmp_path, capsys):
-    import json
-
-    from ladartui.cli import main
-
-    spec = write_spec(tiny, "[grid]\nradius = [10.0, 20.0]\n", name="cli.toml")
-    assert (
-        main(
-            [
-                "sweep",
-                str(spec),
-                "--serial",
-                "--out",
-                str(tmp_path),
-                "--json",
-                "--objective",
-                "coverage-per-km",
-            ]
-        )
-        == 0
-    )
-    report = json.loads(capsys.readouterr().out)
-    assert report["objective"] == "coverage-per-km" and report["variants"] == 2
-    values = [entry["objective"] for entry in report["top"]]
-    assert values == sorted(values, reverse=True)
-    rows, _ = read_table(tmp_path / "results.csv")
-    by_id = {r["variant"]: r for r in rows}
-    for entry in report["top"]:
-        row = by_id[entry["variant"]]
-        assert entry["objective"] == pytest.approx(row["obscured_coverage"] / (row["path_length_m"] / 1000.0))
-    assert os.path.isfile(report["best_scenario"])
-
-
-def test_impossible_values_are_not_called_failures(tiny, tmp_path, capsys):
-    # "failed" rows run again on resume; "error" rows (impossible values) never do
-    import json
-
-    from ladartui.cli import main
-
-    spec = write_spec(tiny, "[grid]\nradius = [10.0]\nsensor_grid = [8, 0]\n", name="impossible.toml")
-    assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path)]) == 0
-    out = capsys.readouterr().out
-    assert "\n1 variant with impossible values (kept as errors, not run again); first: " in out
-    assert "failed" not in out
-    assert main(["sweep", str(spec), "--show", "--out", str(tmp_path), "--json"]) == 0
-    report = json.loads(capsys.readouterr().out)
-    assert (report["failed"], report["impossible"]) == (0, 1)
-
-
-def test_the_summary_counts_in_words_and_says_when_every_variant_was_resumed(tiny, tmp_path, capsys):
-    """A fully resumed sweep said '0 variant(s) run in 0.0 s on 0 worker(s); 2 resumed'."""
-    from ladartui.cli import main
-
-    spec = write_spec(tiny, "[grid]\nradius = [10.0, 12.0]\n", name="words.toml")
-    assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path)]) == 0
-    out = capsys.readouterr().out
-    assert re.search(r"\n2 variants run in [\d.]+ s \([\d.]+ variants/min\) on 1 worker\n", out), out
-    assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path)]) == 0
-    out = capsys.readouterr().out
-    assert "\nnothing to run: all 2 variants resumed from earlier runs\n" in out
-    assert " run in " not in out and "(s)" not in out
-
-
-def test_a_ctrl_c_after_the_last_variant_says_the_sweep_finished(tiny, tmp_path, capsys, monkeypatch):
-    """A Ctrl-C once every variant had run left 'stopping; finished variants are kept'
-    on the bar and exited 0 with the whole set written, the interrupt not mentioned."""
-    import _thread
-
-    import ladartui.sweep.execute as execute
-    from ladartui.cli import main
-
-    real = execute.write_ranking
-
-    def interrupted_first(*args, **kwargs):
-        _thread.interrupt_main()
-        time.sleep(1.0)  # the main thread sees the Ctrl-C and waits for this one
-        return real(*args, **kwargs)
-
-    monkeypatch.setattr(execute, "write_ranking", interrupted_first)
-    spec = write_spec(tiny, "[grid]\nradius = [10.0, 12.0]\n", name="late.toml")
-    assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path)]) == 0
-    captured = capsys.readouterr()
-    said = captured.out + captured.err
-    assert "the interrupt came after the last variant: the sweep finished" in said
-    assert "sweep interrupted" not in said and (tmp_path / "ranking.csv").exists()
-
-
-def test_two_sweeps_never_write_one_folder_at_once(tiny, tmp_path):
-    fcntl = pytest.importorskip("fcntl")  # POSIX only
-    spec = write_spec(tiny, "[grid]\nscans = [2]\n", name="locked.toml")
-    with open(tmp_path / ".lock", "a+b") as held:
-        fcntl.flock(held, fcntl.LOCK_EX)  # as a running sweep holds it
-        with pytest.raises(InputFileError, match="another sweep"):
-            run_sweep(spec, serial=True, out=tmp_path)
-    assert not (tmp_path / "results.csv").exists()
-    assert run_sweep(spec, serial=True, out=tmp_path).ran == 1
-
-
-def test_a_folder_another_sweep_holds_is_refused_before_the_bar(tiny, tmp_path, capsys):
-    """The second sweep drew 'sweep 0/1 starting; a first run compiles kernels' before
-    it was refused."""
-    fcntl = pytest.importorskip("fcntl")
-    from cli_support import one_error_line
-    from ladartui.cli import main
-
-    spec = write_spec(tiny, "[grid]\nscans = [2]\n", name="held.toml")
-    with open(tmp_path / ".lock", "a+b") as held:
-        fcntl.flock(held, fcntl.LOCK_EX)
-        assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path)]) == 2
-    assert "another sweep is writing its results here" in one_error_line(capsys)
 
 
 def test_the_best_scenario_file_does_not_carry_the_base_files_comments(tmp_path):
