@@ -67,3 +67,25 @@ def edited(key_line, new_line, text=BASE):
 
 def line_of(text, fragment):
     return next(i for i, line in enumerate(text.splitlines(), start=1) if fragment in line)
+
+
+# A small valid scenario over s.txt: the parser fuzzers' seed, the model-file tests' plan.
+VALID_SCENARIO = """[files]
+scene = "s.txt"
+voxel_size = 1.0
+
+[sensor]
+grid = 16
+ray_grid = 2
+fov_deg = 20.0
+
+[flight]
+speed_mps = 30.0
+
+[[flight.segments]]
+kind = "orbit"
+centre = [0.5, 0.5, 0.5]
+radius = 20.0
+altitude = 30.0
+scans = 4
+"""
