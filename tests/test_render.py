@@ -113,6 +113,26 @@ def test_a_threshold_rescales_the_colours_to_the_heights_that_remain():
     assert len(np.unique(cut.rgb[cut.voxel_mask], axis=0)) == 9
 
 
+def test_fit_with_points_frames_a_box_and_a_flight_off_one_side_of_it_centred():
+    """A new scene's 3D views frame it with its flight's scan positions; an orbit wider
+    than the scene left the views' sides (their framing took the box alone)."""
+    bounds = (np.zeros(3), np.array([59.0, 59.0, 20.0]))
+    scene = (np.zeros(3), np.array([59.0, 59.0, 20.0]))
+    angle = np.radians(np.arange(0, 270, 15))  # three quarters of an orbit, off to one side
+    path = np.column_stack([150 + 120 * np.cos(angle), 30 + 120 * np.sin(angle), np.full(angle.size, 60.0)])
+    for camera in (Camera(), Camera(45.0, 60.0), TOP):
+        fitted = framing.fit_camera(camera, scene, 40, 100, bounds, points=path)
+        corners = np.array(list(itertools.product(*zip(scene[0] - 0.5, scene[1] + 0.5))))
+        row, col, _, _ = screen_coordinates(np.vstack([corners, path]), fitted, 40, 100, bounds)
+        # the larger side fills the shorter one, less the margins: in a view of any shape
+        assert max(np.ptp(row), np.ptp(col)) == pytest.approx(0.9 * 40, abs=1e-6)
+        assert (row.min() + row.max()) / 2 == pytest.approx(20)
+        assert (col.min() + col.max()) / 2 == pytest.approx(50)
+        for rows, cols in ((100, 40), (60, 60)):  # the same camera in views of other shapes
+            row, col, _, _ = screen_coordinates(np.vstack([corners, path]), fitted, rows, cols, bounds)
+            assert row.min() >= 0 and row.max() <= rows and col.min() >= 0 and col.max() <= cols
+
+
 def test_fit_target_frames_the_targets_projected_box_with_a_small_margin():
     bounds = (np.zeros(3), np.array([199.0, 199.0, 30.0]))
     target = box((120, 40, 0), (126, 43, 2))

@@ -327,3 +327,40 @@ async def test_a_view_too_narrow_for_its_placeholder_wraps_it_whole():
         assert width < len(view.placeholder)
         lines = [view.render_line(y).text.strip() for y in range(height)]
         assert " ".join(line for line in lines if line) == "no output yet: F5 runs"
+
+
+def marker_pixels(widget: ProjectionWidget):
+    rows, cols = widget.picture_size()
+    row, col, _, _ = screen_coordinates(widget.markers, widget.camera, rows, cols, widget.bounds)
+    return row, col, rows, cols
+
+
+def all_in_view(widget: ProjectionWidget) -> bool:
+    row, col, rows, cols = marker_pixels(widget)
+    return bool(np.all((row >= 0) & (row < rows) & (col >= 0) & (col < cols)))
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_the_3d_views_open_on_the_whole_flight_and_an_edit_does_not_move_them(scenario_path):
+    """The 3D views framed the scene alone, so an orbit wider than the scene (the
+    default scenario's) opened with its sides off the view; the top view showed it."""
+    app = LadarApp(scenario_path, compile_in_child=False)
+    async with app.run_test(size=SIZE) as pilot:
+        start = time.monotonic()
+        while app.scene is None or app.busy is not None:
+            assert time.monotonic() - start < 120, "the app did not load the scene"
+            await pilot.pause(0.05)
+        app.action_layout(5)
+        await pilot.pause()
+        await pilot.pause()
+        views = [app.query_one(f"#{name}", ProjectionWidget) for name in ("scene3d", "output3d")]
+        assert all_in_view(views[0])  # (the output's view frames so once it has an output)
+        cameras = [view.camera for view in views]
+        wider = Orbit(centre=app.scenario.flight.segments[0].centre, radius=60.0, altitude=30.0, scans=6)
+        app.set_scenario(app.scenario.with_changes(flight=FlightPlan(None, (wider,))))
+        await pilot.pause()
+        assert [view.camera for view in views] == cameras  # editing never moves the picture
+        assert not all_in_view(views[0])
+        app.action_view("fit_path")  # (p in a view) the whole flight again
+        await pilot.pause()
+        assert all(all_in_view(view) for view in views)

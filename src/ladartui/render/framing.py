@@ -24,22 +24,33 @@ def box_of(voxels) -> tuple[np.ndarray, np.ndarray] | None:
     return pts.min(axis=0), pts.max(axis=0)
 
 
-def fit_camera(camera: Camera, box, rows: int, cols: int, bounds, margin: float = MARGIN) -> Camera:
-    """``camera``'s angles with the zoom and pan that frame ``box`` in a rows x cols image.
+def fit_camera(
+    camera: Camera, box, rows: int, cols: int, bounds, margin: float = MARGIN, points=None
+) -> Camera:
+    """``camera``'s angles with the zoom and pan that frame ``box`` (and ``points``, (N, 3)
+    voxel units, such as a flight's scan positions) in a rows x cols image.
 
-    The box's projected corners fill the image less ``margin`` of it on each
-    side (in the tighter direction), centred.
+    The box's projected corners fill the image less ``margin`` of it on each side (in
+    the tighter direction), centred; with points, their larger side and the box's
+    together fill the shorter side, so the camera frames them in a view of any shape.
     """
     lo, hi = (np.asarray(b, float) for b in box)
     corners = np.array(list(itertools.product(*zip(lo - 0.5, hi + 0.5))))
+    if points is not None and len(points):
+        corners = np.vstack([corners, np.asarray(points, float).reshape(-1, 3)])
     blo, bhi = (np.asarray(b, float) for b in bounds)
     radius = max(float(np.linalg.norm(bhi - blo)) / 2.0, 0.5)
-    centre = (lo + hi) / 2.0  # the view then turns about the box
     right, up, _ = view_axes(camera.azimuth, camera.elevation)
-    sx = (corners - centre) @ right
-    sy = (corners - centre) @ up
+    sx = (corners - (lo + hi) / 2.0) @ right
+    sy = (corners - (lo + hi) / 2.0) @ up
+    # the view turns about the middle of what it frames: for a box alone, its centre
+    centre = (lo + hi) / 2.0 + right * (sx.max() + sx.min()) / 2.0 + up * (sy.max() + sy.min()) / 2.0
     width = max(float(np.ptp(sx)), 1e-6)
     height = max(float(np.ptp(sy)), 1e-6)
+    if points is not None and len(points):
+        # the views share a camera and differ in shape: a flight reaching far from the
+        # box fits in any of them when its larger side fits the shorter one
+        width = height = max(width, height)
     usable = 1.0 - 2.0 * margin
     scale = min(cols * usable / width, rows * usable / height)  # pixels per voxel unit
     zoom = float(np.clip(scale * 2.0 * radius / max(min(cols, rows), 1), MIN_ZOOM, MAX_ZOOM))

@@ -423,7 +423,7 @@ class ProjectionWidget(PictureWidget):
         self.voxel_size = 1.0
         self.camera = Camera()
         self.height_top: float | None = None  # top of the height shading (voxel layers), shared by views
-        self.pending_fit = None  # a box to frame once the widget has a size
+        self.pending_fit = None  # a box and points to frame once the widget has a size
         self._drag: tuple[int, int] | None = None
         self.placeholder = "nothing to show yet"
         self._update_title()
@@ -462,16 +462,21 @@ class ProjectionWidget(PictureWidget):
         self.invalidate()
         self.post_message(self.CameraChanged(self))
 
-    def fit_box(self, box) -> None:
-        """Frame ``box`` (voxel-index lo, hi) now, or when the widget is first drawn."""
+    def fit_box(self, box, points=None) -> None:
+        """Frame ``box`` (voxel-index lo, hi) and ``points`` (voxel units) now, or when the
+        widget is first drawn."""
         rows, cols = self.picture_size()
         if self.bounds is None or box is None:
             return
         if rows and cols:
-            self.set_camera(framing.fit_camera(self.camera, box, rows, cols, self.bounds))
+            self.set_camera(framing.fit_camera(self.camera, box, rows, cols, self.bounds, points=points))
         else:
-            self.pending_fit = box
+            self.pending_fit = (box, points)
             self.invalidate()
+
+    def fit_path(self) -> None:
+        """Frame the scene and the scan positions (``p``; how a new scene opens)."""
+        self.fit_box(self.bounds, self.markers)
 
     def on_resize(self, event: events.Resize) -> None:
         super().on_resize(event)
@@ -499,7 +504,8 @@ class ProjectionWidget(PictureWidget):
         if not self.voxel_layers or self.bounds is None:
             return None
         if self.pending_fit is not None:
-            self.camera = framing.fit_camera(self.camera, self.pending_fit, rows, cols, self.bounds)
+            box, points = self.pending_fit
+            self.camera = framing.fit_camera(self.camera, box, rows, cols, self.bounds, points=points)
             self.pending_fit = None
             self._update_title()
         self.overlays.shown = self.shown_overlays

@@ -77,6 +77,7 @@ class ViewArea(Container):
         self.colour_map = "height"  # or "grey": the report's 56 shades
         self.overlays = OVERLAY_CYCLE[0]
         self.markers: np.ndarray | None = None  # scan positions, voxel units
+        self.path_unframed = False  # a new scene's 3D views frame its path when first drawn
         self._output_args: tuple[Any, float | None, int, Any, Any] = (None, None, OUTPUT_POINTS, None, None)
         self.per_scan_known = False  # the output shown has per-scan returns ("scans" mode)
         self.no_output = "no output yet: F5 runs"  # the app's words, with its run key
@@ -99,10 +100,11 @@ class ViewArea(Container):
         for widget in self.query(ProjectionWidget):
             widget.height_top = top
             # a new scene: keep the angles, frame the scene again (a centre or a pending
-            # fit of the old one would point elsewhere)
+            # fit of the old one would point elsewhere), and its path once it is drawn
             widget.camera = Camera(widget.camera.azimuth, widget.camera.elevation)
             widget.pending_fit = None
             widget._update_title()
+        self.path_unframed = True
         self.query_one("#scene3d", ProjectionWidget).set_layers(
             scene_layers(prepared["points"], prepared["target"], prepared.get("target_ids")),
             prepared["points"],
@@ -139,14 +141,17 @@ class ViewArea(Container):
             except LadarError:
                 pass
         top.set_overlay(scans, scans, [f[:, :2] for f in footprints])
+        frame, self.path_unframed = self.path_unframed and self.prepared is not None, False
         if self.prepared is not None and poses:
             markers = np.array([p.position for p in poses]) / self.voxel_size
             self.markers = markers
             ground = [f / self.voxel_size for f in footprints]
-            # the views frame the scene (the path may leave them: p fits it), so that
-            # editing the path never moves the picture
+            # the views open on the scene and its path (as the top view does), and stay
+            # put as the path is edited (it may leave them: p fits it)
             for widget in self.query(ProjectionWidget):
                 widget.set_markers(markers, self.prepared["bounds"], ground)
+                if frame:
+                    widget.fit_path()
 
     # -- the output view -----------------------------------------------------------
 
@@ -253,11 +258,8 @@ class ViewArea(Container):
         if self.prepared is None:
             return
         self.show_overlays(OVERLAY_CYCLE[0])
-        lo, hi = self.prepared["bounds"]
-        if self.markers is not None and len(self.markers):
-            lo, hi = np.minimum(lo, self.markers.min(axis=0)), np.maximum(hi, self.markers.max(axis=0))
         for widget in self.query(ProjectionWidget):
-            widget.fit_box((lo, hi))
+            widget.fit_path()
         self.query_one(TopViewWidget).fit("path")
 
     def cycle_output_colour(self) -> None:
