@@ -62,14 +62,20 @@ def _check_pointing(segment):
     _set(segment, "azimuth", _optional_number("azimuth", segment.azimuth))
     _set(segment, "depression", _optional_number("depression", segment.depression, 1.0, 90.0))
     _set(segment, "aim_at", _optional_point("aim_at", segment.aim_at))
-    given = [name for name in ("azimuth", "depression") if getattr(segment, name) is not None]
-    if segment.aim_at is not None and given:  # the aim point sets both: what was given would be dropped
-        verb = "is" if len(given) == 1 else "are"
-        raise FieldError(
-            "aim_at",
-            segment.aim_at,
-            f"no aim point while {' and '.join(given)} {verb} given (an aim point sets both)",
-        )
+    refuse_two_pointings(segment.aim_at, {"azimuth": segment.azimuth, "depression": segment.depression})
+
+
+def refuse_two_pointings(aim_at, pointing: dict) -> None:
+    """FieldError on ``aim_at`` when any of ``pointing`` (each named as its user wrote
+    it: a key, a form's label) is given too: the aim point sets both, so what was given
+    there would be dropped without a word."""
+    given = [name for name, value in pointing.items() if value is not None]
+    if aim_at is None or not given:
+        return
+    verb = "is" if len(given) == 1 else "are"
+    raise FieldError(
+        "aim_at", aim_at, f"no aim point while {' and '.join(given)} {verb} given (an aim point sets both)"
+    )
 
 
 def _pointed(segment, current, fly):

@@ -28,6 +28,7 @@ from ladartui.flight import (
     aim_at,
     altitude_field,
 )
+from ladartui.flight.plan import refuse_two_pointings
 from ladartui.scenario import Scenario, load_scenario, target_file_for
 from ladartui.scenario_file import is_record
 from ladartui.sensor import Sensor
@@ -223,24 +224,11 @@ def segment_builder(kind: str):
     cls = SEGMENT_KINDS[kind]
 
     def build(values):
-        refuse_two_pointings(values)
+        pointing = {FIELD_LABELS[name]: values.get(name) for name in ("azimuth", "depression")}
+        refuse_two_pointings(values.get("aim_at"), pointing)  # in the form's words
         return cls(**values)
 
     return build
-
-
-def refuse_two_pointings(values: dict) -> None:
-    """FieldError on the aim point when a sensor azimuth or depression is given too: the
-    aim point sets both, so what was typed there would be dropped without a word."""
-    given = [FIELD_LABELS[name] for name in ("azimuth", "depression") if values.get(name) is not None]
-    if values.get("aim_at") is None or not given:
-        return
-    verb = "is" if len(given) == 1 else "are"
-    raise FieldError(
-        "aim_at",
-        values["aim_at"],
-        f"no aim point while {' and '.join(given)} {verb} given (an aim point sets both)",
-    )
 
 
 def with_article(noun: str) -> str:
