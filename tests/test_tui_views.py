@@ -19,6 +19,7 @@ from ladartui.sensor import Sensor
 from ladartui.tui.app import LadarApp
 from ladartui.tui.canvas import ProjectionWidget, TopViewWidget
 from ladartui.tui.view_area import ViewArea
+from tui_support import loaded, wait_until
 
 SIZE = (120, 40)
 
@@ -346,10 +347,7 @@ async def test_the_3d_views_open_on_the_whole_flight_and_an_edit_does_not_move_t
     default scenario's) opened with its sides off the view; the top view showed it."""
     app = LadarApp(scenario_path, compile_in_child=False)
     async with app.run_test(size=SIZE) as pilot:
-        start = time.monotonic()
-        while app.scene is None or app.busy is not None:
-            assert time.monotonic() - start < 120, "the app did not load the scene"
-            await pilot.pause(0.05)
+        await wait_until(pilot, lambda: loaded(app), timeout=120)
         app.action_layout(5)
         await pilot.pause()
         await pilot.pause()

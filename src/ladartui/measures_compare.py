@@ -214,18 +214,16 @@ def read_measures_files(paths) -> list:
             raise InputFileError(path, "is a folder; expected a .cmf measures file or a scenario (.toml)")
         if problem := file_problem(path):
             raise InputFileError(path, f"{'scenario' if scenario else 'measures file'} {problem}")
-        out.append(read_cmf(measures_file_of(path) if scenario else path))
+        out.append(read_cmf(_measures_file_of(path) if scenario else path))
     return out
 
 
-def measures_file_of(path: Path) -> Path:
-    """``path``, or for a scenario (.toml) the measures file its runs write."""
-    if path.suffix.lower() != ".toml":
-        return path
+def _measures_file_of(scenario: Path) -> Path:
+    """The measures file a scenario's runs write, there to be read."""
     from ladartui.scenario import load_scenario
 
-    measures = load_scenario(path, check_files=False).measures_file
+    measures = load_scenario(scenario, check_files=False).measures_file
     if problem := file_problem(measures):
         first = ": run it first" if problem == "not found" else ""
-        raise InputFileError(measures, f"measures file of {path.name} {problem}{first}")
+        raise InputFileError(measures, f"measures file of {scenario.name} {problem}{first}")
     return measures

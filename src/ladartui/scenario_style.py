@@ -13,7 +13,7 @@ from typing import TypeGuard
 
 import tomlkit
 from tomlkit.exceptions import TOMLKitError
-from tomlkit.items import AoT, Comment, InlineTable, Table, Whitespace
+from tomlkit.items import AoT, Comment, InlineTable, Whitespace
 
 
 def restyle(old_text: str, data: dict, old_data: dict | None = None) -> str | None:
@@ -112,10 +112,10 @@ def _spaced(container, value):
     next one, so a list written afresh would lose it); anything else as it is."""
     if isinstance(container, InlineTable) or not (_is_table_list(value) or isinstance(value, dict)):
         return value
+    if isinstance(value, dict):
+        return _new_table(value)
     written = tomlkit.item(value)  # a list's tables come apart by a blank line already
-    last = written[-1] if isinstance(written, AoT) else written
-    if isinstance(last, Table):
-        last.add(tomlkit.nl())
+    written[-1].add(tomlkit.nl())
     return written
 
 
