@@ -425,3 +425,56 @@ def test_bytes_that_are_not_utf8_are_named_on_the_line_a_bad_number_would_be(tmp
     path.write_bytes(end.join(lines).replace("abc", "a\xffc").encode("latin-1") + end.encode())
     with pytest.raises(TrajectoryError, match=rf"^{re.escape(str(path))}:3: not UTF-8 text \(byte 0xff\)"):
         load_flight_log(path)
+
+
+def _log_scenario(tmp_path, pointing):
+    (tmp_path / "log.csv").write_text("time,x,y,z,heading\n0,0,0,60,0\n1,10,0,60,0\n")
+    (tmp_path / "s.txt").write_text("0,0,0\n")
+    path = tmp_path / "s.toml"
+    path.write_text(
+        '[files]\nscene = "s.txt"\nvoxel_size = 1.0\n\n[flight]\n[[flight.segments]]\n'
+        f'kind = "log"\nfile = "log.csv"\nrate = 1.0\naim_at = [5.0, 20.0, 0.0]\n{pointing}'
+    )
+    return path
+
+
+def test_a_log_s_sensor_pointing_beside_an_aim_point_is_refused_not_dropped(tmp_path):
+    """The aim point set both angles, so a pointing written beside it was dropped without a word."""
+    from ladartui.scenario import load_scenario
+
+    path = _log_scenario(tmp_path, "depression = 30.0\n")
+    with pytest.raises(FieldError) as caught:
+        load_scenario(path, check_files=False)
+    assert str(caught.value).startswith(f"{path}:10: flight.segments[0].aim_at = [5.0, 20.0, 0.0]: expected ")
+    assert "no aim point while depression is given" in str(caught.value)
+
+
+def test_a_log_written_with_the_default_pointing_beside_its_aim_point_still_reads(tmp_path):
+    """Earlier versions wrote azimuth 0 and depression 90 with every log segment, aimed or not;
+    those files read as before, and a new file is written without the pointing the aim sets."""
+    from ladartui.scenario import load_scenario
+
+    scenario = load_scenario(_log_scenario(tmp_path, "azimuth = 0.0\ndepression = 90.0\n"), check_files=False)
+    segment = scenario.flight.segments[0]
+    assert (segment.azimuth, segment.depression) == (None, None)
+    poses = scenario.poses()
+    assert all(p.depression < 90.0 for p in poses)  # aimed, not straight down
+    again = tmp_path / "again.toml"
+    again.write_text(scenario.to_toml())
+    text = again.read_text()
+    assert "aim_at" in text and "depression" not in text and "azimuth" not in text
+    assert [p.to_dict() for p in load_scenario(again, check_files=False).poses()] == [
+        p.to_dict() for p in poses
+    ]
+
+
+def test_a_log_without_an_aim_point_keeps_its_pointing_and_its_defaults(tmp_path):
+    from ladartui.flight import ScanPose
+    from ladartui.trajectory import LogSegment
+
+    (tmp_path / "log.csv").write_text("time,x,y,z,heading\n0,0,0,60,0\n1,10,0,60,0\n")
+    plain = LogSegment(str(tmp_path / "log.csv"), rate=1.0).build(None)
+    assert [(p.azimuth, p.depression) for p in plain] == [(0.0, 90.0)] * 2
+    tilted = LogSegment(str(tmp_path / "log.csv"), rate=1.0, azimuth=30.0, depression=45.0).build(None)
+    assert [(p.azimuth, p.depression) for p in tilted] == [(30.0, 45.0)] * 2
+    assert isinstance(tilted[0], ScanPose)

@@ -110,6 +110,26 @@ async def test_aim_all_leaves_no_sensor_pointing_beside_the_aim(tmp_path, scene_
     assert aimed.poses() == bridge.aim_all(unpointed, (1.0, 2.0, 0.0)).poses()  # the scans are the same
 
 
+async def test_aim_all_clears_a_flight_log_s_own_pointing_too(tmp_path, scene_files):
+    """A log's pointing beside an aim point is refused, as a manoeuvre's is, so aiming
+    a log must clear it, not keep it for the scenario to refuse."""
+    from ladartui.trajectory import LogSegment
+    from ladartui.tui import bridge
+
+    scenario = make_scenario(tmp_path, scene_files)
+    (tmp_path / "log.csv").write_text("time,x,y,z,heading\n0,0,0,60,0\n1,10,0,60,0\n")
+    log = LogSegment(str(tmp_path / "log.csv"), rate=1.0, azimuth=30.0, depression=45.0)
+    aimed = bridge.aim_all(bridge.with_segments(scenario, [log]), (1.0, 2.0, 0.0))
+    segment = aimed.flight.segments[0]
+    assert segment.aim_at == (1.0, 2.0, 0.0) and segment.azimuth is None is segment.depression
+    assert (
+        aimed.poses()
+        == bridge.aim_all(
+            bridge.with_segments(scenario, [LogSegment(log.file, rate=1.0)]), (1.0, 2.0, 0.0)
+        ).poses()
+    )
+
+
 async def test_a_segment_form_stays_put_as_its_message_changes(tmp_path, scene_files):
     """A two-line message, then a one-line one, moved the whole dialog up and down a row,
     so a click meant for one field landed on the next."""

@@ -63,7 +63,8 @@ Other segment kinds and their keys (``aim_at`` is optional on every kind):
   target).
 * ``kind = "log"``: a recorded flight log ``file`` (CSV, relative to this
   file's folder; see ``ladartui.trajectory``), scans at ``rate`` (Hz) or at
-  ``times = [..]`` (s); ``azimuth`` (default 0), ``depression`` (default 90);
+  ``times = [..]`` (s); ``azimuth`` (default 0), ``depression`` (default 90),
+  or ``aim_at`` (not with them);
   ``origin = [lat, lon, alt]`` places a geodetic (latitude, longitude) log.
   Its scans are timed by the log's own clock, not by ``speed_mps``.
 

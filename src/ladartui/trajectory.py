@@ -274,6 +274,7 @@ def log_attitude(log: FlightLog, times) -> tuple[np.ndarray, np.ndarray]:
 
 
 MAX_SCAN_RATE_HZ = 1000.0
+LOG_AZIMUTH, LOG_DEPRESSION = 0.0, 90.0  # a log segment's sensor pointing when none is given
 
 
 @dataclass(frozen=True)
@@ -283,15 +284,16 @@ class LogSegment:
     ``file``: the CSV log (absolute; the scenario reader resolves it against
     the scenario's folder). Scans at ``rate`` Hz from the log's first record,
     or at the listed ``times`` (seconds, within the log), not both. The sensor
-    points at ``azimuth`` and ``depression`` relative to the aircraft, or at
-    ``aim_at``. Roll and pitch come from the log (used by a body-fixed sensor).
+    points at ``azimuth`` and ``depression`` relative to the aircraft (unset:
+    0 and 90, straight down), or at ``aim_at``, not both. Roll and pitch come
+    from the log (used by a body-fixed sensor).
     """
 
     file: str
     rate: float | None = None
     times: tuple | None = None
-    azimuth: float = 0.0
-    depression: float = 90.0
+    azimuth: float | None = None
+    depression: float | None = None
     aim_at: tuple | None = None
     origin: tuple | None = None  # (lat, lon, alt) of the scene origin, for a geodetic log
     kind: ClassVar[str] = "log"
@@ -316,10 +318,16 @@ class LogSegment:
             raise FieldError(
                 "rate", self.rate, "either a scan rate (Hz) or a list of scan times (s), not both"
             )
-        set_("azimuth", number_field("azimuth", self.azimuth))
-        set_("depression", number_field("depression", self.depression, 1.0, 90.0))
+        if self.azimuth is not None:
+            set_("azimuth", number_field("azimuth", self.azimuth))
+        if self.depression is not None:
+            set_("depression", number_field("depression", self.depression, 1.0, 90.0))
         if self.aim_at is not None:
             set_("aim_at", point_field("aim_at", self.aim_at))
+            self._drop_pointing_the_aim_sets()
+        else:  # the unset pointing as a value, so a log written either way reads alike
+            set_("azimuth", LOG_AZIMUTH if self.azimuth is None else self.azimuth)
+            set_("depression", LOG_DEPRESSION if self.depression is None else self.depression)
         if self.origin is not None:
             try:
                 lat, lon, alt = (float(v) for v in self.origin)
@@ -366,6 +374,17 @@ class LogSegment:
                 raise FieldError("times", self.times, f"{expected}, increasing")
             set_("times", times)
 
+    def _drop_pointing_the_aim_sets(self):
+        """Refuse a pointing beside the aim point, which sets both angles. The unset
+        values themselves are let by, as earlier versions wrote them with every log."""
+        from ladartui.flight.plan import refuse_two_pointings
+
+        unset = {"azimuth": LOG_AZIMUTH, "depression": LOG_DEPRESSION}
+        given = {name: value for name, value in unset.items() if getattr(self, name) not in (None, value)}
+        refuse_two_pointings(self.aim_at, {name: getattr(self, name) for name in given})
+        object.__setattr__(self, "azimuth", None)
+        object.__setattr__(self, "depression", None)
+
     @property
     def log(self) -> FlightLog:
         """The flight log read from ``file`` (read once, when the segment is made)."""
@@ -383,7 +402,9 @@ class LogSegment:
         from ladartui.flight import ScanPose as Pose
         from ladartui.flight import aim_at
 
-        template = Pose(0.0, 0.0, 1.0, 0.0, self.azimuth, self.depression)
+        azimuth = LOG_AZIMUTH if self.azimuth is None else self.azimuth
+        depression = LOG_DEPRESSION if self.depression is None else self.depression
+        template = Pose(0.0, 0.0, 1.0, 0.0, azimuth, depression)
         poses = log_poses(self.log, template, times=self.scan_times())
         return poses if self.aim_at is None else [aim_at(p, self.aim_at) for p in poses]
 

@@ -279,9 +279,9 @@ def aim_all(scenario: Scenario, target_xyz) -> Scenario:
 
 
 def _no_pointing(segment) -> dict:
-    """A manoeuvre's optional sensor pointing cleared: an aim point sets it (the scans
-    are the same); a flight log's own pointing is no option and stays."""
-    return {"azimuth": None, "depression": None} if segment.relative else {}
+    """A sensor pointing (a manoeuvre's, a flight log's) cleared: an aim point sets it,
+    and one given beside it is refused; presets have none."""
+    return {"azimuth": None, "depression": None} if hasattr(segment, "depression") else {}
 
 
 def make_pose(values: dict) -> ScanPose:
