@@ -118,3 +118,35 @@ def test_columns_of_one_name_are_told_apart_in_the_table_and_the_json(tmp_path, 
     ):
         assert cli.main(["compare", *(str(tmp_path / f) for f in files), "--json"]) == 0
         assert json.loads(capsys.readouterr().out)["columns"] == columns
+
+
+def test_bundled_scenarios_are_compared_by_name_as_run_takes_them(tmp_path, capsys, monkeypatch):
+    """'ladartui run convoy' then 'ladartui compare convoy default' said convoy was not found."""
+    from ladartui.user_data import data_home
+    from scenario_support import write_scenario
+
+    monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))
+    monkeypatch.chdir(tmp_path)
+    for name, layers in (("default", 3), ("convoy", 1)):
+        folder = data_home() / name
+        folder.mkdir(parents=True)
+        write_scenario(folder, name=f"{name}.toml")
+        write_run(folder / f"{name}.cmf", seen_layers=layers, scans=2)
+    assert cli.main(["compare", "convoy", "default.toml", "--json"]) == 0
+    said = json.loads(capsys.readouterr().out)
+    assert said["columns"] == ["convoy", "default"]
+    assert said["measures"][2]["values"] == [0.25, 0.75]
+    (tmp_path / "convoy.cmf").write_text((data_home() / "default" / "default.cmf").read_text())
+    assert cli.main(["compare", "convoy.cmf", "convoy", "--json"]) == 0  # a file here is that file
+    assert json.loads(capsys.readouterr().out)["measures"][2]["values"] == [0.75, 0.25]
+
+
+def test_a_bundled_scenario_never_made_is_told_to_run_first_and_not_made(tmp_path, capsys, monkeypatch):
+    from ladartui.user_data import data_home
+
+    monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))
+    monkeypatch.chdir(tmp_path)
+    write_run(tmp_path / "one.cmf", seen_layers=1, scans=1)
+    assert cli.main(["compare", "one.cmf", "convoy"]) == 2
+    assert one_error_line(capsys).endswith("convoy.cmf: measures file of convoy.toml not found: run it first")
+    assert not (data_home() / "convoy").exists()  # no scene generated only to say so

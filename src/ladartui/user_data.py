@@ -150,6 +150,24 @@ def bundled_or_path(argument) -> Path:
     return path
 
 
+def bundled_run(argument) -> Path:
+    """A file argument as a path, a bundled scenario's bare name (as ``bundled_or_path``
+    takes it) standing for that scenario where no file of the name is here; for reading
+    what its runs wrote, so one not made yet is not made (``InputFileError``: no run)."""
+    path = user_path(argument)
+    name = bundled_scenario_name(argument)
+    if name is None or path.is_file():
+        return path
+    scenario = data_home() / name / f"{name}.toml"
+    if not scenario.is_file():
+        from ladartui.errors import InputFileError
+
+        raise InputFileError(
+            scenario.with_suffix(".cmf"), f"measures file of {scenario.name} not found: run it first"
+        )
+    return scenario
+
+
 def load_scenario(path, check_files=True) -> Scenario:
     """``ladartui.load_scenario``: ``scenario.load_scenario``, taking a bundled scenario's
     bare name ("default", "convoy") as the commands do, made ready on first use (a

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import json
 
-from ladartui.fileprobe import user_path
-
 
 def add_parser(subparsers):
     parser = subparsers.add_parser(
@@ -17,7 +15,11 @@ def add_parser(subparsers):
         "value is green and the worst red (the TUI's Compare, F10, shows the same).",
     )
     parser.add_argument(
-        "files", metavar="FILE", nargs="+", help="measures file (.cmf) or scenario (.toml); two or more"
+        "files",
+        metavar="FILE",
+        nargs="+",
+        help="measures file (.cmf) or scenario (.toml), or a bundled scenario's name (default, "
+        "convoy); two or more",
     )
     parser.add_argument(
         "--json",
@@ -33,12 +35,13 @@ def run(args) -> int:
     from ladartui.cli.flags import check_file_names
     from ladartui.errors import FieldError
     from ladartui.measures_compare import column_names, read_measures_files, side_by_side
+    from ladartui.user_data import bundled_run
 
     for file in args.files:
         check_file_names({"FILE": file}, "a measures file (.cmf) or a scenario (.toml)")
     if len(args.files) < 2:
         raise FieldError("FILE", args.files[0], "two or more files to compare")
-    paths = [user_path(file) for file in args.files]
+    paths = [bundled_run(file) for file in args.files]  # "convoy", as run takes it
     rows = side_by_side(read_measures_files(paths))  # a folder is refused before it is named
     names = column_names(paths)
     if args.json:
