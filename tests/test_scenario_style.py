@@ -249,3 +249,20 @@ def test_a_segment_list_written_anew_keeps_a_blank_line_before_every_table(folde
     assert [lines[n - 1] for n in headers] == [""] * len(headers), text
     assert text.endswith("fast_mode = false\n")  # and the file ends as it did
     assert load_scenario(path).flight == saved.flight
+
+
+@pytest.mark.parametrize(
+    ("old", "data", "new"),
+    [
+        # a new table: its blank line before it, as the file's tables have, and none after
+        ("[a]\nx = 1\n\n[b]\ny = 2", {"a": {"x": 1}, "b": {"y": 2}, "c": {"q": 1}}, "\n\n[c]\nq = 1\n"),
+        ("[a]\nx = 1", {"a": {"x": 2}}, "[a]\nx = 2\n"),  # a value changed: its line ended
+        ("[a]\nx = 1", {"a": {"x": 1}}, "[a]\nx = 1"),  # nothing changed: not a byte
+    ],
+)
+def test_a_file_without_a_final_newline_is_restyled_as_one_with_it(old, data, new):
+    """A table added to a file whose last line had no newline came straight under the
+    last key, and the file then ended with a blank line."""
+    text = restyle(old, data)
+    assert text is not None and text.endswith(new), repr(text)
+    assert tomllib.loads(text) == data

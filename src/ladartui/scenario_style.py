@@ -22,13 +22,16 @@ def restyle(old_text: str, data: dict, old_data: dict | None = None) -> str | No
     ``old_data`` is what ``old_text`` meant (defaults filled in); a value equal
     to it is left as the file has it, written or left out.
     """
+    ended = old_text if old_text.endswith("\n") or not old_text else old_text + "\n"
     try:
-        document = tomlkit.parse(old_text)
+        document = tomlkit.parse(ended)  # with its last line ended, as tables added expect
     except TOMLKitError:
         return None
     _merge_table(document, data, old_data)
     text = tomlkit.dumps(document)
-    if old_text.endswith("\n") and not old_text.endswith("\n\n"):
+    if text == ended:
+        return old_text  # unchanged: not even the newline added
+    if not ended.endswith("\n\n"):
         text = text.rstrip("\n") + "\n"  # the blank line after a table written last
     return text
 
