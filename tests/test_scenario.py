@@ -253,6 +253,27 @@ def test_points_a_new_scenario_and_aim_all_write_are_rounded_to_millimetres(tmp_
     assert "29.88051" not in aimed.save().path.read_text()
 
 
+def test_a_start_pose_taken_from_the_first_scan_is_written_as_a_person_would(tmp_path):
+    """An orbit turned into a straight took the orbit's first scan as its start, and the
+    file read 'depression = 44.55443822900466'."""
+    import re
+
+    from ladartui.flight import Straight
+    from ladartui.tui import bridge
+
+    write_models(tmp_path, "woods", ((10, 20, 0), (12, 20, 0), (11, 23, 1)))
+    scenario = Scenario.new(tmp_path / "new.toml", "woods.txt", 0.3)
+    first = scenario.poses()[0]
+    straight = bridge.with_segments(scenario, [Straight(distance=100.0, scans=5)])
+    start = straight.flight.start
+    assert start is not None and start.to_dict() == pytest.approx(first.to_dict(), abs=1e-6)
+    text = straight.save().path.read_text()
+    start_table = text[text.index("[flight.start]") :].split("\n\n")[0]
+    assert not re.search(r"\.\d{7}", start_table), start_table
+    moved = bridge.with_param(scenario, "start.x", 5.0).flight.start  # one field typed
+    assert moved is not None and moved.x == 5.0 and moved.depression == start.depression
+
+
 def test_summary_describes_the_collection(tmp_path):
     write_models(tmp_path / "models")
     scenario = load_scenario(write_scenario(tmp_path))

@@ -90,7 +90,15 @@ def start_pose(scenario: Scenario) -> ScanPose:
     if scenario.flight.start is not None:
         return scenario.flight.start
     poses = scenario.poses()
-    return poses[0] if poses else ScanPose(0.0, 0.0, 100.0)
+    return as_written(poses[0]) if poses else ScanPose(0.0, 0.0, 100.0)
+
+
+def as_written(pose: ScanPose) -> ScanPose:
+    """A computed pose as a person would write it: to the millimetre and the millionth
+    of a degree (3.3 and 44.554438, not 3.3000000000000074 and 44.55443822900466)."""
+    x, y, z = to_millimetres(pose.position)
+    angles = (round(a, 6) for a in (pose.heading, pose.azimuth, pose.depression))
+    return ScanPose(x, y, z, *angles)
 
 
 def param_value(scenario: Scenario, key: str):
