@@ -40,6 +40,27 @@ def test_a_mistyped_command_is_named_not_taken_for_a_scenario(tmp_path, capsys, 
     assert err.endswith(", or a scenario file (.toml) (see 'ladartui -h')\n")
 
 
+@pytest.mark.parametrize(
+    ("argv", "said"),
+    [
+        (
+            ["bench", "--bogus"],
+            "ladartui bench: error: unrecognized arguments: --bogus (see 'ladartui bench -h')\n",
+        ),
+        (
+            ["info", "--backends", "--json"],
+            "ladartui info: error: unrecognized arguments: --json (see 'ladartui info -h')\n",
+        ),
+    ],
+)
+def test_a_flag_a_command_lacks_points_at_that_command_s_help(capsys, argv, said):
+    """'ladartui bench --bogus' said to see 'ladartui -h', which lists no flag of bench."""
+    with pytest.raises(SystemExit) as stop:
+        cli.main(argv)
+    assert stop.value.code == 2
+    assert capsys.readouterr().err == said
+
+
 def test_the_terminal_ui_on_a_folder_names_it_a_folder(tmp_path, capsys):
     """'ladartui tui FOLDER' said 'no such file', where run says 'is a folder'."""
     assert cli.main(["tui", str(tmp_path)]) == 2

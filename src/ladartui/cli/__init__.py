@@ -55,6 +55,18 @@ class _Parser(argparse.ArgumentParser):
         # Arguments are echoed in the message: escape them like any user text.
         self.exit(2, f"{self.prog}: error: {one_line(message)} (see '{self.prog} -h')\n")
 
+    def parse_args(self, args=None, namespace=None):
+        # argparse tells words left over at the top, whose help lists no command's flags:
+        # the command's own parser tells them here, pointing at its help.
+        parsed, extras = self.parse_known_args(args, namespace)
+        if extras:
+            commands = next((a.choices for a in self._actions if a.dest == "command"), None)
+            told_by = (
+                commands.get(getattr(parsed, "command", None), self) if isinstance(commands, dict) else self
+            )
+            told_by.error(f"unrecognized arguments: {' '.join(extras)}")
+        return parsed
+
 
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
