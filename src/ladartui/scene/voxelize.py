@@ -116,12 +116,18 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
             # shared edges: an STL repeats a vertex per triangle, an OBJ keeps one apart
             # per texture coordinate or normal, and per material or object (its parts,
             # each merged on reading, are joined without merging).
-            scene = trimesh.load_scene(
-                source, file_type=kind[1:], resolver=resolver, process=True, merge_tex=True, merge_norm=True
-            )
+            # Read unprocessed: processing drops a vertex that is not finite, and the
+            # triangles using it, where it is to be refused
+            scene = trimesh.load_scene(source, file_type=kind[1:], resolver=resolver, process=False)
+            _refuse_not_finite(path, scene.geometry.values())
+            for part in scene.geometry.values():
+                if isinstance(part, trimesh.Trimesh):  # not a point cloud
+                    part.process(merge_tex=True, merge_norm=True)
             loaded = scene.to_mesh()
             if len(scene.graph.nodes_geometry) > 1:
                 loaded.merge_vertices(merge_tex=True, merge_norm=True)
+    except InputFileError:
+        raise
     except Exception as error:  # trimesh's parsers raise many kinds on malformed text
         raise InputFileError(
             path, f"not a readable {kind[1:].upper()} mesh ({type(error).__name__}: {error})"
@@ -130,9 +136,6 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
     vertices = np.asarray(getattr(loaded, "vertices", np.zeros((0, 3))), dtype=np.float64).reshape(-1, 3)
     if len(faces) == 0:
         raise InputFileError(path, "holds no triangles; expected a triangle mesh")
-    if not np.all(np.isfinite(vertices)):
-        bad = int(np.count_nonzero(~np.all(np.isfinite(vertices), axis=1)))
-        raise InputFileError(path, f"{bad} vertices have coordinates that are not finite numbers")
     problem = _closed_problem(loaded, len(vertices))
     if not problem and _signed_volume(vertices, faces) < 0:
         faces = faces[:, ::-1].copy()  # wound inside out: turn the normals outward
@@ -145,6 +148,25 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
     if up == "y":
         vertices = np.column_stack([vertices[:, 0], -vertices[:, 2], vertices[:, 1]])
     return Mesh(path, vertices, faces, not problem, problem, tuple(notes))
+
+
+def _refuse_not_finite(path: Path, parts) -> None:
+    """``InputFileError`` when a vertex of the mesh as read is not a finite number,
+    counting the triangles that use one."""
+    bad_triangles = bad_vertices = 0
+    for part in parts:
+        vertices = np.asarray(getattr(part, "vertices", np.zeros((0, 3))), dtype=np.float64)
+        bad = ~np.all(np.isfinite(vertices.reshape(-1, 3)), axis=1)
+        if bad.any():
+            bad_vertices += int(np.count_nonzero(bad))
+            faces = np.asarray(getattr(part, "faces", np.zeros((0, 3))), dtype=np.int64).reshape(-1, 3)
+            bad_triangles += int(np.count_nonzero(bad[faces].any(axis=1)))
+    if bad_triangles:
+        uses = "1 triangle uses" if bad_triangles == 1 else f"{bad_triangles:,} triangles use"
+        raise InputFileError(path, f"{uses} a vertex whose coordinates are not finite numbers")
+    if bad_vertices:
+        what = "1 vertex has" if bad_vertices == 1 else f"{bad_vertices:,} vertices have"
+        raise InputFileError(path, f"{what} coordinates that are not finite numbers")
 
 
 def _mesh_source(path: Path, kind: str):
