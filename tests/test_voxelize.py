@@ -430,6 +430,22 @@ def test_a_binary_stl_cut_short_says_so(tmp_path, header):
         )
 
 
+@pytest.mark.parametrize("header", [b"solid exported by CAD", b"binary"])
+@pytest.mark.parametrize("extra", [1, 20, 50])
+def test_a_binary_stl_longer_than_its_header_says_so(tmp_path, header, extra):
+    """Bytes past a binary STL's triangles made it read as text: 'holds no triangles'."""
+    whole = tmp_path / "whole.stl"
+    trimesh.creation.box(extents=(1.0, 2.0, 3.0)).export(whole)
+    long = tmp_path / "long.stl"
+    long.write_bytes(header.ljust(80, b" ") + whole.read_bytes()[80:] + b"\0" * extra)
+    with pytest.raises(InputFileError) as caught:
+        load_mesh(long)
+    assert str(caught.value) == (
+        f"{long}: a binary STL longer than its header says: its header counts 12 triangles "
+        f"(684 bytes), the file has {684 + extra} bytes"
+    )
+
+
 CUBE_OBJ = "".join(f"v {x} {y} {z}\n" for x in (0, 1) for y in (0, 1) for z in (0, 1)) + "".join(
     f"f {a} {b} {c}\n"
     for a, b, c in [

@@ -218,18 +218,19 @@ _BINARY_BYTES = frozenset(range(32)) - frozenset(b"\t\n\v\f\r")
 
 
 def _check_stl_whole(path: Path, data: bytes) -> None:
-    """``InputFileError`` for a binary STL shorter than its header's triangle count says
-    (read as text when its header begins "solid", it would hold no triangles)."""
+    """``InputFileError`` for a binary STL shorter or longer than its header's triangle
+    count says (not sized as binary, it would be read as text and hold no triangles)."""
     read = _stl_head(data)
     if read is None:
         return
     size, count, head = read
     need = 84 + 50 * count
-    if count == 0 or size >= need or (size > 84 and not _BINARY_BYTES & set(head[84:])):
+    if count == 0 or size == need or (size > 84 and not _BINARY_BYTES & set(head[84:])):
         return  # whole, or text: an ASCII STL (a bare header holds no triangle either way)
+    what = "cut short" if size < need else "longer than its header says"
     raise InputFileError(
         path,
-        f"a binary STL cut short: its header counts {count:,} triangles ({need:,} bytes), "
+        f"a binary STL {what}: its header counts {count:,} triangles ({need:,} bytes), "
         f"the file has {size:,} bytes",
     )
 
