@@ -311,6 +311,20 @@ def test_too_fine_a_voxel_size_is_refused_up_front(monkeypatch):
         voxelize(sphere, 0.01, solid=True)
 
 
+def test_a_mesh_in_millimetres_too_large_for_the_memory_is_named_by_its_span(monkeypatch):
+    """A CAD model in mm read as metres was refused with 'use a larger --voxel-size' alone."""
+    monkeypatch.setenv("LADARTUI_MAX_MEMORY", str(2**30))
+    truck = as_mesh(trimesh.creation.box(extents=(2500.0, 5000.0, 2200.0)))
+    with pytest.raises(ResourceLimitError) as caught:
+        voxelize(truck, 0.1)
+    assert str(caught.value).startswith(
+        "made.obj: the mesh spans 2500 x 5000 x 2200 m; voxel size 0.1 m makes "
+    )
+    assert str(caught.value).endswith(
+        "check its units (--scale 0.001 for millimetres) or use a larger --voxel-size"
+    )
+
+
 def test_progress_and_cancel():
     sphere = as_mesh(trimesh.creation.icosphere(subdivisions=5, radius=10.0))  # 20,480 triangles
     seen = []

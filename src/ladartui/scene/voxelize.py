@@ -366,10 +366,9 @@ def grid_triangles(mesh: Mesh, voxel_size: float, placement: Placement | None = 
         sides = high - low
     # The mesh first, then where it goes: from here on no sum or quotient overflows.
     if float(sides.max()) / vs >= MAX_INDEX - 1:
-        span = " x ".join(f"{side:.4g}" for side in sides)
         raise InputFileError(
             mesh.path,
-            f"the mesh spans {span} m: at voxel size {vs:g} m its voxel indices would pass "
+            f"the mesh spans {_span_text(sides)} m: at voxel size {vs:g} m its voxel indices would pass "
             f"{MAX_INDEX}; check its units (--scale) and its farthest vertices, or use a coarser "
             "--voxel-size",
         )
@@ -411,6 +410,11 @@ def grid_triangles(mesh: Mesh, voxel_size: float, placement: Placement | None = 
     if placement is not None and grid.max() > MAX_INDEX - 1:  # the mesh fits; where it goes does not
         raise _past_the_grid(placement)
     return np.ascontiguousarray(grid[mesh.faces])
+
+
+def _span_text(sides) -> str:
+    """A mesh's sides in metres, "2500 x 5000 x 2200": units mistaken show."""
+    return " x ".join(f"{side:.4g}" for side in sides)
 
 
 def _past_the_grid(placement) -> FieldError:
@@ -522,10 +526,13 @@ def voxelize(
     grid = _working_grid(triangles)
     if need > limit:
         nx, ny, nz = grid.shape
+        used = mesh.vertices[np.unique(mesh.faces)]
+        span = _span_text(used.max(axis=0) - used.min(axis=0))
         raise ResourceLimitError(
-            f"{mesh.path}: voxel size {voxel_size:g} m makes a {nx:,} x {ny:,} x {nz:,} voxel box "
-            f"needing about {gib(need)}, more than the {gib(limit)} of memory available; "
-            "use a larger --voxel-size"
+            f"{mesh.path}: the mesh spans {span} m; voxel size {voxel_size:g} m makes a "
+            f"{nx:,} x {ny:,} x {nz:,} voxel box needing about {gib(need)}, more than the "
+            f"{gib(limit)} of memory available; check its units (--scale 0.001 for millimetres) "
+            "or use a larger --voxel-size"
         )
     from ladartui.scene import voxelize_kernels as kernels
 
