@@ -206,6 +206,20 @@ def test_info_on_a_target_model_looks_for_no_target_model_of_it(tmp_path, capsys
     assert "target" not in rows and rows["targets"].split(None, 1)[1] == "2 targets (ids 1, 2)"
 
 
+def test_info_reads_x_y_z_id_lines_as_a_target_model_whatever_its_name(tmp_path, capsys):
+    """voxelize MESH truck.txt --id 7 writes x,y,z,id lines; info on it said 'truck.txt:1: 4
+    comma-separated values in '0,0,0,7'; expected three non-negative integers x,y,z'."""
+    (tmp_path / "truck.txt").write_text("0,0,0,7\n1,0,0,7\n")
+    assert main(["info", str(tmp_path / "truck.txt")]) == 0
+    rows = {line.split()[0]: line for line in capsys.readouterr().out.splitlines()[1:]}
+    assert rows["voxels"].split(None, 1)[1] == "2"
+    assert "target" not in rows and rows["targets"].split(None, 1)[1] == "1 target (id 7)"
+    (tmp_path / "bad.txt").write_text("0,0,0,7\n1,0,0\n")  # nor a target model
+    assert main(["info", str(tmp_path / "bad.txt")]) == 2
+    said = one_error_line(capsys).removeprefix("ladartui: error: ")
+    assert said.startswith(f"{tmp_path / 'bad.txt'}:1: 4 comma-separated values in '0,0,0,7'")
+
+
 def test_info_on_a_runs_outputs_says_they_are_a_runs_outputs(tmp_path, capsys):
     """S_Scene.txt was said to have no target model (S_Scene_Target.txt not found), and
     S_Target.txt, the voxels the target-only run saw, was read as a target model."""

@@ -103,6 +103,7 @@ def print_scenario(path: Path) -> None:
 
 
 def print_voxel_list(path: Path, voxel_size=None) -> None:
+    from ladartui.errors import InputFileError
     from ladartui.fingerprint import Digest
     from ladartui.scene.keys import count_inside
     from ladartui.scene.model import target_path_for
@@ -123,7 +124,15 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
         voxels, ids = load_target(path, digest)
         duplicates = 0
     else:
-        voxels, duplicates = load_voxels_counted(path, digest=digest)
+        try:
+            voxels, duplicates = load_voxels_counted(path, digest=digest)
+        except InputFileError as error:
+            # x,y,z,id lines are a target model whatever the file's name (voxelize --id
+            # writes OUT so): read as one, else the error as a voxel list stands
+            target = _as_target_model(path) if record is None and error.line == 1 else None
+            if target is None:
+                raise
+            (voxels, ids), duplicates, is_target_model = target, 0, True
     loaded = time.perf_counter() - started
     output = None if record is None else _run_output(path, record, digest.fingerprint())
     rows = [
@@ -171,6 +180,16 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
     width = max(len(name) for name, _ in rows)
     for name, text in rows:
         print(single_line(f"  {name:<{width}}  {text}"))
+
+
+def _as_target_model(path: Path):
+    """(voxels, ids) of ``path`` read as a target model; None when it is not one either."""
+    from ladartui.scene.target_model import load_target
+
+    try:
+        return load_target(path)
+    except LadarError:
+        return None
 
 
 def _run_record_beside(path: Path) -> Path | None:
