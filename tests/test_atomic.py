@@ -38,3 +38,69 @@ def test_new_file_gets_umask_mode_and_existing_keeps_its_mode(tmp_path):
         assert stat.S_IMODE(kept.stat().st_mode) == 0o640
     finally:
         os.umask(umask)
+
+
+def _writer_paused_mid_write(target, started):
+    """A child that writes ``target`` atomically and stops halfway, as a long write does."""
+    import time
+
+    with atomic_path(target) as tmp:
+        tmp.write_text("half")
+        started.set()
+        time.sleep(60)
+
+
+def _aged(path, seconds=3600):
+    import time
+
+    past = time.time() - seconds
+    os.utime(path, (past, past))
+
+
+def test_a_killed_write_s_temporary_is_removed_by_the_next_write_and_a_live_one_kept(tmp_path):
+    """A write killed (SIGKILL) left its hidden temporary, 40-70 MB for a trace or a
+    voxelised mesh, and every later write left it there: they piled up one a kill."""
+    import multiprocessing
+    import signal
+
+    target = tmp_path / "hits.npy"
+    target.write_text("old")
+    context = multiprocessing.get_context("spawn")  # no threads of this process copied
+    writers = []
+    for _ in range(2):
+        started = context.Event()
+        writer = context.Process(target=_writer_paused_mid_write, args=(target, started))
+        writer.start()
+        assert started.wait(30)
+        writers.append(writer)
+    killed, alive = writers
+    os.kill(killed.pid, signal.SIGKILL)
+    killed.join()
+    temporaries = sorted(p for p in tmp_path.iterdir() if p.name != "hits.npy")
+    assert len(temporaries) == 2
+    for temporary in temporaries:
+        _aged(temporary)  # both old: only the live writer's hold keeps its own
+    try:
+        write_text_atomic(target, "new")
+        assert target.read_text() == "new"
+        left = [p for p in tmp_path.iterdir() if p.name != "hits.npy"]
+        assert len(left) == 1  # the live writer's, still being written
+    finally:
+        alive.kill()
+        alive.join()
+
+
+def test_a_fresh_temporary_no_one_holds_is_left_for_a_writer_about_to_hold_it(tmp_path):
+    """Between making its temporary and holding it a writer is exposed: a temporary a
+    few seconds old is never taken for a killed write's."""
+    target = tmp_path / "out.txt"
+    fresh = tmp_path / ".out.txt.abcd1234.tmp"
+    fresh.write_text("just made")
+    old = tmp_path / ".out.txt.efgh5678.tmp"
+    old.write_text("left by a kill")
+    _aged(old)
+    other = tmp_path / ".other.txt.ijkl9012.tmp"  # another file's: not this write's to judge
+    other.write_text("x")
+    _aged(other)
+    write_text_atomic(target, "new")
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([fresh.name, other.name, "out.txt"])

@@ -1,8 +1,16 @@
-"""Atomic file writes: write a temporary file beside the target, then rename over it."""
+"""Atomic file writes: write a temporary file beside the target, then rename over it.
+
+A writer holds a lock on its temporary (flock) for as long as it writes, and the
+system lets go of it when the writer ends, killed or not; so a temporary no one
+holds, and not made just now, is a killed write's, and the next write of the same
+file removes it (otherwise each kill left one, as large as the file, for good).
+"""
 
 import contextlib
+import fcntl
 import os
 import tempfile
+import time
 from pathlib import Path
 
 from ladartui.errors import OutputFileError, os_reason
@@ -16,17 +24,63 @@ def atomic_path(target):
     """
     target = Path(target)
     target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    os.close(fd)
-    # mkstemp makes the file owner-only; give it the mode a plain open() would.
-    os.chmod(tmp, _default_mode(target))
+    remove_abandoned(target)
+    fd, tmp = held_temporary(target)
     try:
-        yield Path(tmp)
+        yield tmp
         os.replace(tmp, target)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
         raise
+    finally:
+        os.close(fd)  # lets go of the hold
+
+
+# A writer is exposed between making its temporary and holding it: one younger than
+# this is never taken for a killed write's.
+ABANDONED_AFTER_S = 10.0
+
+
+def held_temporary(target: Path, mode: int | None = None) -> tuple[int, Path]:
+    """A new hidden temporary beside ``target`` (".NAME.XXXXXXXX.tmp"), held: the
+    descriptor to close when done with it, and its path. ``mode``: its permissions
+    (default: those a plain open() would give ``target``; mkstemp's are owner-only)."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    with contextlib.suppress(OSError):  # a file system without locks: held by no one
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    os.chmod(tmp, _default_mode(target) if mode is None else mode)
+    return fd, Path(tmp)
+
+
+def remove_abandoned(target: Path) -> None:
+    """Remove the temporaries of ``target`` that killed writes left: held by no one,
+    and older than ``ABANDONED_AFTER_S``. Another file's, or one still held, is kept."""
+    prefix = f".{target.name}."
+    try:
+        entries = list(os.scandir(target.parent))
+    except OSError:
+        return
+    now = time.time()
+    for entry in entries:
+        middle = entry.name[len(prefix) : -len(".tmp")]
+        if not (entry.name.startswith(prefix) and entry.name.endswith(".tmp")) or not middle or "." in middle:
+            continue
+        try:
+            if not entry.is_file(follow_symlinks=False):
+                continue
+            if now - entry.stat(follow_symlinks=False).st_mtime < ABANDONED_AFTER_S:
+                continue
+            fd = os.open(entry.path, os.O_RDONLY | os.O_NONBLOCK | os.O_NOFOLLOW)
+        except OSError:
+            continue
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # refused while its writer lives
+            os.unlink(entry.path)
+        except OSError:
+            pass
+        finally:
+            os.close(fd)
 
 
 @contextlib.contextmanager

@@ -24,6 +24,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from ladartui.atomic import held_temporary
 from ladartui.errors import OutputFileError, check_cancelled, os_reason
 from ladartui.fileprobe import SPECIAL_FILE
 
@@ -268,12 +269,11 @@ class OutputSet:
         on failure), so the files on disk always belong to one run.
         """
         temps: dict[str, Path] = {}
+        holds: list[int] = []  # so a plain atomic write of one of the names keeps them
         try:
             for name, path in self.paths.items():
-                fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-                os.close(fd)
-                temps[name] = Path(tmp)
-                os.chmod(tmp, _default_mode(path))
+                fd, temps[name] = held_temporary(path)
+                holds.append(fd)
                 try:
                     writers[name](temps[name])
                 except OSError as error:
@@ -286,6 +286,8 @@ class OutputSet:
             for temp in temps.values():
                 with contextlib.suppress(OSError):
                     temp.unlink()
+            for fd in holds:
+                os.close(fd)
         return {name: str(path) for name, path in self.paths.items()}
 
     def write_contents(
@@ -427,11 +429,3 @@ def _fsync_dir(folder: Path):
             os.fsync(fd)
         finally:
             os.close(fd)
-
-
-def _default_mode(target: Path) -> int:
-    if target.exists():
-        return target.stat().st_mode & 0o7777
-    umask = os.umask(0)
-    os.umask(umask)
-    return 0o666 & ~umask
