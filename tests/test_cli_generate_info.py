@@ -22,9 +22,23 @@ def test_generate_writes_the_pair_and_reports_it(tmp_path, capsys):
     np.testing.assert_array_equal(target, expected.target)
     assert f"({len(scene):,} voxels)" in out and f"({len(target):,} voxels)" in out
     assert "voxel size 0.25 m" in out
-    assert "extent 240 x 240 x" in out
+    assert "area 60 x 60 m (240 x 240 voxels of 0.25 m)" in out
+    assert "extent x 0..239, y 0..239, z 0.." in out
     x, y, z = expected.target_centre
     assert f"target centre ({x:.2f}, {y:.2f}, {z:.2f}) m" in out
+
+
+def test_generate_gives_the_extent_the_file_reads_back_with_and_the_area_laid_out(tmp_path, capsys):
+    """'generate reference' said 'extent 1500 x 1500 x 900 voxels', the preset's grid,
+    where info on the file it wrote said 'z 0..279': a voxel list keeps no empty space."""
+    stem = tmp_path / "ref"
+    assert main(["generate", "reference", str(stem), "--trees", "2"]) == 0
+    said = dict(line.split(" ", 1) for line in capsys.readouterr().out.splitlines())
+    assert main(["info", str(tmp_path / "ref.txt")]) == 0
+    info = dict(line.strip().split(None, 1) for line in capsys.readouterr().out.splitlines()[1:])
+    assert said["extent"] == info["extent"]  # "x 667..842, y 710..840, z 0..262  (shape ...)"
+    assert said["area"] == "150 x 150 m (1500 x 1500 voxels of 0.1 m)"
+    assert "900" not in said["extent"]
 
 
 def test_generate_accepts_a_txt_stem_and_options(tmp_path, capsys):

@@ -32,6 +32,13 @@ def extent_metres(shape, voxel_size: float) -> str:
     return " x ".join(trimmed(n * voxel_size) for n in shape)
 
 
+def extent_ranges(lo, hi) -> str:
+    """The index ranges of voxels from ``lo`` to ``hi`` and the shape a reader gives
+    them: "x 0..239, y 0..239, z 0..72  (shape 240 x 240 x 73)"."""
+    ranges = ", ".join(f"{axis} {int(low)}..{int(high)}" for axis, low, high in zip("xyz", lo, hi))
+    return f"{ranges}  (shape {' x '.join(str(int(h) + 1) for h in hi)})"
+
+
 def plural(count: int, noun: str, nouns: str | None = None) -> str:
     """``count`` with thousands separators and ``noun``, plural unless it is 1:
     "1 voxel", "2,048 voxels"; ``nouns`` where the plural is not noun + "s"."""

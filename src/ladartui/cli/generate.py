@@ -7,7 +7,7 @@ import time
 from pathlib import Path
 
 from ladartui.errors import FieldError, LadarError
-from ladartui.number_text import extent_metres, plural
+from ladartui.number_text import extent_metres, extent_ranges, plural
 from ladartui.textsafe import single_line
 
 
@@ -129,7 +129,7 @@ def run(args) -> int:
     import numpy as np
 
     vs = scene.voxel_size
-    nx, ny, nz = scene.shape
+    nx, ny = scene.shape[:2]
     print(
         single_line(
             f"wrote {scene_path} ({plural(len(scene.voxels), 'voxel')}) and {target_path} "
@@ -139,7 +139,11 @@ def run(args) -> int:
     if las_files:
         print(single_line(f"wrote {las_files[0]} and {las_files[1]} (voxel centres in metres)"))
     print(f"preset {scene.preset}, seed {scene.seed}, voxel size {vs:g} m")
-    print(f"extent {nx} x {ny} x {nz} voxels = {extent_metres(scene.shape, vs)} m")
+    print(f"area {extent_metres((nx, ny), vs)} m ({nx} x {ny} voxels of {vs:g} m)")
+    if len(scene.voxels):  # as the file reads back: a voxel list keeps no empty space
+        from ladartui.scene.occupancy import column_bounds
+
+        print(f"extent {extent_ranges(*column_bounds(scene.voxels))}")
     print("parts (before merging): " + ", ".join(f"{k} {v:,}" for k, v in scene.parts.items()))
     if scene.target_centre is not None:
         x, y, z = scene.target_centre

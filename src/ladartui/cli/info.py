@@ -7,7 +7,7 @@ from pathlib import Path
 
 from ladartui.errors import LadarError
 from ladartui.fileprobe import file_problem
-from ladartui.number_text import extent_metres, plural
+from ladartui.number_text import extent_metres, extent_ranges, plural
 from ladartui.textsafe import single_line, visible
 
 
@@ -148,8 +148,7 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
     if len(voxels):
         lo, hi = column_bounds(voxels)
         shape = tuple(int(h) + 1 for h in hi)
-        ranges = ", ".join(f"{axis} {int(low)}..{int(high)}" for axis, low, high in zip("xyz", lo, hi))
-        rows.append(("extent", f"{ranges}  (shape {shape[0]} x {shape[1]} x {shape[2]})"))
+        rows.append(("extent", extent_ranges(lo, hi)))
         if voxel_size:  # the span the ranges give, then the shape as validate gives a scene's
             span = extent_metres(hi - lo + 1, voxel_size)
             rows.append(
