@@ -90,8 +90,9 @@ def test_a_clash_of_ids_or_voxels_is_one_line_and_nothing_written(tmp_path, box,
     )
     # The box at (7, 7) m covers voxels 14..15: target 2's voxel 14,14,1 among them.
     assert main([*args, "--at", "7,7", "--into", str(scene_path), "--id", "3"]) == 2
-    line = one_error_line(capsys)
-    assert "1 of the vehicle's voxels are already target voxels (voxel 14,14,1 is target 2)" in line
+    line = one_error_line(capsys)  # named in the file that holds the targets
+    assert f"{tmp_path / 'field_Target.txt'}: 1 of the vehicle's voxels are already target voxels " in line
+    assert "(voxel 14,14,1 is target 2)" in line
     assert main([*args, "--id", "0"]) == 2
     assert "--id = 0: expected a target id from 1 to 65535" in one_error_line(capsys)
     assert (tmp_path / "field_Target.txt").read_text() == before

@@ -145,7 +145,8 @@ def _add_target(
         owner = int(ids[int(np.flatnonzero(target_keys == voxel_keys(first[None, :])[0])[0])])
         x, y, z = (int(c) for c in first)
         raise LadarError(
-            f"{source}: {int(clash.sum()):,} of the vehicle's voxels are already target voxels "
+            f"{target_path_for(Path(str(source)))}: {int(clash.sum()):,} of the vehicle's voxels are "
+            "already target voxels "
             f"(voxel {x},{y},{z} is target {owner}); expected the vehicle apart from the other "
             "targets (move it with --at)"
         )
