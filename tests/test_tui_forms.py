@@ -140,13 +140,40 @@ async def test_a_segment_the_whole_path_refuses_keeps_its_form_open(tmp_path, sc
         form.query_one("#form-ok").press()
         await pilot.pause()
         assert app.screen is form
-        assert message(form) == "flight.segments = '10005 scans': expected at most 10000 scans"
+        # in the form's words, of the field that makes the path too long, focused
+        assert message(form) == (
+            "Scans: 9999 is not allowed; expected at most 9994 here "
+            "(the path's other segments have 6 scans; a path has at most 10000)"
+        )
+        assert app.focused is form.query_one("#f-scans")
         assert form.query_one("#f-scans").value == "9999"
         assert len(app.scenario.flight.segments) == 1
         await type_into(pilot, form.query_one("#f-scans"), "9994", commit="tab")
         form.query_one("#form-ok").press()
         await pilot.pause()
         assert app.screen is not form and len(app.scenario.poses()) == 10000
+
+
+async def test_a_standoff_the_whole_path_refuses_names_its_standoffs(tmp_path, scene_files):
+    """'flight.segments = '10002 scans': expected at most 10000 scans' named no field of
+    the form; a standoff's scans are its standoffs."""
+    from ladartui.flight import FlightPlan, Straight
+
+    scenario = make_scenario(tmp_path, scene_files)  # 6 scans
+    long = Straight(distance=1000.0, scans=9993)
+    scenario = scenario.with_changes(flight=FlightPlan(None, (*scenario.flight.segments, long)))
+    scenario.save()
+    async with opened(scenario) as (app, pilot):
+        app.action_show_tab("flight")
+        form = await screen_after(pilot, lambda: app.action_add_segment("standoff"), FormScreen)
+        form.query_one("#form-ok").press()
+        await pilot.pause()
+        assert app.screen is form
+        assert message(form) == (
+            "Standoffs m: 50, 100, 150 is not allowed; expected at most 1 standoff here "
+            "(the path's other segments have 9999 scans; a path has at most 10000)"
+        )
+        assert app.focused is form.query_one("#f-standoffs")
 
 
 async def test_the_threshold_form_says_why_an_infinite_height_is_refused(tmp_path, scene_files):

@@ -16,6 +16,7 @@ from ladartui.defaults import to_millimetres
 from ladartui.errors import FieldError, InputFileError, LadarError
 from ladartui.fileprobe import file_problem, other_file_kind
 from ladartui.flight import (
+    MAX_SCANS,
     SEGMENT_KINDS,
     FlightPlan,
     FlyPast,
@@ -265,12 +266,41 @@ def segment_summary(segment) -> str:
     return ""
 
 
-def with_segments(scenario: Scenario, segments) -> Scenario:
-    """The scenario with a new segment list (checked by the scenario)."""
+def _plan(scenario: Scenario, segments) -> FlightPlan:
     start = scenario.flight.start
     if start is None and segments and segments[0].relative:  # else no segment starts from it
         start = start_pose(scenario)
-    return scenario.with_changes(flight=FlightPlan(start, tuple(segments)))
+    return FlightPlan(start, tuple(segments))
+
+
+def with_segments(scenario: Scenario, segments) -> Scenario:
+    """The scenario with a new segment list (checked by the scenario)."""
+    return scenario.with_changes(flight=_plan(scenario, segments))
+
+
+def with_segment_at(scenario: Scenario, segments, position: int) -> Scenario:
+    """``with_segments`` for the form of segment ``position``: a path of more scans than
+    a path may have is refused naming that segment's field as the form does (its scans,
+    a standoff's standoffs), with the room the other segments leave it."""
+    try:
+        return with_segments(scenario, segments)
+    except FieldError as error:
+        if error.field != "flight.segments":
+            raise
+        counts = [len(poses) for poses in _plan(scenario, segments).segment_poses()]
+        if sum(counts) <= MAX_SCANS:
+            raise
+    segment = segments[position]
+    others = sum(counts) - counts[position]
+    room = MAX_SCANS - others
+    name, what = "scans", ""
+    value: object = getattr(segment, "scans", counts[position])
+    if isinstance(segment, Standoff):
+        name, value, what = "standoffs", segment.standoffs, " standoff" if room == 1 else " standoffs"
+    why = f"the path's other segments have {others} scans"
+    if room < 1:
+        raise FieldError(name, value, f"none here ({why}, the most a path has)")
+    raise FieldError(name, value, f"at most {room}{what} here ({why}; a path has at most {MAX_SCANS})")
 
 
 def aim_all(scenario: Scenario, target_xyz) -> Scenario:

@@ -137,7 +137,8 @@ class FlightPanel(ParamPanel):
             built = build(values)
             scenario = self.host.scenario
             if scenario is not None:
-                bridge.with_segments(scenario, _placed(scenario.flight.segments, index, built))
+                segments = _placed(scenario.flight.segments, index, built)
+                bridge.with_segment_at(scenario, segments, len(segments) - 1 if index is None else index)
             return built
 
         def done(result):
