@@ -150,3 +150,50 @@ def test_a_bundled_scenario_never_made_is_told_to_run_first_and_not_made(tmp_pat
     assert cli.main(["compare", "one.cmf", "convoy"]) == 2
     assert one_error_line(capsys).endswith("convoy.cmf: measures file of convoy.toml not found: run it first")
     assert not (data_home() / "convoy").exists()  # no scene generated only to say so
+
+
+def test_geiger_runs_are_compared_by_their_detection_figures_too(tmp_path, capsys):
+    """A 10-pulse and a 100-pulse run differ most in their false alarms, which their .cmf
+    files hold: compare showed their coverages alone, as if the sensor were the same."""
+    import dataclasses
+
+    from ladartui.detection.measures import DetectionMeasures
+
+    def geiger(measures, pulses, false_alarms, detection):
+        figures = DetectionMeasures(
+            pulses=pulses,
+            coincidence=max(1, pulses // 10),
+            seed=0,
+            declared_points=1000 + false_alarms,
+            declared_per_look=(1000 + false_alarms) / 10,
+            false_alarms=false_alarms,
+            false_alarms_per_look=false_alarms / 10,
+            false_alarm_probability=false_alarms / 1e6,
+            target_detection=detection,
+            ideal_obscured_coverage=0.75,
+            ideal_unobscured_coverage=0.75,
+        )
+        return dataclasses.replace(measures, detection=figures)
+
+    ten = geiger(write_run(tmp_path / "ten.cmf", seen_layers=3, scans=10), 10, 6908, 0.924)
+    (tmp_path / "ten.cmf").write_text(ten.to_cmf())
+    hundred = geiger(write_run(tmp_path / "hundred.cmf", seen_layers=3, scans=10), 100, 0, 0.898)
+    (tmp_path / "hundred.cmf").write_text(hundred.to_cmf())
+    write_run(tmp_path / "ideal.cmf", seen_layers=3, scans=10)
+    files = [str(tmp_path / f"{name}.cmf") for name in ("ten", "hundred", "ideal")]
+    assert cli.main(["compare", *files, "--json"]) == 0
+    rows = {row["measure"]: row for row in json.loads(capsys.readouterr().out)["measures"]}
+    alarms = rows["False alarms"]
+    assert alarms["values"] == [6908, 0, None] and alarms["text"] == ["6,908", "0", "ideal sensor"]
+    assert (alarms["best"], alarms["worst"]) == (["hundred"], ["ten"])  # fewer is better
+    detected = rows["P_d of target voxels"]
+    assert detected["text"] == ["92.4%", "89.8%", "ideal sensor"] and detected["best"] == ["ten"]
+    assert rows["Pulses per look"]["values"] == [10, 100, None]
+    assert rows["Coincidence k"]["values"] == [1, 10, None]
+    assert rows["Declared points"]["values"] == [7908, 1000, None]
+    ideal = rows["Ideal sensor: obscured coverage"]  # an ideal run's is its own coverage
+    assert ideal["values"] == [0.75, 0.75, 0.75] and ideal["text"] == ["75.0%"] * 3
+    # ideal runs alone have no such rows
+    assert cli.main(["compare", files[2], files[2], "--json"]) == 0
+    said = json.loads(capsys.readouterr().out)["measures"]
+    assert not any(row["measure"] == "False alarms" for row in said)

@@ -1,7 +1,8 @@
 """Several runs' measures side by side: the TUI's Compare (F10) and ``ladartui compare``.
 
 ``side_by_side`` gives one ``CompareRow`` per measure (then per level, then per
-target when every run holds the same several targets): the runs' values, their
+Geiger-mode figure when a run has them, then per target when every run holds the
+same several targets): the runs' values, their
 text, whether the runs differ, and which columns are best and worst for a
 measure with a direction of goodness. ``styled`` colours a row for a terminal
 (rich): differing labels and values yellow, the best bold green, the worst
@@ -49,6 +50,25 @@ ROWS = [
     ("Flight time (s)", "flight_time_s", "num1", "low"),
 ]
 
+# Geiger-mode figures (the .cmf's [geiger detection]), shown when a run has them; a run
+# of the ideal sensor reads IDEAL there, but for the ideal coverages: its own
+DETECTION_ROWS = [
+    ("Pulses per look", "detection.pulses", "int", None),
+    ("Coincidence k", "detection.coincidence", "int", None),
+    ("Declared points", "detection.declared_points", "int", None),
+    ("False alarms", "detection.false_alarms", "int", "low"),
+    ("False alarms per look", "detection.false_alarms_per_look", "num1", "low"),
+    ("False-alarm probability per noise bin", "detection.false_alarm_probability", "prob", "low"),
+    ("P_d of target voxels", "detection.target_detection", "pct", "high"),
+    ("Ideal sensor: obscured coverage", "detection.ideal_obscured_coverage", "pct", None),
+    ("Ideal sensor: unobscured coverage", "detection.ideal_unobscured_coverage", "pct", None),
+]
+IDEAL = "ideal sensor"
+IDEAL_OWN = {
+    "detection.ideal_obscured_coverage": "obscured_coverage",
+    "detection.ideal_unobscured_coverage": "unobscured_coverage",
+}
+
 # per target, in the comparison
 TARGET_ROWS = [
     ("obscured coverage", "obscured_coverage", "pct", "high"),
@@ -80,6 +100,8 @@ def format_value(value, kind: str) -> str:
         return ", ".join(fixed(v, 3) for v in value)
     if kind == "num1":
         return fixed(value, 1)
+    if kind == "prob":
+        return f"{float(value):.6f}"
     return fixed(value, 3)
 
 
@@ -98,8 +120,8 @@ class CompareRow:
 
 def side_by_side(all_measures: list) -> list[CompareRow]:
     """One row per measure of ``all_measures`` (``Measures`` or their dicts), then the
-    scan each level was reached at, then rows per target when every run holds the
-    same several targets."""
+    scan each level was reached at, then the Geiger-mode figures when a run has them,
+    then rows per target when every run holds the same several targets."""
     dicts = [m if isinstance(m, dict) else m.to_dict() for m in all_measures]
     rows = [
         _compare_row(label, [lookup(d, path) for d in dicts], kind, better)
@@ -109,6 +131,13 @@ def side_by_side(all_measures: list) -> list[CompareRow]:
         rows.append(
             _level_row(f"{level.capitalize()} at scan", [lookup(d, f"levels.{level}") for d in dicts])
         )
+    geiger = [isinstance(d.get("detection"), dict) for d in dicts]
+    if any(geiger):
+        for label, path, kind, better in DETECTION_ROWS:
+            own = IDEAL_OWN.get(path)
+            values = [lookup(d, path) if g else own and lookup(d, own) for d, g in zip(dicts, geiger)]
+            texts = tuple(format_value(v, kind) if g or own else IDEAL for v, g in zip(values, geiger))
+            rows.append(_compare_row(label, values, kind, better, texts=texts))
     targets = [d.get("targets") for d in dicts]
     if all(isinstance(t, dict) for t in targets):
         per = [{t["id"]: t for t in tt["per_target"]} for tt in targets if isinstance(tt, dict)]
