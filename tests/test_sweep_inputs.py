@@ -169,6 +169,20 @@ def test_a_base_over_the_ray_limit_can_be_swept_down_to_variants_under_it(tmp_pa
     )
 
 
+def test_a_spec_refused_for_the_ray_limit_says_so_when_other_variants_are_impossible(tmp_path, monkeypatch):
+    """Of 'sensor_grid = [0, 64]' over the limit, the refusal named the impossible 0 alone:
+    dropping it, the analyst met the limit that had stopped the 64 all along."""
+    write_tiny_scenario(tmp_path)
+    spec = write_spec(tmp_path, "[grid]\nsensor_grid = [0, 64]\n", name="mixed.toml")
+    monkeypatch.setenv("LADARTUI_MAX_RAYS", "5000")  # 64 x 64 detectors, 4 scans: 131,072 rays
+    with pytest.raises(InputFileError) as refused:
+        run_sweep(spec, serial=True, out=tmp_path / "o")
+    message = str(refused.value)
+    assert "mixed.toml:4: grid.sensor_grid: no variant can run: " in message
+    assert "1.31e+05 rays" in message and "LADARTUI_MAX_RAYS" in message
+    assert "sensor_grid = 0" not in message and not (tmp_path / "o").exists()
+
+
 def test_a_spec_file_name_that_cannot_name_the_best_path_file_asks_for_sweep_name(tmp_path):
     """'my sweep.toml' was refused as 'sweep.name: ... (got 'my sweep')', a key not in the
     file: the default comes from the file name, which the message now says."""

@@ -124,19 +124,24 @@ def check_some_variant_runs(spec: SweepSpec, base) -> None:
     over a base with no orbit, fly-past or standoff, a preset the base cannot complete,
     every value out of range): a mistake in the spec, named on its key's line, not
     one error row per variant. Stops at the first variant that builds; a preset's
-    aim point comes from the target model alone, never the whole scene."""
-    from ladartui.errors import LadarError
+    aim point comes from the target model alone, never the whole scene. A variant
+    refused by this machine's limits is named before an impossible one: it is what
+    stops the variants that have possible values."""
+    from ladartui.errors import LadarError, ResourceLimitError
     from ladartui.scenario import check_work
     from ladartui.sweep.variant import apply_parameters
 
     target = _TargetCentre(base)
-    first = None
+    first = limit = None
     for variant in spec.variants:
         try:
             check_work(apply_parameters(base, variant.params, lambda: target))
             return
+        except ResourceLimitError as error:
+            limit = limit or error
         except LadarError as error:
             first = first or error
+    first = limit or first
     if first is None:
         return  # a spec of no variants
     from ladartui.resources import sweep_advice
