@@ -137,3 +137,21 @@ def test_a_folder_another_sweep_holds_is_refused_before_the_bar(tiny, tmp_path, 
         fcntl.flock(held, fcntl.LOCK_EX)
         assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path)]) == 2
     assert "another sweep is writing its results here" in one_error_line(capsys)
+
+
+def test_the_command_to_open_the_best_path_runs_as_written_from_a_folder_with_spaces(
+    tiny, tmp_path, capsys, monkeypatch
+):
+    """'(open it with: ladartui my results/cli-best.toml)': pasted into a shell, that opened
+    'my' and 'results/cli-best.toml', neither the best path."""
+    import shlex
+
+    from ladartui.cli import main
+
+    monkeypatch.setenv("COLUMNS", "400")  # the line unwrapped, as a terminal copies it
+    spec = write_spec(tiny, "[grid]\nradius = [10.0]\n", name="cli.toml")
+    out = tmp_path / "my results"
+    assert main(["sweep", str(spec), "--serial", "--out", str(out)]) == 0
+    line = next(s for s in capsys.readouterr().out.splitlines() if s.startswith("best "))
+    command = line.split("(open it with: ", 1)[1].removesuffix(")")
+    assert shlex.split(command) == ["ladartui", str(out / "cli-best.toml")]

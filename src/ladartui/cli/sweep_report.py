@@ -3,6 +3,8 @@ files written (``show_result``), or the same as JSON (``result_dict``)."""
 
 from __future__ import annotations
 
+import shlex
+
 from rich.markup import escape
 
 from ladartui.number_text import plural
@@ -205,7 +207,8 @@ def show_result(console, result, top) -> None:
     if result.best_scenario_path:
         console.print(
             single_line(
-                f"best     {result.best_scenario_path}  (open it with: ladartui {result.best_scenario_path})"
+                f"best     {result.best_scenario_path}  "
+                f"(open it with: ladartui {shlex.quote(str(result.best_scenario_path))})"  # runs as written
             ),
             highlight=False,
             markup=False,
