@@ -437,3 +437,27 @@ def test_a_scan_past_the_coordinate_limit_is_blamed_on_a_field_the_user_wrote(tm
             build()
         assert caught.value.field == field
         assert "within 1000000 m of the scene's origin in x and y" in str(caught.value)
+
+
+def test_a_plan_builds_its_scans_once_however_often_it_is_asked(monkeypatch):
+    """A 9,000-scan fly-past was built 16 times for one OK in its form (0.3 s each): the
+    screen froze for seconds. A plan is immutable, so its scans are made once; what it
+    hands out is the caller's own to change."""
+    import pickle
+
+    built = []
+    original = FlyPast.build
+    monkeypatch.setattr(FlyPast, "build", lambda self, current: built.append(1) or original(self, current))
+    plan = FlightPlan(
+        segments=(FlyPast(target=(0.0, 0.0, 0.0), standoff=50.0, altitude=60.0, length=400.0, scans=40),)
+    )
+    first = plan.poses()
+    assert plan.poses() == first and plan.segment_poses()[0] == first
+    assert plan.path_length() == pytest.approx(400.0) and len(plan.scan_times(10.0)) == 40
+    assert len(built) == 1
+    first.clear()  # the caller's list: the plan's scans stay whole
+    plan.segment_poses()[0].clear()
+    assert len(plan.poses()) == 40 and len(built) == 1
+    again = pickle.loads(pickle.dumps(plan))  # sent to a sweep's workers without its scans
+    assert again == plan and len(pickle.dumps(plan)) < 2000
+    assert again.poses() == plan.poses()

@@ -296,6 +296,8 @@ SEGMENT_KINDS = {cls.kind: cls for cls in (Manual, Straight, Turn, Orbit, FlyPas
 Segment = Manual | Straight | Turn | Orbit | FlyPast | Standoff
 
 
+_MADE = "_made_scans"  # where a plan keeps the scans it made
+
 SEGMENTS_EXPECTED = (
     "a list of flight segments (Manual, Straight, Turn, Orbit, FlyPast, Standoff "
     "or a flight log's LogSegment)"
@@ -331,7 +333,18 @@ class FlightPlan:
         return bool(self.segments) and self.segments[0].relative
 
     def segment_poses(self) -> list[list[ScanPose]]:
-        """The scans of each segment, in order."""
+        """The scans of each segment, in order: made once (the plan and its poses are
+        immutable; a 10,000-scan path takes half a second), handed out as new lists."""
+        made = self.__dict__.get(_MADE)
+        if made is None:
+            made = self._build()
+            self.__dict__[_MADE] = made
+        return [list(poses) for poses in made]
+
+    def __getstate__(self):
+        return {k: v for k, v in self.__dict__.items() if k != _MADE}  # made again where needed
+
+    def _build(self) -> tuple[tuple[ScanPose, ...], ...]:
         current = self.start
         result = []
         for index, segment in enumerate(self.segments):
@@ -343,9 +356,9 @@ class FlightPlan:
                 poses = segment.build(current)
             except FieldError as error:
                 raise _prefixed(error, f"segments[{index}].") from None
-            result.append(poses)
+            result.append(tuple(poses))
             current = poses[-1]
-        return result
+        return tuple(result)
 
     def poses(self) -> list[ScanPose]:
         """Every scan of the plan, in flying order."""
