@@ -216,3 +216,39 @@ def test_half_block_cells_pair_rows_and_pad_an_odd_last_row():
     assert top.shape == (2, 2, 3) and bottom_mask.shape == (2, 2)
     assert top_mask[1, 1] and tuple(top[1, 1]) == (1, 2, 3)
     assert not bottom_mask[1].any()
+
+
+def _polyline_one_segment_at_a_time(picture, pixels, rgb):
+    """The polyline as its segments drawn one by one, each a linspace of a pixel per step
+    of its longer axis: the answer drawing it whole must give."""
+    from ladartui.views import draw_points
+
+    rows, cols = picture.shape
+    limit = 4.0 * (rows + cols)
+    for a, b in zip(pixels[:-1], pixels[1:]):
+        if np.all(np.isfinite(a)) and np.all(np.isfinite(b)):
+            a, b = np.clip(a, -limit, limit), np.clip(b, -limit, limit)
+            steps = min(int(np.ceil(np.abs(b - a).max())) + 1, 100_000)
+            draw_points(picture, a + (b - a) * np.linspace(0.0, 1.0, max(steps, 2))[:, None], rgb)
+
+
+@pytest.mark.parametrize("seed", range(4))
+@pytest.mark.parametrize("batch", [1_000_000, 7])
+def test_a_polyline_drawn_whole_sets_the_pixels_its_segments_drawn_one_by_one_set(seed, batch, monkeypatch):
+    """A 9,000-scan path took 0.7 s a view segment by segment, and the screen froze as
+    it was drawn; drawn whole, in batches of any size, it must set the same pixels."""
+    from ladartui.views import Picture, draw_polyline
+
+    monkeypatch.setattr(views, "POLYLINE_BATCH", batch)
+
+    rng = np.random.default_rng(seed)
+    points = rng.uniform(-20.0, 80.0, (400, 2))
+    points[[5, 77]] = np.nan  # a point off the view's plane: the segments beside it skipped
+    points[100] = (1e9, -1e9)  # far away: clamped, not drawn a billion pixels long
+    points[200:210] = points[200]  # repeated scans: one pixel each
+    pictures = [Picture(np.zeros((60, 70, 3), np.uint8), np.zeros((60, 70), bool)) for _ in range(2)]
+    draw_polyline(pictures[0], points, (255, 0, 0))
+    _polyline_one_segment_at_a_time(pictures[1], points, (255, 0, 0))
+    np.testing.assert_array_equal(pictures[0].mask, pictures[1].mask)
+    np.testing.assert_array_equal(pictures[0].rgb, pictures[1].rgb)
+    assert pictures[0].mask.sum() > 500

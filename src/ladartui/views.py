@@ -297,28 +297,53 @@ def draw_points(picture: Picture, pixels, rgb) -> None:
     picture.mask[pix[:, 0], pix[:, 1]] = True
 
 
+MOST_LINE_STEPS = 100_000  # pixels on one segment at most
+POLYLINE_BATCH = 1_000_000  # pixels made at once: a 10,000-scan path in a few numpy passes
+
+
+def _line_steps(a, b) -> np.ndarray:
+    """Pixels on each segment from ``a`` to ``b`` ((N, 2) each): one per step of the
+    longer axis, at least both ends."""
+    steps = np.ceil(np.abs(b - a).max(axis=1)).astype(np.int64) + 1
+    return np.maximum(np.minimum(steps, MOST_LINE_STEPS), 2)
+
+
 def line_pixels(a, b) -> np.ndarray:
     """Pixels (row, col) on the segment from a to b, one per step of the longer axis."""
-    a = np.asarray(a, float)
-    b = np.asarray(b, float)
-    steps = int(np.ceil(np.abs(b - a).max())) + 1
-    steps = min(steps, 100_000)
-    t = np.linspace(0.0, 1.0, max(steps, 2))
-    return a + (b - a) * t[:, None]
+    a = np.asarray(a, float).reshape(1, 2)
+    b = np.asarray(b, float).reshape(1, 2)
+    return _segments_pixels(a, b, _line_steps(a, b))
+
+
+def _segments_pixels(a, b, steps) -> np.ndarray:
+    """The pixels of every segment in turn, ``steps`` each, as ``np.linspace`` spaces
+    them (its step times the index, the last one exactly at the end)."""
+    segment = np.repeat(np.arange(len(a)), steps)
+    index = np.arange(int(steps.sum())) - np.repeat(np.cumsum(steps) - steps, steps)
+    last = steps[segment] - 1
+    t = index * (1.0 / last)
+    t[index == last] = 1.0
+    return a[segment] + (b[segment] - a[segment]) * t[:, None]
 
 
 def draw_polyline(picture: Picture, pixels, rgb) -> None:
-    """Draw the segments joining consecutive (row, col) points."""
-    pixels = np.asarray(pixels, float)
+    """Draw the segments joining consecutive (row, col) points; a segment with an end
+    that is not finite is left out. Drawn whole, a batch of segments at a time."""
+    pixels = np.asarray(pixels, float).reshape(-1, 2)
+    if len(pixels) < 2:
+        return
+    a, b = pixels[:-1], pixels[1:]
+    kept = np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1)
     rows, cols = picture.shape
-    limit = 4.0 * (rows + cols)
-    for a, b in zip(pixels[:-1], pixels[1:]):
-        if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
-            continue
-        # clamp far-away ends so a path far outside the scene stays cheap
-        a = np.clip(a, -limit, limit)
-        b = np.clip(b, -limit, limit)
-        draw_points(picture, line_pixels(a, b), rgb)
+    limit = 4.0 * (rows + cols)  # far-away ends clamped: a path far outside stays cheap
+    a, b = np.clip(a[kept], -limit, limit), np.clip(b[kept], -limit, limit)
+    steps = _line_steps(a, b)
+    first = 0
+    while first < len(a):
+        made = np.cumsum(steps[first:])
+        end = first + max(1, int(np.searchsorted(made, POLYLINE_BATCH, side="right")))
+        draw_points(picture, _segments_pixels(a[first:end], b[first:end], steps[first:end]), rgb)
+        first = end
 
 
 # -- 3D projection --------------------------------------------------------
