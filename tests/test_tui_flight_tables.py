@@ -25,6 +25,25 @@ async def test_the_scans_table_fits_the_sidebar_at_120_columns(tmp_path, scene_f
         assert not any(str(cell) == "-0" for i in range(scans.row_count) for cell in scans.get_row_at(i))
 
 
+async def test_a_path_of_thousands_of_scans_lists_the_first_thousand_and_says_so(tmp_path, scene_files):
+    """A 9,000-scan fly-past froze the screen for seconds as its rows went into the
+    table (Textual measures every cell of a new row); the table lists the first scans
+    and its heading says how many of all."""
+    from ladartui.flight import FlyPast
+    from ladartui.tui.panels.flight import MOST_SCAN_ROWS
+
+    scenario = make_scenario(tmp_path, scene_files)
+    long = FlyPast(target=(30.0, 30.0, 1.0), standoff=40.0, altitude=30.0, length=600.0, scans=2500)
+    scenario = scenario.with_changes(flight=FlightPlan(None, (*scenario.flight.segments, long))).save()
+    async with opened(scenario, size=(120, 40)) as (app, pilot):
+        app.action_show_tab("flight")
+        await pilot.pause()
+        scans = app.query_one("#scans")
+        assert scans.row_count == MOST_SCAN_ROWS == 1000
+        assert [str(cell) for cell in scans.get_row_at(999)][0] == "1000"
+        assert str(app.query_one("#scans-heading").render()) == "Scans (the first 1,000 of 2,506)"
+
+
 async def test_the_segments_table_fits_the_sidebar_and_wraps_a_long_detail(tmp_path, scene_files):
     import shutil
     from pathlib import Path

@@ -31,6 +31,11 @@ ADD_BUTTONS = "#add-straight,#add-turn,#add-orbit,#add-flypast,#add-standoff"
 START_UNUSED = "The path starts at its first segment: the start pose is not used."
 
 
+# Rows the scans table lists: Textual measures every cell of a new row, and 9,000 rows
+# held the screen still for seconds; the views show the whole path.
+MOST_SCAN_ROWS = 1000
+
+
 class FlightPanel(ParamPanel):
     def compose(self):
         for param in bridge.FLIGHT_PARAMS + bridge.START_PARAMS:
@@ -93,13 +98,15 @@ class FlightPanel(ParamPanel):
         ]
         fill_segments(self.query_one("#segments", FittingTable), segments)
         # Whole metres and degrees (round: an int, never "-0"): more columns fit
+        poses = [pose for poses in per_segment for pose in poses]
         scans = [
             (str(i + 1), *(str(round(v)) for v in (p.x, p.y, p.z, p.heading, p.azimuth, p.depression)))
-            for i, p in enumerate(pose for poses in per_segment for pose in poses)
+            for i, p in enumerate(poses[:MOST_SCAN_ROWS])
         ]
         left_out = fill_whole_columns(self.query_one("#scans", FittingTable), SCAN_COLUMNS, scans)
-        heading = "Scans" + (f" (no room for {', '.join(left_out)})" if left_out else "")
-        self.query_one("#scans-heading", Label).update(heading)
+        notes = [f"the first {len(scans):,} of {len(poses):,}"] if len(poses) > len(scans) else []
+        notes += [f"no room for {', '.join(left_out)}"] if left_out else []
+        self.query_one("#scans-heading", Label).update("Scans" + (f" ({'; '.join(notes)})" if notes else ""))
 
     # -- editing segments ------------------------------------------------------------
 
