@@ -197,3 +197,20 @@ def test_geiger_runs_are_compared_by_their_detection_figures_too(tmp_path, capsy
     assert cli.main(["compare", files[2], files[2], "--json"]) == 0
     said = json.loads(capsys.readouterr().out)["measures"]
     assert not any(row["measure"] == "False alarms" for row in said)
+
+
+def test_compare_offers_the_runs_beside_a_scenario_that_read(tmp_path):
+    """Compare (F10) filled its list with every .cmf of the folder, so one that could not
+    be read opened it on that file's error and no table; it offers the scenario's own
+    run first, then the others that read, four at most."""
+    from ladartui.measures_compare import measures_files_to_offer
+
+    own = tmp_path / "plan.cmf"
+    write_run(own, seen_layers=2, scans=2)
+    for name in ("a", "c", "d", "e"):
+        write_run(tmp_path / f"{name}.cmf", seen_layers=1, scans=1)
+    (tmp_path / "b.cmf").write_text("not a measures file\n")
+    (tmp_path / "cut.cmf").write_text((tmp_path / "a.cmf").read_text()[:200])
+    assert [p.name for p in measures_files_to_offer(own)] == ["plan.cmf", "a.cmf", "c.cmf", "d.cmf"]
+    own.unlink()  # not run yet: the others alone
+    assert [p.name for p in measures_files_to_offer(own)] == ["a.cmf", "c.cmf", "d.cmf", "e.cmf"]

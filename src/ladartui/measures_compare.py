@@ -17,7 +17,7 @@ from pathlib import Path
 
 from rich.text import Text
 
-from ladartui.errors import InputFileError
+from ladartui.errors import InputFileError, LadarError
 from ladartui.fileprobe import file_problem
 from ladartui.levels import LEVELS, NOT_REACHED
 from ladartui.measures_table import UNDEFINED
@@ -245,6 +245,25 @@ def read_measures_files(paths) -> list:
             raise InputFileError(path, f"{'scenario' if scenario else 'measures file'} {problem}")
         out.append(read_cmf(_measures_file_of(path) if scenario else path))
     return out
+
+
+def measures_files_to_offer(own: Path, most: int = 4) -> list[Path]:
+    """The measures files to compare a scenario's run with: its own (``own``) first, then
+    the others in its folder by name, ``most`` in all, each one that reads (one that
+    does not would stop the comparison of the rest before it began)."""
+    from ladartui.cmf import read_cmf
+
+    candidates = [own] + sorted(p for p in own.parent.glob("*.cmf") if p != own)
+    offered: list[Path] = []
+    for path in candidates:
+        if len(offered) == most:
+            break
+        try:
+            read_cmf(path)
+        except (LadarError, OSError):
+            continue
+        offered.append(path)
+    return offered
 
 
 def _measures_file_of(scenario: Path) -> Path:

@@ -24,6 +24,7 @@ from textual.screen import ModalScreen, Screen
 from textual.widgets import Button, Footer, TabbedContent, TabPane, Tabs
 
 from ladartui.edit_history import EditHistory
+from ladartui.measures_compare import measures_files_to_offer
 from ladartui.run_record import setting_changes
 from ladartui.scenario import Scenario
 from ladartui.tui import actions, bridge
@@ -421,14 +422,8 @@ class LadarApp(
         self.push_screen(MeasuresScreen(self.measures, stale=stale))
 
     def action_compare(self) -> None:
-        paths = []
-        if self.scenario is not None:
-            folder = self.scenario.path.parent
-            own = self.scenario.measures_file
-            if own.is_file():
-                paths.append(own)
-            paths += sorted(p for p in folder.glob("*.cmf") if p != own)
-        self.push_screen(CompareScreen(paths[:4], self._folder()))
+        paths = [] if self.scenario is None else measures_files_to_offer(self.scenario.measures_file)
+        self.push_screen(CompareScreen(paths, self._folder()))
 
     def action_view(self, name: str) -> None:
         """A view command (zoom to target, fit, colouring, overlays) in every view."""
