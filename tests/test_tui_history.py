@@ -271,8 +271,13 @@ async def test_compare_takes_files_picked_in_the_tree(tmp_path, scene_files):
     app = LadarApp(scenario.path)
     async with app.run_test(size=(120, 40)) as pilot:
         await wait_until(pilot, lambda: loaded(app))
-        for name in ("a", "b"):
-            (tmp_path / f"{name}.cmf").write_text("")
+        import numpy as np
+
+        from ladartui.measures import compute_measures
+
+        voxels = np.array([(0, 0, 0), (1, 0, 0)], np.int32)
+        for name in ("a", "b"):  # measures files that read: Compare offers no other
+            (tmp_path / f"{name}.cmf").write_text(compute_measures(voxels, voxels, voxels[:1]).to_cmf())
         await app.run_action("compare")
         await pilot.pause()
         screen = app.screen
