@@ -62,3 +62,22 @@ async def test_the_poses_dialog_takes_altitudes_up_to_the_flight_limit(tmp_path,
         assert screen.query_one("#p-z").has_class("-bad")
         await type_into(pilot, screen.query_one("#p-z"), "20000", commit="tab")
         assert str(screen.query_one("#poses-message").render()) == ""
+
+
+async def test_a_row_applied_keeps_the_values_of_the_fields_left_as_shown(tmp_path, scene_files):
+    """Applying a row after typing its z wrote x and y as the fields show them, to six
+    digits: y = -53.934467 came back -53.9345."""
+    scenario = make_scenario(tmp_path, scene_files)
+    exact = ScanPose(12.3456789, -53.93446712, 40.0, 33.3333333, 0.0, 61.7777777)
+    scenario = scenario.with_changes(flight=FlightPlan(None, (Manual((exact,)),))).save()
+    async with opened(scenario, size=(80, 24)) as (app, pilot):
+        app.action_manual_poses()
+        await wait_until(
+            pilot, lambda: isinstance(app.screen, PosesScreen) and app.screen.query("#p-z"), timeout=10.0
+        )
+        screen = app.screen
+        assert screen.query_one("#p-y").value == "-53.9345"  # shown to six digits
+        await type_into(pilot, screen.query_one("#p-z"), "45", commit="enter")
+        assert screen.poses == [ScanPose(exact.x, exact.y, 45.0, exact.heading, 0.0, exact.depression)]
+        await type_into(pilot, screen.query_one("#p-y"), "-53.9", commit="enter")  # typed: as typed
+        assert screen.poses[0].y == -53.9 and screen.poses[0].x == exact.x

@@ -97,11 +97,18 @@ class NumberField(Input):
             value = None
         else:
             try:
-                value = parse_number(self.field_name, self.value, self.integer, self.scale)
+                value = self.number()
             except FieldError as error:
                 raise self._with_limits(error) from None
         self.check(value)
         return value
+
+    def number(self):
+        """The number the text gives, unchecked (FieldError for text that is none): text
+        left as it was shown gives the value shown, not its six digits."""
+        if self._shown is not None and self.value == self._shown[1]:
+            return self._shown[0]
+        return parse_number(self.field_name, self.value, self.integer, self.scale)
 
     def _with_limits(self, error: FieldError) -> FieldError:
         """For text that is no number (or no whole one): the core's expectation with its

@@ -15,7 +15,7 @@ from textual.widgets import Button, DataTable, Input, Label, Static
 
 from ladartui.errors import FieldError, LadarError
 from ladartui.tui import bridge
-from ladartui.tui.fields import NumberField, in_label_unit, parse_number, refusal
+from ladartui.tui.fields import NumberField, in_label_unit, refusal
 from ladartui.tui.screens import Dialog, field_matches
 
 
@@ -116,7 +116,7 @@ class PosesScreen(Dialog):
     def _raw(self, name):
         widget = self.query_one(f"#p-{name}", NumberField)
         try:
-            return parse_number(name, widget.value)
+            return widget.number()
         except FieldError:
             return widget.default
 
