@@ -142,6 +142,27 @@ def test_preset_builds_a_flypast_or_standoff_around_the_base_target(tiny):
     assert all(_bearing(p, CENTRE) == pytest.approx(90.0) for p in turned.poses())
 
 
+def test_a_base_standoff_turned_about_its_target_turns_the_heading_it_gives(tiny):
+    """A standoff with its own heading (0, flying north along a line from the east)
+    turned 90 degrees kept heading 0, so the best path written flew across its line."""
+    from ladartui.flight import FlightPlan, Standoff
+    from ladartui.scenario import load_scenario
+
+    line = Standoff(target=CENTRE, standoffs=(40.0, 20.0), altitude=25.0, bearing=90.0, heading=270.0)
+    base = load_scenario(tiny / "base.toml").with_changes(flight=FlightPlan(segments=(line,)))
+    turned = apply_parameters(base, {"heading_offset": 90.0}).flight.segments[0]
+    assert (turned.bearing, turned.heading) == (180.0, 0.0)  # still flying in towards the target
+    assert all(
+        _bearing(p, CENTRE) == pytest.approx(180.0)
+        for p in apply_parameters(base, {"heading_offset": 90.0}).poses()
+    )
+    unset = apply_parameters(
+        base.with_changes(flight=FlightPlan(segments=(replace(line, heading=None),))),
+        {"heading_offset": 90.0},
+    ).flight.segments[0]
+    assert unset.heading is None  # towards the target, whatever the bearing
+
+
 def test_a_base_standoff_keeps_its_spacing_scaled_to_the_new_standoff(tiny):
     from ladartui.flight import FlightPlan, Standoff
     from ladartui.scenario import load_scenario

@@ -10,7 +10,8 @@ orbit, fly-past or standoff segment of its flight plan):
   ``scans``, ``arc`` (orbit) set that segment's fields;
 * ``heading_offset`` turns the path about its target: it is added to the
   bearing (from the target) of the orbit's first scan, the fly-past's
-  closest point or the standoff line, and a new preset keeps the base's
+  closest point or the standoff line (and to a standoff's own heading, when it
+  gives one), and a new preset keeps the base's
   bearing (so an orbit starting south becomes a fly-past passing south);
 * ``speed`` is the aircraft speed; ``sensor_grid``, ``ray_grid``, ``fov``
   and ``depth_resolution`` set the sensor.
@@ -177,6 +178,8 @@ def build_preset(params: dict, base_segment, default_target):
     fields.update(target=target, standoffs=standoffs, altitude=altitude, bearing=bearing)
     if not same:
         fields["heading"] = None
+    elif fields.get("heading") is not None:  # the base's own heading turns with its line
+        fields["heading"] += params.get("heading_offset", 0.0)
     return Standoff(**fields)
 
 
