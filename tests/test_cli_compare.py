@@ -214,3 +214,15 @@ def test_compare_offers_the_runs_beside_a_scenario_that_read(tmp_path):
     assert [p.name for p in measures_files_to_offer(own)] == ["plan.cmf", "a.cmf", "c.cmf", "d.cmf"]
     own.unlink()  # not run yet: the others alone
     assert [p.name for p in measures_files_to_offer(own)] == ["a.cmf", "c.cmf", "d.cmf", "e.cmf"]
+
+
+def test_the_voxels_seen_obscured_alone_are_compared_as_run_shows_them(tmp_path, capsys):
+    """run's table gives 'Seen obscured but not unobscured'; compare, which says it
+    shows every measure, left it out."""
+    target = box(2, 2, 1)
+    for name, extra in (("a", 1), ("b", 0)):
+        obscured = target[: 2 + extra]  # what the scene run saw: one voxel the target-alone run missed
+        compute_measures(target, obscured, target[:2]).write_cmf(tmp_path / f"{name}.cmf")
+    assert cli.main(["compare", str(tmp_path / "a.cmf"), str(tmp_path / "b.cmf"), "--json"]) == 0
+    rows = {row["measure"]: row for row in json.loads(capsys.readouterr().out)["measures"]}
+    assert rows["Seen obscured but not unobscured"]["values"] == [1, 0]

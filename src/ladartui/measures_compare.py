@@ -32,6 +32,7 @@ ROWS = [
     ("Visible target voxels", "visible_voxels", "int", None),
     ("Unobscured voxels", "unobscured_voxels", "int", "high"),
     ("Obscured voxels", "obscured_voxels", "int", "high"),
+    ("Seen obscured but not unobscured", "obscured_only_voxels", "int", None),
     ("Model mean vector", "model_directions.mean_vector", "vec", None),
     ("Model resultant length", "model_directions.resultant_length", "num", None),
     ("Model mean direction", "model_directions.mean_direction", "vec", None),

@@ -10,7 +10,8 @@ def add_parser(subparsers):
         "compare",
         help="put two or more runs' measures side by side",
         description="Read the measures files (.cmf) two or more runs wrote, or the scenarios "
-        "(.toml) whose last runs wrote them, and print every measure side by side: where the "
+        "(.toml) whose last runs wrote them, and print their figures side by side (the "
+        "coverage after each scan, a list, is left to run and the .cmf): where the "
         "runs differ the row is yellow, and for a measure with a better direction the best "
         "value is green and the worst red (the TUI's Compare, F10, shows the same).",
     )
