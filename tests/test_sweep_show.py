@@ -13,6 +13,22 @@ def tiny(tmp_path_factory):
     return tiny_folder(tmp_path_factory)
 
 
+def test_rows_of_variants_dropped_from_the_grid_are_not_blamed_on_an_earlier_base(tmp_path, capsys):
+    """A spec whose grid lost a value, run again on the same base, said '1 row of other
+    variants or an earlier base left out (a run of this spec runs its variants again for
+    the base as it is now)': the base had not changed."""
+    from ladartui.cli import main
+
+    write_tiny_scenario(tmp_path)
+    spec = write_spec(tmp_path, "[grid]\nradius = [20.0, 30.0]\n", name="grid.toml")
+    run_sweep(spec, serial=True)
+    spec.write_text(spec.read_text(encoding="utf-8").replace("[20.0, 30.0]", "[20.0]"))
+    assert main(["sweep", str(spec), "--serial"]) == 0
+    text = capsys.readouterr().out.replace("\n", " ")
+    assert "left out: 1 row of other variants (not in the spec now)" in text
+    assert "earlier base" not in text
+
+
 def test_show_ranks_the_rows_of_the_current_base_only(tmp_path, capsys):
     """The table keeps rows from an earlier base; a run ranks only the current base's,
     and so must --show and load_sweep_results given the spec (each variant was
@@ -47,7 +63,8 @@ def test_show_ranks_the_rows_of_the_current_base_only(tmp_path, capsys):
     assert main(["sweep", str(spec), "--show"]) == 1  # nothing to rank: a script must know
     captured = capsys.readouterr()
     text = captured.out.replace("\n", " ")
-    assert "4 rows of other variants or an earlier base left out" in text
+    assert "left out: 4 rows of an earlier base (a run of this spec" in text
+    assert "other variants" not in text  # every row left out is of the spec's own variants
     assert "no variant finished (no row of this spec's variants from its base as it is now)" in captured.err
     assert {p: p.read_bytes() for p in out.glob("pareto.*")} == charts  # never redrawn by --show
     # base as it ran: ranked by another objective, the charts stay the sweep's, as its

@@ -185,11 +185,15 @@ def show_result(console, result, top) -> None:
         every = "the variant" if resumed == 1 else f"all {resumed:,} variants"
         console.print(f"nothing to run: {every} resumed from earlier runs", highlight=False)
     if result.left_out:
-        console.print(
-            f"{plural(result.left_out, 'row')} of other variants or an earlier base left out (a run of this "
-            "spec runs its variants again for the base as it is now)",
-            highlight=False,
-        )
+        earlier = result.left_out_earlier_base
+        others = result.left_out - earlier
+        parts = [f"{plural(others, 'row')} of other variants (not in the spec now)"] if others else []
+        if earlier:
+            parts.append(
+                f"{plural(earlier, 'row')} of an earlier base (a run of this spec runs its variants "
+                "again for the base as it is now)"
+            )
+        console.print("left out: " + "; ".join(parts), highlight=False)
     if lines := result.unreadable_lines:
         listed = ", ".join(map(str, lines[:5])) + (", ..." if len(lines) > 5 else "")
         which = f"{plural(len(lines), 'row')} of {result.results_path.name} could not be read"

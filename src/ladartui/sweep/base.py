@@ -88,8 +88,18 @@ def load_base(spec: SweepSpec, check_files: bool = True) -> Scenario:
 
 def spec_rows(table_rows: list[dict], spec: SweepSpec) -> list[dict]:
     """The rows of ``spec``'s variants made from its base as it is now."""
+    return own_rows(table_rows, spec.variants, spec_digest(spec))
+
+
+def spec_digest(spec: SweepSpec) -> str:
+    """The hash of ``spec``'s base as it is now, which its rows carry."""
     base = load_base(spec, check_files=False)
-    return own_rows(table_rows, spec.variants, base_digest(base.path, base))
+    return base_digest(base.path, base)
+
+
+def earlier_base_rows(table_rows: list[dict], digest: str) -> int:
+    """How many rows were made from a base other than the one whose hash is ``digest``."""
+    return sum(row.get("base") != digest for row in table_rows)
 
 
 @dataclass(frozen=True)

@@ -30,7 +30,7 @@ from ladartui.errors import (
 )
 from ladartui.fileprobe import path_field
 from ladartui.precompile import compile_ahead
-from ladartui.sweep.base import CheckedBase, checked_base, own_rows, spec_rows
+from ladartui.sweep.base import CheckedBase, checked_base, earlier_base_rows, own_rows, spec_digest
 from ladartui.sweep.best_file import best_files, write_best_scenario
 from ladartui.sweep.cluster import check_local_workers, close_client, local_client
 from ladartui.sweep.dask_runs import run_on_dask
@@ -89,6 +89,7 @@ class SweepResult:
     best_kept_why: str = ""  # why it was not replaced
     best_earlier: Path | None = None  # none ranked now: the best-path file an earlier ranking wrote
     left_out: int = 0  # rows of the table not ranked: other variants, or an earlier base
+    left_out_earlier_base: int = 0  # of those, the rows made from an earlier base
     unreadable_lines: list[int] = field(default_factory=list)  # of rows the table could not read
     unreadable_removed: bool = False  # the table rewritten since: those lines are gone from it
     ran: int = 0
@@ -380,6 +381,7 @@ def _run_locked(
     table_rows, _ = read_table(results_path)
     rows = own_rows(table_rows, variants, digest)
     left_out = len(table_rows) - len(rows)
+    earlier = earlier_base_rows(table_rows, digest)
     ranking = rank_rows(rows, objective, budget, cost)
     result = SweepResult(
         rows=rows,
@@ -394,6 +396,7 @@ def _run_locked(
         workers=result_workers,
         scheduler=scheduler,
         left_out=left_out,
+        left_out_earlier_base=earlier,
         unreadable_lines=unreadable,
         unreadable_removed=table.written,
     )
@@ -497,9 +500,11 @@ def load_sweep_results(
         raise InputFileError(path, "no sweep results here")
     unreadable: list[int] = []
     rows, header = read_table(path, unreadable)
-    every = len(rows)
+    every, earlier = len(rows), 0
     if spec is not None:
-        rows = spec_rows(rows, spec)
+        digest = spec_digest(spec)
+        earlier = earlier_base_rows(rows, digest)
+        rows = own_rows(rows, spec.variants, digest)
     objective, cost = normal_objective(objective), normal_cost(cost)
     if budget is not None:
         budget = checked_budget(budget)
@@ -529,6 +534,7 @@ def load_sweep_results(
         parameter_names=parameter_names,
         results_path=path,
         left_out=every - len(rows),
+        left_out_earlier_base=earlier,
         unreadable_lines=unreadable,
     )
 
