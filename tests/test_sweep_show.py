@@ -24,8 +24,10 @@ def test_rows_of_variants_dropped_from_the_grid_are_not_blamed_on_an_earlier_bas
     run_sweep(spec, serial=True)
     spec.write_text(spec.read_text(encoding="utf-8").replace("[20.0, 30.0]", "[20.0]"))
     assert main(["sweep", str(spec), "--serial"]) == 0
-    text = capsys.readouterr().out.replace("\n", " ")
+    said = capsys.readouterr()
+    text = said.out.replace("\n", " ")
     assert "left out: 1 row of other variants (not in the spec now)" in text
+    assert "sweep of 1 variant on this process" in said.err  # not "1 variants"
     assert "earlier base" not in text
 
 

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 from ladartui.cli.flags import as_flags, check_file_names
 from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt, stop_status
 from ladartui.errors import Cancelled, FieldError, LadarError
+from ladartui.number_text import plural
 from ladartui.textsafe import single_line
 
 if TYPE_CHECKING:
@@ -302,7 +303,9 @@ def _sweep_with_progress(checked, args, console):
         if args.scheduler
         else ("this process" if args.serial else "local cluster")
     )
-    console.print(f"sweep of {len(spec.variants):,} variants on {where}", highlight=False, markup=False)
+    console.print(
+        f"sweep of {plural(len(spec.variants), 'variant')} on {where}", highlight=False, markup=False
+    )
     try:
         with sweep_progress(console) as bar:
             task = bar.add_task("sweep", total=len(spec.variants), note=STARTING)
