@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from ladartui.tui.screens import FormScreen
 from test_tui_dialogs import message
-from tui_support import make_scenario, opened, screen_after, type_into
+from tui_support import make_scenario, opened, screen_after, type_into, wait_until
 
 
 async def edited_first_segment(app, pilot) -> FormScreen:
@@ -172,3 +172,26 @@ async def test_enter_in_a_lower_wrong_field_names_the_upper_one_it_focuses(tmp_p
         await pilot.pause()
         assert app.focused is depression
         assert message(form) == "Depression deg: [red]x is not allowed; expected a number from 1 to 90 deg"
+
+
+async def test_ok_on_a_segment_form_keeps_the_values_it_was_not_given(tmp_path, scene_files):
+    """OK on an orbit's form, nothing typed, wrote every value as the form shows it, to
+    six digits: a radius of 30.123456789 came back 30.1235, a centre 1.23456789 1.23457."""
+    from ladartui.flight import FlightPlan, Orbit
+
+    scenario = make_scenario(tmp_path, scene_files)
+    exact = Orbit(centre=(1.23456789, 2.0, 0.5), radius=30.123456789, altitude=30.0, scans=6)
+    scenario = scenario.with_changes(flight=FlightPlan(None, (exact,))).save()
+    async with opened(scenario) as (app, pilot):
+        form = await edited_first_segment(app, pilot)
+        assert form.query_one("#f-radius").value == "30.1235"  # shown to six digits
+        form.query_one("#form-ok").press()
+        await wait_until(pilot, lambda: app.screen is not form, timeout=10.0)
+        assert app.scenario.flight.segments[0] == exact
+        form = await edited_first_segment(app, pilot)
+        await type_into(pilot, form.query_one("#f-altitude"), "35", commit=None)
+        await type_into(pilot, form.query_one("#f-centre"), "1.5, 2, 0.5", commit=None)
+        form.query_one("#form-ok").press()
+        await wait_until(pilot, lambda: app.screen is not form, timeout=10.0)
+        orbit = app.scenario.flight.segments[0]
+        assert (orbit.radius, orbit.altitude, orbit.centre) == (exact.radius, 35.0, (1.5, 2.0, 0.5))

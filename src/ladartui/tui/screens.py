@@ -174,6 +174,7 @@ class FormScreen(Dialog):
         self.note = note
         self.cancelled = True
         self._left_for_refusal: Widget | None = None  # the field OK's refusal moved from
+        self._shown_points: dict[str, tuple] = {}  # point field: (its value, the text shown)
 
     def compose(self) -> ComposeResult:
         with Vertical(classes="dialog") as box:
@@ -200,6 +201,7 @@ class FormScreen(Dialog):
                             id=f"f-{name}",
                         )
                     else:
+                        self._shown_points[name] = (value, _point_text(value))
                         widget = Input(
                             _point_text(value),
                             id=f"f-{name}",
@@ -253,19 +255,20 @@ class FormScreen(Dialog):
                 out[name] = self.query_one(f"#f-{name}", Select).value
                 continue
             widget = self.query_one(f"#f-{name}", Input)  # a NumberField is an Input
-            if kind in ("int", "float", "optional"):
+            if isinstance(widget, NumberField):  # text left as shown: the value, not six digits
                 try:
                     if kind == "optional" and not widget.value.strip():
                         out[name] = None
                     else:
-                        out[name] = parse_number(name, widget.value, kind == "int")
+                        out[name] = widget.number()
                 except FieldError:
                     if not raw:
                         raise
                     out[name] = default
             else:
+                value, shown = self._shown_points.get(name, (None, None))
                 try:
-                    out[name] = _parse_points(name, widget.value, kind)
+                    out[name] = value if widget.value == shown else _parse_points(name, widget.value, kind)
                 except FieldError:
                     if not raw:
                         raise
