@@ -226,3 +226,12 @@ def test_the_voxels_seen_obscured_alone_are_compared_as_run_shows_them(tmp_path,
     assert cli.main(["compare", str(tmp_path / "a.cmf"), str(tmp_path / "b.cmf"), "--json"]) == 0
     rows = {row["measure"]: row for row in json.loads(capsys.readouterr().out)["measures"]}
     assert rows["Seen obscured but not unobscured"]["values"] == [1, 0]
+
+
+def test_a_false_alarm_chance_too_small_for_six_decimals_is_not_shown_as_none():
+    """Chances of 2e-7 and 4e-9 per bin both read '0.000000', one painted best, the other
+    worst; run's table writes such a chance with its exponent."""
+    from ladartui.measures_compare import format_value
+
+    assert format_value(2e-7, "prob") == "2.00e-07" and format_value(4e-9, "prob") == "4.00e-09"
+    assert format_value(0.0, "prob") == "0.000000" and format_value(0.0123, "prob") == "0.012300"

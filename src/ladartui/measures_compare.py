@@ -21,7 +21,7 @@ from ladartui.errors import InputFileError, LadarError
 from ladartui.fileprobe import file_problem
 from ladartui.levels import LEVELS, NOT_REACHED
 from ladartui.measures_table import UNDEFINED
-from ladartui.number_text import fixed
+from ladartui.number_text import fixed, fixed_or_tiny
 
 # (label, Measures.to_dict path, kind, better): better is "high", "low" or None
 ROWS = [
@@ -102,7 +102,7 @@ def format_value(value, kind: str) -> str:
     if kind == "num1":
         return fixed(value, 1)
     if kind == "prob":
-        return f"{float(value):.6f}"
+        return fixed_or_tiny(value, 6)
     return fixed(value, 3)
 
 

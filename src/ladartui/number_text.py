@@ -16,6 +16,18 @@ def fixed(value: float, digits: int) -> str:
     return f"{value:.{digits}f}"
 
 
+def fixed_or_tiny(value: float, digits: int, grouped: bool = False) -> str:
+    """``fixed`` (``grouped``: thousands separated, "12,345.6"), but a value too small for
+    ``digits`` decimals and not zero with its exponent ("2.00e-07"): a tiny chance is
+    not none, never "0.000000"."""
+    value = float(value)
+    if 0 < abs(value) < 0.5 * 10**-digits:
+        return f"{value:.2e}"
+    if grouped and math.isfinite(value) and abs(value) < FIXED_BELOW:
+        return f"{value:,.{digits}f}"
+    return fixed(value, digits)
+
+
 def trimmed(value: float, digits: int = 6) -> str:
     """``value`` to ``digits`` significant digits without trailing zeros ("18.25", "150",
     not 150.00000000000003); from 1e10 on with an exponent, as ``fixed`` writes it."""

@@ -343,13 +343,10 @@ def detection_table(detection):
     from rich.table import Table
 
     from ladartui.measures_table import format_share
+    from ladartui.number_text import fixed_or_tiny
 
     def number(value, digits=1):
-        if value is None:
-            return "undefined"
-        if 0 < abs(value) < 0.5 * 10**-digits:  # a tiny chance is not none: never "0.000000"
-            return f"{value:.2e}"
-        return f"{value:,.{digits}f}"
+        return "undefined" if value is None else fixed_or_tiny(value, digits, grouped=True)
 
     table = Table(
         title=f"Geiger-mode detection: {detection.pulses} pulses per look, "
