@@ -191,6 +191,8 @@ def test_geiger_runs_are_compared_by_their_detection_figures_too(tmp_path, capsy
     assert rows["Pulses per look"]["values"] == [10, 100, None]
     assert rows["Coincidence k"]["values"] == [1, 10, None]
     assert rows["Declared points"]["values"] == [7908, 1000, None]
+    assert rows["Declared points per look"]["values"] == [790.8, 100.0, None]
+    assert rows["Random seed"]["values"] == [0, 0, None]  # the docs list it among what is compared
     ideal = rows["Ideal sensor: obscured coverage"]  # an ideal run's is its own coverage
     assert ideal["values"] == [0.75, 0.75, 0.75] and ideal["text"] == ["75.0%"] * 3
     # ideal runs alone have no such rows

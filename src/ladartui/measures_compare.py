@@ -56,7 +56,9 @@ ROWS = [
 DETECTION_ROWS = [
     ("Pulses per look", "detection.pulses", "int", None),
     ("Coincidence k", "detection.coincidence", "int", None),
+    ("Random seed", "detection.seed", "int", None),
     ("Declared points", "detection.declared_points", "int", None),
+    ("Declared points per look", "detection.declared_per_look", "num1", None),
     ("False alarms", "detection.false_alarms", "int", "low"),
     ("False alarms per look", "detection.false_alarms_per_look", "num1", "low"),
     ("False-alarm probability per noise bin", "detection.false_alarm_probability", "prob", "low"),
