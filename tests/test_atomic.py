@@ -104,3 +104,47 @@ def test_a_fresh_temporary_no_one_holds_is_left_for_a_writer_about_to_hold_it(tm
     _aged(other)
     write_text_atomic(target, "new")
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted([fresh.name, other.name, "out.txt"])
+
+
+def test_only_the_names_a_write_makes_are_taken_for_its_temporaries(tmp_path):
+    """'.notes.txt.mine.tmp', a person's own file, was removed as an abandoned
+    temporary the next time notes.txt was written."""
+    own = [
+        tmp_path / ".notes.txt.mine.tmp",
+        tmp_path / ".notes.txt.backup-1.tmp",
+        tmp_path / ".notes.txt.tmp",
+    ]
+    made = tmp_path / ".notes.txt.k2_9zqa0.tmp"  # as tempfile names them: eight of [a-z0-9_]
+    for path in (*own, made):
+        path.write_text("x")
+        _aged(path)
+    write_text_atomic(tmp_path / "notes.txt", "new")
+    assert all(path.exists() for path in own) and not made.exists()
+
+
+def test_an_output_set_keeps_a_temporary_a_live_write_holds(tmp_path):
+    """Entering an output set removed every temporary of its files, a live write's too,
+    whose rename then failed."""
+    from ladartui.atomic import held_temporary
+    from ladartui.outputset import OutputSet
+
+    target = tmp_path / "run.cmf"
+    fd, live = held_temporary(target)  # held, as a plain write of the same name holds it
+    try:
+        left = tmp_path / ".run.cmf.abcd1234.tmp"  # a killed write's: no one holds it
+        left.write_text("x")
+        with OutputSet({"measures": target}, tmp_path / ".run.lock") as outputs:
+            outputs.write_contents({"measures": b"m"})
+        assert live.exists() and not left.exists() and target.read_bytes() == b"m"
+    finally:
+        os.close(fd)
+
+
+def test_a_temporary_that_cannot_be_given_its_mode_is_not_left_behind(tmp_path, monkeypatch):
+    def refused(path, mode):
+        raise PermissionError(1, "Operation not permitted")
+
+    monkeypatch.setattr(os, "chmod", refused)
+    with pytest.raises(PermissionError):
+        write_text_atomic(tmp_path / "out.txt", "x")
+    assert list(tmp_path.iterdir()) == []

@@ -4,11 +4,13 @@ A writer holds a lock on its temporary (flock) for as long as it writes, and the
 system lets go of it when the writer ends, killed or not; so a temporary no one
 holds, and not made just now, is a killed write's, and the next write of the same
 file removes it (otherwise each kill left one, as large as the file, for good).
+Where the file system gives no such lock (flock refused, as on some network
+file systems), nothing is held and nothing is removed.
 """
 
 import contextlib
-import fcntl
 import os
+import string
 import tempfile
 import time
 from pathlib import Path
@@ -40,47 +42,77 @@ def atomic_path(target):
 # A writer is exposed between making its temporary and holding it: one younger than
 # this is never taken for a killed write's.
 ABANDONED_AFTER_S = 10.0
+# What tempfile puts between a temporary's prefix and suffix: eight of these.
+_RANDOM_PART = (8, frozenset(string.ascii_lowercase + string.digits + "_"))
 
 
 def held_temporary(target: Path, mode: int | None = None) -> tuple[int, Path]:
     """A new hidden temporary beside ``target`` (".NAME.XXXXXXXX.tmp"), held: the
     descriptor to close when done with it, and its path. ``mode``: its permissions
     (default: those a plain open() would give ``target``; mkstemp's are owner-only)."""
+    import fcntl
+
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    with contextlib.suppress(OSError):  # a file system without locks: held by no one
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    os.chmod(tmp, _default_mode(target) if mode is None else mode)
+    try:
+        with contextlib.suppress(OSError):  # a file system without locks: held by no one
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        os.chmod(tmp, _default_mode(target) if mode is None else mode)
+    except BaseException:
+        os.close(fd)
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
     return fd, Path(tmp)
+
+
+def is_temporary_of(name: str, target_name: str) -> bool:
+    """Whether ``name`` is one ``held_temporary`` makes for a file named ``target_name``
+    (".NAME." + eight random characters + ".tmp"), not a person's ".NAME.mine.tmp"."""
+    prefix, suffix = f".{target_name}.", ".tmp"
+    if not (name.startswith(prefix) and name.endswith(suffix)):
+        return False
+    middle = name[len(prefix) : -len(suffix)]
+    length, characters = _RANDOM_PART
+    return len(middle) == length and set(middle) <= characters
 
 
 def remove_abandoned(target: Path) -> None:
     """Remove the temporaries of ``target`` that killed writes left: held by no one,
     and older than ``ABANDONED_AFTER_S``. Another file's, or one still held, is kept."""
-    prefix = f".{target.name}."
     try:
         entries = list(os.scandir(target.parent))
     except OSError:
         return
     now = time.time()
     for entry in entries:
-        middle = entry.name[len(prefix) : -len(".tmp")]
-        if not (entry.name.startswith(prefix) and entry.name.endswith(".tmp")) or not middle or "." in middle:
+        if not is_temporary_of(entry.name, target.name):
             continue
         try:
-            if not entry.is_file(follow_symlinks=False):
-                continue
             if now - entry.stat(follow_symlinks=False).st_mtime < ABANDONED_AFTER_S:
                 continue
-            fd = os.open(entry.path, os.O_RDONLY | os.O_NONBLOCK | os.O_NOFOLLOW)
         except OSError:
             continue
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # refused while its writer lives
-            os.unlink(entry.path)
-        except OSError:
-            pass
-        finally:
-            os.close(fd)
+        unlink_unheld(Path(entry.path))
+
+
+def unlink_unheld(path: Path) -> bool:
+    """Remove the regular file ``path`` unless a live writer holds it; whether it went."""
+    import fcntl
+
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | os.O_NOFOLLOW)
+    except OSError:
+        return False
+    try:
+        if not os.path.isfile(path) or os.path.islink(path):
+            return False
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # refused while its writer lives
+        os.unlink(path)
+        return True
+    except OSError:
+        return False
+    finally:
+        os.close(fd)
 
 
 @contextlib.contextmanager

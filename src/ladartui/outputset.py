@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import errno
+import glob
 import json
 import os
 import stat
@@ -24,7 +25,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from ladartui.atomic import held_temporary
+from ladartui.atomic import held_temporary, unlink_unheld
 from ladartui.errors import OutputFileError, check_cancelled, os_reason
 from ladartui.fileprobe import SPECIAL_FILE
 
@@ -252,10 +253,15 @@ class OutputSet:
         with contextlib.suppress(OSError):
             self.journal.with_name(self.journal.name + ".tmp").unlink()
         for path in self.paths.values():
-            for pattern in (f".{path.name}.*.tmp", f"..{path.name}.*.tmp", f".{path.name}.*.old"):
+            name = glob.escape(path.name)  # "[" in a name is no pattern
+            # this set's temporaries (and their writers' own) that no live writer holds: a
+            # plain write of one of the names may be under way, the lock is the set's alone
+            for pattern in (f".{name}.*.tmp", f"..{name}.*.tmp"):
                 for stale in path.parent.glob(pattern):
-                    with contextlib.suppress(OSError):
-                        stale.unlink()
+                    unlink_unheld(stale)
+            for stale in path.parent.glob(f".{name}.*.old"):
+                with contextlib.suppress(OSError):
+                    stale.unlink()
 
     # -- write --
 
