@@ -375,3 +375,18 @@ async def test_forms_open_on_values_of_many_digits(tmp_path, scene_files):
         form = await screen_after(pilot, app.action_edit_segment, FormScreen)
         await pilot.pause()
         assert form.query_one("#f-radius").value == "60.1235"
+
+
+def test_the_room_a_path_leaves_a_segment_is_said_in_english(tmp_path, scene_files):
+    """'the path's other segments have 1 scans'."""
+    import pytest
+
+    from ladartui.errors import FieldError
+    from ladartui.flight import Manual, ScanPose, Straight
+    from ladartui.tui import bridge
+
+    scenario = make_scenario(tmp_path, scene_files)
+    segments = [Manual((ScanPose(0.0, 0.0, 40.0),)), Straight(distance=1000.0, scans=10000)]
+    with pytest.raises(FieldError) as caught:
+        bridge.with_segment_at(scenario, segments, 1)
+    assert "at most 9999 here (the path's other segments have 1 scan; a path has" in str(caught.value)

@@ -263,8 +263,8 @@ async def test_a_spec_opened_shows_only_its_own_variants_from_the_folder(finishe
     async with app.run_test(size=SIZE) as pilot:
         await opened(pilot)
         assert screen.query_one("#sweep-table", DataTable).row_count == 1
-        assert str(screen.query_one("#sweep-counts").render()) == "1 variants, 1 ok, 0 failed"
-        said = "11 rows not ranked: other variants or an earlier base;"
+        assert str(screen.query_one("#sweep-counts").render()) == "1 variant, 1 ok, 0 failed"
+        said = "11 rows not ranked: other variants;"  # the base is the one they ran on
         assert status_of(screen).query_one("#status-text").render().plain.startswith(said)  # whole at 80
 
 

@@ -215,8 +215,8 @@ async def test_rows_left_out_of_the_ranking_are_said_first_on_the_status_line(sw
         await opened(pilot)
         await wait_for(pilot, lambda: "ranked by" in screen.last_message)
         shown = screen.query_one("#sweep-status StatusText", StatusText).render().plain
-        assert shown.startswith("1 row not ranked: other variants or an earlier base;"), shown
-        assert "ranked by obscured-coverage: 1 variants, 1 ok" in screen.last_message
+        assert shown.startswith("1 row not ranked: other variants;"), shown
+        assert "ranked by obscured-coverage: 1 variant, 1 ok" in screen.last_message
 
 
 async def test_a_failed_variants_whole_error_is_on_the_detail_line_at_80_columns(tmp_path):

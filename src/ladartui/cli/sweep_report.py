@@ -61,6 +61,7 @@ def result_dict(result, top) -> dict:
         "best_scenario_kept": str(result.best_kept) if result.best_kept else None,
         "best_scenario_earlier": str(result.best_earlier) if result.best_earlier else None,
         "left_out": result.left_out,
+        "left_out_earlier_base": result.left_out_earlier_base,
         "unreadable_lines": result.unreadable_lines,
         "best_levels": levels_text(result.best.row) if result.best is not None else None,
         "charts": {fmt: str(path) for fmt, path in result.charts.items()},

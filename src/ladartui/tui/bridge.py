@@ -297,7 +297,7 @@ def with_segment_at(scenario: Scenario, segments, position: int) -> Scenario:
     value: object = getattr(segment, "scans", counts[position])
     if isinstance(segment, Standoff):
         name, value, what = "standoffs", segment.standoffs, " standoff" if room == 1 else " standoffs"
-    why = f"the path's other segments have {others} scans"
+    why = f"the path's other segments have {others} scan{'' if others == 1 else 's'}"
     if room < 1:
         raise FieldError(name, value, f"none here ({why}, the most a path has)")
     raise FieldError(name, value, f"at most {room}{what} here ({why}; a path has at most {MAX_SCANS})")

@@ -158,6 +158,7 @@ class OpenedSweep:
     out: Path  # the results folder
     result: Any = None  # SweepResult; None: the spec has no results yet
     own: list[dict] | None = None  # opened by its spec: its variants from its base as it is now
+    earlier_base: int = 0  # of the rows not its own, those made from an earlier base
 
 
 def open_sweep(text: str) -> OpenedSweep:
@@ -165,7 +166,7 @@ def open_sweep(text: str) -> OpenedSweep:
     is wrong. A spec opened ranks only its own variants from its base as it is now (the
     folder may hold others: another seed, an edited base or model)."""
     from ladartui.sweep import default_out_dir, load_sweep_results, load_sweep_spec
-    from ladartui.sweep.base import spec_rows
+    from ladartui.sweep.base import earlier_base_rows, own_rows, spec_digest
 
     if not text:
         raise FieldError("spec", text, "a sweep spec, a results.csv or a results folder")
@@ -184,5 +185,8 @@ def open_sweep(text: str) -> OpenedSweep:
     budget = spec.budget if spec else None
     cost = spec.cost if spec else "flight-time"
     result = load_sweep_results(results, objective=objective, budget=budget, cost=cost)
-    own = spec_rows(result.rows, spec) if spec is not None and by_spec else None
-    return OpenedSweep(path, spec, result.results_path.parent, result, own)
+    own, earlier = None, 0
+    if spec is not None and by_spec:
+        digest = spec_digest(spec)
+        own, earlier = own_rows(result.rows, spec.variants, digest), earlier_base_rows(result.rows, digest)
+    return OpenedSweep(path, spec, result.results_path.parent, result, own, earlier)

@@ -81,7 +81,8 @@ class SweepOpening(RankingView):
             self._redraw()
             self._show_stored(len(spec.variants))
             self._status(
-                NOT_READY, f"{path}: {len(spec.variants)} variants, no results yet: F5 runs the sweep"
+                NOT_READY,
+                f"{path}: {plural(len(spec.variants), 'variant')}, no results yet: F5 runs the sweep",
             )
             remember_path("sweeps", path)
             return
@@ -94,8 +95,12 @@ class SweepOpening(RankingView):
         if own is not None and len(own) < len(result.rows):
             self.rows = own
             # said first: after the ranking's words it was cut off at 80 columns
-            count = plural(len(result.rows) - len(own), "row")
-            left_out = f"{count} not ranked: other variants or an earlier base; "
+            earlier = opened.earlier_base
+            others = len(result.rows) - len(own) - earlier
+            kinds = [
+                words for count, words in ((others, "other variants"), (earlier, "an earlier base")) if count
+            ]
+            left_out = f"{plural(len(result.rows) - len(own), 'row')} not ranked: {', '.join(kinds)}; "
             self._rank_quietly()
         self.progress = None
         self._redraw(best=True)

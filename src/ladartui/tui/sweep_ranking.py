@@ -14,6 +14,7 @@ from textual.widgets import DataTable, ProgressBar, Static
 from textual_plotext import PlotextPlot
 
 from ladartui.errors import LadarError
+from ladartui.number_text import plural
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES
 from ladartui.tui.sweep_view import detail_text, draw_pareto, fill_ranking_table
 
@@ -40,7 +41,7 @@ class RankingView(Screen):
         ok = sum(row.get("status") == "ok" for row in self.rows)
         impossible = sum(row.get("status") == "error" for row in self.rows)  # final, never rerun
         failed = len(self.rows) - ok - impossible
-        return f"{len(self.rows)} variants, {ok} ok, {failed} failed" + (
+        return f"{plural(len(self.rows), 'variant')}, {ok} ok, {failed} failed" + (
             f", {impossible} impossible" if impossible else ""
         )
 

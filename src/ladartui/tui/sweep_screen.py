@@ -27,6 +27,7 @@ from textual_plotext import PlotextPlot
 
 from ladartui.errors import FieldError, LadarError
 from ladartui.fileprobe import user_path
+from ladartui.number_text import plural
 from ladartui.recent import recent_paths, remember_path
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.tui.fields import refusal
@@ -296,7 +297,7 @@ class SweepScreen(SweepOpening):
         self._status(
             BUSY,
             # the folder before the rest: a line cut at 80 columns loses its end
-            f"starting {len(ids)} variants into {short_path(self.out)} on {where}",
+            f"starting {plural(len(ids), 'variant')} into {short_path(self.out)} on {where}",
             0.0,
             cancellable=True,
         )
