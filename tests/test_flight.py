@@ -461,3 +461,25 @@ def test_a_plan_builds_its_scans_once_however_often_it_is_asked(monkeypatch):
     again = pickle.loads(pickle.dumps(plan))  # sent to a sweep's workers without its scans
     assert again == plan and len(pickle.dumps(plan)) < 2000
     assert again.poses() == plan.poses()
+
+
+def test_the_scans_of_plans_long_unused_are_not_kept():
+    """Each edit of a path makes a new plan, and an undo history holds 200 of them: a
+    10,000-scan path kept with every one pinned half a gigabyte."""
+    import gc
+    import weakref
+
+    from ladartui.flight import plan as plan_module
+
+    plans = [
+        FlightPlan(segments=(Orbit(centre=(0.0, 0.0, 0.0), radius=50.0 + k, altitude=60.0, scans=10),))
+        for k in range(3 * plan_module._KEPT_PLANS)
+    ]
+    for plan in plans:
+        plan.poses()
+    held = [entry for _, entry in plan_module._made.items() if any(entry[0]() is p for p in plans)]
+    assert len(held) == plan_module._KEPT_PLANS  # the plans used last, of all still alive
+    gone = weakref.ref(plans[-1])
+    del plans, plan
+    gc.collect()
+    assert gone() is None  # the cache holds no plan alive

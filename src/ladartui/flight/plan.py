@@ -16,6 +16,9 @@ from __future__ import annotations
 
 import itertools
 import math
+import threading
+import weakref
+from collections import OrderedDict
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import ClassVar
@@ -296,7 +299,28 @@ SEGMENT_KINDS = {cls.kind: cls for cls in (Manual, Straight, Turn, Orbit, FlyPas
 Segment = Manual | Straight | Turn | Orbit | FlyPast | Standoff
 
 
-_MADE = "_made_scans"  # where a plan keeps the scans it made
+# The scans of the plans used last, by identity: kept beside the plans, not in them, so
+# that the plans an editor's undo history holds (a few MB each) do not keep theirs.
+_KEPT_PLANS = 8
+_made: OrderedDict[int, tuple[weakref.ref, tuple]] = OrderedDict()
+_made_lock = threading.Lock()
+
+
+def _made_scans(plan: FlightPlan) -> tuple:
+    key = id(plan)
+    with _made_lock:
+        entry = _made.get(key)
+        if entry is not None and entry[0]() is plan:  # (an id outlives its plan)
+            _made.move_to_end(key)
+            return entry[1]
+    made = plan._build()  # unlocked: slow, and two threads building the same plan agree
+    with _made_lock:
+        _made[key] = (weakref.ref(plan), made)
+        _made.move_to_end(key)
+        while len(_made) > _KEPT_PLANS:
+            _made.popitem(last=False)
+    return made
+
 
 SEGMENTS_EXPECTED = (
     "a list of flight segments (Manual, Straight, Turn, Orbit, FlyPast, Standoff "
@@ -333,16 +357,10 @@ class FlightPlan:
         return bool(self.segments) and self.segments[0].relative
 
     def segment_poses(self) -> list[list[ScanPose]]:
-        """The scans of each segment, in order: made once (the plan and its poses are
-        immutable; a 10,000-scan path takes half a second), handed out as new lists."""
-        made = self.__dict__.get(_MADE)
-        if made is None:
-            made = self._build()
-            self.__dict__[_MADE] = made
-        return [list(poses) for poses in made]
-
-    def __getstate__(self):
-        return {k: v for k, v in self.__dict__.items() if k != _MADE}  # made again where needed
+        """The scans of each segment, in order: made once for a plan in use (the plan and
+        its poses are immutable; a 10,000-scan path takes a sixth of a second, and one
+        edit asked for it 16 times), handed out as new lists."""
+        return [list(poses) for poses in _made_scans(self)]
 
     def _build(self) -> tuple[tuple[ScanPose, ...], ...]:
         current = self.start
