@@ -51,6 +51,11 @@ def test_a_mistyped_command_is_named_not_taken_for_a_scenario(tmp_path, capsys, 
             ["info", "--backends", "--json"],
             "ladartui info: error: unrecognized arguments: --json (see 'ladartui info -h')\n",
         ),
+        # before the command: the top level's, not the command's
+        (
+            ["--bogus", "run", "x.toml"],
+            "ladartui: error: unrecognized arguments: --bogus (see 'ladartui -h')\n",
+        ),
     ],
 )
 def test_a_flag_a_command_lacks_points_at_that_command_s_help(capsys, argv, said):

@@ -58,12 +58,14 @@ class _Parser(argparse.ArgumentParser):
     def parse_args(self, args=None, namespace=None):
         # argparse tells words left over at the top, whose help lists no command's flags:
         # the command's own parser tells them here, pointing at its help.
-        parsed, extras = self.parse_known_args(args, namespace)
+        words = list(sys.argv[1:] if args is None else args)
+        parsed, extras = self.parse_known_args(words, namespace)
         if extras:
+            command = getattr(parsed, "command", None)
             commands = next((a.choices for a in self._actions if a.dest == "command"), None)
-            told_by = (
-                commands.get(getattr(parsed, "command", None), self) if isinstance(commands, dict) else self
-            )
+            told_by = commands.get(command, self) if isinstance(commands, dict) else self
+            if command in words and set(extras) & set(words[: words.index(command)]):
+                told_by = self  # given before the command: a word of the top level
             told_by.error(f"unrecognized arguments: {' '.join(extras)}")
         return parsed
 
