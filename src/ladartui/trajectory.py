@@ -324,7 +324,7 @@ class LogSegment:
             set_("depression", number_field("depression", self.depression, 1.0, 90.0))
         if self.aim_at is not None:
             set_("aim_at", point_field("aim_at", self.aim_at))
-            self._drop_pointing_the_aim_sets()
+            self._refuse_or_drop_pointing()
         else:  # the unset pointing as a value, so a log written either way reads alike
             set_("azimuth", LOG_AZIMUTH if self.azimuth is None else self.azimuth)
             set_("depression", LOG_DEPRESSION if self.depression is None else self.depression)
@@ -374,14 +374,18 @@ class LogSegment:
                 raise FieldError("times", self.times, f"{expected}, increasing")
             set_("times", times)
 
-    def _drop_pointing_the_aim_sets(self):
-        """Refuse a pointing beside the aim point, which sets both angles. The unset
-        values themselves are let by, as earlier versions wrote them with every log."""
+    def _refuse_or_drop_pointing(self):
+        """Refuse a pointing beside the aim point, which sets both angles; drop the unset
+        values themselves, which earlier versions wrote with every log."""
         from ladartui.flight.plan import refuse_two_pointings
 
         unset = {"azimuth": LOG_AZIMUTH, "depression": LOG_DEPRESSION}
-        given = {name: value for name, value in unset.items() if getattr(self, name) not in (None, value)}
-        refuse_two_pointings(self.aim_at, {name: getattr(self, name) for name in given})
+        given = {
+            name: getattr(self, name)
+            for name, value in unset.items()
+            if getattr(self, name) not in (None, value)
+        }
+        refuse_two_pointings(self.aim_at, given)
         object.__setattr__(self, "azimuth", None)
         object.__setattr__(self, "depression", None)
 
