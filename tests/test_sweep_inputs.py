@@ -183,6 +183,17 @@ def test_a_spec_refused_for_the_ray_limit_says_so_when_other_variants_are_imposs
     assert "sensor_grid = 0" not in message and not (tmp_path / "o").exists()
 
 
+def test_a_spec_over_the_ray_limit_is_named_on_what_makes_its_rays(tmp_path, monkeypatch):
+    """Over the ray limit, 'grid.radius: no variant can run' blamed the first parameter
+    written, which adds no ray; the sensor grid does."""
+    write_tiny_scenario(tmp_path)
+    spec = write_spec(tmp_path, "[grid]\nradius = [20.0, 30.0]\nsensor_grid = [64]\n", name="rays.toml")
+    monkeypatch.setenv("LADARTUI_MAX_RAYS", "5000")
+    with pytest.raises(InputFileError) as refused:
+        run_sweep(spec, serial=True, out=tmp_path / "o")
+    assert "rays.toml:5: grid.sensor_grid: no variant can run: " in str(refused.value)
+
+
 def test_a_spec_file_name_that_cannot_name_the_best_path_file_asks_for_sweep_name(tmp_path):
     """'my sweep.toml' was refused as 'sweep.name: ... (got 'my sweep')', a key not in the
     file: the default comes from the file name, which the message now says."""

@@ -156,9 +156,17 @@ def check_some_variant_runs(spec: SweepSpec, base) -> None:
         return  # a spec of no variants
     from ladartui.resources import sweep_advice
 
-    key = _blamed_key(spec, getattr(first, "field", ""))
+    if limit is not None:  # the rays: what makes them, of what the spec varies
+        field = next((name for name in RAY_PARAMETERS if name in spec.parameter_names), "")
+    else:
+        field = getattr(first, "field", "")
+    key = _blamed_key(spec, field)
     said = f"{key}: no variant can run: {sweep_advice(first)}"
     raise InputFileError(spec.path, said, line=spec_line(spec.path, *key.split(".")))
+
+
+# The parameters a variant's rays grow with: a refusal for the ray limit is theirs.
+RAY_PARAMETERS = ("sensor_grid", "ray_grid", "scans", "preset", "arc")
 
 
 def _blamed_key(spec: SweepSpec, field: str) -> str:
