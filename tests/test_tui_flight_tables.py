@@ -42,6 +42,14 @@ async def test_a_path_of_thousands_of_scans_lists_the_first_thousand_and_says_so
         assert scans.row_count == MOST_SCAN_ROWS == 1000
         assert [str(cell) for cell in scans.get_row_at(999)][0] == "1000"
         assert str(app.query_one("#scans-heading").render()) == "Scans (the first 1,000 of 2,506)"
+    async with opened(scenario, size=(80, 24)) as (app, pilot):  # the narrow sidebar
+        app.action_show_tab("flight")
+        await pilot.pause()
+        heading = app.query_one("#scans-heading")
+        said = str(heading.render())
+        assert said.startswith("Scans (the first 1,000 of 2,506; no room for ")
+        # whole, over more lines: cut at the sidebar's edge, it lost the columns left out
+        assert heading.size.height * heading.size.width >= cell_len(said) > heading.size.width
 
 
 async def test_the_segments_table_fits_the_sidebar_and_wraps_a_long_detail(tmp_path, scene_files):
