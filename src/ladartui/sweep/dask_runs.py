@@ -1,6 +1,10 @@
 """A sweep's variants on a Dask cluster: the base scene scattered to every worker once,
 the variants submitted a few tasks ahead of the workers, each row recorded as its
-task ends (a lost task as a ``failed`` row, run again on resume)."""
+task ends (a lost task as a ``failed`` row, run again on resume).
+
+The scene lost with the workers that held it (the only worker killed and restarted by
+its nanny) is scattered again and the variants it took with it run again, each once:
+one that kills its worker every time is then recorded ``failed``."""
 
 from __future__ import annotations
 
@@ -13,14 +17,18 @@ from ladartui.sweep.variant import ScenePayload, run_variant
 
 _POLL_SECONDS = 0.05
 _AHEAD_SECONDS = 1.0  # how often the cluster's threads are counted again
+_WORKER_WAIT_SECONDS = 60.0  # for a worker to come back once the scene is lost with them all
 
 
 def _lost_row(variant, digest, future) -> dict:
-    try:
-        error = future.exception(timeout=5)
-        message = f"{type(error).__name__}: {error}"
-    except Exception as reason:  # noqa: BLE001 - the future itself may be gone
-        message = f"task {future.status}: {reason}"
+    if future.status == "error":
+        try:
+            error = future.exception(timeout=5)
+            message = f"{type(error).__name__}: {error}"
+        except Exception as reason:  # noqa: BLE001 - the future itself may be gone
+            message = f"task {future.status}: {reason}"
+    else:  # cancelled: its exception is None
+        message = f"task {future.status} by the cluster (its worker lost, or its data)"
     return {"variant": variant.id, "status": "failed", "base": digest, **variant.params, "error": message}
 
 
@@ -35,6 +43,7 @@ def run_on_dask(client, todo, base, digest, scene, options, record, cancel):
     scene_future = client.scatter(payload, broadcast=True, hash=False)
     tag = uuid.uuid4().hex[:8]
     waiting = list(reversed(todo))  # popped from the end: the first variant first
+    retried: set[str] = set()  # variants run again once after the scene was lost
     pending: dict = {}
     completed = as_completed(loop=client.loop)  # this client's, not the default one's
     ahead, asked = 0, -math.inf
@@ -56,7 +65,7 @@ def run_on_dask(client, todo, base, digest, scene, options, record, cancel):
                 scene_future,
                 options,
                 pure=False,
-                key=f"ladartui-variant-{variant.id}-{tag}",
+                key=f"ladartui-variant-{variant.id}-{tag}{'-again' if variant.id in retried else ''}",
             )
             pending[future] = variant
             completed.add(future)
@@ -75,15 +84,35 @@ def run_on_dask(client, todo, base, digest, scene, options, record, cancel):
                 check_cancelled(cancel, "sweep cancelled")
                 variant = pending.pop(future)
                 if future.status == "finished":
-                    row = future.result()
-                else:
-                    row = _lost_row(variant, digest, future)
-                record(row)
+                    record(future.result())
+                    continue
+                if scene_future.status != "finished" and variant.id not in retried:
+                    retried.add(variant.id)  # lost with the scene, not by its own fault
+                    waiting.append(variant)
+                    continue
+                record(_lost_row(variant, digest, future))
+            if scene_future.status != "finished":
+                scene_future.release()
+                scene_future = _scatter_again(client, payload)
             submit_more()
     finally:
         if pending:
             client.cancel(list(pending))
         scene_future.release()
+
+
+def _scatter_again(client, payload):
+    """The scene scattered anew, once a worker is there to take it (a nanny restarts a
+    killed worker in seconds)."""
+    from ladartui.errors import LadarError
+
+    try:
+        client.wait_for_workers(1, timeout=_WORKER_WAIT_SECONDS)
+    except TimeoutError:
+        raise LadarError(
+            f"the Dask cluster lost every worker and none came back within {_WORKER_WAIT_SECONDS:g} s"
+        ) from None
+    return client.scatter(payload, broadcast=True, hash=False)
 
 
 def tasks_ahead(client) -> int:
