@@ -1,13 +1,18 @@
-"""Sweeps on Dask that lose part of the cluster: the only worker killed."""
+"""Sweeps on Dask that lose part of the cluster: the only worker killed, the scheduler gone."""
 
+import logging
 import os
 import signal
+import subprocess
+import sys
 import threading
 import time
+from pathlib import Path
 
 import pytest
 
-from ladartui.sweep import local_client, run_sweep
+from ladartui.errors import LadarError
+from ladartui.sweep import local_client, read_table, run_sweep
 from ladartui.sweep.cluster import close_client
 from tiny_sweep import write_spec, write_tiny_scenario
 
@@ -59,3 +64,97 @@ def test_the_only_worker_killed_mid_sweep_costs_no_variant(spec, tmp_path):
     assert restarted != pid  # the worker was killed, and its nanny started another
     assert [(r["status"], r["error"]) for r in result.rows] == [("ok", None)] * 4
     assert result.failures == []
+
+
+def test_the_scheduler_gone_mid_sweep_is_told_in_one_line(spec, tmp_path, caplog):
+    """The scheduler gone printed a traceback (ClosedClientError) after 30 s, and
+    recorded every variant in flight as failed with 'NoneType: None'; closing the
+    client then logged its cancelled reconnection with three more tracebacks."""
+    client = local_client(1)
+    cluster = client.cluster
+    closing = threading.Thread(target=cluster.close)
+    try:
+        client.submit(time.sleep, 5, pure=False)
+        _when_variants_wait(client, closing.start)
+        started = time.monotonic()
+        with pytest.raises(LadarError) as caught:
+            run_sweep(spec, client=client, out=tmp_path / "out")
+        took = time.monotonic() - started
+    finally:
+        if closing.is_alive():
+            closing.join()
+        with caplog.at_level(logging.ERROR, logger="distributed.client"):
+            close_client(client)
+    message = str(caught.value)
+    assert "\n" not in message and "NoneType" not in message
+    assert message.startswith(f"lost the connection to the Dask scheduler {cluster.scheduler_address}")
+    assert message.endswith("no variant had finished; run the sweep again to start it")
+    assert took < 20  # not the client's 30 s of trying to reconnect first
+    rows, _ = read_table(tmp_path / "out" / "results.csv")
+    assert all(r["status"] != "failed" for r in rows)
+    assert [r.getMessage() for r in caplog.records if r.name == "distributed.client"] == []
+
+
+def test_the_cli_tells_a_killed_scheduler_in_one_line_and_no_traceback(spec, tmp_path):
+    """Closing the client that lost its scheduler cancelled its attempts to reconnect,
+    which distributed logged with three tracebacks under the sweep's message."""
+    from distributed import Client
+
+    from test_sweep_dask import _start, _stop, _wait_for
+
+    def variants_held(dask_scheduler):  # nested: sent by value to a scheduler that lacks this file
+        return [key for key in dask_scheduler.tasks if str(key).startswith("ladartui-variant-")]
+
+    bin_dir = Path(sys.executable).parent
+    env = dict(os.environ, NUMBA_NUM_THREADS="1")
+    started = []
+    try:
+        scheduler, log = _start(
+            [str(bin_dir / "dask"), "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard"],
+            tmp_path / "scheduler.log",
+            env,
+        )
+        started.append((scheduler, log))
+        address = _wait_for(
+            r"Scheduler at:\s+(tcp://127\.0\.0\.1:\d+)", tmp_path / "scheduler.log", scheduler
+        ).group(1)
+        worker, log = _start(
+            [str(bin_dir / "dask"), "worker", address, "--nthreads", "1", "--no-dashboard"],
+            tmp_path / "worker.log",
+            env,
+        )
+        started.append((worker, log))
+        holder = Client(address, timeout="30s")
+        holder.wait_for_workers(1, timeout=60)
+        holder.submit(time.sleep, 60, pure=False)  # the sweep's variants wait behind it
+        sweep = subprocess.Popen(
+            [
+                str(bin_dir / "ladartui"),
+                "sweep",
+                str(spec),
+                "--scheduler",
+                address,
+                "--out",
+                str(tmp_path / "out"),
+            ],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+            env=env,
+        )
+        deadline = time.monotonic() + 120
+        while not holder.run_on_scheduler(variants_held) and time.monotonic() < deadline:
+            time.sleep(0.1)
+        holder.close()
+        scheduler.kill()
+        _, stderr = sweep.communicate(timeout=60)
+    finally:
+        for process, handle in reversed(started):
+            _stop(process)
+            handle.close()
+    assert sweep.returncode == 2
+    assert "Traceback" not in stderr and "ERROR" not in stderr
+    assert stderr.splitlines()[-1] == (
+        f"ladartui: error: lost the connection to the Dask scheduler {address}; no variant had "
+        "finished; run the sweep again to start it"
+    )

@@ -292,6 +292,7 @@ LATE_INTERRUPT = "the interrupt came after the last variant: the sweep finished"
 
 def _sweep_with_progress(checked, args, console):
     from ladartui.sweep import connect, run_sweep
+    from ladartui.sweep.cluster import close_client
 
     spec = checked.spec
 
@@ -349,7 +350,7 @@ def _sweep_with_progress(checked, args, console):
                 return result
     finally:
         if client is not None:
-            client.close()
+            close_client(client)
     last = outcome.get("progress")
     if last is None or not last.done:
         said = "sweep interrupted before any variant finished; run the same command again to start it"

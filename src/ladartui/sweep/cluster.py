@@ -225,6 +225,33 @@ def check_workers(client) -> None:
 def close_client(client):
     """Close ``client`` and, for a local cluster, the cluster with its workers."""
     cluster = getattr(client, "cluster", None)
-    client.close()
+    with _reconnect_cut_short_unlogged():
+        client.close()
     if cluster is not None:
         cluster.close()
+
+
+# distributed's message when a client stops trying to reconnect, closed or timed out.
+RECONNECT_FAILED = "Failed to reconnect to scheduler"
+
+
+@contextlib.contextmanager
+def _reconnect_cut_short_unlogged():
+    """A client that lost its scheduler keeps trying to reconnect (30 s by default):
+    closing it ends the attempt, which distributed logged as an ERROR under the sweep's
+    one-line message: the attempt cancelled (three tracebacks), or 'Failed to reconnect
+    to scheduler after 30.00 seconds' at once. Other errors are logged as before."""
+    import asyncio
+
+    class DropReconnect(logging.Filter):
+        def filter(self, record):
+            cancelled = record.exc_info and isinstance(record.exc_info[1], asyncio.CancelledError)
+            return not (cancelled or record.getMessage().startswith(RECONNECT_FAILED))
+
+    log = logging.getLogger("distributed.client")
+    drop = DropReconnect()
+    log.addFilter(drop)
+    try:
+        yield
+    finally:
+        log.removeFilter(drop)

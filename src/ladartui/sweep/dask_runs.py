@@ -12,12 +12,23 @@ import math
 import time
 import uuid
 
-from ladartui.errors import check_cancelled
+from ladartui.errors import LadarError, check_cancelled
 from ladartui.sweep.variant import ScenePayload, run_variant
 
 _POLL_SECONDS = 0.05
 _AHEAD_SECONDS = 1.0  # how often the cluster's threads are counted again
 _WORKER_WAIT_SECONDS = 60.0  # for a worker to come back once the scene is lost with them all
+
+
+class ClusterLost(LadarError):
+    """The sweep cannot go on on this cluster: its scheduler gone, or every worker."""
+
+
+def _check_connected(client, address) -> None:
+    """ClusterLost once ``client`` has lost its scheduler: it then cancels every task it
+    holds (and a scheduler started again knows none of them nor the scene)."""
+    if client.status != "running":
+        raise ClusterLost(f"lost the connection to the Dask scheduler {address}")
 
 
 def _lost_row(variant, digest, future) -> dict:
@@ -39,6 +50,7 @@ def run_on_dask(client, todo, base, digest, scene, options, record, cancel):
     from distributed import as_completed
 
     # Plain arrays once to every worker; each rebuilds the Scene once per token.
+    address = client.scheduler.address
     payload = ScenePayload.of(scene, uuid.uuid4().hex)
     scene_future = client.scatter(payload, broadcast=True, hash=False)
     tag = uuid.uuid4().hex[:8]
@@ -55,6 +67,7 @@ def run_on_dask(client, todo, base, digest, scene, options, record, cancel):
         if time.monotonic() - asked >= _AHEAD_SECONDS:  # a round trip: not every batch
             ahead, asked = tasks_ahead(client), time.monotonic()
         while len(pending) < ahead and waiting:
+            _check_connected(client, address)
             variant = waiting.pop()
             future = client.submit(
                 run_variant,
@@ -86,6 +99,7 @@ def run_on_dask(client, todo, base, digest, scene, options, record, cancel):
                 if future.status == "finished":
                     record(future.result())
                     continue
+                _check_connected(client, address)  # not the variant's failure: stop here
                 if scene_future.status != "finished" and variant.id not in retried:
                     retried.add(variant.id)  # lost with the scene, not by its own fault
                     waiting.append(variant)
@@ -93,23 +107,27 @@ def run_on_dask(client, todo, base, digest, scene, options, record, cancel):
                 record(_lost_row(variant, digest, future))
             if scene_future.status != "finished":
                 scene_future.release()
-                scene_future = _scatter_again(client, payload)
+                scene_future = _scatter_again(client, address, payload)
             submit_more()
+    except Exception:
+        if client.status != "running":  # a call that failed for it (ClosedClientError, ...)
+            pending.clear()  # cancelled with the connection
+            raise ClusterLost(f"lost the connection to the Dask scheduler {address}") from None
+        raise
     finally:
         if pending:
             client.cancel(list(pending))
         scene_future.release()
 
 
-def _scatter_again(client, payload):
+def _scatter_again(client, address, payload):
     """The scene scattered anew, once a worker is there to take it (a nanny restarts a
     killed worker in seconds)."""
-    from ladartui.errors import LadarError
-
+    _check_connected(client, address)
     try:
         client.wait_for_workers(1, timeout=_WORKER_WAIT_SECONDS)
     except TimeoutError:
-        raise LadarError(
+        raise ClusterLost(
             f"the Dask cluster lost every worker and none came back within {_WORKER_WAIT_SECONDS:g} s"
         ) from None
     return client.scatter(payload, broadcast=True, hash=False)

@@ -33,7 +33,7 @@ from ladartui.precompile import compile_ahead
 from ladartui.sweep.base import CheckedBase, checked_base, earlier_base_rows, own_rows, spec_digest
 from ladartui.sweep.best_file import best_files, write_best_scenario
 from ladartui.sweep.cluster import check_local_workers, close_client, local_client
-from ladartui.sweep.dask_runs import run_on_dask
+from ladartui.sweep.dask_runs import ClusterLost, run_on_dask
 from ladartui.sweep.ranking import (
     BUDGET_OBJECTIVES,
     COSTS,
@@ -373,6 +373,9 @@ def _run_locked(
             table.flush()
         except LadarError as also:  # the first error is the one to tell
             error.add_note(f"and the results table could not be written: {also}")
+        else:
+            if isinstance(error, ClusterLost):  # what is kept, and how to go on
+                raise ClusterLost(f"{error}; {_kept(state, results_path)}") from None
         raise
     table.flush()
 
@@ -411,6 +414,15 @@ def _run_locked(
         result.best_earlier = next(iter(best_files(out, spec.name)), None)
     result.elapsed = time.perf_counter() - started
     return result
+
+
+def _kept(state: SweepProgress, results_path: Path) -> str:
+    if not state.done:
+        return "no variant had finished; run the sweep again to start it"
+    return (
+        f"{state.done:,} of {state.total:,} variants are kept in {results_path}; "
+        "run the sweep again to resume"
+    )
 
 
 def _run_todo(todo, digest, base, scene, client, cancel, workers, serial, simulate_options, record):

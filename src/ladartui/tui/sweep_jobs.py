@@ -91,6 +91,7 @@ def sweep_job(
     then every finished variant, each a kept progress report."""
     from ladartui.sweep import connect, default_out_dir, run_sweep
     from ladartui.sweep.base import checked_base, own_rows
+    from ladartui.sweep.cluster import close_client
     from ladartui.sweep.table import read_table
 
     checked = checked_base(spec)  # the base read and hashed once, for these rows and the run
@@ -117,7 +118,7 @@ def sweep_job(
         )
     finally:
         if client is not None:
-            client.close()
+            close_client(client)
 
 
 def write_best(spec, row: dict, parameter_names, path: Path) -> BestScenario:
