@@ -158,3 +158,54 @@ def test_the_cli_tells_a_killed_scheduler_in_one_line_and_no_traceback(spec, tmp
         f"ladartui: error: lost the connection to the Dask scheduler {address}; no variant had "
         "finished; run the sweep again to start it"
     )
+
+
+def _left_without_workers(client, then=lambda: None):
+    """Every worker leaves once the sweep's variants wait (the scene goes with them)."""
+
+    def leave():
+        client.cluster.scale(0)
+        then()
+
+    client.submit(time.sleep, 5, pure=False)
+    _when_variants_wait(client, leave)
+
+
+def test_a_cluster_left_without_workers_stops_the_sweep_in_one_line(spec, tmp_path, monkeypatch):
+    import ladartui.sweep.dask_runs as dask_runs
+
+    monkeypatch.setattr(dask_runs, "_WORKER_WAIT_SECONDS", 3.0)
+    client = local_client(1)
+    try:
+        _left_without_workers(client)
+        started = time.monotonic()
+        with pytest.raises(LadarError) as caught:
+            run_sweep(spec, client=client, out=tmp_path)
+        took = time.monotonic() - started
+    finally:
+        close_client(client)
+    assert took < 30
+    assert str(caught.value) == (
+        "the Dask cluster lost every worker and none came back within 3 s; no variant had "
+        "finished; run the sweep again to start it"
+    )
+
+
+def test_waiting_for_a_worker_to_come_back_heeds_a_cancel(spec, tmp_path, monkeypatch):
+    """Once the scene was lost with every worker, the sweep waited for one to come back
+    without looking at a Ctrl-C."""
+    import ladartui.sweep.dask_runs as dask_runs
+    from ladartui.errors import Cancelled
+
+    monkeypatch.setattr(dask_runs, "_WORKER_WAIT_SECONDS", 600.0)
+    client = local_client(1)
+    cancel = threading.Event()
+    try:
+        _left_without_workers(client, threading.Timer(3.0, cancel.set).start)
+        started = time.monotonic()
+        with pytest.raises(Cancelled):
+            run_sweep(spec, client=client, out=tmp_path, cancel=cancel)
+        took = time.monotonic() - started
+    finally:
+        close_client(client)
+    assert took < 30  # not the 600 s allowed for a worker to come back

@@ -107,7 +107,7 @@ def run_on_dask(client, todo, base, digest, scene, options, record, cancel):
                 record(_lost_row(variant, digest, future))
             if scene_future.status != "finished":
                 scene_future.release()
-                scene_future = _scatter_again(client, address, payload)
+                scene_future = _scatter_again(client, address, payload, cancel)
             submit_more()
     except Exception:
         if client.status != "running":  # a call that failed for it (ClosedClientError, ...)
@@ -120,17 +120,22 @@ def run_on_dask(client, todo, base, digest, scene, options, record, cancel):
         scene_future.release()
 
 
-def _scatter_again(client, address, payload):
+def _scatter_again(client, address, payload, cancel):
     """The scene scattered anew, once a worker is there to take it (a nanny restarts a
-    killed worker in seconds)."""
-    _check_connected(client, address)
-    try:
-        client.wait_for_workers(1, timeout=_WORKER_WAIT_SECONDS)
-    except TimeoutError:
-        raise ClusterLost(
-            f"the Dask cluster lost every worker and none came back within {_WORKER_WAIT_SECONDS:g} s"
-        ) from None
-    return client.scatter(payload, broadcast=True, hash=False)
+    killed worker in seconds): waited for a second at a time, heeding ``cancel``."""
+    deadline = time.monotonic() + _WORKER_WAIT_SECONDS
+    while True:
+        _check_connected(client, address)
+        check_cancelled(cancel, "sweep cancelled")
+        try:
+            client.wait_for_workers(1, timeout=1.0)
+            # (a worker still closing counts above; the scatter then finds none)
+            return client.scatter(payload, broadcast=True, hash=False)
+        except TimeoutError:
+            if time.monotonic() >= deadline:
+                raise ClusterLost(
+                    f"the Dask cluster lost every worker and none came back within {_WORKER_WAIT_SECONDS:g} s"
+                ) from None
 
 
 def tasks_ahead(client) -> int:
