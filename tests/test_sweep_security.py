@@ -159,6 +159,17 @@ with LocalCluster(
         raise AssertionError("connected without certificates")
     except FieldError as error:
         assert "--scheduler" in str(error), error
+    # Its port as plain tcp:// (the TLS flags forgotten): the reset is put in words.
+    try:
+        connect(f"tcp://127.0.0.1:{port}", 2.0)
+        raise AssertionError("connected over plain TCP")
+    except FieldError as error:
+        said = str(error)
+        assert said == (
+            f"--scheduler = 'tcp://127.0.0.1:{port}': expected the address of a running Dask "
+            "scheduler (tcp://HOST:PORT); it reset the connection, as a TLS scheduler does to a "
+            f"plain client: give tls://127.0.0.1:{port} with --tls-ca-file, --tls-cert and --tls-key"
+        ), said
     client = connect(address, 10.0, cluster_security(address, ca, cert, key))
     assert client.submit(sum, [1, 2, 3]).result(timeout=10) == 6
     client.close()

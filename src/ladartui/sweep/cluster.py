@@ -160,6 +160,14 @@ def connect(address: str, timeout: float = 30.0, security=None):
     except (OSError, TimeoutError, ValueError, TypeError) as error:  # TypeError: tls:// sans TLS
         if security is not None and (refusal := tls_refusal(error, security)) is not None:
             raise refusal from None
+        if security is None and address.startswith("tcp://") and _was_reset(error):
+            raise FieldError(
+                "--scheduler",
+                address,
+                "the address of a running Dask scheduler (tcp://HOST:PORT); it reset the connection, "
+                f"as a TLS scheduler does to a plain client: give tls://{address[len('tcp://') :]} "
+                "with --tls-ca-file, --tls-cert and --tls-key",
+            ) from None
         raise FieldError(
             "--scheduler",
             address,
@@ -174,6 +182,16 @@ def connect(address: str, timeout: float = 30.0, security=None):
         ) from None
     check_workers(client)
     return client
+
+
+def _was_reset(error: BaseException) -> bool:
+    """Whether the peer reset the connection (``error`` or what caused it)."""
+    seen: BaseException | None = error
+    while seen is not None:
+        if isinstance(seen, ConnectionResetError):
+            return True
+        seen = seen.__cause__ or seen.__context__
+    return False
 
 
 def tls_refusal(error: BaseException, security) -> FieldError | None:
