@@ -47,6 +47,17 @@ def test_tls_flags_must_come_together_and_with_a_tls_address(tmp_path):
     assert (paths["key"].stat().st_mode & 0o077) == 0
 
 
+def test_insecure_with_tls_is_refused_as_a_flag_that_does_not_apply(tmp_path):
+    """--insecure beside a tls:// scheduler and its certificates was taken without a word,
+    as if the connection were plain; a flag that does not apply is refused, as elsewhere."""
+    paths = make_certificates(tmp_path)
+    with pytest.raises(FieldError) as caught:
+        cluster_security("tls://10.0.0.1:8786", paths["ca"], paths["cert"], paths["key"], insecure=True)
+    assert str(caught.value).startswith(
+        "--insecure = True: expected --insecure only with a plain tcp:// address"
+    )
+
+
 def test_tls_files_that_hold_no_certificate_or_key_are_named_by_their_flag(tmp_path):
     """A CA file holding no certificate was reported as '--scheduler = ...: connecting
     failed: [X509: NO_CERTIFICATE_OR_CRL_FOUND]'."""

@@ -61,6 +61,13 @@ def cluster_security(address: str, ca_file=None, cert_file=None, key_file=None, 
     scheme = address.split("://", 1)[0] if "://" in address else "tcp"
     if not _is_address(address):
         raise FieldError("--scheduler", address, "an address such as tcp://127.0.0.1:8786 or tls://HOST:PORT")
+    if insecure and (scheme == "tls" or any(files.values())):
+        raise FieldError(
+            "--insecure",
+            True,
+            "--insecure only with a plain tcp:// address (a tls:// scheduler with its "
+            "certificates needs none)",
+        )
     if any(files.values()):
         for flag, path in files.items():
             if not path:
