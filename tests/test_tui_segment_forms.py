@@ -195,3 +195,21 @@ async def test_ok_on_a_segment_form_keeps_the_values_it_was_not_given(tmp_path, 
         await wait_until(pilot, lambda: app.screen is not form, timeout=10.0)
         orbit = app.scenario.flight.segments[0]
         assert (orbit.radius, orbit.altitude, orbit.centre) == (exact.radius, 35.0, (1.5, 2.0, 0.5))
+
+
+async def test_a_refusal_is_cleared_once_its_field_is_put_right(tmp_path, scene_files):
+    """After OK refused a distance of -100, typing 100 left 'Distance m: -100 is not
+    allowed' under the form until the next OK, as if it still were."""
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario) as (app, pilot):
+        form = await added(app, pilot, "straight")
+        await type_into(pilot, form.query_one("#f-distance"), "-100", commit=None)
+        assert (await pressed_ok(form, pilot)).startswith("Distance m: -100 is not allowed")
+        await type_into(pilot, form.query_one("#f-distance"), "-5", commit=None)  # still wrong: still said
+        assert message(form).startswith("Distance m: -100 is not allowed")
+        await type_into(pilot, form.query_one("#f-distance"), "100", commit=None)
+        assert message(form) == ""
+        await type_into(pilot, form.query_one("#f-aim_at"), "1,", commit=None)
+        assert (await pressed_ok(form, pilot)).startswith("Aim at x,y,z m: 1, is not allowed")
+        await type_into(pilot, form.query_one("#f-aim_at"), "1, 2", commit=None)
+        assert message(form) == ""

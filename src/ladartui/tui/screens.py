@@ -313,8 +313,19 @@ class FormScreen(Dialog):
 
     @on(Input.Changed)
     def _typing(self, event: Input.Changed) -> None:
-        if isinstance(event.input, NumberField):
-            event.input.set_class(event.input.problem() is not None, "-bad")
+        widget = event.input
+        if isinstance(widget, NumberField):
+            widget.set_class(widget.problem() is not None, "-bad")
+        elif widget.has_class("-bad"):  # a point field: marked only by a refusal
+            name = (widget.id or "").removeprefix("f-")
+            kind = next((kind for n, _label, kind, *_ in self.spec if n == name), "point")
+            try:
+                _parse_points(name, widget.value, kind)
+                widget.remove_class("-bad")
+            except FieldError:
+                pass
+        if not self.query(".form .-bad"):  # every refusal put right: nothing left to say
+            self.query_one("#form-message", Static).update("")
 
     @on(Input.Submitted)
     @on(Button.Pressed, "#form-ok")
