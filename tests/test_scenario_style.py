@@ -266,3 +266,24 @@ def test_a_file_without_a_final_newline_is_restyled_as_one_with_it(old, data, ne
     text = restyle(old, data)
     assert text is not None and text.endswith(new), repr(text)
     assert tomllib.loads(text) == data
+
+
+def test_a_default_written_by_hand_stays_when_another_value_of_its_table_changes(folder):
+    """'mount = "stabilised"' and its comment went from the file when the grid was
+    changed: the program writes the mount only when it is body-fixed, so the save took
+    the analyst's line for one the new settings no longer have."""
+    path = folder / "mount.toml"
+    text = (SHIPPED / "orbit.toml").read_text()
+    path.write_text(
+        text.replace("pixel_pitch_um = 100.0\n", 'pixel_pitch_um = 100.0\nmount = "stabilised"  # kept\n')
+    )
+    before = path.read_text()
+    scenario = load_scenario(path)
+    scenario.with_changes(sensor=dataclasses.replace(scenario.sensor, grid=48)).save()
+    assert changed_lines(before, path.read_text()) == ["-grid = 64", "+grid = 48"]
+    scenario = load_scenario(path)
+    scenario.with_changes(sensor=dataclasses.replace(scenario.sensor, mount="body-fixed")).save()
+    assert load_scenario(path).sensor.mount == "body-fixed"
+    scenario = load_scenario(path)
+    scenario.with_changes(sensor=dataclasses.replace(scenario.sensor, mount="stabilised")).save()
+    assert load_scenario(path).sensor.mount == "stabilised"

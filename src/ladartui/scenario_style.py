@@ -4,7 +4,8 @@ A hand-written scenario carries comments, key order and alignment that a
 fresh dump would throw away. ``restyle`` parses the existing text with
 tomlkit and changes only the values that differ from the new data, so a
 load-edit-save round trip changes nothing else. Keys the new data no longer
-has are removed; new keys are appended to their table.
+has are removed (a default written by hand, which the old data lacks as well,
+stays); new keys are appended to their table.
 """
 
 from __future__ import annotations
@@ -36,12 +37,19 @@ def restyle(old_text: str, data: dict, old_data: dict | None = None) -> str | No
     return text
 
 
+def _meant(old_data: dict | None, key: str) -> bool:
+    """Whether the file's ``key`` meant a value that new data without it drops. A key
+    that what the file meant lacks too is a default the program leaves unwritten
+    (``mount = "stabilised"``) but the analyst wrote: it means the same as before."""
+    return not isinstance(old_data, dict) or key in old_data
+
+
 def _plain(item):
     return item.unwrap() if hasattr(item, "unwrap") else item
 
 
 def _merge_table(table, data: dict, old_data: dict | None) -> None:
-    for key in [k for k in table if k not in data]:
+    for key in [k for k in table if k not in data and _meant(old_data, k)]:
         del table[key]
     for key, value in data.items():
         before = old_data.get(key) if isinstance(old_data, dict) else None
