@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pytest
 
+from ladartui.levels import LevelThresholds
 from ladartui.scenario import load_scenario
 from ladartui.scenario_style import restyle
 from ladartui.scene.generate import generate_scene
@@ -287,3 +288,30 @@ def test_a_default_written_by_hand_stays_when_another_value_of_its_table_changes
     scenario = load_scenario(path)
     scenario.with_changes(sensor=dataclasses.replace(scenario.sensor, mount="stabilised")).save()
     assert load_scenario(path).sensor.mount == "stabilised"
+
+
+@pytest.mark.parametrize("mark", ["", "\ufeff"])
+def test_a_file_with_windows_line_ends_keeps_them(folder, mark):
+    """A scenario written on Windows (CRLF) came back from a save with every line end
+    changed to LF: every line differed, even after a save that changed nothing. (A byte
+    order mark is dropped, as before: other TOML readers refuse it.)"""
+    path = folder / "windows.toml"
+    lines = (SHIPPED / "orbit.toml").read_text().splitlines()
+    before = ("\r\n".join(lines) + "\r\n").encode()
+    path.write_bytes(mark.encode() + before)
+    load_scenario(path).save()
+    assert path.read_bytes() == before
+    scenario = load_scenario(path)
+    scenario.with_changes(sensor=dataclasses.replace(scenario.sensor, grid=48), speed=40.0).save()
+    after = path.read_bytes()
+    assert b"\n" not in after.replace(b"\r\n", b"")
+    assert changed_lines(before.decode(), after.decode()) == [
+        "-grid = 64",
+        "+grid = 48",
+        "-speed_mps = 30.0",
+        "+speed_mps = 40.0",
+    ]
+    scenario = load_scenario(path)
+    scenario.with_changes(levels=LevelThresholds(detect=0.2)).save()  # a table added
+    assert b"\n" not in path.read_bytes().replace(b"\r\n", b"")
+    assert load_scenario(path).levels == LevelThresholds(detect=0.2)

@@ -416,13 +416,16 @@ class Scenario:
         text = None
         # keep the analyst's comments, key order and layout (not a record's header)
         if self.path.is_file() and not is_record(self.path):
+            # its line ends as the file has them (restyle keeps CRLF); no byte order mark
             text = restyle(
-                self.path.read_text(encoding="utf-8-sig"), scenario.to_dict(), _saved_data(self.path)
+                self.path.read_bytes().decode("utf-8-sig"), scenario.to_dict(), _saved_data(self.path)
             )
         if text is not None:  # the program's header: its names follow the file's
+            newline = "\r\n" if "\r\n" in text else "\n"
             for old in (self.header(), self.header(quoted=False)):
+                old = old.replace("\n", newline)
                 if text.startswith(old):
-                    text = scenario.header() + text[len(old) :]
+                    text = scenario.header().replace("\n", newline) + text[len(old) :]
                     break
         with write_errors_named(scenario.path):
             write_text_atomic(scenario.path, text if text is not None else scenario.to_toml())

@@ -21,8 +21,18 @@ def restyle(old_text: str, data: dict, old_data: dict | None = None) -> str | No
     """``old_text`` with ``data``'s values in place, or None if it is not a TOML table.
 
     ``old_data`` is what ``old_text`` meant (defaults filled in); a value equal
-    to it is left as the file has it, written or left out.
+    to it is left as the file has it, written or left out. A file's Windows line
+    ends (CRLF) stay, on its new lines too.
     """
+    plain = old_text.replace("\r\n", "\n")
+    text = _restyled(plain, data, old_data)
+    if text is None or text == plain:
+        return None if text is None else old_text  # unchanged: byte for byte
+    return text.replace("\n", "\r\n") if "\r\n" in old_text else text
+
+
+def _restyled(old_text: str, data: dict, old_data: dict | None) -> str | None:
+    """``restyle`` of text whose lines end in LF alone."""
     ended = old_text if old_text.endswith("\n") or not old_text else old_text + "\n"
     try:
         document = tomlkit.parse(ended)  # with its last line ended, as tables added expect
