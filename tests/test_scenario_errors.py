@@ -230,6 +230,42 @@ def test_toml_syntax_error_gives_the_line(tmp_path):
     assert str(caught.value).startswith(f"{path}:{caught.value.line}: not valid TOML: ")
 
 
+@pytest.mark.parametrize(
+    ("old", "new", "first", "second"),
+    [
+        # a key written twice in one table, and in a segment's
+        ("speed_mps = 25.0", "speed_mps = 25.0\nspeed_mps = 30.0", "speed_mps = 25", "speed_mps = 30"),
+        ("radius = 60.0", "radius = 60.0\nradius = 50.0", "radius = 60", "radius = 50"),
+        # a key, then a table of the same name
+        ("speed_mps = 25.0", "speed_mps = 25.0\nstart = 3", "start = 3", "[flight.start]"),
+        # a table header written twice
+        (
+            "[simulation]",
+            "[sensor] # again\nmount = 'body-fixed'\n\n[simulation]",
+            "[sensor]",
+            "again",
+        ),
+    ],
+)
+def test_a_key_or_table_written_twice_is_named_with_both_lines(tmp_path, old, new, first, second):
+    """A key set twice read 'not valid TOML: Cannot overwrite a value', a table declared
+    twice "Cannot declare ('sensor',) twice": neither said which key, or where it was first."""
+    text = edited(old, new)
+    path = write_scenario(tmp_path, text)
+    with pytest.raises(InputFileError) as caught:
+        load_scenario(path, check_files=False)
+    name = {
+        "speed_mps": "key 'flight.speed_mps'",
+        "radius = ": "key 'flight.segments[1].radius'",
+        "start = 3": "table [flight.start]",
+        "[sensor]": "table [sensor]",
+    }[first[:9]]
+    assert str(caught.value) == (
+        f"{path}:{line_of(text, second)}: not valid TOML: {name} written twice (first on line "
+        f"{line_of(text, first)}); expected each key and table once"
+    )
+
+
 @pytest.mark.parametrize("tail", ["x = [\n", "x = [\n\n\n", "x = [1,"])
 def test_a_toml_mistake_at_the_end_of_the_file_names_its_last_line(tmp_path, tail):
     """A file cut off in a value read 'not valid TOML: Invalid value (at end of

@@ -29,11 +29,30 @@ def toml_mistake(error: tomllib.TOMLDecodeError, text: str) -> tuple[str, int | 
     said = str(error)
     found = _AT_LINE.search(said)
     if found:
-        return _AT_LINE.sub("", said), int(found.group(1))
+        line = int(found.group(1))
+        return _written_twice(said, text, line) or _AT_LINE.sub("", said), line
     if said.endswith(_AT_END):
         held = [number for number, line in enumerate(text_lines(text), start=1) if line.strip()]
         return said.removesuffix(_AT_END) + " at the end of the file", held[-1] if held else None
     return said, None
+
+
+def _written_twice(said: str, text: str, line: int) -> str | None:
+    """tomllib's words for a key or table written again ("Cannot overwrite a value",
+    "Cannot declare ('sensor',) twice") as the key or table and the line it was first
+    written on; None for other mistakes, or where the line holds no key this reads."""
+    if not said.startswith(("Cannot overwrite a value", "Cannot declare ")):
+        return None
+    rows = list(_key_rows(text))
+    here = [(name, header) for number, name, header in rows if number == line]
+    if not here:
+        return None
+    name, header = here[0]
+    first = next(number for number, written, _ in rows if written == name)
+    if first == line:
+        return None
+    what = f"table [{name}]" if header else f"key '{name}'"
+    return f"{what} written twice (first on line {first}); expected each key and table once"
 
 
 def key_lines(path: Path) -> dict[str, int]:
@@ -51,6 +70,14 @@ def key_lines_from_text(text: str) -> dict[str, int]:
     a bad value; anything it does not recognise is simply not mapped.
     """
     lines: dict[str, int] = {}
+    for number, name, _ in _key_rows(text):
+        lines.setdefault(name, number)
+    return lines
+
+
+def _key_rows(text: str):
+    """(line, dotted key, whether a table header) for each header and key, in order;
+    an array of tables' header gives the array, then its new table."""
     arrays: dict[str, int] = {}  # array-of-tables name -> current index
     current = ""
     for number, line in enumerate(text_lines(text), start=1):
@@ -58,17 +85,16 @@ def key_lines_from_text(text: str) -> dict[str, int]:
         if header:
             name = _indexed(header.group(2), arrays)
             if header.group(1) == "[[":
-                lines.setdefault(name, number)  # the array itself: its first table
+                yield number, name, True  # the array itself: its first table
                 arrays[header.group(2)] = arrays.get(header.group(2), -1) + 1
                 name = f"{name}[{arrays[header.group(2)]}]"
             current = name
-            lines.setdefault(current, number)
+            yield number, current, True
             continue
         key = _KEY.match(line)
         if key:
             name = next(part for part in key.groups() if part is not None)
-            lines.setdefault(f"{current}.{name}" if current else name, number)
-    return lines
+            yield number, f"{current}.{name}" if current else name, False
 
 
 def _indexed(dotted: str, arrays: dict[str, int]) -> str:
