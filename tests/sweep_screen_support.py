@@ -104,3 +104,18 @@ async def opened(pilot, screen=None):
 
 def status_of(screen) -> StatusBar:
     return screen.query_one("#sweep-status", StatusBar)
+
+
+def footer_keys(screen) -> dict:
+    """The footer's keys as shown: action -> region (the palette's key as "command_palette")."""
+    from textual.widgets._footer import FooterKey
+
+    return {key.action: key.region for key in screen.query(FooterKey)}
+
+
+def assert_clear_of_the_palette_key(shown_keys: dict) -> None:
+    """Every key ends before the palette's key, docked at the footer's right, begins: one
+    under it cannot be read."""
+    palette = shown_keys.pop("command_palette")
+    for action, region in shown_keys.items():
+        assert region.right <= palette.x, (action, region, palette)

@@ -16,7 +16,17 @@ from ladartui.scenario import load_scenario
 from ladartui.sweep import read_table
 from ladartui.tui.status import BUSY, NOT_READY, READY
 from ladartui.tui.sweep_screen import SweepScreen
-from sweep_screen_support import SIZE, SweepHost, finished_sweep, opened, status_of, wait_for, write_spec
+from sweep_screen_support import (
+    SIZE,
+    SweepHost,
+    assert_clear_of_the_palette_key,
+    finished_sweep,
+    footer_keys,
+    opened,
+    status_of,
+    wait_for,
+    write_spec,
+)
 
 
 @pytest.fixture(scope="module")
@@ -55,19 +65,19 @@ async def test_opening_results_shows_the_ranking_failures_and_pareto_front(finis
         costs = [str(cell) for cell in table.get_column("cost") if str(cell) != "-"]
         assert costs and len({len(c.partition(".")[2]) for c in costs}) == 1, costs
         # At 80 x 24 every key is in the footer, and the table and chart share the body.
-        from textual.widgets._footer import FooterKey
-
-        # The footer composes its keys after the screen's bindings settle: on a busy
-        # machine that can take more than one pause (CI once saw none yet).
-        await wait_for(pilot, lambda: any(key.action == "run" for key in screen.query(FooterKey)))
+        await wait_for(pilot, lambda: "run" in footer_keys(screen))
         await pilot.pause()
-        shown_keys = {key.action: key.region for key in screen.query(FooterKey)}
+        shown_keys = footer_keys(screen)
         for binding in SweepScreen.BINDINGS:
             if binding.action == "cancel":  # shown only while a sweep runs
                 assert binding.action not in shown_keys
                 continue
+            if binding.action == "browse":  # its button names its key
+                assert "Browse F2" in str(screen.query_one("#sweep-browse").label)
+                continue
             region = shown_keys[binding.action]
             assert region.width > 0 and region.right <= SIZE[0], binding.action
+        assert_clear_of_the_palette_key(shown_keys)
         assert table.region.height >= 12 and screen.query_one("#sweep-chart").region.width >= 28
         # Ranked by the spec's objective (obscured coverage): best first, ties to the cheaper.
         # Said first: after the folder and the counts it was cut at the screen's edge.

@@ -24,7 +24,9 @@ from ladartui.tui.sweep_view import eta_seconds
 from sweep_screen_support import (
     SIZE,
     SweepHost,
+    assert_clear_of_the_palette_key,
     finished_sweep,
+    footer_keys,
     opened,
     status_of,
     wait_for,
@@ -89,6 +91,19 @@ async def test_a_running_sweep_cancels_keeps_its_rows_and_stays_responsive(tmp_p
         await pilot.press("f5")
         assert screen.running and status_of(screen).state == BUSY
         await wait_for(pilot, lambda: screen.progress is not None and screen.progress.done >= 2)
+        # At 80 columns the keys that act while it runs are all readable: Ctrl+X, F8, F9
+        # and Esc were under the palette's key or past the edge.
+        await wait_for(pilot, lambda: "cancel" in footer_keys(screen))
+        await pilot.pause()
+        shown = footer_keys(screen)
+        assert {"cancel", "objective", "cost", "best", "view", "close"} <= shown.keys()
+        assert_clear_of_the_palette_key(shown)
+        # F5 and F3, off the footer while it runs, still say why they do nothing
+        for key in ("f5", "f3"):
+            before = len(app._notifications)
+            await pilot.press(key)
+            said = [n.message for n in list(app._notifications)[before:]]
+            assert screen.running and said == ["A sweep is running: Ctrl+X cancels it first."]
         # Keys still act while the worker runs.
         await pilot.press("f9")
         assert screen.running and screen.query_one("#sweep-body").has_class("-table")

@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from rich.text import Text
-from textual import on
+from textual import events, on
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal
@@ -58,6 +58,7 @@ if TYPE_CHECKING:
 OBJECTIVE_ORDER = tuple(OBJECTIVES)  # F6 steps through them in this order
 COST_ORDER = ("flight-time", "distance")
 VIEWS = ("both", "table", "chart")
+WHILE_IDLE = ("run", "open_results", "browse")  # keys off (and out of the footer) while a sweep runs
 REDRAW_SECONDS = 0.4  # the ranking and chart are redrawn at most this often while running
 
 
@@ -84,7 +85,8 @@ class SweepScreen(SweepOpening):
         Binding("f1,question_mark", "app.help", "Help"),  # every key, this screen's too; ? as elsewhere
         Binding("f5", "run", "Run", priority=True),
         Binding("f3", "open_results", "Open", priority=True),
-        Binding("f2", "browse", "Browse", priority=True),
+        # its button names its key: the footer's room goes to keys named nowhere else
+        Binding("f2", "browse", "Browse", priority=True, show=False),
         Binding("ctrl+x", "cancel", "Cancel", priority=True),
         Binding("f6", "objective", "Rank by", priority=True),
         Binding("f7", "cost", "Cost", priority=True),
@@ -318,10 +320,22 @@ class SweepScreen(SweepOpening):
         self._open(self._path_text())
 
     def check_action(self, action: str, parameters) -> bool | None:
-        # Cancel joins the footer only while a sweep runs, so every key fits 80 columns
+        # Cancel joins the footer only while a sweep runs, and Run and Open, refused then,
+        # leave it: so every key fits 80 columns beside the palette's key, run or not
         if action == "cancel":
-            return True if self.running else False
+            return self.running
+        if action in WHILE_IDLE:
+            return not self.running
         return True
+
+    def on_key(self, event: events.Key) -> None:
+        # Run, Open and Browse are off while a sweep runs (not in the footer): their keys,
+        # reaching the screen unbound, say why in a note (the status line shows progress)
+        if self.running and any(
+            isinstance(b, Binding) and b.key == event.key and b.action in WHILE_IDLE for b in self.BINDINGS
+        ):
+            event.stop()
+            self.notify("A sweep is running: Ctrl+X cancels it first.", markup=False, timeout=5)
 
     def action_cancel(self) -> None:
         if self.running and self.worker is not None:
