@@ -404,3 +404,36 @@ async def test_switching_the_setup_dialogs_mode_clears_the_other_modes_error(tmp
         dialog.query_one("#mode-new").value = True
         await pilot.pause()
         assert dialog.mode == "new" and str(message.render()) == ""
+
+
+async def test_the_palette_on_the_sweep_and_study_screens_finds_their_actions(tmp_path, scene_files):
+    """Ctrl+P on the sweep screen found no sweep action ("rank", "run": no matches), where
+    the help screen says Ctrl+P finds any action; the study screen's were missing too."""
+    from ladartui.tui.study_screen import StudyScreen
+    from ladartui.tui.sweep_screen import SweepScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        sweep = await screen_after(pilot, "f12", SweepScreen)
+        commands = {command.title: command for command in app.get_system_commands(sweep)}
+        for title in ("Sweep: Run", "Sweep: Rank by", "Sweep: Cost", "Sweep: View", "Sweep: Back"):
+            assert title in commands, sorted(commands)
+        assert "Run simulation" not in commands and "Sweep: Cancel" not in commands  # nothing runs
+        assert commands["Sweep: Rank by"].help == "F6"  # the key it has here
+        objective = sweep.objective
+        commands["Sweep: Rank by"].callback()
+        await pilot.pause()
+        assert sweep.objective != objective  # what F6 does
+        commands["Sweep: View"].callback()
+        await pilot.pause()
+        assert sweep.view == "table"
+        commands["Sweep: Back"].callback()
+        await pilot.pause()
+        assert app.screen is not sweep
+        study = await screen_after(pilot, "f11", StudyScreen)
+        titles = {command.title for command in app.get_system_commands(study)}
+        assert {"Study: Quick study", "Study: Full study", "Study: Back"} <= titles
+        await pilot.press("escape")
+        await pilot.pause()

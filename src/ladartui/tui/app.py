@@ -12,6 +12,7 @@ interface never blocks.
 
 from __future__ import annotations
 
+import functools
 import os
 from pathlib import Path
 
@@ -31,7 +32,7 @@ from ladartui.tui import actions, bridge
 from ladartui.tui.editing import ScenarioEditing
 from ladartui.tui.file_actions import FileActions
 from ladartui.tui.graphics import Graphics, has_truecolor
-from ladartui.tui.help_rows import help_rows, palette_entries
+from ladartui.tui.help_rows import help_rows, palette_entries, tool_screen_entries
 from ladartui.tui.key_words import KeyWords
 from ladartui.tui.loading import SceneLoading
 from ladartui.tui.measures_screens import CompareScreen, MeasuresScreen
@@ -549,7 +550,12 @@ class LadarApp(
             if not (waiting and command.callback == self.action_quit):  # quit would ask again
                 yield command
         if self.tool_screen is not None and screen is self.tool_screen:
-            return  # the study and sweep screens have their own keys
+            # the study and sweep screens have their own keys: those, not the app's
+            for title, keys, action in tool_screen_entries(screen):
+                yield SystemCommand(
+                    title, keys, functools.partial(screen.call_later, screen.run_action, action)
+                )
+            return
         if waiting:
             return  # nothing may start under it
         for title, help_text, action in palette_entries(self):

@@ -29,8 +29,24 @@ def help_rows(app=None) -> list[tuple[str, str, str]]:
     from ladartui.tui.sweep_screen import SweepScreen
 
     for where, screen in (("Study screen", StudyScreen), ("Sweep screen", SweepScreen)):
-        bindings = [b for b in screen.BINDINGS if isinstance(b, Binding) and b.description]
-        rows.extend((where, actions.key_name(b.key), b.description) for b in bindings)
+        rows.extend((where, actions.key_name(b.key), b.description) for b in _described(screen))
     if app is not None:
         rows.append(("Views", "settings.toml", "Drawn as " + app.graphics.describe()))
     return rows
+
+
+def _described(screen) -> list[Binding]:
+    return [b for b in screen.BINDINGS if isinstance(b, Binding) and b.description]
+
+
+def tool_screen_entries(screen) -> list[tuple[str, str, str]]:
+    """The palette's entries on the study or sweep screen: (title, its key, action) for
+    each of the screen's keys that acts now ("Sweep: Rank by", "F6", "objective")."""
+    from ladartui.tui.study_screen import StudyScreen
+
+    name = "Study" if isinstance(screen, StudyScreen) else "Sweep"
+    return [
+        (f"{name}: {b.description}", actions.key_name(b.key), b.action)
+        for b in _described(screen)
+        if screen.check_action(b.action.split("(")[0], ())
+    ]
