@@ -116,3 +116,37 @@ async def test_messages_that_name_a_key_name_the_one_in_force(tmp_path, scene_fi
         dialog = await screen_after(pilot, "f3", SetupScreen)
         said = str(dialog.query_one("#derived").render())
         assert "a run (Ctrl+R) writes them" in said and "F5" not in said
+
+
+async def test_a_remapped_help_key_is_the_one_shown_on_the_sweep_and_study_screens(
+    tmp_path, scene_files, monkeypatch
+):
+    """With help = "ctrl+g", the sweep screen's footer showed "f1 Help" and "^g Help" both
+    (at 80 columns the second under the palette's key), and the help still listed F1 / ?
+    there: the screens' own Help kept its default keys."""
+    from textual.widgets._footer import FooterKey
+
+    from ladartui.tui.app import help_rows
+    from ladartui.tui.help_rows import tool_screen_entries
+    from ladartui.tui.screens import HelpScreen
+    from ladartui.tui.study_screen import StudyScreen
+    from ladartui.tui.sweep_screen import SweepScreen
+
+    keys_in(tmp_path, monkeypatch, '[keys]\nhelp = "ctrl+g"\n')
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=(120, 40)) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        for key, kind, where in (("f12", SweepScreen, "Sweep"), ("f11", StudyScreen, "Study")):
+            screen = await screen_after(pilot, key, kind)
+            await pilot.pause()
+            helps = [k.key for k in screen.query(FooterKey) if k.action in ("help", "app.help")]
+            assert helps == ["ctrl+g"], helps
+            assert (f"{where} screen", "Ctrl+G", "Help") in help_rows(app)
+            assert (f"{where}: Help", "Ctrl+G", "app.help") in tool_screen_entries(screen)
+            await screen_after(pilot, "ctrl+g", HelpScreen)
+            await pilot.press("escape")
+            await pilot.pause()
+            await pilot.press("escape")
+            await pilot.pause()
+            assert app.screen is not screen

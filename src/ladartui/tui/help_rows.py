@@ -28,8 +28,9 @@ def help_rows(app=None) -> list[tuple[str, str, str]]:
     from ladartui.tui.study_screen import StudyScreen  # (plotting: loaded for help, shown on demand)
     from ladartui.tui.sweep_screen import SweepScreen
 
+    keymap = app.keymap if app is not None else None
     for where, screen in (("Study screen", StudyScreen), ("Sweep screen", SweepScreen)):
-        rows.extend((where, actions.key_name(b.key), b.description) for b in _described(screen))
+        rows.extend((where, _key_name(b, keymap), b.description) for b in _described(screen))
     if app is not None:
         rows.append(("Views", "settings.toml", "Drawn as " + app.graphics.describe()))
     return rows
@@ -39,6 +40,12 @@ def _described(screen) -> list[Binding]:
     return [b for b in screen.BINDINGS if isinstance(b, Binding) and b.description]
 
 
+def _key_name(binding: Binding, keymap: dict[str, str] | None) -> str:
+    """A screen's key as people write it: the user's for a binding with a command's id."""
+    key = (keymap or {}).get(binding.id, binding.key) if binding.id else binding.key
+    return actions.key_name(key)
+
+
 def tool_screen_entries(screen) -> list[tuple[str, str, str]]:
     """The palette's entries on the study or sweep screen: (title, its key, action) for
     each of the screen's keys that acts now ("Sweep: Rank by", "F6", "objective")."""
@@ -46,7 +53,7 @@ def tool_screen_entries(screen) -> list[tuple[str, str, str]]:
 
     name = "Study" if isinstance(screen, StudyScreen) else "Sweep"
     return [
-        (f"{name}: {b.description}", actions.key_name(b.key), b.action)
+        (f"{name}: {b.description}", _key_name(b, getattr(screen.app, "keymap", None)), b.action)
         for b in _described(screen)
         if screen.check_action(b.action.split("(")[0], ())
     ]

@@ -33,7 +33,8 @@ class StudyScreen(Screen):
     """Run the study on the open scenario (or the generated scenes) and show its chart."""
 
     BINDINGS = [
-        Binding("f1,question_mark", "app.help", "Help"),  # every key, this screen's too; ? as elsewhere
+        # every key, this screen's too; ? as elsewhere; its id: keys.toml remaps it here too
+        Binding("f1,question_mark", "app.help", "Help", id="help"),
         Binding("q", "run('quick')", "Quick study"),
         Binding("f", "run('full')", "Full study"),
         Binding("ctrl+x", "cancel", "Cancel", priority=True),  # as on the sweep screen and the main one

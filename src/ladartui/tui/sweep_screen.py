@@ -82,7 +82,8 @@ class SweepScreen(SweepOpening):
             self.path = Path(path)
 
     BINDINGS = [
-        Binding("f1,question_mark", "app.help", "Help"),  # every key, this screen's too; ? as elsewhere
+        # every key, this screen's too; ? as elsewhere; its id: keys.toml remaps it here too
+        Binding("f1,question_mark", "app.help", "Help", id="help"),
         Binding("f5", "run", "Run", priority=True),
         Binding("f3", "open_results", "Open", priority=True),
         # its button names its key: the footer's room goes to keys named nowhere else
