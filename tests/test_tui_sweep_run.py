@@ -58,6 +58,27 @@ async def test_a_missing_spec_gives_one_line_and_starts_nothing(tmp_path):
         assert not (tmp_path / "nowhere-results").exists()
 
 
+async def test_an_empty_spec_field_is_named_as_the_form_names_it(tmp_path, monkeypatch):
+    """F5 or F3 with the Spec field empty said "spec = '': expected ...", a name the
+    screen shows nowhere, where its other fields say "Budget s: ... is not allowed"."""
+    monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))  # no last sweep to reopen
+    screen = SweepScreen(serial=True)
+    app = SweepHost(screen)
+    async with app.run_test(size=SIZE) as pilot:
+        await opened(pilot)
+        await pilot.press("f5")
+        await pilot.pause()
+        assert screen.last_message == (
+            "Spec: empty is not allowed; expected the path of a sweep spec (.toml)"
+        )
+        assert not screen.running and status_of(screen).state == NOT_READY
+        await pilot.press("f3")
+        await opened(pilot)
+        assert screen.last_message == (
+            "Spec: empty is not allowed; expected a sweep spec, a results.csv or a results folder"
+        )
+
+
 async def test_a_spec_mistake_names_its_line_and_starts_nothing(tmp_path):
     write_base(tmp_path)
     spec = write_spec(tmp_path, "[grid]\nradius = [10.0]\nscans = [2, 2.5]\n")

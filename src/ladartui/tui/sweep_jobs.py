@@ -18,9 +18,10 @@ if TYPE_CHECKING:
     from ladartui.sweep.best_file import BestScenario
 
 
-# The sweep screen's fields, as the cluster's refusals name them (some name the CLI's
-# flags); its Certificates folder holds the three TLS files.
+# The sweep screen's fields, as the refusals of the spec to run or open and the cluster's
+# name them (some name the CLI's flags); its Certificates folder holds the three TLS files.
 FORM_LABELS = {
+    "spec": "Spec",
     "scheduler": "Scheduler",
     "--scheduler": "Scheduler",
     "certificates": "Certificates",
@@ -31,8 +32,8 @@ FORM_LABELS = {
 
 
 def in_form_words(error: FieldError) -> LadarError:
-    """A refusal of the scheduler or certificates as the sweep screen's other fields say
-    theirs ("Scheduler: X is not allowed; expected ..."); others as they are."""
+    """A refusal of the spec, scheduler or certificates as the sweep screen's other fields
+    say theirs ("Scheduler: X is not allowed; expected ..."); others as they are."""
     label = FORM_LABELS.get(error.field)
     if label is None:
         return error

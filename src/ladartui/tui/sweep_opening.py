@@ -12,11 +12,11 @@ from typing import TYPE_CHECKING, Any
 from textual.widget import Widget
 from textual.widgets import DataTable
 
-from ladartui.errors import LadarError
+from ladartui.errors import FieldError, LadarError
 from ladartui.number_text import plural
 from ladartui.recent import remember_path
 from ladartui.tui.status import BUSY, NOT_READY, READY
-from ladartui.tui.sweep_jobs import open_sweep
+from ladartui.tui.sweep_jobs import in_form_words, open_sweep
 from ladartui.tui.sweep_ranking import RankingView
 from ladartui.tui.sweep_view import short_path
 from ladartui.tui.work import start_job
@@ -57,8 +57,9 @@ class SweepOpening(RankingView):
         def read(cancel, progress):
             try:
                 return number, open_sweep(text), None
-            except LadarError as error:
-                return number, None, str(error)
+            except LadarError as error:  # an empty Spec field named as the form names it
+                said = in_form_words(error) if isinstance(error, FieldError) else error
+                return number, None, str(said)
 
         self._status(BUSY, f"opening {text} ...")
         self.opening = start_job(self, "open", read)
