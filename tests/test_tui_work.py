@@ -201,6 +201,10 @@ async def test_ctrl_x_cancels_a_study_as_it_cancels_a_run_and_a_sweep(tmp_path, 
         await wait_until(pilot, started.is_set)
         await wait_until(pilot, lambda: bar.progress is not None)
         assert bar.state == BUSY and abs(bar.progress - 1 / 3) < 1e-9
+        from textual.widgets._footer import FooterKey
+
+        await pilot.pause()
+        assert "cancel" in {key.action for key in screen.query(FooterKey)}  # running: offered
         await pilot.press("ctrl+x")
         status = screen.query_one("#study-status StatusText", Static)
         await wait_until(pilot, lambda: "study cancelled" in str(status.render()))
@@ -217,7 +221,7 @@ async def test_the_study_screen_keeps_its_controls_at_80x24(tmp_path, scene_file
 
     async with study_screen(tmp_path, scene_files, size=(80, 24)) as (app, pilot, screen):
         status = str(screen.query_one("#study-status StatusText", Static).render())
-        assert status.endswith("q quick, f full, Ctrl+X cancel, Esc back")
+        assert status.endswith("q quick, f full, Esc back")
         # a result's chart, legend, table and verdict leave the controls on screen
         from pathlib import Path
 
@@ -375,7 +379,7 @@ async def test_the_study_status_names_the_scenario_and_keeps_the_keys(tmp_path, 
     async with study_screen(folder, scene_files, size=(80, 24)) as (app, pilot, screen):
         status = screen.query_one("#study-status StatusText", Static)
         shown = str(status.render())
-        assert shown == f"Study on {screen.scenario_path.name}: q quick, f full, Ctrl+X cancel, Esc back"
+        assert shown == f"Study on {screen.scenario_path.name}: q quick, f full, Esc back"
         assert cell_len(shown) <= status.content_size.width
         chart = screen.query_one("#study-chart")
         drawn = [
@@ -455,3 +459,15 @@ async def test_a_cancelled_run_shows_again_the_earlier_outputs_read_from_disk(
         assert app.output_voxels is earlier
         assert output.points is not None and len(output.points)
         assert app.disk_outputs[0] is earlier  # its hidden target voxels are marked again
+
+
+async def test_the_study_screen_offers_cancel_only_while_a_study_runs(tmp_path, scene_files):
+    """Idle, the footer showed '^x Cancel' and the status line 'Ctrl+X cancel', and the
+    key did nothing and said nothing."""
+    from textual.widgets._footer import FooterKey
+
+    async with study_screen(tmp_path, scene_files, size=(80, 24)) as (app, pilot, screen):
+        await pilot.pause()
+        shown = {key.action for key in screen.query(FooterKey)}
+        assert "cancel" not in shown and {"run('quick')", "close"} <= shown
+        assert "Ctrl+X" not in str(screen.query_one("#study-status StatusText").render())

@@ -127,7 +127,7 @@ class StudyScreen(Screen):
     def _idle_text(self) -> str:
         # the file's name: a folder cut to fit cut the name too ("/tmp/...fault.toml")
         where = Path(self.scenario_path).name if self.scenario_path else "the generated scenes"
-        return f"Study on {where}: q quick, f full, Ctrl+X cancel, Esc back"
+        return f"Study on {where}: q quick, f full, Esc back"
 
     # -- actions ---------------------------------------------------------------
 
@@ -151,6 +151,7 @@ class StudyScreen(Screen):
         self.worker = start_job(
             self, "study", lambda cancel, progress: _study(mode, scenario_path, scans, runs, cancel, progress)
         )
+        self.refresh_bindings()  # Cancel joins the footer
 
     def action_cancel(self) -> None:
         if running(self.worker):
@@ -217,7 +218,12 @@ class StudyScreen(Screen):
         self.set_class(event.size.width < NARROW, "-narrow")
         self.call_after_refresh(self._draw_chart)
 
+    def check_action(self, action: str, parameters) -> bool | None:
+        # Cancel in the footer only while a study runs: idle, the key had nothing to do
+        return running(self.worker) if action == "cancel" else True
+
     def _set_busy(self, busy: bool, message: str, progress: float | None = None, said: bool = False) -> None:
+        self.refresh_bindings()
         self.query_one("#study-cancel", Button).disabled = not busy
         self.query_one("#study-quick", Button).disabled = busy
         self.query_one("#study-full", Button).disabled = busy
