@@ -123,6 +123,7 @@ async def test_a_running_sweep_cancels_keeps_its_rows_and_stays_responsive(tmp_p
         for key in ("f5", "f3"):
             before = len(app._notifications)
             await pilot.press(key)
+            await wait_for(pilot, lambda before=before: len(app._notifications) > before)  # a busy machine
             said = [n.message for n in list(app._notifications)[before:]]
             assert screen.running and said == ["A sweep is running: Ctrl+X cancels it first."]
         # Keys still act while the worker runs.
