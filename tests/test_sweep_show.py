@@ -4,6 +4,7 @@ the flags of a run and names what it cannot read."""
 import pytest
 
 from cli_support import one_error_line
+from ladartui.errors import InputFileError
 from ladartui.sweep import load_sweep_results, load_sweep_spec, read_table, run_sweep
 from tiny_sweep import tiny_folder, write_spec, write_tiny_scenario
 
@@ -82,6 +83,30 @@ def test_show_ranks_the_rows_of_the_current_base_only(tmp_path, capsys):
     out_err = capsys.readouterr()
     assert len(json.loads(out_err.out)["top"]) == 4
     assert "base scenario" in out_err.err and "every row of the table is ranked" in out_err.err
+
+
+def test_load_sweep_results_takes_the_spec_as_run_sweep_does_and_names_a_wrong_one(tmp_path):
+    """load_sweep_results(..., spec="x") raised AttributeError: 'str' object has no
+    attribute 'scenario_path'; run_sweep takes a SweepSpec or its path, so this takes
+    either too, and anything else is a FieldError naming spec."""
+    from ladartui.errors import FieldError
+
+    write_tiny_scenario(tmp_path)
+    spec = write_spec(tmp_path, "[grid]\nradius = [20.0, 30.0]\n", name="either.toml")
+    ran = run_sweep(spec, serial=True)
+    out = tmp_path / "either-results"
+    by_path = load_sweep_results(out, spec=spec)
+    by_text = load_sweep_results(out, spec=str(spec))
+    for shown in (by_path, by_text):
+        assert [r.row["variant"] for r in shown.ranking] == [r.row["variant"] for r in ran.ranking]
+    for wrong in (5, ["either.toml"]):
+        with pytest.raises(FieldError) as raised:
+            load_sweep_results(out, spec=wrong)
+        assert str(raised.value).startswith("spec = ")
+        assert "SweepSpec" in str(raised.value) and "\n" not in str(raised.value)
+    with pytest.raises(InputFileError) as raised:
+        load_sweep_results(out, spec=tmp_path / "none.toml")
+    assert "none.toml" in str(raised.value)
 
 
 def test_show_writes_nothing_and_leaves_the_folder_as_the_sweep_ranked_it(tmp_path, capsys):

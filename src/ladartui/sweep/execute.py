@@ -14,6 +14,7 @@ import contextlib
 import dataclasses
 import math
 import numbers
+import os
 import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -202,8 +203,7 @@ def run_sweep(
     started = time.perf_counter()
     _refuse_in_worker_start()
     check_callbacks(progress, cancel)
-    if not isinstance(spec, SweepSpec):
-        spec = load_sweep_spec(path_field("spec", spec, "a SweepSpec or a sweep spec file's path"))
+    spec = spec_argument(spec)
     objective = normal_objective(objective or spec.objective)
     cost = normal_cost(cost or spec.cost)
     if budget is not None:
@@ -491,16 +491,24 @@ def write_ranking(path, ranking: list[Ranked], parameter_names) -> Path:
     return Path(path)
 
 
+def spec_argument(spec) -> SweepSpec:
+    """A ``spec`` argument: a SweepSpec as given, a spec file's path read; anything
+    else a FieldError naming ``spec``."""
+    if isinstance(spec, SweepSpec):
+        return spec
+    return load_sweep_spec(path_field("spec", spec, "a SweepSpec or a sweep spec file's path"))
+
+
 def load_sweep_results(
     path,
     objective: str = "obscured-coverage",
     budget: float | None = None,
     cost: str = "flight-time",
-    spec: SweepSpec | None = None,
+    spec: SweepSpec | str | os.PathLike | None = None,
 ) -> SweepResult:
     """Read a sweep's result table (a results.csv or the folder holding it) and rank its rows.
 
-    With ``spec``, the rows are its variants made from its base as it is now
+    With ``spec`` (a SweepSpec or its file's path), the rows are its variants made from its base as it is now
     (``sweep.base.spec_rows``), as the sweep itself ranks them. Without, every
     row in the file is included; when a variant appears more than once
     (several base scenarios) each row is kept.
@@ -514,6 +522,7 @@ def load_sweep_results(
     rows, header = read_table(path, unreadable)
     every, earlier = len(rows), 0
     if spec is not None:
+        spec = spec_argument(spec)
         digest = spec_digest(spec)
         earlier = earlier_base_rows(rows, digest)
         rows = own_rows(rows, spec.variants, digest)
