@@ -206,3 +206,26 @@ def test_build_holds_few_bytes_per_voxel_beyond_its_result():
         tracemalloc.stop()
     beyond_result = peak - occ.nbytes
     assert beyond_result < 16 * len(vox), f"{beyond_result / len(vox):.1f} bytes a voxel"
+
+
+@pytest.mark.parametrize(
+    "shape", ["abc", 5, (None, 1, 2), (20.7, 20, 20), (20, 20), (True, 20, 20), (-1, 20, 20)]
+)
+def test_a_shape_that_is_not_three_whole_numbers_is_named(shape):
+    """'abc' raised ValueError from int(), 5 a TypeError, and 20.7 was cut to 20 without a word."""
+    voxels = np.array([[1, 1, 1]], np.int32)
+    with pytest.raises(FieldError, match=r"^shape = .*: expected three non-negative integers \(nx, ny, nz\)"):
+        Occupancy.build(voxels, shape=shape)
+
+
+def test_a_shape_of_whole_numbers_in_any_form_is_taken():
+    voxels = np.array([[1, 1, 1]], np.int32)
+    for shape in ((4, 4, 4), [4.0, 4, 4], np.array([4, 4, 4]), (np.int64(4), 4, 4)):
+        assert Occupancy.build(voxels, shape=shape).shape == (4, 4, 4)
+
+
+@pytest.mark.parametrize("ijk", ["abc", [[1, 2]], [1.5, 1, 1]])
+def test_contains_names_what_is_no_voxel_index(ijk):
+    occupancy = Occupancy.build(np.array([[1, 1, 1]], np.int32), shape=(4, 4, 4))
+    with pytest.raises(FieldError, match=r"^ijk = .*: expected voxel indices \(\.\., 3\) of integers"):
+        occupancy.contains(ijk)

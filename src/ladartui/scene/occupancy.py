@@ -48,6 +48,46 @@ def column_bounds(voxels) -> tuple[np.ndarray, np.ndarray]:
     return lo, hi
 
 
+SHAPE_EXPECTED = "three non-negative integers (nx, ny, nz)"
+
+
+def shape_field(shape) -> tuple[int, int, int]:
+    """``shape`` as (nx, ny, nz) ints: whole numbers in any form (4, 4.0, numpy's),
+    else FieldError naming it (20.7 is not cut to 20, nor a bool taken for 1)."""
+    items = None if isinstance(shape, (str, bytes)) else _items(shape)
+    if items is None or len(items) != 3:
+        raise FieldError("shape", shape, SHAPE_EXPECTED)
+    out = []
+    for value in items:
+        whole = isinstance(value, (int, np.integer, float, np.floating)) and not isinstance(
+            value, (bool, np.bool_)
+        )
+        if not whole or not float(value).is_integer() or value < 0:
+            raise FieldError("shape", shape, SHAPE_EXPECTED)
+        out.append(int(value))
+    return out[0], out[1], out[2]
+
+
+def _items(value) -> list | None:
+    try:
+        return list(value)
+    except TypeError:
+        return None
+
+
+def _voxel_indices(ijk) -> np.ndarray:
+    """``ijk`` as an int64 array of shape (.., 3), else FieldError naming it."""
+    expected = "voxel indices (.., 3) of integers"
+    try:
+        array = np.asarray(ijk)
+    except (TypeError, ValueError):
+        raise FieldError("ijk", ijk, expected) from None
+    whole = array.dtype.kind in "iu" or (array.dtype.kind == "f" and bool(np.all(np.mod(array, 1) == 0)))
+    if not whole or array.ndim == 0 or array.shape[-1] != 3:
+        raise FieldError("ijk", ijk, expected)
+    return array.astype(np.int64)
+
+
 @dataclass(frozen=True, eq=False)
 class Occupancy:
     """Which voxels are occupied, as a sparse hierarchy sized to the content.
@@ -102,11 +142,7 @@ class Occupancy:
         else:
             lo, last = column_bounds(vox) if bounds is None else bounds
         hi = last + 1
-        if shape is None:
-            shape = tuple(int(v) for v in hi)
-        shape = tuple(int(s) for s in shape)
-        if len(shape) != 3 or min(shape) < 0:
-            raise FieldError("shape", shape, "three non-negative integers (nx, ny, nz)")
+        shape = tuple(int(v) for v in hi) if shape is None else shape_field(shape)
         if not len(vox):
             return cls._empty(shape)
         if lo.min() < 0 or np.any(hi > np.array(shape)):
@@ -240,7 +276,7 @@ class Occupancy:
 
     def contains(self, ijk) -> np.ndarray:
         """Boolean array: is each (.., 3) voxel index occupied? Outside the scene is False."""
-        ijk = np.asarray(ijk, dtype=np.int64)
+        ijk = _voxel_indices(ijk)
         flat = ijk.reshape(-1, 3)
         out = np.zeros(len(flat), bool)
         if self.count == 0 or len(flat) == 0:
