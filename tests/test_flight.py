@@ -483,3 +483,12 @@ def test_the_scans_of_plans_long_unused_are_not_kept():
     del plans, plan
     gc.collect()
     assert gone() is None  # the cache holds no plan alive
+
+
+def test_manual_poses_and_plan_segments_of_the_wrong_kind_are_named_whole():
+    """Manual(poses=None) raised TypeError from tuple(); FlightPlan(segments="orbit") said
+    segments[0] = 'o', walking the word letter by letter."""
+    with pytest.raises(FieldError, match=r"^poses is not set: expected a list of 1 to"):
+        Manual(None)
+    with pytest.raises(FieldError, match=r"^segments = 'orbit': expected a list of flight segments"):
+        FlightPlan(segments="orbit")

@@ -100,7 +100,10 @@ class Manual:
     relative: ClassVar[bool] = False
 
     def __post_init__(self):
-        poses = tuple(self.poses)
+        try:
+            poses = () if isinstance(self.poses, (str, bytes)) else tuple(self.poses)
+        except TypeError:
+            poses = ()  # no list at all: refused below, named as given
         if not 1 <= len(poses) <= MAX_SCANS or not all(isinstance(p, ScanPose) for p in poses):
             # the count, not the list: 10,001 poses made a message of 300,000 characters
             shown = f"{len(poses):,} items" if len(poses) > 3 else self.poses
@@ -340,6 +343,8 @@ class FlightPlan:
     segments: tuple = field(default_factory=tuple)
 
     def __post_init__(self):
+        if isinstance(self.segments, (str, bytes)):  # not walked a letter at a time
+            raise FieldError("segments", self.segments, SEGMENTS_EXPECTED)
         try:
             segments = tuple(self.segments)
         except TypeError:
