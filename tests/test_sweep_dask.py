@@ -211,6 +211,28 @@ def _wait_for(pattern, log, process, seconds=60.0):
     raise AssertionError(f"no {pattern!r} in {log}:\n{Path(log).read_text(errors='replace')}")
 
 
+def start_scheduler_and_worker(tmp_path, env, started) -> str:
+    """A Dask scheduler on loopback and one single-thread worker, as processes (each with
+    its log appended to ``started``, to stop): the scheduler's address."""
+    bin_dir = Path(sys.executable).parent
+    scheduler, log = _start(
+        [str(bin_dir / "dask"), "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard"],
+        tmp_path / "scheduler.log",
+        env,
+    )
+    started.append((scheduler, log))
+    address = _wait_for(
+        r"Scheduler at:\s+(tcp://127\.0\.0\.1:\d+)", tmp_path / "scheduler.log", scheduler
+    ).group(1)
+    worker, log = _start(
+        [str(bin_dir / "dask"), "worker", address, "--nthreads", "1", "--no-dashboard"],
+        tmp_path / "worker.log",
+        env,
+    )
+    started.append((worker, log))
+    return address
+
+
 def _stop(process):
     if process.poll() is None:
         process.terminate()
@@ -227,21 +249,7 @@ def test_cli_runs_on_a_scheduler_and_worker_started_as_processes(spec, serial_ro
     env = dict(os.environ, NUMBA_NUM_THREADS="1")
     started = []
     try:
-        scheduler, log = _start(
-            [str(bin_dir / "dask"), "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard"],
-            tmp_path / "scheduler.log",
-            env,
-        )
-        started.append((scheduler, log))
-        address = _wait_for(
-            r"Scheduler at:\s+(tcp://127\.0\.0\.1:\d+)", tmp_path / "scheduler.log", scheduler
-        ).group(1)
-        worker, log = _start(
-            [str(bin_dir / "dask"), "worker", address, "--nthreads", "1", "--no-dashboard"],
-            tmp_path / "worker.log",
-            env,
-        )
-        started.append((worker, log))
+        address = start_scheduler_and_worker(tmp_path, env, started)
         out = tmp_path / "out"
         run = subprocess.run(
             [

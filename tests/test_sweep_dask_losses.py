@@ -100,7 +100,7 @@ def test_the_cli_tells_a_killed_scheduler_in_one_line_and_no_traceback(spec, tmp
     which distributed logged with three tracebacks under the sweep's message."""
     from distributed import Client
 
-    from test_sweep_dask import _start, _stop, _wait_for
+    from test_sweep_dask import _stop, start_scheduler_and_worker
 
     def variants_held(dask_scheduler):  # nested: sent by value to a scheduler that lacks this file
         return [key for key in dask_scheduler.tasks if str(key).startswith("ladartui-variant-")]
@@ -109,21 +109,7 @@ def test_the_cli_tells_a_killed_scheduler_in_one_line_and_no_traceback(spec, tmp
     env = dict(os.environ, NUMBA_NUM_THREADS="1")
     started = []
     try:
-        scheduler, log = _start(
-            [str(bin_dir / "dask"), "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard"],
-            tmp_path / "scheduler.log",
-            env,
-        )
-        started.append((scheduler, log))
-        address = _wait_for(
-            r"Scheduler at:\s+(tcp://127\.0\.0\.1:\d+)", tmp_path / "scheduler.log", scheduler
-        ).group(1)
-        worker, log = _start(
-            [str(bin_dir / "dask"), "worker", address, "--nthreads", "1", "--no-dashboard"],
-            tmp_path / "worker.log",
-            env,
-        )
-        started.append((worker, log))
+        address = start_scheduler_and_worker(tmp_path, env, started)
         holder = Client(address, timeout="30s")
         holder.wait_for_workers(1, timeout=60)
         holder.submit(time.sleep, 60, pure=False)  # the sweep's variants wait behind it
@@ -146,7 +132,7 @@ def test_the_cli_tells_a_killed_scheduler_in_one_line_and_no_traceback(spec, tmp
         while not holder.run_on_scheduler(variants_held) and time.monotonic() < deadline:
             time.sleep(0.1)
         holder.close()
-        scheduler.kill()
+        started[0][0].kill()  # the scheduler
         _, stderr = sweep.communicate(timeout=60)
     finally:
         for process, handle in reversed(started):
