@@ -174,7 +174,6 @@ class FormScreen(Dialog):
         self.note = note
         self.cancelled = True
         self._left_for_refusal: Widget | None = None  # the field OK's refusal moved from
-        self._shown_points: dict[str, tuple] = {}  # point field: (its value, the text shown)
 
     def compose(self) -> ComposeResult:
         with Vertical(classes="dialog") as box:
@@ -201,13 +200,7 @@ class FormScreen(Dialog):
                             id=f"f-{name}",
                         )
                     else:
-                        self._shown_points[name] = (value, _point_text(value))
-                        widget = Input(
-                            _point_text(value),
-                            id=f"f-{name}",
-                            compact=True,
-                            placeholder="x, y, z (z 0 if left out)" if kind == "point" else "a, b, c",
-                        )
+                        widget = PointsField(name, value, kind, id=f"f-{name}")
                     yield _row(label, widget)
             if self.note:
                 yield Static(self.note, classes="info")
@@ -254,25 +247,17 @@ class FormScreen(Dialog):
             if isinstance(kind, tuple):
                 out[name] = self.query_one(f"#f-{name}", Select).value
                 continue
-            widget = self.query_one(f"#f-{name}", Input)  # a NumberField is an Input
-            if isinstance(widget, NumberField):  # text left as shown: the value, not six digits
-                try:
-                    if kind == "optional" and not widget.value.strip():
-                        out[name] = None
-                    else:
-                        out[name] = widget.number()
-                except FieldError:
-                    if not raw:
-                        raise
-                    out[name] = default
-            else:
-                value, shown = self._shown_points.get(name, (None, None))
-                try:
-                    out[name] = value if widget.value == shown else _parse_points(name, widget.value, kind)
-                except FieldError:
-                    if not raw:
-                        raise
-                    out[name] = default
+            widget = self.query_one(f"#f-{name}", Input)  # a NumberField or a PointsField
+            try:  # text left as shown gives the value shown, not its six digits
+                if isinstance(widget, NumberField):
+                    out[name] = None if kind == "optional" and not widget.value.strip() else widget.number()
+                else:
+                    assert isinstance(widget, PointsField)
+                    out[name] = widget.points()
+            except FieldError:
+                if not raw:
+                    raise
+                out[name] = default
         return out
 
     def on_input_blurred(self, event: Input.Blurred) -> None:
@@ -316,11 +301,9 @@ class FormScreen(Dialog):
         widget = event.input
         if isinstance(widget, NumberField):
             widget.set_class(widget.problem() is not None, "-bad")
-        elif widget.has_class("-bad"):  # a point field: marked only by a refusal
-            name = (widget.id or "").removeprefix("f-")
-            kind = next((kind for n, _label, kind, *_ in self.spec if n == name), "point")
+        elif isinstance(widget, PointsField) and widget.has_class("-bad"):  # marked by a refusal only
             try:
-                _parse_points(name, widget.value, kind)
+                widget.points()
                 widget.remove_class("-bad")
             except FieldError:
                 pass
@@ -356,9 +339,9 @@ class FormScreen(Dialog):
         widget = self.query_one(f"#f-{name}")
         if isinstance(widget, NumberField):
             allowed = self._check(widget)
-        elif isinstance(widget, Input):
+        elif isinstance(widget, PointsField):
             try:
-                _parse_points(name, widget.value, kind)
+                widget.points()
                 allowed = True
             except FieldError as error:
                 self._refuse(widget, name, error.expected)
@@ -376,6 +359,23 @@ class FormScreen(Dialog):
 
 def field_matches(field: str, name: str) -> bool:
     return field == name or field.endswith("." + name)
+
+
+class PointsField(Input):
+    """A point ("x, y, z") or a list of numbers, typed; ``points()`` reads it, text left
+    as it was shown giving the value shown (not its six digits), as NumberField does."""
+
+    def __init__(self, name: str, value, kind: str, **kwargs):
+        text = _point_text(value)
+        placeholder = "x, y, z (z 0 if left out)" if kind == "point" else "a, b, c"
+        super().__init__(text, compact=True, placeholder=placeholder, **kwargs)
+        self.field_name, self.kind, self._shown = name, kind, (value, text)
+
+    def points(self):
+        """The point or numbers typed (None when empty); FieldError naming the field."""
+        if self.value == self._shown[1]:
+            return self._shown[0]
+        return _parse_points(self.field_name, self.value, self.kind)
 
 
 def _point_text(value) -> str:

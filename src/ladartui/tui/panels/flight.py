@@ -98,13 +98,13 @@ class FlightPanel(ParamPanel):
         ]
         fill_segments(self.query_one("#segments", FittingTable), segments)
         # Whole metres and degrees (round: an int, never "-0"): more columns fit
-        poses = [pose for poses in per_segment for pose in poses]
+        every_scan = [pose for poses in per_segment for pose in poses]
         scans = [
             (str(i + 1), *(str(round(v)) for v in (p.x, p.y, p.z, p.heading, p.azimuth, p.depression)))
-            for i, p in enumerate(poses[:MOST_SCAN_ROWS])
+            for i, p in enumerate(every_scan[:MOST_SCAN_ROWS])
         ]
         left_out = fill_whole_columns(self.query_one("#scans", FittingTable), SCAN_COLUMNS, scans)
-        notes = [f"the first {len(scans):,} of {len(poses):,}"] if len(poses) > len(scans) else []
+        notes = [f"the first {len(scans):,} of {len(every_scan):,}"] if len(every_scan) > len(scans) else []
         notes += [f"no room for {', '.join(left_out)}"] if left_out else []
         self.query_one("#scans-heading", Label).update("Scans" + (f" ({'; '.join(notes)})" if notes else ""))
 
