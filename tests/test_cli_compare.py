@@ -114,6 +114,7 @@ def test_columns_of_one_name_are_told_apart_in_the_table_and_the_json(tmp_path, 
     write_run(tmp_path / "orbit.cmf", seen_layers=3, scans=10)
     for files, columns in (
         (["orbit.cmf", "orbit.cmf"], ["orbit", "orbit (2)"]),
+        (["orbit.cmf"] * 3, ["orbit", "orbit (2)", "orbit (3)"]),  # the third was 'orbit (2)' again
         (["orbit.toml", "orbit.cmf"], ["orbit.toml", "orbit.cmf"]),
     ):
         assert cli.main(["compare", *(str(tmp_path / f) for f in files), "--json"]) == 0

@@ -228,10 +228,11 @@ def column_names(paths: list[Path]) -> list[str]:
         while any(other[-depth:] == parts[-depth:] for other in same) and depth < len(parts):
             depth += 1
         names.append("/".join(parts[-depth:]))
-    for k, name in enumerate(names):
-        if name in names[:k]:
-            names[k] = f"{name} ({names[: k + 1].count(name)})"
-    return names
+    given = list(names)  # counted as given, not as renamed so far
+    return [
+        f"{name} ({given[: k + 1].count(name)})" if name in given[:k] else name
+        for k, name in enumerate(given)
+    ]
 
 
 def read_measures_files(paths) -> list:
