@@ -348,9 +348,11 @@ def test_the_look_at_a_runs_lock_never_waits_on_a_pipe(tmp_path):
     assert said == [None]
 
 
-def test_a_run_is_not_refused_for_a_look_at_its_lock(scenario):
+@pytest.mark.parametrize("left", ["", "12345"])
+def test_a_run_is_not_refused_for_a_look_at_its_lock(scenario, left):
     """validate's look takes the lock shared for a moment: a run that came to lock it
-    then was refused as 'another run (pid ?) is writing this output set'."""
+    then was refused as 'another run (pid ?) is writing this output set', and as 'pid
+    12345' where a killed run had left its pid in the file."""
     import fcntl
     import threading
 
@@ -358,7 +360,8 @@ def test_a_run_is_not_refused_for_a_look_at_its_lock(scenario):
 
     lock = output_lock(scenario)
     lock.parent.mkdir(parents=True, exist_ok=True)
-    fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)  # as the look finds it: no pid in it
+    lock.write_text(left)
+    fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)  # as the look finds it
     fcntl.flock(fd, fcntl.LOCK_SH)
     letting_go = threading.Timer(0.02, lambda: fcntl.flock(fd, fcntl.LOCK_UN))
     letting_go.start()

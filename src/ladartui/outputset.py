@@ -135,8 +135,9 @@ def check_lock(lock) -> None:
         raise OutputFileError(lock, LOCK_FOLDER)
 
 
-# How long a run waits on a lock held with no pid in it: ``lock_holder`` holds it shared
-# for microseconds, and a run writes its pid at once after locking.
+# How long a run waits on a held lock before it is refused: ``lock_holder`` holds it shared
+# for microseconds (the pid it finds may be a killed run's), and a run writes its pid at
+# once after locking.
 LOOK_SECONDS = 0.2
 
 
@@ -214,8 +215,10 @@ class OutputSet:
                 holder = os.read(fd, 32).decode("ascii", "replace").strip()
                 os.close(fd)
                 busy = error.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES)
-                if busy and not holder and time.monotonic() < looked_at_until:
-                    time.sleep(0.002)  # a look at the lock (``lock_holder``), or a run about to say its pid
+                if busy and time.monotonic() < looked_at_until:
+                    # a look at the lock (``lock_holder``; the pid in it may be a killed run's),
+                    # or a run about to say its pid: a real holder is told after this wait
+                    time.sleep(0.002)
                     continue
                 if busy:
                     holder = holder or "?"
