@@ -58,3 +58,12 @@ def scene_files(tmp_path_factory):
     files = scene_path, tuple(float(v) for v in generated.target_centre), generated.voxel_size
     one_ray_run(make_scenario(folder, files, name="warm"))
     return files
+
+
+@pytest.fixture(scope="session")
+def finished(tmp_path_factory):
+    """A sweep run to the end by the core (serially): its spec and results folder, made
+    once for the sweep screen's tests, which copy it before they change it."""
+    from sweep_screen_support import finished_sweep
+
+    return finished_sweep(tmp_path_factory)

@@ -67,8 +67,8 @@ sensor_grid = [8, 0]
 
 
 def finished_sweep(tmp_path_factory):
-    """A sweep run to the end by the core (serially): its spec and results folder (for a
-    module-scoped fixture)."""
+    """A sweep run to the end by the core (serially): its spec and results folder (for
+    conftest's session fixture ``finished``)."""
     folder = tmp_path_factory.mktemp("sweep")
     write_base(folder)
     spec = write_spec(folder, SMALL_GRID)

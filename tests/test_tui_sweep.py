@@ -9,7 +9,6 @@ with an 8 x 8 detector sensor, so each variant takes milliseconds.
 
 from __future__ import annotations
 
-import pytest
 from textual.widgets import DataTable
 
 from ladartui.scenario import load_scenario
@@ -20,19 +19,12 @@ from sweep_screen_support import (
     SIZE,
     SweepHost,
     assert_clear_of_the_palette_key,
-    finished_sweep,
     footer_keys,
     opened,
     status_of,
     wait_for,
     write_spec,
 )
-
-
-@pytest.fixture(scope="module")
-def finished(tmp_path_factory):
-    """A sweep run to the end by the core (serially): its spec and results folder."""
-    return finished_sweep(tmp_path_factory)
 
 
 def table_column(table: DataTable, key: str) -> list[str]:

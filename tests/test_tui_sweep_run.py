@@ -25,7 +25,6 @@ from sweep_screen_support import (
     SIZE,
     SweepHost,
     assert_clear_of_the_palette_key,
-    finished_sweep,
     footer_keys,
     opened,
     status_of,
@@ -33,12 +32,6 @@ from sweep_screen_support import (
     write_base,
     write_spec,
 )
-
-
-@pytest.fixture(scope="module")
-def finished(tmp_path_factory):
-    """A sweep run to the end by the core (serially): its spec and results folder."""
-    return finished_sweep(tmp_path_factory)
 
 
 async def test_a_missing_spec_gives_one_line_and_starts_nothing(tmp_path):
