@@ -59,6 +59,9 @@ MAX_STEP = 10.0
 
 RUN_ONLY_FIELDS = ("path", "backend", "fast_mode")  # change no output (``same_outputs``)
 
+# A run traces every scan twice: against the scene, and against the target alone.
+RUNS_TRACED = 2
+
 
 def _backend_choices():
     # Asking the registry imports every backend module (numba takes about a
@@ -142,7 +145,7 @@ class Scenario:
 
     def traced_rays(self) -> int:
         """Rays a run traces, the ray limit's count: every scan's, in both runs."""
-        return 2 * self.sensor.rays_per_scan * self.scan_count()
+        return RUNS_TRACED * self.sensor.rays_per_scan * self.scan_count()
 
     def scan_count(self) -> int:
         """Scans of the flight plan, counted without building the poses where it can be."""
@@ -585,6 +588,7 @@ def check_work(scenario, raise_with=None):
     check_rays(
         scenario.traced_rays(),
         f"{scenario.path}: sensor.grid = {sensor.grid}, sensor.ray_grid = "
-        f"{sensor.ray_grid}, {plural(scans, 'scan')} x 2 runs (the scene run and the target-alone run)",
+        f"{sensor.ray_grid}, {plural(scans, 'scan')} x {RUNS_TRACED} runs "
+        "(the scene run and the target-alone run)",
         raise_with=raise_with or RAISE_RAYS,
     )
