@@ -1,4 +1,5 @@
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -6,6 +7,8 @@ import pytest
 from ladartui.errors import FieldError, LadarError
 from ladartui.flight import ScanPose, straight
 from ladartui.trajectory import TrajectoryError, load_flight_log, log_attitude, log_poses
+
+EXAMPLE_LOG = Path(__file__).parent.parent / "scenarios" / "flight-log.csv"
 
 
 def test_a_log_path_that_is_no_path_is_a_field_error():
@@ -478,3 +481,31 @@ def test_a_log_without_an_aim_point_keeps_its_pointing_and_its_defaults(tmp_path
     tilted = LogSegment(str(tmp_path / "log.csv"), rate=1.0, azimuth=30.0, depression=45.0).build(None)
     assert [(p.azimuth, p.depression) for p in tilted] == [(30.0, 45.0)] * 2
     assert isinstance(tilted[0], ScanPose)
+
+
+@pytest.mark.parametrize(
+    "arguments, said",
+    [
+        # It flew NaN as the scan's x and blamed 'x', a name the caller never gave.
+        ({"times": [float("nan")]}, "times = [nan]: expected a list of 1 to 10000 times from 0 to 3 s"),
+        ({"times": ["a"]}, "times = ['a']: expected a list of 1 to 10000 times from 0 to 3 s"),
+        ({"times": [2.0, 1.0]}, "times = [2.0, 1.0]: expected a list of 1 to 10000 times from 0 to 3 s"),
+        ({"times": []}, "times = []: expected a list of 1 to 10000 times from 0 to 3 s"),
+        # Both were taken, the rate dropped without a word.
+        ({"rate": 2.0, "times": [0.5]}, "rate = 2.0: expected either a scan rate (Hz) or a list of scan"),
+        # TypeError from the comparison.
+        ({"rate": "a"}, "rate = 'a': expected a number greater than 0 and at most 1000"),
+        ({}, "rate is not set: expected either a scan rate (Hz) or a list of scan times (s)"),
+    ],
+)
+def test_scan_times_or_rate_given_to_log_poses_are_checked_and_named(arguments, said):
+    log = load_flight_log(EXAMPLE_LOG)
+    with pytest.raises(FieldError) as caught:
+        log_poses(log, ScanPose(0, 0, 60), **arguments)
+    assert str(caught.value).startswith(said)
+
+
+def test_log_poses_without_a_scan_pose_template_names_it():
+    # It raised TypeError from dataclasses.replace.
+    with pytest.raises(FieldError, match=r"^template is not set: expected a ScanPose$"):
+        log_poses(load_flight_log(EXAMPLE_LOG), None, rate=2.0)

@@ -24,11 +24,12 @@ from typing import ClassVar
 
 import numpy as np
 
-from ladartui.checks import MAX_COORDINATE
+from ladartui.checks import MAX_COORDINATE, number_field, point_field
 from ladartui.errors import FieldError, LadarError
 from ladartui.fileprobe import file_problem, not_utf8, path_field, refuse_special_file, text_lines
 from ladartui.fingerprint import Fingerprint, fingerprint_of
-from ladartui.flight import MAX_ALTITUDE, ScanPose
+from ladartui.flight import MAX_ALTITUDE, MAX_SCANS, ScanPose
+from ladartui.flight.pose import pose_field
 from ladartui.number_text import plural
 
 REQUIRED = ("time", "x", "y", "z", "heading")
@@ -237,20 +238,58 @@ def _angle(times, angles, t):
 
 
 def log_poses(log: FlightLog, template: ScanPose, rate: float | None = None, times=None) -> list[ScanPose]:
-    """Scan poses along the log; ``template`` gives the sensor azimuth and depression."""
-    if times is None:
-        if rate is None or not rate > 0:
-            raise TrajectoryError(f"scan rate = {rate!r}: expected a number > 0 (Hz)")
-        times = rate_times(log, rate)
-    times = np.asarray(times, dtype=np.float64)
-    if np.any(times < log.time[0]) or np.any(times > log.time[-1]):
-        raise TrajectoryError(f"scan times must lie within the log's {log.time[0]}..{log.time[-1]} s")
+    """Scan poses along the log; ``template`` gives the sensor azimuth and depression.
+
+    Scans at ``rate`` Hz from the log's first record, or at ``times`` (seconds,
+    increasing, within the log's span), not both; a bad value is a ``FieldError``
+    naming it.
+    """
+    template = pose_field("template", template)
+    times = np.asarray(scan_times_field(log, rate, times), dtype=np.float64)
     xyz = np.stack([np.interp(times, log.time, log.xyz[:, a]) for a in range(3)], axis=1)
     heading = _angle(log.time, log.heading, times)
     return [
         replace(template, x=float(p[0]), y=float(p[1]), z=float(p[2]), heading=float(h) % 360.0)
         for p, h in zip(xyz, heading)
     ]
+
+
+def rate_field(log: FlightLog, rate) -> float:
+    """``rate`` (Hz) checked: above 0, at most ``MAX_SCAN_RATE_HZ`` and ``MAX_SCANS`` over the log."""
+    checked = number_field("rate", rate, 0.0, MAX_SCAN_RATE_HZ, low_open=True)
+    if rate_count(log, checked) > MAX_SCANS:
+        raise FieldError("rate", rate, f"at most {MAX_SCANS} scans over the log")
+    return checked
+
+
+def times_field(log: FlightLog, given) -> tuple[float, ...]:
+    """Scan times (seconds) checked: 1 to ``MAX_SCANS`` numbers, increasing, within the log."""
+    span = f"times from {log.time[0]:g} to {log.time[-1]:g} s (the log's span)"
+    expected = f"a list of 1 to {MAX_SCANS} {span}"
+    if given is None or isinstance(given, (str, bytes)):
+        raise FieldError("times", given, expected)
+    try:
+        items = list(given)
+    except TypeError:
+        raise FieldError("times", given, expected) from None
+    if not 1 <= len(items) <= MAX_SCANS:
+        raise FieldError("times", given, expected)
+    try:
+        times = tuple(number_field("times", t, log.time[0], log.time[-1]) for t in items)
+    except FieldError:
+        raise FieldError("times", given, expected) from None
+    if any(later <= earlier for earlier, later in zip(times, times[1:])):  # it would fly backwards
+        raise FieldError("times", given, f"{expected}, increasing")
+    return times
+
+
+def scan_times_field(log: FlightLog, rate, times):
+    """The scan times of a ``rate`` or of ``times``, exactly one of them given, checked."""
+    if (rate is None) == (times is None):
+        raise FieldError("rate", rate, "either a scan rate (Hz) or a list of scan times (s), not both")
+    if times is not None:
+        return times_field(log, times)
+    return rate_times(log, rate_field(log, rate))
 
 
 def rate_times(log: FlightLog, rate: float) -> np.ndarray:
@@ -300,9 +339,6 @@ class LogSegment:
     relative: ClassVar[bool] = False
 
     def __post_init__(self):
-        from ladartui.checks import number_field, point_field
-        from ladartui.flight import MAX_SCANS
-
         set_ = partial(object.__setattr__, self)
         if not isinstance(self.file, (str, Path)) or not str(self.file).strip():
             raise FieldError("file", self.file, "the flight log's file name (.csv)")
@@ -349,30 +385,10 @@ class LogSegment:
             set_("origin", tuple(checked))
         log = load_flight_log(self.file, self.origin)
         set_("_log", log)
-        span = f"times from {log.time[0]:g} to {log.time[-1]:g} s (the log's span)"
         if self.rate is not None:
-            rate = number_field("rate", self.rate, 0.0, MAX_SCAN_RATE_HZ, low_open=True)
-            set_("rate", rate)
-            if rate_count(log, rate) > MAX_SCANS:
-                raise FieldError("rate", self.rate, f"at most {MAX_SCANS} scans over the log")
+            set_("rate", rate_field(log, self.rate))
         else:
-            expected = f"a list of 1 to {MAX_SCANS} {span}"
-            given = self.times
-            if given is None or isinstance(given, (str, bytes)):
-                raise FieldError("times", self.times, expected)
-            try:
-                items = list(given)
-            except TypeError:
-                raise FieldError("times", self.times, expected) from None
-            if not 1 <= len(items) <= MAX_SCANS:
-                raise FieldError("times", self.times, expected)
-            try:
-                times = tuple(number_field("times", t, log.time[0], log.time[-1]) for t in items)
-            except FieldError:
-                raise FieldError("times", self.times, expected) from None
-            if any(later <= earlier for earlier, later in zip(times, times[1:])):  # it would fly backwards
-                raise FieldError("times", self.times, f"{expected}, increasing")
-            set_("times", times)
+            set_("times", times_field(log, self.times))
 
     def _refuse_or_drop_pointing(self):
         """Refuse a pointing beside the aim point, which sets both angles; drop the unset
