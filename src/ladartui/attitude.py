@@ -21,13 +21,20 @@ import math
 
 import numpy as np
 
+from ladartui.checks import number_field
+from ladartui.errors import FieldError
+
 STANDARD_GRAVITY = 9.80665
 
 
 def coordinated_turn_roll(speed: float, radius: float, g: float = STANDARD_GRAVITY) -> float:
-    """Bank angle (degrees) of a coordinated level turn."""
-    if speed < 0 or radius <= 0:
-        raise ValueError("speed must be >= 0 and radius > 0")
+    """Bank angle (degrees) of a coordinated level turn at ``speed`` m/s on ``radius`` metres.
+
+    A speed below 0, a radius not above 0 or a value that is no finite number is a
+    ``FieldError`` naming it.
+    """
+    speed = number_field("speed", speed, 0.0)
+    radius = number_field("radius", radius, 0.0, low_open=True)
     return math.degrees(math.atan(speed * speed / (g * radius)))
 
 
@@ -56,9 +63,21 @@ def body_rotation(heading: float, roll: float = 0.0, pitch: float = 0.0, yaw: fl
 def body_fixed_directions(
     directions, heading: float, roll: float = 0.0, pitch: float = 0.0, yaw: float = 0.0
 ) -> np.ndarray:
-    """Stabilised ray directions (N, 3) turned with the aircraft's attitude."""
+    """Stabilised ray directions (N, 3) turned with the aircraft's attitude (degrees).
+
+    Directions of another shape, or an angle that is no finite number, are a
+    ``FieldError`` naming the argument.
+    """
+    angles = {"heading": heading, "roll": roll, "pitch": pitch, "yaw": yaw}
+    heading, roll, pitch, yaw = (number_field(name, value) for name, value in angles.items())
+    try:
+        array = np.asarray(directions, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise FieldError("directions", type(directions).__name__, "an (N, 3) array of numbers") from None
+    if array.ndim != 2 or array.shape[1] != 3:
+        raise FieldError("directions", f"array of shape {array.shape}", "an (N, 3) array of numbers")
     rotation = body_rotation(heading, roll, pitch, yaw)
-    return np.asarray(directions, dtype=np.float64) @ rotation.T
+    return array @ rotation.T
 
 
 def segment_attitudes(segment, poses, speed: float) -> list[tuple[float, float]]:
