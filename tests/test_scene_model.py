@@ -63,6 +63,31 @@ def test_empty_target_loads_but_has_no_centre(tmp_path):
     )
 
 
+def test_the_bounds_of_an_empty_target_say_it_has_none(tmp_path):
+    # It raised KeyError: True.
+    path = write_pair(tmp_path)
+    (tmp_path / "forest_Target.txt").write_text("")
+    scene = Scene.load(path, 0.5)
+    assert scene.bounds()[1].tolist() == [9, 3, 7]
+    with pytest.raises(LadarError) as caught:
+        scene.bounds(target=True)
+    assert str(caught.value) == (
+        f"scene 'forest' has no target voxels ({tmp_path / 'forest_Target.txt'} is empty)"
+    )
+    with pytest.raises(LadarError, match=r"^scene 'empty' has no voxels$"):
+        Scene(np.zeros((0, 3), np.int32), np.zeros((0, 3), np.int32), 1.0, name="empty").bounds()
+
+
+def test_target_ids_of_voxels_of_another_shape_is_a_field_error():
+    # It raised numpy's 'cannot reshape array of size 1 into shape (3)'.
+    scene = Scene(SCENE, TARGET, 0.5)
+    assert scene.target_ids_of(np.array([[2, 3, 5], [0, 0, 0]])).tolist() == [1, 0]
+    with pytest.raises(FieldError, match=r"^voxels = 'array of shape \(\)': expected an \(N, 3\)"):
+        scene.target_ids_of(None)
+    with pytest.raises(FieldError, match=r"^voxels = 'array of shape \(2,\)': expected an \(N, 3\)"):
+        scene.target_ids_of([1, 2])
+
+
 def test_shape_covers_both_lists_and_can_be_larger():
     target = np.array([[20, 1, 1]])
     assert Scene(SCENE, target, 1.0).shape == (21, 4, 8)

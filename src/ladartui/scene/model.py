@@ -106,8 +106,11 @@ class Scene:
         )
 
     def target_ids_of(self, voxels) -> np.ndarray:
-        """The target id of each of ``voxels`` ((K, 3) inside the shape), 0 where not a target voxel."""
-        voxels = np.asarray(voxels).reshape(-1, 3)
+        """The target id of each of ``voxels`` ((K, 3) inside the shape), 0 where not a target voxel.
+
+        ``voxels`` of another shape, or with fractional or negative indices, are a
+        ``FieldError``."""
+        voxels = voxel_list_field("voxels", voxels)
         out = np.zeros(len(voxels), dtype=np.int32)
         if not (len(self.target) and len(voxels)):
             return out
@@ -153,9 +156,15 @@ class Scene:
     def target_centre_m(self) -> np.ndarray:
         """Centroid of the target voxel centres, metres (x, y, z)."""
         if len(self.target) == 0:
-            where = f" ({self.target_path} is empty)" if self.path is not None else ""
-            raise LadarError(f"scene {self.name!r} has no target voxels{where}")
+            raise self._none_held(target=True)
         return self.target.astype(np.float64).mean(axis=0) * self.voxel_size
+
+    def _none_held(self, target: bool) -> LadarError:
+        """The error of a question only voxels answer, asked of an empty list."""
+        if not target:
+            return LadarError(f"scene {self.name!r} has no voxels")
+        where = f" ({self.target_path} is empty)" if self.path is not None else ""
+        return LadarError(f"scene {self.name!r} has no target voxels{where}")
 
     def column_tops(self, target=False) -> tuple[tuple[int, int], np.ndarray]:
         """The highest occupied z of each column the voxels span: ``(origin, heights)``.
@@ -191,8 +200,12 @@ class Scene:
 
     def bounds(self, target: bool = False) -> tuple[np.ndarray, np.ndarray]:
         """The least and greatest index on each axis of the (non-empty) voxels, or of the
-        target's, as int64 (``column_bounds``, found as the scene was made)."""
-        return self._bounds[target]
+        target's, as int64 (``column_bounds``, found as the scene was made); a
+        ``LadarError`` for an empty list."""
+        bounds = self._bounds.get(bool(target))
+        if bounds is None:
+            raise self._none_held(bool(target))
+        return bounds
 
     def __repr__(self):
         return (
