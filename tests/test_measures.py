@@ -441,3 +441,14 @@ def test_coverage_after_each_scan_never_reads_0_for_a_glimpse_nor_100_short_of_a
     assert rows["Unobscured coverage after each scan"] == said + " (%)"
     per_target = PerTarget((TargetMeasures(1, "truck", measures),))
     assert dict(after_scan_rows(per_target))["1 truck"] == said
+
+
+@pytest.mark.parametrize("per_scan, shown", [(5, "5"), ("abc", "'abc'")])
+def test_per_scan_returns_that_are_no_list_are_named(per_scan, shown):
+    # 5 raised TypeError: 'int' object is not iterable; text was read letter by letter.
+    target = np.array([[0, 0, 0], [1, 0, 0]])
+    with pytest.raises(FieldError) as caught:
+        compute_measures(target, target, target, scene_per_scan=per_scan)
+    assert str(caught.value) == (
+        f"scene_per_scan = {shown}: expected a list of each scan's returns, (K, 3) voxel index arrays"
+    )

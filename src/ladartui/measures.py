@@ -263,6 +263,8 @@ def _voxels_or_none(name, voxels):
 def _checked_scans(name, per_scan):
     if per_scan is None:
         return None
+    if isinstance(per_scan, (str, bytes)) or not hasattr(per_scan, "__iter__"):
+        raise FieldError(name, per_scan, "a list of each scan's returns, (K, 3) voxel index arrays")
     return [voxel_list_field(f"{name}[{scan}]", returns) for scan, returns in enumerate(per_scan)]
 
 
