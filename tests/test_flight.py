@@ -492,3 +492,12 @@ def test_manual_poses_and_plan_segments_of_the_wrong_kind_are_named_whole():
         Manual(None)
     with pytest.raises(FieldError, match=r"^segments = 'orbit': expected a list of flight segments"):
         FlightPlan(segments="orbit")
+
+
+def test_path_length_of_no_list_of_poses_names_the_argument():
+    # It raised TypeError: 'NoneType' object is not iterable.
+    with pytest.raises(FieldError, match=r"^poses is not set: expected a list of ScanPose$"):
+        path_length(None)
+    with pytest.raises(FieldError, match=r"^poses = 3: expected a list of ScanPose$"):
+        path_length(3)
+    assert path_length([]) == 0

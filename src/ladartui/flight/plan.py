@@ -469,6 +469,8 @@ def path_length(poses: Sequence[ScanPose]) -> float:
     This knows only the scan positions, so a turn counts its chords;
     ``FlightPlan.path_length`` measures turns and orbits along their arcs.
     """
+    if isinstance(poses, (str, bytes, ScanPose)) or not hasattr(poses, "__iter__"):
+        raise FieldError("poses", poses, "a list of ScanPose")
     return sum(_chords([pose_field(f"poses[{i}]", pose) for i, pose in enumerate(poses)]))
 
 
