@@ -115,9 +115,9 @@ def test_curves_must_match_the_scans():
 
 def test_bad_voxel_lists_are_refused_not_reshaped_into_other_voxels():
     target = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]])
-    with pytest.raises(FieldError, match=r"^target_voxels = 'array of shape \(4, 2\)'"):
+    with pytest.raises(FieldError, match=r"^target_voxels is an array of shape \(4, 2\)"):
         target_levels(target[:, :2], [target], [0.0], [0.0])
-    with pytest.raises(FieldError, match=r"^per_scan_returns\[0\] = 'array of float64'"):
+    with pytest.raises(FieldError, match=r"^per_scan_returns\[0\] is an array of float64"):
         target_levels(target, [target + 0.5], [0.0], [0.0])
 
 

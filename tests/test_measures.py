@@ -385,11 +385,11 @@ def test_bad_voxel_lists_and_figures_are_field_errors_not_a_wrong_answer():
     from ladartui.errors import FieldError
 
     target = box(3, 2, 1)
-    with pytest.raises(FieldError, match=r"^target_model = 'array of shape \(6, 2\)'"):
+    with pytest.raises(FieldError, match=r"^target_model is an array of shape \(6, 2\)"):
         compute_measures(target[:, :2], target, target)
-    with pytest.raises(FieldError, match=r"^scene_output = 'array of float64'"):
+    with pytest.raises(FieldError, match=r"^scene_output is an array of float64"):
         compute_measures(target, target + 0.5, target)
-    with pytest.raises(FieldError, match=r"^target_per_scan\[1\] = 'array of shape \(1, 2\)'"):
+    with pytest.raises(FieldError, match=r"^target_per_scan\[1\] is an array of shape \(1, 2\)"):
         compute_measures(target, target, target, [target, target], [target, target[:1, :2]])
     with pytest.raises(
         FieldError, match=r"^len\(target_per_scan\) = 1: expected as many scans as scene_per_scan \(2\)"

@@ -183,7 +183,7 @@ def test_bad_arguments_are_field_errors_before_anything_runs(forest):
     cases = [
         (dict(cancel=True), r"^cancel = True: expected a threading\.Event"),
         (dict(progress=3), r"^progress = 3: expected a function"),
-        (dict(scene="forest.txt"), r"^scene = 'str': expected the scenario's Scene"),
+        (dict(scene="forest.txt"), r"^scene = 'forest.txt': expected the scenario's Scene"),
         (dict(scene=other), r"^scene\.voxel_size = 0\.5: expected the scenario's voxel size \(1\.0\)"),
         # a string is true: write="no" wrote the outputs
         (dict(write="no"), r"^write = 'no': expected True or False"),
@@ -192,7 +192,7 @@ def test_bad_arguments_are_field_errors_before_anything_runs(forest):
     for arguments, message in cases:
         with pytest.raises(FieldError, match=message):
             simulate(forest, **arguments)
-    with pytest.raises(FieldError, match=r"^scenario = 'int': expected a Scenario or a scenario file's path"):
+    with pytest.raises(FieldError, match=r"^scenario = 42: expected a Scenario or a scenario file's path"):
         simulate(42)
     assert not forest.scene_output.exists() and not forest.measures_file.exists()
 

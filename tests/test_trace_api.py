@@ -283,3 +283,27 @@ def test_complex_rays_and_a_cancel_that_is_no_event_are_field_errors(block):
     with pytest.raises(FieldError) as error:
         trace(block, origins, directions, cancel=True)
     assert str(error.value) == "cancel = True: expected a threading.Event (or None)"
+
+
+def test_a_value_of_the_wrong_kind_is_told_by_its_kind_not_quoted_as_text():
+    """An argument of the wrong type was named by its type in quotes, as if the caller had
+    written that text ("scene = 'dict'", "origins = 'array of shape (4,)'")."""
+    from ladartui import trace
+    from ladartui.errors import FieldError, described
+
+    class Scenario:  # given where its scene was meant
+        pass
+
+    with pytest.raises(FieldError, match=r"^scene is a Scenario: expected a Scene or an Occupancy$"):
+        trace(Scenario(), np.zeros((1, 3)), np.ones((1, 3)))
+    with pytest.raises(
+        FieldError, match=r"^origins is an array of shape \(4,\): expected an \(N, 3\) array$"
+    ):
+        trace(Occupancy.build(np.zeros((1, 3), np.int64)), np.zeros(4), np.ones((1, 3)))
+    assert str(FieldError("x", described(object()), "a number")) == "x is an object: expected a number"
+    assert (
+        str(FieldError("x", described(np.zeros((4, 2))), "(N, 3)"))
+        == "x is an array of shape (4, 2): expected (N, 3)"
+    )
+    assert str(FieldError("x", described("text"), "a number")) == "x = 'text': expected a number"
+    assert str(FieldError("x", described(7), "a list")) == "x = 7: expected a list"

@@ -22,7 +22,7 @@ import math
 import numpy as np
 
 from ladartui.checks import number_field
-from ladartui.errors import FieldError
+from ladartui.errors import FieldError, described
 
 STANDARD_GRAVITY = 9.80665
 
@@ -73,9 +73,9 @@ def body_fixed_directions(
     try:
         array = np.asarray(directions, dtype=np.float64)
     except (TypeError, ValueError):
-        raise FieldError("directions", type(directions).__name__, "an (N, 3) array of numbers") from None
+        raise FieldError("directions", described(directions), "an (N, 3) array of numbers") from None
     if array.ndim != 2 or array.shape[1] != 3:
-        raise FieldError("directions", f"array of shape {array.shape}", "an (N, 3) array of numbers")
+        raise FieldError("directions", described(array), "an (N, 3) array of numbers")
     rotation = body_rotation(heading, roll, pitch, yaw)
     return array @ rotation.T
 

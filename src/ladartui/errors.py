@@ -28,8 +28,33 @@ class FieldError(LadarError):
         prefix = f"{source}: " if source else ""
         if value is None:  # never given: say so rather than "= None"
             super().__init__(f"{prefix}{field} is not set: expected {expected}")
+        elif isinstance(value, Described):
+            super().__init__(f"{prefix}{field} is {value.text}: expected {expected}")
         else:
             super().__init__(f"{prefix}{field} = {_shown(value)}: expected {expected}")
+
+
+class Described:
+    """A value told in words (an array by its shape, an object by its type) where
+    quoting it would read as text the caller wrote: "scene is a dict", not "scene = 'dict'"."""
+
+    def __init__(self, text: str):
+        self.text = text
+
+    def __repr__(self) -> str:
+        return self.text
+
+
+def described(value):
+    """``value`` itself where its repr says what it is (None, text, a number, a list);
+    else Described: an array by its shape, any other object by its type."""
+    if value is None or isinstance(value, str | int | float | complex | list | tuple | dict):
+        return value
+    shape = getattr(value, "shape", None)
+    if isinstance(shape, tuple):
+        return Described(f"an array of shape {shape}")
+    name = type(value).__name__
+    return Described(f"{'an' if name[:1].lower() in 'aeiou' else 'a'} {name}")
 
 
 VALUE_CHARS = 60  # of a long list or text quoted in a FieldError: room is left for what was expected

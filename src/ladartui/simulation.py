@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ladartui.errors import FieldError, check_callbacks, check_cancelled
+from ladartui.errors import FieldError, check_callbacks, check_cancelled, described
 from ladartui.measures import Measures, compute_measures
 from ladartui.returns import fuse_scans, kept_returns
 from ladartui.run_record import as_run, check_record_spare, record_text, run_inputs
@@ -140,11 +140,11 @@ def simulate(
 def _check_arguments(scenario, progress, cancel, scene) -> None:
     """Refuse, naming it, what would otherwise fail deep in the run or score another scene."""
     if not isinstance(scenario, Scenario):
-        raise FieldError("scenario", type(scenario).__name__, "a Scenario or a scenario file's path")
+        raise FieldError("scenario", described(scenario), "a Scenario or a scenario file's path")
     check_callbacks(progress, cancel)
     if scene is not None:
         if not isinstance(scene, Scene):
-            raise FieldError("scene", type(scene).__name__, "the scenario's Scene (scenario.load_scene())")
+            raise FieldError("scene", described(scene), "the scenario's Scene (scenario.load_scene())")
         if scene.voxel_size != scenario.voxel_size:
             raise FieldError(
                 "scene.voxel_size", scene.voxel_size, f"the scenario's voxel size ({scenario.voxel_size})"

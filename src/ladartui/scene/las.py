@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.atomic import atomic_path, write_errors_named
-from ladartui.errors import FieldError, InputFileError
+from ladartui.errors import FieldError, InputFileError, described
 from ladartui.fileprobe import path_field, require_file
 from ladartui.scene.unique_rows import unique_voxels
 from ladartui.scene.voxel_arrays import voxel_list_field, voxel_size_field
@@ -189,9 +189,7 @@ def _voxel_cloud(voxels, voxel_size, origin, ids):
     if ids is not None:
         ids = np.asarray(ids)
         if ids.shape != (len(centres),):
-            raise FieldError(
-                "ids", f"array of shape {ids.shape}", f"{len(centres)} target ids, one per voxel"
-            )
+            raise FieldError("ids", described(ids), f"{len(centres)} target ids, one per voxel")
         wrong = np.flatnonzero((ids < 0) | (ids > MAX_TARGET_ID))
         if len(wrong):
             row = int(wrong[0])

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from ladartui.errors import FieldError
+from ladartui.errors import Described, FieldError, described
 
 BRICK_WORDS = 16
 NODE_SLOTS = 512
@@ -132,9 +132,9 @@ class Occupancy:
         if vox.size == 0:
             vox = vox.reshape(0, 3)
         if vox.ndim != 2 or vox.shape[1] != 3:
-            raise FieldError("voxels", f"array of shape {vox.shape}", "an (N, 3) integer array")
+            raise FieldError("voxels", described(vox), "an (N, 3) integer array")
         if vox.dtype.kind not in "iu":
-            raise FieldError("voxels", f"dtype {vox.dtype}", "integer voxel indices")
+            raise FieldError("voxels", Described(f"an array of {vox.dtype}"), "integer voxel indices")
         if vox.dtype not in (np.int32, np.int64):  # the kernels are compiled for these two
             vox = vox.astype(np.int64)
         if not len(vox):

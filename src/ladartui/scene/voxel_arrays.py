@@ -11,7 +11,7 @@ import numbers
 
 import numpy as np
 
-from ladartui.errors import FieldError
+from ladartui.errors import Described, FieldError, described
 
 MAX_TARGET_ID = 65535  # a LAS point source id is an unsigned 16-bit number
 
@@ -26,7 +26,7 @@ def voxel_list_field(name, value, high=None) -> np.ndarray:
     if array.size == 0:
         return np.zeros((0, 3), dtype=np.int64)
     if array.ndim != 2 or array.shape[1] != 3:
-        raise FieldError(name, f"array of shape {array.shape}", "an (N, 3) array of voxel indices")
+        raise FieldError(name, described(array), "an (N, 3) array of voxel indices")
     if not np.issubdtype(array.dtype, np.integer):
         # whole numbers in a float array (np.vstack with np.zeros((0, 3))) are indices still
         whole = (
@@ -36,7 +36,9 @@ def voxel_list_field(name, value, high=None) -> np.ndarray:
             and float(np.abs(array).max()) < 2.0**62
         )
         if not whole:
-            raise FieldError(name, f"array of {array.dtype}", "an (N, 3) array of integer voxel indices")
+            raise FieldError(
+                name, Described(f"an array of {array.dtype}"), "an (N, 3) array of integer voxel indices"
+            )
         array = array.astype(np.int64)
     too_high = high is not None and array.max() > high
     if array.min() < 0 or too_high:
@@ -55,9 +57,9 @@ def target_ids_field(name, ids, count: int) -> np.ndarray:
     """``ids`` as ``count`` target ids (1..``MAX_TARGET_ID``), one per target voxel, else FieldError."""
     array = np.asarray(ids)
     if array.shape != (count,):
-        raise FieldError(name, f"array of shape {array.shape}", f"{count} target ids, one per target voxel")
+        raise FieldError(name, described(array), f"{count} target ids, one per target voxel")
     if count and not np.issubdtype(array.dtype, np.integer):
-        raise FieldError(name, f"array of {array.dtype}", f"{count} integer target ids")
+        raise FieldError(name, Described(f"an array of {array.dtype}"), f"{count} integer target ids")
     if count and (array.min() < 1 or array.max() > MAX_TARGET_ID):
         row = int(np.argmax((array < 1) | (array > MAX_TARGET_ID)))
         raise FieldError(f"{name}[{row}]", int(array[row]), f"a target id from 1 to {MAX_TARGET_ID}")

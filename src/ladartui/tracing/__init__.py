@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ladartui.errors import BackendUnavailable, FieldError, check_callbacks
+from ladartui.errors import BackendUnavailable, Described, FieldError, check_callbacks, described
 from ladartui.scene.voxel_arrays import voxel_size_field
 from ladartui.tracing.backend import (
     GROUND,
@@ -125,9 +125,7 @@ def trace(
     origins = _rays("origins", origins)
     directions = _rays("directions", directions)
     if origins.shape != directions.shape:
-        raise FieldError(
-            "directions", f"array of shape {directions.shape}", f"the same shape as origins {origins.shape}"
-        )
+        raise FieldError("directions", described(directions), f"the same shape as origins {origins.shape}")
     if method not in METHODS:
         raise FieldError("method", method, "one of " + ", ".join(METHODS))
     if step is None:
@@ -200,19 +198,19 @@ def _occupancy_and_size(target, voxel_size):
         if voxel_size is not None and voxel_size != size:  # would move its voxels in metres
             raise FieldError("voxel_size", voxel_size, f"the scene's voxel size ({size}) or None")
     else:
-        raise FieldError("scene", type(target).__name__, "a Scene or an Occupancy")
+        raise FieldError("scene", described(target), "a Scene or an Occupancy")
     return occupancy, voxel_size_field(size)
 
 
 def _rays(name, values):
     if np.iscomplexobj(values):  # (numpy would drop the imaginary parts with a warning)
-        raise FieldError(name, "a complex array", "an (N, 3) array of real numbers")
+        raise FieldError(name, Described("a complex array"), "an (N, 3) array of real numbers")
     try:
         array = np.asarray(values, dtype=np.float64)
     except (TypeError, ValueError):
-        raise FieldError(name, type(values).__name__, "an (N, 3) array of numbers") from None
+        raise FieldError(name, described(values), "an (N, 3) array of numbers") from None
     if array.ndim == 1 and array.shape == (3,):
         array = array[None, :]
     if array.ndim != 2 or array.shape[1] != 3:
-        raise FieldError(name, f"array of shape {array.shape}", "an (N, 3) array")
+        raise FieldError(name, described(array), "an (N, 3) array")
     return array
