@@ -170,7 +170,7 @@ def test_info_and_validate_give_a_scene_the_same_extent(tmp_path, capsys):
     (tmp_path / "s_Target.txt").write_text("5,5,0\n")
     assert main(["info", str(tmp_path / "s.txt"), "--voxel-size", "0.25"]) == 0
     assert re.search(
-        r"extent \(m\)\s+1.25 x 1.25 x 18.25 at 0.25 m \(shape 2.5 x 2.5 x 18.25\)\n",
+        r"extent \(m\)\s+1.25 x 1.25 x 18.25 at 0.25 m \(2.5 x 2.5 x 18.25 from the origin\)\n",
         capsys.readouterr().out,
     )
     path = tmp_path / "plan.toml"
@@ -186,7 +186,16 @@ def test_info_gives_in_metres_the_span_its_index_line_gives(tmp_path, capsys):
     assert main(["info", str(tmp_path / "s.txt"), "--voxel-size", "0.25"]) == 0
     rows = [line.split(None, 1)[1] for line in capsys.readouterr().out.splitlines()[1:]]
     assert "x 35..190, y 43..195, z 0..70  (shape 191 x 196 x 71)" in rows
-    assert "(m)  39 x 38.25 x 17.75 at 0.25 m (shape 47.75 x 49 x 17.75)" in rows
+    assert "(m)  39 x 38.25 x 17.75 at 0.25 m (47.75 x 49 x 17.75 from the origin)" in rows
+
+
+def test_info_says_an_extent_in_metres_once_where_the_voxels_start_at_the_origin(tmp_path, capsys):
+    """'extent (m) 60 x 60 x 18.25 at 0.25 m (shape 60 x 60 x 18.25)': the same metres
+    twice, the second called a shape as if it counted voxels."""
+    (tmp_path / "s.txt").write_text("0,0,0\n239,239,72\n")
+    assert main(["info", str(tmp_path / "s.txt"), "--voxel-size", "0.25"]) == 0
+    rows = [line.split(None, 1)[1] for line in capsys.readouterr().out.splitlines()[1:]]
+    assert "(m)  60 x 60 x 18.25 at 0.25 m" in rows
 
 
 def test_an_extent_in_metres_is_written_as_people_write_it():

@@ -149,11 +149,11 @@ def print_voxel_list(path: Path, voxel_size=None) -> None:
         lo, hi = column_bounds(voxels)
         shape = tuple(int(h) + 1 for h in hi)
         rows.append(("extent", extent_ranges(lo, hi)))
-        if voxel_size:  # the span the ranges give, then the shape as validate gives a scene's
-            span = extent_metres(hi - lo + 1, voxel_size)
-            rows.append(
-                ("extent (m)", f"{span} at {voxel_size:g} m (shape {extent_metres(shape, voxel_size)})")
-            )
+        if voxel_size:  # the span the ranges give, then the box from the origin validate gives
+            span = f"{extent_metres(hi - lo + 1, voxel_size)} at {voxel_size:g} m"
+            if lo.any():
+                span += f" ({extent_metres(shape, voxel_size)} from the origin)"
+            rows.append(("extent (m)", span))
     if output is not None:
         rows.append(("output", output))
     # A target model's own targets are counted above: it has no target model of its own;
