@@ -268,6 +268,9 @@ def test_firing_beyond_the_work_limit_is_refused_before_a_pulse(scenario, capsys
     monkeypatch.setenv("LADARTUI_MAX_BIN_VISITS", str(work))
     assert main(["pulses", str(scenario.path), "--pulses", "5,20", "--json"]) == 0
     assert sum(visits) == work
+    monkeypatch.setenv("LADARTUI_MAX_BIN_VISITS", "1")
+    assert main(["pulses", str(scenario.path), "--pulses", "1"]) == 2
+    assert "1 pulse in all on each of 3 looks" in capsys.readouterr().err  # not '1 pulses'
 
 
 def test_a_geiger_run_beyond_the_work_limit_is_refused_before_its_first_pulse(scenario, capsys, monkeypatch):

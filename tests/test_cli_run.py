@@ -260,6 +260,8 @@ def test_flags_the_run_would_ignore_or_round_are_refused(scenario, capsys):
     assert err.startswith("ladartui: error: --las: ") and "--no-write" in err
     assert main(["run", str(scenario.path), "--max-rays", "1.5"]) == 2
     assert "--max-rays = 1.5: expected a whole number of rays >= 1" in capsys.readouterr().err
+    assert main(["run", str(scenario.path), "--max-rays", "-1"]) == 2  # not '-1.0'
+    assert "--max-rays = -1: expected a whole number of rays >= 1" in capsys.readouterr().err
     assert not scenario.measures_file.exists()
 
 

@@ -81,7 +81,8 @@ def run(args) -> int:
         from ladartui.resources import set_max_rays
 
         if not (args.max_rays >= 1 and float(args.max_rays).is_integer()):
-            raise FieldError("--max-rays", args.max_rays, "a whole number of rays >= 1")
+            given = int(args.max_rays) if float(args.max_rays).is_integer() else args.max_rays
+            raise FieldError("--max-rays", given, "a whole number of rays >= 1")  # "-1", not "-1.0"
         set_max_rays(int(args.max_rays))
     if args.las and not args.write:
         raise LadarError("--las: it copies the outputs as LAS files, which --no-write does not write")

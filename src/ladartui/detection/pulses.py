@@ -181,5 +181,6 @@ def _check_work(scenario, looks, pulses_list) -> None:
     check_bin_visits(
         cells * fired,
         scenario.path,
-        f"{fired:,} pulses in all on each of {len(looks):,} looks, {cells:,} detector range bins among them",
+        f"{plural(fired, 'pulse')} in all on each of {plural(len(looks), 'look')}, "
+        f"{plural(cells, 'detector range bin')} among them",
     )
