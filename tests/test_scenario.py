@@ -466,6 +466,21 @@ def test_a_new_scenario_on_a_scene_without_a_target_names_its_empty_target_model
     )
 
 
+def test_a_new_scenario_on_a_missing_scene_model_names_that_file(tmp_path):
+    """Scenario.new on a scene model that is not there blamed its target model, which the
+    default orbit reads first: 'x_Target.txt: target model not found'."""
+    with pytest.raises(InputFileError) as caught:
+        Scenario.new(tmp_path / "new.toml", "models/x.txt", 0.5)
+    assert (
+        str(caught.value)
+        == f"{tmp_path / 'models' / 'x.txt'}: no such file; expected a scene model (voxel list)"
+    )
+    (tmp_path / "models").mkdir()
+    (tmp_path / "models" / "x.txt").mkdir()
+    with pytest.raises(InputFileError, match=r"x\.txt: is a folder; expected a scene model"):
+        Scenario.new(tmp_path / "new.toml", "models/x.txt", 0.5)
+
+
 def test_a_new_scenario_checks_its_voxel_size_before_the_default_orbit(tmp_path):
     """Scenario.new(..., voxel_size="a") raised ValueError from the default orbit's sums."""
     write_models(tmp_path / "models")

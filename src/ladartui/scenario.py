@@ -25,7 +25,15 @@ from ladartui.atomic import write_errors_named, write_text_atomic
 from ladartui.checks import choice_field, number_field
 from ladartui.detection.settings import DetectionSettings
 from ladartui.errors import FieldError, InputFileError, LadarError, OutputFileError
-from ladartui.fileprobe import NO_SUCH_FILE, OTHER_FILE_KINDS, file_problem, path_field, read_utf8, user_path
+from ladartui.fileprobe import (
+    NO_SUCH_FILE,
+    OTHER_FILE_KINDS,
+    file_problem,
+    path_field,
+    read_utf8,
+    require_file,
+    user_path,
+)
 from ladartui.flight import (
     FlightPlan,
     ScanPose,
@@ -278,6 +286,8 @@ class Scenario:
         if sensor is None:
             sensor = defaults.DEFAULT_SENSOR
         if flight is None:
+            # the orbit reads the target model beside the scene's: a missing scene is named first
+            require_file(scene_file, "expected a scene model (voxel list)")
             target_file = target_file_for(scene_file)
             if not target_file.is_file():
                 raise InputFileError(
