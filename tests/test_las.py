@@ -117,3 +117,32 @@ def test_export_to_a_place_that_cannot_be_written_names_it(tmp_path):
 def test_bad_voxel_size(tmp_path):
     with pytest.raises(FieldError, match="voxel_size = 0: expected a positive number of metres"):
         export_las(tmp_path / "a.las", VOXELS, 0)
+
+
+def _cloud_file(path, count, point_format=6):
+    header = laspy.LasHeader(version="1.4", point_format=point_format)
+    header.scales = [0.01] * 3
+    header.offsets = [500000.0, 4100000.0, 0.0]  # UTM metres, as surveys give them
+    cloud = laspy.LasData(header)
+    steps = np.arange(count, dtype=np.float64)
+    cloud.x, cloud.y, cloud.z = 500100.0 + steps, 4100200.0 + steps % 7, 120.0 + steps % 3
+    cloud.write(path)
+    with laspy.open(path) as reader:
+        return reader.header
+
+
+@pytest.mark.parametrize("kept", [50, 50.5], ids=["at-a-point", "inside-a-point"])
+def test_a_cloud_cut_short_is_refused_naming_what_it_lacks(tmp_path, kept):
+    # Cut at a point's end, the first 50 of 100 points were imported as the whole cloud
+    # without a word; cut inside one, "buffer size must be a multiple of element size".
+    path = tmp_path / "survey.las"
+    header = _cloud_file(path, 100)
+    data = path.read_bytes()
+    path.write_bytes(data[: header.offset_to_point_data + int(kept * header.point_format.size)])
+    with pytest.raises(InputFileError) as caught:
+        import_las(path, 0.25)
+    assert str(caught.value) == (
+        f"{path}: cut short: its header gives 100 points ({len(data):,} bytes), the file has "
+        f"{int(len(data) - (100 - kept) * 30):,} bytes; expected the whole file (copied or "
+        "downloaded in full)"
+    )

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.atomic import atomic_path, write_errors_named
-from ladartui.errors import FieldError, InputFileError, described
+from ladartui.errors import FieldError, InputFileError, LadarError, described
 from ladartui.fileprobe import path_field, require_file
 from ladartui.scene.unique_rows import unique_voxels
 from ladartui.scene.voxel_arrays import voxel_list_field, voxel_size_field
@@ -115,15 +115,10 @@ def import_las_target(path, voxel_size, origin=None) -> tuple[np.ndarray, np.nda
 
 def _voxel_indices(path, voxel_size, origin) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Each point's voxel ((P, 3) int32), its point_source_id (P,), and the origin."""
-    import laspy
-
     path = path_field("path", path, "a LAS or LAZ point cloud's path")
     size = voxel_size_field(voxel_size)
     require_file(path, "expected a LAS or LAZ point cloud")
-    try:
-        cloud = laspy.read(path)
-    except Exception as error:  # laspy raises several kinds for a damaged or foreign file
-        raise InputFileError(path, f"not a readable LAS/LAZ point cloud ({error})") from None
+    cloud = _read_cloud(path)
     _check_header(path, cloud.header)
     points = np.stack([np.asarray(cloud.x), np.asarray(cloud.y), np.asarray(cloud.z)], axis=1)
     if not len(points):
@@ -146,6 +141,42 @@ def _voxel_indices(path, voxel_size, origin) -> tuple[np.ndarray, np.ndarray, np
     if indices.max() > MAX_INDEX:
         raise FieldError("voxel_size", voxel_size, "large enough for the cloud's extent", source=str(path))
     return indices.astype(np.int32), np.asarray(cloud.point_source_id), origin
+
+
+def _read_cloud(path):
+    """The whole cloud, refused in one line when damaged, foreign or cut short."""
+    import laspy
+
+    try:
+        with laspy.open(path) as reader:
+            header = reader.header
+            if not header.are_points_compressed:
+                _check_length(path, header)
+            cloud = reader.read()
+    except LadarError:
+        raise
+    except Exception as error:  # laspy raises several kinds for a damaged or foreign file
+        reason = str(error) or type(error).__name__
+        raise InputFileError(path, f"not a readable LAS/LAZ point cloud ({reason})") from None
+    if len(cloud.points) < header.point_count:  # laspy reads what there is without a word
+        raise InputFileError(
+            path,
+            f"cut short: its header gives {header.point_count:,} points, the file holds "
+            f"{len(cloud.points):,}; expected the whole file (copied or downloaded in full)",
+        )
+    return cloud
+
+
+def _check_length(path, header) -> None:
+    """An uncompressed cloud must hold every point its header counts."""
+    needed = header.offset_to_point_data + header.point_count * header.point_format.size
+    size = Path(path).stat().st_size
+    if size < needed:
+        raise InputFileError(
+            path,
+            f"cut short: its header gives {header.point_count:,} points ({needed:,} bytes), the "
+            f"file has {size:,} bytes; expected the whole file (copied or downloaded in full)",
+        )
 
 
 def export_las(path, voxels, voxel_size, origin=(0.0, 0.0, 0.0), ids=None) -> None:
