@@ -5,7 +5,7 @@ import pytest
 
 laspy = pytest.importorskip("laspy")
 
-from ladartui.errors import FieldError, InputFileError, OutputFileError  # noqa: E402
+from ladartui.errors import FieldError, InputFileError, OutputFileError, ResourceLimitError  # noqa: E402
 from ladartui.scene.las import export_las, import_las  # noqa: E402
 
 
@@ -146,3 +146,20 @@ def test_a_cloud_cut_short_is_refused_naming_what_it_lacks(tmp_path, kept):
         f"{int(len(data) - (100 - kept) * 30):,} bytes; expected the whole file (copied or "
         "downloaded in full)"
     )
+
+
+def test_a_cloud_larger_than_the_memory_is_refused_before_it_is_read(tmp_path, monkeypatch):
+    # laspy was asked to read it all: on this machine "not a readable LAS/LAZ point cloud ()"
+    # (a MemoryError) of a sound file; on a larger one a process killed halfway.
+    path = tmp_path / "survey.laz"
+    _cloud_file(path, 1000)
+    monkeypatch.setenv("LADARTUI_MAX_MEMORY", str(64 * 1024))
+    with pytest.raises(ResourceLimitError) as caught:
+        import_las(path, 0.25)
+    assert str(caught.value) == (
+        f"{path}: 1,000 points of 30 bytes need about 123 KiB to voxelise, more than the "
+        "64 KiB of memory available; split the cloud into tiles or thin it"
+    )
+    monkeypatch.setenv("LADARTUI_MAX_MEMORY", str(126_000))
+    voxels, _ = import_las(path, 0.25)
+    assert len(voxels) == 1000
