@@ -126,3 +126,24 @@ async def test_the_top_view_draws_footprints_as_they_fall_with_attitude(tmp_path
         assert len(drawn) == len(expected)
         assert all(np.allclose(d, e) for d, e in zip(drawn, expected))
         assert not all(np.allclose(d, e) for d, e in zip(drawn, level))  # the bank shows
+
+
+async def test_an_export_that_fails_leaves_the_earlier_pair_and_says_so(tmp_path, scene_files):
+    """The scene's cloud was written before the target's failed: a new S_Scene.las beside
+    the earlier S_Target.las (here a folder), while the note said 'Nothing exported'."""
+    from ladartui.simulation import simulate
+
+    scenario = make_scenario(tmp_path, scene_files, scans=2)
+    simulate(scenario)
+    scene_las = scenario.scene_output.with_suffix(".las")
+    scene_las.write_bytes(b"the earlier export")
+    scenario.target_output.with_suffix(".las").mkdir()  # cannot be written: a folder
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app) and app.measures is not None)
+        await app.run_action("export_las")
+        await wait_until(pilot, lambda: any("Nothing exported" in m for m in app.messages))
+        said = next(m for m in app.messages if "Nothing exported" in m)
+        assert f"{scenario.target_output.with_suffix('.las')}: is a folder, expected a file name" in said
+        assert scene_las.read_bytes() == b"the earlier export"
+        assert not list(tmp_path.glob(".*.las.*"))  # no temporaries left beside them

@@ -485,19 +485,30 @@ def export_outputs_las(scenario: Scenario, suffix: str = ".las", scene=None) -> 
     With the loaded ``scene``, each point carries its target id (0: not a target), as
     ``run --las`` writes them.
 
-    Both are read first, so a missing output writes nothing.
+    The two are one output set under the scenario's run lock: both replaced or neither,
+    and never while a run swaps the outputs in. Both outputs are read first, so a missing
+    output writes nothing.
     """
-    from ladartui.scene.las import export_las
+    from ladartui.outputset import OutputSet
+    from ladartui.scene.las import compressed_suffix, write_las
     from ladartui.scene.voxels import load_voxels
+    from ladartui.simulation import output_lock
 
-    outputs = [scenario.scene_output, scenario.target_output]
-    for path in outputs:
+    outputs = {"scene": scenario.scene_output, "target": scenario.target_output}
+    for path in outputs.values():
         if (problem := file_problem(path)) == "not found":
             raise InputFileError(path, "output not found: run the scenario first")
         if problem:
             raise InputFileError(path, f"output {problem}")
-    clouds = [(path.with_suffix(suffix), load_voxels(path)) for path in outputs]
-    for path, voxels in clouds:
-        ids = None if scene is None else scene.target_ids_of(voxels)
-        export_las(path, voxels, scenario.voxel_size, ids=ids)
-    return [path for path, _ in clouds]
+    paths = {name: path.with_suffix(suffix) for name, path in outputs.items()}
+    with OutputSet(paths, output_lock(scenario)) as output_set:
+        clouds = {name: load_voxels(path) for name, path in outputs.items()}
+
+        def writer(name: str):
+            voxels = clouds[name]
+            ids = None if scene is None else scene.target_ids_of(voxels)
+            compress = compressed_suffix(paths[name])
+            return lambda tmp: write_las(tmp, voxels, scenario.voxel_size, ids=ids, compress=compress)
+
+        output_set.write({name: writer(name) for name in paths})
+    return list(paths.values())
