@@ -214,6 +214,26 @@ def test_a_folder_as_out_is_refused(tmp_path, truck, forest, capsys, slash):
     assert sorted(p.name for p in tmp_path.iterdir()) == before and not any((tmp_path / "models").iterdir())
 
 
+@pytest.mark.parametrize("name", ["truck.las", "truck.LAZ", "truck.toml", "truck.cmf"])
+@pytest.mark.parametrize("into", [False, True])
+def test_out_named_as_another_kind_of_file_is_refused(tmp_path, truck, forest, capsys, name, into):
+    """'truck.las' wrote truck.las.txt (with --into, truck.las.txt and truck.las_Target.txt):
+    a voxel list under the name of a point cloud, as generate refuses."""
+    before = sorted(p.name for p in tmp_path.iterdir())
+    out = str(tmp_path / name)
+    args = ["voxelize", str(truck), out, "--voxel-size", "0.1", "--at", "3,3"]
+    assert main([*args, "--into", str(forest)] if into else args) == 2
+    wanted = (
+        "the scene's stem (X writes X.txt and X_Target.txt)" if into else "a voxel-list name ending in .txt"
+    )
+    suffix = name[name.index(".") :]
+    assert (
+        one_error_line(capsys)
+        == f"ladartui: error: OUT = {out!r}: expected {wanted}, not a {suffix} file name"
+    )
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
 def test_one_voxel_is_said_in_the_singular(tmp_path, truck, capsys):
     """A voxel as large as the truck: '1 voxels'."""
     assert main(["voxelize", str(truck), str(tmp_path / "t"), "--voxel-size", "5"]) == 0

@@ -77,6 +77,7 @@ def run(args) -> int:
     from pathlib import Path
 
     from ladartui.cli.console import CliConsole as Console
+    from ladartui.fileprobe import other_file_kind
     from ladartui.outputset import check_writable
     from ladartui.scene.insertion import scene_model_paths
     from ladartui.scene.voxelize import CANCELLED, Placement
@@ -104,6 +105,15 @@ def run(args) -> int:
             else "a target model's file name (X.txt)"
         )
         raise FieldError("OUT", args.out, f"{wanted}, not a folder")
+    if other_file_kind(args.out) is not None:  # 'truck.las' wrote truck.las.txt
+        suffix = Path(args.out).suffix
+        wanted = (
+            "the scene's stem (X writes X.txt and X_Target.txt)"
+            if args.into
+            else "a voxel-list name ending in .txt"
+        )
+        what = "a mesh" if other_file_kind(args.out) == "a mesh" else f"a {suffix} file name"
+        raise FieldError("OUT", args.out, f"{wanted}, not {what}")
     outputs: tuple[Path, ...]
     if args.into:
         outputs = scene_model_paths(args.out)
@@ -120,8 +130,6 @@ def run(args) -> int:
     else:
         target = Path(args.out)
         if target.suffix.lower() != ".txt":
-            if target.suffix.lower() in (".obj", ".stl", ".ply"):
-                raise FieldError("OUT", args.out, "a voxel-list name ending in .txt, not a mesh")
             target = target.with_name(target.name + ".txt")
         outputs = (target,)
     check_writable(*outputs)
