@@ -163,3 +163,13 @@ def test_a_cloud_larger_than_the_memory_is_refused_before_it_is_read(tmp_path, m
     monkeypatch.setenv("LADARTUI_MAX_MEMORY", str(126_000))
     voxels, _ = import_las(path, 0.25)
     assert len(voxels) == 1000
+
+
+def test_a_cloud_wider_than_the_finest_scale_allows_round_trips(tmp_path):
+    # 220 km at 0.1 m: at the scale of a ten-thousandth of a voxel the x integers passed 2**31
+    # and laspy raised OverflowError ("Values given do not fit after applying offset and scale").
+    voxels = np.array([[0, 0, 0], [2_200_000, 3, 1], [1_100_000, 7, 2]], dtype=np.int32)
+    path = tmp_path / "corridor.laz"
+    export_las(path, voxels, 0.1, origin=(500000.0, 4100000.0, 50.0))
+    back, _ = import_las(path, 0.1, origin=(500000.0, 4100000.0, 50.0))
+    np.testing.assert_array_equal(sorted_rows(back), sorted_rows(voxels))

@@ -226,6 +226,11 @@ def compressed_suffix(path) -> bool:
     return Path(path).suffix.lower() == ".laz"
 
 
+# The largest stored coordinate a scale is chosen for: under the 32-bit limit, with room
+# for the rounding of a centre to the nearest step.
+_LARGEST_STORED = 2**31 - 2
+
+
 def _voxel_cloud(voxels, voxel_size, origin, ids):
     """The voxel centres (metres) as a laspy cloud, ``ids`` as point source ids."""
     import laspy
@@ -235,10 +240,13 @@ def _voxel_cloud(voxels, voxel_size, origin, ids):
     origin = np.asarray(origin, dtype=np.float64).reshape(3)
     centres = origin + voxels.reshape(-1, 3).astype(np.float64) * size
     header = laspy.LasHeader(version="1.2", point_format=0)
-    # A scale well below the voxel size keeps every centre recoverable exactly.
-    scale = min(0.001, size / 1000)
+    offsets = np.floor(centres.min(axis=0)) if len(centres) else np.zeros(3)
+    # A scale well below the voxel size keeps every centre recoverable exactly; coarser,
+    # where the cloud is too wide for it, so the coordinates fit their 32-bit integers.
+    span = float((centres.max(axis=0) - offsets).max()) if len(centres) else 0.0
+    scale = max(min(0.001, size / 1000), span / _LARGEST_STORED)
     header.scales = np.full(3, scale)
-    header.offsets = np.floor(centres.min(axis=0)) if len(centres) else np.zeros(3)
+    header.offsets = offsets
     cloud = laspy.LasData(header)
     cloud.x, cloud.y, cloud.z = centres[:, 0], centres[:, 1], centres[:, 2]
     if ids is not None:
