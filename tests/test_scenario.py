@@ -150,6 +150,23 @@ def test_a_scene_file_naming_the_target_model_says_which_file_to_name(tmp_path):
     )
 
 
+@pytest.mark.parametrize(("name", "kind"), [("survey.las", "a LAS point cloud"), ("truck.obj", "a mesh")])
+def test_a_scene_file_of_another_kind_is_named_as_such(tmp_path, name, kind):
+    # A point cloud named as the scene asked for survey_Target.las, and once that was made,
+    # the scene was refused as 'not a voxel list'.
+    models = tmp_path / "models"
+    models.mkdir()
+    (models / name).write_bytes(b"LASF")
+    path = write_scenario(tmp_path, edited('scene = "models/forest.txt"', f'scene = "models/{name}"'))
+    with pytest.raises(InputFileError) as caught:
+        load_scenario(path)
+    suffix = name[name.index(".") :]
+    assert str(caught.value) == (
+        f"{path}:2: scene model file {models / name} is {kind} ({suffix}) (files.scene): "
+        "expected a voxel list (.txt)"
+    )
+
+
 def test_with_changes_names_a_field_it_does_not_have(tmp_path):
     # A typo raised TypeError from the dataclass machinery.
     scenario = load_scenario(write_scenario(tmp_path), check_files=False)

@@ -216,10 +216,18 @@ class Scenario:
         return Scene.load(self.scene_file, self.voxel_size)
 
     def check_files(self) -> None:
-        """InputFileError naming the first referenced model file that does not exist."""
+        """InputFileError naming the first referenced model file that does not exist, or a
+        scene model of another kind (a point cloud, a mesh)."""
+        from ladartui.fileprobe import other_file_kind
+
         missing = None
         if problem := file_problem(self.scene_file):
             missing = f"scene model file {self.scene_file} {problem} (files.scene)"
+        elif kind := other_file_kind(self.scene_file):  # else its target, 'X_Target.las', was asked for
+            missing = (
+                f"scene model file {self.scene_file} is {kind} ({self.scene_file.suffix}) "
+                "(files.scene): expected a voxel list (.txt)"
+            )
         elif (problem := file_problem(self.target_file)) and self.scene_file.stem.endswith("_Target"):
             scene = self.scene_file.with_stem(self.scene_file.stem.removesuffix("_Target"))
             missing = (
