@@ -197,6 +197,25 @@ def test_bad_arguments_are_field_errors_before_anything_runs(forest):
     assert not forest.scene_output.exists() and not forest.measures_file.exists()
 
 
+def test_a_scene_loaded_from_another_file_is_refused(forest, tmp_path):
+    """simulate(scenario, scene=...) with the Scene of another scene model ran on it and
+    scored that scene as the scenario's, without a word."""
+    from ladartui.errors import FieldError
+    from ladartui.scene.model import Scene
+
+    save_voxels(tmp_path / "elsewhere.txt", box(0, 4, 0, 4, 0, 4))
+    save_voxels(tmp_path / "elsewhere_Target.txt", box(0, 1, 0, 1, 0, 1))
+    elsewhere = Scene.load(tmp_path / "elsewhere.txt", forest.voxel_size)
+    with pytest.raises(FieldError) as caught:
+        simulate(forest, scene=elsewhere, write=False)
+    assert str(caught.value) == (
+        f"scene is the scene of {tmp_path / 'elsewhere.txt'}: expected the scenario's Scene, "
+        f"of {forest.scene_file} (scenario.load_scene())"
+    )
+    # the scenario's own, and one made in memory, run
+    assert simulate(forest, scene=forest.load_scene(), write=False).measures is not None
+
+
 def test_las_outputs_hold_the_fused_voxels(forest):
     from ladartui.scene.las import import_las
 

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ladartui.errors import FieldError, check_callbacks, check_cancelled, described
+from ladartui.errors import Described, FieldError, check_callbacks, check_cancelled, described
 from ladartui.measures import Measures, compute_measures
 from ladartui.returns import fuse_scans, kept_returns
 from ladartui.run_record import as_run, check_record_spare, record_text, run_inputs
@@ -145,6 +145,12 @@ def _check_arguments(scenario, progress, cancel, scene) -> None:
     if scene is not None:
         if not isinstance(scene, Scene):
             raise FieldError("scene", described(scene), "the scenario's Scene (scenario.load_scene())")
+        if scene.path is not None and scene.path.resolve() != scenario.scene_file.resolve():
+            raise FieldError(
+                "scene",
+                Described(f"the scene of {scene.path}"),
+                f"the scenario's Scene, of {scenario.scene_file} (scenario.load_scene())",
+            )
         if scene.voxel_size != scenario.voxel_size:
             raise FieldError(
                 "scene.voxel_size", scene.voxel_size, f"the scenario's voxel size ({scenario.voxel_size})"
