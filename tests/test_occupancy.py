@@ -229,3 +229,16 @@ def test_contains_names_what_is_no_voxel_index(ijk):
     occupancy = Occupancy.build(np.array([[1, 1, 1]], np.int32), shape=(4, 4, 4))
     with pytest.raises(FieldError, match=r"^ijk = .*: expected voxel indices \(\.\., 3\) of integers"):
         occupancy.contains(ijk)
+
+
+def test_a_negative_index_is_named_as_such_not_against_a_shape_it_made():
+    """Occupancy.build([[-1, 0, 0]]) said 'expected indices inside the scene shape
+    [0, 1, 1]': a shape taken from the bad data itself."""
+    with pytest.raises(FieldError) as caught:
+        Occupancy.build(np.array([[3, 1, 2], [-1, 0, 0]]))
+    assert str(caught.value) == "voxels[1] = (-1, 0, 0): expected non-negative voxel indices"
+    with pytest.raises(FieldError) as caught:
+        Occupancy.build(np.array([[0, 0, 5]]), (5, 5, 5))
+    assert (
+        str(caught.value) == "voxels[0] = (0, 0, 5): expected voxel indices inside the scene shape (5, 5, 5)"
+    )

@@ -33,8 +33,10 @@ def target_path_for(scene_path) -> Path:
 class Scene:
     """Scene and target voxel lists over one grid.
 
-    ``voxels`` and ``target`` are (N, 3) int32 arrays of unique voxel indices
-    (target voxels also appear in ``voxels`` for a scene model). ``shape`` is
+    ``voxels`` and ``target`` are (N, 3) int32 arrays of voxel indices (target
+    voxels also appear in ``voxels`` for a scene model). ``load`` drops repeated
+    rows; arrays given here are kept as they are (the tracer and the measures count
+    a repeated voxel once, the lengths here do not). ``shape`` is
     ``(nx, ny, nz)``, by default the largest index + 1 over both lists.
     ``target_ids`` (one int32 per target voxel, 1..65535) says which target
     each target voxel belongs to; by default all belong to target 1.

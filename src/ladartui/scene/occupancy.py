@@ -145,11 +145,16 @@ class Occupancy:
         shape = tuple(int(v) for v in hi) if shape is None else shape_field(shape)
         if not len(vox):
             return cls._empty(shape)
-        if lo.min() < 0 or np.any(hi > np.array(shape)):
+        if lo.min() < 0 or np.any(hi > np.array(shape)):  # the first bad row, by its index
+            negative = lo.min() < 0
+            bad = (vox < 0).any(axis=1) if negative else (vox >= np.array(shape)).any(axis=1)
+            row = int(np.argmax(bad))
             raise FieldError(
-                "voxels",
-                f"indices spanning {lo.tolist()}..{last.tolist()}",
-                f"indices inside the scene shape {list(shape)}",
+                f"voxels[{row}]",
+                tuple(int(c) for c in vox[row]),
+                "non-negative voxel indices"
+                if negative
+                else f"voxel indices inside the scene shape ({', '.join(str(n) for n in shape)})",
             )
         from ladartui.resources import check_occupancy
 
