@@ -504,3 +504,14 @@ def test_a_new_scenario_checks_its_voxel_size_before_the_default_orbit(tmp_path)
     with pytest.raises(FieldError) as caught:
         Scenario.new(tmp_path / "new.toml", "models/forest.txt", "a")
     assert str(caught.value) == "files.voxel_size = 'a': expected a number from 0.001 to 100"
+
+
+def test_check_files_given_text_is_refused_not_taken_as_true(tmp_path):
+    """load_scenario(path, check_files="no") checked the files: text is true."""
+    write_models(tmp_path / "models")
+    path = tmp_path / "new.toml"
+    Scenario.new(path, "models/forest.txt", 0.5).save()
+    with pytest.raises(FieldError) as caught:
+        load_scenario(path, check_files="no")
+    assert str(caught.value) == "check_files = 'no': expected True or False"
+    assert load_scenario(path, check_files=False).path == path

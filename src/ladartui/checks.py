@@ -60,6 +60,14 @@ def choice_field(name, value, choices):
     return value
 
 
+def switch_field(name, value) -> bool:
+    """``value`` as a bool if it is True or False (numpy's too), else FieldError: text
+    such as "no" is true, and a switch given it did the opposite of what was meant."""
+    if not isinstance(value, bool | np.bool_):
+        raise FieldError(name, value, "True or False")
+    return bool(value)
+
+
 def point_field(name, value):
     """A point [x, y] or [x, y, z] in metres as a float tuple of three (z = 0 if absent)."""
     expected = f"a point [x, y] or [x, y, z] in metres, each within +-{number_text(MAX_COORDINATE)}"

@@ -22,7 +22,7 @@ import tomli_w
 
 from ladartui import defaults
 from ladartui.atomic import write_errors_named, write_text_atomic
-from ladartui.checks import choice_field, number_field
+from ladartui.checks import choice_field, number_field, switch_field
 from ladartui.detection.settings import DetectionSettings
 from ladartui.errors import FieldError, InputFileError, LadarError, OutputFileError
 from ladartui.fileprobe import (
@@ -505,7 +505,7 @@ def load_scenario(path, check_files=True) -> Scenario:
     except OSError as error:
         raise InputFileError(path, f"cannot read the scenario file: {error.strerror or error}") from None
     scenario = scenario_from_toml(text, path)
-    if check_files:
+    if switch_field("check_files", check_files):
         scenario.check_files()
     return scenario
 

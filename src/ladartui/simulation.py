@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ladartui.checks import switch_field
 from ladartui.errors import Described, FieldError, check_callbacks, check_cancelled, described
 from ladartui.measures import Measures, compute_measures
 from ladartui.returns import fuse_scans, kept_returns
@@ -129,9 +130,7 @@ def simulate(
         scenario = load_scenario(scenario)
     _check_arguments(scenario, progress, cancel, scene)
     check_work(scenario)  # before the output set is locked and before any tracing
-    for name, value in (("write", write), ("las", las)):
-        if not isinstance(value, (bool, np.bool_)):
-            raise FieldError(name, value, "True or False")
+    write, las = switch_field("write", write), switch_field("las", las)
     with contextlib.ExitStack() as stack:
         output_set = stack.enter_context(_output_set(scenario, las)) if write else None
         return _simulate(scenario, backend, method, step, precision, progress, cancel, output_set, scene)

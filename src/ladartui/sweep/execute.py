@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ladartui.atomic import write_errors_named, write_text_atomic
+from ladartui.checks import switch_field
 from ladartui.errors import (
     FieldError,
     InputFileError,
@@ -218,8 +219,7 @@ def run_sweep(
         )
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise FieldError("workers", workers, "an integer >= 1")
-    if not isinstance(serial, bool):  # "no" is truthy: it ran the sweep serially
-        raise FieldError("serial", serial, "True or False")
+    switch_field("serial", serial)
     if client is not None:
         _check_client(client)
     if client is None and not serial:
