@@ -194,6 +194,24 @@ def test_a_scene_named_as_a_target_model_is_refused(tmp_path, truck, forest, cap
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
 
 
+def test_out_naming_a_scene_model_without_into_is_refused(tmp_path, truck, forest, capsys):
+    """'voxelize truck.stl forest --at 3,3' (--into forgotten) wrote the vehicle's target
+    model over the scene model forest.txt, and the forest was gone."""
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir()}
+    args = ["voxelize", str(truck), "--voxel-size", "0.1", "--at", "3,3"]
+    for out in (tmp_path / "forest", forest):
+        assert main([*args, str(out)]) == 2
+        assert one_error_line(capsys) == (
+            f"ladartui: error: OUT = {str(out)!r}: expected a new target model's name, not the scene "
+            f"model {forest.name} (its target model forest_Target.txt is beside it); to add the "
+            f"vehicle to that scene, give --into {forest.name}"
+        )
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+    # a target model written again is replaced as before
+    assert main([*args, str(tmp_path / "truck_model")]) == 0
+    assert main([*args, str(tmp_path / "truck_model")]) == 0
+
+
 @pytest.mark.parametrize("slash", ["", "/"])
 def test_a_folder_as_out_is_refused(tmp_path, truck, forest, capsys, slash):
     """OUT naming a folder ('models' or 'models/') wrote models.txt beside it, and with --into

@@ -128,9 +128,14 @@ def run(args) -> int:
                 "beside it), not a target model",
             )
     else:
-        target = Path(args.out)
-        if target.suffix.lower() != ".txt":
-            target = target.with_name(target.name + ".txt")
+        target, beside = scene_model_paths(args.out)  # X.txt, and X_Target.txt were X a scene
+        if target.is_file() and beside.is_file():  # --into forgotten: the scene would be lost
+            raise FieldError(
+                "OUT",
+                args.out,
+                f"a new target model's name, not the scene model {target.name} (its target model "
+                f"{beside.name} is beside it); to add the vehicle to that scene, give --into {target.name}",
+            )
         outputs = (target,)
     check_writable(*outputs)
     errors = Console(stderr=True)
