@@ -173,3 +173,31 @@ def test_a_cloud_wider_than_the_finest_scale_allows_round_trips(tmp_path):
     export_las(path, voxels, 0.1, origin=(500000.0, 4100000.0, 50.0))
     back, _ = import_las(path, 0.1, origin=(500000.0, 4100000.0, 50.0))
     np.testing.assert_array_equal(sorted_rows(back), sorted_rows(voxels))
+
+
+@pytest.mark.parametrize("version, point_format", [("1.2", 0), ("1.4", 6)])
+def test_noise_and_withheld_points_are_left_out_unless_asked_for(tmp_path, version, point_format):
+    """A survey's one noise point 3 km up (class 18, or 7) made the scene 12,001 voxels
+    tall: points classed as noise, and points flagged withheld, were voxelised as foliage."""
+    header = laspy.LasHeader(version=version, point_format=point_format)
+    header.scales = [0.01] * 3
+    header.offsets = [0, 0, 0]
+    cloud = laspy.LasData(header)
+    cloud.x = np.array([0.0, 1.0, 2.0, 3.0, 4.0])
+    cloud.y = np.zeros(5)
+    cloud.z = np.array([0.0, 1.0, 3000.0, -40.0, 2.0])
+    noise = 18 if point_format >= 6 else 7  # high noise needs the 1.4 formats' 8-bit classes
+    cloud.classification = np.array([2, 5, noise, 7, 5])
+    cloud.withheld = np.array([0, 0, 0, 0, 1], dtype=bool)
+    path = tmp_path / "survey.las"
+    cloud.write(path)
+    voxels, origin = import_las(path, 1.0)
+    assert sorted_rows(voxels).tolist() == [[0, 0, 0], [1, 0, 1]]
+    np.testing.assert_array_equal(origin, [0.0, 0.0, 0.0])
+    voxels, origin = import_las(path, 1.0, keep_noise=True)
+    assert len(voxels) == 5 and origin[2] == -40.0
+    # a cloud of noise alone says so rather than 'holds no points'
+    cloud.classification = np.full(5, 7)
+    cloud.write(path)
+    with pytest.raises(InputFileError, match=r"survey\.las: all 5 points are noise or withheld"):
+        import_las(path, 1.0)

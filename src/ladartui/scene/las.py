@@ -29,6 +29,8 @@ from ladartui.scene.unique_rows import unique_voxels
 from ladartui.scene.voxel_arrays import voxel_list_field, voxel_size_field
 from ladartui.scene.voxels import MAX_INDEX, MAX_TARGET_ID
 
+NOISE_CLASSES = (7, 18)  # ASPRS: low point (noise), high noise
+
 
 def _check_header(path, header):
     """Refuse scale factors and offsets that cannot give distinct, finite coordinates."""
@@ -71,23 +73,30 @@ def _triple(values) -> str:
     return "(" + ", ".join(f"{v:g}" for v in values) + ")"
 
 
-def import_las(path, voxel_size, origin=None) -> tuple[np.ndarray, np.ndarray]:
-    """Voxelise a LAS/LAZ file: returns ((N, 3) int32 unique voxels, origin (3,) metres)."""
-    indices, _, origin = _voxel_indices(path, voxel_size, origin)
+def import_las(path, voxel_size, origin=None, keep_noise=False) -> tuple[np.ndarray, np.ndarray]:
+    """Voxelise a LAS/LAZ file: returns ((N, 3) int32 unique voxels, origin (3,) metres).
+
+    Points classed as noise (ASPRS classes 7 and 18) and points flagged withheld are
+    left out unless ``keep_noise``: a survey's stray return kilometres up would make
+    the scene that tall."""
+    indices, _, origin = _voxel_indices(path, voxel_size, origin, keep_noise)
     voxels, _ = unique_voxels(indices)
     return voxels, origin
 
 
-def import_las_target(path, voxel_size, origin=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def import_las_target(
+    path, voxel_size, origin=None, keep_noise=False
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Voxelise a LAS/LAZ target model with its ids.
 
     Returns ((N, 3) int32 unique voxels, (N,) int32 target ids, origin). The id
     is each point's ``point_source_id``; all 0 reads as one target (id 1). A
     voxel holding points of two targets is refused (a smaller voxel size
-    keeps them apart), as is a source id 0 beside labelled points.
+    keeps them apart), as is a source id 0 beside labelled points. Noise and
+    withheld points are left out unless ``keep_noise``, as ``import_las`` does.
     """
     path = path_field("path", path, "a LAS or LAZ point cloud's path")
-    indices, source_ids, origin = _voxel_indices(path, voxel_size, origin)
+    indices, source_ids, origin = _voxel_indices(path, voxel_size, origin, keep_noise)
     ids = source_ids.astype(np.int32)
     if not ids.any():
         ids[:] = 1
@@ -113,10 +122,12 @@ def import_las_target(path, voxel_size, origin=None) -> tuple[np.ndarray, np.nda
     return indices[keep], ids[keep], origin
 
 
-def _voxel_indices(path, voxel_size, origin) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _voxel_indices(path, voxel_size, origin, keep_noise) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Each point's voxel ((P, 3) int32), its point_source_id (P,), and the origin."""
     path = path_field("path", path, "a LAS or LAZ point cloud's path")
     size = voxel_size_field(voxel_size)
+    if not isinstance(keep_noise, bool | np.bool_):  # "no" is true
+        raise FieldError("keep_noise", keep_noise, "True or False")
     require_file(path, "expected a LAS or LAZ point cloud")
     cloud = _read_cloud(path)
     _check_header(path, cloud.header)
@@ -124,6 +135,17 @@ def _voxel_indices(path, voxel_size, origin) -> tuple[np.ndarray, np.ndarray, np
     if not len(points):
         raise InputFileError(path, "holds no points; expected a LAS or LAZ point cloud")
     _check_no_collapse(path, cloud, points)
+    source_ids = np.asarray(cloud.point_source_id)
+    if not keep_noise:
+        kept = ~(np.isin(np.asarray(cloud.classification), NOISE_CLASSES) | np.asarray(cloud.withheld, bool))
+        if not kept.any():
+            raise InputFileError(
+                path,
+                f"all {len(points):,} points are noise or withheld (ASPRS classes 7 and 18, or the "
+                "withheld flag); expected ground, vegetation or object points (keep_noise=True takes them)",
+            )
+        if not kept.all():
+            points, source_ids = points[kept], source_ids[kept]
     lowest = points.min(axis=0)
     if origin is None:
         origin = lowest
@@ -140,7 +162,7 @@ def _voxel_indices(path, voxel_size, origin) -> tuple[np.ndarray, np.ndarray, np
         )
     if indices.max() > MAX_INDEX:
         raise FieldError("voxel_size", voxel_size, "large enough for the cloud's extent", source=str(path))
-    return indices.astype(np.int32), np.asarray(cloud.point_source_id), origin
+    return indices.astype(np.int32), source_ids, origin
 
 
 def _read_cloud(path):
