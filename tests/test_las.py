@@ -201,3 +201,24 @@ def test_noise_and_withheld_points_are_left_out_unless_asked_for(tmp_path, versi
     cloud.write(path)
     with pytest.raises(InputFileError, match=r"survey\.las: all 5 points are noise or withheld"):
         import_las(path, 1.0)
+
+
+def test_a_cloud_too_wide_for_the_voxel_size_says_its_extent_and_the_smallest_size(tmp_path, monkeypatch):
+    """'voxel_size = 0.25: expected large enough for the cloud's extent' gave neither."""
+    import ladartui.scene.las as las
+
+    monkeypatch.setattr(las, "MAX_INDEX", 999)  # a 1,000-voxel grid side for the test
+    header = laspy.LasHeader(version="1.2", point_format=0)
+    header.scales = [0.01] * 3
+    header.offsets = [0, 0, 0]
+    cloud = laspy.LasData(header)
+    cloud.x, cloud.y, cloud.z = np.array([0.0, 600.0]), np.array([0.0, 20.0]), np.array([0.0, 5.0])
+    path = tmp_path / "corridor.las"
+    cloud.write(path)
+    with pytest.raises(FieldError) as caught:
+        import_las(path, 0.25)
+    assert str(caught.value) == (
+        f"{path}: voxel_size = 0.25: expected at least 0.601 m for the cloud's extent "
+        "(600 x 20 x 5 m; at most 1,000 voxels a side)"
+    )
+    assert len(import_las(path, 0.601)[0]) == 2

@@ -18,6 +18,7 @@ every other voxel (foliage, ground) with 0.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -161,7 +162,18 @@ def _voxel_indices(path, voxel_size, origin, keep_noise) -> tuple[np.ndarray, np
             source=str(path),
         )
     if indices.max() > MAX_INDEX:
-        raise FieldError("voxel_size", voxel_size, "large enough for the cloud's extent", source=str(path))
+        span = points.max(axis=0) - np.minimum(origin, lowest)
+        # the highest index, floor(span / size + 0.5), must stay within MAX_INDEX
+        least = float(span.max()) / (MAX_INDEX + 0.5)
+        digits = 2 - math.floor(math.log10(least))
+        least = math.ceil(least * 10**digits) / 10**digits  # three figures, rounded up
+        raise FieldError(
+            "voxel_size",
+            voxel_size,
+            f"at least {least:g} m for the cloud's extent ({' x '.join(f'{s:.4g}' for s in span)} m; "
+            f"at most {MAX_INDEX + 1:,} voxels a side)",
+            source=str(path),
+        )
     return indices.astype(np.int32), source_ids, origin
 
 
