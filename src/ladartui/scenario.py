@@ -424,7 +424,8 @@ class Scenario:
         return _compact_arrays(tomli_w.dumps(self.to_dict()))
 
     def save(self, path=None) -> Scenario:
-        """Write the scenario atomically to ``path`` (default: its own path).
+        """Write the scenario atomically to ``path`` (default: its own path), making
+        its folder if there is none.
 
         Returns the scenario as saved (with ``path`` as its path, so its
         outputs sit beside the new file).

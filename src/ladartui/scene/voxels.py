@@ -448,7 +448,8 @@ def describe_bad_line(text: str, columns: int = 3, target: bool = False) -> str:
 
 
 def save_voxels(path, voxels, ids=None) -> None:
-    """Write ``voxels`` ((N, 3) non-negative integers) as an ``x,y,z`` list, atomically.
+    """Write ``voxels`` ((N, 3) non-negative integers) as an ``x,y,z`` list, atomically,
+    making the file's folder if there is none.
 
     With ``ids`` ((N,) target ids 1..``MAX_TARGET_ID``) the lines are ``x,y,z,id``. A path
     that cannot be written is an ``OutputFileError`` naming it.
