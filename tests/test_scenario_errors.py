@@ -292,3 +292,24 @@ def test_a_comment_holding_a_unicode_line_separator_keeps_the_lines_that_follow(
         load_scenario(path, check_files=False)
     line = text[: text.index("grid = 0")].count("\n") + 1  # 7: the file's line, as an editor numbers it
     assert str(caught.value).startswith(f"{path}:{line}: sensor.grid = 0")
+
+
+def test_a_path_of_millions_of_scans_is_refused_before_its_scans_are_made(tmp_path, monkeypatch):
+    """500 orbits of 10,000 scans each were each built, 5 million poses over 114 s and
+    1.6 GB, before 'expected at most 10000 scans'; the scans the segments declare are
+    counted first."""
+    from ladartui.flight import Orbit
+
+    def never(self, current):
+        raise AssertionError("an orbit's scans were made")
+
+    orbit = (
+        '[[flight.segments]]\nkind = "orbit"\ncentre = [0.0, 0.0, 0.0]\n'
+        "radius = 60.0\naltitude = 60.0\nscans = 10000\n"
+    )
+    monkeypatch.setattr(Orbit, "build", never)
+    path = write_scenario(tmp_path, BASE + orbit * 500)
+    with pytest.raises(FieldError) as caught:
+        load_scenario(path, check_files=False)
+    assert caught.value.field == "flight.segments"
+    assert str(caught.value).endswith("flight.segments = '5000010 scans': expected at most 10000 scans")

@@ -430,12 +430,28 @@ def check_flight(plan: FlightPlan) -> None:
     """Every scan can be built, and there is at least one and at most MAX_SCANS."""
     if not plan.segments:
         raise FieldError("flight.segments", [], "at least one segment")
+    declared = sum(_declared_scans(segment) for segment in plan.segments)
+    if declared > MAX_SCANS:  # refused before millions of scans are made only to be counted
+        raise FieldError("flight.segments", f"{declared} scans", f"at most {MAX_SCANS} scans")
     try:
         count = sum(len(p) for p in plan.segment_poses())
     except FieldError as error:
         raise FieldError("flight." + error.field, error.value, error.expected) from None
     if count > MAX_SCANS:
         raise FieldError("flight.segments", f"{count} scans", f"at most {MAX_SCANS} scans")
+
+
+def _declared_scans(segment) -> int:
+    """The scans ``segment`` says it makes, without making them: its ``scans``, its poses,
+    standoffs or listed times; 1 for one known only once made (a log flown at a rate)."""
+    scans = getattr(segment, "scans", None)
+    if isinstance(scans, int):
+        return scans
+    for name in ("poses", "standoffs", "times"):
+        items = getattr(segment, name, None)
+        if isinstance(items, tuple):
+            return len(items)
+    return 1
 
 
 def resolve_path(folder: Path, file) -> Path:
