@@ -264,3 +264,63 @@ def test_the_tui_study_says_how_to_raise_the_ray_limit_as_its_run_does(tmp_path,
     with pytest.raises(RayLimitError) as refused:
         _study("quick", path, 2, 3, None, lambda *args: None)
     assert f"(raise it with {RAISE_IN_TUI} if this is meant)" in str(refused.value)
+
+
+def _address_space_in_use() -> int:
+    with open("/proc/self/status", encoding="ascii") as status:
+        line = next(line for line in status if line.startswith("VmSize:"))
+    return int(line.split()[1]) * 1024
+
+
+def test_an_address_space_limit_bounds_the_memory_available(tmp_path, capsys, monkeypatch):
+    """Under `ulimit -v 4000000` a trace of 30 million rays, estimated at 7.1 GiB, was
+    checked against the 22 GiB the kernel had free, read its rays, traced for 80 s and
+    ended in a MemoryError traceback; the limit left to the process is what it has."""
+    import resource
+
+    from numpy.lib import format as npy
+
+    from ladartui.resources import available_memory
+
+    room = 100 * 2**20
+    limit = _address_space_in_use() + room
+    real = resource.getrlimit
+    monkeypatch.setattr(
+        resource, "getrlimit", lambda which: (limit, limit) if which == resource.RLIMIT_AS else real(which)
+    )
+    assert available_memory() <= room
+    rays = tmp_path / "rays.npy"
+    with open(rays, "wb") as handle:  # a million rays on paper
+        npy.write_array_header_1_0(handle, {"descr": "<f8", "fortran_order": False, "shape": (10**6, 6)})
+    assert main(["trace", "--scene", str(tmp_path / "s.txt"), "--rays", str(rays), "--out", "h.npy"]) == 2
+    err = one_error_line(capsys)
+    assert "rays.npy: 1,000,000 rays need about" in err and "MiB of memory available" in err
+
+
+@pytest.mark.parametrize("version", [1, 2])
+def test_a_memory_cgroup_limit_bounds_the_memory_available(tmp_path, monkeypatch, version):
+    """In a container or a batch job limited to 2 GiB the host's free memory was taken as
+    what a run may allocate; the cgroup's limit less its use (page cache aside) is."""
+    from ladartui import resources
+
+    proc = tmp_path / "cgroup"
+    if version == 2:
+        proc.write_text("0::/job/7\n")
+        folder, names, prefix = tmp_path / "job" / "7", ("memory.max", "memory.current"), ""
+    else:
+        proc.write_text("5:cpu:/x\n4:memory:/job/7\n")
+        folder = tmp_path / "memory"  # the container's own group, at the root of the mount
+        names, prefix = ("memory.limit_in_bytes", "memory.usage_in_bytes"), "total_"
+    folder.mkdir(parents=True)
+    (folder / names[0]).write_text(f"{2 * 2**30}\n")
+    (folder / names[1]).write_text(f"{2**30 + 300 * 2**20}\n")
+    (folder / "memory.stat").write_text(
+        f"{prefix}inactive_file {200 * 2**20}\n{prefix}active_file {100 * 2**20}\n"
+    )
+    monkeypatch.setattr(resources, "_PROC_CGROUP", str(proc))
+    monkeypatch.setattr(resources, "_CGROUP_ROOT", str(tmp_path))
+    monkeypatch.setattr(resources, "_free_memory", lambda: 64 * 2**30)
+    monkeypatch.setattr(resources, "_address_space_left", lambda: None)
+    assert resources.available_memory() == 2**30
+    (folder / names[0]).write_text("max\n" if version == 2 else f"{2**63 - 4096}\n")
+    assert resources.available_memory() == 64 * 2**30

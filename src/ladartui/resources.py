@@ -39,21 +39,118 @@ def memory_override() -> int | None:
 
 
 def available_memory() -> int:
-    """Bytes the run may allocate: ``LADARTUI_MAX_MEMORY``, else the kernel's MemAvailable."""
+    """Bytes the run may allocate: ``LADARTUI_MAX_MEMORY``, else the least of the kernel's
+    MemAvailable, the address space this process may still map (``ulimit -v``) and
+    what its memory cgroup has left (a container's or a batch job's limit)."""
     override = memory_override()
     if override is not None:
         return override
+    known = [v for v in (_free_memory(), _address_space_left(), _cgroup_left()) if v is not None]
+    return max(0, min(known)) if known else 8 * 2**30
+
+
+def _free_memory() -> int | None:
     try:
         with open("/proc/meminfo", encoding="ascii") as meminfo:
             for line in meminfo:
                 if line.startswith("MemAvailable:"):
                     return int(line.split()[1]) * 1024
-    except OSError:
+    except (OSError, ValueError):
         pass
     try:
         return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
     except (OSError, ValueError):
-        return 8 * 2**30
+        return None
+
+
+def _address_space_left() -> int | None:
+    """``RLIMIT_AS`` less the address space already mapped; None without a limit."""
+    try:
+        import resource
+    except ImportError:  # not a POSIX system
+        return None
+    soft = resource.getrlimit(resource.RLIMIT_AS)[0]
+    if soft == resource.RLIM_INFINITY or soft < 0:
+        return None
+    return soft - (_status_bytes("VmSize:") or 0)
+
+
+def _status_bytes(key: str) -> int | None:
+    try:
+        with open("/proc/self/status", encoding="ascii") as status:
+            for line in status:
+                if line.startswith(key):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError):
+        pass
+    return None
+
+
+_CGROUP_ROOT = "/sys/fs/cgroup"
+_PROC_CGROUP = "/proc/self/cgroup"
+_NO_CGROUP_LIMIT = 2**60  # cgroup v1 writes "no limit" as a number near 2**63
+
+
+def _cgroup_left() -> int | None:
+    """The memory limit of this process's cgroup (v2 ``memory.max``, v1
+    ``memory.limit_in_bytes``) less its usage; None without one. A container sees its
+    own cgroup at the root of the mount, so the root is read where the path is not there.
+    Usage counts the page cache, which the kernel gives back: its file pages are left out."""
+    try:
+        with open(_PROC_CGROUP, encoding="ascii") as groups:
+            lines = groups.read().splitlines()
+    except OSError:
+        return None
+    for line in lines:
+        parts = line.split(":", 2)
+        if len(parts) != 3:
+            continue
+        _, controllers, path = parts
+        if controllers == "":
+            found = _cgroup_files(_CGROUP_ROOT, path, "memory.max", "memory.current", "")
+        elif "memory" in controllers.split(","):
+            found = _cgroup_files(
+                os.path.join(_CGROUP_ROOT, "memory"),
+                path,
+                "memory.limit_in_bytes",
+                "memory.usage_in_bytes",
+                "total_",
+            )
+        else:
+            continue
+        if found is not None:
+            return found
+    return None
+
+
+def _cgroup_files(mount: str, path: str, limit_name: str, usage_name: str, stat_prefix: str) -> int | None:
+    for folder in (os.path.join(mount, path.lstrip("/")), mount):
+        try:
+            with open(os.path.join(folder, limit_name), encoding="ascii") as handle:
+                limit_text = handle.read().strip()
+            with open(os.path.join(folder, usage_name), encoding="ascii") as handle:
+                usage = int(handle.read().strip())
+        except (OSError, ValueError):
+            continue
+        if limit_text == "max" or not limit_text.isdigit() or int(limit_text) >= _NO_CGROUP_LIMIT:
+            return None
+        cache = _cgroup_stat(folder, (stat_prefix + "inactive_file", stat_prefix + "active_file"))
+        return int(limit_text) - max(0, usage - cache)
+    return None
+
+
+def _cgroup_stat(folder: str, keys: tuple[str, ...]) -> int:
+    """The sum of ``keys`` in the cgroup's ``memory.stat`` (0 where unread)."""
+    total = 0
+    try:
+        with open(os.path.join(folder, "memory.stat"), encoding="ascii") as handle:
+            for line in handle:
+                name, _, value = line.partition(" ")
+                if name in keys and value.strip().isdigit():
+                    total += int(value)
+    except OSError:
+        pass
+    return total
 
 
 _max_rays_flag: int | None = None
