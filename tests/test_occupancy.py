@@ -242,3 +242,58 @@ def test_a_negative_index_is_named_as_such_not_against_a_shape_it_made():
     assert (
         str(caught.value) == "voxels[0] = (0, 0, 5): expected voxel indices inside the scene shape (5, 5, 5)"
     )
+
+
+def test_a_few_voxels_over_a_huge_box_take_memory_for_what_they_hold(tmp_path, capsys):
+    """116 voxels spread over 10 km x 10 km x 1 km at 0.25 m were refused: 'need about 420
+    GiB for the tracing structures', the empty cubes and halos of the whole box; they are
+    left out where the content is this small for its box."""
+    from ladartui.cli import main
+    from ladartui.resources import occupancy_bytes
+
+    rng = np.random.default_rng(5)
+    far = np.array([40000, 40000, 4000])
+    vox = np.concatenate([[[0, 0, 0], far - 1], rng.integers(0, far, size=(114, 3))])
+    estimate = occupancy_bytes(vox.min(axis=0), vox.max(axis=0) + 1, len(vox))
+    import tracemalloc
+
+    Occupancy.build(vox[:3])  # kernels loaded before measuring
+    tracemalloc.start()
+    occ = Occupancy.build(vox)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert occ.nbytes <= peak <= estimate < 150 * 2**20  # the column tops (4 bytes a brick column) and nodes
+    assert occ.cubes is None and occ.halo is None and occ.halo4 is None
+    assert occ.contains(vox).all() and occ.count == len(vox)
+    path = tmp_path / "far.txt"
+    path.write_text("".join(f"{x},{y},{z}\n" for x, y, z in vox))
+    assert main(["info", str(path)]) == 0
+    assert "occupancy" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_an_occupancy_without_the_box_sized_accelerations_traces_the_same(monkeypatch, seed):
+    from ladartui import resources
+    from ladartui.tracing.backend import get_backend
+
+    rng = np.random.default_rng(seed)
+    shape = (300, 260, 90)
+    vox = _random_scene(rng, shape, 20_000)
+    dense = Occupancy.build(vox, shape)
+    monkeypatch.setattr(resources, "ACCELERATION_FLOOR", 0)
+    monkeypatch.setattr(resources, "ACCELERATION_SHARE", 0)
+    sparse = Occupancy.build(vox, shape)
+    assert dense.cubes is not None and sparse.cubes is None
+    for field in ("root", "regions", "tiles", "bricks", "columns", "blocks"):
+        assert np.array_equal(getattr(sparse, field), getattr(dense, field)), field
+    o = np.column_stack(
+        [rng.uniform(-50, 350, 20_000), rng.uniform(-50, 310, 20_000), rng.uniform(60, 200, 20_000)]
+    )
+    d = rng.normal(size=(20_000, 3))
+    d[:, 2] = -np.abs(d[:, 2]) - 0.3
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    backend = get_backend("numba")
+    a = backend.trace_cells(dense, o, d, method="exact")
+    b = backend.trace_cells(sparse, o, d, method="exact")
+    assert (a.kind == 1).sum() > 1000
+    assert np.array_equal(a.kind, b.kind) and np.array_equal(a.index, b.index) and np.array_equal(a.t, b.t)

@@ -202,30 +202,67 @@ def _env_limit(name: str, expected: str) -> int | None:
     return int(value)
 
 
+# The extent-sized accelerations (empty cubes, halos) are built while they cost at most
+# this, or ACCELERATION_SHARE times the content's nodes; a few voxels spread over a big
+# box go without them (same answers, slower through the empty space), so memory follows
+# what the scene holds.
+ACCELERATION_FLOOR = 256 * 2**20
+ACCELERATION_SHARE = 4
+# Per voxel, a build without them sorts the voxels' brick keys (a key, its sorted copy,
+# its brick number) in place of the grid of brick cells.
+_SORTED_VOXEL_BYTES = 40
+
+
 def occupancy_bytes(lo, hi, count) -> int:
     """Estimated peak bytes to build the occupancy of ``count`` voxels spanning ``lo..hi``.
 
-    The extent-sized arrays (root grid, column tops, empty-cube distances,
-    halo bits) dominate when voxels are few and far apart.
+    The root grid and the column tops are sized by the extent (coarsely); the empty
+    cubes and halos too, when ``builds_accelerations`` says they are built.
     """
-    lo = np.asarray(lo, dtype=object)  # Python ints: extents near 2**31 overflow int64 products
-    hi = np.asarray(hi, dtype=object)
-    last = hi - 1
+    lo, last = _corners(lo, hi)
     root = [int(b >> 9) - int(a >> 9) + 1 for a, b in zip(lo, last)]
-    cubes = [int(b >> 3) - int(a >> 3) + 1 for a, b in zip(lo, last)]
-    cells4 = [int(b >> 2) - int(a >> 2) + 3 for a, b in zip(lo, last)]
     size = 4 * root[0] * root[1] * root[2]
     size += 4 * (root[0] * 64) * (root[1] * 64)  # column tops
+    nodes = _node_bytes(lo, last, count)
+    accelerations = _acceleration_bytes(lo, last)
+    if _affordable(accelerations, nodes):
+        return int(size + nodes + accelerations)
+    return int(size + nodes + _SORTED_VOXEL_BYTES * int(count))
+
+
+def builds_accelerations(lo, hi, count) -> bool:
+    """Whether the occupancy of ``count`` voxels spanning ``lo..hi`` gets the empty cubes
+    and halos: when they cost at most ACCELERATION_FLOOR or ACCELERATION_SHARE times the
+    content's nodes."""
+    lo, last = _corners(lo, hi)
+    return _affordable(_acceleration_bytes(lo, last), _node_bytes(lo, last, count))
+
+
+def _affordable(accelerations: int, nodes: int) -> bool:
+    return accelerations <= max(ACCELERATION_FLOOR, ACCELERATION_SHARE * nodes)
+
+
+def _corners(lo, hi):
+    lo = np.asarray(lo, dtype=object)  # Python ints: extents near 2**31 overflow int64 products
+    return lo, np.asarray(hi, dtype=object) - 1
+
+
+def _acceleration_bytes(lo, last) -> int:
+    cubes = [int(b >> 3) - int(a >> 3) + 1 for a, b in zip(lo, last)]
+    cells4 = [int(b >> 2) - int(a >> 2) + 3 for a, b in zip(lo, last)]
     # the brick cells: a 0/1 grid (kept for the empty cubes' 4 octants) and a brick number each
-    size += (1 + 4 + 4) * cubes[0] * cubes[1] * cubes[2]
+    size = (1 + 4 + 4) * cubes[0] * cubes[1] * cubes[2]
     # halos: a bool grid, its grown copy and a temporary of the growing, then the bits
     size += 3 * (cubes[0] + 2) * (cubes[1] + 2) * (cubes[2] + 2)  # brick halo
     size += 3 * cells4[0] * cells4[1] * cells4[2]  # 4-voxel halo
+    return size
+
+
+def _node_bytes(lo, last, count) -> int:
     count = int(count)
-    nodes = _BRICK_BYTES * min(count, _cells(lo, last, 3)) + _NODE_BYTES * (
+    return _BRICK_BYTES * min(count, _cells(lo, last, 3)) + _NODE_BYTES * (
         min(count, _cells(lo, last, 6)) + min(count, _cells(lo, last, 9))
     )
-    return int(size + nodes)
 
 
 def _cells(lo, last, shift) -> int:

@@ -20,7 +20,9 @@ blocks, cubes and halo are optional accelerations a tracer may ignore.
 
 Inside any node the local position (lx, ly, lz), each 0..7, is linear
 ``l = lx + 8 * ly + 64 * lz``; a brick's bit ``l`` is bit ``l & 31`` of word ``l >> 5``.
-Memory grows with the content only: one node per non-empty cell at its level.
+Memory grows with the content: one node per non-empty cell at its level. The root
+grid and column tops are sized by the box coarsely; cubes and halos are built only
+while affordable for the content (``resources.builds_accelerations``), else left None.
 """
 
 from __future__ import annotations
@@ -156,11 +158,13 @@ class Occupancy:
                 if negative
                 else f"voxel indices inside the scene shape ({', '.join(str(n) for n in shape)})",
             )
-        from ladartui.resources import check_occupancy
+        from ladartui.resources import builds_accelerations, check_occupancy
 
         # Some arrays are sized by extent: refuse before allocating what cannot fit.
         check_occupancy(lo, hi, len(vox), source)
-        return cls._from_nonempty(vox, lo, hi, shape)
+        if builds_accelerations(lo, hi, len(vox)):
+            return cls._from_nonempty(vox, lo, hi, shape)
+        return cls._sparse(vox, lo, hi, shape)
 
     @classmethod
     def _empty(cls, shape):
@@ -255,6 +259,44 @@ class Occupancy:
             halo4_dims.astype(np.int64),
         )
 
+    @classmethod
+    def _sparse(cls, vox, lo, hi, shape):
+        """The hierarchy of voxels few for their box, without the extent-sized empty
+        cubes and halos: the bricks come from the voxels' sorted brick keys, not a grid
+        of the box's brick cells."""
+        root_origin = (lo >> REGION_SHIFT) << REGION_SHIFT
+        root_dims = ((hi - 1) >> REGION_SHIFT) - (lo >> REGION_SHIFT) + 1
+        keys = np.empty(len(vox), np.int64)
+        for a in range(0, len(vox), _CHUNK):
+            q = (vox[a : a + _CHUNK].astype(np.int64) - root_origin) >> BRICK_SHIFT
+            keys[a : a + _CHUNK] = _keys_of_bricks(q[:, 0], q[:, 1], q[:, 2], root_dims)
+        bkeys = np.unique(keys)
+        n_bricks = len(bkeys)
+        bricks = np.zeros(n_bricks * BRICK_WORDS, np.uint32)
+        count = 0
+        for a in range(0, len(vox), _CHUNK):
+            brick_of_voxel = np.searchsorted(bkeys, keys[a : a + _CHUNK]).astype(np.int64)
+            count += _set_bits_of_bricks(vox[a : a + _CHUNK], brick_of_voxel, bricks)
+        del keys
+        tiles, tkeys = _parents(bkeys, n_bricks)
+        regions, rkeys = _parents(tkeys, len(tkeys))
+        root = np.zeros(int(np.prod(root_dims)), np.uint32)
+        root[rkeys] = np.arange(1, len(rkeys) + 1, dtype=np.uint32)
+        return cls(
+            shape,
+            lo.astype(np.int64),
+            hi.astype(np.int64),
+            root_origin.astype(np.int64),
+            root_dims.astype(np.int64),
+            root,
+            regions,
+            tiles,
+            bricks,
+            count,
+            _column_tops(bkeys, root_dims),
+            block_masks(bricks),
+        )
+
     @property
     def nbytes(self) -> int:
         """Bytes held by the hierarchy arrays."""
@@ -324,11 +366,40 @@ def _brick_keys(cells, cube_dims, root_offset, root_dims):
     into a ``cube_dims`` box whose cell 0 is brick ``root_offset`` from the root
     origin): root cell << 18 | region slot << 9 | tile slot, the order of bricks."""
     dx, dy = int(cube_dims[0]), int(cube_dims[1])
-    q = [cells % dx + root_offset[0], cells // dx % dy + root_offset[1], cells // (dx * dy) + root_offset[2]]
-    key = (q[0] >> 6) + root_dims[0] * ((q[1] >> 6) + root_dims[1] * (q[2] >> 6))
+    return _keys_of_bricks(
+        cells % dx + root_offset[0],
+        cells // dx % dy + root_offset[1],
+        cells // (dx * dy) + root_offset[2],
+        root_dims,
+    )
+
+
+def _keys_of_bricks(qx, qy, qz, root_dims):
+    """The key of each brick ``q = (c - root_origin) >> 3``: root cell << 18 | region
+    slot << 9 | tile slot."""
+    key = (qx >> 6) + root_dims[0] * ((qy >> 6) + root_dims[1] * (qz >> 6))
     for shift in (3, 0):
-        key = (key << 9) | ((q[0] >> shift) & 7) | (((q[1] >> shift) & 7) << 3) | (((q[2] >> shift) & 7) << 6)
+        key = (key << 9) | ((qx >> shift) & 7) | (((qy >> shift) & 7) << 3) | (((qz >> shift) & 7) << 6)
     return key
+
+
+# voxels a step of a sparse build works on: its int64 temporaries stay tens of megabytes
+_CHUNK = 1 << 20
+
+
+@njit(nogil=True, cache=True)
+def _set_bits_of_bricks(vox, brick_of_voxel, bricks):
+    # Each voxel's bit in its brick (brick_of_voxel[i]); returns the number newly set.
+    count = 0
+    for i in range(vox.shape[0]):
+        x, y, z = vox[i, 0], vox[i, 1], vox[i, 2]
+        bit = (x & 7) | ((y & 7) << 3) | ((z & 7) << 6)
+        word = brick_of_voxel[i] * BRICK_WORDS + (bit >> 5)
+        mask = np.uint32(1) << np.uint32(bit & 31)
+        if not bricks[word] & mask:
+            bricks[word] |= mask
+            count += 1
+    return count
 
 
 @njit(nogil=True, cache=True)
