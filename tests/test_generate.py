@@ -185,6 +185,12 @@ def test_to_scene_keeps_the_grid(small):
         # a vehicle lost at 30 m voxels ('no target'), nothing left at 1000 m (a traceback)
         ({"voxel_size": 30.0}, "voxel_size = 30.0: expected at most 1.1 m (half the vehicle's"),
         ({"voxel_size": 1000.0, "vehicles": 0}, "voxel_size = 1000.0: expected at most 7.5 m (an eighth"),
+        # 1 mm over the reference area said only 'a size giving at most 1e8 ground cells'
+        (
+            {"voxel_size": 0.001},
+            "voxel_size = 0.001: expected a size giving at most 1e8 ground cells "
+            "(0.001 m gives 3.6e+09 over 60 x 60 m)",
+        ),
         # any text was true: terrain = "false" made terrain
         ({"terrain": "false"}, "terrain = 'false': expected True or False"),
         ({"camouflage": 1}, "camouflage = 1: expected True or False"),

@@ -343,7 +343,12 @@ def _check(p: SceneParams):
         raise FieldError("voxel_size", p.voxel_size, f"at most {coarsest:g} m ({why})")
     cells = (p.width / p.voxel_size) * (p.depth / p.voxel_size)
     if cells > 1e8:
-        raise FieldError("voxel_size", p.voxel_size, "a size giving at most 1e8 ground cells")
+        raise FieldError(
+            "voxel_size",
+            p.voxel_size,
+            f"a size giving at most 1e8 ground cells ({p.voxel_size:g} m gives {cells:.2g} "
+            f"over {p.width:g} x {p.depth:g} m)",
+        )
     if p.vehicles and min(p.width, p.depth) < max(p.vehicle_size[:2]) + 4:
         raise FieldError("width", p.width, "room for the vehicle and 2 m around it")
 
