@@ -377,3 +377,40 @@ def test_a_misspelt_setting_or_a_file_nested_too_deep_is_reported(tmp_path):
     ]
     path.write_text("a = " + "[" * 3000 + "]" * 3000 + "\n")
     assert read_setting(tmp_path) == ("auto", [f"{path}: nested too deep to read"])
+
+
+@pytest.mark.parametrize("mode", ["halfblocks", "characters"])
+async def test_the_views_draw_in_greys_where_no_color_is_set(tmp_path, scene_files, monkeypatch, mode):
+    """NO_COLOR (Textual reads it) turns every colour grey; the app opened with it had
+    stopped on its first frame with a traceback, the views' blank cells having no style."""
+    from textual.geometry import Region
+
+    from ladartui.tui.app import LadarApp
+    from ladartui.tui.canvas import PictureWidget
+    from tui_support import make_scenario
+
+    monkeypatch.setenv("NO_COLOR", "1")
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path, compile_in_child=False, graphics=Graphics(mode, False, "set"))
+    async with app.run_test(size=(120, 40)) as pilot:
+        assert app.no_color
+        await _loaded(pilot)
+        for layout in (1, 2, 3, 4, 5):  # each view drawn, the output's placeholder too
+            app.action_layout(layout)
+            await pilot.pause(0.2)
+        for view in app.query(PictureWidget):
+            width, height = view.size
+            # the view's lines as they reach the terminal, NO_COLOR's filter applied
+            strips = view.render_lines(Region(0, 0, width, height))
+            colours = {
+                colour.get_truecolor()
+                for strip in strips
+                for seg in strip
+                if seg.style is not None
+                for colour in (seg.style.color, seg.style.bgcolor)
+                if colour is not None
+            }
+            assert all(r == g == b for r, g, b in colours), view.id
+            if view.id != "output3d":  # nothing run: the output view is its placeholder
+                assert len(colours) > 5, view.id  # the picture is drawn, in several greys
+    assert app.return_code in (None, 0)

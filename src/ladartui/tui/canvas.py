@@ -28,6 +28,9 @@ from ladartui.render.raster import OVERLAYS, Layer, Overlays, render
 from ladartui.views import Camera, Picture
 
 UPPER = "\u2580"
+# every cell drawn gets a style, blank ones too: Textual's filters (NO_COLOR's
+# monochrome) read each segment's style and fail on one without
+BLANK = Style.null()
 MAX_IMAGE_SIDE = 960  # pixels: the terminal scales the picture up to the view
 LOWER = "\u2584"
 
@@ -50,7 +53,7 @@ def picture_strips(picture: Picture, use_256: bool = False) -> list[Strip]:
             p = rgb[r, c]
             return Color.from_rgb(int(p[0]), int(p[1]), int(p[2]))
 
-    styles: dict = {}
+    styles: dict = {None: BLANK}
     strips = []
     rows, cols = top_mask.shape
     for r in range(rows):
@@ -105,7 +108,7 @@ def character_strips(picture: Picture, use_256: bool = False) -> list[Strip]:
         segments = []
         for c in range(cols):
             if not picture.mask[r, c]:
-                segments.append(Segment("  "))
+                segments.append(Segment("  ", BLANK))
                 continue
             key = int(codes[r, c]) if codes is not None else tuple(int(v) for v in picture.rgb[r, c])
             style = styles.get(key)
@@ -247,17 +250,17 @@ class PictureWidget(Widget, can_focus=True):
                 shown = self.image_view is not None and self.image_view.display
                 # wrapped, not cut: "no output yet: F5 run" read as another key's word
                 lines = [] if shown or width < 1 else textwrap.wrap(self.placeholder, width)[:height]
-                blank = [Strip.blank(width)] * height
+                blank = [Strip.blank(width, BLANK)] * height
                 top = (height - len(lines)) // 2
                 for row, text in enumerate(lines, start=top):
                     blank[row] = Strip([Segment(text.center(width), Style(dim=True))], width)
                 self._strips = blank
             else:
                 draw = character_strips if self.characters else picture_strips
-                self._strips = [s.extend_cell_length(width) for s in draw(picture, self._use_256())]
+                self._strips = [s.extend_cell_length(width, BLANK) for s in draw(picture, self._use_256())]
         if y < len(self._strips):
             return self._strips[y]
-        return Strip.blank(width)
+        return Strip.blank(width, BLANK)
 
 
 def top_view_width(metres: float) -> str:
