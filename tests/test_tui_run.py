@@ -114,6 +114,11 @@ async def test_a_run_disables_controls_and_cancel_keeps_earlier_outputs(tmp_path
         await pilot.press("ctrl+s")  # does nothing while busy, and says why
         assert scenario.path.read_bytes() == saved
         assert app.messages[-1] == "Save scenario is off while the run goes on; Esc cancels the run."
+        # Ctrl+C, the reflex to stop it, copies in a terminal app: it says how to cancel
+        # and quit, where it had said nothing while the run went on
+        await pilot.press("ctrl+c")
+        assert app.run_in_progress()
+        assert app.messages[-1] == "Ctrl+C does not stop the run: Esc cancels it; Ctrl+Q quits."
         await pilot.press("escape")
         await wait_until(pilot, lambda: app.busy is None, timeout=30)
         assert "cancelled" in app.messages[-1].lower()

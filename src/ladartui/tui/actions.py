@@ -175,6 +175,7 @@ DISPLAY_ACTIONS = {
     "view_angle",
     "threshold",
     "quit",
+    "help_quit",  # Ctrl+C: how to cancel and quit (RunControl)
     "command_palette",
     "show_tab",
     "cancel_run",

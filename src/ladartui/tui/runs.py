@@ -71,6 +71,15 @@ class RunControl(Host):
             worker.cancel()
             self.set_busy("Cancelling: earlier outputs stay as they were...", self.progress)
 
+    def action_help_quit(self) -> None:
+        """Ctrl+C: a terminal app's copy, which Textual follows with how to quit. During
+        a run, the reflex to stop it, it says how to cancel the run as well."""
+        if not self.run_in_progress():
+            super().action_help_quit()
+            return
+        cancel = self.key_says("cancel", "cancels it")
+        self.tell("Ctrl+C does not stop the run" + (f": {cancel}" if cancel else "") + "; Ctrl+Q quits.")
+
     def run_finished(
         self, result: SimulationResult | None = None, cancelled: bool = False, error: str | None = None
     ) -> None:
