@@ -362,3 +362,46 @@ async def test_the_3d_views_open_on_the_whole_flight_and_an_edit_does_not_move_t
         app.action_view("fit_path")  # (p in a view) the whole flight again
         await pilot.pause()
         assert all(all_in_view(view) for view in views)
+
+
+def contrast(a, b) -> float:
+    """The WCAG contrast ratio of two colours (1 to 21)."""
+
+    def luminance(colour) -> float:
+        def linear(v: int) -> float:
+            c = v / 255
+            return c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4
+
+        r, g, b = colour.get_truecolor()
+        return 0.2126 * linear(r) + 0.7152 * linear(g) + 0.0722 * linear(b)
+
+    lighter, darker = sorted((luminance(a), luminance(b)), reverse=True)
+    return (lighter + 0.05) / (darker + 0.05)
+
+
+@pytest.mark.asyncio(loop_scope="module")
+@pytest.mark.parametrize("theme", ["textual-dark", "textual-light", "solarized-light", "nord"])
+async def test_the_views_titles_read_in_every_theme(app_pilot, theme):
+    """In a light theme (the palette's Theme) the views' titles, which carry the camera
+    and the top view's width, were drawn near white on a near-white border line."""
+    from textual.geometry import Region
+
+    from ladartui.tui.canvas import PictureWidget
+
+    pilot = app_pilot
+    app, area = await reset(pilot)
+    app.theme = theme
+    await pilot.pause()
+    try:
+        for view in app.query(PictureWidget):
+            width = view.outer_size.width
+            top = view.render_lines(Region(0, 0, width, 1))[0]
+            title = str(view.border_title)
+            segments = [seg for seg in top if seg.text.strip() and seg.text.strip() in title]
+            assert segments, (view.id, title, top.text)
+            for seg in segments:
+                ratio = contrast(seg.style.color, seg.style.bgcolor)
+                assert ratio >= 4.5, (theme, view.id, seg.text, round(ratio, 2))
+    finally:
+        app.theme = "textual-dark"
+        await pilot.pause()

@@ -136,6 +136,9 @@ class PictureWidget(Widget, can_focus=True):
 
     DEFAULT_CSS = """
     PictureWidget { width: 1fr; height: 1fr; border: round $panel-lighten-2; }
+    /* the title (the camera, the top view's width) in the text colour, not the faint
+       border's, which in a light theme is near white on near white */
+    PictureWidget { border-title-color: $foreground; }
     PictureWidget:focus { border: round $accent; }
     PictureWidget > .view-image { width: 1fr; height: 1fr; }
     """
