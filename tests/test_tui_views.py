@@ -405,3 +405,34 @@ async def test_the_views_titles_read_in_every_theme(app_pilot, theme):
     finally:
         app.theme = "textual-dark"
         await pilot.pause()
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_w_a_s_d_move_the_3d_views_and_the_top_view_the_same_way(app_pilot):
+    """The top view's d showed more to the east, its picture sliding left; the 3D views'
+    d slid their picture right, showing more to the west: one key, two directions."""
+    from ladartui.views import project_float
+
+    pilot = app_pilot
+    app, area = await reset(pilot)
+    scene3d = app.query_one("#scene3d", ProjectionWidget)
+    top = app.query_one(TopViewWidget)
+    target_m = np.array(area.prepared["target_m"])
+
+    def on_top():  # the target's (row, col) pixel in the top view
+        rows, cols = top.picture_size()
+        return top.top.to_pixels(target_m[None, :2], rows, cols, top.frame)[0]
+
+    def in_3d():  # ... and in the 3D scene view
+        rows, cols = scene3d.picture_size()
+        row, col, _, _ = project_float(target_m / area.voxel_size, scene3d.camera, rows, cols, scene3d.bounds)
+        return np.array([row[0], col[0]])
+
+    for key, moved in (("d", (0, -1)), ("a", (0, 1)), ("w", (1, 0)), ("s", (-1, 0))):
+        for view, where in ((top, on_top), (scene3d, in_3d)):
+            view.focus()
+            before = where()
+            await pilot.press(key)
+            step = where() - before
+            # the picture slides against the key: d shows more to the right, w more above
+            assert np.sign(step).tolist() == list(moved), (key, view.id, step)

@@ -404,10 +404,11 @@ class ProjectionWidget(PictureWidget):
         Binding("down", "rotate(0, -10)", "Tilt down", show=False),
         Binding("plus,equals_sign", "zoom(1.25)", "Zoom in", show=False),
         Binding("minus", "zoom(0.8)", "Zoom out", show=False),
-        Binding("w", "pan(0, 0.05)", "Pan up", show=False),
-        Binding("s", "pan(0, -0.05)", "Pan down", show=False),
-        Binding("a", "pan(-0.05, 0)", "Pan left", show=False),
-        Binding("d", "pan(0.05, 0)", "Pan right", show=False),
+        # the view moves, its picture the other way (as the top view's window does)
+        Binding("w", "pan(0, -0.05)", "Pan up", show=False),
+        Binding("s", "pan(0, 0.05)", "Pan down", show=False),
+        Binding("a", "pan(0.05, 0)", "Pan left", show=False),
+        Binding("d", "pan(-0.05, 0)", "Pan right", show=False),
         Binding("0", "reset_view", "Reset view", show=False),
         *VIEW_BINDINGS,
     ]
