@@ -119,6 +119,15 @@ async def test_a_run_disables_controls_and_cancel_keeps_earlier_outputs(tmp_path
         await pilot.press("ctrl+c")
         assert app.run_in_progress()
         assert app.messages[-1] == "Ctrl+C does not stop the run: Esc cancels it; Ctrl+Q quits."
+        # a click on a dimmed key in the footer says why, as the key does (it rang the bell)
+        from textual.widgets._footer import FooterKey
+
+        (compare,) = [k for k in app.query(FooterKey) if k.key == "f10"]
+        assert compare.has_class("-disabled")
+        # at its place on the screen, as a terminal's click comes (not addressed to it)
+        await pilot.click(offset=compare.region.offset + (1, 0))
+        assert app.run_in_progress() and not app.screen_stack[1:]
+        assert app.messages[-1] == "Compare is off while the run goes on; Esc cancels the run."
         await pilot.press("escape")
         await wait_until(pilot, lambda: app.busy is None, timeout=30)
         assert "cancelled" in app.messages[-1].lower()

@@ -106,6 +106,9 @@ class AppHost(App[None]):
     def key_note(self, command_id: str) -> str:
         raise NotImplementedError
 
+    def tell_why_off(self, what: str, action: str) -> None:
+        raise NotImplementedError
+
     def refresh_status(self) -> None:
         raise NotImplementedError
 

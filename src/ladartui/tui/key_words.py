@@ -3,6 +3,10 @@ user's keys.toml may remap it (``actions.keys_in_force``), never "F5" written ou
 
 from __future__ import annotations
 
+from textual import events
+from textual.errors import NoWidget
+from textual.widgets._footer import FooterKey
+
 from ladartui.tui import actions
 from ladartui.tui.host import Host
 
@@ -23,3 +27,15 @@ class KeyWords(Host):
     def key_note(self, command_id: str) -> str:
         """ " (F5)" after the advice that names the command ("run the scenario first (F5)")."""
         return actions.key_note(command_id, self.keymap)
+
+    def on_mouse_down(self, event: events.MouseDown) -> None:
+        """A click on a dimmed key in the footer says why its command is off, as pressing
+        the key does (``LadarApp.on_key``); the footer itself only rings the bell."""
+        if len(self.screen_stack) > 1:  # a dialog or tool screen: its own footer
+            return
+        try:  # what is under the pointer (a terminal's click is addressed to no widget)
+            key, _ = self.get_widget_at(*event.screen_offset)
+        except NoWidget:
+            return
+        if isinstance(key, FooterKey) and key.has_class("-disabled"):
+            self.tell_why_off(key.description or key.action, key.action)
