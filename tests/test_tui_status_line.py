@@ -176,3 +176,31 @@ async def test_a_scenario_over_the_ray_limit_opens_not_ready_and_runs_once_cut_d
         await pilot.press("f5")
         await pilot.pause()
         assert [run.sensor.grid for run in runs] == [7]
+
+
+async def test_an_output_name_a_folder_holds_turns_the_bar_yellow(tmp_path, scene_files):
+    """A folder of the scene output's name left the bar green, 'F5 runs.', and F5 failed
+    at once (``ladartui validate`` refused that run before it traced). The outputs are
+    looked at as before, no more often: at opening, after a failed run, and every 2 s
+    while one is held."""
+    from ladartui.tui.status import NOT_READY, READY
+    from tui_support import opened
+
+    scenario = make_scenario(tmp_path, scene_files)
+    folder = scenario.scene_output
+    folder.mkdir()
+    async with opened(scenario, size=(100, 30)) as (app, pilot):
+        await pilot.pause()
+        bar = app.query_one(StatusBar)
+        assert bar.state == NOT_READY
+        assert bar.message == f"output {folder.name} is a folder, expected a file name", bar.message
+        await pilot.press("f5")
+        await pilot.pause()
+        assert not app.run_in_progress()
+        assert app.messages[-1] == f"Run is off: output {folder.name} is a folder, expected a file name."
+        folder.rmdir()  # cleared: the next look finds it gone
+        await wait_until(pilot, lambda: bar.state == READY, timeout=10)
+        folder.mkdir()  # made again while the app shows the bar green: F5 finds it
+        await pilot.press("f5")
+        await wait_until(pilot, lambda: not app.run_in_progress() and bar.state == NOT_READY, timeout=60)
+        assert bar.message == f"output {folder.name} is a folder, expected a file name", bar.message

@@ -97,6 +97,7 @@ class LadarApp(
         self.shown_before_run: tuple = (None, None)  # the outputs a cancelled run shows again
         self.missing_outputs: list[Path] = []
         self.outputs_interrupted = False  # a killed run's swap is on disk (not read)
+        self.output_blocked: str | None = None  # an output's name held by a folder (loading)
         self.outputs_from: Scenario | None = None  # the settings that made the outputs shown
         self.inputs_changed: list[str] = []  # the files they read that changed since their run
         self.changed_since_opened: list[str] = []  # read here before they changed (reopen)
@@ -219,7 +220,7 @@ class LadarApp(
             status = {name: ok for name, _, ok in rows}
             if not status.get(self.scenario.backend, True):
                 out.append(f"backend {self.scenario.backend} unavailable")
-        refusal = bridge.run_refusal(self.scenario)
+        refusal = bridge.run_refusal(self.scenario) or self.output_blocked
         if refusal:
             out.append(refusal)
         return out

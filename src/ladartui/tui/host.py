@@ -50,6 +50,7 @@ class AppHost(App[None]):
     shown_before_run: tuple  # (output_voxels, disk_outputs) while a run goes on
     missing_outputs: list[Path]
     outputs_interrupted: bool  # a run was stopped while it replaced the outputs
+    output_blocked: str | None  # an output's name that a folder or special file holds
     outputs_from: Scenario | None  # the settings that made the outputs shown
     inputs_changed: list[str]  # their model files and flight logs changed since (out of date)
     changed_since_opened: list[str]  # names of those the app read before they changed on disk

@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ladartui.errors import LadarError
+from ladartui.fileprobe import SPECIAL_FILE
 from ladartui.fingerprint import file_fingerprint
 from ladartui.recent import remember_scenario
 from ladartui.run_record import (
@@ -56,6 +57,8 @@ class OutputFiles:
     # a run was stopped while it replaced them (simulation.swap_interrupted): neither
     # read nor called missing; the next run puts the earlier set back first
     interrupted: bool = False
+    # an output's name that a folder or a special file holds: the run would be refused
+    blocked: str | None = None
 
 
 @dataclass
@@ -133,6 +136,7 @@ class SceneLoading(Host):
         self.view_area.set_scene(done.prepared, done.scene.voxel_size)
         self.missing_outputs = done.earlier.files.missing
         self.outputs_interrupted = done.earlier.files.interrupted
+        self.output_blocked = done.earlier.files.blocked
         self.outputs_from = done.earlier.made_with  # before the status is drawn
         self.inputs_changed = done.earlier.inputs_changed
         self.changed_since_opened = done.earlier.changed_since_opened
@@ -173,6 +177,7 @@ class SceneLoading(Host):
         self.outputs_seen = files.seen  # the ones about to be shown: no other run's
         self.missing_outputs = files.missing
         self.outputs_interrupted = files.interrupted
+        self.output_blocked = files.blocked
         if files.readable:
             scene = self.scene
             start_job(self, "earlier", lambda cancel, progress: _earlier(scenario, files, scene))
@@ -194,6 +199,12 @@ class SceneLoading(Host):
         self.check_inputs_on_disk()
         if self.check_swap_on_disk(scenario):
             return
+        if self.output_blocked:  # looked at again while an output's name is held
+            files = look_at_outputs(scenario)
+            if files.blocked != self.output_blocked:
+                self.show_outputs_of(scenario, files)
+                self.scenario_changed()
+                return
         measures = _file_status(scenario.measures_file)
         now = _stamp(measures)
         if now == self.outputs_seen:
@@ -539,12 +550,22 @@ def outputs_with(scenario, measures: os.stat_result | None) -> OutputFiles:
         scenario.measures_file: measures,
     }
     is_file = {path: status is not None and stat.S_ISREG(status.st_mode) for path, status in found.items()}
+    blocked = next(
+        (
+            f"output {path.name} {'is a folder' if stat.S_ISDIR(status.st_mode) else SPECIAL_FILE}, "
+            "expected a file name"
+            for path, status in found.items()
+            if status is not None and not is_file[path]
+        ),
+        None,
+    )
     if swap_interrupted(scenario):
         return OutputFiles(readable=False, missing=[], seen=_stamp(measures), interrupted=True)
     return OutputFiles(
         readable=is_file[scenario.scene_output] and is_file[scenario.measures_file],
         missing=missing_outputs(scenario, is_file.__getitem__),
         seen=_stamp(measures),
+        blocked=blocked,
     )
 
 

@@ -19,6 +19,7 @@ from textual.widgets import TabbedContent
 
 from ladartui.errors import Cancelled
 from ladartui.tui.host import Host
+from ladartui.tui.loading import look_at_outputs
 from ladartui.tui.measures_screens import MeasuresScreen
 from ladartui.tui.status import format_eta
 from ladartui.tui.work import running, start_job
@@ -98,6 +99,9 @@ class RunControl(Host):
             return
         if error or result is None:
             self.run_panel.say(error or "Run failed: no result.")
+            if self.scenario is not None:  # refused for an output's name a folder took since?
+                self.output_blocked = look_at_outputs(self.scenario).blocked
+                self.refresh_status()
             return
         self.result = result
         self.missing_outputs, self.outputs_interrupted = [], False  # (it put the earlier set back first)
