@@ -204,3 +204,30 @@ async def test_an_output_name_a_folder_holds_turns_the_bar_yellow(tmp_path, scen
         await pilot.press("f5")
         await wait_until(pilot, lambda: not app.run_in_progress() and bar.state == NOT_READY, timeout=60)
         assert bar.message == f"output {folder.name} is a folder, expected a file name", bar.message
+
+
+async def test_a_view_keeps_the_keys_while_a_run_goes_on(tmp_path, scene_files):
+    """F5 pressed in a 3D view moved the focus to the status bar's Cancel: the arrows,
+    + and - there did nothing while the run went on, though the views may be turned
+    during a run. A control the run disables still hands the focus to Cancel."""
+    from ladartui.tui.canvas import ProjectionWidget
+
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=(100, 30)) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        capture_runs(app)  # the run never reports back: it goes on
+        view = app.query_one("#scene3d", ProjectionWidget)
+        view.focus()
+        await pilot.press("f5")
+        await pilot.pause()
+        assert app.run_in_progress() and app.focused is view
+        azimuth, zoom = view.camera.azimuth, view.camera.zoom
+        await pilot.press("right", "plus")
+        assert view.camera.azimuth == (azimuth + 15) % 360 and view.camera.zoom > zoom
+        app.run_finished(cancelled=True)
+        await pilot.pause()
+        app.query_one("#btn-run").focus()  # the Run tab's button, off during a run
+        await pilot.press("f5")
+        await pilot.pause()
+        assert app.focused is app.query_one("#status #cancel")

@@ -29,6 +29,7 @@ from ladartui.measures_compare import measures_files_to_offer
 from ladartui.run_record import setting_changes
 from ladartui.scenario import Scenario
 from ladartui.tui import actions, bridge
+from ladartui.tui.canvas import PictureWidget
 from ladartui.tui.editing import ScenarioEditing
 from ladartui.tui.file_actions import FileActions
 from ladartui.tui.graphics import Graphics, has_truecolor
@@ -190,8 +191,8 @@ class LadarApp(
         if not busy and self.scenario is not None:
             self.run_panel.enable_step()
             self.flight_panel.enable_start()
-        if busy and not was_busy and running:
-            self.query_one("#status #cancel").focus()
+        if busy and not was_busy and running and not isinstance(self.focused, PictureWidget):
+            self.query_one("#status #cancel").focus()  # a view keeps its keys (turn, zoom)
         self.refresh_status()
         if busy != was_busy:
             self.refresh_bindings()
