@@ -140,3 +140,22 @@ def test_pictures_use_24_bit_colour_or_the_256_colour_palette():
     (strip,) = picture_strips(picture, use_256=True)
     first = list(strip)[0]
     assert (first.style.color.number, first.style.bgcolor.number) == (196, 21)  # xterm red, blue
+
+
+async def test_0_in_a_3d_view_goes_back_to_the_view_it_opened_with(tmp_path, scene_files):
+    """0 gave zoom 1 on the scene alone, which cut off the far side of the flight path
+    the opening view (the scene and the path framed) had shown; the top view's 0 goes
+    back to its opening framing."""
+    from tui_support import make_scenario, opened
+
+    async with opened(make_scenario(tmp_path, scene_files)) as (app, pilot):
+        scene3d = app.query_one("#scene3d", ProjectionWidget)
+        await pilot.pause()
+        opening = scene3d.camera
+        assert opening.zoom != 1.0  # framed to hold the flight path, not the default
+        scene3d.focus()
+        await pilot.press("right", "up", "plus", "d")
+        assert scene3d.camera != opening
+        await pilot.press("0")
+        await pilot.pause()
+        assert scene3d.camera == opening

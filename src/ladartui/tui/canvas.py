@@ -548,7 +548,10 @@ class ProjectionWidget(PictureWidget):
         self.set_camera(self.camera.panned(dx, dy))
 
     def action_reset_view(self) -> None:
+        """0: the view a scene opens with, the default angles framing the scene and the
+        flight path (zoom 1 on the scene alone cut off the far side of an orbit)."""
         self.set_camera(Camera())
+        self.fit_path()
 
     def on_mouse_down(self, event: events.MouseDown) -> None:
         self._drag = (event.screen_x, event.screen_y)
