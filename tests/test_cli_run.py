@@ -332,3 +332,16 @@ def test_a_scene_model_refused_in_setting_up_leaves_no_progress_line(scenario, c
     assert main(["run", str(scenario.path)]) == 2
     err = one_error_line(capsys)
     assert "1,2" in err and "expected three non-negative integers" in err
+
+
+def test_a_run_refused_while_another_writes_the_set_says_one_line_alone(scenario, capsys):
+    """Two runs of one scenario from a batch script, stderr to a log: the one refused
+    wrote a blank line (the hidden bar's last frame) above its error."""
+    from ladartui.simulation import _output_set
+
+    with _output_set(scenario, False):
+        assert main(["run", str(scenario.path), "--json"]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err.startswith("ladartui: error: "), repr(captured.err)
+    assert captured.err.count("\n") == 1 and "is writing this output set" in captured.err

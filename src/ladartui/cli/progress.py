@@ -55,12 +55,16 @@ def progress_display(console, after, description=None, **options):
 def bar_hidden_if_refused(bar, task, started: Callable[[], bool]):
     """A refusal before the work reported progress (a model file's bad line, memory),
     or work refused for its size once traced (Geiger-mode firing), hides the bar: no
-    "scan 1  0.0 %" line is left above the one-line error."""
+    "scan 1  0.0 %" line is left above the one-line error, nor, where stderr is a log
+    or a pipe, the blank line rich ends a display there with."""
     try:
         yield
     except LadarError as error:
         if not started() or isinstance(error, ResourceLimitError):  # refused, not stopped
             bar.update(task, visible=False)
+            bar.live.transient = True  # cleared from a terminal, never written to a file
+            bar.live.stop()  # (Progress.stop would end it with a blank line in a log)
+            bar.disable = True  # and leaving the display adds nothing after it
         raise
 
 
