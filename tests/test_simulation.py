@@ -289,3 +289,41 @@ def test_simulate_takes_a_scenario_files_path_as_the_scenario_itself(tmp_path):
     by_object = simulate(scenario, write=False).measures
     for given in (str(scenario.path), scenario.path):
         assert simulate(given, write=False).measures.to_dict() == by_object.to_dict()
+
+
+def test_a_process_pools_refused_runs_come_back_as_their_errors(forest):
+    """simulate over variants in a process pool: a variant refused in its worker (the set
+    being written, a mistyped backend, a missing file) could not be unpickled, so
+    ProcessPoolExecutor broke and lost every other variant, and Pool.map hung."""
+    import multiprocessing
+    import pickle
+    from concurrent.futures import ProcessPoolExecutor
+
+    from ladartui.errors import FieldError, InputFileError, OutputFileError
+
+    missing = str(forest.path.with_name("missing.toml"))
+    spawn = multiprocessing.get_context("spawn")
+    with simulation._output_set(forest, False), ProcessPoolExecutor(1, mp_context=spawn) as pool:
+        busy = pool.submit(simulate, forest)
+        mistyped = pool.submit(simulate, forest, backend="gpu", write=False)
+        absent = pool.submit(simulate, missing)
+        ran = pool.submit(simulate, forest, write=False)
+        with pytest.raises(OutputFileError, match="is writing this output set") as refused:
+            busy.result(timeout=120)
+        assert refused.value.path == str(forest.path.with_name(".S.outputs.lock"))
+        with pytest.raises(FieldError, match="backend = 'gpu': expected one of") as field:
+            mistyped.result(timeout=120)
+        assert (field.value.field, field.value.value) == ("backend", "gpu")
+        with pytest.raises(InputFileError, match="no such file") as file:
+            absent.result(timeout=120)
+        assert file.value.path == missing
+        assert ran.result(timeout=120).scans == 4
+    error = FieldError("radius", -5.0, "a positive number", source="s.toml", limits=(0.0, None, True, True))
+    again = pickle.loads(pickle.dumps(error))
+    assert type(again) is FieldError and str(again) == str(error) and again.args == error.args
+    assert (again.field, again.value, again.expected, again.limits) == (
+        "radius",
+        -5.0,
+        "a positive number",
+        error.limits,
+    )

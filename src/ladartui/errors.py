@@ -2,7 +2,21 @@
 
 
 class LadarError(Exception):
-    """A mistake in user input (file, scenario field, flag). Shown as one line, no traceback."""
+    """A mistake in user input (file, scenario field, flag). Shown as one line, no traceback.
+
+    Pickled as its message and attributes, not its constructor's arguments (a subclass's
+    differ from ``args``), so one raised in a worker process (a process pool's, a Dask
+    worker's) comes back as itself.
+    """
+
+    def __reduce__(self):
+        return _remade, (type(self), self.args), self.__dict__
+
+
+def _remade(cls, args):
+    """An error of class ``cls`` holding ``args``, its ``__init__`` not run: unpickling
+    then restores the attributes it had set."""
+    return cls.__new__(cls, *args)
 
 
 class InputFileError(LadarError):
