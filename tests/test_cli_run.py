@@ -1,6 +1,7 @@
 """``ladartui run``: JSON and table output, --no-write, Ctrl-C, bad input."""
 
 import json
+import os
 
 import numpy as np
 import pytest
@@ -334,14 +335,38 @@ def test_a_scene_model_refused_in_setting_up_leaves_no_progress_line(scenario, c
     assert "1,2" in err and "expected three non-negative integers" in err
 
 
-def test_a_run_refused_while_another_writes_the_set_says_one_line_alone(scenario, capsys):
+@pytest.mark.parametrize("refusal", ["another run", "bad model line"])
+def test_a_run_refused_while_another_writes_the_set_says_one_line_alone(scenario, capsys, refusal):
     """Two runs of one scenario from a batch script, stderr to a log: the one refused
-    wrote a blank line (the hidden bar's last frame) above its error."""
+    wrote a blank line (the hidden bar's last frame) above its error, as did a run
+    refused for its scene model's bad line."""
     from ladartui.simulation import _output_set
 
-    with _output_set(scenario, False):
+    if refusal == "bad model line":
+        with open(scenario.scene_file, "a", encoding="utf-8") as handle:
+            handle.write("1,2\n")
         assert main(["run", str(scenario.path), "--json"]) == 2
+        said = "expected three non-negative integers"
+    else:
+        with _output_set(scenario, False):
+            assert main(["run", str(scenario.path), "--json"]) == 2
+        said = "is writing this output set"
     captured = capsys.readouterr()
     assert captured.out == ""
     assert captured.err.startswith("ladartui: error: "), repr(captured.err)
-    assert captured.err.count("\n") == 1 and "is writing this output set" in captured.err
+    assert captured.err.count("\n") == 1 and said in captured.err
+
+
+def test_a_run_of_a_set_being_written_is_refused_before_compiling_or_loading(scenario, capsys, monkeypatch):
+    """A second run of one scenario compiled the kernels (minutes on a fresh clone) and
+    loaded the scene before it was told another run was writing the set."""
+    from ladartui import precompile
+    from ladartui.simulation import _output_set
+
+    started = []
+    monkeypatch.setattr(precompile, "compile_ahead", lambda *args, **kwargs: started.append(args))
+    with _output_set(scenario, False):
+        assert main(["run", str(scenario.path), "--json"]) == 2
+    err = one_error_line(capsys)
+    assert err.endswith("is writing this output set; wait for it to finish") and not started
+    assert f"another run (pid {os.getpid()})" in err

@@ -168,6 +168,21 @@ def lock_holder(lock) -> str | None:
         os.close(fd)
 
 
+def held_refusal(lock, holder: str) -> OutputFileError:
+    """The refusal of a run whose set's ``lock`` the run of pid ``holder`` holds."""
+    return OutputFileError(
+        lock, f"another run (pid {holder}) is writing this output set; wait for it to finish"
+    )
+
+
+def check_not_held(lock) -> None:
+    """``held_refusal`` when a run holds ``lock`` now: asked before long work (compiling the
+    kernels, loading the scene) that the lock, taken after it, would refuse."""
+    holder = lock_holder(lock)
+    if holder is not None:
+        raise held_refusal(lock, holder)
+
+
 class OutputSet:
     """The files of one run, written together; use as a context manager around the work.
 
@@ -221,11 +236,7 @@ class OutputSet:
                     time.sleep(0.002)
                     continue
                 if busy:
-                    holder = holder or "?"
-                    raise OutputFileError(
-                        self.lock,
-                        f"another run (pid {holder}) is writing this output set; wait for it to finish",
-                    ) from None
+                    raise held_refusal(self.lock, holder or "?") from None
                 raise
             # The holder before us removes the file as it lets go: lock the one on disk.
             try:

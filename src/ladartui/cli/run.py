@@ -101,11 +101,12 @@ def run(args) -> int:
     )
     refuse_step_without_march(args.step, scenario.method, f"this run is {how}")
     if args.write:  # before any progress is drawn; the run checks again under its lock
-        from ladartui.outputset import check_writable
-        from ladartui.simulation import check_outputs_spare_inputs, output_paths
+        from ladartui.outputset import check_not_held, check_writable
+        from ladartui.simulation import check_outputs_spare_inputs, output_lock, output_paths
 
         check_outputs_spare_inputs(scenario, args.las)
         check_writable(*output_paths(scenario, args.las).values())
+        check_not_held(output_lock(scenario))  # not after minutes of compiling
     if args.chart is not None:
         from ladartui.outputset import output_problem
 
