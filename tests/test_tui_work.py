@@ -205,6 +205,13 @@ async def test_ctrl_x_cancels_a_study_as_it_cancels_a_run_and_a_sweep(tmp_path, 
 
         await pilot.pause()
         assert "cancel" in {key.action for key in screen.query(FooterKey)}  # running: offered
+        # Ctrl+C, the reflex to stop it, said 'press Ctrl+Q to quit' alone
+        said: list[str] = []
+        app.tell = lambda message, **kwargs: said.append(message)
+        await pilot.press("ctrl+c")
+        await pilot.pause()
+        assert said == ["Ctrl+C does not stop the study: Ctrl+X cancels it; Ctrl+Q quits."]
+        assert bar.state == BUSY
         await pilot.press("ctrl+x")
         status = screen.query_one("#study-status StatusText", Static)
         await wait_until(pilot, lambda: "study cancelled" in str(status.render()))

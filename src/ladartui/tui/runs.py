@@ -74,7 +74,12 @@ class RunControl(Host):
 
     def action_help_quit(self) -> None:
         """Ctrl+C: a terminal app's copy, which Textual follows with how to quit. During
-        a run, the reflex to stop it, it says how to cancel the run as well."""
+        a run, the reflex to stop it, it says how to cancel the run as well; so on a study's
+        or sweep's screen while it works (its Ctrl+X cancels it)."""
+        work = getattr(self.screen, "work_going_on", lambda: None)()
+        if work:
+            self.tell(f"Ctrl+C does not stop the {work}: Ctrl+X cancels it; Ctrl+Q quits.")
+            return
         if not self.run_in_progress():
             super().action_help_quit()
             return

@@ -153,6 +153,10 @@ class StudyScreen(Screen):
         )
         self.refresh_bindings()  # Cancel joins the footer
 
+    def work_going_on(self) -> str | None:
+        """What Ctrl+C would be pressed to stop (the app says how): the study, while it runs."""
+        return "study" if running(self.worker) else None
+
     def action_cancel(self) -> None:
         if running(self.worker):
             self.worker.cancel()

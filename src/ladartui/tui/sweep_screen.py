@@ -338,6 +338,10 @@ class SweepScreen(SweepOpening):
             event.stop()
             self.notify("A sweep is running: Ctrl+X cancels it first.", markup=False, timeout=5)
 
+    def work_going_on(self) -> str | None:
+        """What Ctrl+C would be pressed to stop (the app says how): the sweep, while it runs."""
+        return "sweep" if self.running else None
+
     def action_cancel(self) -> None:
         if self.running and self.worker is not None:
             self.worker.cancel()
