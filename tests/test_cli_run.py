@@ -348,8 +348,8 @@ def test_a_run_refused_while_another_writes_the_set_says_one_line_alone(scenario
         assert main(["run", str(scenario.path), "--json"]) == 2
         said = "expected three non-negative integers"
     else:
-        with _output_set(scenario, False):
-            assert main(["run", str(scenario.path), "--json"]) == 2
+        with _output_set(scenario, False):  # 75, EX_TEMPFAIL: a script may try again later
+            assert main(["run", str(scenario.path), "--json"]) == 75
         said = "is writing this output set"
     captured = capsys.readouterr()
     assert captured.out == ""
@@ -366,7 +366,7 @@ def test_a_run_of_a_set_being_written_is_refused_before_compiling_or_loading(sce
     started = []
     monkeypatch.setattr(precompile, "compile_ahead", lambda *args, **kwargs: started.append(args))
     with _output_set(scenario, False):
-        assert main(["run", str(scenario.path), "--json"]) == 2
+        assert main(["run", str(scenario.path), "--json"]) == 75
     err = one_error_line(capsys)
     assert err.endswith("is writing this output set; wait for it to finish") and not started
     assert f"another run (pid {os.getpid()})" in err

@@ -8,7 +8,7 @@ import time
 
 import pytest
 
-from ladartui.errors import InputFileError
+from ladartui.errors import OutputSetBusy
 from ladartui.sweep import read_table, run_sweep
 from tiny_sweep import tiny_folder, write_spec
 
@@ -119,7 +119,7 @@ def test_two_sweeps_never_write_one_folder_at_once(tiny, tmp_path):
     spec = write_spec(tiny, "[grid]\nscans = [2]\n", name="locked.toml")
     with open(tmp_path / ".lock", "a+b") as held:
         fcntl.flock(held, fcntl.LOCK_EX)  # as a running sweep holds it
-        with pytest.raises(InputFileError, match="another sweep"):
+        with pytest.raises(OutputSetBusy, match="another sweep"):
             run_sweep(spec, serial=True, out=tmp_path)
     assert not (tmp_path / "results.csv").exists()
     assert run_sweep(spec, serial=True, out=tmp_path).ran == 1
@@ -135,7 +135,7 @@ def test_a_folder_another_sweep_holds_is_refused_before_the_bar(tiny, tmp_path, 
     spec = write_spec(tiny, "[grid]\nscans = [2]\n", name="held.toml")
     with open(tmp_path / ".lock", "a+b") as held:
         fcntl.flock(held, fcntl.LOCK_EX)
-        assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path)]) == 2
+        assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path)]) == 75  # try again later
     assert "another sweep is writing its results here" in one_error_line(capsys)
 
 

@@ -120,6 +120,11 @@ class OutputFileError(LadarError):
         super().__init__(f"{self.path}: {message}")
 
 
+class OutputSetBusy(OutputFileError):
+    """Another run is writing the output set: nothing is wrong with the input, and the
+    same command may succeed once that run ends (the CLI's exit status 75)."""
+
+
 def os_reason(error: OSError) -> str:
     """An OSError's reason in words, without the path it names ("Permission denied")."""
     import os

@@ -26,7 +26,7 @@ from pathlib import Path
 from typing import Any
 
 from ladartui.atomic import held_temporary, unlink_unheld
-from ladartui.errors import OutputFileError, check_cancelled, os_reason
+from ladartui.errors import OutputFileError, OutputSetBusy, check_cancelled, os_reason
 from ladartui.fileprobe import SPECIAL_FILE
 
 # Called with a step name ("temporaries", "swap", "backups") at each stage of the
@@ -168,9 +168,9 @@ def lock_holder(lock) -> str | None:
         os.close(fd)
 
 
-def held_refusal(lock, holder: str) -> OutputFileError:
+def held_refusal(lock, holder: str) -> OutputSetBusy:
     """The refusal of a run whose set's ``lock`` the run of pid ``holder`` holds."""
-    return OutputFileError(
+    return OutputSetBusy(
         lock, f"another run (pid {holder}) is writing this output set; wait for it to finish"
     )
 

@@ -2,7 +2,9 @@
 
 Each command is a module in this package with ``add_parser(subparsers)`` that
 registers itself (``parser.set_defaults(handler=run)``). User mistakes become
-one line on stderr and exit status 2; no traceback reaches the user.
+one line on stderr and exit status 2; no traceback reaches the user. A run refused
+because another is writing the same output set exits 75 (sysexits' EX_TEMPFAIL), so a
+batch script can tell "try again later" from "fix the input".
 """
 
 from __future__ import annotations
@@ -21,9 +23,11 @@ from pathlib import Path
 
 from ladartui import __version__
 from ladartui.cli.progress import reset_stop, stop_status
-from ladartui.errors import Cancelled, LadarError, os_reason
+from ladartui.errors import Cancelled, LadarError, OutputSetBusy, os_reason
 from ladartui.textsafe import one_line
 from ladartui.threads import environment_problem
+
+BUSY_STATUS = 75  # another run writes the output set: the same command may succeed later
 
 # Command name -> module under ladartui.cli. Modules load only when needed.
 COMMANDS = {
@@ -133,7 +137,7 @@ def main(argv: list[str] | None = None) -> int:
         return int(args.handler(args) or 0)
     except LadarError as error:
         print(f"ladartui: error: {one_line(error)}", file=sys.stderr)
-        return 2
+        return BUSY_STATUS if isinstance(error, OutputSetBusy) else 2
     except Cancelled as error:  # its message says what was (not) written
         print(f"ladartui: {one_line(error)}", file=sys.stderr)
         return stop_status()

@@ -27,6 +27,7 @@ from ladartui.errors import (
     InputFileError,
     LadarError,
     OutputFileError,
+    OutputSetBusy,
     check_callbacks,
     check_cancelled,
 )
@@ -270,7 +271,7 @@ def check_sweep_files(out: Path, name: str) -> None:
     """``OutputFileError`` naming a file the sweep keeps in ``out`` that it could not
     write (a folder, a pipe or a device there, say), before any variant runs: a pipe
     would be waited on for ever when read, or replaced by a file when written; and
-    ``InputFileError`` when another sweep holds the folder now."""
+    ``OutputSetBusy`` when another sweep holds the folder now."""
     from ladartui.outputset import check_writable
 
     check_writable(
@@ -313,7 +314,7 @@ def _exclusive(out: Path):
         try:
             fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
-            raise InputFileError(
+            raise OutputSetBusy(
                 out, "another sweep is writing its results here; wait for it or choose another --out"
             ) from None
         try:
