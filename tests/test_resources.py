@@ -324,3 +324,32 @@ def test_a_memory_cgroup_limit_bounds_the_memory_available(tmp_path, monkeypatch
     assert resources.available_memory() == 2**30
     (folder / names[0]).write_text("max\n" if version == 2 else f"{2**63 - 4096}\n")
     assert resources.available_memory() == 64 * 2**30
+
+
+@pytest.mark.parametrize("version", [1, 2])
+def test_a_limit_on_a_parent_cgroup_bounds_the_memory_available(tmp_path, monkeypatch, version):
+    """A batch scheduler limits its job's cgroup and leaves the task's own unlimited
+    (job_1 at 1 GiB, job_1/step_0/task_0 at 'max'): the host's free memory was taken."""
+    from ladartui import resources
+
+    proc = tmp_path / "cgroup"
+    if version == 2:
+        proc.write_text("0::/job_1/step_0/task_0\n")
+        mount, names, unlimited = tmp_path, ("memory.max", "memory.current"), "max"
+    else:
+        proc.write_text("4:memory:/job_1/step_0/task_0\n")
+        mount = tmp_path / "memory"
+        names, unlimited = ("memory.limit_in_bytes", "memory.usage_in_bytes"), str(2**63 - 4096)
+    job = mount / "job_1"
+    task = job / "step_0" / "task_0"
+    task.mkdir(parents=True)
+    for folder, limit, used in ((job, str(2**30), 300 * 2**20), (task, unlimited, 100 * 2**20)):
+        (folder / names[0]).write_text(limit + "\n")
+        (folder / names[1]).write_text(f"{used}\n")
+    monkeypatch.setattr(resources, "_PROC_CGROUP", str(proc))
+    monkeypatch.setattr(resources, "_CGROUP_ROOT", str(tmp_path))
+    monkeypatch.setattr(resources, "_free_memory", lambda: 64 * 2**30)
+    monkeypatch.setattr(resources, "_address_space_left", lambda: None)
+    assert resources.available_memory() == 2**30 - 300 * 2**20  # the job's room, not the host's
+    (task / names[0]).write_text(f"{200 * 2**20}\n")  # a tighter limit below it wins
+    assert resources.available_memory() == 100 * 2**20

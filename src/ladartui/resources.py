@@ -124,19 +124,36 @@ def _cgroup_left() -> int | None:
 
 
 def _cgroup_files(mount: str, path: str, limit_name: str, usage_name: str, stat_prefix: str) -> int | None:
-    for folder in (os.path.join(mount, path.lstrip("/")), mount):
-        try:
-            with open(os.path.join(folder, limit_name), encoding="ascii") as handle:
-                limit_text = handle.read().strip()
-            with open(os.path.join(folder, usage_name), encoding="ascii") as handle:
-                usage = int(handle.read().strip())
-        except (OSError, ValueError):
-            continue
-        if limit_text == "max" or not limit_text.isdigit() or int(limit_text) >= _NO_CGROUP_LIMIT:
-            return None
-        cache = _cgroup_stat(folder, (stat_prefix + "inactive_file", stat_prefix + "active_file"))
-        return int(limit_text) - max(0, usage - cache)
-    return None
+    """The least room left under a limit by the cgroup at ``path`` and every cgroup above
+    it up to the mount (a batch job limits its job's group, not each task's); the mount
+    alone where ``path`` is not there (a container's view). None without a limit."""
+    root = os.path.normpath(mount)
+    folder = os.path.normpath(os.path.join(root, path.lstrip("/")))
+    if not (folder.startswith(root + os.sep) and os.path.isdir(folder)):
+        folder = root
+    least = None
+    while True:
+        room = _room_under_limit(folder, limit_name, usage_name, stat_prefix)
+        if room is not None:
+            least = room if least is None else min(least, room)
+        if folder == root:
+            return least
+        folder = os.path.dirname(folder)
+
+
+def _room_under_limit(folder: str, limit_name: str, usage_name: str, stat_prefix: str) -> int | None:
+    """One cgroup's limit less its use (page cache aside); None without a limit."""
+    try:
+        with open(os.path.join(folder, limit_name), encoding="ascii") as handle:
+            limit_text = handle.read().strip()
+        with open(os.path.join(folder, usage_name), encoding="ascii") as handle:
+            usage = int(handle.read().strip())
+    except (OSError, ValueError):
+        return None
+    if limit_text == "max" or not limit_text.isdigit() or int(limit_text) >= _NO_CGROUP_LIMIT:
+        return None
+    cache = _cgroup_stat(folder, (stat_prefix + "inactive_file", stat_prefix + "active_file"))
+    return int(limit_text) - max(0, usage - cache)
 
 
 def _cgroup_stat(folder: str, keys: tuple[str, ...]) -> int:
