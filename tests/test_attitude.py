@@ -61,7 +61,7 @@ def test_a_coordinated_turn_s_speed_and_radius_are_checked_and_named(speed, radi
             {},
             "directions is an array of shape (2,): expected an (N, 3) array of numbers",
         ),
-        (None, {}, "directions is an array of shape (): expected an (N, 3) array of numbers"),
+        (None, {}, "directions is not set: expected an (N, 3) array of numbers"),
         # NaN directions came back for a NaN angle.
         (np.array([[0.0, 0.0, -1.0]]), {"roll": float("nan")}, "roll = nan: expected a finite number"),
         (np.array([[0.0, 0.0, -1.0]]), {"heading": None}, "heading is not set: expected a finite number"),

@@ -91,9 +91,9 @@ def test_a_folder_is_named_as_a_folder(tmp_path):
     ("voxels", "ids", "message"),
     [
         ([[1, -2, 3]], None, r"^voxels\[0\] = \(1, -2, 3\): expected non-negative voxel indices"),
-        ([[1, 2]], None, r"^voxels is an array of shape \(1, 2\): expected an \(N, 3\) array"),
+        ([[1, 2]], None, r"^voxels = \[\[1, 2\]\]: expected an \(N, 3\) array"),
         ([[1, 2, 3]], [70000], r"^ids\[0\] = 70000: expected a target id from 0 \(no target\) to 65535"),
-        ([[1, 2, 3]], [1, 2], r"^ids is an array of shape \(2,\): expected 1 target ids"),
+        ([[1, 2, 3]], [1, 2], r"^ids = \[1, 2\]: expected 1 target ids"),
     ],
 )
 def test_export_refuses_bad_voxels_and_ids_naming_them(tmp_path, voxels, ids, message):

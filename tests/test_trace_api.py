@@ -307,3 +307,7 @@ def test_a_value_of_the_wrong_kind_is_told_by_its_kind_not_quoted_as_text():
     )
     assert str(FieldError("x", described("text"), "a number")) == "x = 'text': expected a number"
     assert str(FieldError("x", described(7), "a list")) == "x = 7: expected a list"
+    # a numpy number is the number it holds; what was given is told, not numpy's conversion
+    assert str(FieldError("x", described(np.float64(2.5)), "a list")) == "x = 2.5: expected a list"
+    with pytest.raises(FieldError, match=r"^origins is not set: expected an \(N, 3\) array"):
+        trace(Occupancy.build(np.zeros((1, 3), np.int64)), None, np.ones((1, 3)))

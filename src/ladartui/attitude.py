@@ -75,7 +75,7 @@ def body_fixed_directions(
     except (TypeError, ValueError):
         raise FieldError("directions", described(directions), "an (N, 3) array of numbers") from None
     if array.ndim != 2 or array.shape[1] != 3:
-        raise FieldError("directions", described(array), "an (N, 3) array of numbers")
+        raise FieldError("directions", described(directions), "an (N, 3) array of numbers")
     rotation = body_rotation(heading, roll, pitch, yaw)
     return array @ rotation.T
 

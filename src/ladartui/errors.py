@@ -50,7 +50,8 @@ class FieldError(LadarError):
 
 class Described:
     """A value told in words (an array by its shape, an object by its type) where
-    quoting it would read as text the caller wrote: "scene is a dict", not "scene = 'dict'"."""
+    quoting it would read as text the caller wrote: "scene is a Scenario", not
+    "scene = 'Scenario'"."""
 
     def __init__(self, text: str):
         self.text = text
@@ -62,6 +63,8 @@ class Described:
 def described(value):
     """``value`` itself where its repr says what it is (None, text, a number, a list);
     else Described: an array by its shape, any other object by its type."""
+    if getattr(value, "shape", None) == () and callable(getattr(value, "item", None)):
+        return value.item()  # a numpy number (or a 0-d array): said as the value it holds
     if value is None or isinstance(value, str | int | float | complex | list | tuple | dict):
         return value
     shape = getattr(value, "shape", None)

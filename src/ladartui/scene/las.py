@@ -284,9 +284,9 @@ def _voxel_cloud(voxels, voxel_size, origin, ids):
     cloud = laspy.LasData(header)
     cloud.x, cloud.y, cloud.z = centres[:, 0], centres[:, 1], centres[:, 2]
     if ids is not None:
-        ids = np.asarray(ids)
+        given, ids = ids, np.asarray(ids)
         if ids.shape != (len(centres),):
-            raise FieldError("ids", described(ids), f"{len(centres)} target ids, one per voxel")
+            raise FieldError("ids", described(given), f"{len(centres)} target ids, one per voxel")
         wrong = np.flatnonzero((ids < 0) | (ids > MAX_TARGET_ID))
         if len(wrong):
             row = int(wrong[0])

@@ -134,7 +134,7 @@ class Occupancy:
         if vox.size == 0:
             vox = vox.reshape(0, 3)
         if vox.ndim != 2 or vox.shape[1] != 3:
-            raise FieldError("voxels", described(vox), "an (N, 3) integer array")
+            raise FieldError("voxels", described(voxels), "an (N, 3) integer array")
         if vox.dtype.kind not in "iu":
             raise FieldError("voxels", Described(f"an array of {vox.dtype}"), "integer voxel indices")
         if vox.dtype not in (np.int32, np.int64):  # the kernels are compiled for these two

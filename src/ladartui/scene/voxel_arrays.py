@@ -26,7 +26,7 @@ def voxel_list_field(name, value, high=None) -> np.ndarray:
     if array.size == 0:
         return np.zeros((0, 3), dtype=np.int64)
     if array.ndim != 2 or array.shape[1] != 3:
-        raise FieldError(name, described(array), "an (N, 3) array of voxel indices")
+        raise FieldError(name, described(value), "an (N, 3) array of voxel indices")
     if not np.issubdtype(array.dtype, np.integer):
         # whole numbers in a float array (np.vstack with np.zeros((0, 3))) are indices still
         whole = (
@@ -57,7 +57,7 @@ def target_ids_field(name, ids, count: int) -> np.ndarray:
     """``ids`` as ``count`` target ids (1..``MAX_TARGET_ID``), one per target voxel, else FieldError."""
     array = np.asarray(ids)
     if array.shape != (count,):
-        raise FieldError(name, described(array), f"{count} target ids, one per target voxel")
+        raise FieldError(name, described(ids), f"{count} target ids, one per target voxel")
     if count and not np.issubdtype(array.dtype, np.integer):
         raise FieldError(name, Described(f"an array of {array.dtype}"), f"{count} integer target ids")
     if count and (array.min() < 1 or array.max() > MAX_TARGET_ID):

@@ -212,5 +212,5 @@ def _rays(name, values):
     if array.ndim == 1 and array.shape == (3,):
         array = array[None, :]
     if array.ndim != 2 or array.shape[1] != 3:
-        raise FieldError(name, described(array), "an (N, 3) array")
+        raise FieldError(name, described(values), "an (N, 3) array")
     return array
