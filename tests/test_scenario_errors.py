@@ -312,4 +312,23 @@ def test_a_path_of_millions_of_scans_is_refused_before_its_scans_are_made(tmp_pa
     with pytest.raises(FieldError) as caught:
         load_scenario(path, check_files=False)
     assert caught.value.field == "flight.segments"
-    assert str(caught.value).endswith("flight.segments = '5000010 scans': expected at most 10000 scans")
+    assert str(caught.value).endswith("flight.segments is 5,000,010 scans: expected at most 10,000 scans")
+
+
+def test_flight_logs_flown_at_a_rate_count_their_scans_before_they_are_made(tmp_path, monkeypatch):
+    """A log flown at a rate was counted as one scan, so 500 of them (up to 10,000 scans
+    each) were all built before the path was refused."""
+    from pathlib import Path
+
+    from ladartui.trajectory import LogSegment
+
+    def never(self, current):
+        raise AssertionError("a log's scans were made")
+
+    log = Path(__file__).parent.parent / "scenarios" / "flight-log.csv"  # 3 s: 3,001 scans at 1 kHz
+    segment = f'[[flight.segments]]\nkind = "log"\nfile = "{log}"\nrate = 1000.0\n'
+    monkeypatch.setattr(LogSegment, "build", never)
+    path = write_scenario(tmp_path, BASE + segment * 4)
+    with pytest.raises(FieldError) as caught:
+        load_scenario(path, check_files=False)
+    assert str(caught.value).endswith("flight.segments is 12,014 scans: expected at most 10,000 scans")

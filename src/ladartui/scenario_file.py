@@ -110,13 +110,14 @@ from pathlib import Path
 
 from ladartui.checks import number_field
 from ladartui.detection.settings import DETECTION_KEYS, detection_from_table
-from ladartui.errors import FieldError, InputFileError
+from ladartui.errors import Described, FieldError, InputFileError
 from ladartui.fileprobe import user_path
 from ladartui.flight import MAX_SCANS, SEGMENT_KINDS, FlightPlan, Manual, ScanPose
 from ladartui.levels import LEVEL_KEYS, level_below, levels_from_table
+from ladartui.number_text import plural
 from ladartui.sensor import MAX_PIXEL_PITCH, MIN_PIXEL_PITCH, Sensor
 from ladartui.toml_lines import key_lines_from_text, toml_mistake
-from ladartui.trajectory import LogSegment
+from ladartui.trajectory import LogSegment, rate_count
 
 SENSOR_KEYS = {  # TOML key -> (Sensor field, file units per Sensor unit)
     "grid": ("grid", None),
@@ -432,18 +433,22 @@ def check_flight(plan: FlightPlan) -> None:
         raise FieldError("flight.segments", [], "at least one segment")
     declared = sum(_declared_scans(segment) for segment in plan.segments)
     if declared > MAX_SCANS:  # refused before millions of scans are made only to be counted
-        raise FieldError("flight.segments", f"{declared} scans", f"at most {MAX_SCANS} scans")
+        raise FieldError(
+            "flight.segments", Described(plural(declared, "scan")), f"at most {MAX_SCANS:,} scans"
+        )
     try:
         count = sum(len(p) for p in plan.segment_poses())
     except FieldError as error:
         raise FieldError("flight." + error.field, error.value, error.expected) from None
     if count > MAX_SCANS:
-        raise FieldError("flight.segments", f"{count} scans", f"at most {MAX_SCANS} scans")
+        raise FieldError("flight.segments", Described(plural(count, "scan")), f"at most {MAX_SCANS:,} scans")
 
 
 def _declared_scans(segment) -> int:
     """The scans ``segment`` says it makes, without making them: its ``scans``, its poses,
-    standoffs or listed times; 1 for one known only once made (a log flown at a rate)."""
+    standoffs or listed times, a log's scans at its rate; else 1."""
+    if isinstance(segment, LogSegment) and segment.rate is not None:
+        return rate_count(segment.log, segment.rate)
     scans = getattr(segment, "scans", None)
     if isinstance(scans, int):
         return scans
