@@ -212,8 +212,11 @@ def test_a_scene_loaded_from_another_file_is_refused(forest, tmp_path):
         f"scene is the scene of {tmp_path / 'elsewhere.txt'}: expected the scenario's Scene, "
         f"of {forest.scene_file} (scenario.load_scene())"
     )
-    # the scenario's own, and one made in memory, run
-    assert simulate(forest, scene=forest.load_scene(), write=False).measures is not None
+    # the scenario's own, and one made in memory from its voxels, run
+    own = forest.load_scene()
+    assert simulate(forest, scene=own, write=False).measures is not None
+    in_memory = Scene(own.voxels, own.target, own.voxel_size, target_ids=own.target_ids)
+    assert in_memory.path is None and simulate(forest, scene=in_memory, write=False).measures is not None
 
 
 def test_las_outputs_hold_the_fused_voxels(forest):
