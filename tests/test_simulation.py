@@ -321,6 +321,10 @@ def test_a_process_pools_refused_runs_come_back_as_their_errors(forest):
             absent.result(timeout=120)
         assert file.value.path == missing
         assert ran.result(timeout=120).scans == 4
+    # a value that cannot cross (an Event given as progress) crosses as its description
+    event = FieldError("progress", threading.Event(), "a function (or None)")
+    again = pickle.loads(pickle.dumps(event))
+    assert str(again) == str(event) and repr(again.value) == "an Event"
     error = FieldError("radius", -5.0, "a positive number", source="s.toml", limits=(0.0, None, True, True))
     again = pickle.loads(pickle.dumps(error))
     assert type(again) is FieldError and str(again) == str(error) and again.args == error.args

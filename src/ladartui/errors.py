@@ -10,7 +10,25 @@ class LadarError(Exception):
     """
 
     def __reduce__(self):
-        return _remade, (type(self), self.args), self.__dict__
+        return _remade, (type(self), self.args), {name: _picklable(v) for name, v in self.__dict__.items()}
+
+
+def _picklable(value):
+    """``value`` where it is plain data; else its description (an Event, a lock given
+    where a number was expected could not be pickled), so the error crosses to another
+    process either way. Plain by type, not by trying: a trial pickle of a live object
+    (a client, its loop) may act on it."""
+    if value is None or isinstance(value, str | bytes | int | float | complex | Described):
+        return value
+    if isinstance(value, list | tuple):
+        items = [_picklable(v) for v in value]
+        return items if isinstance(value, list) else tuple(items)
+    if isinstance(value, dict):
+        return {k: _picklable(v) for k, v in value.items()}
+    if type(value).__module__.split(".")[0] in ("numpy", "pathlib"):
+        return value
+    told = described(value)
+    return told if isinstance(told, Described) else Described(repr(value))
 
 
 def _remade(cls, args):
