@@ -30,6 +30,7 @@ from ladartui.colour import (  # noqa: F401  (the palette, named here too)
     shade_indices,
     target_colour,
 )
+from ladartui.scene.column_tops import SparseTops
 
 OVERLAYS = ("path", "scans", "footprints")
 
@@ -98,14 +99,15 @@ class TopView:
     ``heights`` is the scene's top height map, (nx, ny) voxel layers with a
     negative value where a column is empty (bare ground), whose entry (0, 0)
     is column ``origin`` (the map spans the voxels' columns, not the grid from
-    (0, 0)); ``voxel_size`` converts metres to voxels. A *frame* is the window
-    shown, in cell units (x0, y0, x1, y1) where voxel i spans [i, i + 1); by
+    (0, 0)), or the same columns kept sparsely (``SparseTops``: a wide box holding
+    few columns), which draws the same pictures; ``voxel_size`` converts metres to
+    voxels. A *frame* is the window shown, in cell units (x0, y0, x1, y1) where voxel i spans [i, i + 1); by
     default the map's extent. Overlays (flight path, scans, footprints) are drawn on a copy of
     the cached layer, so changing parameters never re-renders the scene; only
     a new picture size or frame does.
     """
 
-    heights: np.ndarray
+    heights: np.ndarray | SparseTops
     voxel_size: float = 1.0
     origin: tuple[int, int] = (0, 0)  # the column of heights[0, 0]
     # The ground plane's (nx, ny) from (0, 0), drawn as bare ground where the map
@@ -274,12 +276,15 @@ def _within(centres, lo: float, hi: float) -> np.ndarray:
 
 
 def _block_max(heights, x0, x1, y_lo, y_hi):
-    """Max of ``heights`` over the block [x0, x1) x [y_lo, y_hi) for each pixel (clipped)."""
+    """Max of ``heights`` over the block [x0, x1) x [y_lo, y_hi) for each pixel (clipped).
+    A sparse map pools the columns of the window only (``SparseTops.block_max``)."""
     nx, ny = heights.shape
     xa = np.clip(x0, 0, nx - 1)
     xb = np.maximum(np.clip(x1, 1, nx), xa + 1)
     ya = np.clip(y_lo, 0, ny - 1)
     yb = np.maximum(np.clip(y_hi, 1, ny), ya + 1)
+    if isinstance(heights, SparseTops):
+        return heights.block_max(xa, xb, ya, yb)
     # one slice per picture column, then one per picture row: a few hundred
     # numpy reductions, fast even for a 1500 x 1500 height map
     by_col = np.stack([heights[a:b].max(axis=0) for a, b in zip(xa, xb)])  # (cols, ny)
@@ -442,14 +447,18 @@ def surface_points(heights: np.ndarray, limit: int = 250_000, origin=(0, 0)) -> 
 
     The canopy top is what an overhead view sees; adding it to a random voxel
     sample keeps the 3D scene view solid at any sample size. ``origin`` is the
-    column of ``heights[0, 0]``.
+    column of ``heights[0, 0]``; a sparse map gives the same points.
     """
-    heights = np.asarray(heights)
+    if not isinstance(heights, SparseTops):
+        heights = np.asarray(heights)
     stride = max(1, int(np.ceil(np.sqrt(heights.size / max(limit, 1)))))
-    sub = heights[::stride, ::stride]
-    xs, ys = np.nonzero(sub >= 0)
-    x, y = xs * stride + origin[0], ys * stride + origin[1]
-    return np.stack([x, y, sub[xs, ys]], axis=1).astype(np.int32)
+    if isinstance(heights, SparseTops):
+        x, y, z = heights.surface(stride)
+    else:
+        sub = heights[::stride, ::stride]
+        xs, ys = np.nonzero(sub >= 0)
+        x, y, z = xs * stride, ys * stride, sub[xs, ys]
+    return np.stack([x + origin[0], y + origin[1], z], axis=1).astype(np.int32)
 
 
 def threshold_points(voxels, voxel_size: float, max_height_m: float | None) -> np.ndarray:

@@ -16,6 +16,7 @@ import numpy as np
 from ladartui.errors import FieldError, InputFileError, LadarError
 from ladartui.fileprobe import path_field
 from ladartui.fingerprint import Digest, Fingerprint
+from ladartui.scene.column_tops import SparseTops, map_layout
 from ladartui.scene.keys import voxel_keys
 from ladartui.scene.occupancy import Occupancy, column_bounds
 from ladartui.scene.target_model import load_target
@@ -183,6 +184,26 @@ class Scene:
         origin = (int(lo[0]), int(lo[1]))
         nx, ny = int(hi[0] - lo[0]) + 1, int(hi[1] - lo[1]) + 1
         return origin, top_height_map(voxels, nx, ny, origin)
+
+    def view_columns(self) -> tuple[tuple[int, int], np.ndarray | SparseTops]:
+        """``column_tops`` as the views keep them: the dense map where it is cheap, else
+        the occupied columns only (``column_tops.map_layout``), so a few voxels spread
+        over a wide box cost what they hold."""
+        if not len(self.voxels):
+            return self.column_tops()
+        nx, ny = self.column_box()
+        if map_layout(nx, ny, len(self.voxels))[0]:
+            return self.column_tops()
+        lo, _ = self.bounds()
+        origin = (int(lo[0]), int(lo[1]))
+        return origin, SparseTops.of_voxels(self.voxels, nx, ny, origin)
+
+    def column_box(self) -> tuple[int, int]:
+        """The columns (nx, ny) of the voxels' x-y extent; (0, 0) for an empty list."""
+        if not len(self.voxels):
+            return 0, 0
+        lo, last = self.bounds()
+        return int(last[0] - lo[0]) + 1, int(last[1] - lo[1]) + 1
 
     def tracing_bytes(self) -> int:
         """About the memory the tracing structures of both models take, before

@@ -392,27 +392,26 @@ def _input_paths(scenario) -> list[Path]:
 
 def _check_memory(scenario, scene) -> None:
     """Refuse, with its estimate, a scene whose tracing structures the memory cannot
-    hold, as validate and run do, and one whose views' height map (one cell a
-    column over the voxels' x-y extent) it cannot hold."""
+    hold, as validate and run do, and one whose views' height map (``Scene.view_columns``:
+    one cell a column over the voxels' x-y extent, or the occupied columns alone where
+    that extent is wide for them) it cannot hold."""
     from ladartui.errors import ResourceLimitError
     from ladartui.resources import available_memory, gib
+    from ladartui.scene.column_tops import map_layout
 
     scene.tracing_bytes()
-    nx, ny = 0, 0  # the height map spans the scene's voxels' columns
-    if len(scene.voxels):
-        lo, last = scene.bounds()
-        nx, ny = int(last[0] - lo[0]) + 1, int(last[1] - lo[1]) + 1
-    need = VIEW_BYTES_PER_COLUMN * nx * ny
+    nx, ny = scene.column_box()  # the height map spans the scene's voxels' columns
+    dense, need = map_layout(nx, ny, len(scene.voxels))
     if need > available_memory():
-        raise ResourceLimitError(
-            f"{scenario.scene_file}: the views' height map of {nx:,} x {ny:,} columns needs about "
-            f"{gib(need)}, more than the {gib(available_memory())} of memory available; its "
-            "voxels spread too far apart for the views: crop the scene or use a coarser voxel size"
+        held = (
+            f"{nx:,} x {ny:,} columns" if dense else f"the occupied columns of {len(scene.voxels):,} voxels"
         )
-
-
-# The height map (int32) and a temporary of its size as the top view is made.
-VIEW_BYTES_PER_COLUMN = 8
+        why = "its voxels spread too far apart for the views: " if dense else ""
+        raise ResourceLimitError(
+            f"{scenario.scene_file}: the views' height map of {held} needs about {gib(need)}, more "
+            f"than the {gib(available_memory())} of memory available; {why}crop the scene or use "
+            "a coarser voxel size"
+        )
 
 
 def file_seen(path: Path) -> FileSeen:

@@ -35,7 +35,7 @@ LAYOUTS = {
 
 def prepare_views(scene) -> dict:
     """View data that depends only on the scene: top view, 3D sample, bounds (worker thread)."""
-    origin, heights = scene.column_tops()
+    origin, heights = scene.view_columns()
     columns, column_rgb = views.target_columns(scene.target, scene.target_ids)
     top = views.TopView(
         heights,
