@@ -222,11 +222,6 @@ class Occupancy:
         )
         del brick_of_cell
 
-        tiles, tkeys = _parents(bkeys, n_bricks)
-        regions, rkeys = _parents(tkeys, len(tkeys))
-        root = np.zeros(int(np.prod(root_dims)), np.uint32)
-        root[rkeys] = np.arange(1, len(rkeys) + 1, dtype=np.uint32)
-        columns = _column_tops(bkeys, root_dims)
         brick_cells = _brick_cells(bkeys, root_dims) + (root_origin >> BRICK_SHIFT)
         cubes = _empty_cubes(occupied)
         del occupied
@@ -235,6 +230,33 @@ class Occupancy:
         halo4_origin = (lo >> 2) - 1
         halo4_dims = ((hi - 1) >> 2) - (lo >> 2) + 3
         halo4 = _halo_bits_of_voxels(vox, 2, halo4_origin, halo4_dims)
+        return cls._over_bricks(
+            shape,
+            (lo, hi, root_origin, root_dims),
+            bkeys,
+            bricks,
+            count,
+            cubes=cubes,
+            cube_origin=cube_origin.astype(np.int64),
+            cube_dims=cube_dims.astype(np.int64),
+            halo=halo,
+            halo_origin=halo_origin.astype(np.int64),
+            halo_dims=halo_dims.astype(np.int64),
+            halo4=halo4,
+            halo4_origin=halo4_origin.astype(np.int64),
+            halo4_dims=halo4_dims.astype(np.int64),
+        )
+
+    @classmethod
+    def _over_bricks(cls, shape, box, bkeys, bricks, count, **accelerations):
+        """The occupancy of the sorted brick keys ``bkeys`` and their ``bricks``: the tiles,
+        regions and root above them, the column tops and block masks; ``box`` (lo, hi,
+        root origin, root dims); ``accelerations``: the optional empty cubes and halos."""
+        lo, hi, root_origin, root_dims = box
+        tiles, tkeys = _parents(bkeys, len(bkeys))
+        regions, rkeys = _parents(tkeys, len(tkeys))
+        root = np.zeros(int(np.prod(root_dims)), np.uint32)
+        root[rkeys] = np.arange(1, len(rkeys) + 1, dtype=np.uint32)
         return cls(
             shape,
             lo.astype(np.int64),
@@ -246,17 +268,9 @@ class Occupancy:
             tiles,
             bricks,
             count,
-            columns,
+            _column_tops(bkeys, root_dims),
             block_masks(bricks),
-            cubes,
-            cube_origin.astype(np.int64),
-            cube_dims.astype(np.int64),
-            halo,
-            halo_origin.astype(np.int64),
-            halo_dims.astype(np.int64),
-            halo4,
-            halo4_origin.astype(np.int64),
-            halo4_dims.astype(np.int64),
+            **accelerations,
         )
 
     @classmethod
@@ -278,24 +292,7 @@ class Occupancy:
             brick_of_voxel = np.searchsorted(bkeys, keys[a : a + _CHUNK]).astype(np.int64)
             count += _set_bits_of_bricks(vox[a : a + _CHUNK], brick_of_voxel, bricks)
         del keys
-        tiles, tkeys = _parents(bkeys, n_bricks)
-        regions, rkeys = _parents(tkeys, len(tkeys))
-        root = np.zeros(int(np.prod(root_dims)), np.uint32)
-        root[rkeys] = np.arange(1, len(rkeys) + 1, dtype=np.uint32)
-        return cls(
-            shape,
-            lo.astype(np.int64),
-            hi.astype(np.int64),
-            root_origin.astype(np.int64),
-            root_dims.astype(np.int64),
-            root,
-            regions,
-            tiles,
-            bricks,
-            count,
-            _column_tops(bkeys, root_dims),
-            block_masks(bricks),
-        )
+        return cls._over_bricks(shape, (lo, hi, root_origin, root_dims), bkeys, bricks, count)
 
     @property
     def nbytes(self) -> int:
