@@ -111,30 +111,16 @@ def test_an_encrypted_key_is_refused_without_asking_for_its_password(tmp_path):
     assert "pass phrase" not in (run.stdout + run.stderr).lower()
 
 
-# Run in its own process: Dask's in-process cluster can hang a later test (or its own
-# teardown) after the refused handshakes; the checks are done once "checked" is printed.
-TLS_CHECKS = r"""
-import os
+# The TLS scheduler runs in a process of its own, and each client check in another: several
+# clients refused in one process sometimes left the next one's IO-loop thread unstarted
+# past distributed's 10 s ("assert loop is not None"), failing the test at random.
+TLS_SERVER = r"""
 import sys
 
-from distributed import Client, LocalCluster
+from distributed import LocalCluster
 from distributed.security import Security
 
-from ladartui.errors import FieldError
-from ladartui.sweep import connect
-from ladartui.sweep.security import cluster_security
-
-ca, cert, key, rogue_ca, rogue_cert, rogue_key = sys.argv[1:7]
-
-
-def refused(make, kinds):
-    try:
-        make().close()
-    except kinds:
-        return True
-    return False
-
-
+ca, cert, key = sys.argv[1:4]
 server = Security(
     tls_ca_file=ca,
     tls_scheduler_cert=cert,
@@ -145,9 +131,6 @@ server = Security(
     tls_client_key=key,
     require_encryption=True,
 )
-foreign = Security(
-    tls_ca_file=rogue_ca, tls_client_cert=rogue_cert, tls_client_key=rogue_key, require_encryption=True
-)
 with LocalCluster(
     n_workers=1,
     threads_per_worker=1,
@@ -157,20 +140,49 @@ with LocalCluster(
     dashboard_address=None,
     security=server,
 ) as cluster:
-    address = cluster.scheduler_address
-    assert address.startswith("tls://127.0.0.1:"), address
-    port = address.rsplit(":", 1)[1]
-    # A rogue client speaking plain TCP, or TLS with no or foreign certificates, gets nothing.
+    print(cluster.scheduler_address, flush=True)
+    sys.stdin.read()  # until the test closes it
+"""
+
+TLS_CLIENT = r"""
+import os
+import sys
+
+from distributed import Client
+from distributed.security import Security
+
+from ladartui.errors import FieldError
+from ladartui.sweep import connect
+from ladartui.sweep.security import cluster_security
+
+check, address, ca, cert, key, rogue_ca, rogue_cert, rogue_key = sys.argv[1:9]
+port = address.rsplit(":", 1)[1]
+
+
+def refused(make, kinds):
+    try:
+        make().close()
+    except kinds:
+        return True
+    return False
+
+
+if check == "plain tcp":  # a rogue client speaking plain TCP gets nothing
     assert refused(lambda: Client(f"tcp://127.0.0.1:{port}", timeout="2s"), (OSError, TimeoutError))
+elif check == "no certificates":
     assert refused(lambda: Client(address, timeout="2s"), (OSError, TimeoutError, TypeError))
+elif check == "foreign certificates":
+    foreign = Security(
+        tls_ca_file=rogue_ca, tls_client_cert=rogue_cert, tls_client_key=rogue_key, require_encryption=True
+    )
     assert refused(lambda: Client(address, timeout="2s", security=foreign), (OSError, TimeoutError))
-    # Through the sweep's own connect: refused without the files, accepted with them.
+elif check == "connect without the files":  # the sweep's own connect
     try:
         connect(address, 2.0)
         raise AssertionError("connected without certificates")
     except FieldError as error:
         assert "--scheduler" in str(error), error
-    # Its port as plain tcp:// (the TLS flags forgotten): the reset is put in words.
+elif check == "connect over tcp":  # its port as plain tcp:// (the TLS flags forgotten): said in words
     try:
         connect(f"tcp://127.0.0.1:{port}", 2.0)
         raise AssertionError("connected over plain TCP")
@@ -181,26 +193,54 @@ with LocalCluster(
             "scheduler (tcp://HOST:PORT); it reset the connection, as a TLS scheduler does to a "
             f"plain client: give tls://127.0.0.1:{port} with --tls-ca-file, --tls-cert and --tls-key"
         ), said
+else:  # with the files: accepted, and a task runs
     client = connect(address, 10.0, cluster_security(address, ca, cert, key))
     assert client.submit(sum, [1, 2, 3]).result(timeout=10) == 6
     client.close()
-    print("checked", flush=True)
-    os._exit(0)
+print("checked", flush=True)
+os._exit(0)
 """
+
+TLS_CHECK_NAMES = (
+    "plain tcp",
+    "no certificates",
+    "foreign certificates",
+    "connect without the files",
+    "connect over tcp",
+    "connect with the files",
+)
 
 
 def test_tls_scheduler_on_loopback_refuses_clients_without_its_certificates(tmp_path):
     ours = make_certificates(tmp_path / "ours")
     rogue = make_certificates(tmp_path / "rogue")
     paths = [str(files[k]) for files in (ours, rogue) for k in ("ca", "cert", "key")]
-    run = subprocess.run(
-        [sys.executable, "-c", TLS_CHECKS, *paths],
-        stdin=subprocess.DEVNULL,
-        capture_output=True,
+    server = subprocess.Popen(
+        [sys.executable, "-c", TLS_SERVER, *paths[:3]],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.DEVNULL,
         text=True,
-        timeout=120,
     )
-    assert run.returncode == 0 and run.stdout.strip() == "checked", run.stderr[-2000:]
+    try:
+        address = server.stdout.readline().strip()
+        assert address.startswith("tls://127.0.0.1:"), address
+        for check in TLS_CHECK_NAMES:
+            run = subprocess.run(
+                [sys.executable, "-c", TLS_CLIENT, check, address, *paths],
+                stdin=subprocess.DEVNULL,
+                capture_output=True,
+                text=True,
+                timeout=120,
+            )
+            assert run.returncode == 0 and run.stdout.strip() == "checked", (check, run.stderr[-2000:])
+    finally:
+        server.stdin.close()
+        try:
+            server.wait(timeout=30)
+        except subprocess.TimeoutExpired:
+            server.kill()
+            server.wait()
 
 
 @pytest.mark.parametrize("address", ["foo", "tcp://head", "http://10.0.0.1:8786", "tcp://head:port"])
