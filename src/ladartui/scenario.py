@@ -11,14 +11,11 @@ from __future__ import annotations
 
 import dataclasses
 import os
-import re
 import shlex
 import sys
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
-
-import tomli_w
 
 from ladartui import defaults
 from ladartui.atomic import write_errors_named, write_text_atomic
@@ -45,11 +42,13 @@ from ladartui.scenario_file import (
     ScenarioReader,
     check_flight,
     checked_target_names,
+    declared_scans,
     is_record,
     parse_document,
     record_owner,
-    relative_path,
     resolve_path,
+    scenario_document,
+    toml_text,
 )
 from ladartui.scenario_style import restyle
 from ladartui.sensor import Sensor
@@ -57,7 +56,6 @@ from ladartui.textsafe import one_line, single_line
 from ladartui.toml_lines import key_lines
 from ladartui.tracing.backend import METHODS, PRECISIONS
 from ladartui.tracing.config import MIN_STEP
-from ladartui.trajectory import LogSegment
 
 BUILTIN_BACKENDS = ("numba", "wgpu")
 MAX_VOXEL_SIZE = 100.0
@@ -157,7 +155,7 @@ class Scenario:
 
     def scan_count(self) -> int:
         """Scans of the flight plan, counted without building the poses where it can be."""
-        return sum(_segment_scans(seg) for seg in self.flight.segments)
+        return sum(declared_scans(seg) for seg in self.flight.segments)
 
     # -- derived file names (report table 2) --
 
@@ -367,42 +365,7 @@ class Scenario:
 
     def to_dict(self) -> dict:
         """The TOML document as plain data (paths relative to the scenario's folder)."""
-        s = self.sensor
-        flight: dict[str, object] = {"speed_mps": self.speed}
-        if self.flight.start is not None:
-            flight["start"] = self.flight.start.to_dict()
-        flight["segments"] = [_segment_to_dict(seg, self.path.parent) for seg in self.flight.segments]
-        sensor: dict[str, object] = {
-            "grid": s.grid,
-            "ray_grid": s.ray_grid,
-            "fov_deg": s.fov,
-            "depth_resolution_m": s.depth_resolution,
-            "pixel_pitch_um": _to_micrometres(s.pixel_pitch),
-        }
-        if s.mount != "stabilised":  # written only when chosen: older files stay as they were
-            sensor["mount"] = s.mount
-        data = {
-            "files": {
-                "scene": relative_path(self.scene_file, self.path.parent),
-                "voxel_size": self.voxel_size,
-            },
-            "sensor": sensor,
-            "flight": flight,
-            "simulation": {
-                "backend": self.backend,
-                "method": self.method,
-                "step": self.step,
-                "precision": self.precision,
-                "fast_mode": self.fast_mode,
-            },
-        }
-        if self.detection is not None:
-            data["detection"] = self.detection.to_dict()
-        if self.levels is not None:
-            data["levels"] = self.levels.to_dict()
-        if self.target_names:
-            data["targets"] = {"names": {str(i): name for i, name in self.target_names}}
-        return data
+        return scenario_document(self)
 
     def to_toml(self) -> str:
         return self.header() + self.toml_body()
@@ -421,7 +384,7 @@ class Scenario:
 
     def toml_body(self) -> str:
         """The TOML document without the header comments."""
-        return _compact_arrays(tomli_w.dumps(self.to_dict()))
+        return toml_text(self.to_dict())
 
     def save(self, path=None) -> Scenario:
         """Write the scenario atomically to ``path`` (default: its own path), making
@@ -546,54 +509,11 @@ def scenario_from_toml(text: str, path) -> Scenario:
 # -- writing ------------------------------------------------------------------------
 
 
-def _segment_to_dict(segment, folder: Path) -> dict:
-    data = {"kind": segment.kind}
-    for f in dataclasses.fields(segment):
-        value = getattr(segment, f.name)
-        if value is None:
-            continue
-        if f.name == "poses":
-            value = [p.to_dict() for p in value]
-        elif isinstance(segment, LogSegment) and f.name == "file":
-            value = relative_path(Path(value), folder)
-        elif isinstance(value, tuple):
-            value = list(value)
-        data[f.name] = value
-    return data
-
-
-def _to_micrometres(metres: float) -> float:
-    # Shortest decimal, so 100e-6 m is written as 100.0 and reads back identically.
-    micrometres = float(f"{metres * 1e6:.12g}")
-    return micrometres if micrometres / 1e6 == metres else metres * 1e6
-
-
-def _compact_arrays(text: str) -> str:
-    """Put short numeric arrays on one line: ``centre = [32.0, 32.0, 1.0]``."""
-    number = r"[-+]?(?:\d[\d_]*(?:\.\d+)?(?:[eE][-+]?\d+)?|inf|nan)"
-
-    def join(match):
-        items = re.findall(number, match.group(1))
-        return "[" + ", ".join(items) + "]"
-
-    return re.sub(r"\[\n((?:[ \t]+" + number + r",\n)+)[ \t]*\]", join, text)
-
-
 def _absolute(path) -> Path:
     return Path(os.path.normpath(user_path(path).absolute()))
 
 
 __all__ = ["Scenario", "load_scenario", "scenario_from_toml", "target_file_for"]
-
-
-def _segment_scans(segment) -> int:
-    if hasattr(segment, "poses"):
-        return len(segment.poses)
-    if hasattr(segment, "standoffs"):
-        return len(segment.standoffs)
-    if hasattr(segment, "scans"):
-        return segment.scans
-    return len(segment.build(None))  # a recorded log: its scans come from the file
 
 
 def check_work(scenario, raise_with=None):
