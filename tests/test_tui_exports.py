@@ -147,3 +147,35 @@ async def test_an_export_that_fails_leaves_the_earlier_pair_and_says_so(tmp_path
         assert f"{scenario.target_output.with_suffix('.las')}: is a folder, expected a file name" in said
         assert scene_las.read_bytes() == b"the earlier export"
         assert not list(tmp_path.glob(".*.las.*"))  # no temporaries left beside them
+
+
+async def test_the_palette_screenshot_goes_beside_the_scenario(tmp_path, scene_files, monkeypatch):
+    """Textual's Screenshot command wrote to ~/Downloads, which a server reached over SSH
+    seldom has: it failed there with no reason given. The picture now goes beside the
+    scenario, as a saved view does, never over an earlier one, and a failure says why."""
+    home = tmp_path / "home"
+    home.mkdir()  # no Downloads folder in it
+    monkeypatch.setenv("HOME", str(home))
+    monkeypatch.delenv("XDG_DOWNLOAD_DIR", raising=False)
+    scenario = make_scenario(tmp_path, scene_files)
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        await app.run_action("screenshot")
+        await wait_until(pilot, lambda: any(m.startswith("Wrote") for m in app.messages))
+        written = tmp_path / "demo-screen.svg"
+        assert app.messages[-1] == f"Wrote {written}"
+        assert written.read_text(encoding="utf-8").lstrip().startswith("<svg")
+        await app.run_action("screenshot")
+        await wait_until(pilot, lambda: app.messages[-1] == f"Wrote {tmp_path / 'demo-screen-2.svg'}")
+        assert (tmp_path / "demo-screen-2.svg").stat().st_size > 0
+
+        def full_disk(target, text, durable=False):
+            raise OSError(28, "No space left on device")
+
+        monkeypatch.setattr("ladartui.tui.file_actions.write_text_atomic", full_disk)
+        await app.run_action("screenshot")
+        await wait_until(pilot, lambda: "Screenshot not saved" in app.messages[-1])
+        assert str(tmp_path / "demo-screen-3.svg") in app.messages[-1]
+        assert "no space left on device" in app.messages[-1].lower()
+        assert not (tmp_path / "demo-screen-3.svg").exists()

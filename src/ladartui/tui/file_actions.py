@@ -1,4 +1,4 @@
-"""New, Open, Save, Save As and the recent list, as the app runs them.
+"""New, Open, Save, Save As, the recent list and the screenshot, as the app runs them.
 
 Every action that would replace the scenario asks first when there are
 unsaved edits (``confirm_discard``); a save first commits what is typed in
@@ -10,7 +10,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
-from ladartui.errors import LadarError
+from ladartui.atomic import numbered_paths, write_text_atomic
+from ladartui.errors import LadarError, os_reason
 from ladartui.recent import remember_scenario
 from ladartui.tui import bridge
 from ladartui.tui.file_dialogs import SaveAsScreen, SetupScreen
@@ -22,6 +23,24 @@ class FileActions(Host):
 
     def _folder(self) -> Path:
         return self.scenario.path.parent if self.scenario else self.cwd
+
+    def action_screenshot(self, filename: str | None = None, path: str | None = None) -> None:
+        """The palette's Screenshot, beside the scenario as a saved view is: Textual's own
+        goes to ~/Downloads, which a server reached over SSH seldom has."""
+        if self.is_web:  # served in a browser: Textual hands the file to it
+            super().action_screenshot(filename, path)
+            return
+        stem = self.scenario.path.stem if self.scenario else "ladartui"
+        target = Path(path) if path else self._folder()
+        target /= filename or f"{stem}-screen.svg"
+        if not filename:  # beside an earlier picture, never over it
+            target = next(candidate for candidate in numbered_paths(target) if not candidate.exists())
+        try:
+            write_text_atomic(target, self.export_screenshot())
+        except OSError as error:
+            self.tell(f"Screenshot not saved: {target}: {os_reason(error)}", severity="error")
+        else:
+            self.tell(f"Wrote {target}")
 
     def action_new_scenario(self) -> None:
         self._setup("new")
