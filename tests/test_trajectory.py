@@ -509,3 +509,16 @@ def test_log_poses_without_a_scan_pose_template_names_it():
     # It raised TypeError from dataclasses.replace.
     with pytest.raises(FieldError, match=r"^template is not set: expected a ScanPose$"):
         log_poses(load_flight_log(EXAMPLE_LOG), None, rate=2.0)
+
+
+def test_the_span_of_a_log_in_gps_seconds_is_written_to_the_decimal_its_records_have(tmp_path):
+    """A log timed in GPS seconds was said to span 'from 1.4e+09 to 1.4e+09 s': the
+    times a user had to write were not in the message."""
+    path = tmp_path / "log.csv"
+    path.write_text("time,x,y,z,heading\n1400000000.5,0,0,60,0\n1400000010.25,10,0,60,0\n")
+    with pytest.raises(FieldError) as caught:
+        log_poses(load_flight_log(path), ScanPose(0, 0, 60), times=[0.5])
+    assert str(caught.value) == (
+        "times = [0.5]: expected a list of 1 to 10000 times from 1400000000.5 to "
+        "1400000010.25 s (the log's span)"
+    )

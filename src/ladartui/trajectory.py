@@ -264,7 +264,8 @@ def rate_field(log: FlightLog, rate) -> float:
 
 def times_field(log: FlightLog, given) -> tuple[float, ...]:
     """Scan times (seconds) checked: 1 to ``MAX_SCANS`` numbers, increasing, within the log."""
-    span = f"times from {log.time[0]:g} to {log.time[-1]:g} s (the log's span)"
+    # to the decimal: a log in GPS seconds spans "1400000000.5 to 1400000010.25", not "1.4e+09"
+    span = f"times from {log.time[0]:.15g} to {log.time[-1]:.15g} s (the log's span)"
     expected = f"a list of 1 to {MAX_SCANS} {span}"
     if given is None or isinstance(given, (str, bytes)):
         raise FieldError("times", given, expected)
