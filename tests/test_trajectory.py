@@ -90,6 +90,24 @@ def test_a_log_of_another_separator_is_told_so_not_that_its_header_lacks_every_c
     )
 
 
+@pytest.mark.parametrize(
+    "header, lacks",
+    [
+        ("time,latitude,longitude,alt,heading", "altitude"),
+        ("time,latitude,longitude,altitude", "heading"),
+        ("time,lat,longitude,altitude,heading", "latitude"),
+    ],
+)
+def test_a_log_in_latitude_and_longitude_lacking_one_of_them_is_told_which(tmp_path, header, lacks):
+    """A latitude and longitude log whose height was headed 'alt' was said to lack x, y
+    and z, columns it was never meant to have, and not the altitude it lacked."""
+    path = tmp_path / "log.csv"
+    path.write_text(f"{header}\n0,51,0,60,90\n1,51.0001,0,60,90\n")
+    with pytest.raises(TrajectoryError) as caught:
+        load_flight_log(path, origin=(51.0, 0.0, 0.0))
+    assert str(caught.value).startswith(f"{path}:1: header lacks {lacks}: expected columns ")
+
+
 def test_example_log_loads():
     from pathlib import Path
 

@@ -121,7 +121,10 @@ def load_flight_log(path, origin=None) -> FlightLog:
                 f"{path}:{header_line}: header names {name} twice "
                 f"(columns {names.index(name) + 1} and {column + 1})"
             )
-    geodetic = all(c in names for c in GEODETIC)
+    # a latitude or a longitude without x, y and z: a geodetic log, whatever else it lacks
+    geodetic = all(c in names for c in GEODETIC) or (
+        any(c in names for c in GEODETIC[:2]) and not all(c in names for c in ("x", "y", "z"))
+    )
     required = ("time", *GEODETIC, "heading") if geodetic else REQUIRED
     missing = [c for c in required if c not in names]
     if missing:
