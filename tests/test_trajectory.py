@@ -540,3 +540,25 @@ def test_the_span_of_a_log_in_gps_seconds_is_written_to_the_decimal_its_records_
         "times = [0.5]: expected a list of 1 to 10000 times from 1400000000.5 to "
         "1400000010.25 s (the log's span)"
     )
+
+
+@pytest.mark.parametrize(
+    "header, column",
+    [
+        ("time (s),x (m),y (m),z (m),heading (deg)", "time (s)"),
+        ("time,x,y,z,heading,roll [deg],pitch [deg]", "roll [deg]"),
+        ("time,x,y,z,heading,roll_rad,pitch_rad", "roll_rad"),
+    ],
+)
+def test_a_log_whose_columns_are_named_with_their_units_is_told_so(tmp_path, header, column):
+    """A header 'time (s),x (m),...' was said to lack time, x, y, z and heading; a roll
+    headed 'roll [deg]' was left out without a word and the log flown wings level."""
+    path = tmp_path / "log.csv"
+    path.write_text(f"{header}\n0,0,0,60,0,5,1\n1,1,0,60,0,5,1\n")
+    with pytest.raises(TrajectoryError) as caught:
+        load_flight_log(path)
+    assert str(caught.value) == (
+        f"{path}:1: header column {column!r} is named with a unit: expected the names alone, "
+        "time, x, y, z, heading, or time, latitude, longitude, altitude, heading (optional roll, "
+        "pitch), in seconds, metres and degrees"
+    )

@@ -17,6 +17,7 @@ along the shortest arc. Errors name ``file:line``.
 from __future__ import annotations
 
 import csv
+import re
 from dataclasses import dataclass, replace
 from functools import partial
 from pathlib import Path
@@ -38,6 +39,8 @@ OPTIONAL = ("roll", "pitch")
 LOG_COLUMNS = (
     f"{', '.join(REQUIRED)}, or time, {', '.join(GEODETIC)}, heading (optional {', '.join(OPTIONAL)})"
 )
+# a unit written after a column's name: "time (s)", "roll [deg]", "pitch_rad"
+UNIT_SUFFIX = re.compile(r"\s*(\(.*\)|\[.*\]|_(s|sec|m|ft|deg|degs|degrees|rad|radians))$")
 LOG_SEPARATORS = (";", "\t", "|")  # what other exports separate columns with
 WGS84_A = 6378137.0  # semi-major axis, metres
 WGS84_F = 1 / 298.257223563  # flattening
@@ -120,6 +123,13 @@ def load_flight_log(path, origin=None) -> FlightLog:
             raise TrajectoryError(
                 f"{path}:{header_line}: header names {name} twice "
                 f"(columns {names.index(name) + 1} and {column + 1})"
+            )
+    for name in names:  # "time (s)", "roll [deg]": not the column, and roll left out unseen
+        bare = UNIT_SUFFIX.sub("", name)
+        if bare != name and bare in (*REQUIRED, *GEODETIC, *OPTIONAL) and bare not in names:
+            raise TrajectoryError(
+                f"{path}:{header_line}: header column {name!r} is named with a unit: expected the "
+                f"names alone, {LOG_COLUMNS}, in seconds, metres and degrees"
             )
     # a latitude or a longitude without x, y and z: a geodetic log, whatever else it lacks
     geodetic = all(c in names for c in GEODETIC) or (
