@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import csv
 import re
+import warnings
 from dataclasses import dataclass, replace
 from functools import partial
 from pathlib import Path
@@ -155,8 +156,82 @@ def load_flight_log(path, origin=None) -> FlightLog:
             "origin on the earth)"
         )
     columns = {name: names.index(name) for name in (*required, *OPTIONAL) if name in names}
+    arr = _clean_records(rows[1:], len(names), required, columns, geodetic)
+    if arr is None:  # read record by record: the first bad one is named
+        values = _checked_records(path, rows[1:], names, required, columns, geodetic)
+        arr = {k: np.array(v, dtype=np.float64) for k, v in values.items()}
+    if len(arr["time"]) < 2:
+        raise TrajectoryError(f"{path}: {plural(len(arr['time']), 'record')}: expected at least 2")
+    if geodetic:
+        xyz = geodetic_to_local(arr["latitude"], arr["longitude"], arr["altitude"], origin)
+        far = np.flatnonzero(np.abs(xyz[:, :2]).max(axis=1) > MAX_COORDINATE)
+        if far.size:  # first: so far away the earth's curve also takes it below the origin
+            at = int(far[0])
+            raise TrajectoryError(
+                f"{path}:{rows[1 + at][0]}: latitude = {float(arr['latitude'][at])!r}, "
+                f"longitude = {float(arr['longitude'][at])!r} put the aircraft "
+                f"{xyz[at, 0] / 1000:.0f} km east and {xyz[at, 1] / 1000:.0f} km north of the "
+                f"origin: expected within {MAX_COORDINATE / 1000:g} km of it each way"
+            )
+        high = int(np.argmax(xyz[:, 2]))
+        if xyz[high, 2] > MAX_ALTITUDE:
+            raise TrajectoryError(
+                f"{path}:{rows[1 + high][0]}: altitude = "
+                f"{float(arr['altitude'][high])!r} puts the aircraft "
+                f"{xyz[high, 2]:.1f} m above the origin: expected at most {MAX_ALTITUDE:g} m above it"
+            )
+        low = int(np.argmin(xyz[:, 2]))
+        if xyz[low, 2] <= 0:
+            raise TrajectoryError(
+                f"{path}:{rows[1 + low][0]}: altitude = "
+                f"{float(arr['altitude'][low])!r} puts the aircraft at "
+                f"{xyz[low, 2]:.1f} m above the origin: expected above it"
+            )
+    else:
+        xyz = np.stack([arr["x"], arr["y"], arr["z"]], axis=1)
+    return FlightLog(arr["time"], xyz, arr["heading"], arr["roll"], arr["pitch"], fingerprint_of(data))
+
+
+def _clean_records(records, width, required, columns, geodetic) -> dict[str, np.ndarray] | None:
+    """The columns of ``records`` ((line number, text) pairs) read at once, or None where
+    any record is not plain numbers within bounds (``_checked_records`` then names it):
+    a million records read in a second or two, not twenty."""
+    lines = [line for _, line in records]
+    if not lines or any('"' in line or line.count(",") != width - 1 for line in lines):
+        return None  # quoted fields, a record of another width: for the csv reading
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            table = np.loadtxt(
+                lines,
+                delimiter=",",
+                comments=None,
+                quotechar=None,
+                usecols=list(columns.values()),
+                dtype=np.float64,
+                ndmin=2,
+            )
+        except ValueError:  # a value no number: named by the record-by-record reading
+            return None
+    got = dict(zip(columns, table.T))
+    checks = [np.isfinite(table).all(), np.all(np.diff(got["time"]) > 0)]
+    checks.append(np.abs(got["time"]).max() <= MAX_LOG_TIME)
+    checks += [np.abs(got[name]).max() <= limit for name, limit in LOG_ANGLE_LIMITS.items() if name in got]
+    checks += [np.abs(got[name]).max() <= MAX_COORDINATE for name in ("x", "y", "z") if name in got]
+    if geodetic:
+        checks += [np.abs(got["latitude"]).max() <= 90.0, np.abs(got["longitude"]).max() <= 180.0]
+    else:
+        checks += [got["z"].min() > 0, got["z"].max() <= MAX_ALTITUDE]
+    if not all(checks) or table.shape != (len(lines), len(columns)):
+        return None
+    return {name: got.get(name, np.zeros(len(lines))) for name in (*required, *OPTIONAL)}
+
+
+def _checked_records(path, records, names, required, columns, geodetic) -> dict[str, list[float]]:
+    """The columns of ``records`` ((line number, text) pairs) read one value at a time:
+    the first that is no number or out of bounds raises, naming its line."""
     values: dict[str, list[float]] = {name: [] for name in (*required, *OPTIONAL)}
-    for number, line in rows[1:]:
+    for number, line in records:
         fields = next(csv.reader([line]))
         if len(fields) != len(names):
             raise TrajectoryError(f"{path}:{number}: {len(fields)} fields, expected {len(names)}")
@@ -202,37 +277,7 @@ def load_flight_log(path, origin=None) -> FlightLog:
             raise TrajectoryError(
                 f"{path}:{number}: z = {fields[columns['z']].strip()!r}: expected at most {MAX_ALTITUDE:g} m"
             )
-    if len(values["time"]) < 2:
-        raise TrajectoryError(f"{path}: {plural(len(values['time']), 'record')}: expected at least 2")
-    arr = {k: np.array(v, dtype=np.float64) for k, v in values.items()}
-    if geodetic:
-        xyz = geodetic_to_local(arr["latitude"], arr["longitude"], arr["altitude"], origin)
-        far = np.flatnonzero(np.abs(xyz[:, :2]).max(axis=1) > MAX_COORDINATE)
-        if far.size:  # first: so far away the earth's curve also takes it below the origin
-            at = int(far[0])
-            raise TrajectoryError(
-                f"{path}:{rows[1 + at][0]}: latitude = {float(arr['latitude'][at])!r}, "
-                f"longitude = {float(arr['longitude'][at])!r} put the aircraft "
-                f"{xyz[at, 0] / 1000:.0f} km east and {xyz[at, 1] / 1000:.0f} km north of the "
-                f"origin: expected within {MAX_COORDINATE / 1000:g} km of it each way"
-            )
-        high = int(np.argmax(xyz[:, 2]))
-        if xyz[high, 2] > MAX_ALTITUDE:
-            raise TrajectoryError(
-                f"{path}:{rows[1 + high][0]}: altitude = "
-                f"{float(arr['altitude'][high])!r} puts the aircraft "
-                f"{xyz[high, 2]:.1f} m above the origin: expected at most {MAX_ALTITUDE:g} m above it"
-            )
-        low = int(np.argmin(xyz[:, 2]))
-        if xyz[low, 2] <= 0:
-            raise TrajectoryError(
-                f"{path}:{rows[1 + low][0]}: altitude = "
-                f"{float(arr['altitude'][low])!r} puts the aircraft at "
-                f"{xyz[low, 2]:.1f} m above the origin: expected above it"
-            )
-    else:
-        xyz = np.stack([arr["x"], arr["y"], arr["z"]], axis=1)
-    return FlightLog(arr["time"], xyz, arr["heading"], arr["roll"], arr["pitch"], fingerprint_of(data))
+    return values
 
 
 # A record's time, in seconds either way of 0: milliseconds since 1970 fit (1.7e12); past
