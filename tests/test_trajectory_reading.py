@@ -38,3 +38,19 @@ def test_logs_of_every_spelling_read_the_same_numbers(tmp_path, header, record):
     log = load_flight_log(path)
     x = [20.0 * t for t in range(4)] if "_0" in record else [2.0 * t for t in range(4)]
     assert log.time.tolist() == [0.0, 1.0, 2.0, 3.0] and log.xyz[:, 0].tolist() == x
+
+
+def test_a_rate_too_high_for_a_log_in_milliseconds_names_the_span_it_was_given(tmp_path):
+    """A minute's log timed in milliseconds was refused 'expected at most 10000 scans over
+    the log': nothing showed that the log's clock read 60,000 s."""
+    from ladartui.errors import FieldError
+    from ladartui.trajectory import LogSegment
+
+    path = tmp_path / "log.csv"
+    path.write_text("time,x,y,z,heading\n1700000000000,0,0,50,90\n1700000060000,1800,0,50,90\n")
+    with pytest.raises(FieldError) as caught:
+        LogSegment(str(path), rate=2.0)
+    assert str(caught.value) == (
+        "rate = 2.0: expected at most 10000 scans over the log, which spans 60000 s "
+        "(from 1700000000000 to 1700000060000 s): 120,001 at this rate"
+    )

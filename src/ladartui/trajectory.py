@@ -315,15 +315,26 @@ def log_poses(log: FlightLog, template: ScanPose, rate: float | None = None, tim
 def rate_field(log: FlightLog, rate) -> float:
     """``rate`` (Hz) checked: above 0, at most ``MAX_SCAN_RATE_HZ`` and ``MAX_SCANS`` over the log."""
     checked = number_field("rate", rate, 0.0, MAX_SCAN_RATE_HZ, low_open=True)
-    if rate_count(log, checked) > MAX_SCANS:
-        raise FieldError("rate", rate, f"at most {MAX_SCANS} scans over the log")
+    count = rate_count(log, checked)
+    if count > MAX_SCANS:  # the span shown: a log in milliseconds reads 1,000 times too long
+        raise FieldError(
+            "rate",
+            rate,
+            f"at most {MAX_SCANS} scans over the log, which spans "
+            f"{log.time[-1] - log.time[0]:.15g} s ({_span(log)}): {count:,} at this rate",
+        )
     return checked
+
+
+def _span(log: FlightLog) -> str:
+    """The log's first and last times to the decimal: a log in GPS seconds spans "from
+    1400000000.5 to 1400000010.25 s", not "from 1.4e+09 to 1.4e+09 s"."""
+    return f"from {log.time[0]:.15g} to {log.time[-1]:.15g} s"
 
 
 def times_field(log: FlightLog, given) -> tuple[float, ...]:
     """Scan times (seconds) checked: 1 to ``MAX_SCANS`` numbers, increasing, within the log."""
-    # to the decimal: a log in GPS seconds spans "1400000000.5 to 1400000010.25", not "1.4e+09"
-    span = f"times from {log.time[0]:.15g} to {log.time[-1]:.15g} s (the log's span)"
+    span = f"times {_span(log)} (the log's span)"
     expected = f"a list of 1 to {MAX_SCANS} {span}"
     if given is None or isinstance(given, (str, bytes)):
         raise FieldError("times", given, expected)
