@@ -59,7 +59,7 @@ def test_roll_across_180_degrees_comes_back_between_minus_180_and_180(tmp_path):
 @pytest.mark.parametrize(
     "text, where, what",
     [
-        ("time,x,y,z\n0,0,0,50\n", ":1:", "header lacks heading"),
+        ("time,x,y,z\n0,0,0,50\n", ":1:", "header 'time,x,y,z' lacks heading"),
         ("time,x,y,z,heading\n0,0,0,50,0\n1,0,abc,50,0\n", ":3:", "y = 'abc': expected a number"),
         ("time,x,y,z,heading\n0,0,0,50,0\n0,0,1,50,0\n", ":3:", "expected times increasing"),
         ("time,x,y,z,heading\n0,0,0,50,0\n1,0,1,50\n", ":3:", "4 fields, expected 5"),
@@ -105,7 +105,7 @@ def test_a_log_in_latitude_and_longitude_lacking_one_of_them_is_told_which(tmp_p
     path.write_text(f"{header}\n0,51,0,60,90\n1,51.0001,0,60,90\n")
     with pytest.raises(TrajectoryError) as caught:
         load_flight_log(path, origin=(51.0, 0.0, 0.0))
-    assert str(caught.value).startswith(f"{path}:1: header lacks {lacks}: expected columns ")
+    assert str(caught.value).startswith(f"{path}:1: header {header!r} lacks {lacks}: expected columns ")
 
 
 def test_example_log_loads():

@@ -54,3 +54,18 @@ def test_a_rate_too_high_for_a_log_in_milliseconds_names_the_span_it_was_given(t
         "rate = 2.0: expected at most 10000 scans over the log, which spans 60000 s "
         "(from 1700000000000 to 1700000060000 s): 120,001 at this rate"
     )
+
+
+@pytest.mark.parametrize("first", ["sep=,", "Logger v2.1 exported 2024-05-01"])
+def test_a_log_whose_first_line_is_no_header_shows_the_line_it_took_for_one(tmp_path, first):
+    """A log whose exporter wrote a line above the header was said to lack time, x, y, z
+    and heading, with nothing of the line read as its header."""
+    from ladartui.trajectory import TrajectoryError
+
+    path = tmp_path / "log.csv"
+    path.write_text(f"{first}\ntime,x,y,z,heading\n0,0,0,60,0\n1,1,0,60,0\n")
+    with pytest.raises(TrajectoryError) as caught:
+        load_flight_log(path)
+    assert str(caught.value).startswith(
+        f"{path}:1: header {first!r} lacks time, x, y, z, heading: expected columns time, x, y, z, "
+    )

@@ -140,7 +140,8 @@ def load_flight_log(path, origin=None) -> FlightLog:
     missing = [c for c in required if c not in names]
     if missing:
         raise TrajectoryError(
-            f"{path}:{header_line}: header lacks {', '.join(missing)}: expected columns {LOG_COLUMNS}"
+            f"{path}:{header_line}: header {_quoted(header, len(names))} lacks {', '.join(missing)}: "
+            f"expected columns {LOG_COLUMNS}"
         )
     if origin is not None and not geodetic:  # it would be taken and never used
         raise FieldError(
@@ -190,6 +191,13 @@ def load_flight_log(path, origin=None) -> FlightLog:
     else:
         xyz = np.stack([arr["x"], arr["y"], arr["z"]], axis=1)
     return FlightLog(arr["time"], xyz, arr["heading"], arr["roll"], arr["pitch"], fingerprint_of(data))
+
+
+def _quoted(header: str, columns: int, limit: int = 80) -> str:
+    """The header line as found (a line an exporter wrote above it, "sep=,"), quoted; a
+    long one cut to its start with its count of columns."""
+    text = header.strip()
+    return repr(text) if len(text) <= limit else f"{text[:limit]!r}... ({columns} columns)"
 
 
 def _clean_records(records, width, required, columns, geodetic) -> dict[str, np.ndarray] | None:
