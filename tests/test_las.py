@@ -222,3 +222,102 @@ def test_a_cloud_too_wide_for_the_voxel_size_says_its_extent_and_the_smallest_si
         "(600 x 20 x 5 m; at most 1,000 voxels a side)"
     )
     assert len(import_las(path, 0.601)[0]) == 2
+
+
+def _cloud_in(path, crs, x, z, *, geotiff_vertical_units=None):
+    """A cloud at ``x`` (and y 0) and heights ``z``, in the units ``crs`` (a pyproj CRS)
+    gives: a LAS 1.4 cloud names it in WKT, a 1.2 cloud in GeoTIFF keys."""
+    from laspy.vlrs.geotiff import GeoKeyEntryStruct
+
+    header = laspy.LasHeader(version="1.2" if geotiff_vertical_units else "1.4", point_format=3)
+    header.scales, header.offsets = [0.01] * 3, [0.0] * 3
+    header.add_crs(crs, keep_compatibility=geotiff_vertical_units is not None)
+    if geotiff_vertical_units:  # VerticalUnitsGeoKey: the heights' own unit (9001 metre)
+        keys = header.vlrs.get("GeoKeyDirectoryVlr")[0]
+        entry = GeoKeyEntryStruct()
+        entry.id, entry.tiff_tag_location, entry.count, entry.value_offset = (
+            4099,
+            0,
+            1,
+            geotiff_vertical_units,
+        )
+        keys.geo_keys.append(entry)
+        keys.geo_keys_header.number_of_keys += 1
+    cloud = laspy.LasData(header)
+    cloud.x, cloud.y, cloud.z = np.asarray(x, float), np.zeros(len(x)), np.asarray(z, float)
+    cloud.write(path)
+    return path
+
+
+def test_a_cloud_in_feet_is_voxelised_in_metres(tmp_path):
+    """A survey in US survey feet (a US state plane) was voxelised as if in metres: its
+    forest came out 3.28 times wider and taller than it is. The units are read from the
+    cloud's coordinate reference system, in WKT (LAS 1.4) or GeoTIFF keys (LAS 1.2)."""
+    import pyproj
+
+    foot = 1200 / 3937  # metres in a US survey foot
+    feet = [0.0, 10.0, 20.0, 30.0]
+    metres = [value * foot for value in feet]
+    for crs in ("EPSG:2263", "EPSG:2263+6360"):  # NY Long Island (ftUS), with NAVD88 height (ftUS)
+        for compatible in (False, True):
+            if compatible and "+" in crs:
+                continue  # GeoTIFF keys name a projected CRS alone
+            path = _cloud_in(
+                tmp_path / "ft.las",
+                pyproj.CRS(crs),
+                feet,
+                feet,
+                geotiff_vertical_units=9003 if compatible else None,
+            )
+            voxels, origin = import_las(path, 1.0, origin=(0.0, 0.0, 0.0))
+            assert sorted_rows(voxels).tolist() == [[0, 0, 0], [3, 0, 3], [6, 0, 6], [9, 0, 9]], crs
+            voxels, origin = import_las(path, 1.0)
+            np.testing.assert_allclose(origin, [0.0, 0.0, 0.0])
+    # heights in metres under a horizontal CRS in feet: only x and y are converted
+    path = _cloud_in(tmp_path / "mixed.las", pyproj.CRS("EPSG:2263+5703"), feet, metres)
+    assert sorted_rows(import_las(path, 1.0, origin=(0, 0, 0))[0]).tolist() == [
+        [0, 0, 0],
+        [3, 0, 3],
+        [6, 0, 6],
+        [9, 0, 9],
+    ]
+    path = _cloud_in(
+        tmp_path / "mixed12.las", pyproj.CRS("EPSG:2263"), feet, metres, geotiff_vertical_units=9001
+    )
+    assert sorted_rows(import_las(path, 1.0, origin=(0, 0, 0))[0]).tolist() == [
+        [0, 0, 0],
+        [3, 0, 3],
+        [6, 0, 6],
+        [9, 0, 9],
+    ]
+    # a cloud in metres (UTM) is read as it is
+    path = _cloud_in(tmp_path / "utm.las", pyproj.CRS("EPSG:32618"), metres, metres)
+    assert sorted_rows(import_las(path, 1.0, origin=(0, 0, 0))[0]).tolist() == [
+        [0, 0, 0],
+        [3, 0, 3],
+        [6, 0, 6],
+        [9, 0, 9],
+    ]
+
+
+def test_a_cloud_in_degrees_or_an_unreadable_crs_is_refused_naming_it(tmp_path):
+    """A cloud in latitude and longitude was voxelised as metres: a whole survey fell in
+    one voxel column. It is refused, as is a coordinate system that cannot be read."""
+    import pyproj
+
+    path = _cloud_in(tmp_path / "geo.las", pyproj.CRS("EPSG:4326"), [10.0, 10.001], [5.0, 6.0])
+    with pytest.raises(InputFileError) as caught:
+        import_las(path, 1.0)
+    said = str(caught.value)
+    assert said.startswith(f"{path}: coordinates in degrees (WGS 84): expected a projected coordinate system")
+    assert "\n" not in said
+    header = laspy.LasHeader(version="1.4", point_format=6)
+    header.vlrs.append(laspy.vlrs.known.WktCoordinateSystemVlr('PROJCS["broken'))
+    header.global_encoding.wkt = True
+    cloud = laspy.LasData(header)
+    cloud.x, cloud.y, cloud.z = np.array([0.0, 1.0]), np.zeros(2), np.zeros(2)
+    cloud.write(tmp_path / "broken.las")
+    with pytest.raises(
+        InputFileError, match=r"broken\.las: its coordinate reference system cannot be read \("
+    ):
+        import_las(tmp_path / "broken.las", 1.0)

@@ -6,7 +6,8 @@ voxel ``floor((p - origin) / voxel_size + 0.5)``. By default the origin is the
 lowest coordinate of the cloud on each axis: the minimum point lands in voxel
 0 on every axis and no index is negative. Export writes voxel centres,
 ``origin + index * voxel_size`` metres. LAZ (compressed) is chosen by the
-``.laz`` suffix.
+``.laz`` suffix. A cloud in feet (its coordinate reference system says so) is
+read in metres; one in latitude and longitude is refused (``las_crs``).
 
 A target model's target ids travel as each point's ``point_source_id`` (an
 unsigned 16-bit field every LAS point format has, hence ids 1..65535):
@@ -26,6 +27,7 @@ import numpy as np
 from ladartui.atomic import atomic_path, write_errors_named
 from ladartui.errors import FieldError, InputFileError, LadarError, described
 from ladartui.fileprobe import path_field, require_file
+from ladartui.scene.las_crs import metres_per_unit
 from ladartui.scene.unique_rows import unique_voxels
 from ladartui.scene.voxel_arrays import voxel_list_field, voxel_size_field
 from ladartui.scene.voxels import MAX_INDEX, MAX_TARGET_ID
@@ -76,6 +78,9 @@ def _triple(values) -> str:
 
 def import_las(path, voxel_size, origin=None, keep_noise=False) -> tuple[np.ndarray, np.ndarray]:
     """Voxelise a LAS/LAZ file: returns ((N, 3) int32 unique voxels, origin (3,) metres).
+
+    Coordinates in feet, as the cloud's coordinate reference system gives them, are
+    read in metres; a cloud in latitude and longitude is refused.
 
     Points classed as noise (ASPRS classes 7 and 18) and points flagged withheld are
     left out unless ``keep_noise``: a survey's stray return kilometres up would make
@@ -136,6 +141,9 @@ def _voxel_indices(path, voxel_size, origin, keep_noise) -> tuple[np.ndarray, np
     if not len(points):
         raise InputFileError(path, "holds no points; expected a LAS or LAZ point cloud")
     _check_no_collapse(path, cloud, points)
+    horizontal, vertical = metres_per_unit(path, cloud.header)
+    if (horizontal, vertical) != (1.0, 1.0):  # a survey in feet
+        points = points * np.array([horizontal, horizontal, vertical])
     source_ids = np.asarray(cloud.point_source_id)
     if not keep_noise:
         kept = ~(np.isin(np.asarray(cloud.classification), NOISE_CLASSES) | np.asarray(cloud.withheld, bool))
