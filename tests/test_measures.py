@@ -452,3 +452,18 @@ def test_per_scan_returns_that_are_no_list_are_named(per_scan, shown):
     assert str(caught.value) == (
         f"scene_per_scan = {shown}: expected a list of each scan's returns, (K, 3) voxel index arrays"
     )
+
+
+def test_a_figure_halfway_between_two_shown_values_rounds_up_everywhere():
+    """A coverage of 5 voxels in 8 (62.5 %) read '62' in the per-scan row beside '62.5 %':
+    Python's formatting rounds an exact half to the even digit, so 12.5 showed as 12
+    and 61.25 as 61.2. Halves now round away from zero, as a reader rounds them."""
+    from ladartui.measures_table import format_number
+    from ladartui.number_text import coverage_steps, fixed, fixed_or_tiny
+
+    assert coverage_steps([0.625, 0.125, 0.875, 0.5]) == "63 13 88 50"
+    assert fixed(61.25, 1) == "61.3" and fixed(62.5, 0) == "63" and fixed(-0.125, 2) == "-0.13"
+    assert fixed(2.675, 2) == "2.67"  # 2.675 is 2.67499999... in binary: no half there
+    assert fixed(0.0, 1) == "0.0" and fixed(-0.01, 1) == "-0.0" and fixed(float("nan"), 1) == "nan"
+    assert fixed_or_tiny(1234.25, 1, grouped=True) == "1,234.3"
+    assert format_number(37.5, 0, "%") == "38 %"
