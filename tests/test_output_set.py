@@ -181,6 +181,32 @@ def test_a_full_disk_at_the_lock_names_it_and_replaces_nothing(scenario, capsys)
     assert hidden(scenario.path.parent) == []
 
 
+def test_no_room_for_a_temporary_names_the_output_in_one_line(scenario, capsys, monkeypatch):
+    """A folder out of inodes (or over an inode quota) let the run's checks through, then
+    refused a temporary beside an output: a traceback ending in tempfile's OSError."""
+    import tempfile
+
+    old = write_old_set(scenario)
+    real = tempfile.mkstemp
+
+    def over_quota(suffix=None, prefix=None, dir=None, text=False):
+        if prefix == ".S_Target.txt." and suffix == ".tmp":  # the set's temporary, not the check's probe
+            path = os.path.join(dir, prefix + "abcdefgh" + suffix)
+            raise OSError(errno.EDQUOT, "Disk quota exceeded", path)
+        return real(suffix, prefix, dir, text)
+
+    monkeypatch.setattr(tempfile, "mkstemp", over_quota)
+    assert main(["run", str(scenario.path)]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert err.strip().splitlines()[-1] == (
+        f"ladartui: error: {scenario.target_output}: could not be written (disk quota exceeded); "
+        "nothing was replaced, earlier outputs are unchanged"
+    )
+    assert snapshot(scenario) == old
+    assert hidden(scenario.path.parent) == []
+
+
 def test_a_full_disk_at_the_journal_names_it_and_replaces_nothing(scenario, capsys, monkeypatch):
     import json
     from types import SimpleNamespace

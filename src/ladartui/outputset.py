@@ -292,9 +292,9 @@ class OutputSet:
         holds: list[int] = []  # so a plain atomic write of one of the names keeps them
         try:
             for name, path in self.paths.items():
-                fd, temps[name] = held_temporary(path)
-                holds.append(fd)
-                try:
+                try:  # a folder out of inodes (or over its quota) refuses the temporary itself
+                    fd, temps[name] = held_temporary(path)
+                    holds.append(fd)
                     writers[name](temps[name])
                 except OSError as error:
                     raise _write_error(path, error) from None
