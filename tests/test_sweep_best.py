@@ -138,20 +138,21 @@ def test_a_ctrl_c_while_the_charts_are_drawn_waits_for_the_whole_set(base, tmp_p
 
     spec = tmp_path / "spec.toml"
     spec.write_text('[sweep]\nscenario = "base.toml"\n[grid]\nradius = [20.0, 30.0]\n', encoding="utf-8")
-    draw = charts.write_sweep_charts
+    draw = charts.sweep_figure
     drawn = []
 
-    def interrupted_while_drawing(result, folder):
+    def interrupted_while_drawing(result):
         _thread.interrupt_main()  # as the key lands on the main thread
-        drawn.append(draw(result, folder))
+        drawn.append(draw(result))
         return drawn[-1]
 
-    monkeypatch.setattr(charts, "write_sweep_charts", interrupted_while_drawing)
+    monkeypatch.setattr(charts, "sweep_figure", interrupted_while_drawing)
     assert main(["sweep", str(spec), "--serial"]) == 0
     out = capsys.readouterr().out.replace("\n", "")
-    assert drawn and all(path.is_file() for path in drawn[0].values())
-    for path in drawn[0].values():
-        assert f"chart    {path}" in out
+    assert drawn
+    for name in ("pareto.svg", "pareto.png"):
+        path = tmp_path / "spec-results" / name
+        assert path.is_file() and f"chart    {path}" in out
 
 
 def test_a_ranking_with_no_best_says_the_best_path_file_is_from_an_earlier_one(base, tmp_path, capsys):
@@ -195,17 +196,72 @@ def test_a_ranking_file_the_folder_will_not_replace_is_one_line(base, tmp_path, 
     before = refused.read_bytes()
     real = os.replace
 
-    def replace(src, dst):
-        if os.path.abspath(dst) == str(refused):
-            raise PermissionError(errno.EPERM, "Operation not permitted", str(src), str(dst))
-        return real(src, dst)
+    real_rename = os.rename
 
-    monkeypatch.setattr(ladartui.atomic.os, "replace", replace)
+    def refusing(real):
+        def move(src, dst):
+            if str(refused) in (os.path.abspath(src), os.path.abspath(dst)):
+                raise PermissionError(errno.EPERM, "Operation not permitted", str(src), str(dst))
+            return real(src, dst)
+
+        return move
+
+    monkeypatch.setattr(ladartui.atomic.os, "replace", refusing(real))
+    monkeypatch.setattr(ladartui.atomic.os, "rename", refusing(real_rename))
     assert main(["sweep", str(spec), "--serial", "--objective", "obscured-coverage"]) == 2
     err = capsys.readouterr().err
     assert "Traceback" not in err
     assert err.strip().splitlines()[-1] == (
-        f"ladartui: error: {refused}: cannot be written (operation not permitted)"
+        f"ladartui: error: {refused}: could not be replaced (operation not permitted); nothing was "
+        f"replaced, earlier outputs are unchanged; {refused.parent / 'results.csv'} keeps this sweep's "
+        "rows (2 variants): the same command ranks them, running none again"
     )
     assert refused.read_bytes() == before
     assert not [p.name for p in refused.parent.iterdir() if p.name.endswith(".tmp")]
+
+
+def test_a_full_disk_at_the_charts_leaves_the_earlier_ranking_whole(base, tmp_path, capsys, monkeypatch):
+    """ranking.csv and the best path were replaced, then the disk filled at the charts:
+    the folder held the new ranking beside the earlier ranking's charts, and the one line
+    said only that pareto.png could not be written."""
+    import errno
+    import os
+    import tempfile
+
+    from ladartui.cli import main
+    from ladartui.sweep import read_table
+
+    spec = tmp_path / "spec.toml"
+    spec.write_text('[sweep]\nscenario = "base.toml"\n[grid]\nradius = [20.0, 30.0]\n', encoding="utf-8")
+    assert main(["sweep", str(spec), "--serial"]) == 0
+    out = tmp_path / "spec-results"
+    ranked = [out / name for name in ("ranking.csv", "spec-best.toml", "pareto.svg", "pareto.png")]
+    before = [path.read_bytes() for path in ranked]
+    spec.write_text(
+        '[sweep]\nscenario = "base.toml"\n[grid]\nradius = [20.0, 30.0, 12.0]\n', encoding="utf-8"
+    )
+    real = tempfile.mkstemp
+
+    def disk_full(suffix=None, prefix=None, dir=None, text=False):
+        if prefix == ".pareto.png." and suffix == ".tmp":  # the chart's temporary
+            raise OSError(errno.ENOSPC, "No space left on device", os.path.join(dir, prefix + suffix))
+        return real(suffix, prefix, dir, text)
+
+    monkeypatch.setattr(tempfile, "mkstemp", disk_full)
+    capsys.readouterr()
+    assert main(["sweep", str(spec), "--serial"]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert err.strip().splitlines()[-1] == (
+        f"ladartui: error: {out / 'pareto.png'}: could not be written (no space left on device); "
+        "nothing was replaced, earlier outputs are unchanged; "
+        f"{out / 'results.csv'} keeps this sweep's rows (3 variants): the same command ranks them, "
+        "running none again"
+    )
+    assert [path.read_bytes() for path in ranked] == before
+    assert len(read_table(out / "results.csv")[0]) == 3
+    assert sorted(p.name for p in out.iterdir() if p.name.startswith(".")) == [".lock"]
+    monkeypatch.undo()
+    assert main(["sweep", str(spec), "--serial"]) == 0
+    assert "nothing to run: all 3 variants resumed" in capsys.readouterr().out
+    assert all(path.read_bytes() != old for path, old in zip(ranked[::2], before[::2]))

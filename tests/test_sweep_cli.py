@@ -95,17 +95,17 @@ def test_a_ctrl_c_after_the_last_variant_says_the_sweep_finished(tiny, tmp_path,
     on the bar and exited 0 with the whole set written, the interrupt not mentioned."""
     import _thread
 
-    import ladartui.sweep.execute as execute
+    import ladartui.sweep.ranked_set as ranked_set
     from ladartui.cli import main
 
-    real = execute.write_ranking
+    real = ranked_set.ranking_text
 
     def interrupted_first(*args, **kwargs):
         _thread.interrupt_main()
         time.sleep(1.0)  # the main thread sees the Ctrl-C and waits for this one
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(execute, "write_ranking", interrupted_first)
+    monkeypatch.setattr(ranked_set, "ranking_text", interrupted_first)
     spec = write_spec(tiny, "[grid]\nradius = [10.0, 12.0]\n", name="late.toml")
     assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path)]) == 0
     captured = capsys.readouterr()

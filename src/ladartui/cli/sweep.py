@@ -316,7 +316,10 @@ def _sweep_with_progress(checked, args, console):
                 bar.update(task, completed=p.done, total=p.total, note=progress_note(p))
 
             def work():
-                result = run_sweep(
+                # The charts are drawn in the set with the ranking and best path: a Ctrl-C
+                # once every variant is done waits for the whole set (it left the last
+                # run's charts), and a full disk leaves the earlier set whole.
+                return run_sweep(
                     spec,
                     client=client,
                     progress=report,
@@ -327,14 +330,9 @@ def _sweep_with_progress(checked, args, console):
                     budget=args.budget,
                     cost=args.cost,
                     serial=args.serial,
+                    charts=True,
                     checked=checked,
                 )
-                # Drawn here, with the ranking and best path written: a Ctrl-C once every
-                # variant is done waits for the whole set (it left the last run's charts).
-                from ladartui.charts.sweep import write_sweep_charts
-
-                result.charts = write_sweep_charts(result, result.results_path.parent)
-                return result
 
             def stopping() -> None:  # a cluster still starting finishes first (seconds)
                 bar.update(task, note="stopping; finished variants are kept")

@@ -97,11 +97,20 @@ def best_files(folder, name: str | None = None) -> list[Path]:
 
 def write_best_scenario(path, base, row: dict, parameter_names, scene_loader) -> BestScenario:
     """Save the scenario of ``row`` (the base with its parameters) as a ready-to-open file,
-    at ``path`` or beside it (``best_target``).
-
-    Written afresh, not over the base file's text: the base's comments describe its own
-    values (an orbit's looks, an altitude's depression), which a variant may change."""
+    at ``path`` or beside it (``best_target``)."""
     from ladartui.atomic import write_errors_named, write_text_atomic
+
+    target, text = best_scenario_text(path, base, row, parameter_names, scene_loader)
+    with write_errors_named(target.path):
+        write_text_atomic(target.path, text)
+    return target  # relative scene path and outputs follow the file
+
+
+def best_scenario_text(path, base, row: dict, parameter_names, scene_loader) -> tuple[BestScenario, str]:
+    """Where the scenario of ``row`` goes (``best_target`` of ``path``) and its text there.
+
+    Made afresh, not from the base file's text: the base's comments describe its own
+    values (an orbit's looks, an altitude's depression), which a variant may change."""
     from ladartui.sweep.table import display_cell
     from ladartui.sweep.variant import apply_parameters
 
@@ -113,8 +122,6 @@ def write_best_scenario(path, base, row: dict, parameter_names, scene_loader) ->
         f"{HEADER} (variant {row.get('variant', '?')}): "
         f"{base.path.name}" + (f" with {settings}" if settings else "")
     )
-    body = scenario.to_toml()
+    body = scenario.to_toml()  # its scene path relative to its own folder
     mark = f"# A later sweep replaces this file until it is edited (fingerprint {_fingerprint(body)})."
-    with write_errors_named(scenario.path):
-        write_text_atomic(scenario.path, f"{header}\n{mark}\n{body}")
-    return target  # relative scene path and outputs follow the file
+    return target, f"{header}\n{mark}\n{body}"

@@ -20,7 +20,6 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ladartui.atomic import write_errors_named, write_text_atomic
 from ladartui.checks import switch_field
 from ladartui.errors import (
     FieldError,
@@ -34,9 +33,9 @@ from ladartui.errors import (
 from ladartui.fileprobe import path_field
 from ladartui.precompile import compile_ahead
 from ladartui.sweep.base import CheckedBase, checked_base, earlier_base_rows, own_rows, spec_digest
-from ladartui.sweep.best_file import best_files, write_best_scenario
 from ladartui.sweep.cluster import check_local_workers, close_client, local_client
 from ladartui.sweep.dask_runs import ClusterLost, run_on_dask
+from ladartui.sweep.ranked_set import CHART_NAMES, RANKING_NAME, set_lock, write_ranked_set
 from ladartui.sweep.ranking import (
     BUDGET_OBJECTIVES,
     COSTS,
@@ -46,11 +45,10 @@ from ladartui.sweep.ranking import (
     rank_rows,
 )
 from ladartui.sweep.spec import SweepSpec, load_sweep_spec
-from ladartui.sweep.table import TableWriter, read_table, table_text
+from ladartui.sweep.table import TableWriter, read_table
 from ladartui.sweep.variant import run_variant
 
 RESULTS_NAME = "results.csv"
-RANKING_NAME = "ranking.csv"
 LOCK_NAME = ".lock"  # held while a sweep writes the folder's tables
 # Rows with these statuses are final; "failed" rows (a crash, a lost worker) run again.
 FINAL_STATUSES = ("ok", "error")
@@ -185,6 +183,7 @@ def run_sweep(
     cost: str | None = None,
     serial: bool = False,
     simulate_options: dict | None = None,
+    charts: bool = False,
     checked: CheckedBase | None = None,
 ) -> SweepResult:
     """Run every variant of ``spec`` not already in the result table, then rank them all.
@@ -199,6 +198,8 @@ def run_sweep(
     ``out/ranking.csv`` and the best scenario ``out/<name>-best.toml``.
     ``simulate_options`` (``backend``, ``method``, ``step``, ``precision``) go to
     every variant's ``simulate``; they are checked before any variant runs.
+    ``charts=True`` also draws the Pareto charts ``out/pareto.svg`` and ``.png``;
+    the ranking, the best scenario and the charts are replaced together or not at all.
     ``checked`` is ``checked_base(spec)`` where the caller refused a bad base or
     spec before this call; without it (or for another spec) this call makes it.
     """
@@ -221,6 +222,7 @@ def run_sweep(
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise FieldError("workers", workers, "an integer >= 1")
     switch_field("serial", serial)
+    switch_field("charts", charts)
     if client is not None:
         _check_client(client)
     if client is None and not serial:
@@ -250,6 +252,7 @@ def run_sweep(
             cost,
             serial,
             simulate_options,
+            charts,
             started,
         )
 
@@ -263,20 +266,17 @@ def _check_client(client) -> None:
         raise FieldError("client", client, "a distributed.Client (or None)")
 
 
-# The sweep command's Pareto charts beside the tables (charts/sweep.py writes them).
-CHART_NAMES = ("pareto.svg", "pareto.png")
-
-
 def check_sweep_files(out: Path, name: str) -> None:
     """``OutputFileError`` naming a file the sweep keeps in ``out`` that it could not
     write (a folder, a pipe or a device there, say), before any variant runs: a pipe
     would be waited on for ever when read, or replaced by a file when written; and
     ``OutputSetBusy`` when another sweep holds the folder now."""
-    from ladartui.outputset import check_writable
+    from ladartui.outputset import check_lock, check_writable
 
     check_writable(
         *(out / file for file in (LOCK_NAME, RESULTS_NAME, RANKING_NAME, f"{name}-best.toml", *CHART_NAMES))
     )
+    check_lock(set_lock(out))
     if (out / LOCK_NAME).is_file():  # held now: said before a bar or a cluster starts
         with _exclusive(out):
             pass
@@ -338,6 +338,7 @@ def _run_locked(
     cost,
     serial,
     simulate_options,
+    charts,
     started,
 ) -> SweepResult:
     variants = spec.variants
@@ -404,15 +405,7 @@ def _run_locked(
         unreadable_lines=unreadable,
         unreadable_removed=table.written,
     )
-    result.ranking_path = write_ranking(out / RANKING_NAME, ranking, spec.parameter_names)
-    if result.best is not None:
-        written = write_best_scenario(
-            out / f"{spec.name}-best.toml", base, result.best.row, spec.parameter_names, scene
-        )
-        result.best_scenario_path, result.best_kept = written.path, written.kept
-        result.best_kept_why = written.kept_why
-    else:  # what an earlier ranking found: kept, named
-        result.best_earlier = next(iter(best_files(out, spec.name)), None)
+    write_ranked_set(result, spec.name, base, scene, charts)
     result.elapsed = time.perf_counter() - started
     return result
 
@@ -456,40 +449,6 @@ def _run_serial(todo, base, digest, scene, options, record, cancel):
         if cancel is not None:
             run_options["cancel"] = cancel
         record(run_variant(base, variant.params, variant.id, digest, scene, run_options))
-
-
-def write_ranking(path, ranking: list[Ranked], parameter_names) -> Path:
-    """The ranking as CSV (rank, objective value, Pareto flag, then the row), written atomically."""
-    columns = [
-        "rank",
-        "variant",
-        "objective",
-        "pareto",
-        "coverage",
-        "cost",
-        "status",
-        *parameter_names,
-        "path_length_m",
-        "flight_time_s",
-        "error",
-    ]
-    rows = []
-    for entry in ranking:
-        row = entry.row
-        rows.append(
-            {
-                **{name: row.get(name) for name in columns},
-                "rank": entry.rank,
-                "objective": entry.value,
-                "pareto": entry.pareto,
-                "coverage": entry.coverage,
-                "cost": entry.cost,
-            }
-        )
-    text = table_text(rows, columns=columns)
-    with write_errors_named(path):
-        write_text_atomic(path, text)
-    return Path(path)
 
 
 def spec_argument(spec) -> SweepSpec:
