@@ -155,3 +155,40 @@ def test_the_command_to_open_the_best_path_runs_as_written_from_a_folder_with_sp
     line = next(s for s in capsys.readouterr().out.splitlines() if s.startswith("best "))
     command = line.split("(open it with: ", 1)[1].removesuffix(")")
     assert shlex.split(command) == ["ladartui", str(out / "cli-best.toml")]
+
+
+def test_a_disk_full_mid_sweep_says_how_many_variants_the_table_keeps(tiny, tmp_path, capsys, monkeypatch):
+    """The disk filled as the table was rewritten: the sweep stopped saying only that
+    results.csv could not be written, as if nothing were kept, where an interruption says
+    how many variants are kept and that the same command resumes."""
+    import errno
+    import functools
+    import tempfile
+
+    from ladartui.cli import main
+    from ladartui.sweep.table import TableWriter
+
+    spec = write_spec(tiny, "[grid]\nradius = [10.0, 12.0, 14.0, 16.0]\n", name="filling.toml")
+    real, made = tempfile.mkstemp, []
+
+    def filling(suffix=None, prefix=None, dir=None, text=False):
+        if prefix == ".results.csv." and suffix == ".tmp":  # the table's rewrites
+            made.append(prefix)
+            if len(made) > 2:
+                raise OSError(errno.ENOSPC, "No space left on device", os.path.join(dir, prefix + suffix))
+        return real(suffix, prefix, dir, text)
+
+    monkeypatch.setattr(tempfile, "mkstemp", filling)
+    each_row = functools.partial(TableWriter, spacing=0.0)  # each row rewrites the table
+    monkeypatch.setattr("ladartui.sweep.execute.TableWriter", each_row)
+    assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert err.strip().splitlines()[-1] == (
+        f"ladartui: error: {tmp_path / 'results.csv'}: cannot be written (no space left on device); "
+        "it keeps 2 of 4 variants, as last written: run the sweep again to resume once it can be written"
+    )
+    assert len(read_table(tmp_path / "results.csv")[0]) == 2
+    monkeypatch.undo()
+    assert main(["sweep", str(spec), "--serial", "--out", str(tmp_path)]) == 0
+    assert run_sweep(spec, serial=True, out=tmp_path).resumed == 4

@@ -31,6 +31,7 @@ from ladartui.errors import (
     check_cancelled,
 )
 from ladartui.fileprobe import path_field
+from ladartui.number_text import plural
 from ladartui.precompile import compile_ahead
 from ladartui.sweep.base import CheckedBase, checked_base, earlier_base_rows, own_rows, spec_digest
 from ladartui.sweep.cluster import check_local_workers, close_client, local_client
@@ -355,8 +356,8 @@ def _run_locked(
     state = SweepProgress(total=len(variants), done=resumed, resumed=resumed, failed=0, elapsed=0.0)
 
     def record(row):
+        state.done += 1  # (before the row is put: a put that fails counts it as unwritten)
         table.put(row)
-        state.done += 1
         state.failed += row.get("status") not in FINAL_STATUSES
         state.impossible += row.get("status") == "error"
         state.elapsed = time.perf_counter() - started
@@ -378,6 +379,13 @@ def _run_locked(
         else:
             if isinstance(error, ClusterLost):  # what is kept, and how to go on
                 raise ClusterLost(f"{error}; {_kept(state, results_path)}") from None
+        if isinstance(error, OutputFileError) and error.path == str(results_path):  # a full disk
+            kept = state.done - table.unwritten
+            raise OutputFileError(
+                error.path,
+                f"{error.reason}; it keeps {kept:,} of {plural(state.total, 'variant')}, as last written: "
+                "run the sweep again to resume once it can be written",
+            ) from None
         raise
     table.flush()
 

@@ -188,6 +188,7 @@ class TableWriter:
         self._columns: list[str] = []
         self._known: set[str] = set()  # the columns, to look up
         self._held = False  # rows put since the last write
+        self.unwritten = 0  # of those, how many (a row put twice counts twice)
         self._next_write = 0.0  # clock() from which a rewrite may start
         self.written = False  # whether the file was rewritten
 
@@ -220,6 +221,7 @@ class TableWriter:
         else:
             lines[at] = _row_line(row, self._columns)
         self._held = True
+        self.unwritten += 1
         if self.clock() >= self._next_write:
             self.flush()
 
@@ -234,7 +236,7 @@ class TableWriter:
             write_text_atomic(self.path, text, durable=True)
         finished = self.clock()
         self._next_write = finished + self.spacing * (finished - started)
-        self._held, self.written = False, True
+        self._held, self.written, self.unwritten = False, True, 0
 
 
 def read_table(path, unreadable: list[int] | None = None) -> tuple[list[dict], list[str]]:
