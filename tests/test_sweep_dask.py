@@ -71,6 +71,36 @@ def test_local_workers_ignore_ctrl_c_which_this_process_handles(client):
     assert set(client.run(_sigint_handler).values()) == {signal.SIG_IGN}
 
 
+def _worker_errors_logged():
+    """In a worker: which of a failed heartbeat and another error its log lets through."""
+    import logging
+
+    from ladartui.sweep.cluster import HEARTBEAT_FAILED
+
+    log, seen = logging.getLogger("distributed.worker"), []
+
+    class Keep(logging.Handler):
+        def emit(self, record):
+            seen.append(record.getMessage())
+
+    keep = Keep()
+    log.addHandler(keep)
+    try:
+        log.error(HEARTBEAT_FAILED + ".")
+        log.error("another worker error")
+    finally:
+        log.removeHandler(keep)
+    return tuple(seen)
+
+
+def test_local_workers_never_log_a_failed_heartbeat(client):
+    """A sweep killed (kill -9, the kernel's out-of-memory killer) took the scheduler
+    with it: its running workers printed 'Failed to communicate with scheduler during
+    heartbeat' with two tracebacks each under the command's last line, in two kills of
+    three. A local worker's scheduler is the sweep's own process."""
+    assert set(client.run(_worker_errors_logged).values()) == {("another worker error",)}
+
+
 def test_a_local_schedulers_lost_scattered_data_is_not_logged(client, caplog):
     """SIGTERM to the process group reaches the workers too: every stop printed the
     scheduler's 'caused the cluster to lose scattered data' ERROR line."""
