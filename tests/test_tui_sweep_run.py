@@ -279,3 +279,20 @@ async def test_a_finished_sweep_shows_its_whole_100_percent(finished, tmp_path):
         percent = screen.query_one("#sweep-progress PercentageStatus")
         assert str(percent.render()) == "100%"
         assert percent.content_region.width >= len("100%")
+
+
+async def test_a_sweep_from_the_screen_draws_its_charts_with_its_ranking(finished, tmp_path):
+    """The screen's sweep replaced the ranking and best path but left an earlier sweep's
+    pareto.svg and .png beside them, charts of another ranking; it draws them as the
+    command does, in one set with the ranking."""
+    spec = _copy_of_finished(finished, tmp_path)
+    out = tmp_path / finished[1].name
+    (out / "pareto.svg").write_text("an earlier sweep's chart")
+    screen = SweepScreen(spec, serial=True)
+    app = SweepHost(screen)
+    async with app.run_test(size=SIZE) as pilot:
+        await opened(pilot)
+        await pilot.press("f5")
+        await wait_for(pilot, lambda: not screen.running)
+    assert (out / "pareto.svg").read_text().lstrip().startswith("<?xml"), screen.last_message
+    assert (out / "pareto.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -115,6 +115,7 @@ def sweep_job(
             cost=cost,
             budget=budget,
             serial=serial,
+            charts=True,  # as the command draws them: never an earlier ranking's beside this one
             progress=lambda p: progress(p.fraction, "", p, keep=p.row is not None),
         )
     finally:
