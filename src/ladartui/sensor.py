@@ -64,8 +64,9 @@ def pose_rotation(pose: ScanPose) -> np.ndarray:
     return rotation_z(-(pose.heading + pose.azimuth)) @ rotation_x(90.0 - pose.depression)
 
 
-def _rotation(pose: ScanPose, attitude) -> np.ndarray:
-    """``pose_rotation``, turned by the aircraft's (roll, pitch) for a body-fixed sensor."""
+def scan_rotation(pose: ScanPose, attitude=None) -> np.ndarray:
+    """Sensor-to-scene rotation of a scan: ``pose_rotation``, turned by the aircraft's
+    (roll, pitch) for a body-fixed sensor (``attitude``; None: stabilised)."""
     rotation = pose_rotation(pose_field("pose", pose))
     if attitude is None:
         return rotation
@@ -247,7 +248,7 @@ class Sensor:
             row0,
             row1,
             *self._axes,
-            _rotation(pose, attitude),
+            scan_rotation(pose, attitude),
             np.array(pose.position, dtype=np.float64),
             origins,
             directions,
@@ -257,7 +258,7 @@ class Sensor:
 
     def central_ray(self, pose: ScanPose, attitude=None):
         """(origin (3,), unit direction (3,)) of the sensor's boresight at ``pose``."""
-        rotation = _rotation(pose, attitude)
+        rotation = scan_rotation(pose, attitude)
         return np.array(pose.position), rotation @ np.array([0.0, 0.0, -1.0])
 
     def corner_directions(self, pose: ScanPose, attitude=None) -> np.ndarray:
@@ -266,7 +267,7 @@ class Sensor:
         t = math.tan(math.radians(self.fov / 2))
         local = np.array([[-t, t, -1.0], [t, t, -1.0], [t, -t, -1.0], [-t, -t, -1.0]])
         local /= np.linalg.norm(local, axis=1, keepdims=True)
-        return local @ _rotation(pose, attitude).T
+        return local @ scan_rotation(pose, attitude).T
 
     def footprint(self, pose: ScanPose, ground_z: float = 0.0, attitude=None) -> np.ndarray:
         """Where the four field-of-view corners meet the plane z = ``ground_z``: (4, 3).

@@ -15,7 +15,8 @@ def add_parser(subparsers):
         "scene and target model files, estimate the memory the tracing structures need, then "
         "print a summary (sensor, scans, path length, flight time, scene size, memory, "
         "outputs, and whether the outputs on disk came from this file's settings and its "
-        "model files as they are now). A mistake "
+        "model files as they are now), with notes such as a flight path whose scans never "
+        "look at the scene or at a target. A mistake "
         "is reported on one line with exit status 2. A sound scenario that a run would "
         "still refuse before tracing (a folder or a file of another kind where an output "
         "goes, more rays than LADARTUI_MAX_RAYS allows, another run writing its outputs now) "
@@ -53,7 +54,7 @@ def run(args) -> int:
     except OutputFileError as error:  # a file where an output goes: the scenario is sound
         refused = error
     print(visible(scenario.summary()))
-    notes = [*flight_notes(scenario.flight), *detection_notes(scenario)]
+    notes = [*flight_notes(scenario.flight), *reach_lines(scenario, scene), *detection_notes(scenario)]
     writer = run_writing(scenario)
     refusals = [*ray_limit_refusals(scenario), *next_run_refusals(scenario, refused, writer)]
     earlier = last_run_lines(scenario, scene, writable=not refusals, writer=writer)
@@ -71,6 +72,13 @@ def flight_notes(flight) -> list[str]:
         f"note       [flight.start] is not used: the path starts at its first segment ({first}), "
         "which places its own scans"
     ]
+
+
+def reach_lines(scenario, scene) -> list[str]:
+    """A path none of whose scans looks at the scene, or at a target: a run covers nothing there."""
+    from ladartui.view_reach import reach_notes
+
+    return [f"note       {note}" for note in reach_notes(scenario, scene)]
 
 
 def detection_notes(scenario) -> list[str]:
