@@ -516,3 +516,45 @@ class LogSegment:
     def leg_seconds(self, poses) -> list[float]:
         """Seconds between consecutive scans by the log's own clock, not the plan's speed."""
         return np.diff(self.scan_times()).tolist()
+
+
+HEADING_TOLERANCE = 45.0  # degrees off the track: a crab in a strong wind stays well within it
+MIN_TRACK_SPEED = 1.0  # m/s across the ground: slower, a heading says nothing of a track
+
+
+def heading_note(log: FlightLog, name: str = "") -> str | None:
+    """A sentence when the logged heading is more than ``HEADING_TOLERANCE`` off the
+    direction of travel over most of the distance flown, saying whether the headings
+    read as radians or as degrees counter-clockwise from east; None otherwise."""
+    legs = np.diff(log.xyz[:, :2], axis=0)
+    length = np.hypot(legs[:, 0], legs[:, 1])
+    moving = length > MIN_TRACK_SPEED * np.diff(log.time)
+    if not moving.any():
+        return None
+    length = length[moving]
+    track = np.degrees(np.arctan2(legs[moving, 0], legs[moving, 1])) % 360.0
+    first, turn = log.heading[:-1][moving], log.heading[1:][moving]
+
+    def off_share(convert) -> float:
+        start, end = convert(first), convert(turn)
+        middle = start + ((end - start + 180.0) % 360.0 - 180.0) / 2  # along the shortest arc
+        off = np.abs((middle - track + 180.0) % 360.0 - 180.0) > HEADING_TOLERANCE
+        return float(length[off].sum() / length.sum())
+
+    share = off_share(lambda h: h)
+    if share <= 0.5:
+        return None
+    said = (
+        f"{name or 'the log'}: the logged heading differs from the direction of travel by more than "
+        f"{HEADING_TOLERANCE:g} degrees over {share:.0%} of the distance flown: "
+    )
+    expected = "expected degrees clockwise from north"
+    value, along = float(first[0]), f"{track[0]:.0f}"
+    if np.abs(log.heading).max() <= 2 * np.pi + 1e-6 and off_share(np.degrees) <= 0.5:
+        return f"{said}the headings read as radians ({value:.4g} for {along} degrees): {expected}"
+    if off_share(lambda h: 90.0 - h) <= 0.5:
+        return (
+            f"{said}the headings read as degrees counter-clockwise from east ({value:.4g} for {along} "
+            f"degrees clockwise from north): {expected}"
+        )
+    return f"{said}{expected} (an aircraft flying sideways, as a multirotor can, gives this too)"

@@ -64,13 +64,19 @@ def run(args) -> int:
 
 
 def flight_notes(flight) -> list[str]:
-    """A start pose the path never flies from (the TUI greys its fields out)."""
+    """A start pose the path never flies from (the TUI greys its fields out), and a flight
+    log whose heading disagrees with its direction of travel."""
+    from ladartui.trajectory import heading_note
+
+    logs = [seg for seg in flight.segments if seg.kind == "log"]
+    notes = [f"note       {note}" for seg in logs if (note := heading_note(seg.log, Path(seg.file).name))]
     if flight.start is None or flight.uses_start:
-        return []
+        return notes
     first = flight.segments[0].kind
     return [
         f"note       [flight.start] is not used: the path starts at its first segment ({first}), "
-        "which places its own scans"
+        "which places its own scans",
+        *notes,
     ]
 
 
