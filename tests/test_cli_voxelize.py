@@ -163,12 +163,12 @@ def test_a_negative_value_is_taken_as_the_value_of_its_flag(tmp_path, truck, cap
     assert with_equals.startswith("ladartui: error: --at = ") and "expected a position" in with_equals
 
 
-@pytest.mark.parametrize("empty", ["MESH", "OUT", "--into"])
+@pytest.mark.parametrize("empty", ["SOURCE", "OUT", "--into"])
 def test_an_empty_path_names_its_argument(tmp_path, truck, forest, capsys, monkeypatch, empty):
-    """An empty OUT ended in a ValueError traceback; an empty MESH was '.: is a folder' and
+    """An empty OUT ended in a ValueError traceback; an empty SOURCE (MESH) was '.: is a folder' and
     an empty --into was taken as no --into."""
     monkeypatch.chdir(tmp_path)
-    mesh, out = ("" if empty == "MESH" else str(truck)), ("" if empty == "OUT" else "t")
+    mesh, out = ("" if empty == "SOURCE" else str(truck)), ("" if empty == "OUT" else "t")
     into = "" if empty == "--into" else str(forest)
     assert main(["voxelize", mesh, out, "--voxel-size", "0.1", "--at", "3,3", "--into", into]) == 2
     assert one_error_line(capsys) == f"ladartui: error: {empty} = '': expected a file name"

@@ -1,4 +1,5 @@
-"""``ladartui voxelize MESH OUT``: a target model from a triangle mesh, optionally put into a scene."""
+"""``ladartui voxelize SOURCE OUT``: a target model from a triangle mesh, optionally put into a
+scene; or a scene model from a LAS/LAZ point cloud (``voxelize_cloud``)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import time
 
 from ladartui.cli.flags import as_flags, check_file_names, check_scene_stem, voxel_size_flag
 from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt
-from ladartui.errors import Cancelled, FieldError, check_cancelled
+from ladartui.errors import Cancelled, FieldError, LadarError, check_cancelled
 from ladartui.number_text import extent_metres, plural
 from ladartui.textsafe import one_line, single_line
 
@@ -17,18 +18,33 @@ from ladartui.textsafe import one_line, single_line
 def add_parser(subparsers):
     parser = subparsers.add_parser(
         "voxelize",
-        help="make a target model from a mesh (.obj, .stl, .ply), optionally inserted into a scene",
+        help="make a target model from a mesh (.obj, .stl, .ply), optionally inserted into a scene; "
+        "or a scene model from a point cloud (.las, .laz)",
         description="Voxelise a triangle mesh exactly: a voxel is set when the surface passes "
         "through its interior (a face lying on a voxel boundary counts for the voxel on its "
         "inner side), and with --solid also when its centre is inside the closed mesh. The mesh "
         "is in metres (see --scale), z up (see --up), its +y the vehicle's forward direction. "
         "Without --into, OUT is the target model (a comma-delimited voxel list). With --into "
         "SCENE.txt, the vehicle is added to that scene model and its SCENE_Target.txt, written "
-        "together as OUT.txt and OUT_Target.txt (OUT may be SCENE itself).",
+        "together as OUT.txt and OUT_Target.txt (OUT may be SCENE itself). "
+        "A point cloud (a survey, .las or .laz) is voxelised where it was surveyed into a scene "
+        "model: OUT.txt holds a voxel for each voxel its points fall in, and OUT_Target.txt is "
+        "written beside it empty (no vehicle yet: a scenario plans over it as it is, and "
+        "'voxelize MESH OUT --into OUT.txt --at X,Y' adds one). Voxel (0, 0, 0) is centred on "
+        "the cloud's lowest x, y and z; the command says where that is in the cloud's "
+        "coordinates, and scene metres (--at, flight paths) count from there. A cloud in feet "
+        "(as its coordinate system says) is read in metres. Points classed as noise (ASPRS 7, "
+        "18) or flagged withheld are left out unless --keep-noise. The mesh flags (--at, "
+        "--heading, --solid, --scale, --up, --id, --into) are refused with a point cloud.",
     )
-    parser.add_argument("mesh", metavar="MESH", help="mesh file: .obj, .stl or .ply")
     parser.add_argument(
-        "out", metavar="OUT", help="target model to write (.txt added when missing); with --into, the scene"
+        "mesh", metavar="SOURCE", help="mesh file (.obj, .stl or .ply), or point cloud (.las or .laz)"
+    )
+    parser.add_argument(
+        "out",
+        metavar="OUT",
+        help="target model to write (.txt added when missing); with --into or a point cloud, the "
+        "scene's stem (X writes X.txt and X_Target.txt)",
     )
     parser.add_argument(
         "--voxel-size", metavar="V", type=float, required=True, help="voxel size in metres (the scene's)"
@@ -41,7 +57,7 @@ def add_parser(subparsers):
         "the mesh starts at voxel (0, 0, 0)",
     )
     parser.add_argument(
-        "--heading", metavar="DEG", type=float, default=0.0, help="degrees clockwise from north (needs --at)"
+        "--heading", metavar="DEG", type=float, help="degrees clockwise from north (needs --at; default 0)"
     )
     parser.add_argument("--solid", action="store_true", help="fill the inside (needs a closed mesh)")
     parser.add_argument(
@@ -56,11 +72,53 @@ def add_parser(subparsers):
         "new. Without --id the vehicle joins a one-target model, or takes the next free id",
     )
     parser.add_argument(
-        "--scale", metavar="S", type=float, default=1.0, help="metres per mesh unit (default 1; 0.001 for mm)"
+        "--scale", metavar="S", type=float, help="metres per mesh unit (default 1; 0.001 for mm)"
     )
-    parser.add_argument("--up", choices=("z", "y"), default="z", help="the mesh's up axis (default z)")
+    parser.add_argument("--up", choices=("z", "y"), help="the mesh's up axis (default z)")
+    parser.add_argument(
+        "--keep-noise",
+        action="store_true",
+        help="point clouds: keep points classed as noise (ASPRS 7, 18) or flagged withheld",
+    )
     parser.set_defaults(handler=run)
     return parser
+
+
+CLOUD_SUFFIXES = (".las", ".laz")
+# Flags that place, shape or label a mesh: a point cloud is voxelised where it was surveyed.
+MESH_FLAGS = ("at", "heading", "solid", "scale", "up", "id")
+
+
+def is_point_cloud(source: str) -> bool:
+    """Whether SOURCE names a LAS or LAZ point cloud (by its suffix, in any case)."""
+    from pathlib import Path
+
+    return Path(source).suffix.lower() in CLOUD_SUFFIXES
+
+
+def refuse_mesh_flags(args) -> None:
+    """A mesh's flag given with a point cloud would be dropped without a word: refused,
+    naming it; ``--into`` too (a survey is a scene of its own, vehicles go into it after)."""
+    for name in MESH_FLAGS:
+        if getattr(args, name) is not None and getattr(args, name) is not False:  # --heading 0 too
+            flag = "--" + name
+            raise LadarError(
+                f"{flag} is for a mesh; {args.mesh} is a point cloud, voxelised where it was "
+                f"surveyed as a whole scene: drop {flag}"
+            )
+    if args.into is not None:
+        raise LadarError(
+            f"--into adds a mesh's vehicle to a scene; {args.mesh} is a point cloud, voxelised as a "
+            "scene of its own: drop --into, then add vehicles to that scene with "
+            "'voxelize MESH OUT --into OUT.txt --at X,Y'"
+        )
+
+
+def mesh_defaults(args) -> None:
+    """The mesh flags not given take their defaults (left None to tell a flag typed)."""
+    for name, default in (("heading", 0.0), ("scale", 1.0), ("up", "z")):
+        if getattr(args, name) is None:
+            setattr(args, name, default)
 
 
 def _position(text: str) -> tuple[float, ...]:
@@ -83,8 +141,16 @@ def run(args) -> int:
     from ladartui.scene.voxelize import CANCELLED, Placement
     from ladartui.scene.voxels import MAX_TARGET_ID
 
-    check_file_names({"MESH": args.mesh, "OUT": args.out, "--into": args.into})
+    check_file_names({"SOURCE": args.mesh, "OUT": args.out, "--into": args.into})
     voxel_size_flag(args.voxel_size)  # the scene's, so one a scenario takes
+    cloud = is_point_cloud(args.mesh)
+    if cloud:
+        refuse_mesh_flags(args)
+    elif args.keep_noise:
+        raise LadarError(
+            f"--keep-noise is for a point cloud (.las, .laz); {args.mesh} is a mesh: drop --keep-noise"
+        )
+    mesh_defaults(args)
     if not (args.scale > 0 and math.isfinite(args.scale)):
         raise FieldError("--scale", args.scale, "a positive number of metres per mesh unit")
     if not (math.isfinite(args.heading) and abs(args.heading) <= 360.0):
@@ -98,10 +164,11 @@ def run(args) -> int:
     if args.at is not None:
         x, y, *rest = _position(args.at)
         placement = Placement(x, y, rest[0] if rest else 0.0, args.heading)
+    scene_out = bool(args.into) or cloud  # OUT is a scene's stem
     if args.out.endswith(("/", os.sep)) or Path(args.out).is_dir():  # not a stem: "models" + ".txt"
         wanted = (
             "the scene's stem (X writes X.txt and X_Target.txt)"
-            if args.into
+            if scene_out
             else "a target model's file name (X.txt)"
         )
         raise FieldError("OUT", args.out, f"{wanted}, not a folder")
@@ -109,12 +176,19 @@ def run(args) -> int:
         suffix = Path(args.out).suffix
         wanted = (
             "the scene's stem (X writes X.txt and X_Target.txt)"
-            if args.into
+            if scene_out
             else "a voxel-list name ending in .txt"
         )
         what = "a mesh" if other_file_kind(args.out) == "a mesh" else f"a {suffix} file name"
         raise FieldError("OUT", args.out, f"{wanted}, not {what}")
     outputs: tuple[Path, ...]
+    if cloud:
+        from ladartui.cli.voxelize_cloud import scene_from_cloud
+
+        outputs = scene_model_paths(args.out)
+        check_scene_stem("OUT", args.out, outputs[0])
+        check_writable(*outputs)
+        return scene_from_cloud(args, outputs)
     if args.into:
         outputs = scene_model_paths(args.out)
         check_scene_stem("OUT", args.out, outputs[0])

@@ -20,12 +20,15 @@ every other voxel (foliage, ground) with 0.
 from __future__ import annotations
 
 import math
+import threading
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from ladartui.atomic import atomic_path, write_errors_named
-from ladartui.errors import FieldError, InputFileError, LadarError, described
+from ladartui.errors import Cancelled, FieldError, InputFileError, LadarError, check_cancelled, described
 from ladartui.fileprobe import path_field, require_file
 from ladartui.scene.las_crs import metres_per_unit
 from ladartui.scene.unique_rows import unique_voxels
@@ -33,6 +36,35 @@ from ladartui.scene.voxel_arrays import voxel_list_field, voxel_size_field
 from ladartui.scene.voxels import MAX_INDEX, MAX_TARGET_ID
 
 NOISE_CLASSES = (7, 18)  # ASPRS: low point (noise), high noise
+READ_POINTS = 1_000_000  # points read at a time: progress and the cancel between them
+CANCELLED = "voxelisation cancelled; nothing was written"
+
+Progress = Callable[[str, int, int], None]
+
+
+class AllNoise(InputFileError):
+    """Every point of a cloud is noise or withheld; ``keep`` says how to keep them (a
+    command passing ``keep_noise`` on from a flag names the flag)."""
+
+    def __init__(self, path, points: int, keep: str = "keep_noise=True"):
+        self.points = points
+        super().__init__(
+            path,
+            f"all {points:,} points are noise or withheld (ASPRS classes 7 and 18, or the "
+            f"withheld flag); expected ground, vegetation or object points ({keep} takes them)",
+        )
+
+
+@dataclass(frozen=True)
+class CloudVoxels:
+    """A point cloud voxelised: what ``voxelize_cloud`` gives."""
+
+    voxels: np.ndarray  # (N, 3) int32, unique
+    origin: np.ndarray  # (3,) metres: voxel (0, 0, 0)'s centre
+    metres_per_unit: tuple[float, float]  # in the cloud's coordinates: x and y, z
+    unit: str  # the unit of its x and y, as its coordinate system names it ("metre")
+    points: int  # points in the file
+    left_out: int  # of them, noise or withheld points left out
 
 
 def _check_header(path, header):
@@ -76,7 +108,15 @@ def _triple(values) -> str:
     return "(" + ", ".join(f"{v:g}" for v in values) + ")"
 
 
-def import_las(path, voxel_size, origin=None, keep_noise=False) -> tuple[np.ndarray, np.ndarray]:
+def import_las(
+    path,
+    voxel_size,
+    origin=None,
+    keep_noise=False,
+    *,
+    progress: Progress | None = None,
+    cancel: threading.Event | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
     """Voxelise a LAS/LAZ file: returns ((N, 3) int32 unique voxels, origin (3,) metres).
 
     Coordinates in feet, as the cloud's coordinate reference system gives them, are
@@ -84,10 +124,29 @@ def import_las(path, voxel_size, origin=None, keep_noise=False) -> tuple[np.ndar
 
     Points classed as noise (ASPRS classes 7 and 18) and points flagged withheld are
     left out unless ``keep_noise``: a survey's stray return kilometres up would make
-    the scene that tall."""
-    indices, _, origin = _voxel_indices(path, voxel_size, origin, keep_noise)
+    the scene that tall.
+
+    The points are read ``READ_POINTS`` at a time: ``progress("reading", points, of)``
+    after each chunk, and a set ``cancel`` raises ``Cancelled`` between them."""
+    cloud = voxelize_cloud(path, voxel_size, origin, keep_noise, progress=progress, cancel=cancel)
+    return cloud.voxels, cloud.origin
+
+
+def voxelize_cloud(
+    path,
+    voxel_size,
+    origin=None,
+    keep_noise=False,
+    *,
+    progress: Progress | None = None,
+    cancel: threading.Event | None = None,
+) -> CloudVoxels:
+    """``import_las`` with what a report of it needs: the cloud's units (to give the
+    origin in its own coordinates) and how many points were read and left out."""
+    indices, _, found = _voxel_indices(path, voxel_size, origin, keep_noise, progress, cancel)
+    check_cancelled(cancel, CANCELLED)
     voxels, _ = unique_voxels(indices)
-    return voxels, origin
+    return CloudVoxels(voxels, *found)
 
 
 def import_las_target(
@@ -102,7 +161,7 @@ def import_las_target(
     withheld points are left out unless ``keep_noise``, as ``import_las`` does.
     """
     path = path_field("path", path, "a LAS or LAZ point cloud's path")
-    indices, source_ids, origin = _voxel_indices(path, voxel_size, origin, keep_noise)
+    indices, source_ids, (origin, *_) = _voxel_indices(path, voxel_size, origin, keep_noise)
     ids = source_ids.astype(np.int32)
     if not ids.any():
         ids[:] = 1
@@ -128,31 +187,34 @@ def import_las_target(
     return indices[keep], ids[keep], origin
 
 
-def _voxel_indices(path, voxel_size, origin, keep_noise) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Each point's voxel ((P, 3) int32), its point_source_id (P,), and the origin."""
+def _voxel_indices(
+    path, voxel_size, origin, keep_noise, progress=None, cancel=None
+) -> tuple[np.ndarray, np.ndarray, tuple]:
+    """Each point's voxel ((P, 3) int32), its point_source_id (P,), and the origin,
+    the metres in a unit, the unit's name, the points read and those left out."""
     path = path_field("path", path, "a LAS or LAZ point cloud's path")
     size = voxel_size_field(voxel_size)
     if not isinstance(keep_noise, bool | np.bool_):  # "no" is true
         raise FieldError("keep_noise", keep_noise, "True or False")
     require_file(path, "expected a LAS or LAZ point cloud")
-    cloud = _read_cloud(path)
+    cloud = _read_cloud(path, progress, cancel)
     _check_header(path, cloud.header)
+    if progress is not None:
+        progress("voxelising", 0, 1)
     points = np.stack([np.asarray(cloud.x), np.asarray(cloud.y), np.asarray(cloud.z)], axis=1)
     if not len(points):
         raise InputFileError(path, "holds no points; expected a LAS or LAZ point cloud")
     _check_no_collapse(path, cloud, points)
-    horizontal, vertical = metres_per_unit(path, cloud.header)
+    check_cancelled(cancel, CANCELLED)
+    horizontal, vertical, unit = metres_per_unit(path, cloud.header)
     if (horizontal, vertical) != (1.0, 1.0):  # a survey in feet
         points = points * np.array([horizontal, horizontal, vertical])
     source_ids = np.asarray(cloud.point_source_id)
+    read = len(points)
     if not keep_noise:
         kept = ~(np.isin(np.asarray(cloud.classification), NOISE_CLASSES) | np.asarray(cloud.withheld, bool))
         if not kept.any():
-            raise InputFileError(
-                path,
-                f"all {len(points):,} points are noise or withheld (ASPRS classes 7 and 18, or the "
-                "withheld flag); expected ground, vegetation or object points (keep_noise=True takes them)",
-            )
+            raise AllNoise(path, len(points))
         if not kept.all():
             points, source_ids = points[kept], source_ids[kept]
     lowest = points.min(axis=0)
@@ -182,11 +244,13 @@ def _voxel_indices(path, voxel_size, origin, keep_noise) -> tuple[np.ndarray, np
             f"at most {MAX_INDEX + 1:,} voxels a side)",
             source=str(path),
         )
-    return indices.astype(np.int32), source_ids, origin
+    found = (origin, (horizontal, vertical), unit, read, read - len(points))
+    return indices.astype(np.int32), source_ids, found
 
 
-def _read_cloud(path):
-    """The whole cloud, refused in one line when damaged, foreign or cut short."""
+def _read_cloud(path, progress=None, cancel=None):
+    """The whole cloud, refused in one line when damaged, foreign or cut short; read
+    ``READ_POINTS`` at a time, with ``progress`` and ``cancel`` between them."""
     import laspy
 
     try:
@@ -195,17 +259,35 @@ def _read_cloud(path):
             if not header.are_points_compressed:
                 _check_length(path, header)
             _check_memory(path, header)
-            cloud = reader.read()
-    except LadarError:
+            total = header.point_count
+            # one array filled chunk by chunk: no second copy of the cloud to join them
+            array = np.empty(total, dtype=header.point_format.dtype())
+            done = 0
+            while done < total:
+                check_cancelled(cancel, CANCELLED)
+                wanted = min(READ_POINTS, total - done)
+                chunk = reader.read_points(wanted).array
+                array[done : done + len(chunk)] = chunk
+                done += len(chunk)
+                if progress is not None:
+                    progress("reading", done, total)
+                if len(chunk) < wanted:  # the file ended early: laspy reads what there is
+                    break
+            check_cancelled(cancel, CANCELLED)
+            points = laspy.ScaleAwarePointRecord(
+                array[:done], header.point_format, header.scales, header.offsets
+            )
+            cloud = laspy.LasData(header=header, points=points)
+    except (LadarError, Cancelled):
         raise
     except Exception as error:  # laspy raises several kinds for a damaged or foreign file
         reason = str(error) or type(error).__name__
         raise InputFileError(path, f"not a readable LAS/LAZ point cloud ({reason})") from None
-    if len(cloud.points) < header.point_count:  # laspy reads what there is without a word
+    if done < header.point_count:
         raise InputFileError(
             path,
             f"cut short: its header gives {header.point_count:,} points, the file holds "
-            f"{len(cloud.points):,}; expected the whole file (copied or downloaded in full)",
+            f"{done:,}; expected the whole file (copied or downloaded in full)",
         )
     return cloud
 

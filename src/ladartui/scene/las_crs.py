@@ -18,9 +18,10 @@ VERTICAL_UNITS_KEY = 4099
 EPSG_LENGTH_UNITS = {9001: 1.0, 9002: 0.3048, 9003: 1200 / 3937}
 
 
-def metres_per_unit(path, header) -> tuple[float, float]:
-    """Metres in one unit of the cloud's (x and y, z) coordinates; (1, 1) when the
-    cloud names no coordinate system."""
+def metres_per_unit(path, header) -> tuple[float, float, str]:
+    """Metres in one unit of the cloud's (x and y, z) coordinates, and the name of its
+    x and y unit ("metre", "US survey foot"); (1, 1, "metre") when the cloud names no
+    coordinate system."""
     try:
         crs = header.parse_crs()
     except Exception as error:  # pyproj's CRSError, or laspy's on a damaged record
@@ -31,7 +32,7 @@ def metres_per_unit(path, header) -> tuple[float, float]:
             "or GeoTIFF keys naming a projected system (rewrite the record with the survey's tools)",
         ) from None
     if crs is None:
-        return 1.0, 1.0
+        return 1.0, 1.0, "metre"
     horizontal_crs, vertical_crs = crs, None
     if crs.is_compound:
         horizontal_crs = next((sub for sub in crs.sub_crs_list if not sub.is_vertical), crs)
@@ -44,9 +45,10 @@ def metres_per_unit(path, header) -> tuple[float, float]:
             "system in metres or feet (reproject the cloud, to its UTM zone for one)",
         )
     horizontal = _axis_metres(path, horizontal_crs)
+    unit = horizontal_crs.axis_info[0].unit_name
     if vertical_crs is not None:
-        return horizontal, _axis_metres(path, vertical_crs)
-    return horizontal, _geotiff_vertical_metres(header) or horizontal
+        return horizontal, _axis_metres(path, vertical_crs), unit
+    return horizontal, _geotiff_vertical_metres(header) or horizontal, unit
 
 
 def _axis_metres(path, crs) -> float:

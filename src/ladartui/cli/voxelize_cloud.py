@@ -1,0 +1,108 @@
+"""``ladartui voxelize SURVEY.las OUT``: a scene model from a LAS/LAZ point cloud.
+
+OUT.txt gets the cloud's voxels and OUT_Target.txt is written beside it empty, the two
+as one set (a scenario needs the target model beside its scene; an empty one is a
+scene with no vehicle yet, and ``voxelize MESH OUT --into OUT.txt`` adds one).
+"""
+
+from __future__ import annotations
+
+import threading
+
+from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt
+from ladartui.errors import Cancelled, FieldError, check_cancelled
+from ladartui.number_text import extent_metres, plural
+from ladartui.textsafe import single_line
+
+
+def scene_from_cloud(args, outputs) -> int:
+    """Voxelise ``args.mesh`` (a point cloud) at ``args.voxel_size`` into ``outputs``
+    (OUT.txt, OUT_Target.txt, checked writable), with progress, cancelled by Ctrl-C."""
+    from ladartui.cli.console import CliConsole as Console
+    from ladartui.scene.las import CANCELLED
+
+    errors = Console(stderr=True)
+    cancel = threading.Event()
+    with sigterm_as_interrupt():
+        cloud = run_cancellable(
+            lambda: _work(args, outputs, errors, cancel), cancel, "ladartui-voxelize", Cancelled(CANCELLED)
+        )
+    _report(args, cloud, outputs)
+    return 0
+
+
+def _work(args, outputs, console, cancel):
+    """Read and voxelise the cloud, then write the scene and its empty target model as
+    one set; on the worker thread."""
+    import numpy as np
+    from rich.progress import TextColumn, TimeElapsedColumn
+
+    from ladartui.scene.las import CANCELLED, AllNoise, voxelize_cloud
+    from ladartui.scene.model_files import write_model_pair
+    from ladartui.scene.voxelize import merge_voxels
+
+    description = TextColumn("{task.description}", markup=False)  # paths are not markup
+    after = (TextColumn("{task.fields[done]}", markup=False), TimeElapsedColumn())
+    with progress_display(
+        console, after, description, transient=True, disable=not console.is_terminal
+    ) as bar:
+        task = bar.add_task(f"reading {args.mesh}", total=None, done="")
+        units = {"reading": "points", "writing": "voxels"}
+
+        def report(stage: str, done: int, total: int) -> None:
+            shown = f"{done:,}/{total:,} {units[stage]}" if stage in units else ""
+            label = f"reading {args.mesh}" if stage == "reading" else stage
+            bar.update(task, description=label, completed=done / max(total, 1), total=1.0, done=shown)
+
+        try:
+            cloud = voxelize_cloud(
+                args.mesh, args.voxel_size, keep_noise=args.keep_noise, progress=report, cancel=cancel
+            )
+        except AllNoise as error:  # say the flag that keeps them
+            raise AllNoise(error.path, error.points, "--keep-noise") from None
+        except FieldError as error:  # too fine for the cloud's extent: the flag, and the cloud
+            if error.field != "voxel_size":
+                raise
+            raise FieldError("--voxel-size", args.voxel_size, error.expected, source=args.mesh) from None
+        check_cancelled(cancel, CANCELLED)
+        voxels = merge_voxels(cloud.voxels)  # sorted, as the project writes models
+        scene_path, target_path = outputs
+        nothing = np.zeros((0, 3), dtype=np.int32)  # no vehicle yet
+        write_model_pair(scene_path, target_path, voxels, nothing, None, cancel, report)
+        return cloud, len(voxels)
+
+
+def _report(args, done, outputs) -> None:
+    """One line: what was written, the scene's size, and where its voxel (0, 0, 0) lies in
+    the cloud's own coordinates; a note of the points left out as noise."""
+    from ladartui.cli.console import CliConsole as Console
+
+    cloud, count = done
+    console = Console()
+    say = lambda text: console.print(single_line(text), highlight=False, markup=False, soft_wrap=True)  # noqa: E731
+    scene_path, target_path = outputs
+    vs = args.voxel_size
+    shape = cloud.voxels.max(axis=0) + 1
+    horizontal, vertical = cloud.metres_per_unit
+    x, y, z = cloud.origin / [horizontal, horizontal, vertical]
+    across = "m" if horizontal == 1.0 else cloud.unit
+    up = _unit_name(vertical) if vertical != horizontal else across
+    place = f"x {x:.3f}, y {y:.3f}" + (f" {across}" if up != across else "") + f", z {z:.3f} {up}"
+    scale = f"{horizontal:.7g} m a unit" + (f", z {vertical:.7g} m" if up != across else "")
+    read_as = f"{scale}; " if (horizontal, vertical) != (1.0, 1.0) else ""
+    say(
+        f"wrote {scene_path} ({plural(count, 'voxel')}, {extent_metres(shape, vs)} m at {vs:g} m) and "
+        f"{target_path} (empty: no vehicle yet); voxel 0,0,0 is centred at {place} of {args.mesh} "
+        f"({read_as}scene metres count from there)"
+    )
+    if cloud.left_out:
+        say(
+            f"note: {cloud.left_out:,} of {plural(cloud.points, 'point')} left out as noise or withheld "
+            "(--keep-noise keeps them)"
+        )
+
+
+def _unit_name(metres: float) -> str:
+    """A height unit by its length in metres: "m", "foot", "US survey foot"."""
+    names = {1.0: "m", 0.3048: "foot", 1200 / 3937: "US survey foot"}
+    return names.get(metres, f"units of {metres:.7g} m")
