@@ -93,8 +93,12 @@ def _check_no_collapse(path, cloud, points):
     if not np.all(np.isfinite(points)):
         raise InputFileError(path, "coordinates overflow once scaled and offset; expected finite coordinates")
     raw = np.stack([np.asarray(cloud.X), np.asarray(cloud.Y), np.asarray(cloud.Z)], axis=1)
-    stored = len(np.unique(raw, axis=0))
-    kept = len(np.unique(points, axis=0))
+    # Scaling keeps each axis in order: two points merge only where an axis's distinct
+    # stored values do. Each axis is checked alone (a sort of one column); the rows,
+    # sorted whole, are counted only where one does.
+    if all(_axis_apart(raw[:, axis], points[:, axis]) for axis in range(3)):
+        return
+    stored, kept = _distinct_rows(raw), _distinct_rows(points)
     if kept < stored:
         raise InputFileError(
             path,
@@ -102,6 +106,16 @@ def _check_no_collapse(path, cloud, points):
             "once scaled and offset; expected scale factors and offsets that "
             "keep them apart",
         )
+
+
+def _axis_apart(stored: np.ndarray, scaled: np.ndarray) -> bool:
+    """Whether distinct ``stored`` values of an axis stay distinct ``scaled``."""
+    _, first = np.unique(stored, return_index=True)
+    return len(np.unique(scaled[first])) == len(first)
+
+
+def _distinct_rows(values: np.ndarray) -> int:
+    return len(np.unique(values, axis=0))
 
 
 def _triple(values) -> str:
