@@ -161,9 +161,14 @@ def test_a_scene_file_of_another_kind_is_named_as_such(tmp_path, name, kind):
     with pytest.raises(InputFileError) as caught:
         load_scenario(path)
     suffix = name[name.index(".") :]
+    advice = (
+        f": make one from it with 'ladartui voxelize {models / name} {models / 'survey'} --voxel-size 0.5'"
+        if suffix == ".las"
+        else ""
+    )
     assert str(caught.value) == (
         f"{path}:2: scene model file {models / name} is {kind} ({suffix}) (files.scene): "
-        "expected a voxel list (.txt)"
+        f"expected a voxel list (.txt){advice}"
     )
 
 

@@ -224,7 +224,7 @@ class Scenario:
         elif kind := other_file_kind(self.scene_file):  # else its target, 'X_Target.las', was asked for
             missing = (
                 f"scene model file {self.scene_file} is {kind} ({self.scene_file.suffix}) "
-                "(files.scene): expected a voxel list (.txt)"
+                "(files.scene): expected a voxel list (.txt)" + self._scene_from(kind)
             )
         elif (problem := file_problem(self.target_file)) and self.scene_file.stem.endswith("_Target"):
             scene = self.scene_file.with_stem(self.scene_file.stem.removesuffix("_Target"))
@@ -240,6 +240,18 @@ class Scenario:
             )
         if missing:
             raise InputFileError(self.path, missing, self.key_line("files.scene"))
+
+    def _scene_from(self, kind: str) -> str:
+        """For a point cloud named as the scene: the command that makes a scene model of it."""
+        if kind != "a LAS point cloud":
+            return ""
+        import shlex
+
+        cloud, stem = self.scene_file, self.scene_file.with_suffix("")
+        return (
+            f": make one from it with 'ladartui voxelize {shlex.quote(str(cloud))} "
+            f"{shlex.quote(str(stem))} --voxel-size {self.voxel_size:g}'"
+        )
 
     def key_line(self, key: str) -> int | None:
         """The line of ``key`` ("files.scene") in the scenario's file; None when the file
