@@ -31,7 +31,8 @@ def field(tmp_path, target, ids=None):
 
 
 def vehicle_at(box, x, y):
-    return voxelize(load_mesh(box), SIZE, Placement(x, y, 0.0, 0.0), solid=True).voxels
+    """The box inserted at (x, y) m: resting on the field's ground, on top of layer 0."""
+    return voxelize(load_mesh(box), SIZE, Placement(x, y, 0.0, 0.0), solid=True).voxels + [0, 0, 1]
 
 
 def test_id_writes_a_four_column_target_model_that_loads_back(tmp_path, box, capsys):

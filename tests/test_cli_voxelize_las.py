@@ -85,7 +85,7 @@ def test_a_survey_makes_a_scene_model_and_an_empty_target_model(tmp_path, capsys
     assert lines == [
         f"wrote {out}.txt ({len(voxels):,} voxels, 20 x 15 x 10 m at 1 m) and {out}_Target.txt "
         f"(empty: no vehicle yet); voxel 0,0,0 is centred at x 500100.000, y 4100200.000, "
-        f"z 120.000 m of {path} (scene metres count from there)"
+        f"z 120.000 m in the coordinates of {path} (scene metres count from there)"
     ]
 
 
@@ -106,6 +106,10 @@ def test_the_next_steps_take_the_scene_vehicle_scenario_validate_run(tmp_path, s
     said = capsys.readouterr().out
     assert f"wrote {tmp_path / 'forest.txt'}" in said and "a new target model" not in said
     vehicle = voxelize(load_mesh(truck), 0.5, Placement(10.0, 7.0, 1.0), solid=True).voxels
+    # 1 m above the ground under it: the survey's ground at x 9..11 m is z 0.9..1.1 m, in voxel
+    # layer 2, so the vehicle goes up 3 layers from the floor (the bottom of layer 0)
+    assert "resting on the ground under its footprint at z 1.25 m" in " ".join(said.split())
+    vehicle = vehicle + [0, 0, 3]
     np.testing.assert_array_equal(load_voxels(tmp_path / "forest_Target.txt"), vehicle)
     assert main(["validate", str(scenario)]) == 0
     assert "holds no voxels" not in capsys.readouterr().out
@@ -125,8 +129,21 @@ def test_a_survey_in_feet_gives_its_origin_in_feet_and_the_scene_in_metres(tmp_p
     line = capsys.readouterr().out.strip()
     assert "(4 voxels, 10 x 1 x 10 m at 1 m)" in line
     assert line.endswith(
-        f"voxel 0,0,0 is centred at x 1000.000, y 2000.000, z 100.000 US survey foot of {path} "
-        f"({foot:.7g} m a unit; scene metres count from there)"
+        f"voxel 0,0,0 is centred at x 1000.000, y 2000.000, z 100.000 US survey feet ({foot:.7g} m) "
+        f"in the coordinates of {path} (scene metres count from there)"
+    )
+    # heights in metres under feet across (NAVD88 height in metres): each axis its unit
+    mixed = _write_cloud(
+        tmp_path / "mixed.las",
+        feet,
+        feet * 0 + 2000.0,
+        (feet - 900.0) * foot,
+        crs=pyproj.CRS("EPSG:2263+5703"),
+    )
+    assert main(["voxelize", str(mixed), str(tmp_path / "mixed"), "--voxel-size", "1"]) == 0
+    assert load_voxels(tmp_path / "mixed.txt").tolist() == [[0, 0, 0], [3, 0, 3], [6, 0, 6], [9, 0, 9]]
+    assert f"x 1000.000, y 2000.000 US survey feet ({foot:.7g} m), z {100 * foot:.3f} m in" in (
+        capsys.readouterr().out
     )
 
 

@@ -53,8 +53,11 @@ def add_parser(subparsers):
         "--at",
         metavar="X,Y[,Z]",
         help="where the middle of the mesh's footprint goes, metres in the scene; Z is the height "
-        "of its lowest point above the ground (default 0, resting on flat ground). Without --at "
-        "the mesh starts at voxel (0, 0, 0)",
+        "of its lowest point above the ground (default 0). With --into it rests on the scene's "
+        "ground under its footprint (each column's lowest voxel, up to the vehicle's height above "
+        "the lowest nearby; higher ones are overhead): on the top of the highest; where none is "
+        "found, as in a generated flat scene, on the floor (the bottom of voxel layer 0). The "
+        "command says which. Without --at the mesh starts at voxel (0, 0, 0)",
     )
     parser.add_argument(
         "--heading", metavar="DEG", type=float, help="degrees clockwise from north (needs --at; default 0)"
@@ -304,6 +307,8 @@ def _report(console, args, mesh, done, outputs, elapsed) -> None:
     )
     if len(result.voxels):
         low, high = result.voxels.min(axis=0), result.voxels.max(axis=0)
+        if insertion is not None and insertion.resting is not None:  # where it went in the scene
+            low, high = low + [0, 0, insertion.resting.lift], high + [0, 0, insertion.resting.lift]
         say(
             "voxels "
             + ", ".join(f"{n} {lo}..{hi}" for n, lo, hi in zip("xyz", low, high))
@@ -325,6 +330,11 @@ def _report(console, args, mesh, done, outputs, elapsed) -> None:
         )
         + ")"
     )
+    resting = insertion.resting
+    if resting is not None:
+        say(resting.describe(vs))
+        if resting.buried:
+            say(resting.warning(vs))
     if insertion.occupied:
         say(
             f"note: {insertion.occupied:,} of the vehicle's voxels were already in the scene "

@@ -85,15 +85,15 @@ def _report(args, done, outputs) -> None:
     shape = cloud.voxels.max(axis=0) + 1
     horizontal, vertical = cloud.metres_per_unit
     x, y, z = cloud.origin / [horizontal, horizontal, vertical]
-    across = "m" if horizontal == 1.0 else cloud.unit
-    up = _unit_name(vertical) if vertical != horizontal else across
-    place = f"x {x:.3f}, y {y:.3f}" + (f" {across}" if up != across else "") + f", z {z:.3f} {up}"
-    scale = f"{horizontal:.7g} m a unit" + (f", z {vertical:.7g} m" if up != across else "")
-    read_as = f"{scale}; " if (horizontal, vertical) != (1.0, 1.0) else ""
+    across, up = _units(horizontal, cloud.unit), _units(vertical)
+    if across == up:
+        place = f"x {x:.3f}, y {y:.3f}, z {z:.3f} {across}"
+    else:
+        place = f"x {x:.3f}, y {y:.3f} {across}, z {z:.3f} {up}"
     say(
         f"wrote {scene_path} ({plural(count, 'voxel')}, {extent_metres(shape, vs)} m at {vs:g} m) and "
-        f"{target_path} (empty: no vehicle yet); voxel 0,0,0 is centred at {place} of {args.mesh} "
-        f"({read_as}scene metres count from there)"
+        f"{target_path} (empty: no vehicle yet); voxel 0,0,0 is centred at {place} in the "
+        f"coordinates of {args.mesh} (scene metres count from there)"
     )
     if cloud.left_out:
         say(
@@ -102,7 +102,10 @@ def _report(args, done, outputs) -> None:
         )
 
 
-def _unit_name(metres: float) -> str:
-    """A height unit by its length in metres: "m", "foot", "US survey foot"."""
-    names = {1.0: "m", 0.3048: "foot", 1200 / 3937: "US survey foot"}
-    return names.get(metres, f"units of {metres:.7g} m")
+def _units(metres: float, name: str | None = None) -> str:
+    """A length unit in the plural, by its length in metres: "m", "feet (0.3048 m)"."""
+    if metres == 1.0:
+        return "m"
+    plurals = {0.3048: "feet", 1200 / 3937: "US survey feet"}  # pyproj's differ in the last bit
+    named = next((words for length, words in plurals.items() if abs(metres / length - 1) < 1e-9), None)
+    return f"{named or name or 'units'} ({metres:.7g} m)"

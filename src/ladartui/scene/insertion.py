@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ladartui.errors import InputFileError, LadarError
+from ladartui.scene.ground import Resting, rest_on_ground
 from ladartui.scene.model import target_path_for
 from ladartui.scene.model_files import write_model_pair
 from ladartui.scene.voxelize import merge_voxels
@@ -34,6 +35,7 @@ class Insertion:
     # (the report's x,y,z layout: one target, which the vehicle joins).
     target_ids: np.ndarray | None = None
     vehicle_id: int | None = None  # the vehicle's target id, when the model names targets
+    resting: Resting | None = None  # where it was set: on the ground found, or on the floor
 
 
 def scene_model_paths(out) -> tuple[Path, Path]:
@@ -70,8 +72,15 @@ def insert_vehicle(
     source: object = "scene",
     target_ids: np.ndarray | None = None,
     vehicle_id: int | None = None,
+    on_ground: bool = True,
 ) -> Insertion:
     """Add ``vehicle`` voxels to ``scene`` and ``target``.
+
+    ``vehicle`` is placed on the floor (the plane at the bottom of voxel
+    layer 0, as ``Placement`` puts it); with ``on_ground`` it is first raised
+    whole layers to rest on the scene's ground under its footprint
+    (:func:`ladartui.scene.ground.rest_on_ground`: unchanged where none is
+    found, as in a generated flat scene), and ``Insertion.resting`` says how.
 
     Refused (``LadarError`` naming ``source``, the scene file) when the
     vehicle reaches past the scene's x-y extent: the scene's ground ends there.
@@ -93,6 +102,9 @@ def insert_vehicle(
                 f"{source}: the vehicle would reach {name} = {(reach[axis] + 0.5) * voxel_size:.3f} m, "
                 f"past the scene's edge at {name} = {edge:g} m; place it inside the scene"
             )
+    resting = None
+    if on_ground:
+        vehicle, resting = rest_on_ground(scene, vehicle, voxel_size)
     merged = merge_voxels(scene, vehicle)
     added = len(merged) - len(scene)
     ids = np.ones(len(target), dtype=np.int32) if target_ids is None else np.asarray(target_ids, np.int32)
@@ -104,6 +116,7 @@ def insert_vehicle(
             added=added,
             occupied=len(vehicle) - added,
             new_target=not had_target,
+            resting=resting,
         )
     if vehicle_id is None:
         vehicle_id = int(ids.max()) + 1
@@ -116,6 +129,7 @@ def insert_vehicle(
         new_target=not had_target,
         target_ids=labelled_ids,
         vehicle_id=vehicle_id,
+        resting=resting,
     )
 
 
