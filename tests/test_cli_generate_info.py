@@ -339,8 +339,13 @@ def test_info_on_a_point_cloud_or_measures_file_says_what_it_takes(tmp_path, cap
         b"LASF\x00\x01" if name.endswith(".laz") else b"# ladartui comparison measures, format cmf 2\n"
     )
     assert main(["info", str(path)]) == 2
+    advice = (
+        ": make a scene model of it with 'ladartui voxelize CLOUD OUT --voxel-size V'"
+        if "LAS" in what
+        else ""
+    )
     assert one_error_line(capsys) == (
-        f"ladartui: error: {path}: {what}; info takes a voxel list (.txt) or a scenario (.toml)"
+        f"ladartui: error: {path}: {what}; info takes a voxel list (.txt) or a scenario (.toml){advice}"
     )
 
 

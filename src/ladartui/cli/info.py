@@ -73,18 +73,19 @@ def run(args) -> int:
 
 def refuse_other_kinds(path: Path) -> None:
     """A mesh, point cloud or measures file would be read as a voxel list and fail on its
-    first line: say what it is, and for a mesh what to do."""
+    first line: say what it is, and for a mesh or a point cloud what to do."""
     from ladartui.fileprobe import other_file_kind
 
     what = other_file_kind(path)
     if what is not None:
         from ladartui.errors import InputFileError
 
-        advice = (
-            ": voxelise the mesh first with 'ladartui voxelize MESH OUT --voxel-size V'"
-            if what == "a mesh"
-            else ""
-        )
+        advice = {
+            "a mesh": ": voxelise the mesh first with 'ladartui voxelize MESH OUT --voxel-size V'",
+            "a LAS point cloud": (
+                ": make a scene model of it with 'ladartui voxelize CLOUD OUT --voxel-size V'"
+            ),
+        }.get(what, "")
         raise InputFileError(
             path, f"{what} ({path.suffix}); info takes a voxel list (.txt) or a scenario (.toml){advice}"
         )
