@@ -520,3 +520,24 @@ def test_check_files_given_text_is_refused_not_taken_as_true(tmp_path):
         load_scenario(path, check_files="no")
     assert str(caught.value) == "check_files = 'no': expected True or False"
     assert load_scenario(path, check_files=False).path == path
+
+
+@pytest.mark.parametrize("name, kind", [("survey.las", "a LAS point cloud"), ("truck.obj", "a mesh")])
+def test_a_new_scenario_on_a_scene_file_of_another_kind_is_named_as_such(tmp_path, name, kind):
+    """New (the TUI's form, the API) on a survey's point cloud asked for survey_Target.las
+    for its default orbit, with nothing on the cloud not being a scene model."""
+    from ladartui.scenario import Scenario
+
+    scene = tmp_path / name
+    scene.write_bytes(b"LASF" if name.endswith(".las") else b"v 0 0 0\n")
+    with pytest.raises(FieldError) as caught:
+        Scenario.new(tmp_path / "plan.toml", scene, 0.5)
+    assert caught.value.field == "files.scene"
+    advice = (
+        f": make one from it with 'ladartui voxelize {scene} {tmp_path / 'survey'} --voxel-size 0.5'"
+        if name.endswith(".las")
+        else ""
+    )
+    assert str(caught.value) == (
+        f"files.scene = '{scene}': expected a voxel list (.txt), not {kind} ({scene.suffix}){advice}"
+    )

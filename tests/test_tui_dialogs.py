@@ -333,3 +333,21 @@ def test_the_png_and_compare_dialogs_name_what_is_wrong(tmp_path):
         str(caught.value)
         == f"{tmp_path / 'pipe.cmf'}: scene model file is not a regular file (a pipe or device)"
     )
+
+
+def test_new_on_a_survey_s_point_cloud_gives_the_command_that_makes_a_scene_of_it(tmp_path):
+    """New's form given a survey's .las as the scene model said only 'expected a scene
+    model (.txt)', where the scenario check gives the voxelize command."""
+    import pytest
+
+    from ladartui.errors import InputFileError
+    from ladartui.tui import bridge
+
+    cloud = tmp_path / "survey.las"
+    cloud.write_bytes(b"LASF")
+    with pytest.raises(InputFileError) as caught:
+        bridge.new_scenario(tmp_path / "new.toml", cloud, 0.5)
+    assert str(caught.value) == (
+        f"{cloud}: scene model file is a LAS point cloud (.las); expected a scene model (.txt): make one "
+        f"from it with 'ladartui voxelize {cloud} {tmp_path / 'survey'} --voxel-size 0.5'"
+    )

@@ -224,7 +224,8 @@ class Scenario:
         elif kind := other_file_kind(self.scene_file):  # else its target, 'X_Target.las', was asked for
             missing = (
                 f"scene model file {self.scene_file} is {kind} ({self.scene_file.suffix}) "
-                "(files.scene): expected a voxel list (.txt)" + self._scene_from(kind)
+                "(files.scene): expected a voxel list (.txt)"
+                + voxelize_hint(self.scene_file, kind, self.voxel_size)
             )
         elif (problem := file_problem(self.target_file)) and self.scene_file.stem.endswith("_Target"):
             scene = self.scene_file.with_stem(self.scene_file.stem.removesuffix("_Target"))
@@ -240,18 +241,6 @@ class Scenario:
             )
         if missing:
             raise InputFileError(self.path, missing, self.key_line("files.scene"))
-
-    def _scene_from(self, kind: str) -> str:
-        """For a point cloud named as the scene: the command that makes a scene model of it."""
-        if kind != "a LAS point cloud":
-            return ""
-        import shlex
-
-        cloud, stem = self.scene_file, self.scene_file.with_suffix("")
-        return (
-            f": make one from it with 'ladartui voxelize {shlex.quote(str(cloud))} "
-            f"{shlex.quote(str(stem))} --voxel-size {self.voxel_size:g}'"
-        )
 
     def key_line(self, key: str) -> int | None:
         """The line of ``key`` ("files.scene") in the scenario's file; None when the file
@@ -301,6 +290,13 @@ class Scenario:
         scene_file = resolve_path(path.parent, path_field("files.scene", scene_file, "a scene model's path"))
         # before the default orbit reads it: a bad size is the field's error, not the sums'
         voxel_size = number_field("files.voxel_size", voxel_size, MIN_VOXEL_SIZE, MAX_VOXEL_SIZE)
+        from ladartui.fileprobe import other_file_kind
+
+        if kind := other_file_kind(scene_file):  # else its default orbit asks for 'X_Target.las'
+            expected = f"a voxel list (.txt), not {kind} ({scene_file.suffix})"
+            raise FieldError(
+                "files.scene", str(scene_file), expected + voxelize_hint(scene_file, kind, voxel_size)
+            )
         if sensor is None:
             sensor = defaults.DEFAULT_SENSOR
         if flight is None:
@@ -542,4 +538,14 @@ def check_work(scenario, raise_with=None):
         f"{sensor.ray_grid}, {plural(scans, 'scan')} x {RUNS_TRACED} runs "
         "(the scene run and the target-alone run)",
         raise_with=raise_with or RAISE_RAYS,
+    )
+
+
+def voxelize_hint(cloud: Path, kind: str, voxel_size: float) -> str:
+    """For a point cloud named as the scene: the command that makes a scene model of it."""
+    if kind != "a LAS point cloud":
+        return ""
+    return (
+        f": make one from it with 'ladartui voxelize {shlex.quote(str(cloud))} "
+        f"{shlex.quote(str(cloud.with_suffix('')))} --voxel-size {voxel_size:g}'"
     )

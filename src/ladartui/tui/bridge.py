@@ -30,7 +30,7 @@ from ladartui.flight import (
     altitude_field,
 )
 from ladartui.flight.plan import refuse_two_pointings
-from ladartui.scenario import Scenario, load_scenario, target_file_for
+from ladartui.scenario import Scenario, load_scenario, target_file_for, voxelize_hint
 from ladartui.scenario_file import is_record
 from ladartui.sensor import Sensor
 
@@ -396,7 +396,9 @@ def new_scenario(scenario_path: Path, scene_path: Path, voxel_size: float = 1.0)
         if kind := other_file_kind(path):
             kind = "a scenario file" if Path(path).suffix.lower() == ".toml" else kind
             raise InputFileError(
-                path, f"{what} file is {kind} ({Path(path).suffix}); expected a {what} (.txt)"
+                path,
+                f"{what} file is {kind} ({Path(path).suffix}); expected a {what} (.txt)"
+                + voxelize_hint(Path(path), kind, voxel_size),
             )
     return Scenario.new(scenario_path, scene_path, voxel_size)
 
