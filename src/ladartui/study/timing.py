@@ -36,6 +36,27 @@ def timed(call: Callable[[], object], clock=time.perf_counter):
     return result, clock() - start
 
 
+# A call that compiled is run again at most this many times: a call compiles only what the
+# calls before it did not reach (a scan's other tracing order), so one more call is enough.
+RETRIES_AFTER_COMPILING = 3
+
+
+def timed_without_compiling(call: Callable[[], object], clock=time.perf_counter):
+    """``timed``, where a call during which numba compiled or loaded kernels (a kernel's
+    first call in the process, which a warm-up need not reach: the exact trace takes
+    turns between its two orders) is run again: its time was the compiler's. Returns
+    (the result, seconds of the call that compiled nothing) after at most
+    ``RETRIES_AFTER_COMPILING`` calls again, the last one timed whatever it did."""
+    from ladartui.tracing.order_choice import compile_time
+
+    for retry in range(RETRIES_AFTER_COMPILING + 1):
+        with compile_time(clock) as compiling:
+            result, seconds = timed(call, clock)
+        if compiling.seconds == 0 or retry == RETRIES_AFTER_COMPILING:
+            break
+    return result, seconds
+
+
 def measure(
     call: Callable[[], object],
     runs: int = 5,
