@@ -195,6 +195,9 @@ class OutputSet:
         self.lock = Path(lock)
         self.journal = journal_path(self.lock)
         self._lock_fd: int | None = None
+        # True once every new file is in place for good: an interruption after it (as the
+        # old files' backups go) leaves the new set written, not the earlier one
+        self.committed = False
 
     def __enter__(self) -> OutputSet:
         check_writable(*self.paths.values())
@@ -372,6 +375,7 @@ class OutputSet:
                     f"{failed} ({_reason(error)}); nothing was replaced, earlier outputs are unchanged",
                 ) from None
             raise
+        self.committed = True
         _step("backups")
         for entry in entries:
             with contextlib.suppress(OSError):

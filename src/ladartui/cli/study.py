@@ -190,6 +190,25 @@ def _run_with_progress(console, inputs, settings, runs, warmup):
 
 
 def _report(result, out_dir) -> int:
+    """Show the study and write its files: a Ctrl-C or SIGTERM on the way says whether
+    they were written (130 or 143 either way)."""
+    # matplotlib first: a SIGTERM taken as Ctrl-C inside its extension modules' start
+    # fails the import and then the interpreter as it ends, where it would end quietly
+    import ladartui.charts  # noqa: F401
+    import ladartui.study.figure  # noqa: F401
+    from ladartui.study.run import interrupted_after_writing
+
+    written: list[dict] = []
+    try:
+        with sigterm_as_interrupt():
+            return _show_and_write(result, out_dir, written)
+    except KeyboardInterrupt:
+        if written:
+            raise Cancelled(interrupted_after_writing(written[0])) from None
+        raise Cancelled(_nothing_written(out_dir)) from None
+
+
+def _show_and_write(result, out_dir, written: list) -> int:
     from rich.table import Table
     from rich.text import Text
 
@@ -213,6 +232,7 @@ def _report(result, out_dir) -> int:
     console.print(table)
     console.print(visible(result.verdict()), highlight=False, markup=False)
     paths = write_outputs(result, out_dir, width=CHART_WIDTH, height=CHART_HEIGHT)
+    written.append(paths)
     console.print(
         single_line("wrote " + ", ".join(str(p) for p in paths.values())), highlight=False, markup=False
     )

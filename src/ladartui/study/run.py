@@ -309,7 +309,8 @@ def write_outputs(
 ) -> dict[str, Path]:
     """Write the CSV, JSON, plotted chart (SVG, PNG) and plain-text chart into ``out_dir``
     as one output set: all five replaced, or none (a Ctrl-C while they are written
-    leaves the earlier study whole)."""
+    leaves the earlier study whole; one that comes once they are all in place is
+    ``Cancelled`` saying they were written)."""
     from ladartui.charts import figure_bytes
     from ladartui.outputset import OutputSet
     from ladartui.study.chart import chart_text
@@ -325,6 +326,17 @@ def write_outputs(
         "txt": (chart_text(result, width, height, color=False) + "\n\n" + result.verdict() + "\n").encode(),
     }
     paths = output_paths(out_dir, chart_stem, stem)
-    with OutputSet(paths, _lock_path(out_dir, stem)) as output_set:
-        output_set.write_contents(contents)
+    output_set = OutputSet(paths, _lock_path(out_dir, stem))
+    try:
+        with output_set:
+            output_set.write_contents(contents)
+    except KeyboardInterrupt:
+        if not output_set.committed:  # rolled back, or never begun: the earlier set stands
+            raise
+        raise Cancelled(interrupted_after_writing(paths)) from None
     return paths
+
+
+def interrupted_after_writing(paths: dict[str, Path]) -> str:
+    """What a Ctrl-C (or SIGTERM) that came once a study's files were in place says."""
+    return "interrupted after the study was written; it wrote " + ", ".join(str(p) for p in paths.values())
