@@ -29,13 +29,20 @@ DEFAULT_SCANS = 8
 
 @dataclass
 class StudyInputs:
-    """A scene, a sensor and the scan poses to trace; ``name`` says where they came from."""
+    """A scene, a sensor and the scan poses to trace; ``name`` says where they came from.
+    ``attitudes``: per pose, the aircraft's (roll, pitch) turning a body-fixed sensor's
+    rays, as a run of the scenario turns them (None, or None for a pose: stabilised)."""
 
     scene: Scene
     sensor: Sensor
     poses: list
     name: str
     notes: list = field(default_factory=list)
+    attitudes: list | None = None
+
+    def attitude(self, scan: int):
+        """The attitude the rays of scan ``scan`` (0-based) are turned by; None: stabilised."""
+        return None if self.attitudes is None else self.attitudes[scan]
 
     def describe(self) -> dict:
         scene = self.scene
@@ -51,6 +58,7 @@ class StudyInputs:
                 "grid": self.sensor.grid,
                 "fov_deg": self.sensor.fov,
                 "depth_resolution_m": self.sensor.depth_resolution,
+                "mount": self.sensor.mount,
             },
             "poses": [p.to_dict() for p in self.poses],
         }
@@ -74,6 +82,7 @@ def check_scans(field: str, scans: int | None, available: int, flight: str) -> N
 def scenario_inputs(path, scans: int | None = DEFAULT_SCANS, refuse_as: str | None = None) -> StudyInputs:
     """The scene, sensor and poses of the scenario file at ``path``. More ``scans`` than
     the flight has: all of them, or with ``refuse_as`` (a flag) a FieldError naming it."""
+    from ladartui.attitude import plan_attitudes
     from ladartui.scenario import load_scenario
 
     scenario = load_scenario(path)
@@ -81,8 +90,10 @@ def scenario_inputs(path, scans: int | None = DEFAULT_SCANS, refuse_as: str | No
     if refuse_as:
         check_scans(refuse_as, scans, len(all_poses), f"the flight of {path}")  # before the scene loads
     scene = scenario.load_scene()
-    poses = pick_scans(all_poses, scans)
-    inputs = StudyInputs(scene, scenario.sensor, poses, str(path))
+    picks = pick_scans(range(len(all_poses)), scans)
+    poses = [all_poses[i] for i in picks]
+    attitudes = plan_attitudes(scenario.flight, scenario.speed, scenario.sensor)  # as a run turns its rays
+    inputs = StudyInputs(scene, scenario.sensor, poses, str(path), attitudes=[attitudes[i] for i in picks])
     if len(poses) < len(all_poses):
         inputs.notes.append(
             f"{len(poses)} of the scenario's {len(all_poses)} scans traced "

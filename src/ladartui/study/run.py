@@ -118,7 +118,7 @@ def run_study(
         grid_settings = [s for s in active if s.ray_grid == m]
         for scan, pose in enumerate(poses):
             check_cancelled(cancel, "study cancelled")
-            origins, directions, detector = sensor.rays(pose)
+            origins, directions, detector = sensor.rays(pose, attitude=inputs.attitude(scan))
             cells = origins / scene.voxel_size + 0.5
             exact = None
             exact_classes = None
