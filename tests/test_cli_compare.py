@@ -238,3 +238,28 @@ def test_a_false_alarm_chance_too_small_for_six_decimals_is_not_shown_as_none():
 
     assert format_value(2e-7, "prob") == "2.00e-07" and format_value(4e-9, "prob") == "4.00e-09"
     assert format_value(0.0, "prob") == "0.000000" and format_value(0.0123, "prob") == "0.012300"
+
+
+def test_a_scenario_edited_since_its_run_is_compared_with_a_note_naming_what_changed(tmp_path, capsys):
+    """'compare orbit.toml flypast.cmf' after the orbit's radius was changed and not run
+    again showed the old run's path length and coverage under 'orbit' without a word,
+    where validate says the outputs came from other settings."""
+    from tiny_sweep import write_tiny_scenario
+
+    pytest.importorskip("numba")
+    scenario = write_tiny_scenario(tmp_path, "orbit.toml")
+    assert cli.main(["run", str(scenario.path)]) == 0
+    write_run(tmp_path / "flypast.cmf", seen_layers=2, scans=10)
+    text = scenario.path.read_text()
+    scenario.path.write_text(text.replace("radius = 20.0", "radius = 35.0"))
+    capsys.readouterr()
+    for extra in ([], ["--json"]):
+        assert cli.main(["compare", str(scenario.path), str(tmp_path / "flypast.cmf"), *extra]) == 0
+        err = capsys.readouterr().err.strip()
+        assert err == (
+            f"note: {scenario.path}: its measures are its last run's, made with other settings "
+            "than this file: flight.segments[0].radius 20 (here 35); run it again to compare these"
+        )
+    scenario.path.write_text(text)  # as it ran: nothing to say
+    assert cli.main(["compare", str(scenario.path), str(tmp_path / "flypast.cmf")]) == 0
+    assert capsys.readouterr().err == ""

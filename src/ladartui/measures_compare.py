@@ -251,6 +251,30 @@ def read_measures_files(paths) -> list:
     return out
 
 
+def earlier_settings_note(path) -> str | None:
+    """For a scenario (.toml) compared by its last run's measures: a line naming the
+    settings that run went with where the file now says otherwise (an edit not run
+    again); None where they agree, or no readable record says."""
+    from ladartui.run_record import changes_text, read_run_record, setting_changes
+    from ladartui.scenario import load_scenario
+
+    path = Path(path)
+    if path.suffix.lower() != ".toml":
+        return None
+    scenario = load_scenario(path, check_files=False)
+    try:
+        ran = read_run_record(scenario)
+    except LadarError:  # a record that does not read: validate names it
+        return None
+    changes = [] if ran is None else setting_changes(ran, scenario)
+    if not changes:
+        return None
+    return (
+        f"{path}: its measures are its last run's, made with other settings than this file: "
+        f"{changes_text(changes)}; run it again to compare these"
+    )
+
+
 def measures_files_to_offer(own: Path, most: int = 4) -> list[Path]:
     """The measures files to compare a scenario's run with: its own (``own``) first, then
     the others in its folder by name, ``most`` in all, each one that reads (one that

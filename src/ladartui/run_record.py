@@ -263,6 +263,12 @@ def setting_changes(ran, scenario) -> list[str]:
     ]
 
 
+def changes_text(changes: list[str], most: int = 4) -> str:
+    """``setting_changes`` as one clause: the first ``most``, then how many more."""
+    more = len(changes) - most
+    return "; ".join(changes[:most]) + (f"; and {more} more" if more > 0 else "")
+
+
 def _flat(data, prefix: str = "") -> dict:
     """Nested TOML data as dotted keys; a list of tables by index from 0, as errors name
     them (flight.segments[0].radius)."""

@@ -13,7 +13,9 @@ def add_parser(subparsers):
         "(.toml) whose last runs wrote them, and print their figures side by side (the "
         "coverage after each scan, a list, is left to run and the .cmf): where the "
         "runs differ the row is yellow, and for a measure with a better direction the best "
-        "value is green and the worst red (the TUI's Compare, F10, shows the same).",
+        "value is green and the worst red (the TUI's Compare, F10, shows the same). A scenario "
+        "edited since its last run is compared by that run's measures, with a note on standard "
+        "error naming the settings that differ.",
     )
     parser.add_argument(
         "files",
@@ -45,11 +47,26 @@ def run(args) -> int:
     paths = [bundled_run(file) for file in args.files]  # "convoy", as run takes it
     rows = side_by_side(read_measures_files(paths))  # a folder is refused before it is named
     names = column_names(paths)
+    _note_earlier_settings(paths)
     if args.json:
         print(json.dumps(as_json(names, paths, rows), indent=2, allow_nan=False))
     else:
         show(names, rows)
     return 0
+
+
+def _note_earlier_settings(paths) -> None:
+    """A note on standard error for each scenario whose last run (its measures compared)
+    went with other settings than the file has now."""
+    from ladartui.cli.console import CliConsole
+    from ladartui.measures_compare import earlier_settings_note
+    from ladartui.textsafe import one_line
+
+    console = CliConsole(stderr=True)
+    for path in dict.fromkeys(paths):  # a file given twice: said once
+        note = earlier_settings_note(path)
+        if note:
+            console.print(one_line(f"note: {note}"), highlight=False, markup=False, soft_wrap=True)
 
 
 def as_json(names, paths, rows) -> dict:

@@ -160,7 +160,13 @@ def last_run_lines(scenario, scene, writable: bool = True, writer: str | None = 
     the next run can write its outputs; ``writer``: the run holding the set now, if one
     does (``run_writing``: until its swap the files are the earlier run's)."""
     from ladartui.errors import LadarError
-    from ladartui.run_record import earlier_las, missing_outputs, read_run_record, setting_changes
+    from ladartui.run_record import (
+        changes_text,
+        earlier_las,
+        missing_outputs,
+        read_run_record,
+        setting_changes,
+    )
     from ladartui.simulation import swap_interrupted
 
     if swap_interrupted(scenario) and writer is not None:  # its swap, under way
@@ -191,7 +197,7 @@ def last_run_lines(scenario, scene, writable: bool = True, writer: str | None = 
     if not changes:
         lines = [f"last run   made the outputs with this file's settings ({record})"]
     else:
-        shown = "; ".join(changes[:4]) + (f"; and {len(changes) - 4} more" if len(changes) > 4 else "")
+        shown = changes_text(changes)
         lines = [
             f"last run   made the outputs with other settings than this file: {shown}; they are in {record}"
         ]
