@@ -5,7 +5,9 @@ the exact float64 answer for the same ray. Each differing ray is classified by
 the geometry of its *feature voxel*: the voxel the exact answer hit, or, when
 the exact answer is ground or a miss, the voxel the method hit. Classes are not
 exclusive (a ray can be thin and diagonal); each is also counted over all rays
-that hit a voxel, so a class that explains misses shows up over-represented.
+that hit a voxel, so a class that explains misses shows up over-represented
+(``class_share`` against ``base_share``: a class's share of the differing rays
+that have a feature voxel, against its share of every voxel hit).
 
 - thin: the ray's chord through the feature voxel is shorter than
   ``THIN_CHORD`` voxel and the voxel it leaves into is empty, so the occupied
@@ -119,6 +121,17 @@ class MissSummary:
         """Share of rays whose first hit differs (0..1), None with no rays."""
         return self.differing / self.rays if self.rays else None
 
+    def class_share(self, name: str) -> float | None:
+        """Share of the differing rays with a feature voxel (those a class can describe)
+        that fall in class ``name``; None when no differing ray has one."""
+        classified = self.differing - self.no_voxel
+        return self.classes[name] / classified if classified > 0 else None
+
+    def base_share(self, name: str) -> float | None:
+        """Share of all the rays whose exact answer is a voxel that fall in class ``name``:
+        what ``class_share`` is set against; None when no ray hit a voxel."""
+        return self.base[name] / self.voxel_rays if self.voxel_rays else None
+
     def add(self, other: MissSummary) -> None:
         self.rays += other.rays
         self.voxel_rays += other.voxel_rays
@@ -149,13 +162,14 @@ class MissSummary:
             return "no differing rays"
         parts = []
         for name in CLASSES:
-            own = self.classes[name] / self.differing
-            base = self.base[name] / self.voxel_rays if self.voxel_rays else 0.0
-            parts.append(f"{name} {own:.0%} (all rays {base:.0%})")
-        return (
+            own, base = self.class_share(name), self.base_share(name)
+            if own is not None:
+                parts.append(f"{name} {own:.0%} (all rays {base or 0.0:.0%})")
+        said = (
             f"{self.differing} differ ({self.later} later, {self.earlier} earlier, "
-            f"{self.no_voxel} ground or miss on both sides); " + ", ".join(parts)
+            f"{self.no_voxel} ground or miss on both sides)"
         )
+        return "; ".join([said, ", ".join(parts)]) if parts else said
 
 
 def summarise(origins, directions, exact, other, occupancy=None, exact_voxel_classes=None) -> MissSummary:

@@ -110,6 +110,7 @@ CSV_COLUMNS = (
     "later",
     "earlier",
     *(f"{name}_share" for name in CLASSES),
+    *(f"{name}_all_rays_share" for name in CLASSES),
     "coverage",
     "coverage_error",
     "front",
@@ -249,7 +250,8 @@ class StudyResult:
 def _csv_record(row: StudyRow) -> list:
     s = row.setting
     m = row.misses
-    shares = [m.classes[name] / m.differing if m.differing else None for name in CLASSES]
+    shares = [m.class_share(name) for name in CLASSES]
+    base_shares = [m.base_share(name) for name in CLASSES]
     return [
         row.label,
         s.backend,
@@ -269,6 +271,7 @@ def _csv_record(row: StudyRow) -> list:
         m.later,
         m.earlier,
         *shares,
+        *base_shares,
         row.coverage,
         row.coverage_error,
         row.front,
