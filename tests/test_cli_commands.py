@@ -83,6 +83,31 @@ def test_ctrl_c_while_the_commands_load_is_one_line(monkeypatch, capsys):
     assert capsys.readouterr().err == "ladartui: interrupted\n"
 
 
+def test_ctrl_c_inside_an_extension_module_s_start_is_one_line(monkeypatch, capsys):
+    """A Ctrl-C as 'study' imported matplotlib ended in a traceback: CPython turns a
+    KeyboardInterrupt inside an extension module's start into 'ImportError:
+    initialization failed' (its cause the interrupt), which no handler took."""
+
+    def importing():
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt as interrupt:
+            raise ImportError("initialization failed") from interrupt
+
+    monkeypatch.setattr(cli, "build_parser", importing)
+    assert cli.main(["study", "--quick"]) == 130
+    assert capsys.readouterr().err == "ladartui: interrupted\n"
+
+
+def test_an_import_that_fails_for_another_reason_is_not_taken_for_a_ctrl_c(monkeypatch):
+    def importing():
+        raise ImportError("libGL.so.1: cannot open shared object file")
+
+    monkeypatch.setattr(cli, "build_parser", importing)
+    with pytest.raises(ImportError, match="libGL"):
+        cli.main(["study", "--quick"])
+
+
 def test_the_commands_load_without_numba_or_dask():
     import subprocess
     import sys

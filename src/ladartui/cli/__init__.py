@@ -144,6 +144,13 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("ladartui: interrupted", file=sys.stderr)
         return stop_status()
+    except ImportError as error:
+        # a Ctrl-C inside an extension module's start (matplotlib's, as a chart is drawn)
+        # reaches here as the import's failure, the interrupt its cause
+        if not isinstance(error.__cause__, KeyboardInterrupt):
+            raise
+        print("ladartui: interrupted", file=sys.stderr)
+        return stop_status()
     except BrokenPipeError:
         return _reader_gone()
     except OSError as error:
