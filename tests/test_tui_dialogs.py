@@ -175,6 +175,33 @@ async def test_markup_in_names_shows_as_typed_and_compare_reads_spaced_paths(tmp
         assert message(compare, "#compare-message").startswith(".cmf files: ")
 
 
+async def test_compare_notes_a_scenario_edited_since_its_run(tmp_path, scene_files):
+    """A scenario's path typed in Compare stood for its last run's measures without a word
+    when the file had been changed since, as ``ladartui compare`` did."""
+    scenario = make_scenario(tmp_path, scene_files, name="orbit")
+    async with opened(scenario) as (app, pilot):
+        await app.run_action("run")
+        await wait_until(pilot, lambda: isinstance(app.screen, MeasuresScreen) and app.screen.is_mounted)
+        await pilot.press("escape")
+        await pilot.pause()
+        other = tmp_path / "other.cmf"
+        other.write_bytes(scenario.measures_file.read_bytes())
+        compare = await screen_after(pilot, app.action_compare, CompareScreen)
+        compare.query_one("#cmf-files").value = f"orbit.toml {other}"
+        await pilot.press("enter")
+        await pilot.pause()
+        assert message(compare, "#compare-message") == ""  # as it ran: nothing to say
+        text = scenario.path.read_text()
+        scenario.path.write_text(text.replace("radius = 30.0", "radius = 45.0"))
+        await pilot.press("enter")
+        await pilot.pause()
+        assert message(compare, "#compare-message") == (
+            f"Note: {scenario.path}: its measures are its last run's, made with other settings than "
+            "this file: flight.segments[0].radius 30 (here 45); run it again to compare these"
+        )
+        assert len(compare.query_one("#compare-table").columns) == 3  # compared all the same
+
+
 def test_segment_words_read_as_english():
     from ladartui.flight import Manual, ScanPose
     from ladartui.tui import bridge

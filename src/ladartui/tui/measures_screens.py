@@ -16,7 +16,13 @@ from textual.widgets import Button, DataTable, Input, Static
 from ladartui.errors import LadarError
 from ladartui.fileprobe import user_path
 from ladartui.measures import Measures
-from ladartui.measures_compare import column_names, read_measures_files, side_by_side, styled
+from ladartui.measures_compare import (
+    column_names,
+    earlier_settings_note,
+    read_measures_files,
+    side_by_side,
+    styled,
+)
 from ladartui.tui.file_tree import FileTree
 from ladartui.tui.measures_view import level_rows, measure_rows, target_rows
 from ladartui.tui.screens import Dialog, TreeDialog, _row
@@ -144,12 +150,15 @@ class CompareScreen(TreeDialog):
         if len(text) < 2:
             message.update("Give two or more .cmf files to compare.")
             return
+        paths = [self.base / user_path(t) for t in text]
         try:
-            loaded = read_measures_files([self.base / user_path(t) for t in text])
+            loaded = read_measures_files(paths)
+            # a scenario stands for its last run's measures: say so where it has changed since
+            notes = [note for path in dict.fromkeys(paths) if (note := earlier_settings_note(path))]
         except LadarError as error:
             message.update(escape(str(error)))
             return
-        message.update("")
+        message.update(escape(" ".join(f"Note: {note}" for note in notes)))
         table.add_column("Measure")
         for name in column_names([Path(t) for t in text]):
             table.add_column(Text(name))  # names from files: never markup
