@@ -77,3 +77,32 @@ def test_an_unknown_command_id_in_keys_toml_is_told_with_every_id_there_is(tmp_p
     assert problems[0] == f"{keys}:2: keys.zoom-targt: no such command; expected one of {ids}"
     assert "keys.\\x1b[31mxxx" in problems[1] and problems[1].endswith(ids)
     assert "more characters)" in problems[1] and "\x1b" not in problems[1]
+
+
+def test_a_key_the_app_keeps_for_itself_is_refused_in_keys_toml(tmp_path):
+    """run = "ctrl+q" was taken without a word: Ctrl+Q then ran the scenario and nothing
+    quit, while the help still said Ctrl+Q quits; "ctrl+p" lost the command palette, and
+    "tab" (or "ctrl+i", the terminal's Tab) the way between controls. Such a remap is
+    refused on its line, naming what the key does, and the command keeps its default."""
+    from ladartui.tui.actions import keys_in_force, load_keymap
+
+    keys = tmp_path / "keys.toml"
+    keys.write_text(
+        '[keys]\nrun = "ctrl+q"\nmeasures = "ctrl+p"\ncompare = "f10,tab"\n'
+        'threshold = "ctrl+c"\nstudy = "shift+tab"\nsweep = "ctrl+i"\nlayout = "ctrl+l"\n'
+    )
+    keymap, problems = load_keymap(tmp_path)
+    assert keymap == {"layout": "ctrl+l"}
+    assert [p.split(": ", 2)[1] for p in problems] == [
+        "keys.run = 'ctrl+q'",
+        "keys.measures = 'ctrl+p'",
+        "keys.compare = 'f10,tab'",
+        "keys.threshold = 'ctrl+c'",
+        "keys.study = 'shift+tab'",
+        "keys.sweep = 'ctrl+i'",
+    ]
+    assert problems[0] == f"{keys}:2: keys.run = 'ctrl+q': Ctrl+Q quits the app; choose another key"
+    assert "Ctrl+P opens the command palette" in problems[1]
+    assert "Tab moves to the next control" in problems[2]
+    assert "Ctrl+I is the terminal's Tab" in problems[5]
+    assert keys_in_force(keymap)["run"] == "f5"

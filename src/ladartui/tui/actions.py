@@ -282,12 +282,24 @@ def _view_keys() -> dict[str, tuple[str, str]]:
 # the command does what the view's key does.
 VIEW_KEYS = _view_keys()
 
+# Keys the app keeps for itself (Textual's quit, palette, focus and Ctrl+C): a command
+# remapped onto one would take it from them (Ctrl+Q would run, and nothing would quit).
+APP_KEYS = {
+    "ctrl+q": "quits the app",
+    "ctrl+p": "opens the command palette",
+    "ctrl+c": "says how to quit (and copies selected text)",
+    "tab": "moves to the next control",
+    "shift+tab": "moves to the previous control",
+    "ctrl+i": "is the terminal's Tab, which moves to the next control",
+}
+
 
 def load_keymap(folder: Path | None = None) -> tuple[dict[str, str], list[str]]:
     """The user's key remapping from ``keys.toml``, and one line per problem found.
 
     A missing file is no remapping; a damaged one, an unknown table or command
-    id, a key that is not text, one the views take (``VIEW_KEYS``), or one
+    id, a key that is not text, one the app keeps (``APP_KEYS``), one the views take
+    (``VIEW_KEYS``), or one
     another command has, is reported (on its line) and left out, never fatal.
     """
     config = read_config_table((folder or config_folder()) / KEYS_FILE, "keys", "command id = key")
@@ -305,6 +317,13 @@ def load_keymap(folder: Path | None = None) -> tuple[dict[str, str], list[str]]:
             problems.append(
                 one_line(
                     f'{where}: keys.{command_id} = {key!r}: expected a key name such as "f9" or "ctrl+r"'
+                )
+            )
+        elif kept := [k for k in _bound_keys(key) if k in APP_KEYS]:
+            problems.append(
+                one_line(
+                    f"{where}: keys.{command_id} = {key!r}: {key_name(kept[0])} {APP_KEYS[kept[0]]}; "
+                    "choose another key"
                 )
             )
         elif taken_by_views := [
@@ -380,6 +399,8 @@ def key_name(key: str) -> str:
         "up": "Up",
         "down": "Down",
         "delete": "Delete",
+        "tab": "Tab",
+        "shift+tab": "Shift+Tab",
     }
 
     def one(k: str) -> str:
