@@ -384,3 +384,34 @@ async def test_a_flight_log_segment_is_listed_and_says_where_it_is_edited(tmp_pa
         await pilot.pause()
         assert not isinstance(app.screen, FormScreen)  # no number form for a file's data
         assert "scenario file" in app.messages[-1]
+
+
+async def test_the_palette_names_a_recent_scenario_whose_path_holds_brackets(
+    tmp_path, scene_files, monkeypatch
+):
+    """A recent scenario "run [final].toml" was offered in the palette as "run .toml" (its
+    name read as markup), and one in a folder named "[" (its path holding "[/red]")
+    ended the app with a MarkupError once the palette was opened."""
+    from textual.command import CommandPalette
+    from textual.widgets import OptionList
+
+    monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))
+    (tmp_path / "[").mkdir()
+    first = make_scenario(tmp_path / "[", scene_files, name="red]x")
+    second = make_scenario(tmp_path, scene_files, name="run [final]")
+    third = make_scenario(tmp_path, scene_files, name="third")
+    app = LadarApp(first.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        for path in (second.path, third.path):
+            app.open_path(path)
+            await wait_until(pilot, lambda path=path: app.scenario.path == path and app.busy is None)
+        await pilot.press("ctrl+p")
+        palette = await screen_after(pilot, lambda: None, CommandPalette)
+        await pilot.press(*"recent")
+        hits = palette.query_one(OptionList)
+        await wait_until(pilot, lambda: hits.option_count >= 3)
+        shown = [str(hits.get_option_at_index(i).prompt) for i in range(hits.option_count)]
+        assert any("Open recent: run [final].toml" in s and str(second.path) in s for s in shown), shown
+        assert any("Open recent: red]x.toml" in s and f"{tmp_path}/[/red]x.toml" in s for s in shown), shown
+        assert app.is_running

@@ -20,6 +20,7 @@ from textual import events, on
 from textual.app import App, ComposeResult, SystemCommand
 from textual.containers import Horizontal, Vertical
 from textual.css.query import NoMatches
+from textual.markup import escape
 from textual.notifications import SeverityLevel
 from textual.screen import ModalScreen, Screen
 from textual.widgets import Button, Footer, TabbedContent, TabPane, Tabs
@@ -555,13 +556,16 @@ class LadarApp(
             # the study and sweep screens have their own keys: those, not the app's
             for title, keys, action in tool_screen_entries(screen):
                 yield SystemCommand(
-                    title, keys, functools.partial(screen.call_later, screen.run_action, action)
+                    escape(title),
+                    escape(keys),
+                    functools.partial(screen.call_later, screen.run_action, action),
                 )
             return
         if waiting:
             return  # nothing may start under it
         for title, help_text, action in palette_entries(self):
-            yield SystemCommand(title, help_text, _runner(self, action, title))
+            # the palette reads its titles and help as markup: a recent file's path is text
+            yield SystemCommand(escape(title), escape(help_text), _runner(self, action, title))
 
 
 def _runner(app, action: str, title: str):
