@@ -390,15 +390,16 @@ async def test_the_palette_names_a_recent_scenario_whose_path_holds_brackets(
     tmp_path, scene_files, monkeypatch
 ):
     """A recent scenario "run [final].toml" was offered in the palette as "run .toml" (its
-    name read as markup), and one in a folder named "[" (its path holding "[/red]")
-    ended the app with a MarkupError once the palette was opened."""
+    name read as markup), and one in a folder named "[" (its path holding "[/red]", or
+    "[/run [final]", which escaping each tag missed) ended the app with a MarkupError
+    once the palette was opened."""
     from textual.command import CommandPalette
     from textual.widgets import OptionList
 
     monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))
     (tmp_path / "[").mkdir()
     first = make_scenario(tmp_path / "[", scene_files, name="red]x")
-    second = make_scenario(tmp_path, scene_files, name="run [final]")
+    second = make_scenario(tmp_path / "[", scene_files, name="run [final]")
     third = make_scenario(tmp_path, scene_files, name="third")
     app = LadarApp(first.path)
     async with app.run_test(size=SIZE) as pilot:
@@ -410,8 +411,27 @@ async def test_the_palette_names_a_recent_scenario_whose_path_holds_brackets(
         palette = await screen_after(pilot, lambda: None, CommandPalette)
         await pilot.press(*"recent")
         hits = palette.query_one(OptionList)
-        await wait_until(pilot, lambda: hits.option_count >= 3)
+        await wait_until(pilot, lambda: hits.option_count >= 3 or not app.is_running, timeout=30)
         shown = [str(hits.get_option_at_index(i).prompt) for i in range(hits.option_count)]
         assert any("Open recent: run [final].toml" in s and str(second.path) in s for s in shown), shown
         assert any("Open recent: red]x.toml" in s and f"{tmp_path}/[/red]x.toml" in s for s in shown), shown
         assert app.is_running
+
+
+def test_names_holding_brackets_or_backslashes_show_as_written_in_markup():
+    """rich's escape, used for the unsaved-edits question, the measures' title and the
+    forms' messages, escapes only what looks like a tag: "x[b [c].toml" showed as
+    "x[b \\[c].toml", and a backslash before a bracket or at the end came out twice."""
+    from textual.content import Content
+
+    from ladartui.tui.plain_text import literal
+
+    for name in (
+        "x[b [c].toml",
+        "[a[b]].toml",
+        "a\\[red]b.toml",
+        "tail\\",
+        "/p/[/run [final].toml",
+        "[@click=quit]",
+    ):
+        assert Content.from_markup(literal(name)).plain == name

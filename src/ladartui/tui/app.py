@@ -20,7 +20,6 @@ from textual import events, on
 from textual.app import App, ComposeResult, SystemCommand
 from textual.containers import Horizontal, Vertical
 from textual.css.query import NoMatches
-from textual.markup import escape
 from textual.notifications import SeverityLevel
 from textual.screen import ModalScreen, Screen
 from textual.widgets import Button, Footer, TabbedContent, TabPane, Tabs
@@ -41,6 +40,7 @@ from ladartui.tui.measures_screens import CompareScreen, MeasuresScreen
 from ladartui.tui.notes import NoteKeeping
 from ladartui.tui.panels import FilePanel, FlightPanel, ResultsPanel, RunPanel, SensorPanel
 from ladartui.tui.params import ParamField
+from ladartui.tui.plain_text import literal
 from ladartui.tui.runs import RunControl
 from ladartui.tui.screens import AngleScreen, HelpScreen, ImageSizeScreen, ThresholdScreen
 from ladartui.tui.startup_problems import startup_notice
@@ -556,8 +556,8 @@ class LadarApp(
             # the study and sweep screens have their own keys: those, not the app's
             for title, keys, action in tool_screen_entries(screen):
                 yield SystemCommand(
-                    escape(title),
-                    escape(keys),
+                    literal(title),
+                    literal(keys),
                     functools.partial(screen.call_later, screen.run_action, action),
                 )
             return
@@ -565,7 +565,7 @@ class LadarApp(
             return  # nothing may start under it
         for title, help_text, action in palette_entries(self):
             # the palette reads its titles and help as markup: a recent file's path is text
-            yield SystemCommand(escape(title), escape(help_text), _runner(self, action, title))
+            yield SystemCommand(literal(title), literal(help_text), _runner(self, action, title))
 
 
 def _runner(app, action: str, title: str):

@@ -11,7 +11,6 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
-from rich.markup import escape
 from textual import on
 from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical
@@ -24,6 +23,7 @@ from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField, in_label_unit, refusal
 from ladartui.tui.file_tree import SCENARIO_TABLE
 from ladartui.tui.host import host_of
+from ladartui.tui.plain_text import literal
 from ladartui.tui.screens import TreeDialog, _row
 
 SCENARIO_SUFFIXES = (".toml",)
@@ -163,7 +163,7 @@ class SetupScreen(TreeDialog):
         scenario_path, scene_path = self._paths()
         if self.mode == "new":
             names = bridge.derived_names(scenario_path, scene_path)
-            text = escape("\n".join(f"{label:<26}{visible(value)}" for label, value in names))
+            text = literal("\n".join(f"{label:<26}{visible(value)}" for label, value in names))
         else:
             text = (
                 "Every model file of the scenario is checked before anything is loaded; "

@@ -6,7 +6,6 @@ from __future__ import annotations
 import shlex
 from pathlib import Path
 
-from rich.markup import escape
 from rich.text import Text
 from textual import on
 from textual.app import ComposeResult
@@ -25,6 +24,7 @@ from ladartui.measures_compare import (
 )
 from ladartui.tui.file_tree import FileTree
 from ladartui.tui.measures_view import level_rows, measure_rows, target_rows
+from ladartui.tui.plain_text import literal
 from ladartui.tui.screens import Dialog, TreeDialog, _row
 
 
@@ -156,7 +156,7 @@ class CompareScreen(TreeDialog):
             # a scenario stands for its last run's measures: say so where it has changed since
             notes = [note for path in dict.fromkeys(paths) if (note := earlier_settings_note(path))]
         except LadarError as error:
-            message.update(escape(str(error)))
+            message.update(literal(str(error)))
             return
         message.update(escape(" ".join(f"Note: {note}" for note in notes)))
         table.add_column("Measure")

@@ -6,7 +6,6 @@ and OK refuse until it is corrected, and OK applies the row being edited first.
 
 from __future__ import annotations
 
-from rich.markup import escape
 from textual import on
 from textual.app import ComposeResult
 from textual.binding import Binding
@@ -16,6 +15,7 @@ from textual.widgets import Button, DataTable, Input, Label, Static
 from ladartui.errors import FieldError, LadarError
 from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField, in_label_unit, refusal
+from ladartui.tui.plain_text import literal
 from ladartui.tui.screens import Dialog, field_matches
 
 
@@ -143,7 +143,7 @@ class PosesScreen(Dialog):
             widget.add_class("-bad")
             label = self.LABELS[widget.field_name]
             expected = in_label_unit(label, problem.split("expected ", 1)[-1])
-            self.query_one("#poses-message", Static).update(escape(refusal(label, widget.value, expected)))
+            self.query_one("#poses-message", Static).update(literal(refusal(label, widget.value, expected)))
         return problem is None
 
     def _refused(self) -> bool:
@@ -177,7 +177,7 @@ class PosesScreen(Dialog):
         try:
             pose = bridge.make_pose({c: self._raw(c) for c in self.COLUMNS})
         except LadarError as error:
-            message.update(escape(str(error)))
+            message.update(literal(str(error)))
             return False
         row = self.query_one(DataTable).cursor_row if row is None else row
         if 0 <= row < len(self.poses):

@@ -14,13 +14,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
-from rich.markup import escape
 from textual.widgets import TabbedContent
 
 from ladartui.errors import Cancelled
 from ladartui.tui.host import Host
 from ladartui.tui.loading import look_at_outputs
 from ladartui.tui.measures_screens import MeasuresScreen
+from ladartui.tui.plain_text import literal
 from ladartui.tui.status import format_eta
 from ladartui.tui.work import running, start_job
 
@@ -127,7 +127,7 @@ class RunControl(Host):
         self.refresh_status()
         self.query_one("#tabs", TabbedContent).active = "tab-results"
         name = scenario.name if scenario is not None else ""
-        self.push_screen(MeasuresScreen(result.measures, f"Comparison measures: {escape(name)}"))
+        self.push_screen(MeasuresScreen(result.measures, f"Comparison measures: {literal(name)}"))
 
 
 def _run(scenario, scene, fast: bool, warm, cancel, progress):

@@ -10,7 +10,6 @@ import shlex
 from collections.abc import Callable
 from pathlib import Path
 
-from rich.markup import escape
 from rich.text import Text
 from textual import on
 from textual.app import ComposeResult
@@ -26,6 +25,7 @@ from ladartui.fileprobe import user_path
 from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField, format_number, in_label_unit, parse_number, refusal
 from ladartui.tui.file_tree import FileTree
+from ladartui.tui.plain_text import literal
 
 
 class PathSuggester(Suggester):
@@ -294,7 +294,7 @@ class FormScreen(Dialog):
         if expected.startswith("an integer"):  # the form's word for it, as in the sidebar
             expected = "a whole number" + expected.removeprefix("an integer")
         expected = in_label_unit(label, expected)
-        self.query_one("#form-message", Static).update(escape(refusal(label, widget.value, expected)))
+        self.query_one("#form-message", Static).update(literal(refusal(label, widget.value, expected)))
 
     @on(Input.Changed)
     def _typing(self, event: Input.Changed) -> None:
@@ -328,7 +328,7 @@ class FormScreen(Dialog):
                     if isinstance(wrong, Input):
                         self._refuse(wrong, name, error.expected)
                         return
-            self.query_one("#form-message", Static).update(escape(str(error)))
+            self.query_one("#form-message", Static).update(literal(str(error)))
             return
         self.cancelled = False
         self.dismiss(result)

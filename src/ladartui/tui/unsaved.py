@@ -8,7 +8,6 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TypeVar
 
-from rich.markup import escape
 from textual import on
 from textual.app import ComposeResult
 from textual.binding import Binding
@@ -19,6 +18,7 @@ from textual.widgets import Button, Static
 from ladartui.errors import LadarError
 from ladartui.tui.host import Host
 from ladartui.tui.params import ParamField, field_message
+from ladartui.tui.plain_text import literal
 
 Answer = TypeVar("Answer")
 
@@ -47,7 +47,7 @@ class UnsavedScreen(QuestionScreen[str | None]):
         self.scenario_name, self.doing, self.rereads = name, doing, rereads
 
     def compose(self) -> ComposeResult:
-        name = escape(self.scenario_name)
+        name = literal(self.scenario_name)
         with Vertical():
             if self.rereads:
                 yield Static(
@@ -55,7 +55,7 @@ class UnsavedScreen(QuestionScreen[str | None]):
                     "lost. Discard them, or Cancel (Save As keeps them under another name)."
                 )
             else:
-                yield Static(f"{name} has unsaved edits. Save them before you {escape(self.doing)}?")
+                yield Static(f"{name} has unsaved edits. Save them before you {literal(self.doing)}?")
             with Horizontal():
                 if not self.rereads:
                     yield Button("Save", id="unsaved-save", variant="primary", compact=True)
