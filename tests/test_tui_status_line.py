@@ -4,6 +4,7 @@ asking before it cancels a run."""
 
 from __future__ import annotations
 
+from ladartui.tui.actions import palette_entries
 from ladartui.tui.status import StatusBar
 from test_tui_edits import SIZE, capture_runs, copy_scene
 from tui_support import LadarApp, loaded, make_scenario, wait_until
@@ -231,3 +232,35 @@ async def test_a_view_keeps_the_keys_while_a_run_goes_on(tmp_path, scene_files):
         await pilot.press("f5")
         await pilot.pause()
         assert app.focused is app.query_one("#status #cancel")
+
+
+async def test_a_scenario_name_holding_control_characters_is_shown_escaped(
+    tmp_path, scene_files, monkeypatch
+):
+    """A scenario named "ctl<ESC>[31mred<newline>nl.toml" reached the terminal raw: the
+    File tab broke its row in two and coloured the rest red, and the status bar's line
+    was torn. Its name is shown with the controls written out, as messages write them."""
+    monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))
+    scenario = make_scenario(tmp_path, scene_files, name="ctl\x1b[31mred\nnl")
+    other = make_scenario(tmp_path, scene_files, name="other")
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        shown = "ctl\\x1b[31mred\\x0anl"
+        info = str(app.query_one("#file-info").render())
+        assert f"Scenario      {shown}.toml\n" in info and "\x1b" not in info, info
+        assert f"Measures      {shown}.cmf" in info
+        line = str(app.query_one("#status-text").render())
+        assert line.startswith(f"{shown}.toml: ") and "\x1b" not in line and "\n" not in line, line
+        app.open_path(other.path)
+        await wait_until(pilot, lambda: app.scenario.path == other.path and app.busy is None)
+        recent = app.query_one("#recent")
+        listed = str(recent.get_option_at_index(0).prompt)
+        assert listed.startswith(f"{shown}.toml  ") and "\x1b" not in listed, listed
+        offered = [(title, where) for title, where, _ in palette_entries() if title.startswith("Open recent")]
+        assert (f"Open recent: {shown}.toml", f"{tmp_path}/{shown}.toml") in offered, offered
+        app.open_path(scenario.path)
+        await wait_until(pilot, lambda: app.scenario.path == scenario.path and app.busy is None)
+        await app.run_action("save")
+        await pilot.pause()
+        assert app.messages[-1] == f"Saved {tmp_path}/{shown}.toml", app.messages[-1]

@@ -20,7 +20,7 @@ from pathlib import Path
 
 from textual.binding import Binding, BindingType
 
-from ladartui.textsafe import one_line
+from ladartui.textsafe import one_line, single_line
 from ladartui.toml_lines import read_config_table
 from ladartui.tui import bridge
 from ladartui.tui.canvas import ProjectionWidget, TopViewWidget
@@ -226,7 +226,9 @@ def palette_entries(keymap: dict[str, str] | None = None) -> list[tuple[str, str
     from ladartui.recent import recent_scenarios
 
     for path in recent_scenarios():
-        entries.append((f"Open recent: {path.name}", str(path), f"open_recent({str(path)!r})"))
+        # a name's controls written out: one line each, and no escape reaches the terminal
+        title, where = single_line(f"Open recent: {path.name}"), single_line(path)
+        entries.append((title, where, f"open_recent({str(path)!r})"))
     return entries
 
 

@@ -28,6 +28,7 @@ from ladartui.edit_history import EditHistory
 from ladartui.measures_compare import measures_files_to_offer
 from ladartui.run_record import setting_changes
 from ladartui.scenario import Scenario
+from ladartui.textsafe import single_line
 from ladartui.tui import actions, bridge
 from ladartui.tui.canvas import PictureWidget
 from ladartui.tui.editing import ScenarioEditing
@@ -466,6 +467,8 @@ class LadarApp(
         self, message: str, *, title: str = "", severity: SeverityLevel = "information", timeout: float = 5
     ) -> None:
         """Show a message to the analyst (and keep it in ``messages`` for the record)."""
+        # a file name's controls written out (a newline, an escape) must not reach the terminal
+        message, title = single_line(message), single_line(title)
         self.messages.append(f"{title}: {message}" if title else message)
         # text from files and fields must not be read as markup
         self.notify(message, title=title, severity=severity, timeout=timeout, markup=False)

@@ -8,7 +8,10 @@ raised a MarkupError, and a backslash before a bracket or at the end was doubled
 
 from __future__ import annotations
 
+from ladartui.textsafe import visible
+
 
 def literal(text: object) -> str:
-    """``text`` for Textual markup: shown as it is, never read as tags."""
-    return str(text).replace("[", "\\[")
+    """``text`` for Textual markup: shown as it is, never read as tags, its lines kept and
+    any other control character (a file name's terminal escape) written out."""
+    return visible(text).replace("[", "\\[")

@@ -17,6 +17,7 @@ import numpy as np
 from textual.widgets import TabbedContent
 
 from ladartui.errors import Cancelled
+from ladartui.textsafe import single_line
 from ladartui.tui.host import Host
 from ladartui.tui.loading import look_at_outputs
 from ladartui.tui.measures_screens import MeasuresScreen
@@ -127,7 +128,9 @@ class RunControl(Host):
         self.refresh_status()
         self.query_one("#tabs", TabbedContent).active = "tab-results"
         name = scenario.name if scenario is not None else ""
-        self.push_screen(MeasuresScreen(result.measures, f"Comparison measures: {literal(name)}"))
+        self.push_screen(
+            MeasuresScreen(result.measures, f"Comparison measures: {literal(single_line(name))}")
+        )
 
 
 def _run(scenario, scene, fast: bool, warm, cancel, progress):

@@ -12,6 +12,8 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal
 from textual.widgets import Button, Static
 
+from ladartui.textsafe import single_line
+
 NOT_READY, READY, BUSY = "not-ready", "ready", "busy"
 LABELS = {NOT_READY: "NOT READY", READY: "READY", BUSY: "BUSY"}
 
@@ -42,7 +44,9 @@ class StatusText(Static):
         self.name_shown: str | None = None
 
     def show(self, message: str, name: str | None = None) -> None:
-        self.message, self.name_shown = message, name
+        # one line: a name's controls (a newline, a terminal escape) are written out
+        self.message = single_line(message)
+        self.name_shown = single_line(name) if name is not None else None
         self.refresh()
 
     def render(self) -> Text:

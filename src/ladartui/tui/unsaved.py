@@ -16,6 +16,7 @@ from textual.screen import ModalScreen
 from textual.widgets import Button, Static
 
 from ladartui.errors import LadarError
+from ladartui.textsafe import single_line
 from ladartui.tui.host import Host
 from ladartui.tui.params import ParamField, field_message
 from ladartui.tui.plain_text import literal
@@ -47,7 +48,7 @@ class UnsavedScreen(QuestionScreen[str | None]):
         self.scenario_name, self.doing, self.rereads = name, doing, rereads
 
     def compose(self) -> ComposeResult:
-        name = literal(self.scenario_name)
+        name = literal(single_line(self.scenario_name))
         with Vertical():
             if self.rereads:
                 yield Static(
@@ -84,7 +85,7 @@ class QuitRunScreen(QuestionScreen[bool]):
         done = f" ({100 * self.progress:.0f}%)" if self.progress is not None else ""
         with Vertical():
             yield Static(
-                f"A run of {self.scenario_name} is going on{done}. Quit and cancel it? "
+                f"A run of {single_line(self.scenario_name)} is going on{done}. Quit and cancel it? "
                 "The outputs on disk stay as they were.",
                 id="quit-run-question",
                 markup=False,

@@ -13,6 +13,7 @@ from textual.widgets import Button, Label, OptionList, Static
 from textual.widgets.option_list import Option
 
 from ladartui.recent import recent_scenarios
+from ladartui.textsafe import single_line
 from ladartui.tui.host import host_of
 
 
@@ -62,11 +63,11 @@ class FilePanel(VerticalScroll):
             if text:
                 text.append("\n")
             text.append(f"{key:<14}", style="bold")
-            text.append(value)  # names from files and fields: plain text, never markup
+            text.append(single_line(value))  # names from files: plain text, controls written out
         if missing:
             host = host_of(self)  # the key in force, and only while a run would write them
             writes = "" if host.problems(fields=False) else host.key_says("run", "writes them")
-            names = ", ".join(p.name for p in missing)
+            names = single_line(", ".join(p.name for p in missing))
             text.append(f"\nNot on disk yet: {names}" + (f" ({writes})" if writes else ""), style="yellow")
         self.query_one("#file-info", Static).update(text)
 
@@ -75,7 +76,8 @@ class FilePanel(VerticalScroll):
         listing.clear_options()
         paths = [p for p in recent_scenarios() if p != current]
         for path in paths:
-            listing.add_option(Option(Text(f"{path.name}  {shown_folder(path.parent)}"), id=str(path)))
+            shown = single_line(f"{path.name}  {shown_folder(path.parent)}")
+            listing.add_option(Option(Text(shown), id=str(path)))
         listing.display = bool(paths)
         self.query_one("#recent-heading", Label).display = bool(paths)
 

@@ -11,6 +11,7 @@ from textual.containers import Grid, Horizontal
 from textual.widgets import Button, Checkbox, Label, Select, Static
 
 from ladartui.errors import LadarError
+from ladartui.textsafe import visible
 from ladartui.tracing.backend import METHODS
 from ladartui.tui import bridge
 from ladartui.tui.params import ParamPanel, field_id
@@ -89,7 +90,7 @@ class RunPanel(ParamPanel):
         step.disabled = scenario is None or scenario.method != "march" or bool(self.host.busy)
 
     def say(self, text: str) -> None:
-        self.query_one("#run-info", Static).update(text)
+        self.query_one("#run-info", Static).update(visible(text))  # the names it wrote: controls written out
 
     def set_running(self, running: bool) -> None:
         self.query_one("#btn-cancel-run", Button).disabled = not running
