@@ -111,6 +111,33 @@ async def test_a_new_scenario_whose_scene_cannot_be_read_is_not_written_and_its_
         assert app.scenario.path == scenario.path  # the one open before stays
 
 
+async def test_a_new_scenario_whose_scene_cannot_be_read_comes_back_at_its_scene_model(tmp_path, scene_files):
+    """The form came back with the focus on Scenario file, its name selected, while the
+    message named the scene model: the corrected model name, typed, replaced the
+    scenario's name. The focus is now on 3D scene model."""
+    from ladartui.tui.file_dialogs import SetupScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    (tmp_path / "bad.txt").write_text("1,2,3\n1,2,abc\n", encoding="utf-8")
+    (tmp_path / "bad_Target.txt").write_text("1,2,3\n", encoding="utf-8")
+    async with opened(scenario) as (app, pilot):
+        dialog = await screen_after(pilot, "f2", SetupScreen)
+        await pilot.press(*"fresh", "tab", *"bad.txt", "tab", "ctrl+u", *"0.25", "enter")
+        await wait_until(
+            pilot,
+            lambda: app.busy is None and isinstance(app.screen, SetupScreen) and app.screen is not dialog,
+            60,
+        )
+        again = app.screen
+        await wait_until(pilot, lambda: again.is_mounted, 10)
+        await pilot.pause()
+        scene_field = again.query_one("#scene-file")
+        assert app.focused is scene_field, app.focused
+        await pilot.press("ctrl+u", *"forest.txt")
+        assert again.query_one("#scenario-file").value == "fresh"
+        assert scene_field.value == "forest.txt"
+
+
 async def test_open_shows_only_the_fields_it_reads(tmp_path, scene_files):
     """Open showed New's scene model and voxel size, the voxel size in plain text as if
     it were read; they show again on switching to New."""

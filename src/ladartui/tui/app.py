@@ -111,7 +111,7 @@ class LadarApp(
         self.busy: str | None = None
         self.progress: float | None = None
         self.load_worker = self.warm_worker = self.run_worker_handle = None  # the jobs
-        self.new_pending: tuple[Path, tuple[str, ...]] | None = None  # New's folder and fields
+        self.new_pending: tuple[Path, tuple[str, ...], Path] | None = None  # New's folder, fields, file
         self.messages: list[str] = []
         self.leaving = False  # set by exit: news from jobs is no longer shown
         self.running = False

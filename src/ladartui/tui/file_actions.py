@@ -55,15 +55,18 @@ class FileActions(Host):
             "open another scenario" if mode == "load" else "start a new one", lambda: self._open_setup(mode)
         )
 
-    def _open_setup(self, mode: str, folder: Path | None = None, typed=None, said: str = "") -> None:
+    def _open_setup(
+        self, mode: str, folder: Path | None = None, typed=None, said: str = "", focus: str | None = None
+    ) -> None:
         current = self.scenario.path if self.scenario is not None else None
-        setup = SetupScreen(mode, folder or self._folder(), current, typed, said)
+        setup = SetupScreen(mode, folder or self._folder(), current, typed, said, focus)
 
         def done(scenario):
             if scenario is not None:
                 self.result = None
                 # New's form comes back as typed should its scene prove unreadable
-                self.new_pending = (setup.folder, setup.typed) if setup.mode == "new" else None
+                new = setup.mode == "new"
+                self.new_pending = (setup.folder, setup.typed, scenario.path) if new else None
                 self.load(None, scenario=scenario, new=setup.mode == "new")
 
         self.push_screen(setup, done)
@@ -72,8 +75,11 @@ class FileActions(Host):
         """A new scenario whose scene could not be read (nothing was written): its form
         again, as it was typed, saying why."""
         if self.new_pending is not None:
-            folder, typed = self.new_pending
-            self._open_setup("new", folder, typed, error)
+            folder, typed, path = self.new_pending
+            # the field to put right has the focus: the scenario file's, where it could not
+            # be written, else the scene model's (a bad line, too large, its target model)
+            field = "scenario-file" if error.startswith(str(path)) else "scene-file"
+            self._open_setup("new", folder, typed, error, field)
 
     def open_path(self, path: Path, before: Callable[[], None] | None = None) -> None:
         """Open a scenario file (recent list, best sweep path), asking about unsaved edits;

@@ -38,7 +38,8 @@ class SetupScreen(TreeDialog):
     model is named and nothing is loaded. Dismisses with the loaded Scenario.
     Load opens holding ``current`` (the open scenario), selected: Enter reopens it
     as it is on disk, typing replaces it. New opens holding ``typed`` (scenario file,
-    scene model, voxel size) and ``said`` when a new scenario's scene could not be read.
+    scene model, voxel size) and ``said`` when a new scenario's scene could not be read,
+    ``focus`` naming the field to put right.
     """
 
     prefilled_ids = ("scenario-file", "scene-file", "voxel-size")
@@ -50,11 +51,13 @@ class SetupScreen(TreeDialog):
         current: Path | None = None,
         typed: tuple[str, ...] | None = None,
         said: str = "",
+        focus: str | None = None,
     ):
         super().__init__()
         self.mode = mode
         self.current = current
         self.said = said
+        self.focus_id = focus or "scenario-file"  # the field that opens with the focus
         # field id -> the text New's form comes back with; its Changed event clears nothing
         self.prefilled = dict(zip(self.prefilled_ids, typed or ()))
         self.typed: tuple[str, ...] = ()  # the fields as OK took them
@@ -111,7 +114,7 @@ class SetupScreen(TreeDialog):
         if self.mode == "load" and self.current is not None:
             field.value = self.relative(self.current)
         self.query_one("#setup-message", Static).update(self.said)
-        field.focus()
+        self.query_one(f"#{self.focus_id}", Input).focus()
 
     @on(RadioSet.Changed, "#mode")
     def _mode_changed(self, event: RadioSet.Changed) -> None:

@@ -65,7 +65,7 @@ class AppHost(App[None]):
     progress: float | None
     running: bool
     load_worker: Worker[Any] | None
-    new_pending: tuple[Path, tuple[str, ...]] | None  # New's folder and fields, as typed
+    new_pending: tuple[Path, tuple[str, ...], Path] | None  # New's folder, fields as typed, file
     warm_worker: Worker[Any] | None
     run_worker_handle: Worker[Any] | None
     tool_screen: Screen[None] | None  # the study or sweep screen while it is open
