@@ -138,6 +138,22 @@ async def test_a_new_scenario_whose_scene_cannot_be_read_comes_back_at_its_scene
         assert scene_field.value == "forest.txt"
 
 
+async def test_a_scene_model_name_holding_a_terminal_escape_is_said_written_out(tmp_path, scene_files):
+    """Open on a scenario whose scene = "sm\\u001b[2Jall.txt" (a model not there) said so
+    with the escape raw: the terminal cleared the screen under the dialog."""
+    from ladartui.tui.file_dialogs import SetupScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    lines = scenario.path.read_text(encoding="utf-8").splitlines()
+    lines = ['scene = "sm\\u001b[2Jall.txt"' if line.startswith("scene = ") else line for line in lines]
+    (tmp_path / "bad.toml").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    async with opened(scenario) as (app, pilot):
+        dialog = await screen_after(pilot, "f3", SetupScreen)
+        await type_into(pilot, dialog.query_one("#scenario-file"), "bad.toml")
+        said = message(dialog, "#setup-message")
+        assert "sm\\x1b[2Jall.txt not found" in said and "\x1b" not in said, said
+
+
 async def test_open_shows_only_the_fields_it_reads(tmp_path, scene_files):
     """Open showed New's scene model and voxel size, the voxel size in plain text as if
     it were read; they show again on switching to New."""

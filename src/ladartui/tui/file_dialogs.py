@@ -23,7 +23,7 @@ from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField, in_label_unit, refusal
 from ladartui.tui.file_tree import SCENARIO_TABLE
 from ladartui.tui.host import host_of
-from ladartui.tui.plain_text import literal
+from ladartui.tui.plain_text import PlainStatic, literal
 from ladartui.tui.screens import TreeDialog, _row
 
 SCENARIO_SUFFIXES = (".toml",)
@@ -102,7 +102,7 @@ class SetupScreen(TreeDialog):
                 ),
             )
             yield Static("", id="derived", classes="info")
-            yield Static("", id="setup-message", classes="message", markup=False)
+            yield PlainStatic("", id="setup-message", classes="message")
             with Horizontal(classes="buttons"):
                 yield Button("OK", id="setup-ok", variant="primary", compact=True)
                 yield Button("Cancel", id="setup-cancel", compact=True)
@@ -248,7 +248,7 @@ class SaveAsScreen(TreeDialog):
                 ),
             )
             yield Static("Outputs are named after the scenario and sit beside it.", classes="info")
-            yield Static("", id="save-as-message", classes="message", markup=False)
+            yield PlainStatic("", id="save-as-message", classes="message")
             with Horizontal(classes="buttons"):
                 yield Button("OK", id="save-as-ok", variant="primary", compact=True)
                 yield Button("Cancel", id="save-as-cancel", compact=True)
@@ -325,7 +325,7 @@ class PickPathScreen(TreeDialog):
             yield _row(
                 "Path", Input(id="pick-path", compact=True, suggester=self.path_suggester(self.suffixes))
             )
-            yield Static("", id="pick-message", classes="message", markup=False)
+            yield PlainStatic("", id="pick-message", classes="message")
             with Horizontal(classes="buttons"):
                 yield Button("OK", id="pick-ok", variant="primary", compact=True)
                 yield Button("Cancel", id="pick-cancel", compact=True)

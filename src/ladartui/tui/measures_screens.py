@@ -24,7 +24,7 @@ from ladartui.measures_compare import (
 )
 from ladartui.tui.file_tree import FileTree
 from ladartui.tui.measures_view import level_rows, measure_rows, target_rows
-from ladartui.tui.plain_text import literal
+from ladartui.tui.plain_text import PlainStatic, literal
 from ladartui.tui.screens import Dialog, TreeDialog, _row
 
 
@@ -48,7 +48,7 @@ class MeasuresScreen(Dialog):
         with Vertical(classes="dialog") as box:
             box.border_title = self.title_text
             if self.stale:  # words from settings and file names: never markup
-                yield Static(self.stale, id="measures-stale", markup=False)
+                yield PlainStatic(self.stale, id="measures-stale")
             yield DataTable(cursor_type="row", zebra_stripes=True)
             with Horizontal(classes="buttons"):
                 yield Button("Close", id="measures-close", variant="primary", compact=True)

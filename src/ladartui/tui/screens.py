@@ -25,7 +25,7 @@ from ladartui.fileprobe import user_path
 from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField, format_number, in_label_unit, parse_number, refusal
 from ladartui.tui.file_tree import FileTree
-from ladartui.tui.plain_text import literal
+from ladartui.tui.plain_text import PlainStatic, literal
 
 
 class PathSuggester(Suggester):
@@ -107,7 +107,7 @@ class TreeDialog(Dialog):
 
     def tree_rows(self, suffixes, toml_table: str | None = None) -> ComposeResult:
         with Horizontal(classes="tree-row"):
-            yield Static("", id="tree-root", markup=False)
+            yield PlainStatic("", id="tree-root")
             yield Button("Up a folder", id="tree-up", compact=True)
         yield FileTree(self.folder, suffixes, toml_table, id="tree")
 

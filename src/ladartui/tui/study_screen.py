@@ -23,6 +23,7 @@ from textual_plotext import PlotextPlot
 from ladartui.study.chart import TABLE_COLUMNS, draw_chart, label_places, legend_text, table_rows
 from ladartui.textsafe import visible
 from ladartui.tui.fitted_tables import FittingTable, fill_whole_columns
+from ladartui.tui.plain_text import PlainStatic
 from ladartui.tui.status import BUSY, READY, StatusBar
 from ladartui.tui.work import JobDone, JobProgress, running, start_job
 
@@ -75,7 +76,7 @@ class StudyScreen(Screen):
                 yield Static("", id="study-legend")  # beside the points, never over them
             with Vertical(id="study-side"):
                 yield FittingTable(self._fill_table, id="study-table", zebra_stripes=True, cursor_type="row")
-                yield Static("", id="study-table-note", markup=False)
+                yield PlainStatic("", id="study-table-note")
                 yield Static("", id="study-verdict")
         # green ready, red busy with its progress, as on the main and sweep screens; one
         # line: a long path gives way, not the keys, and a line cut short (where the study

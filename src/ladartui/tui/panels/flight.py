@@ -18,6 +18,7 @@ from ladartui.flight import Manual
 from ladartui.tui import bridge
 from ladartui.tui.fitted_tables import SEGMENT_COLUMNS, FittingTable, fill_segments, fill_whole_columns
 from ladartui.tui.params import ParamPanel, field_id
+from ladartui.tui.plain_text import PlainStatic
 from ladartui.tui.poses_screen import PosesScreen
 from ladartui.tui.screens import FormScreen
 
@@ -40,7 +41,7 @@ class FlightPanel(ParamPanel):
     def compose(self):
         for param in bridge.FLIGHT_PARAMS + bridge.START_PARAMS:
             yield self.param_row(param)
-        yield Static("", id="start-note", classes="info", markup=False)
+        yield PlainStatic("", id="start-note", classes="info")
         yield Label("Segments (Enter edits)", classes="heading")
         yield FittingTable(self.refit_tables, id="segments", cursor_type="row", zebra_stripes=True)
         with Grid(classes="button-grid"):

@@ -10,13 +10,14 @@ from textual.widgets import Button, DataTable, Static
 from ladartui.measures import Measures
 from ladartui.tui.host import host_of
 from ladartui.tui.measures_view import compact_rows, level_rows, target_rows
+from ladartui.tui.plain_text import PlainStatic
 
 
 class ResultsPanel(VerticalScroll):
     DEFAULT_CLASSES = "pane"
 
     def compose(self):
-        yield Static(self._no_results(), id="results-info", classes="info", markup=False)
+        yield PlainStatic(self._no_results(), id="results-info", classes="info")
         yield DataTable(id="measures", cursor_type="row", zebra_stripes=True)
         with Grid(classes="button-grid run-buttons"):
             yield Button("Measures", id="btn-measures", compact=True)

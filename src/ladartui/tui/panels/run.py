@@ -11,10 +11,10 @@ from textual.containers import Grid, Horizontal
 from textual.widgets import Button, Checkbox, Label, Select, Static
 
 from ladartui.errors import LadarError
-from ladartui.textsafe import visible
 from ladartui.tracing.backend import METHODS
 from ladartui.tui import bridge
 from ladartui.tui.params import ParamPanel, field_id
+from ladartui.tui.plain_text import PlainStatic
 
 STEP_KEY = "scenario.step"
 
@@ -68,7 +68,7 @@ class RunPanel(ParamPanel):
                 compact=True,
                 tooltip="Launch, open or watch a flight-path sweep",
             )
-        yield Static("", id="run-info", classes="info", markup=False)
+        yield PlainStatic("", id="run-info", classes="info")
         yield Static("probing backends...", id="backend-info", classes="info")
 
     def show(self, scenario) -> None:
@@ -90,7 +90,7 @@ class RunPanel(ParamPanel):
         step.disabled = scenario is None or scenario.method != "march" or bool(self.host.busy)
 
     def say(self, text: str) -> None:
-        self.query_one("#run-info", Static).update(visible(text))  # the names it wrote: controls written out
+        self.query_one("#run-info", Static).update(text)
 
     def set_running(self, running: bool) -> None:
         self.query_one("#btn-cancel-run", Button).disabled = not running

@@ -6,13 +6,14 @@ from textual.widgets import Static
 
 from ladartui.tui import bridge
 from ladartui.tui.params import ParamPanel
+from ladartui.tui.plain_text import PlainStatic
 
 
 class SensorPanel(ParamPanel):
     def compose(self):
         for param in bridge.SENSOR_PARAMS:
             yield self.param_row(param)
-        yield Static("", id="sensor-info", classes="info", markup=False)
+        yield PlainStatic("", id="sensor-info", classes="info")
 
     def show(self, scenario) -> None:
         self.fill_fields(scenario)
