@@ -241,6 +241,21 @@ async def test_the_folder_tree_fills_the_scenario_field(tmp_path, scene_files):
         assert screen.query_one("#scenario-file").value == "demo.toml"
 
 
+async def test_the_folder_tree_writes_out_the_controls_in_a_file_name(tmp_path, scene_files):
+    """Open's tree showed "ctl<ESC>[31mred<newline>nl.toml" as "ctl" and its escape, raw:
+    the terminal coloured the rows below red, and the name was cut at its newline."""
+    scenario = make_scenario(tmp_path, scene_files)
+    make_scenario(tmp_path, scene_files, name="ctl\x1b[31mred\nnl")
+    app = LadarApp(scenario.path)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        screen = await screen_after(pilot, "f3", SetupScreen)
+        tree = screen.query_one(FileTree)
+        await wait_until(pilot, lambda: len(tree.root.children) > 1, 10)
+        labels = [node.label.plain for node in tree.root.children]
+        assert "ctl\\x1b[31mred\\x0anl.toml" in labels, labels
+
+
 async def test_start_pose_fields_follow_the_path_kind_and_refuse_impractical_values(tmp_path, scene_files):
     scenario = make_scenario(tmp_path, scene_files)
     app = LadarApp(scenario.path)

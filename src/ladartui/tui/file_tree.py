@@ -4,9 +4,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from rich.text import Text
 from textual.widgets import DirectoryTree
 
 from ladartui.run_record import is_record
+from ladartui.textsafe import single_line
 
 # A scenario file has a [files] table (scenario.py); other .toml files (pyproject.toml,
 # sweep specs) are not scenarios, nor are run records (outputs, though they have one).
@@ -24,6 +26,11 @@ class FileTree(DirectoryTree):
         super().__init__(path, **kwargs)
         self.suffixes = suffixes
         self.toml_table = toml_table
+
+    def process_label(self, label) -> Text:
+        """A file's name, whole on its line, its controls (an escape, a newline) written out:
+        raw, they reached the terminal, and the name was cut at a newline."""
+        return Text(single_line(label)) if isinstance(label, str) else super().process_label(label)
 
     def filter_paths(self, paths):
         return [p for p in paths if not p.name.startswith(".") and (p.is_dir() or self._takes(p))]
