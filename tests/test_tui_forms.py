@@ -261,6 +261,21 @@ async def test_compare_names_the_files_in_its_folder_by_their_names(tmp_path, sc
         assert [str(c.label) for c in table.columns.values()] == ["Measure", "demo", "other run"]
 
 
+async def test_compare_writes_out_the_controls_in_a_file_name(tmp_path, scene_files):
+    """A column headed by "run<ESC>[2J.cmf" sent the escape to the terminal: the screen
+    was cleared under the dialog."""
+    from ladartui.measures import Measures
+
+    scenario = make_scenario(tmp_path, scene_files)
+    Measures(target_voxels=100, obscured_coverage=0.2, scans=10).write_cmf(scenario.measures_file)
+    Measures(target_voxels=100, obscured_coverage=0.3, scans=10).write_cmf(tmp_path / "run\x1b[2J.cmf")
+    async with opened(scenario, size=(80, 24)) as (app, pilot):
+        compare = await screen_after(pilot, app.action_compare, CompareScreen)
+        table = compare.query_one("#compare-table")
+        await wait_until(pilot, lambda: len(table.columns) == 3, 10)
+        assert [str(c.label) for c in table.columns.values()] == ["Measure", "demo", "run\\x1b[2J"]
+
+
 async def test_open_offers_the_open_scenario_so_enter_reopens_it(tmp_path, scene_files):
     """'changed on disk; reopen (F3)' left the user to find and pick the file again in an
     empty Open dialog. Open now holds the open scenario's name, selected (typing replaces

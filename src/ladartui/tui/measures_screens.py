@@ -22,6 +22,7 @@ from ladartui.measures_compare import (
     side_by_side,
     styled,
 )
+from ladartui.textsafe import single_line
 from ladartui.tui.file_tree import FileTree
 from ladartui.tui.measures_view import level_rows, measure_rows, target_rows
 from ladartui.tui.plain_text import PlainStatic, literal
@@ -158,10 +159,10 @@ class CompareScreen(TreeDialog):
         except LadarError as error:
             message.update(literal(str(error)))
             return
-        message.update(escape(" ".join(f"Note: {note}" for note in notes)))
+        message.update(literal(" ".join(f"Note: {note}" for note in notes)))
         table.add_column("Measure")
         for name in column_names([Path(t) for t in text]):
-            table.add_column(Text(name))  # names from files: never markup
+            table.add_column(Text(single_line(name)))  # names from files: never markup, controls written out
         for row in side_by_side(loaded):
             table.add_row(*styled(row))
 
