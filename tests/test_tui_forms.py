@@ -262,8 +262,8 @@ async def test_compare_names_the_files_in_its_folder_by_their_names(tmp_path, sc
 
 
 async def test_compare_writes_out_the_controls_in_a_file_name(tmp_path, scene_files):
-    """A column headed by "run<ESC>[2J.cmf" sent the escape to the terminal: the screen
-    was cleared under the dialog."""
+    """A column headed by "run<ESC>[2J.cmf", and the field of files filled in with it,
+    sent the escape to the terminal: the screen was cleared under the dialog."""
     from ladartui.measures import Measures
 
     scenario = make_scenario(tmp_path, scene_files)
@@ -274,6 +274,10 @@ async def test_compare_writes_out_the_controls_in_a_file_name(tmp_path, scene_fi
         table = compare.query_one("#compare-table")
         await wait_until(pilot, lambda: len(table.columns) == 3, 10)
         assert [str(c.label) for c in table.columns.values()] == ["Measure", "demo", "run\\x1b[2J"]
+        field = compare.query_one("#cmf-files")
+        shown = field.render_line(0).text
+        assert "run\u241b[2J.cmf" in shown and "\x1b" not in shown, shown
+        assert field.value == "demo.cmf 'run\x1b[2J.cmf'"  # the name on disk, to be read
 
 
 async def test_open_offers_the_open_scenario_so_enter_reopens_it(tmp_path, scene_files):

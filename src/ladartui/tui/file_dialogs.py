@@ -23,7 +23,7 @@ from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField, in_label_unit, refusal
 from ladartui.tui.file_tree import SCENARIO_TABLE
 from ladartui.tui.host import host_of
-from ladartui.tui.plain_text import PlainStatic, literal
+from ladartui.tui.plain_text import PathInput, PlainStatic, literal
 from ladartui.tui.screens import TreeDialog, _row
 
 SCENARIO_SUFFIXES = (".toml",)
@@ -73,7 +73,7 @@ class SetupScreen(TreeDialog):
             yield from self.tree_rows(SCENARIO_SUFFIXES + SCENE_SUFFIXES, SCENARIO_TABLE)
             yield _row(
                 "Scenario file",
-                Input(
+                PathInput(
                     self.prefilled.get("scenario-file", ""),
                     placeholder="name.toml",
                     id="scenario-file",
@@ -83,7 +83,7 @@ class SetupScreen(TreeDialog):
             )
             yield _row(
                 "3D scene model",
-                Input(
+                PathInput(
                     self.prefilled.get("scene-file", ""),
                     placeholder="scene.txt",
                     id="scene-file",
@@ -240,7 +240,7 @@ class SaveAsScreen(TreeDialog):
             yield from self.tree_rows(SCENARIO_SUFFIXES, SCENARIO_TABLE)
             yield _row(
                 "Scenario file",
-                Input(
+                PathInput(
                     self.current.name,
                     id="save-as-file",
                     compact=True,
@@ -323,7 +323,7 @@ class PickPathScreen(TreeDialog):
             box.border_title = self.title_text
             yield from self.tree_rows(self.suffixes)
             yield _row(
-                "Path", Input(id="pick-path", compact=True, suggester=self.path_suggester(self.suffixes))
+                "Path", PathInput(id="pick-path", compact=True, suggester=self.path_suggester(self.suffixes))
             )
             yield PlainStatic("", id="pick-message", classes="message")
             with Horizontal(classes="buttons"):

@@ -25,7 +25,7 @@ from ladartui.measures_compare import (
 from ladartui.textsafe import single_line
 from ladartui.tui.file_tree import FileTree
 from ladartui.tui.measures_view import level_rows, measure_rows, target_rows
-from ladartui.tui.plain_text import PlainStatic, literal
+from ladartui.tui.plain_text import PathInput, PlainStatic, literal
 from ladartui.tui.screens import Dialog, TreeDialog, _row
 
 
@@ -92,7 +92,7 @@ class CompareScreen(TreeDialog):
             box.border_title = "Compare scenarios"
             yield _row(
                 ".cmf files",
-                Input(
+                PathInput(
                     shlex.join(self.relative(p) for p in self.paths),  # in the folder: by name
                     id="cmf-files",
                     compact=True,

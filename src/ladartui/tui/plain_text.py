@@ -11,8 +11,9 @@ from __future__ import annotations
 
 from typing import Any
 
+from rich.text import Text
 from textual.visual import VisualType
-from textual.widgets import Static
+from textual.widgets import Input, Static
 
 from ladartui.textsafe import visible
 
@@ -36,3 +37,26 @@ class PlainStatic(Static):
 
 def _written_out(content: VisualType) -> VisualType:
     return visible(content) if isinstance(content, str) else content
+
+
+# Each control character as one printable one (ESC as the picture of ESC), so that a
+# field's cursor keeps its place over the value it shows.
+_PICTURES = {code: 0x2400 + code for code in range(0x20)} | {0x7F: 0x2421}
+_PICTURES |= {code: 0xFFFD for code in (*range(0x80, 0xA0), 0x2028, 0x2029, *range(0xD800, 0xE000))}
+
+
+class PathInput(Input):
+    """A field of file paths: a name holding controls (picked in a tree, or offered
+    filled in) shows them as their pictures, never raw to the terminal; its value stays
+    the name on disk."""
+
+    @property
+    def _value(self) -> Text:
+        text = super()._value
+        shown = text.plain.translate(_PICTURES)
+        if shown == text.plain:
+            return text
+        pictured = Text(shown, no_wrap=True, overflow="ignore", end="")
+        for span in text.spans:
+            pictured.stylize(span.style, span.start, span.end)
+        return pictured
