@@ -161,7 +161,9 @@ async def test_the_palette_screenshot_goes_beside_the_scenario(tmp_path, scene_f
     app = LadarApp(scenario.path)
     async with app.run_test(size=SIZE) as pilot:
         await wait_until(pilot, lambda: loaded(app))
-        await app.run_action("screenshot")
+        # as the palette runs it (Textual's own command, not the screenshot action)
+        palette = next(c for c in app.get_system_commands(app.screen) if c.title == "Screenshot")
+        palette.callback()
         await wait_until(pilot, lambda: any(m.startswith("Wrote") for m in app.messages))
         written = tmp_path / "demo-screen.svg"
         assert app.messages[-1] == f"Wrote {written}"

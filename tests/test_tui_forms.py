@@ -75,7 +75,11 @@ async def test_a_point_cloud_or_mesh_given_as_the_new_scenarios_scene_model_is_n
         (tmp_path / name).write_bytes(b"\x00")
     async with opened(scenario) as (app, pilot):
         said = await new_scenario_said(app, pilot, scene, "0.25")
-        assert said == f"{tmp_path / scene}: scene model file is {kind}; expected a scene model (.txt)"
+        command = f"ladartui voxelize {tmp_path / scene} {tmp_path / 'cloud'} --voxel-size 0.25"
+        advice = f": make one from it with '{command}'" if scene.endswith(".las") else ""
+        assert (
+            said == f"{tmp_path / scene}: scene model file is {kind}; expected a scene model (.txt){advice}"
+        )
         assert not (tmp_path / "fresh.toml").exists()
 
 

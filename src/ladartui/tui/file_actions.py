@@ -24,12 +24,14 @@ class FileActions(Host):
     def _folder(self) -> Path:
         return self.scenario.path.parent if self.scenario else self.cwd
 
-    def action_screenshot(self, filename: str | None = None, path: str | None = None) -> None:
-        """The palette's Screenshot, beside the scenario as a saved view is: Textual's own
-        goes to ~/Downloads, which a server reached over SSH seldom has."""
+    def deliver_screenshot(
+        self, filename: str | None = None, path: str | None = None, time_format: str | None = None
+    ) -> str | None:
+        """The palette's Screenshot (and the screenshot action), beside the scenario as a
+        saved view is: Textual's own goes to ~/Downloads, which a server reached over SSH
+        seldom has, and fails there without a reason."""
         if self.is_web:  # served in a browser: Textual hands the file to it
-            super().action_screenshot(filename, path)
-            return
+            return super().deliver_screenshot(filename, path, time_format)
         stem = self.scenario.path.stem if self.scenario else "ladartui"
         target = Path(path) if path else self._folder()
         target /= filename or f"{stem}-screen.svg"
@@ -41,6 +43,7 @@ class FileActions(Host):
             self.tell(f"Screenshot not saved: {target}: {os_reason(error)}", severity="error")
         else:
             self.tell(f"Wrote {target}")
+        return None
 
     def action_new_scenario(self) -> None:
         self._setup("new")
