@@ -195,3 +195,46 @@ def test_waiting_for_a_worker_to_come_back_heeds_a_cancel(spec, tmp_path, monkey
     finally:
         close_client(client)
     assert took < 30  # not the 600 s allowed for a worker to come back
+
+
+class _ClosingScheduler:
+    """A client whose scheduler is closing: a call to it hangs (as an RPC to a closing
+    scheduler does, until the 30 s connect timeout) unless the call bounds its wait, and
+    the client sees the connection gone only after a few calls."""
+
+    def __init__(self):
+        self.calls = 0
+        self.address = "tcp://127.0.0.1:1"
+
+    @property
+    def status(self):
+        return "running" if self.calls < 3 else "closing"
+
+    def _hang(self, callback_timeout=None):
+        self.calls += 1
+        if callback_timeout is None or callback_timeout > 1:
+            raise AssertionError("a call to a closing scheduler with no bound on its wait")
+        raise TimeoutError(f"timed out after {callback_timeout} s.")
+
+    def wait_for_workers(self, n_workers, timeout=None):
+        self._hang()  # the cluster's wait asks the scheduler with no bound of its own
+
+    def nthreads(self, workers=None, callback_timeout=None):
+        return self._hang(callback_timeout)
+
+    def scatter(self, *args, **kwargs):
+        raise AssertionError("scattered to a closing scheduler")
+
+
+def test_waiting_for_a_worker_never_hangs_on_a_closing_scheduler(monkeypatch):
+    """The scheduler gone as the scene was lost with it took 30 s and more to be told
+    (1 in 10 runs of the test above): waiting for a worker to scatter the scene to asked
+    the closing scheduler with no bound, until the connection timed out."""
+    from ladartui.sweep import dask_runs
+    from ladartui.sweep.dask_runs import ClusterLost, _scatter_again
+
+    monkeypatch.setattr(dask_runs, "_PROBE_SECONDS", 0.01)
+    client = _ClosingScheduler()
+    with pytest.raises(ClusterLost, match="lost the connection to the Dask scheduler tcp://127.0.0.1:1"):
+        _scatter_again(client, client.address, payload=None, cancel=None)
+    assert client.calls == 3

@@ -18,6 +18,7 @@ from ladartui.sweep.variant import ScenePayload, run_variant
 _POLL_SECONDS = 0.05
 _AHEAD_SECONDS = 1.0  # how often the cluster's threads are counted again
 _WORKER_WAIT_SECONDS = 60.0  # for a worker to come back once the scene is lost with them all
+_PROBE_SECONDS = 1.0  # the longest a question to the scheduler is waited for
 
 
 class ClusterLost(LadarError):
@@ -122,20 +123,27 @@ def run_on_dask(client, todo, base, digest, scene, options, record, cancel):
 
 def _scatter_again(client, address, payload, cancel):
     """The scene scattered anew, once a worker is there to take it (a nanny restarts a
-    killed worker in seconds): waited for a second at a time, heeding ``cancel``."""
+    killed worker in seconds): asked for a second at a time, heeding ``cancel``.
+
+    Each question to the scheduler is bounded: one that is closing answers none, and an
+    unbounded call (the cluster's own ``wait_for_workers``) hung until the connection
+    timed out, 30 s, before the sweep could say the scheduler was gone."""
     deadline = time.monotonic() + _WORKER_WAIT_SECONDS
     while True:
         _check_connected(client, address)
         check_cancelled(cancel, "sweep cancelled")
+        asked = time.monotonic()
         try:
-            client.wait_for_workers(1, timeout=1.0)
-            # (a worker still closing counts above; the scatter then finds none)
-            return client.scatter(payload, broadcast=True, hash=False)
-        except TimeoutError:
-            if time.monotonic() >= deadline:
-                raise ClusterLost(
-                    f"the Dask cluster lost every worker and none came back within {_WORKER_WAIT_SECONDS:g} s"
-                ) from None
+            if client.nthreads(callback_timeout=_PROBE_SECONDS):
+                # (a worker still closing counts here; the scatter then finds none)
+                return client.scatter(payload, broadcast=True, hash=False)
+        except (TimeoutError, OSError):  # no answer, or the connection closing under it
+            pass
+        if time.monotonic() >= deadline:
+            raise ClusterLost(
+                f"the Dask cluster lost every worker and none came back within {_WORKER_WAIT_SECONDS:g} s"
+            )
+        time.sleep(max(0.0, _PROBE_SECONDS - (time.monotonic() - asked)))
 
 
 def tasks_ahead(client) -> int:
