@@ -96,3 +96,27 @@ def test_generated_scenes_place_vehicles_exactly_as_before(tmp_path, truck, pres
             np.testing.assert_array_equal(done.scene, merge_voxels(generated.voxels, vehicle))
             checked += 1
     assert checked > 250
+
+
+def test_a_vehicle_under_sparse_survey_ground_is_warned_of_and_told_its_height(tmp_path, truck, capsys):
+    """A survey with a ground return in one column in eight (too few to rest on) keeps the
+    vehicle on the floor, ten metres under that ground: the command says the ground it found
+    and the --at height that sets the vehicle on it."""
+    scene = slope()
+    scene = scene[(scene[:, 0] + 3 * scene[:, 1]) % 8 == 0]
+    save_voxels(tmp_path / "survey.txt", scene)
+    args = ["voxelize", str(truck), str(tmp_path / "out"), "--voxel-size", "0.5", "--solid"]
+    assert main([*args, "--at", "20.25,20.25", "--into", str(tmp_path / "survey.txt")]) == 0
+    assert load_voxels(tmp_path / "out_Target.txt")[:, 2].min() == 0
+    lines = [" ".join(line.split()) for line in capsys.readouterr().out.splitlines()]
+    text = " ".join(lines)
+    assert "no ground found" not in text
+    assert "too little ground under the vehicle's footprint to rest on (4 of its 32 columns" in text
+    warnings = [line for line in lines if line.startswith("warning")]
+    assert len(warnings) == 1
+    assert "ground found under it (z 9.75..10.75 m) lies above the vehicle's top (z 1.25 m)" in warnings[0]
+    assert "--at 20.25,20.25,11 sets it on that ground" in warnings[0]
+    # The height it gives does set it there, with no warning.
+    assert main([*args, "--at", "20.25,20.25,11", "--into", str(tmp_path / "survey.txt")]) == 0
+    assert load_voxels(tmp_path / "out_Target.txt")[:, 2].min() == 22
+    assert "warning" not in capsys.readouterr().out

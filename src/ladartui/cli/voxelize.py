@@ -335,6 +335,9 @@ def _report(console, args, mesh, done, outputs, elapsed) -> None:
         say(resting.describe(vs))
         if resting.buried:
             say(resting.warning(vs))
+        if resting.beneath and args.at is not None:
+            x, y, *_ = _position(args.at)
+            say(resting.beneath_warning(vs, (x, y)))
     if insertion.occupied:
         say(
             f"note: {insertion.occupied:,} of the vehicle's voxels were already in the scene "

@@ -36,10 +36,17 @@ class Resting:
     ground_high: int | None  # (None when it stays on the floor)
     covered: int  # footprint columns with scene voxels less than its height over its top
     height: int  # the vehicle's height in layers
+    found: tuple[int, int] | None = None  # the lowest and highest ground voxel found, rested on or not
+    top: int = 0  # the vehicle's top layer where it was set
 
     @property
     def on_ground(self) -> bool:
         return self.ground_high is not None
+
+    @property
+    def beneath(self) -> bool:
+        """Left on the floor under ground too sparse to rest on: all of it above the vehicle."""
+        return not self.on_ground and self.found is not None and self.found[0] > self.top
 
     @property
     def buried(self) -> bool:
@@ -49,6 +56,13 @@ class Resting:
     def describe(self, voxel_size: float) -> str:
         """Where it rests, in scene metres (z 0 at voxel layer 0's centre)."""
         vs = voxel_size
+        if (self.ground_high is None or self.ground_low is None) and self.ground_columns:
+            return (
+                f"too little ground under the vehicle's footprint to rest on ({self.ground_columns} "
+                f"of its {self.columns} columns; a quarter are needed): it is set on the scene's floor "
+                f"at z {-0.5 * vs:g} m, the bottom of voxel layer 0, as on flat ground; on steep ground "
+                "give its height with --at X,Y,Z"
+            )
         if self.ground_high is None or self.ground_low is None:
             return (
                 f"no ground found under the vehicle's footprint ({self.ground_columns} of its "
@@ -68,6 +82,18 @@ class Resting:
             f"warning: scene voxels lie less than the vehicle's height ({self.height * voxel_size:g} m) "
             f"over {self.covered} of its {self.columns} footprint columns: check that it is not "
             "buried under the ground (move it with --at)"
+        )
+
+    def beneath_warning(self, voxel_size: float, at: tuple[float, float]) -> str:
+        """The ground found over a vehicle left on the floor, and the ``--at`` that sets it there."""
+        if self.found is None:
+            raise ValueError("no ground was found")
+        vs = voxel_size
+        low, high = (self.found[0] - 0.5) * vs, (self.found[1] + 0.5) * vs
+        return (
+            f"warning: the ground found under it (z {low:g}..{high:g} m) lies above the vehicle's top "
+            f"(z {(self.top + 0.5) * vs:g} m): it is buried; --at {at[0]:g},{at[1]:g},{high + 0.5 * vs:g} "
+            "sets it on that ground"
         )
 
 
@@ -120,5 +146,8 @@ def rest_on_ground(scene: np.ndarray, vehicle: np.ndarray, voxel_size: float) ->
     top = int(high[2]) + lift
     over = near[(near[:, 2] > top) & (near[:, 2] <= top + height)]
     covered = int(np.count_nonzero(np.isin(footprint, _columns(over, x0, y0, width))))
-    resting = Resting(lift, len(footprint), len(ground), ground_low, ground_high, covered, height)
+    ground_span = (int(ground.min()), int(ground.max())) if len(ground) else None
+    resting = Resting(
+        lift, len(footprint), len(ground), ground_low, ground_high, covered, height, ground_span, top
+    )
     return vehicle, resting
