@@ -241,3 +241,21 @@ def test_a_failure_in_the_answers_reaches_the_caller(numba_backend, case, monkey
         backend.trace_cells(occupancy, origins, directions, order="ray"),
         numba_backend.trace_cells(occupancy, origins, directions, order="ray"),
     )
+
+
+def test_an_origin_on_a_voxels_face_gives_a_range_of_plus_zero_as_numba_does(wgpu_backend, numba_backend):
+    """A ray starting on a face of an occupied voxel and going into it enters it at
+    range 0; entering through a face it moves down across, the slab test's
+    ``(b - o) / d`` is -0.0 there, and the answer must still be numba's +0.0 bit for
+    bit (a range printed as "-0.0")."""
+    occupancy = Occupancy.build(np.array([[0, 0, 0], [2, 2, 2]]), shape=(5, 5, 5))
+    # Cell space: the top face of (2, 2, 2), its top corner, (0, 0, 0)'s upper corner.
+    origins = np.array([[2.5, 2.5, 3.0], [3.0, 3.0, 3.0], [1.0, 1.0, 1.0], [2.5, 2.5, 2.0]])
+    directions = np.array([[0.0, 0.0, -1.0], [-1.0, -1.0, -1.0], [-1.0, -1.0, -1.0], [0.0, 0.0, 1.0]])
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    expected = numba_backend.trace_cells(occupancy, origins, directions, order="ray")
+    assert (expected.kind == VOXEL).all() and (expected.t == 0.0).all()
+    assert not np.signbit(expected.t).any()
+    got = wgpu_backend.trace_cells(occupancy, origins, directions, order="ray")
+    assert_same(got, expected)
+    assert not np.signbit(got.t).any(), got.t

@@ -58,11 +58,14 @@ def slab(o, d, inv, lo, hi):
 def cube_start(ox, oy, oz, dx, dy, dz, ix, iy, iz, x, y, z):
     """(start, leave): where the ray enters the cell at (x, y, z), from t = 0 on, and
     leaves it (the reference tracer's slab test of the cell's open interior; ``i*``
-    are ``1 / d``, inf for 0). It meets the cell if start < leave."""
+    are ``1 / d``, inf for 0). It meets the cell if start < leave. An origin on the
+    face it enters by gives an entry of -0.0 (``(b - o) * inv`` with ``b == o`` and
+    ``d < 0``); 0.0 comes first in the clamp so that such a start is +0.0, as the
+    exact kernel's."""
     ex, lx = slab(ox, dx, ix, x, x + 1.0)
     ey, ly = slab(oy, dy, iy, y, y + 1.0)
     ez, lz = slab(oz, dz, iz, z, z + 1.0)
-    return max(max(ex, max(ey, ez)), 0.0), min(lx, min(ly, lz))
+    return max(0.0, max(ex, max(ey, ez))), min(lx, min(ly, lz))
 
 
 @njit(nogil=True, cache=True, inline="always")

@@ -185,7 +185,7 @@ def _start_and_leave(builder, ray_row, scalar, shared, k):
         flat_leave = builder.select(inside, inf, minus_inf)
         enters.append(builder.select(up, t_lo, builder.select(down, t_hi, flat_enter)))
         leaves.append(builder.select(up, t_hi, builder.select(down, t_lo, flat_leave)))
-    start = numba_max(numba_max(enters[0], numba_max(enters[1], enters[2])), zero)
+    start = numba_max(zero, numba_max(enters[0], numba_max(enters[1], enters[2])))
     leave = numba_min(leaves[0], numba_min(leaves[1], leaves[2]))
     return start, leave
 
