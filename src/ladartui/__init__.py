@@ -8,10 +8,13 @@ an exported function.
 """
 
 from ladartui import threads
+from ladartui.kernel_cache import clear_stale_kernels
 from ladartui.lazy import lazy_getattr
 
 # Before numba loads: its TBB layer where installed, else a short OpenMP spin.
 threads.configure()
+# Before a kernel loads from the cache: none compiled from sources since changed.
+clear_stale_kernels(__path__[0])
 
 __version__ = "0.1.0"
 

@@ -20,9 +20,9 @@ starts in an empty cell and the cells it visits afterwards, and their
 parameters, are those of a traversal from its box entry.
 
 The numba exact kernel compiles ``bundle_start`` (and tracing.axis) into
-itself, and numba's on-disk cache only notices edits to the kernel's own file:
-after editing this one or axis.py, clear ``tracing/__pycache__/*.nb*`` (a
-fresh install has no stale cache).
+itself; numba's on-disk cache only notices edits to the kernel's own file, so
+``ladartui.kernel_cache`` clears the cached kernels once this one or axis.py
+changed.
 """
 
 from __future__ import annotations

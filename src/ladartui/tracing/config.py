@@ -5,9 +5,9 @@ live here once: ``wgsl_constants`` writes them into the shader source when it is
 assembled, so the shaders never restate them. The tuning knobs of both backends
 sit below them, each with why it has its value.
 
-The numba kernels take these as compile-time constants, and numba's on-disk
-cache only notices edits to a kernel's own file: after changing a value here,
-clear ``tracing/__pycache__/*.nb*`` (a fresh install has no stale cache).
+The numba kernels take these as compile-time constants; numba's on-disk cache
+only notices edits to a kernel's own file, so ``ladartui.kernel_cache`` clears
+the cached kernels once any of their sources changed.
 """
 
 from __future__ import annotations
