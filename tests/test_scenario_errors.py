@@ -332,3 +332,19 @@ def test_flight_logs_flown_at_a_rate_count_their_scans_before_they_are_made(tmp_
     with pytest.raises(FieldError) as caught:
         load_scenario(path, check_files=False)
     assert str(caught.value).endswith("flight.segments is 12,014 scans: expected at most 10,000 scans")
+
+
+def test_a_scenario_with_no_flight_is_told_what_a_flight_is(tmp_path):
+    """A scenario of files alone was refused "missing key 'flight.segments'", with
+    nothing on what a flight is written as."""
+    from ladartui.scenario_file import SEGMENT_FILE_KINDS
+
+    path = tmp_path / "plan.toml"
+    path.write_text('[files]\nscene = "forest.txt"\nvoxel_size = 0.25\n')
+    with pytest.raises(InputFileError) as caught:
+        load_scenario(path, check_files=False)
+    assert str(caught.value) == (
+        f"{path}: missing key 'flight.segments': expected one or more [[flight.segments]] tables, "
+        f"each with its kind ({', '.join(SEGMENT_FILE_KINDS)}), as in the bundled scenarios "
+        "('ladartui validate default' writes one to copy)"
+    )

@@ -151,6 +151,16 @@ RECORD_SECTIONS = {"run": ("inputs", "outputs")}
 SEGMENT_FILE_KINDS = {**SEGMENT_KINDS, LogSegment.kind: LogSegment}
 
 
+# What a key left out is written as, where its name alone does not say.
+MISSING_HINTS = {
+    "flight.segments": (
+        ": expected one or more [[flight.segments]] tables, each with its kind "
+        f"({', '.join(SEGMENT_FILE_KINDS)}), as in the bundled scenarios ('ladartui validate "
+        "default' writes one to copy)"
+    ),
+}
+
+
 NESTED_TOO_DEEP = "not valid TOML: arrays or tables nested too deep to read"
 
 
@@ -221,7 +231,8 @@ class ScenarioReader:
                 )
         for name in required:
             if name not in table:
-                raise self.file_error(where, f"missing key '{where}.{name}'{what}")
+                hint = MISSING_HINTS.get(f"{where}.{name}", "")
+                raise self.file_error(where, f"missing key '{where}.{name}'{what}{hint}")
 
     def _levels_error(self, error: FieldError, table: dict) -> FieldError:
         """A [levels] error named by the key written: a default that falls below the
