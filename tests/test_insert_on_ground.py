@@ -61,6 +61,16 @@ def test_a_footprint_with_no_scene_voxels_keeps_the_floor_and_says_so(tmp_path, 
     assert "no ground found under the vehicle's footprint (0 of its 32 columns)" in text
     assert "give its height with --at X,Y,Z" in text
     assert "on the scene's floor at z -0.25 m" in text
+    # given a height, that is where it goes, and the line says so
+    out = str(tmp_path / "lifted")
+    assert (
+        main([*args[:2], out, *args[3:], "--at", "20.25,20.25,2", "--into", str(tmp_path / "survey.txt")])
+        == 0
+    )
+    assert load_voxels(tmp_path / "lifted_Target.txt")[:, 2].min() == 4  # 2 m (4 layers) up
+    text = " ".join(capsys.readouterr().out.split())
+    assert "it is set 2 m above the scene's floor (z -0.25 m, the bottom of voxel layer 0)" in text
+    assert "give its height" not in text
 
 
 def test_a_vehicle_covered_from_above_is_warned_of(tmp_path, truck, capsys):

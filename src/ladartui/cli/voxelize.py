@@ -332,7 +332,8 @@ def _report(console, args, mesh, done, outputs, elapsed) -> None:
     )
     resting = insertion.resting
     if resting is not None:
-        say(resting.describe(vs))
+        above = ([*_position(args.at), 0.0][2]) if args.at is not None else 0.0  # Z of X,Y[,Z]
+        say(resting.describe(vs, above))
         if resting.buried:
             say(resting.warning(vs))
         if resting.beneath and args.at is not None:

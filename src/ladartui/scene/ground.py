@@ -53,22 +53,23 @@ class Resting:
         """Most of the footprint covered from above within the vehicle's height."""
         return 2 * self.covered > self.columns
 
-    def describe(self, voxel_size: float) -> str:
-        """Where it rests, in scene metres (z 0 at voxel layer 0's centre)."""
+    def describe(self, voxel_size: float, above: float = 0.0) -> str:
+        """Where it rests, in scene metres (z 0 at voxel layer 0's centre); ``above``:
+        the height given for it (--at X,Y,Z), over the ground or else the floor."""
         vs = voxel_size
-        if (self.ground_high is None or self.ground_low is None) and self.ground_columns:
-            return (
-                f"too little ground under the vehicle's footprint to rest on ({self.ground_columns} "
-                f"of its {self.columns} columns; a quarter are needed): it is set on the scene's floor "
-                f"at z {-0.5 * vs:g} m, the bottom of voxel layer 0, as on flat ground; on steep ground "
-                "give its height with --at X,Y,Z"
-            )
         if self.ground_high is None or self.ground_low is None:
+            found = (
+                f"too little ground under the vehicle's footprint to rest on ({self.ground_columns} "
+                f"of its {self.columns} columns; a quarter are needed)"
+                if self.ground_columns
+                else f"no ground found under the vehicle's footprint (0 of its {self.columns} columns)"
+            )
+            floor = f"z {-0.5 * vs:g} m, the bottom of voxel layer 0"
+            if above:
+                return f"{found}: it is set {above:g} m above the scene's floor ({floor})"
             return (
-                f"no ground found under the vehicle's footprint ({self.ground_columns} of its "
-                f"{self.columns} columns): it is set on the scene's floor at z {-0.5 * vs:g} m, the "
-                "bottom of voxel layer 0, as on flat ground; on steep ground give its height with "
-                "--at X,Y,Z"
+                f"{found}: it is set on the scene's floor at {floor}, as on flat ground; on steep "
+                "ground give its height with --at X,Y,Z"
             )
         top = (self.ground_high + 0.5) * vs
         return (
