@@ -385,3 +385,28 @@ def test_f32_far_aircraft(wgpu_backend, numba_backend, forest_and_voxel_size, me
     origins, directions = aircraft_rays(rng, forest, 30_000, distance=ten_km)
     assert np.all(np.linalg.norm(origins, axis=1) > 0.95 * ten_km)
     check_f32(wgpu_backend, numba_backend, forest, origins, directions, method)
+
+
+def offset_scene_and_rays(offset, n):
+    """A random 20 x 20 x 10 block of voxels at x and y index ``offset`` (a scene in
+    absolute map indices), and rays from 200 cells above aimed into and around it."""
+    rng = np.random.default_rng(8)
+    block = np.argwhere(rng.random((20, 20, 10)) < 0.15)
+    occupancy = Occupancy.build(block + [offset, offset, 0], shape=(offset + 50, offset + 50, 10))
+    aims = np.column_stack([rng.uniform(-10, 25, (n, 2)) + offset, rng.uniform(0, 10, n)])
+    origins = aims + np.column_stack([rng.uniform(-50, 50, (n, 2)), np.full(n, 200.0)])
+    directions = aims - origins
+    return occupancy, origins, directions / np.linalg.norm(directions, axis=1)[:, None]
+
+
+@pytest.mark.parametrize("method", ["exact", "march"])
+@pytest.mark.parametrize("offset", [1_000_037, 1 << 24])
+def test_f32_voxels_far_from_index_0(wgpu_backend, numba_backend, method, offset):
+    """Voxels at large indices (UTM metres at 0.25 m are ~2e6): float32 keeps the same
+    bar, the rays seen by the shader being near the voxels, not near index 0."""
+    occupancy, origins, directions = offset_scene_and_rays(offset, 1500)
+    reference = numba_backend.trace_cells(occupancy, origins, directions, method=method, step=0.5)
+    assert np.count_nonzero(reference.kind == VOXEL) > 300
+    assert np.count_nonzero(reference.kind == GROUND) > 300
+    assert np.count_nonzero(reference.index[:, 0] < offset) > 100  # ground short of the block
+    check_f32(wgpu_backend, numba_backend, occupancy, origins, directions, method)

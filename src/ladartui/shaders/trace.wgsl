@@ -36,6 +36,7 @@ struct Params {
     extra: vec4<u32>,        // first word of columns in occ(), march: first sample, samples per pass; first_hits: 1 when all rays share origins[0..3]
     cube_origin: vec4<i32>,  // brick cell of the empty-cube box's corner; w: first word of cubes in occ()
     cube_dims: vec4<i32>,    // its size in bricks; all zero without cubes (no jumps)
+    footprint: vec4<i32>,    // the scene's [0, nx) x [0, ny) in the rays' cell space: x0, y0, x1, y1
     reals: vec2<real>,       // march step (voxels), unused
 }
 
@@ -399,13 +400,14 @@ fn last_sample_on_axis(o: real, d: real, lo_face: real, hi_face: real, t_s: real
 }
 
 // The last sample certain to stay in the empty node of 1 << shift cells a side holding
-// cell c and in the scene's box (below the current sample when no later one is).
-fn last_sample_in_node(c: vec3<i32>, shift: u32, o: vec3<real>, d: vec3<real>, t_s: real, step: real, box: vec3<real>, samples: i32) -> i32 {
+// cell c and in the scene's box [lo.x, box.x) x [lo.y, box.y) x [0, box.z) (below the
+// current sample when no later one is).
+fn last_sample_in_node(c: vec3<i32>, shift: u32, o: vec3<real>, d: vec3<real>, t_s: real, step: real, lo: vec2<real>, box: vec3<real>, samples: i32) -> i32 {
     let size = real(1 << shift);
     let b = vec3<real>((c >> vec3<u32>(shift)) << vec3<u32>(shift));
     let cap = real(samples - 1);
-    let kx = last_sample_on_axis(o.x, d.x, max(b.x, 0.0), min(b.x + size, box.x), t_s, step, cap);
-    let ky = last_sample_on_axis(o.y, d.y, max(b.y, 0.0), min(b.y + size, box.y), t_s, step, cap);
+    let kx = last_sample_on_axis(o.x, d.x, max(b.x, lo.x), min(b.x + size, box.x), t_s, step, cap);
+    let ky = last_sample_on_axis(o.y, d.y, max(b.y, lo.y), min(b.y + size, box.y), t_s, step, cap);
     let kz = last_sample_on_axis(o.z, d.z, max(b.z, 0.0), min(b.z + size, box.z), t_s, step, cap);
     let last = min(kx, min(ky, kz));
     if (last >= 1.0) {
@@ -427,6 +429,12 @@ fn march_one(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hit 
     let zmax = real(params.run.z);
     let nx = real(params.shape.x);
     let ny = real(params.shape.y);
+    // The footprint's sides: 0 and nx, 0 and ny unless f32 rays come shifted
+    // (tracing/f32_rays.py, f32_shift; every box below is shifted with them).
+    let x0 = real(params.footprint.x);
+    let y0 = real(params.footprint.y);
+    let x1 = real(params.footprint.z);
+    let y1 = real(params.footprint.w);
     let top = zmax + 1.0;
     let lo = params.bbox_lo.xyz;
     let hi = params.bbox_hi.xyz;
@@ -449,7 +457,7 @@ fn march_one(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hit 
         let cx = ox + t * dx;
         let cy = oy + t * dy;
         let cz = oz + t * dz;
-        let inside = 0.0 <= cx && cx < nx && 0.0 <= cy && cy < ny;
+        let inside = x0 <= cx && cx < x1 && y0 <= cy && cy < y1;
         if (cz < 0.0) {
             if (inside) {
                 return Hit(GROUND, i32(floor(cx)), i32(floor(cy)), 0, t);
@@ -483,7 +491,7 @@ fn march_one(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hit 
                 // An empty node: on past its samples (none of them ends the ray).
                 let o = vec3<real>(ox, oy, oz);
                 let d = vec3<real>(dx, dy, dz);
-                k = max(k, last_sample_in_node(c, empty, o, d, t_s, step, vec3<real>(nx, ny, top), last));
+                k = max(k, last_sample_in_node(c, empty, o, d, t_s, step, vec2<real>(x0, y0), vec3<real>(x1, y1, top), last));
                 continue;
             }
             let bit = slot(c.x, c.y, c.z, 0u);

@@ -25,9 +25,9 @@ from ladartui.tracing.config import MARCH_SAMPLES_PER_PASS, METHOD_CODES, wgsl_c
 # found (first_hits, tracing/wgpu_hits.py).
 FIXED_BINDINGS = 8
 
-# Params (uniform, see struct Params in trace.wgsl): 10 vec4 of 32-bit integers
+# Params (uniform, see struct Params in trace.wgsl): 11 vec4 of 32-bit integers
 # then a vec2<real> of float parameters (16 bytes in f64, 8 in f32).
-PARAMS_BYTES = 10 * 16 + 16
+PARAMS_BYTES = 11 * 16 + 16
 
 
 class Upload:
@@ -177,26 +177,35 @@ def pack_params(
     first_sample=0,
     samples_per_pass=MARCH_SAMPLES_PER_PASS,
     shared_origin=False,
+    shift=(0, 0),
 ) -> bytes:
     """The uniform block for one dispatch, laid out as ``struct Params``.
 
     ``first_sample`` and ``samples_per_pass`` bound the march's samples in this
     dispatch (see MARCH_SAMPLES_PER_PASS); ``shared_origin``: first_hits reads
-    one origin for every ray.
+    one origin for every ray. ``shift``: the (x, y) cell, a multiple of the root
+    cell's 512 (so every node's slots stay as they are), that the rays' cell
+    space starts at: the occupancy's boxes and the scene's footprint are given
+    less it (tracing/f32_rays.py, ``f32_shift``).
     """
-    ints = np.zeros((10, 4), dtype=np.int32)
+    move = np.array([shift[0], shift[1], 0], dtype=np.int64)
+    if np.any(move % 512):
+        raise ValueError(f"shift {tuple(shift)} is not a multiple of 512 cells")
+    ints = np.zeros((11, 4), dtype=np.int32)
     ints[0, :3] = occupancy.shape
-    ints[1, :3] = occupancy.bbox_lo
-    ints[2, :3] = occupancy.bbox_hi
-    ints[3, :3] = occupancy.root_origin
+    ints[1, :3] = np.asarray(occupancy.bbox_lo, dtype=np.int64) - move
+    ints[2, :3] = np.asarray(occupancy.bbox_hi, dtype=np.int64) - move
+    ints[3, :3] = np.asarray(occupancy.root_origin, dtype=np.int64) - move
     ints[4, :3] = occupancy.root_dims
     ints[5, :] = np.array(upload.bases[:4], dtype=np.int64).astype(np.uint32).view(np.int32)
     ints[6, :] = (count, METHOD_CODES[method], int(occupancy.zmax), len(occupancy.root))
     ints[7, 0] = np.array(upload.bases[4], dtype=np.int64).astype(np.uint32).view(np.int32)
     ints[7, 1:4] = (first_sample, samples_per_pass, int(shared_origin))
     cube_origin, cube_dims = cube_box(occupancy)
-    ints[8, :3] = cube_origin
+    ints[8, :3] = cube_origin - (move >> 3)
     ints[8, 3] = np.array(upload.bases[5], dtype=np.int64).astype(np.uint32).view(np.int32)
     ints[9, :3] = cube_dims
+    # The scene's footprint [0, nx) x [0, ny) in the rays' cell space.
+    ints[10, :] = (-move[0], -move[1], int(occupancy.shape[0]) - move[0], int(occupancy.shape[1]) - move[1])
     reals = np.array([step, 0], dtype=np.float64 if precision == "f64" else np.float32)
     return ints.tobytes() + reals.tobytes()

@@ -24,7 +24,7 @@ from ladartui.tracing.answers import ground_answers
 from ladartui.tracing.backend import GROUND, MISS, VOXEL
 from ladartui.tracing.bundle import bundle_start_array, halo_arrays
 from ladartui.tracing.config import BUNDLE, CUT, MARCH_SAMPLES_PER_PASS, SHADER_INF, UNFINISHED
-from ladartui.tracing.f32_rays import f32_start_offsets, floor_preserving_f32
+from ladartui.tracing.f32_rays import f32_shift, f32_start_offsets, floor_preserving_f32
 from ladartui.tracing.prepare import origin_rows
 from ladartui.tracing.wgpu_occupancy import PARAMS_BYTES, pack_params
 from ladartui.tracing.wgpu_scans import dispatch_encoder, rays_per_dispatch
@@ -93,6 +93,7 @@ class RayPasses:
         real = np.float64 if precision == "f64" else np.float32
         halo = halo_arrays(occupancy)
         offsets = None
+        shift = np.zeros(3, dtype=np.int64)
         if precision == "f32":
             # f32 moves each origin to its start on the host (the shader sees no starts).
             top = float(max(int(occupancy.zmax) + 1, 0))
@@ -100,6 +101,7 @@ class RayPasses:
             if method == "exact":
                 ray_starts = np.repeat(bundle_start_array(origins, directions, halo), BUNDLE)[:n]
             offsets = f32_start_offsets(origins, directions, occupancy.shape, top, method, ray_starts)
+            shift = f32_shift(occupancy)  # the cells found come back less it
         capacity = buffers["capacity"]
         pending = None  # None: every ray (the first pass), taken in slices, not copies
         first_sample = 0
@@ -120,7 +122,7 @@ class RayPasses:
                     packed[:, :3] = batch_origins
                 else:
                     packed[:, :3] = floor_preserving_f32(
-                        batch_origins + offsets[rows, None] * batch_directions
+                        batch_origins + offsets[rows, None] * batch_directions - shift
                     )
                 packed[:, 3:] = batch_directions
                 if offsets is None and method == "exact":
@@ -131,12 +133,23 @@ class RayPasses:
                 else:
                     starts = np.zeros(-(-count // BUNDLE), dtype=real)
                 params = pack_params(
-                    occupancy, upload, method, step, count, precision, first_sample, MARCH_SAMPLES_PER_PASS
+                    occupancy,
+                    upload,
+                    method,
+                    step,
+                    count,
+                    precision,
+                    first_sample,
+                    MARCH_SAMPLES_PER_PASS,
+                    shift=shift[:2],
                 )
                 cells, ranges = self._dispatch(pipeline, bind_group, buffers, params, packed, starts)
                 batch_kind = cells[:, 0]
                 kind[rows] = batch_kind
                 index[rows] = cells[:, 1:]
+                if shift.any():  # f32: back from the shifted cell space
+                    found = (batch_kind == VOXEL) | (batch_kind == GROUND)
+                    index[rows] += np.where(found[:, None], shift, 0).astype(np.int32)
                 batch_t = ranges.astype(np.float64)
                 if offsets is not None:
                     batch_t += offsets[rows]
