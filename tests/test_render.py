@@ -133,6 +133,21 @@ def test_fit_with_points_frames_a_box_and_a_flight_off_one_side_of_it_centred():
             assert row.min() >= 0 and row.max() <= rows and col.min() >= 0 and col.max() <= cols
 
 
+def test_fit_frames_a_flight_many_times_wider_than_a_one_voxel_scene_or_far_from_it():
+    """A one-voxel scene under a 30-voxel orbit, or a small scene with its flight 2 km
+    off, opened on a black 3D view: the fit's zoom stopped at the keys' least (0.1)."""
+    one = (np.zeros(3), np.array([0.0, 0.0, 1.0]))
+    angle = np.radians(np.arange(0, 360, 30))
+    orbit = np.column_stack([30 * np.cos(angle), 30 * np.sin(angle), np.full(angle.size, 30.0)])
+    small = (np.zeros(3), np.array([39.0, 39.0, 1.0]))
+    for box_, path in ((one, orbit), (small, orbit * 10 + [8000.0, 6000.0, 0.0])):
+        fitted = framing.fit_camera(Camera(), box_, 40, 100, box_, points=path)
+        row, col, _, _ = screen_coordinates(np.vstack([box_[0], path]), fitted, 40, 100, box_)
+        assert row.min() >= 0 and row.max() <= 40 and col.min() >= 0 and col.max() <= 100
+        # from there the zoom keys zoom in, and out no further: never a jump back to 0.1
+        assert fitted.zoomed(0.8).zoom == fitted.zoom < fitted.zoomed(1.25).zoom < 0.1
+
+
 def test_fit_target_frames_the_targets_projected_box_with_a_small_margin():
     bounds = (np.zeros(3), np.array([199.0, 199.0, 30.0]))
     target = box((120, 40, 0), (126, 43, 2))

@@ -379,7 +379,10 @@ class Camera:
         return self.at_angle(self.azimuth + d_azimuth, self.elevation + d_elevation)
 
     def zoomed(self, factor: float) -> Camera:
-        return replace(self, zoom=float(np.clip(self.zoom * factor, MIN_ZOOM, MAX_ZOOM)))
+        """Zoomed by ``factor`` within MIN_ZOOM..MAX_ZOOM; a fit beyond them (a flight far
+        wider than its scene) zooms on from there, never back the other way."""
+        lo, hi = min(MIN_ZOOM, self.zoom), max(MAX_ZOOM, self.zoom)
+        return replace(self, zoom=float(np.clip(self.zoom * factor, lo, hi)))
 
     def panned(self, dx=0.0, dy=0.0) -> Camera:
         return replace(self, pan_x=self.pan_x + dx / self.zoom, pan_y=self.pan_y + dy / self.zoom)

@@ -10,7 +10,7 @@ import itertools
 
 import numpy as np
 
-from ladartui.views import MAX_ZOOM, MIN_ZOOM, Camera, view_axes
+from ladartui.views import Camera, view_axes
 
 MARGIN = 0.05  # of the image on each side
 
@@ -53,7 +53,9 @@ def fit_camera(
         width = height = max(width, height)
     usable = 1.0 - 2.0 * margin
     scale = min(cols * usable / width, rows * usable / height)  # pixels per voxel unit
-    zoom = float(np.clip(scale * 2.0 * radius / max(min(cols, rows), 1), MIN_ZOOM, MAX_ZOOM))
+    # not held to the zoom keys' range: a flight far wider than a small scene (a lone
+    # vehicle, a path kilometres off) needs less than MIN_ZOOM to be seen at all
+    zoom = float(scale * 2.0 * radius / max(min(cols, rows), 1))
     return Camera(camera.azimuth, camera.elevation, zoom, 0.0, 0.0, tuple(float(v) for v in centre))
 
 
