@@ -83,6 +83,27 @@ def test_the_ground_plane_beyond_the_maps_columns_is_drawn_as_ground():
     assert tuple(pic.rgb[4, 9]) == tuple(views.height_ramp()[-1])  # x 101..103, y 4..6: the tall column
 
 
+def test_zoomed_in_each_pixel_shows_the_column_under_its_centre_where_the_target_is_marked():
+    """Zoomed on a target at the scene's corner, its magenta cells sat a pixel off the
+    tall columns under them (a strip of the scene's top colour beside them): the scene
+    showed the column under each pixel's west and south edges, the target's cells those
+    under its centre."""
+    heights = np.ones((40, 40), np.int32)
+    cells = np.array([[0, 39], [1, 39], [0, 38]])
+    heights[cells[:, 0], cells[:, 1]] = 2
+    top = TopView(heights, 0.25, target_columns=cells, ground=(40, 40))
+    tallest = np.array(views.height_ramp()[-1], np.uint8)
+    for frame in ((-1.0, 37.0, 3.0, 41.0), (-3.3, 30.1, 9.7, 41.7)):
+        for rows, cols in ((20, 41), (36, 78), (55, 63)):
+            scene = top.scene_layer(rows, cols, frame)
+            marked = (top.render(rows, cols, frame=frame).rgb == views.TARGET_RGB).all(axis=2)
+            centre_r, centre_c = np.meshgrid(np.arange(rows) + 0.5, np.arange(cols) + 0.5, indexing="ij")
+            x, y = top.to_cells(centre_r, centre_c, rows, cols, frame)
+            under = np.isin(np.floor(x) * 100 + np.floor(y), cells[:, 0] * 100 + cells[:, 1])
+            np.testing.assert_array_equal((scene.rgb == tallest).all(axis=2), under)
+            np.testing.assert_array_equal(marked, under)
+
+
 def test_top_view_letterboxes_a_wide_scene_and_leaves_the_margin_undrawn():
     top = TopView(np.zeros((10, 5), np.int32))
     pic = top.scene_layer(10, 10)  # 10 x 5 scene into 10 x 10 pixels: rows 2.5..7.5 drawn

@@ -192,11 +192,8 @@ class TopView:
         scale, off_c, off_r = self.fit(rows, cols, frame)
         c = np.arange(cols)
         r = np.arange(rows)
-        # each pixel covers a block of voxel columns and shows its highest voxel
-        x_lo = np.floor(fx0 + (c - off_c) * scale).astype(np.int64)
-        x_hi = np.maximum(np.floor(fx0 + (c + 1 - off_c) * scale).astype(np.int64), x_lo + 1)
-        y_lo = np.floor(fy1 - (r + 1 - off_r) * scale).astype(np.int64)
-        y_hi = np.maximum(np.floor(fy1 - (r - off_r) * scale).astype(np.int64), y_lo + 1)
+        # each pixel shows the highest voxel of the columns whose centres it covers, or
+        # zoomed in (none covered), of the column under its centre, as overlays are placed
         centre_x = fx0 + (c + 0.5 - off_c) * scale
         centre_y = fy1 - (r + 0.5 - off_r) * scale
         if self.ground is not None:
@@ -205,12 +202,17 @@ class TopView:
             )
             picture.rgb[on_ground] = GROUND_RGB
             picture.mask[on_ground] = True
+        # counted from the map's column (0, 0): a map far from the origin draws alike
         ox, oy = self.origin
-        inside = _within(centre_y, oy, oy + ny)[:, None] & _within(centre_x, ox, ox + nx)[None, :]
+        local_x = (fx0 - ox) + (c + 0.5 - off_c) * scale
+        local_y = (fy1 - oy) - (r + 0.5 - off_r) * scale
+        inside = _within(local_y, 0, ny)[:, None] & _within(local_x, 0, nx)[None, :]
         if not inside.any():
             return picture
+        x_lo, x_hi = _columns_covered(local_x - scale / 2, scale, local_x)
+        y_lo, y_hi = _columns_covered(local_y - scale / 2, scale, local_y)
         heights = self.heights
-        pooled = _block_max(heights, x_lo - ox, x_hi - ox, y_lo - oy, y_hi - oy)
+        pooled = _block_max(heights, x_lo, x_hi, y_lo, y_hi)
         top = max(int(heights.max()), 1)
         ramp = colour_map(self.colour_map)
         shade = ramp[shade_indices(pooled, 0, top, len(ramp))]
@@ -229,10 +231,12 @@ class TopView:
         # cell corners (x - 0.5, y + 0.5) and (x + 0.5, y - 0.5) in metres
         corner_a = self.to_pixels((cells + [-0.5, 0.5]) * self.voxel_size, rows, cols, frame)
         corner_b = self.to_pixels((cells + [0.5, -0.5]) * self.voxel_size, rows, cols, frame)
+        # the pixels whose centres lie in the cell [x, x + 1) x [y, y + 1), as the scene
+        # layer shows it (rows run south: a centre on the cell's north edge is not in it)
         r0 = np.floor(corner_a[:, 0] + 0.5).astype(np.int64)
-        c0 = np.floor(corner_a[:, 1] + 0.5).astype(np.int64)
+        c0 = np.ceil(corner_a[:, 1] - 0.5).astype(np.int64)
         r1 = np.maximum(np.floor(corner_b[:, 0] + 0.5).astype(np.int64), r0 + 1)
-        c1 = np.maximum(np.floor(corner_b[:, 1] + 0.5).astype(np.int64), c0 + 1)
+        c1 = np.maximum(np.ceil(corner_b[:, 1] - 0.5).astype(np.int64), c0 + 1)
         rgb = self.target_column_rgb
         for k, (ra, rb, ca, cb) in enumerate(
             zip(np.clip(r0, 0, rows), np.clip(r1, 0, rows), np.clip(c0, 0, cols), np.clip(c1, 0, cols))
@@ -269,6 +273,16 @@ class TopView:
             draw_points(picture, pix, SCAN_RGB)
             draw_points(picture, pix[:1], START_RGB)
         return picture
+
+
+def _columns_covered(low_edges, size: float, centres) -> tuple[np.ndarray, np.ndarray]:
+    """[lo, hi) of the columns whose centres (i + 0.5) lie in [edge, edge + size) of each
+    pixel, else the column holding the pixel's centre."""
+    lo = np.ceil(low_edges - 0.5).astype(np.int64)
+    hi = np.ceil(low_edges + size - 0.5).astype(np.int64)
+    none = hi <= lo
+    lo = np.where(none, np.floor(centres).astype(np.int64), lo)
+    return lo, np.where(none, lo + 1, hi)
 
 
 def _within(centres, lo: float, hi: float) -> np.ndarray:
