@@ -130,6 +130,25 @@ def test_run_chart_plots_coverage_after_each_scan_with_the_90_percent_point(
         assert image.size == (800, 480)
 
 
+def test_a_run_that_never_saw_the_target_charts_it_on_a_0_to_100_percent_axis_and_says_so():
+    """A run whose scans missed the target drew its flat lines on an axis from 0.00 to
+    0.05 %, ticks of hundredths of a per cent that no run measured, with no word."""
+    from ladartui.charts.coverage import coverage_figure
+    from ladartui.measures import Measures
+
+    never = Measures(target_voxels=2, obscured_after_scan=(0.0,) * 12, unobscured_after_scan=(0.0,) * 12)
+    figure = coverage_figure(never)
+    (axes,) = figure.axes
+    assert axes.get_ylim() == (0.0, 100.0)
+    assert [t.get_text() for t in axes.texts] == ["the target was not seen in any scan"]
+    # a run that saw a little keeps an axis fitted to what it saw
+    little = Measures(
+        target_voxels=200, obscured_after_scan=(0.005, 0.01), unobscured_after_scan=(0.01, 0.02)
+    )
+    (axes,) = coverage_figure(little).axes
+    assert axes.get_ylim()[0] == 0.0 and 2.0 <= axes.get_ylim()[1] < 3.0 and not axes.texts
+
+
 def test_run_chart_refuses_another_suffix_before_tracing(three_scan_scenario, tmp_path, capsys):
     assert main(["run", str(three_scan_scenario.path), "--chart", str(tmp_path / "c.pdf")]) == 2
     err = capsys.readouterr().err

@@ -78,7 +78,12 @@ def coverage_figure(measures: Measures, width_px: int = 800, height_px: int = 48
     if not drawn:
         axes.text(0.5, 0.5, "no per-scan coverage in this run", ha="center", transform=axes.transAxes)
         return figure
-    axes.set_ylim(bottom=0)
+    seen = [v for _, attribute, _, _ in SERIES for v in getattr(measures, attribute) or ()]
+    if max(seen, default=0.0) > 0:
+        axes.set_ylim(bottom=0)
+    else:  # flat at 0: matplotlib's own axis would run to 0.05 %, a precision no run has
+        axes.set_ylim(0, 100)
+        axes.text(0.5, 0.5, "the target was not seen in any scan", ha="center", transform=axes.transAxes)
     axes.xaxis.set_major_locator(MaxNLocator(integer=True))
     axes.grid(True, alpha=0.3)
     axes.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0, fontsize=8)
