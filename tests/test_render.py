@@ -274,3 +274,24 @@ def test_the_top_view_window_zooms_about_a_point_that_stays_put_and_pans_by_frac
     )
     assert framing.zoom_window(frame, 1000.0)[2] - framing.zoom_window(frame, 1000.0)[0] == 2.0
     assert framing.pan_window(frame, 0.1, -0.2) == (10.0, -10.0, 110.0, 40.0)
+
+
+def test_a_picture_saved_large_marks_each_scan_and_the_start_as_a_square_one_can_see():
+    """A view saved as a 1200 x 800 PNG marked each scan and the start with one pixel,
+    lost in the picture; at the terminal's sizes a pixel is half a cell and stays one."""
+    from ladartui.views import SCAN_RGB, START_RGB, TopView
+
+    bounds = (np.zeros(3), np.array([39.0, 39.0, 10.0]))
+    scans = np.array([[5.0, 5.0, 30.0], [20.0, 35.0, 30.0], [35.0, 5.0, 30.0]])
+    top = TopView(np.zeros((40, 40), np.int32), voxel_size=1.0)
+    for rows, cols, side in ((800, 1200, 5), (40, 80, 1)):
+        camera = framing.fit_camera(TOP, bounds, rows, cols, bounds, points=scans)
+        pictures = (
+            render(
+                [], camera, rows, cols, bounds, overlays=Overlays(None, scans, shown=frozenset({"scans"}))
+            ),
+            top.render(rows, cols, scans=scans[:, :2], shown=("scans",)),
+        )
+        for picture in pictures:
+            assert is_rgb(picture, START_RGB).sum() == side * side
+            assert is_rgb(picture, SCAN_RGB).sum() == 2 * side * side

@@ -270,8 +270,9 @@ class TopView:
             draw_polyline(picture, self.to_pixels(path, rows, cols, frame), PATH_RGB)
         if scans is not None and len(scans):
             pix = self.to_pixels(scans, rows, cols, frame)
-            draw_points(picture, pix, SCAN_RGB)
-            draw_points(picture, pix[:1], START_RGB)
+            side = marker_side(rows, cols)
+            draw_points(picture, pix, SCAN_RGB, side)
+            draw_points(picture, pix[:1], START_RGB, side)
         return picture
 
 
@@ -306,9 +307,23 @@ def _block_max(heights, x0, x1, y_lo, y_hi):
     return pooled
 
 
-def draw_points(picture: Picture, pixels, rgb) -> None:
-    """Set each (row, col) pixel that falls inside the picture."""
+MARKER_PIXELS = 160  # a picture's shorter side over this: pixels on a scan marker's side
+
+
+def marker_side(rows: int, cols: int) -> int:
+    """The side of a scan's square marker: one pixel at the terminal's sizes (half a
+    cell), more in a large picture (5 in a 1200 x 800 PNG), where one would be lost."""
+    return max(1, min(rows, cols) // MARKER_PIXELS)
+
+
+def draw_points(picture: Picture, pixels, rgb, side: int = 1) -> None:
+    """Set each (row, col) pixel that falls inside the picture, or the square of ``side``
+    pixels centred on it."""
     pix = np.floor(np.asarray(pixels, float)).astype(np.int64).reshape(-1, 2)
+    if side > 1:
+        steps = np.arange(side) - (side - 1) // 2
+        square = np.stack(np.meshgrid(steps, steps, indexing="ij"), axis=-1).reshape(-1, 2)
+        pix = (pix[:, None, :] + square[None, :, :]).reshape(-1, 2)
     rows, cols = picture.shape
     ok = (pix[:, 0] >= 0) & (pix[:, 0] < rows) & (pix[:, 1] >= 0) & (pix[:, 1] < cols)
     pix = pix[ok]
