@@ -149,6 +149,37 @@ def test_a_run_that_never_saw_the_target_charts_it_on_a_0_to_100_percent_axis_an
     assert axes.get_ylim()[0] == 0.0 and 2.0 <= axes.get_ylim()[1] < 3.0 and not axes.texts
 
 
+def test_each_targets_line_has_a_colour_no_series_or_level_line_has():
+    """With three targets, 'obscured: 1 netted truck' was drawn dotted in tab:purple, as
+    the recognise line is: the legend could not tell them apart (the fourth target took
+    detect's grey, the seventh identify's red)."""
+    from matplotlib.colors import to_hex
+
+    from ladartui.charts.coverage import coverage_figure
+    from ladartui.levels import levels_from_curves
+    from ladartui.measures import Measures
+    from ladartui.target_measures import PerTarget, TargetMeasures
+
+    curve = (0.2, 0.4, 0.6, 0.7)
+    levels = levels_from_curves(curve, (0.2, 0.8, 0.9, 0.9), (0.0, 1.0, 2.0, 3.0), (0.0, 30.0, 60.0, 90.0))
+    each = Measures(obscured_after_scan=curve)
+    targets = PerTarget(tuple(TargetMeasures(i, f"truck {i}", each) for i in range(1, 9)))
+    measures = Measures(
+        obscured_after_scan=curve,
+        unobscured_after_scan=curve,
+        scans_for_enough=3,
+        levels=levels,
+        targets=targets,
+    )
+    (axes,) = coverage_figure(measures).axes
+    colours = {line.get_gid() or "": to_hex(line.get_color()) for line in axes.lines}
+    assert {"level-detect", "level-recognise", "level-identify", "enough-point"} <= set(colours)
+    others = {c for gid, c in colours.items() if not gid.startswith("target-")}
+    target_colours = [colours[f"target-{i}"] for i in range(1, 9)]
+    assert not set(target_colours) & others
+    assert len(set(target_colours[:7])) == 7  # seven targets, seven colours
+
+
 def test_run_chart_refuses_another_suffix_before_tracing(three_scan_scenario, tmp_path, capsys):
     assert main(["run", str(three_scan_scenario.path), "--chart", str(tmp_path / "c.pdf")]) == 2
     err = capsys.readouterr().err

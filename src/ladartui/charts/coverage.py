@@ -18,8 +18,9 @@ from ladartui.charts import new_figure
 from ladartui.measures import ENOUGH_SHARE, Measures
 
 LEVEL_COLOURS = {"detect": "tab:gray", "recognise": "tab:purple", "identify": "tab:red"}
-# Colours of the per-target lines, apart from the overall series and the 90 % mark.
-TARGET_COLOURS = ("tab:purple", "tab:brown", "tab:pink", "tab:gray", "tab:olive", "tab:cyan", "tab:red")
+# Colours of the per-target lines, apart from the overall series, the 90 % mark and the
+# level lines (a dotted purple target line read as the recognise line).
+TARGET_COLOURS = ("tab:brown", "tab:pink", "tab:olive", "tab:cyan", "darkgoldenrod", "teal", "slateblue")
 SERIES = (
     ("unobscured", "unobscured_after_scan", "tab:blue", "s"),
     ("obscured", "obscured_after_scan", "tab:green", "o"),
