@@ -437,3 +437,38 @@ async def test_w_a_s_d_move_the_3d_views_and_the_top_view_the_same_way(app_pilot
             step = where() - before
             # the picture slides against the key: d shows more to the right, w more above
             assert np.sign(step).tolist() == list(moved), (key, view.id, step)
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_a_fitted_3d_view_stays_fitted_as_the_terminal_is_resized(scenario_path):
+    """A tall thin scene fitted (f) at 80x24 lost its top and bottom once the terminal
+    grew to 200x60: the zoom made for a narrow view was kept for a wider one. A view the
+    analyst turned keeps its camera."""
+    app = LadarApp(scenario_path, compile_in_child=False)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await wait_until(pilot, lambda: loaded(app), timeout=120)
+        app.action_layout(1)
+        await pilot.pause()
+        view = app.query_one("#scene3d", ProjectionWidget)
+        tall = (np.array([30.0, 30.0, 0.0]), np.array([33.0, 33.0, 70.0]))
+        corners = np.array([[x, y, z] for x in (29.5, 33.5) for y in (29.5, 33.5) for z in (-0.5, 70.5)])
+
+        def fills() -> float:
+            rows, cols = view.picture_size()
+            row, col, _, _ = screen_coordinates(corners, view.camera, rows, cols, view.bounds)
+            inside = (row >= 0) & (row <= rows) & (col >= 0) & (col <= cols)
+            return float(np.ptp(row) / rows) if inside.all() else 0.0
+
+        view.fit_box(tall)
+        await pilot.pause()
+        assert fills() == pytest.approx(0.9)
+        for size in ((200, 60), (120, 40), (80, 24)):
+            await pilot.resize_terminal(*size)
+            await pilot.pause()
+            await pilot.pause()
+            assert fills() == pytest.approx(0.9), size
+        view.action_rotate(15, 0)  # the analyst's own camera from here
+        camera = view.camera
+        await pilot.resize_terminal(200, 60)
+        await pilot.pause()
+        assert view.camera == camera

@@ -431,6 +431,9 @@ class ProjectionWidget(PictureWidget):
         self.camera = Camera()
         self.height_top: float | None = None  # top of the height shading (voxel layers), shared by views
         self.pending_fit = None  # a box and points to frame once the widget has a size
+        # the box and points the camera frames, kept framed as the view is resized, until
+        # the camera is moved (None: the analyst's own camera, kept as it is)
+        self.fitted = None
         self._drag: tuple[int, int] | None = None
         self.placeholder = "nothing to show yet"
         self._update_title()
@@ -465,6 +468,7 @@ class ProjectionWidget(PictureWidget):
     def set_camera(self, camera: Camera) -> None:
         self.camera = camera
         self.pending_fit = None
+        self.fitted = None
         self._update_title()
         self.invalidate()
         self.post_message(self.CameraChanged(self))
@@ -480,12 +484,20 @@ class ProjectionWidget(PictureWidget):
         else:
             self.pending_fit = (box, points)
             self.invalidate()
+        self.fitted = (box, points)
 
     def fit_path(self) -> None:
         """Frame the scene and the scan positions (``p``; how a new scene opens)."""
         self.fit_box(self.bounds, self.markers)
 
     def on_resize(self, event: events.Resize) -> None:
+        # a fit made for the old shape can cut off what it framed in the new one (a tall
+        # box fitted in a narrow view): framed again, at the same angles
+        rows, cols = self.picture_size()
+        if self.fitted is not None and self.pending_fit is None and self.bounds is not None and rows and cols:
+            box, points = self.fitted
+            self.camera = framing.fit_camera(self.camera, box, rows, cols, self.bounds, points=points)
+            self.invalidate()
         super().on_resize(event)
         self._update_title()
 
