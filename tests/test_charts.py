@@ -224,6 +224,32 @@ def test_sweep_writes_the_pareto_chart_with_the_front_cheapest_first_and_the_bes
         assert image.size == (800, 480)
 
 
+def test_a_sweep_chart_never_shows_a_negative_coverage():
+    """A sweep whose variants all saw nothing charted them on an axis from -0.05 % to
+    0.05 %; one with a variant at 0 % ran below 0."""
+    from ladartui.charts.sweep import sweep_figure
+    from ladartui.sweep.execute import SweepResult
+    from ladartui.sweep.ranking import Ranked
+
+    def chart(coverages):
+        rows = [{"variant": f"v{i}"} for i in range(len(coverages))]
+        ranking = [
+            Ranked(r, c, i + 1, i == 0, 100.0 + 10 * i, c) for i, (r, c) in enumerate(zip(rows, coverages))
+        ]
+        (axes,) = sweep_figure(
+            SweepResult(rows, ranking, "coverage", "distance", None, [], Path("r.csv"))
+        ).axes
+        return axes
+
+    axes = chart([0.0] * 5)
+    assert axes.get_ylim() == (0.0, 100.0)
+    assert [t.get_text() for t in axes.texts] == ["no variant saw the target"]
+    axes = chart([0.0, 0.02, 0.05])
+    assert axes.get_ylim()[0] == 0.0 and 5.0 <= axes.get_ylim()[1] < 6.0 and not axes.texts
+    axes = chart([0.3, 0.4])  # far from 0: fitted to the variants, as before
+    assert 29.0 < axes.get_ylim()[0] < 30.0
+
+
 def test_study_chart_from_prints_an_output_folder_with_markup_as_it_is(tmp_path, capsys):
     out = tmp_path / "a[" / "bold]st"  # the path holds "[/bold]": a closing tag to rich
     assert main(["study", "--chart-from", str(ROOT / "docs" / "study.json"), "--out", str(out)]) == 0
