@@ -472,3 +472,31 @@ async def test_a_fitted_3d_view_stays_fitted_as_the_terminal_is_resized(scenario
         await pilot.resize_terminal(200, 60)
         await pilot.pause()
         assert view.camera == camera
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_a_fitted_3d_view_saved_in_another_shape_keeps_what_it_framed_whole(tmp_path):
+    """A long low target fitted (t) in a wide view and saved as a tall PNG lost both its
+    ends: the PNG took the view's zoom, made for the view's shape."""
+    from PIL import Image
+    from textual.app import App
+
+    class Views(App):
+        def compose(self):
+            yield ViewArea()
+
+    app = Views()
+    async with app.run_test(size=(200, 30)) as pilot:
+        await pilot.pause()
+        area = app.query_one(ViewArea)
+        view = area.query_one("#scene3d", ProjectionWidget)
+        slab = np.array([[x, y, z] for x in range(40) for y in range(8) for z in range(3)])
+        view.set_points(slab, (np.zeros(3), np.array([39.0, 7.0, 2.0])))
+        view.fit_box((slab.min(axis=0), slab.max(axis=0)))
+        await pilot.pause()
+        path = area.save_png(tmp_path / "tall.png", 300, 900, "scene3d")
+        with Image.open(path) as image:
+            rgb = np.asarray(image.convert("RGB"))
+        rows, cols = np.nonzero(np.any(rgb != np.array(colour.BACKGROUND, np.uint8), axis=2))
+        assert cols.min() > 0 and cols.max() < 299 and rows.min() > 0 and rows.max() < 899
+        assert np.ptp(cols) == pytest.approx(0.9 * 300, abs=3)  # filling the PNG's width as the view's

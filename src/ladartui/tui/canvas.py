@@ -519,7 +519,9 @@ class ProjectionWidget(PictureWidget):
         # else the short name and colouring ("Out <=12.5 scans"), cut at the edge, before the camera
         self.border_title = next((t for t in titles if len(t) <= room), titles[0] if room <= 0 else short)
 
-    def make_picture(self, rows, cols):
+    def make_picture(self, rows, cols, refit: bool = False):
+        """The picture at rows x cols; ``refit`` (a picture saved in another shape) frames
+        what a fitted view frames in that shape, leaving the view's camera as it is."""
         if not self.voxel_layers or self.bounds is None:
             return None
         if self.pending_fit is not None:
@@ -527,10 +529,14 @@ class ProjectionWidget(PictureWidget):
             self.camera = framing.fit_camera(self.camera, box, rows, cols, self.bounds, points=points)
             self.pending_fit = None
             self._update_title()
+        camera = self.camera
+        if refit and self.fitted is not None:
+            box, points = self.fitted
+            camera = framing.fit_camera(camera, box, rows, cols, self.bounds, points=points)
         self.overlays.shown = self.shown_overlays
         return render(
             self.voxel_layers,
-            self.camera,
+            camera,
             rows,
             cols,
             self.bounds,

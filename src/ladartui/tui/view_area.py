@@ -320,7 +320,10 @@ class ViewArea(Container):
         widget = (
             self.query_one(f"#{view}", PictureWidget) if isinstance(view, str) else self.current_view(view)
         )
-        picture = widget.make_picture(height, width)
+        if isinstance(widget, ProjectionWidget):  # a fitted view frames the same in the PNG's shape
+            picture = widget.make_picture(height, width, refit=True)
+        else:
+            picture = widget.make_picture(height, width)
         if picture is None:
             raise LadarError(f"{widget.border_title}: nothing to draw yet")
         return png.write_png(picture.rgb, path)
