@@ -271,3 +271,21 @@ async def test_a_finished_sweep_is_ready_without_a_percentage(swept, tmp_path, m
         bar = screen.query_one("#sweep-status", StatusBar)
         assert bar.state == READY and bar.progress is None
         assert str(bar.query_one("#status-word").render()) == "READY"
+
+
+def test_the_chart_of_variants_that_all_saw_nothing_shows_no_negative_coverage():
+    """Every variant at 0 % drew the sweep screen's chart on an axis from -1.00 to 1.00."""
+    import plotext as plt
+
+    from ladartui.sweep.ranking import Ranked
+    from ladartui.tui.sweep_view import draw_pareto
+
+    ranking = [Ranked({"variant": f"v{i}"}, 0.0, i + 1, i == 0, 100.0 + 10 * i, 0.0) for i in range(5)]
+    plt.clf()
+    plt.plotsize(80, 20)
+    draw_pareto(plt, ranking, "distance")
+    ticks = [line.split("\u2524")[0] for line in plt.build().splitlines() if "\u2524" in line]
+    plain = [re.sub(r"\x1b\[[0-9;]*m", "", tick).strip() for tick in ticks]
+    assert plain and not any(tick.startswith("-") for tick in plain), plain
+    assert max(float(tick) for tick in plain) == 100.0
+    plt.clf()

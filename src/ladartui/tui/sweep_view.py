@@ -147,6 +147,8 @@ def draw_pareto(plt, ranking, cost: str) -> None:
     # read as many points)
     plt.plot([p[0] for p in front], [p[1] for p in front], marker="braille", color="orange")
     plt.scatter([p[0] for p in front], [p[1] for p in front], marker=FRONT_MARKER, color="orange")
+    if max(p[1] for p in points) <= 0:  # flat at 0: plotext's own axis runs from -1 to 1 %
+        plt.ylim(0, 100)
     best = [p for p in points if p[2].rank == 1]
     if best:
         plt.scatter([best[0][0]], [best[0][1]], marker=BEST_MARKER, color="green")
