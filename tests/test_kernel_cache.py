@@ -91,3 +91,16 @@ def test_the_package_s_caches_are_stamped_on_import():
     root = Path(ladartui.__file__).parent
     stamp = root / "tracing" / "__pycache__" / STAMP_NAME
     assert stamp.read_text() == sources_digest(root)
+
+
+def test_kernels_cached_into_a_folder_made_since_are_kept(tmp_path, monkeypatch):
+    """A cache folder numba had not made yet (a new NUMBA_CACHE_DIR, a package's first
+    kernels) got no stamp: the kernels numba then cached there were taken for stale ones
+    at the next start and compiled again, though no source had changed."""
+    root = _package(tmp_path / "pkg")
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path / "numba-cache"))
+    assert clear_stale_kernels(root, SOURCES) is False  # nothing cached yet: nothing cleared
+    user = next((tmp_path / "numba-cache").glob("tracing_*"))
+    (user / "kernel.step-12.py311.nbi").write_bytes(b"compiled")  # as numba caches it
+    assert clear_stale_kernels(root, SOURCES) is False
+    assert (user / "kernel.step-12.py311.nbi").exists()

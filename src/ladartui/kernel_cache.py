@@ -63,13 +63,16 @@ def clear_stale_kernels(root, sources=KERNEL_SOURCES) -> bool:
     for cache in cache_folders(root, sources):
         stamp = cache / STAMP_NAME
         try:
-            if not cache.is_dir() or (stamp.is_file() and stamp.read_text() == digest):
+            if stamp.is_file() and stamp.read_text() == digest:
                 continue
+            # stamped before numba makes the folder: else its first kernels, unstamped,
+            # would be taken for stale ones at the next start and compiled again
+            cache.mkdir(parents=True, exist_ok=True)
             for path in cache.iterdir():
                 if path.suffix in KERNEL_SUFFIXES:
                     os.unlink(path)
+                    cleared = True
             stamp.write_text(digest)
-            cleared = True
         except OSError:  # read-only, or another process clearing it too: left as it is
             continue
     return cleared
