@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from rich.text import Text
 
@@ -22,6 +23,9 @@ from ladartui.fileprobe import file_problem
 from ladartui.levels import LEVELS, NOT_REACHED
 from ladartui.measures_table import UNDEFINED
 from ladartui.number_text import fixed, fixed_or_tiny
+
+if TYPE_CHECKING:
+    from ladartui.scenario import Scenario
 
 # (label, Measures.to_dict path, kind, better): better is "high", "low" or None
 ROWS = [
@@ -238,30 +242,42 @@ def column_names(paths: list[Path]) -> list[str]:
 def read_measures_files(paths) -> list:
     """The ``Measures`` of each .cmf file (a scenario's .toml: its run's measures file);
     ``InputFileError`` naming the first that cannot be read."""
-    from ladartui.cmf import read_cmf
+    return read_compared(paths)[0]
 
-    out = []
+
+def read_compared(paths) -> tuple[list, list[str]]:
+    """The ``Measures`` of each .cmf file (a scenario's .toml: its run's measures file),
+    and for each scenario given (once, however often it is given) whose last run went
+    with other settings than the file has now, a note saying so (``earlier_settings_note``).
+    ``InputFileError`` naming the first file that cannot be read. Each scenario is
+    loaded once (a flight log's records read once)."""
+    from ladartui.cmf import read_cmf
+    from ladartui.scenario import load_scenario
+
+    measures = []
+    notes: dict[Path, str | None] = {}
     for path in map(Path, paths):
         scenario = path.suffix.lower() == ".toml"
         if path.is_dir():
             raise InputFileError(path, "is a folder; expected a .cmf measures file or a scenario (.toml)")
         if problem := file_problem(path):
             raise InputFileError(path, f"{'scenario' if scenario else 'measures file'} {problem}")
-        out.append(read_cmf(_measures_file_of(path) if scenario else path))
-    return out
+        if not scenario:
+            measures.append(read_cmf(path))
+            continue
+        loaded = load_scenario(path, check_files=False)
+        measures.append(read_cmf(_measures_file_of(loaded, path)))
+        if path not in notes:
+            notes[path] = earlier_settings_note(loaded, path)
+    return measures, [note for note in notes.values() if note]
 
 
-def earlier_settings_note(path) -> str | None:
-    """For a scenario (.toml) compared by its last run's measures: a line naming the
-    settings that run went with where the file now says otherwise (an edit not run
-    again); None where they agree, or no readable record says."""
+def earlier_settings_note(scenario: Scenario, path: Path) -> str | None:
+    """For a scenario (loaded from ``path``) compared by its last run's measures: a line
+    naming the settings that run went with where the file now says otherwise (an edit
+    not run again); None where they agree, or no readable record says."""
     from ladartui.run_record import changes_text, read_run_record, setting_changes
-    from ladartui.scenario import load_scenario
 
-    path = Path(path)
-    if path.suffix.lower() != ".toml":
-        return None
-    scenario = load_scenario(path, check_files=False)
     try:
         ran = read_run_record(scenario)
     except LadarError:  # a record that does not read: validate names it
@@ -294,12 +310,11 @@ def measures_files_to_offer(own: Path, most: int = 4) -> list[Path]:
     return offered
 
 
-def _measures_file_of(scenario: Path) -> Path:
-    """The measures file a scenario's runs write, there to be read."""
-    from ladartui.scenario import load_scenario
-
-    measures = load_scenario(scenario, check_files=False).measures_file
+def _measures_file_of(scenario: Scenario, path: Path) -> Path:
+    """The measures file a scenario's runs write (the scenario loaded from ``path``),
+    there to be read."""
+    measures = scenario.measures_file
     if problem := file_problem(measures):
         first = ": run it first" if problem == "not found" else ""
-        raise InputFileError(measures, f"measures file of {scenario.name} {problem}{first}")
+        raise InputFileError(measures, f"measures file of {path.name} {problem}{first}")
     return measures

@@ -37,7 +37,7 @@ def add_parser(subparsers):
 def run(args) -> int:
     from ladartui.cli.flags import check_file_names
     from ladartui.errors import FieldError
-    from ladartui.measures_compare import column_names, read_measures_files, side_by_side
+    from ladartui.measures_compare import column_names, read_compared, side_by_side
     from ladartui.user_data import bundled_run
 
     for file in args.files:
@@ -45,9 +45,10 @@ def run(args) -> int:
     if len(args.files) < 2:
         raise FieldError("FILE", args.files[0], "two or more files to compare")
     paths = [bundled_run(file) for file in args.files]  # "convoy", as run takes it
-    rows = side_by_side(read_measures_files(paths))  # a folder is refused before it is named
+    measures, notes = read_compared(paths)  # a folder is refused before it is named
+    rows = side_by_side(measures)
     names = column_names(paths)
-    _note_earlier_settings(paths)
+    _note_earlier_settings(notes)
     if args.json:
         print(json.dumps(as_json(names, paths, rows), indent=2, allow_nan=False))
     else:
@@ -55,18 +56,15 @@ def run(args) -> int:
     return 0
 
 
-def _note_earlier_settings(paths) -> None:
+def _note_earlier_settings(notes) -> None:
     """A note on standard error for each scenario whose last run (its measures compared)
-    went with other settings than the file has now."""
+    went with other settings than the file has now (a file given twice: said once)."""
     from ladartui.cli.console import CliConsole
-    from ladartui.measures_compare import earlier_settings_note
     from ladartui.textsafe import one_line
 
     console = CliConsole(stderr=True)
-    for path in dict.fromkeys(paths):  # a file given twice: said once
-        note = earlier_settings_note(path)
-        if note:
-            console.print(one_line(f"note: {note}"), highlight=False, markup=False, soft_wrap=True)
+    for note in notes:
+        console.print(one_line(f"note: {note}"), highlight=False, markup=False, soft_wrap=True)
 
 
 def as_json(names, paths, rows) -> dict:

@@ -17,8 +17,7 @@ from ladartui.fileprobe import user_path
 from ladartui.measures import Measures
 from ladartui.measures_compare import (
     column_names,
-    earlier_settings_note,
-    read_measures_files,
+    read_compared,
     side_by_side,
     styled,
 )
@@ -153,9 +152,8 @@ class CompareScreen(TreeDialog):
             return
         paths = [self.base / user_path(t) for t in text]
         try:
-            loaded = read_measures_files(paths)
             # a scenario stands for its last run's measures: say so where it has changed since
-            notes = [note for path in dict.fromkeys(paths) if (note := earlier_settings_note(path))]
+            loaded, notes = read_compared(paths)
         except LadarError as error:
             message.update(literal(str(error)))
             return
