@@ -24,9 +24,9 @@ def test_a_clean_log_is_read_at_once_and_to_the_same_numbers(tmp_path, monkeypat
     first = records[0].split(",")
     records[0] = ",".join([*first[:4], f'"{first[4]}"', *first[5:]])  # csv reading only
     quoted.write_text("time,x,y,z,heading,roll,pitch\n" + "\n".join(records) + "\n")
-    one_by_one = trajectory._checked_records
+    one_by_one = trajectory._parsed_records
     calls = []
-    monkeypatch.setattr(trajectory, "_checked_records", lambda *args: calls.append(1) or one_by_one(*args))
+    monkeypatch.setattr(trajectory, "_parsed_records", lambda *args: calls.append(1) or one_by_one(*args))
     at_once = load_flight_log(clean)
     assert not calls  # a clean log is not read record by record
     checked = load_flight_log(quoted)

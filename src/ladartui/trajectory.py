@@ -157,10 +157,13 @@ def load_flight_log(path, origin=None) -> FlightLog:
             "origin on the earth)"
         )
     columns = {name: names.index(name) for name in (*required, *OPTIONAL) if name in names}
-    arr = _clean_records(rows[1:], len(names), required, columns, geodetic)
-    if arr is None:  # read record by record: the first bad one is named
-        values = _checked_records(path, rows[1:], names, required, columns, geodetic)
-        arr = {k: np.array(v, dtype=np.float64) for k, v in values.items()}
+    table = _plain_records(rows[1:], len(names), columns)
+    stop = None  # a record of another width, or a field no number: (index, field, problem)
+    if table is None:  # quoted fields, irregular records: read record by record
+        table, stop = _parsed_records(rows[1:], names, columns)
+    _check_records(path, rows[1:], table, columns, geodetic, stop)
+    got = dict(zip(columns, table.T))
+    arr = {name: got.get(name, np.zeros(len(table))) for name in (*required, *OPTIONAL)}
     if len(arr["time"]) < 2:
         raise TrajectoryError(f"{path}: {plural(len(arr['time']), 'record')}: expected at least 2")
     if geodetic:
@@ -200,10 +203,10 @@ def _quoted(header: str, columns: int, limit: int = 80) -> str:
     return repr(text) if len(text) <= limit else f"{text[:limit]!r}... ({columns} columns)"
 
 
-def _clean_records(records, width, required, columns, geodetic) -> dict[str, np.ndarray] | None:
-    """The columns of ``records`` ((line number, text) pairs) read at once, or None where
-    any record is not plain numbers within bounds (``_checked_records`` then names it):
-    a million records read in a second or two, not twenty."""
+def _plain_records(records, width, columns) -> np.ndarray | None:
+    """The ``columns`` of ``records`` ((line number, text) pairs) read at once, or None
+    where any record is quoted, of another width or holds a value no number (for
+    ``_parsed_records``): a million records read in a second or two, not twenty."""
     lines = [line for _, line in records]
     if not lines or any('"' in line or line.count(",") != width - 1 for line in lines):
         return None  # quoted fields, a record of another width: for the csv reading
@@ -221,71 +224,86 @@ def _clean_records(records, width, required, columns, geodetic) -> dict[str, np.
             )
         except ValueError:  # a value no number: named by the record-by-record reading
             return None
-    got = dict(zip(columns, table.T))
-    checks = [np.isfinite(table).all(), np.all(np.diff(got["time"]) > 0)]
-    checks.append(np.abs(got["time"]).max() <= MAX_LOG_TIME)
-    checks += [np.abs(got[name]).max() <= limit for name, limit in LOG_ANGLE_LIMITS.items() if name in got]
-    checks += [np.abs(got[name]).max() <= MAX_COORDINATE for name in ("x", "y", "z") if name in got]
-    if geodetic:
-        checks += [np.abs(got["latitude"]).max() <= 90.0, np.abs(got["longitude"]).max() <= 180.0]
-    else:
-        checks += [got["z"].min() > 0, got["z"].max() <= MAX_ALTITUDE]
-    if not all(checks) or table.shape != (len(lines), len(columns)):
-        return None
-    return {name: got.get(name, np.zeros(len(lines))) for name in (*required, *OPTIONAL)}
+    return table if table.shape == (len(lines), len(columns)) else None
 
 
-def _checked_records(path, records, names, required, columns, geodetic) -> dict[str, list[float]]:
-    """The columns of ``records`` ((line number, text) pairs) read one value at a time:
-    the first that is no number or out of bounds raises, naming its line."""
-    values: dict[str, list[float]] = {name: [] for name in (*required, *OPTIONAL)}
-    for number, line in records:
+def _parsed_records(records, names, columns) -> tuple[np.ndarray, tuple[int, int, str] | None]:
+    """The ``columns`` of ``records`` read one record at a time with the csv module, up to
+    the first record of another width or with a field that is no number; then that
+    stop, (record index, field index (-1: the whole record), what is wrong), else None.
+    The stopped record's fields from the one that is no number on are NaN."""
+    table = np.full((len(records), len(columns)), np.nan)
+    for index, (_, line) in enumerate(records):
         fields = next(csv.reader([line]))
         if len(fields) != len(names):
-            raise TrajectoryError(f"{path}:{number}: {len(fields)} fields, expected {len(names)}")
-        for name in (*required, *OPTIONAL):
-            if name not in columns:
-                values[name].append(0.0)
-                continue
-            raw = fields[columns[name]].strip()
+            return table[: index + 1], (index, -1, f"{len(fields)} fields, expected {len(names)}")
+        for field, (name, column) in enumerate(columns.items()):
+            raw = fields[column].strip()
             try:
-                value = float(raw)
+                table[index, field] = float(raw)
             except ValueError:
-                raise TrajectoryError(f"{path}:{number}: {name} = {raw!r}: expected a number") from None
-            if not np.isfinite(value):
-                raise TrajectoryError(f"{path}:{number}: {name} = {raw!r}: expected a finite number")
-            if name == "time" and abs(value) > MAX_LOG_TIME:
-                raise TrajectoryError(
-                    f"{path}:{number}: time = {raw!r}: expected seconds within +-{MAX_LOG_TIME:g}"
-                )
-            if name in LOG_ANGLE_LIMITS and abs(value) > LOG_ANGLE_LIMITS[name]:
-                raise TrajectoryError(
-                    f"{path}:{number}: {name} = {raw!r}: expected degrees within +-{LOG_ANGLE_LIMITS[name]:g}"
-                )
-            if name in ("x", "y", "z") and abs(value) > MAX_COORDINATE:
-                raise TrajectoryError(
-                    f"{path}:{number}: {name} = {raw!r}: expected a coordinate within "
-                    f"{MAX_COORDINATE:g} m of the scene's origin"
-                )
-            values[name].append(value)
-        if len(values["time"]) > 1 and values["time"][-1] <= values["time"][-2]:
-            raise TrajectoryError(
-                f"{path}:{number}: time = {values['time'][-1]!r}: "
-                f"expected times increasing (previous {values['time'][-2]!r})"
+                return table[: index + 1], (index, field, f"{name} = {raw!r}: expected a number")
+    return table, None
+
+
+def _check_records(path, records, table, columns, geodetic, stop=None) -> None:
+    """Raise for the first value of the log's ``table`` (a row per record, a column per
+    one of ``columns``) out of bounds, or for ``stop`` (from ``_parsed_records``) where it
+    comes first. Records in order; in a record, each field in turn (a number, finite,
+    within bounds), then its time after the one before, then its latitude and longitude,
+    or its height. The message names the record's line and the value as written."""
+    found = []  # (record index, place in the record's order, what is wrong with it)
+
+    def first(fails, place, problem) -> None:  # problem: of a record's index, its text
+        at = np.flatnonzero(fails)
+        if at.size:
+            found.append((int(at[0]), place, problem))
+
+    def written(name):  # a value as its record wrote it
+        return lambda i: next(csv.reader([records[i][1]]))[columns[name]].strip()
+
+    for field, name in enumerate(columns):
+        value, text = table[:, field], written(name)
+        problem = partial(_bound_problem, name, text)
+        first(~np.isfinite(value), 3 * field + 1, partial(problem, "expected a finite number"))
+        if name == "time":
+            expected, limit = f"expected seconds within +-{MAX_LOG_TIME:g}", MAX_LOG_TIME
+        elif name in LOG_ANGLE_LIMITS:
+            limit = LOG_ANGLE_LIMITS[name]
+            expected = f"expected degrees within +-{limit:g}"
+        elif name in ("x", "y", "z"):
+            expected, limit = (
+                f"expected a coordinate within {MAX_COORDINATE:g} m of the scene's origin",
+                MAX_COORDINATE,
             )
-        if geodetic:
-            lat, lon = values["latitude"][-1], values["longitude"][-1]
-            if not -90.0 <= lat <= 90.0:
-                raise TrajectoryError(f"{path}:{number}: latitude = {lat!r}: expected -90..90")
-            if not -180.0 <= lon <= 180.0:
-                raise TrajectoryError(f"{path}:{number}: longitude = {lon!r}: expected -180..180")
-        elif values["z"][-1] <= 0:
-            raise TrajectoryError(f"{path}:{number}: z = {values['z'][-1]!r}: expected > 0")
-        elif values["z"][-1] > MAX_ALTITUDE:  # a scan pose's limit, named here on the log's line
-            raise TrajectoryError(
-                f"{path}:{number}: z = {fields[columns['z']].strip()!r}: expected at most {MAX_ALTITUDE:g} m"
-            )
-    return values
+        else:
+            continue
+        first(np.abs(value) > limit, 3 * field + 2, partial(problem, expected))
+    got, end = dict(zip(columns, table.T)), 3 * len(columns)
+    time = got["time"]
+    first(
+        np.concatenate([[False], time[1:] <= time[:-1]]),
+        end,
+        lambda i: f"time = {float(time[i])!r}: expected times increasing (previous {float(time[i - 1])!r})",
+    )
+    if geodetic:
+        lat, lon = got["latitude"], got["longitude"]
+        first(np.abs(lat) > 90.0, end + 1, lambda i: f"latitude = {float(lat[i])!r}: expected -90..90")
+        first(np.abs(lon) > 180.0, end + 2, lambda i: f"longitude = {float(lon[i])!r}: expected -180..180")
+    else:
+        z, text = got["z"], written("z")
+        first(z <= 0, end + 1, lambda i: f"z = {float(z[i])!r}: expected > 0")
+        first(z > MAX_ALTITUDE, end + 2, lambda i: f"z = {text(i)!r}: expected at most {MAX_ALTITUDE:g} m")
+    if stop is not None:
+        index, field, problem = stop
+        found.append((index, 3 * field, lambda i: problem))
+    if found:
+        index, _, what = min(found, key=lambda f: f[:2])
+        raise TrajectoryError(f"{path}:{records[index][0]}: {what(index)}")
+
+
+def _bound_problem(name, written, expected, index) -> str:
+    return f"{name} = {written(index)!r}: {expected}"
 
 
 # A record's time, in seconds either way of 0: milliseconds since 1970 fit (1.7e12); past
