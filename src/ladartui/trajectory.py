@@ -329,7 +329,11 @@ def log_poses(log: FlightLog, template: ScanPose, rate: float | None = None, tim
     naming it.
     """
     template = pose_field("template", template)
-    times = np.asarray(scan_times_field(log, rate, times), dtype=np.float64)
+    return _poses_at(log, template, np.asarray(scan_times_field(log, rate, times), dtype=np.float64))
+
+
+def _poses_at(log: FlightLog, template: ScanPose, times: np.ndarray) -> list[ScanPose]:
+    """``log_poses`` at ``times`` already checked (a segment's), not checked again."""
     xyz = np.stack([np.interp(times, log.time, log.xyz[:, a]) for a in range(3)], axis=1)
     heading = _angle(log.time, log.heading, times)
     return [
@@ -381,11 +385,16 @@ def times_field(log: FlightLog, given) -> tuple[float, ...]:
 
 def scan_times_field(log: FlightLog, rate, times):
     """The scan times of a ``rate`` or of ``times``, exactly one of them given, checked."""
-    if (rate is None) == (times is None):
-        raise FieldError("rate", rate, "either a scan rate (Hz) or a list of scan times (s), not both")
+    one_of_rate_or_times(rate, times)
     if times is not None:
         return times_field(log, times)
     return rate_times(log, rate_field(log, rate))
+
+
+def one_of_rate_or_times(rate, times) -> None:
+    """A ``FieldError`` unless exactly one of a scan ``rate`` and scan ``times`` is given."""
+    if (rate is None) == (times is None):
+        raise FieldError("rate", rate, "either a scan rate (Hz) or a list of scan times (s), not both")
 
 
 def rate_times(log: FlightLog, rate: float) -> np.ndarray:
@@ -446,10 +455,7 @@ class LogSegment:
                 self.file,
                 f"a flight log file (CSV): {problem}",
             )
-        if (self.rate is None) == (self.times is None):
-            raise FieldError(
-                "rate", self.rate, "either a scan rate (Hz) or a list of scan times (s), not both"
-            )
+        one_of_rate_or_times(self.rate, self.times)
         if self.azimuth is not None:
             set_("azimuth", number_field("azimuth", self.azimuth))
         if self.depression is not None:
@@ -521,7 +527,7 @@ class LogSegment:
         azimuth = LOG_AZIMUTH if self.azimuth is None else self.azimuth
         depression = LOG_DEPRESSION if self.depression is None else self.depression
         template = Pose(0.0, 0.0, 1.0, 0.0, azimuth, depression)
-        poses = log_poses(self.log, template, times=self.scan_times())
+        poses = _poses_at(self.log, template, self.scan_times())  # times checked when made
         return poses if self.aim_at is None else [aim_at(p, self.aim_at) for p in poses]
 
     def attitudes(self) -> list[tuple[float, float]]:
