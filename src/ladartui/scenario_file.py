@@ -115,7 +115,18 @@ from ladartui.checks import number_field
 from ladartui.detection.settings import DETECTION_KEYS, detection_from_table
 from ladartui.errors import Described, FieldError, InputFileError
 from ladartui.fileprobe import user_path
-from ladartui.flight import MAX_SCANS, SEGMENT_KINDS, FlightPlan, Manual, ScanPose
+from ladartui.flight import (
+    MAX_SCANS,
+    SEGMENT_KINDS,
+    FlightPlan,
+    FlyPast,
+    Manual,
+    Orbit,
+    ScanPose,
+    Standoff,
+    Straight,
+    Turn,
+)
 from ladartui.levels import LEVEL_KEYS, level_below, levels_from_table
 from ladartui.number_text import plural
 from ladartui.sensor import MAX_PIXEL_PITCH, MIN_PIXEL_PITCH, Sensor
@@ -454,23 +465,26 @@ def check_flight(plan: FlightPlan) -> None:
         count = sum(len(p) for p in plan.segment_poses())
     except FieldError as error:
         raise FieldError("flight." + error.field, error.value, error.expected) from None
-    if count > MAX_SCANS:
+    if count > MAX_SCANS:  # each segment makes its declared scans: a guard, not met in use
         raise FieldError("flight.segments", Described(plural(count, "scan")), f"at most {MAX_SCANS:,} scans")
 
 
 def declared_scans(segment) -> int:
     """The scans ``segment`` makes, counted without making them: its ``scans``, its poses,
-    standoffs or listed times, a log's scans at its rate."""
-    if isinstance(segment, LogSegment) and segment.rate is not None:
+    standoffs or listed times, a log's scans at its rate. ``TypeError`` for an object no
+    segment."""
+    if isinstance(segment, LogSegment):
+        if segment.times is not None:
+            return len(segment.times)
+        assert segment.rate is not None  # a log scans at a rate or at times
         return rate_count(segment.log, segment.rate)
-    scans = getattr(segment, "scans", None)
-    if isinstance(scans, int):
-        return scans
-    for name in ("poses", "standoffs", "times"):
-        items = getattr(segment, name, None)
-        if isinstance(items, tuple):
-            return len(items)
-    return 1
+    if isinstance(segment, Manual):
+        return len(segment.poses)
+    if isinstance(segment, Standoff):
+        return len(segment.standoffs)
+    if isinstance(segment, (Straight, Turn, Orbit, FlyPast)):
+        return segment.scans
+    raise TypeError(f"no flight segment: {segment!r}")
 
 
 def resolve_path(folder: Path, file) -> Path:
