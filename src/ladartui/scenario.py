@@ -26,6 +26,7 @@ from ladartui.fileprobe import (
     NO_SUCH_FILE,
     OTHER_FILE_KINDS,
     file_problem,
+    other_file_kind,
     path_field,
     read_utf8,
     require_file,
@@ -216,16 +217,15 @@ class Scenario:
     def check_files(self) -> None:
         """InputFileError naming the first referenced model file that does not exist, or a
         scene model of another kind (a point cloud, a mesh)."""
-        from ladartui.fileprobe import other_file_kind
-
         missing = None
         if problem := file_problem(self.scene_file):
             missing = f"scene model file {self.scene_file} {problem} (files.scene)"
-        elif kind := other_file_kind(self.scene_file):  # else its target, 'X_Target.las', was asked for
+        # another kind of file: else its target, 'X_Target.las', was asked for
+        elif other := other_model_kind(self.scene_file, self.voxel_size):
+            kind, hint = other
             missing = (
                 f"scene model file {self.scene_file} is {kind} ({self.scene_file.suffix}) "
-                "(files.scene): expected a voxel list (.txt)"
-                + voxelize_hint(self.scene_file, kind, self.voxel_size)
+                f"(files.scene): expected a voxel list (.txt){hint}"
             )
         elif (problem := file_problem(self.target_file)) and self.scene_file.stem.endswith("_Target"):
             scene = self.scene_file.with_stem(self.scene_file.stem.removesuffix("_Target"))
@@ -290,12 +290,11 @@ class Scenario:
         scene_file = resolve_path(path.parent, path_field("files.scene", scene_file, "a scene model's path"))
         # before the default orbit reads it: a bad size is the field's error, not the sums'
         voxel_size = number_field("files.voxel_size", voxel_size, MIN_VOXEL_SIZE, MAX_VOXEL_SIZE)
-        from ladartui.fileprobe import other_file_kind
-
-        if kind := other_file_kind(scene_file):  # else its default orbit asks for 'X_Target.las'
-            expected = f"a voxel list (.txt), not {kind} ({scene_file.suffix})"
+        # another kind of file: else its default orbit asks for 'X_Target.las'
+        if other := other_model_kind(scene_file, voxel_size):
+            kind, hint = other
             raise FieldError(
-                "files.scene", str(scene_file), expected + voxelize_hint(scene_file, kind, voxel_size)
+                "files.scene", str(scene_file), f"a voxel list (.txt), not {kind} ({scene_file.suffix}){hint}"
             )
         if sensor is None:
             sensor = defaults.DEFAULT_SENSOR
@@ -539,6 +538,14 @@ def check_work(scenario, raise_with=None):
         "(the scene run and the target-alone run)",
         raise_with=raise_with or RAISE_RAYS,
     )
+
+
+def other_model_kind(path: Path, voxel_size: float) -> tuple[str, str] | None:
+    """A model file of another kind than a voxel list, by its suffix (a point cloud, a
+    mesh): what it is, and the hint that makes a scene model of it (``voxelize_hint``);
+    None for a voxel list."""
+    kind = other_file_kind(path)
+    return (kind, voxelize_hint(path, kind, voxel_size)) if kind else None
 
 
 def voxelize_hint(cloud: Path, kind: str, voxel_size: float) -> str:

@@ -14,7 +14,7 @@ from pathlib import Path
 from ladartui.checks import compass_field, number_field
 from ladartui.defaults import to_millimetres
 from ladartui.errors import FieldError, InputFileError, LadarError
-from ladartui.fileprobe import file_problem, other_file_kind
+from ladartui.fileprobe import file_problem
 from ladartui.flight import (
     MAX_SCANS,
     SEGMENT_KINDS,
@@ -30,7 +30,7 @@ from ladartui.flight import (
     altitude_field,
 )
 from ladartui.flight.plan import refuse_two_pointings
-from ladartui.scenario import Scenario, load_scenario, target_file_for, voxelize_hint
+from ladartui.scenario import Scenario, load_scenario, other_model_kind, target_file_for
 from ladartui.scenario_file import is_record
 from ladartui.sensor import Sensor
 
@@ -393,12 +393,11 @@ def new_scenario(scenario_path: Path, scene_path: Path, voxel_size: float = 1.0)
             raise InputFileError(path, f"{what} file {problem}")
         # another kind of file, by its suffix: else 'S_Target.las: ... not a voxel list' or
         # 'S_Target.toml: ... not found', of a file no one named
-        if kind := other_file_kind(path):
+        if other := other_model_kind(Path(path), voxel_size):
+            kind, hint = other
             kind = "a scenario file" if Path(path).suffix.lower() == ".toml" else kind
             raise InputFileError(
-                path,
-                f"{what} file is {kind} ({Path(path).suffix}); expected a {what} (.txt)"
-                + voxelize_hint(Path(path), kind, voxel_size),
+                path, f"{what} file is {kind} ({Path(path).suffix}); expected a {what} (.txt){hint}"
             )
     return Scenario.new(scenario_path, scene_path, voxel_size)
 
