@@ -50,13 +50,9 @@ def available_memory() -> int:
 
 
 def _free_memory() -> int | None:
-    try:
-        with open("/proc/meminfo", encoding="ascii") as meminfo:
-            for line in meminfo:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except (OSError, ValueError):
-        pass
+    available = _proc_kib("/proc/meminfo", "MemAvailable:")
+    if available is not None:
+        return available
     try:
         return os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
     except (OSError, ValueError):
@@ -72,13 +68,14 @@ def _address_space_left() -> int | None:
     soft = resource.getrlimit(resource.RLIMIT_AS)[0]
     if soft == resource.RLIM_INFINITY or soft < 0:
         return None
-    return soft - (_status_bytes("VmSize:") or 0)
+    return soft - (_proc_kib("/proc/self/status", "VmSize:") or 0)
 
 
-def _status_bytes(key: str) -> int | None:
+def _proc_kib(path: str, key: str) -> int | None:
+    """Bytes of the "``key`` N kB" line of a /proc file; None where it cannot be read."""
     try:
-        with open("/proc/self/status", encoding="ascii") as status:
-            for line in status:
+        with open(path, encoding="ascii") as lines:
+            for line in lines:
                 if line.startswith(key):
                     return int(line.split()[1]) * 1024
     except (OSError, ValueError):
