@@ -128,15 +128,15 @@ def _target_notes(scenario, scene, views, none: str) -> list[str]:
     ids = scene.target_id_list
     if len(ids) < 2 or len(ids) * len(views.positions) > MAX_TARGET_TESTS:
         return []
-    boxes = _target_boxes(scene)
-    unseen = [i for i in ids if not views.meet(*voxel_box(boxes[i], scene.voxel_size)).any()]
+    boxes = {i: voxel_box(box, scene.voxel_size) for i, box in _target_boxes(scene).items()}
+    unseen = [i for i in ids if not views.meet(*boxes[i]).any()]
     if not unseen:
         return []
     named = [
         f"target {i}" + (f" {name!r}" if (name := dict(scenario.target_names).get(i)) else "") for i in unseen
     ]
     if len(unseen) == 1:
-        return [f"{none} at {named[0]} ({_box(*voxel_box(boxes[unseen[0]], scene.voxel_size))})"]
+        return [f"{none} at {named[0]} ({_box(*boxes[unseen[0]])})"]
     shown = ", ".join(named[:3]) + (f" and {len(named) - 3} more" if len(named) > 3 else "")
     return [f"{none} at {len(unseen)} of the {len(ids)} targets: {shown}"]
 
@@ -169,7 +169,7 @@ def _distance(metres: float) -> str:
 def _where(positions, lo, hi) -> str:
     """Where the scans are against the scene's box ``lo``..``hi``, across the ground."""
     low, high = positions[:, :2].min(axis=0), positions[:, :2].max(axis=0)
-    gaps = [max(lo[k] - high[k], low[k] - hi[k], 0.0) for k in range(2)]
+    gaps = _gaps(positions, lo, hi)
     if not any(gaps):
         return (
             f"the path comes over it (x {_span(low[0], high[0])}, y {_span(low[1], high[1])} against "
@@ -189,10 +189,17 @@ def _where(positions, lo, hi) -> str:
     )
 
 
+def _gaps(positions, lo, hi) -> list[float]:
+    """How far the scans lie outside the scene's box ``lo``..``hi`` in x and in y (0 where
+    they overlap it)."""
+    low, high = positions[:, :2].min(axis=0), positions[:, :2].max(axis=0)
+    return [max(lo[k] - high[k], low[k] - hi[k], 0.0) for k in range(2)]
+
+
 def _map_hint(scenario, positions, lo, hi) -> str:
     """For a path of flight logs far off the scene: how a log's positions are read."""
     logs = [seg for seg in scenario.flight.segments if seg.kind == "log"]
-    gaps = [max(lo[k] - positions[:, k].max(), positions[:, k].min() - hi[k], 0.0) for k in range(2)]
+    gaps = _gaps(positions, lo, hi)
     if not logs or math.hypot(*gaps) < FAR_FOR_MAP:
         return ""
     from pathlib import Path
