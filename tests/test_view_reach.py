@@ -34,7 +34,7 @@ def test_a_straight_down_view_meets_a_box_inside_its_cone_and_not_one_just_outsi
     assert views.meet(np.array([-1.0, -1.0, 100.5]), np.array([1.0, 1.0, 101.0])).tolist() == [False]
 
 
-def test_views_meet_a_box_exactly_when_some_ray_passes_through_it():
+def test_a_box_is_met_whenever_a_ray_passes_through_it():
     """Against every ray of the scan, slab-tested: a box a ray passes is always met (no
     scan is said to miss what it sees); boxes of both kinds are drawn."""
     rng = np.random.default_rng(7)
