@@ -68,13 +68,21 @@ def switch_field(name, value) -> bool:
     return bool(value)
 
 
+def items_or_none(value) -> list | None:
+    """The items of ``value`` as a list where it is an iterable but not text (a string
+    is an iterable of its letters, which no list field means); else None."""
+    if isinstance(value, (str, bytes)):
+        return None
+    try:
+        return list(value)
+    except TypeError:
+        return None
+
+
 def point_field(name, value):
     """A point [x, y] or [x, y, z] in metres as a float tuple of three (z = 0 if absent)."""
     expected = f"a point [x, y] or [x, y, z] in metres, each within +-{number_text(MAX_COORDINATE)}"
-    try:
-        items = None if isinstance(value, (str, bytes)) else list(value)
-    except TypeError:
-        items = None
+    items = items_or_none(value)
     if items is None or len(items) not in (2, 3):
         raise FieldError(name, value, expected)
     try:

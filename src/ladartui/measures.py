@@ -43,7 +43,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ladartui.atomic import write_errors_named, write_text_atomic
-from ladartui.checks import number_field
+from ladartui.checks import items_or_none, number_field
 from ladartui.directions import DirectionStats, angle_between, direction_stats
 from ladartui.errors import FieldError, InputFileError
 from ladartui.fileprobe import path_field
@@ -263,9 +263,10 @@ def _voxels_or_none(name, voxels):
 def _checked_scans(name, per_scan):
     if per_scan is None:
         return None
-    if isinstance(per_scan, (str, bytes)) or not hasattr(per_scan, "__iter__"):
+    scans = items_or_none(per_scan)
+    if scans is None:
         raise FieldError(name, per_scan, "a list of each scan's returns, (K, 3) voxel index arrays")
-    return [voxel_list_field(f"{name}[{scan}]", returns) for scan, returns in enumerate(per_scan)]
+    return [voxel_list_field(f"{name}[{scan}]", returns) for scan, returns in enumerate(scans)]
 
 
 def _cumulative_coverage(target_keys, per_scan) -> tuple[float, ...] | None:

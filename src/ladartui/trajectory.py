@@ -26,7 +26,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from ladartui.checks import MAX_COORDINATE, number_field, point_field
+from ladartui.checks import MAX_COORDINATE, items_or_none, number_field, point_field
 from ladartui.errors import FieldError, LadarError
 from ladartui.fileprobe import file_problem, not_utf8, path_field, refuse_special_file, text_lines
 from ladartui.fingerprint import Fingerprint, fingerprint_of
@@ -366,13 +366,8 @@ def times_field(log: FlightLog, given) -> tuple[float, ...]:
     """Scan times (seconds) checked: 1 to ``MAX_SCANS`` numbers, increasing, within the log."""
     span = f"times {_span(log)} (the log's span)"
     expected = f"a list of 1 to {MAX_SCANS} {span}"
-    if given is None or isinstance(given, (str, bytes)):
-        raise FieldError("times", given, expected)
-    try:
-        items = list(given)
-    except TypeError:
-        raise FieldError("times", given, expected) from None
-    if not 1 <= len(items) <= MAX_SCANS:
+    items = items_or_none(given)
+    if items is None or not 1 <= len(items) <= MAX_SCANS:
         raise FieldError("times", given, expected)
     try:
         times = tuple(number_field("times", t, log.time[0], log.time[-1]) for t in items)

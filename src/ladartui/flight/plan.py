@@ -26,6 +26,7 @@ from typing import ClassVar
 from ladartui.checks import (
     MAX_COORDINATE,
     choice_field,
+    items_or_none,
     number_field,
     point_field,
 )
@@ -469,9 +470,10 @@ def path_length(poses: Sequence[ScanPose]) -> float:
     This knows only the scan positions, so a turn counts its chords;
     ``FlightPlan.path_length`` measures turns and orbits along their arcs.
     """
-    if isinstance(poses, (str, bytes, ScanPose)) or not hasattr(poses, "__iter__"):
+    items = None if isinstance(poses, ScanPose) else items_or_none(poses)
+    if items is None:
         raise FieldError("poses", poses, "a list of ScanPose")
-    return sum(_chords([pose_field(f"poses[{i}]", pose) for i, pose in enumerate(poses)]))
+    return sum(_chords([pose_field(f"poses[{i}]", pose) for i, pose in enumerate(items)]))
 
 
 def flight_time(distance: float, speed: float) -> float:
