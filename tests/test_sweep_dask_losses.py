@@ -238,3 +238,32 @@ def test_waiting_for_a_worker_never_hangs_on_a_closing_scheduler(monkeypatch):
     with pytest.raises(ClusterLost, match="lost the connection to the Dask scheduler tcp://127.0.0.1:1"):
         _scatter_again(client, client.address, payload=None, cancel=None)
     assert client.calls == 3
+
+
+class _ClosingWorkerOnly(_ClosingScheduler):
+    """A closing scheduler whose one worker is closing too: the worker is still counted
+    among the cluster's threads, but a scatter finds no running worker to take the scene
+    and waits for one as long as it is let (30 s unless told)."""
+
+    def nthreads(self, workers=None, callback_timeout=None):
+        self.calls += 1
+        if callback_timeout is None or callback_timeout > 1:
+            raise AssertionError("a call to a closing scheduler with no bound on its wait")
+        return {"tcp://127.0.0.1:2": 1}  # the closing worker
+
+    def scatter(self, data, workers=None, broadcast=False, hash=True, timeout=None):
+        return self._hang(timeout)
+
+
+def test_waiting_for_a_worker_never_hangs_on_a_scatter_with_only_a_closing_worker(monkeypatch):
+    """A closing worker is counted among the threads, so the scene was scattered to the
+    cluster, which waited with no bound of the sweep's for a running worker, the sweep's
+    cancel unheeded meanwhile."""
+    from ladartui.sweep import dask_runs
+    from ladartui.sweep.dask_runs import ClusterLost, _scatter_again
+
+    monkeypatch.setattr(dask_runs, "_PROBE_SECONDS", 0.01)
+    client = _ClosingWorkerOnly()
+    with pytest.raises(ClusterLost, match="lost the connection to the Dask scheduler tcp://127.0.0.1:1"):
+        _scatter_again(client, client.address, payload=None, cancel=None)
+    assert client.calls == 4  # asked twice each: the threads, then the scatter

@@ -135,8 +135,9 @@ def _scatter_again(client, address, payload, cancel):
         asked = time.monotonic()
         try:
             if client.nthreads(callback_timeout=_PROBE_SECONDS):
-                # (a worker still closing counts here; the scatter then finds none)
-                return client.scatter(payload, broadcast=True, hash=False)
+                # (a worker still closing counts here; the scatter then waits for a
+                # running one, so its wait is bounded too: TimeoutError, asked again)
+                return client.scatter(payload, broadcast=True, hash=False, timeout=_PROBE_SECONDS)
         except (TimeoutError, OSError):  # no answer, or the connection closing under it
             pass
         if time.monotonic() >= deadline:
