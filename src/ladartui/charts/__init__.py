@@ -49,6 +49,19 @@ def save_figure(figure: Figure, path) -> Path:
     return path
 
 
+def coverage_axis(axes, peak: float, unseen: str, *, from_zero: bool) -> None:
+    """A coverage axis (in %) never below 0, starting at 0 when ``from_zero``. With
+    ``peak``, the highest coverage drawn, at 0 (nothing seen) it runs 0 to 100 % and
+    says ``unseen``: matplotlib's own axis around a flat 0 would run from -0.05 % to
+    0.05 %, a precision no run has."""
+    if peak > 0:
+        bottom, top = axes.get_ylim()
+        axes.set_ylim(0.0 if from_zero else max(bottom, 0.0), top)
+    else:
+        axes.set_ylim(0, 100)
+        axes.text(0.5, 0.5, unseen, ha="center", transform=axes.transAxes)
+
+
 @contextlib.contextmanager
 def undrawn_characters() -> Iterator[list[str]]:
     """The characters no font has (each drawn as a box) in the charts made and written

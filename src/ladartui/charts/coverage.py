@@ -14,7 +14,7 @@ from __future__ import annotations
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
-from ladartui.charts import new_figure
+from ladartui.charts import coverage_axis, new_figure
 from ladartui.measures import ENOUGH_SHARE, Measures
 
 LEVEL_COLOURS = {"detect": "tab:gray", "recognise": "tab:purple", "identify": "tab:red"}
@@ -34,10 +34,12 @@ def coverage_figure(measures: Measures, width_px: int = 800, height_px: int = 48
     axes.set_xlabel("scans flown")
     axes.set_ylabel("target coverage (%)")
     drawn = 0
+    peak = 0.0  # the highest coverage of the series drawn
     for name, attribute, color, marker in SERIES:
         after = getattr(measures, attribute)
         if not after:
             continue
+        peak = max(peak, *after)
         scans = list(range(1, len(after) + 1))
         axes.plot(
             scans, [100.0 * v for v in after], color=color, marker=marker, label=name, gid=f"series-{name}"
@@ -79,12 +81,7 @@ def coverage_figure(measures: Measures, width_px: int = 800, height_px: int = 48
     if not drawn:
         axes.text(0.5, 0.5, "no per-scan coverage in this run", ha="center", transform=axes.transAxes)
         return figure
-    seen = [v for _, attribute, _, _ in SERIES for v in getattr(measures, attribute) or ()]
-    if max(seen, default=0.0) > 0:
-        axes.set_ylim(bottom=0)
-    else:  # flat at 0: matplotlib's own axis would run to 0.05 %, a precision no run has
-        axes.set_ylim(0, 100)
-        axes.text(0.5, 0.5, "the target was not seen in any scan", ha="center", transform=axes.transAxes)
+    coverage_axis(axes, peak, "the target was not seen in any scan", from_zero=True)
     axes.xaxis.set_major_locator(MaxNLocator(integer=True))
     axes.grid(True, alpha=0.3)
     axes.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0, fontsize=8)

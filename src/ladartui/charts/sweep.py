@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from matplotlib.figure import Figure
 
-from ladartui.charts import new_figure
+from ladartui.charts import coverage_axis, new_figure
 
 COST_AXIS = {"flight-time": "flight time (s)", "distance": "path length (m)"}
 
@@ -60,12 +60,8 @@ def sweep_figure(result, width_px: int = 800, height_px: int = 480) -> Figure:
             gid="best",
             zorder=4,
         )
-    bottom, top = axes.get_ylim()
-    if max(100.0 * r.coverage for r in placed) > 0:
-        axes.set_ylim(max(bottom, 0.0), top)  # a coverage is never below 0
-    else:  # flat at 0: matplotlib's own axis would run from -0.05 % to 0.05 %
-        axes.set_ylim(0, 100)
-        axes.text(0.5, 0.5, "no variant saw the target", ha="center", transform=axes.transAxes)
+    peak = max(r.coverage for r in placed)
+    coverage_axis(axes, peak, "no variant saw the target", from_zero=False)
     axes.grid(True, alpha=0.3)
     axes.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0, fontsize=8)
     figure.tight_layout()
