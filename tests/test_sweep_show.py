@@ -45,12 +45,9 @@ def test_show_ranks_the_rows_of_the_current_base_only(tmp_path, capsys):
     run_sweep(spec, serial=True)
     base = tmp_path / "base.toml"
     base.write_text(base.read_text(encoding="utf-8").replace("fov_deg = 20.0", "fov_deg = 18.0"))
-    ran = run_sweep(spec, serial=True)
+    ran = run_sweep(spec, serial=True, charts=True)  # as the command draws them
     assert ran.ran == 2 and len(ran.rows) == 2
     out = tmp_path / "bases-results"
-    from ladartui.charts.sweep import write_sweep_charts
-
-    write_sweep_charts(ran, out)  # as the command draws them
     assert len(read_table(out / "results.csv")[0]) == 4  # both bases' rows are kept
     shown = load_sweep_results(out, spec=load_sweep_spec(spec))
     assert [r.row["variant"] for r in shown.ranking] == [r.row["variant"] for r in ran.ranking]

@@ -66,19 +66,3 @@ def sweep_figure(result, width_px: int = 800, height_px: int = 480) -> Figure:
     axes.legend(loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0, fontsize=8)
     figure.tight_layout()
     return figure
-
-
-def write_sweep_charts(result, out_dir, stem: str = "pareto") -> dict:
-    """pareto.svg and pareto.png beside results.csv; returns {format: path}."""
-    from pathlib import Path
-
-    from ladartui.atomic import write_errors_named
-    from ladartui.charts import FORMATS, save_figure
-
-    figure = sweep_figure(result)
-    written = {}
-    for fmt in FORMATS:
-        path = Path(out_dir) / f"{stem}.{fmt}"
-        with write_errors_named(path):  # one line naming the chart, not a traceback
-            written[fmt] = save_figure(figure, path)
-    return written
