@@ -187,8 +187,7 @@ class TableWriter:
         self._lines: list[str] | None = None  # formatted on the first put
         self._columns: list[str] = []
         self._known: set[str] = set()  # the columns, to look up
-        self._held = False  # rows put since the last write
-        self.unwritten = 0  # of those, how many (a row put twice counts twice)
+        self.unwritten = 0  # rows put since the last write (a row put twice counts twice)
         self._next_write = 0.0  # clock() from which a rewrite may start
         self.written = False  # whether the file was rewritten
 
@@ -220,7 +219,6 @@ class TableWriter:
             lines.append(_row_line(row, self._columns))
         else:
             lines[at] = _row_line(row, self._columns)
-        self._held = True
         self.unwritten += 1
         if self.clock() >= self._next_write:
             self.flush()
@@ -228,7 +226,7 @@ class TableWriter:
     def flush(self) -> None:
         """Write the rows held back, if any; ``OutputFileError`` naming the table when it
         cannot be written."""
-        if not self._held:  # (rows are held only once put formatted them)
+        if not self.unwritten:  # (rows are held only once put formatted them)
             return
         started = self.clock()
         with write_errors_named(self.path):
@@ -236,7 +234,7 @@ class TableWriter:
             write_text_atomic(self.path, text, durable=True)
         finished = self.clock()
         self._next_write = finished + self.spacing * (finished - started)
-        self._held, self.written, self.unwritten = False, True, 0
+        self.written, self.unwritten = True, 0
 
 
 def read_table(path, unreadable: list[int] | None = None) -> tuple[list[dict], list[str]]:
