@@ -196,25 +196,32 @@ def _report(result, out_dir) -> int:
     # fails the import and then the interpreter as it ends, where it would end quietly
     import ladartui.charts  # noqa: F401
     import ladartui.study.figure  # noqa: F401
-    from ladartui.study.run import interrupted_after_writing
+    from ladartui.study.run import interrupted_after_writing, write_outputs
 
-    written: list[dict] = []
+    paths: dict | None = None  # once in place (write_outputs tells an interrupt as it puts them)
     try:
         with sigterm_as_interrupt():
-            return _show_and_write(result, out_dir, written)
+            console = _show(result)
+            paths = write_outputs(result, out_dir, width=CHART_WIDTH, height=CHART_HEIGHT)
+            console.print(
+                single_line("wrote " + ", ".join(str(p) for p in paths.values())),
+                highlight=False,
+                markup=False,
+            )
+            return 0
     except KeyboardInterrupt:
-        if written:
-            raise Cancelled(interrupted_after_writing(written[0])) from None
+        if paths is not None:
+            raise Cancelled(interrupted_after_writing(paths)) from None
         raise Cancelled(_nothing_written(out_dir)) from None
 
 
-def _show_and_write(result, out_dir, written: list) -> int:
+def _show(result):
+    """The study's chart, table and verdict on the terminal; the console they went to."""
     from rich.table import Table
     from rich.text import Text
 
     from ladartui.cli.console import CliConsole as Console
     from ladartui.study.chart import TABLE_COLUMNS, chart_text, table_rows
-    from ladartui.study.run import write_outputs
 
     console = Console()
     if not console.is_terminal and "COLUMNS" not in os.environ:
@@ -231,9 +238,4 @@ def _show_and_write(result, out_dir, written: list) -> int:
         table.add_row(*(Text(single_line(cell)) for cell in row))  # a reason read from a file: never markup
     console.print(table)
     console.print(visible(result.verdict()), highlight=False, markup=False)
-    paths = write_outputs(result, out_dir, width=CHART_WIDTH, height=CHART_HEIGHT)
-    written.append(paths)
-    console.print(
-        single_line("wrote " + ", ".join(str(p) for p in paths.values())), highlight=False, markup=False
-    )
-    return 0
+    return console
