@@ -36,8 +36,11 @@ def timed(call: Callable[[], object], clock=time.perf_counter):
     return result, clock() - start
 
 
-# A call that compiled is run again at most this many times: a call compiles only what the
-# calls before it did not reach (a scan's other tracing order), so one more call is enough.
+# A call that compiled is run again at most this many times. A call compiles only what the
+# calls before it did not reach (a scan's other tracing order), so one more call is normally
+# enough; but the order is learned from the calls' own times, so the next call may still
+# reach a kernel none did before: two spare, and the last timed whatever it did, so a
+# compiler that goes on compiling cannot hold the study.
 RETRIES_AFTER_COMPILING = 3
 
 
