@@ -54,7 +54,7 @@ def f32_start_offsets(origins, directions, shape, top, method, at_least=None):
 
 def f32_shift(occupancy) -> np.ndarray:
     """The (x, y, 0) cell the f32 rays' cell space starts at: the corner of the
-    occupancy's root grid, a multiple of 512 cells at or below its lowest voxel
+    occupancy's root grid, a multiple of 2**REGION_SHIFT (512) cells at or below its lowest voxel
     (so every node keeps its slots, ``wgpu_occupancy.pack_params``); (0, 0, 0)
     for an empty scene. A float32 holds a coordinate near 2^k to 2^(k-23) cells:
     with voxels 2^16 cells from the rays' zero, 0.5 % of the rays into them

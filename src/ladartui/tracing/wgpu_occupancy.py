@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from ladartui.errors import BackendUnavailable
+from ladartui.scene.occupancy import BRICK_SHIFT, REGION_SHIFT
 from ladartui.tracing.config import MARCH_SAMPLES_PER_PASS, METHOD_CODES, wgsl_constants
 
 # trace.wgsl's bindings besides the occupancy chunks, which follow them: params,
@@ -184,13 +185,13 @@ def pack_params(
     ``first_sample`` and ``samples_per_pass`` bound the march's samples in this
     dispatch (see MARCH_SAMPLES_PER_PASS); ``shared_origin``: first_hits reads
     one origin for every ray. ``shift``: the (x, y) cell, a multiple of the root
-    cell's 512 (so every node's slots stay as they are), that the rays' cell
+    cell's 2**REGION_SHIFT = 512 (so every node's slots stay as they are), that the rays' cell
     space starts at: the occupancy's boxes and the scene's footprint are given
     less it (tracing/f32_rays.py, ``f32_shift``).
     """
     move = np.array([shift[0], shift[1], 0], dtype=np.int64)
-    if np.any(move % 512):
-        raise ValueError(f"shift {tuple(shift)} is not a multiple of 512 cells")
+    if np.any(move % (1 << REGION_SHIFT)):
+        raise ValueError(f"shift {tuple(shift)} is not a multiple of {1 << REGION_SHIFT} cells")
     ints = np.zeros((11, 4), dtype=np.int32)
     ints[0, :3] = occupancy.shape
     ints[1, :3] = np.asarray(occupancy.bbox_lo, dtype=np.int64) - move
@@ -202,7 +203,7 @@ def pack_params(
     ints[7, 0] = np.array(upload.bases[4], dtype=np.int64).astype(np.uint32).view(np.int32)
     ints[7, 1:4] = (first_sample, samples_per_pass, int(shared_origin))
     cube_origin, cube_dims = cube_box(occupancy)
-    ints[8, :3] = cube_origin - (move >> 3)
+    ints[8, :3] = cube_origin - (move >> BRICK_SHIFT)  # the cubes are in bricks
     ints[8, 3] = np.array(upload.bases[5], dtype=np.int64).astype(np.uint32).view(np.int32)
     ints[9, :3] = cube_dims
     # The scene's footprint [0, nx) x [0, ny) in the rays' cell space.
