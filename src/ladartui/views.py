@@ -269,10 +269,7 @@ class TopView:
         if path is not None and len(path) >= 2:
             draw_polyline(picture, self.to_pixels(path, rows, cols, frame), PATH_RGB)
         if scans is not None and len(scans):
-            pix = self.to_pixels(scans, rows, cols, frame)
-            side = marker_side(rows, cols)
-            draw_points(picture, pix, SCAN_RGB, side)
-            draw_points(picture, pix[:1], START_RGB, side)
+            draw_scan_markers(picture, self.to_pixels(scans, rows, cols, frame))
         return picture
 
 
@@ -314,6 +311,14 @@ def marker_side(rows: int, cols: int) -> int:
     """The side of a scan's square marker: one pixel at the terminal's sizes (half a
     cell), more in a large picture (5 in a 1200 x 800 PNG), where one would be lost."""
     return max(1, min(rows, cols) // MARKER_PIXELS)
+
+
+def draw_scan_markers(picture: Picture, pixels) -> None:
+    """The scans' square markers at ``pixels`` ((N, 2) row, col), the first one marked
+    as the start, sized for the picture (``marker_side``)."""
+    side = marker_side(*picture.shape)
+    draw_points(picture, pixels, SCAN_RGB, side)
+    draw_points(picture, pixels[:1], START_RGB, side)
 
 
 def draw_points(picture: Picture, pixels, rgb, side: int = 1) -> None:

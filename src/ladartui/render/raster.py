@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ladartui import colour
-from ladartui.views import Camera, Picture, draw_points, draw_polyline, marker_side, project_float
+from ladartui.views import Camera, Picture, draw_polyline, draw_scan_markers, project_float
 
 MAX_SPLAT_SAMPLES = 6_000_000  # pixel writes per render; squares shrink beyond it
 OVERLAYS = ("path", "scans", "footprints")
@@ -175,7 +175,4 @@ def draw_flight(image: Rendering, overlays: Overlays, camera: Camera, bounds) ->
     if "path" in shown and overlays.path is not None and len(overlays.path) >= 2:
         draw_polyline(image, _pixels(overlays.path, camera, image, bounds), colour.PATH_RGB)
     if "scans" in shown and overlays.scans is not None and len(overlays.scans):
-        pix = _pixels(overlays.scans, camera, image, bounds)
-        side = marker_side(*image.shape)
-        draw_points(image, pix, colour.SCAN_RGB, side)
-        draw_points(image, pix[:1], colour.START_RGB, side)
+        draw_scan_markers(image, _pixels(overlays.scans, camera, image, bounds))
