@@ -75,15 +75,17 @@ def write_ranked_set(result: SweepResult, name: str, base, scene_loader, charts:
             out / f"{name}-best.toml", base, result.best.row, result.parameter_names, scene_loader
         )
         paths["best"], contents["best"] = best.path, text.encode("utf-8")
+    chart_paths: dict[str, Path] = {}
     if charts:
         from ladartui.charts import FORMATS, figure_bytes
         from ladartui.charts.sweep import sweep_figure
 
         figure = sweep_figure(result)
-        for fmt in FORMATS:
-            paths[fmt], contents[fmt] = out / f"{CHART_STEM}.{fmt}", figure_bytes(figure, fmt)
+        chart_paths = {fmt: out / f"{CHART_STEM}.{fmt}" for fmt in FORMATS}
+        paths.update(chart_paths)
+        contents.update({fmt: figure_bytes(figure, fmt) for fmt in FORMATS})
     try:
-        with OutputSet(paths, out / SET_LOCK_NAME) as output_set:
+        with OutputSet(paths, set_lock(out)) as output_set:
             output_set.write_contents(contents)
     except OutputFileError as error:  # the rows are kept: what to do to rank them
         rows = plural(len(result.rows), "variant")
@@ -93,7 +95,7 @@ def write_ranked_set(result: SweepResult, name: str, base, scene_loader, charts:
             "the same command ranks them, running none again",
         ) from None
     result.ranking_path = paths["ranking"]
-    result.charts = {fmt: path for fmt, path in paths.items() if fmt not in ("ranking", "best")}
+    result.charts = chart_paths
     if best is not None:
         result.best_scenario_path, result.best_kept, result.best_kept_why = (
             best.path,
