@@ -400,15 +400,15 @@ fn last_sample_on_axis(o: real, d: real, lo_face: real, hi_face: real, t_s: real
 }
 
 // The last sample certain to stay in the empty node of 1 << shift cells a side holding
-// cell c and in the scene's box [lo.x, box.x) x [lo.y, box.y) x [0, box.z) (below the
+// cell c and in the scene's box [lo.x, box.x) x [lo.y, box.y) x [lo.z, box.z) (below the
 // current sample when no later one is).
-fn last_sample_in_node(c: vec3<i32>, shift: u32, o: vec3<real>, d: vec3<real>, t_s: real, step: real, lo: vec2<real>, box: vec3<real>, samples: i32) -> i32 {
+fn last_sample_in_node(c: vec3<i32>, shift: u32, o: vec3<real>, d: vec3<real>, t_s: real, step: real, lo: vec3<real>, box: vec3<real>, samples: i32) -> i32 {
     let size = real(1 << shift);
     let b = vec3<real>((c >> vec3<u32>(shift)) << vec3<u32>(shift));
     let cap = real(samples - 1);
     let kx = last_sample_on_axis(o.x, d.x, max(b.x, lo.x), min(b.x + size, box.x), t_s, step, cap);
     let ky = last_sample_on_axis(o.y, d.y, max(b.y, lo.y), min(b.y + size, box.y), t_s, step, cap);
-    let kz = last_sample_on_axis(o.z, d.z, max(b.z, 0.0), min(b.z + size, box.z), t_s, step, cap);
+    let kz = last_sample_on_axis(o.z, d.z, max(b.z, lo.z), min(b.z + size, box.z), t_s, step, cap);
     let last = min(kx, min(ky, kz));
     if (last >= 1.0) {
         return i32(last) - 1;
@@ -491,7 +491,7 @@ fn march_one(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real) -> Hit 
                 // An empty node: on past its samples (none of them ends the ray).
                 let o = vec3<real>(ox, oy, oz);
                 let d = vec3<real>(dx, dy, dz);
-                k = max(k, last_sample_in_node(c, empty, o, d, t_s, step, vec2<real>(x0, y0), vec3<real>(x1, y1, top), last));
+                k = max(k, last_sample_in_node(c, empty, o, d, t_s, step, vec3<real>(x0, y0, 0.0), vec3<real>(x1, y1, top), last));
                 continue;
             }
             let bit = slot(c.x, c.y, c.z, 0u);
