@@ -478,3 +478,20 @@ async def test_the_study_screen_offers_cancel_only_while_a_study_runs(tmp_path, 
         shown = {key.action for key in screen.query(FooterKey)}
         assert "cancel" not in shown and {"run('quick')", "close"} <= shown
         assert "Ctrl+X" not in str(screen.query_one("#study-status StatusText").render())
+
+
+async def test_a_failed_studys_note_writes_out_a_control_character(tmp_path, scene_files, monkeypatch):
+    """A study's error naming a file whose name holds a terminal escape reached the
+    note raw: every note, not only those told through the app, writes controls out."""
+    import ladartui.study.run as study_run
+    from ladartui.errors import LadarError
+
+    def failing(*args, **kwargs):
+        raise LadarError("cannot read /tmp/bad\x1b[31mname")
+
+    monkeypatch.setattr(study_run, "run_study", failing)
+    async with study_screen(tmp_path, scene_files, size=(120, 40)) as (app, pilot, screen):
+        await pilot.press("q")
+        await wait_until(pilot, lambda: any("Study failed" in note.message for note in app._notifications))
+        note = next(note.message for note in app._notifications if "Study failed" in note.message)
+        assert note == "Study failed: cannot read /tmp/bad\\x1b[31mname"

@@ -13,6 +13,7 @@ from textual.notifications import Notification, Notifications, SeverityLevel
 from textual.screen import ModalScreen, Screen
 from textual.widgets._toast import ToastRack  # (the rack of each screen: no public name)
 
+from ladartui.textsafe import single_line, visible
 from ladartui.tui.host import Host
 
 
@@ -36,6 +37,8 @@ class NoteKeeping(Host):
         markup: bool = True,
     ) -> None:
         seconds = self.NOTIFICATION_TIMEOUT if timeout is None else timeout
+        if not markup:  # text from files and fields: its controls written out, its lines kept
+            message, title = visible(message), single_line(title)
         if self._dialog_open():
             self.notes_held.append(Notification(message, title, severity, seconds, markup))
             return
