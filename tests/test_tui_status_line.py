@@ -264,3 +264,29 @@ async def test_a_scenario_name_holding_control_characters_is_shown_escaped(
         await app.run_action("save")
         await pilot.pause()
         assert app.messages[-1] == f"Saved {tmp_path}/{shown}.toml", app.messages[-1]
+
+
+async def test_a_message_its_written_out_controls_make_too_long_is_told_whole():
+    """A message holding a terminal escape was measured raw, where the escape takes no
+    cell, but shown written out (four cells): cut on the line, it was judged to fit and
+    said nowhere whole."""
+    from textual.app import App
+
+    from ladartui.tui.status import NOT_READY
+
+    told: list[str] = []
+
+    class Bar(App):
+        def compose(self):
+            yield StatusBar(tell=told.append)
+
+    app = Bar()
+    async with app.run_test(size=(80, 3)) as pilot:
+        await pilot.pause()
+        bar = app.query_one(StatusBar)
+        room = app.query_one("#status-text").content_size.width
+        message = "a" * (room - 1) + "\x1b" + "b"  # raw: room cells; written out: room + 4
+        bar.show(NOT_READY, message)
+        await pilot.pause()
+        assert told == ["a" * (room - 1) + "\\x1bb"]
+        assert bar.message == told[0]

@@ -31,7 +31,7 @@ from ladartui.run_record import (
     run_inputs,
 )
 from ladartui.scenario_file import record_owner
-from ladartui.textsafe import visible
+from ladartui.textsafe import single_line, visible
 from ladartui.tui import actions, bridge
 from ladartui.tui.host import Host
 from ladartui.tui.status import StatusBar
@@ -261,7 +261,7 @@ class SceneLoading(Host):
         if change is not None:
             problem = self.scenario_file_problem()
             self.tell(f"{problem}.", severity="warning", timeout=8)
-            self.query_one("#status", StatusBar).told = problem  # told: not again as a cut line
+            self.query_one("#status", StatusBar).told = single_line(problem)  # told: not again as a cut line
         self.scenario_changed()
 
     def check_inputs_on_disk(self) -> None:

@@ -44,9 +44,8 @@ class StatusText(Static):
         self.name_shown: str | None = None
 
     def show(self, message: str, name: str | None = None) -> None:
-        # one line: a name's controls (a newline, a terminal escape) are written out
-        self.message = single_line(message)
-        self.name_shown = single_line(name) if name is not None else None
+        """``message`` and ``name`` as one line each (``StatusBar.show`` writes them so)."""
+        self.message, self.name_shown = message, name
         self.refresh()
 
     def render(self) -> Text:
@@ -103,6 +102,10 @@ class StatusBar(Horizontal):
         """Show ``state`` with ``message``; ``progress`` 0..1 adds a percentage; ``name``
         (the scenario's, in the message) is what gets shortened when the line is short;
         ``said``: the message was just said whole elsewhere, so a cut is not told again."""
+        # one line: a name's controls (a newline, a terminal escape) are written out, before
+        # the message is measured against the line (an escape takes no cell, written out four)
+        message = single_line(message)
+        name = single_line(name) if name is not None else None
         for label in LABELS:
             self.set_class(label == state, f"-{label}")
         self.state, self.message, self.progress = state, message, progress

@@ -242,10 +242,8 @@ class StudyScreen(Screen):
     ) -> None:
         """``said``: the message was just said whole in a note of its own."""
         # it may name files: shown as text, the scenario's path shortened first
-        path = visible(str(self.scenario_path)) if self.scenario_path else None
-        self.query_one("#study-status", StatusBar).show(
-            state, visible(message), progress, name=path, said=said
-        )
+        path = str(self.scenario_path) if self.scenario_path else None
+        self.query_one("#study-status", StatusBar).show(state, message, progress, name=path, said=said)
 
 
 def _study(mode: str, scenario_path, scans, runs, cancel, progress):
