@@ -18,12 +18,12 @@ from textual.widgets import Button, DirectoryTree, Input, RadioButton, RadioSet,
 
 from ladartui.errors import FieldError, LadarError
 from ladartui.fileprobe import user_path
-from ladartui.textsafe import visible
+from ladartui.textsafe import single_line
 from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField, in_label_unit, refusal
 from ladartui.tui.file_tree import SCENARIO_TABLE
 from ladartui.tui.host import host_of
-from ladartui.tui.plain_text import PathInput, PlainStatic, literal
+from ladartui.tui.plain_text import PathInput, PlainStatic
 from ladartui.tui.screens import TreeDialog, _row
 
 SCENARIO_SUFFIXES = (".toml",)
@@ -101,7 +101,7 @@ class SetupScreen(TreeDialog):
                     id="voxel-size",
                 ),
             )
-            yield Static("", id="derived", classes="info")
+            yield PlainStatic("", id="derived", classes="info")
             yield PlainStatic("", id="setup-message", classes="message")
             with Horizontal(classes="buttons"):
                 yield Button("OK", id="setup-ok", variant="primary", compact=True)
@@ -166,7 +166,7 @@ class SetupScreen(TreeDialog):
         scenario_path, scene_path = self._paths()
         if self.mode == "new":
             names = bridge.derived_names(scenario_path, scene_path)
-            text = literal("\n".join(f"{label:<26}{visible(value)}" for label, value in names))
+            text = "\n".join(f"{label:<26}{single_line(value)}" for label, value in names)
         else:
             text = (
                 "Every model file of the scenario is checked before anything is loaded; "

@@ -24,7 +24,7 @@ from ladartui.measures_compare import (
 from ladartui.textsafe import single_line
 from ladartui.tui.file_tree import FileTree
 from ladartui.tui.measures_view import level_rows, measure_rows, target_rows
-from ladartui.tui.plain_text import PathInput, PlainStatic, literal
+from ladartui.tui.plain_text import PathInput, PlainStatic
 from ladartui.tui.screens import Dialog, TreeDialog, _row
 
 
@@ -105,7 +105,7 @@ class CompareScreen(TreeDialog):
                 "to drop one); Enter compares. Green best, red worst, yellow differs.",
                 classes="info",
             )
-            yield Static("", id="compare-message", classes="message")
+            yield PlainStatic("", id="compare-message", classes="message")
             yield DataTable(id="compare-table", zebra_stripes=True)
             with Horizontal(classes="buttons"):
                 yield Button("Compare", id="compare-go", compact=True, variant="primary")
@@ -155,9 +155,9 @@ class CompareScreen(TreeDialog):
             # a scenario stands for its last run's measures: say so where it has changed since
             loaded, notes = read_compared(paths)
         except LadarError as error:
-            message.update(literal(str(error)))
+            message.update(str(error))
             return
-        message.update(literal(" ".join(f"Note: {note}" for note in notes)))
+        message.update(" ".join(f"Note: {note}" for note in notes))
         table.add_column("Measure")
         for name in column_names([Path(t) for t in text]):
             table.add_column(Text(single_line(name)))  # names from files: never markup, controls written out

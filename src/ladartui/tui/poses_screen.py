@@ -15,7 +15,7 @@ from textual.widgets import Button, DataTable, Input, Label, Static
 from ladartui.errors import FieldError, LadarError
 from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField, in_label_unit, refusal
-from ladartui.tui.plain_text import literal
+from ladartui.tui.plain_text import PlainStatic
 from ladartui.tui.screens import Dialog, field_matches
 
 
@@ -61,7 +61,7 @@ class PosesScreen(Dialog):
                         check=self._checker(name),
                         id=f"p-{name}",
                     )
-            yield Static("", id="poses-message", classes="message")
+            yield PlainStatic("", id="poses-message", classes="message")
             with Horizontal(classes="buttons"):
                 yield Button("Apply row", id="pose-apply", compact=True)
                 yield Button("Add", id="pose-add", compact=True)
@@ -143,7 +143,7 @@ class PosesScreen(Dialog):
             widget.add_class("-bad")
             label = self.LABELS[widget.field_name]
             expected = in_label_unit(label, problem.split("expected ", 1)[-1])
-            self.query_one("#poses-message", Static).update(literal(refusal(label, widget.value, expected)))
+            self.query_one("#poses-message", Static).update(refusal(label, widget.value, expected))
         return problem is None
 
     def _refused(self) -> bool:
@@ -177,7 +177,7 @@ class PosesScreen(Dialog):
         try:
             pose = bridge.make_pose({c: self._raw(c) for c in self.COLUMNS})
         except LadarError as error:
-            message.update(literal(str(error)))
+            message.update(str(error))
             return False
         row = self.query_one(DataTable).cursor_row if row is None else row
         if 0 <= row < len(self.poses):

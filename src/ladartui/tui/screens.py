@@ -25,7 +25,7 @@ from ladartui.fileprobe import user_path
 from ladartui.tui import bridge
 from ladartui.tui.fields import NumberField, format_number, in_label_unit, parse_number, refusal
 from ladartui.tui.file_tree import FileTree
-from ladartui.tui.plain_text import PlainStatic, literal
+from ladartui.tui.plain_text import PlainStatic
 
 
 class PathSuggester(Suggester):
@@ -204,7 +204,7 @@ class FormScreen(Dialog):
                     yield _row(label, widget)
             if self.note:
                 yield Static(self.note, classes="info")
-            yield Static("", id="form-message", classes="message")
+            yield PlainStatic("", id="form-message", classes="message")
             with Horizontal(classes="buttons"):
                 yield Button("OK", id="form-ok", variant="primary", compact=True)
                 yield Button("Cancel", id="form-cancel", compact=True)
@@ -294,7 +294,7 @@ class FormScreen(Dialog):
         if expected.startswith("an integer"):  # the form's word for it, as in the sidebar
             expected = "a whole number" + expected.removeprefix("an integer")
         expected = in_label_unit(label, expected)
-        self.query_one("#form-message", Static).update(literal(refusal(label, widget.value, expected)))
+        self.query_one("#form-message", Static).update(refusal(label, widget.value, expected))
 
     @on(Input.Changed)
     def _typing(self, event: Input.Changed) -> None:
@@ -328,7 +328,7 @@ class FormScreen(Dialog):
                     if isinstance(wrong, Input):
                         self._refuse(wrong, name, error.expected)
                         return
-            self.query_one("#form-message", Static).update(literal(str(error)))
+            self.query_one("#form-message", Static).update(str(error))
             return
         self.cancelled = False
         self.dismiss(result)
