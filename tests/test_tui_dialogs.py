@@ -378,3 +378,23 @@ def test_new_on_a_survey_s_point_cloud_gives_the_command_that_makes_a_scene_of_i
         f"{cloud}: scene model file is a LAS point cloud (.las); expected a scene model (.txt): make one "
         f"from it with 'ladartui voxelize {cloud} {tmp_path / 'survey'} --voxel-size 0.5'"
     )
+
+
+async def test_the_unsaved_question_keeps_a_file_names_newline_on_its_line():
+    """What was being done named a file whose name holds a newline: the question broke
+    in two there. Both the name and what is being done are written out on one line."""
+    from textual.app import App
+
+    from ladartui.tui.unsaved import QuitRunScreen, UnsavedScreen
+
+    app = App()
+    async with app.run_test(size=(200, 24)) as pilot:
+        app.push_screen(UnsavedScreen("a\nb.toml", "open /tmp/c\nd.toml"))
+        await pilot.pause()
+        said = str(app.screen.query_one("Static").render())
+        assert said == "a\\x0ab.toml has unsaved edits. Save them before you open /tmp/c\\x0ad.toml?", said
+        app.pop_screen()
+        app.push_screen(QuitRunScreen("a\x1b[31mb.toml", None))
+        await pilot.pause()
+        said = str(app.screen.query_one("#quit-run-question").render())
+        assert said.startswith("A run of a\\x1b[31mb.toml is going on. Quit"), said

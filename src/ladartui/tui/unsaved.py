@@ -13,13 +13,13 @@ from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.screen import ModalScreen
-from textual.widgets import Button, Static
+from textual.widgets import Button
 
 from ladartui.errors import LadarError
 from ladartui.textsafe import single_line
 from ladartui.tui.host import Host
 from ladartui.tui.params import ParamField, field_message
-from ladartui.tui.plain_text import literal
+from ladartui.tui.plain_text import PlainStatic
 
 Answer = TypeVar("Answer")
 
@@ -48,15 +48,16 @@ class UnsavedScreen(QuestionScreen[str | None]):
         self.scenario_name, self.doing, self.rereads = name, doing, rereads
 
     def compose(self) -> ComposeResult:
-        name = literal(single_line(self.scenario_name))
+        name = self.scenario_name
+        if self.rereads:
+            question = (
+                f"{name} has unsaved edits, and opening it reads the file again: they would be "
+                "lost. Discard them, or Cancel (Save As keeps them under another name)."
+            )
+        else:
+            question = f"{name} has unsaved edits. Save them before you {self.doing}?"
         with Vertical():
-            if self.rereads:
-                yield Static(
-                    f"{name} has unsaved edits, and opening it reads the file again: they would be "
-                    "lost. Discard them, or Cancel (Save As keeps them under another name)."
-                )
-            else:
-                yield Static(f"{name} has unsaved edits. Save them before you {literal(self.doing)}?")
+            yield PlainStatic(single_line(question))
             with Horizontal():
                 if not self.rereads:
                     yield Button("Save", id="unsaved-save", variant="primary", compact=True)
@@ -84,11 +85,12 @@ class QuitRunScreen(QuestionScreen[bool]):
     def compose(self) -> ComposeResult:
         done = f" ({100 * self.progress:.0f}%)" if self.progress is not None else ""
         with Vertical():
-            yield Static(
-                f"A run of {single_line(self.scenario_name)} is going on{done}. Quit and cancel it? "
-                "The outputs on disk stay as they were.",
+            yield PlainStatic(
+                single_line(
+                    f"A run of {self.scenario_name} is going on{done}. Quit and cancel it? "
+                    "The outputs on disk stay as they were."
+                ),
                 id="quit-run-question",
-                markup=False,
             )
             with Horizontal():
                 yield Button("Keep running", id="quit-run-keep", variant="primary", compact=True)
