@@ -8,10 +8,15 @@ imports) so the CLI and the TUI both use it.
 MAX_MESSAGE_CHARS = 400
 
 
+# The code points written out: C0 and C1 controls, DEL, the line and paragraph
+# separators, and lone surrogates (a file name's byte that is not UTF-8, which a strict
+# stdout refuses). The TUI's path fields show the same ones as pictures.
+CONTROL_CODES = frozenset((*range(0x20), *range(0x7F, 0xA0), 0x2028, 0x2029, *range(0xD800, 0xE000)))
+
+
 def _visible(char: str) -> str:
     code = ord(char)
-    # (a lone surrogate: a file name's byte that is not UTF-8, which a strict stdout refuses)
-    if code < 0x20 or 0x7F <= code < 0xA0 or code in (0x2028, 0x2029) or 0xD800 <= code < 0xE000:
+    if code in CONTROL_CODES:
         return f"\\x{code:02x}" if code < 0x100 else f"\\u{code:04x}"
     return char
 

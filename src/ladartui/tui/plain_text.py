@@ -15,7 +15,7 @@ from rich.text import Text
 from textual.visual import VisualType
 from textual.widgets import Input, Static
 
-from ladartui.textsafe import visible
+from ladartui.textsafe import CONTROL_CODES, visible
 
 
 def literal(text: object) -> str:
@@ -41,8 +41,8 @@ def _written_out(content: VisualType) -> VisualType:
 
 # Each control character as one printable one (ESC as the picture of ESC), so that a
 # field's cursor keeps its place over the value it shows.
-_PICTURES = {code: 0x2400 + code for code in range(0x20)} | {0x7F: 0x2421}
-_PICTURES |= {code: 0xFFFD for code in (*range(0x80, 0xA0), 0x2028, 0x2029, *range(0xD800, 0xE000))}
+# (the controls messages write out; those without a picture of their own as U+FFFD)
+_PICTURES = {code: 0x2400 + code if code < 0x20 else 0xFFFD for code in CONTROL_CODES} | {0x7F: 0x2421}
 
 
 class PathInput(Input):
