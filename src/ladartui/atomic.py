@@ -158,3 +158,8 @@ def numbered_paths(path, most: int | None = None):
     while most is None or number <= most:
         yield path.with_name(f"{path.stem}-{number}{path.suffix}")
         number += 1
+
+
+def unused_path(path) -> Path:
+    """``path``, or the first of ``STEM-2.SUFFIX``, ``STEM-3.SUFFIX``, ... not on disk."""
+    return next(candidate for candidate in numbered_paths(path) if not candidate.exists())

@@ -24,6 +24,7 @@ from textual.notifications import SeverityLevel
 from textual.screen import ModalScreen, Screen
 from textual.widgets import Button, Footer, TabbedContent, TabPane, Tabs
 
+from ladartui.atomic import unused_path
 from ladartui.edit_history import EditHistory
 from ladartui.measures_compare import measures_files_to_offer
 from ladartui.run_record import setting_changes
@@ -588,10 +589,3 @@ def named_changes(changes: list[str], shown: int = 2) -> str:
         return ""
     more = len(changes) - shown
     return ": " + "; ".join(changes[:shown]) + (f"; and {more} more" if more > 0 else "")
-
-
-def unused_path(path: Path) -> Path:
-    """``path``, or the first of ``STEM-2.SUFFIX``, ``STEM-3.SUFFIX``, ... not on disk."""
-    from ladartui.atomic import numbered_paths
-
-    return next(candidate for candidate in numbered_paths(path) if not candidate.exists())

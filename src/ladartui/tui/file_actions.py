@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from pathlib import Path
 
-from ladartui.atomic import numbered_paths, write_text_atomic
+from ladartui.atomic import unused_path, write_text_atomic
 from ladartui.errors import LadarError, os_reason
 from ladartui.recent import remember_scenario
 from ladartui.tui import bridge
@@ -36,7 +36,7 @@ class FileActions(Host):
         target = Path(path) if path else self._folder()
         target /= filename or f"{stem}-screen.svg"
         if not filename:  # beside an earlier picture, never over it
-            target = next(candidate for candidate in numbered_paths(target) if not candidate.exists())
+            target = unused_path(target)
         try:
             write_text_atomic(target, self.export_screenshot())
         except OSError as error:
