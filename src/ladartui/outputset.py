@@ -68,14 +68,19 @@ def check_names(*paths, extra: int = TEMPORARY_EXTRA, advice: str = "") -> None:
             raise OutputFileError(path, problem + advice)
 
 
+def not_a_file(folder: bool) -> str:
+    """What is wrong with an output name that a folder (``folder``) or a special file holds."""
+    return f"{'is a folder' if folder else SPECIAL_FILE}, expected a file name"
+
+
 def output_problem(path) -> str | None:
     """None when ``path`` can be written as a file; else what is wrong, in words."""
     path = Path(path)
     try:
         if path.is_dir():
-            return "is a folder, expected a file name"
+            return not_a_file(folder=True)
         if path.exists() and not path.is_file():  # a pipe would be replaced, a device written over
-            return f"{SPECIAL_FILE}, expected a file name"
+            return not_a_file(folder=False)
         problem = name_problem(path)
         if problem:
             return problem

@@ -19,8 +19,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from ladartui.errors import LadarError
-from ladartui.fileprobe import SPECIAL_FILE
 from ladartui.fingerprint import file_fingerprint
+from ladartui.outputset import not_a_file
 from ladartui.recent import remember_scenario
 from ladartui.run_record import (
     input_changes,
@@ -548,18 +548,17 @@ def outputs_with(scenario, measures: os.stat_result | None) -> OutputFiles:
         scenario.target_output: _file_status(scenario.target_output),
         scenario.measures_file: measures,
     }
+    if swap_interrupted(scenario):
+        return OutputFiles(readable=False, missing=[], seen=_stamp(measures), interrupted=True)
     is_file = {path: status is not None and stat.S_ISREG(status.st_mode) for path, status in found.items()}
     blocked = next(
         (
-            f"output {path.name} {'is a folder' if stat.S_ISDIR(status.st_mode) else SPECIAL_FILE}, "
-            "expected a file name"
+            f"output {path.name} {not_a_file(folder=stat.S_ISDIR(status.st_mode))}"
             for path, status in found.items()
             if status is not None and not is_file[path]
         ),
         None,
     )
-    if swap_interrupted(scenario):
-        return OutputFiles(readable=False, missing=[], seen=_stamp(measures), interrupted=True)
     return OutputFiles(
         readable=is_file[scenario.scene_output] and is_file[scenario.measures_file],
         missing=missing_outputs(scenario, is_file.__getitem__),
