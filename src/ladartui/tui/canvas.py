@@ -430,10 +430,11 @@ class ProjectionWidget(PictureWidget):
         self.voxel_size = 1.0
         self.camera = Camera()
         self.height_top: float | None = None  # top of the height shading (voxel layers), shared by views
-        self.pending_fit = None  # a box and points to frame once the widget has a size
-        # the box and points the camera frames, kept framed as the view is resized, until
-        # the camera is moved (None: the analyst's own camera, kept as it is)
+        # the box and points the camera frames, framed again for each new picture size
+        # (a view first drawn, or resized) until the camera is moved (None: the analyst's
+        # own camera, kept as it is); framed_for: the (rows, cols) it was framed for
         self.fitted = None
+        self.framed_for: tuple[int, int] | None = None
         self._drag: tuple[int, int] | None = None
         self.placeholder = "nothing to show yet"
         self._update_title()
@@ -467,8 +468,7 @@ class ProjectionWidget(PictureWidget):
 
     def set_camera(self, camera: Camera) -> None:
         self.camera = camera
-        self.pending_fit = None
-        self.fitted = None
+        self.fitted = self.framed_for = None
         self._update_title()
         self.invalidate()
         self.post_message(self.CameraChanged(self))
@@ -481,8 +481,9 @@ class ProjectionWidget(PictureWidget):
             return
         if rows and cols:
             self.set_camera(framing.fit_camera(self.camera, box, rows, cols, self.bounds, points=points))
-        else:
-            self.pending_fit = (box, points)
+            self.framed_for = (rows, cols)
+        else:  # framed when first drawn
+            self.framed_for = None
             self.invalidate()
         self.fitted = (box, points)
 
@@ -491,13 +492,6 @@ class ProjectionWidget(PictureWidget):
         self.fit_box(self.bounds, self.markers)
 
     def on_resize(self, event: events.Resize) -> None:
-        # a fit made for the old shape can cut off what it framed in the new one (a tall
-        # box fitted in a narrow view): framed again, at the same angles
-        rows, cols = self.picture_size()
-        if self.fitted is not None and self.pending_fit is None and self.bounds is not None and rows and cols:
-            box, points = self.fitted
-            self.camera = framing.fit_camera(self.camera, box, rows, cols, self.bounds, points=points)
-            self.invalidate()
         super().on_resize(event)
         self._update_title()
 
@@ -524,15 +518,15 @@ class ProjectionWidget(PictureWidget):
         what a fitted view frames in that shape, leaving the view's camera as it is."""
         if not self.voxel_layers or self.bounds is None:
             return None
-        if self.pending_fit is not None:
-            box, points = self.pending_fit
-            self.camera = framing.fit_camera(self.camera, box, rows, cols, self.bounds, points=points)
-            self.pending_fit = None
-            self._update_title()
         camera = self.camera
-        if refit and self.fitted is not None:
+        # a fit made for another shape can cut off what it framed in this one (a tall box
+        # fitted in a narrow view): framed again, at the same angles
+        if self.fitted is not None and (refit or self.framed_for != (rows, cols)):
             box, points = self.fitted
             camera = framing.fit_camera(camera, box, rows, cols, self.bounds, points=points)
+            if not refit:  # the view itself, first drawn or resized
+                self.camera, self.framed_for = camera, (rows, cols)
+                self._update_title()
         self.overlays.shown = self.shown_overlays
         return render(
             self.voxel_layers,

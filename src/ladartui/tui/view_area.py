@@ -102,7 +102,7 @@ class ViewArea(Container):
             # a new scene: keep the angles, frame the scene again (a centre or a pending
             # fit of the old one would point elsewhere), and its path once it is drawn
             widget.camera = Camera(widget.camera.azimuth, widget.camera.elevation)
-            widget.pending_fit = widget.fitted = None
+            widget.fitted = widget.framed_for = None
             widget._update_title()
         self.path_unframed = True
         self.query_one("#scene3d", ProjectionWidget).set_layers(
@@ -340,7 +340,7 @@ class ViewArea(Container):
         for widget in self.query(ProjectionWidget):
             if widget is not message.widget and widget.camera != message.widget.camera:
                 widget.camera = message.widget.camera
-                widget.pending_fit = None
                 widget.fitted = message.widget.fitted  # framed again when resized, or not
+                widget.framed_for = widget.picture_size()  # (as it is: the camera shared)
                 widget._update_title()
                 widget.invalidate()
