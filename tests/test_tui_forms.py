@@ -142,6 +142,29 @@ async def test_a_new_scenario_whose_scene_cannot_be_read_comes_back_at_its_scene
         assert scene_field.value == "forest.txt"
 
 
+async def test_a_scene_model_named_after_the_new_scenario_still_gets_the_focus(tmp_path, scene_files):
+    """The field was chosen by whether the error began with the scenario's path: a scene
+    model fresh.toml.txt beside a new fresh.toml read as the scenario file's error."""
+    from ladartui.tui.file_dialogs import SetupScreen
+
+    scenario = make_scenario(tmp_path, scene_files)
+    (tmp_path / "fresh.toml.txt").write_text("1,2,3\n1,2,abc\n", encoding="utf-8")
+    (tmp_path / "fresh.toml_Target.txt").write_text("1,2,3\n", encoding="utf-8")
+    async with opened(scenario) as (app, pilot):
+        dialog = await screen_after(pilot, "f2", SetupScreen)
+        await pilot.press(*"fresh", "tab", *"fresh.toml.txt", "tab", "ctrl+u", *"0.25", "enter")
+        await wait_until(
+            pilot,
+            lambda: app.busy is None and isinstance(app.screen, SetupScreen) and app.screen is not dialog,
+            60,
+        )
+        again = app.screen
+        await wait_until(pilot, lambda: again.is_mounted, 10)
+        await pilot.pause()
+        assert message(again, "#setup-message").startswith(f"{tmp_path / 'fresh.toml.txt'}:2: ")
+        assert app.focused is again.query_one("#scene-file"), app.focused
+
+
 async def test_a_scene_model_name_holding_a_terminal_escape_is_said_written_out(tmp_path, scene_files):
     """Open on a scenario whose scene = "sm\\u001b[2Jall.txt" (a model not there) said so
     with the escape raw: the terminal cleared the screen under the dialog."""

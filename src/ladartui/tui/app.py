@@ -520,7 +520,7 @@ class LadarApp(
                     # a recent scenario deleted since leaves the list (it lists files there are)
                     self.file_panel.show_recent(self.scenario.path if self.scenario else None)
                 if message.job == "new" and message.error:
-                    self.new_refused(message.error)
+                    self.new_refused(message.error, message.error_path)
         elif message.job == "probe":
             self.backends_probed(
                 message.result

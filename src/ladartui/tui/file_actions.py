@@ -74,14 +74,14 @@ class FileActions(Host):
 
         self.push_screen(setup, done)
 
-    def new_refused(self, error: str) -> None:
+    def new_refused(self, error: str, error_path: str | None = None) -> None:
         """A new scenario whose scene could not be read (nothing was written): its form
-        again, as it was typed, saying why."""
+        again, as it was typed, saying why (``error_path``: the file the error is about)."""
         if self.new_pending is not None:
             folder, typed, path = self.new_pending
             # the field to put right has the focus: the scenario file's, where it could not
             # be written, else the scene model's (a bad line, too large, its target model)
-            field = "scenario-file" if error.startswith(str(path)) else "scene-file"
+            field = "scenario-file" if error_path is not None and Path(error_path) == path else "scene-file"
             self._open_setup("new", folder, typed, error, field)
 
     def open_path(self, path: Path, before: Callable[[], None] | None = None) -> None:

@@ -177,7 +177,7 @@ class AppHost(App[None]):
     def load(self, path: Path | None, scenario: Scenario | None = None, new: bool = False) -> None:
         raise NotImplementedError
 
-    def new_refused(self, error: str) -> None:
+    def new_refused(self, error: str, error_path: str | None = None) -> None:
         raise NotImplementedError
 
 

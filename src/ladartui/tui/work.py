@@ -22,7 +22,7 @@ from typing import Any, TypeGuard
 from textual.message import Message
 from textual.worker import Worker, get_current_worker
 
-from ladartui.errors import Cancelled, LadarError
+from ladartui.errors import Cancelled, InputFileError, LadarError, OutputFileError
 from ladartui.textsafe import one_line
 
 
@@ -55,12 +55,15 @@ class JobProgress(Message, bubble=False):
 
 @dataclass
 class JobDone(Message, bubble=False):
-    """Job ``job`` ended: with ``result``, or ``cancelled``, or ``error`` (one line)."""
+    """Job ``job`` ended: with ``result``, or ``cancelled``, or ``error`` (one line);
+    ``error_path``: the file the error is about, where it names one (an input or output
+    file's error)."""
 
     job: str
     result: Any = None
     cancelled: bool = False
     error: str | None = None
+    error_path: str | None = None
 
 
 Task = Callable[[Any, Callable[..., None]], Any]
@@ -80,13 +83,17 @@ def start_job(node, job: str, task: Task) -> Worker:
         except Cancelled:
             node.post_message(JobDone(job, cancelled=True))
         except LadarError as error:
-            node.post_message(JobDone(job, error=str(error)))
+            node.post_message(JobDone(job, error=str(error), error_path=_file_of(error)))
         except Exception as error:  # unexpected: say what broke, keep the app open
             node.post_message(JobDone(job, error=one_line(f"{type(error).__name__}: {error}")))
         else:  # a task that finished did its work, even if cancel came too late to stop it
             node.post_message(JobDone(job, result))
 
     return node.run_worker(body, name=job, group=job, thread=True, exclusive=True, exit_on_error=False)
+
+
+def _file_of(error: LadarError) -> str | None:
+    return error.path if isinstance(error, (InputFileError, OutputFileError)) else None
 
 
 def running(worker: Worker | None) -> TypeGuard[Worker]:
