@@ -30,6 +30,7 @@ from ladartui.fileprobe import user_path
 from ladartui.number_text import plural
 from ladartui.recent import recent_paths, remember_path
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
+from ladartui.textsafe import single_line
 from ladartui.tui.fields import refusal
 from ladartui.tui.status import BUSY, NOT_READY, READY, StatusBar, format_eta
 from ladartui.tui.sweep_jobs import (
@@ -592,7 +593,7 @@ class SweepScreen(SweepOpening):
         if kept:  # the app opens the best path next, over this screen's status line
             self.app.notify(f"Best path written to {path.name}; {kept}.", markup=False, timeout=10)
         # paths: never markup
-        self.query_one("#sweep-detail", Static).update(Text(f"best path: {path}{beside}"))
+        self.query_one("#sweep-detail", Static).update(Text(single_line(f"best path: {path}{beside}")))
         said = f"best path ({how}): {path}{beside}"
         self._status(self._idle_state(), said, self._fraction() if self.running else None)
         self.post_message(self.OpenScenario(path))
