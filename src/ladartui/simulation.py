@@ -522,14 +522,8 @@ def _write_outputs(output_set, scene_output, target_output, measures, record, sc
     writers = {name: put(data) for name, data in contents.items()}
     writers["record"] = put(record(written).encode("utf-8"))
     if "scene_las" in output_set.paths:
-        from ladartui.scene.las import compressed_suffix, write_las
+        from ladartui.scene.las import las_writer
 
-        size = scene.voxel_size
-        laz = {name: compressed_suffix(output_set.paths[name]) for name in ("scene_las", "target_las")}
-        writers["scene_las"] = lambda tmp: write_las(
-            tmp, scene_output, size, ids=scene.target_ids_of(scene_output), compress=laz["scene_las"]
-        )
-        writers["target_las"] = lambda tmp: write_las(
-            tmp, target_output, size, ids=scene.target_ids_of(target_output), compress=laz["target_las"]
-        )
+        for name, voxels in (("scene_las", scene_output), ("target_las", target_output)):
+            writers[name] = las_writer(output_set.paths[name], voxels, scene.voxel_size, scene)
     return output_set.write(writers, cancel)

@@ -359,6 +359,19 @@ def write_las(path, voxels, voxel_size, origin=(0.0, 0.0, 0.0), ids=None, *, com
     _write_cloud(path, _voxel_cloud(voxels, voxel_size, origin, ids), compress)
 
 
+def las_writer(path, voxels, voxel_size, scene=None) -> Callable[[Path], None]:
+    """An output set's writer of ``voxels`` for ``path`` (LAZ for a ``.laz`` name): it
+    writes the temporary it is given; with the loaded ``scene``, each point carries its
+    target id (0: not a target)."""
+    compress = compressed_suffix(path)
+
+    def write(tmp: Path) -> None:
+        ids = None if scene is None else scene.target_ids_of(voxels)
+        write_las(tmp, voxels, voxel_size, ids=ids, compress=compress)
+
+    return write
+
+
 def compressed_suffix(path) -> bool:
     """True for a ``.laz`` name: LAZ, else plain LAS."""
     return Path(path).suffix.lower() == ".laz"

@@ -491,7 +491,7 @@ def export_outputs_las(scenario: Scenario, suffix: str = ".las", scene=None) -> 
     output writes nothing.
     """
     from ladartui.outputset import OutputSet
-    from ladartui.scene.las import compressed_suffix, write_las
+    from ladartui.scene.las import las_writer
     from ladartui.scene.voxels import load_voxels
     from ladartui.simulation import output_lock
 
@@ -504,12 +504,7 @@ def export_outputs_las(scenario: Scenario, suffix: str = ".las", scene=None) -> 
     paths = {name: path.with_suffix(suffix) for name, path in outputs.items()}
     with OutputSet(paths, output_lock(scenario)) as output_set:
         clouds = {name: load_voxels(path) for name, path in outputs.items()}
-
-        def writer(name: str):
-            voxels = clouds[name]
-            ids = None if scene is None else scene.target_ids_of(voxels)
-            compress = compressed_suffix(paths[name])
-            return lambda tmp: write_las(tmp, voxels, scenario.voxel_size, ids=ids, compress=compress)
-
-        output_set.write({name: writer(name) for name in paths})
+        output_set.write(
+            {name: las_writer(paths[name], clouds[name], scenario.voxel_size, scene) for name in paths}
+        )
     return list(paths.values())
