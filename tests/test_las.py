@@ -323,6 +323,21 @@ def test_a_cloud_in_degrees_or_an_unreadable_crs_is_refused_naming_it(tmp_path):
         import_las(tmp_path / "broken.las", 1.0)
 
 
+def test_what_the_header_refuses_is_refused_before_the_points_are_read(tmp_path, monkeypatch):
+    """A cloud in degrees was read whole (and its points sorted) before its coordinate
+    system was looked at: a large one waited, or was told to split into tiles for the
+    memory, before being told it is in degrees."""
+    import pyproj
+
+    import ladartui.scene.las as las
+
+    path = _cloud_in(tmp_path / "geo.las", pyproj.CRS("EPSG:4326"), [10.0, 10.001], [5.0, 6.0])
+    monkeypatch.setenv("LADARTUI_MAX_MEMORY", "16")  # the points alone would be refused
+    monkeypatch.setattr(las, "_check_no_collapse", lambda *_: pytest.fail("the points were read"))
+    with pytest.raises(InputFileError, match=r"coordinates in degrees \(WGS 84\)"):
+        import_las(path, 1.0)
+
+
 def test_a_clean_cloud_is_checked_for_merged_points_axis_by_axis(tmp_path, monkeypatch):
     """The check that no points merge once scaled sorted every point twice as rows: 13 of
     the 15 s a 3 M-point survey took to voxelise, none of it stoppable by Ctrl-C. Scaling

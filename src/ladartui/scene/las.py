@@ -211,8 +211,7 @@ def _voxel_indices(
     if not isinstance(keep_noise, bool | np.bool_):  # "no" is true
         raise FieldError("keep_noise", keep_noise, "True or False")
     require_file(path, "expected a LAS or LAZ point cloud")
-    cloud = _read_cloud(path, progress, cancel)
-    _check_header(path, cloud.header)
+    cloud, (horizontal, vertical, unit) = _read_cloud(path, progress, cancel)
     if progress is not None:
         progress("voxelising", 0, 1)
     points = np.stack([np.asarray(cloud.x), np.asarray(cloud.y), np.asarray(cloud.z)], axis=1)
@@ -220,7 +219,6 @@ def _voxel_indices(
         raise InputFileError(path, "holds no points; expected a LAS or LAZ point cloud")
     _check_no_collapse(path, cloud, points)
     check_cancelled(cancel, CANCELLED)
-    horizontal, vertical, unit = metres_per_unit(path, cloud.header)
     if (horizontal, vertical) != (1.0, 1.0):  # a survey in feet
         points = points * np.array([horizontal, horizontal, vertical])
     source_ids = np.asarray(cloud.point_source_id)
@@ -263,13 +261,17 @@ def _voxel_indices(
 
 
 def _read_cloud(path, progress=None, cancel=None):
-    """The whole cloud, refused in one line when damaged, foreign or cut short; read
-    ``READ_POINTS`` at a time, with ``progress`` and ``cancel`` between them."""
+    """The whole cloud and its units (``metres_per_unit``), refused in one line when damaged,
+    foreign or cut short; read ``READ_POINTS`` at a time, with ``progress`` and ``cancel``
+    between them. What the header alone refuses (its scales and offsets, a coordinate
+    system in degrees) is refused before a point is read."""
     import laspy
 
     try:
         with laspy.open(path) as reader:
-            header = reader.header
+            header = reader.header  # with its VLRs and EVLRs: the coordinate system
+            _check_header(path, header)
+            units = metres_per_unit(path, header)
             if not header.are_points_compressed:
                 _check_length(path, header)
             _check_memory(path, header)
@@ -303,7 +305,7 @@ def _read_cloud(path, progress=None, cancel=None):
             f"cut short: its header gives {header.point_count:,} points, the file holds "
             f"{done:,}; expected the whole file (copied or downloaded in full)",
         )
-    return cloud
+    return cloud, units
 
 
 def _check_length(path, header) -> None:
