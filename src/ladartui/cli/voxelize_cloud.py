@@ -39,7 +39,6 @@ def _work(args, outputs, console, cancel):
 
     from ladartui.scene.las import CANCELLED, AllNoise, voxelize_cloud
     from ladartui.scene.model_files import write_model_pair
-    from ladartui.scene.voxelize import merge_voxels
 
     description = TextColumn("{task.description}", markup=False)  # paths are not markup
     after = (TextColumn("{task.fields[done]}", markup=False), TimeElapsedColumn())
@@ -65,19 +64,17 @@ def _work(args, outputs, console, cancel):
                 raise
             raise FieldError("--voxel-size", args.voxel_size, error.expected, source=args.mesh) from None
         check_cancelled(cancel, CANCELLED)
-        voxels = merge_voxels(cloud.voxels)  # sorted, as the project writes models
         scene_path, target_path = outputs
         nothing = np.zeros((0, 3), dtype=np.int32)  # no vehicle yet
-        write_model_pair(scene_path, target_path, voxels, nothing, None, cancel, report)
-        return cloud, len(voxels)
+        write_model_pair(scene_path, target_path, cloud.voxels, nothing, None, cancel, report)
+        return cloud
 
 
-def _report(args, done, outputs) -> None:
+def _report(args, cloud, outputs) -> None:
     """One line: what was written, the scene's size, and where its voxel (0, 0, 0) lies in
     the cloud's own coordinates; a note of the points left out as noise."""
     from ladartui.cli.console import CliConsole as Console
 
-    cloud, count = done
     console = Console()
     say = lambda text: console.print(single_line(text), highlight=False, markup=False, soft_wrap=True)  # noqa: E731
     scene_path, target_path = outputs
@@ -91,7 +88,8 @@ def _report(args, done, outputs) -> None:
     else:
         place = f"x {x:.3f}, y {y:.3f} {across}, z {z:.3f} {up}"
     say(
-        f"wrote {scene_path} ({plural(count, 'voxel')}, {extent_metres(shape, vs)} m at {vs:g} m) and "
+        f"wrote {scene_path} ({plural(len(cloud.voxels), 'voxel')}, {extent_metres(shape, vs)} m "
+        f"at {vs:g} m) and "
         f"{target_path} (empty: no vehicle yet); voxel 0,0,0 is centred at {place} in the "
         f"coordinates of {args.mesh} (scene metres count from there)"
     )
