@@ -307,7 +307,7 @@ def _report(console, args, mesh, done, outputs, elapsed) -> None:
     )
     if len(result.voxels):
         low, high = result.voxels.min(axis=0), result.voxels.max(axis=0)
-        if insertion is not None and insertion.resting is not None:  # where it went in the scene
+        if insertion is not None:  # where it went in the scene
             low, high = low + [0, 0, insertion.resting.lift], high + [0, 0, insertion.resting.lift]
         say(
             "voxels "
@@ -331,14 +331,13 @@ def _report(console, args, mesh, done, outputs, elapsed) -> None:
         + ")"
     )
     resting = insertion.resting
-    if resting is not None:
-        above = ([*_position(args.at), 0.0][2]) if args.at is not None else 0.0  # Z of X,Y[,Z]
-        say(resting.describe(vs, above))
-        if resting.buried:
-            say(resting.warning(vs))
-        if resting.beneath and args.at is not None:
-            x, y, *_ = _position(args.at)
-            say(resting.beneath_warning(vs, (x, y)))
+    above = ([*_position(args.at), 0.0][2]) if args.at is not None else 0.0  # Z of X,Y[,Z]
+    say(resting.describe(vs, above))
+    if resting.buried:
+        say(resting.warning(vs))
+    if resting.beneath and args.at is not None:
+        x, y, *_ = _position(args.at)
+        say(resting.beneath_warning(vs, (x, y)))
     if insertion.occupied:
         say(
             f"note: {insertion.occupied:,} of the vehicle's voxels were already in the scene "

@@ -31,11 +31,11 @@ class Insertion:
     added: int  # vehicle voxels new to the scene
     occupied: int  # vehicle voxels the scene already held (ground, plants, another vehicle)
     new_target: bool  # the scene had no target model file: one is started
+    resting: Resting  # where it was set: on the ground found, or on the floor
     # One id per target voxel when the target model names targets (x,y,z,id lines), else None
     # (the report's x,y,z layout: one target, which the vehicle joins).
     target_ids: np.ndarray | None = None
     vehicle_id: int | None = None  # the vehicle's target id, when the model names targets
-    resting: Resting | None = None  # where it was set: on the ground found, or on the floor
 
 
 def scene_model_paths(out) -> tuple[Path, Path]:
@@ -72,12 +72,11 @@ def insert_vehicle(
     source: object = "scene",
     target_ids: np.ndarray | None = None,
     vehicle_id: int | None = None,
-    on_ground: bool = True,
 ) -> Insertion:
     """Add ``vehicle`` voxels to ``scene`` and ``target``.
 
     ``vehicle`` is placed on the floor (the plane at the bottom of voxel
-    layer 0, as ``Placement`` puts it); with ``on_ground`` it is first raised
+    layer 0, as ``Placement`` puts it); it is first raised
     whole layers to rest on the scene's ground under its footprint
     (:func:`ladartui.scene.ground.rest_on_ground`: unchanged where none is
     found, as in a generated flat scene), and ``Insertion.resting`` says how.
@@ -102,9 +101,7 @@ def insert_vehicle(
                 f"{source}: the vehicle would reach {name} = {(reach[axis] + 0.5) * voxel_size:.3f} m, "
                 f"past the scene's edge at {name} = {edge:g} m; place it inside the scene"
             )
-    resting = None
-    if on_ground:
-        vehicle, resting = rest_on_ground(scene, vehicle, voxel_size)
+    vehicle, resting = rest_on_ground(scene, vehicle, voxel_size)
     merged = merge_voxels(scene, vehicle)
     added = len(merged) - len(scene)
     ids = np.ones(len(target), dtype=np.int32) if target_ids is None else np.asarray(target_ids, np.int32)
