@@ -32,8 +32,6 @@ class Resting:
     lift: int  # layers the vehicle was raised from the floor placement
     columns: int  # its footprint's columns
     ground_columns: int  # of them, those whose ground was found
-    ground_low: int | None  # the lowest and highest ground voxel under the footprint
-    ground_high: int | None  # (None when it stays on the floor)
     covered: int  # footprint columns with scene voxels less than its height over its top
     height: int  # the vehicle's height in layers
     found: tuple[int, int] | None = None  # the lowest and highest ground voxel found, rested on or not
@@ -41,7 +39,8 @@ class Resting:
 
     @property
     def on_ground(self) -> bool:
-        return self.ground_high is not None
+        """Raised onto the ground found (voxel indices start at 0: a lift of at least one)."""
+        return self.lift > 0
 
     @property
     def beneath(self) -> bool:
@@ -57,7 +56,7 @@ class Resting:
         """Where it rests, in scene metres (z 0 at voxel layer 0's centre); ``above``:
         the height given for it (--at X,Y,Z), over the ground or else the floor."""
         vs = voxel_size
-        if self.ground_high is None or self.ground_low is None:
+        if not self.on_ground or self.found is None:
             found = (
                 f"too little ground under the vehicle's footprint to rest on ({self.ground_columns} "
                 f"of its {self.columns} columns; a quarter are needed)"
@@ -71,10 +70,11 @@ class Resting:
                 f"{found}: it is set on the scene's floor at {floor}, as on flat ground; on steep "
                 "ground give its height with --at X,Y,Z"
             )
-        top = (self.ground_high + 0.5) * vs
+        ground_low, ground_high = self.found
+        top = (ground_high + 0.5) * vs
         return (
             f"the vehicle is resting on the ground under its footprint at z {top:g} m "
-            f"(ground voxels there span z {(self.ground_low - 0.5) * vs:g}..{top:g} m, "
+            f"(ground voxels there span z {(ground_low - 0.5) * vs:g}..{top:g} m, "
             f"found in {self.ground_columns} of its {self.columns} columns)"
         )
 
@@ -109,7 +109,7 @@ def rest_on_ground(scene: np.ndarray, vehicle: np.ndarray, voxel_size: float) ->
     """
     vehicle = np.asarray(vehicle, dtype=np.int32).reshape(-1, 3)
     if len(vehicle) == 0:
-        return vehicle, Resting(0, 0, 0, None, None, 0, 0)
+        return vehicle, Resting(0, 0, 0, 0, 0)
     margin = int(np.ceil(MARGIN_M / voxel_size))
     low, high = vehicle.min(axis=0).astype(np.int64), vehicle.max(axis=0).astype(np.int64)
     x0, y0 = low[0] - margin, low[1] - margin
@@ -133,9 +133,8 @@ def rest_on_ground(scene: np.ndarray, vehicle: np.ndarray, voxel_size: float) ->
     under = lowest[where[found]]  # the lowest voxel of each footprint column holding any
     ground = under[under < lowest.min() + height] if len(under) else under
     lift = 0
-    ground_low = ground_high = None
     if len(ground) and len(ground) >= GROUND_SHARE * len(footprint):
-        ground_low, ground_high = int(ground.min()), int(ground.max())
+        ground_high = int(ground.max())
         lift = ground_high + 1
         if int(high[2]) + lift > MAX_INDEX:
             raise LadarError(
@@ -148,7 +147,5 @@ def rest_on_ground(scene: np.ndarray, vehicle: np.ndarray, voxel_size: float) ->
     over = near[(near[:, 2] > top) & (near[:, 2] <= top + height)]
     covered = int(np.count_nonzero(np.isin(footprint, _columns(over, x0, y0, width))))
     ground_span = (int(ground.min()), int(ground.max())) if len(ground) else None
-    resting = Resting(
-        lift, len(footprint), len(ground), ground_low, ground_high, covered, height, ground_span, top
-    )
+    resting = Resting(lift, len(footprint), len(ground), covered, height, ground_span, top)
     return vehicle, resting
