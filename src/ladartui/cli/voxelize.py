@@ -226,7 +226,7 @@ def run(args) -> int:
             Cancelled(CANCELLED),
         )
     elapsed = time.perf_counter() - started
-    _report(Console(), args, mesh, (result, insertion), outputs, elapsed)
+    _report(Console(), args, mesh, (result, insertion, placement), outputs, elapsed)
     return 0
 
 
@@ -293,7 +293,7 @@ def _typed(args) -> dict:
 
 
 def _report(console, args, mesh, done, outputs, elapsed) -> None:
-    result, insertion = done
+    result, insertion, placement = done
     vs = args.voxel_size
     kind = "solid" if result.solid else "surface"
     detail = f"{result.surface:,} on the surface"
@@ -330,14 +330,13 @@ def _report(console, args, mesh, done, outputs, elapsed) -> None:
         )
         + ")"
     )
+    assert placement is not None  # --into needs --at
     resting = insertion.resting
-    above = ([*_position(args.at), 0.0][2]) if args.at is not None else 0.0  # Z of X,Y[,Z]
-    say(resting.describe(vs, above))
+    say(resting.describe(vs, placement.z))  # Z of X,Y[,Z]: its height over the ground
     if resting.buried:
         say(resting.warning(vs))
-    if resting.beneath and args.at is not None:
-        x, y, *_ = _position(args.at)
-        say(resting.beneath_warning(vs, (x, y)))
+    if resting.beneath:
+        say(resting.beneath_warning(vs, (placement.x, placement.y)))
     if insertion.occupied:
         say(
             f"note: {insertion.occupied:,} of the vehicle's voxels were already in the scene "
