@@ -74,6 +74,7 @@ def _report(args, cloud, outputs) -> None:
     """One line: what was written, the scene's size, and where its voxel (0, 0, 0) lies in
     the cloud's own coordinates; a note of the points left out as noise."""
     from ladartui.cli.console import CliConsole as Console
+    from ladartui.scene.las_crs import unit_words
 
     console = Console()
     say = lambda text: console.print(single_line(text), highlight=False, markup=False, soft_wrap=True)  # noqa: E731
@@ -82,7 +83,7 @@ def _report(args, cloud, outputs) -> None:
     shape = cloud.voxels.max(axis=0) + 1
     horizontal, vertical = cloud.metres_per_unit
     x, y, z = cloud.origin / [horizontal, horizontal, vertical]
-    across, up = _units(horizontal, cloud.unit), _units(vertical)
+    across, up = unit_words(horizontal, cloud.unit), unit_words(vertical)
     if across == up:
         place = f"x {x:.3f}, y {y:.3f}, z {z:.3f} {across}"
     else:
@@ -98,12 +99,3 @@ def _report(args, cloud, outputs) -> None:
             f"note: {cloud.left_out:,} of {plural(cloud.points, 'point')} left out as noise or withheld "
             "(--keep-noise keeps them)"
         )
-
-
-def _units(metres: float, name: str | None = None) -> str:
-    """A length unit in the plural, by its length in metres: "m", "feet (0.3048 m)"."""
-    if metres == 1.0:
-        return "m"
-    plurals = {0.3048: "feet", 1200 / 3937: "US survey feet"}  # pyproj's differ in the last bit
-    named = next((words for length, words in plurals.items() if abs(metres / length - 1) < 1e-9), None)
-    return f"{named or name or 'units'} ({metres:.7g} m)"

@@ -13,9 +13,23 @@ from __future__ import annotations
 
 from ladartui.errors import InputFileError
 
-# GeoTIFF's VerticalUnitsGeoKey and the EPSG units it may give: metres in each
+# GeoTIFF's VerticalUnitsGeoKey and the EPSG units it may give: metres in each, and
+# the unit in the plural as a report of lengths names it
 VERTICAL_UNITS_KEY = 4099
-EPSG_LENGTH_UNITS = {9001: 1.0, 9002: 0.3048, 9003: 1200 / 3937}
+EPSG_LENGTH_UNITS = {9001: (1.0, "m"), 9002: (0.3048, "feet"), 9003: (1200 / 3937, "US survey feet")}
+
+
+def unit_words(metres: float, name: str | None = None) -> str:
+    """A length unit in the plural, by its length in metres: "m", "feet (0.3048 m)";
+    one not in ``EPSG_LENGTH_UNITS`` by ``name`` (its coordinate system's), else "units"."""
+    if metres == 1.0:
+        return "m"
+    named = next(
+        # pyproj's lengths differ from these in the last bit
+        (words for length, words in EPSG_LENGTH_UNITS.values() if abs(metres / length - 1) < 1e-9),
+        None,
+    )
+    return f"{named or name or 'units'} ({metres:.7g} m)"
 
 
 def metres_per_unit(path, header) -> tuple[float, float, str]:
@@ -67,5 +81,6 @@ def _geotiff_vertical_metres(header) -> float | None:
     for record in header.vlrs.get("GeoKeyDirectoryVlr"):
         for key in record.geo_keys:
             if key.id == VERTICAL_UNITS_KEY and key.tiff_tag_location == 0:
-                return EPSG_LENGTH_UNITS.get(key.value_offset)
+                known = EPSG_LENGTH_UNITS.get(key.value_offset)
+                return known[0] if known else None
     return None
