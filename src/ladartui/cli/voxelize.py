@@ -87,16 +87,8 @@ def add_parser(subparsers):
     return parser
 
 
-CLOUD_SUFFIXES = (".las", ".laz")
 # Flags that place, shape or label a mesh: a point cloud is voxelised where it was surveyed.
 MESH_FLAGS = ("at", "heading", "solid", "scale", "up", "id")
-
-
-def is_point_cloud(source: str) -> bool:
-    """Whether SOURCE names a LAS or LAZ point cloud (by its suffix, in any case)."""
-    from pathlib import Path
-
-    return Path(source).suffix.lower() in CLOUD_SUFFIXES
 
 
 def refuse_mesh_flags(args) -> None:
@@ -146,7 +138,7 @@ def run(args) -> int:
 
     check_file_names({"SOURCE": args.mesh, "OUT": args.out, "--into": args.into})
     voxel_size_flag(args.voxel_size)  # the scene's, so one a scenario takes
-    cloud = is_point_cloud(args.mesh)
+    cloud = other_file_kind(args.mesh) == "a LAS point cloud"  # .las or .laz, in any case
     if cloud:
         refuse_mesh_flags(args)
     elif args.keep_noise:
