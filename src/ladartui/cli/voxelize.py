@@ -160,33 +160,25 @@ def run(args) -> int:
         x, y, *rest = _position(args.at)
         placement = Placement(x, y, rest[0] if rest else 0.0, args.heading)
     scene_out = bool(args.into) or cloud  # OUT is a scene's stem
+    stem = "the scene's stem (X writes X.txt and X_Target.txt)"
     if args.out.endswith(("/", os.sep)) or Path(args.out).is_dir():  # not a stem: "models" + ".txt"
-        wanted = (
-            "the scene's stem (X writes X.txt and X_Target.txt)"
-            if scene_out
-            else "a target model's file name (X.txt)"
-        )
+        wanted = stem if scene_out else "a target model's file name (X.txt)"
         raise FieldError("OUT", args.out, f"{wanted}, not a folder")
-    if other_file_kind(args.out) is not None:  # 'truck.las' wrote truck.las.txt
-        suffix = Path(args.out).suffix
-        wanted = (
-            "the scene's stem (X writes X.txt and X_Target.txt)"
-            if scene_out
-            else "a voxel-list name ending in .txt"
-        )
-        what = "a mesh" if other_file_kind(args.out) == "a mesh" else f"a {suffix} file name"
+    out_kind = other_file_kind(args.out)
+    if out_kind is not None:  # 'truck.las' wrote truck.las.txt
+        wanted = stem if scene_out else "a voxel-list name ending in .txt"
+        what = "a mesh" if out_kind == "a mesh" else f"a {Path(args.out).suffix} file name"
         raise FieldError("OUT", args.out, f"{wanted}, not {what}")
     outputs: tuple[Path, ...]
+    if scene_out:
+        outputs = scene_model_paths(args.out)
+        check_scene_stem("OUT", args.out, outputs[0])
     if cloud:
         from ladartui.cli.voxelize_cloud import scene_from_cloud
 
-        outputs = scene_model_paths(args.out)
-        check_scene_stem("OUT", args.out, outputs[0])
         check_writable(*outputs)
         return scene_from_cloud(args, outputs)
     if args.into:
-        outputs = scene_model_paths(args.out)
-        check_scene_stem("OUT", args.out, outputs[0])
         into = Path(args.into)
         if into.stem.endswith("_Target"):  # a target model read as the scene
             name = into.stem.removesuffix("_Target")

@@ -19,7 +19,7 @@ def scene_from_cloud(args, outputs) -> int:
     """Voxelise ``args.mesh`` (a point cloud) at ``args.voxel_size`` into ``outputs``
     (OUT.txt, OUT_Target.txt, checked writable), with progress, cancelled by Ctrl-C."""
     from ladartui.cli.console import CliConsole as Console
-    from ladartui.scene.las import CANCELLED
+    from ladartui.scene.voxelize import CANCELLED
 
     errors = Console(stderr=True)
     cancel = threading.Event()
@@ -37,8 +37,9 @@ def _work(args, outputs, console, cancel):
     import numpy as np
     from rich.progress import TextColumn, TimeElapsedColumn
 
-    from ladartui.scene.las import CANCELLED, AllNoise, voxelize_cloud
+    from ladartui.scene.las import AllNoise, voxelize_cloud
     from ladartui.scene.model_files import write_model_pair
+    from ladartui.scene.voxelize import CANCELLED
 
     description = TextColumn("{task.description}", markup=False)  # paths are not markup
     after = (TextColumn("{task.fields[done]}", markup=False), TimeElapsedColumn())

@@ -32,12 +32,11 @@ from ladartui.errors import Cancelled, FieldError, InputFileError, LadarError, c
 from ladartui.fileprobe import path_field, require_file
 from ladartui.scene.las_crs import metres_per_unit
 from ladartui.scene.voxel_arrays import voxel_list_field, voxel_size_field
-from ladartui.scene.voxelize import merge_voxels
+from ladartui.scene.voxelize import CANCELLED, merge_voxels
 from ladartui.scene.voxels import MAX_INDEX, MAX_TARGET_ID
 
 NOISE_CLASSES = (7, 18)  # ASPRS: low point (noise), high noise
 READ_POINTS = 1_000_000  # points read at a time: progress and the cancel between them
-CANCELLED = "voxelisation cancelled; nothing was written"
 
 Progress = Callable[[str, int, int], None]
 
