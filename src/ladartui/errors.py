@@ -54,6 +54,7 @@ class FieldError(LadarError):
         self.field = field
         self.value = value
         self.expected = expected
+        self.source = source  # the file (and line) it was read from, if any
         # (low, high, low_open, high_open) of a numeric range, so a form can say the
         # range in its own units; None for other checks
         self.limits = limits

@@ -22,7 +22,8 @@ from ladartui.errors import FieldError, LadarError
 def as_flags(typed: dict, labels: dict | None = None):
     """Re-raise a FieldError whose field ends in one of ``typed``'s names (``n_ref``) as
     that flag (``--n-ref``), or as ``labels[name]`` where given (``PRESET``), with the
-    value typed; names whose value is None were not typed and pass the error on as it is."""
+    value typed, and the file it was checked against where the error names one; names whose
+    value is None were not typed and pass the error on as it is."""
     try:
         yield
     except FieldError as error:
@@ -30,7 +31,7 @@ def as_flags(typed: dict, labels: dict | None = None):
         if typed.get(name) is None:
             raise
         label = (labels or {}).get(name) or "--" + name.replace("_", "-")
-        raise FieldError(label, typed[name], error.expected) from None
+        raise FieldError(label, typed[name], error.expected, source=error.source) from None
 
 
 MAX_RUNS = 1000  # timed runs or warm-up calls: more would take hours and tell no more

@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import threading
 
+from ladartui.cli.flags import as_flags
 from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt
-from ladartui.errors import Cancelled, FieldError, check_cancelled
+from ladartui.errors import Cancelled, check_cancelled
 from ladartui.number_text import extent_metres, plural
 from ladartui.textsafe import single_line
 
@@ -55,15 +56,13 @@ def _work(args, outputs, console, cancel):
             bar.update(task, description=label, completed=done / max(total, 1), total=1.0, done=shown)
 
         try:
-            cloud = voxelize_cloud(
-                args.mesh, args.voxel_size, keep_noise=args.keep_noise, progress=report, cancel=cancel
-            )
+            # too fine for the cloud's extent: the flag, and the cloud
+            with as_flags({"voxel_size": args.voxel_size}):
+                cloud = voxelize_cloud(
+                    args.mesh, args.voxel_size, keep_noise=args.keep_noise, progress=report, cancel=cancel
+                )
         except AllNoise as error:  # say the flag that keeps them
             raise AllNoise(error.path, error.points, "--keep-noise") from None
-        except FieldError as error:  # too fine for the cloud's extent: the flag, and the cloud
-            if error.field != "voxel_size":
-                raise
-            raise FieldError("--voxel-size", args.voxel_size, error.expected, source=args.mesh) from None
         check_cancelled(cancel, CANCELLED)
         scene_path, target_path = outputs
         nothing = np.zeros((0, 3), dtype=np.int32)  # no vehicle yet
