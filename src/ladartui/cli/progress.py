@@ -51,6 +51,17 @@ def progress_display(console, after, description=None, **options):
     return Progress(description, BarColumn(bar_width=None), *after, console=console, expand=True, **options)
 
 
+def voxelize_display(console):
+    """``progress_display`` for voxelising a file: its stage or path (not markup), the bar,
+    the count done and the time taken; drawn on a terminal only (a log or a pipe gets the
+    summary alone)."""
+    from rich.progress import TextColumn, TimeElapsedColumn
+
+    description = TextColumn("{task.description}", markup=False)  # paths are not markup
+    after = (TextColumn("{task.fields[done]}", markup=False), TimeElapsedColumn())
+    return progress_display(console, after, description, transient=True, disable=not console.is_terminal)
+
+
 @contextlib.contextmanager
 def bar_hidden_if_refused(bar, task, started: Callable[[], bool]):
     """A refusal before the work reported progress (a model file's bad line, memory),

@@ -9,7 +9,7 @@ import threading
 import time
 
 from ladartui.cli.flags import as_flags, check_file_names, check_scene_stem, voxel_size_flag
-from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt
+from ladartui.cli.progress import run_cancellable, sigterm_as_interrupt, voxelize_display
 from ladartui.errors import Cancelled, FieldError, LadarError, check_cancelled
 from ladartui.number_text import extent_metres, plural
 from ladartui.textsafe import one_line, single_line
@@ -217,18 +217,12 @@ def run(args) -> int:
 def _work(args, placement, outputs, console, cancel):
     """Read, voxelise (with progress), insert and write; runs on the worker thread."""
     import numpy as np
-    from rich.progress import TextColumn, TimeElapsedColumn
 
     from ladartui.scene.insertion import insert_vehicle, load_scene_model, write_scene_model
     from ladartui.scene.model_files import save_model
     from ladartui.scene.voxelize import CANCELLED, load_mesh, voxelize
 
-    description = TextColumn("{task.description}", markup=False)  # paths are not markup
-    after = (TextColumn("{task.fields[done]}", markup=False), TimeElapsedColumn())
-    # A bar only on a terminal: a log or a pipe gets the summary alone.
-    with progress_display(
-        console, after, description, transient=True, disable=not console.is_terminal
-    ) as bar:
+    with voxelize_display(console) as bar:
         task = bar.add_task(f"reading {args.mesh}", total=None, done="")
         mesh = load_mesh(args.mesh, scale=args.scale, up=args.up)
         for note in mesh.notes:

@@ -10,7 +10,7 @@ from __future__ import annotations
 import threading
 
 from ladartui.cli.flags import as_flags
-from ladartui.cli.progress import progress_display, run_cancellable, sigterm_as_interrupt
+from ladartui.cli.progress import run_cancellable, sigterm_as_interrupt, voxelize_display
 from ladartui.errors import Cancelled, check_cancelled
 from ladartui.number_text import extent_metres, plural
 from ladartui.textsafe import single_line
@@ -36,17 +36,12 @@ def _work(args, outputs, console, cancel):
     """Read and voxelise the cloud, then write the scene and its empty target model as
     one set; on the worker thread."""
     import numpy as np
-    from rich.progress import TextColumn, TimeElapsedColumn
 
     from ladartui.scene.las import AllNoise, voxelize_cloud
     from ladartui.scene.model_files import write_model_pair
     from ladartui.scene.voxelize import CANCELLED
 
-    description = TextColumn("{task.description}", markup=False)  # paths are not markup
-    after = (TextColumn("{task.fields[done]}", markup=False), TimeElapsedColumn())
-    with progress_display(
-        console, after, description, transient=True, disable=not console.is_terminal
-    ) as bar:
+    with voxelize_display(console) as bar:
         task = bar.add_task(f"reading {args.mesh}", total=None, done="")
         units = {"reading": "points", "writing": "voxels"}
 
