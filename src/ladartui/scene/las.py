@@ -24,6 +24,7 @@ import threading
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -158,7 +159,8 @@ def voxelize_cloud(
     origin in its own coordinates) and how many points were read and left out."""
     indices, _, found = _voxel_indices(path, voxel_size, origin, keep_noise, progress, cancel)
     check_cancelled(cancel, CANCELLED)
-    return CloudVoxels(merge_voxels(indices), *found)  # sorted, as the project writes models
+    # sorted, as the project writes models
+    return CloudVoxels(merge_voxels(indices), **found._asdict())
 
 
 def import_las_target(
@@ -173,7 +175,8 @@ def import_las_target(
     withheld points are left out unless ``keep_noise``, as ``import_las`` does.
     """
     path = path_field("path", path, "a LAS or LAZ point cloud's path")
-    indices, source_ids, (origin, *_) = _voxel_indices(path, voxel_size, origin, keep_noise)
+    indices, source_ids, found = _voxel_indices(path, voxel_size, origin, keep_noise)
+    origin = found.origin
     ids = source_ids.astype(np.int32)
     if not ids.any():
         ids[:] = 1
@@ -199,11 +202,22 @@ def import_las_target(
     return indices[keep], ids[keep], origin
 
 
+class CloudFound(NamedTuple):
+    """What voxelising a cloud found besides its voxels (``CloudVoxels``'s other fields)."""
+
+    origin: np.ndarray
+    metres_per_unit: tuple[float, float]
+    unit: str
+    points: int
+    left_out: int
+
+
 def _voxel_indices(
     path, voxel_size, origin, keep_noise, progress=None, cancel=None
-) -> tuple[np.ndarray, np.ndarray, tuple]:
-    """Each point's voxel ((P, 3) int32), its point_source_id (P,), and the origin,
-    the metres in a unit, the unit's name, the points read and those left out."""
+) -> tuple[np.ndarray, np.ndarray, CloudFound]:
+    """Each point's voxel ((P, 3) int32), its point_source_id (P,), and what else was
+    found: the origin, the metres in a unit, the unit's name, the points read and those
+    left out."""
     path = path_field("path", path, "a LAS or LAZ point cloud's path")
     size = voxel_size_field(voxel_size)
     if not isinstance(keep_noise, bool | np.bool_):  # "no" is true
@@ -254,7 +268,7 @@ def _voxel_indices(
             f"at most {MAX_INDEX + 1:,} voxels a side)",
             source=str(path),
         )
-    found = (origin, (horizontal, vertical), unit, read, read - len(points))
+    found = CloudFound(origin, (horizontal, vertical), unit, read, read - len(points))
     return indices.astype(np.int32), source_ids, found
 
 
