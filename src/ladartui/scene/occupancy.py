@@ -196,8 +196,7 @@ class Occupancy:
 
     @classmethod
     def _from_nonempty(cls, vox, lo, hi, shape):
-        root_origin = (lo >> REGION_SHIFT) << REGION_SHIFT
-        root_dims = ((hi - 1) >> REGION_SHIFT) - (lo >> REGION_SHIFT) + 1
+        root_origin, root_dims = _root_box(lo, hi)
         cube_origin = lo >> BRICK_SHIFT
         cube_dims = ((hi - 1) >> BRICK_SHIFT) - cube_origin + 1
         # Bricks without sorting the voxels (a sort of 3.8 million keys was half the
@@ -278,8 +277,7 @@ class Occupancy:
         """The hierarchy of voxels few for their box, without the extent-sized empty
         cubes and halos: the bricks come from the voxels' sorted brick keys, not a grid
         of the box's brick cells."""
-        root_origin = (lo >> REGION_SHIFT) << REGION_SHIFT
-        root_dims = ((hi - 1) >> REGION_SHIFT) - (lo >> REGION_SHIFT) + 1
+        root_origin, root_dims = _root_box(lo, hi)
         keys = np.empty(len(vox), np.int64)
         for a in range(0, len(vox), _CHUNK):
             q = (vox[a : a + _CHUNK].astype(np.int64) - root_origin) >> BRICK_SHIFT
@@ -356,6 +354,11 @@ class Occupancy:
             "bricks": self.n_bricks,
             "nbytes": self.nbytes,
         }
+
+
+def _root_box(lo, hi):
+    """The root grid's origin (a region corner) and its size in regions over voxels ``lo..hi - 1``."""
+    return (lo >> REGION_SHIFT) << REGION_SHIFT, ((hi - 1) >> REGION_SHIFT) - (lo >> REGION_SHIFT) + 1
 
 
 def _brick_keys(cells, cube_dims, root_offset, root_dims):
