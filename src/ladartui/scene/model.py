@@ -180,9 +180,7 @@ class Scene:
         voxels = self.target if target else self.voxels
         if not len(voxels):
             return (0, 0), np.full((1, 1), -1, np.int32)
-        lo, hi = self.bounds(target)
-        origin = (int(lo[0]), int(lo[1]))
-        nx, ny = int(hi[0] - lo[0]) + 1, int(hi[1] - lo[1]) + 1
+        origin, (nx, ny) = self._column_extent(target)
         return origin, top_height_map(voxels, nx, ny, origin)
 
     def view_columns(self) -> tuple[tuple[int, int], np.ndarray | SparseTops]:
@@ -191,19 +189,21 @@ class Scene:
         over a wide box cost what they hold."""
         if not len(self.voxels):
             return self.column_tops()
-        nx, ny = self.column_box()
+        origin, (nx, ny) = self._column_extent()
         if map_layout(nx, ny, len(self.voxels))[0]:
             return self.column_tops()
-        lo, _ = self.bounds()
-        origin = (int(lo[0]), int(lo[1]))
         return origin, SparseTops.of_voxels(self.voxels, nx, ny, origin)
 
     def column_box(self) -> tuple[int, int]:
         """The columns (nx, ny) of the voxels' x-y extent; (0, 0) for an empty list."""
         if not len(self.voxels):
             return 0, 0
-        lo, last = self.bounds()
-        return int(last[0] - lo[0]) + 1, int(last[1] - lo[1]) + 1
+        return self._column_extent()[1]
+
+    def _column_extent(self, target=False) -> tuple[tuple[int, int], tuple[int, int]]:
+        """The x-y extent of a non-empty list: its lowest column and its columns (nx, ny)."""
+        lo, last = self.bounds(target)
+        return (int(lo[0]), int(lo[1])), (int(last[0] - lo[0]) + 1, int(last[1] - lo[1]) + 1)
 
     def tracing_bytes(self) -> int:
         """About the memory the tracing structures of both models take, before
