@@ -39,7 +39,7 @@ def _work(args, outputs, console, cancel):
 
     from ladartui.scene.las import AllNoise, voxelize_cloud
     from ladartui.scene.model_files import write_model_pair
-    from ladartui.scene.voxelize import CANCELLED
+    from ladartui.scene.voxelize import CANCELLED, merge_voxels
 
     with voxelize_display(console) as bar:
         task = bar.add_task(f"reading {args.mesh}", total=None, done="")
@@ -59,9 +59,10 @@ def _work(args, outputs, console, cancel):
         except AllNoise as error:  # say the flag that keeps them
             raise AllNoise(error.path, error.points, "--keep-noise") from None
         check_cancelled(cancel, CANCELLED)
+        voxels = merge_voxels(cloud.voxels)  # sorted, as the project writes models
         scene_path, target_path = outputs
         nothing = np.zeros((0, 3), dtype=np.int32)  # no vehicle yet
-        write_model_pair(scene_path, target_path, cloud.voxels, nothing, None, cancel, report)
+        write_model_pair(scene_path, target_path, voxels, nothing, None, cancel, report)
         return cloud
 
 

@@ -32,8 +32,9 @@ from ladartui.atomic import atomic_path, write_errors_named
 from ladartui.errors import Cancelled, FieldError, InputFileError, LadarError, check_cancelled, described
 from ladartui.fileprobe import path_field, require_file
 from ladartui.scene.las_crs import metres_per_unit
+from ladartui.scene.unique_rows import unique_voxels
 from ladartui.scene.voxel_arrays import voxel_list_field, voxel_size_field
-from ladartui.scene.voxelize import CANCELLED, merge_voxels
+from ladartui.scene.voxelize import CANCELLED
 from ladartui.scene.voxels import MAX_INDEX, MAX_TARGET_ID
 
 NOISE_CLASSES = (7, 18)  # ASPRS: low point (noise), high noise
@@ -59,7 +60,7 @@ class AllNoise(InputFileError):
 class CloudVoxels:
     """A point cloud voxelised: what ``voxelize_cloud`` gives."""
 
-    voxels: np.ndarray  # (N, 3) int32, unique, sorted by (x, y, z)
+    voxels: np.ndarray  # (N, 3) int32, unique
     origin: np.ndarray  # (3,) metres: voxel (0, 0, 0)'s centre
     metres_per_unit: tuple[float, float]  # in the cloud's coordinates: x and y, z
     unit: str  # the unit of its x and y, as its coordinate system names it ("metre")
@@ -159,8 +160,8 @@ def voxelize_cloud(
     origin in its own coordinates) and how many points were read and left out."""
     indices, _, found = _voxel_indices(path, voxel_size, origin, keep_noise, progress, cancel)
     check_cancelled(cancel, CANCELLED)
-    # sorted, as the project writes models
-    return CloudVoxels(merge_voxels(indices), **found._asdict())
+    voxels, _ = unique_voxels(indices)  # in the cloud's order, first point first
+    return CloudVoxels(voxels, **found._asdict())
 
 
 def import_las_target(
