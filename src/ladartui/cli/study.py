@@ -63,7 +63,8 @@ def add_parser(subparsers) -> None:
         "--scans",
         type=int,
         default=None,
-        help="scans traced, evenly spread over the flight; no more than it has "
+        help="scans traced, evenly spread over the flight (around it, for a full orbit); "
+        "no more than it has "
         "(default 3, or all when it has fewer; 2 with --quick)",
     )
     parser.set_defaults(handler=run)

@@ -362,6 +362,14 @@ class FlightPlan:
         """Whether ``start`` shapes the path: only when the first segment is relative."""
         return bool(self.segments) and self.segments[0].relative
 
+    @property
+    def closed(self) -> bool:
+        """Whether the scans go round a loop: one full orbit, its last scan a step before
+        its first (so scans picked from it are spread around the circle, not its ends)."""
+        return (
+            len(self.segments) == 1 and isinstance(self.segments[0], Orbit) and self.segments[0].arc >= 360.0
+        )
+
     def segment_poses(self) -> list[list[ScanPose]]:
         """The scans of each segment, in order: made once for a plan in use (the plan and
         its poses are immutable; a 10,000-scan path takes a sixth of a second, and one

@@ -64,12 +64,16 @@ class StudyInputs:
         }
 
 
-def pick_scans(poses, limit: int | None):
-    """At most ``limit`` poses, evenly spread over the flight (first one included)."""
+def pick_scans(poses, limit: int | None, closed: bool = False):
+    """At most ``limit`` poses, evenly spread over the flight (first one included): over
+    its length, both ends kept, or where the flight is ``closed`` around its loop."""
     poses = list(poses)
     if limit is None or len(poses) <= limit:
         return poses
-    picks = np.linspace(0, len(poses) - 1, limit).round().astype(int)
+    if closed:
+        picks = (np.arange(limit) * (len(poses) / limit)).round().astype(int)
+    else:
+        picks = np.linspace(0, len(poses) - 1, limit).round().astype(int)
     return [poses[i] for i in sorted(set(picks.tolist()))]
 
 
@@ -90,7 +94,7 @@ def scenario_inputs(path, scans: int | None = DEFAULT_SCANS, refuse_as: str | No
     if refuse_as:
         check_scans(refuse_as, scans, len(all_poses), f"the flight of {path}")  # before the scene loads
     scene = scenario.load_scene()
-    picks = pick_scans(range(len(all_poses)), scans)
+    picks = pick_scans(range(len(all_poses)), scans, scenario.flight.closed)
     poses = [all_poses[i] for i in picks]
     attitudes = plan_attitudes(scenario.flight, scenario.speed, scenario.sensor)  # as a run turns its rays
     inputs = StudyInputs(scene, scenario.sensor, poses, str(path), attitudes=[attitudes[i] for i in picks])
@@ -119,8 +123,9 @@ def generated_inputs(
         check_scans(refuse_as, scans, defaults.DEFAULT_SCANS, "the default orbit")
     scene = cached_scene(preset, progress=progress)
     sensor = Sensor()
-    all_poses = default_flight(scene.target, scene.voxel_size, sensor).poses()
-    poses = pick_scans(all_poses, scans)
+    flight = default_flight(scene.target, scene.voxel_size, sensor)
+    all_poses = flight.poses()
+    poses = pick_scans(all_poses, scans, flight.closed)
     inputs = StudyInputs(scene, sensor, poses, f"generated scene {preset!r}")
     inputs.notes.append(f"{len(poses)} of the default orbit's {len(all_poses)} scans traced.")
     return inputs
