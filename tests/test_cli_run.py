@@ -370,3 +370,38 @@ def test_a_run_of_a_set_being_written_is_refused_before_compiling_or_loading(sce
     err = one_error_line(capsys)
     assert err.endswith("is writing this output set; wait for it to finish") and not started
     assert f"another run (pid {os.getpid()})" in err
+
+
+def _aimed_away(scenario):
+    """The scenario with a lone tree 50 m from the target, its two scans aimed at it."""
+    import dataclasses
+
+    from ladartui.scene.voxels import load_voxels
+
+    scene = load_voxels(scenario.scene_file)
+    save_voxels(scenario.scene_file, np.vstack([scene, np.array([(60, 60, 6)], np.int32)]))
+    poses = tuple(aim_at(ScanPose(x, 50.0, 40.0), (60.5, 60.5, 6.5)) for x in (58.0, 62.0))
+    return dataclasses.replace(scenario, flight=FlightPlan(segments=[Manual(poses)])).save()
+
+
+def test_a_run_whose_scans_never_look_at_the_target_says_so(scenario, capsys):
+    """Such a run printed 0.0 % coverage and nothing more; validate said why, run did not."""
+    from ladartui.view_reach import reach_notes
+
+    scenario = _aimed_away(scenario)
+    (expected,) = reach_notes(scenario, scenario.load_scene())
+    assert "at the target" in expected
+    assert main(["run", str(scenario.path), "--no-write"]) == 0
+    said = capsys.readouterr()
+    assert f"note: {expected}" in " ".join((said.out + said.err).split())
+
+
+def test_a_json_run_gives_its_notes_and_keeps_stdout_json(scenario, capsys):
+    from ladartui.view_reach import reach_notes
+
+    assert main(["run", str(scenario.path), "--json", "--no-write"]) == 0
+    assert json.loads(capsys.readouterr().out)["notes"] == []  # its scans look at the target
+    scenario = _aimed_away(scenario)
+    assert main(["run", str(scenario.path), "--json", "--no-write"]) == 0
+    said = capsys.readouterr()
+    assert json.loads(said.out)["notes"] == reach_notes(scenario, scenario.load_scene())

@@ -121,7 +121,8 @@ def run(args) -> int:
     errors = Console(stderr=True)
     finished: list[SimulationResult] = []  # the result, once there is one
     with _told_if_finished(finished):  # a Ctrl-C from then on says what the run wrote
-        result = _simulate_with_progress(scenario, args, errors, finished)
+        notes: list[str] = []
+        result = _simulate_with_progress(scenario, args, errors, finished, notes)
         chart_error = chart_line = chart_path = undrawn_line = None
         if args.chart is not None:
             from ladartui import charts
@@ -143,7 +144,7 @@ def run(args) -> int:
         # The chart's line follows the run's own "wrote" lines; --json keeps stdout JSON.
         said = errors if args.json else Console()
         if args.json:
-            print(json.dumps(result_dict(scenario, result, chart_path), indent=2, allow_nan=False))
+            print(json.dumps(result_dict(scenario, result, chart_path, notes), indent=2, allow_nan=False))
         else:
             show_result(said, result, asked_precision=scenario.precision)
         for line in (chart_line, undrawn_line):
@@ -196,8 +197,9 @@ def run_progress(console, **options):
     return progress_display(console, after, **options)
 
 
-def _simulate_with_progress(scenario, args, console, finished: list):
-    """The run's result, also appended to ``finished`` as soon as there is one."""
+def _simulate_with_progress(scenario, args, console, finished: list, notes: list):
+    """The run's result, also appended to ``finished`` as soon as there is one; ``notes``
+    gets the sentences for scans that never look at the scene or a target (view_reach)."""
     from ladartui.precompile import compile_ahead
     from ladartui.simulation import NOTHING_WRITTEN, simulate
 
@@ -218,7 +220,12 @@ def _simulate_with_progress(scenario, args, console, finished: list):
         # A stop during the write lets the swap finish (or roll back): the files on
         # disk belong to one run and the result says which.
         def work():
-            scene = compile_ahead(scenario, cancel, load_scene=True)
+            from ladartui.view_reach import reach_notes
+
+            scene = compile_ahead(scenario, cancel, load_scene=True) or scenario.load_scene()
+            notes[:] = reach_notes(scenario, scene)  # told before the tracing: Ctrl-C saves it
+            for note in notes:
+                bar.console.print(single_line(f"note: {note}"), markup=False, highlight=False, soft_wrap=True)
             return simulate(
                 scenario, progress=report, cancel=cancel, write=args.write, las=args.las, scene=scene
             )
@@ -245,9 +252,9 @@ def _told_if_finished(finished: list):
         ) from None
 
 
-def result_dict(scenario, result, chart=None) -> dict:
+def result_dict(scenario, result, chart=None, notes=()) -> dict:
     """The run as a JSON-safe dict: backend, outputs, the chart written (None: none),
-    timings and measures."""
+    the ``notes`` on scans that never look at the scene or a target, timings and measures."""
     return {
         "scenario": str(getattr(scenario, "path", "")),
         "backend": result.backend,
@@ -259,6 +266,7 @@ def result_dict(scenario, result, chart=None) -> dict:
         "target_output_voxels": int(len(result.target_output)),
         "outputs": dict(result.outputs),
         "chart": None if chart is None else str(chart),
+        "notes": list(notes),
         "timings_s": {k: round(v, 4) for k, v in result.timings.items()},
         "measures": result.measures.to_dict(),
     }
