@@ -205,3 +205,28 @@ def test_the_settings_that_made_the_outputs_are_named_in_a_sentence():
     )
     assert named_changes(["a 1 (here 2)"]) == ": a 1 (here 2)"
     assert named_changes([]) == ""
+
+
+async def test_the_bar_warns_of_a_path_whose_scans_never_look_at_the_target(tmp_path, scene_files):
+    """Aimed past the target, a path ran to 0 % with the bar green; validate said why."""
+    from ladartui.flight import FlightPlan, Orbit
+    from ladartui.tui.status import NOT_READY, READY, StatusBar
+    from ladartui.view_reach import reach_notes
+
+    scenario = make_scenario(tmp_path, scene_files)
+    orbit = Orbit(centre=(0.5, 15.5, 0.0), radius=20.0, altitude=30.0, scans=6, aim_at=(15.5, 15.5, 0.0))
+    away = scenario.with_changes(flight=FlightPlan(None, (orbit,))).save()
+    (note,) = reach_notes(away, away.load_scene())
+    assert note.startswith("none of the 6 scans looks at the target")
+    async with opened(away) as (app, pilot):
+        bar = app.query_one(StatusBar)
+        await wait_until(pilot, lambda: app.scene is not None and app.busy is None and note in bar.message)
+        assert bar.state == NOT_READY and bar.message == f"demo.toml: {note}; F5 runs anyway."
+        app.set_scenario(scenario)  # aimed at it: ready
+        await pilot.pause()
+        assert bar.state == READY and bar.message.startswith("demo.toml (modified): 6 scans")
+        app.set_scenario(away)
+        await wait_until(pilot, lambda: note in bar.message)
+        assert bar.state == NOT_READY
+        await app.run_action("run")  # a warning, not a refusal
+        await wait_until(pilot, lambda: isinstance(app.screen, MeasuresScreen) and app.screen.is_mounted)

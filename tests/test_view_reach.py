@@ -234,3 +234,24 @@ def test_the_bundled_body_fixed_orbit_is_said_to_look_away_from_the_scene():
     ]
     stabilised = scenario.with_changes(sensor=dataclasses.replace(scenario.sensor, mount="stabilised"))
     assert reach_notes(stabilised, scene) == []
+
+
+def test_without_partial_misses_only_the_notes_of_nothing_seen_are_given(tmp_path):
+    """The app's status bar warns of scans that see nothing of the scene or a target, not
+    of a path some of whose scans look elsewhere (lead-ins, turns)."""
+    from ladartui.scenario import load_scenario
+    from ladartui.view_reach import reach_notes
+
+    _models(tmp_path)
+    _log(tmp_path, "inbound", -200.0, 50.0, step=(25.0, 0.0))
+    path = _scenario(tmp_path, LOG_SEGMENT.format(name="inbound").replace("60.0", "90.0"))
+    scenario = load_scenario(path)
+    scene = scenario.load_scene()
+    assert reach_notes(scenario, scene) == [
+        "8 of the 11 scans do not look at the scene: 8 of segment 1 (log)"
+    ]
+    assert reach_notes(scenario, scene, partial=False) == []
+    _log(tmp_path, "far", 5000.0, 50.0)
+    far = load_scenario(_scenario(tmp_path, LOG_SEGMENT.format(name="far"), "far.toml"))
+    assert reach_notes(far, scene, partial=False) == reach_notes(far, scene)
+    assert reach_notes(far, scene)[0].startswith("none of the 11 scans looks at the scene")

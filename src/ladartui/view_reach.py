@@ -76,9 +76,10 @@ def voxel_box(bounds, voxel_size: float) -> tuple[np.ndarray, np.ndarray]:
     return (np.asarray(lo) - 0.5) * voxel_size, (np.asarray(hi) + 0.5) * voxel_size
 
 
-def reach_notes(scenario, scene) -> list[str]:
+def reach_notes(scenario, scene, partial: bool = True) -> list[str]:
     """Sentences for a path whose scans never look at ``scene`` (the scenario's, loaded),
-    or at its target or one of its targets: a run of it would cover nothing there."""
+    or at its target or one of its targets: a run of it would cover nothing there. With
+    ``partial`` also one for some of its scans that do not look at the scene."""
     from ladartui.attitude import plan_attitudes
 
     poses = scenario.poses()
@@ -94,7 +95,7 @@ def reach_notes(scenario, scene) -> list[str]:
     if not seen.any():
         said = f"{none} at the scene: {_where(views.positions, lo, hi)}"
         return [said + _map_hint(scenario, views.positions, lo, hi)]
-    notes = [] if seen.all() else [_missed(scenario, seen)]
+    notes = [] if seen.all() or not partial else [_missed(scenario, seen)]
     return notes + _target_notes(scenario, scene, views, none)
 
 

@@ -92,6 +92,7 @@ class LadarApp(
         self.cwd = Path(cwd) if cwd else Path.cwd()
         self.history: EditHistory[Scenario] | None = None
         self.scene = None
+        self.blind_kept: tuple | None = None  # (scenario, scene, note): RunControl.blind_note
         self.prepared = None
         self.measures = None
         self.result = None
@@ -269,6 +270,9 @@ class LadarApp(
             if files := self.changed_on_disk():  # a rerun would read the copies from before
                 stale = f"{', '.join(files)} changed on disk; reopen to read {'them' if files[1:] else 'it'}."
             show(NOT_READY, f"{scenario.path.name}{mark}: {stale}")
+            return
+        if blind := self.blind_note():  # runnable, but a run would see nothing there
+            show(NOT_READY, f"{scenario.path.name}{mark}: {blind}" + (f"; {runs} anyway." if runs else "."))
             return
         show(READY, text)
 

@@ -42,6 +42,7 @@ class AppHost(App[None]):
     # the scenario under edit, its scene and results
     history: EditHistory[Scenario] | None
     scene: Scene | None
+    blind_kept: tuple | None
     prepared: dict[str, Any] | None
     measures: Measures | None
     result: SimulationResult | None

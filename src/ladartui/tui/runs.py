@@ -52,6 +52,38 @@ class RunControl(Host):
         self.set_busy("Starting the run...", 0.0)
         self._run_worker(self.scenario, self.scene, self.scenario.fast_mode)
 
+    def blind_note(self) -> str | None:
+        """The first of validate's notes on scans that see nothing of the scene or of a
+        target: found in a thread for each scenario and scene (a 10,000-scan path takes
+        a second on two busy cores), None until then; the bar is redrawn once it is."""
+        scenario, scene = self.scenario, self.scene
+        if scenario is None or scene is None:
+            return None
+        kept = self.blind_kept
+        if kept is None or kept[0] is not scenario or kept[1] is not scene:
+            self.blind_kept = (scenario, scene, None)
+            self.run_worker(
+                lambda: self._find_blind(scenario, scene),
+                group="reach",
+                thread=True,
+                exclusive=True,
+                exit_on_error=False,
+            )
+            return None
+        return kept[2]
+
+    def _find_blind(self, scenario, scene) -> None:
+        from ladartui.view_reach import reach_notes
+
+        notes = reach_notes(scenario, scene, partial=False)
+        self.call_from_thread(self._blind_found, scenario, scene, notes[0] if notes else None)
+
+    def _blind_found(self, scenario, scene, note: str | None) -> None:
+        kept = self.blind_kept
+        if note and kept is not None and kept[0] is scenario and kept[1] is scene:
+            self.blind_kept = (scenario, scene, note)
+            self.refresh_status()
+
     def _run_worker(self, scenario, scene, fast: bool) -> None:
         warm = self.warm_worker
         self.run_worker_handle = start_job(
