@@ -28,9 +28,9 @@ def test_a_level_not_reached_reads_not_reached_and_is_the_worst():
     orbit = with_levels([0.2, 0.4, 0.6, 0.8])  # detect 1, recognise 3, identify 4
     flypast = with_levels([0.2, 0.2, 0.2, 0.2])  # detect 1 only
     rows = {row.label: row for row in side_by_side([orbit, flypast])}
-    assert rows["Detect at scan"].texts == ("1", "1")
-    assert rows["Recognise at scan"].texts == ("3", "not reached")
-    assert rows["Identify at scan"].texts == ("4", "not reached")
+    assert rows["Detect at scan"].texts == ("1, 0.0 s", "1, 0.0 s")
+    assert rows["Recognise at scan"].texts == ("3, 2.0 s", "not reached")
+    assert rows["Identify at scan"].texts == ("4, 3.0 s", "not reached")
     recognise = rows["Recognise at scan"]
     assert (recognise.best, recognise.worst) == ((0,), (1,))
     assert recognise.values == (3, None)  # the scans, as --json gives them
@@ -41,4 +41,17 @@ def test_a_level_not_reached_reads_not_reached_and_is_the_worst():
     # a file without levels (format 1) still reads 'undefined'
     old = Measures(target_voxels=100, scans=4)
     mixed = {row.label: row for row in side_by_side([old, orbit])}["Identify at scan"]
-    assert mixed.texts == ("undefined", "4") and mixed.best == ()
+    assert mixed.texts == ("undefined", "4, 3.0 s") and mixed.best == ()
+
+
+def test_flights_of_other_scan_rates_show_the_flight_time_beside_the_scan():
+    """A 24-scan and a 12-scan orbit compared read 'Identify at scan: 10' and '6': the
+    looks needed, not how long each flew to get there. The time is now beside the scan;
+    the ranking stays by scans (looks needed), as --json gives them."""
+    visible = [0.2, 0.4, 0.6, 0.8]
+    times = [0.5 * k for k in range(4)]
+    levels = levels_from_curves(visible, visible, times, [30.0 * t for t in times], visible_voxels=100)
+    quick = dataclasses.replace(Measures(target_voxels=100, scans=4), levels=levels)
+    identify = {row.label: row for row in side_by_side([with_levels(visible), quick])}["Identify at scan"]
+    assert identify.texts == ("4, 3.0 s", "4, 1.5 s")
+    assert identify.values == (4, 4) and identify.best == () and identify.worst == ()

@@ -179,15 +179,23 @@ def _compare_row(label: str, values: list, kind: str, better, texts=None, numeri
     return CompareRow(label, tuple(values), texts, differ, best, worst)
 
 
+def _reached_text(scan, flight_time_s) -> str:
+    """``10, 4.7 s``: the scan and, flights of other scan rates being compared, the
+    flight time it came at (the scan alone from a file without it)."""
+    text = format_value(scan, "int")
+    return text if flight_time_s is None else f"{text}, {fixed(flight_time_s, 1)} s"
+
+
 def _level_row(label: str, levels: list) -> CompareRow:
-    """The scan each run reached a level at (``levels``: each run's level dict, None where
-    its file has no levels): one never reached reads "not reached" and ranks after
-    every scan, as the Results tab and the .cmf say it."""
+    """The scan each run reached a level at, with its flight time (``levels``: each run's
+    level dict, None where its file has no levels), ranked by scans (looks needed): one
+    never reached reads "not reached" and ranks after every scan, as the Results tab
+    and the .cmf say it."""
     scans = [level.get("scan") if isinstance(level, dict) else None for level in levels]
     texts = tuple(
         UNDEFINED
         if not isinstance(level, dict)
-        else format_value(scan, "int")
+        else _reached_text(scan, level.get("flight_time_s"))
         if level.get("reached")
         else NOT_REACHED
         for level, scan in zip(levels, scans)
