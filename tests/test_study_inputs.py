@@ -58,6 +58,10 @@ def test_a_study_spreads_its_scans_around_a_closed_orbit(tmp_path, scans, picked
     scenario = dataclasses.replace(scenario, flight=FlightPlan(segments=(orbit,))).save()
     inputs = scenario_inputs(scenario.path, picked)
     assert len(inputs.poses) == picked
+    assert inputs.notes == [
+        f"{picked} of the scenario's {scans} scans traced "
+        "(evenly spread around its orbit; --scans changes this)."
+    ]
     gaps = _gaps(_bearings(inputs.poses, CENTRE))
     step = 360.0 / scans
     assert max(gaps) - min(gaps) <= step + 1e-9  # as even as whole scans allow
@@ -73,7 +77,11 @@ def test_a_study_of_an_open_arc_keeps_both_its_ends(tmp_path):
     orbit = Orbit(centre=CENTRE, radius=20.0, altitude=20.0, scans=13, arc=120.0)
     scenario = dataclasses.replace(scenario, flight=FlightPlan(segments=(orbit,))).save()
     every = scenario_inputs(scenario.path, None).poses
-    picked = scenario_inputs(scenario.path, 3).poses
+    picked_inputs = scenario_inputs(scenario.path, 3)
+    picked = picked_inputs.poses
+    assert picked_inputs.notes == [
+        "3 of the scenario's 13 scans traced (evenly spread; --scans changes this)."
+    ]
     assert [picked[0], picked[-1]] == [every[0], every[-1]]
     assert _bearings(picked[1:2], CENTRE) == pytest.approx(_bearings(every[6:7], CENTRE))
 

@@ -101,7 +101,7 @@ def scenario_inputs(path, scans: int | None = DEFAULT_SCANS, refuse_as: str | No
     if len(poses) < len(all_poses):
         inputs.notes.append(
             f"{len(poses)} of the scenario's {len(all_poses)} scans traced "
-            f"(evenly spread; --scans changes this)."
+            f"(evenly spread{' around its orbit' if scenario.flight.closed else ''}; --scans changes this)."
         )
     return inputs
 
