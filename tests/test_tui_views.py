@@ -17,7 +17,7 @@ from ladartui.scenario import Scenario
 from ladartui.scene.generate import generate_scene
 from ladartui.sensor import Sensor
 from ladartui.tui.app import LadarApp
-from ladartui.tui.canvas import ProjectionWidget, TopViewWidget
+from ladartui.tui.canvas import ProjectionWidget, TopViewWidget, top_view_width
 from ladartui.tui.view_area import ViewArea
 from tui_support import loaded, wait_until
 
@@ -158,6 +158,26 @@ async def test_top_view_zooms_pans_and_goes_back_to_the_path(app_pilot):
 
 
 @pytest.mark.asyncio(loop_scope="module")
+async def test_the_top_views_width_is_what_a_wide_view_shows(app_pilot):
+    """Layout 5's top view is wide and low: fitted on the scene it showed the scene's
+    width in its middle and some three times as much beside it, yet its title gave the
+    scene's width ("Top view 16 m across") as the view's."""
+    pilot = app_pilot
+    app, area = await reset(pilot)
+    top = app.query_one(TopViewWidget)
+    top.focus()
+    for key in ("f", "t", "plus"):
+        await pilot.press(key)
+        await pilot.pause()
+        rows, cols = top.picture_size()
+        assert cols > 2 * rows  # the window's height sets its scale
+        # metres across the picture, from two points a metre apart as drawn
+        (_, west), (_, east) = top.top.to_pixels([(0.0, 0.0), (1.0, 0.0)], rows, cols, top.frame)
+        shown = cols / (east - west)
+        assert str(top.border_title).endswith(top_view_width(shown) + " across"), (key, shown)
+
+
+@pytest.mark.asyncio(loop_scope="module")
 async def test_output_colours_show_what_the_foliage_hid_and_switch_to_height(app_pilot):
     pilot = app_pilot
     app, area = await reset(pilot)
@@ -284,8 +304,6 @@ async def test_a_message_leaves_the_status_bar_in_sight(scenario_path):
 async def test_the_top_views_width_reads_whole_at_80_columns_at_any_zoom(scenario_path):
     """Zoomed out, the title read 'Top view 3.07e+0…' at 80 columns: a number cut inside
     its exponent (3070 m read as 3.07), and '3.07e+03 m across' where it had room."""
-    from ladartui.tui.canvas import top_view_width
-
     assert [top_view_width(w) for w in (5.784, 61.44, 999.4, 999.6, 3072.0, 2.5e6)] == [
         "5.78 m",
         "61.4 m",

@@ -343,11 +343,22 @@ class TopViewWidget(PictureWidget):
         border is narrow (at 80 columns "Top view 3.07e+0…" was cut inside the number)."""
         title = "Top view"
         if self.top is not None and self.frame is not None and self.framing != "path":
-            width = top_view_width((self.frame[2] - self.frame[0]) * self.top.voxel_size)
+            width = top_view_width(self.shown_width())
             titles = (f"{title} {width} across", f"{title} {width}", f"Top {width}")
             room = self.size.width - 4  # the border's corners and a space each side
             title = next((t for t in titles if len(t) <= room), titles[0] if room <= 0 else titles[-1])
         self.border_title = title
+
+    def shown_width(self) -> float:
+        """Metres across the picture: the frame's width, or more where the view is wider
+        than the frame (its height then sets the scale, and the picture shows more
+        beside it)."""
+        assert self.top is not None and self.frame is not None
+        rows, cols = self.picture_size()
+        if not rows or not cols:
+            return (self.frame[2] - self.frame[0]) * self.top.voxel_size
+        scale, _, _ = self.top.fit(rows, cols, self.frame)  # cells per pixel
+        return scale * cols * self.top.voxel_size
 
     def action_zoom(self, factor: float, about=None) -> None:
         if self.top is None or self.frame is None:
