@@ -19,7 +19,7 @@ from ladartui.sensor import Sensor
 from ladartui.tui.app import LadarApp
 from ladartui.tui.canvas import ProjectionWidget, TopViewWidget, top_view_width
 from ladartui.tui.view_area import ViewArea
-from tui_support import loaded, wait_until
+from tui_support import field, loaded, type_into, wait_until
 
 SIZE = (120, 40)
 
@@ -175,6 +175,26 @@ async def test_the_top_views_width_is_what_a_wide_view_shows(app_pilot):
         (_, west), (_, east) = top.top.to_pixels([(0.0, 0.0), (1.0, 0.0)], rows, cols, top.frame)
         shown = cols / (east - west)
         assert str(top.border_title).endswith(top_view_width(shown) + " across"), (key, shown)
+
+
+async def test_the_top_views_width_follows_a_new_voxel_size(scenario_path):
+    """The top view zoomed showed 'Top view 16 m across'; with the voxel size doubled the
+    same voxels spanned 32 m, and the title still said 16."""
+    app = LadarApp(scenario_path, compile_in_child=False)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        top = app.query_one(TopViewWidget)
+        top.focus()
+        await pilot.press("f")
+        await pilot.pause()
+        before = top.shown_width()
+        assert str(top.border_title).endswith(top_view_width(before) + " across")
+        app.action_show_tab("run")
+        await type_into(pilot, field(app, "scenario.voxel_size"), f"{2 * app.scenario.voxel_size:g}")
+        await wait_until(pilot, lambda: top.top.voxel_size == app.scenario.voxel_size)
+        await pilot.pause()
+        assert top.shown_width() == pytest.approx(2 * before)
+        assert str(top.border_title).endswith(top_view_width(2 * before) + " across"), top.border_title
 
 
 @pytest.mark.asyncio(loop_scope="module")

@@ -308,8 +308,7 @@ class TopViewWidget(PictureWidget):
         self.target_box = target_box
         self.framing = "path"
         self._reframe()
-        self._update_title()  # (a zoom's "m across" is the old scene's)
-        self.invalidate()
+        self.invalidate()  # (retitled: a zoom's "m across" is the old scene's)
 
     def set_overlay(self, path, scans, footprints) -> None:
         """New flight path overlays; the window grows to hold the scans if it follows them."""
@@ -331,8 +330,13 @@ class TopViewWidget(PictureWidget):
         """Frame the ``"path"``, the ``"scene"`` or the ``"target"``."""
         self.framing = what
         self._reframe()
-        self._update_title()
         self.invalidate()
+
+    def invalidate(self) -> None:
+        """Redraw, and title the view again: its width follows the frame, the view's size
+        and the voxel size (a new one leaves the frame's voxels where they were)."""
+        self._update_title()
+        super().invalidate()
 
     def on_resize(self, event: events.Resize) -> None:
         super().on_resize(event)
@@ -365,7 +369,6 @@ class TopViewWidget(PictureWidget):
             return
         self.frame = framing.zoom_window(self.frame, factor, about)
         self.framing = "manual"
-        self._update_title()
         self.invalidate()
 
     def action_pan(self, dx: float, dy: float) -> None:
@@ -373,7 +376,6 @@ class TopViewWidget(PictureWidget):
             return
         self.frame = framing.pan_window(self.frame, dx, dy)
         self.framing = "manual"
-        self._update_title()
         self.invalidate()
 
     def action_reset_view(self) -> None:
