@@ -285,6 +285,25 @@ async def test_a_narrow_view_keeps_its_camera_in_its_title(app_pilot):
 
 
 @pytest.mark.asyncio(loop_scope="module")
+async def test_a_3d_views_zoom_reads_without_an_exponent(app_pilot):
+    """Zoomed in past 100 ('+' a dozen times after 'z'), the title read
+    '3D scene az 210 el 30 x1.6e+02'."""
+    from dataclasses import replace
+
+    pilot = app_pilot
+    app, area = await reset(pilot)
+    scene3d = app.query_one("#scene3d", ProjectionWidget)
+    c = scene3d.camera
+    try:
+        for zoom, shown in ((163.8, "x160"), (1234.0, "x1200"), (0.65, "x0.65"), (0.00047, "x0.00047")):
+            scene3d.set_camera(replace(c, zoom=zoom))
+            await pilot.pause()
+            assert scene3d.border_title == f"3D scene az {c.azimuth:.0f} el {c.elevation:.0f} {shown}"
+    finally:
+        scene3d.set_camera(c)
+
+
+@pytest.mark.asyncio(loop_scope="module")
 async def test_a_narrow_output_view_keeps_its_threshold_whole(app_pilot):
     """At 80 columns the output view read '3D output <= 12.…' and lost its camera."""
     pilot = app_pilot

@@ -274,6 +274,11 @@ def top_view_width(metres: float) -> str:
     return f"{km:.3g} km" if km < 999.5 else f"{km:,.0f} km"
 
 
+def zoom_text(zoom: float) -> str:
+    """A 3D view's zoom as its title gives it: two figures, no exponent (x160, x0.65)."""
+    return np.format_float_positional(float(f"{zoom:.2g}"), trim="-")
+
+
 class TopViewWidget(PictureWidget):
     """The scene from above, with the flight path, scans and footprints over it.
 
@@ -512,7 +517,7 @@ class ProjectionWidget(PictureWidget):
         """The view's name and camera, put shorter where the border is narrow (at 80
         columns "3D scene az 210 el 30" was cut before the elevation)."""
         c = self.camera
-        zoom = f" x{c.zoom:.2g}" if abs(c.zoom - 1.0) > 1e-9 else ""
+        zoom = f" x{zoom_text(c.zoom)}" if abs(c.zoom - 1.0) > 1e-9 else ""
         az, el = f"{c.azimuth:.0f}", f"{c.elevation:.0f}"
         room = self.size.width - 4  # the border's corners and a space each side
         base, short = self.base_title, self.short_title or self.base_title
