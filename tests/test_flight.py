@@ -150,6 +150,24 @@ def test_segments_continue_from_the_last_scan_with_continuous_heading():
     assert plan.flight_time(25.0) == pytest.approx(expected / 25.0)
 
 
+def test_the_path_drawn_follows_the_turn_from_the_scan_before_it():
+    """The views drew a turn as chords between its scans, from the straight's end
+    cutting inside the 50 m circle; the points drawn now lie on it, every 5 degrees."""
+    start = ScanPose(0.0, 0.0, 100.0, heading=90.0, depression=45.0)
+    plan = FlightPlan(start, [Straight(300.0, 3), Turn(50.0, 180.0, "left", 3), Straight(100.0, 2)])
+    points = np.array(plan.path_points())
+    scans = np.array([pose.position for pose in plan.poses()])
+    assert len(points) == len(scans) + 3 * (60 // 5 - 1)  # 11 between each pair on the arc
+    on_turn = points[(points[:, 0] >= 300.0 - 1e-9) & (points[:, 1] > 1e-9)]
+    assert len(on_turn) == 3 * 12  # the turn's scans and the 11 points before each
+    assert np.hypot(on_turn[:, 0] - 300.0, on_turn[:, 1] - 50.0) == pytest.approx(50.0)
+    assert (on_turn[:, 2] == 100.0).all()
+    length = np.linalg.norm(np.diff(points, axis=0), axis=1).sum()
+    assert length == pytest.approx(plan.path_length(), rel=1e-3)
+    # the scans are all on it, in order
+    assert [tuple(p) for p in points if any(np.allclose(p, s) for s in scans)] == [tuple(s) for s in scans]
+
+
 def test_relative_segment_without_start_names_the_field():
     with pytest.raises(FieldError) as caught:
         FlightPlan(None, [Straight(100.0, 2)]).poses()

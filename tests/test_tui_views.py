@@ -197,6 +197,39 @@ async def test_the_top_views_width_follows_a_new_voxel_size(scenario_path):
         assert str(top.border_title).endswith(top_view_width(2 * before) + " across"), top.border_title
 
 
+async def test_the_views_draw_an_orbit_as_flown_not_as_chords_between_its_scans(tmp_path):
+    """A 3-scan orbit of radius 30 m was drawn as a triangle through its scans, its sides
+    15 m from the centre over the scene, and the top view was framed on the triangle:
+    the path drawn was not the one flown (nor the one Path m measures)."""
+    generated = generate_scene("small", seed=3, width=16.0, depth=16.0, trees=5)
+    scene_path, _ = generated.write(tmp_path / "forest")
+    centre = tuple(round(float(v), 3) for v in generated.target_centre)
+    scenario = Scenario(
+        tmp_path / "three.toml",
+        scene_path,
+        generated.voxel_size,
+        Sensor(grid=8, ray_grid=1, fov=8.0),
+        FlightPlan(None, (Orbit(centre=centre, radius=30.0, altitude=30.0, scans=3),)),
+    ).save()
+    app = LadarApp(scenario.path, compile_in_child=False)
+    async with app.run_test(size=SIZE) as pilot:
+        await wait_until(pilot, lambda: loaded(app))
+        top = app.query_one(TopViewWidget)
+        path = np.asarray(top.path, float)
+        # every point drawn lies on the circle flown, and the path is as long as Path m
+        assert np.hypot(path[:, 0] - centre[0], path[:, 1] - centre[1]) == pytest.approx(30.0, rel=0.01)
+        drawn = float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum())
+        assert drawn == pytest.approx(scenario.flight.path_length(), rel=0.01)
+        # the top view frames the whole arc; the 3D views draw it too (in voxel units)
+        x0, y0, x1, y1 = np.asarray(top.frame) * top.top.voxel_size
+        assert (path[:, 0].min() >= x0) and (path[:, 0].max() <= x1)
+        assert (path[:, 1].min() >= y0) and (path[:, 1].max() <= y1)
+        scene3d = app.query_one("#scene3d", ProjectionWidget)
+        drawn3d = np.asarray(scene3d.overlays.path, float) * generated.voxel_size
+        assert len(drawn3d) == len(path)
+        assert np.hypot(drawn3d[:, 0] - centre[0], drawn3d[:, 1] - centre[1]) == pytest.approx(30.0, rel=0.01)
+
+
 @pytest.mark.asyncio(loop_scope="module")
 async def test_output_colours_show_what_the_foliage_hid_and_switch_to_height(app_pilot):
     pilot = app_pilot

@@ -38,6 +38,7 @@ from ladartui.flight.paths import (
     _arc_steps,
     _length,
     _scans,
+    _turn_centre,
     _with_sensor,
     flypast,
     orbit,
@@ -46,7 +47,7 @@ from ladartui.flight.paths import (
     straight,
     turn,
 )
-from ladartui.flight.pose import DIRECTIONS, MAX_SCANS, ScanPose, _heading, pose_field
+from ladartui.flight.pose import DIRECTIONS, MAX_SCANS, ScanPose, _forward, _heading, pose_field
 
 
 def _optional_point(name, value):
@@ -90,6 +91,24 @@ def _pointed(segment, current, fly):
 
 def _chords(poses):
     return [math.dist(a.position, b.position) for a, b in zip(poses, poses[1:])]
+
+
+ARC_STEP_DEG = 5.0  # a drawn arc's pieces: a circle in 72 chords
+
+
+def _along_arc(a: ScanPose, b: ScanPose, centre, clockwise: bool, degrees: float, step_deg: float):
+    """Points strictly between ``a`` and ``b`` on the circle about ``centre`` (x, y) that
+    runs ``degrees`` from ``a`` to ``b``, at most ``step_deg`` apart."""
+    pieces = max(1, math.ceil(degrees / step_deg))
+    radius = math.hypot(a.x - centre[0], a.y - centre[1])
+    bearing = math.degrees(math.atan2(a.x - centre[0], a.y - centre[1]))
+    sign = 1.0 if clockwise else -1.0
+    points = []
+    for k in range(1, pieces):
+        fx, fy = _forward(bearing + sign * degrees * k / pieces)
+        z = a.z + (b.z - a.z) * k / pieces
+        points.append((centre[0] + radius * fx, centre[1] + radius * fy, z))
+    return points
 
 
 @dataclass(frozen=True)
@@ -179,6 +198,12 @@ class Turn:
     def legs(self, poses):
         return [self.lead_in()] * (len(poses) - 1)
 
+    def circle(self, poses) -> tuple[tuple[float, float], bool, float]:
+        """The circle its scans lie on: centre (x, y), clockwise, degrees between scans
+        (from the turn's start to its first scan too)."""
+        clockwise = self.direction == "right"
+        return _turn_centre(poses[0], self.radius, clockwise), clockwise, self.arc / self.scans
+
 
 @dataclass(frozen=True)
 class Orbit:
@@ -220,6 +245,10 @@ class Orbit:
     def legs(self, poses):
         arc_between = math.radians(_arc_steps(self.arc, self.scans)) * self.radius
         return [arc_between] * (len(poses) - 1)
+
+    def circle(self, poses) -> tuple[tuple[float, float], bool, float]:
+        """The circle its scans lie on: centre (x, y), clockwise, degrees between scans."""
+        return (self.centre[0], self.centre[1]), self.direction == "right", _arc_steps(self.arc, self.scans)
 
 
 @dataclass(frozen=True)
@@ -407,6 +436,22 @@ class FlightPlan:
         """
         distances = self.scan_distances()
         return distances[-1] if distances else 0.0
+
+    def path_points(self, step_deg: float = ARC_STEP_DEG) -> list[tuple[float, float, float]]:
+        """Positions along the path flown from the first scan to the last, as
+        ``path_length`` measures it: every scan, with points at most ``step_deg`` apart
+        along the arc between the scans of a turn or an orbit (and from the scan before a
+        turn to its first); elsewhere the straight line between scans joins them."""
+        points: list[tuple[float, float, float]] = []
+        previous = None
+        for segment, poses in zip(self.segments, self.segment_poses()):
+            circle = segment.circle(poses) if isinstance(segment, (Turn, Orbit)) else None
+            for index, pose in enumerate(poses):
+                if previous is not None and circle is not None and (index or segment.relative):
+                    points.extend(_along_arc(previous, pose, *circle, step_deg))
+                points.append(pose.position)
+                previous = pose
+        return points
 
     def scan_distances(self) -> list[float]:
         """Metres flown from the first scan to each scan (0 for the first), in flying order.

@@ -316,7 +316,7 @@ class TopViewWidget(PictureWidget):
         self.invalidate()  # (retitled: a zoom's "m across" is the old scene's)
 
     def set_overlay(self, path, scans, footprints) -> None:
-        """New flight path overlays; the window grows to hold the scans if it follows them."""
+        """New flight path overlays; the window grows to hold the path if it follows it."""
         self.path, self.scans, self.footprints = path, scans, footprints
         self._reframe()
         self.invalidate()
@@ -325,7 +325,7 @@ class TopViewWidget(PictureWidget):
         if self.top is None:
             self.frame = None
         elif self.framing == "path":
-            self.frame = self.top.frame_for(self.scans)
+            self.frame = self.top.frame_for(self.scans if self.path is None else self.path)
         elif self.framing == "scene":
             self.frame = self.top.scene_frame()
         elif self.framing == "target" and self.target_box is not None:
@@ -476,10 +476,12 @@ class ProjectionWidget(PictureWidget):
         self.height_range = height_range
         self.invalidate()
 
-    def set_markers(self, markers, bounds=None, footprints=None) -> None:
-        """Scan positions (voxel units) drawn as a path over the voxels, and footprints."""
+    def set_markers(self, markers, bounds=None, footprints=None, path=None) -> None:
+        """Scan positions (voxel units) over the voxels, the ``path`` flown through them
+        (by default straight from scan to scan), and footprints."""
         markers = None if markers is None else np.asarray(markers, float)
-        self.overlays = Overlays(markers, markers, list(footprints or []), self.shown_overlays)
+        path = markers if path is None else np.asarray(path, float)
+        self.overlays = Overlays(path, markers, list(footprints or []), self.shown_overlays)
         if bounds is not None:
             self.bounds = bounds
         self.invalidate()
@@ -506,8 +508,9 @@ class ProjectionWidget(PictureWidget):
         self.fitted = (box, points)
 
     def fit_path(self) -> None:
-        """Frame the scene and the scan positions (``p``; how a new scene opens)."""
-        self.fit_box(self.bounds, self.markers)
+        """Frame the scene and the flight path (``p``; how a new scene opens)."""
+        path = self.overlays.path
+        self.fit_box(self.bounds, self.markers if path is None else path)
 
     def on_resize(self, event: events.Resize) -> None:
         super().on_resize(event)

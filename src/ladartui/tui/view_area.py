@@ -140,7 +140,9 @@ class ViewArea(Container):
                 footprints.append(scenario.sensor.footprint(pose, 0.0, attitude))
             except LadarError:
                 pass
-        top.set_overlay(scans, scans, [f[:, :2] for f in footprints])
+        # the path as flown (along a turn's or an orbit's arc), not chords between scans
+        path = np.array(scenario.flight.path_points()).reshape(-1, 3)
+        top.set_overlay(path[:, :2] if poses else None, scans, [f[:, :2] for f in footprints])
         frame, self.path_unframed = self.path_unframed and self.prepared is not None, False
         if self.prepared is not None and poses:
             markers = np.array([p.position for p in poses]) / self.voxel_size
@@ -149,7 +151,7 @@ class ViewArea(Container):
             # the views open on the scene and its path (as the top view does), and stay
             # put as the path is edited (it may leave them: p fits it)
             for widget in self.query(ProjectionWidget):
-                widget.set_markers(markers, self.prepared["bounds"], ground)
+                widget.set_markers(markers, self.prepared["bounds"], ground, path / self.voxel_size)
                 if frame:
                     widget.fit_path()
 
