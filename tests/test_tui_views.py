@@ -12,12 +12,13 @@ from textual import events
 from ladartui import colour
 from ladartui.errors import LadarError
 from ladartui.flight import FlightPlan, Orbit
+from ladartui.number_text import top_view_width
 from ladartui.render.raster import screen_coordinates
 from ladartui.scenario import Scenario
 from ladartui.scene.generate import generate_scene
 from ladartui.sensor import Sensor
 from ladartui.tui.app import LadarApp
-from ladartui.tui.canvas import ProjectionWidget, TopViewWidget, top_view_width
+from ladartui.tui.canvas import ProjectionWidget, TopViewWidget
 from ladartui.tui.view_area import ViewArea
 from tui_support import field, loaded, type_into, wait_until
 

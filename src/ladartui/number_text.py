@@ -81,3 +81,16 @@ def coverage_steps(shares) -> str:
         return _half_up(percent, 0)
 
     return " ".join(step(share) for share in shares)
+
+
+def top_view_width(metres: float) -> str:
+    """A width as the top view's title gives it: three figures in m or km, no exponent."""
+    if metres < 999.5:
+        return f"{metres:.3g} m"
+    km = metres / 1000
+    return f"{km:.3g} km" if km < 999.5 else f"{km:,.0f} km"
+
+
+def zoom_text(zoom: float) -> str:
+    """A 3D view's zoom as its title gives it: two figures, no exponent (x160, x0.65)."""
+    return format(Decimal(f"{zoom:.2g}"), "f")

@@ -23,6 +23,7 @@ from textual.strip import Strip
 from textual.widget import Widget
 
 from ladartui import views
+from ladartui.number_text import top_view_width, zoom_text
 from ladartui.render import framing
 from ladartui.render.raster import OVERLAYS, Layer, Overlays, render
 from ladartui.views import Camera, Picture
@@ -264,19 +265,6 @@ class PictureWidget(Widget, can_focus=True):
         if y < len(self._strips):
             return self._strips[y]
         return Strip.blank(width, BLANK)
-
-
-def top_view_width(metres: float) -> str:
-    """A width as the top view's title gives it: three figures in m or km, no exponent."""
-    if metres < 999.5:
-        return f"{metres:.3g} m"
-    km = metres / 1000
-    return f"{km:.3g} km" if km < 999.5 else f"{km:,.0f} km"
-
-
-def zoom_text(zoom: float) -> str:
-    """A 3D view's zoom as its title gives it: two figures, no exponent (x160, x0.65)."""
-    return np.format_float_positional(float(f"{zoom:.2g}"), trim="-")
 
 
 class TopViewWidget(PictureWidget):
