@@ -71,3 +71,31 @@ def test_target_names_that_are_no_table_are_refused(tmp_path, names):
         load_scenario(scenario.path)
     line = text.splitlines().index(f"names = {names}") + 1
     assert str(caught.value).startswith(f"{scenario.path}:{line}: targets.names = ")
+
+
+def test_a_flight_log_named_relative_to_the_working_folder_is_saved_where_it_lies(tmp_path, monkeypatch):
+    """A LogSegment given 'log.csv' in a script was read from the working folder, but a
+    scenario saved elsewhere wrote file = "log.csv", which reads from the scenario's
+    folder: the saved file named a log that is not there."""
+    from ladartui.flight import FlightPlan
+    from ladartui.scenario import Scenario
+    from ladartui.sensor import Sensor
+    from ladartui.trajectory import LogSegment
+    from scenario_support import write_models
+
+    work = tmp_path / "work"
+    work.mkdir()
+    (work / "log.csv").write_text("time,x,y,z,heading\n0,0,0,50,90\n1,30,0,50,90\n")
+    scene = write_models(tmp_path / "models")
+    monkeypatch.chdir(work)
+    segment = LogSegment("log.csv", rate=1.0)
+    assert segment.file == str(work / "log.csv")
+    scenario = Scenario(
+        tmp_path / "plans" / "s.toml", scene, 1.0, Sensor(grid=4), FlightPlan(None, (segment,))
+    )
+    scenario.save()
+    assert 'file = "../work/log.csv"' in scenario.path.read_text()
+    monkeypatch.chdir(tmp_path)
+    again = load_scenario(scenario.path)
+    assert again.flight.segments[0].file == str(work / "log.csv")
+    assert again.poses() == scenario.poses()

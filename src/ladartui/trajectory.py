@@ -17,6 +17,7 @@ along the shortest arc. Errors name ``file:line``.
 from __future__ import annotations
 
 import csv
+import os
 import re
 import warnings
 from dataclasses import dataclass, replace
@@ -28,7 +29,7 @@ import numpy as np
 
 from ladartui.checks import MAX_COORDINATE, items_or_none, number_field, point_field
 from ladartui.errors import FieldError, LadarError
-from ladartui.fileprobe import file_problem, not_utf8, path_field, refuse_special_file, text_lines
+from ladartui.fileprobe import file_problem, not_utf8, path_field, refuse_special_file, text_lines, user_path
 from ladartui.fingerprint import Fingerprint, fingerprint_of
 from ladartui.flight import MAX_ALTITUDE, MAX_SCANS, ScanPose
 from ladartui.flight.pose import pose_field
@@ -420,11 +421,13 @@ LOG_AZIMUTH, LOG_DEPRESSION = 0.0, 90.0  # a log segment's sensor pointing when 
 class LogSegment:
     """A recorded flight log as a flight-path segment (``kind = "log"``).
 
-    ``file``: the CSV log (absolute; the scenario reader resolves it against
-    the scenario's folder). Scans at ``rate`` Hz from the log's first record,
-    or at the listed ``times`` (seconds, within the log), not both. The sensor
-    points at ``azimuth`` and ``depression`` relative to the aircraft (unset:
-    0 and 90, straight down), or at ``aim_at``, not both. Roll and pitch come
+    ``file``: the CSV log, made absolute (the scenario reader resolves a relative
+    one against the scenario's folder; given in code, against the working folder,
+    as ``open`` would), so a scenario saved anywhere names the same file. Scans at
+    ``rate`` Hz from the log's first record, or at the listed ``times`` (seconds,
+    within the log), not both. The sensor points at ``azimuth`` and ``depression``
+    relative to the aircraft (unset: 0 and 90, straight down), or at ``aim_at``,
+    not both. Roll and pitch come
     from the log (used by a body-fixed sensor).
     """
 
@@ -442,7 +445,7 @@ class LogSegment:
         set_ = partial(object.__setattr__, self)
         if not isinstance(self.file, (str, Path)) or not str(self.file).strip():
             raise FieldError("file", self.file, "the flight log's file name (.csv)")
-        set_("file", str(self.file))
+        set_("file", os.path.normpath(user_path(self.file).absolute()))
         problem = file_problem(Path(self.file))
         if problem:  # named on the segment's file line, not as the log's own error
             raise FieldError(
