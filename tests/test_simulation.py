@@ -197,6 +197,33 @@ def test_bad_arguments_are_field_errors_before_anything_runs(forest):
     assert not forest.scene_output.exists() and not forest.measures_file.exists()
 
 
+@pytest.mark.parametrize(
+    "arguments, message",
+    [
+        # step=50 traced every scan, then the record of the run could not be written
+        (dict(method="march", step=50), r"^step = 50: expected a number from 0\.001 to 10$"),
+        (dict(method="march", step=True), r"^step = True: expected a number from 0\.001 to 10$"),
+        (dict(method="marsh"), r"^method = 'marsh': expected one of 'exact', 'march'$"),
+        (dict(precision="f16"), r"^precision = 'f16': expected one of 'f64', 'f32'$"),
+    ],
+)
+def test_overrides_the_scenario_would_refuse_are_refused_before_any_tracing(
+    forest, monkeypatch, arguments, message
+):
+    from ladartui.errors import FieldError
+    from ladartui.scene.model import Scene
+
+    loads = []
+    monkeypatch.setattr(Scene, "load", lambda *args, **kwargs: loads.append(args))
+    write_earlier_outputs(forest)
+    earlier = {path: path.read_bytes() for path in simulation.output_paths(forest).values() if path.exists()}
+    for write in (True, False):
+        with pytest.raises(FieldError, match=message):
+            simulate(forest, write=write, **arguments)
+    assert loads == []
+    assert {path: path.read_bytes() for path in earlier} == earlier
+
+
 def test_a_scene_loaded_from_another_file_is_refused(forest, tmp_path):
     """simulate(scenario, scene=...) with the Scene of another scene model ran on it and
     scored that scene as the scenario's, without a word."""

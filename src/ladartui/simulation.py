@@ -129,6 +129,7 @@ def simulate(
 
         scenario = load_scenario(scenario)
     _check_arguments(scenario, progress, cancel, scene)
+    _check_overrides(scenario, backend, method, step, precision)
     check_work(scenario)  # before the output set is locked and before any tracing
     write, las = switch_field("write", write), switch_field("las", las)
     with contextlib.ExitStack() as stack:
@@ -154,6 +155,18 @@ def _check_arguments(scenario, progress, cancel, scene) -> None:
             raise FieldError(
                 "scene.voxel_size", scene.voxel_size, f"the scenario's voxel size ({scenario.voxel_size})"
             )
+
+
+def _check_overrides(scenario, backend, method, step, precision) -> None:
+    """The overrides held to what the scenario's own fields take, named as the arguments:
+    a march step of 50 voxels ran to nonsense, or traced every scan and then failed to
+    write the record of the run, which holds the settings as run."""
+    if backend is method is step is precision is None:
+        return
+    try:
+        as_run(scenario, backend, method, step, precision)
+    except FieldError as error:  # "simulation.step": the file's key, the argument's name
+        raise FieldError(error.field.rpartition(".")[2], error.value, error.expected) from None
 
 
 def _simulate(scenario, backend, method, step, precision, progress, cancel, output_set, scene):
