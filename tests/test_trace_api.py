@@ -67,6 +67,9 @@ def test_top_level_export_is_the_function():
         # a march this fine never ends (or its sample count overflows: misses)
         ({"method": "march", "step": 1e-12}, "step"),
         ({"method": "march", "step": 1e-7}, "step"),
+        # True marched at one voxel a step, as if 1 had been given
+        ({"method": "march", "step": True}, "step"),
+        ({"method": "march", "step": np.True_}, "step"),
         ({"voxel_size": 0}, "voxel_size"),
         ({"precision": "f16"}, "precision"),
     ],

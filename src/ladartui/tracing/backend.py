@@ -38,7 +38,8 @@ def check_order(order: str) -> TraceOrder:
 def check_step(step) -> None:
     """FieldError unless ``step`` is a number of voxels of at least MIN_STEP (the march's
     floor: finer never ended, or overflowed its count of samples)."""
-    number = isinstance(step, (int, float, np.floating, np.integer))
+    # bool is an int, but True is no step of one voxel
+    number = isinstance(step, (int, float, np.floating, np.integer)) and not isinstance(step, bool)
     if not (number and np.isfinite(step) and step >= MIN_STEP):
         raise FieldError("step", step, f"a number of voxels from {MIN_STEP:g}")
 
