@@ -91,6 +91,17 @@ def test_bad_ray_arrays_are_field_errors(block):
         trace(block, np.full((1, 3), np.nan), np.ones((1, 3)))
 
 
+def test_rays_of_true_and_false_are_refused_not_read_as_ones_and_zeros(block):
+    """A mask given for the rays traced from (1, 1, 1) along (0, 0, 1), silently."""
+    flags = np.array([[True, True, True]])
+    with pytest.raises(
+        FieldError, match=r"^origins is an array of bool: expected an \(N, 3\) array of numbers"
+    ):
+        trace(block, flags, np.ones((1, 3)))
+    with pytest.raises(FieldError, match=r"^directions = \[\[False, False, True\]\]: expected an \(N, 3\)"):
+        trace(block, np.zeros((1, 3)), [[False, False, True]])
+
+
 def test_unknown_backend_is_a_field_error(block):
     with pytest.raises(FieldError, match="backend"):
         trace(block, np.zeros((1, 3)), np.ones((1, 3)), backend="nope")

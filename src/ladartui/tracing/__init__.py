@@ -206,9 +206,13 @@ def _rays(name, values):
     if np.iscomplexobj(values):  # (numpy would drop the imaginary parts with a warning)
         raise FieldError(name, Described("a complex array"), "an (N, 3) array of real numbers")
     try:
-        array = np.asarray(values, dtype=np.float64)
+        given = np.asarray(values)
+        array = None if given.dtype == np.bool_ else given.astype(np.float64, copy=False)
     except (TypeError, ValueError):
         raise FieldError(name, described(values), "an (N, 3) array of numbers") from None
+    if array is None:  # a mask given for the rays: True read as 1
+        shown = Described("an array of bool") if isinstance(values, np.ndarray) else described(values)
+        raise FieldError(name, shown, "an (N, 3) array of numbers")
     if array.ndim == 1 and array.shape == (3,):
         array = array[None, :]
     if array.ndim != 2 or array.shape[1] != 3:
