@@ -348,3 +348,21 @@ def test_a_scenario_with_no_flight_is_told_what_a_flight_is(tmp_path):
         f"each with its kind ({', '.join(SEGMENT_FILE_KINDS)}), as in the bundled scenarios "
         "('ladartui validate default' writes one to copy)"
     )
+
+
+@pytest.mark.parametrize("model", ["geiger", "ideal"])
+def test_fewer_pulses_than_the_default_coincidence_names_the_pulses_written(tmp_path, model):
+    """'pulses = 4' alone was reported as 'detection.coincidence = 10', a key not in the
+    file, on the [detection] line."""
+    text = BASE + f'\n[detection]\nmodel = "{model}"\npulses = 4\n'
+    path = write_scenario(tmp_path, text)
+    with pytest.raises(FieldError) as caught:
+        load_scenario(path, check_files=False)
+    assert str(caught.value) == (
+        f"{path}:{line_of(text, 'pulses = 4')}: detection.pulses = 4: expected at least "
+        "detection.coincidence (10, its default: set it too; k of the pulses must fire "
+        "to declare a point)"
+    )
+    written = path.read_text().replace("pulses = 4\n", "pulses = 4\ncoincidence = 2\n")
+    path.write_text(written)
+    assert load_scenario(path, check_files=False).detection.coincidence == 2

@@ -150,5 +150,17 @@ DETECTION_KEYS = tuple(f.name for f in fields(DetectionSettings))
 
 
 def detection_from_table(table: dict) -> DetectionSettings:
-    """A ``[detection]`` table (keys already checked against DETECTION_KEYS) as settings."""
-    return DetectionSettings(**table)
+    """A ``[detection]`` table (keys already checked against DETECTION_KEYS) as settings.
+    Errors name a key the table holds: ``pulses = 4`` alone, under the default
+    coincidence of 10, is the pulses' error, not the coincidence's, which it lacks."""
+    try:
+        return DetectionSettings(**table)
+    except FieldError as error:
+        if error.field != "detection.coincidence" or "coincidence" in table or "pulses" not in table:
+            raise
+        raise FieldError(
+            "detection.pulses",
+            table["pulses"],
+            f"at least detection.coincidence ({error.value}, its default: set it too; "
+            "k of the pulses must fire to declare a point)",
+        ) from None
