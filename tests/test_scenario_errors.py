@@ -366,3 +366,37 @@ def test_fewer_pulses_than_the_default_coincidence_names_the_pulses_written(tmp_
     written = path.read_text().replace("pulses = 4\n", "pulses = 4\ncoincidence = 2\n")
     path.write_text(written)
     assert load_scenario(path, check_files=False).detection.coincidence == 2
+
+
+def test_a_bad_value_in_a_segment_written_one_a_line_is_named_on_its_own_line(tmp_path):
+    """A scenario saved afresh writes short segments as 'segments = [' then one inline
+    table a line, and a manual segment's poses likewise; a bad distance in the third
+    segment was reported on the 'segments = [' line, as was a bad pose among a hundred."""
+    from ladartui.flight import FlightPlan, Manual, ScanPose, Straight
+    from ladartui.scenario import Scenario
+    from ladartui.sensor import Sensor
+    from scenario_support import write_models
+
+    scene = write_models(tmp_path / "models")
+    legs = tuple(Straight(distance, 2) for distance in (40.0, 50.0, 60.0))
+    poses = Manual(tuple(ScanPose(x, 0.0, 50.0) for x in range(100)))
+    cases = [
+        (FlightPlan(ScanPose(0.0, -100.0, 50.0), legs), "segments = [", "distance = 60.0", "distance = -6.0"),
+        (
+            FlightPlan(None, (poses,)),
+            "poses = [",
+            "x = 77.0, y = 0.0, z = 50.0",
+            "x = 77.0, y = 0.0, z = -5.0",
+        ),
+    ]
+    heads = ["flight.segments[2].distance = -6.0", "flight.segments[0].poses[77].z = -5.0"]
+    for (plan, opening, old, new), head in zip(cases, heads):
+        saved = Scenario(tmp_path / "s.toml", scene, 1.0, Sensor(grid=4), plan).save()
+        text = saved.path.read_text()
+        assert f"{opening}\n" in text
+        written = text.replace(old, new, 1)
+        saved.path.write_text(written)
+        with pytest.raises(FieldError) as caught:
+            load_scenario(saved.path)
+        assert str(caught.value).startswith(f"{saved.path}:{line_of(written, new)}: {head}: expected ")
+        saved.path.unlink()

@@ -15,6 +15,7 @@ from pathlib import Path
 from ladartui.fileprobe import SPECIAL_FILE, file_problem, text_lines
 
 _HEADER = re.compile(r"^\s*(\[\[?)\s*([A-Za-z0-9_.\-]+)\s*\]\]?")
+_LAST_KEY = re.compile(r"([A-Za-z0-9_\-]+)\s*$")  # the bare key before an inline table's '='
 _KEY = re.compile(r"""^\s*(?:([A-Za-z0-9_\-]+)|"([^"\\]*)"|'([^']*)')\s*=""")  # bare or quoted
 
 
@@ -77,10 +78,17 @@ def key_lines_from_text(text: str) -> dict[str, int]:
 
 def _key_rows(text: str):
     """(line, dotted key, whether a table header) for each header and key, in order;
-    an array of tables' header gives the array, then its new table."""
+    an array of tables' header gives the array, then its new table. An array of inline
+    tables written over lines (``segments = [`` then one ``{ ... }`` a line, as a saved
+    scenario has its segments and poses) gives each item and its keys on their line."""
     arrays: dict[str, int] = {}  # array-of-tables name -> current index
     current = ""
+    inline: list = []  # the array of inline tables open over lines: [dotted name, next index]
     for number, line in enumerate(text_lines(text), start=1):
+        if inline:
+            for name in _inline_items(line, inline):
+                yield number, name, False
+            continue
         header = _HEADER.match(line)
         if header:
             name = _indexed(header.group(2), arrays)
@@ -94,7 +102,46 @@ def _key_rows(text: str):
         key = _KEY.match(line)
         if key:
             name = next(part for part in key.groups() if part is not None)
-            yield number, f"{current}.{name}" if current else name, False
+            dotted = f"{current}.{name}" if current else name
+            yield number, dotted, False
+            value = line[key.end() :].lstrip()
+            if value.startswith("["):  # an array: perhaps of inline tables, perhaps over lines
+                inline = [dotted, 0]
+                for name in _inline_items(value[1:], inline):
+                    yield number, name, False
+
+
+def _inline_items(line: str, array: list) -> list[str]:
+    """The items of ``array`` ([dotted name, next index]) begun on ``line`` and the keys of
+    their tables, as dotted keys; empties ``array`` where the line closes it. (An inline
+    table is one line long in TOML; strings and comments are skipped.)"""
+    name, index = array
+    found: list[str] = []
+    depth, quote, skip = 0, "", False  # depth 0: in the array, 1: in an item's table
+    for at, char in enumerate(line):
+        if skip:
+            skip = False
+        elif quote:
+            skip = char == "\\" and quote == '"'
+            quote = "" if char == quote else quote
+        elif char in "\"'":
+            quote = char
+        elif char == "#":
+            break
+        elif char in "[{":
+            if depth == 0 and char == "{":
+                found.append(f"{name}[{index}]")
+                index += 1
+            depth += 1
+        elif char in "]}":
+            depth -= 1
+            if depth < 0:  # the array's own closing bracket
+                array.clear()
+                return found
+        elif char == "=" and depth == 1 and (key := _LAST_KEY.search(line, 0, at)):
+            found.append(f"{name}[{index - 1}].{key.group(1)}")
+    array[1] = index
+    return found
 
 
 def _indexed(dotted: str, arrays: dict[str, int]) -> str:
