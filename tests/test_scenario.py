@@ -71,6 +71,20 @@ def test_round_trip_every_segment_kind(tmp_path):
     assert "centre = [10.0, 12.0, 1.0]" in first_text  # points on one line
 
 
+def test_a_numpy_true_or_false_is_taken_for_fast_mode_and_saved_as_toml(tmp_path):
+    """fast_mode=np.True_ (a comparison of numpy numbers) was refused as 'expected true or
+    false', which it is."""
+    import numpy as np
+
+    scene = write_models(tmp_path / "models")
+    scenario = full_scenario(tmp_path / "s.toml", scene)
+    for flag in (np.True_, np.False_):
+        changed = scenario.with_changes(fast_mode=flag)
+        assert changed.fast_mode is bool(flag)
+        changed.save()
+        assert load_scenario(changed.path) == changed
+
+
 def test_round_trip_of_the_base_text(tmp_path):
     write_models(tmp_path / "models")
     scenario = load_scenario(write_scenario(tmp_path))
