@@ -85,6 +85,35 @@ def test_a_numpy_true_or_false_is_taken_for_fast_mode_and_saved_as_toml(tmp_path
         assert load_scenario(changed.path) == changed
 
 
+def test_saving_a_scenario_over_its_own_scene_target_or_flight_log_is_refused(tmp_path):
+    """save(path) wrote the TOML over the scene model, its target model or the flight log
+    it reads, whichever path it was given: the voxels were gone, and the scenario named
+    itself as its scene."""
+    from ladartui.errors import OutputFileError
+    from ladartui.trajectory import LogSegment
+
+    scene = write_models(tmp_path / "models")
+    log = tmp_path / "log.csv"
+    log.write_text("time,x,y,z,heading\n0,0,0,50,90\n1,30,0,50,90\n")
+    plan = FlightPlan(None, (LogSegment(str(log), rate=1.0),))
+    scenario = Scenario(tmp_path / "s.toml", scene, 1.0, Sensor(grid=4), plan)
+    link = tmp_path / "linked.txt"
+    link.symlink_to(scene)
+    cases = [
+        (scene, "the scene model (files.scene)"),
+        (scene.with_name("forest_Target.txt"), "the target model of forest.txt"),
+        (log, "the flight log of flight.segments[0]"),
+        (link, "the scene model (files.scene)"),
+    ]
+    for path, what in cases:
+        before = path.read_bytes()
+        with pytest.raises(OutputFileError) as caught:
+            scenario.save(path)
+        assert str(caught.value) == f"{path}: is {what} this scenario reads: save it under another name"
+        assert path.read_bytes() == before
+    assert scenario.save().path.is_file()
+
+
 def test_round_trip_of_the_base_text(tmp_path):
     write_models(tmp_path / "models")
     scenario = load_scenario(write_scenario(tmp_path))

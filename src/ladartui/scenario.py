@@ -406,7 +406,7 @@ class Scenario:
         if path is not None:
             path = path_field("path", path, "a scenario file's path, or None for its own")
         scenario = self if path is None else self.with_changes(path=path)
-        if refused := record_refusal(scenario.path):
+        if refused := record_refusal(scenario.path) or input_refusal(scenario):
             raise OutputFileError(scenario.path, refused)
         text = None
         # keep the analyst's comments, key order and layout (not a record's header)
@@ -436,6 +436,26 @@ def record_refusal(path) -> str | None:
         f"is a run record (the settings that made {record_owner(path)}'s outputs, "
         "written by its runs): save under another name"
     )
+
+
+def input_refusal(scenario) -> str | None:
+    """Why ``scenario`` is not saved at its path: that is a file it reads, its scene or
+    target model or a flight log (paths compared resolved: a link is the file it names),
+    whose contents the TOML would replace; None where it may be."""
+    where = os.path.realpath(scenario.path)
+    inputs = [
+        (scenario.scene_file, "the scene model (files.scene)"),
+        (scenario.target_file, f"the target model of {scenario.scene_file.name}"),
+        *(
+            (Path(segment.file), f"the flight log of flight.segments[{index}]")
+            for index, segment in enumerate(scenario.flight.segments)
+            if segment.kind == "log"
+        ),
+    ]
+    for path, what in inputs:
+        if os.path.realpath(path) == where:
+            return f"is {what} this scenario reads: save it under another name"
+    return None
 
 
 def _levels_text(thresholds: LevelThresholds, default: bool) -> str:
