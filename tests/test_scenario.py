@@ -114,6 +114,25 @@ def test_saving_a_scenario_over_its_own_scene_target_or_flight_log_is_refused(tm
     assert scenario.save().path.is_file()
 
 
+def test_a_folder_given_as_the_scenario_s_path_is_refused(tmp_path, monkeypatch):
+    """Scenario("results/", ...) was taken: a run wrote results_Scene.txt and the rest
+    beside the folder, and save() failed only then."""
+    scene = write_models(tmp_path / "models")
+    (tmp_path / "results").mkdir()
+    monkeypatch.chdir(tmp_path)
+    plan = FlightPlan(None, (Orbit((1.0, 1.0, 0.0), 40.0, 50.0, 4),))
+    for given in ("results/", tmp_path / "results", ""):
+        with pytest.raises(FieldError) as caught:
+            Scenario(given, scene, 1.0, Sensor(grid=4), plan)
+        folder = tmp_path / "results" if given else tmp_path
+        assert (
+            str(caught.value) == f"path = '{folder}': expected a scenario file's path (S.toml), not a folder"
+        )
+    with pytest.raises(FieldError, match=r"^path = '.*results': expected a scenario file's path \(S\.toml\)"):
+        Scenario.new("results", scene, 1.0)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["models", "results"]
+
+
 def test_round_trip_of_the_base_text(tmp_path):
     write_models(tmp_path / "models")
     scenario = load_scenario(write_scenario(tmp_path))

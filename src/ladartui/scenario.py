@@ -108,7 +108,7 @@ class Scenario:
 
     def __post_init__(self):
         set_ = object.__setattr__
-        path = _absolute(path_field("path", self.path, "a scenario file's path"))
+        path = _scenario_path(self.path)
         set_(self, "path", path)
         scene_file = path_field("files.scene", self.scene_file, "a scene model's path")
         set_(self, "scene_file", resolve_path(path.parent, scene_file))
@@ -289,7 +289,7 @@ class Scenario:
         The default orbit (see ``ladartui.defaults.default_flight``) reads the
         target model to find the target centre; ``sensor`` defaults likewise.
         """
-        path = _absolute(path_field("path", path, "a scenario file's path"))
+        path = _scenario_path(path)
         scene_file = resolve_path(path.parent, path_field("files.scene", scene_file, "a scene model's path"))
         # before the default orbit reads it: a bad size is the field's error, not the sums'
         voxel_size = number_field("files.voxel_size", voxel_size, MIN_VOXEL_SIZE, MAX_VOXEL_SIZE)
@@ -537,6 +537,15 @@ def scenario_from_toml(text: str, path) -> Scenario:
 
 
 # -- writing ------------------------------------------------------------------------
+
+
+def _scenario_path(path) -> Path:
+    """A scenario's path, absolute; FieldError for a folder (a run would write its
+    outputs beside the folder, named after it)."""
+    path = _absolute(path_field("path", path, "a scenario file's path"))
+    if path.is_dir():
+        raise FieldError("path", str(path), "a scenario file's path (S.toml), not a folder")
+    return path
 
 
 def _absolute(path) -> Path:
