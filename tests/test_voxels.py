@@ -74,7 +74,14 @@ def test_tolerated_layouts(tmp_path, data):
         (
             b"1,2,3,4\n",
             1,
-            "4 comma-separated values in '1,2,3,4'; expected three non-negative "
+            "4 comma-separated values in '1,2,3,4' (a target model's x,y,z,id lines, which "
+            "ladartui.scene.target_model.load_target reads with their ids); expected three "
+            "non-negative integers x,y,z separated by commas",
+        ),
+        (
+            b"1,2,3,x\n",
+            1,
+            "4 comma-separated values in '1,2,3,x'; expected three non-negative "
             "integers x,y,z separated by commas",
         ),
         (
@@ -302,3 +309,21 @@ def test_reading_a_plain_file_does_not_import_numba(tmp_path):
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+def test_load_voxels_of_a_target_model_with_ids_says_what_reads_it(tmp_path):
+    """save_voxels(path, voxels, ids) writes x,y,z,id lines, as the bundled convoy's target
+    model has them; load_voxels called the file a mistake: "4 comma-separated values in
+    '1,2,3,1'; expected three non-negative integers x,y,z", with nothing on reading it."""
+    path = tmp_path / "t_Target.txt"
+    voxels = np.array([[1, 2, 3], [4, 5, 6]], dtype=np.int32)
+    save_voxels(path, voxels, ids=[1, 2])
+    with pytest.raises(InputFileError) as caught:
+        load_voxels(path)
+    assert str(caught.value) == (
+        f"{path}:1: 4 comma-separated values in '1,2,3,1' (a target model's x,y,z,id lines, "
+        "which ladartui.scene.target_model.load_target reads with their ids); expected three "
+        "non-negative integers x,y,z separated by commas"
+    )
+    read, ids = load_target(path)
+    assert read.tolist() == voxels.tolist() and ids.tolist() == [1, 2]

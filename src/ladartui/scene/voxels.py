@@ -427,6 +427,12 @@ def describe_bad_line(text: str, columns: int = 3, target: bool = False) -> str:
                 f"{len(fields)} comma-separated values in {_quoted(body.strip())} but the file's first "
                 f"line has {columns}; {EXPECTED_TARGET}"
             )
+        if not target and columns == 3 and len(fields) == 4 and all(f.strip(" \t").isdigit() for f in fields):
+            # a target model's lines with ids, as save_voxels(ids=...) writes them
+            return (
+                f"4 comma-separated values in {_quoted(body.strip())} (a target model's x,y,z,id "
+                f"lines, which ladartui.scene.target_model.load_target reads with their ids); {expected}"
+            )
         return f"{len(fields)} comma-separated values in {_quoted(body.strip())}; {expected}"
     for axis, field in zip((*_AXES, "id"), fields):
         token = field.strip(" \t")
