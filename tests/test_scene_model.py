@@ -51,6 +51,16 @@ def test_missing_scene_is_named(tmp_path):
         Scene.load(tmp_path / "nothing.txt", 0.5)
 
 
+@pytest.mark.parametrize("given", [".", "/"])
+def test_a_folder_without_a_name_given_as_the_scene_is_named_a_folder(tmp_path, monkeypatch, given):
+    """Scene.load(".") failed with ValueError: PosixPath('.') has an empty name, making the
+    name of a target model beside it."""
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(InputFileError) as caught:
+        Scene.load(given, 1.0)
+    assert str(caught.value) == f"{given}: is a folder; expected a voxel-list file"
+
+
 def test_empty_target_loads_but_has_no_centre(tmp_path):
     path = write_pair(tmp_path)
     (tmp_path / "forest_Target.txt").write_text("")

@@ -86,9 +86,9 @@ class Scene:
         """Read ``X.txt`` and its target ``X_Target.txt``."""
         voxel_size_field(voxel_size)  # before reading what may be large files
         scene_path = path_field("scene_path", scene_path, "a scene model file's path")
-        target_path = target_path_for(scene_path)
         scene_digest, target_digest = Digest(), Digest()
         voxels, _ = load_voxels_counted(scene_path, digest=scene_digest)
+        target_path = target_path_for(scene_path)  # once it is a file: "." has no name to follow
         if not target_path.is_file():
             raise InputFileError(
                 target_path,
