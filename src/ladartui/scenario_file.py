@@ -46,7 +46,8 @@ are caught; keys marked "default" may be left out)::
     arc = 360.0                     # default 360 degrees
     # aim_at = [x, y, z]            # default: the centre
 
-Other segment kinds and their keys (``aim_at`` is optional on every kind):
+Other segment kinds and their keys (``aim_at`` is optional on every kind but
+``manual``, whose poses carry their own pointing):
 
 * ``kind = "straight"``: ``distance`` (m), ``scans``; optional ``azimuth``,
   ``depression`` (new sensor pointing from here on; not with ``aim_at``, which
