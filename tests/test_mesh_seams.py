@@ -122,3 +122,25 @@ def test_a_ply_with_texture_coordinates_per_corner_is_the_same_cube(tmp_path):
     assert (mesh.closed, len(mesh.vertices), len(mesh.faces)) == (True, 8, 12)
     plain = load_mesh(write_cube(tmp_path, "plain"))
     assert voxel_set(voxelize(mesh, 0.5, solid=True)) == voxel_set(voxelize(plain, 0.5, solid=True))
+
+
+@pytest.mark.parametrize("file_type", ["stl", "stl_ascii", "obj"])
+def test_collapsed_triangles_leave_a_closed_mesh_closed(tmp_path, file_type):
+    """An export's collapsed triangles (two or three corners the same point: no area,
+    no surface) made a closed cube '1 edges border only one triangle (holes); 2 edges
+    are shared by more than two triangles' and refused it in solid mode; they are
+    left out, with a note, and the cube is the cube."""
+    box = trimesh.creation.box(extents=(2.0, 2.0, 2.0))
+    a, b = box.faces[0][:2]
+    box.faces = list(box.faces) + [[a, a, b], [b, b, b]]
+    path = tmp_path / f"box.{file_type[:3]}"
+    path.write_bytes(
+        stl_bytes(box, file_type) if file_type != "obj" else box.export(file_type="obj").encode()
+    )
+    mesh = load_mesh(path)
+    assert (mesh.closed, mesh.problem, len(mesh.faces)) == (True, "", 12)
+    assert mesh.notes == ("left out 2 collapsed triangles (corners at the same point: no area)",)
+    plain = load_mesh(write_cube(tmp_path, "plain"))
+    solid = voxelize(mesh, 0.5, solid=True)
+    assert voxel_set(solid) == voxel_set(voxelize(plain, 0.5, solid=True))
+    assert voxel_set(voxelize(mesh, 0.5)) == voxel_set(voxelize(plain, 0.5))

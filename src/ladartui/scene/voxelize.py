@@ -45,6 +45,7 @@ import numpy as np
 
 from ladartui.errors import FieldError, InputFileError, ResourceLimitError, check_cancelled
 from ladartui.fileprobe import require_file, text_lines
+from ladartui.number_text import plural
 from ladartui.scene.voxel_arrays import voxel_size_field
 from ladartui.scene.voxels import MAX_INDEX
 from ladartui.textsafe import one_line
@@ -120,8 +121,10 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
             # triangles using it, where it is to be refused
             scene = trimesh.load_scene(source, file_type=kind[1:], resolver=resolver, process=False)
             _refuse_not_finite(path, scene.geometry.values())
+            collapsed = 0
             for part in scene.geometry.values():
                 if isinstance(part, trimesh.Trimesh):  # not a point cloud
+                    collapsed += _drop_collapsed(part)
                     part.process(merge_tex=True, merge_norm=True)
             loaded = scene.to_mesh()
             if len(scene.graph.nodes_geometry) > 1:
@@ -136,6 +139,10 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
     vertices = np.asarray(getattr(loaded, "vertices", np.zeros((0, 3))), dtype=np.float64).reshape(-1, 3)
     if len(faces) == 0:
         raise InputFileError(path, "holds no triangles; expected a triangle mesh")
+    if collapsed:
+        notes.append(
+            f"left out {plural(collapsed, 'collapsed triangle')} (corners at the same point: no area)"
+        )
     problem = _closed_problem(loaded, len(vertices))
     if not problem and _signed_volume(vertices, faces) < 0:
         faces = faces[:, ::-1].copy()  # wound inside out: turn the normals outward
@@ -148,6 +155,22 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
     if up == "y":
         vertices = np.column_stack([vertices[:, 0], -vertices[:, 2], vertices[:, 1]])
     return Mesh(path, vertices, faces, not problem, problem, tuple(notes))
+
+
+def _drop_collapsed(mesh) -> int:
+    """Leave out the triangles two of whose corners are the very same point (an
+    exporter's slivers rounded to float32), before the vertices are merged: they have
+    no area, and once merged their edges would read as holes and as edges shared by
+    more than two triangles. Compared exactly: merging rounds, and far out (1e308)
+    it would join distinct corners. How many."""
+    corners = np.asarray(mesh.vertices, dtype=np.float64)[np.asarray(mesh.faces, dtype=np.int64)]
+    a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
+    same = lambda p, q: np.all(p == q, axis=1)  # noqa: E731
+    keep = ~(same(a, b) | same(b, c) | same(a, c))
+    dropped = int(np.count_nonzero(~keep))
+    if dropped:
+        mesh.update_faces(keep)
+    return dropped
 
 
 def _refuse_not_finite(path: Path, parts) -> None:
@@ -333,9 +356,11 @@ def _closed_problem(mesh, vertex_count: int) -> str:
     if open_edges or shared:
         parts = []
         if open_edges:
-            parts.append(f"{open_edges:,} edges border only one triangle (holes)")
+            verb = "borders" if open_edges == 1 else "border"
+            parts.append(f"{plural(open_edges, 'edge')} {verb} only one triangle (holes)")
         if shared:
-            parts.append(f"{shared:,} edges are shared by more than two triangles")
+            verb = "is" if shared == 1 else "are"
+            parts.append(f"{plural(shared, 'edge')} {verb} shared by more than two triangles")
         return "; ".join(parts)
     if not mesh.is_winding_consistent:
         return "its triangles are not wound consistently (some face inward)"
