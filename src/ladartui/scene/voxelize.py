@@ -38,17 +38,16 @@ import threading
 import warnings
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
-from functools import partial
 from pathlib import Path
 
 import numpy as np
 
 from ladartui.errors import FieldError, InputFileError, ResourceLimitError, check_cancelled
-from ladartui.fileprobe import require_file, text_lines
+from ladartui.fileprobe import require_file
 from ladartui.number_text import plural
+from ladartui.scene.mesh_files import binary_stl, check_obj_lines, check_ply_whole, check_stl_whole
 from ladartui.scene.voxel_arrays import voxel_size_field
 from ladartui.scene.voxels import MAX_INDEX
-from ladartui.textsafe import one_line
 
 MESH_SUFFIXES = (".obj", ".stl", ".ply")
 CANCELLED = "voxelisation cancelled; nothing was written"
@@ -199,14 +198,15 @@ def _mesh_source(path: Path, kind: str):
     import io
 
     if kind == ".ply":
+        check_ply_whole(path)
         return str(path), None
     try:
         data = path.read_bytes()
     except OSError as error:
         raise InputFileError(path, f"cannot be read ({error.strerror or error})") from None
     if kind == ".stl":
-        _check_stl_whole(path, data)
-        if _binary_stl(data):
+        check_stl_whole(path, data)
+        if binary_stl(data):
             return io.BytesIO(data), None
     if data.startswith(codecs.BOM_UTF8):  # saved by a Windows editor: no part of the first line
         data = data[len(codecs.BOM_UTF8) :]
@@ -220,100 +220,6 @@ def _mesh_source(path: Path, kind: str):
     from trimesh.resolvers import FilePathResolver
 
     return io.BytesIO(data), FilePathResolver(str(path))
-
-
-def _stl_head(data: bytes) -> tuple[int, int, bytes] | None:
-    """(file size, the triangle count a binary header gives, the first 584 bytes); None
-    when it is shorter than a header."""
-    size = len(data)
-    return (size, int.from_bytes(data[80:84], "little"), data[: 84 + 50 * 10]) if size >= 84 else None
-
-
-def _binary_stl(data: bytes) -> bool:
-    """Whether ``data`` is sized as a binary STL: an 84-byte header, 50 bytes a triangle."""
-    head = _stl_head(data)
-    return head is not None and head[0] == 84 + 50 * head[1]
-
-
-# Control bytes a text STL never holds, where a binary one's floats and attribute
-# words (usually zero) hold some in every triangle.
-_BINARY_BYTES = frozenset(range(32)) - frozenset(b"\t\n\v\f\r")
-
-
-def _check_stl_whole(path: Path, data: bytes) -> None:
-    """``InputFileError`` for a binary STL shorter or longer than its header's triangle
-    count says (not sized as binary, it would be read as text and hold no triangles)."""
-    read = _stl_head(data)
-    if read is None:
-        return
-    size, count, head = read
-    need = 84 + 50 * count
-    if count == 0 or size == need or (size > 84 and not _BINARY_BYTES & set(head[84:])):
-        return  # whole, or text: an ASCII STL (a bare header holds no triangle either way)
-    what = "cut short" if size < need else "longer than its header says"
-    raise InputFileError(
-        path,
-        f"a binary STL {what}: its header counts {count:,} triangles ({need:,} bytes), "
-        f"the file has {size:,} bytes",
-    )
-
-
-def check_obj_lines(path: Path, text: str) -> None:
-    """``InputFileError`` at the first vertex or face line of an OBJ file's ``text`` that
-    is malformed: a vertex without three finite numbers, a face whose vertex numbers
-    are not integers or lie outside the file's vertices (1..V, or -1..-V counting
-    back from the latest). Called before the mesh reader, which reads past such
-    lines (a nan vertex's faces dropped, index 0 taken) or fails naming none."""
-    lines = text_lines(text)
-    records = ("v ", "v\t", "f ", "f\t")
-
-    def record(line: str) -> str:
-        """'v', 'f' or '' (another record); the common case without splitting the line."""
-        if line[:2] in records:
-            return line[0]
-        if line[:1] in (" ", "\t"):  # indented
-            first = line.split(maxsplit=1)[:1]
-            return first[0] if first in (["v"], ["f"]) else ""
-        return ""
-
-    total = sum(1 for line in lines if record(line) == "v")
-    seen = 0
-    isfinite = math.isfinite
-    for number, line in enumerate(lines, 1):
-        if not record(line):
-            continue
-        words = line.split()
-        shown = partial(_shown_line, words)  # made only for a message: millions of lines pass
-        if words[0] == "v":
-            seen += 1
-            try:
-                xyz = [float(w) for w in words[1:4]]
-            except ValueError:
-                raise InputFileError(
-                    path, f"vertex '{shown()}': expected x, y, z as numbers", number
-                ) from None
-            if len(xyz) < 3:
-                raise InputFileError(path, f"vertex '{shown()}': expected x, y, z", number)
-            if not (isfinite(xyz[0]) and isfinite(xyz[1]) and isfinite(xyz[2])):
-                raise InputFileError(path, f"vertex '{shown()}': expected x, y, z as finite numbers", number)
-            continue
-        for word in words[1:]:
-            try:
-                index = int(word.split("/", 1)[0])
-            except ValueError:
-                raise InputFileError(path, f"face '{shown()}': expected vertex numbers", number) from None
-            if not (1 <= index <= total or -seen <= index <= -1):
-                if not total:  # no vertex at all: no range to name
-                    expected = "vertices ('v x y z') in the file; it has none"
-                else:
-                    expected = f"1 to {total}" + (f" (or -1 to -{seen})" if seen else "")
-                raise InputFileError(
-                    path, f"face '{shown()}' refers to vertex {index}: expected {expected}", number
-                )
-
-
-def _shown_line(words: list[str]) -> str:
-    return one_line(" ".join(words))[:80]
 
 
 @contextlib.contextmanager
