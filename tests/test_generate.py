@@ -348,6 +348,34 @@ def test_a_scene_too_large_for_the_memory_is_refused_before_its_trees_are_made(m
     generate_scene("small", trees=20)  # a small one fits
 
 
+def test_a_fine_voxel_size_is_refused_before_the_vehicles_are_made(monkeypatch):
+    """--voxel-size 0.01 spent 37 s and 4 GB making the vehicle (a 563 x 563 x 221
+    voxel box, 60 bytes a cell) before the estimate, which counted the trees only,
+    refused it; under a 3.5 GB address-space limit it died with a traceback."""
+    from ladartui.errors import ResourceLimitError
+    from ladartui.scene import generate
+
+    made = []
+    terrain = generate._terrain
+    monkeypatch.setattr(generate, "vehicle_voxels", lambda *a: made.append(1))
+    monkeypatch.setattr(generate, "_terrain", lambda *a: made.append(2))
+    monkeypatch.setenv("LADARTUI_MAX_MEMORY", str(3 * 2**30))
+    with pytest.raises(ResourceLimitError) as caught:
+        generate_scene("small", voxel_size=0.01)
+    assert made == []
+    message = str(caught.value)
+    assert message.startswith("generating 1 vehicle at 0.01 m (a 563 x 563 x 221 voxel box) and the ground")
+    assert "more than the 3 GiB of memory available" in message and "coarser voxel size" in message
+    need = float(message.split("needs about ")[1].split(" GiB")[0])
+    assert 4.0 < need < 6.0  # 4.2 GB measured at its peak (the vehicle, the ground's maps)
+    monkeypatch.setattr(generate, "_terrain", terrain)
+    monkeypatch.setenv("LADARTUI_MAX_MEMORY", str(8 * 2**30))
+    with pytest.raises(ResourceLimitError) as caught:  # the trees' estimate, still before the vehicle
+        generate_scene("small", voxel_size=0.01)
+    assert str(caught.value).startswith("generating 48 trees (about ")
+    assert made == []
+
+
 def test_las_copies_are_part_of_the_set(tmp_path, small, monkeypatch):
     """The .laz copies were written after the models, outside their set: a Ctrl-C there
     left new models beside old copies (and a killed run a temporary no run removed)."""
