@@ -6,8 +6,11 @@ mesh with holes, a vertex dropped, index 0 taken) or fail naming nothing."""
 from __future__ import annotations
 
 import math
+from array import array
 from functools import partial
 from pathlib import Path
+
+import numpy as np
 
 from ladartui.errors import InputFileError
 from ladartui.fileprobe import text_lines
@@ -89,12 +92,16 @@ def check_ply_whole(path: Path) -> None:
         )
 
 
-def check_obj_lines(path: Path, text: str) -> None:
+def check_obj_lines(path: Path, text: str) -> str:
     """``InputFileError`` at the first vertex or face line of an OBJ file's ``text`` that
     is malformed: a vertex without three finite numbers, a face whose vertex numbers
     are not integers or lie outside the file's vertices (1..V, or -1..-V counting
     back from the latest). Called before the mesh reader, which reads past such
-    lines (a nan vertex's faces dropped, index 0 taken) or fails naming none."""
+    lines (a nan vertex's faces dropped, index 0 taken) or fails naming none.
+
+    Returns the text for the reader: as it is, or with each face of more than three
+    corners that a fan from its first corner would not cover (a concave one) cut
+    into triangles inside it (the reader fans every face)."""
     lines = text_lines(text)
     records = ("v ", "v\t", "f ", "f\t")
 
@@ -109,6 +116,9 @@ def check_obj_lines(path: Path, text: str) -> None:
 
     total = sum(1 for line in lines if record(line) == "v")
     seen = 0
+    points = array("d")  # every vertex's x, y, z
+    # faces of n > 3 corners, by n: their line indices, their vertex indices in a row
+    polygons: dict[int, tuple[array, array]] = {}
     isfinite = math.isfinite
     for number, line in enumerate(lines, 1):
         if not record(line):
@@ -127,7 +137,9 @@ def check_obj_lines(path: Path, text: str) -> None:
                 raise InputFileError(path, f"vertex '{shown()}': expected x, y, z", number)
             if not (isfinite(xyz[0]) and isfinite(xyz[1]) and isfinite(xyz[2])):
                 raise InputFileError(path, f"vertex '{shown()}': expected x, y, z as finite numbers", number)
+            points.extend(xyz[:3])
             continue
+        corners = []
         for word in words[1:]:
             try:
                 index = int(word.split("/", 1)[0])
@@ -141,6 +153,75 @@ def check_obj_lines(path: Path, text: str) -> None:
                 raise InputFileError(
                     path, f"face '{shown()}' refers to vertex {index}: expected {expected}", number
                 )
+            corners.append(index - 1 if index > 0 else seen + index)
+        if len(corners) > 3:
+            at, indices = polygons.setdefault(len(corners), (array("q"), array("q")))
+            at.append(number - 1)
+            indices.extend(corners)
+    cut = False
+    vertices = np.asarray(points).reshape(-1, 3)
+    for n, (at, indices) in polygons.items():
+        rows = np.asarray(indices).reshape(-1, n)
+        for k in _fans_short(vertices[rows]):
+            order = polygon_triangles(vertices[rows[k]])
+            if order is not None:
+                words = lines[at[k]].split()[1:]
+                lines[at[k]] = "\n".join("f " + " ".join(words[c] for c in triangle) for triangle in order)
+                cut = True
+    return "\n".join(lines) + "\n" if cut else text
+
+
+def _fans_short(corners: np.ndarray) -> np.ndarray:
+    """Which of the polygons ``corners`` (P, n, 3) a fan from their first corner may not
+    cover (a fan triangle not turning with the polygon): the few to look at one by
+    one, all found at once (a mesh of quads has millions)."""
+    normal = np.cross(corners, np.roll(corners, -1, axis=1)).sum(axis=1)  # Newell's
+    first = corners[:, :1]
+    turns = np.einsum("pkc,pc->pk", np.cross(corners[:, 1:-1] - first, corners[:, 2:] - first), normal)
+    return np.flatnonzero(~np.all(turns > 0, axis=1))
+
+
+def polygon_triangles(corners: np.ndarray) -> list[tuple[int, int, int]] | None:
+    """Triangles (corner numbers, in the polygon's winding) covering a planar polygon
+    whose fan from corner 0 would not: None when the fan does (a convex polygon, or
+    one corner 0 sees whole). Cut by clipping ears in the polygon's plane."""
+    normal = np.zeros(3)
+    for a, b in zip(corners, np.roll(corners, -1, axis=0)):  # Newell's normal
+        normal += np.cross(a, b)
+    if not np.any(normal):
+        return None  # no area: nothing to cover
+    turns = np.cross(corners[1:-1] - corners[0], corners[2:] - corners[0]) @ normal
+    if np.all(turns > 0):
+        return None
+    axis = int(np.argmax(np.abs(normal)))  # seen along the axis the plane faces most,
+    u, v = (axis + 1) % 3, (axis + 2) % 3  # counter-clockwise when it faces that axis
+    flat = np.column_stack([corners[:, u], corners[:, v] * (1.0 if normal[axis] > 0 else -1.0)])
+    left = list(range(len(corners)))
+    triangles = []
+    while len(left) > 3:
+        for k in range(len(left)):
+            i, j, m = left[k - 1], left[k], left[(k + 1) % len(left)]
+            if _cross2(flat[i], flat[j], flat[m]) <= 0:
+                continue  # a reflex corner: no ear
+            others = [q for q in left if q not in (i, j, m)]
+            if any(_inside2(flat[q], flat[i], flat[j], flat[m]) for q in others):
+                continue
+            triangles.append((i, j, m))
+            left.pop(k)
+            break
+        else:  # not a simple polygon: leave it to the reader's fan
+            return None
+    triangles.append((left[0], left[1], left[2]))
+    return triangles
+
+
+def _cross2(a, b, c) -> float:
+    return float((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+
+
+def _inside2(p, a, b, c) -> bool:
+    """Whether ``p`` lies in the counter-clockwise triangle a, b, c or on its sides."""
+    return _cross2(a, b, p) >= 0 and _cross2(b, c, p) >= 0 and _cross2(c, a, p) >= 0
 
 
 def _shown_line(words: list[str]) -> str:

@@ -216,7 +216,9 @@ def _mesh_source(path: Path, kind: str):
         text = data.decode("latin-1")  # guess the encoding with a package not installed here
         data = text.encode("utf-8")
     if kind == ".obj":  # the reader drops a nan vertex's faces and takes face index 0
-        check_obj_lines(path, text)
+        checked = check_obj_lines(path, text)
+        if checked is not text:  # concave faces cut into triangles
+            data = checked.encode("utf-8")
     from trimesh.resolvers import FilePathResolver
 
     return io.BytesIO(data), FilePathResolver(str(path))
