@@ -178,6 +178,24 @@ def test_work_beyond_the_memory_limit_is_refused_up_front(scenario, capsys, monk
     assert not traced and not scenario.scene_output.exists() and not scenario.measures_file.exists()
 
 
+def test_the_geiger_memory_limit_is_what_the_memory_cgroup_has_left(scenario, capsys, monkeypatch):
+    """The Geiger model allowed half the machine's physical memory whatever a container's
+    or a batch job's memory cgroup had left, so a study past that limit was killed by the
+    kernel rather than refused, where the README says the least of them is the limit."""
+    import ladartui.resources as resources
+
+    monkeypatch.delenv("LADARTUI_MAX_MEMORY", raising=False)
+    monkeypatch.setattr(resources, "_cgroup_left", lambda: 1 << 17)
+    traced = []
+    monkeypatch.setattr("ladartui.tracing.trace", lambda *a, **k: traced.append(1))
+    assert main(["pulses", str(scenario.path), "--pulses", "1"]) == 2
+    assert (  # 3 x 1,024 rays x 110 bytes
+        "the Geiger-mode model would need about 330 KiB for 3 scans of 1,024 rays, more than the "
+        "128 KiB it may use here" in capsys.readouterr().err
+    )
+    assert not traced
+
+
 def test_geiger_markers_stay_visible_where_they_meet_the_ideal_line():
     # coverage a hair under the ideal: on the same character row as its line
     rows = [PulseRow(m, 1, 0.2499, 100, 0, 0.5) for m in (1, 10, 30, 100)]

@@ -10,7 +10,6 @@ counts as coverage and with certain detection the answer is the ideal one.
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -32,17 +31,12 @@ BYTES_PER_BIN = 22
 
 
 def memory_limit() -> int:
-    """Bytes the model may hold at once: ``LADARTUI_MAX_MEMORY`` where set, as for the
-    tracing structures, else half the machine's physical memory."""
-    from ladartui.resources import memory_override
+    """Bytes the model may hold at once: the memory available, as for the tracing
+    structures (``resources.available_memory``: ``LADARTUI_MAX_MEMORY`` where set, else
+    the least of the free memory, ``ulimit -v`` and the memory cgroup's room)."""
+    from ladartui.resources import available_memory
 
-    override = memory_override()
-    if override is not None:
-        return override
-    try:
-        return os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE") // 2
-    except (ValueError, OSError, AttributeError):
-        return 8 << 30
+    return available_memory()
 
 
 def check_memory(nbytes: float, what: str, advice: str) -> None:
