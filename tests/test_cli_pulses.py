@@ -336,3 +336,26 @@ def test_validate_names_a_mistyped_firing_limit_of_a_geiger_scenario(scenario, c
     assert one_error_line(capsys).endswith(
         "LADARTUI_MAX_BIN_VISITS = 'abc': expected a number of visits >= 1"
     )
+
+
+@pytest.mark.parametrize(
+    "pulse_counts, shown",
+    [
+        ([2.5], "[2.5]"),  # was studied as 2 pulses in a row that read 2.5
+        ([10, 0], "[10, 0]"),  # was a ValueError from deep in the firing
+        ([200_000], "[200000]"),  # was fired past the scenario's and the command's limit
+        (10, "10"),  # was a TypeError: 'int' object is not iterable
+        ("10", "'10'"),  # was a TypeError from dividing text
+    ],
+)
+def test_pulse_study_refuses_pulse_counts_the_command_refuses(scenario, pulse_counts, shown, monkeypatch):
+    from ladartui.errors import FieldError
+
+    traced = []
+    monkeypatch.setattr("ladartui.tracing.trace", lambda *a, **k: traced.append(1))
+    with pytest.raises(FieldError) as caught:
+        pulses_module.pulse_study(scenario, pulse_counts)
+    assert str(caught.value) == (
+        f"pulses_list = {shown}: expected a list of pulse counts, whole numbers from 1 to 100000"
+    )
+    assert not traced  # refused before any tracing

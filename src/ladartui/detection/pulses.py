@@ -18,9 +18,10 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from ladartui.checks import integer_field, items_or_none
 from ladartui.detection.scan import BYTES_PER_HELD_RAY, check_memory, declare_look, prepare_look
-from ladartui.detection.settings import DetectionSettings
-from ladartui.errors import check_cancelled
+from ladartui.detection.settings import MAX_PULSES, DetectionSettings
+from ladartui.errors import FieldError, check_cancelled
 from ladartui.number_text import plural
 from ladartui.returns import kept_returns
 from ladartui.scene.keys import voxel_keys
@@ -80,6 +81,7 @@ def pulse_study(
     from ladartui.attitude import plan_attitudes
     from ladartui.tracing import trace
 
+    pulses_list = pulse_counts_field(pulses_list)
     settings = settings or scenario.detection or DetectionSettings()
     check_study_rays(scenario)
     poses = scenario.poses()
@@ -159,6 +161,23 @@ def pulse_study(
             )
         )
     return ideal_cov, rows
+
+
+def pulse_counts_field(pulses_list) -> list[int]:
+    """``pulses_list`` as a list of ints, each a pulse count a scenario may hold
+    (1..MAX_PULSES), else ``FieldError`` naming it: a count of 2.5 was fired as 2
+    pulses in a row that read 2.5, and a 0 failed deep in the firing."""
+    items = items_or_none(pulses_list)
+    try:
+        if items is None:
+            raise FieldError("pulses_list", pulses_list, "a list")
+        return [integer_field("pulses_list", p, 1, MAX_PULSES) for p in items]
+    except FieldError:
+        raise FieldError(
+            "pulses_list",
+            pulses_list,
+            f"a list of pulse counts, whole numbers from 1 to {MAX_PULSES}",
+        ) from None
 
 
 def check_study_rays(scenario) -> None:
