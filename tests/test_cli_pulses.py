@@ -359,3 +359,22 @@ def test_pulse_study_refuses_pulse_counts_the_command_refuses(scenario, pulse_co
         f"pulses_list = {shown}: expected a list of pulse counts, whole numbers from 1 to 100000"
     )
     assert not traced  # refused before any tracing
+
+
+def test_pulse_study_names_a_scenario_or_settings_of_the_wrong_kind(scenario, monkeypatch):
+    """A scenario's path and a dict of settings ended in AttributeError ('str' object
+    has no attribute 'detection', 'dict' object has no attribute 'bin_width')."""
+    from ladartui.errors import FieldError
+
+    monkeypatch.setattr("ladartui.tracing.trace", lambda *a, **k: pytest.fail("traced"))
+    with pytest.raises(FieldError) as caught:
+        pulses_module.pulse_study(scenario, [10], settings={"pulses": 10})
+    assert str(caught.value) == (
+        "settings = {'pulses': 10}: expected a DetectionSettings (or None: the scenario's)"
+    )
+    with pytest.raises(FieldError) as caught:
+        pulses_module.pulse_study(str(scenario.path), [10])
+    assert str(caught.value) == (
+        f"scenario = {str(scenario.path)!r}: expected a Scenario "
+        "(ladartui.load_scenario reads one from a file)"
+    )

@@ -21,7 +21,7 @@ import numpy as np
 from ladartui.checks import integer_field, items_or_none
 from ladartui.detection.scan import BYTES_PER_HELD_RAY, check_memory, declare_look, prepare_look
 from ladartui.detection.settings import MAX_PULSES, DetectionSettings
-from ladartui.errors import FieldError, check_cancelled
+from ladartui.errors import FieldError, check_cancelled, described
 from ladartui.number_text import plural
 from ladartui.returns import kept_returns
 from ladartui.scene.keys import voxel_keys
@@ -82,6 +82,12 @@ def pulse_study(
     from ladartui.tracing import trace
 
     pulses_list = pulse_counts_field(pulses_list)
+    if not all(hasattr(scenario, name) for name in ("poses", "sensor", "detection", "load_scene")):
+        raise FieldError(
+            "scenario", described(scenario), "a Scenario (ladartui.load_scenario reads one from a file)"
+        )
+    if settings is not None and not isinstance(settings, DetectionSettings):
+        raise FieldError("settings", described(settings), "a DetectionSettings (or None: the scenario's)")
     settings = settings or scenario.detection or DetectionSettings()
     check_study_rays(scenario)
     poses = scenario.poses()
