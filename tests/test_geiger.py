@@ -279,3 +279,30 @@ def test_incidence_cosine_takes_a_face_the_ray_can_enter():
             origin[None], d[None], np.array([1]), np.array([[0, 0, 0]]), np.array([9.0 + error]), 1.0
         )
         assert cos[0] == pytest.approx(abs(d[2])), error
+
+
+@pytest.mark.parametrize(
+    "call, message",
+    [
+        # no foliage: the optimum is no finite scale (was ZeroDivisionError)
+        (lambda: optimal_energy_scale(5.0, 0.0), "n_foliage = 0.0: expected a number > 0"),
+        # a target that never fires has no optimum (was ZeroDivisionError)
+        (lambda: optimal_energy_scale(0.0, 5.0), "n_target = 0.0: expected a number > 0"),
+        # was 0.223, a scale for a negative signal
+        (lambda: optimal_energy_scale(-1.0, 5.0), "n_target = -1.0: expected a number > 0"),
+        # was 1.0: a certain declaration from a probability that is not one
+        (lambda: binomial_at_least(100, 10, math.nan), "p = nan: expected a number from 0 to 1"),
+        (lambda: binomial_at_least(10, 3, 1.5), "p = 1.5: expected a number from 0 to 1"),
+        # was a TypeError from range()
+        (lambda: binomial_at_least(10.5, 3, 0.5), "pulses = 10.5: expected an integer from 0 to 100000"),
+        # was -3.3e-09 mean counts
+        (lambda: noise_per_bin(-1.0, 0.5), "rate_hz = -1.0: expected a number >= 0"),
+        (lambda: noise_per_bin(1e6, 0.0), "bin_width_m = 0.0: expected a number > 0"),
+    ],
+)
+def test_closed_forms_refuse_values_outside_their_meaning(call, message):
+    from ladartui.errors import FieldError
+
+    with pytest.raises(FieldError) as caught:
+        call()
+    assert str(caught.value).startswith(message)

@@ -29,6 +29,8 @@ import math
 import numba
 import numpy as np
 
+from ladartui.checks import integer_field, number_field
+from ladartui.detection.settings import MAX_PULSES
 from ladartui.errors import check_cancelled
 
 SPEED_OF_LIGHT = 299_792_458.0
@@ -131,15 +133,22 @@ def declare_points(counts, threshold: int) -> np.ndarray:
 
 def noise_per_bin(rate_hz: float, bin_width_m: float) -> float:
     """Mean noise counts in one range bin: rate times the bin's round-trip time."""
-    return float(rate_hz) * 2.0 * float(bin_width_m) / SPEED_OF_LIGHT
+    rate_hz = number_field("rate_hz", rate_hz, 0.0)
+    bin_width_m = number_field("bin_width_m", bin_width_m, 0.0, low_open=True)
+    return rate_hz * 2.0 * bin_width_m / SPEED_OF_LIGHT
 
 
 def binomial_at_least(pulses: int, threshold: int, p: float) -> float:
     """P(at least ``threshold`` of ``pulses`` Bernoulli(p) trials succeed).
 
     Each term ``C(M, j) p^j (1 - p)^(M - j)`` is taken through its logarithm:
-    past about 1,030 pulses ``C(M, j)`` alone is beyond the largest float.
+    past about 1,030 pulses ``C(M, j)`` alone is beyond the largest float. A
+    value outside its meaning (``p`` not a probability, a count not a whole number
+    of at most ``MAX_PULSES``) is a ``FieldError`` naming it.
     """
+    pulses = integer_field("pulses", pulses, 0, MAX_PULSES)
+    threshold = integer_field("threshold", threshold, 0, MAX_PULSES + 1)
+    p = number_field("p", p, 0.0, 1.0)
     if threshold <= 0:
         return 1.0
     if threshold > pulses or p <= 0.0:
@@ -160,6 +169,10 @@ def binomial_at_least(pulses: int, threshold: int, p: float) -> float:
 def optimal_energy_scale(n_target: float, n_foliage: float) -> float:
     """Energy scale ``a`` maximising ``exp(-a N_f) (1 - exp(-a N_t))``.
 
-    Setting the derivative to zero gives ``a* = ln(1 + N_t / N_f) / N_t``.
+    Setting the derivative to zero gives ``a* = ln(1 + N_t / N_f) / N_t``. Both
+    counts must be above 0: without foliage no finite scale is best, and a target
+    that never fires has no optimum (``FieldError`` naming the count).
     """
+    n_target = number_field("n_target", n_target, 0.0, low_open=True)
+    n_foliage = number_field("n_foliage", n_foliage, 0.0, low_open=True)
     return math.log1p(n_target / n_foliage) / n_target
