@@ -306,3 +306,30 @@ def test_closed_forms_refuse_values_outside_their_meaning(call, message):
     with pytest.raises(FieldError) as caught:
         call()
     assert str(caught.value).startswith(message)
+
+
+@pytest.mark.parametrize(
+    "call, message",
+    [
+        (lambda: fire_counts(np.ones((1, 3)), 0, 1, 0), "pulses = 0: expected an integer from 1 to 100000"),
+        (lambda: fire_counts(np.ones((1, 3)), 2.5, 1, 0), "pulses = 2.5: expected an integer from 1 to"),
+        (lambda: fire_counts(np.ones((1, 3)), 1, 0, 0), "dead_bins = 0: expected an integer from 1 to"),
+        (
+            lambda: fire_counts(-np.ones((1, 3)), 1, 1, 0),
+            "mean_counts is a (1, 3) array holding -1.0: expected finite mean counts >= 0",
+        ),
+        (
+            lambda: fire_counts(np.ones(3), 1, 1, 0),
+            "mean_counts is a (3,) array: expected a (detectors, bins) array",
+        ),
+        (lambda: declare_points(np.ones((1, 3)), 0), "threshold = 0: expected an integer from 1 to"),
+    ],
+)
+def test_firing_refuses_bad_arguments_with_one_line_naming_them(call, message):
+    """They raised ValueError ("pulses and dead_bins must be at least 1", naming neither),
+    where the README says bad values given to the API raise a LadarError naming them."""
+    from ladartui.errors import FieldError
+
+    with pytest.raises(FieldError) as caught:
+        call()
+    assert str(caught.value).startswith(message)

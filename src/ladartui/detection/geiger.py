@@ -31,10 +31,12 @@ import numpy as np
 
 from ladartui.checks import integer_field, number_field
 from ladartui.detection.settings import MAX_PULSES
-from ladartui.errors import check_cancelled
+from ladartui.errors import Described, FieldError, check_cancelled
 
 SPEED_OF_LIGHT = 299_792_458.0
 _MASK = (1 << 64) - 1
+# The longest dead time in bins (an int32 in the kernel's arithmetic).
+MAX_DEAD_BINS = 2**31 - 1
 
 
 @numba.njit(cache=True, nogil=True)
@@ -102,11 +104,16 @@ def fire_counts(
     """
     mean = np.ascontiguousarray(mean_counts, dtype=np.float64)
     if mean.ndim != 2:
-        raise ValueError("mean_counts must be (detectors, bins)")
-    if pulses < 1 or dead_bins < 1:
-        raise ValueError("pulses and dead_bins must be at least 1")
-    if np.any(~np.isfinite(mean)) or np.any(mean < 0):
-        raise ValueError("mean counts must be finite and non-negative")
+        raise FieldError("mean_counts", Described(f"a {mean.shape} array"), "a (detectors, bins) array")
+    pulses = integer_field("pulses", pulses, 1, MAX_PULSES)
+    dead_bins = integer_field("dead_bins", dead_bins, 1, MAX_DEAD_BINS)
+    bad = ~np.isfinite(mean) | (mean < 0)
+    if bad.any():
+        raise FieldError(
+            "mean_counts",
+            Described(f"a {mean.shape} array holding {float(mean[bad][0])!r}"),
+            "finite mean counts >= 0",
+        )
     ids = (
         np.arange(mean.shape[0], dtype=np.uint64)
         if detectors is None
@@ -115,19 +122,16 @@ def fire_counts(
     counts = np.zeros(mean.shape, dtype=np.int32)
     fire_prob = -np.expm1(-mean)
     block = max(1, FIRE_BLOCK_VISITS // max(mean.size, 1))
-    for first in range(0, int(pulses), block):
+    for first in range(0, pulses, block):
         check_cancelled(cancel, "cancelled while firing pulses")
-        end = min(int(pulses), first + block)
-        _fire_kernel(
-            fire_prob, ids, first, end, int(dead_bins), np.uint64(seed & _MASK), np.uint64(scan), counts
-        )
+        end = min(pulses, first + block)
+        _fire_kernel(fire_prob, ids, first, end, dead_bins, np.uint64(seed & _MASK), np.uint64(scan), counts)
     return counts
 
 
 def declare_points(counts, threshold: int) -> np.ndarray:
     """Coincidence processing: True where a bin fired at least ``threshold`` times."""
-    if threshold < 1:
-        raise ValueError("threshold must be at least 1")
+    threshold = integer_field("threshold", threshold, 1, MAX_PULSES)
     return np.asarray(counts) >= threshold
 
 
