@@ -284,7 +284,8 @@ def test_an_occupancy_without_the_box_sized_accelerations_traces_the_same(monkey
     monkeypatch.setattr(resources, "ACCELERATION_SHARE", 0)
     sparse = Occupancy.build(vox, shape)
     assert dense.cubes is not None and sparse.cubes is None
-    for field in ("root", "regions", "tiles", "bricks", "columns", "blocks"):
+    assert dense.columns is not None and sparse.columns is None  # on the same terms
+    for field in ("root", "regions", "tiles", "bricks", "blocks"):
         assert np.array_equal(getattr(sparse, field), getattr(dense, field)), field
     o = np.column_stack(
         [rng.uniform(-50, 350, 20_000), rng.uniform(-50, 310, 20_000), rng.uniform(60, 200, 20_000)]
@@ -297,3 +298,42 @@ def test_an_occupancy_without_the_box_sized_accelerations_traces_the_same(monkey
     b = backend.trace_cells(sparse, o, d, method="exact")
     assert (a.kind == 1).sum() > 1000
     assert np.array_equal(a.kind, b.kind) and np.array_equal(a.index, b.index) and np.array_equal(a.t, b.t)
+
+
+@pytest.mark.parametrize("backend_name", ["numba", "wgpu"])
+def test_two_voxels_a_million_apart_take_memory_for_what_they_hold(backend_name):
+    """Two voxels 10^6 cells apart on x and y (100 km at 0.1 m) needed about 58 GiB, the
+    column tops (4 bytes an 8 x 8 voxel column) of the whole box: refused, and past the
+    limit numpy's allocation failed. Unaffordable column tops are left out (the column
+    skip only passes empty cells), and both backends trace the reference's answers."""
+    import tracemalloc
+
+    from ladartui.resources import occupancy_bytes
+    from ladartui.tracing.backend import BackendUnavailable, get_backend
+    from ladartui.tracing.reference import reference_trace_cells
+
+    try:
+        backend = get_backend(backend_name)
+    except BackendUnavailable:
+        pytest.skip(f"{backend_name} unavailable here")
+    vox = np.array([[3, 5, 0], [1_000_000, 1_000_003, 2], [1_000_001, 1_000_003, 0]])
+    shape = (1_000_010, 1_000_010, 16)
+    estimate = occupancy_bytes(vox.min(axis=0), vox.max(axis=0) + 1, len(vox))
+    Occupancy.build(vox[:1], shape)  # kernels loaded before measuring
+    tracemalloc.start()
+    occ = Occupancy.build(vox, shape)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert occ.nbytes <= peak <= estimate < 64 * 2**20
+    assert occ.columns is None and occ.contains(vox).all()
+    rng = np.random.default_rng(3)
+    aim = vox[rng.integers(0, len(vox), 600)] + rng.uniform(0, 1, size=(600, 3))
+    o = aim + rng.uniform(-30, 30, size=(600, 3))
+    o[:, 2] = rng.uniform(5, 40, 600)  # above: descending rays, where the column skip was
+    o[:300] = [500_000.5, 500_002.5, 30.0]  # and across the empty half of the box
+    d = aim - o
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    got = backend.trace_cells(occ, o, d, method="exact")
+    ref = reference_trace_cells(vox, shape, o, d)
+    assert np.array_equal(got.kind, ref.kind) and np.array_equal(got.index, ref.index)
+    assert (got.kind == 1).sum() > 500

@@ -216,7 +216,7 @@ def _env_limit(name: str, expected: str) -> int | None:
     return int(value)
 
 
-# The extent-sized accelerations (empty cubes, halos) are built while they cost at most
+# The extent-sized accelerations (column tops, empty cubes, halos) are built while they cost at most
 # this, or ACCELERATION_SHARE times the content's nodes; a few voxels spread over a big
 # box go without them (same answers, slower through the empty space), so memory follows
 # what the scene holds.
@@ -230,14 +230,15 @@ _SORTED_VOXEL_BYTES = 40
 def occupancy_bytes(lo, hi, count) -> int:
     """Estimated peak bytes to build the occupancy of ``count`` voxels spanning ``lo..hi``.
 
-    The root grid and the column tops are sized by the extent (coarsely); the empty
-    cubes and halos too, when ``builds_accelerations`` says they are built.
+    The root grid is sized by the extent (coarsely); the column tops, empty cubes and
+    halos too, when ``builds_columns`` and ``builds_accelerations`` say they are built.
     """
     lo, last = _corners(lo, hi)
     root = [int(b >> 9) - int(a >> 9) + 1 for a, b in zip(lo, last)]
     size = 4 * root[0] * root[1] * root[2]
-    size += 4 * (root[0] * 64) * (root[1] * 64)  # column tops
     nodes = _node_bytes(lo, last, count)
+    if _affordable(_column_bytes(lo, last), nodes):
+        size += _column_bytes(lo, last)
     accelerations = _acceleration_bytes(lo, last)
     if _affordable(accelerations, nodes):
         return int(size + nodes + accelerations)
@@ -250,6 +251,19 @@ def builds_accelerations(lo, hi, count) -> bool:
     content's nodes."""
     lo, last = _corners(lo, hi)
     return _affordable(_acceleration_bytes(lo, last), _node_bytes(lo, last, count))
+
+
+def builds_columns(lo, hi, count) -> bool:
+    """Whether the occupancy of ``count`` voxels spanning ``lo..hi`` gets its column tops
+    (4 bytes an 8 x 8 voxel column of the root grid), on the same terms as the cubes:
+    two voxels 10^6 voxels apart on x and y would need 58 GiB of them."""
+    lo, last = _corners(lo, hi)
+    return _affordable(_column_bytes(lo, last), _node_bytes(lo, last, count))
+
+
+def _column_bytes(lo, last) -> int:
+    root = [int(b >> 9) - int(a >> 9) + 1 for a, b in zip(lo, last)]
+    return 4 * (root[0] * 64) * (root[1] * 64)
 
 
 def _affordable(accelerations: int, nodes: int) -> bool:

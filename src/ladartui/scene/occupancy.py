@@ -8,7 +8,7 @@ blocks, cubes and halo are optional accelerations a tracer may ignore.
     regions 512 slots per region (64-voxel cells): tile number, 0 = empty
     tiles   512 slots per tile (8-voxel cells): brick number, 0 = empty
     bricks  16 words per brick: one bit per voxel
-    columns per 8 x 8 column of bricks: 1 + highest non-empty brick z (relative to the root grid)
+    columns (optional) per 8 x 8 column of bricks: 1 + highest non-empty brick z (relative to the root grid)
     blocks  (uint64, optional acceleration) per brick: bit b of its 64 2x2x2 blocks is set
             when block b holds a voxel, b = bx + 4 * by + 16 * bz with (bx, by, bz) = l >> 1
     cubes   (uint8, optional acceleration) per downward ray octant and brick cell of the occupied
@@ -21,8 +21,9 @@ blocks, cubes and halo are optional accelerations a tracer may ignore.
 Inside any node the local position (lx, ly, lz), each 0..7, is linear
 ``l = lx + 8 * ly + 64 * lz``; a brick's bit ``l`` is bit ``l & 31`` of word ``l >> 5``.
 Memory grows with the content: one node per non-empty cell at its level. The root
-grid and column tops are sized by the box coarsely; cubes and halos are built only
-while affordable for the content (``resources.builds_accelerations``), else left None.
+grid is sized by the box coarsely; column tops, cubes and halos are built only while
+affordable for the content (``resources.builds_columns``, ``builds_accelerations``),
+else left None.
 """
 
 from __future__ import annotations
@@ -249,8 +250,11 @@ class Occupancy:
     @classmethod
     def _over_bricks(cls, shape, box, bkeys, bricks, count, **accelerations):
         """The occupancy of the sorted brick keys ``bkeys`` and their ``bricks``: the tiles,
-        regions and root above them, the column tops and block masks; ``box`` (lo, hi,
-        root origin, root dims); ``accelerations``: the optional empty cubes and halos."""
+        regions and root above them, the column tops (while affordable) and block masks;
+        ``box`` (lo, hi, root origin, root dims); ``accelerations``: the optional empty
+        cubes and halos."""
+        from ladartui.resources import builds_columns
+
         lo, hi, root_origin, root_dims = box
         tiles, tkeys = _parents(bkeys, len(bkeys))
         regions, rkeys = _parents(tkeys, len(tkeys))
@@ -267,7 +271,7 @@ class Occupancy:
             tiles,
             bricks,
             count,
-            _column_tops(bkeys, root_dims),
+            _column_tops(bkeys, root_dims) if builds_columns(lo, hi, count) else None,
             block_masks(bricks),
             **accelerations,
         )

@@ -33,7 +33,7 @@ struct Params {
     root_dims: vec4<i32>,
     bases: vec4<u32>,        // first word of root, regions, tiles, bricks in occ()
     run: vec4<i32>,          // ray count, method (0 exact, 1 march), zmax, root cells
-    extra: vec4<u32>,        // first word of columns in occ(), march: first sample, samples per pass; first_hits: 1 when all rays share origins[0..3]
+    extra: vec4<u32>,        // first word of columns in occ() (NO_COLUMNS: none), march: first sample, samples per pass; first_hits: 1 when all rays share origins[0..3]
     cube_origin: vec4<i32>,  // brick cell of the empty-cube box's corner; w: first word of cubes in occ()
     cube_dims: vec4<i32>,    // its size in bricks; all zero without cubes (no jumps)
     footprint: vec4<i32>,    // the scene's [0, nx) x [0, ny) in the rays' cell space: x0, y0, x1, y1
@@ -190,7 +190,7 @@ fn first_voxel(ox: real, oy: real, oz: real, dx: real, dy: real, dz: real, start
     if (pz) {  // cubes are kept for rays that do not climb only
         ddx = 0;
     }
-    let descending = dz < 0.0;
+    let descending = dz < 0.0 && params.extra.x != NO_COLUMNS;  // the column skip's one gate
     let cap = 4 * (hi.x - lo.x + hi.y - lo.y + hi.z - lo.z) + 64;
     var steps = 0;
     while (steps < cap) {

@@ -91,6 +91,9 @@ NO_VOXEL, CUT_WORD = -1, -2
 # The object-order shader's word for a ray without a hit: the packed cell no voxel
 # has (shader_scan.cell_packing refuses the one box whose corner packs to it).
 NO_CELL = 0xFFFFFFFF
+# The parameter block's first word of the column tops when the occupancy has none
+# (Occupancy.columns is None, as for a few voxels over a huge box): no column skip.
+NO_COLUMNS = 0xFFFFFFFF
 
 
 def wgsl_constants(real: str) -> str:
@@ -115,6 +118,7 @@ def wgsl_constants(real: str) -> str:
         f"const MARCH_SKIP_MARGIN: real = {_wgsl_float(MARCH_SKIP_MARGIN)};",
         f"const BUNDLE: u32 = {BUNDLE}u;",
         f"const NO_CELL: u32 = {NO_CELL}u;",
+        f"const NO_COLUMNS: u32 = {NO_COLUMNS}u;",
     ]
     return "\n".join(lines) + "\n"
 

@@ -101,16 +101,17 @@ def _exact_kernel(
     from one aircraft begin near the first brick any of them can meet.
     Empty root cells and regions are skipped as nodes; a DDA over 8-voxel
     bricks skips empty bricks (and, for descending rays, whole empty brick
-    columns), jumps across the empty cube of bricks ahead of the ray
-    (``Occupancy.cubes``) and walks on past tile faces while bricks are known
-    empty; inside a brick a voxel DDA skips empty 4- and 2-voxel blocks (one
-    mask word per brick), tests bits and goes on into neighbouring non-empty
-    bricks of the tile. Every cell boundary parameter comes from
-    the one formula ``(b - o) * inv``, so the cells visited are those of a
-    plain voxel DDA.
+    columns; not where ``columns`` is empty, the occupancy having none), jumps
+    across the empty cube of bricks ahead of the ray (``Occupancy.cubes``) and
+    walks on past tile faces while bricks are known empty; inside a brick a
+    voxel DDA skips empty 4- and 2-voxel blocks (one mask word per brick),
+    tests bits and goes on into neighbouring non-empty bricks of the tile.
+    Every cell boundary parameter comes from the one formula ``(b - o) * inv``,
+    so the cells visited are those of a plain voxel DDA.
     """
     n = orig.shape[0]
     chunks = (n + BUNDLE - 1) // BUNDLE
+    has_columns = columns.shape[0] > 0
     for ch in prange(chunks):
         # Step 0: where the chunk's rays may all start (tracing.bundle; 0 when they diverge).
         start = bundle_start(
@@ -173,7 +174,7 @@ def _exact_kernel(
                 octant = (0 if px else 1) | (0 if py else 2)
                 if pz:  # cubes are kept for rays that do not climb only
                     ddx = 0
-                descending = dz < 0.0
+                descending = dz < 0.0 and has_columns  # the column skip's one gate
                 cap = 4 * (hi[0] - lo[0] + hi[1] - lo[1] + hi[2] - lo[2]) + 64
                 steps = 0
                 while steps < cap:
@@ -429,6 +430,7 @@ class NumbaBackend:
         cubes, corg, cdims = _cube_arrays(occ)
         halo = halo_arrays(occ) if bundles else halo_arrays(None)
         blocks = occ.blocks if getattr(occ, "blocks", None) is not None else block_masks(occ.bricks)
+        columns = occ.columns if occ.columns is not None else np.zeros(0, np.uint32)
         started = time.perf_counter()
 
         tree = (occ.root, occ.regions, occ.tiles, occ.bricks)
@@ -443,7 +445,7 @@ class NumbaBackend:
                     answers = (kind[c:d], index[c:d], t[c:d])
                     if method == "exact":
                         _exact_kernel(
-                            *rays, *tree, blocks, occ.columns, cubes, corg, cdims, *halo, *extent, *answers
+                            *rays, *tree, blocks, columns, cubes, corg, cdims, *halo, *extent, *answers
                         )
                     else:
                         march_kernel(*rays, float(step), float(occ.zmax), *tree, *extent, *answers)

@@ -19,7 +19,7 @@ import numpy as np
 
 from ladartui.errors import BackendUnavailable
 from ladartui.scene.occupancy import BRICK_SHIFT, REGION_SHIFT
-from ladartui.tracing.config import MARCH_SAMPLES_PER_PASS, METHOD_CODES, wgsl_constants
+from ladartui.tracing.config import MARCH_SAMPLES_PER_PASS, METHOD_CODES, NO_COLUMNS, wgsl_constants
 
 # trace.wgsl's bindings besides the occupancy chunks, which follow them: params,
 # rays, hit cells, hit ranges, bundle starts (trace_rays); origins, directions,
@@ -134,11 +134,8 @@ def occupancy_header(real: str, chunks: int, chunk_shift: int) -> str:
 def occupancy_arrays(occupancy):
     """The u32 arrays laid end to end on the device: root, regions, tiles, bricks, columns, cubes."""
     columns = getattr(occupancy, "columns", None)
-    if columns is None:
-        # No brick-column tops: every column reaches the top of the root grid, so
-        # the column skip never fires (same cells visited, only slower).
-        dims = np.asarray(occupancy.root_dims, dtype=np.int64)
-        columns = np.full(int(dims[0] * 64 * dims[1] * 64), int(dims[2]) * 64, dtype=np.uint32)
+    if columns is None:  # none: pack_params says NO_COLUMNS, and the column skip is off
+        columns = np.zeros(0, np.uint32)
     return [
         occupancy.root,
         occupancy.regions,
@@ -200,7 +197,8 @@ def pack_params(
     ints[4, :3] = occupancy.root_dims
     ints[5, :] = np.array(upload.bases[:4], dtype=np.int64).astype(np.uint32).view(np.int32)
     ints[6, :] = (count, METHOD_CODES[method], int(occupancy.zmax), len(occupancy.root))
-    ints[7, 0] = np.array(upload.bases[4], dtype=np.int64).astype(np.uint32).view(np.int32)
+    columns_at = NO_COLUMNS if getattr(occupancy, "columns", None) is None else upload.bases[4]
+    ints[7, 0] = np.array(columns_at, dtype=np.int64).astype(np.uint32).view(np.int32)
     ints[7, 1:4] = (first_sample, samples_per_pass, int(shared_origin))
     cube_origin, cube_dims = cube_box(occupancy)
     ints[8, :3] = cube_origin - (move >> BRICK_SHIFT)  # the cubes are in bricks
