@@ -17,8 +17,9 @@ def add_parser(subparsers):
         help="generate a synthetic forest scene with a vehicle under the canopy",
         description="Generate a forest scene (trees with gappy crowns, a vehicle under the "
         "canopy at the centre) and write OUT.txt and OUT_Target.txt, comma-delimited voxel "
-        "lists. Presets: 'small' (60 m x 60 m at 0.25 m) and 'reference' (the report's "
-        "figure-11 scale: 1500 x 1500 x 900 voxels at 0.1 m, about 3.8 M voxels). The same "
+        "lists. Presets: 'small' (60 m x 60 m at 0.25 m) and 'reference' (150 m x 150 m at "
+        "0.1 m, the report's figure-11 scale: 1500 x 1500 voxels across, about "
+        "3.8 M voxels). The same "
         "seed and options always give the same scene.",
     )
     parser.add_argument("preset", metavar="PRESET", help="small or reference")

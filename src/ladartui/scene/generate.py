@@ -69,7 +69,7 @@ class SceneParams:
 PRESETS = {
     # Tests and the default scenario: 240 x 240 voxels, a few dozen trees.
     "small": SceneParams(),
-    # The report's figure-11 scale: 1500 x 1500 x 900 voxels, about 3.8 M voxels.
+    # The report's figure-11 scale: 1500 x 1500 voxels across (a 900-layer box), about 3.8 M voxels.
     "reference": SceneParams(
         voxel_size=0.1,
         width=150.0,
