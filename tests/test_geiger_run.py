@@ -215,3 +215,11 @@ def test_a_false_alarm_probability_below_the_shown_decimals_is_not_shown_as_zero
     console.print(detection_table(DetectionMeasures(**counts, false_alarm_probability=probability)))
     row = next(line for line in console.export_text().splitlines() if "false-alarm probability" in line)
     assert row.split()[-2] == shown
+
+
+def test_one_pulse_a_look_is_said_in_the_singular(woods, capsys):
+    """'1 pulses per look' in the run's table and the scenario's summary."""
+    scenario = _geiger(woods, pulses=1, coincidence=1).save()
+    assert "detection  geiger, 1 pulse, k = 1" in scenario.summary()
+    assert main(["run", str(scenario.path), "--no-write"]) == 0
+    assert "Geiger-mode detection: 1 pulse per look, k = 1" in capsys.readouterr().out

@@ -182,7 +182,7 @@ def _study_with_progress(scenario, pulses, settings, backend, console, state):
             what = (
                 f"tracing scan {p.done}/{p.total}"
                 if p.stage == "trace"
-                else f"pulse count {p.done}/{p.total} ({pulses[p.done - 1]} pulses)"
+                else f"pulse count {p.done}/{p.total} ({plural(pulses[p.done - 1], 'pulse')})"
             )
             bar.update(task, completed=p.units_done / p.units_total, description=what)
 

@@ -353,13 +353,13 @@ def detection_table(detection):
     from rich.table import Table
 
     from ladartui.measures_table import format_share
-    from ladartui.number_text import fixed_or_tiny
+    from ladartui.number_text import fixed_or_tiny, plural
 
     def number(value, digits=1):
         return "undefined" if value is None else fixed_or_tiny(value, digits, grouped=True)
 
     table = Table(
-        title=f"Geiger-mode detection: {detection.pulses} pulses per look, "
+        title=f"Geiger-mode detection: {plural(detection.pulses, 'pulse')} per look, "
         f"k = {detection.coincidence}, seed {detection.seed}",
         show_header=False,
     )

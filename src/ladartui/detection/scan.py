@@ -17,6 +17,7 @@ import numpy as np
 from ladartui.detection.geiger import noise_per_bin
 from ladartui.detection.look import geiger_look, incidence_cosines, range_gate
 from ladartui.errors import ResourceLimitError
+from ladartui.number_text import plural
 from ladartui.returns import unique_voxels
 from ladartui.scene.keys import voxel_keys
 
@@ -241,7 +242,7 @@ class GeigerRun:
         check_bin_visits(
             (self.cells_fired + detectors * bins * (self.scans - scan)) * pulses,
             self.source,
-            f"{pulses:,} pulses on each of {self.scans:,} looks, those to come taken as look "
+            f"{plural(pulses, 'pulse')} on each of {plural(self.scans, 'look')}, those to come taken as look "
             f"{scan}'s {detectors:,} detectors x {bins:,} range bins",
         )
 

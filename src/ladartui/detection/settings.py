@@ -30,6 +30,7 @@ from dataclasses import dataclass, fields
 
 from ladartui.checks import choice_field, integer_field, number_field
 from ladartui.errors import FieldError
+from ladartui.number_text import plural
 
 MODELS = ("ideal", "geiger")
 MAX_PULSES = 100_000
@@ -140,7 +141,7 @@ class DetectionSettings:
         dead = "one fire per pulse" if self.dead_time_m is None else f"dead time {self.dead_time_m:g} m"
         width = "depth resolution" if self.bin_width_m is None else f"{self.bin_width_m:g} m"
         return (
-            f"geiger, {self.pulses} pulses, k = {self.coincidence}, N_ref {self.n_ref:g} "
+            f"geiger, {plural(self.pulses, 'pulse')}, k = {self.coincidence}, N_ref {self.n_ref:g} "
             f"at {self.range_ref_m:g} m, noise {self.noise_rate_hz:g} Hz, bins {width}, "
             f"{dead}, seed {self.seed}"
         )
