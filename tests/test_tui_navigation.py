@@ -48,3 +48,14 @@ def test_the_segments_table_says_at_of_the_altitude_alone():
 
     assert wrap_detail("200 m, 80 m off at 60 m", 13) == ["200 m,", "80 m off", "at 60 m"]
     assert wrap_detail("200 m, 80 m off at 60 m", 17) == ["200 m, 80 m off", "at 60 m"]
+
+
+def test_the_segments_table_gives_a_partial_orbits_arc():
+    """A half orbit read 'r 60 m at 60 m', as the full circle does."""
+    from ladartui.flight import Orbit
+    from ladartui.tui.bridge import segment_summary
+
+    target = (30.0, 30.0, 1.0)
+    half = Orbit(centre=target, radius=60.0, altitude=60.0, scans=12, arc=180.0)
+    assert segment_summary(half) == "180 deg r 60 m at 60 m"
+    assert segment_summary(Orbit(centre=target, radius=60.0, altitude=60.0, scans=12)) == "r 60 m at 60 m"

@@ -255,7 +255,8 @@ def segment_summary(segment) -> str:
     if k == "turn":
         return f"{segment.direction} {segment.arc:g} deg r {segment.radius:g} m"
     if k == "orbit":
-        return f"r {segment.radius:g} m at {segment.altitude:g} m"
+        arc = f"{segment.arc:g} deg " if segment.arc < 360.0 else ""  # the full circle unsaid
+        return f"{arc}r {segment.radius:g} m at {segment.altitude:g} m"
     if k == "flypast":
         return f"{segment.length:g} m, {segment.standoff:g} m off at {segment.altitude:g} m"
     if k == "standoff":
