@@ -414,3 +414,33 @@ async def test_the_views_draw_in_greys_where_no_color_is_set(tmp_path, scene_fil
             if view.id != "output3d":  # nothing run: the output view is its placeholder
                 assert len(colours) > 5, view.id  # the picture is drawn, in several greys
     assert app.return_code in (None, 0)
+
+
+class _Terminal(io.StringIO):
+    def isatty(self):
+        return True
+
+
+def test_the_interface_with_standard_error_sent_to_a_file_is_refused_in_one_line(monkeypatch, capsys):
+    """'ladartui 2>errors.log' (or 2>/dev/null) opened the interface on a blank terminal:
+    Textual draws on standard error, so its screens went into the file while it waited
+    for keys typed blind."""
+    import sys
+
+    import ladartui.tui
+    from ladartui import cli
+
+    calls = []
+    monkeypatch.setattr(ladartui.tui, "run_app", lambda path, graphics=None: calls.append(path))
+    monkeypatch.setattr(sys, "__stdin__", _Terminal())
+    monkeypatch.setattr(sys, "__stdout__", _Terminal())
+    monkeypatch.setattr(sys, "__stderr__", io.StringIO())  # 2>errors.log
+    assert cli.main([]) == 2
+    assert capsys.readouterr().err == (
+        "ladartui: error: the terminal UI draws on standard error, and it is a file or pipe "
+        "(2>FILE); run it with standard error on the terminal, or for a run without one: "
+        "ladartui run SCENARIO\n"
+    )
+    assert calls == []
+    monkeypatch.setattr(sys, "__stderr__", _Terminal())  # all three on the terminal: it opens
+    assert cli.main([]) == 0 and calls == [None]

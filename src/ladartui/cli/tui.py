@@ -28,11 +28,16 @@ def add_parser(subparsers) -> None:
     parser.set_defaults(handler=run)
 
 
+def _terminals(*streams) -> bool:
+    return all(stream is not None and stream.isatty() for stream in streams)
+
+
 def on_a_terminal() -> bool:
-    """Whether the process reads keys from, and draws on, a terminal."""
+    """Whether the process reads keys from, and draws on, a terminal: standard input and
+    output, and standard error, the stream Textual's driver draws every screen on."""
     import sys
 
-    return all(stream is not None and stream.isatty() for stream in (sys.__stdin__, sys.__stdout__))
+    return _terminals(sys.__stdin__, sys.__stdout__, sys.__stderr__)
 
 
 def run(args) -> int:
@@ -46,8 +51,16 @@ def run(args) -> int:
     if path is not None:
         require_file(path, "expected a scenario file (.toml)")
     if not on_a_terminal():  # the app would draw into a file or pipe and wait for keys for ever
+        import sys
+
         from ladartui.errors import LadarError
 
+        if _terminals(sys.__stdin__, sys.__stdout__):  # 2>errors.log: a blank terminal
+            raise LadarError(
+                "the terminal UI draws on standard error, and it is a file or pipe (2>FILE); "
+                "run it with standard error on the terminal, or for a run without one: "
+                "ladartui run SCENARIO"
+            )
         raise LadarError(
             "the terminal UI needs a terminal, and its input or output is a file or pipe; "
             "for a run without one: ladartui run SCENARIO"
