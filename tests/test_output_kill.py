@@ -53,7 +53,9 @@ POINTS = [("temporaries", 1), ("swap", 2), ("backups", 1)]
 
 
 @pytest.mark.parametrize(
-    "sig", [signal.SIGKILL, signal.SIGINT, signal.SIGTERM], ids=["SIGKILL", "SIGINT", "SIGTERM"]
+    "sig",
+    [signal.SIGKILL, signal.SIGINT, signal.SIGTERM, signal.SIGHUP],
+    ids=["SIGKILL", "SIGINT", "SIGTERM", "SIGHUP"],  # SIGHUP: the SSH connection dropped
 )
 @pytest.mark.parametrize("step, occurrence", POINTS, ids=[p[0] for p in POINTS])
 def test_killed_run_leaves_one_set(tmp_path, new_set, sig, step, occurrence):
@@ -79,9 +81,29 @@ def test_killed_run_leaves_one_set(tmp_path, new_set, sig, step, occurrence):
         # A stop before the swap writes nothing; once the swap began it finishes.
         assert after == (old_set if step == "temporaries" else new_set)
         if after == old_set:
-            # 128 + the signal, as a shell reports it: 130 for Ctrl-C, 143 for SIGTERM
+            # 128 + the signal, as a shell reports it: 130 for Ctrl-C, 143 for SIGTERM,
+            # 129 for a hangup
             assert process.returncode == 128 + sig and "nothing was written" in err
         else:
             assert process.returncode == 0 and "wrote measures" in out + err
     assert hidden(scenario.path.parent) == []
     shutil.rmtree(tmp_path / "s")
+
+
+def test_a_run_under_nohup_finishes_through_a_hangup(tmp_path, new_set):
+    """nohup (SIGHUP ignored) keeps a run going when the SSH connection drops: the
+    handler that stops a run on a hangup is not put in place of the ignore."""
+    scenario = make_scenario(tmp_path / "s")
+    write_old_set(scenario)
+    process = subprocess.Popen(
+        [sys.executable, "-c", PAUSING_RUN, "temporaries", "1", str(scenario.path)],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        preexec_fn=lambda: signal.signal(signal.SIGHUP, signal.SIG_IGN),
+    )
+    assert process.stdout.readline().strip() == "paused"
+    process.send_signal(signal.SIGHUP)
+    out, err = process.communicate(timeout=60)
+    assert process.returncode == 0 and "wrote measures" in out + err
+    assert digest(scenario) == new_set

@@ -150,7 +150,7 @@ def _wait_out_interrupts(finished: threading.Event, stopping: Callable[[], None]
             sys.stderr.flush()
 
 
-# The signal that stopped the command (SIGINT unless SIGTERM did): its exit status is
+# The signal that stopped the command (SIGINT unless SIGTERM or SIGHUP did): its exit status is
 # 128 + its number, as a shell reports a process that signal killed.
 _stopped_by = {"signal": int(signal.SIGINT)}
 
@@ -160,7 +160,8 @@ def reset_stop() -> None:
 
 
 def stop_status() -> int:
-    """The exit status of a command stopped by a signal: 130 for Ctrl-C, 143 for SIGTERM."""
+    """The exit status of a command stopped by a signal: 130 for Ctrl-C, 143 for SIGTERM,
+    129 for SIGHUP."""
     return 128 + _stopped_by["signal"]
 
 
@@ -169,14 +170,25 @@ def _interrupt(signum, frame):
     raise KeyboardInterrupt
 
 
+# SIGTERM: a batch system's or kill's stop; SIGHUP: the terminal went away (an SSH
+# connection dropped), which sends it to the jobs the shell started.
+STOP_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
+
+
 @contextlib.contextmanager
 def sigterm_as_interrupt():
-    """Treat SIGTERM (a batch system's or ``kill``'s stop) like Ctrl-C while inside."""
+    """Treat SIGTERM and SIGHUP like Ctrl-C while inside: the work stops where it may, a
+    set being swapped in finishes, and the message says what was written. A signal the
+    command started with ignored (``nohup`` ignores SIGHUP) stays ignored."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    previous = signal.signal(signal.SIGTERM, _interrupt)
+    previous = {}
+    for number in STOP_SIGNALS:
+        if signal.getsignal(number) is not signal.SIG_IGN:
+            previous[number] = signal.signal(number, _interrupt)
     try:
         yield
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for number, handler in previous.items():
+            signal.signal(number, handler)
