@@ -106,3 +106,24 @@ def test_a_key_the_app_keeps_for_itself_is_refused_in_keys_toml(tmp_path):
     assert "Tab moves to the next control" in problems[2]
     assert "Ctrl+I is the terminal's Tab" in problems[5]
     assert keys_in_force(keymap)["run"] == "f5"
+
+
+async def test_the_screen_is_drawn_again_after_a_suspend_and_fg(tmp_path, scene_files):
+    """After Ctrl+Z at the shell's level (SIGTSTP) and fg, Textual went back to the
+    terminal's alternate screen, which starts blank, and drew nothing until something
+    changed: the interface stayed an empty terminal. The whole screen is drawn again."""
+    from textual._compositor import LayoutUpdate
+
+    from tui_support import make_scenario, opened
+
+    scenario = make_scenario(tmp_path, scene_files)
+    async with opened(scenario, size=(80, 24)) as (app, pilot):
+        await pilot.pause()
+        drawn = []
+        display = app._display
+        app._display = lambda screen, update: (drawn.append(update), display(screen, update))[1]
+        app.app_resume_signal.publish(app)  # what the driver does once the app is in the foreground
+        await pilot.pause()
+        await pilot.pause()
+        full = [u for u in drawn if isinstance(u, LayoutUpdate) and u.region == app.screen.region]
+        assert full, drawn
