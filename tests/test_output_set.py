@@ -419,3 +419,25 @@ def test_names_are_measured_with_what_each_file_writes_beside_it(tmp_path, capsy
         f"written beside it; at most {most} a name)"
     )
     assert "scenario" not in outputset.output_problem(tmp_path / ("c" * 242))
+
+
+def test_a_scenario_name_that_is_not_utf8_is_refused_before_tracing(tmp_path, capsys):
+    """A scenario copied from a Latin-1 system ('plan\\xe9.toml') traced the whole run,
+    then ended in a UnicodeEncodeError traceback writing its run record, a UTF-8 file
+    that names the outputs after the scenario. Its folder may hold such bytes."""
+    scenario = make_scenario(tmp_path / os.fsdecode(b"lat\xe9"))
+    latin = scenario.path.with_name(os.fsdecode(b"plan\xe9.toml"))
+    latin.write_bytes(scenario.path.read_bytes())
+    for command in ("run", "validate"):
+        assert main([command, str(latin)]) == 2, command
+        err = last_error_line(capsys)
+        assert (
+            "Traceback" not in err
+            and "plan\\udce9_Scene.txt: its name is not UTF-8 text (the byte 0xe9)" in err
+        ), err
+        assert "rename the scenario" in err, err
+    assert sorted(p.name for p in latin.parent.iterdir()) == sorted(
+        ["S.toml", "woods.txt", "woods_Target.txt", latin.name]
+    )
+    assert main(["run", str(scenario.path)]) == 0  # the folder's own byte is no matter
+    assert scenario.run_record.is_file()

@@ -433,6 +433,26 @@ def check_output_names(scenario, las=False) -> None:
     shorter = "; use a shorter scenario name"
     check_names(*output_paths(scenario, las).values(), extra=SET_MEMBER_EXTRA, advice=shorter)
     check_names(output_lock(scenario), extra=LOCK_EXTRA, advice=shorter)
+    _check_names_are_text(output_paths(scenario, las).values())
+
+
+def _check_names_are_text(paths) -> None:
+    """Refuse outputs whose names hold a byte that is not UTF-8 (a scenario named on a
+    Latin-1 system): the run record, a UTF-8 file, names them, and could not be written
+    once the run had traced. Their folder's name is not in the record."""
+    from ladartui.errors import OutputFileError
+
+    for path in paths:
+        name = os.fsencode(Path(path).name)
+        try:
+            name.decode("utf-8")
+        except UnicodeDecodeError as error:
+            byte = name[error.start]
+            raise OutputFileError(
+                path,
+                f"its name is not UTF-8 text (the byte 0x{byte:02x}), and the run record, a UTF-8 "
+                "file, names each output; rename the scenario",
+            ) from None
 
 
 def check_outputs_spare_inputs(scenario, las=False) -> None:
