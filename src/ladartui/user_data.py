@@ -46,6 +46,8 @@ BUNDLED = {
 def config_folder() -> Path:
     if os.environ.get("LADARTUI_HOME"):
         return user_path(os.environ["LADARTUI_HOME"]) / "config"
+    if not os.environ.get("XDG_CONFIG_HOME"):
+        home_folder()  # platformdirs would name a folder "~" in the current one
     return platformdirs.user_config_path("ladartui")
 
 
@@ -53,8 +55,24 @@ def data_home() -> Path:
     """The user data folder of ladartui (default scenario, benchmark scenes)."""
     if os.environ.get("LADARTUI_HOME"):
         return user_path(os.environ["LADARTUI_HOME"])
-    base = os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share"
+    base = os.environ.get("XDG_DATA_HOME") or home_folder() / ".local" / "share"
     return user_path(base) / "ladartui"
+
+
+def home_folder() -> Path:
+    """The user's home folder; a LadarError where there is none: no HOME, and a user id
+    the password database does not know (a container or batch job given a bare user
+    id), where pathlib raised RuntimeError."""
+    home = os.path.expanduser("~")
+    if home.startswith("~"):
+        from ladartui.errors import LadarError
+
+        raise LadarError(
+            f"no home folder: HOME is not set and user id {os.getuid()} has no entry in the "
+            "password database; set LADARTUI_HOME (or XDG_DATA_HOME and XDG_CONFIG_HOME) to a "
+            "folder for ladartui's data and settings"
+        )
+    return Path(home)
 
 
 def made_folder(folder: Path) -> Path:
