@@ -192,3 +192,55 @@ def test_the_sweep_progress_keeps_its_figures_whole_in_80_columns():
     assert len(line) <= 80 and "\u2026" not in line
     assert re.search(f"480/960 {re.escape(note)} (-:--:--|\\d:\\d\\d:\\d\\d)$", line.rstrip())
     assert "\u2501" in line
+
+
+@pytest.mark.parametrize("where", ["log", "dumb"])
+def test_progress_into_a_log_or_a_dumb_terminal_says_how_far_now_and_then(monkeypatch, where):
+    """'ladartui run S.toml > run.log 2>&1' (a batch job, nohup) or TERM=dumb (an editor's
+    shell): rich redraws nothing there and wrote the progress once, at the end; an
+    hour's run said nothing for an hour ('tail -f run.log' stayed empty). A line now
+    comes every LOG_EVERY_SECONDS, and the last one at the end as before."""
+    import io
+
+    from rich.console import Console
+
+    import ladartui.cli.progress as progress
+    from ladartui.cli.run import run_progress
+
+    monkeypatch.delenv("COLUMNS", raising=False)
+    monkeypatch.setattr(progress, "LOG_EVERY_SECONDS", 0.0)
+    out = io.StringIO()
+    if where == "dumb":
+        monkeypatch.setenv("TERM", "dumb")
+        console = Console(file=out, force_terminal=True, color_system=None)
+        assert console.is_dumb_terminal
+    else:
+        console = Console(file=out, color_system=None)
+    assert not console.is_interactive
+    with run_progress(console, transient=False) as bar:
+        task = bar.add_task("scan 1", total=1.0, rays="")
+        for scan in (1, 2, 3):
+            bar.update(task, completed=scan / 4, description=f"scan {scan}/4", rays=f"{scan},000/4,000 rays")
+            assert f"scan {scan}/4" in out.getvalue()  # said as it happens, not at the end
+        bar.update(task, completed=1.0, description="scan 4/4", rays="4,000/4,000 rays")
+    lines = [line for line in out.getvalue().splitlines() if line.strip()]
+    assert [line.split()[1] for line in lines] == ["1/4", "2/4", "3/4", "4/4", "4/4"], lines
+    assert "\x1b" not in out.getvalue()
+
+
+def test_progress_on_a_terminal_is_not_logged_line_by_line(monkeypatch):
+    import io
+
+    from rich.console import Console
+
+    import ladartui.cli.progress as progress
+    from ladartui.cli.run import run_progress
+
+    monkeypatch.setattr(progress, "LOG_EVERY_SECONDS", 0.0)
+    monkeypatch.setenv("TERM", "xterm")
+    out = io.StringIO()
+    console = Console(file=out, width=80, force_terminal=True, color_system=None)
+    with run_progress(console, transient=True, auto_refresh=False) as bar:
+        task = bar.add_task("scan 1", total=1.0, rays="")
+        bar.update(task, completed=0.5, description="scan 2/4")
+        assert "scan 2/4" not in out.getvalue()  # redrawn in place (at refresh), never a line

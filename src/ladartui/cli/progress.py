@@ -34,6 +34,31 @@ def first_scan(scenario) -> str:
 
 
 LOG_WIDTH = 200  # progress written to a file or pipe: wide enough for every line
+# Where nothing is redrawn (a file or pipe, TERM=dumb), a progress line this often.
+LOG_EVERY_SECONDS = 30.0
+
+
+def _logging_progress(columns, console, **options):
+    """rich's Progress that, where nothing is redrawn in place (a log, a pipe, a dumb
+    terminal: rich writes the display once, as it ends), prints the progress as a line
+    every ``LOG_EVERY_SECONDS``, so that a long run in a log says how far it is."""
+    import time
+
+    from rich.progress import Progress
+
+    class LoggingProgress(Progress):
+        logged_at = time.monotonic()
+
+        def update(self, task_id, **fields) -> None:
+            super().update(task_id, **fields)
+            if self.disable or self.console.is_interactive or not self.live.is_started:
+                return
+            now = time.monotonic()
+            if now - self.logged_at >= LOG_EVERY_SECONDS:
+                self.logged_at = now
+                self.console.print(self.make_tasks_table(self.tasks))
+
+    return LoggingProgress(*columns, console=console, **options)
 
 
 def progress_display(console, after, description=None, **options):
@@ -41,14 +66,16 @@ def progress_display(console, after, description=None, **options):
     task's description by default), a bar taking the room the texts leave, then the
     columns ``after`` (a fixed 40-cell bar cut the texts and times short in an
     80-column terminal)."""
-    from rich.progress import BarColumn, Progress, TextColumn
+    from rich.progress import BarColumn, TextColumn
 
     description = description or TextColumn("{task.description}")
     if not console.is_terminal and "COLUMNS" not in os.environ:
         # A file or pipe (a log): no width to fit, so a short bar and nothing cut short.
         console.width = max(console.width, LOG_WIDTH)
-        return Progress(description, BarColumn(bar_width=20), *after, console=console, **options)
-    return Progress(description, BarColumn(bar_width=None), *after, console=console, expand=True, **options)
+        return _logging_progress((description, BarColumn(bar_width=20), *after), console, **options)
+    return _logging_progress(
+        (description, BarColumn(bar_width=None), *after), console, expand=True, **options
+    )
 
 
 def voxelize_display(console):
