@@ -99,3 +99,32 @@ def test_a_flight_log_named_relative_to_the_working_folder_is_saved_where_it_lie
     again = load_scenario(scenario.path)
     assert again.flight.segments[0].file == str(work / "log.csv")
     assert again.poses() == scenario.poses()
+
+
+def test_a_model_file_named_in_other_unicode_code_points_is_pointed_to(tmp_path):
+    """'scène.txt' in the scenario (é one code point), 'scène.txt' on disk copied from a
+    Mac (e and a combining accent): 'not found' named a file ls shows right there."""
+    import shutil
+    import unicodedata
+
+    orbit = Path(__file__).resolve().parent.parent / "scenarios" / "orbit.toml"
+    text = orbit.read_text()
+    start = text.index('scene = "') + len('scene = "')
+    written = text[start : text.index('"', start)]
+    path = tmp_path / "s.toml"
+    path.write_text(text.replace(f'scene = "{written}"', 'scene = "scène.txt"', 1))
+    decomposed = unicodedata.normalize("NFD", "scène.txt")
+    assert decomposed != "scène.txt"
+    shutil.copy(orbit, tmp_path / decomposed)
+    with pytest.raises(InputFileError) as caught:
+        load_scenario(path)
+    said = str(caught.value)
+    assert f"scene model file {tmp_path / 'scène.txt'} not found (files.scene)" in said
+    assert (
+        "\n" not in said
+        and f"the folder holds {decomposed}, the same name in other Unicode code points" in said
+    )
+    (tmp_path / decomposed).unlink()
+    with pytest.raises(InputFileError) as caught:
+        load_scenario(path)
+    assert "Unicode" not in str(caught.value)  # nothing like it there: not found, alone

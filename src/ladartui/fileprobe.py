@@ -114,6 +114,29 @@ def _name_max(path: Path) -> int:
         return 255
 
 
+def other_code_points(path) -> str:
+    """ "; the folder holds NAME, ..." when a file beside ``path`` has its name in other
+    Unicode code points (an accent as a letter and a combining mark, as macOS writes
+    names, against one code point as typed): the same on screen, so "not found" alone
+    named a file that ``ls`` shows; else ""."""
+    import unicodedata
+
+    path = Path(path)
+    wanted = unicodedata.normalize("NFC", path.name)
+    try:
+        with os.scandir(path.parent) as entries:
+            for entry in entries:
+                if entry.name != path.name and unicodedata.normalize("NFC", entry.name) == wanted:
+                    return (
+                        f"; the folder holds {entry.name}, the same name in other Unicode code "
+                        "points (accents as separate marks, as macOS writes names): rename that "
+                        "file to the name written here"
+                    )
+    except OSError:
+        pass
+    return ""
+
+
 def require_file(path, expected: str) -> None:
     """``refuse_special_file``, "PATH: is a folder; ``expected``", and "PATH: no such file;
     ``expected``" for anything else that is no regular file, from one look (for readers

@@ -28,6 +28,7 @@ from ladartui.fileprobe import (
     NO_SUCH_FILE,
     OTHER_FILE_KINDS,
     file_problem,
+    other_code_points,
     other_file_kind,
     path_field,
     read_utf8,
@@ -223,6 +224,8 @@ class Scenario:
         missing = None
         if problem := file_problem(self.scene_file):
             missing = f"scene model file {self.scene_file} {problem} (files.scene)"
+            if problem == "not found":
+                missing += other_code_points(self.scene_file)
         # another kind of file: else its target, 'X_Target.las', was asked for
         elif other := other_model_kind(self.scene_file, self.voxel_size):
             kind, hint = other
@@ -242,6 +245,8 @@ class Scenario:
                 f"{self.scene_file.name} must sit beside it, named "
                 f"{self.target_file.name})"
             )
+            if problem == "not found":
+                missing += other_code_points(self.target_file)
         if missing:
             raise InputFileError(self.path, missing, self.key_line("files.scene"))
 
