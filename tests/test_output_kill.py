@@ -6,6 +6,7 @@ files by checksum with the old set and with the set an uninterrupted run
 writes. The next run over the set then leaves no hidden temporaries.
 """
 
+import errno
 import hashlib
 import shutil
 import signal
@@ -107,3 +108,44 @@ def test_a_run_under_nohup_finishes_through_a_hangup(tmp_path, new_set):
     out, err = process.communicate(timeout=60)
     assert process.returncode == 0 and "wrote measures" in out + err
     assert digest(scenario) == new_set
+
+
+class _GoneTerminal:
+    """A terminal the SSH connection took with it: every write fails with EIO."""
+
+    def write(self, text):
+        raise OSError(errno.EIO, "Input/output error")
+
+    def flush(self):
+        raise OSError(errno.EIO, "Input/output error")
+
+    def isatty(self):
+        return True
+
+    def fileno(self):
+        import io
+
+        raise io.UnsupportedOperation("fileno")  # (no descriptor here to point at /dev/null)
+
+
+@pytest.mark.parametrize("bar_drawn_on_the_way_out", [True, False])
+def test_a_hangup_whose_terminal_is_gone_ends_with_129_not_a_traceback(monkeypatch, bar_drawn_on_the_way_out):
+    """An SSH connection dropping stops a run (SIGHUP) and takes its terminal: the
+    progress bar's last draw, then the message, failed with EIO; the command ended in
+    an OSError traceback with status 1, as if it had failed, not been stopped."""
+    import ladartui.cli.progress as progress
+    import ladartui.cli.run as run_command
+    from ladartui.errors import Cancelled
+
+    def stopped_run(args):
+        progress._stopped_by["signal"] = int(signal.SIGHUP)
+        try:
+            raise Cancelled("run cancelled; nothing was written, earlier outputs are unchanged")
+        finally:
+            if bar_drawn_on_the_way_out:
+                sys.stderr.write("scan 3/24\n")
+
+    monkeypatch.setattr(run_command, "run", stopped_run)
+    monkeypatch.setattr(sys, "stderr", _GoneTerminal())
+    monkeypatch.setattr(sys, "stdout", _GoneTerminal())
+    assert main(["run", "default"]) == 128 + signal.SIGHUP

@@ -139,10 +139,10 @@ def main(argv: list[str] | None = None) -> int:
         print(f"ladartui: error: {one_line(error)}", file=sys.stderr)
         return BUSY_STATUS if isinstance(error, OutputSetBusy) else 2
     except Cancelled as error:  # its message says what was (not) written
-        print(f"ladartui: {one_line(error)}", file=sys.stderr)
+        _say(f"ladartui: {one_line(error)}")
         return stop_status()
     except KeyboardInterrupt:
-        print("ladartui: interrupted", file=sys.stderr)
+        _say("ladartui: interrupted")
         return stop_status()
     except ImportError as error:
         # a Ctrl-C inside an extension module's start (matplotlib's, as a chart is drawn)
@@ -158,6 +158,9 @@ def main(argv: list[str] | None = None) -> int:
         # file. An error naming one, or of another kind, is no failed write: raised as it is.
         if error.filename is not None or error.errno not in _WRITE_ERRORS:
             raise
+        if _while_stopping(error):  # a hangup took the terminal the stop was to be told on
+            _reader_gone()
+            return stop_status()
         what = "numba's cache of the compiled kernels" if _in_numba(error) else "the output"
         print(f"ladartui: error: could not write {what}: {os_reason(error)}", file=sys.stderr)
         _reader_gone()  # no second failure as Python flushes standard output at exit
@@ -165,6 +168,24 @@ def main(argv: list[str] | None = None) -> int:
 
 
 _WRITE_ERRORS = {errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO}
+
+
+def _say(line: str) -> None:
+    """``line`` on standard error, unless it cannot be written there (the terminal an SSH
+    connection took with it as its hangup stopped the command): the exit status tells."""
+    with contextlib.suppress(OSError, ValueError):
+        print(line, file=sys.stderr)
+
+
+def _while_stopping(error: BaseException) -> bool:
+    """Whether ``error`` came as the command stopped (a Ctrl-C, SIGTERM or SIGHUP being
+    handled): the progress bar's last draw on a terminal that has gone."""
+    seen = error.__context__
+    while seen is not None:
+        if isinstance(seen, (Cancelled, KeyboardInterrupt)):
+            return True
+        seen = seen.__context__
+    return False
 
 
 def _in_numba(error: BaseException) -> bool:
