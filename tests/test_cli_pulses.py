@@ -378,3 +378,25 @@ def test_pulse_study_names_a_scenario_or_settings_of_the_wrong_kind(scenario, mo
         f"scenario = {str(scenario.path)!r}: expected a Scenario "
         "(ladartui.load_scenario reads one from a file)"
     )
+
+
+@pytest.mark.parametrize(
+    ("env", "coloured"), [({}, True), ({"NO_COLOR": "1"}, False), ({"TERM": "dumb"}, False)]
+)
+def test_the_chart_on_a_terminal_is_coloured_unless_no_color_or_a_dumb_terminal(
+    scenario, capsys, monkeypatch, env, coloured
+):
+    """NO_COLOR=1 (and TERM=dumb, which shows escapes as text) still got the chart's ANSI
+    colours: it asked only whether standard output was a terminal."""
+    import sys
+
+    monkeypatch.delenv("NO_COLOR", raising=False)
+    monkeypatch.delenv("FORCE_COLOR", raising=False)
+    monkeypatch.setenv("TERM", "xterm-256color")
+    for name, value in env.items():
+        monkeypatch.setenv(name, value)
+    monkeypatch.setattr(sys.stdout, "isatty", lambda: True)  # a terminal
+    assert main(["pulses", str(scenario.path), "--pulses", "1,2"]) == 0
+    out = capsys.readouterr().out
+    assert ("\x1b[" in out) is coloured, out[-400:]
+    assert "obscured coverage % (ideal)" in out

@@ -130,8 +130,17 @@ def run(args) -> int:
     if args.chart:
         columns = shutil.get_terminal_size((CHART_WIDTH, CHART_HEIGHT)).columns  # COLUMNS first
         width = max(CHART_MIN_WIDTH, min(columns, CHART_WIDTH))
-        print(chart_text(ideal, rows, width=width, color=sys.stdout.isatty()))
+        print(chart_text(ideal, rows, width=width, color=_colours_shown()))
     return 0
+
+
+def _colours_shown() -> bool:
+    """Whether standard output takes the chart's ANSI colours, as rich decides for the
+    tables: a terminal, not dumb (TERM=dumb shows escapes as text), and no NO_COLOR."""
+    from ladartui.cli.console import CliConsole
+
+    console = CliConsole()
+    return console.is_terminal and console.color_system is not None and not console.no_color
 
 
 def _print_table(ideal, rows) -> None:
