@@ -105,6 +105,32 @@ class RunControl(Host):
             worker.cancel()
             self.set_busy("Cancelling: earlier outputs stay as they were...", self.progress)
 
+    def stop_on_sigterm(self) -> None:
+        """SIGTERM (``kill PID`` from another login, ``timeout``) killed the app where it
+        stood, the terminal left on the alternate screen, mouse reports on and nothing
+        echoed: it now cancels a run (the earlier outputs stay; a swap under way
+        finishes) and leaves as Quit does, giving the terminal back, status 143."""
+        import asyncio
+        import contextlib
+        import signal
+
+        with contextlib.suppress(NotImplementedError, RuntimeError, ValueError):  # not the main thread
+            asyncio.get_running_loop().add_signal_handler(signal.SIGTERM, self._terminated)
+
+    def _terminated(self) -> None:
+        import signal
+
+        self.action_cancel_run()
+        self.exit(return_code=128 + signal.SIGTERM)
+
+    def on_unmount(self) -> None:
+        import asyncio
+        import contextlib
+        import signal
+
+        with contextlib.suppress(NotImplementedError, RuntimeError, ValueError):
+            asyncio.get_running_loop().remove_signal_handler(signal.SIGTERM)
+
     def action_help_quit(self) -> None:
         """Ctrl+C: a terminal app's copy, which Textual follows with how to quit. During
         a run, the reflex to stop it, it says how to cancel the run as well; so on a study's
