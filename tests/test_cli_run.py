@@ -405,3 +405,16 @@ def test_a_json_run_gives_its_notes_and_keeps_stdout_json(scenario, capsys):
     assert main(["run", str(scenario.path), "--json", "--no-write"]) == 0
     said = capsys.readouterr()
     assert json.loads(said.out)["notes"] == reach_notes(scenario, scenario.load_scene())
+
+
+def test_a_run_under_columns_0_still_shows_its_measures(tmp_path, capsys, monkeypatch):
+    """COLUMNS=0 (exported where 0 is taken to mean no limit) made rich's width 0: the
+    run printed nothing at all, not even its 'backend:' line, and exited 0."""
+    from ladartui.cli.console import CliConsole
+
+    monkeypatch.setenv("COLUMNS", "0")
+    assert CliConsole().width == 80  # as rich takes a terminal that reports no size
+    monkeypatch.setenv("LADARTUI_HOME", str(tmp_path / "home"))
+    assert main(["run", "default", "--no-write"]) == 0
+    out = capsys.readouterr().out
+    assert "Target coverage" in out and "backend: " in out and "no scenario outputs written" in out

@@ -11,5 +11,10 @@ from rich.console import Console
 
 
 class CliConsole(Console):
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        if self.width < 1:  # COLUMNS=0: rich drew every line 0 wide, so nothing at all
+            self.width = 80  # as rich takes a terminal that reports no size
+
     def on_broken_pipe(self) -> None:
         raise BrokenPipeError
