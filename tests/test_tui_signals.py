@@ -12,6 +12,8 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
 SRC = Path(__file__).resolve().parent.parent / "src"
 LEAVE_ALTERNATE_SCREEN = b"\x1b[?1049l"
 
@@ -31,10 +33,12 @@ def read_until(fd, wanted: bytes, seen: bytearray, timeout: float) -> bool:
     return wanted in seen
 
 
-def test_sigterm_gives_the_terminal_back(tmp_path):
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP], ids=["SIGTERM", "SIGHUP"])
+def test_a_stop_signal_gives_the_terminal_back(tmp_path, sig):
     """SIGTERM killed the app where it stood: the terminal stayed on the alternate
     screen with mouse reports on, the cursor hidden and nothing echoed, until 'reset'
-    was typed blind."""
+    was typed blind. SIGHUP (an SSH connection dropping) killed it too, a run's swap of
+    its outputs cut short; both now quit as Quit does."""
     primary, secondary = pty.openpty()
     env = dict(os.environ, PYTHONPATH=str(SRC), LADARTUI_HOME=str(tmp_path / "home"), TERM="xterm")
     env.pop("TMUX", None)
@@ -51,8 +55,8 @@ def test_sigterm_gives_the_terminal_back(tmp_path):
     seen = bytearray()
     try:
         assert read_until(primary, b"F5 runs", seen, timeout=300), bytes(seen[-400:])
-        process.send_signal(signal.SIGTERM)
-        assert process.wait(timeout=60) == 128 + signal.SIGTERM
+        process.send_signal(sig)
+        assert process.wait(timeout=60) == 128 + sig
         read_until(primary, LEAVE_ALTERNATE_SCREEN, seen, timeout=5)
         assert LEAVE_ALTERNATE_SCREEN in seen, bytes(seen[-400:])
     finally:

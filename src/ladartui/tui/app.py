@@ -157,7 +157,7 @@ class LadarApp(
         self.keep_notes_off_dialogs()
         # back from SIGTSTP (fg): the alternate screen starts blank, and Textual draws nothing
         self.app_resume_signal.subscribe(self, lambda _app: self.refresh(layout=True))
-        self.stop_on_sigterm()
+        self.stop_on_signals()
         self.view_area = self.query_one(ViewArea)
         runs = self.key_says("run", "runs")
         self.view_area.no_output = "no output yet" + (f": {runs}" if runs else "")

@@ -105,23 +105,26 @@ class RunControl(Host):
             worker.cancel()
             self.set_busy("Cancelling: earlier outputs stay as they were...", self.progress)
 
-    def stop_on_sigterm(self) -> None:
+    def stop_on_signals(self) -> None:
         """SIGTERM (``kill PID`` from another login, ``timeout``) killed the app where it
         stood, the terminal left on the alternate screen, mouse reports on and nothing
-        echoed: it now cancels a run (the earlier outputs stay; a swap under way
-        finishes) and leaves as Quit does, giving the terminal back, status 143."""
+        echoed, and SIGHUP (an SSH connection dropping) cut a run's swap short: each now
+        cancels a run (the earlier outputs stay; a swap under way finishes) and leaves
+        as Quit does, giving the terminal back, status 128 + the signal. A signal
+        ignored at start (``nohup``) stays ignored."""
         import asyncio
         import contextlib
         import signal
 
         with contextlib.suppress(NotImplementedError, RuntimeError, ValueError):  # not the main thread
-            asyncio.get_running_loop().add_signal_handler(signal.SIGTERM, self._terminated)
+            loop = asyncio.get_running_loop()
+            for number in (signal.SIGTERM, signal.SIGHUP):
+                if signal.getsignal(number) is not signal.SIG_IGN:  # nohup's ignore kept
+                    loop.add_signal_handler(number, self._terminated, int(number))
 
-    def _terminated(self) -> None:
-        import signal
-
+    def _terminated(self, number: int) -> None:
         self.action_cancel_run()
-        self.exit(return_code=128 + signal.SIGTERM)
+        self.exit(return_code=128 + number)
 
     def on_unmount(self) -> None:
         import asyncio
@@ -129,7 +132,8 @@ class RunControl(Host):
         import signal
 
         with contextlib.suppress(NotImplementedError, RuntimeError, ValueError):
-            asyncio.get_running_loop().remove_signal_handler(signal.SIGTERM)
+            for number in (signal.SIGTERM, signal.SIGHUP):
+                asyncio.get_running_loop().remove_signal_handler(number)
 
     def action_help_quit(self) -> None:
         """Ctrl+C: a terminal app's copy, which Textual follows with how to quit. During
