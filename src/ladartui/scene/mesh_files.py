@@ -162,7 +162,7 @@ def check_obj_lines(path: Path, text: str) -> str:
     vertices = np.asarray(points).reshape(-1, 3)
     for n, (at, indices) in polygons.items():
         rows = np.asarray(indices).reshape(-1, n)
-        for k in _fans_short(vertices[rows]):
+        for k in fans_short(vertices[rows]):
             order = polygon_triangles(vertices[rows[k]])
             if order is not None:
                 words = lines[at[k]].split()[1:]
@@ -171,7 +171,7 @@ def check_obj_lines(path: Path, text: str) -> str:
     return "\n".join(lines) + "\n" if cut else text
 
 
-def _fans_short(corners: np.ndarray) -> np.ndarray:
+def fans_short(corners: np.ndarray) -> np.ndarray:
     """Which of the polygons ``corners`` (P, n, 3) a fan from their first corner may not
     cover (a fan triangle not turning with the polygon): the few to look at one by
     one, all found at once (a mesh of quads has millions)."""

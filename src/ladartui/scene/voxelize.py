@@ -39,6 +39,7 @@ import warnings
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -46,6 +47,7 @@ from ladartui.errors import FieldError, InputFileError, ResourceLimitError, chec
 from ladartui.fileprobe import require_file
 from ladartui.number_text import plural
 from ladartui.scene.mesh_files import binary_stl, check_obj_lines, check_ply_whole, check_stl_whole
+from ladartui.scene.ply_faces import binary_ply_triangles, cut_read_polygons
 from ladartui.scene.voxel_arrays import voxel_size_field
 from ladartui.scene.voxels import MAX_INDEX
 
@@ -118,8 +120,16 @@ def load_mesh(path, scale: float = 1.0, up: str = "z") -> Mesh:
             # each merged on reading, are joined without merging).
             # Read unprocessed: processing drops a vertex that is not finite, and the
             # triangles using it, where it is to be refused
-            scene = trimesh.load_scene(source, file_type=kind[1:], resolver=resolver, process=False)
+            # a PLY's vertices as in the file (not parted by texture coordinates), for
+            # its polygons to be cut again where the reader's fans leave them
+            options: dict[str, Any] = {"fix_texture": False} if kind == ".ply" else {}
+            scene = trimesh.load_scene(
+                source, file_type=kind[1:], resolver=resolver, process=False, **options
+            )
             _refuse_not_finite(path, scene.geometry.values())
+            if kind == ".ply":
+                for part in scene.geometry.values():
+                    cut_read_polygons(part)
             collapsed = 0
             for part in scene.geometry.values():
                 if isinstance(part, trimesh.Trimesh):  # not a point cloud
@@ -199,7 +209,8 @@ def _mesh_source(path: Path, kind: str):
 
     if kind == ".ply":
         check_ply_whole(path)
-        return str(path), None
+        rewritten = binary_ply_triangles(path)  # face lists of differing lengths
+        return (str(path) if rewritten is None else io.BytesIO(rewritten)), None
     try:
         data = path.read_bytes()
     except OSError as error:
