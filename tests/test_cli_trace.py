@@ -298,12 +298,14 @@ def test_a_rays_file_is_checked_from_its_header_before_it_is_read(tmp_path, scen
 
 def test_a_scene_too_large_to_trace_is_named_by_its_file(tmp_path, capsys):
     far = tmp_path / "far.txt"
-    far.write_text("0,0,0\n1000000,1000000,1000\n")  # its column tops alone: about 58 GiB
+    far.write_text("0,0,0\n100000000,100000000,1000\n")  # its root grid alone: about 284 GiB
     rays = tmp_path / "rays.npy"
     np.save(rays, np.array([[5.0, 5.0, 50.0, 0.0, 0.0, -1.0]]))
     code = main(["trace", "--scene", str(far), "--rays", str(rays), "--out", str(tmp_path / "h.npy")])
     err = capsys.readouterr().err.strip()
-    assert code == 2 and err.startswith(f"ladartui: error: {far}: 2 voxels spanning 1000001 x 1000001 x 1001")
+    assert code == 2 and err.startswith(
+        f"ladartui: error: {far}: 2 voxels spanning 100000001 x 100000001 x 1001"
+    )
 
 
 def test_a_march_step_too_fine_names_the_flag(tmp_path, scene_file, capsys):

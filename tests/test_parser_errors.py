@@ -138,9 +138,11 @@ def test_validate_summary_gives_scene_size_and_memory(tmp_path, capsys):
 
 
 def test_validate_refuses_a_scene_too_large_for_memory(tmp_path, capsys):
-    path = write_scenario(tmp_path, b"0,0,0\n2147483647,0,0\n")
+    """Its root grid (4 bytes a 512-voxel cell of the box) alone: about 64 TiB; two voxels
+    2^31 apart on x alone take 16 MiB since their column tops are left out."""
+    path = write_scenario(tmp_path, b"0,0,0\n2147483647,2147483647,0\n")
     assert main(["validate", str(path)]) == 2
-    assert "m.txt: 2 voxels spanning 2147483648 x 1 x 1 voxels need about" in one_error_line(capsys)
+    assert "m.txt: 2 voxels spanning 2147483648 x 2147483648 x 1 voxels need about" in one_error_line(capsys)
 
 
 def las_with(tmp_path, offset, value):
