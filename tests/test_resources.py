@@ -41,6 +41,8 @@ def test_a_memory_limit_of_one_byte_is_said_in_the_singular(tmp_path, capsys, mo
     assert main(["info", str(path)]) == 2
     assert one_error_line(capsys).endswith("more than the 1 byte of memory available")
     assert [gib(n) for n in (0, 2, 1023, 1024)] == ["0 bytes", "2 bytes", "1,023 bytes", "1 KiB"]
+    # a box far too large read '6.55e+04 GiB'
+    assert [gib(n) for n in (999 * 2**30, 2**46, 2**60)] == ["999 GiB", "64 TiB", "1,048,576 TiB"]
 
 
 @pytest.mark.parametrize(

@@ -360,7 +360,11 @@ def check_rays(rays, source, limit=None, raise_with=RAISE_RAYS) -> None:
 
 
 def gib(nbytes) -> str:
-    """A size in words: GiB from 128 MiB up, then MiB, KiB, bytes ("1 byte")."""
+    """A size in words: TiB from 999.5 GiB up (whole ones past 999), GiB from 128 MiB up,
+    then MiB, KiB, bytes ("1 byte")."""
+    if nbytes >= 999.5 * 2**30:  # not "1e+03 GiB"
+        tib = nbytes / 2**40
+        return f"{tib:.3g} TiB" if tib < 1000 else f"{round(tib):,} TiB"
     if nbytes >= 2**27:
         return f"{nbytes / 2**30:.3g} GiB"
     if nbytes >= 2**20:
