@@ -7,6 +7,7 @@ import struct
 import numpy as np
 import pytest
 
+from ladartui.scene.ply_faces import binary_ply_triangles
 from ladartui.scene.voxelize import load_mesh, voxelize
 
 L_SHAPE = [(2, 1), (1, 1), (1, 2), (0, 2), (0, 0), (2, 0)]  # counter-clockwise, 3 m2
@@ -53,13 +54,16 @@ def l_prism_faces(start: int) -> tuple[list[tuple[int, int, int]], list[list[int
 PLY_COUNTS = {"uchar": "B", "uint8": "B", "int": "i", "int32": "i", "uint": "I", "uint32": "I"}
 
 
-def ply_bytes(vertices, faces, encoding: str, count: str = "uchar", extra: bool = False) -> bytes:
+def ply_bytes(
+    vertices, faces, encoding: str, count: str = "uchar", extra: bool = False, comment: bool = False
+) -> bytes:
     """A PLY of ``vertices`` and polygon ``faces`` (lists of their corners, counted as
     ``count``); with ``extra``, each face also has a flags byte before its list and a
-    quality float after it."""
+    quality float after it; with ``comment``, a comment line opens the face element."""
     header = ["ply", f"format {encoding} 1.0", f"element vertex {len(vertices)}"]
     header += [f"property float {axis}" for axis in "xyz"]
-    header += [f"element face {len(faces)}"] + (["property uchar flags"] if extra else [])
+    header += [f"element face {len(faces)}"] + (["comment exported by X"] if comment else [])
+    header += ["property uchar flags"] if extra else []
     header += [f"property list {count} int vertex_indices"] + (["property float quality"] if extra else [])
     head = ("\n".join([*header, "end_header"]) + "\n").encode()
     if encoding == "ascii":
@@ -98,6 +102,20 @@ def test_a_concave_ply_face_is_cut_whatever_counts_its_lists(tmp_path, count, en
     path = tmp_path / "l.ply"
     path.write_bytes(ply_bytes(*l_prism_faces(0), encoding, count, extra=True))
     assert_l_prism(path)
+
+
+@pytest.mark.parametrize("extra", [False, True])
+@pytest.mark.parametrize("encoding", ["ascii", "binary_little_endian"])
+def test_a_comment_among_the_face_properties_is_kept_apart(tmp_path, extra, encoding):
+    """A comment line after ``element face`` took a property line's place when the binary
+    file was rewritten: 'not a readable PLY mesh (ValueError: PLY is unexpected length!)'."""
+    path = tmp_path / "l.ply"
+    path.write_bytes(ply_bytes(*l_prism_faces(0), encoding, extra=extra, comment=True))
+    assert_l_prism(path)
+    if encoding != "ascii":
+        header = binary_ply_triangles(path).split(b"end_header")[0].decode().splitlines()
+        face = header[header.index("element face 20") :]
+        assert face == ["element face 20", "property list uchar int vertex_indices", "comment exported by X"]
 
 
 # A dart: a concave quad of 1 m2, its reflex corner (0.5, 0.5) third when listed from (0, 0)

@@ -111,19 +111,20 @@ def _rewritten(data) -> bytes | None:
     header = data[:newline].decode("latin-1").splitlines()
     body = newline + 1
     order = None
-    elements: list[tuple[str, int, list[list[str]], int]] = []  # name, count, properties, header line
+    elements: list[tuple[str, int, list[list[str]], list[int]]] = []  # name, count, properties, header lines
     for at, line in enumerate(header):
         words = line.split()
         if words[:1] == ["format"] and len(words) > 1:
             order = {"binary_little_endian": "<", "binary_big_endian": ">"}.get(words[1])
         elif words[:1] == ["element"] and len(words) == 3 and words[2].isdigit():
-            elements.append((words[1], int(words[2]), [], at))
+            elements.append((words[1], int(words[2]), [], [at]))
         elif words[:1] == ["property"] and elements:
             elements[-1][2].append(words[1:])
+            elements[-1][3].append(at)
     if order is None or not any(name == "face" for name, *_ in elements):
         return None
     offset, vertices, face = body, None, None
-    for name, count, properties, at in elements:
+    for name, count, properties, places in elements:
         if any(p[:1] == ["list"] for p in properties):
             if sum(p[:1] == ["list"] for p in properties) > 1:
                 return None
@@ -132,7 +133,7 @@ def _rewritten(data) -> bytes | None:
                 return None
             size, lists = read
             if name == "face" and lists is not None:
-                face = (offset, offset + size, lists, at, len(properties))
+                face = (offset, offset + size, lists, places)
             offset += size
             continue
         dtype = np.dtype([(f"p{k}", order + _TYPES[p[0]]) for k, p in enumerate(properties)])
@@ -145,12 +146,13 @@ def _rewritten(data) -> bytes | None:
         offset += count * dtype.itemsize
     if face is None or vertices is None:
         return None
-    start, stop, lists, at, kept = face
+    start, stop, lists, dropped = face
     triangles = cut_polygons(vertices, polygon_groups(lists), always=True)
     if triangles is None:
         return None
+    at = dropped[0]  # the element's line, then its properties' (comments among them kept)
     lines = header[:at] + [f"element face {len(triangles)}", "property list uchar int vertex_indices"]
-    lines += header[at + 1 + kept :]
+    lines += [line for k, line in enumerate(header[at + 1 :], at + 1) if k not in dropped]
     packed = np.zeros(len(triangles), dtype=[("n", "u1"), ("v", order + "i4", (3,))])
     packed["n"], packed["v"] = 3, triangles
     return ("\n".join(lines) + "\n").encode("latin-1") + data[body:start] + packed.tobytes() + data[stop:]
