@@ -14,6 +14,7 @@ import numpy as np
 
 from ladartui.errors import InputFileError
 from ladartui.fileprobe import text_lines
+from ladartui.scene.polygons import concave_cuts
 from ladartui.textsafe import one_line
 
 
@@ -161,67 +162,11 @@ def check_obj_lines(path: Path, text: str) -> str:
     cut = False
     vertices = np.asarray(points).reshape(-1, 3)
     for n, (at, indices) in polygons.items():
-        rows = np.asarray(indices).reshape(-1, n)
-        for k in fans_short(vertices[rows]):
-            order = polygon_triangles(vertices[rows[k]])
-            if order is not None:
-                words = lines[at[k]].split()[1:]
-                lines[at[k]] = "\n".join("f " + " ".join(words[c] for c in triangle) for triangle in order)
-                cut = True
+        for k, order in concave_cuts(vertices, np.asarray(indices).reshape(-1, n)).items():
+            words = lines[at[k]].split()[1:]
+            lines[at[k]] = "\n".join("f " + " ".join(words[c] for c in triangle) for triangle in order)
+            cut = True
     return "\n".join(lines) + "\n" if cut else text
-
-
-def fans_short(corners: np.ndarray) -> np.ndarray:
-    """Which of the polygons ``corners`` (P, n, 3) a fan from their first corner may not
-    cover (a fan triangle not turning with the polygon): the few to look at one by
-    one, all found at once (a mesh of quads has millions)."""
-    normal = np.cross(corners, np.roll(corners, -1, axis=1)).sum(axis=1)  # Newell's
-    first = corners[:, :1]
-    turns = np.einsum("pkc,pc->pk", np.cross(corners[:, 1:-1] - first, corners[:, 2:] - first), normal)
-    return np.flatnonzero(~np.all(turns > 0, axis=1))
-
-
-def polygon_triangles(corners: np.ndarray) -> list[tuple[int, int, int]] | None:
-    """Triangles (corner numbers, in the polygon's winding) covering a planar polygon
-    whose fan from corner 0 would not: None when the fan does (a convex polygon, or
-    one corner 0 sees whole). Cut by clipping ears in the polygon's plane."""
-    normal = np.zeros(3)
-    for a, b in zip(corners, np.roll(corners, -1, axis=0)):  # Newell's normal
-        normal += np.cross(a, b)
-    if not np.any(normal):
-        return None  # no area: nothing to cover
-    turns = np.cross(corners[1:-1] - corners[0], corners[2:] - corners[0]) @ normal
-    if np.all(turns > 0):
-        return None
-    axis = int(np.argmax(np.abs(normal)))  # seen along the axis the plane faces most,
-    u, v = (axis + 1) % 3, (axis + 2) % 3  # counter-clockwise when it faces that axis
-    flat = np.column_stack([corners[:, u], corners[:, v] * (1.0 if normal[axis] > 0 else -1.0)])
-    left = list(range(len(corners)))
-    triangles = []
-    while len(left) > 3:
-        for k in range(len(left)):
-            i, j, m = left[k - 1], left[k], left[(k + 1) % len(left)]
-            if _cross2(flat[i], flat[j], flat[m]) <= 0:
-                continue  # a reflex corner: no ear
-            others = [q for q in left if q not in (i, j, m)]
-            if any(_inside2(flat[q], flat[i], flat[j], flat[m]) for q in others):
-                continue
-            triangles.append((i, j, m))
-            left.pop(k)
-            break
-        else:  # not a simple polygon: leave it to the reader's fan
-            return None
-    triangles.append((left[0], left[1], left[2]))
-    return triangles
-
-
-def _cross2(a, b, c) -> float:
-    return float((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
-
-
-def _inside2(p, a, b, c) -> bool:
-    """Whether ``p`` lies in the counter-clockwise triangle a, b, c or on its sides."""
-    return _cross2(a, b, p) >= 0 and _cross2(b, c, p) >= 0 and _cross2(c, a, p) >= 0
 
 
 def _shown_line(words: list[str]) -> str:

@@ -4,7 +4,7 @@ The mesh reader fans each polygon from its first corner, which puts triangles
 outside a concave one (an L-shaped panel as one six-cornered face), and reads
 no binary PLY whose face lists differ in length (triangles with quads, a
 six-cornered cap with its quad sides). Concave polygons are cut by
-``mesh_files.polygon_triangles``; a file of triangles alone is left as it is."""
+``polygons.concave_cuts``; a file of triangles alone is left as it is."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from ladartui.scene.mesh_files import fans_short, polygon_triangles
+from ladartui.scene.polygons import concave_cuts
 
 _TYPES = {
     "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1",
@@ -22,7 +22,6 @@ _TYPES = {
     "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4",
     "float": "f4", "float32": "f4", "double": "f8", "float64": "f8",
 }  # fmt: skip
-_CHUNK = 2**16  # polygons looked at together: a mesh of quads has millions
 
 
 def polygon_groups(lists) -> dict[int, np.ndarray]:
@@ -43,13 +42,7 @@ def cut_polygons(vertices: np.ndarray, groups: dict[int, np.ndarray], always: bo
     None when no polygon needed cutting (unless ``always``) or a corner is not a vertex."""
     if any(len(rows) and (rows.min() < 0 or rows.max() >= len(vertices)) for rows in groups.values()):
         return None
-    cuts: dict[int, dict[int, list[tuple[int, int, int]]]] = {}
-    for n, rows in groups.items():
-        for start in range(0, len(rows) if n > 3 else 0, _CHUNK):
-            for k in fans_short(vertices[rows[start : start + _CHUNK]]):
-                order = polygon_triangles(vertices[rows[start + k]])
-                if order is not None:
-                    cuts.setdefault(n, {})[start + int(k)] = order
+    cuts = {n: found for n, rows in groups.items() if n > 3 and (found := concave_cuts(vertices, rows))}
     if not cuts and not always:
         return None
     parts = []
