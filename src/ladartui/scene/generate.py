@@ -36,6 +36,7 @@ import numpy as np
 
 from ladartui.errors import FieldError, check_callbacks, check_cancelled
 from ladartui.fileprobe import path_field
+from ladartui.number_text import plural
 from ladartui.scene.occupancy import column_bounds
 from ladartui.scene.trees import branch_voxels, concat_voxels, foliage_voxels, place_trees, trunk_voxels
 from ladartui.scene.vehicles import in_clearing, net_voxels, place_vehicles, vehicle_voxels
@@ -210,8 +211,8 @@ def check_memory(params: SceneParams, trees, nx: int, ny: int) -> int:
     limit = available_memory()
     if need > limit:
         if trees is None:
-            vehicles = "1 vehicle" if params.vehicles == 1 else f"{params.vehicles} vehicles"
             sides = " x ".join(map(str, box))
+            vehicles = plural(params.vehicles, "vehicle")
             what = f"{vehicles} at {params.voxel_size:g} m (a {sides} voxel box) and the ground"
             advice = "use a coarser voxel size"
         else:
