@@ -39,7 +39,7 @@ from ladartui.fileprobe import path_field
 from ladartui.number_text import plural
 from ladartui.scene.occupancy import column_bounds
 from ladartui.scene.trees import branch_voxels, concat_voxels, foliage_voxels, place_trees, trunk_voxels
-from ladartui.scene.vehicles import in_clearing, net_voxels, place_vehicles, vehicle_voxels
+from ladartui.scene.vehicles import box_shape, in_clearing, net_voxels, place_vehicles, vehicle_voxels
 
 
 @dataclass(frozen=True)
@@ -228,8 +228,8 @@ def check_memory(params: SceneParams, trees, nx: int, ny: int) -> int:
 def vehicle_box(p: SceneParams) -> tuple[int, int, int]:
     """The voxel cells a side (x, y, z) of the box a vehicle is cut from."""
     length, width, height = p.vehicle_size
-    reach = math.ceil(math.hypot(length, width) / 2 / p.voxel_size) + 1
-    return 2 * reach + 1, 2 * reach + 1, math.ceil(height / p.voxel_size) + 1
+    reach, top = box_shape(math.hypot(length, width) / 2, height, p.voxel_size)
+    return 2 * reach + 1, 2 * reach + 1, top
 
 
 GENERATE_STAGES = ("ground", "vehicles", "trees", "trunks", "branches", "foliage", "clearing", "merging")

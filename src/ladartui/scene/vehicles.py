@@ -70,11 +70,17 @@ def _local_frame(vehicle: Vehicle, voxels, vs):
     return u, v, w
 
 
+def box_shape(reach_m: float, top_m: float, vs: float) -> tuple[int, int]:
+    """(cells either side of a vehicle's centre, cells up from its base) of the box it
+    is cut from: ``reach_m`` and ``top_m`` at voxel size ``vs``, a cell to spare."""
+    return int(math.ceil(reach_m / vs)) + 1, int(math.ceil(top_m / vs)) + 1
+
+
 def _box_grid(vehicle: Vehicle, reach_m, top_m, vs):
-    reach = int(math.ceil(reach_m / vs)) + 1
+    reach, top = box_shape(reach_m, top_m, vs)
     xs = np.arange(int(vehicle.cx) - reach, int(vehicle.cx) + reach + 1)
     ys = np.arange(int(vehicle.cy) - reach, int(vehicle.cy) + reach + 1)
-    zs = np.arange(vehicle.base, vehicle.base + int(math.ceil(top_m / vs)) + 1)
+    zs = np.arange(vehicle.base, vehicle.base + top)
     grid = np.stack(np.meshgrid(xs, ys, zs, indexing="ij"), axis=-1).reshape(-1, 3)
     return grid[(grid[:, 0] >= 0) & (grid[:, 1] >= 0)].astype(np.int32)
 
