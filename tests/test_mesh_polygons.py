@@ -33,12 +33,7 @@ def test_a_concave_face_is_cut_inside_itself(tmp_path, start, texture):
     """Listed from (2, 1), the fan put 26 of 218 voxels in the L's empty corner."""
     path = tmp_path / "l.obj"
     path.write_text(l_prism_obj(start, texture))
-    mesh = load_mesh(path)
-    assert (mesh.closed, len(mesh.faces)) == (True, 20)
-    solid = voxelize(mesh, 0.25, solid=True)
-    voxels = {tuple(int(v) for v in row) for row in solid.voxels}
-    assert not {(x, y, z) for x, y, z in voxels if x >= 4 and y >= 4}  # the L's empty corner
-    assert len(voxels) == solid.inside == 192 and max(z for _, _, z in voxels) == 3  # 3 m3 of 1/64 m3
+    assert_l_prism(path)
 
 
 def l_prism_faces(start: int) -> tuple[list[tuple[int, int, int]], list[list[int]]]:
@@ -83,7 +78,7 @@ def assert_l_prism(path) -> None:
     solid = voxelize(mesh, 0.25, solid=True)
     voxels = {tuple(int(v) for v in row) for row in solid.voxels}
     assert not {(x, y, z) for x, y, z in voxels if x >= 4 and y >= 4}  # the L's empty corner
-    assert len(voxels) == solid.inside == 192 and max(z for _, _, z in voxels) == 3
+    assert len(voxels) == solid.inside == 192 and max(z for _, _, z in voxels) == 3  # 3 m3 of 1/64 m3
 
 
 @pytest.mark.parametrize("start", range(6))

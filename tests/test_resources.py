@@ -14,8 +14,8 @@ from ladartui.scene.voxels import save_voxels
 @pytest.mark.parametrize("far", ["2147483647,2147483647,0", "300000000,0,300000000"])
 def test_two_voxels_far_apart_are_refused_not_allocated(tmp_path, capsys, far):
     """Where even the root grid (4 bytes a 512-voxel cell of the box) cannot fit; two
-    voxels 10^6 apart on x and y, or 2^31 apart on x, fit in a few MiB since their
-    column tops are left out (test_occupancy)."""
+    voxels 10^6 apart on x and y fit in a few MiB since their column tops are left out
+    (test_occupancy)."""
     path = tmp_path / "f.txt"
     path.write_text(f"0,0,0\n{far}\n")
     assert main(["info", str(path)]) == 2
