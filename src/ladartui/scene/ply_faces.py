@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numba import njit
 
 from ladartui.scene.polygons import concave_cuts
 
@@ -124,9 +125,9 @@ def _rewritten(data) -> bytes | None:
             read = _list_rows(data, offset, count, properties, order)
             if read is None:
                 return None
-            size, lists = read
-            if name == "face" and lists is not None:
-                face = (offset, offset + size, lists, places)
+            size, groups = read
+            if name == "face" and groups is not None:
+                face = (offset, offset + size, groups, places)
             offset += size
             continue
         dtype = np.dtype([(f"p{k}", order + _TYPES[p[0]]) for k, p in enumerate(properties)])
@@ -139,8 +140,8 @@ def _rewritten(data) -> bytes | None:
         offset += count * dtype.itemsize
     if face is None or vertices is None:
         return None
-    start, stop, lists, dropped = face
-    triangles = cut_polygons(vertices, polygon_groups(lists), always=True)
+    start, stop, groups, dropped = face
+    triangles = cut_polygons(vertices, groups, always=True)
     if triangles is None:
         return None
     at = dropped[0]  # the element's line, then its properties' (comments among them kept)
@@ -152,8 +153,9 @@ def _rewritten(data) -> bytes | None:
 
 
 def _list_rows(data, offset: int, count: int, properties: list[list[str]], order: str):
-    """(bytes, the lists when they differ in length, else None) of an element of one
-    list property at ``offset``; None when it runs past the end of the file."""
+    """(bytes, the lists by length as ``polygon_groups`` gives them when they differ in
+    length, else None) of an element of one list property at ``offset``; None when it
+    runs past the end of the file or counts its lists as floats."""
     sizes = [np.dtype(_TYPES[p[0]]).itemsize for p in properties if p[0] != "list"]
     at = next(k for k, p in enumerate(properties) if p[0] == "list")
     before = sum(sizes[:at])
@@ -168,13 +170,58 @@ def _list_rows(data, offset: int, count: int, properties: list[list[str]], order
         counts = np.ndarray((count,), counter, data, offset + before, (row,))
         if np.all(counts == first):
             return count * row, None  # one length: the reader reads it
-    lists = []
+    if counter.kind not in "iu":
+        return None  # counts as floats: left to the reader
+    buffer = np.frombuffer(data, np.uint8)
+    starts, counts, end = _scan_lists(
+        buffer,
+        offset,
+        count,
+        before,
+        counter.itemsize,
+        counter.kind == "i",
+        order == ">",
+        item.itemsize,
+        after,
+    )
+    if end < 0:
+        return None
+    groups = {}
+    for n in np.unique(counts):
+        rows = _gather_rows(buffer, starts[counts == n], int(n) * item.itemsize)
+        groups[int(n)] = rows.view(item).reshape(len(rows), int(n)).astype(np.int64)
+    return end - offset, groups
+
+
+@njit(nogil=True, cache=True)
+def _scan_lists(buffer, offset, count, before, size, signed, big, item, after):
+    """(where each row's list starts, its length, where the element ends) of ``count``
+    rows of a list property from ``offset`` in ``buffer``: ``before`` bytes, a
+    ``size``-byte count, its items of ``item`` bytes, ``after`` bytes; the end -1 when
+    a count is negative or the rows run past the buffer."""
+    starts = np.empty(count, np.int64)
+    counts = np.empty(count, np.int64)
     position = offset
-    for _ in range(count):
-        n = int(np.frombuffer(data, counter, 1, position + before)[0])
-        start = position + before + counter.itemsize
-        lists.append(np.frombuffer(data, item, n, start))
-        position = start + n * item.itemsize + after
-    arranged = np.empty(len(lists), dtype=object)
-    arranged[:] = lists
-    return position - offset, arranged
+    for r in range(count):
+        at = position + before
+        if at + size > len(buffer):
+            return starts, counts, -1
+        n = 0
+        for b in range(size):
+            n |= np.int64(buffer[at + (b if big else size - 1 - b)]) << (8 * (size - 1 - b))
+        if signed and n >= np.int64(1) << (8 * size - 1):
+            n -= np.int64(1) << (8 * size)
+        if n < 0:
+            return starts, counts, -1
+        starts[r], counts[r] = at + size, n
+        position = at + size + n * item + after
+    return starts, counts, position if position <= len(buffer) else -1
+
+
+@njit(nogil=True, cache=True)
+def _gather_rows(buffer, starts, width):
+    """The ``width`` bytes from each of ``starts`` in ``buffer``, a row each."""
+    rows = np.empty((len(starts), width), np.uint8)
+    for r in range(len(starts)):
+        rows[r] = buffer[starts[r] : starts[r] + width]
+    return rows
