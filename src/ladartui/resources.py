@@ -234,11 +234,11 @@ def occupancy_bytes(lo, hi, count) -> int:
     halos too, when ``builds_columns`` and ``builds_accelerations`` say they are built.
     """
     lo, last = _corners(lo, hi)
-    root = [int(b >> 9) - int(a >> 9) + 1 for a, b in zip(lo, last)]
-    size = 4 * root[0] * root[1] * root[2]
+    size = 4 * _cells(lo, last, 9)  # the root grid: a word a 512-voxel cell
     nodes = _node_bytes(lo, last, count)
-    if _affordable(_column_bytes(lo, last), nodes):
-        size += _column_bytes(lo, last)
+    columns = _column_bytes(lo, last)
+    if _affordable(columns, nodes):
+        size += columns
     accelerations = _acceleration_bytes(lo, last)
     if _affordable(accelerations, nodes):
         return int(size + nodes + accelerations)
@@ -262,8 +262,8 @@ def builds_columns(lo, hi, count) -> bool:
 
 
 def _column_bytes(lo, last) -> int:
-    root = [int(b >> 9) - int(a >> 9) + 1 for a, b in zip(lo, last)]
-    return 4 * (root[0] * 64) * (root[1] * 64)
+    """4 bytes an 8 x 8 voxel column over the root grid's cells on x and y."""
+    return 4 * 64 * 64 * _cells(lo[:2], last[:2], 9)
 
 
 def _affordable(accelerations: int, nodes: int) -> bool:

@@ -159,13 +159,14 @@ class Occupancy:
                 if negative
                 else f"voxel indices inside the scene shape ({', '.join(str(n) for n in shape)})",
             )
-        from ladartui.resources import builds_accelerations, check_occupancy
+        from ladartui.resources import builds_accelerations, builds_columns, check_occupancy
 
         # Some arrays are sized by extent: refuse before allocating what cannot fit.
         check_occupancy(lo, hi, len(vox), source)
+        columns = builds_columns(lo, hi, len(vox))
         if builds_accelerations(lo, hi, len(vox)):
-            return cls._from_nonempty(vox, lo, hi, shape)
-        return cls._sparse(vox, lo, hi, shape)
+            return cls._from_nonempty(vox, lo, hi, shape, columns)
+        return cls._sparse(vox, lo, hi, shape, columns)
 
     @classmethod
     def _empty(cls, shape):
@@ -196,7 +197,7 @@ class Occupancy:
         )
 
     @classmethod
-    def _from_nonempty(cls, vox, lo, hi, shape):
+    def _from_nonempty(cls, vox, lo, hi, shape, columns: bool):
         root_origin, root_dims = _root_box(lo, hi)
         cube_origin = lo >> BRICK_SHIFT
         cube_dims = ((hi - 1) >> BRICK_SHIFT) - cube_origin + 1
@@ -236,6 +237,7 @@ class Occupancy:
             bkeys,
             bricks,
             count,
+            columns,
             cubes=cubes,
             cube_origin=cube_origin.astype(np.int64),
             cube_dims=cube_dims.astype(np.int64),
@@ -248,13 +250,11 @@ class Occupancy:
         )
 
     @classmethod
-    def _over_bricks(cls, shape, box, bkeys, bricks, count, **accelerations):
+    def _over_bricks(cls, shape, box, bkeys, bricks, count, columns: bool, **accelerations):
         """The occupancy of the sorted brick keys ``bkeys`` and their ``bricks``: the tiles,
-        regions and root above them, the column tops (while affordable) and block masks;
+        regions and root above them, the column tops (when ``columns``) and block masks;
         ``box`` (lo, hi, root origin, root dims); ``accelerations``: the optional empty
         cubes and halos."""
-        from ladartui.resources import builds_columns
-
         lo, hi, root_origin, root_dims = box
         tiles, tkeys = _parents(bkeys, len(bkeys))
         regions, rkeys = _parents(tkeys, len(tkeys))
@@ -271,13 +271,13 @@ class Occupancy:
             tiles,
             bricks,
             count,
-            _column_tops(bkeys, root_dims) if builds_columns(lo, hi, count) else None,
+            _column_tops(bkeys, root_dims) if columns else None,
             block_masks(bricks),
             **accelerations,
         )
 
     @classmethod
-    def _sparse(cls, vox, lo, hi, shape):
+    def _sparse(cls, vox, lo, hi, shape, columns: bool):
         """The hierarchy of voxels few for their box, without the extent-sized empty
         cubes and halos: the bricks come from the voxels' sorted brick keys, not a grid
         of the box's brick cells."""
@@ -294,7 +294,7 @@ class Occupancy:
             brick_of_voxel = np.searchsorted(bkeys, keys[a : a + _CHUNK]).astype(np.int64)
             count += _set_bits_of_bricks(vox[a : a + _CHUNK], brick_of_voxel, bricks)
         del keys
-        return cls._over_bricks(shape, (lo, hi, root_origin, root_dims), bkeys, bricks, count)
+        return cls._over_bricks(shape, (lo, hi, root_origin, root_dims), bkeys, bricks, count, columns)
 
     @property
     def nbytes(self) -> int:
