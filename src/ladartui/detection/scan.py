@@ -31,20 +31,13 @@ BYTES_PER_HELD_RAY = 110
 BYTES_PER_BIN = 22
 
 
-def memory_limit() -> int:
-    """Bytes the model may hold at once: the memory available, as for the tracing
-    structures (``resources.available_memory``: ``LADARTUI_MAX_MEMORY`` where set, else
-    the least of the free memory, ``ulimit -v`` and the memory cgroup's room)."""
-    from ladartui.resources import available_memory
-
-    return available_memory()
-
-
 def check_memory(nbytes: float, what: str, advice: str) -> None:
-    """``ResourceLimitError`` up front when ``nbytes`` would exceed ``memory_limit()``."""
-    from ladartui.resources import gib
+    """``ResourceLimitError`` up front when ``nbytes`` would exceed the memory available,
+    as for the tracing structures (``resources.available_memory``: ``LADARTUI_MAX_MEMORY``
+    where set, else the least of the free memory, ``ulimit -v`` and the memory cgroup's room)."""
+    from ladartui.resources import available_memory, gib
 
-    limit = memory_limit()
+    limit = available_memory()
     if nbytes > limit:
         raise ResourceLimitError(
             f"the Geiger-mode model would need about {gib(nbytes)} for {what}, more than the "
