@@ -67,12 +67,14 @@ def add_parser(sub):
 
 
 def _pulse_counts(text):
+    from ladartui.detection.settings import MAX_PULSES
+
     try:
         pulses = [int(v) for v in text.split(",")]
     except ValueError:
         raise FieldError("--pulses", text, "comma-separated whole numbers") from None
-    if any(p < 1 or p > 100_000 for p in pulses):
-        raise FieldError("--pulses", text, "pulse counts in 1..100000")
+    if any(p < 1 or p > MAX_PULSES for p in pulses):
+        raise FieldError("--pulses", text, f"pulse counts in 1..{MAX_PULSES}")
     return sorted(set(pulses))  # each count once, in the order the chart's line is drawn
 
 

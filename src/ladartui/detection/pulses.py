@@ -174,16 +174,13 @@ def pulse_counts_field(pulses_list) -> list[int]:
     (1..MAX_PULSES), else ``FieldError`` naming it: a count of 2.5 was fired as 2
     pulses in a row that read 2.5, and a 0 failed deep in the firing."""
     items = items_or_none(pulses_list)
+    expected = f"a list of pulse counts, whole numbers from 1 to {MAX_PULSES}"
+    if items is None:
+        raise FieldError("pulses_list", pulses_list, expected)
     try:
-        if items is None:
-            raise FieldError("pulses_list", pulses_list, "a list")
         return [integer_field("pulses_list", p, 1, MAX_PULSES) for p in items]
     except FieldError:
-        raise FieldError(
-            "pulses_list",
-            pulses_list,
-            f"a list of pulse counts, whole numbers from 1 to {MAX_PULSES}",
-        ) from None
+        raise FieldError("pulses_list", pulses_list, expected) from None
 
 
 def check_study_rays(scenario) -> None:
