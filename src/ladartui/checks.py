@@ -60,11 +60,12 @@ def choice_field(name, value, choices):
     return value
 
 
-def switch_field(name, value) -> bool:
+def switch_field(name, value, expected: str = "True or False") -> bool:
     """``value`` as a bool if it is True or False (numpy's too), else FieldError: text
-    such as "no" is true, and a switch given it did the opposite of what was meant."""
+    such as "no" is true, and a switch given it did the opposite of what was meant.
+    ``expected`` words the error in the reader's terms ("true or false" in TOML)."""
     if not isinstance(value, bool | np.bool_):
-        raise FieldError(name, value, "True or False")
+        raise FieldError(name, value, expected)
     return bool(value)
 
 

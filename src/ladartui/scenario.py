@@ -17,8 +17,6 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
-
 from ladartui import defaults
 from ladartui.atomic import write_errors_named, write_text_atomic
 from ladartui.checks import choice_field, number_field, switch_field
@@ -127,9 +125,8 @@ class Scenario:
         set_(self, "method", choice_field("simulation.method", self.method, METHODS))
         set_(self, "step", number_field("simulation.step", self.step, MIN_STEP, MAX_STEP))
         set_(self, "precision", choice_field("simulation.precision", self.precision, PRECISIONS))
-        if not isinstance(self.fast_mode, bool | np.bool_):  # (numpy's too, kept as a bool)
-            raise FieldError("simulation.fast_mode", self.fast_mode, "true or false")
-        set_(self, "fast_mode", bool(self.fast_mode))
+        fast_mode = switch_field("simulation.fast_mode", self.fast_mode, "true or false")
+        set_(self, "fast_mode", fast_mode)
         check_flight(self.flight)
         set_(self, "target_names", checked_target_names(self.target_names))
         if self.detection is not None:
