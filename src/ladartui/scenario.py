@@ -440,21 +440,30 @@ def record_refusal(path) -> str | None:
     )
 
 
+def input_files(scenario) -> list[tuple[Path, str, str]]:
+    """The files ``scenario`` reads, each as (path, the key that names it, what it is):
+    its scene and target models, then each flight log with its segment's index."""
+    return [
+        (Path(scenario.scene_file), "files.scene", "the scene model (files.scene)"),
+        (Path(scenario.target_file), "files.scene", f"the target model of {scenario.scene_file.name}"),
+        *(
+            (
+                Path(segment.file),
+                f"flight.segments[{index}].file",
+                f"the flight log of flight.segments[{index}]",
+            )
+            for index, segment in enumerate(scenario.flight.segments)
+            if segment.kind == "log"
+        ),
+    ]
+
+
 def input_refusal(scenario) -> str | None:
     """Why ``scenario`` is not saved at its path: that is a file it reads, its scene or
     target model or a flight log (paths compared resolved: a link is the file it names),
     whose contents the TOML would replace; None where it may be."""
     where = os.path.realpath(scenario.path)
-    inputs = [
-        (scenario.scene_file, "the scene model (files.scene)"),
-        (scenario.target_file, f"the target model of {scenario.scene_file.name}"),
-        *(
-            (Path(segment.file), f"the flight log of flight.segments[{index}]")
-            for index, segment in enumerate(scenario.flight.segments)
-            if segment.kind == "log"
-        ),
-    ]
-    for path, what in inputs:
+    for path, _key, what in input_files(scenario):
         if os.path.realpath(path) == where:
             return f"is {what} this scenario reads: save it under another name"
     return None

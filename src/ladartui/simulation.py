@@ -28,7 +28,7 @@ from ladartui.errors import Described, FieldError, check_callbacks, check_cancel
 from ladartui.measures import Measures, compute_measures
 from ladartui.returns import fuse_scans, kept_returns
 from ladartui.run_record import as_run, check_record_spare, record_text, run_inputs
-from ladartui.scenario import Scenario, check_work
+from ladartui.scenario import Scenario, check_work, input_files
 from ladartui.scene.model import Scene
 from ladartui.tracing.config import SCAN_BLOCK
 
@@ -477,28 +477,24 @@ def check_outputs_named_apart(scenario, las=False) -> None:
     from ladartui.errors import FieldError
 
     # resolved: a model or log reached through a link is the file the link names
-    inputs = {os.path.realpath(f) for f in (scenario.scene_file, scenario.target_file)}
-    logs = {
-        os.path.realpath(segment.file): index
-        for index, segment in enumerate(scenario.flight.segments)
-        if segment.kind == "log"
-    }
+    inputs = [(os.path.realpath(file), key) for file, key, _what in input_files(scenario)]
     for name, path in output_paths(scenario, las).items():
         where = os.path.realpath(path)
-        if where in inputs:
-            key, found = "files.scene", Path(scenario.scene_file).name
+        key = next((key for file, key in inputs if file == where), None)
+        if key is None:
+            continue
+        if key == "files.scene":
+            found = Path(scenario.scene_file).name
             expected = (
                 f"a scene model not named after the scenario: the run's {name} output "
                 f"{path.name} would overwrite a model file"
             )
-        elif where in logs:
-            key, found = f"flight.segments[{logs[where]}].file", path.name
+        else:
+            found = path.name
             expected = (
                 f"a flight log not named as a run output: the run's {name} output would "
                 "overwrite the flight log"
             )
-        else:
-            continue
         line = scenario.key_line(key)
         raise FieldError(
             key, found, expected, source=f"{scenario.path}:{line}" if line else str(scenario.path)
