@@ -230,3 +230,36 @@ async def test_the_bar_warns_of_a_path_whose_scans_never_look_at_the_target(tmp_
         assert bar.state == NOT_READY
         await app.run_action("run")  # a warning, not a refusal
         await wait_until(pilot, lambda: isinstance(app.screen, MeasuresScreen) and app.screen.is_mounted)
+
+
+async def test_an_edit_the_reach_notes_do_not_read_keeps_the_bar_note_without_a_new_search(
+    tmp_path, scene_files, monkeypatch
+):
+    """The note is found again for a new path, sensor, speed, target names or scene, not
+    for an edit of a field it does not read (the step): no second search in a thread."""
+    from ladartui import view_reach
+    from ladartui.flight import FlightPlan, Orbit
+    from ladartui.tui.status import NOT_READY, StatusBar
+
+    scenario = make_scenario(tmp_path, scene_files)
+    orbit = Orbit(centre=(0.5, 15.5, 0.0), radius=20.0, altitude=30.0, scans=6, aim_at=(15.5, 15.5, 0.0))
+    away = scenario.with_changes(flight=FlightPlan(None, (orbit,))).save()
+    searches = []
+    reach_notes = view_reach.reach_notes
+    monkeypatch.setattr(
+        view_reach, "reach_notes", lambda *args, **kw: searches.append(args) or reach_notes(*args, **kw)
+    )
+    async with opened(away) as (app, pilot):
+        bar = app.query_one(StatusBar)
+        await wait_until(
+            pilot, lambda: app.scene is not None and app.busy is None and "looks at" in bar.message
+        )
+        assert len(searches) == 1
+        note = bar.message.split(": ", 1)[1]
+        app.set_scenario(away.with_changes(step=away.step * 2))
+        await pilot.pause()
+        await pilot.pause()
+        assert bar.state == NOT_READY and note in bar.message
+        assert len(searches) == 1
+        app.set_scenario(away.with_changes(speed=away.speed * 2))  # read by the notes: found again
+        await wait_until(pilot, lambda: len(searches) == 2)

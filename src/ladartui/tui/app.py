@@ -92,7 +92,7 @@ class LadarApp(
         self.cwd = Path(cwd) if cwd else Path.cwd()
         self.history: EditHistory[Scenario] | None = None
         self.scene = None
-        self.blind_kept: tuple | None = None  # (scenario, scene, note): RunControl.blind_note
+        self.blind_kept: tuple | None = None  # (reach inputs, scene, note): RunControl.blind_note
         self.prepared = None
         self.measures = None
         self.result = None

@@ -54,16 +54,18 @@ class RunControl(Host):
 
     def blind_note(self) -> str | None:
         """The first of validate's notes on scans that see nothing of the scene or of a
-        target: found in a thread for each scenario and scene (a 10,000-scan path takes
-        a second on two busy cores), None until then; the bar is redrawn once it is."""
+        target: found in a thread for each path, sensor, speed and target names (what the
+        notes read; an edit of another field keeps the note) and scene (a 10,000-scan path
+        takes a second on two busy cores), None until then; the bar is redrawn once it is."""
         scenario, scene = self.scenario, self.scene
         if scenario is None or scene is None:
             return None
+        reach = _reach_inputs(scenario)
         kept = self.blind_kept
-        if kept is None or kept[0] is not scenario or kept[1] is not scene:
-            self.blind_kept = (scenario, scene, None)
+        if kept is None or kept[0] != reach or kept[1] is not scene:
+            self.blind_kept = (reach, scene, None)
             self.run_worker(
-                lambda: self._find_blind(scenario, scene),
+                lambda: self._find_blind(scenario, reach, scene),
                 group="reach",
                 thread=True,
                 exclusive=True,
@@ -72,16 +74,16 @@ class RunControl(Host):
             return None
         return kept[2]
 
-    def _find_blind(self, scenario, scene) -> None:
+    def _find_blind(self, scenario, reach, scene) -> None:
         from ladartui.view_reach import reach_notes
 
         notes = reach_notes(scenario, scene, partial=False)
-        self.call_from_thread(self._blind_found, scenario, scene, notes[0] if notes else None)
+        self.call_from_thread(self._blind_found, reach, scene, notes[0] if notes else None)
 
-    def _blind_found(self, scenario, scene, note: str | None) -> None:
+    def _blind_found(self, reach, scene, note: str | None) -> None:
         kept = self.blind_kept
-        if note and kept is not None and kept[0] is scenario and kept[1] is scene:
-            self.blind_kept = (scenario, scene, note)
+        if note and kept is not None and kept[0] == reach and kept[1] is scene:
+            self.blind_kept = (reach, scene, note)
             self.refresh_status()
 
     def _run_worker(self, scenario, scene, fast: bool) -> None:
@@ -193,6 +195,15 @@ class RunControl(Host):
         self.push_screen(
             MeasuresScreen(result.measures, f"Comparison measures: {literal(single_line(name))}")
         )
+
+
+def _reach_inputs(scenario) -> tuple:
+    """What ``view_reach.reach_notes`` reads of ``scenario``, compared with ==: a flight
+    log's segment is equal to one of the same file whose contents changed since, so the
+    contents read are in it too."""
+    flight = scenario.flight
+    logs = tuple(segment.log.fingerprint for segment in flight.segments if segment.kind == "log")
+    return (flight, logs, scenario.sensor, scenario.speed, scenario.target_names)
 
 
 def _run(scenario, scene, fast: bool, warm, cancel, progress):
