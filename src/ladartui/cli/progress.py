@@ -16,6 +16,7 @@ from collections.abc import Callable
 from typing import Any, TypeVar
 
 from ladartui.errors import Cancelled, LadarError, ResourceLimitError
+from ladartui.stop_signals import stop_signals_to_catch
 
 T = TypeVar("T")
 
@@ -197,11 +198,6 @@ def _interrupt(signum, frame):
     raise KeyboardInterrupt
 
 
-# SIGTERM: a batch system's or kill's stop; SIGHUP: the terminal went away (an SSH
-# connection dropped), which sends it to the jobs the shell started.
-STOP_SIGNALS = (signal.SIGTERM, signal.SIGHUP)
-
-
 @contextlib.contextmanager
 def sigterm_as_interrupt():
     """Treat SIGTERM and SIGHUP like Ctrl-C while inside: the work stops where it may, a
@@ -210,10 +206,7 @@ def sigterm_as_interrupt():
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    previous = {}
-    for number in STOP_SIGNALS:
-        if signal.getsignal(number) is not signal.SIG_IGN:
-            previous[number] = signal.signal(number, _interrupt)
+    previous = {number: signal.signal(number, _interrupt) for number in stop_signals_to_catch()}
     try:
         yield
     finally:

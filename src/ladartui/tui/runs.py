@@ -116,13 +116,13 @@ class RunControl(Host):
         ignored at start (``nohup``) stays ignored."""
         import asyncio
         import contextlib
-        import signal
+
+        from ladartui.stop_signals import stop_signals_to_catch
 
         with contextlib.suppress(NotImplementedError, RuntimeError, ValueError):  # not the main thread
             loop = asyncio.get_running_loop()
-            for number in (signal.SIGTERM, signal.SIGHUP):
-                if signal.getsignal(number) is not signal.SIG_IGN:  # nohup's ignore kept
-                    loop.add_signal_handler(number, self._terminated, int(number))
+            for number in stop_signals_to_catch():  # nohup's ignore kept
+                loop.add_signal_handler(number, self._terminated, int(number))
 
     def _terminated(self, number: int) -> None:
         self.action_cancel_run()
@@ -131,10 +131,11 @@ class RunControl(Host):
     def on_unmount(self) -> None:
         import asyncio
         import contextlib
-        import signal
+
+        from ladartui.stop_signals import STOP_SIGNALS
 
         with contextlib.suppress(NotImplementedError, RuntimeError, ValueError):
-            for number in (signal.SIGTERM, signal.SIGHUP):
+            for number in STOP_SIGNALS:
                 asyncio.get_running_loop().remove_signal_handler(number)
 
     def action_help_quit(self) -> None:
