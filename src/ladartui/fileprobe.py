@@ -45,6 +45,13 @@ def user_path(path) -> Path:
     return Path(os.path.expanduser(os.fspath(path)))
 
 
+def absolute_path(path) -> Path:
+    """``path`` (``~`` made a home, as ``user_path`` does) made absolute against the
+    working folder and normalised (``..`` and ``.`` taken out), so that the same file is
+    named the same wherever it is named from."""
+    return Path(os.path.normpath(user_path(path).absolute()))
+
+
 def file_problem(path: Path) -> str | None:
     """None when ``path`` is a regular file; else what is wrong ("not found", "is a folder", ...)."""
     try:

@@ -25,13 +25,13 @@ from ladartui.errors import FieldError, InputFileError, LadarError, OutputFileEr
 from ladartui.fileprobe import (
     NO_SUCH_FILE,
     OTHER_FILE_KINDS,
+    absolute_path,
     file_problem,
     other_code_points,
     other_file_kind,
     path_field,
     read_utf8,
     require_file,
-    user_path,
 )
 from ladartui.flight import (
     FlightPlan,
@@ -496,7 +496,7 @@ def load_scenario(path, check_files=True) -> Scenario:
     """Read and check a scenario file; with ``check_files``, its model files must exist.
     A flight log is read either way: its records are the flight's poses, which the
     scenario's checks (scan count, work limit) need."""
-    path = _absolute(path_field("path", path, "a scenario file's path"))
+    path = absolute_path(path_field("path", path, "a scenario file's path"))
     try:
         try:
             text = read_utf8(path, "expected a scenario file (.toml)")
@@ -539,7 +539,7 @@ def _refuse_other_kind(path: Path, text: str | None) -> None:
 
 def scenario_from_toml(text: str, path) -> Scenario:
     """Parse scenario TOML ``text`` as if read from ``path`` (errors name that file)."""
-    path = _absolute(path)
+    path = absolute_path(path)
     doc = parse_document(text, path)
     reader = ScenarioReader(path, text)
     arguments = reader.arguments(doc)
@@ -553,14 +553,10 @@ def scenario_from_toml(text: str, path) -> Scenario:
 def _scenario_path(path) -> Path:
     """A scenario's path, absolute; FieldError for a folder (a run would write its
     outputs beside the folder, named after it)."""
-    path = _absolute(path_field("path", path, "a scenario file's path"))
+    path = absolute_path(path_field("path", path, "a scenario file's path"))
     if path.is_dir():
         raise FieldError("path", str(path), "a scenario file's path (S.toml), not a folder")
     return path
-
-
-def _absolute(path) -> Path:
-    return Path(os.path.normpath(user_path(path).absolute()))
 
 
 __all__ = ["Scenario", "load_scenario", "scenario_from_toml", "target_file_for"]

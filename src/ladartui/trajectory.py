@@ -17,7 +17,6 @@ along the shortest arc. Errors name ``file:line``.
 from __future__ import annotations
 
 import csv
-import os
 import re
 import warnings
 from dataclasses import dataclass, replace
@@ -29,7 +28,14 @@ import numpy as np
 
 from ladartui.checks import MAX_COORDINATE, items_or_none, number_field, point_field
 from ladartui.errors import FieldError, LadarError
-from ladartui.fileprobe import file_problem, not_utf8, path_field, refuse_special_file, text_lines, user_path
+from ladartui.fileprobe import (
+    absolute_path,
+    file_problem,
+    not_utf8,
+    path_field,
+    refuse_special_file,
+    text_lines,
+)
 from ladartui.fingerprint import Fingerprint, fingerprint_of
 from ladartui.flight import MAX_ALTITUDE, MAX_SCANS, ScanPose
 from ladartui.flight.pose import pose_field
@@ -445,7 +451,7 @@ class LogSegment:
         set_ = partial(object.__setattr__, self)
         if not isinstance(self.file, (str, Path)) or not str(self.file).strip():
             raise FieldError("file", self.file, "the flight log's file name (.csv)")
-        set_("file", os.path.normpath(user_path(self.file).absolute()))
+        set_("file", str(absolute_path(self.file)))
         problem = file_problem(Path(self.file))
         if problem:  # named on the segment's file line, not as the log's own error
             raise FieldError(
