@@ -128,3 +128,34 @@ def test_a_model_file_named_in_other_unicode_code_points_is_pointed_to(tmp_path)
     with pytest.raises(InputFileError) as caught:
         load_scenario(path)
     assert "Unicode" not in str(caught.value)  # nothing like it there: not found, alone
+
+
+def test_a_flight_log_or_scenario_file_named_in_other_unicode_code_points_is_pointed_to(tmp_path):
+    """'vol-é.csv' in the scenario, copied from a Mac as e and a combining accent: the
+    flight log, and the scenario file itself, said a bare 'not found' for a file that
+    ls shows right there, where the scene model pointed to it."""
+    import shutil
+    import unicodedata
+
+    from ladartui.scenario import scenario_from_toml
+
+    folder = Path(__file__).resolve().parent.parent / "scenarios"
+    decomposed = unicodedata.normalize("NFD", "vol-é.csv")
+    assert decomposed != "vol-é.csv"
+    shutil.copy(folder / "flight-log.csv", tmp_path / decomposed)
+    shutil.copy(folder / "orbit.toml", tmp_path / unicodedata.normalize("NFD", "é.toml"))
+    hint = "the same name in other Unicode code points"
+    text = '[files]\nscene = "s.txt"\n[[flight.segments]]\nkind = "log"\nfile = "vol-é.csv"\nrate = 2.0\n'
+    with pytest.raises(FieldError) as caught:
+        scenario_from_toml(text, tmp_path / "s.toml")
+    said = str(caught.value)
+    assert "\n" not in said and "not found" in said and f"the folder holds {decomposed}, {hint}" in said
+    with pytest.raises(InputFileError) as caught:
+        load_scenario(tmp_path / "é.toml")
+    said = str(caught.value)
+    assert said.startswith(f"{tmp_path / 'é.toml'}: no such file; the folder holds ")
+    assert "\n" not in said and hint in said and said.endswith("expected a scenario file (.toml)")
+    (tmp_path / decomposed).unlink()
+    with pytest.raises(FieldError) as caught:
+        scenario_from_toml(text, tmp_path / "s.toml")
+    assert "not found" in str(caught.value) and "Unicode" not in str(caught.value)

@@ -144,6 +144,12 @@ def other_code_points(path) -> str:
     return ""
 
 
+def no_such_file(path) -> str:
+    """ "no such file", every reader's words for a missing input, with ``other_code_points``'
+    hint where a file beside ``path`` has its name in other code points."""
+    return NO_SUCH_FILE + other_code_points(path)
+
+
 def require_file(path, expected: str) -> None:
     """``refuse_special_file``, "PATH: is a folder; ``expected``", and "PATH: no such file;
     ``expected``" for anything else that is no regular file, from one look (for readers
@@ -154,7 +160,7 @@ def require_file(path, expected: str) -> None:
     if problem == FOLDER:
         raise InputFileError(path, f"is a folder; {expected}")
     if problem:
-        said = NO_SUCH_FILE if problem == "not found" else problem  # (a link that loops)
+        said = no_such_file(path) if problem == "not found" else problem  # (a link that loops)
         raise InputFileError(path, f"{said}; {expected}")
 
 

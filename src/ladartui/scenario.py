@@ -23,10 +23,10 @@ from ladartui.checks import choice_field, number_field, switch_field
 from ladartui.detection.settings import DetectionSettings
 from ladartui.errors import FieldError, InputFileError, LadarError, OutputFileError
 from ladartui.fileprobe import (
-    NO_SUCH_FILE,
     OTHER_FILE_KINDS,
     absolute_path,
     file_problem,
+    no_such_file,
     other_code_points,
     other_file_kind,
     path_field,
@@ -506,7 +506,7 @@ def load_scenario(path, check_files=True) -> Scenario:
             raise
         _refuse_other_kind(path, text)
     except FileNotFoundError:
-        raise InputFileError(path, f"{NO_SUCH_FILE}; expected a scenario file (.toml)") from None
+        raise InputFileError(path, f"{no_such_file(path)}; expected a scenario file (.toml)") from None
     except OSError as error:
         raise InputFileError(path, f"cannot read the scenario file: {error.strerror or error}") from None
     scenario = scenario_from_toml(text, path)

@@ -32,6 +32,7 @@ from ladartui.fileprobe import (
     absolute_path,
     file_problem,
     not_utf8,
+    other_code_points,
     path_field,
     refuse_special_file,
     text_lines,
@@ -454,6 +455,8 @@ class LogSegment:
         set_("file", str(absolute_path(self.file)))
         problem = file_problem(Path(self.file))
         if problem:  # named on the segment's file line, not as the log's own error
+            if problem == "not found":
+                problem += other_code_points(self.file)
             raise FieldError(
                 "file",
                 self.file,

@@ -160,11 +160,11 @@ def bundled_or_path(argument) -> Path:
     bare = path.parent == Path(".") and not _names_a_folder(argument)
     if bare and path.suffix in ("", ".toml") and not os.path.lexists(path):  # (a link that loops is there)
         from ladartui.errors import InputFileError
-        from ladartui.fileprobe import NO_SUCH_FILE
+        from ladartui.fileprobe import no_such_file
 
         # a bare name: perhaps a bundled one mistyped
         expected = "expected a scenario file (.toml) or a bundled scenario: " + ", ".join(BUNDLED)
-        raise InputFileError(path.absolute(), f"{NO_SUCH_FILE}; {expected}")
+        raise InputFileError(path.absolute(), f"{no_such_file(path)}; {expected}")
     return path
 
 

@@ -16,7 +16,7 @@ import numpy as np
 from ladartui.atomic import atomic_path, write_errors_named
 from ladartui.checks import MAX_COORDINATE
 from ladartui.errors import Cancelled, FieldError, InputFileError, ResourceLimitError
-from ladartui.fileprobe import NO_SUCH_FILE, refuse_special_file
+from ladartui.fileprobe import no_such_file, refuse_special_file
 from ladartui.number_text import plural
 from ladartui.textsafe import single_line
 from ladartui.tracing.backend import METHODS, PRECISIONS
@@ -87,7 +87,7 @@ def check_rays_header(path) -> None:
             read = npy.read_array_header_1_0 if version == (1, 0) else npy.read_array_header_2_0
             shape, _, dtype = read(handle)
     except FileNotFoundError:
-        raise InputFileError(path, f"{NO_SUCH_FILE}; expected a NumPy .npy array") from None
+        raise InputFileError(path, f"{no_such_file(path)}; expected a NumPy .npy array") from None
     except OSError as error:
         raise InputFileError(path, f"cannot be read ({error.strerror or error})") from None
     except ValueError as error:

@@ -22,7 +22,7 @@ import numpy as np
 
 from ladartui.atomic import atomic_path, write_errors_named
 from ladartui.errors import InputFileError
-from ladartui.fileprobe import NO_SUCH_FILE, other_file_kind, path_field, refuse_special_file
+from ladartui.fileprobe import no_such_file, other_file_kind, path_field, refuse_special_file
 from ladartui.fingerprint import Digest
 from ladartui.scene.lazy_kernels import NUMPY_BYTES, LazyKernels
 from ladartui.scene.unique_rows import unique_voxels
@@ -361,7 +361,7 @@ def _opened(path: Path):
         _check_read_size(path)
         handle = open(path, "rb")  # noqa: SIM115 (closed below)
     except FileNotFoundError:
-        raise InputFileError(path, f"{NO_SUCH_FILE}; expected a voxel-list file") from None
+        raise InputFileError(path, f"{no_such_file(path)}; expected a voxel-list file") from None
     except IsADirectoryError:
         raise InputFileError(path, "is a folder; expected a voxel-list file") from None
     except PermissionError:

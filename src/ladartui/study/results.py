@@ -361,7 +361,7 @@ def _no_constant(name: str):
 def read_study(path) -> StudyResult:
     """A ``study.json`` written by a study (the CLI's or the terminal UI's), read back."""
     from ladartui.errors import InputFileError
-    from ladartui.fileprobe import NO_SUCH_FILE, refuse_special_file
+    from ladartui.fileprobe import no_such_file, refuse_special_file
 
     refuse_special_file(path, STUDY_JSON)
     try:
@@ -370,7 +370,7 @@ def read_study(path) -> StudyResult:
             raise InputFileError(path, f"a JSON {type(data).__name__}, not an object; {STUDY_JSON}")
         return StudyResult.from_dict(data)
     except FileNotFoundError:
-        raise InputFileError(path, f"{NO_SUCH_FILE}; {STUDY_JSON}") from None
+        raise InputFileError(path, f"{no_such_file(path)}; {STUDY_JSON}") from None
     except IsADirectoryError:
         raise InputFileError(path, f"is a folder; {STUDY_JSON}") from None
     except OSError as error:

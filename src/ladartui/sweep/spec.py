@@ -41,7 +41,7 @@ from typing import NoReturn
 import numpy as np
 
 from ladartui.errors import InputFileError
-from ladartui.fileprobe import NO_SUCH_FILE, path_field, read_utf8, text_lines
+from ladartui.fileprobe import no_such_file, path_field, read_utf8, text_lines
 from ladartui.scenario_file import SECTIONS as SCENARIO_SECTIONS
 from ladartui.sweep.ranking import BUDGET_OBJECTIVES, OBJECTIVES
 from ladartui.sweep.variant import applicable
@@ -219,7 +219,7 @@ def load_sweep_spec(path) -> SweepSpec:
         text = read_utf8(path, "expected a sweep spec (.toml)")
         data = tomllib.loads(text)
     except FileNotFoundError:
-        raise InputFileError(path, f"{NO_SUCH_FILE}; expected a sweep spec (.toml)") from None
+        raise InputFileError(path, f"{no_such_file(path)}; expected a sweep spec (.toml)") from None
     except RecursionError:
         raise InputFileError(path, "not valid TOML: arrays or tables nested too deep to read") from None
     except OSError as error:
