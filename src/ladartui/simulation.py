@@ -129,12 +129,12 @@ def simulate(
 
         scenario = load_scenario(scenario)
     _check_arguments(scenario, progress, cancel, scene)
-    _check_overrides(scenario, backend, method, step, precision)
+    ran = _as_run(scenario, backend, method, step, precision)
     check_work(scenario)  # before the output set is locked and before any tracing
     write, las = switch_field("write", write), switch_field("las", las)
     with contextlib.ExitStack() as stack:
         output_set = stack.enter_context(_output_set(scenario, las)) if write else None
-        return _simulate(scenario, backend, method, step, precision, progress, cancel, output_set, scene)
+        return _simulate(scenario, ran, progress, cancel, output_set, scene)
 
 
 def _check_arguments(scenario, progress, cancel, scene) -> None:
@@ -157,22 +157,24 @@ def _check_arguments(scenario, progress, cancel, scene) -> None:
             )
 
 
-def _check_overrides(scenario, backend, method, step, precision) -> None:
-    """The overrides held to what the scenario's own fields take, named as the arguments:
+def _as_run(scenario, backend, method, step, precision) -> Scenario | None:
+    """The scenario as a run with these overrides goes (``as_run``; None without any),
+    the overrides held to what the scenario's own fields take, named as the arguments:
     a march step of 50 voxels ran to nonsense, or traced every scan and then failed to
     write the record of the run, which holds the settings as run."""
     if backend is method is step is precision is None:
-        return
+        return None
     try:
-        as_run(scenario, backend, method, step, precision)
+        return as_run(scenario, backend, method, step, precision)
     except FieldError as error:  # "simulation.step": the file's key, the argument's name
         raise FieldError(error.field.rpartition(".")[2], error.value, error.expected) from None
 
 
-def _simulate(scenario, backend, method, step, precision, progress, cancel, output_set, scene):
+def _simulate(scenario, ran, progress, cancel, output_set, scene):
+    """Run ``scenario`` with the tracing settings of ``ran`` (``_as_run``; None: its own)."""
     started = time.perf_counter()
     timings = dict.fromkeys(("setup", "rays", "trace", "depth_rule", "fusion", "measures", "write"), 0.0)
-    settings = _trace_settings(scenario, backend, method, step, precision)
+    settings = _trace_settings(scenario if ran is None else ran)
     if scene is None:
         scene = scenario.load_scene()
     poses = list(scenario.poses())
@@ -222,7 +224,7 @@ def _simulate(scenario, backend, method, step, precision, progress, cancel, outp
     if output_set is not None:
         check_cancelled(cancel, NOTHING_WRITTEN)
         tick = time.perf_counter()
-        ran = as_run(scenario, backend, method, step, precision)
+        ran = as_run(scenario) if ran is None else ran
         inputs = run_inputs(scenario, scene)
         outputs = _write_outputs(
             output_set,
@@ -382,18 +384,13 @@ class _ScanRunner:
             )
 
 
-def _trace_settings(scenario, backend, method, step, precision) -> dict:
-    """The scenario's tracing settings with the caller's overrides; "auto" resolved
-    once, unless its calls are left to trace()'s learned choice (a GPU is there)."""
+def _trace_settings(ran) -> dict:
+    """The tracing settings of ``ran`` (the scenario with the caller's overrides); "auto"
+    resolved once, unless its calls are left to trace()'s learned choice (a GPU is there)."""
     from ladartui.tracing import choose_backend
     from ladartui.tracing.backend_choice import learns
 
-    settings = {
-        "backend": scenario.backend if backend is None else backend,
-        "method": scenario.method if method is None else method,
-        "step": scenario.step if step is None else step,
-        "precision": scenario.precision if precision is None else precision,
-    }
+    settings = {"backend": ran.backend, "method": ran.method, "step": ran.step, "precision": ran.precision}
     if settings["backend"] == "auto":
         best = choose_backend()
         if not learns(best, settings["method"], settings["precision"]):
