@@ -222,7 +222,8 @@ def _simulate_with_progress(scenario, args, console, finished: list, notes: list
         def work():
             from ladartui.view_reach import reach_notes
 
-            scene = compile_ahead(scenario, cancel, load_scene=True) or scenario.load_scene()
+            scene = scenario.load_scene()  # a mistake in a model file told before any compiling
+            compile_ahead(scenario, cancel)
             notes[:] = reach_notes(scenario, scene)  # told before the tracing: Ctrl-C saves it
             for note in notes:
                 bar.console.print(single_line(f"note: {note}"), markup=False, highlight=False, soft_wrap=True)
