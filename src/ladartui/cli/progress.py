@@ -8,6 +8,7 @@ the work's cancel event and waits for the worker to stop between chunks.
 from __future__ import annotations
 
 import contextlib
+import functools
 import os
 import signal
 import sys
@@ -43,12 +44,20 @@ def _logging_progress(columns, console, **options):
     """rich's Progress that, where nothing is redrawn in place (a log, a pipe, a dumb
     terminal: rich writes the display once, as it ends), prints the progress as a line
     every ``LOG_EVERY_SECONDS``, so that a long run in a log says how far it is."""
+    return _logging_progress_class()(*columns, console=console, **options)
+
+
+@functools.cache
+def _logging_progress_class():
+    """The class, made on first use: rich stays off the commands' start-up path."""
     import time
 
     from rich.progress import Progress
 
     class LoggingProgress(Progress):
-        logged_at = time.monotonic()
+        def __init__(self, *args, **kwargs) -> None:
+            super().__init__(*args, **kwargs)
+            self.logged_at = time.monotonic()
 
         def update(self, task_id, **fields) -> None:
             super().update(task_id, **fields)
@@ -59,7 +68,7 @@ def _logging_progress(columns, console, **options):
                 self.logged_at = now
                 self.console.print(self.make_tasks_table(self.tasks))
 
-    return LoggingProgress(*columns, console=console, **options)
+    return LoggingProgress
 
 
 def progress_display(console, after, description=None, **options):
