@@ -428,9 +428,10 @@ def check_output_names(scenario, las=False) -> None:
     from ladartui.outputset import LOCK_EXTRA, SET_MEMBER_EXTRA, check_names
 
     shorter = "; use a shorter scenario name"
-    check_names(*output_paths(scenario, las).values(), extra=SET_MEMBER_EXTRA, advice=shorter)
+    paths = output_paths(scenario, las).values()
+    check_names(*paths, extra=SET_MEMBER_EXTRA, advice=shorter)
     check_names(output_lock(scenario), extra=LOCK_EXTRA, advice=shorter)
-    _check_names_are_text(output_paths(scenario, las).values())
+    _check_names_are_text(paths)
 
 
 def _check_names_are_text(paths) -> None:
