@@ -13,9 +13,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numba import njit
 
+from ladartui.scene.lazy_kernels import LazyKernels
 from ladartui.scene.polygons import concave_cuts
+
+_kernel = LazyKernels(globals())  # numba only once a mixed binary PLY is read
 
 _TYPES = {
     "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1",
@@ -193,7 +195,7 @@ def _list_rows(data, offset: int, count: int, properties: list[list[str]], order
     return end - offset, groups
 
 
-@njit(nogil=True, cache=True)
+@_kernel
 def _scan_lists(buffer, offset, count, before, size, signed, big, item, after):
     """(where each row's list starts, its length, where the element ends) of ``count``
     rows of a list property from ``offset`` in ``buffer``: ``before`` bytes, a
@@ -218,7 +220,7 @@ def _scan_lists(buffer, offset, count, before, size, signed, big, item, after):
     return starts, counts, position if position <= len(buffer) else -1
 
 
-@njit(nogil=True, cache=True)
+@_kernel
 def _gather_rows(buffer, starts, width):
     """The ``width`` bytes from each of ``starts`` in ``buffer``, a row each."""
     rows = np.empty((len(starts), width), np.uint8)
