@@ -93,6 +93,7 @@ SHARED = (
     "INF",
     "BUNDLE",
     "NO_CELL",
+    "NO_COLUMNS",
     "METHOD_EXACT",
     "METHOD_MARCH",
     "MARCH_SKIP_MARGIN",
@@ -120,6 +121,7 @@ def test_the_shader_header_carries_the_python_values(real):
     assert float(consts["INF"]) == config.SHADER_INF
     assert float(consts["MARCH_SKIP_MARGIN"]) == config.MARCH_SKIP_MARGIN
     assert consts["NO_CELL"] == f"{config.NO_CELL}u" and config.NO_CELL == 2**32 - 1
+    assert consts["NO_COLUMNS"] == f"{config.NO_COLUMNS}u" and config.NO_COLUMNS == 2**32 - 1
     assert consts["BUNDLE"] == f"{config.BUNDLE}u"
     assert int(consts["METHOD_EXACT"]) == config.METHOD_CODES["exact"]
     assert int(consts["METHOD_MARCH"]) == config.METHOD_CODES["march"]

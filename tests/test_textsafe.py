@@ -114,14 +114,15 @@ def _rays(folder):
 def test_a_file_name_that_is_not_utf8_is_written_escaped(tmp_path, capsys):
     """Bytes of a file name that are not UTF-8 (b'\\xff', a lone surrogate in Python) reached
     standard output as they were: where its encoding is strict (an en_US.UTF-8 locale,
-    PYTHONIOENCODING=utf-8), validate ended in a UnicodeEncodeError traceback."""
+    PYTHONIOENCODING=utf-8), validate ended in a UnicodeEncodeError traceback. (Such a
+    scenario is refused, its run record being UTF-8 text: the refusal names it escaped.)"""
     import os
 
     from tiny_sweep import write_tiny_scenario
 
     base = write_tiny_scenario(tmp_path, name="bad\udcffname.toml")
-    assert main(["validate", os.fsdecode(base.path)]) == 0
-    out = capsys.readouterr().out
-    out.encode("utf-8")  # strict: no lone surrogate left
-    assert "bad\\udcffname.toml" in out
+    assert main(["validate", os.fsdecode(base.path)]) == 2
+    err = capsys.readouterr().err
+    err.encode("utf-8")  # strict: no lone surrogate left
+    assert "bad\\udcffname_Scene.txt: its name is not UTF-8 text" in err
     assert one_line("a\udcffb") == "a\\udcffb"

@@ -30,8 +30,9 @@ async def refusal_on_opening(tmp_path, scene_files, monkeypatch, voxels, limit) 
 async def test_a_scene_too_large_for_memory_is_refused_with_its_estimate(tmp_path, scene_files, monkeypatch):
     """Two voxels 20 million apart: the views' height map was allocated whatever its size,
     and a wider scene ended in numpy's 'Unable to allocate 44.7 GiB for an array with
-    shape (2000000001, 6) and data type int32', naming no file."""
-    voxels = [[1, 2, 3], [20_000_000, 5, 5]]
+    shape (2000000001, 6) and data type int32', naming no file. (Apart on x alone they now
+    fit: their column tops are left out; apart on y too, the root grid is 5.7 GiB.)"""
+    voxels = [[1, 2, 3], [20_000_000, 20_000_000, 5]]
     said, scene = await refusal_on_opening(tmp_path, scene_files, monkeypatch, voxels, 100 * 2**20)
     assert f"{scene}: 2 voxels spanning" in said and "crop the scene or use a coarser voxel size" in said
 

@@ -225,6 +225,9 @@ ACCELERATION_SHARE = 4
 # Per voxel, a build without them sorts the voxels' brick keys (a key, its sorted copy,
 # its brick number) in place of the grid of brick cells.
 _SORTED_VOXEL_BYTES = 40
+# The build's small arrays and objects, whatever the scene: a few voxels over a wide box
+# peaked 316 bytes above an estimate of their root grid and nodes alone.
+_BUILD_OVERHEAD = 64 * 2**10
 
 
 def occupancy_bytes(lo, hi, count) -> int:
@@ -234,7 +237,7 @@ def occupancy_bytes(lo, hi, count) -> int:
     halos too, when ``builds_columns`` and ``builds_accelerations`` say they are built.
     """
     lo, last = _corners(lo, hi)
-    size = 4 * _cells(lo, last, 9)  # the root grid: a word a 512-voxel cell
+    size = _BUILD_OVERHEAD + 4 * _cells(lo, last, 9)  # the root grid: a word a 512-voxel cell
     nodes = _node_bytes(lo, last, count)
     columns = _column_bytes(lo, last)
     if _affordable(columns, nodes):
