@@ -227,7 +227,7 @@ ACCELERATION_SHARE = 4
 _SORTED_VOXEL_BYTES = 40
 # The build's small arrays and objects, whatever the scene: a few voxels over a wide box
 # peaked 316 bytes above an estimate of their root grid and nodes alone.
-_BUILD_OVERHEAD = 64 * 2**10
+_BUILD_OVERHEAD = 4 * 2**10
 
 
 def occupancy_bytes(lo, hi, count) -> int:
