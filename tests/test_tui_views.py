@@ -25,20 +25,23 @@ from tui_support import field, loaded, type_into, wait_until
 SIZE = (120, 40)
 
 
-@pytest.fixture(scope="module")
-def scenario_path(tmp_path_factory):
-    folder = tmp_path_factory.mktemp("views")
+def orbit_scenario(folder, name: str, scans: int) -> Scenario:
+    """A small generated forest and a saved scenario orbiting it at 30 m, ``scans`` scans."""
     generated = generate_scene("small", seed=3, width=16.0, depth=16.0, trees=5)
     scene_path, _ = generated.write(folder / "forest")
     centre = tuple(round(float(v), 3) for v in generated.target_centre)
-    scenario = Scenario(
-        folder / "views.toml",
+    return Scenario(
+        folder / name,
         scene_path,
         generated.voxel_size,
         Sensor(grid=8, ray_grid=1, fov=8.0),
-        FlightPlan(None, (Orbit(centre=centre, radius=30.0, altitude=30.0, scans=6),)),
-    )
-    return scenario.save().path
+        FlightPlan(None, (Orbit(centre=centre, radius=30.0, altitude=30.0, scans=scans),)),
+    ).save()
+
+
+@pytest.fixture(scope="module")
+def scenario_path(tmp_path_factory):
+    return orbit_scenario(tmp_path_factory.mktemp("views"), "views.toml", 6).path
 
 
 @pytest_asyncio.fixture(loop_scope="module", scope="module")
@@ -202,16 +205,8 @@ async def test_the_views_draw_an_orbit_as_flown_not_as_chords_between_its_scans(
     """A 3-scan orbit of radius 30 m was drawn as a triangle through its scans, its sides
     15 m from the centre over the scene, and the top view was framed on the triangle:
     the path drawn was not the one flown (nor the one Path m measures)."""
-    generated = generate_scene("small", seed=3, width=16.0, depth=16.0, trees=5)
-    scene_path, _ = generated.write(tmp_path / "forest")
-    centre = tuple(round(float(v), 3) for v in generated.target_centre)
-    scenario = Scenario(
-        tmp_path / "three.toml",
-        scene_path,
-        generated.voxel_size,
-        Sensor(grid=8, ray_grid=1, fov=8.0),
-        FlightPlan(None, (Orbit(centre=centre, radius=30.0, altitude=30.0, scans=3),)),
-    ).save()
+    scenario = orbit_scenario(tmp_path, "three.toml", 3)
+    centre = scenario.flight.segments[0].centre
     app = LadarApp(scenario.path, compile_in_child=False)
     async with app.run_test(size=SIZE) as pilot:
         await wait_until(pilot, lambda: loaded(app))
@@ -226,7 +221,7 @@ async def test_the_views_draw_an_orbit_as_flown_not_as_chords_between_its_scans(
         assert (path[:, 0].min() >= x0) and (path[:, 0].max() <= x1)
         assert (path[:, 1].min() >= y0) and (path[:, 1].max() <= y1)
         scene3d = app.query_one("#scene3d", ProjectionWidget)
-        drawn3d = np.asarray(scene3d.overlays.path, float) * generated.voxel_size
+        drawn3d = np.asarray(scene3d.overlays.path, float) * scenario.voxel_size
         assert len(drawn3d) == len(path)
         assert np.hypot(drawn3d[:, 0] - centre[0], drawn3d[:, 1] - centre[1]) == pytest.approx(30.0, rel=0.01)
 
