@@ -228,7 +228,7 @@ async def test_quit_without_edits_does_not_ask(tmp_path, scene_files):
 def test_a_value_typed_in_other_units_is_saved_as_typed():
     """A pitch of 50 um typed in the form was saved as 49.99999999999999: 50 * 1e-6 is
     not the double nearest 50 um, so the file could not write it back as 50."""
-    from ladartui.scenario_file import _to_micrometres
+    from ladartui.scenario_writer import _to_micrometres
     from ladartui.tui.fields import format_number, parse_number
 
     for typed in ("50", "57", "0.3", "12.3", "100", "9999"):

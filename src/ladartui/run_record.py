@@ -32,7 +32,8 @@ import tomli_w
 
 from ladartui.errors import LadarError, OutputFileError
 from ladartui.fingerprint import Fingerprint
-from ladartui.scenario_file import RECORD_HEADER, is_record, relative_path, resolve_path
+from ladartui.scenario_file import RECORD_HEADER, is_record, resolve_path
+from ladartui.scenario_writer import relative_path
 from ladartui.textsafe import one_line
 from ladartui.trajectory import LogSegment
 

@@ -49,10 +49,9 @@ from ladartui.scenario_file import (
     parse_document,
     record_owner,
     resolve_path,
-    scenario_document,
-    toml_text,
 )
 from ladartui.scenario_style import restyle
+from ladartui.scenario_writer import scenario_document, toml_text
 from ladartui.sensor import Sensor
 from ladartui.textsafe import one_line, single_line
 from ladartui.toml_lines import key_lines
