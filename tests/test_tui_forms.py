@@ -115,26 +115,34 @@ async def test_a_new_scenario_whose_scene_cannot_be_read_is_not_written_and_its_
         assert app.scenario.path == scenario.path  # the one open before stays
 
 
+async def new_scenario_on_an_unreadable_scene(folder, app, pilot, scene: str):
+    """New (F2) for a scenario 'fresh' on the scene model ``scene``, written in ``folder``
+    with a bad second line: the form that comes back, mounted."""
+    from ladartui.tui.file_dialogs import SetupScreen
+
+    (folder / scene).write_text("1,2,3\n1,2,abc\n", encoding="utf-8")
+    (folder / scene.replace(".txt", "_Target.txt")).write_text("1,2,3\n", encoding="utf-8")
+    dialog = await screen_after(pilot, "f2", SetupScreen)
+    await pilot.press(*"fresh", "tab", *scene, "tab", "ctrl+u", *"0.25", "enter")
+    await wait_until(
+        pilot,
+        lambda: app.busy is None and isinstance(app.screen, SetupScreen) and app.screen is not dialog,
+        60,
+    )
+    again = app.screen
+    await wait_until(pilot, lambda: again.is_mounted, 10)
+    await pilot.pause()
+    return again
+
+
 async def test_a_new_scenario_whose_scene_cannot_be_read_comes_back_at_its_scene_model(tmp_path, scene_files):
     """The form came back with the focus on Scenario file, its name selected, while the
     message named the scene model: the corrected model name, typed, replaced the
     scenario's name. The focus is now on 3D scene model."""
-    from ladartui.tui.file_dialogs import SetupScreen
 
     scenario = make_scenario(tmp_path, scene_files)
-    (tmp_path / "bad.txt").write_text("1,2,3\n1,2,abc\n", encoding="utf-8")
-    (tmp_path / "bad_Target.txt").write_text("1,2,3\n", encoding="utf-8")
     async with opened(scenario) as (app, pilot):
-        dialog = await screen_after(pilot, "f2", SetupScreen)
-        await pilot.press(*"fresh", "tab", *"bad.txt", "tab", "ctrl+u", *"0.25", "enter")
-        await wait_until(
-            pilot,
-            lambda: app.busy is None and isinstance(app.screen, SetupScreen) and app.screen is not dialog,
-            60,
-        )
-        again = app.screen
-        await wait_until(pilot, lambda: again.is_mounted, 10)
-        await pilot.pause()
+        again = await new_scenario_on_an_unreadable_scene(tmp_path, app, pilot, "bad.txt")
         scene_field = again.query_one("#scene-file")
         assert app.focused is scene_field, app.focused
         await pilot.press("ctrl+u", *"forest.txt")
@@ -145,22 +153,10 @@ async def test_a_new_scenario_whose_scene_cannot_be_read_comes_back_at_its_scene
 async def test_a_scene_model_named_after_the_new_scenario_still_gets_the_focus(tmp_path, scene_files):
     """The field was chosen by whether the error began with the scenario's path: a scene
     model fresh.toml.txt beside a new fresh.toml read as the scenario file's error."""
-    from ladartui.tui.file_dialogs import SetupScreen
 
     scenario = make_scenario(tmp_path, scene_files)
-    (tmp_path / "fresh.toml.txt").write_text("1,2,3\n1,2,abc\n", encoding="utf-8")
-    (tmp_path / "fresh.toml_Target.txt").write_text("1,2,3\n", encoding="utf-8")
     async with opened(scenario) as (app, pilot):
-        dialog = await screen_after(pilot, "f2", SetupScreen)
-        await pilot.press(*"fresh", "tab", *"fresh.toml.txt", "tab", "ctrl+u", *"0.25", "enter")
-        await wait_until(
-            pilot,
-            lambda: app.busy is None and isinstance(app.screen, SetupScreen) and app.screen is not dialog,
-            60,
-        )
-        again = app.screen
-        await wait_until(pilot, lambda: again.is_mounted, 10)
-        await pilot.pause()
+        again = await new_scenario_on_an_unreadable_scene(tmp_path, app, pilot, "fresh.toml.txt")
         assert message(again, "#setup-message").startswith(f"{tmp_path / 'fresh.toml.txt'}:2: ")
         assert app.focused is again.query_one("#scene-file"), app.focused
 
